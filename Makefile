@@ -1,0 +1,38 @@
+# Makefile: the two commands of the README's Quick start, and a few more.
+#   make demo            install dependencies, build, run the demo
+#   make test            install dependencies, build with -Werror, run every test
+#   make test-sanitize   the same tests under AddressSanitizer + UBSan
+#   make bench           build and run the benchmarks (figures, not tests)
+# Everything else is plain CMake: cmake -S . -B build && cmake --build build
+JOBS ?= $(shell nproc 2>/dev/null || echo 2)
+
+.PHONY: all deps build demo test test-sanitize bench clean
+
+all: build
+
+deps:
+	@bash deploy/install-deps.sh
+
+build: deps
+	@cmake -S . -B build -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
+	@cmake --build build -j $(JOBS)
+
+demo: build
+	@bash deploy/demo.sh build
+
+test: deps
+	@cmake -S . -B build-test -DCMAKE_BUILD_TYPE=RelWithDebInfo -DAAFARM_WERROR=ON >/dev/null
+	@cmake --build build-test -j $(JOBS)
+	@cd build-test && ctest --output-on-failure -j $(JOBS)
+
+test-sanitize: deps
+	@cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=Debug -DAAFARM_WERROR=ON -DAAFARM_SANITIZE=ON >/dev/null
+	@cmake --build build-asan -j $(JOBS)
+	@cd build-asan && ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
+		ctest --output-on-failure -j $(JOBS)
+
+bench: build
+	@build/bin/aa_bench
+
+clean:
+	rm -rf build build-test build-asan

@@ -1,0 +1,377 @@
+/*
+ * affine.c: affine forms, the noise symbol context, and the operations that
+ * are affine or nearly so: linear combinations, products, branch merges.
+ * The approximations of non-affine library functions live in affine_funcs.c.
+ *
+ * Rounding (docs/arithmetic.md): coefficients are computed in round-to-
+ * nearest. The exact error of every sum is known from TwoSum; the error of
+ * a product is at most 2^-53 of its magnitude (plus an underflow term).
+ * These errors are summed, bounded from above, and added to the form's
+ * private error term err, so the form stays a guaranteed enclosure.
+ */
+#include "aa/affine_internal.h"
+#include "aa/rounding.h"
+
+#include <math.h>
+
+/* ---------------------------------------------------------------------- */
+/* context                                                                 */
+/* ---------------------------------------------------------------------- */
+
+void aa_context_init(aa_context *ctx, int capacity)
+{
+    if (capacity < 0)
+        capacity = 0;
+    if (capacity > AA_MAX_SYMBOLS)
+        capacity = AA_MAX_SYMBOLS;
+    ctx->used = 0;
+    ctx->capacity = capacity;
+    ctx->folded = 0;
+}
+
+void aa_context_reset(aa_context *ctx)
+{
+    ctx->used = 0;
+}
+
+/* A fresh noise symbol, or -1 when the context's capacity is spent. */
+static int fresh_symbol(aa_context *ctx)
+{
+    if (ctx->used >= ctx->capacity)
+        return -1;
+    return ctx->used++;
+}
+
+/* ---------------------------------------------------------------------- */
+/* construction and queries                                                */
+/* ---------------------------------------------------------------------- */
+
+void aa_unbounded(aa_form *z, unsigned flags)
+{
+    z->x0 = 0.0;
+    z->err = INFINITY;
+    z->n = 0;
+    z->flags = (unsigned short)(flags | AA_UNBOUNDED);
+}
+
+void aa_const(aa_form *z, double value)
+{
+    if (!isfinite(value)) {
+        aa_unbounded(z, 0);
+        return;
+    }
+    z->x0 = value;
+    z->err = 0.0;
+    z->n = 0;
+    z->flags = 0;
+}
+
+void aa_add_new_error(aa_context *ctx, aa_form *z, double delta)
+{
+    if (delta == 0.0 || (z->flags & AA_UNBOUNDED))
+        return;
+    if (!(delta < INFINITY)) {
+        aa_unbounded(z, z->flags);
+        return;
+    }
+    int k = fresh_symbol(ctx);
+    if (k < 0) {
+        z->err = fp_add_up(z->err, delta);
+        ctx->folded++;
+        return;
+    }
+    for (int i = z->n; i < k; i++)
+        z->c[i] = 0.0;
+    z->c[k] = delta;
+    if (k + 1 > z->n)
+        z->n = (unsigned short)(k + 1);
+}
+
+void aa_input(aa_context *ctx, aa_form *z, double lo, double hi)
+{
+    if (!(lo <= hi) || !isfinite(lo) || !isfinite(hi)) {
+        aa_unbounded(z, 0);
+        return;
+    }
+    double mid = 0.5 * lo + 0.5 * hi;
+    if (mid < lo) mid = lo;      /* halving subnormals may round */
+    if (mid > hi) mid = hi;
+    double rad = fmax(fp_add_up(hi, -mid), fp_add_up(mid, -lo));
+    aa_const(z, mid);
+    int k = fresh_symbol(ctx);
+    if (k < 0) {
+        z->err = rad;
+        ctx->folded++;
+        return;
+    }
+    for (int i = 0; i < k; i++)
+        z->c[i] = 0.0;
+    z->c[k] = rad;
+    z->n = (unsigned short)(k + 1);
+}
+
+void aa_set_interval(aa_context *ctx, aa_form *z, ia_interval r, unsigned flags)
+{
+    if (ia_is_empty(r) || !isfinite(r.lo) || !isfinite(r.hi)) {
+        aa_unbounded(z, flags);
+        return;
+    }
+    double mid = ia_mid(r);
+    double rad = fmax(fp_add_up(r.hi, -mid), fp_add_up(mid, -r.lo));
+    aa_const(z, mid);
+    z->flags = (unsigned short)(flags & ~AA_UNBOUNDED);
+    aa_add_new_error(ctx, z, rad);
+}
+
+void aa_from_interval(aa_context *ctx, aa_form *z, ia_interval x)
+{
+    aa_set_interval(ctx, z, x, x.flags);
+}
+
+/* Sum of |xi| + err, rounded up: every addition is rounded upward exactly
+ * (TwoSum), so a single term comes back unchanged. */
+double aa_radius(const aa_form *x)
+{
+    if (x->flags & AA_UNBOUNDED)
+        return INFINITY;
+    double r = x->err;
+    for (int i = 0; i < x->n; i++)
+        r = fp_add_up(r, fabs(x->c[i]));
+    return r;
+}
+
+ia_interval aa_range(const aa_form *x)
+{
+    if (x->flags & AA_UNBOUNDED) {
+        ia_interval e = ia_entire();
+        e.flags |= x->flags;
+        return e;
+    }
+    double r = aa_radius(x);
+    ia_interval out = ia_make(fp_add_dn(x->x0, -r), fp_add_up(x->x0, r));
+    out.flags |= x->flags;
+    return out;
+}
+
+bool aa_is_point(const aa_form *x)
+{
+    if ((x->flags & AA_UNBOUNDED) || x->err != 0.0)
+        return false;
+    for (int i = 0; i < x->n; i++)
+        if (x->c[i] != 0.0)
+            return false;
+    return true;
+}
+
+/* ---------------------------------------------------------------------- */
+/* linear combinations                                                     */
+/* ---------------------------------------------------------------------- */
+
+static bool exact_factor(double a) { return a == 0.0 || a == 1.0 || a == -1.0; }
+
+/* Upper bound on a sum of |TwoSum errors| accumulated in RN. */
+static double sum_err_bound(double es)
+{
+    return es == 0.0 ? 0.0 : fp_next_up(es * (1.0 + 0x1p-45));
+}
+
+void aa_lincomb(aa_context *ctx, aa_form *z, double a, const aa_form *x,
+                double b, const aa_form *y, double c)
+{
+    (void)ctx;
+    static const aa_form zero = { 0.0, 0.0, 0, 0, { 0.0 } };
+    if (y == NULL) {
+        y = &zero;
+        b = 0.0;
+    }
+    unsigned flags = x->flags | y->flags;
+    if (((x->flags & AA_UNBOUNDED) && a != 0.0) ||
+        ((y->flags & AA_UNBOUNDED) && b != 0.0) || !isfinite(a) ||
+        !isfinite(b) || !isfinite(c)) {
+        aa_unbounded(z, flags);
+        return;
+    }
+    flags &= ~AA_UNBOUNDED;
+    bool ea = exact_factor(a), eb = exact_factor(b);
+    int xn = (a == 0.0) ? 0 : x->n, yn = (b == 0.0) ? 0 : y->n;
+    int n = xn > yn ? xn : yn;
+    double x0 = x->x0, y0 = y->x0;
+    double xe = a == 0.0 ? 0.0 : x->err, ye = b == 0.0 ? 0.0 : y->err;
+
+    double es = 0.0;      /* sum of exact errors of the additions */
+    double ap = 0.0;      /* sum of |inexact products| */
+    int np = 0;
+    for (int i = 0; i < n; i++) {
+        double xi = i < xn ? x->c[i] : 0.0;
+        double yi = i < yn ? y->c[i] : 0.0;
+        double p = a * xi, q = b * yi, s = p + q;
+        es += fabs(fp_two_sum_err(p, q, s));
+        if (!ea) { ap += fabs(p); np++; }
+        if (!eb) { ap += fabs(q); np++; }
+        z->c[i] = s;
+    }
+    double p = a * x0, q = b * y0;
+    double s1 = p + q, s2 = s1 + c;
+    es += fabs(fp_two_sum_err(p, q, s1)) + fabs(fp_two_sum_err(s1, c, s2));
+    if (!ea) { ap += fabs(p); np++; }
+    if (!eb) { ap += fabs(q); np++; }
+
+    double err = 0.0;
+    if (xe != 0.0)
+        err = ea ? xe : fp_mul_up(fabs(a), xe);
+    if (ye != 0.0)
+        err = fp_add_up(err, eb ? ye : fp_mul_up(fabs(b), ye));
+    err = fp_add_up(err, sum_err_bound(es));
+    if (np > 0)
+        err = fp_add_up(err, fp_rounding_bound(ap, np));
+
+    z->x0 = s2;
+    z->err = err;
+    z->n = (unsigned short)n;
+    z->flags = (unsigned short)flags;
+    if (!isfinite(s2) || !isfinite(err) || !isfinite(es) || !isfinite(ap))
+        aa_unbounded(z, flags);
+}
+
+void aa_add(aa_context *ctx, aa_form *z, const aa_form *x, const aa_form *y)
+{
+    aa_lincomb(ctx, z, 1.0, x, 1.0, y, 0.0);
+}
+
+void aa_sub(aa_context *ctx, aa_form *z, const aa_form *x, const aa_form *y)
+{
+    aa_lincomb(ctx, z, 1.0, x, -1.0, y, 0.0);
+}
+
+void aa_neg(aa_context *ctx, aa_form *z, const aa_form *x)
+{
+    aa_lincomb(ctx, z, -1.0, x, 0.0, NULL, 0.0);
+}
+
+void aa_add_s(aa_context *ctx, aa_form *z, const aa_form *x, double s)
+{
+    aa_lincomb(ctx, z, 1.0, x, 0.0, NULL, s);
+}
+
+void aa_mul_s(aa_context *ctx, aa_form *z, const aa_form *x, double s)
+{
+    if (s == 0.0) {                       /* 0 * x = 0, even unbounded x */
+        unsigned flags = x->flags & ~AA_UNBOUNDED;
+        aa_const(z, 0.0);
+        z->flags = (unsigned short)flags;
+        return;
+    }
+    aa_lincomb(ctx, z, s, x, 0.0, NULL, 0.0);
+}
+
+void aa_apply_linear(aa_context *ctx, aa_form *z, const aa_form *x,
+                     double alpha, double zeta, double delta, unsigned flags)
+{
+    aa_lincomb(ctx, z, alpha, x, 0.0, NULL, zeta);
+    z->flags |= (unsigned short)(flags & ~AA_UNBOUNDED);
+    aa_add_new_error(ctx, z, delta);
+}
+
+/* ---------------------------------------------------------------------- */
+/* products                                                                */
+/* ---------------------------------------------------------------------- */
+
+/*
+ * x*y = x0*y0 + sum (x0*yi + y0*xi) ei + Q, Q the quadratic part.
+ * Q's diagonal sum xi*yi*ei^2 lies in [min(0, .), max(0, .)] per term: its
+ * midpoint sum(xi*yi)/2 moves to the centre, its half-width sum|xi*yi|/2
+ * stays as error. The rest of Q is bounded by rx*ry - sum|xi*yi| (rx, ry
+ * the radii including the private terms). So the new error is
+ * rx*ry - sum|xi*yi|/2. With x == y this gives x^2 over [-1,1] as [0,1].
+ */
+void aa_mul(aa_context *ctx, aa_form *z, const aa_form *x, const aa_form *y)
+{
+    unsigned flags = x->flags | y->flags;
+    if (x == y) {                         /* x*x: the Chebyshev square */
+        aa_sqr(ctx, z, x);
+        return;
+    }
+    if (aa_is_point(x) || aa_is_point(y)) {
+        const aa_form *p = aa_is_point(x) ? x : y;
+        const aa_form *o = p == x ? y : x;
+        if (p->x0 == 0.0) {
+            aa_const(z, 0.0);
+            z->flags = (unsigned short)(flags & ~AA_UNBOUNDED);
+            return;
+        }
+        double k = p->x0;
+        aa_lincomb(ctx, z, k, o, 0.0, NULL, 0.0);
+        z->flags |= (unsigned short)flags;
+        return;
+    }
+    if ((x->flags | y->flags) & AA_UNBOUNDED) {
+        aa_unbounded(z, flags);
+        return;
+    }
+    double rx = aa_radius(x), ry = aa_radius(y);
+    int n = x->n > y->n ? x->n : y->n;
+    int xn = x->n, yn = y->n;
+    double x0 = x->x0, y0 = y->x0, xe = x->err, ye = y->err;
+
+    double es = 0.0, ap = 0.0, dsum = 0.0, dabs = 0.0;
+    for (int i = 0; i < n; i++) {
+        double xi = i < xn ? x->c[i] : 0.0;
+        double yi = i < yn ? y->c[i] : 0.0;
+        double p = x0 * yi, q = y0 * xi, s = p + q;
+        double d = xi * yi;
+        es += fabs(fp_two_sum_err(p, q, s));
+        ap += fabs(p) + fabs(q);
+        dsum += d;
+        dabs += fabs(d);
+        z->c[i] = s;
+    }
+    double p0 = x0 * y0, m = 0.5 * dsum, s0 = p0 + m;
+    es += fabs(fp_two_sum_err(p0, m, s0));
+    /* errors: 2n + 1 products above, the n products d and their RN sum
+     * (at most (n+1) * 2^-53 * dabs), and the halving */
+    ap += fabs(p0) + (double)(n + 2) * dabs;
+
+    double err = fp_add_up(fp_mul_up(fabs(x0), ye), fp_mul_up(fabs(y0), xe));
+    err = fp_add_up(err, sum_err_bound(es));
+    err = fp_add_up(err, fp_rounding_bound(ap, 3 * n + 3));
+
+    /* lower bound of sum|xi*yi|/2 */
+    double dlow = dabs - dabs * (double)(n + 2) * 0x1p-52 - (double)n * 0x1p-1074;
+    dlow = dlow > 0.0 ? fp_next_down(fp_next_down(dlow) * 0.5) : 0.0;
+    double delta = fp_add_up(fp_mul_up(rx, ry), -(dlow > 0.0 ? dlow : 0.0));
+    if (delta < 0.0)
+        delta = 0.0;
+
+    z->x0 = s0;
+    z->err = err;
+    z->n = (unsigned short)n;
+    z->flags = (unsigned short)(flags & ~AA_UNBOUNDED);
+    if (!isfinite(s0) || !isfinite(err) || !isfinite(delta) || !isfinite(ap)) {
+        aa_unbounded(z, flags);
+        return;
+    }
+    aa_add_new_error(ctx, z, delta);
+}
+
+/* ---------------------------------------------------------------------- */
+/* merging two branches (paper §4.1 and §5)                                */
+/* ---------------------------------------------------------------------- */
+
+/*
+ * x = m + d and y = m - d with m = (x + y)/2, d = (x - y)/2. Both lie in
+ * m +- max|d|, so z = m with a new error max|d| = |d0| + radius(d). The
+ * shared symbols of x and y stay correlated through m.
+ */
+void aa_merge(aa_context *ctx, aa_form *z, const aa_form *x, const aa_form *y)
+{
+    unsigned flags = x->flags | y->flags | AA_DISCONTINUOUS;
+    if ((x->flags | y->flags) & AA_UNBOUNDED) {
+        aa_unbounded(z, flags);
+        return;
+    }
+    aa_form d;
+    aa_lincomb(ctx, &d, 0.5, x, -0.5, y, 0.0);
+    aa_lincomb(ctx, z, 0.5, x, 0.5, y, 0.0);
+    z->flags = (unsigned short)(flags & ~AA_UNBOUNDED);
+    aa_add_new_error(ctx, z, fp_add_up(fabs(d.x0), aa_radius(&d)));
+}

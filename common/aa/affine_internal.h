@@ -1,0 +1,25 @@
+/*
+ * affine_internal.h: the pieces affine.c shares with affine_funcs.c. Not a
+ * public interface.
+ */
+#ifndef AA_AFFINE_INTERNAL_H
+#define AA_AFFINE_INTERNAL_H
+
+#include "aa/affine.h"
+
+/* Adds delta >= 0 (an upper bound, already rounded up) as a new error of z:
+ * on a fresh noise symbol while the context has one, else on z->err. */
+void aa_add_new_error(aa_context *ctx, aa_form *z, double delta);
+
+/* z = alpha*x + zeta +- delta: the result of a linear approximation of a
+ * non-affine function (Heidrich & Seidel §4: f^a plus a new noise symbol).
+ * delta must already be an upper bound on the approximation error; the
+ * rounding of alpha*x + zeta is accounted for here. */
+void aa_apply_linear(aa_context *ctx, aa_form *z, const aa_form *x,
+                     double alpha, double zeta, double delta, unsigned flags);
+
+/* z = the interval r on a fresh noise symbol (min-range approximation with
+ * alpha = 0), with flags; unbounded when r is. */
+void aa_set_interval(aa_context *ctx, aa_form *z, ia_interval r, unsigned flags);
+
+#endif

@@ -1,0 +1,157 @@
+/*
+ * rounding.h: the floating-point facts every bound in common/aa rests on.
+ *
+ * aa never changes the FPU rounding mode. All arithmetic runs in IEEE 754
+ * binary64 round-to-nearest-even (RN), whose error on + - * / sqrt is at most
+ * half an ulp of the result (plus half the smallest subnormal on underflow).
+ * A bound is made safe by stepping the RN result one representable number
+ * outward (fp_next_up / fp_next_down): one full step always covers a half-ulp
+ * error, including in the subnormal range. Library functions (sin, exp, ...)
+ * are not correctly rounded; their results are widened by AA_LIBM_ULPS steps
+ * (see the note on AA_LIBM_ULPS). docs/arithmetic.md gives the whole argument.
+ */
+#ifndef AA_ROUNDING_H
+#define AA_ROUNDING_H
+
+#include <math.h>
+#include <stdint.h>
+#include <string.h>
+
+/*
+ * Widening applied to the results of libm functions that are not correctly
+ * rounded (sin cos tan asin acos atan atan2 exp log pow). glibc's manual,
+ * "Known Maximum Errors in Math Functions", lists at most 1-2 ulp for these
+ * binary64 functions on x86_64 (glibc 2.36, Debian 12), and glibc's own test
+ * suite rejects any ulp figure above 9 for any function. We widen by 4: twice
+ * the documented bound. tests/aa/test_aa_containment.c checks the widened
+ * results against a long double oracle on every run.
+ */
+#define AA_LIBM_ULPS 4
+
+/* The doubles just below and above pi and pi/2 (M_PI and M_PI_2 are the
+ * lower ones): exact real constants are enclosed, never rounded. */
+#define AA_PI_LO   0x1.921fb54442d18p+1
+#define AA_PI_HI   0x1.921fb54442d19p+1
+#define AA_PI_2_LO 0x1.921fb54442d18p+0
+#define AA_PI_2_HI 0x1.921fb54442d19p+0
+
+/* The next representable double above x (+inf stays +inf, NaN stays NaN). */
+static inline double fp_next_up(double x)
+{
+    uint64_t bits;
+    if (x != x || x == INFINITY)
+        return x;
+    if (x == 0.0)
+        return 0x1p-1074;               /* smallest positive subnormal */
+    memcpy(&bits, &x, sizeof bits);
+    if (x > 0.0)
+        bits++;
+    else
+        bits--;
+    memcpy(&x, &bits, sizeof bits);
+    return x;
+}
+
+/* The next representable double below x (-inf stays -inf, NaN stays NaN). */
+static inline double fp_next_down(double x)
+{
+    return -fp_next_up(-x);
+}
+
+/* x stepped k representable numbers up (k >= 0). */
+static inline double fp_up_by(double x, int k)
+{
+    while (k-- > 0)
+        x = fp_next_up(x);
+    return x;
+}
+
+/* x stepped k representable numbers down (k >= 0). */
+static inline double fp_down_by(double x, int k)
+{
+    while (k-- > 0)
+        x = fp_next_down(x);
+    return x;
+}
+
+/*
+ * Exact rounding error of an addition (Knuth's TwoSum, 6 flops, no branch):
+ * s = fl(a + b) and the returned e satisfy s + e == a + b exactly, for all
+ * finite a, b without overflow. Used for affine coefficients so that an
+ * addition that rounds nothing (x - x) adds nothing to the error term.
+ */
+static inline double fp_two_sum_err(double a, double b, double s)
+{
+    double bb = s - a;
+    return (a - (s - bb)) + (b - bb);
+}
+
+/*
+ * Directed rounding of single operations, computed in RN.
+ * fp_add_dn/up are exact directed roundings: TwoSum tells whether (and in
+ * which direction) the sum was rounded, so an exact sum is not widened.
+ * fp_mul_* and fp_div_* step one ulp outward unless trivially exact.
+ * Infinite operands stand for unbounded ends of ranges: 0 * inf is 0 and
+ * a / inf is 0 (the limit), overflow of finite operands gives DBL_MAX on
+ * the inner side and infinity on the outer side.
+ */
+static inline double fp_add_dn(double a, double b)
+{
+    double s = a + b;
+    if (!isfinite(s))
+        return (s == INFINITY && isfinite(a) && isfinite(b)) ? 0x1.fffffffffffffp+1023 : s;
+    return fp_two_sum_err(a, b, s) < 0 ? fp_next_down(s) : s;
+}
+
+static inline double fp_add_up(double a, double b)
+{
+    double s = a + b;
+    if (!isfinite(s))
+        return (s == -INFINITY && isfinite(a) && isfinite(b)) ? -0x1.fffffffffffffp+1023 : s;
+    return fp_two_sum_err(a, b, s) > 0 ? fp_next_up(s) : s;
+}
+
+static inline double fp_mul_dn(double a, double b)
+{
+    if (a == 0.0 || b == 0.0)
+        return 0.0;
+    double p = a * b;
+    if (isinf(p) && isfinite(a) && isfinite(b))
+        return p > 0 ? 0x1.fffffffffffffp+1023 : -INFINITY;
+    return fp_next_down(p);
+}
+
+static inline double fp_mul_up(double a, double b)
+{
+    return -fp_mul_dn(-a, b);
+}
+
+static inline double fp_div_dn(double a, double b)
+{
+    if (a == 0.0)
+        return 0.0;
+    if (isinf(b))
+        return isinf(a) ? -INFINITY : 0.0;
+    double q = a / b;
+    if (isinf(q) && isfinite(a))
+        return q > 0 ? 0x1.fffffffffffffp+1023 : -INFINITY;
+    return fp_next_down(q);
+}
+
+static inline double fp_div_up(double a, double b)
+{
+    return -fp_div_dn(-a, b);
+}
+
+/*
+ * Upper bound on the rounding error of n products/sums whose absolute values
+ * add up (in RN) to acc: each RN operation errs by at most u*|result| + eta
+ * with u = 2^-53 and eta = 2^-1075. We return 2u*acc + 4*n*eta stepped up,
+ * which also covers the RN error of computing acc itself (n <= 2^40).
+ */
+static inline double fp_rounding_bound(double acc, int n)
+{
+    return fp_next_up(acc * 0x1p-52 + (double)(n + 1) * 0x1p-1072);
+}
+
+#endif
