@@ -36,11 +36,12 @@ if ! command -v apt-get >/dev/null 2>&1; then
 fi
 SUDO=""
 if [ "$(id -u)" -ne 0 ]; then
-  if command -v sudo >/dev/null 2>&1 && sudo -n true 2>/dev/null; then
-    SUDO="sudo -n"
+  if command -v sudo >/dev/null 2>&1 && { [ -t 0 ] || sudo -n true 2>/dev/null; }; then
+    SUDO="sudo"
+    echo "install-deps: not root; using sudo"
   else
-    echo "install-deps: error: installing packages needs root; run as root or with sudo:" >&2
-    echo "  sudo apt-get install -y ${missing[*]}" >&2
+    echo "install-deps: error: installing packages needs root (and sudo is not usable here)." >&2
+    echo "  as root, run: apt-get install -y ${missing[*]}" >&2
     exit 1
   fi
 fi

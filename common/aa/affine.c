@@ -50,6 +50,8 @@ void aa_unbounded(aa_form *z, unsigned flags)
 {
     z->x0 = 0.0;
     z->err = INFINITY;
+    z->lo = -INFINITY;
+    z->hi = INFINITY;
     z->n = 0;
     z->flags = (unsigned short)(flags | AA_UNBOUNDED);
 }
@@ -62,6 +64,8 @@ void aa_const(aa_form *z, double value)
     }
     z->x0 = value;
     z->err = 0.0;
+    z->lo = value;
+    z->hi = value;
     z->n = 0;
     z->flags = 0;
 }
@@ -98,6 +102,8 @@ void aa_input(aa_context *ctx, aa_form *z, double lo, double hi)
     if (mid > hi) mid = hi;
     double rad = fmax(fp_add_up(hi, -mid), fp_add_up(mid, -lo));
     aa_const(z, mid);
+    z->lo = lo;
+    z->hi = hi;
     int k = fresh_symbol(ctx);
     if (k < 0) {
         z->err = rad;
@@ -119,6 +125,8 @@ void aa_set_interval(aa_context *ctx, aa_form *z, ia_interval r, unsigned flags)
     double mid = ia_mid(r);
     double rad = fmax(fp_add_up(r.hi, -mid), fp_add_up(mid, -r.lo));
     aa_const(z, mid);
+    z->lo = r.lo;
+    z->hi = r.hi;
     z->flags = (unsigned short)(flags & ~AA_UNBOUNDED);
     aa_add_new_error(ctx, z, rad);
 }
@@ -148,7 +156,16 @@ ia_interval aa_range(const aa_form *x)
         return e;
     }
     double r = aa_radius(x);
-    ia_interval out = ia_make(fp_add_dn(x->x0, -r), fp_add_up(x->x0, r));
+    double lo = fp_add_dn(x->x0, -r), hi = fp_add_up(x->x0, r);
+    if (x->lo > lo)
+        lo = x->lo;
+    if (x->hi < hi)
+        hi = x->hi;
+    if (!(lo <= hi)) {        /* disjoint: possible only outside a domain */
+        lo = x->lo;
+        hi = x->hi;
+    }
+    ia_interval out = ia_make(lo, hi);
     out.flags |= x->flags;
     return out;
 }
@@ -179,7 +196,7 @@ void aa_lincomb(aa_context *ctx, aa_form *z, double a, const aa_form *x,
                 double b, const aa_form *y, double c)
 {
     (void)ctx;
-    static const aa_form zero = { 0.0, 0.0, 0, 0, { 0.0 } };
+    static const aa_form zero = { .x0 = 0.0 };
     if (y == NULL) {
         y = &zero;
         b = 0.0;
@@ -197,6 +214,8 @@ void aa_lincomb(aa_context *ctx, aa_form *z, double a, const aa_form *x,
     int n = xn > yn ? xn : yn;
     double x0 = x->x0, y0 = y->x0;
     double xe = a == 0.0 ? 0.0 : x->err, ye = b == 0.0 ? 0.0 : y->err;
+    ia_interval hull = ia_add_s(ia_add(ia_mul_s(ia_make(x->lo, x->hi), a),
+                                       ia_mul_s(ia_make(y->lo, y->hi), b)), c);
 
     double es = 0.0;      /* sum of exact errors of the additions */
     double ap = 0.0;      /* sum of |inexact products| */
@@ -227,6 +246,8 @@ void aa_lincomb(aa_context *ctx, aa_form *z, double a, const aa_form *x,
 
     z->x0 = s2;
     z->err = err;
+    z->lo = hull.lo;
+    z->hi = hull.hi;
     z->n = (unsigned short)n;
     z->flags = (unsigned short)flags;
     if (!isfinite(s2) || !isfinite(err) || !isfinite(es) || !isfinite(ap))
@@ -265,9 +286,14 @@ void aa_mul_s(aa_context *ctx, aa_form *z, const aa_form *x, double s)
 }
 
 void aa_apply_linear(aa_context *ctx, aa_form *z, const aa_form *x,
-                     double alpha, double zeta, double delta, unsigned flags)
+                     double alpha, double zeta, double delta, ia_interval hull,
+                     unsigned flags)
 {
     aa_lincomb(ctx, z, alpha, x, 0.0, NULL, zeta);
+    if (!(z->flags & AA_UNBOUNDED)) {
+        z->lo = hull.lo;
+        z->hi = hull.hi;
+    }
     z->flags |= (unsigned short)(flags & ~AA_UNBOUNDED);
     aa_add_new_error(ctx, z, delta);
 }
@@ -309,6 +335,7 @@ void aa_mul(aa_context *ctx, aa_form *z, const aa_form *x, const aa_form *y)
         return;
     }
     double rx = aa_radius(x), ry = aa_radius(y);
+    ia_interval hull = ia_mul(aa_range(x), aa_range(y));
     int n = x->n > y->n ? x->n : y->n;
     int xn = x->n, yn = y->n;
     double x0 = x->x0, y0 = y->x0, xe = x->err, ye = y->err;
@@ -344,6 +371,8 @@ void aa_mul(aa_context *ctx, aa_form *z, const aa_form *x, const aa_form *y)
 
     z->x0 = s0;
     z->err = err;
+    z->lo = hull.lo;
+    z->hi = hull.hi;
     z->n = (unsigned short)n;
     z->flags = (unsigned short)(flags & ~AA_UNBOUNDED);
     if (!isfinite(s0) || !isfinite(err) || !isfinite(delta) || !isfinite(ap)) {
@@ -370,8 +399,21 @@ void aa_merge(aa_context *ctx, aa_form *z, const aa_form *x, const aa_form *y)
         return;
     }
     aa_form d;
+    ia_interval hull = ia_hull(aa_range(x), aa_range(y));
     aa_lincomb(ctx, &d, 0.5, x, -0.5, y, 0.0);
     aa_lincomb(ctx, z, 0.5, x, 0.5, y, 0.0);
+    z->lo = hull.lo;
+    z->hi = hull.hi;
     z->flags = (unsigned short)(flags & ~AA_UNBOUNDED);
     aa_add_new_error(ctx, z, fp_add_up(fabs(d.x0), aa_radius(&d)));
+}
+
+void aa_meet_hull(aa_form *z, ia_interval r)
+{
+    if ((z->flags & AA_UNBOUNDED) || ia_is_empty(r))
+        return;
+    if (r.lo > z->lo)
+        z->lo = r.lo;
+    if (r.hi < z->hi)
+        z->hi = r.hi;
 }

@@ -32,6 +32,14 @@
  * is bounded and added to err (exactly, via TwoSum, for sums and
  * differences, so that x - x is exactly 0).
  *
+ * Interval hull: each form also carries [lo, hi], the interval-arithmetic
+ * enclosure of the same quantity, computed alongside from the operands'
+ * ranges. aa_range returns the intersection of the affine range and the
+ * hull, and every non-affine operation approximates its function over that
+ * intersection. Both are enclosures of the same exact values, so the
+ * intersection is one too; a result is thus never wider than interval
+ * arithmetic gives, and the affine part keeps the correlations.
+ *
  * Flags (AA_DISCONTINUOUS, AA_UNBOUNDED) as in interval.h. An unbounded form
  * has x0 = 0, no coefficients and err = +inf.
  *
@@ -44,11 +52,12 @@
 #include "aa/interval.h"
 
 #define AA_MAX_SYMBOLS 32
-#define AA_DEFAULT_CAPACITY 16
+#define AA_DEFAULT_CAPACITY 8
 
 typedef struct aa_form {
     double x0;                    /* central value */
     double err;                   /* private error term, >= 0 */
+    double lo, hi;                /* interval hull, see below */
     unsigned short n;             /* symbols 0..n-1 may be non-zero */
     unsigned short flags;         /* AA_DISCONTINUOUS | AA_UNBOUNDED */
     double c[AA_MAX_SYMBOLS];     /* coefficient of noise symbol i */
@@ -69,7 +78,7 @@ void aa_input(aa_context *ctx, aa_form *z, double lo, double hi); /* new symbol 
 void aa_const(aa_form *z, double value);
 void aa_from_interval(aa_context *ctx, aa_form *z, ia_interval x);
 void aa_unbounded(aa_form *z, unsigned flags);
-ia_interval aa_range(const aa_form *x);               /* rounded outward */
+ia_interval aa_range(const aa_form *x);   /* affine range (rounded outward) meet hull */
 double aa_radius(const aa_form *x);                   /* sum |xi| + err, up */
 bool aa_is_point(const aa_form *x);                   /* no noise at all */
 

@@ -122,7 +122,7 @@ static void finish(aa_context *ctx, aa_form *z, const aa_form *x, bool ok,
         double w_aff = fp_add_up(fp_mul_up(fabs(alpha), aa_radius(x)), delta);
         double w_int = 0.5 * ia_width(fallback);
         if (isfinite(w_aff) && !(w_int * AA_MINRANGE_RATIO < w_aff)) {
-            aa_apply_linear(ctx, z, x, alpha, zeta, delta, flags);
+            aa_apply_linear(ctx, z, x, alpha, zeta, delta, fallback, flags);
             return;
         }
     }
@@ -507,6 +507,7 @@ void aa_pow(aa_context *ctx, aa_form *z, const aa_form *x, const aa_form *y)
         aa_log(ctx, &l, x);
         aa_mul(ctx, &l, &l, y);
         aa_exp(ctx, z, &l);
+        aa_meet_hull(z, fallback);
         ia_interval got = aa_range(z);
         if (!(ia_width(fallback) < ia_width(got)))
             return;
@@ -603,8 +604,11 @@ static void add_interval_constant(aa_context *ctx, aa_form *z, const aa_form *w,
 {
     double mid = ia_mid(c);
     double rad = fmax(fp_add_up(c.hi, -mid), fp_add_up(mid, -c.lo));
+    ia_interval hull = ia_add(ia_make(w->lo, w->hi), c);
     aa_lincomb(ctx, z, 1.0, w, 0.0, NULL, mid);
     z->err = fp_add_up(z->err, rad);
+    z->lo = hull.lo;
+    z->hi = hull.hi;
 }
 
 /* atan2 away from the branch cut: atan(y/x) for x > 0, and
@@ -633,6 +637,7 @@ void aa_atan2(aa_context *ctx, aa_form *z, const aa_form *y, const aa_form *x)
         ia_width(aa_range(&t)) <= ia_width(fallback)) {
         *z = t;
         z->flags = (unsigned short)(fl | (t.flags & ~AA_UNBOUNDED));
+        aa_meet_hull(z, fallback);
         return;
     }
     aa_set_interval(ctx, z, fallback, fl | fallback.flags);
@@ -698,6 +703,7 @@ static void min_max(aa_context *ctx, aa_form *z, const aa_form *x,
     aa_add(ctx, &s, x, y);
     aa_lincomb(ctx, z, 0.5, &s, 0.5 * sign, &d, 0.0);
     z->flags |= (unsigned short)(fl & ~AA_UNBOUNDED);
+    aa_meet_hull(z, sign < 0 ? ia_min(rx, ry) : ia_max(rx, ry));
 }
 
 void aa_min(aa_context *ctx, aa_form *z, const aa_form *x, const aa_form *y)
@@ -722,16 +728,19 @@ void aa_clamp(aa_context *ctx, aa_form *z, const aa_form *x,
 void aa_mix(aa_context *ctx, aa_form *z, const aa_form *x, const aa_form *y,
             const aa_form *a)
 {
+    ia_interval hull = ia_mix(aa_range(x), aa_range(y), aa_range(a));
     aa_form d;
     aa_sub(ctx, &d, y, x);
     if (aa_is_point(a)) {
         unsigned af = a->flags;
         aa_lincomb(ctx, z, 1.0, x, a->x0, &d, 0.0);
         z->flags |= (unsigned short)af;
+        aa_meet_hull(z, hull);
         return;
     }
     aa_mul(ctx, &d, &d, a);
     aa_add(ctx, z, x, &d);
+    aa_meet_hull(z, hull);
 }
 
 /* smoothstep(e0, e1, x) = ramp((x - e0)/(e1 - e0)) for constant edges, the
@@ -784,7 +793,7 @@ static void stepped(aa_context *ctx, aa_form *z, const aa_form *x,
         aa_set_interval(ctx, z, v, fl | v.flags);
         return;
     }
-    aa_apply_linear(ctx, z, x, 1.0, offset, 0.5, fl | AA_DISCONTINUOUS);
+    aa_apply_linear(ctx, z, x, 1.0, offset, 0.5, v, fl | AA_DISCONTINUOUS);
 }
 
 void aa_floor(aa_context *ctx, aa_form *z, const aa_form *x) { stepped(ctx, z, x, ia_floor, -0.5); }
@@ -829,6 +838,7 @@ void aa_mod(aa_context *ctx, aa_form *z, const aa_form *x, const aa_form *y)
         if (k.lo == k.hi && isfinite(k.lo)) {
             aa_lincomb(ctx, z, 1.0, x, -k.lo, y, 0.0);
             z->flags = (unsigned short)fl;
+            aa_meet_hull(z, v);
             return;
         }
     }

@@ -14,9 +14,14 @@ void aa_add_new_error(aa_context *ctx, aa_form *z, double delta);
 /* z = alpha*x + zeta +- delta: the result of a linear approximation of a
  * non-affine function (Heidrich & Seidel §4: f^a plus a new noise symbol).
  * delta must already be an upper bound on the approximation error; the
- * rounding of alpha*x + zeta is accounted for here. */
+ * rounding of alpha*x + zeta is accounted for here. hull is the interval
+ * enclosure of f over the operand's range, which becomes z's hull. */
 void aa_apply_linear(aa_context *ctx, aa_form *z, const aa_form *x,
-                     double alpha, double zeta, double delta, unsigned flags);
+                     double alpha, double zeta, double delta, ia_interval hull,
+                     unsigned flags);
+
+/* Intersects z's hull with r (another enclosure of the same values). */
+void aa_meet_hull(aa_form *z, ia_interval r);
 
 /* z = the interval r on a fresh noise symbol (min-range approximation with
  * alpha = 0), with flags; unbounded when r is. */

@@ -340,7 +340,11 @@ ia_interval ia_pow(ia_interval x, ia_interval y)
     double c[4] = { pow(a, y.lo), pow(a, y.hi), pow(b, y.lo), pow(b, y.hi) };
     double lo = INFINITY, hi = -INFINITY;
     for (int i = 0; i < 4; i++) {
-        lo = min2(lo, c[i]);
+        /* an overflow (inf from a finite base) is only known to exceed
+         * about DBL_MAX */
+        double low_c = (isinf(c[i]) && (i < 2 ? a : b) != 0.0 && isfinite(i < 2 ? a : b))
+                           ? DBL_MAX : c[i];
+        lo = min2(lo, low_c);
         hi = max2(hi, c[i]);
     }
     unsigned flags = x.flags | y.flags;
