@@ -4,6 +4,7 @@
 #   make test-sanitize   the same tests under AddressSanitizer + UBSan
 #   make bench           build and run the benchmarks (figures, not tests)
 # Everything else is plain CMake: cmake -S . -B build && cmake --build build
+MAKEFLAGS += --no-print-directory
 JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 
 .PHONY: all deps build demo test test-sanitize bench clean
