@@ -1,0 +1,1272 @@
+/*
+ * noise.c: noise, pnoise, cellnoise and their vector variants in float,
+ * interval and affine modes (the interface and its promises: noise.h; the
+ * derivations in full: docs/noise.md).
+ *
+ * Sources:
+ *   K. Perlin, "Improving Noise", SIGGRAPH 2002: the quintic fade
+ *     s(t) = 6t^5 - 15t^4 + 10t^3 and the gradient scheme (gradients from a
+ *     small fixed set chosen by a hash of the lattice point; the 3D set is
+ *     Perlin's twelve cube-edge directions).
+ *   W. Heidrich, H.-P. Seidel, "Ray-tracing Procedural Displacement
+ *     Shaders", GI 1998, §4: a non-affine function in affine arithmetic is
+ *     its affine approximation plus a new noise symbol for its error.
+ *   The hash's mixing step is the 32-bit finaliser of MurmurHash3
+ *   (A. Appleby, public domain): xor-shift/multiply constants only.
+ *
+ * ---- the function ----------------------------------------------------
+ * With i = floor(x) and f = x - i in [0, 1]^D, the raw noise is
+ *
+ *     raw(x) = sum over corners c in {0,1}^D of W_c(f) * (g_c . (f - c)),
+ *     W_c(f) = prod_k w_{c_k}(f_k),  w_1 = s, w_0 = 1 - s,
+ *
+ * g_c the gradient hashed from lattice point i + c. Gradient sets:
+ *   1D: g in {+-1, ..., +-8}                          (16)
+ *   2D: (+-1,+-1), (+-1,0), (0,+-1)                   (8)
+ *   3D: permutations of (+-1,+-1,0), Perlin 2002       (12)
+ *   4D: three components +-1 and one 0                 (32)
+ * Every set is symmetric under sign changes and permutations of the axes,
+ * and max over the set of g . d is gmax * (sum of the m largest |d_k|),
+ * with (gmax, m) = (8,1), (1,2), (1,2), (1,3).
+ *
+ * ---- the global bound (docs/noise.md, "The global bound") --------------
+ * Since W_c >= 0 and sum_c W_c = 1:
+ *     |raw(x)| <= Phi(f) := sum_c W_c(f) * gmax * top_m(|f - c|).
+ * (Phi is also the supremum over all gradient assignments, so no bound
+ * valid for every hash can be smaller.) Phi is invariant under f_k -> 1-f_k
+ * (w_0(1-t) = w_1(t), |1-t-c| = |t-(1-c)|) and under permutations of the
+ * axes, so its maximum is taken on S = {0 <= f_1 <= ... <= f_D <= 1/2}.
+ *   1D: Phi = 8 phi(f) with phi(t) = (1-s(t)) t + s(t)(1-t). On [0, 1/2],
+ *       phi(t) - 1/2 = (1-2t)(s(t) - 1/2) <= 0 because s is increasing and
+ *       s(1/2) = 1/2. So B_1 = 4 (reached at f = 1/2).
+ *   2D: top_2 is the sum of both: Phi = phi(f_1) + phi(f_2) <= 1, B_2 = 1.
+ *   3D, 4D: on S the set of the m largest |f_k - c_k| is the same for every
+ *       point (the components with c_k = 1 are >= 1/2 >= those with
+ *       c_k = 0, and each group is ordered by k), so Phi is a polynomial P
+ *       on S. A branch-and-bound over S with interval arithmetic and the
+ *       mean-value form (tests/sl/test_sl_noise.c, run on every test run)
+ *       proves P <= 1.0364 (3D) and P <= 1.537 (4D); the largest values
+ *       it meets are 1.0363524 and 1.5365770 (a local search finds the
+ *       maxima 1.03635381 and 1.53658233), so the bounds are within 0.03%
+ *       of the supremum over all hashes.
+ * The scale K_D is a double with K_D * B_D <= 1/2 exactly (checked by the
+ * test with directed rounding), so the real function 0.5 + K_D * raw lies
+ * in [0, 1]; the float result is clamped to [0, 1] against its own
+ * rounding.
+ *
+ * ---- smoothness, and why one Taylor expansion spans cells --------------
+ * s(0) = s'(0) = s''(0) = 0 and s(1) = 1, s'(1) = s''(1) = 0, so on a face
+ * f_k = 1 of a cell the terms with c_k = 0 vanish to second order and the
+ * others agree to second order with the neighbour cell's terms at f_k = 0:
+ * the noise is C^2 everywhere (its third derivative jumps). Hence
+ *     N(x) = N(c) + grad N(c) . (x - c) + 1/2 (x-c)^T H(xi) (x-c)
+ * holds for any box, xi on the segment from c to x, with H enclosed over
+ * every cell piece of the box.
+ *
+ * ---- bounds over a box ---------------------------------------------------
+ * The box is cut at the lattice planes into pieces (at most 2 cells per
+ * axis; 3 or more give the global range [0, 1]); a piece wider than
+ * NOISE_SPLIT_WIDTH is halved while the box has at most NOISE_MAX_SUBBOXES
+ * sub-boxes. On each sub-box an interval "jet" is evaluated: value,
+ * gradient and Hessian of raw, from per-axis enclosures of s, s', s''
+ * (s and s' have exact ranges from their monotonicity; s'' from its end
+ * points and its extrema at (3 -+ sqrt 3)/6) and the product form above.
+ * At the box centre c the same jet is taken at the point (a width of a few
+ * ulps).
+ *   interval: [0,1] ∩ natural extension (hull over sub-boxes)
+ *             ∩ centred (mean-value) form N(c) + sum_k [dN/dx_k over box]
+ *               [-r_k, r_k] (one sub-box), or the hull over sub-boxes of
+ *               their own centred forms (several).
+ *   affine:   N(x) = n0 + sum_k alpha_k (x_k - c_k) +- delta with
+ *             n0, alpha_k the midpoints of the enclosures of N(c), dN/dx_k(c),
+ *             delta = rad N(c) + sum_k rad(dN/dx_k(c)) r_k
+ *                     + 1/2 sum_jk mag(H_jk over box) r_j r_k,
+ *             the x_k - c_k being the input forms less their centre values
+ *             (so the result is an alpha-combination of the inputs' noise
+ *             symbols plus one new symbol with coefficient delta). If its
+ *             radius exceeds the interval result's by NOISE_MINRANGE_RATIO
+ *             the interval result on a new symbol is used instead. The
+ *             form's interval hull is met with the interval result.
+ * Every value is an enclosure computed with outward rounding (interval
+ * kit below, on rounding.h), so both results hold for the exact real
+ * function, rounding included.
+ */
+#include "sl/noise.h"
+#include "aa/rounding.h"
+
+#include <math.h>
+#include <stdbool.h>
+#include <stdint.h>
+#include <string.h>
+
+/* the proven bounds B_D of |raw| and the scales K_D (K_D * B_D <= 1/2) */
+static const double raw_bound[SL_NOISE_MAX_DIM + 1] = {
+    0.0, 4.0, 1.0, 1.0364, 1.537
+};
+static const double noise_scale[SL_NOISE_MAX_DIM + 1] = {
+    0.0, 0.125, 0.5,
+    0x1.ee048b82b793bp-2,       /* 0.5/1.0364, rounded down */
+    0x1.4d1dd05d45c9bp-2,       /* 0.5/1.537, rounded down */
+};
+
+/*
+ * The affine result keeps its correlation with the inputs, which later
+ * operations can use (noise(P) - noise(P) is small, P + N*noise(P) keeps
+ * its dependence on u and v); the interval one does not. The linear form
+ * is kept unless its radius exceeds the interval's by this factor.
+ */
+#define NOISE_MINRANGE_RATIO 1.25
+
+/* Coordinates beyond this magnitude give the global range in interval and
+ * affine mode (all lattice arithmetic stays exact far below it). */
+#define NOISE_BOX_LIMIT 0x1p51
+
+/* Bounds over a box: cell pieces wider than this are halved, as long as
+ * the box has at most NOISE_MAX_SUBBOXES sub-boxes (docs/noise.md). */
+#define NOISE_SPLIT_WIDTH 0.2
+#define NOISE_MAX_SUBBOXES 16
+
+/* Cellnoise enumerates at most this many cells of a box. */
+#define CELLNOISE_MAX_CELLS 64
+
+/* Hash channels: the scalar noise, three vector channels, and cellnoise. */
+enum {
+    CH_NOISE = 0,
+    CH_VNOISE = 1,        /* 1, 2, 3 */
+    CH_CELL = 4,
+    CH_VCELL = 5,         /* 5, 6, 7 */
+};
+
+/* ---------------------------------------------------------------------- */
+/* lattice hashing                                                         */
+/* ---------------------------------------------------------------------- */
+
+static inline uint32_t mix32(uint32_t h)
+{
+    h ^= h >> 16;
+    h *= 0x85ebca6bu;
+    h ^= h >> 13;
+    h *= 0xc2b2ae35u;
+    h ^= h >> 16;
+    return h;
+}
+
+static uint32_t channel_seed(unsigned channel)
+{
+    return mix32(0x6a09e667u ^ (0x9e3779b9u * (channel + 1u)));
+}
+
+/* floor(x) as an integer; 0 for NaN, infinities and |x| >= 2^62. */
+static int64_t lat_floor(double x)
+{
+    if (!(x > -0x1p62 && x < 0x1p62))
+        return 0;
+    int64_t i = (int64_t)x;              /* toward zero, exact here */
+    if ((double)i > x)
+        i--;
+    return i;
+}
+
+/* The hash key of lattice coordinate i on axis k: wrapped by the period,
+ * else taken modulo 2^32. */
+static uint32_t lat_key(int64_t i, const int *period, int k)
+{
+    if (period != NULL && period[k] >= 1) {
+        int64_t p = period[k];
+        int64_t m = i % p;
+        if (m < 0)
+            m += p;
+        return (uint32_t)m;
+    }
+    return (uint32_t)(uint64_t)i;
+}
+
+/* Hashes of the 2^dim corners: corner c (bit k = axis k) uses key[k][c_k].
+ * Axes are mixed from the last to the first, sharing prefixes. */
+static inline void corner_hashes(int dim, uint32_t seed, const uint32_t key[][2],
+                          uint32_t h[16])
+{
+    int n = 1;
+    h[0] = seed;
+    for (int k = dim - 1; k >= 0; k--) {
+        for (int j = n - 1; j >= 0; j--) {
+            uint32_t e = h[j];
+            h[2 * j + 1] = mix32(e ^ key[k][1]);
+            h[2 * j] = mix32(e ^ key[k][0]);
+        }
+        n *= 2;
+    }
+}
+
+static const signed char grad2[8][2] = {
+    { 1, 1 }, { -1, 1 }, { 1, -1 }, { -1, -1 },
+    { 1, 0 }, { -1, 0 }, { 0, 1 }, { 0, -1 },
+};
+
+static const signed char grad3[12][3] = {
+    { 1, 1, 0 }, { -1, 1, 0 }, { 1, -1, 0 }, { -1, -1, 0 },
+    { 1, 0, 1 }, { -1, 0, 1 }, { 1, 0, -1 }, { -1, 0, -1 },
+    { 0, 1, 1 }, { 0, -1, 1 }, { 0, 1, -1 }, { 0, -1, -1 },
+};
+
+/* 4D: three components +-1 and one 0; index h & 31: bits 3-4 the zero
+ * axis, bits 0-2 the signs of the other three in order */
+static const signed char grad4[32][4] = {
+    {  0,  1,  1,  1 }, {  0, -1,  1,  1 }, {  0,  1, -1,  1 }, {  0, -1, -1,  1 },
+    {  0,  1,  1, -1 }, {  0, -1,  1, -1 }, {  0,  1, -1, -1 }, {  0, -1, -1, -1 },
+    {  1,  0,  1,  1 }, { -1,  0,  1,  1 }, {  1,  0, -1,  1 }, { -1,  0, -1,  1 },
+    {  1,  0,  1, -1 }, { -1,  0,  1, -1 }, {  1,  0, -1, -1 }, { -1,  0, -1, -1 },
+    {  1,  1,  0,  1 }, { -1,  1,  0,  1 }, {  1, -1,  0,  1 }, { -1, -1,  0,  1 },
+    {  1,  1,  0, -1 }, { -1,  1,  0, -1 }, {  1, -1,  0, -1 }, { -1, -1,  0, -1 },
+    {  1,  1,  1,  0 }, { -1,  1,  1,  0 }, {  1, -1,  1,  0 }, { -1, -1,  1,  0 },
+    {  1,  1, -1,  0 }, { -1,  1, -1,  0 }, {  1, -1, -1,  0 }, { -1, -1, -1,  0 },
+};
+
+/* 1D: 1 + (h & 7), negated when bit 3 is set */
+static inline int grad1(uint32_t h)
+{
+    int g = 1 + (int)(h & 7u);
+    return (h & 8u) ? -g : g;
+}
+
+/* 3D: one of twelve, h scaled to [0, 12) by a multiply-high (unbiased to
+ * within 2^-32) */
+static inline const signed char *grad3_of(uint32_t h)
+{
+    return grad3[((uint64_t)h * 12u) >> 32];
+}
+
+/* The gradient of hash h (integer components). */
+static inline void gradient(int dim, uint32_t h, int g[4])
+{
+    switch (dim) {
+    case 1:
+        g[0] = grad1(h);
+        break;
+    case 2:
+        g[0] = grad2[h & 7u][0];
+        g[1] = grad2[h & 7u][1];
+        break;
+    case 3: {
+        const signed char *t = grad3_of(h);
+        g[0] = t[0];
+        g[1] = t[1];
+        g[2] = t[2];
+        break;
+    }
+    default: {
+        const signed char *t = grad4[h & 31u];
+        g[0] = t[0];
+        g[1] = t[1];
+        g[2] = t[2];
+        g[3] = t[3];
+        break;
+    }
+    }
+}
+
+/* ---------------------------------------------------------------------- */
+/* float mode                                                              */
+/* ---------------------------------------------------------------------- */
+
+static inline double fade(double t)
+{
+    return t * t * t * (t * (t * 6.0 - 15.0) + 10.0);
+}
+
+static inline double dfade(double t)
+{
+    double q = t * (1.0 - t);
+    return 30.0 * q * q;
+}
+
+static bool dim_ok(int dim) { return dim >= 1 && dim <= SL_NOISE_MAX_DIM; }
+
+/* Fractional parts and corner hashes of point p. */
+static inline void lattice_at(int dim, const double *p, const int *period,
+                       uint32_t seed, double f[4], uint32_t h[16])
+{
+    uint32_t key[4][2];
+    for (int k = 0; k < dim; k++) {
+        int64_t i = lat_floor(p[k]);
+        f[k] = (p[k] > -0x1p62 && p[k] < 0x1p62) ? p[k] - (double)i : 0.0;
+        key[k][0] = lat_key(i, period, k);
+        key[k][1] = lat_key(i + 1, period, k);
+    }
+    corner_hashes(dim, seed, key, h);
+}
+
+/* raw noise by nested linear interpolation of the corner dot products
+ * g_c . (f - c), one loop per dimension so that the loops have constant
+ * bounds */
+static double raw_value(int dim, const double f[4], const uint32_t h[16])
+{
+    double v[16], d[4][2];
+    for (int k = 0; k < dim; k++) {
+        d[k][0] = f[k];
+        d[k][1] = f[k] - 1.0;
+    }
+    switch (dim) {
+    case 1:
+        for (int c = 0; c < 2; c++)
+            v[c] = (double)grad1(h[c]) * d[0][c];
+        break;
+    case 2:
+        for (int c = 0; c < 4; c++) {
+            const signed char *g = grad2[h[c] & 7u];
+            v[c] = g[0] * d[0][c & 1] + g[1] * d[1][(c >> 1) & 1];
+        }
+        break;
+    case 3:
+        for (int c = 0; c < 8; c++) {
+            const signed char *g = grad3_of(h[c]);
+            v[c] = g[0] * d[0][c & 1] + g[1] * d[1][(c >> 1) & 1] +
+                   g[2] * d[2][(c >> 2) & 1];
+        }
+        break;
+    default:
+        for (int c = 0; c < 16; c++) {
+            const signed char *g = grad4[h[c] & 31u];
+            v[c] = g[0] * d[0][c & 1] + g[1] * d[1][(c >> 1) & 1] +
+                   g[2] * d[2][(c >> 2) & 1] + g[3] * d[3][(c >> 3) & 1];
+        }
+        break;
+    }
+    int n = 1 << dim;
+    for (int k = 0; k < dim; k++) {
+        double s = fade(f[k]);
+        n >>= 1;
+        for (int j = 0; j < n; j++)
+            v[j] = v[2 * j] + s * (v[2 * j + 1] - v[2 * j]);
+    }
+    return v[0];
+}
+
+static double scaled(int dim, double raw)
+{
+    double v = 0.5 + noise_scale[dim] * raw;
+    return v < 0.0 ? 0.0 : (v > 1.0 ? 1.0 : v);
+}
+
+static inline double noise_float_d(int dim, const double *p, const int *period,
+                                   uint32_t seed)
+{
+    double f[4];
+    uint32_t h[16];
+    lattice_at(dim, p, period, seed, f, h);
+    return scaled(dim, raw_value(dim, f, h));
+}
+
+/* dispatched on a constant dim, so that the loops above unroll */
+static double noise_float(int dim, const double *p, const int *period,
+                          unsigned channel)
+{
+    uint32_t seed = channel_seed(channel);
+    switch (dim) {
+    case 1: return noise_float_d(1, p, period, seed);
+    case 2: return noise_float_d(2, p, period, seed);
+    case 3: return noise_float_d(3, p, period, seed);
+    case 4: return noise_float_d(4, p, period, seed);
+    default: return 0.5;
+    }
+}
+
+double sl_noise(int dim, const double *p)
+{
+    return noise_float(dim, p, NULL, CH_NOISE);
+}
+
+double sl_pnoise(int dim, const double *p, const int *period)
+{
+    return noise_float(dim, p, period, CH_NOISE);
+}
+
+void sl_vnoise(int dim, const double *p, double out[3])
+{
+    for (int i = 0; i < 3; i++)
+        out[i] = noise_float(dim, p, NULL, CH_VNOISE + (unsigned)i);
+}
+
+void sl_vpnoise(int dim, const double *p, const int *period, double out[3])
+{
+    for (int i = 0; i < 3; i++)
+        out[i] = noise_float(dim, p, period, CH_VNOISE + (unsigned)i);
+}
+
+double sl_noise_grad(int dim, const double *p, const int *period, double *grad)
+{
+    if (!dim_ok(dim))
+        return 0.5;
+    double f[4], s[4], ds[4];
+    uint32_t h[16];
+    lattice_at(dim, p, period, channel_seed(CH_NOISE), f, h);
+    for (int k = 0; k < dim; k++) {
+        s[k] = fade(f[k]);
+        ds[k] = dfade(f[k]);
+        grad[k] = 0.0;
+    }
+    for (int c = 0; c < (1 << dim); c++) {
+        int g[4];
+        double w[4], dw[4], dot = 0.0;
+        gradient(dim, h[c], g);
+        for (int k = 0; k < dim; k++) {
+            int b = (c >> k) & 1;
+            w[k] = b ? s[k] : 1.0 - s[k];
+            dw[k] = b ? ds[k] : -ds[k];
+            dot += (double)g[k] * (b ? f[k] - 1.0 : f[k]);
+        }
+        for (int j = 0; j < dim; j++) {
+            double pw = 1.0, pdw = dw[j];
+            for (int k = 0; k < dim; k++) {
+                if (k != j) {
+                    pw *= w[k];
+                    pdw *= w[k];
+                }
+            }
+            grad[j] += pdw * dot + pw * w[j] * (double)g[j];
+        }
+    }
+    for (int k = 0; k < dim; k++)
+        grad[k] *= noise_scale[dim];
+    return scaled(dim, raw_value(dim, f, h));
+}
+
+/* ---- cellnoise ---- */
+
+static double cell_value(int dim, const int64_t *cell, uint32_t seed)
+{
+    uint32_t h = seed;
+    for (int k = dim - 1; k >= 0; k--)
+        h = mix32(h ^ lat_key(cell[k], NULL, k));
+    return (double)(h >> 8) * 0x1p-24;
+}
+
+static double cellnoise_float(int dim, const double *p, unsigned channel)
+{
+    if (!dim_ok(dim))
+        return 0.5;
+    int64_t cell[4];
+    for (int k = 0; k < dim; k++)
+        cell[k] = lat_floor(p[k]);
+    return cell_value(dim, cell, channel_seed(channel));
+}
+
+double sl_cellnoise(int dim, const double *p)
+{
+    return cellnoise_float(dim, p, CH_CELL);
+}
+
+void sl_vcellnoise(int dim, const double *p, double out[3])
+{
+    for (int i = 0; i < 3; i++)
+        out[i] = cellnoise_float(dim, p, CH_VCELL + (unsigned)i);
+}
+
+double sl_noise_raw_bound(int dim)
+{
+    return dim_ok(dim) ? raw_bound[dim] : 0.0;
+}
+
+double sl_noise_scale(int dim)
+{
+    return dim_ok(dim) ? noise_scale[dim] : 0.0;
+}
+
+/* ---------------------------------------------------------------------- */
+/* a small inline interval kit                                             */
+/* ---------------------------------------------------------------------- */
+/*
+ * All quantities here are finite and small (|.| < 2^10): no overflow. Each
+ * bound is the round-to-nearest result x of ONE operation (+ - *), moved
+ * outward by out_dn/out_up, which is branch-free and always covers that
+ * operation's rounding:
+ *   x normal: the exact result v is within half an ulp of x, i.e. v >=
+ *     pred(x). t = RN(|x| 2^-52 + 2^-1074) >= |x| 2^-52 >= ulp(x) (|x|
+ *     2^-52 is exact: scaling a normal number by a power of two lands on a
+ *     multiple of 2^-1074), so x - t <= x - ulp(x) <= pred(x), and by the
+ *     monotonicity of rounding RN(x - t) <= pred(x) <= v.
+ *   x subnormal or zero: v >= x - 2^-1075 (the underflow of a product; a
+ *     sum is exact there), t >= 2^-1074, and x - t is computed exactly.
+ * out_up is the mirror image. The cost is one or two ulps of width.
+ */
+
+typedef struct iv {
+    double lo, hi;
+} iv;
+
+static inline double out_dn(double x) { return x - (fabs(x) * 0x1p-52 + 0x1p-1074); }
+static inline double out_up(double x) { return x + (fabs(x) * 0x1p-52 + 0x1p-1074); }
+
+static inline iv iv_mk(double lo, double hi)
+{
+    iv r = { lo, hi };
+    return r;
+}
+static inline iv iv_pt(double x) { return iv_mk(x, x); }
+static inline iv iv_add(iv a, iv b)
+{
+    return iv_mk(out_dn(a.lo + b.lo), out_up(a.hi + b.hi));
+}
+static inline iv iv_sub(iv a, iv b)
+{
+    return iv_mk(out_dn(a.lo - b.hi), out_up(a.hi - b.lo));
+}
+static inline iv iv_neg(iv a) { return iv_mk(-a.hi, -a.lo); }
+static inline iv iv_mul(iv a, iv b)
+{
+    double p1 = a.lo * b.lo, p2 = a.lo * b.hi, p3 = a.hi * b.lo, p4 = a.hi * b.hi;
+    double lo = p1 < p2 ? p1 : p2, hi = p1 < p2 ? p2 : p1;
+    double lo2 = p3 < p4 ? p3 : p4, hi2 = p3 < p4 ? p4 : p3;
+    return iv_mk(out_dn(lo < lo2 ? lo : lo2), out_up(hi > hi2 ? hi : hi2));
+}
+/* a times a small integer: exact for 0, +-1, +-2, +-4, +-8 */
+static inline iv iv_mul_int(iv a, int g)
+{
+    switch (g) {
+    case 0: return iv_pt(0.0);
+    case 1: return a;
+    case -1: return iv_neg(a);
+    case 2: case 4: case 8:
+        return iv_mk(a.lo * g, a.hi * g);
+    case -2: case -4: case -8:
+        return iv_mk(a.hi * g, a.lo * g);
+    default: {
+        double x = a.lo * g, y = a.hi * g;
+        if (g < 0) { double t = x; x = y; y = t; }
+        return iv_mk(out_dn(x), out_up(y));
+    }
+    }
+}
+/* a times a non-negative double */
+static inline iv iv_scale_pos(iv a, double k)
+{
+    return iv_mk(out_dn(a.lo * k), out_up(a.hi * k));
+}
+static inline iv iv_hull(iv a, iv b)
+{
+    return iv_mk(a.lo < b.lo ? a.lo : b.lo, a.hi > b.hi ? a.hi : b.hi);
+}
+static inline double iv_mag(iv a)
+{
+    double l = fabs(a.lo), h = fabs(a.hi);
+    return l > h ? l : h;
+}
+static inline double iv_mid(iv a) { return 0.5 * a.lo + 0.5 * a.hi; }
+/* max |a - m| for a point m, rounded up */
+static inline double iv_rad_about(iv a, double m)
+{
+    double r1 = fp_add_up(a.hi, -m), r2 = fp_add_up(m, -a.lo);
+    double r = r1 > r2 ? r1 : r2;
+    return r > 0.0 ? r : 0.0;
+}
+
+/* ---------------------------------------------------------------------- */
+/* enclosures of the fade and its derivatives                              */
+/* ---------------------------------------------------------------------- */
+
+/* s(t) at a point, as an enclosure */
+static iv fade_at(double t)
+{
+    iv x = iv_pt(t);
+    iv inner = iv_add(iv_mul(x, iv_sub(iv_mul_int(x, 6), iv_pt(15.0))),
+                      iv_pt(10.0));
+    return iv_mul(iv_mul(iv_mul(x, x), x), inner);
+}
+
+/* q(t) = t(1 - t) at a point */
+static iv q_at(double t)
+{
+    return iv_mul(iv_pt(t), iv_sub(iv_pt(1.0), iv_pt(t)));
+}
+
+/* s''(t) = 60 q(t) (1 - 2t) at a point */
+static iv dds_at(double t)
+{
+    iv one_m = iv_sub(iv_pt(1.0), iv_mul_int(iv_pt(t), 2));
+    return iv_mul(iv_scale_pos(q_at(t), 60.0), one_m);
+}
+
+/* s'' has its extrema +-10/sqrt(3) at t = (3 -+ sqrt 3)/6; these brackets
+ * contain the two points and DDS_MAX is above 10/sqrt(3) = 5.7735026918962576. */
+#define DDS_T1_LO 0.2113248654
+#define DDS_T1_HI 0.2113248655
+#define DDS_T2_LO 0.7886751345
+#define DDS_T2_HI 0.7886751346
+#define DDS_MAX   5.77350269189626
+
+static iv clip01(iv a)
+{
+    return iv_mk(a.lo < 0.0 ? 0.0 : a.lo, a.hi > 1.0 ? 1.0 : a.hi);
+}
+
+/* Per axis: the weights w_b, their derivatives and the offsets f - b over
+ * an interval F within [0, 1]. */
+typedef struct axis_fade {
+    iv w[2], dw[2], ddw[2], d[2];
+} axis_fade;
+
+static void axis_setup(axis_fade *a, iv F, int order)
+{
+    a->d[0] = F;
+    a->d[1] = iv_sub(F, iv_pt(1.0));
+    /* s is increasing on [0, 1] (s' = 30 t^2 (1-t)^2 >= 0) */
+    iv s = clip01(iv_mk(fade_at(F.lo).lo, fade_at(F.hi).hi));
+    a->w[1] = s;
+    a->w[0] = iv_sub(iv_pt(1.0), s);
+    if (order >= 1) {
+        /* s' = 30 q^2, q = t(1-t) increasing below 1/2, decreasing above */
+        iv qa = q_at(F.lo), qb = q_at(F.hi);
+        double qlo = qa.lo < qb.lo ? qa.lo : qb.lo;
+        double qhi = (F.lo <= 0.5 && F.hi >= 0.5) ? 0.25
+                     : (qa.hi > qb.hi ? qa.hi : qb.hi);
+        if (qlo < 0.0)
+            qlo = 0.0;
+        iv q = iv_mk(qlo, qhi);
+        iv ds = iv_scale_pos(iv_mul(q, q), 30.0);
+        if (ds.lo < 0.0)
+            ds.lo = 0.0;
+        a->dw[1] = ds;
+        a->dw[0] = iv_neg(ds);
+    }
+    if (order >= 2) {
+        iv dd = iv_hull(dds_at(F.lo), dds_at(F.hi));
+        if (F.lo <= DDS_T1_HI && F.hi >= DDS_T1_LO && dd.hi < DDS_MAX)
+            dd.hi = DDS_MAX;
+        if (F.lo <= DDS_T2_HI && F.hi >= DDS_T2_LO && dd.lo > -DDS_MAX)
+            dd.lo = -DDS_MAX;
+        a->ddw[1] = dd;
+        a->ddw[0] = iv_neg(dd);
+    }
+}
+
+/* ---------------------------------------------------------------------- */
+/* interval jets of raw noise over one cell piece                          */
+/* ---------------------------------------------------------------------- */
+
+typedef struct jet {
+    iv v;
+    iv g[4];
+    iv h[4][4];          /* j <= k used */
+} jet;
+
+/* product of the w[m] for m not j and not k (j, k may be -1) */
+static inline iv prod_except(const iv *w, int dim, int j, int k)
+{
+    iv p = iv_pt(1.0);
+    bool first = true;
+    for (int m = 0; m < dim; m++) {
+        if (m == j || m == k)
+            continue;
+        p = first ? w[m] : iv_mul(p, w[m]);
+        first = false;
+    }
+    return p;
+}
+
+/*
+ * Value (order 0), gradient (order >= 1) and Hessian (order 2) of raw
+ * noise over the piece described by ax[], in the product form
+ *   raw = sum_c W_c l_c,  l_c = g_c . (f - c),
+ *   d_j raw = sum_c dW_c/df_j l_c + W_c g_cj,
+ *   d_jk raw = sum_c d2W_c/df_j df_k l_c + dW_c/df_j g_ck + dW_c/df_k g_cj.
+ */
+static inline void cell_jet_d(int dim, const axis_fade *ax, const uint32_t h[16],
+                              int order, jet *J)
+{
+    J->v = iv_pt(0.0);
+    for (int j = 0; j < dim; j++) {
+        J->g[j] = iv_pt(0.0);
+        for (int k = j; k < dim; k++)
+            J->h[j][k] = iv_pt(0.0);
+    }
+    for (int c = 0; c < (1 << dim); c++) {
+        int g[4];
+        iv w[4], dw[4], ddw[4], pj[4], dW[4];
+        gradient(dim, h[c], g);
+        iv l = iv_pt(0.0);
+        for (int k = 0; k < dim; k++) {
+            int b = (c >> k) & 1;
+            w[k] = ax[k].w[b];
+            l = iv_add(l, iv_mul_int(ax[k].d[b], g[k]));
+            if (order >= 1)
+                dw[k] = ax[k].dw[b];
+            if (order >= 2)
+                ddw[k] = ax[k].ddw[b];
+        }
+        for (int j = 0; j < dim; j++)
+            pj[j] = prod_except(w, dim, j, -1);
+        iv W = dim == 1 ? w[0] : iv_mul(pj[0], w[0]);
+        J->v = iv_add(J->v, iv_mul(W, l));
+        if (order < 1)
+            continue;
+        for (int j = 0; j < dim; j++) {
+            dW[j] = dim == 1 ? dw[0] : iv_mul(dw[j], pj[j]);
+            J->g[j] = iv_add(J->g[j], iv_add(iv_mul(dW[j], l),
+                                             iv_mul_int(W, g[j])));
+        }
+        if (order < 2)
+            continue;
+        for (int j = 0; j < dim; j++) {
+            iv ddW = dim == 1 ? ddw[0] : iv_mul(ddw[j], pj[j]);
+            J->h[j][j] = iv_add(J->h[j][j],
+                                iv_add(iv_mul(ddW, l), iv_mul_int(dW[j], 2 * g[j])));
+            for (int k = j + 1; k < dim; k++) {
+                iv dd = iv_mul(dw[j], dw[k]);
+                if (dim > 2)
+                    dd = iv_mul(dd, prod_except(w, dim, j, k));
+                iv t = iv_add(iv_mul(dd, l), iv_add(iv_mul_int(dW[j], g[k]),
+                                                    iv_mul_int(dW[k], g[j])));
+                J->h[j][k] = iv_add(J->h[j][k], t);
+            }
+        }
+    }
+}
+
+static void cell_jet(int dim, const axis_fade *ax, const uint32_t h[16],
+                     int order, jet *J)
+{
+    switch (dim) {
+    case 1: cell_jet_d(1, ax, h, order, J); break;
+    case 2: cell_jet_d(2, ax, h, order, J); break;
+    case 3: cell_jet_d(3, ax, h, order, J); break;
+    default: cell_jet_d(4, ax, h, order, J); break;
+    }
+}
+
+/* ---------------------------------------------------------------------- */
+/* bounds over a box                                                       */
+/* ---------------------------------------------------------------------- */
+
+typedef struct box_query {
+    int dim;
+    uint32_t seed;
+    const int *period;
+    double lo[4], hi[4];       /* the box */
+    double c[4], r[4];         /* centre in the box; |x_k - c_k| <= r_k on it */
+} box_query;
+
+typedef struct box_result {
+    iv range;                  /* encloses N over the box, within [0, 1] */
+    double n0, alpha[4], delta;   /* affine: N(x) in n0 + sum alpha (x-c) +- delta */
+} box_result;
+
+/* the piece interval of cell i for the box [lo, hi] along one axis */
+static iv piece_of(double lo, double hi, int64_t i)
+{
+    double di = (double)i;
+    return clip01(iv_mk(fp_add_dn(lo, -di), fp_add_up(hi, -di)));
+}
+
+/*
+ * Encloses N = 0.5 + K raw over the box (and, with want_affine, its
+ * linearisation at the centre). Returns false when only the global range
+ * [0, 1] is known (non-finite or huge box, or 3+ cells along an axis).
+ */
+static bool enclose(const box_query *q, bool want_affine, box_result *res)
+{
+    int dim = q->dim;
+    int64_t i0[4];
+    int ncell[4];
+    for (int k = 0; k < dim; k++) {
+        double lo = q->lo[k], hi = q->hi[k];
+        if (!(lo <= hi) || !(lo > -NOISE_BOX_LIMIT) || !(hi < NOISE_BOX_LIMIT))
+            return false;
+        int64_t a = lat_floor(lo), b = lat_floor(hi);
+        if (b > a && (double)b == hi)
+            b--;                       /* the face f = 0 of cell b is in cell b-1 */
+        if (b - a >= 2)
+            return false;
+        i0[k] = a;
+        ncell[k] = (int)(b - a) + 1;
+    }
+
+    /* segments per axis: the cell pieces, each halved when wider than
+     * NOISE_SPLIT_WIDTH, as long as there are at most NOISE_MAX_SUBBOXES
+     * sub-boxes in all */
+    iv piece[4][2];
+    int parts[4][2], total = 1, split_total = 1;
+    for (int k = 0; k < dim; k++) {
+        int nk = 0, sk = 0;
+        for (int j = 0; j < ncell[k]; j++) {
+            piece[k][j] = piece_of(q->lo[k], q->hi[k], i0[k] + j);
+            parts[k][j] = piece[k][j].hi - piece[k][j].lo > NOISE_SPLIT_WIDTH ? 2 : 1;
+            nk += 1;
+            sk += parts[k][j];
+        }
+        total *= nk;
+        split_total *= sk;
+    }
+    bool split = split_total > total && split_total <= NOISE_MAX_SUBBOXES;
+    int order = want_affine ? 2 : 1;
+    axis_fade ax[4][4];
+    iv segF[4][4];
+    int segcell[4][4], nseg[4];
+    uint32_t key[4][3];
+    for (int k = 0; k < dim; k++) {
+        nseg[k] = 0;
+        for (int j = 0; j < ncell[k]; j++) {
+            iv F = piece[k][j];
+            if (split && parts[k][j] == 2) {
+                double m = iv_mid(F);
+                segF[k][nseg[k]] = iv_mk(F.lo, m);
+                segcell[k][nseg[k]++] = j;
+                segF[k][nseg[k]] = iv_mk(m, F.hi);
+                segcell[k][nseg[k]++] = j;
+            } else {
+                segF[k][nseg[k]] = F;
+                segcell[k][nseg[k]++] = j;
+            }
+        }
+        for (int s = 0; s < nseg[k]; s++)
+            axis_setup(&ax[k][s], segF[k][s], order);
+        for (int j = 0; j <= ncell[k]; j++)
+            key[k][j] = lat_key(i0[k] + j, q->period, k);
+    }
+    int nsub = 1;
+    for (int k = 0; k < dim; k++)
+        nsub *= nseg[k];
+
+    /* every sub-box: its jet (hull of gradient and Hessian kept), and with
+     * several sub-boxes its own range: natural extension meet the centred
+     * form about its midpoint */
+    jet hull;
+    memset(&hull, 0, sizeof hull);
+    iv subrange = iv_mk(0.0, 0.0);
+    for (int sb = 0; sb < nsub; sb++) {
+        axis_fade pax[4];
+        uint32_t pkey[4][2];
+        int rest = sb;
+        for (int k = 0; k < dim; k++) {
+            int s = rest % nseg[k];
+            rest /= nseg[k];
+            pax[k] = ax[k][s];
+            pkey[k][0] = key[k][segcell[k][s]];
+            pkey[k][1] = key[k][segcell[k][s] + 1];
+        }
+        uint32_t h[16];
+        corner_hashes(dim, q->seed, pkey, h);
+        jet J;
+        cell_jet(dim, pax, h, order, &J);
+        if (nsub > 1) {
+            axis_fade max_[4];
+            double r[4];
+            rest = sb;
+            for (int k = 0; k < dim; k++) {
+                iv F = segF[k][rest % nseg[k]];
+                rest /= nseg[k];
+                double m = iv_mid(F);
+                r[k] = iv_rad_about(F, m);
+                axis_setup(&max_[k], iv_pt(m), 0);
+            }
+            jet M;
+            cell_jet(dim, max_, h, 0, &M);
+            iv mv = M.v;
+            for (int k = 0; k < dim; k++)
+                mv = iv_add(mv, iv_mul(J.g[k], iv_mk(-r[k], r[k])));
+            iv sr = J.v;
+            if (mv.lo > sr.lo) sr.lo = mv.lo;
+            if (mv.hi < sr.hi) sr.hi = mv.hi;
+            subrange = sb == 0 ? sr : iv_hull(subrange, sr);
+        }
+        if (sb == 0) {
+            hull = J;
+            continue;
+        }
+        hull.v = iv_hull(hull.v, J.v);
+        for (int j = 0; j < dim; j++) {
+            hull.g[j] = iv_hull(hull.g[j], J.g[j]);
+            if (order >= 2)
+                for (int k = j; k < dim; k++)
+                    hull.h[j][k] = iv_hull(hull.h[j][k], J.h[j][k]);
+        }
+    }
+
+    /* the centre point of the whole box (for the affine linearisation, or
+     * for the centred form when the box is one sub-box) */
+    jet C;
+    memset(&C, 0, sizeof C);
+    bool need_centre = want_affine || nsub == 1;
+    if (need_centre) {
+        axis_fade cax[4];
+        uint32_t ckey[4][2], ch[16];
+        for (int k = 0; k < dim; k++) {
+            int64_t i = lat_floor(q->c[k]);
+            double di = (double)i;
+            iv F = clip01(iv_mk(fp_add_dn(q->c[k], -di), fp_add_up(q->c[k], -di)));
+            axis_setup(&cax[k], F, want_affine ? 1 : 0);
+            ckey[k][0] = lat_key(i, q->period, k);
+            ckey[k][1] = lat_key(i + 1, q->period, k);
+        }
+        corner_hashes(dim, q->seed, ckey, ch);
+        cell_jet(dim, cax, ch, want_affine ? 1 : 0, &C);
+    }
+
+    double K = noise_scale[dim];
+    iv half = iv_pt(0.5);
+    iv raw = hull.v;
+    if (nsub > 1) {
+        if (subrange.lo > raw.lo) raw.lo = subrange.lo;
+        if (subrange.hi < raw.hi) raw.hi = subrange.hi;
+    }
+    if (need_centre) {
+        /* the centred form over the whole box */
+        iv mv = C.v;
+        for (int k = 0; k < dim; k++)
+            mv = iv_add(mv, iv_mul(hull.g[k], iv_mk(-q->r[k], q->r[k])));
+        if (mv.lo > raw.lo) raw.lo = mv.lo;
+        if (mv.hi < raw.hi) raw.hi = mv.hi;
+    }
+    iv scaled_raw = iv_add(half, iv_scale_pos(raw, K));
+    iv range = iv_mk(0.0, 1.0);
+    if (scaled_raw.lo > range.lo) range.lo = scaled_raw.lo;
+    if (scaled_raw.hi < range.hi) range.hi = scaled_raw.hi;
+    if (!(range.lo <= range.hi))       /* cannot happen; stay safe */
+        range = iv_mk(0.0, 1.0);
+    res->range = range;
+
+    if (!want_affine)
+        return true;
+    iv N0 = iv_add(half, iv_scale_pos(C.v, K));
+    double n0 = iv_mid(N0);
+    double delta = iv_rad_about(N0, n0);
+    for (int k = 0; k < dim; k++) {
+        iv G = iv_scale_pos(C.g[k], K);
+        double a = iv_mid(G);
+        res->alpha[k] = a;
+        delta = fp_add_up(delta, fp_mul_up(iv_rad_about(G, a), q->r[k]));
+    }
+    /* Lagrange remainder: 1/2 sum_jk |H_jk| r_j r_k, H symmetric */
+    double rem = 0.0;
+    for (int j = 0; j < dim; j++) {
+        rem = fp_add_up(rem, fp_mul_up(iv_mag(hull.h[j][j]),
+                                       fp_mul_up(q->r[j], q->r[j])));
+        for (int k = j + 1; k < dim; k++)
+            rem = fp_add_up(rem, fp_mul_up(2.0 * iv_mag(hull.h[j][k]),
+                                           fp_mul_up(q->r[j], q->r[k])));
+    }
+    rem = fp_mul_up(0.5 * K, rem);
+    res->n0 = n0;
+    res->delta = fp_add_up(delta, rem);
+    return true;
+}
+
+/* ---------------------------------------------------------------------- */
+/* interval mode                                                           */
+/* ---------------------------------------------------------------------- */
+
+static ia_interval ia_with(double lo, double hi, unsigned flags)
+{
+    ia_interval r = ia_make(lo, hi);
+    r.flags |= flags;
+    return r;
+}
+
+/* The box of interval inputs; false when an input is unbounded. */
+static bool box_from_ia(box_query *q, int dim, const ia_interval *p,
+                        unsigned *flags, bool *empty)
+{
+    bool ok = true;
+    *flags = 0;
+    *empty = false;
+    for (int k = 0; k < dim; k++) {
+        *flags |= p[k].flags;
+        if (ia_is_empty(p[k])) {
+            *empty = true;
+            continue;
+        }
+        double lo = p[k].lo, hi = p[k].hi;
+        if (!isfinite(lo) || !isfinite(hi)) {
+            ok = false;
+            continue;
+        }
+        double c = 0.5 * lo + 0.5 * hi;
+        if (c < lo) c = lo;
+        if (c > hi) c = hi;
+        q->lo[k] = lo;
+        q->hi[k] = hi;
+        q->c[k] = c;
+        double r1 = fp_add_up(hi, -c), r2 = fp_add_up(c, -lo);
+        q->r[k] = r1 > r2 ? r1 : r2;
+    }
+    *flags &= ~(unsigned)AA_UNBOUNDED;
+    return ok;
+}
+
+static ia_interval noise_ia(int dim, const ia_interval *p, const int *period,
+                            unsigned channel)
+{
+    if (!dim_ok(dim))
+        return ia_make(0.0, 1.0);
+    box_query q;
+    unsigned flags;
+    bool empty;
+    q.dim = dim;
+    q.seed = channel_seed(channel);
+    q.period = period;
+    bool ok = box_from_ia(&q, dim, p, &flags, &empty);
+    if (empty) {
+        ia_interval e = ia_empty();
+        e.flags = flags;
+        return e;
+    }
+    box_result res;
+    if (!ok || !enclose(&q, false, &res))
+        return ia_with(0.0, 1.0, flags);
+    return ia_with(res.range.lo, res.range.hi, flags);
+}
+
+ia_interval sl_noise_ia(int dim, const ia_interval *p)
+{
+    return noise_ia(dim, p, NULL, CH_NOISE);
+}
+
+ia_interval sl_pnoise_ia(int dim, const ia_interval *p, const int *period)
+{
+    return noise_ia(dim, p, period, CH_NOISE);
+}
+
+void sl_vnoise_ia(int dim, const ia_interval *p, ia_interval out[3])
+{
+    for (int i = 0; i < 3; i++)
+        out[i] = noise_ia(dim, p, NULL, CH_VNOISE + (unsigned)i);
+}
+
+void sl_vpnoise_ia(int dim, const ia_interval *p, const int *period,
+                   ia_interval out[3])
+{
+    for (int i = 0; i < 3; i++)
+        out[i] = noise_ia(dim, p, period, CH_VNOISE + (unsigned)i);
+}
+
+/* ---- cellnoise over a box ---- */
+
+#define CELL_MAX_VALUE (1.0 - 0x1p-24)
+
+/* Range of cellnoise over [lo, hi] per axis; sets *many when the box
+ * meets more than one cell. */
+static ia_interval cell_range(int dim, const double *lo, const double *hi,
+                              unsigned channel, bool *many)
+{
+    int64_t a[4], n[4];
+    int64_t total = 1;
+    *many = true;
+    for (int k = 0; k < dim; k++) {
+        if (!(lo[k] <= hi[k]) || !(lo[k] > -0x1p62) || !(hi[k] < 0x1p62))
+            return ia_make(0.0, CELL_MAX_VALUE);
+        a[k] = lat_floor(lo[k]);
+        n[k] = lat_floor(hi[k]) - a[k] + 1;
+        if (n[k] > CELLNOISE_MAX_CELLS)
+            return ia_make(0.0, CELL_MAX_VALUE);
+        total *= n[k];
+        if (total > CELLNOISE_MAX_CELLS)
+            return ia_make(0.0, CELL_MAX_VALUE);
+    }
+    *many = total > 1;
+    uint32_t seed = channel_seed(channel);
+    double vlo = 1.0, vhi = 0.0;
+    for (int64_t t = 0; t < total; t++) {
+        int64_t cell[4], rest = t;
+        for (int k = 0; k < dim; k++) {
+            cell[k] = a[k] + rest % n[k];
+            rest /= n[k];
+        }
+        double v = cell_value(dim, cell, seed);
+        if (v < vlo) vlo = v;
+        if (v > vhi) vhi = v;
+    }
+    return ia_make(vlo, vhi);
+}
+
+static ia_interval cellnoise_ia(int dim, const ia_interval *p, unsigned channel)
+{
+    if (!dim_ok(dim))
+        return ia_make(0.0, 1.0);
+    double lo[4], hi[4];
+    unsigned flags = 0;
+    for (int k = 0; k < dim; k++) {
+        flags |= p[k].flags;
+        lo[k] = p[k].lo;
+        hi[k] = p[k].hi;
+        if (ia_is_empty(p[k])) {
+            ia_interval e = ia_empty();
+            e.flags = flags;
+            return e;
+        }
+    }
+    flags &= ~(unsigned)AA_UNBOUNDED;
+    bool many;
+    ia_interval r = cell_range(dim, lo, hi, channel, &many);
+    r.flags |= flags | (many ? (unsigned)AA_DISCONTINUOUS : 0u);
+    return r;
+}
+
+ia_interval sl_cellnoise_ia(int dim, const ia_interval *p)
+{
+    return cellnoise_ia(dim, p, CH_CELL);
+}
+
+void sl_vcellnoise_ia(int dim, const ia_interval *p, ia_interval out[3])
+{
+    for (int i = 0; i < 3; i++)
+        out[i] = cellnoise_ia(dim, p, CH_VCELL + (unsigned)i);
+}
+
+/* ---------------------------------------------------------------------- */
+/* affine mode                                                             */
+/* ---------------------------------------------------------------------- */
+
+static void aa_interval_result(aa_context *ctx, aa_form *out, double lo,
+                               double hi, unsigned flags)
+{
+    aa_from_interval(ctx, out, ia_with(lo, hi, flags));
+}
+
+static void noise_aa(aa_context *ctx, aa_form *out, int dim, const aa_form *p,
+                     const int *period, unsigned channel)
+{
+    if (!dim_ok(dim)) {
+        aa_interval_result(ctx, out, 0.0, 1.0, 0);
+        return;
+    }
+    box_query q;
+    unsigned flags = 0;
+    bool ok = true;
+    q.dim = dim;
+    q.seed = channel_seed(channel);
+    q.period = period;
+    for (int k = 0; k < dim; k++) {
+        flags |= p[k].flags;
+        if (p[k].flags & AA_UNBOUNDED) {
+            ok = false;
+            continue;
+        }
+        /* The box: the input's range, widened to contain the centre x0
+         * (the Taylor expansion runs from x0 to every value, so the
+         * segment must lie in the box where the Hessian is enclosed).
+         * |x - x0| is bounded both by the form's radius and by the box. */
+        ia_interval R = aa_range(&p[k]);
+        double c = p[k].x0, rad = aa_radius(&p[k]);
+        q.lo[k] = R.lo < c ? R.lo : c;
+        q.hi[k] = R.hi > c ? R.hi : c;
+        q.c[k] = c;
+        double rb1 = fp_add_up(q.hi[k], -c), rb2 = fp_add_up(c, -q.lo[k]);
+        double rb = rb1 > rb2 ? rb1 : rb2;
+        q.r[k] = rb < rad ? rb : rad;
+        if (!isfinite(R.lo) || !isfinite(R.hi) || !isfinite(rad))
+            ok = false;
+    }
+    flags &= ~(unsigned)AA_UNBOUNDED;
+    box_result res;
+    if (!ok || !enclose(&q, true, &res)) {
+        aa_interval_result(ctx, out, 0.0, 1.0, flags);
+        return;
+    }
+
+    double rho_lin = res.delta;
+    for (int k = 0; k < dim; k++)
+        rho_lin = fp_add_up(rho_lin, fp_mul_up(fabs(res.alpha[k]), q.r[k]));
+    double rho_int = 0.5 * fp_add_up(res.range.hi, -res.range.lo);
+    if (!(rho_lin <= NOISE_MINRANGE_RATIO * rho_int) || !isfinite(rho_lin)) {
+        aa_interval_result(ctx, out, res.range.lo, res.range.hi, flags);
+        return;
+    }
+
+    /* n0 + sum alpha_k (x_k - c_k): y_k is x_k with its centre removed
+     * (exactly: the same coefficients, centre x0 - x0 = 0); the rounding of
+     * the combination goes to err in aa_lincomb. */
+    aa_form y[4];
+    for (int k = 0; k < dim; k++)
+        aa_add_s(ctx, &y[k], &p[k], -p[k].x0);    /* x0 - x0: exact */
+    if (dim == 1) {
+        aa_lincomb(ctx, out, res.alpha[0], &y[0], 0.0, NULL, res.n0);
+    } else {
+        aa_lincomb(ctx, out, res.alpha[0], &y[0], res.alpha[1], &y[1], res.n0);
+        for (int k = 2; k < dim; k++)
+            aa_lincomb(ctx, out, 1.0, out, res.alpha[k], &y[k], 0.0);
+    }
+    aa_form e;
+    aa_from_interval(ctx, &e, ia_make(-res.delta, res.delta));
+    aa_add(ctx, out, out, &e);
+    if (out->flags & AA_UNBOUNDED) {    /* cannot happen: stay safe */
+        aa_interval_result(ctx, out, res.range.lo, res.range.hi, flags);
+        return;
+    }
+    out->flags = (unsigned short)(out->flags | flags);
+    /* The form's interval hull (affine.h) becomes the interval result: both
+     * enclose the noise over the box, so aa_range gives their meet and the
+     * affine result is never wider than the interval one. */
+    if (res.range.lo > out->lo)
+        out->lo = res.range.lo;
+    if (res.range.hi < out->hi)
+        out->hi = res.range.hi;
+}
+
+void sl_noise_aa(aa_context *ctx, aa_form *out, int dim, const aa_form *p)
+{
+    noise_aa(ctx, out, dim, p, NULL, CH_NOISE);
+}
+
+void sl_pnoise_aa(aa_context *ctx, aa_form *out, int dim, const aa_form *p,
+                  const int *period)
+{
+    noise_aa(ctx, out, dim, p, period, CH_NOISE);
+}
+
+void sl_vnoise_aa(aa_context *ctx, aa_form out[3], int dim, const aa_form *p)
+{
+    for (int i = 0; i < 3; i++)
+        noise_aa(ctx, &out[i], dim, p, NULL, CH_VNOISE + (unsigned)i);
+}
+
+void sl_vpnoise_aa(aa_context *ctx, aa_form out[3], int dim, const aa_form *p,
+                   const int *period)
+{
+    for (int i = 0; i < 3; i++)
+        noise_aa(ctx, &out[i], dim, p, period, CH_VNOISE + (unsigned)i);
+}
+
+static void cellnoise_aa(aa_context *ctx, aa_form *out, int dim,
+                         const aa_form *p, unsigned channel)
+{
+    if (!dim_ok(dim)) {
+        aa_interval_result(ctx, out, 0.0, 1.0, 0);
+        return;
+    }
+    double lo[4], hi[4];
+    unsigned flags = 0;
+    bool bounded = true;
+    for (int k = 0; k < dim; k++) {
+        flags |= p[k].flags;
+        if (p[k].flags & AA_UNBOUNDED) {
+            bounded = false;
+            lo[k] = -INFINITY;
+            hi[k] = INFINITY;
+            continue;
+        }
+        ia_interval R = aa_range(&p[k]);
+        lo[k] = R.lo;
+        hi[k] = R.hi;
+    }
+    flags &= ~(unsigned)AA_UNBOUNDED;
+    bool many = true;
+    ia_interval r = bounded ? cell_range(dim, lo, hi, channel, &many)
+                            : ia_make(0.0, CELL_MAX_VALUE);
+    if (!many) {
+        aa_const(out, r.lo);
+        out->flags = (unsigned short)flags;
+        return;
+    }
+    aa_interval_result(ctx, out, r.lo, r.hi, flags | AA_DISCONTINUOUS);
+}
+
+void sl_cellnoise_aa(aa_context *ctx, aa_form *out, int dim, const aa_form *p)
+{
+    cellnoise_aa(ctx, out, dim, p, CH_CELL);
+}
+
+void sl_vcellnoise_aa(aa_context *ctx, aa_form out[3], int dim,
+                      const aa_form *p)
+{
+    for (int i = 0; i < 3; i++)
+        cellnoise_aa(ctx, &out[i], dim, p, CH_VCELL + (unsigned)i);
+}
