@@ -8,6 +8,7 @@
  * sl_diag_to_string, so both produce byte-identical text.
  */
 #include "sl/diag.h"
+#include "sl/strbuf.h"
 #include "sl/source.h"
 
 #include <stdint.h>
@@ -25,51 +26,6 @@ struct sl_diag {
     const sl_source_set *sources;
 };
 
-static void *xrealloc(void *p, size_t size)
-{
-    void *q = realloc(p, size ? size : 1);
-    if (!q) {
-        fputs("sl: out of memory\n", stderr);
-        abort();
-    }
-    return q;
-}
-
-static char *xstrndup(const char *s, size_t len)
-{
-    char *copy = xrealloc(NULL, len + 1);
-    memcpy(copy, s, len);
-    copy[len] = '\0';
-    return copy;
-}
-
-/* ---------------------------------------------------------------------- */
-/* a tiny string builder                                                   */
-/* ---------------------------------------------------------------------- */
-
-typedef struct sbuf {
-    char *data;
-    size_t len, cap;
-} sbuf;
-
-static void sbuf_put(sbuf *b, const char *s, size_t n)
-{
-    if (b->len + n + 1 > b->cap) {
-        size_t cap = b->cap ? b->cap : 256;
-        while (cap < b->len + n + 1)
-            cap *= 2;
-        b->data = xrealloc(b->data, cap);
-        b->cap = cap;
-    }
-    memcpy(b->data + b->len, s, n);
-    b->len += n;
-    b->data[b->len] = '\0';
-}
-
-static void sbuf_puts(sbuf *b, const char *s) { sbuf_put(b, s, strlen(s)); }
-
-static void sbuf_putc(sbuf *b, char c) { sbuf_put(b, &c, 1); }
-
 static const char *level_name(sl_diag_level level)
 {
     switch (level) {
@@ -83,21 +39,21 @@ static const char *level_name(sl_diag_level level)
 /* Appends one diagnostic: the header line, then the source and caret lines
  * when the source line is known and the column lies on it (or just past
  * its end, where "expected ';'" errors point). */
-static void format_one(sbuf *b, const sl_diagnostic *d)
+static void format_one(sl_strbuf *b, const sl_diagnostic *d)
 {
     char num[32];
     if (d->file) {
-        sbuf_puts(b, d->file);
+        sl_strbuf_puts(b, d->file);
         if (d->line > 0) {
             snprintf(num, sizeof num, ":%d:%d", d->line, d->col);
-            sbuf_puts(b, num);
+            sl_strbuf_puts(b, num);
         }
-        sbuf_puts(b, ": ");
+        sl_strbuf_puts(b, ": ");
     }
-    sbuf_puts(b, level_name(d->level));
-    sbuf_puts(b, ": ");
-    sbuf_puts(b, d->message);
-    sbuf_putc(b, '\n');
+    sl_strbuf_puts(b, level_name(d->level));
+    sl_strbuf_puts(b, ": ");
+    sl_strbuf_puts(b, d->message);
+    sl_strbuf_putc(b, '\n');
 
     if (!d->source_line || d->col < 1)
         return;
@@ -105,16 +61,16 @@ static void format_one(sbuf *b, const sl_diagnostic *d)
     size_t before = (size_t)d->col - 1;
     if (before > len)
         return;
-    sbuf_puts(b, d->source_line);
-    sbuf_putc(b, '\n');
+    sl_strbuf_puts(b, d->source_line);
+    sl_strbuf_putc(b, '\n');
     for (size_t i = 0; i < before; i++) {
         unsigned char c = (unsigned char)d->source_line[i];
         if (c == '\t')
-            sbuf_putc(b, '\t');
+            sl_strbuf_putc(b, '\t');
         else if ((c & 0xC0) != 0x80)   /* one space per UTF-8 character */
-            sbuf_putc(b, ' ');
+            sl_strbuf_putc(b, ' ');
     }
-    sbuf_puts(b, "^\n");
+    sl_strbuf_puts(b, "^\n");
 }
 
 /* ---------------------------------------------------------------------- */
@@ -123,7 +79,7 @@ static void format_one(sbuf *b, const sl_diagnostic *d)
 
 sl_diag *sl_diag_new(void)
 {
-    sl_diag *self = xrealloc(NULL, sizeof *self);
+    sl_diag *self = sl_xrealloc(NULL, sizeof *self);
     memset(self, 0, sizeof *self);
     self->max_errors = SL_DIAG_DEFAULT_MAX_ERRORS;
     return self;
@@ -172,11 +128,11 @@ static void store(sl_diag *self, sl_diag_level level, sl_pos pos, char *message)
 {
     if (self->count == self->cap) {
         self->cap = self->cap ? 2 * self->cap : 16;
-        self->items = xrealloc(self->items, self->cap * sizeof *self->items);
+        self->items = sl_xrealloc(self->items, self->cap * sizeof *self->items);
     }
     sl_diagnostic *d = &self->items[self->count++];
     d->level = level;
-    d->file = pos.file ? xstrndup(pos.file, strlen(pos.file)) : NULL;
+    d->file = pos.file ? sl_xstrndup(pos.file, strlen(pos.file)) : NULL;
     d->line = pos.file ? pos.line : 0;
     d->col = pos.file && pos.line > 0 ? pos.col : 0;
     d->message = message;
@@ -185,7 +141,7 @@ static void store(sl_diag *self, sl_diag_level level, sl_pos pos, char *message)
         size_t len;
         const char *text = sl_source_set_line(self->sources, pos.file, pos.line, &len);
         if (text && len <= SL_DIAG_MAX_LINE)
-            d->source_line = xstrndup(text, len);
+            d->source_line = sl_xstrndup(text, len);
     }
     if (level != SL_DIAG_ERROR)
         self->others_stored++;
@@ -216,7 +172,7 @@ void sl_diag_vreport(sl_diag *self, sl_diag_level level, sl_pos pos,
     va_end(ap2);
     if (n < 0)
         n = 0;
-    char *message = xrealloc(NULL, (size_t)n + 1);
+    char *message = sl_xrealloc(NULL, (size_t)n + 1);
     vsnprintf(message, (size_t)n + 1, fmt, ap);
     store(self, level, pos, message);
 
@@ -227,7 +183,7 @@ void sl_diag_vreport(sl_diag *self, sl_diag_level level, sl_pos pos,
         snprintf(note, sizeof note,
                  "too many errors emitted, stopping now (limit %d)", self->max_errors);
         sl_pos none = { NULL, 0, 0 };
-        store(self, SL_DIAG_NOTE, none, xstrndup(note, strlen(note)));
+        store(self, SL_DIAG_NOTE, none, sl_xstrndup(note, strlen(note)));
         self->dropped_last = true;   /* notes of the last error go too */
     }
 }
@@ -276,7 +232,7 @@ const sl_diagnostic *sl_diag_get(const sl_diag *self, size_t index)
 
 void sl_diag_print_one(const sl_diagnostic *d, FILE *out)
 {
-    sbuf b = { 0 };
+    sl_strbuf b = { 0 };
     format_one(&b, d);
     if (b.len)
         fwrite(b.data, 1, b.len, out);
@@ -291,8 +247,8 @@ void sl_diag_print(const sl_diag *self, FILE *out)
 
 char *sl_diag_to_string(const sl_diag *self)
 {
-    sbuf b = { 0 };
-    sbuf_put(&b, "", 0);
+    sl_strbuf b = { 0 };
+    sl_strbuf_put(&b, "", 0);
     for (size_t i = 0; i < self->count; i++)
         format_one(&b, &self->items[i]);
     return b.data;

@@ -27,6 +27,7 @@
  * own positions.
  */
 #include "sl/preproc.h"
+#include "sl/strbuf.h"
 
 #include <limits.h>
 #include <stdarg.h>
@@ -38,16 +39,6 @@
 /* ---------------------------------------------------------------------- */
 /* memory                                                                  */
 /* ---------------------------------------------------------------------- */
-
-static void *xrealloc(void *p, size_t size)
-{
-    void *q = realloc(p, size ? size : 1);
-    if (!q) {
-        fputs("sl: out of memory\n", stderr);
-        abort();
-    }
-    return q;
-}
 
 enum { ARENA_BLOCK = 64 * 1024 };
 
@@ -78,7 +69,7 @@ static void tv_push(tokvec *tv, const sl_pptoken *t)
 {
     if (tv->n == tv->cap) {
         tv->cap = tv->cap ? 2 * tv->cap : 16;
-        tv->v = xrealloc(tv->v, tv->cap * sizeof *tv->v);
+        tv->v = sl_xrealloc(tv->v, tv->cap * sizeof *tv->v);
     }
     tv->v[tv->n++] = *t;
 }
@@ -88,26 +79,6 @@ static void tv_free(tokvec *tv)
     free(tv->v);
     tv->v = NULL;
     tv->n = tv->cap = 0;
-}
-
-/* A growing string, for stringizing and #error texts. */
-typedef struct strbuf {
-    char *data;
-    size_t len, cap;
-} strbuf;
-
-static void sb_put(strbuf *b, const char *s, size_t n)
-{
-    if (b->len + n + 1 > b->cap) {
-        size_t cap = b->cap ? b->cap : 64;
-        while (cap < b->len + n + 1)
-            cap *= 2;
-        b->data = xrealloc(b->data, cap);
-        b->cap = cap;
-    }
-    memcpy(b->data + b->len, s, n);
-    b->len += n;
-    b->data[b->len] = '\0';
 }
 
 /* ---------------------------------------------------------------------- */
@@ -209,7 +180,7 @@ static void *arena_alloc(sl_preproc *pp, size_t size)
     arena_block *b = pp->arena;
     if (!b || b->cap - b->used < size) {
         size_t cap = size > ARENA_BLOCK ? size : ARENA_BLOCK;
-        b = xrealloc(NULL, sizeof *b + cap);
+        b = sl_xrealloc(NULL, sizeof *b + cap);
         b->next = pp->arena;
         b->used = 0;
         b->cap = cap;
@@ -271,7 +242,7 @@ static map_entry *map_put(pp_map *m, const char *key, size_t len)
     if (2 * (m->count + 1) > m->cap) {
         pp_map bigger = { 0 };
         bigger.cap = m->cap ? 2 * m->cap : 64;
-        bigger.slots = xrealloc(NULL, bigger.cap * sizeof *bigger.slots);
+        bigger.slots = sl_xrealloc(NULL, bigger.cap * sizeof *bigger.slots);
         memset(bigger.slots, 0, bigger.cap * sizeof *bigger.slots);
         for (size_t i = 0; i < m->cap; i++) {
             map_entry *e = &m->slots[i];
@@ -601,7 +572,7 @@ static const pp_text *text_of(sl_preproc *pp, const sl_source *src)
     if (e->value)
         return e->value;
     pp_text *t = arena_alloc(pp, sizeof *t);
-    size_t *splices = xrealloc(NULL, (src->len / 2 + 1) * sizeof *splices);
+    size_t *splices = sl_xrealloc(NULL, (src->len / 2 + 1) * sizeof *splices);
     t->src = src;
     t->name = e->key;
     t->text = arena_alloc(pp, src->len + 1);
@@ -762,23 +733,23 @@ static void append_arg(pp_subst *s, const sl_pptoken *v, size_t n)
 /* `#param`: the argument's spelling as a string literal. */
 static void append_stringized(pp_subst *s, const pp_arg *a)
 {
-    strbuf b = { 0 };
-    sb_put(&b, "\"", 1);
+    sl_strbuf b = { 0 };
+    sl_strbuf_put(&b, "\"", 1);
     for (size_t i = 0; i < a->nraw; i++) {
         const sl_pptoken *t = &a->raw[i];
         if (i > 0 && (t->flags & SL_PPF_SPACE))
-            sb_put(&b, " ", 1);
+            sl_strbuf_put(&b, " ", 1);
         if (t->kind == SL_TOK_STRING) {
             for (size_t k = 0; k < t->len; k++) {
                 if (t->text[k] == '"' || t->text[k] == '\\')
-                    sb_put(&b, "\\", 1);
-                sb_put(&b, &t->text[k], 1);
+                    sl_strbuf_put(&b, "\\", 1);
+                sl_strbuf_put(&b, &t->text[k], 1);
             }
         } else {
-            sb_put(&b, t->text, t->len);
+            sl_strbuf_put(&b, t->text, t->len);
         }
     }
-    sb_put(&b, "\"", 1);
+    sl_strbuf_put(&b, "\"", 1);
     sl_pptoken t = { 0 };
     t.kind = SL_TOK_STRING;
     t.text = arena_strndup(s->pp, b.data, b.len);
@@ -909,7 +880,7 @@ static void expand_call(sl_preproc *pp, pp_input *in, const sl_macro *m,
                         const sl_pptoken *name)
 {
     tokvec toks = { 0 };
-    size_t *starts = xrealloc(NULL, 8 * sizeof *starts);
+    size_t *starts = sl_xrealloc(NULL, 8 * sizeof *starts);
     size_t nargs = 1, cap = 8;
     starts[0] = 0;
     int depth = 0;
@@ -932,7 +903,7 @@ static void expand_call(sl_preproc *pp, pp_input *in, const sl_macro *m,
         } else if (t.kind == SL_TOK_COMMA && depth == 0) {
             if (nargs == cap) {
                 cap *= 2;
-                starts = xrealloc(starts, cap * sizeof *starts);
+                starts = sl_xrealloc(starts, cap * sizeof *starts);
             }
             starts[nargs++] = toks.n;
             continue;
@@ -955,7 +926,7 @@ static void expand_call(sl_preproc *pp, pp_input *in, const sl_macro *m,
         goto done;
     }
 
-    pp_arg *args = xrealloc(NULL, (nargs ? nargs : 1) * sizeof *args);
+    pp_arg *args = sl_xrealloc(NULL, (nargs ? nargs : 1) * sizeof *args);
     for (size_t a = 0; a < nargs; a++) {
         size_t end = a + 1 < nargs ? starts[a + 1] : toks.n;
         args[a].raw = toks.v ? toks.v + starts[a] : NULL;
@@ -1294,7 +1265,7 @@ static void push_cond(sl_preproc *pp, const sl_pptoken *hash, const char *direct
 {
     if (pp->nconds == pp->capconds) {
         pp->capconds = pp->capconds ? 2 * pp->capconds : 16;
-        pp->conds = xrealloc(pp->conds, pp->capconds * sizeof *pp->conds);
+        pp->conds = sl_xrealloc(pp->conds, pp->capconds * sizeof *pp->conds);
     }
     bool parent = !skipping(pp);
     pp_cond c = { hash->pos, directive, parent, parent && value, parent && value, false };
@@ -1430,13 +1401,13 @@ static void do_undef(sl_preproc *pp, const sl_pptoken *name)
 static void do_message(sl_preproc *pp, const sl_pptoken *hash, sl_diag_level level)
 {
     enum { MAX_TEXT = 512 };
-    strbuf b = { 0 };
-    sb_put(&b, "", 0);
+    sl_strbuf b = { 0 };
+    sl_strbuf_put(&b, "", 0);
     for (size_t i = 0; i < pp->line.n && b.len < MAX_TEXT; i++) {
         const sl_pptoken *t = &pp->line.v[i];
         if (i > 0 && (t->flags & SL_PPF_SPACE))
-            sb_put(&b, " ", 1);
-        sb_put(&b, t->text, t->len);
+            sl_strbuf_put(&b, " ", 1);
+        sl_strbuf_put(&b, t->text, t->len);
     }
     const char *word = level == SL_DIAG_ERROR ? "#error" : "#warning";
     sl_diag_report(pp->diag, level, hash->pos, "%s%s%.*s%s", word, b.len ? " " : "",
@@ -1472,7 +1443,7 @@ static void do_include(sl_preproc *pp)
         sl_diag_error(pp->diag, file.pos, "empty filename in '#include'");
         return;
     }
-    char *name = xrealloc(NULL, file.len - 1);
+    char *name = sl_xrealloc(NULL, file.len - 1);
     memcpy(name, file.text + 1, file.len - 2);
     name[file.len - 2] = '\0';
 
@@ -1488,12 +1459,12 @@ static void do_include(sl_preproc *pp)
     for (int i = 0; i < pp->nframes; i++) {
         if (pp->frames[i].text->src != src)
             continue;
-        strbuf chain = { 0 };
+        sl_strbuf chain = { 0 };
         for (int k = i; k < pp->nframes; k++) {
-            sb_put(&chain, pp->frames[k].text->name, strlen(pp->frames[k].text->name));
-            sb_put(&chain, " -> ", 4);
+            sl_strbuf_put(&chain, pp->frames[k].text->name, strlen(pp->frames[k].text->name));
+            sl_strbuf_put(&chain, " -> ", 4);
         }
-        sb_put(&chain, src->name, strlen(src->name));
+        sl_strbuf_put(&chain, src->name, strlen(src->name));
         sl_diag_error(pp->diag, file.pos, "include cycle: %s", chain.data);
         free(chain.data);
         goto done;
@@ -1566,7 +1537,7 @@ static void directive(sl_preproc *pp, const sl_pptoken *hash)
 sl_preproc *sl_preproc_new(sl_source_set *set, const char *main_file,
                            const char *const *search_path, sl_diag *diag)
 {
-    sl_preproc *self = xrealloc(NULL, sizeof *self);
+    sl_preproc *self = sl_xrealloc(NULL, sizeof *self);
     memset(self, 0, sizeof *self);
     self->set = set;
     self->diag = diag;
@@ -1575,10 +1546,10 @@ sl_preproc *sl_preproc_new(sl_source_set *set, const char *main_file,
     size_t n = 0;
     while (search_path && search_path[n])
         n++;
-    self->search_path = xrealloc(NULL, (n + 1) * sizeof *self->search_path);
+    self->search_path = sl_xrealloc(NULL, (n + 1) * sizeof *self->search_path);
     for (size_t i = 0; i < n; i++) {
         size_t len = strlen(search_path[i]);
-        self->search_path[i] = xrealloc(NULL, len + 1);
+        self->search_path[i] = sl_xrealloc(NULL, len + 1);
         memcpy(self->search_path[i], search_path[i], len + 1);
     }
     self->search_path[n] = NULL;
