@@ -1,0 +1,110 @@
+/*
+ * surface.h: the base surfaces of aafarm (RenderMan's quadrics, convex
+ * planar polygons and bilinear patches) as parametric surfaces P(u,v) over
+ * the unit square, evaluated in four arithmetics:
+ *
+ *   float     P, dPdu, dPdv, Ng at one (u,v)                (shading)
+ *   dual      the same plus the (u,v)-derivatives of Ng     (calculatenormal
+ *             of a displaced point needs d/du and d/dv of N)
+ *   interval  conservative enclosures over a (u,v) box      (--arith interval)
+ *   affine    affine forms over a (u,v) box, u and v being  (Heidrich-Seidel
+ *             the two input noise symbols                   §3, §4)
+ *
+ * plus exact ray intersection for surfaces that carry no displacement, and
+ * an object-space bounding box of the undisplaced surface.
+ *
+ * Parameterisations are RenderMan's (RI Specification 3.2, §5.2 Quadrics):
+ * theta = u * thetamax, and v sweeps phi / z / the radius as the spec says.
+ * All angles here are in RADIANS (the scene parser converts RIB degrees).
+ * Ng = dPdu x dPdv (not normalised), which points outward for the quadrics
+ * with their default parameters; for polygons it follows the vertex order
+ * (Newell's normal). Everything is in object space.
+ *
+ * Conservative means: for every (u,v) in the box, the exact real value of
+ * P(u,v) (and dPdu, dPdv, Ng) lies inside the interval / affine result,
+ * floating-point rounding included (common/aa guarantees its operations).
+ */
+#ifndef GEOM_SURFACE_H
+#define GEOM_SURFACE_H
+
+#include <stdbool.h>
+
+#include "aa/affine.h"
+#include "aa/interval.h"
+#include "util/vecmath.h"
+
+typedef enum geom_kind {
+    GEOM_SPHERE,        /* radius zmin zmax thetamax */
+    GEOM_DISK,          /* height radius thetamax */
+    GEOM_CYLINDER,      /* radius zmin zmax thetamax */
+    GEOM_CONE,          /* height radius thetamax */
+    GEOM_PARABOLOID,    /* rmax zmin zmax thetamax */
+    GEOM_HYPERBOLOID,   /* point1 point2 thetamax */
+    GEOM_TORUS,         /* majorradius minorradius phimin phimax thetamax */
+    GEOM_POLYGON,       /* convex planar polygon, nverts >= 3 */
+    GEOM_PATCH,         /* bilinear patch, 4 corners in RIB order */
+    GEOM__COUNT
+} geom_kind;
+
+enum { GEOM_MAX_POLY_VERTS = 64 };
+
+typedef struct geom_surface {
+    geom_kind kind;
+    double radius, zmin, zmax, thetamax;   /* sphere, cylinder, disk, cone, paraboloid */
+    double height;                         /* disk, cone */
+    double rmax;                           /* paraboloid */
+    double majorrad, minorrad, phimin, phimax;   /* torus (radians) */
+    vec3 point1, point2;                   /* hyperboloid */
+    /* polygon: vertices; patch: corners P00 P10 P01 P11 (RIB order) */
+    int nverts;
+    vec3 verts[GEOM_MAX_POLY_VERTS];
+    /* derived by geom_surface_prepare (do not set by hand) */
+    double phi0, phi1;                     /* sphere: phi range of zmin/zmax */
+    vec3 origin, axis_u, axis_v, normal;   /* polygon: P = origin + u*axis_u + v*axis_v */
+} geom_surface;
+
+/* Float evaluation at one (u,v). */
+typedef struct geom_sample {
+    vec3 P, dPdu, dPdv, Ng;
+    vec3 dNgdu, dNgdv;     /* filled by geom_eval_dual only */
+} geom_sample;
+
+/* Checks the parameters (finite numbers, radius > 0, zmin < zmax,
+ * thetamax != 0, polygon convex and planar with >= 3 distinct vertices,
+ * ...), fills the derived fields. On failure returns false and writes a
+ * one-line reason ("sphere radius must be > 0, got -1") into why. */
+bool geom_surface_prepare(geom_surface *s, char *why, int why_size);
+
+const char *geom_kind_name(geom_kind kind);    /* "sphere", "disk", ... */
+
+void geom_eval(const geom_surface *s, double u, double v, geom_sample *out);
+void geom_eval_dual(const geom_surface *s, double u, double v, geom_sample *out);
+
+/* Enclosures over the box [u0,u1] x [v0,v1]. */
+typedef struct geom_ia { ia_interval P[3], dPdu[3], dPdv[3], Ng[3]; } geom_ia;
+void geom_eval_ia(const geom_surface *s, ia_interval u, ia_interval v, geom_ia *out);
+
+/* u and v are affine forms the caller made with aa_input (so they own the
+ * query's first two noise symbols); results share them. */
+typedef struct geom_aa { aa_form P[3], dPdu[3], dPdv[3], Ng[3]; } geom_aa;
+void geom_eval_aa(aa_context *ctx, const geom_surface *s, const aa_form *u,
+                  const aa_form *v, geom_aa *out);
+
+/* Polygons only cover part of their (u,v) rectangle. For the other kinds
+ * these say "inside" everywhere. */
+typedef enum geom_cover { GEOM_OUTSIDE, GEOM_PARTIAL, GEOM_INSIDE } geom_cover;
+bool geom_uv_inside(const geom_surface *s, double u, double v);
+geom_cover geom_uv_box_cover(const geom_surface *s, double u0, double u1,
+                             double v0, double v1);
+
+/* Object-space bounds of the undisplaced surface (conservative). */
+void geom_bounds(const geom_surface *s, vec3 *lo, vec3 *hi);
+
+/* Exact intersection of the undisplaced surface with the ray o + t d
+ * (object space), nearest t in (tmin, tmax). Fills t, u, v. Partial sweeps
+ * (thetamax, zmin/zmax, phimin/phimax) are honoured. */
+typedef struct geom_hit { double t, u, v; } geom_hit;
+bool geom_intersect(const geom_surface *s, vec3 o, vec3 d, double tmin,
+                    double tmax, geom_hit *hit);
+
+#endif

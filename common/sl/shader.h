@@ -1,0 +1,182 @@
+/*
+ * shader.h: the public face of the shading language, what the renderer
+ * (common/trace) and the tools (aafarm-slc, the worker) use:
+ *
+ *   sl_program   a compiled shader: one bytecode for all four modes
+ *   sl_instance  a program plus the parameter values of one RIB
+ *                Surface/Displacement call (uniform values)
+ *   sl_vm        per-thread execution state: globals, spaces, lights,
+ *                limits; runs an instance in one of four arithmetics
+ *
+ * Modes (Heidrich & Seidel 1998 §4, §4.1):
+ *   SL_MODE_FLOAT     plain doubles (surface shading)
+ *   SL_MODE_DUAL      value + d/du + d/dv per scalar (automatic
+ *                     differentiation): Du, Dv, Deriv, calculatenormal
+ *   SL_MODE_INTERVAL  ia_interval per scalar (conservative, --arith interval)
+ *   SL_MODE_AFFINE    aa_form per scalar over the caller's aa_context
+ *                     (conservative, correlations kept)
+ *
+ * In FLOAT mode derivatives are 0 and calculatenormal(P) returns the
+ * current N. In INTERVAL/AFFINE modes Du/Dv/Deriv/calculatenormal/area give
+ * unbounded results (flag AA_UNBOUNDED): the box cache only needs P.
+ * In INTERVAL/AFFINE modes a comparison whose operands overlap runs both
+ * branches and merges the results (flag AA_DISCONTINUOUS); see
+ * docs/shading-language.md "Evaluation".
+ *
+ * "current" space is camera space (RenderMan's convention): the renderer
+ * sets P, N, I, E, ... in camera space and supplies the matrices of the
+ * named spaces (sl_spaces).
+ */
+#ifndef SL_SHADER_H
+#define SL_SHADER_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdio.h>
+
+#include "aa/affine.h"
+#include "aa/interval.h"
+#include "sl/diag.h"
+#include "sl/source.h"
+#include "util/vecmath.h"
+
+typedef enum sl_shader_kind {
+    SL_SHADER_SURFACE,
+    SL_SHADER_DISPLACEMENT,
+} sl_shader_kind;
+
+typedef enum sl_type {
+    SL_TYPE_VOID, SL_TYPE_FLOAT, SL_TYPE_POINT, SL_TYPE_VECTOR, SL_TYPE_NORMAL,
+    SL_TYPE_COLOR, SL_TYPE_STRING, SL_TYPE_MATRIX,
+} sl_type;
+
+typedef enum sl_mode {
+    SL_MODE_FLOAT, SL_MODE_DUAL, SL_MODE_INTERVAL, SL_MODE_AFFINE,
+} sl_mode;
+
+/* The renderer-supplied global variables (RenderMan names). Scalars take
+ * one value, point/vector/normal/color globals three. */
+typedef enum sl_global {
+    SL_G_P, SL_G_N, SL_G_Ng, SL_G_I, SL_G_E,
+    SL_G_s, SL_G_t, SL_G_u, SL_G_v, SL_G_du, SL_G_dv,
+    SL_G_dPdu, SL_G_dPdv, SL_G_Cs, SL_G_Os, SL_G_Ci, SL_G_Oi,
+    SL_G_L, SL_G_Cl, SL_G_time,
+    SL_G__COUNT
+} sl_global;
+
+/* ---- compiling ---------------------------------------------------------- */
+
+typedef struct sl_program sl_program;
+
+/* Compiles main_file (a name in `set`, or one its loader finds) with
+ * #include search path `search_path` (NULL-terminated, may be NULL).
+ * Returns NULL when there were errors; every error is in `diag` with its
+ * file:line:col. Warnings may be reported on success too. */
+sl_program *sl_compile(sl_source_set *set, const char *main_file,
+                       const char *const *search_path, sl_diag *diag);
+void sl_program_destroy(sl_program **self_p);
+
+const char *sl_program_name(const sl_program *self);      /* "wave" */
+sl_shader_kind sl_program_kind(const sl_program *self);
+/* Bytecode listing for aafarm-slc --dump. */
+void sl_program_dump(const sl_program *self, FILE *out);
+
+typedef struct sl_param_info {
+    const char *name;
+    sl_type type;
+    bool output;
+} sl_param_info;
+int sl_program_param_count(const sl_program *self);
+void sl_program_param(const sl_program *self, int index, sl_param_info *info);
+int sl_program_find_param(const sl_program *self, const char *name); /* -1 */
+
+/* ---- instances: parameter values --------------------------------------- */
+
+typedef struct sl_instance sl_instance;
+
+sl_instance *sl_instance_new(const sl_program *program);  /* defaults */
+void sl_instance_destroy(sl_instance **self_p);
+const sl_program *sl_instance_program(const sl_instance *self);
+
+/* Sets parameter `name` from RIB values: `type` is what the RIB declared
+ * (float: 1 value, point/vector/normal/color: 3, matrix: 16, string: use
+ * sl_instance_set_string). On a mismatch (unknown name, wrong type or
+ * count) returns false with a one-line reason in why. */
+bool sl_instance_set(sl_instance *self, const char *name, sl_type type,
+                     const double *values, int count, char *why, int why_size);
+bool sl_instance_set_string(sl_instance *self, const char *name,
+                            const char *value, char *why, int why_size);
+
+/* ---- the virtual machine ------------------------------------------------ */
+
+typedef struct sl_limits {
+    long max_instructions;     /* per run (default 1,000,000) */
+    int max_loop_iterations;   /* per loop in interval/affine mode (default 64) */
+} sl_limits;
+
+enum { SL_SPACE_CURRENT, SL_SPACE_WORLD, SL_SPACE_OBJECT, SL_SPACE_SHADER,
+       SL_SPACE_CAMERA, SL_SPACE__COUNT };
+
+/* For each named space, the matrix from that space to "current" and back
+ * (util/vecmath.h conventions). transform("object", P) applies
+ * from_current[SL_SPACE_OBJECT]. */
+typedef struct sl_spaces {
+    mat4 to_current[SL_SPACE__COUNT];
+    mat4 from_current[SL_SPACE__COUNT];
+} sl_spaces;
+
+/* Lights, for ambient/diffuse/specular/phong in surface shaders (float
+ * mode). The callback fills up to `max` samples for surface point P
+ * (current space) and returns how many: L points from P towards the light
+ * (unnormalised), Cl is the light's colour arriving at P with shadows
+ * already applied; ambient lights set `ambient` (L ignored). */
+typedef struct sl_light_sample {
+    double L[3];
+    double Cl[3];
+    bool ambient;
+} sl_light_sample;
+typedef int (*sl_light_fn)(void *user, const double P[3], sl_light_sample *out, int max);
+
+typedef struct sl_dual { double v, du, dv; } sl_dual;
+
+typedef enum sl_status {
+    SL_OK = 0,
+    SL_ERR_BUDGET,       /* instruction budget exhausted */
+    SL_ERR_LOOP_CAP,     /* interval/affine loop hit its iteration cap */
+    SL_ERR_RUNTIME,      /* anything else the VM refuses */
+} sl_status;
+
+typedef struct sl_vm sl_vm;
+
+sl_vm *sl_vm_new(const sl_limits *limits);    /* NULL: defaults */
+void sl_vm_destroy(sl_vm **self_p);
+
+void sl_vm_set_spaces(sl_vm *self, const sl_spaces *spaces);
+void sl_vm_set_lights(sl_vm *self, sl_light_fn fn, void *user);
+
+/* Globals, before a run, in the arithmetic of the coming run. Globals not
+ * set since the last sl_vm_clear_globals are 0 (point values). */
+void sl_vm_clear_globals(sl_vm *self);
+void sl_vm_set_float(sl_vm *self, sl_global g, const double *values);
+void sl_vm_set_dual(sl_vm *self, sl_global g, const sl_dual *values);
+void sl_vm_set_interval(sl_vm *self, sl_global g, const ia_interval *values);
+void sl_vm_set_affine(sl_vm *self, sl_global g, const aa_form *values);
+
+/* Runs the instance. `ctx` is used (and required) in affine mode only. */
+sl_status sl_vm_run(sl_vm *self, const sl_instance *inst, sl_mode mode,
+                    aa_context *ctx);
+/* After a failed run: "shader 'wave': instruction budget of 1000000
+ * exceeded" and the like. */
+const char *sl_vm_error(const sl_vm *self);
+
+/* Globals after a run (P and N of a displacement shader, Ci and Oi of a
+ * surface shader), in the arithmetic of the run. */
+void sl_vm_get_float(const sl_vm *self, sl_global g, double *values);
+void sl_vm_get_dual(const sl_vm *self, sl_global g, sl_dual *values);
+void sl_vm_get_interval(const sl_vm *self, sl_global g, ia_interval *values);
+void sl_vm_get_affine(const sl_vm *self, sl_global g, aa_form *values);
+
+/* Instructions executed by the last run (statistics). */
+long sl_vm_instructions(const sl_vm *self);
+
+#endif
