@@ -1,0 +1,248 @@
+/*
+ * job.c: building, checking and hashing render jobs (see job.h).
+ */
+#include "job/job.h"
+
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "job/job_scene.h"
+#include "scene/scene.h"
+
+static char *dup_n(const char *s, size_t n)
+{
+    char *p = malloc(n + 1);
+    if (!p) abort();
+    memcpy(p, s, n);
+    p[n] = '\0';
+    return p;
+}
+
+static char *dup_s(const char *s) { return dup_n(s, strlen(s)); }
+
+void job_options_default(job_options *opt)
+{
+    opt->arith = TRACE_ARITH_AFFINE;
+    opt->tile_size = 32;
+    opt->max_instructions = 1000000;
+}
+
+const char *trace_arith_name(trace_arith arith)
+{
+    return arith == TRACE_ARITH_INTERVAL ? "interval" : "affine";
+}
+
+bool trace_arith_parse(const char *text, trace_arith *out)
+{
+    if (strcmp(text, "affine") == 0) { *out = TRACE_ARITH_AFFINE; return true; }
+    if (strcmp(text, "interval") == 0) { *out = TRACE_ARITH_INTERVAL; return true; }
+    return false;
+}
+
+job *job_new(const char *scene_file, const char *scene_text, size_t scene_len,
+             const job_options *options)
+{
+    job *self = calloc(1, sizeof *self);
+    if (!self) abort();
+    self->scene_file = dup_s(scene_file);
+    self->scene_text = dup_n(scene_text, scene_len);
+    self->scene_len = scene_len;
+    self->sources = sl_source_set_new();
+    if (options) self->options = *options;
+    else job_options_default(&self->options);
+    return self;
+}
+
+void job_destroy(job **self_p)
+{
+    job *self = *self_p;
+    if (!self) return;
+    free(self->scene_file);
+    free(self->scene_text);
+    sl_source_set_destroy(&self->sources);
+    for (int i = 0; i < self->nshaders; i++) {
+        free(self->shaders[i].name);
+        free(self->shaders[i].file);
+    }
+    free(self->shaders);
+    free(self);
+    *self_p = NULL;
+}
+
+bool job_add_source(job *self, const char *name, const char *text, size_t len,
+                    char *why, int why_size)
+{
+    if (sl_source_set_add(self->sources, name, text, len) == 0) return true;
+    if (errno == EFBIG)
+        snprintf(why, (size_t)why_size, "shader source '%s' is larger than %zu bytes",
+                 name, sl_source_set_max_size(self->sources));
+    else if (errno == EEXIST)
+        snprintf(why, (size_t)why_size, "two different shader sources named '%s'", name);
+    else
+        snprintf(why, (size_t)why_size, "invalid shader source name '%s'", name);
+    return false;
+}
+
+const char *job_shader_file(const job *self, const char *name)
+{
+    for (int i = 0; i < self->nshaders; i++)
+        if (strcmp(self->shaders[i].name, name) == 0) return self->shaders[i].file;
+    return NULL;
+}
+
+bool job_add_shader(job *self, const char *name, const char *file,
+                    char *why, int why_size)
+{
+    if (!*name || !*file) {
+        snprintf(why, (size_t)why_size, "a shader entry with an empty name or file");
+        return false;
+    }
+    if (job_shader_file(self, name)) {
+        snprintf(why, (size_t)why_size, "shader '%s' listed twice", name);
+        return false;
+    }
+    self->shaders = realloc(self->shaders, sizeof(job_shader) * (size_t)(self->nshaders + 1));
+    if (!self->shaders) abort();
+    self->shaders[self->nshaders].name = dup_s(name);
+    self->shaders[self->nshaders].file = dup_s(file);
+    self->nshaders++;
+    return true;
+}
+
+bool job_finish(job *self, char *why, int why_size)
+{
+    for (int i = 0; i < self->nshaders; i++)
+        if (!sl_source_set_find(self->sources, self->shaders[i].file)) {
+            snprintf(why, (size_t)why_size, "shader '%s': its source '%s' is missing from the job",
+                     self->shaders[i].name, self->shaders[i].file);
+            return false;
+        }
+    size_t nsrc = sl_source_set_count(self->sources);
+    hash_shader *hs = calloc(nsrc + 1, sizeof *hs);
+    int nopt = 3 + self->nshaders;
+    hash_option *ho = calloc((size_t)nopt, sizeof *ho);
+    char (*keys)[160] = calloc((size_t)nopt, sizeof *keys);
+    char (*vals)[600] = calloc((size_t)nopt, sizeof *vals);
+    if (!hs || !ho || !keys || !vals) abort();
+    for (size_t i = 0; i < nsrc; i++) {
+        const sl_source *s = sl_source_set_at(self->sources, i);
+        hs[i] = (hash_shader){s->name, s->text, s->len};
+    }
+    snprintf(keys[0], sizeof keys[0], "arith");
+    snprintf(vals[0], sizeof vals[0], "%s", trace_arith_name(self->options.arith));
+    snprintf(keys[1], sizeof keys[1], "tile_size");
+    snprintf(vals[1], sizeof vals[1], "%d", self->options.tile_size);
+    snprintf(keys[2], sizeof keys[2], "max_instructions");
+    snprintf(vals[2], sizeof vals[2], "%ld", self->options.max_instructions);
+    for (int i = 0; i < self->nshaders; i++) {
+        snprintf(keys[3 + i], sizeof keys[0], "shader:%s", self->shaders[i].name);
+        snprintf(vals[3 + i], sizeof vals[0], "%s", self->shaders[i].file);
+    }
+    for (int i = 0; i < nopt; i++) ho[i] = (hash_option){keys[i], vals[i]};
+    hash_job_input in = {self->scene_file, self->scene_text, self->scene_len,
+                         hs, nsrc, ho, (size_t)nopt};
+    int rc = hash_job(&in, self->hash);
+    free(hs);
+    free(ho);
+    free(keys);
+    free(vals);
+    if (rc != 0) {
+        snprintf(why, (size_t)why_size, "the job cannot be hashed (duplicate names)");
+        return false;
+    }
+    return true;
+}
+
+static char *read_file(const char *path, size_t *len, sl_diag *diag)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f) {
+        sl_diag_error(diag, (sl_pos){0}, "cannot open scene '%s': %s", path, strerror(errno));
+        return NULL;
+    }
+    size_t cap = 1 << 16, n = 0;
+    char *buf = malloc(cap);
+    if (!buf) abort();
+    size_t got;
+    while ((got = fread(buf + n, 1, cap - n, f)) > 0) {
+        n += got;
+        if (n == cap) {
+            if (cap >= (size_t)64 << 20) {
+                sl_diag_error(diag, (sl_pos){0}, "scene '%s' is larger than 64 MiB", path);
+                free(buf);
+                fclose(f);
+                return NULL;
+            }
+            cap *= 2;
+            buf = realloc(buf, cap);
+            if (!buf) abort();
+        }
+    }
+    bool bad = ferror(f);
+    fclose(f);
+    if (bad) {
+        sl_diag_error(diag, (sl_pos){0}, "cannot read scene '%s'", path);
+        free(buf);
+        return NULL;
+    }
+    *len = n;
+    return buf;
+}
+
+job *job_load(const char *rib_path, const job_options *options, sl_diag *diag)
+{
+    size_t len = 0;
+    char *text = read_file(rib_path, &len, diag);
+    if (!text) return NULL;
+    scene *sc = scene_parse(rib_path, text, len, diag);
+    if (!sc) {
+        free(text);
+        return NULL;
+    }
+    job *self = job_new(rib_path, text, len, options);
+    free(text);
+    char why[512];
+    bool ok = true;
+    for (int i = 0; i < sc->nshader_names; i++) {
+        const char *name = sc->shader_names[i];
+        char *path = scene_find_shader(sc, name, NULL, NULL);
+        if (!path) {
+            /* point at the first call that names it */
+            sl_pos pos = {0};
+            for (int k = 0; k < sc->nshaders; k++)
+                if (strcmp(sc->shaders[k].name, name) == 0) { pos = sc->shaders[k].pos; break; }
+            char dirs[1024] = "";
+            for (int k = 0; k < sc->nsearch_path; k++) {
+                if (k) strncat(dirs, ", ", sizeof dirs - strlen(dirs) - 1);
+                strncat(dirs, sc->search_path[k], sizeof dirs - strlen(dirs) - 1);
+            }
+            sl_diag_error(diag, pos, "shader '%s' not found: looked for '%s.sl' in %s; "
+                          "add its folder with Option \"searchpath\" \"shader\" [\"dir:&\"]",
+                          name, name, dirs);
+            ok = false;
+            continue;
+        }
+        if (sl_source_set_load_file(self->sources, path, path, diag) != 0 ||
+            !job_add_shader(self, name, path, why, sizeof why)) {
+            ok = false;
+        }
+        free(path);
+    }
+    scene_destroy(&sc);
+    if (ok) {
+        /* compiling pulls the #included files into the set, from disk */
+        sl_source_set_set_loader(self->sources, sl_source_load_from_disk, NULL);
+        job_scene *js = job_scene_new(self, 0, false, diag);
+        sl_source_set_set_loader(self->sources, NULL, NULL);
+        ok = js != NULL;
+        job_scene_destroy(&js);
+    }
+    if (ok && !job_finish(self, why, sizeof why)) {
+        sl_diag_error(diag, (sl_pos){0}, "%s", why);
+        ok = false;
+    }
+    if (!ok) job_destroy(&self);
+    return self;
+}

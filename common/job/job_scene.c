@@ -1,0 +1,224 @@
+/*
+ * job_scene.c: from a job to a renderable world (see job_scene.h): parse
+ * the RIB, compile each shader once, make one instance per shader call
+ * with the RIB's parameter values, and translate the scene model (RIB
+ * terms) into the renderer's camera-space world (trace/world.h).
+ */
+#include "job/job_scene.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static void spaces_for(const scene *sc, const scene_object *o, const scene_shader *sh,
+                       sl_spaces *sp)
+{
+    mat4 id = mat4_identity();
+    for (int i = 0; i < SL_SPACE__COUNT; i++) sp->to_current[i] = sp->from_current[i] = id;
+    sp->to_current[SL_SPACE_WORLD] = sc->camera.camera_from_world;
+    sp->from_current[SL_SPACE_WORLD] = sc->camera.world_from_camera;
+    sp->to_current[SL_SPACE_OBJECT] = o->object_to_camera;
+    sp->from_current[SL_SPACE_OBJECT] = o->camera_to_object;
+    if (sh) {
+        sp->to_current[SL_SPACE_SHADER] = sh->shader_to_camera;
+        mat4_invert(&sh->shader_to_camera, &sp->from_current[SL_SPACE_SHADER]);
+    } else {
+        sp->to_current[SL_SPACE_SHADER] = o->object_to_camera;
+        sp->from_current[SL_SPACE_SHADER] = o->camera_to_object;
+    }
+}
+
+static void build_camera(const scene *sc, trace_world *w)
+{
+    const scene_camera *c = &sc->camera;
+    trace_camera *t = &w->camera;
+    t->xres = c->xres;
+    t->yres = c->yres;
+    t->orthographic = c->projection == SCENE_ORTHOGRAPHIC;
+    memcpy(t->screen, c->screen, sizeof t->screen);
+    t->tan_half_fov = tan(c->fov * (M_PI / 360.0));
+    t->near_clip = c->near_clip;
+    t->far_clip = c->far_clip;
+    t->camera_from_world = c->camera_from_world;
+    t->world_from_camera = c->world_from_camera;
+}
+
+static void build_lights(const scene *sc, trace_world *w)
+{
+    w->nlights = sc->nlights;
+    w->lights = calloc((size_t)(sc->nlights > 0 ? sc->nlights : 1), sizeof *w->lights);
+    if (!w->lights) abort();
+    for (int i = 0; i < sc->nlights; i++) {
+        const scene_light *l = &sc->lights[i];
+        trace_light *t = &w->lights[i];
+        static const trace_light_kind kinds[] = {
+            [SCENE_AMBIENT_LIGHT] = TRACE_LIGHT_AMBIENT, [SCENE_DISTANT_LIGHT] = TRACE_LIGHT_DISTANT,
+            [SCENE_POINT_LIGHT] = TRACE_LIGHT_POINT, [SCENE_SPOT_LIGHT] = TRACE_LIGHT_SPOT};
+        t->kind = kinds[l->kind];
+        for (int k = 0; k < 3; k++) t->color[k] = l->intensity * l->lightcolor[k];
+        t->from = l->from_camera;
+        t->dir = v3_normalize(v3_sub(l->to_camera, l->from_camera));
+        t->cos_outside = cos(l->coneangle);
+        t->cos_inside = cos(l->coneangle - l->conedeltaangle);
+        t->beamdistribution = l->beamdistribution;
+        t->shadows = l->shadows;
+    }
+}
+
+static trace_filter_kind filter_kind(scene_filter_kind k)
+{
+    switch (k) {
+    case SCENE_FILTER_BOX: return TRACE_FILTER_BOX;
+    case SCENE_FILTER_TRIANGLE: return TRACE_FILTER_TRIANGLE;
+    case SCENE_FILTER_CATMULL_ROM: return TRACE_FILTER_CATMULL_ROM;
+    case SCENE_FILTER_SINC: return TRACE_FILTER_SINC;
+    case SCENE_FILTER_GAUSSIAN:
+    default: return TRACE_FILTER_GAUSSIAN;
+    }
+}
+
+static int program_index(const job *jb, const char *name)
+{
+    for (int i = 0; i < jb->nshaders; i++)
+        if (strcmp(jb->shaders[i].name, name) == 0) return i;
+    return -1;
+}
+
+static bool compile_programs(job_scene *self, sl_diag *diag)
+{
+    const job *jb = self->job;
+    bool ok = true;
+    self->programs = calloc((size_t)(jb->nshaders > 0 ? jb->nshaders : 1), sizeof *self->programs);
+    if (!self->programs) abort();
+    for (int i = 0; i < jb->nshaders; i++) {
+        const char *search[] = {NULL};
+        self->programs[i] = sl_compile(jb->sources, jb->shaders[i].file, search, diag);
+        if (!self->programs[i]) ok = false;
+    }
+    return ok;
+}
+
+static sl_instance *make_instance(job_scene *self, const scene_shader *call, sl_diag *diag)
+{
+    int p = program_index(self->job, call->name);
+    if (p < 0) {
+        sl_diag_error(diag, call->pos, "shader '%s' is not part of the job", call->name);
+        return NULL;
+    }
+    const sl_program *prog = self->programs[p];
+    if (sl_program_kind(prog) != call->kind) {
+        sl_diag_error(diag, call->pos, "'%s' is a %s shader, used here as a %s shader",
+                      call->name,
+                      sl_program_kind(prog) == SL_SHADER_SURFACE ? "surface" : "displacement",
+                      call->kind == SL_SHADER_SURFACE ? "surface" : "displacement");
+        return NULL;
+    }
+    sl_instance *inst = sl_instance_new(prog);
+    for (int k = 0; k < call->nparams; k++) {
+        const scene_param *pa = &call->params[k];
+        char why[256];
+        bool ok = pa->type == SL_TYPE_STRING
+                      ? sl_instance_set_string(inst, pa->name, pa->string, why, sizeof why)
+                      : sl_instance_set(inst, pa->name, pa->type, pa->values, pa->count,
+                                        why, sizeof why);
+        if (!ok) sl_diag_warning(diag, pa->pos, "shader '%s': %s (parameter ignored)", call->name, why);
+    }
+    return inst;
+}
+
+static bool build_objects(job_scene *self, sl_diag *diag)
+{
+    const scene *sc = self->scene;
+    trace_world *w = &self->world;
+    bool ok = true;
+    self->instances = calloc((size_t)(sc->nshaders > 0 ? sc->nshaders : 1), sizeof *self->instances);
+    if (!self->instances) abort();
+    for (int i = 0; i < sc->nshaders; i++) {
+        self->instances[i] = make_instance(self, &sc->shaders[i], diag);
+        if (!self->instances[i]) ok = false;
+    }
+    if (!ok) return false;
+    w->nobjects = sc->nobjects;
+    w->objects = calloc((size_t)(sc->nobjects > 0 ? sc->nobjects : 1), sizeof *w->objects);
+    if (!w->objects) abort();
+    for (int i = 0; i < sc->nobjects; i++) {
+        const scene_object *o = &sc->objects[i];
+        trace_object *t = &w->objects[i];
+        t->id = i;
+        snprintf(t->name, sizeof t->name, "%s at %s:%d", o->name ? o->name : geom_kind_name(o->surface.kind),
+                 o->pos.file ? o->pos.file : sc->file, o->pos.line);
+        t->surf = o->surface;
+        t->to_camera = o->object_to_camera;
+        t->from_camera = o->camera_to_object;
+        const scene_shader *ds = scene_object_displacement(sc, o);
+        const scene_shader *ss = scene_object_surface(sc, o);
+        spaces_for(sc, o, ds, &t->displacement_spaces);
+        spaces_for(sc, o, ss, &t->surface_spaces);
+        t->displacement = o->displacement_shader >= 0 ? self->instances[o->displacement_shader] : NULL;
+        t->surface = o->surface_shader >= 0 ? self->instances[o->surface_shader] : NULL;
+        memcpy(t->Cs, o->Cs, sizeof t->Cs);
+        memcpy(t->Os, o->Os, sizeof t->Os);
+        t->sides = o->sides;
+        t->flip = o->reverse_normals;
+    }
+    return true;
+}
+
+job_scene *job_scene_new(const job *jb, size_t cache_bytes, bool render, sl_diag *diag)
+{
+    job_scene *self = calloc(1, sizeof *self);
+    if (!self) abort();
+    self->job = jb;
+    self->scene = scene_parse(jb->scene_file, jb->scene_text, jb->scene_len, diag);
+    bool ok = self->scene != NULL;
+    if (ok) ok = compile_programs(self, diag);
+    if (ok) ok = build_objects(self, diag);
+    if (ok) {
+        const scene *sc = self->scene;
+        trace_world *w = &self->world;
+        build_camera(sc, w);
+        build_lights(sc, w);
+        w->samples_x = sc->pixel_samples[0];
+        w->samples_y = sc->pixel_samples[1];
+        w->shading_rate = sc->shading_rate;
+        w->filter = filter_kind(sc->filter.kind);
+        w->filter_width[0] = sc->filter.xwidth;
+        w->filter_width[1] = sc->filter.ywidth;
+        w->gain = sc->exposure_gain;
+        w->gamma = sc->exposure_gamma;
+        trace_options_default(&w->options);
+        w->options.arith = jb->options.arith;
+        w->options.max_instructions = jb->options.max_instructions;
+        w->options.cache_bytes = cache_bytes;
+    }
+    if (ok && render) {
+        char err[512];
+        self->renderer = trace_renderer_new(&self->world, err, sizeof err);
+        if (!self->renderer) {
+            sl_diag_error(diag, (sl_pos){0}, "%s", err);
+            ok = false;
+        }
+    }
+    if (!ok) job_scene_destroy(&self);
+    return self;
+}
+
+void job_scene_destroy(job_scene **self_p)
+{
+    job_scene *self = *self_p;
+    if (!self) return;
+    trace_renderer_destroy(&self->renderer);
+    if (self->instances)
+        for (int i = 0; i < (self->scene ? self->scene->nshaders : 0); i++)
+            sl_instance_destroy(&self->instances[i]);
+    free(self->instances);
+    if (self->programs)
+        for (int i = 0; i < self->job->nshaders; i++) sl_program_destroy(&self->programs[i]);
+    free(self->programs);
+    free(self->world.objects);
+    free(self->world.lights);
+    scene_destroy(&self->scene);
+    free(self);
+    *self_p = NULL;
+}

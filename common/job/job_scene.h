@@ -1,0 +1,33 @@
+/*
+ * job_scene.h: a job made ready to render: the parsed scene, its compiled
+ * shader programs and instances (one per Surface / Displacement call, with
+ * the RIB's parameter values), the renderer's camera-space world built
+ * from them, and the prepared renderer (root boxes, BVH).
+ *
+ * A worker builds one per job and keeps it across tiles; the master builds
+ * one without the renderer, only to check the job before sending it.
+ */
+#ifndef JOB_JOB_SCENE_H
+#define JOB_JOB_SCENE_H
+
+#include "job/job.h"
+#include "scene/scene.h"
+#include "trace/render.h"
+
+typedef struct job_scene {
+    const job *job;
+    scene *scene;
+    sl_program **programs;         /* per job shader (job->shaders order) */
+    sl_instance **instances;       /* per scene shader call (scene->shaders) */
+    trace_world world;
+    trace_renderer *renderer;      /* NULL when built with render = false */
+} job_scene;
+
+/* cache_bytes: this worker's box cache budget per thread (0: unlimited).
+ * render: also prepare the renderer (root boxes and BVH). NULL on errors
+ * (in diag). The job must outlive the job_scene. */
+job_scene *job_scene_new(const job *job, size_t cache_bytes, bool render,
+                         sl_diag *diag);
+void job_scene_destroy(job_scene **self_p);
+
+#endif

@@ -1,0 +1,97 @@
+/*
+ * box.h: axis-aligned boxes in camera space and the ray/box slab test.
+ *
+ * A trace_box is what the bounding arithmetic (affine or interval) gives for
+ * the displaced surface over one (u,v) range (Heidrich & Seidel §3): the
+ * ranges of x, y, z. It also carries the flags of those ranges
+ * (AA_DISCONTINUOUS, AA_UNBOUNDED, aa/interval.h), which the subdivision
+ * uses for the §5 termination rule.
+ *
+ * The slab test is conservative under rounding: the far distance is widened
+ * by 2*gamma(3) as in pbrt (Pharr, Jakob, Humphreys, "Physically Based
+ * Rendering" 3rd ed., §3.9.2), so a ray that truly meets the box is never
+ * reported as a miss. Boxes themselves are conservative (common/aa), so
+ * together no hit is lost to floating point.
+ */
+#ifndef TRACE_BOX_H
+#define TRACE_BOX_H
+
+#include <float.h>
+#include <math.h>
+#include <stdbool.h>
+
+#include "util/vecmath.h"
+
+typedef struct trace_box {
+    vec3 lo, hi;
+    unsigned flags;          /* AA_DISCONTINUOUS | AA_UNBOUNDED */
+} trace_box;
+
+typedef struct trace_ray {
+    vec3 o, d;               /* origin, direction (not necessarily unit) */
+    vec3 invd;               /* 1 / d per component */
+    double tmin, tmax;
+} trace_ray;
+
+static inline void trace_ray_init(trace_ray *r, vec3 o, vec3 d, double tmin, double tmax)
+{
+    r->o = o;
+    r->d = d;
+    r->invd = v3(1.0 / d.x, 1.0 / d.y, 1.0 / d.z);
+    r->tmin = tmin;
+    r->tmax = tmax;
+}
+
+static inline vec3 trace_ray_at(const trace_ray *r, double t)
+{
+    return v3(r->o.x + r->d.x * t, r->o.y + r->d.y * t, r->o.z + r->d.z * t);
+}
+
+/* Largest side of the box (the size the termination rules compare). */
+static inline double trace_box_extent(const trace_box *b)
+{
+    double e = b->hi.x - b->lo.x;
+    if (b->hi.y - b->lo.y > e) e = b->hi.y - b->lo.y;
+    if (b->hi.z - b->lo.z > e) e = b->hi.z - b->lo.z;
+    return e;
+}
+
+static inline bool trace_box_is_empty(const trace_box *b)
+{
+    return !(b->lo.x <= b->hi.x && b->lo.y <= b->hi.y && b->lo.z <= b->hi.z);
+}
+
+static inline void trace_box_union(trace_box *a, const trace_box *b)
+{
+    a->lo = v3(fmin(a->lo.x, b->lo.x), fmin(a->lo.y, b->lo.y), fmin(a->lo.z, b->lo.z));
+    a->hi = v3(fmax(a->hi.x, b->hi.x), fmax(a->hi.y, b->hi.y), fmax(a->hi.z, b->hi.z));
+    a->flags |= b->flags;
+}
+
+/* Slab test: the parameter interval [*t0, *t1] where the ray is inside the
+ * box, clipped to [tmin, tmax]; false when empty. Axis of entry in *axis
+ * (0..2, or -1 when the ray starts inside). Unbounded boxes always hit. */
+static inline bool trace_box_hit(const trace_box *b, const trace_ray *r,
+                                 double tmin, double tmax,
+                                 double *t0, double *t1, int *axis)
+{
+    const double widen = 1.0 + 6.0 * (DBL_EPSILON * 0.5) / (1.0 - 3.0 * DBL_EPSILON * 0.5);
+    double lo = tmin, hi = tmax;
+    int ax = -1;
+    const double *blo = &b->lo.x, *bhi = &b->hi.x, *o = &r->o.x, *inv = &r->invd.x;
+    for (int i = 0; i < 3; i++) {
+        double tn = (blo[i] - o[i]) * inv[i];
+        double tf = (bhi[i] - o[i]) * inv[i];
+        if (tn > tf) { double s = tn; tn = tf; tf = s; }
+        tf *= widen;
+        if (tn > lo) { lo = tn; ax = i; }   /* NaN (0 * inf) compares false */
+        if (tf < hi) hi = tf;
+        if (lo > hi) return false;
+    }
+    *t0 = lo;
+    *t1 = hi;
+    if (axis) *axis = ax;
+    return true;
+}
+
+#endif

@@ -1,0 +1,265 @@
+/*
+ * displace.c: boxes and points of displaced surfaces (see displace.h).
+ *
+ * Box of a (u,v) range, Heidrich & Seidel §3: u and v become the query's
+ * first two noise symbols, the base surface is evaluated in affine form
+ * (geom_eval_aa), moved to camera space (an affine map: exact up to the
+ * rounding the aa library accounts for), handed to the displacement shader
+ * as the globals P, N, Ng, dPdu, dPdv, u, v, s, t, I, and the shader's P
+ * afterwards gives x, y, z ranges. The interval mode does the same with
+ * ia_interval (the comparison of §7.1).
+ */
+#include "trace/displace.h"
+
+#include <stdio.h>
+#include <string.h>
+
+/* ---- affine ---- */
+
+static void aa_xform(aa_context *ctx, const mat4 *m, const aa_form in[3],
+                     aa_form out[3], bool point)
+{
+    aa_form t;
+    for (int i = 0; i < 3; i++) {
+        aa_lincomb(ctx, &t, m->m[i][0], &in[0], m->m[i][1], &in[1],
+                   point ? m->m[i][3] : 0.0);
+        aa_lincomb(ctx, &out[i], 1.0, &t, m->m[i][2], &in[2], 0.0);
+    }
+}
+
+/* normals: the inverse transpose; `inv` is the inverse of the map */
+static void aa_xform_normal(aa_context *ctx, const mat4 *inv, const aa_form in[3],
+                            aa_form out[3])
+{
+    mat4 t = mat4_transpose(*inv);
+    aa_xform(ctx, &t, in, out, false);
+}
+
+static void set_affine3(sl_vm *vm, sl_global g, const aa_form v[3])
+{
+    sl_vm_set_affine(vm, g, v);
+}
+
+static void box_from_affine(const aa_form P[3], trace_box *out)
+{
+    ia_interval r[3];
+    unsigned flags = 0;
+    for (int i = 0; i < 3; i++) {
+        r[i] = aa_range(&P[i]);
+        flags |= P[i].flags | r[i].flags;
+    }
+    out->lo = v3(r[0].lo, r[1].lo, r[2].lo);
+    out->hi = v3(r[0].hi, r[1].hi, r[2].hi);
+    out->flags = flags & (AA_DISCONTINUOUS | AA_UNBOUNDED);
+}
+
+static void shader_failed(trace_thread *th, const char *what)
+{
+    char msg[512];
+    snprintf(msg, sizeof msg, "%s", what);
+    trace_thread_fail(th, msg);
+}
+
+static void box_affine(trace_thread *th, const trace_object *obj,
+                       double u0, double u1, double v0, double v1, trace_box *out)
+{
+    aa_context *ctx = &th->ctx;
+    aa_context_reset(ctx);
+    aa_form u, v;
+    aa_input(ctx, &u, u0, u1);
+    aa_input(ctx, &v, v0, v1);
+    geom_aa g;
+    geom_eval_aa(ctx, &obj->surf, &u, &v, &g);
+    th->stats.evals_affine++;
+
+    if (!obj->displacement) {
+        box_from_affine(g.P, out);
+        return;
+    }
+    aa_form P[3], N[3], dPdu[3], dPdv[3];
+    aa_xform(ctx, &obj->to_camera, g.P, P, true);
+    aa_xform_normal(ctx, &obj->from_camera, g.Ng, N);
+    if (obj->flip)
+        for (int i = 0; i < 3; i++) aa_neg(ctx, &N[i], &N[i]);
+    aa_xform(ctx, &obj->to_camera, g.dPdu, dPdu, false);
+    aa_xform(ctx, &obj->to_camera, g.dPdv, dPdv, false);
+
+    sl_vm *vm = th->vm;
+    sl_vm_clear_globals(vm);
+    sl_vm_set_spaces(vm, &obj->displacement_spaces);
+    set_affine3(vm, SL_G_P, P);
+    set_affine3(vm, SL_G_N, N);
+    set_affine3(vm, SL_G_Ng, N);
+    set_affine3(vm, SL_G_I, P);
+    set_affine3(vm, SL_G_dPdu, dPdu);
+    set_affine3(vm, SL_G_dPdv, dPdv);
+    sl_vm_set_affine(vm, SL_G_u, &u);
+    sl_vm_set_affine(vm, SL_G_v, &v);
+    sl_vm_set_affine(vm, SL_G_s, &u);
+    sl_vm_set_affine(vm, SL_G_t, &v);
+    aa_form du, dv;
+    aa_const(&du, u1 - u0);
+    aa_const(&dv, v1 - v0);
+    sl_vm_set_affine(vm, SL_G_du, &du);
+    sl_vm_set_affine(vm, SL_G_dv, &dv);
+    if (sl_vm_run(vm, obj->displacement, SL_MODE_AFFINE, ctx) != SL_OK) {
+        shader_failed(th, sl_vm_error(vm));
+        aa_unbounded(&P[0], AA_UNBOUNDED);
+        P[1] = P[2] = P[0];
+    } else {
+        aa_form Pc[3];
+        sl_vm_get_affine(vm, SL_G_P, Pc);
+        aa_xform(ctx, &obj->from_camera, Pc, P, true);
+    }
+    box_from_affine(P, out);
+}
+
+/* ---- interval ---- */
+
+static void ia_xform(const mat4 *m, const ia_interval in[3], ia_interval out[3],
+                     bool point)
+{
+    for (int i = 0; i < 3; i++) {
+        ia_interval s = ia_add(ia_mul_s(in[0], m->m[i][0]), ia_mul_s(in[1], m->m[i][1]));
+        s = ia_add(s, ia_mul_s(in[2], m->m[i][2]));
+        out[i] = point ? ia_add_s(s, m->m[i][3]) : s;
+    }
+}
+
+static void box_from_interval(const ia_interval P[3], trace_box *out)
+{
+    out->lo = v3(P[0].lo, P[1].lo, P[2].lo);
+    out->hi = v3(P[0].hi, P[1].hi, P[2].hi);
+    out->flags = (P[0].flags | P[1].flags | P[2].flags) & (AA_DISCONTINUOUS | AA_UNBOUNDED);
+}
+
+static void box_interval(trace_thread *th, const trace_object *obj,
+                         double u0, double u1, double v0, double v1, trace_box *out)
+{
+    ia_interval u = ia_make(u0, u1), v = ia_make(v0, v1);
+    geom_ia g;
+    geom_eval_ia(&obj->surf, u, v, &g);
+    th->stats.evals_interval++;
+    if (!obj->displacement) {
+        box_from_interval(g.P, out);
+        return;
+    }
+    ia_interval P[3], N[3], dPdu[3], dPdv[3];
+    ia_xform(&obj->to_camera, g.P, P, true);
+    mat4 nt = mat4_transpose(obj->from_camera);
+    ia_xform(&nt, g.Ng, N, false);
+    if (obj->flip)
+        for (int i = 0; i < 3; i++) N[i] = ia_neg(N[i]);
+    ia_xform(&obj->to_camera, g.dPdu, dPdu, false);
+    ia_xform(&obj->to_camera, g.dPdv, dPdv, false);
+
+    sl_vm *vm = th->vm;
+    sl_vm_clear_globals(vm);
+    sl_vm_set_spaces(vm, &obj->displacement_spaces);
+    sl_vm_set_interval(vm, SL_G_P, P);
+    sl_vm_set_interval(vm, SL_G_N, N);
+    sl_vm_set_interval(vm, SL_G_Ng, N);
+    sl_vm_set_interval(vm, SL_G_I, P);
+    sl_vm_set_interval(vm, SL_G_dPdu, dPdu);
+    sl_vm_set_interval(vm, SL_G_dPdv, dPdv);
+    sl_vm_set_interval(vm, SL_G_u, &u);
+    sl_vm_set_interval(vm, SL_G_v, &v);
+    sl_vm_set_interval(vm, SL_G_s, &u);
+    sl_vm_set_interval(vm, SL_G_t, &v);
+    ia_interval du = ia_point(u1 - u0), dv = ia_point(v1 - v0);
+    sl_vm_set_interval(vm, SL_G_du, &du);
+    sl_vm_set_interval(vm, SL_G_dv, &dv);
+    if (sl_vm_run(vm, obj->displacement, SL_MODE_INTERVAL, NULL) != SL_OK) {
+        shader_failed(th, sl_vm_error(vm));
+        P[0] = P[1] = P[2] = ia_entire();
+    } else {
+        ia_interval Pc[3];
+        sl_vm_get_interval(vm, SL_G_P, Pc);
+        ia_xform(&obj->from_camera, Pc, P, true);
+    }
+    box_from_interval(P, out);
+}
+
+void trace_surface_box(trace_thread *th, const trace_object *obj,
+                       double u0, double u1, double v0, double v1, trace_box *out)
+{
+    if (th->world->options.arith == TRACE_ARITH_INTERVAL)
+        box_interval(th, obj, u0, u1, v0, v1, out);
+    else
+        box_affine(th, obj, u0, u1, v0, v1, out);
+    th->stats.boxes++;
+    /* a NaN bound means we know nothing: the whole space */
+    if (isnan(out->lo.x) || isnan(out->lo.y) || isnan(out->lo.z) ||
+        isnan(out->hi.x) || isnan(out->hi.y) || isnan(out->hi.z)) {
+        out->lo = v3(-INFINITY, -INFINITY, -INFINITY);
+        out->hi = v3(INFINITY, INFINITY, INFINITY);
+        out->flags |= AA_UNBOUNDED;
+    }
+}
+
+/* ---- points: dual mode ---- */
+
+static void dual3(vec3 v, vec3 du, vec3 dv, sl_dual out[3])
+{
+    out[0] = (sl_dual){v.x, du.x, dv.x};
+    out[1] = (sl_dual){v.y, du.y, dv.y};
+    out[2] = (sl_dual){v.z, du.z, dv.z};
+}
+
+void trace_surface_point_eval(trace_thread *th, const trace_object *obj,
+                              double u, double v, trace_surface_point *out)
+{
+    geom_sample g;
+    if (obj->displacement) geom_eval_dual(&obj->surf, u, v, &g);
+    else geom_eval(&obj->surf, u, v, &g);
+    vec3 P = mat4_xform_point(&obj->to_camera, g.P);
+    vec3 dPdu = mat4_xform_vector(&obj->to_camera, g.dPdu);
+    vec3 dPdv = mat4_xform_vector(&obj->to_camera, g.dPdv);
+    vec3 Ng = mat4_xform_normal(&obj->from_camera, g.Ng);
+    if (obj->flip) Ng = v3_neg(Ng);
+    out->u = u;
+    out->v = v;
+    out->dPdu = dPdu;
+    out->dPdv = dPdv;
+    out->Ng = v3_normalize(Ng);
+    out->P = P;
+    out->N = out->Ng;
+    if (!obj->displacement) return;
+
+    vec3 dNdu = mat4_xform_normal(&obj->from_camera, g.dNgdu);
+    vec3 dNdv = mat4_xform_normal(&obj->from_camera, g.dNgdv);
+    if (obj->flip) { dNdu = v3_neg(dNdu); dNdv = v3_neg(dNdv); }
+    sl_dual dP[3], dN[3], ddPdu[3], ddPdv[3], zero3[3];
+    dual3(P, dPdu, dPdv, dP);
+    dual3(Ng, dNdu, dNdv, dN);
+    dual3(dPdu, v3(0, 0, 0), v3(0, 0, 0), ddPdu);
+    dual3(dPdv, v3(0, 0, 0), v3(0, 0, 0), ddPdv);
+    dual3(v3(0, 0, 0), v3(0, 0, 0), v3(0, 0, 0), zero3);
+    sl_dual du_ = {u, 1, 0}, dv_ = {v, 0, 1};
+    sl_vm *vm = th->vm;
+    sl_vm_clear_globals(vm);
+    sl_vm_set_spaces(vm, &obj->displacement_spaces);
+    sl_vm_set_dual(vm, SL_G_P, dP);
+    sl_vm_set_dual(vm, SL_G_N, dN);
+    sl_vm_set_dual(vm, SL_G_Ng, dN);
+    sl_vm_set_dual(vm, SL_G_I, dP);
+    sl_vm_set_dual(vm, SL_G_E, zero3);
+    sl_vm_set_dual(vm, SL_G_dPdu, ddPdu);
+    sl_vm_set_dual(vm, SL_G_dPdv, ddPdv);
+    sl_vm_set_dual(vm, SL_G_u, &du_);
+    sl_vm_set_dual(vm, SL_G_v, &dv_);
+    sl_vm_set_dual(vm, SL_G_s, &du_);
+    sl_vm_set_dual(vm, SL_G_t, &dv_);
+    th->stats.evals_dual++;
+    if (sl_vm_run(vm, obj->displacement, SL_MODE_DUAL, NULL) != SL_OK) {
+        shader_failed(th, sl_vm_error(vm));
+        return;
+    }
+    sl_dual rP[3], rN[3];
+    sl_vm_get_dual(vm, SL_G_P, rP);
+    sl_vm_get_dual(vm, SL_G_N, rN);
+    out->P = v3(rP[0].v, rP[1].v, rP[2].v);
+    vec3 N = v3(rN[0].v, rN[1].v, rN[2].v);
+    double len = v3_length(N);
+    if (len > 0 && isfinite(len)) out->N = v3_scale(N, 1.0 / len);
+}

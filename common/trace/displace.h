@@ -1,0 +1,41 @@
+/*
+ * displace.h: an object's displaced surface, evaluated through its base
+ * surface (common/geom) and its displacement shader (common/sl) in the
+ * arithmetic a caller needs (Heidrich & Seidel §3):
+ *
+ *   trace_surface_box    conservative OBJECT-space box of the displaced
+ *                        surface over a (u,v) range: affine (default) or
+ *                        interval arithmetic, per trace_options.arith.
+ *                        The shader runs in camera ("current") space; its
+ *                        P is mapped back to object space as affine forms
+ *                        (exact), so boxes of e.g. the nail's vertical walls
+ *                        stay axis-aligned and tight whatever the camera.
+ *   trace_surface_point  the displaced point and its shading normal at one
+ *                        (u,v): dual mode (value + d/du + d/dv), so that
+ *                        calculatenormal(P) in the shader is exact
+ *
+ * Both are pure functions of (object, u, v): the box cache and every
+ * determinism test rely on that.
+ */
+#ifndef TRACE_DISPLACE_H
+#define TRACE_DISPLACE_H
+
+#include "trace/thread.h"
+#include "trace/world.h"
+
+void trace_surface_box(trace_thread *th, const trace_object *obj,
+                       double u0, double u1, double v0, double v1,
+                       trace_box *out);
+
+typedef struct trace_surface_point {
+    vec3 P;              /* displaced, camera space */
+    vec3 N;              /* shading normal (unit), after the displacement shader */
+    vec3 Ng;             /* geometric normal of the base surface (unit) */
+    vec3 dPdu, dPdv;     /* of the base surface, camera space */
+    double u, v;
+} trace_surface_point;
+
+void trace_surface_point_eval(trace_thread *th, const trace_object *obj,
+                              double u, double v, trace_surface_point *out);
+
+#endif

@@ -1,0 +1,198 @@
+/*
+ * intersect.c: the subdivision intersector of Heidrich & Seidel §3, §5, §6
+ * (see intersect.h) and the exact path for undisplaced objects.
+ */
+#include "trace/intersect.h"
+
+#include <math.h>
+
+#include "aa/interval.h"
+
+/* §5: a discontinuous box "stopped shrinking" when a child keeps more than
+ * this fraction of its parent's size (smooth boxes halve, roughly). */
+#define TRACE_NO_SHRINK 0.75
+
+typedef struct walk {
+    trace_thread *th;
+    const trace_object *obj;
+    const trace_ray *cam_ray;      /* camera space */
+    trace_ray ray;                 /* object space */
+    trace_tolerance tol;
+    bool any;
+    bool found;
+    trace_hit *best;
+} walk;
+
+typedef struct child_order { double t0, t1; int i, axis; } child_order;
+
+static void child_range(int i, double u0, double u1, double v0, double v1,
+                        double r[4])
+{
+    double um = 0.5 * (u0 + u1), vm = 0.5 * (v0 + v1);
+    r[0] = (i & 1) ? um : u0;
+    r[1] = (i & 1) ? u1 : um;
+    r[2] = (i & 2) ? vm : v0;
+    r[3] = (i & 2) ? v1 : vm;
+}
+
+static double box_min_extent(const trace_box *b)
+{
+    double e = b->hi.x - b->lo.x;
+    if (b->hi.y - b->lo.y < e) e = b->hi.y - b->lo.y;
+    if (b->hi.z - b->lo.z < e) e = b->hi.z - b->lo.z;
+    return e;
+}
+
+static void leaf_hit(walk *w, const trace_box *box, const double r[4],
+                     double t0, double t1, int axis, trace_leaf_kind kind)
+{
+    const trace_object *obj = w->obj;
+    double uc = 0.5 * (r[0] + r[1]), vc = 0.5 * (r[2] + r[3]);
+    if (!geom_uv_inside(&obj->surf, uc, vc)) return;
+    trace_thread *th = w->th;
+    th->stats.leaves++;
+    double t;
+    vec3 wall_n = v3(0, 0, 0);
+    if (kind == TRACE_LEAF_WALL) {
+        /* the ray meets the wall where it enters its box */
+        th->stats.wall_leaves++;
+        t = t0;
+        if (axis >= 0) {
+            double n[3] = {0, 0, 0};
+            n[axis] = (&w->ray.d.x)[axis] > 0 ? -1.0 : 1.0;
+            wall_n = v3_normalize(mat4_xform_normal(&obj->from_camera, v3(n[0], n[1], n[2])));
+        } else {
+            wall_n = v3_normalize(v3_neg(w->cam_ray->d));
+        }
+    } else {
+        if (kind == TRACE_LEAF_DEPTH) th->stats.depth_cap_leaves++;
+        trace_surface_point sp;
+        trace_surface_point_eval(th, obj, uc, vc, &sp);
+        const trace_ray *cr = w->cam_ray;
+        double dd = v3_dot(cr->d, cr->d);
+        t = dd > 0 ? v3_dot(v3_sub(sp.P, cr->o), cr->d) / dd : t0;
+        if (!(t >= t0)) t = t0;
+        if (t > t1) t = t1;
+    }
+    if (!(t > w->ray.tmin) || !(t < w->best->t)) return;
+    trace_hit *b = w->best;
+    b->t = t;
+    b->obj = obj;
+    b->u = uc;
+    b->v = vc;
+    b->leaf_size = trace_box_extent(box) * obj->scale;
+    b->kind = kind;
+    b->wall_normal = wall_n;
+    w->found = true;
+}
+
+static trace_brood_id children_of(walk *w, trace_brood_id parent, int slot,
+                                  const double r[4], trace_box kids[4])
+{
+    trace_thread *th = w->th;
+    trace_brood_id id = trace_boxcache_lookup(th->cache, w->obj->id, parent, slot, kids);
+    if (id != TRACE_BROOD_NONE) return id;
+    for (int i = 0; i < 4; i++) {
+        double c[4];
+        child_range(i, r[0], r[1], r[2], r[3], c);
+        trace_surface_box(th, w->obj, c[0], c[1], c[2], c[3], &kids[i]);
+    }
+    return trace_boxcache_insert(th->cache, w->obj->id, parent, slot, kids);
+}
+
+static void visit(walk *w, const trace_box *node, const double r[4],
+                  trace_brood_id parent, int slot, int depth)
+{
+    trace_box kids[4];
+    trace_brood_id brood = children_of(w, parent, slot, r, kids);
+    trace_boxcache_pin(w->th->cache, brood);
+
+    child_order order[4];
+    int n = 0;
+    double node_extent = trace_box_extent(node);
+    for (int i = 0; i < 4; i++) {
+        double c[4];
+        child_range(i, r[0], r[1], r[2], r[3], c);
+        if (trace_box_is_empty(&kids[i]) && !(kids[i].flags & AA_UNBOUNDED)) continue;
+        if (geom_uv_box_cover(&w->obj->surf, c[0], c[1], c[2], c[3]) == GEOM_OUTSIDE) continue;
+        double t0, t1;
+        int axis;
+        if (!trace_box_hit(&kids[i], &w->ray, w->ray.tmin, w->best->t, &t0, &t1, &axis)) continue;
+        child_order o = {t0, t1, i, axis};
+        int k = n++;
+        while (k > 0 && order[k - 1].t0 > o.t0) { order[k] = order[k - 1]; k--; }
+        order[k] = o;
+    }
+
+    for (int k = 0; k < n && !(w->any && w->found); k++) {
+        if (!(order[k].t0 < w->best->t)) break;
+        const trace_box *kid = &kids[order[k].i];
+        double c[4];
+        child_range(order[k].i, r[0], r[1], r[2], r[3], c);
+        double size = trace_box_extent(kid) * w->obj->scale;
+        double t_at = order[k].t0 > 0 ? order[k].t0 : 0;
+        double tol = w->tol.a + w->tol.b * t_at;
+        int d = depth + 1;
+        bool unbounded = (kid->flags & AA_UNBOUNDED) != 0;
+        if (d >= TRACE_MAX_DEPTH)
+            leaf_hit(w, kid, c, order[k].t0, order[k].t1, order[k].axis, TRACE_LEAF_DEPTH);
+        else if (!unbounded && size <= tol)
+            leaf_hit(w, kid, c, order[k].t0, order[k].t1, order[k].axis, TRACE_LEAF_SMALL);
+        else if (!unbounded && (kid->flags & AA_DISCONTINUOUS) &&
+                 trace_box_extent(kid) >= TRACE_NO_SHRINK * node_extent &&
+                 box_min_extent(kid) * w->obj->scale <= tol)
+            leaf_hit(w, kid, c, order[k].t0, order[k].t1, order[k].axis, TRACE_LEAF_WALL);
+        else
+            visit(w, kid, c, brood, order[k].i, d);
+    }
+    trace_boxcache_unpin(w->th->cache, brood);
+}
+
+static void object_ray(const trace_object *obj, const trace_ray *cam, double tmax,
+                       trace_ray *out)
+{
+    vec3 o = mat4_xform_point(&obj->from_camera, cam->o);
+    vec3 d = mat4_xform_vector(&obj->from_camera, cam->d);
+    trace_ray_init(out, o, d, cam->tmin, tmax);
+}
+
+static bool intersect_displaced(trace_thread *th, const trace_object *obj,
+                                const trace_ray *ray, const trace_tolerance *tol,
+                                bool any, trace_hit *best)
+{
+    walk w = {.th = th, .obj = obj, .cam_ray = ray, .tol = *tol, .any = any,
+              .found = false, .best = best};
+    object_ray(obj, ray, best->t, &w.ray);
+    double t0, t1;
+    if (!trace_box_hit(&obj->root, &w.ray, ray->tmin, best->t, &t0, &t1, NULL))
+        return false;
+    double r[4] = {0, 1, 0, 1};
+    visit(&w, &obj->root, r, TRACE_BROOD_NONE, 0, 0);
+    return w.found;
+}
+
+static bool intersect_exact(const trace_object *obj, const trace_ray *ray,
+                            trace_hit *best)
+{
+    trace_ray oray;
+    object_ray(obj, ray, best->t, &oray);
+    geom_hit h;
+    if (!geom_intersect(&obj->surf, oray.o, oray.d, ray->tmin, best->t, &h)) return false;
+    if (!(h.t < best->t)) return false;
+    best->t = h.t;
+    best->obj = obj;
+    best->u = h.u;
+    best->v = h.v;
+    best->leaf_size = 0;
+    best->kind = TRACE_LEAF_EXACT;
+    best->wall_normal = v3(0, 0, 0);
+    return true;
+}
+
+bool trace_intersect_object(trace_thread *th, const trace_object *obj,
+                            const trace_ray *ray, const trace_tolerance *tol,
+                            bool any, trace_hit *best)
+{
+    if (obj->displacement) return intersect_displaced(th, obj, ray, tol, any, best);
+    return intersect_exact(obj, ray, best);
+}

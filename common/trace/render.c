@@ -1,0 +1,217 @@
+/*
+ * render.c: preparing a world for rendering and rendering tiles (see
+ * render.h): samples, pixel filter (RI Spec 3.2 §4.1.4 filter functions),
+ * exposure.
+ */
+#include "trace/render.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "trace/camera.h"
+#include "trace/sampler.h"
+#include "trace/shade.h"
+
+/* Spectral norm of the 3x3 part (largest stretch), by power iteration on
+ * M^T M, rounded up a little: the leaf test multiplies object-space sizes
+ * by it, so a slight overestimate only makes leaves smaller. */
+static double stretch_of(const mat4 *m)
+{
+    vec3 x = v3(1, 1, 1);
+    double s = 0;
+    for (int it = 0; it < 64; it++) {
+        vec3 y = mat4_xform_vector(m, x);
+        vec3 z = v3(m->m[0][0] * y.x + m->m[1][0] * y.y + m->m[2][0] * y.z,
+                    m->m[0][1] * y.x + m->m[1][1] * y.y + m->m[2][1] * y.z,
+                    m->m[0][2] * y.x + m->m[1][2] * y.y + m->m[2][2] * y.z);
+        double l = v3_length(z);
+        if (!(l > 0)) break;
+        s = sqrt(l / v3_length(x));
+        x = v3_scale(z, 1.0 / l);
+    }
+    return s * (1.0 + 1e-6);
+}
+
+static void camera_bound(const trace_object *obj, const trace_box *b, trace_box *out)
+{
+    if (b->flags & AA_UNBOUNDED || !isfinite(b->lo.x + b->lo.y + b->lo.z + b->hi.x + b->hi.y + b->hi.z)) {
+        out->lo = v3(-INFINITY, -INFINITY, -INFINITY);
+        out->hi = v3(INFINITY, INFINITY, INFINITY);
+        out->flags = AA_UNBOUNDED;
+        return;
+    }
+    out->flags = b->flags;
+    for (int i = 0; i < 8; i++) {
+        vec3 c = v3((i & 1) ? b->hi.x : b->lo.x, (i & 2) ? b->hi.y : b->lo.y,
+                    (i & 4) ? b->hi.z : b->lo.z);
+        vec3 p = mat4_xform_point(&obj->to_camera, c);
+        if (i == 0) { out->lo = out->hi = p; continue; }
+        out->lo = v3(fmin(out->lo.x, p.x), fmin(out->lo.y, p.y), fmin(out->lo.z, p.z));
+        out->hi = v3(fmax(out->hi.x, p.x), fmax(out->hi.y, p.y), fmax(out->hi.z, p.z));
+    }
+    /* the corner transform rounds: widen by a relative hair */
+    vec3 e = v3_scale(v3(fabs(out->hi.x) + fabs(out->lo.x), fabs(out->hi.y) + fabs(out->lo.y),
+                         fabs(out->hi.z) + fabs(out->lo.z)), 1e-12);
+    out->lo = v3_sub(out->lo, e);
+    out->hi = v3_add(out->hi, e);
+}
+
+trace_renderer *trace_renderer_new(trace_world *world, char *err, int errsz)
+{
+    trace_thread *th = trace_thread_new(world);
+    for (int i = 0; i < world->nobjects; i++) {
+        trace_object *obj = &world->objects[i];
+        obj->id = i;
+        obj->scale = stretch_of(&obj->to_camera);
+        if (obj->displacement) {
+            trace_surface_box(th, obj, 0, 1, 0, 1, &obj->root);
+        } else {
+            geom_bounds(&obj->surf, &obj->root.lo, &obj->root.hi);
+            obj->root.flags = 0;
+        }
+        camera_bound(obj, &obj->root, &obj->bound);
+    }
+    if (th->failed) {
+        snprintf(err, (size_t)errsz, "%s", th->error);
+        trace_thread_destroy(&th);
+        return NULL;
+    }
+    trace_thread_destroy(&th);
+    trace_renderer *self = calloc(1, sizeof *self);
+    if (!self) abort();
+    self->world = world;
+    self->bvh = trace_bvh_new(world);
+    self->primary_tol = trace_camera_tolerance(&world->camera, world->shading_rate,
+                                               world->options.leaf_fraction);
+    return self;
+}
+
+void trace_renderer_destroy(trace_renderer **self_p)
+{
+    trace_renderer *self = *self_p;
+    if (!self) return;
+    trace_bvh_destroy(&self->bvh);
+    free(self);
+    *self_p = NULL;
+}
+
+void trace_render_sample(const trace_renderer *self, trace_thread *th,
+                         double x, double y, double rgb[3], double *alpha,
+                         double *z)
+{
+    trace_ray ray;
+    trace_camera_ray(&self->world->camera, x, y, &ray);
+    trace_hit hit = {.t = ray.tmax, .obj = NULL};
+    th->stats.primary_rays++;
+    if (!trace_bvh_intersect(self->bvh, th, &ray, &self->primary_tol, false, &hit)) {
+        rgb[0] = rgb[1] = rgb[2] = 0;
+        *alpha = 0;
+        *z = INFINITY;
+        return;
+    }
+    vec3 P;
+    trace_shade_hit(self, th, &ray, &hit, rgb, alpha, &P);
+    *z = trace_ray_at(&ray, hit.t).z;
+}
+
+/* ---- pixel filter ---- */
+
+static double filter_weight(const trace_world *w, double dx, double dy)
+{
+    double wx = w->filter_width[0], wy = w->filter_width[1];
+    switch (w->filter) {
+    case TRACE_FILTER_GAUSSIAN: {
+        double x = dx * 2.0 / wx, y = dy * 2.0 / wy;
+        return exp(-2.0 * (x * x + y * y));
+    }
+    case TRACE_FILTER_TRIANGLE:
+        return (1.0 - fabs(dx) / (0.5 * wx)) * (1.0 - fabs(dy) / (0.5 * wy));
+    case TRACE_FILTER_CATMULL_ROM: {
+        /* radial, support 2 (in units of half the width) */
+        double x = dx * 4.0 / wx, y = dy * 4.0 / wy, r = sqrt(x * x + y * y);
+        if (r >= 2) return 0;
+        if (r < 1) return 3 * r * r * r - 5 * r * r + 2;
+        return -r * r * r + 5 * r * r - 8 * r + 4;
+    }
+    case TRACE_FILTER_SINC: {
+        double x = dx * M_PI, y = dy * M_PI;
+        return (x != 0 ? sin(x) / x : 1.0) * (y != 0 ? sin(y) / y : 1.0);
+    }
+    case TRACE_FILTER_BOX:
+    default:
+        return 1.0;
+    }
+}
+
+typedef struct sample_rec { float x, y, r, g, b, a, z; } sample_rec;
+
+bool trace_render_tile(const trace_renderer *self, trace_thread *th,
+                       int x0, int y0, int w, int h, float *rgba, float *z)
+{
+    const trace_world *world = self->world;
+    double rx = 0.5 * world->filter_width[0], ry = 0.5 * world->filter_width[1];
+    int nx = world->samples_x > 0 ? world->samples_x : 1;
+    int ny = world->samples_y > 0 ? world->samples_y : 1;
+    int ns = nx * ny;
+    /* pixels whose samples can reach the tile's pixels through the filter */
+    int qx0 = (int)floor(x0 + 0.5 - rx), qx1 = (int)floor(x0 + w - 0.5 + rx);
+    int qy0 = (int)floor(y0 + 0.5 - ry), qy1 = (int)floor(y0 + h - 0.5 + ry);
+    int qw = qx1 - qx0 + 1, qh = qy1 - qy0 + 1;
+    sample_rec *smp = malloc(sizeof(sample_rec) * (size_t)qw * (size_t)qh * (size_t)ns);
+    if (!smp) {
+        trace_thread_fail(th, "out of memory for the samples of a tile");
+        return false;
+    }
+    for (int qy = qy0; qy <= qy1; qy++)
+        for (int qx = qx0; qx <= qx1; qx++)
+            for (int s = 0; s < ns; s++) {
+                sample_rec *r = &smp[(((size_t)(qy - qy0) * (size_t)qw) + (size_t)(qx - qx0)) * (size_t)ns + (size_t)s];
+                double sx, sy, rgb[3], a, d;
+                trace_sample_position(qx, qy, s, nx, ny, &sx, &sy);
+                trace_render_sample(self, th, sx, sy, rgb, &a, &d);
+                /* the offset inside the pixel (exact), rounded to float the
+                 * same way in every tile that traces this sample */
+                *r = (sample_rec){(float)(sx - qx), (float)(sy - qy), (float)rgb[0],
+                                  (float)rgb[1], (float)rgb[2], (float)a, (float)d};
+            }
+    double inv_gamma = world->gamma > 0 ? 1.0 / world->gamma : 1.0;
+    for (int py = y0; py < y0 + h; py++)
+        for (int px = x0; px < x0 + w; px++) {
+            double cx = px + 0.5, cy = py + 0.5, sum[4] = {0, 0, 0, 0}, wsum = 0;
+            float zmin = INFINITY;
+            int ax0 = (int)floor(cx - rx) - 1, ax1 = (int)floor(cx + rx);
+            int ay0 = (int)floor(cy - ry) - 1, ay1 = (int)floor(cy + ry);
+            for (int qy = ay0; qy <= ay1; qy++) {
+                if (qy < qy0 || qy > qy1) continue;
+                for (int qx = ax0; qx <= ax1; qx++) {
+                    if (qx < qx0 || qx > qx1) continue;
+                    const sample_rec *r = &smp[(((size_t)(qy - qy0) * (size_t)qw) + (size_t)(qx - qx0)) * (size_t)ns];
+                    for (int s = 0; s < ns; s++) {
+                        double dx = (qx + (double)r[s].x) - cx, dy = (qy + (double)r[s].y) - cy;
+                        if (!(dx >= -rx && dx < rx && dy >= -ry && dy < ry)) continue;
+                        double wgt = filter_weight(world, dx, dy);
+                        sum[0] += wgt * r[s].r;
+                        sum[1] += wgt * r[s].g;
+                        sum[2] += wgt * r[s].b;
+                        sum[3] += wgt * r[s].a;
+                        wsum += wgt;
+                        if (qx == px && qy == py && r[s].z < zmin) zmin = r[s].z;
+                    }
+                }
+            }
+            float *o = &rgba[((size_t)(py - y0) * (size_t)w + (size_t)(px - x0)) * 4];
+            for (int k = 0; k < 4; k++) {
+                double v = wsum > 0 ? sum[k] / wsum : 0.0;
+                if (k < 3) {
+                    v *= world->gain;
+                    if (inv_gamma != 1.0 && v > 0) v = pow(v, inv_gamma);
+                }
+                o[k] = (float)v;
+            }
+            z[(size_t)(py - y0) * (size_t)w + (size_t)(px - x0)] = zmin;
+        }
+    free(smp);
+    return !th->failed;
+}

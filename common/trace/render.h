@@ -1,0 +1,50 @@
+/*
+ * render.h: rendering tiles of an image (the part of the renderer a worker
+ * thread calls).
+ *
+ *   trace_renderer   the prepared world (root boxes, BVH); shared, read-only
+ *   trace_thread     per-thread state (thread.h)
+ *   trace_render_tile  one tile: primary rays for every sample of every
+ *                    pixel whose filter reaches the tile, shading with
+ *                    shadows, pixel filter, exposure
+ *
+ * Determinism (DESIGN.md §2): a pixel's value depends only on the world and
+ * the pixel: samples are hashed from (pixel, index), a sample outside the
+ * tile that the filter needs is traced again rather than borrowed, and the
+ * box cache only changes speed.
+ */
+#ifndef TRACE_RENDER_H
+#define TRACE_RENDER_H
+
+#include <stdbool.h>
+
+#include "trace/bvh.h"
+#include "trace/thread.h"
+#include "trace/world.h"
+
+typedef struct trace_renderer {
+    const trace_world *world;
+    trace_bvh *bvh;
+    trace_tolerance primary_tol;
+} trace_renderer;
+
+/* Computes every object's scale, root box (through its displacement
+ * shader, in the world's arithmetic) and camera-space bound, then builds
+ * the BVH. The world must stay alive and unchanged while the renderer
+ * exists. On a shader failure returns NULL with the message in err. */
+trace_renderer *trace_renderer_new(trace_world *world, char *err, int errsz);
+void trace_renderer_destroy(trace_renderer **self_p);
+
+/* Renders pixels [x0, x0+w) x [y0, y0+h): rgba gets 4 floats per pixel
+ * (premultiplied, exposure applied), z one float (camera-space depth of the
+ * nearest sample of the pixel; +inf where nothing was hit). Returns false
+ * when a shader failed (th->error says why); the buffers are then garbage. */
+bool trace_render_tile(const trace_renderer *self, trace_thread *th,
+                       int x0, int y0, int w, int h, float *rgba, float *z);
+
+/* One primary sample at raster (x, y): colour, alpha, depth. For tests. */
+void trace_render_sample(const trace_renderer *self, trace_thread *th,
+                         double x, double y, double rgb[3], double *alpha,
+                         double *z);
+
+#endif

@@ -1,0 +1,155 @@
+/*
+ * shade.c: surface shading, lights and shadows (see shade.h).
+ */
+#include "trace/shade.h"
+
+#include <math.h>
+
+typedef struct shade_ctx {
+    const trace_renderer *r;
+    trace_thread *th;
+    vec3 P;              /* the shaded point */
+    vec3 N;              /* unit normal used to offset shadow rays */
+    double offset;       /* shadow ray offset (camera units) */
+    double tol;          /* shadow ray leaf tolerance (camera units) */
+} shade_ctx;
+
+static double smoothstep_d(double e0, double e1, double x)
+{
+    if (x <= e0) return 0;
+    if (x >= e1) return 1;
+    double t = (x - e0) / (e1 - e0);
+    return t * t * (3 - 2 * t);
+}
+
+/* Is the segment from the shaded point along L (to parameter tmax) blocked? */
+static bool occluded(shade_ctx *c, vec3 L, double tmax)
+{
+    trace_thread *th = c->th;
+    vec3 side = v3_dot(c->N, L) >= 0 ? c->N : v3_neg(c->N);
+    vec3 o = v3_add(c->P, v3_scale(side, c->offset));
+    trace_ray ray;
+    trace_ray_init(&ray, o, L, 0.0, tmax);
+    trace_tolerance tol = {c->tol, 0.0};
+    trace_hit hit = {.t = tmax, .obj = NULL};
+    th->stats.shadow_rays++;
+    return trace_bvh_intersect(c->r->bvh, th, &ray, &tol, true, &hit);
+}
+
+static int light_samples(void *user, const double P[3], sl_light_sample *out, int max)
+{
+    (void)P;   /* the shaded point is c->P: a shader moving P does not move shadows */
+    shade_ctx *c = user;
+    const trace_world *w = c->r->world;
+    int n = 0;
+    for (int i = 0; i < w->nlights && n < max; i++) {
+        const trace_light *l = &w->lights[i];
+        sl_light_sample *s = &out[n];
+        double atten = 1.0, tmax = 1.0;
+        vec3 L;
+        s->ambient = false;
+        switch (l->kind) {
+        case TRACE_LIGHT_AMBIENT:
+            s->ambient = true;
+            s->L[0] = s->L[1] = s->L[2] = 0;
+            for (int k = 0; k < 3; k++) s->Cl[k] = l->color[k];
+            n++;
+            continue;
+        case TRACE_LIGHT_DISTANT:
+            L = v3_neg(l->dir);
+            tmax = INFINITY;
+            break;
+        case TRACE_LIGHT_POINT:
+            L = v3_sub(l->from, c->P);
+            atten = 1.0 / v3_dot(L, L);
+            break;
+        case TRACE_LIGHT_SPOT: {
+            L = v3_sub(l->from, c->P);
+            double d2 = v3_dot(L, L);
+            double cosang = -v3_dot(L, l->dir) / sqrt(d2);
+            if (cosang <= l->cos_outside) { atten = 0; break; }
+            atten = pow(cosang, l->beamdistribution) / d2 *
+                    smoothstep_d(l->cos_outside, l->cos_inside, cosang);
+            break;
+        }
+        default:
+            continue;
+        }
+        if (!(atten > 0) || !isfinite(atten)) continue;
+        if (l->shadows && occluded(c, L, tmax * (1.0 - 1e-9))) continue;
+        s->L[0] = L.x; s->L[1] = L.y; s->L[2] = L.z;
+        for (int k = 0; k < 3; k++) s->Cl[k] = l->color[k] * atten;
+        n++;
+    }
+    return n;
+}
+
+static void set3(sl_vm *vm, sl_global g, vec3 v)
+{
+    double a[3] = {v.x, v.y, v.z};
+    sl_vm_set_float(vm, g, a);
+}
+
+static void default_surface(const trace_object *obj, vec3 I, vec3 N,
+                            double rgb[3], double *alpha)
+{
+    /* RenderMan's defaultsurface: a facing ratio, Ka 0.2, Kd 0.8 */
+    double f = fabs(v3_dot(v3_normalize(I), N));
+    for (int k = 0; k < 3; k++) rgb[k] = obj->Os[k] * obj->Cs[k] * (0.2 + 0.8 * f);
+    *alpha = (obj->Os[0] + obj->Os[1] + obj->Os[2]) / 3.0;
+}
+
+void trace_shade_hit(const trace_renderer *r, trace_thread *th,
+                     const trace_ray *ray, const trace_hit *hit,
+                     double rgb[3], double *alpha, vec3 *P_out)
+{
+    const trace_object *obj = hit->obj;
+    trace_surface_point sp;
+    trace_surface_point_eval(th, obj, hit->u, hit->v, &sp);
+    if (hit->kind == TRACE_LEAF_WALL) {
+        sp.P = trace_ray_at(ray, hit->t);
+        sp.N = sp.Ng = hit->wall_normal;
+    } else if (hit->kind == TRACE_LEAF_EXACT) {
+        sp.P = trace_ray_at(ray, hit->t);
+    }
+    *P_out = sp.P;
+    vec3 I = v3_sub(sp.P, ray->o);
+
+    if (!obj->surface) {
+        default_surface(obj, I, sp.N, rgb, alpha);
+        return;
+    }
+    double pixel_tol = r->primary_tol.a + r->primary_tol.b * fabs(sp.P.z);
+    shade_ctx c = {.r = r, .th = th, .P = sp.P, .N = sp.N,
+                   .offset = 2.0 * hit->leaf_size + 1e-9 * (1.0 + v3_length(sp.P)),
+                   .tol = hit->leaf_size > pixel_tol ? hit->leaf_size : pixel_tol};
+    sl_vm *vm = th->shade_vm;
+    sl_vm_clear_globals(vm);
+    sl_vm_set_spaces(vm, &obj->surface_spaces);
+    sl_vm_set_lights(vm, light_samples, &c);
+    set3(vm, SL_G_P, sp.P);
+    set3(vm, SL_G_N, sp.N);
+    set3(vm, SL_G_Ng, sp.Ng);
+    set3(vm, SL_G_I, I);
+    set3(vm, SL_G_E, ray->o);
+    set3(vm, SL_G_dPdu, sp.dPdu);
+    set3(vm, SL_G_dPdv, sp.dPdv);
+    sl_vm_set_float(vm, SL_G_Cs, obj->Cs);
+    sl_vm_set_float(vm, SL_G_Os, obj->Os);
+    sl_vm_set_float(vm, SL_G_u, &sp.u);
+    sl_vm_set_float(vm, SL_G_v, &sp.v);
+    sl_vm_set_float(vm, SL_G_s, &sp.u);
+    sl_vm_set_float(vm, SL_G_t, &sp.v);
+    th->stats.evals_float++;
+    if (sl_vm_run(vm, obj->surface, SL_MODE_FLOAT, NULL) != SL_OK) {
+        trace_thread_fail(th, sl_vm_error(vm));
+        rgb[0] = rgb[1] = rgb[2] = 0;
+        *alpha = 1;
+        return;
+    }
+    double Ci[3], Oi[3];
+    sl_vm_get_float(vm, SL_G_Ci, Ci);
+    sl_vm_get_float(vm, SL_G_Oi, Oi);
+    for (int k = 0; k < 3; k++) rgb[k] = Ci[k];
+    *alpha = (Oi[0] + Oi[1] + Oi[2]) / 3.0;
+}

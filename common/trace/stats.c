@@ -1,0 +1,42 @@
+/*
+ * stats.c: adding, printing and writing render statistics (see stats.h).
+ */
+#include "trace/stats.h"
+
+#define STATS_FIELDS(X) \
+    X(primary_rays) X(shadow_rays) X(boxes) X(evals_affine) X(evals_interval) \
+    X(evals_dual) X(evals_float) X(leaves) X(wall_leaves) X(depth_cap_leaves) \
+    X(cache_hits) X(cache_misses) X(cache_evictions)
+
+void trace_stats_add(trace_stats *into, const trace_stats *from)
+{
+#define ADD(f) into->f += from->f;
+    STATS_FIELDS(ADD)
+#undef ADD
+    if (from->cache_peak_bytes > into->cache_peak_bytes)
+        into->cache_peak_bytes = from->cache_peak_bytes;
+}
+
+void trace_stats_print(const trace_stats *s, FILE *out)
+{
+#define PRINT(f) fprintf(out, "  %-18s %ld\n", #f, s->f);
+    STATS_FIELDS(PRINT)
+#undef PRINT
+    fprintf(out, "  %-18s %zu\n", "cache_peak_bytes", s->cache_peak_bytes);
+    long rays = s->primary_rays + s->shadow_rays;
+    if (rays > 0)
+        fprintf(out, "  %-18s %.2f\n", "boxes_per_ray", (double)s->boxes / (double)rays);
+    long lookups = s->cache_hits + s->cache_misses;
+    if (lookups > 0)
+        fprintf(out, "  %-18s %.1f%%\n", "cache_hit_rate", 100.0 * (double)s->cache_hits / (double)lookups);
+}
+
+void trace_stats_write_json(const trace_stats *s, const char *extra, FILE *out)
+{
+    fputc('{', out);
+    if (extra && *extra) fprintf(out, "%s, ", extra);
+#define JSON(f) fprintf(out, "\"%s\": %ld, ", #f, s->f);
+    STATS_FIELDS(JSON)
+#undef JSON
+    fprintf(out, "\"cache_peak_bytes\": %zu}", s->cache_peak_bytes);
+}

@@ -1,0 +1,31 @@
+/*
+ * stats.h: render statistics (what `--stats` prints and `--stats-json`
+ * writes): rays, boxes, shader evaluations per mode, leaves by kind, box
+ * cache hits / misses / evictions / peak bytes. Each thread counts its own
+ * (thread.h); totals are sums, the peak is the largest thread's.
+ */
+#ifndef TRACE_STATS_H
+#define TRACE_STATS_H
+
+#include <stddef.h>
+#include <stdio.h>
+
+typedef struct trace_stats {
+    long primary_rays, shadow_rays;
+    long boxes;                    /* boxes computed (root + 4 per cache miss) */
+    long evals_affine, evals_interval, evals_dual, evals_float;
+    long leaves, wall_leaves, depth_cap_leaves;
+    long cache_hits, cache_misses, cache_evictions;
+    size_t cache_peak_bytes;
+} trace_stats;
+
+void trace_stats_add(trace_stats *into, const trace_stats *from);
+
+/* A readable table (one "name value" line each). */
+void trace_stats_print(const trace_stats *s, FILE *out);
+
+/* One JSON object (no trailing newline); extra: more "key": value pairs to
+ * put first (already formatted, may be NULL or ""). */
+void trace_stats_write_json(const trace_stats *s, const char *extra, FILE *out);
+
+#endif

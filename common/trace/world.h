@@ -1,0 +1,98 @@
+/*
+ * world.h: the renderer's view of a scene, everything in CAMERA space
+ * (RenderMan's "current" space, so shaders see the values they expect):
+ * the camera, the objects (base surface + transforms + shader instances +
+ * their camera-space root box), the lights, and the render options.
+ *
+ * The RIB parser (common/scene) produces a scene model in RIB terms; the
+ * adapter in render_setup.c turns it into a trace_world. Everything here is
+ * read-only while rendering and shared by all threads; the per-thread
+ * mutable state (VM, box cache, statistics) lives in trace_thread
+ * (render.h).
+ */
+#ifndef TRACE_WORLD_H
+#define TRACE_WORLD_H
+
+#include <stdbool.h>
+#include <stddef.h>
+
+#include "geom/surface.h"
+#include "sl/shader.h"
+#include "trace/box.h"
+#include "util/vecmath.h"
+
+typedef enum trace_arith { TRACE_ARITH_AFFINE, TRACE_ARITH_INTERVAL } trace_arith;
+
+typedef struct trace_object {
+    int id;                        /* index in trace_world.objects */
+    char name[64];                 /* for messages: "sphere at ufo.rib:12" */
+    geom_surface surf;
+    mat4 to_camera, from_camera;   /* object space <-> camera space */
+    sl_spaces displacement_spaces; /* named spaces for each shader: "shader" */
+    sl_spaces surface_spaces;      /* space is where its RIB call was made */
+    const sl_instance *displacement;   /* NULL: no displacement */
+    const sl_instance *surface;        /* NULL: the default surface */
+    double Cs[3], Os[3];
+    int sides;                     /* 1 or 2 */
+    bool flip;                     /* reversed orientation: negate normals */
+    double scale;                  /* largest stretch of to_camera (spectral norm) */
+    trace_box root;                /* OBJECT space box over the whole (u,v) square */
+    trace_box bound;               /* camera space box of root (for the BVH) */
+} trace_object;
+
+typedef enum trace_light_kind {
+    TRACE_LIGHT_AMBIENT, TRACE_LIGHT_DISTANT, TRACE_LIGHT_POINT, TRACE_LIGHT_SPOT,
+} trace_light_kind;
+
+/* RenderMan's standard light sources (RI Spec 3.2, Appendix A), in camera
+ * space. */
+typedef struct trace_light {
+    trace_light_kind kind;
+    double color[3];               /* intensity * lightcolor */
+    vec3 from;                     /* point, spot */
+    vec3 dir;                      /* distant, spot: unit, from -> to */
+    double cos_outside, cos_inside;    /* spot: cos(coneangle), cos(coneangle - delta) */
+    double beamdistribution;
+    bool shadows;
+} trace_light;
+
+/* RI Spec 3.2 §4.1.4 (and its filter functions in the appendix) */
+typedef enum trace_filter_kind {
+    TRACE_FILTER_BOX, TRACE_FILTER_GAUSSIAN, TRACE_FILTER_TRIANGLE,
+    TRACE_FILTER_CATMULL_ROM, TRACE_FILTER_SINC,
+} trace_filter_kind;
+
+typedef struct trace_camera {
+    int xres, yres;
+    bool orthographic;
+    double screen[4];              /* ScreenWindow left right bottom top */
+    double tan_half_fov;           /* perspective: screen window at z = 1 is scaled by this */
+    double near_clip, far_clip;
+    mat4 camera_from_world, world_from_camera;
+} trace_camera;
+
+typedef struct trace_options {
+    trace_arith arith;             /* bounding arithmetic */
+    size_t cache_bytes;            /* per thread box cache budget; 0: unlimited */
+    int aa_capacity;               /* noise symbols per box query */
+    long max_instructions;         /* shader budget per evaluation */
+    double leaf_fraction;          /* box size / pixel footprint at which to stop */
+} trace_options;
+
+void trace_options_default(trace_options *opt);
+
+typedef struct trace_world {
+    trace_camera camera;
+    int samples_x, samples_y;      /* PixelSamples */
+    double shading_rate;
+    trace_filter_kind filter;
+    double filter_width[2];
+    double gain, gamma;            /* Exposure */
+    trace_object *objects;
+    int nobjects;
+    trace_light *lights;
+    int nlights;
+    trace_options options;
+} trace_world;
+
+#endif

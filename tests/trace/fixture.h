@@ -1,0 +1,36 @@
+/*
+ * fixture.h: test helpers for the renderer: a job built in memory from RIB
+ * text and shader sources (no files), made ready to render.
+ */
+#ifndef TESTS_TRACE_FIXTURE_H
+#define TESTS_TRACE_FIXTURE_H
+
+#include "job/job.h"
+#include "job/job_scene.h"
+
+typedef struct fixture_shader {
+    const char *name;      /* "constd" (its source is named "<name>.sl") */
+    const char *source;
+} fixture_shader;
+
+typedef struct fixture {
+    job *job;
+    job_scene *js;
+    sl_diag *diag;
+} fixture;
+
+/* Builds the job and its scene with the given options (NULL: defaults) and
+ * cache budget. On failure prints the diagnostics and returns false
+ * (f->js NULL; f->diag keeps them for tests of error messages). */
+bool fixture_open(fixture *f, const char *rib, const fixture_shader *shaders,
+                  int nshaders, const job_options *opt, size_t cache_bytes);
+void fixture_close(fixture *f);
+
+/* Renders the whole image into rgba (4 per px) and z with tiles of `tile`
+ * pixels, each tile on one of `nthreads` trace_threads in turn (round
+ * robin, so threads see tiles in different orders than a single one).
+ * cache_bytes overrides the world's budget for these threads. */
+bool fixture_render(fixture *f, int tile, int nthreads, size_t cache_bytes,
+                    float *rgba, float *z);
+
+#endif

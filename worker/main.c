@@ -1,0 +1,168 @@
+/*
+ * main.c: the aafarm-worker command line.
+ *
+ *   aafarm-worker --standalone SCENE.rib -o OUT.exr [options]
+ *   aafarm-worker --connect ENDPOINT [options]          (the farm: docs/farm.md)
+ */
+#include <getopt.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "standalone.h"
+#include "util/exitcodes.h"
+#include "worker_loop.h"
+
+static void usage(FILE *out)
+{
+    fprintf(out,
+        "usage: aafarm-worker --standalone SCENE.rib -o OUT.exr [options]\n"
+        "       aafarm-worker --connect ENDPOINT [options]\n"
+        "\n"
+        "Renders RenderMan scenes with procedural displacement shaders, ray-traced\n"
+        "directly with affine arithmetic (Heidrich & Seidel 1998).\n"
+        "\n"
+        "  --standalone SCENE.rib  render the whole image in this process (the\n"
+        "                          reference a farm render equals pixel for pixel)\n"
+        "  -o, --output OUT.exr    output file (tiled OpenEXR: RGBA half + Z float)\n"
+        "  --connect ENDPOINT      serve a master, e.g. tcp://render1:5555\n"
+        "  --name NAME             worker name in the master's logs (default host:pid)\n"
+        "  -t, --threads N         rendering threads (default: number of cores)\n"
+        "  --tile S                tile size in pixels (standalone; default 32)\n"
+        "  --cache-bytes B         box cache budget per thread, e.g. 40K, 400K, 4M,\n"
+        "                          0 = unlimited (default)\n"
+        "  --arith affine|interval bounding arithmetic (default affine)\n"
+        "  --budget N              shader instruction budget per evaluation (default 1000000)\n"
+        "  --preview OUT.png       also write an sRGB PNG preview\n"
+        "  --stats                 print render statistics\n"
+        "  --stats-json FILE       write render statistics as JSON\n"
+        "  -q, --quiet             only errors;  -v, --verbose  more detail\n"
+        "  -h, --help              this text\n"
+        "\n"
+        "Exit status: 0 done, 1 render failed, 2 usage, 3 bad scene or shader,\n"
+        "130 interrupted (no output file is left behind).\n");
+}
+
+/* "400K", "4M", "1G", "123" -> bytes; false on garbage */
+static bool parse_bytes(const char *s, size_t *out)
+{
+    char *end;
+    double v = strtod(s, &end);
+    if (end == s || v < 0) return false;
+    double mul = 1;
+    if (*end == 'K' || *end == 'k') { mul = 1024; end++; }
+    else if (*end == 'M' || *end == 'm') { mul = 1024.0 * 1024; end++; }
+    else if (*end == 'G' || *end == 'g') { mul = 1024.0 * 1024 * 1024; end++; }
+    if (*end == 'B' || *end == 'b') end++;
+    if (*end) return false;
+    *out = (size_t)(v * mul);
+    return true;
+}
+
+static bool parse_int(const char *s, long lo, long hi, long *out)
+{
+    char *end;
+    long v = strtol(s, &end, 10);
+    if (end == s || *end || v < lo || v > hi) return false;
+    *out = v;
+    return true;
+}
+
+int main(int argc, char **argv)
+{
+    standalone_options so = {0};
+    worker_loop_options wo = {0};
+    job_options_default(&so.job);
+    const char *connect = NULL;
+    enum { O_STANDALONE = 256, O_CONNECT, O_NAME, O_TILE, O_CACHE, O_ARITH, O_BUDGET,
+           O_PREVIEW, O_STATS, O_STATS_JSON };
+    static const struct option longopts[] = {
+        {"standalone", required_argument, 0, O_STANDALONE},
+        {"output", required_argument, 0, 'o'},
+        {"connect", required_argument, 0, O_CONNECT},
+        {"name", required_argument, 0, O_NAME},
+        {"threads", required_argument, 0, 't'},
+        {"tile", required_argument, 0, O_TILE},
+        {"cache-bytes", required_argument, 0, O_CACHE},
+        {"arith", required_argument, 0, O_ARITH},
+        {"budget", required_argument, 0, O_BUDGET},
+        {"preview", required_argument, 0, O_PREVIEW},
+        {"stats", no_argument, 0, O_STATS},
+        {"stats-json", required_argument, 0, O_STATS_JSON},
+        {"quiet", no_argument, 0, 'q'},
+        {"verbose", no_argument, 0, 'v'},
+        {"help", no_argument, 0, 'h'},
+        {0, 0, 0, 0}};
+    int c;
+    long n;
+    while ((c = getopt_long(argc, argv, "o:t:qvh", longopts, NULL)) != -1) {
+        switch (c) {
+        case O_STANDALONE: so.scene_path = optarg; break;
+        case 'o': so.output = optarg; break;
+        case O_CONNECT: connect = optarg; break;
+        case O_NAME: wo.name = optarg; break;
+        case 't':
+            if (!parse_int(optarg, 1, 1024, &n)) {
+                fprintf(stderr, "aafarm-worker: --threads wants a number 1..1024, got '%s'\n", optarg);
+                return AAFARM_EXIT_USAGE;
+            }
+            so.threads = wo.threads = (int)n;
+            break;
+        case O_TILE:
+            if (!parse_int(optarg, 1, 1024, &n)) {
+                fprintf(stderr, "aafarm-worker: --tile wants a size 1..1024, got '%s'\n", optarg);
+                return AAFARM_EXIT_USAGE;
+            }
+            so.job.tile_size = (int)n;
+            break;
+        case O_CACHE:
+            if (!parse_bytes(optarg, &so.cache_bytes)) {
+                fprintf(stderr, "aafarm-worker: --cache-bytes wants e.g. 40K, 4M or 0, got '%s'\n", optarg);
+                return AAFARM_EXIT_USAGE;
+            }
+            wo.cache_bytes = so.cache_bytes;
+            break;
+        case O_ARITH:
+            if (!trace_arith_parse(optarg, &so.job.arith)) {
+                fprintf(stderr, "aafarm-worker: --arith wants 'affine' or 'interval', got '%s'\n", optarg);
+                return AAFARM_EXIT_USAGE;
+            }
+            break;
+        case O_BUDGET:
+            if (!parse_int(optarg, 1000, 1000000000L, &n)) {
+                fprintf(stderr, "aafarm-worker: --budget wants a number >= 1000, got '%s'\n", optarg);
+                return AAFARM_EXIT_USAGE;
+            }
+            so.job.max_instructions = n;
+            break;
+        case O_PREVIEW: so.preview = optarg; break;
+        case O_STATS: so.stats = true; break;
+        case O_STATS_JSON: so.stats_json = optarg; break;
+        case 'q': so.verbosity = wo.verbosity = -1; break;
+        case 'v': so.verbosity = wo.verbosity = 1; break;
+        case 'h': usage(stdout); return AAFARM_EXIT_OK;
+        default: usage(stderr); return AAFARM_EXIT_USAGE;
+        }
+    }
+    if (optind < argc) {
+        fprintf(stderr, "aafarm-worker: unexpected argument '%s' (see --help)\n", argv[optind]);
+        return AAFARM_EXIT_USAGE;
+    }
+    if (so.scene_path && connect) {
+        fprintf(stderr, "aafarm-worker: --standalone and --connect exclude each other\n");
+        return AAFARM_EXIT_USAGE;
+    }
+    if (so.scene_path) {
+        if (!so.output) {
+            fprintf(stderr, "aafarm-worker: --standalone needs -o OUT.exr\n");
+            return AAFARM_EXIT_USAGE;
+        }
+        return worker_standalone(&so);
+    }
+    if (connect) {
+        wo.endpoint = connect;
+        return worker_loop_run(&wo);
+    }
+    usage(stderr);
+    return AAFARM_EXIT_USAGE;
+}

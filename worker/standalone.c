@@ -1,0 +1,222 @@
+/*
+ * standalone.c: the standalone renderer (see standalone.h). Threads take
+ * tiles from a shared counter in scanline order of tiles (neighbouring
+ * tiles close in time, which keeps each thread's box cache warm, as Pharr
+ * & Hanrahan's tile orders do), render them with their own trace_thread,
+ * and hand them to the one writer under a mutex.
+ */
+#include "standalone.h"
+
+#include <errno.h>
+#include <pthread.h>
+#include <signal.h>
+#include <stdatomic.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "image/preview.h"
+#include "image/writer.h"
+#include "job/job_scene.h"
+#include "tile_render.h"
+#include "util/exitcodes.h"
+
+static volatile sig_atomic_t interrupted;
+
+static void on_signal(int sig)
+{
+    (void)sig;
+    interrupted = 1;
+}
+
+typedef struct shared {
+    const standalone_options *opt;
+    const job_scene *js;
+    image_format fmt;
+    image_writer *writer;
+    float *preview;                /* full image RGBA, when a preview is wanted */
+    atomic_int next_tile;
+    int ntiles;
+    pthread_mutex_t lock;          /* writer, preview, progress, error */
+    int done;
+    bool failed;
+    char error[600];
+    trace_stats stats;
+    double t_start;
+} shared;
+
+static double now_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + ts.tv_nsec * 1e-9;
+}
+
+static void progress(shared *s)
+{
+    if (s->opt->verbosity < 0 || !isatty(STDERR_FILENO)) return;
+    double el = now_s() - s->t_start;
+    double eta = s->done > 0 ? el * (s->ntiles - s->done) / s->done : 0;
+    fprintf(stderr, "\r  %d/%d tiles  %.1f s  ETA %.0f s   ", s->done, s->ntiles, el, eta);
+    if (s->done == s->ntiles) fputc('\n', stderr);
+    fflush(stderr);
+}
+
+static void copy_preview(shared *s, const image_tile *t)
+{
+    for (int y = 0; y < t->h; y++)
+        memcpy(&s->preview[(((size_t)(t->y0 + y)) * (size_t)s->fmt.width + (size_t)t->x0) * 4],
+               &t->rgba[(size_t)y * (size_t)t->w * 4], sizeof(float) * 4 * (size_t)t->w);
+}
+
+static void *render_thread(void *arg)
+{
+    shared *s = arg;
+    trace_thread *th = trace_thread_new(&s->js->world);
+    int tx_count = image_format_tiles_x(&s->fmt);
+    for (;;) {
+        int i = atomic_fetch_add(&s->next_tile, 1);
+        if (i >= s->ntiles || interrupted) break;
+        pthread_mutex_lock(&s->lock);
+        bool stop = s->failed;
+        pthread_mutex_unlock(&s->lock);
+        if (stop) break;
+        image_rect r = image_format_tile_rect(&s->fmt, i % tx_count, i / tx_count);
+        char err[600];
+        image_tile *tile = worker_render_tile(s->js, th, r, s->fmt.layers, err, sizeof err);
+        pthread_mutex_lock(&s->lock);
+        if (!tile) {
+            if (!s->failed) snprintf(s->error, sizeof s->error, "%s", err);
+            s->failed = true;
+        } else if (!image_writer_put_tile(s->writer, tile, err, sizeof err)) {
+            if (!s->failed) snprintf(s->error, sizeof s->error, "%s", err);
+            s->failed = true;
+        } else {
+            if (s->preview) copy_preview(s, tile);
+            s->done++;
+            progress(s);
+        }
+        pthread_mutex_unlock(&s->lock);
+        image_tile_destroy(&tile);
+    }
+    trace_thread_sync_stats(th);
+    pthread_mutex_lock(&s->lock);
+    trace_stats_add(&s->stats, &th->stats);
+    pthread_mutex_unlock(&s->lock);
+    trace_thread_destroy(&th);
+    return NULL;
+}
+
+static int default_threads(void)
+{
+    long n = sysconf(_SC_NPROCESSORS_ONLN);
+    return n > 0 ? (int)n : 1;
+}
+
+static bool write_stats_json(const char *path, const shared *s, int threads, double secs)
+{
+    FILE *f = fopen(path, "w");
+    if (!f) return false;
+    char extra[512];
+    snprintf(extra, sizeof extra,
+             "\"scene\": \"%s\", \"width\": %d, \"height\": %d, \"tiles\": %d, "
+             "\"threads\": %d, \"arith\": \"%s\", \"cache_bytes\": %zu, \"seconds\": %.3f",
+             s->opt->scene_path, s->fmt.width, s->fmt.height, s->ntiles, threads,
+             trace_arith_name(s->opt->job.arith), s->opt->cache_bytes, secs);
+    trace_stats_write_json(&s->stats, extra, f);
+    fputc('\n', f);
+    return fclose(f) == 0;
+}
+
+int worker_standalone(const standalone_options *opt)
+{
+    sl_diag *diag = sl_diag_new();
+    job *jb = job_load(opt->scene_path, &opt->job, diag);
+    job_scene *js = jb ? job_scene_new(jb, opt->cache_bytes, true, diag) : NULL;
+    sl_diag_print(diag, stderr);
+    sl_diag_destroy(&diag);
+    if (!js) {
+        job_destroy(&jb);
+        return AAFARM_EXIT_INPUT;
+    }
+
+    shared s = {.opt = opt, .js = js};
+    s.fmt = (image_format){js->world.camera.xres, js->world.camera.yres,
+                           opt->job.tile_size, 0};
+    char err[600];
+    if (!image_format_check(&s.fmt, err, sizeof err)) {
+        fprintf(stderr, "aafarm-worker: %s\n", err);
+        job_scene_destroy(&js);
+        job_destroy(&jb);
+        return AAFARM_EXIT_INPUT;
+    }
+    s.writer = image_writer_new(opt->output, &s.fmt, err, sizeof err);
+    if (!s.writer) {
+        fprintf(stderr, "aafarm-worker: %s\n", err);
+        job_scene_destroy(&js);
+        job_destroy(&jb);
+        return AAFARM_EXIT_FAILURE;
+    }
+    if (opt->preview) {
+        s.preview = calloc((size_t)s.fmt.width * (size_t)s.fmt.height * 4, sizeof(float));
+        if (!s.preview) abort();
+    }
+    s.ntiles = image_format_tile_count(&s.fmt);
+    atomic_init(&s.next_tile, 0);
+    pthread_mutex_init(&s.lock, NULL);
+    int threads = opt->threads > 0 ? opt->threads : default_threads();
+    if (opt->verbosity >= 0)
+        fprintf(stderr, "aafarm-worker: %s: %dx%d, %d tiles of %d, %d thread%s, %s arithmetic\n",
+                opt->scene_path, s.fmt.width, s.fmt.height, s.ntiles, s.fmt.tile_size,
+                threads, threads == 1 ? "" : "s", trace_arith_name(opt->job.arith));
+
+    struct sigaction sa = {0};
+    sa.sa_handler = on_signal;
+    sigaction(SIGINT, &sa, NULL);
+    sigaction(SIGTERM, &sa, NULL);
+
+    s.t_start = now_s();
+    pthread_t *tids = calloc((size_t)threads, sizeof *tids);
+    if (!tids) abort();
+    for (int i = 0; i < threads; i++) pthread_create(&tids[i], NULL, render_thread, &s);
+    for (int i = 0; i < threads; i++) pthread_join(tids[i], NULL);
+    free(tids);
+    double secs = now_s() - s.t_start;
+
+    int rc = AAFARM_EXIT_OK;
+    if (interrupted) {
+        fprintf(stderr, "\naafarm-worker: interrupted; %s not written\n", opt->output);
+        image_writer_destroy(&s.writer);
+        rc = AAFARM_EXIT_INTERRUPTED;
+    } else if (s.failed) {
+        fprintf(stderr, "aafarm-worker: %s\naafarm-worker: %s not written\n", s.error, opt->output);
+        image_writer_destroy(&s.writer);
+        rc = AAFARM_EXIT_FAILURE;
+    } else if (!image_writer_finish(&s.writer, err, sizeof err)) {
+        fprintf(stderr, "aafarm-worker: %s\n", err);
+        image_writer_destroy(&s.writer);
+        rc = AAFARM_EXIT_FAILURE;
+    }
+    if (rc == AAFARM_EXIT_OK && opt->preview &&
+        !image_preview_write_png(opt->preview, s.preview, s.fmt.width, s.fmt.height, err, sizeof err)) {
+        fprintf(stderr, "aafarm-worker: %s\n", err);
+        rc = AAFARM_EXIT_FAILURE;
+    }
+    if (rc == AAFARM_EXIT_OK && opt->verbosity >= 0)
+        fprintf(stderr, "aafarm-worker: wrote %s (%.2f s)\n", opt->output, secs);
+    if (opt->stats) {
+        fprintf(stderr, "statistics:\n");
+        trace_stats_print(&s.stats, stderr);
+    }
+    if (opt->stats_json && !write_stats_json(opt->stats_json, &s, threads, secs)) {
+        fprintf(stderr, "aafarm-worker: cannot write %s: %s\n", opt->stats_json, strerror(errno));
+        if (rc == AAFARM_EXIT_OK) rc = AAFARM_EXIT_FAILURE;
+    }
+    free(s.preview);
+    pthread_mutex_destroy(&s.lock);
+    job_scene_destroy(&js);
+    job_destroy(&jb);
+    return rc;
+}

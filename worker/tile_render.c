@@ -1,0 +1,26 @@
+/*
+ * tile_render.c: one tile through the renderer into an image_tile.
+ */
+#include "tile_render.h"
+
+#include <stdio.h>
+
+image_tile *worker_render_tile(const job_scene *js, trace_thread *th,
+                               image_rect rect, unsigned layers,
+                               char *err, size_t errsz)
+{
+    image_tile *tile = image_tile_new(rect.x0, rect.y0, rect.w, rect.h, layers);
+    if (!tile) {
+        snprintf(err, errsz, "cannot allocate a %dx%d tile", rect.w, rect.h);
+        return NULL;
+    }
+    if (!trace_render_tile(js->renderer, th, rect.x0, rect.y0, rect.w, rect.h,
+                           tile->rgba, tile->z)) {
+        snprintf(err, errsz, "tile at (%d,%d): %s", rect.x0, rect.y0, th->error);
+        th->failed = false;
+        th->error[0] = '\0';
+        image_tile_destroy(&tile);
+        return NULL;
+    }
+    return tile;
+}
