@@ -1,0 +1,169 @@
+/*
+ * preview.c: the PNG preview (see preview.h for the conversion).
+ *
+ * libpng reports errors by longjmp; the setjmp lives in write_rows() alone
+ * with no local state to clobber, and every error message is collected in
+ * png_context so the caller gets one line naming the file.
+ */
+#include "image/preview.h"
+
+#include <errno.h>
+#include <math.h>
+#include <png.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "image/outfile.h"
+
+uint8_t image_preview_srgb8(float linear)
+{
+    double c = linear;
+    if (!(c > 0.0))            /* negative, zero and NaN */
+        return 0;
+    if (c >= 1.0)
+        return 255;
+    double v = c <= 0.0031308 ? 12.92 * c : 1.055 * pow(c, 1.0 / 2.4) - 0.055;
+    long code = lround(v * 255.0);
+    return (uint8_t) (code < 0 ? 0 : code > 255 ? 255 : code);
+}
+
+/* Where the R, G, B values of pixel i are: ch[c][i * stride], NULL = 0. */
+typedef struct pixel_source {
+    const float *ch[3];
+    size_t stride;
+    int width, height;
+} pixel_source;
+
+typedef struct png_context {
+    int fd;
+    char message[200];
+} png_context;
+
+static void on_png_error(png_structp png, png_const_charp msg)
+{
+    png_context *ctx = png_get_error_ptr(png);
+    snprintf(ctx->message, sizeof ctx->message, "%s", msg);
+    png_longjmp(png, 1);
+}
+
+static void on_png_warning(png_structp png, png_const_charp msg)
+{
+    (void) png;
+    (void) msg;
+}
+
+static void on_png_write(png_structp png, png_bytep data, size_t len)
+{
+    png_context *ctx = png_get_io_ptr(png);
+    while (len > 0) {
+        ssize_t n = write(ctx->fd, data, len);
+        if (n < 0 && errno == EINTR)
+            continue;
+        if (n <= 0)
+            png_error(png, n < 0 ? strerror(errno) : "short write");
+        data += n;
+        len -= (size_t) n;
+    }
+}
+
+static void on_png_flush(png_structp png)
+{
+    (void) png;
+}
+
+static void convert_row(const pixel_source *src, int y, uint8_t *row)
+{
+    for (int x = 0; x < src->width; x++) {
+        size_t i = ((size_t) y * (size_t) src->width + (size_t) x)
+                   * src->stride;
+        for (int c = 0; c < 3; c++)
+            row[3 * x + c] = src->ch[c] ? image_preview_srgb8(src->ch[c][i])
+                                        : 0;
+    }
+}
+
+/* Returns 0 on success, 1 after a libpng error (message in ctx). */
+static int write_rows(png_structp png, png_infop info,
+                      const pixel_source *src, uint8_t *row)
+{
+    if (setjmp(png_jmpbuf(png)))
+        return 1;
+    png_set_IHDR(png, info, (png_uint_32) src->width,
+                 (png_uint_32) src->height, 8, PNG_COLOR_TYPE_RGB,
+                 PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT,
+                 PNG_FILTER_TYPE_DEFAULT);
+    png_set_sRGB(png, info, PNG_sRGB_INTENT_PERCEPTUAL);
+    png_set_compression_level(png, 6);
+    png_write_info(png, info);
+    for (int y = 0; y < src->height; y++) {
+        convert_row(src, y, row);
+        png_write_row(png, row);
+    }
+    png_write_end(png, NULL);
+    return 0;
+}
+
+static bool write_png(image_outfile *file, const pixel_source *src,
+                      char *err, size_t errsz)
+{
+    png_context ctx = {image_outfile_fd(file), ""};
+    png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &ctx,
+                                              on_png_error, on_png_warning);
+    png_infop info = png ? png_create_info_struct(png) : NULL;
+    uint8_t *row = malloc((size_t) src->width * 3);
+    int rc = 1;
+    if (png && info && row) {
+        png_set_write_fn(png, &ctx, on_png_write, on_png_flush);
+        rc = write_rows(png, info, src, row);
+    } else {
+        snprintf(ctx.message, sizeof ctx.message, "out of memory");
+    }
+    png_destroy_write_struct(&png, &info);
+    free(row);
+    if (rc != 0)
+        snprintf(err, errsz, "cannot write PNG %s: %s",
+                 image_outfile_temp_path(file), ctx.message);
+    return rc == 0;
+}
+
+static bool write_preview(const char *path, const pixel_source *src,
+                          char *err, size_t errsz)
+{
+    if (src->width < 1 || src->height < 1
+        || src->width > 1000000 || src->height > 1000000) {
+        snprintf(err, errsz, "cannot write PNG %s: image size %dx%d out of "
+                 "range", path, src->width, src->height);
+        return false;
+    }
+    image_outfile *file = image_outfile_new(path, err, errsz);
+    if (!file)
+        return false;
+    if (!write_png(file, src, err, errsz)) {
+        image_outfile_destroy(&file);
+        return false;
+    }
+    return image_outfile_commit(&file, err, errsz);
+}
+
+bool image_preview_write_png(const char *path, const float *rgba, int width,
+                             int height, char *err, size_t errsz)
+{
+    if (!rgba) {
+        snprintf(err, errsz, "cannot write PNG %s: no pixels given", path);
+        return false;
+    }
+    pixel_source src = {{rgba, rgba + 1, rgba + 2}, 4, width, height};
+    return write_preview(path, &src, err, errsz);
+}
+
+bool image_preview_write_png_buffer(const char *path, const image_buffer *buf,
+                                    char *err, size_t errsz)
+{
+    pixel_source src = {{image_buffer_channel(buf, "R"),
+                         image_buffer_channel(buf, "G"),
+                         image_buffer_channel(buf, "B")},
+                        1, buf->width, buf->height};
+    return write_preview(path, &src, err, errsz);
+}

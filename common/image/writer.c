@@ -1,0 +1,221 @@
+/*
+ * writer.c: the tiled output EXR (see writer.h).
+ *
+ * Stitching by chunk copy: a tile file's only chunk was compressed from a
+ * w x h block with the output's channels, types, ZIP level and tile size
+ * (tile.h), which is exactly what the output file's chunk for that tile
+ * must hold (OpenEXR file layout: a tiled chunk is tile coordinates, level,
+ * size and the compressed pixel block; nothing in the compressed block
+ * depends on where the tile sits). So the master hands the validated bytes
+ * to exr_write_tile_chunk() with the output tile coordinates, and
+ * OpenEXRCore writes the chunk leader, the data and (at exr_finish) the
+ * offset table. No pixel is decoded or re-encoded on the master except
+ * once, inside validation, to prove the chunk is intact.
+ */
+#include "image/writer.h"
+
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "image/exr_io.h"
+#include "image/outfile.h"
+
+struct image_writer {
+    image_format fmt;
+    image_outfile *file;
+    image_exr_stream stream;    /* the context's I/O; address must not move */
+    exr_context_t ctxt;
+    uint8_t *written;           /* one flag per tile, row-major */
+    int tiles_written;
+    char failure[256];          /* set once a write failed: writer unusable */
+};
+
+image_writer *image_writer_new(const char *path, const image_format *fmt,
+                               char *err, size_t errsz)
+{
+    if (!image_format_check(fmt, err, errsz))
+        return NULL;
+    image_writer *self = calloc(1, sizeof *self);
+    uint8_t *written = calloc((size_t) image_format_tile_count(fmt), 1);
+    if (!self || !written) {
+        snprintf(err, errsz, "out of memory creating output image %s", path);
+        free(self);
+        free(written);
+        return NULL;
+    }
+    self->fmt = *fmt;
+    self->written = written;
+    self->file = image_outfile_new(path, err, errsz);
+    if (!self->file) {
+        image_writer_destroy(&self);
+        return NULL;
+    }
+    image_exr_stream_fd(&self->stream, image_outfile_fd(self->file));
+    image_rect whole = {0, 0, fmt->width, fmt->height};
+    exr_result_t rv = image_exr_start_write(&self->ctxt, path, &self->stream);
+    if (rv == EXR_ERR_SUCCESS)
+        rv = image_exr_define_part(self->ctxt, fmt, whole);
+    if (rv != EXR_ERR_SUCCESS) {
+        char what[300];
+        snprintf(what, sizeof what, "cannot write EXR header to %s",
+                 image_outfile_temp_path(self->file));
+        image_exr_error(err, errsz, what, rv, &self->stream);
+        image_writer_destroy(&self);
+    }
+    return self;
+}
+
+void image_writer_destroy(image_writer **self_p)
+{
+    if (!self_p || !*self_p)
+        return;
+    image_writer *self = *self_p;
+    if (self->ctxt) {
+        self->stream.discard = true;   /* the file is going away */
+        exr_finish(&self->ctxt);
+    }
+    image_outfile_destroy(&self->file);
+    free(self->written);
+    free(self);
+    *self_p = NULL;
+}
+
+static bool usable(const image_writer *self, char *err, size_t errsz)
+{
+    if (self->failure[0] == '\0')
+        return true;
+    snprintf(err, errsz, "%s", self->failure);
+    return false;
+}
+
+static uint8_t *written_flag(const image_writer *self, int tx, int ty)
+{
+    return &self->written[(size_t) ty * (size_t) image_format_tiles_x(&self->fmt)
+                          + (size_t) tx];
+}
+
+/* After a successful chunk write; or records the failure for good (the
+ * file's chunk area may hold a partial chunk now). */
+static bool record_write(image_writer *self, int tx, int ty, exr_result_t rv,
+                         char *err, size_t errsz)
+{
+    if (rv == EXR_ERR_SUCCESS) {
+        *written_flag(self, tx, ty) = 1;
+        self->tiles_written++;
+        return true;
+    }
+    char what[320];
+    snprintf(what, sizeof what, "cannot write tile (%d,%d) to %s", tx, ty,
+             image_outfile_temp_path(self->file));
+    image_exr_error(self->failure, sizeof self->failure, what, rv,
+                    &self->stream);
+    snprintf(err, errsz, "%s", self->failure);
+    return false;
+}
+
+bool image_writer_put_tile(image_writer *self, const image_tile *tile,
+                           char *err, size_t errsz)
+{
+    int tx, ty;
+    if (!usable(self, err, errsz)
+        || !image_format_tile_index(&self->fmt, image_tile_rect(tile), &tx,
+                                    &ty, err, errsz))
+        return false;
+    if (tile->layers != self->fmt.layers || !tile->rgba || !tile->z
+        || (tile->layers & IMAGE_LAYER_N && !tile->n)
+        || (tile->layers & IMAGE_LAYER_P && !tile->p)) {
+        snprintf(err, errsz, "tile at (%d,%d) does not have the image's "
+                 "layers 0x%x", tile->x0, tile->y0, self->fmt.layers);
+        return false;
+    }
+    if (*written_flag(self, tx, ty))
+        return true;
+    self->stream.message[0] = '\0';
+    exr_result_t rv = image_exr_write_tile(self->ctxt, &self->fmt, tx, ty,
+                                           tile);
+    return record_write(self, tx, ty, rv, err, errsz);
+}
+
+bool image_writer_put_exr_chunk(image_writer *self, const void *bytes,
+                                size_t len, image_rect expect,
+                                char *err, size_t errsz)
+{
+    const void *chunk = NULL;
+    size_t chunk_len = 0;
+    int tx, ty;
+    if (!usable(self, err, errsz)
+        || !image_format_tile_index(&self->fmt, expect, &tx, &ty, err, errsz)
+        || !image_tile_exr_chunk(bytes, len, &self->fmt, expect, &chunk,
+                                 &chunk_len, err, errsz))
+        return false;
+    if (*written_flag(self, tx, ty))
+        return true;
+    self->stream.message[0] = '\0';
+    exr_result_t rv = exr_write_tile_chunk(self->ctxt, 0, tx, ty, 0, 0, chunk,
+                                           chunk_len);
+    return record_write(self, tx, ty, rv, err, errsz);
+}
+
+bool image_writer_has_tile(const image_writer *self, int tx, int ty)
+{
+    return tx >= 0 && ty >= 0 && tx < image_format_tiles_x(&self->fmt)
+           && ty < image_format_tiles_y(&self->fmt)
+           && *written_flag(self, tx, ty);
+}
+
+int image_writer_tiles_written(const image_writer *self)
+{
+    return self->tiles_written;
+}
+
+const image_format *image_writer_format(const image_writer *self)
+{
+    return &self->fmt;
+}
+
+const char *image_writer_temp_path(const image_writer *self)
+{
+    return image_outfile_temp_path(self->file);
+}
+
+static bool report_missing(const image_writer *self, char *err, size_t errsz)
+{
+    int total = image_format_tile_count(&self->fmt);
+    int nx = image_format_tiles_x(&self->fmt);
+    for (int i = 0; i < total; i++) {
+        if (!self->written[i]) {
+            snprintf(err, errsz, "cannot finish %s: %d of %d tiles missing, "
+                     "first tile (%d,%d)", image_outfile_path(self->file),
+                     total - self->tiles_written, total, i % nx, i / nx);
+            return true;
+        }
+    }
+    return false;
+}
+
+bool image_writer_finish(image_writer **self_p, char *err, size_t errsz)
+{
+    image_writer *self = *self_p;
+    if (self->failure[0] == '\0' && report_missing(self, err, errsz))
+        return false;
+    if (!usable(self, err, errsz)) {
+        image_writer_destroy(self_p);
+        return false;
+    }
+    self->stream.message[0] = '\0';
+    exr_result_t rv = exr_finish(&self->ctxt);
+    self->ctxt = NULL;
+    if (rv != EXR_ERR_SUCCESS) {
+        char what[300];
+        snprintf(what, sizeof what, "cannot finish %s",
+                 image_outfile_temp_path(self->file));
+        image_exr_error(err, errsz, what, rv, &self->stream);
+        image_writer_destroy(self_p);
+        return false;
+    }
+    bool ok = image_outfile_commit(&self->file, err, errsz);
+    image_writer_destroy(self_p);
+    return ok;
+}
