@@ -1,0 +1,573 @@
+/*
+ * message.c: the checks every message passes before the master or a
+ * worker reads it (the rules: message.h and docs/protocol.md, "Messages"
+ * and "Limits"), the names and directions of the message kinds.
+ *
+ * One check_<kind>() per message kind, built from a few field checks
+ * (hash, name, text, range, count). Each failing check writes one
+ * sentence "<Message>.<field>: <problem>" and returns -1; nothing here
+ * trusts a length or a count that it has not compared with a limit.
+ */
+#include "message.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "util/hash.h"
+#include "version.h"
+
+proto_limits proto_limits_default(void)
+{
+    proto_limits l = {
+        .max_header_bytes = 4u << 20,
+        .max_bulk_bytes = 64u << 20,
+        .max_name_bytes = 4096,
+        .max_text_bytes = 4u << 20,
+        .max_list = 4096,
+        .max_image_side = 65536,
+        .max_tile_side = 8192,
+        .max_threads = 4096,
+        .max_credits = 4096,
+        .max_deadline_ms = 86400000u,
+        .unpack_factor = 16,
+    };
+    return l;
+}
+
+/* ---------------------------------------------------------------------- */
+/* kinds                                                                   */
+/* ---------------------------------------------------------------------- */
+
+const char *proto_message_name(proto_kind kind)
+{
+    switch (kind) {
+    case AAFARM__ENVELOPE__BODY__NOT_SET: return "(no message)";
+    case AAFARM__ENVELOPE__BODY_HELLO: return "Hello";
+    case AAFARM__ENVELOPE__BODY_WELCOME: return "Welcome";
+    case AAFARM__ENVELOPE__BODY_REJECT: return "Reject";
+    case AAFARM__ENVELOPE__BODY_ASK: return "Ask";
+    case AAFARM__ENVELOPE__BODY_JOB: return "Job";
+    case AAFARM__ENVELOPE__BODY_NEED_JOB: return "NeedJob";
+    case AAFARM__ENVELOPE__BODY_GRANT: return "Grant";
+    case AAFARM__ENVELOPE__BODY_RESULT: return "Result";
+    case AAFARM__ENVELOPE__BODY_FAILURE: return "Failure";
+    case AAFARM__ENVELOPE__BODY_HEARTBEAT: return "Heartbeat";
+    case AAFARM__ENVELOPE__BODY_JOB_DONE: return "JobDone";
+    case AAFARM__ENVELOPE__BODY_SHUTDOWN: return "Shutdown";
+    default: return "(unknown message)";
+    }
+}
+
+bool proto_message_from_worker(proto_kind kind)
+{
+    switch (kind) {
+    case AAFARM__ENVELOPE__BODY_HELLO:
+    case AAFARM__ENVELOPE__BODY_ASK:
+    case AAFARM__ENVELOPE__BODY_NEED_JOB:
+    case AAFARM__ENVELOPE__BODY_RESULT:
+    case AAFARM__ENVELOPE__BODY_FAILURE:
+    case AAFARM__ENVELOPE__BODY_HEARTBEAT:
+    case AAFARM__ENVELOPE__BODY_SHUTDOWN:
+        return true;
+    default:
+        return false;
+    }
+}
+
+bool proto_message_from_master(proto_kind kind)
+{
+    switch (kind) {
+    case AAFARM__ENVELOPE__BODY_WELCOME:
+    case AAFARM__ENVELOPE__BODY_REJECT:
+    case AAFARM__ENVELOPE__BODY_JOB:
+    case AAFARM__ENVELOPE__BODY_GRANT:
+    case AAFARM__ENVELOPE__BODY_HEARTBEAT:
+    case AAFARM__ENVELOPE__BODY_JOB_DONE:
+    case AAFARM__ENVELOPE__BODY_SHUTDOWN:
+        return true;
+    default:
+        return false;
+    }
+}
+
+bool proto_message_has_bulk(proto_kind kind)
+{
+    return kind == AAFARM__ENVELOPE__BODY_RESULT;
+}
+
+/* ---------------------------------------------------------------------- */
+/* field checks                                                            */
+/* ---------------------------------------------------------------------- */
+
+/* Where a check writes its sentence. */
+typedef struct checker {
+    const proto_limits *limits;
+    char *err;
+    size_t errlen;
+} checker;
+
+#if defined(__GNUC__)
+__attribute__((format(printf, 3, 4)))
+#endif
+static int fail(checker *c, const char *field, const char *fmt, ...)
+{
+    if (c->err && c->errlen > 0) {
+        int n = snprintf(c->err, c->errlen, "%s: ", field);
+        if (n >= 0 && (size_t)n < c->errlen) {
+            va_list ap;
+            va_start(ap, fmt);
+            vsnprintf(c->err + n, c->errlen - (size_t)n, fmt, ap);
+            va_end(ap);
+        }
+    }
+    return -1;
+}
+
+static int check_hash(checker *c, const char *field, const char *s)
+{
+    if (!s || !*s)
+        return fail(c, field, "missing (a job hash is 64 lowercase hex digits)");
+    if (!hash_hex_valid(s))
+        return fail(c, field, "not a job hash (64 lowercase hex digits, got %zu bytes)",
+                    strnlen(s, 1000));
+    return 0;
+}
+
+/* A control character other than the allowed ones, or -1. */
+static long control_at(const char *s, size_t len, bool multiline)
+{
+    for (size_t i = 0; i < len; i++) {
+        unsigned char ch = (unsigned char)s[i];
+        bool layout = ch == '\n' || ch == '\t' || ch == '\r';
+        if ((ch < 0x20 || ch == 0x7f) && !(multiline && layout))
+            return (long)i;
+    }
+    return -1;
+}
+
+/* A one-line name: at most max_name_bytes, no control characters. */
+static int check_name(checker *c, const char *field, const char *s, bool required)
+{
+    size_t len = s ? strlen(s) : 0;
+    if (len == 0)
+        return required ? fail(c, field, "missing (must not be empty)") : 0;
+    if (len > c->limits->max_name_bytes)
+        return fail(c, field, "%zu bytes, the limit is %zu", len, c->limits->max_name_bytes);
+    long at = control_at(s, len, false);
+    if (at >= 0)
+        return fail(c, field, "control character 0x%02x at byte %ld",
+                    (unsigned)(unsigned char)s[at], at);
+    return 0;
+}
+
+/* Free text (a reason, an error message): at most max_text_bytes; line
+ * breaks and tabs allowed, other control characters not. */
+static int check_prose(checker *c, const char *field, const char *s, bool required)
+{
+    size_t len = s ? strlen(s) : 0;
+    if (len == 0)
+        return required ? fail(c, field, "missing (must not be empty)") : 0;
+    if (len > c->limits->max_text_bytes)
+        return fail(c, field, "%zu bytes, the limit is %zu", len, c->limits->max_text_bytes);
+    long at = control_at(s, len, true);
+    if (at >= 0)
+        return fail(c, field, "control character 0x%02x at byte %ld",
+                    (unsigned)(unsigned char)s[at], at);
+    return 0;
+}
+
+/* Source text (scene, shader) in a bytes field: non-empty, bounded, no
+ * NUL byte (the parsers read C strings). */
+static int check_source(checker *c, const char *field, ProtobufCBinaryData text)
+{
+    if (text.len == 0 || !text.data)
+        return fail(c, field, "missing (must not be empty)");
+    if (text.len > c->limits->max_text_bytes)
+        return fail(c, field, "%zu bytes, the limit is %zu", text.len, c->limits->max_text_bytes);
+    const uint8_t *nul = memchr(text.data, 0, text.len);
+    if (nul)
+        return fail(c, field, "NUL byte at offset %zu (source text must be text)",
+                    (size_t)(nul - text.data));
+    return 0;
+}
+
+static int check_range(checker *c, const char *field, uint64_t v, uint64_t lo, uint64_t hi)
+{
+    if (v < lo || v > hi)
+        return fail(c, field, "%llu is outside %llu..%llu", (unsigned long long)v,
+                    (unsigned long long)lo, (unsigned long long)hi);
+    return 0;
+}
+
+static int check_count(checker *c, const char *field, size_t n)
+{
+    if (n > c->limits->max_list)
+        return fail(c, field, "%zu entries, the limit is %zu", n, c->limits->max_list);
+    return 0;
+}
+
+static int check_present(checker *c, const char *field, const void *p)
+{
+    return p ? 0 : fail(c, field, "missing");
+}
+
+static int check_seconds(checker *c, const char *field, double v)
+{
+    if (!isfinite(v) || v < 0)
+        return fail(c, field, "%g is not a finite number of seconds >= 0", v);
+    return 0;
+}
+
+static int by_string(const void *a, const void *b)
+{
+    return strcmp(*(const char *const *)a, *(const char *const *)b);
+}
+
+/* Fails when two of names[0..n) are equal (names already checked). */
+static int check_unique(checker *c, const char *field, const char *const *names, size_t n)
+{
+    if (n < 2)
+        return 0;
+    const char **v = malloc(n * sizeof *v);
+    if (!v)
+        return fail(c, field, "out of memory checking %zu names", n);
+    memcpy(v, names, n * sizeof *v);
+    qsort(v, n, sizeof *v, by_string);
+    int rc = 0;
+    for (size_t i = 1; i < n && rc == 0; i++)
+        if (strcmp(v[i - 1], v[i]) == 0)
+            rc = fail(c, field, "\"%s\" appears twice", v[i]);
+    free(v);
+    return rc;
+}
+
+/* ---------------------------------------------------------------------- */
+/* one check per message kind                                              */
+/* ---------------------------------------------------------------------- */
+
+static int check_hello(checker *c, const Aafarm__Hello *m)
+{
+    if (m->protocol_version == 0)
+        return fail(c, "Hello.protocol_version", "missing");
+    if (m->protocol_version != AAFARM_PROTOCOL_VERSION)
+        return 0; /* frozen fields only: the master answers with a Reject */
+    if (check_name(c, "Hello.worker_name", m->worker_name, true) ||
+        check_name(c, "Hello.host", m->host, true) ||
+        check_range(c, "Hello.threads", m->threads, 1, c->limits->max_threads) ||
+        check_name(c, "Hello.software", m->software, false) ||
+        check_count(c, "Hello.jobs_held", m->n_jobs_held))
+        return -1;
+    for (size_t i = 0; i < m->n_jobs_held; i++)
+        if (check_hash(c, "Hello.jobs_held", m->jobs_held[i]))
+            return -1;
+    return 0;
+}
+
+static int check_welcome(checker *c, const Aafarm__Welcome *m)
+{
+    if (m->protocol_version == 0)
+        return fail(c, "Welcome.protocol_version", "missing");
+    if (m->protocol_version != AAFARM_PROTOCOL_VERSION)
+        return 0; /* frozen fields only: the worker reports the mismatch */
+    if (check_name(c, "Welcome.master_name", m->master_name, false))
+        return -1;
+    if (m->master_session == 0)
+        return fail(c, "Welcome.master_session", "missing (must not be 0)");
+    return check_range(c, "Welcome.heartbeat_ms", m->heartbeat_ms, PROTO_HEARTBEAT_MS_MIN,
+                       PROTO_HEARTBEAT_MS_MAX) ||
+                   check_range(c, "Welcome.heartbeat_liveness", m->heartbeat_liveness, 1,
+                               PROTO_LIVENESS_MAX)
+               ? -1
+               : 0;
+}
+
+/* Reject is frozen: any code (a newer master may have more; unknown codes
+ * read as REFUSED), a reason in words. */
+static int check_reject(checker *c, const Aafarm__Reject *m)
+{
+    return check_prose(c, "Reject.reason", m->reason, true);
+}
+
+static int check_ask(checker *c, const Aafarm__Ask *m)
+{
+    return check_range(c, "Ask.credits", m->credits, 1, c->limits->max_credits);
+}
+
+/* The source files: names unique, texts present. */
+static int check_sources(checker *c, const Aafarm__Job *m)
+{
+    if (check_count(c, "Job.sources", m->n_sources))
+        return -1;
+    const char **names = malloc((m->n_sources + 1) * sizeof *names);
+    if (!names)
+        return fail(c, "Job.sources", "out of memory");
+    int rc = 0;
+    for (size_t i = 0; i < m->n_sources && rc == 0; i++) {
+        const Aafarm__Source *s = m->sources[i];
+        if (!s) {
+            rc = fail(c, "Job.sources", "entry %zu is missing", i);
+            break;
+        }
+        rc = check_name(c, "Job.sources.name", s->name, true) ||
+             check_source(c, "Job.sources.text", s->text);
+        names[i] = s->name;
+    }
+    if (rc == 0)
+        rc = check_unique(c, "Job.sources.name", names, m->n_sources);
+    free(names);
+    return rc ? -1 : 0;
+}
+
+static bool has_source(const Aafarm__Job *m, const char *name)
+{
+    for (size_t i = 0; i < m->n_sources; i++)
+        if (strcmp(m->sources[i]->name, name) == 0)
+            return true;
+    return false;
+}
+
+/* The shader bindings: names unique, each naming a source of the job
+ * (sources already checked). */
+static int check_bindings(checker *c, const Aafarm__Job *m)
+{
+    if (check_count(c, "Job.shaders", m->n_shaders))
+        return -1;
+    const char **names = malloc((m->n_shaders + 1) * sizeof *names);
+    if (!names)
+        return fail(c, "Job.shaders", "out of memory");
+    int rc = 0;
+    for (size_t i = 0; i < m->n_shaders && rc == 0; i++) {
+        const Aafarm__ShaderBinding *b = m->shaders[i];
+        if (!b) {
+            rc = fail(c, "Job.shaders", "entry %zu is missing", i);
+            break;
+        }
+        rc = check_name(c, "Job.shaders.name", b->name, true) ||
+             check_name(c, "Job.shaders.source", b->source, true);
+        if (rc == 0 && !has_source(m, b->source))
+            rc = fail(c, "Job.shaders.source", "\"%s\" (for shader \"%s\") is not among Job.sources",
+                      b->source, b->name);
+        names[i] = b->name;
+    }
+    if (rc == 0)
+        rc = check_unique(c, "Job.shaders.name", names, m->n_shaders);
+    free(names);
+    return rc ? -1 : 0;
+}
+
+static int check_extra(checker *c, const Aafarm__RenderOptions *o)
+{
+    if (check_count(c, "Job.options.extra", o->n_extra))
+        return -1;
+    const char **keys = malloc((o->n_extra + 1) * sizeof *keys);
+    if (!keys)
+        return fail(c, "Job.options.extra", "out of memory");
+    int rc = 0;
+    for (size_t i = 0; i < o->n_extra && rc == 0; i++) {
+        const Aafarm__Option *kv = o->extra[i];
+        if (!kv) {
+            rc = fail(c, "Job.options.extra", "entry %zu is missing", i);
+            break;
+        }
+        rc = check_name(c, "Job.options.extra.key", kv->key, true) ||
+             check_name(c, "Job.options.extra.value", kv->value, false);
+        keys[i] = kv->key;
+    }
+    if (rc == 0)
+        rc = check_unique(c, "Job.options.extra.key", keys, o->n_extra);
+    free(keys);
+    return rc ? -1 : 0;
+}
+
+static int check_layers(checker *c, const Aafarm__RenderOptions *o)
+{
+    if (check_count(c, "Job.options.layers", o->n_layers))
+        return -1;
+    for (size_t i = 0; i < o->n_layers; i++)
+        if (check_name(c, "Job.options.layers", o->layers[i], true))
+            return -1;
+    return check_unique(c, "Job.options.layers", (const char *const *)o->layers, o->n_layers);
+}
+
+static int check_options(checker *c, const Aafarm__RenderOptions *o)
+{
+    const proto_limits *l = c->limits;
+    if (check_present(c, "Job.options", o) ||
+        check_range(c, "Job.options.width", o->width, 1, l->max_image_side) ||
+        check_range(c, "Job.options.height", o->height, 1, l->max_image_side) ||
+        check_range(c, "Job.options.tile_size", o->tile_size, 1, l->max_tile_side))
+        return -1;
+    if (o->arithmetic != AAFARM__ARITHMETIC__ARITHMETIC_AFFINE &&
+        o->arithmetic != AAFARM__ARITHMETIC__ARITHMETIC_INTERVAL)
+        return fail(c, "Job.options.arithmetic", "%d is neither affine (0) nor interval (1)",
+                    (int)o->arithmetic);
+    return check_layers(c, o) || check_extra(c, o) ? -1 : 0;
+}
+
+static int check_job(checker *c, const Aafarm__Job *m)
+{
+    return check_hash(c, "Job.job_hash", m->job_hash) ||
+                   check_name(c, "Job.scene_name", m->scene_name, true) ||
+                   check_source(c, "Job.scene_text", m->scene_text) || check_sources(c, m) ||
+                   check_bindings(c, m) || check_options(c, m->options)
+               ? -1
+               : 0;
+}
+
+static int check_need_job(checker *c, const Aafarm__NeedJob *m)
+{
+    return check_hash(c, "NeedJob.job_hash", m->job_hash);
+}
+
+static int check_lease(checker *c, const char *field, uint64_t lease)
+{
+    return lease == 0 ? fail(c, field, "missing (must not be 0)") : 0;
+}
+
+static int check_rect(checker *c, const Aafarm__Rect *r)
+{
+    const proto_limits *l = c->limits;
+    if (check_present(c, "Grant.tile", r) ||
+        check_range(c, "Grant.tile.width", r->width, 1, l->max_tile_side) ||
+        check_range(c, "Grant.tile.height", r->height, 1, l->max_tile_side))
+        return -1;
+    if ((uint64_t)r->x + r->width > l->max_image_side)
+        return fail(c, "Grant.tile", "right edge x + width = %llu is beyond the image limit %u",
+                    (unsigned long long)r->x + r->width, l->max_image_side);
+    if ((uint64_t)r->y + r->height > l->max_image_side)
+        return fail(c, "Grant.tile", "bottom edge y + height = %llu is beyond the image limit %u",
+                    (unsigned long long)r->y + r->height, l->max_image_side);
+    return 0;
+}
+
+static int check_grant(checker *c, const Aafarm__Grant *m)
+{
+    return check_hash(c, "Grant.job_hash", m->job_hash) ||
+                   check_lease(c, "Grant.lease_id", m->lease_id) || check_rect(c, m->tile) ||
+                   check_range(c, "Grant.deadline_ms", m->deadline_ms, 1,
+                               c->limits->max_deadline_ms)
+               ? -1
+               : 0;
+}
+
+static int check_result(checker *c, const Aafarm__Result *m, bool has_bulk, size_t bulk_len)
+{
+    if (check_hash(c, "Result.job_hash", m->job_hash) ||
+        check_lease(c, "Result.lease_id", m->lease_id) ||
+        check_present(c, "Result.stats", m->stats) ||
+        check_seconds(c, "Result.stats.cpu_seconds", m->stats->cpu_seconds) ||
+        check_seconds(c, "Result.stats.wall_seconds", m->stats->wall_seconds))
+        return -1;
+    if (!has_bulk)
+        return fail(c, "Result", "the bulk frame with the tile's EXR bytes is missing");
+    if (m->exr_bytes == 0 || m->exr_bytes != bulk_len)
+        return fail(c, "Result.exr_bytes", "says %llu but the bulk frame has %zu bytes",
+                    (unsigned long long)m->exr_bytes, bulk_len);
+    return 0;
+}
+
+static int check_failure(checker *c, const Aafarm__Failure *m)
+{
+    return check_hash(c, "Failure.job_hash", m->job_hash) ||
+                   check_lease(c, "Failure.lease_id", m->lease_id) ||
+                   check_prose(c, "Failure.message", m->message, true)
+               ? -1
+               : 0;
+}
+
+static int check_heartbeat(checker *c, const Aafarm__Heartbeat *m)
+{
+    if (check_count(c, "Heartbeat.leases", m->n_leases))
+        return -1;
+    for (size_t i = 0; i < m->n_leases; i++)
+        if (check_lease(c, "Heartbeat.leases", m->leases[i]))
+            return -1;
+    return 0;
+}
+
+static int check_job_done(checker *c, const Aafarm__JobDone *m)
+{
+    if (check_hash(c, "JobDone.job_hash", m->job_hash))
+        return -1;
+    switch (m->status) {
+    case AAFARM__JOB_STATUS__JOB_STATUS_DONE:
+        return check_prose(c, "JobDone.message", m->message, false);
+    case AAFARM__JOB_STATUS__JOB_STATUS_FAILED:
+    case AAFARM__JOB_STATUS__JOB_STATUS_CANCELLED:
+        return check_prose(c, "JobDone.message", m->message, true);
+    default:
+        return fail(c, "JobDone.status", "%d is not DONE, FAILED or CANCELLED", (int)m->status);
+    }
+}
+
+static int check_shutdown(checker *c, const Aafarm__Shutdown *m)
+{
+    return check_prose(c, "Shutdown.reason", m->reason, false);
+}
+
+/* The body for its kind; a oneof member can still be NULL if a sender
+ * built the struct by hand. */
+static const void *body_of(const Aafarm__Envelope *m)
+{
+    switch (m->body_case) {
+    case AAFARM__ENVELOPE__BODY_HELLO: return m->hello;
+    case AAFARM__ENVELOPE__BODY_WELCOME: return m->welcome;
+    case AAFARM__ENVELOPE__BODY_REJECT: return m->reject;
+    case AAFARM__ENVELOPE__BODY_ASK: return m->ask;
+    case AAFARM__ENVELOPE__BODY_JOB: return m->job;
+    case AAFARM__ENVELOPE__BODY_NEED_JOB: return m->need_job;
+    case AAFARM__ENVELOPE__BODY_GRANT: return m->grant;
+    case AAFARM__ENVELOPE__BODY_RESULT: return m->result;
+    case AAFARM__ENVELOPE__BODY_FAILURE: return m->failure;
+    case AAFARM__ENVELOPE__BODY_HEARTBEAT: return m->heartbeat;
+    case AAFARM__ENVELOPE__BODY_JOB_DONE: return m->job_done;
+    case AAFARM__ENVELOPE__BODY_SHUTDOWN: return m->shutdown;
+    default: return NULL;
+    }
+}
+
+static int check_body(checker *c, const Aafarm__Envelope *m, bool has_bulk, size_t bulk_len)
+{
+    switch (m->body_case) {
+    case AAFARM__ENVELOPE__BODY_HELLO: return check_hello(c, m->hello);
+    case AAFARM__ENVELOPE__BODY_WELCOME: return check_welcome(c, m->welcome);
+    case AAFARM__ENVELOPE__BODY_REJECT: return check_reject(c, m->reject);
+    case AAFARM__ENVELOPE__BODY_ASK: return check_ask(c, m->ask);
+    case AAFARM__ENVELOPE__BODY_JOB: return check_job(c, m->job);
+    case AAFARM__ENVELOPE__BODY_NEED_JOB: return check_need_job(c, m->need_job);
+    case AAFARM__ENVELOPE__BODY_GRANT: return check_grant(c, m->grant);
+    case AAFARM__ENVELOPE__BODY_RESULT: return check_result(c, m->result, has_bulk, bulk_len);
+    case AAFARM__ENVELOPE__BODY_FAILURE: return check_failure(c, m->failure);
+    case AAFARM__ENVELOPE__BODY_HEARTBEAT: return check_heartbeat(c, m->heartbeat);
+    case AAFARM__ENVELOPE__BODY_JOB_DONE: return check_job_done(c, m->job_done);
+    case AAFARM__ENVELOPE__BODY_SHUTDOWN: return check_shutdown(c, m->shutdown);
+    default: return fail(c, "Envelope", "unknown message kind %d", (int)m->body_case);
+    }
+}
+
+int proto_message_check(const Aafarm__Envelope *msg, bool has_bulk, size_t bulk_len,
+                        const proto_limits *limits, char *err, size_t errlen)
+{
+    proto_limits defaults = proto_limits_default();
+    checker c = {limits ? limits : &defaults, err, errlen};
+    if (!msg)
+        return fail(&c, "Envelope", "missing");
+    if (msg->body_case == AAFARM__ENVELOPE__BODY__NOT_SET)
+        return fail(&c, "Envelope", "carries no message (an unknown kind from a newer peer?)");
+    if (msg->body_case < AAFARM__ENVELOPE__BODY_HELLO ||
+        msg->body_case > AAFARM__ENVELOPE__BODY_SHUTDOWN)
+        return fail(&c, "Envelope", "unknown message kind %d", (int)msg->body_case);
+    const char *name = proto_message_name(msg->body_case);
+    if (!body_of(msg))
+        return check_present(&c, name, NULL);
+    if (has_bulk && !proto_message_has_bulk(msg->body_case))
+        return fail(&c, name, "comes with a bulk frame of %zu bytes; only Result has one",
+                    bulk_len);
+    if (has_bulk && bulk_len > c.limits->max_bulk_bytes)
+        return fail(&c, name, "bulk frame of %zu bytes, the limit is %zu", bulk_len,
+                    c.limits->max_bulk_bytes);
+    return check_body(&c, msg, has_bulk, bulk_len);
+}
