@@ -1,0 +1,304 @@
+/*
+ * rib_geometry.c: the geometric primitives of RI Specification 3.2 §5:
+ * the quadrics of §5.2 (Sphere, Disk, Cylinder, Cone, Torus, Hyperboloid,
+ * Paraboloid), Polygon (§5.1, convex planar) and Patch "bilinear" (§5.3).
+ * Each becomes one scene_object: its geom_surface in object space (angles
+ * converted from the RIB's degrees to radians), its transforms and a copy
+ * of the current attributes.
+ *
+ * Validation is geom_surface_prepare's (common/geom), whose reason goes
+ * into the message ("Sphere: sphere radius must be > 0, got -1"); when the
+ * library is built without common/geom, basic checks here stand in.
+ */
+#include "scene/rib_parser.h"
+#include "sl/strbuf.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static double radians(double degrees) { return degrees * (M_PI / 180.0); }
+
+/* ---------------------------------------------------------------------- */
+/* validation                                                              */
+/* ---------------------------------------------------------------------- */
+
+#ifndef SCENE_HAVE_GEOM
+/* Stand-in checks for builds without common/geom. */
+static bool basic_check(const geom_surface *s, char *why, int n)
+{
+    const char *what = NULL;
+    switch (s->kind) {
+    case GEOM_SPHERE: case GEOM_CYLINDER:
+        if (!(s->radius > 0)) what = "radius must be > 0";
+        else if (!(s->zmin < s->zmax)) what = "zmin must be < zmax";
+        break;
+    case GEOM_DISK: case GEOM_CONE:
+        if (!(s->radius > 0)) what = "radius must be > 0";
+        break;
+    case GEOM_PARABOLOID:
+        if (!(s->rmax > 0)) what = "rmax must be > 0";
+        else if (!(s->zmin < s->zmax)) what = "zmin must be < zmax";
+        break;
+    case GEOM_TORUS:
+        if (!(s->minorrad > 0)) what = "minor radius must be > 0";
+        else if (s->phimin == s->phimax) what = "phimin must differ from phimax";
+        break;
+    case GEOM_HYPERBOLOID:
+        if (s->point1.x == s->point2.x && s->point1.y == s->point2.y &&
+            s->point1.z == s->point2.z)
+            what = "point1 and point2 must differ";
+        break;
+    default:
+        break;
+    }
+    bool theta_ok = s->thetamax != 0 && fabs(s->thetamax) <= 2 * M_PI + 1e-9;
+    if (!what && s->kind < GEOM_POLYGON && !theta_ok)
+        what = "thetamax must be non-zero and at most 360 degrees";
+    if (what)
+        snprintf(why, (size_t)n, "%s", what);
+    return what == NULL;
+}
+#endif
+
+static bool prepare_surface(geom_surface *s, char *why, int n)
+{
+#ifdef SCENE_HAVE_GEOM
+    return geom_surface_prepare(s, why, n);
+#else
+    return basic_check(s, why, n);
+#endif
+}
+
+/* ---------------------------------------------------------------------- */
+/* the object                                                              */
+/* ---------------------------------------------------------------------- */
+
+/* The flip of Ng the orientation asks for: "outside" keeps the normals
+ * geom computes (outward for quadrics), "inside" flips them, "lh"/"rh"
+ * flip when the object's space has the other handedness (camera space is
+ * left-handed; a negative determinant mirrors). */
+static bool reverse_normals(scene_orientation o, const mat4 *object_to_camera)
+{
+    bool left_handed = mat4_det3(object_to_camera) > 0;
+    switch (o) {
+    case SCENE_OUTSIDE: return false;
+    case SCENE_INSIDE:  return true;
+    case SCENE_LH:      return !left_handed;
+    case SCENE_RH:      return left_handed;
+    }
+    return false;
+}
+
+static void object_lights(const rib_parser *p, scene_object *o)
+{
+    const rib_attributes *a = &p->attr;
+    o->lights = sl_xrealloc(NULL, (size_t)(p->scene->nlights ? p->scene->nlights : 1) *
+                            sizeof *o->lights);
+    for (int i = 0; i < p->scene->nlights && i < a->nlight_on; i++)
+        if (a->light_on[i])
+            o->lights[o->nlights++] = i;
+}
+
+/* Validates the surface and adds the object with the current attributes. */
+static void add_object(rib_parser *p, const rib_request *req, geom_surface *surf)
+{
+    char why[256] = "";
+    if (!prepare_surface(surf, why, sizeof why)) {
+        rib_error(p, req, req->pos, "%s", why[0] ? why : "invalid parameters");
+        return;
+    }
+    const rib_attributes *a = &p->attr;
+    mat4 to_camera = mat4_mul(p->scene->camera.camera_from_world, a->ctm), inv;
+    if (!mat4_invert(&to_camera, &inv)) {
+        rib_error(p, req, req->pos, "the current transform is singular (a Scale by 0?)");
+        return;
+    }
+    scene_object *o = rib_add_object(p);
+    o->surface = *surf;
+    o->object_to_world = a->ctm;
+    o->object_to_camera = to_camera;
+    o->camera_to_object = inv;
+    o->surface_shader = a->surface;
+    o->displacement_shader = a->displacement;
+    memcpy(o->Cs, a->Cs, sizeof o->Cs);
+    memcpy(o->Os, a->Os, sizeof o->Os);
+    o->sides = a->sides;
+    o->orientation = a->orientation;
+    o->reverse_normals = reverse_normals(a->orientation, &to_camera);
+    o->shading_rate = a->shading_rate;
+    o->displacement_bound = a->displacement_bound;
+    o->displacement_bound_space = sl_xstrndup(a->bound_space, strlen(a->bound_space));
+    o->name = a->name ? sl_xstrndup(a->name, strlen(a->name)) : NULL;
+    o->pos = req->pos;
+    object_lights(p, o);
+}
+
+/* Reads the positional numbers, then the parameter list (typed, values
+ * ignored: aafarm's quadrics take no primitive variables). */
+static bool read_quadric(rib_parser *p, const rib_request *req, int n, double *v,
+                         const char *what)
+{
+    int next = rib_read_numbers(p, req, 0, n, v, what);
+    rib_params params;
+    if (next < 0 || !rib_params_read(p, req, next, RIB_PARAMS_VARYING, &params))
+        return false;
+    rib_params_free(&params);
+    return true;
+}
+
+static geom_surface new_surface(geom_kind kind)
+{
+    geom_surface s;
+    memset(&s, 0, sizeof s);
+    s.kind = kind;
+    return s;
+}
+
+/* ---------------------------------------------------------------------- */
+/* quadrics (§5.2)                                                         */
+/* ---------------------------------------------------------------------- */
+
+void rib_sphere(rib_parser *p, const rib_request *req)
+{
+    double v[4];
+    if (!read_quadric(p, req, 4, v, "radius zmin zmax thetamax"))
+        return;
+    geom_surface s = new_surface(GEOM_SPHERE);
+    s.radius = v[0], s.zmin = v[1], s.zmax = v[2], s.thetamax = radians(v[3]);
+    add_object(p, req, &s);
+}
+
+void rib_disk(rib_parser *p, const rib_request *req)
+{
+    double v[3];
+    if (!read_quadric(p, req, 3, v, "height radius thetamax"))
+        return;
+    geom_surface s = new_surface(GEOM_DISK);
+    s.height = v[0], s.radius = v[1], s.thetamax = radians(v[2]);
+    add_object(p, req, &s);
+}
+
+void rib_cylinder(rib_parser *p, const rib_request *req)
+{
+    double v[4];
+    if (!read_quadric(p, req, 4, v, "radius zmin zmax thetamax"))
+        return;
+    geom_surface s = new_surface(GEOM_CYLINDER);
+    s.radius = v[0], s.zmin = v[1], s.zmax = v[2], s.thetamax = radians(v[3]);
+    add_object(p, req, &s);
+}
+
+void rib_cone(rib_parser *p, const rib_request *req)
+{
+    double v[3];
+    if (!read_quadric(p, req, 3, v, "height radius thetamax"))
+        return;
+    geom_surface s = new_surface(GEOM_CONE);
+    s.height = v[0], s.radius = v[1], s.thetamax = radians(v[2]);
+    add_object(p, req, &s);
+}
+
+void rib_torus(rib_parser *p, const rib_request *req)
+{
+    double v[5];
+    if (!read_quadric(p, req, 5, v, "majorradius minorradius phimin phimax thetamax"))
+        return;
+    geom_surface s = new_surface(GEOM_TORUS);
+    s.majorrad = v[0], s.minorrad = v[1];
+    s.phimin = radians(v[2]), s.phimax = radians(v[3]), s.thetamax = radians(v[4]);
+    add_object(p, req, &s);
+}
+
+void rib_hyperboloid(rib_parser *p, const rib_request *req)
+{
+    double v[7];
+    if (!read_quadric(p, req, 7, v, "point1 point2 thetamax"))
+        return;
+    geom_surface s = new_surface(GEOM_HYPERBOLOID);
+    s.point1 = v3(v[0], v[1], v[2]);
+    s.point2 = v3(v[3], v[4], v[5]);
+    s.thetamax = radians(v[6]);
+    add_object(p, req, &s);
+}
+
+void rib_paraboloid(rib_parser *p, const rib_request *req)
+{
+    double v[4];
+    if (!read_quadric(p, req, 4, v, "rmax zmin zmax thetamax"))
+        return;
+    geom_surface s = new_surface(GEOM_PARABOLOID);
+    s.rmax = v[0], s.zmin = v[1], s.zmax = v[2], s.thetamax = radians(v[3]);
+    add_object(p, req, &s);
+}
+
+/* ---------------------------------------------------------------------- */
+/* Polygon (§5.1), Patch "bilinear" (§5.3)                                 */
+/* ---------------------------------------------------------------------- */
+
+/* The "P" parameter of a primitive; NULL (with an error) when missing. */
+static const scene_param *find_P(rib_parser *p, const rib_request *req, const rib_params *params)
+{
+    const scene_param *P = rib_params_find(params, "P");
+    if (!P)
+        rib_error(p, req, req->pos, "missing the vertices: add \"P\" [x y z x y z ...]");
+    else if (P->type != SL_TYPE_POINT) {
+        rib_error(p, req, P->pos, "\"P\" must be declared as a point, not a %s",
+                  rib_type_name(P->type));
+        P = NULL;
+    }
+    return P;
+}
+
+static void take_vertices(geom_surface *s, const scene_param *P, int n)
+{
+    s->nverts = n;
+    for (int i = 0; i < n; i++)
+        s->verts[i] = v3(P->values[3 * i], P->values[3 * i + 1], P->values[3 * i + 2]);
+}
+
+void rib_polygon(rib_parser *p, const rib_request *req)
+{
+    rib_params params;
+    if (!rib_params_read(p, req, 0, RIB_PARAMS_VARYING, &params))
+        return;
+    const scene_param *P = find_P(p, req, &params);
+    int n = P ? P->count / 3 : 0;
+    if (P && n < 3)
+        rib_error(p, req, P->pos, "a polygon needs at least 3 vertices, got %d", n);
+    else if (P && n > GEOM_MAX_POLY_VERTS)
+        rib_error(p, req, P->pos, "at most %d vertices are supported, got %d",
+                  GEOM_MAX_POLY_VERTS, n);
+    else if (P) {
+        geom_surface s = new_surface(GEOM_POLYGON);
+        take_vertices(&s, P, n);
+        add_object(p, req, &s);
+    }
+    rib_params_free(&params);
+}
+
+void rib_patch(rib_parser *p, const rib_request *req)
+{
+    const char *type = rib_read_string(p, req, 0, "the patch type");
+    if (!type)
+        return;
+    if (strcmp(type, "bilinear") != 0) {
+        rib_error(p, req, req->args[0].pos, "only \"bilinear\" patches are supported, got "
+                  "\"%s\"", type);
+        return;
+    }
+    rib_params params;
+    if (!rib_params_read(p, req, 1, RIB_PARAMS_VARYING, &params))
+        return;
+    const scene_param *P = find_P(p, req, &params);
+    if (P && P->count != 12)
+        rib_error(p, req, P->pos, "a bilinear patch needs 4 points in \"P\" (12 numbers), "
+                  "got %d numbers", P->count);
+    else if (P) {
+        geom_surface s = new_surface(GEOM_PATCH);
+        take_vertices(&s, P, 4);
+        add_object(p, req, &s);
+    }
+    rib_params_free(&params);
+}

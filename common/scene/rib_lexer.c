@@ -1,0 +1,289 @@
+/*
+ * rib_lexer.c: ASCII RIB tokens (see rib_lexer.h).
+ *
+ * A hand-written scanner in the clox manner: one switch on the first byte
+ * of a token. Numbers are checked against the RIB number syntax
+ * ([+-] digits [. digits] [e [+-] digits], digits on at least one side of
+ * the point) over the whole run of non-delimiter bytes, so "1.2.3" and
+ * "12abc" are one bad number, not two tokens. A run of unexpected bytes is
+ * reported once.
+ */
+#include "scene/rib_lexer.h"
+#include "sl/strbuf.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdbool.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+struct rib_lexer {
+    const char *file;
+    const char *text, *end, *p;
+    const char *line_start;
+    int line;
+    sl_strbuf str;          /* the last decoded string */
+    char why[160];          /* the last bad token's reason */
+};
+
+rib_lexer *rib_lexer_new(const char *file, const char *text, size_t len)
+{
+    rib_lexer *self = sl_xrealloc(NULL, sizeof *self);
+    memset(self, 0, sizeof *self);
+    self->file = file;
+    self->text = self->p = self->line_start = text;
+    self->end = text + len;
+    self->line = 1;
+    /* a UTF-8 byte order mark is not part of the scene */
+    if (len >= 3 && memcmp(text, "\xEF\xBB\xBF", 3) == 0)
+        self->p += 3;
+    return self;
+}
+
+void rib_lexer_destroy(rib_lexer **self_p)
+{
+    if (!self_p || !*self_p)
+        return;
+    free((*self_p)->str.data);
+    free(*self_p);
+    *self_p = NULL;
+}
+
+/* ---------------------------------------------------------------------- */
+/* characters                                                              */
+/* ---------------------------------------------------------------------- */
+
+static sl_pos pos_at(const rib_lexer *self, const char *p)
+{
+    sl_pos pos = { self->file, self->line, (int)(p - self->line_start) + 1 };
+    return pos;
+}
+
+static void newline(rib_lexer *self, const char *after)
+{
+    self->line++;
+    self->line_start = after;
+}
+
+static bool is_space(char c)
+{
+    return c == ' ' || c == '\t' || c == '\r' || c == '\n' || c == '\f' || c == '\v';
+}
+
+static bool is_digit(char c) { return c >= '0' && c <= '9'; }
+
+static bool is_name_start(char c)
+{
+    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || c == '_';
+}
+
+static bool is_name_char(char c) { return is_name_start(c) || is_digit(c); }
+
+/* Bytes that end a number or a bad word. */
+static bool is_delimiter(char c)
+{
+    return is_space(c) || c == '[' || c == ']' || c == '"' || c == '#';
+}
+
+static bool starts_token(char c)
+{
+    return is_space(c) || is_name_start(c) || is_digit(c) || c == '[' || c == ']' ||
+           c == '"' || c == '#' || c == '+' || c == '-' || c == '.';
+}
+
+static void skip_space_and_comments(rib_lexer *self)
+{
+    while (self->p < self->end) {
+        char c = *self->p;
+        if (c == '\n') {
+            self->p++;
+            newline(self, self->p);
+        } else if (is_space(c)) {
+            self->p++;
+        } else if (c == '#') {
+            while (self->p < self->end && *self->p != '\n')
+                self->p++;
+        } else {
+            return;
+        }
+    }
+}
+
+/* Turns *t into a bad token with the printf-formatted reason. */
+static void bad(rib_lexer *self, rib_token *t, const char *fmt, ...) SL_PRINTF(3, 4);
+static void bad(rib_lexer *self, rib_token *t, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(self->why, sizeof self->why, fmt, ap);
+    va_end(ap);
+    t->kind = RIB_TOK_BAD;
+    t->error = self->why;
+}
+
+static rib_token make(rib_lexer *self, rib_token_kind kind, const char *start)
+{
+    rib_token t;
+    memset(&t, 0, sizeof t);
+    t.kind = kind;
+    t.pos = pos_at(self, start);
+    t.text = start;
+    t.len = (size_t)(self->p - start);
+    return t;
+}
+
+/* ---------------------------------------------------------------------- */
+/* numbers                                                                 */
+/* ---------------------------------------------------------------------- */
+
+/* True when s[0..n) is exactly a RIB number. */
+static bool number_syntax(const char *s, size_t n)
+{
+    size_t i = 0, digits = 0;
+    if (i < n && (s[i] == '+' || s[i] == '-'))
+        i++;
+    while (i < n && is_digit(s[i])) { i++; digits++; }
+    if (i < n && s[i] == '.') {
+        i++;
+        while (i < n && is_digit(s[i])) { i++; digits++; }
+    }
+    if (digits == 0)
+        return false;
+    if (i < n && (s[i] == 'e' || s[i] == 'E')) {
+        i++;
+        if (i < n && (s[i] == '+' || s[i] == '-'))
+            i++;
+        size_t exp_digits = 0;
+        while (i < n && is_digit(s[i])) { i++; exp_digits++; }
+        if (exp_digits == 0)
+            return false;
+    }
+    return i == n;
+}
+
+static rib_token lex_number(rib_lexer *self)
+{
+    const char *start = self->p;
+    while (self->p < self->end && !is_delimiter(*self->p))
+        self->p++;
+    rib_token t = make(self, RIB_TOK_NUMBER, start);
+    int shown = t.len > 40 ? 40 : (int)t.len;
+    const char *more = t.len > 40 ? "..." : "";
+    if (!number_syntax(start, t.len)) {
+        bad(self, &t, "bad number '%.*s%s'", shown, start, more);
+        return t;
+    }
+    char buf[512];
+    if (t.len >= sizeof buf) {
+        bad(self, &t, "number '%.*s%s' is too long", shown, start, more);
+        return t;
+    }
+    memcpy(buf, start, t.len);
+    buf[t.len] = '\0';
+    t.number = strtod(buf, NULL);
+    if (!isfinite(t.number)) {
+        bad(self, &t, "number '%.*s%s' is out of range", shown, start, more);
+    }
+    return t;
+}
+
+/* ---------------------------------------------------------------------- */
+/* strings                                                                 */
+/* ---------------------------------------------------------------------- */
+
+/* Decodes one escape after a backslash at self->p[-1]; RI Spec C.1 lists
+ * \n \r \t \b \f \\ \" and octal \ddd; a backslash before a line end
+ * continues the string on the next line. Others stand for themselves. */
+static void lex_escape(rib_lexer *self)
+{
+    char c = *self->p++;
+    switch (c) {
+    case 'n': sl_strbuf_putc(&self->str, '\n'); return;
+    case 'r': sl_strbuf_putc(&self->str, '\r'); return;
+    case 't': sl_strbuf_putc(&self->str, '\t'); return;
+    case 'b': sl_strbuf_putc(&self->str, '\b'); return;
+    case 'f': sl_strbuf_putc(&self->str, '\f'); return;
+    case '\n': newline(self, self->p); return;
+    default: break;
+    }
+    if (c >= '0' && c <= '7') {
+        int v = c - '0';
+        for (int k = 0; k < 2 && self->p < self->end && *self->p >= '0' && *self->p <= '7'; k++)
+            v = v * 8 + (*self->p++ - '0');
+        sl_strbuf_putc(&self->str, (char)(v & 0xFF));
+        return;
+    }
+    sl_strbuf_putc(&self->str, c);
+}
+
+static rib_token lex_string(rib_lexer *self)
+{
+    const char *start = self->p++;
+    sl_pos pos = pos_at(self, start);
+    self->str.len = 0;
+    sl_strbuf_put(&self->str, "", 0);
+    while (self->p < self->end && *self->p != '"' && *self->p != '\n') {
+        if (*self->p == '\\' && self->p + 1 < self->end) {
+            self->p++;
+            lex_escape(self);
+        } else {
+            sl_strbuf_putc(&self->str, *self->p++);
+        }
+    }
+    rib_token t;
+    memset(&t, 0, sizeof t);
+    t.pos = pos;
+    if (self->p >= self->end || *self->p != '"') {
+        bad(self, &t, "unterminated string (missing '\"' before the end of the line)");
+        return t;
+    }
+    self->p++;
+    t.kind = RIB_TOK_STRING;
+    t.text = self->str.data;
+    t.len = self->str.len;
+    return t;
+}
+
+/* ---------------------------------------------------------------------- */
+/* the token switch                                                        */
+/* ---------------------------------------------------------------------- */
+
+static rib_token lex_unexpected(rib_lexer *self)
+{
+    const char *start = self->p;
+    unsigned char c = (unsigned char)*self->p;
+    rib_token t = make(self, RIB_TOK_BAD, start);
+    if (c >= 0x20 && c < 0x7F)
+        bad(self, &t, "unexpected character '%c'", c);
+    else
+        bad(self, &t, "unexpected byte 0x%02x (binary RIB is not supported)", c);
+    while (self->p < self->end && !starts_token(*self->p))
+        self->p++;
+    if (self->p == start)
+        self->p++;
+    return t;
+}
+
+rib_token rib_lexer_next(rib_lexer *self)
+{
+    skip_space_and_comments(self);
+    if (self->p >= self->end)
+        return make(self, RIB_TOK_EOF, self->p);
+    char c = *self->p;
+    if (c == '[' || c == ']') {
+        const char *start = self->p++;
+        return make(self, c == '[' ? RIB_TOK_LBRACKET : RIB_TOK_RBRACKET, start);
+    }
+    if (c == '"')
+        return lex_string(self);
+    if (is_digit(c) || c == '+' || c == '-' || c == '.')
+        return lex_number(self);
+    if (is_name_start(c)) {
+        const char *start = self->p;
+        while (self->p < self->end && is_name_char(*self->p))
+            self->p++;
+        return make(self, RIB_TOK_NAME, start);
+    }
+    return lex_unexpected(self);
+}

@@ -1,0 +1,667 @@
+/*
+ * rib_parser.c: the RIB request loop (scene_parse, scene_load): the table
+ * of supported requests with where each may appear, the block structure
+ * (FrameBegin/End, WorldBegin/End, AttributeBegin/End, TransformBegin/End,
+ * RI Specification 3.2 §4), unknown requests, and the checks at the end of
+ * the text. The requests themselves live in rib_options.c,
+ * rib_attributes.c and rib_geometry.c.
+ *
+ * Error policy: every error names the request and its file:line:col; the
+ * parser goes on with the next request (so one run reports many errors,
+ * up to the diagnostics' cap) and returns NULL at the end if there was
+ * any. A request with a malformed argument is skipped whole.
+ */
+#include "scene/rib_parser.h"
+#include "sl/source.h"
+#include "sl/strbuf.h"
+
+#include <ctype.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+
+/* ---------------------------------------------------------------------- */
+/* messages and small helpers                                              */
+/* ---------------------------------------------------------------------- */
+
+static void vreport(rib_parser *p, sl_diag_level level, const rib_request *req,
+                    sl_pos pos, const char *fmt, va_list ap)
+{
+    char msg[1024];
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    if (req)
+        sl_diag_report(p->diag, level, pos, "%s: %s", req->name, msg);
+    else
+        sl_diag_report(p->diag, level, pos, "%s", msg);
+}
+
+void rib_error(rib_parser *p, const rib_request *req, sl_pos pos, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vreport(p, SL_DIAG_ERROR, req, pos, fmt, ap);
+    va_end(ap);
+}
+
+void rib_warning(rib_parser *p, const rib_request *req, sl_pos pos, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vreport(p, SL_DIAG_WARNING, req, pos, fmt, ap);
+    va_end(ap);
+}
+
+const char *rib_parser_intern(rib_parser *p, const char *s)
+{
+    if (p->nstrings == p->strings_cap) {
+        p->strings_cap = p->strings_cap ? 2 * p->strings_cap : 16;
+        p->strings = sl_xrealloc(p->strings, (size_t)p->strings_cap * sizeof *p->strings);
+    }
+    p->strings[p->nstrings] = sl_xstrndup(s, strlen(s));
+    return p->strings[p->nstrings++];
+}
+
+int rib_read_numbers(rib_parser *p, const rib_request *req, int first, int n,
+                     double *out, const char *what)
+{
+    int got = 0, i = first;
+    for (; i < req->nargs && rib_arg_is_numeric(&req->args[i]); i++) {
+        int k;
+        const double *v = rib_arg_numbers(req, &req->args[i], &k);
+        for (int j = 0; j < k; j++, got++)
+            if (got < n)
+                out[got] = v[j];
+    }
+    if (got != n) {
+        rib_error(p, req, req->pos, "expected %d number%s (%s), got %d", n,
+                  n == 1 ? "" : "s", what, got);
+        return -1;
+    }
+    return i;
+}
+
+const char *rib_read_string(rib_parser *p, const rib_request *req, int i, const char *what)
+{
+    if (i >= req->nargs) {
+        rib_error(p, req, req->pos, "missing %s (a string)", what);
+        return NULL;
+    }
+    const rib_arg *arg = &req->args[i];
+    if (!rib_arg_is_string(arg) || arg->count != 1) {
+        rib_error(p, req, arg->pos, "%s must be a string, got %s", what, rib_arg_describe(arg));
+        return NULL;
+    }
+    return rib_arg_string(req, arg);
+}
+
+bool rib_no_more_args(rib_parser *p, const rib_request *req, int i)
+{
+    if (i >= req->nargs)
+        return true;
+    rib_error(p, req, req->args[i].pos, "unexpected extra argument (%s)",
+              rib_arg_describe(&req->args[i]));
+    return false;
+}
+
+/* ---------------------------------------------------------------------- */
+/* growing the scene                                                       */
+/* ---------------------------------------------------------------------- */
+
+static void *grow(void *items, int count, int *cap, size_t size)
+{
+    if (count < *cap)
+        return items;
+    *cap = *cap ? 2 * *cap : 8;
+    return sl_xrealloc(items, (size_t)*cap * size);
+}
+
+scene_light *rib_add_light(rib_parser *p)
+{
+    scene *s = p->scene;
+    s->lights = grow(s->lights, s->nlights, &p->lights_cap, sizeof *s->lights);
+    memset(&s->lights[s->nlights], 0, sizeof *s->lights);
+    return &s->lights[s->nlights++];
+}
+
+scene_object *rib_add_object(rib_parser *p)
+{
+    scene *s = p->scene;
+    s->objects = grow(s->objects, s->nobjects, &p->objects_cap, sizeof *s->objects);
+    memset(&s->objects[s->nobjects], 0, sizeof *s->objects);
+    return &s->objects[s->nobjects++];
+}
+
+scene_shader *rib_add_shader(rib_parser *p)
+{
+    scene *s = p->scene;
+    s->shaders = grow(s->shaders, s->nshaders, &p->shaders_cap, sizeof *s->shaders);
+    memset(&s->shaders[s->nshaders], 0, sizeof *s->shaders);
+    return &s->shaders[s->nshaders++];
+}
+
+scene_space *rib_add_space(rib_parser *p)
+{
+    scene *s = p->scene;
+    s->spaces = grow(s->spaces, s->nspaces, &p->spaces_cap, sizeof *s->spaces);
+    memset(&s->spaces[s->nspaces], 0, sizeof *s->spaces);
+    return &s->spaces[s->nspaces++];
+}
+
+/* ---------------------------------------------------------------------- */
+/* blocks                                                                  */
+/* ---------------------------------------------------------------------- */
+
+static const char *begin_name(rib_block_kind kind)
+{
+    static const char *const names[] = { "FrameBegin", "WorldBegin", "AttributeBegin",
+                                         "TransformBegin" };
+    return names[kind];
+}
+
+static const char *end_name(rib_block_kind kind)
+{
+    static const char *const names[] = { "FrameEnd", "WorldEnd", "AttributeEnd",
+                                         "TransformEnd" };
+    return names[kind];
+}
+
+static void push_block(rib_parser *p, rib_block_kind kind, sl_pos pos)
+{
+    p->blocks = grow(p->blocks, p->nblocks, &p->blocks_cap, sizeof *p->blocks);
+    rib_block *b = &p->blocks[p->nblocks++];
+    b->kind = kind;
+    b->pos = pos;
+    rib_attributes_copy(&b->saved, &p->attr);
+}
+
+/* The end of the world: it must hold an object (unless the objects it
+ * tried to hold were wrong: those have their own errors). `who` names the
+ * request that ends it (WorldEnd, or WorldBegin when never closed). */
+static void world_finish(rib_parser *p, const char *who, sl_pos pos)
+{
+    p->in_world = false;
+    p->world_done = true;
+    if (p->scene->nobjects == 0 && !p->primitives_tried)
+        sl_diag_error(p->diag, pos,
+                      "%s: the world has no objects (add a surface between WorldBegin and "
+                      "WorldEnd, e.g. Sphere 1 -1 1 360)", who);
+}
+
+/* Pops the innermost block, restoring what it saved. */
+static void pop_block(rib_parser *p, const char *who, sl_pos pos)
+{
+    rib_block *b = &p->blocks[--p->nblocks];
+    if (b->kind == RIB_BLOCK_TRANSFORM) {
+        p->attr.ctm = b->saved.ctm;
+        rib_attributes_free(&b->saved);
+    } else {
+        rib_attributes_free(&p->attr);
+        p->attr = b->saved;
+    }
+    if (b->kind == RIB_BLOCK_WORLD)
+        world_finish(p, who, pos);
+}
+
+/* Blocks of `kind` cannot be closed from inside these. */
+static bool is_boundary(rib_block_kind kind, rib_block_kind inner)
+{
+    if (kind == RIB_BLOCK_ATTRIBUTE || kind == RIB_BLOCK_TRANSFORM)
+        return inner == RIB_BLOCK_WORLD || inner == RIB_BLOCK_FRAME;
+    if (kind == RIB_BLOCK_WORLD)
+        return inner == RIB_BLOCK_FRAME;
+    return false;
+}
+
+/* An ...End request: closes the innermost open block of `kind`, with an
+ * error for each block left open inside it. */
+static void close_block(rib_parser *p, const rib_request *req, rib_block_kind kind)
+{
+    int i = p->nblocks - 1;
+    while (i >= 0 && p->blocks[i].kind != kind && !is_boundary(kind, p->blocks[i].kind))
+        i--;
+    if (i < 0 || p->blocks[i].kind != kind) {
+        rib_error(p, req, req->pos, "there is no open %s to close", begin_name(kind));
+        return;
+    }
+    while (p->nblocks - 1 > i) {
+        const rib_block *b = &p->blocks[p->nblocks - 1];
+        rib_error(p, req, req->pos, "the %s opened at %s:%d:%d is not closed (missing %s)",
+                  begin_name(b->kind), b->pos.file, b->pos.line, b->pos.col, end_name(b->kind));
+        pop_block(p, req->name, req->pos);
+    }
+    pop_block(p, req->name, req->pos);
+}
+
+/* ---------------------------------------------------------------------- */
+/* block requests                                                          */
+/* ---------------------------------------------------------------------- */
+
+static void frame_begin(rib_parser *p, const rib_request *req)
+{
+    bool one_number = req->nargs == 1 && req->args[0].kind == RIB_ARG_NUMBER;
+    if (!req->broken && req->nargs > 0 && !one_number)
+        rib_error(p, req, req->pos, "takes one argument, the frame number");
+    if (p->frame_done || p->world_done) {
+        if (!p->warned_frames)
+            rib_warning(p, req, req->pos, "only the first frame is rendered; this frame and "
+                        "the later ones are ignored");
+        p->warned_frames = true;
+        p->skipping_frame = true;
+        p->skip_depth = 0;
+        return;
+    }
+    for (int i = 0; i < p->nblocks; i++)
+        if (p->blocks[i].kind == RIB_BLOCK_FRAME || p->blocks[i].kind == RIB_BLOCK_WORLD) {
+            const rib_block *b = &p->blocks[i];
+            rib_error(p, req, req->pos, "not allowed inside the %s opened at %s:%d:%d",
+                      begin_name(b->kind), b->pos.file, b->pos.line, b->pos.col);
+            return;
+        }
+    push_block(p, RIB_BLOCK_FRAME, req->pos);
+}
+
+static void frame_end(rib_parser *p, const rib_request *req)
+{
+    close_block(p, req, RIB_BLOCK_FRAME);
+    p->frame_done = true;
+}
+
+static void world_begin(rib_parser *p, const rib_request *req)
+{
+    if (p->in_world) {
+        rib_error(p, req, req->pos, "the world opened at %s:%d:%d is still open (missing WorldEnd)",
+                  p->world_pos.file, p->world_pos.line, p->world_pos.col);
+        return;
+    }
+    if (p->world_done) {
+        rib_error(p, req, req->pos, "a scene has one world, and the one at %s:%d:%d is closed "
+                  "(put all objects in it)", p->world_pos.file, p->world_pos.line,
+                  p->world_pos.col);
+        return;
+    }
+    rib_options_finish(p, req);
+    scene_camera *cam = &p->scene->camera;
+    cam->camera_from_world = p->attr.ctm;
+    if (!mat4_invert(&cam->camera_from_world, &cam->world_from_camera))
+        rib_error(p, req, req->pos, "the camera transform is singular (check the Scale, "
+                  "Transform and ConcatTransform requests before WorldBegin)");
+    p->scene->shading_rate = p->attr.shading_rate;
+    rib_shaders_finish(p);
+    push_block(p, RIB_BLOCK_WORLD, req->pos);
+    p->attr.ctm = mat4_identity();
+    p->in_world = p->world_seen = true;
+    p->world_pos = req->pos;
+}
+
+static void world_end(rib_parser *p, const rib_request *req)
+{
+    close_block(p, req, RIB_BLOCK_WORLD);
+}
+
+static void attribute_begin(rib_parser *p, const rib_request *req)
+{
+    push_block(p, RIB_BLOCK_ATTRIBUTE, req->pos);
+}
+
+static void attribute_end(rib_parser *p, const rib_request *req)
+{
+    close_block(p, req, RIB_BLOCK_ATTRIBUTE);
+}
+
+static void transform_begin(rib_parser *p, const rib_request *req)
+{
+    push_block(p, RIB_BLOCK_TRANSFORM, req->pos);
+}
+
+static void transform_end(rib_parser *p, const rib_request *req)
+{
+    close_block(p, req, RIB_BLOCK_TRANSFORM);
+}
+
+/* ---------------------------------------------------------------------- */
+/* the table of requests                                                   */
+/* ---------------------------------------------------------------------- */
+
+typedef enum where {
+    ANYWHERE,
+    OPTIONS,        /* before WorldBegin */
+    WORLD,          /* between WorldBegin and WorldEnd */
+    PRIMITIVE,      /* a base surface: in the world */
+    BLOCK,          /* block structure: run even when malformed */
+} where;
+
+typedef struct request_def {
+    const char *name;
+    rib_request_fn fn;
+    where where;
+} request_def;
+
+static const request_def requests[] = {
+    { "version", rib_version, ANYWHERE },
+    { "Display", rib_display, OPTIONS },
+    { "Format", rib_format, OPTIONS },
+    { "Projection", rib_projection, OPTIONS },
+    { "ScreenWindow", rib_screen_window, OPTIONS },
+    { "Clipping", rib_clipping, OPTIONS },
+    { "PixelSamples", rib_pixel_samples, OPTIONS },
+    { "PixelFilter", rib_pixel_filter, OPTIONS },
+    { "Exposure", rib_exposure, OPTIONS },
+    { "Option", rib_option, OPTIONS },
+    { "FrameBegin", frame_begin, BLOCK },
+    { "FrameEnd", frame_end, BLOCK },
+    { "WorldBegin", world_begin, BLOCK },
+    { "WorldEnd", world_end, BLOCK },
+    { "AttributeBegin", attribute_begin, BLOCK },
+    { "AttributeEnd", attribute_end, BLOCK },
+    { "TransformBegin", transform_begin, BLOCK },
+    { "TransformEnd", transform_end, BLOCK },
+    { "ShadingRate", rib_shading_rate, ANYWHERE },
+    { "Identity", rib_identity, ANYWHERE },
+    { "Translate", rib_translate, ANYWHERE },
+    { "Rotate", rib_rotate, ANYWHERE },
+    { "Scale", rib_scale, ANYWHERE },
+    { "ConcatTransform", rib_concat_transform, ANYWHERE },
+    { "Transform", rib_transform, ANYWHERE },
+    { "CoordinateSystem", rib_coordinate_system, WORLD },
+    { "CoordSysTransform", rib_coord_sys_transform, WORLD },
+    { "LightSource", rib_light_source, WORLD },
+    { "Illuminate", rib_illuminate, WORLD },
+    { "Surface", rib_surface, ANYWHERE },
+    { "Displacement", rib_displacement, ANYWHERE },
+    { "Color", rib_color, ANYWHERE },
+    { "Opacity", rib_opacity, ANYWHERE },
+    { "Attribute", rib_attribute, ANYWHERE },
+    { "Declare", rib_declare, ANYWHERE },
+    { "Sides", rib_sides, ANYWHERE },
+    { "Orientation", rib_orientation, ANYWHERE },
+    { "ReverseOrientation", rib_reverse_orientation, ANYWHERE },
+    { "Sphere", rib_sphere, PRIMITIVE },
+    { "Disk", rib_disk, PRIMITIVE },
+    { "Cylinder", rib_cylinder, PRIMITIVE },
+    { "Cone", rib_cone, PRIMITIVE },
+    { "Torus", rib_torus, PRIMITIVE },
+    { "Hyperboloid", rib_hyperboloid, PRIMITIVE },
+    { "Paraboloid", rib_paraboloid, PRIMITIVE },
+    { "Polygon", rib_polygon, PRIMITIVE },
+    { "Patch", rib_patch, PRIMITIVE },
+};
+
+enum { NREQUESTS = sizeof requests / sizeof requests[0] };
+
+static const request_def *find_request(const char *name)
+{
+    for (int i = 0; i < NREQUESTS; i++)
+        if (strcmp(requests[i].name, name) == 0)
+            return &requests[i];
+    return NULL;
+}
+
+/* One warning per unknown request name, with a suggestion when only the
+ * case differs ("sphere" for "Sphere"); past RIB_MAX_UNKNOWN_NAMES names
+ * (binary or garbage input) one last warning says that no more come. */
+enum { RIB_MAX_UNKNOWN_NAMES = 100 };
+static void unknown_request(rib_parser *p, const rib_request *req)
+{
+    for (int i = 0; i < p->nwarned; i++)
+        if (strcmp(p->warned[i], req->name) == 0)
+            return;
+    if (p->nwarned == RIB_MAX_UNKNOWN_NAMES) {
+        if (!p->unknown_overflow)
+            rib_warning(p, req, req->pos, "unknown request, ignored with its arguments; "
+                        "%d unknown names so far: not reporting more", p->nwarned);
+        p->unknown_overflow = true;
+        return;
+    }
+    p->warned = sl_xrealloc(p->warned, (size_t)(p->nwarned + 1) * sizeof *p->warned);
+    p->warned[p->nwarned++] = sl_xstrndup(req->name, strlen(req->name));
+    for (int i = 0; i < NREQUESTS; i++)
+        if (strcasecmp(requests[i].name, req->name) == 0) {
+            rib_warning(p, req, req->pos, "unknown request, ignored with its arguments "
+                        "(did you mean %s?)", requests[i].name);
+            return;
+        }
+    rib_warning(p, req, req->pos, "unknown request, ignored with its arguments");
+}
+
+/* False (with an error) when the request may not appear here. */
+static bool allowed_here(rib_parser *p, const rib_request *req, where w)
+{
+    if (w == OPTIONS && (p->in_world || p->world_done)) {
+        rib_error(p, req, req->pos, "must come before WorldBegin (options are fixed for the "
+                  "whole world)");
+        return false;
+    }
+    if ((w == WORLD || w == PRIMITIVE) && !p->in_world) {
+        rib_error(p, req, req->pos, "must come between WorldBegin and WorldEnd");
+        return false;
+    }
+    return true;
+}
+
+/* While skipping a later frame, only the frame nesting matters. */
+static void skip_frame_request(rib_parser *p, const rib_request *req)
+{
+    if (strcmp(req->name, "FrameBegin") == 0)
+        p->skip_depth++;
+    else if (strcmp(req->name, "FrameEnd") == 0 && p->skip_depth-- == 0)
+        p->skipping_frame = false;
+}
+
+static void dispatch(rib_parser *p, const rib_request *req)
+{
+    if (p->skipping_frame) {
+        skip_frame_request(p, req);
+        return;
+    }
+    const request_def *def = find_request(req->name);
+    if (!def) {
+        unknown_request(p, req);
+        return;
+    }
+    if (def->where == PRIMITIVE && p->in_world)
+        p->primitives_tried = true;
+    if (req->broken && def->where != BLOCK)
+        return;
+    if (!allowed_here(p, req, def->where))
+        return;
+    if (def->where == BLOCK && strcmp(req->name, "FrameBegin") != 0 && !req->broken)
+        rib_no_more_args(p, req, 0);
+    def->fn(p, req);
+}
+
+/* ---------------------------------------------------------------------- */
+/* the end of the text                                                     */
+/* ---------------------------------------------------------------------- */
+
+static void close_open_blocks(rib_parser *p)
+{
+    while (p->nblocks > 0) {
+        const rib_block *b = &p->blocks[p->nblocks - 1];
+        const char *who = begin_name(b->kind);
+        sl_pos pos = b->pos;
+        sl_diag_error(p->diag, pos, "%s: this block is never closed (missing %s)", who,
+                      end_name(b->kind));
+        pop_block(p, who, pos);
+    }
+}
+
+/* "scenes" for "scenes/wave.rib", "." for "wave.rib". */
+static char *rib_folder(const char *file)
+{
+    const char *slash = strrchr(file, '/');
+    if (!slash)
+        return sl_xstrndup(".", 1);
+    if (slash == file)
+        return sl_xstrndup("/", 1);
+    return sl_xstrndup(file, (size_t)(slash - file));
+}
+
+static void add_path(scene *s, char *dir)
+{
+    for (int i = 0; i < s->nsearch_path; i++)
+        if (strcmp(s->search_path[i], dir) == 0) {
+            free(dir);
+            return;
+        }
+    s->search_path = sl_xrealloc(s->search_path,
+                                 (size_t)(s->nsearch_path + 2) * sizeof *s->search_path);
+    s->search_path[s->nsearch_path++] = dir;
+    s->search_path[s->nsearch_path] = NULL;
+}
+
+/* The Option dirs (relative ones are relative to the RIB's folder), then
+ * the RIB's folder itself. */
+static void finish_search_path(rib_parser *p)
+{
+    scene *s = p->scene;
+    char *folder = rib_folder(s->file);
+    for (int i = 0; i < p->nshader_path; i++) {
+        const char *dir = p->shader_path[i];
+        if (dir[0] == '/' || strcmp(folder, ".") == 0) {
+            add_path(s, sl_source_normalize(dir));
+            continue;
+        }
+        size_t n = strlen(folder) + strlen(dir) + 2;
+        char *joined = sl_xrealloc(NULL, n);
+        snprintf(joined, n, "%s/%s", folder, dir);
+        add_path(s, sl_source_normalize(joined));
+        free(joined);
+    }
+    add_path(s, sl_source_normalize(folder));
+    free(folder);
+    if (!s->search_path) {
+        s->search_path = sl_xrealloc(NULL, sizeof *s->search_path);
+        s->search_path[0] = NULL;
+    }
+}
+
+static void add_shader_name(scene *s, const char *name)
+{
+    for (int i = 0; i < s->nshader_names; i++)
+        if (strcmp(s->shader_names[i], name) == 0)
+            return;
+    s->shader_names = sl_xrealloc(s->shader_names,
+                                  (size_t)(s->nshader_names + 1) * sizeof *s->shader_names);
+    s->shader_names[s->nshader_names++] = sl_xstrndup(name, strlen(name));
+}
+
+static void finish_shader_names(scene *s)
+{
+    for (int i = 0; i < s->nobjects; i++) {
+        const scene_shader *surf = scene_object_surface(s, &s->objects[i]);
+        const scene_shader *disp = scene_object_displacement(s, &s->objects[i]);
+        if (surf)
+            add_shader_name(s, surf->name);
+        if (disp)
+            add_shader_name(s, disp->name);
+    }
+}
+
+static void finish(rib_parser *p)
+{
+    if (p->skipping_frame)
+        p->skipping_frame = false;
+    close_open_blocks(p);
+    if (!p->world_seen) {
+        sl_pos whole = { p->file, 0, 0 };
+        sl_diag_error(p->diag, whole, "the scene has no world (add WorldBegin, then the "
+                      "lights and objects, then WorldEnd)");
+    }
+    finish_search_path(p);
+    finish_shader_names(p->scene);
+}
+
+/* ---------------------------------------------------------------------- */
+/* entry points                                                            */
+/* ---------------------------------------------------------------------- */
+
+static scene *scene_new(const char *file)
+{
+    scene *s = sl_xrealloc(NULL, sizeof *s);
+    memset(s, 0, sizeof *s);
+    s->file = sl_xstrndup(file, strlen(file));
+    s->camera.fov = 90;
+    s->camera.near_clip = 1e-10;
+    s->camera.far_clip = 1e30;
+    s->camera.pixel_aspect = 1;
+    s->camera.camera_from_world = s->camera.world_from_camera = mat4_identity();
+    s->pixel_samples[0] = s->pixel_samples[1] = 2;
+    s->shading_rate = 1;
+    s->exposure_gain = s->exposure_gamma = 1;
+    s->filter.kind = SCENE_FILTER_GAUSSIAN;
+    s->filter.xwidth = s->filter.ywidth = 2;
+    return s;
+}
+
+static void parser_free(rib_parser *p)
+{
+    while (p->nblocks > 0)
+        rib_attributes_free(&p->blocks[--p->nblocks].saved);
+    free(p->blocks);
+    rib_attributes_free(&p->attr);
+    for (int i = 0; i < p->nstrings; i++)
+        free(p->strings[i]);
+    free(p->strings);
+    for (int i = 0; i < p->nwarned; i++)
+        free(p->warned[i]);
+    free(p->warned);
+    for (int i = 0; i < p->nshader_path; i++)
+        free(p->shader_path[i]);
+    free(p->shader_path);
+    rib_decls_destroy(&p->decls);
+    rib_reader_destroy(&p->reader);
+}
+
+static void parse_all(rib_parser *p)
+{
+    rib_request *req;
+    while (!sl_diag_full(p->diag) && (req = rib_reader_next(p->reader)))
+        dispatch(p, req);
+    if (!sl_diag_full(p->diag))
+        finish(p);
+}
+
+scene *scene_parse(const char *file, const char *text, size_t len, sl_diag *diag)
+{
+    if (!file || !*file)
+        file = "<scene>";
+    if (!text)
+        len = 0, text = "";
+    sl_source_set *set = sl_source_set_new();
+    if (len >= sl_source_set_max_size(set))
+        sl_source_set_set_max_size(set, len + 1);
+    sl_source_set_add(set, file, text, len);
+    sl_diag_set_sources(diag, set);
+
+    int errors_before = sl_diag_error_count(diag);
+    rib_parser p;
+    memset(&p, 0, sizeof p);
+    p.diag = diag;
+    p.scene = scene_new(file);
+    p.file = p.scene->file;
+    p.decls = rib_decls_new();
+    p.reader = rib_reader_new(p.file, text, len, diag);
+    rib_attributes_init(&p.attr);
+    parse_all(&p);
+    parser_free(&p);
+
+    sl_diag_set_sources(diag, NULL);
+    sl_source_set_destroy(&set);
+    if (sl_diag_error_count(diag) > errors_before)
+        scene_destroy(&p.scene);
+    return p.scene;
+}
+
+scene *scene_load(const char *path, sl_diag *diag)
+{
+    sl_source_set *set = sl_source_set_new();
+    scene *s = NULL;
+    if (sl_source_set_load_file(set, path, path, diag) == 0) {
+        const sl_source *src = sl_source_set_at(set, 0);
+        s = scene_parse(path, src->text, src->len, diag);
+    }
+    sl_source_set_destroy(&set);
+    return s;
+}

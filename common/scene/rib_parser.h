@@ -1,0 +1,189 @@
+/*
+ * rib_parser.h: the parser's state, shared by the files that implement
+ * the RIB requests (internal to common/scene; the public entry points are
+ * scene_parse / scene_load in scene.h).
+ *
+ *   rib_parser.c       the request loop, the table of requests and where
+ *                      each may appear, blocks (Frame/World/Attribute/
+ *                      Transform), the end-of-file checks
+ *   rib_options.c      camera and image options (Format, Projection, ...)
+ *   rib_attributes.c   attributes, transforms, shaders, lights, Declare
+ *   rib_geometry.c     the base surfaces (Sphere ... Polygon, Patch)
+ *   rib_params.c       parameter lists: typing and reading values
+ *
+ * The graphics state follows RI Specification 3.2 §4: options are global
+ * and frozen at WorldBegin; attributes (with the current transform) are
+ * saved and restored by AttributeBegin/End, the transform alone by
+ * TransformBegin/End. Before WorldBegin the current transform maps to
+ * camera space (it becomes camera_from_world); inside the world it maps
+ * object space to world space, starting from the identity.
+ */
+#ifndef SCENE_RIB_PARSER_H
+#define SCENE_RIB_PARSER_H
+
+#include <stdbool.h>
+
+#include "scene/rib_decl.h"
+#include "scene/rib_reader.h"
+#include "scene/scene.h"
+#include "sl/diag.h"
+
+/* The attributes of RI Spec §4.2 that aafarm records. */
+typedef struct rib_attributes {
+    mat4 ctm;                      /* current transform (see above) */
+    int surface, displacement;     /* shader call indices, -1: none */
+    double Cs[3], Os[3];
+    int sides;
+    scene_orientation orientation;
+    double shading_rate;
+    double displacement_bound;
+    const char *bound_space;       /* interned (rib_parser_intern) */
+    const char *name;              /* interned, or NULL */
+    bool shadows;                  /* Attribute "light" "shadows" */
+    unsigned char *light_on;       /* per scene light: on for new objects */
+    int nlight_on;
+} rib_attributes;
+
+typedef enum rib_block_kind {
+    RIB_BLOCK_FRAME,
+    RIB_BLOCK_WORLD,
+    RIB_BLOCK_ATTRIBUTE,
+    RIB_BLOCK_TRANSFORM,
+} rib_block_kind;
+
+typedef struct rib_block {
+    rib_block_kind kind;
+    sl_pos pos;                    /* where it opened */
+    rib_attributes saved;          /* restored when it closes */
+} rib_block;
+
+typedef struct rib_parser {
+    sl_diag *diag;
+    const char *file;              /* owned by scene->file */
+    rib_reader *reader;
+    scene *scene;
+    rib_decls *decls;
+    rib_attributes attr;
+    rib_block *blocks;
+    int nblocks, blocks_cap;
+    int lights_cap, objects_cap, shaders_cap, spaces_cap;
+    char **strings;                /* interned strings */
+    int nstrings, strings_cap;
+    char **warned;                 /* unknown requests already warned about */
+    int nwarned;
+    bool unknown_overflow;         /* too many names to track: silent */
+    /* progress */
+    bool have_format, have_projection, have_screen;
+    bool in_world, world_seen, world_done;
+    bool primitives_tried;         /* a base surface request was seen */
+    sl_pos world_pos;
+    bool frame_done, skipping_frame, warned_frames;
+    int skip_depth;                /* FrameBegin nesting while skipping */
+    char **shader_path;            /* Option "searchpath" "shader" dirs */
+    int nshader_path;
+} rib_parser;
+
+/* Reports an error / warning naming the request: "Sphere: <message>". */
+void rib_error(rib_parser *p, const rib_request *req, sl_pos pos, const char *fmt, ...)
+    SL_PRINTF(4, 5);
+void rib_warning(rib_parser *p, const rib_request *req, sl_pos pos, const char *fmt, ...)
+    SL_PRINTF(4, 5);
+
+/* A copy of s that lives as long as the parser. */
+const char *rib_parser_intern(rib_parser *p, const char *s);
+
+/* Reads the numbers from argument `first` on (bare numbers and arrays,
+ * flattened) up to the next string; exactly `n` of them are needed, named
+ * `what` in the error ("radius zmin zmax thetamax"). Returns the index of
+ * the first argument after them, or -1 after an error. */
+int rib_read_numbers(rib_parser *p, const rib_request *req, int first, int n,
+                     double *out, const char *what);
+
+/* Reads one string argument at index `i` named `what`; NULL after an
+ * error. */
+const char *rib_read_string(rib_parser *p, const rib_request *req, int i, const char *what);
+
+/* Fails (with an error) when arguments are left after index `i`. */
+bool rib_no_more_args(rib_parser *p, const rib_request *req, int i);
+
+/* ---- parameter lists (rib_params.c) ------------------------------------- */
+
+typedef enum rib_params_mode {
+    RIB_PARAMS_UNIFORM,            /* shader calls: exactly one value each */
+    RIB_PARAMS_VARYING,            /* primitives: a multiple of the type's size */
+    RIB_PARAMS_LOOSE,              /* Attribute/Option: undeclared names untyped */
+} rib_params_mode;
+
+typedef struct rib_params {
+    scene_param *items;
+    int count;
+} rib_params;
+
+/* Reads "name" value pairs from argument `first` on. Returns false after
+ * an error (reported); *out is then empty. */
+bool rib_params_read(rib_parser *p, const rib_request *req, int first,
+                     rib_params_mode mode, rib_params *out);
+void rib_params_free(rib_params *params);
+const scene_param *rib_params_find(const rib_params *params, const char *name);
+
+/* ---- the requests -------------------------------------------------------- */
+
+typedef void (*rib_request_fn)(rib_parser *p, const rib_request *req);
+
+/* rib_options.c */
+void rib_version(rib_parser *p, const rib_request *req);
+void rib_display(rib_parser *p, const rib_request *req);
+void rib_format(rib_parser *p, const rib_request *req);
+void rib_projection(rib_parser *p, const rib_request *req);
+void rib_screen_window(rib_parser *p, const rib_request *req);
+void rib_clipping(rib_parser *p, const rib_request *req);
+void rib_pixel_samples(rib_parser *p, const rib_request *req);
+void rib_pixel_filter(rib_parser *p, const rib_request *req);
+void rib_exposure(rib_parser *p, const rib_request *req);
+void rib_option(rib_parser *p, const rib_request *req);
+void rib_options_finish(rib_parser *p, const rib_request *req);   /* WorldBegin */
+
+/* rib_attributes.c */
+void rib_shading_rate(rib_parser *p, const rib_request *req);
+void rib_identity(rib_parser *p, const rib_request *req);
+void rib_translate(rib_parser *p, const rib_request *req);
+void rib_rotate(rib_parser *p, const rib_request *req);
+void rib_scale(rib_parser *p, const rib_request *req);
+void rib_concat_transform(rib_parser *p, const rib_request *req);
+void rib_transform(rib_parser *p, const rib_request *req);
+void rib_coordinate_system(rib_parser *p, const rib_request *req);
+void rib_coord_sys_transform(rib_parser *p, const rib_request *req);
+void rib_light_source(rib_parser *p, const rib_request *req);
+void rib_illuminate(rib_parser *p, const rib_request *req);
+void rib_surface(rib_parser *p, const rib_request *req);
+void rib_displacement(rib_parser *p, const rib_request *req);
+void rib_color(rib_parser *p, const rib_request *req);
+void rib_opacity(rib_parser *p, const rib_request *req);
+void rib_attribute(rib_parser *p, const rib_request *req);
+void rib_declare(rib_parser *p, const rib_request *req);
+void rib_sides(rib_parser *p, const rib_request *req);
+void rib_orientation(rib_parser *p, const rib_request *req);
+void rib_reverse_orientation(rib_parser *p, const rib_request *req);
+void rib_attributes_init(rib_attributes *a);
+void rib_attributes_copy(rib_attributes *dst, const rib_attributes *src);
+void rib_attributes_free(rib_attributes *a);
+void rib_shaders_finish(rib_parser *p);           /* at WorldBegin */
+
+/* rib_geometry.c */
+void rib_sphere(rib_parser *p, const rib_request *req);
+void rib_disk(rib_parser *p, const rib_request *req);
+void rib_cylinder(rib_parser *p, const rib_request *req);
+void rib_cone(rib_parser *p, const rib_request *req);
+void rib_torus(rib_parser *p, const rib_request *req);
+void rib_hyperboloid(rib_parser *p, const rib_request *req);
+void rib_paraboloid(rib_parser *p, const rib_request *req);
+void rib_polygon(rib_parser *p, const rib_request *req);
+void rib_patch(rib_parser *p, const rib_request *req);
+
+/* Growing the scene's arrays (rib_parser.c). */
+scene_light *rib_add_light(rib_parser *p);
+scene_object *rib_add_object(rib_parser *p);
+scene_shader *rib_add_shader(rib_parser *p);
+scene_space *rib_add_space(rib_parser *p);
+
+#endif

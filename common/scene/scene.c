@@ -1,0 +1,117 @@
+/*
+ * scene.c: the scene model's own functions (see scene.h): freeing it, and
+ * the queries the renderer and the master ask of it (an object's shaders,
+ * a parameter by name, the file of a shader on the search path). Building
+ * a scene is the RIB parser's job (rib_parser.c and the files it names).
+ */
+#include "scene/scene.h"
+#include "sl/strbuf.h"
+
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+void scene_param_free(scene_param *param)
+{
+    free(param->name);
+    free(param->values);
+    free(param->string);
+    memset(param, 0, sizeof *param);
+}
+
+static void free_shader(scene_shader *sh)
+{
+    free(sh->name);
+    for (int i = 0; i < sh->nparams; i++)
+        scene_param_free(&sh->params[i]);
+    free(sh->params);
+}
+
+static void free_strings(char **list, int n)
+{
+    for (int i = 0; i < n; i++)
+        free(list[i]);
+    free(list);
+}
+
+void scene_destroy(scene **self_p)
+{
+    if (!self_p || !*self_p)
+        return;
+    scene *self = *self_p;
+    for (int i = 0; i < self->nlights; i++)
+        free(self->lights[i].handle);
+    free(self->lights);
+    for (int i = 0; i < self->nobjects; i++) {
+        free(self->objects[i].displacement_bound_space);
+        free(self->objects[i].name);
+        free(self->objects[i].lights);
+    }
+    free(self->objects);
+    for (int i = 0; i < self->nshaders; i++)
+        free_shader(&self->shaders[i]);
+    free(self->shaders);
+    for (int i = 0; i < self->nspaces; i++)
+        free(self->spaces[i].name);
+    free(self->spaces);
+    free_strings(self->search_path, self->nsearch_path);
+    free_strings(self->shader_names, self->nshader_names);
+    free(self->display_name);
+    free(self->display_type);
+    free(self->display_mode);
+    free(self->file);
+    free(self);
+    *self_p = NULL;
+}
+
+const scene_shader *scene_object_surface(const scene *self, const scene_object *object)
+{
+    int i = object->surface_shader;
+    return i >= 0 && i < self->nshaders ? &self->shaders[i] : NULL;
+}
+
+const scene_shader *scene_object_displacement(const scene *self, const scene_object *object)
+{
+    int i = object->displacement_shader;
+    return i >= 0 && i < self->nshaders ? &self->shaders[i] : NULL;
+}
+
+const scene_param *scene_shader_param(const scene_shader *shader, const char *name)
+{
+    for (int i = shader->nparams - 1; i >= 0; i--)
+        if (strcmp(shader->params[i].name, name) == 0)
+            return &shader->params[i];
+    return NULL;
+}
+
+const char *const *scene_search_path(const scene *self)
+{
+    return (const char *const *)self->search_path;
+}
+
+static bool readable_on_disk(const char *path, void *arg)
+{
+    (void)arg;
+    return access(path, R_OK) == 0;
+}
+
+char *scene_find_shader(const scene *self, const char *name,
+                        scene_file_exists_fn exists, void *arg)
+{
+    if (!exists)
+        exists = readable_on_disk;
+    for (int i = 0; i < self->nsearch_path; i++) {
+        const char *dir = self->search_path[i];
+        bool here = strcmp(dir, ".") == 0;
+        size_t n = strlen(dir) + strlen(name) + 5;
+        char *path = sl_xrealloc(NULL, n);
+        if (here)
+            snprintf(path, n, "%s.sl", name);
+        else
+            snprintf(path, n, "%s%s%s.sl", dir, dir[strlen(dir) - 1] == '/' ? "" : "/", name);
+        if (exists(path, arg))
+            return path;
+        free(path);
+    }
+    return NULL;
+}

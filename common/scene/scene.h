@@ -1,0 +1,234 @@
+/*
+ * scene.h: the scene model (scene) that the RIB parser builds and the
+ * renderer consumes: the camera and image options, the lights, the objects
+ * (a base surface from common/geom plus its transforms, attributes and
+ * shader references), the shader search path.
+ *
+ * A scene is built from RenderMan Interface Bytestream text (a subset of
+ * RI Specification 3.2, see docs/scenes.md for the table of requests):
+ *
+ *   scene_parse(file, text, len, diag)   from memory (a worker gets the
+ *                                        scene text over the network)
+ *   scene_load(path, diag)               from a file (the master, the CLI)
+ *
+ * Both return NULL when there was any error; every error is in diag with
+ * its file:line:col and names the RIB request. Warnings (unknown requests,
+ * ignored frames) may be reported on success.
+ *
+ * Spaces (RenderMan conventions, docs/scenes.md "Conventions"):
+ *   camera space is left-handed, the camera at the origin looking down +z,
+ *   x right, y up. "world" is the space current at WorldBegin. Every
+ *   transform is stored twice, to world and to camera, so the renderer may
+ *   work in either; camera.camera_from_world links the two
+ *   (to_camera = camera_from_world * to_world). Matrices follow
+ *   util/vecmath.h (column vectors: p' = m * p).
+ *
+ * Units: angles in the RIB are degrees; base surfaces here (geom_surface)
+ * are in radians as common/geom expects. The field of view stays in
+ * degrees (camera.fov); the spotlight's cone angles are radians, as in the
+ * standard spotlight shader.
+ *
+ * All strings and arrays are owned by the scene; scene_destroy frees them.
+ */
+#ifndef SCENE_SCENE_H
+#define SCENE_SCENE_H
+
+#include <stdbool.h>
+#include <stddef.h>
+
+#include "geom/surface.h"
+#include "sl/diag.h"
+#include "sl/shader.h"
+#include "util/vecmath.h"
+
+/* ---- camera and image options ------------------------------------------ */
+
+typedef enum scene_projection {
+    SCENE_PERSPECTIVE,
+    SCENE_ORTHOGRAPHIC,
+} scene_projection;
+
+typedef struct scene_camera {
+    int xres, yres;                /* Format */
+    double pixel_aspect;           /* Format's third number */
+    scene_projection projection;   /* Projection */
+    double fov;                    /* degrees, perspective only (default 90) */
+    double screen[4];              /* ScreenWindow left right bottom top */
+    double near_clip, far_clip;    /* Clipping (default 1e-10, 1e30) */
+    mat4 camera_from_world;        /* the transform current at WorldBegin */
+    mat4 world_from_camera;        /* its inverse */
+} scene_camera;
+
+typedef enum scene_filter_kind {
+    SCENE_FILTER_BOX,
+    SCENE_FILTER_GAUSSIAN,
+    SCENE_FILTER_TRIANGLE,
+    SCENE_FILTER_CATMULL_ROM,
+    SCENE_FILTER_SINC,
+} scene_filter_kind;
+
+typedef struct scene_filter {
+    scene_filter_kind kind;        /* default gaussian 2 2 */
+    double xwidth, ywidth;         /* in pixels */
+} scene_filter;
+
+/* ---- shader references ------------------------------------------------- */
+
+/* One parameter of a Surface / Displacement call, typed from Declare, the
+ * predeclared standard names or an inline declaration ("uniform float Km").
+ * Numbers: values[0..count), count = components(type) * arraylen (float 1,
+ * point/vector/normal/color 3, matrix 16). Strings: string, count 1. */
+typedef struct scene_param {
+    char *name;
+    sl_type type;
+    int arraylen;                  /* 1 unless declared as an array */
+    double *values;                /* NULL for strings */
+    int count;
+    char *string;                  /* string parameters only */
+    sl_pos pos;                    /* where the name was written */
+} scene_param;
+
+/* One Surface or Displacement request. "shader" space is the transform
+ * current at the request. */
+typedef struct scene_shader {
+    sl_shader_kind kind;
+    char *name;                    /* "wave": find "wave.sl" on the search path */
+    scene_param *params;
+    int nparams;
+    mat4 shader_to_world;
+    mat4 shader_to_camera;
+    sl_pos pos;
+} scene_shader;
+
+/* ---- lights -------------------------------------------------------------- */
+
+typedef enum scene_light_kind {
+    SCENE_AMBIENT_LIGHT,           /* intensity lightcolor */
+    SCENE_DISTANT_LIGHT,           /* + from to */
+    SCENE_POINT_LIGHT,             /* + from */
+    SCENE_SPOT_LIGHT,              /* + from to coneangle conedeltaangle beamdistribution */
+} scene_light_kind;
+
+typedef struct scene_light {
+    scene_light_kind kind;
+    char *handle;                  /* the RIB sequence number or name, as text */
+    /* parameters in light space, RenderMan's defaults where not given:
+     * intensity 1, lightcolor (1,1,1), from (0,0,0), to (0,0,1),
+     * coneangle 30 deg, conedeltaangle 5 deg (in radians),
+     * beamdistribution 2 */
+    double intensity;
+    double lightcolor[3];
+    vec3 from, to;
+    double coneangle, conedeltaangle, beamdistribution;
+    bool shadows;                  /* casts shadows (docs/scenes.md "Shadows") */
+    mat4 light_to_world, light_to_camera;
+    vec3 from_world, to_world;     /* from / to transformed */
+    vec3 from_camera, to_camera;
+    sl_pos pos;
+} scene_light;
+
+/* ---- objects -------------------------------------------------------------- */
+
+typedef enum scene_orientation {
+    SCENE_OUTSIDE,                 /* RenderMan's default */
+    SCENE_INSIDE,
+    SCENE_LH,
+    SCENE_RH,
+} scene_orientation;
+
+typedef struct scene_object {
+    geom_surface surface;          /* object space, radians; prepared */
+    mat4 object_to_world;
+    mat4 object_to_camera;
+    mat4 camera_to_object;
+    int surface_shader;            /* index into scene.shaders, -1: none */
+    int displacement_shader;       /* index into scene.shaders, -1: none */
+    double Cs[3], Os[3];           /* Color, Opacity */
+    int sides;                     /* 1 or 2 */
+    scene_orientation orientation; /* as recorded (ReverseOrientation applied) */
+    bool reverse_normals;          /* flip Ng (orientation vs handedness) */
+    double shading_rate;
+    double displacement_bound;     /* Attribute "displacementbound" "sphere" */
+    char *displacement_bound_space;   /* its "coordinatesystem" ("object") */
+    char *name;                    /* Attribute "identifier" "name", or NULL */
+    int *lights;                   /* indices into scene.lights that are on */
+    int nlights;
+    sl_pos pos;                    /* the defining request (file = scene.file) */
+} scene_object;
+
+/* CoordinateSystem "name": a named space. */
+typedef struct scene_space {
+    char *name;
+    mat4 to_world, to_camera;
+    sl_pos pos;
+} scene_space;
+
+/* ---- the scene ------------------------------------------------------------ */
+
+typedef struct scene {
+    char *file;                    /* the name the RIB was parsed under */
+    scene_camera camera;
+    int pixel_samples[2];          /* PixelSamples (default 2 2) */
+    double shading_rate;           /* ShadingRate current at WorldBegin */
+    double exposure_gain, exposure_gamma;   /* Exposure (default 1 1) */
+    scene_filter filter;
+    char *display_name;            /* Display, NULL when not given */
+    char *display_type;            /* "file", "openexr", ... */
+    char *display_mode;            /* "rgb", "rgba", ... */
+    scene_light *lights;
+    int nlights;
+    scene_object *objects;
+    int nobjects;
+    scene_shader *shaders;         /* every Surface / Displacement call */
+    int nshaders;
+    scene_space *spaces;
+    int nspaces;
+    char **search_path;            /* NULL-terminated directories */
+    int nsearch_path;
+    char **shader_names;           /* distinct shaders the objects use */
+    int nshader_names;
+} scene;
+
+/* ---- building ------------------------------------------------------------ */
+
+/* Parses RIB text[0..len) named `file` (for positions and the RIB folder
+ * of the search path). While parsing, diag's source set is a private copy
+ * of the text (for caret lines); it is set to NULL before returning. */
+scene *scene_parse(const char *file, const char *text, size_t len, sl_diag *diag);
+
+/* Reads the file at `path` and parses it under that name. */
+scene *scene_load(const char *path, sl_diag *diag);
+
+void scene_destroy(scene **self_p);
+
+/* ---- queries -------------------------------------------------------------- */
+
+/* The object's shaders, or NULL when it has none. */
+const scene_shader *scene_object_surface(const scene *self, const scene_object *object);
+const scene_shader *scene_object_displacement(const scene *self, const scene_object *object);
+
+/* Frees a parameter's strings and values (and zeroes it). */
+void scene_param_free(scene_param *param);
+
+/* A parameter of a shader call by name, or NULL. */
+const scene_param *scene_shader_param(const scene_shader *shader, const char *name);
+
+/* The search path as sl_compile takes it (NULL-terminated). */
+const char *const *scene_search_path(const scene *self);
+
+/* Decides whether a candidate file exists (arg: the caller's context). */
+typedef bool (*scene_file_exists_fn)(const char *path, void *arg);
+
+/* The file of shader `name`: the first "<dir>/<name>.sl" on the search
+ * path for which exists() says yes (exists NULL: readable on disk).
+ * Returns a malloc'd path the caller frees, or NULL. */
+char *scene_find_shader(const scene *self, const char *name,
+                        scene_file_exists_fn exists, void *arg);
+
+/* Names for messages and tools. */
+const char *scene_light_kind_name(scene_light_kind kind);     /* "spotlight" */
+const char *scene_filter_name(scene_filter_kind kind);        /* "gaussian" */
+const char *scene_projection_name(scene_projection p);        /* "perspective" */
+const char *scene_orientation_name(scene_orientation o);      /* "outside" */
+
+#endif
