@@ -47,6 +47,7 @@ typedef enum geom_kind {
 } geom_kind;
 
 enum { GEOM_MAX_POLY_VERTS = 64 };
+enum { GEOM_NCONST = 18 };             /* size of geom_surface.consts (added) */
 
 typedef struct geom_surface {
     geom_kind kind;
@@ -61,6 +62,13 @@ typedef struct geom_surface {
     /* derived by geom_surface_prepare (do not set by hand) */
     double phi0, phi1;                     /* sphere: phi range of zmin/zmax */
     vec3 origin, axis_u, axis_v, normal;   /* polygon: P = origin + u*axis_u + v*axis_v */
+    /* added by the geom implementation (also derived by prepare): */
+    int nuv;                               /* polygon: distinct vertices, ... */
+    double uv[GEOM_MAX_POLY_VERTS][2];     /* ... their (u,v), counter-clockwise */
+    double edge[GEOM_MAX_POLY_VERTS][3];   /* edge i: a*u + b*v + c >= 0 inside (unit (a,b)) */
+    ia_interval consts[GEOM_NCONST];       /* enclosures of exact derived constants
+                                            * (zmax - zmin, ...) for the interval and
+                                            * affine evaluations; see surface_internal.h */
 } geom_surface;
 
 /* Float evaluation at one (u,v). */

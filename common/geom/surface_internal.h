@@ -1,0 +1,64 @@
+/*
+ * surface_internal.h: what the files implementing surface.h share and no one
+ * else needs: the slots of geom_surface.consts, the sweep constants, and the
+ * inverse of the sweep angle used by the ray intersection.
+ *
+ * Exact constants. The interval and affine evaluations must enclose the
+ * exact real P(u,v) of the parameters as given, so a derived constant such
+ * as zmax - zmin is never rounded to one double: geom_surface_prepare keeps
+ * an interval enclosure of it (computed with the rounding-safe ia_* ops) in
+ * s->consts[], and the evaluations multiply by that interval. Which slot holds
+ * what depends on the kind:
+ *
+ *   sphere, torus   K_DPHI            phi1 - phi0 (sphere), phimax - phimin
+ *   cylinder        K_DZ              zmax - zmin
+ *   paraboloid      K_DZ, K_PK, K_PC  zmax - zmin, rmax^2/zmax, K_DZ*K_PK/2
+ *   hyperboloid     K_D + 0..2        point2 - point1
+ *   polygon         K_NG + 0..2       axis_u x axis_v
+ *   patch           K_B, K_C, K_A     P10-P00, P01-P00, P11-P10-P01+P00
+ *                   K_N0, K_N1, K_N2  b x c, b x a, a x c: Ng = n0 + u n1 + v n2
+ */
+#ifndef GEOM_SURFACE_INTERNAL_H
+#define GEOM_SURFACE_INTERNAL_H
+
+#include "geom/surface.h"
+
+enum {
+    K_DPHI = 0,
+    K_DZ = 0, K_PK = 1, K_PC = 2,
+    K_D = 0,
+    K_NG = 0,
+    K_B = 0, K_C = 3, K_A = 6, K_N0 = 9, K_N1 = 12, K_N2 = 15,
+};
+
+#define GEOM_TWO_PI 6.283185307179586     /* 2*M_PI, the double below 2 pi */
+
+/* A sweep angle may exceed 2 pi by this much (degrees converted to radians
+ * by the scene parser round); the surface is then the full revolution. */
+#define GEOM_SWEEP_SLACK 1e-9
+
+/* The phi range of a sphere or torus: [*a, *b]. */
+static inline void geom_phi_range(const geom_surface *s, double *a, double *b)
+{
+    if (s->kind == GEOM_SPHERE) {
+        *a = s->phi0;
+        *b = s->phi1;
+    } else {
+        *a = s->phimin;
+        *b = s->phimax;
+    }
+}
+
+/* The parameter t in [0,1] with angle == t*sweep (mod 2 pi), sweep != 0 of
+ * either sign; false when the angle lies in the cut-away part. Angles within
+ * tol radians of either end count as that end. */
+bool geom_sweep_param(double angle, double sweep, double tol, double *t);
+
+/* The polygon part of geom_surface_prepare (surface_polygon.c). */
+bool geom_polygon_prepare(geom_surface *s, char *why, int why_size);
+
+/* Formats a one-line reason into why (may be NULL) and returns false. */
+bool geom_fail(char *why, int why_size, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+
+#endif

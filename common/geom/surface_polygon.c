@@ -1,0 +1,270 @@
+/*
+ * surface_polygon.c: convex planar polygons as parametric surfaces.
+ *
+ * RenderMan's Polygon (RI spec §5.1) has no (u,v) of its own; we give it
+ * one so that the same box machinery (Heidrich & Seidel §3) refines it:
+ * P(u,v) = origin + u*axis_u + v*axis_v over [0,1]^2, the smallest
+ * rectangle in the polygon's plane that holds it. axis_u x axis_v points
+ * along Newell's normal of the vertex order, so the vertices run counter-
+ * clockwise in (u,v). Only part of the rectangle is polygon:
+ * geom_uv_inside and geom_uv_box_cover say which.
+ *
+ * The rectangle's orientation is the minimum-area one; for a convex polygon
+ * one of its sides lies along a polygon edge (Freeman & Shapira 1975), so
+ * trying every edge direction finds it. Small polygons (<= 64 vertices)
+ * make the O(n^2) search cheap, and it runs once per surface.
+ */
+#include "geom/surface.h"
+#include "geom/surface_internal.h"
+
+#include <math.h>
+
+/* (u,v) distance by which a point may lie outside an edge and still count
+ * as inside: keeps neighbouring polygons that share an edge crack-free. */
+#define UV_TOL 1e-12
+
+/* Relative tolerances of the checks in prepare. */
+#define PLANAR_TOL 1e-6
+#define CONVEX_TOL 1e-9
+
+typedef struct poly_work {
+    int n;                                  /* distinct vertices */
+    int index[GEOM_MAX_POLY_VERTS];         /* their index in s->verts */
+    vec3 p[GEOM_MAX_POLY_VERTS];
+    double size;                            /* largest extent of the vertices */
+} poly_work;
+
+static bool check_vertices(const geom_surface *s, char *why, int n)
+{
+    if (s->nverts < 3 || s->nverts > GEOM_MAX_POLY_VERTS)
+        return geom_fail(why, n, "polygon needs 3 to %d vertices, got %d",
+                         GEOM_MAX_POLY_VERTS, s->nverts);
+    for (int i = 0; i < s->nverts; i++) {
+        vec3 p = s->verts[i];
+        if (!isfinite(p.x) || !isfinite(p.y) || !isfinite(p.z))
+            return geom_fail(why, n, "polygon vertex %d must be finite numbers, got (%g %g %g)",
+                             i, p.x, p.y, p.z);
+    }
+    return true;
+}
+
+/* Drops repeated consecutive vertices (and a last one equal to the first). */
+static bool distinct_vertices(const geom_surface *s, poly_work *w, char *why, int n)
+{
+    vec3 lo = s->verts[0], hi = s->verts[0];
+    for (int i = 1; i < s->nverts; i++) {
+        vec3 p = s->verts[i];
+        lo = v3(fmin(lo.x, p.x), fmin(lo.y, p.y), fmin(lo.z, p.z));
+        hi = v3(fmax(hi.x, p.x), fmax(hi.y, p.y), fmax(hi.z, p.z));
+    }
+    vec3 ext = v3_sub(hi, lo);
+    w->size = fmax(ext.x, fmax(ext.y, ext.z));
+    if (!isfinite(w->size))
+        return geom_fail(why, n, "polygon vertices are too large");
+    double same = 1e-12 * w->size;
+    w->n = 0;
+    for (int i = 0; i < s->nverts; i++) {
+        vec3 p = s->verts[i];
+        if (w->n > 0 && v3_length(v3_sub(p, w->p[w->n - 1])) <= same)
+            continue;
+        if (i == s->nverts - 1 && w->n > 0 && v3_length(v3_sub(p, w->p[0])) <= same)
+            continue;
+        w->index[w->n] = i;
+        w->p[w->n++] = p;
+    }
+    if (w->n < 3)
+        return geom_fail(why, n, "polygon needs at least 3 distinct vertices, got %d", w->n);
+    return true;
+}
+
+/* Newell's normal: twice the vector area of the vertex loop. */
+static vec3 newell_normal(const poly_work *w)
+{
+    vec3 nn = v3(0, 0, 0);
+    for (int i = 0; i < w->n; i++) {
+        vec3 a = w->p[i], b = w->p[(i + 1) % w->n];
+        nn.x += (a.y - b.y) * (a.z + b.z);
+        nn.y += (a.z - b.z) * (a.x + b.x);
+        nn.z += (a.x - b.x) * (a.y + b.y);
+    }
+    return nn;
+}
+
+static vec3 centroid(const poly_work *w)
+{
+    vec3 c = v3(0, 0, 0);
+    for (int i = 0; i < w->n; i++)
+        c = v3_add(c, w->p[i]);
+    return v3_scale(c, 1.0 / w->n);
+}
+
+/* Extents of the vertices along e1 and e2 (relative to c). */
+static void extents(const poly_work *w, vec3 c, vec3 e1, vec3 e2, double *a0,
+                    double *a1, double *b0, double *b1)
+{
+    *a0 = *b0 = INFINITY;
+    *a1 = *b1 = -INFINITY;
+    for (int i = 0; i < w->n; i++) {
+        vec3 r = v3_sub(w->p[i], c);
+        double a = v3_dot(r, e1), b = v3_dot(r, e2);
+        *a0 = fmin(*a0, a); *a1 = fmax(*a1, a);
+        *b0 = fmin(*b0, b); *b1 = fmax(*b1, b);
+    }
+}
+
+/* The in-plane direction of the minimum-area bounding rectangle. */
+static vec3 best_axis(const poly_work *w, vec3 nrm, vec3 c)
+{
+    vec3 best = v3(0, 0, 0);
+    double best_area = INFINITY;
+    for (int i = 0; i < w->n; i++) {
+        vec3 e = v3_sub(w->p[(i + 1) % w->n], w->p[i]);
+        e = v3_normalize(v3_sub(e, v3_scale(nrm, v3_dot(nrm, e))));
+        if (v3_length(e) == 0)
+            continue;
+        double a0, a1, b0, b1;
+        extents(w, c, e, v3_cross(nrm, e), &a0, &a1, &b0, &b1);
+        double area = (a1 - a0) * (b1 - b0);
+        if (area < best_area * (1 - 1e-12)) {
+            best_area = area;
+            best = e;
+        }
+    }
+    return best;
+}
+
+/* Edge i as a*u + b*v + c >= 0 inside, (a,b) of unit length. */
+static void edge_lines(geom_surface *s)
+{
+    for (int i = 0; i < s->nuv; i++) {
+        const double *p = s->uv[i], *q = s->uv[(i + 1) % s->nuv];
+        double dx = q[0] - p[0], dy = q[1] - p[1], len = hypot(dx, dy);
+        if (len == 0)
+            len = 1;
+        s->edge[i][0] = -dy / len;
+        s->edge[i][1] = dx / len;
+        s->edge[i][2] = (dy * p[0] - dx * p[1]) / len;
+    }
+}
+
+static double edge_eval(const geom_surface *s, int i, double u, double v)
+{
+    return s->edge[i][0] * u + s->edge[i][1] * v + s->edge[i][2];
+}
+
+/* Convex: every vertex turns left (counter-clockwise in (u,v)), and, so
+ * that stars whose every turn is a left one are caught too, every vertex
+ * lies inside every edge. */
+static bool check_convex(const geom_surface *s, const poly_work *w, char *why, int n)
+{
+    for (int i = 0; i < s->nuv; i++) {
+        int prev = (i + s->nuv - 1) % s->nuv, next = (i + 1) % s->nuv;
+        if (edge_eval(s, prev, s->uv[next][0], s->uv[next][1]) < -CONVEX_TOL)
+            return geom_fail(why, n, "polygon is not convex: it turns the other way at vertex %d",
+                             w->index[i]);
+    }
+    for (int i = 0; i < s->nuv; i++)
+        for (int j = 0; j < s->nuv; j++)
+            if (edge_eval(s, i, s->uv[j][0], s->uv[j][1]) < -CONVEX_TOL)
+                return geom_fail(why, n,
+                                 "polygon is not convex: its edges cross (vertex %d lies "
+                                 "outside the edge from vertex %d to vertex %d)",
+                                 w->index[j], w->index[i], w->index[(i + 1) % w->n]);
+    return true;
+}
+
+static bool check_planar(const poly_work *w, vec3 nrm, vec3 c, char *why, int n)
+{
+    for (int i = 0; i < w->n; i++) {
+        double off = fabs(v3_dot(nrm, v3_sub(w->p[i], c)));
+        if (off > PLANAR_TOL * w->size)
+            return geom_fail(why, n, "polygon is not planar: vertex %d lies %g off its plane",
+                             w->index[i], off);
+    }
+    return true;
+}
+
+/* The plane basis, the vertices' (u,v) and the edge lines. */
+static void plane_basis(geom_surface *s, const poly_work *w, vec3 nrm, vec3 c)
+{
+    vec3 e1 = best_axis(w, nrm, c), e2 = v3_cross(nrm, e1);
+    double a0, a1, b0, b1;
+    extents(w, c, e1, e2, &a0, &a1, &b0, &b1);
+    s->normal = nrm;
+    s->origin = v3_add(c, v3_add(v3_scale(e1, a0), v3_scale(e2, b0)));
+    s->axis_u = v3_scale(e1, a1 - a0);
+    s->axis_v = v3_scale(e2, b1 - b0);
+    s->nuv = w->n;
+    for (int i = 0; i < w->n; i++) {
+        vec3 r = v3_sub(w->p[i], c);
+        s->uv[i][0] = (v3_dot(r, e1) - a0) / (a1 - a0);
+        s->uv[i][1] = (v3_dot(r, e2) - b0) / (b1 - b0);
+    }
+    edge_lines(s);
+    ia_interval au[3], av[3];
+    for (int k = 0; k < 3; k++) {
+        au[k] = ia_point(v3_comp(s->axis_u, k));
+        av[k] = ia_point(v3_comp(s->axis_v, k));
+    }
+    for (int k = 0; k < 3; k++) {
+        int i = (k + 1) % 3, j = (k + 2) % 3;
+        s->consts[K_NG + k] = ia_sub(ia_mul(au[i], av[j]), ia_mul(au[j], av[i]));
+    }
+}
+
+bool geom_polygon_prepare(geom_surface *s, char *why, int why_size)
+{
+    poly_work w;
+    if (!check_vertices(s, why, why_size) || !distinct_vertices(s, &w, why, why_size))
+        return false;
+    vec3 nn = newell_normal(&w);
+    double len = v3_length(nn);
+    if (!(len > 1e-12 * w.size * w.size))
+        return geom_fail(why, why_size, "polygon has no area: its vertices lie on one line");
+    vec3 nrm = v3_scale(nn, 1.0 / len), c = centroid(&w);
+    if (!check_planar(&w, nrm, c, why, why_size))
+        return false;
+    plane_basis(s, &w, nrm, c);
+    return check_convex(s, &w, why, why_size);
+}
+
+/* ---------------------------------------------------------------------- */
+/* (u,v) coverage                                                          */
+/* ---------------------------------------------------------------------- */
+
+bool geom_uv_inside(const geom_surface *s, double u, double v)
+{
+    if (s->kind != GEOM_POLYGON)
+        return true;
+    for (int i = 0; i < s->nuv; i++)
+        if (edge_eval(s, i, u, v) < -UV_TOL)
+            return false;
+    return true;
+}
+
+/* Separating axes (polygon and box are both convex): the box is outside when
+ * one edge has all four corners beyond it, or the box misses the polygon's
+ * (u,v) extent; inside when all four corners are inside (the inside set,
+ * tolerance included, is convex). Otherwise partial, which is also the
+ * safe answer. */
+geom_cover geom_uv_box_cover(const geom_surface *s, double u0, double u1,
+                             double v0, double v1)
+{
+    if (s->kind != GEOM_POLYGON)
+        return GEOM_INSIDE;
+    const double margin = 1e-9;
+    if (u1 < -margin || u0 > 1 + margin || v1 < -margin || v0 > 1 + margin)
+        return GEOM_OUTSIDE;
+    bool all_in = true;
+    for (int i = 0; i < s->nuv; i++) {
+        double e00 = edge_eval(s, i, u0, v0), e10 = edge_eval(s, i, u1, v0);
+        double e01 = edge_eval(s, i, u0, v1), e11 = edge_eval(s, i, u1, v1);
+        double emax = fmax(fmax(e00, e10), fmax(e01, e11));
+        double emin = fmin(fmin(e00, e10), fmin(e01, e11));
+        if (emax < -2 * UV_TOL)           /* margins: rounding inside the box */
+            return GEOM_OUTSIDE;
+        if (emin < -0.5 * UV_TOL)
+            all_in = false;
+    }
+    return all_in ? GEOM_INSIDE : GEOM_PARTIAL;
+}
