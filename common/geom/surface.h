@@ -94,9 +94,21 @@ void geom_eval_ia(const geom_surface *s, ia_interval u, ia_interval v, geom_ia *
 
 /* u and v are affine forms the caller made with aa_input (so they own the
  * query's first two noise symbols); results share them. */
+
 typedef struct geom_aa { aa_form P[3], dPdu[3], dPdv[3], Ng[3]; } geom_aa;
 void geom_eval_aa(aa_context *ctx, const geom_surface *s, const aa_form *u,
                   const aa_form *v, geom_aa *out);
+
+/* The UNIT normal Ng/|Ng| over the box (surface_normal.c), in closed form
+ * where one exists (sphere, torus, disk, cylinder, cone, polygon), so that
+ * it stays bounded where Ng vanishes (the poles of a sphere, the centre of
+ * a disk, the apex of a cone); elsewhere Ng normalised in the same
+ * arithmetic. `g` is the result of geom_eval_aa / geom_eval_ia for the same
+ * box. Where Ng = 0 the unit normal is the limit the closed form gives. */
+void geom_unit_normal_aa(aa_context *ctx, const geom_surface *s, const aa_form *u,
+                         const aa_form *v, const geom_aa *g, aa_form Nn[3]);
+void geom_unit_normal_ia(const geom_surface *s, ia_interval u, ia_interval v,
+                         const geom_ia *g, ia_interval Nn[3]);
 
 /* Polygons only cover part of their (u,v) rectangle. For the other kinds
  * these say "inside" everywhere. */

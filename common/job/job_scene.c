@@ -92,8 +92,8 @@ static bool compile_programs(job_scene *self, sl_diag *diag)
     self->programs = calloc((size_t)(jb->nshaders > 0 ? jb->nshaders : 1), sizeof *self->programs);
     if (!self->programs) abort();
     for (int i = 0; i < jb->nshaders; i++) {
-        const char *search[] = {NULL};
-        self->programs[i] = sl_compile(jb->sources, jb->shaders[i].file, search, diag);
+        self->programs[i] = sl_compile(jb->sources, jb->shaders[i].file,
+                                       scene_search_path(self->scene), diag);
         if (!self->programs[i]) ok = false;
     }
     return ok;
@@ -161,6 +161,8 @@ static bool build_objects(job_scene *self, sl_diag *diag)
         memcpy(t->Os, o->Os, sizeof t->Os);
         t->sides = o->sides;
         t->flip = o->reverse_normals;
+        t->lights = o->lights;
+        t->nlights = o->nlights;
     }
     return true;
 }

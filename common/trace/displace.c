@@ -76,9 +76,10 @@ static void box_affine(trace_thread *th, const trace_object *obj,
         box_from_affine(g.P, out);
         return;
     }
-    aa_form P[3], N[3], dPdu[3], dPdv[3];
+    aa_form P[3], N[3], dPdu[3], dPdv[3], Nn[3];
     aa_xform(ctx, &obj->to_camera, g.P, P, true);
-    aa_xform_normal(ctx, &obj->from_camera, g.Ng, N);
+    geom_unit_normal_aa(ctx, &obj->surf, &u, &v, &g, Nn);
+    aa_xform_normal(ctx, &obj->from_camera, Nn, N);
     if (obj->flip)
         for (int i = 0; i < 3; i++) aa_neg(ctx, &N[i], &N[i]);
     aa_xform(ctx, &obj->to_camera, g.dPdu, dPdu, false);
@@ -144,10 +145,11 @@ static void box_interval(trace_thread *th, const trace_object *obj,
         box_from_interval(g.P, out);
         return;
     }
-    ia_interval P[3], N[3], dPdu[3], dPdv[3];
+    ia_interval P[3], N[3], dPdu[3], dPdv[3], Nn[3];
     ia_xform(&obj->to_camera, g.P, P, true);
+    geom_unit_normal_ia(&obj->surf, u, v, &g, Nn);
     mat4 nt = mat4_transpose(obj->from_camera);
-    ia_xform(&nt, g.Ng, N, false);
+    ia_xform(&nt, Nn, N, false);
     if (obj->flip)
         for (int i = 0; i < 3; i++) N[i] = ia_neg(N[i]);
     ia_xform(&obj->to_camera, g.dPdu, dPdu, false);
@@ -226,12 +228,20 @@ void trace_surface_point_eval(trace_thread *th, const trace_object *obj,
     out->N = out->Ng;
     if (!obj->displacement) return;
 
+    /* N is the unit normal in every mode (see docs/renderer.md): here
+     * Nn = Ng/|Ng| with d(Nn) = (dNg - Nn (Nn . dNg)) / |Ng| */
     vec3 dNdu = mat4_xform_normal(&obj->from_camera, g.dNgdu);
     vec3 dNdv = mat4_xform_normal(&obj->from_camera, g.dNgdv);
     if (obj->flip) { dNdu = v3_neg(dNdu); dNdv = v3_neg(dNdv); }
+    double glen = v3_length(Ng);
+    vec3 Nn = out->Ng;
+    if (glen > 0) {
+        dNdu = v3_scale(v3_sub(dNdu, v3_scale(Nn, v3_dot(Nn, dNdu))), 1.0 / glen);
+        dNdv = v3_scale(v3_sub(dNdv, v3_scale(Nn, v3_dot(Nn, dNdv))), 1.0 / glen);
+    }
     sl_dual dP[3], dN[3], ddPdu[3], ddPdv[3], zero3[3];
     dual3(P, dPdu, dPdv, dP);
-    dual3(Ng, dNdu, dNdv, dN);
+    dual3(Nn, dNdu, dNdv, dN);
     dual3(dPdu, v3(0, 0, 0), v3(0, 0, 0), ddPdu);
     dual3(dPdv, v3(0, 0, 0), v3(0, 0, 0), ddPdv);
     dual3(v3(0, 0, 0), v3(0, 0, 0), v3(0, 0, 0), zero3);

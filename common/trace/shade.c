@@ -8,6 +8,7 @@
 typedef struct shade_ctx {
     const trace_renderer *r;
     trace_thread *th;
+    const trace_object *obj;       /* the shaded object: its lights */
     vec3 P;              /* the shaded point */
     vec3 N;              /* unit normal used to offset shadow rays */
     double offset;       /* shadow ray offset (camera units) */
@@ -42,8 +43,8 @@ static int light_samples(void *user, const double P[3], sl_light_sample *out, in
     shade_ctx *c = user;
     const trace_world *w = c->r->world;
     int n = 0;
-    for (int i = 0; i < w->nlights && n < max; i++) {
-        const trace_light *l = &w->lights[i];
+    for (int i = 0; i < c->obj->nlights && n < max; i++) {
+        const trace_light *l = &w->lights[c->obj->lights[i]];
         sl_light_sample *s = &out[n];
         double atten = 1.0, tmax = 1.0;
         vec3 L;
@@ -120,7 +121,7 @@ void trace_shade_hit(const trace_renderer *r, trace_thread *th,
         return;
     }
     double pixel_tol = r->primary_tol.a + r->primary_tol.b * fabs(sp.P.z);
-    shade_ctx c = {.r = r, .th = th, .P = sp.P, .N = sp.N,
+    shade_ctx c = {.r = r, .th = th, .obj = obj, .P = sp.P, .N = sp.N,
                    .offset = 2.0 * hit->leaf_size + 1e-9 * (1.0 + v3_length(sp.P)),
                    .tol = hit->leaf_size > pixel_tol ? hit->leaf_size : pixel_tol};
     sl_vm *vm = th->shade_vm;

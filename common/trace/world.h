@@ -34,6 +34,8 @@ typedef struct trace_object {
     const sl_instance *surface;        /* NULL: the default surface */
     double Cs[3], Os[3];
     int sides;                     /* 1 or 2 */
+    const int *lights;             /* indices into trace_world.lights that */
+    int nlights;                   /* shine on this object (Illuminate, scopes) */
     bool flip;                     /* reversed orientation: negate normals */
     double scale;                  /* largest stretch of to_camera (spectral norm) */
     trace_box root;                /* OBJECT space box over the whole (u,v) square */

@@ -97,7 +97,7 @@ static void test_zero_displacement_sphere_silhouette(void **state)
         int hits = 0, misses = 0, near = 0;
         for (int j = 0; j < 48; j++)
             for (int i = 0; i < 48; i++) {
-                double dx = (i - 23.5) * 0.006, dy = (j - 23.5) * 0.006;
+                double dx = (i - 23.5) * 0.012, dy = (j - 23.5) * 0.012;
                 /* distance of the ray (t*(dx,dy,1)) from the centre (0,0,5) */
                 double dd = dx * dx + dy * dy + 1;
                 double tc = 5.0 / dd;

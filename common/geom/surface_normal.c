@@ -1,0 +1,209 @@
+/*
+ * surface_normal.c: the unit normal of a base surface over a (u,v) box, in
+ * affine and interval arithmetic (see geom_unit_normal_aa in surface.h).
+ *
+ * Why: displacement shaders move P along normalize(N). Normalising Ng over
+ * a box that touches a point where Ng = 0 (a sphere's pole, a disk's
+ * centre, a cone's apex: RenderMan's parameterisations all have them)
+ * divides by a range containing 0, the box becomes unbounded, and the
+ * subdivision around that point never ends (Heidrich & Seidel §3 assume
+ * bounded boxes). The closed forms below have no such points:
+ *
+ *   sphere     P / r                         (P = r (cos t cos p, sin t cos p, sin p))
+ *   torus      (cos p cos t, cos p sin t, sin p)
+ *   disk       (0, 0, 1)
+ *   cylinder   (P.x, P.y, 0) / r
+ *   cone       (h cos t, h sin t, r) / sqrt(h^2 + r^2)
+ *   polygon    the constant Ng / |Ng|
+ *
+ * each times the sign that makes it point along Ng. Paraboloids,
+ * hyperboloids and patches normalise Ng. Constant factors are applied as
+ * intervals on a context of capacity 0, so rounding lands in the result's
+ * own error term and the enclosures hold for the exact real values.
+ */
+#include "geom/surface.h"
+#include "geom/surface_internal.h"
+
+#include <math.h>
+
+/* z = x * k for every k in the interval k, no new noise symbol */
+static void scale_k(aa_form *z, const aa_form *x, ia_interval k)
+{
+    aa_context none;
+    aa_context_init(&none, 0);
+    if (k.lo == k.hi) {
+        aa_mul_s(&none, z, x, k.lo);
+        return;
+    }
+    aa_form kf;
+    aa_from_interval(&none, &kf, k);
+    aa_mul(&none, z, x, &kf);
+}
+
+static void const_form(aa_form *z, ia_interval k)
+{
+    aa_context none;
+    aa_context_init(&none, 0);
+    if (k.lo == k.hi) aa_const(z, k.lo);
+    else aa_from_interval(&none, z, k);
+}
+
+static double sgn(double x) { return x < 0 ? -1.0 : 1.0; }
+
+/* 1 / sqrt(a^2 + b^2) as an enclosing interval */
+static ia_interval inv_hypot(double a, double b)
+{
+    ia_interval n2 = ia_add(ia_sqr(ia_point(a)), ia_sqr(ia_point(b)));
+    return ia_recip(ia_sqrt(n2));
+}
+
+static double dphi_sign(const geom_surface *s)
+{
+    double a, b;
+    geom_phi_range(s, &a, &b);
+    return sgn(b - a);
+}
+
+/* ---- affine ---- */
+
+static void normalize_aa(aa_context *ctx, const aa_form Ng[3], aa_form Nn[3])
+{
+    aa_form n2, t, inv;
+    aa_sqr(ctx, &n2, &Ng[0]);
+    aa_sqr(ctx, &t, &Ng[1]);
+    aa_add(ctx, &n2, &n2, &t);
+    aa_sqr(ctx, &t, &Ng[2]);
+    aa_add(ctx, &n2, &n2, &t);
+    aa_invsqrt(ctx, &inv, &n2);
+    for (int i = 0; i < 3; i++) aa_mul(ctx, &Nn[i], &Ng[i], &inv);
+}
+
+static void cos_sin_theta(aa_context *ctx, const geom_surface *s, const aa_form *u,
+                          aa_form *c, aa_form *sn)
+{
+    aa_form theta;
+    aa_mul_s(ctx, &theta, u, s->thetamax);
+    aa_cos(ctx, c, &theta);
+    aa_sin(ctx, sn, &theta);
+}
+
+void geom_unit_normal_aa(aa_context *ctx, const geom_surface *s, const aa_form *u,
+                         const aa_form *v, const geom_aa *g, aa_form Nn[3])
+{
+    switch (s->kind) {
+    case GEOM_SPHERE: {
+        ia_interval k = ia_mul_s(ia_recip(ia_point(s->radius)), sgn(s->thetamax) * dphi_sign(s));
+        for (int i = 0; i < 3; i++) scale_k(&Nn[i], &g->P[i], k);
+        return;
+    }
+    case GEOM_TORUS: {
+        /* (cos p cos t, cos p sin t, sin p): the tube's own direction */
+        aa_form c, sn, phi, cp, sp;
+        double pa, pb;
+        geom_phi_range(s, &pa, &pb);
+        cos_sin_theta(ctx, s, u, &c, &sn);
+        aa_context none;
+        aa_context_init(&none, 0);
+        scale_k(&phi, v, s->consts[K_DPHI]);
+        aa_add_s(&none, &phi, &phi, pa);
+        aa_cos(ctx, &cp, &phi);
+        aa_sin(ctx, &sp, &phi);
+        double k = sgn(s->thetamax) * dphi_sign(s);
+        aa_mul(ctx, &Nn[0], &cp, &c);
+        aa_mul(ctx, &Nn[1], &cp, &sn);
+        Nn[2] = sp;
+        for (int i = 0; i < 3; i++) aa_mul_s(&none, &Nn[i], &Nn[i], k);
+        return;
+    }
+    case GEOM_DISK:
+        aa_const(&Nn[0], 0);
+        aa_const(&Nn[1], 0);
+        aa_const(&Nn[2], sgn(s->thetamax));
+        return;
+    case GEOM_CYLINDER: {
+        ia_interval k = ia_mul_s(ia_recip(ia_point(s->radius)), sgn(s->thetamax) * sgn(s->zmax - s->zmin));
+        scale_k(&Nn[0], &g->P[0], k);
+        scale_k(&Nn[1], &g->P[1], k);
+        aa_const(&Nn[2], 0);
+        return;
+    }
+    case GEOM_CONE: {
+        aa_form c, sn;
+        cos_sin_theta(ctx, s, u, &c, &sn);
+        ia_interval k = ia_mul_s(inv_hypot(s->height, s->radius), sgn(s->thetamax));
+        scale_k(&Nn[0], &c, ia_mul_s(k, s->height));
+        scale_k(&Nn[1], &sn, ia_mul_s(k, s->height));
+        const_form(&Nn[2], ia_mul_s(k, s->radius));
+        return;
+    }
+    case GEOM_POLYGON: {
+        ia_interval n[3];
+        geom_ia gi;
+        for (int i = 0; i < 3; i++) gi.Ng[i] = aa_range(&g->Ng[i]);
+        ia_interval n2 = ia_add(ia_add(ia_sqr(gi.Ng[0]), ia_sqr(gi.Ng[1])), ia_sqr(gi.Ng[2]));
+        ia_interval inv = ia_recip(ia_sqrt(n2));
+        for (int i = 0; i < 3; i++) {
+            n[i] = ia_mul(gi.Ng[i], inv);
+            const_form(&Nn[i], n[i]);
+        }
+        return;
+    }
+    default:
+        normalize_aa(ctx, g->Ng, Nn);
+        return;
+    }
+}
+
+/* ---- interval ---- */
+
+static void normalize_ia(const ia_interval Ng[3], ia_interval Nn[3])
+{
+    ia_interval n2 = ia_add(ia_add(ia_sqr(Ng[0]), ia_sqr(Ng[1])), ia_sqr(Ng[2]));
+    ia_interval inv = ia_invsqrt(n2);
+    for (int i = 0; i < 3; i++) Nn[i] = ia_mul(Ng[i], inv);
+}
+
+void geom_unit_normal_ia(const geom_surface *s, ia_interval u, ia_interval v,
+                         const geom_ia *g, ia_interval Nn[3])
+{
+    ia_interval theta = ia_mul_s(u, s->thetamax);
+    switch (s->kind) {
+    case GEOM_SPHERE: {
+        ia_interval k = ia_mul_s(ia_recip(ia_point(s->radius)), sgn(s->thetamax) * dphi_sign(s));
+        for (int i = 0; i < 3; i++) Nn[i] = ia_mul(g->P[i], k);
+        return;
+    }
+    case GEOM_TORUS: {
+        double pa, pb;
+        geom_phi_range(s, &pa, &pb);
+        ia_interval phi = ia_add_s(ia_mul(v, s->consts[K_DPHI]), pa);
+        ia_interval cp = ia_cos(phi);
+        double k = sgn(s->thetamax) * dphi_sign(s);
+        Nn[0] = ia_mul_s(ia_mul(cp, ia_cos(theta)), k);
+        Nn[1] = ia_mul_s(ia_mul(cp, ia_sin(theta)), k);
+        Nn[2] = ia_mul_s(ia_sin(phi), k);
+        return;
+    }
+    case GEOM_DISK:
+        Nn[0] = Nn[1] = ia_point(0);
+        Nn[2] = ia_point(sgn(s->thetamax));
+        return;
+    case GEOM_CYLINDER: {
+        ia_interval k = ia_mul_s(ia_recip(ia_point(s->radius)), sgn(s->thetamax) * sgn(s->zmax - s->zmin));
+        Nn[0] = ia_mul(g->P[0], k);
+        Nn[1] = ia_mul(g->P[1], k);
+        Nn[2] = ia_point(0);
+        return;
+    }
+    case GEOM_CONE: {
+        ia_interval k = ia_mul_s(inv_hypot(s->height, s->radius), sgn(s->thetamax));
+        Nn[0] = ia_mul(ia_cos(theta), ia_mul_s(k, s->height));
+        Nn[1] = ia_mul(ia_sin(theta), ia_mul_s(k, s->height));
+        Nn[2] = ia_mul_s(k, s->radius);
+        return;
+    }
+    default:
+        normalize_ia(g->Ng, Nn);
+        return;
+    }
+}
