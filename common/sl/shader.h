@@ -32,6 +32,7 @@
 
 #include <stdbool.h>
 #include <stddef.h>
+#include <stdint.h>
 #include <stdio.h>
 
 #include "aa/affine.h"
@@ -178,5 +179,19 @@ void sl_vm_get_affine(const sl_vm *self, sl_global g, aa_form *values);
 
 /* Instructions executed by the last run (statistics). */
 long sl_vm_instructions(const sl_vm *self);
+
+/* ---- additions (not part of the original contract) -------------------- */
+
+/* Lights whose L and Cl do not depend on the surface point (distant and
+ * ambient lights): used by ambient/diffuse/specular/phong in ALL modes,
+ * after the callback's samples, so that interval/affine runs of surface
+ * shaders get sound bounds. At most 64; replaces the previous set. In
+ * interval/affine mode a light callback (sl_vm_set_lights) makes these
+ * functions unbounded, since its samples are only known at points. */
+void sl_vm_set_fixed_lights(sl_vm *self, const sl_light_sample *samples, int count);
+
+/* Seed of random(): every run restarts the sequence from it (default 0),
+ * so results are a pure function of the inputs. */
+void sl_vm_set_seed(sl_vm *self, uint64_t seed);
 
 #endif

@@ -1,0 +1,164 @@
+/*
+ * ast.h: the syntax tree of a shading-language source, as the parser
+ * (parser.c) builds it, the checker (check.c) annotates it and the code
+ * generator (codegen.c) lowers it to bytecode.
+ *
+ * One node type (sl_node) for expressions and statements: a kind, a source
+ * position, up to four children and a list, plus the annotations the
+ * checker adds (result type, resolved symbol / built-in / user function,
+ * escape targets of statements). Nodes, symbols and functions live in an
+ * arena (sl_arena) freed in one go after compiling; names point into the
+ * lexer's interned strings, so the lexer outlives the tree.
+ *
+ * Types (sl_ty) are the public sl_type values plus two internal ones:
+ * SL_TY_BOOL, the type of comparisons and logical operators (RenderMan's
+ * "relation"), and SL_TY_ERROR, the type of an expression that already
+ * produced an error (it silences follow-up errors: no cascades).
+ */
+#ifndef SL_AST_H
+#define SL_AST_H
+
+#include <stdbool.h>
+#include <stddef.h>
+
+#include "sl/diag.h"
+#include "sl/shader.h"
+
+/* ---- types ---- */
+
+typedef int sl_ty;
+enum { SL_TY_BOOL = SL_TYPE_MATRIX + 1, SL_TY_ERROR };
+
+const char *sl_ty_name(sl_ty ty);            /* "float", "point", "bool" */
+int sl_ty_slots(sl_ty ty);                   /* scalar slots: 1, 3, 16; 0 */
+bool sl_ty_is_triple(sl_ty ty);              /* point vector normal color */
+bool sl_ty_is_spatial(sl_ty ty);             /* point vector normal */
+
+/* ---- arena ---- */
+
+typedef struct sl_arena sl_arena;
+sl_arena *sl_arena_new(void);
+void sl_arena_destroy(sl_arena **self_p);
+void *sl_arena_alloc(sl_arena *self, size_t size);     /* zeroed */
+
+/* ---- symbols and functions ---- */
+
+typedef enum sl_sym_kind {
+    SL_SYM_GLOBAL,      /* P, N, ... (renderer-supplied) */
+    SL_SYM_CONST,       /* PI */
+    SL_SYM_PARAM,       /* shader parameter */
+    SL_SYM_LOCAL,       /* local variable */
+    SL_SYM_FPARAM,      /* user function parameter */
+} sl_sym_kind;
+
+typedef struct sl_sym {
+    const char *name;
+    sl_ty ty;
+    sl_sym_kind kind;
+    sl_pos pos;
+    bool output;        /* output parameter */
+    bool writable;      /* may be assigned */
+    int global;         /* SL_SYM_GLOBAL: the sl_global */
+    double value;       /* SL_SYM_CONST */
+    int param_index;    /* SL_SYM_PARAM */
+    int slot;           /* codegen: first slot (scalar or string file) */
+} sl_sym;
+
+typedef struct sl_node sl_node;
+
+typedef struct sl_func {
+    const char *name;
+    sl_ty ret;
+    sl_pos pos;
+    sl_sym **params;
+    int nparams;
+    sl_node *body;
+    /* checker */
+    struct sl_func **calls;     /* user functions called, for the recursion check */
+    int ncalls, calls_cap;
+    int mark;                   /* DFS state */
+    bool needs_ret_flag;        /* a return that is not the last statement */
+    /* codegen: the inlined call being generated */
+    int cg_ret_slot, cg_ret_flag, cg_id;
+} sl_func;
+
+/* ---- nodes ---- */
+
+typedef enum sl_node_kind {
+    /* expressions */
+    SL_N_NUM,        /* num */
+    SL_N_STR,        /* name/len: the string */
+    SL_N_IDENT,      /* name; sym */
+    SL_N_CALL,       /* name, list: args; builtin or func */
+    SL_N_UNARY,      /* op ('-' or '!'), a */
+    SL_N_BINARY,     /* op, a, b */
+    SL_N_COND,       /* a ? b : c */
+    SL_N_ASSIGN,     /* op (= += -= *= /=), a (lvalue), b */
+    SL_N_CAST,       /* cast_ty, name: space or NULL, list: 1, 3 or 16 values */
+    SL_N_CONV,       /* implicit conversion of a to ty (checker) */
+    SL_N_ERROR,      /* an expression that failed to parse (already reported) */
+    /* statements */
+    SL_N_BLOCK,      /* list */
+    SL_N_DECL,       /* list of SL_N_VAR */
+    SL_N_VAR,        /* sym, a: initializer or NULL */
+    SL_N_EXPR,       /* a */
+    SL_N_IF,         /* a: cond, b: then, c: else or NULL */
+    SL_N_WHILE,      /* a: cond, b: body */
+    SL_N_FOR,        /* a: init or NULL, b: cond or NULL, c: step or NULL, d: body */
+    SL_N_BREAK,      /* num: levels; target: the loop */
+    SL_N_CONTINUE,   /* num: levels; target: the loop */
+    SL_N_RETURN,     /* a: value or NULL; func: the function (NULL: shader) */
+    SL_N_EMPTY,
+} sl_node_kind;
+
+/* A statement's escape: a break/continue/return inside it that leaves it. */
+typedef enum sl_escape_kind { SL_ESC_BREAK, SL_ESC_CONTINUE, SL_ESC_RETURN } sl_escape_kind;
+typedef struct sl_escape {
+    sl_escape_kind kind;
+    sl_node *loop;       /* BREAK/CONTINUE: the target loop */
+    sl_func *func;       /* RETURN: the function (NULL: the shader body) */
+} sl_escape;
+
+struct sl_node {
+    sl_node_kind kind;
+    sl_pos pos;
+    sl_ty ty;                   /* checker: type of an expression */
+    int op;                     /* operator token kind */
+    double num;
+    const char *name;
+    size_t len;
+    sl_ty cast_ty;              /* SL_N_CAST */
+    sl_node *a, *b, *c, *d;
+    sl_node **list;
+    int nlist;
+    /* checker annotations */
+    sl_sym *sym;
+    const struct sl_builtin *builtin;
+    sl_func *func;
+    sl_node *target;
+    sl_escape *escapes;
+    int nescapes;
+    bool tail;                  /* SL_N_RETURN: last statement of its function */
+    /* codegen scratch for loops: flag slots (-1: none), pc of LOOP_TEST */
+    int cg_brk, cg_cnt, cg_test;
+};
+
+/* A parsed source: the user functions and the one shader. */
+typedef struct sl_ast_file {
+    sl_func **funcs;
+    int nfuncs;
+    bool has_shader;
+    sl_shader_kind kind;
+    const char *name;
+    sl_pos pos;
+    sl_node **params;           /* SL_N_VAR nodes (sym->kind SL_SYM_PARAM) */
+    int nparams;
+    sl_node *body;
+    bool needs_ret_flag;        /* checker: a 'return' before the body's end */
+} sl_ast_file;
+
+sl_node *sl_node_new(sl_arena *arena, sl_node_kind kind, sl_pos pos);
+/* Appends to a growing pointer array kept in the arena. */
+void sl_list_push(sl_arena *arena, void ***list, int *n, int *cap, void *item);
+
+#endif

@@ -1,0 +1,302 @@
+/*
+ * builtins.c: the table of built-in functions (RI Spec 3.2 §15, "Built-in
+ * Functions": math, geometry, noise, shading) with their signatures and
+ * lowerings, overload resolution against it, and the table of global
+ * variables (§14, "Predefined Shader Variables").
+ *
+ * Overload resolution scores each candidate of the right arity: an exact
+ * argument costs 0, a point/vector/normal passed as another of the three
+ * costs 1, a float promoted to a triple costs 2; the cheapest candidate
+ * wins, the first of equally cheap ones (the table lists float versions
+ * first).
+ */
+#include "sl/builtins.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#define OP(n, s, o) { n, s, SL_LOWER_OP, SL_OP_##o, 0 }
+#define LW(n, s, l, o, k) { n, s, SL_LOWER_##l, SL_OP_##o, k }
+
+static const sl_builtin table[] = {
+    /* math (§15.1) */
+    OP("sin", "f:f", SIN), OP("cos", "f:f", COS), OP("tan", "f:f", TAN),
+    OP("asin", "f:f", ASIN), OP("acos", "f:f", ACOS),
+    OP("atan", "f:f", ATAN), OP("atan", "f:ff", ATAN2),
+    OP("exp", "f:f", EXP), OP("sqrt", "f:f", SQRT),
+    OP("inversesqrt", "f:f", INVSQRT),
+    OP("log", "f:f", LOG), LW("log", "f:ff", LOGBASE, END, 0),
+    OP("pow", "f:ff", POW),
+    LW("radians", "f:f", SCALE, MUL, M_PI / 180.0),
+    LW("degrees", "f:f", SCALE, MUL, 180.0 / M_PI),
+    OP("abs", "G:G", ABS), OP("sign", "G:G", SIGN),
+    OP("floor", "G:G", FLOOR), OP("ceil", "G:G", CEIL),
+    OP("round", "G:G", ROUND),
+    OP("mod", "f:ff", MOD),
+    OP("min", "G:GG", MIN), OP("max", "G:GG", MAX),
+    OP("clamp", "G:GGG", CLAMP),
+    OP("step", "f:ff", STEP), OP("smoothstep", "f:fff", SMOOTHSTEP),
+    OP("mix", "G:GGf", MIX), OP("mix", "T:TTT", MIX),
+    /* geometry (§15.2) */
+    LW("length", "f:S", LENGTH, END, 0),
+    LW("normalize", "v:v", NORMALIZE, END, 0),
+    LW("normalize", "n:n", NORMALIZE, END, 0),
+    LW("normalize", "v:p", NORMALIZE, END, 0),
+    LW("distance", "f:pp", DISTANCE, END, 0),
+    LW("dot", "f:SS", DOT, END, 0), LW("dot", "f:cc", DOT, END, 0),
+    LW("cross", "v:SS", CROSS, END, 0),
+    LW("faceforward", "A:SS", FACEFORWARD, END, 0),
+    LW("faceforward", "A:SSS", FACEFORWARD, END, 0),
+    LW("reflect", "v:SS", REFLECT, END, 0),
+    LW("transform", "p:sp", TRANSFORM, XPOINT, 0),
+    LW("transform", "p:ssp", TRANSFORM, XPOINT, 0),
+    LW("transform", "p:mp", TRANSFORM, XPOINT, 0),
+    LW("vtransform", "v:sv", TRANSFORM, XVECTOR, 0),
+    LW("vtransform", "v:ssv", TRANSFORM, XVECTOR, 0),
+    LW("vtransform", "v:mv", TRANSFORM, XVECTOR, 0),
+    LW("ntransform", "n:sn", TRANSFORM, XNORMAL, 0),
+    LW("ntransform", "n:ssn", TRANSFORM, XNORMAL, 0),
+    LW("ntransform", "n:mn", TRANSFORM, XNORMAL, 0),
+    LW("calculatenormal", "n:p", CALCNORMAL, CALCNORMAL, 0),
+    LW("area", "f:p", AREA, AREA, 0),
+    LW("Du", "f:f", DERIV, DU, 0), LW("Du", "v:p", DERIV, DU, 0),
+    LW("Du", "T:T", DERIV, DU, 0),
+    LW("Dv", "f:f", DERIV, DV, 0), LW("Dv", "v:p", DERIV, DV, 0),
+    LW("Dv", "T:T", DERIV, DV, 0),
+    LW("Deriv", "f:ff", DERIV, DERIV, 0), LW("Deriv", "v:pf", DERIV, DERIV, 0),
+    LW("Deriv", "T:Tf", DERIV, DERIV, 0),
+    LW("xcomp", "f:S", COMP, END, 0), LW("ycomp", "f:S", COMP, END, 1),
+    LW("zcomp", "f:S", COMP, END, 2),
+    LW("setxcomp", "0:of", SETCOMP_K, END, 0),
+    LW("setycomp", "0:of", SETCOMP_K, END, 1),
+    LW("setzcomp", "0:of", SETCOMP_K, END, 2),
+    LW("comp", "f:Tf", COMP_RT, COMP, 0),
+    LW("setcomp", "0:Off", SETCOMP_RT, SETCOMP, 0),
+    /* noise (§15.1) */
+    LW("noise", "F:f", NOISE, NOISE, SL_NOISE_PLAIN),
+    LW("noise", "F:ff", NOISE, NOISE, SL_NOISE_PLAIN),
+    LW("noise", "F:p", NOISE, NOISE, SL_NOISE_PLAIN),
+    LW("noise", "F:pf", NOISE, NOISE, SL_NOISE_PLAIN),
+    LW("pnoise", "F:ff", NOISE, NOISE, SL_NOISE_PERIODIC),
+    LW("pnoise", "F:ffff", NOISE, NOISE, SL_NOISE_PERIODIC),
+    LW("pnoise", "F:pp", NOISE, NOISE, SL_NOISE_PERIODIC),
+    LW("pnoise", "F:pfpf", NOISE, NOISE, SL_NOISE_PERIODIC),
+    LW("cellnoise", "F:f", NOISE, NOISE, SL_NOISE_CELL),
+    LW("cellnoise", "F:ff", NOISE, NOISE, SL_NOISE_CELL),
+    LW("cellnoise", "F:p", NOISE, NOISE, SL_NOISE_CELL),
+    LW("cellnoise", "F:pf", NOISE, NOISE, SL_NOISE_CELL),
+    LW("random", "F:", RANDOM, RANDOM, 0),
+    /* shading (§15.4) */
+    LW("ambient", "c:", LIGHT, AMBIENT, 0),
+    LW("diffuse", "c:n", LIGHT, DIFFUSE, 0),
+    LW("specular", "c:nvf", LIGHT, SPECULAR, 0),
+    LW("phong", "c:nvf", LIGHT, PHONG, 0),
+};
+
+enum { TABLE_SIZE = sizeof table / sizeof table[0] };
+
+const sl_builtin *sl_builtin_find(const char *name, int *count)
+{
+    for (int i = 0; i < TABLE_SIZE; i++) {
+        if (strcmp(table[i].name, name) != 0)
+            continue;
+        int n = 1;
+        while (i + n < TABLE_SIZE && strcmp(table[i + n].name, name) == 0)
+            n++;
+        *count = n;
+        return &table[i];
+    }
+    *count = 0;
+    return NULL;
+}
+
+/* ---------------------------------------------------------------------- */
+/* resolution                                                              */
+/* ---------------------------------------------------------------------- */
+
+static sl_ty letter_type(char c)
+{
+    switch (c) {
+    case 'f': return SL_TYPE_FLOAT;
+    case 'p': return SL_TYPE_POINT;
+    case 'v': return SL_TYPE_VECTOR;
+    case 'n': return SL_TYPE_NORMAL;
+    case 'c': return SL_TYPE_COLOR;
+    case 's': return SL_TYPE_STRING;
+    case 'm': return SL_TYPE_MATRIX;
+    default: return SL_TYPE_VOID;
+    }
+}
+
+/* Cost of passing `have` where `want` (a concrete type) is expected; -1: no. */
+static int conversion_cost(sl_ty have, sl_ty want)
+{
+    if (have == want)
+        return 0;
+    if (sl_ty_is_spatial(have) && sl_ty_is_spatial(want))
+        return 1;
+    if (have == SL_TYPE_FLOAT && (sl_ty_is_triple(want) || want == SL_TYPE_MATRIX))
+        return 2;
+    return -1;
+}
+
+/* The type the generic letter g (G or T) stands for in this call: the
+ * first triple among its arguments, else float (G) / nothing (T). */
+static sl_ty bind_generic(const char *args, char g, const sl_ty *have, int n)
+{
+    for (int i = 0; i < n; i++)
+        if (args[i] == g && sl_ty_is_triple(have[i]))
+            return have[i];
+    return g == 'G' ? SL_TYPE_FLOAT : SL_TYPE_VOID;
+}
+
+/* Cost of one candidate, filling the wanted argument types; -1: no. */
+static int candidate_cost(const sl_builtin *b, const sl_ty *have, int n, sl_ty *want)
+{
+    const char *args = strchr(b->sig, ':') + 1;
+    if ((int)strlen(args) != n)
+        return -1;
+    sl_ty g = bind_generic(args, 'G', have, n);
+    sl_ty t = bind_generic(args, 'T', have, n);
+    int cost = 0;
+    for (int i = 0; i < n; i++) {
+        char c = args[i];
+        if (c == 'S' || c == 'o') {
+            if (!sl_ty_is_spatial(have[i]))
+                return -1;
+            want[i] = have[i];
+            continue;
+        }
+        if (c == 'O') {
+            if (!sl_ty_is_triple(have[i]))
+                return -1;
+            want[i] = have[i];
+            continue;
+        }
+        want[i] = c == 'G' ? g : c == 'T' ? t : letter_type(c);
+        if (want[i] == SL_TYPE_VOID)
+            return -1;
+        int k = conversion_cost(have[i], want[i]);
+        if (k < 0)
+            return -1;
+        cost += k;
+    }
+    return cost;
+}
+
+const sl_builtin *sl_builtin_resolve(const char *name, const sl_ty *args, int nargs,
+                                     sl_ty hint, sl_ty *arg_types, sl_ty *result)
+{
+    int count;
+    const sl_builtin *first = sl_builtin_find(name, &count);
+    const sl_builtin *best = NULL;
+    int best_cost = 0;
+    sl_ty want[8];
+    if (nargs > 8)
+        return NULL;
+    for (int i = 0; i < count; i++) {
+        int cost = candidate_cost(&first[i], args, nargs, want);
+        if (cost < 0 || (best && cost >= best_cost))
+            continue;
+        best = &first[i];
+        best_cost = cost;
+        memcpy(arg_types, want, (size_t)nargs * sizeof *want);
+    }
+    if (!best)
+        return NULL;
+    char r = best->sig[0];
+    const char *sig_args = best->sig + 2;
+    if (r == 'A')
+        *result = args[0];
+    else if (r == 'G')
+        *result = bind_generic(sig_args, 'G', args, nargs);
+    else if (r == 'T')
+        *result = bind_generic(sig_args, 'T', args, nargs);
+    else if (r == 'F')
+        *result = sl_ty_is_triple(hint) ? hint : SL_TYPE_FLOAT;
+    else
+        *result = letter_type(r);
+    return best;
+}
+
+static const char *letter_name(char c)
+{
+    switch (c) {
+    case 'S': case 'o': return "point|vector|normal";
+    case 'O': case 'T': return "triple";
+    case 'G': return "float|triple";
+    default: return sl_ty_name(letter_type(c));
+    }
+}
+
+void sl_builtin_candidates(const char *name, char *buf, size_t size)
+{
+    int count;
+    const sl_builtin *b = sl_builtin_find(name, &count);
+    size_t o = 0;
+    buf[0] = '\0';
+    for (int i = 0; i < count && o < size; i++) {
+        o += (size_t)snprintf(buf + o, size - o, "%s%s(", i ? ", " : "", name);
+        for (const char *a = b[i].sig + 2; *a && o < size; a++)
+            o += (size_t)snprintf(buf + o, size - o, "%s%s", a == b[i].sig + 2 ? "" : ", ",
+                                  letter_name(*a));
+        if (o < size)
+            o += (size_t)snprintf(buf + o, size - o, ")");
+    }
+}
+
+/* ---------------------------------------------------------------------- */
+/* globals                                                                 */
+/* ---------------------------------------------------------------------- */
+
+static const struct {
+    const char *name;
+    sl_ty ty;
+    bool writable;
+} globals[SL_G__COUNT] = {
+    [SL_G_P] = { "P", SL_TYPE_POINT, true },
+    [SL_G_N] = { "N", SL_TYPE_NORMAL, true },
+    [SL_G_Ng] = { "Ng", SL_TYPE_NORMAL, false },
+    [SL_G_I] = { "I", SL_TYPE_VECTOR, false },
+    [SL_G_E] = { "E", SL_TYPE_POINT, false },
+    [SL_G_s] = { "s", SL_TYPE_FLOAT, false },
+    [SL_G_t] = { "t", SL_TYPE_FLOAT, false },
+    [SL_G_u] = { "u", SL_TYPE_FLOAT, false },
+    [SL_G_v] = { "v", SL_TYPE_FLOAT, false },
+    [SL_G_du] = { "du", SL_TYPE_FLOAT, false },
+    [SL_G_dv] = { "dv", SL_TYPE_FLOAT, false },
+    [SL_G_dPdu] = { "dPdu", SL_TYPE_VECTOR, false },
+    [SL_G_dPdv] = { "dPdv", SL_TYPE_VECTOR, false },
+    [SL_G_Cs] = { "Cs", SL_TYPE_COLOR, false },
+    [SL_G_Os] = { "Os", SL_TYPE_COLOR, false },
+    [SL_G_Ci] = { "Ci", SL_TYPE_COLOR, true },
+    [SL_G_Oi] = { "Oi", SL_TYPE_COLOR, true },
+    [SL_G_L] = { "L", SL_TYPE_VECTOR, false },
+    [SL_G_Cl] = { "Cl", SL_TYPE_COLOR, false },
+    [SL_G_time] = { "time", SL_TYPE_FLOAT, false },
+};
+
+int sl_global_find(const char *name)
+{
+    for (int g = 0; g < SL_G__COUNT; g++)
+        if (strcmp(globals[g].name, name) == 0)
+            return g;
+    return -1;
+}
+
+sl_ty sl_global_type(sl_global g) { return globals[g].ty; }
+bool sl_global_writable(sl_global g) { return globals[g].writable; }
+const char *sl_global_name(sl_global g) { return globals[g].name; }
+/* Slot offsets of the globals in the order of sl_global: 3 slots for
+ * points, vectors, normals and colors, 1 for floats. */
+static const unsigned char global_slots[SL_G__COUNT + 1] = {
+    [SL_G_P] = 0, [SL_G_N] = 3, [SL_G_Ng] = 6, [SL_G_I] = 9, [SL_G_E] = 12,
+    [SL_G_s] = 15, [SL_G_t] = 16, [SL_G_u] = 17, [SL_G_v] = 18, [SL_G_du] = 19,
+    [SL_G_dv] = 20, [SL_G_dPdu] = 21, [SL_G_dPdv] = 24, [SL_G_Cs] = 27, [SL_G_Os] = 30,
+    [SL_G_Ci] = 33, [SL_G_Oi] = 36, [SL_G_L] = 39, [SL_G_Cl] = 42, [SL_G_time] = 45,
+    [SL_G__COUNT] = 46,
+};
+
+int sl_global_size(sl_global g) { return global_slots[g + 1] - global_slots[g]; }
+int sl_global_slot(sl_global g) { return global_slots[g]; }

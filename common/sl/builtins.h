@@ -1,0 +1,72 @@
+/*
+ * builtins.h: the built-in functions and global variables of the shading
+ * language: one table of signatures that the checker resolves calls
+ * against (overloads, generic triples, conversions) and that tells the
+ * code generator how to lower each call to scalar bytecode.
+ *
+ * Signature strings: "R:AB..." with R the result and A, B... the arguments:
+ *   f float  p point  v vector  n normal  c color  s string  m matrix
+ *   0 void (result)   o an assignable variable of any spatial type
+ *   O an assignable variable of any triple type
+ *   S any spatial type (point/vector/normal)
+ *   T any triple (point/vector/normal/color; all T of a call agree)
+ *   G float or any triple (all G of a call agree; floats promote)
+ *   A (result) the type of the first argument
+ *   F (result) float, or the triple type the context asks for
+ *                (`color noise(P)`, `point p = noise(P)`): RenderMan's
+ *                polymorphic noise
+ */
+#ifndef SL_BUILTINS_H
+#define SL_BUILTINS_H
+
+#include "sl/ast.h"
+#include "sl/bytecode.h"
+
+typedef enum sl_lowering {
+    SL_LOWER_OP,          /* componentwise scalar op (op) */
+    SL_LOWER_SCALE,       /* x * constant (radians, degrees) */
+    SL_LOWER_LOGBASE,     /* log(x) / log(b) */
+    SL_LOWER_LENGTH, SL_LOWER_NORMALIZE, SL_LOWER_DISTANCE,
+    SL_LOWER_DOT, SL_LOWER_CROSS, SL_LOWER_FACEFORWARD, SL_LOWER_REFLECT,
+    SL_LOWER_TRANSFORM,   /* op: XPOINT / XVECTOR / XNORMAL */
+    SL_LOWER_CALCNORMAL, SL_LOWER_AREA,
+    SL_LOWER_DERIV,       /* op: DU / DV / DERIV */
+    SL_LOWER_COMP,        /* xcomp ycomp zcomp: constant index (k) */
+    SL_LOWER_SETCOMP_K,   /* setxcomp ...: constant index (k) */
+    SL_LOWER_COMP_RT,     /* comp(x, i) */
+    SL_LOWER_SETCOMP_RT,  /* setcomp(x, i, v) */
+    SL_LOWER_NOISE,       /* k: SL_NOISE_PLAIN / PERIODIC / CELL */
+    SL_LOWER_RANDOM,
+    SL_LOWER_LIGHT,       /* op: AMBIENT DIFFUSE SPECULAR PHONG */
+} sl_lowering;
+
+typedef struct sl_builtin {
+    const char *name;
+    const char *sig;
+    sl_lowering lower;
+    sl_opcode op;
+    double k;
+} sl_builtin;
+
+/* All entries for `name` are consecutive in the table: returns the first
+ * and their number, or NULL. */
+const sl_builtin *sl_builtin_find(const char *name, int *count);
+
+/* Resolution of one call: the chosen entry, the type each argument must
+ * be converted to, and the result type. hint: the type the context wants
+ * (SL_TYPE_VOID: none), for 'F' results. Returns NULL when nothing
+ * matches. Of equally good candidates the first in the table wins (the
+ * table lists the float versions first). */
+const sl_builtin *sl_builtin_resolve(const char *name, const sl_ty *args, int nargs,
+                                     sl_ty hint, sl_ty *arg_types, sl_ty *result);
+
+/* "noise(float), noise(float, float), ..." for a message, into buf. */
+void sl_builtin_candidates(const char *name, char *buf, size_t size);
+
+/* Globals: name -> sl_global (or -1), its type, whether shaders may
+ * assign it (P, N, Ci, Oi). */
+int sl_global_find(const char *name);
+sl_ty sl_global_type(sl_global g);
+bool sl_global_writable(sl_global g);
+
+#endif

@@ -1,0 +1,195 @@
+/*
+ * bytecode.c: opcode names, freeing a program, and the bytecode listing
+ * (`aafarm-slc --dump`): the slot layout, parameters, constants and one
+ * line per instruction with its source position and operands written out
+ * (globals by name, constants by value, jumps as @pc, merge tables as
+ * slot lists).
+ */
+#include "sl/bytecode.h"
+#include "sl/ast.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+static const char *const names[SL_OP__COUNT] = {
+#define SL_OPCODE_NAME(name, text, operands) text,
+    SL_OPCODES(SL_OPCODE_NAME)
+#undef SL_OPCODE_NAME
+};
+
+static const char *const kinds[SL_OP__COUNT] = {
+#define SL_OPCODE_KINDS(name, text, operands) operands,
+    SL_OPCODES(SL_OPCODE_KINDS)
+#undef SL_OPCODE_KINDS
+};
+
+const char *sl_opcode_name(sl_opcode op)
+{
+    return (unsigned)op < SL_OP__COUNT ? names[op] : "?";
+}
+
+void sl_program_free(sl_program *p)
+{
+    if (!p)
+        return;
+    free(p->name);
+    free(p->code);
+    free(p->pos);
+    free(p->consts);
+    free(p->tables);
+    for (int i = 0; i < p->nstrings; i++)
+        free(p->strings[i]);
+    free(p->strings);
+    free(p->string_slots);
+    for (int i = 0; i < p->nparams; i++)
+        free(p->params[i].name);
+    free(p->params);
+    for (int i = 0; i < p->nfiles; i++)
+        free(p->files[i]);
+    free(p->files);
+    free(p);
+}
+
+void sl_program_pos_string(const sl_program *self, int pc, char *buf, size_t size)
+{
+    if (pc < 0 || pc >= self->ncode) {
+        snprintf(buf, size, "?");
+        return;
+    }
+    const sl_insn_pos *ip = &self->pos[pc];
+    snprintf(buf, size, "%s:%d:%d", self->files[ip->file], ip->line, ip->col);
+}
+
+/* ---------------------------------------------------------------------- */
+/* the listing                                                             */
+/* ---------------------------------------------------------------------- */
+
+/* "P.x", "Cs.g", "time" for a global slot; "r12" otherwise; "#0.5" for a
+ * constant. */
+static void slot_name(const sl_program *p, int slot, char *buf, size_t size)
+{
+    if (slot < SL_GLOBAL_SLOTS) {
+        for (int g = 0; g < SL_G__COUNT; g++) {
+            int base = sl_global_slot((sl_global)g), n = sl_global_size((sl_global)g);
+            if (slot < base || slot >= base + n)
+                continue;
+            const char *comp = g >= SL_G_Cs && g <= SL_G_Oi ? "rgb"
+                             : g == SL_G_Cl ? "rgb" : "xyz";
+            if (n == 1)
+                snprintf(buf, size, "%s", sl_global_name((sl_global)g));
+            else
+                snprintf(buf, size, "%s.%c", sl_global_name((sl_global)g), comp[slot - base]);
+            return;
+        }
+    }
+    if (slot >= p->const_base && slot < p->const_base + p->nconsts) {
+        double k = p->consts[slot - p->const_base];
+        for (int digits = 1; digits <= 17; digits++) {     /* shortest exact form */
+            snprintf(buf, size, "#%.*g", digits, k);
+            if (strtod(buf + 1, NULL) == k)
+                break;
+        }
+        return;
+    }
+    snprintf(buf, size, "r%d", slot);
+}
+
+static void string_name(const sl_program *p, int slot, char *buf, size_t size)
+{
+    for (int i = 0; i < p->nstrings; i++) {
+        if (p->string_slots[i] == slot) {
+            snprintf(buf, size, "\"%s\"", p->strings[i]);
+            return;
+        }
+    }
+    snprintf(buf, size, "s%d", slot);
+}
+
+static void dump_table(const sl_program *p, int index, FILE *out)
+{
+    int count = p->tables[index];
+    fputc('[', out);
+    for (int i = 0; i < count; i++) {
+        char buf[64], flag[64];
+        int v = p->tables[index + 1 + i];
+        if (v & SL_TABLE_STRING) {
+            fprintf(out, "%ss%d", i ? " " : "", v & SL_TABLE_SLOT);
+        } else if (v & SL_TABLE_GUARDED) {
+            slot_name(p, v & SL_TABLE_SLOT, buf, sizeof buf);
+            slot_name(p, p->tables[index + 2 + i], flag, sizeof flag);
+            fprintf(out, "%s%s?%s", i ? " " : "", buf, flag);
+            i++;
+        } else {
+            slot_name(p, v & SL_TABLE_SLOT, buf, sizeof buf);
+            fprintf(out, "%s%s%s", i ? " " : "", buf, (v & SL_TABLE_DEATH) ? "!" : "");
+        }
+    }
+    fputc(']', out);
+}
+
+static void dump_noise_variant(int v, FILE *out)
+{
+    static const char *const kind[] = { "noise", "pnoise", "cellnoise", "?" };
+    fprintf(out, "%s/%dd%s", kind[SL_NOISE_KIND(v)], SL_NOISE_DIM(v),
+            (v & SL_NOISE_VECTOR) ? "/3" : "");
+}
+
+static void dump_operand(const sl_program *p, char kind, int value, FILE *out)
+{
+    char buf[128];
+    switch (kind) {
+    case 'z': case 'x': slot_name(p, value, buf, sizeof buf); fputs(buf, out); break;
+    case 's': string_name(p, value, buf, sizeof buf); fputs(buf, out); break;
+    case 'j': fprintf(out, "@%04d", value); break;
+    case 't': dump_table(p, value, out); break;
+    case 'p': fprintf(out, "%s", p->params[value].name); break;
+    case 'n': dump_noise_variant(value, out); break;
+    default: fprintf(out, "%d", value); break;
+    }
+}
+
+static void dump_insn(const sl_program *p, int pc, int width, FILE *out)
+{
+    const sl_insn *in = &p->code[pc];
+    char where[256];
+    sl_program_pos_string(p, pc, where, sizeof where);
+    fprintf(out, "  %04d  %-*s  %-11s", pc, width, where, names[in->op]);
+    const uint16_t ops[4] = { in->a, in->b, in->c, in->d };
+    const char *k = kinds[in->op];
+    bool first = true;
+    for (int i = 0; i < 4; i++) {
+        if (k[i] == '-')
+            continue;
+        if (i == 3 && ops[i] == 0 && (in->op == SL_OP_PARAM || in->op == SL_OP_SPARAM))
+            continue;                 /* no constant default */
+        fputs(first ? " " : ", ", out);
+        first = false;
+        dump_operand(p, k[i], ops[i], out);
+    }
+    fputc('\n', out);
+}
+
+void sl_program_dump(const sl_program *self, FILE *out)
+{
+    const sl_program *p = self;
+    fprintf(out, "shader '%s' (%s): %d instructions, %d slots (%d globals, %d constants "
+                 "from r%d), %d string slots\n",
+            p->name, p->kind == SL_SHADER_SURFACE ? "surface" : "displacement", p->ncode,
+            p->nslots, SL_GLOBAL_SLOTS, p->nconsts, p->const_base, p->nstring_slots);
+    if (p->nparams)
+        fprintf(out, "parameters:\n");
+    for (int i = 0; i < p->nparams; i++)
+        fprintf(out, "  %s%-6s %-16s %s%d\n", p->params[i].output ? "output " : "",
+                sl_ty_name(p->params[i].type), p->params[i].name,
+                p->params[i].type == SL_TYPE_STRING ? "s" : "r", p->params[i].slot);
+    int width = 0;
+    for (int pc = 0; pc < p->ncode; pc++) {
+        char where[256];
+        sl_program_pos_string(p, pc, where, sizeof where);
+        if ((int)strlen(where) > width)
+            width = (int)strlen(where);
+    }
+    fprintf(out, "code:\n");
+    for (int pc = 0; pc < p->ncode; pc++)
+        dump_insn(p, pc, width, out);
+}

@@ -1,0 +1,194 @@
+/*
+ * bytecode.h: the compiled form of a shader (struct sl_program): a scalar
+ * register machine's instructions, its constant pool, operand tables and
+ * the layout of its slot file, plus the listing of aafarm-slc --dump.
+ *
+ * Register model (docs/shading-language.md, "Evaluation"): every scalar is
+ * one slot of the slot file; point/vector/normal/color take 3 consecutive
+ * slots, matrix 16. A slot holds a double, an sl_dual, an ia_interval or
+ * an aa_form depending on the mode of the run; the same bytecode serves
+ * all four. Strings live in a separate, mode-independent string file (one
+ * `const char *` per string slot). The code generator lowers all vector
+ * work to scalar operations, so a backend implements scalar operations
+ * only, plus a few special ones (noise, derivatives, lights, transforms).
+ *
+ * Slot file layout:
+ *   [0, SL_GLOBAL_SLOTS)           the renderer's globals (P, N, ...), at
+ *                                  fixed offsets (sl_global_slot)
+ *   [const_base, +nconsts)         the constant pool, loaded per run
+ *   [...,  nslots)                 parameters, variables, temporaries
+ *
+ * Booleans (comparisons, && || !) are slots too: 0 and 1 in float/dual
+ * mode; in interval/affine mode an enclosure of {0}, {1} or {0, 1} (the
+ * "maybe" of paper §4.1). A branch tests lo > 0.5 (true), hi < 0.5 (false).
+ *
+ * Instruction: an opcode and up to four 16-bit operands (slots, string
+ * slots, jump targets, table indexes or small immediates, per opcode).
+ * Programs are limited to SL_MAX_CODE instructions and SL_MAX_SLOTS slots.
+ */
+#ifndef SL_BYTECODE_H
+#define SL_BYTECODE_H
+
+#include <stdint.h>
+#include <stdio.h>
+
+#include "sl/shader.h"
+
+enum {
+    SL_MAX_SLOTS = 4096,          /* scalar slots per program */
+    SL_MAX_STRING_SLOTS = 1024,   /* string slots per program */
+    SL_MAX_CODE = 65535,          /* instructions per program */
+    SL_GLOBAL_SLOTS = 46,         /* slots of the globals, below */
+};
+
+/* Operand kinds for the listing: z/x = slot (written/read), s = string
+ * slot, j = jump target, t = table, k = immediate, p = parameter, n =
+ * noise variant, - = unused. */
+#define SL_OPCODES(X)                                            \
+    X(END, "end", "----")                                        \
+    X(MOV, "mov", "zx--") X(MOVN, "movn", "zxk-")                \
+    X(ADD, "add", "zxx-") X(SUB, "sub", "zxx-")                  \
+    X(MUL, "mul", "zxx-") X(DIV, "div", "zxx-")                  \
+    X(NEG, "neg", "zx--")                                        \
+    X(SQRT, "sqrt", "zx--") X(INVSQRT, "invsqrt", "zx--")        \
+    X(EXP, "exp", "zx--") X(LOG, "log", "zx--")                  \
+    X(SIN, "sin", "zx--") X(COS, "cos", "zx--")                  \
+    X(TAN, "tan", "zx--") X(ASIN, "asin", "zx--")                \
+    X(ACOS, "acos", "zx--") X(ATAN, "atan", "zx--")              \
+    X(ABS, "abs", "zx--") X(SIGN, "sign", "zx--")                \
+    X(FLOOR, "floor", "zx--") X(CEIL, "ceil", "zx--")            \
+    X(ROUND, "round", "zx--")                                    \
+    X(POW, "pow", "zxx-") X(ATAN2, "atan2", "zxx-")              \
+    X(MOD, "mod", "zxx-") X(MIN, "min", "zxx-")                  \
+    X(MAX, "max", "zxx-") X(STEP, "step", "zxx-")                \
+    X(CLAMP, "clamp", "zxxx") X(SMOOTHSTEP, "smoothstep", "zxxx")\
+    X(MIX, "mix", "zxxx")                                        \
+    X(LT, "lt", "zxx-") X(LE, "le", "zxx-") X(GT, "gt", "zxx-")  \
+    X(GE, "ge", "zxx-") X(EQ, "eq", "zxx-") X(NE, "ne", "zxx-")  \
+    X(AND, "and", "zxx-") X(OR, "or", "zxx-") X(NOT, "not", "zx--") \
+    X(SEQ, "seq", "zss-") X(SNE, "sne", "zss-")                  \
+    X(SMOV, "smov", "ss--")                                      \
+    X(NOISE, "noise", "zxnx") X(RANDOM, "random", "zk--")        \
+    X(DU, "du", "zx--") X(DV, "dv", "zx--")                      \
+    X(DERIV, "deriv", "zxx-")                                    \
+    X(CALCNORMAL, "calcnormal", "zx--") X(AREA, "area", "zx--")  \
+    X(AMBIENT, "ambient", "z---") X(DIFFUSE, "diffuse", "zx--")  \
+    X(SPECULAR, "specular", "zxxx") X(PHONG, "phong", "zxxx")    \
+    X(SPACE, "space", "zsk-") X(SPACEK, "spacek", "zkk-")        \
+    X(XPOINT, "xpoint", "zxx-") X(XVECTOR, "xvector", "zxx-")    \
+    X(XNORMAL, "xnormal", "zxx-") X(MINVERT, "minvert", "zx--")  \
+    X(COMP, "comp", "zxx-") X(SETCOMP, "setcomp", "zxx-")        \
+    X(JMP, "jmp", "j---")                                        \
+    X(BR_BEGIN, "br.begin", "xjt-") X(BR_ELSE, "br.else", "jk--") \
+    X(BR_END, "br.end", "kt--")                                  \
+    X(LOOP_TEST, "loop.test", "xjt-") X(LOOP_END, "loop.end", "kt--") \
+    X(PARAM, "param", "zpjx") X(SPARAM, "sparam", "spjs")        \
+    X(ESCAPE, "escape", "zktk") X(ACCUM_END, "accum.end", "kt-k")
+
+typedef enum sl_opcode {
+#define SL_OPCODE_ENUM(name, text, operands) SL_OP_##name,
+    SL_OPCODES(SL_OPCODE_ENUM)
+#undef SL_OPCODE_ENUM
+    SL_OP__COUNT
+} sl_opcode;
+
+const char *sl_opcode_name(sl_opcode op);
+
+typedef struct sl_insn {
+    uint8_t op;
+    uint16_t a, b, c, d;
+} sl_insn;
+
+/* Where an instruction came from (for runtime errors and the listing). */
+typedef struct sl_insn_pos {
+    uint16_t file;     /* index into sl_program.files */
+    uint16_t col;
+    int line;
+} sl_insn_pos;
+
+/* Merge tables: tables[i] = number of positions, then one position per
+ * slot written in the region; a string slot is tagged SL_TABLE_STRING; a
+ * function's return slot is tagged SL_TABLE_GUARDED and followed by the
+ * slot of its "returned" flag: where that flag is definitely 0 on one side
+ * the return slot is dead there and the other side's value is taken. */
+enum {
+    SL_TABLE_STRING = 0x8000, SL_TABLE_GUARDED = 0x4000, SL_TABLE_DEATH = 0x2000,
+    SL_TABLE_SLOT = 0x0fff,
+};
+
+/* break and return (paper §4.1 "dead paths"): ESCAPE flag, id, table, kind
+ * sets the escape flag (a break or "returned" flag) and, in interval and
+ * affine mode, first saves the merge table of the construct it leaves
+ * (kind SL_ESCAPE_LOOP, id = the pc of its LOOP_TEST; kind SL_ESCAPE_FUNC,
+ * id = the inlined call, 0 for the shader body) into that construct's
+ * accumulator. From then on the path is dead: in the merge tables the flag
+ * is tagged SL_TABLE_DEATH, and a side whose flag is definitely 1 is
+ * dropped at BR_END. LOOP_END (loops) and ACCUM_END (functions) merge the
+ * accumulator back. */
+enum { SL_ESCAPE_LOOP = 0, SL_ESCAPE_FUNC = 1 };
+
+/* NOISE variant (operand c): dimension in bits 0-2, kind in bits 3-4,
+ * three outputs (point/vector/color noise) in bit 5. */
+enum {
+    SL_NOISE_PLAIN = 0, SL_NOISE_PERIODIC = 1, SL_NOISE_CELL = 2,
+    SL_NOISE_VECTOR = 1 << 5,
+};
+#define SL_NOISE_VARIANT(dim, kind, vec) ((dim) | ((kind) << 3) | ((vec) ? SL_NOISE_VECTOR : 0))
+#define SL_NOISE_DIM(v) ((v) & 7)
+#define SL_NOISE_KIND(v) (((v) >> 3) & 3)
+
+/* SPACE/SPACEK direction (operand c): the matrix that takes points from the
+ * named space to "current", or the one from "current" to it. */
+enum { SL_SPACE_TO_CURRENT = 0, SL_SPACE_FROM_CURRENT = 1 };
+
+typedef struct sl_param {
+    char *name;
+    sl_type type;
+    bool output;
+    int slot;          /* scalar slot, or string slot for strings */
+    int size;          /* slots */
+} sl_param;
+
+struct sl_program {
+    char *name;
+    sl_shader_kind kind;
+    unsigned long serial;           /* unique per compiled program */
+
+    sl_insn *code;
+    sl_insn_pos *pos;
+    int ncode;
+
+    double *consts;                 /* loaded into [const_base, +nconsts) */
+    int nconsts, const_base;
+
+    uint16_t *tables;               /* merge lists: count, then slots */
+    int ntables;
+
+    char **strings;                 /* string constants ... */
+    int *string_slots;              /* ... and the string slots they load into */
+    int nstrings;
+
+    sl_param *params;
+    int nparams;
+
+    char **files;                   /* file names for positions */
+    int nfiles;
+
+    int nslots;                     /* scalar slots used */
+    int nstring_slots;
+};
+
+/* Scalar slot of a global: P at 0, N at 3, ... (3 slots for points and
+ * colors, 1 for s t u v du dv time). */
+int sl_global_slot(sl_global g);
+int sl_global_size(sl_global g);
+const char *sl_global_name(sl_global g);
+
+/* Frees a program and everything it owns (sl_program_destroy without the
+ * pointer reset; used by the code generator on failure). */
+void sl_program_free(sl_program *p);
+
+/* Source position of instruction pc as "file:line:col". */
+void sl_program_pos_string(const sl_program *self, int pc, char *buf, size_t size);
+
+#endif

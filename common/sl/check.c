@@ -1,0 +1,912 @@
+/*
+ * check.c: names, types and control-flow facts of a parsed shader (see
+ * check.h).
+ *
+ * Typing follows RI Spec 3.2 §13 ("Language Constructs"): arithmetic on
+ * triples is componentwise and a float operand is promoted by duplication;
+ * point - point is a vector, point +/- vector a point; a point and a color
+ * do not mix; '.' is the dot product of two vectors (or colors), '^' the
+ * cross product; comparisons and && || ! give a relation (SL_TY_BOOL).
+ * A float used as a condition means "!= 0". Polymorphic noise takes its
+ * result type from the context ("hint": a declaration, an assignment, a
+ * cast, a parameter, a return).
+ *
+ * Escapes: every statement records the break/continue/return inside it
+ * that leave it (sl_node.escapes). The code generator turns them into flag
+ * variables and guards (paper §4.1 needs structured control flow to merge
+ * both sides of an undecided branch), so it must know them before it
+ * generates the statements that follow.
+ */
+#include "sl/check.h"
+#include "sl/builtins.h"
+#include "sl/lexer.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+typedef struct checker {
+    sl_arena *arena;
+    sl_diag *diag;
+    sl_ast_file *file;
+    sl_sym *globals[SL_G__COUNT];
+    sl_sym *pi;
+    sl_sym **syms;                 /* scope stack */
+    int nsyms, syms_cap;
+    int scope_start;               /* first sym of the innermost scope */
+    sl_func *func;                 /* function being checked (NULL: shader) */
+    sl_node **loops;
+    int nloops, loops_cap;
+} checker;
+
+static sl_ty check_expr(checker *c, sl_node **np, sl_ty hint);
+static void check_stmt(checker *c, sl_node *n);
+
+static void error(checker *c, sl_pos pos, const char *fmt, ...) SL_PRINTF(3, 4);
+static void error(checker *c, sl_pos pos, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    sl_diag_vreport(c->diag, SL_DIAG_ERROR, pos, fmt, ap);
+    va_end(ap);
+}
+
+int sl_space_find(const char *name)
+{
+    static const char *const names[SL_SPACE__COUNT] = {
+        [SL_SPACE_CURRENT] = "current", [SL_SPACE_WORLD] = "world",
+        [SL_SPACE_OBJECT] = "object", [SL_SPACE_SHADER] = "shader",
+        [SL_SPACE_CAMERA] = "camera",
+    };
+    for (int i = 0; i < SL_SPACE__COUNT; i++)
+        if (strcmp(names[i], name) == 0)
+            return i;
+    return -1;
+}
+
+/* ---------------------------------------------------------------------- */
+/* scopes                                                                  */
+/* ---------------------------------------------------------------------- */
+
+static sl_sym *lookup(checker *c, const char *name)
+{
+    for (int i = c->nsyms - 1; i >= 0; i--)
+        if (strcmp(c->syms[i]->name, name) == 0)
+            return c->syms[i];
+    int g = sl_global_find(name);
+    if (g >= 0)
+        return c->globals[g];
+    if (strcmp(name, "PI") == 0)
+        return c->pi;
+    return NULL;
+}
+
+static void declare(checker *c, sl_sym *sym)
+{
+    for (int i = c->scope_start; i < c->nsyms; i++) {
+        if (strcmp(c->syms[i]->name, sym->name) == 0) {
+            error(c, sym->pos, "redefinition of '%s'", sym->name);
+            sl_diag_note(c->diag, c->syms[i]->pos, "previous definition is here");
+            return;
+        }
+    }
+    if (sl_global_find(sym->name) >= 0 || strcmp(sym->name, "PI") == 0)
+        error(c, sym->pos, "'%s' is a predefined variable and cannot be redeclared",
+              sym->name);      /* declared anyway: later uses are not errors too */
+    sl_list_push(c->arena, (void ***)&c->syms, &c->nsyms, &c->syms_cap, sym);
+}
+
+static int push_scope(checker *c)
+{
+    int saved = c->scope_start;
+    c->scope_start = c->nsyms;
+    return saved;
+}
+
+static void pop_scope(checker *c, int saved)
+{
+    c->nsyms = c->scope_start;
+    c->scope_start = saved;
+}
+
+static sl_func *find_func(checker *c, const char *name)
+{
+    for (int i = 0; i < c->file->nfuncs; i++)
+        if (strcmp(c->file->funcs[i]->name, name) == 0)
+            return c->file->funcs[i];
+    return NULL;
+}
+
+/* ---------------------------------------------------------------------- */
+/* conversions                                                             */
+/* ---------------------------------------------------------------------- */
+
+static bool can_convert(sl_ty have, sl_ty want)
+{
+    if (have == want || have == SL_TY_ERROR || want == SL_TY_ERROR)
+        return true;
+    if (sl_ty_is_spatial(have) && sl_ty_is_spatial(want))
+        return true;
+    if (have == SL_TYPE_FLOAT &&
+        (sl_ty_is_triple(want) || want == SL_TYPE_MATRIX || want == SL_TY_BOOL))
+        return true;
+    return false;
+}
+
+/* Wraps *np in a conversion to `want` (the caller checked can_convert). */
+static void wrap_conv(checker *c, sl_node **np, sl_ty want)
+{
+    sl_node *e = *np;
+    if (e->ty == want || e->ty == SL_TY_ERROR || want == SL_TY_ERROR)
+        return;
+    if (sl_ty_is_spatial(e->ty) && sl_ty_is_spatial(want)) {
+        e->ty = want;          /* same slots, another name */
+        return;
+    }
+    sl_node *conv = sl_node_new(c->arena, SL_N_CONV, e->pos);
+    conv->a = e;
+    conv->ty = want;
+    *np = conv;
+}
+
+static void check_cond(checker *c, sl_node **np)
+{
+    sl_ty ty = check_expr(c, np, SL_TY_BOOL);
+    if (ty == SL_TY_BOOL || ty == SL_TY_ERROR)
+        return;
+    if (ty == SL_TYPE_FLOAT) {
+        wrap_conv(c, np, SL_TY_BOOL);
+        return;
+    }
+    error(c, (*np)->pos, "a value of type '%s' cannot be used as a condition",
+          sl_ty_name(ty));
+    (*np)->ty = SL_TY_ERROR;
+}
+
+/* ---------------------------------------------------------------------- */
+/* expressions                                                             */
+/* ---------------------------------------------------------------------- */
+
+static sl_ty set_ty(sl_node *n, sl_ty ty)
+{
+    n->ty = ty;
+    return ty;
+}
+
+static sl_ty check_ident(checker *c, sl_node *n)
+{
+    sl_sym *s = lookup(c, n->name);
+    if (!s) {
+        if (find_func(c, n->name) || sl_builtin_find(n->name, &(int){ 0 }))
+            error(c, n->pos, "'%s' is a function; call it with '(...)'", n->name);
+        else
+            error(c, n->pos, "use of undeclared identifier '%s'", n->name);
+        return set_ty(n, SL_TY_ERROR);
+    }
+    n->sym = s;
+    return set_ty(n, s->ty);
+}
+
+/* Arithmetic result type of a op b, or SL_TY_ERROR after reporting. */
+static sl_ty arith_type(checker *c, const sl_node *n, sl_ty a, sl_ty b)
+{
+    int op = n->op;
+    if (a == SL_TY_ERROR || b == SL_TY_ERROR)
+        return SL_TY_ERROR;
+    if (a == SL_TYPE_FLOAT && b == SL_TYPE_FLOAT)
+        return SL_TYPE_FLOAT;
+    if (a == SL_TYPE_MATRIX || b == SL_TYPE_MATRIX) {
+        if (op == SL_TOK_STAR && (a == b || a == SL_TYPE_FLOAT || b == SL_TYPE_FLOAT))
+            return SL_TYPE_MATRIX;
+        if (op == SL_TOK_SLASH && a == SL_TYPE_MATRIX && b == SL_TYPE_FLOAT)
+            return SL_TYPE_MATRIX;
+        goto bad;
+    }
+    if (a == SL_TYPE_FLOAT && sl_ty_is_triple(b))
+        return b;
+    if (b == SL_TYPE_FLOAT && sl_ty_is_triple(a))
+        return a;
+    if (a == SL_TYPE_COLOR && b == SL_TYPE_COLOR)
+        return SL_TYPE_COLOR;
+    if (sl_ty_is_spatial(a) && sl_ty_is_spatial(b)) {
+        bool additive = op == SL_TOK_PLUS || op == SL_TOK_MINUS;
+        if (a == b)
+            return additive && op == SL_TOK_MINUS && a == SL_TYPE_POINT ? SL_TYPE_VECTOR : a;
+        if (additive && (a == SL_TYPE_POINT || b == SL_TYPE_POINT))
+            return op == SL_TOK_MINUS && b == SL_TYPE_POINT ? SL_TYPE_VECTOR : SL_TYPE_POINT;
+        return SL_TYPE_VECTOR;
+    }
+bad:
+    error(c, n->pos, "invalid operands to binary '%s' ('%s' and '%s')",
+          sl_token_kind_spelling(op), sl_ty_name(a), sl_ty_name(b));
+    return SL_TY_ERROR;
+}
+
+static sl_ty compare_type(checker *c, const sl_node *n, sl_ty a, sl_ty b)
+{
+    if (a == SL_TY_ERROR || b == SL_TY_ERROR)
+        return SL_TY_ERROR;
+    bool eq = n->op == SL_TOK_EQ || n->op == SL_TOK_NE;
+    if (a == SL_TYPE_FLOAT && b == SL_TYPE_FLOAT)
+        return SL_TY_BOOL;
+    if (eq && ((sl_ty_is_spatial(a) && sl_ty_is_spatial(b)) ||
+               (a == SL_TYPE_COLOR && b == SL_TYPE_COLOR) ||
+               (a == SL_TYPE_STRING && b == SL_TYPE_STRING) ||
+               (a == SL_TY_BOOL && b == SL_TY_BOOL) ||
+               (a == SL_TYPE_MATRIX && b == SL_TYPE_MATRIX)))
+        return SL_TY_BOOL;
+    error(c, n->pos, "invalid operands to binary '%s' ('%s' and '%s')",
+          sl_token_kind_spelling(n->op), sl_ty_name(a), sl_ty_name(b));
+    return SL_TY_ERROR;
+}
+
+static sl_ty check_binary(checker *c, sl_node *n)
+{
+    int op = n->op;
+    if (op == SL_TOK_AND || op == SL_TOK_OR) {
+        check_cond(c, &n->a);
+        check_cond(c, &n->b);
+        return set_ty(n, SL_TY_BOOL);
+    }
+    sl_ty a = check_expr(c, &n->a, SL_TYPE_VOID);
+    sl_ty b = check_expr(c, &n->b, SL_TYPE_VOID);
+    if (a == SL_TY_ERROR || b == SL_TY_ERROR)
+        return set_ty(n, SL_TY_ERROR);
+    switch (op) {
+    case SL_TOK_PLUS: case SL_TOK_MINUS: case SL_TOK_STAR: case SL_TOK_SLASH:
+        return set_ty(n, arith_type(c, n, a, b));
+    case SL_TOK_DOT:
+        if ((sl_ty_is_spatial(a) && sl_ty_is_spatial(b)) ||
+            (a == SL_TYPE_COLOR && b == SL_TYPE_COLOR))
+            return set_ty(n, SL_TYPE_FLOAT);
+        break;
+    case SL_TOK_CARET:
+        if (sl_ty_is_spatial(a) && sl_ty_is_spatial(b))
+            return set_ty(n, SL_TYPE_VECTOR);
+        break;
+    default:
+        return set_ty(n, compare_type(c, n, a, b));
+    }
+    error(c, n->pos, "invalid operands to binary '%s' ('%s' and '%s')",
+          sl_token_kind_spelling(op), sl_ty_name(a), sl_ty_name(b));
+    return set_ty(n, SL_TY_ERROR);
+}
+
+static sl_ty check_unary(checker *c, sl_node *n)
+{
+    if (n->op == SL_TOK_NOT) {
+        check_cond(c, &n->a);
+        return set_ty(n, SL_TY_BOOL);
+    }
+    sl_ty a = check_expr(c, &n->a, SL_TYPE_VOID);
+    if (a == SL_TY_ERROR || a == SL_TYPE_FLOAT || sl_ty_is_triple(a) || a == SL_TYPE_MATRIX)
+        return set_ty(n, a);
+    error(c, n->pos, "invalid argument type '%s' to unary '-'", sl_ty_name(a));
+    return set_ty(n, SL_TY_ERROR);
+}
+
+/* The common type of the two results of ?: */
+static sl_ty unify(sl_ty a, sl_ty b)
+{
+    if (a == b)
+        return a;
+    if (a == SL_TYPE_FLOAT && (sl_ty_is_triple(b) || b == SL_TYPE_MATRIX))
+        return b;
+    if (b == SL_TYPE_FLOAT && (sl_ty_is_triple(a) || a == SL_TYPE_MATRIX))
+        return a;
+    if (sl_ty_is_spatial(a) && sl_ty_is_spatial(b))
+        return SL_TYPE_VECTOR;
+    return SL_TY_ERROR;
+}
+
+static sl_ty check_cond_expr(checker *c, sl_node *n, sl_ty hint)
+{
+    check_cond(c, &n->a);
+    sl_ty a = check_expr(c, &n->b, hint);
+    sl_ty b = check_expr(c, &n->c, hint);
+    if (a == SL_TY_ERROR || b == SL_TY_ERROR)
+        return set_ty(n, SL_TY_ERROR);
+    sl_ty ty = unify(a, b);
+    if (ty == SL_TY_ERROR || ty == SL_TYPE_VOID) {
+        error(c, n->pos, "incompatible operand types ('%s' and '%s') in conditional expression",
+              sl_ty_name(a), sl_ty_name(b));
+        return set_ty(n, SL_TY_ERROR);
+    }
+    wrap_conv(c, &n->b, ty);
+    wrap_conv(c, &n->c, ty);
+    return set_ty(n, ty);
+}
+
+static bool check_assignable(checker *c, sl_node *lhs, const char *what)
+{
+    sl_sym *s = lhs->sym;
+    if (!s || s->writable)
+        return true;
+    if (s->kind == SL_SYM_GLOBAL)
+        error(c, lhs->pos, "cannot %s '%s': it is a read-only global variable", what, s->name);
+    else if (s->kind == SL_SYM_CONST)
+        error(c, lhs->pos, "cannot %s '%s': it is a constant", what, s->name);
+    else
+        error(c, lhs->pos, "cannot %s parameter '%s': it is not declared 'output'", what,
+              s->name);
+    return false;
+}
+
+static sl_ty check_assign(checker *c, sl_node *n)
+{
+    sl_node *lhs = n->a;
+    if (lhs->kind != SL_N_IDENT)
+        return set_ty(n, SL_TY_ERROR);
+    sl_ty lt = check_ident(c, lhs);
+    if (lt == SL_TY_ERROR) {
+        check_expr(c, &n->b, SL_TYPE_VOID);
+        return set_ty(n, SL_TY_ERROR);
+    }
+    check_assignable(c, lhs, "assign to");
+    if (n->op != SL_TOK_ASSIGN) {     /* x op= e  ->  x = x op e */
+        sl_node *bin = sl_node_new(c->arena, SL_N_BINARY, n->pos);
+        bin->op = n->op == SL_TOK_PLUS_ASSIGN ? SL_TOK_PLUS
+                : n->op == SL_TOK_MINUS_ASSIGN ? SL_TOK_MINUS
+                : n->op == SL_TOK_STAR_ASSIGN ? SL_TOK_STAR : SL_TOK_SLASH;
+        sl_node *read = sl_node_new(c->arena, SL_N_IDENT, lhs->pos);
+        read->name = lhs->name;
+        bin->a = read;
+        bin->b = n->b;
+        n->b = bin;
+        n->op = SL_TOK_ASSIGN;
+    }
+    sl_ty rt = check_expr(c, &n->b, lt);
+    if (!can_convert(rt, lt)) {
+        error(c, n->b->pos, "cannot assign a value of type '%s' to '%s' (%s)",
+              sl_ty_name(rt), lhs->name, sl_ty_name(lt));
+        return set_ty(n, SL_TY_ERROR);
+    }
+    wrap_conv(c, &n->b, lt);
+    return set_ty(n, lt);
+}
+
+/* A constant string argument naming a space: known? */
+static void check_space_arg(checker *c, const sl_node *arg)
+{
+    if (arg->kind == SL_N_STR && sl_space_find(arg->name) < 0)
+        error(c, arg->pos, "unknown space '%s' (known: \"current\", \"world\", "
+                           "\"object\", \"shader\", \"camera\")", arg->name);
+}
+
+static sl_ty check_builtin_call(checker *c, sl_node *n, const sl_ty *args, sl_ty hint)
+{
+    sl_ty want[8], result;
+    const sl_builtin *b = sl_builtin_resolve(n->name, args, n->nlist, hint, want, &result);
+    if (!b) {
+        char list[256] = "";
+        for (int i = 0; i < n->nlist; i++) {
+            size_t len = strlen(list);
+            snprintf(list + len, sizeof list - len, "%s%s", i ? ", " : "",
+                     sl_ty_name(args[i]));
+        }
+        error(c, n->pos, "no matching function for call to '%s' with arguments (%s)",
+              n->name, list);
+        char cands[512];
+        sl_builtin_candidates(n->name, cands, sizeof cands);
+        sl_diag_note(c->diag, n->pos, "candidates are: %s", cands);
+        return set_ty(n, SL_TY_ERROR);
+    }
+    n->builtin = b;
+    const char *sig = b->sig + 2;
+    for (int i = 0; i < n->nlist; i++) {
+        if (sig[i] == 'o' || sig[i] == 'O') {
+            sl_node *a = n->list[i];
+            if (a->kind != SL_N_IDENT)
+                error(c, a->pos, "argument %d of '%s' must be a variable", i + 1, n->name);
+            else
+                check_assignable(c, a, "modify");
+            continue;
+        }
+        if (sig[i] == 's')
+            check_space_arg(c, n->list[i]);
+        wrap_conv(c, &n->list[i], want[i]);
+    }
+    return set_ty(n, result);
+}
+
+static void add_call_edge(checker *c, sl_func *callee)
+{
+    if (!c->func)
+        return;
+    for (int i = 0; i < c->func->ncalls; i++)
+        if (c->func->calls[i] == callee)
+            return;
+    sl_list_push(c->arena, (void ***)&c->func->calls, &c->func->ncalls,
+                 &c->func->calls_cap, callee);
+}
+
+static sl_ty check_user_call(checker *c, sl_node *n, sl_func *f, const sl_ty *args)
+{
+    n->func = f;
+    add_call_edge(c, f);
+    if (n->nlist != f->nparams) {
+        error(c, n->pos, "function '%s' takes %d argument%s, but %d %s given", f->name,
+              f->nparams, f->nparams == 1 ? "" : "s", n->nlist, n->nlist == 1 ? "was" : "were");
+        sl_diag_note(c->diag, f->pos, "'%s' declared here", f->name);
+        return set_ty(n, SL_TY_ERROR);
+    }
+    bool ok = true;
+    for (int i = 0; i < n->nlist; i++) {
+        sl_sym *p = f->params[i];
+        if (args[i] == SL_TY_ERROR) {
+            ok = false;
+            continue;
+        }
+        if (p->output) {
+            sl_node *a = n->list[i];
+            if (a->kind != SL_N_IDENT) {
+                error(c, a->pos, "argument %d of '%s' must be a variable (the parameter "
+                                 "is 'output')", i + 1, f->name);
+                ok = false;
+            } else if (!(args[i] == p->ty ||
+                         (sl_ty_is_spatial(args[i]) && sl_ty_is_spatial(p->ty)))) {
+                error(c, a->pos, "argument %d of '%s': cannot pass a '%s' variable to an "
+                                 "output parameter of type '%s'", i + 1, f->name,
+                      sl_ty_name(args[i]), sl_ty_name(p->ty));
+                ok = false;
+            } else {
+                check_assignable(c, a, "modify");
+            }
+            continue;
+        }
+        if (!can_convert(args[i], p->ty)) {
+            error(c, n->list[i]->pos, "argument %d of '%s': cannot convert '%s' to '%s'",
+                  i + 1, f->name, sl_ty_name(args[i]), sl_ty_name(p->ty));
+            ok = false;
+            continue;
+        }
+        wrap_conv(c, &n->list[i], p->ty);
+    }
+    return set_ty(n, ok ? f->ret : SL_TY_ERROR);
+}
+
+static sl_ty check_call(checker *c, sl_node *n, sl_ty hint)
+{
+    sl_func *f = find_func(c, n->name);
+    int count;
+    if (!f && !sl_builtin_find(n->name, &count)) {
+        for (int i = 0; i < n->nlist; i++)
+            check_expr(c, &n->list[i], SL_TYPE_VOID);
+        if (lookup(c, n->name))
+            error(c, n->pos, "called object '%s' is not a function", n->name);
+        else
+            error(c, n->pos, "use of undeclared function '%s'", n->name);
+        return set_ty(n, SL_TY_ERROR);
+    }
+    if (n->nlist > 8) {
+        error(c, n->pos, "too many arguments in call to '%s'", n->name);
+        return set_ty(n, SL_TY_ERROR);
+    }
+    sl_ty args[8];
+    bool bad = false;
+    for (int i = 0; i < n->nlist; i++) {
+        sl_ty h = f && i < f->nparams ? f->params[i]->ty : SL_TYPE_VOID;
+        args[i] = check_expr(c, &n->list[i], h);
+        bad |= args[i] == SL_TY_ERROR;
+    }
+    if (f)
+        return check_user_call(c, n, f, args);
+    if (bad)
+        return set_ty(n, SL_TY_ERROR);
+    return check_builtin_call(c, n, args, hint);
+}
+
+static sl_ty check_cast_values(checker *c, sl_node *n)
+{
+    sl_ty ty = n->cast_ty;
+    int count = n->nlist;
+    sl_ty hint = count == 1 ? ty : SL_TYPE_FLOAT;
+    bool bad = false;
+    for (int i = 0; i < count; i++)
+        bad |= check_expr(c, &n->list[i], hint) == SL_TY_ERROR;
+    if (bad)
+        return SL_TY_ERROR;
+    int want = sl_ty_slots(ty);
+    if (count == 1) {
+        sl_ty a = n->list[0]->ty;
+        if (a == ty || can_convert(a, ty)) {
+            wrap_conv(c, &n->list[0], ty);
+            return ty;
+        }
+        error(c, n->pos, "cannot convert '%s' to '%s'", sl_ty_name(a), sl_ty_name(ty));
+        return SL_TY_ERROR;
+    }
+    if (count != want || ty == SL_TYPE_FLOAT || ty == SL_TYPE_STRING) {
+        error(c, n->pos, "a '%s' is built from %s, not from %d values", sl_ty_name(ty),
+              ty == SL_TYPE_MATRIX ? "1 or 16 floats" : want == 3 ? "1 or 3 floats" : "1 value",
+              count);
+        return SL_TY_ERROR;
+    }
+    for (int i = 0; i < count; i++) {
+        if (n->list[i]->ty != SL_TYPE_FLOAT) {
+            error(c, n->list[i]->pos, "component %d of '%s' must be a float, not '%s'", i + 1,
+                  sl_ty_name(ty), sl_ty_name(n->list[i]->ty));
+            return SL_TY_ERROR;
+        }
+    }
+    return ty;
+}
+
+static sl_ty check_cast(checker *c, sl_node *n)
+{
+    sl_ty ty = check_cast_values(c, n);
+    if (ty == SL_TY_ERROR || !n->name)
+        return set_ty(n, ty);
+    if (sl_ty_is_spatial(ty)) {
+        if (sl_space_find(n->name) < 0) {
+            error(c, n->pos, "unknown space '%s' (known: \"current\", \"world\", "
+                             "\"object\", \"shader\", \"camera\")", n->name);
+            return set_ty(n, SL_TY_ERROR);
+        }
+    } else if (ty == SL_TYPE_COLOR) {
+        if (strcmp(n->name, "rgb") != 0) {
+            error(c, n->pos, "unsupported color space '%s' (only \"rgb\")", n->name);
+            return set_ty(n, SL_TY_ERROR);
+        }
+    } else {
+        error(c, n->pos, "a space name is not allowed in a cast to '%s'", sl_ty_name(ty));
+        return set_ty(n, SL_TY_ERROR);
+    }
+    return set_ty(n, ty);
+}
+
+static sl_ty check_expr(checker *c, sl_node **np, sl_ty hint)
+{
+    sl_node *n = *np;
+    switch (n->kind) {
+    case SL_N_NUM: return set_ty(n, SL_TYPE_FLOAT);
+    case SL_N_STR: return set_ty(n, SL_TYPE_STRING);
+    case SL_N_ERROR: return set_ty(n, SL_TY_ERROR);
+    case SL_N_IDENT: return check_ident(c, n);
+    case SL_N_CALL: return check_call(c, n, hint);
+    case SL_N_UNARY: return check_unary(c, n);
+    case SL_N_BINARY: return check_binary(c, n);
+    case SL_N_COND: return check_cond_expr(c, n, hint);
+    case SL_N_ASSIGN: return check_assign(c, n);
+    case SL_N_CAST: return check_cast(c, n);
+    case SL_N_CONV: return n->ty;
+    default: return set_ty(n, SL_TY_ERROR);
+    }
+}
+
+/* ---------------------------------------------------------------------- */
+/* statements and escapes                                                  */
+/* ---------------------------------------------------------------------- */
+
+static bool same_escape(const sl_escape *a, const sl_escape *b)
+{
+    return a->kind == b->kind && a->loop == b->loop && a->func == b->func;
+}
+
+static void add_escape(checker *c, sl_node *n, sl_escape e)
+{
+    for (int i = 0; i < n->nescapes; i++)
+        if (same_escape(&n->escapes[i], &e))
+            return;
+    sl_escape *grown = sl_arena_alloc(c->arena, (size_t)(n->nescapes + 1) * sizeof *grown);
+    if (n->nescapes)
+        memcpy(grown, n->escapes, (size_t)n->nescapes * sizeof *grown);
+    grown[n->nescapes++] = e;
+    n->escapes = grown;
+}
+
+/* n inherits the escapes of child, except those that end at `loop`. */
+static void inherit(checker *c, sl_node *n, const sl_node *child, const sl_node *loop)
+{
+    if (!child)
+        return;
+    for (int i = 0; i < child->nescapes; i++)
+        if (!loop || child->escapes[i].loop != loop)
+            add_escape(c, n, child->escapes[i]);
+}
+
+static void check_decl(checker *c, sl_node *n)
+{
+    for (int i = 0; i < n->nlist; i++) {
+        sl_node *v = n->list[i];
+        sl_sym *s = v->sym;
+        if (v->num != 0) {            /* extern */
+            sl_sym *outer = lookup(c, s->name);
+            if (!outer || outer->kind != SL_SYM_GLOBAL) {
+                error(c, v->pos, "'extern' may only name a predefined variable here "
+                                 "(pass '%s' as a parameter instead)", s->name);
+                s->kind = SL_SYM_LOCAL;     /* declared anyway: no follow-up errors */
+                declare(c, s);
+                v->num = 0;
+                continue;
+            } else if (outer->ty != s->ty)
+                error(c, v->pos, "'extern' declaration of '%s' as '%s' does not match its "
+                                 "type '%s'", s->name, sl_ty_name(s->ty),
+                      sl_ty_name(outer->ty));
+            v->sym = NULL;
+            continue;
+        }
+        if (v->a) {
+            sl_ty t = check_expr(c, &v->a, s->ty);
+            if (!can_convert(t, s->ty))
+                error(c, v->a->pos, "cannot initialize '%s' (%s) with a value of type '%s'",
+                      s->name, sl_ty_name(s->ty), sl_ty_name(t));
+            else
+                wrap_conv(c, &v->a, s->ty);
+        }
+        declare(c, s);
+    }
+}
+
+static void check_loop_body(checker *c, sl_node *loop, sl_node *body)
+{
+    sl_list_push(c->arena, (void ***)&c->loops, &c->nloops, &c->loops_cap, loop);
+    check_stmt(c, body);
+    c->nloops--;
+    inherit(c, loop, body, loop);
+}
+
+static void check_loop_mod(checker *c, sl_node *n)
+{
+    const char *kw = n->kind == SL_N_BREAK ? "break" : "continue";
+    int levels = (int)n->num;
+    if (c->nloops == 0) {
+        error(c, n->pos, "'%s' statement not in loop", kw);
+        return;
+    }
+    if (levels > c->nloops) {
+        error(c, n->pos, "'%s %d' leaves more loops than the %d around it", kw, levels,
+              c->nloops);
+        return;
+    }
+    n->target = c->loops[c->nloops - levels];
+    sl_escape e = { n->kind == SL_N_BREAK ? SL_ESC_BREAK : SL_ESC_CONTINUE, n->target, NULL };
+    add_escape(c, n, e);
+}
+
+static void check_return(checker *c, sl_node *n)
+{
+    sl_ty want = c->func ? c->func->ret : SL_TYPE_VOID;
+    n->func = c->func;
+    if (n->a) {
+        sl_ty t = check_expr(c, &n->a, want);
+        if (want == SL_TYPE_VOID) {
+            error(c, n->pos, c->func ? "void function '%s' should not return a value"
+                                     : "shader '%s' should not return a value",
+                  c->func ? c->func->name : c->file->name);
+        } else if (!can_convert(t, want)) {
+            error(c, n->a->pos, "cannot return a value of type '%s' from function '%s' "
+                                "returning '%s'", sl_ty_name(t), c->func->name,
+                  sl_ty_name(want));
+        } else {
+            wrap_conv(c, &n->a, want);
+        }
+    } else if (want != SL_TYPE_VOID) {
+        error(c, n->pos, "non-void function '%s' should return a value", c->func->name);
+    }
+    sl_escape e = { SL_ESC_RETURN, NULL, c->func };
+    add_escape(c, n, e);
+}
+
+static void check_stmt(checker *c, sl_node *n)
+{
+    if (!n || sl_diag_full(c->diag))
+        return;
+    switch (n->kind) {
+    case SL_N_BLOCK: {
+        int saved = push_scope(c);
+        for (int i = 0; i < n->nlist; i++) {
+            check_stmt(c, n->list[i]);
+            inherit(c, n, n->list[i], NULL);
+        }
+        pop_scope(c, saved);
+        break;
+    }
+    case SL_N_DECL: check_decl(c, n); break;
+    case SL_N_EXPR: check_expr(c, &n->a, SL_TYPE_VOID); break;
+    case SL_N_IF:
+        check_cond(c, &n->a);
+        check_stmt(c, n->b);
+        check_stmt(c, n->c);
+        inherit(c, n, n->b, NULL);
+        inherit(c, n, n->c, NULL);
+        break;
+    case SL_N_WHILE:
+        check_cond(c, &n->a);
+        check_loop_body(c, n, n->b);
+        break;
+    case SL_N_FOR: {
+        int saved = push_scope(c);
+        if (n->a)
+            check_stmt(c, n->a);
+        if (n->b)
+            check_cond(c, &n->b);
+        if (n->c)
+            check_stmt(c, n->c);
+        check_loop_body(c, n, n->d);
+        pop_scope(c, saved);
+        break;
+    }
+    case SL_N_BREAK: case SL_N_CONTINUE: check_loop_mod(c, n); break;
+    case SL_N_RETURN: check_return(c, n); break;
+    default: break;
+    }
+}
+
+/* Marks the body's final return as the tail one; true when some other
+ * return exists (the code generator then needs a "returned" flag). */
+static bool count_returns(const sl_node *n, int *count)
+{
+    if (!n)
+        return false;
+    if (n->kind == SL_N_RETURN)
+        (*count)++;
+    count_returns(n->a, count);
+    count_returns(n->b, count);
+    count_returns(n->c, count);
+    count_returns(n->d, count);
+    if (n->kind == SL_N_BLOCK)
+        for (int i = 0; i < n->nlist; i++)
+            count_returns(n->list[i], count);
+    return *count > 0;
+}
+
+static bool needs_ret_flag(sl_node *body)
+{
+    int count = 0;
+    count_returns(body, &count);
+    if (count == 0)
+        return false;
+    if (body->kind == SL_N_BLOCK && body->nlist > 0 &&
+        body->list[body->nlist - 1]->kind == SL_N_RETURN) {
+        body->list[body->nlist - 1]->tail = true;
+        return count > 1;
+    }
+    return true;
+}
+
+/* ---------------------------------------------------------------------- */
+/* functions, recursion, the shader                                        */
+/* ---------------------------------------------------------------------- */
+
+static void check_function(checker *c, sl_func *f)
+{
+    c->func = f;
+    c->nsyms = 0;
+    c->scope_start = 0;
+    for (int i = 0; i < f->nparams; i++)
+        declare(c, f->params[i]);
+    check_stmt(c, f->body);
+    f->needs_ret_flag = needs_ret_flag(f->body);
+    if (f->ret != SL_TYPE_VOID) {
+        int count = 0;
+        if (!count_returns(f->body, &count))
+            error(c, f->pos, "non-void function '%s' has no 'return' statement", f->name);
+    }
+    c->func = NULL;
+}
+
+/* Depth-first search for a cycle through f; reports the chain. */
+static bool find_cycle(checker *c, sl_func *f, sl_func **path, int depth)
+{
+    if (f->mark == 2)
+        return false;
+    path[depth] = f;
+    if (f->mark == 1) {
+        int start = 0;
+        while (path[start] != f)
+            start++;
+        char chain[512] = "";
+        for (int i = start; i <= depth; i++) {
+            size_t len = strlen(chain);
+            snprintf(chain + len, sizeof chain - len, "%s%s", i > start ? " -> " : "",
+                     path[i]->name);
+        }
+        error(c, f->pos, "recursion is not supported: %s", chain);
+        return true;
+    }
+    f->mark = 1;
+    for (int i = 0; i < f->ncalls; i++)
+        if (find_cycle(c, f->calls[i], path, depth + 1))
+            return true;
+    f->mark = 2;
+    return false;
+}
+
+static void check_recursion(checker *c)
+{
+    sl_func **path = sl_arena_alloc(c->arena,
+                                    (size_t)(c->file->nfuncs + 2) * sizeof *path);
+    for (int i = 0; i < c->file->nfuncs; i++) {
+        if (find_cycle(c, c->file->funcs[i], path, 0)) {
+            for (int j = 0; j < c->file->nfuncs; j++)
+                c->file->funcs[j]->mark = 2;
+            return;
+        }
+    }
+}
+
+/* Reports f when an earlier function has its name. */
+static void check_duplicate(checker *c, int i)
+{
+    sl_func *f = c->file->funcs[i];
+    for (int j = 0; j < i; j++) {
+        if (strcmp(f->name, c->file->funcs[j]->name) == 0) {
+            error(c, f->pos, "redefinition of function '%s'", f->name);
+            sl_diag_note(c->diag, c->file->funcs[j]->pos, "previous definition is here");
+            return;
+        }
+    }
+}
+
+/* Does position a come before b (same file, or the main file first)? */
+static bool before(sl_pos a, sl_pos b)
+{
+    if (a.file && b.file && strcmp(a.file, b.file) != 0)
+        return false;
+    return a.line < b.line || (a.line == b.line && a.col < b.col);
+}
+
+static void make_globals(checker *c)
+{
+    for (int g = 0; g < SL_G__COUNT; g++) {
+        sl_sym *s = sl_arena_alloc(c->arena, sizeof *s);
+        s->name = sl_global_name((sl_global)g);
+        s->ty = sl_global_type((sl_global)g);
+        s->kind = SL_SYM_GLOBAL;
+        s->global = g;
+        s->writable = sl_global_writable((sl_global)g);
+        s->slot = sl_global_slot((sl_global)g);
+        c->globals[g] = s;
+    }
+    c->pi = sl_arena_alloc(c->arena, sizeof *c->pi);
+    c->pi->name = "PI";
+    c->pi->ty = SL_TYPE_FLOAT;
+    c->pi->kind = SL_SYM_CONST;
+    c->pi->value = M_PI;
+    c->pi->slot = -1;
+}
+
+static void check_shader(checker *c)
+{
+    sl_ast_file *f = c->file;
+    c->nsyms = 0;
+    c->scope_start = 0;
+    for (int i = 0; i < f->nparams; i++) {
+        sl_node *v = f->params[i];
+        if (v->a) {
+            sl_ty t = check_expr(c, &v->a, v->sym->ty);
+            if (!can_convert(t, v->sym->ty))
+                error(c, v->a->pos, "cannot initialize '%s' (%s) with a value of type '%s'",
+                      v->sym->name, sl_ty_name(v->sym->ty), sl_ty_name(t));
+            else
+                wrap_conv(c, &v->a, v->sym->ty);
+        }
+        declare(c, v->sym);
+    }
+    if (f->body) {
+        check_stmt(c, f->body);
+        f->needs_ret_flag = needs_ret_flag(f->body);
+    }
+}
+
+bool sl_check(sl_ast_file *file, sl_arena *arena, sl_diag *diag)
+{
+    checker c = { .arena = arena, .diag = diag, .file = file };
+    int errors = sl_diag_error_count(diag);
+    make_globals(&c);
+    /* definitions in source order, so that messages come in that order */
+    bool shader_done = !file->has_shader;
+    for (int i = 0; i < file->nfuncs && !sl_diag_full(diag); i++) {
+        if (!shader_done && before(file->pos, file->funcs[i]->pos)) {
+            check_shader(&c);
+            shader_done = true;
+        }
+        check_duplicate(&c, i);
+        check_function(&c, file->funcs[i]);
+    }
+    if (!shader_done)
+        check_shader(&c);
+    check_recursion(&c);
+    return sl_diag_error_count(diag) == errors;
+}

@@ -1,0 +1,1388 @@
+/*
+ * codegen.c: from the checked tree to bytecode (see codegen.h).
+ *
+ * Slots. Variables and temporaries are allocated from a stack pointer
+ * (sp): a statement frees its temporaries, a block its variables. The
+ * constant pool is placed after the highest slot used, so constant
+ * operands are emitted with CONST_TAG and fixed up at the end; string
+ * constants likewise in the string file.
+ *
+ * Expressions. gen_expr(e, dst) returns the slot holding e's value; with
+ * dst >= 0 the value must end up in dst. Componentwise (lane-wise) work
+ * writes straight into dst: lane i only reads lane i of its operands, all
+ * computed before, so an assignment like P = P + N * d needs no copy. Work
+ * that mixes lanes (cross, transforms, calls) goes through temporaries.
+ *
+ * Control flow (paper §4.1). `if` becomes BR_BEGIN cond / BR_ELSE /
+ * BR_END, loops LOOP_TEST / LOOP_END, each with a merge table: the slots
+ * below the region's starting sp (variables that outlive the region) that
+ * the region writes. A backend that cannot decide the condition runs both
+ * sides and merges exactly those slots. break, continue and return become
+ * flag variables: the statements after one that may escape are guarded by
+ * "no flag set", and loop conditions test the flags; so every region is
+ * single-entry single-exit and the merges stay sound.
+ *
+ * User functions are inlined at each call: parameters are bound to the
+ * argument slots (by reference, as in RenderMan), the result goes to a
+ * fresh slot.
+ */
+#include "sl/codegen.h"
+#include "sl/builtins.h"
+#include "sl/check.h"
+#include "sl/lexer.h"
+#include "sl/strbuf.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdatomic.h>
+#include <stdlib.h>
+#include <string.h>
+
+enum { CONST_TAG = 0x8000 };
+
+typedef struct region {
+    int start_sp, start_ssp;
+    uint8_t bits[SL_MAX_SLOTS / 8];
+    uint8_t sbits[SL_MAX_STRING_SLOTS / 8];
+} region;
+
+/* The return slot of a function being inlined, dead while its "returned"
+ * flag is 0 (every path that has not returned yet will still write it). */
+typedef struct inline_ret {
+    int slot, size, flag;
+} inline_ret;
+
+typedef struct cg {
+    const sl_ast_file *file;
+    sl_diag *diag;
+    sl_program *prog;
+    int code_cap, consts_cap, tables_cap, strings_cap, files_cap;
+    int sp, max_sp, ssp, max_ssp;
+    region *regions;
+    int nregions, regions_cap;
+    sl_pos cur;
+    int inline_depth;
+    inline_ret rets[SL_MAX_INLINE_DEPTH + 1];
+    int nrets;
+    sl_func *func;
+    int shader_ret_flag;
+    uint8_t death[SL_MAX_SLOTS / 8];     /* escape flags: their paths are saved */
+    struct pending_escape { int pc, kind, id; } *escapes;
+    int nescapes, escapes_cap, next_id;
+    bool failed;
+} cg;
+
+static int gen_expr(cg *g, sl_node *e, int dst);
+static void gen_stmt(cg *g, sl_node *n);
+
+static void fail(cg *g, const char *fmt, ...) SL_PRINTF(2, 3);
+static void fail(cg *g, const char *fmt, ...)
+{
+    if (g->failed)
+        return;
+    g->failed = true;
+    va_list ap;
+    va_start(ap, fmt);
+    sl_diag_vreport(g->diag, SL_DIAG_ERROR, g->cur, fmt, ap);
+    va_end(ap);
+}
+
+/* ---------------------------------------------------------------------- */
+/* slots                                                                   */
+/* ---------------------------------------------------------------------- */
+
+static int alloc_slots(cg *g, int n)
+{
+    int slot = g->sp;
+    if (g->sp + n > SL_MAX_SLOTS) {
+        fail(g, "shader needs more than %d registers (the limit per shader)", SL_MAX_SLOTS);
+        return SL_GLOBAL_SLOTS;
+    }
+    g->sp += n;
+    if (g->sp > g->max_sp)
+        g->max_sp = g->sp;
+    return slot;
+}
+
+static int alloc_string(cg *g)
+{
+    if (g->ssp + 1 > SL_MAX_STRING_SLOTS / 2) {
+        fail(g, "shader needs more than %d string registers", SL_MAX_STRING_SLOTS / 2);
+        return 0;
+    }
+    int slot = g->ssp++;
+    if (g->ssp > g->max_ssp)
+        g->max_ssp = g->ssp;
+    return slot;
+}
+
+static int const_slot(cg *g, double value)
+{
+    sl_program *p = g->prog;
+    for (int i = 0; i < p->nconsts; i++)
+        if (memcmp(&p->consts[i], &value, sizeof value) == 0)
+            return CONST_TAG | i;
+    if (p->nconsts >= SL_MAX_SLOTS / 2) {
+        fail(g, "shader has more than %d constants", SL_MAX_SLOTS / 2);
+        return CONST_TAG;
+    }
+    if (p->nconsts == g->consts_cap) {
+        g->consts_cap = g->consts_cap ? 2 * g->consts_cap : 16;
+        p->consts = sl_xrealloc(p->consts, (size_t)g->consts_cap * sizeof *p->consts);
+    }
+    p->consts[p->nconsts] = value;
+    return CONST_TAG | p->nconsts++;
+}
+
+static int string_const(cg *g, const char *text, size_t len)
+{
+    sl_program *p = g->prog;
+    for (int i = 0; i < p->nstrings; i++)
+        if (strlen(p->strings[i]) == len && memcmp(p->strings[i], text, len) == 0)
+            return CONST_TAG | i;
+    if (p->nstrings >= SL_MAX_STRING_SLOTS / 2) {
+        fail(g, "shader has more than %d string constants", SL_MAX_STRING_SLOTS / 2);
+        return CONST_TAG;
+    }
+    if (p->nstrings == g->strings_cap) {
+        g->strings_cap = g->strings_cap ? 2 * g->strings_cap : 8;
+        p->strings = sl_xrealloc(p->strings, (size_t)g->strings_cap * sizeof *p->strings);
+        p->string_slots = sl_xrealloc(p->string_slots,
+                                      (size_t)g->strings_cap * sizeof *p->string_slots);
+    }
+    p->strings[p->nstrings] = sl_xstrndup(text, len);
+    return CONST_TAG | p->nstrings++;
+}
+
+static int file_index(cg *g, const char *file)
+{
+    sl_program *p = g->prog;
+    if (!file)
+        file = "";
+    for (int i = 0; i < p->nfiles; i++)
+        if (strcmp(p->files[i], file) == 0)
+            return i;
+    if (p->nfiles == g->files_cap) {
+        g->files_cap = g->files_cap ? 2 * g->files_cap : 4;
+        p->files = sl_xrealloc(p->files, (size_t)g->files_cap * sizeof *p->files);
+    }
+    p->files[p->nfiles] = sl_xstrndup(file, strlen(file));
+    return p->nfiles++;
+}
+
+/* ---------------------------------------------------------------------- */
+/* merge regions                                                           */
+/* ---------------------------------------------------------------------- */
+
+static void region_begin(cg *g)
+{
+    if (g->nregions == g->regions_cap) {
+        g->regions_cap = g->regions_cap ? 2 * g->regions_cap : 8;
+        g->regions = sl_xrealloc(g->regions, (size_t)g->regions_cap * sizeof *g->regions);
+    }
+    region *r = &g->regions[g->nregions++];
+    memset(r, 0, sizeof *r);
+    r->start_sp = g->sp;
+    r->start_ssp = g->ssp;
+}
+
+static void record_write(cg *g, int slot, int n)
+{
+    if (g->nregions == 0)
+        return;
+    region *r = &g->regions[g->nregions - 1];
+    for (int s = slot; s < slot + n && s < r->start_sp; s++)
+        r->bits[s / 8] |= (uint8_t)(1u << (s % 8));
+}
+
+static void record_string_write(cg *g, int slot)
+{
+    if (g->nregions == 0 || (slot & CONST_TAG))
+        return;
+    region *r = &g->regions[g->nregions - 1];
+    if (slot < r->start_ssp)
+        r->sbits[slot / 8] |= (uint8_t)(1u << (slot % 8));
+}
+
+static int push_table_entry(cg *g, uint16_t value)
+{
+    sl_program *p = g->prog;
+    if (p->ntables == g->tables_cap) {
+        g->tables_cap = g->tables_cap ? 2 * g->tables_cap : 64;
+        p->tables = sl_xrealloc(p->tables, (size_t)g->tables_cap * sizeof *p->tables);
+    }
+    p->tables[p->ntables] = value;
+    return p->ntables++;
+}
+
+/* The "returned" flag guarding slot s, or -1. */
+static int ret_guard(const cg *g, int s)
+{
+    for (int i = 0; i < g->nrets; i++)
+        if (s >= g->rets[i].slot && s < g->rets[i].slot + g->rets[i].size)
+            return g->rets[i].flag;
+    return -1;
+}
+
+/* Closes the innermost region: its table (count of positions, then the
+ * slots; string slots tagged SL_TABLE_STRING; a return slot tagged
+ * SL_TABLE_GUARDED followed by its flag slot), merged into the enclosing
+ * region. */
+static int region_end(cg *g)
+{
+    region *r = &g->regions[g->nregions - 1];
+    int count = 0;
+    for (int s = 0; s < r->start_sp; s++)
+        if ((r->bits[s / 8] >> (s % 8)) & 1)
+            count += ret_guard(g, s) >= 0 ? 2 : 1;
+    for (int s = 0; s < r->start_ssp; s++)
+        count += (r->sbits[s / 8] >> (s % 8)) & 1;
+    if (g->prog->ntables + count + 1 > 0xffff) {
+        fail(g, "shader too large: merge tables exceed %d entries", 0xffff);
+        g->nregions--;
+        return 0;
+    }
+    int index = push_table_entry(g, (uint16_t)count);
+    for (int s = 0; s < r->start_sp; s++) {
+        if (!((r->bits[s / 8] >> (s % 8)) & 1))
+            continue;
+        int flag = ret_guard(g, s);
+        if (flag >= 0) {
+            push_table_entry(g, (uint16_t)(SL_TABLE_GUARDED | s));
+            push_table_entry(g, (uint16_t)flag);
+        } else if ((g->death[s / 8] >> (s % 8)) & 1) {
+            push_table_entry(g, (uint16_t)(SL_TABLE_DEATH | s));
+        } else {
+            push_table_entry(g, (uint16_t)s);
+        }
+    }
+    for (int s = 0; s < r->start_ssp; s++)
+        if ((r->sbits[s / 8] >> (s % 8)) & 1)
+            push_table_entry(g, (uint16_t)(SL_TABLE_STRING | s));
+    g->nregions--;
+    if (g->nregions > 0) {
+        region *outer = &g->regions[g->nregions - 1];
+        for (int s = 0; s < r->start_sp && s < outer->start_sp; s++)
+            if ((r->bits[s / 8] >> (s % 8)) & 1)
+                outer->bits[s / 8] |= (uint8_t)(1u << (s % 8));
+        for (int s = 0; s < r->start_ssp && s < outer->start_ssp; s++)
+            if ((r->sbits[s / 8] >> (s % 8)) & 1)
+                outer->sbits[s / 8] |= (uint8_t)(1u << (s % 8));
+    }
+    return index;
+}
+
+static void set_death(cg *g, int slot, bool on)
+{
+    if (slot < 0)
+        return;
+    if (on)
+        g->death[slot / 8] |= (uint8_t)(1u << (slot % 8));
+    else
+        g->death[slot / 8] &= (uint8_t)~(1u << (slot % 8));
+}
+
+/* ---------------------------------------------------------------------- */
+/* emitting                                                                */
+/* ---------------------------------------------------------------------- */
+
+static int written_count(const sl_insn *in, const sl_program *p)
+{
+    switch (in->op) {
+    case SL_OP_MOVN: return in->c;
+    case SL_OP_NOISE: return (in->c & SL_NOISE_VECTOR) ? 3 : 1;
+    case SL_OP_RANDOM: return in->b;
+    case SL_OP_CALCNORMAL: case SL_OP_AMBIENT: case SL_OP_DIFFUSE: case SL_OP_SPECULAR:
+    case SL_OP_PHONG: case SL_OP_XPOINT: case SL_OP_XVECTOR: case SL_OP_XNORMAL:
+    case SL_OP_SETCOMP:
+        return 3;
+    case SL_OP_SPACE: case SL_OP_SPACEK: case SL_OP_MINVERT: return 16;
+    case SL_OP_PARAM: return p->params[in->b].size;
+    case SL_OP_END: case SL_OP_SMOV: case SL_OP_SPARAM: case SL_OP_JMP:
+    case SL_OP_BR_BEGIN: case SL_OP_BR_ELSE: case SL_OP_BR_END:
+    case SL_OP_LOOP_TEST: case SL_OP_LOOP_END: case SL_OP_ACCUM_END:
+        return 0;
+    default: return 1;
+    }
+}
+
+static int emit(cg *g, sl_opcode op, int a, int b, int c, int d)
+{
+    sl_program *p = g->prog;
+    if (g->failed)
+        return 0;
+    if (p->ncode >= SL_MAX_CODE - 1) {
+        fail(g, "shader too large: more than %d instructions (after inlining functions)",
+             SL_MAX_CODE - 1);
+        return 0;
+    }
+    if (p->ncode == g->code_cap) {
+        g->code_cap = g->code_cap ? 2 * g->code_cap : 256;
+        p->code = sl_xrealloc(p->code, (size_t)g->code_cap * sizeof *p->code);
+        p->pos = sl_xrealloc(p->pos, (size_t)g->code_cap * sizeof *p->pos);
+    }
+    sl_insn *in = &p->code[p->ncode];
+    in->op = (uint8_t)op;
+    in->a = (uint16_t)a;
+    in->b = (uint16_t)b;
+    in->c = (uint16_t)c;
+    in->d = (uint16_t)d;
+    sl_insn_pos *ip = &p->pos[p->ncode];
+    ip->file = (uint16_t)file_index(g, g->cur.file);
+    ip->line = g->cur.line;
+    ip->col = (uint16_t)(g->cur.col > 0xffff ? 0xffff : g->cur.col);
+    int w = written_count(in, p);
+    if (w > 0)
+        record_write(g, a, w);
+    if (op == SL_OP_SMOV || op == SL_OP_SPARAM)
+        record_string_write(g, a);
+    return p->ncode++;
+}
+
+static int here(const cg *g) { return g->prog->ncode; }
+
+/* ESCAPE flag: its table is patched when the construct it leaves closes. */
+static void emit_escape(cg *g, int flag, int kind, int id)
+{
+    int pc = emit(g, SL_OP_ESCAPE, flag, id, 0, kind);
+    if (g->failed)
+        return;
+    if (g->nescapes == g->escapes_cap) {
+        g->escapes_cap = g->escapes_cap ? 2 * g->escapes_cap : 16;
+        g->escapes = sl_xrealloc(g->escapes, (size_t)g->escapes_cap * sizeof *g->escapes);
+    }
+    g->escapes[g->nescapes++] = (struct pending_escape){ pc, kind, id };
+}
+
+static void patch_escapes(cg *g, int kind, int id, int table)
+{
+    int kept = 0;
+    for (int i = 0; i < g->nescapes; i++) {
+        struct pending_escape *e = &g->escapes[i];
+        if (e->kind == kind && e->id == id) {
+            if (!g->failed)
+                g->prog->code[e->pc].c = (uint16_t)table;
+        } else {
+            g->escapes[kept++] = *e;
+        }
+    }
+    g->nescapes = kept;
+}
+
+static void emit_mov(cg *g, int dst, int src, int n)
+{
+    if (dst == src || n == 0)
+        return;
+    if (n == 1)
+        emit(g, SL_OP_MOV, dst, src, 0, 0);
+    else
+        emit(g, SL_OP_MOVN, dst, src, n, 0);
+}
+
+/* The value at src (size n) in dst when dst >= 0. */
+static int into(cg *g, int src, int dst, int n)
+{
+    if (dst < 0 || dst == src)
+        return src;
+    emit_mov(g, dst, src, n);
+    return dst;
+}
+
+static int into_string(cg *g, int src, int dst)
+{
+    if (dst < 0 || dst == src)
+        return src;
+    emit(g, SL_OP_SMOV, dst, src, 0, 0);
+    return dst;
+}
+
+static int target(cg *g, int dst, int n) { return dst >= 0 ? dst : alloc_slots(g, n); }
+
+/* Lane i of a value of n slots (a float broadcasts). */
+static int lane(int slot, int n, int i) { return n == 1 ? slot : slot + i; }
+
+static int size_of(const sl_node *e) { return sl_ty_slots(e->ty); }
+
+/* dst, or -1 when writing lane by lane into dst could overwrite a lane of
+ * an operand before it is read (v = v.x * v: the broadcast v.x is lane 0
+ * of the destination). */
+static int lane_safe(int dst, int n, const int *args, const int *sizes, int k)
+{
+    if (dst < 0)
+        return -1;
+    for (int j = 0; j < k; j++) {
+        int s = args[j], len = sizes[j];
+        if (s & CONST_TAG)
+            continue;
+        bool overlap = s < dst + n && dst < s + len;
+        if (overlap && !(len == n && s == dst))
+            return -1;
+    }
+    return dst;
+}
+
+/* ---------------------------------------------------------------------- */
+/* scalar helpers                                                          */
+/* ---------------------------------------------------------------------- */
+
+static int op1(cg *g, sl_opcode op, int x)
+{
+    int z = alloc_slots(g, 1);
+    emit(g, op, z, x, 0, 0);
+    return z;
+}
+
+static int op2(cg *g, sl_opcode op, int x, int y)
+{
+    int z = alloc_slots(g, 1);
+    emit(g, op, z, x, y, 0);
+    return z;
+}
+
+/* x . y over n lanes into z (or a new slot). */
+static int gen_dot(cg *g, int x, int y, int n, int dst)
+{
+    int z = target(g, dst, 1);
+    emit(g, SL_OP_MUL, z, x, y, 0);
+    for (int i = 1; i < n; i++) {
+        int t = op2(g, SL_OP_MUL, x + i, y + i);
+        emit(g, SL_OP_ADD, z, z, t, 0);
+    }
+    return z;
+}
+
+/* Logical OR of flag slots, negated: "no flag set". -1 when none. */
+static int none_set(cg *g, const int *flags, int n)
+{
+    if (n == 0)
+        return -1;
+    int any = flags[0];
+    for (int i = 1; i < n; i++)
+        any = op2(g, SL_OP_OR, any, flags[i]);
+    return op1(g, SL_OP_NOT, any);
+}
+
+/* ---------------------------------------------------------------------- */
+/* expressions                                                             */
+/* ---------------------------------------------------------------------- */
+
+static int gen_ident(cg *g, sl_node *e, int dst)
+{
+    sl_sym *s = e->sym;
+    if (s->kind == SL_SYM_CONST)
+        return into(g, const_slot(g, s->value), dst, 1);
+    if (s->ty == SL_TYPE_STRING)
+        return into_string(g, s->slot, dst);
+    return into(g, s->slot, dst, size_of(e));
+}
+
+static sl_opcode arith_op(int tok)
+{
+    switch (tok) {
+    case SL_TOK_PLUS: return SL_OP_ADD;
+    case SL_TOK_MINUS: return SL_OP_SUB;
+    case SL_TOK_STAR: return SL_OP_MUL;
+    case SL_TOK_SLASH: return SL_OP_DIV;
+    case SL_TOK_LT: return SL_OP_LT;
+    case SL_TOK_LE: return SL_OP_LE;
+    case SL_TOK_GT: return SL_OP_GT;
+    case SL_TOK_GE: return SL_OP_GE;
+    case SL_TOK_EQ: return SL_OP_EQ;
+    case SL_TOK_NE: return SL_OP_NE;
+    case SL_TOK_AND: return SL_OP_AND;
+    default: return SL_OP_OR;
+    }
+}
+
+/* Matrix product a * b (4x4, row-major lanes: m[r][c] at r * 4 + c). */
+static int gen_matmul(cg *g, int a, int b, int dst)
+{
+    int z = alloc_slots(g, 16);
+    for (int r = 0; r < 4; r++) {
+        for (int c = 0; c < 4; c++) {
+            int acc = z + r * 4 + c;
+            emit(g, SL_OP_MUL, acc, a + r * 4, b + c, 0);
+            for (int k = 1; k < 4; k++) {
+                int t = op2(g, SL_OP_MUL, a + r * 4 + k, b + k * 4 + c);
+                emit(g, SL_OP_ADD, acc, acc, t, 0);
+            }
+        }
+    }
+    return into(g, z, dst, 16);
+}
+
+static int gen_cross(cg *g, int a, int b, int dst)
+{
+    int z = alloc_slots(g, 3);
+    for (int i = 0; i < 3; i++) {
+        int j = (i + 1) % 3, k = (i + 2) % 3;
+        int t = op2(g, SL_OP_MUL, a + j, b + k);
+        int u = op2(g, SL_OP_MUL, a + k, b + j);
+        emit(g, SL_OP_SUB, z + i, t, u, 0);
+    }
+    return into(g, z, dst, 3);
+}
+
+/* Constant folding: + - * / of two constants, evaluated once in double
+ * (as the float mode would); -1 when not both constant. */
+static int fold(cg *g, int op, int x, int y)
+{
+    if (!(x & CONST_TAG) || !(y & CONST_TAG))
+        return -1;
+    double a = g->prog->consts[x & ~CONST_TAG], b = g->prog->consts[y & ~CONST_TAG], r;
+    switch (op) {
+    case SL_TOK_PLUS: r = a + b; break;
+    case SL_TOK_MINUS: r = a - b; break;
+    case SL_TOK_STAR: r = a * b; break;
+    case SL_TOK_SLASH: r = a / b; break;
+    default: return -1;
+    }
+    if (!isfinite(r))
+        return -1;
+    return const_slot(g, r);
+}
+
+static int gen_binary(cg *g, sl_node *e, int dst)
+{
+    int na = size_of(e->a), nb = size_of(e->b);
+    if (e->a->ty == SL_TYPE_STRING) {
+        int x = gen_expr(g, e->a, -1), y = gen_expr(g, e->b, -1);
+        int z = target(g, dst, 1);
+        emit(g, e->op == SL_TOK_EQ ? SL_OP_SEQ : SL_OP_SNE, z, x, y, 0);
+        return z;
+    }
+    int x = gen_expr(g, e->a, -1);
+    int y = gen_expr(g, e->b, -1);
+    int folded = fold(g, e->op, x, y);
+    if (folded >= 0)
+        return into(g, folded, dst, 1);
+    switch (e->op) {
+    case SL_TOK_DOT: return gen_dot(g, x, y, 3, dst);
+    case SL_TOK_CARET: return gen_cross(g, x, y, dst);
+    case SL_TOK_STAR:
+        if (na == 16 && nb == 16)     /* RenderMan's a * b: a first, then b */
+            return gen_matmul(g, y, x, dst);
+        break;
+    case SL_TOK_EQ: case SL_TOK_NE:
+        if (na > 1) {          /* all lanes equal / some lane differs */
+            int z = target(g, dst, 1);
+            sl_opcode cmp = e->op == SL_TOK_EQ ? SL_OP_EQ : SL_OP_NE;
+            sl_opcode join = e->op == SL_TOK_EQ ? SL_OP_AND : SL_OP_OR;
+            int acc = op2(g, cmp, x, y);
+            for (int i = 1; i < na; i++)
+                acc = op2(g, join, acc, op2(g, cmp, x + i, y + i));
+            emit_mov(g, z, acc, 1);
+            return z;
+        }
+        break;
+    default: break;
+    }
+    int n = size_of(e);
+    if (e->ty == SL_TY_BOOL)
+        n = 1;
+    int ops[2] = { x, y }, sizes[2] = { na, nb };
+    int z = target(g, lane_safe(dst, n, ops, sizes, 2), n);
+    for (int i = 0; i < n; i++)
+        emit(g, arith_op(e->op), z + i, lane(x, na, i), lane(y, nb, i), 0);
+    return into(g, z, dst, n);
+}
+
+static int gen_unary(cg *g, sl_node *e, int dst)
+{
+    int x = gen_expr(g, e->a, -1);
+    if (e->op == SL_TOK_MINUS && (x & CONST_TAG))
+        return into(g, const_slot(g, -g->prog->consts[x & ~CONST_TAG]), dst, 1);
+    int n = e->op == SL_TOK_NOT ? 1 : size_of(e);
+    int z = target(g, dst, n);
+    for (int i = 0; i < n; i++)
+        emit(g, e->op == SL_TOK_NOT ? SL_OP_NOT : SL_OP_NEG, z + i, x + i, 0, 0);
+    return z;
+}
+
+/* BR_BEGIN cond ... BR_ELSE ... BR_END around two generators. */
+typedef void (*branch_fn)(cg *g, void *arg);
+
+static void gen_branches(cg *g, int cond, branch_fn then_fn, void *then_arg,
+                         branch_fn else_fn, void *else_arg)
+{
+    sl_pos at = g->cur;              /* the if: where merge errors point */
+    int begin = emit(g, SL_OP_BR_BEGIN, cond, 0, 0, 0);
+    region_begin(g);
+    then_fn(g, then_arg);
+    g->cur = at;
+    int mid = emit(g, SL_OP_BR_ELSE, 0, begin, 0, 0);
+    if (else_fn)
+        else_fn(g, else_arg);
+    g->cur = at;
+    int end = emit(g, SL_OP_BR_END, begin, 0, 0, 0);
+    int table = region_end(g);
+    if (g->failed)
+        return;
+    sl_insn *code = g->prog->code;
+    code[begin].b = (uint16_t)(mid + 1);
+    code[begin].c = (uint16_t)table;
+    code[mid].a = (uint16_t)end;
+    code[end].b = (uint16_t)table;
+}
+
+typedef struct value_job {
+    sl_node *e;
+    int dst;
+} value_job;
+
+static void gen_value_job(cg *g, void *arg)
+{
+    value_job *job = arg;
+    int saved = g->sp;
+    if (job->e->ty == SL_TYPE_STRING)
+        into_string(g, gen_expr(g, job->e, -1), job->dst);
+    else
+        gen_expr(g, job->e, job->dst);
+    g->sp = saved;
+}
+
+static int gen_cond_expr(cg *g, sl_node *e, int dst)
+{
+    bool str = e->ty == SL_TYPE_STRING;
+    int z = dst >= 0 ? dst : str ? alloc_string(g) : alloc_slots(g, size_of(e));
+    int mark = g->sp;
+    int c = gen_expr(g, e->a, -1);
+    g->sp = mark;
+    value_job a = { e->b, z }, b = { e->c, z };
+    gen_branches(g, c, gen_value_job, &a, gen_value_job, &b);
+    return z;
+}
+
+static int gen_assign(cg *g, sl_node *e, int dst)
+{
+    sl_sym *s = e->a->sym;
+    if (s->ty == SL_TYPE_STRING) {
+        int v = gen_expr(g, e->b, -1);
+        into_string(g, v, s->slot);
+        return into_string(g, s->slot, dst);
+    }
+    gen_expr(g, e->b, s->slot);
+    return into(g, s->slot, dst, sl_ty_slots(s->ty));
+}
+
+/* The matrix of a named space (constant or string slot), into 16 slots. */
+static int gen_space_matrix(cg *g, sl_node *space, int dir)
+{
+    int m = alloc_slots(g, 16);
+    if (space->kind == SL_N_STR) {
+        emit(g, SL_OP_SPACEK, m, sl_space_find(space->name), dir, 0);
+    } else {
+        int s = gen_expr(g, space, -1);
+        emit(g, SL_OP_SPACE, m, s, dir, 0);
+    }
+    return m;
+}
+
+static bool is_current(const sl_node *space)
+{
+    return space->kind == SL_N_STR && strcmp(space->name, "current") == 0;
+}
+
+/* Applies the named-space transform to x (3 slots): op XPOINT/XVECTOR use
+ * the matrix itself, XNORMAL the inverse (it applies the transpose). */
+static int gen_space_xform(cg *g, sl_opcode op, sl_node *space, int dir, int x, int dst)
+{
+    if (is_current(space))
+        return into(g, x, dst, 3);
+    int use = op == SL_OP_XNORMAL ? 1 - dir : dir;
+    int m = gen_space_matrix(g, space, use);
+    int z = target(g, dst, 3);       /* the transform reads x before it writes z */
+    emit(g, op, z, m, x, 0);
+    return z;
+}
+
+static int gen_cast(cg *g, sl_node *e, int dst)
+{
+    int n = size_of(e);
+    int v;
+    if (e->nlist == 1) {
+        v = gen_expr(g, e->list[0], e->name ? -1 : dst);
+    } else {
+        /* a component may read the destination: build in fresh slots. A
+         * matrix is written in RenderMan's order (row vectors, the
+         * translation in elements 12..14) and kept transposed, as vecmath
+         * does: element k goes to row k % 4, column k / 4. */
+        v = alloc_slots(g, n);
+        for (int i = 0; i < e->nlist; i++)
+            gen_expr(g, e->list[i], n == 16 ? v + (i % 4) * 4 + i / 4 : v + i);
+    }
+    if (e->name && sl_ty_is_spatial(e->ty)) {
+        sl_opcode op = e->ty == SL_TYPE_POINT ? SL_OP_XPOINT
+                     : e->ty == SL_TYPE_VECTOR ? SL_OP_XVECTOR : SL_OP_XNORMAL;
+        sl_node space = { .kind = SL_N_STR, .name = e->name, .pos = e->pos };
+        return gen_space_xform(g, op, &space, SL_SPACE_TO_CURRENT, v, dst);
+    }
+    return into(g, v, dst, n);
+}
+
+static int gen_conv(cg *g, sl_node *e, int dst)
+{
+    int x = gen_expr(g, e->a, -1);
+    if (e->ty == SL_TY_BOOL) {
+        int z = target(g, dst, 1);
+        emit(g, SL_OP_NE, z, x, const_slot(g, 0), 0);
+        return z;
+    }
+    int n = size_of(e);
+    int z = target(g, dst, n);
+    if (n == 16) {
+        for (int i = 0; i < 16; i++)
+            emit(g, SL_OP_MOV, z + i, i % 5 == 0 ? x : const_slot(g, 0), 0, 0);
+        return z;
+    }
+    for (int i = 0; i < n; i++)
+        emit(g, SL_OP_MOV, z + i, x, 0, 0);
+    return z;
+}
+
+/* ---------------------------------------------------------------------- */
+/* built-in calls                                                          */
+/* ---------------------------------------------------------------------- */
+
+static int op_inputs(sl_opcode op)
+{
+    switch (op) {
+    case SL_OP_CLAMP: case SL_OP_SMOOTHSTEP: case SL_OP_MIX: return 3;
+    case SL_OP_POW: case SL_OP_ATAN2: case SL_OP_MOD: case SL_OP_MIN: case SL_OP_MAX:
+    case SL_OP_STEP: case SL_OP_DERIV:
+        return 2;
+    default: return 1;
+    }
+}
+
+/* Componentwise op over the result's lanes. */
+static int gen_lanes(cg *g, sl_opcode op, const int *args, const int *sizes, int n, int dst)
+{
+    int k = op_inputs(op);
+    int z = target(g, lane_safe(dst, n, args, sizes, k), n);
+    for (int i = 0; i < n; i++) {
+        int in[3] = { 0, 0, 0 };
+        for (int j = 0; j < k; j++)
+            in[j] = lane(args[j], sizes[j], i);
+        emit(g, op, z + i, in[0], in[1], in[2]);
+    }
+    return into(g, z, dst, n);
+}
+
+/* Copies n values into consecutive fresh slots unless they already are. */
+static int consecutive(cg *g, const int *slots, const int *sizes, int n)
+{
+    int total = 0;
+    for (int i = 0; i < n; i++)
+        total += sizes[i];
+    if (n == 1 && !(slots[0] & CONST_TAG))
+        return slots[0];
+    int base = alloc_slots(g, total), o = 0;
+    for (int i = 0; i < n; i++) {
+        emit_mov(g, base + o, slots[i], sizes[i]);
+        o += sizes[i];
+    }
+    return base;
+}
+
+static int gen_noise(cg *g, sl_node *e, const int *args, const int *sizes, int dst)
+{
+    const sl_builtin *b = e->builtin;
+    int kind = (int)b->k;
+    int n = e->nlist;
+    int inputs = kind == SL_NOISE_PERIODIC ? n / 2 : n;
+    int dim = 0;
+    for (int i = 0; i < inputs; i++)
+        dim += sizes[i];
+    int in = consecutive(g, args, sizes, inputs);
+    int period = 0;
+    if (kind == SL_NOISE_PERIODIC)
+        period = consecutive(g, args + inputs, sizes + inputs, inputs);
+    int outs = size_of(e);
+    int z = alloc_slots(g, outs);
+    emit(g, SL_OP_NOISE, z, in, SL_NOISE_VARIANT(dim, kind, outs == 3), period);
+    return into(g, z, dst, outs);
+}
+
+static int gen_transform(cg *g, sl_node *e, const int *args, int dst)
+{
+    sl_opcode op = e->builtin->op;
+    int n = e->nlist;
+    int x = args[n - 1];
+    if (n == 2 && e->list[0]->ty == SL_TYPE_MATRIX) {
+        int m = args[0];
+        if (op == SL_OP_XNORMAL) {
+            int inv = alloc_slots(g, 16);
+            emit(g, SL_OP_MINVERT, inv, m, 0, 0);
+            m = inv;
+        }
+        int z = alloc_slots(g, 3);
+        emit(g, op, z, m, x, 0);
+        return into(g, z, dst, 3);
+    }
+    if (n == 3)       /* from space a to "current", then to space b */
+        x = gen_space_xform(g, op, e->list[0], SL_SPACE_TO_CURRENT, x, -1);
+    return gen_space_xform(g, op, e->list[n - 2], SL_SPACE_FROM_CURRENT, x, dst);
+}
+
+static int gen_normalize(cg *g, int v, int dst)
+{
+    int d = gen_dot(g, v, v, 3, -1);
+    int r = op1(g, SL_OP_INVSQRT, d);
+    int z = target(g, dst, 3);
+    for (int i = 0; i < 3; i++)
+        emit(g, SL_OP_MUL, z + i, v + i, r, 0);
+    return z;
+}
+
+/* faceforward(N, I [, Nref = Ng]) = (I . Nref < 0) ? N : -N */
+typedef struct ff_job {
+    int n, z;
+    bool negate;
+} ff_job;
+
+static void gen_ff_job(cg *g, void *arg)
+{
+    ff_job *job = arg;
+    for (int i = 0; i < 3; i++)
+        emit(g, job->negate ? SL_OP_NEG : SL_OP_MOV, job->z + i, job->n + i, 0, 0);
+}
+
+static int gen_faceforward(cg *g, sl_node *e, const int *args, int dst)
+{
+    int nref = e->nlist == 3 ? args[2] : sl_global_slot(SL_G_Ng);
+    int z = alloc_slots(g, 3);
+    int mark = g->sp;
+    int d = gen_dot(g, args[1], nref, 3, -1);
+    int c = op2(g, SL_OP_LT, d, const_slot(g, 0));
+    g->sp = mark;
+    ff_job a = { args[0], z, false }, b = { args[0], z, true };
+    gen_branches(g, c, gen_ff_job, &a, gen_ff_job, &b);
+    return into(g, z, dst, 3);
+}
+
+static int gen_reflect(cg *g, const int *args, int dst)
+{
+    int d = gen_dot(g, args[0], args[1], 3, -1);
+    int t = op2(g, SL_OP_MUL, d, const_slot(g, 2));
+    int z = alloc_slots(g, 3);
+    for (int i = 0; i < 3; i++) {
+        int u = op2(g, SL_OP_MUL, t, args[1] + i);
+        emit(g, SL_OP_SUB, z + i, args[0] + i, u, 0);
+    }
+    return into(g, z, dst, 3);
+}
+
+static int gen_light(cg *g, sl_node *e, const int *args, int dst)
+{
+    int z = alloc_slots(g, 3);
+    emit(g, e->builtin->op, z, e->nlist > 0 ? args[0] : 0, e->nlist > 1 ? args[1] : 0,
+         e->nlist > 2 ? args[2] : 0);
+    return into(g, z, dst, 3);
+}
+
+static int gen_builtin(cg *g, sl_node *e, int dst)
+{
+    const sl_builtin *b = e->builtin;
+    int args[8], sizes[8];
+    for (int i = 0; i < e->nlist; i++) {
+        sl_node *a = e->list[i];
+        sizes[i] = size_of(a);
+        args[i] = gen_expr(g, a, -1);
+    }
+    int n = size_of(e);
+    switch (b->lower) {
+    case SL_LOWER_OP: return gen_lanes(g, b->op, args, sizes, n, dst);
+    case SL_LOWER_SCALE: {
+        int z = target(g, dst, 1);
+        emit(g, SL_OP_MUL, z, args[0], const_slot(g, b->k), 0);
+        return z;
+    }
+    case SL_LOWER_LOGBASE: {
+        int z = target(g, dst, 1);
+        emit(g, SL_OP_DIV, z, op1(g, SL_OP_LOG, args[0]), op1(g, SL_OP_LOG, args[1]), 0);
+        return z;
+    }
+    case SL_LOWER_LENGTH: {
+        int z = target(g, dst, 1);
+        emit(g, SL_OP_SQRT, z, gen_dot(g, args[0], args[0], 3, -1), 0, 0);
+        return z;
+    }
+    case SL_LOWER_NORMALIZE: return gen_normalize(g, args[0], dst);
+    case SL_LOWER_DISTANCE: {
+        int d = alloc_slots(g, 3);
+        for (int i = 0; i < 3; i++)
+            emit(g, SL_OP_SUB, d + i, args[1] + i, args[0] + i, 0);
+        int z = target(g, dst, 1);
+        emit(g, SL_OP_SQRT, z, gen_dot(g, d, d, 3, -1), 0, 0);
+        return z;
+    }
+    case SL_LOWER_DOT: return gen_dot(g, args[0], args[1], 3, dst);
+    case SL_LOWER_CROSS: return gen_cross(g, args[0], args[1], dst);
+    case SL_LOWER_FACEFORWARD: return gen_faceforward(g, e, args, dst);
+    case SL_LOWER_REFLECT: return gen_reflect(g, args, dst);
+    case SL_LOWER_TRANSFORM: return gen_transform(g, e, args, dst);
+    case SL_LOWER_CALCNORMAL: case SL_LOWER_AREA: {
+        int z = alloc_slots(g, n);
+        emit(g, b->op, z, args[0], 0, 0);
+        return into(g, z, dst, n);
+    }
+    case SL_LOWER_DERIV: return gen_lanes(g, b->op, args, sizes, n, dst);
+    case SL_LOWER_COMP: return into(g, args[0] + (int)b->k, dst, 1);
+    case SL_LOWER_SETCOMP_K:
+        emit(g, SL_OP_MOV, args[0] + (int)b->k, args[1], 0, 0);
+        return 0;
+    case SL_LOWER_COMP_RT: {
+        int z = target(g, dst, 1);
+        emit(g, SL_OP_COMP, z, args[0], args[1], 0);
+        return z;
+    }
+    case SL_LOWER_SETCOMP_RT:
+        emit(g, SL_OP_SETCOMP, args[0], args[1], args[2], 0);
+        return 0;
+    case SL_LOWER_NOISE: return gen_noise(g, e, args, sizes, dst);
+    case SL_LOWER_RANDOM: {
+        int z = alloc_slots(g, n);
+        emit(g, SL_OP_RANDOM, z, n, 0, 0);
+        return into(g, z, dst, n);
+    }
+    case SL_LOWER_LIGHT: return gen_light(g, e, args, dst);
+    }
+    return 0;
+}
+
+/* ---------------------------------------------------------------------- */
+/* user functions: inlined                                                 */
+/* ---------------------------------------------------------------------- */
+
+static int gen_user_call(cg *g, sl_node *e, int dst)
+{
+    sl_func *f = e->func;
+    if (g->inline_depth >= SL_MAX_INLINE_DEPTH) {
+        fail(g, "function calls nested too deeply (limit %d)", SL_MAX_INLINE_DEPTH);
+        return 0;
+    }
+    int args[64];
+    if (e->nlist > 64) {
+        fail(g, "too many arguments in call to '%s'", f->name);
+        return 0;
+    }
+    for (int i = 0; i < e->nlist; i++)
+        args[i] = gen_expr(g, e->list[i], -1);
+    for (int i = 0; i < e->nlist; i++)
+        f->params[i]->slot = args[i];
+    int size = sl_ty_slots(f->ret);
+    bool str = f->ret == SL_TYPE_STRING;
+    int ret = size == 0 ? -1 : str ? alloc_string(g) : alloc_slots(g, size);
+    int flag = -1;
+    if (f->needs_ret_flag) {
+        flag = alloc_slots(g, 1);
+        emit(g, SL_OP_MOV, flag, const_slot(g, 0), 0, 0);
+    }
+    int saved_slot = f->cg_ret_slot, saved_flag = f->cg_ret_flag, saved_id = f->cg_id;
+    sl_func *saved_func = g->func;
+    int saved_sp = g->sp, saved_ssp = g->ssp;
+    f->cg_ret_slot = ret;
+    f->cg_ret_flag = flag;
+    f->cg_id = ++g->next_id;
+    g->func = f;
+    g->inline_depth++;
+    if (flag >= 0 && ret >= 0 && !str)
+        g->rets[g->nrets++] = (inline_ret){ ret, size, flag };
+    if (flag >= 0) {                 /* early returns: the body is one region */
+        set_death(g, flag, true);
+        region_begin(g);
+    }
+    gen_stmt(g, f->body);
+    if (flag >= 0) {
+        int table = region_end(g);
+        emit(g, SL_OP_ACCUM_END, f->cg_id, table, 0, SL_ESCAPE_FUNC);
+        patch_escapes(g, SL_ESCAPE_FUNC, f->cg_id, table);
+        set_death(g, flag, false);
+    }
+    if (flag >= 0 && ret >= 0 && !str)
+        g->nrets--;
+    g->inline_depth--;
+    g->func = saved_func;
+    f->cg_ret_slot = saved_slot;
+    f->cg_ret_flag = saved_flag;
+    f->cg_id = saved_id;
+    g->sp = saved_sp;
+    g->ssp = saved_ssp;
+    if (size == 0)
+        return 0;
+    return str ? into_string(g, ret, dst) : into(g, ret, dst, size);
+}
+
+static int gen_expr(cg *g, sl_node *e, int dst)
+{
+    if (g->failed)
+        return dst >= 0 ? dst : SL_GLOBAL_SLOTS;
+    sl_pos saved = g->cur;
+    g->cur = e->pos;
+    int r = 0;
+    switch (e->kind) {
+    case SL_N_NUM: r = into(g, const_slot(g, e->num), dst, 1); break;
+    case SL_N_STR: r = into_string(g, string_const(g, e->name, e->len), dst); break;
+    case SL_N_IDENT: r = gen_ident(g, e, dst); break;
+    case SL_N_CALL: r = e->func ? gen_user_call(g, e, dst) : gen_builtin(g, e, dst); break;
+    case SL_N_UNARY: r = gen_unary(g, e, dst); break;
+    case SL_N_BINARY: r = gen_binary(g, e, dst); break;
+    case SL_N_COND: r = gen_cond_expr(g, e, dst); break;
+    case SL_N_ASSIGN: r = gen_assign(g, e, dst); break;
+    case SL_N_CAST: r = gen_cast(g, e, dst); break;
+    case SL_N_CONV: r = gen_conv(g, e, dst); break;
+    default: fail(g, "internal error: unexpected expression"); break;
+    }
+    g->cur = saved;
+    return r;
+}
+
+/* ---------------------------------------------------------------------- */
+/* statements                                                              */
+/* ---------------------------------------------------------------------- */
+
+/* The flag slots of the escapes of n (loop's own continue excluded). */
+static int escape_flags(cg *g, const sl_node *n, const sl_node *loop, int *flags)
+{
+    int count = 0;
+    for (int i = 0; i < n->nescapes; i++) {
+        const sl_escape *e = &n->escapes[i];
+        int f = -1;
+        if (e->kind == SL_ESC_BREAK)
+            f = e->loop->cg_brk;
+        else if (e->kind == SL_ESC_CONTINUE)
+            f = e->loop == loop ? -1 : e->loop->cg_cnt;
+        else
+            f = e->func ? e->func->cg_ret_flag : g->shader_ret_flag;
+        bool dup = false;
+        for (int j = 0; j < count; j++)
+            dup |= flags[j] == f;
+        if (f >= 0 && !dup && count < 64)
+            flags[count++] = f;
+    }
+    return count;
+}
+
+typedef struct list_job {
+    sl_node **list;
+    int from, n;
+} list_job;
+
+static void gen_list(cg *g, sl_node **list, int from, int n);
+
+static void gen_list_job(cg *g, void *arg)
+{
+    list_job *job = arg;
+    gen_list(g, job->list, job->from, job->n);
+}
+
+/* Statements list[from..n), the rest guarded after one that may escape. */
+static void gen_list(cg *g, sl_node **list, int from, int n)
+{
+    for (int i = from; i < n && !g->failed; i++) {
+        gen_stmt(g, list[i]);
+        if (list[i]->nescapes == 0 || i == n - 1)
+            continue;
+        int flags[64];
+        int count = escape_flags(g, list[i], NULL, flags);
+        if (count == 0)
+            continue;
+        int mark = g->sp;
+        g->cur = list[i + 1]->pos;
+        int go = none_set(g, flags, count);
+        g->sp = mark;
+        list_job job = { list, i + 1, n };
+        gen_branches(g, go, gen_list_job, &job, NULL, NULL);
+        return;
+    }
+}
+
+static void gen_decl(cg *g, sl_node *n)
+{
+    for (int i = 0; i < n->nlist && !g->failed; i++) {
+        sl_node *v = n->list[i];
+        sl_sym *s = v->sym;
+        if (!s)
+            continue;       /* extern */
+        g->cur = v->pos;
+        if (s->ty == SL_TYPE_STRING) {
+            s->slot = alloc_string(g);
+            int mark = g->sp;
+            into_string(g, v->a ? gen_expr(g, v->a, -1) : string_const(g, "", 0), s->slot);
+            g->sp = mark;
+            continue;
+        }
+        int size = sl_ty_slots(s->ty);
+        s->slot = alloc_slots(g, size);
+        if (v->a) {
+            gen_expr(g, v->a, s->slot);
+        } else {
+            for (int k = 0; k < size; k++)
+                emit(g, SL_OP_MOV, s->slot + k, const_slot(g, 0), 0, 0);
+        }
+        g->sp = s->slot + size;
+    }
+}
+
+typedef struct stmt_job {
+    sl_node *stmt;
+} stmt_job;
+
+static void gen_stmt_job(cg *g, void *arg)
+{
+    stmt_job *job = arg;
+    if (job->stmt) {
+        int sp = g->sp, ssp = g->ssp;
+        gen_stmt(g, job->stmt);
+        g->sp = sp;
+        g->ssp = ssp;
+    }
+}
+
+static void gen_if(cg *g, sl_node *n)
+{
+    int mark = g->sp;
+    int c = gen_expr(g, n->a, -1);
+    g->sp = mark;
+    stmt_job a = { n->b }, b = { n->c };
+    gen_branches(g, c, gen_stmt_job, &a, n->c ? gen_stmt_job : NULL, &b);
+}
+
+static bool has_escape(const sl_node *body, sl_escape_kind kind, const sl_node *loop)
+{
+    for (int i = 0; i < body->nescapes; i++)
+        if (body->escapes[i].kind == kind && body->escapes[i].loop == loop)
+            return true;
+    return false;
+}
+
+static int new_flag(cg *g)
+{
+    int f = alloc_slots(g, 1);
+    emit(g, SL_OP_MOV, f, const_slot(g, 0), 0, 0);
+    return f;
+}
+
+/* while (cond) body, or for (; cond; step) body: loop is the node. */
+static void gen_loop(cg *g, sl_node *loop, sl_node *cond, sl_node *step, sl_node *body)
+{
+    int saved_sp = g->sp;
+    loop->cg_brk = has_escape(body, SL_ESC_BREAK, loop) ? new_flag(g) : -1;
+    set_death(g, loop->cg_brk, true);
+    loop->cg_cnt = has_escape(body, SL_ESC_CONTINUE, loop) ? alloc_slots(g, 1) : -1;
+    int flags[64];
+    int nflags = escape_flags(g, body, loop, flags);
+    int mark = g->sp;
+    region_begin(g);
+    int top = here(g);
+    g->cur = loop->pos;
+    int c = cond ? gen_expr(g, cond, -1) : const_slot(g, 1);
+    int go = none_set(g, flags, nflags);
+    if (go >= 0)
+        c = op2(g, SL_OP_AND, c, go);
+    g->cur = loop->pos;
+    int test = emit(g, SL_OP_LOOP_TEST, c, 0, 0, 0);
+    loop->cg_test = test;
+    g->sp = mark;
+    if (loop->cg_cnt >= 0)
+        emit(g, SL_OP_MOV, loop->cg_cnt, const_slot(g, 0), 0, 0);
+    stmt_job job = { body };
+    gen_stmt_job(g, &job);
+    if (step) {
+        if (nflags > 0) {
+            int go2 = none_set(g, flags, nflags);
+            g->sp = mark;
+            stmt_job sj = { step };
+            gen_branches(g, go2, gen_stmt_job, &sj, NULL, NULL);
+        } else {
+            gen_stmt_job(g, &(stmt_job){ step });
+        }
+    }
+    g->cur = loop->pos;
+    emit(g, SL_OP_JMP, top, 0, 0, 0);
+    int end = emit(g, SL_OP_LOOP_END, test, 0, 0, 0);
+    int table = region_end(g);
+    if (!g->failed) {
+        g->prog->code[test].b = (uint16_t)end;
+        g->prog->code[test].c = (uint16_t)table;
+        g->prog->code[end].b = (uint16_t)table;
+    }
+    patch_escapes(g, SL_ESCAPE_LOOP, test, table);
+    set_death(g, loop->cg_brk, false);
+    g->sp = saved_sp;
+}
+
+static void gen_return(cg *g, sl_node *n)
+{
+    sl_func *f = n->func;
+    if (f) {
+        if (n->a) {
+            if (f->ret == SL_TYPE_STRING)
+                into_string(g, gen_expr(g, n->a, -1), f->cg_ret_slot);
+            else
+                gen_expr(g, n->a, f->cg_ret_slot);
+        }
+        if (f->cg_ret_flag >= 0 && !n->tail)
+            emit_escape(g, f->cg_ret_flag, SL_ESCAPE_FUNC, f->cg_id);
+    } else if (g->shader_ret_flag >= 0 && !n->tail) {
+        emit_escape(g, g->shader_ret_flag, SL_ESCAPE_FUNC, 0);
+    }
+}
+
+static void gen_stmt(cg *g, sl_node *n)
+{
+    if (!n || g->failed)
+        return;
+    g->cur = n->pos;
+    int mark = g->sp;
+    switch (n->kind) {
+    case SL_N_BLOCK: {
+        int ssp = g->ssp;
+        gen_list(g, n->list, 0, n->nlist);
+        g->ssp = ssp;
+        break;
+    }
+    case SL_N_DECL: gen_decl(g, n); return;
+    case SL_N_EXPR: gen_expr(g, n->a, -1); break;
+    case SL_N_IF: gen_if(g, n); break;
+    case SL_N_WHILE: gen_loop(g, n, n->a, NULL, n->b); break;
+    case SL_N_FOR: {
+        int ssp = g->ssp;
+        gen_stmt(g, n->a);
+        gen_loop(g, n, n->b, n->c, n->d);
+        g->ssp = ssp;
+        break;
+    }
+    case SL_N_BREAK:
+        emit_escape(g, n->target->cg_brk, SL_ESCAPE_LOOP, n->target->cg_test);
+        break;
+    case SL_N_CONTINUE:
+        emit(g, SL_OP_MOV, n->target->cg_cnt, const_slot(g, 1), 0, 0);
+        break;
+    case SL_N_RETURN: gen_return(g, n); break;
+    default: break;
+    }
+    g->sp = mark;
+}
+
+/* ---------------------------------------------------------------------- */
+/* the shader                                                              */
+/* ---------------------------------------------------------------------- */
+
+static void gen_params(cg *g)
+{
+    const sl_ast_file *f = g->file;
+    sl_program *p = g->prog;
+    p->params = sl_xrealloc(NULL, (size_t)(f->nparams + 1) * sizeof *p->params);
+    p->nparams = f->nparams;
+    for (int i = 0; i < f->nparams; i++) {
+        sl_node *v = f->params[i];
+        sl_sym *s = v->sym;
+        sl_param *pp = &p->params[i];
+        pp->name = sl_xstrndup(s->name, strlen(s->name));
+        pp->type = (sl_type)s->ty;
+        pp->output = s->output;
+        pp->size = sl_ty_slots(s->ty);
+        g->cur = v->pos;
+        bool str = s->ty == SL_TYPE_STRING;
+        s->slot = str ? alloc_string(g) : alloc_slots(g, pp->size);
+        pp->slot = s->slot;
+        /* a constant default (a number or a string) travels in operand d:
+         * one instruction per parameter */
+        int k = -1;
+        if (!v->a)
+            k = str ? string_const(g, "", 0) : pp->size == 1 ? const_slot(g, 0) : -1;
+        else if (v->a->kind == SL_N_NUM)
+            k = const_slot(g, v->a->num);
+        else if (v->a->kind == SL_N_STR)
+            k = string_const(g, v->a->name, v->a->len);
+        int at = emit(g, str ? SL_OP_SPARAM : SL_OP_PARAM, s->slot, i, 0, k < 0 ? 0 : k);
+        int mark = g->sp;
+        if (k >= 0)
+            ;
+        else if (v->a)
+            gen_expr(g, v->a, s->slot);
+        else
+            for (int c = 0; c < pp->size; c++)
+                emit(g, SL_OP_MOV, s->slot + c, const_slot(g, 0), 0, 0);
+        g->sp = mark;
+        if (!g->failed)
+            p->code[at].c = (uint16_t)here(g);
+    }
+}
+
+static const char *const operand_kinds[SL_OP__COUNT] = {
+#define SL_OPCODE_OPERANDS(name, text, operands) operands,
+    SL_OPCODES(SL_OPCODE_OPERANDS)
+#undef SL_OPCODE_OPERANDS
+};
+
+/* Constants and string constants go after the highest slot used. */
+static void fix_constants(cg *g)
+{
+    sl_program *p = g->prog;
+    p->const_base = g->max_sp;
+    p->nslots = g->max_sp + p->nconsts;
+    p->nstring_slots = g->max_ssp + p->nstrings;
+    for (int i = 0; i < p->nstrings; i++)
+        p->string_slots[i] = g->max_ssp + i;
+    for (int pc = 0; pc < p->ncode; pc++) {
+        sl_insn *in = &p->code[pc];
+        uint16_t *ops[4] = { &in->a, &in->b, &in->c, &in->d };
+        const char *kinds = operand_kinds[in->op];
+        for (int k = 0; k < 4; k++) {
+            if (!(*ops[k] & CONST_TAG))
+                continue;
+            if (kinds[k] == 'x')
+                *ops[k] = (uint16_t)(p->const_base + (*ops[k] & ~CONST_TAG));
+            else if (kinds[k] == 's')
+                *ops[k] = (uint16_t)(g->max_ssp + (*ops[k] & ~CONST_TAG));
+        }
+    }
+    if (p->nslots > SL_MAX_SLOTS)
+        fail(g, "shader needs more than %d registers (the limit per shader)", SL_MAX_SLOTS);
+}
+
+static unsigned long next_serial(void)
+{
+    static atomic_ulong serial;
+    return atomic_fetch_add(&serial, 1) + 1;
+}
+
+sl_program *sl_codegen(const sl_ast_file *file, sl_diag *diag)
+{
+    cg g = { .file = file, .diag = diag };
+    g.prog = sl_xrealloc(NULL, sizeof *g.prog);
+    memset(g.prog, 0, sizeof *g.prog);
+    sl_program *p = g.prog;
+    p->name = sl_xstrndup(file->name, strlen(file->name));
+    p->kind = file->kind;
+    p->serial = next_serial();
+    g.sp = g.max_sp = SL_GLOBAL_SLOTS;
+    g.shader_ret_flag = -1;
+    g.cur = file->pos;
+    gen_params(&g);
+    if (file->needs_ret_flag) {
+        g.shader_ret_flag = new_flag(&g);
+        set_death(&g, g.shader_ret_flag, true);
+        region_begin(&g);
+    }
+    gen_stmt(&g, file->body);
+    if (file->needs_ret_flag) {
+        int table = region_end(&g);
+        g.cur = file->pos;
+        emit(&g, SL_OP_ACCUM_END, 0, table, 0, SL_ESCAPE_FUNC);
+        patch_escapes(&g, SL_ESCAPE_FUNC, 0, table);
+    }
+    g.cur = file->pos;
+    emit(&g, SL_OP_END, 0, 0, 0, 0);
+    fix_constants(&g);
+    free(g.regions);
+    free(g.escapes);
+    if (g.failed) {
+        sl_program_free(p);
+        return NULL;
+    }
+    return p;
+}

@@ -1,0 +1,891 @@
+/*
+ * parser.c: recursive descent over the grammar of RenderMan's Shading
+ * Language (RI Spec 3.2 Appendix B), one function per rule.
+ *
+ *   file        := { shader | function }
+ *   shader      := ('surface' | 'displacement') IDENT '(' [formals] ')' block
+ *   function    := [type] IDENT '(' [formals] ')' block
+ *   formals     := formal { (';' | ',') formal } [';']
+ *   formal      := ['output'] ['uniform'|'varying'] type def {',' def}
+ *   statement   := block | declaration | if | while | for | break | continue
+ *                | return | expr ';' | ';'
+ *   expr        := assignment, then ?: || && (== !=) (< > <= >=) (+ -)
+ *                  (^) (* /) (.) unary, lowest to highest precedence (the
+ *                  spec's order: "." binds tighter than "*", "^" between
+ *                  "*" and "+")
+ *   unary       := ('-' | '+' | '!') unary | type [STRING] unary | primary
+ *   primary     := NUMBER | STRING | IDENT | IDENT '(' args ')' | '(' expr ')'
+ *
+ * A type keyword followed by '(' or a string is a cast (`point "object"
+ * (x, y, z)`, `color (0.5)`), followed by an identifier a declaration.
+ * Parenthesised lists of 3 or 16 values only appear after a type.
+ *
+ * Error handling: the first error of a statement is reported, the parser
+ * enters panic mode (no more reports) and skips to the next ';' or '}' at
+ * the same brace depth.
+ */
+#include "sl/parser.h"
+
+#include <stdio.h>
+#include <string.h>
+
+typedef struct parser {
+    sl_lexer *lx;
+    sl_arena *arena;
+    sl_diag *diag;
+    sl_token cur;        /* the next token, not yet consumed */
+    sl_token prev;       /* the last consumed token */
+    bool panic;
+    int depth;
+    long consumed;       /* tokens consumed so far: progress of the loops */
+} parser;
+
+/* ---------------------------------------------------------------------- */
+/* tokens                                                                  */
+/* ---------------------------------------------------------------------- */
+
+static void advance(parser *p)
+{
+    p->consumed++;
+    p->prev = p->cur;
+    sl_lexer_next(p->lx, &p->cur);
+}
+
+static bool check(const parser *p, sl_token_kind kind) { return p->cur.kind == kind; }
+
+static bool match(parser *p, sl_token_kind kind)
+{
+    if (!check(p, kind))
+        return false;
+    advance(p);
+    return true;
+}
+
+static sl_token_kind peek_kind(parser *p, int k) { return sl_lexer_peek(p->lx, k)->kind; }
+
+static void error_at(parser *p, sl_pos pos, const sl_token *tok, const char *fmt, ...)
+    SL_PRINTF(4, 5);
+static void error_at(parser *p, sl_pos pos, const sl_token *tok, const char *fmt, ...)
+{
+    if (p->panic)
+        return;
+    p->panic = true;
+    va_list ap;
+    va_start(ap, fmt);
+    sl_diag_vreport(p->diag, SL_DIAG_ERROR, pos, fmt, ap);
+    va_end(ap);
+    if (tok)
+        sl_token_note_macro(tok, p->diag);
+}
+
+/* The position just after the previous token: where a missing ';' goes. */
+static sl_pos after_prev(const parser *p)
+{
+    sl_pos pos = p->prev.pos;
+    if (!pos.file)
+        return p->cur.pos;
+    size_t len = p->prev.len;
+    if (p->prev.kind == SL_TOK_STRING)
+        len += 2;
+    if (p->prev.macro)            /* a macro's tokens sit at the invocation */
+        return pos;
+    pos.col += (int)len;
+    return pos;
+}
+
+/* "expected ';' after expression": reported after the previous token. */
+static bool expect_after(parser *p, sl_token_kind kind, const char *what)
+{
+    if (match(p, kind))
+        return true;
+    error_at(p, after_prev(p), &p->prev, "expected %s after %s",
+             sl_token_kind_name(kind), what);
+    return false;
+}
+
+/* "expected ')'": reported at the current token, with a note at the
+ * opening bracket when there is one. */
+static bool expect_closing(parser *p, sl_token_kind kind, const sl_token *open)
+{
+    if (match(p, kind))
+        return true;
+    if (p->panic)
+        return false;
+    error_at(p, p->cur.pos, &p->cur, "expected %s", sl_token_kind_name(kind));
+    if (open)
+        sl_diag_note(p->diag, open->pos, "to match this %s", sl_token_kind_name(open->kind));
+    return false;
+}
+
+static bool expect(parser *p, sl_token_kind kind, const char *context)
+{
+    if (match(p, kind))
+        return true;
+    error_at(p, p->cur.pos, &p->cur, "expected %s %s", sl_token_kind_name(kind), context);
+    return false;
+}
+
+/* Skips to the end of the current statement: past a ';' or up to a '}'
+ * at brace depth 0. */
+static void synchronize(parser *p)
+{
+    int depth = 0;
+    while (!check(p, SL_TOK_EOF)) {
+        if (depth == 0 && check(p, SL_TOK_SEMICOLON)) {
+            advance(p);
+            break;
+        }
+        if (check(p, SL_TOK_LBRACE))
+            depth++;
+        if (check(p, SL_TOK_RBRACE)) {
+            if (depth == 0)
+                break;
+            depth--;
+            advance(p);
+            if (depth == 0 && !check(p, SL_KW_ELSE))
+                break;
+            continue;
+        }
+        advance(p);
+    }
+    p->panic = false;
+}
+
+/* ---------------------------------------------------------------------- */
+/* types                                                                   */
+/* ---------------------------------------------------------------------- */
+
+static bool is_type_kw(sl_token_kind k)
+{
+    return k == SL_KW_FLOAT || k == SL_KW_POINT || k == SL_KW_VECTOR ||
+           k == SL_KW_NORMAL || k == SL_KW_COLOR || k == SL_KW_STRING ||
+           k == SL_KW_MATRIX || k == SL_KW_VOID;
+}
+
+static bool is_qualifier(sl_token_kind k)
+{
+    return k == SL_KW_UNIFORM || k == SL_KW_VARYING || k == SL_KW_OUTPUT ||
+           k == SL_KW_EXTERN;
+}
+
+static sl_ty type_of_kw(sl_token_kind k)
+{
+    switch (k) {
+    case SL_KW_FLOAT: return SL_TYPE_FLOAT;
+    case SL_KW_POINT: return SL_TYPE_POINT;
+    case SL_KW_VECTOR: return SL_TYPE_VECTOR;
+    case SL_KW_NORMAL: return SL_TYPE_NORMAL;
+    case SL_KW_COLOR: return SL_TYPE_COLOR;
+    case SL_KW_STRING: return SL_TYPE_STRING;
+    case SL_KW_MATRIX: return SL_TYPE_MATRIX;
+    default: return SL_TYPE_VOID;
+    }
+}
+
+/* ---------------------------------------------------------------------- */
+/* expressions                                                             */
+/* ---------------------------------------------------------------------- */
+
+static sl_node *expression(parser *p);
+static sl_node *unary(parser *p);
+
+static sl_node *error_node(parser *p, sl_pos pos)
+{
+    return sl_node_new(p->arena, SL_N_ERROR, pos);
+}
+
+static bool enter(parser *p, const char *what)
+{
+    if (p->depth >= SL_PARSE_MAX_DEPTH) {
+        error_at(p, p->cur.pos, &p->cur, "%s nested too deeply (limit %d)", what,
+                 SL_PARSE_MAX_DEPTH);
+        return false;
+    }
+    p->depth++;
+    return true;
+}
+
+static void push_node(parser *p, sl_node *n, int *cap, sl_node *item)
+{
+    sl_list_push(p->arena, (void ***)&n->list, &n->nlist, cap, item);
+}
+
+/* '(' args ')' after a function name; the '(' is the current token. */
+static sl_node *call(parser *p, sl_token name)
+{
+    sl_node *n = sl_node_new(p->arena, SL_N_CALL, name.pos);
+    n->name = name.text;
+    sl_token open = p->cur;
+    advance(p);
+    int cap = 0;
+    if (!check(p, SL_TOK_RPAREN)) {
+        do {
+            push_node(p, n, &cap, expression(p));
+        } while (match(p, SL_TOK_COMMA));
+    }
+    expect_closing(p, SL_TOK_RPAREN, &open);
+    return n;
+}
+
+static sl_node *primary(parser *p)
+{
+    sl_token t = p->cur;
+    switch (t.kind) {
+    case SL_TOK_INT:
+    case SL_TOK_FLOAT: {
+        advance(p);
+        sl_node *n = sl_node_new(p->arena, SL_N_NUM, t.pos);
+        n->num = t.number;
+        return n;
+    }
+    case SL_TOK_STRING: {
+        advance(p);
+        sl_node *n = sl_node_new(p->arena, SL_N_STR, t.pos);
+        n->name = t.text;
+        n->len = t.len;
+        return n;
+    }
+    case SL_TOK_IDENT: {
+        advance(p);
+        if (check(p, SL_TOK_LPAREN))
+            return call(p, t);
+        if (check(p, SL_TOK_LBRACKET)) {
+            error_at(p, p->cur.pos, &p->cur, "arrays are not supported");
+            return error_node(p, t.pos);
+        }
+        sl_node *n = sl_node_new(p->arena, SL_N_IDENT, t.pos);
+        n->name = t.text;
+        return n;
+    }
+    case SL_TOK_LPAREN: {
+        advance(p);
+        sl_node *e = expression(p);
+        if (check(p, SL_TOK_COMMA)) {
+            error_at(p, p->cur.pos, &p->cur,
+                     "a list of values needs a type in front, as in 'point (x, y, z)'");
+            return error_node(p, t.pos);
+        }
+        expect_closing(p, SL_TOK_RPAREN, &t);
+        return e;
+    }
+    default:
+        error_at(p, t.pos, &t, "expected expression");
+        return error_node(p, t.pos);
+    }
+}
+
+/* type [STRING] ( '(' list ')' | unary ): a cast or a constructor. */
+static sl_node *typecast(parser *p)
+{
+    sl_token t = p->cur;
+    advance(p);
+    sl_node *n = sl_node_new(p->arena, SL_N_CAST, t.pos);
+    n->cast_ty = type_of_kw(t.kind);
+    if (t.kind == SL_KW_VOID) {
+        error_at(p, t.pos, &t, "cannot cast to 'void'");
+        return error_node(p, t.pos);
+    }
+    if (check(p, SL_TOK_STRING)) {
+        n->name = p->cur.text;
+        n->len = p->cur.len;
+        n->pos = p->cur.pos;
+        advance(p);
+    }
+    int cap = 0;
+    if (check(p, SL_TOK_LPAREN)) {
+        sl_token open = p->cur;
+        advance(p);
+        do {
+            push_node(p, n, &cap, expression(p));
+        } while (match(p, SL_TOK_COMMA));
+        expect_closing(p, SL_TOK_RPAREN, &open);
+    } else {
+        push_node(p, n, &cap, unary(p));
+    }
+    n->pos = t.pos;
+    return n;
+}
+
+static sl_node *unary(parser *p)
+{
+    if (!enter(p, "expression"))
+        return error_node(p, p->cur.pos);
+    sl_node *result;
+    sl_token t = p->cur;
+    if (t.kind == SL_TOK_MINUS || t.kind == SL_TOK_NOT || t.kind == SL_TOK_PLUS) {
+        advance(p);
+        sl_node *a = unary(p);
+        if (t.kind == SL_TOK_PLUS) {
+            result = a;
+        } else {
+            result = sl_node_new(p->arena, SL_N_UNARY, t.pos);
+            result->op = t.kind;
+            result->a = a;
+        }
+    } else if (is_type_kw(t.kind)) {
+        result = typecast(p);
+    } else {
+        result = primary(p);
+    }
+    p->depth--;
+    return result;
+}
+
+static sl_node *binary(parser *p, sl_token op, sl_node *a, sl_node *b)
+{
+    sl_node *n = sl_node_new(p->arena, SL_N_BINARY, op.pos);
+    n->op = op.kind;
+    n->a = a;
+    n->b = b;
+    return n;
+}
+
+/* One level of left-associative binary operators. */
+typedef sl_node *(*level_fn)(parser *p);
+
+static sl_node *left_assoc(parser *p, level_fn next, const sl_token_kind *ops, int nops)
+{
+    sl_node *a = next(p);
+    for (;;) {
+        int i = 0;
+        while (i < nops && !check(p, ops[i]))
+            i++;
+        if (i == nops)
+            return a;
+        sl_token op = p->cur;
+        advance(p);
+        a = binary(p, op, a, next(p));
+    }
+}
+
+static sl_node *dot_level(parser *p)
+{
+    static const sl_token_kind ops[] = { SL_TOK_DOT };
+    return left_assoc(p, unary, ops, 1);
+}
+static sl_node *mul_level(parser *p)
+{
+    static const sl_token_kind ops[] = { SL_TOK_STAR, SL_TOK_SLASH };
+    return left_assoc(p, dot_level, ops, 2);
+}
+static sl_node *cross_level(parser *p)
+{
+    static const sl_token_kind ops[] = { SL_TOK_CARET };
+    return left_assoc(p, mul_level, ops, 1);
+}
+static sl_node *add_level(parser *p)
+{
+    static const sl_token_kind ops[] = { SL_TOK_PLUS, SL_TOK_MINUS };
+    return left_assoc(p, cross_level, ops, 2);
+}
+static sl_node *rel_level(parser *p)
+{
+    static const sl_token_kind ops[] = { SL_TOK_LT, SL_TOK_GT, SL_TOK_LE, SL_TOK_GE };
+    return left_assoc(p, add_level, ops, 4);
+}
+static sl_node *eq_level(parser *p)
+{
+    static const sl_token_kind ops[] = { SL_TOK_EQ, SL_TOK_NE };
+    return left_assoc(p, rel_level, ops, 2);
+}
+static sl_node *and_level(parser *p)
+{
+    static const sl_token_kind ops[] = { SL_TOK_AND };
+    return left_assoc(p, eq_level, ops, 1);
+}
+static sl_node *or_level(parser *p)
+{
+    static const sl_token_kind ops[] = { SL_TOK_OR };
+    return left_assoc(p, and_level, ops, 1);
+}
+
+static sl_node *conditional(parser *p)
+{
+    sl_node *c = or_level(p);
+    if (!check(p, SL_TOK_QUESTION))
+        return c;
+    sl_token q = p->cur;
+    advance(p);
+    if (!enter(p, "expression"))
+        return error_node(p, q.pos);
+    sl_node *n = sl_node_new(p->arena, SL_N_COND, q.pos);
+    n->a = c;
+    n->b = expression(p);
+    if (expect(p, SL_TOK_COLON, "in conditional expression"))
+        n->c = conditional(p);
+    else
+        n->c = error_node(p, p->cur.pos);
+    p->depth--;
+    return n;
+}
+
+static bool is_assign_op(sl_token_kind k)
+{
+    return k == SL_TOK_ASSIGN || k == SL_TOK_PLUS_ASSIGN || k == SL_TOK_MINUS_ASSIGN ||
+           k == SL_TOK_STAR_ASSIGN || k == SL_TOK_SLASH_ASSIGN;
+}
+
+static sl_node *expression(parser *p)
+{
+    if (!enter(p, "expression"))
+        return error_node(p, p->cur.pos);
+    sl_node *lhs = conditional(p);
+    if (is_assign_op(p->cur.kind)) {
+        sl_token op = p->cur;
+        advance(p);
+        sl_node *n = sl_node_new(p->arena, SL_N_ASSIGN, op.pos);
+        n->op = op.kind;
+        n->a = lhs;
+        n->b = expression(p);
+        if (lhs->kind != SL_N_IDENT && lhs->kind != SL_N_ERROR)
+            error_at(p, lhs->pos, NULL, "expression is not assignable");
+        lhs = n;
+    }
+    p->depth--;
+    return lhs;
+}
+
+/* ---------------------------------------------------------------------- */
+/* declarations                                                            */
+/* ---------------------------------------------------------------------- */
+
+typedef struct declspec {
+    sl_ty ty;
+    bool output, external;
+    sl_token type_tok;
+} declspec;
+
+/* [output|extern|uniform|varying]* type; false (reported) without a type */
+static bool decl_spec(parser *p, declspec *spec, const char *context)
+{
+    memset(spec, 0, sizeof *spec);
+    while (is_qualifier(p->cur.kind)) {
+        if (p->cur.kind == SL_KW_OUTPUT)
+            spec->output = true;
+        if (p->cur.kind == SL_KW_EXTERN)
+            spec->external = true;
+        advance(p);
+    }
+    if (!is_type_kw(p->cur.kind)) {
+        error_at(p, p->cur.pos, &p->cur, "expected type name %s", context);
+        return false;
+    }
+    spec->type_tok = p->cur;
+    spec->ty = type_of_kw(p->cur.kind);
+    advance(p);
+    if (check(p, SL_TOK_STRING)) {    /* 'point "object"' in a declaration */
+        error_at(p, p->cur.pos, &p->cur,
+                 "a space name is not allowed in a declaration; cast the value instead");
+        return false;
+    }
+    return true;
+}
+
+static sl_sym *new_sym(parser *p, const sl_token *name, const declspec *spec, sl_sym_kind kind)
+{
+    sl_sym *s = sl_arena_alloc(p->arena, sizeof *s);
+    s->name = name->text;
+    s->pos = name->pos;
+    s->ty = spec->ty;
+    s->kind = kind;
+    s->output = spec->output;
+    s->writable = true;
+    s->slot = -1;
+    return s;
+}
+
+/* name [= expr]; returns an SL_N_VAR node or NULL after an error */
+static sl_node *declarator(parser *p, const declspec *spec, sl_sym_kind kind, bool allow_init)
+{
+    if (!check(p, SL_TOK_IDENT)) {
+        error_at(p, p->cur.pos, &p->cur, "expected identifier");
+        return NULL;
+    }
+    sl_token name = p->cur;
+    advance(p);
+    if (check(p, SL_TOK_LBRACKET)) {
+        error_at(p, p->cur.pos, &p->cur, "arrays are not supported");
+        return NULL;
+    }
+    sl_node *v = sl_node_new(p->arena, SL_N_VAR, name.pos);
+    v->sym = new_sym(p, &name, spec, kind);
+    v->name = name.text;
+    if (spec->ty == SL_TYPE_VOID) {
+        error_at(p, spec->type_tok.pos, &spec->type_tok,
+                 "variable '%s' declared 'void'", name.text);
+        return NULL;
+    }
+    if (check(p, SL_TOK_ASSIGN)) {
+        if (!allow_init) {
+            error_at(p, p->cur.pos, &p->cur,
+                     "default values are only allowed for shader parameters");
+            return NULL;
+        }
+        advance(p);
+        v->a = expression(p);
+    }
+    return v;
+}
+
+/* A group of formals: spec name [= e] {, name [= e]}; appended to *list. */
+static bool formal_group(parser *p, sl_node ***list, int *n, int *cap, sl_sym_kind kind)
+{
+    declspec spec;
+    if (!decl_spec(p, &spec, "in parameter list"))
+        return false;
+    do {
+        sl_node *v = declarator(p, &spec, kind, kind == SL_SYM_PARAM);
+        if (!v)
+            return false;
+        sl_list_push(p->arena, (void ***)list, n, cap, v);
+        /* ', type ...' starts a new group (C style) */
+        if (check(p, SL_TOK_COMMA) &&
+            (is_type_kw(peek_kind(p, 0)) || is_qualifier(peek_kind(p, 0))))
+            return true;
+    } while (match(p, SL_TOK_COMMA));
+    return true;
+}
+
+/* '(' formals ')', the '(' already consumed. */
+static void formals(parser *p, const sl_token *open, sl_node ***list, int *n, sl_sym_kind kind)
+{
+    int cap = 0;
+    while (!check(p, SL_TOK_RPAREN) && !check(p, SL_TOK_EOF)) {
+        if (!formal_group(p, list, n, &cap, kind)) {
+            /* skip to ')' */
+            while (!check(p, SL_TOK_RPAREN) && !check(p, SL_TOK_EOF) &&
+                   !check(p, SL_TOK_LBRACE))
+                advance(p);
+            break;
+        }
+        if (!match(p, SL_TOK_SEMICOLON) && !match(p, SL_TOK_COMMA))
+            break;
+    }
+    expect_closing(p, SL_TOK_RPAREN, open);
+    p->panic = false;
+}
+
+/* ---------------------------------------------------------------------- */
+/* statements                                                              */
+/* ---------------------------------------------------------------------- */
+
+static sl_node *statement(parser *p);
+
+static sl_node *block(parser *p)
+{
+    sl_token open = p->cur;
+    sl_node *b = sl_node_new(p->arena, SL_N_BLOCK, open.pos);
+    if (!expect(p, SL_TOK_LBRACE, "to start a block"))
+        return b;
+    int cap = 0;
+    while (!check(p, SL_TOK_RBRACE) && !check(p, SL_TOK_EOF)) {
+        long start = p->consumed;
+        sl_node *s = statement(p);
+        if (s)
+            push_node(p, b, &cap, s);
+        if (p->panic) {
+            /* a statement that failed but reached its ';' (or '}') ends
+             * there; otherwise skip to the end of the statement (always
+             * moving on: '}' and the end of file end the loop) */
+            if (p->consumed > start &&
+                (p->prev.kind == SL_TOK_SEMICOLON || p->prev.kind == SL_TOK_RBRACE))
+                p->panic = false;
+            else
+                synchronize(p);
+        }
+    }
+    expect_closing(p, SL_TOK_RBRACE, &open);
+    return b;
+}
+
+/* A declaration statement: spec declarator {, declarator} ';' */
+static sl_node *declaration(parser *p, bool need_semicolon)
+{
+    sl_node *d = sl_node_new(p->arena, SL_N_DECL, p->cur.pos);
+    declspec spec;
+    if (!decl_spec(p, &spec, "in declaration"))
+        return d;
+    if (spec.output)
+        error_at(p, spec.type_tok.pos, &spec.type_tok,
+                 "'output' is only allowed on parameters");
+    if (check(p, SL_TOK_IDENT) && peek_kind(p, 0) == SL_TOK_LPAREN) {
+        error_at(p, p->cur.pos, &p->cur,
+                 "nested function definitions are not supported; define '%s' at file level",
+                 p->cur.text);
+        return d;
+    }
+    int cap = 0;
+    do {
+        sl_node *v = declarator(p, &spec, SL_SYM_LOCAL, true);
+        if (!v)
+            return d;
+        v->sym->output = false;
+        v->num = spec.external;    /* extern: refers to an existing variable */
+        push_node(p, d, &cap, v);
+    } while (match(p, SL_TOK_COMMA));
+    if (need_semicolon)
+        expect_after(p, SL_TOK_SEMICOLON, "declaration");
+    return d;
+}
+
+static sl_node *paren_condition(parser *p, const char *keyword)
+{
+    sl_token open = p->cur;
+    char context[48];
+    snprintf(context, sizeof context, "after '%s'", keyword);
+    if (!expect(p, SL_TOK_LPAREN, context))
+        return error_node(p, p->cur.pos);
+    sl_node *c = expression(p);
+    expect_closing(p, SL_TOK_RPAREN, &open);
+    return c;
+}
+
+static sl_node *if_statement(parser *p)
+{
+    sl_node *n = sl_node_new(p->arena, SL_N_IF, p->cur.pos);
+    advance(p);
+    n->a = paren_condition(p, "if");
+    if (p->panic)
+        return n;
+    n->b = statement(p);
+    if (!p->panic && match(p, SL_KW_ELSE))
+        n->c = statement(p);
+    return n;
+}
+
+static sl_node *while_statement(parser *p)
+{
+    sl_node *n = sl_node_new(p->arena, SL_N_WHILE, p->cur.pos);
+    advance(p);
+    n->a = paren_condition(p, "while");
+    if (p->panic)
+        return n;
+    n->b = statement(p);
+    return n;
+}
+
+static sl_node *for_statement(parser *p)
+{
+    sl_node *n = sl_node_new(p->arena, SL_N_FOR, p->cur.pos);
+    advance(p);
+    sl_token open = p->cur;
+    if (!expect(p, SL_TOK_LPAREN, "after 'for'"))
+        return n;
+    if (!check(p, SL_TOK_SEMICOLON)) {
+        if (is_qualifier(p->cur.kind) ||
+            (is_type_kw(p->cur.kind) && peek_kind(p, 0) == SL_TOK_IDENT)) {
+            n->a = declaration(p, false);
+        } else {
+            n->a = sl_node_new(p->arena, SL_N_EXPR, p->cur.pos);
+            n->a->a = expression(p);
+        }
+    }
+    if (!expect_after(p, SL_TOK_SEMICOLON, "'for' initialization"))
+        return n;
+    if (!check(p, SL_TOK_SEMICOLON))
+        n->b = expression(p);
+    if (!expect_after(p, SL_TOK_SEMICOLON, "'for' condition"))
+        return n;
+    if (!check(p, SL_TOK_RPAREN)) {
+        n->c = sl_node_new(p->arena, SL_N_EXPR, p->cur.pos);
+        n->c->a = expression(p);
+    }
+    if (!expect_closing(p, SL_TOK_RPAREN, &open))
+        return n;
+    n->d = statement(p);
+    return n;
+}
+
+/* break [n] ';' / continue [n] ';' */
+static sl_node *loop_mod(parser *p, sl_node_kind kind)
+{
+    sl_token kw = p->cur;
+    sl_node *n = sl_node_new(p->arena, kind, kw.pos);
+    advance(p);
+    n->num = 1;
+    if (check(p, SL_TOK_INT)) {
+        n->num = p->cur.number;
+        if (n->num < 1) {
+            error_at(p, p->cur.pos, &p->cur, "'%s' level must be at least 1", kw.text);
+            return n;
+        }
+        advance(p);
+    }
+    expect_after(p, SL_TOK_SEMICOLON, kind == SL_N_BREAK ? "'break'" : "'continue'");
+    return n;
+}
+
+static sl_node *return_statement(parser *p)
+{
+    sl_node *n = sl_node_new(p->arena, SL_N_RETURN, p->cur.pos);
+    advance(p);
+    if (!check(p, SL_TOK_SEMICOLON))
+        n->a = expression(p);
+    expect_after(p, SL_TOK_SEMICOLON, "return statement");
+    return n;
+}
+
+static sl_node *unsupported(parser *p, const char *message)
+{
+    error_at(p, p->cur.pos, &p->cur, "%s", message);
+    return NULL;
+}
+
+static sl_node *statement_inner(parser *p)
+{
+    switch (p->cur.kind) {
+    case SL_TOK_LBRACE: return block(p);
+    case SL_KW_IF: return if_statement(p);
+    case SL_KW_WHILE: return while_statement(p);
+    case SL_KW_FOR: return for_statement(p);
+    case SL_KW_BREAK: return loop_mod(p, SL_N_BREAK);
+    case SL_KW_CONTINUE: return loop_mod(p, SL_N_CONTINUE);
+    case SL_KW_RETURN: return return_statement(p);
+    case SL_TOK_SEMICOLON: {
+        sl_node *n = sl_node_new(p->arena, SL_N_EMPTY, p->cur.pos);
+        advance(p);
+        return n;
+    }
+    case SL_KW_ILLUMINANCE: case SL_KW_ILLUMINATE: case SL_KW_SOLAR:
+        return unsupported(p, "light loops are not supported (use ambient(), "
+                              "diffuse(), specular() or phong())");
+    default: break;
+    }
+    if (is_qualifier(p->cur.kind) ||
+        (is_type_kw(p->cur.kind) && peek_kind(p, 0) == SL_TOK_IDENT))
+        return declaration(p, true);
+    sl_node *n = sl_node_new(p->arena, SL_N_EXPR, p->cur.pos);
+    n->a = expression(p);
+    expect_after(p, SL_TOK_SEMICOLON, "expression");
+    return n;
+}
+
+static sl_node *statement(parser *p)
+{
+    if (!enter(p, "statements"))
+        return NULL;
+    sl_node *s = statement_inner(p);
+    p->depth--;
+    return s;
+}
+
+/* ---------------------------------------------------------------------- */
+/* definitions                                                             */
+/* ---------------------------------------------------------------------- */
+
+static void shader_definition(parser *p, sl_ast_file *file)
+{
+    sl_token kw = p->cur;
+    advance(p);
+    if (kw.kind != SL_KW_SURFACE && kw.kind != SL_KW_DISPLACEMENT) {
+        error_at(p, kw.pos, &kw,
+                 "'%s' shaders are not supported (only 'surface' and 'displacement')",
+                 kw.text);
+        return;
+    }
+    if (!check(p, SL_TOK_IDENT)) {
+        error_at(p, p->cur.pos, &p->cur, "expected shader name after '%s'", kw.text);
+        return;
+    }
+    sl_token name = p->cur;
+    advance(p);
+    if (file->has_shader) {
+        error_at(p, name.pos, &name, "more than one shader in one source ('%s' and '%s')",
+                 file->name, name.text);
+        sl_diag_note(p->diag, file->pos, "'%s' defined here", file->name);
+        return;
+    }
+    file->has_shader = true;
+    file->kind = kw.kind == SL_KW_SURFACE ? SL_SHADER_SURFACE : SL_SHADER_DISPLACEMENT;
+    file->name = name.text;
+    file->pos = name.pos;
+    sl_token open = p->cur;
+    if (!expect(p, SL_TOK_LPAREN, "after shader name"))
+        return;
+    formals(p, &open, &file->params, &file->nparams, SL_SYM_PARAM);
+    for (int i = 0; i < file->nparams; i++)
+        file->params[i]->sym->param_index = i;
+    file->body = block(p);
+}
+
+static void function_definition(parser *p, sl_ast_file *file, int *funcs_cap)
+{
+    sl_ty ret = SL_TYPE_VOID;
+    if (is_type_kw(p->cur.kind)) {
+        ret = type_of_kw(p->cur.kind);
+        advance(p);
+    }
+    if (!check(p, SL_TOK_IDENT)) {
+        error_at(p, p->cur.pos, &p->cur, "expected function name");
+        return;
+    }
+    sl_token name = p->cur;
+    advance(p);
+    sl_token open = p->cur;
+    if (!expect(p, SL_TOK_LPAREN, "after function name"))
+        return;
+    sl_func *f = sl_arena_alloc(p->arena, sizeof *f);
+    f->name = name.text;
+    f->pos = name.pos;
+    f->ret = ret;
+    sl_node **params = NULL;
+    formals(p, &open, &params, &f->nparams, SL_SYM_FPARAM);
+    f->params = sl_arena_alloc(p->arena, (size_t)(f->nparams + 1) * sizeof *f->params);
+    for (int i = 0; i < f->nparams; i++) {
+        f->params[i] = params[i]->sym;
+        f->params[i]->writable = f->params[i]->output;
+    }
+    f->body = block(p);
+    sl_list_push(p->arena, (void ***)&file->funcs, &file->nfuncs, funcs_cap, f);
+}
+
+static void skip_definition(parser *p)
+{
+    while (!check(p, SL_TOK_EOF)) {
+        if (check(p, SL_TOK_LBRACE)) {
+            int depth = 0;
+            do {
+                if (check(p, SL_TOK_LBRACE))
+                    depth++;
+                if (check(p, SL_TOK_RBRACE))
+                    depth--;
+                advance(p);
+            } while (depth > 0 && !check(p, SL_TOK_EOF));
+            break;
+        }
+        advance(p);
+        if (p->cur.kind == SL_KW_SURFACE || p->cur.kind == SL_KW_DISPLACEMENT)
+            break;
+    }
+    p->panic = false;
+}
+
+sl_ast_file *sl_parse(sl_lexer *lx, sl_arena *arena, sl_diag *diag)
+{
+    parser p = { .lx = lx, .arena = arena, .diag = diag };
+    sl_ast_file *file = sl_arena_alloc(arena, sizeof *file);
+    sl_lexer_next(lx, &p.cur);
+    int funcs_cap = 0;
+    while (!check(&p, SL_TOK_EOF)) {
+        sl_token_kind k = p.cur.kind;
+        if (k == SL_KW_SURFACE || k == SL_KW_DISPLACEMENT || k == SL_KW_LIGHT ||
+            k == SL_KW_VOLUME || k == SL_KW_IMAGER) {
+            shader_definition(&p, file);
+        } else if (is_type_kw(k) || (k == SL_TOK_IDENT && peek_kind(&p, 0) == SL_TOK_LPAREN)) {
+            function_definition(&p, file, &funcs_cap);
+        } else {
+            error_at(&p, p.cur.pos, &p.cur,
+                     "expected a shader ('surface' or 'displacement') or a function definition");
+        }
+        if (p.panic)
+            skip_definition(&p);
+        if (sl_diag_full(diag))
+            break;
+    }
+    if (!file->has_shader && sl_diag_error_count(diag) == 0) {
+        sl_pos whole = { p.cur.pos.file, 0, 0 };       /* the whole file */
+        sl_diag_error(diag, whole, "no shader definition (expected 'surface' or "
+                                   "'displacement')");
+    }
+    return file;
+}

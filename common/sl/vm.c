@@ -1,0 +1,288 @@
+/*
+ * vm.c: the virtual machine's public face (shader.h): creation with all
+ * memory allocated up front, globals in and out in each arithmetic, spaces
+ * and lights, and sl_vm_run, which checks its arguments and hands over to
+ * the backend of the mode (vm_float.c, vm_dual.c, vm_interval.c,
+ * vm_affine.c).
+ */
+#include "sl/vm_internal.h"
+#include "sl/check.h"
+#include "sl/strbuf.h"
+
+#include <stdarg.h>
+#include <stdlib.h>
+#include <string.h>
+
+static const sl_limits default_limits = { 1000000, 64 };
+
+const char *sl_mode_name(sl_mode mode)
+{
+    switch (mode) {
+    case SL_MODE_FLOAT: return "float";
+    case SL_MODE_DUAL: return "dual";
+    case SL_MODE_INTERVAL: return "interval";
+    case SL_MODE_AFFINE: return "affine";
+    }
+    return "?";
+}
+
+static void *xcalloc(size_t n, size_t size)
+{
+    void *p = calloc(n, size);
+    if (!p) {
+        fputs("sl: out of memory\n", stderr);
+        abort();
+    }
+    return p;
+}
+
+sl_vm *sl_vm_new(const sl_limits *limits)
+{
+    sl_vm *self = xcalloc(1, sizeof *self);
+    self->limits = limits ? *limits : default_limits;
+    if (self->limits.max_instructions <= 0)
+        self->limits.max_instructions = default_limits.max_instructions;
+    if (self->limits.max_loop_iterations <= 0)
+        self->limits.max_loop_iterations = default_limits.max_loop_iterations;
+    for (int s = 0; s < SL_SPACE__COUNT; s++) {
+        self->spaces.to_current[s] = mat4_identity();
+        self->spaces.from_current[s] = mat4_identity();
+    }
+    self->f = xcalloc(SL_MAX_SLOTS, sizeof *self->f);
+    self->d = xcalloc(SL_MAX_SLOTS, sizeof *self->d);
+    self->i = xcalloc(SL_MAX_SLOTS, sizeof *self->i);
+    self->a = xcalloc(SL_MAX_SLOTS, sizeof *self->a);
+    self->str = xcalloc(SL_MAX_STRING_SLOTS, sizeof *self->str);
+    self->pool = xcalloc(SL_VM_POOL_VALUES, sizeof(aa_form));
+    self->spool = xcalloc(SL_VM_POOL_VALUES, sizeof *self->spool);
+    sl_vm_clear_globals(self);
+    return self;
+}
+
+void sl_vm_destroy(sl_vm **self_p)
+{
+    sl_vm *self = *self_p;
+    if (!self)
+        return;
+    free(self->f);
+    free(self->d);
+    free(self->i);
+    free(self->a);
+    free(self->str);
+    free(self->pool);
+    free(self->spool);
+    free(self);
+    *self_p = NULL;
+}
+
+void sl_vm_set_spaces(sl_vm *self, const sl_spaces *spaces) { self->spaces = *spaces; }
+
+void sl_vm_set_lights(sl_vm *self, sl_light_fn fn, void *user)
+{
+    self->light_fn = fn;
+    self->light_user = user;
+}
+
+void sl_vm_set_fixed_lights(sl_vm *self, const sl_light_sample *samples, int count)
+{
+    if (count < 0)
+        count = 0;
+    if (count > SL_VM_MAX_LIGHTS)
+        count = SL_VM_MAX_LIGHTS;
+    if (count)
+        memcpy(self->fixed_lights, samples, (size_t)count * sizeof *samples);
+    self->nfixed_lights = count;
+}
+
+void sl_vm_set_seed(sl_vm *self, uint64_t seed) { self->seed = seed; }
+
+/* ---------------------------------------------------------------------- */
+/* globals                                                                 */
+/* ---------------------------------------------------------------------- */
+
+/* Clearing is lazy: each mode's globals are zeroed when that mode is
+ * first used after sl_vm_clear_globals (the renderer clears before every
+ * run, and uses one mode per run). */
+void sl_vm_clear_globals(sl_vm *self) { self->clear_pending = 0xf; }
+
+static void ensure_clear(sl_vm *self, sl_mode mode)
+{
+    unsigned bit = 1u << mode;
+    if (!(self->clear_pending & bit))
+        return;
+    self->clear_pending &= ~bit;
+    switch (mode) {
+    case SL_MODE_FLOAT: memset(self->f, 0, SL_GLOBAL_SLOTS * sizeof *self->f); break;
+    case SL_MODE_DUAL: memset(self->d, 0, SL_GLOBAL_SLOTS * sizeof *self->d); break;
+    case SL_MODE_INTERVAL:
+        for (int s = 0; s < SL_GLOBAL_SLOTS; s++)
+            self->i[s] = ia_point(0.0);
+        break;
+    case SL_MODE_AFFINE:
+        for (int s = 0; s < SL_GLOBAL_SLOTS; s++)
+            aa_const(&self->a[s], 0.0);
+        break;
+    }
+}
+
+static bool global_ok(sl_global g) { return (unsigned)g < SL_G__COUNT; }
+
+void sl_vm_set_float(sl_vm *self, sl_global g, const double *values)
+{
+    ensure_clear(self, SL_MODE_FLOAT);
+    if (!global_ok(g))
+        return;
+    memcpy(&self->f[sl_global_slot(g)], values, (size_t)sl_global_size(g) * sizeof *values);
+}
+
+void sl_vm_set_dual(sl_vm *self, sl_global g, const sl_dual *values)
+{
+    ensure_clear(self, SL_MODE_DUAL);
+    if (!global_ok(g))
+        return;
+    memcpy(&self->d[sl_global_slot(g)], values, (size_t)sl_global_size(g) * sizeof *values);
+}
+
+void sl_vm_set_interval(sl_vm *self, sl_global g, const ia_interval *values)
+{
+    ensure_clear(self, SL_MODE_INTERVAL);
+    if (!global_ok(g))
+        return;
+    memcpy(&self->i[sl_global_slot(g)], values, (size_t)sl_global_size(g) * sizeof *values);
+}
+
+void sl_vm_set_affine(sl_vm *self, sl_global g, const aa_form *values)
+{
+    ensure_clear(self, SL_MODE_AFFINE);
+    if (!global_ok(g))
+        return;
+    memcpy(&self->a[sl_global_slot(g)], values, (size_t)sl_global_size(g) * sizeof *values);
+}
+
+void sl_vm_get_float(const sl_vm *self, sl_global g, double *values)
+{
+    ensure_clear((sl_vm *)self, SL_MODE_FLOAT);
+    if (global_ok(g))
+        memcpy(values, &self->f[sl_global_slot(g)], (size_t)sl_global_size(g) * sizeof *values);
+}
+
+void sl_vm_get_dual(const sl_vm *self, sl_global g, sl_dual *values)
+{
+    ensure_clear((sl_vm *)self, SL_MODE_DUAL);
+    if (global_ok(g))
+        memcpy(values, &self->d[sl_global_slot(g)], (size_t)sl_global_size(g) * sizeof *values);
+}
+
+void sl_vm_get_interval(const sl_vm *self, sl_global g, ia_interval *values)
+{
+    ensure_clear((sl_vm *)self, SL_MODE_INTERVAL);
+    if (global_ok(g))
+        memcpy(values, &self->i[sl_global_slot(g)], (size_t)sl_global_size(g) * sizeof *values);
+}
+
+void sl_vm_get_affine(const sl_vm *self, sl_global g, aa_form *values)
+{
+    ensure_clear((sl_vm *)self, SL_MODE_AFFINE);
+    if (global_ok(g))
+        memcpy(values, &self->a[sl_global_slot(g)], (size_t)sl_global_size(g) * sizeof *values);
+}
+
+/* ---------------------------------------------------------------------- */
+/* helpers of the backends                                                 */
+/* ---------------------------------------------------------------------- */
+
+sl_status sl_vm_fail(sl_vm *vm, sl_status st, const char *fmt, ...)
+{
+    int n = snprintf(vm->error, sizeof vm->error, "shader '%s': ",
+                     vm->prog ? vm->prog->name : "?");
+    if (n < 0 || (size_t)n >= sizeof vm->error)
+        n = 0;
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(vm->error + n, sizeof vm->error - (size_t)n, fmt, ap);
+    va_end(ap);
+    return st;
+}
+
+const mat4 *sl_vm_space_id(const sl_vm *vm, int space, int dir)
+{
+    if (space < 0 || space >= SL_SPACE__COUNT)
+        return NULL;
+    return dir == SL_SPACE_TO_CURRENT ? &vm->spaces.to_current[space]
+                                      : &vm->spaces.from_current[space];
+}
+
+const mat4 *sl_vm_space(const sl_vm *vm, const char *name, int dir)
+{
+    return sl_vm_space_id(vm, name ? sl_space_find(name) : -1, dir);
+}
+
+int sl_vm_light_samples(sl_vm *vm, const double P[3], sl_light_sample *out)
+{
+    int n = 0;
+    if (vm->light_fn) {
+        n = vm->light_fn(vm->light_user, P, out, SL_VM_MAX_LIGHTS);
+        if (n < 0)
+            n = 0;
+        if (n > SL_VM_MAX_LIGHTS)
+            n = SL_VM_MAX_LIGHTS;
+    }
+    for (int k = 0; k < vm->nfixed_lights && n < SL_VM_MAX_LIGHTS; k++)
+        out[n++] = vm->fixed_lights[k];
+    return n;
+}
+
+double sl_vm_random(sl_vm *vm)
+{
+    uint64_t z = (vm->rng += 0x9e3779b97f4a7c15ull);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    z ^= z >> 31;
+    return (double)(z >> 11) * 0x1p-53;
+}
+
+/* ---------------------------------------------------------------------- */
+/* running                                                                 */
+/* ---------------------------------------------------------------------- */
+
+static void load_strings(sl_vm *vm, const sl_program *p)
+{
+    for (int k = 0; k < p->nstrings; k++)
+        vm->str[p->string_slots[k]] = p->strings[k];
+}
+
+sl_status sl_vm_run(sl_vm *self, const sl_instance *inst, sl_mode mode, aa_context *ctx)
+{
+    self->error[0] = '\0';
+    self->executed = 0;
+    self->prog = inst ? inst->program : NULL;
+    if (!inst)
+        return sl_vm_fail(self, SL_ERR_RUNTIME, "no shader instance to run");
+    if (mode == SL_MODE_AFFINE && !ctx)
+        return sl_vm_fail(self, SL_ERR_RUNTIME, "affine mode needs an aa_context");
+    const sl_program *p = inst->program;
+    if (p->nslots > SL_MAX_SLOTS || p->nstring_slots > SL_MAX_STRING_SLOTS)
+        return sl_vm_fail(self, SL_ERR_RUNTIME, "program exceeds the VM's slot limits");
+    self->inst = inst;
+    self->ctx = ctx;
+    self->mode = mode;
+    self->nframes = 0;
+    self->pool_top = 0;
+    self->spool_top = 0;
+    self->naccs = 0;
+    self->acc_bottom = SL_VM_POOL_VALUES;
+    self->sacc_bottom = SL_VM_POOL_VALUES;
+    self->rng = self->seed;
+    ensure_clear(self, mode);
+    load_strings(self, p);
+    switch (mode) {
+    case SL_MODE_FLOAT: return sl_vm_exec_float(self);
+    case SL_MODE_DUAL: return sl_vm_exec_dual(self);
+    case SL_MODE_INTERVAL: return sl_vm_exec_interval(self);
+    case SL_MODE_AFFINE: return sl_vm_exec_affine(self);
+    }
+    return sl_vm_fail(self, SL_ERR_RUNTIME, "unknown mode %d", (int)mode);
+}
+
+const char *sl_vm_error(const sl_vm *self) { return self->error; }
+long sl_vm_instructions(const sl_vm *self) { return self->executed; }

@@ -1,0 +1,154 @@
+/*
+ * vm_internal.h: what the virtual machine's files share: the sl_vm and
+ * sl_instance structures, the merge frames of interval/affine control flow,
+ * and the entry points of the four backends (vm_float.c, vm_dual.c,
+ * vm_interval.c, vm_affine.c), each an instance of the dispatch loop in
+ * vm_exec.inc over its own slot type.
+ *
+ * Memory: every slot file (one per mode), the string file and the merge
+ * pool are allocated at their hard limits when the VM is created, so that
+ * a run never allocates and a shader cannot make it grow.
+ */
+#ifndef SL_VM_INTERNAL_H
+#define SL_VM_INTERNAL_H
+
+#include <math.h>
+#include <stdint.h>
+
+#include "sl/bytecode.h"
+#include "sl/shader.h"
+
+enum {
+    SL_VM_POOL_VALUES = 8192,     /* snapshot values of open merge frames */
+    SL_VM_MAX_FRAMES = 512,       /* open merge frames (nested maybe-branches) */
+    SL_VM_MAX_LIGHTS = 64,        /* light samples per shading call */
+};
+
+/* The parameter values of one instance. */
+typedef struct sl_inst_value {
+    bool set;
+    double v[16];
+    char *s;
+} sl_inst_value;
+
+struct sl_instance {
+    const sl_program *program;
+    sl_inst_value *values;
+};
+
+/* An open merge frame: an undecided `if` (then or else part running) or
+ * one undecided iteration of a loop; `pool` is where the snapshot of the
+ * frame's merge table starts. */
+typedef enum { VM_FRAME_IF, VM_FRAME_LOOP } vm_frame_kind;
+typedef struct vm_frame {
+    vm_frame_kind kind;
+    int phase;          /* IF: 0 then, 1 else */
+    int owner;          /* pc of its BR_BEGIN / LOOP_TEST */
+    int count;          /* LOOP: undecided iterations so far */
+    int table;
+    int pool, spool;
+} vm_frame;
+
+/* The saved states of the dead paths of one loop or inlined call (its
+ * break or early return), merged back where it ends. Stored at the top end
+ * of the merge pool, growing down. */
+enum { SL_VM_MAX_ACCUMULATORS = 64 };
+typedef struct vm_accumulator {
+    int kind, id;
+    int pool, spool;
+    bool live;
+} vm_accumulator;
+
+struct sl_vm {
+    sl_limits limits;
+    sl_spaces spaces;
+    sl_light_fn light_fn;
+    void *light_user;
+    sl_light_sample fixed_lights[SL_VM_MAX_LIGHTS];
+    int nfixed_lights;
+    uint64_t seed;
+
+    double *f;                    /* slot files, SL_MAX_SLOTS each */
+    sl_dual *d;
+    ia_interval *i;
+    aa_form *a;
+    const char **str;             /* string file */
+    unsigned long loaded[4];      /* program whose constants each file holds */
+    unsigned clear_pending;       /* modes whose globals still have to be zeroed */
+
+    void *pool;                   /* SL_VM_POOL_VALUES values of the run's mode */
+    const char **spool;
+    int pool_top, spool_top;
+    vm_frame frames[SL_VM_MAX_FRAMES];
+    int nframes;
+    vm_accumulator accs[SL_VM_MAX_ACCUMULATORS];
+    int naccs, acc_bottom, sacc_bottom;
+
+    /* the current run */
+    const sl_program *prog;
+    const sl_instance *inst;
+    aa_context *ctx;
+    sl_mode mode;
+    long executed;
+    uint64_t rng;
+    char error[512];
+};
+
+sl_status sl_vm_exec_float(sl_vm *vm);
+sl_status sl_vm_exec_dual(sl_vm *vm);
+sl_status sl_vm_exec_interval(sl_vm *vm);
+sl_status sl_vm_exec_affine(sl_vm *vm);
+
+/* "shader 'name': " + message into vm->error; returns st. */
+sl_status sl_vm_fail(sl_vm *vm, sl_status st, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+
+/* The matrix of space `name` (SL_SPACE_TO_CURRENT or _FROM_CURRENT), or
+ * NULL for an unknown name. */
+const mat4 *sl_vm_space(const sl_vm *vm, const char *name, int dir);
+const mat4 *sl_vm_space_id(const sl_vm *vm, int space, int dir);
+
+/* Light samples at surface point P for float/dual runs: the callback's,
+ * then the fixed lights. */
+int sl_vm_light_samples(sl_vm *vm, const double P[3], sl_light_sample *out);
+
+/* The next random number in [0, 1) of this run (splitmix64). */
+double sl_vm_random(sl_vm *vm);
+
+const char *sl_mode_name(sl_mode mode);
+
+/* a op b (op: SL_OP_ADD/SUB/MUL/DIV) when the double result is EXACT, so
+ * that interval and affine runs keep integer counters and octave
+ * frequencies as points instead of widening them by a rounding error
+ * (which would leave `i < 5` undecided). TwoSum for sums, fma for
+ * products and quotients; results near underflow are refused. */
+static inline bool sl_exact_op(int op, double a, double b, double *r)
+{
+    double s;
+    if (op == SL_OP_ADD || op == SL_OP_SUB) {
+        if (op == SL_OP_SUB)
+            b = -b;
+        s = a + b;
+        double bb = s - a;
+        if (!isfinite(s) || (a - (s - bb)) + (b - bb) != 0.0)
+            return false;
+    } else if (op == SL_OP_MUL) {
+        s = a * b;
+        if (!isfinite(s) || (fabs(s) < 0x1p-900 && a != 0.0 && b != 0.0) ||
+            fma(a, b, -s) != 0.0)
+            return false;
+    } else {
+        if (b == 0.0)
+            return false;
+        s = a / b;
+        if (!isfinite(s) || (fabs(s) < 0x1p-900 && a != 0.0) || fma(s, b, -a) != 0.0)
+            return false;
+    }
+    *r = s;
+    return true;
+}
+
+#endif

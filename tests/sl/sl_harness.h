@@ -1,0 +1,235 @@
+/*
+ * sl_harness.h: helpers shared by the shading-language tests: compile a
+ * source held in memory or a library shader from scenes/shaders, set up
+ * the two base surfaces of the bound tests (the plane P = (2u-1, 2v-1, 0)
+ * and the unit sphere with RenderMan's parameterisation) in all four
+ * arithmetics, and run a program.
+ *
+ * Everything is static inline so that each test includes what it uses.
+ */
+#ifndef SL_HARNESS_H
+#define SL_HARNESS_H
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "aa/affine.h"
+#include "aa/interval.h"
+#include "sl/diag.h"
+#include "sl/shader.h"
+#include "sl/source.h"
+
+#ifndef AAFARM_SHADER_DIR
+#define AAFARM_SHADER_DIR "scenes/shaders"
+#endif
+
+/* Compiles `text` as file `name`; NULL on errors. *diag_out (if not NULL)
+ * receives the rendered diagnostics (caller frees). */
+static inline sl_program *h_compile_named(const char *name, const char *text, char **diag_out)
+{
+    sl_source_set *set = sl_source_set_new();
+    sl_diag *diag = sl_diag_new();
+    sl_source_set_add(set, name, text, strlen(text));
+    sl_program *p = sl_compile(set, name, NULL, diag);
+    if (diag_out)
+        *diag_out = sl_diag_to_string(diag);
+    else if (!p)
+        sl_diag_print(diag, stderr);
+    sl_diag_destroy(&diag);
+    sl_source_set_destroy(&set);
+    return p;
+}
+
+static inline sl_program *h_compile(const char *text) { return h_compile_named("t.sl", text, NULL); }
+
+/* Compiles scenes/shaders/<name>.sl from disk. */
+static inline sl_program *h_compile_library(const char *name)
+{
+    char path[1024];
+    snprintf(path, sizeof path, "%s/%s.sl", AAFARM_SHADER_DIR, name);
+    sl_source_set *set = sl_source_set_new();
+    sl_diag *diag = sl_diag_new();
+    sl_program *p = NULL;
+    if (sl_source_set_load_file(set, path, "lib.sl", diag) == 0)
+        p = sl_compile(set, "lib.sl", NULL, diag);
+    if (!p)
+        sl_diag_print(diag, stderr);
+    sl_diag_destroy(&diag);
+    sl_source_set_destroy(&set);
+    return p;
+}
+
+/* ---- base surfaces ---- */
+
+typedef enum { H_PLANE, H_SPHERE } h_surface;
+
+/* Float: P, N (unit), dPdu, dPdv at (u, v). */
+static inline void h_surface_float(h_surface s, double u, double v, double P[3], double N[3],
+                                   double dPdu[3], double dPdv[3])
+{
+    if (s == H_PLANE) {
+        P[0] = 2 * u - 1; P[1] = 2 * v - 1; P[2] = 0;
+        N[0] = 0; N[1] = 0; N[2] = 1;
+        dPdu[0] = 2; dPdu[1] = 0; dPdu[2] = 0;
+        dPdv[0] = 0; dPdv[1] = 2; dPdv[2] = 0;
+        return;
+    }
+    /* RenderMan sphere, radius 1: theta = 2 pi u, phi = -pi/2 + pi v */
+    double th = 2 * M_PI * u, ph = M_PI * v - M_PI / 2;
+    P[0] = cos(th) * cos(ph); P[1] = sin(th) * cos(ph); P[2] = sin(ph);
+    N[0] = P[0]; N[1] = P[1]; N[2] = P[2];
+    dPdu[0] = -2 * M_PI * sin(th) * cos(ph); dPdu[1] = 2 * M_PI * cos(th) * cos(ph); dPdu[2] = 0;
+    dPdv[0] = -M_PI * cos(th) * sin(ph); dPdv[1] = -M_PI * sin(th) * sin(ph);
+    dPdv[2] = M_PI * cos(ph);
+}
+
+/* Sets the float globals of a displacement run at (u, v). */
+static inline void h_globals_float(sl_vm *vm, h_surface s, double u, double v)
+{
+    double P[3], N[3], du[3], dv[3];
+    h_surface_float(s, u, v, P, N, du, dv);
+    sl_vm_clear_globals(vm);
+    sl_vm_set_float(vm, SL_G_P, P);
+    sl_vm_set_float(vm, SL_G_N, N);
+    sl_vm_set_float(vm, SL_G_Ng, N);
+    sl_vm_set_float(vm, SL_G_dPdu, du);
+    sl_vm_set_float(vm, SL_G_dPdv, dv);
+    sl_vm_set_float(vm, SL_G_u, &u);
+    sl_vm_set_float(vm, SL_G_v, &v);
+    sl_vm_set_float(vm, SL_G_s, &u);
+    sl_vm_set_float(vm, SL_G_t, &v);
+    double one[3] = { 1, 1, 1 }, I[3] = { 0, 0, 1 };
+    sl_vm_set_float(vm, SL_G_Cs, one);
+    sl_vm_set_float(vm, SL_G_Os, one);
+    sl_vm_set_float(vm, SL_G_I, I);
+}
+
+/* Dual globals: derivatives with respect to u and v. */
+static inline void h_globals_dual(sl_vm *vm, h_surface s, double u, double v)
+{
+    double P[3], N[3], du[3], dv[3];
+    h_surface_float(s, u, v, P, N, du, dv);
+    sl_dual Pd[3], Nd[3], ud = { u, 1, 0 }, vd = { v, 0, 1 };
+    for (int i = 0; i < 3; i++) {
+        Pd[i].v = P[i]; Pd[i].du = du[i]; Pd[i].dv = dv[i];
+        Nd[i].v = N[i];
+        /* sphere: N = P; plane: constant */
+        Nd[i].du = s == H_SPHERE ? du[i] : 0;
+        Nd[i].dv = s == H_SPHERE ? dv[i] : 0;
+    }
+    sl_vm_clear_globals(vm);
+    sl_vm_set_dual(vm, SL_G_P, Pd);
+    sl_vm_set_dual(vm, SL_G_N, Nd);
+    sl_vm_set_dual(vm, SL_G_Ng, Nd);
+    sl_vm_set_dual(vm, SL_G_u, &ud);
+    sl_vm_set_dual(vm, SL_G_v, &vd);
+    sl_vm_set_dual(vm, SL_G_s, &ud);
+    sl_vm_set_dual(vm, SL_G_t, &vd);
+    sl_dual one[3] = { { 1, 0, 0 }, { 1, 0, 0 }, { 1, 0, 0 } };
+    sl_dual I[3] = { { 0, 0, 0 }, { 0, 0, 0 }, { 1, 0, 0 } };
+    sl_vm_set_dual(vm, SL_G_Cs, one);
+    sl_vm_set_dual(vm, SL_G_Os, one);
+    sl_vm_set_dual(vm, SL_G_I, I);
+}
+
+/* Affine globals over [u0,u1] x [v0,v1]: u and v are the first two noise
+ * symbols of ctx (reset here). */
+static inline void h_globals_affine(sl_vm *vm, aa_context *ctx, h_surface s, double u0,
+                                    double u1, double v0, double v1)
+{
+    aa_form U, V, P[3], N[3];
+    aa_context_reset(ctx);
+    aa_input(ctx, &U, u0, u1);
+    aa_input(ctx, &V, v0, v1);
+    if (s == H_PLANE) {
+        aa_lincomb(ctx, &P[0], 2, &U, 0, NULL, -1);
+        aa_lincomb(ctx, &P[1], 2, &V, 0, NULL, -1);
+        aa_const(&P[2], 0);
+        aa_const(&N[0], 0);
+        aa_const(&N[1], 0);
+        aa_const(&N[2], 1);
+    } else {
+        aa_form th, ph, ct, st, cp, sp;
+        aa_mul_s(ctx, &th, &U, 2 * M_PI);
+        aa_lincomb(ctx, &ph, M_PI, &V, 0, NULL, -M_PI / 2);
+        aa_cos(ctx, &ct, &th);
+        aa_sin(ctx, &st, &th);
+        aa_cos(ctx, &cp, &ph);
+        aa_sin(ctx, &sp, &ph);
+        aa_mul(ctx, &P[0], &ct, &cp);
+        aa_mul(ctx, &P[1], &st, &cp);
+        P[2] = sp;
+        N[0] = P[0];
+        N[1] = P[1];
+        N[2] = P[2];
+    }
+    aa_form one[3], I[3];
+    for (int i = 0; i < 3; i++) {
+        aa_const(&one[i], 1);
+        aa_const(&I[i], i == 2 ? 1 : 0);
+    }
+    sl_vm_clear_globals(vm);
+    sl_vm_set_affine(vm, SL_G_I, I);
+    sl_vm_set_affine(vm, SL_G_P, P);
+    sl_vm_set_affine(vm, SL_G_N, N);
+    sl_vm_set_affine(vm, SL_G_Ng, N);
+    sl_vm_set_affine(vm, SL_G_u, &U);
+    sl_vm_set_affine(vm, SL_G_v, &V);
+    sl_vm_set_affine(vm, SL_G_s, &U);
+    sl_vm_set_affine(vm, SL_G_t, &V);
+    sl_vm_set_affine(vm, SL_G_Cs, one);
+    sl_vm_set_affine(vm, SL_G_Os, one);
+}
+
+/* Interval globals over the box, from the same formulas in IA. */
+static inline void h_globals_interval(sl_vm *vm, h_surface s, double u0, double u1,
+                                      double v0, double v1)
+{
+    ia_interval U = ia_make(u0, u1), V = ia_make(v0, v1), P[3], N[3];
+    if (s == H_PLANE) {
+        P[0] = ia_add_s(ia_mul_s(U, 2), -1);
+        P[1] = ia_add_s(ia_mul_s(V, 2), -1);
+        P[2] = ia_point(0);
+        N[0] = ia_point(0);
+        N[1] = ia_point(0);
+        N[2] = ia_point(1);
+    } else {
+        ia_interval th = ia_mul_s(U, 2 * M_PI);
+        ia_interval ph = ia_add_s(ia_mul_s(V, M_PI), -M_PI / 2);
+        ia_interval cp = ia_cos(ph);
+        P[0] = ia_mul(ia_cos(th), cp);
+        P[1] = ia_mul(ia_sin(th), cp);
+        P[2] = ia_sin(ph);
+        N[0] = P[0];
+        N[1] = P[1];
+        N[2] = P[2];
+    }
+    ia_interval one[3] = { ia_point(1), ia_point(1), ia_point(1) };
+    ia_interval I[3] = { ia_point(0), ia_point(0), ia_point(1) };
+    sl_vm_clear_globals(vm);
+    sl_vm_set_interval(vm, SL_G_I, I);
+    sl_vm_set_interval(vm, SL_G_P, P);
+    sl_vm_set_interval(vm, SL_G_N, N);
+    sl_vm_set_interval(vm, SL_G_Ng, N);
+    sl_vm_set_interval(vm, SL_G_u, &U);
+    sl_vm_set_interval(vm, SL_G_v, &V);
+    sl_vm_set_interval(vm, SL_G_s, &U);
+    sl_vm_set_interval(vm, SL_G_t, &V);
+    sl_vm_set_interval(vm, SL_G_Cs, one);
+    sl_vm_set_interval(vm, SL_G_Os, one);
+}
+
+/* ---- small random numbers (xorshift64*), fixed seed ---- */
+static inline double h_rand(unsigned long long *state)
+{
+    unsigned long long x = *state;
+    x ^= x >> 12;
+    x ^= x << 25;
+    x ^= x >> 27;
+    *state = x;
+    return (double)((x * 0x2545F4914F6CDD1DULL) >> 11) * 0x1p-53;
+}
+
+#endif
