@@ -1,23 +1,20 @@
 #!/usr/bin/env bash
-# deploy/demo.sh BUILD_DIR: the demo behind `make demo`.
-# Today aafarm has its arithmetic foundation only: the renderer (issue 4)
-# and the farm (issue 5) are not built yet. The demo says so and shows what
-# exists: the affine vs interval bounds the renderer will build its boxes
-# from, measured on shader-like expressions (bench/aa_bench --quick).
+# deploy/demo.sh BUILD_DIR: the demo behind `make demo`: renders the paper's
+# wave scene (scenes/wave.rib, 512x256) through the farm with the embedded
+# default: aafarm-master starts local worker processes (one per core) on a
+# private ipc:// endpoint, ships them the job, stitches their EXR tiles and
+# stops them. Output: demo-out/wave.exr (tiled OpenEXR, RGBA + Z) and
+# demo-out/wave.png (sRGB preview). AAFARM_DEMO_OUT overrides the folder.
 set -euo pipefail
 build=${1:-build}
-if [ ! -x "$build/bin/aa_bench" ]; then
-  echo "demo: $build/bin/aa_bench not found; run 'make build' first" >&2
+out=${AAFARM_DEMO_OUT:-demo-out}
+master="$build/bin/aafarm-master"
+if [ ! -x "$master" ]; then
+  echo "demo: $master not found; run 'make build' first" >&2
   exit 1
 fi
-cat <<'MSG'
-aafarm demo
------------
-Not yet here: the renderer and the farm (master, workers) are still being
-built, so this demo cannot render a scene yet. What exists is the
-rounding-safe interval and affine arithmetic that bounds displaced surfaces
-(common/aa). Below: its speed, and how much tighter affine bounds are than
-interval bounds on displacement-shader-like expressions.
-
-MSG
-"$build/bin/aa_bench" --quick
+mkdir -p "$out"
+echo "aafarm demo: rendering scenes/wave.rib through the farm with local workers"
+"$master" scenes/wave.rib -o "$out/wave.exr" --preview "$out/wave.png"
+echo "demo: wrote $out/wave.exr and $out/wave.png"
+echo "demo: more scenes: scenes/{nail,ufo,gallery,surfaces}.rib; see README.md"

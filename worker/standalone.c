@@ -138,8 +138,11 @@ int worker_standalone(const standalone_options *opt)
     sl_diag_print(diag, stderr);
     sl_diag_destroy(&diag);
     if (!js) {
+        /* job_load checked the scene and compiled the shaders; what fails
+         * after it is a shader at run time (its budget): a render failure */
+        int rc = jb ? AAFARM_EXIT_FAILURE : AAFARM_EXIT_INPUT;
         job_destroy(&jb);
-        return AAFARM_EXIT_INPUT;
+        return rc;
     }
 
     shared s = {.opt = opt, .js = js};

@@ -1,0 +1,168 @@
+/*
+ * test_worker_cli.c: `aafarm-worker --standalone` as a user runs it (a real
+ * process): help, usage errors, a bad scene and a bad shader give exit 3
+ * with file:line:col diagnostics, a shader over its budget gives exit 1
+ * and leaves no output file, a good render leaves exactly OUT.exr (no
+ * temporary file) with the scene's size and channels.
+ *
+ * argv[1]: the aafarm-worker binary.
+ */
+#include <dirent.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+#include <cmocka.h>
+
+#include "image/buffer.h"
+
+static const char *worker;
+static char dir[256];
+
+static void write_file(const char *name, const char *text)
+{
+    char path[512];
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    FILE *f = fopen(path, "w");
+    assert_non_null(f);
+    fputs(text, f);
+    fclose(f);
+}
+
+/* runs the worker with args (a shell fragment), output in *out; returns the exit status */
+static int run(const char *args, char *out, size_t outsz)
+{
+    char cmd[2048];
+    snprintf(cmd, sizeof cmd, "cd %s && '%s' %s 2>&1", dir, worker, args);
+    FILE *p = popen(cmd, "r");
+    assert_non_null(p);
+    size_t n = fread(out, 1, outsz - 1, p);
+    out[n] = '\0';
+    int st = pclose(p);
+    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+static int count_files(const char *needle)
+{
+    DIR *d = opendir(dir);
+    int n = 0;
+    struct dirent *e;
+    while ((e = readdir(d)))
+        if (strstr(e->d_name, needle)) n++;
+    closedir(d);
+    return n;
+}
+
+static const char *SCENE_FMT =
+    "Format 24 16 1\nProjection \"perspective\" \"fov\" [40]\n"
+    "Option \"searchpath\" \"shader\" [\".\"]\n"
+    "WorldBegin\n"
+    "Displacement \"%s\"\n"
+    "Polygon \"P\" [-1 -1 5  1 -1 5  1 1 5  -1 1 5]\n"
+    "WorldEnd\n";
+
+static void scene_with(const char *name, const char *shader)
+{
+    char text[1024];
+    snprintf(text, sizeof text, SCENE_FMT, shader);
+    write_file(name, text);
+}
+
+static void test_help_and_usage(void **state)
+{
+    (void)state;
+    char out[8192];
+    assert_int_equal(run("--help", out, sizeof out), 0);
+    assert_non_null(strstr(out, "--standalone"));
+    assert_int_equal(run("--standalone x.rib", out, sizeof out), 2);
+    assert_non_null(strstr(out, "needs -o OUT.exr"));
+    assert_int_equal(run("--cache-bytes lots --standalone x.rib -o x.exr", out, sizeof out), 2);
+    assert_non_null(strstr(out, "--cache-bytes"));
+}
+
+static void test_bad_scene_and_bad_shader(void **state)
+{
+    (void)state;
+    char out[8192];
+    write_file("bad.rib", "Format 24 16 1\nProjection \"perspective\" \"fov\" [40]\nWorldBegin\nSphere 1 -1 1\nWorldEnd\n");
+    assert_int_equal(run("--standalone bad.rib -o bad.exr", out, sizeof out), 3);
+    assert_non_null(strstr(out, "bad.rib:4:"));
+    write_file("broken.sl", "displacement broken()\n{\n    P += 0.1 * ;\n}\n");
+    scene_with("uses_broken.rib", "broken");
+    assert_int_equal(run("--standalone uses_broken.rib -o b.exr", out, sizeof out), 3);
+    assert_non_null(strstr(out, "broken.sl:3:"));
+    scene_with("missing.rib", "nosuchshader");
+    assert_int_equal(run("--standalone missing.rib -o m.exr", out, sizeof out), 3);
+    assert_non_null(strstr(out, "shader 'nosuchshader' not found"));
+    assert_int_equal(count_files(".exr"), 0);
+}
+
+static void test_budget_exceeded_leaves_nothing(void **state)
+{
+    (void)state;
+    char out[8192];
+    write_file("spin.sl",
+               "displacement spin()\n{\n    float i = 0;\n    while (i < 1e9) i += 1;\n"
+               "    P += 0.01 * i * normalize(N);\n}\n");
+    scene_with("spin.rib", "spin");
+    assert_int_equal(run("--standalone spin.rib -o spin.exr --budget 5000 -q", out, sizeof out), 1);
+    assert_non_null(strstr(out, "spin"));
+    assert_non_null(strstr(out, "5000"));
+    assert_int_equal(count_files("spin.exr"), 0);
+}
+
+static void test_good_render_leaves_exactly_the_output(void **state)
+{
+    (void)state;
+    char out[8192];
+    write_file("flat.sl", "displacement flat(float h = 0.1)\n{\n    P += h * normalize(N);\n"
+                          "    N = calculatenormal(P);\n}\n");
+    scene_with("flat.rib", "flat");
+    assert_int_equal(run("--standalone flat.rib -o flat.exr --tile 7 --threads 2 "
+                         "--preview flat.png --stats-json flat.json -q", out, sizeof out), 0);
+    assert_int_equal(count_files(".tmp"), 0);
+    assert_int_equal(count_files("flat.png"), 1);
+    assert_int_equal(count_files("flat.json"), 1);
+    char path[512], err[256];
+    snprintf(path, sizeof path, "%s/flat.exr", dir);
+    image_buffer *b = image_buffer_read_exr(path, err, sizeof err);
+    assert_non_null(b);
+    assert_int_equal(b->width, 24);
+    assert_int_equal(b->height, 16);
+    float *z = image_buffer_channel(b, "Z");
+    float *a = image_buffer_channel(b, "A");
+    assert_non_null(z);
+    assert_non_null(a);
+    /* the centre pixel sees the displaced plane at depth 5.1 */
+    size_t c = (size_t)8 * 24 + 12;
+    assert_true(z[c] > 5.05f && z[c] < 5.15f);
+    assert_true(a[c] > 0.99f);
+    image_buffer_destroy(&b);
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 2) {
+        fprintf(stderr, "usage: test_worker_cli AAFARM_WORKER\n");
+        return 2;
+    }
+    worker = argv[1];
+    snprintf(dir, sizeof dir, "/tmp/aafarm-cli-XXXXXX");
+    if (!mkdtemp(dir)) return 2;
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_help_and_usage),
+        cmocka_unit_test(test_bad_scene_and_bad_shader),
+        cmocka_unit_test(test_budget_exceeded_leaves_nothing),
+        cmocka_unit_test(test_good_render_leaves_exactly_the_output),
+    };
+    int rc = cmocka_run_group_tests(tests, NULL, NULL);
+    char cmd[512];
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
+    if (system(cmd) != 0) fprintf(stderr, "could not remove %s\n", dir);
+    return rc;
+}
