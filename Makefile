@@ -34,6 +34,7 @@ test-sanitize: deps
 
 bench: build
 	@build/bin/aa_bench
+	@build/bin/render_bench
 
 clean:
 	rm -rf build build-test build-asan
