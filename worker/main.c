@@ -25,7 +25,9 @@ static void usage(FILE *out)
         "  --standalone SCENE.rib  render the whole image in this process (the\n"
         "                          reference a farm render equals pixel for pixel)\n"
         "  -o, --output OUT.exr    output file (tiled OpenEXR: RGBA half + Z float)\n"
-        "  --connect ENDPOINT      serve a master, e.g. tcp://render1:5555\n"
+        "  --connect ENDPOINT      serve a master, e.g. tcp://render1:5555; serves one\n"
+        "                          job after another, reconnects when the master goes\n"
+        "                          away (docs/farm.md)\n"
         "  --name NAME             worker name in the master's logs (default host:pid)\n"
         "  -t, --threads N         rendering threads (default: number of cores)\n"
         "  --tile S                tile size in pixels (standalone; default 32)\n"
@@ -36,11 +38,15 @@ static void usage(FILE *out)
         "  --preview OUT.png       also write an sRGB PNG preview\n"
         "  --stats                 print render statistics\n"
         "  --stats-json FILE       write render statistics as JSON\n"
+        "  --tile-delay MS          (--connect) sleep MS before each tile: a testing aid\n"
+        "                          that makes renders slow enough to interrupt\n"
         "  -q, --quiet             only errors;  -v, --verbose  more detail\n"
         "  -h, --help              this text\n"
         "\n"
         "Exit status: 0 done, 1 render failed, 2 usage, 3 bad scene or shader,\n"
-        "130 interrupted (no output file is left behind).\n");
+        "130 interrupted (no output file is left behind).\n"
+        "With --connect: 0 after the master's Shutdown, 2 bad endpoint or refused by\n"
+        "the master (protocol version mismatch), 130 after SIGINT/SIGTERM.\n");
 }
 
 /* "400K", "4M", "1G", "123" -> bytes; false on garbage */
@@ -75,7 +81,7 @@ int main(int argc, char **argv)
     job_options_default(&so.job);
     const char *connect = NULL;
     enum { O_STANDALONE = 256, O_CONNECT, O_NAME, O_TILE, O_CACHE, O_ARITH, O_BUDGET,
-           O_PREVIEW, O_STATS, O_STATS_JSON };
+           O_PREVIEW, O_STATS, O_STATS_JSON, O_TILE_DELAY };
     static const struct option longopts[] = {
         {"standalone", required_argument, 0, O_STANDALONE},
         {"output", required_argument, 0, 'o'},
@@ -89,6 +95,7 @@ int main(int argc, char **argv)
         {"preview", required_argument, 0, O_PREVIEW},
         {"stats", no_argument, 0, O_STATS},
         {"stats-json", required_argument, 0, O_STATS_JSON},
+        {"tile-delay", required_argument, 0, O_TILE_DELAY},
         {"quiet", no_argument, 0, 'q'},
         {"verbose", no_argument, 0, 'v'},
         {"help", no_argument, 0, 'h'},
@@ -138,6 +145,13 @@ int main(int argc, char **argv)
         case O_PREVIEW: so.preview = optarg; break;
         case O_STATS: so.stats = true; break;
         case O_STATS_JSON: so.stats_json = optarg; break;
+        case O_TILE_DELAY:
+            if (!parse_int(optarg, 0, 600000, &n)) {
+                fprintf(stderr, "aafarm-worker: --tile-delay wants milliseconds 0..600000, got '%s'\n", optarg);
+                return AAFARM_EXIT_USAGE;
+            }
+            wo.tile_delay_ms = (int)n;
+            break;
         case 'q': so.verbosity = wo.verbosity = -1; break;
         case 'v': so.verbosity = wo.verbosity = 1; break;
         case 'h': usage(stdout); return AAFARM_EXIT_OK;

@@ -1,16 +1,594 @@
 /*
- * worker_loop.c: the farm side of the worker. Not written yet (issue 5):
- * says so instead of pretending.
+ * worker_loop.c: the worker's connection loop, the state machine of
+ * docs/protocol.md ("The worker's state machine"), Paranoid Pirate style
+ * (ZeroMQ Guide, ch. 4):
+ *
+ *   CONNECTING  new DEALER, connect, Hello
+ *   READY       Welcome: Ask(credits = pipeline target - leases held)
+ *   WORKING     Grant -> task on the pool (or NeedJob and wait for the
+ *               Job); each finished tile -> Result + EXR, or Failure;
+ *               Ask again as threads free up; Heartbeat when quiet
+ *   BACKOFF     master silent for liveness x interval (or no Welcome):
+ *               close, drop leases, wait 1, 2, 4 ... 32 s, reconnect
+ *   FATAL       Reject VERSION_MISMATCH / REFUSED, or a Welcome of another
+ *               protocol version: print the reason, exit 2
+ *
+ * Only this thread touches the socket; render threads report through the
+ * pool's pipe, which sits in the same zmq_poll set.
  */
 #include "worker_loop.h"
 
+#include <errno.h>
+#include <signal.h>
+#include <stdarg.h>
+#include <stdint.h>
 #include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+#include <zmq.h>
 
 #include "util/exitcodes.h"
+#include "version.h"
+#include "wire.h"
+#include "worker_jobs.h"
+#include "worker_pool.h"
+
+enum { MAX_JOBS_HELD = 4, BACKOFF_FIRST_MS = 1000, BACKOFF_MAX_MS = 32000 };
+
+typedef enum session_end {
+    SESSION_LOST,          /* the master went silent: back off, reconnect */
+    SESSION_FATAL,         /* refused: exit */
+    SESSION_SHUTDOWN,      /* the master said so */
+    SESSION_INTERRUPTED    /* SIGINT / SIGTERM */
+} session_end;
+
+/* A grant whose job has not arrived yet. */
+typedef struct pending_grant {
+    uint64_t lease_id;
+    uint32_t tile_index;
+    image_rect rect;
+    char hash[HASH_HEX_SIZE];
+    struct pending_grant *next;
+} pending_grant;
+
+typedef struct worker_loop {
+    const worker_loop_options *opt;
+    char name[128], host[128];
+    int threads, target;           /* target: leases wanted (2 per thread) */
+    void *ctx, *dealer;
+    worker_pool *pool;
+    worker_jobs *jobs;
+    proto_limits limits;
+    wire_stats wstats;
+    /* the current session */
+    bool welcomed, ever_welcomed;
+    uint64_t master_session;
+    int heartbeat_ms, liveness;
+    int64_t last_heard_ms, last_sent_ms;
+    uint32_t asked;                /* credits the master still owes us */
+    pending_grant *pending;
+    worker_task *outbox;           /* finished tiles the socket could not take yet */
+    session_end end;
+    char fatal[600];
+    int64_t drop_logged_ms;
+    uint64_t tiles_sent, failures_sent;
+} worker_loop;
+
+static volatile sig_atomic_t interrupted;
+
+static void on_signal(int sig)
+{
+    (void)sig;
+    interrupted = 1;
+}
+
+static int64_t now_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (int64_t)ts.tv_sec * 1000 + ts.tv_nsec / 1000000;
+}
+
+static void wlog(const worker_loop *w, int level, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+
+static void wlog(const worker_loop *w, int level, const char *fmt, ...)
+{
+    if (level > w->opt->verbosity) return;
+    va_list ap;
+    va_start(ap, fmt);
+    fprintf(stderr, "aafarm-worker %s: ", w->name);
+    vfprintf(stderr, fmt, ap);
+    fputc('\n', stderr);
+    va_end(ap);
+}
+
+/* ---- sending ---- */
+
+static int send_env(worker_loop *w, Aafarm__Envelope *env, const void *bulk, size_t len)
+{
+    if (wire_send_limited(w->dealer, &w->limits, NULL, 0, env, bulk, len) != 0) return -1;
+    w->last_sent_ms = now_ms();
+    return 0;
+}
+
+static void send_hello(worker_loop *w)
+{
+    char *held[MAX_JOBS_HELD];
+    Aafarm__Hello h = AAFARM__HELLO__INIT;
+    h.protocol_version = AAFARM_PROTOCOL_VERSION;
+    h.worker_name = w->name;
+    h.host = w->host;
+    h.pid = (uint32_t)getpid();
+    h.threads = (uint32_t)w->threads;
+    h.n_jobs_held = worker_jobs_hashes(w->jobs, held, MAX_JOBS_HELD);
+    h.jobs_held = held;
+    h.software = "aafarm 0.1.0";
+    Aafarm__Envelope env = AAFARM__ENVELOPE__INIT;
+    env.body_case = AAFARM__ENVELOPE__BODY_HELLO;
+    env.hello = &h;
+    if (send_env(w, &env, NULL, 0) != 0)
+        wlog(w, -1, "cannot send Hello: %s", wire_last_error());
+}
+
+static void send_ask(worker_loop *w, uint32_t credits)
+{
+    Aafarm__Ask a = AAFARM__ASK__INIT;
+    a.credits = credits;
+    Aafarm__Envelope env = AAFARM__ENVELOPE__INIT;
+    env.body_case = AAFARM__ENVELOPE__BODY_ASK;
+    env.ask = &a;
+    if (send_env(w, &env, NULL, 0) == 0) w->asked += credits;
+}
+
+static void send_need_job(worker_loop *w, const char *hash, uint64_t lease)
+{
+    Aafarm__NeedJob n = AAFARM__NEED_JOB__INIT;
+    n.job_hash = (char *)hash;
+    n.lease_id = lease;
+    Aafarm__Envelope env = AAFARM__ENVELOPE__INIT;
+    env.body_case = AAFARM__ENVELOPE__BODY_NEED_JOB;
+    env.need_job = &n;
+    send_env(w, &env, NULL, 0);
+}
+
+static void send_failure(worker_loop *w, const char *hash, uint64_t lease, uint32_t tile,
+                         const char *message, bool retryable)
+{
+    Aafarm__Failure f = AAFARM__FAILURE__INIT;
+    f.job_hash = (char *)hash;
+    f.lease_id = lease;
+    f.tile_index = tile;
+    f.message = (char *)(message && *message ? message : "unknown error");
+    f.retryable = retryable;
+    Aafarm__Envelope env = AAFARM__ENVELOPE__INIT;
+    env.body_case = AAFARM__ENVELOPE__BODY_FAILURE;
+    env.failure = &f;
+    if (send_env(w, &env, NULL, 0) == 0) w->failures_sent++;
+    wlog(w, 0, "tile %u failed: %s", tile, f.message);
+}
+
+static void send_heartbeat(worker_loop *w)
+{
+    uint64_t leases[4096];
+    size_t n = worker_pool_leases(w->pool, leases, 4096);
+    for (pending_grant *p = w->pending; p && n < 4096; p = p->next) leases[n++] = p->lease_id;
+    Aafarm__Heartbeat hb = AAFARM__HEARTBEAT__INIT;
+    hb.n_leases = n;
+    hb.leases = leases;
+    Aafarm__Envelope env = AAFARM__ENVELOPE__INIT;
+    env.body_case = AAFARM__ENVELOPE__BODY_HEARTBEAT;
+    env.heartbeat = &hb;
+    send_env(w, &env, NULL, 0);
+}
+
+static void send_shutdown(worker_loop *w, const char *reason)
+{
+    Aafarm__Shutdown s = AAFARM__SHUTDOWN__INIT;
+    s.reason = (char *)reason;
+    Aafarm__Envelope env = AAFARM__ENVELOPE__INIT;
+    env.body_case = AAFARM__ENVELOPE__BODY_SHUTDOWN;
+    env.shutdown = &s;
+    send_env(w, &env, NULL, 0);
+}
+
+/* A finished task: Result + EXR, or Failure. False when the socket's queue
+ * is full (try again later). */
+static bool send_task(worker_loop *w, worker_task *t)
+{
+    if (!t->ok) {
+        send_failure(w, t->job->hash, t->lease_id, t->tile_index, t->error, true);
+        return true;
+    }
+    Aafarm__TileStats st = AAFARM__TILE_STATS__INIT;
+    st.rays = t->stats.rays;
+    st.boxes = t->stats.boxes;
+    st.shader_evals = t->stats.shader_evals;
+    st.cache_hits = t->stats.cache_hits;
+    st.cache_misses = t->stats.cache_misses;
+    st.cache_evictions = t->stats.cache_evictions;
+    st.peak_cache_bytes = t->stats.peak_cache_bytes;
+    st.cpu_seconds = t->stats.cpu_seconds;
+    st.wall_seconds = t->stats.wall_seconds;
+    Aafarm__Result r = AAFARM__RESULT__INIT;
+    r.job_hash = t->job->hash;
+    r.lease_id = t->lease_id;
+    r.tile_index = t->tile_index;
+    r.stats = &st;
+    r.exr_bytes = t->exr_len;
+    Aafarm__Envelope env = AAFARM__ENVELOPE__INIT;
+    env.body_case = AAFARM__ENVELOPE__BODY_RESULT;
+    env.result = &r;
+    if (send_env(w, &env, t->exr, t->exr_len) != 0) {
+        if (errno == EAGAIN) return false;
+        wlog(w, -1, "cannot send tile %u: %s", t->tile_index, wire_last_error());
+        return true;
+    }
+    w->tiles_sent++;
+    wlog(w, 1, "tile %u sent (lease %llu, %zu bytes, %.3f s)", t->tile_index,
+         (unsigned long long)t->lease_id, t->exr_len, t->stats.wall_seconds);
+    return true;
+}
+
+/* ---- leases ---- */
+
+static int pending_count(const worker_loop *w)
+{
+    int n = 0;
+    for (const pending_grant *p = w->pending; p; p = p->next) n++;
+    return n;
+}
+
+static void drop_pending(worker_loop *w, const char *hash)
+{
+    for (pending_grant **at = &w->pending; *at;) {
+        pending_grant *p = *at;
+        if (hash && strcmp(p->hash, hash) != 0) {
+            at = &p->next;
+            continue;
+        }
+        *at = p->next;
+        free(p);
+    }
+}
+
+static void free_outbox(worker_loop *w)
+{
+    while (w->outbox) {
+        worker_task *t = w->outbox;
+        w->outbox = t->next;
+        worker_task_destroy(&t);
+    }
+}
+
+/* Forgets every lease: the master that granted them is gone or has
+ * forgotten this connection. Running tiles finish and are dropped. */
+static void drop_all_leases(worker_loop *w)
+{
+    worker_pool_cancel(w->pool, NULL);
+    drop_pending(w, NULL);
+    free_outbox(w);
+    w->asked = 0;
+}
+
+/* Checks the grant's rectangle against the job's tile grid, then queues
+ * it on the pool. */
+static void start_tile(worker_loop *w, held_job *h, uint64_t lease, uint32_t tile,
+                       image_rect rect)
+{
+    if (h->broken) {
+        send_failure(w, h->hash, lease, tile, h->error, true);
+        return;
+    }
+    int tx, ty;
+    char err[300];
+    if (!image_format_tile_index(&h->fmt, rect, &tx, &ty, err, sizeof err) ||
+        (uint32_t)(ty * image_format_tiles_x(&h->fmt) + tx) != tile) {
+        char msg[400];
+        snprintf(msg, sizeof msg, "Grant for tile %u: the rectangle (%d,%d) %dx%d is not that "
+                 "tile of the job's image", tile, rect.x0, rect.y0, rect.w, rect.h);
+        send_failure(w, h->hash, lease, tile, msg, false);
+        return;
+    }
+    worker_pool_submit(w->pool, worker_task_new(lease, tile, rect, h));
+}
+
+/* ---- messages from the master ---- */
+
+static void on_welcome(worker_loop *w, const Aafarm__Welcome *m)
+{
+    char why[200];
+    if (proto_version_check(m->protocol_version, AAFARM_PROTOCOL_VERSION, why, sizeof why) != 0) {
+        snprintf(w->fatal, sizeof w->fatal, "the master at %s cannot serve this worker: %s",
+                 w->opt->endpoint, why);
+        w->end = SESSION_FATAL;
+        return;
+    }
+    drop_all_leases(w);   /* a new registration at the master: old leases are void */
+    if (w->master_session && w->master_session != m->master_session)
+        wlog(w, 0, "a new master at %s", w->opt->endpoint);
+    w->master_session = m->master_session;
+    w->heartbeat_ms = (int)m->heartbeat_ms;
+    w->liveness = (int)m->heartbeat_liveness;
+    w->welcomed = w->ever_welcomed = true;
+    wlog(w, 0, "connected to master %s at %s (heartbeat %d ms x %d)",
+         m->master_name && *m->master_name ? m->master_name : "?", w->opt->endpoint,
+         w->heartbeat_ms, w->liveness);
+}
+
+static void on_reject(worker_loop *w, const Aafarm__Reject *m)
+{
+    if (m->code == AAFARM__REJECT_CODE__REJECT_CODE_HELLO_FIRST) {
+        wlog(w, 0, "the master does not know this connection: saying Hello again");
+        drop_all_leases(w);
+        w->welcomed = false;
+        send_hello(w);
+        return;
+    }
+    snprintf(w->fatal, sizeof w->fatal, "the master at %s refused this worker: %s",
+             w->opt->endpoint, m->reason);
+    w->end = SESSION_FATAL;
+}
+
+static void on_job(worker_loop *w, const Aafarm__Job *m)
+{
+    held_job *h = worker_jobs_add(w->jobs, m);
+    if (h->broken) wlog(w, -1, "%s", h->error);
+    else wlog(w, 0, "job %.12s (%s, %dx%d) ready", h->hash, h->jb->scene_file, h->fmt.width,
+              h->fmt.height);
+    for (pending_grant **at = &w->pending; *at;) {
+        pending_grant *p = *at;
+        if (strcmp(p->hash, h->hash) != 0) {
+            at = &p->next;
+            continue;
+        }
+        *at = p->next;
+        start_tile(w, h, p->lease_id, p->tile_index, p->rect);
+        free(p);
+    }
+}
+
+static void on_grant(worker_loop *w, const Aafarm__Grant *g)
+{
+    if (w->asked) w->asked--;
+    image_rect rect = {(int)g->tile->x, (int)g->tile->y, (int)g->tile->width, (int)g->tile->height};
+    held_job *h = worker_jobs_find(w->jobs, g->job_hash);
+    if (h) {
+        start_tile(w, h, g->lease_id, g->tile_index, rect);
+        return;
+    }
+    bool asked_already = false;
+    for (pending_grant *p = w->pending; p; p = p->next)
+        if (strcmp(p->hash, g->job_hash) == 0) asked_already = true;
+    pending_grant *p = calloc(1, sizeof *p);
+    if (!p) abort();
+    *p = (pending_grant){g->lease_id, g->tile_index, rect, "", w->pending};
+    snprintf(p->hash, sizeof p->hash, "%s", g->job_hash);
+    w->pending = p;
+    if (!asked_already) send_need_job(w, g->job_hash, g->lease_id);
+}
+
+static void on_job_done(worker_loop *w, const Aafarm__JobDone *d)
+{
+    worker_pool_cancel(w->pool, d->job_hash);
+    drop_pending(w, d->job_hash);
+    const char *how = d->status == AAFARM__JOB_STATUS__JOB_STATUS_DONE     ? "done"
+                      : d->status == AAFARM__JOB_STATUS__JOB_STATUS_FAILED ? "failed"
+                                                                            : "cancelled";
+    wlog(w, 0, "job %.12s %s%s%s", d->job_hash, how, d->message && *d->message ? ": " : "",
+         d->message ? d->message : "");
+}
+
+static void handle(worker_loop *w, const wire_msg *m)
+{
+    const Aafarm__Envelope *env = wire_msg_envelope(m);
+    proto_kind kind = wire_msg_kind(m);
+    if (!w->welcomed && kind != AAFARM__ENVELOPE__BODY_WELCOME &&
+        kind != AAFARM__ENVELOPE__BODY_REJECT && kind != AAFARM__ENVELOPE__BODY_SHUTDOWN)
+        return;   /* from before our Hello was answered: ignore */
+    switch (kind) {
+    case AAFARM__ENVELOPE__BODY_WELCOME: on_welcome(w, env->welcome); break;
+    case AAFARM__ENVELOPE__BODY_REJECT: on_reject(w, env->reject); break;
+    case AAFARM__ENVELOPE__BODY_JOB: on_job(w, env->job); break;
+    case AAFARM__ENVELOPE__BODY_GRANT: on_grant(w, env->grant); break;
+    case AAFARM__ENVELOPE__BODY_JOB_DONE: on_job_done(w, env->job_done); break;
+    case AAFARM__ENVELOPE__BODY_SHUTDOWN:
+        wlog(w, 0, "the master says shut down%s%s",
+             env->shutdown->reason && *env->shutdown->reason ? ": " : "",
+             env->shutdown->reason ? env->shutdown->reason : "");
+        w->end = SESSION_SHUTDOWN;
+        break;
+    default: break;   /* Heartbeat: liveness only */
+    }
+}
+
+/* ---- one session ---- */
+
+static void read_master(worker_loop *w)
+{
+    for (int i = 0; i < 1000 && w->end == SESSION_LOST; i++) {
+        wire_msg *m = wire_recv(w->dealer, &w->limits, &w->wstats, ZMQ_DONTWAIT);
+        if (!m) {
+            if (errno != EPROTO) return;
+            int64_t now = now_ms();
+            if (now - w->drop_logged_ms >= 1000) {
+                wlog(w, 0, "%s (%llu dropped so far)", wire_last_error(),
+                     (unsigned long long)w->wstats.dropped);
+                w->drop_logged_ms = now;
+            }
+            w->last_heard_ms = now;   /* something came from the master's side */
+            continue;
+        }
+        w->last_heard_ms = now_ms();
+        handle(w, m);
+        wire_msg_destroy(&m);
+    }
+}
+
+/* Sends finished tiles (the outbox first, in order). */
+static void send_finished(worker_loop *w)
+{
+    worker_task *t;
+    while ((t = worker_pool_take_done(w->pool))) {
+        worker_task **tail = &w->outbox;
+        while (*tail) tail = &(*tail)->next;
+        *tail = t;
+    }
+    while ((t = w->outbox)) {
+        if (!t->cancelled && w->welcomed && !send_task(w, t)) return;   /* queue full */
+        w->outbox = t->next;
+        worker_task_destroy(&t);
+    }
+}
+
+static void ask_for_more(worker_loop *w)
+{
+    if (!w->welcomed) return;
+    int held = worker_pool_busy(w->pool) + pending_count(w);
+    long deficit = (long)w->target - held - (long)w->asked;
+    if (deficit > 0) send_ask(w, (uint32_t)deficit);
+}
+
+static bool open_socket(worker_loop *w)
+{
+    w->dealer = zmq_socket(w->ctx, ZMQ_DEALER);
+    if (!w->dealer || wire_socket_setup(w->dealer, &w->limits) != 0) {
+        snprintf(w->fatal, sizeof w->fatal, "cannot create a socket: %s", zmq_strerror(errno));
+        return false;
+    }
+    if (zmq_connect(w->dealer, w->opt->endpoint) != 0) {
+        snprintf(w->fatal, sizeof w->fatal, "cannot connect to '%s': %s", w->opt->endpoint,
+                 zmq_strerror(errno));
+        return false;
+    }
+    return true;
+}
+
+static void close_socket(worker_loop *w, int linger_ms)
+{
+    if (!w->dealer) return;
+    zmq_setsockopt(w->dealer, ZMQ_LINGER, &linger_ms, sizeof linger_ms);
+    zmq_close(w->dealer);
+    w->dealer = NULL;
+}
+
+static session_end session(worker_loop *w)
+{
+    w->end = SESSION_LOST;
+    w->welcomed = false;
+    w->heartbeat_ms = 1000;   /* until the first Welcome */
+    w->liveness = 3;
+    if (!open_socket(w)) {
+        close_socket(w, 0);
+        return SESSION_FATAL;
+    }
+    send_hello(w);
+    w->last_heard_ms = now_ms();
+    while (w->end == SESSION_LOST) {
+        zmq_pollitem_t items[2] = {{w->dealer, 0, ZMQ_POLLIN, 0},
+                                   {NULL, worker_pool_wake_fd(w->pool), ZMQ_POLLIN, 0}};
+        long timeout = w->heartbeat_ms / 2 < 100 ? w->heartbeat_ms / 2 : 100;
+        if (zmq_poll(items, 2, timeout) < 0 && errno != EINTR) break;
+        if (interrupted) {
+            send_shutdown(w, "the worker was stopped (SIGINT/SIGTERM)");
+            w->end = SESSION_INTERRUPTED;
+            break;
+        }
+        read_master(w);
+        send_finished(w);
+        ask_for_more(w);
+        int64_t now = now_ms();
+        if (now - w->last_heard_ms > (int64_t)w->heartbeat_ms * w->liveness) {
+            wlog(w, 0, "%s at %s: no answer for %.1f s", w->welcomed ? "master" : "no master",
+                 w->opt->endpoint, (double)(now - w->last_heard_ms) / 1000.0);
+            break;
+        }
+        if (w->welcomed && now - w->last_sent_ms >= w->heartbeat_ms) send_heartbeat(w);
+    }
+    drop_all_leases(w);
+    close_socket(w, w->end == SESSION_LOST ? 0 : 200);
+    return w->end;
+}
+
+/* Waits ms before reconnecting; finished tiles of dropped leases are
+ * freed meanwhile. False when interrupted. */
+static bool backoff_wait(worker_loop *w, int ms)
+{
+    for (int64_t until = now_ms() + ms; now_ms() < until;) {
+        zmq_pollitem_t item = {NULL, worker_pool_wake_fd(w->pool), ZMQ_POLLIN, 0};
+        zmq_poll(&item, 1, 100);
+        if (interrupted) return false;
+        send_finished(w);
+    }
+    return true;
+}
+
+static int serve(worker_loop *w)
+{
+    int backoff = BACKOFF_FIRST_MS;
+    for (;;) {
+        w->ever_welcomed = false;
+        session_end end = session(w);
+        switch (end) {
+        case SESSION_FATAL:
+            wlog(w, -1, "%s", w->fatal);
+            return AAFARM_EXIT_USAGE;
+        case SESSION_SHUTDOWN: return AAFARM_EXIT_OK;
+        case SESSION_INTERRUPTED:
+            wlog(w, 0, "stopped (%llu tiles sent)", (unsigned long long)w->tiles_sent);
+            return AAFARM_EXIT_INTERRUPTED;
+        default: break;
+        }
+        if (w->ever_welcomed) backoff = BACKOFF_FIRST_MS;
+        wlog(w, 0, "reconnecting in %d s", backoff / 1000);
+        if (!backoff_wait(w, backoff)) return AAFARM_EXIT_INTERRUPTED;
+        backoff = backoff * 2 > BACKOFF_MAX_MS ? BACKOFF_MAX_MS : backoff * 2;
+    }
+}
+
+static int default_threads(void)
+{
+    long n = sysconf(_SC_NPROCESSORS_ONLN);
+    return n > 0 ? (int)n : 1;
+}
 
 int worker_loop_run(const worker_loop_options *opt)
 {
-    fprintf(stderr, "aafarm-worker: --connect %s: the farm mode is not built yet "
-            "(use --standalone)\n", opt->endpoint);
-    return AAFARM_EXIT_USAGE;
+    worker_loop w;
+    memset(&w, 0, sizeof w);
+    w.opt = opt;
+    w.limits = proto_limits_default();
+    w.threads = opt->threads > 0 ? opt->threads : default_threads();
+    w.target = 2 * w.threads;
+    if (gethostname(w.host, 100) != 0 || !w.host[0]) snprintf(w.host, sizeof w.host, "localhost");
+    w.host[100] = '\0';
+    if (opt->name) snprintf(w.name, sizeof w.name, "%s", opt->name);
+    else snprintf(w.name, sizeof w.name, "%.100s:%d", w.host, (int)getpid());
+
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_signal;   /* no SA_RESTART: zmq_poll returns EINTR */
+    sigaction(SIGINT, &sa, NULL);
+    sigaction(SIGTERM, &sa, NULL);
+    signal(SIGPIPE, SIG_IGN);
+
+    w.ctx = zmq_ctx_new();
+    w.pool = worker_pool_new(w.threads, opt->tile_delay_ms);
+    w.jobs = worker_jobs_new(MAX_JOBS_HELD, opt->cache_bytes);
+    int rc = AAFARM_EXIT_FAILURE;
+    if (!w.ctx || !w.pool) {
+        wlog(&w, -1, "cannot start: %s", strerror(errno));
+    } else {
+        wlog(&w, 1, "%d render thread%s, serving %s", w.threads, w.threads == 1 ? "" : "s",
+             opt->endpoint);
+        rc = serve(&w);
+    }
+    worker_pool_destroy(&w.pool);   /* before the jobs: threads hold references */
+    free_outbox(&w);
+    drop_pending(&w, NULL);
+    worker_jobs_destroy(&w.jobs);
+    if (w.ctx) zmq_ctx_term(w.ctx);
+    return rc;
 }

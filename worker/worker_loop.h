@@ -1,6 +1,12 @@
 /*
  * worker_loop.h: `aafarm-worker --connect`: the farm side of a worker
- * (docs/protocol.md has the state machine).
+ * (docs/protocol.md, "The worker's state machine"; docs/farm.md).
+ *
+ * Long-lived: connects a DEALER to the master, says Hello, asks for
+ * tiles, renders them on a pool of threads (worker_pool.h) with the jobs
+ * it holds compiled (worker_jobs.h), sends the tiles back as EXR, and
+ * heartbeats meanwhile. When the master goes silent it reconnects with
+ * exponential backoff (1 s, 2 s, ... 32 s) and serves the next master.
  */
 #ifndef WORKER_LOOP_H
 #define WORKER_LOOP_H
@@ -8,13 +14,19 @@
 #include <stddef.h>
 
 typedef struct worker_loop_options {
-    const char *endpoint;
-    const char *name;
-    int threads;
-    size_t cache_bytes;
-    int verbosity;
+    const char *endpoint;          /* e.g. tcp://render1:5555 */
+    const char *name;              /* NULL: host:pid */
+    int threads;                   /* 0: number of cores */
+    size_t cache_bytes;            /* box cache per thread; 0: the job's (unlimited) */
+    int verbosity;                 /* -1 quiet, 0 normal, 1 verbose */
+    int tile_delay_ms;             /* testing aid: sleep before each tile */
 } worker_loop_options;
 
+/* Serves masters until told to stop. Returns an AAFARM_EXIT_* code:
+ * OK after Shutdown from the master, USAGE for a bad endpoint or a master
+ * that refuses this worker (protocol version mismatch: the reason is
+ * printed), INTERRUPTED after SIGINT/SIGTERM (a Shutdown is sent first),
+ * FAILURE when the sockets or threads cannot be set up. */
 int worker_loop_run(const worker_loop_options *opt);
 
 #endif

@@ -1,0 +1,107 @@
+/*
+ * console.c: the master's log lines and progress display (see console.h).
+ */
+#include "console.h"
+
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+struct console {
+    int verbosity;
+    bool tty;
+    char line[200];        /* the progress line shown on the terminal */
+    bool shown;            /* line is on screen now */
+    int64_t last_ms;       /* last redraw or progress log */
+    int last_tenth;        /* last tenth of the image logged */
+};
+
+console *console_new(int verbosity, bool tty)
+{
+    console *self = calloc(1, sizeof *self);
+    if (!self) abort();
+    self->verbosity = verbosity;
+    self->tty = tty;
+    self->last_ms = INT64_MIN / 2;
+    return self;
+}
+
+void console_destroy(console **self_p)
+{
+    console *self = *self_p;
+    if (!self) return;
+    if (self->shown) fputc('\n', stderr);
+    free(self);
+    *self_p = NULL;
+}
+
+static void clear_line(console *self)
+{
+    if (!self->shown) return;
+    fputs("\r\033[K", stderr);
+    self->shown = false;
+}
+
+static void draw_line(console *self)
+{
+    if (!self->line[0]) return;
+    fprintf(stderr, "\r%s\033[K", self->line);
+    fflush(stderr);
+    self->shown = true;
+}
+
+void console_log(console *self, console_level level, const char *fmt, ...)
+{
+    if ((int)level > self->verbosity) return;
+    clear_line(self);
+    va_list ap;
+    va_start(ap, fmt);
+    fputs("aafarm-master: ", stderr);
+    vfprintf(stderr, fmt, ap);
+    fputc('\n', stderr);
+    va_end(ap);
+    if (self->tty && self->line[0]) draw_line(self);
+    fflush(stderr);
+}
+
+static void format_progress(char *buf, size_t n, int done, int total, int workers,
+                            double secs)
+{
+    double rate = secs > 0 ? done / secs : 0;
+    char eta[32] = "-";
+    if (rate > 0 && done < total) snprintf(eta, sizeof eta, "%.0f s", (total - done) / rate);
+    else if (done == total) snprintf(eta, sizeof eta, "0 s");
+    snprintf(buf, n, "%d/%d tiles (%d%%), %.1f tiles/s, ETA %s, %d worker%s alive",
+             done, total, total ? (int)(100.0 * done / total) : 100, rate, eta, workers,
+             workers == 1 ? "" : "s");
+}
+
+void console_progress(console *self, int done, int total, int workers, int64_t start_ms,
+                      int64_t now_ms, bool final)
+{
+    if (self->verbosity < 0) return;
+    double secs = (double)(now_ms - start_ms) / 1000.0;
+    if (self->tty) {
+        if (!final && now_ms - self->last_ms < 100) return;
+        self->last_ms = now_ms;
+        char body[160];
+        format_progress(body, sizeof body, done, total, workers, secs);
+        snprintf(self->line, sizeof self->line, "  %s", body);
+        draw_line(self);
+        if (final) {
+            fputc('\n', stderr);
+            self->shown = false;
+            self->line[0] = '\0';
+        }
+        return;
+    }
+    int tenth = total ? done * 10 / total : 10;
+    if (!final && (tenth <= self->last_tenth || now_ms - self->last_ms < 2000)) return;
+    self->last_tenth = tenth;
+    self->last_ms = now_ms;
+    char body[160];
+    format_progress(body, sizeof body, done, total, workers, secs);
+    fprintf(stderr, "aafarm-master: %s\n", body);
+    fflush(stderr);
+}

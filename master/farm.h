@@ -1,0 +1,48 @@
+/*
+ * farm.h: one render on the farm, from a loaded job to the stitched EXR
+ * (the master of docs/protocol.md and docs/farm.md).
+ *
+ * farm_run() binds the ROUTER, optionally starts local worker processes,
+ * and runs the master's single-threaded loop: zmq_poll on the socket with
+ * a short timeout, then the timers (heartbeats, dead workers, lease
+ * deadlines, local children, progress), then grants. Tiles that come back
+ * are validated and their compressed chunks copied into the output file
+ * (image_writer); the file is renamed into place only when complete.
+ */
+#ifndef MASTER_FARM_H
+#define MASTER_FARM_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "image/format.h"
+#include "job/job.h"
+
+typedef struct farm_options {
+    const char *scene_path;
+    const char *output;            /* OUT.exr */
+    const char *preview;           /* OUT.png or NULL */
+    const char *stats_json;        /* FILE or NULL */
+    const char *bind;              /* endpoint; NULL: embedded (private ipc://) */
+    int local_workers;             /* processes to start (embedded default: cores) */
+    int threads_per_worker;        /* --threads of each local worker (1) */
+    const char *worker_binary;     /* NULL: aafarm-worker next to this program */
+    int heartbeat_ms;              /* Welcome.heartbeat_ms (1000) */
+    int liveness;                  /* Welcome.heartbeat_liveness (3) */
+    int max_attempts;              /* failures of one tile that fail the job (3) */
+    int max_duplicates;            /* end-game duplicate leases per tile (1) */
+    int64_t lease_ms;              /* Grant.deadline_ms (120000) */
+    int verbosity;                 /* -1 quiet, 0 normal, 1 verbose */
+} farm_options;
+
+void farm_options_default(farm_options *opt);
+
+/* Renders `jb` (loaded and checked by job_load) into opt->output with the
+ * image format `fmt`. Returns an AAFARM_EXIT_* code (util/exitcodes.h):
+ * OK, FAILURE (a tile failed too often, no workers left, output not
+ * writable), USAGE (an endpoint ZeroMQ cannot bind), INTERRUPTED
+ * (SIGINT/SIGTERM: nothing written). */
+int farm_run(const farm_options *opt, const job *jb, const image_format *fmt);
+
+#endif

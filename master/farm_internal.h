@@ -1,0 +1,78 @@
+/*
+ * farm_internal.h: the state of one farm render, shared by the files of
+ * the master's loop (not a public interface):
+ *
+ *   farm.c           set-up, the poll loop, timers, the end of the job
+ *   farm_messages.c  what each message from a worker does; sending
+ *   report.c         the summary per worker and the statistics file
+ */
+#ifndef MASTER_FARM_INTERNAL_H
+#define MASTER_FARM_INTERNAL_H
+
+#include <limits.h>
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "console.h"
+#include "farm.h"
+#include "image/writer.h"
+#include "job_message.h"
+#include "local_workers.h"
+#include "registry.h"
+#include "scheduler.h"
+#include "wire.h"
+
+typedef enum farm_state {
+    FARM_RUNNING,
+    FARM_DONE,           /* every tile is in */
+    FARM_FAILED,         /* a tile failed too often, or no workers are left */
+    FARM_INTERRUPTED     /* SIGINT / SIGTERM */
+} farm_state;
+
+typedef struct farm {
+    const farm_options *opt;
+    const job *jb;
+    image_format fmt;
+    int tiles_x, ntiles;
+    void *ctx, *router;
+    wire_monitor *monitor;
+    wire_stats wstats;
+    proto_limits limits;
+    char endpoint[PATH_MAX + 64];  /* what the local workers connect to */
+    char ipc_dir[PATH_MAX];        /* embedded mode's private folder, or "" */
+    scheduler *sched;
+    registry *reg;
+    image_writer *writer;
+    local_workers *locals;
+    console *con;
+    job_message *jobmsg;
+    size_t job_bytes;              /* packed size of the Job envelope */
+    uint64_t session;              /* Welcome.master_session */
+    char host[128];
+    int64_t start_ms, end_ms;
+    farm_state state;
+    char failure[1200];
+    /* counters beyond the scheduler's and the socket's */
+    uint64_t invalid_tiles, rejects_sent, version_mismatches, jobs_sent;
+    uint64_t grant_bytes, result_bytes, sent_bytes;
+    uint64_t drops_unlogged;       /* malformed messages not logged yet */
+    int64_t drop_logged_ms;
+} farm;
+
+int64_t farm_now_ms(void);
+
+/* farm_messages.c */
+void farm_handle(farm *f, wire_msg *m, int64_t now);
+void farm_grant_all(farm *f, int64_t now);
+void farm_send_heartbeat(farm *f, farm_worker *w, int64_t now);
+void farm_send_job_done(farm *f, farm_worker *w, int64_t now);
+void farm_send_shutdown(farm *f, farm_worker *w, const char *reason, int64_t now);
+/* Retires the worker and requeues its tiles (logged at INFO). */
+void farm_lose_worker(farm *f, farm_worker *w, const char *why, int64_t now);
+void farm_fail(farm *f, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+
+/* report.c */
+void farm_report_summary(const farm *f);
+bool farm_report_json(const farm *f, const char *path, char *err, size_t errsz);
+
+#endif

@@ -1,0 +1,400 @@
+/*
+ * farm_messages.c: the master's side of each message (docs/protocol.md,
+ * "The master's state machine"), and the messages it sends.
+ *
+ *   Hello      version check (Reject VERSION_MISMATCH), register, Welcome
+ *   Ask        credits += n; granting happens in farm_grant_all()
+ *   Result     stale (unknown lease, other job) / duplicate (tile DONE) /
+ *              taken: the EXR is validated and its chunk copied into the
+ *              output; an invalid EXR counts as a retryable failure
+ *   Failure    retried elsewhere up to max_attempts, then the job fails
+ *   NeedJob    the Job again
+ *   Heartbeat  liveness only (any message counts)
+ *   Shutdown   the worker leaves: its tiles go back to the queue
+ * Anything but Hello from a peer the master does not know gets Reject
+ * HELLO_FIRST, at most once per heartbeat interval per peer.
+ */
+#include <errno.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "farm_internal.h"
+#include "version.h"
+
+/* ---- sending ---- */
+
+static int send_to(farm *f, const uint8_t *id, size_t id_len, Aafarm__Envelope *env)
+{
+    if (wire_send_limited(f->router, &f->limits, id, id_len, env, NULL, 0) != 0) return -1;
+    return 0;
+}
+
+/* Sends to a registered worker; a worker that cannot be reached any more
+ * (connection gone, or its queue full because it stopped reading) is
+ * lost. */
+static int send_env(farm *f, farm_worker *w, Aafarm__Envelope *env, int64_t now)
+{
+    size_t n = aafarm__envelope__get_packed_size(env);
+    if (send_to(f, w->id, w->id_len, env) != 0) {
+        int e = errno;
+        const char *what = proto_message_name(env->body_case);
+        if (e == EHOSTUNREACH) {
+            farm_lose_worker(f, w, "disconnected", now);
+        } else if (e == EAGAIN) {
+            farm_lose_worker(f, w, "stopped reading its messages", now);
+        } else {
+            console_log(f->con, CONSOLE_ERROR, "cannot send %s to worker %s: %s", what,
+                        w->name, wire_last_error());
+        }
+        return -1;
+    }
+    w->last_sent_ms = now;
+    w->bytes_out += n;
+    f->sent_bytes += n;
+    return (int)n;
+}
+
+static void send_reject(farm *f, const uint8_t *id, size_t id_len, Aafarm__RejectCode code,
+                        const char *reason)
+{
+    Aafarm__Reject r = AAFARM__REJECT__INIT;
+    r.code = code;
+    r.reason = (char *)reason;
+    r.protocol_version = AAFARM_PROTOCOL_VERSION;
+    Aafarm__Envelope env = AAFARM__ENVELOPE__INIT;
+    env.body_case = AAFARM__ENVELOPE__BODY_REJECT;
+    env.reject = &r;
+    if (send_to(f, id, id_len, &env) == 0) f->rejects_sent++;
+}
+
+static void send_welcome(farm *f, farm_worker *w, int64_t now)
+{
+    Aafarm__Welcome wel = AAFARM__WELCOME__INIT;
+    wel.protocol_version = AAFARM_PROTOCOL_VERSION;
+    wel.master_name = f->host;
+    wel.master_session = f->session;
+    wel.heartbeat_ms = (uint32_t)f->opt->heartbeat_ms;
+    wel.heartbeat_liveness = (uint32_t)f->opt->liveness;
+    Aafarm__Envelope env = AAFARM__ENVELOPE__INIT;
+    env.body_case = AAFARM__ENVELOPE__BODY_WELCOME;
+    env.welcome = &wel;
+    send_env(f, w, &env, now);
+}
+
+static int send_job(farm *f, farm_worker *w, int64_t now)
+{
+    Aafarm__Envelope env = AAFARM__ENVELOPE__INIT;
+    env.body_case = AAFARM__ENVELOPE__BODY_JOB;
+    env.job = job_message_job(f->jobmsg);
+    int n = send_env(f, w, &env, now);
+    if (n < 0) return -1;
+    w->has_job = true;
+    w->job_bytes += (uint64_t)n;
+    f->jobs_sent++;
+    console_log(f->con, CONSOLE_DETAIL, "sent the job (%d bytes) to %s", n, w->name);
+    return 0;
+}
+
+static int send_grant(farm *f, farm_worker *w, const scheduler_lease *l, int64_t now)
+{
+    image_rect r = image_format_tile_rect(&f->fmt, l->tile % f->tiles_x, l->tile / f->tiles_x);
+    Aafarm__Rect rect = AAFARM__RECT__INIT;
+    rect.x = (uint32_t)r.x0;
+    rect.y = (uint32_t)r.y0;
+    rect.width = (uint32_t)r.w;
+    rect.height = (uint32_t)r.h;
+    Aafarm__Grant g = AAFARM__GRANT__INIT;
+    g.job_hash = (char *)f->jb->hash;
+    g.lease_id = l->id;
+    g.tile_index = (uint32_t)l->tile;
+    g.tile = &rect;
+    g.deadline_ms = (uint32_t)f->opt->lease_ms;
+    Aafarm__Envelope env = AAFARM__ENVELOPE__INIT;
+    env.body_case = AAFARM__ENVELOPE__BODY_GRANT;
+    env.grant = &g;
+    int n = send_env(f, w, &env, now);
+    if (n < 0) return -1;
+    f->grant_bytes += (uint64_t)n;
+    console_log(f->con, CONSOLE_DETAIL, "granted tile %d to %s (lease %llu%s)", l->tile, w->name,
+                (unsigned long long)l->id, l->duplicate ? ", duplicate" : "");
+    return 0;
+}
+
+void farm_send_heartbeat(farm *f, farm_worker *w, int64_t now)
+{
+    Aafarm__Heartbeat hb = AAFARM__HEARTBEAT__INIT;
+    Aafarm__Envelope env = AAFARM__ENVELOPE__INIT;
+    env.body_case = AAFARM__ENVELOPE__BODY_HEARTBEAT;
+    env.heartbeat = &hb;
+    send_env(f, w, &env, now);
+}
+
+void farm_send_job_done(farm *f, farm_worker *w, int64_t now)
+{
+    Aafarm__JobDone d = AAFARM__JOB_DONE__INIT;
+    d.job_hash = (char *)f->jb->hash;
+    d.status = f->state == FARM_DONE     ? AAFARM__JOB_STATUS__JOB_STATUS_DONE
+               : f->state == FARM_FAILED ? AAFARM__JOB_STATUS__JOB_STATUS_FAILED
+                                         : AAFARM__JOB_STATUS__JOB_STATUS_CANCELLED;
+    d.message = f->state == FARM_DONE ? "" : f->state == FARM_FAILED ? f->failure : "interrupted";
+    Aafarm__Envelope env = AAFARM__ENVELOPE__INIT;
+    env.body_case = AAFARM__ENVELOPE__BODY_JOB_DONE;
+    env.job_done = &d;
+    send_env(f, w, &env, now);
+}
+
+void farm_send_shutdown(farm *f, farm_worker *w, const char *reason, int64_t now)
+{
+    Aafarm__Shutdown s = AAFARM__SHUTDOWN__INIT;
+    s.reason = (char *)reason;
+    Aafarm__Envelope env = AAFARM__ENVELOPE__INIT;
+    env.body_case = AAFARM__ENVELOPE__BODY_SHUTDOWN;
+    env.shutdown = &s;
+    send_env(f, w, &env, now);
+}
+
+/* ---- bookkeeping ---- */
+
+void farm_fail(farm *f, const char *fmt, ...)
+{
+    if (f->state != FARM_RUNNING) return;
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(f->failure, sizeof f->failure, fmt, ap);
+    va_end(ap);
+    f->state = FARM_FAILED;
+}
+
+void farm_lose_worker(farm *f, farm_worker *w, const char *why, int64_t now)
+{
+    if (!w->alive) return;
+    int requeued = scheduler_worker_remove(f->sched, w->slot);
+    registry_retire(f->reg, w, why, now);
+    console_log(f->con, CONSOLE_INFO, "worker %s %s; %d tile%s back in the queue", w->name, why,
+                requeued, requeued == 1 ? "" : "s");
+}
+
+static bool holds_job(const Aafarm__Hello *h, const char *hash)
+{
+    for (size_t i = 0; i < h->n_jobs_held; i++)
+        if (strcmp(h->jobs_held[i], hash) == 0) return true;
+    return false;
+}
+
+static void copy_name(char *dst, size_t n, const char *src)
+{
+    snprintf(dst, n, "%s", src && *src ? src : "?");
+}
+
+/* ---- incoming messages ---- */
+
+static void on_hello(farm *f, const Aafarm__Hello *h, const uint8_t *id, size_t id_len,
+                     int64_t now)
+{
+    char why[200], hex[24];
+    if (proto_version_check(AAFARM_PROTOCOL_VERSION, h->protocol_version, why, sizeof why) != 0) {
+        f->version_mismatches++;
+        console_log(f->con, CONSOLE_INFO, "refused worker %s on %s (peer %s): %s",
+                    h->worker_name && *h->worker_name ? h->worker_name : "?",
+                    h->host && *h->host ? h->host : "?", registry_id_hex(id, id_len, hex, sizeof hex),
+                    why);
+        send_reject(f, id, id_len, AAFARM__REJECT_CODE__REJECT_CODE_VERSION_MISMATCH, why);
+        return;
+    }
+    farm_worker *w = registry_find(f->reg, id, id_len);
+    if (w) farm_lose_worker(f, w, "said Hello again", now);
+    w = registry_add(f->reg, id, id_len, now);
+    if (!w) return;
+    copy_name(w->name, sizeof w->name, h->worker_name);
+    copy_name(w->host, sizeof w->host, h->host);
+    w->pid = h->pid;
+    w->threads = h->threads ? h->threads : 1;
+    w->slot = scheduler_worker_add(f->sched);
+    w->has_job = holds_job(h, f->jb->hash);
+    w->local = f->locals && strcmp(w->host, f->host) == 0 &&
+               local_workers_has_pid(f->locals, (pid_t)w->pid);
+    console_log(f->con, CONSOLE_INFO, "worker %s joined (%s, pid %u, %u thread%s%s)", w->name,
+                w->host, w->pid, w->threads, w->threads == 1 ? "" : "s",
+                w->has_job ? ", holds the job" : "");
+    send_welcome(f, w, now);
+}
+
+static void on_ask(farm *f, farm_worker *w, const Aafarm__Ask *a)
+{
+    (void)f;
+    /* a worker asks for about two tiles per thread; more is a broken peer */
+    uint64_t cap = 4u * (uint64_t)w->threads + 8u;
+    uint64_t c = (uint64_t)w->credits + a->credits;
+    w->credits = (uint32_t)(c > cap ? cap : c);
+}
+
+static void tile_failed(farm *f, farm_worker *w, uint64_t lease, int tile, const char *text,
+                        bool retryable)
+{
+    char msg[1200];   /* the message without trailing line breaks, for one log line */
+    snprintf(msg, sizeof msg, "%s", text);
+    for (size_t n = strlen(msg); n > 0 && (msg[n - 1] == '\n' || msg[n - 1] == ' ');)
+        msg[--n] = '\0';
+    scheduler_failure r = scheduler_fail(f->sched, w->slot, lease, retryable);
+    if (r == SCHEDULER_FAIL_IGNORED) return;
+    w->failures++;
+    image_rect rect = image_format_tile_rect(&f->fmt, tile % f->tiles_x, tile / f->tiles_x);
+    int attempts = scheduler_tile_attempts(f->sched, tile);
+    if (r == SCHEDULER_RETRY) {
+        console_log(f->con, CONSOLE_INFO,
+                    "tile %d at (%d,%d) failed on %s (attempt %d of %d): %s; trying again",
+                    tile, rect.x0, rect.y0, w->name, attempts, f->opt->max_attempts, msg);
+        return;
+    }
+    farm_fail(f, "tile %d at (%d,%d) failed on worker %s (%s): %s", tile, rect.x0, rect.y0,
+              w->name, retryable ? "attempts exhausted" : "not retryable", msg);
+}
+
+static void add_stats(farm_worker *w, const Aafarm__TileStats *s)
+{
+    if (!s) return;
+    w->rays += s->rays;
+    w->boxes += s->boxes;
+    w->shader_evals += s->shader_evals;
+    w->cache_hits += s->cache_hits;
+    w->cache_misses += s->cache_misses;
+    w->cache_evictions += s->cache_evictions;
+    if (s->peak_cache_bytes > w->peak_cache_bytes) w->peak_cache_bytes = s->peak_cache_bytes;
+    w->render_seconds += s->wall_seconds;
+    w->cpu_seconds += s->cpu_seconds;
+}
+
+static void on_result(farm *f, farm_worker *w, const Aafarm__Result *r, const wire_msg *m,
+                      int64_t now)
+{
+    size_t len = 0;
+    const uint8_t *bulk = wire_msg_bulk(m, &len);
+    w->bytes_in += len;
+    f->result_bytes += len;
+    bool ours = strcmp(r->job_hash, f->jb->hash) == 0;
+    scheduler_verdict v = ours ? scheduler_check_result(f->sched, w->slot, r->lease_id)
+                               : SCHEDULER_STALE;
+    if (v != SCHEDULER_TAKEN) {
+        scheduler_complete(f->sched, w->slot, ours ? r->lease_id : 0, now);   /* counts it */
+        if (v == SCHEDULER_DUPLICATE) w->duplicates++;
+        console_log(f->con, CONSOLE_DETAIL, "%s result from %s (lease %llu) dropped",
+                    v == SCHEDULER_DUPLICATE ? "duplicate" : "stale", w->name,
+                    (unsigned long long)r->lease_id);
+        return;
+    }
+    int tile = scheduler_lease_find(f->sched, w->slot, r->lease_id)->tile;
+    char err[600];
+    if (r->tile_index != (uint32_t)tile) {
+        snprintf(err, sizeof err, "its result names tile %u, the lease was for tile %d",
+                 r->tile_index, tile);
+    } else {
+        image_rect rect = image_format_tile_rect(&f->fmt, tile % f->tiles_x, tile / f->tiles_x);
+        if (image_writer_put_exr_chunk(f->writer, bulk, len, rect, err, sizeof err)) {
+            scheduler_complete(f->sched, w->slot, r->lease_id, now);
+            w->tiles++;
+            add_stats(w, r->stats);
+            console_log(f->con, CONSOLE_DETAIL, "took tile %d from %s (lease %llu, %zu bytes)", tile,
+                        w->name, (unsigned long long)r->lease_id, len);
+            return;
+        }
+    }
+    f->invalid_tiles++;
+    w->invalid_tiles++;
+    char msg[700];
+    snprintf(msg, sizeof msg, "invalid tile from the worker: %s", err);
+    tile_failed(f, w, r->lease_id, tile, msg, true);
+}
+
+static void on_failure(farm *f, farm_worker *w, const Aafarm__Failure *x)
+{
+    if (strcmp(x->job_hash, f->jb->hash) != 0) return;
+    const scheduler_lease *l = scheduler_lease_find(f->sched, w->slot, x->lease_id);
+    if (!l) {
+        console_log(f->con, CONSOLE_DETAIL, "stale failure from %s (lease %llu) dropped",
+                    w->name, (unsigned long long)x->lease_id);
+        return;
+    }
+    tile_failed(f, w, x->lease_id, l->tile, x->message, x->retryable);
+}
+
+static void on_need_job(farm *f, farm_worker *w, const Aafarm__NeedJob *n, int64_t now)
+{
+    if (strcmp(n->job_hash, f->jb->hash) != 0) {
+        console_log(f->con, CONSOLE_DETAIL, "%s asked for job %.12s..., not this master's",
+                    w->name, n->job_hash);
+        return;
+    }
+    send_job(f, w, now);
+}
+
+static void on_unknown_peer(farm *f, proto_kind kind, const uint8_t *id, size_t id_len,
+                            int64_t now)
+{
+    if (kind == AAFARM__ENVELOPE__BODY_SHUTDOWN) return;
+    if (!registry_reject_due(f->reg, id, id_len, now, f->opt->heartbeat_ms)) return;
+    char hex[24];
+    console_log(f->con, CONSOLE_DETAIL, "%s from unknown peer %s: asking it to say Hello",
+                proto_message_name(kind), registry_id_hex(id, id_len, hex, sizeof hex));
+    send_reject(f, id, id_len, AAFARM__REJECT_CODE__REJECT_CODE_HELLO_FIRST,
+                "the master does not know this connection (it restarted, or the "
+                "connection was renewed): say Hello again");
+}
+
+void farm_handle(farm *f, wire_msg *m, int64_t now)
+{
+    size_t id_len = 0;
+    const uint8_t *id = wire_msg_identity(m, &id_len);
+    const Aafarm__Envelope *env = wire_msg_envelope(m);
+    proto_kind kind = wire_msg_kind(m);
+    if (kind == AAFARM__ENVELOPE__BODY_HELLO) {
+        on_hello(f, env->hello, id, id_len, now);
+        return;
+    }
+    farm_worker *w = registry_find(f->reg, id, id_len);
+    if (!w) {
+        on_unknown_peer(f, kind, id, id_len, now);
+        return;
+    }
+    w->last_seen_ms = now;
+    switch (kind) {
+    case AAFARM__ENVELOPE__BODY_ASK: on_ask(f, w, env->ask); break;
+    case AAFARM__ENVELOPE__BODY_RESULT: on_result(f, w, env->result, m, now); break;
+    case AAFARM__ENVELOPE__BODY_FAILURE: on_failure(f, w, env->failure); break;
+    case AAFARM__ENVELOPE__BODY_NEED_JOB: on_need_job(f, w, env->need_job, now); break;
+    case AAFARM__ENVELOPE__BODY_SHUTDOWN: {
+        char why[160];
+        snprintf(why, sizeof why, "left (%s)",
+                 env->shutdown->reason && *env->shutdown->reason ? env->shutdown->reason
+                                                                 : "no reason given");
+        farm_lose_worker(f, w, why, now);
+        break;
+    }
+    default: break;   /* Heartbeat: liveness only */
+    }
+}
+
+/* ---- granting ---- */
+
+/* One tile to one worker: the Job first if it does not hold it. */
+static bool grant_one(farm *f, farm_worker *w, int64_t now)
+{
+    scheduler_lease l;
+    if (!scheduler_grant(f->sched, w->slot, now, &l)) return false;
+    if (!w->has_job && send_job(f, w, now) != 0) return false;
+    if (send_grant(f, w, &l, now) != 0) return false;
+    w->credits--;
+    return true;
+}
+
+void farm_grant_all(farm *f, int64_t now)
+{
+    bool granted = true;
+    while (granted && f->state == FARM_RUNNING) {
+        granted = false;
+        for (size_t i = 0; i < registry_count(f->reg); i++) {
+            farm_worker *w = registry_at(f->reg, i);
+            if (w->alive && w->credits > 0 && grant_one(f, w, now)) granted = true;
+        }
+    }
+}

@@ -1,0 +1,219 @@
+/*
+ * main.c: the aafarm-master command line (docs/farm.md).
+ *
+ *   aafarm-master SCENE.rib -o OUT.exr [--bind ENDPOINT] [--local-workers N] ...
+ *
+ * Everything is read, parsed and compiled here, before any worker is
+ * started or contacted (job_load: the same diagnostics as the standalone
+ * renderer, exit 3); farm_run() does the rest.
+ */
+#include <getopt.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "farm.h"
+#include "job/job_scene.h"
+#include "util/exitcodes.h"
+
+static void usage(FILE *out)
+{
+    fprintf(out,
+        "usage: aafarm-master SCENE.rib -o OUT.exr [options]\n"
+        "\n"
+        "Renders a RenderMan scene with procedural displacement shaders on a farm of\n"
+        "aafarm-worker processes (ZeroMQ) and stitches their EXR tiles into OUT.exr.\n"
+        "With no --bind it starts its own local workers and stops them at the end.\n"
+        "\n"
+        "  -o, --output OUT.exr       output file (tiled OpenEXR, written via a temporary\n"
+        "                             file, renamed only when complete)\n"
+        "  --bind ENDPOINT            also wait for remote workers, e.g. tcp://*:5555\n"
+        "  --local-workers N          worker processes to start here (default: the number\n"
+        "                             of cores without --bind, 0 with it)\n"
+        "  --threads-per-worker N     --threads of each local worker (default 1)\n"
+        "  --tile S                   tile size in pixels (default 32)\n"
+        "  --arith affine|interval    bounding arithmetic (default affine)\n"
+        "  --budget N                 shader instruction budget per evaluation (default 1000000)\n"
+        "  --preview OUT.png          also write an sRGB PNG preview\n"
+        "  --stats-json FILE          write the summary and statistics as JSON\n"
+        "  --heartbeat MS             heartbeat interval announced to workers (default 1000)\n"
+        "  --liveness N               a worker is dead after N silent intervals (default 3)\n"
+        "  --retries N                failures of one tile before the job fails (default 3)\n"
+        "  --lease S                  seconds before a leased tile is handed out again (120)\n"
+        "  --duplicates N             end-game duplicate leases per tile (default 1, 0: off)\n"
+        "  --worker-binary PATH       aafarm-worker to start (default: next to this program)\n"
+        "  -q, --quiet                only errors;  -v, --verbose  every grant and tile\n"
+        "  -h, --help                 this text\n"
+        "\n"
+        "At the end it prints a summary per worker: tiles taken, duplicates dropped,\n"
+        "failures, render and CPU seconds, bytes received (tiles) and sent (job, grants).\n"
+        "\n"
+        "Exit status: 0 the image is complete, 1 the render failed (a tile failed on\n"
+        "--retries workers, no workers left, output not writable), 2 usage (bad options\n"
+        "or endpoint), 3 bad scene or shader (diagnostics printed, no worker contacted),\n"
+        "130 interrupted by SIGINT/SIGTERM (no output file is left behind).\n");
+}
+
+static bool parse_long(const char *s, long lo, long hi, long *out)
+{
+    char *end;
+    long v = strtol(s, &end, 10);
+    if (end == s || *end || v < lo || v > hi) return false;
+    *out = v;
+    return true;
+}
+
+typedef struct cli {
+    farm_options farm;
+    job_options job;
+    bool local_given;
+} cli;
+
+static int bad_number(const char *opt, const char *what, const char *got)
+{
+    fprintf(stderr, "aafarm-master: %s wants %s, got '%s'\n", opt, what, got);
+    return AAFARM_EXIT_USAGE;
+}
+
+/* Returns -1 to go on, or an exit code. */
+static int parse(int argc, char **argv, cli *c)
+{
+    enum { O_BIND = 256, O_LOCAL, O_TPW, O_TILE, O_ARITH, O_BUDGET, O_PREVIEW, O_STATS_JSON,
+           O_HEARTBEAT, O_LIVENESS, O_RETRIES, O_LEASE, O_DUPS, O_WORKER_BIN };
+    static const struct option longopts[] = {
+        {"output", required_argument, 0, 'o'},
+        {"bind", required_argument, 0, O_BIND},
+        {"local-workers", required_argument, 0, O_LOCAL},
+        {"threads-per-worker", required_argument, 0, O_TPW},
+        {"tile", required_argument, 0, O_TILE},
+        {"arith", required_argument, 0, O_ARITH},
+        {"budget", required_argument, 0, O_BUDGET},
+        {"preview", required_argument, 0, O_PREVIEW},
+        {"stats-json", required_argument, 0, O_STATS_JSON},
+        {"heartbeat", required_argument, 0, O_HEARTBEAT},
+        {"liveness", required_argument, 0, O_LIVENESS},
+        {"retries", required_argument, 0, O_RETRIES},
+        {"lease", required_argument, 0, O_LEASE},
+        {"duplicates", required_argument, 0, O_DUPS},
+        {"worker-binary", required_argument, 0, O_WORKER_BIN},
+        {"quiet", no_argument, 0, 'q'},
+        {"verbose", no_argument, 0, 'v'},
+        {"help", no_argument, 0, 'h'},
+        {0, 0, 0, 0}};
+    farm_options *f = &c->farm;
+    int ch;
+    long n;
+    while ((ch = getopt_long(argc, argv, "o:qvh", longopts, NULL)) != -1) {
+        switch (ch) {
+        case 'o': f->output = optarg; break;
+        case O_BIND: f->bind = optarg; break;
+        case O_LOCAL:
+            if (!parse_long(optarg, 0, 1024, &n)) return bad_number("--local-workers", "0..1024", optarg);
+            f->local_workers = (int)n;
+            c->local_given = true;
+            break;
+        case O_TPW:
+            if (!parse_long(optarg, 1, 1024, &n)) return bad_number("--threads-per-worker", "1..1024", optarg);
+            f->threads_per_worker = (int)n;
+            break;
+        case O_TILE:
+            if (!parse_long(optarg, 1, 1024, &n)) return bad_number("--tile", "a size 1..1024", optarg);
+            c->job.tile_size = (int)n;
+            break;
+        case O_ARITH:
+            if (!trace_arith_parse(optarg, &c->job.arith))
+                return bad_number("--arith", "'affine' or 'interval'", optarg);
+            break;
+        case O_BUDGET:
+            if (!parse_long(optarg, 1000, 1000000000L, &n)) return bad_number("--budget", "a number >= 1000", optarg);
+            c->job.max_instructions = n;
+            break;
+        case O_PREVIEW: f->preview = optarg; break;
+        case O_STATS_JSON: f->stats_json = optarg; break;
+        case O_HEARTBEAT:
+            if (!parse_long(optarg, 10, 3600000, &n)) return bad_number("--heartbeat", "milliseconds 10..3600000", optarg);
+            f->heartbeat_ms = (int)n;
+            break;
+        case O_LIVENESS:
+            if (!parse_long(optarg, 1, 1000, &n)) return bad_number("--liveness", "1..1000", optarg);
+            f->liveness = (int)n;
+            break;
+        case O_RETRIES:
+            if (!parse_long(optarg, 1, 1000, &n)) return bad_number("--retries", "1..1000", optarg);
+            f->max_attempts = (int)n;
+            break;
+        case O_LEASE:
+            if (!parse_long(optarg, 1, 86400, &n)) return bad_number("--lease", "seconds 1..86400", optarg);
+            f->lease_ms = n * 1000;
+            break;
+        case O_DUPS:
+            if (!parse_long(optarg, 0, 100, &n)) return bad_number("--duplicates", "0..100", optarg);
+            f->max_duplicates = (int)n;
+            break;
+        case O_WORKER_BIN: f->worker_binary = optarg; break;
+        case 'q': f->verbosity = -1; break;
+        case 'v': f->verbosity = 1; break;
+        case 'h': usage(stdout); return AAFARM_EXIT_OK;
+        default: usage(stderr); return AAFARM_EXIT_USAGE;
+        }
+    }
+    if (optind < argc) f->scene_path = argv[optind++];
+    if (optind < argc) {
+        fprintf(stderr, "aafarm-master: unexpected argument '%s' (see --help)\n", argv[optind]);
+        return AAFARM_EXIT_USAGE;
+    }
+    if (!f->scene_path || !f->output) {
+        fprintf(stderr, "aafarm-master: %s (see --help)\n",
+                !f->scene_path ? "which scene? usage: aafarm-master SCENE.rib -o OUT.exr"
+                               : "needs -o OUT.exr");
+        return AAFARM_EXIT_USAGE;
+    }
+    if (f->bind && !c->local_given) f->local_workers = 0;
+    if (!f->bind && f->local_workers == 0) {
+        fprintf(stderr, "aafarm-master: --local-workers 0 without --bind: no worker could "
+                "ever connect\n");
+        return AAFARM_EXIT_USAGE;
+    }
+    return -1;
+}
+
+/* Loads and checks the job; finds the image size. Exit code or -1. */
+static int load(cli *c, job **jb_out, image_format *fmt)
+{
+    sl_diag *diag = sl_diag_new();
+    job *jb = job_load(c->farm.scene_path, &c->job, diag);
+    job_scene *js = jb ? job_scene_new(jb, 0, false, diag) : NULL;
+    sl_diag_print(diag, stderr);
+    sl_diag_destroy(&diag);
+    if (!js) {
+        job_destroy(&jb);
+        return AAFARM_EXIT_INPUT;
+    }
+    *fmt = (image_format){js->world.camera.xres, js->world.camera.yres, c->job.tile_size, 0};
+    job_scene_destroy(&js);
+    char err[300];
+    if (!image_format_check(fmt, err, sizeof err)) {
+        fprintf(stderr, "aafarm-master: %s: %s\n", c->farm.scene_path, err);
+        job_destroy(&jb);
+        return AAFARM_EXIT_INPUT;
+    }
+    *jb_out = jb;
+    return -1;
+}
+
+int main(int argc, char **argv)
+{
+    cli c;
+    memset(&c, 0, sizeof c);
+    farm_options_default(&c.farm);
+    job_options_default(&c.job);
+    int rc = parse(argc, argv, &c);
+    if (rc >= 0) return rc;
+    job *jb = NULL;
+    image_format fmt;
+    rc = load(&c, &jb, &fmt);
+    if (rc >= 0) return rc;
+    rc = farm_run(&c.farm, jb, &fmt);
+    job_destroy(&jb);
+    return rc;
+}

@@ -1,0 +1,124 @@
+/*
+ * registry.c: the master's list of workers and the HELLO_FIRST rate
+ * limit (see registry.h). Farms have tens to hundreds of workers, so a
+ * plain array searched linearly is enough and keeps the code obvious.
+ */
+#include "registry.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+enum { REJECT_TABLE = 64 };
+
+typedef struct reject_entry {
+    uint8_t id[REGISTRY_MAX_ID];
+    size_t id_len;
+    int64_t at_ms;
+} reject_entry;
+
+struct registry {
+    farm_worker **workers;
+    size_t count, cap;
+    reject_entry rejects[REJECT_TABLE];
+    size_t next_reject;
+};
+
+registry *registry_new(void)
+{
+    registry *self = calloc(1, sizeof *self);
+    if (!self) abort();
+    return self;
+}
+
+void registry_destroy(registry **self_p)
+{
+    registry *self = *self_p;
+    if (!self) return;
+    for (size_t i = 0; i < self->count; i++) free(self->workers[i]);
+    free(self->workers);
+    free(self);
+    *self_p = NULL;
+}
+
+farm_worker *registry_add(registry *self, const uint8_t *id, size_t id_len, int64_t now_ms)
+{
+    if (id_len == 0 || id_len > REGISTRY_MAX_ID) return NULL;
+    if (self->count == self->cap) {
+        self->cap = self->cap ? self->cap * 2 : 16;
+        self->workers = realloc(self->workers, sizeof *self->workers * self->cap);
+        if (!self->workers) abort();
+    }
+    farm_worker *w = calloc(1, sizeof *w);
+    if (!w) abort();
+    memcpy(w->id, id, id_len);
+    w->id_len = id_len;
+    w->alive = true;
+    w->slot = -1;
+    w->joined_ms = w->last_seen_ms = w->last_sent_ms = now_ms;
+    self->workers[self->count++] = w;
+    return w;
+}
+
+farm_worker *registry_find(const registry *self, const uint8_t *id, size_t id_len)
+{
+    for (size_t i = 0; i < self->count; i++) {
+        farm_worker *w = self->workers[i];
+        if (w->alive && w->id_len == id_len && memcmp(w->id, id, id_len) == 0) return w;
+    }
+    return NULL;
+}
+
+void registry_retire(registry *self, farm_worker *w, const char *why, int64_t now_ms)
+{
+    (void)self;
+    w->alive = false;
+    w->credits = 0;
+    w->left_ms = now_ms;
+    snprintf(w->gone, sizeof w->gone, "%s", why);
+}
+
+size_t registry_count(const registry *self) { return self->count; }
+
+farm_worker *registry_at(const registry *self, size_t i)
+{
+    return i < self->count ? self->workers[i] : NULL;
+}
+
+int registry_alive(const registry *self)
+{
+    int n = 0;
+    for (size_t i = 0; i < self->count; i++) n += self->workers[i]->alive;
+    return n;
+}
+
+bool registry_reject_due(registry *self, const uint8_t *id, size_t id_len, int64_t now_ms,
+                         int64_t interval_ms)
+{
+    if (id_len == 0 || id_len > REGISTRY_MAX_ID) return false;
+    for (size_t i = 0; i < REJECT_TABLE; i++) {
+        reject_entry *e = &self->rejects[i];
+        if (e->id_len != id_len || memcmp(e->id, id, id_len) != 0) continue;
+        if (now_ms - e->at_ms < interval_ms) return false;
+        e->at_ms = now_ms;
+        return true;
+    }
+    reject_entry *e = &self->rejects[self->next_reject];
+    self->next_reject = (self->next_reject + 1) % REJECT_TABLE;
+    memcpy(e->id, id, id_len);
+    e->id_len = id_len;
+    e->at_ms = now_ms;
+    return true;
+}
+
+const char *registry_id_hex(const uint8_t *id, size_t id_len, char *buf, size_t bufsz)
+{
+    size_t n = 0, max = (bufsz - 4) / 2;
+    if (bufsz < 24) {
+        if (bufsz) buf[0] = '\0';
+        return buf;
+    }
+    for (size_t i = 0; i < id_len && i < max; i++) n += (size_t)snprintf(buf + n, bufsz - n, "%02x", id[i]);
+    if (id_len > max) snprintf(buf + n, bufsz - n, "...");
+    return buf;
+}

@@ -1,0 +1,475 @@
+/*
+ * scheduler.c: tiles, leases, requeues, end-game duplicates and retries
+ * (see scheduler.h for the rules and docs/protocol.md for where they come
+ * from).
+ *
+ * Data:
+ *   tiles[]   per tile: done, failures so far, live leases (unexpired) and
+ *             held leases (all valid ones), whether it sits in the requeue
+ *             list. "Queued" = PENDING and no live lease.
+ *   leases[]  every valid lease, appended in grant order; since ids grow
+ *             with every grant the array stays sorted by id, so a lookup is
+ *             a binary search. A resolved lease becomes a hole (id 0) and
+ *             the holes are squeezed out when they are half the array.
+ *   rq[]      the requeue list ("the queue's front"): tiles that were
+ *             leased before and came back, oldest first, each at most once;
+ *             entries that are no longer queued are skipped lazily.
+ *   failed[]  (tile, worker) pairs of failures, to prefer other workers.
+ */
+#include "scheduler.h"
+
+#include <limits.h>
+#include <stdlib.h>
+#include <string.h>
+
+typedef struct tile_state {
+    uint8_t done;
+    uint8_t in_rq;
+    uint16_t attempts;
+    uint32_t live;     /* unexpired leases */
+    uint32_t held;     /* valid leases, expired or not */
+} tile_state;
+
+typedef struct worker_slot {
+    bool active;
+    int cursor;        /* last fresh tile granted, -1: none yet */
+} worker_slot;
+
+typedef struct failed_pair {
+    int tile, worker;
+} failed_pair;
+
+struct scheduler {
+    scheduler_options opt;
+    int ntiles;
+    tile_state *tiles;
+    scheduler_lease *leases;
+    size_t nleases, cap_leases, holes;
+    uint64_t next_id;
+    int *rq;
+    int rq_head, rq_len;
+    worker_slot *workers;
+    int nworkers;
+    failed_pair *failed;
+    size_t nfailed;
+    bool job_failed;
+    int done;
+    int64_t taken_ms_sum;      /* grant-to-result time of taken leases */
+    scheduler_counts counts;
+};
+
+static void *xrealloc(void *p, size_t n)
+{
+    p = realloc(p, n ? n : 1);
+    if (!p) abort();
+    return p;
+}
+
+void scheduler_options_default(scheduler_options *opt)
+{
+    opt->max_attempts = 3;
+    opt->max_duplicates = 1;
+    opt->lease_ms = 120000;
+    opt->duplicate_after_ms = 1000;
+}
+
+scheduler *scheduler_new(int tiles_x, int tiles_y, const scheduler_options *opt)
+{
+    if (tiles_x < 1 || tiles_y < 1 || tiles_x > INT_MAX / 2 / tiles_y)
+        return NULL;
+    scheduler *self = calloc(1, sizeof *self);
+    if (!self) abort();
+    if (opt) self->opt = *opt;
+    else scheduler_options_default(&self->opt);
+    if (self->opt.max_attempts < 1) self->opt.max_attempts = 1;
+    if (self->opt.max_attempts > 1000) self->opt.max_attempts = 1000;
+    if (self->opt.max_duplicates < 0) self->opt.max_duplicates = 0;
+    if (self->opt.lease_ms < 1) self->opt.lease_ms = 1;
+    self->ntiles = tiles_x * tiles_y;
+    self->tiles = calloc((size_t)self->ntiles, sizeof *self->tiles);
+    self->rq = calloc((size_t)self->ntiles, sizeof *self->rq);
+    if (!self->tiles || !self->rq) abort();
+    self->next_id = 1;
+    self->counts.tiles = self->ntiles;
+    return self;
+}
+
+void scheduler_destroy(scheduler **self_p)
+{
+    scheduler *self = *self_p;
+    if (!self) return;
+    free(self->tiles);
+    free(self->leases);
+    free(self->rq);
+    free(self->workers);
+    free(self->failed);
+    free(self);
+    *self_p = NULL;
+}
+
+int scheduler_worker_add(scheduler *self)
+{
+    self->workers = xrealloc(self->workers, sizeof *self->workers * (size_t)(self->nworkers + 1));
+    self->workers[self->nworkers] = (worker_slot){.active = true, .cursor = -1};
+    return self->nworkers++;
+}
+
+static bool worker_ok(const scheduler *self, int worker)
+{
+    return worker >= 0 && worker < self->nworkers && self->workers[worker].active;
+}
+
+/* ---- tiles and the requeue list ---- */
+
+static bool queued(const scheduler *self, int tile)
+{
+    const tile_state *t = &self->tiles[tile];
+    return !t->done && t->live == 0;
+}
+
+/* Drops resolved entries and holes from the requeue list. */
+static void rq_compact(scheduler *self)
+{
+    int j = 0;
+    for (int i = self->rq_head; i < self->rq_len; i++) {
+        int t = self->rq[i];
+        if (t < 0) continue;
+        if (queued(self, t)) self->rq[j++] = t;
+        else self->tiles[t].in_rq = 0;
+    }
+    self->rq_head = 0;
+    self->rq_len = j;
+}
+
+static void rq_push(scheduler *self, int tile)
+{
+    if (self->tiles[tile].in_rq) return;
+    if (self->rq_len == self->ntiles) rq_compact(self);
+    self->rq[self->rq_len++] = tile;
+    self->tiles[tile].in_rq = 1;
+    self->counts.requeued++;
+}
+
+static void rq_take(scheduler *self, int i)
+{
+    self->tiles[self->rq[i]].in_rq = 0;
+    self->rq[i] = -1;
+    while (self->rq_head < self->rq_len && self->rq[self->rq_head] < 0) self->rq_head++;
+}
+
+/* A tile lost a live lease: back to the queue when nothing else holds it. */
+static void tile_lost_live(scheduler *self, int tile)
+{
+    tile_state *t = &self->tiles[tile];
+    t->live--;
+    if (!t->done && t->live == 0) rq_push(self, tile);
+}
+
+static bool failed_by(const scheduler *self, int tile, int worker)
+{
+    for (size_t i = 0; i < self->nfailed; i++)
+        if (self->failed[i].tile == tile && self->failed[i].worker == worker) return true;
+    return false;
+}
+
+/* Is there an active worker other than `worker` that has not failed tile? */
+static bool someone_else_for(const scheduler *self, int tile, int worker)
+{
+    for (int w = 0; w < self->nworkers; w++)
+        if (w != worker && self->workers[w].active && !failed_by(self, tile, w)) return true;
+    return false;
+}
+
+/* ---- leases ---- */
+
+static scheduler_lease *lease_lookup(const scheduler *self, uint64_t id)
+{
+    size_t lo = 0, hi = self->nleases;
+    while (lo < hi) {
+        size_t mid = lo + (hi - lo) / 2;
+        uint64_t at = self->leases[mid].id;
+        /* holes (id 0) keep their neighbours' order: search past them */
+        size_t probe = mid;
+        while (at == 0 && probe + 1 < hi) at = self->leases[++probe].id;
+        if (at == 0 || at > id) hi = mid;
+        else if (at < id) lo = probe + 1;
+        else return &self->leases[probe];
+    }
+    return NULL;
+}
+
+static void leases_compact(scheduler *self)
+{
+    size_t j = 0;
+    for (size_t i = 0; i < self->nleases; i++)
+        if (self->leases[i].id) self->leases[j++] = self->leases[i];
+    self->nleases = j;
+    self->holes = 0;
+}
+
+static void lease_remove(scheduler *self, scheduler_lease *l)
+{
+    int tile = l->tile;
+    bool was_live = !l->expired;
+    l->id = 0;
+    self->holes++;
+    self->tiles[tile].held--;
+    if (was_live) tile_lost_live(self, tile);
+    if (self->holes * 2 > self->nleases) leases_compact(self);
+}
+
+static void lease_add(scheduler *self, int worker, int tile, int64_t now, bool dup,
+                      scheduler_lease *out)
+{
+    if (self->nleases == self->cap_leases) {
+        self->cap_leases = self->cap_leases ? self->cap_leases * 2 : 64;
+        self->leases = xrealloc(self->leases, sizeof *self->leases * self->cap_leases);
+    }
+    scheduler_lease *l = &self->leases[self->nleases++];
+    *l = (scheduler_lease){.id = self->next_id++, .worker = worker, .tile = tile,
+                           .granted_ms = now, .deadline_ms = now + self->opt.lease_ms,
+                           .duplicate = dup};
+    self->tiles[tile].live++;
+    self->tiles[tile].held++;
+    self->counts.grants++;
+    if (dup) self->counts.duplicate_grants++;
+    *out = *l;
+}
+
+static bool worker_holds(const scheduler *self, int worker, int tile)
+{
+    for (size_t i = 0; i < self->nleases; i++) {
+        const scheduler_lease *l = &self->leases[i];
+        if (l->id && l->worker == worker && l->tile == tile) return true;
+    }
+    return false;
+}
+
+/* ---- choosing a tile ---- */
+
+/* The oldest requeued tile for this worker, or -1. */
+static int pick_requeued(scheduler *self, int worker)
+{
+    for (int i = self->rq_head; i < self->rq_len; i++) {
+        int t = self->rq[i];
+        if (t < 0) continue;
+        if (!queued(self, t)) {
+            rq_take(self, i);
+            continue;
+        }
+        if (failed_by(self, t, worker) && someone_else_for(self, t, worker)) continue;
+        rq_take(self, i);
+        return t;
+    }
+    return -1;
+}
+
+static bool fresh(const scheduler *self, int tile)
+{
+    return queued(self, tile) && !self->tiles[tile].in_rq;
+}
+
+/* Is another active worker's run about to continue into tile? */
+static bool run_heading_into(const scheduler *self, int tile, int worker)
+{
+    for (int w = 0; w < self->nworkers; w++)
+        if (tile > 0 && w != worker && self->workers[w].active &&
+            self->workers[w].cursor == tile - 1)
+            return true;
+    return false;
+}
+
+/* The next tile of the worker's run, or else a new run in the longest run
+ * of fresh tiles: in its middle when another worker's run is about to
+ * continue into it, at its start otherwise; -1 when none. */
+static int pick_fresh(scheduler *self, int worker)
+{
+    int c = self->workers[worker].cursor;
+    if (c >= 0 && c + 1 < self->ntiles && fresh(self, c + 1)) return c + 1;
+    int best_start = -1, best_len = 0;
+    for (int i = 0; i < self->ntiles;) {
+        if (!fresh(self, i)) { i++; continue; }
+        int j = i;
+        while (j < self->ntiles && fresh(self, j)) j++;
+        if (j - i > best_len) { best_len = j - i; best_start = i; }
+        i = j;
+    }
+    if (best_start < 0) return -1;
+    return run_heading_into(self, best_start, worker) ? best_start + best_len / 2 : best_start;
+}
+
+/* End game: the outstanding tile leased longest ago that this worker does
+ * not hold, that has room for one more lease and whose lease is old
+ * enough to be a straggler; -1 when none. */
+static int pick_duplicate(const scheduler *self, int worker, int64_t now)
+{
+    if (self->opt.max_duplicates == 0) return -1;
+    int64_t wait = self->opt.duplicate_after_ms;
+    if (self->done > 0 && 3 * (self->taken_ms_sum / self->done) > wait)
+        wait = 3 * (self->taken_ms_sum / self->done);
+    for (size_t i = 0; i < self->nleases; i++) {
+        const scheduler_lease *l = &self->leases[i];
+        if (!l->id || l->worker == worker) continue;
+        if (now - l->granted_ms < wait) break;   /* the rest are younger still */
+        const tile_state *t = &self->tiles[l->tile];
+        if (t->done || t->live == 0 || t->held > (uint32_t)self->opt.max_duplicates) continue;
+        if (!worker_holds(self, worker, l->tile) && !failed_by(self, l->tile, worker))
+            return l->tile;
+    }
+    return -1;
+}
+
+bool scheduler_grant(scheduler *self, int worker, int64_t now_ms, scheduler_lease *out)
+{
+    if (!worker_ok(self, worker) || self->job_failed || self->done == self->ntiles) return false;
+    int tile = pick_requeued(self, worker);
+    if (tile >= 0) {
+        lease_add(self, worker, tile, now_ms, self->tiles[tile].held > 0, out);
+        return true;
+    }
+    tile = pick_fresh(self, worker);
+    if (tile >= 0) {
+        self->workers[worker].cursor = tile;
+        lease_add(self, worker, tile, now_ms, false, out);
+        return true;
+    }
+    tile = pick_duplicate(self, worker, now_ms);
+    if (tile < 0) return false;
+    lease_add(self, worker, tile, now_ms, true, out);
+    return true;
+}
+
+/* ---- resolving leases ---- */
+
+const scheduler_lease *scheduler_lease_find(const scheduler *self, int worker, uint64_t lease_id)
+{
+    if (lease_id == 0) return NULL;
+    const scheduler_lease *l = lease_lookup(self, lease_id);
+    return l && l->worker == worker ? l : NULL;
+}
+
+scheduler_verdict scheduler_check_result(const scheduler *self, int worker, uint64_t lease_id)
+{
+    const scheduler_lease *l = scheduler_lease_find(self, worker, lease_id);
+    if (!l) return SCHEDULER_STALE;
+    return self->tiles[l->tile].done ? SCHEDULER_DUPLICATE : SCHEDULER_TAKEN;
+}
+
+scheduler_verdict scheduler_complete(scheduler *self, int worker, uint64_t lease_id,
+                                     int64_t now_ms)
+{
+    scheduler_lease *l = (scheduler_lease *)scheduler_lease_find(self, worker, lease_id);
+    if (!l) {
+        self->counts.stale_results++;
+        return SCHEDULER_STALE;
+    }
+    tile_state *t = &self->tiles[l->tile];
+    if (t->done) {
+        self->counts.duplicate_results++;
+        lease_remove(self, l);
+        return SCHEDULER_DUPLICATE;
+    }
+    t->done = 1;
+    self->done++;
+    self->taken_ms_sum += now_ms > l->granted_ms ? now_ms - l->granted_ms : 0;
+    lease_remove(self, l);
+    return SCHEDULER_TAKEN;
+}
+
+scheduler_failure scheduler_fail(scheduler *self, int worker, uint64_t lease_id, bool retryable)
+{
+    scheduler_lease *l = (scheduler_lease *)scheduler_lease_find(self, worker, lease_id);
+    if (!l) return SCHEDULER_FAIL_IGNORED;
+    int tile = l->tile;
+    if (self->tiles[tile].done) {
+        lease_remove(self, l);
+        return SCHEDULER_FAIL_IGNORED;
+    }
+    self->counts.failures++;
+    self->tiles[tile].attempts++;
+    if (!failed_by(self, tile, worker)) {
+        self->failed = xrealloc(self->failed, sizeof *self->failed * (self->nfailed + 1));
+        self->failed[self->nfailed++] = (failed_pair){tile, worker};
+    }
+    lease_remove(self, l);
+    if (!retryable || self->tiles[tile].attempts >= self->opt.max_attempts) {
+        self->job_failed = true;
+        return SCHEDULER_JOB_FAILED;
+    }
+    return SCHEDULER_RETRY;
+}
+
+int scheduler_worker_remove(scheduler *self, int worker)
+{
+    if (!worker_ok(self, worker)) return 0;
+    uint64_t before = self->counts.requeued;
+    self->workers[worker].active = false;
+    for (size_t i = 0; i < self->nleases; i++) {
+        scheduler_lease *l = &self->leases[i];
+        if (l->id && l->worker == worker) {
+            size_t n = self->nleases;
+            lease_remove(self, l);
+            if (self->nleases != n) i = (size_t)-1;   /* compacted: start over */
+        }
+    }
+    return (int)(self->counts.requeued - before);
+}
+
+int scheduler_expire(scheduler *self, int64_t now_ms)
+{
+    uint64_t before = self->counts.requeued;
+    for (size_t i = 0; i < self->nleases; i++) {
+        scheduler_lease *l = &self->leases[i];
+        if (!l->id || l->expired || l->deadline_ms > now_ms) continue;
+        l->expired = true;
+        self->counts.expired++;
+        tile_lost_live(self, l->tile);
+    }
+    return (int)(self->counts.requeued - before);
+}
+
+int64_t scheduler_next_deadline(const scheduler *self)
+{
+    int64_t next = INT64_MAX;
+    for (size_t i = 0; i < self->nleases; i++) {
+        const scheduler_lease *l = &self->leases[i];
+        if (l->id && !l->expired && l->deadline_ms < next) next = l->deadline_ms;
+    }
+    return next;
+}
+
+/* ---- questions ---- */
+
+bool scheduler_finished(const scheduler *self) { return self->done == self->ntiles; }
+bool scheduler_failed(const scheduler *self) { return self->job_failed; }
+int scheduler_tiles_done(const scheduler *self) { return self->done; }
+
+bool scheduler_tile_done(const scheduler *self, int tile)
+{
+    return tile >= 0 && tile < self->ntiles && self->tiles[tile].done;
+}
+
+int scheduler_tile_attempts(const scheduler *self, int tile)
+{
+    return tile >= 0 && tile < self->ntiles ? self->tiles[tile].attempts : 0;
+}
+
+int scheduler_worker_leases(const scheduler *self, int worker)
+{
+    int n = 0;
+    for (size_t i = 0; i < self->nleases; i++)
+        if (self->leases[i].id && self->leases[i].worker == worker) n++;
+    return n;
+}
+
+void scheduler_counts_get(const scheduler *self, scheduler_counts *out)
+{
+    *out = self->counts;
+    out->done = self->done;
+    out->queued = out->leased = 0;
+    for (int i = 0; i < self->ntiles; i++) {
+        if (self->tiles[i].done) continue;
+        if (self->tiles[i].live) out->leased++;
+        else out->queued++;
+    }
+}

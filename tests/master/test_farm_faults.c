@@ -1,0 +1,307 @@
+/*
+ * test_farm_faults.c: the farm under faults, with real processes:
+ *   - kill -9 a worker mid-render: its tiles are requeued, the render
+ *     completes and equals the standalone render;
+ *   - SIGSTOP a worker: after the heartbeat timeout its tiles are
+ *     requeued, the result equals standalone; SIGCONT it and it carries
+ *     on (says Hello again) and stops cleanly on SIGTERM;
+ *   - random bytes, truncated ZMTP frames and malformed messages sent to
+ *     the master's port while it renders: it keeps working, counts them,
+ *     and answers a message from an unknown peer with Reject HELLO_FIRST;
+ *   - SIGINT to a master with local workers: exit 130, no output and no
+ *     temporary file left, the local workers stopped.
+ * Workers are slowed down with --tile-delay so that "mid-render" is
+ * certain; liveness is measured in seconds, never speed.
+ */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <arpa/inet.h>
+#include <errno.h>
+#include <netinet/in.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/socket.h>
+#include <sys/stat.h>
+#include <unistd.h>
+#include <zmq.h>
+
+#include "farm_testutil.h"
+#include "version.h"
+#include "wire.h"
+
+static char *dir;
+
+static int group_setup(void **state)
+{
+    (void)state;
+    dir = ft_tempdir();
+    ft_write_scene(dir, FT_SCENE_WAVE);
+    return ft_standalone(dir, 8) == 0 ? 0 : -1;
+}
+
+static int group_teardown(void **state)
+{
+    (void)state;
+    ft_stop_all();
+    ft_rmtree(dir);
+    free(dir);
+    return 0;
+}
+
+static int teardown(void **state)
+{
+    (void)state;
+    ft_stop_all();
+    return 0;
+}
+
+static pid_t start_worker(const char *endpoint, const char *name, const char *delay_ms)
+{
+    char log[64];
+    snprintf(log, sizeof log, "%s.log", name);
+    const char *argv[] = {ft_worker, "--connect", endpoint, "--name", name, "--threads", "1",
+                          "--tile-delay", delay_ms, NULL};
+    return ft_spawn(ft_path(dir, log), argv);
+}
+
+/* A master on tcp://127.0.0.1:<any> with a 1 s heartbeat timeout. */
+static pid_t start_master(const char *out, const char *log, const char *json, char *ep,
+                          size_t epsz)
+{
+    const char *argv[] = {ft_master, ft_path(dir, "scene.rib"), "-o", out, "--bind",
+                          "tcp://127.0.0.1:*", "--tile", "8", "--heartbeat", "250",
+                          "--liveness", "4", "--stats-json", json, "-v", NULL};
+    pid_t master = ft_spawn(log, argv);
+    assert_true(ft_master_endpoint(log, ep, epsz, 30));
+    return master;
+}
+
+static void test_farm_kill9_worker_mid_render(void **state)
+{
+    (void)state;
+    const char *log = ft_path(dir, "kill9.log"), *json = ft_path(dir, "kill9.json");
+    char ep[256];
+    pid_t master = start_master(ft_path(dir, "kill9.exr"), log, json, ep, sizeof ep);
+    pid_t victim = start_worker(ep, "victim", "40");
+    assert_true(ft_wait_for(log, " from victim (lease", 2, 60));
+    pid_t other = start_worker(ep, "other", "20");
+    assert_true(ft_wait_for(log, "worker other joined", 1, 30));
+    /* the victim holds leases now (it asks for two per thread) */
+    kill(victim, SIGKILL);
+    assert_int_equal(ft_wait(victim, 10), 128 + SIGKILL);
+    assert_int_equal(ft_wait(master, 120), 0);
+    assert_int_equal(ft_exr_diff(ft_path(dir, "ref.exr"), ft_path(dir, "kill9.exr")), 0);
+    /* noticed by the missing heartbeats or by the closed connection */
+    assert_int_equal(ft_count(log, "worker victim missed 4 heartbeats") +
+                     ft_count(log, "worker victim disconnected"), 1);
+    assert_true(ft_json_number(json, "requeued") >= 1);
+    assert_true(ft_count(json, "\"tiles_done\": 48") == 1);
+    kill(other, SIGTERM);
+    assert_int_equal(ft_wait(other, 20), 130);
+}
+
+static void test_farm_sigstop_worker_requeued(void **state)
+{
+    (void)state;
+    const char *log = ft_path(dir, "stop.log"), *json = ft_path(dir, "stop.json");
+    char ep[256];
+    pid_t master = start_master(ft_path(dir, "stop.exr"), log, json, ep, sizeof ep);
+    pid_t sleeper = start_worker(ep, "sleeper", "40");
+    assert_true(ft_wait_for(log, " from sleeper (lease", 2, 60));
+    kill(sleeper, SIGSTOP);
+    pid_t other = start_worker(ep, "other", "60");
+    /* 4 x 250 ms of silence: the master gives the sleeper's tiles away */
+    assert_true(ft_wait_for(log, "worker sleeper missed 4 heartbeats", 1, 30));
+    /* wake it while the render goes on: the master has forgotten it. It
+     * either finds the master silent too long and reconnects, or its next
+     * message gets Reject HELLO_FIRST; either way it says Hello again and
+     * joins as a new worker, and its old results are stale */
+    kill(sleeper, SIGCONT);
+    assert_true(ft_wait_for(log, "worker sleeper joined", 2, 30));
+    assert_int_equal(ft_wait(master, 120), 0);
+    assert_int_equal(ft_exr_diff(ft_path(dir, "ref.exr"), ft_path(dir, "stop.exr")), 0);
+    assert_true(ft_json_number(json, "requeued") >= 1);
+    assert_int_equal(ft_count(ft_path(dir, "sleeper.log"), "connected to master"), 2);
+    /* and it is still a healthy worker */
+    assert_true(ft_running(sleeper));
+    kill(sleeper, SIGTERM);
+    assert_int_equal(ft_wait(sleeper, 20), 130);
+    kill(other, SIGTERM);
+    assert_int_equal(ft_wait(other, 20), 130);
+}
+
+/* ---- garbage for the master's port ---- */
+
+static int tcp_connect(int port)
+{
+    int s = socket(AF_INET, SOCK_STREAM, 0);
+    struct sockaddr_in a;
+    memset(&a, 0, sizeof a);
+    a.sin_family = AF_INET;
+    a.sin_port = htons((uint16_t)port);
+    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    assert_true(s >= 0);
+    assert_int_equal(connect(s, (struct sockaddr *)&a, sizeof a), 0);
+    return s;
+}
+
+static void send_all(int s, const void *buf, size_t len)
+{
+    (void)!send(s, buf, len, MSG_NOSIGNAL);   /* the peer may hang up: fine */
+}
+
+/* The ZMTP 3.0 greeting and READY command of a DEALER (RFC 23). */
+static void zmtp_handshake(int s)
+{
+    unsigned char g[64] = {0xFF, 0, 0, 0, 0, 0, 0, 0, 1, 0x7F, 3, 0, 'N', 'U', 'L', 'L'};
+    send_all(s, g, sizeof g);
+    unsigned char ready[] = {0x04, 28, 5, 'R', 'E', 'A', 'D', 'Y', 11, 'S', 'o', 'c', 'k', 'e',
+                             't', '-', 'T', 'y', 'p', 'e', 0, 0, 0, 6, 'D', 'E', 'A', 'L',
+                             'E', 'R'};
+    send_all(s, ready, sizeof ready);
+}
+
+static void tcp_garbage(int port)
+{
+    srand(7);
+    for (int i = 0; i < 20; i++) {          /* random bytes instead of a greeting */
+        int s = tcp_connect(port);
+        unsigned char junk[300];
+        for (size_t k = 0; k < sizeof junk; k++) junk[k] = (unsigned char)rand();
+        send_all(s, junk, (size_t)(1 + rand() % (int)sizeof junk));
+        close(s);
+    }
+    for (int i = 0; i < 10; i++) {          /* a frame cut short, then hang up */
+        int s = tcp_connect(port);
+        zmtp_handshake(s);
+        unsigned char frame[2 + 20] = {0x00, 200};
+        send_all(s, frame, sizeof frame);
+        close(s);
+    }
+    int s = tcp_connect(port);              /* a frame claiming 2^60 bytes */
+    zmtp_handshake(s);
+    unsigned char huge[9] = {0x02, 0x10, 0, 0, 0, 0, 0, 0, 0};
+    send_all(s, huge, sizeof huge);
+    close(s);
+}
+
+/* Malformed messages through a real DEALER, then one from a peer that
+ * never said Hello: it must get Reject HELLO_FIRST. Returns how many
+ * malformed messages were sent. */
+static int dealer_garbage(const char *ep)
+{
+    void *ctx = zmq_ctx_new();
+    void *d = zmq_socket(ctx, ZMQ_DEALER);
+    int linger = 0, timeout = 20000;
+    zmq_setsockopt(d, ZMQ_LINGER, &linger, sizeof linger);
+    zmq_setsockopt(d, ZMQ_RCVTIMEO, &timeout, sizeof timeout);
+    assert_int_equal(zmq_connect(d, ep), 0);
+    int sent = 0;
+    for (int i = 0; i < 300; i++) {         /* headers that cannot be protobuf */
+        unsigned char junk[40];
+        for (size_t k = 0; k < sizeof junk; k++) junk[k] = (unsigned char)rand();
+        junk[0] = 0x07;                     /* field 0 with wire type 7: invalid */
+        zmq_send(d, junk, (size_t)(1 + rand() % 40), 0);
+        sent++;
+    }
+    for (int i = 0; i < 20; i++) {          /* four frames: never a message */
+        zmq_send(d, "a", 1, ZMQ_SNDMORE);
+        zmq_send(d, "b", 1, ZMQ_SNDMORE);
+        zmq_send(d, "c", 1, ZMQ_SNDMORE);
+        zmq_send(d, "d", 1, 0);
+        sent++;
+    }
+    Aafarm__Heartbeat hb = AAFARM__HEARTBEAT__INIT;
+    Aafarm__Envelope env = AAFARM__ENVELOPE__INIT;
+    env.body_case = AAFARM__ENVELOPE__BODY_HEARTBEAT;
+    env.heartbeat = &hb;
+    assert_int_equal(wire_send(d, NULL, 0, &env, NULL, 0), 0);
+    wire_msg *m = wire_recv(d, NULL, NULL, 0);
+    assert_non_null(m);
+    assert_int_equal(wire_msg_kind(m), AAFARM__ENVELOPE__BODY_REJECT);
+    assert_int_equal(wire_msg_envelope(m)->reject->code,
+                     AAFARM__REJECT_CODE__REJECT_CODE_HELLO_FIRST);
+    wire_msg_destroy(&m);
+    zmq_close(d);
+    zmq_ctx_term(ctx);
+    return sent;
+}
+
+static void test_farm_garbage_to_master_port(void **state)
+{
+    (void)state;
+    const char *log = ft_path(dir, "junk.log"), *json = ft_path(dir, "junk.json");
+    char ep[256];
+    pid_t master = start_master(ft_path(dir, "junk.exr"), log, json, ep, sizeof ep);
+    pid_t worker = start_worker(ep, "steady", "20");
+    assert_true(ft_wait_for(log, " from steady (lease", 1, 60));
+    int port = atoi(strrchr(ep, ':') + 1);
+    tcp_garbage(port);
+    int sent = dealer_garbage(ep);
+    assert_int_equal(ft_wait(master, 120), 0);
+    assert_int_equal(ft_exr_diff(ft_path(dir, "ref.exr"), ft_path(dir, "junk.exr")), 0);
+    assert_true(ft_count(log, "dropped a message from peer") >= 1);
+    /* every malformed message was counted */
+    assert_true(ft_json_number(json, "malformed_messages") >= sent);
+    /* the worker was never disturbed */
+    assert_int_equal(ft_count(log, "worker steady joined"), 1);
+    kill(worker, SIGTERM);
+    assert_int_equal(ft_wait(worker, 20), 130);
+}
+
+/* ---- SIGINT ---- */
+
+static void test_farm_sigint_master_cleans_up(void **state)
+{
+    (void)state;
+    /* local workers slowed down through a wrapper the master starts */
+    const char *wrapper = ft_path(dir, "slow-worker.sh");
+    FILE *f = fopen(wrapper, "w");
+    assert_non_null(f);
+    fprintf(f, "#!/bin/sh\nexec '%s' --tile-delay 100 \"$@\"\n", ft_worker);
+    fclose(f);
+    chmod(wrapper, 0755);
+    const char *log = ft_path(dir, "int.log"), *out = ft_path(dir, "int.exr");
+    setenv("TMPDIR", dir, 1);
+    const char *argv[] = {ft_master, ft_path(dir, "scene.rib"), "-o", out, "--tile", "8",
+                          "--local-workers", "2", "--worker-binary", wrapper, "-v", NULL};
+    pid_t master = ft_spawn(log, argv);
+    unsetenv("TMPDIR");
+    assert_true(ft_wait_for(log, "took tile ", 2, 60));
+    assert_int_equal(ft_count_files(dir, "int.exr.tmp"), 1);   /* being written */
+    kill(master, SIGINT);
+    assert_int_equal(ft_wait(master, 30), 130);
+    assert_int_equal(ft_count(log, "interrupted; "), 1);
+    assert_int_equal(access(out, F_OK), -1);
+    assert_int_equal(ft_count_files(dir, "int.exr.tmp"), 0);
+    assert_int_equal(ft_count_files(dir, "aafarm-"), 0);
+    /* both local workers were stopped and reaped by the master */
+    char *text = ft_read(log);
+    int n = 0;
+    for (const char *p = text; (p = strstr(p, ", pid ")); p++, n++) {
+        pid_t pid = (pid_t)atoi(p + 6);
+        errno = 0;
+        assert_int_equal(kill(pid, 0), -1);
+        assert_int_equal(errno, ESRCH);
+    }
+    free(text);
+    assert_int_equal(n, 2);
+}
+
+int main(int argc, char **argv)
+{
+    if (!ft_init(argc, argv)) return 2;
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test_teardown(test_farm_kill9_worker_mid_render, teardown),
+        cmocka_unit_test_teardown(test_farm_sigstop_worker_requeued, teardown),
+        cmocka_unit_test_teardown(test_farm_garbage_to_master_port, teardown),
+        cmocka_unit_test_teardown(test_farm_sigint_master_cleans_up, teardown),
+    };
+    return cmocka_run_group_tests(tests, group_setup, group_teardown);
+}

@@ -1,0 +1,189 @@
+/*
+ * test_farm_render.c: the farm renders what the standalone renderer
+ * renders, pixel for pixel, with real processes over real sockets:
+ *   - the local two-process test: one master, one worker, tcp://127.0.0.1;
+ *   - three workers: one started before the master, one joining mid-render;
+ *   - the embedded default (no --bind): local workers started and stopped
+ *     by the master, preview and statistics written, nothing left behind.
+ * The reference is `aafarm-worker --standalone` of the same scene.
+ */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <errno.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "farm_testutil.h"
+
+static char *dir;
+
+static int group_setup(void **state)
+{
+    (void)state;
+    dir = ft_tempdir();
+    ft_write_scene(dir, FT_SCENE_WAVE);
+    if (ft_standalone(dir, 8) != 0) {
+        fprintf(stderr, "the standalone reference render failed:\n%s\n",
+                ft_read(ft_path(dir, "standalone.log")));
+        return -1;
+    }
+    return 0;
+}
+
+static int group_teardown(void **state)
+{
+    (void)state;
+    ft_stop_all();
+    ft_rmtree(dir);
+    free(dir);
+    return 0;
+}
+
+static int teardown(void **state)
+{
+    (void)state;
+    ft_stop_all();
+    return 0;
+}
+
+static pid_t start_worker(const char *endpoint, const char *name, const char *threads,
+                          const char *delay_ms)
+{
+    char log[64];
+    snprintf(log, sizeof log, "%s.log", name);
+    const char *argv[] = {ft_worker, "--connect", endpoint, "--name", name, "--threads", threads,
+                          "--tile-delay", delay_ms, NULL};
+    return ft_spawn(ft_path(dir, log), argv);
+}
+
+/* A worker that served a master keeps waiting for the next one; SIGTERM
+ * ends it with status 130. */
+static void stop_worker(pid_t pid)
+{
+    assert_true(ft_running(pid));
+    kill(pid, SIGTERM);
+    assert_int_equal(ft_wait(pid, 20), 130);
+}
+
+static void test_farm_two_processes_equal_standalone(void **state)
+{
+    (void)state;
+    const char *log = ft_path(dir, "two.log");
+    const char *argv[] = {ft_master, ft_path(dir, "scene.rib"), "-o", ft_path(dir, "two.exr"),
+                          "--bind", "tcp://127.0.0.1:*", "--tile", "8", NULL};
+    pid_t master = ft_spawn(log, argv);
+    char ep[256];
+    assert_true(ft_master_endpoint(log, ep, sizeof ep, 30));
+    assert_non_null(strstr(ep, "tcp://127.0.0.1:"));
+    pid_t worker = start_worker(ep, "solo", "2", "0");
+    assert_int_equal(ft_wait(master, 120), 0);
+    assert_int_equal(ft_exr_diff(ft_path(dir, "ref.exr"), ft_path(dir, "two.exr")), 0);
+    assert_int_equal(ft_count_files(dir, "two.exr.tmp"), 0);
+    /* the summary names the worker and its 48 tiles */
+    assert_int_equal(ft_count(log, "worker solo joined"), 1);
+    char *text = ft_read(log);
+    const char *row = strstr(text, "  solo ");
+    assert_non_null(row);
+    long tiles = -1;
+    sscanf(row, " solo %*s %ld", &tiles);
+    assert_int_equal(tiles, 48);
+    free(text);
+    stop_worker(worker);
+}
+
+static void test_farm_three_workers_early_and_late(void **state)
+{
+    (void)state;
+    int port = ft_free_port();
+    assert_true(port > 0);
+    char bind[64];
+    snprintf(bind, sizeof bind, "tcp://127.0.0.1:%d", port);
+    /* early: connects (and keeps trying) before the master exists */
+    pid_t early = start_worker(bind, "early", "1", "60");
+    ft_sleep_ms(300);
+    const char *log = ft_path(dir, "three.log");
+    const char *json = ft_path(dir, "three.json");
+    const char *argv[] = {ft_master, ft_path(dir, "scene.rib"), "-o", ft_path(dir, "three.exr"),
+                          "--bind", bind, "--tile", "8", "--stats-json", json, "-v", NULL};
+    pid_t master = ft_spawn(log, argv);
+    assert_true(ft_wait_for(log, "worker early joined", 1, 30));
+    pid_t second = start_worker(bind, "second", "1", "60");
+    /* late: joins once tiles are coming back */
+    assert_true(ft_wait_for(log, "took tile ", 4, 60));
+    assert_true(ft_count(log, "wrote ") == 0);
+    pid_t late = start_worker(bind, "late", "1", "60");
+    assert_int_equal(ft_wait(master, 120), 0);
+    assert_int_equal(ft_exr_diff(ft_path(dir, "ref.exr"), ft_path(dir, "three.exr")), 0);
+    assert_int_equal(ft_count(log, "worker second joined"), 1);
+    assert_int_equal(ft_count(log, "worker late joined"), 1);
+    /* the late worker took part: some tile came from it */
+    assert_true(ft_count(log, " from late (lease") >= 1);
+    assert_true(ft_count(json, "\"tiles_done\": 48") == 1);
+    stop_worker(early);
+    stop_worker(second);
+    stop_worker(late);
+}
+
+/* The pids of "worker local-K joined (host, pid P" lines. */
+static int local_pids(const char *log, pid_t *pids, int max)
+{
+    char *text = ft_read(log);
+    int n = 0;
+    for (const char *p = text; n < max && (p = strstr(p, "joined (")); p++) {
+        const char *q = strstr(p, ", pid ");
+        if (q) pids[n++] = (pid_t)atoi(q + 6);
+    }
+    free(text);
+    return n;
+}
+
+static void test_farm_embedded_default(void **state)
+{
+    (void)state;
+    const char *log = ft_path(dir, "embedded.log");
+    const char *json = ft_path(dir, "embedded.json");
+    const char *png = ft_path(dir, "embedded.png");
+    setenv("TMPDIR", dir, 1);   /* the master's private socket folder goes here */
+    const char *argv[] = {ft_master, ft_path(dir, "scene.rib"), "-o", ft_path(dir, "embedded.exr"),
+                          "--local-workers", "2", "--tile", "8", "--preview", png,
+                          "--stats-json", json, NULL};
+    pid_t master = ft_spawn(log, argv);
+    unsetenv("TMPDIR");
+    assert_int_equal(ft_wait(master, 120), 0);
+    assert_int_equal(ft_exr_diff(ft_path(dir, "ref.exr"), ft_path(dir, "embedded.exr")), 0);
+    /* the preview is a PNG */
+    char *head = ft_read(png);
+    assert_memory_equal(head, "\x89PNG", 4);
+    free(head);
+    /* statistics: done, every tile, two local workers */
+    assert_int_equal(ft_count(json, "\"status\": \"done\""), 1);
+    assert_int_equal(ft_count(json, "\"tiles_done\": 48"), 1);
+    assert_int_equal(ft_count(json, "\"local\": true"), 2);
+    /* the local workers are gone and the private socket folder removed */
+    pid_t pids[2];
+    assert_int_equal(local_pids(log, pids, 2), 2);
+    for (int i = 0; i < 2; i++) {
+        errno = 0;
+        assert_int_equal(kill(pids[i], 0), -1);
+        assert_int_equal(errno, ESRCH);
+    }
+    assert_int_equal(ft_count_files(dir, "aafarm-"), 0);
+    assert_int_equal(ft_count_files(dir, "embedded.exr.tmp"), 0);
+}
+
+int main(int argc, char **argv)
+{
+    if (!ft_init(argc, argv)) return 2;
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test_teardown(test_farm_two_processes_equal_standalone, teardown),
+        cmocka_unit_test_teardown(test_farm_three_workers_early_and_late, teardown),
+        cmocka_unit_test_teardown(test_farm_embedded_default, teardown),
+    };
+    return cmocka_run_group_tests(tests, group_setup, group_teardown);
+}

@@ -1,0 +1,331 @@
+/*
+ * test_farm_scheduler.c: the master's tile scheduler (master/scheduler.h)
+ * without sockets: runs of neighbouring tiles per worker, requeue to the
+ * front, deadlines, end-game duplicates, retries and the job failing, stale
+ * and duplicate results, and a randomised run in which workers come, go,
+ * fail and time out while every tile must end up taken exactly once.
+ */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <stdlib.h>
+#include <string.h>
+
+#include "scheduler.h"
+
+static scheduler *make(int tx, int ty, int attempts, int dups, int64_t lease_ms)
+{
+    scheduler_options o;
+    scheduler_options_default(&o);
+    o.max_attempts = attempts;
+    o.max_duplicates = dups;
+    o.lease_ms = lease_ms;
+    o.duplicate_after_ms = 0;
+    scheduler *s = scheduler_new(tx, ty, &o);
+    assert_non_null(s);
+    return s;
+}
+
+static int grant_tile(scheduler *s, int w, int64_t now, uint64_t *id)
+{
+    scheduler_lease l;
+    if (id) *id = 0;
+    if (!scheduler_grant(s, w, now, &l)) return -1;
+    assert_int_equal(l.worker, w);
+    if (id) *id = l.id;
+    return l.tile;
+}
+
+static void test_one_worker_row_major(void **state)
+{
+    (void)state;
+    scheduler *s = make(4, 3, 3, 0, 1000);
+    int w = scheduler_worker_add(s);
+    uint64_t ids[12];
+    for (int i = 0; i < 12; i++) assert_int_equal(grant_tile(s, w, 0, &ids[i]), i);
+    assert_int_equal(grant_tile(s, w, 0, NULL), -1);   /* no duplicates: off */
+    assert_int_equal(scheduler_worker_leases(s, w), 12);
+    for (int i = 0; i < 12; i++) {
+        assert_false(scheduler_finished(s));
+        assert_int_equal(scheduler_complete(s, w, ids[i], 0), SCHEDULER_TAKEN);
+        assert_true(scheduler_tile_done(s, i));
+    }
+    assert_true(scheduler_finished(s));
+    assert_int_equal(grant_tile(s, w, 0, NULL), -1);
+    scheduler_destroy(&s);
+    assert_null(s);
+}
+
+static void test_second_worker_splits_longest_run(void **state)
+{
+    (void)state;
+    scheduler *s = make(10, 1, 3, 0, 1000);
+    int a = scheduler_worker_add(s), b = scheduler_worker_add(s), c = scheduler_worker_add(s);
+    assert_int_equal(grant_tile(s, a, 0, NULL), 0);
+    /* fresh run 1..9: b starts in its middle */
+    assert_int_equal(grant_tile(s, b, 0, NULL), 5);
+    /* runs now 1..4 and 6..9 (4 each): c takes the middle of the first */
+    assert_int_equal(grant_tile(s, c, 0, NULL), 3);
+    /* each continues its own run: neighbours stay with one worker */
+    assert_int_equal(grant_tile(s, a, 0, NULL), 1);
+    assert_int_equal(grant_tile(s, b, 0, NULL), 6);
+    assert_int_equal(grant_tile(s, c, 0, NULL), 4);
+    assert_int_equal(grant_tile(s, a, 0, NULL), 2);
+    /* a's run hits c's tiles: it jumps to the longest run left (7..9) */
+    assert_int_equal(grant_tile(s, a, 0, NULL), 8);
+    scheduler_destroy(&s);
+}
+
+static void test_requeue_goes_first_oldest_first(void **state)
+{
+    (void)state;
+    scheduler *s = make(8, 1, 3, 0, 1000);
+    int a = scheduler_worker_add(s), b = scheduler_worker_add(s);
+    assert_int_equal(grant_tile(s, a, 0, NULL), 0);
+    assert_int_equal(grant_tile(s, a, 0, NULL), 1);
+    uint64_t id2;
+    assert_int_equal(grant_tile(s, a, 0, &id2), 2);
+    assert_int_equal(scheduler_complete(s, a, id2, 0), SCHEDULER_TAKEN);
+    /* a dies holding 0 and 1: both come back, before any fresh tile */
+    assert_int_equal(scheduler_worker_remove(s, a), 2);
+    assert_int_equal(grant_tile(s, b, 0, NULL), 0);
+    assert_int_equal(grant_tile(s, b, 0, NULL), 1);
+    assert_int_equal(grant_tile(s, b, 0, NULL), 3);
+    /* a removed worker gets nothing, and its results are stale */
+    assert_int_equal(grant_tile(s, a, 0, NULL), -1);
+    assert_int_equal(scheduler_complete(s, a, 1, 0), SCHEDULER_STALE);
+    scheduler_counts c;
+    scheduler_counts_get(s, &c);
+    assert_int_equal(c.requeued, 2);
+    assert_int_equal(c.stale_results, 1);
+    assert_int_equal(c.done, 1);
+    scheduler_destroy(&s);
+}
+
+static void test_deadline_requeues_but_lease_stays_valid(void **state)
+{
+    (void)state;
+    scheduler *s = make(2, 1, 3, 0, 100);
+    int a = scheduler_worker_add(s), b = scheduler_worker_add(s);
+    uint64_t slow, quick, again;
+    assert_int_equal(grant_tile(s, a, 0, &slow), 0);
+    assert_int_equal(grant_tile(s, b, 10, &quick), 1);
+    assert_int_equal(scheduler_next_deadline(s), 100);
+    assert_int_equal(scheduler_expire(s, 99), 0);
+    assert_int_equal(grant_tile(s, b, 99, NULL), -1);
+    assert_int_equal(scheduler_expire(s, 100), 1);            /* tile 0 is back */
+    assert_int_equal(scheduler_next_deadline(s), 110);
+    assert_int_equal(grant_tile(s, b, 101, &again), 0);
+    /* the expired lease answers first: taken; the new one is a duplicate */
+    assert_int_equal(scheduler_check_result(s, a, slow), SCHEDULER_TAKEN);
+    assert_int_equal(scheduler_complete(s, a, slow, 0), SCHEDULER_TAKEN);
+    assert_int_equal(scheduler_check_result(s, b, again), SCHEDULER_DUPLICATE);
+    assert_int_equal(scheduler_complete(s, b, again, 0), SCHEDULER_DUPLICATE);
+    assert_int_equal(scheduler_complete(s, b, quick, 0), SCHEDULER_TAKEN);
+    assert_true(scheduler_finished(s));
+    scheduler_counts c;
+    scheduler_counts_get(s, &c);
+    assert_int_equal(c.expired, 1);
+    assert_int_equal(c.duplicate_results, 1);
+    scheduler_destroy(&s);
+}
+
+static void test_end_game_duplicates(void **state)
+{
+    (void)state;
+    scheduler *s = make(3, 1, 3, 1, 100000);
+    int a = scheduler_worker_add(s), b = scheduler_worker_add(s), c = scheduler_worker_add(s);
+    uint64_t a0, a1, a2, b0, c1;
+    assert_int_equal(grant_tile(s, a, 0, &a0), 0);
+    assert_int_equal(grant_tile(s, a, 1, &a1), 1);
+    assert_int_equal(grant_tile(s, a, 2, &a2), 2);
+    /* nothing queued: b duplicates the tile leased longest ago */
+    assert_int_equal(grant_tile(s, b, 3, &b0), 0);
+    const scheduler_lease *l = scheduler_lease_find(s, b, b0);
+    assert_non_null(l);
+    assert_true(l->duplicate);
+    /* tile 0 has its one duplicate: c gets the next oldest */
+    assert_int_equal(grant_tile(s, c, 4, &c1), 1);
+    /* a holds every tile already: nothing for it */
+    assert_int_equal(grant_tile(s, a, 5, NULL), -1);
+    /* first result wins */
+    assert_int_equal(scheduler_complete(s, b, b0, 0), SCHEDULER_TAKEN);
+    assert_int_equal(scheduler_complete(s, a, a0, 0), SCHEDULER_DUPLICATE);
+    assert_int_equal(scheduler_complete(s, a, a1, 0), SCHEDULER_TAKEN);
+    assert_int_equal(scheduler_complete(s, c, c1, 0), SCHEDULER_DUPLICATE);
+    /* b may now duplicate tile 2 */
+    uint64_t b2;
+    assert_int_equal(grant_tile(s, b, 6, &b2), 2);
+    assert_int_equal(scheduler_complete(s, a, a2, 0), SCHEDULER_TAKEN);
+    assert_int_equal(scheduler_complete(s, b, b2, 0), SCHEDULER_DUPLICATE);
+    assert_true(scheduler_finished(s));
+    scheduler_destroy(&s);
+}
+
+static void test_duplicates_wait_for_stragglers(void **state)
+{
+    (void)state;
+    scheduler_options o;
+    scheduler_options_default(&o);
+    o.max_duplicates = 1;
+    o.duplicate_after_ms = 100;
+    scheduler *s = scheduler_new(3, 1, &o);
+    int a = scheduler_worker_add(s), b = scheduler_worker_add(s);
+    uint64_t b2;
+    assert_int_equal(grant_tile(s, a, 0, NULL), 0);
+    assert_int_equal(grant_tile(s, a, 0, NULL), 1);
+    assert_int_equal(grant_tile(s, b, 0, &b2), 2);
+    assert_int_equal(scheduler_complete(s, b, b2, 50), SCHEDULER_TAKEN);
+    /* mean lease 50 ms: a duplicate only of a lease 150 ms old (3 x 50 > 100) */
+    assert_int_equal(grant_tile(s, b, 100, NULL), -1);
+    assert_int_equal(grant_tile(s, b, 149, NULL), -1);
+    assert_int_equal(grant_tile(s, b, 150, NULL), 0);
+    scheduler_destroy(&s);
+}
+
+static void test_failures_retry_elsewhere_then_fail_job(void **state)
+{
+    (void)state;
+    scheduler *s = make(4, 1, 3, 0, 100000);
+    int a = scheduler_worker_add(s), b = scheduler_worker_add(s);
+    uint64_t id;
+    assert_int_equal(grant_tile(s, a, 0, &id), 0);
+    assert_int_equal(scheduler_fail(s, a, id, true), SCHEDULER_RETRY);
+    assert_int_equal(scheduler_tile_attempts(s, 0), 1);
+    /* a failed tile 0: a gets a fresh tile, b gets tile 0 */
+    assert_int_equal(grant_tile(s, a, 0, NULL), 1);
+    assert_int_equal(grant_tile(s, b, 0, &id), 0);
+    assert_int_equal(scheduler_fail(s, b, id, true), SCHEDULER_RETRY);
+    /* both failed it: anyone may take it; third failure fails the job */
+    assert_int_equal(grant_tile(s, a, 0, &id), 0);
+    assert_false(scheduler_failed(s));
+    assert_int_equal(scheduler_fail(s, a, id, true), SCHEDULER_JOB_FAILED);
+    assert_true(scheduler_failed(s));
+    assert_int_equal(grant_tile(s, b, 0, NULL), -1);
+    scheduler_destroy(&s);
+}
+
+static void test_not_retryable_fails_at_once(void **state)
+{
+    (void)state;
+    scheduler *s = make(2, 2, 5, 0, 1000);
+    int a = scheduler_worker_add(s);
+    uint64_t id;
+    assert_int_equal(grant_tile(s, a, 0, &id), 0);
+    assert_int_equal(scheduler_fail(s, a, id + 7, false), SCHEDULER_FAIL_IGNORED);
+    assert_false(scheduler_failed(s));
+    assert_int_equal(scheduler_fail(s, a, id, false), SCHEDULER_JOB_FAILED);
+    assert_true(scheduler_failed(s));
+    scheduler_destroy(&s);
+}
+
+static void test_only_worker_gets_its_failed_tile_back(void **state)
+{
+    (void)state;
+    scheduler *s = make(1, 1, 3, 0, 1000);
+    int a = scheduler_worker_add(s);
+    uint64_t id;
+    assert_int_equal(grant_tile(s, a, 0, &id), 0);
+    assert_int_equal(scheduler_fail(s, a, id, true), SCHEDULER_RETRY);
+    assert_int_equal(grant_tile(s, a, 0, &id), 0);
+    assert_int_equal(scheduler_complete(s, a, id, 0), SCHEDULER_TAKEN);
+    assert_true(scheduler_finished(s));
+    scheduler_destroy(&s);
+}
+
+static void test_stale_results(void **state)
+{
+    (void)state;
+    scheduler *s = make(2, 1, 3, 0, 1000);
+    int a = scheduler_worker_add(s), b = scheduler_worker_add(s);
+    uint64_t id;
+    assert_int_equal(grant_tile(s, a, 0, &id), 0);
+    assert_int_equal(scheduler_check_result(s, b, id), SCHEDULER_STALE);  /* not b's */
+    assert_int_equal(scheduler_complete(s, b, id, 0), SCHEDULER_STALE);
+    assert_int_equal(scheduler_complete(s, a, 0, 0), SCHEDULER_STALE);
+    assert_int_equal(scheduler_complete(s, a, 999, 0), SCHEDULER_STALE);
+    assert_int_equal(scheduler_complete(s, a, id, 0), SCHEDULER_TAKEN);
+    assert_int_equal(scheduler_complete(s, a, id, 0), SCHEDULER_STALE);      /* resolved */
+    assert_null(scheduler_lease_find(s, a, id));
+    assert_null(scheduler_new(0, 5, NULL));
+    assert_null(scheduler_new(1 << 16, 1 << 16, NULL));
+    scheduler_destroy(&s);
+}
+
+/* Random workers that join, die, fail, stall and answer in random order;
+ * at the end every tile must have been taken exactly once. */
+static void test_random_farm_takes_every_tile_once(void **state)
+{
+    (void)state;
+    srand(12345);
+    for (int round = 0; round < 20; round++) {
+        int tx = 1 + rand() % 9, ty = 1 + rand() % 7, n = tx * ty;
+        scheduler *s = make(tx, ty, 1000, rand() % 3, 50);
+        int *taken = calloc((size_t)n, sizeof *taken);
+        typedef struct { int w; uint64_t id; } held;
+        held *out = NULL;
+        size_t nout = 0;
+        int workers[64], nw = 0;
+        workers[nw++] = scheduler_worker_add(s);
+        int64_t now = 0;
+        for (int step = 0; step < 100000 && !scheduler_finished(s); step++) {
+            now += rand() % 7;
+            int r = rand() % 100;
+            if (r < 3 && nw < 64) {
+                workers[nw++] = scheduler_worker_add(s);
+            } else if (r < 5 && nw > 1) {
+                int k = rand() % nw;
+                scheduler_worker_remove(s, workers[k]);
+                workers[k] = workers[--nw];
+            } else if (r < 45) {
+                int w = workers[rand() % nw];
+                scheduler_lease l;
+                if (scheduler_grant(s, w, now, &l)) {
+                    out = realloc(out, sizeof *out * (nout + 1));
+                    out[nout++] = (held){w, l.id};
+                }
+            } else if (r < 90 && nout > 0) {
+                size_t k = (size_t)rand() % nout;
+                held h = out[k];
+                out[k] = out[--nout];
+                const scheduler_lease *l = scheduler_lease_find(s, h.w, h.id);
+                int tile = l ? l->tile : -1;
+                if (rand() % 10 == 0) {
+                    scheduler_fail(s, h.w, h.id, true);
+                } else if (scheduler_complete(s, h.w, h.id, now) == SCHEDULER_TAKEN) {
+                    assert_true(tile >= 0);
+                    taken[tile]++;
+                }
+            } else {
+                scheduler_expire(s, now);
+            }
+        }
+        assert_true(scheduler_finished(s));
+        assert_false(scheduler_failed(s));
+        for (int i = 0; i < n; i++) assert_int_equal(taken[i], 1);
+        free(taken);
+        free(out);
+        scheduler_destroy(&s);
+    }
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_one_worker_row_major),
+        cmocka_unit_test(test_second_worker_splits_longest_run),
+        cmocka_unit_test(test_requeue_goes_first_oldest_first),
+        cmocka_unit_test(test_deadline_requeues_but_lease_stays_valid),
+        cmocka_unit_test(test_end_game_duplicates),
+        cmocka_unit_test(test_duplicates_wait_for_stragglers),
+        cmocka_unit_test(test_failures_retry_elsewhere_then_fail_job),
+        cmocka_unit_test(test_not_retryable_fails_at_once),
+        cmocka_unit_test(test_only_worker_gets_its_failed_tile_back),
+        cmocka_unit_test(test_stale_results),
+        cmocka_unit_test(test_random_farm_takes_every_tile_once),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

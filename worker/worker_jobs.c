@@ -1,0 +1,183 @@
+/*
+ * worker_jobs.c: Job message -> verified, compiled job, and the small
+ * list of jobs a worker keeps (see worker_jobs.h).
+ */
+#include "worker_jobs.h"
+
+#include <limits.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+struct worker_jobs {
+    held_job **jobs;           /* newest first */
+    int count, max;
+    size_t cache_bytes;
+};
+
+held_job *held_job_retain(held_job *self)
+{
+    atomic_fetch_add(&self->refs, 1);
+    return self;
+}
+
+void held_job_release(held_job **self_p)
+{
+    held_job *self = *self_p;
+    if (!self) return;
+    *self_p = NULL;
+    if (atomic_fetch_sub(&self->refs, 1) != 1) return;
+    job_scene_destroy(&self->js);
+    job_destroy(&self->jb);
+    free(self);
+}
+
+worker_jobs *worker_jobs_new(int max_held, size_t cache_bytes)
+{
+    worker_jobs *self = calloc(1, sizeof *self);
+    if (!self) abort();
+    self->max = max_held < 1 ? 1 : max_held;
+    self->jobs = calloc((size_t)self->max, sizeof *self->jobs);
+    if (!self->jobs) abort();
+    self->cache_bytes = cache_bytes;
+    return self;
+}
+
+void worker_jobs_destroy(worker_jobs **self_p)
+{
+    worker_jobs *self = *self_p;
+    if (!self) return;
+    for (int i = 0; i < self->count; i++) held_job_release(&self->jobs[i]);
+    free(self->jobs);
+    free(self);
+    *self_p = NULL;
+}
+
+held_job *worker_jobs_find(const worker_jobs *self, const char *hash)
+{
+    for (int i = 0; i < self->count; i++)
+        if (strcmp(self->jobs[i]->hash, hash) == 0) return self->jobs[i];
+    return NULL;
+}
+
+static job_options options_of(const Aafarm__RenderOptions *o)
+{
+    job_options jo;
+    job_options_default(&jo);
+    jo.arith = o->arithmetic == AAFARM__ARITHMETIC__ARITHMETIC_INTERVAL ? TRACE_ARITH_INTERVAL
+                                                                         : TRACE_ARITH_AFFINE;
+    jo.tile_size = (int)o->tile_size;
+    if (o->instruction_budget)
+        jo.max_instructions = o->instruction_budget > (uint64_t)LONG_MAX ? LONG_MAX
+                                                                          : (long)o->instruction_budget;
+    return jo;
+}
+
+/* The job from the message's fields, hashed again and compared. */
+static job *rebuild(const Aafarm__Job *m, char *err, size_t errsz)
+{
+    job_options jo = options_of(m->options);
+    job *jb = job_new(m->scene_name, (const char *)m->scene_text.data, m->scene_text.len, &jo);
+    char why[600];
+    bool ok = true;
+    for (size_t i = 0; ok && i < m->n_sources; i++)
+        ok = job_add_source(jb, m->sources[i]->name, (const char *)m->sources[i]->text.data,
+                            m->sources[i]->text.len, why, sizeof why);
+    for (size_t i = 0; ok && i < m->n_shaders; i++)
+        ok = job_add_shader(jb, m->shaders[i]->name, m->shaders[i]->source, why, sizeof why);
+    if (ok) ok = job_finish(jb, why, sizeof why);
+    if (!ok) {
+        snprintf(err, errsz, "job %.12s... is inconsistent: %s", m->job_hash, why);
+        job_destroy(&jb);
+        return NULL;
+    }
+    if (strcmp(jb->hash, m->job_hash) != 0) {
+        snprintf(err, errsz, "job %.12s...: its content hashes to %.12s... here (the master "
+                 "and this worker run different aafarm versions?)", m->job_hash, jb->hash);
+        job_destroy(&jb);
+        return NULL;
+    }
+    return jb;
+}
+
+static bool layers_of(const Aafarm__RenderOptions *o, unsigned *layers, char *err, size_t errsz)
+{
+    *layers = 0;
+    for (size_t i = 0; i < o->n_layers; i++) {
+        if (strcmp(o->layers[i], "N") == 0) *layers |= IMAGE_LAYER_N;
+        else if (strcmp(o->layers[i], "P") == 0) *layers |= IMAGE_LAYER_P;
+        else if (strcmp(o->layers[i], "RGBA") != 0) {
+            snprintf(err, errsz, "unknown EXR layer '%s' (this worker writes RGBA, Z, N, P)",
+                     o->layers[i]);
+            return false;
+        }
+    }
+    return true;
+}
+
+/* Compiles the job and checks the image it describes. */
+static bool prepare(held_job *h, const Aafarm__Job *m, size_t cache_bytes)
+{
+    sl_diag *diag = sl_diag_new();
+    h->js = job_scene_new(h->jb, cache_bytes, true, diag);
+    if (!h->js) {
+        char *text = sl_diag_to_string(diag);
+        size_t n = strlen(text);
+        while (n > 0 && (text[n - 1] == '\n' || text[n - 1] == ' ')) text[--n] = '\0';
+        snprintf(h->error, sizeof h->error, "job %.12s... does not compile here: %s", h->hash, text);
+        free(text);
+        sl_diag_destroy(&diag);
+        return false;
+    }
+    sl_diag_destroy(&diag);
+    const Aafarm__RenderOptions *o = m->options;
+    h->fmt = (image_format){(int)o->width, (int)o->height, (int)o->tile_size, 0};
+    if (!layers_of(o, &h->fmt.layers, h->error, sizeof h->error)) return false;
+    if (h->js->world.camera.xres != h->fmt.width || h->js->world.camera.yres != h->fmt.height) {
+        snprintf(h->error, sizeof h->error, "job %.12s...: the master says %ux%u pixels, the "
+                 "scene here says %dx%d", h->hash, o->width, o->height,
+                 h->js->world.camera.xres, h->js->world.camera.yres);
+        return false;
+    }
+    char err[300];
+    if (!image_format_check(&h->fmt, err, sizeof err)) {
+        snprintf(h->error, sizeof h->error, "job %.12s...: %s", h->hash, err);
+        return false;
+    }
+    return true;
+}
+
+static void keep(worker_jobs *self, held_job *h)
+{
+    if (self->count == self->max) held_job_release(&self->jobs[--self->count]);
+    memmove(&self->jobs[1], &self->jobs[0], sizeof *self->jobs * (size_t)self->count);
+    self->jobs[0] = h;
+    self->count++;
+}
+
+held_job *worker_jobs_add(worker_jobs *self, const Aafarm__Job *m)
+{
+    held_job *h = worker_jobs_find(self, m->job_hash);
+    if (h) return h;
+    h = calloc(1, sizeof *h);
+    if (!h) abort();
+    atomic_init(&h->refs, 1);
+    snprintf(h->hash, sizeof h->hash, "%s", m->job_hash);
+    size_t cache = self->cache_bytes ? self->cache_bytes : (size_t)m->options->cache_bytes;
+    h->jb = rebuild(m, h->error, sizeof h->error);
+    if (!h->jb || !prepare(h, m, cache)) {
+        h->broken = true;
+        job_scene_destroy(&h->js);
+        job_destroy(&h->jb);
+    }
+    keep(self, h);
+    return h;
+}
+
+size_t worker_jobs_hashes(const worker_jobs *self, char **out, size_t max)
+{
+    size_t n = 0;
+    for (int i = 0; i < self->count && n < max; i++)
+        if (!self->jobs[i]->broken) out[n++] = self->jobs[i]->hash;
+    return n;
+}
