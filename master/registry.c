@@ -9,7 +9,10 @@
 #include <stdlib.h>
 #include <string.h>
 
-enum { REJECT_TABLE = 64 };
+enum {
+    REJECT_TABLE = 64,
+    KEEP_RETIRED = 4096    /* retired workers kept for the summary */
+};
 
 typedef struct reject_entry {
     uint8_t id[REGISTRY_MAX_ID];
@@ -41,9 +44,24 @@ void registry_destroy(registry **self_p)
     *self_p = NULL;
 }
 
+/* Forgets the oldest retired worker when too many are kept: a peer that
+ * says Hello over and over must not grow the master without bound. */
+static void drop_old_retired(registry *self)
+{
+    size_t retired = 0, first = self->count;
+    for (size_t i = 0; i < self->count; i++)
+        if (!self->workers[i]->alive && retired++ == 0) first = i;
+    if (retired < KEEP_RETIRED) return;
+    free(self->workers[first]);
+    memmove(&self->workers[first], &self->workers[first + 1],
+            sizeof *self->workers * (self->count - first - 1));
+    self->count--;
+}
+
 farm_worker *registry_add(registry *self, const uint8_t *id, size_t id_len, int64_t now_ms)
 {
     if (id_len == 0 || id_len > REGISTRY_MAX_ID) return NULL;
+    drop_old_retired(self);
     if (self->count == self->cap) {
         self->cap = self->cap ? self->cap * 2 : 16;
         self->workers = realloc(self->workers, sizeof *self->workers * self->cap);

@@ -5,7 +5,9 @@
  * statistics file). A worker that leaves or dies is retired, not freed:
  * it stays in the list for the summary, but lookups by routing id no
  * longer find it, so its next message is answered with Reject
- * HELLO_FIRST.
+ * HELLO_FIRST. At most 4096 retired workers are kept (the oldest go
+ * first), so a peer saying Hello over and over cannot grow the master
+ * without bound.
  *
  * Also here: the rate limit for those HELLO_FIRST answers (at most one per
  * unknown peer per heartbeat interval, over a small table of peers).
