@@ -35,11 +35,6 @@ static void aa_xform_normal(aa_context *ctx, const mat4 *inv, const aa_form in[3
     aa_xform(ctx, &t, in, out, false);
 }
 
-static void set_affine3(sl_vm *vm, sl_global g, const aa_form v[3])
-{
-    sl_vm_set_affine(vm, g, v);
-}
-
 static void box_from_affine(const aa_form P[3], trace_box *out)
 {
     ia_interval r[3];
@@ -51,13 +46,6 @@ static void box_from_affine(const aa_form P[3], trace_box *out)
     out->lo = v3(r[0].lo, r[1].lo, r[2].lo);
     out->hi = v3(r[0].hi, r[1].hi, r[2].hi);
     out->flags = flags & (AA_DISCONTINUOUS | AA_UNBOUNDED);
-}
-
-static void shader_failed(trace_thread *th, const char *what)
-{
-    char msg[512];
-    snprintf(msg, sizeof msg, "%s", what);
-    trace_thread_fail(th, msg);
 }
 
 static void box_affine(trace_thread *th, const trace_object *obj,
@@ -88,12 +76,12 @@ static void box_affine(trace_thread *th, const trace_object *obj,
     sl_vm *vm = th->vm;
     sl_vm_clear_globals(vm);
     sl_vm_set_spaces(vm, &obj->displacement_spaces);
-    set_affine3(vm, SL_G_P, P);
-    set_affine3(vm, SL_G_N, N);
-    set_affine3(vm, SL_G_Ng, N);
-    set_affine3(vm, SL_G_I, P);
-    set_affine3(vm, SL_G_dPdu, dPdu);
-    set_affine3(vm, SL_G_dPdv, dPdv);
+    sl_vm_set_affine(vm, SL_G_P, P);
+    sl_vm_set_affine(vm, SL_G_N, N);
+    sl_vm_set_affine(vm, SL_G_Ng, N);
+    sl_vm_set_affine(vm, SL_G_I, P);
+    sl_vm_set_affine(vm, SL_G_dPdu, dPdu);
+    sl_vm_set_affine(vm, SL_G_dPdv, dPdv);
     sl_vm_set_affine(vm, SL_G_u, &u);
     sl_vm_set_affine(vm, SL_G_v, &v);
     sl_vm_set_affine(vm, SL_G_s, &u);
@@ -104,7 +92,7 @@ static void box_affine(trace_thread *th, const trace_object *obj,
     sl_vm_set_affine(vm, SL_G_du, &du);
     sl_vm_set_affine(vm, SL_G_dv, &dv);
     if (sl_vm_run(vm, obj->displacement, SL_MODE_AFFINE, ctx) != SL_OK) {
-        shader_failed(th, sl_vm_error(vm));
+        trace_thread_fail(th, sl_vm_error(vm));
         aa_unbounded(&P[0], AA_UNBOUNDED);
         P[1] = P[2] = P[0];
     } else {
@@ -172,7 +160,7 @@ static void box_interval(trace_thread *th, const trace_object *obj,
     sl_vm_set_interval(vm, SL_G_du, &du);
     sl_vm_set_interval(vm, SL_G_dv, &dv);
     if (sl_vm_run(vm, obj->displacement, SL_MODE_INTERVAL, NULL) != SL_OK) {
-        shader_failed(th, sl_vm_error(vm));
+        trace_thread_fail(th, sl_vm_error(vm));
         P[0] = P[1] = P[2] = ia_entire();
     } else {
         ia_interval Pc[3];
@@ -262,7 +250,7 @@ void trace_surface_point_eval(trace_thread *th, const trace_object *obj,
     sl_vm_set_dual(vm, SL_G_t, &dv_);
     th->stats.evals_dual++;
     if (sl_vm_run(vm, obj->displacement, SL_MODE_DUAL, NULL) != SL_OK) {
-        shader_failed(th, sl_vm_error(vm));
+        trace_thread_fail(th, sl_vm_error(vm));
         return;
     }
     sl_dual rP[3], rN[3];

@@ -53,6 +53,8 @@ static void leaf_hit(walk *w, const trace_box *box, const double r[4],
     th->stats.leaves++;
     double t;
     vec3 wall_n = v3(0, 0, 0);
+    trace_surface_point sp;
+    bool has_point = false;
     if (kind == TRACE_LEAF_WALL) {
         /* the ray meets the wall where it enters its box */
         th->stats.wall_leaves++;
@@ -66,8 +68,8 @@ static void leaf_hit(walk *w, const trace_box *box, const double r[4],
         }
     } else {
         if (kind == TRACE_LEAF_DEPTH) th->stats.depth_cap_leaves++;
-        trace_surface_point sp;
         trace_surface_point_eval(th, obj, uc, vc, &sp);
+        has_point = true;
         const trace_ray *cr = w->cam_ray;
         double dd = v3_dot(cr->d, cr->d);
         t = dd > 0 ? v3_dot(v3_sub(sp.P, cr->o), cr->d) / dd : t0;
@@ -83,6 +85,8 @@ static void leaf_hit(walk *w, const trace_box *box, const double r[4],
     b->leaf_size = trace_box_extent(box) * obj->scale;
     b->kind = kind;
     b->wall_normal = wall_n;
+    b->has_point = has_point;
+    if (has_point) b->point = sp;
     w->found = true;
 }
 
@@ -186,6 +190,7 @@ static bool intersect_exact(const trace_object *obj, const trace_ray *ray,
     best->leaf_size = 0;
     best->kind = TRACE_LEAF_EXACT;
     best->wall_normal = v3(0, 0, 0);
+    best->has_point = false;
     return true;
 }
 

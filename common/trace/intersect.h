@@ -49,6 +49,10 @@ typedef struct trace_hit {
     double leaf_size;              /* camera-space size of the leaf box (0: exact) */
     trace_leaf_kind kind;
     vec3 wall_normal;              /* TRACE_LEAF_WALL: camera space, unit */
+    bool has_point;                /* point holds the surface at (u, v) */
+    trace_surface_point point;     /* small and depth-cap leaves: the dual
+                                      evaluation the hit was placed with,
+                                      reused for shading */
 } trace_hit;
 
 /* Intersects one object; updates *best when a hit nearer than best->t is

@@ -106,7 +106,8 @@ void trace_shade_hit(const trace_renderer *r, trace_thread *th,
 {
     const trace_object *obj = hit->obj;
     trace_surface_point sp;
-    trace_surface_point_eval(th, obj, hit->u, hit->v, &sp);
+    if (hit->has_point) sp = hit->point;
+    else trace_surface_point_eval(th, obj, hit->u, hit->v, &sp);
     if (hit->kind == TRACE_LEAF_WALL) {
         sp.P = trace_ray_at(ray, hit->t);
         sp.N = sp.Ng = hit->wall_normal;
