@@ -23,12 +23,15 @@
 #include "tile_render.h"
 #include "util/exitcodes.h"
 
-static volatile sig_atomic_t interrupted;
+/* Set by SIGINT/SIGTERM (a lock-free atomic: safe in a handler); every
+ * render thread's trace_thread watches it, so a render stops within one
+ * ray's walk, not at the end of a tile. */
+static atomic_int interrupted;
 
 static void on_signal(int sig)
 {
     (void)sig;
-    interrupted = 1;
+    atomic_store(&interrupted, 1);
 }
 
 typedef struct shared {
@@ -44,6 +47,7 @@ typedef struct shared {
     bool failed;
     char error[600];
     trace_stats stats;
+    trace_object_work *work;       /* per object, summed over the threads */
     double t_start;
 } shared;
 
@@ -75,6 +79,7 @@ static void *render_thread(void *arg)
 {
     shared *s = arg;
     trace_thread *th = trace_thread_new(&s->js->world);
+    th->cancel = &interrupted;
     int tx_count = image_format_tiles_x(&s->fmt);
     for (;;) {
         int i = atomic_fetch_add(&s->next_tile, 1);
@@ -104,6 +109,7 @@ static void *render_thread(void *arg)
     trace_thread_sync_stats(th);
     pthread_mutex_lock(&s->lock);
     trace_stats_add(&s->stats, &th->stats);
+    trace_object_work_add(s->work, th->work, s->js->world.nobjects);
     pthread_mutex_unlock(&s->lock);
     trace_thread_destroy(&th);
     return NULL;
@@ -132,12 +138,24 @@ static bool write_stats_json(const char *path, const shared *s, int threads, dou
 
 int worker_standalone(const standalone_options *opt)
 {
+    /* first: a signal during preparation must not leave a temporary file */
+    struct sigaction sa = {0};
+    sa.sa_handler = on_signal;
+    sigaction(SIGINT, &sa, NULL);
+    sigaction(SIGTERM, &sa, NULL);
+
     sl_diag *diag = sl_diag_new();
     job *jb = job_load(opt->scene_path, &opt->job, diag);
     job_scene *js = jb ? job_scene_new(jb, opt->cache_bytes, true, diag) : NULL;
     sl_diag_print(diag, stderr);
     sl_diag_destroy(&diag);
-    if (!js) {
+    if (!js || atomic_load(&interrupted)) {
+        if (js && atomic_load(&interrupted)) {
+            fprintf(stderr, "aafarm-worker: interrupted; %s not written\n", opt->output);
+            job_scene_destroy(&js);
+            job_destroy(&jb);
+            return AAFARM_EXIT_INTERRUPTED;
+        }
         /* job_load checked the scene and compiled the shaders; what fails
          * after it is a shader at run time (its budget): a render failure */
         int rc = jb ? AAFARM_EXIT_FAILURE : AAFARM_EXIT_INPUT;
@@ -167,6 +185,8 @@ int worker_standalone(const standalone_options *opt)
         if (!s.preview) abort();
     }
     s.ntiles = image_format_tile_count(&s.fmt);
+    s.work = calloc((size_t)js->world.nobjects + 1, sizeof *s.work);
+    if (!s.work) abort();
     atomic_init(&s.next_tile, 0);
     pthread_mutex_init(&s.lock, NULL);
     int threads = opt->threads > 0 ? opt->threads : default_threads();
@@ -174,11 +194,6 @@ int worker_standalone(const standalone_options *opt)
         fprintf(stderr, "aafarm-worker: %s: %dx%d, %d tiles of %d, %d thread%s, %s arithmetic\n",
                 opt->scene_path, s.fmt.width, s.fmt.height, s.ntiles, s.fmt.tile_size,
                 threads, threads == 1 ? "" : "s", trace_arith_name(opt->job.arith));
-
-    struct sigaction sa = {0};
-    sa.sa_handler = on_signal;
-    sigaction(SIGINT, &sa, NULL);
-    sigaction(SIGTERM, &sa, NULL);
 
     s.t_start = now_s();
     pthread_t *tids = calloc((size_t)threads, sizeof *tids);
@@ -207,8 +222,10 @@ int worker_standalone(const standalone_options *opt)
         fprintf(stderr, "aafarm-worker: %s\n", err);
         rc = AAFARM_EXIT_FAILURE;
     }
-    if (rc == AAFARM_EXIT_OK && opt->verbosity >= 0)
+    if (rc == AAFARM_EXIT_OK && opt->verbosity >= 0) {
+        trace_object_work_report(&js->world, s.work, "aafarm-worker", stderr);
         fprintf(stderr, "aafarm-worker: wrote %s (%.2f s)\n", opt->output, secs);
+    }
     if (opt->stats) {
         fprintf(stderr, "statistics:\n");
         trace_stats_print(&s.stats, stderr);
@@ -218,6 +235,7 @@ int worker_standalone(const standalone_options *opt)
         if (rc == AAFARM_EXIT_OK) rc = AAFARM_EXIT_FAILURE;
     }
     free(s.preview);
+    free(s.work);
     pthread_mutex_destroy(&s.lock);
     job_scene_destroy(&js);
     job_destroy(&jb);

@@ -9,6 +9,7 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <pthread.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -34,6 +35,7 @@ struct worker_pool {
     render_thread *threads;
     int nthreads;
     bool stopping;
+    atomic_int abort_render;   /* set when stopping: running tiles end at once */
     int pipe_fd[2];
     int tile_delay_ms;
 };
@@ -144,6 +146,15 @@ static worker_task *take_nearest(worker_pool *p, long last)
     return t;
 }
 
+/* The end of a thread's work on a job: its work-limit warnings (one line
+ * per object, trace_object_work_report), then its VM and box cache go. */
+static void retire_thread(trace_thread **th, const held_job *held)
+{
+    if (*th && held)
+        trace_object_work_report(&held->js->world, (*th)->work, "aafarm-worker", stderr);
+    trace_thread_destroy(th);
+}
+
 static void *render_main(void *arg)
 {
     render_thread *rt = arg;
@@ -158,10 +169,11 @@ static void *render_main(void *arg)
         rt->current = t;
         pthread_mutex_unlock(&p->lock);
         if (cur != t->job) {   /* another job: a new VM and box cache */
-            trace_thread_destroy(&th);
+            retire_thread(&th, cur);
             held_job_release(&cur);
             cur = held_job_retain(t->job);
             th = trace_thread_new(&cur->js->world);
+            th->cancel = &p->abort_render;
         }
         render_task(p, th, t);
         pthread_mutex_lock(&p->lock);
@@ -171,7 +183,7 @@ static void *render_main(void *arg)
         wake_loop(p);
     }
     pthread_mutex_unlock(&p->lock);
-    trace_thread_destroy(&th);
+    retire_thread(&th, cur);
     held_job_release(&cur);
     return NULL;
 }
@@ -182,6 +194,7 @@ worker_pool *worker_pool_new(int threads, int tile_delay_ms)
 {
     worker_pool *p = calloc(1, sizeof *p);
     if (!p) abort();
+    atomic_init(&p->abort_render, 0);
     p->nthreads = threads < 1 ? 1 : threads;
     p->tile_delay_ms = tile_delay_ms;
     p->threads = calloc((size_t)p->nthreads, sizeof *p->threads);
@@ -223,6 +236,7 @@ void worker_pool_destroy(worker_pool **self_p)
     if (!p) return;
     pthread_mutex_lock(&p->lock);
     p->stopping = true;
+    atomic_store(&p->abort_render, 1);
     pthread_cond_broadcast(&p->wake);
     pthread_mutex_unlock(&p->lock);
     for (int i = 0; i < p->nthreads; i++)

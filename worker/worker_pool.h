@@ -60,7 +60,8 @@ typedef struct worker_pool worker_pool;
  * thread cannot be created. */
 worker_pool *worker_pool_new(int threads, int tile_delay_ms);
 
-/* Stops the threads (after the tiles they are rendering) and frees
+/* Stops the threads (a tile being rendered ends within one ray: its
+ * trace_thread watches the pool's abort flag) and frees
  * everything still queued or done. */
 void worker_pool_destroy(worker_pool **self_p);
 

@@ -178,12 +178,15 @@ void trace_surface_box(trace_thread *th, const trace_object *obj,
     else
         box_affine(th, obj, u0, u1, v0, v1, out);
     th->stats.boxes++;
-    /* a NaN bound means we know nothing: the whole space */
+    /* A NaN bound: the shader's result is defined nowhere in the range
+     * (common/aa gives unbounded, not NaN, where only some points are
+     * undefined or huge): no surface there. Empty box, counted. */
     if (isnan(out->lo.x) || isnan(out->lo.y) || isnan(out->lo.z) ||
         isnan(out->hi.x) || isnan(out->hi.y) || isnan(out->hi.z)) {
-        out->lo = v3(-INFINITY, -INFINITY, -INFINITY);
-        out->hi = v3(INFINITY, INFINITY, INFINITY);
-        out->flags |= AA_UNBOUNDED;
+        out->lo = v3(INFINITY, INFINITY, INFINITY);
+        out->hi = v3(-INFINITY, -INFINITY, -INFINITY);
+        out->flags &= ~(unsigned)AA_UNBOUNDED;
+        th->stats.empty_boxes++;
     }
 }
 

@@ -20,6 +20,8 @@ typedef struct walk {
     trace_tolerance tol;
     bool any;
     bool found;
+    bool stopped;                  /* the work limit or a cancel ended the walk */
+    long nodes;                    /* quadtree nodes visited so far */
     trace_hit *best;
 } walk;
 
@@ -72,7 +74,22 @@ static void leaf_hit(walk *w, const trace_box *box, const double r[4],
         has_point = true;
         const trace_ray *cr = w->cam_ray;
         double dd = v3_dot(cr->d, cr->d);
-        t = dd > 0 ? v3_dot(v3_sub(sp.P, cr->o), cr->d) / dd : t0;
+        if (!v3_is_finite(sp.P) || !(dd > 0)) {
+            th->stats.rejected_leaves++;   /* no surface point to place a hit */
+            return;
+        }
+        t = v3_dot(v3_sub(sp.P, cr->o), cr->d) / dd;
+        if (kind == TRACE_LEAF_DEPTH) {
+            /* The box never got small: the surface jumps or is unbounded in
+             * this tiny (u,v) cell. A hit only where the surface point
+             * itself lies on the ray within the tolerance (issue 9). */
+            vec3 off = v3_sub(sp.P, trace_ray_at(cr, t));
+            double tol = w->tol.a + w->tol.b * (t > 0 ? t : 0);
+            if (!(v3_length(off) <= tol)) {
+                th->stats.rejected_leaves++;
+                return;
+            }
+        }
         if (!(t >= t0)) t = t0;
         if (t > t1) t = t1;
     }
@@ -104,9 +121,32 @@ static trace_brood_id children_of(walk *w, trace_brood_id parent, int slot,
     return trace_boxcache_insert(th->cache, w->obj->id, parent, slot, kids);
 }
 
+/* Bounded work (issue 9): a walk ends after max_nodes_per_ray nodes, or
+ * at once when the render is cancelled. The hits found so far stay; the
+ * ray and the (u,v) range where it stopped are counted per object. */
+static bool over_limit(walk *w, const double r[4])
+{
+    if (w->stopped) return true;
+    trace_thread *th = w->th;
+    if (++w->nodes <= th->world->options.max_nodes_per_ray && !trace_thread_cancelled(th))
+        return false;
+    w->stopped = true;
+    if (th->failed) return true;           /* cancelled: nothing to report */
+    th->stats.limited_rays++;
+    trace_object_work *ow = &th->work[w->obj->id];
+    if (ow->limited_rays++ == 0) {
+        ow->u0 = r[0]; ow->u1 = r[1]; ow->v0 = r[2]; ow->v1 = r[3];
+    } else {
+        ow->u0 = fmin(ow->u0, r[0]); ow->u1 = fmax(ow->u1, r[1]);
+        ow->v0 = fmin(ow->v0, r[2]); ow->v1 = fmax(ow->v1, r[3]);
+    }
+    return true;
+}
+
 static void visit(walk *w, const trace_box *node, const double r[4],
                   trace_brood_id parent, int slot, int depth)
 {
+    if (over_limit(w, r)) return;
     trace_box kids[4];
     trace_brood_id brood = children_of(w, parent, slot, r, kids);
     trace_boxcache_pin(w->th->cache, brood);
@@ -128,7 +168,7 @@ static void visit(walk *w, const trace_box *node, const double r[4],
         order[k] = o;
     }
 
-    for (int k = 0; k < n && !(w->any && w->found); k++) {
+    for (int k = 0; k < n && !(w->any && w->found) && !w->stopped; k++) {
         if (!(order[k].t0 < w->best->t)) break;
         const trace_box *kid = &kids[order[k].i];
         double c[4];
@@ -172,6 +212,8 @@ static bool intersect_displaced(trace_thread *th, const trace_object *obj,
         return false;
     double r[4] = {0, 1, 0, 1};
     visit(&w, &obj->root, r, TRACE_BROOD_NONE, 0, 0);
+    th->stats.nodes += w.nodes;
+    if (w.nodes > th->stats.max_nodes_per_ray) th->stats.max_nodes_per_ray = w.nodes;
     return w.found;
 }
 

@@ -167,6 +167,10 @@ bool trace_render_tile(const trace_renderer *self, trace_thread *th,
     for (int qy = qy0; qy <= qy1; qy++)
         for (int qx = qx0; qx <= qx1; qx++)
             for (int s = 0; s < ns; s++) {
+                if (trace_thread_cancelled(th)) {
+                    free(smp);
+                    return false;
+                }
                 sample_rec *r = &smp[(((size_t)(qy - qy0) * (size_t)qw) + (size_t)(qx - qx0)) * (size_t)ns + (size_t)s];
                 double sx, sy, rgb[3], a, d;
                 trace_sample_position(qx, qy, s, nx, ny, &sx, &sy);

@@ -6,6 +6,7 @@
 #define STATS_FIELDS(X) \
     X(primary_rays) X(shadow_rays) X(boxes) X(evals_affine) X(evals_interval) \
     X(evals_dual) X(evals_float) X(leaves) X(wall_leaves) X(depth_cap_leaves) \
+    X(rejected_leaves) X(nodes) X(limited_rays) X(empty_boxes) \
     X(cache_hits) X(cache_misses) X(cache_evictions)
 
 void trace_stats_add(trace_stats *into, const trace_stats *from)
@@ -13,6 +14,8 @@ void trace_stats_add(trace_stats *into, const trace_stats *from)
 #define ADD(f) into->f += from->f;
     STATS_FIELDS(ADD)
 #undef ADD
+    if (from->max_nodes_per_ray > into->max_nodes_per_ray)
+        into->max_nodes_per_ray = from->max_nodes_per_ray;
     if (from->cache_peak_bytes > into->cache_peak_bytes)
         into->cache_peak_bytes = from->cache_peak_bytes;
 }
@@ -22,6 +25,7 @@ void trace_stats_print(const trace_stats *s, FILE *out)
 #define PRINT(f) fprintf(out, "  %-18s %ld\n", #f, s->f);
     STATS_FIELDS(PRINT)
 #undef PRINT
+    fprintf(out, "  %-18s %ld\n", "max_nodes_per_ray", s->max_nodes_per_ray);
     fprintf(out, "  %-18s %zu\n", "cache_peak_bytes", s->cache_peak_bytes);
     long rays = s->primary_rays + s->shadow_rays;
     if (rays > 0)
@@ -38,5 +42,6 @@ void trace_stats_write_json(const trace_stats *s, const char *extra, FILE *out)
 #define JSON(f) fprintf(out, "\"%s\": %ld, ", #f, s->f);
     STATS_FIELDS(JSON)
 #undef JSON
+    fprintf(out, "\"max_nodes_per_ray\": %ld, ", s->max_nodes_per_ray);
     fprintf(out, "\"cache_peak_bytes\": %zu}", s->cache_peak_bytes);
 }

@@ -15,6 +15,13 @@ typedef struct trace_stats {
     long boxes;                    /* boxes computed (root + 4 per cache miss) */
     long evals_affine, evals_interval, evals_dual, evals_float;
     long leaves, wall_leaves, depth_cap_leaves;
+    long rejected_leaves;          /* leaves whose surface point was not on the
+                                      ray (depth cap) or not finite: no hit */
+    long nodes;                    /* quadtree nodes visited by all rays */
+    long limited_rays;             /* walks stopped by the work limit */
+    long empty_boxes;              /* boxes that were NaN: no point of the
+                                      range is defined (pruned, counted) */
+    long max_nodes_per_ray;        /* the largest walk (a peak, not a sum) */
     long cache_hits, cache_misses, cache_evictions;
     size_t cache_peak_bytes;
 } trace_stats;

@@ -14,6 +14,7 @@ void trace_options_default(trace_options *opt)
     opt->aa_capacity = 16;   /* a sphere alone takes 11 symbols (docs/renderer.md) */
     opt->max_instructions = 1000000;
     opt->leaf_fraction = 1.0;
+    opt->max_nodes_per_ray = TRACE_DEFAULT_MAX_NODES_PER_RAY;
 }
 
 trace_thread *trace_thread_new(const trace_world *world)
@@ -27,6 +28,8 @@ trace_thread *trace_thread_new(const trace_world *world)
     self->shade_vm = sl_vm_new(&limits);
     aa_context_init(&self->ctx, world->options.aa_capacity);
     self->cache = trace_boxcache_new(world->options.cache_bytes, world->nobjects);
+    self->work = calloc(world->nobjects > 0 ? (size_t)world->nobjects : 1, sizeof *self->work);
+    if (!self->work) abort();
     return self;
 }
 
@@ -37,6 +40,7 @@ void trace_thread_destroy(trace_thread **self_p)
     sl_vm_destroy(&self->vm);
     sl_vm_destroy(&self->shade_vm);
     trace_boxcache_destroy(&self->cache);
+    free(self->work);
     free(self);
     *self_p = NULL;
 }
@@ -46,6 +50,42 @@ void trace_thread_fail(trace_thread *self, const char *message)
     if (self->failed) return;
     self->failed = true;
     snprintf(self->error, sizeof self->error, "%s", message);
+}
+
+void trace_object_work_add(trace_object_work *dst, const trace_object_work *src,
+                           int nobjects)
+{
+    for (int i = 0; i < nobjects; i++) {
+        const trace_object_work *s = &src[i];
+        trace_object_work *d = &dst[i];
+        if (s->limited_rays == 0) continue;
+        if (d->limited_rays == 0) {
+            *d = *s;
+            continue;
+        }
+        d->limited_rays += s->limited_rays;
+        if (s->u0 < d->u0) d->u0 = s->u0;
+        if (s->u1 > d->u1) d->u1 = s->u1;
+        if (s->v0 < d->v0) d->v0 = s->v0;
+        if (s->v1 > d->v1) d->v1 = s->v1;
+    }
+}
+
+void trace_object_work_report(const trace_world *world, const trace_object_work *work,
+                              const char *prog, FILE *out)
+{
+    for (int i = 0; i < world->nobjects; i++) {
+        const trace_object_work *w = &work[i];
+        if (w->limited_rays == 0) continue;
+        const trace_object *obj = &world->objects[i];
+        const char *shader = obj->displacement
+            ? sl_program_name(sl_instance_program(obj->displacement)) : "(none)";
+        fprintf(out, "%s: warning: %s, displacement shader '%s': %ld ray(s) reached the "
+                "work limit of %ld quadtree nodes per ray in (u,v) [%.4g, %.4g] x [%.4g, %.4g]; "
+                "the surface may be missing from those pixels (see docs/renderer.md, "
+                "\"Bounded work\")\n", prog, obj->name, shader, w->limited_rays,
+                world->options.max_nodes_per_ray, w->u0, w->u1, w->v0, w->v1);
+    }
 }
 
 void trace_thread_sync_stats(trace_thread *self)

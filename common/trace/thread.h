@@ -8,6 +8,7 @@
 #ifndef TRACE_THREAD_H
 #define TRACE_THREAD_H
 
+#include <stdatomic.h>
 #include <stdbool.h>
 
 #include "aa/affine.h"
@@ -16,6 +17,14 @@
 #include "trace/world.h"
 
 #include "trace/stats.h"
+#include <stdio.h>
+
+/* Per object: the rays whose walk hit the work limit (intersect.c) and the
+ * (u,v) region where those walks stopped, for one warning per object. */
+typedef struct trace_object_work {
+    long limited_rays;
+    double u0, u1, v0, v1;         /* union of the stopped nodes' ranges */
+} trace_object_work;
 
 typedef struct trace_thread {
     const trace_world *world;
@@ -25,6 +34,9 @@ typedef struct trace_thread {
     aa_context ctx;
     trace_boxcache *cache;
     trace_stats stats;
+    trace_object_work *work;       /* world->nobjects entries */
+    const atomic_int *cancel;      /* non-zero: stop tracing at once (a signal,
+                                      the pool stopping); NULL: never */
     bool failed;
     char error[512];
 } trace_thread;
@@ -34,6 +46,25 @@ void trace_thread_destroy(trace_thread **self_p);
 
 /* Records the first error of this thread (later ones are dropped). */
 void trace_thread_fail(trace_thread *self, const char *message);
+
+/* Has the render been cancelled? Then the thread is failed with
+ * "interrupted" and every walk unwinds without finding more hits. */
+static inline bool trace_thread_cancelled(trace_thread *self)
+{
+    if (!self->cancel || !atomic_load_explicit(self->cancel, memory_order_relaxed))
+        return false;
+    trace_thread_fail(self, "interrupted");
+    return true;
+}
+
+/* Adds src's per-object work records into dst (nobjects entries each). */
+void trace_object_work_add(trace_object_work *dst, const trace_object_work *src,
+                           int nobjects);
+
+/* One warning line per object whose rays hit the work limit (nothing when
+ * none did): what, where in (u,v), and what it means for the image. */
+void trace_object_work_report(const trace_world *world, const trace_object_work *work,
+                              const char *prog, FILE *out);
 
 /* Folds the cache's counters into stats (call before reading stats). */
 void trace_thread_sync_stats(trace_thread *self);

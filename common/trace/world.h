@@ -79,7 +79,14 @@ typedef struct trace_options {
     int aa_capacity;               /* noise symbols per box query */
     long max_instructions;         /* shader budget per evaluation */
     double leaf_fraction;          /* box size / pixel footprint at which to stop */
+    long max_nodes_per_ray;        /* work limit of one ray against one object:
+                                      quadtree nodes visited (intersect.c) */
 } trace_options;
+
+/* The default work limit: 20x the largest walk of the paper's scenes
+ * (wave 54, nail 205, ufo 156 nodes: `aafarm-worker --stats` prints
+ * max_nodes_per_ray); docs/renderer.md "Bounded work". */
+enum { TRACE_DEFAULT_MAX_NODES_PER_RAY = 4096 };
 
 void trace_options_default(trace_options *opt);
 

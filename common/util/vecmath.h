@@ -38,6 +38,10 @@ static inline vec3 v3_normalize(vec3 a)
     double l = v3_length(a);
     return l > 0 ? v3_scale(a, 1.0 / l) : a;
 }
+static inline bool v3_is_finite(vec3 a)
+{
+    return isfinite(a.x) && isfinite(a.y) && isfinite(a.z);
+}
 static inline vec3 v3_lerp(vec3 a, vec3 b, double t)
 {
     return v3(a.x + (b.x - a.x) * t, a.y + (b.y - a.y) * t, a.z + (b.z - a.z) * t);

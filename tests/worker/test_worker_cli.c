@@ -15,7 +15,9 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <signal.h>
 #include <sys/wait.h>
+#include <time.h>
 #include <unistd.h>
 #include <cmocka.h>
 
@@ -145,6 +147,48 @@ static void test_good_render_leaves_exactly_the_output(void **state)
     image_buffer_destroy(&b);
 }
 
+/* A render that can never finish quickly (the shader is NaN everywhere, so
+ * every ray runs to the work limit) stops on SIGTERM with exit 130 and
+ * leaves nothing. A worker that ignored SIGTERM is killed by the watchdog
+ * after 10 s and the test fails (issue 9: stop within 1 s). */
+static void test_sigterm_stops_a_runaway_render(void **state)
+{
+    (void)state;
+    write_file("nanp.sl", "displacement nanp()\n{\n    P += (0/0) * N;\n}\n");
+    write_file("nanp.rib",
+               "Format 320 240 1\nProjection \"perspective\" \"fov\" [40]\n"
+               "Option \"searchpath\" \"shader\" [\".\"]\nTranslate 0 0 5\nWorldBegin\n"
+               "Displacement \"nanp\"\nSphere 1 -1 1 360\nWorldEnd\n");
+    pid_t pid = fork();
+    assert_true(pid >= 0);
+    if (pid == 0) {
+        if (chdir(dir) != 0) _exit(127);
+        freopen("/dev/null", "w", stderr);
+        execl(worker, worker, "--standalone", "nanp.rib", "-o", "nanp.exr", "-t", "2", "-q",
+              (char *)NULL);
+        _exit(127);
+    }
+    struct timespec pause = {0, 300 * 1000000L};
+    nanosleep(&pause, NULL);
+    kill(pid, SIGTERM);
+    int status = 0, waited_ms = 0;
+    pid_t r;
+    while ((r = waitpid(pid, &status, WNOHANG)) == 0 && waited_ms < 10000) {
+        struct timespec tick = {0, 10 * 1000000L};
+        nanosleep(&tick, NULL);
+        waited_ms += 10;
+    }
+    if (r == 0) {
+        kill(pid, SIGKILL);
+        waitpid(pid, &status, 0);
+        fail_msg("aafarm-worker ignored SIGTERM for 10 s");
+    }
+    printf("SIGTERM: exited after ~%d ms\n", waited_ms);
+    assert_true(WIFEXITED(status));
+    assert_int_equal(WEXITSTATUS(status), 130);
+    assert_int_equal(count_files("nanp.exr"), 0);
+}
+
 int main(int argc, char **argv)
 {
     if (argc < 2) {
@@ -159,6 +203,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_bad_scene_and_bad_shader),
         cmocka_unit_test(test_budget_exceeded_leaves_nothing),
         cmocka_unit_test(test_good_render_leaves_exactly_the_output),
+        cmocka_unit_test(test_sigterm_stops_a_runaway_render),
     };
     int rc = cmocka_run_group_tests(tests, NULL, NULL);
     char cmd[512];
