@@ -719,6 +719,14 @@ void aa_max(aa_context *ctx, aa_form *z, const aa_form *x, const aa_form *y)
 void aa_clamp(aa_context *ctx, aa_form *z, const aa_form *x,
               const aa_form *lo, const aa_form *hi)
 {
+    unsigned fl = x->flags | lo->flags | hi->flags;
+    if (fl & AA_UNBOUNDED) {
+        /* max then min would stay unbounded ([lo, inf] is still infinite):
+         * clamp the ranges at once, bounded again when lo and hi are */
+        ia_interval r = ia_clamp(aa_range(x), aa_range(lo), aa_range(hi));
+        aa_set_interval(ctx, z, r, fl | r.flags);
+        return;
+    }
     aa_form t;
     aa_max(ctx, &t, x, lo);
     aa_min(ctx, z, &t, hi);

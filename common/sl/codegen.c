@@ -825,13 +825,20 @@ static int gen_transform(cg *g, sl_node *e, const int *args, int dst)
     return gen_space_xform(g, op, e->list[n - 2], SL_SPACE_FROM_CURRENT, x, dst);
 }
 
+/* v * inversesqrt(v . v), each component clamped to [-1, 1]: the identity
+ * on a unit vector, and in interval/affine mode it keeps the result bounded
+ * where |v| can vanish over a range (normalize(dPdu) at a pole, N of a
+ * wide range): a unit vector's components never leave [-1, 1] (issue 9). */
 static int gen_normalize(cg *g, int v, int dst)
 {
     int d = gen_dot(g, v, v, 3, -1);
     int r = op1(g, SL_OP_INVSQRT, d);
     int z = target(g, dst, 3);
-    for (int i = 0; i < 3; i++)
+    int lo = const_slot(g, -1.0), hi = const_slot(g, 1.0);
+    for (int i = 0; i < 3; i++) {
         emit(g, SL_OP_MUL, z + i, v + i, r, 0);
+        emit(g, SL_OP_CLAMP, z + i, z + i, lo, hi);
+    }
     return z;
 }
 

@@ -5,14 +5,35 @@
  * first two noise symbols, the base surface is evaluated in affine form
  * (geom_eval_aa), moved to camera space (an affine map: exact up to the
  * rounding the aa library accounts for), handed to the displacement shader
- * as the globals P, N, Ng, dPdu, dPdv, u, v, s, t, I, and the shader's P
- * afterwards gives x, y, z ranges. The interval mode does the same with
- * ia_interval (the comparison of §7.1).
+ * as its globals, and the shader's P afterwards gives x, y, z ranges. The
+ * interval mode does the same with ia_interval (the comparison of §7.1).
+ * The globals are bound by one template for every arithmetic
+ * (globals.inc), so boxes and points see the same surface.
  */
 #include "trace/displace.h"
 
 #include <stdio.h>
 #include <string.h>
+
+#define G_T aa_form
+#define G_SUFFIX affine
+#define G_SET sl_vm_set_affine
+#define G_CONST aa_const
+#include "trace/globals.inc"
+
+static inline void ia_const_(ia_interval *z, double k) { *z = ia_point(k); }
+#define G_T ia_interval
+#define G_SUFFIX interval
+#define G_SET sl_vm_set_interval
+#define G_CONST ia_const_
+#include "trace/globals.inc"
+
+static inline void dual_const_(sl_dual *z, double k) { *z = (sl_dual){k, 0, 0}; }
+#define G_T sl_dual
+#define G_SUFFIX dual
+#define G_SET sl_vm_set_dual
+#define G_CONST dual_const_
+#include "trace/globals.inc"
 
 /* ---- affine ---- */
 
@@ -27,12 +48,52 @@ static void aa_xform(aa_context *ctx, const mat4 *m, const aa_form in[3],
     }
 }
 
-/* normals: the inverse transpose; `inv` is the inverse of the map */
-static void aa_xform_normal(aa_context *ctx, const mat4 *inv, const aa_form in[3],
-                            aa_form out[3])
+/* The camera-space unit normal from the object-space one Nn: the inverse
+ * transpose of to_camera (from_camera^T), then normalised; for a similarity
+ * (obj->normal_scale > 0) the length is that constant and no non-affine
+ * operation is needed. */
+static void aa_camera_normal(aa_context *ctx, const trace_object *obj,
+                             const aa_form Nn[3], aa_form N[3])
 {
-    mat4 t = mat4_transpose(*inv);
-    aa_xform(ctx, &t, in, out, false);
+    mat4 t = mat4_transpose(obj->from_camera);
+    aa_xform(ctx, &t, Nn, N, false);
+    double k = obj->flip ? -1.0 : 1.0;
+    if (obj->normal_scale > 0) {
+        for (int i = 0; i < 3; i++) aa_mul_s(ctx, &N[i], &N[i], k * obj->normal_scale);
+        return;
+    }
+    /* |N|^2 of the true normal lies in obj->normal_len2 (render.c): meeting
+     * the computed form with it is sound and keeps wide ranges bounded
+     * away from 0, as are the components of a unit vector in [-1, 1] */
+    aa_form len2, sq, inv, lo, hi;
+    aa_sqr(ctx, &len2, &N[0]);
+    aa_sqr(ctx, &sq, &N[1]);
+    aa_add(ctx, &len2, &len2, &sq);
+    aa_sqr(ctx, &sq, &N[2]);
+    aa_add(ctx, &len2, &len2, &sq);
+    aa_const(&lo, obj->normal_len2[0]);
+    aa_const(&hi, obj->normal_len2[1]);
+    aa_clamp(ctx, &len2, &len2, &lo, &hi);
+    aa_invsqrt(ctx, &inv, &len2);
+    if (obj->flip) aa_neg(ctx, &inv, &inv);
+    aa_const(&lo, -1.0);
+    aa_const(&hi, 1.0);
+    for (int i = 0; i < 3; i++) {
+        aa_mul(ctx, &N[i], &N[i], &inv);
+        aa_clamp(ctx, &N[i], &N[i], &lo, &hi);
+    }
+}
+
+/* A box is unbounded when a side is infinite. The arithmetic's
+ * AA_UNBOUNDED flag is sticky (it stays on a clamp or a normalize of an
+ * unbounded value, whose range is finite again), so it is not used. */
+static unsigned box_flags(const trace_box *b, unsigned flags)
+{
+    unsigned f = flags & AA_DISCONTINUOUS;
+    if (!isfinite(b->lo.x) || !isfinite(b->lo.y) || !isfinite(b->lo.z) ||
+        !isfinite(b->hi.x) || !isfinite(b->hi.y) || !isfinite(b->hi.z))
+        f |= AA_UNBOUNDED;
+    return f;
 }
 
 static void box_from_affine(const aa_form P[3], trace_box *out)
@@ -45,7 +106,7 @@ static void box_from_affine(const aa_form P[3], trace_box *out)
     }
     out->lo = v3(r[0].lo, r[1].lo, r[2].lo);
     out->hi = v3(r[0].hi, r[1].hi, r[2].hi);
-    out->flags = flags & (AA_DISCONTINUOUS | AA_UNBOUNDED);
+    out->flags = box_flags(out, flags);
 }
 
 static void box_affine(trace_thread *th, const trace_object *obj,
@@ -67,30 +128,12 @@ static void box_affine(trace_thread *th, const trace_object *obj,
     aa_form P[3], N[3], dPdu[3], dPdv[3], Nn[3];
     aa_xform(ctx, &obj->to_camera, g.P, P, true);
     geom_unit_normal_aa(ctx, &obj->surf, &u, &v, &g, Nn);
-    aa_xform_normal(ctx, &obj->from_camera, Nn, N);
-    if (obj->flip)
-        for (int i = 0; i < 3; i++) aa_neg(ctx, &N[i], &N[i]);
+    aa_camera_normal(ctx, obj, Nn, N);
     aa_xform(ctx, &obj->to_camera, g.dPdu, dPdu, false);
     aa_xform(ctx, &obj->to_camera, g.dPdv, dPdv, false);
 
     sl_vm *vm = th->vm;
-    sl_vm_clear_globals(vm);
-    sl_vm_set_spaces(vm, &obj->displacement_spaces);
-    sl_vm_set_affine(vm, SL_G_P, P);
-    sl_vm_set_affine(vm, SL_G_N, N);
-    sl_vm_set_affine(vm, SL_G_Ng, N);
-    sl_vm_set_affine(vm, SL_G_I, P);
-    sl_vm_set_affine(vm, SL_G_dPdu, dPdu);
-    sl_vm_set_affine(vm, SL_G_dPdv, dPdv);
-    sl_vm_set_affine(vm, SL_G_u, &u);
-    sl_vm_set_affine(vm, SL_G_v, &v);
-    sl_vm_set_affine(vm, SL_G_s, &u);
-    sl_vm_set_affine(vm, SL_G_t, &v);
-    aa_form du, dv;
-    aa_const(&du, u1 - u0);
-    aa_const(&dv, v1 - v0);
-    sl_vm_set_affine(vm, SL_G_du, &du);
-    sl_vm_set_affine(vm, SL_G_dv, &dv);
+    bind_globals_affine(vm, obj, &obj->displacement_spaces, P, N, N, dPdu, dPdv, &u, &v);
     if (sl_vm_run(vm, obj->displacement, SL_MODE_AFFINE, ctx) != SL_OK) {
         trace_thread_fail(th, sl_vm_error(vm));
         aa_unbounded(&P[0], AA_UNBOUNDED);
@@ -115,11 +158,30 @@ static void ia_xform(const mat4 *m, const ia_interval in[3], ia_interval out[3],
     }
 }
 
+/* as aa_camera_normal, in interval arithmetic */
+static void ia_camera_normal(const trace_object *obj, const ia_interval Nn[3],
+                             ia_interval N[3])
+{
+    mat4 t = mat4_transpose(obj->from_camera);
+    ia_xform(&t, Nn, N, false);
+    double k = obj->flip ? -1.0 : 1.0;
+    if (obj->normal_scale > 0) {
+        for (int i = 0; i < 3; i++) N[i] = ia_mul_s(N[i], k * obj->normal_scale);
+        return;
+    }
+    ia_interval len2 = ia_add(ia_add(ia_sqr(N[0]), ia_sqr(N[1])), ia_sqr(N[2]));
+    len2 = ia_clamp(len2, ia_point(obj->normal_len2[0]), ia_point(obj->normal_len2[1]));
+    ia_interval inv = ia_invsqrt(len2);
+    if (obj->flip) inv = ia_neg(inv);
+    for (int i = 0; i < 3; i++)
+        N[i] = ia_clamp(ia_mul(N[i], inv), ia_point(-1.0), ia_point(1.0));
+}
+
 static void box_from_interval(const ia_interval P[3], trace_box *out)
 {
     out->lo = v3(P[0].lo, P[1].lo, P[2].lo);
     out->hi = v3(P[0].hi, P[1].hi, P[2].hi);
-    out->flags = (P[0].flags | P[1].flags | P[2].flags) & (AA_DISCONTINUOUS | AA_UNBOUNDED);
+    out->flags = box_flags(out, P[0].flags | P[1].flags | P[2].flags);
 }
 
 static void box_interval(trace_thread *th, const trace_object *obj,
@@ -136,29 +198,12 @@ static void box_interval(trace_thread *th, const trace_object *obj,
     ia_interval P[3], N[3], dPdu[3], dPdv[3], Nn[3];
     ia_xform(&obj->to_camera, g.P, P, true);
     geom_unit_normal_ia(&obj->surf, u, v, &g, Nn);
-    mat4 nt = mat4_transpose(obj->from_camera);
-    ia_xform(&nt, Nn, N, false);
-    if (obj->flip)
-        for (int i = 0; i < 3; i++) N[i] = ia_neg(N[i]);
+    ia_camera_normal(obj, Nn, N);
     ia_xform(&obj->to_camera, g.dPdu, dPdu, false);
     ia_xform(&obj->to_camera, g.dPdv, dPdv, false);
 
     sl_vm *vm = th->vm;
-    sl_vm_clear_globals(vm);
-    sl_vm_set_spaces(vm, &obj->displacement_spaces);
-    sl_vm_set_interval(vm, SL_G_P, P);
-    sl_vm_set_interval(vm, SL_G_N, N);
-    sl_vm_set_interval(vm, SL_G_Ng, N);
-    sl_vm_set_interval(vm, SL_G_I, P);
-    sl_vm_set_interval(vm, SL_G_dPdu, dPdu);
-    sl_vm_set_interval(vm, SL_G_dPdv, dPdv);
-    sl_vm_set_interval(vm, SL_G_u, &u);
-    sl_vm_set_interval(vm, SL_G_v, &v);
-    sl_vm_set_interval(vm, SL_G_s, &u);
-    sl_vm_set_interval(vm, SL_G_t, &v);
-    ia_interval du = ia_point(u1 - u0), dv = ia_point(v1 - v0);
-    sl_vm_set_interval(vm, SL_G_du, &du);
-    sl_vm_set_interval(vm, SL_G_dv, &dv);
+    bind_globals_interval(vm, obj, &obj->displacement_spaces, P, N, N, dPdu, dPdv, &u, &v);
     if (sl_vm_run(vm, obj->displacement, SL_MODE_INTERVAL, NULL) != SL_OK) {
         trace_thread_fail(th, sl_vm_error(vm));
         P[0] = P[1] = P[2] = ia_entire();
@@ -230,27 +275,14 @@ void trace_surface_point_eval(trace_thread *th, const trace_object *obj,
         dNdu = v3_scale(v3_sub(dNdu, v3_scale(Nn, v3_dot(Nn, dNdu))), 1.0 / glen);
         dNdv = v3_scale(v3_sub(dNdv, v3_scale(Nn, v3_dot(Nn, dNdv))), 1.0 / glen);
     }
-    sl_dual dP[3], dN[3], ddPdu[3], ddPdv[3], zero3[3];
+    sl_dual dP[3], dN[3], ddPdu[3], ddPdv[3];
     dual3(P, dPdu, dPdv, dP);
     dual3(Nn, dNdu, dNdv, dN);
     dual3(dPdu, v3(0, 0, 0), v3(0, 0, 0), ddPdu);
     dual3(dPdv, v3(0, 0, 0), v3(0, 0, 0), ddPdv);
-    dual3(v3(0, 0, 0), v3(0, 0, 0), v3(0, 0, 0), zero3);
     sl_dual du_ = {u, 1, 0}, dv_ = {v, 0, 1};
     sl_vm *vm = th->vm;
-    sl_vm_clear_globals(vm);
-    sl_vm_set_spaces(vm, &obj->displacement_spaces);
-    sl_vm_set_dual(vm, SL_G_P, dP);
-    sl_vm_set_dual(vm, SL_G_N, dN);
-    sl_vm_set_dual(vm, SL_G_Ng, dN);
-    sl_vm_set_dual(vm, SL_G_I, dP);
-    sl_vm_set_dual(vm, SL_G_E, zero3);
-    sl_vm_set_dual(vm, SL_G_dPdu, ddPdu);
-    sl_vm_set_dual(vm, SL_G_dPdv, ddPdv);
-    sl_vm_set_dual(vm, SL_G_u, &du_);
-    sl_vm_set_dual(vm, SL_G_v, &dv_);
-    sl_vm_set_dual(vm, SL_G_s, &du_);
-    sl_vm_set_dual(vm, SL_G_t, &dv_);
+    bind_globals_dual(vm, obj, &obj->displacement_spaces, dP, dN, dN, ddPdu, ddPdv, &du_, &dv_);
     th->stats.evals_dual++;
     if (sl_vm_run(vm, obj->displacement, SL_MODE_DUAL, NULL) != SL_OK) {
         trace_thread_fail(th, sl_vm_error(vm));

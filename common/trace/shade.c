@@ -85,6 +85,13 @@ static int light_samples(void *user, const double P[3], sl_light_sample *out, in
     return n;
 }
 
+static inline void float_const_(double *z, double k) { *z = k; }
+#define G_T double
+#define G_SUFFIX float
+#define G_SET sl_vm_set_float
+#define G_CONST float_const_
+#include "trace/globals.inc"
+
 static void set3(sl_vm *vm, sl_global g, vec3 v)
 {
     double a[3] = {v.x, v.y, v.z};
@@ -126,22 +133,17 @@ void trace_shade_hit(const trace_renderer *r, trace_thread *th,
                    .offset = 2.0 * hit->leaf_size + 1e-9 * (1.0 + v3_length(sp.P)),
                    .tol = hit->leaf_size > pixel_tol ? hit->leaf_size : pixel_tol};
     sl_vm *vm = th->shade_vm;
-    sl_vm_clear_globals(vm);
-    sl_vm_set_spaces(vm, &obj->surface_spaces);
-    sl_vm_set_lights(vm, light_samples, &c);
-    set3(vm, SL_G_P, sp.P);
-    set3(vm, SL_G_N, sp.N);
-    set3(vm, SL_G_Ng, sp.Ng);
+    double P[3] = {sp.P.x, sp.P.y, sp.P.z}, N[3] = {sp.N.x, sp.N.y, sp.N.z};
+    double Ng[3] = {sp.Ng.x, sp.Ng.y, sp.Ng.z};
+    double dPdu[3] = {sp.dPdu.x, sp.dPdu.y, sp.dPdu.z};
+    double dPdv[3] = {sp.dPdv.x, sp.dPdv.y, sp.dPdv.z};
+    bind_globals_float(vm, obj, &obj->surface_spaces, P, N, Ng, dPdu, dPdv, &sp.u, &sp.v);
+    /* a surface shader's I is the incident ray (from the ray's origin: the
+     * eye for perspective, the image plane for orthographic cameras) */
     set3(vm, SL_G_I, I);
-    set3(vm, SL_G_E, ray->o);
-    set3(vm, SL_G_dPdu, sp.dPdu);
-    set3(vm, SL_G_dPdv, sp.dPdv);
+    sl_vm_set_lights(vm, light_samples, &c);
     sl_vm_set_float(vm, SL_G_Cs, obj->Cs);
     sl_vm_set_float(vm, SL_G_Os, obj->Os);
-    sl_vm_set_float(vm, SL_G_u, &sp.u);
-    sl_vm_set_float(vm, SL_G_v, &sp.v);
-    sl_vm_set_float(vm, SL_G_s, &sp.u);
-    sl_vm_set_float(vm, SL_G_t, &sp.v);
     th->stats.evals_float++;
     if (sl_vm_run(vm, obj->surface, SL_MODE_FLOAT, NULL) != SL_OK) {
         trace_thread_fail(th, sl_vm_error(vm));

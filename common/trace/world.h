@@ -38,6 +38,11 @@ typedef struct trace_object {
     int nlights;                   /* shine on this object (Illuminate, scopes) */
     bool flip;                     /* reversed orientation: negate normals */
     double scale;                  /* largest stretch of to_camera (spectral norm) */
+    double normal_scale;           /* to_camera a similarity: |camera N| of a unit
+                                      object normal is 1/normal_scale; else 0 */
+    double normal_len2[2];         /* bounds of |from_camera^T n|^2, n unit */
+    double du, dv;                 /* the shader globals du, dv: per-object
+                                      constants (render.c, docs/renderer.md) */
     trace_box root;                /* OBJECT space box over the whole (u,v) square */
     trace_box bound;               /* camera space box of root (for the BVH) */
 } trace_object;
