@@ -176,6 +176,9 @@ struct sl_program {
 
     int nslots;                     /* scalar slots used */
     int nstring_slots;
+    bool takes_derivatives;         /* has DU, DV, DERIV, CALCNORMAL or AREA:
+                                       interval/affine runs carry derivative
+                                       bounds (vm_deriv.inc) */
 };
 
 /* Scalar slot of a global: P at 0, N at 3, ... (3 slots for points and

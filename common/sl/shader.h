@@ -17,8 +17,11 @@
  *                     (conservative, correlations kept)
  *
  * In FLOAT mode derivatives are 0 and calculatenormal(P) returns the
- * current N. In INTERVAL/AFFINE modes Du/Dv/Deriv/calculatenormal/area give
- * unbounded results (flag AA_UNBOUNDED): the box cache only needs P.
+ * current N. In INTERVAL/AFFINE modes a program that takes derivatives
+ * (Du/Dv/Deriv/calculatenormal/area) runs with interval bounds of every
+ * value's d/du and d/dv (vm_deriv.inc), seeded from the globals' bounds
+ * (sl_vm_set_derivs): its results enclose the DUAL mode's at every point
+ * of the range.
  * In INTERVAL/AFFINE modes a comparison whose operands overlap runs both
  * branches and merges the results (flag AA_DISCONTINUOUS); see
  * docs/shading-language.md "Evaluation".
@@ -162,6 +165,11 @@ void sl_vm_set_float(sl_vm *self, sl_global g, const double *values);
 void sl_vm_set_dual(sl_vm *self, sl_global g, const sl_dual *values);
 void sl_vm_set_interval(sl_vm *self, sl_global g, const ia_interval *values);
 void sl_vm_set_affine(sl_vm *self, sl_global g, const aa_form *values);
+/* Bounds of the d/du and d/dv of global g over the range of the coming
+ * interval/affine run (one interval per component). Globals without them
+ * have unknown derivatives (the whole line) until sl_vm_clear_globals. */
+void sl_vm_set_derivs(sl_vm *self, sl_global g, const ia_interval *du,
+                      const ia_interval *dv);
 
 /* Runs the instance. `ctx` is used (and required) in affine mode only. */
 sl_status sl_vm_run(sl_vm *self, const sl_instance *inst, sl_mode mode,

@@ -10,6 +10,7 @@
 #include "sl/strbuf.h"
 
 #include <stdarg.h>
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -53,7 +54,12 @@ sl_vm *sl_vm_new(const sl_limits *limits)
     self->i = xcalloc(SL_MAX_SLOTS, sizeof *self->i);
     self->a = xcalloc(SL_MAX_SLOTS, sizeof *self->a);
     self->str = xcalloc(SL_MAX_STRING_SLOTS, sizeof *self->str);
-    self->pool = xcalloc(SL_VM_POOL_VALUES, sizeof(aa_form));
+    size_t pool_value = sizeof(aa_form);
+    if (sizeof(sl_aderiv) > pool_value)
+        pool_value = sizeof(sl_aderiv);
+    if (sizeof(sl_ideriv) > pool_value)
+        pool_value = sizeof(sl_ideriv);
+    self->pool = xcalloc(SL_VM_POOL_VALUES, pool_value);
     self->spool = xcalloc(SL_VM_POOL_VALUES, sizeof *self->spool);
     sl_vm_clear_globals(self);
     return self;
@@ -68,6 +74,8 @@ void sl_vm_destroy(sl_vm **self_p)
     free(self->d);
     free(self->i);
     free(self->a);
+    free(self->id);
+    free(self->ad);
     free(self->str);
     free(self->pool);
     free(self->spool);
@@ -100,10 +108,28 @@ void sl_vm_set_seed(sl_vm *self, uint64_t seed) { self->seed = seed; }
 /* globals                                                                 */
 /* ---------------------------------------------------------------------- */
 
+static bool global_ok(sl_global g) { return (unsigned)g < SL_G__COUNT; }
+
 /* Clearing is lazy: each mode's globals are zeroed when that mode is
  * first used after sl_vm_clear_globals (the renderer clears before every
  * run, and uses one mode per run). */
-void sl_vm_clear_globals(sl_vm *self) { self->clear_pending = 0xf; }
+void sl_vm_clear_globals(sl_vm *self)
+{
+    self->clear_pending = 0xf;
+    for (int s = 0; s < SL_GLOBAL_SLOTS; s++)
+        self->gderiv[s][0] = self->gderiv[s][1] = ia_entire();
+}
+
+void sl_vm_set_derivs(sl_vm *self, sl_global g, const ia_interval *du, const ia_interval *dv)
+{
+    if (!global_ok(g))
+        return;
+    int s = sl_global_slot(g);
+    for (int k = 0; k < sl_global_size(g); k++) {
+        self->gderiv[s + k][0] = du[k];
+        self->gderiv[s + k][1] = dv[k];
+    }
+}
 
 static void ensure_clear(sl_vm *self, sl_mode mode)
 {
@@ -124,8 +150,6 @@ static void ensure_clear(sl_vm *self, sl_mode mode)
         break;
     }
 }
-
-static bool global_ok(sl_global g) { return (unsigned)g < SL_G__COUNT; }
 
 void sl_vm_set_float(sl_vm *self, sl_global g, const double *values)
 {
@@ -251,6 +275,39 @@ static void load_strings(sl_vm *vm, const sl_program *p)
         vm->str[p->string_slots[k]] = p->strings[k];
 }
 
+/* A program that takes derivatives runs in the derivative-carrying variant
+ * of its range mode (vm_deriv.inc): the globals go in with the bounds of
+ * sl_vm_set_derivs, and their values come back to the mode's own file,
+ * where sl_vm_get_* read them. */
+static sl_status run_with_derivatives(sl_vm *self, sl_mode mode)
+{
+    sl_status st;
+    if (mode == SL_MODE_AFFINE) {
+        if (!self->ad)
+            self->ad = xcalloc(SL_MAX_SLOTS, sizeof *self->ad);
+        for (int s = 0; s < SL_GLOBAL_SLOTS; s++) {
+            const aa_form *x = &self->a[s];
+            memcpy(&self->ad[s].v, x, offsetof(aa_form, c) + (size_t)x->n * sizeof x->c[0]);
+            self->ad[s].du = self->gderiv[s][0];
+            self->ad[s].dv = self->gderiv[s][1];
+        }
+        st = sl_vm_exec_affine_deriv(self);
+        for (int s = 0; s < SL_GLOBAL_SLOTS; s++) {
+            const aa_form *x = &self->ad[s].v;
+            memcpy(&self->a[s], x, offsetof(aa_form, c) + (size_t)x->n * sizeof x->c[0]);
+        }
+    } else {
+        if (!self->id)
+            self->id = xcalloc(SL_MAX_SLOTS, sizeof *self->id);
+        for (int s = 0; s < SL_GLOBAL_SLOTS; s++)
+            self->id[s] = (sl_ideriv){self->i[s], self->gderiv[s][0], self->gderiv[s][1]};
+        st = sl_vm_exec_interval_deriv(self);
+        for (int s = 0; s < SL_GLOBAL_SLOTS; s++)
+            self->i[s] = self->id[s].v;
+    }
+    return st;
+}
+
 sl_status sl_vm_run(sl_vm *self, const sl_instance *inst, sl_mode mode, aa_context *ctx)
 {
     self->error[0] = '\0';
@@ -275,6 +332,8 @@ sl_status sl_vm_run(sl_vm *self, const sl_instance *inst, sl_mode mode, aa_conte
     self->rng = self->seed;
     ensure_clear(self, mode);
     load_strings(self, p);
+    if (p->takes_derivatives && (mode == SL_MODE_INTERVAL || mode == SL_MODE_AFFINE))
+        return run_with_derivatives(self, mode);
     switch (mode) {
     case SL_MODE_FLOAT: return sl_vm_exec_float(self);
     case SL_MODE_DUAL: return sl_vm_exec_dual(self);

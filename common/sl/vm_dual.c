@@ -20,6 +20,7 @@
 #define VM_T sl_dual
 #define VM_SUFFIX dual
 #define VM_FILE(vm) ((vm)->d)
+#define VM_VARIANT VM_VAR_DUAL
 
 static inline sl_dual dd(double v, double du, double dv)
 {

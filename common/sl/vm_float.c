@@ -18,6 +18,7 @@
 #define VM_T double
 #define VM_SUFFIX float
 #define VM_FILE(vm) ((vm)->f)
+#define VM_VARIANT VM_VAR_FLOAT
 
 static inline void v_const(sl_vm *vm, double *z, double k) { (void)vm; *z = k; }
 static inline void v_mov(sl_vm *vm, double *z, const double *x) { (void)vm; *z = *x; }

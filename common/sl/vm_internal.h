@@ -24,6 +24,21 @@ enum {
     SL_VM_MAX_LIGHTS = 64,        /* light samples per shading call */
 };
 
+/* The instantiations of the dispatch loop (vm_exec.inc). The two _DERIV
+ * ones run programs that take derivatives (Du, Dv, Deriv, calculatenormal,
+ * area) in interval/affine mode: each slot carries its value in the mode's
+ * arithmetic and interval bounds of its d/du and d/dv (vm_deriv.inc). */
+enum {
+    VM_VAR_FLOAT, VM_VAR_DUAL, VM_VAR_INTERVAL, VM_VAR_AFFINE,
+    VM_VAR_INTERVAL_DERIV, VM_VAR_AFFINE_DERIV, VM_VAR__COUNT
+};
+
+/* Slots of the derivative-carrying modes: the value, and enclosures of
+ * its derivatives over the range (every d/du of the dual mode at a point
+ * inside lies in du). */
+typedef struct sl_ideriv { ia_interval v, du, dv; } sl_ideriv;
+typedef struct sl_aderiv { ia_interval du, dv; aa_form v; } sl_aderiv;
+
 /* The parameter values of one instance. */
 typedef struct sl_inst_value {
     bool set;
@@ -72,8 +87,12 @@ struct sl_vm {
     sl_dual *d;
     ia_interval *i;
     aa_form *a;
+    sl_ideriv *id;                /* allocated on the first derivative run */
+    sl_aderiv *ad;
+    ia_interval gderiv[SL_GLOBAL_SLOTS][2];   /* d/du, d/dv of the globals for
+                                                 interval/affine runs */
     const char **str;             /* string file */
-    unsigned long loaded[4];      /* program whose constants each file holds */
+    unsigned long loaded[VM_VAR__COUNT];   /* program whose constants each file holds */
     unsigned clear_pending;       /* modes whose globals still have to be zeroed */
 
     void *pool;                   /* SL_VM_POOL_VALUES values of the run's mode */
@@ -98,6 +117,8 @@ sl_status sl_vm_exec_float(sl_vm *vm);
 sl_status sl_vm_exec_dual(sl_vm *vm);
 sl_status sl_vm_exec_interval(sl_vm *vm);
 sl_status sl_vm_exec_affine(sl_vm *vm);
+sl_status sl_vm_exec_interval_deriv(sl_vm *vm);
+sl_status sl_vm_exec_affine_deriv(sl_vm *vm);
 
 /* "shader 'name': " + message into vm->error; returns st. */
 sl_status sl_vm_fail(sl_vm *vm, sl_status st, const char *fmt, ...)

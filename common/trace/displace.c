@@ -133,7 +133,13 @@ static void box_affine(trace_thread *th, const trace_object *obj,
     aa_xform(ctx, &obj->to_camera, g.dPdv, dPdv, false);
 
     sl_vm *vm = th->vm;
-    bind_globals_affine(vm, obj, &obj->displacement_spaces, P, N, N, dPdu, dPdv, &u, &v);
+    ia_interval Pd[2][3];
+    for (int i = 0; i < 3; i++) {
+        Pd[0][i] = aa_range(&dPdu[i]);
+        Pd[1][i] = aa_range(&dPdv[i]);
+    }
+    bind_globals_affine(vm, obj, &obj->displacement_spaces, P, N, N, dPdu, dPdv, &u, &v,
+                        Pd, obj->surf.kind == GEOM_POLYGON);
     if (sl_vm_run(vm, obj->displacement, SL_MODE_AFFINE, ctx) != SL_OK) {
         trace_thread_fail(th, sl_vm_error(vm));
         aa_unbounded(&P[0], AA_UNBOUNDED);
@@ -203,7 +209,9 @@ static void box_interval(trace_thread *th, const trace_object *obj,
     ia_xform(&obj->to_camera, g.dPdv, dPdv, false);
 
     sl_vm *vm = th->vm;
-    bind_globals_interval(vm, obj, &obj->displacement_spaces, P, N, N, dPdu, dPdv, &u, &v);
+    ia_interval Pd[2][3] = {{dPdu[0], dPdu[1], dPdu[2]}, {dPdv[0], dPdv[1], dPdv[2]}};
+    bind_globals_interval(vm, obj, &obj->displacement_spaces, P, N, N, dPdu, dPdv, &u, &v,
+                          Pd, obj->surf.kind == GEOM_POLYGON);
     if (sl_vm_run(vm, obj->displacement, SL_MODE_INTERVAL, NULL) != SL_OK) {
         trace_thread_fail(th, sl_vm_error(vm));
         P[0] = P[1] = P[2] = ia_entire();
@@ -282,7 +290,8 @@ void trace_surface_point_eval(trace_thread *th, const trace_object *obj,
     dual3(dPdv, v3(0, 0, 0), v3(0, 0, 0), ddPdv);
     sl_dual du_ = {u, 1, 0}, dv_ = {v, 0, 1};
     sl_vm *vm = th->vm;
-    bind_globals_dual(vm, obj, &obj->displacement_spaces, dP, dN, dN, ddPdu, ddPdv, &du_, &dv_);
+    bind_globals_dual(vm, obj, &obj->displacement_spaces, dP, dN, dN, ddPdu, ddPdv, &du_, &dv_,
+                      NULL, false);
     th->stats.evals_dual++;
     if (sl_vm_run(vm, obj->displacement, SL_MODE_DUAL, NULL) != SL_OK) {
         trace_thread_fail(th, sl_vm_error(vm));

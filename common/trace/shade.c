@@ -137,7 +137,8 @@ void trace_shade_hit(const trace_renderer *r, trace_thread *th,
     double Ng[3] = {sp.Ng.x, sp.Ng.y, sp.Ng.z};
     double dPdu[3] = {sp.dPdu.x, sp.dPdu.y, sp.dPdu.z};
     double dPdv[3] = {sp.dPdv.x, sp.dPdv.y, sp.dPdv.z};
-    bind_globals_float(vm, obj, &obj->surface_spaces, P, N, Ng, dPdu, dPdv, &sp.u, &sp.v);
+    bind_globals_float(vm, obj, &obj->surface_spaces, P, N, Ng, dPdu, dPdv, &sp.u, &sp.v,
+                       NULL, false);
     /* a surface shader's I is the incident ray (from the ray's origin: the
      * eye for perspective, the image plane for orthographic cameras) */
     set3(vm, SL_G_I, I);

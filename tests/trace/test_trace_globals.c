@@ -38,6 +38,30 @@ static const char *DUFILTER_SL =
     "    P += Km * m * normalize(N);\n"
     "}\n";
 
+/* the antialiasing idiom of production shaders: a filter width from Du/Dv
+ * and du/dv, a box-filtered pulse, and a normal taken before moving P */
+static const char *FILTERED_SL =
+    "#define MINFILTWIDTH 1.0e-6\n"
+    "#define filterwidth(x) max(abs(Du(x)*du) + abs(Dv(x)*dv), MINFILTWIDTH)\n"
+    "#define boxpulse(a, b, x, w) (max(0, min((x) + (w)/2, b) - max((x) - (w)/2, a)) / (w))\n"
+    "displacement filtered(float Km = 0.03, freq = 6)\n"
+    "{\n"
+    "    float ss = s * freq;\n"
+    "    float fw = filterwidth(ss);\n"
+    "    float m = boxpulse(0.3, 0.7, mod(ss, 1), fw);\n"
+    "    normal Nn = normalize(calculatenormal(P));\n"
+    "    float bump = noise(P * 3);\n"
+    "    float fn = filterwidth(bump);\n"
+    "    float oct = 0, amp = 1, sum = 0;\n"
+    "    while (oct < 4 && amp * fn < 0.5) {\n"
+    "        sum += amp * (noise(P * 3 / amp) - 0.5);\n"
+    "        amp *= 0.5;\n"
+    "        oct += 1;\n"
+    "    }\n"
+    "    P += Km * (m + 0.3 * sum + 0.1 * area(P) + 0.01 * Deriv(ss, s)) * Nn;\n"
+    "    N = calculatenormal(P);\n"
+    "}\n";
+
 /* writes du and dv into the displacement, so points show their values */
 static const char *DUVALUE_SL =
     "displacement duvalue()\n"
@@ -138,6 +162,23 @@ static void test_du_in_a_filter_width(void **state)
                 "Sphere 1 -1 1 360"), "dufilter", DUFILTER_SL);
 }
 
+/* Issue 9 finding 2: filter widths from Du/Dv, normalize(calculatenormal(P))
+ * before moving P, noise-driven octave loops: bounded boxes that contain
+ * the surface (derivative bounds, common/sl/vm_deriv.inc). */
+static void test_filterwidth_idioms(void **state)
+{
+    (void)state;
+    containment("filterwidth, plane", SCENE("filtered", "",
+                "Polygon \"P\" [-1 -1 0  1 -1 0  1 1 0  -1 1 0]"), "filtered", FILTERED_SL);
+    containment("filterwidth, sphere", SCENE("filtered", "", "Sphere 1 -1 1 360"),
+                "filtered", FILTERED_SL);
+    containment("filterwidth, ellipsoid", SCENE("filtered", "Rotate 20 0 1 1 Scale 1 0.5 2",
+                "Sphere 1 -1 1 360"), "filtered", FILTERED_SL);
+    containment("filterwidth, patch", SCENE("filtered", "",
+                "Patch \"bilinear\" \"P\" [-1 -1 0  1 -1 0.3  -1 1 0.2  1 1 -0.4]"),
+                "filtered", FILTERED_SL);
+}
+
 /* du and dv: what the shader sees equals the object's constants, in a box
  * (a point range) and at a point, and they follow the projected size. */
 static void test_du_dv_are_per_object_constants(void **state)
@@ -182,6 +223,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_raw_n_on_an_ellipsoid),
         cmocka_unit_test(test_du_in_a_filter_width),
+        cmocka_unit_test(test_filterwidth_idioms),
         cmocka_unit_test(test_du_dv_are_per_object_constants),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

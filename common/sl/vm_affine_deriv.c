@@ -1,0 +1,30 @@
+/*
+ * vm_affine_deriv.c: the VM in affine arithmetic with derivative bounds
+ * (vm_deriv.inc): for shaders that take derivatives (Du, Dv, Deriv,
+ * calculatenormal, area), each slot is an affine form of its value plus
+ * interval enclosures of its d/du and d/dv over the range (issue 9).
+ */
+#include "sl/noise.h"
+#include "sl/vm_internal.h"
+
+#include <math.h>
+#include <stddef.h>
+#include <string.h>
+
+#define VM_OP(name) b_##name
+#include "vm_affine_ops.h"
+#undef VM_OP
+
+typedef aa_form B;
+
+static inline ia_interval b_hull(const B *x) { return aa_range(x); }
+static inline void b_from_interval(sl_vm *vm, B *z, ia_interval r)
+{
+    aa_from_interval(vm->ctx, z, r);
+}
+
+#define VM_T sl_aderiv
+#define VM_SUFFIX affine_deriv
+#define VM_FILE(vm) ((vm)->ad)
+#define VM_VARIANT VM_VAR_AFFINE_DERIV
+#include "vm_deriv.inc"

@@ -1,0 +1,223 @@
+/*
+ * vm_affine_ops.h: the scalar operations of the VM in affine arithmetic,
+ * shared by two instantiations of the dispatch loop: vm_affine.c (names
+ * v_*, the plain mode) and vm_affine_deriv.c (names b_*, the values of the
+ * mode that also carries derivative bounds, vm_deriv.inc). The including
+ * file defines VM_OP(name) to give the names.
+ */
+#ifndef VM_OP
+#error "define VM_OP(name) before including this file"
+#endif
+
+typedef aa_form A;
+
+static inline void VM_OP(const)(sl_vm *vm, A *z, double k) { (void)vm; aa_const(z, k); }
+static inline void VM_OP(mov)(sl_vm *vm, A *z, const A *x)
+{
+    (void)vm;
+    if (z != x)
+        memcpy(z, x, offsetof(aa_form, c) + (size_t)x->n * sizeof x->c[0]);
+}
+static inline void VM_OP(swap)(sl_vm *vm, A *a, A *b)
+{
+    A t;
+    VM_OP(mov)(vm, &t, a);
+    VM_OP(mov)(vm, a, b);
+    VM_OP(mov)(vm, b, &t);
+}
+static inline void VM_OP(unbounded)(sl_vm *vm, A *z) { (void)vm; aa_unbounded(z, 0); }
+static inline bool VM_OP(is_const)(const A *x, double *k)
+{
+    *k = x->x0;
+    return aa_is_point(x);
+}
+static inline void VM_OP(range)(const A *x, double *lo, double *hi)
+{
+    ia_interval r = aa_range(x);
+    *lo = r.lo;
+    *hi = r.hi;
+}
+
+/* exact point arithmetic where the double result is exact (vm_internal.h) */
+static inline bool exact(int op, A *z, const A *x, const A *y)
+{
+    double r;
+    if (x->err != 0.0 || y->err != 0.0 || !aa_is_point(x) || !aa_is_point(y) ||
+        !sl_exact_op(op, x->x0, y->x0, &r))
+        return false;
+    unsigned short flags = (unsigned short)(x->flags | y->flags);
+    aa_const(z, r);
+    z->flags = flags;
+    return true;
+}
+
+#define BIN(name, f) \
+    static inline void name(sl_vm *vm, A *z, const A *x, const A *y) { f(vm->ctx, z, x, y); }
+#define UN(name, f) \
+    static inline void name(sl_vm *vm, A *z, const A *x) { f(vm->ctx, z, x); }
+#define EXACT_BIN(name, op, f)                                               \
+    static inline void name(sl_vm *vm, A *z, const A *x, const A *y)        \
+    {                                                                        \
+        if (!exact(op, z, x, y))                                             \
+            f(vm->ctx, z, x, y);                                             \
+    }
+EXACT_BIN(VM_OP(add), SL_OP_ADD, aa_add)
+EXACT_BIN(VM_OP(sub), SL_OP_SUB, aa_sub)
+EXACT_BIN(VM_OP(mul), SL_OP_MUL, aa_mul)
+EXACT_BIN(VM_OP(div), SL_OP_DIV, aa_div)
+BIN(VM_OP(pow), aa_pow)
+BIN(VM_OP(atan2), aa_atan2)
+BIN(VM_OP(mod), aa_mod)
+BIN(VM_OP(min), aa_min)
+BIN(VM_OP(max), aa_max)
+BIN(VM_OP(step), aa_step)
+UN(VM_OP(neg), aa_neg)
+UN(VM_OP(sqrt), aa_sqrt)
+UN(VM_OP(invsqrt), aa_invsqrt)
+UN(VM_OP(exp), aa_exp)
+UN(VM_OP(log), aa_log)
+UN(VM_OP(sin), aa_sin)
+UN(VM_OP(cos), aa_cos)
+UN(VM_OP(tan), aa_tan)
+UN(VM_OP(asin), aa_asin)
+UN(VM_OP(acos), aa_acos)
+UN(VM_OP(atan), aa_atan)
+UN(VM_OP(abs), aa_abs)
+UN(VM_OP(sign), aa_sign)
+UN(VM_OP(floor), aa_floor)
+UN(VM_OP(ceil), aa_ceil)
+UN(VM_OP(round), aa_round)
+#undef BIN
+#undef UN
+#undef EXACT_BIN
+
+static inline void VM_OP(clamp)(sl_vm *vm, A *z, const A *x, const A *lo, const A *hi)
+{
+    aa_clamp(vm->ctx, z, x, lo, hi);
+}
+static inline void VM_OP(smoothstep)(sl_vm *vm, A *z, const A *e0, const A *e1, const A *x)
+{
+    aa_smoothstep(vm->ctx, z, e0, e1, x);
+}
+static inline void VM_OP(mix)(sl_vm *vm, A *z, const A *x, const A *y, const A *a)
+{
+    aa_mix(vm->ctx, z, x, y, a);
+}
+
+/* Tri-state comparison through the range of x - y (keeps correlations). */
+static inline int VM_OP(cmp)(sl_vm *vm, int op, const A *x, const A *y)
+{
+    A d;
+    aa_sub(vm->ctx, &d, x, y);
+    ia_interval r = aa_range(&d);
+    if ((d.flags & AA_UNBOUNDED) || !(r.lo <= r.hi))
+        return 2;
+    switch (op) {
+    case SL_OP_LT: return r.hi < 0 ? 1 : r.lo >= 0 ? 0 : 2;
+    case SL_OP_LE: return r.hi <= 0 ? 1 : r.lo > 0 ? 0 : 2;
+    case SL_OP_GT: return r.lo > 0 ? 1 : r.hi <= 0 ? 0 : 2;
+    case SL_OP_GE: return r.lo >= 0 ? 1 : r.hi < 0 ? 0 : 2;
+    case SL_OP_EQ: return (r.lo == 0 && r.hi == 0) ? 1 : (r.lo > 0 || r.hi < 0) ? 0 : 2;
+    default: return (r.lo == 0 && r.hi == 0) ? 0 : (r.lo > 0 || r.hi < 0) ? 1 : 2;
+    }
+}
+
+/* 0, 1, or the form 0.5 +- 0.5 (no noise symbol: a private error) */
+static inline void VM_OP(bool)(sl_vm *vm, A *z, int t)
+{
+    (void)vm;
+    aa_const(z, t == 1 ? 1.0 : 0.0);
+    if (t == 2) {
+        z->x0 = 0.5;
+        z->err = 0.5;
+        z->lo = 0.0;
+        z->hi = 1.0;
+    }
+}
+static inline int VM_OP(truth)(const A *x)
+{
+    ia_interval r = aa_range(x);
+    return r.lo > 0.5 ? 1 : r.hi < 0.5 ? 0 : 2;
+}
+static inline bool VM_OP(same)(const A *x, const A *y)
+{
+    if (x->x0 != y->x0 || x->err != y->err || x->n != y->n || x->flags != y->flags ||
+        x->lo != y->lo || x->hi != y->hi)
+        return false;
+    return memcmp(x->c, y->c, (size_t)x->n * sizeof x->c[0]) == 0;
+}
+static inline void VM_OP(merge)(sl_vm *vm, A *z, const A *x, const A *y)
+{
+    aa_merge(vm->ctx, z, x, y);
+}
+
+static inline sl_status VM_OP(noise)(sl_vm *vm, A *S, const sl_insn *in, int pc)
+{
+    int v = in->c, dim = SL_NOISE_DIM(v), kind = SL_NOISE_KIND(v);
+    const A *p = &S[in->b];
+    int period[4] = { 0, 0, 0, 0 };
+    if (kind == SL_NOISE_PERIODIC) {
+        for (int k = 0; k < dim; k++) {
+            double q;
+            if (!VM_OP(is_const)(&S[in->d + k], &q)) {
+                char where[256];
+                sl_program_pos_string(vm->prog, pc, where, sizeof where);
+                return sl_vm_fail(vm, SL_ERR_RUNTIME, "the period of pnoise must not vary "
+                                  "over the surface (at %s)", where);
+            }
+            period[k] = (int)q;
+        }
+    }
+    A out[3];                        /* the noise functions may not alias p */
+    int outs = (v & SL_NOISE_VECTOR) ? 3 : 1;
+    const int *per = kind == SL_NOISE_PERIODIC ? period : NULL;
+    if (outs == 3) {
+        if (kind == SL_NOISE_CELL)
+            sl_vcellnoise_aa(vm->ctx, out, dim, p);
+        else
+            sl_vpnoise_aa(vm->ctx, out, dim, p, per);
+    } else if (kind == SL_NOISE_CELL) {
+        sl_cellnoise_aa(vm->ctx, out, dim, p);
+    } else {
+        sl_pnoise_aa(vm->ctx, out, dim, p, per);
+    }
+    for (int i = 0; i < outs; i++)
+        VM_OP(mov)(vm, &S[in->a + i], &out[i]);
+    return SL_OK;
+}
+
+static inline void VM_OP(random)(sl_vm *vm, A *z)
+{
+    VM_OP(bool)(vm, z, 2);               /* [0, 1] on a private error term */
+    z->flags |= AA_DISCONTINUOUS;
+}
+
+static inline void VM_OP(unknown)(A *z) { aa_unbounded(z, 0); }
+static inline void VM_OP(du)(sl_vm *vm, A *z, const A *x) { (void)vm; (void)x; VM_OP(unknown)(z); }
+static inline void VM_OP(dv)(sl_vm *vm, A *z, const A *x) { (void)vm; (void)x; VM_OP(unknown)(z); }
+static inline void VM_OP(deriv)(sl_vm *vm, A *z, const A *x, const A *y)
+{
+    (void)vm; (void)x; (void)y;
+    VM_OP(unknown)(z);
+}
+static inline void VM_OP(calcnormal)(sl_vm *vm, A *S, int z, int p)
+{
+    (void)vm; (void)p;
+    for (int i = 0; i < 3; i++)
+        VM_OP(unknown)(&S[z + i]);
+}
+static inline void VM_OP(area)(sl_vm *vm, A *S, int z, int p)
+{
+    (void)vm; (void)p;
+    VM_OP(unknown)(&S[z]);
+}
+
+static inline int VM_OP(light_samples)(sl_vm *vm, A *S, sl_light_sample *out, bool *unbounded)
+{
+    (void)S;
+    *unbounded = vm->light_fn != NULL;
+    for (int k = 0; k < vm->nfixed_lights; k++)
+        out[k] = vm->fixed_lights[k];
+    return vm->nfixed_lights;
+}
+

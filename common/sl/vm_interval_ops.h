@@ -1,0 +1,232 @@
+/*
+ * vm_interval_ops.h: the scalar operations of the VM in interval arithmetic,
+ * shared by two instantiations of the dispatch loop: vm_interval.c (names
+ * v_*, the plain mode) and vm_interval_deriv.c (names b_*, the values of the
+ * mode that also carries derivative bounds, vm_deriv.inc). The including
+ * file defines VM_OP(name) to give the names.
+ */
+#ifndef VM_OP
+#error "define VM_OP(name) before including this file"
+#endif
+
+typedef ia_interval I;
+
+static inline void VM_OP(const)(sl_vm *vm, I *z, double k)
+{
+    (void)vm;
+    *z = isfinite(k) ? ia_point(k) : ia_entire();
+}
+static inline void VM_OP(mov)(sl_vm *vm, I *z, const I *x) { (void)vm; *z = *x; }
+static inline void VM_OP(swap)(sl_vm *vm, I *a, I *b)
+{
+    (void)vm;
+    I t = *a;
+    *a = *b;
+    *b = t;
+}
+static inline void VM_OP(unbounded)(sl_vm *vm, I *z) { (void)vm; *z = ia_entire(); }
+static inline bool VM_OP(is_const)(const I *x, double *k)
+{
+    *k = x->lo;
+    return x->lo == x->hi && !(x->flags & AA_UNBOUNDED);
+}
+static inline void VM_OP(range)(const I *x, double *lo, double *hi)
+{
+    *lo = x->lo;
+    *hi = x->hi;
+}
+
+/* exact point arithmetic where the double result is exact (vm_internal.h) */
+static inline bool exact(int op, I *z, const I *x, const I *y)
+{
+    double r;
+    if (x->lo != x->hi || y->lo != y->hi || ((x->flags | y->flags) & AA_UNBOUNDED) ||
+        !sl_exact_op(op, x->lo, y->lo, &r))
+        return false;
+    unsigned flags = x->flags | y->flags;
+    *z = ia_point(r);
+    z->flags = flags;
+    return true;
+}
+
+#define BIN(name, f) \
+    static inline void name(sl_vm *vm, I *z, const I *x, const I *y) { (void)vm; *z = f(*x, *y); }
+#define UN(name, f) \
+    static inline void name(sl_vm *vm, I *z, const I *x) { (void)vm; *z = f(*x); }
+#define EXACT_BIN(name, op, f)                                               \
+    static inline void name(sl_vm *vm, I *z, const I *x, const I *y)        \
+    {                                                                        \
+        (void)vm;                                                            \
+        if (!exact(op, z, x, y))                                             \
+            *z = f(*x, *y);                                                  \
+    }
+EXACT_BIN(VM_OP(add), SL_OP_ADD, ia_add)
+EXACT_BIN(VM_OP(sub), SL_OP_SUB, ia_sub)
+EXACT_BIN(VM_OP(div), SL_OP_DIV, ia_div)
+BIN(VM_OP(pow), ia_pow)
+BIN(VM_OP(atan2), ia_atan2)
+BIN(VM_OP(mod), ia_mod)
+BIN(VM_OP(min), ia_min)
+BIN(VM_OP(max), ia_max)
+BIN(VM_OP(step), ia_step)
+UN(VM_OP(neg), ia_neg)
+UN(VM_OP(sqrt), ia_sqrt)
+UN(VM_OP(invsqrt), ia_invsqrt)
+UN(VM_OP(exp), ia_exp)
+UN(VM_OP(log), ia_log)
+UN(VM_OP(sin), ia_sin)
+UN(VM_OP(cos), ia_cos)
+UN(VM_OP(tan), ia_tan)
+UN(VM_OP(asin), ia_asin)
+UN(VM_OP(acos), ia_acos)
+UN(VM_OP(atan), ia_atan)
+UN(VM_OP(abs), ia_abs)
+UN(VM_OP(sign), ia_sign)
+UN(VM_OP(floor), ia_floor)
+UN(VM_OP(ceil), ia_ceil)
+UN(VM_OP(round), ia_round)
+#undef BIN
+#undef UN
+#undef EXACT_BIN
+
+/* x * x is a square (never negative), as aa_mul does for its affine forms */
+static inline void VM_OP(mul)(sl_vm *vm, I *z, const I *x, const I *y)
+{
+    (void)vm;
+    if (!exact(SL_OP_MUL, z, x, y))
+        *z = x == y ? ia_sqr(*x) : ia_mul(*x, *y);
+}
+
+static inline void VM_OP(clamp)(sl_vm *vm, I *z, const I *x, const I *lo, const I *hi)
+{
+    (void)vm;
+    *z = ia_clamp(*x, *lo, *hi);
+}
+static inline void VM_OP(smoothstep)(sl_vm *vm, I *z, const I *e0, const I *e1, const I *x)
+{
+    (void)vm;
+    *z = ia_smoothstep(*e0, *e1, *x);
+}
+static inline void VM_OP(mix)(sl_vm *vm, I *z, const I *x, const I *y, const I *a)
+{
+    (void)vm;
+    *z = ia_mix(*x, *y, *a);
+}
+
+/* Tri-state comparison of two enclosures. Empty or NaN bounds: maybe. */
+static inline int cmp_ranges(int op, double alo, double ahi, double blo, double bhi)
+{
+    switch (op) {
+    case SL_OP_LT:
+        return ahi < blo ? 1 : alo >= bhi ? 0 : 2;
+    case SL_OP_LE:
+        return ahi <= blo ? 1 : alo > bhi ? 0 : 2;
+    case SL_OP_GT:
+        return alo > bhi ? 1 : ahi <= blo ? 0 : 2;
+    case SL_OP_GE:
+        return alo >= bhi ? 1 : ahi < blo ? 0 : 2;
+    case SL_OP_EQ:
+        return (alo == ahi && blo == bhi && alo == blo) ? 1 : (ahi < blo || bhi < alo) ? 0 : 2;
+    default:
+        return (alo == ahi && blo == bhi && alo == blo) ? 0 : (ahi < blo || bhi < alo) ? 1 : 2;
+    }
+}
+
+static inline int VM_OP(cmp)(sl_vm *vm, int op, const I *x, const I *y)
+{
+    (void)vm;
+    if (ia_is_empty(*x) || ia_is_empty(*y))
+        return 2;
+    return cmp_ranges(op, x->lo, x->hi, y->lo, y->hi);
+}
+
+static inline void VM_OP(bool)(sl_vm *vm, I *z, int t)
+{
+    (void)vm;
+    *z = t == 2 ? ia_make(0.0, 1.0) : ia_point(t ? 1.0 : 0.0);
+}
+static inline int VM_OP(truth)(const I *x)
+{
+    return x->lo > 0.5 ? 1 : x->hi < 0.5 ? 0 : 2;
+}
+static inline bool VM_OP(same)(const I *x, const I *y)
+{
+    return x->lo == y->lo && x->hi == y->hi && x->flags == y->flags;
+}
+static inline void VM_OP(merge)(sl_vm *vm, I *z, const I *x, const I *y)
+{
+    (void)vm;
+    *z = ia_merge(*x, *y);
+}
+
+static inline sl_status VM_OP(noise)(sl_vm *vm, I *S, const sl_insn *in, int pc)
+{
+    int v = in->c, dim = SL_NOISE_DIM(v), kind = SL_NOISE_KIND(v);
+    I p[4];
+    memcpy(p, &S[in->b], (size_t)dim * sizeof *p);
+    int period[4] = { 0, 0, 0, 0 };
+    if (kind == SL_NOISE_PERIODIC) {
+        for (int k = 0; k < dim; k++) {
+            double q;
+            if (!VM_OP(is_const)(&S[in->d + k], &q)) {
+                char where[256];
+                sl_program_pos_string(vm->prog, pc, where, sizeof where);
+                return sl_vm_fail(vm, SL_ERR_RUNTIME, "the period of pnoise must not vary "
+                                  "over the surface (at %s)", where);
+            }
+            period[k] = (int)q;
+        }
+    }
+    I out[3];
+    if (v & SL_NOISE_VECTOR) {
+        if (kind == SL_NOISE_CELL)
+            sl_vcellnoise_ia(dim, p, out);
+        else
+            sl_vpnoise_ia(dim, p, kind == SL_NOISE_PERIODIC ? period : NULL, out);
+        memcpy(&S[in->a], out, sizeof out);
+    } else {
+        S[in->a] = kind == SL_NOISE_CELL ? sl_cellnoise_ia(dim, p)
+                                         : sl_pnoise_ia(dim, p, kind == SL_NOISE_PERIODIC ? period : NULL);
+    }
+    return SL_OK;
+}
+
+static inline void VM_OP(random)(sl_vm *vm, I *z)
+{
+    (void)vm;
+    *z = ia_make(0.0, 1.0);
+    z->flags |= AA_DISCONTINUOUS;
+}
+
+static inline void VM_OP(unknown)(I *z)
+{
+    *z = ia_entire();
+}
+static inline void VM_OP(du)(sl_vm *vm, I *z, const I *x) { (void)vm; (void)x; VM_OP(unknown)(z); }
+static inline void VM_OP(dv)(sl_vm *vm, I *z, const I *x) { (void)vm; (void)x; VM_OP(unknown)(z); }
+static inline void VM_OP(deriv)(sl_vm *vm, I *z, const I *x, const I *y)
+{
+    (void)vm; (void)x; (void)y;
+    VM_OP(unknown)(z);
+}
+static inline void VM_OP(calcnormal)(sl_vm *vm, I *S, int z, int p)
+{
+    (void)vm; (void)p;
+    for (int i = 0; i < 3; i++)
+        VM_OP(unknown)(&S[z + i]);
+}
+static inline void VM_OP(area)(sl_vm *vm, I *S, int z, int p)
+{
+    (void)vm; (void)p;
+    VM_OP(unknown)(&S[z]);
+}
+
+static inline int VM_OP(light_samples)(sl_vm *vm, I *S, sl_light_sample *out, bool *unbounded)
+{
+    (void)S;
+    *unbounded = vm->light_fn != NULL;
+    for (int k = 0; k < vm->nfixed_lights; k++)
+        out[k] = vm->fixed_lights[k];
+    return vm->nfixed_lights;
+}
+
