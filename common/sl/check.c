@@ -90,9 +90,6 @@ static void declare(checker *c, sl_sym *sym)
             return;
         }
     }
-    if (sl_global_find(sym->name) >= 0 || strcmp(sym->name, "PI") == 0)
-        error(c, sym->pos, "'%s' is a predefined variable and cannot be redeclared",
-              sym->name);      /* declared anyway: later uses are not errors too */
     sl_list_push(c->arena, (void ***)&c->syms, &c->nsyms, &c->syms_cap, sym);
 }
 

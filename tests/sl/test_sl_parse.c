@@ -207,9 +207,12 @@ static void test_names(void **state)
                   "t.sl:5:7: note: previous definition is here\n"
                   "float g() { return 1; }\n"
                   "      ^\n");
-    /* a redeclared predefined variable is reported once, its uses are not */
-    expect_errors("displacement t() {\n    float s = 1;\n    s += 1;\n}\n",
-                  "t.sl:2:11: error: 's' is a predefined variable and cannot be redeclared\n"
+    /* a local may shadow a predefined variable, but not twice in one scope */
+    expect_errors("displacement t() {\n    float s = 1;\n    float s = 2;\n}\n",
+                  "t.sl:3:11: error: redefinition of 's'\n"
+                  "    float s = 2;\n"
+                  "          ^\n"
+                  "t.sl:2:11: note: previous definition is here\n"
                   "    float s = 1;\n"
                   "          ^\n");
     expect_errors("float f() { extern float Km; return Km; }\ndisplacement t() { }\n",
