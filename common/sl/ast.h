@@ -73,6 +73,7 @@ typedef struct sl_func {
     sl_sym **params;
     int nparams;
     sl_node *body;
+    bool nested;                /* defined inside a function or the shader body */
     /* checker */
     struct sl_func **calls;     /* user functions called, for the recursion check */
     int ncalls, calls_cap;
@@ -109,6 +110,7 @@ typedef enum sl_node_kind {
     SL_N_CONTINUE,   /* num: levels; target: the loop */
     SL_N_RETURN,     /* a: value or NULL; func: the function (NULL: shader) */
     SL_N_EMPTY,
+    SL_N_FUNC,       /* a nested function definition: func (no code of its own) */
 } sl_node_kind;
 
 /* A statement's escape: a break/continue/return inside it that leaves it. */

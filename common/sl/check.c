@@ -34,6 +34,12 @@ typedef struct checker {
     sl_sym **syms;                 /* scope stack */
     int nsyms, syms_cap;
     int scope_start;               /* first sym of the innermost scope */
+    int func_base;                 /* first sym of the current function */
+    sl_func **vfuncs;              /* nested functions in scope, innermost last */
+    int nvfuncs, vfuncs_cap;
+    int vfuncs_start;              /* first of the innermost scope */
+    sl_func **allfuncs;            /* every function, nested ones too */
+    int nallfuncs, allfuncs_cap;
     sl_func *func;                 /* function being checked (NULL: shader) */
     sl_node **loops;
     int nloops, loops_cap;
@@ -68,9 +74,13 @@ int sl_space_find(const char *name)
 /* scopes                                                                  */
 /* ---------------------------------------------------------------------- */
 
+/* The variable `name` as the current function sees it: its own scopes
+ * (down to func_base), then the predefined variables and PI. Variables of
+ * an enclosing function are seen only through 'extern' (RI Spec 3.2
+ * §14.2), which copies them into the current scope. */
 static sl_sym *lookup(checker *c, const char *name)
 {
-    for (int i = c->nsyms - 1; i >= 0; i--)
+    for (int i = c->nsyms - 1; i >= c->func_base; i--)
         if (strcmp(c->syms[i]->name, name) == 0)
             return c->syms[i];
     int g = sl_global_find(name);
@@ -93,21 +103,43 @@ static void declare(checker *c, sl_sym *sym)
     sl_list_push(c->arena, (void ***)&c->syms, &c->nsyms, &c->syms_cap, sym);
 }
 
-static int push_scope(checker *c)
+/* A variable of the scopes around the current function (for 'extern' and
+ * for the message when one is used without it), innermost first. */
+static sl_sym *lookup_enclosing(checker *c, const char *name)
 {
-    int saved = c->scope_start;
+    for (int i = c->func_base - 1; i >= 0; i--)
+        if (strcmp(c->syms[i]->name, name) == 0)
+            return c->syms[i];
+    return NULL;
+}
+
+typedef struct scope_mark {
+    int scope_start, vfuncs_start;
+} scope_mark;
+
+static scope_mark push_scope(checker *c)
+{
+    scope_mark saved = { c->scope_start, c->vfuncs_start };
     c->scope_start = c->nsyms;
+    c->vfuncs_start = c->nvfuncs;
     return saved;
 }
 
-static void pop_scope(checker *c, int saved)
+static void pop_scope(checker *c, scope_mark saved)
 {
     c->nsyms = c->scope_start;
-    c->scope_start = saved;
+    c->nvfuncs = c->vfuncs_start;
+    c->scope_start = saved.scope_start;
+    c->vfuncs_start = saved.vfuncs_start;
 }
 
+/* The function `name` names here: a nested one in scope (innermost
+ * first), else one at file level. */
 static sl_func *find_func(checker *c, const char *name)
 {
+    for (int i = c->nvfuncs - 1; i >= 0; i--)
+        if (strcmp(c->vfuncs[i]->name, name) == 0)
+            return c->vfuncs[i];
     for (int i = 0; i < c->file->nfuncs; i++)
         if (strcmp(c->file->funcs[i]->name, name) == 0)
             return c->file->funcs[i];
@@ -174,7 +206,12 @@ static sl_ty check_ident(checker *c, sl_node *n)
 {
     sl_sym *s = lookup(c, n->name);
     if (!s) {
-        if (find_func(c, n->name) || sl_builtin_find(n->name, &(int){ 0 }))
+        sl_sym *outer = lookup_enclosing(c, n->name);
+        if (outer)
+            error(c, n->pos, "'%s' belongs to an enclosing scope; declare it 'extern %s %s;' "
+                             "in function '%s' to use it here", n->name, sl_ty_name(outer->ty),
+                  n->name, c->func->name);
+        else if (find_func(c, n->name) || sl_builtin_find(n->name, &(int){ 0 }))
             error(c, n->pos, "'%s' is a function; call it with '(...)'", n->name);
         else
             error(c, n->pos, "use of undeclared identifier '%s'", n->name);
@@ -608,10 +645,17 @@ static void check_decl(checker *c, sl_node *n)
         sl_node *v = n->list[i];
         sl_sym *s = v->sym;
         if (v->num != 0) {            /* extern */
-            sl_sym *outer = lookup(c, s->name);
-            if (!outer || outer->kind != SL_SYM_GLOBAL) {
-                error(c, v->pos, "'extern' may only name a predefined variable here "
-                                 "(pass '%s' as a parameter instead)", s->name);
+            sl_sym *outer = lookup_enclosing(c, s->name);
+            if (!outer) {
+                outer = lookup(c, s->name);
+                if (outer && outer->kind != SL_SYM_GLOBAL)
+                    outer = NULL;         /* a variable of this very function */
+            }
+            if (!outer) {
+                error(c, v->pos, c->func && c->func->nested
+                          ? "'extern' names no variable '%s' of an enclosing scope"
+                          : "'extern' may only name a predefined variable here "
+                            "(pass '%s' as a parameter instead)", s->name);
                 s->kind = SL_SYM_LOCAL;     /* declared anyway: no follow-up errors */
                 declare(c, s);
                 v->num = 0;
@@ -621,6 +665,8 @@ static void check_decl(checker *c, sl_node *n)
                                  "type '%s'", s->name, sl_ty_name(s->ty),
                       sl_ty_name(outer->ty));
             v->sym = NULL;
+            if (outer->kind != SL_SYM_GLOBAL && outer->kind != SL_SYM_CONST)
+                declare(c, outer);        /* the enclosing variable itself */
             continue;
         }
         if (v->a) {
@@ -685,13 +731,15 @@ static void check_return(checker *c, sl_node *n)
     add_escape(c, n, e);
 }
 
+static void check_nested_function(checker *c, sl_func *f);
+
 static void check_stmt(checker *c, sl_node *n)
 {
     if (!n || sl_diag_full(c->diag))
         return;
     switch (n->kind) {
     case SL_N_BLOCK: {
-        int saved = push_scope(c);
+        scope_mark saved = push_scope(c);
         for (int i = 0; i < n->nlist; i++) {
             check_stmt(c, n->list[i]);
             inherit(c, n, n->list[i], NULL);
@@ -713,7 +761,7 @@ static void check_stmt(checker *c, sl_node *n)
         check_loop_body(c, n, n->b);
         break;
     case SL_N_FOR: {
-        int saved = push_scope(c);
+        scope_mark saved = push_scope(c);
         if (n->a)
             check_stmt(c, n->a);
         if (n->b)
@@ -726,6 +774,7 @@ static void check_stmt(checker *c, sl_node *n)
     }
     case SL_N_BREAK: case SL_N_CONTINUE: check_loop_mod(c, n); break;
     case SL_N_RETURN: check_return(c, n); break;
+    case SL_N_FUNC: check_nested_function(c, n->func); break;
     default: break;
     }
 }
@@ -766,21 +815,61 @@ static bool needs_ret_flag(sl_node *body)
 /* functions, recursion, the shader                                        */
 /* ---------------------------------------------------------------------- */
 
-static void check_function(checker *c, sl_func *f)
+/* The parameters and body of f, in a scope of their own above the
+ * current one (func_base: the variables below it are the enclosing ones). */
+static void check_function_body(checker *c, sl_func *f)
 {
+    sl_list_push(c->arena, (void ***)&c->allfuncs, &c->nallfuncs, &c->allfuncs_cap, f);
     c->func = f;
-    c->nsyms = 0;
-    c->scope_start = 0;
+    c->func_base = c->nsyms;
+    scope_mark saved = push_scope(c);
     for (int i = 0; i < f->nparams; i++)
         declare(c, f->params[i]);
     check_stmt(c, f->body);
+    pop_scope(c, saved);
     f->needs_ret_flag = needs_ret_flag(f->body);
     if (f->ret != SL_TYPE_VOID) {
         int count = 0;
         if (!count_returns(f->body, &count))
             error(c, f->pos, "non-void function '%s' has no 'return' statement", f->name);
     }
+}
+
+static void check_function(checker *c, sl_func *f)
+{
+    c->nsyms = c->scope_start = 0;
+    c->nvfuncs = c->vfuncs_start = 0;
+    check_function_body(c, f);
     c->func = NULL;
+    c->func_base = 0;
+}
+
+/* A function defined inside a function or the shader body: callable from
+ * its definition to the end of the enclosing block (its own body
+ * included, so that recursion is reported as such), seeing the enclosing
+ * variables through 'extern' only. */
+static void check_nested_function(checker *c, sl_func *f)
+{
+    for (int i = c->vfuncs_start; i < c->nvfuncs; i++) {
+        if (strcmp(c->vfuncs[i]->name, f->name) == 0) {
+            error(c, f->pos, "redefinition of function '%s'", f->name);
+            sl_diag_note(c->diag, c->vfuncs[i]->pos, "previous definition is here");
+            return;
+        }
+    }
+    sl_list_push(c->arena, (void ***)&c->vfuncs, &c->nvfuncs, &c->vfuncs_cap, f);
+    sl_func *saved_func = c->func;
+    int saved_base = c->func_base;
+    sl_node **saved_loops = c->loops;           /* break cannot leave a function */
+    int saved_nloops = c->nloops, saved_cap = c->loops_cap;
+    c->loops = NULL;
+    c->nloops = c->loops_cap = 0;
+    check_function_body(c, f);
+    c->loops = saved_loops;
+    c->nloops = saved_nloops;
+    c->loops_cap = saved_cap;
+    c->func = saved_func;
+    c->func_base = saved_base;
 }
 
 /* Depth-first search for a cycle through f; reports the chain. */
@@ -812,12 +901,11 @@ static bool find_cycle(checker *c, sl_func *f, sl_func **path, int depth)
 
 static void check_recursion(checker *c)
 {
-    sl_func **path = sl_arena_alloc(c->arena,
-                                    (size_t)(c->file->nfuncs + 2) * sizeof *path);
-    for (int i = 0; i < c->file->nfuncs; i++) {
-        if (find_cycle(c, c->file->funcs[i], path, 0)) {
-            for (int j = 0; j < c->file->nfuncs; j++)
-                c->file->funcs[j]->mark = 2;
+    sl_func **path = sl_arena_alloc(c->arena, (size_t)(c->nallfuncs + 2) * sizeof *path);
+    for (int i = 0; i < c->nallfuncs; i++) {
+        if (find_cycle(c, c->allfuncs[i], path, 0)) {
+            for (int j = 0; j < c->nallfuncs; j++)
+                c->allfuncs[j]->mark = 2;
             return;
         }
     }
@@ -867,8 +955,9 @@ static void make_globals(checker *c)
 static void check_shader(checker *c)
 {
     sl_ast_file *f = c->file;
-    c->nsyms = 0;
-    c->scope_start = 0;
+    c->nsyms = c->scope_start = c->func_base = 0;
+    c->nvfuncs = c->vfuncs_start = 0;
+    c->func = NULL;
     for (int i = 0; i < f->nparams; i++) {
         sl_node *v = f->params[i];
         if (v->a) {

@@ -7,8 +7,8 @@
  *   function    := [type] IDENT '(' [formals] ')' block
  *   formals     := formal { (';' | ',') formal } [';']
  *   formal      := ['output'] ['uniform'|'varying'] type def {',' def}
- *   statement   := block | declaration | if | while | for | break | continue
- *                | return | expr ';' | ';'
+ *   statement   := block | declaration | function | if | while | for | break
+ *                | continue | return | expr ';' | ';'
  *   expr        := assignment, then ?: || && (== !=) (< > <= >=) (+ -)
  *                  (^) (* /) (.) unary, lowest to highest precedence (the
  *                  spec's order: "." binds tighter than "*", "^" between
@@ -598,6 +598,32 @@ static sl_node *block(parser *p)
     return b;
 }
 
+/* name '(' formals ')' block, the name being the current token: the rest
+ * of a function definition, at file level or nested (RI Spec 3.2 §14.2:
+ * "Functions may be declared anyplace that it is legal to declare a
+ * variable"). NULL after an error. */
+static sl_func *function_rest(parser *p, sl_ty ret)
+{
+    sl_token name = p->cur;
+    advance(p);
+    sl_token open = p->cur;
+    if (!expect(p, SL_TOK_LPAREN, "after function name"))
+        return NULL;
+    sl_func *f = sl_arena_alloc(p->arena, sizeof *f);
+    f->name = name.text;
+    f->pos = name.pos;
+    f->ret = ret;
+    sl_node **params = NULL;
+    formals(p, &open, &params, &f->nparams, SL_SYM_FPARAM);
+    f->params = sl_arena_alloc(p->arena, (size_t)(f->nparams + 1) * sizeof *f->params);
+    for (int i = 0; i < f->nparams; i++) {
+        f->params[i] = params[i]->sym;
+        f->params[i]->writable = f->params[i]->output;
+    }
+    f->body = block(p);
+    return f;
+}
+
 /* A declaration statement: spec declarator {, declarator} ';' */
 static sl_node *declaration(parser *p, bool need_semicolon)
 {
@@ -609,10 +635,16 @@ static sl_node *declaration(parser *p, bool need_semicolon)
         error_at(p, spec.type_tok.pos, &spec.type_tok,
                  "'output' is only allowed on parameters");
     if (check(p, SL_TOK_IDENT) && peek_kind(p, 0) == SL_TOK_LPAREN) {
-        error_at(p, p->cur.pos, &p->cur,
-                 "nested function definitions are not supported; define '%s' at file level",
-                 p->cur.text);
-        return d;
+        if (spec.external) {
+            error_at(p, spec.type_tok.pos, &spec.type_tok,
+                     "'extern' is only allowed on variables");
+            return d;
+        }
+        sl_node *n = sl_node_new(p->arena, SL_N_FUNC, p->cur.pos);
+        n->func = function_rest(p, spec.ty);
+        if (n->func)
+            n->func->nested = true;
+        return n->func ? n : d;
     }
     int cap = 0;
     do {
@@ -819,24 +851,9 @@ static void function_definition(parser *p, sl_ast_file *file, int *funcs_cap)
         error_at(p, p->cur.pos, &p->cur, "expected function name");
         return;
     }
-    sl_token name = p->cur;
-    advance(p);
-    sl_token open = p->cur;
-    if (!expect(p, SL_TOK_LPAREN, "after function name"))
-        return;
-    sl_func *f = sl_arena_alloc(p->arena, sizeof *f);
-    f->name = name.text;
-    f->pos = name.pos;
-    f->ret = ret;
-    sl_node **params = NULL;
-    formals(p, &open, &params, &f->nparams, SL_SYM_FPARAM);
-    f->params = sl_arena_alloc(p->arena, (size_t)(f->nparams + 1) * sizeof *f->params);
-    for (int i = 0; i < f->nparams; i++) {
-        f->params[i] = params[i]->sym;
-        f->params[i]->writable = f->params[i]->output;
-    }
-    f->body = block(p);
-    sl_list_push(p->arena, (void ***)&file->funcs, &file->nfuncs, funcs_cap, f);
+    sl_func *f = function_rest(p, ret);
+    if (f)
+        sl_list_push(p->arena, (void ***)&file->funcs, &file->nfuncs, funcs_cap, f);
 }
 
 static void skip_definition(parser *p)

@@ -139,11 +139,6 @@ static void test_unsupported(void **state)
                   "specular() or phong())\n"
                   "    illuminance(P) { }\n"
                   "    ^\n");
-    expect_errors("displacement t() {\n    float f(float x) { return x; }\n}\n",
-                  "t.sl:2:11: error: nested function definitions are not supported; define "
-                  "'f' at file level\n"
-                  "    float f(float x) { return x; }\n"
-                  "          ^\n");
     expect_errors("displacement t() {\n    output float x = 1;\n    void y;\n}\n",
                   "t.sl:2:12: error: 'output' is only allowed on parameters\n"
                   "    output float x = 1;\n"

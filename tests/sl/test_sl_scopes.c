@@ -6,6 +6,10 @@
  *   shadowing     locals, function and shader parameters named like the
  *                 predefined variables (s, t, u, P, PI) and like built-in
  *                 functions, which stay callable
+ *   nested        functions defined inside functions and the shader body
+ *                 (the patterns.h idiom), scoped like variables, seeing
+ *                 enclosing variables through 'extern' (also writing
+ *                 them, also two levels out), recursion and misuse
  *
  * Globals are those of the plane at (u, v) = (0.25, 0.75):
  * P = (-0.5, 0.5, 0), N = (0, 0, 1), s = u, t = v.
@@ -135,12 +139,156 @@ static void test_shadow_errors(void **state)
                   "    ^\n");
 }
 
+/* ---------------------------------------------------------------------- */
+/* nested functions                                                        */
+/* ---------------------------------------------------------------------- */
+
+static double sgn(double x) { return x > 0 ? 1 : x < 0 ? -1 : 0; }
+
+/* The integral of |x| over [x - dx/2, x + dx/2], divided by dx. */
+static double filteredabs(double x, double dx)
+{
+    double x0 = x - 0.5 * dx, x1 = x0 + dx;
+    return (sgn(x1) * 0.5 * x1 * x1 - sgn(x0) * 0.5 * x0 * x0) / dx;
+}
+
+static void test_nested_functions(void **state)
+{
+    (void)state;
+    /* the widely copied idiom: a helper inside the function using it */
+    expect_src("float filteredabs(float x, dx) {\n"
+               "    float integral(float t) { return sign(t) * 0.5 * t * t; }\n"
+               "    float x0 = x - 0.5 * dx;\n"
+               "    float x1 = x0 + dx;\n"
+               "    return (integral(x1) - integral(x0)) / dx;\n"
+               "}\n"
+               "displacement d() {\n"
+               "    P = point(filteredabs(s - 0.5, 0.1), filteredabs(t - 0.5, 0.3), 0);\n"
+               "}\n",
+               filteredabs(U - 0.5, 0.1), filteredabs(V - 0.5, 0.3), 0);
+    /* in the shader body, writing a local and reading a parameter of the
+     * shader through extern */
+    expect_src("displacement d(float Km = 2) {\n"
+               "    float acc = 1;\n"
+               "    void bump(float x) { extern float acc, Km; acc += Km * x; }\n"
+               "    bump(s);\n"
+               "    bump(t);\n"
+               "    P = point(acc, 0, 0);\n"
+               "}\n",
+               1 + 2 * (U + V), 0, 0);
+    /* two levels: the innermost reaches the outermost's local */
+    expect_src("float outer(float a) {\n"
+               "    float b = a * 2;\n"
+               "    float mid(float c) {\n"
+               "        float inner(float d) { extern float b; return b + d; }\n"
+               "        return inner(c) * 10;\n"
+               "    }\n"
+               "    return mid(a + 1);\n"
+               "}\n"
+               "displacement d() { P = point(outer(1), outer(s), 0); }\n",
+               40, (2 * U + U + 1) * 10, 0);
+    /* extern s names the enclosing local s; without extern, s is the global */
+    expect_src("displacement d() {\n"
+               "    float s = 5;\n"
+               "    float f() { extern float s; return s; }\n"
+               "    float g() { return s; }\n"
+               "    P = point(f(), g(), 0);\n"
+               "}\n",
+               5, U, 0);
+    /* one name, two blocks, two functions; a nested one hides a file-level one */
+    expect_src("float h(float x) { return x - 1; }\n"
+               "displacement d() {\n"
+               "    float a, b;\n"
+               "    { float h(float x) { return x + 1; } a = h(1); }\n"
+               "    { float h(float x) { return x * 3; } b = h(1); }\n"
+               "    P = point(a, b, h(1));\n"
+               "}\n",
+               2, 3, 0);
+    /* a nested function with a loop and an early return, called in a loop */
+    expect_src("displacement d() {\n"
+               "    float total = 0;\n"
+               "    float firstabove(float lim) {\n"
+               "        float i;\n"
+               "        for (i = 0; i < 10; i += 1) {\n"
+               "            if (i * i > lim) return i;\n"
+               "        }\n"
+               "        return -1;\n"
+               "    }\n"
+               "    float k;\n"
+               "    for (k = 0; k < 3; k += 1) total += firstabove(k * 10);\n"
+               "    P = point(total, firstabove(1000), 0);\n"
+               "}\n",
+               1 + 4 + 5, -1, 0);
+}
+
+static void test_nested_errors(void **state)
+{
+    (void)state;
+    expect_errors("float f(float a) {\n"
+                  "    float g() { return a; }\n"
+                  "    return g();\n"
+                  "}\n"
+                  "displacement d() { }\n",
+                  "t.sl:2:24: error: 'a' belongs to an enclosing scope; declare it "
+                  "'extern float a;' in function 'g' to use it here\n"
+                  "    float g() { return a; }\n"
+                  "                       ^\n");
+    /* scoped like a variable: not before its definition, not after its block */
+    expect_errors("displacement d() {\n"
+                  "    float a = h(1);\n"
+                  "    { float h(float x) { return x; } }\n"
+                  "    a = h(2);\n"
+                  "}\n",
+                  "t.sl:2:15: error: use of undeclared function 'h'\n"
+                  "    float a = h(1);\n"
+                  "              ^\n"
+                  "t.sl:4:9: error: use of undeclared function 'h'\n"
+                  "    a = h(2);\n"
+                  "        ^\n");
+    expect_errors("displacement d() {\n"
+                  "    float h(float x) { return x; }\n"
+                  "    float h(float x) { return x + 1; }\n"
+                  "}\n",
+                  "t.sl:3:11: error: redefinition of function 'h'\n"
+                  "    float h(float x) { return x + 1; }\n"
+                  "          ^\n"
+                  "t.sl:2:11: note: previous definition is here\n"
+                  "    float h(float x) { return x; }\n"
+                  "          ^\n");
+    expect_errors("displacement d() {\n"
+                  "    float h(float x) { return x > 0 ? h(x - 1) : 0; }\n"
+                  "    P += h(3);\n"
+                  "}\n",
+                  "t.sl:2:11: error: recursion is not supported: h -> h\n"
+                  "    float h(float x) { return x > 0 ? h(x - 1) : 0; }\n"
+                  "          ^\n");
+    /* break cannot leave a function; extern must name something */
+    expect_errors("displacement d() {\n"
+                  "    while (1) {\n"
+                  "        void stop() { break; }\n"
+                  "        float q() { extern float zz; extern color P; return 1; }\n"
+                  "    }\n"
+                  "}\n",
+                  "t.sl:3:23: error: 'break' statement not in loop\n"
+                  "        void stop() { break; }\n"
+                  "                      ^\n"
+                  "t.sl:4:34: error: 'extern' names no variable 'zz' of an enclosing scope\n"
+                  "        float q() { extern float zz; extern color P; return 1; }\n"
+                  "                                 ^\n"
+                  "t.sl:4:51: error: 'extern' declaration of 'P' as 'color' does not match "
+                  "its type 'point'\n"
+                  "        float q() { extern float zz; extern color P; return 1; }\n"
+                  "                                                  ^\n");
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_shadow_globals),
         cmocka_unit_test(test_shadow_builtins),
         cmocka_unit_test(test_shadow_errors),
+        cmocka_unit_test(test_nested_functions),
+        cmocka_unit_test(test_nested_errors),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
