@@ -74,6 +74,7 @@ typedef struct sl_func {
     int nparams;
     sl_node *body;
     bool nested;                /* defined inside a function or the shader body */
+    int depth;                  /* checker: block depth of a nested definition (0: file) */
     /* checker */
     struct sl_func **calls;     /* user functions called, for the recursion check */
     int ncalls, calls_cap;

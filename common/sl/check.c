@@ -38,6 +38,7 @@ typedef struct checker {
     sl_func **vfuncs;              /* nested functions in scope, innermost last */
     int nvfuncs, vfuncs_cap;
     int vfuncs_start;              /* first of the innermost scope */
+    int depth;                     /* block depth */
     sl_func **allfuncs;            /* every function, nested ones too */
     int nallfuncs, allfuncs_cap;
     sl_func *func;                 /* function being checked (NULL: shader) */
@@ -122,6 +123,7 @@ static scope_mark push_scope(checker *c)
     scope_mark saved = { c->scope_start, c->vfuncs_start };
     c->scope_start = c->nsyms;
     c->vfuncs_start = c->nvfuncs;
+    c->depth++;
     return saved;
 }
 
@@ -131,19 +133,54 @@ static void pop_scope(checker *c, scope_mark saved)
     c->nvfuncs = c->vfuncs_start;
     c->scope_start = saved.scope_start;
     c->vfuncs_start = saved.vfuncs_start;
+    c->depth--;
 }
 
-/* The function `name` names here: a nested one in scope (innermost
- * first), else one at file level. */
+enum { MAX_OVERLOADS = 32 };
+
+/* The user functions `name` may call here, the overloads: nested ones in
+ * scope (innermost first), then those at file level. Returns how many
+ * (at most max are stored). */
+static int find_funcs(checker *c, const char *name, sl_func **out, int max)
+{
+    int n = 0;
+    for (int i = c->nvfuncs - 1; i >= 0; i--)
+        if (strcmp(c->vfuncs[i]->name, name) == 0 && n < max)
+            out[n++] = c->vfuncs[i];
+    for (int i = 0; i < c->file->nfuncs; i++)
+        if (strcmp(c->file->funcs[i]->name, name) == 0 && n < max)
+            out[n++] = c->file->funcs[i];
+    return n;
+}
+
 static sl_func *find_func(checker *c, const char *name)
 {
-    for (int i = c->nvfuncs - 1; i >= 0; i--)
-        if (strcmp(c->vfuncs[i]->name, name) == 0)
-            return c->vfuncs[i];
-    for (int i = 0; i < c->file->nfuncs; i++)
-        if (strcmp(c->file->funcs[i]->name, name) == 0)
-            return c->file->funcs[i];
-    return NULL;
+    sl_func *f;
+    return find_funcs(c, name, &f, 1) ? f : NULL;
+}
+
+/* Same parameter types (and 'output'-ness) in the same order. */
+static bool same_params(const sl_func *a, const sl_func *b)
+{
+    if (a->nparams != b->nparams)
+        return false;
+    for (int i = 0; i < a->nparams; i++)
+        if (a->params[i]->ty != b->params[i]->ty ||
+            a->params[i]->output != b->params[i]->output)
+            return false;
+    return true;
+}
+
+/* "float f(point, output float)" for a message. */
+static void func_signature(const sl_func *f, char *buf, size_t size)
+{
+    size_t o = (size_t)snprintf(buf, size, "%s %s(", sl_ty_name(f->ret), f->name);
+    for (int i = 0; i < f->nparams && o < size; i++)
+        o += (size_t)snprintf(buf + o, size - o, "%s%s%s", i ? ", " : "",
+                              f->params[i]->output ? "output " : "",
+                              sl_ty_name(f->params[i]->ty));
+    if (o < size)
+        snprintf(buf + o, size - o, ")");
 }
 
 /* ---------------------------------------------------------------------- */
@@ -499,11 +536,122 @@ static sl_ty check_user_call(checker *c, sl_node *n, sl_func *f, const sl_ty *ar
     return set_ty(n, ok ? f->ret : SL_TY_ERROR);
 }
 
+/* Cost of passing an argument of type `have` to parameter p; -1: not
+ * viable. As for the built-ins (builtins.c): exact 0, point/vector/normal
+ * as another of the three 1, a float promoted 2; an 'output' parameter
+ * takes a variable of its own type (or another spatial type, cost 1). */
+static int param_cost(const sl_sym *p, sl_ty have)
+{
+    if (have == p->ty)
+        return 0;
+    if (sl_ty_is_spatial(have) && sl_ty_is_spatial(p->ty))
+        return 1;
+    if (p->output)
+        return -1;
+    if (have == SL_TYPE_FLOAT && (sl_ty_is_triple(p->ty) || p->ty == SL_TYPE_MATRIX))
+        return 2;
+    return -1;
+}
+
+/* Keeps the candidates for which keep() holds, when any does. */
+static int narrow(sl_func **f, int n, bool (*keep)(const sl_func *, sl_ty), sl_ty hint)
+{
+    int k = 0;
+    for (int i = 0; i < n; i++)
+        if (keep(f[i], hint))
+            f[k++] = f[i];
+    return k ? k : n;
+}
+static bool returns_exactly(const sl_func *f, sl_ty hint) { return f->ret == hint; }
+static bool returns_convertible(const sl_func *f, sl_ty hint)
+{
+    return can_convert(f->ret, hint) && f->ret != SL_TYPE_VOID;
+}
+
+/* Overload resolution among user functions (see docs/shading-language.md):
+ * the viable candidate of least total conversion cost; of equally cheap
+ * ones, those returning the type the context asks for (hint), then those
+ * returning a type convertible to it, then the innermost definitions. A
+ * tie left after that is an error. NULL: none viable (not reported) or
+ * ambiguous (reported, *ambiguous set). */
+static sl_func *resolve_user(checker *c, sl_node *n, sl_func **cands, int ncands,
+                             const sl_ty *args, sl_ty hint, bool *ambiguous)
+{
+    sl_func *best[MAX_OVERLOADS];
+    int nbest = 0, best_cost = 0;
+    *ambiguous = false;
+    for (int k = 0; k < ncands; k++) {
+        sl_func *f = cands[k];
+        if (f->nparams != n->nlist)
+            continue;
+        int cost = 0;
+        for (int i = 0; i < n->nlist && cost >= 0; i++) {
+            int ci = param_cost(f->params[i], args[i]);
+            cost = ci < 0 ? -1 : cost + ci;
+        }
+        if (cost < 0 || (nbest > 0 && cost > best_cost))
+            continue;
+        if (nbest == 0 || cost < best_cost)
+            nbest = 0;
+        best_cost = cost;
+        best[nbest++] = f;
+    }
+    if (nbest > 1 && hint != SL_TYPE_VOID && hint != SL_TY_ERROR) {
+        nbest = narrow(best, nbest, returns_exactly, hint);
+        nbest = narrow(best, nbest, returns_convertible, hint);
+    }
+    if (nbest > 1) {
+        int deepest = 0, k = 0;
+        for (int i = 0; i < nbest; i++)
+            deepest = best[i]->depth > deepest ? best[i]->depth : deepest;
+        for (int i = 0; i < nbest; i++)
+            if (best[i]->depth == deepest)
+                best[k++] = best[i];
+        nbest = k;
+    }
+    if (nbest == 1)
+        return best[0];
+    if (nbest > 1) {
+        *ambiguous = true;
+        error(c, n->pos, "call to '%s' is ambiguous", n->name);
+        for (int i = 0; i < nbest; i++) {
+            char sig[256];
+            func_signature(best[i], sig, sizeof sig);
+            sl_diag_note(c->diag, best[i]->pos, "candidate: %s", sig);
+        }
+    }
+    return NULL;
+}
+
+static void no_match(checker *c, sl_node *n, const sl_ty *args, sl_func **cands, int ncands,
+                     bool builtin)
+{
+    char list[256] = "";
+    for (int i = 0; i < n->nlist; i++) {
+        size_t len = strlen(list);
+        snprintf(list + len, sizeof list - len, "%s%s", i ? ", " : "", sl_ty_name(args[i]));
+    }
+    error(c, n->pos, "no matching function for call to '%s' with arguments (%s)", n->name,
+          list);
+    for (int i = 0; i < ncands; i++) {
+        char sig[256];
+        func_signature(cands[i], sig, sizeof sig);
+        sl_diag_note(c->diag, cands[i]->pos, "candidate: %s", sig);
+    }
+    if (builtin) {
+        char names[512];
+        sl_builtin_candidates(n->name, names, sizeof names);
+        sl_diag_note(c->diag, n->pos, "built-in candidates are: %s", names);
+    }
+}
+
 static sl_ty check_call(checker *c, sl_node *n, sl_ty hint)
 {
-    sl_func *f = find_func(c, n->name);
+    sl_func *cands[MAX_OVERLOADS];
+    int ncands = find_funcs(c, n->name, cands, MAX_OVERLOADS);
     int count;
-    if (!f && !sl_builtin_find(n->name, &count)) {
+    bool builtin = sl_builtin_find(n->name, &count) != NULL;
+    if (!ncands && !builtin) {
         for (int i = 0; i < n->nlist; i++)
             check_expr(c, &n->list[i], SL_TYPE_VOID);
         if (lookup(c, n->name))
@@ -519,15 +667,34 @@ static sl_ty check_call(checker *c, sl_node *n, sl_ty hint)
     sl_ty args[8];
     bool bad = false;
     for (int i = 0; i < n->nlist; i++) {
-        sl_ty h = f && i < f->nparams ? f->params[i]->ty : SL_TYPE_VOID;
-        args[i] = check_expr(c, &n->list[i], h);
+        /* the parameter type as a hint, when the overloads of this arity agree */
+        sl_ty h = SL_TY_ERROR;
+        for (int k = 0; k < ncands; k++) {
+            if (cands[k]->nparams != n->nlist)
+                continue;
+            sl_ty pt = cands[k]->params[i]->ty;
+            h = h == SL_TY_ERROR || h == pt ? pt : SL_TYPE_VOID;
+        }
+        args[i] = check_expr(c, &n->list[i], h == SL_TY_ERROR ? SL_TYPE_VOID : h);
         bad |= args[i] == SL_TY_ERROR;
     }
-    if (f)
-        return check_user_call(c, n, f, args);
+    if (ncands == 1 && !builtin)     /* one function: its own, precise messages */
+        return check_user_call(c, n, cands[0], args);
     if (bad)
         return set_ty(n, SL_TY_ERROR);
-    return check_builtin_call(c, n, args, hint);
+    if (ncands) {
+        bool ambiguous;
+        sl_func *f = resolve_user(c, n, cands, ncands, args, hint, &ambiguous);
+        if (ambiguous)
+            return set_ty(n, SL_TY_ERROR);
+        if (f)
+            return check_user_call(c, n, f, args);
+    }
+    sl_ty want[8], result;
+    if (builtin && (!ncands || sl_builtin_resolve(n->name, args, n->nlist, hint, want, &result)))
+        return check_builtin_call(c, n, args, hint);
+    no_match(c, n, args, cands, ncands, builtin);
+    return set_ty(n, SL_TY_ERROR);
 }
 
 static sl_ty check_cast_values(checker *c, sl_node *n)
@@ -850,8 +1017,10 @@ static void check_function(checker *c, sl_func *f)
  * variables through 'extern' only. */
 static void check_nested_function(checker *c, sl_func *f)
 {
+    f->depth = c->depth;
     for (int i = c->vfuncs_start; i < c->nvfuncs; i++) {
-        if (strcmp(c->vfuncs[i]->name, f->name) == 0) {
+        sl_func *g = c->vfuncs[i];
+        if (strcmp(g->name, f->name) == 0 && same_params(f, g) && f->ret == g->ret) {
             error(c, f->pos, "redefinition of function '%s'", f->name);
             sl_diag_note(c->diag, c->vfuncs[i]->pos, "previous definition is here");
             return;
@@ -916,7 +1085,8 @@ static void check_duplicate(checker *c, int i)
 {
     sl_func *f = c->file->funcs[i];
     for (int j = 0; j < i; j++) {
-        if (strcmp(f->name, c->file->funcs[j]->name) == 0) {
+        sl_func *g = c->file->funcs[j];
+        if (strcmp(f->name, g->name) == 0 && same_params(f, g) && f->ret == g->ret) {
             error(c, f->pos, "redefinition of function '%s'", f->name);
             sl_diag_note(c->diag, c->file->funcs[j]->pos, "previous definition is here");
             return;

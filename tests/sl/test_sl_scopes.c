@@ -10,6 +10,9 @@
  *                 (the patterns.h idiom), scoped like variables, seeing
  *                 enclosing variables through 'extern' (also writing
  *                 them, also two levels out), recursion and misuse
+ *   overloading   one name for several argument types, by return type
+ *                 from the context, nested overloads hiding file-level
+ *                 ones, user overloads beside built-ins, ambiguity
  *
  * Globals are those of the plane at (u, v) = (0.25, 0.75):
  * P = (-0.5, 0.5, 0), N = (0, 0, 1), s = u, t = v.
@@ -281,6 +284,110 @@ static void test_nested_errors(void **state)
                   "                                                  ^\n");
 }
 
+/* ---------------------------------------------------------------------- */
+/* overloading                                                             */
+/* ---------------------------------------------------------------------- */
+
+static void test_overloading(void **state)
+{
+    (void)state;
+    /* by argument type: exact first, then point/vector/normal, then float */
+    expect_src("float twice(float x) { return 2 * x; }\n"
+               "color twice(color c) { return c * 2; }\n"
+               "point twice(point p) { return p * 3; }\n"
+               "displacement d() {\n"
+               "    color c = twice(color(1, 2, 3));\n"
+               "    point q = twice(vector(1, 0, 0));\n"
+               "    P = point(twice(s), comp(c, 1), xcomp(q));\n"
+               "}\n",
+               2 * U, 4, 3);
+    /* by return type, from a declaration, a cast, and a convertible target */
+    expect_src("float pick(point p) { return xcomp(p); }\n"
+               "color pick(point p) { return color(ycomp(p)); }\n"
+               "displacement d() {\n"
+               "    float f = pick(P);\n"
+               "    color c = pick(P);\n"
+               "    vector w = pick(P);\n"
+               "    P = point(f + 10 * comp(c, 0), float pick(P), ycomp(w));\n"
+               "}\n",
+               -0.5 + 10 * 0.5, -0.5, -0.5);
+    /* a nested definition hides the file-level one of the same signature
+     * only; output parameters select by the variable's type */
+    expect_src("float f(float x) { return x + 1; }\n"
+               "float f(color c) { return comp(c, 0) + 100; }\n"
+               "void setv(output float x) { x = 1; }\n"
+               "void setv(output color c) { c = color(2); }\n"
+               "displacement d() {\n"
+               "    float f(float x) { return x + 2; }\n"
+               "    float a; color b;\n"
+               "    setv(a); setv(b);\n"
+               "    P = point(f(1), f(color(5)), a + comp(b, 2));\n"
+               "}\n",
+               3, 105, 3);
+    /* user overloads beside built-ins: a new signature adds to the
+     * built-in's, an equal one replaces it */
+    expect_src("float length(color c) { return comp(c, 0) + comp(c, 1) + comp(c, 2); }\n"
+               "float step(float a, x) { return 42; }\n"
+               "displacement d() {\n"
+               "    P = point(length(color(3, 4, 0)), length(vector(3, 4, 0)), step(0, 1));\n"
+               "}\n",
+               7, 5, 42);
+}
+
+static void test_overloading_errors(void **state)
+{
+    (void)state;
+    expect_errors("float pick(point p) { return xcomp(p); }\n"
+                  "color pick(point p) { return color(ycomp(p)); }\n"
+                  "displacement d() {\n"
+                  "    float x = 1 + pick(P);\n"
+                  "}\n",
+                  "t.sl:4:19: error: call to 'pick' is ambiguous\n"
+                  "    float x = 1 + pick(P);\n"
+                  "                  ^\n"
+                  "t.sl:1:7: note: candidate: float pick(point)\n"
+                  "float pick(point p) { return xcomp(p); }\n"
+                  "      ^\n"
+                  "t.sl:2:7: note: candidate: color pick(point)\n"
+                  "color pick(point p) { return color(ycomp(p)); }\n"
+                  "      ^\n");
+    expect_errors("float g(point p) { return 1; }\n"
+                  "float g(color c) { return 2; }\n"
+                  "displacement d() {\n"
+                  "    float x = g(1);\n"
+                  "    x = g(\"a\");\n"
+                  "}\n",
+                  "t.sl:4:15: error: call to 'g' is ambiguous\n"
+                  "    float x = g(1);\n"
+                  "              ^\n"
+                  "t.sl:1:7: note: candidate: float g(point)\n"
+                  "float g(point p) { return 1; }\n"
+                  "      ^\n"
+                  "t.sl:2:7: note: candidate: float g(color)\n"
+                  "float g(color c) { return 2; }\n"
+                  "      ^\n"
+                  "t.sl:5:9: error: no matching function for call to 'g' with arguments "
+                  "(string)\n"
+                  "    x = g(\"a\");\n"
+                  "        ^\n"
+                  "t.sl:1:7: note: candidate: float g(point)\n"
+                  "float g(point p) { return 1; }\n"
+                  "      ^\n"
+                  "t.sl:2:7: note: candidate: float g(color)\n"
+                  "float g(color c) { return 2; }\n"
+                  "      ^\n");
+    /* the same signature twice is a redefinition, whatever the parameter names */
+    expect_errors("float g(point p) { return 1; }\n"
+                  "float g(point q) { return 2; }\n"
+                  "displacement d() { }\n",
+                  "t.sl:2:7: error: redefinition of function 'g'\n"
+                  "float g(point q) { return 2; }\n"
+                  "      ^\n"
+                  "t.sl:1:7: note: previous definition is here\n"
+                  "float g(point p) { return 1; }\n"
+                  "      ^\n");
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -289,6 +396,8 @@ int main(void)
         cmocka_unit_test(test_shadow_errors),
         cmocka_unit_test(test_nested_functions),
         cmocka_unit_test(test_nested_errors),
+        cmocka_unit_test(test_overloading),
+        cmocka_unit_test(test_overloading_errors),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
