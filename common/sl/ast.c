@@ -24,6 +24,8 @@ const char *sl_ty_name(sl_ty ty)
     case SL_TYPE_STRING: return "string";
     case SL_TYPE_MATRIX: return "matrix";
     case SL_TY_BOOL: return "bool";
+    case SL_TY_LIST3: return "untyped triple";
+    case SL_TY_LIST16: return "untyped 16-tuple";
     default: return "<error>";
     }
 }
@@ -33,8 +35,8 @@ int sl_ty_slots(sl_ty ty)
     switch (ty) {
     case SL_TYPE_FLOAT: case SL_TY_BOOL: case SL_TYPE_STRING: return 1;
     case SL_TYPE_POINT: case SL_TYPE_VECTOR: case SL_TYPE_NORMAL:
-    case SL_TYPE_COLOR: return 3;
-    case SL_TYPE_MATRIX: return 16;
+    case SL_TYPE_COLOR: case SL_TY_LIST3: return 3;
+    case SL_TYPE_MATRIX: case SL_TY_LIST16: return 16;
     default: return 0;
     }
 }

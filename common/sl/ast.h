@@ -13,7 +13,8 @@
  * Types (sl_ty) are the public sl_type values plus two internal ones:
  * SL_TY_BOOL, the type of comparisons and logical operators (RenderMan's
  * "relation"), and SL_TY_ERROR, the type of an expression that already
- * produced an error (it silences follow-up errors: no cascades).
+ * produced an error (it silences follow-up errors: no cascades), and the
+ * two types of untyped lists (below).
  */
 #ifndef SL_AST_H
 #define SL_AST_H
@@ -27,7 +28,12 @@
 /* ---- types ---- */
 
 typedef int sl_ty;
-enum { SL_TY_BOOL = SL_TYPE_MATRIX + 1, SL_TY_ERROR };
+enum { SL_TY_BOOL = SL_TYPE_MATRIX + 1, SL_TY_ERROR, SL_TY_LIST3, SL_TY_LIST16 };
+
+/* SL_TY_LIST3 / SL_TY_LIST16: an untyped list `(x, y, z)` (16 values: a
+ * matrix) whose type the context has not given yet; the checker retypes
+ * it where it is assigned, passed or returned, or reports it. */
+static inline bool sl_ty_is_list(sl_ty ty) { return ty == SL_TY_LIST3 || ty == SL_TY_LIST16; }
 
 const char *sl_ty_name(sl_ty ty);            /* "float", "point", "bool" */
 int sl_ty_slots(sl_ty ty);                   /* scalar slots: 1, 3, 16; 0 */
@@ -96,7 +102,8 @@ typedef enum sl_node_kind {
     SL_N_BINARY,     /* op, a, b */
     SL_N_COND,       /* a ? b : c */
     SL_N_ASSIGN,     /* op (= += -= *= /=), a (lvalue), b */
-    SL_N_CAST,       /* cast_ty, name: space or NULL, list: 1, 3 or 16 values */
+    SL_N_CAST,       /* cast_ty, name: space or NULL, list: 1, 3 or 16 values;
+                        cast_ty SL_TYPE_VOID: an untyped list (x, y, z) */
     SL_N_CONV,       /* implicit conversion of a to ty (checker) */
     SL_N_ERROR,      /* an expression that failed to parse (already reported) */
     /* statements */

@@ -191,6 +191,10 @@ static bool can_convert(sl_ty have, sl_ty want)
 {
     if (have == want || have == SL_TY_ERROR || want == SL_TY_ERROR)
         return true;
+    if (have == SL_TY_LIST3)
+        return sl_ty_is_triple(want);
+    if (have == SL_TY_LIST16)
+        return want == SL_TYPE_MATRIX;
     if (sl_ty_is_spatial(have) && sl_ty_is_spatial(want))
         return true;
     if (have == SL_TYPE_FLOAT &&
@@ -199,12 +203,32 @@ static bool can_convert(sl_ty have, sl_ty want)
     return false;
 }
 
+/* Gives an untyped list (and the -, ?: and arithmetic over lists around
+ * it) the triple or matrix type `want`. */
+static void retype_list(sl_node *e, sl_ty want)
+{
+    if (!e || !sl_ty_is_list(e->ty))
+        return;
+    e->ty = want;
+    switch (e->kind) {
+    case SL_N_CAST: e->cast_ty = want; break;
+    case SL_N_UNARY: retype_list(e->a, want); break;
+    case SL_N_BINARY: retype_list(e->a, want); retype_list(e->b, want); break;
+    case SL_N_COND: retype_list(e->b, want); retype_list(e->c, want); break;
+    default: break;
+    }
+}
+
 /* Wraps *np in a conversion to `want` (the caller checked can_convert). */
 static void wrap_conv(checker *c, sl_node **np, sl_ty want)
 {
     sl_node *e = *np;
     if (e->ty == want || e->ty == SL_TY_ERROR || want == SL_TY_ERROR)
         return;
+    if (sl_ty_is_list(e->ty)) {
+        retype_list(e, want);
+        return;
+    }
     if (sl_ty_is_spatial(e->ty) && sl_ty_is_spatial(want)) {
         e->ty = want;          /* same slots, another name */
         return;
@@ -213,6 +237,17 @@ static void wrap_conv(checker *c, sl_node **np, sl_ty want)
     conv->a = e;
     conv->ty = want;
     *np = conv;
+}
+
+/* An untyped list where nothing gives it a type: reported. */
+static sl_ty settle(checker *c, sl_node *e)
+{
+    if (!sl_ty_is_list(e->ty))
+        return e->ty;
+    error(c, e->pos, "cannot tell the type of this list of %d values here; put a type in "
+                     "front, as in '%s (...)'", sl_ty_slots(e->ty),
+          e->ty == SL_TY_LIST3 ? "point" : "matrix");
+    return e->ty = SL_TY_ERROR;
 }
 
 static void check_cond(checker *c, sl_node **np)
@@ -323,6 +358,24 @@ static sl_ty check_binary(checker *c, sl_node *n)
     sl_ty b = check_expr(c, &n->b, SL_TYPE_VOID);
     if (a == SL_TY_ERROR || b == SL_TY_ERROR)
         return set_ty(n, SL_TY_ERROR);
+    if (sl_ty_is_list(a) || sl_ty_is_list(b)) {
+        /* a typed operand types the list: P + (0, 0, 1) */
+        if (sl_ty_is_list(a) && can_convert(a, b) && !sl_ty_is_list(b))
+            wrap_conv(c, &n->a, a = b);
+        else if (sl_ty_is_list(b) && can_convert(b, a) && !sl_ty_is_list(a))
+            wrap_conv(c, &n->b, b = a);
+        bool arith = op == SL_TOK_PLUS || op == SL_TOK_MINUS || op == SL_TOK_STAR ||
+                     op == SL_TOK_SLASH;
+        sl_ty list = sl_ty_is_list(a) ? a : b, other = sl_ty_is_list(a) ? b : a;
+        /* lists among themselves and with floats stay untyped: (1, 2, 3) * 2 */
+        if (list == SL_TY_LIST3 && arith && (other == list || other == SL_TYPE_FLOAT))
+            return set_ty(n, list);
+        if (sl_ty_is_list(a) && sl_ty_is_list(b) && (op == SL_TOK_EQ || op == SL_TOK_NE) &&
+            a == b)
+            return set_ty(n, SL_TY_BOOL);
+        if (settle(c, n->a) == SL_TY_ERROR || settle(c, n->b) == SL_TY_ERROR)
+            return set_ty(n, SL_TY_ERROR);
+    }
     switch (op) {
     case SL_TOK_PLUS: case SL_TOK_MINUS: case SL_TOK_STAR: case SL_TOK_SLASH:
         return set_ty(n, arith_type(c, n, a, b));
@@ -350,7 +403,8 @@ static sl_ty check_unary(checker *c, sl_node *n)
         return set_ty(n, SL_TY_BOOL);
     }
     sl_ty a = check_expr(c, &n->a, SL_TYPE_VOID);
-    if (a == SL_TY_ERROR || a == SL_TYPE_FLOAT || sl_ty_is_triple(a) || a == SL_TYPE_MATRIX)
+    if (a == SL_TY_ERROR || a == SL_TYPE_FLOAT || sl_ty_is_triple(a) || a == SL_TYPE_MATRIX ||
+        sl_ty_is_list(a))
         return set_ty(n, a);
     error(c, n->pos, "invalid argument type '%s' to unary '-'", sl_ty_name(a));
     return set_ty(n, SL_TY_ERROR);
@@ -360,6 +414,10 @@ static sl_ty check_unary(checker *c, sl_node *n)
 static sl_ty unify(sl_ty a, sl_ty b)
 {
     if (a == b)
+        return a;
+    if (sl_ty_is_list(a) && !sl_ty_is_list(b) && can_convert(a, b))
+        return b;
+    if (sl_ty_is_list(b) && !sl_ty_is_list(a) && can_convert(b, a))
         return a;
     if (a == SL_TYPE_FLOAT && (sl_ty_is_triple(b) || b == SL_TYPE_MATRIX))
         return b;
@@ -544,6 +602,8 @@ static int param_cost(const sl_sym *p, sl_ty have)
 {
     if (have == p->ty)
         return 0;
+    if (sl_ty_is_list(have))
+        return !p->output && can_convert(have, p->ty) ? 0 : -1;
     if (sl_ty_is_spatial(have) && sl_ty_is_spatial(p->ty))
         return 1;
     if (p->output)
@@ -697,6 +757,37 @@ static sl_ty check_call(checker *c, sl_node *n, sl_ty hint)
     return set_ty(n, SL_TY_ERROR);
 }
 
+/* (x, y, z) or 16 values without a type: a triple or matrix of the type
+ * the context asks for (hint), else an untyped list for the context to
+ * type later (RI Spec 3.2 §13: "the type of a parenthesised triple is
+ * taken from its context"). */
+static sl_ty check_untyped_list(checker *c, sl_node *n, sl_ty hint)
+{
+    bool bad = false;
+    for (int i = 0; i < n->nlist; i++)
+        bad |= check_expr(c, &n->list[i], SL_TYPE_FLOAT) == SL_TY_ERROR;
+    if (bad)
+        return SL_TY_ERROR;
+    if (n->nlist != 3 && n->nlist != 16) {
+        error(c, n->pos, "a list of %d values is neither a triple (3 values) nor a "
+                         "matrix (16)", n->nlist);
+        return SL_TY_ERROR;
+    }
+    for (int i = 0; i < n->nlist; i++) {
+        if (n->list[i]->ty != SL_TYPE_FLOAT) {
+            error(c, n->list[i]->pos, "component %d of a list must be a float, not '%s'",
+                  i + 1, sl_ty_name(n->list[i]->ty));
+            return SL_TY_ERROR;
+        }
+    }
+    sl_ty list = n->nlist == 3 ? SL_TY_LIST3 : SL_TY_LIST16;
+    if (can_convert(list, hint)) {
+        n->cast_ty = hint;
+        return hint;
+    }
+    return list;
+}
+
 static sl_ty check_cast_values(checker *c, sl_node *n)
 {
     sl_ty ty = n->cast_ty;
@@ -733,8 +824,10 @@ static sl_ty check_cast_values(checker *c, sl_node *n)
     return ty;
 }
 
-static sl_ty check_cast(checker *c, sl_node *n)
+static sl_ty check_cast(checker *c, sl_node *n, sl_ty hint)
 {
+    if (n->cast_ty == SL_TYPE_VOID || sl_ty_is_list(n->cast_ty))
+        return set_ty(n, check_untyped_list(c, n, hint));
     sl_ty ty = check_cast_values(c, n);
     if (ty == SL_TY_ERROR || !n->name)
         return set_ty(n, ty);
@@ -769,7 +862,7 @@ static sl_ty check_expr(checker *c, sl_node **np, sl_ty hint)
     case SL_N_BINARY: return check_binary(c, n);
     case SL_N_COND: return check_cond_expr(c, n, hint);
     case SL_N_ASSIGN: return check_assign(c, n);
-    case SL_N_CAST: return check_cast(c, n);
+    case SL_N_CAST: return check_cast(c, n, hint);
     case SL_N_CONV: return n->ty;
     default: return set_ty(n, SL_TY_ERROR);
     }

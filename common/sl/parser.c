@@ -18,7 +18,8 @@
  *
  * A type keyword followed by '(' or a string is a cast (`point "object"
  * (x, y, z)`, `color (0.5)`), followed by an identifier a declaration.
- * Parenthesised lists of 3 or 16 values only appear after a type.
+ * A parenthesised list of values without a type (`(x, y, z)`) is an
+ * SL_N_CAST of type void, which the checker types from the context.
  *
  * Error handling: the first error of a statement is reported, the parser
  * enters panic mode (no more reports) and skips to the next ';' or '}' at
@@ -260,10 +261,14 @@ static sl_node *primary(parser *p)
     case SL_TOK_LPAREN: {
         advance(p);
         sl_node *e = expression(p);
-        if (check(p, SL_TOK_COMMA)) {
-            error_at(p, p->cur.pos, &p->cur,
-                     "a list of values needs a type in front, as in 'point (x, y, z)'");
-            return error_node(p, t.pos);
+        if (check(p, SL_TOK_COMMA)) {    /* (x, y, z): typed by the checker */
+            sl_node *n = sl_node_new(p->arena, SL_N_CAST, t.pos);
+            n->cast_ty = SL_TYPE_VOID;
+            int cap = 0;
+            push_node(p, n, &cap, e);
+            while (match(p, SL_TOK_COMMA))
+                push_node(p, n, &cap, expression(p));
+            e = n;
         }
         expect_closing(p, SL_TOK_RPAREN, &t);
         return e;

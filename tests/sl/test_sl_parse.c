@@ -77,11 +77,11 @@ static void test_brackets_and_expressions(void **state)
                   "t.sl:2:5: error: expression is not assignable\n"
                   "    1 = 2;\n"
                   "    ^\n");
-    expect_errors("displacement t() {\n    P = (1, 2, 3);\n}\n",
-                  "t.sl:2:11: error: a list of values needs a type in front, as in "
-                  "'point (x, y, z)'\n"
-                  "    P = (1, 2, 3);\n"
-                  "          ^\n");
+    expect_errors("displacement t() {\n    P = (1, 2);\n}\n",
+                  "t.sl:2:9: error: a list of 2 values is neither a triple (3 values) nor a "
+                  "matrix (16)\n"
+                  "    P = (1, 2);\n"
+                  "        ^\n");
 }
 
 /* Several syntax errors in one run: each reported once, the parser goes

@@ -13,6 +13,9 @@
  *   overloading   one name for several argument types, by return type
  *                 from the context, nested overloads hiding file-level
  *                 ones, user overloads beside built-ins, ambiguity
+ *   untyped lists (x, y, z) and 16 values typed by a declaration, an
+ *                 assignment, an argument (user, built-in, overloaded), a
+ *                 return, ?:, the other operand; what stays untyped
  *
  * Globals are those of the plane at (u, v) = (0.25, 0.75):
  * P = (-0.5, 0.5, 0), N = (0, 0, 1), s = u, t = v.
@@ -388,6 +391,83 @@ static void test_overloading_errors(void **state)
                   "      ^\n");
 }
 
+/* ---------------------------------------------------------------------- */
+/* untyped lists                                                           */
+/* ---------------------------------------------------------------------- */
+
+static void test_untyped_lists(void **state)
+{
+    (void)state;
+    expect_src("displacement d() { P = (1, 2, 3); }\n", 1, 2, 3);
+    expect_src("float f(color c) { return comp(c, 1); }\n"
+               "vector up() { return (0, 0, 1); }\n"
+               "displacement d() {\n"
+               "    color c = (0.5, 0.25, 1);\n"
+               "    P = point(comp(c, 0), f((1, 2, 3)), zcomp(up()));\n"
+               "}\n",
+               0.5, 2, 1);
+    /* ?: and the other operand of + */
+    expect_src("displacement d() {\n"
+               "    point q = u > 0.5 ? (1, 0, 0) : (0, 1, 0);\n"
+               "    P = P + (0, 0, 1) + q;\n"
+               "}\n",
+               -0.5, 1.5, 1);
+    /* arithmetic among lists and floats stays untyped until assigned */
+    expect_src("displacement d() { P = -(1, 2, 3) * 2 + (0.5, 0, 0); }\n", -1.5, -4, -6);
+    /* built-ins: a point where a spatial type is wanted, the context's
+     * type for a generic one */
+    expect_src("displacement d() {\n"
+               "    color c = mix((1, 0, 0), (0, 0, 1), 0.25);\n"
+               "    P = point(length((3, 4, 0)), distance((0, 0, 0), (0, 0, 2)), "
+               "comp(c, 0) + 10 * comp(c, 2));\n"
+               "}\n",
+               5, 2, 0.75 + 2.5);
+    /* 16 values in a matrix context (the translation in elements 12..14) */
+    expect_src("displacement d() {\n"
+               "    matrix m = (1, 0, 0, 0,  0, 1, 0, 0,  0, 0, 1, 0,  2, 3, 4, 1);\n"
+               "    P = transform(m, point(0, 0, 0));\n"
+               "}\n",
+               2, 3, 4);
+    /* an overloaded function: the list matches the triple overload */
+    expect_src("float h(float x) { return x; }\n"
+               "float h(color c) { return comp(c, 2); }\n"
+               "displacement d() { P = point(h((1, 2, 3)), h(5), 0); }\n",
+               3, 5, 0);
+}
+
+static void test_untyped_list_errors(void **state)
+{
+    (void)state;
+    expect_errors("displacement d() {\n"
+                  "    float f = (1, 2, 3);\n"
+                  "    f = (1, 2, 3) . (4, 5, 6);\n"
+                  "}\n",
+                  "t.sl:2:15: error: cannot initialize 'f' (float) with a value of type "
+                  "'untyped triple'\n"
+                  "    float f = (1, 2, 3);\n"
+                  "              ^\n"
+                  "t.sl:3:9: error: cannot tell the type of this list of 3 values here; put a "
+                  "type in front, as in 'point (...)'\n"
+                  "    f = (1, 2, 3) . (4, 5, 6);\n"
+                  "        ^\n");
+    expect_errors("float g(point p) { return 1; }\n"
+                  "float g(color c) { return 2; }\n"
+                  "displacement d() { P += g((1, 2, 3)); }\n",
+                  "t.sl:3:25: error: call to 'g' is ambiguous\n"
+                  "displacement d() { P += g((1, 2, 3)); }\n"
+                  "                        ^\n"
+                  "t.sl:1:7: note: candidate: float g(point)\n"
+                  "float g(point p) { return 1; }\n"
+                  "      ^\n"
+                  "t.sl:2:7: note: candidate: float g(color)\n"
+                  "float g(color c) { return 2; }\n"
+                  "      ^\n");
+    expect_errors("displacement d() { P = (1, \"a\", 3); }\n",
+                  "t.sl:1:28: error: component 2 of a list must be a float, not 'string'\n"
+                  "displacement d() { P = (1, \"a\", 3); }\n"
+                  "                           ^\n");
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -398,6 +478,8 @@ int main(void)
         cmocka_unit_test(test_nested_errors),
         cmocka_unit_test(test_overloading),
         cmocka_unit_test(test_overloading_errors),
+        cmocka_unit_test(test_untyped_lists),
+        cmocka_unit_test(test_untyped_list_errors),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
