@@ -1,0 +1,529 @@
+/*
+ * tests/sl/test_sl_conformance.c: the conformance suite of the shading
+ * language (issue 15), the shaders in tests/shaders/conformance, each
+ * exercising one feature in the idioms of the books and of the widely
+ * copied helper headers (patterns.h, noises.h, voronoi.h, filterwidth.h,
+ * written for this suite).
+ *
+ * Every shader is a displacement shader on the plane P = (2u-1, 2v-1, 0),
+ * N = (0, 0, 1), s = u, t = v, that sets P to three values. Per shader:
+ *
+ *   float      P at 7x7 points of the plane against an independent C
+ *              computation of the same values (ref_* below)
+ *   range      over 12 random (u,v) boxes (sides 2^-2 .. 2^-6), the
+ *              interval and the affine enclosure of P contain P in float
+ *              mode at 4x4 points of the box (paper §4, issue 9); the
+ *              ranges whose enclosures are all finite are counted (only
+ *              filterwidth's derivatives are unbounded in range modes)
+ *
+ * The shaders in errors/ must stay errors: their diagnostics are compared
+ * whole (file:line:col, message, source line, caret).
+ *
+ * Prints the features covered, the cases run and the failures; fails when
+ * there is any failure.
+ */
+#include <stdarg.h>
+#include <stddef.h>
+#include <setjmp.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include "sl/noise.h"
+#include "sl_harness.h"
+
+#ifndef AAFARM_CONFORMANCE_DIR
+#define AAFARM_CONFORMANCE_DIR "tests/shaders/conformance"
+#endif
+
+/* ---------------------------------------------------------------------- */
+/* independent computations                                                */
+/* ---------------------------------------------------------------------- */
+
+static double sgn(double x) { return x > 0 ? 1 : x < 0 ? -1 : 0; }
+static double fmodf_(double a, double b) { return a - b * floor(a / b); }
+static double clampd(double x, double lo, double hi) { return x < lo ? lo : x > hi ? hi : x; }
+static double stepd(double e, double x) { return x < e ? 0 : 1; }
+static double smooth(double e0, double e1, double x)
+{
+    if (x < e0)
+        return 0;
+    if (x >= e1)
+        return 1;
+    double r = (x - e0) / (e1 - e0);
+    return r * r * (3 - 2 * r);
+}
+static double noise1(double x) { return sl_noise(1, &x); }
+static double noise3(double x, double y, double z)
+{
+    double p[3] = { x, y, z };
+    return sl_noise(3, p);
+}
+
+static void ref_shadow_global_local(double u, double v, double o[3])
+{
+    o[0] = u + 9 * v * v; o[1] = u; o[2] = 0;
+}
+
+static double tilecoord(double s, double t, double f)
+{
+    return fmodf_(s * f, 1) * fmodf_(t * f, 1);
+}
+static void ref_shadow_function_params(double u, double v, double o[3])
+{
+    o[0] = tilecoord(v, u, 3); o[1] = tilecoord(u + 0.1, v, 2); o[2] = 0;
+}
+
+static void ref_shadow_shader_param(double u, double v, double o[3])
+{
+    o[0] = 2 * v; o[1] = 3; o[2] = u;
+}
+
+static void ref_shadow_builtin_names(double u, double v, double o[3])
+{
+    o[0] = u * 0.75 + 2 * 0.25; o[1] = stepd(0.5, v); o[2] = 2;
+}
+
+static double filteredabs(double x, double dx)
+{
+    double x0 = x - 0.5 * dx, x1 = x0 + dx;
+    return (sgn(x1) * 0.5 * x1 * x1 - sgn(x0) * 0.5 * x0 * x0) / dx;
+}
+static void ref_nested_filteredabs(double u, double v, double o[3])
+{
+    o[0] = filteredabs(u - 0.5, 0.2); o[1] = filteredabs(v - 0.3, 0.1); o[2] = 0;
+}
+
+static void ref_nested_extern_accumulate(double u, double v, double o[3])
+{
+    o[0] = 0.5 * u + 0.5 * v * v + 0.5; o[1] = 0; o[2] = 0;
+}
+
+static double outer(double a) { return 2 * a * (a + 1) + 1; }
+static void ref_nested_two_levels(double u, double v, double o[3])
+{
+    o[0] = outer(u); o[1] = outer(v); o[2] = 0;
+}
+
+static void ref_nested_in_loop(double u, double v, double o[3])
+{
+    (void)v;
+    o[0] = u + u * u / 2 + u * u * u / 3; o[1] = 0; o[2] = 0;
+}
+
+static double bias_perlin(double b, double x) { return pow(x, log(b) / log(0.5)); }
+static double bias_schlick(double b, double x) { return x / ((1 / b - 2) * (1 - x) + 1); }
+static void ref_nested_hides_file_level(double u, double v, double o[3])
+{
+    o[0] = bias_perlin(0.7, u) - bias_schlick(0.7, u); o[1] = bias_perlin(0.3, v); o[2] = 0;
+}
+
+static void ref_overload_snoise(double u, double v, double o[3])
+{
+    double p[3] = { 2 * u - 1, 2 * v - 1, 0 }, vn[3];
+    sl_vnoise(3, p, vn);
+    o[0] = 2 * noise1(u * 4) - 1;
+    o[1] = 2 * noise3(3 * u, 3 * v, 0) - 1;
+    o[2] = 2 * vn[1] - 1;
+}
+
+static void ref_overload_return_type(double u, double v, double o[3])
+{
+    double x = 2 * u - 1, y = 2 * v - 1;
+    o[0] = x + y; o[1] = 2 * y; o[2] = 2 * x + 2 * y;
+}
+
+static void ref_overload_builtin(double u, double v, double o[3])
+{
+    o[0] = u + v + 1; o[1] = sqrt(u * u + v * v); o[2] = clampd((u - 0.2) / 0.6, 0, 1);
+}
+
+static void ref_overload_output(double u, double v, double o[3])
+{
+    o[0] = 1 + u; o[1] = 0.125; o[2] = 1 + v;
+}
+
+static void ref_overload_conversion_cost(double u, double v, double o[3])
+{
+    o[0] = 13; o[1] = u; o[2] = -v;
+}
+
+static void ref_list_assign(double u, double v, double o[3])
+{
+    o[0] = u; o[1] = v; o[2] = 0.5;
+}
+
+static void ref_list_param_default(double u, double v, double o[3])
+{
+    o[0] = 2 * u - 1 - 0.5; o[1] = 0.5; o[2] = 0.25 * v;
+}
+
+static void ref_list_return_arg(double u, double v, double o[3])
+{
+    o[0] = u + v + 1; o[1] = u > 0.5 ? 0 : 1; o[2] = v > 0.5 ? 1 : 0;
+}
+
+static void ref_list_operators(double u, double v, double o[3])
+{
+    o[0] = 1 - 2 * u; o[1] = 1 - 2 * v; o[2] = -1 + v;
+    if (u > 0.5) {
+        o[0] = (o[0] + 1) / 2; o[1] /= 2; o[2] /= 2;
+    }
+}
+
+static void ref_list_matrix(double u, double v, double o[3])
+{
+    o[0] = 2 + u; o[1] = 3 + v; o[2] = 1;
+}
+
+static double filteredpulse(double e0, double e1, double x, double dx)
+{
+    double x0 = x - dx / 2, x1 = x0 + dx;
+    double a = (fmin(x1, e1) - fmax(x0, e0)) / dx;
+    return a > 0 ? a : 0;
+}
+static void ref_patterns_pulses(double u, double v, double o[3])
+{
+    o[0] = filteredpulse(0.3, 0.7, u, 0.05);
+    o[1] = smooth(0.1, 0.3, v) - smooth(0.6, 0.9, v);
+    o[2] = 2 * (stepd(0.3, u) - stepd(0.7, u));
+}
+
+static double fbm3(double x, double y, double z, int oct, double lac, double gain)
+{
+    double sum = 0, amp = 1;
+    for (int i = 0; i < oct; i++) {
+        sum += amp * (2 * noise3(x, y, z) - 1);
+        amp *= gain;
+        x *= lac; y *= lac; z *= lac;
+    }
+    return sum;
+}
+static double fbm1(double x, int oct, double lac, double gain)
+{
+    double sum = 0, amp = 1;
+    for (int i = 0; i < oct; i++) {
+        sum += amp * (2 * noise1(x) - 1);
+        amp *= gain;
+        x *= lac;
+    }
+    return sum;
+}
+static void ref_noises_fbm(double u, double v, double o[3])
+{
+    o[0] = fbm3(2 * u, 2 * v, 0, 3, 2, 0.5); o[1] = fbm1(3 * v, 3, 2.17, 0.6); o[2] = 0;
+}
+
+static void ref_noises_turbulence(double u, double v, double o[3])
+{
+    double sum = 0, f = 1;
+    for (int i = 0; i < 3; i++) {
+        sum += fabs(2 * noise3(2 * u * f, 2 * v * f, f) - 1) / f;
+        f *= 2;
+    }
+    o[0] = 2 * u - 1; o[1] = 2 * v - 1; o[2] = sum;
+}
+
+static void ref_voronoi_cells(double u, double v, double o[3])
+{
+    double ss = 3 * u, tt = 3 * v, f1 = 1000, sp = 0, tp = 0;
+    double sc = floor(ss) + 0.5, tc = floor(tt) + 0.5;
+    for (int i = -1; i <= 1; i++) {
+        for (int j = -1; j <= 1; j++) {
+            double cell[2] = { sc + i, tc + j }, jit[3];
+            sl_vcellnoise(2, cell, jit);
+            double ps = cell[0] + 0.8 * (jit[0] - 0.5), pt = cell[1] + 0.8 * (jit[1] - 0.5);
+            double d = (ps - ss) * (ps - ss) + (pt - tt) * (pt - tt);
+            if (d < f1) {
+                f1 = d; sp = ps; tp = pt;
+            }
+        }
+    }
+    o[0] = sqrt(f1); o[1] = sp; o[2] = tp;
+}
+
+static void ref_filterwidth_overloads(double u, double v, double o[3])
+{
+    (void)v;   /* float mode: no derivatives, so both widths are MINFILTWIDTH */
+    o[0] = filteredpulse(0.25, 0.75, u, 1e-6 + 0.1); o[1] = 1e-6 * 1e6; o[2] = 0;
+}
+
+static void ref_scope_blocks_for(double u, double v, double o[3])
+{
+    (void)v;
+    o[0] = 2 * u - 1 + 3 * u; o[1] = 1; o[2] = 1 + u;
+}
+
+static void ref_extern_globals_nested(double u, double v, double o[3])
+{
+    o[0] = 2 * u - 1; o[1] = 2 * v - 1; o[2] = 0.1 * u + 0.1 * 2 * v;
+}
+
+/* ---------------------------------------------------------------------- */
+/* the cases                                                               */
+/* ---------------------------------------------------------------------- */
+
+typedef struct conf_case {
+    const char *file;
+    const char *feature;
+    void (*ref)(double u, double v, double out[3]);
+} conf_case;
+
+#define CASE(name, feature) { #name ".sl", feature, ref_##name }
+static const conf_case cases[] = {
+    CASE(shadow_global_local, "shadowed globals"),
+    CASE(shadow_function_params, "shadowed globals"),
+    CASE(shadow_shader_param, "shadowed globals"),
+    CASE(shadow_builtin_names, "shadowed built-in names"),
+    CASE(scope_blocks_for, "block scopes"),
+    CASE(nested_filteredabs, "nested functions"),
+    CASE(nested_extern_accumulate, "extern of enclosing variables"),
+    CASE(nested_two_levels, "extern of enclosing variables"),
+    CASE(nested_in_loop, "nested functions"),
+    CASE(nested_hides_file_level, "nested functions"),
+    CASE(extern_globals_nested, "extern of enclosing variables"),
+    CASE(overload_snoise, "overloading by argument type"),
+    CASE(overload_return_type, "overloading by return type"),
+    CASE(overload_builtin, "overloads beside built-ins"),
+    CASE(overload_output, "overloading by argument type"),
+    CASE(overload_conversion_cost, "overloading by argument type"),
+    CASE(list_assign, "untyped triples"),
+    CASE(list_param_default, "untyped triples"),
+    CASE(list_return_arg, "untyped triples"),
+    CASE(list_operators, "untyped triples"),
+    CASE(list_matrix, "untyped 16-tuples"),
+    CASE(patterns_pulses, "helper headers"),
+    CASE(noises_fbm, "helper headers"),
+    CASE(noises_turbulence, "helper headers"),
+    CASE(voronoi_cells, "helper headers"),
+    CASE(filterwidth_overloads, "helper headers"),
+};
+#undef CASE
+
+typedef struct conf_error {
+    const char *file;
+    const char *expected;
+} conf_error;
+
+static const conf_error errors[] = {
+    { "errors/redefinition.sl",
+      "errors/redefinition.sl:5:11: error: redefinition of 's'\n"
+      "    float s = 2;\n"
+      "          ^\n"
+      "errors/redefinition.sl:4:11: note: previous definition is here\n"
+      "    float s = 1;\n"
+      "          ^\n" },
+    { "errors/ambiguous.sl",
+      "errors/ambiguous.sl:8:10: error: call to 'pick' is ambiguous\n"
+      "    P += pick(P);\n"
+      "         ^\n"
+      "errors/ambiguous.sl:3:7: note: candidate: float pick(point)\n"
+      "float pick(point p) { return xcomp(p); }\n"
+      "      ^\n"
+      "errors/ambiguous.sl:4:7: note: candidate: color pick(point)\n"
+      "color pick(point p) { return color(ycomp(p)); }\n"
+      "      ^\n" },
+    { "errors/no_extern.sl",
+      "errors/no_extern.sl:4:34: error: 'Km' belongs to an enclosing scope; declare it "
+      "'extern float Km;' in function 'bump' to use it here\n"
+      "    float bump(float x) { return Km * x; }\n"
+      "                                 ^\n" },
+    { "errors/out_of_scope.sl",
+      "errors/out_of_scope.sl:7:10: error: use of undeclared function 'twice'\n"
+      "    P += twice(s) * N;\n"
+      "         ^\n" },
+    { "errors/untyped.sl",
+      "errors/untyped.sl:4:15: error: cannot tell the type of this list of 3 values here; "
+      "put a type in front, as in 'point (...)'\n"
+      "    float d = (1, 0, 0) . (0, 1, 0);\n"
+      "              ^\n" },
+};
+
+/* ---------------------------------------------------------------------- */
+/* running                                                                 */
+/* ---------------------------------------------------------------------- */
+
+/* Reads `name` from the conformance directory (the #include loader). */
+static int load_conformance(sl_source_set *set, const char *name, sl_diag *diag, void *arg)
+{
+    (void)arg;
+    char path[1024];
+    snprintf(path, sizeof path, "%s/%s", AAFARM_CONFORMANCE_DIR, name);
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return 1;
+    fclose(f);
+    return sl_source_set_load_file(set, path, name, diag) == 0 ? 0 : -1;
+}
+
+static sl_program *compile_file(const char *name, char **diag_out)
+{
+    sl_source_set *set = sl_source_set_new();
+    sl_source_set_set_loader(set, load_conformance, NULL);
+    sl_diag *diag = sl_diag_new();
+    sl_program *p = NULL;
+    if (sl_source_set_get(set, name, diag))
+        p = sl_compile(set, name, NULL, diag);
+    *diag_out = sl_diag_to_string(diag);
+    sl_diag_destroy(&diag);
+    sl_source_set_destroy(&set);
+    return p;
+}
+
+typedef struct tally {
+    int floats, ranges, bounded, samples, failures;
+} tally;
+
+static bool close_to(double got, double want)
+{
+    return fabs(got - want) <= 1e-9 * (1 + fabs(want));
+}
+
+static bool inside(ia_interval r, double x)
+{
+    double tol = 1e-9 * (1 + fabs(x));
+    return x >= r.lo - tol && x <= r.hi + tol;
+}
+
+static bool run_float(sl_vm *vm, const sl_instance *inst, double u, double v, double P[3])
+{
+    h_globals_float(vm, H_PLANE, u, v);
+    if (sl_vm_run(vm, inst, SL_MODE_FLOAT, NULL) != SL_OK) {
+        fprintf(stderr, "%s\n", sl_vm_error(vm));
+        return false;
+    }
+    sl_vm_get_float(vm, SL_G_P, P);
+    return true;
+}
+
+/* Float values at 7x7 points against the reference. */
+static void check_float(const conf_case *cc, sl_vm *vm, const sl_instance *inst, tally *t)
+{
+    for (int i = 0; i < 7; i++) {
+        for (int j = 0; j < 7; j++) {
+            double u = 0.05 + 0.9 * (i + 0.31) / 7, v = 0.05 + 0.9 * (j + 0.57) / 7;
+            double P[3], want[3];
+            t->floats++;
+            cc->ref(u, v, want);
+            bool ok = run_float(vm, inst, u, v, P);
+            for (int k = 0; ok && k < 3; k++)
+                ok = close_to(P[k], want[k]);
+            if (!ok) {
+                t->failures++;
+                fprintf(stderr, "%s: at (u, v) = (%.17g, %.17g): P = (%.17g, %.17g, %.17g), "
+                                "want (%.17g, %.17g, %.17g)\n", cc->file, u, v, P[0], P[1],
+                        P[2], want[0], want[1], want[2]);
+            }
+        }
+    }
+}
+
+/* Interval and affine enclosures over random boxes contain float samples. */
+static void check_ranges(const conf_case *cc, sl_vm *vm, const sl_instance *inst, tally *t,
+                         unsigned long long *rng)
+{
+    aa_context ctx;
+    aa_context_init(&ctx, AA_DEFAULT_CAPACITY);
+    for (int r = 0; r < 12; r++) {
+        double side = ldexp(1, -2 - (int)(h_rand(rng) * 5));
+        double u0 = 0.02 + h_rand(rng) * (0.96 - side), v0 = 0.02 + h_rand(rng) * (0.96 - side);
+        double u1 = u0 + side, v1 = v0 + side;
+        ia_interval I[3], A[3];
+        aa_form a[3];
+        t->ranges++;
+        h_globals_interval(vm, H_PLANE, u0, u1, v0, v1);
+        sl_status st = sl_vm_run(vm, inst, SL_MODE_INTERVAL, NULL);
+        if (st == SL_OK) {
+            sl_vm_get_interval(vm, SL_G_P, I);
+            h_globals_affine(vm, &ctx, H_PLANE, u0, u1, v0, v1);
+            st = sl_vm_run(vm, inst, SL_MODE_AFFINE, &ctx);
+        }
+        if (st != SL_OK) {
+            t->failures++;
+            fprintf(stderr, "%s: %s\n", cc->file, sl_vm_error(vm));
+            continue;
+        }
+        sl_vm_get_affine(vm, SL_G_P, a);
+        bool bounded = true;
+        for (int k = 0; k < 3; k++) {
+            A[k] = aa_range(&a[k]);
+            bounded &= isfinite(A[k].lo) && isfinite(A[k].hi) && isfinite(I[k].lo) &&
+                       isfinite(I[k].hi);
+        }
+        t->bounded += bounded;
+        for (int i = 0; i < 4; i++) {
+            for (int j = 0; j < 4; j++) {
+                double u = u0 + (u1 - u0) * i / 3, v = v0 + (v1 - v0) * j / 3, P[3];
+                t->samples++;
+                bool ok = run_float(vm, inst, u, v, P);
+                for (int k = 0; ok && k < 3; k++)
+                    ok = inside(I[k], P[k]) && inside(A[k], P[k]);
+                if (!ok) {
+                    t->failures++;
+                    fprintf(stderr, "%s: box [%g, %g] x [%g, %g]: sample (%g, %g) outside\n",
+                            cc->file, u0, u1, v0, v1, u, v);
+                }
+            }
+        }
+    }
+}
+
+static void test_conformance(void **state)
+{
+    (void)state;
+    tally t = { 0, 0, 0, 0, 0 };
+    unsigned long long rng = 0x5eed15ULL;
+    sl_vm *vm = sl_vm_new(NULL);
+    const char *features[64];
+    int nfeatures = 0;
+    size_t ncases = sizeof cases / sizeof cases[0];
+    for (size_t c = 0; c < ncases; c++) {
+        const conf_case *cc = &cases[c];
+        bool seen = false;
+        for (int f = 0; f < nfeatures; f++)
+            seen |= strcmp(features[f], cc->feature) == 0;
+        if (!seen && nfeatures < 64)
+            features[nfeatures++] = cc->feature;
+        char *diag = NULL;
+        sl_program *p = compile_file(cc->file, &diag);
+        if (!p || diag[0]) {
+            t.failures++;
+            fprintf(stderr, "%s: does not compile cleanly:\n%s", cc->file, diag);
+        }
+        free(diag);
+        if (!p)
+            continue;
+        sl_instance *inst = sl_instance_new(p);
+        check_float(cc, vm, inst, &t);
+        check_ranges(cc, vm, inst, &t, &rng);
+        sl_instance_destroy(&inst);
+        sl_program_destroy(&p);
+    }
+    size_t nerrors = sizeof errors / sizeof errors[0];
+    for (size_t e = 0; e < nerrors; e++) {
+        char *diag = NULL;
+        sl_program *p = compile_file(errors[e].file, &diag);
+        if (p || strcmp(diag, errors[e].expected) != 0) {
+            t.failures++;
+            fprintf(stderr, "%s: --- got:\n%s--- expected:\n%s", errors[e].file, diag,
+                    errors[e].expected);
+        }
+        sl_program_destroy(&p);
+        free(diag);
+    }
+    sl_vm_destroy(&vm);
+    printf("conformance: %zu shaders and %zu error cases; features:", ncases, nerrors);
+    for (int f = 0; f < nfeatures; f++)
+        printf("%s %s", f ? "," : "", features[f]);
+    printf("\nconformance: %d float checks, %d ranges (interval and affine; %d of them "
+           "bounded) with %d samples, %zu diagnostics; %d failures\n", t.floats, t.ranges,
+           t.bounded, t.samples, nerrors, t.failures);
+    assert_int_equal(t.failures, 0);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_conformance),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
