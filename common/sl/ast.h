@@ -35,8 +35,16 @@ enum { SL_TY_BOOL = SL_TYPE_MATRIX + 1, SL_TY_ERROR, SL_TY_LIST3, SL_TY_LIST16 }
  * it where it is assigned, passed or returned, or reports it. */
 static inline bool sl_ty_is_list(sl_ty ty) { return ty == SL_TY_LIST3 || ty == SL_TY_LIST16; }
 
-const char *sl_ty_name(sl_ty ty);            /* "float", "point", "bool" */
-int sl_ty_slots(sl_ty ty);                   /* scalar slots: 1, 3, 16; 0 */
+/* Arrays: a flag, the element type and the length (0: an unsized function
+ * parameter `float a[]`, which takes the length of each argument). */
+enum { SL_TY_ARRAY_FLAG = 1 << 24, SL_MAX_ARRAY_LEN = 4095 };
+static inline sl_ty sl_ty_array(sl_ty elem, int len) { return SL_TY_ARRAY_FLAG | elem | (len << 8); }
+static inline bool sl_ty_is_array(sl_ty ty) { return (ty & SL_TY_ARRAY_FLAG) != 0; }
+static inline sl_ty sl_ty_elem(sl_ty ty) { return sl_ty_is_array(ty) ? (ty & 0xff) : ty; }
+static inline int sl_ty_len(sl_ty ty) { return (ty >> 8) & 0xfff; }
+
+const char *sl_ty_name(sl_ty ty);            /* "float", "point", "bool", "float[4]" */
+int sl_ty_slots(sl_ty ty);                   /* scalar slots: 1, 3, 16, n * those; 0 */
 bool sl_ty_is_triple(sl_ty ty);              /* point vector normal color */
 bool sl_ty_is_spatial(sl_ty ty);             /* point vector normal */
 
@@ -68,6 +76,7 @@ typedef struct sl_sym {
     double value;       /* SL_SYM_CONST */
     int param_index;    /* SL_SYM_PARAM */
     int slot;           /* codegen: first slot (scalar or string file) */
+    int cg_len;         /* codegen: the length bound to an unsized array parameter */
 } sl_sym;
 
 typedef struct sl_node sl_node;
@@ -105,6 +114,8 @@ typedef enum sl_node_kind {
     SL_N_CAST,       /* cast_ty, name: space or NULL, list: 1, 3 or 16 values;
                         cast_ty SL_TYPE_VOID: an untyped list (x, y, z) */
     SL_N_CONV,       /* implicit conversion of a to ty (checker) */
+    SL_N_INDEX,      /* a[b]: a the array (an SL_N_IDENT), b the index */
+    SL_N_ARRAYINIT,  /* { list }: the initializer of an array */
     SL_N_ERROR,      /* an expression that failed to parse (already reported) */
     /* statements */
     SL_N_BLOCK,      /* list */

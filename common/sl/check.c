@@ -461,24 +461,74 @@ static bool check_assignable(checker *c, sl_node *lhs, const char *what)
     return false;
 }
 
+/* A constant index: its value, true; false when the index varies. */
+static bool const_index(const sl_node *x, double *k)
+{
+    if (x->kind == SL_N_NUM) {
+        *k = floor(x->num);
+        return true;
+    }
+    if (x->kind == SL_N_UNARY && x->op == SL_TOK_MINUS && x->a->kind == SL_N_NUM) {
+        *k = floor(-x->a->num);
+        return true;
+    }
+    return false;
+}
+
+/* a[i]: a an array variable, i a float (rounded down); a constant index
+ * must lie inside a sized array. n->num != 0: the index node is shared
+ * with the target of `a[i] op= e` and already checked. */
+static sl_ty check_index(checker *c, sl_node *n)
+{
+    sl_ty at = check_ident(c, n->a);
+    sl_ty it = n->num != 0 ? n->b->ty : check_expr(c, &n->b, SL_TYPE_FLOAT);
+    if (at == SL_TY_ERROR || it == SL_TY_ERROR)
+        return set_ty(n, SL_TY_ERROR);
+    if (!sl_ty_is_array(at)) {
+        error(c, n->pos, "'%s' is not an array (it is a '%s')", n->a->name, sl_ty_name(at));
+        return set_ty(n, SL_TY_ERROR);
+    }
+    if (it != SL_TYPE_FLOAT) {
+        error(c, n->b->pos, "an array index must be a float, not '%s'", sl_ty_name(it));
+        return set_ty(n, SL_TY_ERROR);
+    }
+    double k;
+    int len = sl_ty_len(at);
+    if (len > 0 && const_index(n->b, &k) && !(k >= 0 && k < len)) {
+        error(c, n->b->pos, "array index %g is out of range for '%s' (%s: 0 to %d)", k,
+              n->a->name, sl_ty_name(at), len - 1);
+        return set_ty(n, SL_TY_ERROR);
+    }
+    return set_ty(n, sl_ty_elem(at));
+}
+
 static sl_ty check_assign(checker *c, sl_node *n)
 {
     sl_node *lhs = n->a;
-    if (lhs->kind != SL_N_IDENT)
+    if (lhs->kind != SL_N_IDENT && lhs->kind != SL_N_INDEX)
         return set_ty(n, SL_TY_ERROR);
-    sl_ty lt = check_ident(c, lhs);
+    bool element = lhs->kind == SL_N_INDEX;
+    sl_node *var = element ? lhs->a : lhs;
+    sl_ty lt = element ? check_index(c, lhs) : check_ident(c, lhs);
     if (lt == SL_TY_ERROR) {
         check_expr(c, &n->b, SL_TYPE_VOID);
         return set_ty(n, SL_TY_ERROR);
     }
-    check_assignable(c, lhs, "assign to");
+    check_assignable(c, var, "assign to");
     if (n->op != SL_TOK_ASSIGN) {     /* x op= e  ->  x = x op e */
         sl_node *bin = sl_node_new(c->arena, SL_N_BINARY, n->pos);
         bin->op = n->op == SL_TOK_PLUS_ASSIGN ? SL_TOK_PLUS
                 : n->op == SL_TOK_MINUS_ASSIGN ? SL_TOK_MINUS
                 : n->op == SL_TOK_STAR_ASSIGN ? SL_TOK_STAR : SL_TOK_SLASH;
-        sl_node *read = sl_node_new(c->arena, SL_N_IDENT, lhs->pos);
-        read->name = lhs->name;
+        sl_node *read = sl_node_new(c->arena, SL_N_IDENT, var->pos);
+        read->name = var->name;
+        if (element) {                /* a[i] op= e: the index is evaluated twice */
+            sl_node *x = sl_node_new(c->arena, SL_N_INDEX, lhs->pos);
+            x->a = read;
+            x->b = lhs->b;
+            x->num = 1;
+            read = x;
+        }
         bin->a = read;
         bin->b = n->b;
         n->b = bin;
@@ -486,8 +536,8 @@ static sl_ty check_assign(checker *c, sl_node *n)
     }
     sl_ty rt = check_expr(c, &n->b, lt);
     if (!can_convert(rt, lt)) {
-        error(c, n->b->pos, "cannot assign a value of type '%s' to '%s' (%s)",
-              sl_ty_name(rt), lhs->name, sl_ty_name(lt));
+        error(c, n->b->pos, "cannot assign a value of type '%s' to '%s%s' (%s)",
+              sl_ty_name(rt), var->name, element ? "[...]" : "", sl_ty_name(lt));
         return set_ty(n, SL_TY_ERROR);
     }
     wrap_conv(c, &n->b, lt);
@@ -549,6 +599,17 @@ static void add_call_edge(checker *c, sl_func *callee)
                  &c->func->calls_cap, callee);
 }
 
+/* An array argument for an array parameter: the same element type and
+ * length; an unsized parameter takes any length (an unsized argument is
+ * checked when the call is inlined, where its length is known). */
+static bool array_arg_ok(sl_ty param, sl_ty arg)
+{
+    if (!sl_ty_is_array(param) || !sl_ty_is_array(arg) ||
+        sl_ty_elem(param) != sl_ty_elem(arg))
+        return false;
+    return sl_ty_len(param) == 0 || sl_ty_len(arg) == 0 || sl_ty_len(param) == sl_ty_len(arg);
+}
+
 static sl_ty check_user_call(checker *c, sl_node *n, sl_func *f, const sl_ty *args)
 {
     n->func = f;
@@ -564,6 +625,17 @@ static sl_ty check_user_call(checker *c, sl_node *n, sl_func *f, const sl_ty *ar
         sl_sym *p = f->params[i];
         if (args[i] == SL_TY_ERROR) {
             ok = false;
+            continue;
+        }
+        if (sl_ty_is_array(p->ty) || sl_ty_is_array(args[i])) {
+            if (!array_arg_ok(p->ty, args[i])) {
+                error(c, n->list[i]->pos, "argument %d of '%s': cannot pass a '%s' to a "
+                                          "parameter of type '%s'", i + 1, f->name,
+                      sl_ty_name(args[i]), sl_ty_name(p->ty));
+                ok = false;
+            } else if (p->output) {
+                check_assignable(c, n->list[i], "modify");
+            }
             continue;
         }
         if (p->output) {
@@ -600,6 +672,8 @@ static sl_ty check_user_call(checker *c, sl_node *n, sl_func *f, const sl_ty *ar
  * takes a variable of its own type (or another spatial type, cost 1). */
 static int param_cost(const sl_sym *p, sl_ty have)
 {
+    if (sl_ty_is_array(p->ty) || sl_ty_is_array(have))
+        return array_arg_ok(p->ty, have) ? 0 : -1;
     if (have == p->ty)
         return 0;
     if (sl_ty_is_list(have))
@@ -705,10 +779,27 @@ static void no_match(checker *c, sl_node *n, const sl_ty *args, sl_func **cands,
     }
 }
 
+/* arraylength(a): the number of elements of an array (a constant where
+ * the array's length is; an unsized parameter's is known per call). */
+static sl_ty check_arraylength(checker *c, sl_node *n)
+{
+    for (int i = 0; i < n->nlist; i++)
+        check_expr(c, &n->list[i], SL_TYPE_VOID);
+    if (n->nlist != 1 || !sl_ty_is_array(n->list[0]->ty) ||
+        n->list[0]->kind != SL_N_IDENT) {
+        if (n->nlist != 1 || n->list[0]->ty != SL_TY_ERROR)
+            error(c, n->pos, "arraylength() takes one array variable");
+        return set_ty(n, SL_TY_ERROR);
+    }
+    return set_ty(n, SL_TYPE_FLOAT);
+}
+
 static sl_ty check_call(checker *c, sl_node *n, sl_ty hint)
 {
     sl_func *cands[MAX_OVERLOADS];
     int ncands = find_funcs(c, n->name, cands, MAX_OVERLOADS);
+    if (ncands == 0 && strcmp(n->name, "arraylength") == 0)
+        return check_arraylength(c, n);
     int count;
     bool builtin = sl_builtin_find(n->name, &count) != NULL;
     if (!ncands && !builtin) {
@@ -863,6 +954,7 @@ static sl_ty check_expr(checker *c, sl_node **np, sl_ty hint)
     case SL_N_COND: return check_cond_expr(c, n, hint);
     case SL_N_ASSIGN: return check_assign(c, n);
     case SL_N_CAST: return check_cast(c, n, hint);
+    case SL_N_INDEX: return check_index(c, n);
     case SL_N_CONV: return n->ty;
     default: return set_ty(n, SL_TY_ERROR);
     }
@@ -899,6 +991,49 @@ static void inherit(checker *c, sl_node *n, const sl_node *child, const sl_node 
             add_escape(c, n, child->escapes[i]);
 }
 
+/* The initializer (or shader parameter default) v->a of variable s: an
+ * expression of a convertible type, or for an array '{ values }' (one per
+ * element; an array declared without a size takes their number). */
+static void check_init(checker *c, sl_node *v, sl_sym *s)
+{
+    sl_node *init = v->a;
+    if (init && init->kind == SL_N_ARRAYINIT) {
+        if (!sl_ty_is_array(s->ty)) {
+            error(c, init->pos, "cannot initialize '%s' (%s) with a list in braces", s->name,
+                  sl_ty_name(s->ty));
+            return;
+        }
+        sl_ty elem = sl_ty_elem(s->ty);
+        int len = sl_ty_len(s->ty);
+        if (len == 0 && init->nlist > 0 && init->nlist <= SL_MAX_ARRAY_LEN)
+            s->ty = sl_ty_array(elem, len = init->nlist);
+        init->ty = s->ty;
+        for (int i = 0; i < init->nlist; i++) {
+            sl_ty t = check_expr(c, &init->list[i], elem);
+            if (!can_convert(t, elem)) {
+                error(c, init->list[i]->pos, "element %d of '%s' (%s) cannot be a '%s'", i + 1,
+                      s->name, sl_ty_name(s->ty), sl_ty_name(t));
+                return;
+            }
+            wrap_conv(c, &init->list[i], elem);
+        }
+        if (init->nlist != len)
+            error(c, init->pos, "'%s' has %d elements, but %d value%s given", s->name, len,
+                  init->nlist, init->nlist == 1 ? " is" : "s are");
+        return;
+    }
+    if (init) {
+        sl_ty t = check_expr(c, &v->a, s->ty);
+        if (!can_convert(t, s->ty))
+            error(c, v->a->pos, "cannot initialize '%s' (%s) with a value of type '%s'",
+                  s->name, sl_ty_name(s->ty), sl_ty_name(t));
+        else
+            wrap_conv(c, &v->a, s->ty);
+    }
+    if (sl_ty_is_array(s->ty) && sl_ty_len(s->ty) == 0)
+        error(c, v->pos, "array '%s' needs a size or an initializer", s->name);
+}
+
 static void check_decl(checker *c, sl_node *n)
 {
     for (int i = 0; i < n->nlist; i++) {
@@ -920,7 +1055,10 @@ static void check_decl(checker *c, sl_node *n)
                 declare(c, s);
                 v->num = 0;
                 continue;
-            } else if (outer->ty != s->ty)
+            } else if (outer->ty != s->ty &&
+                       !(sl_ty_is_array(s->ty) && sl_ty_len(s->ty) == 0 &&
+                         sl_ty_is_array(outer->ty) &&
+                         sl_ty_elem(outer->ty) == sl_ty_elem(s->ty)))
                 error(c, v->pos, "'extern' declaration of '%s' as '%s' does not match its "
                                  "type '%s'", s->name, sl_ty_name(s->ty),
                       sl_ty_name(outer->ty));
@@ -929,14 +1067,7 @@ static void check_decl(checker *c, sl_node *n)
                 declare(c, outer);        /* the enclosing variable itself */
             continue;
         }
-        if (v->a) {
-            sl_ty t = check_expr(c, &v->a, s->ty);
-            if (!can_convert(t, s->ty))
-                error(c, v->a->pos, "cannot initialize '%s' (%s) with a value of type '%s'",
-                      s->name, sl_ty_name(s->ty), sl_ty_name(t));
-            else
-                wrap_conv(c, &v->a, s->ty);
-        }
+        check_init(c, v, s);
         declare(c, s);
     }
 }
@@ -1223,14 +1354,7 @@ static void check_shader(checker *c)
     c->func = NULL;
     for (int i = 0; i < f->nparams; i++) {
         sl_node *v = f->params[i];
-        if (v->a) {
-            sl_ty t = check_expr(c, &v->a, v->sym->ty);
-            if (!can_convert(t, v->sym->ty))
-                error(c, v->a->pos, "cannot initialize '%s' (%s) with a value of type '%s'",
-                      v->sym->name, sl_ty_name(v->sym->ty), sl_ty_name(t));
-            else
-                wrap_conv(c, &v->a, v->sym->ty);
-        }
+        check_init(c, v, v->sym);
         declare(c, v->sym);
     }
     if (f->body) {

@@ -14,7 +14,8 @@
  *                  spec's order: "." binds tighter than "*", "^" between
  *                  "*" and "+")
  *   unary       := ('-' | '+' | '!') unary | type [STRING] unary | primary
- *   primary     := NUMBER | STRING | IDENT | IDENT '(' args ')' | '(' expr ')'
+ *   primary     := NUMBER | STRING | IDENT | IDENT '[' expr ']'
+ *                | IDENT '(' args ')' | '(' expr ')'
  *
  * A type keyword followed by '(' or a string is a cast (`point "object"
  * (x, y, z)`, `color (0.5)`), followed by an identifier a declaration.
@@ -250,12 +251,17 @@ static sl_node *primary(parser *p)
         advance(p);
         if (check(p, SL_TOK_LPAREN))
             return call(p, t);
-        if (check(p, SL_TOK_LBRACKET)) {
-            error_at(p, p->cur.pos, &p->cur, "arrays are not supported");
-            return error_node(p, t.pos);
-        }
         sl_node *n = sl_node_new(p->arena, SL_N_IDENT, t.pos);
         n->name = t.text;
+        if (check(p, SL_TOK_LBRACKET)) {         /* a[i] */
+            sl_token open = p->cur;
+            advance(p);
+            sl_node *x = sl_node_new(p->arena, SL_N_INDEX, open.pos);
+            x->a = n;
+            x->b = expression(p);
+            expect_closing(p, SL_TOK_RBRACKET, &open);
+            return x;
+        }
         return n;
     }
     case SL_TOK_LPAREN: {
@@ -442,7 +448,7 @@ static sl_node *expression(parser *p)
         n->op = op.kind;
         n->a = lhs;
         n->b = expression(p);
-        if (lhs->kind != SL_N_IDENT && lhs->kind != SL_N_ERROR)
+        if (lhs->kind != SL_N_IDENT && lhs->kind != SL_N_INDEX && lhs->kind != SL_N_ERROR)
             error_at(p, lhs->pos, NULL, "expression is not assignable");
         lhs = n;
     }
@@ -499,7 +505,51 @@ static sl_sym *new_sym(parser *p, const sl_token *name, const declspec *spec, sl
     return s;
 }
 
-/* name [= expr]; returns an SL_N_VAR node or NULL after an error */
+/* '[' [N] ']' after a declared name: v's type becomes an array of N
+ * (N: an integer literal; none: the length comes from the initializer or,
+ * for a function parameter, from each argument). */
+static bool array_size(parser *p, sl_node *v, const declspec *spec)
+{
+    sl_token open = p->cur;
+    advance(p);
+    int len = 0;
+    if (!check(p, SL_TOK_RBRACKET)) {
+        if (!check(p, SL_TOK_INT) || p->cur.number < 1 || p->cur.number > SL_MAX_ARRAY_LEN) {
+            error_at(p, p->cur.pos, &p->cur, "array size must be an integer from 1 to %d",
+                     SL_MAX_ARRAY_LEN);
+            return false;
+        }
+        len = (int)p->cur.number;
+        advance(p);
+    }
+    if (!expect_closing(p, SL_TOK_RBRACKET, &open))
+        return false;
+    if (spec->ty == SL_TYPE_STRING) {
+        error_at(p, open.pos, &open, "arrays of strings are not supported");
+        return false;
+    }
+    v->sym->ty = sl_ty_array(spec->ty, len);
+    return true;
+}
+
+/* '{' expr {, expr} '}': the values of an array. */
+static sl_node *array_init(parser *p)
+{
+    sl_token open = p->cur;
+    advance(p);
+    sl_node *n = sl_node_new(p->arena, SL_N_ARRAYINIT, open.pos);
+    int cap = 0;
+    if (!check(p, SL_TOK_RBRACE)) {
+        do {
+            push_node(p, n, &cap, expression(p));
+        } while (match(p, SL_TOK_COMMA));
+    }
+    expect_closing(p, SL_TOK_RBRACE, &open);
+    return n;
+}
+
+/* name ['[' [N] ']'] [= expr | = '{' exprs '}']; returns an SL_N_VAR node
+ * or NULL after an error */
 static sl_node *declarator(parser *p, const declspec *spec, sl_sym_kind kind, bool allow_init)
 {
     if (!check(p, SL_TOK_IDENT)) {
@@ -508,10 +558,6 @@ static sl_node *declarator(parser *p, const declspec *spec, sl_sym_kind kind, bo
     }
     sl_token name = p->cur;
     advance(p);
-    if (check(p, SL_TOK_LBRACKET)) {
-        error_at(p, p->cur.pos, &p->cur, "arrays are not supported");
-        return NULL;
-    }
     sl_node *v = sl_node_new(p->arena, SL_N_VAR, name.pos);
     v->sym = new_sym(p, &name, spec, kind);
     v->name = name.text;
@@ -520,6 +566,8 @@ static sl_node *declarator(parser *p, const declspec *spec, sl_sym_kind kind, bo
                  "variable '%s' declared 'void'", name.text);
         return NULL;
     }
+    if (check(p, SL_TOK_LBRACKET) && !array_size(p, v, spec))
+        return NULL;
     if (check(p, SL_TOK_ASSIGN)) {
         if (!allow_init) {
             error_at(p, p->cur.pos, &p->cur,
@@ -527,7 +575,7 @@ static sl_node *declarator(parser *p, const declspec *spec, sl_sym_kind kind, bo
             return NULL;
         }
         advance(p);
-        v->a = expression(p);
+        v->a = check(p, SL_TOK_LBRACE) ? array_init(p) : expression(p);
     }
     return v;
 }

@@ -258,6 +258,35 @@ static void ref_extern_globals_nested(double u, double v, double o[3])
     o[0] = 2 * u - 1; o[1] = 2 * v - 1; o[2] = 0.1 * u + 0.1 * 2 * v;
 }
 
+static void ref_array_lookup(double u, double v, double o[3])
+{
+    static const double h[5] = { 0, 0.1, 0.3, 0.2, 0.05 };
+    o[0] = 2 * u - 1; o[1] = 2 * v - 1; o[2] = h[(int)floor(5 * v)];
+}
+
+static void ref_array_unsized_param(double u, double v, double o[3])
+{
+    o[0] = (1 + 2 * u + 3 * u * u) / 6; o[1] = (4 + v * v * v) / 5; o[2] = 4;
+}
+
+static void ref_array_store_loop(double u, double v, double o[3])
+{
+    double k = floor(4 * v);
+    bool on = u > 0.25 * k;
+    o[0] = on ? k : -1; o[1] = on ? k * k : -1; o[2] = on ? 1 : -1;
+}
+
+static void ref_array_nested_extern(double u, double v, double o[3])
+{
+    static const double oct[3] = { 1, 0.5, 0.25 };
+    double k = floor(3 * v);
+    o[0] = 0;
+    for (int i = 0; i < 3; i++)
+        o[0] += oct[i] * sin(2 * u * pow(2, i));
+    o[1] = oct[(int)k] * sin(pow(2, 3 * v));   /* the index rounds down, pow does not */
+    o[2] = 0;
+}
+
 /* ---------------------------------------------------------------------- */
 /* the cases                                                               */
 /* ---------------------------------------------------------------------- */
@@ -296,6 +325,10 @@ static const conf_case cases[] = {
     CASE(noises_turbulence, "helper headers"),
     CASE(voronoi_cells, "helper headers"),
     CASE(filterwidth_overloads, "helper headers"),
+    CASE(array_lookup, "arrays"),
+    CASE(array_unsized_param, "arrays"),
+    CASE(array_store_loop, "arrays"),
+    CASE(array_nested_extern, "arrays"),
 };
 #undef CASE
 
@@ -331,6 +364,11 @@ static const conf_error errors[] = {
       "errors/out_of_scope.sl:7:10: error: use of undeclared function 'twice'\n"
       "    P += twice(s) * N;\n"
       "         ^\n" },
+    { "errors/array_index.sl",
+      "errors/array_index.sl:5:12: error: array index 3 is out of range for 'a' (float[3]: "
+      "0 to 2)\n"
+      "    P += a[3] * N;\n"
+      "           ^\n" },
     { "errors/untyped.sl",
       "errors/untyped.sl:4:15: error: cannot tell the type of this list of 3 values here; "
       "put a type in front, as in 'point (...)'\n"

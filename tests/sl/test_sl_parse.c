@@ -125,10 +125,6 @@ static void test_error_in_macro(void **state)
 static void test_unsupported(void **state)
 {
     (void)state;
-    expect_errors("displacement t() {\n    float a[4];\n}\n",
-                  "t.sl:2:12: error: arrays are not supported\n"
-                  "    float a[4];\n"
-                  "           ^\n");
     expect_errors("light l() { }\n",
                   "t.sl:1:1: error: 'light' shaders are not supported (only 'surface' and "
                   "'displacement')\n"
