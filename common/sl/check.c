@@ -9,7 +9,16 @@
  * cross product; comparisons and && || ! give a relation (SL_TY_BOOL).
  * A float used as a condition means "!= 0". Polymorphic noise takes its
  * result type from the context ("hint": a declaration, an assignment, a
- * cast, a parameter, a return).
+ * cast, a parameter, a return), as do untyped lists `(x, y, z)` (typed
+ * late: SL_TY_LIST3/LIST16 until a context retypes them) and user
+ * functions overloaded by return type.
+ *
+ * Scopes (RI Spec 3.2 §14.2): one stack of variables; a function's own
+ * start at func_base, below it are the enclosing scopes of a nested
+ * function, visible only through 'extern'. Nested functions are scoped
+ * like variables (vfuncs); calls resolve among the overloads in scope
+ * (resolve_user, rules in docs/shading-language.md), then the built-ins.
+ * Arrays: fixed-size, indexed by a float; a[i] op= e reads a[i] again.
  *
  * Escapes: every statement records the break/continue/return inside it
  * that leave it (sl_node.escapes). The code generator turns them into flag

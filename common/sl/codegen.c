@@ -24,7 +24,12 @@
  *
  * User functions are inlined at each call: parameters are bound to the
  * argument slots (by reference, as in RenderMan), the result goes to a
- * fresh slot.
+ * fresh slot. A nested function's extern variables are the enclosing
+ * function's symbols, whose slots are those of the call being generated.
+ *
+ * Arrays occupy length * element slots; a constant index addresses an
+ * element directly, a varying one goes through ALOAD/ASTORE lane by lane,
+ * and a store puts the whole array in the enclosing merge table.
  */
 #include "sl/codegen.h"
 #include "sl/builtins.h"

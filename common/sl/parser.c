@@ -7,6 +7,7 @@
  *   function    := [type] IDENT '(' [formals] ')' block
  *   formals     := formal { (';' | ',') formal } [';']
  *   formal      := ['output'] ['uniform'|'varying'] type def {',' def}
+ *   def         := IDENT ['[' [INT] ']'] ['=' (expr | '{' expr {',' expr} '}')]
  *   statement   := block | declaration | function | if | while | for | break
  *                | continue | return | expr ';' | ';'
  *   expr        := assignment, then ?: || && (== !=) (< > <= >=) (+ -)

@@ -287,6 +287,90 @@ static void ref_array_nested_extern(double u, double v, double o[3])
     o[2] = 0;
 }
 
+static void ref_shadow_output_param(double u, double v, double o[3])
+{
+    o[0] = 2 * u - 1; o[1] = 2 * v - 1; o[2] = 0.2 * u + v;
+}
+
+static void ref_shadow_global_in_nested(double u, double v, double o[3])
+{
+    o[0] = 6 + u; o[1] = 2; o[2] = v;
+}
+
+static void ref_nested_sibling_calls(double u, double v, double o[3])
+{
+    o[0] = u * u * u * u; o[1] = v * v + 0.0625; o[2] = 0;
+}
+
+static void ref_nested_output_param(double u, double v, double o[3])
+{
+    (void)v;
+    double w = floor(3 * u);
+    o[0] = w; o[1] = 3 * u - w; o[2] = 0;
+}
+
+static void ref_overload_nested_local(double u, double v, double o[3])
+{
+    o[0] = 0.3 * u + 0.59 * v + 0.11; o[1] = v; o[2] = 0;
+}
+
+static void ref_overload_triples(double u, double v, double o[3])
+{
+    o[0] = 321; o[1] = u; o[2] = v;
+}
+
+static void ref_overload_return_noise(double u, double v, double o[3])
+{
+    double p[3] = { 2 * (2 * u - 1), 2 * (2 * v - 1), 0 }, c[3];
+    sl_vnoise(3, p, c);
+    o[0] = sl_noise(3, p); o[1] = c[0]; o[2] = c[2];
+}
+
+static void ref_list_nested_return(double u, double v, double o[3])
+{
+    o[0] = (u < 0.5) + (v < 0.5); o[1] = 0; o[2] = (u >= 0.5) + (v >= 0.5);
+}
+
+static void ref_list_builtins(double u, double v, double o[3])
+{
+    double x = 2 * u - 1, y = 2 * v - 1;
+    o[0] = 0.6 + 0.8; o[1] = sqrt(x * x + y * y); o[2] = sqrt(u * u + v * v);
+}
+
+static void ref_array_color_ramp(double u, double v, double o[3])
+{
+    static const double k[5] = { 0, 0.2, 0.9, 0.4, 1 };
+    double x = 4 * u, i = floor(x), f = x - i;
+    int a = (int)i, b = a + 1 < 4 ? a + 1 : 4;
+    o[0] = k[a] * (1 - f) + k[b] * f; o[1] = k[(int)floor(5 * v)]; o[2] = 0;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+static void ref_array_sort(double u, double v, double o[3])
+{
+    double a[4] = { u, v, 0.5, 1 - u };
+    qsort(a, 4, sizeof a[0], cmp_double);
+    o[0] = a[0]; o[1] = a[1]; o[2] = a[3];
+}
+
+static void ref_array_output_fill(double u, double v, double o[3])
+{
+    double x = u + 0.5;
+    o[0] = x + x * x; o[1] = x * x * x; o[2] = pow(x, floor(4 * v));
+}
+
+static void ref_array_points(double u, double v, double o[3])
+{
+    double d0 = sqrt(u * u + v * v), d1 = sqrt((u - 1) * (u - 1) + v * v);
+    double d2 = sqrt(u * u + (v - 1) * (v - 1));
+    static const double px[3] = { 0, 1, 0 };
+    o[0] = fmin(fmin(d0, d1), d2); o[1] = px[(int)floor(3 * u)]; o[2] = 0;
+}
+
 /* ---------------------------------------------------------------------- */
 /* the cases                                                               */
 /* ---------------------------------------------------------------------- */
@@ -329,6 +413,19 @@ static const conf_case cases[] = {
     CASE(array_unsized_param, "arrays"),
     CASE(array_store_loop, "arrays"),
     CASE(array_nested_extern, "arrays"),
+    CASE(shadow_output_param, "shadowed globals"),
+    CASE(shadow_global_in_nested, "shadowed globals"),
+    CASE(nested_sibling_calls, "nested functions"),
+    CASE(nested_output_param, "extern of enclosing variables"),
+    CASE(overload_nested_local, "overloading by argument type"),
+    CASE(overload_triples, "overloading by argument type"),
+    CASE(overload_return_noise, "overloading by return type"),
+    CASE(list_nested_return, "untyped triples"),
+    CASE(list_builtins, "untyped triples"),
+    CASE(array_color_ramp, "arrays"),
+    CASE(array_sort, "arrays"),
+    CASE(array_output_fill, "arrays"),
+    CASE(array_points, "arrays"),
 };
 #undef CASE
 
@@ -369,6 +466,26 @@ static const conf_error errors[] = {
       "0 to 2)\n"
       "    P += a[3] * N;\n"
       "           ^\n" },
+    { "errors/array_string.sl",
+      "errors/array_string.sl:4:17: error: arrays of strings are not supported\n"
+      "    string names[2];\n"
+      "                ^\n" },
+    { "errors/extern_missing.sl",
+      "errors/extern_missing.sl:4:35: error: 'extern' names no variable 'Kd' of an "
+      "enclosing scope\n"
+      "    float helper() { extern float Kd; return Kd; }\n"
+      "                                  ^\n" },
+    { "errors/overload_nomatch.sl",
+      "errors/overload_nomatch.sl:7:10: error: no matching function for call to 'w' with "
+      "arguments (string)\n"
+      "    P += w(\"heavy\") * N;\n"
+      "         ^\n"
+      "errors/overload_nomatch.sl:2:7: note: candidate: float w(float)\n"
+      "float w(float x) { return x; }\n"
+      "      ^\n"
+      "errors/overload_nomatch.sl:3:7: note: candidate: float w(color)\n"
+      "float w(color c) { return comp(c, 0); }\n"
+      "      ^\n" },
     { "errors/untyped.sl",
       "errors/untyped.sl:4:15: error: cannot tell the type of this list of 3 values here; "
       "put a type in front, as in 'point (...)'\n"
