@@ -72,6 +72,7 @@ typedef struct sl_sym {
     sl_pos pos;
     bool output;        /* output parameter */
     bool writable;      /* may be assigned */
+    bool warned;        /* checker: hidden from a nested function, said once */
     int global;         /* SL_SYM_GLOBAL: the sl_global */
     double value;       /* SL_SYM_CONST */
     int param_index;    /* SL_SYM_PARAM */

@@ -298,6 +298,20 @@ static sl_ty check_ident(checker *c, sl_node *n)
             error(c, n->pos, "use of undeclared identifier '%s'", n->name);
         return set_ty(n, SL_TY_ERROR);
     }
+    if (s->kind == SL_SYM_GLOBAL || s->kind == SL_SYM_CONST) {
+        /* a nested function reading `s` while the enclosing code has its
+         * own `s`: the predefined one is meant, as the specification says,
+         * but say so (other renderers may differ) */
+        sl_sym *outer = lookup_enclosing(c, n->name);
+        if (outer && !outer->warned) {
+            outer->warned = true;
+            sl_diag_warning(c->diag, n->pos, "'%s' in function '%s' is the predefined "
+                            "variable, not the enclosing scope's; declare 'extern %s %s;' "
+                            "to use that one", n->name, c->func->name, sl_ty_name(outer->ty),
+                            n->name);
+            sl_diag_note(c->diag, outer->pos, "the enclosing '%s' is declared here", n->name);
+        }
+    }
     n->sym = s;
     return set_ty(n, s->ty);
 }

@@ -193,14 +193,29 @@ static void test_nested_functions(void **state)
                "}\n"
                "displacement d() { P = point(outer(1), outer(s), 0); }\n",
                40, (2 * U + U + 1) * 10, 0);
-    /* extern s names the enclosing local s; without extern, s is the global */
-    expect_src("displacement d() {\n"
-               "    float s = 5;\n"
-               "    float f() { extern float s; return s; }\n"
-               "    float g() { return s; }\n"
-               "    P = point(f(), g(), 0);\n"
-               "}\n",
-               5, U, 0);
+    /* extern s names the enclosing local s; without extern, s is the global
+     * (with a warning, once) */
+    const char *src = "displacement d() {\n"
+                      "    float s = 5;\n"
+                      "    float f() { extern float s; return s; }\n"
+                      "    float g() { return s + s; }\n"
+                      "    P = point(f(), g(), 0);\n"
+                      "}\n";
+    expect_src(src, 5, 2 * U, 0);
+    char *text = NULL;
+    sl_program *p = h_compile_named("t.sl", src, &text);
+    assert_non_null(p);
+    assert_string_equal(text,
+                        "t.sl:4:24: warning: 's' in function 'g' is the predefined variable, "
+                        "not the enclosing scope's; declare 'extern float s;' to use that "
+                        "one\n"
+                        "    float g() { return s + s; }\n"
+                        "                       ^\n"
+                        "t.sl:2:11: note: the enclosing 's' is declared here\n"
+                        "    float s = 5;\n"
+                        "          ^\n");
+    free(text);
+    sl_program_destroy(&p);
     /* one name, two blocks, two functions; a nested one hides a file-level one */
     expect_src("float h(float x) { return x - 1; }\n"
                "displacement d() {\n"
