@@ -371,6 +371,23 @@ static void ref_array_points(double u, double v, double o[3])
     o[0] = fmin(fmin(d0, d1), d2); o[1] = px[(int)floor(3 * u)]; o[2] = 0;
 }
 
+static double pulsetrain_integral(double t, double nedge)
+{
+    double f = t - floor(t) - nedge;
+    return (1 - nedge) * floor(t) + (f > 0 ? f : 0);
+}
+static double filteredpulsetrain(double edge, double period, double x, double dx)
+{
+    double w = dx / period, x0 = x / period - w / 2, x1 = x0 + w, ne = edge / period;
+    return (pulsetrain_integral(x1, ne) - pulsetrain_integral(x0, ne)) / w;
+}
+static void ref_nested_pulsetrain(double u, double v, double o[3])
+{
+    o[0] = filteredpulsetrain(0.5, 1, 4 * u, 0.03);
+    o[1] = filteredpulsetrain(0.25, 0.5, 2 * v, 0.12);
+    o[2] = 0;
+}
+
 /* ---------------------------------------------------------------------- */
 /* the cases                                                               */
 /* ---------------------------------------------------------------------- */
@@ -389,6 +406,7 @@ static const conf_case cases[] = {
     CASE(shadow_builtin_names, "shadowed built-in names"),
     CASE(scope_blocks_for, "block scopes"),
     CASE(nested_filteredabs, "nested functions"),
+    CASE(nested_pulsetrain, "extern of enclosing variables"),
     CASE(nested_extern_accumulate, "extern of enclosing variables"),
     CASE(nested_two_levels, "extern of enclosing variables"),
     CASE(nested_in_loop, "nested functions"),

@@ -34,6 +34,24 @@ float smoothpulse(float e0, e1, e2, e3, x)
     return smoothstep(e0, e1, x) - smoothstep(e2, e3, x);
 }
 
+/* a pulse train of the given period, 0 on [0, edge) and 1 on [edge,
+ * period) of each period, box-filtered over width dx: its integral from 0
+ * is a nested helper that reads the enclosing normalized edge through
+ * extern */
+float filteredpulsetrain(float edge, period, x, dx)
+{
+    float w = dx / period;
+    float x0 = x / period - w / 2;
+    float x1 = x0 + w;
+    float nedge = edge / period;
+    float integral(float t)
+    {
+        extern float nedge;
+        return (1 - nedge) * floor(t) + max(0, t - floor(t) - nedge);
+    }
+    return (integral(x1) - integral(x0)) / w;
+}
+
 /* a tile coordinate: parameters named s and t, like the globals */
 float tilecoord(float s, t; float freq)
 {
