@@ -10,6 +10,9 @@
  *
  *   float      P at 7x7 points of the plane against an independent C
  *              computation of the same values (ref_* below)
+ *   dual       at the same points, dual mode gives the float values, and
+ *              derivatives matching central differences where those are
+ *              stable
  *   range      over 12 random (u,v) boxes (sides 2^-2 .. 2^-6), the
  *              interval and the affine enclosure of P contain P in float
  *              mode at 4x4 points of the box (paper §4, issue 9); the
@@ -396,9 +399,11 @@ typedef struct conf_case {
     const char *file;
     const char *feature;
     void (*ref)(double u, double v, double out[3]);
+    bool no_dual;       /* uses derivatives: dual values differ from float ones */
 } conf_case;
 
-#define CASE(name, feature) { #name ".sl", feature, ref_##name }
+#define CASE(name, feature) { #name ".sl", feature, ref_##name, false }
+#define CASE_NO_DUAL(name, feature) { #name ".sl", feature, ref_##name, true }
 static const conf_case cases[] = {
     CASE(shadow_global_local, "shadowed globals"),
     CASE(shadow_function_params, "shadowed globals"),
@@ -426,7 +431,7 @@ static const conf_case cases[] = {
     CASE(noises_fbm, "helper headers"),
     CASE(noises_turbulence, "helper headers"),
     CASE(voronoi_cells, "helper headers"),
-    CASE(filterwidth_overloads, "helper headers"),
+    CASE_NO_DUAL(filterwidth_overloads, "helper headers"),
     CASE(array_lookup, "arrays"),
     CASE(array_unsized_param, "arrays"),
     CASE(array_store_loop, "arrays"),
@@ -446,6 +451,7 @@ static const conf_case cases[] = {
     CASE(array_points, "arrays"),
 };
 #undef CASE
+#undef CASE_NO_DUAL
 
 typedef struct conf_error {
     const char *file;
@@ -543,7 +549,7 @@ static sl_program *compile_file(const char *name, char **diag_out)
 }
 
 typedef struct tally {
-    int floats, ranges, bounded, samples, failures;
+    int floats, duals, derivs, ranges, bounded, samples, failures;
 } tally;
 
 static bool close_to(double got, double want)
@@ -568,7 +574,50 @@ static bool run_float(sl_vm *vm, const sl_instance *inst, double u, double v, do
     return true;
 }
 
-/* Float values at 7x7 points against the reference. */
+/* Dual mode at (u, v): the values are the float ones, and each derivative
+ * matches central differences of float P where those are stable (two step
+ * sizes agree; not across a step or a floor). */
+static void check_dual(const conf_case *cc, sl_vm *vm, const sl_instance *inst, double u,
+                       double v, const double F[3], tally *t)
+{
+    sl_dual D[3];
+    h_globals_dual(vm, H_PLANE, u, v);
+    bool ok = sl_vm_run(vm, inst, SL_MODE_DUAL, NULL) == SL_OK;
+    t->duals++;
+    if (ok) {
+        sl_vm_get_dual(vm, SL_G_P, D);
+        for (int k = 0; k < 3; k++)
+            ok &= close_to(D[k].v, F[k]);
+    }
+    for (int dir = 0; ok && dir < 2; dir++) {
+        double e1[3], e2[3], Pp[3], Pm[3];
+        for (int m = 0; ok && m < 2; m++) {
+            double h = m ? 2e-5 : 1e-5;
+            ok &= run_float(vm, inst, u + (dir ? 0 : h), v + (dir ? h : 0), Pp) &&
+                  run_float(vm, inst, u - (dir ? 0 : h), v - (dir ? h : 0), Pm);
+            for (int k = 0; k < 3; k++)
+                (m ? e2 : e1)[k] = (Pp[k] - Pm[k]) / (2 * h);
+        }
+        for (int k = 0; ok && k < 3; k++) {
+            if (fabs(e1[k] - e2[k]) > 1e-5 * (1 + fabs(e1[k])))
+                continue;           /* not smooth here */
+            t->derivs++;
+            double d = dir ? D[k].dv : D[k].du;
+            ok = fabs(d - e1[k]) <= 1e-4 * (1 + fabs(e1[k]));
+            if (!ok)
+                fprintf(stderr, "%s: d/d%c of P[%d] at (%.17g, %.17g): dual %.17g, "
+                                "differences %.17g\n", cc->file, dir ? 'v' : 'u', k, u, v,
+                        d, e1[k]);
+        }
+    }
+    if (!ok) {
+        t->failures++;
+        fprintf(stderr, "%s: dual mode at (u, v) = (%.17g, %.17g) disagrees\n", cc->file,
+                u, v);
+    }
+}
+
+/* Float values at 7x7 points against the reference; dual mode there. */
 static void check_float(const conf_case *cc, sl_vm *vm, const sl_instance *inst, tally *t)
 {
     for (int i = 0; i < 7; i++) {
@@ -585,6 +634,8 @@ static void check_float(const conf_case *cc, sl_vm *vm, const sl_instance *inst,
                 fprintf(stderr, "%s: at (u, v) = (%.17g, %.17g): P = (%.17g, %.17g, %.17g), "
                                 "want (%.17g, %.17g, %.17g)\n", cc->file, u, v, P[0], P[1],
                         P[2], want[0], want[1], want[2]);
+            } else if (!cc->no_dual) {
+                check_dual(cc, vm, inst, u, v, P, t);
             }
         }
     }
@@ -643,7 +694,7 @@ static void check_ranges(const conf_case *cc, sl_vm *vm, const sl_instance *inst
 static void test_conformance(void **state)
 {
     (void)state;
-    tally t = { 0, 0, 0, 0, 0 };
+    tally t = { 0, 0, 0, 0, 0, 0, 0 };
     unsigned long long rng = 0x5eed15ULL;
     sl_vm *vm = sl_vm_new(NULL);
     const char *features[64];
@@ -687,8 +738,9 @@ static void test_conformance(void **state)
     printf("conformance: %zu shaders and %zu error cases; features:", ncases, nerrors);
     for (int f = 0; f < nfeatures; f++)
         printf("%s %s", f ? "," : "", features[f]);
-    printf("\nconformance: %d float checks, %d ranges (interval and affine; %d of them "
-           "bounded) with %d samples, %zu diagnostics; %d failures\n", t.floats, t.ranges,
+    printf("\nconformance: %d float checks, %d dual checks (%d derivatives against "
+           "differences), %d ranges (interval and affine; %d of them bounded) with %d "
+           "samples, %zu diagnostics; %d failures\n", t.floats, t.duals, t.derivs, t.ranges,
            t.bounded, t.samples, nerrors, t.failures);
     assert_int_equal(t.failures, 0);
 }
