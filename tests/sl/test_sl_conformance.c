@@ -391,6 +391,52 @@ static void ref_nested_pulsetrain(double u, double v, double o[3])
     o[2] = 0;
 }
 
+static void ref_nested_early_return(double u, double v, double o[3])
+{
+    double c = floor(u * 8);
+    o[0] = c; o[1] = c + 1; o[2] = floor(v * 8);
+}
+
+static void ref_overload_arrays(double u, double v, double o[3])
+{
+    o[0] = u + v + 1; o[1] = u + 2 * v; o[2] = 0;
+}
+
+static void ref_list_array_init(double u, double v, double o[3])
+{
+    o[0] = u; o[1] = v; o[2] = u * v;
+}
+
+static void ref_nested_break_continue(double u, double v, double o[3])
+{
+    (void)v;
+    double n = floor(u * 10), acc = 0;
+    for (int i = 1; i < n; i += 2)
+        acc += i;
+    o[0] = acc; o[1] = 1 + 3 + 5; o[2] = 0;
+}
+
+static void ref_shadow_overload_params(double u, double v, double o[3])
+{
+    o[0] = 10 * v + u; o[1] = 10 * u + v; o[2] = 10 * (2 * u - 1) + (2 * v - 1);
+}
+
+static void ref_extern_write_chain(double u, double v, double o[3])
+{
+    o[0] = (1 + (u > 0.5)) + (1 + (v > 0.5)) + 2; o[1] = 0; o[2] = 0;
+}
+
+static void ref_array_matrices(double u, double v, double o[3])
+{
+    double k = floor(2 * u) + 1;
+    o[0] = k; o[1] = k * v; o[2] = k;
+}
+
+static void ref_nested_shadows_builtin(double u, double v, double o[3])
+{
+    o[0] = 2 * u; o[1] = noise3(u, v, 0); o[2] = 0;
+}
+
 /* ---------------------------------------------------------------------- */
 /* the cases                                                               */
 /* ---------------------------------------------------------------------- */
@@ -449,6 +495,14 @@ static const conf_case cases[] = {
     CASE(array_sort, "arrays"),
     CASE(array_output_fill, "arrays"),
     CASE(array_points, "arrays"),
+    CASE(nested_early_return, "extern of enclosing variables"),
+    CASE(overload_arrays, "overloading by argument type"),
+    CASE(list_array_init, "untyped triples"),
+    CASE(nested_break_continue, "nested functions"),
+    CASE(shadow_overload_params, "shadowed globals"),
+    CASE(extern_write_chain, "extern of enclosing variables"),
+    CASE(array_matrices, "arrays"),
+    CASE(nested_shadows_builtin, "shadowed built-in names"),
 };
 #undef CASE
 #undef CASE_NO_DUAL
