@@ -5,6 +5,7 @@
 #include "sl/ast.h"
 #include "sl/strbuf.h"
 
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -14,6 +15,17 @@
 
 const char *sl_ty_name(sl_ty ty)
 {
+    if (sl_ty_is_array(ty)) {       /* "float[4]", "color[]": a few per thread */
+        static _Thread_local char names[4][32];
+        static _Thread_local int next;
+        char *buf = names[next++ % 4];
+        int len = sl_ty_len(ty);
+        if (len)
+            snprintf(buf, sizeof names[0], "%s[%d]", sl_ty_name(sl_ty_elem(ty)), len);
+        else
+            snprintf(buf, sizeof names[0], "%s[]", sl_ty_name(sl_ty_elem(ty)));
+        return buf;
+    }
     switch (ty) {
     case SL_TYPE_VOID: return "void";
     case SL_TYPE_FLOAT: return "float";
@@ -24,17 +36,21 @@ const char *sl_ty_name(sl_ty ty)
     case SL_TYPE_STRING: return "string";
     case SL_TYPE_MATRIX: return "matrix";
     case SL_TY_BOOL: return "bool";
+    case SL_TY_LIST3: return "untyped triple";
+    case SL_TY_LIST16: return "untyped 16-tuple";
     default: return "<error>";
     }
 }
 
 int sl_ty_slots(sl_ty ty)
 {
+    if (sl_ty_is_array(ty))
+        return sl_ty_len(ty) * sl_ty_slots(sl_ty_elem(ty));
     switch (ty) {
     case SL_TYPE_FLOAT: case SL_TY_BOOL: case SL_TYPE_STRING: return 1;
     case SL_TYPE_POINT: case SL_TYPE_VECTOR: case SL_TYPE_NORMAL:
-    case SL_TYPE_COLOR: return 3;
-    case SL_TYPE_MATRIX: return 16;
+    case SL_TYPE_COLOR: case SL_TY_LIST3: return 3;
+    case SL_TYPE_MATRIX: case SL_TY_LIST16: return 16;
     default: return 0;
     }
 }

@@ -13,7 +13,8 @@
  * Types (sl_ty) are the public sl_type values plus two internal ones:
  * SL_TY_BOOL, the type of comparisons and logical operators (RenderMan's
  * "relation"), and SL_TY_ERROR, the type of an expression that already
- * produced an error (it silences follow-up errors: no cascades).
+ * produced an error (it silences follow-up errors: no cascades), and the
+ * two types of untyped lists (below).
  */
 #ifndef SL_AST_H
 #define SL_AST_H
@@ -27,10 +28,23 @@
 /* ---- types ---- */
 
 typedef int sl_ty;
-enum { SL_TY_BOOL = SL_TYPE_MATRIX + 1, SL_TY_ERROR };
+enum { SL_TY_BOOL = SL_TYPE_MATRIX + 1, SL_TY_ERROR, SL_TY_LIST3, SL_TY_LIST16 };
 
-const char *sl_ty_name(sl_ty ty);            /* "float", "point", "bool" */
-int sl_ty_slots(sl_ty ty);                   /* scalar slots: 1, 3, 16; 0 */
+/* SL_TY_LIST3 / SL_TY_LIST16: an untyped list `(x, y, z)` (16 values: a
+ * matrix) whose type the context has not given yet; the checker retypes
+ * it where it is assigned, passed or returned, or reports it. */
+static inline bool sl_ty_is_list(sl_ty ty) { return ty == SL_TY_LIST3 || ty == SL_TY_LIST16; }
+
+/* Arrays: a flag, the element type and the length (0: an unsized function
+ * parameter `float a[]`, which takes the length of each argument). */
+enum { SL_TY_ARRAY_FLAG = 1 << 24, SL_MAX_ARRAY_LEN = 4095 };
+static inline sl_ty sl_ty_array(sl_ty elem, int len) { return SL_TY_ARRAY_FLAG | elem | (len << 8); }
+static inline bool sl_ty_is_array(sl_ty ty) { return (ty & SL_TY_ARRAY_FLAG) != 0; }
+static inline sl_ty sl_ty_elem(sl_ty ty) { return sl_ty_is_array(ty) ? (ty & 0xff) : ty; }
+static inline int sl_ty_len(sl_ty ty) { return (ty >> 8) & 0xfff; }
+
+const char *sl_ty_name(sl_ty ty);            /* "float", "point", "bool", "float[4]" */
+int sl_ty_slots(sl_ty ty);                   /* scalar slots: 1, 3, 16, n * those; 0 */
 bool sl_ty_is_triple(sl_ty ty);              /* point vector normal color */
 bool sl_ty_is_spatial(sl_ty ty);             /* point vector normal */
 
@@ -58,10 +72,12 @@ typedef struct sl_sym {
     sl_pos pos;
     bool output;        /* output parameter */
     bool writable;      /* may be assigned */
+    bool warned;        /* checker: hidden from a nested function, said once */
     int global;         /* SL_SYM_GLOBAL: the sl_global */
     double value;       /* SL_SYM_CONST */
     int param_index;    /* SL_SYM_PARAM */
     int slot;           /* codegen: first slot (scalar or string file) */
+    int cg_len;         /* codegen: the length bound to an unsized array parameter */
 } sl_sym;
 
 typedef struct sl_node sl_node;
@@ -73,6 +89,8 @@ typedef struct sl_func {
     sl_sym **params;
     int nparams;
     sl_node *body;
+    bool nested;                /* defined inside a function or the shader body */
+    int depth;                  /* checker: block depth of a nested definition (0: file) */
     /* checker */
     struct sl_func **calls;     /* user functions called, for the recursion check */
     int ncalls, calls_cap;
@@ -94,8 +112,11 @@ typedef enum sl_node_kind {
     SL_N_BINARY,     /* op, a, b */
     SL_N_COND,       /* a ? b : c */
     SL_N_ASSIGN,     /* op (= += -= *= /=), a (lvalue), b */
-    SL_N_CAST,       /* cast_ty, name: space or NULL, list: 1, 3 or 16 values */
+    SL_N_CAST,       /* cast_ty, name: space or NULL, list: 1, 3 or 16 values;
+                        cast_ty SL_TYPE_VOID: an untyped list (x, y, z) */
     SL_N_CONV,       /* implicit conversion of a to ty (checker) */
+    SL_N_INDEX,      /* a[b]: a the array (an SL_N_IDENT), b the index */
+    SL_N_ARRAYINIT,  /* { list }: the initializer of an array */
     SL_N_ERROR,      /* an expression that failed to parse (already reported) */
     /* statements */
     SL_N_BLOCK,      /* list */
@@ -109,6 +130,7 @@ typedef enum sl_node_kind {
     SL_N_CONTINUE,   /* num: levels; target: the loop */
     SL_N_RETURN,     /* a: value or NULL; func: the function (NULL: shader) */
     SL_N_EMPTY,
+    SL_N_FUNC,       /* a nested function definition: func (no code of its own) */
 } sl_node_kind;
 
 /* A statement's escape: a break/continue/return inside it that leaves it. */

@@ -134,6 +134,9 @@ static int conversion_cost(sl_ty have, sl_ty want)
 {
     if (have == want)
         return 0;
+    if ((have == SL_TY_LIST3 && sl_ty_is_triple(want)) ||
+        (have == SL_TY_LIST16 && want == SL_TYPE_MATRIX))
+        return 0;
     if (sl_ty_is_spatial(have) && sl_ty_is_spatial(want))
         return 1;
     if (have == SL_TYPE_FLOAT && (sl_ty_is_triple(want) || want == SL_TYPE_MATRIX))
@@ -142,26 +145,38 @@ static int conversion_cost(sl_ty have, sl_ty want)
 }
 
 /* The type the generic letter g (G or T) stands for in this call: the
- * first triple among its arguments, else float (G) / nothing (T). */
-static sl_ty bind_generic(const char *args, char g, const sl_ty *have, int n)
+ * first triple among its arguments; else, when an untyped list (x, y, z)
+ * is among them, the triple the context asks for (hint) or a point; else
+ * float (G) / nothing (T). */
+static sl_ty bind_generic(const char *args, char g, const sl_ty *have, int n, sl_ty hint)
 {
-    for (int i = 0; i < n; i++)
+    bool list = false;
+    for (int i = 0; i < n; i++) {
         if (args[i] == g && sl_ty_is_triple(have[i]))
             return have[i];
+        list |= args[i] == g && have[i] == SL_TY_LIST3;
+    }
+    if (list)
+        return sl_ty_is_triple(hint) ? hint : SL_TYPE_POINT;
     return g == 'G' ? SL_TYPE_FLOAT : SL_TYPE_VOID;
 }
 
 /* Cost of one candidate, filling the wanted argument types; -1: no. */
-static int candidate_cost(const sl_builtin *b, const sl_ty *have, int n, sl_ty *want)
+static int candidate_cost(const sl_builtin *b, const sl_ty *have, int n, sl_ty hint,
+                          sl_ty *want)
 {
     const char *args = strchr(b->sig, ':') + 1;
     if ((int)strlen(args) != n)
         return -1;
-    sl_ty g = bind_generic(args, 'G', have, n);
-    sl_ty t = bind_generic(args, 'T', have, n);
+    sl_ty g = bind_generic(args, 'G', have, n, hint);
+    sl_ty t = bind_generic(args, 'T', have, n, hint);
     int cost = 0;
     for (int i = 0; i < n; i++) {
         char c = args[i];
+        if (c == 'S' && have[i] == SL_TY_LIST3) {     /* (x, y, z) as a point */
+            want[i] = SL_TYPE_POINT;
+            continue;
+        }
         if (c == 'S' || c == 'o') {
             if (!sl_ty_is_spatial(have[i]))
                 return -1;
@@ -196,7 +211,7 @@ const sl_builtin *sl_builtin_resolve(const char *name, const sl_ty *args, int na
     if (nargs > 8)
         return NULL;
     for (int i = 0; i < count; i++) {
-        int cost = candidate_cost(&first[i], args, nargs, want);
+        int cost = candidate_cost(&first[i], args, nargs, hint, want);
         if (cost < 0 || (best && cost >= best_cost))
             continue;
         best = &first[i];
@@ -208,11 +223,11 @@ const sl_builtin *sl_builtin_resolve(const char *name, const sl_ty *args, int na
     char r = best->sig[0];
     const char *sig_args = best->sig + 2;
     if (r == 'A')
-        *result = args[0];
+        *result = arg_types[0];
     else if (r == 'G')
-        *result = bind_generic(sig_args, 'G', args, nargs);
+        *result = bind_generic(sig_args, 'G', args, nargs, hint);
     else if (r == 'T')
-        *result = bind_generic(sig_args, 'T', args, nargs);
+        *result = bind_generic(sig_args, 'T', args, nargs, hint);
     else if (r == 'F')
         *result = sl_ty_is_triple(hint) ? hint : SL_TYPE_FLOAT;
     else

@@ -83,7 +83,8 @@ enum {
     X(BR_END, "br.end", "kt--")                                  \
     X(LOOP_TEST, "loop.test", "xjt-") X(LOOP_END, "loop.end", "kt--") \
     X(PARAM, "param", "zpjx") X(SPARAM, "sparam", "spjs")        \
-    X(ESCAPE, "escape", "zktk") X(ACCUM_END, "accum.end", "kt-k")
+    X(ESCAPE, "escape", "zktk") X(ACCUM_END, "accum.end", "kt-k") \
+    X(ALOAD, "aload", "zxxk") X(ASTORE, "astore", "zxxk")
 
 typedef enum sl_opcode {
 #define SL_OPCODE_ENUM(name, text, operands) SL_OP_##name,
@@ -93,6 +94,18 @@ typedef enum sl_opcode {
 } sl_opcode;
 
 const char *sl_opcode_name(sl_opcode op);
+
+/* ALOAD z, base, index, d / ASTORE base, index, value, d: one lane of an
+ * array element, z = base[index * stride] / base[index * stride] = value,
+ * the index rounded down; d = length | stride code << 12 (code 0, 1, 2:
+ * stride 1, 3, 16). In interval/affine mode every element the index can
+ * reach is read (merged) or written (merged with its old value). */
+enum { SL_ARRAY_LEN_MASK = 0xfff, SL_ARRAY_STRIDE_SHIFT = 12 };
+static inline int sl_array_stride(int d)
+{
+    int code = d >> SL_ARRAY_STRIDE_SHIFT;
+    return code == 0 ? 1 : code == 1 ? 3 : 16;
+}
 
 typedef struct sl_insn {
     uint8_t op;

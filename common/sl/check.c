@@ -9,7 +9,16 @@
  * cross product; comparisons and && || ! give a relation (SL_TY_BOOL).
  * A float used as a condition means "!= 0". Polymorphic noise takes its
  * result type from the context ("hint": a declaration, an assignment, a
- * cast, a parameter, a return).
+ * cast, a parameter, a return), as do untyped lists `(x, y, z)` (typed
+ * late: SL_TY_LIST3/LIST16 until a context retypes them) and user
+ * functions overloaded by return type.
+ *
+ * Scopes (RI Spec 3.2 §14.2): one stack of variables; a function's own
+ * start at func_base, below it are the enclosing scopes of a nested
+ * function, visible only through 'extern'. Nested functions are scoped
+ * like variables (vfuncs); calls resolve among the overloads in scope
+ * (resolve_user, rules in docs/shading-language.md), then the built-ins.
+ * Arrays: fixed-size, indexed by a float; a[i] op= e reads a[i] again.
  *
  * Escapes: every statement records the break/continue/return inside it
  * that leave it (sl_node.escapes). The code generator turns them into flag
@@ -34,6 +43,13 @@ typedef struct checker {
     sl_sym **syms;                 /* scope stack */
     int nsyms, syms_cap;
     int scope_start;               /* first sym of the innermost scope */
+    int func_base;                 /* first sym of the current function */
+    sl_func **vfuncs;              /* nested functions in scope, innermost last */
+    int nvfuncs, vfuncs_cap;
+    int vfuncs_start;              /* first of the innermost scope */
+    int depth;                     /* block depth */
+    sl_func **allfuncs;            /* every function, nested ones too */
+    int nallfuncs, allfuncs_cap;
     sl_func *func;                 /* function being checked (NULL: shader) */
     sl_node **loops;
     int nloops, loops_cap;
@@ -68,9 +84,13 @@ int sl_space_find(const char *name)
 /* scopes                                                                  */
 /* ---------------------------------------------------------------------- */
 
+/* The variable `name` as the current function sees it: its own scopes
+ * (down to func_base), then the predefined variables and PI. Variables of
+ * an enclosing function are seen only through 'extern' (RI Spec 3.2
+ * §14.2), which copies them into the current scope. */
 static sl_sym *lookup(checker *c, const char *name)
 {
-    for (int i = c->nsyms - 1; i >= 0; i--)
+    for (int i = c->nsyms - 1; i >= c->func_base; i--)
         if (strcmp(c->syms[i]->name, name) == 0)
             return c->syms[i];
     int g = sl_global_find(name);
@@ -90,31 +110,86 @@ static void declare(checker *c, sl_sym *sym)
             return;
         }
     }
-    if (sl_global_find(sym->name) >= 0 || strcmp(sym->name, "PI") == 0)
-        error(c, sym->pos, "'%s' is a predefined variable and cannot be redeclared",
-              sym->name);      /* declared anyway: later uses are not errors too */
     sl_list_push(c->arena, (void ***)&c->syms, &c->nsyms, &c->syms_cap, sym);
 }
 
-static int push_scope(checker *c)
+/* A variable of the scopes around the current function (for 'extern' and
+ * for the message when one is used without it), innermost first. */
+static sl_sym *lookup_enclosing(checker *c, const char *name)
 {
-    int saved = c->scope_start;
+    for (int i = c->func_base - 1; i >= 0; i--)
+        if (strcmp(c->syms[i]->name, name) == 0)
+            return c->syms[i];
+    return NULL;
+}
+
+typedef struct scope_mark {
+    int scope_start, vfuncs_start;
+} scope_mark;
+
+static scope_mark push_scope(checker *c)
+{
+    scope_mark saved = { c->scope_start, c->vfuncs_start };
     c->scope_start = c->nsyms;
+    c->vfuncs_start = c->nvfuncs;
+    c->depth++;
     return saved;
 }
 
-static void pop_scope(checker *c, int saved)
+static void pop_scope(checker *c, scope_mark saved)
 {
     c->nsyms = c->scope_start;
-    c->scope_start = saved;
+    c->nvfuncs = c->vfuncs_start;
+    c->scope_start = saved.scope_start;
+    c->vfuncs_start = saved.vfuncs_start;
+    c->depth--;
+}
+
+enum { MAX_OVERLOADS = 32 };
+
+/* The user functions `name` may call here, the overloads: nested ones in
+ * scope (innermost first), then those at file level. Returns how many
+ * (at most max are stored). */
+static int find_funcs(checker *c, const char *name, sl_func **out, int max)
+{
+    int n = 0;
+    for (int i = c->nvfuncs - 1; i >= 0; i--)
+        if (strcmp(c->vfuncs[i]->name, name) == 0 && n < max)
+            out[n++] = c->vfuncs[i];
+    for (int i = 0; i < c->file->nfuncs; i++)
+        if (strcmp(c->file->funcs[i]->name, name) == 0 && n < max)
+            out[n++] = c->file->funcs[i];
+    return n;
 }
 
 static sl_func *find_func(checker *c, const char *name)
 {
-    for (int i = 0; i < c->file->nfuncs; i++)
-        if (strcmp(c->file->funcs[i]->name, name) == 0)
-            return c->file->funcs[i];
-    return NULL;
+    sl_func *f;
+    return find_funcs(c, name, &f, 1) ? f : NULL;
+}
+
+/* Same parameter types (and 'output'-ness) in the same order. */
+static bool same_params(const sl_func *a, const sl_func *b)
+{
+    if (a->nparams != b->nparams)
+        return false;
+    for (int i = 0; i < a->nparams; i++)
+        if (a->params[i]->ty != b->params[i]->ty ||
+            a->params[i]->output != b->params[i]->output)
+            return false;
+    return true;
+}
+
+/* "float f(point, output float)" for a message. */
+static void func_signature(const sl_func *f, char *buf, size_t size)
+{
+    size_t o = (size_t)snprintf(buf, size, "%s %s(", sl_ty_name(f->ret), f->name);
+    for (int i = 0; i < f->nparams && o < size; i++)
+        o += (size_t)snprintf(buf + o, size - o, "%s%s%s", i ? ", " : "",
+                              f->params[i]->output ? "output " : "",
+                              sl_ty_name(f->params[i]->ty));
+    if (o < size)
+        snprintf(buf + o, size - o, ")");
 }
 
 /* ---------------------------------------------------------------------- */
@@ -125,6 +200,10 @@ static bool can_convert(sl_ty have, sl_ty want)
 {
     if (have == want || have == SL_TY_ERROR || want == SL_TY_ERROR)
         return true;
+    if (have == SL_TY_LIST3)
+        return sl_ty_is_triple(want);
+    if (have == SL_TY_LIST16)
+        return want == SL_TYPE_MATRIX;
     if (sl_ty_is_spatial(have) && sl_ty_is_spatial(want))
         return true;
     if (have == SL_TYPE_FLOAT &&
@@ -133,12 +212,32 @@ static bool can_convert(sl_ty have, sl_ty want)
     return false;
 }
 
+/* Gives an untyped list (and the -, ?: and arithmetic over lists around
+ * it) the triple or matrix type `want`. */
+static void retype_list(sl_node *e, sl_ty want)
+{
+    if (!e || !sl_ty_is_list(e->ty))
+        return;
+    e->ty = want;
+    switch (e->kind) {
+    case SL_N_CAST: e->cast_ty = want; break;
+    case SL_N_UNARY: retype_list(e->a, want); break;
+    case SL_N_BINARY: retype_list(e->a, want); retype_list(e->b, want); break;
+    case SL_N_COND: retype_list(e->b, want); retype_list(e->c, want); break;
+    default: break;
+    }
+}
+
 /* Wraps *np in a conversion to `want` (the caller checked can_convert). */
 static void wrap_conv(checker *c, sl_node **np, sl_ty want)
 {
     sl_node *e = *np;
     if (e->ty == want || e->ty == SL_TY_ERROR || want == SL_TY_ERROR)
         return;
+    if (sl_ty_is_list(e->ty)) {
+        retype_list(e, want);
+        return;
+    }
     if (sl_ty_is_spatial(e->ty) && sl_ty_is_spatial(want)) {
         e->ty = want;          /* same slots, another name */
         return;
@@ -147,6 +246,17 @@ static void wrap_conv(checker *c, sl_node **np, sl_ty want)
     conv->a = e;
     conv->ty = want;
     *np = conv;
+}
+
+/* An untyped list where nothing gives it a type: reported. */
+static sl_ty settle(checker *c, sl_node *e)
+{
+    if (!sl_ty_is_list(e->ty))
+        return e->ty;
+    error(c, e->pos, "cannot tell the type of this list of %d values here; put a type in "
+                     "front, as in '%s (...)'", sl_ty_slots(e->ty),
+          e->ty == SL_TY_LIST3 ? "point" : "matrix");
+    return e->ty = SL_TY_ERROR;
 }
 
 static void check_cond(checker *c, sl_node **np)
@@ -177,11 +287,30 @@ static sl_ty check_ident(checker *c, sl_node *n)
 {
     sl_sym *s = lookup(c, n->name);
     if (!s) {
-        if (find_func(c, n->name) || sl_builtin_find(n->name, &(int){ 0 }))
+        sl_sym *outer = lookup_enclosing(c, n->name);
+        if (outer)
+            error(c, n->pos, "'%s' belongs to an enclosing scope; declare it 'extern %s %s;' "
+                             "in function '%s' to use it here", n->name, sl_ty_name(outer->ty),
+                  n->name, c->func->name);
+        else if (find_func(c, n->name) || sl_builtin_find(n->name, &(int){ 0 }))
             error(c, n->pos, "'%s' is a function; call it with '(...)'", n->name);
         else
             error(c, n->pos, "use of undeclared identifier '%s'", n->name);
         return set_ty(n, SL_TY_ERROR);
+    }
+    if (s->kind == SL_SYM_GLOBAL || s->kind == SL_SYM_CONST) {
+        /* a nested function reading `s` while the enclosing code has its
+         * own `s`: the predefined one is meant, as the specification says,
+         * but say so (other renderers may differ) */
+        sl_sym *outer = lookup_enclosing(c, n->name);
+        if (outer && !outer->warned) {
+            outer->warned = true;
+            sl_diag_warning(c->diag, n->pos, "'%s' in function '%s' is the predefined "
+                            "variable, not the enclosing scope's; declare 'extern %s %s;' "
+                            "to use that one", n->name, c->func->name, sl_ty_name(outer->ty),
+                            n->name);
+            sl_diag_note(c->diag, outer->pos, "the enclosing '%s' is declared here", n->name);
+        }
     }
     n->sym = s;
     return set_ty(n, s->ty);
@@ -252,6 +381,24 @@ static sl_ty check_binary(checker *c, sl_node *n)
     sl_ty b = check_expr(c, &n->b, SL_TYPE_VOID);
     if (a == SL_TY_ERROR || b == SL_TY_ERROR)
         return set_ty(n, SL_TY_ERROR);
+    if (sl_ty_is_list(a) || sl_ty_is_list(b)) {
+        /* a typed operand types the list: P + (0, 0, 1) */
+        if (sl_ty_is_list(a) && can_convert(a, b) && !sl_ty_is_list(b))
+            wrap_conv(c, &n->a, a = b);
+        else if (sl_ty_is_list(b) && can_convert(b, a) && !sl_ty_is_list(a))
+            wrap_conv(c, &n->b, b = a);
+        bool arith = op == SL_TOK_PLUS || op == SL_TOK_MINUS || op == SL_TOK_STAR ||
+                     op == SL_TOK_SLASH;
+        sl_ty list = sl_ty_is_list(a) ? a : b, other = sl_ty_is_list(a) ? b : a;
+        /* lists among themselves and with floats stay untyped: (1, 2, 3) * 2 */
+        if (list == SL_TY_LIST3 && arith && (other == list || other == SL_TYPE_FLOAT))
+            return set_ty(n, list);
+        if (sl_ty_is_list(a) && sl_ty_is_list(b) && (op == SL_TOK_EQ || op == SL_TOK_NE) &&
+            a == b)
+            return set_ty(n, SL_TY_BOOL);
+        if (settle(c, n->a) == SL_TY_ERROR || settle(c, n->b) == SL_TY_ERROR)
+            return set_ty(n, SL_TY_ERROR);
+    }
     switch (op) {
     case SL_TOK_PLUS: case SL_TOK_MINUS: case SL_TOK_STAR: case SL_TOK_SLASH:
         return set_ty(n, arith_type(c, n, a, b));
@@ -279,7 +426,8 @@ static sl_ty check_unary(checker *c, sl_node *n)
         return set_ty(n, SL_TY_BOOL);
     }
     sl_ty a = check_expr(c, &n->a, SL_TYPE_VOID);
-    if (a == SL_TY_ERROR || a == SL_TYPE_FLOAT || sl_ty_is_triple(a) || a == SL_TYPE_MATRIX)
+    if (a == SL_TY_ERROR || a == SL_TYPE_FLOAT || sl_ty_is_triple(a) || a == SL_TYPE_MATRIX ||
+        sl_ty_is_list(a))
         return set_ty(n, a);
     error(c, n->pos, "invalid argument type '%s' to unary '-'", sl_ty_name(a));
     return set_ty(n, SL_TY_ERROR);
@@ -289,6 +437,10 @@ static sl_ty check_unary(checker *c, sl_node *n)
 static sl_ty unify(sl_ty a, sl_ty b)
 {
     if (a == b)
+        return a;
+    if (sl_ty_is_list(a) && !sl_ty_is_list(b) && can_convert(a, b))
+        return b;
+    if (sl_ty_is_list(b) && !sl_ty_is_list(a) && can_convert(b, a))
         return a;
     if (a == SL_TYPE_FLOAT && (sl_ty_is_triple(b) || b == SL_TYPE_MATRIX))
         return b;
@@ -332,24 +484,74 @@ static bool check_assignable(checker *c, sl_node *lhs, const char *what)
     return false;
 }
 
+/* A constant index: its value, true; false when the index varies. */
+static bool const_index(const sl_node *x, double *k)
+{
+    if (x->kind == SL_N_NUM) {
+        *k = floor(x->num);
+        return true;
+    }
+    if (x->kind == SL_N_UNARY && x->op == SL_TOK_MINUS && x->a->kind == SL_N_NUM) {
+        *k = floor(-x->a->num);
+        return true;
+    }
+    return false;
+}
+
+/* a[i]: a an array variable, i a float (rounded down); a constant index
+ * must lie inside a sized array. n->num != 0: the index node is shared
+ * with the target of `a[i] op= e` and already checked. */
+static sl_ty check_index(checker *c, sl_node *n)
+{
+    sl_ty at = check_ident(c, n->a);
+    sl_ty it = n->num != 0 ? n->b->ty : check_expr(c, &n->b, SL_TYPE_FLOAT);
+    if (at == SL_TY_ERROR || it == SL_TY_ERROR)
+        return set_ty(n, SL_TY_ERROR);
+    if (!sl_ty_is_array(at)) {
+        error(c, n->pos, "'%s' is not an array (it is a '%s')", n->a->name, sl_ty_name(at));
+        return set_ty(n, SL_TY_ERROR);
+    }
+    if (it != SL_TYPE_FLOAT) {
+        error(c, n->b->pos, "an array index must be a float, not '%s'", sl_ty_name(it));
+        return set_ty(n, SL_TY_ERROR);
+    }
+    double k;
+    int len = sl_ty_len(at);
+    if (len > 0 && const_index(n->b, &k) && !(k >= 0 && k < len)) {
+        error(c, n->b->pos, "array index %g is out of range for '%s' (%s: 0 to %d)", k,
+              n->a->name, sl_ty_name(at), len - 1);
+        return set_ty(n, SL_TY_ERROR);
+    }
+    return set_ty(n, sl_ty_elem(at));
+}
+
 static sl_ty check_assign(checker *c, sl_node *n)
 {
     sl_node *lhs = n->a;
-    if (lhs->kind != SL_N_IDENT)
+    if (lhs->kind != SL_N_IDENT && lhs->kind != SL_N_INDEX)
         return set_ty(n, SL_TY_ERROR);
-    sl_ty lt = check_ident(c, lhs);
+    bool element = lhs->kind == SL_N_INDEX;
+    sl_node *var = element ? lhs->a : lhs;
+    sl_ty lt = element ? check_index(c, lhs) : check_ident(c, lhs);
     if (lt == SL_TY_ERROR) {
         check_expr(c, &n->b, SL_TYPE_VOID);
         return set_ty(n, SL_TY_ERROR);
     }
-    check_assignable(c, lhs, "assign to");
+    check_assignable(c, var, "assign to");
     if (n->op != SL_TOK_ASSIGN) {     /* x op= e  ->  x = x op e */
         sl_node *bin = sl_node_new(c->arena, SL_N_BINARY, n->pos);
         bin->op = n->op == SL_TOK_PLUS_ASSIGN ? SL_TOK_PLUS
                 : n->op == SL_TOK_MINUS_ASSIGN ? SL_TOK_MINUS
                 : n->op == SL_TOK_STAR_ASSIGN ? SL_TOK_STAR : SL_TOK_SLASH;
-        sl_node *read = sl_node_new(c->arena, SL_N_IDENT, lhs->pos);
-        read->name = lhs->name;
+        sl_node *read = sl_node_new(c->arena, SL_N_IDENT, var->pos);
+        read->name = var->name;
+        if (element) {                /* a[i] op= e: the index is evaluated twice */
+            sl_node *x = sl_node_new(c->arena, SL_N_INDEX, lhs->pos);
+            x->a = read;
+            x->b = lhs->b;
+            x->num = 1;
+            read = x;
+        }
         bin->a = read;
         bin->b = n->b;
         n->b = bin;
@@ -357,8 +559,8 @@ static sl_ty check_assign(checker *c, sl_node *n)
     }
     sl_ty rt = check_expr(c, &n->b, lt);
     if (!can_convert(rt, lt)) {
-        error(c, n->b->pos, "cannot assign a value of type '%s' to '%s' (%s)",
-              sl_ty_name(rt), lhs->name, sl_ty_name(lt));
+        error(c, n->b->pos, "cannot assign a value of type '%s' to '%s%s' (%s)",
+              sl_ty_name(rt), var->name, element ? "[...]" : "", sl_ty_name(lt));
         return set_ty(n, SL_TY_ERROR);
     }
     wrap_conv(c, &n->b, lt);
@@ -420,6 +622,17 @@ static void add_call_edge(checker *c, sl_func *callee)
                  &c->func->calls_cap, callee);
 }
 
+/* An array argument for an array parameter: the same element type and
+ * length; an unsized parameter takes any length (an unsized argument is
+ * checked when the call is inlined, where its length is known). */
+static bool array_arg_ok(sl_ty param, sl_ty arg)
+{
+    if (!sl_ty_is_array(param) || !sl_ty_is_array(arg) ||
+        sl_ty_elem(param) != sl_ty_elem(arg))
+        return false;
+    return sl_ty_len(param) == 0 || sl_ty_len(arg) == 0 || sl_ty_len(param) == sl_ty_len(arg);
+}
+
 static sl_ty check_user_call(checker *c, sl_node *n, sl_func *f, const sl_ty *args)
 {
     n->func = f;
@@ -435,6 +648,17 @@ static sl_ty check_user_call(checker *c, sl_node *n, sl_func *f, const sl_ty *ar
         sl_sym *p = f->params[i];
         if (args[i] == SL_TY_ERROR) {
             ok = false;
+            continue;
+        }
+        if (sl_ty_is_array(p->ty) || sl_ty_is_array(args[i])) {
+            if (!array_arg_ok(p->ty, args[i])) {
+                error(c, n->list[i]->pos, "argument %d of '%s': cannot pass a '%s' to a "
+                                          "parameter of type '%s'", i + 1, f->name,
+                      sl_ty_name(args[i]), sl_ty_name(p->ty));
+                ok = false;
+            } else if (p->output) {
+                check_assignable(c, n->list[i], "modify");
+            }
             continue;
         }
         if (p->output) {
@@ -465,11 +689,143 @@ static sl_ty check_user_call(checker *c, sl_node *n, sl_func *f, const sl_ty *ar
     return set_ty(n, ok ? f->ret : SL_TY_ERROR);
 }
 
+/* Cost of passing an argument of type `have` to parameter p; -1: not
+ * viable. As for the built-ins (builtins.c): exact 0, point/vector/normal
+ * as another of the three 1, a float promoted 2; an 'output' parameter
+ * takes a variable of its own type (or another spatial type, cost 1). */
+static int param_cost(const sl_sym *p, sl_ty have)
+{
+    if (sl_ty_is_array(p->ty) || sl_ty_is_array(have))
+        return array_arg_ok(p->ty, have) ? 0 : -1;
+    if (have == p->ty)
+        return 0;
+    if (sl_ty_is_list(have))
+        return !p->output && can_convert(have, p->ty) ? 0 : -1;
+    if (sl_ty_is_spatial(have) && sl_ty_is_spatial(p->ty))
+        return 1;
+    if (p->output)
+        return -1;
+    if (have == SL_TYPE_FLOAT && (sl_ty_is_triple(p->ty) || p->ty == SL_TYPE_MATRIX))
+        return 2;
+    return -1;
+}
+
+/* Keeps the candidates for which keep() holds, when any does. */
+static int narrow(sl_func **f, int n, bool (*keep)(const sl_func *, sl_ty), sl_ty hint)
+{
+    int k = 0;
+    for (int i = 0; i < n; i++)
+        if (keep(f[i], hint))
+            f[k++] = f[i];
+    return k ? k : n;
+}
+static bool returns_exactly(const sl_func *f, sl_ty hint) { return f->ret == hint; }
+static bool returns_convertible(const sl_func *f, sl_ty hint)
+{
+    return can_convert(f->ret, hint) && f->ret != SL_TYPE_VOID;
+}
+
+/* Overload resolution among user functions (see docs/shading-language.md):
+ * the viable candidate of least total conversion cost; of equally cheap
+ * ones, those returning the type the context asks for (hint), then those
+ * returning a type convertible to it, then the innermost definitions. A
+ * tie left after that is an error. NULL: none viable (not reported) or
+ * ambiguous (reported, *ambiguous set). */
+static sl_func *resolve_user(checker *c, sl_node *n, sl_func **cands, int ncands,
+                             const sl_ty *args, sl_ty hint, bool *ambiguous)
+{
+    sl_func *best[MAX_OVERLOADS];
+    int nbest = 0, best_cost = 0;
+    *ambiguous = false;
+    for (int k = 0; k < ncands; k++) {
+        sl_func *f = cands[k];
+        if (f->nparams != n->nlist)
+            continue;
+        int cost = 0;
+        for (int i = 0; i < n->nlist && cost >= 0; i++) {
+            int ci = param_cost(f->params[i], args[i]);
+            cost = ci < 0 ? -1 : cost + ci;
+        }
+        if (cost < 0 || (nbest > 0 && cost > best_cost))
+            continue;
+        if (nbest == 0 || cost < best_cost)
+            nbest = 0;
+        best_cost = cost;
+        best[nbest++] = f;
+    }
+    if (nbest > 1 && hint != SL_TYPE_VOID && hint != SL_TY_ERROR) {
+        nbest = narrow(best, nbest, returns_exactly, hint);
+        nbest = narrow(best, nbest, returns_convertible, hint);
+    }
+    if (nbest > 1) {
+        int deepest = 0, k = 0;
+        for (int i = 0; i < nbest; i++)
+            deepest = best[i]->depth > deepest ? best[i]->depth : deepest;
+        for (int i = 0; i < nbest; i++)
+            if (best[i]->depth == deepest)
+                best[k++] = best[i];
+        nbest = k;
+    }
+    if (nbest == 1)
+        return best[0];
+    if (nbest > 1) {
+        *ambiguous = true;
+        error(c, n->pos, "call to '%s' is ambiguous", n->name);
+        for (int i = 0; i < nbest; i++) {
+            char sig[256];
+            func_signature(best[i], sig, sizeof sig);
+            sl_diag_note(c->diag, best[i]->pos, "candidate: %s", sig);
+        }
+    }
+    return NULL;
+}
+
+static void no_match(checker *c, sl_node *n, const sl_ty *args, sl_func **cands, int ncands,
+                     bool builtin)
+{
+    char list[256] = "";
+    for (int i = 0; i < n->nlist; i++) {
+        size_t len = strlen(list);
+        snprintf(list + len, sizeof list - len, "%s%s", i ? ", " : "", sl_ty_name(args[i]));
+    }
+    error(c, n->pos, "no matching function for call to '%s' with arguments (%s)", n->name,
+          list);
+    for (int i = 0; i < ncands; i++) {
+        char sig[256];
+        func_signature(cands[i], sig, sizeof sig);
+        sl_diag_note(c->diag, cands[i]->pos, "candidate: %s", sig);
+    }
+    if (builtin) {
+        char names[512];
+        sl_builtin_candidates(n->name, names, sizeof names);
+        sl_diag_note(c->diag, n->pos, "built-in candidates are: %s", names);
+    }
+}
+
+/* arraylength(a): the number of elements of an array (a constant where
+ * the array's length is; an unsized parameter's is known per call). */
+static sl_ty check_arraylength(checker *c, sl_node *n)
+{
+    for (int i = 0; i < n->nlist; i++)
+        check_expr(c, &n->list[i], SL_TYPE_VOID);
+    if (n->nlist != 1 || !sl_ty_is_array(n->list[0]->ty) ||
+        n->list[0]->kind != SL_N_IDENT) {
+        if (n->nlist != 1 || n->list[0]->ty != SL_TY_ERROR)
+            error(c, n->pos, "arraylength() takes one array variable");
+        return set_ty(n, SL_TY_ERROR);
+    }
+    return set_ty(n, SL_TYPE_FLOAT);
+}
+
 static sl_ty check_call(checker *c, sl_node *n, sl_ty hint)
 {
-    sl_func *f = find_func(c, n->name);
+    sl_func *cands[MAX_OVERLOADS];
+    int ncands = find_funcs(c, n->name, cands, MAX_OVERLOADS);
+    if (ncands == 0 && strcmp(n->name, "arraylength") == 0)
+        return check_arraylength(c, n);
     int count;
-    if (!f && !sl_builtin_find(n->name, &count)) {
+    bool builtin = sl_builtin_find(n->name, &count) != NULL;
+    if (!ncands && !builtin) {
         for (int i = 0; i < n->nlist; i++)
             check_expr(c, &n->list[i], SL_TYPE_VOID);
         if (lookup(c, n->name))
@@ -485,15 +841,65 @@ static sl_ty check_call(checker *c, sl_node *n, sl_ty hint)
     sl_ty args[8];
     bool bad = false;
     for (int i = 0; i < n->nlist; i++) {
-        sl_ty h = f && i < f->nparams ? f->params[i]->ty : SL_TYPE_VOID;
-        args[i] = check_expr(c, &n->list[i], h);
+        /* the parameter type as a hint, when the overloads of this arity agree */
+        sl_ty h = SL_TY_ERROR;
+        for (int k = 0; k < ncands; k++) {
+            if (cands[k]->nparams != n->nlist)
+                continue;
+            sl_ty pt = cands[k]->params[i]->ty;
+            h = h == SL_TY_ERROR || h == pt ? pt : SL_TYPE_VOID;
+        }
+        args[i] = check_expr(c, &n->list[i], h == SL_TY_ERROR ? SL_TYPE_VOID : h);
         bad |= args[i] == SL_TY_ERROR;
     }
-    if (f)
-        return check_user_call(c, n, f, args);
+    if (ncands == 1 && !builtin)     /* one function: its own, precise messages */
+        return check_user_call(c, n, cands[0], args);
     if (bad)
         return set_ty(n, SL_TY_ERROR);
-    return check_builtin_call(c, n, args, hint);
+    if (ncands) {
+        bool ambiguous;
+        sl_func *f = resolve_user(c, n, cands, ncands, args, hint, &ambiguous);
+        if (ambiguous)
+            return set_ty(n, SL_TY_ERROR);
+        if (f)
+            return check_user_call(c, n, f, args);
+    }
+    sl_ty want[8], result;
+    if (builtin && (!ncands || sl_builtin_resolve(n->name, args, n->nlist, hint, want, &result)))
+        return check_builtin_call(c, n, args, hint);
+    no_match(c, n, args, cands, ncands, builtin);
+    return set_ty(n, SL_TY_ERROR);
+}
+
+/* (x, y, z) or 16 values without a type: a triple or matrix of the type
+ * the context asks for (hint), else an untyped list for the context to
+ * type later (RI Spec 3.2 §13: "the type of a parenthesised triple is
+ * taken from its context"). */
+static sl_ty check_untyped_list(checker *c, sl_node *n, sl_ty hint)
+{
+    bool bad = false;
+    for (int i = 0; i < n->nlist; i++)
+        bad |= check_expr(c, &n->list[i], SL_TYPE_FLOAT) == SL_TY_ERROR;
+    if (bad)
+        return SL_TY_ERROR;
+    if (n->nlist != 3 && n->nlist != 16) {
+        error(c, n->pos, "a list of %d values is neither a triple (3 values) nor a "
+                         "matrix (16)", n->nlist);
+        return SL_TY_ERROR;
+    }
+    for (int i = 0; i < n->nlist; i++) {
+        if (n->list[i]->ty != SL_TYPE_FLOAT) {
+            error(c, n->list[i]->pos, "component %d of a list must be a float, not '%s'",
+                  i + 1, sl_ty_name(n->list[i]->ty));
+            return SL_TY_ERROR;
+        }
+    }
+    sl_ty list = n->nlist == 3 ? SL_TY_LIST3 : SL_TY_LIST16;
+    if (can_convert(list, hint)) {
+        n->cast_ty = hint;
+        return hint;
+    }
+    return list;
 }
 
 static sl_ty check_cast_values(checker *c, sl_node *n)
@@ -532,8 +938,10 @@ static sl_ty check_cast_values(checker *c, sl_node *n)
     return ty;
 }
 
-static sl_ty check_cast(checker *c, sl_node *n)
+static sl_ty check_cast(checker *c, sl_node *n, sl_ty hint)
 {
+    if (n->cast_ty == SL_TYPE_VOID || sl_ty_is_list(n->cast_ty))
+        return set_ty(n, check_untyped_list(c, n, hint));
     sl_ty ty = check_cast_values(c, n);
     if (ty == SL_TY_ERROR || !n->name)
         return set_ty(n, ty);
@@ -568,7 +976,8 @@ static sl_ty check_expr(checker *c, sl_node **np, sl_ty hint)
     case SL_N_BINARY: return check_binary(c, n);
     case SL_N_COND: return check_cond_expr(c, n, hint);
     case SL_N_ASSIGN: return check_assign(c, n);
-    case SL_N_CAST: return check_cast(c, n);
+    case SL_N_CAST: return check_cast(c, n, hint);
+    case SL_N_INDEX: return check_index(c, n);
     case SL_N_CONV: return n->ty;
     default: return set_ty(n, SL_TY_ERROR);
     }
@@ -605,35 +1014,83 @@ static void inherit(checker *c, sl_node *n, const sl_node *child, const sl_node 
             add_escape(c, n, child->escapes[i]);
 }
 
+/* The initializer (or shader parameter default) v->a of variable s: an
+ * expression of a convertible type, or for an array '{ values }' (one per
+ * element; an array declared without a size takes their number). */
+static void check_init(checker *c, sl_node *v, sl_sym *s)
+{
+    sl_node *init = v->a;
+    if (init && init->kind == SL_N_ARRAYINIT) {
+        if (!sl_ty_is_array(s->ty)) {
+            error(c, init->pos, "cannot initialize '%s' (%s) with a list in braces", s->name,
+                  sl_ty_name(s->ty));
+            return;
+        }
+        sl_ty elem = sl_ty_elem(s->ty);
+        int len = sl_ty_len(s->ty);
+        if (len == 0 && init->nlist > 0 && init->nlist <= SL_MAX_ARRAY_LEN)
+            s->ty = sl_ty_array(elem, len = init->nlist);
+        init->ty = s->ty;
+        for (int i = 0; i < init->nlist; i++) {
+            sl_ty t = check_expr(c, &init->list[i], elem);
+            if (!can_convert(t, elem)) {
+                error(c, init->list[i]->pos, "element %d of '%s' (%s) cannot be a '%s'", i + 1,
+                      s->name, sl_ty_name(s->ty), sl_ty_name(t));
+                return;
+            }
+            wrap_conv(c, &init->list[i], elem);
+        }
+        if (init->nlist != len)
+            error(c, init->pos, "'%s' has %d elements, but %d value%s given", s->name, len,
+                  init->nlist, init->nlist == 1 ? " is" : "s are");
+        return;
+    }
+    if (init) {
+        sl_ty t = check_expr(c, &v->a, s->ty);
+        if (!can_convert(t, s->ty))
+            error(c, v->a->pos, "cannot initialize '%s' (%s) with a value of type '%s'",
+                  s->name, sl_ty_name(s->ty), sl_ty_name(t));
+        else
+            wrap_conv(c, &v->a, s->ty);
+    }
+    if (sl_ty_is_array(s->ty) && sl_ty_len(s->ty) == 0)
+        error(c, v->pos, "array '%s' needs a size or an initializer", s->name);
+}
+
 static void check_decl(checker *c, sl_node *n)
 {
     for (int i = 0; i < n->nlist; i++) {
         sl_node *v = n->list[i];
         sl_sym *s = v->sym;
         if (v->num != 0) {            /* extern */
-            sl_sym *outer = lookup(c, s->name);
-            if (!outer || outer->kind != SL_SYM_GLOBAL) {
-                error(c, v->pos, "'extern' may only name a predefined variable here "
-                                 "(pass '%s' as a parameter instead)", s->name);
+            sl_sym *outer = lookup_enclosing(c, s->name);
+            if (!outer) {
+                outer = lookup(c, s->name);
+                if (outer && outer->kind != SL_SYM_GLOBAL)
+                    outer = NULL;         /* a variable of this very function */
+            }
+            if (!outer) {
+                error(c, v->pos, c->func && c->func->nested
+                          ? "'extern' names no variable '%s' of an enclosing scope"
+                          : "'extern' may only name a predefined variable here "
+                            "(pass '%s' as a parameter instead)", s->name);
                 s->kind = SL_SYM_LOCAL;     /* declared anyway: no follow-up errors */
                 declare(c, s);
                 v->num = 0;
                 continue;
-            } else if (outer->ty != s->ty)
+            } else if (outer->ty != s->ty &&
+                       !(sl_ty_is_array(s->ty) && sl_ty_len(s->ty) == 0 &&
+                         sl_ty_is_array(outer->ty) &&
+                         sl_ty_elem(outer->ty) == sl_ty_elem(s->ty)))
                 error(c, v->pos, "'extern' declaration of '%s' as '%s' does not match its "
                                  "type '%s'", s->name, sl_ty_name(s->ty),
                       sl_ty_name(outer->ty));
             v->sym = NULL;
+            if (outer->kind != SL_SYM_GLOBAL && outer->kind != SL_SYM_CONST)
+                declare(c, outer);        /* the enclosing variable itself */
             continue;
         }
-        if (v->a) {
-            sl_ty t = check_expr(c, &v->a, s->ty);
-            if (!can_convert(t, s->ty))
-                error(c, v->a->pos, "cannot initialize '%s' (%s) with a value of type '%s'",
-                      s->name, sl_ty_name(s->ty), sl_ty_name(t));
-            else
-                wrap_conv(c, &v->a, s->ty);
-        }
+        check_init(c, v, s);
         declare(c, s);
     }
 }
@@ -688,13 +1145,15 @@ static void check_return(checker *c, sl_node *n)
     add_escape(c, n, e);
 }
 
+static void check_nested_function(checker *c, sl_func *f);
+
 static void check_stmt(checker *c, sl_node *n)
 {
     if (!n || sl_diag_full(c->diag))
         return;
     switch (n->kind) {
     case SL_N_BLOCK: {
-        int saved = push_scope(c);
+        scope_mark saved = push_scope(c);
         for (int i = 0; i < n->nlist; i++) {
             check_stmt(c, n->list[i]);
             inherit(c, n, n->list[i], NULL);
@@ -716,7 +1175,7 @@ static void check_stmt(checker *c, sl_node *n)
         check_loop_body(c, n, n->b);
         break;
     case SL_N_FOR: {
-        int saved = push_scope(c);
+        scope_mark saved = push_scope(c);
         if (n->a)
             check_stmt(c, n->a);
         if (n->b)
@@ -729,6 +1188,7 @@ static void check_stmt(checker *c, sl_node *n)
     }
     case SL_N_BREAK: case SL_N_CONTINUE: check_loop_mod(c, n); break;
     case SL_N_RETURN: check_return(c, n); break;
+    case SL_N_FUNC: check_nested_function(c, n->func); break;
     default: break;
     }
 }
@@ -769,21 +1229,63 @@ static bool needs_ret_flag(sl_node *body)
 /* functions, recursion, the shader                                        */
 /* ---------------------------------------------------------------------- */
 
-static void check_function(checker *c, sl_func *f)
+/* The parameters and body of f, in a scope of their own above the
+ * current one (func_base: the variables below it are the enclosing ones). */
+static void check_function_body(checker *c, sl_func *f)
 {
+    sl_list_push(c->arena, (void ***)&c->allfuncs, &c->nallfuncs, &c->allfuncs_cap, f);
     c->func = f;
-    c->nsyms = 0;
-    c->scope_start = 0;
+    c->func_base = c->nsyms;
+    scope_mark saved = push_scope(c);
     for (int i = 0; i < f->nparams; i++)
         declare(c, f->params[i]);
     check_stmt(c, f->body);
+    pop_scope(c, saved);
     f->needs_ret_flag = needs_ret_flag(f->body);
     if (f->ret != SL_TYPE_VOID) {
         int count = 0;
         if (!count_returns(f->body, &count))
             error(c, f->pos, "non-void function '%s' has no 'return' statement", f->name);
     }
+}
+
+static void check_function(checker *c, sl_func *f)
+{
+    c->nsyms = c->scope_start = 0;
+    c->nvfuncs = c->vfuncs_start = 0;
+    check_function_body(c, f);
     c->func = NULL;
+    c->func_base = 0;
+}
+
+/* A function defined inside a function or the shader body: callable from
+ * its definition to the end of the enclosing block (its own body
+ * included, so that recursion is reported as such), seeing the enclosing
+ * variables through 'extern' only. */
+static void check_nested_function(checker *c, sl_func *f)
+{
+    f->depth = c->depth;
+    for (int i = c->vfuncs_start; i < c->nvfuncs; i++) {
+        sl_func *g = c->vfuncs[i];
+        if (strcmp(g->name, f->name) == 0 && same_params(f, g) && f->ret == g->ret) {
+            error(c, f->pos, "redefinition of function '%s'", f->name);
+            sl_diag_note(c->diag, c->vfuncs[i]->pos, "previous definition is here");
+            return;
+        }
+    }
+    sl_list_push(c->arena, (void ***)&c->vfuncs, &c->nvfuncs, &c->vfuncs_cap, f);
+    sl_func *saved_func = c->func;
+    int saved_base = c->func_base;
+    sl_node **saved_loops = c->loops;           /* break cannot leave a function */
+    int saved_nloops = c->nloops, saved_cap = c->loops_cap;
+    c->loops = NULL;
+    c->nloops = c->loops_cap = 0;
+    check_function_body(c, f);
+    c->loops = saved_loops;
+    c->nloops = saved_nloops;
+    c->loops_cap = saved_cap;
+    c->func = saved_func;
+    c->func_base = saved_base;
 }
 
 /* Depth-first search for a cycle through f; reports the chain. */
@@ -815,12 +1317,11 @@ static bool find_cycle(checker *c, sl_func *f, sl_func **path, int depth)
 
 static void check_recursion(checker *c)
 {
-    sl_func **path = sl_arena_alloc(c->arena,
-                                    (size_t)(c->file->nfuncs + 2) * sizeof *path);
-    for (int i = 0; i < c->file->nfuncs; i++) {
-        if (find_cycle(c, c->file->funcs[i], path, 0)) {
-            for (int j = 0; j < c->file->nfuncs; j++)
-                c->file->funcs[j]->mark = 2;
+    sl_func **path = sl_arena_alloc(c->arena, (size_t)(c->nallfuncs + 2) * sizeof *path);
+    for (int i = 0; i < c->nallfuncs; i++) {
+        if (find_cycle(c, c->allfuncs[i], path, 0)) {
+            for (int j = 0; j < c->nallfuncs; j++)
+                c->allfuncs[j]->mark = 2;
             return;
         }
     }
@@ -831,7 +1332,8 @@ static void check_duplicate(checker *c, int i)
 {
     sl_func *f = c->file->funcs[i];
     for (int j = 0; j < i; j++) {
-        if (strcmp(f->name, c->file->funcs[j]->name) == 0) {
+        sl_func *g = c->file->funcs[j];
+        if (strcmp(f->name, g->name) == 0 && same_params(f, g) && f->ret == g->ret) {
             error(c, f->pos, "redefinition of function '%s'", f->name);
             sl_diag_note(c->diag, c->file->funcs[j]->pos, "previous definition is here");
             return;
@@ -870,18 +1372,12 @@ static void make_globals(checker *c)
 static void check_shader(checker *c)
 {
     sl_ast_file *f = c->file;
-    c->nsyms = 0;
-    c->scope_start = 0;
+    c->nsyms = c->scope_start = c->func_base = 0;
+    c->nvfuncs = c->vfuncs_start = 0;
+    c->func = NULL;
     for (int i = 0; i < f->nparams; i++) {
         sl_node *v = f->params[i];
-        if (v->a) {
-            sl_ty t = check_expr(c, &v->a, v->sym->ty);
-            if (!can_convert(t, v->sym->ty))
-                error(c, v->a->pos, "cannot initialize '%s' (%s) with a value of type '%s'",
-                      v->sym->name, sl_ty_name(v->sym->ty), sl_ty_name(t));
-            else
-                wrap_conv(c, &v->a, v->sym->ty);
-        }
+        check_init(c, v, v->sym);
         declare(c, v->sym);
     }
     if (f->body) {

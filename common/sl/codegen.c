@@ -24,7 +24,12 @@
  *
  * User functions are inlined at each call: parameters are bound to the
  * argument slots (by reference, as in RenderMan), the result goes to a
- * fresh slot.
+ * fresh slot. A nested function's extern variables are the enclosing
+ * function's symbols, whose slots are those of the call being generated.
+ *
+ * Arrays occupy length * element slots; a constant index addresses an
+ * element directly, a varying one goes through ALOAD/ASTORE lane by lane,
+ * and a store puts the whole array in the enclosing merge table.
  */
 #include "sl/codegen.h"
 #include "sl/builtins.h"
@@ -298,6 +303,7 @@ static int written_count(const sl_insn *in, const sl_program *p)
         return 3;
     case SL_OP_SPACE: case SL_OP_SPACEK: case SL_OP_MINVERT: return 16;
     case SL_OP_PARAM: return p->params[in->b].size;
+    case SL_OP_ASTORE: return 0;     /* the whole array: recorded by gen_store */
     case SL_OP_END: case SL_OP_SMOV: case SL_OP_SPARAM: case SL_OP_JMP:
     case SL_OP_BR_BEGIN: case SL_OP_BR_ELSE: case SL_OP_BR_END:
     case SL_OP_LOOP_TEST: case SL_OP_LOOP_END: case SL_OP_ACCUM_END:
@@ -653,8 +659,89 @@ static int gen_cond_expr(cg *g, sl_node *e, int dst)
     return z;
 }
 
+/* ---------------------------------------------------------------------- */
+/* arrays                                                                  */
+/* ---------------------------------------------------------------------- */
+
+/* The length of array variable s here (an unsized parameter: its argument's). */
+static int array_len(const sl_sym *s)
+{
+    int len = sl_ty_len(s->ty);
+    return len ? len : s->cg_len;
+}
+
+static int array_operand(int len, int stride)
+{
+    int code = stride == 1 ? 0 : stride == 3 ? 1 : 2;
+    return len | code << SL_ARRAY_STRIDE_SHIFT;
+}
+
+/* The element a constant index names, or -1 (reported) out of range. */
+static int const_element(cg *g, const sl_node *x, int index, int len)
+{
+    double k = floor(g->prog->consts[index & ~CONST_TAG]);
+    if (!(k >= 0 && k < len)) {
+        fail(g, "array index %g is out of range for '%s' (0 to %d)", k, x->a->name, len - 1);
+        return -1;
+    }
+    return (int)k;
+}
+
+/* a[i] (x) into dst: a constant index addresses the element's slots, a
+ * varying one loads lane by lane (paper §4: in range modes the merge of
+ * every element the index can reach). */
+static int gen_index(cg *g, sl_node *x, int dst)
+{
+    const sl_sym *s = x->a->sym;
+    int len = array_len(s), n = size_of(x);
+    int i = gen_expr(g, x->b, -1);
+    if (i & CONST_TAG) {
+        int k = const_element(g, x, i, len);
+        return k < 0 ? 0 : into(g, s->slot + k * n, dst, n);
+    }
+    /* lanes write z in turn: z must not hold the index */
+    int z = dst >= 0 && !(i >= dst && i < dst + n) ? dst : alloc_slots(g, n);
+    for (int k = 0; k < n; k++)
+        emit(g, SL_OP_ALOAD, z + k, s->slot + k, i, array_operand(len, n));
+    return into(g, z, dst, n);
+}
+
+/* a[i] = v: v's slots (size n) stored; every element may change. */
+static int gen_store(cg *g, sl_node *x, sl_node *value, int dst)
+{
+    const sl_sym *s = x->a->sym;
+    int len = array_len(s), n = size_of(x);
+    int i = gen_expr(g, x->b, -1);
+    int v = gen_expr(g, value, -1);
+    if (i & CONST_TAG) {
+        int k = const_element(g, x, i, len);
+        if (k < 0)
+            return 0;
+        emit_mov(g, s->slot + k * n, v, n);
+        return into(g, s->slot + k * n, dst, n);
+    }
+    for (int k = 0; k < n; k++)
+        emit(g, SL_OP_ASTORE, s->slot + k, i, v + k, array_operand(len, n));
+    record_write(g, s->slot, len * n);
+    return into(g, v, dst, n);
+}
+
+/* { values } into the array at dst. */
+static int gen_array_init(cg *g, sl_node *e, int dst)
+{
+    int n = sl_ty_slots(sl_ty_elem(e->ty));
+    for (int i = 0; i < e->nlist; i++) {
+        int mark = g->sp;
+        gen_expr(g, e->list[i], dst + i * n);
+        g->sp = mark;
+    }
+    return dst;
+}
+
 static int gen_assign(cg *g, sl_node *e, int dst)
 {
+    if (e->a->kind == SL_N_INDEX)
+        return gen_store(g, e->a, e->b, dst);
     sl_sym *s = e->a->sym;
     if (s->ty == SL_TYPE_STRING) {
         int v = gen_expr(g, e->b, -1);
@@ -976,8 +1063,19 @@ static int gen_user_call(cg *g, sl_node *e, int dst)
     }
     for (int i = 0; i < e->nlist; i++)
         args[i] = gen_expr(g, e->list[i], -1);
-    for (int i = 0; i < e->nlist; i++)
-        f->params[i]->slot = args[i];
+    for (int i = 0; i < e->nlist; i++) {
+        sl_sym *p = f->params[i];
+        if (sl_ty_is_array(p->ty)) {       /* by reference, with its length */
+            int len = array_len(e->list[i]->sym);
+            if (sl_ty_len(p->ty) && sl_ty_len(p->ty) != len) {
+                fail(g, "argument %d of '%s': an array of %d elements where %d are expected",
+                     i + 1, f->name, len, sl_ty_len(p->ty));
+                return 0;
+            }
+            p->cg_len = len;
+        }
+        p->slot = args[i];
+    }
     int size = sl_ty_slots(f->ret);
     bool str = f->ret == SL_TYPE_STRING;
     int ret = size == 0 ? -1 : str ? alloc_string(g) : alloc_slots(g, size);
@@ -1032,7 +1130,16 @@ static int gen_expr(cg *g, sl_node *e, int dst)
     case SL_N_NUM: r = into(g, const_slot(g, e->num), dst, 1); break;
     case SL_N_STR: r = into_string(g, string_const(g, e->name, e->len), dst); break;
     case SL_N_IDENT: r = gen_ident(g, e, dst); break;
-    case SL_N_CALL: r = e->func ? gen_user_call(g, e, dst) : gen_builtin(g, e, dst); break;
+    case SL_N_CALL:
+        if (e->func)
+            r = gen_user_call(g, e, dst);
+        else if (e->builtin)
+            r = gen_builtin(g, e, dst);
+        else            /* arraylength(a) */
+            r = into(g, const_slot(g, array_len(e->list[0]->sym)), dst, 1);
+        break;
+    case SL_N_INDEX: r = gen_index(g, e, dst); break;
+    case SL_N_ARRAYINIT: r = gen_array_init(g, e, dst); break;
     case SL_N_UNARY: r = gen_unary(g, e, dst); break;
     case SL_N_BINARY: r = gen_binary(g, e, dst); break;
     case SL_N_COND: r = gen_cond_expr(g, e, dst); break;
@@ -1288,7 +1395,7 @@ static void gen_params(cg *g)
         sl_sym *s = v->sym;
         sl_param *pp = &p->params[i];
         pp->name = sl_xstrndup(s->name, strlen(s->name));
-        pp->type = (sl_type)s->ty;
+        pp->type = (sl_type)sl_ty_elem(s->ty);     /* arrays: the element type */
         pp->output = s->output;
         pp->size = sl_ty_slots(s->ty);
         g->cur = v->pos;

@@ -7,18 +7,21 @@
  *   function    := [type] IDENT '(' [formals] ')' block
  *   formals     := formal { (';' | ',') formal } [';']
  *   formal      := ['output'] ['uniform'|'varying'] type def {',' def}
- *   statement   := block | declaration | if | while | for | break | continue
- *                | return | expr ';' | ';'
+ *   def         := IDENT ['[' [INT] ']'] ['=' (expr | '{' expr {',' expr} '}')]
+ *   statement   := block | declaration | function | if | while | for | break
+ *                | continue | return | expr ';' | ';'
  *   expr        := assignment, then ?: || && (== !=) (< > <= >=) (+ -)
  *                  (^) (* /) (.) unary, lowest to highest precedence (the
  *                  spec's order: "." binds tighter than "*", "^" between
  *                  "*" and "+")
  *   unary       := ('-' | '+' | '!') unary | type [STRING] unary | primary
- *   primary     := NUMBER | STRING | IDENT | IDENT '(' args ')' | '(' expr ')'
+ *   primary     := NUMBER | STRING | IDENT | IDENT '[' expr ']'
+ *                | IDENT '(' args ')' | '(' expr ')'
  *
  * A type keyword followed by '(' or a string is a cast (`point "object"
  * (x, y, z)`, `color (0.5)`), followed by an identifier a declaration.
- * Parenthesised lists of 3 or 16 values only appear after a type.
+ * A parenthesised list of values without a type (`(x, y, z)`) is an
+ * SL_N_CAST of type void, which the checker types from the context.
  *
  * Error handling: the first error of a statement is reported, the parser
  * enters panic mode (no more reports) and skips to the next ';' or '}' at
@@ -249,21 +252,30 @@ static sl_node *primary(parser *p)
         advance(p);
         if (check(p, SL_TOK_LPAREN))
             return call(p, t);
-        if (check(p, SL_TOK_LBRACKET)) {
-            error_at(p, p->cur.pos, &p->cur, "arrays are not supported");
-            return error_node(p, t.pos);
-        }
         sl_node *n = sl_node_new(p->arena, SL_N_IDENT, t.pos);
         n->name = t.text;
+        if (check(p, SL_TOK_LBRACKET)) {         /* a[i] */
+            sl_token open = p->cur;
+            advance(p);
+            sl_node *x = sl_node_new(p->arena, SL_N_INDEX, open.pos);
+            x->a = n;
+            x->b = expression(p);
+            expect_closing(p, SL_TOK_RBRACKET, &open);
+            return x;
+        }
         return n;
     }
     case SL_TOK_LPAREN: {
         advance(p);
         sl_node *e = expression(p);
-        if (check(p, SL_TOK_COMMA)) {
-            error_at(p, p->cur.pos, &p->cur,
-                     "a list of values needs a type in front, as in 'point (x, y, z)'");
-            return error_node(p, t.pos);
+        if (check(p, SL_TOK_COMMA)) {    /* (x, y, z): typed by the checker */
+            sl_node *n = sl_node_new(p->arena, SL_N_CAST, t.pos);
+            n->cast_ty = SL_TYPE_VOID;
+            int cap = 0;
+            push_node(p, n, &cap, e);
+            while (match(p, SL_TOK_COMMA))
+                push_node(p, n, &cap, expression(p));
+            e = n;
         }
         expect_closing(p, SL_TOK_RPAREN, &t);
         return e;
@@ -437,7 +449,7 @@ static sl_node *expression(parser *p)
         n->op = op.kind;
         n->a = lhs;
         n->b = expression(p);
-        if (lhs->kind != SL_N_IDENT && lhs->kind != SL_N_ERROR)
+        if (lhs->kind != SL_N_IDENT && lhs->kind != SL_N_INDEX && lhs->kind != SL_N_ERROR)
             error_at(p, lhs->pos, NULL, "expression is not assignable");
         lhs = n;
     }
@@ -494,7 +506,51 @@ static sl_sym *new_sym(parser *p, const sl_token *name, const declspec *spec, sl
     return s;
 }
 
-/* name [= expr]; returns an SL_N_VAR node or NULL after an error */
+/* '[' [N] ']' after a declared name: v's type becomes an array of N
+ * (N: an integer literal; none: the length comes from the initializer or,
+ * for a function parameter, from each argument). */
+static bool array_size(parser *p, sl_node *v, const declspec *spec)
+{
+    sl_token open = p->cur;
+    advance(p);
+    int len = 0;
+    if (!check(p, SL_TOK_RBRACKET)) {
+        if (!check(p, SL_TOK_INT) || p->cur.number < 1 || p->cur.number > SL_MAX_ARRAY_LEN) {
+            error_at(p, p->cur.pos, &p->cur, "array size must be an integer from 1 to %d",
+                     SL_MAX_ARRAY_LEN);
+            return false;
+        }
+        len = (int)p->cur.number;
+        advance(p);
+    }
+    if (!expect_closing(p, SL_TOK_RBRACKET, &open))
+        return false;
+    if (spec->ty == SL_TYPE_STRING) {
+        error_at(p, open.pos, &open, "arrays of strings are not supported");
+        return false;
+    }
+    v->sym->ty = sl_ty_array(spec->ty, len);
+    return true;
+}
+
+/* '{' expr {, expr} '}': the values of an array. */
+static sl_node *array_init(parser *p)
+{
+    sl_token open = p->cur;
+    advance(p);
+    sl_node *n = sl_node_new(p->arena, SL_N_ARRAYINIT, open.pos);
+    int cap = 0;
+    if (!check(p, SL_TOK_RBRACE)) {
+        do {
+            push_node(p, n, &cap, expression(p));
+        } while (match(p, SL_TOK_COMMA));
+    }
+    expect_closing(p, SL_TOK_RBRACE, &open);
+    return n;
+}
+
+/* name ['[' [N] ']'] [= expr | = '{' exprs '}']; returns an SL_N_VAR node
+ * or NULL after an error */
 static sl_node *declarator(parser *p, const declspec *spec, sl_sym_kind kind, bool allow_init)
 {
     if (!check(p, SL_TOK_IDENT)) {
@@ -503,10 +559,6 @@ static sl_node *declarator(parser *p, const declspec *spec, sl_sym_kind kind, bo
     }
     sl_token name = p->cur;
     advance(p);
-    if (check(p, SL_TOK_LBRACKET)) {
-        error_at(p, p->cur.pos, &p->cur, "arrays are not supported");
-        return NULL;
-    }
     sl_node *v = sl_node_new(p->arena, SL_N_VAR, name.pos);
     v->sym = new_sym(p, &name, spec, kind);
     v->name = name.text;
@@ -515,6 +567,8 @@ static sl_node *declarator(parser *p, const declspec *spec, sl_sym_kind kind, bo
                  "variable '%s' declared 'void'", name.text);
         return NULL;
     }
+    if (check(p, SL_TOK_LBRACKET) && !array_size(p, v, spec))
+        return NULL;
     if (check(p, SL_TOK_ASSIGN)) {
         if (!allow_init) {
             error_at(p, p->cur.pos, &p->cur,
@@ -522,7 +576,7 @@ static sl_node *declarator(parser *p, const declspec *spec, sl_sym_kind kind, bo
             return NULL;
         }
         advance(p);
-        v->a = expression(p);
+        v->a = check(p, SL_TOK_LBRACE) ? array_init(p) : expression(p);
     }
     return v;
 }
@@ -598,6 +652,32 @@ static sl_node *block(parser *p)
     return b;
 }
 
+/* name '(' formals ')' block, the name being the current token: the rest
+ * of a function definition, at file level or nested (RI Spec 3.2 §14.2:
+ * "Functions may be declared anyplace that it is legal to declare a
+ * variable"). NULL after an error. */
+static sl_func *function_rest(parser *p, sl_ty ret)
+{
+    sl_token name = p->cur;
+    advance(p);
+    sl_token open = p->cur;
+    if (!expect(p, SL_TOK_LPAREN, "after function name"))
+        return NULL;
+    sl_func *f = sl_arena_alloc(p->arena, sizeof *f);
+    f->name = name.text;
+    f->pos = name.pos;
+    f->ret = ret;
+    sl_node **params = NULL;
+    formals(p, &open, &params, &f->nparams, SL_SYM_FPARAM);
+    f->params = sl_arena_alloc(p->arena, (size_t)(f->nparams + 1) * sizeof *f->params);
+    for (int i = 0; i < f->nparams; i++) {
+        f->params[i] = params[i]->sym;
+        f->params[i]->writable = f->params[i]->output;
+    }
+    f->body = block(p);
+    return f;
+}
+
 /* A declaration statement: spec declarator {, declarator} ';' */
 static sl_node *declaration(parser *p, bool need_semicolon)
 {
@@ -609,10 +689,16 @@ static sl_node *declaration(parser *p, bool need_semicolon)
         error_at(p, spec.type_tok.pos, &spec.type_tok,
                  "'output' is only allowed on parameters");
     if (check(p, SL_TOK_IDENT) && peek_kind(p, 0) == SL_TOK_LPAREN) {
-        error_at(p, p->cur.pos, &p->cur,
-                 "nested function definitions are not supported; define '%s' at file level",
-                 p->cur.text);
-        return d;
+        if (spec.external) {
+            error_at(p, spec.type_tok.pos, &spec.type_tok,
+                     "'extern' is only allowed on variables");
+            return d;
+        }
+        sl_node *n = sl_node_new(p->arena, SL_N_FUNC, p->cur.pos);
+        n->func = function_rest(p, spec.ty);
+        if (n->func)
+            n->func->nested = true;
+        return n->func ? n : d;
     }
     int cap = 0;
     do {
@@ -819,24 +905,9 @@ static void function_definition(parser *p, sl_ast_file *file, int *funcs_cap)
         error_at(p, p->cur.pos, &p->cur, "expected function name");
         return;
     }
-    sl_token name = p->cur;
-    advance(p);
-    sl_token open = p->cur;
-    if (!expect(p, SL_TOK_LPAREN, "after function name"))
-        return;
-    sl_func *f = sl_arena_alloc(p->arena, sizeof *f);
-    f->name = name.text;
-    f->pos = name.pos;
-    f->ret = ret;
-    sl_node **params = NULL;
-    formals(p, &open, &params, &f->nparams, SL_SYM_FPARAM);
-    f->params = sl_arena_alloc(p->arena, (size_t)(f->nparams + 1) * sizeof *f->params);
-    for (int i = 0; i < f->nparams; i++) {
-        f->params[i] = params[i]->sym;
-        f->params[i]->writable = f->params[i]->output;
-    }
-    f->body = block(p);
-    sl_list_push(p->arena, (void ***)&file->funcs, &file->nfuncs, funcs_cap, f);
+    sl_func *f = function_rest(p, ret);
+    if (f)
+        sl_list_push(p->arena, (void ***)&file->funcs, &file->nfuncs, funcs_cap, f);
 }
 
 static void skip_definition(parser *p)

@@ -133,6 +133,10 @@ bool sl_instance_set(sl_instance *self, const char *name, sl_type type,
     if (!types_match(pp->type, type))
         return why_fail(why, why_size, "parameter '%s' of shader '%s' is a %s, not a %s",
                         name, p->name, sl_ty_name(pp->type), sl_ty_name(type));
+    if (pp->size > 16)       /* the instance holds 16 values per parameter */
+        return why_fail(why, why_size, "parameter '%s' of shader '%s' is an array of more "
+                        "than 16 values, which cannot be set from the scene yet", name,
+                        p->name);
     if (count != pp->size)
         return why_fail(why, why_size, "parameter '%s' of shader '%s' takes %d value%s, "
                         "got %d", name, p->name, pp->size, pp->size == 1 ? "" : "s", count);

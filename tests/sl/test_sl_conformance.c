@@ -1,0 +1,808 @@
+/*
+ * tests/sl/test_sl_conformance.c: the conformance suite of the shading
+ * language (issue 15), the shaders in tests/shaders/conformance, each
+ * exercising one feature in the idioms of the books and of the widely
+ * copied helper headers (patterns.h, noises.h, voronoi.h, filterwidth.h,
+ * written for this suite).
+ *
+ * Every shader is a displacement shader on the plane P = (2u-1, 2v-1, 0),
+ * N = (0, 0, 1), s = u, t = v, that sets P to three values. Per shader:
+ *
+ *   float      P at 7x7 points of the plane against an independent C
+ *              computation of the same values (ref_* below)
+ *   dual       at the same points, dual mode gives the float values, and
+ *              derivatives matching central differences where those are
+ *              stable
+ *   range      over 12 random (u,v) boxes (sides 2^-2 .. 2^-6), the
+ *              interval and the affine enclosure of P contain P in float
+ *              mode at 4x4 points of the box (paper §4, issue 9); the
+ *              ranges whose enclosures are all finite are counted (only
+ *              filterwidth's derivatives are unbounded in range modes)
+ *
+ * The shaders in errors/ must stay errors: their diagnostics are compared
+ * whole (file:line:col, message, source line, caret).
+ *
+ * Prints the features covered, the cases run and the failures; fails when
+ * there is any failure.
+ */
+#include <stdarg.h>
+#include <stddef.h>
+#include <setjmp.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include "sl/noise.h"
+#include "sl_harness.h"
+
+#ifndef AAFARM_CONFORMANCE_DIR
+#define AAFARM_CONFORMANCE_DIR "tests/shaders/conformance"
+#endif
+
+/* ---------------------------------------------------------------------- */
+/* independent computations                                                */
+/* ---------------------------------------------------------------------- */
+
+static double sgn(double x) { return x > 0 ? 1 : x < 0 ? -1 : 0; }
+static double fmodf_(double a, double b) { return a - b * floor(a / b); }
+static double clampd(double x, double lo, double hi) { return x < lo ? lo : x > hi ? hi : x; }
+static double stepd(double e, double x) { return x < e ? 0 : 1; }
+static double smooth(double e0, double e1, double x)
+{
+    if (x < e0)
+        return 0;
+    if (x >= e1)
+        return 1;
+    double r = (x - e0) / (e1 - e0);
+    return r * r * (3 - 2 * r);
+}
+static double noise1(double x) { return sl_noise(1, &x); }
+static double noise3(double x, double y, double z)
+{
+    double p[3] = { x, y, z };
+    return sl_noise(3, p);
+}
+
+static void ref_shadow_global_local(double u, double v, double o[3])
+{
+    o[0] = u + 9 * v * v; o[1] = u; o[2] = 0;
+}
+
+static double tilecoord(double s, double t, double f)
+{
+    return fmodf_(s * f, 1) * fmodf_(t * f, 1);
+}
+static void ref_shadow_function_params(double u, double v, double o[3])
+{
+    o[0] = tilecoord(v, u, 3); o[1] = tilecoord(u + 0.1, v, 2); o[2] = 0;
+}
+
+static void ref_shadow_shader_param(double u, double v, double o[3])
+{
+    o[0] = 2 * v; o[1] = 3; o[2] = u;
+}
+
+static void ref_shadow_builtin_names(double u, double v, double o[3])
+{
+    o[0] = u * 0.75 + 2 * 0.25; o[1] = stepd(0.5, v); o[2] = 2;
+}
+
+static double filteredabs(double x, double dx)
+{
+    double x0 = x - 0.5 * dx, x1 = x0 + dx;
+    return (sgn(x1) * 0.5 * x1 * x1 - sgn(x0) * 0.5 * x0 * x0) / dx;
+}
+static void ref_nested_filteredabs(double u, double v, double o[3])
+{
+    o[0] = filteredabs(u - 0.5, 0.2); o[1] = filteredabs(v - 0.3, 0.1); o[2] = 0;
+}
+
+static void ref_nested_extern_accumulate(double u, double v, double o[3])
+{
+    o[0] = 0.5 * u + 0.5 * v * v + 0.5; o[1] = 0; o[2] = 0;
+}
+
+static double outer(double a) { return 2 * a * (a + 1) + 1; }
+static void ref_nested_two_levels(double u, double v, double o[3])
+{
+    o[0] = outer(u); o[1] = outer(v); o[2] = 0;
+}
+
+static void ref_nested_in_loop(double u, double v, double o[3])
+{
+    (void)v;
+    o[0] = u + u * u / 2 + u * u * u / 3; o[1] = 0; o[2] = 0;
+}
+
+static double bias_perlin(double b, double x) { return pow(x, log(b) / log(0.5)); }
+static double bias_schlick(double b, double x) { return x / ((1 / b - 2) * (1 - x) + 1); }
+static void ref_nested_hides_file_level(double u, double v, double o[3])
+{
+    o[0] = bias_perlin(0.7, u) - bias_schlick(0.7, u); o[1] = bias_perlin(0.3, v); o[2] = 0;
+}
+
+static void ref_overload_snoise(double u, double v, double o[3])
+{
+    double p[3] = { 2 * u - 1, 2 * v - 1, 0 }, vn[3];
+    sl_vnoise(3, p, vn);
+    o[0] = 2 * noise1(u * 4) - 1;
+    o[1] = 2 * noise3(3 * u, 3 * v, 0) - 1;
+    o[2] = 2 * vn[1] - 1;
+}
+
+static void ref_overload_return_type(double u, double v, double o[3])
+{
+    double x = 2 * u - 1, y = 2 * v - 1;
+    o[0] = x + y; o[1] = 2 * y; o[2] = 2 * x + 2 * y;
+}
+
+static void ref_overload_builtin(double u, double v, double o[3])
+{
+    o[0] = u + v + 1; o[1] = sqrt(u * u + v * v); o[2] = clampd((u - 0.2) / 0.6, 0, 1);
+}
+
+static void ref_overload_output(double u, double v, double o[3])
+{
+    o[0] = 1 + u; o[1] = 0.125; o[2] = 1 + v;
+}
+
+static void ref_overload_conversion_cost(double u, double v, double o[3])
+{
+    o[0] = 13; o[1] = u; o[2] = -v;
+}
+
+static void ref_list_assign(double u, double v, double o[3])
+{
+    o[0] = u; o[1] = v; o[2] = 0.5;
+}
+
+static void ref_list_param_default(double u, double v, double o[3])
+{
+    o[0] = 2 * u - 1 - 0.5; o[1] = 0.5; o[2] = 0.25 * v;
+}
+
+static void ref_list_return_arg(double u, double v, double o[3])
+{
+    o[0] = u + v + 1; o[1] = u > 0.5 ? 0 : 1; o[2] = v > 0.5 ? 1 : 0;
+}
+
+static void ref_list_operators(double u, double v, double o[3])
+{
+    o[0] = 1 - 2 * u; o[1] = 1 - 2 * v; o[2] = -1 + v;
+    if (u > 0.5) {
+        o[0] = (o[0] + 1) / 2; o[1] /= 2; o[2] /= 2;
+    }
+}
+
+static void ref_list_matrix(double u, double v, double o[3])
+{
+    o[0] = 2 + u; o[1] = 3 + v; o[2] = 1;
+}
+
+static double filteredpulse(double e0, double e1, double x, double dx)
+{
+    double x0 = x - dx / 2, x1 = x0 + dx;
+    double a = (fmin(x1, e1) - fmax(x0, e0)) / dx;
+    return a > 0 ? a : 0;
+}
+static void ref_patterns_pulses(double u, double v, double o[3])
+{
+    o[0] = filteredpulse(0.3, 0.7, u, 0.05);
+    o[1] = smooth(0.1, 0.3, v) - smooth(0.6, 0.9, v);
+    o[2] = 2 * (stepd(0.3, u) - stepd(0.7, u));
+}
+
+static double fbm3(double x, double y, double z, int oct, double lac, double gain)
+{
+    double sum = 0, amp = 1;
+    for (int i = 0; i < oct; i++) {
+        sum += amp * (2 * noise3(x, y, z) - 1);
+        amp *= gain;
+        x *= lac; y *= lac; z *= lac;
+    }
+    return sum;
+}
+static double fbm1(double x, int oct, double lac, double gain)
+{
+    double sum = 0, amp = 1;
+    for (int i = 0; i < oct; i++) {
+        sum += amp * (2 * noise1(x) - 1);
+        amp *= gain;
+        x *= lac;
+    }
+    return sum;
+}
+static void ref_noises_fbm(double u, double v, double o[3])
+{
+    o[0] = fbm3(2 * u, 2 * v, 0, 3, 2, 0.5); o[1] = fbm1(3 * v, 3, 2.17, 0.6); o[2] = 0;
+}
+
+static void ref_noises_turbulence(double u, double v, double o[3])
+{
+    double sum = 0, f = 1;
+    for (int i = 0; i < 3; i++) {
+        sum += fabs(2 * noise3(2 * u * f, 2 * v * f, f) - 1) / f;
+        f *= 2;
+    }
+    o[0] = 2 * u - 1; o[1] = 2 * v - 1; o[2] = sum;
+}
+
+static void ref_voronoi_cells(double u, double v, double o[3])
+{
+    double ss = 3 * u, tt = 3 * v, f1 = 1000, sp = 0, tp = 0;
+    double sc = floor(ss) + 0.5, tc = floor(tt) + 0.5;
+    for (int i = -1; i <= 1; i++) {
+        for (int j = -1; j <= 1; j++) {
+            double cell[2] = { sc + i, tc + j }, jit[3];
+            sl_vcellnoise(2, cell, jit);
+            double ps = cell[0] + 0.8 * (jit[0] - 0.5), pt = cell[1] + 0.8 * (jit[1] - 0.5);
+            double d = (ps - ss) * (ps - ss) + (pt - tt) * (pt - tt);
+            if (d < f1) {
+                f1 = d; sp = ps; tp = pt;
+            }
+        }
+    }
+    o[0] = sqrt(f1); o[1] = sp; o[2] = tp;
+}
+
+static void ref_filterwidth_overloads(double u, double v, double o[3])
+{
+    (void)v;   /* float mode: no derivatives, so both widths are MINFILTWIDTH */
+    o[0] = filteredpulse(0.25, 0.75, u, 1e-6 + 0.1); o[1] = 1e-6 * 1e6; o[2] = 0;
+}
+
+static void ref_scope_blocks_for(double u, double v, double o[3])
+{
+    (void)v;
+    o[0] = 2 * u - 1 + 3 * u; o[1] = 1; o[2] = 1 + u;
+}
+
+static void ref_extern_globals_nested(double u, double v, double o[3])
+{
+    o[0] = 2 * u - 1; o[1] = 2 * v - 1; o[2] = 0.1 * u + 0.1 * 2 * v;
+}
+
+static void ref_array_lookup(double u, double v, double o[3])
+{
+    static const double h[5] = { 0, 0.1, 0.3, 0.2, 0.05 };
+    o[0] = 2 * u - 1; o[1] = 2 * v - 1; o[2] = h[(int)floor(5 * v)];
+}
+
+static void ref_array_unsized_param(double u, double v, double o[3])
+{
+    o[0] = (1 + 2 * u + 3 * u * u) / 6; o[1] = (4 + v * v * v) / 5; o[2] = 4;
+}
+
+static void ref_array_store_loop(double u, double v, double o[3])
+{
+    double k = floor(4 * v);
+    bool on = u > 0.25 * k;
+    o[0] = on ? k : -1; o[1] = on ? k * k : -1; o[2] = on ? 1 : -1;
+}
+
+static void ref_array_nested_extern(double u, double v, double o[3])
+{
+    static const double oct[3] = { 1, 0.5, 0.25 };
+    double k = floor(3 * v);
+    o[0] = 0;
+    for (int i = 0; i < 3; i++)
+        o[0] += oct[i] * sin(2 * u * pow(2, i));
+    o[1] = oct[(int)k] * sin(pow(2, 3 * v));   /* the index rounds down, pow does not */
+    o[2] = 0;
+}
+
+static void ref_shadow_output_param(double u, double v, double o[3])
+{
+    o[0] = 2 * u - 1; o[1] = 2 * v - 1; o[2] = 0.2 * u + v;
+}
+
+static void ref_shadow_global_in_nested(double u, double v, double o[3])
+{
+    o[0] = 6 + u; o[1] = 2; o[2] = v;
+}
+
+static void ref_nested_sibling_calls(double u, double v, double o[3])
+{
+    o[0] = u * u * u * u; o[1] = v * v + 0.0625; o[2] = 0;
+}
+
+static void ref_nested_output_param(double u, double v, double o[3])
+{
+    (void)v;
+    double w = floor(3 * u);
+    o[0] = w; o[1] = 3 * u - w; o[2] = 0;
+}
+
+static void ref_overload_nested_local(double u, double v, double o[3])
+{
+    o[0] = 0.3 * u + 0.59 * v + 0.11; o[1] = v; o[2] = 0;
+}
+
+static void ref_overload_triples(double u, double v, double o[3])
+{
+    o[0] = 321; o[1] = u; o[2] = v;
+}
+
+static void ref_overload_return_noise(double u, double v, double o[3])
+{
+    double p[3] = { 2 * (2 * u - 1), 2 * (2 * v - 1), 0 }, c[3];
+    sl_vnoise(3, p, c);
+    o[0] = sl_noise(3, p); o[1] = c[0]; o[2] = c[2];
+}
+
+static void ref_list_nested_return(double u, double v, double o[3])
+{
+    o[0] = (u < 0.5) + (v < 0.5); o[1] = 0; o[2] = (u >= 0.5) + (v >= 0.5);
+}
+
+static void ref_list_builtins(double u, double v, double o[3])
+{
+    double x = 2 * u - 1, y = 2 * v - 1;
+    o[0] = 0.6 + 0.8; o[1] = sqrt(x * x + y * y); o[2] = sqrt(u * u + v * v);
+}
+
+static void ref_array_color_ramp(double u, double v, double o[3])
+{
+    static const double k[5] = { 0, 0.2, 0.9, 0.4, 1 };
+    double x = 4 * u, i = floor(x), f = x - i;
+    int a = (int)i, b = a + 1 < 4 ? a + 1 : 4;
+    o[0] = k[a] * (1 - f) + k[b] * f; o[1] = k[(int)floor(5 * v)]; o[2] = 0;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+static void ref_array_sort(double u, double v, double o[3])
+{
+    double a[4] = { u, v, 0.5, 1 - u };
+    qsort(a, 4, sizeof a[0], cmp_double);
+    o[0] = a[0]; o[1] = a[1]; o[2] = a[3];
+}
+
+static void ref_array_output_fill(double u, double v, double o[3])
+{
+    double x = u + 0.5;
+    o[0] = x + x * x; o[1] = x * x * x; o[2] = pow(x, floor(4 * v));
+}
+
+static void ref_array_points(double u, double v, double o[3])
+{
+    double d0 = sqrt(u * u + v * v), d1 = sqrt((u - 1) * (u - 1) + v * v);
+    double d2 = sqrt(u * u + (v - 1) * (v - 1));
+    static const double px[3] = { 0, 1, 0 };
+    o[0] = fmin(fmin(d0, d1), d2); o[1] = px[(int)floor(3 * u)]; o[2] = 0;
+}
+
+static double pulsetrain_integral(double t, double nedge)
+{
+    double f = t - floor(t) - nedge;
+    return (1 - nedge) * floor(t) + (f > 0 ? f : 0);
+}
+static double filteredpulsetrain(double edge, double period, double x, double dx)
+{
+    double w = dx / period, x0 = x / period - w / 2, x1 = x0 + w, ne = edge / period;
+    return (pulsetrain_integral(x1, ne) - pulsetrain_integral(x0, ne)) / w;
+}
+static void ref_nested_pulsetrain(double u, double v, double o[3])
+{
+    o[0] = filteredpulsetrain(0.5, 1, 4 * u, 0.03);
+    o[1] = filteredpulsetrain(0.25, 0.5, 2 * v, 0.12);
+    o[2] = 0;
+}
+
+static void ref_nested_early_return(double u, double v, double o[3])
+{
+    double c = floor(u * 8);
+    o[0] = c; o[1] = c + 1; o[2] = floor(v * 8);
+}
+
+static void ref_overload_arrays(double u, double v, double o[3])
+{
+    o[0] = u + v + 1; o[1] = u + 2 * v; o[2] = 0;
+}
+
+static void ref_list_array_init(double u, double v, double o[3])
+{
+    o[0] = u; o[1] = v; o[2] = u * v;
+}
+
+static void ref_nested_break_continue(double u, double v, double o[3])
+{
+    (void)v;
+    double n = floor(u * 10), acc = 0;
+    for (int i = 1; i < n; i += 2)
+        acc += i;
+    o[0] = acc; o[1] = 1 + 3 + 5; o[2] = 0;
+}
+
+static void ref_shadow_overload_params(double u, double v, double o[3])
+{
+    o[0] = 10 * v + u; o[1] = 10 * u + v; o[2] = 10 * (2 * u - 1) + (2 * v - 1);
+}
+
+static void ref_extern_write_chain(double u, double v, double o[3])
+{
+    o[0] = (1 + (u > 0.5)) + (1 + (v > 0.5)) + 2; o[1] = 0; o[2] = 0;
+}
+
+static void ref_array_matrices(double u, double v, double o[3])
+{
+    double k = floor(2 * u) + 1;
+    o[0] = k; o[1] = k * v; o[2] = k;
+}
+
+static void ref_nested_shadows_builtin(double u, double v, double o[3])
+{
+    o[0] = 2 * u; o[1] = noise3(u, v, 0); o[2] = 0;
+}
+
+/* ---------------------------------------------------------------------- */
+/* the cases                                                               */
+/* ---------------------------------------------------------------------- */
+
+typedef struct conf_case {
+    const char *file;
+    const char *feature;
+    void (*ref)(double u, double v, double out[3]);
+    bool no_dual;       /* uses derivatives: dual values differ from float ones */
+} conf_case;
+
+#define CASE(name, feature) { #name ".sl", feature, ref_##name, false }
+#define CASE_NO_DUAL(name, feature) { #name ".sl", feature, ref_##name, true }
+static const conf_case cases[] = {
+    CASE(shadow_global_local, "shadowed globals"),
+    CASE(shadow_function_params, "shadowed globals"),
+    CASE(shadow_shader_param, "shadowed globals"),
+    CASE(shadow_builtin_names, "shadowed built-in names"),
+    CASE(scope_blocks_for, "block scopes"),
+    CASE(nested_filteredabs, "nested functions"),
+    CASE(nested_pulsetrain, "extern of enclosing variables"),
+    CASE(nested_extern_accumulate, "extern of enclosing variables"),
+    CASE(nested_two_levels, "extern of enclosing variables"),
+    CASE(nested_in_loop, "nested functions"),
+    CASE(nested_hides_file_level, "nested functions"),
+    CASE(extern_globals_nested, "extern of enclosing variables"),
+    CASE(overload_snoise, "overloading by argument type"),
+    CASE(overload_return_type, "overloading by return type"),
+    CASE(overload_builtin, "overloads beside built-ins"),
+    CASE(overload_output, "overloading by argument type"),
+    CASE(overload_conversion_cost, "overloading by argument type"),
+    CASE(list_assign, "untyped triples"),
+    CASE(list_param_default, "untyped triples"),
+    CASE(list_return_arg, "untyped triples"),
+    CASE(list_operators, "untyped triples"),
+    CASE(list_matrix, "untyped 16-tuples"),
+    CASE(patterns_pulses, "helper headers"),
+    CASE(noises_fbm, "helper headers"),
+    CASE(noises_turbulence, "helper headers"),
+    CASE(voronoi_cells, "helper headers"),
+    CASE_NO_DUAL(filterwidth_overloads, "helper headers"),
+    CASE(array_lookup, "arrays"),
+    CASE(array_unsized_param, "arrays"),
+    CASE(array_store_loop, "arrays"),
+    CASE(array_nested_extern, "arrays"),
+    CASE(shadow_output_param, "shadowed globals"),
+    CASE(shadow_global_in_nested, "shadowed globals"),
+    CASE(nested_sibling_calls, "nested functions"),
+    CASE(nested_output_param, "extern of enclosing variables"),
+    CASE(overload_nested_local, "overloading by argument type"),
+    CASE(overload_triples, "overloading by argument type"),
+    CASE(overload_return_noise, "overloading by return type"),
+    CASE(list_nested_return, "untyped triples"),
+    CASE(list_builtins, "untyped triples"),
+    CASE(array_color_ramp, "arrays"),
+    CASE(array_sort, "arrays"),
+    CASE(array_output_fill, "arrays"),
+    CASE(array_points, "arrays"),
+    CASE(nested_early_return, "extern of enclosing variables"),
+    CASE(overload_arrays, "overloading by argument type"),
+    CASE(list_array_init, "untyped triples"),
+    CASE(nested_break_continue, "nested functions"),
+    CASE(shadow_overload_params, "shadowed globals"),
+    CASE(extern_write_chain, "extern of enclosing variables"),
+    CASE(array_matrices, "arrays"),
+    CASE(nested_shadows_builtin, "shadowed built-in names"),
+};
+#undef CASE
+#undef CASE_NO_DUAL
+
+typedef struct conf_error {
+    const char *file;
+    const char *expected;
+} conf_error;
+
+static const conf_error errors[] = {
+    { "errors/redefinition.sl",
+      "errors/redefinition.sl:5:11: error: redefinition of 's'\n"
+      "    float s = 2;\n"
+      "          ^\n"
+      "errors/redefinition.sl:4:11: note: previous definition is here\n"
+      "    float s = 1;\n"
+      "          ^\n" },
+    { "errors/ambiguous.sl",
+      "errors/ambiguous.sl:8:10: error: call to 'pick' is ambiguous\n"
+      "    P += pick(P);\n"
+      "         ^\n"
+      "errors/ambiguous.sl:3:7: note: candidate: float pick(point)\n"
+      "float pick(point p) { return xcomp(p); }\n"
+      "      ^\n"
+      "errors/ambiguous.sl:4:7: note: candidate: color pick(point)\n"
+      "color pick(point p) { return color(ycomp(p)); }\n"
+      "      ^\n" },
+    { "errors/no_extern.sl",
+      "errors/no_extern.sl:4:34: error: 'Km' belongs to an enclosing scope; declare it "
+      "'extern float Km;' in function 'bump' to use it here\n"
+      "    float bump(float x) { return Km * x; }\n"
+      "                                 ^\n" },
+    { "errors/out_of_scope.sl",
+      "errors/out_of_scope.sl:7:10: error: use of undeclared function 'twice'\n"
+      "    P += twice(s) * N;\n"
+      "         ^\n" },
+    { "errors/array_index.sl",
+      "errors/array_index.sl:5:12: error: array index 3 is out of range for 'a' (float[3]: "
+      "0 to 2)\n"
+      "    P += a[3] * N;\n"
+      "           ^\n" },
+    { "errors/array_string.sl",
+      "errors/array_string.sl:4:17: error: arrays of strings are not supported\n"
+      "    string names[2];\n"
+      "                ^\n" },
+    { "errors/extern_missing.sl",
+      "errors/extern_missing.sl:4:35: error: 'extern' names no variable 'Kd' of an "
+      "enclosing scope\n"
+      "    float helper() { extern float Kd; return Kd; }\n"
+      "                                  ^\n" },
+    { "errors/overload_nomatch.sl",
+      "errors/overload_nomatch.sl:7:10: error: no matching function for call to 'w' with "
+      "arguments (string)\n"
+      "    P += w(\"heavy\") * N;\n"
+      "         ^\n"
+      "errors/overload_nomatch.sl:2:7: note: candidate: float w(float)\n"
+      "float w(float x) { return x; }\n"
+      "      ^\n"
+      "errors/overload_nomatch.sl:3:7: note: candidate: float w(color)\n"
+      "float w(color c) { return comp(c, 0); }\n"
+      "      ^\n" },
+    { "errors/untyped.sl",
+      "errors/untyped.sl:4:15: error: cannot tell the type of this list of 3 values here; "
+      "put a type in front, as in 'point (...)'\n"
+      "    float d = (1, 0, 0) . (0, 1, 0);\n"
+      "              ^\n" },
+};
+
+/* ---------------------------------------------------------------------- */
+/* running                                                                 */
+/* ---------------------------------------------------------------------- */
+
+/* Reads `name` from the conformance directory (the #include loader). */
+static int load_conformance(sl_source_set *set, const char *name, sl_diag *diag, void *arg)
+{
+    (void)arg;
+    char path[1024];
+    snprintf(path, sizeof path, "%s/%s", AAFARM_CONFORMANCE_DIR, name);
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return 1;
+    fclose(f);
+    return sl_source_set_load_file(set, path, name, diag) == 0 ? 0 : -1;
+}
+
+static sl_program *compile_file(const char *name, char **diag_out)
+{
+    sl_source_set *set = sl_source_set_new();
+    sl_source_set_set_loader(set, load_conformance, NULL);
+    sl_diag *diag = sl_diag_new();
+    sl_program *p = NULL;
+    if (sl_source_set_get(set, name, diag))
+        p = sl_compile(set, name, NULL, diag);
+    *diag_out = sl_diag_to_string(diag);
+    sl_diag_destroy(&diag);
+    sl_source_set_destroy(&set);
+    return p;
+}
+
+typedef struct tally {
+    int floats, duals, derivs, ranges, bounded, samples, failures;
+} tally;
+
+static bool close_to(double got, double want)
+{
+    return fabs(got - want) <= 1e-9 * (1 + fabs(want));
+}
+
+static bool inside(ia_interval r, double x)
+{
+    double tol = 1e-9 * (1 + fabs(x));
+    return x >= r.lo - tol && x <= r.hi + tol;
+}
+
+static bool run_float(sl_vm *vm, const sl_instance *inst, double u, double v, double P[3])
+{
+    h_globals_float(vm, H_PLANE, u, v);
+    if (sl_vm_run(vm, inst, SL_MODE_FLOAT, NULL) != SL_OK) {
+        fprintf(stderr, "%s\n", sl_vm_error(vm));
+        return false;
+    }
+    sl_vm_get_float(vm, SL_G_P, P);
+    return true;
+}
+
+/* Dual mode at (u, v): the values are the float ones, and each derivative
+ * matches central differences of float P where those are stable (two step
+ * sizes agree; not across a step or a floor). */
+static void check_dual(const conf_case *cc, sl_vm *vm, const sl_instance *inst, double u,
+                       double v, const double F[3], tally *t)
+{
+    sl_dual D[3];
+    h_globals_dual(vm, H_PLANE, u, v);
+    bool ok = sl_vm_run(vm, inst, SL_MODE_DUAL, NULL) == SL_OK;
+    t->duals++;
+    if (ok) {
+        sl_vm_get_dual(vm, SL_G_P, D);
+        for (int k = 0; k < 3; k++)
+            ok &= close_to(D[k].v, F[k]);
+    }
+    for (int dir = 0; ok && dir < 2; dir++) {
+        double e1[3], e2[3], Pp[3], Pm[3];
+        for (int m = 0; ok && m < 2; m++) {
+            double h = m ? 2e-5 : 1e-5;
+            ok &= run_float(vm, inst, u + (dir ? 0 : h), v + (dir ? h : 0), Pp) &&
+                  run_float(vm, inst, u - (dir ? 0 : h), v - (dir ? h : 0), Pm);
+            for (int k = 0; k < 3; k++)
+                (m ? e2 : e1)[k] = (Pp[k] - Pm[k]) / (2 * h);
+        }
+        for (int k = 0; ok && k < 3; k++) {
+            if (fabs(e1[k] - e2[k]) > 1e-5 * (1 + fabs(e1[k])))
+                continue;           /* not smooth here */
+            t->derivs++;
+            double d = dir ? D[k].dv : D[k].du;
+            ok = fabs(d - e1[k]) <= 1e-4 * (1 + fabs(e1[k]));
+            if (!ok)
+                fprintf(stderr, "%s: d/d%c of P[%d] at (%.17g, %.17g): dual %.17g, "
+                                "differences %.17g\n", cc->file, dir ? 'v' : 'u', k, u, v,
+                        d, e1[k]);
+        }
+    }
+    if (!ok) {
+        t->failures++;
+        fprintf(stderr, "%s: dual mode at (u, v) = (%.17g, %.17g) disagrees\n", cc->file,
+                u, v);
+    }
+}
+
+/* Float values at 7x7 points against the reference; dual mode there. */
+static void check_float(const conf_case *cc, sl_vm *vm, const sl_instance *inst, tally *t)
+{
+    for (int i = 0; i < 7; i++) {
+        for (int j = 0; j < 7; j++) {
+            double u = 0.05 + 0.9 * (i + 0.31) / 7, v = 0.05 + 0.9 * (j + 0.57) / 7;
+            double P[3], want[3];
+            t->floats++;
+            cc->ref(u, v, want);
+            bool ok = run_float(vm, inst, u, v, P);
+            for (int k = 0; ok && k < 3; k++)
+                ok = close_to(P[k], want[k]);
+            if (!ok) {
+                t->failures++;
+                fprintf(stderr, "%s: at (u, v) = (%.17g, %.17g): P = (%.17g, %.17g, %.17g), "
+                                "want (%.17g, %.17g, %.17g)\n", cc->file, u, v, P[0], P[1],
+                        P[2], want[0], want[1], want[2]);
+            } else if (!cc->no_dual) {
+                check_dual(cc, vm, inst, u, v, P, t);
+            }
+        }
+    }
+}
+
+/* Interval and affine enclosures over random boxes contain float samples. */
+static void check_ranges(const conf_case *cc, sl_vm *vm, const sl_instance *inst, tally *t,
+                         unsigned long long *rng)
+{
+    aa_context ctx;
+    aa_context_init(&ctx, AA_DEFAULT_CAPACITY);
+    for (int r = 0; r < 12; r++) {
+        double side = ldexp(1, -2 - (int)(h_rand(rng) * 5));
+        double u0 = 0.02 + h_rand(rng) * (0.96 - side), v0 = 0.02 + h_rand(rng) * (0.96 - side);
+        double u1 = u0 + side, v1 = v0 + side;
+        ia_interval I[3], A[3];
+        aa_form a[3];
+        t->ranges++;
+        h_globals_interval(vm, H_PLANE, u0, u1, v0, v1);
+        sl_status st = sl_vm_run(vm, inst, SL_MODE_INTERVAL, NULL);
+        if (st == SL_OK) {
+            sl_vm_get_interval(vm, SL_G_P, I);
+            h_globals_affine(vm, &ctx, H_PLANE, u0, u1, v0, v1);
+            st = sl_vm_run(vm, inst, SL_MODE_AFFINE, &ctx);
+        }
+        if (st != SL_OK) {
+            t->failures++;
+            fprintf(stderr, "%s: %s\n", cc->file, sl_vm_error(vm));
+            continue;
+        }
+        sl_vm_get_affine(vm, SL_G_P, a);
+        bool bounded = true;
+        for (int k = 0; k < 3; k++) {
+            A[k] = aa_range(&a[k]);
+            bounded &= isfinite(A[k].lo) && isfinite(A[k].hi) && isfinite(I[k].lo) &&
+                       isfinite(I[k].hi);
+        }
+        t->bounded += bounded;
+        for (int i = 0; i < 4; i++) {
+            for (int j = 0; j < 4; j++) {
+                double u = u0 + (u1 - u0) * i / 3, v = v0 + (v1 - v0) * j / 3, P[3];
+                t->samples++;
+                bool ok = run_float(vm, inst, u, v, P);
+                for (int k = 0; ok && k < 3; k++)
+                    ok = inside(I[k], P[k]) && inside(A[k], P[k]);
+                if (!ok) {
+                    t->failures++;
+                    fprintf(stderr, "%s: box [%g, %g] x [%g, %g]: sample (%g, %g) outside\n",
+                            cc->file, u0, u1, v0, v1, u, v);
+                }
+            }
+        }
+    }
+}
+
+static void test_conformance(void **state)
+{
+    (void)state;
+    tally t = { 0, 0, 0, 0, 0, 0, 0 };
+    unsigned long long rng = 0x5eed15ULL;
+    sl_vm *vm = sl_vm_new(NULL);
+    const char *features[64];
+    int nfeatures = 0;
+    size_t ncases = sizeof cases / sizeof cases[0];
+    for (size_t c = 0; c < ncases; c++) {
+        const conf_case *cc = &cases[c];
+        bool seen = false;
+        for (int f = 0; f < nfeatures; f++)
+            seen |= strcmp(features[f], cc->feature) == 0;
+        if (!seen && nfeatures < 64)
+            features[nfeatures++] = cc->feature;
+        char *diag = NULL;
+        sl_program *p = compile_file(cc->file, &diag);
+        if (!p || diag[0]) {
+            t.failures++;
+            fprintf(stderr, "%s: does not compile cleanly:\n%s", cc->file, diag);
+        }
+        free(diag);
+        if (!p)
+            continue;
+        sl_instance *inst = sl_instance_new(p);
+        check_float(cc, vm, inst, &t);
+        check_ranges(cc, vm, inst, &t, &rng);
+        sl_instance_destroy(&inst);
+        sl_program_destroy(&p);
+    }
+    size_t nerrors = sizeof errors / sizeof errors[0];
+    for (size_t e = 0; e < nerrors; e++) {
+        char *diag = NULL;
+        sl_program *p = compile_file(errors[e].file, &diag);
+        if (p || strcmp(diag, errors[e].expected) != 0) {
+            t.failures++;
+            fprintf(stderr, "%s: --- got:\n%s--- expected:\n%s", errors[e].file, diag,
+                    errors[e].expected);
+        }
+        sl_program_destroy(&p);
+        free(diag);
+    }
+    sl_vm_destroy(&vm);
+    printf("conformance: %zu shaders and %zu error cases; features:", ncases, nerrors);
+    for (int f = 0; f < nfeatures; f++)
+        printf("%s %s", f ? "," : "", features[f]);
+    printf("\nconformance: %d float checks, %d dual checks (%d derivatives against "
+           "differences), %d ranges (interval and affine; %d of them bounded) with %d "
+           "samples, %zu diagnostics; %d failures\n", t.floats, t.duals, t.derivs, t.ranges,
+           t.bounded, t.samples, nerrors, t.failures);
+    assert_int_equal(t.failures, 0);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_conformance),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
