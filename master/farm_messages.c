@@ -298,6 +298,12 @@ static void on_result(farm *f, farm_worker *w, const Aafarm__Result *r, const wi
                         w->name, (unsigned long long)r->lease_id, len);
             return;
         }
+        if (image_writer_failed(f->writer)) {
+            /* the master's own output failed (disk full): not the worker's
+             * fault, and no other worker can do better */
+            farm_fail(f, "%s", err);
+            return;
+        }
     }
     f->invalid_tiles++;
     w->invalid_tiles++;

@@ -132,7 +132,7 @@ bool image_writer_put_tile(image_writer *self, const image_tile *tile,
     }
     if (*written_flag(self, tx, ty))
         return true;
-    self->stream.message[0] = '\0';
+    image_exr_stream_clear(&self->stream);
     exr_result_t rv = image_exr_write_tile(self->ctxt, &self->fmt, tx, ty,
                                            tile);
     return record_write(self, tx, ty, rv, err, errsz);
@@ -152,10 +152,15 @@ bool image_writer_put_exr_chunk(image_writer *self, const void *bytes,
         return false;
     if (*written_flag(self, tx, ty))
         return true;
-    self->stream.message[0] = '\0';
+    image_exr_stream_clear(&self->stream);
     exr_result_t rv = exr_write_tile_chunk(self->ctxt, 0, tx, ty, 0, 0, chunk,
                                            chunk_len);
     return record_write(self, tx, ty, rv, err, errsz);
+}
+
+bool image_writer_failed(const image_writer *self)
+{
+    return self->failure[0] != '\0';
 }
 
 bool image_writer_has_tile(const image_writer *self, int tx, int ty)
@@ -204,7 +209,7 @@ bool image_writer_finish(image_writer **self_p, char *err, size_t errsz)
         image_writer_destroy(self_p);
         return false;
     }
-    self->stream.message[0] = '\0';
+    image_exr_stream_clear(&self->stream);
     exr_result_t rv = exr_finish(&self->ctxt);
     self->ctxt = NULL;
     if (rv != EXR_ERR_SUCCESS) {
