@@ -17,6 +17,7 @@
 #include "farm.h"
 #include "image/writer.h"
 #include "job_message.h"
+#include "journal.h"
 #include "local_workers.h"
 #include "registry.h"
 #include "scheduler.h"
@@ -43,6 +44,8 @@ typedef struct farm {
     scheduler *sched;
     registry *reg;
     image_writer *writer;
+    journal *jnl;                  /* OUT.exr.journal: the tiles taken so far */
+    int resumed_tiles;             /* tiles replayed from the journal (--resume) */
     local_workers *locals;
     console *con;
     job_message *jobmsg;

@@ -5,8 +5,10 @@
  *   Hello      version check (Reject VERSION_MISMATCH), register, Welcome
  *   Ask        credits += n; granting happens in farm_grant_all()
  *   Result     stale (unknown lease, other job) / duplicate (tile DONE) /
- *              taken: the EXR is validated and its chunk copied into the
- *              output; an invalid EXR counts as a retryable failure
+ *              taken: the EXR is validated, its chunk appended to the
+ *              journal and copied into the output; an invalid EXR counts
+ *              as a retryable failure of the worker, a write error of the
+ *              journal or the output fails the render (the master's fault)
  *   Failure    retried elsewhere up to max_attempts, then the job fails
  *   NeedJob    the Job again
  *   Heartbeat  liveness only (any message counts)
@@ -290,18 +292,24 @@ static void on_result(farm *f, farm_worker *w, const Aafarm__Result *r, const wi
                  r->tile_index, tile);
     } else {
         image_rect rect = image_format_tile_rect(&f->fmt, tile % f->tiles_x, tile / f->tiles_x);
-        if (image_writer_put_exr_chunk(f->writer, bulk, len, rect, err, sizeof err)) {
+        const void *chunk = NULL;
+        size_t chunk_len = 0;
+        if (image_tile_exr_chunk(bulk, len, &f->fmt, rect, &chunk, &chunk_len, err, sizeof err)) {
+            /* journal first: a tile in the journal survives the master */
+            char ioerr[700];
+            if (!journal_append(f->jnl, tile, chunk, chunk_len, now, ioerr, sizeof ioerr) ||
+                !image_writer_put_chunk(f->writer, tile % f->tiles_x, tile / f->tiles_x, chunk,
+                                        chunk_len, ioerr, sizeof ioerr)) {
+                /* the master's own output failed (disk full): not the
+                 * worker's fault, and no other worker can do better */
+                farm_fail(f, "%s", ioerr);
+                return;
+            }
             scheduler_complete(f->sched, w->slot, r->lease_id, now);
             w->tiles++;
             add_stats(w, r->stats);
             console_log(f->con, CONSOLE_DETAIL, "took tile %d from %s (lease %llu, %zu bytes)", tile,
                         w->name, (unsigned long long)r->lease_id, len);
-            return;
-        }
-        if (image_writer_failed(f->writer)) {
-            /* the master's own output failed (disk full): not the worker's
-             * fault, and no other worker can do better */
-            farm_fail(f, "%s", err);
             return;
         }
     }

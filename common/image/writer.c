@@ -150,6 +150,19 @@ bool image_writer_put_exr_chunk(image_writer *self, const void *bytes,
         || !image_tile_exr_chunk(bytes, len, &self->fmt, expect, &chunk,
                                  &chunk_len, err, errsz))
         return false;
+    return image_writer_put_chunk(self, tx, ty, chunk, chunk_len, err, errsz);
+}
+
+bool image_writer_put_chunk(image_writer *self, int tx, int ty, const void *chunk,
+                            size_t chunk_len, char *err, size_t errsz)
+{
+    if (!usable(self, err, errsz))
+        return false;
+    if (tx < 0 || ty < 0 || tx >= image_format_tiles_x(&self->fmt)
+        || ty >= image_format_tiles_y(&self->fmt)) {
+        snprintf(err, errsz, "tile (%d,%d) is not in the image", tx, ty);
+        return false;
+    }
     if (*written_flag(self, tx, ty))
         return true;
     image_exr_stream_clear(&self->stream);
