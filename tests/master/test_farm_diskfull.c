@@ -8,7 +8,10 @@
  *     and the cause, no output and no temporary file left;
  *   - full in the middle of the render (master and standalone): exit 1,
  *     the master reports its own write error and never blames a worker
- *     (no "invalid tile", no retry), nothing half-written left;
+ *     (no "invalid tile", no retry), nothing half-written left but the
+ *     master's journal; once there is space again (the tmpfs remounted
+ *     larger) `--resume` completes the image, equal to the standalone
+ *     render;
  *   - the final rename fails (OUT.exr is a folder): exit 1, "cannot
  *     rename", no temporary file left.
  * Every process runs under timeout -k and is reaped by PID. Needs root
@@ -42,6 +45,7 @@ static int group_setup(void **state)
     (void)state;
     dir = ft_tempdir();
     ft_write_scene(dir, FT_SCENE_WAVE);
+    if (ft_standalone(dir, 8) != 0) return -1;
     snprintf(mnt, sizeof mnt, "%s/mnt", dir);
     mkdir(mnt, 0755);
     if (geteuid() != 0) {
@@ -103,10 +107,10 @@ static int run_bounded(const char *log, const char *const *args)
     return ft_wait(pid, 90);
 }
 
-static int master(const char *log, const char *out)
+static int master(const char *log, const char *out, bool resume)
 {
     const char *argv[] = {ft_master, ft_path(dir, "scene.rib"), "-o", out, "--tile", "8",
-                          "--local-workers", "2", NULL};
+                          "--local-workers", "2", resume ? "--resume" : NULL, NULL};
     setenv("TMPDIR", dir, 1);   /* the private ipc folder: counted below */
     int rc = run_bounded(log, argv);
     unsetenv("TMPDIR");
@@ -132,7 +136,7 @@ static void test_diskfull_at_header_master(void **state)
     (void)state;
     mount_small(16, 64);
     const char *log = ft_path(dir, "hdr-master.log");
-    assert_int_equal(master(log, ft_path(mnt, "out.exr")), 1);
+    assert_int_equal(master(log, ft_path(mnt, "out.exr"), false), 1);
     assert_int_equal(ft_count(log, "cannot write EXR header to "), 1);
     assert_int_equal(ft_count(log, "/mnt/out.exr.tmp-"), 1);
     assert_int_equal(ft_count(log, "No space left on device"), 1);
@@ -156,12 +160,23 @@ static void test_diskfull_mid_render_master(void **state)
     (void)state;
     mount_small(16, 0);
     const char *log = ft_path(dir, "mid-master.log");
-    assert_int_equal(master(log, ft_path(mnt, "out.exr")), 1);
+    assert_int_equal(master(log, ft_path(mnt, "out.exr"), false), 1);
     assert_int_equal(ft_count(log, "render failed: cannot write tile ("), 1);
     assert_int_equal(ft_count(log, "No space left on device"), 1);
     assert_int_equal(ft_count(log, "invalid tile"), 0);
     assert_int_equal(ft_count(log, "trying again"), 0);
-    assert_nothing_left();
+    assert_int_equal(ft_count(log, " tiles kept in "), 1);
+    assert_int_equal(ft_count_files(mnt, "out.exr.tmp"), 0);
+    assert_int_equal(ft_count_files(mnt, "out.exr"), 1);   /* the journal */
+    assert_int_equal(ft_count_files(dir, "aafarm-"), 0);
+    /* space again: resume */
+    assert_int_equal(mount("tmpfs", mnt, "tmpfs", MS_REMOUNT, "size=256k"), 0);
+    const char *log2 = ft_path(dir, "mid-master-resume.log");
+    assert_int_equal(master(log2, ft_path(mnt, "out.exr"), true), 0);
+    assert_int_equal(ft_count(log2, "resuming: "), 1);
+    assert_int_equal(ft_count(log2, "resuming: 0 of"), 0);
+    assert_int_equal(ft_exr_diff(ft_path(dir, "ref.exr"), ft_path(mnt, "out.exr")), 0);
+    assert_int_equal(ft_count_files(mnt, "out.exr"), 1);     /* no journal, no temporary */
 }
 
 static void test_diskfull_mid_render_standalone(void **state)
@@ -181,7 +196,7 @@ static void test_rename_fails_master(void **state)
     mount_small(256, 0);
     assert_int_equal(mkdir(ft_path(mnt, "out.exr"), 0755), 0);   /* in the way */
     const char *log = ft_path(dir, "rename.log");
-    assert_int_equal(master(log, ft_path(mnt, "out.exr")), 1);
+    assert_int_equal(master(log, ft_path(mnt, "out.exr"), false), 1);
     assert_int_equal(ft_count(log, "cannot rename "), 1);
     assert_int_equal(ft_count_files(mnt, "out.exr.tmp"), 0);
     assert_int_equal(ft_count_files(dir, "aafarm-"), 0);
