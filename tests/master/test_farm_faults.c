@@ -8,6 +8,9 @@
  *   - random bytes, truncated ZMTP frames and malformed messages sent to
  *     the master's port while it renders: it keeps working, counts them,
  *     and answers a message from an unknown peer with Reject HELLO_FIRST;
+ *   - a worker whose job preparation takes longer than the heartbeat
+ *     timeout (--prepare-delay) keeps heartbeating: never declared dead,
+ *     nothing requeued, it renders its tiles;
  *   - SIGINT to a master with local workers: exit 130, no output and no
  *     temporary file left, the local workers stopped.
  * Workers are slowed down with --tile-delay so that "mid-render" is
@@ -134,6 +137,26 @@ static void test_farm_sigstop_worker_requeued(void **state)
     assert_int_equal(ft_wait(sleeper, 20), 130);
     kill(other, SIGTERM);
     assert_int_equal(ft_wait(other, 20), 130);
+}
+
+static void test_farm_slow_preparation_keeps_heartbeating(void **state)
+{
+    (void)state;
+    const char *log = ft_path(dir, "prep.log"), *json = ft_path(dir, "prep.json");
+    char ep[256];
+    pid_t master = start_master(ft_path(dir, "prep.exr"), log, json, ep, sizeof ep);
+    /* 2.5 s of preparation against a 4 x 250 ms heartbeat timeout */
+    const char *argv[] = {ft_worker, "--connect", ep, "--name", "slowprep", "--threads", "1",
+                          "--prepare-delay", "2500", NULL};
+    pid_t worker = ft_spawn(ft_path(dir, "slowprep.log"), argv);
+    assert_int_equal(ft_wait(master, 120), 0);
+    assert_int_equal(ft_exr_diff(ft_path(dir, "ref.exr"), ft_path(dir, "prep.exr")), 0);
+    assert_int_equal(ft_count(log, "missed 4 heartbeats"), 0);
+    assert_int_equal(ft_count(log, "worker slowprep joined"), 1);
+    assert_int_equal(ft_json_number(json, "requeued"), 0);
+    assert_true(ft_count(log, " from slowprep (lease") >= 1);
+    kill(worker, SIGTERM);
+    assert_int_equal(ft_wait(worker, 20), 130);
 }
 
 /* ---- garbage for the master's port ---- */
@@ -301,6 +324,7 @@ int main(int argc, char **argv)
         cmocka_unit_test_teardown(test_farm_kill9_worker_mid_render, teardown),
         cmocka_unit_test_teardown(test_farm_sigstop_worker_requeued, teardown),
         cmocka_unit_test_teardown(test_farm_garbage_to_master_port, teardown),
+        cmocka_unit_test_teardown(test_farm_slow_preparation_keeps_heartbeating, teardown),
         cmocka_unit_test_teardown(test_farm_sigint_master_cleans_up, teardown),
     };
     return cmocka_run_group_tests(tests, group_setup, group_teardown);
