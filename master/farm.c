@@ -456,6 +456,10 @@ static int finish(farm *f)
     int rc = AAFARM_EXIT_OK;
     switch (f->state) {
     case FARM_DONE:
+        if (f->nonfinite_samples)
+            console_log(f->con, CONSOLE_ERROR, "warning: %llu NaN/Inf samples in %d tiles were "
+                        "written as 0 (Z: as no hit); a shader divides by zero or overflows "
+                        "there", (unsigned long long)f->nonfinite_samples, f->nonfinite_tiles);
         console_log(f->con, CONSOLE_INFO, "wrote %s (%dx%d, %d tiles, %.2f s)", f->opt->output,
                     f->fmt.width, f->fmt.height, f->ntiles, (double)(f->end_ms - f->start_ms) / 1000.0);
         if (f->opt->preview) write_preview(f);

@@ -59,6 +59,8 @@ typedef struct farm {
     uint64_t invalid_tiles, rejects_sent, version_mismatches, jobs_sent;
     uint64_t grant_bytes, result_bytes, sent_bytes;
     uint64_t drops_unlogged;       /* malformed messages not logged yet */
+    uint64_t nonfinite_samples;    /* NaN/Inf samples in the tiles taken */
+    int nonfinite_tiles;
     int64_t drop_logged_ms;
 } farm;
 

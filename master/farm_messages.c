@@ -264,6 +264,7 @@ static void add_stats(farm_worker *w, const Aafarm__TileStats *s)
     w->cache_evictions += s->cache_evictions;
     if (s->peak_cache_bytes > w->peak_cache_bytes) w->peak_cache_bytes = s->peak_cache_bytes;
     w->render_seconds += s->wall_seconds;
+    w->nonfinite_samples += s->nonfinite_samples;
     w->cpu_seconds += s->cpu_seconds;
 }
 
@@ -308,6 +309,14 @@ static void on_result(farm *f, farm_worker *w, const Aafarm__Result *r, const wi
             scheduler_complete(f->sched, w->slot, r->lease_id, now);
             w->tiles++;
             add_stats(w, r->stats);
+            if (r->stats && r->stats->nonfinite_samples) {
+                if (f->nonfinite_tiles++ == 0)
+                    console_log(f->con, CONSOLE_INFO, "warning: tile %d at (%d,%d) from %s had %llu "
+                                "NaN/Inf samples, written as 0 (further ones are counted at the "
+                                "end)", tile, rect.x0, rect.y0, w->name,
+                                (unsigned long long)r->stats->nonfinite_samples);
+                f->nonfinite_samples += r->stats->nonfinite_samples;
+            }
             console_log(f->con, CONSOLE_DETAIL, "took tile %d from %s (lease %llu, %zu bytes)", tile,
                         w->name, (unsigned long long)r->lease_id, len);
             return;

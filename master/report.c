@@ -129,7 +129,8 @@ static void json_farm(FILE *out, const farm *f)
             "\"duplicate_grants\": %llu, \"requeued\": %llu, \"expired_leases\": %llu, "
             "\"duplicate_results\": %llu, \"stale_results\": %llu, \"failures\": %llu, "
             "\"invalid_tiles\": %llu, \"malformed_messages\": %llu, \"rejects_sent\": %llu, "
-            "\"version_mismatches\": %llu, \"disconnects\": %llu, \"master_cpu_seconds\": %.3f},\n",
+            "\"version_mismatches\": %llu, \"disconnects\": %llu, \"nonfinite_samples\": %llu, "
+            "\"master_cpu_seconds\": %.3f},\n",
             f->job_bytes, (unsigned long long)f->jobs_sent, per_grant,
             (unsigned long long)f->result_bytes, (unsigned long long)f->sent_bytes,
             (unsigned long long)c.grants, (unsigned long long)c.duplicate_grants,
@@ -138,6 +139,7 @@ static void json_farm(FILE *out, const farm *f)
             (unsigned long long)c.failures, (unsigned long long)f->invalid_tiles,
             (unsigned long long)f->wstats.dropped, (unsigned long long)f->rejects_sent,
             (unsigned long long)f->version_mismatches, (unsigned long long)f->wstats.disconnects,
+            (unsigned long long)f->nonfinite_samples,
             master_cpu_seconds());
 }
 

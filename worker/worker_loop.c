@@ -221,6 +221,7 @@ static bool send_task(worker_loop *w, worker_task *t)
     st.peak_cache_bytes = t->stats.peak_cache_bytes;
     st.cpu_seconds = t->stats.cpu_seconds;
     st.wall_seconds = t->stats.wall_seconds;
+    st.nonfinite_samples = t->stats.nonfinite_samples;
     Aafarm__Result r = AAFARM__RESULT__INIT;
     r.job_hash = t->job->hash;
     r.lease_id = t->lease_id;

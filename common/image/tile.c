@@ -20,6 +20,7 @@
  */
 #include "image/tile.h"
 
+#include <math.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -101,6 +102,35 @@ static bool tile_fits_format(const image_tile *self, const image_format *fmt,
         return false;
     }
     return true;
+}
+
+static size_t clear_plane(const image_tile *t, float *v, int per_pixel, bool depth, size_t *first)
+{
+    if (!v) return 0;
+    size_t n = 0, count = (size_t)t->w * (size_t)t->h * (size_t)per_pixel;
+    for (size_t i = 0; i < count; i++) {
+        float x = v[i];
+        if (depth ? !(x == x) || x == -INFINITY : !isfinite(x)) {
+            v[i] = depth ? INFINITY : 0.0f;
+            if (*first > i / (size_t)per_pixel) *first = i / (size_t)per_pixel;
+            n++;
+        }
+    }
+    return n;
+}
+
+size_t image_tile_clear_nonfinite(image_tile *self, int *first_x, int *first_y)
+{
+    size_t first = SIZE_MAX;
+    size_t n = clear_plane(self, self->rgba, 4, false, &first)
+               + clear_plane(self, self->z, 1, true, &first)
+               + clear_plane(self, self->n, 3, false, &first)
+               + clear_plane(self, self->p, 3, false, &first);
+    if (n) {
+        *first_x = self->x0 + (int) (first % (size_t) self->w);
+        *first_y = self->y0 + (int) (first / (size_t) self->w);
+    }
+    return n;
 }
 
 bool image_tile_encode_exr(const image_tile *self, const image_format *fmt,

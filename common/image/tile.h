@@ -56,6 +56,14 @@ image_rect image_tile_rect(const image_tile *self);
 /* Encodes the tile as a one-tile EXR file of image `fmt` (the tile must be
  * a tile of fmt's grid and have fmt's layers). On success *bytes (malloc'd,
  * the caller frees) and *len hold the file. Same pixels, same bytes. */
+/* Non-finite samples (a surface shader dividing by zero, overflowing...)
+ * made safe before the tile is written: NaN, +Inf and -Inf in RGBA, N and P
+ * become 0; in Z, NaN and -Inf become +Inf ("nothing hit", what Z holds
+ * where no object is) while +Inf stays. Returns how many samples were
+ * changed; the first one's pixel goes to *first_x, *first_y (full-image
+ * coordinates; untouched when none). */
+size_t image_tile_clear_nonfinite(image_tile *self, int *first_x, int *first_y);
+
 bool image_tile_encode_exr(const image_tile *self, const image_format *fmt,
                            void **bytes, size_t *len, char *err, size_t errsz);
 
