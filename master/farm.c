@@ -522,6 +522,7 @@ int farm_run(const farm_options *opt, const job *jb, const image_format *fmt)
         return rc;
     }
     f.start_ms = farm_now_ms();
+    console_set_resumed(f.con, f.resumed_tiles);
     console_log(f.con, CONSOLE_INFO, "%s: %dx%d, %d tiles of %d, job %.12s (%zu bytes)",
                 opt->scene_path, f.fmt.width, f.fmt.height, f.ntiles, f.fmt.tile_size, jb->hash,
                 f.job_bytes);

@@ -19,8 +19,11 @@
  * flags, tiling, tile size, data and display windows, channels, types and
  * compression are all checked before OpenEXRCore parses anything), the
  * chunk offset table and chunk leader must point exactly at the chunk, the
- * chunk must fill the rest of the bytes, and the chunk must decode cleanly
- * to the expected layout.
+ * chunk must fill the rest of the bytes, and the chunk must decompress
+ * cleanly (zlib's checks) to exactly the expected unpacked size. The
+ * samples are not converted: any bit pattern is a valid half or float.
+ * Cost on the master: about 0.05 ms for a 32x32 tile, 13 ms for 512x512
+ * (bench/tile_validate_bench).
  *
  * Buffers of an image_tile are row-major, w*h pixels, row y of the tile
  * first at index y*w: rgba 4 floats per pixel (R G B A, premultiplied),
