@@ -9,8 +9,8 @@
  * depends on where the tile sits). So the master hands the validated bytes
  * to exr_write_tile_chunk() with the output tile coordinates, and
  * OpenEXRCore writes the chunk leader, the data and (at exr_finish) the
- * offset table. No pixel is decoded or re-encoded on the master except
- * once, inside validation, to prove the chunk is intact.
+ * offset table. No pixel is decoded or re-encoded on the master; the chunk
+ * is decompressed once, inside validation, to prove it intact.
  */
 #include "image/writer.h"
 
