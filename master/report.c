@@ -7,6 +7,7 @@
 #include <errno.h>
 #include <stdio.h>
 #include <string.h>
+#include <unistd.h>
 #include <sys/resource.h>
 
 #include "farm_internal.h"
@@ -169,8 +170,11 @@ bool farm_report_json(const farm *f, const char *path, char *err, size_t errsz)
         fputs(i + 1 < registry_count(f->reg) ? ",\n" : "\n", out);
     }
     fputs("  ]\n}\n", out);
-    if (fclose(out) != 0) {
-        snprintf(err, errsz, "cannot write %s: %s", path, strerror(errno));
+    bool failed = ferror(out) != 0;
+    if (fclose(out) != 0 || failed) {
+        snprintf(err, errsz, "cannot write %s: %s", path,
+                 strerror(errno ? errno : EIO));
+        unlink(path);   /* no half-written statistics file */
         return false;
     }
     return true;

@@ -13,7 +13,9 @@
  *     larger) `--resume` completes the image, equal to the standalone
  *     render;
  *   - the final rename fails (OUT.exr is a folder): exit 1, "cannot
- *     rename", no temporary file left.
+ *     rename", no temporary file left;
+ *   - --stats-json on a full disk (the image elsewhere): exit 1, the
+ *     image in place, no half-written statistics file.
  * Every process runs under timeout -k and is reaped by PID. Needs root
  * (mount); skipped with a message otherwise.
  */
@@ -203,6 +205,20 @@ static void test_rename_fails_master(void **state)
     assert_int_equal(rmdir(ft_path(mnt, "out.exr")), 0);   /* still an empty folder */
 }
 
+static void test_stats_json_on_full_disk(void **state)
+{
+    (void)state;
+    mount_small(16, 64);
+    const char *log = ft_path(dir, "stats.log"), *out = ft_path(dir, "stats.exr");
+    const char *argv[] = {ft_master, ft_path(dir, "scene.rib"), "-o", out, "--tile", "8",
+                          "--local-workers", "2", "--stats-json", ft_path(mnt, "stats.json"),
+                          NULL};
+    assert_int_equal(run_bounded(log, argv), 1);
+    assert_int_equal(ft_count(log, "/mnt/stats.json: No space left on device"), 1);
+    assert_int_equal(ft_count_files(mnt, "stats.json"), 0);
+    assert_int_equal(ft_exr_diff(ft_path(dir, "ref.exr"), out), 0);
+}
+
 int main(int argc, char **argv)
 {
     if (!ft_init(argc, argv)) return 2;
@@ -212,6 +228,7 @@ int main(int argc, char **argv)
         cmocka_unit_test_teardown(test_diskfull_mid_render_master, teardown),
         cmocka_unit_test_teardown(test_diskfull_mid_render_standalone, teardown),
         cmocka_unit_test_teardown(test_rename_fails_master, teardown),
+        cmocka_unit_test_teardown(test_stats_json_on_full_disk, teardown),
     };
     return cmocka_run_group_tests(tests, group_setup, group_teardown);
 }
