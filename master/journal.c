@@ -256,6 +256,11 @@ journal *journal_resume(const char *path, const journal_id *id, journal_tile_fn 
         return NULL;
     }
     struct stat st;
+    if (fstat(fd, &st) == 0 && st.st_size < HEADER_BYTES) {
+        close(fd);           /* killed while creating it: no tile was journaled */
+        *missing = true;
+        return NULL;
+    }
     if (fstat(fd, &st) != 0 || !check_header(path, fd, id, err, errsz)) {
         close(fd);
         return NULL;

@@ -79,7 +79,8 @@ typedef bool (*journal_tile_fn)(void *arg, int tile, const void *chunk, size_t l
  * (else NULL, err says which job it belongs to), replays its intact
  * records through fn, truncates a torn or corrupt tail and leaves the
  * journal ready for appending. *missing is set (and NULL returned, err
- * empty) when there is no journal at path. */
+ * empty) when there is no journal at path, or one shorter than its header
+ * (a master killed while creating it: it holds no tile). */
 journal *journal_resume(const char *path, const journal_id *id, journal_tile_fn fn, void *arg,
                         journal_replay *info, bool *missing, char *err, size_t errsz);
 

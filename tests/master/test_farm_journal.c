@@ -254,6 +254,11 @@ static void test_journal_missing_and_locked(void **state)
     assert_null(journal_resume(path, &job_a, on_tile, &s, &info, &missing, err, sizeof err));
     assert_false(missing);
     journal_close(&j);
+    /* a journal cut inside its header holds no tile: as good as missing */
+    assert_int_equal(truncate(path, 40), 0);
+    missing = false;
+    assert_null(journal_resume(path, &job_a, on_tile, &s, &info, &missing, err, sizeof err));
+    assert_true(missing);
     /* a fresh render replaces a journal with records and says so */
     write_journal();
     j = journal_create(path, &job_a, &replaced, err, sizeof err);
