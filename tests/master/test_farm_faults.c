@@ -8,6 +8,8 @@
  *   - random bytes, truncated ZMTP frames and malformed messages sent to
  *     the master's port while it renders: it keeps working, counts them,
  *     and answers a message from an unknown peer with Reject HELLO_FIRST;
+ *   - a worker named with bytes that are not UTF-8: --stats-json stays
+ *     valid (U+FFFD for each bad byte);
  *   - a worker whose job preparation takes longer than the heartbeat
  *     timeout (--prepare-delay) keeps heartbeating: never declared dead,
  *     nothing requeued, it renders its tiles;
@@ -137,6 +139,25 @@ static void test_farm_sigstop_worker_requeued(void **state)
     assert_int_equal(ft_wait(sleeper, 20), 130);
     kill(other, SIGTERM);
     assert_int_equal(ft_wait(other, 20), 130);
+}
+
+/* A worker may call itself anything: --stats-json stays valid UTF-8 JSON */
+static void test_farm_raw_byte_worker_name(void **state)
+{
+    (void)state;
+    const char *log = ft_path(dir, "raw.log"), *json = ft_path(dir, "raw.json");
+    char ep[256];
+    pid_t master = start_master(ft_path(dir, "raw.exr"), log, json, ep, sizeof ep);
+    pid_t worker = start_worker(ep, "w\xff\xc0\xe2\x82\xac\\q\xed\xa0\x80", "0");
+    assert_int_equal(ft_wait(master, 120), 0);
+    char *text = ft_read(json);
+    /* invalid bytes as U+FFFD, the euro sign kept, the backslash escaped */
+    assert_non_null(strstr(text, "\"name\": \"w\\ufffd\\ufffd\xe2\x82\xac\\\\q\\ufffd\\ufffd\\ufffd\""));
+    for (const unsigned char *p = (const unsigned char *)text; *p; p++)
+        assert_true(*p != 0xff && *p != 0xc0 && *p != 0xed);
+    free(text);
+    kill(worker, SIGTERM);
+    assert_int_equal(ft_wait(worker, 20), 130);
 }
 
 static void test_farm_slow_preparation_keeps_heartbeating(void **state)
@@ -325,6 +346,7 @@ int main(int argc, char **argv)
         cmocka_unit_test_teardown(test_farm_sigstop_worker_requeued, teardown),
         cmocka_unit_test_teardown(test_farm_garbage_to_master_port, teardown),
         cmocka_unit_test_teardown(test_farm_slow_preparation_keeps_heartbeating, teardown),
+        cmocka_unit_test_teardown(test_farm_raw_byte_worker_name, teardown),
         cmocka_unit_test_teardown(test_farm_sigint_master_cleans_up, teardown),
     };
     return cmocka_run_group_tests(tests, group_setup, group_teardown);
