@@ -21,7 +21,8 @@
  * heartbeating and sending finished tiles, so the master does not take a
  * slow preparation for a dead worker (issue 12). Messages that arrive
  * meanwhile wait in the socket's queue (their arrival counts as a sign of
- * the master's life) and are handled when the job is ready.
+ * the master's life) and are handled when the job is ready. SIGINT or
+ * SIGTERM meanwhile: Shutdown to the master, then exit 130 at once.
  */
 #include "worker_loop.h"
 
@@ -378,6 +379,18 @@ static held_job *prepare_job(worker_loop *w, const Aafarm__Job *m)
     }
     long step = w->heartbeat_ms / 4 < 50 ? (w->heartbeat_ms / 4 > 0 ? w->heartbeat_ms / 4 : 1) : 50;
     while (!atomic_load(&p.done)) {
+        if (interrupted) {
+            /* the helper cannot be stopped and holds the job list: tell the
+             * master (it requeues our tiles at once) and leave without
+             * tearing anything down */
+            wlog(w, 0, "interrupted while preparing job %.12s; leaving", m->job_hash);
+            send_shutdown(w, "the worker was stopped (SIGINT/SIGTERM) while preparing a job");
+            int linger = 500;
+            zmq_setsockopt(w->dealer, ZMQ_LINGER, &linger, sizeof linger);
+            zmq_close(w->dealer);
+            zmq_ctx_term(w->ctx);   /* sends what is queued, for at most 500 ms */
+            _exit(AAFARM_EXIT_INTERRUPTED);
+        }
         zmq_pollitem_t item = {NULL, worker_pool_wake_fd(w->pool), ZMQ_POLLIN, 0};
         zmq_poll(&item, 1, step);
         int events = 0;

@@ -12,7 +12,8 @@
  *     valid (U+FFFD for each bad byte);
  *   - a worker whose job preparation takes longer than the heartbeat
  *     timeout (--prepare-delay) keeps heartbeating: never declared dead,
- *     nothing requeued, it renders its tiles;
+ *     nothing requeued, it renders its tiles; SIGTERM during a long
+ *     preparation ends it at once (exit 130, Shutdown sent);
  *   - SIGINT to a master with local workers: exit 130, no output and no
  *     temporary file left, the local workers stopped.
  * Workers are slowed down with --tile-delay so that "mid-render" is
@@ -178,6 +179,29 @@ static void test_farm_slow_preparation_keeps_heartbeating(void **state)
     assert_true(ft_count(log, " from slowprep (lease") >= 1);
     kill(worker, SIGTERM);
     assert_int_equal(ft_wait(worker, 20), 130);
+}
+
+/* SIGTERM while the worker prepares: it says Shutdown and exits 130 at
+ * once (not after the preparation); the master requeues its tiles */
+static void test_farm_sigterm_during_preparation(void **state)
+{
+    (void)state;
+    const char *log = ft_path(dir, "prepint.log"), *json = ft_path(dir, "prepint.json");
+    char ep[256];
+    pid_t master = start_master(ft_path(dir, "prepint.exr"), log, json, ep, sizeof ep);
+    const char *argv[] = {ft_worker, "--connect", ep, "--name", "quitter", "--threads", "1",
+                          "--prepare-delay", "60000", NULL};
+    pid_t quitter = ft_spawn(ft_path(dir, "quitter.log"), argv);
+    assert_true(ft_wait_for(log, "granted tile ", 1, 30));
+    assert_true(ft_wait_for(log, "sent the job ", 1, 30));
+    kill(quitter, SIGTERM);
+    assert_int_equal(ft_wait(quitter, 10), 130);   /* not 60 s */
+    assert_true(ft_wait_for(log, "worker quitter left (the worker was stopped", 1, 10));
+    pid_t other = start_worker(ep, "finisher", "0");
+    assert_int_equal(ft_wait(master, 120), 0);
+    assert_int_equal(ft_exr_diff(ft_path(dir, "ref.exr"), ft_path(dir, "prepint.exr")), 0);
+    kill(other, SIGTERM);
+    assert_int_equal(ft_wait(other, 20), 130);
 }
 
 /* ---- garbage for the master's port ---- */
@@ -347,6 +371,7 @@ int main(int argc, char **argv)
         cmocka_unit_test_teardown(test_farm_garbage_to_master_port, teardown),
         cmocka_unit_test_teardown(test_farm_slow_preparation_keeps_heartbeating, teardown),
         cmocka_unit_test_teardown(test_farm_raw_byte_worker_name, teardown),
+        cmocka_unit_test_teardown(test_farm_sigterm_during_preparation, teardown),
         cmocka_unit_test_teardown(test_farm_sigint_master_cleans_up, teardown),
     };
     return cmocka_run_group_tests(tests, group_setup, group_teardown);
