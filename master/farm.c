@@ -55,6 +55,7 @@ void farm_options_default(farm_options *opt)
     opt->max_attempts = 3;
     opt->max_duplicates = 1;
     opt->lease_ms = 120000;
+    opt->max_workers = 1024;
 }
 
 int64_t farm_now_ms(void)

@@ -35,6 +35,7 @@ typedef struct farm_options {
     int64_t lease_ms;              /* Grant.deadline_ms (120000) */
     int verbosity;                 /* -1 quiet, 0 normal, 1 verbose */
     bool resume;                   /* --resume: take the tiles in OUT.exr.journal */
+    int max_workers;               /* live workers at most; more are refused (1024) */
 } farm_options;
 
 void farm_options_default(farm_options *opt);

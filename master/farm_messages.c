@@ -206,6 +206,16 @@ static void on_hello(farm *f, const Aafarm__Hello *h, const uint8_t *id, size_t 
     }
     farm_worker *w = registry_find(f->reg, id, id_len);
     if (w) farm_lose_worker(f, w, "said Hello again", now);
+    if (registry_alive(f->reg) >= f->opt->max_workers) {
+        snprintf(why, sizeof why, "the master serves at most %d workers at a time "
+                 "(--max-workers)", f->opt->max_workers);
+        console_log(f->con, CONSOLE_INFO, "refused worker %s on %s (peer %s): %s",
+                    h->worker_name && *h->worker_name ? h->worker_name : "?",
+                    h->host && *h->host ? h->host : "?", registry_id_hex(id, id_len, hex, sizeof hex),
+                    why);
+        send_reject(f, id, id_len, AAFARM__REJECT_CODE__REJECT_CODE_REFUSED, why);
+        return;
+    }
     w = registry_add(f->reg, id, id_len, now);
     if (!w) return;
     copy_name(w->name, sizeof w->name, h->worker_name);

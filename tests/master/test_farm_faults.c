@@ -204,6 +204,31 @@ static void test_farm_sigterm_during_preparation(void **state)
     assert_int_equal(ft_wait(other, 20), 130);
 }
 
+/* --max-workers 1: the second worker is refused (exit 2, the reason
+ * printed), the first renders everything */
+static void test_farm_max_workers(void **state)
+{
+    (void)state;
+    const char *log = ft_path(dir, "max.log"), *json = ft_path(dir, "max.json");
+    const char *argv[] = {ft_master, ft_path(dir, "scene.rib"), "-o", ft_path(dir, "max.exr"),
+                          "--bind", "tcp://127.0.0.1:*", "--tile", "8", "--max-workers", "1",
+                          "--stats-json", json, "-v", NULL};
+    pid_t master = ft_spawn(log, argv);
+    char ep[256];
+    assert_true(ft_master_endpoint(log, ep, sizeof ep, 30));
+    pid_t first = start_worker(ep, "first", "20");
+    assert_true(ft_wait_for(log, "worker first joined", 1, 30));
+    pid_t second = start_worker(ep, "second", "0");
+    assert_int_equal(ft_wait(second, 30), 2);
+    assert_int_equal(ft_count(ft_path(dir, "second.log"),
+                              "refused this worker: the master serves at most 1 workers"), 1);
+    assert_int_equal(ft_count(log, "refused worker second"), 1);
+    assert_int_equal(ft_wait(master, 120), 0);
+    assert_int_equal(ft_exr_diff(ft_path(dir, "ref.exr"), ft_path(dir, "max.exr")), 0);
+    kill(first, SIGTERM);
+    assert_int_equal(ft_wait(first, 20), 130);
+}
+
 /* ---- garbage for the master's port ---- */
 
 static int tcp_connect(int port)
@@ -372,6 +397,7 @@ int main(int argc, char **argv)
         cmocka_unit_test_teardown(test_farm_slow_preparation_keeps_heartbeating, teardown),
         cmocka_unit_test_teardown(test_farm_raw_byte_worker_name, teardown),
         cmocka_unit_test_teardown(test_farm_sigterm_during_preparation, teardown),
+        cmocka_unit_test_teardown(test_farm_max_workers, teardown),
         cmocka_unit_test_teardown(test_farm_sigint_master_cleans_up, teardown),
     };
     return cmocka_run_group_tests(tests, group_setup, group_teardown);
