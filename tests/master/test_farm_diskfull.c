@@ -87,7 +87,14 @@ static void mount_small(int kib, int fill_kib)
     if (!can_mount) skip();
     char opt[64];
     snprintf(opt, sizeof opt, "size=%dk,mode=0755", kib);
-    assert_int_equal(mount("tmpfs", mnt, "tmpfs", 0, opt), 0);
+    int rc = mount("tmpfs", mnt, "tmpfs", 0, opt);
+    if (rc != 0 && (errno == EPERM || errno == EACCES)) {   /* a container without the right */
+        fprintf(stderr, "test_farm_diskfull: SKIPPED: cannot mount a tmpfs here: %s\n",
+                strerror(errno));
+        can_mount = false;
+        skip();
+    }
+    assert_int_equal(rc, 0);
     if (fill_kib <= 0) return;
     int fd = open(ft_path(mnt, "filler"), O_WRONLY | O_CREAT, 0644);
     assert_true(fd >= 0);
