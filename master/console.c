@@ -15,7 +15,13 @@ struct console {
     bool shown;            /* line is on screen now */
     int64_t last_ms;       /* last redraw or progress log */
     int last_tenth;        /* last tenth of the image logged */
+    int resumed;           /* tiles done before the start (--resume): not in the rate */
 };
+
+void console_set_resumed(console *self, int tiles)
+{
+    self->resumed = tiles;
+}
 
 console *console_new(int verbosity, bool tty)
 {
@@ -65,10 +71,10 @@ void console_log(console *self, console_level level, const char *fmt, ...)
     fflush(stderr);
 }
 
-static void format_progress(char *buf, size_t n, int done, int total, int workers,
-                            double secs)
+static void format_progress(char *buf, size_t n, int done, int total, int resumed,
+                            int workers, double secs)
 {
-    double rate = secs > 0 ? done / secs : 0;
+    double rate = secs > 0 ? (done - resumed) / secs : 0;
     char eta[32] = "-";
     if (rate > 0 && done < total) snprintf(eta, sizeof eta, "%.0f s", (total - done) / rate);
     else if (done == total) snprintf(eta, sizeof eta, "0 s");
@@ -86,7 +92,7 @@ void console_progress(console *self, int done, int total, int workers, int64_t s
         if (!final && now_ms - self->last_ms < 100) return;
         self->last_ms = now_ms;
         char body[160];
-        format_progress(body, sizeof body, done, total, workers, secs);
+        format_progress(body, sizeof body, done, total, self->resumed, workers, secs);
         snprintf(self->line, sizeof self->line, "  %s", body);
         draw_line(self);
         if (final) {
@@ -101,7 +107,7 @@ void console_progress(console *self, int done, int total, int workers, int64_t s
     self->last_tenth = tenth;
     self->last_ms = now_ms;
     char body[160];
-    format_progress(body, sizeof body, done, total, workers, secs);
+    format_progress(body, sizeof body, done, total, self->resumed, workers, secs);
     fprintf(stderr, "aafarm-master: %s\n", body);
     fflush(stderr);
 }

@@ -31,6 +31,10 @@ void console_log(console *self, console_level level, const char *fmt, ...)
 
 /* The render's progress at time now_ms (elapsed since start_ms); redraws or
  * logs when due. final: the last call (always shown, ends the line). */
+/* Tiles that were done before the render started (--resume): the rate
+ * and the ETA count only the others. */
+void console_set_resumed(console *self, int tiles);
+
 void console_progress(console *self, int done, int total, int workers, int64_t start_ms,
                       int64_t now_ms, bool final);
 

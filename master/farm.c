@@ -33,6 +33,7 @@
 #include "farm_internal.h"
 #include "image/buffer.h"
 #include "image/preview.h"
+#include "stale.h"
 #include "util/exitcodes.h"
 
 static volatile sig_atomic_t interrupted;
@@ -54,6 +55,7 @@ void farm_options_default(farm_options *opt)
     opt->max_attempts = 3;
     opt->max_duplicates = 1;
     opt->lease_ms = 120000;
+    opt->max_workers = 1024;
 }
 
 int64_t farm_now_ms(void)
@@ -77,17 +79,38 @@ static uint64_t random_session(void)
     return v ? v : 1;
 }
 
-/* The embedded mode's private endpoint: ipc://<new temp folder>/master.sock */
+static void report_leftover(void *arg, const char *path, long pid, int removed)
+{
+    farm *f = arg;
+    if (removed)
+        console_log(f->con, CONSOLE_INFO, "removed %s, left behind by a master that died "
+                    "(pid %ld)", path, pid);
+    else
+        console_log(f->con, CONSOLE_INFO, "left %s alone: it belongs to process %ld, which "
+                    "still runs (remove it by hand if that is no master)", path, pid);
+}
+
+/* The embedded mode's private endpoint: ipc://<new temp folder>/master.sock,
+ * with master.pid beside it so that the next master can tell the folder of
+ * a dead master from that of a running one (stale.h). */
 static bool make_private_endpoint(farm *f, char *ep, size_t n, char *err, size_t errsz)
 {
     const char *tmp = getenv("TMPDIR");
     if (!tmp || !*tmp || strlen(tmp) > 60) tmp = "/tmp";
+    stale_clean_ipc_dirs(tmp, report_leftover, f);
     snprintf(f->ipc_dir, sizeof f->ipc_dir, "%s/aafarm-XXXXXX", tmp);
     if (!mkdtemp(f->ipc_dir)) {
         snprintf(err, errsz, "cannot create a private folder in %s for the local workers' "
                  "socket: %s", tmp, strerror(errno));
         f->ipc_dir[0] = '\0';
         return false;
+    }
+    char pidfile[PATH_MAX + 16];
+    snprintf(pidfile, sizeof pidfile, "%s/%s", f->ipc_dir, STALE_PID_FILE);
+    FILE *pf = fopen(pidfile, "w");
+    if (pf) {
+        fprintf(pf, "%ld\n", (long)getpid());
+        fclose(pf);
     }
     snprintf(ep, n, "ipc://%s/master.sock", f->ipc_dir);
     return true;
@@ -98,6 +121,8 @@ static void remove_private_endpoint(farm *f)
     if (!f->ipc_dir[0]) return;
     char sock[PATH_MAX + 16];
     snprintf(sock, sizeof sock, "%s/master.sock", f->ipc_dir);
+    unlink(sock);
+    snprintf(sock, sizeof sock, "%s/%s", f->ipc_dir, STALE_PID_FILE);
     unlink(sock);
     rmdir(f->ipc_dir);
     f->ipc_dir[0] = '\0';
@@ -179,6 +204,62 @@ static int check_job_message(farm *f, char *err, size_t errsz)
     return AAFARM_EXIT_OK;
 }
 
+/* A journaled tile goes into the new output file and is DONE. */
+static bool replay_tile(void *arg, int tile, const void *chunk, size_t len, char *err,
+                        size_t errsz)
+{
+    farm *f = arg;
+    if (!image_writer_put_chunk(f->writer, tile % f->tiles_x, tile / f->tiles_x, chunk, len,
+                                err, errsz))
+        return false;
+    if (scheduler_mark_done(f->sched, tile)) f->resumed_tiles++;
+    return true;
+}
+
+/* --resume: the journal's tiles are in; otherwise a new, empty journal. */
+static int open_journal(farm *f, char *err, size_t errsz)
+{
+    char *path = journal_path_for(f->opt->output);
+    if (!path) abort();
+    journal_id id;
+    memset(&id, 0, sizeof id);
+    snprintf(id.job_hash, sizeof id.job_hash, "%s", f->jb->hash);
+    id.width = (uint32_t)f->fmt.width;
+    id.height = (uint32_t)f->fmt.height;
+    id.tile_size = (uint32_t)f->fmt.tile_size;
+    id.layers = (uint32_t)f->fmt.layers;
+    id.tiles = (uint32_t)f->ntiles;
+    int rc = AAFARM_EXIT_OK;
+    bool missing = !f->opt->resume;
+    if (f->opt->resume) {
+        journal_replay info;
+        f->jnl = journal_resume(path, &id, replay_tile, f, &info, &missing, err, errsz);
+        if (f->jnl) {
+            console_log(f->con, CONSOLE_INFO, "resuming: %d of %d tiles taken from %s", info.tiles,
+                        f->ntiles, path);
+            if (info.dropped_bytes)
+                console_log(f->con, CONSOLE_INFO, "the journal ended in %s: dropped its last "
+                            "%llu bytes (those tiles are rendered again)", info.dropped_why,
+                            (unsigned long long)info.dropped_bytes);
+        } else if (missing) {
+            console_log(f->con, CONSOLE_INFO, "--resume: no journal %s, rendering every tile",
+                        path);
+        } else {
+            rc = image_writer_failed(f->writer) ? AAFARM_EXIT_FAILURE : AAFARM_EXIT_USAGE;
+        }
+    }
+    if (missing) {
+        bool replaced = false;
+        f->jnl = journal_create(path, &id, &replaced, err, errsz);
+        if (!f->jnl) rc = AAFARM_EXIT_FAILURE;
+        else if (replaced)
+            console_log(f->con, CONSOLE_INFO, "replaced the journal of an unfinished render "
+                        "(%s): --resume would have continued it", path);
+    }
+    free(path);
+    return rc;
+}
+
 static int setup(farm *f, char *err, size_t errsz)
 {
     f->limits = proto_limits_default();
@@ -196,8 +277,12 @@ static int setup(farm *f, char *err, size_t errsz)
     f->jobmsg = job_message_new(f->jb, &f->fmt);
     int rc = check_job_message(f, err, errsz);
     if (rc != AAFARM_EXIT_OK) return rc;
+    stale_clean_outputs(f->opt->output, report_leftover, f);
+    if (f->opt->preview) stale_clean_outputs(f->opt->preview, report_leftover, f);
     f->writer = image_writer_new(f->opt->output, &f->fmt, err, errsz);
     if (!f->writer) return AAFARM_EXIT_FAILURE;
+    rc = open_journal(f, err, errsz);
+    if (rc != AAFARM_EXIT_OK) return rc;
     rc = open_socket(f, err, errsz);
     if (rc != AAFARM_EXIT_OK) return rc;
     return start_local_workers(f, err, errsz);
@@ -351,6 +436,18 @@ static int finish(farm *f)
         f->state = FARM_FAILED;
         snprintf(f->failure, sizeof f->failure, "%s", err);
     }
+    if (f->state == FARM_DONE || (f->jnl && scheduler_tiles_done(f->sched) == 0)) {
+        journal_remove(&f->jnl);   /* the image is in place, or nothing to resume */
+    } else if (f->jnl) {
+        char jerr[600];
+        if (journal_sync(f->jnl, jerr, sizeof jerr))
+            console_log(f->con, CONSOLE_ERROR, "%d of %d tiles kept in %s: the same command with "
+                        "--resume renders only the others", scheduler_tiles_done(f->sched),
+                        f->ntiles, journal_file(f->jnl));
+        else
+            console_log(f->con, CONSOLE_ERROR, "%s", jerr);
+        journal_close(&f->jnl);
+    }
     f->end_ms = farm_now_ms();
     if (f->state == FARM_DONE)
         console_progress(f->con, f->ntiles, f->ntiles, registry_alive(f->reg), f->start_ms,
@@ -360,6 +457,10 @@ static int finish(farm *f)
     int rc = AAFARM_EXIT_OK;
     switch (f->state) {
     case FARM_DONE:
+        if (f->nonfinite_samples)
+            console_log(f->con, CONSOLE_ERROR, "warning: %llu NaN/Inf samples in %d tiles were "
+                        "written as 0 (Z: as no hit); a shader divides by zero or overflows "
+                        "there", (unsigned long long)f->nonfinite_samples, f->nonfinite_tiles);
         console_log(f->con, CONSOLE_INFO, "wrote %s (%dx%d, %d tiles, %.2f s)", f->opt->output,
                     f->fmt.width, f->fmt.height, f->ntiles, (double)(f->end_ms - f->start_ms) / 1000.0);
         if (f->opt->preview) write_preview(f);
@@ -385,6 +486,8 @@ static int finish(farm *f)
 static void teardown(farm *f)
 {
     image_writer_destroy(&f->writer);   /* unfinished: removes the temporary file */
+    if (f->jnl && scheduler_tiles_done(f->sched) == 0) journal_remove(&f->jnl);
+    journal_close(&f->jnl);             /* kept for --resume */
     local_workers_destroy(&f->locals);
     wire_monitor_destroy(&f->monitor);
     if (f->router) zmq_close(f->router);
@@ -420,6 +523,7 @@ int farm_run(const farm_options *opt, const job *jb, const image_format *fmt)
         return rc;
     }
     f.start_ms = farm_now_ms();
+    console_set_resumed(f.con, f.resumed_tiles);
     console_log(f.con, CONSOLE_INFO, "%s: %dx%d, %d tiles of %d, job %.12s (%zu bytes)",
                 opt->scene_path, f.fmt.width, f.fmt.height, f.ntiles, f.fmt.tile_size, jb->hash,
                 f.job_bytes);

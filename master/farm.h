@@ -34,6 +34,8 @@ typedef struct farm_options {
     int max_duplicates;            /* end-game duplicate leases per tile (1) */
     int64_t lease_ms;              /* Grant.deadline_ms (120000) */
     int verbosity;                 /* -1 quiet, 0 normal, 1 verbose */
+    bool resume;                   /* --resume: take the tiles in OUT.exr.journal */
+    int max_workers;               /* live workers at most; more are refused (1024) */
 } farm_options;
 
 void farm_options_default(farm_options *opt);

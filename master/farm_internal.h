@@ -17,6 +17,7 @@
 #include "farm.h"
 #include "image/writer.h"
 #include "job_message.h"
+#include "journal.h"
 #include "local_workers.h"
 #include "registry.h"
 #include "scheduler.h"
@@ -43,6 +44,8 @@ typedef struct farm {
     scheduler *sched;
     registry *reg;
     image_writer *writer;
+    journal *jnl;                  /* OUT.exr.journal: the tiles taken so far */
+    int resumed_tiles;             /* tiles replayed from the journal (--resume) */
     local_workers *locals;
     console *con;
     job_message *jobmsg;
@@ -56,6 +59,8 @@ typedef struct farm {
     uint64_t invalid_tiles, rejects_sent, version_mismatches, jobs_sent;
     uint64_t grant_bytes, result_bytes, sent_bytes;
     uint64_t drops_unlogged;       /* malformed messages not logged yet */
+    uint64_t nonfinite_samples;    /* NaN/Inf samples in the tiles taken */
+    int nonfinite_tiles;
     int64_t drop_logged_ms;
 } farm;
 

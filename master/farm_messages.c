@@ -5,8 +5,10 @@
  *   Hello      version check (Reject VERSION_MISMATCH), register, Welcome
  *   Ask        credits += n; granting happens in farm_grant_all()
  *   Result     stale (unknown lease, other job) / duplicate (tile DONE) /
- *              taken: the EXR is validated and its chunk copied into the
- *              output; an invalid EXR counts as a retryable failure
+ *              taken: the EXR is validated, its chunk appended to the
+ *              journal and copied into the output; an invalid EXR counts
+ *              as a retryable failure of the worker, a write error of the
+ *              journal or the output fails the render (the master's fault)
  *   Failure    retried elsewhere up to max_attempts, then the job fails
  *   NeedJob    the Job again
  *   Heartbeat  liveness only (any message counts)
@@ -204,6 +206,16 @@ static void on_hello(farm *f, const Aafarm__Hello *h, const uint8_t *id, size_t 
     }
     farm_worker *w = registry_find(f->reg, id, id_len);
     if (w) farm_lose_worker(f, w, "said Hello again", now);
+    if (registry_alive(f->reg) >= f->opt->max_workers) {
+        snprintf(why, sizeof why, "the master serves at most %d workers at a time "
+                 "(--max-workers)", f->opt->max_workers);
+        console_log(f->con, CONSOLE_INFO, "refused worker %s on %s (peer %s): %s",
+                    h->worker_name && *h->worker_name ? h->worker_name : "?",
+                    h->host && *h->host ? h->host : "?", registry_id_hex(id, id_len, hex, sizeof hex),
+                    why);
+        send_reject(f, id, id_len, AAFARM__REJECT_CODE__REJECT_CODE_REFUSED, why);
+        return;
+    }
     w = registry_add(f->reg, id, id_len, now);
     if (!w) return;
     copy_name(w->name, sizeof w->name, h->worker_name);
@@ -262,6 +274,7 @@ static void add_stats(farm_worker *w, const Aafarm__TileStats *s)
     w->cache_evictions += s->cache_evictions;
     if (s->peak_cache_bytes > w->peak_cache_bytes) w->peak_cache_bytes = s->peak_cache_bytes;
     w->render_seconds += s->wall_seconds;
+    w->nonfinite_samples += s->nonfinite_samples;
     w->cpu_seconds += s->cpu_seconds;
 }
 
@@ -290,10 +303,30 @@ static void on_result(farm *f, farm_worker *w, const Aafarm__Result *r, const wi
                  r->tile_index, tile);
     } else {
         image_rect rect = image_format_tile_rect(&f->fmt, tile % f->tiles_x, tile / f->tiles_x);
-        if (image_writer_put_exr_chunk(f->writer, bulk, len, rect, err, sizeof err)) {
+        const void *chunk = NULL;
+        size_t chunk_len = 0;
+        if (image_tile_exr_chunk(bulk, len, &f->fmt, rect, &chunk, &chunk_len, err, sizeof err)) {
+            /* journal first: a tile in the journal survives the master */
+            char ioerr[700];
+            if (!journal_append(f->jnl, tile, chunk, chunk_len, now, ioerr, sizeof ioerr) ||
+                !image_writer_put_chunk(f->writer, tile % f->tiles_x, tile / f->tiles_x, chunk,
+                                        chunk_len, ioerr, sizeof ioerr)) {
+                /* the master's own output failed (disk full): not the
+                 * worker's fault, and no other worker can do better */
+                farm_fail(f, "%s", ioerr);
+                return;
+            }
             scheduler_complete(f->sched, w->slot, r->lease_id, now);
             w->tiles++;
             add_stats(w, r->stats);
+            if (r->stats && r->stats->nonfinite_samples) {
+                if (f->nonfinite_tiles++ == 0)
+                    console_log(f->con, CONSOLE_INFO, "warning: tile %d at (%d,%d) from %s had %llu "
+                                "NaN/Inf samples, written as 0 (further ones are counted at the "
+                                "end)", tile, rect.x0, rect.y0, w->name,
+                                (unsigned long long)r->stats->nonfinite_samples);
+                f->nonfinite_samples += r->stats->nonfinite_samples;
+            }
             console_log(f->con, CONSOLE_DETAIL, "took tile %d from %s (lease %llu, %zu bytes)", tile,
                         w->name, (unsigned long long)r->lease_id, len);
             return;

@@ -42,6 +42,10 @@ static void usage(FILE *out)
         "  --lease S                  seconds before a leased tile is handed out again (120)\n"
         "  --duplicates N             end-game duplicate leases per tile (default 1, 0: off)\n"
         "  --worker-binary PATH       aafarm-worker to start (default: next to this program)\n"
+        "  --max-workers N            workers served at a time; more are refused (1024)\n"
+        "  --resume                   continue an unfinished render of the same job: the\n"
+        "                             tiles in OUT.exr.journal are kept, only the others\n"
+        "                             are rendered (every render journals its tiles there)\n"
         "  -q, --quiet                only errors;  -v, --verbose  every grant and tile\n"
         "  -h, --help                 this text\n"
         "\n"
@@ -51,7 +55,8 @@ static void usage(FILE *out)
         "Exit status: 0 the image is complete, 1 the render failed (a tile failed on\n"
         "--retries workers, no workers left, output not writable), 2 usage (bad options\n"
         "or endpoint), 3 bad scene or shader (diagnostics printed, no worker contacted),\n"
-        "130 interrupted by SIGINT/SIGTERM (no output file is left behind).\n");
+        "130 interrupted by SIGINT/SIGTERM (no output file is left behind; the journal\n"
+        "is, for --resume). --resume with another job's journal is a usage error (2).\n");
 }
 
 static bool parse_long(const char *s, long lo, long hi, long *out)
@@ -79,7 +84,7 @@ static int bad_number(const char *opt, const char *what, const char *got)
 static int parse(int argc, char **argv, cli *c)
 {
     enum { O_BIND = 256, O_LOCAL, O_TPW, O_TILE, O_ARITH, O_BUDGET, O_PREVIEW, O_STATS_JSON,
-           O_HEARTBEAT, O_LIVENESS, O_RETRIES, O_LEASE, O_DUPS, O_WORKER_BIN };
+           O_HEARTBEAT, O_LIVENESS, O_RETRIES, O_LEASE, O_DUPS, O_WORKER_BIN, O_RESUME, O_MAX_WORKERS };
     static const struct option longopts[] = {
         {"output", required_argument, 0, 'o'},
         {"bind", required_argument, 0, O_BIND},
@@ -96,6 +101,8 @@ static int parse(int argc, char **argv, cli *c)
         {"lease", required_argument, 0, O_LEASE},
         {"duplicates", required_argument, 0, O_DUPS},
         {"worker-binary", required_argument, 0, O_WORKER_BIN},
+        {"resume", no_argument, 0, O_RESUME},
+        {"max-workers", required_argument, 0, O_MAX_WORKERS},
         {"quiet", no_argument, 0, 'q'},
         {"verbose", no_argument, 0, 'v'},
         {"help", no_argument, 0, 'h'},
@@ -151,6 +158,11 @@ static int parse(int argc, char **argv, cli *c)
             f->max_duplicates = (int)n;
             break;
         case O_WORKER_BIN: f->worker_binary = optarg; break;
+        case O_RESUME: f->resume = true; break;
+        case O_MAX_WORKERS:
+            if (!parse_long(optarg, 1, 65536, &n)) return bad_number("--max-workers", "1..65536", optarg);
+            f->max_workers = (int)n;
+            break;
         case 'q': f->verbosity = -1; break;
         case 'v': f->verbosity = 1; break;
         case 'h': usage(stdout); return AAFARM_EXIT_OK;
@@ -169,6 +181,11 @@ static int parse(int argc, char **argv, cli *c)
         return AAFARM_EXIT_USAGE;
     }
     if (f->bind && !c->local_given) f->local_workers = 0;
+    if (f->local_workers > f->max_workers) {
+        fprintf(stderr, "aafarm-master: --local-workers %d is more than --max-workers %d\n",
+                f->local_workers, f->max_workers);
+        return AAFARM_EXIT_USAGE;
+    }
     if (!f->bind && f->local_workers == 0) {
         fprintf(stderr, "aafarm-master: --local-workers 0 without --bind: no worker could "
                 "ever connect\n");

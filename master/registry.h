@@ -42,6 +42,7 @@ typedef struct farm_worker {
     double render_seconds, cpu_seconds;
     uint64_t rays, boxes, shader_evals, cache_hits, cache_misses, cache_evictions;
     uint64_t peak_cache_bytes;
+    uint64_t nonfinite_samples;    /* NaN/Inf samples its tiles had (written as 0) */
 } farm_worker;
 
 typedef struct registry registry;

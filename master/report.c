@@ -7,6 +7,7 @@
 #include <errno.h>
 #include <stdio.h>
 #include <string.h>
+#include <unistd.h>
 #include <sys/resource.h>
 
 #include "farm_internal.h"
@@ -54,15 +55,36 @@ void farm_report_summary(const farm *f)
 }
 
 /* A JSON string with the characters JSON requires escaped. */
+/* Length of the well-formed UTF-8 sequence at p (RFC 3629: no overlong
+ * forms, no surrogates, at most U+10FFFF), 0 when it is not one. */
+static int utf8_length(const unsigned char *p)
+{
+    if (p[0] < 0x80) return 1;
+    int n = p[0] >= 0xC2 && p[0] <= 0xDF ? 2 : p[0] >= 0xE0 && p[0] <= 0xEF ? 3
+            : p[0] >= 0xF0 && p[0] <= 0xF4 ? 4 : 0;
+    for (int i = 1; i < n; i++)
+        if ((p[i] & 0xC0) != 0x80) return 0;   /* also stops at the NUL */
+    if ((p[0] == 0xE0 && p[1] < 0xA0) || (p[0] == 0xED && p[1] > 0x9F) ||
+        (p[0] == 0xF0 && p[1] < 0x90) || (p[0] == 0xF4 && p[1] > 0x8F))
+        return 0;
+    return n;
+}
+
+/* A JSON string with the characters JSON requires escaped; bytes that are
+ * not UTF-8 (a worker may name itself anything) become U+FFFD, so the file
+ * is always valid JSON. */
 static void json_string(FILE *out, const char *s)
 {
     fputc('"', out);
-    for (const unsigned char *p = (const unsigned char *)s; *p; p++) {
-        if (*p == '"' || *p == '\\') fprintf(out, "\\%c", *p);
+    for (const unsigned char *p = (const unsigned char *)s; *p;) {
+        int n = utf8_length(p);
+        if (n == 0) fputs("\\ufffd", out);
+        else if (*p == '"' || *p == '\\') fprintf(out, "\\%c", *p);
         else if (*p == '\n') fputs("\\n", out);
         else if (*p == '\t') fputs("\\t", out);
         else if (*p < 0x20) fprintf(out, "\\u%04x", *p);
-        else fputc(*p, out);
+        else fwrite(p, 1, (size_t)n, out);
+        p += n ? n : 1;
     }
     fputc('"', out);
 }
@@ -129,7 +151,8 @@ static void json_farm(FILE *out, const farm *f)
             "\"duplicate_grants\": %llu, \"requeued\": %llu, \"expired_leases\": %llu, "
             "\"duplicate_results\": %llu, \"stale_results\": %llu, \"failures\": %llu, "
             "\"invalid_tiles\": %llu, \"malformed_messages\": %llu, \"rejects_sent\": %llu, "
-            "\"version_mismatches\": %llu, \"disconnects\": %llu, \"master_cpu_seconds\": %.3f},\n",
+            "\"version_mismatches\": %llu, \"disconnects\": %llu, \"nonfinite_samples\": %llu, "
+            "\"master_cpu_seconds\": %.3f},\n",
             f->job_bytes, (unsigned long long)f->jobs_sent, per_grant,
             (unsigned long long)f->result_bytes, (unsigned long long)f->sent_bytes,
             (unsigned long long)c.grants, (unsigned long long)c.duplicate_grants,
@@ -138,6 +161,7 @@ static void json_farm(FILE *out, const farm *f)
             (unsigned long long)c.failures, (unsigned long long)f->invalid_tiles,
             (unsigned long long)f->wstats.dropped, (unsigned long long)f->rejects_sent,
             (unsigned long long)f->version_mismatches, (unsigned long long)f->wstats.disconnects,
+            (unsigned long long)f->nonfinite_samples,
             master_cpu_seconds());
 }
 
@@ -155,9 +179,10 @@ bool farm_report_json(const farm *f, const char *path, char *err, size_t errsz)
     fprintf(out, ", \"status\": \"%s\", \"error\": ", state_name(f->state));
     json_string(out, f->state == FARM_FAILED ? f->failure : "");
     fprintf(out, ",\n  \"width\": %d, \"height\": %d, \"tile_size\": %d, \"tiles\": %d, "
-            "\"tiles_done\": %d, \"seconds\": %.6f, \"job_hash\": \"%s\",\n",
+            "\"tiles_done\": %d, \"resumed_tiles\": %d, \"seconds\": %.6f, "
+            "\"job_hash\": \"%s\",\n",
             f->fmt.width, f->fmt.height, f->fmt.tile_size, f->ntiles,
-            scheduler_tiles_done(f->sched), (double)(f->end_ms - f->start_ms) / 1000.0, f->jb->hash);
+            scheduler_tiles_done(f->sched), f->resumed_tiles, (double)(f->end_ms - f->start_ms) / 1000.0, f->jb->hash);
     json_farm(out, f);
     json_totals(out, f);
     fputs("  \"workers\": [\n", out);
@@ -166,8 +191,11 @@ bool farm_report_json(const farm *f, const char *path, char *err, size_t errsz)
         fputs(i + 1 < registry_count(f->reg) ? ",\n" : "\n", out);
     }
     fputs("  ]\n}\n", out);
-    if (fclose(out) != 0) {
-        snprintf(err, errsz, "cannot write %s: %s", path, strerror(errno));
+    bool failed = ferror(out) != 0;
+    if (fclose(out) != 0 || failed) {
+        snprintf(err, errsz, "cannot write %s: %s", path,
+                 strerror(errno ? errno : EIO));
+        unlink(path);   /* no half-written statistics file */
         return false;
     }
     return true;

@@ -438,6 +438,16 @@ int64_t scheduler_next_deadline(const scheduler *self)
     return next;
 }
 
+bool scheduler_mark_done(scheduler *self, int tile)
+{
+    if (tile < 0 || tile >= self->ntiles) return false;
+    tile_state *t = &self->tiles[tile];
+    if (t->done || t->held) return false;
+    t->done = 1;
+    self->done++;
+    return true;
+}
+
 /* ---- questions ---- */
 
 bool scheduler_finished(const scheduler *self) { return self->done == self->ntiles; }

@@ -126,6 +126,11 @@ scheduler_verdict scheduler_complete(scheduler *self, int worker, uint64_t lease
 /* Resolves the lease with a failure. */
 scheduler_failure scheduler_fail(scheduler *self, int worker, uint64_t lease_id, bool retryable);
 
+/* A tile that is already in the output (a resumed render's journal):
+ * DONE before any grant. False when the tile is out of range, DONE or
+ * leased already. */
+bool scheduler_mark_done(scheduler *self, int tile);
+
 /* Marks leases whose deadline is <= now_ms as expired and requeues their
  * tiles. Returns the number of tiles requeued. */
 int scheduler_expire(scheduler *self, int64_t now_ms);

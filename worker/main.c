@@ -40,6 +40,8 @@ static void usage(FILE *out)
         "  --stats-json FILE       write render statistics as JSON\n"
         "  --tile-delay MS          (--connect) sleep MS before each tile: a testing aid\n"
         "                          that makes renders slow enough to interrupt\n"
+        "  --prepare-delay MS       (--connect) sleep MS before compiling each job: a\n"
+        "                          testing aid for slow preparations (heartbeats go on)\n"
         "  -q, --quiet             only errors;  -v, --verbose  more detail\n"
         "  -h, --help              this text\n"
         "\n"
@@ -81,7 +83,7 @@ int main(int argc, char **argv)
     job_options_default(&so.job);
     const char *connect = NULL;
     enum { O_STANDALONE = 256, O_CONNECT, O_NAME, O_TILE, O_CACHE, O_ARITH, O_BUDGET,
-           O_PREVIEW, O_STATS, O_STATS_JSON, O_TILE_DELAY };
+           O_PREVIEW, O_STATS, O_STATS_JSON, O_TILE_DELAY, O_PREPARE_DELAY };
     static const struct option longopts[] = {
         {"standalone", required_argument, 0, O_STANDALONE},
         {"output", required_argument, 0, 'o'},
@@ -96,6 +98,7 @@ int main(int argc, char **argv)
         {"stats", no_argument, 0, O_STATS},
         {"stats-json", required_argument, 0, O_STATS_JSON},
         {"tile-delay", required_argument, 0, O_TILE_DELAY},
+        {"prepare-delay", required_argument, 0, O_PREPARE_DELAY},
         {"quiet", no_argument, 0, 'q'},
         {"verbose", no_argument, 0, 'v'},
         {"help", no_argument, 0, 'h'},
@@ -151,6 +154,13 @@ int main(int argc, char **argv)
                 return AAFARM_EXIT_USAGE;
             }
             wo.tile_delay_ms = (int)n;
+            break;
+        case O_PREPARE_DELAY:
+            if (!parse_int(optarg, 0, 600000, &n)) {
+                fprintf(stderr, "aafarm-worker: --prepare-delay wants milliseconds 0..600000, got '%s'\n", optarg);
+                return AAFARM_EXIT_USAGE;
+            }
+            wo.prepare_delay_ms = (int)n;
             break;
         case 'q': so.verbosity = wo.verbosity = -1; break;
         case 'v': so.verbosity = wo.verbosity = 1; break;

@@ -48,6 +48,7 @@ typedef struct shared {
     char error[600];
     trace_stats stats;
     trace_object_work *work;       /* per object, summed over the threads */
+    worker_nonfinite nonfinite;    /* summed; x, y of the first tile's first */
     double t_start;
 } shared;
 
@@ -90,8 +91,17 @@ static void *render_thread(void *arg)
         if (stop) break;
         image_rect r = image_format_tile_rect(&s->fmt, i % tx_count, i / tx_count);
         char err[600];
-        image_tile *tile = worker_render_tile(s->js, th, r, s->fmt.layers, err, sizeof err);
+        worker_nonfinite nf;
+        image_tile *tile = worker_render_tile(s->js, th, r, s->fmt.layers, &nf, err, sizeof err);
         pthread_mutex_lock(&s->lock);
+        if (tile && nf.count) {
+            if (!s->nonfinite.count || nf.y < s->nonfinite.y ||
+                (nf.y == s->nonfinite.y && nf.x < s->nonfinite.x)) {
+                s->nonfinite.x = nf.x;
+                s->nonfinite.y = nf.y;
+            }
+            s->nonfinite.count += nf.count;
+        }
         if (!tile) {
             if (!s->failed) snprintf(s->error, sizeof s->error, "%s", err);
             s->failed = true;
@@ -128,9 +138,11 @@ static bool write_stats_json(const char *path, const shared *s, int threads, dou
     char extra[512];
     snprintf(extra, sizeof extra,
              "\"scene\": \"%s\", \"width\": %d, \"height\": %d, \"tiles\": %d, "
-             "\"threads\": %d, \"arith\": \"%s\", \"cache_bytes\": %zu, \"seconds\": %.3f",
+             "\"threads\": %d, \"arith\": \"%s\", \"cache_bytes\": %zu, \"seconds\": %.3f, "
+             "\"nonfinite_samples\": %llu",
              s->opt->scene_path, s->fmt.width, s->fmt.height, s->ntiles, threads,
-             trace_arith_name(s->opt->job.arith), s->opt->cache_bytes, secs);
+             trace_arith_name(s->opt->job.arith), s->opt->cache_bytes, secs,
+             (unsigned long long)s->nonfinite.count);
     trace_stats_write_json(&s->stats, extra, f);
     fputc('\n', f);
     return fclose(f) == 0;
@@ -222,6 +234,11 @@ int worker_standalone(const standalone_options *opt)
         fprintf(stderr, "aafarm-worker: %s\n", err);
         rc = AAFARM_EXIT_FAILURE;
     }
+    if (rc == AAFARM_EXIT_OK && s.nonfinite.count)
+        fprintf(stderr, "aafarm-worker: warning: %llu NaN/Inf samples (the first at pixel "
+                "(%d,%d)) were written as 0 (Z: as no hit); a shader divides by zero or "
+                "overflows there\n", (unsigned long long)s.nonfinite.count, s.nonfinite.x,
+                s.nonfinite.y);
     if (rc == AAFARM_EXIT_OK && opt->verbosity >= 0) {
         trace_object_work_report(&js->world, s.work, "aafarm-worker", stderr);
         fprintf(stderr, "aafarm-worker: wrote %s (%.2f s)\n", opt->output, secs);

@@ -7,8 +7,10 @@
 
 image_tile *worker_render_tile(const job_scene *js, trace_thread *th,
                                image_rect rect, unsigned layers,
+                               worker_nonfinite *nonfinite,
                                char *err, size_t errsz)
 {
+    nonfinite->count = 0;
     image_tile *tile = image_tile_new(rect.x0, rect.y0, rect.w, rect.h, layers);
     if (!tile) {
         snprintf(err, errsz, "cannot allocate a %dx%d tile", rect.w, rect.h);
@@ -22,5 +24,6 @@ image_tile *worker_render_tile(const job_scene *js, trace_thread *th,
         image_tile_destroy(&tile);
         return NULL;
     }
+    nonfinite->count = image_tile_clear_nonfinite(tile, &nonfinite->x, &nonfinite->y);
     return tile;
 }

@@ -7,15 +7,26 @@
 
 #include <stdbool.h>
 #include <stddef.h>
+#include <stdint.h>
 
 #include "image/tile.h"
 #include "job/job_scene.h"
 #include "trace/thread.h"
 
+/* Non-finite samples found in a tile and written as 0 (image/tile.h,
+ * image_tile_clear_nonfinite): how many, and the first one's pixel. */
+typedef struct worker_nonfinite {
+    uint64_t count;
+    int x, y;
+} worker_nonfinite;
+
 /* Renders rectangle `rect` with the given layers. NULL on failure (a
- * shader over its budget ...), with the reason in err. */
+ * shader over its budget ...), with the reason in err. NaN and infinite
+ * samples of the film are made safe here, at the film, and counted in
+ * *nonfinite (the renderer itself is not asked to avoid them). */
 image_tile *worker_render_tile(const job_scene *js, trace_thread *th,
                                image_rect rect, unsigned layers,
+                               worker_nonfinite *nonfinite,
                                char *err, size_t errsz);
 
 #endif

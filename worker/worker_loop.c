@@ -15,11 +15,21 @@
  *
  * Only this thread touches the socket; render threads report through the
  * pool's pipe, which sits in the same zmq_poll set.
+ *
+ * Preparing a Job (parse, compile, build the scene) can take seconds for a
+ * large scene. It runs on a helper thread while this thread goes on
+ * heartbeating and sending finished tiles, so the master does not take a
+ * slow preparation for a dead worker (issue 12). Messages that arrive
+ * meanwhile wait in the socket's queue (their arrival counts as a sign of
+ * the master's life) and are handled when the job is ready. SIGINT or
+ * SIGTERM meanwhile: Shutdown to the master, then exit 130 at once.
  */
 #include "worker_loop.h"
 
 #include <errno.h>
+#include <pthread.h>
 #include <signal.h>
+#include <stdatomic.h>
 #include <stdarg.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -212,6 +222,7 @@ static bool send_task(worker_loop *w, worker_task *t)
     st.peak_cache_bytes = t->stats.peak_cache_bytes;
     st.cpu_seconds = t->stats.cpu_seconds;
     st.wall_seconds = t->stats.wall_seconds;
+    st.nonfinite_samples = t->stats.nonfinite_samples;
     Aafarm__Result r = AAFARM__RESULT__INIT;
     r.job_hash = t->job->hash;
     r.lease_id = t->lease_id;
@@ -332,9 +343,70 @@ static void on_reject(worker_loop *w, const Aafarm__Reject *m)
     w->end = SESSION_FATAL;
 }
 
+static void send_finished(worker_loop *w);
+
+typedef struct preparation {
+    worker_jobs *jobs;
+    const Aafarm__Job *msg;
+    int delay_ms;
+    held_job *result;
+    atomic_bool done;
+} preparation;
+
+static void *prepare_thread(void *arg)
+{
+    preparation *p = arg;
+    if (p->delay_ms > 0) {
+        struct timespec ts = {p->delay_ms / 1000, (long)(p->delay_ms % 1000) * 1000000L};
+        while (nanosleep(&ts, &ts) != 0 && errno == EINTR) {}
+    }
+    p->result = worker_jobs_add(p->jobs, p->msg);
+    atomic_store(&p->done, true);
+    return NULL;
+}
+
+/* worker_jobs_add on a helper thread; this one heartbeats meanwhile (only
+ * the helper touches w->jobs until it is done; only this thread touches
+ * the socket). */
+static held_job *prepare_job(worker_loop *w, const Aafarm__Job *m)
+{
+    if (worker_jobs_find(w->jobs, m->job_hash)) return worker_jobs_add(w->jobs, m);
+    preparation p = {w->jobs, m, w->opt->prepare_delay_ms, NULL, false};
+    pthread_t tid;
+    if (pthread_create(&tid, NULL, prepare_thread, &p) != 0) {
+        prepare_thread(&p);   /* no thread: prepare here, without heartbeats */
+        return p.result;
+    }
+    long step = w->heartbeat_ms / 4 < 50 ? (w->heartbeat_ms / 4 > 0 ? w->heartbeat_ms / 4 : 1) : 50;
+    while (!atomic_load(&p.done)) {
+        if (interrupted) {
+            /* the helper cannot be stopped and holds the job list: tell the
+             * master (it requeues our tiles at once) and leave without
+             * tearing anything down */
+            wlog(w, 0, "interrupted while preparing job %.12s; leaving", m->job_hash);
+            send_shutdown(w, "the worker was stopped (SIGINT/SIGTERM) while preparing a job");
+            int linger = 500;
+            zmq_setsockopt(w->dealer, ZMQ_LINGER, &linger, sizeof linger);
+            zmq_close(w->dealer);
+            zmq_ctx_term(w->ctx);   /* sends what is queued, for at most 500 ms */
+            _exit(AAFARM_EXIT_INTERRUPTED);
+        }
+        zmq_pollitem_t item = {NULL, worker_pool_wake_fd(w->pool), ZMQ_POLLIN, 0};
+        zmq_poll(&item, 1, step);
+        int events = 0;
+        size_t len = sizeof events;
+        if (zmq_getsockopt(w->dealer, ZMQ_EVENTS, &events, &len) == 0 && (events & ZMQ_POLLIN))
+            w->last_heard_ms = now_ms();   /* the master is there; read it later */
+        send_finished(w);
+        if (w->welcomed && now_ms() - w->last_sent_ms >= w->heartbeat_ms) send_heartbeat(w);
+    }
+    pthread_join(tid, NULL);
+    return p.result;
+}
+
 static void on_job(worker_loop *w, const Aafarm__Job *m)
 {
-    held_job *h = worker_jobs_add(w->jobs, m);
+    held_job *h = prepare_job(w, m);
     if (h->broken) wlog(w, -1, "%s", h->error);
     else wlog(w, 0, "job %.12s (%s, %dx%d) ready", h->hash, h->jb->scene_file, h->fmt.width,
               h->fmt.height);

@@ -20,6 +20,7 @@ typedef struct worker_loop_options {
     size_t cache_bytes;            /* box cache per thread; 0: the job's (unlimited) */
     int verbosity;                 /* -1 quiet, 0 normal, 1 verbose */
     int tile_delay_ms;             /* testing aid: sleep before each tile */
+    int prepare_delay_ms;          /* testing aid: sleep before compiling a Job */
 } worker_loop_options;
 
 /* Serves masters until told to stop. Returns an AAFARM_EXIT_* code:

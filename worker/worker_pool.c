@@ -98,7 +98,8 @@ static void render_task(worker_pool *p, trace_thread *th, worker_task *t)
     double wall0 = clock_s(CLOCK_MONOTONIC), cpu0 = clock_s(CLOCK_THREAD_CPUTIME_ID);
     trace_thread_sync_stats(th);
     trace_stats before = th->stats;
-    image_tile *tile = worker_render_tile(h->js, th, t->rect, h->fmt.layers, t->error,
+    worker_nonfinite nf;
+    image_tile *tile = worker_render_tile(h->js, th, t->rect, h->fmt.layers, &nf, t->error,
                                           sizeof t->error);
     if (tile)
         t->ok = image_tile_encode_exr(tile, &h->fmt, &t->exr, &t->exr_len, t->error,
@@ -106,6 +107,7 @@ static void render_task(worker_pool *p, trace_thread *th, worker_task *t)
     image_tile_destroy(&tile);
     trace_thread_sync_stats(th);
     stats_delta(&t->stats, &before, &th->stats);
+    t->stats.nonfinite_samples = t->ok ? nf.count : 0;
     t->stats.cpu_seconds = clock_s(CLOCK_THREAD_CPUTIME_ID) - cpu0;
     t->stats.wall_seconds = clock_s(CLOCK_MONOTONIC) - wall0;
     if (t->stats.cpu_seconds < 0) t->stats.cpu_seconds = 0;

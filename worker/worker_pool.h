@@ -30,6 +30,7 @@ typedef struct worker_tile_stats {
     uint64_t rays, boxes, shader_evals;
     uint64_t cache_hits, cache_misses, cache_evictions, peak_cache_bytes;
     double cpu_seconds, wall_seconds;
+    uint64_t nonfinite_samples;    /* NaN/Inf samples written as 0 */
 } worker_tile_stats;
 
 typedef struct worker_task {

@@ -7,6 +7,16 @@
  * the furthest byte written as the file length and zero-fills any gap; the
  * readers return short counts past the end, which OpenEXRCore reports as a
  * read error, never as a crash.
+ *
+ * Error messages never go through exr_get_user_data(): OpenEXRCore calls
+ * its error handler while it holds the context's lock (exr_write_header,
+ * exr_write_tile_chunk, exr_finish), and exr_get_user_data() takes the
+ * same non-recursive lock, so asking it from the handler deadlocks the
+ * process the first time a header write fails (a full disk). Instead the
+ * stream callbacks, which get their stream as an argument, note I/O errors
+ * themselves (with errno), and the handler keeps OpenEXRCore's own text in
+ * a per-thread buffer that image_exr_error() reads when the stream has no
+ * message (image_exr_stream_clear() empties both before an operation).
  */
 #include "image/exr_io.h"
 
@@ -59,13 +69,25 @@ static void stream_note(image_exr_stream *self, const char *msg)
         snprintf(self->message, sizeof self->message, "%s", msg);
 }
 
+/* OpenEXRCore's text for the current operation of this thread (first one
+ * wins, like stream_note); see the comment at the top. */
+static _Thread_local char thread_message[256];
+
 static void capture_error(exr_const_context_t ctxt, exr_result_t code,
                           const char *msg)
 {
+    (void) ctxt;    /* locked by the caller: never call back into it here */
     (void) code;
-    void *user = NULL;
-    if (ctxt && exr_get_user_data(ctxt, &user) == EXR_ERR_SUCCESS && user)
-        stream_note(user, msg ? msg : "unknown OpenEXR error");
+    if (thread_message[0] == '\0')
+        snprintf(thread_message, sizeof thread_message, "%s",
+                 msg ? msg : "unknown OpenEXR error");
+}
+
+void image_exr_stream_clear(image_exr_stream *self)
+{
+    self->message[0] = '\0';
+    self->sys_errno = 0;
+    thread_message[0] = '\0';
 }
 
 static int64_t read_memory(image_exr_stream *self, void *buffer, uint64_t sz,
@@ -107,9 +129,13 @@ static int64_t stream_read(exr_const_context_t ctxt, void *user, void *buffer,
     image_exr_stream *self = user;
     int64_t n = self->fd < 0 ? read_memory(self, buffer, sz, offset)
                              : read_fd(self, buffer, sz, offset);
-    if (n < 0 && error_cb)
-        error_cb(ctxt, EXR_ERR_READ_IO, "read failed: %s",
-                 strerror(self->sys_errno));
+    if (n < 0) {
+        char msg[160];
+        snprintf(msg, sizeof msg, "read failed: %s", strerror(self->sys_errno));
+        stream_note(self, msg);
+        if (error_cb)
+            error_cb(ctxt, EXR_ERR_READ_IO, "%s", msg);
+    }
     return n;
 }
 
@@ -181,9 +207,15 @@ static int64_t stream_write(exr_const_context_t ctxt, void *user,
         return (int64_t) sz;
     int64_t n = self->fd < 0 ? write_memory(self, buffer, sz, offset)
                              : write_fd(self, buffer, sz, offset);
-    if (n < 0 && error_cb)
-        error_cb(ctxt, EXR_ERR_WRITE_IO, "write failed: %s",
-                 strerror(self->sys_errno));
+    if (n < 0) {
+        char msg[160];
+        snprintf(msg, sizeof msg, "write failed: %s%s", strerror(self->sys_errno),
+                 self->sys_errno == ENOSPC || self->sys_errno == EDQUOT
+                 ? " (free some space on that file system)" : "");
+        stream_note(self, msg);
+        if (error_cb)
+            error_cb(ctxt, EXR_ERR_WRITE_IO, "%s", msg);
+    }
     return n;
 }
 
@@ -202,6 +234,7 @@ exr_result_t image_exr_start_read(exr_context_t *ctxt, const char *name,
                                   image_exr_stream *stream)
 {
     exr_context_initializer_t init = initializer(stream);
+    image_exr_stream_clear(stream);
     init.read_fn = stream_read;
     init.size_fn = stream_size;
     init.flags = EXR_CONTEXT_FLAG_DISABLE_CHUNK_RECONSTRUCTION;
@@ -212,6 +245,7 @@ exr_result_t image_exr_start_write(exr_context_t *ctxt, const char *name,
                                    image_exr_stream *stream)
 {
     exr_context_initializer_t init = initializer(stream);
+    image_exr_stream_clear(stream);
     init.write_fn = stream_write;
     return exr_start_write(ctxt, name, EXR_WRITE_FILE_DIRECTLY, &init);
 }
@@ -359,7 +393,9 @@ exr_result_t image_exr_decode_chunk(exr_const_context_t ctxt,
 void image_exr_error(char *err, size_t errsz, const char *what,
                      exr_result_t rv, const image_exr_stream *stream)
 {
-    const char *why = stream && stream->message[0]
-                      ? stream->message : exr_get_default_error_message(rv);
+    const char *why = stream && stream->message[0] ? stream->message
+                      : thread_message[0] ? thread_message
+                      : exr_get_default_error_message(rv);
     snprintf(err, errsz, "%s: %s", what, why);
+    thread_message[0] = '\0';
 }

@@ -46,6 +46,9 @@ void image_exr_stream_memory_reader(image_exr_stream *self, const void *bytes,
                                     size_t len);
 void image_exr_stream_memory_writer(image_exr_stream *self);
 void image_exr_stream_fd(image_exr_stream *self, int fd);
+/* Forgets the error messages of earlier operations (call before each
+ * OpenEXRCore operation whose failure image_exr_error() will report). */
+void image_exr_stream_clear(image_exr_stream *self);
 /* Frees a memory writer's buffer (unless taken by setting out to NULL). */
 void image_exr_stream_release(image_exr_stream *self);
 
@@ -74,8 +77,9 @@ exr_result_t image_exr_decode_chunk(exr_const_context_t ctxt,
                                     const exr_chunk_info_t *cinfo,
                                     float *const *dst, size_t line_stride);
 
-/* Writes "what: reason" into err, the reason being the stream's captured
- * message when there is one, else OpenEXR's text for rv. */
+/* Writes "what: reason" into err, the reason being the stream's own
+ * message (an I/O error with errno) when there is one, else the text
+ * OpenEXRCore reported on this thread, else its default text for rv. */
 void image_exr_error(char *err, size_t errsz, const char *what,
                      exr_result_t rv, const image_exr_stream *stream);
 

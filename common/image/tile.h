@@ -19,8 +19,11 @@
  * flags, tiling, tile size, data and display windows, channels, types and
  * compression are all checked before OpenEXRCore parses anything), the
  * chunk offset table and chunk leader must point exactly at the chunk, the
- * chunk must fill the rest of the bytes, and the chunk must decode cleanly
- * to the expected layout.
+ * chunk must fill the rest of the bytes, and the chunk must decompress
+ * cleanly (zlib's checks) to exactly the expected unpacked size. The
+ * samples are not converted: any bit pattern is a valid half or float.
+ * Cost on the master: about 0.05 ms for a 32x32 tile, 13 ms for 512x512
+ * (bench/tile_validate_bench).
  *
  * Buffers of an image_tile are row-major, w*h pixels, row y of the tile
  * first at index y*w: rgba 4 floats per pixel (R G B A, premultiplied),
@@ -56,6 +59,14 @@ image_rect image_tile_rect(const image_tile *self);
 /* Encodes the tile as a one-tile EXR file of image `fmt` (the tile must be
  * a tile of fmt's grid and have fmt's layers). On success *bytes (malloc'd,
  * the caller frees) and *len hold the file. Same pixels, same bytes. */
+/* Non-finite samples (a surface shader dividing by zero, overflowing...)
+ * made safe before the tile is written: NaN, +Inf and -Inf in RGBA, N and P
+ * become 0; in Z, NaN and -Inf become +Inf ("nothing hit", what Z holds
+ * where no object is) while +Inf stays. Returns how many samples were
+ * changed; the first one's pixel goes to *first_x, *first_y (full-image
+ * coordinates; untouched when none). */
+size_t image_tile_clear_nonfinite(image_tile *self, int *first_x, int *first_y);
+
 bool image_tile_encode_exr(const image_tile *self, const image_format *fmt,
                            void **bytes, size_t *len, char *err, size_t errsz);
 

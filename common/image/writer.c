@@ -9,8 +9,8 @@
  * depends on where the tile sits). So the master hands the validated bytes
  * to exr_write_tile_chunk() with the output tile coordinates, and
  * OpenEXRCore writes the chunk leader, the data and (at exr_finish) the
- * offset table. No pixel is decoded or re-encoded on the master except
- * once, inside validation, to prove the chunk is intact.
+ * offset table. No pixel is decoded or re-encoded on the master; the chunk
+ * is decompressed once, inside validation, to prove it intact.
  */
 #include "image/writer.h"
 
@@ -132,7 +132,7 @@ bool image_writer_put_tile(image_writer *self, const image_tile *tile,
     }
     if (*written_flag(self, tx, ty))
         return true;
-    self->stream.message[0] = '\0';
+    image_exr_stream_clear(&self->stream);
     exr_result_t rv = image_exr_write_tile(self->ctxt, &self->fmt, tx, ty,
                                            tile);
     return record_write(self, tx, ty, rv, err, errsz);
@@ -150,12 +150,30 @@ bool image_writer_put_exr_chunk(image_writer *self, const void *bytes,
         || !image_tile_exr_chunk(bytes, len, &self->fmt, expect, &chunk,
                                  &chunk_len, err, errsz))
         return false;
+    return image_writer_put_chunk(self, tx, ty, chunk, chunk_len, err, errsz);
+}
+
+bool image_writer_put_chunk(image_writer *self, int tx, int ty, const void *chunk,
+                            size_t chunk_len, char *err, size_t errsz)
+{
+    if (!usable(self, err, errsz))
+        return false;
+    if (tx < 0 || ty < 0 || tx >= image_format_tiles_x(&self->fmt)
+        || ty >= image_format_tiles_y(&self->fmt)) {
+        snprintf(err, errsz, "tile (%d,%d) is not in the image", tx, ty);
+        return false;
+    }
     if (*written_flag(self, tx, ty))
         return true;
-    self->stream.message[0] = '\0';
+    image_exr_stream_clear(&self->stream);
     exr_result_t rv = exr_write_tile_chunk(self->ctxt, 0, tx, ty, 0, 0, chunk,
                                            chunk_len);
     return record_write(self, tx, ty, rv, err, errsz);
+}
+
+bool image_writer_failed(const image_writer *self)
+{
+    return self->failure[0] != '\0';
 }
 
 bool image_writer_has_tile(const image_writer *self, int tx, int ty)
@@ -204,7 +222,7 @@ bool image_writer_finish(image_writer **self_p, char *err, size_t errsz)
         image_writer_destroy(self_p);
         return false;
     }
-    self->stream.message[0] = '\0';
+    image_exr_stream_clear(&self->stream);
     exr_result_t rv = exr_finish(&self->ctxt);
     self->ctxt = NULL;
     if (rv != EXR_ERR_SUCCESS) {

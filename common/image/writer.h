@@ -55,6 +55,17 @@ bool image_writer_put_exr_chunk(image_writer *self, const void *bytes,
                                 size_t len, image_rect expect,
                                 char *err, size_t errsz);
 
+/* True once a write to the file failed (disk full, I/O error): the
+ * writer's own fault, never the tile's. A false return of a put call with
+ * this still false means the tile was rejected and the writer is fine. */
+bool image_writer_failed(const image_writer *self);
+
+/* Copies a compressed chunk that was validated before (a chunk
+ * image_tile_exr_chunk() returned, kept in the master's journal) into the
+ * file as tile (tx, ty). */
+bool image_writer_put_chunk(image_writer *self, int tx, int ty, const void *chunk,
+                            size_t chunk_len, char *err, size_t errsz);
+
 bool image_writer_has_tile(const image_writer *self, int tx, int ty);
 int image_writer_tiles_written(const image_writer *self);
 const image_format *image_writer_format(const image_writer *self);

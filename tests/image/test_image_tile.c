@@ -23,6 +23,7 @@
 #include <stdint.h>
 #include <cmocka.h>
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -325,6 +326,37 @@ static void test_encode_errors(void **state)
     image_tile_destroy(&layered);              /* NULL: no-op */
 }
 
+/* NaN and infinities become 0 in RGBA/N/P; in Z NaN and -Inf become +Inf
+ * ("nothing hit") and +Inf stays; the count and first pixel are exact. */
+static void test_clear_nonfinite(void **state)
+{
+    (void) state;
+    image_tile *t = image_tile_new(16, 8, 4, 3, IMAGE_LAYER_N);
+    assert_non_null(t);
+    int fx = -1, fy = -1;
+    assert_int_equal(image_tile_clear_nonfinite(t, &fx, &fy), 0);
+    assert_int_equal(fx, -1);
+    t->rgba[(1 * 4 + 2) * 4 + 0] = NAN;         /* pixel (2,1) R */
+    t->rgba[(2 * 4 + 0) * 4 + 3] = INFINITY;    /* pixel (0,2) A */
+    t->n[(2 * 4 + 3) * 3 + 1] = -INFINITY;      /* pixel (3,2) N.y */
+    t->z[0] = INFINITY;                         /* no hit: stays */
+    t->z[1] = NAN;
+    t->z[2] = -INFINITY;
+    t->rgba[5] = 1e30f;                         /* large but finite: stays */
+    assert_int_equal(image_tile_clear_nonfinite(t, &fx, &fy), 5);
+    assert_int_equal(fx, 16 + 1);               /* z[1]: pixel (1,0) comes first */
+    assert_int_equal(fy, 8);
+    assert_true(t->rgba[(1 * 4 + 2) * 4 + 0] == 0.0f);
+    assert_true(t->rgba[(2 * 4 + 0) * 4 + 3] == 0.0f);
+    assert_true(t->n[(2 * 4 + 3) * 3 + 1] == 0.0f);
+    assert_true(isinf(t->z[0]) && t->z[0] > 0);
+    assert_true(isinf(t->z[1]) && t->z[1] > 0);
+    assert_true(isinf(t->z[2]) && t->z[2] > 0);
+    assert_true(t->rgba[5] == 1e30f);
+    assert_int_equal(image_tile_clear_nonfinite(t, &fx, &fy), 0);
+    image_tile_destroy(&t);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -336,6 +368,7 @@ int main(void)
         cmocka_unit_test(test_byte_flips),
         cmocka_unit_test(test_garbage),
         cmocka_unit_test(test_encode_errors),
+        cmocka_unit_test(test_clear_nonfinite),
     };
     return cmocka_run_group_tests_name("image_tile", tests, NULL, NULL);
 }

@@ -138,6 +138,16 @@ static const char broken_sl[] =
     "    P += Km * * normalize(N);\n"
     "}\n";
 
+static const char tnan_sl[] =
+    "surface tnan()\n"
+    "{\n"
+    "    Oi = Os;\n"
+    "    if (s > 0.5)\n"
+    "        Ci = color(0 / 0, 1 / 0, -1 / 0);\n"
+    "    else\n"
+    "        Ci = Os * Cs;\n"
+    "}\n";
+
 static const char scene_rib[] =
     "# a small scene for the farm tests\n"
     "Option \"searchpath\" \"shader\" [\"shaders:&\"]\n"
@@ -151,7 +161,7 @@ static const char scene_rib[] =
     "  LightSource \"distantlight\" 2 \"intensity\" [1.0] \"from\" [-1 2 -2] \"to\" [0 0 0]\n"
     "  AttributeBegin\n"
     "    Color [0.8 0.75 0.6]\n"
-    "    Surface \"tmatte\"\n"
+    "    Surface \"%s\"\n"
     "    Displacement \"%s\"\n"
     "    Sides 2\n"
     "    Polygon \"P\" [-1 0 -1  -1 0 1  1 0 1  1 0 -1]\n"
@@ -164,14 +174,19 @@ void ft_write_scene(const char *dir, ft_scene_kind kind)
     snprintf(shaders, sizeof shaders, "%s/shaders", dir);
     mkdir(shaders, 0755);
     write_file(ft_path(shaders, "tmatte.sl"), tmatte_sl);
-    const char *disp = "twave";
-    if (kind == FT_SCENE_WAVE) write_file(ft_path(shaders, "twave.sl"), twave_sl);
+    const char *disp = "twave", *surf = "tmatte";
+    if (kind == FT_SCENE_WAVE || kind == FT_SCENE_NAN)
+        write_file(ft_path(shaders, "twave.sl"), twave_sl);
+    if (kind == FT_SCENE_NAN) {
+        write_file(ft_path(shaders, "tnan.sl"), tnan_sl);
+        surf = "tnan";
+    }
     if (kind == FT_SCENE_BROKEN) write_file(ft_path(shaders, "twave.sl"), broken_sl);
     if (kind == FT_SCENE_BUDGET) {
         write_file(ft_path(shaders, "spin.sl"), spin_sl);
         disp = "spin";
     }
-    snprintf(rib, sizeof rib, scene_rib, disp);
+    snprintf(rib, sizeof rib, scene_rib, surf, disp);
     write_file(ft_path(dir, "scene.rib"), rib);
 }
 

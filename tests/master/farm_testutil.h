@@ -33,7 +33,9 @@ void ft_rmtree(const char *dir);
  *   FT_SCENE_BUDGET  the same with a shader that loops far beyond any
  *                    instruction budget
  *   FT_SCENE_BROKEN  a shader with a syntax error (line 3) */
-typedef enum { FT_SCENE_WAVE, FT_SCENE_BUDGET, FT_SCENE_BROKEN } ft_scene_kind;
+/*   FT_SCENE_NAN     the wave with a surface shader writing NaN, +Inf
+ *                    and -Inf into Ci on half of the square */
+typedef enum { FT_SCENE_WAVE, FT_SCENE_BUDGET, FT_SCENE_BROKEN, FT_SCENE_NAN } ft_scene_kind;
 void ft_write_scene(const char *dir, ft_scene_kind kind);
 
 /* "dir/name" in a static ring of buffers (valid for a few calls). */

@@ -8,6 +8,12 @@
  *   - random bytes, truncated ZMTP frames and malformed messages sent to
  *     the master's port while it renders: it keeps working, counts them,
  *     and answers a message from an unknown peer with Reject HELLO_FIRST;
+ *   - a worker named with bytes that are not UTF-8: --stats-json stays
+ *     valid (U+FFFD for each bad byte);
+ *   - a worker whose job preparation takes longer than the heartbeat
+ *     timeout (--prepare-delay) keeps heartbeating: never declared dead,
+ *     nothing requeued, it renders its tiles; SIGTERM during a long
+ *     preparation ends it at once (exit 130, Shutdown sent);
  *   - SIGINT to a master with local workers: exit 130, no output and no
  *     temporary file left, the local workers stopped.
  * Workers are slowed down with --tile-delay so that "mid-render" is
@@ -134,6 +140,93 @@ static void test_farm_sigstop_worker_requeued(void **state)
     assert_int_equal(ft_wait(sleeper, 20), 130);
     kill(other, SIGTERM);
     assert_int_equal(ft_wait(other, 20), 130);
+}
+
+/* A worker may call itself anything: --stats-json stays valid UTF-8 JSON */
+static void test_farm_raw_byte_worker_name(void **state)
+{
+    (void)state;
+    const char *log = ft_path(dir, "raw.log"), *json = ft_path(dir, "raw.json");
+    char ep[256];
+    pid_t master = start_master(ft_path(dir, "raw.exr"), log, json, ep, sizeof ep);
+    pid_t worker = start_worker(ep, "w\xff\xc0\xe2\x82\xac\\q\xed\xa0\x80", "0");
+    assert_int_equal(ft_wait(master, 120), 0);
+    char *text = ft_read(json);
+    /* invalid bytes as U+FFFD, the euro sign kept, the backslash escaped */
+    assert_non_null(strstr(text, "\"name\": \"w\\ufffd\\ufffd\xe2\x82\xac\\\\q\\ufffd\\ufffd\\ufffd\""));
+    for (const unsigned char *p = (const unsigned char *)text; *p; p++)
+        assert_true(*p != 0xff && *p != 0xc0 && *p != 0xed);
+    free(text);
+    kill(worker, SIGTERM);
+    assert_int_equal(ft_wait(worker, 20), 130);
+}
+
+static void test_farm_slow_preparation_keeps_heartbeating(void **state)
+{
+    (void)state;
+    const char *log = ft_path(dir, "prep.log"), *json = ft_path(dir, "prep.json");
+    char ep[256];
+    pid_t master = start_master(ft_path(dir, "prep.exr"), log, json, ep, sizeof ep);
+    /* 2.5 s of preparation against a 4 x 250 ms heartbeat timeout */
+    const char *argv[] = {ft_worker, "--connect", ep, "--name", "slowprep", "--threads", "1",
+                          "--prepare-delay", "2500", NULL};
+    pid_t worker = ft_spawn(ft_path(dir, "slowprep.log"), argv);
+    assert_int_equal(ft_wait(master, 120), 0);
+    assert_int_equal(ft_exr_diff(ft_path(dir, "ref.exr"), ft_path(dir, "prep.exr")), 0);
+    assert_int_equal(ft_count(log, "missed 4 heartbeats"), 0);
+    assert_int_equal(ft_count(log, "worker slowprep joined"), 1);
+    assert_int_equal(ft_json_number(json, "requeued"), 0);
+    assert_true(ft_count(log, " from slowprep (lease") >= 1);
+    kill(worker, SIGTERM);
+    assert_int_equal(ft_wait(worker, 20), 130);
+}
+
+/* SIGTERM while the worker prepares: it says Shutdown and exits 130 at
+ * once (not after the preparation); the master requeues its tiles */
+static void test_farm_sigterm_during_preparation(void **state)
+{
+    (void)state;
+    const char *log = ft_path(dir, "prepint.log"), *json = ft_path(dir, "prepint.json");
+    char ep[256];
+    pid_t master = start_master(ft_path(dir, "prepint.exr"), log, json, ep, sizeof ep);
+    const char *argv[] = {ft_worker, "--connect", ep, "--name", "quitter", "--threads", "1",
+                          "--prepare-delay", "60000", NULL};
+    pid_t quitter = ft_spawn(ft_path(dir, "quitter.log"), argv);
+    assert_true(ft_wait_for(log, "granted tile ", 1, 30));
+    assert_true(ft_wait_for(log, "sent the job ", 1, 30));
+    kill(quitter, SIGTERM);
+    assert_int_equal(ft_wait(quitter, 10), 130);   /* not 60 s */
+    assert_true(ft_wait_for(log, "worker quitter left (the worker was stopped", 1, 10));
+    pid_t other = start_worker(ep, "finisher", "0");
+    assert_int_equal(ft_wait(master, 120), 0);
+    assert_int_equal(ft_exr_diff(ft_path(dir, "ref.exr"), ft_path(dir, "prepint.exr")), 0);
+    kill(other, SIGTERM);
+    assert_int_equal(ft_wait(other, 20), 130);
+}
+
+/* --max-workers 1: the second worker is refused (exit 2, the reason
+ * printed), the first renders everything */
+static void test_farm_max_workers(void **state)
+{
+    (void)state;
+    const char *log = ft_path(dir, "max.log"), *json = ft_path(dir, "max.json");
+    const char *argv[] = {ft_master, ft_path(dir, "scene.rib"), "-o", ft_path(dir, "max.exr"),
+                          "--bind", "tcp://127.0.0.1:*", "--tile", "8", "--max-workers", "1",
+                          "--stats-json", json, "-v", NULL};
+    pid_t master = ft_spawn(log, argv);
+    char ep[256];
+    assert_true(ft_master_endpoint(log, ep, sizeof ep, 30));
+    pid_t first = start_worker(ep, "first", "20");
+    assert_true(ft_wait_for(log, "worker first joined", 1, 30));
+    pid_t second = start_worker(ep, "second", "0");
+    assert_int_equal(ft_wait(second, 30), 2);
+    assert_int_equal(ft_count(ft_path(dir, "second.log"),
+                              "refused this worker: the master serves at most 1 workers"), 1);
+    assert_int_equal(ft_count(log, "refused worker second"), 1);
+    assert_int_equal(ft_wait(master, 120), 0);
+    assert_int_equal(ft_exr_diff(ft_path(dir, "ref.exr"), ft_path(dir, "max.exr")), 0);
+    kill(first, SIGTERM);
+    assert_int_equal(ft_wait(first, 20), 130);
 }
 
 /* ---- garbage for the master's port ---- */
@@ -301,6 +394,10 @@ int main(int argc, char **argv)
         cmocka_unit_test_teardown(test_farm_kill9_worker_mid_render, teardown),
         cmocka_unit_test_teardown(test_farm_sigstop_worker_requeued, teardown),
         cmocka_unit_test_teardown(test_farm_garbage_to_master_port, teardown),
+        cmocka_unit_test_teardown(test_farm_slow_preparation_keeps_heartbeating, teardown),
+        cmocka_unit_test_teardown(test_farm_raw_byte_worker_name, teardown),
+        cmocka_unit_test_teardown(test_farm_sigterm_during_preparation, teardown),
+        cmocka_unit_test_teardown(test_farm_max_workers, teardown),
         cmocka_unit_test_teardown(test_farm_sigint_master_cleans_up, teardown),
     };
     return cmocka_run_group_tests(tests, group_setup, group_teardown);

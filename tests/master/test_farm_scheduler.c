@@ -2,7 +2,8 @@
  * test_farm_scheduler.c: the master's tile scheduler (master/scheduler.h)
  * without sockets: runs of neighbouring tiles per worker, requeue to the
  * front, deadlines, end-game duplicates, retries and the job failing, stale
- * and duplicate results, and a randomised run in which workers come, go,
+ * and duplicate results, tiles already DONE from a resumed journal, and a
+ * randomised run in which workers come, go,
  * fail and time out while every tile must end up taken exactly once.
  */
 #include <setjmp.h>
@@ -312,6 +313,29 @@ static void test_random_farm_takes_every_tile_once(void **state)
     }
 }
 
+/* --resume: journaled tiles are DONE before any grant and never granted */
+static void test_resumed_tiles_never_granted(void **state)
+{
+    (void)state;
+    scheduler *s = make(4, 3, 3, 1, 1000);
+    int done[] = {0, 1, 5, 6, 11};
+    for (int i = 0; i < 5; i++) assert_true(scheduler_mark_done(s, done[i]));
+    assert_false(scheduler_mark_done(s, 5));    /* twice */
+    assert_false(scheduler_mark_done(s, 12));   /* out of range */
+    assert_false(scheduler_mark_done(s, -1));
+    assert_int_equal(scheduler_tiles_done(s), 5);
+    int w = scheduler_worker_add(s);
+    uint64_t ids[7];
+    int want[] = {7, 8, 9, 10, 2, 3, 4};   /* the longest run of fresh tiles first */
+    for (int i = 0; i < 7; i++) assert_int_equal(grant_tile(s, w, 0, &ids[i]), want[i]);
+    int t = grant_tile(s, w, 0, NULL);   /* end game: a duplicate at most, never a DONE tile */
+    assert_true(t == -1 || (t != 0 && t != 1 && t != 5 && t != 6 && t != 11));
+    assert_false(scheduler_mark_done(s, 2));    /* leased */
+    for (int i = 0; i < 7; i++) assert_int_equal(scheduler_complete(s, w, ids[i], 0), SCHEDULER_TAKEN);
+    assert_true(scheduler_finished(s));
+    scheduler_destroy(&s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -325,6 +349,7 @@ int main(void)
         cmocka_unit_test(test_not_retryable_fails_at_once),
         cmocka_unit_test(test_only_worker_gets_its_failed_tile_back),
         cmocka_unit_test(test_stale_results),
+        cmocka_unit_test(test_resumed_tiles_never_granted),
         cmocka_unit_test(test_random_farm_takes_every_tile_once),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
