@@ -134,6 +134,42 @@ static inline void h_globals_dual(sl_vm *vm, h_surface s, double u, double v)
     sl_vm_set_dual(vm, SL_G_I, I);
 }
 
+/* Bounds of the globals' d/du and d/dv over the box, for range runs of
+ * shaders that take derivatives (the same formulas in IA; the sphere's N
+ * is its P). */
+static inline void h_derivs(sl_vm *vm, h_surface s, double u0, double u1, double v0,
+                            double v1)
+{
+    ia_interval Pu[3], Pv[3], zero[3], one = ia_point(1), U = ia_make(u0, u1),
+                                           V = ia_make(v0, v1);
+    for (int i = 0; i < 3; i++)
+        zero[i] = ia_point(0);
+    if (s == H_PLANE) {
+        Pu[0] = ia_point(2); Pu[1] = ia_point(0); Pu[2] = ia_point(0);
+        Pv[0] = ia_point(0); Pv[1] = ia_point(2); Pv[2] = ia_point(0);
+    } else {
+        ia_interval th = ia_mul_s(U, 2 * M_PI);
+        ia_interval ph = ia_add_s(ia_mul_s(V, M_PI), -M_PI / 2);
+        ia_interval cp = ia_cos(ph), sp = ia_sin(ph), ct = ia_cos(th), st = ia_sin(th);
+        Pu[0] = ia_mul_s(ia_neg(ia_mul(st, cp)), 2 * M_PI);
+        Pu[1] = ia_mul_s(ia_mul(ct, cp), 2 * M_PI);
+        Pu[2] = ia_point(0);
+        Pv[0] = ia_mul_s(ia_neg(ia_mul(ct, sp)), M_PI);
+        Pv[1] = ia_mul_s(ia_neg(ia_mul(st, sp)), M_PI);
+        Pv[2] = ia_mul_s(cp, M_PI);
+    }
+    sl_vm_set_derivs(vm, SL_G_P, Pu, Pv);
+    sl_vm_set_derivs(vm, SL_G_N, s == H_PLANE ? zero : Pu, s == H_PLANE ? zero : Pv);
+    sl_vm_set_derivs(vm, SL_G_Ng, s == H_PLANE ? zero : Pu, s == H_PLANE ? zero : Pv);
+    sl_vm_set_derivs(vm, SL_G_u, &one, zero);
+    sl_vm_set_derivs(vm, SL_G_s, &one, zero);
+    sl_vm_set_derivs(vm, SL_G_v, zero, &one);
+    sl_vm_set_derivs(vm, SL_G_t, zero, &one);
+    sl_vm_set_derivs(vm, SL_G_I, zero, zero);
+    sl_vm_set_derivs(vm, SL_G_Cs, zero, zero);
+    sl_vm_set_derivs(vm, SL_G_Os, zero, zero);
+}
+
 /* Affine globals over [u0,u1] x [v0,v1]: u and v are the first two noise
  * symbols of ctx (reset here). */
 static inline void h_globals_affine(sl_vm *vm, aa_context *ctx, h_surface s, double u0,
@@ -181,6 +217,7 @@ static inline void h_globals_affine(sl_vm *vm, aa_context *ctx, h_surface s, dou
     sl_vm_set_affine(vm, SL_G_t, &V);
     sl_vm_set_affine(vm, SL_G_Cs, one);
     sl_vm_set_affine(vm, SL_G_Os, one);
+    h_derivs(vm, s, u0, u1, v0, v1);
 }
 
 /* Interval globals over the box, from the same formulas in IA. */
@@ -219,6 +256,7 @@ static inline void h_globals_interval(sl_vm *vm, h_surface s, double u0, double 
     sl_vm_set_interval(vm, SL_G_t, &V);
     sl_vm_set_interval(vm, SL_G_Cs, one);
     sl_vm_set_interval(vm, SL_G_Os, one);
+    h_derivs(vm, s, u0, u1, v0, v1);
 }
 
 /* ---- small random numbers (xorshift64*), fixed seed ---- */
