@@ -269,6 +269,8 @@ void trace_surface_point_eval(trace_thread *th, const trace_object *obj,
     out->dPdv = dPdv;
     out->Ng = v3_normalize(Ng);
     out->P = P;
+    out->Pu = dPdu;
+    out->Pv = dPdv;
     out->N = out->Ng;
     if (!obj->displacement) return;
 
@@ -301,6 +303,8 @@ void trace_surface_point_eval(trace_thread *th, const trace_object *obj,
     sl_vm_get_dual(vm, SL_G_P, rP);
     sl_vm_get_dual(vm, SL_G_N, rN);
     out->P = v3(rP[0].v, rP[1].v, rP[2].v);
+    out->Pu = v3(rP[0].du, rP[1].du, rP[2].du);
+    out->Pv = v3(rP[0].dv, rP[1].dv, rP[2].dv);
     vec3 N = v3(rN[0].v, rN[1].v, rN[2].v);
     double len = v3_length(N);
     if (len > 0 && isfinite(len)) out->N = v3_scale(N, 1.0 / len);

@@ -32,6 +32,7 @@ typedef struct trace_surface_point {
     vec3 N;              /* shading normal (unit), after the displacement shader */
     vec3 Ng;             /* geometric normal of the base surface (unit) */
     vec3 dPdu, dPdv;     /* of the base surface, camera space */
+    vec3 Pu, Pv;         /* d/du, d/dv of the displaced P (dual mode) */
     double u, v;
 } trace_surface_point;
 

@@ -45,8 +45,95 @@ static double box_min_extent(const trace_box *b)
     return e;
 }
 
+/* §5 walls, issue 9: a discontinuous box that stopped shrinking is a wall
+ * only where the surface really jumps. The displaced surface is sampled
+ * on a 3x3 grid of the cell (dual mode, as hit points are, with its
+ * derivatives): between grid neighbours a continuous surface follows the
+ * trapezoid rule, P_k - P_i = (J_i + J_k) d / 2 up to third-order terms,
+ * while a jump misses it by the jump's size. If no neighbours miss it by
+ * more than twice the tolerance, the surface is continuous at this scale
+ * (sin of a mod, a branch whose sides agree, a steep slope) and the cell
+ * is subdivided further like any other. Otherwise the samples fall into
+ * the two sides of the jump (nearer to one or the other of the two
+ * farthest samples); the wall's normal is the step between the sides'
+ * base-surface centroids, made perpendicular to the jump of their
+ * displacements: for a nail, the radius. */
+static bool real_wall(walk *w, const double r[4], double tol, vec3 *normal)
+{
+    enum { G = 3, NS = G * G };
+    const trace_object *obj = w->obj;
+    vec3 P[NS], Pu[NS], Pv[NS], base[NS];
+    bool ok[NS];
+    double du = (r[1] - r[0]) / (G - 1), dv = (r[3] - r[2]) / (G - 1);
+    for (int j = 0; j < G; j++)
+        for (int i = 0; i < G; i++) {
+            int k = j * G + i;
+            double u = r[0] + du * i, v = r[2] + dv * j;
+            ok[k] = false;
+            if (!geom_uv_inside(&obj->surf, u, v)) continue;
+            trace_surface_point sp;
+            trace_surface_point_eval(w->th, obj, u, v, &sp);
+            if (!v3_is_finite(sp.P)) continue;
+            geom_sample g;
+            geom_eval(&obj->surf, u, v, &g);
+            P[k] = sp.P;
+            Pu[k] = sp.Pu;
+            Pv[k] = sp.Pv;
+            base[k] = mat4_xform_point(&obj->to_camera, g.P);
+            ok[k] = true;
+        }
+    double miss = 0;
+    for (int k = 0; k < NS; k++) {
+        int right = k % G < G - 1 ? k + 1 : -1, down = k + G < NS ? k + G : -1;
+        if (ok[k] && right >= 0 && ok[right]) {
+            vec3 pred = v3_add(P[k], v3_scale(v3_add(Pu[k], Pu[right]), 0.5 * du));
+            miss = fmax(miss, v3_length(v3_sub(P[right], pred)));
+        }
+        if (ok[k] && down >= 0 && ok[down]) {
+            vec3 pred = v3_add(P[k], v3_scale(v3_add(Pv[k], Pv[down]), 0.5 * dv));
+            miss = fmax(miss, v3_length(v3_sub(P[down], pred)));
+        }
+    }
+    if (!(miss > 2.0 * tol)) return false;
+    int a = -1, b = -1, n = 0;
+    double far = -1;
+    for (int i = 0; i < NS; i++) {
+        if (!ok[i]) continue;
+        P[n] = P[i];
+        base[n] = base[i];
+        n++;
+    }
+    for (int i = 0; i < n; i++)
+        for (int k = i + 1; k < n; k++) {
+            double d = v3_length(v3_sub(P[i], P[k]));
+            if (d > far) { far = d; a = i; b = k; }
+        }
+    vec3 sum_base[2] = {v3(0, 0, 0), v3(0, 0, 0)}, sum_disp[2] = {v3(0, 0, 0), v3(0, 0, 0)};
+    int count[2] = {0, 0};
+    for (int i = 0; i < n; i++) {
+        int side = v3_length(v3_sub(P[i], P[b])) < v3_length(v3_sub(P[i], P[a]));
+        sum_base[side] = v3_add(sum_base[side], base[i]);
+        sum_disp[side] = v3_add(sum_disp[side], v3_sub(P[i], base[i]));
+        count[side]++;
+    }
+    vec3 step = v3_sub(v3_scale(sum_base[1], 1.0 / count[1]), v3_scale(sum_base[0], 1.0 / count[0]));
+    vec3 jump = v3_sub(v3_scale(sum_disp[1], 1.0 / count[1]), v3_scale(sum_disp[0], 1.0 / count[0]));
+    double jj = v3_dot(jump, jump);
+    vec3 nrm = jj > 0 ? v3_sub(step, v3_scale(jump, v3_dot(step, jump) / jj)) : step;
+    double len = v3_length(nrm);
+    if (!(len > 0) || !isfinite(len)) {
+        *normal = v3(0, 0, 0);       /* the box face's, in leaf_hit */
+        return true;
+    }
+    nrm = v3_scale(nrm, 1.0 / len);
+    if (v3_dot(nrm, w->cam_ray->d) > 0) nrm = v3_neg(nrm);
+    *normal = nrm;
+    return true;
+}
+
 static void leaf_hit(walk *w, const trace_box *box, const double r[4],
-                     double t0, double t1, int axis, trace_leaf_kind kind)
+                     double t0, double t1, int axis, trace_leaf_kind kind,
+                     vec3 surface_normal)
 {
     const trace_object *obj = w->obj;
     double uc = 0.5 * (r[0] + r[1]), vc = 0.5 * (r[2] + r[3]);
@@ -61,7 +148,9 @@ static void leaf_hit(walk *w, const trace_box *box, const double r[4],
         /* the ray meets the wall where it enters its box */
         th->stats.wall_leaves++;
         t = t0;
-        if (axis >= 0) {
+        if (v3_dot(surface_normal, surface_normal) > 0) {
+            wall_n = surface_normal;
+        } else if (axis >= 0) {
             double n[3] = {0, 0, 0};
             n[axis] = (&w->ray.d.x)[axis] > 0 ? -1.0 : 1.0;
             wall_n = v3_normalize(mat4_xform_normal(&obj->from_camera, v3(n[0], n[1], n[2])));
@@ -178,14 +267,15 @@ static void visit(walk *w, const trace_box *node, const double r[4],
         double tol = w->tol.a + w->tol.b * t_at;
         int d = depth + 1;
         bool unbounded = (kid->flags & AA_UNBOUNDED) != 0;
+        vec3 wall_n = v3(0, 0, 0);
         if (d >= TRACE_MAX_DEPTH)
-            leaf_hit(w, kid, c, order[k].t0, order[k].t1, order[k].axis, TRACE_LEAF_DEPTH);
+            leaf_hit(w, kid, c, order[k].t0, order[k].t1, order[k].axis, TRACE_LEAF_DEPTH, wall_n);
         else if (!unbounded && size <= tol)
-            leaf_hit(w, kid, c, order[k].t0, order[k].t1, order[k].axis, TRACE_LEAF_SMALL);
+            leaf_hit(w, kid, c, order[k].t0, order[k].t1, order[k].axis, TRACE_LEAF_SMALL, wall_n);
         else if (!unbounded && (kid->flags & AA_DISCONTINUOUS) &&
                  trace_box_extent(kid) >= TRACE_NO_SHRINK * node_extent &&
-                 box_min_extent(kid) * w->obj->scale <= tol)
-            leaf_hit(w, kid, c, order[k].t0, order[k].t1, order[k].axis, TRACE_LEAF_WALL);
+                 box_min_extent(kid) * w->obj->scale <= tol && real_wall(w, c, tol, &wall_n))
+            leaf_hit(w, kid, c, order[k].t0, order[k].t1, order[k].axis, TRACE_LEAF_WALL, wall_n);
         else
             visit(w, kid, c, brood, order[k].i, d);
     }

@@ -1,0 +1,263 @@
+/*
+ * test_trace_walls.c: wrong images with exit 0 (issue 9, finding 5), as
+ * regressions. A wall (Heidrich & Seidel §5) only where the surface really
+ * jumps; a leaf that reached the depth cap is a hit only where the surface
+ * is on the ray; a vanishing normalize() leaves boxes bounded:
+ *   - sin(2 PI mod(s*4, 1)) is continuous across the mod seams: no wall
+ *     leaves, no dark seam lines (every hit faces the camera);
+ *   - a bricks shader (floor/mod/step, displacement <= 0.01) covers its
+ *     polygon and nothing else (it used to cover the whole frame);
+ *   - atan(y/x) jumps where x changes sign: hits stay on the object;
+ *   - normalize(dPdu) vanishes at a sphere's poles: the root box is finite;
+ *   - a raised disc (a nail head) has walls, shaded with the wall's own
+ *     normal (radial), not a box face's.
+ */
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <cmocka.h>
+
+#include "fixture.h"
+#include "trace/camera.h"
+#include "trace/render.h"
+
+static const char *SINMOD_SL =
+    "displacement sinmod(float Km = 0.02)\n"
+    "{\n"
+    "    float h = sin(2 * PI * mod(s * 4, 1)) * sin(2 * PI * mod(t * 4, 1));\n"
+    "    P += Km * h * normalize(N);\n"
+    "    N = calculatenormal(P);\n"
+    "}\n";
+
+static const char *BRICKS_SL =
+    "displacement bricks(float Km = 0.01, bw = 0.25, bh = 0.1, mortar = 0.02)\n"
+    "{\n"
+    "    float ss = s / bw, tt = t / bh;\n"
+    "    if (mod(tt, 2) >= 1)\n"
+    "        ss += 0.5;\n"
+    "    ss -= floor(ss);\n"
+    "    tt -= floor(tt);\n"
+    "    float w = step(mortar / bw, ss) - step(1 - mortar / bw, ss);\n"
+    "    float h = step(mortar / bh, tt) - step(1 - mortar / bh, tt);\n"
+    "    P += Km * w * h * normalize(N);\n"
+    "    N = calculatenormal(P);\n"
+    "}\n";
+
+static const char *ATAN_SL =
+    "displacement atanyx(float Km = 0.03)\n"
+    "{\n"
+    "    point Pc = transform(\"object\", P);\n"
+    "    P += Km * atan(ycomp(Pc) / xcomp(Pc)) * normalize(N);\n"
+    "}\n";
+
+static const char *POLE_SL =
+    "displacement pole(float Km = 0.05)\n"
+    "{\n"
+    "    P += Km * normalize(dPdu) + Km * 0.5 * normalize(N);\n"
+    "}\n";
+
+static const char *HEAD_SL =
+    "displacement head(float r0 = 0.3, h = 0.2)\n"
+    "{\n"
+    "    float r = distance(point(s, t, 0), point(0.5, 0.5, 0));\n"
+    "    if (r < r0)\n"
+    "        P += h * normalize(N);\n"
+    "}\n";
+
+/* a square polygon facing the camera at z = 5, side 2 */
+#define FACING_RIB(shader)                                                 \
+    "Format 48 48 1\nProjection \"perspective\" \"fov\" [30]\n"            \
+    "WorldBegin\nDisplacement \"" shader "\"\n"                            \
+    "Polygon \"P\" [-1 -1 5  1 -1 5  1 1 5  -1 1 5]\nWorldEnd\n"
+
+typedef struct scan {
+    int inside, inside_hits, outside, outside_hits;
+    double min_shade;            /* smallest red of a hit inside (default surface) */
+    double zlo, zhi;             /* depths of the hits inside */
+    trace_stats st;
+} scan;
+
+/* One ray through every pixel centre; inside = the ray meets the
+ * undisplaced square at least `margin` (in x, y at z = 5) from its edge. */
+static void scan_square(const char *name, const char *src, double margin, scan *out)
+{
+    fixture f;
+    fixture_shader sh[] = {{name, src}};
+    char rib[512];
+    snprintf(rib, sizeof rib, FACING_RIB("%s"), name);
+    assert_true(fixture_open(&f, rib, sh, 1, NULL, 0));
+    trace_thread *th = trace_thread_new(&f.js->world);
+    const trace_camera *cam = &f.js->world.camera;
+    *out = (scan){0, 0, 0, 0, 1e300, 1e300, -1e300, {0}};
+    for (int y = 0; y < cam->yres; y++)
+        for (int x = 0; x < cam->xres; x++) {
+            trace_ray ray;
+            trace_camera_ray(cam, x + 0.5, y + 0.5, &ray);
+            vec3 at = trace_ray_at(&ray, 5.0 / ray.d.z);
+            double edge = fmin(1 - fabs(at.x), 1 - fabs(at.y));
+            double rgb[3], a, z;
+            trace_render_sample(f.js->renderer, th, x + 0.5, y + 0.5, rgb, &a, &z);
+            bool hit = a > 0;
+            if (edge > margin) {
+                out->inside++;
+                out->inside_hits += hit;
+                if (hit) {
+                    out->min_shade = fmin(out->min_shade, rgb[0]);
+                    out->zlo = fmin(out->zlo, z);
+                    out->zhi = fmax(out->zhi, z);
+                }
+            } else if (edge < -margin) {
+                out->outside++;
+                out->outside_hits += hit;
+            }
+        }
+    out->st = th->stats;
+    printf("%-8s inside %d/%d hit, outside %d/%d hit, min shade %.3f, z [%.4f, %.4f], "
+           "walls %ld, depth-cap leaves %ld (rejected %ld), boxes/ray %.2f\n", name,
+           out->inside_hits, out->inside, out->outside_hits, out->outside, out->min_shade,
+           out->zlo, out->zhi, th->stats.wall_leaves, th->stats.depth_cap_leaves,
+           th->stats.rejected_leaves, (double)th->stats.boxes / (double)th->stats.primary_rays);
+    trace_thread_destroy(&th);
+    fixture_close(&f);
+}
+
+static void test_sin_of_mod_has_no_seams(void **state)
+{
+    (void)state;
+    scan s;
+    scan_square("sinmod", SINMOD_SL, 0.03, &s);
+    assert_int_equal(s.st.wall_leaves, 0);
+    assert_int_equal(s.inside_hits, s.inside);
+    assert_int_equal(s.outside_hits, 0);
+    /* the surface tilts by at most atan(0.02 * 2 PI * 4 / 2) = 14 degrees:
+     * the default surface's facing ratio stays above 0.9 (a wall's box face
+     * would give about 0.2) */
+    assert_true(s.min_shade > 0.2 + 0.8 * 0.9);
+    assert_true(s.zlo > 5 - 0.02 - 0.01 && s.zhi < 5 + 0.02 + 0.01);
+
+    /* seen at a grazing angle with five times the amplitude (the old rule
+     * reported 5,472 wall leaves along the seams here) */
+    const char *rib = "Format 96 72 1\nProjection \"perspective\" \"fov\" [40]\n"
+                      "Translate 0 -0.2 3\nRotate -50 1 0 0\nWorldBegin\n"
+                      "Displacement \"sinmod\" \"float Km\" [0.1]\n"
+                      "Polygon \"P\" [-1 -1 0  1 -1 0  1 1 0  -1 1 0]\nWorldEnd\n";
+    fixture f;
+    fixture_shader sh[] = {{"sinmod", SINMOD_SL}};
+    assert_true(fixture_open(&f, rib, sh, 1, NULL, 0));
+    trace_thread *th = trace_thread_new(&f.js->world);
+    int w = 96, h = 72;
+    float *rgba = calloc((size_t)w * h * 4, sizeof *rgba), *z = calloc((size_t)w * h, sizeof *z);
+    assert_true(trace_render_tile(f.js->renderer, th, 0, 0, w, h, rgba, z));
+    printf("sinmod grazing: walls %ld, depth-cap leaves %ld, boxes/ray %.2f\n",
+           th->stats.wall_leaves, th->stats.depth_cap_leaves,
+           (double)th->stats.boxes / (double)th->stats.primary_rays);
+    assert_int_equal(th->stats.wall_leaves, 0);
+    free(rgba);
+    free(z);
+    trace_thread_destroy(&th);
+    fixture_close(&f);
+}
+
+static void test_bricks_cover_their_polygon_only(void **state)
+{
+    (void)state;
+    scan s;
+    scan_square("bricks", BRICKS_SL, 0.03, &s);
+    assert_int_equal(s.inside_hits, s.inside);
+    assert_int_equal(s.outside_hits, 0);
+    assert_true(s.zlo > 5 - 0.01 - 0.01 && s.zhi < 5 + 0.01 + 0.01);
+}
+
+static void test_atan_jump_stays_on_the_object(void **state)
+{
+    (void)state;
+    scan s;
+    scan_square("atanyx", ATAN_SL, 0.06, &s);
+    assert_int_equal(s.inside_hits, s.inside);
+    assert_int_equal(s.outside_hits, 0);
+    double amp = 0.03 * M_PI / 2;
+    assert_true(s.zlo > 5 - amp - 0.02 && s.zhi < 5 + amp + 0.02);
+}
+
+static void test_normalize_at_the_poles_is_bounded(void **state)
+{
+    (void)state;
+    const char *rib = "Format 32 32 1\nProjection \"perspective\" \"fov\" [40]\n"
+                      "WorldBegin\nTranslate 0 0 5\nDisplacement \"pole\"\n"
+                      "Sphere 1 -1 1 360\nWorldEnd\n";
+    fixture f;
+    fixture_shader sh[] = {{"pole", POLE_SL}};
+    for (int a = 0; a < 2; a++) {
+        job_options opt;
+        job_options_default(&opt);
+        opt.arith = a ? TRACE_ARITH_INTERVAL : TRACE_ARITH_AFFINE;
+        assert_true(fixture_open(&f, rib, sh, 1, &opt, 0));
+        const trace_box *root = &f.js->world.objects[0].root;
+        printf("pole root box (%s): [%g %g %g] - [%g %g %g]\n", trace_arith_name(opt.arith),
+               root->lo.x, root->lo.y, root->lo.z, root->hi.x, root->hi.y, root->hi.z);
+        assert_false(root->flags & AA_UNBOUNDED);
+        assert_true(trace_box_extent(root) < 2 * (1 + 0.05 + 0.025) + 1e-9);
+        /* a ray that misses the sphere visits only a few nodes */
+        trace_thread *th = trace_thread_new(&f.js->world);
+        double rgb[3], al, z;
+        trace_render_sample(f.js->renderer, th, 1.5, 1.5, rgb, &al, &z);
+        assert_true(al == 0);
+        assert_true(th->stats.nodes < 50);
+        trace_thread_destroy(&th);
+        fixture_close(&f);
+    }
+}
+
+/* A disc of radius 0.3 (in s, t) raised by 0.2 on a square seen from the
+ * side and above: rays that hit the head's wall are shaded with a normal
+ * perpendicular to the displacement (the wall's), so its facing ratio is
+ * that of a vertical cylinder, not of the box faces. */
+static void test_wall_normals_are_the_walls(void **state)
+{
+    (void)state;
+    const char *rib = "Format 64 64 1\nProjection \"perspective\" \"fov\" [30]\n"
+                      "WorldBegin\nTranslate 0 0 5\nRotate -60 1 0 0\n"
+                      "Displacement \"head\"\n"
+                      "Polygon \"P\" [-1 -1 0  1 -1 0  1 1 0  -1 1 0]\nWorldEnd\n";
+    fixture f;
+    fixture_shader sh[] = {{"head", HEAD_SL}};
+    assert_true(fixture_open(&f, rib, sh, 1, NULL, 0));
+    trace_thread *th = trace_thread_new(&f.js->world);
+    const trace_object *obj = &f.js->world.objects[0];
+    vec3 up = v3_normalize(mat4_xform_normal(&obj->from_camera, v3(0, 0, 1)));
+    int walls = 0, radial = 0;
+    for (int y = 0; y < 64; y++)
+        for (int x = 0; x < 64; x++) {
+            trace_ray ray;
+            trace_camera_ray(&f.js->world.camera, x + 0.5, y + 0.5, &ray);
+            trace_hit hit = {.t = ray.tmax, .obj = NULL};
+            if (!trace_bvh_intersect(f.js->renderer->bvh, th, &ray,
+                                     &f.js->renderer->primary_tol, false, &hit))
+                continue;
+            if (hit.kind != TRACE_LEAF_WALL) continue;
+            walls++;
+            /* perpendicular to the displacement (the polygon's normal) */
+            if (fabs(v3_dot(hit.wall_normal, up)) < 0.2) radial++;
+        }
+    printf("head: %d wall hits, %d with a normal perpendicular to the displacement\n",
+           walls, radial);
+    assert_true(walls > 20);
+    assert_true(radial >= walls * 9 / 10);
+    trace_thread_destroy(&th);
+    fixture_close(&f);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_sin_of_mod_has_no_seams),
+        cmocka_unit_test(test_bricks_cover_their_polygon_only),
+        cmocka_unit_test(test_atan_jump_stays_on_the_object),
+        cmocka_unit_test(test_normalize_at_the_poles_is_bounded),
+        cmocka_unit_test(test_wall_normals_are_the_walls),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
