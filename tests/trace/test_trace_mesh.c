@@ -1,0 +1,122 @@
+/*
+ * test_trace_mesh.c: watertight meshes (issue 9, finding 4). Adjacent
+ * Polygons (triangles and quads) and bilinear Patches that share edges,
+ * displaced by zero or by a shader that is continuous across the edges,
+ * must leave no gap: every pixel whose samples all fall well inside the
+ * mesh's outline has alpha exactly 1. (The subdivision used to keep a leaf
+ * only when the centre of its (u,v) cell was on the polygon, so along a
+ * shared edge both neighbours could drop the ray.)
+ */
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <cmocka.h>
+
+#include "fixture.h"
+#include "trace/render.h"
+
+static const char *WAVY_SL =
+    "displacement wavy(float Km = 0)\n"
+    "{\n"
+    "    point Pw = transform(\"world\", P);\n"
+    "    P += Km * sin(5 * xcomp(Pw)) * cos(4 * ycomp(Pw)) * normalize(N);\n"
+    "    N = calculatenormal(P);\n"
+    "}\n";
+
+enum { RES = 64 };
+
+/* An n x n grid over [-1,1]^2 at z = 0 in world space, seen from z = -4:
+ * quads as two triangles (kind 0), as quads (1) or as bilinear patches (2). */
+static char *mesh_rib(int n, int kind, double km)
+{
+    size_t cap = 65536;
+    char *s = malloc(cap);
+    size_t len = (size_t)snprintf(s, cap,
+        "Format %d %d 1\nPixelSamples 3 3\nProjection \"perspective\" \"fov\" [40]\n"
+        "Translate 0 0 4\nWorldBegin\nDisplacement \"wavy\" \"float Km\" [%g]\n",
+        RES, RES, km);
+    for (int j = 0; j < n; j++)
+        for (int i = 0; i < n; i++) {
+            double x0 = -1 + 2.0 * i / n, x1 = -1 + 2.0 * (i + 1) / n;
+            double y0 = -1 + 2.0 * j / n, y1 = -1 + 2.0 * (j + 1) / n;
+            if (kind == 0)
+                len += (size_t)snprintf(s + len, cap - len,
+                    "Polygon \"P\" [%.17g %.17g 0  %.17g %.17g 0  %.17g %.17g 0]\n"
+                    "Polygon \"P\" [%.17g %.17g 0  %.17g %.17g 0  %.17g %.17g 0]\n",
+                    x0, y0, x1, y0, x1, y1, x0, y0, x1, y1, x0, y1);
+            else if (kind == 1)
+                len += (size_t)snprintf(s + len, cap - len,
+                    "Polygon \"P\" [%.17g %.17g 0  %.17g %.17g 0  %.17g %.17g 0  %.17g %.17g 0]\n",
+                    x0, y0, x1, y0, x1, y1, x0, y1);
+            else
+                len += (size_t)snprintf(s + len, cap - len,
+                    "Patch \"bilinear\" \"P\" [%.17g %.17g 0  %.17g %.17g 0  %.17g %.17g 0  "
+                    "%.17g %.17g 0]\n", x0, y0, x1, y0, x0, y1, x1, y1);
+        }
+    snprintf(s + len, cap - len, "WorldEnd\n");
+    return s;
+}
+
+/* Renders the mesh; counts pixels well inside the outline (every sample
+ * and the filter's reach at least 2 pixels from it) whose alpha is not 1. */
+static int gaps_in(int n, int kind, double km, int *inside)
+{
+    char *rib = mesh_rib(n, kind, km);
+    fixture f;
+    fixture_shader sh[] = {{"wavy", WAVY_SL}};
+    assert_true(fixture_open(&f, rib, sh, 1, NULL, 0));
+    free(rib);
+    trace_thread *th = trace_thread_new(&f.js->world);
+    float *rgba = calloc((size_t)RES * RES * 4, sizeof *rgba), *z = calloc((size_t)RES * RES, sizeof *z);
+    assert_true(trace_render_tile(f.js->renderer, th, 0, 0, RES, RES, rgba, z));
+    /* the outline at z = 4 spans tan(20 deg) * 4 per half screen */
+    double half = 1.0 / (4.0 * tan(20 * M_PI / 180)) * RES / 2;
+    int gaps = 0;
+    *inside = 0;
+    for (int y = 0; y < RES; y++)
+        for (int x = 0; x < RES; x++) {
+            double dx = fabs(x + 0.5 - RES / 2.0), dy = fabs(y + 0.5 - RES / 2.0);
+            if (dx > half - 3 || dy > half - 3) continue;
+            (*inside)++;
+            if (rgba[((size_t)y * RES + x) * 4 + 3] != 1.0f) gaps++;
+        }
+    printf("mesh %dx%d %s, Km %g: %d of %d inside pixels with alpha < 1\n", n, n,
+           kind == 0 ? "triangles" : kind == 1 ? "quads" : "bilinear patches", km, gaps,
+           *inside);
+    free(rgba);
+    free(z);
+    trace_thread_destroy(&th);
+    fixture_close(&f);
+    return gaps;
+}
+
+static void test_flat_meshes_are_watertight(void **state)
+{
+    (void)state;
+    int inside;
+    for (int kind = 0; kind < 3; kind++) {
+        assert_int_equal(gaps_in(8, kind, 0.0, &inside), 0);
+        assert_true(inside > 1000);
+    }
+}
+
+static void test_displaced_meshes_are_watertight(void **state)
+{
+    (void)state;
+    int inside;
+    for (int kind = 0; kind < 3; kind++)
+        assert_int_equal(gaps_in(8, kind, 0.05, &inside), 0);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_flat_meshes_are_watertight),
+        cmocka_unit_test(test_displaced_meshes_are_watertight),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
