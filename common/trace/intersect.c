@@ -7,6 +7,7 @@
 #include <math.h>
 
 #include "aa/interval.h"
+#include "trace/converge.h"
 
 /* §5: a discontinuous box "stopped shrinking" when a child keeps more than
  * this fraction of its parent's size (smooth boxes halve, roughly). */
@@ -262,12 +263,19 @@ static bool over_limit(walk *w, const double r[4])
 {
     if (w->stopped) return true;
     trace_thread *th = w->th;
-    if (++w->nodes <= th->world->options.max_nodes_per_ray && !trace_thread_cancelled(th))
+    if (++w->nodes <= th->world->options.max_nodes_per_ray && !th->failed &&
+        !trace_thread_cancelled(th))
         return false;
     w->stopped = true;
-    if (th->failed) return true;           /* cancelled: nothing to report */
+    if (th->failed) return true;           /* failed or cancelled: the tile ends */
     th->stats.limited_rays++;
     trace_object_work *ow = &th->work[w->obj->id];
+    if (!ow->probed) {                     /* converge.h: fail fast where hopeless */
+        ow->probed = true;
+        char why[400];
+        if (!trace_surface_converges(th, w->obj, why, sizeof why))
+            trace_thread_fail(th, why);
+    }
     if (ow->limited_rays++ == 0) {
         ow->u0 = r[0]; ow->u1 = r[1]; ow->v0 = r[2]; ow->v1 = r[3];
     } else {

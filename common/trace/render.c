@@ -253,7 +253,7 @@ bool trace_render_tile(const trace_renderer *self, trace_thread *th,
     for (int qy = qy0; qy <= qy1; qy++)
         for (int qx = qx0; qx <= qx1; qx++)
             for (int s = 0; s < ns; s++) {
-                if (trace_thread_cancelled(th)) {
+                if (th->failed || trace_thread_cancelled(th)) {
                     free(smp);
                     return false;
                 }

@@ -1,10 +1,12 @@
 /*
  * test_trace_bounded.c: bounded work (issue 9, docs/renderer.md "Bounded
- * work"). Shaders whose result is NaN or unbounded everywhere used to make
- * every ray search the quadtree without end; now each walk stops at the
- * work limit, the ray is counted per object, and no hit is invented from a
- * surface point that is not on the ray. A cancelled thread stops a tile at
- * once. Counts are deterministic (nodes, not seconds).
+ * work"). Shaders whose result is NaN or unbounded everywhere, or with an
+ * extreme parameter, used to make every ray search the quadtree without
+ * end; now each walk stops at the work limit, and the first ray that
+ * reaches it finds out whether the surface can converge at all (fail fast
+ * with the cause) or is merely costly (the ray is counted per object). A
+ * cancelled thread stops a tile at once. Counts are deterministic (nodes,
+ * not seconds).
  */
 #include <math.h>
 #include <setjmp.h>
@@ -12,6 +14,7 @@
 #include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 #include <cmocka.h>
 
 #include "fixture.h"
@@ -38,12 +41,31 @@ static const char *SQRTNEG_SL =
     "    P += Km * sqrt(-1 - s) * normalize(N);\n"
     "}\n";
 
-/* Renders the whole small image with a low work limit; returns the
- * thread's statistics and the largest alpha. */
-static void render_limited(const char *rib, const char *name, const char *src,
-                           long limit, trace_stats *st, long *object_rays,
-                           double *max_alpha)
+static const char *HUGEFREQ_SL =
+    "displacement hugefreq(float Km = 0.5, frequency = -1e308)\n"
+    "{\n"
+    "    P += Km * sin(2 * PI * frequency * s) * normalize(N);\n"
+    "}\n";
+
+static const char *RIPPLE_SL =
+    "displacement ripple(float Km = 0.05)\n"
+    "{\n"
+    "    P += Km * sin(20 * s) * sin(17 * t) * normalize(N);\n"
+    "}\n";
+
+typedef struct outcome {
+    bool ok;                     /* the tile rendered */
+    char error[512];
+    trace_stats st;
+    long object_rays;            /* limited rays counted on the object */
+    double max_alpha;
+} outcome;
+
+/* Renders the whole small image with the given work limit. */
+static void render_limited(const char *name, const char *src, long limit, outcome *out)
 {
+    char rib[512];
+    snprintf(rib, sizeof rib, SPHERE_RIB("%s"), name);
     fixture f;
     fixture_shader sh[] = {{name, src}};
     assert_true(fixture_open(&f, rib, sh, 1, NULL, 0));
@@ -52,64 +74,76 @@ static void render_limited(const char *rib, const char *name, const char *src,
     int w = f.js->world.camera.xres, h = f.js->world.camera.yres;
     float *rgba = calloc((size_t)w * (size_t)h * 4, sizeof *rgba);
     float *z = calloc((size_t)w * (size_t)h, sizeof *z);
-    assert_true(trace_render_tile(f.js->renderer, th, 0, 0, w, h, rgba, z));
-    *max_alpha = 0;
-    for (int i = 0; i < w * h; i++)
-        if (rgba[i * 4 + 3] > *max_alpha) *max_alpha = rgba[i * 4 + 3];
-    *st = th->stats;
-    *object_rays = th->work[0].limited_rays;
+    out->ok = trace_render_tile(f.js->renderer, th, 0, 0, w, h, rgba, z);
+    snprintf(out->error, sizeof out->error, "%s", th->error);
+    out->max_alpha = 0;
+    for (int i = 0; out->ok && i < w * h; i++)
+        if (rgba[i * 4 + 3] > out->max_alpha) out->max_alpha = rgba[i * 4 + 3];
+    out->st = th->stats;
+    out->object_rays = th->work[0].limited_rays;
+    printf("%s (limit %ld): %s; %ld primary rays, %ld limited, %ld nodes, max %ld nodes/ray\n",
+           name, limit, out->ok ? "rendered" : out->error, out->st.primary_rays,
+           out->st.limited_rays, out->st.nodes, out->st.max_nodes_per_ray);
     free(rgba);
     free(z);
     trace_thread_destroy(&th);
     fixture_close(&f);
 }
 
-static void check_undefined_shader(const char *name, const char *src)
+/* NaN or infinite everywhere: the first ray that reaches the work limit
+ * finds the surface undefined (converge.h) and the tile fails at once,
+ * naming the shader and the cause; no hit is invented. */
+static void check_fails_fast(const char *name, const char *src, const char *cause)
 {
-    trace_stats st;
-    long object_rays;
-    double max_alpha;
+    outcome o;
     const long limit = 300;
-    char rib[512];
-    snprintf(rib, sizeof rib, SPHERE_RIB("%s"), name);
-    render_limited(rib, name, src, limit, &st, &object_rays, &max_alpha);
-    printf("%s: %ld primary rays, %ld limited, %ld nodes, max %ld nodes/ray, "
-           "%ld rejected leaves, max alpha %.3f\n", name, st.primary_rays,
-           st.limited_rays, st.nodes, st.max_nodes_per_ray, st.rejected_leaves, max_alpha);
-    /* every ray that meets the root box runs into the limit, and stops there */
-    assert_true(st.limited_rays > 0);
-    assert_int_equal(object_rays, st.limited_rays);
-    assert_true(st.max_nodes_per_ray <= limit + 1);
-    assert_true(st.nodes <= (limit + 1) * st.primary_rays);
-    /* a surface that is nowhere defined is nowhere drawn */
-    assert_true(st.rejected_leaves > 0);
-    assert_true(max_alpha == 0.0);
+    render_limited(name, src, limit, &o);
+    assert_false(o.ok);
+    assert_non_null(strstr(o.error, name));
+    assert_non_null(strstr(o.error, cause));
+    assert_int_equal(o.st.limited_rays, 1);
+    assert_true(o.st.max_nodes_per_ray <= limit + 1);
 }
 
-static void test_nan_shader_is_bounded(void **state)
+static void test_nan_shader_fails_fast(void **state)
 {
     (void)state;
-    check_undefined_shader("nanp", NAN_SL);
+    check_fails_fast("nanp", NAN_SL, "gives no finite surface");
 }
 
-static void test_sqrt_of_negative_is_bounded(void **state)
+static void test_sqrt_of_negative_fails_fast(void **state)
 {
     (void)state;
-    check_undefined_shader("sqrtneg", SQRTNEG_SL);
+    check_fails_fast("sqrtneg", SQRTNEG_SL, "gives no finite surface");
 }
 
-/* The limit is a pure function of the ray: two renders, one with a warm
- * cache, count the same nodes and limited rays. */
-static void test_limit_is_deterministic(void **state)
+static void test_extreme_frequency_fails_fast(void **state)
 {
     (void)state;
-    trace_stats a, b;
-    long ra, rb;
-    double ma, mb;
-    render_limited(SPHERE_RIB("nanp"), "nanp", NAN_SL, 200, &a, &ra, &ma);
-    render_limited(SPHERE_RIB("nanp"), "nanp", NAN_SL, 200, &b, &rb, &mb);
-    assert_int_equal(a.nodes, b.nodes);
-    assert_int_equal(a.limited_rays, b.limited_rays);
+    check_fails_fast("hugefreq", HUGEFREQ_SL, "does not converge");
+}
+
+/* A surface that converges but needs more nodes than the limit allows:
+ * the rays that reach it are counted on the object and keep what they
+ * found; the render goes on. The counts are a pure function of the rays:
+ * the same in a second render. */
+static void test_limited_rays_are_counted(void **state)
+{
+    (void)state;
+    outcome a, b;
+    render_limited("ripple", RIPPLE_SL, 5, &a);
+    assert_true(a.ok);
+    assert_true(a.st.limited_rays > 0);
+    assert_int_equal(a.object_rays, a.st.limited_rays);
+    assert_true(a.st.max_nodes_per_ray <= 6);
+    assert_true(a.max_alpha > 0);
+    render_limited("ripple", RIPPLE_SL, 5, &b);
+    assert_int_equal(a.st.nodes, b.st.nodes);
+    assert_int_equal(a.st.limited_rays, b.st.limited_rays);
+    /* with the default limit no ray of this scene needs it */
+    render_limited("ripple", RIPPLE_SL, TRACE_DEFAULT_MAX_NODES_PER_RAY, &a);
+    assert_true(a.ok);
+    assert_int_equal(a.st.limited_rays, 0);
 }
 
 /* A cancelled thread ends the tile at the next sample: false, "interrupted". */
@@ -134,9 +168,10 @@ static void test_cancel_stops_a_tile(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_nan_shader_is_bounded),
-        cmocka_unit_test(test_sqrt_of_negative_is_bounded),
-        cmocka_unit_test(test_limit_is_deterministic),
+        cmocka_unit_test(test_nan_shader_fails_fast),
+        cmocka_unit_test(test_sqrt_of_negative_fails_fast),
+        cmocka_unit_test(test_extreme_frequency_fails_fast),
+        cmocka_unit_test(test_limited_rays_are_counted),
         cmocka_unit_test(test_cancel_stops_a_tile),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
