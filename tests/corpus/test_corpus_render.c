@@ -1,6 +1,8 @@
 /*
  * test_corpus_render.c: issue 9, "the corpus", renders: every corpus
- * shader on the plane and on the sphere, a small image (one primary ray per
+ * shader on the plane, the sphere and the mesh of eight triangles sharing
+ * edges (where cracks between polygons would show as missed pixels), a
+ * small image (one primary ray per
  * pixel through its centre, trace_render_sample) in affine arithmetic,
  * against a brute-force reference: the displaced surface tessellated on a
  * fine (u,v) grid with the renderer's own point path
@@ -42,7 +44,8 @@
 #include "trace/displace.h"
 
 enum { W = 48, H = 36 };            /* image */
-enum { GRID = 200 };                /* reference tessellation per object: GRID x GRID points */
+enum { GRID = 200 };                /* reference tessellation: GRID x GRID points per scene,
+                                       split among its objects */
 enum { MAX_BOXES_PER_RAY = 100 };   /* the stated bound: boxes computed / primary rays */
 enum { MAX_BOXES_ONE_RAY = 20000 }; /* a single ray past this is a runaway */
 static const double MARGIN = 0.5;   /* pixels: how far inside the reference a centre must be */
@@ -56,6 +59,7 @@ typedef struct render_result {
     long rendered;                  /* pixels traced before any stop */
     long hits, certain, missed, extra;
     long boxes, wall_leaves, depth_cap_leaves;
+    double render_s, reference_s;   /* CPU seconds (printed, never asserted) */
     int miss_x, miss_y;             /* the first missed pixel */
     char error[256];
 } render_result;
@@ -122,26 +126,63 @@ static void raster_triangle(const double a[2], const double b[2], const double c
             }
 }
 
-/* the reference: each object tessellated on a GRID x GRID (u,v) grid */
+/* one point of the reference: raster position, false when behind the eye */
+static bool ref_point(trace_thread *th, const trace_object *obj, const trace_camera *cam,
+                      double u, double v, double xy[2])
+{
+    trace_surface_point sp;
+    trace_surface_point_eval(th, obj, u, v, &sp);
+    return raster_of(cam, sp.P, &xy[0], &xy[1]);
+}
+
+/* the (u,v) triangle abc on a triangular grid of G steps per side */
+static void ref_triangle(trace_thread *th, const trace_object *obj, const trace_camera *cam,
+                         const double a[2], const double b[2], const double c[2], int G,
+                         double (*xy)[2], bool *ok, unsigned char *cover)
+{
+    const int S = G + 1;
+    for (int j = 0; j <= G; j++)
+        for (int i = 0; i + j <= G; i++) {
+            double fi = (double)i / G, fj = (double)j / G;
+            double u = a[0] + (b[0] - a[0]) * fi + (c[0] - a[0]) * fj;
+            double v = a[1] + (b[1] - a[1]) * fi + (c[1] - a[1]) * fj;
+            ok[j * S + i] = ref_point(th, obj, cam, u, v, xy[j * S + i]);
+        }
+    for (int j = 0; j < G; j++)
+        for (int i = 0; i + j < G; i++) {
+            int k = j * S + i;
+            if (ok[k] && ok[k + 1] && ok[k + S]) raster_triangle(xy[k], xy[k + 1], xy[k + S], cover);
+            if (i + j + 1 < G && ok[k + 1] && ok[k + S + 1] && ok[k + S])
+                raster_triangle(xy[k + 1], xy[k + S + 1], xy[k + S], cover);
+        }
+}
+
+/* the reference: each object tessellated finely (about GRID x GRID points
+ * per scene, split among its objects, since the triangles of a mesh are
+ * small): quadrics and patches on a (u,v) grid, polygons as a fan of
+ * triangles over their own (u,v) outline, each on a triangular grid, so
+ * that the tessellation reaches the polygon's edges exactly */
 static void reference(trace_thread *th, const trace_world *w, unsigned char *cover)
 {
-    double (*xy)[2] = malloc(sizeof *xy * GRID * GRID);
-    bool *ok = malloc(sizeof *ok * GRID * GRID);
+    const int G = (int)ceil(GRID / sqrt((double)w->nobjects));
+    double (*xy)[2] = malloc(sizeof *xy * (size_t)(G + 1) * (size_t)(G + 1));
+    bool *ok = malloc(sizeof *ok * (size_t)(G + 1) * (size_t)(G + 1));
     for (int o = 0; o < w->nobjects; o++) {
         const trace_object *obj = &w->objects[o];
-        for (int j = 0; j < GRID; j++)
-            for (int i = 0; i < GRID; i++) {
-                double u = (double)i / (GRID - 1), v = (double)j / (GRID - 1);
-                int k = j * GRID + i;
-                ok[k] = false;
-                if (!geom_uv_inside(&obj->surf, u, v)) continue;
-                trace_surface_point sp;
-                trace_surface_point_eval(th, obj, u, v, &sp);
-                ok[k] = raster_of(&w->camera, sp.P, &xy[k][0], &xy[k][1]);
-            }
-        for (int j = 0; j + 1 < GRID; j++)
-            for (int i = 0; i + 1 < GRID; i++) {
-                int k00 = j * GRID + i, k10 = k00 + 1, k01 = k00 + GRID, k11 = k01 + 1;
+        if (obj->surf.kind == GEOM_POLYGON) {
+            const geom_surface *g = &obj->surf;
+            for (int k = 1; k + 1 < g->nuv; k++)
+                ref_triangle(th, obj, &w->camera, g->uv[0], g->uv[k], g->uv[k + 1], G, xy, ok,
+                             cover);
+            continue;
+        }
+        for (int j = 0; j < G; j++)
+            for (int i = 0; i < G; i++)
+                ok[j * G + i] = ref_point(th, obj, &w->camera, (double)i / (G - 1),
+                                          (double)j / (G - 1), xy[j * G + i]);
+        for (int j = 0; j + 1 < G; j++)
+            for (int i = 0; i + 1 < G; i++) {
+                int k00 = j * G + i, k10 = k00 + 1, k01 = k00 + G, k11 = k01 + 1;
                 if (!(ok[k00] && ok[k10] && ok[k01] && ok[k11])) continue;
                 raster_triangle(xy[k00], xy[k10], xy[k11], cover);
                 raster_triangle(xy[k00], xy[k11], xy[k01], cover);
@@ -149,6 +190,13 @@ static void reference(trace_thread *th, const trace_world *w, unsigned char *cov
     }
     free(xy);
     free(ok);
+}
+
+static double cpu_now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return ts.tv_sec + ts.tv_nsec * 1e-9;
 }
 
 /* the child's box watchdog: the render thread publishes the pixel it
@@ -208,6 +256,7 @@ static void render_one(const corpus_file *sh, corpus_surface s, int fd, render_r
     memset(hit, 0, sizeof hit);
     watch wd = {.th = th, .ray_start = 0, .pixel = 0, .rendering = 1, .fd = fd, .r = r};
     pthread_t tid;
+    double c0 = cpu_now();
     if (pthread_create(&tid, NULL, watchdog, &wd) != 0) wd.rendering = 0;
     for (int j = 0; j < H && r->status == RS_OK; j++)
         for (int i = 0; i < W; i++) {
@@ -231,10 +280,13 @@ static void render_one(const corpus_file *sh, corpus_surface s, int fd, render_r
     r->boxes = th->stats.boxes;
     r->wall_leaves = th->stats.wall_leaves;
     r->depth_cap_leaves = th->stats.depth_cap_leaves;
+    r->render_s = cpu_now() - c0;
     if (r->status == RS_OK) {
         unsigned char cover[W * H];
         memset(cover, 0, sizeof cover);
+        c0 = cpu_now();
         reference(th, &f.js->world, cover);
+        r->reference_s = cpu_now() - c0;
         for (int k = 0; k < W * H; k++) {
             r->hits += hit[k];
             if (cover[k] == 0x1f) {
@@ -309,8 +361,9 @@ static void run_surface(corpus_surface s)
 {
     double limit = (double)corpus_env_long("AAFARM_CORPUS_RENDER_LIMIT", 30);
     long bad = 0, missed = 0, certain = 0, boxes = 0, rays = 0;
-    printf("%-20s %-7s %-16s %5s %5s %7s %6s %5s %9s %7s %6s\n", "shader", "surface", "status",
-           "hits", "sure", "missed", "extra", "first", "boxes/ray", "walls", "depth");
+    printf("%-20s %-7s %-16s %5s %5s %7s %6s %5s %9s %7s %6s %6s %6s\n", "shader", "surface",
+           "status", "hits", "sure", "missed", "extra", "first", "boxes/ray", "walls", "depth",
+           "cpu_s", "ref_s");
     for (int i = 0; i < C.nshaders; i++) {
         render_result r;
         render_guarded(&C.shaders[i], s, limit, &r);
@@ -318,9 +371,10 @@ static void run_surface(corpus_surface s)
         bool fail = r.status != RS_OK || r.missed > 0 || bpr > MAX_BOXES_PER_RAY;
         char first[32] = "-";
         if (r.missed) snprintf(first, sizeof first, "%d,%d", r.miss_x, r.miss_y);
-        printf("%-20s %-7s %-16s %5ld %5ld %7ld %6ld %5s %9.1f %7ld %6ld%s\n", C.shaders[i].name,
-               corpus_surface_name(s), STATUS[r.status], r.hits, r.certain, r.missed, r.extra,
-               first, bpr, r.wall_leaves, r.depth_cap_leaves, fail ? "  FAIL" : "");
+        printf("%-20s %-7s %-16s %5ld %5ld %7ld %6ld %5s %9.1f %7ld %6ld %6.2f %6.2f%s\n",
+               C.shaders[i].name, corpus_surface_name(s), STATUS[r.status], r.hits, r.certain,
+               r.missed, r.extra, first, bpr, r.wall_leaves, r.depth_cap_leaves, r.render_s,
+               r.reference_s, fail ? "  FAIL" : "");
         if (r.error[0]) printf("    %s\n", r.error);
         bad += fail;
         missed += r.missed;
@@ -341,12 +395,14 @@ static void run_surface(corpus_surface s)
 
 static void test_plane(void **state) { (void)state; run_surface(CORPUS_PLANE); }
 static void test_sphere(void **state) { (void)state; run_surface(CORPUS_SPHERE); }
+static void test_mesh(void **state) { (void)state; run_surface(CORPUS_MESH); }
 
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_plane),
         cmocka_unit_test(test_sphere),
+        cmocka_unit_test(test_mesh),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }
