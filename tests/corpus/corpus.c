@@ -1,0 +1,216 @@
+/*
+ * corpus.c: loading the shader corpus and building its test scenes (see
+ * corpus.h).
+ */
+#include "corpus.h"
+
+#include <dirent.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#ifndef AAFARM_CORPUS_DIR
+#error "AAFARM_CORPUS_DIR must name tests/shaders/corpus"
+#endif
+
+static char *read_all(const char *path)
+{
+    FILE *fp = fopen(path, "rb");
+    if (!fp) return NULL;
+    fseek(fp, 0, SEEK_END);
+    long n = ftell(fp);
+    fseek(fp, 0, SEEK_SET);
+    char *buf = malloc((size_t)n + 1);
+    if (n < 0 || fread(buf, 1, (size_t)n, fp) != (size_t)n) {
+        free(buf);
+        fclose(fp);
+        return NULL;
+    }
+    buf[n] = 0;
+    fclose(fp);
+    return buf;
+}
+
+static int by_name(const void *a, const void *b)
+{
+    return strcmp(((const corpus_file *)a)->name, ((const corpus_file *)b)->name);
+}
+
+static bool wanted(const char *name)
+{
+    const char *only = getenv("AAFARM_CORPUS_ONLY");
+    if (!only || !*only) return true;
+    size_t n = strlen(name);
+    for (const char *p = only; *p;) {
+        const char *e = strchr(p, ',');
+        size_t len = e ? (size_t)(e - p) : strlen(p);
+        if (len == n && strncmp(p, name, n) == 0) return true;
+        if (!e) break;
+        p = e + 1;
+    }
+    return false;
+}
+
+/* the files of dir ending in ext, names (without ext when strip) prefixed */
+static bool load_dir(const char *dir, const char *ext, bool strip, const char *prefix,
+                     bool filter, corpus_file **out, int *count)
+{
+    DIR *d = opendir(dir);
+    if (!d) {
+        fprintf(stderr, "corpus: cannot open %s\n", dir);
+        return false;
+    }
+    struct dirent *e;
+    size_t el = strlen(ext);
+    while ((e = readdir(d))) {
+        size_t n = strlen(e->d_name);
+        if (n <= el || strcmp(e->d_name + n - el, ext) != 0) continue;
+        corpus_file f;
+        memset(&f, 0, sizeof f);
+        snprintf(f.name, sizeof f.name, "%s%.*s", prefix, (int)(strip ? n - el : n), e->d_name);
+        if (filter && !wanted(f.name)) continue;
+        char path[1024];
+        snprintf(path, sizeof path, "%s/%s", dir, e->d_name);
+        f.text = read_all(path);
+        if (!f.text) {
+            fprintf(stderr, "corpus: cannot read %s\n", path);
+            closedir(d);
+            return false;
+        }
+        *out = realloc(*out, sizeof **out * (size_t)(*count + 1));
+        (*out)[(*count)++] = f;
+    }
+    closedir(d);
+    if (*count) qsort(*out, (size_t)*count, sizeof **out, by_name);
+    return true;
+}
+
+bool corpus_load(corpus *c)
+{
+    memset(c, 0, sizeof *c);
+    return load_dir(AAFARM_CORPUS_DIR, ".sl", true, "", true, &c->shaders, &c->nshaders) &&
+           load_dir(AAFARM_CORPUS_DIR "/include", ".h", false, "include/", false,
+                    &c->headers, &c->nheaders);
+}
+
+void corpus_free(corpus *c)
+{
+    for (int i = 0; i < c->nshaders; i++) free(c->shaders[i].text);
+    for (int i = 0; i < c->nheaders; i++) free(c->headers[i].text);
+    free(c->shaders);
+    free(c->headers);
+    memset(c, 0, sizeof *c);
+}
+
+const char *corpus_surface_name(corpus_surface s)
+{
+    static const char *names[] = {"plane", "sphere", "ellipsoid", "cylinder", "patch", "mesh"};
+    return s < CORPUS_NSURFACES ? names[s] : "?";
+}
+
+/* A 2x2 grid of quads over [-1,1]^2, each split into two triangles, with
+ * heights z = 0.25 x y + 0.15 x: eight Polygons sharing their edges, all
+ * counter-clockwise seen from +z. */
+static void mesh_rib(char *out, size_t size, const char *disp)
+{
+    size_t n = (size_t)snprintf(out, size, "%s", disp);
+    double g[3] = {-1, 0, 1};
+    for (int j = 0; j < 2; j++)
+        for (int i = 0; i < 2; i++) {
+            double x0 = g[i], x1 = g[i + 1], y0 = g[j], y1 = g[j + 1];
+#define Z(x, y) (0.25 * (x) * (y) + 0.15 * (x))
+            n += (size_t)snprintf(out + n, size - n,
+                                  "Polygon \"P\" [%g %g %g  %g %g %g  %g %g %g]\n"
+                                  "Polygon \"P\" [%g %g %g  %g %g %g  %g %g %g]\n",
+                                  x0, y0, Z(x0, y0), x1, y0, Z(x1, y0), x1, y1, Z(x1, y1),
+                                  x0, y0, Z(x0, y0), x1, y1, Z(x1, y1), x0, y1, Z(x0, y1));
+#undef Z
+        }
+}
+
+bool corpus_open(fixture *f, const corpus *c, const corpus_file *sh,
+                 corpus_surface s, trace_arith arith, int xres, int yres, bool render)
+{
+    char disp[128], geom[4096], rib[8192];
+    snprintf(disp, sizeof disp, "Displacement \"%s\"\n", sh->name);
+    switch (s) {
+    case CORPUS_PLANE:
+        snprintf(geom, sizeof geom, "Translate 0 0 5\nRotate -50 1 0 0\n%s"
+                 "Polygon \"P\" [-1 -1 0  1 -1 0  1 1 0  -1 1 0]\n", disp);
+        break;
+    case CORPUS_SPHERE:
+        snprintf(geom, sizeof geom, "Translate 0 0 5\nRotate 70 1 0 0\n%s"
+                 "Sphere 1 -1 1 360\n", disp);
+        break;
+    case CORPUS_ELLIPSOID:
+        snprintf(geom, sizeof geom, "Translate 0 0 5\nRotate 30 0 1 0\nRotate 60 1 0 0\n"
+                 "Scale 1.3 0.6 0.9\n%sSphere 1 -1 1 360\n", disp);
+        break;
+    case CORPUS_CYLINDER:
+        snprintf(geom, sizeof geom, "Translate 0 0 5\nRotate 60 1 0 0\n%s"
+                 "Cylinder 0.7 -1 1 360\n", disp);
+        break;
+    case CORPUS_PATCH:
+        snprintf(geom, sizeof geom, "Translate 0 0 5\nRotate -40 1 0 0\n%s"
+                 "Patch \"bilinear\" \"P\" [-1 -1 0.3  1 -1 -0.2  -1 1 -0.3  1 1 0.4]\n", disp);
+        break;
+    case CORPUS_MESH: {
+        char tmp[256];
+        snprintf(tmp, sizeof tmp, "Translate 0 0 5\nRotate -40 1 0 0\n%s", disp);
+        mesh_rib(geom, sizeof geom, tmp);
+        break;
+    }
+    default:
+        return false;
+    }
+    snprintf(rib, sizeof rib,
+             "Format %d %d 1\nProjection \"perspective\" \"fov\" [35]\n"
+             "WorldBegin\nAttributeBegin\n%sAttributeEnd\nWorldEnd\n",
+             xres, yres, geom);
+
+    job_options opt;
+    job_options_default(&opt);
+    opt.arith = arith;
+    memset(f, 0, sizeof *f);
+    f->diag = sl_diag_new();
+    f->job = job_new("corpus.rib", rib, strlen(rib), &opt);
+    char why[256], file[96];
+    for (int i = 0; i < c->nheaders; i++)
+        if (!job_add_source(f->job, c->headers[i].name, c->headers[i].text,
+                            strlen(c->headers[i].text), why, sizeof why)) {
+            fprintf(stderr, "corpus: %s\n", why);
+            return false;
+        }
+    snprintf(file, sizeof file, "%s.sl", sh->name);
+    if (!job_add_source(f->job, file, sh->text, strlen(sh->text), why, sizeof why) ||
+        !job_add_shader(f->job, sh->name, file, why, sizeof why) ||
+        !job_finish(f->job, why, sizeof why)) {
+        fprintf(stderr, "corpus: %s: %s\n", sh->name, why);
+        return false;
+    }
+    f->js = job_scene_new(f->job, 0, render, f->diag);
+    if (!f->js) {
+        fprintf(stderr, "corpus: %s on the %s:\n", sh->name, corpus_surface_name(s));
+        sl_diag_print(f->diag, stderr);
+        return false;
+    }
+    return true;
+}
+
+long corpus_env_long(const char *name, long def)
+{
+    const char *v = getenv(name);
+    if (!v || !*v) return def;
+    char *end;
+    long n = strtol(v, &end, 10);
+    return (*end || n < 1) ? def : n;
+}
+
+double corpus_rng_uniform(corpus_rng *r)
+{
+    uint64_t z = (r->s += 0x9e3779b97f4a7c15ULL);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+    z ^= z >> 31;
+    return (double)(z >> 11) * 0x1.0p-53;
+}

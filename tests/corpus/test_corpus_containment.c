@@ -1,0 +1,222 @@
+/*
+ * test_corpus_containment.c: issue 9, "the corpus", containment: for every
+ * shader of tests/shaders/corpus on each of the six test surfaces, in
+ * affine and in interval arithmetic, random (u,v) ranges with sides from
+ * the whole domain down to ~1e-3 of it; the OBJECT-space box of each range
+ * from the renderer's own code path (trace_surface_box), and dense samples
+ * inside the range from the renderer's point path (trace_surface_point_eval,
+ * dual mode, camera space, mapped to object space with obj->from_camera).
+ * Every sample must lie inside its box up to a rounding slack of a few
+ * ulps of the coordinates' magnitude (Heidrich & Seidel §3: the boxes are
+ * conservative), and no box may be unbounded (AA_UNBOUNDED or an infinite
+ * side) or come from a failed shader run.
+ *
+ * Prints one row per shader x surface x arithmetic: cases, points,
+ * violations, unbounded boxes, shader errors (box runs / point runs), worst
+ * excess, and the smallest range (its larger side, as a fraction of the
+ * domain) whose box was unbounded.
+ *
+ *   AAFARM_CORPUS_CASES  ranges per shader, surface and arithmetic (default 1000)
+ *   AAFARM_CORPUS_ONLY   comma-separated shader names to run (default all)
+ */
+#include <float.h>
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <cmocka.h>
+
+#include "corpus.h"
+#include "geom/surface.h"
+#include "trace/displace.h"
+
+enum { GRID = 4, RANDOM_POINTS = 16 };   /* samples per range: 4x4 grid (corners and
+                                          * edges included) + 16 random */
+
+typedef struct tally {
+    long cases, points, violations, unbounded, box_errors, point_errors;
+    double worst;                   /* largest excess outside the box, object units */
+    double unb_side;                /* smallest range (larger side) with an unbounded box */
+    char error[512];                /* the first shader error */
+} tally;
+
+static corpus C;
+
+static int setup(void **state)
+{
+    (void)state;
+    return corpus_load(&C) ? 0 : -1;
+}
+
+static int teardown(void **state)
+{
+    (void)state;
+    corpus_free(&C);
+    return 0;
+}
+
+static void take_error(trace_thread *th, tally *t, long *counter)
+{
+    if (!th->failed) return;
+    (*counter)++;
+    if (!t->error[0]) memcpy(t->error, th->error, sizeof t->error);
+    th->failed = false;
+    th->error[0] = 0;
+}
+
+static double vmax_abs(vec3 a)
+{
+    return fmax(fabs(a.x), fmax(fabs(a.y), fabs(a.z)));
+}
+
+/* excess of p outside [lo, hi] beyond the slack (0 when inside) */
+static double excess(double p, double lo, double hi, double slack)
+{
+    if (p < lo - slack) return lo - p;
+    if (p > hi + slack) return p - hi;
+    return 0;
+}
+
+static void check_point(trace_thread *th, const trace_object *obj, const trace_box *b,
+                        double u, double v, tally *t)
+{
+    if (!geom_uv_inside(&obj->surf, u, v)) return;     /* not on the polygon */
+    trace_surface_point sp;
+    trace_surface_point_eval(th, obj, u, v, &sp);
+    take_error(th, t, &t->point_errors);
+    vec3 p = mat4_xform_point(&obj->from_camera, sp.P);
+    double slack = 8 * DBL_EPSILON * (vmax_abs(sp.P) + vmax_abs(p));
+    double e = fmax(excess(p.x, b->lo.x, b->hi.x, slack),
+                    fmax(excess(p.y, b->lo.y, b->hi.y, slack),
+                         excess(p.z, b->lo.z, b->hi.z, slack)));
+    t->points++;
+    if (e > 0 || isnan(p.x) || isnan(p.y) || isnan(p.z)) {
+        t->violations++;
+        if (!(e <= t->worst)) t->worst = e;
+    }
+}
+
+/* a side between 1 and 1e-3 of the domain, log-uniform */
+static double side(corpus_rng *r)
+{
+    return pow(10.0, -3.0 * corpus_rng_uniform(r));
+}
+
+static void run_cases(trace_thread *th, const trace_world *w, long ncases, uint64_t seed,
+                      tally *t)
+{
+    corpus_rng rng = {seed};
+    for (long k = 0; k < ncases; k++) {
+        const trace_object *obj = &w->objects[k % w->nobjects];
+        double su = side(&rng), sv = side(&rng);
+        double u0 = (1 - su) * corpus_rng_uniform(&rng), v0 = (1 - sv) * corpus_rng_uniform(&rng);
+        double u1 = u0 + su, v1 = v0 + sv;
+        if (u1 > 1) u1 = 1;
+        if (v1 > 1) v1 = 1;
+        trace_box b;
+        trace_surface_box(th, obj, u0, u1, v0, v1, &b);
+        take_error(th, t, &t->box_errors);
+        t->cases++;
+        if ((b.flags & AA_UNBOUNDED) || !isfinite(b.lo.x) || !isfinite(b.lo.y) ||
+            !isfinite(b.lo.z) || !isfinite(b.hi.x) || !isfinite(b.hi.y) || !isfinite(b.hi.z)) {
+            t->unbounded++;
+            if (fmax(u1 - u0, v1 - v0) < t->unb_side) t->unb_side = fmax(u1 - u0, v1 - v0);
+            continue;          /* such a box contains everything: nothing to sample */
+        }
+        for (int j = 0; j < GRID; j++)
+            for (int i = 0; i < GRID; i++)
+                check_point(th, obj, &b, u0 + (u1 - u0) * i / (GRID - 1),
+                            v0 + (v1 - v0) * j / (GRID - 1), t);
+        for (int i = 0; i < RANDOM_POINTS; i++) {
+            double u = u0 + (u1 - u0) * corpus_rng_uniform(&rng);
+            double v = v0 + (v1 - v0) * corpus_rng_uniform(&rng);
+            check_point(th, obj, &b, u, v, t);
+        }
+    }
+}
+
+static void run_surface(corpus_surface s)
+{
+    static const trace_arith ariths[] = {TRACE_ARITH_AFFINE, TRACE_ARITH_INTERVAL};
+    long ncases = corpus_env_long("AAFARM_CORPUS_CASES", 1000);
+    long bad_rows = 0, failed_opens = 0;
+    tally total;
+    memset(&total, 0, sizeof total);
+    printf("%-20s %-9s %-8s %6s %7s %7s %6s %5s %5s %9s %9s\n", "shader", "surface", "arith",
+           "cases", "points", "viol", "unbnd", "berr", "perr", "worst", "unb-side");
+    for (int i = 0; i < C.nshaders; i++)
+        for (int a = 0; a < 2; a++) {
+            fixture f;
+            if (!corpus_open(&f, &C, &C.shaders[i], s, ariths[a], 64, 48, false)) {
+                printf("%-20s %-9s %-8s did not open (see above)\n", C.shaders[i].name,
+                       corpus_surface_name(s), trace_arith_name(ariths[a]));
+                failed_opens++;
+                fixture_close(&f);
+                continue;
+            }
+            trace_thread *th = trace_thread_new(&f.js->world);
+            tally t;
+            memset(&t, 0, sizeof t);
+            t.unb_side = INFINITY;
+            run_cases(th, &f.js->world, ncases, 0x5eed0000u + (uint64_t)i * 16 + (uint64_t)s, &t);
+            bool bad = t.violations || t.unbounded || t.box_errors || t.point_errors;
+            printf("%-20s %-9s %-8s %6ld %7ld %7ld %6ld %5ld %5ld %9.2e %9.2e%s\n",
+                   C.shaders[i].name, corpus_surface_name(s), trace_arith_name(ariths[a]),
+                   t.cases, t.points, t.violations, t.unbounded, t.box_errors, t.point_errors,
+                   t.worst, t.unbounded ? t.unb_side : 0.0, bad ? "  FAIL" : "");
+            if (t.error[0]) printf("    first shader error: %s\n", t.error);
+            bad_rows += bad;
+            total.cases += t.cases;
+            total.points += t.points;
+            total.violations += t.violations;
+            total.unbounded += t.unbounded;
+            total.box_errors += t.box_errors;
+            total.point_errors += t.point_errors;
+            if (t.worst > total.worst) total.worst = t.worst;
+            trace_thread_destroy(&th);
+            fixture_close(&f);
+        }
+    printf("%s total: %ld cases, %ld points, %ld violations (worst %.2e), %ld unbounded boxes, "
+           "%ld/%ld shader errors (box/point), %ld failing rows, %ld scenes not opened\n",
+           corpus_surface_name(s), total.cases, total.points, total.violations, total.worst,
+           total.unbounded, total.box_errors, total.point_errors, bad_rows, failed_opens);
+    fflush(stdout);
+    assert_int_equal(failed_opens, 0);
+    assert_true(total.points > 0);
+    assert_int_equal(total.violations, 0);
+    assert_int_equal(total.unbounded, 0);
+    assert_int_equal(total.box_errors + total.point_errors, 0);
+}
+
+static void test_corpus_size(void **state)
+{
+    (void)state;
+    printf("corpus: %d shaders, %d headers\n", C.nshaders, C.nheaders);
+    const char *only = getenv("AAFARM_CORPUS_ONLY");
+    if (!only || !*only) assert_true(C.nshaders >= 40);
+    assert_true(C.nshaders >= 1);
+}
+
+static void test_plane(void **state) { (void)state; run_surface(CORPUS_PLANE); }
+static void test_sphere(void **state) { (void)state; run_surface(CORPUS_SPHERE); }
+static void test_ellipsoid(void **state) { (void)state; run_surface(CORPUS_ELLIPSOID); }
+static void test_cylinder(void **state) { (void)state; run_surface(CORPUS_CYLINDER); }
+static void test_patch(void **state) { (void)state; run_surface(CORPUS_PATCH); }
+static void test_mesh(void **state) { (void)state; run_surface(CORPUS_MESH); }
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_corpus_size),
+        cmocka_unit_test(test_plane),
+        cmocka_unit_test(test_sphere),
+        cmocka_unit_test(test_ellipsoid),
+        cmocka_unit_test(test_cylinder),
+        cmocka_unit_test(test_patch),
+        cmocka_unit_test(test_mesh),
+    };
+    return cmocka_run_group_tests(tests, setup, teardown);
+}
