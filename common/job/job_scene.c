@@ -194,6 +194,13 @@ job_scene *job_scene_new(const job *jb, size_t cache_bytes, bool render, sl_diag
         w->options.max_instructions = jb->options.max_instructions;
         w->options.cache_bytes = cache_bytes;
     }
+    if (ok && !render) {
+        char err[512];
+        if (!trace_world_prepare(&self->world, err, sizeof err)) {
+            sl_diag_error(diag, (sl_pos){0}, "%s", err);
+            ok = false;
+        }
+    }
     if (ok && render) {
         char err[512];
         self->renderer = trace_renderer_new(&self->world, err, sizeof err);

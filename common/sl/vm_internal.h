@@ -141,11 +141,12 @@ double sl_vm_random(sl_vm *vm);
 
 const char *sl_mode_name(sl_mode mode);
 
-/* a op b (op: SL_OP_ADD/SUB/MUL/DIV) when the double result is EXACT, so
+/* a op b (op: SL_OP_ADD/SUB/MUL/DIV/MOD) when the double result is EXACT, so
  * that interval and affine runs keep integer counters and octave
  * frequencies as points instead of widening them by a rounding error
- * (which would leave `i < 5` undecided). TwoSum for sums, fma for
- * products and quotients; results near underflow are refused. */
+ * (which would leave `i < 5` undecided, or mod(2, 1) straddle its jump).
+ * TwoSum for sums, fma for products and quotients; results near underflow
+ * are refused. */
 static inline bool sl_exact_op(int op, double a, double b, double *r)
 {
     double s;
@@ -161,6 +162,14 @@ static inline bool sl_exact_op(int op, double a, double b, double *r)
         if (!isfinite(s) || (fabs(s) < 0x1p-900 && a != 0.0 && b != 0.0) ||
             fma(a, b, -s) != 0.0)
             return false;
+    } else if (op == SL_OP_MOD) {
+        /* RenderMan mod(a, b) = a - b floor(a/b), as vm_float.c computes it:
+         * fmod is exact; the sign correction r + b must be exact too */
+        if (b == 0.0 || !isfinite(a) || !isfinite(b))
+            return false;
+        s = fmod(a, b);
+        if (s != 0 && ((s < 0) != (b < 0)))
+            return sl_exact_op(SL_OP_ADD, s, b, r);
     } else {
         if (b == 0.0)
             return false;

@@ -22,9 +22,13 @@
 
 #include "util/vecmath.h"
 
+/* A box estimated from samples where range arithmetic stagnated
+ * (intersect.c, "stagnant-box fallback"); above the flags of common/aa. */
+#define TRACE_BOX_SAMPLED (1u << 8)
+
 typedef struct trace_box {
     vec3 lo, hi;
-    unsigned flags;          /* AA_DISCONTINUOUS | AA_UNBOUNDED */
+    unsigned flags;          /* AA_DISCONTINUOUS | AA_UNBOUNDED | TRACE_BOX_SAMPLED */
 } trace_box;
 
 typedef struct trace_ray {

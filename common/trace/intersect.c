@@ -13,6 +13,9 @@
  * this fraction of its parent's size (smooth boxes halve, roughly). */
 #define TRACE_NO_SHRINK 0.75
 
+/* The first depth at which stagnant flagged boxes may be sampled. */
+#define TRACE_SAMPLE_DEPTH 6
+
 typedef struct walk {
     trace_thread *th;
     const trace_object *obj;
@@ -242,16 +245,87 @@ static void leaf_hit(walk *w, const trace_box *box, const double r[4],
     w->found = true;
 }
 
+/* The stagnant-box fallback (issue 9; docs/renderer.md "Stagnant boxes").
+ * Range arithmetic loses the correlation of some continuous idioms, and
+ * their boxes then stop shrinking along a curve of (u,v): a box-filtered
+ * pulse train (floor(x) and x - floor(x) jump together where x crosses an
+ * integer, their sum does not), normalize(calculatenormal(P)) at a pole.
+ * Every cell along such a seam keeps a fat box that every nearby ray
+ * meets, so the walk fans out exponentially into the work limit and the
+ * surface there is lost. When a child's bounded box is flagged
+ * discontinuous (only a flagged operation can lose such a correlation
+ * without an unbounded result) and keeps more than TRACE_NO_SHRINK of its
+ * parent's size, at depth TRACE_SAMPLE_DEPTH or deeper (cells of at most
+ * 1/64 of the (u,v) square per side), the
+ * surface is sampled on a 3x3 grid of the cell (dual mode); if the
+ * samples follow the trapezoid rule (a continuous surface at this scale:
+ * residual at most a quarter of their spread), the child's box becomes
+ * their hull widened by twice the residual. This is an estimate, not a
+ * proof: a step-built feature narrower than the sample spacing (1/128 of
+ * the square at the first level sampled) inside such a cell can be
+ * missed; surfaces whose operations are all continuous never take this
+ * path and keep the guarantee. It is used only where the proof had
+ * already failed, and each use is counted (stats: sampled_boxes). A pure
+ * function of the cell, so it is cached like any box. Returns true when it
+ * replaced the box. */
+static bool sample_stagnant(trace_thread *th, const trace_object *obj, const double r[4],
+                            trace_box *box)
+{
+    enum { G = 3, NS = G * G };
+    vec3 P[NS], Pu[NS], Pv[NS];
+    double du = (r[1] - r[0]) / (G - 1), dv = (r[3] - r[2]) / (G - 1);
+    for (int j = 0; j < G; j++)
+        for (int i = 0; i < G; i++) {
+            int k = j * G + i;
+            trace_surface_point sp;
+            trace_surface_point_eval(th, obj, r[0] + du * i, r[2] + dv * j, &sp);
+            if (!v3_is_finite(sp.P) || !v3_is_finite(sp.Pu) || !v3_is_finite(sp.Pv))
+                return false;
+            P[k] = mat4_xform_point(&obj->from_camera, sp.P);
+            Pu[k] = mat4_xform_vector(&obj->from_camera, sp.Pu);
+            Pv[k] = mat4_xform_vector(&obj->from_camera, sp.Pv);
+        }
+    double miss = 0;
+    vec3 lo = P[0], hi = P[0];
+    for (int k = 0; k < NS; k++) {
+        lo = v3(fmin(lo.x, P[k].x), fmin(lo.y, P[k].y), fmin(lo.z, P[k].z));
+        hi = v3(fmax(hi.x, P[k].x), fmax(hi.y, P[k].y), fmax(hi.z, P[k].z));
+        if (k % G < G - 1) {
+            vec3 pred = v3_add(P[k], v3_scale(v3_add(Pu[k], Pu[k + 1]), 0.5 * du));
+            miss = fmax(miss, v3_length(v3_sub(P[k + 1], pred)));
+        }
+        if (k + G < NS) {
+            vec3 pred = v3_add(P[k], v3_scale(v3_add(Pv[k], Pv[k + G]), 0.5 * dv));
+            miss = fmax(miss, v3_length(v3_sub(P[k + G], pred)));
+        }
+    }
+    double spread = v3_length(v3_sub(hi, lo));
+    if (!(miss <= 0.25 * spread) && !(spread == 0)) return false;
+    double m = 2.0 * miss + 1e-12 * (1.0 + fmax(v3_length(lo), v3_length(hi)));
+    box->lo = v3_sub(lo, v3(m, m, m));
+    box->hi = v3_add(hi, v3(m, m, m));
+    box->flags &= ~(unsigned)AA_DISCONTINUOUS;
+    box->flags |= TRACE_BOX_SAMPLED;
+    th->stats.sampled_boxes++;
+    return true;
+}
+
 static trace_brood_id children_of(walk *w, trace_brood_id parent, int slot,
-                                  const double r[4], trace_box kids[4])
+                                  const double r[4], const trace_box *node, int depth,
+                                  trace_box kids[4])
 {
     trace_thread *th = w->th;
     trace_brood_id id = trace_boxcache_lookup(th->cache, w->obj->id, parent, slot, kids);
     if (id != TRACE_BROOD_NONE) return id;
+    double node_extent = trace_box_extent(node);
     for (int i = 0; i < 4; i++) {
         double c[4];
         child_range(i, r[0], r[1], r[2], r[3], c);
         trace_surface_box(th, w->obj, c[0], c[1], c[2], c[3], &kids[i]);
+        if (depth >= TRACE_SAMPLE_DEPTH && (kids[i].flags & AA_DISCONTINUOUS) &&
+            !(kids[i].flags & AA_UNBOUNDED) && !trace_box_is_empty(&kids[i]) &&
+            trace_box_extent(&kids[i]) >= TRACE_NO_SHRINK * node_extent)
+            sample_stagnant(th, w->obj, c, &kids[i]);
     }
     return trace_boxcache_insert(th->cache, w->obj->id, parent, slot, kids);
 }
@@ -290,7 +364,7 @@ static void visit(walk *w, const trace_box *node, const double r[4],
 {
     if (over_limit(w, r)) return;
     trace_box kids[4];
-    trace_brood_id brood = children_of(w, parent, slot, r, kids);
+    trace_brood_id brood = children_of(w, parent, slot, r, node, depth, kids);
     trace_boxcache_pin(w->th->cache, brood);
 
     child_order order[4];

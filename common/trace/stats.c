@@ -6,7 +6,7 @@
 #define STATS_FIELDS(X) \
     X(primary_rays) X(shadow_rays) X(boxes) X(evals_affine) X(evals_interval) \
     X(evals_dual) X(evals_float) X(leaves) X(wall_leaves) X(depth_cap_leaves) \
-    X(rejected_leaves) X(nodes) X(limited_rays) X(empty_boxes) \
+    X(rejected_leaves) X(nodes) X(limited_rays) X(sampled_boxes) X(empty_boxes) \
     X(cache_hits) X(cache_misses) X(cache_evictions)
 
 void trace_stats_add(trace_stats *into, const trace_stats *from)

@@ -19,6 +19,8 @@ typedef struct trace_stats {
                                       ray (depth cap) or not finite: no hit */
     long nodes;                    /* quadtree nodes visited by all rays */
     long limited_rays;             /* walks stopped by the work limit */
+    long sampled_boxes;            /* stagnant boxes replaced by samples
+                                      (intersect.c), counted */
     long empty_boxes;              /* boxes that were NaN: no point of the
                                       range is defined (pruned, counted) */
     long max_nodes_per_ray;        /* the largest walk (a peak, not a sum) */

@@ -109,4 +109,9 @@ typedef struct trace_world {
     trace_options options;
 } trace_world;
 
+/* Derives each object's id, scale, normal bounds and du/dv (world.c);
+ * false with a message naming the object when its transform is not finite
+ * or nearly singular. Called by trace_renderer_new; idempotent. */
+bool trace_world_prepare(trace_world *world, char *err, int errsz);
+
 #endif

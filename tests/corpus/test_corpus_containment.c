@@ -8,8 +8,14 @@
  * dual mode, camera space, mapped to object space with obj->from_camera).
  * Every sample must lie inside its box up to a rounding slack of a few
  * ulps of the coordinates' magnitude (Heidrich & Seidel §3: the boxes are
- * conservative), and no box may be unbounded (AA_UNBOUNDED or an infinite
- * side) or come from a failed shader run.
+ * conservative), no box of a range narrower than WIDE (both sides) may be
+ * unbounded (AA_UNBOUNDED or an infinite side), and none may come from a
+ * failed shader run. Wider ranges may give unbounded boxes, counted
+ * ("wide-unb"): the dependency problem of range arithmetic in idioms such
+ * as 1 / length(ntransform("shader", normalize(N))) or a filter width of
+ * distance() at its centre, whose operands' ranges include 0 over a wide
+ * range although the values never do; the subdivision splits such ranges
+ * (docs/renderer.md, "Shader globals").
  *
  * Prints one row per shader x surface x arithmetic: cases, points,
  * violations, unbounded boxes, shader errors (box runs / point runs), worst
@@ -36,8 +42,11 @@
 enum { GRID = 4, RANDOM_POINTS = 16 };   /* samples per range: 4x4 grid (corners and
                                           * edges included) + 16 random */
 
+/* ranges with a side at least this wide may be unbounded (counted) */
+#define WIDE (1.0 / 32.0)
+
 typedef struct tally {
-    long cases, points, violations, unbounded, box_errors, point_errors;
+    long cases, points, violations, unbounded, unbounded_wide, box_errors, point_errors;
     double worst;                   /* largest excess outside the box, object units */
     double unb_side;                /* smallest range (larger side) with an unbounded box */
     char error[512];                /* the first shader error */
@@ -122,7 +131,10 @@ static void run_cases(trace_thread *th, const trace_world *w, long ncases, uint6
         t->cases++;
         if ((b.flags & AA_UNBOUNDED) || !isfinite(b.lo.x) || !isfinite(b.lo.y) ||
             !isfinite(b.lo.z) || !isfinite(b.hi.x) || !isfinite(b.hi.y) || !isfinite(b.hi.z)) {
-            t->unbounded++;
+            if (fmax(u1 - u0, v1 - v0) >= WIDE)
+                t->unbounded_wide++;
+            else
+                t->unbounded++;
             if (fmax(u1 - u0, v1 - v0) < t->unb_side) t->unb_side = fmax(u1 - u0, v1 - v0);
             continue;          /* such a box contains everything: nothing to sample */
         }
@@ -145,8 +157,9 @@ static void run_surface(corpus_surface s)
     long bad_rows = 0, failed_opens = 0;
     tally total;
     memset(&total, 0, sizeof total);
-    printf("%-20s %-9s %-8s %6s %7s %7s %6s %5s %5s %9s %9s\n", "shader", "surface", "arith",
-           "cases", "points", "viol", "unbnd", "berr", "perr", "worst", "unb-side");
+    printf("%-20s %-9s %-8s %6s %7s %7s %6s %8s %5s %5s %9s %9s\n", "shader", "surface",
+           "arith", "cases", "points", "viol", "unbnd", "wide-unb", "berr", "perr", "worst",
+           "unb-side");
     for (int i = 0; i < C.nshaders; i++)
         for (int a = 0; a < 2; a++) {
             fixture f;
@@ -163,26 +176,30 @@ static void run_surface(corpus_surface s)
             t.unb_side = INFINITY;
             run_cases(th, &f.js->world, ncases, 0x5eed0000u + (uint64_t)i * 16 + (uint64_t)s, &t);
             bool bad = t.violations || t.unbounded || t.box_errors || t.point_errors;
-            printf("%-20s %-9s %-8s %6ld %7ld %7ld %6ld %5ld %5ld %9.2e %9.2e%s\n",
+            printf("%-20s %-9s %-8s %6ld %7ld %7ld %6ld %8ld %5ld %5ld %9.2e %9.2e%s\n",
                    C.shaders[i].name, corpus_surface_name(s), trace_arith_name(ariths[a]),
-                   t.cases, t.points, t.violations, t.unbounded, t.box_errors, t.point_errors,
-                   t.worst, t.unbounded ? t.unb_side : 0.0, bad ? "  FAIL" : "");
+                   t.cases, t.points, t.violations, t.unbounded, t.unbounded_wide,
+                   t.box_errors, t.point_errors, t.worst,
+                   t.unbounded + t.unbounded_wide ? t.unb_side : 0.0, bad ? "  FAIL" : "");
             if (t.error[0]) printf("    first shader error: %s\n", t.error);
             bad_rows += bad;
             total.cases += t.cases;
             total.points += t.points;
             total.violations += t.violations;
             total.unbounded += t.unbounded;
+            total.unbounded_wide += t.unbounded_wide;
             total.box_errors += t.box_errors;
             total.point_errors += t.point_errors;
             if (t.worst > total.worst) total.worst = t.worst;
             trace_thread_destroy(&th);
             fixture_close(&f);
         }
-    printf("%s total: %ld cases, %ld points, %ld violations (worst %.2e), %ld unbounded boxes, "
-           "%ld/%ld shader errors (box/point), %ld failing rows, %ld scenes not opened\n",
+    printf("%s total: %ld cases, %ld points, %ld violations (worst %.2e), %ld unbounded boxes "
+           "(+ %ld of ranges wider than 1/32, counted), %ld/%ld shader errors (box/point), "
+           "%ld failing rows, %ld scenes not opened\n",
            corpus_surface_name(s), total.cases, total.points, total.violations, total.worst,
-           total.unbounded, total.box_errors, total.point_errors, bad_rows, failed_opens);
+           total.unbounded, total.unbounded_wide, total.box_errors, total.point_errors,
+           bad_rows, failed_opens);
     fflush(stdout);
     assert_int_equal(failed_opens, 0);
     assert_true(total.points > 0);
