@@ -62,7 +62,7 @@ static void aa_camera_normal(aa_context *ctx, const trace_object *obj,
         for (int i = 0; i < 3; i++) aa_mul_s(ctx, &N[i], &N[i], k * obj->normal_scale);
         return;
     }
-    /* |N|^2 of the true normal lies in obj->normal_len2 (render.c): meeting
+    /* |N|^2 of the true normal lies in obj->normal_len2 (world.c): meeting
      * the computed form with it is sound and keeps wide ranges bounded
      * away from 0, as are the components of a unit vector in [-1, 1] */
     aa_form len2, sq, inv, lo, hi;
