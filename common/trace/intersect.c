@@ -49,75 +49,85 @@ static double box_min_extent(const trace_box *b)
     return e;
 }
 
+/* The displaced surface on a 3x3 grid of a (u,v) cell, in dual mode (as
+ * hit points are), camera space, with its derivatives; the samples off a
+ * polygon or not finite are marked missing. `residual` is how far grid
+ * neighbours miss the trapezoid rule P_k - P_i = (J_i + J_k) d / 2: a few
+ * third-order terms on a continuous surface, the size of the jump where it
+ * jumps. Used by the wall test and the stagnant-box fallback. */
+enum { CELL_G = 3, CELL_N = CELL_G * CELL_G };
+typedef struct cell_samples {
+    vec3 P[CELL_N], Pu[CELL_N], Pv[CELL_N], base[CELL_N];
+    bool ok[CELL_N];
+    int n;                         /* samples present */
+    double residual;
+} cell_samples;
+
+static void sample_cell(trace_thread *th, const trace_object *obj, const double r[4],
+                        cell_samples *cs)
+{
+    double du = (r[1] - r[0]) / (CELL_G - 1), dv = (r[3] - r[2]) / (CELL_G - 1);
+    cs->n = 0;
+    for (int k = 0; k < CELL_N; k++) {
+        double u = r[0] + du * (k % CELL_G), v = r[2] + dv * (k / CELL_G);
+        cs->ok[k] = false;
+        if (!geom_uv_inside(&obj->surf, u, v)) continue;
+        trace_surface_point sp;
+        trace_surface_point_eval(th, obj, u, v, &sp);
+        if (!v3_is_finite(sp.P) || !v3_is_finite(sp.Pu) || !v3_is_finite(sp.Pv)) continue;
+        geom_sample g;
+        geom_eval(&obj->surf, u, v, &g);
+        cs->P[k] = sp.P;
+        cs->Pu[k] = sp.Pu;
+        cs->Pv[k] = sp.Pv;
+        cs->base[k] = mat4_xform_point(&obj->to_camera, g.P);
+        cs->ok[k] = true;
+        cs->n++;
+    }
+    cs->residual = 0;
+    for (int k = 0; k < CELL_N; k++) {
+        int right = k % CELL_G < CELL_G - 1 ? k + 1 : -1;
+        int down = k + CELL_G < CELL_N ? k + CELL_G : -1;
+        if (cs->ok[k] && right >= 0 && cs->ok[right]) {
+            vec3 pred = v3_add(cs->P[k], v3_scale(v3_add(cs->Pu[k], cs->Pu[right]), 0.5 * du));
+            cs->residual = fmax(cs->residual, v3_length(v3_sub(cs->P[right], pred)));
+        }
+        if (cs->ok[k] && down >= 0 && cs->ok[down]) {
+            vec3 pred = v3_add(cs->P[k], v3_scale(v3_add(cs->Pv[k], cs->Pv[down]), 0.5 * dv));
+            cs->residual = fmax(cs->residual, v3_length(v3_sub(cs->P[down], pred)));
+        }
+    }
+}
+
 /* §5 walls, issue 9: a discontinuous box that stopped shrinking is a wall
- * only where the surface really jumps. The displaced surface is sampled
- * on a 3x3 grid of the cell (dual mode, as hit points are, with its
- * derivatives): between grid neighbours a continuous surface follows the
- * trapezoid rule, P_k - P_i = (J_i + J_k) d / 2 up to third-order terms,
- * while a jump misses it by the jump's size. If no neighbours miss it by
- * more than twice the tolerance, the surface is continuous at this scale
- * (sin of a mod, a branch whose sides agree, a steep slope) and the cell
- * is subdivided further like any other. Otherwise the samples fall into
- * the two sides of the jump (nearer to one or the other of the two
- * farthest samples); the wall's normal is the step between the sides'
- * base-surface centroids, made perpendicular to the jump of their
- * displacements: for a nail, the radius. */
+ * only where the surface really jumps: its samples (sample_cell) miss the
+ * trapezoid rule by more than twice the tolerance. A function that is
+ * continuous at this scale (sin of a mod, a branch whose sides agree, a
+ * steep slope) passes, and its cell is subdivided further like any other.
+ * At a wall the samples fall into the two sides of the jump (nearer to one
+ * or the other of the two farthest samples); the wall's normal is the step
+ * between the sides' base-surface centroids, made perpendicular to the
+ * jump of their displacements: for a nail, the radius. */
 static bool real_wall(walk *w, const double r[4], double tol, vec3 *normal)
 {
-    enum { G = 3, NS = G * G };
-    const trace_object *obj = w->obj;
-    vec3 P[NS], Pu[NS], Pv[NS], base[NS];
-    bool ok[NS];
-    double du = (r[1] - r[0]) / (G - 1), dv = (r[3] - r[2]) / (G - 1);
-    for (int j = 0; j < G; j++)
-        for (int i = 0; i < G; i++) {
-            int k = j * G + i;
-            double u = r[0] + du * i, v = r[2] + dv * j;
-            ok[k] = false;
-            if (!geom_uv_inside(&obj->surf, u, v)) continue;
-            trace_surface_point sp;
-            trace_surface_point_eval(w->th, obj, u, v, &sp);
-            if (!v3_is_finite(sp.P)) continue;
-            geom_sample g;
-            geom_eval(&obj->surf, u, v, &g);
-            P[k] = sp.P;
-            Pu[k] = sp.Pu;
-            Pv[k] = sp.Pv;
-            base[k] = mat4_xform_point(&obj->to_camera, g.P);
-            ok[k] = true;
-        }
-    double miss = 0;
-    for (int k = 0; k < NS; k++) {
-        int right = k % G < G - 1 ? k + 1 : -1, down = k + G < NS ? k + G : -1;
-        if (ok[k] && right >= 0 && ok[right]) {
-            vec3 pred = v3_add(P[k], v3_scale(v3_add(Pu[k], Pu[right]), 0.5 * du));
-            miss = fmax(miss, v3_length(v3_sub(P[right], pred)));
-        }
-        if (ok[k] && down >= 0 && ok[down]) {
-            vec3 pred = v3_add(P[k], v3_scale(v3_add(Pv[k], Pv[down]), 0.5 * dv));
-            miss = fmax(miss, v3_length(v3_sub(P[down], pred)));
-        }
-    }
-    if (!(miss > 2.0 * tol)) return false;
-    int a = -1, b = -1, n = 0;
+    cell_samples cs;
+    sample_cell(w->th, w->obj, r, &cs);
+    if (!(cs.residual > 2.0 * tol)) return false;
+    int a = -1, b = -1;
     double far = -1;
-    for (int i = 0; i < NS; i++) {
-        if (!ok[i]) continue;
-        P[n] = P[i];
-        base[n] = base[i];
-        n++;
-    }
-    for (int i = 0; i < n; i++)
-        for (int k = i + 1; k < n; k++) {
-            double d = v3_length(v3_sub(P[i], P[k]));
+    for (int i = 0; i < CELL_N; i++)
+        for (int k = i + 1; k < CELL_N; k++) {
+            if (!cs.ok[i] || !cs.ok[k]) continue;
+            double d = v3_length(v3_sub(cs.P[i], cs.P[k]));
             if (d > far) { far = d; a = i; b = k; }
         }
     vec3 sum_base[2] = {v3(0, 0, 0), v3(0, 0, 0)}, sum_disp[2] = {v3(0, 0, 0), v3(0, 0, 0)};
     int count[2] = {0, 0};
-    for (int i = 0; i < n; i++) {
-        int side = v3_length(v3_sub(P[i], P[b])) < v3_length(v3_sub(P[i], P[a]));
-        sum_base[side] = v3_add(sum_base[side], base[i]);
-        sum_disp[side] = v3_add(sum_disp[side], v3_sub(P[i], base[i]));
+    for (int i = 0; i < CELL_N; i++) {
+        if (!cs.ok[i]) continue;
+        int side = v3_length(v3_sub(cs.P[i], cs.P[b])) < v3_length(v3_sub(cs.P[i], cs.P[a]));
+        sum_base[side] = v3_add(sum_base[side], cs.base[i]);
+        sum_disp[side] = v3_add(sum_disp[side], v3_sub(cs.P[i], cs.base[i]));
         count[side]++;
     }
     vec3 step = v3_sub(v3_scale(sum_base[1], 1.0 / count[1]), v3_scale(sum_base[0], 1.0 / count[0]));
@@ -271,37 +281,22 @@ static void leaf_hit(walk *w, const trace_box *box, const double r[4],
 static bool sample_stagnant(trace_thread *th, const trace_object *obj, const double r[4],
                             trace_box *box)
 {
-    enum { G = 3, NS = G * G };
-    vec3 P[NS], Pu[NS], Pv[NS];
-    double du = (r[1] - r[0]) / (G - 1), dv = (r[3] - r[2]) / (G - 1);
-    for (int j = 0; j < G; j++)
-        for (int i = 0; i < G; i++) {
-            int k = j * G + i;
-            trace_surface_point sp;
-            trace_surface_point_eval(th, obj, r[0] + du * i, r[2] + dv * j, &sp);
-            if (!v3_is_finite(sp.P) || !v3_is_finite(sp.Pu) || !v3_is_finite(sp.Pv))
-                return false;
-            P[k] = mat4_xform_point(&obj->from_camera, sp.P);
-            Pu[k] = mat4_xform_vector(&obj->from_camera, sp.Pu);
-            Pv[k] = mat4_xform_vector(&obj->from_camera, sp.Pv);
-        }
-    double miss = 0;
-    vec3 lo = P[0], hi = P[0];
-    for (int k = 0; k < NS; k++) {
-        lo = v3(fmin(lo.x, P[k].x), fmin(lo.y, P[k].y), fmin(lo.z, P[k].z));
-        hi = v3(fmax(hi.x, P[k].x), fmax(hi.y, P[k].y), fmax(hi.z, P[k].z));
-        if (k % G < G - 1) {
-            vec3 pred = v3_add(P[k], v3_scale(v3_add(Pu[k], Pu[k + 1]), 0.5 * du));
-            miss = fmax(miss, v3_length(v3_sub(P[k + 1], pred)));
-        }
-        if (k + G < NS) {
-            vec3 pred = v3_add(P[k], v3_scale(v3_add(Pv[k], Pv[k + G]), 0.5 * dv));
-            miss = fmax(miss, v3_length(v3_sub(P[k + G], pred)));
-        }
+    cell_samples cs;
+    sample_cell(th, obj, r, &cs);
+    if (cs.n < CELL_N) return false;
+    vec3 lo = v3(INFINITY, INFINITY, INFINITY), hi = v3(-INFINITY, -INFINITY, -INFINITY);
+    double spread = 0;
+    for (int k = 0; k < CELL_N; k++) {
+        vec3 p = mat4_xform_point(&obj->from_camera, cs.P[k]);
+        lo = v3(fmin(lo.x, p.x), fmin(lo.y, p.y), fmin(lo.z, p.z));
+        hi = v3(fmax(hi.x, p.x), fmax(hi.y, p.y), fmax(hi.z, p.z));
+        spread = fmax(spread, v3_length(v3_sub(cs.P[k], cs.P[0])));
     }
-    double spread = v3_length(v3_sub(hi, lo));
-    if (!(miss <= 0.25 * spread) && !(spread == 0)) return false;
-    double m = 2.0 * miss + 1e-12 * (1.0 + fmax(v3_length(lo), v3_length(hi)));
+    if (!(cs.residual <= 0.25 * spread) && !(spread == 0)) return false;
+    /* twice the camera-space residual in object units (world.c's bound of
+     * the stretch of from_camera), and a rounding hair */
+    double m = 2.0 * cs.residual * sqrt(obj->normal_len2[1]) +
+               1e-12 * (1.0 + fmax(v3_length(lo), v3_length(hi)));
     box->lo = v3_sub(lo, v3(m, m, m));
     box->hi = v3_add(hi, v3(m, m, m));
     box->flags &= ~(unsigned)AA_DISCONTINUOUS;
