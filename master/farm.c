@@ -30,6 +30,7 @@
 #include <unistd.h>
 #include <zmq.h>
 
+#include "curve_cert.h"
 #include "farm_internal.h"
 #include "image/buffer.h"
 #include "image/preview.h"
@@ -137,6 +138,30 @@ static int bind_endpoint(farm *f, const char *ep, char *err, size_t errsz)
                                                                        : AAFARM_EXIT_FAILURE;
 }
 
+/* CURVE on the network endpoint (zap.h): the master's secret key, and the
+ * handler that admits only the allowed workers' keys. Options set here
+ * apply to the binds that follow, not to the ipc endpoint bound before. */
+static int enable_curve(farm *f, char *err, size_t errsz)
+{
+    curve_cert cert;
+    if (!curve_cert_read(f->opt->curve_secret, true, &cert, err, errsz)) return AAFARM_EXIT_USAGE;
+    f->zap = zap_new(f->ctx, f->opt->allow_keys, f->con, err, errsz);
+    if (!f->zap) return AAFARM_EXIT_USAGE;
+    int on = 1;
+    if (zmq_setsockopt(f->router, ZMQ_CURVE_SERVER, &on, sizeof on) != 0 ||
+        zmq_setsockopt(f->router, ZMQ_CURVE_SECRETKEY, cert.secret_key, CURVE_Z85_LEN) != 0 ||
+        zmq_setsockopt(f->router, ZMQ_ZAP_DOMAIN, "aafarm", 6) != 0) {
+        snprintf(err, errsz, "cannot turn CURVE on: %s (does this libzmq have CURVE?)",
+                 zmq_strerror(errno));
+        memset(&cert, 0, sizeof cert);
+        return AAFARM_EXIT_FAILURE;
+    }
+    memset(&cert, 0, sizeof cert);
+    console_log(f->con, CONSOLE_INFO, "CURVE on: %d worker key%s allowed (%s)",
+                zap_key_count(f->zap), zap_key_count(f->zap) == 1 ? "" : "s", f->opt->allow_keys);
+    return AAFARM_EXIT_OK;
+}
+
 static int open_socket(farm *f, char *err, size_t errsz)
 {
     f->ctx = zmq_ctx_new();
@@ -146,21 +171,31 @@ static int open_socket(farm *f, char *err, size_t errsz)
         return AAFARM_EXIT_FAILURE;
     }
     f->monitor = wire_monitor_new(f->ctx, f->router);
-    if (f->opt->bind) {
-        int rc = bind_endpoint(f, f->opt->bind, err, errsz);
-        if (rc != AAFARM_EXIT_OK) return rc;
-        char last[600] = "";
-        size_t len = sizeof last;
-        zmq_getsockopt(f->router, ZMQ_LAST_ENDPOINT, last, &len);
-        console_log(f->con, CONSOLE_INFO, "listening on %s", last[0] ? last : f->opt->bind);
-        snprintf(f->endpoint, sizeof f->endpoint, "%s", last[0] ? last : f->opt->bind);
-    }
-    if (f->opt->local_workers > 0) {
+    if (f->opt->local_workers > 0) {   /* private, plaintext: bound before CURVE is on */
         char ep[PATH_MAX + 32];
         if (!make_private_endpoint(f, ep, sizeof ep, err, errsz)) return AAFARM_EXIT_FAILURE;
         int rc = bind_endpoint(f, ep, err, errsz);
         if (rc != AAFARM_EXIT_OK) return AAFARM_EXIT_FAILURE;
         snprintf(f->endpoint, sizeof f->endpoint, "%s", ep);
+    }
+    if (f->opt->bind) {
+        if (f->opt->curve_secret) {
+            int rc = enable_curve(f, err, errsz);
+            if (rc != AAFARM_EXIT_OK) return rc;
+        } else if (!curve_endpoint_is_local(f->opt->bind)) {
+            console_log(f->con, CONSOLE_ERROR, "WARNING: --insecure: %s is open to the network "
+                        "without CURVE: anyone who can reach it can take the job (scene and "
+                        "shaders, in clear text) and send tiles into the image", f->opt->bind);
+        }
+        int rc = bind_endpoint(f, f->opt->bind, err, errsz);
+        if (rc != AAFARM_EXIT_OK) return rc;
+        char last[600] = "";
+        size_t len = sizeof last;
+        zmq_getsockopt(f->router, ZMQ_LAST_ENDPOINT, last, &len);
+        console_log(f->con, CONSOLE_INFO, "listening on %s%s", last[0] ? last : f->opt->bind,
+                    f->zap ? " (CURVE)" : "");
+        if (!f->opt->local_workers)
+            snprintf(f->endpoint, sizeof f->endpoint, "%s", last[0] ? last : f->opt->bind);
     }
     return AAFARM_EXIT_OK;
 }
@@ -360,6 +395,20 @@ static void check_workers(farm *f, int64_t now)
     }
 }
 
+/* Failed handshakes (a plaintext peer on the CURVE endpoint, a wrong
+ * master key): logged with the endpoint, at most once per 10 s. */
+static void log_handshakes(farm *f, int64_t now)
+{
+    uint64_t n = f->wstats.handshake_failures;
+    if (n == f->handshakes_logged || now - f->handshake_logged_ms < 10000) return;
+    console_log(f->con, CONSOLE_INFO, "%llu connection%s failed the %s handshake (last: %s)%s",
+                (unsigned long long)(n - f->handshakes_logged), n - f->handshakes_logged == 1 ? "" : "s",
+                f->zap ? "CURVE" : "ZMTP", f->wstats.last_handshake,
+                f->zap ? ": plaintext peers, or keys this master does not allow" : "");
+    f->handshakes_logged = n;
+    f->handshake_logged_ms = now;
+}
+
 static void timers(farm *f, int64_t now)
 {
     check_workers(f, now);
@@ -368,7 +417,10 @@ static void timers(farm *f, int64_t now)
         console_log(f->con, CONSOLE_INFO, "%d lease%s passed %.0f s without a result: tile%s "
                     "back in the queue", n, n == 1 ? "" : "s", (double)f->opt->lease_ms / 1000.0,
                     n == 1 ? "" : "s");
-    if (f->monitor) wire_monitor_poll(f->monitor, &f->wstats);
+    if (f->monitor) {
+        wire_monitor_poll(f->monitor, &f->wstats);
+        log_handshakes(f, now);
+    }
     if (f->locals) {
         local_workers_reap(f->locals, on_child_exit, f);
         if (!f->opt->bind && local_workers_running(f->locals) == 0 && registry_alive(f->reg) == 0)
@@ -381,10 +433,13 @@ static void run_loop(farm *f)
     long timeout = f->opt->heartbeat_ms / 2 < 100 ? f->opt->heartbeat_ms / 2 : 100;
     if (timeout < 1) timeout = 1;
     while (f->state == FARM_RUNNING) {
-        zmq_pollitem_t items[2] = {{f->router, 0, ZMQ_POLLIN, 0}, {NULL, 0, ZMQ_POLLIN, 0}};
+        zmq_pollitem_t items[3] = {{f->router, 0, ZMQ_POLLIN, 0}, {NULL, 0, ZMQ_POLLIN, 0},
+                                   {NULL, 0, ZMQ_POLLIN, 0}};
         int nitems = 1;
         if (f->monitor) items[nitems++].socket = wire_monitor_socket(f->monitor);
+        if (f->zap) items[nitems++].socket = zap_socket(f->zap);
         int rc = zmq_poll(items, nitems, timeout);
+        zap_answer(f->zap);
         if (interrupted) {
             f->state = FARM_INTERRUPTED;
             break;
@@ -491,6 +546,7 @@ static void teardown(farm *f)
     local_workers_destroy(&f->locals);
     wire_monitor_destroy(&f->monitor);
     if (f->router) zmq_close(f->router);
+    zap_destroy(&f->zap);
     if (f->ctx) zmq_ctx_term(f->ctx);
     remove_private_endpoint(f);
     job_message_destroy(&f->jobmsg);

@@ -36,6 +36,9 @@ typedef struct farm_options {
     int verbosity;                 /* -1 quiet, 0 normal, 1 verbose */
     bool resume;                   /* --resume: take the tiles in OUT.exr.journal */
     int max_workers;               /* live workers at most; more are refused (1024) */
+    const char *curve_secret;      /* --curve-secret: the master's NAME.key_secret, or NULL */
+    const char *allow_keys;        /* --allow-keys: folder of workers' NAME.key files */
+    bool insecure;                 /* --insecure: plaintext on a network endpoint */
 } farm_options;
 
 void farm_options_default(farm_options *opt);

@@ -22,6 +22,7 @@
 #include "registry.h"
 #include "scheduler.h"
 #include "wire.h"
+#include "zap.h"
 
 typedef enum farm_state {
     FARM_RUNNING,
@@ -37,6 +38,9 @@ typedef struct farm {
     int tiles_x, ntiles;
     void *ctx, *router;
     wire_monitor *monitor;
+    zap *zap;                      /* CURVE: the key check (NULL: plaintext) */
+    uint64_t handshakes_logged;    /* handshake failures logged so far */
+    int64_t handshake_logged_ms;
     wire_stats wstats;
     proto_limits limits;
     char endpoint[PATH_MAX + 64];  /* what the local workers connect to */

@@ -12,6 +12,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "curve_cert.h"
 #include "farm.h"
 #include "job/job_scene.h"
 #include "util/exitcodes.h"
@@ -43,6 +44,12 @@ static void usage(FILE *out)
         "  --duplicates N             end-game duplicate leases per tile (default 1, 0: off)\n"
         "  --worker-binary PATH       aafarm-worker to start (default: next to this program)\n"
         "  --max-workers N            workers served at a time; more are refused (1024)\n"
+        "  --curve-secret FILE        CurveZMQ on --bind: this master's NAME.key_secret\n"
+        "                             (aafarm-keygen NAME); needs --allow-keys\n"
+        "  --allow-keys DIR           the workers' public keys (NAME.key files) that may\n"
+        "                             connect; others are refused and logged\n"
+        "  --insecure                 allow --bind on a network address without CURVE\n"
+        "                             (anyone who reaches it can join; not recommended)\n"
         "  --resume                   continue an unfinished render of the same job: the\n"
         "                             tiles in OUT.exr.journal are kept, only the others\n"
         "                             are rendered (every render journals its tiles there)\n"
@@ -84,7 +91,8 @@ static int bad_number(const char *opt, const char *what, const char *got)
 static int parse(int argc, char **argv, cli *c)
 {
     enum { O_BIND = 256, O_LOCAL, O_TPW, O_TILE, O_ARITH, O_BUDGET, O_PREVIEW, O_STATS_JSON,
-           O_HEARTBEAT, O_LIVENESS, O_RETRIES, O_LEASE, O_DUPS, O_WORKER_BIN, O_RESUME, O_MAX_WORKERS };
+           O_HEARTBEAT, O_LIVENESS, O_RETRIES, O_LEASE, O_DUPS, O_WORKER_BIN, O_RESUME, O_MAX_WORKERS,
+           O_CURVE_SECRET, O_ALLOW_KEYS, O_INSECURE };
     static const struct option longopts[] = {
         {"output", required_argument, 0, 'o'},
         {"bind", required_argument, 0, O_BIND},
@@ -103,6 +111,9 @@ static int parse(int argc, char **argv, cli *c)
         {"worker-binary", required_argument, 0, O_WORKER_BIN},
         {"resume", no_argument, 0, O_RESUME},
         {"max-workers", required_argument, 0, O_MAX_WORKERS},
+        {"curve-secret", required_argument, 0, O_CURVE_SECRET},
+        {"allow-keys", required_argument, 0, O_ALLOW_KEYS},
+        {"insecure", no_argument, 0, O_INSECURE},
         {"quiet", no_argument, 0, 'q'},
         {"verbose", no_argument, 0, 'v'},
         {"help", no_argument, 0, 'h'},
@@ -163,6 +174,9 @@ static int parse(int argc, char **argv, cli *c)
             if (!parse_long(optarg, 1, 65536, &n)) return bad_number("--max-workers", "1..65536", optarg);
             f->max_workers = (int)n;
             break;
+        case O_CURVE_SECRET: f->curve_secret = optarg; break;
+        case O_ALLOW_KEYS: f->allow_keys = optarg; break;
+        case O_INSECURE: f->insecure = true; break;
         case 'q': f->verbosity = -1; break;
         case 'v': f->verbosity = 1; break;
         case 'h': usage(stdout); return AAFARM_EXIT_OK;
@@ -178,6 +192,27 @@ static int parse(int argc, char **argv, cli *c)
         fprintf(stderr, "aafarm-master: %s (see --help)\n",
                 !f->scene_path ? "which scene? usage: aafarm-master SCENE.rib -o OUT.exr"
                                : "needs -o OUT.exr");
+        return AAFARM_EXIT_USAGE;
+    }
+    if (!f->curve_secret != !f->allow_keys) {
+        fprintf(stderr, "aafarm-master: --curve-secret and --allow-keys go together (the "
+                "master's key, and the workers' keys it admits)\n");
+        return AAFARM_EXIT_USAGE;
+    }
+    if (f->curve_secret && !f->bind) {
+        fprintf(stderr, "aafarm-master: --curve-secret secures --bind ENDPOINT; without --bind "
+                "the local workers use a private ipc:// socket\n");
+        return AAFARM_EXIT_USAGE;
+    }
+    if (f->curve_secret && f->insecure) {
+        fprintf(stderr, "aafarm-master: --insecure and --curve-secret exclude each other\n");
+        return AAFARM_EXIT_USAGE;
+    }
+    if (f->bind && !f->curve_secret && !f->insecure && !curve_endpoint_is_local(f->bind)) {
+        fprintf(stderr, "aafarm-master: --bind %s is reachable from other hosts, and without "
+                "CURVE anyone there could take the job and send tiles: give --curve-secret "
+                "FILE --allow-keys DIR (docs/cluster.md), bind a loopback address "
+                "(tcp://127.0.0.1:PORT), or say --insecure\n", f->bind);
         return AAFARM_EXIT_USAGE;
     }
     if (f->bind && !c->local_given) f->local_workers = 0;
