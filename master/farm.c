@@ -37,6 +37,18 @@
 #include "stale.h"
 #include "util/exitcodes.h"
 
+/* What one peer can make the master hold (issue 11): a message from a
+ * worker has a header of at most FARM_MAX_HEADER bytes (a Hello, a
+ * Result's metadata: small; the Job the master sends may be larger, see
+ * send_limits), and a Result's bulk
+ * frame is at most what a tile of this job can take (every channel of
+ * every layer as 32-bit floats, uncompressed, 64 bytes a pixel at most,
+ * plus 64 KiB of header); ZeroMQ refuses a bigger frame before allocating
+ * it and disconnects the peer. With FARM_RCVHWM messages queued per
+ * connection at most, the bytes queued per connection are bounded by
+ * (FARM_RCVHWM + 1) x that (the +1: the message being read). */
+enum { FARM_RCVHWM = 8, FARM_SNDHWM = 256, FARM_MAX_HEADER = 256 << 10 };
+
 static volatile sig_atomic_t interrupted;
 
 static void on_signal(int sig)
@@ -56,6 +68,7 @@ void farm_options_default(farm_options *opt)
     opt->max_attempts = 3;
     opt->max_duplicates = 1;
     opt->lease_ms = 120000;
+    opt->lease_factor = 4;
     opt->max_workers = 1024;
 }
 
@@ -166,7 +179,10 @@ static int open_socket(farm *f, char *err, size_t errsz)
 {
     f->ctx = zmq_ctx_new();
     f->router = f->ctx ? zmq_socket(f->ctx, ZMQ_ROUTER) : NULL;
-    if (!f->router || wire_socket_setup(f->router, &f->limits) != 0) {
+    int rcvhwm = FARM_RCVHWM, sndhwm = FARM_SNDHWM;
+    if (!f->router || wire_socket_setup(f->router, &f->limits) != 0 ||
+        zmq_setsockopt(f->router, ZMQ_RCVHWM, &rcvhwm, sizeof rcvhwm) != 0 ||
+        zmq_setsockopt(f->router, ZMQ_SNDHWM, &sndhwm, sizeof sndhwm) != 0) {
         snprintf(err, errsz, "cannot create the master's socket: %s", zmq_strerror(errno));
         return AAFARM_EXIT_FAILURE;
     }
@@ -226,14 +242,14 @@ static int check_job_message(farm *f, char *err, size_t errsz)
     env.body_case = AAFARM__ENVELOPE__BODY_JOB;
     env.job = job_message_job(f->jobmsg);
     char why[300];
-    if (proto_message_check(&env, false, 0, &f->limits, why, sizeof why) != 0) {
+    if (proto_message_check(&env, false, 0, &f->send_limits, why, sizeof why) != 0) {
         snprintf(err, errsz, "the job cannot be sent to workers: %s", why);
         return AAFARM_EXIT_INPUT;
     }
     f->job_bytes = job_message_packed_size(f->jobmsg);
-    if (f->job_bytes > f->limits.max_header_bytes) {
+    if (f->job_bytes > f->send_limits.max_header_bytes) {
         snprintf(err, errsz, "the job is %zu bytes, more than the %zu a message may carry",
-                 f->job_bytes, f->limits.max_header_bytes);
+                 f->job_bytes, f->send_limits.max_header_bytes);
         return AAFARM_EXIT_INPUT;
     }
     return AAFARM_EXIT_OK;
@@ -295,9 +311,19 @@ static int open_journal(farm *f, char *err, size_t errsz)
     return rc;
 }
 
+static void bound_limits(farm *f)
+{
+    f->send_limits = proto_limits_default();
+    f->limits = proto_limits_default();
+    f->limits.max_header_bytes = FARM_MAX_HEADER;
+    size_t px = (size_t)f->fmt.tile_size * (size_t)f->fmt.tile_size;
+    size_t bound = 65536 + px * 64;
+    if (bound < f->limits.max_bulk_bytes) f->limits.max_bulk_bytes = bound;
+}
+
 static int setup(farm *f, char *err, size_t errsz)
 {
-    f->limits = proto_limits_default();
+    bound_limits(f);
     f->session = random_session();
     if (gethostname(f->host, sizeof f->host - 1) != 0) snprintf(f->host, sizeof f->host, "master");
     f->tiles_x = image_format_tiles_x(&f->fmt);
@@ -307,6 +333,7 @@ static int setup(farm *f, char *err, size_t errsz)
     so.max_attempts = f->opt->max_attempts;
     so.max_duplicates = f->opt->max_duplicates;
     so.lease_ms = f->opt->lease_ms;
+    so.lease_factor = f->opt->lease_factor;
     f->sched = scheduler_new(f->tiles_x, image_format_tiles_y(&f->fmt), &so);
     f->reg = registry_new();
     f->jobmsg = job_message_new(f->jb, &f->fmt);
@@ -414,9 +441,10 @@ static void timers(farm *f, int64_t now)
     check_workers(f, now);
     int n = scheduler_expire(f->sched, now);
     if (n > 0)
-        console_log(f->con, CONSOLE_INFO, "%d lease%s passed %.0f s without a result: tile%s "
-                    "back in the queue", n, n == 1 ? "" : "s", (double)f->opt->lease_ms / 1000.0,
-                    n == 1 ? "" : "s");
+        console_log(f->con, CONSOLE_INFO, "%d lease%s passed %s deadline without a result "
+                    "(%d x the measured time per tile, at most %.0f s): tile%s back in the "
+                    "queue", n, n == 1 ? "" : "s", n == 1 ? "its" : "their",
+                    f->opt->lease_factor, (double)f->opt->lease_ms / 1000.0, n == 1 ? "" : "s");
     if (f->monitor) {
         wire_monitor_poll(f->monitor, &f->wstats);
         log_handshakes(f, now);

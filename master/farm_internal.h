@@ -42,7 +42,8 @@ typedef struct farm {
     uint64_t handshakes_logged;    /* handshake failures logged so far */
     int64_t handshake_logged_ms;
     wire_stats wstats;
-    proto_limits limits;
+    proto_limits limits;           /* what workers may send (bounded per tile: farm.c) */
+    proto_limits send_limits;      /* what the master sends (the Job may be large) */
     char endpoint[PATH_MAX + 64];  /* what the local workers connect to */
     char ipc_dir[PATH_MAX];        /* embedded mode's private folder, or "" */
     scheduler *sched;

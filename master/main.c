@@ -40,7 +40,10 @@ static void usage(FILE *out)
         "  --heartbeat MS             heartbeat interval announced to workers (default 1000)\n"
         "  --liveness N               a worker is dead after N silent intervals (default 3)\n"
         "  --retries N                failures of one tile before the job fails (default 3)\n"
-        "  --lease S                  seconds before a leased tile is handed out again (120)\n"
+        "  --lease S                  the longest a leased tile waits before it is handed\n"
+        "                             out again (120 s)\n"
+        "  --lease-factor N           a lease lasts N x its worker's measured time per tile\n"
+        "                             (at least 2 s, at most --lease; default 4, 0: --lease)\n"
         "  --duplicates N             end-game duplicate leases per tile (default 1, 0: off)\n"
         "  --worker-binary PATH       aafarm-worker to start (default: next to this program)\n"
         "  --max-workers N            workers served at a time; more are refused (1024)\n"
@@ -92,7 +95,7 @@ static int parse(int argc, char **argv, cli *c)
 {
     enum { O_BIND = 256, O_LOCAL, O_TPW, O_TILE, O_ARITH, O_BUDGET, O_PREVIEW, O_STATS_JSON,
            O_HEARTBEAT, O_LIVENESS, O_RETRIES, O_LEASE, O_DUPS, O_WORKER_BIN, O_RESUME, O_MAX_WORKERS,
-           O_CURVE_SECRET, O_ALLOW_KEYS, O_INSECURE };
+           O_CURVE_SECRET, O_ALLOW_KEYS, O_INSECURE, O_LEASE_FACTOR };
     static const struct option longopts[] = {
         {"output", required_argument, 0, 'o'},
         {"bind", required_argument, 0, O_BIND},
@@ -107,6 +110,7 @@ static int parse(int argc, char **argv, cli *c)
         {"liveness", required_argument, 0, O_LIVENESS},
         {"retries", required_argument, 0, O_RETRIES},
         {"lease", required_argument, 0, O_LEASE},
+        {"lease-factor", required_argument, 0, O_LEASE_FACTOR},
         {"duplicates", required_argument, 0, O_DUPS},
         {"worker-binary", required_argument, 0, O_WORKER_BIN},
         {"resume", no_argument, 0, O_RESUME},
@@ -163,6 +167,10 @@ static int parse(int argc, char **argv, cli *c)
         case O_LEASE:
             if (!parse_long(optarg, 1, 86400, &n)) return bad_number("--lease", "seconds 1..86400", optarg);
             f->lease_ms = n * 1000;
+            break;
+        case O_LEASE_FACTOR:
+            if (!parse_long(optarg, 0, 1000, &n)) return bad_number("--lease-factor", "0..1000", optarg);
+            f->lease_factor = (int)n;
             break;
         case O_DUPS:
             if (!parse_long(optarg, 0, 100, &n)) return bad_number("--duplicates", "0..100", optarg);

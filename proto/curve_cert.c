@@ -216,8 +216,11 @@ bool curve_cert_read(const char *path, bool want_secret, curve_cert *out, char *
 
 bool curve_endpoint_is_local(const char *ep)
 {
-    if (strncmp(ep, "ipc://", 6) == 0 || strncmp(ep, "inproc://", 9) == 0) return true;
-    if (strncmp(ep, "tcp://", 6) != 0) return false;
+    static const char *const network[] = {"udp://", "pgm://", "epgm://", "norm://", "ws://",
+                                          "wss://", "tipc://", "vmci://"};
+    for (size_t i = 0; i < sizeof network / sizeof *network; i++)
+        if (strncmp(ep, network[i], strlen(network[i])) == 0) return false;
+    if (strncmp(ep, "tcp://", 6) != 0) return true;   /* ipc, inproc, or ZeroMQ refuses it */
     const char *host = ep + 6;
     const char *semi = strchr(host, ';');   /* "source;dest": judge the bound side */
     if (semi) host = semi + 1;

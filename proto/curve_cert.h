@@ -40,10 +40,11 @@ bool curve_cert_generate(const char *base, const char *name, char *err, size_t e
 bool curve_cert_read(const char *path, bool want_secret, curve_cert *out, char *err,
                      size_t errsz);
 
-/* True for endpoints that cannot be reached from another host: ipc://,
- * inproc://, tcp:// on 127.x.x.x, localhost or [::1] (also with a
- * "source;" part). Everything else (a wildcard, a host name, an interface
- * address) needs CURVE or --insecure. */
+/* False for endpoints another host can reach: tcp:// other than on
+ * 127.x.x.x, localhost or [::1] (a wildcard, a host name, an interface
+ * address), and the other network transports (udp, pgm, epgm, norm, ws,
+ * wss, tipc, vmci): those need CURVE or --insecure. True otherwise (ipc,
+ * inproc, loopback; a transport ZeroMQ does not know fails at bind). */
 bool curve_endpoint_is_local(const char *endpoint);
 
 #endif

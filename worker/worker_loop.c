@@ -392,6 +392,7 @@ static held_job *prepare_job(worker_loop *w, const Aafarm__Job *m)
             wlog(w, 0, "interrupted while preparing job %.12s; leaving", m->job_hash);
             send_shutdown(w, "the worker was stopped (SIGINT/SIGTERM) while preparing a job");
             int linger = 500;
+            wire_monitor_destroy(&w->monitor);   /* its socket would hold up zmq_ctx_term */
             zmq_setsockopt(w->dealer, ZMQ_LINGER, &linger, sizeof linger);
             zmq_close(w->dealer);
             zmq_ctx_term(w->ctx);   /* sends what is queued, for at most 500 ms */
