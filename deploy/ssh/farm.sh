@@ -27,6 +27,7 @@
 #   AAFARM_PORT         the master's port (5555)
 #   AAFARM_BIND_HOST    the address the master binds ("*": every interface)
 #   AAFARM_MASTER_HOST  the name workers reach this host by (hostname -f)
+#   AAFARM_WORKER_OPTS  more worker options, e.g. "--cache-bytes 400K"
 #   SSH, SCP            the commands (ssh -o BatchMode=yes, scp -q -o BatchMode=yes)
 set -euo pipefail
 
@@ -49,6 +50,7 @@ master_host=${AAFARM_MASTER_HOST:-$(hostname -f 2>/dev/null || hostname)}
 read -r -a ssh_cmd <<<"${SSH:-ssh -o BatchMode=yes}"
 read -r -a scp_cmd <<<"${SCP:-scp -q -o BatchMode=yes}"
 q() { printf '%q' "$1"; }   # one word for the remote shell
+read -r -a worker_opts <<<"${AAFARM_WORKER_OPTS:-}"
 
 hosts=()
 threads=()
@@ -108,6 +110,7 @@ for i in "${!hosts[@]}"; do
   host=${hosts[$i]}
   opts=""
   [ "${threads[$i]}" -gt 0 ] && opts="--threads ${threads[$i]}"
+  for o in "${worker_opts[@]}"; do opts+=" $(q "$o")"; done
   rdir="$run/$host"
   "${ssh_cmd[@]}" "$host" "mkdir -p $(q "$rdir")/keys && chmod 700 $(q "$rdir")/keys"
   "${scp_cmd[@]}" "$keys/$host.key_secret" "$keys/master.key" "$host:$rdir/keys/"

@@ -5,7 +5,8 @@
  *     ssh and scp (deploy/fake-ssh, fake-scp: run here what ssh would run
  *     there), with CURVE keys it makes and copies; the image equals
  *     --standalone; every worker it started is stopped, the copied secret
- *     keys removed;
+ *     keys removed; Ctrl-C mid-render stops the master and every worker,
+ *     exit 130, no image;
  *   - deploy/slurm/aafarm.sbatch renders for real with stand-in srun and
  *     scontrol (two tasks for two nodes); equal image, the job's keys removed;
  *   - deploy/systemd: install.sh into a scratch root, and
@@ -138,6 +139,53 @@ static void test_ssh_farm_renders_and_stops_its_workers(void **state)
     assert_int_equal(ft_count(ft_path(dir, "badhosts.log"), "badhosts:2: expected"), 1);
 }
 
+/* Ctrl-C (SIGINT to the script) mid-render: the master is stopped, every
+ * worker it started is stopped, the copied secrets removed, exit 130, no
+ * image. */
+static void test_ssh_farm_ctrl_c_stops_everything(void **state)
+{
+    (void)state;
+    FILE *fp = fopen(ft_path(dir, "hosts2"), "w");
+    assert_non_null(fp);
+    fputs("hostC 1\nhostD 1\n", fp);
+    fclose(fp);
+    char cmd[20000], log[4200];
+    snprintf(log, sizeof log, "%s/ctrlc.log", dir);
+    snprintf(cmd, sizeof cmd,
+             "cd %s && AAFARM_BIN=%s AAFARM_REMOTE_BIN=%s AAFARM_KEYS=%s/keys2 AAFARM_RUN=%s/run2 "
+             "AAFARM_PORT=%d AAFARM_BIND_HOST=127.0.0.1 AAFARM_MASTER_HOST=127.0.0.1 "
+             "AAFARM_WORKER_OPTS=\"--tile-delay 300\" SSH=%s/tests/master/deploy/fake-ssh "
+             "SCP=%s/tests/master/deploy/fake-scp exec timeout -k 2 120 %s/deploy/ssh/farm.sh "
+             "hosts2 scene.rib -o ctrlc.exr --tile 16",
+             dir, bindir, bindir, dir, dir, ft_free_port(), src, src, src);
+    /* timeout runs farm.sh in its own process: signal that one */
+    const char *argv[] = {"/bin/sh", "-c", cmd, NULL};
+    pid_t sh_pid = ft_spawn(log, argv);   /* exec: sh becomes timeout */
+    assert_true(ft_wait_for(log, "worker hostD joined", 1, 60));
+    assert_true(ft_wait_for(log, " tiles (", 1, 60));   /* rendering */
+    assert_int_equal(sh("pgrep.log", "pgrep -P %d", (int)sh_pid), 0);
+    char *kids = ft_read(ft_path(dir, "pgrep.log"));
+    long script = atol(kids);
+    free(kids);
+    assert_true(script > 1);
+    kill((pid_t)script, SIGINT);
+    assert_int_equal(ft_wait(sh_pid, 60), 130);
+    assert_int_equal(ft_count(log, "hostC: stopped worker "), 1);
+    assert_int_equal(ft_count(log, "hostD: stopped worker "), 1);
+    assert_true(ft_count(log, "ctrlc.exr not written") >= 1);
+    struct stat st;
+    assert_int_equal(stat(ft_path(dir, "ctrlc.exr"), &st), -1);
+    assert_int_equal(stat(ft_path(dir, "run2/hostC/keys"), &st), -1);
+    assert_int_equal(stat(ft_path(dir, "run2/hostD/keys"), &st), -1);
+    char *text = ft_read(log);
+    const char *at = strstr(text, "hostC: stopped worker ");
+    long pid = at ? atol(at + strlen("hostC: stopped worker ")) : 0;
+    free(text);
+    assert_true(pid > 1);
+    for (int i = 0; i < 100 && kill((pid_t)pid, 0) == 0; i++) ft_sleep_ms(50);
+    assert_int_equal(kill((pid_t)pid, 0), -1);
+}
+
 static void test_slurm_script_with_stand_in_srun(void **state)
 {
     (void)state;
@@ -230,6 +278,7 @@ int main(int argc, char **argv)
     src = argv[3];
     const struct CMUnitTest tests[] = {
         cmocka_unit_test_teardown(test_ssh_farm_renders_and_stops_its_workers, teardown),
+        cmocka_unit_test_teardown(test_ssh_farm_ctrl_c_stops_everything, teardown),
         cmocka_unit_test_teardown(test_slurm_script_with_stand_in_srun, teardown),
         cmocka_unit_test_teardown(test_systemd_unit_and_install, teardown),
         cmocka_unit_test_teardown(test_scripts_and_manifests_checked, teardown),
