@@ -86,9 +86,25 @@ static int sh(const char *fmt, ...)
 static void remove_namespaces(const char *prefix)
 {
     for (int i = 0; i < NNS; i++) {
-        sh("for p in $(ip netns pids %s%s 2>/dev/null); do kill -9 $p; done; "
-           "ip netns del %s%s 2>/dev/null; true", prefix, role[i], prefix, role[i]);
+        sh("n=%s%s; ip netns list | grep -q \"^$n\\b\" || exit 0; "
+           "for i in 1 2 3 4 5 6 7 8 9 10; do p=$(ip netns pids $n); [ -z \"$p\" ] && break; "
+           "kill -9 $p; sleep 0.2; done; ip netns del $n", prefix, role[i]);
     }
+}
+
+/* Is pid gone (or a zombie nobody reaped yet)? */
+static bool pid_gone(long pid)
+{
+    if (kill((pid_t)pid, 0) != 0) return errno == ESRCH;
+    char path[64], buf[512] = "";
+    snprintf(path, sizeof path, "/proc/%ld/stat", pid);
+    FILE *fp = fopen(path, "r");
+    if (!fp) return true;
+    size_t n = fread(buf, 1, sizeof buf - 1, fp);
+    fclose(fp);
+    buf[n] = '\0';
+    const char *end = strrchr(buf, ')');   /* "pid (comm) S ..." */
+    return end && end[1] == ' ' && end[2] == 'Z';
 }
 
 /* Namespaces of an earlier run that was killed (its pid is gone). */
@@ -101,9 +117,10 @@ static void remove_leftovers(void)
     int n = 0;
     while (fgets(line, sizeof line, p) && n < 64) {
         long pid;
-        if (sscanf(line, "aafarm-t%ld-", &pid) == 1 && pid != (long)getpid() &&
-            kill((pid_t)pid, 0) != 0 && errno == ESRCH)
-            pids[n++] = pid;
+        if (sscanf(line, "aafarm-t%ld-", &pid) != 1 || pid == (long)getpid()) continue;
+        bool seen = false;
+        for (int i = 0; i < n; i++) seen = seen || pids[i] == pid;
+        if (!seen && pid_gone(pid)) pids[n++] = pid;
     }
     pclose(p);
     for (int i = 0; i < n; i++) {
@@ -160,7 +177,6 @@ static int group_setup(void **state)
     }
     remove_leftovers();
     if (!make_topology()) {
-        remove_namespaces(ns[SW][0] ? "" : "");
         snprintf(skip_reason, sizeof skip_reason, "network namespaces, veth or bridge cannot be "
                  "created here (see %s/net.log)", dir);
         for (int i = 0; i < NNS; i++) sh("ip netns del %s 2>/dev/null; true", ns[i]);
@@ -361,7 +377,8 @@ static void test_partition_then_heal(void **state)
     pid_t master = start_master("part");
     char log[4096];
     snprintf(log, sizeof log, "%s", p("part.log"));
-    pid_t w1 = start_worker(W1, "w1", 0, "200"), w2 = start_worker(W2, "w2", 1, "50");
+    /* w1 alone would need 48 x 300 ms: w2 has time to come back */
+    pid_t w1 = start_worker(W1, "w1", 0, "300"), w2 = start_worker(W2, "w2", 1, "50");
     assert_true(ft_wait_for(log, " from w2 (lease", 1, 60));
     /* cut w2's link longer than the heartbeat timeout (4 x 250 ms) */
     assert_int_equal(sh("ip -n %s link set v-w2 down", ns[SW]), 0);
