@@ -223,7 +223,9 @@ static void on_hello(farm *f, const Aafarm__Hello *h, const uint8_t *id, size_t 
     copy_name(w->name, sizeof w->name, h->worker_name);
     copy_name(w->host, sizeof w->host, h->host);
     w->pid = h->pid;
-    w->threads = h->threads ? h->threads : 1;
+    /* its credits are capped by its threads: a claim of more than a worker
+     * can have (aafarm-worker --threads 1..1024) buys a peer no more tiles */
+    w->threads = h->threads ? (h->threads > 1024 ? 1024 : h->threads) : 1;
     w->slot = scheduler_worker_add(f->sched);
     w->has_job = holds_job(h, f->jb->hash);
     w->local = f->locals && strcmp(w->host, f->host) == 0 &&
