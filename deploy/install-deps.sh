@@ -15,6 +15,10 @@ PACKAGES=(
   libpng-dev        # PNG previews
   libcmocka-dev     # unit and property tests
   protobuf-c-compiler libprotobuf-c-dev  # wire protocol schema
+  libsodium-dev     # CurveZMQ: Debian's libzmq5 has CURVE through libsodium
+  iproute2          # the multi-host test's network namespaces (ip netns)
+  shellcheck        # lints deploy/'s scripts (test_deploy)
+  python3-yaml      # checks deploy/'s compose and Kubernetes files (test_deploy)
 )
 
 missing=()

@@ -30,11 +30,24 @@
 #include <unistd.h>
 #include <zmq.h>
 
+#include "curve_cert.h"
 #include "farm_internal.h"
 #include "image/buffer.h"
 #include "image/preview.h"
 #include "stale.h"
 #include "util/exitcodes.h"
+
+/* What one peer can make the master hold (issue 11): a message from a
+ * worker has a header of at most FARM_MAX_HEADER bytes (a Hello, a
+ * Result's metadata: small; the Job the master sends may be larger, see
+ * send_limits), and a Result's bulk
+ * frame is at most what a tile of this job can take (every channel of
+ * every layer as 32-bit floats, uncompressed, 64 bytes a pixel at most,
+ * plus 64 KiB of header); ZeroMQ refuses a bigger frame before allocating
+ * it and disconnects the peer. With FARM_RCVHWM messages queued per
+ * connection at most, the bytes queued per connection are bounded by
+ * (FARM_RCVHWM + 1) x that (the +1: the message being read). */
+enum { FARM_RCVHWM = 8, FARM_SNDHWM = 256, FARM_MAX_HEADER = 256 << 10 };
 
 static volatile sig_atomic_t interrupted;
 
@@ -55,6 +68,7 @@ void farm_options_default(farm_options *opt)
     opt->max_attempts = 3;
     opt->max_duplicates = 1;
     opt->lease_ms = 120000;
+    opt->lease_factor = 4;
     opt->max_workers = 1024;
 }
 
@@ -137,30 +151,67 @@ static int bind_endpoint(farm *f, const char *ep, char *err, size_t errsz)
                                                                        : AAFARM_EXIT_FAILURE;
 }
 
+/* CURVE on the network endpoint (zap.h): the master's secret key, and the
+ * handler that admits only the allowed workers' keys. Options set here
+ * apply to the binds that follow, not to the ipc endpoint bound before. */
+static int enable_curve(farm *f, char *err, size_t errsz)
+{
+    curve_cert cert;
+    if (!curve_cert_read(f->opt->curve_secret, true, &cert, err, errsz)) return AAFARM_EXIT_USAGE;
+    f->zap = zap_new(f->ctx, f->opt->allow_keys, f->con, err, errsz);
+    if (!f->zap) return AAFARM_EXIT_USAGE;
+    int on = 1;
+    if (zmq_setsockopt(f->router, ZMQ_CURVE_SERVER, &on, sizeof on) != 0 ||
+        zmq_setsockopt(f->router, ZMQ_CURVE_SECRETKEY, cert.secret_key, CURVE_Z85_LEN) != 0 ||
+        zmq_setsockopt(f->router, ZMQ_ZAP_DOMAIN, "aafarm", 6) != 0) {
+        snprintf(err, errsz, "cannot turn CURVE on: %s (does this libzmq have CURVE?)",
+                 zmq_strerror(errno));
+        memset(&cert, 0, sizeof cert);
+        return AAFARM_EXIT_FAILURE;
+    }
+    memset(&cert, 0, sizeof cert);
+    console_log(f->con, CONSOLE_INFO, "CURVE on: %d worker key%s allowed (%s)",
+                zap_key_count(f->zap), zap_key_count(f->zap) == 1 ? "" : "s", f->opt->allow_keys);
+    return AAFARM_EXIT_OK;
+}
+
 static int open_socket(farm *f, char *err, size_t errsz)
 {
     f->ctx = zmq_ctx_new();
     f->router = f->ctx ? zmq_socket(f->ctx, ZMQ_ROUTER) : NULL;
-    if (!f->router || wire_socket_setup(f->router, &f->limits) != 0) {
+    int rcvhwm = FARM_RCVHWM, sndhwm = FARM_SNDHWM;
+    if (!f->router || wire_socket_setup(f->router, &f->limits) != 0 ||
+        zmq_setsockopt(f->router, ZMQ_RCVHWM, &rcvhwm, sizeof rcvhwm) != 0 ||
+        zmq_setsockopt(f->router, ZMQ_SNDHWM, &sndhwm, sizeof sndhwm) != 0) {
         snprintf(err, errsz, "cannot create the master's socket: %s", zmq_strerror(errno));
         return AAFARM_EXIT_FAILURE;
     }
     f->monitor = wire_monitor_new(f->ctx, f->router);
-    if (f->opt->bind) {
-        int rc = bind_endpoint(f, f->opt->bind, err, errsz);
-        if (rc != AAFARM_EXIT_OK) return rc;
-        char last[600] = "";
-        size_t len = sizeof last;
-        zmq_getsockopt(f->router, ZMQ_LAST_ENDPOINT, last, &len);
-        console_log(f->con, CONSOLE_INFO, "listening on %s", last[0] ? last : f->opt->bind);
-        snprintf(f->endpoint, sizeof f->endpoint, "%s", last[0] ? last : f->opt->bind);
-    }
-    if (f->opt->local_workers > 0) {
+    if (f->opt->local_workers > 0) {   /* private, plaintext: bound before CURVE is on */
         char ep[PATH_MAX + 32];
         if (!make_private_endpoint(f, ep, sizeof ep, err, errsz)) return AAFARM_EXIT_FAILURE;
         int rc = bind_endpoint(f, ep, err, errsz);
         if (rc != AAFARM_EXIT_OK) return AAFARM_EXIT_FAILURE;
         snprintf(f->endpoint, sizeof f->endpoint, "%s", ep);
+    }
+    if (f->opt->bind) {
+        if (f->opt->curve_secret) {
+            int rc = enable_curve(f, err, errsz);
+            if (rc != AAFARM_EXIT_OK) return rc;
+        } else if (!curve_endpoint_is_local(f->opt->bind)) {
+            console_log(f->con, CONSOLE_ERROR, "WARNING: --insecure: %s is open to the network "
+                        "without CURVE: anyone who can reach it can take the job (scene and "
+                        "shaders, in clear text) and send tiles into the image", f->opt->bind);
+        }
+        int rc = bind_endpoint(f, f->opt->bind, err, errsz);
+        if (rc != AAFARM_EXIT_OK) return rc;
+        char last[600] = "";
+        size_t len = sizeof last;
+        zmq_getsockopt(f->router, ZMQ_LAST_ENDPOINT, last, &len);
+        console_log(f->con, CONSOLE_INFO, "listening on %s%s", last[0] ? last : f->opt->bind,
+                    f->zap ? " (CURVE)" : "");
+        if (!f->opt->local_workers)
+            snprintf(f->endpoint, sizeof f->endpoint, "%s", last[0] ? last : f->opt->bind);
     }
     return AAFARM_EXIT_OK;
 }
@@ -191,14 +242,14 @@ static int check_job_message(farm *f, char *err, size_t errsz)
     env.body_case = AAFARM__ENVELOPE__BODY_JOB;
     env.job = job_message_job(f->jobmsg);
     char why[300];
-    if (proto_message_check(&env, false, 0, &f->limits, why, sizeof why) != 0) {
+    if (proto_message_check(&env, false, 0, &f->send_limits, why, sizeof why) != 0) {
         snprintf(err, errsz, "the job cannot be sent to workers: %s", why);
         return AAFARM_EXIT_INPUT;
     }
     f->job_bytes = job_message_packed_size(f->jobmsg);
-    if (f->job_bytes > f->limits.max_header_bytes) {
+    if (f->job_bytes > f->send_limits.max_header_bytes) {
         snprintf(err, errsz, "the job is %zu bytes, more than the %zu a message may carry",
-                 f->job_bytes, f->limits.max_header_bytes);
+                 f->job_bytes, f->send_limits.max_header_bytes);
         return AAFARM_EXIT_INPUT;
     }
     return AAFARM_EXIT_OK;
@@ -260,9 +311,19 @@ static int open_journal(farm *f, char *err, size_t errsz)
     return rc;
 }
 
+static void bound_limits(farm *f)
+{
+    f->send_limits = proto_limits_default();
+    f->limits = proto_limits_default();
+    f->limits.max_header_bytes = FARM_MAX_HEADER;
+    size_t px = (size_t)f->fmt.tile_size * (size_t)f->fmt.tile_size;
+    size_t bound = 65536 + px * 64;
+    if (bound < f->limits.max_bulk_bytes) f->limits.max_bulk_bytes = bound;
+}
+
 static int setup(farm *f, char *err, size_t errsz)
 {
-    f->limits = proto_limits_default();
+    bound_limits(f);
     f->session = random_session();
     if (gethostname(f->host, sizeof f->host - 1) != 0) snprintf(f->host, sizeof f->host, "master");
     f->tiles_x = image_format_tiles_x(&f->fmt);
@@ -272,6 +333,7 @@ static int setup(farm *f, char *err, size_t errsz)
     so.max_attempts = f->opt->max_attempts;
     so.max_duplicates = f->opt->max_duplicates;
     so.lease_ms = f->opt->lease_ms;
+    so.lease_factor = f->opt->lease_factor;
     f->sched = scheduler_new(f->tiles_x, image_format_tiles_y(&f->fmt), &so);
     f->reg = registry_new();
     f->jobmsg = job_message_new(f->jb, &f->fmt);
@@ -360,15 +422,33 @@ static void check_workers(farm *f, int64_t now)
     }
 }
 
+/* Failed handshakes (a plaintext peer on the CURVE endpoint, a wrong
+ * master key): logged with the endpoint, at most once per 10 s. */
+static void log_handshakes(farm *f, int64_t now)
+{
+    uint64_t n = f->wstats.handshake_failures;
+    if (n == f->handshakes_logged || now - f->handshake_logged_ms < 10000) return;
+    console_log(f->con, CONSOLE_INFO, "%llu connection%s failed the %s handshake (last: %s)%s",
+                (unsigned long long)(n - f->handshakes_logged), n - f->handshakes_logged == 1 ? "" : "s",
+                f->zap ? "CURVE" : "ZMTP", f->wstats.last_handshake,
+                f->zap ? ": plaintext peers, or keys this master does not allow" : "");
+    f->handshakes_logged = n;
+    f->handshake_logged_ms = now;
+}
+
 static void timers(farm *f, int64_t now)
 {
     check_workers(f, now);
     int n = scheduler_expire(f->sched, now);
     if (n > 0)
-        console_log(f->con, CONSOLE_INFO, "%d lease%s passed %.0f s without a result: tile%s "
-                    "back in the queue", n, n == 1 ? "" : "s", (double)f->opt->lease_ms / 1000.0,
-                    n == 1 ? "" : "s");
-    if (f->monitor) wire_monitor_poll(f->monitor, &f->wstats);
+        console_log(f->con, CONSOLE_INFO, "%d lease%s passed %s deadline without a result "
+                    "(%d x the measured time per tile, at most %.0f s): tile%s back in the "
+                    "queue", n, n == 1 ? "" : "s", n == 1 ? "its" : "their",
+                    f->opt->lease_factor, (double)f->opt->lease_ms / 1000.0, n == 1 ? "" : "s");
+    if (f->monitor) {
+        wire_monitor_poll(f->monitor, &f->wstats);
+        log_handshakes(f, now);
+    }
     if (f->locals) {
         local_workers_reap(f->locals, on_child_exit, f);
         if (!f->opt->bind && local_workers_running(f->locals) == 0 && registry_alive(f->reg) == 0)
@@ -381,10 +461,13 @@ static void run_loop(farm *f)
     long timeout = f->opt->heartbeat_ms / 2 < 100 ? f->opt->heartbeat_ms / 2 : 100;
     if (timeout < 1) timeout = 1;
     while (f->state == FARM_RUNNING) {
-        zmq_pollitem_t items[2] = {{f->router, 0, ZMQ_POLLIN, 0}, {NULL, 0, ZMQ_POLLIN, 0}};
+        zmq_pollitem_t items[3] = {{f->router, 0, ZMQ_POLLIN, 0}, {NULL, 0, ZMQ_POLLIN, 0},
+                                   {NULL, 0, ZMQ_POLLIN, 0}};
         int nitems = 1;
         if (f->monitor) items[nitems++].socket = wire_monitor_socket(f->monitor);
+        if (f->zap) items[nitems++].socket = zap_socket(f->zap);
         int rc = zmq_poll(items, nitems, timeout);
+        zap_answer(f->zap);
         if (interrupted) {
             f->state = FARM_INTERRUPTED;
             break;
@@ -491,6 +574,7 @@ static void teardown(farm *f)
     local_workers_destroy(&f->locals);
     wire_monitor_destroy(&f->monitor);
     if (f->router) zmq_close(f->router);
+    zap_destroy(&f->zap);
     if (f->ctx) zmq_ctx_term(f->ctx);
     remove_private_endpoint(f);
     job_message_destroy(&f->jobmsg);

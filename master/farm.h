@@ -32,10 +32,14 @@ typedef struct farm_options {
     int liveness;                  /* Welcome.heartbeat_liveness (3) */
     int max_attempts;              /* failures of one tile that fail the job (3) */
     int max_duplicates;            /* end-game duplicate leases per tile (1) */
-    int64_t lease_ms;              /* Grant.deadline_ms (120000) */
+    int64_t lease_ms;              /* the longest lease (120000) */
+    int lease_factor;              /* leases last this x the measured time per tile (4) */
     int verbosity;                 /* -1 quiet, 0 normal, 1 verbose */
     bool resume;                   /* --resume: take the tiles in OUT.exr.journal */
     int max_workers;               /* live workers at most; more are refused (1024) */
+    const char *curve_secret;      /* --curve-secret: the master's NAME.key_secret, or NULL */
+    const char *allow_keys;        /* --allow-keys: folder of workers' NAME.key files */
+    bool insecure;                 /* --insecure: plaintext on a network endpoint */
 } farm_options;
 
 void farm_options_default(farm_options *opt);

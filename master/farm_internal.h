@@ -22,6 +22,7 @@
 #include "registry.h"
 #include "scheduler.h"
 #include "wire.h"
+#include "zap.h"
 
 typedef enum farm_state {
     FARM_RUNNING,
@@ -37,8 +38,12 @@ typedef struct farm {
     int tiles_x, ntiles;
     void *ctx, *router;
     wire_monitor *monitor;
+    zap *zap;                      /* CURVE: the key check (NULL: plaintext) */
+    uint64_t handshakes_logged;    /* handshake failures logged so far */
+    int64_t handshake_logged_ms;
     wire_stats wstats;
-    proto_limits limits;
+    proto_limits limits;           /* what workers may send (bounded per tile: farm.c) */
+    proto_limits send_limits;      /* what the master sends (the Job may be large) */
     char endpoint[PATH_MAX + 64];  /* what the local workers connect to */
     char ipc_dir[PATH_MAX];        /* embedded mode's private folder, or "" */
     scheduler *sched;

@@ -9,7 +9,9 @@
  *              journal and copied into the output; an invalid EXR counts
  *              as a retryable failure of the worker, a write error of the
  *              journal or the output fails the render (the master's fault)
- *   Failure    retried elsewhere up to max_attempts, then the job fails
+ *   Failure    retried elsewhere up to max_attempts, then the job fails;
+ *              a non-retryable one fails it only when a second worker
+ *              confirms it (scheduler.h: no single peer ends a render)
  *   NeedJob    the Job again
  *   Heartbeat  liveness only (any message counts)
  *   Shutdown   the worker leaves: its tiles go back to the queue
@@ -28,7 +30,7 @@
 
 static int send_to(farm *f, const uint8_t *id, size_t id_len, Aafarm__Envelope *env)
 {
-    if (wire_send_limited(f->router, &f->limits, id, id_len, env, NULL, 0) != 0) return -1;
+    if (wire_send_limited(f->router, &f->send_limits, id, id_len, env, NULL, 0) != 0) return -1;
     return 0;
 }
 
@@ -111,7 +113,7 @@ static int send_grant(farm *f, farm_worker *w, const scheduler_lease *l, int64_t
     g.lease_id = l->id;
     g.tile_index = (uint32_t)l->tile;
     g.tile = &rect;
-    g.deadline_ms = (uint32_t)f->opt->lease_ms;
+    g.deadline_ms = (uint32_t)(l->deadline_ms - l->granted_ms);
     Aafarm__Envelope env = AAFARM__ENVELOPE__INIT;
     env.body_case = AAFARM__ENVELOPE__BODY_GRANT;
     env.grant = &g;
@@ -221,7 +223,9 @@ static void on_hello(farm *f, const Aafarm__Hello *h, const uint8_t *id, size_t 
     copy_name(w->name, sizeof w->name, h->worker_name);
     copy_name(w->host, sizeof w->host, h->host);
     w->pid = h->pid;
-    w->threads = h->threads ? h->threads : 1;
+    /* its credits are capped by its threads: a claim of more than a worker
+     * can have (aafarm-worker --threads 1..1024) buys a peer no more tiles */
+    w->threads = h->threads ? (h->threads > 1024 ? 1024 : h->threads) : 1;
     w->slot = scheduler_worker_add(f->sched);
     w->has_job = holds_job(h, f->jb->hash);
     w->local = f->locals && strcmp(w->host, f->host) == 0 &&
@@ -260,7 +264,8 @@ static void tile_failed(farm *f, farm_worker *w, uint64_t lease, int tile, const
         return;
     }
     farm_fail(f, "tile %d at (%d,%d) failed on worker %s (%s): %s", tile, rect.x0, rect.y0,
-              w->name, retryable ? "attempts exhausted" : "not retryable", msg);
+              w->name, retryable ? "attempts exhausted" : "not retryable, confirmed by a second "
+              "worker", msg);
 }
 
 static void add_stats(farm_worker *w, const Aafarm__TileStats *s)

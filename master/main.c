@@ -12,6 +12,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "curve_cert.h"
 #include "farm.h"
 #include "job/job_scene.h"
 #include "util/exitcodes.h"
@@ -39,10 +40,19 @@ static void usage(FILE *out)
         "  --heartbeat MS             heartbeat interval announced to workers (default 1000)\n"
         "  --liveness N               a worker is dead after N silent intervals (default 3)\n"
         "  --retries N                failures of one tile before the job fails (default 3)\n"
-        "  --lease S                  seconds before a leased tile is handed out again (120)\n"
+        "  --lease S                  the longest a leased tile waits before it is handed\n"
+        "                             out again (120 s)\n"
+        "  --lease-factor N           a lease lasts N x its worker's measured time per tile\n"
+        "                             (at least 2 s, at most --lease; default 4, 0: --lease)\n"
         "  --duplicates N             end-game duplicate leases per tile (default 1, 0: off)\n"
         "  --worker-binary PATH       aafarm-worker to start (default: next to this program)\n"
         "  --max-workers N            workers served at a time; more are refused (1024)\n"
+        "  --curve-secret FILE        CurveZMQ on --bind: this master's NAME.key_secret\n"
+        "                             (aafarm-keygen NAME); needs --allow-keys\n"
+        "  --allow-keys DIR           the workers' public keys (NAME.key files) that may\n"
+        "                             connect; others are refused and logged\n"
+        "  --insecure                 allow --bind on a network address without CURVE\n"
+        "                             (anyone who reaches it can join; not recommended)\n"
         "  --resume                   continue an unfinished render of the same job: the\n"
         "                             tiles in OUT.exr.journal are kept, only the others\n"
         "                             are rendered (every render journals its tiles there)\n"
@@ -84,7 +94,8 @@ static int bad_number(const char *opt, const char *what, const char *got)
 static int parse(int argc, char **argv, cli *c)
 {
     enum { O_BIND = 256, O_LOCAL, O_TPW, O_TILE, O_ARITH, O_BUDGET, O_PREVIEW, O_STATS_JSON,
-           O_HEARTBEAT, O_LIVENESS, O_RETRIES, O_LEASE, O_DUPS, O_WORKER_BIN, O_RESUME, O_MAX_WORKERS };
+           O_HEARTBEAT, O_LIVENESS, O_RETRIES, O_LEASE, O_DUPS, O_WORKER_BIN, O_RESUME, O_MAX_WORKERS,
+           O_CURVE_SECRET, O_ALLOW_KEYS, O_INSECURE, O_LEASE_FACTOR };
     static const struct option longopts[] = {
         {"output", required_argument, 0, 'o'},
         {"bind", required_argument, 0, O_BIND},
@@ -99,10 +110,14 @@ static int parse(int argc, char **argv, cli *c)
         {"liveness", required_argument, 0, O_LIVENESS},
         {"retries", required_argument, 0, O_RETRIES},
         {"lease", required_argument, 0, O_LEASE},
+        {"lease-factor", required_argument, 0, O_LEASE_FACTOR},
         {"duplicates", required_argument, 0, O_DUPS},
         {"worker-binary", required_argument, 0, O_WORKER_BIN},
         {"resume", no_argument, 0, O_RESUME},
         {"max-workers", required_argument, 0, O_MAX_WORKERS},
+        {"curve-secret", required_argument, 0, O_CURVE_SECRET},
+        {"allow-keys", required_argument, 0, O_ALLOW_KEYS},
+        {"insecure", no_argument, 0, O_INSECURE},
         {"quiet", no_argument, 0, 'q'},
         {"verbose", no_argument, 0, 'v'},
         {"help", no_argument, 0, 'h'},
@@ -153,6 +168,10 @@ static int parse(int argc, char **argv, cli *c)
             if (!parse_long(optarg, 1, 86400, &n)) return bad_number("--lease", "seconds 1..86400", optarg);
             f->lease_ms = n * 1000;
             break;
+        case O_LEASE_FACTOR:
+            if (!parse_long(optarg, 0, 1000, &n)) return bad_number("--lease-factor", "0..1000", optarg);
+            f->lease_factor = (int)n;
+            break;
         case O_DUPS:
             if (!parse_long(optarg, 0, 100, &n)) return bad_number("--duplicates", "0..100", optarg);
             f->max_duplicates = (int)n;
@@ -163,6 +182,9 @@ static int parse(int argc, char **argv, cli *c)
             if (!parse_long(optarg, 1, 65536, &n)) return bad_number("--max-workers", "1..65536", optarg);
             f->max_workers = (int)n;
             break;
+        case O_CURVE_SECRET: f->curve_secret = optarg; break;
+        case O_ALLOW_KEYS: f->allow_keys = optarg; break;
+        case O_INSECURE: f->insecure = true; break;
         case 'q': f->verbosity = -1; break;
         case 'v': f->verbosity = 1; break;
         case 'h': usage(stdout); return AAFARM_EXIT_OK;
@@ -178,6 +200,27 @@ static int parse(int argc, char **argv, cli *c)
         fprintf(stderr, "aafarm-master: %s (see --help)\n",
                 !f->scene_path ? "which scene? usage: aafarm-master SCENE.rib -o OUT.exr"
                                : "needs -o OUT.exr");
+        return AAFARM_EXIT_USAGE;
+    }
+    if (!f->curve_secret != !f->allow_keys) {
+        fprintf(stderr, "aafarm-master: --curve-secret and --allow-keys go together (the "
+                "master's key, and the workers' keys it admits)\n");
+        return AAFARM_EXIT_USAGE;
+    }
+    if (f->curve_secret && !f->bind) {
+        fprintf(stderr, "aafarm-master: --curve-secret secures --bind ENDPOINT; without --bind "
+                "the local workers use a private ipc:// socket\n");
+        return AAFARM_EXIT_USAGE;
+    }
+    if (f->curve_secret && f->insecure) {
+        fprintf(stderr, "aafarm-master: --insecure and --curve-secret exclude each other\n");
+        return AAFARM_EXIT_USAGE;
+    }
+    if (f->bind && !f->curve_secret && !f->insecure && !curve_endpoint_is_local(f->bind)) {
+        fprintf(stderr, "aafarm-master: --bind %s is reachable from other hosts, and without "
+                "CURVE anyone there could take the job and send tiles: give --curve-secret "
+                "FILE --allow-keys DIR (docs/cluster.md), bind a loopback address "
+                "(tcp://127.0.0.1:PORT), or say --insecure\n", f->bind);
         return AAFARM_EXIT_USAGE;
     }
     if (f->bind && !c->local_given) f->local_workers = 0;

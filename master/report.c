@@ -141,6 +141,13 @@ static double master_cpu_seconds(void)
            (double)ru.ru_stime.tv_sec + (double)ru.ru_stime.tv_usec * 1e-6;
 }
 
+/* The master's peak resident memory (KiB). */
+static long master_peak_rss_kb(void)
+{
+    struct rusage ru;
+    return getrusage(RUSAGE_SELF, &ru) == 0 ? ru.ru_maxrss : 0;
+}
+
 static void json_farm(FILE *out, const farm *f)
 {
     scheduler_counts c;
@@ -152,7 +159,8 @@ static void json_farm(FILE *out, const farm *f)
             "\"duplicate_results\": %llu, \"stale_results\": %llu, \"failures\": %llu, "
             "\"invalid_tiles\": %llu, \"malformed_messages\": %llu, \"rejects_sent\": %llu, "
             "\"version_mismatches\": %llu, \"disconnects\": %llu, \"nonfinite_samples\": %llu, "
-            "\"master_cpu_seconds\": %.3f},\n",
+            "\"handshake_failures\": %llu, \"auth_refusals\": %llu, \"max_bulk_bytes\": %zu, "
+            "\"master_cpu_seconds\": %.3f, \"master_peak_rss_kb\": %ld},\n",
             f->job_bytes, (unsigned long long)f->jobs_sent, per_grant,
             (unsigned long long)f->result_bytes, (unsigned long long)f->sent_bytes,
             (unsigned long long)c.grants, (unsigned long long)c.duplicate_grants,
@@ -162,7 +170,9 @@ static void json_farm(FILE *out, const farm *f)
             (unsigned long long)f->wstats.dropped, (unsigned long long)f->rejects_sent,
             (unsigned long long)f->version_mismatches, (unsigned long long)f->wstats.disconnects,
             (unsigned long long)f->nonfinite_samples,
-            master_cpu_seconds());
+            (unsigned long long)f->wstats.handshake_failures,
+            (unsigned long long)zap_refused(f->zap), f->limits.max_bulk_bytes,
+            master_cpu_seconds(), master_peak_rss_kb());
 }
 
 bool farm_report_json(const farm *f, const char *path, char *err, size_t errsz)

@@ -33,6 +33,9 @@ typedef struct tile_state {
 typedef struct worker_slot {
     bool active;
     int cursor;        /* last fresh tile granted, -1: none yet */
+    int taken;         /* results taken from it, and their grant-to-result time */
+    int64_t taken_ms_sum;
+    int overdue;       /* its valid leases past their deadline */
 } worker_slot;
 
 typedef struct failed_pair {
@@ -55,6 +58,7 @@ struct scheduler {
     bool job_failed;
     int done;
     int64_t taken_ms_sum;      /* grant-to-result time of taken leases */
+    int taken;                 /* their number (done counts resumed tiles too) */
     scheduler_counts counts;
 };
 
@@ -68,6 +72,8 @@ static void *xrealloc(void *p, size_t n)
 void scheduler_options_default(scheduler_options *opt)
 {
     opt->max_attempts = 3;
+    opt->lease_factor = 4;
+    opt->lease_min_ms = 2000;
     opt->max_duplicates = 1;
     opt->lease_ms = 120000;
     opt->duplicate_after_ms = 1000;
@@ -211,6 +217,8 @@ static void lease_remove(scheduler *self, scheduler_lease *l)
 {
     int tile = l->tile;
     bool was_live = !l->expired;
+    if (l->expired && l->worker >= 0 && l->worker < self->nworkers)
+        self->workers[l->worker].overdue--;
     l->id = 0;
     self->holes++;
     self->tiles[tile].held--;
@@ -227,7 +235,8 @@ static void lease_add(scheduler *self, int worker, int tile, int64_t now, bool d
     }
     scheduler_lease *l = &self->leases[self->nleases++];
     *l = (scheduler_lease){.id = self->next_id++, .worker = worker, .tile = tile,
-                           .granted_ms = now, .deadline_ms = now + self->opt.lease_ms,
+                           .granted_ms = now,
+                           .deadline_ms = now + scheduler_lease_limit(self, worker),
                            .duplicate = dup};
     self->tiles[tile].live++;
     self->tiles[tile].held++;
@@ -322,6 +331,7 @@ static int pick_duplicate(const scheduler *self, int worker, int64_t now)
 bool scheduler_grant(scheduler *self, int worker, int64_t now_ms, scheduler_lease *out)
 {
     if (!worker_ok(self, worker) || self->job_failed || self->done == self->ntiles) return false;
+    if (self->workers[worker].overdue > 0) return false;   /* a hoarder, or a stalled worker */
     int tile = pick_requeued(self, worker);
     if (tile >= 0) {
         lease_add(self, worker, tile, now_ms, self->tiles[tile].held > 0, out);
@@ -371,7 +381,11 @@ scheduler_verdict scheduler_complete(scheduler *self, int worker, uint64_t lease
     }
     t->done = 1;
     self->done++;
-    self->taken_ms_sum += now_ms > l->granted_ms ? now_ms - l->granted_ms : 0;
+    int64_t took = now_ms > l->granted_ms ? now_ms - l->granted_ms : 0;
+    self->taken_ms_sum += took;
+    self->taken++;
+    self->workers[worker].taken++;
+    self->workers[worker].taken_ms_sum += took;
     lease_remove(self, l);
     return SCHEDULER_TAKEN;
 }
@@ -392,7 +406,13 @@ scheduler_failure scheduler_fail(scheduler *self, int worker, uint64_t lease_id,
         self->failed[self->nfailed++] = (failed_pair){tile, worker};
     }
     lease_remove(self, l);
-    if (!retryable || self->tiles[tile].attempts >= self->opt.max_attempts) {
+    /* one worker alone cannot fail the job while another could try */
+    int failers = 0;
+    for (size_t i = 0; i < self->nfailed; i++)
+        if (self->failed[i].tile == tile) failers++;
+    bool confirmed = failers >= 2 || !someone_else_for(self, tile, worker);
+    if ((!retryable && failers >= 2) ||
+        (self->tiles[tile].attempts >= self->opt.max_attempts && confirmed)) {
         self->job_failed = true;
         return SCHEDULER_JOB_FAILED;
     }
@@ -420,12 +440,33 @@ int scheduler_expire(scheduler *self, int64_t now_ms)
     uint64_t before = self->counts.requeued;
     for (size_t i = 0; i < self->nleases; i++) {
         scheduler_lease *l = &self->leases[i];
-        if (!l->id || l->expired || l->deadline_ms > now_ms) continue;
+        if (!l->id || l->expired) continue;
+        l->deadline_ms = l->granted_ms + scheduler_lease_limit(self, l->worker);
+        if (l->deadline_ms > now_ms) continue;
         l->expired = true;
+        if (l->worker >= 0 && l->worker < self->nworkers) self->workers[l->worker].overdue++;
         self->counts.expired++;
         tile_lost_live(self, l->tile);
     }
     return (int)(self->counts.requeued - before);
+}
+
+int64_t scheduler_lease_limit(const scheduler *self, int worker)
+{
+    int64_t sum = self->taken_ms_sum, n = self->taken;
+    if (worker >= 0 && worker < self->nworkers && self->workers[worker].taken > 0) {
+        sum = self->workers[worker].taken_ms_sum;
+        n = self->workers[worker].taken;
+    }
+    if (self->opt.lease_factor <= 0 || n == 0) return self->opt.lease_ms;
+    int64_t limit = self->opt.lease_factor * (sum / n);
+    if (limit < self->opt.lease_min_ms) limit = self->opt.lease_min_ms;
+    return limit < self->opt.lease_ms ? limit : self->opt.lease_ms;
+}
+
+bool scheduler_worker_overdue(const scheduler *self, int worker)
+{
+    return worker_ok(self, worker) && self->workers[worker].overdue > 0;
 }
 
 int64_t scheduler_next_deadline(const scheduler *self)

@@ -32,8 +32,19 @@
  *     first result wins, later ones are duplicates (results are
  *     deterministic);
  *   - a failed tile is requeued, avoiding the workers that failed it while
- *     another worker is there to take it; after max_attempts failures, or
- *     one that is not retryable, the job has failed.
+ *     another worker is there to take it. No single worker can fail the
+ *     job while another one could take the tile (issue 11): the job fails
+ *     on a non-retryable failure only once a second, different worker
+ *     confirms it (until then it counts as a retryable one), and after
+ *     max_attempts failures only when they came from two workers or no
+ *     other active worker is left to try;
+ *   - lease deadlines follow the measured speed: a lease lasts
+ *     lease_factor x the mean grant-to-result time of its worker (of all
+ *     workers until this one has delivered a tile; lease_ms until anyone
+ *     has), clamped to [lease_min_ms, lease_ms], judged when it is checked,
+ *     so a worker that takes tiles and never returns them (a hoarder) loses
+ *     them to others soon after the others' speed is known; a worker
+ *     holding an expired lease gets no new tile until it delivers.
  *
  * Cost: grants, results and failures are O(log leases) except when a
  * worker starts a new run, which scans the tile states once (O(tiles)).
@@ -51,6 +62,9 @@ typedef struct scheduler_options {
     int64_t duplicate_after_ms; /* duplicate only leases at least this old, and
                                    at least 3 x the mean time from grant to
                                    result so far (1000) */
+    int lease_factor;      /* a lease lasts lease_factor x the measured mean
+                              grant-to-result time (4; 0: always lease_ms) */
+    int64_t lease_min_ms;  /* but at least this long (2000) */
 } scheduler_options;
 
 void scheduler_options_default(scheduler_options *opt);
@@ -131,9 +145,18 @@ scheduler_failure scheduler_fail(scheduler *self, int worker, uint64_t lease_id,
  * leased already. */
 bool scheduler_mark_done(scheduler *self, int tile);
 
-/* Marks leases whose deadline is <= now_ms as expired and requeues their
- * tiles. Returns the number of tiles requeued. */
+/* Marks leases whose deadline (granted + scheduler_lease_limit of their
+ * worker now) is <= now_ms as expired and requeues their tiles. Returns
+ * the number of tiles requeued. */
 int scheduler_expire(scheduler *self, int64_t now_ms);
+
+/* How long a lease granted to this worker now would last (ms): see the
+ * rule above. */
+int64_t scheduler_lease_limit(const scheduler *self, int worker);
+
+/* Does the worker hold a lease that passed its deadline (it gets no new
+ * grant until it delivers or is gone)? */
+bool scheduler_worker_overdue(const scheduler *self, int worker);
 
 /* The earliest deadline of an unexpired lease, or INT64_MAX. */
 int64_t scheduler_next_deadline(const scheduler *self);

@@ -528,8 +528,9 @@ wire_monitor *wire_monitor_new(void *ctx, void *socket)
     return self;
 }
 
-/* Reads one event (both frames); its number, or -1 when none is pending. */
-static int read_event(void *pair)
+/* Reads one event (both frames); its number, or -1 when none is pending.
+ * The endpoint it names goes to where[0..wheresz). */
+static int read_event(void *pair, char *where_out, size_t wheresz)
 {
     zmq_msg_t head, where;
     zmq_msg_init(&head);
@@ -548,12 +549,17 @@ static int read_event(void *pair)
     }
     bool more = zmq_msg_more(&head);
     zmq_msg_close(&head);
+    where_out[0] = '\0';
     while (more) {
         zmq_msg_init(&where);
         if (zmq_msg_recv(&where, pair, 0) < 0) {
             zmq_msg_close(&where);
             break;
         }
+        size_t len = zmq_msg_size(&where);
+        if (len >= wheresz) len = wheresz - 1;
+        memcpy(where_out, zmq_msg_data(&where), len);
+        where_out[len] = '\0';
         more = zmq_msg_more(&where);
         zmq_msg_close(&where);
     }
@@ -567,7 +573,8 @@ int wire_monitor_poll(wire_monitor *self, wire_stats *stats)
         return -1;
     }
     int n = 0;
-    for (int event; (event = read_event(self->pair)) >= 0; n++) {
+    char where[128];
+    for (int event; (event = read_event(self->pair, where, sizeof where)) >= 0; n++) {
         if (!stats)
             continue;
         if (event == ZMQ_EVENT_CONNECTED || event == ZMQ_EVENT_ACCEPTED)
@@ -576,8 +583,15 @@ int wire_monitor_poll(wire_monitor *self, wire_stats *stats)
             stats->disconnects++;
         else if (event == ZMQ_EVENT_HANDSHAKE_FAILED_NO_DETAIL ||
                  event == ZMQ_EVENT_HANDSHAKE_FAILED_PROTOCOL ||
-                 event == ZMQ_EVENT_HANDSHAKE_FAILED_AUTH)
+                 event == ZMQ_EVENT_HANDSHAKE_FAILED_AUTH) {
             stats->handshake_failures++;
+            if (event == ZMQ_EVENT_HANDSHAKE_FAILED_AUTH) stats->auth_failures++;
+            snprintf(stats->last_handshake, sizeof stats->last_handshake, "%s on %s",
+                     event == ZMQ_EVENT_HANDSHAKE_FAILED_AUTH       ? "refused by authentication"
+                     : event == ZMQ_EVENT_HANDSHAKE_FAILED_PROTOCOL ? "protocol or security mismatch"
+                                                                    : "failed",
+                     where[0] ? where : "?");
+        }
     }
     if (errno != EAGAIN) {
         set_error(errno, "wire_monitor_poll: %s", zmq_strerror(errno));

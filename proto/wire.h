@@ -44,6 +44,9 @@ typedef struct wire_stats {
     uint64_t disconnects;  /* wire_monitor: peers gone, including those ZeroMQ
                               cut off for a frame over ZMQ_MAXMSGSIZE */
     uint64_t handshake_failures; /* wire_monitor: ZMTP handshakes that failed */
+    uint64_t auth_failures;      /* of those: refused by authentication (CURVE
+                                    key not allowed, ZAP status 400) */
+    char last_handshake[160];    /* the last failure: its kind and endpoint */
     char last_error[256];  /* why the last message was dropped */
 } wire_stats;
 

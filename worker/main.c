@@ -28,6 +28,9 @@ static void usage(FILE *out)
         "  --connect ENDPOINT      serve a master, e.g. tcp://render1:5555; serves one\n"
         "                          job after another, reconnects when the master goes\n"
         "                          away (docs/farm.md)\n"
+        "  --curve-secret FILE     CurveZMQ: this worker's NAME.key_secret (aafarm-keygen\n"
+        "                          NAME; the master must allow NAME.key); needs --master-key\n"
+        "  --master-key FILE       CurveZMQ: the master's public key (its NAME.key)\n"
         "  --name NAME             worker name in the master's logs (default host:pid)\n"
         "  -t, --threads N         rendering threads (default: number of cores)\n"
         "  --tile S                tile size in pixels (standalone; default 32)\n"
@@ -83,7 +86,8 @@ int main(int argc, char **argv)
     job_options_default(&so.job);
     const char *connect = NULL;
     enum { O_STANDALONE = 256, O_CONNECT, O_NAME, O_TILE, O_CACHE, O_ARITH, O_BUDGET,
-           O_PREVIEW, O_STATS, O_STATS_JSON, O_TILE_DELAY, O_PREPARE_DELAY };
+           O_PREVIEW, O_STATS, O_STATS_JSON, O_TILE_DELAY, O_PREPARE_DELAY,
+           O_CURVE_SECRET, O_MASTER_KEY };
     static const struct option longopts[] = {
         {"standalone", required_argument, 0, O_STANDALONE},
         {"output", required_argument, 0, 'o'},
@@ -99,6 +103,8 @@ int main(int argc, char **argv)
         {"stats-json", required_argument, 0, O_STATS_JSON},
         {"tile-delay", required_argument, 0, O_TILE_DELAY},
         {"prepare-delay", required_argument, 0, O_PREPARE_DELAY},
+        {"curve-secret", required_argument, 0, O_CURVE_SECRET},
+        {"master-key", required_argument, 0, O_MASTER_KEY},
         {"quiet", no_argument, 0, 'q'},
         {"verbose", no_argument, 0, 'v'},
         {"help", no_argument, 0, 'h'},
@@ -162,6 +168,8 @@ int main(int argc, char **argv)
             }
             wo.prepare_delay_ms = (int)n;
             break;
+        case O_CURVE_SECRET: wo.curve_secret = optarg; break;
+        case O_MASTER_KEY: wo.master_key = optarg; break;
         case 'q': so.verbosity = wo.verbosity = -1; break;
         case 'v': so.verbosity = wo.verbosity = 1; break;
         case 'h': usage(stdout); return AAFARM_EXIT_OK;
@@ -182,6 +190,11 @@ int main(int argc, char **argv)
             return AAFARM_EXIT_USAGE;
         }
         return worker_standalone(&so);
+    }
+    if (!wo.curve_secret != !wo.master_key) {
+        fprintf(stderr, "aafarm-worker: --curve-secret and --master-key go together (this "
+                "worker's key pair, and the master's public key)\n");
+        return AAFARM_EXIT_USAGE;
     }
     if (connect) {
         wo.endpoint = connect;

@@ -39,6 +39,7 @@
 #include <unistd.h>
 #include <zmq.h>
 
+#include "curve_cert.h"
 #include "util/exitcodes.h"
 #include "version.h"
 #include "wire.h"
@@ -84,6 +85,11 @@ typedef struct worker_loop {
     char fatal[600];
     int64_t drop_logged_ms;
     uint64_t tiles_sent, failures_sent;
+    /* CURVE (opt->curve_secret): this worker's keys and the master's */
+    bool curve;
+    curve_cert own, master;
+    wire_monitor *monitor;         /* handshake failures: refused keys */
+    bool handshake_said;           /* a failed handshake was reported this session */
 } worker_loop;
 
 static volatile sig_atomic_t interrupted;
@@ -386,6 +392,7 @@ static held_job *prepare_job(worker_loop *w, const Aafarm__Job *m)
             wlog(w, 0, "interrupted while preparing job %.12s; leaving", m->job_hash);
             send_shutdown(w, "the worker was stopped (SIGINT/SIGTERM) while preparing a job");
             int linger = 500;
+            wire_monitor_destroy(&w->monitor);   /* its socket would hold up zmq_ctx_term */
             zmq_setsockopt(w->dealer, ZMQ_LINGER, &linger, sizeof linger);
             zmq_close(w->dealer);
             zmq_ctx_term(w->ctx);   /* sends what is queued, for at most 500 ms */
@@ -530,6 +537,14 @@ static bool open_socket(worker_loop *w)
         snprintf(w->fatal, sizeof w->fatal, "cannot create a socket: %s", zmq_strerror(errno));
         return false;
     }
+    if (w->curve &&
+        (zmq_setsockopt(w->dealer, ZMQ_CURVE_SERVERKEY, w->master.public_key, CURVE_Z85_LEN) != 0 ||
+         zmq_setsockopt(w->dealer, ZMQ_CURVE_PUBLICKEY, w->own.public_key, CURVE_Z85_LEN) != 0 ||
+         zmq_setsockopt(w->dealer, ZMQ_CURVE_SECRETKEY, w->own.secret_key, CURVE_Z85_LEN) != 0)) {
+        snprintf(w->fatal, sizeof w->fatal, "cannot turn CURVE on: %s", zmq_strerror(errno));
+        return false;
+    }
+    w->monitor = wire_monitor_new(w->ctx, w->dealer);
     if (zmq_connect(w->dealer, w->opt->endpoint) != 0) {
         snprintf(w->fatal, sizeof w->fatal, "cannot connect to '%s': %s", w->opt->endpoint,
                  zmq_strerror(errno));
@@ -540,10 +555,30 @@ static bool open_socket(worker_loop *w)
 
 static void close_socket(worker_loop *w, int linger_ms)
 {
+    wire_monitor_destroy(&w->monitor);
     if (!w->dealer) return;
     zmq_setsockopt(w->dealer, ZMQ_LINGER, &linger_ms, sizeof linger_ms);
     zmq_close(w->dealer);
     w->dealer = NULL;
+}
+
+/* A failed handshake means the master refused this worker's key, or one
+ * side speaks CURVE and the other not: said once per session. */
+static void check_handshakes(worker_loop *w)
+{
+    if (!w->monitor) return;
+    wire_monitor_poll(w->monitor, &w->wstats);
+    if (w->wstats.handshake_failures == 0 || w->handshake_said || w->welcomed) return;
+    w->handshake_said = true;
+    if (w->wstats.auth_failures)
+        wlog(w, -1, "the master at %s refused this worker's key: its public key (%s) is not "
+             "in the master's --allow-keys folder; retrying with backoff", w->opt->endpoint,
+             w->own.public_key);
+    else
+        wlog(w, -1, "the handshake with the master at %s failed (%s): %s; retrying with "
+             "backoff", w->opt->endpoint, w->wstats.last_handshake,
+             w->curve ? "does the master speak CURVE, and is --master-key its public key?"
+                      : "the master may require CURVE (give --curve-secret and --master-key)");
 }
 
 static session_end session(worker_loop *w)
@@ -558,6 +593,8 @@ static session_end session(worker_loop *w)
     }
     send_hello(w);
     w->last_heard_ms = now_ms();
+    w->wstats.handshake_failures = w->wstats.auth_failures = 0;
+    w->handshake_said = false;
     while (w->end == SESSION_LOST) {
         zmq_pollitem_t items[2] = {{w->dealer, 0, ZMQ_POLLIN, 0},
                                    {NULL, worker_pool_wake_fd(w->pool), ZMQ_POLLIN, 0}};
@@ -571,6 +608,7 @@ static session_end session(worker_loop *w)
         read_master(w);
         send_finished(w);
         ask_for_more(w);
+        check_handshakes(w);
         int64_t now = now_ms();
         if (now - w->last_heard_ms > (int64_t)w->heartbeat_ms * w->liveness) {
             wlog(w, 0, "%s at %s: no answer for %.1f s", w->welcomed ? "master" : "no master",
@@ -646,6 +684,15 @@ int worker_loop_run(const worker_loop_options *opt)
     sigaction(SIGTERM, &sa, NULL);
     signal(SIGPIPE, SIG_IGN);
 
+    if (opt->curve_secret) {
+        char err[1200];
+        if (!curve_cert_read(opt->curve_secret, true, &w.own, err, sizeof err) ||
+            !curve_cert_read(opt->master_key, false, &w.master, err, sizeof err)) {
+            wlog(&w, -1, "%s", err);
+            return AAFARM_EXIT_USAGE;
+        }
+        w.curve = true;
+    }
     w.ctx = zmq_ctx_new();
     w.pool = worker_pool_new(w.threads, opt->tile_delay_ms);
     w.jobs = worker_jobs_new(MAX_JOBS_HELD, opt->cache_bytes);
@@ -662,5 +709,6 @@ int worker_loop_run(const worker_loop_options *opt)
     drop_pending(&w, NULL);
     worker_jobs_destroy(&w.jobs);
     if (w.ctx) zmq_ctx_term(w.ctx);
+    memset(&w.own, 0, sizeof w.own);
     return rc;
 }

@@ -7,6 +7,10 @@
  * it holds compiled (worker_jobs.h), sends the tiles back as EXR, and
  * heartbeats meanwhile. When the master goes silent it reconnects with
  * exponential backoff (1 s, 2 s, ... 32 s) and serves the next master.
+ * With a CURVE key pair and the master's public key every byte is
+ * encrypted and the master checks this worker's key; a refusal is said
+ * in plain words (once per session) and the worker keeps retrying with
+ * the same backoff (the key may be allowed later).
  */
 #ifndef WORKER_LOOP_H
 #define WORKER_LOOP_H
@@ -21,6 +25,8 @@ typedef struct worker_loop_options {
     int verbosity;                 /* -1 quiet, 0 normal, 1 verbose */
     int tile_delay_ms;             /* testing aid: sleep before each tile */
     int prepare_delay_ms;          /* testing aid: sleep before compiling a Job */
+    const char *curve_secret;      /* CURVE: this worker's NAME.key_secret, or NULL */
+    const char *master_key;        /* CURVE: the master's NAME.key */
 } worker_loop_options;
 
 /* Serves masters until told to stop. Returns an AAFARM_EXIT_* code:

@@ -246,7 +246,7 @@ bool ft_master_endpoint(const char *log, char *buf, size_t bufsz, double timeout
     if (!ft_wait_for(log, "listening on ", 1, timeout_s)) return false;
     char *text = ft_read(log);
     const char *p = strstr(text, "listening on ") + strlen("listening on ");
-    size_t len = strcspn(p, "\n");
+    size_t len = strcspn(p, " \n");
     bool ok = len > 0 && len < bufsz;
     if (ok) {
         memcpy(buf, p, len);

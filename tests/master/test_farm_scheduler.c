@@ -209,17 +209,78 @@ static void test_failures_retry_elsewhere_then_fail_job(void **state)
     scheduler_destroy(&s);
 }
 
-static void test_not_retryable_fails_at_once(void **state)
+/* No single worker ends the job (issue 11): a non-retryable failure is
+ * retried on another worker and fails the job only when that one confirms
+ * it; alone, a worker fails it only after max_attempts. */
+static void test_not_retryable_needs_a_second_worker(void **state)
 {
     (void)state;
     scheduler *s = make(2, 2, 5, 0, 1000);
-    int a = scheduler_worker_add(s);
+    int a = scheduler_worker_add(s), b = scheduler_worker_add(s);
     uint64_t id;
     assert_int_equal(grant_tile(s, a, 0, &id), 0);
     assert_int_equal(scheduler_fail(s, a, id + 7, false), SCHEDULER_FAIL_IGNORED);
     assert_false(scheduler_failed(s));
-    assert_int_equal(scheduler_fail(s, a, id, false), SCHEDULER_JOB_FAILED);
+    assert_int_equal(scheduler_fail(s, a, id, false), SCHEDULER_RETRY);
+    assert_false(scheduler_failed(s));
+    /* the tile goes to b, not back to a */
+    assert_int_equal(grant_tile(s, a, 0, NULL), 1);
+    assert_int_equal(grant_tile(s, b, 0, &id), 0);
+    assert_int_equal(scheduler_fail(s, b, id, false), SCHEDULER_JOB_FAILED);
     assert_true(scheduler_failed(s));
+    scheduler_destroy(&s);
+    /* alone: retried on the same worker, failed after max_attempts */
+    s = make(1, 1, 3, 0, 1000);
+    a = scheduler_worker_add(s);
+    for (int i = 0; i < 2; i++) {
+        assert_int_equal(grant_tile(s, a, 0, &id), 0);
+        assert_int_equal(scheduler_fail(s, a, id, false), SCHEDULER_RETRY);
+    }
+    assert_int_equal(grant_tile(s, a, 0, &id), 0);
+    assert_int_equal(scheduler_fail(s, a, id, false), SCHEDULER_JOB_FAILED);
+    scheduler_destroy(&s);
+}
+
+/* A lease lasts lease_factor x the measured grant-to-result time (the
+ * worker's own once known), at least lease_min_ms: a worker that takes a
+ * tile and never returns it loses it soon after the others' speed is
+ * known, and gets nothing new while it holds an overdue lease. */
+static void test_lease_deadline_follows_measured_rate(void **state)
+{
+    (void)state;
+    scheduler_options o;
+    scheduler_options_default(&o);
+    o.lease_ms = 120000;
+    o.lease_factor = 4;
+    o.lease_min_ms = 500;
+    o.max_duplicates = 0;
+    scheduler *s = scheduler_new(8, 1, &o);
+    int honest = scheduler_worker_add(s), hoarder = scheduler_worker_add(s);
+    assert_int_equal(scheduler_lease_limit(s, hoarder), 120000);   /* nothing measured */
+    scheduler_lease h, l;
+    assert_true(scheduler_grant(s, hoarder, 0, &h));
+    /* the honest worker takes two tiles in 300 ms each */
+    for (int i = 0; i < 2; i++) {
+        assert_true(scheduler_grant(s, honest, 1000 * i, &l));
+        assert_int_equal(scheduler_complete(s, honest, l.id, 1000 * i + 300), SCHEDULER_TAKEN);
+    }
+    assert_int_equal(scheduler_lease_limit(s, honest), 1200);
+    assert_int_equal(scheduler_lease_limit(s, hoarder), 1200);   /* the farm's measure */
+    /* the hoarder's lease, granted before anything was measured, now
+     * passes its deadline at 1200 ms, not 120 s */
+    assert_int_equal(scheduler_expire(s, 1100), 0);
+    assert_int_equal(scheduler_expire(s, 1200), 1);
+    assert_true(scheduler_worker_overdue(s, hoarder));
+    assert_false(scheduler_grant(s, hoarder, 1300, &l));   /* nothing new for it */
+    assert_true(scheduler_grant(s, honest, 1300, &l));
+    assert_int_equal(l.tile, h.tile);                      /* its tile went to another */
+    /* a late result is still taken and lifts the block */
+    assert_int_equal(scheduler_complete(s, hoarder, h.id, 5000), SCHEDULER_TAKEN);
+    assert_false(scheduler_worker_overdue(s, hoarder));
+    assert_int_equal(scheduler_lease_limit(s, hoarder), 4 * 5000);   /* its own measure */
+    assert_true(scheduler_grant(s, hoarder, 5000, &l));
+    /* the honest worker's copy of that tile is a duplicate now */
+    assert_int_equal(scheduler_complete(s, honest, l.id - 1, 1310), SCHEDULER_DUPLICATE);
     scheduler_destroy(&s);
 }
 
@@ -346,7 +407,8 @@ int main(void)
         cmocka_unit_test(test_end_game_duplicates),
         cmocka_unit_test(test_duplicates_wait_for_stragglers),
         cmocka_unit_test(test_failures_retry_elsewhere_then_fail_job),
-        cmocka_unit_test(test_not_retryable_fails_at_once),
+        cmocka_unit_test(test_not_retryable_needs_a_second_worker),
+        cmocka_unit_test(test_lease_deadline_follows_measured_rate),
         cmocka_unit_test(test_only_worker_gets_its_failed_tile_back),
         cmocka_unit_test(test_stale_results),
         cmocka_unit_test(test_resumed_tiles_never_granted),

@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
-# deploy/launch-workers.sh: start (or stop) one aafarm-worker per host over ssh
-# (docs/farm.md, "Workers on other hosts").
+# deploy/ssh/launch-workers.sh: start (or stop) one long-lived aafarm-worker per host over ssh
+# (docs/cluster.md, "Over ssh"; for one render with CURVE keys, farm.sh).
 #
-#   deploy/launch-workers.sh ENDPOINT HOST... [-- WORKER_OPTIONS...]
-#   deploy/launch-workers.sh --stop HOST...
+#   deploy/ssh/launch-workers.sh ENDPOINT HOST... [-- WORKER_OPTIONS...]
+#   deploy/ssh/launch-workers.sh --stop HOST...
 #
 # ENDPOINT is what the workers connect to, e.g. tcp://render-master:5555
 # (start the master with --bind tcp://*:5555). Each worker runs in the
