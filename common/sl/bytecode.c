@@ -28,6 +28,57 @@ const char *sl_opcode_name(sl_opcode op)
     return (unsigned)op < SL_OP__COUNT ? names[op] : "?";
 }
 
+static bool is_derivative_op(int op)
+{
+    return op == SL_OP_DU || op == SL_OP_DV || op == SL_OP_DERIV || op == SL_OP_CALCNORMAL ||
+           op == SL_OP_AREA;
+}
+
+/* Does instruction `in` possibly write one of P's slots [0, 3)? A written
+ * slot ('z') is the first of up to three; a merge table ('t') lists the
+ * slots its construct writes. */
+static bool may_write_P(const sl_program *p, const sl_insn *in)
+{
+    const char *k = kinds[in->op];
+    const uint16_t ops[4] = { in->a, in->b, in->c, in->d };
+    int P = sl_global_slot(SL_G_P);
+    for (int i = 0; i < 4; i++) {
+        if (k[i] == 'z' && ops[i] < P + 3)
+            return true;
+        if (k[i] == 't' && ops[i] < p->ntables) {
+            const uint16_t *t = &p->tables[ops[i]];
+            for (int e = 1; e <= t[0] && ops[i] + e < p->ntables; e++)
+                if (!(t[e] & SL_TABLE_STRING) && (t[e] & SL_TABLE_SLOT) < P + 3)
+                    return true;
+        }
+    }
+    return false;
+}
+
+bool sl_program_derivatives_reach_P(const sl_program *p)
+{
+    int first = -1, last_write = -1;
+    for (int pc = 0; pc < p->ncode; pc++) {
+        if (is_derivative_op(p->code[pc].op) && first < 0)
+            first = pc;
+        if (may_write_P(p, &p->code[pc]))
+            last_write = pc;
+    }
+    if (first < 0)
+        return false;
+    if (last_write > first)
+        return true;
+    /* a jump back over the first derivative (a loop around it) */
+    for (int pc = first; pc < p->ncode; pc++) {
+        const char *k = kinds[p->code[pc].op];
+        const uint16_t ops[4] = { p->code[pc].a, p->code[pc].b, p->code[pc].c, p->code[pc].d };
+        for (int i = 0; i < 4; i++)
+            if (k[i] == 'j' && ops[i] <= first)
+                return true;
+    }
+    return false;
+}
+
 void sl_program_free(sl_program *p)
 {
     if (!p)

@@ -189,9 +189,9 @@ struct sl_program {
 
     int nslots;                     /* scalar slots used */
     int nstring_slots;
-    bool takes_derivatives;         /* has DU, DV, DERIV, CALCNORMAL or AREA:
-                                       interval/affine runs carry derivative
-                                       bounds (vm_deriv.inc) */
+    bool takes_derivatives;         /* a DU, DV, DERIV, CALCNORMAL or AREA may
+                                       flow into P: interval/affine runs carry
+                                       derivative bounds (vm_deriv.inc) */
 };
 
 /* Scalar slot of a global: P at 0, N at 3, ... (3 slots for points and
@@ -199,6 +199,13 @@ struct sl_program {
 int sl_global_slot(sl_global g);
 int sl_global_size(sl_global g);
 const char *sl_global_name(sl_global g);
+
+/* Can a derivative (Du, Dv, Deriv, calculatenormal, area) flow into P? A
+ * conservative test on the bytecode: some derivative precedes a possible
+ * write of P, or a jump leads back over the first derivative. When it
+ * cannot (`N = calculatenormal(P)` after the last write of P, the common
+ * case), range runs need no derivative bounds to bound P. */
+bool sl_program_derivatives_reach_P(const sl_program *p);
 
 /* Frees a program and everything it owns (sl_program_destroy without the
  * pointer reset; used by the code generator on failure). */

@@ -32,12 +32,8 @@ sl_program *sl_compile(sl_source_set *set, const char *main_file,
         sl_program_free(program);
         return NULL;
     }
-    for (int pc = 0; program && pc < program->ncode; pc++) {
-        int op = program->code[pc].op;
-        if (op == SL_OP_DU || op == SL_OP_DV || op == SL_OP_DERIV ||
-            op == SL_OP_CALCNORMAL || op == SL_OP_AREA)
-            program->takes_derivatives = true;
-    }
+    if (program)
+        program->takes_derivatives = sl_program_derivatives_reach_P(program);
     return program;
 }
 

@@ -17,11 +17,13 @@
  *                     (conservative, correlations kept)
  *
  * In FLOAT mode derivatives are 0 and calculatenormal(P) returns the
- * current N. In INTERVAL/AFFINE modes a program that takes derivatives
- * (Du/Dv/Deriv/calculatenormal/area) runs with interval bounds of every
- * value's d/du and d/dv (vm_deriv.inc), seeded from the globals' bounds
- * (sl_vm_set_derivs): its results enclose the DUAL mode's at every point
- * of the range.
+ * current N. In INTERVAL/AFFINE modes a program whose derivatives
+ * (Du/Dv/Deriv/calculatenormal/area) can flow into P runs with interval
+ * bounds of every value's d/du and d/dv (vm_deriv.inc), seeded from the
+ * globals' bounds (sl_vm_set_derivs): its P encloses the DUAL mode's at
+ * every point of the range. Derivatives that cannot reach P (`N =
+ * calculatenormal(P)` after the last write of P) are not tracked, and what
+ * they compute is unbounded in these modes: range runs are for P.
  * In INTERVAL/AFFINE modes a comparison whose operands overlap runs both
  * branches and merges the results (flag AA_DISCONTINUOUS); see
  * docs/shading-language.md "Evaluation".
