@@ -92,6 +92,8 @@ static const sl_builtin table[] = {
     LW("diffuse", "c:n", LIGHT, DIFFUSE, 0),
     LW("specular", "c:nvf", LIGHT, SPECULAR, 0),
     LW("phong", "c:nvf", LIGHT, PHONG, 0),
+    /* spline (§15.1): variadic, checked by check_spline */
+    LW("spline", "A:", SPLINE, END, 0),
 };
 
 enum { TABLE_SIZE = sizeof table / sizeof table[0] };
@@ -260,6 +262,44 @@ void sl_builtin_candidates(const char *name, char *buf, size_t size)
             o += (size_t)snprintf(buf + o, size - o, ")");
     }
 }
+
+/* ---------------------------------------------------------------------- */
+/* spline bases                                                            */
+/* ---------------------------------------------------------------------- */
+
+/* The basis matrices of RiBasis (RI Spec 3.2 §4.1.2) in the power form
+ * x^3, x^2, x, 1 (rows) over the segment's 4 knots (columns). */
+static const sl_spline_basis bases[] = {
+    [SL_SPLINE_CATMULL_ROM] = { "catmull-rom", 1, { { -0.5, 1.5, -1.5, 0.5 },
+                                                    { 1, -2.5, 2, -0.5 },
+                                                    { -0.5, 0, 0.5, 0 },
+                                                    { 0, 1, 0, 0 } } },
+    [1] = { "bezier", 3, { { -1, 3, -3, 1 }, { 3, -6, 3, 0 }, { -3, 3, 0, 0 },
+                           { 1, 0, 0, 0 } } },
+    [2] = { "b-spline", 1, { { -1 / 6.0, 0.5, -0.5, 1 / 6.0 }, { 0.5, -1, 0.5, 0 },
+                             { -0.5, 0, 0.5, 0 }, { 1 / 6.0, 4 / 6.0, 1 / 6.0, 0 } } },
+    /* knots: value0, tangent0, value1, tangent1 */
+    [3] = { "hermite", 2, { { 2, 1, -2, 1 }, { -3, -2, 3, -1 }, { 0, 1, 0, 0 },
+                            { 1, 0, 0, 0 } } },
+    [4] = { "linear", 1, { { 0, 0, 0, 0 }, { 0, 0, 0, 0 }, { 0, -1, 1, 0 },
+                           { 0, 1, 0, 0 } } },
+    [SL_SPLINE_CONSTANT] = { "constant", 1, { { 0, 0, 0, 0 }, { 0, 0, 0, 0 },
+                                              { 0, 0, 0, 0 }, { 0, 1, 0, 0 } } },
+};
+
+int sl_spline_basis_find(const char *name)
+{
+    for (int i = 0; i < (int)(sizeof bases / sizeof bases[0]); i++)
+        if (strcmp(bases[i].name, name) == 0)
+            return i;
+    if (strcmp(name, "catmullrom") == 0)
+        return SL_SPLINE_CATMULL_ROM;
+    if (strcmp(name, "bspline") == 0)
+        return 2;
+    return -1;
+}
+
+const sl_spline_basis *sl_spline_basis_get(int index) { return &bases[index]; }
 
 /* ---------------------------------------------------------------------- */
 /* globals                                                                 */

@@ -38,6 +38,8 @@ typedef enum sl_lowering {
     SL_LOWER_NOISE,       /* k: SL_NOISE_PLAIN / PERIODIC / CELL */
     SL_LOWER_RANDOM,
     SL_LOWER_LIGHT,       /* op: AMBIENT DIFFUSE SPECULAR PHONG */
+    SL_LOWER_SPLINE,      /* spline([basis,] t, knots... | knots[]): checked
+                             apart (variadic); node op = the basis index */
 } sl_lowering;
 
 typedef struct sl_builtin {
@@ -62,6 +64,24 @@ const sl_builtin *sl_builtin_resolve(const char *name, const sl_ty *args, int na
 
 /* "noise(float), noise(float, float), ..." for a message, into buf. */
 void sl_builtin_candidates(const char *name, char *buf, size_t size);
+
+/* The spline bases (RI Spec 3.2 §15.1 spline, RiBasis §4.1.2): a cubic
+ * segment over 4 consecutive knots, the segments `step` knots apart:
+ * value(x) = sum_i x^(3-i) sum_j m[i][j] knot[seg*step + j], x in [0, 1].
+ * "linear" and "constant" use catmull-rom's layout (the first and the last
+ * knot are not interpolated); "constant" is knot[seg*step + 1]. */
+typedef struct sl_spline_basis {
+    const char *name;
+    int step;
+    double m[4][4];
+} sl_spline_basis;
+
+enum { SL_SPLINE_CATMULL_ROM = 0, SL_SPLINE_CONSTANT = 5 };
+
+/* The basis index of `name` ("catmull-rom", "bezier", "b-spline",
+ * "hermite", "linear", "constant"), or -1. */
+int sl_spline_basis_find(const char *name);
+const sl_spline_basis *sl_spline_basis_get(int index);
 
 /* Globals: name -> sl_global (or -1), its type, whether shaders may
  * assign it (P, N, Ci, Oi). */

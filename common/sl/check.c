@@ -817,12 +817,96 @@ static sl_ty check_arraylength(checker *c, sl_node *n)
     return set_ty(n, SL_TYPE_FLOAT);
 }
 
+/* spline([basis,] t, k0, k1, ...) and spline([basis,] t, knots[]) (RI
+ * Spec 3.2 §15.1): the knots are floats, colors, points or vectors (the
+ * first knot's type, or the context's for an untyped first knot); the
+ * basis a constant string naming one of sl_spline_basis_find's. At least
+ * 4 knots, and 4 + a multiple of the basis' step. The node's op is the
+ * basis; an array's length is checked where it is known (an unsized
+ * parameter's: when its call is generated). */
+static sl_ty check_spline(checker *c, sl_node *n, sl_ty hint)
+{
+    int first = 0, basis = SL_SPLINE_CATMULL_ROM;
+    bool bad = false;
+    if (n->nlist > 0 && n->list[0]->kind == SL_N_STR) {
+        basis = sl_spline_basis_find(n->list[0]->name);
+        if (basis < 0) {
+            error(c, n->list[0]->pos, "unknown spline basis '%s' (known: \"catmull-rom\", "
+                  "\"bezier\", \"b-spline\", \"hermite\", \"linear\", \"constant\")",
+                  n->list[0]->name);
+            bad = true;
+        }
+        check_expr(c, &n->list[0], SL_TYPE_STRING);
+        first = 1;
+    }
+    for (int i = first; i < n->nlist; i++)
+        bad |= check_expr(c, &n->list[i], i == first ? SL_TYPE_FLOAT
+                          : sl_ty_is_triple(hint) ? hint : SL_TYPE_VOID) == SL_TY_ERROR;
+    if (bad)
+        return set_ty(n, SL_TY_ERROR);
+    if (first == 0 && n->nlist > 0 && n->list[0]->ty == SL_TYPE_STRING) {
+        error(c, n->list[0]->pos, "the basis of spline() must be a constant string");
+        return set_ty(n, SL_TY_ERROR);
+    }
+    int nknots = n->nlist - first - 1;
+    if (nknots < 1 || n->list[first]->ty != SL_TYPE_FLOAT) {
+        error(c, n->pos, "spline() takes [basis,] a float parameter and the knots "
+                         "(4 or more values, or an array)");
+        return set_ty(n, SL_TY_ERROR);
+    }
+    const sl_spline_basis *b = sl_spline_basis_get(basis);
+    sl_node *k0 = n->list[first + 1];
+    sl_ty elem;
+    if (nknots == 1 && sl_ty_is_array(k0->ty)) {
+        elem = sl_ty_elem(k0->ty);
+        nknots = sl_ty_len(k0->ty);
+        if (k0->kind != SL_N_IDENT) {
+            error(c, k0->pos, "the knots of spline() must be an array variable");
+            return set_ty(n, SL_TY_ERROR);
+        }
+        if (elem == SL_TYPE_MATRIX || elem == SL_TYPE_STRING) {
+            error(c, k0->pos, "spline() interpolates floats and triples, not '%s'",
+                  sl_ty_name(k0->ty));
+            return set_ty(n, SL_TY_ERROR);
+        }
+    } else {
+        elem = k0->ty == SL_TY_LIST3 ? (sl_ty_is_triple(hint) ? hint : SL_TYPE_POINT) : k0->ty;
+        if (elem != SL_TYPE_FLOAT && !sl_ty_is_triple(elem)) {
+            error(c, k0->pos, "spline() interpolates floats and triples, not '%s'",
+                  sl_ty_name(k0->ty));
+            return set_ty(n, SL_TY_ERROR);
+        }
+        for (int i = first + 1; i < n->nlist; i++) {
+            sl_ty have = n->list[i]->ty;
+            if (!can_convert(have, elem) || sl_ty_is_array(have) ||
+                (elem == SL_TYPE_FLOAT && have != SL_TYPE_FLOAT)) {
+                error(c, n->list[i]->pos, "knot %d of spline() is a '%s', the first a '%s'",
+                      i - first, sl_ty_name(have), sl_ty_name(elem));
+                return set_ty(n, SL_TY_ERROR);
+            }
+            wrap_conv(c, &n->list[i], elem);
+        }
+    }
+    if (nknots && (nknots < 4 || (nknots - 4) % b->step != 0)) {
+        error(c, n->pos, "a '%s' spline takes 4%s knots, not %d", b->name,
+              b->step == 3 ? ", 7, 10, ..." : b->step == 2 ? ", 6, 8, ..." : " or more",
+              nknots);
+        return set_ty(n, SL_TY_ERROR);
+    }
+    int count;
+    n->builtin = sl_builtin_find("spline", &count);
+    n->op = basis;
+    return set_ty(n, elem);
+}
+
 static sl_ty check_call(checker *c, sl_node *n, sl_ty hint)
 {
     sl_func *cands[MAX_OVERLOADS];
     int ncands = find_funcs(c, n->name, cands, MAX_OVERLOADS);
     if (ncands == 0 && strcmp(n->name, "arraylength") == 0)
         return check_arraylength(c, n);
+    if (ncands == 0 && strcmp(n->name, "spline") == 0)
+        return check_spline(c, n, hint);
     int count;
     bool builtin = sl_builtin_find(n->name, &count) != NULL;
     if (!ncands && !builtin) {

@@ -975,6 +975,87 @@ static int gen_light(cg *g, sl_node *e, const int *args, int dst)
     return into(g, z, dst, 3);
 }
 
+/* spline([basis,] t, knots): x = clamp(t, 0, 1) * segments; the segment
+ * seg = min(floor(x), segments - 1) and its 4 knots are read with aload
+ * (in interval/affine mode: the merge of every knot the segment range can
+ * reach, so the result is conservative), then the cubic of the basis is
+ * evaluated in x - seg by Horner's rule. */
+static int gen_spline(cg *g, sl_node *e, int dst)
+{
+    const sl_spline_basis *b = sl_spline_basis_get(e->op);
+    int first = e->list[0]->ty == SL_TYPE_STRING ? 1 : 0;
+    int n = size_of(e);
+    int t = gen_expr(g, e->list[first], -1);
+    int nknots, base;
+    sl_node *k0 = e->list[first + 1];
+    if (sl_ty_is_array(k0->ty)) {
+        nknots = array_len(k0->sym);
+        base = k0->sym->slot;
+        if (nknots < 4 || (nknots - 4) % b->step != 0) {
+            fail(g, "a '%s' spline takes 4%s knots, not the %d of '%s'", b->name,
+                 b->step == 3 ? ", 7, 10, ..." : b->step == 2 ? ", 6, 8, ..." : " or more",
+                 nknots, k0->name);
+            return 0;
+        }
+    } else {
+        nknots = e->nlist - first - 1;
+        base = alloc_slots(g, nknots * n);
+        for (int i = 0; i < nknots; i++) {
+            int mark = g->sp;
+            gen_expr(g, e->list[first + 1 + i], base + i * n);
+            g->sp = mark;
+        }
+    }
+    int segs = (nknots - 4) / b->step + 1;
+    int x = alloc_slots(g, 1);
+    emit(g, SL_OP_CLAMP, x, t, const_slot(g, 0), const_slot(g, 1));
+    int knot[4];                     /* first slot of each of the segment's knots */
+    if (segs == 1) {
+        for (int j = 0; j < 4; j++)
+            knot[j] = base + j * n;
+    } else {
+        emit(g, SL_OP_MUL, x, x, const_slot(g, segs), 0);
+        int seg = op2(g, SL_OP_MIN, op1(g, SL_OP_FLOOR, x), const_slot(g, segs - 1));
+        emit(g, SL_OP_SUB, x, x, seg, 0);
+        int at = op2(g, SL_OP_MUL, seg, const_slot(g, b->step));
+        for (int j = 0; j < 4; j++) {
+            if (e->op == SL_SPLINE_CONSTANT && j != 1)
+                continue;
+            int index = j ? op2(g, SL_OP_ADD, at, const_slot(g, j)) : at;
+            knot[j] = alloc_slots(g, n);
+            for (int k = 0; k < n; k++)
+                emit(g, SL_OP_ALOAD, knot[j] + k, base + k, index, array_operand(nknots, n));
+        }
+    }
+    if (e->op == SL_SPLINE_CONSTANT)
+        return into(g, knot[1], dst, n);
+    int z = target(g, dst, n);
+    for (int k = 0; k < n; k++) {
+        bool started = false;
+        for (int i = 0; i < 4; i++) {
+            /* the coefficient of x^(3-i): sum_j m[i][j] knot_j */
+            int c = -1;
+            for (int j = 0; j < 4; j++) {
+                double w = b->m[i][j];
+                if (w == 0)
+                    continue;
+                int term = w == 1 ? knot[j] + k : op2(g, SL_OP_MUL, knot[j] + k, const_slot(g, w));
+                c = c < 0 ? term : op2(g, SL_OP_ADD, c, term);
+            }
+            if (started)
+                emit(g, SL_OP_MUL, z + k, z + k, x, 0);
+            if (c >= 0) {
+                if (started)
+                    emit(g, SL_OP_ADD, z + k, z + k, c, 0);
+                else
+                    emit(g, SL_OP_MOV, z + k, c, 0, 0);
+                started = true;
+            }
+        }
+    }
+    return z;
+}
+
 static int gen_builtin(cg *g, sl_node *e, int dst)
 {
     const sl_builtin *b = e->builtin;
@@ -1041,6 +1122,7 @@ static int gen_builtin(cg *g, sl_node *e, int dst)
         return into(g, z, dst, n);
     }
     case SL_LOWER_LIGHT: return gen_light(g, e, args, dst);
+    case SL_LOWER_SPLINE: break;     /* gen_spline */
     }
     return 0;
 }
@@ -1133,6 +1215,8 @@ static int gen_expr(cg *g, sl_node *e, int dst)
     case SL_N_CALL:
         if (e->func)
             r = gen_user_call(g, e, dst);
+        else if (e->builtin && e->builtin->lower == SL_LOWER_SPLINE)
+            r = gen_spline(g, e, dst);
         else if (e->builtin)
             r = gen_builtin(g, e, dst);
         else            /* arraylength(a) */

@@ -437,6 +437,126 @@ static void ref_nested_shadows_builtin(double u, double v, double o[3])
     o[0] = 2 * u; o[1] = noise3(u, v, 0); o[2] = 0;
 }
 
+/* spline, written from each basis' own formula (not the basis matrices
+ * the compiler uses): the segment of x = clamp(t, 0, 1) * segments */
+static double spline_ref(const char *basis, double t, const double *k, int n)
+{
+    int step = strcmp(basis, "bezier") == 0 ? 3 : strcmp(basis, "hermite") == 0 ? 2 : 1;
+    int segs = (n - 4) / step + 1;
+    double x = clampd(t, 0, 1) * segs;
+    double seg = floor(x) < segs - 1 ? floor(x) : segs - 1, f = x - seg;
+    const double *p = k + (int)seg * step;
+    if (strcmp(basis, "catmull-rom") == 0)
+        return p[1] + 0.5 * f * (p[2] - p[0] + f * (2 * p[0] - 5 * p[1] + 4 * p[2] - p[3] +
+                                                     f * (3 * (p[1] - p[2]) + p[3] - p[0])));
+    if (strcmp(basis, "bezier") == 0) {           /* de Casteljau */
+        double a = p[0] + f * (p[1] - p[0]), b = p[1] + f * (p[2] - p[1]);
+        double c = p[2] + f * (p[3] - p[2]);
+        double ab = a + f * (b - a), bc = b + f * (c - b);
+        return ab + f * (bc - ab);
+    }
+    if (strcmp(basis, "b-spline") == 0) {
+        double g = 1 - f;
+        return (g * g * g * p[0] + (3 * f * f * f - 6 * f * f + 4) * p[1] +
+                (-3 * f * f * f + 3 * f * f + 3 * f + 1) * p[2] + f * f * f * p[3]) / 6;
+    }
+    if (strcmp(basis, "hermite") == 0)
+        return (2 * f * f * f - 3 * f * f + 1) * p[0] + (f * f * f - 2 * f * f + f) * p[1] +
+               (-2 * f * f * f + 3 * f * f) * p[2] + (f * f * f - f * f) * p[3];
+    if (strcmp(basis, "linear") == 0)
+        return p[1] + f * (p[2] - p[1]);
+    return p[1];                                  /* constant */
+}
+
+/* lane k of a spline over n triples */
+static double spline3(const char *basis, double t, const double (*k)[3], int n, int lane)
+{
+    double x[16];
+    for (int i = 0; i < n; i++)
+        x[i] = k[i][lane];
+    return spline_ref(basis, t, x, n);
+}
+
+static void ref_spline_float(double u, double v, double o[3])
+{
+    static const double a[] = { 0, 0, 0.3, 0.8, 1, 1 }, b[] = { -1, 0, 1, 0.5, 2, 0.25, 3 };
+    static const double c[] = { 0, 1, 2, 3 };
+    o[0] = spline_ref("catmull-rom", u, a, 6);
+    o[1] = spline_ref("catmull-rom", v, b, 7);
+    o[2] = 0.5 * spline_ref("catmull-rom", 0.5, c, 4);
+}
+
+static void ref_spline_color_ramp(double u, double v, double o[3])
+{
+    static const double k[7][3] = { { 0.3, 0.12, 0.03 }, { 0.3, 0.12, 0.03 },
+                                    { 0.69, 0.44, 0.25 }, { 0.8, 0.5, 0.3 },
+                                    { 0.69, 0.44, 0.25 }, { 0.3, 0.12, 0.03 },
+                                    { 0.3, 0.12, 0.03 } };
+    double ring = fmodf_(u * 3 + 0.5 * v, 1);
+    for (int i = 0; i < 3; i++)
+        o[i] = spline3("catmull-rom", ring, k, 7, i);
+}
+
+static void ref_spline_bezier_point(double u, double v, double o[3])
+{
+    static const double k[7][3] = { { 0, 0, 0 }, { 1, 2, 0 }, { 2, -1, 1 }, { 3, 0, 1 },
+                                    { 4, 1, 1 }, { 5, 0, 2 }, { 6, 3, 0 } };
+    for (int i = 0; i < 3; i++)
+        o[i] = spline3("bezier", u, k, 7, i);
+    o[2] += v;
+}
+
+static void ref_spline_bspline(double u, double v, double o[3])
+{
+    static const double a[] = { 0, 1, 0, 1, 0, 1, 0 }, b[] = { 0, 0, 0, 1, 1, 1 };
+    o[0] = spline_ref("b-spline", u, a, 7);
+    o[1] = spline_ref("b-spline", v * v, b, 6);
+    o[2] = o[0] * o[1];
+}
+
+static void ref_spline_hermite(double u, double v, double o[3])
+{
+    static const double a[] = { 0, 2, 1, 0 };
+    static const double k[6][3] = { { 0, 0, 0 }, { 1, 0, 0 }, { 0, 1, 0 },
+                                    { 0, 0, 1 }, { 1, 1, 0 }, { -1, 0, 0 } };
+    o[0] = spline_ref("hermite", u, a, 4);
+    o[1] = spline3("hermite", v, k, 6, 1) + spline3("hermite", v, k, 6, 0);
+    o[2] = spline3("hermite", v, k, 6, 2);
+}
+
+static void ref_spline_linear_constant(double u, double v, double o[3])
+{
+    static const double a[] = { 9, 0, 1, 0.5, 2, 9 }, c[] = { 9, 1, 0.5, 9 };
+    o[0] = spline_ref("linear", u, a, 6);
+    o[1] = spline_ref("constant", v, a, 6);
+    o[2] = spline_ref("linear", v, c, 4);
+}
+
+static void ref_spline_array(double u, double v, double o[3])
+{
+    static const double h[] = { 0, 0.2, 0.1, 0.7, 1, 1.2 }, g[] = { 0, 0.4, 0.8, 1 };
+    o[0] = spline_ref("catmull-rom", u, h, 6);
+    o[1] = spline_ref("linear", v, h, 6);
+    o[2] = spline_ref("b-spline", v, g, 4);
+}
+
+static void ref_spline_unsized_param(double u, double v, double o[3])
+{
+    static const double a[] = { 0, 1, 2, 3 }, b[] = { 1, 0, 0.5, 0.25, 1, 0 };
+    o[0] = spline_ref("catmull-rom", u, a, 4);
+    o[1] = spline_ref("catmull-rom", v, b, 6);
+    o[2] = spline_ref("catmull-rom", u * v, b, 6);
+}
+
+static void ref_spline_noise_marble(double u, double v, double o[3])
+{
+    double n = noise3(3 * u, 3 * v, 0);
+    double k[] = { 0, 0.1, 0.6, 0.3 * 0.6, 1, 0.8 }, b[] = { 0, 1, -1, 0 };
+    o[0] = spline_ref("catmull-rom", n, k, 6);
+    o[1] = n;
+    o[2] = spline_ref("bezier", n, b, 4);
+}
+
 /* ---------------------------------------------------------------------- */
 /* the cases                                                               */
 /* ---------------------------------------------------------------------- */
@@ -503,6 +623,15 @@ static const conf_case cases[] = {
     CASE(extern_write_chain, "extern of enclosing variables"),
     CASE(array_matrices, "arrays"),
     CASE(nested_shadows_builtin, "shadowed built-in names"),
+    CASE(spline_float, "spline"),
+    CASE(spline_color_ramp, "spline"),
+    CASE(spline_bezier_point, "spline"),
+    CASE(spline_bspline, "spline"),
+    CASE(spline_hermite, "spline"),
+    CASE(spline_linear_constant, "spline"),
+    CASE(spline_array, "spline"),
+    CASE(spline_unsized_param, "spline"),
+    CASE(spline_noise_marble, "spline"),
 };
 #undef CASE
 #undef CASE_NO_DUAL
@@ -569,6 +698,16 @@ static const conf_error errors[] = {
       "put a type in front, as in 'point (...)'\n"
       "    float d = (1, 0, 0) . (0, 1, 0);\n"
       "              ^\n" },
+    { "errors/spline_basis.sl",
+      "errors/spline_basis.sl:4:17: error: unknown spline basis 'cardinal' (known: "
+      "\"catmull-rom\", \"bezier\", \"b-spline\", \"hermite\", \"linear\", \"constant\")\n"
+      "    P += spline(\"cardinal\", s, 0, 1, 2, 3) * N;\n"
+      "                ^\n" },
+    { "errors/spline_count.sl",
+      "errors/spline_count.sl:4:10: error: a 'bezier' spline takes 4, 7, 10, ... knots, "
+      "not 5\n"
+      "    P += spline(\"bezier\", s, 0, 1, 2, 3, 4) * N;\n"
+      "         ^\n" },
 };
 
 /* ---------------------------------------------------------------------- */
