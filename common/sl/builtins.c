@@ -72,7 +72,19 @@ static const sl_builtin table[] = {
     LW("setycomp", "0:of", SETCOMP_K, END, 1),
     LW("setzcomp", "0:of", SETCOMP_K, END, 2),
     LW("comp", "f:Tf", COMP_RT, COMP, 0),
+    LW("comp", "f:mff", MCOMP, END, 0),
     LW("setcomp", "0:Off", SETCOMP_RT, SETCOMP, 0),
+    LW("setcomp", "0:Mfff", MSETCOMP, END, 0),
+    LW("ptransform", "p:sp", TRANSFORM, XPOINT, 0),
+    LW("ptransform", "p:ssp", TRANSFORM, XPOINT, 0),
+    LW("ptransform", "p:mp", TRANSFORM, XPOINT, 0),
+    LW("ctransform", "c:sc", CTRANSFORM, END, 0),
+    LW("ctransform", "c:ssc", CTRANSFORM, END, 0),
+    /* matrices (§15.3) */
+    LW("determinant", "f:m", DETERMINANT, END, 0),
+    LW("translate", "m:mv", MATRIX_XFORM, END, 0),
+    LW("rotate", "m:mfv", MATRIX_XFORM, END, 1),
+    LW("scale", "m:mp", MATRIX_XFORM, END, 2),
     /* noise (§15.1) */
     LW("noise", "F:f", NOISE, NOISE, SL_NOISE_PLAIN),
     LW("noise", "F:ff", NOISE, NOISE, SL_NOISE_PLAIN),
@@ -185,6 +197,12 @@ static int candidate_cost(const sl_builtin *b, const sl_ty *have, int n, sl_ty h
             want[i] = have[i];
             continue;
         }
+        if (c == 'M') {
+            if (have[i] != SL_TYPE_MATRIX)
+                return -1;
+            want[i] = have[i];
+            continue;
+        }
         if (c == 'O') {
             if (!sl_ty_is_triple(have[i]))
                 return -1;
@@ -242,6 +260,7 @@ static const char *letter_name(char c)
     switch (c) {
     case 'S': case 'o': return "point|vector|normal";
     case 'O': case 'T': return "triple";
+    case 'M': return "matrix";
     case 'G': return "float|triple";
     default: return sl_ty_name(letter_type(c));
     }
@@ -300,6 +319,26 @@ int sl_spline_basis_find(const char *name)
 }
 
 const sl_spline_basis *sl_spline_basis_get(int index) { return &bases[index]; }
+
+/* ---------------------------------------------------------------------- */
+/* color spaces                                                            */
+/* ---------------------------------------------------------------------- */
+
+int sl_color_space_find(const char *name)
+{
+    static const struct {
+        const char *name;
+        sl_color_space space;
+    } names[] = {
+        { "rgb", SL_CSPACE_RGB }, { "hsv", SL_CSPACE_HSV }, { "hsl", SL_CSPACE_HSL },
+        { "xyz", SL_CSPACE_XYZ }, { "XYZ", SL_CSPACE_XYZ }, { "xyY", SL_CSPACE_XYY },
+        { "YIQ", SL_CSPACE_YIQ },
+    };
+    for (size_t i = 0; i < sizeof names / sizeof names[0]; i++)
+        if (strcmp(names[i].name, name) == 0)
+            return (int)names[i].space;
+    return -1;
+}
 
 /* ---------------------------------------------------------------------- */
 /* globals                                                                 */

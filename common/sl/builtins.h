@@ -8,6 +8,7 @@
  *   f float  p point  v vector  n normal  c color  s string  m matrix
  *   0 void (result)   o an assignable variable of any spatial type
  *   O an assignable variable of any triple type
+ *   M an assignable matrix variable
  *   S any spatial type (point/vector/normal)
  *   T any triple (point/vector/normal/color; all T of a call agree)
  *   G float or any triple (all G of a call agree; floats promote)
@@ -38,6 +39,11 @@ typedef enum sl_lowering {
     SL_LOWER_NOISE,       /* k: SL_NOISE_PLAIN / PERIODIC / CELL */
     SL_LOWER_RANDOM,
     SL_LOWER_LIGHT,       /* op: AMBIENT DIFFUSE SPECULAR PHONG */
+    SL_LOWER_CTRANSFORM,  /* ctransform([from,] to, c): constant color spaces */
+    SL_LOWER_DETERMINANT,
+    SL_LOWER_MATRIX_XFORM, /* k: 0 translate, 1 rotate, 2 scale */
+    SL_LOWER_MCOMP,       /* comp(m, row, col) */
+    SL_LOWER_MSETCOMP,    /* setcomp(m, row, col, v) */
     SL_LOWER_SPLINE,      /* spline([basis,] t, knots... | knots[]): checked
                              apart (variadic); node op = the basis index */
 } sl_lowering;
@@ -82,6 +88,18 @@ enum { SL_SPLINE_CATMULL_ROM = 0, SL_SPLINE_CONSTANT = 5 };
  * "hermite", "linear", "constant"), or -1. */
 int sl_spline_basis_find(const char *name);
 const sl_spline_basis *sl_spline_basis_get(int index);
+
+/* Color spaces (RI Spec 3.2 §15.1 ctransform, §13 color constructors):
+ * "rgb" (the current one), "hsv", "hsl", "xyz" and "XYZ" (CIE XYZ of
+ * linear Rec. 709 / sRGB primaries, D65), "xyY", "YIQ" (NTSC). */
+typedef enum sl_color_space {
+    SL_CSPACE_RGB, SL_CSPACE_HSV, SL_CSPACE_HSL, SL_CSPACE_XYZ, SL_CSPACE_XYY,
+    SL_CSPACE_YIQ,
+} sl_color_space;
+
+/* The color space called `name`, or -1. */
+int sl_color_space_find(const char *name);
+#define SL_COLOR_SPACE_NAMES "\"rgb\", \"hsv\", \"hsl\", \"xyz\", \"XYZ\", \"xyY\", \"YIQ\""
 
 /* Globals: name -> sl_global (or -1), its type, whether shaders may
  * assign it (P, N, Ci, Oi). */

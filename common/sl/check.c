@@ -575,6 +575,16 @@ static void check_space_arg(checker *c, const sl_node *arg)
                            "\"object\", \"shader\", \"camera\")", arg->name);
 }
 
+/* A color space argument (ctransform): a constant string naming one. */
+static void check_color_space_arg(checker *c, const sl_node *arg)
+{
+    if (arg->kind != SL_N_STR)
+        error(c, arg->pos, "the color space of ctransform() must be a constant string");
+    else if (sl_color_space_find(arg->name) < 0)
+        error(c, arg->pos, "unknown color space '%s' (known: " SL_COLOR_SPACE_NAMES ")",
+              arg->name);
+}
+
 static sl_ty check_builtin_call(checker *c, sl_node *n, const sl_ty *args, sl_ty hint)
 {
     sl_ty want[8], result;
@@ -596,7 +606,7 @@ static sl_ty check_builtin_call(checker *c, sl_node *n, const sl_ty *args, sl_ty
     n->builtin = b;
     const char *sig = b->sig + 2;
     for (int i = 0; i < n->nlist; i++) {
-        if (sig[i] == 'o' || sig[i] == 'O') {
+        if (sig[i] == 'o' || sig[i] == 'O' || sig[i] == 'M') {
             sl_node *a = n->list[i];
             if (a->kind != SL_N_IDENT)
                 error(c, a->pos, "argument %d of '%s' must be a variable", i + 1, n->name);
@@ -604,7 +614,9 @@ static sl_ty check_builtin_call(checker *c, sl_node *n, const sl_ty *args, sl_ty
                 check_assignable(c, a, "modify");
             continue;
         }
-        if (sig[i] == 's')
+        if (sig[i] == 's' && b->lower == SL_LOWER_CTRANSFORM)
+            check_color_space_arg(c, n->list[i]);
+        else if (sig[i] == 's')
             check_space_arg(c, n->list[i]);
         wrap_conv(c, &n->list[i], want[i]);
     }
@@ -1036,8 +1048,15 @@ static sl_ty check_cast(checker *c, sl_node *n, sl_ty hint)
             return set_ty(n, SL_TY_ERROR);
         }
     } else if (ty == SL_TYPE_COLOR) {
-        if (strcmp(n->name, "rgb") != 0) {
-            error(c, n->pos, "unsupported color space '%s' (only \"rgb\")", n->name);
+        if (sl_color_space_find(n->name) < 0) {
+            error(c, n->pos, "unknown color space '%s' (known: " SL_COLOR_SPACE_NAMES ")",
+                  n->name);
+            return set_ty(n, SL_TY_ERROR);
+        }
+    } else if (ty == SL_TYPE_MATRIX) {
+        if (sl_space_find(n->name) < 0) {
+            error(c, n->pos, "unknown space '%s' (known: \"current\", \"world\", "
+                             "\"object\", \"shader\", \"camera\")", n->name);
             return set_ty(n, SL_TY_ERROR);
         }
     } else {

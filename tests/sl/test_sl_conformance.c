@@ -557,6 +557,201 @@ static void ref_spline_noise_marble(double u, double v, double o[3])
     o[2] = spline_ref("bezier", n, b, 4);
 }
 
+/* color spaces, the textbook way (Foley & van Dam's sector switch) */
+static void hsv_to_rgb(double h, double s, double v, double o[3])
+{
+    double h6 = fmodf_(h, 1) * 6, i = floor(h6), f = h6 - i;
+    double p = v * (1 - s), q = v * (1 - s * f), t = v * (1 - s * (1 - f));
+    double tab[6][3] = { { v, t, p }, { q, v, p }, { p, v, t },
+                         { p, q, v }, { t, p, v }, { v, p, q } };
+    for (int k = 0; k < 3; k++)
+        o[k] = tab[(int)i % 6][k];
+}
+
+static double hue_channel(double p, double q, double t)
+{
+    t = fmodf_(t, 1);
+    if (t < 1 / 6.0)
+        return p + (q - p) * 6 * t;
+    if (t < 0.5)
+        return q;
+    if (t < 2 / 3.0)
+        return p + (q - p) * (2 / 3.0 - t) * 6;
+    return p;
+}
+
+static void hsl_to_rgb(double h, double s, double l, double o[3])
+{
+    double q = l < 0.5 ? l * (1 + s) : l + s - l * s, p = 2 * l - q;
+    o[0] = hue_channel(p, q, h + 1 / 3.0);
+    o[1] = hue_channel(p, q, h);
+    o[2] = hue_channel(p, q, h - 1 / 3.0);
+}
+
+static void rgb_to_hsv(const double c[3], double o[3])
+{
+    double M = fmax(c[0], fmax(c[1], c[2])), m = fmin(c[0], fmin(c[1], c[2])), d = M - m;
+    double h = 0;
+    if (d > 0) {
+        if (M == c[0])
+            h = fmodf_((c[1] - c[2]) / d, 6);
+        else if (M == c[1])
+            h = (c[2] - c[0]) / d + 2;
+        else
+            h = (c[0] - c[1]) / d + 4;
+    }
+    o[0] = h / 6; o[1] = M > 0 ? d / M : 0; o[2] = M;
+}
+
+static void ref_color_hsv(double u, double v, double o[3])
+{
+    hsv_to_rgb(u, 0.8, 0.5 + 0.5 * v, o);
+}
+
+static void ref_color_hsl(double u, double v, double o[3])
+{
+    hsl_to_rgb(v + 0.5, 0.6, 0.2 + 0.6 * u, o);
+}
+
+static void ref_color_hue_shift(double u, double v, double o[3])
+{
+    double c[3] = { u, 1 - u, 0.1 }, hsv[3], back[3], d[3] = { 0.5 * u, 0.25 * v, 1.2 }, b[3];
+    rgb_to_hsv(c, hsv);
+    hsv_to_rgb(hsv[0] + 0.1, hsv[1], hsv[2], back);
+    rgb_to_hsv(d, b);
+    o[0] = hsv[0]; o[1] = back[1] + back[2]; o[2] = b[0] + b[1];
+}
+
+/* CIE XYZ of linear Rec. 709 primaries (D65) and NTSC YIQ */
+static const double M_xyz[3][3] = { { 0.4124564, 0.3575761, 0.1804375 },
+                                    { 0.2126729, 0.7151522, 0.0721750 },
+                                    { 0.0193339, 0.1191920, 0.9503041 } };
+static const double M_yiq[3][3] = { { 0.299, 0.587, 0.114 },
+                                    { 0.596, -0.274, -0.322 },
+                                    { 0.211, -0.523, 0.312 } };
+static void mat3_apply(const double m[3][3], const double x[3], double o[3])
+{
+    for (int r = 0; r < 3; r++)
+        o[r] = m[r][0] * x[0] + m[r][1] * x[1] + m[r][2] * x[2];
+}
+/* x = m^-1 y by Cramer's rule */
+static void mat3_solve(const double m[3][3], const double y[3], double x[3])
+{
+    double det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) -
+                 m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
+                 m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+    for (int k = 0; k < 3; k++) {
+        double a[3][3];
+        memcpy(a, m, sizeof a);
+        for (int r = 0; r < 3; r++)
+            a[r][k] = y[r];
+        x[k] = (a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1]) -
+                a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0]) +
+                a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0])) / det;
+    }
+}
+
+static void ref_color_xyz_yiq(double u, double v, double o[3])
+{
+    double c[3] = { u, v, 0.5 }, xyz[3], yiq[3];
+    mat3_apply(M_xyz, c, xyz);
+    mat3_apply(M_yiq, c, yiq);
+    double sum = xyz[0] + xyz[1] + xyz[2];
+    double xyY[3] = { xyz[0] / sum, xyz[1] / sum, xyz[1] };
+    /* back: "xyY" -> rgb is c again */
+    double in[3] = { 0.5, 0.1 * u, -0.1 * v }, rgb[3], lum[3], fromxyz[3];
+    mat3_solve(M_yiq, in, rgb);
+    mat3_apply(M_xyz, rgb, lum);
+    double given[3] = { u, v, 1 };
+    mat3_solve(M_xyz, given, fromxyz);
+    o[0] = xyz[0] + yiq[1];
+    o[1] = xyY[0] + c[1];
+    o[2] = lum[2] + fromxyz[0];
+}
+
+/* the conformance VM's "object" space: object -> current scales by 2, then
+ * translates by (1, 2, 3) */
+static void ref_ptransform_spaces(double u, double v, double o[3])
+{
+    double P[3] = { 2 * u - 1, 2 * v - 1, 0 };
+    double obj[3] = { (P[0] - 1) / 2, (P[1] - 2) / 2, (P[2] - 3) / 2 };
+    double m[3] = { 2 * u + 1, 2 * v + 2, 3 };
+    o[0] = obj[0]; o[1] = P[1] + m[0]; o[2] = m[2] + v / 2;
+}
+
+/* determinant by Gaussian elimination with partial pivoting */
+static double det4(double a[4][4])
+{
+    double det = 1;
+    for (int c = 0; c < 4; c++) {
+        int p = c;
+        for (int r = c + 1; r < 4; r++)
+            if (fabs(a[r][c]) > fabs(a[p][c]))
+                p = r;
+        if (a[p][c] == 0)
+            return 0;
+        if (p != c) {
+            for (int k = 0; k < 4; k++) {
+                double t = a[c][k];
+                a[c][k] = a[p][k];
+                a[p][k] = t;
+            }
+            det = -det;
+        }
+        det *= a[c][c];
+        for (int r = c + 1; r < 4; r++) {
+            double f = a[r][c] / a[c][c];
+            for (int k = c; k < 4; k++)
+                a[r][k] -= f * a[c][k];
+        }
+    }
+    return det;
+}
+
+static void ref_matrix_determinant(double u, double v, double o[3])
+{
+    double a[4][4] = { { 2, u, 0, 0 }, { v, 1, 0.5, 0 }, { 0, 0.25, 3, 0 }, { u, v, 1, 1 } };
+    double b[4][4] = { { 1, 0, 0, 0 }, { 0, 1 + u, 0, 0 }, { 0, v, 2, 0 }, { 0, 0, 0, 1 } };
+    double ab[4][4], a2[4][4];
+    for (int r = 0; r < 4; r++)
+        for (int c = 0; c < 4; c++) {
+            ab[r][c] = 0;
+            for (int k = 0; k < 4; k++)
+                ab[r][c] += a[r][k] * b[k][c];
+        }
+    memcpy(a2, a, sizeof a2);
+    o[0] = det4(a2); o[1] = det4(ab); o[2] = 16;
+}
+
+/* rotation of p about the unit axis a by angle w (Rodrigues) */
+static void rodrigues(const double a[3], double w, const double p[3], double o[3])
+{
+    double c = cos(w), s = sin(w), d = a[0] * p[0] + a[1] * p[1] + a[2] * p[2];
+    double x[3] = { a[1] * p[2] - a[2] * p[1], a[2] * p[0] - a[0] * p[2],
+                    a[0] * p[1] - a[1] * p[0] };
+    for (int k = 0; k < 3; k++)
+        o[k] = p[k] * c + x[k] * s + a[k] * d * (1 - c);
+}
+
+static void ref_matrix_build(double u, double v, double o[3])
+{
+    static const double z[3] = { 0, 0, 1 };
+    double k = 1 / sqrt(3.0), diag[3] = { k, k, k };
+    double p[3] = { 1, 2, v }, r[3], q[3], e[3] = { 1, 0, 0 };
+    rodrigues(z, 90 * u * M_PI / 180, p, r);     /* scale, rotate, translate */
+    r[0] += 0.5;
+    rodrigues(diag, v, e, q);
+    o[0] = r[0] + q[2]; o[1] = r[1]; o[2] = r[2] + q[0];
+}
+
+static void ref_matrix_comp(double u, double v, double o[3])
+{
+    double m[4][4] = { { 1, 2, 3, 4 }, { 5, 6, 7, 8 }, { 9, 10, 11, 12 }, { 13, v, 15, 16 } };
+    int row = (int)floor(u * 4);
+    o[0] = m[3][0] + m[0][2]; o[1] = m[3][1] + m[row][1];
+    o[2] = 2 + 3;    /* object -> current: scale 2, then translate (1, 2, 3) */
+}
+
 /* ---------------------------------------------------------------------- */
 /* the cases                                                               */
 /* ---------------------------------------------------------------------- */
@@ -632,6 +827,14 @@ static const conf_case cases[] = {
     CASE(spline_array, "spline"),
     CASE(spline_unsized_param, "spline"),
     CASE(spline_noise_marble, "spline"),
+    CASE(color_hsv, "color spaces"),
+    CASE(color_hsl, "color spaces"),
+    CASE(color_hue_shift, "color spaces"),
+    CASE(color_xyz_yiq, "color spaces"),
+    CASE(ptransform_spaces, "space transforms"),
+    CASE(matrix_determinant, "matrices"),
+    CASE(matrix_build, "matrices"),
+    CASE(matrix_comp, "matrices"),
 };
 #undef CASE
 #undef CASE_NO_DUAL
@@ -708,6 +911,11 @@ static const conf_error errors[] = {
       "not 5\n"
       "    P += spline(\"bezier\", s, 0, 1, 2, 3, 4) * N;\n"
       "         ^\n" },
+    { "errors/color_space.sl",
+      "errors/color_space.sl:4:26: error: unknown color space 'cmyk' (known: \"rgb\", "
+      "\"hsv\", \"hsl\", \"xyz\", \"XYZ\", \"xyY\", \"YIQ\")\n"
+      "    color c = ctransform(\"cmyk\", Cs);\n"
+      "                         ^\n" },
 };
 
 /* ---------------------------------------------------------------------- */
@@ -906,6 +1114,13 @@ static void test_conformance(void **state)
     tally t = { 0, 0, 0, 0, 0, 0, 0 };
     unsigned long long rng = 0x5eed15ULL;
     sl_vm *vm = sl_vm_new(NULL);
+    /* "object" -> "current": scale by 2, then translate by (1, 2, 3) */
+    sl_spaces sp;
+    for (int k = 0; k < SL_SPACE__COUNT; k++)
+        sp.to_current[k] = sp.from_current[k] = mat4_identity();
+    sp.to_current[SL_SPACE_OBJECT] = mat4_mul(mat4_translate(1, 2, 3), mat4_scale(2, 2, 2));
+    mat4_invert(&sp.to_current[SL_SPACE_OBJECT], &sp.from_current[SL_SPACE_OBJECT]);
+    sl_vm_set_spaces(vm, &sp);
     const char *features[64];
     int nfeatures = 0;
     size_t ncases = sizeof cases / sizeof cases[0];

@@ -300,7 +300,7 @@ static void test_calls(void **state)
                   "float f(float a; float b) { return a + b; }\n"
                   "      ^\n");
     expect_errors("displacement t() {\n    P = transform(\"raster\", P);\n"
-                  "    P = point \"screen\" (0, 0, 0);\n    color c = color \"hsv\" (1, 0, 0);\n}\n",
+                  "    P = point \"screen\" (0, 0, 0);\n    color c = color \"cmyk\" (1, 0, 0);\n}\n",
                   "t.sl:2:19: error: unknown space 'raster' (known: \"current\", \"world\", "
                   "\"object\", \"shader\", \"camera\")\n"
                   "    P = transform(\"raster\", P);\n"
@@ -309,8 +309,9 @@ static void test_calls(void **state)
                   "\"object\", \"shader\", \"camera\")\n"
                   "    P = point \"screen\" (0, 0, 0);\n"
                   "        ^\n"
-                  "t.sl:4:15: error: unsupported color space 'hsv' (only \"rgb\")\n"
-                  "    color c = color \"hsv\" (1, 0, 0);\n"
+                  "t.sl:4:15: error: unknown color space 'cmyk' (known: \"rgb\", \"hsv\", "
+                  "\"hsl\", \"xyz\", \"XYZ\", \"xyY\", \"YIQ\")\n"
+                  "    color c = color \"cmyk\" (1, 0, 0);\n"
                   "              ^\n");
 }
 
