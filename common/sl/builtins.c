@@ -37,6 +37,16 @@ static const sl_builtin table[] = {
     OP("min", "G:GG", MIN), OP("max", "G:GG", MAX),
     OP("clamp", "G:GGG", CLAMP),
     OP("step", "f:ff", STEP), OP("smoothstep", "f:fff", SMOOTHSTEP),
+    LW("filterstep", "f:ff", FILTERSTEP, END, 0),
+    LW("filterstep", "f:fff", FILTERSTEP, END, 0),
+    LW("filterstep", "f:ffsf", FILTERSTEP, END, 0),
+    LW("filterstep", "f:ffss", FILTERSTEP, END, 0),
+    LW("filterstep", "f:fffsf", FILTERSTEP, END, 0),
+    LW("filterstep", "f:fffss", FILTERSTEP, END, 0),
+    LW("filterstep", "f:ffsfss", FILTERSTEP, END, 0),
+    LW("filterstep", "f:ffsssf", FILTERSTEP, END, 0),
+    LW("filterstep", "f:fffsfss", FILTERSTEP, END, 0),
+    LW("filterstep", "f:fffsssf", FILTERSTEP, END, 0),
     OP("mix", "G:GGf", MIX), OP("mix", "T:TTT", MIX),
     /* geometry (§15.2) */
     LW("length", "f:S", LENGTH, END, 0),
@@ -49,6 +59,10 @@ static const sl_builtin table[] = {
     LW("faceforward", "A:SS", FACEFORWARD, END, 0),
     LW("faceforward", "A:SSS", FACEFORWARD, END, 0),
     LW("reflect", "v:SS", REFLECT, END, 0),
+    LW("refract", "v:SSf", REFRACT, END, 0),
+    LW("fresnel", "0:SSfww", FRESNEL, END, 0),
+    LW("fresnel", "0:SSfwwoo", FRESNEL, END, 0),
+    LW("depth", "f:p", DEPTH, END, 0),
     LW("transform", "p:sp", TRANSFORM, XPOINT, 0),
     LW("transform", "p:ssp", TRANSFORM, XPOINT, 0),
     LW("transform", "p:mp", TRANSFORM, XPOINT, 0),
@@ -197,6 +211,12 @@ static int candidate_cost(const sl_builtin *b, const sl_ty *have, int n, sl_ty h
             want[i] = have[i];
             continue;
         }
+        if (c == 'w') {
+            if (have[i] != SL_TYPE_FLOAT)
+                return -1;
+            want[i] = have[i];
+            continue;
+        }
         if (c == 'M') {
             if (have[i] != SL_TYPE_MATRIX)
                 return -1;
@@ -261,6 +281,7 @@ static const char *letter_name(char c)
     case 'S': case 'o': return "point|vector|normal";
     case 'O': case 'T': return "triple";
     case 'M': return "matrix";
+    case 'w': return "float";
     case 'G': return "float|triple";
     default: return sl_ty_name(letter_type(c));
     }

@@ -8,7 +8,7 @@
  *   f float  p point  v vector  n normal  c color  s string  m matrix
  *   0 void (result)   o an assignable variable of any spatial type
  *   O an assignable variable of any triple type
- *   M an assignable matrix variable
+ *   M an assignable matrix variable   w an assignable float variable
  *   S any spatial type (point/vector/normal)
  *   T any triple (point/vector/normal/color; all T of a call agree)
  *   G float or any triple (all G of a call agree; floats promote)
@@ -44,6 +44,8 @@ typedef enum sl_lowering {
     SL_LOWER_MATRIX_XFORM, /* k: 0 translate, 1 rotate, 2 scale */
     SL_LOWER_MCOMP,       /* comp(m, row, col) */
     SL_LOWER_MSETCOMP,    /* setcomp(m, row, col, v) */
+    SL_LOWER_REFRACT, SL_LOWER_FRESNEL, SL_LOWER_DEPTH,
+    SL_LOWER_FILTERSTEP,  /* filterstep(edge, x [, x1] [, "width", w] [, "filter", f]) */
     SL_LOWER_SPLINE,      /* spline([basis,] t, knots... | knots[]): checked
                              apart (variadic); node op = the basis index */
 } sl_lowering;

@@ -154,6 +154,10 @@ enum {
  * named space to "current", or the one from "current" to it. */
 enum { SL_SPACE_TO_CURRENT = 0, SL_SPACE_FROM_CURRENT = 1 };
 
+/* SPACEK's pseudo-space of depth(P): the matrix from "current" to camera
+ * space with z mapped to (z - near) / (far - near) (sl_vm_set_clipping). */
+enum { SL_SPACE_DEPTH = 15 };
+
 typedef struct sl_param {
     char *name;
     sl_type type;

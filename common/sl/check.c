@@ -575,6 +575,34 @@ static void check_space_arg(checker *c, const sl_node *arg)
                            "\"object\", \"shader\", \"camera\")", arg->name);
 }
 
+/* filterstep's optional parameters: "width", a float (the filter width's
+ * multiplier), and "filter", a constant filter name (the box filter is
+ * used whatever the name). Called for each string argument i. */
+static void check_filter_param(checker *c, const sl_node *n, int i)
+{
+    static const char *const filters[] = { "box", "triangle", "catmull-rom", "gaussian",
+                                           "sinc", "disk", "bessel" };
+    const sl_node *arg = n->list[i];
+    bool value = i > 0 && n->list[i - 1]->ty == SL_TYPE_STRING &&
+                 n->list[i - 1]->kind == SL_N_STR && strcmp(n->list[i - 1]->name, "filter") == 0;
+    if (arg->kind != SL_N_STR) {
+        error(c, arg->pos, "filterstep() parameters must be constant strings");
+        return;
+    }
+    if (value) {
+        for (size_t k = 0; k < sizeof filters / sizeof filters[0]; k++)
+            if (strcmp(arg->name, filters[k]) == 0)
+                return;
+        error(c, arg->pos, "unknown filter '%s' (known: \"box\", \"triangle\", "
+              "\"catmull-rom\", \"gaussian\", \"sinc\", \"disk\", \"bessel\")", arg->name);
+        return;
+    }
+    bool takes_string = i + 1 < n->nlist && n->list[i + 1]->ty == SL_TYPE_STRING;
+    if (strcmp(arg->name, takes_string ? "filter" : "width") != 0)
+        error(c, arg->pos, "unknown filterstep() parameter '%s' (known: \"width\" with a "
+              "float, \"filter\" with a name)", arg->name);
+}
+
 /* A color space argument (ctransform): a constant string naming one. */
 static void check_color_space_arg(checker *c, const sl_node *arg)
 {
@@ -606,12 +634,16 @@ static sl_ty check_builtin_call(checker *c, sl_node *n, const sl_ty *args, sl_ty
     n->builtin = b;
     const char *sig = b->sig + 2;
     for (int i = 0; i < n->nlist; i++) {
-        if (sig[i] == 'o' || sig[i] == 'O' || sig[i] == 'M') {
+        if (sig[i] == 'o' || sig[i] == 'O' || sig[i] == 'M' || sig[i] == 'w') {
             sl_node *a = n->list[i];
             if (a->kind != SL_N_IDENT)
                 error(c, a->pos, "argument %d of '%s' must be a variable", i + 1, n->name);
             else
                 check_assignable(c, a, "modify");
+            continue;
+        }
+        if (sig[i] == 's' && b->lower == SL_LOWER_FILTERSTEP) {
+            check_filter_param(c, n, i);
             continue;
         }
         if (sig[i] == 's' && b->lower == SL_LOWER_CTRANSFORM)

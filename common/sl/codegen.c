@@ -1253,6 +1253,108 @@ static int gen_mcomp(cg *g, const int *args, bool set, int dst)
     return into(g, z, dst, 1);
 }
 
+/* refract(I, N, eta) = eta I - (eta I.N + sqrt(k)) N with k = 1 - eta^2
+ * (1 - (I.N)^2); (0, 0, 0) where k < 0 (total internal reflection). */
+static int gen_refract(cg *g, int I, int N, int eta, int dst)
+{
+    int d = gen_dot(g, I, N, 3, -1);
+    int one = const_slot(g, 1);
+    int sin2 = op2(g, SL_OP_SUB, one, op2(g, SL_OP_MUL, d, d));
+    int k = op2(g, SL_OP_SUB, one, op2(g, SL_OP_MUL, op2(g, SL_OP_MUL, eta, eta), sin2));
+    int root = op1(g, SL_OP_SQRT, op2(g, SL_OP_MAX, k, const_slot(g, 0)));
+    int a = op2(g, SL_OP_ADD, op2(g, SL_OP_MUL, eta, d), root);
+    int r = alloc_slots(g, 3), zero = alloc_slots(g, 3);
+    for (int i = 0; i < 3; i++) {
+        emit(g, SL_OP_SUB, r + i, op2(g, SL_OP_MUL, eta, I + i), op2(g, SL_OP_MUL, a, N + i), 0);
+        emit(g, SL_OP_MOV, zero + i, const_slot(g, 0), 0, 0);
+    }
+    int z = gen_select(g, op2(g, SL_OP_LT, k, const_slot(g, 0)), zero, r, 3);
+    return into(g, z, dst, 3);
+}
+
+/* fresnel(I, N, eta, Kr, Kt [, R, T]) (I and N unit vectors; eta the
+ * ratio of the indices of refraction, as for refract): Cook and Torrance's
+ * unpolarised dielectric reflectance with c = |I.N|, g^2 = 1/eta^2 + c^2 -
+ * 1: Kr = 1/2 ((g - c)/(g + c))^2 (1 + ((c (g + c) - 1)/(c (g - c) + 1))^2),
+ * 1 where g^2 < 0 (total internal reflection); Kt = 1 - Kr; R = reflect(I,
+ * N), T = refract(I, N, eta). */
+static int gen_fresnel(cg *g, sl_node *e, const int *args)
+{
+    int I = args[0], N = args[1], eta = args[2];
+    int one = const_slot(g, 1);
+    int c = op1(g, SL_OP_ABS, gen_dot(g, I, N, 3, -1));
+    int inv = op2(g, SL_OP_DIV, one, eta);
+    int g2 = op2(g, SL_OP_SUB, op2(g, SL_OP_ADD, op2(g, SL_OP_MUL, inv, inv),
+                                   op2(g, SL_OP_MUL, c, c)), one);
+    int gg = op1(g, SL_OP_SQRT, op2(g, SL_OP_MAX, g2, const_slot(g, 0)));
+    int gpc = op2(g, SL_OP_ADD, gg, c), gmc = op2(g, SL_OP_SUB, gg, c);
+    int a = safe_div(g, gmc, gpc);
+    int b = safe_div(g, op2(g, SL_OP_SUB, op2(g, SL_OP_MUL, c, gpc), one),
+                     op2(g, SL_OP_ADD, op2(g, SL_OP_MUL, c, gmc), one));
+    int f = op2(g, SL_OP_MUL, op2(g, SL_OP_MUL, const_slot(g, 0.5), op2(g, SL_OP_MUL, a, a)),
+                op2(g, SL_OP_ADD, one, op2(g, SL_OP_MUL, b, b)));
+    int kr = gen_select(g, op2(g, SL_OP_LT, g2, const_slot(g, 0)), one, f, 1);
+    if (e->nlist == 7) {      /* before Kr and Kt: the outputs may alias I or N */
+        int r = gen_reflect(g, args, -1), t = gen_refract(g, I, N, eta, -1);
+        emit_mov(g, args[5], r, 3);
+        emit_mov(g, args[6], t, 3);
+    }
+    emit(g, SL_OP_MOV, args[3], kr, 0, 0);
+    emit(g, SL_OP_SUB, args[4], one, kr, 0);
+    return 0;
+}
+
+/* depth(P): z of P in camera space, (z - near) / (far - near), through the
+ * VM's depth pseudo-space (sl_vm_set_clipping). */
+static int gen_depth(cg *g, int p, int dst)
+{
+    int m = alloc_slots(g, 16);
+    emit(g, SL_OP_SPACEK, m, SL_SPACE_DEPTH, SL_SPACE_TO_CURRENT, 0);
+    int z = alloc_slots(g, 3);
+    emit(g, SL_OP_XPOINT, z, m, p, 0);
+    return into(g, z + 2, dst, 1);
+}
+
+/* filterstep(edge, x [, x1] [, "width", w] [, "filter", name]): the step
+ * box-filtered over [x - fw/2, x + fw/2], fw = w (|Du(x)| du + |Dv(x)| dv)
+ * the filter width of x, i.e. clamp((x - edge) / fw + 1/2, 0, 1); with x1,
+ * over [min(x, x1), max(x, x1)]. A zero width gives the step. */
+static int gen_filterstep(cg *g, sl_node *e, const int *args, int dst)
+{
+    int nf = 0;
+    while (nf < e->nlist && e->list[nf]->ty == SL_TYPE_FLOAT)
+        nf++;
+    int width = -1;
+    for (int i = nf; i + 1 < e->nlist; i += 2)
+        if (strcmp(e->list[i]->name, "width") == 0)
+            width = args[i + 1];
+    int edge = args[0], x = args[1];
+    int tiny = const_slot(g, 1e-12);
+    int r;
+    if (nf == 3) {
+        int lo = op2(g, SL_OP_MIN, x, args[2]), hi = op2(g, SL_OP_MAX, x, args[2]);
+        int w = op2(g, SL_OP_SUB, hi, lo);
+        if (width >= 0) {       /* widen about the middle */
+            int mid = op2(g, SL_OP_MUL, op2(g, SL_OP_ADD, lo, hi), const_slot(g, 0.5));
+            w = op2(g, SL_OP_MUL, w, width);
+            hi = op2(g, SL_OP_ADD, mid, op2(g, SL_OP_MUL, w, const_slot(g, 0.5)));
+        }
+        r = op2(g, SL_OP_DIV, op2(g, SL_OP_SUB, hi, edge), op2(g, SL_OP_MAX, w, tiny));
+    } else {
+        int du = op1(g, SL_OP_ABS, op1(g, SL_OP_DU, x));
+        int dv = op1(g, SL_OP_ABS, op1(g, SL_OP_DV, x));
+        int w = op2(g, SL_OP_ADD, op2(g, SL_OP_MUL, du, sl_global_slot(SL_G_du)),
+                    op2(g, SL_OP_MUL, dv, sl_global_slot(SL_G_dv)));
+        if (width >= 0)
+            w = op2(g, SL_OP_MUL, w, width);
+        r = op2(g, SL_OP_DIV, op2(g, SL_OP_SUB, x, edge), op2(g, SL_OP_MAX, w, tiny));
+        r = op2(g, SL_OP_ADD, r, const_slot(g, 0.5));
+    }
+    int z = target(g, dst, 1);
+    emit(g, SL_OP_CLAMP, z, r, const_slot(g, 0), const_slot(g, 1));
+    return z;
+}
+
 /* spline([basis,] t, knots): x = clamp(t, 0, 1) * segments; the segment
  * seg = min(floor(x), segments - 1) and its 4 knots are read with aload
  * (in interval/affine mode: the merge of every knot the segment range can
@@ -1405,6 +1507,10 @@ static int gen_builtin(cg *g, sl_node *e, int dst)
     case SL_LOWER_MATRIX_XFORM: return gen_matrix_xform(g, e, args, dst);
     case SL_LOWER_MCOMP: return gen_mcomp(g, args, false, dst);
     case SL_LOWER_MSETCOMP: return gen_mcomp(g, args, true, dst);
+    case SL_LOWER_REFRACT: return gen_refract(g, args[0], args[1], args[2], dst);
+    case SL_LOWER_FRESNEL: return gen_fresnel(g, e, args);
+    case SL_LOWER_DEPTH: return gen_depth(g, args[0], dst);
+    case SL_LOWER_FILTERSTEP: return gen_filterstep(g, e, args, dst);
     case SL_LOWER_SPLINE: break;     /* gen_spline */
     }
     return 0;

@@ -202,4 +202,9 @@ void sl_vm_set_fixed_lights(sl_vm *self, const sl_light_sample *samples, int cou
  * so results are a pure function of the inputs. */
 void sl_vm_set_seed(sl_vm *self, uint64_t seed);
 
+/* The camera's clipping planes (RIB Clipping), for depth(P) =
+ * (z_camera - near) / (far - near). Default near 0, far 1: depth(P) is
+ * then the camera-space z. far <= near is ignored. */
+void sl_vm_set_clipping(sl_vm *self, double near, double far);
+
 #endif

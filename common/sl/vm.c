@@ -9,6 +9,7 @@
 #include "sl/check.h"
 #include "sl/strbuf.h"
 
+#include <math.h>
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdlib.h>
@@ -37,6 +38,8 @@ static void *xcalloc(size_t n, size_t size)
     return p;
 }
 
+static void update_depth(sl_vm *self);
+
 sl_vm *sl_vm_new(const sl_limits *limits)
 {
     sl_vm *self = xcalloc(1, sizeof *self);
@@ -49,6 +52,9 @@ sl_vm *sl_vm_new(const sl_limits *limits)
         self->spaces.to_current[s] = mat4_identity();
         self->spaces.from_current[s] = mat4_identity();
     }
+    self->near = 0;
+    self->far = 1;
+    update_depth(self);
     self->f = xcalloc(SL_MAX_SLOTS, sizeof *self->f);
     self->d = xcalloc(SL_MAX_SLOTS, sizeof *self->d);
     self->i = xcalloc(SL_MAX_SLOTS, sizeof *self->i);
@@ -83,7 +89,28 @@ void sl_vm_destroy(sl_vm **self_p)
     *self_p = NULL;
 }
 
-void sl_vm_set_spaces(sl_vm *self, const sl_spaces *spaces) { self->spaces = *spaces; }
+/* current -> camera, then z -> (z - near) / (far - near) */
+static void update_depth(sl_vm *self)
+{
+    mat4 norm = mat4_mul(mat4_scale(1, 1, 1 / (self->far - self->near)),
+                         mat4_translate(0, 0, -self->near));
+    self->depth = mat4_mul(norm, self->spaces.from_current[SL_SPACE_CAMERA]);
+}
+
+void sl_vm_set_spaces(sl_vm *self, const sl_spaces *spaces)
+{
+    self->spaces = *spaces;
+    update_depth(self);
+}
+
+void sl_vm_set_clipping(sl_vm *self, double near, double far)
+{
+    if (!(far > near) || !isfinite(far) || !isfinite(near))
+        return;
+    self->near = near;
+    self->far = far;
+    update_depth(self);
+}
 
 void sl_vm_set_lights(sl_vm *self, sl_light_fn fn, void *user)
 {
@@ -230,6 +257,8 @@ sl_status sl_vm_fail(sl_vm *vm, sl_status st, const char *fmt, ...)
 
 const mat4 *sl_vm_space_id(const sl_vm *vm, int space, int dir)
 {
+    if (space == SL_SPACE_DEPTH)
+        return &vm->depth;
     if (space < 0 || space >= SL_SPACE__COUNT)
         return NULL;
     return dir == SL_SPACE_TO_CURRENT ? &vm->spaces.to_current[space]

@@ -77,6 +77,8 @@ typedef struct vm_accumulator {
 struct sl_vm {
     sl_limits limits;
     sl_spaces spaces;
+    double near, far;             /* clipping planes, for depth() */
+    mat4 depth;                   /* current -> camera, z to depth */
     sl_light_fn light_fn;
     void *light_user;
     sl_light_sample fixed_lights[SL_VM_MAX_LIGHTS];

@@ -752,6 +752,127 @@ static void ref_matrix_comp(double u, double v, double o[3])
     o[2] = 2 + 3;    /* object -> current: scale 2, then translate (1, 2, 3) */
 }
 
+static void normalize3(double v[3])
+{
+    double l = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+    for (int k = 0; k < 3; k++)
+        v[k] /= l;
+}
+
+/* Snell's law: T = eta I + (eta c1 - c2) N, c1 = -I.N, c2 = cos of the
+ * refracted angle; none (0) past the critical angle */
+static void snell(const double I[3], const double N[3], double eta, double T[3])
+{
+    double c1 = -(I[0] * N[0] + I[1] * N[1] + I[2] * N[2]);
+    double s2 = eta * eta * (1 - c1 * c1);
+    for (int k = 0; k < 3; k++)
+        T[k] = s2 > 1 ? 0 : eta * I[k] + (eta * c1 - sqrt(1 - s2)) * N[k];
+}
+
+static void ref_geom_refract(double u, double v, double o[3])
+{
+    double I1[3] = { u - 0.5, v - 0.5, -1 }, I2[3] = { 3 * u - 1.5, 0.5, -1 };
+    double N[3] = { 0, 0, 1 }, a[3], b[3];
+    normalize3(I1);
+    normalize3(I2);
+    snell(I1, N, 1 / 1.5, a);
+    snell(I2, N, 1.5, b);
+    o[0] = a[0] + a[2]; o[1] = a[1]; o[2] = b[0] + b[2];
+}
+
+/* unpolarised Fresnel reflectance from the s and p amplitudes; n = n2/n1 */
+static double fresnel_sp(double c, double n)
+{
+    double sin_t2 = (1 - c * c) / (n * n);
+    if (sin_t2 > 1)
+        return 1;
+    double ct = sqrt(1 - sin_t2);
+    double rs = (c - n * ct) / (c + n * ct), rp = (n * c - ct) / (n * c + ct);
+    return (rs * rs + rp * rp) / 2;
+}
+
+static void ref_geom_fresnel(double u, double v, double o[3])
+{
+    double N[3] = { 0, 0, 1 }, V[3] = { u - 0.5, 0.3 * v, -1 }, T[3], R[3];
+    double V2[3] = { 2 * v - 1, 0.2, -0.5 };
+    normalize3(V);
+    normalize3(V2);
+    double kr = fresnel_sp(fabs(V[2]), 1.5);
+    for (int k = 0; k < 3; k++)
+        R[k] = V[k] - 2 * V[2] * N[k];
+    snell(V, N, 1 / 1.5, T);
+    double kr2 = fresnel_sp(fabs(V2[2]), 1 / 1.5);
+    o[0] = kr + T[0]; o[1] = 1 - kr + R[2] + T[1]; o[2] = kr2 + (1 - kr2) * 0.5;
+}
+
+static void ref_geom_faceforward_reflect(double u, double v, double o[3])
+{
+    double V[3] = { u - 0.5, v - 0.3, 0.25 - u * v };
+    double nf = V[2] < 0 ? 1 : -1;                   /* z of faceforward(N, V, N) */
+    normalize3(V);
+    double R[3] = { V[0], V[1], V[2] - 2 * V[2] * nf * nf };
+    o[0] = R[0]; o[1] = R[1] + nf; o[2] = R[2] - 1;  /* I . Ng > 0: -(0, 1, 0) */
+}
+
+static double rnd(double x) { return x < 0 ? -floor(-x + 0.5) : floor(x + 0.5); }
+static void ref_math_round_sign(double u, double v, double o[3])
+{
+    double x = 6 * u - 3, q[3] = { x, 4 * v - 2, x * v };
+    double r[3];
+    for (int k = 0; k < 3; k++)
+        r[k] = rnd(q[k]) + sgn(q[k]) * 10;
+    o[0] = r[0] + 1 / sqrt(1 + u * u);
+    o[1] = r[1] + fabs(q[2]);
+    o[2] = r[2] + floor(q[0]) + ceil(q[0]);
+}
+
+/* Clipping 0.5 10.5, camera = current */
+static double depth_of(double z) { return (z - 0.5) / 10; }
+static void ref_depth_clip(double u, double v, double o[3])
+{
+    o[0] = depth_of(4 * u + 1); o[1] = depth_of(10 * v); o[2] = depth_of(1);
+}
+
+static void ref_filterstep_box(double u, double v, double o[3])
+{
+    /* the harness sets no du, dv: the point's filter width is 0 */
+    double a = u < 0.5 ? 0 : 1;
+    double b = clampd((u + 0.05 - 0.5) / 0.1, 0, 1);
+    double c = clampd((v + 0.05 + 0.1 - 0.3) / 0.2, 0, 1);
+    double d = clampd((v + 0.1 - 0.6) / 0.1, 0, 1);
+    o[0] = a + b; o[1] = c; o[2] = d;
+}
+
+static void ref_noise_float_forms(double u, double v, double o[3])
+{
+    double q[4] = { 3 * u, 3 * v, 0, 2 * v }, x5 = 5 * u, xy[2] = { 3 * u, 3 * v };
+    int p4 = 4, p23[2] = { 2, 3 }, p444[3] = { 4, 4, 4 }, p2223[4] = { 2, 2, 2, 3 };
+    o[0] = noise1(5 * u) + sl_noise(2, xy) + sl_noise(3, q) + sl_noise(4, q);
+    o[1] = sl_pnoise(1, &x5, &p4) + sl_pnoise(2, xy, p23) + sl_pnoise(3, q, p444) +
+           sl_pnoise(4, q, p2223);
+    double c1 = 4 * u, c2[2] = { 4 * u, 4 * v }, c4[4] = { 3 * u, 3 * v, 0, 4 * v };
+    o[2] = sl_cellnoise(1, &c1) + sl_cellnoise(2, c2) + sl_cellnoise(3, q) +
+           sl_cellnoise(4, c4);
+}
+
+static void ref_noise_triple_forms(double u, double v, double o[3])
+{
+    double q[4] = { 2 * u, 2 * v, 1, v }, st[2] = { 4 * u, 4 * v }, s7 = 7 * u;
+    double c1[3], c2[3], v1[3], v2[3], p[3], w1[3], w2[3];
+    int p444[3] = { 4, 4, 4 }, p33[2] = { 3, 3 };
+    double q2[3] = { 4 * u, 4 * v, 2 }, st3[2] = { 3 * u, 3 * v };
+    sl_vnoise(3, q, c1);
+    sl_vnoise(2, st, c2);
+    sl_vnoise(4, q, v1);
+    sl_vnoise(1, &s7, v2);
+    sl_vpnoise(3, q, p444, p);
+    sl_vcellnoise(3, q2, w1);
+    sl_vpnoise(2, st3, p33, w2);
+    o[0] = c1[0] + c2[0] + v1[0] + v2[0];
+    o[1] = v1[1] + v2[1] + p[1];
+    o[2] = w1[2] + w2[2] + p[2];
+}
+
 /* ---------------------------------------------------------------------- */
 /* the cases                                                               */
 /* ---------------------------------------------------------------------- */
@@ -835,6 +956,14 @@ static const conf_case cases[] = {
     CASE(matrix_determinant, "matrices"),
     CASE(matrix_build, "matrices"),
     CASE(matrix_comp, "matrices"),
+    CASE(geom_refract, "shading geometry"),
+    CASE(geom_fresnel, "shading geometry"),
+    CASE(geom_faceforward_reflect, "shading geometry"),
+    CASE(math_round_sign, "math"),
+    CASE(depth_clip, "depth"),
+    CASE(filterstep_box, "filterstep"),
+    CASE(noise_float_forms, "noise family"),
+    CASE(noise_triple_forms, "noise family"),
 };
 #undef CASE
 #undef CASE_NO_DUAL
@@ -916,6 +1045,11 @@ static const conf_error errors[] = {
       "\"hsv\", \"hsl\", \"xyz\", \"XYZ\", \"xyY\", \"YIQ\")\n"
       "    color c = ctransform(\"cmyk\", Cs);\n"
       "                         ^\n" },
+    { "errors/filterstep_param.sl",
+      "errors/filterstep_param.sl:4:29: error: unknown filterstep() parameter 'blur' "
+      "(known: \"width\" with a float, \"filter\" with a name)\n"
+      "    P += filterstep(0.5, s, \"blur\", 0.1) * N;\n"
+      "                            ^\n" },
 };
 
 /* ---------------------------------------------------------------------- */
@@ -1121,6 +1255,7 @@ static void test_conformance(void **state)
     sp.to_current[SL_SPACE_OBJECT] = mat4_mul(mat4_translate(1, 2, 3), mat4_scale(2, 2, 2));
     mat4_invert(&sp.to_current[SL_SPACE_OBJECT], &sp.from_current[SL_SPACE_OBJECT]);
     sl_vm_set_spaces(vm, &sp);
+    sl_vm_set_clipping(vm, 0.5, 10.5);
     const char *features[64];
     int nfeatures = 0;
     size_t ncases = sizeof cases / sizeof cases[0];
