@@ -118,6 +118,11 @@ static const sl_builtin table[] = {
     LW("diffuse", "c:n", LIGHT, DIFFUSE, 0),
     LW("specular", "c:nvf", LIGHT, SPECULAR, 0),
     LW("phong", "c:nvf", LIGHT, PHONG, 0),
+    /* the parts of an illuminance loop (parser.c builds the calls; their
+     * names cannot be written in a source) */
+    LW("illuminance start", "0:p", ILLUMINANCE, LSTART, 0),
+    LW("illuminance next", "f:", ILLUMINANCE, LNEXT, 0),
+    LW("illuminance cone", "f:vf", ILLUMINANCE, END, 0),
     /* spline (§15.1): variadic, checked by check_spline */
     LW("spline", "A:", SPLINE, END, 0),
 };

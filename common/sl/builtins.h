@@ -46,6 +46,8 @@ typedef enum sl_lowering {
     SL_LOWER_MSETCOMP,    /* setcomp(m, row, col, v) */
     SL_LOWER_REFRACT, SL_LOWER_FRESNEL, SL_LOWER_DEPTH,
     SL_LOWER_FILTERSTEP,  /* filterstep(edge, x [, x1] [, "width", w] [, "filter", f]) */
+    SL_LOWER_ILLUMINANCE, /* the parts of an illuminance loop (parser.c):
+                             op LSTART / LNEXT, or END: the cone test */
     SL_LOWER_SPLINE,      /* spline([basis,] t, knots... | knots[]): checked
                              apart (variadic); node op = the basis index */
 } sl_lowering;

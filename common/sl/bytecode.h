@@ -84,7 +84,8 @@ enum {
     X(LOOP_TEST, "loop.test", "xjt-") X(LOOP_END, "loop.end", "kt--") \
     X(PARAM, "param", "zpjx") X(SPARAM, "sparam", "spjs")        \
     X(ESCAPE, "escape", "zktk") X(ACCUM_END, "accum.end", "kt-k") \
-    X(ALOAD, "aload", "zxxk") X(ASTORE, "astore", "zxxk")
+    X(ALOAD, "aload", "zxxk") X(ASTORE, "astore", "zxxk")        \
+    X(LSTART, "lstart", "----") X(LNEXT, "lnext", "z---")
 
 typedef enum sl_opcode {
 #define SL_OPCODE_ENUM(name, text, operands) SL_OP_##name,
@@ -139,6 +140,10 @@ enum {
  * dropped at BR_END. LOOP_END (loops) and ACCUM_END (functions) merge the
  * accumulator back. */
 enum { SL_ESCAPE_LOOP = 0, SL_ESCAPE_FUNC = 1 };
+
+/* illuminance loops (RI Spec 3.2 §15.4): LSTART takes the non-ambient
+ * light samples of this mode at P; each LNEXT z loads the next one into the
+ * globals L and Cl and sets z to 1, or sets z to 0 after the last. */
 
 /* NOISE variant (operand c): dimension in bits 0-2, kind in bits 3-4,
  * three outputs (point/vector/color noise) in bit 5. */

@@ -1355,6 +1355,33 @@ static int gen_filterstep(cg *g, sl_node *e, const int *args, int dst)
     return z;
 }
 
+/* The parts of an illuminance loop (parser.c): start, next (loads L and
+ * Cl: they are written by the loop), and the cone test of
+ * illuminance(P, axis, angle): L . axis >= cos(angle) |L| |axis|. */
+static int gen_illuminance(cg *g, sl_node *e, const int *args, int dst)
+{
+    sl_opcode op = e->builtin->op;
+    if (op == SL_OP_LSTART) {
+        emit(g, SL_OP_LSTART, 0, 0, 0, 0);
+        return 0;
+    }
+    int L = sl_global_slot(SL_G_L);
+    if (op == SL_OP_LNEXT) {
+        int z = target(g, dst, 1);
+        emit(g, SL_OP_LNEXT, z, 0, 0, 0);
+        record_write(g, L, 3);
+        record_write(g, sl_global_slot(SL_G_Cl), 3);
+        return z;
+    }
+    int d = gen_dot(g, L, args[0], 3, -1);
+    int ll = op1(g, SL_OP_SQRT, gen_dot(g, L, L, 3, -1));
+    int la = op1(g, SL_OP_SQRT, gen_dot(g, args[0], args[0], 3, -1));
+    int r = op2(g, SL_OP_MUL, op2(g, SL_OP_MUL, op1(g, SL_OP_COS, args[1]), ll), la);
+    int z = target(g, dst, 1);
+    emit(g, SL_OP_GE, z, d, r, 0);
+    return z;
+}
+
 /* spline([basis,] t, knots): x = clamp(t, 0, 1) * segments; the segment
  * seg = min(floor(x), segments - 1) and its 4 knots are read with aload
  * (in interval/affine mode: the merge of every knot the segment range can
@@ -1511,6 +1538,7 @@ static int gen_builtin(cg *g, sl_node *e, int dst)
     case SL_LOWER_FRESNEL: return gen_fresnel(g, e, args);
     case SL_LOWER_DEPTH: return gen_depth(g, args[0], dst);
     case SL_LOWER_FILTERSTEP: return gen_filterstep(g, e, args, dst);
+    case SL_LOWER_ILLUMINANCE: return gen_illuminance(g, e, args, dst);
     case SL_LOWER_SPLINE: break;     /* gen_spline */
     }
     return 0;

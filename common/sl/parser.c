@@ -811,6 +811,67 @@ static sl_node *return_statement(parser *p)
     return n;
 }
 
+/* illuminance ([category,] position [, axis, angle]) statement (RI Spec 3.2
+ * §15.4) becomes
+ *   { "illuminance start"(position);
+ *     while ("illuminance next"())          (loads L and Cl, 0 at the end)
+ *         if ("illuminance cone"(axis, angle)) statement }
+ * (no `if` without a cone), so break, continue and the range modes' loop
+ * handling work as for any loop. The category (a string) is accepted and
+ * matches every light. */
+static sl_node *illuminance_statement(parser *p)
+{
+    sl_token kw = p->cur;
+    advance(p);
+    sl_token open = p->cur;
+    sl_node *args = sl_node_new(p->arena, SL_N_CALL, kw.pos);
+    int cap = 0;
+    if (!expect(p, SL_TOK_LPAREN, "after 'illuminance'"))
+        return NULL;
+    do {
+        push_node(p, args, &cap, expression(p));
+    } while (!p->panic && match(p, SL_TOK_COMMA));
+    if (!expect_closing(p, SL_TOK_RPAREN, &open))
+        return NULL;
+    int first = args->nlist > 0 && args->list[0]->kind == SL_N_STR ? 1 : 0;
+    int n = args->nlist - first;
+    if (n != 1 && n != 3) {
+        error_at(p, kw.pos, &kw, "illuminance takes [category,] position [, axis, angle], "
+                                 "not %d values", args->nlist);
+        return NULL;
+    }
+    sl_node *body = statement(p);
+    if (!body)
+        return NULL;
+    sl_node *start = sl_node_new(p->arena, SL_N_CALL, kw.pos);
+    start->name = "illuminance start";
+    int c1 = 0;
+    push_node(p, start, &c1, args->list[first]);
+    sl_node *start_stmt = sl_node_new(p->arena, SL_N_EXPR, kw.pos);
+    start_stmt->a = start;
+    sl_node *next = sl_node_new(p->arena, SL_N_CALL, kw.pos);
+    next->name = "illuminance next";
+    sl_node *loop = sl_node_new(p->arena, SL_N_WHILE, kw.pos);
+    loop->a = next;
+    loop->b = body;
+    if (n == 3) {
+        sl_node *cone = sl_node_new(p->arena, SL_N_CALL, kw.pos);
+        cone->name = "illuminance cone";
+        int c2 = 0;
+        push_node(p, cone, &c2, args->list[first + 1]);
+        push_node(p, cone, &c2, args->list[first + 2]);
+        sl_node *test = sl_node_new(p->arena, SL_N_IF, kw.pos);
+        test->a = cone;
+        test->b = body;
+        loop->b = test;
+    }
+    sl_node *b = sl_node_new(p->arena, SL_N_BLOCK, kw.pos);
+    int c3 = 0;
+    push_node(p, b, &c3, start_stmt);
+    push_node(p, b, &c3, loop);
+    return b;
+}
+
 static sl_node *unsupported(parser *p, const char *message)
 {
     error_at(p, p->cur.pos, &p->cur, "%s", message);
@@ -832,9 +893,10 @@ static sl_node *statement_inner(parser *p)
         advance(p);
         return n;
     }
-    case SL_KW_ILLUMINANCE: case SL_KW_ILLUMINATE: case SL_KW_SOLAR:
-        return unsupported(p, "light loops are not supported (use ambient(), "
-                              "diffuse(), specular() or phong())");
+    case SL_KW_ILLUMINANCE: return illuminance_statement(p);
+    case SL_KW_ILLUMINATE: case SL_KW_SOLAR:
+        return unsupported(p, "'illuminate' and 'solar' belong in light shaders, which are "
+                              "not supported (the renderer's lights are used)");
     default: break;
     }
     if (is_qualifier(p->cur.kind) ||

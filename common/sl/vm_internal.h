@@ -82,6 +82,8 @@ struct sl_vm {
     sl_light_fn light_fn;
     void *light_user;
     sl_light_sample fixed_lights[SL_VM_MAX_LIGHTS];
+    sl_light_sample illum[SL_VM_MAX_LIGHTS];   /* the illuminance loop's lights */
+    int nillum, illum_next;
     int nfixed_lights;
     uint64_t seed;
 

@@ -1053,6 +1053,125 @@ static const conf_error errors[] = {
 };
 
 /* ---------------------------------------------------------------------- */
+/* surface shaders: illuminance loops                                      */
+/* ---------------------------------------------------------------------- */
+
+/* Surface shaders run on the unit sphere with I = (0, 0, 1) under these
+ * fixed lights (three distant ones and an ambient one); Ci and Oi are
+ * checked. */
+static const sl_light_sample surface_lights[] = {
+    { { 0.3, 0.2, -1 }, { 1, 0.8, 0.6 }, false },
+    { { -0.5, 0.1, 0.4 }, { 0.2, 0.3, 1 }, false },
+    { { 0.6, -0.7, 0.2 }, { 0.5, 0.5, 0.2 }, false },
+    { { 0, 0, 0 }, { 0.05, 0.05, 0.05 }, true },
+};
+enum { NSURFACE_LIGHTS = sizeof surface_lights / sizeof surface_lights[0] };
+
+static double dot3(const double a[3], const double b[3])
+{
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+/* faceforward(normalize(N), I) with I = (0, 0, 1), Ng = N */
+static void facing(const double N[3], double Nf[3])
+{
+    double Nn[3] = { N[0], N[1], N[2] };
+    normalize3(Nn);
+    for (int k = 0; k < 3; k++)
+        Nf[k] = N[2] < 0 ? Nn[k] : -Nn[k];
+}
+
+static void ref_surface_illuminance_diffuse(const double N[3], double Ci[3], double Oi[3])
+{
+    double Nf[3];
+    facing(N, Nf);
+    for (int k = 0; k < 3; k++)
+        Ci[k] = Oi[k] = 0;
+    for (int i = 0; i < NSURFACE_LIGHTS; i++) {
+        const sl_light_sample *l = &surface_lights[i];
+        if (l->ambient)
+            continue;
+        double Ln[3] = { l->L[0], l->L[1], l->L[2] };
+        normalize3(Ln);
+        double d = dot3(Ln, Nf);
+        for (int k = 0; k < 3; k++) {
+            Ci[k] += d >= 0 ? 0.8 * l->Cl[k] * d : 0;
+            Oi[k] += 0.8 * l->Cl[k] * (d > 0 ? d : 0);
+        }
+    }
+}
+
+static void ref_surface_illuminance_specular(const double N[3], double Ci[3], double Oi[3])
+{
+    double Nf[3], V[3] = { 0, 0, -1 };
+    facing(N, Nf);
+    for (int k = 0; k < 3; k++)
+        Ci[k] = Oi[k] = 0;
+    for (int i = 0; i < NSURFACE_LIGHTS; i++) {
+        const sl_light_sample *l = &surface_lights[i];
+        if (l->ambient)
+            continue;
+        double Ln[3] = { l->L[0], l->L[1], l->L[2] }, H[3];
+        normalize3(Ln);
+        for (int k = 0; k < 3; k++)
+            H[k] = Ln[k] + V[k];
+        normalize3(H);
+        double c = dot3(Nf, H), lobe = pow(c > 0 ? c : 0, 4);
+        for (int k = 0; k < 3; k++) {
+            Ci[k] += dot3(Ln, Nf) >= 0 ? l->Cl[k] * lobe : 0;
+            Oi[k] += l->Cl[k] * lobe;       /* specular(): every light */
+        }
+    }
+}
+
+static void ref_surface_illuminance_category(const double N[3], double Ci[3], double Oi[3])
+{
+    double Nf[3];
+    facing(N, Nf);
+    for (int k = 0; k < 3; k++)
+        Ci[k] = 0;
+    for (int i = 0; i < NSURFACE_LIGHTS; i++)
+        if (!surface_lights[i].ambient && dot3(surface_lights[i].L, Nf) >= 0)
+            for (int k = 0; k < 3; k++)
+                Ci[k] += 0.5 * surface_lights[i].Cl[k];
+    Oi[0] = 3; Oi[1] = 0; Oi[2] = 0;
+}
+
+static void ref_surface_illuminance_helper(const double N[3], double Ci[3], double Oi[3])
+{
+    double Nf[3];
+    facing(N, Nf);
+    for (int k = 0; k < 3; k++)
+        Ci[k] = Oi[k] = 0;
+    for (int i = 0; i < NSURFACE_LIGHTS; i++) {
+        const sl_light_sample *l = &surface_lights[i];
+        if (l->ambient)
+            continue;
+        double Ln[3] = { l->L[0], l->L[1], l->L[2] };
+        normalize3(Ln);
+        double d = dot3(Ln, Nf), w = (d + 0.3) / 1.3;
+        for (int k = 0; k < 3; k++) {
+            Ci[k] += l->Cl[k] * (w > 0 ? w : 0);
+            Oi[k] += -d >= cos(M_PI / 3) ? l->Cl[k] : 0;   /* the cone about -Nf */
+        }
+    }
+}
+
+typedef struct surface_case {
+    const char *file;
+    void (*ref)(const double N[3], double Ci[3], double Oi[3]);
+} surface_case;
+
+#define SURFACE(name) { #name ".sl", ref_##name }
+static const surface_case surface_cases[] = {
+    SURFACE(surface_illuminance_diffuse),
+    SURFACE(surface_illuminance_specular),
+    SURFACE(surface_illuminance_category),
+    SURFACE(surface_illuminance_helper),
+};
+#undef SURFACE
+
+/* ---------------------------------------------------------------------- */
 /* running                                                                 */
 /* ---------------------------------------------------------------------- */
 
@@ -1242,6 +1361,129 @@ static void check_ranges(const conf_case *cc, sl_vm *vm, const sl_instance *inst
     }
 }
 
+/* A surface shader on the sphere: Ci and Oi in float mode at 7x7 points
+ * against the reference; interval and affine enclosures over 12 random
+ * boxes contain the float values at 4x4 points of each. */
+static void check_surface(const surface_case *sc, sl_vm *vm, const sl_instance *inst,
+                          tally *t, unsigned long long *rng)
+{
+    for (int i = 0; i < 7; i++) {
+        for (int j = 0; j < 7; j++) {
+            double u = 0.05 + 0.9 * (i + 0.31) / 7, v = 0.05 + 0.9 * (j + 0.57) / 7;
+            double P[3], N[3], du[3], dv[3], C[6], want[6];
+            h_surface_float(H_SPHERE, u, v, P, N, du, dv);
+            sc->ref(N, want, want + 3);
+            h_globals_float(vm, H_SPHERE, u, v);
+            t->floats++;
+            bool ok = sl_vm_run(vm, inst, SL_MODE_FLOAT, NULL) == SL_OK;
+            if (ok) {
+                sl_vm_get_float(vm, SL_G_Ci, C);
+                sl_vm_get_float(vm, SL_G_Oi, C + 3);
+            }
+            for (int k = 0; ok && k < 6; k++)
+                ok = close_to(C[k], want[k]);
+            if (!ok) {
+                t->failures++;
+                fprintf(stderr, "%s: at (u, v) = (%.17g, %.17g): Ci, Oi = (%g %g %g, %g %g "
+                                "%g), want (%g %g %g, %g %g %g)\n", sc->file, u, v, C[0], C[1],
+                        C[2], C[3], C[4], C[5], want[0], want[1], want[2], want[3], want[4],
+                        want[5]);
+            }
+        }
+    }
+    aa_context ctx;
+    aa_context_init(&ctx, AA_DEFAULT_CAPACITY);
+    for (int r = 0; r < 12; r++) {
+        double side = ldexp(1, -2 - (int)(h_rand(rng) * 5));
+        double u0 = 0.02 + h_rand(rng) * (0.96 - side), v0 = 0.02 + h_rand(rng) * (0.96 - side);
+        double u1 = u0 + side, v1 = v0 + side;
+        ia_interval I[6], A[6];
+        aa_form a[6];
+        t->ranges++;
+        h_globals_interval(vm, H_SPHERE, u0, u1, v0, v1);
+        sl_status st = sl_vm_run(vm, inst, SL_MODE_INTERVAL, NULL);
+        if (st == SL_OK) {
+            sl_vm_get_interval(vm, SL_G_Ci, I);
+            sl_vm_get_interval(vm, SL_G_Oi, I + 3);
+            h_globals_affine(vm, &ctx, H_SPHERE, u0, u1, v0, v1);
+            st = sl_vm_run(vm, inst, SL_MODE_AFFINE, &ctx);
+        }
+        if (st != SL_OK) {
+            t->failures++;
+            fprintf(stderr, "%s: %s\n", sc->file, sl_vm_error(vm));
+            continue;
+        }
+        sl_vm_get_affine(vm, SL_G_Ci, a);
+        sl_vm_get_affine(vm, SL_G_Oi, a + 3);
+        bool bounded = true;
+        for (int k = 0; k < 6; k++) {
+            A[k] = aa_range(&a[k]);
+            bounded &= isfinite(A[k].lo) && isfinite(A[k].hi) && isfinite(I[k].lo) &&
+                       isfinite(I[k].hi);
+        }
+        t->bounded += bounded;
+        if (!bounded)
+            fprintf(stderr, "%s: box [%g, %g] x [%g, %g]: unbounded\n", sc->file, u0, u1,
+                    v0, v1);
+        for (int i = 0; i < 4; i++) {
+            for (int j = 0; j < 4; j++) {
+                double u = u0 + (u1 - u0) * i / 3, v = v0 + (v1 - v0) * j / 3, C[6];
+                t->samples++;
+                h_globals_float(vm, H_SPHERE, u, v);
+                bool ok = sl_vm_run(vm, inst, SL_MODE_FLOAT, NULL) == SL_OK;
+                if (ok) {
+                    sl_vm_get_float(vm, SL_G_Ci, C);
+                    sl_vm_get_float(vm, SL_G_Oi, C + 3);
+                }
+                for (int k = 0; ok && k < 6; k++)
+                    ok = inside(I[k], C[k]) && inside(A[k], C[k]);
+                if (!ok) {
+                    t->failures++;
+                    fprintf(stderr, "%s: box [%g, %g] x [%g, %g]: sample (%g, %g) outside\n",
+                            sc->file, u0, u1, v0, v1, u, v);
+                }
+            }
+        }
+    }
+}
+
+/* The same lights from the renderer's callback: float mode agrees with the
+ * fixed lights; interval mode cannot bound them and says so. */
+static int callback_lights(void *user, const double P[3], sl_light_sample *out, int max)
+{
+    (void)user;
+    (void)P;
+    int n = NSURFACE_LIGHTS < max ? NSURFACE_LIGHTS : max;
+    memcpy(out, surface_lights, (size_t)n * sizeof *out);
+    return n;
+}
+
+static void check_light_callback(const sl_instance *inst, sl_vm *fixed, tally *t)
+{
+    sl_vm *vm = sl_vm_new(NULL);
+    sl_vm_set_lights(vm, callback_lights, NULL);
+    double a[3], b[3];
+    h_globals_float(vm, H_SPHERE, 0.3, 0.7);
+    h_globals_float(fixed, H_SPHERE, 0.3, 0.7);
+    t->floats++;
+    bool ok = sl_vm_run(vm, inst, SL_MODE_FLOAT, NULL) == SL_OK &&
+              sl_vm_run(fixed, inst, SL_MODE_FLOAT, NULL) == SL_OK;
+    if (ok) {
+        sl_vm_get_float(vm, SL_G_Ci, a);
+        sl_vm_get_float(fixed, SL_G_Ci, b);
+        for (int k = 0; k < 3; k++)
+            ok &= close_to(a[k], b[k]);
+    }
+    h_globals_interval(vm, H_SPHERE, 0.3, 0.31, 0.7, 0.71);
+    ok &= sl_vm_run(vm, inst, SL_MODE_INTERVAL, NULL) == SL_ERR_RUNTIME &&
+          strstr(sl_vm_error(vm), "illuminance at") != NULL;
+    if (!ok) {
+        t->failures++;
+        fprintf(stderr, "illuminance with a light callback: %s\n", sl_vm_error(vm));
+    }
+    sl_vm_destroy(&vm);
+}
+
 static void test_conformance(void **state)
 {
     (void)state;
@@ -1281,6 +1523,27 @@ static void test_conformance(void **state)
         sl_instance_destroy(&inst);
         sl_program_destroy(&p);
     }
+    size_t nsurfaces = sizeof surface_cases / sizeof surface_cases[0];
+    sl_vm_set_fixed_lights(vm, surface_lights, NSURFACE_LIGHTS);
+    if (nfeatures < 64)
+        features[nfeatures++] = "illuminance (surface shaders)";
+    for (size_t c = 0; c < nsurfaces; c++) {
+        char *diag = NULL;
+        sl_program *p = compile_file(surface_cases[c].file, &diag);
+        if (!p || diag[0]) {
+            t.failures++;
+            fprintf(stderr, "%s: does not compile cleanly:\n%s", surface_cases[c].file, diag);
+        }
+        free(diag);
+        if (!p)
+            continue;
+        sl_instance *inst = sl_instance_new(p);
+        check_surface(&surface_cases[c], vm, inst, &t, &rng);
+        if (c == 0)
+            check_light_callback(inst, vm, &t);
+        sl_instance_destroy(&inst);
+        sl_program_destroy(&p);
+    }
     size_t nerrors = sizeof errors / sizeof errors[0];
     for (size_t e = 0; e < nerrors; e++) {
         char *diag = NULL;
@@ -1294,7 +1557,8 @@ static void test_conformance(void **state)
         free(diag);
     }
     sl_vm_destroy(&vm);
-    printf("conformance: %zu shaders and %zu error cases; features:", ncases, nerrors);
+    printf("conformance: %zu displacement and %zu surface shaders and %zu error cases; "
+           "features:", ncases, nsurfaces, nerrors);
     for (int f = 0; f < nfeatures; f++)
         printf("%s %s", f ? "," : "", features[f]);
     printf("\nconformance: %d float checks, %d dual checks (%d derivatives against "

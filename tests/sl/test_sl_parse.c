@@ -130,10 +130,14 @@ static void test_unsupported(void **state)
                   "'displacement')\n"
                   "light l() { }\n"
                   "^\n");
-    expect_errors("surface s() {\n    illuminance(P) { }\n}\n",
-                  "t.sl:2:5: error: light loops are not supported (use ambient(), diffuse(), "
-                  "specular() or phong())\n"
-                  "    illuminance(P) { }\n"
+    expect_errors("surface s() {\n    illuminate(P) { }\n    illuminance(P, N) { }\n}\n",
+                  "t.sl:2:5: error: 'illuminate' and 'solar' belong in light shaders, which "
+                  "are not supported (the renderer's lights are used)\n"
+                  "    illuminate(P) { }\n"
+                  "    ^\n"
+                  "t.sl:3:5: error: illuminance takes [category,] position [, axis, angle], "
+                  "not 2 values\n"
+                  "    illuminance(P, N) { }\n"
                   "    ^\n");
     expect_errors("displacement t() {\n    output float x = 1;\n    void y;\n}\n",
                   "t.sl:2:12: error: 'output' is only allowed on parameters\n"
