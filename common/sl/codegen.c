@@ -1241,8 +1241,15 @@ static int gen_mcomp(cg *g, const int *args, bool set, int dst)
         emit(g, SL_OP_MOV, slot, args[3], 0, 0);
         return 0;
     }
-    int index = op2(g, SL_OP_ADD, op2(g, SL_OP_MUL, op1(g, SL_OP_FLOOR, c), const_slot(g, 4)),
-                    op1(g, SL_OP_FLOOR, r));
+    /* a row or column outside 0..3 pushes the index past the 16 elements,
+     * where aload/astore stop the run (range modes: clamped, conservative) */
+    int fr = op1(g, SL_OP_FLOOR, r), fc = op1(g, SL_OP_FLOOR, c);
+    int bad = op2(g, SL_OP_OR, op2(g, SL_OP_OR, op2(g, SL_OP_LT, fr, const_slot(g, 0)),
+                                   op2(g, SL_OP_GT, fr, const_slot(g, 3))),
+                  op2(g, SL_OP_OR, op2(g, SL_OP_LT, fc, const_slot(g, 0)),
+                      op2(g, SL_OP_GT, fc, const_slot(g, 3))));
+    int index = op2(g, SL_OP_ADD, op2(g, SL_OP_MUL, fc, const_slot(g, 4)), fr);
+    index = op2(g, SL_OP_ADD, index, op2(g, SL_OP_MUL, bad, const_slot(g, 64)));
     if (set) {
         emit(g, SL_OP_ASTORE, m, index, args[3], array_operand(16, 1));
         record_write(g, m, 16);

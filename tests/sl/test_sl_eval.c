@@ -518,6 +518,26 @@ static void test_vm_errors_and_counts(void **state)
     assert_null(inst);
     sl_program_destroy(&p);
     assert_null(p);
+    /* a matrix row past 3 with a varying index stops the run (it would
+     * otherwise name another element); rows 0..3 read what they name */
+    p = h_compile("displacement t() {\n"
+                  "  matrix m = matrix (1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16);\n"
+                  "  float row = floor(u * 8);\n"
+                  "  P = point(comp(m, row, 1), 0, 0);\n"
+                  "}\n");
+    assert_non_null(p);
+    inst = sl_instance_new(p);
+    vm = sl_vm_new(NULL);
+    h_globals_float(vm, H_PLANE, 0.3, 0.5);          /* row 2: element (2, 1) */
+    assert_int_equal(sl_vm_run(vm, inst, SL_MODE_FLOAT, NULL), SL_OK);
+    sl_vm_get_float(vm, SL_G_P, P);
+    assert_true(P[0] == 10);
+    h_globals_float(vm, H_PLANE, 0.55, 0.5);         /* row 4 */
+    assert_int_equal(sl_vm_run(vm, inst, SL_MODE_FLOAT, NULL), SL_ERR_RUNTIME);
+    assert_non_null(strstr(sl_vm_error(vm), "array index"));
+    sl_vm_destroy(&vm);
+    sl_instance_destroy(&inst);
+    sl_program_destroy(&p);
 }
 
 static void test_dump(void **state)
