@@ -873,6 +873,62 @@ static void ref_noise_triple_forms(double u, double v, double o[3])
     o[2] = w1[2] + w2[2] + p[2];
 }
 
+static double fstep3(double e, double x0, double x1)
+{
+    double lo = fmin(x0, x1), hi = fmax(x0, x1), w = hi - lo;
+    return clampd((hi - e) / (w > 1e-12 ? w : 1e-12), 0, 1);
+}
+static double fpulse(double a, double b, double x, double w)
+{
+    return fstep3(a, x - w / 2, x + w / 2) - fstep3(b, x - w / 2, x + w / 2);
+}
+static void ref_filterstep_pulse(double u, double v, double o[3])
+{
+    o[0] = fpulse(0.3, 0.7, fmodf_(u * 4, 1), 0.08);
+    o[1] = fpulse(0.2, 0.4, v, 0.16);
+    o[2] = stepd(0.5, u) - stepd(0.8, u);
+}
+
+static void ref_matrix_det_compose(double u, double v, double o[3])
+{
+    (void)u;
+    o[0] = 2 * (1 + v) * 0.5; o[1] = 1; o[2] = 16 * (1 + v);
+}
+
+static void ref_matrix_setcomp_loop(double u, double v, double o[3])
+{
+    o[0] = 1 + u; o[1] = 4; o[2] = 1 + v;
+}
+
+static void ref_color_roundtrip(double u, double v, double o[3])
+{
+    double c[3] = { 0.2 + 0.6 * u, 0.7 - 0.5 * v, 0.3 + 0.2 * u * v }, xyz[3];
+    mat3_apply(M_xyz, c, xyz);
+    o[0] = c[0] + c[1]; o[1] = c[2] + c[1]; o[2] = xyz[1] + c[2];
+}
+
+static void ref_noise_periodic(double u, double v, double o[3])
+{
+    double x = 3 * u, x4 = 3 * u + 4;
+    int p4 = 4, p235[3] = { 2, 3, 5 }, p33[2] = { 3, 3 };
+    double q[3] = { 2 * u, 2 * v, 0 }, q2[3] = { 2 * u + 2, 2 * v + 3, 5 };
+    double a2[2] = { 2 * u, 2 * v }, b2[2] = { 2 * u + 3, 2 * v - 3 }, c1[3], c2[3];
+    sl_vpnoise(2, a2, p33, c1);
+    sl_vpnoise(2, b2, p33, c2);
+    o[0] = sl_pnoise(1, &x, &p4) - sl_pnoise(1, &x4, &p4);
+    o[1] = sl_pnoise(3, q, p235) + sl_pnoise(3, q2, p235);
+    o[2] = c1[2] - c2[2];
+}
+
+static void ref_spline_octaves(double u, double v, double o[3])
+{
+    static const double k[5] = { 0, 1 / 16.0, 4 / 16.0, 9 / 16.0, 1 };
+    double sum = 0;
+    for (int i = 0; i < 3; i++)
+        sum += spline_ref("catmull-rom", fmodf_(u * pow(2, i), 1), k, 5) / pow(2, i);
+    o[0] = sum; o[1] = spline_ref("linear", v, k, 5); o[2] = spline_ref("constant", u, k, 5);
+}
+
 /* ---------------------------------------------------------------------- */
 /* the cases                                                               */
 /* ---------------------------------------------------------------------- */
@@ -964,6 +1020,12 @@ static const conf_case cases[] = {
     CASE(filterstep_box, "filterstep"),
     CASE(noise_float_forms, "noise family"),
     CASE(noise_triple_forms, "noise family"),
+    CASE(filterstep_pulse, "filterstep"),
+    CASE(matrix_det_compose, "matrices"),
+    CASE(matrix_setcomp_loop, "matrices"),
+    CASE(color_roundtrip, "color spaces"),
+    CASE(noise_periodic, "noise family"),
+    CASE(spline_octaves, "spline"),
 };
 #undef CASE
 #undef CASE_NO_DUAL
