@@ -123,6 +123,13 @@ static const sl_builtin table[] = {
     LW("illuminance start", "0:p", ILLUMINANCE, LSTART, 0),
     LW("illuminance next", "f:", ILLUMINANCE, LNEXT, 0),
     LW("illuminance cone", "f:vf", ILLUMINANCE, END, 0),
+    /* message passing (§15.7) */
+    LW("displacement", "f:sV", MESSAGE, MESSAGE, SL_MSG_DISPLACEMENT),
+    LW("surface", "f:sV", MESSAGE, MESSAGE, SL_MSG_SURFACE),
+    LW("lightsource", "f:sV", MESSAGE, MESSAGE, SL_MSG_LIGHTSOURCE),
+    LW("attribute", "f:sV", MESSAGE, MESSAGE, SL_MSG_ATTRIBUTE),
+    LW("option", "f:sV", MESSAGE, MESSAGE, SL_MSG_OPTION),
+    LW("rendererinfo", "f:sV", MESSAGE, MESSAGE, SL_MSG_RENDERERINFO),
     /* spline (§15.1): variadic, checked by check_spline */
     LW("spline", "A:", SPLINE, END, 0),
 };
@@ -216,6 +223,13 @@ static int candidate_cost(const sl_builtin *b, const sl_ty *have, int n, sl_ty h
             want[i] = have[i];
             continue;
         }
+        if (c == 'V') {
+            if (sl_ty_is_array(have[i]) || sl_ty_is_list(have[i]) || have[i] == SL_TY_BOOL ||
+                have[i] == SL_TY_ERROR)
+                return -1;
+            want[i] = have[i];
+            continue;
+        }
         if (c == 'w') {
             if (have[i] != SL_TYPE_FLOAT)
                 return -1;
@@ -287,6 +301,7 @@ static const char *letter_name(char c)
     case 'O': case 'T': return "triple";
     case 'M': return "matrix";
     case 'w': return "float";
+    case 'V': return "variable";
     case 'G': return "float|triple";
     default: return sl_ty_name(letter_type(c));
     }

@@ -9,6 +9,7 @@
  *   0 void (result)   o an assignable variable of any spatial type
  *   O an assignable variable of any triple type
  *   M an assignable matrix variable   w an assignable float variable
+ *   V an assignable variable of any type but arrays
  *   S any spatial type (point/vector/normal)
  *   T any triple (point/vector/normal/color; all T of a call agree)
  *   G float or any triple (all G of a call agree; floats promote)
@@ -48,6 +49,7 @@ typedef enum sl_lowering {
     SL_LOWER_FILTERSTEP,  /* filterstep(edge, x [, x1] [, "width", w] [, "filter", f]) */
     SL_LOWER_ILLUMINANCE, /* the parts of an illuminance loop (parser.c):
                              op LSTART / LNEXT, or END: the cone test */
+    SL_LOWER_MESSAGE,     /* displacement("name", x) ...: k = sl_message_scope */
     SL_LOWER_SPLINE,      /* spline([basis,] t, knots... | knots[]): checked
                              apart (variadic); node op = the basis index */
 } sl_lowering;

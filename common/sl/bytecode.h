@@ -85,7 +85,8 @@ enum {
     X(PARAM, "param", "zpjx") X(SPARAM, "sparam", "spjs")        \
     X(ESCAPE, "escape", "zktk") X(ACCUM_END, "accum.end", "kt-k") \
     X(ALOAD, "aload", "zxxk") X(ASTORE, "astore", "zxxk")        \
-    X(LSTART, "lstart", "----") X(LNEXT, "lnext", "z---")
+    X(LSTART, "lstart", "----") X(LNEXT, "lnext", "z---")          \
+    X(MESSAGE, "message", "zskk")
 
 typedef enum sl_opcode {
 #define SL_OPCODE_ENUM(name, text, operands) SL_OP_##name,
@@ -140,6 +141,9 @@ enum {
  * dropped at BR_END. LOOP_END (loops) and ACCUM_END (functions) merge the
  * accumulator back. */
 enum { SL_ESCAPE_LOOP = 0, SL_ESCAPE_FUNC = 1 };
+
+/* MESSAGE flag, name, var, d (message passing, shader.h): d = scope | size
+ * << 4 (size 0: var is a string slot, else var's numeric slots). */
 
 /* illuminance loops (RI Spec 3.2 §15.4): LSTART takes the non-ambient
  * light samples of this mode at P; each LNEXT z loads the next one into the

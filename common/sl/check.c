@@ -634,7 +634,8 @@ static sl_ty check_builtin_call(checker *c, sl_node *n, const sl_ty *args, sl_ty
     n->builtin = b;
     const char *sig = b->sig + 2;
     for (int i = 0; i < n->nlist; i++) {
-        if (sig[i] == 'o' || sig[i] == 'O' || sig[i] == 'M' || sig[i] == 'w') {
+        if (sig[i] == 'o' || sig[i] == 'O' || sig[i] == 'M' || sig[i] == 'w' ||
+            sig[i] == 'V') {
             sl_node *a = n->list[i];
             if (a->kind != SL_N_IDENT)
                 error(c, a->pos, "argument %d of '%s' must be a variable", i + 1, n->name);
@@ -644,6 +645,10 @@ static sl_ty check_builtin_call(checker *c, sl_node *n, const sl_ty *args, sl_ty
         }
         if (sig[i] == 's' && b->lower == SL_LOWER_FILTERSTEP) {
             check_filter_param(c, n, i);
+            continue;
+        }
+        if (sig[i] == 's' && b->lower == SL_LOWER_MESSAGE) {
+            wrap_conv(c, &n->list[i], want[i]);
             continue;
         }
         if (sig[i] == 's' && b->lower == SL_LOWER_CTRANSFORM)

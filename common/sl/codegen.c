@@ -1546,6 +1546,17 @@ static int gen_builtin(cg *g, sl_node *e, int dst)
     case SL_LOWER_DEPTH: return gen_depth(g, args[0], dst);
     case SL_LOWER_FILTERSTEP: return gen_filterstep(g, e, args, dst);
     case SL_LOWER_ILLUMINANCE: return gen_illuminance(g, e, args, dst);
+    case SL_LOWER_MESSAGE: {
+        bool str = e->list[1]->ty == SL_TYPE_STRING;
+        int size = str ? 0 : size_of(e->list[1]);
+        int z = target(g, dst, 1);
+        emit(g, SL_OP_MESSAGE, z, args[0], args[1], (int)b->k | size << 4);
+        if (str)
+            record_string_write(g, args[1]);
+        else
+            record_write(g, args[1], size);
+        return z;
+    }
     case SL_LOWER_SPLINE: break;     /* gen_spline */
     }
     return 0;

@@ -265,6 +265,12 @@ static sl_node *primary(parser *p)
         }
         return n;
     }
+    case SL_KW_DISPLACEMENT: case SL_KW_SURFACE:
+        if (peek_kind(p, 0) == SL_TOK_LPAREN) {   /* message passing: a call */
+            advance(p);
+            return call(p, t);
+        }
+        break;
     case SL_TOK_LPAREN: {
         advance(p);
         sl_node *e = expression(p);
@@ -281,9 +287,10 @@ static sl_node *primary(parser *p)
         return e;
     }
     default:
-        error_at(p, t.pos, &t, "expected expression");
-        return error_node(p, t.pos);
+        break;
     }
+    error_at(p, t.pos, &t, "expected expression");
+    return error_node(p, t.pos);
 }
 
 /* type [STRING] ( '(' list ')' | unary ): a cast or a constructor. */

@@ -55,6 +55,7 @@ sl_vm *sl_vm_new(const sl_limits *limits)
     self->near = 0;
     self->far = 1;
     update_depth(self);
+    sl_vm_set_message(self, SL_MSG_RENDERERINFO, "renderer", SL_TYPE_STRING, NULL, "aafarm");
     self->f = xcalloc(SL_MAX_SLOTS, sizeof *self->f);
     self->d = xcalloc(SL_MAX_SLOTS, sizeof *self->d);
     self->i = xcalloc(SL_MAX_SLOTS, sizeof *self->i);
@@ -101,6 +102,91 @@ void sl_vm_set_spaces(sl_vm *self, const sl_spaces *spaces)
 {
     self->spaces = *spaces;
     update_depth(self);
+}
+
+/* ---- message passing ---- */
+
+static vm_message *message_slot(sl_vm *self, int scope, const char *name)
+{
+    for (int i = 0; i < self->nmessages; i++)
+        if (self->messages[i].scope == scope && strcmp(self->messages[i].name, name) == 0)
+            return &self->messages[i];
+    if (self->nmessages == SL_VM_MAX_MESSAGES)
+        return NULL;
+    vm_message *m = &self->messages[self->nmessages++];
+    memset(m, 0, sizeof *m);
+    m->scope = scope;
+    snprintf(m->name, sizeof m->name, "%s", name);
+    return m;
+}
+
+static bool set_message(sl_vm *self, int scope, const char *name, int size,
+                        const double *values, const char *string, bool varying)
+{
+    if (scope < 0 || scope >= SL_MSG__COUNT || !name || strlen(name) >= 64 ||
+        (size == 0 && (!string || strlen(string) >= 128)) || (size > 0 && !values))
+        return false;
+    vm_message *m = message_slot(self, scope, name);
+    if (!m)
+        return false;
+    m->size = size;
+    m->varying = varying;
+    if (size)
+        memcpy(m->v, values, (size_t)size * sizeof *values);
+    else
+        snprintf(m->s, sizeof m->s, "%s", string);
+    return true;
+}
+
+bool sl_vm_set_message(sl_vm *self, sl_message_scope scope, const char *name, sl_type type,
+                       const double *values, const char *string)
+{
+    int size = type == SL_TYPE_STRING ? 0 : type == SL_TYPE_FLOAT ? 1
+             : type == SL_TYPE_MATRIX ? 16 : 3;
+    return set_message(self, (int)scope, name, size, values, string, false);
+}
+
+int sl_vm_capture_outputs(sl_vm *self, sl_message_scope scope)
+{
+    const sl_program *p = self->prog;
+    if (!p || (self->mode != SL_MODE_FLOAT && self->mode != SL_MODE_DUAL))
+        return 0;
+    int n = 0;
+    for (int i = 0; i < p->nparams; i++) {
+        const sl_param *q = &p->params[i];
+        if (!q->output)
+            continue;
+        double v[16];
+        bool str = q->type == SL_TYPE_STRING;
+        if (!str && q->size > 16)
+            continue;                   /* arrays are not messages */
+        for (int k = 0; !str && k < q->size; k++)
+            v[k] = self->mode == SL_MODE_FLOAT ? self->f[q->slot + k] : self->d[q->slot + k].v;
+        const char *s = str ? self->str[q->slot] : NULL;
+        n += set_message(self, (int)scope, q->name, str ? 0 : q->size, v, s ? s : "", true);
+    }
+    return n;
+}
+
+void sl_vm_clear_messages(sl_vm *self, sl_message_scope scope)
+{
+    int kept = 0;
+    for (int i = 0; i < self->nmessages; i++)
+        if (self->messages[i].scope != (int)scope)
+            self->messages[kept++] = self->messages[i];
+    self->nmessages = kept;
+}
+
+const vm_message *sl_vm_message(const sl_vm *vm, int scope, const char *name, int size)
+{
+    if (!name)
+        return NULL;
+    for (int i = 0; i < vm->nmessages; i++) {
+        const vm_message *m = &vm->messages[i];
+        if (m->scope == scope && m->size == size && strcmp(m->name, name) == 0)
+            return m;
+    }
+    return NULL;
 }
 
 void sl_vm_set_clipping(sl_vm *self, double near, double far)

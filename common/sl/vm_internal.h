@@ -22,6 +22,7 @@ enum {
     SL_VM_POOL_VALUES = 8192,     /* snapshot values of open merge frames */
     SL_VM_MAX_FRAMES = 512,       /* open merge frames (nested maybe-branches) */
     SL_VM_MAX_LIGHTS = 64,        /* light samples per shading call */
+    SL_VM_MAX_MESSAGES = 64,      /* message-passing values (sl_vm_set_message) */
 };
 
 /* The instantiations of the dispatch loop (vm_exec.inc). The two _DERIV
@@ -68,6 +69,16 @@ typedef struct vm_frame {
  * break or early return), merged back where it ends. Stored at the top end
  * of the merge pool, growing down. */
 enum { SL_VM_MAX_ACCUMULATORS = 64 };
+/* One message (shader.h, sl_vm_set_message): size 1, 3 or 16 numbers, or
+ * 0 for a string; varying: a captured output, known at one point only. */
+typedef struct vm_message {
+    int scope, size;
+    bool varying;
+    char name[64];
+    double v[16];
+    char s[128];
+} vm_message;
+
 typedef struct vm_accumulator {
     int kind, id;
     int pool, spool;
@@ -84,6 +95,8 @@ struct sl_vm {
     sl_light_sample fixed_lights[SL_VM_MAX_LIGHTS];
     sl_light_sample illum[SL_VM_MAX_LIGHTS];   /* the illuminance loop's lights */
     int nillum, illum_next;
+    vm_message messages[SL_VM_MAX_MESSAGES];
+    int nmessages;
     int nfixed_lights;
     uint64_t seed;
 
@@ -144,6 +157,8 @@ int sl_vm_light_samples(sl_vm *vm, const double P[3], sl_light_sample *out);
 double sl_vm_random(sl_vm *vm);
 
 const char *sl_mode_name(sl_mode mode);
+/* The message of this scope, name and size (0: a string), or NULL. */
+const vm_message *sl_vm_message(const sl_vm *vm, int scope, const char *name, int size);
 
 /* a op b (op: SL_OP_ADD/SUB/MUL/DIV) when the double result is EXACT, so
  * that interval and affine runs keep integer counters and octave

@@ -929,6 +929,12 @@ static void ref_spline_octaves(double u, double v, double o[3])
     o[0] = sum; o[1] = spline_ref("linear", v, k, 5); o[2] = spline_ref("constant", u, k, 5);
 }
 
+static void ref_message_attribute(double u, double v, double o[3])
+{
+    (void)v;
+    o[0] = 1 + 10 + 0 + 1000 + 10000; o[1] = 0.25 + 3 * sin(u * 4); o[2] = 7 + 0.2 + 1;
+}
+
 /* ---------------------------------------------------------------------- */
 /* the cases                                                               */
 /* ---------------------------------------------------------------------- */
@@ -1026,6 +1032,7 @@ static const conf_case cases[] = {
     CASE(color_roundtrip, "color spaces"),
     CASE(noise_periodic, "noise family"),
     CASE(spline_octaves, "spline"),
+    CASE(message_attribute, "message passing"),
 };
 #undef CASE
 #undef CASE_NO_DUAL
@@ -1546,6 +1553,60 @@ static void check_light_callback(const sl_instance *inst, sl_vm *fixed, tally *t
     sl_vm_destroy(&vm);
 }
 
+/* Message passing from the displacement shader to the surface shader run
+ * next on the same VM: the outputs captured after the float run are what
+ * displacement("name", x) reads; a range run reads them as unbounded. */
+static void check_message_passing(sl_vm *vm, tally *t)
+{
+    char *d1 = NULL, *d2 = NULL;
+    sl_program *disp = compile_file("message_height.sl", &d1);
+    sl_program *surf = compile_file("surface_message.sl", &d2);
+    bool ok = disp && surf && !d1[0] && !d2[0];
+    free(d1);
+    free(d2);
+    sl_instance *di = disp ? sl_instance_new(disp) : NULL;
+    sl_instance *si = surf ? sl_instance_new(surf) : NULL;
+    for (int k = 0; ok && k < 5; k++) {
+        double u = 0.1 + 0.17 * k, v = 0.8 - 0.13 * k, C[3];
+        double h = 0.1 * sin(u * 6) * cos(v * 4);
+        double want[3] = { u + h, v + 2, h };
+        t->floats++;
+        h_globals_float(vm, H_PLANE, u, v);
+        ok = sl_vm_run(vm, di, SL_MODE_FLOAT, NULL) == SL_OK &&
+             sl_vm_capture_outputs(vm, SL_MSG_DISPLACEMENT) == 2;
+        h_globals_float(vm, H_SPHERE, u, v);
+        ok = ok && sl_vm_run(vm, si, SL_MODE_FLOAT, NULL) == SL_OK;
+        if (ok)
+            sl_vm_get_float(vm, SL_G_Ci, C);
+        for (int i = 0; ok && i < 3; i++)
+            ok = close_to(C[i], want[i]);
+    }
+    if (ok) {                       /* a range run: unbounded, not wrong */
+        ia_interval I[3];
+        h_globals_interval(vm, H_SPHERE, 0.3, 0.35, 0.3, 0.35);
+        ok = sl_vm_run(vm, si, SL_MODE_INTERVAL, NULL) == SL_OK;
+        sl_vm_get_interval(vm, SL_G_Ci, I);
+        for (int i = 0; ok && i < 3; i++)
+            ok = !isfinite(I[i].lo) && !isfinite(I[i].hi);
+    }
+    if (ok) {                       /* no displacement outputs: the defaults */
+        double C[3];
+        sl_vm_clear_messages(vm, SL_MSG_DISPLACEMENT);
+        h_globals_float(vm, H_SPHERE, 0.5, 0.5);
+        ok = sl_vm_run(vm, si, SL_MODE_FLOAT, NULL) == SL_OK;
+        sl_vm_get_float(vm, SL_G_Ci, C);
+        ok = ok && C[0] == -1 && C[1] == 0 && C[2] == 0;
+    }
+    if (!ok) {
+        t->failures++;
+        fprintf(stderr, "message passing from message_height.sl to surface_message.sl fails\n");
+    }
+    sl_instance_destroy(&di);
+    sl_instance_destroy(&si);
+    sl_program_destroy(&disp);
+    sl_program_destroy(&surf);
+}
+
 static void test_conformance(void **state)
 {
     (void)state;
@@ -1560,6 +1621,12 @@ static void test_conformance(void **state)
     mat4_invert(&sp.to_current[SL_SPACE_OBJECT], &sp.from_current[SL_SPACE_OBJECT]);
     sl_vm_set_spaces(vm, &sp);
     sl_vm_set_clipping(vm, 0.5, 10.5);
+    double bound = 0.25, freq = 3, tint[3] = { 0.1, 0.2, 0.3 };
+    assert_true(sl_vm_set_message(vm, SL_MSG_ATTRIBUTE, "displacementbound:sphere",
+                                  SL_TYPE_FLOAT, &bound, NULL));
+    assert_true(sl_vm_set_message(vm, SL_MSG_OPTION, "user:frequency", SL_TYPE_FLOAT, &freq,
+                                  NULL));
+    assert_true(sl_vm_set_message(vm, SL_MSG_ATTRIBUTE, "user:tint", SL_TYPE_COLOR, tint, NULL));
     const char *features[64];
     int nfeatures = 0;
     size_t ncases = sizeof cases / sizeof cases[0];
@@ -1606,6 +1673,7 @@ static void test_conformance(void **state)
         sl_instance_destroy(&inst);
         sl_program_destroy(&p);
     }
+    check_message_passing(vm, &t);
     size_t nerrors = sizeof errors / sizeof errors[0];
     for (size_t e = 0; e < nerrors; e++) {
         char *diag = NULL;
@@ -1619,8 +1687,8 @@ static void test_conformance(void **state)
         free(diag);
     }
     sl_vm_destroy(&vm);
-    printf("conformance: %zu displacement and %zu surface shaders and %zu error cases; "
-           "features:", ncases, nsurfaces, nerrors);
+    printf("conformance: %zu displacement and %zu surface shaders, a displacement-to-surface "
+           "message pair and %zu error cases; features:", ncases, nsurfaces, nerrors);
     for (int f = 0; f < nfeatures; f++)
         printf("%s %s", f ? "," : "", features[f]);
     printf("\nconformance: %d float checks, %d dual checks (%d derivatives against "
