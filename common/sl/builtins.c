@@ -123,6 +123,9 @@ static const sl_builtin table[] = {
     LW("illuminance start", "0:p", ILLUMINANCE, LSTART, 0),
     LW("illuminance next", "f:", ILLUMINANCE, LNEXT, 0),
     LW("illuminance cone", "f:vf", ILLUMINANCE, END, 0),
+    LW("illuminate begin", "0:p", EMITTER, END, 0),
+    LW("solar begin", "0:v", EMITTER, END, 1),
+    LW("solar begin", "0:", EMITTER, END, 1),
     /* message passing (§15.7) */
     LW("displacement", "f:sV", MESSAGE, MESSAGE, SL_MSG_DISPLACEMENT),
     LW("surface", "f:sV", MESSAGE, MESSAGE, SL_MSG_SURFACE),
@@ -414,6 +417,8 @@ static const struct {
 
 int sl_global_find(const char *name)
 {
+    if (strcmp(name, "Ps") == 0)     /* light shaders: the point being lit */
+        return SL_G_P;
     for (int g = 0; g < SL_G__COUNT; g++)
         if (strcmp(globals[g].name, name) == 0)
             return g;

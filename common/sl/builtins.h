@@ -49,6 +49,7 @@ typedef enum sl_lowering {
     SL_LOWER_FILTERSTEP,  /* filterstep(edge, x [, x1] [, "width", w] [, "filter", f]) */
     SL_LOWER_ILLUMINANCE, /* the parts of an illuminance loop (parser.c):
                              op LSTART / LNEXT, or END: the cone test */
+    SL_LOWER_EMITTER,     /* illuminate / solar (parser.c): k 0 / 1 */
     SL_LOWER_MESSAGE,     /* displacement("name", x) ...: k = sl_message_scope */
     SL_LOWER_SPLINE,      /* spline([basis,] t, knots... | knots[]): checked
                              apart (variadic); node op = the basis index */

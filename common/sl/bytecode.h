@@ -202,6 +202,7 @@ struct sl_program {
 
     int nslots;                     /* scalar slots used */
     int nstring_slots;
+    bool emits_light;               /* a light shader with illuminate or solar */
     bool takes_derivatives;         /* has DU, DV, DERIV, CALCNORMAL or AREA:
                                        interval/affine runs carry derivative
                                        bounds (vm_deriv.inc) */

@@ -632,6 +632,11 @@ static sl_ty check_builtin_call(checker *c, sl_node *n, const sl_ty *args, sl_ty
         return set_ty(n, SL_TY_ERROR);
     }
     n->builtin = b;
+    if (b->lower == SL_LOWER_EMITTER && c->file->kind != SL_SHADER_LIGHT) {
+        error(c, n->pos, "'%s' is only allowed in light shaders", b->op == SL_OP_END &&
+              b->k == 0 ? "illuminate" : "solar");
+        return set_ty(n, SL_TY_ERROR);
+    }
     const char *sig = b->sig + 2;
     for (int i = 0; i < n->nlist; i++) {
         if (sig[i] == 'o' || sig[i] == 'O' || sig[i] == 'M' || sig[i] == 'w' ||
@@ -1497,7 +1502,8 @@ static void make_globals(checker *c)
         s->ty = sl_global_type((sl_global)g);
         s->kind = SL_SYM_GLOBAL;
         s->global = g;
-        s->writable = sl_global_writable((sl_global)g);
+        s->writable = sl_global_writable((sl_global)g) ||
+                      (c->file->kind == SL_SHADER_LIGHT && (g == SL_G_Cl || g == SL_G_L));
         s->slot = sl_global_slot((sl_global)g);
         c->globals[g] = s;
     }

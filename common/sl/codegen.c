@@ -1546,6 +1546,17 @@ static int gen_builtin(cg *g, sl_node *e, int dst)
     case SL_LOWER_DEPTH: return gen_depth(g, args[0], dst);
     case SL_LOWER_FILTERSTEP: return gen_filterstep(g, e, args, dst);
     case SL_LOWER_ILLUMINANCE: return gen_illuminance(g, e, args, dst);
+    case SL_LOWER_EMITTER: {      /* L = Ps - position / axis / 0 */
+        int L = sl_global_slot(SL_G_L), P = sl_global_slot(SL_G_P);
+        g->prog->emits_light = true;
+        for (int i = 0; i < 3; i++) {
+            if (b->k == 0)
+                emit(g, SL_OP_SUB, L + i, P + i, args[0] + i, 0);
+            else
+                emit(g, SL_OP_MOV, L + i, e->nlist ? args[0] + i : const_slot(g, 0), 0, 0);
+        }
+        return 0;
+    }
     case SL_LOWER_MESSAGE: {
         bool str = e->list[1]->ty == SL_TYPE_STRING;
         int size = str ? 0 : size_of(e->list[1]);

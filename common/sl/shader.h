@@ -47,6 +47,7 @@
 typedef enum sl_shader_kind {
     SL_SHADER_SURFACE,
     SL_SHADER_DISPLACEMENT,
+    SL_SHADER_LIGHT,        /* evaluated with sl_light_eval */
 } sl_shader_kind;
 
 typedef enum sl_type {
@@ -227,6 +228,16 @@ bool sl_vm_set_message(sl_vm *self, sl_message_scope scope, const char *name, sl
  * interval or affine run reads them as unbounded. Returns how many. */
 int sl_vm_capture_outputs(sl_vm *self, sl_message_scope scope);
 void sl_vm_clear_messages(sl_vm *self, sl_message_scope scope);
+
+/* Light shaders (RI Spec 3.2 §9.3, §15.4 illuminate, solar): runs the light
+ * instance `inst` in float mode for the surface point Ps (current space)
+ * and fills the sample the surface shader's light functions take: L from
+ * Ps towards the light, Cl, and ambient for a light shader without
+ * illuminate or solar. Cl is 0 where the light's illuminate/solar cone
+ * leaves Ps out. Use a VM of its own (a light callback runs while the
+ * surface shader's VM is busy), with the scene's spaces set on it. */
+sl_status sl_light_eval(sl_vm *self, const sl_instance *inst, const double Ps[3],
+                        sl_light_sample *out);
 
 /* The camera's clipping planes (RIB Clipping), for depth(P) =
  * (z_camera - near) / (far - near). Default near 0, far 1: depth(P) is

@@ -104,6 +104,32 @@ void sl_vm_set_spaces(sl_vm *self, const sl_spaces *spaces)
     update_depth(self);
 }
 
+/* ---- light shaders ---- */
+
+sl_status sl_light_eval(sl_vm *self, const sl_instance *inst, const double Ps[3],
+                        sl_light_sample *out)
+{
+    static const double zero[3] = { 0, 0, 0 };
+    memset(out, 0, sizeof *out);
+    sl_vm_clear_globals(self);
+    sl_vm_set_float(self, SL_G_P, Ps);
+    sl_vm_set_float(self, SL_G_L, zero);
+    sl_vm_set_float(self, SL_G_Cl, zero);
+    sl_status st = sl_vm_run(self, inst, SL_MODE_FLOAT, NULL);
+    if (st != SL_OK)
+        return st;
+    const sl_program *p = inst->program;
+    if (p->kind != SL_SHADER_LIGHT)
+        return sl_vm_fail(self, SL_ERR_RUNTIME, "'%s' is not a light shader", p->name);
+    double L[3];
+    sl_vm_get_float(self, SL_G_L, L);
+    sl_vm_get_float(self, SL_G_Cl, out->Cl);
+    for (int i = 0; i < 3; i++)      /* the light's L points at Ps; the sample's away */
+        out->L[i] = -L[i];
+    out->ambient = !p->emits_light;
+    return SL_OK;
+}
+
 /* ---- message passing ---- */
 
 static vm_message *message_slot(sl_vm *self, int scope, const char *name)

@@ -1607,6 +1607,165 @@ static void check_message_passing(sl_vm *vm, tally *t)
     sl_program_destroy(&surf);
 }
 
+/* Light shaders (sl_light_eval) at points of the plane against their
+ * formulas, and the point light feeding surface_illuminance_diffuse.sl
+ * through a light callback. */
+typedef struct light_case {
+    const char *file;
+    const char *param;          /* one parameter set besides the defaults */
+    double value[3];
+} light_case;
+
+static sl_instance *light_instance(const char *file, tally *t)
+{
+    char *diag = NULL;
+    sl_program *p = compile_file(file, &diag);
+    if (!p || diag[0]) {
+        t->failures++;
+        fprintf(stderr, "%s: does not compile cleanly:\n%s", file, diag);
+    }
+    free(diag);
+    return p ? sl_instance_new(p) : NULL;
+}
+
+static void free_light(sl_instance **inst)
+{
+    if (!*inst)
+        return;
+    sl_program *p = (sl_program *)sl_instance_program(*inst);
+    sl_instance_destroy(inst);
+    sl_program_destroy(&p);
+}
+
+static void set_param(sl_instance *inst, const char *name, sl_type type, const double *v, int n)
+{
+    char why[256];
+    assert_true(sl_instance_set(inst, name, type, v, n, why, sizeof why));
+}
+
+typedef struct light_ctx {
+    sl_vm *vm;
+    sl_instance *lights[2];
+} light_ctx;
+
+static int shader_lights(void *user, const double P[3], sl_light_sample *out, int max)
+{
+    light_ctx *lc = user;
+    int n = 0;
+    for (int i = 0; i < 2 && n < max; i++)
+        if (sl_light_eval(lc->vm, lc->lights[i], P, &out[n]) == SL_OK)
+            n++;
+    return n;
+}
+
+static void check_light_shaders(tally *t)
+{
+    sl_vm *lvm = sl_vm_new(NULL);
+    sl_instance *point = light_instance("light_point.sl", t);
+    sl_instance *spot = light_instance("light_spot.sl", t);
+    sl_instance *distant = light_instance("light_distant.sl", t);
+    sl_instance *ambient = light_instance("light_ambient.sl", t);
+    if (!point || !spot || !distant || !ambient)
+        goto done;
+    double two = 2, tenth = 0.1, lc[3] = { 1, 0.5, 0.25 }, from[3] = { 0, 0, 2 };
+    double origin[3] = { 0, 0, 0 }, dir[3] = { 1, 0, -1 };
+    set_param(point, "intensity", SL_TYPE_FLOAT, &two, 1);
+    set_param(point, "lightcolor", SL_TYPE_COLOR, lc, 3);
+    set_param(point, "from", SL_TYPE_POINT, from, 3);
+    set_param(spot, "from", SL_TYPE_POINT, from, 3);
+    set_param(spot, "to", SL_TYPE_POINT, origin, 3);
+    double cone = M_PI / 9;                      /* 20 degrees */
+    set_param(spot, "coneangle", SL_TYPE_FLOAT, &cone, 1);
+    set_param(distant, "to", SL_TYPE_POINT, dir, 3);
+    set_param(ambient, "intensity", SL_TYPE_FLOAT, &tenth, 1);
+    int lit = 0;
+    for (int i = 0; i < 7; i++) {
+        for (int j = 0; j < 7; j++) {
+            double u = 0.05 + 0.9 * (i + 0.31) / 7, v = 0.05 + 0.9 * (j + 0.57) / 7;
+            double Ps[3] = { 2 * u - 1, 2 * v - 1, 0 }, want[4][7];
+            /* point: L towards "from", Cl = 2 lc / |from - Ps|^2 */
+            double Lp[3] = { -Ps[0], -Ps[1], 2 - Ps[2] }, d2 = dot3(Lp, Lp);
+            /* spot: axis (0, 0, -1), cone 20 degrees, smooth over the last 5 */
+            double Ls[3] = { Ps[0], Ps[1], Ps[2] - 2 }, ca = -Ls[2] / sqrt(dot3(Ls, Ls));
+            bool in = ca >= cos(cone);
+            double spot_cl = in ? pow(ca, 2) / dot3(Ls, Ls) *
+                                  smooth(cos(cone), cos(cone - M_PI / 36), ca) : 0;
+            lit += in;
+            for (int k = 0; k < 3; k++) {
+                want[0][k] = Lp[k];
+                want[0][3 + k] = 2 * lc[k] / d2;
+                want[1][k] = -Ls[k];
+                want[1][3 + k] = spot_cl;
+                want[2][k] = -dir[k];
+                want[2][3 + k] = 1;
+                want[3][3 + k] = 0.1;
+            }
+            want[0][6] = want[1][6] = want[2][6] = 0;
+            want[3][6] = 1;
+            sl_instance *insts[4] = { point, spot, distant, ambient };
+            for (int l = 0; l < 4; l++) {
+                sl_light_sample ls;
+                t->floats++;
+                bool ok = sl_light_eval(lvm, insts[l], Ps, &ls) == SL_OK;
+                for (int k = 0; ok && k < 3; k++)
+                    ok = (l == 3 || close_to(ls.L[k], want[l][k])) &&
+                         close_to(ls.Cl[k], want[l][3 + k]);
+                ok = ok && ls.ambient == (want[l][6] == 1);
+                if (!ok) {
+                    t->failures++;
+                    fprintf(stderr, "light shader %d at Ps = (%g, %g, %g): L (%g %g %g), Cl "
+                                    "(%g %g %g)\n", l, Ps[0], Ps[1], Ps[2], ls.L[0], ls.L[1],
+                            ls.L[2], ls.Cl[0], ls.Cl[1], ls.Cl[2]);
+                }
+            }
+        }
+    }
+    if (lit == 0 || lit == 49) {      /* the spot's cone must cut the samples */
+        t->failures++;
+        fprintf(stderr, "light_spot.sl: %d of 49 points lit\n", lit);
+    }
+    /* the point and ambient lights through a callback, for the diffuse loop */
+    char *diag = NULL;
+    sl_program *sp = compile_file("surface_illuminance_diffuse.sl", &diag);
+    free(diag);
+    if (!sp) {
+        t->failures++;
+        goto done;
+    }
+    sl_instance *si = sl_instance_new(sp);
+    sl_vm *vm = sl_vm_new(NULL);
+    light_ctx ctx = { lvm, { point, ambient } };
+    sl_vm_set_lights(vm, shader_lights, &ctx);
+    for (int k = 0; k < 5; k++) {
+        double u = 0.1 + 0.19 * k, v = 0.7 - 0.11 * k, P[3], N[3], du[3], dv[3], Nf[3], C[3];
+        h_surface_float(H_SPHERE, u, v, P, N, du, dv);
+        facing(N, Nf);
+        double L[3] = { -P[0], -P[1], 2 - P[2] }, d2 = dot3(L, L), Ln[3] = { L[0], L[1], L[2] };
+        normalize3(Ln);
+        double d = dot3(Ln, Nf);
+        h_globals_float(vm, H_SPHERE, u, v);
+        t->floats++;
+        bool ok = sl_vm_run(vm, si, SL_MODE_FLOAT, NULL) == SL_OK;
+        sl_vm_get_float(vm, SL_G_Ci, C);
+        for (int c = 0; ok && c < 3; c++)
+            ok = close_to(C[c], d >= 0 ? 0.8 * 2 * lc[c] / d2 * d : 0);
+        if (!ok) {
+            t->failures++;
+            fprintf(stderr, "surface_illuminance_diffuse.sl under light_point.sl at (%g, %g): "
+                            "%s\n", u, v, sl_vm_error(vm));
+        }
+    }
+    sl_vm_destroy(&vm);
+    sl_instance_destroy(&si);
+    sl_program_destroy(&sp);
+done:
+    free_light(&point);
+    free_light(&spot);
+    free_light(&distant);
+    free_light(&ambient);
+    sl_vm_destroy(&lvm);
+}
+
 static void test_conformance(void **state)
 {
     (void)state;
@@ -1656,6 +1815,8 @@ static void test_conformance(void **state)
     sl_vm_set_fixed_lights(vm, surface_lights, NSURFACE_LIGHTS);
     if (nfeatures < 64)
         features[nfeatures++] = "illuminance (surface shaders)";
+    if (nfeatures < 64)
+        features[nfeatures++] = "light shaders (illuminate, solar)";
     for (size_t c = 0; c < nsurfaces; c++) {
         char *diag = NULL;
         sl_program *p = compile_file(surface_cases[c].file, &diag);
@@ -1674,6 +1835,7 @@ static void test_conformance(void **state)
         sl_program_destroy(&p);
     }
     check_message_passing(vm, &t);
+    check_light_shaders(&t);
     size_t nerrors = sizeof errors / sizeof errors[0];
     for (size_t e = 0; e < nerrors; e++) {
         char *diag = NULL;
@@ -1687,8 +1849,9 @@ static void test_conformance(void **state)
         free(diag);
     }
     sl_vm_destroy(&vm);
-    printf("conformance: %zu displacement and %zu surface shaders, a displacement-to-surface "
-           "message pair and %zu error cases; features:", ncases, nsurfaces, nerrors);
+    printf("conformance: %zu displacement, %zu surface and 4 light shaders, a "
+           "displacement-to-surface message pair and %zu error cases; features:", ncases,
+           nsurfaces, nerrors);
     for (int f = 0; f < nfeatures; f++)
         printf("%s %s", f ? "," : "", features[f]);
     printf("\nconformance: %d float checks, %d dual checks (%d derivatives against "

@@ -125,17 +125,17 @@ static void test_error_in_macro(void **state)
 static void test_unsupported(void **state)
 {
     (void)state;
-    expect_errors("light l() { }\n",
-                  "t.sl:1:1: error: 'light' shaders are not supported (only 'surface' and "
-                  "'displacement')\n"
-                  "light l() { }\n"
+    expect_errors("volume l() { }\n",
+                  "t.sl:1:1: error: 'volume' shaders are not supported (only 'surface', "
+                  "'displacement' and 'light')\n"
+                  "volume l() { }\n"
                   "^\n");
-    expect_errors("surface s() {\n    illuminate(P) { }\n    illuminance(P, N) { }\n}\n",
-                  "t.sl:2:5: error: 'illuminate' and 'solar' belong in light shaders, which "
-                  "are not supported (the renderer's lights are used)\n"
+    expect_errors("surface s() {\n    illuminate(P) { }\n}\n",
+                  "t.sl:2:5: error: 'illuminate' is only allowed in light shaders\n"
                   "    illuminate(P) { }\n"
-                  "    ^\n"
-                  "t.sl:3:5: error: illuminance takes [category,] position [, axis, angle], "
+                  "    ^\n");
+    expect_errors("surface s() {\n    illuminance(P, N) { }\n}\n",
+                  "t.sl:2:5: error: illuminance takes [category,] position [, axis, angle], "
                   "not 2 values\n"
                   "    illuminance(P, N) { }\n"
                   "    ^\n");
