@@ -126,6 +126,11 @@ static const sl_builtin table[] = {
     LW("illuminate begin", "0:p", EMITTER, END, 0),
     LW("solar begin", "0:v", EMITTER, END, 1),
     LW("solar begin", "0:", EMITTER, END, 1),
+    /* strings (§15.6): concat, format and printf are variadic */
+    LW("concat", "s:", STRINGS, SCAT, 0),
+    LW("format", "s:", STRINGS, SFMT, 0),
+    LW("printf", "0:", STRINGS, SPRINT, 0),
+    LW("match", "f:ss", MATCH, SMATCH, 0),
     /* message passing (§15.7) */
     LW("displacement", "f:sV", MESSAGE, MESSAGE, SL_MSG_DISPLACEMENT),
     LW("surface", "f:sV", MESSAGE, MESSAGE, SL_MSG_SURFACE),

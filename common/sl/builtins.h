@@ -50,6 +50,9 @@ typedef enum sl_lowering {
     SL_LOWER_ILLUMINANCE, /* the parts of an illuminance loop (parser.c):
                              op LSTART / LNEXT, or END: the cone test */
     SL_LOWER_EMITTER,     /* illuminate / solar (parser.c): k 0 / 1 */
+    SL_LOWER_STRINGS,     /* concat, format, printf: variadic, checked apart
+                             (check_strings); op SCAT / SFMT / SPRINT */
+    SL_LOWER_MATCH,
     SL_LOWER_MESSAGE,     /* displacement("name", x) ...: k = sl_message_scope */
     SL_LOWER_SPLINE,      /* spline([basis,] t, knots... | knots[]): checked
                              apart (variadic); node op = the basis index */

@@ -86,7 +86,9 @@ enum {
     X(ESCAPE, "escape", "zktk") X(ACCUM_END, "accum.end", "kt-k") \
     X(ALOAD, "aload", "zxxk") X(ASTORE, "astore", "zxxk")        \
     X(LSTART, "lstart", "----") X(LNEXT, "lnext", "z---")          \
-    X(MESSAGE, "message", "zskk")
+    X(MESSAGE, "message", "zskk")                                \
+    X(SCAT, "scat", "sss-") X(SFMT, "sfmt", "sxsk")              \
+    X(SPRINT, "sprint", "s---") X(SMATCH, "smatch", "zss-")
 
 typedef enum sl_opcode {
 #define SL_OPCODE_ENUM(name, text, operands) SL_OP_##name,
@@ -144,6 +146,13 @@ enum { SL_ESCAPE_LOOP = 0, SL_ESCAPE_FUNC = 1 };
 
 /* MESSAGE flag, name, var, d (message passing, shader.h): d = scope | size
  * << 4 (size 0: var is a string slot, else var's numeric slots). */
+
+/* Strings (RI Spec 3.2 §15.6): SCAT z, a, b concatenates; SFMT z, x, spec,
+ * size formats size numbers from slot x with the C conversion spec (checked
+ * when compiling: flags, width, precision, one of f e g or lld), a range
+ * as "[lo hi]"; SPRINT s prints a line to stderr (float mode only, at most
+ * SL_VM_MAX_PRINTS lines per VM); SMATCH z, pattern, subject is match().
+ * Results live in the VM's string space, reset at each run. */
 
 /* illuminance loops (RI Spec 3.2 §15.4): LSTART takes the non-ambient
  * light samples of this mode at P; each LNEXT z loads the next one into the

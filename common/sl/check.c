@@ -29,6 +29,7 @@
 #include "sl/check.h"
 #include "sl/builtins.h"
 #include "sl/lexer.h"
+#include "sl/strmatch.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -652,6 +653,14 @@ static sl_ty check_builtin_call(checker *c, sl_node *n, const sl_ty *args, sl_ty
             check_filter_param(c, n, i);
             continue;
         }
+        if (sig[i] == 's' && b->lower == SL_LOWER_MATCH) {
+            int bad = i == 0 && n->list[0]->kind == SL_N_STR ? sl_match_check(n->list[0]->name)
+                                                             : 0;
+            if (bad)
+                error(c, n->list[0]->pos, "malformed regular expression '%s' (at character "
+                      "%d)", n->list[0]->name, bad);
+            continue;
+        }
         if (sig[i] == 's' && b->lower == SL_LOWER_MESSAGE) {
             wrap_conv(c, &n->list[i], want[i]);
             continue;
@@ -953,6 +962,120 @@ static sl_ty check_spline(checker *c, sl_node *n, sl_ty hint)
     return set_ty(n, elem);
 }
 
+/* The conversions of a format string (RI Spec 3.2 §15.6): "%%", or "%"
+ * flags [-+ 0], width, .precision and one of f e g d i (a float), p v n
+ * (a point, vector or normal), c (a color), m (a matrix), s (a string).
+ * Calls fn for each; returns the number of conversions, or -1 (reported)
+ * for a malformed one. Shared with the code generator. */
+int sl_format_walk(const char *fmt, void (*fn)(void *, const char *spec, size_t len, char conv,
+                                              const char *lit, size_t litlen), void *arg)
+{
+    int count = 0;
+    const char *lit = fmt;
+    for (const char *p = fmt; *p; p++) {
+        if (*p != '%')
+            continue;
+        if (p[1] == '%') {              /* the literal up to and with one '%' */
+            if (fn)
+                fn(arg, NULL, 0, '%', lit, (size_t)(p + 1 - lit));
+            lit = ++p + 1;
+            continue;
+        }
+        const char *q = p + 1;
+        while (*q && strchr("-+ 0", *q))
+            q++;
+        while (*q >= '0' && *q <= '9')
+            q++;
+        if (*q == '.')
+            for (q++; *q >= '0' && *q <= '9'; q++)
+                ;
+        if (!*q || !strchr("fegdipvncms", *q) || q - p > 20)
+            return -1;
+        if (fn)
+            fn(arg, p, (size_t)(q - p), *q, lit, (size_t)(p - lit));
+        count++;
+        p = q;
+        lit = q + 1;
+    }
+    if (fn && *lit)
+        fn(arg, NULL, 0, 0, lit, strlen(lit));
+    return count;
+}
+
+typedef struct format_check {
+    char convs[64];
+    int n;
+} format_check;
+
+static void collect_conv(void *arg, const char *spec, size_t len, char conv, const char *lit,
+                         size_t litlen)
+{
+    (void)len;
+    (void)lit;
+    (void)litlen;
+    format_check *f = arg;
+    if (spec && f->n < 64)
+        f->convs[f->n] = conv;
+    if (spec)
+        f->n++;
+}
+
+/* concat(s, ...), format(fmt, ...), printf(fmt, ...): strings, and a
+ * constant format whose conversions match the arguments' types. */
+static sl_ty check_strings(checker *c, sl_node *n, const sl_builtin *b)
+{
+    bool bad = false;
+    for (int i = 0; i < n->nlist; i++)
+        bad |= check_expr(c, &n->list[i], SL_TYPE_VOID) == SL_TY_ERROR;
+    if (bad)
+        return set_ty(n, SL_TY_ERROR);
+    if (b->op == SL_OP_SCAT) {
+        for (int i = 0; i < n->nlist; i++) {
+            if (n->list[i]->ty != SL_TYPE_STRING) {
+                error(c, n->list[i]->pos, "argument %d of concat() is a '%s', not a string",
+                      i + 1, sl_ty_name(n->list[i]->ty));
+                return set_ty(n, SL_TY_ERROR);
+            }
+        }
+        if (n->nlist == 0) {
+            error(c, n->pos, "concat() takes one or more strings");
+            return set_ty(n, SL_TY_ERROR);
+        }
+    } else {
+        if (n->nlist == 0 || n->list[0]->kind != SL_N_STR) {
+            error(c, n->pos, "%s() needs a constant format string first", n->name);
+            return set_ty(n, SL_TY_ERROR);
+        }
+        format_check f = { .n = 0 };
+        int count = sl_format_walk(n->list[0]->name, collect_conv, &f);
+        if (count < 0) {
+            error(c, n->list[0]->pos, "malformed conversion in the format string (known: "
+                  "%%f %%e %%g %%d %%i %%p %%v %%n %%c %%m %%s %%%%)");
+            return set_ty(n, SL_TY_ERROR);
+        }
+        if (count != n->nlist - 1 || count > 64) {
+            error(c, n->pos, "the format string of %s() has %d conversions, but %d values "
+                  "follow it", n->name, count, n->nlist - 1);
+            return set_ty(n, SL_TY_ERROR);
+        }
+        for (int i = 0; i < count; i++) {
+            sl_ty ty = n->list[i + 1]->ty;
+            char k = f.convs[i];
+            bool ok = strchr("fegdi", k) ? ty == SL_TYPE_FLOAT
+                    : strchr("pvn", k) ? sl_ty_is_spatial(ty)
+                    : k == 'c' ? ty == SL_TYPE_COLOR
+                    : k == 'm' ? ty == SL_TYPE_MATRIX : ty == SL_TYPE_STRING;
+            if (!ok) {
+                error(c, n->list[i + 1]->pos, "'%%%c' in the format string of %s() does not "
+                      "take a '%s'", k, n->name, sl_ty_name(ty));
+                return set_ty(n, SL_TY_ERROR);
+            }
+        }
+    }
+    n->builtin = b;
+    return set_ty(n, b->op == SL_OP_SPRINT ? SL_TYPE_VOID : SL_TYPE_STRING);
+}
+
 static sl_ty check_call(checker *c, sl_node *n, sl_ty hint)
 {
     sl_func *cands[MAX_OVERLOADS];
@@ -961,11 +1084,32 @@ static sl_ty check_call(checker *c, sl_node *n, sl_ty hint)
         return check_arraylength(c, n);
     if (ncands == 0 && strcmp(n->name, "spline") == 0)
         return check_spline(c, n, hint);
+    if (ncands == 0) {
+        int count;
+        const sl_builtin *b = sl_builtin_find(n->name, &count);
+        if (b && b->lower == SL_LOWER_STRINGS)
+            return check_strings(c, n, b);
+    }
     int count;
     bool builtin = sl_builtin_find(n->name, &count) != NULL;
     if (!ncands && !builtin) {
         for (int i = 0; i < n->nlist; i++)
             check_expr(c, &n->list[i], SL_TYPE_VOID);
+        static const char *const later[] = {
+            "texture", "environment", "shadow", "bump", "textureinfo",
+        };
+        for (size_t k = 0; k < sizeof later / sizeof later[0]; k++) {
+            if (strcmp(n->name, later[k]) == 0) {
+                error(c, n->pos, "'%s' is not supported yet: texture, environment and "
+                                 "shadow maps come with the texture work (issue 16)", n->name);
+                return set_ty(n, SL_TY_ERROR);
+            }
+        }
+        if (strcmp(n->name, "trace") == 0 || strcmp(n->name, "gather") == 0) {
+            error(c, n->pos, "'%s' is not supported yet: shaders cannot trace rays in "
+                             "aafarm's ray tracer", n->name);
+            return set_ty(n, SL_TY_ERROR);
+        }
         if (lookup(c, n->name))
             error(c, n->pos, "called object '%s' is not a function", n->name);
         else

@@ -1389,6 +1389,66 @@ static int gen_illuminance(cg *g, sl_node *e, const int *args, int dst)
     return z;
 }
 
+/* concat, format, printf: a chain of scat over the pieces; a numeric
+ * conversion becomes sfmt with the C spec ("%5.2f"; d and i as "lld"; the
+ * triple and matrix conversions as "f" per component). */
+typedef struct fmt_job {
+    cg *g;
+    sl_node *e;
+    int next, cur;
+} fmt_job;
+
+static void fmt_append(cg *g, fmt_job *job, int s)
+{
+    int z = alloc_string(g);
+    emit(g, SL_OP_SCAT, z, job->cur, s, 0);
+    record_string_write(g, z);
+    job->cur = z;
+}
+
+static void fmt_piece(void *arg, const char *spec, size_t len, char conv, const char *lit,
+                      size_t litlen)
+{
+    fmt_job *job = arg;
+    cg *g = job->g;
+    if (litlen)
+        fmt_append(g, job, string_const(g, lit, litlen));
+    if (!spec)
+        return;
+    sl_node *a = job->e->list[job->next++];
+    int x = gen_expr(g, a, -1);
+    if (conv == 's') {
+        fmt_append(g, job, x);
+        return;
+    }
+    char c_spec[32];
+    const char *tail = strchr("di", conv) ? "lld" : strchr("eg", conv) ? (conv == 'e' ? "e" : "g")
+                                                                      : "f";
+    snprintf(c_spec, sizeof c_spec, "%.*s%s", (int)(len), spec, tail);
+    int t = alloc_string(g);
+    emit(g, SL_OP_SFMT, t, x, string_const(g, c_spec, strlen(c_spec)), size_of(a));
+    record_string_write(g, t);
+    fmt_append(g, job, t);
+}
+
+static int gen_strings(cg *g, sl_node *e, int dst)
+{
+    sl_opcode op = e->builtin->op;
+    fmt_job job = { g, e, 1, string_const(g, "", 0) };
+    if (op == SL_OP_SCAT) {
+        job.cur = gen_expr(g, e->list[0], -1);
+        for (int i = 1; i < e->nlist; i++)
+            fmt_append(g, &job, gen_expr(g, e->list[i], -1));
+        return into_string(g, job.cur, dst);
+    }
+    sl_format_walk(e->list[0]->name, fmt_piece, &job);
+    if (op == SL_OP_SPRINT) {
+        emit(g, SL_OP_SPRINT, job.cur, 0, 0, 0);
+        return 0;
+    }
+    return into_string(g, job.cur, dst);
+}
+
 /* spline([basis,] t, knots): x = clamp(t, 0, 1) * segments; the segment
  * seg = min(floor(x), segments - 1) and its 4 knots are read with aload
  * (in interval/affine mode: the merge of every knot the segment range can
@@ -1568,7 +1628,12 @@ static int gen_builtin(cg *g, sl_node *e, int dst)
             record_write(g, args[1], size);
         return z;
     }
-    case SL_LOWER_SPLINE: break;     /* gen_spline */
+    case SL_LOWER_SPLINE: case SL_LOWER_STRINGS: break;     /* gen_spline, gen_strings */
+    case SL_LOWER_MATCH: {
+        int z = target(g, dst, 1);
+        emit(g, SL_OP_SMATCH, z, args[0], args[1], 0);
+        return z;
+    }
     }
     return 0;
 }
@@ -1663,6 +1728,8 @@ static int gen_expr(cg *g, sl_node *e, int dst)
             r = gen_user_call(g, e, dst);
         else if (e->builtin && e->builtin->lower == SL_LOWER_SPLINE)
             r = gen_spline(g, e, dst);
+        else if (e->builtin && e->builtin->lower == SL_LOWER_STRINGS)
+            r = gen_strings(g, e, dst);
         else if (e->builtin)
             r = gen_builtin(g, e, dst);
         else            /* arraylength(a) */

@@ -464,6 +464,7 @@ sl_status sl_vm_run(sl_vm *self, const sl_instance *inst, sl_mode mode, aa_conte
     self->inst = inst;
     self->ctx = ctx;
     self->mode = mode;
+    self->strings_used = 0;
     self->nframes = 0;
     self->pool_top = 0;
     self->spool_top = 0;

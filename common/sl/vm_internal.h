@@ -17,12 +17,18 @@
 
 #include "sl/bytecode.h"
 #include "sl/shader.h"
+#include "sl/strmatch.h"
+
+#include <stdio.h>
+#include <string.h>
 
 enum {
     SL_VM_POOL_VALUES = 8192,     /* snapshot values of open merge frames */
     SL_VM_MAX_FRAMES = 512,       /* open merge frames (nested maybe-branches) */
     SL_VM_MAX_LIGHTS = 64,        /* light samples per shading call */
     SL_VM_MAX_MESSAGES = 64,      /* message-passing values (sl_vm_set_message) */
+    SL_VM_STRING_SPACE = 16384,   /* bytes of strings made by one run (concat, format) */
+    SL_VM_MAX_PRINTS = 100,       /* printf lines per VM, then one note */
 };
 
 /* The instantiations of the dispatch loop (vm_exec.inc). The two _DERIV
@@ -97,6 +103,9 @@ struct sl_vm {
     int nillum, illum_next;
     vm_message messages[SL_VM_MAX_MESSAGES];
     int nmessages;
+    char strings[SL_VM_STRING_SPACE];  /* strings made by this run */
+    int strings_used;
+    int prints;
     int nfixed_lights;
     uint64_t seed;
 

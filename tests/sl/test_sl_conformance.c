@@ -935,6 +935,11 @@ static void ref_message_attribute(double u, double v, double o[3])
     o[0] = 1 + 10 + 0 + 1000 + 10000; o[1] = 0.25 + 3 * sin(u * 4); o[2] = 7 + 0.2 + 1;
 }
 
+static void ref_strings_format(double u, double v, double o[3])
+{
+    o[0] = floor(u * 10) + 10; o[1] = 5 + v; o[2] = 15;
+}
+
 /* ---------------------------------------------------------------------- */
 /* the cases                                                               */
 /* ---------------------------------------------------------------------- */
@@ -1033,6 +1038,7 @@ static const conf_case cases[] = {
     CASE(noise_periodic, "noise family"),
     CASE(spline_octaves, "spline"),
     CASE(message_attribute, "message passing"),
+    CASE(strings_format, "strings"),
 };
 #undef CASE
 #undef CASE_NO_DUAL
@@ -1114,6 +1120,11 @@ static const conf_error errors[] = {
       "\"hsv\", \"hsl\", \"xyz\", \"XYZ\", \"xyY\", \"YIQ\")\n"
       "    color c = ctransform(\"cmyk\", Cs);\n"
       "                         ^\n" },
+    { "errors/format_type.sl",
+      "errors/format_type.sl:4:46: error: '%f' in the format string of format() does not "
+      "take a 'point'\n"
+      "    string label = format(\"height %f at %p\", P, s);\n"
+      "                                             ^\n" },
     { "errors/filterstep_param.sl",
       "errors/filterstep_param.sl:4:29: error: unknown filterstep() parameter 'blur' "
       "(known: \"width\" with a float, \"filter\" with a name)\n"
