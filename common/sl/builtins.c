@@ -37,6 +37,16 @@ static const sl_builtin table[] = {
     OP("min", "G:GG", MIN), OP("max", "G:GG", MAX),
     OP("clamp", "G:GGG", CLAMP),
     OP("step", "f:ff", STEP), OP("smoothstep", "f:fff", SMOOTHSTEP),
+    LW("filterstep", "f:ff", FILTERSTEP, END, 0),
+    LW("filterstep", "f:fff", FILTERSTEP, END, 0),
+    LW("filterstep", "f:ffsf", FILTERSTEP, END, 0),
+    LW("filterstep", "f:ffss", FILTERSTEP, END, 0),
+    LW("filterstep", "f:fffsf", FILTERSTEP, END, 0),
+    LW("filterstep", "f:fffss", FILTERSTEP, END, 0),
+    LW("filterstep", "f:ffsfss", FILTERSTEP, END, 0),
+    LW("filterstep", "f:ffsssf", FILTERSTEP, END, 0),
+    LW("filterstep", "f:fffsfss", FILTERSTEP, END, 0),
+    LW("filterstep", "f:fffsssf", FILTERSTEP, END, 0),
     OP("mix", "G:GGf", MIX), OP("mix", "T:TTT", MIX),
     /* geometry (§15.2) */
     LW("length", "f:S", LENGTH, END, 0),
@@ -49,6 +59,10 @@ static const sl_builtin table[] = {
     LW("faceforward", "A:SS", FACEFORWARD, END, 0),
     LW("faceforward", "A:SSS", FACEFORWARD, END, 0),
     LW("reflect", "v:SS", REFLECT, END, 0),
+    LW("refract", "v:SSf", REFRACT, END, 0),
+    LW("fresnel", "0:SSfww", FRESNEL, END, 0),
+    LW("fresnel", "0:SSfwwoo", FRESNEL, END, 0),
+    LW("depth", "f:p", DEPTH, END, 0),
     LW("transform", "p:sp", TRANSFORM, XPOINT, 0),
     LW("transform", "p:ssp", TRANSFORM, XPOINT, 0),
     LW("transform", "p:mp", TRANSFORM, XPOINT, 0),
@@ -72,7 +86,19 @@ static const sl_builtin table[] = {
     LW("setycomp", "0:of", SETCOMP_K, END, 1),
     LW("setzcomp", "0:of", SETCOMP_K, END, 2),
     LW("comp", "f:Tf", COMP_RT, COMP, 0),
+    LW("comp", "f:mff", MCOMP, END, 0),
     LW("setcomp", "0:Off", SETCOMP_RT, SETCOMP, 0),
+    LW("setcomp", "0:Mfff", MSETCOMP, END, 0),
+    LW("ptransform", "p:sp", TRANSFORM, XPOINT, 0),
+    LW("ptransform", "p:ssp", TRANSFORM, XPOINT, 0),
+    LW("ptransform", "p:mp", TRANSFORM, XPOINT, 0),
+    LW("ctransform", "c:sc", CTRANSFORM, END, 0),
+    LW("ctransform", "c:ssc", CTRANSFORM, END, 0),
+    /* matrices (§15.3) */
+    LW("determinant", "f:m", DETERMINANT, END, 0),
+    LW("translate", "m:mv", MATRIX_XFORM, END, 0),
+    LW("rotate", "m:mfv", MATRIX_XFORM, END, 1),
+    LW("scale", "m:mp", MATRIX_XFORM, END, 2),
     /* noise (§15.1) */
     LW("noise", "F:f", NOISE, NOISE, SL_NOISE_PLAIN),
     LW("noise", "F:ff", NOISE, NOISE, SL_NOISE_PLAIN),
@@ -92,6 +118,28 @@ static const sl_builtin table[] = {
     LW("diffuse", "c:n", LIGHT, DIFFUSE, 0),
     LW("specular", "c:nvf", LIGHT, SPECULAR, 0),
     LW("phong", "c:nvf", LIGHT, PHONG, 0),
+    /* the parts of an illuminance loop (parser.c builds the calls; their
+     * names cannot be written in a source) */
+    LW("illuminance start", "0:p", ILLUMINANCE, LSTART, 0),
+    LW("illuminance next", "f:", ILLUMINANCE, LNEXT, 0),
+    LW("illuminance cone", "f:vf", ILLUMINANCE, END, 0),
+    LW("illuminate begin", "0:p", EMITTER, END, 0),
+    LW("solar begin", "0:v", EMITTER, END, 1),
+    LW("solar begin", "0:", EMITTER, END, 1),
+    /* strings (§15.6): concat, format and printf are variadic */
+    LW("concat", "s:", STRINGS, SCAT, 0),
+    LW("format", "s:", STRINGS, SFMT, 0),
+    LW("printf", "0:", STRINGS, SPRINT, 0),
+    LW("match", "f:ss", MATCH, SMATCH, 0),
+    /* message passing (§15.7) */
+    LW("displacement", "f:sV", MESSAGE, MESSAGE, SL_MSG_DISPLACEMENT),
+    LW("surface", "f:sV", MESSAGE, MESSAGE, SL_MSG_SURFACE),
+    LW("lightsource", "f:sV", MESSAGE, MESSAGE, SL_MSG_LIGHTSOURCE),
+    LW("attribute", "f:sV", MESSAGE, MESSAGE, SL_MSG_ATTRIBUTE),
+    LW("option", "f:sV", MESSAGE, MESSAGE, SL_MSG_OPTION),
+    LW("rendererinfo", "f:sV", MESSAGE, MESSAGE, SL_MSG_RENDERERINFO),
+    /* spline (§15.1): variadic, checked by check_spline */
+    LW("spline", "A:", SPLINE, END, 0),
 };
 
 enum { TABLE_SIZE = sizeof table / sizeof table[0] };
@@ -183,6 +231,25 @@ static int candidate_cost(const sl_builtin *b, const sl_ty *have, int n, sl_ty h
             want[i] = have[i];
             continue;
         }
+        if (c == 'V') {
+            if (sl_ty_is_array(have[i]) || sl_ty_is_list(have[i]) || have[i] == SL_TY_BOOL ||
+                have[i] == SL_TY_ERROR)
+                return -1;
+            want[i] = have[i];
+            continue;
+        }
+        if (c == 'w') {
+            if (have[i] != SL_TYPE_FLOAT)
+                return -1;
+            want[i] = have[i];
+            continue;
+        }
+        if (c == 'M') {
+            if (have[i] != SL_TYPE_MATRIX)
+                return -1;
+            want[i] = have[i];
+            continue;
+        }
         if (c == 'O') {
             if (!sl_ty_is_triple(have[i]))
                 return -1;
@@ -240,6 +307,9 @@ static const char *letter_name(char c)
     switch (c) {
     case 'S': case 'o': return "point|vector|normal";
     case 'O': case 'T': return "triple";
+    case 'M': return "matrix";
+    case 'w': return "float";
+    case 'V': return "variable";
     case 'G': return "float|triple";
     default: return sl_ty_name(letter_type(c));
     }
@@ -259,6 +329,64 @@ void sl_builtin_candidates(const char *name, char *buf, size_t size)
         if (o < size)
             o += (size_t)snprintf(buf + o, size - o, ")");
     }
+}
+
+/* ---------------------------------------------------------------------- */
+/* spline bases                                                            */
+/* ---------------------------------------------------------------------- */
+
+/* The basis matrices of RiBasis (RI Spec 3.2 §4.1.2) in the power form
+ * x^3, x^2, x, 1 (rows) over the segment's 4 knots (columns). */
+static const sl_spline_basis bases[] = {
+    [SL_SPLINE_CATMULL_ROM] = { "catmull-rom", 1, { { -0.5, 1.5, -1.5, 0.5 },
+                                                    { 1, -2.5, 2, -0.5 },
+                                                    { -0.5, 0, 0.5, 0 },
+                                                    { 0, 1, 0, 0 } } },
+    [1] = { "bezier", 3, { { -1, 3, -3, 1 }, { 3, -6, 3, 0 }, { -3, 3, 0, 0 },
+                           { 1, 0, 0, 0 } } },
+    [2] = { "b-spline", 1, { { -1 / 6.0, 0.5, -0.5, 1 / 6.0 }, { 0.5, -1, 0.5, 0 },
+                             { -0.5, 0, 0.5, 0 }, { 1 / 6.0, 4 / 6.0, 1 / 6.0, 0 } } },
+    /* knots: value0, tangent0, value1, tangent1 */
+    [3] = { "hermite", 2, { { 2, 1, -2, 1 }, { -3, -2, 3, -1 }, { 0, 1, 0, 0 },
+                            { 1, 0, 0, 0 } } },
+    [4] = { "linear", 1, { { 0, 0, 0, 0 }, { 0, 0, 0, 0 }, { 0, -1, 1, 0 },
+                           { 0, 1, 0, 0 } } },
+    [SL_SPLINE_CONSTANT] = { "constant", 1, { { 0, 0, 0, 0 }, { 0, 0, 0, 0 },
+                                              { 0, 0, 0, 0 }, { 0, 1, 0, 0 } } },
+};
+
+int sl_spline_basis_find(const char *name)
+{
+    for (int i = 0; i < (int)(sizeof bases / sizeof bases[0]); i++)
+        if (strcmp(bases[i].name, name) == 0)
+            return i;
+    if (strcmp(name, "catmullrom") == 0)
+        return SL_SPLINE_CATMULL_ROM;
+    if (strcmp(name, "bspline") == 0)
+        return 2;
+    return -1;
+}
+
+const sl_spline_basis *sl_spline_basis_get(int index) { return &bases[index]; }
+
+/* ---------------------------------------------------------------------- */
+/* color spaces                                                            */
+/* ---------------------------------------------------------------------- */
+
+int sl_color_space_find(const char *name)
+{
+    static const struct {
+        const char *name;
+        sl_color_space space;
+    } names[] = {
+        { "rgb", SL_CSPACE_RGB }, { "hsv", SL_CSPACE_HSV }, { "hsl", SL_CSPACE_HSL },
+        { "xyz", SL_CSPACE_XYZ }, { "XYZ", SL_CSPACE_XYZ }, { "xyY", SL_CSPACE_XYY },
+        { "YIQ", SL_CSPACE_YIQ },
+    };
+    for (size_t i = 0; i < sizeof names / sizeof names[0]; i++)
+        if (strcmp(names[i].name, name) == 0)
+            return (int)names[i].space;
+    return -1;
 }
 
 /* ---------------------------------------------------------------------- */
@@ -294,6 +422,8 @@ static const struct {
 
 int sl_global_find(const char *name)
 {
+    if (strcmp(name, "Ps") == 0)     /* light shaders: the point being lit */
+        return SL_G_P;
     for (int g = 0; g < SL_G__COUNT; g++)
         if (strcmp(globals[g].name, name) == 0)
             return g;

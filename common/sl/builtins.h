@@ -8,6 +8,8 @@
  *   f float  p point  v vector  n normal  c color  s string  m matrix
  *   0 void (result)   o an assignable variable of any spatial type
  *   O an assignable variable of any triple type
+ *   M an assignable matrix variable   w an assignable float variable
+ *   V an assignable variable of any type but arrays
  *   S any spatial type (point/vector/normal)
  *   T any triple (point/vector/normal/color; all T of a call agree)
  *   G float or any triple (all G of a call agree; floats promote)
@@ -38,6 +40,22 @@ typedef enum sl_lowering {
     SL_LOWER_NOISE,       /* k: SL_NOISE_PLAIN / PERIODIC / CELL */
     SL_LOWER_RANDOM,
     SL_LOWER_LIGHT,       /* op: AMBIENT DIFFUSE SPECULAR PHONG */
+    SL_LOWER_CTRANSFORM,  /* ctransform([from,] to, c): constant color spaces */
+    SL_LOWER_DETERMINANT,
+    SL_LOWER_MATRIX_XFORM, /* k: 0 translate, 1 rotate, 2 scale */
+    SL_LOWER_MCOMP,       /* comp(m, row, col) */
+    SL_LOWER_MSETCOMP,    /* setcomp(m, row, col, v) */
+    SL_LOWER_REFRACT, SL_LOWER_FRESNEL, SL_LOWER_DEPTH,
+    SL_LOWER_FILTERSTEP,  /* filterstep(edge, x [, x1] [, "width", w] [, "filter", f]) */
+    SL_LOWER_ILLUMINANCE, /* the parts of an illuminance loop (parser.c):
+                             op LSTART / LNEXT, or END: the cone test */
+    SL_LOWER_EMITTER,     /* illuminate / solar (parser.c): k 0 / 1 */
+    SL_LOWER_STRINGS,     /* concat, format, printf: variadic, checked apart
+                             (check_strings); op SCAT / SFMT / SPRINT */
+    SL_LOWER_MATCH,
+    SL_LOWER_MESSAGE,     /* displacement("name", x) ...: k = sl_message_scope */
+    SL_LOWER_SPLINE,      /* spline([basis,] t, knots... | knots[]): checked
+                             apart (variadic); node op = the basis index */
 } sl_lowering;
 
 typedef struct sl_builtin {
@@ -62,6 +80,36 @@ const sl_builtin *sl_builtin_resolve(const char *name, const sl_ty *args, int na
 
 /* "noise(float), noise(float, float), ..." for a message, into buf. */
 void sl_builtin_candidates(const char *name, char *buf, size_t size);
+
+/* The spline bases (RI Spec 3.2 §15.1 spline, RiBasis §4.1.2): a cubic
+ * segment over 4 consecutive knots, the segments `step` knots apart:
+ * value(x) = sum_i x^(3-i) sum_j m[i][j] knot[seg*step + j], x in [0, 1].
+ * "linear" and "constant" use catmull-rom's layout (the first and the last
+ * knot are not interpolated); "constant" is knot[seg*step + 1]. */
+typedef struct sl_spline_basis {
+    const char *name;
+    int step;
+    double m[4][4];
+} sl_spline_basis;
+
+enum { SL_SPLINE_CATMULL_ROM = 0, SL_SPLINE_CONSTANT = 5 };
+
+/* The basis index of `name` ("catmull-rom", "bezier", "b-spline",
+ * "hermite", "linear", "constant"), or -1. */
+int sl_spline_basis_find(const char *name);
+const sl_spline_basis *sl_spline_basis_get(int index);
+
+/* Color spaces (RI Spec 3.2 §15.1 ctransform, §13 color constructors):
+ * "rgb" (the current one), "hsv", "hsl", "xyz" and "XYZ" (CIE XYZ of
+ * linear Rec. 709 / sRGB primaries, D65), "xyY", "YIQ" (NTSC). */
+typedef enum sl_color_space {
+    SL_CSPACE_RGB, SL_CSPACE_HSV, SL_CSPACE_HSL, SL_CSPACE_XYZ, SL_CSPACE_XYY,
+    SL_CSPACE_YIQ,
+} sl_color_space;
+
+/* The color space called `name`, or -1. */
+int sl_color_space_find(const char *name);
+#define SL_COLOR_SPACE_NAMES "\"rgb\", \"hsv\", \"hsl\", \"xyz\", \"XYZ\", \"xyY\", \"YIQ\""
 
 /* Globals: name -> sl_global (or -1), its type, whether shaders may
  * assign it (P, N, Ci, Oi). */

@@ -225,7 +225,9 @@ void sl_program_dump(const sl_program *self, FILE *out)
     const sl_program *p = self;
     fprintf(out, "shader '%s' (%s): %d instructions, %d slots (%d globals, %d constants "
                  "from r%d), %d string slots\n",
-            p->name, p->kind == SL_SHADER_SURFACE ? "surface" : "displacement", p->ncode,
+            p->name,
+            p->kind == SL_SHADER_SURFACE ? "surface"
+            : p->kind == SL_SHADER_LIGHT ? "light" : "displacement", p->ncode,
             p->nslots, SL_GLOBAL_SLOTS, p->nconsts, p->const_base, p->nstring_slots);
     if (p->nparams)
         fprintf(out, "parameters:\n");

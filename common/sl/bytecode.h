@@ -84,7 +84,11 @@ enum {
     X(LOOP_TEST, "loop.test", "xjt-") X(LOOP_END, "loop.end", "kt--") \
     X(PARAM, "param", "zpjx") X(SPARAM, "sparam", "spjs")        \
     X(ESCAPE, "escape", "zktk") X(ACCUM_END, "accum.end", "kt-k") \
-    X(ALOAD, "aload", "zxxk") X(ASTORE, "astore", "zxxk")
+    X(ALOAD, "aload", "zxxk") X(ASTORE, "astore", "zxxk")        \
+    X(LSTART, "lstart", "----") X(LNEXT, "lnext", "z---")          \
+    X(MESSAGE, "message", "zskk")                                \
+    X(SCAT, "scat", "sss-") X(SFMT, "sfmt", "sxsk")              \
+    X(SPRINT, "sprint", "s---") X(SMATCH, "smatch", "zss-")
 
 typedef enum sl_opcode {
 #define SL_OPCODE_ENUM(name, text, operands) SL_OP_##name,
@@ -140,6 +144,20 @@ enum {
  * accumulator back. */
 enum { SL_ESCAPE_LOOP = 0, SL_ESCAPE_FUNC = 1 };
 
+/* MESSAGE flag, name, var, d (message passing, shader.h): d = scope | size
+ * << 4 (size 0: var is a string slot, else var's numeric slots). */
+
+/* Strings (RI Spec 3.2 §15.6): SCAT z, a, b concatenates; SFMT z, x, spec,
+ * size formats size numbers from slot x with the C conversion spec (checked
+ * when compiling: flags, width, precision, one of f e g or lld), a range
+ * as "[lo hi]"; SPRINT s prints a line to stderr (float mode only, at most
+ * SL_VM_MAX_PRINTS lines per VM); SMATCH z, pattern, subject is match().
+ * Results live in the VM's string space, reset at each run. */
+
+/* illuminance loops (RI Spec 3.2 §15.4): LSTART takes the non-ambient
+ * light samples of this mode at P; each LNEXT z loads the next one into the
+ * globals L and Cl and sets z to 1, or sets z to 0 after the last. */
+
 /* NOISE variant (operand c): dimension in bits 0-2, kind in bits 3-4,
  * three outputs (point/vector/color noise) in bit 5. */
 enum {
@@ -153,6 +171,10 @@ enum {
 /* SPACE/SPACEK direction (operand c): the matrix that takes points from the
  * named space to "current", or the one from "current" to it. */
 enum { SL_SPACE_TO_CURRENT = 0, SL_SPACE_FROM_CURRENT = 1 };
+
+/* SPACEK's pseudo-space of depth(P): the matrix from "current" to camera
+ * space with z mapped to (z - near) / (far - near) (sl_vm_set_clipping). */
+enum { SL_SPACE_DEPTH = 15 };
 
 typedef struct sl_param {
     char *name;
@@ -189,6 +211,7 @@ struct sl_program {
 
     int nslots;                     /* scalar slots used */
     int nstring_slots;
+    bool emits_light;               /* a light shader with illuminate or solar */
     bool takes_derivatives;         /* a DU, DV, DERIV, CALCNORMAL or AREA may
                                        flow into P: interval/affine runs carry
                                        derivative bounds (vm_deriv.inc) */

@@ -29,6 +29,7 @@
 #include "sl/check.h"
 #include "sl/builtins.h"
 #include "sl/lexer.h"
+#include "sl/strmatch.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -575,6 +576,44 @@ static void check_space_arg(checker *c, const sl_node *arg)
                            "\"object\", \"shader\", \"camera\")", arg->name);
 }
 
+/* filterstep's optional parameters: "width", a float (the filter width's
+ * multiplier), and "filter", a constant filter name (the box filter is
+ * used whatever the name). Called for each string argument i. */
+static void check_filter_param(checker *c, const sl_node *n, int i)
+{
+    static const char *const filters[] = { "box", "triangle", "catmull-rom", "gaussian",
+                                           "sinc", "disk", "bessel" };
+    const sl_node *arg = n->list[i];
+    bool value = i > 0 && n->list[i - 1]->ty == SL_TYPE_STRING &&
+                 n->list[i - 1]->kind == SL_N_STR && strcmp(n->list[i - 1]->name, "filter") == 0;
+    if (arg->kind != SL_N_STR) {
+        error(c, arg->pos, "filterstep() parameters must be constant strings");
+        return;
+    }
+    if (value) {
+        for (size_t k = 0; k < sizeof filters / sizeof filters[0]; k++)
+            if (strcmp(arg->name, filters[k]) == 0)
+                return;
+        error(c, arg->pos, "unknown filter '%s' (known: \"box\", \"triangle\", "
+              "\"catmull-rom\", \"gaussian\", \"sinc\", \"disk\", \"bessel\")", arg->name);
+        return;
+    }
+    bool takes_string = i + 1 < n->nlist && n->list[i + 1]->ty == SL_TYPE_STRING;
+    if (strcmp(arg->name, takes_string ? "filter" : "width") != 0)
+        error(c, arg->pos, "unknown filterstep() parameter '%s' (known: \"width\" with a "
+              "float, \"filter\" with a name)", arg->name);
+}
+
+/* A color space argument (ctransform): a constant string naming one. */
+static void check_color_space_arg(checker *c, const sl_node *arg)
+{
+    if (arg->kind != SL_N_STR)
+        error(c, arg->pos, "the color space of ctransform() must be a constant string");
+    else if (sl_color_space_find(arg->name) < 0)
+        error(c, arg->pos, "unknown color space '%s' (known: " SL_COLOR_SPACE_NAMES ")",
+              arg->name);
+}
+
 static sl_ty check_builtin_call(checker *c, sl_node *n, const sl_ty *args, sl_ty hint)
 {
     sl_ty want[8], result;
@@ -594,9 +633,15 @@ static sl_ty check_builtin_call(checker *c, sl_node *n, const sl_ty *args, sl_ty
         return set_ty(n, SL_TY_ERROR);
     }
     n->builtin = b;
+    if (b->lower == SL_LOWER_EMITTER && c->file->kind != SL_SHADER_LIGHT) {
+        error(c, n->pos, "'%s' is only allowed in light shaders", b->op == SL_OP_END &&
+              b->k == 0 ? "illuminate" : "solar");
+        return set_ty(n, SL_TY_ERROR);
+    }
     const char *sig = b->sig + 2;
     for (int i = 0; i < n->nlist; i++) {
-        if (sig[i] == 'o' || sig[i] == 'O') {
+        if (sig[i] == 'o' || sig[i] == 'O' || sig[i] == 'M' || sig[i] == 'w' ||
+            sig[i] == 'V') {
             sl_node *a = n->list[i];
             if (a->kind != SL_N_IDENT)
                 error(c, a->pos, "argument %d of '%s' must be a variable", i + 1, n->name);
@@ -604,7 +649,25 @@ static sl_ty check_builtin_call(checker *c, sl_node *n, const sl_ty *args, sl_ty
                 check_assignable(c, a, "modify");
             continue;
         }
-        if (sig[i] == 's')
+        if (sig[i] == 's' && b->lower == SL_LOWER_FILTERSTEP) {
+            check_filter_param(c, n, i);
+            continue;
+        }
+        if (sig[i] == 's' && b->lower == SL_LOWER_MATCH) {
+            int bad = i == 0 && n->list[0]->kind == SL_N_STR ? sl_match_check(n->list[0]->name)
+                                                             : 0;
+            if (bad)
+                error(c, n->list[0]->pos, "malformed regular expression '%s' (at character "
+                      "%d)", n->list[0]->name, bad);
+            continue;
+        }
+        if (sig[i] == 's' && b->lower == SL_LOWER_MESSAGE) {
+            wrap_conv(c, &n->list[i], want[i]);
+            continue;
+        }
+        if (sig[i] == 's' && b->lower == SL_LOWER_CTRANSFORM)
+            check_color_space_arg(c, n->list[i]);
+        else if (sig[i] == 's')
             check_space_arg(c, n->list[i]);
         wrap_conv(c, &n->list[i], want[i]);
     }
@@ -817,17 +880,236 @@ static sl_ty check_arraylength(checker *c, sl_node *n)
     return set_ty(n, SL_TYPE_FLOAT);
 }
 
+/* spline([basis,] t, k0, k1, ...) and spline([basis,] t, knots[]) (RI
+ * Spec 3.2 §15.1): the knots are floats, colors, points or vectors (the
+ * first knot's type, or the context's for an untyped first knot); the
+ * basis a constant string naming one of sl_spline_basis_find's. At least
+ * 4 knots, and 4 + a multiple of the basis' step. The node's op is the
+ * basis; an array's length is checked where it is known (an unsized
+ * parameter's: when its call is generated). */
+static sl_ty check_spline(checker *c, sl_node *n, sl_ty hint)
+{
+    int first = 0, basis = SL_SPLINE_CATMULL_ROM;
+    bool bad = false;
+    if (n->nlist > 0 && n->list[0]->kind == SL_N_STR) {
+        basis = sl_spline_basis_find(n->list[0]->name);
+        if (basis < 0) {
+            error(c, n->list[0]->pos, "unknown spline basis '%s' (known: \"catmull-rom\", "
+                  "\"bezier\", \"b-spline\", \"hermite\", \"linear\", \"constant\")",
+                  n->list[0]->name);
+            bad = true;
+        }
+        check_expr(c, &n->list[0], SL_TYPE_STRING);
+        first = 1;
+    }
+    for (int i = first; i < n->nlist; i++)
+        bad |= check_expr(c, &n->list[i], i == first ? SL_TYPE_FLOAT
+                          : sl_ty_is_triple(hint) ? hint : SL_TYPE_VOID) == SL_TY_ERROR;
+    if (bad)
+        return set_ty(n, SL_TY_ERROR);
+    if (first == 0 && n->nlist > 0 && n->list[0]->ty == SL_TYPE_STRING) {
+        error(c, n->list[0]->pos, "the basis of spline() must be a constant string");
+        return set_ty(n, SL_TY_ERROR);
+    }
+    int nknots = n->nlist - first - 1;
+    if (nknots < 1 || n->list[first]->ty != SL_TYPE_FLOAT) {
+        error(c, n->pos, "spline() takes [basis,] a float parameter and the knots "
+                         "(4 or more values, or an array)");
+        return set_ty(n, SL_TY_ERROR);
+    }
+    const sl_spline_basis *b = sl_spline_basis_get(basis);
+    sl_node *k0 = n->list[first + 1];
+    sl_ty elem;
+    if (nknots == 1 && sl_ty_is_array(k0->ty)) {
+        elem = sl_ty_elem(k0->ty);
+        nknots = sl_ty_len(k0->ty);
+        if (k0->kind != SL_N_IDENT) {
+            error(c, k0->pos, "the knots of spline() must be an array variable");
+            return set_ty(n, SL_TY_ERROR);
+        }
+        if (elem == SL_TYPE_MATRIX || elem == SL_TYPE_STRING) {
+            error(c, k0->pos, "spline() interpolates floats and triples, not '%s'",
+                  sl_ty_name(k0->ty));
+            return set_ty(n, SL_TY_ERROR);
+        }
+    } else {
+        elem = k0->ty == SL_TY_LIST3 ? (sl_ty_is_triple(hint) ? hint : SL_TYPE_POINT) : k0->ty;
+        if (elem != SL_TYPE_FLOAT && !sl_ty_is_triple(elem)) {
+            error(c, k0->pos, "spline() interpolates floats and triples, not '%s'",
+                  sl_ty_name(k0->ty));
+            return set_ty(n, SL_TY_ERROR);
+        }
+        for (int i = first + 1; i < n->nlist; i++) {
+            sl_ty have = n->list[i]->ty;
+            if (!can_convert(have, elem) || sl_ty_is_array(have) ||
+                (elem == SL_TYPE_FLOAT && have != SL_TYPE_FLOAT)) {
+                error(c, n->list[i]->pos, "knot %d of spline() is a '%s', the first a '%s'",
+                      i - first, sl_ty_name(have), sl_ty_name(elem));
+                return set_ty(n, SL_TY_ERROR);
+            }
+            wrap_conv(c, &n->list[i], elem);
+        }
+    }
+    if (nknots && (nknots < 4 || (nknots - 4) % b->step != 0)) {
+        error(c, n->pos, "a '%s' spline takes 4%s knots, not %d", b->name,
+              b->step == 3 ? ", 7, 10, ..." : b->step == 2 ? ", 6, 8, ..." : " or more",
+              nknots);
+        return set_ty(n, SL_TY_ERROR);
+    }
+    int count;
+    n->builtin = sl_builtin_find("spline", &count);
+    n->op = basis;
+    return set_ty(n, elem);
+}
+
+/* The conversions of a format string (RI Spec 3.2 §15.6): "%%", or "%"
+ * flags [-+ 0], width, .precision and one of f e g d i (a float), p v n
+ * (a point, vector or normal), c (a color), m (a matrix), s (a string).
+ * Calls fn for each; returns the number of conversions, or -1 (reported)
+ * for a malformed one. Shared with the code generator. */
+int sl_format_walk(const char *fmt, void (*fn)(void *, const char *spec, size_t len, char conv,
+                                              const char *lit, size_t litlen), void *arg)
+{
+    int count = 0;
+    const char *lit = fmt;
+    for (const char *p = fmt; *p; p++) {
+        if (*p != '%')
+            continue;
+        if (p[1] == '%') {              /* the literal up to and with one '%' */
+            if (fn)
+                fn(arg, NULL, 0, '%', lit, (size_t)(p + 1 - lit));
+            lit = ++p + 1;
+            continue;
+        }
+        const char *q = p + 1;
+        while (*q && strchr("-+ 0", *q))
+            q++;
+        while (*q >= '0' && *q <= '9')
+            q++;
+        if (*q == '.')
+            for (q++; *q >= '0' && *q <= '9'; q++)
+                ;
+        if (!*q || !strchr("fegdipvncms", *q) || q - p > 20)
+            return -1;
+        if (fn)
+            fn(arg, p, (size_t)(q - p), *q, lit, (size_t)(p - lit));
+        count++;
+        p = q;
+        lit = q + 1;
+    }
+    if (fn && *lit)
+        fn(arg, NULL, 0, 0, lit, strlen(lit));
+    return count;
+}
+
+typedef struct format_check {
+    char convs[64];
+    int n;
+} format_check;
+
+static void collect_conv(void *arg, const char *spec, size_t len, char conv, const char *lit,
+                         size_t litlen)
+{
+    (void)len;
+    (void)lit;
+    (void)litlen;
+    format_check *f = arg;
+    if (spec && f->n < 64)
+        f->convs[f->n] = conv;
+    if (spec)
+        f->n++;
+}
+
+/* concat(s, ...), format(fmt, ...), printf(fmt, ...): strings, and a
+ * constant format whose conversions match the arguments' types. */
+static sl_ty check_strings(checker *c, sl_node *n, const sl_builtin *b)
+{
+    bool bad = false;
+    for (int i = 0; i < n->nlist; i++)
+        bad |= check_expr(c, &n->list[i], SL_TYPE_VOID) == SL_TY_ERROR;
+    if (bad)
+        return set_ty(n, SL_TY_ERROR);
+    if (b->op == SL_OP_SCAT) {
+        for (int i = 0; i < n->nlist; i++) {
+            if (n->list[i]->ty != SL_TYPE_STRING) {
+                error(c, n->list[i]->pos, "argument %d of concat() is a '%s', not a string",
+                      i + 1, sl_ty_name(n->list[i]->ty));
+                return set_ty(n, SL_TY_ERROR);
+            }
+        }
+        if (n->nlist == 0) {
+            error(c, n->pos, "concat() takes one or more strings");
+            return set_ty(n, SL_TY_ERROR);
+        }
+    } else {
+        if (n->nlist == 0 || n->list[0]->kind != SL_N_STR) {
+            error(c, n->pos, "%s() needs a constant format string first", n->name);
+            return set_ty(n, SL_TY_ERROR);
+        }
+        format_check f = { .n = 0 };
+        int count = sl_format_walk(n->list[0]->name, collect_conv, &f);
+        if (count < 0) {
+            error(c, n->list[0]->pos, "malformed conversion in the format string (known: "
+                  "%%f %%e %%g %%d %%i %%p %%v %%n %%c %%m %%s %%%%)");
+            return set_ty(n, SL_TY_ERROR);
+        }
+        if (count != n->nlist - 1 || count > 64) {
+            error(c, n->pos, "the format string of %s() has %d conversions, but %d values "
+                  "follow it", n->name, count, n->nlist - 1);
+            return set_ty(n, SL_TY_ERROR);
+        }
+        for (int i = 0; i < count; i++) {
+            sl_ty ty = n->list[i + 1]->ty;
+            char k = f.convs[i];
+            bool ok = strchr("fegdi", k) ? ty == SL_TYPE_FLOAT
+                    : strchr("pvn", k) ? sl_ty_is_spatial(ty)
+                    : k == 'c' ? ty == SL_TYPE_COLOR
+                    : k == 'm' ? ty == SL_TYPE_MATRIX : ty == SL_TYPE_STRING;
+            if (!ok) {
+                error(c, n->list[i + 1]->pos, "'%%%c' in the format string of %s() does not "
+                      "take a '%s'", k, n->name, sl_ty_name(ty));
+                return set_ty(n, SL_TY_ERROR);
+            }
+        }
+    }
+    n->builtin = b;
+    return set_ty(n, b->op == SL_OP_SPRINT ? SL_TYPE_VOID : SL_TYPE_STRING);
+}
+
 static sl_ty check_call(checker *c, sl_node *n, sl_ty hint)
 {
     sl_func *cands[MAX_OVERLOADS];
     int ncands = find_funcs(c, n->name, cands, MAX_OVERLOADS);
     if (ncands == 0 && strcmp(n->name, "arraylength") == 0)
         return check_arraylength(c, n);
+    if (ncands == 0 && strcmp(n->name, "spline") == 0)
+        return check_spline(c, n, hint);
+    if (ncands == 0) {
+        int count;
+        const sl_builtin *b = sl_builtin_find(n->name, &count);
+        if (b && b->lower == SL_LOWER_STRINGS)
+            return check_strings(c, n, b);
+    }
     int count;
     bool builtin = sl_builtin_find(n->name, &count) != NULL;
     if (!ncands && !builtin) {
         for (int i = 0; i < n->nlist; i++)
             check_expr(c, &n->list[i], SL_TYPE_VOID);
+        static const char *const later[] = {
+            "texture", "environment", "shadow", "bump", "textureinfo",
+        };
+        for (size_t k = 0; k < sizeof later / sizeof later[0]; k++) {
+            if (strcmp(n->name, later[k]) == 0) {
+                error(c, n->pos, "'%s' is not supported yet: texture, environment and "
+                                 "shadow maps come with the texture work (issue 16)", n->name);
+                return set_ty(n, SL_TY_ERROR);
+            }
+        }
+        if (strcmp(n->name, "trace") == 0 || strcmp(n->name, "gather") == 0) {
+            error(c, n->pos, "'%s' is not supported yet: shaders cannot trace rays in "
+                             "aafarm's ray tracer", n->name);
+            return set_ty(n, SL_TY_ERROR);
+        }
         if (lookup(c, n->name))
             error(c, n->pos, "called object '%s' is not a function", n->name);
         else
@@ -952,8 +1234,15 @@ static sl_ty check_cast(checker *c, sl_node *n, sl_ty hint)
             return set_ty(n, SL_TY_ERROR);
         }
     } else if (ty == SL_TYPE_COLOR) {
-        if (strcmp(n->name, "rgb") != 0) {
-            error(c, n->pos, "unsupported color space '%s' (only \"rgb\")", n->name);
+        if (sl_color_space_find(n->name) < 0) {
+            error(c, n->pos, "unknown color space '%s' (known: " SL_COLOR_SPACE_NAMES ")",
+                  n->name);
+            return set_ty(n, SL_TY_ERROR);
+        }
+    } else if (ty == SL_TYPE_MATRIX) {
+        if (sl_space_find(n->name) < 0) {
+            error(c, n->pos, "unknown space '%s' (known: \"current\", \"world\", "
+                             "\"object\", \"shader\", \"camera\")", n->name);
             return set_ty(n, SL_TY_ERROR);
         }
     } else {
@@ -1357,7 +1646,8 @@ static void make_globals(checker *c)
         s->ty = sl_global_type((sl_global)g);
         s->kind = SL_SYM_GLOBAL;
         s->global = g;
-        s->writable = sl_global_writable((sl_global)g);
+        s->writable = sl_global_writable((sl_global)g) ||
+                      (c->file->kind == SL_SHADER_LIGHT && (g == SL_G_Cl || g == SL_G_L));
         s->slot = sl_global_slot((sl_global)g);
         c->globals[g] = s;
     }

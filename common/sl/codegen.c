@@ -79,6 +79,7 @@ typedef struct cg {
 
 static int gen_expr(cg *g, sl_node *e, int dst);
 static void gen_stmt(cg *g, sl_node *n);
+static int gen_color_space(cg *g, int space, int x, bool from);
 
 static void fail(cg *g, const char *fmt, ...) SL_PRINTF(2, 3);
 static void fail(cg *g, const char *fmt, ...)
@@ -798,6 +799,15 @@ static int gen_cast(cg *g, sl_node *e, int dst)
         for (int i = 0; i < e->nlist; i++)
             gen_expr(g, e->list[i], n == 16 ? v + (i % 4) * 4 + i / 4 : v + i);
     }
+    if (e->name && e->ty == SL_TYPE_COLOR)      /* color "hsv" (h, s, v) */
+        return into(g, gen_color_space(g, sl_color_space_find(e->name), v, true), dst, 3);
+    if (e->name && e->ty == SL_TYPE_MATRIX) {   /* given in that space: M * to_current */
+        sl_node space = { .kind = SL_N_STR, .name = e->name, .pos = e->pos };
+        if (is_current(&space))
+            return into(g, v, dst, 16);
+        int m = gen_space_matrix(g, &space, SL_SPACE_TO_CURRENT);
+        return gen_matmul(g, m, v, dst);
+    }
     if (e->name && sl_ty_is_spatial(e->ty)) {
         sl_opcode op = e->ty == SL_TYPE_POINT ? SL_OP_XPOINT
                      : e->ty == SL_TYPE_VECTOR ? SL_OP_XVECTOR : SL_OP_XNORMAL;
@@ -975,6 +985,551 @@ static int gen_light(cg *g, sl_node *e, const int *args, int dst)
     return into(g, z, dst, 3);
 }
 
+/* ---------------------------------------------------------------------- */
+/* color spaces and matrices                                               */
+/* ---------------------------------------------------------------------- */
+
+typedef struct select_job {
+    int src, z, n;
+} select_job;
+
+static void gen_select_job(cg *g, void *arg)
+{
+    select_job *job = arg;
+    emit_mov(g, job->z, job->src, job->n);
+}
+
+/* z = cond ? x : y over n slots (a branch: merged where cond is maybe). */
+static int gen_select(cg *g, int cond, int x, int y, int n)
+{
+    int z = alloc_slots(g, n);
+    select_job a = { x, z, n }, b = { y, z, n };
+    gen_branches(g, cond, gen_select_job, &a, gen_select_job, &b);
+    return z;
+}
+
+/* x / y, y replaced by 1 where it is 0 (the conversions' black and grey). */
+static int safe_div(cg *g, int x, int y)
+{
+    int one = const_slot(g, 1);
+    int d = gen_select(g, op2(g, SL_OP_EQ, y, const_slot(g, 0)), one, y, 1);
+    return op2(g, SL_OP_DIV, x, d);
+}
+
+/* The linear color spaces: rgb -> space (3x3, row-major). */
+static const double xyz_from_rgb[9] = {      /* linear Rec. 709 / sRGB primaries, D65 */
+    0.4124564, 0.3575761, 0.1804375,
+    0.2126729, 0.7151522, 0.0721750,
+    0.0193339, 0.1191920, 0.9503041,
+};
+static const double yiq_from_rgb[9] = {      /* NTSC */
+    0.299, 0.587, 0.114,
+    0.596, -0.274, -0.322,
+    0.211, -0.523, 0.312,
+};
+
+static void invert3(const double m[9], double inv[9])
+{
+    double c[9] = {
+        m[4] * m[8] - m[5] * m[7], m[2] * m[7] - m[1] * m[8], m[1] * m[5] - m[2] * m[4],
+        m[5] * m[6] - m[3] * m[8], m[0] * m[8] - m[2] * m[6], m[2] * m[3] - m[0] * m[5],
+        m[3] * m[7] - m[4] * m[6], m[1] * m[6] - m[0] * m[7], m[0] * m[4] - m[1] * m[3],
+    };
+    double det = m[0] * c[0] + m[1] * c[3] + m[2] * c[6];
+    for (int i = 0; i < 9; i++)
+        inv[i] = c[i] / det;
+}
+
+static int gen_mat3(cg *g, const double m[9], int x)
+{
+    int z = alloc_slots(g, 3);
+    for (int r = 0; r < 3; r++) {
+        emit(g, SL_OP_MUL, z + r, x, const_slot(g, m[r * 3]), 0);
+        for (int k = 1; k < 3; k++)
+            emit(g, SL_OP_ADD, z + r, z + r, op2(g, SL_OP_MUL, x + k, const_slot(g, m[r * 3 + k])), 0);
+    }
+    return z;
+}
+
+/* hsv / hsl -> rgb without branches: channel k of the fully saturated hue
+ * is clamp(|mod(6 h + (0, 4, 2)_k, 6) - 3| - 1, 0, 1); hsv scales it
+ * towards white by s and by v, hsl around l. */
+static int gen_from_hue(cg *g, int x, bool hsl)
+{
+    static const double offset[3] = { 0, 4, 2 };
+    int z = alloc_slots(g, 3);
+    int h6 = op2(g, SL_OP_MUL, x, const_slot(g, 6));
+    int chroma;
+    if (hsl) {       /* s (1 - |2 l - 1|) */
+        int l2 = op2(g, SL_OP_SUB, op2(g, SL_OP_MUL, x + 2, const_slot(g, 2)), const_slot(g, 1));
+        chroma = op2(g, SL_OP_MUL, x + 1, op2(g, SL_OP_SUB, const_slot(g, 1), op1(g, SL_OP_ABS, l2)));
+    } else {         /* s v */
+        chroma = op2(g, SL_OP_MUL, x + 1, x + 2);
+    }
+    for (int k = 0; k < 3; k++) {
+        int a = offset[k] ? op2(g, SL_OP_ADD, h6, const_slot(g, offset[k])) : h6;
+        a = op2(g, SL_OP_MOD, a, const_slot(g, 6));
+        a = op1(g, SL_OP_ABS, op2(g, SL_OP_SUB, a, const_slot(g, 3)));
+        a = op2(g, SL_OP_SUB, a, const_slot(g, 1));
+        emit(g, SL_OP_CLAMP, a, a, const_slot(g, 0), const_slot(g, 1));
+        if (hsl) {   /* l + chroma (c - 1/2) */
+            int d = op2(g, SL_OP_SUB, a, const_slot(g, 0.5));
+            emit(g, SL_OP_ADD, z + k, x + 2, op2(g, SL_OP_MUL, chroma, d), 0);
+        } else {     /* v - chroma + chroma c = v (1 - s + s c) */
+            int d = op2(g, SL_OP_SUB, a, const_slot(g, 1));
+            emit(g, SL_OP_ADD, z + k, x + 2, op2(g, SL_OP_MUL, chroma, d), 0);
+        }
+    }
+    return z;
+}
+
+/* rgb -> hsv / hsl: M = max, m = min, C = M - m; the hue from the sector
+ * of the largest channel (0 for greys), h in [0, 1). */
+static int gen_to_hue(cg *g, int x, bool hsl)
+{
+    int z = alloc_slots(g, 3);
+    int r = x, gg = x + 1, b = x + 2;
+    int M = op2(g, SL_OP_MAX, r, op2(g, SL_OP_MAX, gg, b));
+    int m = op2(g, SL_OP_MIN, r, op2(g, SL_OP_MIN, gg, b));
+    int C = op2(g, SL_OP_SUB, M, m);
+    int hr = op2(g, SL_OP_MOD, safe_div(g, op2(g, SL_OP_SUB, gg, b), C), const_slot(g, 6));
+    int hg = op2(g, SL_OP_ADD, safe_div(g, op2(g, SL_OP_SUB, b, r), C), const_slot(g, 2));
+    int hb = op2(g, SL_OP_ADD, safe_div(g, op2(g, SL_OP_SUB, r, gg), C), const_slot(g, 4));
+    int h = gen_select(g, op2(g, SL_OP_EQ, M, r), hr,
+                       gen_select(g, op2(g, SL_OP_EQ, M, gg), hg, hb, 1), 1);
+    emit(g, SL_OP_DIV, z, h, const_slot(g, 6), 0);
+    if (hsl) {
+        int l = op2(g, SL_OP_MUL, op2(g, SL_OP_ADD, M, m), const_slot(g, 0.5));
+        int l2 = op2(g, SL_OP_SUB, op2(g, SL_OP_MUL, l, const_slot(g, 2)), const_slot(g, 1));
+        int d = op2(g, SL_OP_SUB, const_slot(g, 1), op1(g, SL_OP_ABS, l2));
+        emit(g, SL_OP_MOV, z + 1, safe_div(g, C, d), 0, 0);
+        emit(g, SL_OP_MOV, z + 2, l, 0, 0);
+    } else {
+        emit(g, SL_OP_MOV, z + 1, safe_div(g, C, M), 0, 0);
+        emit(g, SL_OP_MOV, z + 2, M, 0, 0);
+    }
+    return z;
+}
+
+/* A color in `space` to rgb (from) or rgb to `space` (!from). */
+static int gen_color_space(cg *g, int space, int x, bool from)
+{
+    double inv[9];
+    switch ((sl_color_space)space) {
+    case SL_CSPACE_RGB: return x;
+    case SL_CSPACE_HSV: return from ? gen_from_hue(g, x, false) : gen_to_hue(g, x, false);
+    case SL_CSPACE_HSL: return from ? gen_from_hue(g, x, true) : gen_to_hue(g, x, true);
+    case SL_CSPACE_YIQ:
+        if (!from)
+            return gen_mat3(g, yiq_from_rgb, x);
+        invert3(yiq_from_rgb, inv);
+        return gen_mat3(g, inv, x);
+    case SL_CSPACE_XYZ:
+        if (!from)
+            return gen_mat3(g, xyz_from_rgb, x);
+        invert3(xyz_from_rgb, inv);
+        return gen_mat3(g, inv, x);
+    case SL_CSPACE_XYY:
+        if (!from) {     /* XYZ -> (X, Y) / (X + Y + Z), Y */
+            int q = gen_mat3(g, xyz_from_rgb, x);
+            int sum = op2(g, SL_OP_ADD, op2(g, SL_OP_ADD, q, q + 1), q + 2);
+            int z = alloc_slots(g, 3);
+            emit(g, SL_OP_MOV, z, safe_div(g, q, sum), 0, 0);
+            emit(g, SL_OP_MOV, z + 1, safe_div(g, q + 1, sum), 0, 0);
+            emit(g, SL_OP_MOV, z + 2, q + 1, 0, 0);
+            return z;
+        } else {         /* X = x Y / y, Z = (1 - x - y) Y / y */
+            int q = alloc_slots(g, 3);
+            int k = safe_div(g, x + 2, x + 1);
+            emit(g, SL_OP_MUL, q, x, k, 0);
+            emit(g, SL_OP_MOV, q + 1, x + 2, 0, 0);
+            int w = op2(g, SL_OP_SUB, op2(g, SL_OP_SUB, const_slot(g, 1), x), x + 1);
+            emit(g, SL_OP_MUL, q + 2, w, k, 0);
+            invert3(xyz_from_rgb, inv);
+            return gen_mat3(g, inv, q);
+        }
+    }
+    return x;
+}
+
+static int gen_ctransform(cg *g, sl_node *e, const int *args, int dst)
+{
+    int n = e->nlist, x = args[n - 1];
+    if (n == 3)
+        x = gen_color_space(g, sl_color_space_find(e->list[0]->name), x, true);
+    x = gen_color_space(g, sl_color_space_find(e->list[n - 2]->name), x, false);
+    return into(g, x, dst, 3);
+}
+
+/* determinant: Laplace expansion by the 2x2 minors of rows 0-1 and 2-3
+ * (the same for the transposed matrix the slots hold). */
+static int gen_determinant(cg *g, int m, int dst)
+{
+    static const int pairs[6][2] = { { 0, 1 }, { 0, 2 }, { 0, 3 }, { 1, 2 }, { 1, 3 }, { 2, 3 } };
+    static const double sign[6] = { 1, -1, 1, 1, -1, 1 };
+    int z = target(g, dst, 1);
+    for (int i = 0; i < 6; i++) {
+        int a = pairs[i][0], b = pairs[i][1];
+        int c = pairs[5 - i][0], d = pairs[5 - i][1];
+        int top = op2(g, SL_OP_SUB, op2(g, SL_OP_MUL, m + a, m + 4 + b),
+                      op2(g, SL_OP_MUL, m + b, m + 4 + a));
+        int bot = op2(g, SL_OP_SUB, op2(g, SL_OP_MUL, m + 8 + c, m + 12 + d),
+                      op2(g, SL_OP_MUL, m + 8 + d, m + 12 + c));
+        int t = op2(g, SL_OP_MUL, top, bot);
+        if (i == 0)
+            emit(g, SL_OP_MOV, z, t, 0, 0);
+        else
+            emit(g, sign[i] > 0 ? SL_OP_ADD : SL_OP_SUB, z, z, t, 0);
+    }
+    return z;
+}
+
+/* translate(m, t), rotate(m, angle, axis), scale(m, s): the transform is
+ * applied first, then m (as RiTranslate, RiRotate and RiScale concatenate
+ * onto the current transformation): m' = X * m in RenderMan's order. The
+ * slots hold the transpose (points as columns): X's 3x3 part at r * 4 + c,
+ * the translation in column 3. */
+static int gen_matrix_xform(cg *g, sl_node *e, const int *args, int dst)
+{
+    int x = alloc_slots(g, 16);
+    int zero = const_slot(g, 0), one = const_slot(g, 1);
+    for (int i = 0; i < 16; i++)
+        emit(g, SL_OP_MOV, x + i, i % 5 == 0 ? one : zero, 0, 0);
+    int kind = (int)e->builtin->k;
+    if (kind == 0) {
+        for (int r = 0; r < 3; r++)
+            emit(g, SL_OP_MOV, x + r * 4 + 3, args[1] + r, 0, 0);
+    } else if (kind == 2) {
+        for (int r = 0; r < 3; r++)
+            emit(g, SL_OP_MOV, x + r * 5, args[1] + r, 0, 0);
+    } else {         /* Rodrigues: c I + s [a]x + (1 - c) a a^T, a the unit axis */
+        int a = gen_normalize(g, args[2], -1);
+        int c = op1(g, SL_OP_COS, args[1]), s = op1(g, SL_OP_SIN, args[1]);
+        int t = op2(g, SL_OP_SUB, one, c);
+        for (int r = 0; r < 3; r++) {
+            for (int col = 0; col < 3; col++) {
+                int v = op2(g, SL_OP_MUL, t, op2(g, SL_OP_MUL, a + r, a + col));
+                if (r == col) {
+                    emit(g, SL_OP_ADD, x + r * 4 + col, v, c, 0);
+                    continue;
+                }
+                int k = 3 - r - col;              /* the third axis */
+                bool plus = (col - r + 3) % 3 == 2; /* [a]x: +a_k below the cycle */
+                int w = op2(g, SL_OP_MUL, s, a + k);
+                emit(g, plus ? SL_OP_ADD : SL_OP_SUB, x + r * 4 + col, v, w, 0);
+            }
+        }
+    }
+    return gen_matmul(g, args[0], x, dst);
+}
+
+/* comp(m, row, col) / setcomp(m, row, col, v): element (row, col) of the
+ * matrix as written (row vectors) is slot col * 4 + row. */
+static int gen_mcomp(cg *g, const int *args, bool set, int dst)
+{
+    int m = args[0], r = args[1], c = args[2];
+    if ((r & CONST_TAG) && (c & CONST_TAG)) {
+        double rv = floor(g->prog->consts[r & ~CONST_TAG]);
+        double cv = floor(g->prog->consts[c & ~CONST_TAG]);
+        if (!(rv >= 0 && rv < 4 && cv >= 0 && cv < 4)) {
+            fail(g, "matrix element (%g, %g) does not exist (rows and columns 0 to 3)", rv, cv);
+            return 0;
+        }
+        int slot = m + (int)cv * 4 + (int)rv;
+        if (!set)
+            return into(g, slot, dst, 1);
+        emit(g, SL_OP_MOV, slot, args[3], 0, 0);
+        return 0;
+    }
+    /* a row or column outside 0..3 pushes the index past the 16 elements,
+     * where aload/astore stop the run (range modes: clamped, conservative) */
+    int fr = op1(g, SL_OP_FLOOR, r), fc = op1(g, SL_OP_FLOOR, c);
+    int bad = op2(g, SL_OP_OR, op2(g, SL_OP_OR, op2(g, SL_OP_LT, fr, const_slot(g, 0)),
+                                   op2(g, SL_OP_GT, fr, const_slot(g, 3))),
+                  op2(g, SL_OP_OR, op2(g, SL_OP_LT, fc, const_slot(g, 0)),
+                      op2(g, SL_OP_GT, fc, const_slot(g, 3))));
+    int index = op2(g, SL_OP_ADD, op2(g, SL_OP_MUL, fc, const_slot(g, 4)), fr);
+    index = op2(g, SL_OP_ADD, index, op2(g, SL_OP_MUL, bad, const_slot(g, 64)));
+    if (set) {
+        emit(g, SL_OP_ASTORE, m, index, args[3], array_operand(16, 1));
+        record_write(g, m, 16);
+        return 0;
+    }
+    int z = alloc_slots(g, 1);
+    emit(g, SL_OP_ALOAD, z, m, index, array_operand(16, 1));
+    return into(g, z, dst, 1);
+}
+
+/* refract(I, N, eta) = eta I - (eta I.N + sqrt(k)) N with k = 1 - eta^2
+ * (1 - (I.N)^2); (0, 0, 0) where k < 0 (total internal reflection). */
+static int gen_refract(cg *g, int I, int N, int eta, int dst)
+{
+    int d = gen_dot(g, I, N, 3, -1);
+    int one = const_slot(g, 1);
+    int sin2 = op2(g, SL_OP_SUB, one, op2(g, SL_OP_MUL, d, d));
+    int k = op2(g, SL_OP_SUB, one, op2(g, SL_OP_MUL, op2(g, SL_OP_MUL, eta, eta), sin2));
+    int root = op1(g, SL_OP_SQRT, op2(g, SL_OP_MAX, k, const_slot(g, 0)));
+    int a = op2(g, SL_OP_ADD, op2(g, SL_OP_MUL, eta, d), root);
+    int r = alloc_slots(g, 3), zero = alloc_slots(g, 3);
+    for (int i = 0; i < 3; i++) {
+        emit(g, SL_OP_SUB, r + i, op2(g, SL_OP_MUL, eta, I + i), op2(g, SL_OP_MUL, a, N + i), 0);
+        emit(g, SL_OP_MOV, zero + i, const_slot(g, 0), 0, 0);
+    }
+    int z = gen_select(g, op2(g, SL_OP_LT, k, const_slot(g, 0)), zero, r, 3);
+    return into(g, z, dst, 3);
+}
+
+/* fresnel(I, N, eta, Kr, Kt [, R, T]) (I and N unit vectors; eta the
+ * ratio of the indices of refraction, as for refract): Cook and Torrance's
+ * unpolarised dielectric reflectance with c = |I.N|, g^2 = 1/eta^2 + c^2 -
+ * 1: Kr = 1/2 ((g - c)/(g + c))^2 (1 + ((c (g + c) - 1)/(c (g - c) + 1))^2),
+ * 1 where g^2 < 0 (total internal reflection); Kt = 1 - Kr; R = reflect(I,
+ * N), T = refract(I, N, eta). */
+static int gen_fresnel(cg *g, sl_node *e, const int *args)
+{
+    int I = args[0], N = args[1], eta = args[2];
+    int one = const_slot(g, 1);
+    int c = op1(g, SL_OP_ABS, gen_dot(g, I, N, 3, -1));
+    int inv = op2(g, SL_OP_DIV, one, eta);
+    int g2 = op2(g, SL_OP_SUB, op2(g, SL_OP_ADD, op2(g, SL_OP_MUL, inv, inv),
+                                   op2(g, SL_OP_MUL, c, c)), one);
+    int gg = op1(g, SL_OP_SQRT, op2(g, SL_OP_MAX, g2, const_slot(g, 0)));
+    int gpc = op2(g, SL_OP_ADD, gg, c), gmc = op2(g, SL_OP_SUB, gg, c);
+    int a = safe_div(g, gmc, gpc);
+    int b = safe_div(g, op2(g, SL_OP_SUB, op2(g, SL_OP_MUL, c, gpc), one),
+                     op2(g, SL_OP_ADD, op2(g, SL_OP_MUL, c, gmc), one));
+    int f = op2(g, SL_OP_MUL, op2(g, SL_OP_MUL, const_slot(g, 0.5), op2(g, SL_OP_MUL, a, a)),
+                op2(g, SL_OP_ADD, one, op2(g, SL_OP_MUL, b, b)));
+    int kr = gen_select(g, op2(g, SL_OP_LT, g2, const_slot(g, 0)), one, f, 1);
+    if (e->nlist == 7) {      /* before Kr and Kt: the outputs may alias I or N */
+        int r = gen_reflect(g, args, -1), t = gen_refract(g, I, N, eta, -1);
+        emit_mov(g, args[5], r, 3);
+        emit_mov(g, args[6], t, 3);
+    }
+    emit(g, SL_OP_MOV, args[3], kr, 0, 0);
+    emit(g, SL_OP_SUB, args[4], one, kr, 0);
+    return 0;
+}
+
+/* depth(P): z of P in camera space, (z - near) / (far - near), through the
+ * VM's depth pseudo-space (sl_vm_set_clipping). */
+static int gen_depth(cg *g, int p, int dst)
+{
+    int m = alloc_slots(g, 16);
+    emit(g, SL_OP_SPACEK, m, SL_SPACE_DEPTH, SL_SPACE_TO_CURRENT, 0);
+    int z = alloc_slots(g, 3);
+    emit(g, SL_OP_XPOINT, z, m, p, 0);
+    return into(g, z + 2, dst, 1);
+}
+
+/* filterstep(edge, x [, x1] [, "width", w] [, "filter", name]): the step
+ * box-filtered over [x - fw/2, x + fw/2], fw = w (|Du(x)| du + |Dv(x)| dv)
+ * the filter width of x, i.e. clamp((x - edge) / fw + 1/2, 0, 1); with x1,
+ * over [min(x, x1), max(x, x1)]. A zero width gives the step. */
+static int gen_filterstep(cg *g, sl_node *e, const int *args, int dst)
+{
+    int nf = 0;
+    while (nf < e->nlist && e->list[nf]->ty == SL_TYPE_FLOAT)
+        nf++;
+    int width = -1;
+    for (int i = nf; i + 1 < e->nlist; i += 2)
+        if (strcmp(e->list[i]->name, "width") == 0)
+            width = args[i + 1];
+    int edge = args[0], x = args[1];
+    int tiny = const_slot(g, 1e-12);
+    int r;
+    if (nf == 3) {
+        int lo = op2(g, SL_OP_MIN, x, args[2]), hi = op2(g, SL_OP_MAX, x, args[2]);
+        int w = op2(g, SL_OP_SUB, hi, lo);
+        if (width >= 0) {       /* widen about the middle */
+            int mid = op2(g, SL_OP_MUL, op2(g, SL_OP_ADD, lo, hi), const_slot(g, 0.5));
+            w = op2(g, SL_OP_MUL, w, width);
+            hi = op2(g, SL_OP_ADD, mid, op2(g, SL_OP_MUL, w, const_slot(g, 0.5)));
+        }
+        r = op2(g, SL_OP_DIV, op2(g, SL_OP_SUB, hi, edge), op2(g, SL_OP_MAX, w, tiny));
+    } else {
+        int du = op1(g, SL_OP_ABS, op1(g, SL_OP_DU, x));
+        int dv = op1(g, SL_OP_ABS, op1(g, SL_OP_DV, x));
+        int w = op2(g, SL_OP_ADD, op2(g, SL_OP_MUL, du, sl_global_slot(SL_G_du)),
+                    op2(g, SL_OP_MUL, dv, sl_global_slot(SL_G_dv)));
+        if (width >= 0)
+            w = op2(g, SL_OP_MUL, w, width);
+        r = op2(g, SL_OP_DIV, op2(g, SL_OP_SUB, x, edge), op2(g, SL_OP_MAX, w, tiny));
+        r = op2(g, SL_OP_ADD, r, const_slot(g, 0.5));
+    }
+    int z = target(g, dst, 1);
+    emit(g, SL_OP_CLAMP, z, r, const_slot(g, 0), const_slot(g, 1));
+    return z;
+}
+
+/* The parts of an illuminance loop (parser.c): start, next (loads L and
+ * Cl: they are written by the loop), and the cone test of
+ * illuminance(P, axis, angle): L . axis >= cos(angle) |L| |axis|. */
+static int gen_illuminance(cg *g, sl_node *e, const int *args, int dst)
+{
+    sl_opcode op = e->builtin->op;
+    if (op == SL_OP_LSTART) {
+        emit(g, SL_OP_LSTART, 0, 0, 0, 0);
+        return 0;
+    }
+    int L = sl_global_slot(SL_G_L);
+    if (op == SL_OP_LNEXT) {
+        int z = target(g, dst, 1);
+        emit(g, SL_OP_LNEXT, z, 0, 0, 0);
+        record_write(g, L, 3);
+        record_write(g, sl_global_slot(SL_G_Cl), 3);
+        return z;
+    }
+    int d = gen_dot(g, L, args[0], 3, -1);
+    int ll = op1(g, SL_OP_SQRT, gen_dot(g, L, L, 3, -1));
+    int la = op1(g, SL_OP_SQRT, gen_dot(g, args[0], args[0], 3, -1));
+    int r = op2(g, SL_OP_MUL, op2(g, SL_OP_MUL, op1(g, SL_OP_COS, args[1]), ll), la);
+    int z = target(g, dst, 1);
+    emit(g, SL_OP_GE, z, d, r, 0);
+    return z;
+}
+
+/* concat, format, printf: a chain of scat over the pieces; a numeric
+ * conversion becomes sfmt with the C spec ("%5.2f"; d and i as "lld"; the
+ * triple and matrix conversions as "f" per component). */
+typedef struct fmt_job {
+    cg *g;
+    sl_node *e;
+    int next, cur;
+} fmt_job;
+
+static void fmt_append(cg *g, fmt_job *job, int s)
+{
+    int z = alloc_string(g);
+    emit(g, SL_OP_SCAT, z, job->cur, s, 0);
+    record_string_write(g, z);
+    job->cur = z;
+}
+
+static void fmt_piece(void *arg, const char *spec, size_t len, char conv, const char *lit,
+                      size_t litlen)
+{
+    fmt_job *job = arg;
+    cg *g = job->g;
+    if (litlen)
+        fmt_append(g, job, string_const(g, lit, litlen));
+    if (!spec)
+        return;
+    sl_node *a = job->e->list[job->next++];
+    int x = gen_expr(g, a, -1);
+    if (conv == 's') {
+        fmt_append(g, job, x);
+        return;
+    }
+    char c_spec[32];
+    const char *tail = strchr("di", conv) ? "lld" : strchr("eg", conv) ? (conv == 'e' ? "e" : "g")
+                                                                      : "f";
+    snprintf(c_spec, sizeof c_spec, "%.*s%s", (int)(len), spec, tail);
+    int t = alloc_string(g);
+    emit(g, SL_OP_SFMT, t, x, string_const(g, c_spec, strlen(c_spec)), size_of(a));
+    record_string_write(g, t);
+    fmt_append(g, job, t);
+}
+
+static int gen_strings(cg *g, sl_node *e, int dst)
+{
+    sl_opcode op = e->builtin->op;
+    fmt_job job = { g, e, 1, string_const(g, "", 0) };
+    if (op == SL_OP_SCAT) {
+        job.cur = gen_expr(g, e->list[0], -1);
+        for (int i = 1; i < e->nlist; i++)
+            fmt_append(g, &job, gen_expr(g, e->list[i], -1));
+        return into_string(g, job.cur, dst);
+    }
+    sl_format_walk(e->list[0]->name, fmt_piece, &job);
+    if (op == SL_OP_SPRINT) {
+        emit(g, SL_OP_SPRINT, job.cur, 0, 0, 0);
+        return 0;
+    }
+    return into_string(g, job.cur, dst);
+}
+
+/* spline([basis,] t, knots): x = clamp(t, 0, 1) * segments; the segment
+ * seg = min(floor(x), segments - 1) and its 4 knots are read with aload
+ * (in interval/affine mode: the merge of every knot the segment range can
+ * reach, so the result is conservative), then the cubic of the basis is
+ * evaluated in x - seg by Horner's rule. */
+static int gen_spline(cg *g, sl_node *e, int dst)
+{
+    const sl_spline_basis *b = sl_spline_basis_get(e->op);
+    int first = e->list[0]->ty == SL_TYPE_STRING ? 1 : 0;
+    int n = size_of(e);
+    int t = gen_expr(g, e->list[first], -1);
+    int nknots, base;
+    sl_node *k0 = e->list[first + 1];
+    if (sl_ty_is_array(k0->ty)) {
+        nknots = array_len(k0->sym);
+        base = k0->sym->slot;
+        if (nknots < 4 || (nknots - 4) % b->step != 0) {
+            fail(g, "a '%s' spline takes 4%s knots, not the %d of '%s'", b->name,
+                 b->step == 3 ? ", 7, 10, ..." : b->step == 2 ? ", 6, 8, ..." : " or more",
+                 nknots, k0->name);
+            return 0;
+        }
+    } else {
+        nknots = e->nlist - first - 1;
+        base = alloc_slots(g, nknots * n);
+        for (int i = 0; i < nknots; i++) {
+            int mark = g->sp;
+            gen_expr(g, e->list[first + 1 + i], base + i * n);
+            g->sp = mark;
+        }
+    }
+    int segs = (nknots - 4) / b->step + 1;
+    int x = alloc_slots(g, 1);
+    emit(g, SL_OP_CLAMP, x, t, const_slot(g, 0), const_slot(g, 1));
+    int knot[4];                     /* first slot of each of the segment's knots */
+    if (segs == 1) {
+        for (int j = 0; j < 4; j++)
+            knot[j] = base + j * n;
+    } else {
+        emit(g, SL_OP_MUL, x, x, const_slot(g, segs), 0);
+        int seg = op2(g, SL_OP_MIN, op1(g, SL_OP_FLOOR, x), const_slot(g, segs - 1));
+        emit(g, SL_OP_SUB, x, x, seg, 0);
+        int at = op2(g, SL_OP_MUL, seg, const_slot(g, b->step));
+        for (int j = 0; j < 4; j++) {
+            if (e->op == SL_SPLINE_CONSTANT && j != 1)
+                continue;
+            int index = j ? op2(g, SL_OP_ADD, at, const_slot(g, j)) : at;
+            knot[j] = alloc_slots(g, n);
+            for (int k = 0; k < n; k++)
+                emit(g, SL_OP_ALOAD, knot[j] + k, base + k, index, array_operand(nknots, n));
+        }
+    }
+    if (e->op == SL_SPLINE_CONSTANT)
+        return into(g, knot[1], dst, n);
+    int z = target(g, dst, n);
+    for (int k = 0; k < n; k++) {
+        bool started = false;
+        for (int i = 0; i < 4; i++) {
+            /* the coefficient of x^(3-i): sum_j m[i][j] knot_j */
+            int c = -1;
+            for (int j = 0; j < 4; j++) {
+                double w = b->m[i][j];
+                if (w == 0)
+                    continue;
+                int term = w == 1 ? knot[j] + k : op2(g, SL_OP_MUL, knot[j] + k, const_slot(g, w));
+                c = c < 0 ? term : op2(g, SL_OP_ADD, c, term);
+            }
+            if (started)
+                emit(g, SL_OP_MUL, z + k, z + k, x, 0);
+            if (c >= 0) {
+                if (started)
+                    emit(g, SL_OP_ADD, z + k, z + k, c, 0);
+                else
+                    emit(g, SL_OP_MOV, z + k, c, 0, 0);
+                started = true;
+            }
+        }
+    }
+    return z;
+}
+
 static int gen_builtin(cg *g, sl_node *e, int dst)
 {
     const sl_builtin *b = e->builtin;
@@ -1041,6 +1596,44 @@ static int gen_builtin(cg *g, sl_node *e, int dst)
         return into(g, z, dst, n);
     }
     case SL_LOWER_LIGHT: return gen_light(g, e, args, dst);
+    case SL_LOWER_CTRANSFORM: return gen_ctransform(g, e, args, dst);
+    case SL_LOWER_DETERMINANT: return gen_determinant(g, args[0], dst);
+    case SL_LOWER_MATRIX_XFORM: return gen_matrix_xform(g, e, args, dst);
+    case SL_LOWER_MCOMP: return gen_mcomp(g, args, false, dst);
+    case SL_LOWER_MSETCOMP: return gen_mcomp(g, args, true, dst);
+    case SL_LOWER_REFRACT: return gen_refract(g, args[0], args[1], args[2], dst);
+    case SL_LOWER_FRESNEL: return gen_fresnel(g, e, args);
+    case SL_LOWER_DEPTH: return gen_depth(g, args[0], dst);
+    case SL_LOWER_FILTERSTEP: return gen_filterstep(g, e, args, dst);
+    case SL_LOWER_ILLUMINANCE: return gen_illuminance(g, e, args, dst);
+    case SL_LOWER_EMITTER: {      /* L = Ps - position / axis / 0 */
+        int L = sl_global_slot(SL_G_L), P = sl_global_slot(SL_G_P);
+        g->prog->emits_light = true;
+        for (int i = 0; i < 3; i++) {
+            if (b->k == 0)
+                emit(g, SL_OP_SUB, L + i, P + i, args[0] + i, 0);
+            else
+                emit(g, SL_OP_MOV, L + i, e->nlist ? args[0] + i : const_slot(g, 0), 0, 0);
+        }
+        return 0;
+    }
+    case SL_LOWER_MESSAGE: {
+        bool str = e->list[1]->ty == SL_TYPE_STRING;
+        int size = str ? 0 : size_of(e->list[1]);
+        int z = target(g, dst, 1);
+        emit(g, SL_OP_MESSAGE, z, args[0], args[1], (int)b->k | size << 4);
+        if (str)
+            record_string_write(g, args[1]);
+        else
+            record_write(g, args[1], size);
+        return z;
+    }
+    case SL_LOWER_SPLINE: case SL_LOWER_STRINGS: break;     /* gen_spline, gen_strings */
+    case SL_LOWER_MATCH: {
+        int z = target(g, dst, 1);
+        emit(g, SL_OP_SMATCH, z, args[0], args[1], 0);
+        return z;
+    }
     }
     return 0;
 }
@@ -1133,6 +1726,10 @@ static int gen_expr(cg *g, sl_node *e, int dst)
     case SL_N_CALL:
         if (e->func)
             r = gen_user_call(g, e, dst);
+        else if (e->builtin && e->builtin->lower == SL_LOWER_SPLINE)
+            r = gen_spline(g, e, dst);
+        else if (e->builtin && e->builtin->lower == SL_LOWER_STRINGS)
+            r = gen_strings(g, e, dst);
         else if (e->builtin)
             r = gen_builtin(g, e, dst);
         else            /* arraylength(a) */

@@ -265,6 +265,12 @@ static sl_node *primary(parser *p)
         }
         return n;
     }
+    case SL_KW_DISPLACEMENT: case SL_KW_SURFACE:
+        if (peek_kind(p, 0) == SL_TOK_LPAREN) {   /* message passing: a call */
+            advance(p);
+            return call(p, t);
+        }
+        break;
     case SL_TOK_LPAREN: {
         advance(p);
         sl_node *e = expression(p);
@@ -281,9 +287,10 @@ static sl_node *primary(parser *p)
         return e;
     }
     default:
-        error_at(p, t.pos, &t, "expected expression");
-        return error_node(p, t.pos);
+        break;
     }
+    error_at(p, t.pos, &t, "expected expression");
+    return error_node(p, t.pos);
 }
 
 /* type [STRING] ( '(' list ')' | unary ): a cast or a constructor. */
@@ -811,11 +818,125 @@ static sl_node *return_statement(parser *p)
     return n;
 }
 
-static sl_node *unsupported(parser *p, const char *message)
+/* illuminance ([category,] position [, axis, angle]) statement (RI Spec 3.2
+ * §15.4) becomes
+ *   { "illuminance start"(position);
+ *     while ("illuminance next"())          (loads L and Cl, 0 at the end)
+ *         if ("illuminance cone"(axis, angle)) statement }
+ * (no `if` without a cone), so break, continue and the range modes' loop
+ * handling work as for any loop. The category (a string) is accepted and
+ * matches every light. */
+static sl_node *illuminance_statement(parser *p)
 {
-    error_at(p, p->cur.pos, &p->cur, "%s", message);
-    return NULL;
+    sl_token kw = p->cur;
+    advance(p);
+    sl_token open = p->cur;
+    sl_node *args = sl_node_new(p->arena, SL_N_CALL, kw.pos);
+    int cap = 0;
+    if (!expect(p, SL_TOK_LPAREN, "after 'illuminance'"))
+        return NULL;
+    do {
+        push_node(p, args, &cap, expression(p));
+    } while (!p->panic && match(p, SL_TOK_COMMA));
+    if (!expect_closing(p, SL_TOK_RPAREN, &open))
+        return NULL;
+    int first = args->nlist > 0 && args->list[0]->kind == SL_N_STR ? 1 : 0;
+    int n = args->nlist - first;
+    if (n != 1 && n != 3) {
+        error_at(p, kw.pos, &kw, "illuminance takes [category,] position [, axis, angle], "
+                                 "not %d values", args->nlist);
+        return NULL;
+    }
+    sl_node *body = statement(p);
+    if (!body)
+        return NULL;
+    sl_node *start = sl_node_new(p->arena, SL_N_CALL, kw.pos);
+    start->name = "illuminance start";
+    int c1 = 0;
+    push_node(p, start, &c1, args->list[first]);
+    sl_node *start_stmt = sl_node_new(p->arena, SL_N_EXPR, kw.pos);
+    start_stmt->a = start;
+    sl_node *next = sl_node_new(p->arena, SL_N_CALL, kw.pos);
+    next->name = "illuminance next";
+    sl_node *loop = sl_node_new(p->arena, SL_N_WHILE, kw.pos);
+    loop->a = next;
+    loop->b = body;
+    if (n == 3) {
+        sl_node *cone = sl_node_new(p->arena, SL_N_CALL, kw.pos);
+        cone->name = "illuminance cone";
+        int c2 = 0;
+        push_node(p, cone, &c2, args->list[first + 1]);
+        push_node(p, cone, &c2, args->list[first + 2]);
+        sl_node *test = sl_node_new(p->arena, SL_N_IF, kw.pos);
+        test->a = cone;
+        test->b = body;
+        loop->b = test;
+    }
+    sl_node *b = sl_node_new(p->arena, SL_N_BLOCK, kw.pos);
+    int c3 = 0;
+    push_node(p, b, &c3, start_stmt);
+    push_node(p, b, &c3, loop);
+    return b;
 }
+
+/* illuminate (position [, axis, angle]) statement and solar ([axis,
+ * angle]) statement, in light shaders (RI Spec 3.2 §15.4) become
+ *   { "illuminate begin"(position);   (L = Ps - position)
+ *     if ("illuminance cone"(axis, angle)) statement }
+ *   { "solar begin"(axis); statement } (L = axis: the light's direction)
+ * (no `if` without a cone). */
+static sl_node *emitter_statement(parser *p)
+{
+    sl_token kw = p->cur;
+    bool solar = kw.kind == SL_KW_SOLAR;
+    advance(p);
+    sl_token open = p->cur;
+    sl_node *args = sl_node_new(p->arena, SL_N_CALL, kw.pos);
+    int cap = 0;
+    if (!expect(p, SL_TOK_LPAREN, solar ? "after 'solar'" : "after 'illuminate'"))
+        return NULL;
+    if (!check(p, SL_TOK_RPAREN)) {
+        do {
+            push_node(p, args, &cap, expression(p));
+        } while (!p->panic && match(p, SL_TOK_COMMA));
+    }
+    if (!expect_closing(p, SL_TOK_RPAREN, &open))
+        return NULL;
+    int n = args->nlist;
+    if (solar ? (n != 0 && n != 2) : (n != 1 && n != 3)) {
+        error_at(p, kw.pos, &kw, solar ? "solar takes [axis, angle], not %d values"
+                                       : "illuminate takes position [, axis, angle], not %d "
+                                         "values", n);
+        return NULL;
+    }
+    sl_node *body = statement(p);
+    if (!body)
+        return NULL;
+    sl_node *begin = sl_node_new(p->arena, SL_N_CALL, kw.pos);
+    begin->name = solar ? "solar begin" : "illuminate begin";
+    int c1 = 0;
+    if (n > 0)
+        push_node(p, begin, &c1, args->list[0]);
+    sl_node *begin_stmt = sl_node_new(p->arena, SL_N_EXPR, kw.pos);
+    begin_stmt->a = begin;
+    if (n == 3) {
+        sl_node *cone = sl_node_new(p->arena, SL_N_CALL, kw.pos);
+        cone->name = "illuminance cone";
+        int c2 = 0;
+        push_node(p, cone, &c2, args->list[1]);
+        push_node(p, cone, &c2, args->list[2]);
+        sl_node *test = sl_node_new(p->arena, SL_N_IF, kw.pos);
+        test->a = cone;
+        test->b = body;
+        body = test;
+    }
+    sl_node *b = sl_node_new(p->arena, SL_N_BLOCK, kw.pos);
+    int c3 = 0;
+    push_node(p, b, &c3, begin_stmt);
+    push_node(p, b, &c3, body);
+    return b;
+}
+
 
 static sl_node *statement_inner(parser *p)
 {
@@ -832,9 +953,8 @@ static sl_node *statement_inner(parser *p)
         advance(p);
         return n;
     }
-    case SL_KW_ILLUMINANCE: case SL_KW_ILLUMINATE: case SL_KW_SOLAR:
-        return unsupported(p, "light loops are not supported (use ambient(), "
-                              "diffuse(), specular() or phong())");
+    case SL_KW_ILLUMINANCE: return illuminance_statement(p);
+    case SL_KW_ILLUMINATE: case SL_KW_SOLAR: return emitter_statement(p);
     default: break;
     }
     if (is_qualifier(p->cur.kind) ||
@@ -863,10 +983,10 @@ static void shader_definition(parser *p, sl_ast_file *file)
 {
     sl_token kw = p->cur;
     advance(p);
-    if (kw.kind != SL_KW_SURFACE && kw.kind != SL_KW_DISPLACEMENT) {
+    if (kw.kind != SL_KW_SURFACE && kw.kind != SL_KW_DISPLACEMENT && kw.kind != SL_KW_LIGHT) {
         error_at(p, kw.pos, &kw,
-                 "'%s' shaders are not supported (only 'surface' and 'displacement')",
-                 kw.text);
+                 "'%s' shaders are not supported (only 'surface', 'displacement' and "
+                 "'light')", kw.text);
         return;
     }
     if (!check(p, SL_TOK_IDENT)) {
@@ -882,7 +1002,8 @@ static void shader_definition(parser *p, sl_ast_file *file)
         return;
     }
     file->has_shader = true;
-    file->kind = kw.kind == SL_KW_SURFACE ? SL_SHADER_SURFACE : SL_SHADER_DISPLACEMENT;
+    file->kind = kw.kind == SL_KW_SURFACE ? SL_SHADER_SURFACE
+               : kw.kind == SL_KW_LIGHT ? SL_SHADER_LIGHT : SL_SHADER_DISPLACEMENT;
     file->name = name.text;
     file->pos = name.pos;
     sl_token open = p->cur;

@@ -49,6 +49,7 @@
 typedef enum sl_shader_kind {
     SL_SHADER_SURFACE,
     SL_SHADER_DISPLACEMENT,
+    SL_SHADER_LIGHT,        /* evaluated with sl_light_eval */
 } sl_shader_kind;
 
 typedef enum sl_type {
@@ -203,5 +204,46 @@ void sl_vm_set_fixed_lights(sl_vm *self, const sl_light_sample *samples, int cou
 /* Seed of random(): every run restarts the sequence from it (default 0),
  * so results are a pure function of the inputs. */
 void sl_vm_set_seed(sl_vm *self, uint64_t seed);
+
+/* Message passing (RI Spec 3.2 §15.7): what `displacement("name", x)`,
+ * `surface(...)`, `lightsource(...)`, `attribute(...)`, `option(...)` and
+ * `rendererinfo(...)` read. A call finds the message of its scope and name
+ * whose type matches the variable's (float, triple, matrix, string), sets
+ * the variable and returns 1; otherwise it returns 0 and leaves the
+ * variable alone. */
+typedef enum sl_message_scope {
+    SL_MSG_DISPLACEMENT, SL_MSG_SURFACE, SL_MSG_LIGHTSOURCE, SL_MSG_ATTRIBUTE,
+    SL_MSG_OPTION, SL_MSG_RENDERERINFO, SL_MSG__COUNT
+} sl_message_scope;
+
+/* Sets (or replaces) a uniform message: values has sl_type's count of
+ * numbers (1, 3 or 16), or string is the value of a string message (copied;
+ * at most 127 bytes). Uniform messages are the same over any range, so
+ * interval and affine runs read them exactly. Names: at most 63 bytes. At
+ * most 64 messages; returns false when full or too long. A new VM has
+ * rendererinfo "renderer" = "aafarm". */
+bool sl_vm_set_message(sl_vm *self, sl_message_scope scope, const char *name, sl_type type,
+                       const double *values, const char *string);
+/* After a float or dual run: the output parameters of the program just run
+ * become messages of `scope` (the displacement shader's outputs, for the
+ * surface shader run next on this VM). They are values at one point: an
+ * interval or affine run reads them as unbounded. Returns how many. */
+int sl_vm_capture_outputs(sl_vm *self, sl_message_scope scope);
+void sl_vm_clear_messages(sl_vm *self, sl_message_scope scope);
+
+/* Light shaders (RI Spec 3.2 §9.3, §15.4 illuminate, solar): runs the light
+ * instance `inst` in float mode for the surface point Ps (current space)
+ * and fills the sample the surface shader's light functions take: L from
+ * Ps towards the light, Cl, and ambient for a light shader without
+ * illuminate or solar. Cl is 0 where the light's illuminate/solar cone
+ * leaves Ps out. Use a VM of its own (a light callback runs while the
+ * surface shader's VM is busy), with the scene's spaces set on it. */
+sl_status sl_light_eval(sl_vm *self, const sl_instance *inst, const double Ps[3],
+                        sl_light_sample *out);
+
+/* The camera's clipping planes (RIB Clipping), for depth(P) =
+ * (z_camera - near) / (far - near). Default near 0, far 1: depth(P) is
+ * then the camera-space z. far <= near is ignored. */
+void sl_vm_set_clipping(sl_vm *self, double near, double far);
 
 #endif

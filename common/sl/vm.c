@@ -9,6 +9,7 @@
 #include "sl/check.h"
 #include "sl/strbuf.h"
 
+#include <math.h>
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdlib.h>
@@ -37,6 +38,8 @@ static void *xcalloc(size_t n, size_t size)
     return p;
 }
 
+static void update_depth(sl_vm *self);
+
 sl_vm *sl_vm_new(const sl_limits *limits)
 {
     sl_vm *self = xcalloc(1, sizeof *self);
@@ -49,6 +52,10 @@ sl_vm *sl_vm_new(const sl_limits *limits)
         self->spaces.to_current[s] = mat4_identity();
         self->spaces.from_current[s] = mat4_identity();
     }
+    self->near = 0;
+    self->far = 1;
+    update_depth(self);
+    sl_vm_set_message(self, SL_MSG_RENDERERINFO, "renderer", SL_TYPE_STRING, NULL, "aafarm");
     self->f = xcalloc(SL_MAX_SLOTS, sizeof *self->f);
     self->d = xcalloc(SL_MAX_SLOTS, sizeof *self->d);
     self->i = xcalloc(SL_MAX_SLOTS, sizeof *self->i);
@@ -83,7 +90,139 @@ void sl_vm_destroy(sl_vm **self_p)
     *self_p = NULL;
 }
 
-void sl_vm_set_spaces(sl_vm *self, const sl_spaces *spaces) { self->spaces = *spaces; }
+/* current -> camera, then z -> (z - near) / (far - near) */
+static void update_depth(sl_vm *self)
+{
+    mat4 norm = mat4_mul(mat4_scale(1, 1, 1 / (self->far - self->near)),
+                         mat4_translate(0, 0, -self->near));
+    self->depth = mat4_mul(norm, self->spaces.from_current[SL_SPACE_CAMERA]);
+}
+
+void sl_vm_set_spaces(sl_vm *self, const sl_spaces *spaces)
+{
+    self->spaces = *spaces;
+    update_depth(self);
+}
+
+/* ---- light shaders ---- */
+
+sl_status sl_light_eval(sl_vm *self, const sl_instance *inst, const double Ps[3],
+                        sl_light_sample *out)
+{
+    static const double zero[3] = { 0, 0, 0 };
+    memset(out, 0, sizeof *out);
+    sl_vm_clear_globals(self);
+    sl_vm_set_float(self, SL_G_P, Ps);
+    sl_vm_set_float(self, SL_G_L, zero);
+    sl_vm_set_float(self, SL_G_Cl, zero);
+    sl_status st = sl_vm_run(self, inst, SL_MODE_FLOAT, NULL);
+    if (st != SL_OK)
+        return st;
+    const sl_program *p = inst->program;
+    if (p->kind != SL_SHADER_LIGHT)
+        return sl_vm_fail(self, SL_ERR_RUNTIME, "'%s' is not a light shader", p->name);
+    double L[3];
+    sl_vm_get_float(self, SL_G_L, L);
+    sl_vm_get_float(self, SL_G_Cl, out->Cl);
+    for (int i = 0; i < 3; i++)      /* the light's L points at Ps; the sample's away */
+        out->L[i] = -L[i];
+    out->ambient = !p->emits_light;
+    return SL_OK;
+}
+
+/* ---- message passing ---- */
+
+static vm_message *message_slot(sl_vm *self, int scope, const char *name)
+{
+    for (int i = 0; i < self->nmessages; i++)
+        if (self->messages[i].scope == scope && strcmp(self->messages[i].name, name) == 0)
+            return &self->messages[i];
+    if (self->nmessages == SL_VM_MAX_MESSAGES)
+        return NULL;
+    vm_message *m = &self->messages[self->nmessages++];
+    memset(m, 0, sizeof *m);
+    m->scope = scope;
+    snprintf(m->name, sizeof m->name, "%s", name);
+    return m;
+}
+
+static bool set_message(sl_vm *self, int scope, const char *name, int size,
+                        const double *values, const char *string, bool varying)
+{
+    if (scope < 0 || scope >= SL_MSG__COUNT || !name || strlen(name) >= 64 ||
+        (size == 0 && (!string || strlen(string) >= 128)) || (size > 0 && !values))
+        return false;
+    vm_message *m = message_slot(self, scope, name);
+    if (!m)
+        return false;
+    m->size = size;
+    m->varying = varying;
+    if (size)
+        memcpy(m->v, values, (size_t)size * sizeof *values);
+    else
+        snprintf(m->s, sizeof m->s, "%s", string);
+    return true;
+}
+
+bool sl_vm_set_message(sl_vm *self, sl_message_scope scope, const char *name, sl_type type,
+                       const double *values, const char *string)
+{
+    int size = type == SL_TYPE_STRING ? 0 : type == SL_TYPE_FLOAT ? 1
+             : type == SL_TYPE_MATRIX ? 16 : 3;
+    return set_message(self, (int)scope, name, size, values, string, false);
+}
+
+int sl_vm_capture_outputs(sl_vm *self, sl_message_scope scope)
+{
+    const sl_program *p = self->prog;
+    if (!p || (self->mode != SL_MODE_FLOAT && self->mode != SL_MODE_DUAL))
+        return 0;
+    int n = 0;
+    for (int i = 0; i < p->nparams; i++) {
+        const sl_param *q = &p->params[i];
+        if (!q->output)
+            continue;
+        double v[16];
+        bool str = q->type == SL_TYPE_STRING;
+        if (!str && q->size > 16)
+            continue;                   /* arrays are not messages */
+        for (int k = 0; !str && k < q->size; k++)
+            v[k] = self->mode == SL_MODE_FLOAT ? self->f[q->slot + k] : self->d[q->slot + k].v;
+        const char *s = str ? self->str[q->slot] : NULL;
+        n += set_message(self, (int)scope, q->name, str ? 0 : q->size, v, s ? s : "", true);
+    }
+    return n;
+}
+
+void sl_vm_clear_messages(sl_vm *self, sl_message_scope scope)
+{
+    int kept = 0;
+    for (int i = 0; i < self->nmessages; i++)
+        if (self->messages[i].scope != (int)scope)
+            self->messages[kept++] = self->messages[i];
+    self->nmessages = kept;
+}
+
+const vm_message *sl_vm_message(const sl_vm *vm, int scope, const char *name, int size)
+{
+    if (!name)
+        return NULL;
+    for (int i = 0; i < vm->nmessages; i++) {
+        const vm_message *m = &vm->messages[i];
+        if (m->scope == scope && m->size == size && strcmp(m->name, name) == 0)
+            return m;
+    }
+    return NULL;
+}
+
+void sl_vm_set_clipping(sl_vm *self, double near, double far)
+{
+    if (!(far > near) || !isfinite(far) || !isfinite(near))
+        return;
+    self->near = near;
+    self->far = far;
+    update_depth(self);
+}
 
 void sl_vm_set_lights(sl_vm *self, sl_light_fn fn, void *user)
 {
@@ -230,6 +369,8 @@ sl_status sl_vm_fail(sl_vm *vm, sl_status st, const char *fmt, ...)
 
 const mat4 *sl_vm_space_id(const sl_vm *vm, int space, int dir)
 {
+    if (space == SL_SPACE_DEPTH)
+        return &vm->depth;
     if (space < 0 || space >= SL_SPACE__COUNT)
         return NULL;
     return dir == SL_SPACE_TO_CURRENT ? &vm->spaces.to_current[space]
@@ -323,6 +464,7 @@ sl_status sl_vm_run(sl_vm *self, const sl_instance *inst, sl_mode mode, aa_conte
     self->inst = inst;
     self->ctx = ctx;
     self->mode = mode;
+    self->strings_used = 0;
     self->nframes = 0;
     self->pool_top = 0;
     self->spool_top = 0;

@@ -17,11 +17,18 @@
 
 #include "sl/bytecode.h"
 #include "sl/shader.h"
+#include "sl/strmatch.h"
+
+#include <stdio.h>
+#include <string.h>
 
 enum {
     SL_VM_POOL_VALUES = 8192,     /* snapshot values of open merge frames */
     SL_VM_MAX_FRAMES = 512,       /* open merge frames (nested maybe-branches) */
     SL_VM_MAX_LIGHTS = 64,        /* light samples per shading call */
+    SL_VM_MAX_MESSAGES = 64,      /* message-passing values (sl_vm_set_message) */
+    SL_VM_STRING_SPACE = 16384,   /* bytes of strings made by one run (concat, format) */
+    SL_VM_MAX_PRINTS = 100,       /* printf lines per VM, then one note */
 };
 
 /* The instantiations of the dispatch loop (vm_exec.inc). The two _DERIV
@@ -68,6 +75,16 @@ typedef struct vm_frame {
  * break or early return), merged back where it ends. Stored at the top end
  * of the merge pool, growing down. */
 enum { SL_VM_MAX_ACCUMULATORS = 64 };
+/* One message (shader.h, sl_vm_set_message): size 1, 3 or 16 numbers, or
+ * 0 for a string; varying: a captured output, known at one point only. */
+typedef struct vm_message {
+    int scope, size;
+    bool varying;
+    char name[64];
+    double v[16];
+    char s[128];
+} vm_message;
+
 typedef struct vm_accumulator {
     int kind, id;
     int pool, spool;
@@ -77,9 +94,18 @@ typedef struct vm_accumulator {
 struct sl_vm {
     sl_limits limits;
     sl_spaces spaces;
+    double near, far;             /* clipping planes, for depth() */
+    mat4 depth;                   /* current -> camera, z to depth */
     sl_light_fn light_fn;
     void *light_user;
     sl_light_sample fixed_lights[SL_VM_MAX_LIGHTS];
+    sl_light_sample illum[SL_VM_MAX_LIGHTS];   /* the illuminance loop's lights */
+    int nillum, illum_next;
+    vm_message messages[SL_VM_MAX_MESSAGES];
+    int nmessages;
+    char strings[SL_VM_STRING_SPACE];  /* strings made by this run */
+    int strings_used;
+    int prints;
     int nfixed_lights;
     uint64_t seed;
 
@@ -140,6 +166,8 @@ int sl_vm_light_samples(sl_vm *vm, const double P[3], sl_light_sample *out);
 double sl_vm_random(sl_vm *vm);
 
 const char *sl_mode_name(sl_mode mode);
+/* The message of this scope, name and size (0: a string), or NULL. */
+const vm_message *sl_vm_message(const sl_vm *vm, int scope, const char *name, int size);
 
 /* a op b (op: SL_OP_ADD/SUB/MUL/DIV/MOD) when the double result is EXACT, so
  * that interval and affine runs keep integer counters and octave

@@ -437,6 +437,509 @@ static void ref_nested_shadows_builtin(double u, double v, double o[3])
     o[0] = 2 * u; o[1] = noise3(u, v, 0); o[2] = 0;
 }
 
+/* spline, written from each basis' own formula (not the basis matrices
+ * the compiler uses): the segment of x = clamp(t, 0, 1) * segments */
+static double spline_ref(const char *basis, double t, const double *k, int n)
+{
+    int step = strcmp(basis, "bezier") == 0 ? 3 : strcmp(basis, "hermite") == 0 ? 2 : 1;
+    int segs = (n - 4) / step + 1;
+    double x = clampd(t, 0, 1) * segs;
+    double seg = floor(x) < segs - 1 ? floor(x) : segs - 1, f = x - seg;
+    const double *p = k + (int)seg * step;
+    if (strcmp(basis, "catmull-rom") == 0)
+        return p[1] + 0.5 * f * (p[2] - p[0] + f * (2 * p[0] - 5 * p[1] + 4 * p[2] - p[3] +
+                                                     f * (3 * (p[1] - p[2]) + p[3] - p[0])));
+    if (strcmp(basis, "bezier") == 0) {           /* de Casteljau */
+        double a = p[0] + f * (p[1] - p[0]), b = p[1] + f * (p[2] - p[1]);
+        double c = p[2] + f * (p[3] - p[2]);
+        double ab = a + f * (b - a), bc = b + f * (c - b);
+        return ab + f * (bc - ab);
+    }
+    if (strcmp(basis, "b-spline") == 0) {
+        double g = 1 - f;
+        return (g * g * g * p[0] + (3 * f * f * f - 6 * f * f + 4) * p[1] +
+                (-3 * f * f * f + 3 * f * f + 3 * f + 1) * p[2] + f * f * f * p[3]) / 6;
+    }
+    if (strcmp(basis, "hermite") == 0)
+        return (2 * f * f * f - 3 * f * f + 1) * p[0] + (f * f * f - 2 * f * f + f) * p[1] +
+               (-2 * f * f * f + 3 * f * f) * p[2] + (f * f * f - f * f) * p[3];
+    if (strcmp(basis, "linear") == 0)
+        return p[1] + f * (p[2] - p[1]);
+    return p[1];                                  /* constant */
+}
+
+/* lane k of a spline over n triples */
+static double spline3(const char *basis, double t, const double (*k)[3], int n, int lane)
+{
+    double x[16];
+    for (int i = 0; i < n; i++)
+        x[i] = k[i][lane];
+    return spline_ref(basis, t, x, n);
+}
+
+static void ref_spline_float(double u, double v, double o[3])
+{
+    static const double a[] = { 0, 0, 0.3, 0.8, 1, 1 }, b[] = { -1, 0, 1, 0.5, 2, 0.25, 3 };
+    static const double c[] = { 0, 1, 2, 3 };
+    o[0] = spline_ref("catmull-rom", u, a, 6);
+    o[1] = spline_ref("catmull-rom", v, b, 7);
+    o[2] = 0.5 * spline_ref("catmull-rom", 0.5, c, 4);
+}
+
+static void ref_spline_color_ramp(double u, double v, double o[3])
+{
+    static const double k[7][3] = { { 0.3, 0.12, 0.03 }, { 0.3, 0.12, 0.03 },
+                                    { 0.69, 0.44, 0.25 }, { 0.8, 0.5, 0.3 },
+                                    { 0.69, 0.44, 0.25 }, { 0.3, 0.12, 0.03 },
+                                    { 0.3, 0.12, 0.03 } };
+    double ring = fmodf_(u * 3 + 0.5 * v, 1);
+    for (int i = 0; i < 3; i++)
+        o[i] = spline3("catmull-rom", ring, k, 7, i);
+}
+
+static void ref_spline_bezier_point(double u, double v, double o[3])
+{
+    static const double k[7][3] = { { 0, 0, 0 }, { 1, 2, 0 }, { 2, -1, 1 }, { 3, 0, 1 },
+                                    { 4, 1, 1 }, { 5, 0, 2 }, { 6, 3, 0 } };
+    for (int i = 0; i < 3; i++)
+        o[i] = spline3("bezier", u, k, 7, i);
+    o[2] += v;
+}
+
+static void ref_spline_bspline(double u, double v, double o[3])
+{
+    static const double a[] = { 0, 1, 0, 1, 0, 1, 0 }, b[] = { 0, 0, 0, 1, 1, 1 };
+    o[0] = spline_ref("b-spline", u, a, 7);
+    o[1] = spline_ref("b-spline", v * v, b, 6);
+    o[2] = o[0] * o[1];
+}
+
+static void ref_spline_hermite(double u, double v, double o[3])
+{
+    static const double a[] = { 0, 2, 1, 0 };
+    static const double k[6][3] = { { 0, 0, 0 }, { 1, 0, 0 }, { 0, 1, 0 },
+                                    { 0, 0, 1 }, { 1, 1, 0 }, { -1, 0, 0 } };
+    o[0] = spline_ref("hermite", u, a, 4);
+    o[1] = spline3("hermite", v, k, 6, 1) + spline3("hermite", v, k, 6, 0);
+    o[2] = spline3("hermite", v, k, 6, 2);
+}
+
+static void ref_spline_linear_constant(double u, double v, double o[3])
+{
+    static const double a[] = { 9, 0, 1, 0.5, 2, 9 }, c[] = { 9, 1, 0.5, 9 };
+    o[0] = spline_ref("linear", u, a, 6);
+    o[1] = spline_ref("constant", v, a, 6);
+    o[2] = spline_ref("linear", v, c, 4);
+}
+
+static void ref_spline_array(double u, double v, double o[3])
+{
+    static const double h[] = { 0, 0.2, 0.1, 0.7, 1, 1.2 }, g[] = { 0, 0.4, 0.8, 1 };
+    o[0] = spline_ref("catmull-rom", u, h, 6);
+    o[1] = spline_ref("linear", v, h, 6);
+    o[2] = spline_ref("b-spline", v, g, 4);
+}
+
+static void ref_spline_unsized_param(double u, double v, double o[3])
+{
+    static const double a[] = { 0, 1, 2, 3 }, b[] = { 1, 0, 0.5, 0.25, 1, 0 };
+    o[0] = spline_ref("catmull-rom", u, a, 4);
+    o[1] = spline_ref("catmull-rom", v, b, 6);
+    o[2] = spline_ref("catmull-rom", u * v, b, 6);
+}
+
+static void ref_spline_noise_marble(double u, double v, double o[3])
+{
+    double n = noise3(3 * u, 3 * v, 0);
+    double k[] = { 0, 0.1, 0.6, 0.3 * 0.6, 1, 0.8 }, b[] = { 0, 1, -1, 0 };
+    o[0] = spline_ref("catmull-rom", n, k, 6);
+    o[1] = n;
+    o[2] = spline_ref("bezier", n, b, 4);
+}
+
+/* color spaces, the textbook way (Foley & van Dam's sector switch) */
+static void hsv_to_rgb(double h, double s, double v, double o[3])
+{
+    double h6 = fmodf_(h, 1) * 6, i = floor(h6), f = h6 - i;
+    double p = v * (1 - s), q = v * (1 - s * f), t = v * (1 - s * (1 - f));
+    double tab[6][3] = { { v, t, p }, { q, v, p }, { p, v, t },
+                         { p, q, v }, { t, p, v }, { v, p, q } };
+    for (int k = 0; k < 3; k++)
+        o[k] = tab[(int)i % 6][k];
+}
+
+static double hue_channel(double p, double q, double t)
+{
+    t = fmodf_(t, 1);
+    if (t < 1 / 6.0)
+        return p + (q - p) * 6 * t;
+    if (t < 0.5)
+        return q;
+    if (t < 2 / 3.0)
+        return p + (q - p) * (2 / 3.0 - t) * 6;
+    return p;
+}
+
+static void hsl_to_rgb(double h, double s, double l, double o[3])
+{
+    double q = l < 0.5 ? l * (1 + s) : l + s - l * s, p = 2 * l - q;
+    o[0] = hue_channel(p, q, h + 1 / 3.0);
+    o[1] = hue_channel(p, q, h);
+    o[2] = hue_channel(p, q, h - 1 / 3.0);
+}
+
+static void rgb_to_hsv(const double c[3], double o[3])
+{
+    double M = fmax(c[0], fmax(c[1], c[2])), m = fmin(c[0], fmin(c[1], c[2])), d = M - m;
+    double h = 0;
+    if (d > 0) {
+        if (M == c[0])
+            h = fmodf_((c[1] - c[2]) / d, 6);
+        else if (M == c[1])
+            h = (c[2] - c[0]) / d + 2;
+        else
+            h = (c[0] - c[1]) / d + 4;
+    }
+    o[0] = h / 6; o[1] = M > 0 ? d / M : 0; o[2] = M;
+}
+
+static void ref_color_hsv(double u, double v, double o[3])
+{
+    hsv_to_rgb(u, 0.8, 0.5 + 0.5 * v, o);
+}
+
+static void ref_color_hsl(double u, double v, double o[3])
+{
+    hsl_to_rgb(v + 0.5, 0.6, 0.2 + 0.6 * u, o);
+}
+
+static void ref_color_hue_shift(double u, double v, double o[3])
+{
+    double c[3] = { u, 1 - u, 0.1 }, hsv[3], back[3], d[3] = { 0.5 * u, 0.25 * v, 1.2 }, b[3];
+    rgb_to_hsv(c, hsv);
+    hsv_to_rgb(hsv[0] + 0.1, hsv[1], hsv[2], back);
+    rgb_to_hsv(d, b);
+    o[0] = hsv[0]; o[1] = back[1] + back[2]; o[2] = b[0] + b[1];
+}
+
+/* CIE XYZ of linear Rec. 709 primaries (D65) and NTSC YIQ */
+static const double M_xyz[3][3] = { { 0.4124564, 0.3575761, 0.1804375 },
+                                    { 0.2126729, 0.7151522, 0.0721750 },
+                                    { 0.0193339, 0.1191920, 0.9503041 } };
+static const double M_yiq[3][3] = { { 0.299, 0.587, 0.114 },
+                                    { 0.596, -0.274, -0.322 },
+                                    { 0.211, -0.523, 0.312 } };
+static void mat3_apply(const double m[3][3], const double x[3], double o[3])
+{
+    for (int r = 0; r < 3; r++)
+        o[r] = m[r][0] * x[0] + m[r][1] * x[1] + m[r][2] * x[2];
+}
+/* x = m^-1 y by Cramer's rule */
+static void mat3_solve(const double m[3][3], const double y[3], double x[3])
+{
+    double det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) -
+                 m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
+                 m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+    for (int k = 0; k < 3; k++) {
+        double a[3][3];
+        memcpy(a, m, sizeof a);
+        for (int r = 0; r < 3; r++)
+            a[r][k] = y[r];
+        x[k] = (a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1]) -
+                a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0]) +
+                a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0])) / det;
+    }
+}
+
+static void ref_color_xyz_yiq(double u, double v, double o[3])
+{
+    double c[3] = { u, v, 0.5 }, xyz[3], yiq[3];
+    mat3_apply(M_xyz, c, xyz);
+    mat3_apply(M_yiq, c, yiq);
+    double sum = xyz[0] + xyz[1] + xyz[2];
+    double xyY[3] = { xyz[0] / sum, xyz[1] / sum, xyz[1] };
+    /* back: "xyY" -> rgb is c again */
+    double in[3] = { 0.5, 0.1 * u, -0.1 * v }, rgb[3], lum[3], fromxyz[3];
+    mat3_solve(M_yiq, in, rgb);
+    mat3_apply(M_xyz, rgb, lum);
+    double given[3] = { u, v, 1 };
+    mat3_solve(M_xyz, given, fromxyz);
+    o[0] = xyz[0] + yiq[1];
+    o[1] = xyY[0] + c[1];
+    o[2] = lum[2] + fromxyz[0];
+}
+
+/* the conformance VM's "object" space: object -> current scales by 2, then
+ * translates by (1, 2, 3) */
+static void ref_ptransform_spaces(double u, double v, double o[3])
+{
+    double P[3] = { 2 * u - 1, 2 * v - 1, 0 };
+    double obj[3] = { (P[0] - 1) / 2, (P[1] - 2) / 2, (P[2] - 3) / 2 };
+    double m[3] = { 2 * u + 1, 2 * v + 2, 3 };
+    o[0] = obj[0]; o[1] = P[1] + m[0]; o[2] = m[2] + v / 2;
+}
+
+/* determinant by Gaussian elimination with partial pivoting */
+static double det4(double a[4][4])
+{
+    double det = 1;
+    for (int c = 0; c < 4; c++) {
+        int p = c;
+        for (int r = c + 1; r < 4; r++)
+            if (fabs(a[r][c]) > fabs(a[p][c]))
+                p = r;
+        if (a[p][c] == 0)
+            return 0;
+        if (p != c) {
+            for (int k = 0; k < 4; k++) {
+                double t = a[c][k];
+                a[c][k] = a[p][k];
+                a[p][k] = t;
+            }
+            det = -det;
+        }
+        det *= a[c][c];
+        for (int r = c + 1; r < 4; r++) {
+            double f = a[r][c] / a[c][c];
+            for (int k = c; k < 4; k++)
+                a[r][k] -= f * a[c][k];
+        }
+    }
+    return det;
+}
+
+static void ref_matrix_determinant(double u, double v, double o[3])
+{
+    double a[4][4] = { { 2, u, 0, 0 }, { v, 1, 0.5, 0 }, { 0, 0.25, 3, 0 }, { u, v, 1, 1 } };
+    double b[4][4] = { { 1, 0, 0, 0 }, { 0, 1 + u, 0, 0 }, { 0, v, 2, 0 }, { 0, 0, 0, 1 } };
+    double ab[4][4], a2[4][4];
+    for (int r = 0; r < 4; r++)
+        for (int c = 0; c < 4; c++) {
+            ab[r][c] = 0;
+            for (int k = 0; k < 4; k++)
+                ab[r][c] += a[r][k] * b[k][c];
+        }
+    memcpy(a2, a, sizeof a2);
+    o[0] = det4(a2); o[1] = det4(ab); o[2] = 16;
+}
+
+/* rotation of p about the unit axis a by angle w (Rodrigues) */
+static void rodrigues(const double a[3], double w, const double p[3], double o[3])
+{
+    double c = cos(w), s = sin(w), d = a[0] * p[0] + a[1] * p[1] + a[2] * p[2];
+    double x[3] = { a[1] * p[2] - a[2] * p[1], a[2] * p[0] - a[0] * p[2],
+                    a[0] * p[1] - a[1] * p[0] };
+    for (int k = 0; k < 3; k++)
+        o[k] = p[k] * c + x[k] * s + a[k] * d * (1 - c);
+}
+
+static void ref_matrix_build(double u, double v, double o[3])
+{
+    static const double z[3] = { 0, 0, 1 };
+    double k = 1 / sqrt(3.0), diag[3] = { k, k, k };
+    double p[3] = { 1, 2, v }, r[3], q[3], e[3] = { 1, 0, 0 };
+    rodrigues(z, 90 * u * M_PI / 180, p, r);     /* scale, rotate, translate */
+    r[0] += 0.5;
+    rodrigues(diag, v, e, q);
+    o[0] = r[0] + q[2]; o[1] = r[1]; o[2] = r[2] + q[0];
+}
+
+static void ref_matrix_comp(double u, double v, double o[3])
+{
+    double m[4][4] = { { 1, 2, 3, 4 }, { 5, 6, 7, 8 }, { 9, 10, 11, 12 }, { 13, v, 15, 16 } };
+    int row = (int)floor(u * 4);
+    o[0] = m[3][0] + m[0][2]; o[1] = m[3][1] + m[row][1];
+    o[2] = 2 + 3;    /* object -> current: scale 2, then translate (1, 2, 3) */
+}
+
+static void normalize3(double v[3])
+{
+    double l = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+    for (int k = 0; k < 3; k++)
+        v[k] /= l;
+}
+
+/* Snell's law: T = eta I + (eta c1 - c2) N, c1 = -I.N, c2 = cos of the
+ * refracted angle; none (0) past the critical angle */
+static void snell(const double I[3], const double N[3], double eta, double T[3])
+{
+    double c1 = -(I[0] * N[0] + I[1] * N[1] + I[2] * N[2]);
+    double s2 = eta * eta * (1 - c1 * c1);
+    for (int k = 0; k < 3; k++)
+        T[k] = s2 > 1 ? 0 : eta * I[k] + (eta * c1 - sqrt(1 - s2)) * N[k];
+}
+
+static void ref_geom_refract(double u, double v, double o[3])
+{
+    double I1[3] = { u - 0.5, v - 0.5, -1 }, I2[3] = { 3 * u - 1.5, 0.5, -1 };
+    double N[3] = { 0, 0, 1 }, a[3], b[3];
+    normalize3(I1);
+    normalize3(I2);
+    snell(I1, N, 1 / 1.5, a);
+    snell(I2, N, 1.5, b);
+    o[0] = a[0] + a[2]; o[1] = a[1]; o[2] = b[0] + b[2];
+}
+
+/* unpolarised Fresnel reflectance from the s and p amplitudes; n = n2/n1 */
+static double fresnel_sp(double c, double n)
+{
+    double sin_t2 = (1 - c * c) / (n * n);
+    if (sin_t2 > 1)
+        return 1;
+    double ct = sqrt(1 - sin_t2);
+    double rs = (c - n * ct) / (c + n * ct), rp = (n * c - ct) / (n * c + ct);
+    return (rs * rs + rp * rp) / 2;
+}
+
+static void ref_geom_fresnel(double u, double v, double o[3])
+{
+    double N[3] = { 0, 0, 1 }, V[3] = { u - 0.5, 0.3 * v, -1 }, T[3], R[3];
+    double V2[3] = { 2 * v - 1, 0.2, -0.5 };
+    normalize3(V);
+    normalize3(V2);
+    double kr = fresnel_sp(fabs(V[2]), 1.5);
+    for (int k = 0; k < 3; k++)
+        R[k] = V[k] - 2 * V[2] * N[k];
+    snell(V, N, 1 / 1.5, T);
+    double kr2 = fresnel_sp(fabs(V2[2]), 1 / 1.5);
+    o[0] = kr + T[0]; o[1] = 1 - kr + R[2] + T[1]; o[2] = kr2 + (1 - kr2) * 0.5;
+}
+
+static void ref_geom_faceforward_reflect(double u, double v, double o[3])
+{
+    double V[3] = { u - 0.5, v - 0.3, 0.25 - u * v };
+    double nf = V[2] < 0 ? 1 : -1;                   /* z of faceforward(N, V, N) */
+    normalize3(V);
+    double R[3] = { V[0], V[1], V[2] - 2 * V[2] * nf * nf };
+    o[0] = R[0]; o[1] = R[1] + nf; o[2] = R[2] - 1;  /* I . Ng > 0: -(0, 1, 0) */
+}
+
+static double rnd(double x) { return x < 0 ? -floor(-x + 0.5) : floor(x + 0.5); }
+static void ref_math_round_sign(double u, double v, double o[3])
+{
+    double x = 6 * u - 3, q[3] = { x, 4 * v - 2, x * v };
+    double r[3];
+    for (int k = 0; k < 3; k++)
+        r[k] = rnd(q[k]) + sgn(q[k]) * 10;
+    o[0] = r[0] + 1 / sqrt(1 + u * u);
+    o[1] = r[1] + fabs(q[2]);
+    o[2] = r[2] + floor(q[0]) + ceil(q[0]);
+}
+
+/* Clipping 0.5 10.5, camera = current */
+static double depth_of(double z) { return (z - 0.5) / 10; }
+static void ref_depth_clip(double u, double v, double o[3])
+{
+    o[0] = depth_of(4 * u + 1); o[1] = depth_of(10 * v); o[2] = depth_of(1);
+}
+
+static void ref_filterstep_box(double u, double v, double o[3])
+{
+    /* the harness sets no du, dv: the point's filter width is 0 */
+    double a = u < 0.5 ? 0 : 1;
+    double b = clampd((u + 0.05 - 0.5) / 0.1, 0, 1);
+    double c = clampd((v + 0.05 + 0.1 - 0.3) / 0.2, 0, 1);
+    double d = clampd((v + 0.1 - 0.6) / 0.1, 0, 1);
+    o[0] = a + b; o[1] = c; o[2] = d;
+}
+
+static void ref_noise_float_forms(double u, double v, double o[3])
+{
+    double q[4] = { 3 * u, 3 * v, 0, 2 * v }, x5 = 5 * u, xy[2] = { 3 * u, 3 * v };
+    int p4 = 4, p23[2] = { 2, 3 }, p444[3] = { 4, 4, 4 }, p2223[4] = { 2, 2, 2, 3 };
+    o[0] = noise1(5 * u) + sl_noise(2, xy) + sl_noise(3, q) + sl_noise(4, q);
+    o[1] = sl_pnoise(1, &x5, &p4) + sl_pnoise(2, xy, p23) + sl_pnoise(3, q, p444) +
+           sl_pnoise(4, q, p2223);
+    double c1 = 4 * u, c2[2] = { 4 * u, 4 * v }, c4[4] = { 3 * u, 3 * v, 0, 4 * v };
+    o[2] = sl_cellnoise(1, &c1) + sl_cellnoise(2, c2) + sl_cellnoise(3, q) +
+           sl_cellnoise(4, c4);
+}
+
+static void ref_noise_triple_forms(double u, double v, double o[3])
+{
+    double q[4] = { 2 * u, 2 * v, 1, v }, st[2] = { 4 * u, 4 * v }, s7 = 7 * u;
+    double c1[3], c2[3], v1[3], v2[3], p[3], w1[3], w2[3];
+    int p444[3] = { 4, 4, 4 }, p33[2] = { 3, 3 };
+    double q2[3] = { 4 * u, 4 * v, 2 }, st3[2] = { 3 * u, 3 * v };
+    sl_vnoise(3, q, c1);
+    sl_vnoise(2, st, c2);
+    sl_vnoise(4, q, v1);
+    sl_vnoise(1, &s7, v2);
+    sl_vpnoise(3, q, p444, p);
+    sl_vcellnoise(3, q2, w1);
+    sl_vpnoise(2, st3, p33, w2);
+    o[0] = c1[0] + c2[0] + v1[0] + v2[0];
+    o[1] = v1[1] + v2[1] + p[1];
+    o[2] = w1[2] + w2[2] + p[2];
+}
+
+static double fstep3(double e, double x0, double x1)
+{
+    double lo = fmin(x0, x1), hi = fmax(x0, x1), w = hi - lo;
+    return clampd((hi - e) / (w > 1e-12 ? w : 1e-12), 0, 1);
+}
+static double fpulse(double a, double b, double x, double w)
+{
+    return fstep3(a, x - w / 2, x + w / 2) - fstep3(b, x - w / 2, x + w / 2);
+}
+static void ref_filterstep_pulse(double u, double v, double o[3])
+{
+    o[0] = fpulse(0.3, 0.7, fmodf_(u * 4, 1), 0.08);
+    o[1] = fpulse(0.2, 0.4, v, 0.16);
+    o[2] = stepd(0.5, u) - stepd(0.8, u);
+}
+
+static void ref_matrix_det_compose(double u, double v, double o[3])
+{
+    (void)u;
+    o[0] = 2 * (1 + v) * 0.5; o[1] = 1; o[2] = 16 * (1 + v);
+}
+
+static void ref_matrix_setcomp_loop(double u, double v, double o[3])
+{
+    o[0] = 1 + u; o[1] = 4; o[2] = 1 + v;
+}
+
+static void ref_color_roundtrip(double u, double v, double o[3])
+{
+    double c[3] = { 0.2 + 0.6 * u, 0.7 - 0.5 * v, 0.3 + 0.2 * u * v }, xyz[3];
+    mat3_apply(M_xyz, c, xyz);
+    o[0] = c[0] + c[1]; o[1] = c[2] + c[1]; o[2] = xyz[1] + c[2];
+}
+
+static void ref_noise_periodic(double u, double v, double o[3])
+{
+    double x = 3 * u, x4 = 3 * u + 4;
+    int p4 = 4, p235[3] = { 2, 3, 5 }, p33[2] = { 3, 3 };
+    double q[3] = { 2 * u, 2 * v, 0 }, q2[3] = { 2 * u + 2, 2 * v + 3, 5 };
+    double a2[2] = { 2 * u, 2 * v }, b2[2] = { 2 * u + 3, 2 * v - 3 }, c1[3], c2[3];
+    sl_vpnoise(2, a2, p33, c1);
+    sl_vpnoise(2, b2, p33, c2);
+    o[0] = sl_pnoise(1, &x, &p4) - sl_pnoise(1, &x4, &p4);
+    o[1] = sl_pnoise(3, q, p235) + sl_pnoise(3, q2, p235);
+    o[2] = c1[2] - c2[2];
+}
+
+static void ref_spline_octaves(double u, double v, double o[3])
+{
+    static const double k[5] = { 0, 1 / 16.0, 4 / 16.0, 9 / 16.0, 1 };
+    double sum = 0;
+    for (int i = 0; i < 3; i++)
+        sum += spline_ref("catmull-rom", fmodf_(u * pow(2, i), 1), k, 5) / pow(2, i);
+    o[0] = sum; o[1] = spline_ref("linear", v, k, 5); o[2] = spline_ref("constant", u, k, 5);
+}
+
+static void ref_message_attribute(double u, double v, double o[3])
+{
+    (void)v;
+    o[0] = 1 + 10 + 0 + 1000 + 10000; o[1] = 0.25 + 3 * sin(u * 4); o[2] = 7 + 0.2 + 1;
+}
+
+static void ref_strings_format(double u, double v, double o[3])
+{
+    o[0] = floor(u * 10) + 10; o[1] = 5 + v; o[2] = 15;
+}
+
 /* ---------------------------------------------------------------------- */
 /* the cases                                                               */
 /* ---------------------------------------------------------------------- */
@@ -503,6 +1006,39 @@ static const conf_case cases[] = {
     CASE(extern_write_chain, "extern of enclosing variables"),
     CASE(array_matrices, "arrays"),
     CASE(nested_shadows_builtin, "shadowed built-in names"),
+    CASE(spline_float, "spline"),
+    CASE(spline_color_ramp, "spline"),
+    CASE(spline_bezier_point, "spline"),
+    CASE(spline_bspline, "spline"),
+    CASE(spline_hermite, "spline"),
+    CASE(spline_linear_constant, "spline"),
+    CASE(spline_array, "spline"),
+    CASE(spline_unsized_param, "spline"),
+    CASE(spline_noise_marble, "spline"),
+    CASE(color_hsv, "color spaces"),
+    CASE(color_hsl, "color spaces"),
+    CASE(color_hue_shift, "color spaces"),
+    CASE(color_xyz_yiq, "color spaces"),
+    CASE(ptransform_spaces, "space transforms"),
+    CASE(matrix_determinant, "matrices"),
+    CASE(matrix_build, "matrices"),
+    CASE(matrix_comp, "matrices"),
+    CASE(geom_refract, "shading geometry"),
+    CASE(geom_fresnel, "shading geometry"),
+    CASE(geom_faceforward_reflect, "shading geometry"),
+    CASE(math_round_sign, "math"),
+    CASE(depth_clip, "depth"),
+    CASE(filterstep_box, "filterstep"),
+    CASE(noise_float_forms, "noise family"),
+    CASE(noise_triple_forms, "noise family"),
+    CASE(filterstep_pulse, "filterstep"),
+    CASE(matrix_det_compose, "matrices"),
+    CASE(matrix_setcomp_loop, "matrices"),
+    CASE(color_roundtrip, "color spaces"),
+    CASE(noise_periodic, "noise family"),
+    CASE(spline_octaves, "spline"),
+    CASE(message_attribute, "message passing"),
+    CASE(strings_format, "strings"),
 };
 #undef CASE
 #undef CASE_NO_DUAL
@@ -569,7 +1105,151 @@ static const conf_error errors[] = {
       "put a type in front, as in 'point (...)'\n"
       "    float d = (1, 0, 0) . (0, 1, 0);\n"
       "              ^\n" },
+    { "errors/spline_basis.sl",
+      "errors/spline_basis.sl:4:17: error: unknown spline basis 'cardinal' (known: "
+      "\"catmull-rom\", \"bezier\", \"b-spline\", \"hermite\", \"linear\", \"constant\")\n"
+      "    P += spline(\"cardinal\", s, 0, 1, 2, 3) * N;\n"
+      "                ^\n" },
+    { "errors/spline_count.sl",
+      "errors/spline_count.sl:4:10: error: a 'bezier' spline takes 4, 7, 10, ... knots, "
+      "not 5\n"
+      "    P += spline(\"bezier\", s, 0, 1, 2, 3, 4) * N;\n"
+      "         ^\n" },
+    { "errors/color_space.sl",
+      "errors/color_space.sl:4:26: error: unknown color space 'cmyk' (known: \"rgb\", "
+      "\"hsv\", \"hsl\", \"xyz\", \"XYZ\", \"xyY\", \"YIQ\")\n"
+      "    color c = ctransform(\"cmyk\", Cs);\n"
+      "                         ^\n" },
+    { "errors/format_type.sl",
+      "errors/format_type.sl:4:46: error: '%f' in the format string of format() does not "
+      "take a 'point'\n"
+      "    string label = format(\"height %f at %p\", P, s);\n"
+      "                                             ^\n" },
+    { "errors/filterstep_param.sl",
+      "errors/filterstep_param.sl:4:29: error: unknown filterstep() parameter 'blur' "
+      "(known: \"width\" with a float, \"filter\" with a name)\n"
+      "    P += filterstep(0.5, s, \"blur\", 0.1) * N;\n"
+      "                            ^\n" },
 };
+
+/* ---------------------------------------------------------------------- */
+/* surface shaders: illuminance loops                                      */
+/* ---------------------------------------------------------------------- */
+
+/* Surface shaders run on the unit sphere with I = (0, 0, 1) under these
+ * fixed lights (three distant ones and an ambient one); Ci and Oi are
+ * checked. */
+static const sl_light_sample surface_lights[] = {
+    { { 0.3, 0.2, -1 }, { 1, 0.8, 0.6 }, false },
+    { { -0.5, 0.1, 0.4 }, { 0.2, 0.3, 1 }, false },
+    { { 0.6, -0.7, 0.2 }, { 0.5, 0.5, 0.2 }, false },
+    { { 0, 0, 0 }, { 0.05, 0.05, 0.05 }, true },
+};
+enum { NSURFACE_LIGHTS = sizeof surface_lights / sizeof surface_lights[0] };
+
+static double dot3(const double a[3], const double b[3])
+{
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+/* faceforward(normalize(N), I) with I = (0, 0, 1), Ng = N */
+static void facing(const double N[3], double Nf[3])
+{
+    double Nn[3] = { N[0], N[1], N[2] };
+    normalize3(Nn);
+    for (int k = 0; k < 3; k++)
+        Nf[k] = N[2] < 0 ? Nn[k] : -Nn[k];
+}
+
+static void ref_surface_illuminance_diffuse(const double N[3], double Ci[3], double Oi[3])
+{
+    double Nf[3];
+    facing(N, Nf);
+    for (int k = 0; k < 3; k++)
+        Ci[k] = Oi[k] = 0;
+    for (int i = 0; i < NSURFACE_LIGHTS; i++) {
+        const sl_light_sample *l = &surface_lights[i];
+        if (l->ambient)
+            continue;
+        double Ln[3] = { l->L[0], l->L[1], l->L[2] };
+        normalize3(Ln);
+        double d = dot3(Ln, Nf);
+        for (int k = 0; k < 3; k++) {
+            Ci[k] += d >= 0 ? 0.8 * l->Cl[k] * d : 0;
+            Oi[k] += 0.8 * l->Cl[k] * (d > 0 ? d : 0);
+        }
+    }
+}
+
+static void ref_surface_illuminance_specular(const double N[3], double Ci[3], double Oi[3])
+{
+    double Nf[3], V[3] = { 0, 0, -1 };
+    facing(N, Nf);
+    for (int k = 0; k < 3; k++)
+        Ci[k] = Oi[k] = 0;
+    for (int i = 0; i < NSURFACE_LIGHTS; i++) {
+        const sl_light_sample *l = &surface_lights[i];
+        if (l->ambient)
+            continue;
+        double Ln[3] = { l->L[0], l->L[1], l->L[2] }, H[3];
+        normalize3(Ln);
+        for (int k = 0; k < 3; k++)
+            H[k] = Ln[k] + V[k];
+        normalize3(H);
+        double c = dot3(Nf, H), lobe = pow(c > 0 ? c : 0, 4);
+        for (int k = 0; k < 3; k++) {
+            Ci[k] += dot3(Ln, Nf) >= 0 ? l->Cl[k] * lobe : 0;
+            Oi[k] += l->Cl[k] * lobe;       /* specular(): every light */
+        }
+    }
+}
+
+static void ref_surface_illuminance_category(const double N[3], double Ci[3], double Oi[3])
+{
+    double Nf[3];
+    facing(N, Nf);
+    for (int k = 0; k < 3; k++)
+        Ci[k] = 0;
+    for (int i = 0; i < NSURFACE_LIGHTS; i++)
+        if (!surface_lights[i].ambient && dot3(surface_lights[i].L, Nf) >= 0)
+            for (int k = 0; k < 3; k++)
+                Ci[k] += 0.5 * surface_lights[i].Cl[k];
+    Oi[0] = 3; Oi[1] = 0; Oi[2] = 0;
+}
+
+static void ref_surface_illuminance_helper(const double N[3], double Ci[3], double Oi[3])
+{
+    double Nf[3];
+    facing(N, Nf);
+    for (int k = 0; k < 3; k++)
+        Ci[k] = Oi[k] = 0;
+    for (int i = 0; i < NSURFACE_LIGHTS; i++) {
+        const sl_light_sample *l = &surface_lights[i];
+        if (l->ambient)
+            continue;
+        double Ln[3] = { l->L[0], l->L[1], l->L[2] };
+        normalize3(Ln);
+        double d = dot3(Ln, Nf), w = (d + 0.3) / 1.3;
+        for (int k = 0; k < 3; k++) {
+            Ci[k] += l->Cl[k] * (w > 0 ? w : 0);
+            Oi[k] += -d >= cos(M_PI / 3) ? l->Cl[k] : 0;   /* the cone about -Nf */
+        }
+    }
+}
+
+typedef struct surface_case {
+    const char *file;
+    void (*ref)(const double N[3], double Ci[3], double Oi[3]);
+} surface_case;
+
+#define SURFACE(name) { #name ".sl", ref_##name }
+static const surface_case surface_cases[] = {
+    SURFACE(surface_illuminance_diffuse),
+    SURFACE(surface_illuminance_specular),
+    SURFACE(surface_illuminance_category),
+    SURFACE(surface_illuminance_helper),
+};
+#undef SURFACE
 
 /* ---------------------------------------------------------------------- */
 /* running                                                                 */
@@ -761,12 +1441,362 @@ static void check_ranges(const conf_case *cc, sl_vm *vm, const sl_instance *inst
     }
 }
 
+/* A surface shader on the sphere: Ci and Oi in float mode at 7x7 points
+ * against the reference; interval and affine enclosures over 12 random
+ * boxes contain the float values at 4x4 points of each. */
+static void check_surface(const surface_case *sc, sl_vm *vm, const sl_instance *inst,
+                          tally *t, unsigned long long *rng)
+{
+    for (int i = 0; i < 7; i++) {
+        for (int j = 0; j < 7; j++) {
+            double u = 0.05 + 0.9 * (i + 0.31) / 7, v = 0.05 + 0.9 * (j + 0.57) / 7;
+            double P[3], N[3], du[3], dv[3], C[6], want[6];
+            h_surface_float(H_SPHERE, u, v, P, N, du, dv);
+            sc->ref(N, want, want + 3);
+            h_globals_float(vm, H_SPHERE, u, v);
+            t->floats++;
+            bool ok = sl_vm_run(vm, inst, SL_MODE_FLOAT, NULL) == SL_OK;
+            if (ok) {
+                sl_vm_get_float(vm, SL_G_Ci, C);
+                sl_vm_get_float(vm, SL_G_Oi, C + 3);
+            }
+            for (int k = 0; ok && k < 6; k++)
+                ok = close_to(C[k], want[k]);
+            if (!ok) {
+                t->failures++;
+                fprintf(stderr, "%s: at (u, v) = (%.17g, %.17g): Ci, Oi = (%g %g %g, %g %g "
+                                "%g), want (%g %g %g, %g %g %g)\n", sc->file, u, v, C[0], C[1],
+                        C[2], C[3], C[4], C[5], want[0], want[1], want[2], want[3], want[4],
+                        want[5]);
+            }
+        }
+    }
+    aa_context ctx;
+    aa_context_init(&ctx, AA_DEFAULT_CAPACITY);
+    for (int r = 0; r < 12; r++) {
+        double side = ldexp(1, -2 - (int)(h_rand(rng) * 5));
+        double u0 = 0.02 + h_rand(rng) * (0.96 - side), v0 = 0.02 + h_rand(rng) * (0.96 - side);
+        double u1 = u0 + side, v1 = v0 + side;
+        ia_interval I[6], A[6];
+        aa_form a[6];
+        t->ranges++;
+        h_globals_interval(vm, H_SPHERE, u0, u1, v0, v1);
+        sl_status st = sl_vm_run(vm, inst, SL_MODE_INTERVAL, NULL);
+        if (st == SL_OK) {
+            sl_vm_get_interval(vm, SL_G_Ci, I);
+            sl_vm_get_interval(vm, SL_G_Oi, I + 3);
+            h_globals_affine(vm, &ctx, H_SPHERE, u0, u1, v0, v1);
+            st = sl_vm_run(vm, inst, SL_MODE_AFFINE, &ctx);
+        }
+        if (st != SL_OK) {
+            t->failures++;
+            fprintf(stderr, "%s: %s\n", sc->file, sl_vm_error(vm));
+            continue;
+        }
+        sl_vm_get_affine(vm, SL_G_Ci, a);
+        sl_vm_get_affine(vm, SL_G_Oi, a + 3);
+        bool bounded = true;
+        for (int k = 0; k < 6; k++) {
+            A[k] = aa_range(&a[k]);
+            bounded &= isfinite(A[k].lo) && isfinite(A[k].hi) && isfinite(I[k].lo) &&
+                       isfinite(I[k].hi);
+        }
+        t->bounded += bounded;
+        if (!bounded)
+            fprintf(stderr, "%s: box [%g, %g] x [%g, %g]: unbounded\n", sc->file, u0, u1,
+                    v0, v1);
+        for (int i = 0; i < 4; i++) {
+            for (int j = 0; j < 4; j++) {
+                double u = u0 + (u1 - u0) * i / 3, v = v0 + (v1 - v0) * j / 3, C[6];
+                t->samples++;
+                h_globals_float(vm, H_SPHERE, u, v);
+                bool ok = sl_vm_run(vm, inst, SL_MODE_FLOAT, NULL) == SL_OK;
+                if (ok) {
+                    sl_vm_get_float(vm, SL_G_Ci, C);
+                    sl_vm_get_float(vm, SL_G_Oi, C + 3);
+                }
+                for (int k = 0; ok && k < 6; k++)
+                    ok = inside(I[k], C[k]) && inside(A[k], C[k]);
+                if (!ok) {
+                    t->failures++;
+                    fprintf(stderr, "%s: box [%g, %g] x [%g, %g]: sample (%g, %g) outside\n",
+                            sc->file, u0, u1, v0, v1, u, v);
+                }
+            }
+        }
+    }
+}
+
+/* The same lights from the renderer's callback: float mode agrees with the
+ * fixed lights; interval mode cannot bound them and says so. */
+static int callback_lights(void *user, const double P[3], sl_light_sample *out, int max)
+{
+    (void)user;
+    (void)P;
+    int n = NSURFACE_LIGHTS < max ? NSURFACE_LIGHTS : max;
+    memcpy(out, surface_lights, (size_t)n * sizeof *out);
+    return n;
+}
+
+static void check_light_callback(const sl_instance *inst, sl_vm *fixed, tally *t)
+{
+    sl_vm *vm = sl_vm_new(NULL);
+    sl_vm_set_lights(vm, callback_lights, NULL);
+    double a[3], b[3];
+    h_globals_float(vm, H_SPHERE, 0.3, 0.7);
+    h_globals_float(fixed, H_SPHERE, 0.3, 0.7);
+    t->floats++;
+    bool ok = sl_vm_run(vm, inst, SL_MODE_FLOAT, NULL) == SL_OK &&
+              sl_vm_run(fixed, inst, SL_MODE_FLOAT, NULL) == SL_OK;
+    if (ok) {
+        sl_vm_get_float(vm, SL_G_Ci, a);
+        sl_vm_get_float(fixed, SL_G_Ci, b);
+        for (int k = 0; k < 3; k++)
+            ok &= close_to(a[k], b[k]);
+    }
+    h_globals_interval(vm, H_SPHERE, 0.3, 0.31, 0.7, 0.71);
+    ok &= sl_vm_run(vm, inst, SL_MODE_INTERVAL, NULL) == SL_ERR_RUNTIME &&
+          strstr(sl_vm_error(vm), "illuminance at") != NULL;
+    if (!ok) {
+        t->failures++;
+        fprintf(stderr, "illuminance with a light callback: %s\n", sl_vm_error(vm));
+    }
+    sl_vm_destroy(&vm);
+}
+
+/* Message passing from the displacement shader to the surface shader run
+ * next on the same VM: the outputs captured after the float run are what
+ * displacement("name", x) reads; a range run reads them as unbounded. */
+static void check_message_passing(sl_vm *vm, tally *t)
+{
+    char *d1 = NULL, *d2 = NULL;
+    sl_program *disp = compile_file("message_height.sl", &d1);
+    sl_program *surf = compile_file("surface_message.sl", &d2);
+    bool ok = disp && surf && !d1[0] && !d2[0];
+    free(d1);
+    free(d2);
+    sl_instance *di = disp ? sl_instance_new(disp) : NULL;
+    sl_instance *si = surf ? sl_instance_new(surf) : NULL;
+    for (int k = 0; ok && k < 5; k++) {
+        double u = 0.1 + 0.17 * k, v = 0.8 - 0.13 * k, C[3];
+        double h = 0.1 * sin(u * 6) * cos(v * 4);
+        double want[3] = { u + h, v + 2, h };
+        t->floats++;
+        h_globals_float(vm, H_PLANE, u, v);
+        ok = sl_vm_run(vm, di, SL_MODE_FLOAT, NULL) == SL_OK &&
+             sl_vm_capture_outputs(vm, SL_MSG_DISPLACEMENT) == 2;
+        h_globals_float(vm, H_SPHERE, u, v);
+        ok = ok && sl_vm_run(vm, si, SL_MODE_FLOAT, NULL) == SL_OK;
+        if (ok)
+            sl_vm_get_float(vm, SL_G_Ci, C);
+        for (int i = 0; ok && i < 3; i++)
+            ok = close_to(C[i], want[i]);
+    }
+    if (ok) {                       /* a range run: unbounded, not wrong */
+        ia_interval I[3];
+        h_globals_interval(vm, H_SPHERE, 0.3, 0.35, 0.3, 0.35);
+        ok = sl_vm_run(vm, si, SL_MODE_INTERVAL, NULL) == SL_OK;
+        sl_vm_get_interval(vm, SL_G_Ci, I);
+        for (int i = 0; ok && i < 3; i++)
+            ok = !isfinite(I[i].lo) && !isfinite(I[i].hi);
+    }
+    if (ok) {                       /* no displacement outputs: the defaults */
+        double C[3];
+        sl_vm_clear_messages(vm, SL_MSG_DISPLACEMENT);
+        h_globals_float(vm, H_SPHERE, 0.5, 0.5);
+        ok = sl_vm_run(vm, si, SL_MODE_FLOAT, NULL) == SL_OK;
+        sl_vm_get_float(vm, SL_G_Ci, C);
+        ok = ok && C[0] == -1 && C[1] == 0 && C[2] == 0;
+    }
+    if (!ok) {
+        t->failures++;
+        fprintf(stderr, "message passing from message_height.sl to surface_message.sl fails\n");
+    }
+    sl_instance_destroy(&di);
+    sl_instance_destroy(&si);
+    sl_program_destroy(&disp);
+    sl_program_destroy(&surf);
+}
+
+/* Light shaders (sl_light_eval) at points of the plane against their
+ * formulas, and the point light feeding surface_illuminance_diffuse.sl
+ * through a light callback. */
+typedef struct light_case {
+    const char *file;
+    const char *param;          /* one parameter set besides the defaults */
+    double value[3];
+} light_case;
+
+static sl_instance *light_instance(const char *file, tally *t)
+{
+    char *diag = NULL;
+    sl_program *p = compile_file(file, &diag);
+    if (!p || diag[0]) {
+        t->failures++;
+        fprintf(stderr, "%s: does not compile cleanly:\n%s", file, diag);
+    }
+    free(diag);
+    return p ? sl_instance_new(p) : NULL;
+}
+
+static void free_light(sl_instance **inst)
+{
+    if (!*inst)
+        return;
+    sl_program *p = (sl_program *)sl_instance_program(*inst);
+    sl_instance_destroy(inst);
+    sl_program_destroy(&p);
+}
+
+static void set_param(sl_instance *inst, const char *name, sl_type type, const double *v, int n)
+{
+    char why[256];
+    assert_true(sl_instance_set(inst, name, type, v, n, why, sizeof why));
+}
+
+typedef struct light_ctx {
+    sl_vm *vm;
+    sl_instance *lights[2];
+} light_ctx;
+
+static int shader_lights(void *user, const double P[3], sl_light_sample *out, int max)
+{
+    light_ctx *lc = user;
+    int n = 0;
+    for (int i = 0; i < 2 && n < max; i++)
+        if (sl_light_eval(lc->vm, lc->lights[i], P, &out[n]) == SL_OK)
+            n++;
+    return n;
+}
+
+static void check_light_shaders(tally *t)
+{
+    sl_vm *lvm = sl_vm_new(NULL);
+    sl_instance *point = light_instance("light_point.sl", t);
+    sl_instance *spot = light_instance("light_spot.sl", t);
+    sl_instance *distant = light_instance("light_distant.sl", t);
+    sl_instance *ambient = light_instance("light_ambient.sl", t);
+    if (!point || !spot || !distant || !ambient)
+        goto done;
+    double two = 2, tenth = 0.1, lc[3] = { 1, 0.5, 0.25 }, from[3] = { 0, 0, 2 };
+    double origin[3] = { 0, 0, 0 }, dir[3] = { 1, 0, -1 };
+    set_param(point, "intensity", SL_TYPE_FLOAT, &two, 1);
+    set_param(point, "lightcolor", SL_TYPE_COLOR, lc, 3);
+    set_param(point, "from", SL_TYPE_POINT, from, 3);
+    set_param(spot, "from", SL_TYPE_POINT, from, 3);
+    set_param(spot, "to", SL_TYPE_POINT, origin, 3);
+    double cone = M_PI / 9;                      /* 20 degrees */
+    set_param(spot, "coneangle", SL_TYPE_FLOAT, &cone, 1);
+    set_param(distant, "to", SL_TYPE_POINT, dir, 3);
+    set_param(ambient, "intensity", SL_TYPE_FLOAT, &tenth, 1);
+    int lit = 0;
+    for (int i = 0; i < 7; i++) {
+        for (int j = 0; j < 7; j++) {
+            double u = 0.05 + 0.9 * (i + 0.31) / 7, v = 0.05 + 0.9 * (j + 0.57) / 7;
+            double Ps[3] = { 2 * u - 1, 2 * v - 1, 0 }, want[4][7];
+            /* point: L towards "from", Cl = 2 lc / |from - Ps|^2 */
+            double Lp[3] = { -Ps[0], -Ps[1], 2 - Ps[2] }, d2 = dot3(Lp, Lp);
+            /* spot: axis (0, 0, -1), cone 20 degrees, smooth over the last 5 */
+            double Ls[3] = { Ps[0], Ps[1], Ps[2] - 2 }, ca = -Ls[2] / sqrt(dot3(Ls, Ls));
+            bool in = ca >= cos(cone);
+            double spot_cl = in ? pow(ca, 2) / dot3(Ls, Ls) *
+                                  smooth(cos(cone), cos(cone - M_PI / 36), ca) : 0;
+            lit += in;
+            for (int k = 0; k < 3; k++) {
+                want[0][k] = Lp[k];
+                want[0][3 + k] = 2 * lc[k] / d2;
+                want[1][k] = -Ls[k];
+                want[1][3 + k] = spot_cl;
+                want[2][k] = -dir[k];
+                want[2][3 + k] = 1;
+                want[3][3 + k] = 0.1;
+            }
+            want[0][6] = want[1][6] = want[2][6] = 0;
+            want[3][6] = 1;
+            sl_instance *insts[4] = { point, spot, distant, ambient };
+            for (int l = 0; l < 4; l++) {
+                sl_light_sample ls;
+                t->floats++;
+                bool ok = sl_light_eval(lvm, insts[l], Ps, &ls) == SL_OK;
+                for (int k = 0; ok && k < 3; k++)
+                    ok = (l == 3 || close_to(ls.L[k], want[l][k])) &&
+                         close_to(ls.Cl[k], want[l][3 + k]);
+                ok = ok && ls.ambient == (want[l][6] == 1);
+                if (!ok) {
+                    t->failures++;
+                    fprintf(stderr, "light shader %d at Ps = (%g, %g, %g): L (%g %g %g), Cl "
+                                    "(%g %g %g)\n", l, Ps[0], Ps[1], Ps[2], ls.L[0], ls.L[1],
+                            ls.L[2], ls.Cl[0], ls.Cl[1], ls.Cl[2]);
+                }
+            }
+        }
+    }
+    if (lit == 0 || lit == 49) {      /* the spot's cone must cut the samples */
+        t->failures++;
+        fprintf(stderr, "light_spot.sl: %d of 49 points lit\n", lit);
+    }
+    /* the point and ambient lights through a callback, for the diffuse loop */
+    char *diag = NULL;
+    sl_program *sp = compile_file("surface_illuminance_diffuse.sl", &diag);
+    free(diag);
+    if (!sp) {
+        t->failures++;
+        goto done;
+    }
+    sl_instance *si = sl_instance_new(sp);
+    sl_vm *vm = sl_vm_new(NULL);
+    light_ctx ctx = { lvm, { point, ambient } };
+    sl_vm_set_lights(vm, shader_lights, &ctx);
+    for (int k = 0; k < 5; k++) {
+        double u = 0.1 + 0.19 * k, v = 0.7 - 0.11 * k, P[3], N[3], du[3], dv[3], Nf[3], C[3];
+        h_surface_float(H_SPHERE, u, v, P, N, du, dv);
+        facing(N, Nf);
+        double L[3] = { -P[0], -P[1], 2 - P[2] }, d2 = dot3(L, L), Ln[3] = { L[0], L[1], L[2] };
+        normalize3(Ln);
+        double d = dot3(Ln, Nf);
+        h_globals_float(vm, H_SPHERE, u, v);
+        t->floats++;
+        bool ok = sl_vm_run(vm, si, SL_MODE_FLOAT, NULL) == SL_OK;
+        sl_vm_get_float(vm, SL_G_Ci, C);
+        for (int c = 0; ok && c < 3; c++)
+            ok = close_to(C[c], d >= 0 ? 0.8 * 2 * lc[c] / d2 * d : 0);
+        if (!ok) {
+            t->failures++;
+            fprintf(stderr, "surface_illuminance_diffuse.sl under light_point.sl at (%g, %g): "
+                            "%s\n", u, v, sl_vm_error(vm));
+        }
+    }
+    sl_vm_destroy(&vm);
+    sl_instance_destroy(&si);
+    sl_program_destroy(&sp);
+done:
+    free_light(&point);
+    free_light(&spot);
+    free_light(&distant);
+    free_light(&ambient);
+    sl_vm_destroy(&lvm);
+}
+
 static void test_conformance(void **state)
 {
     (void)state;
     tally t = { 0, 0, 0, 0, 0, 0, 0 };
     unsigned long long rng = 0x5eed15ULL;
     sl_vm *vm = sl_vm_new(NULL);
+    /* "object" -> "current": scale by 2, then translate by (1, 2, 3) */
+    sl_spaces sp;
+    for (int k = 0; k < SL_SPACE__COUNT; k++)
+        sp.to_current[k] = sp.from_current[k] = mat4_identity();
+    sp.to_current[SL_SPACE_OBJECT] = mat4_mul(mat4_translate(1, 2, 3), mat4_scale(2, 2, 2));
+    mat4_invert(&sp.to_current[SL_SPACE_OBJECT], &sp.from_current[SL_SPACE_OBJECT]);
+    sl_vm_set_spaces(vm, &sp);
+    sl_vm_set_clipping(vm, 0.5, 10.5);
+    double bound = 0.25, freq = 3, tint[3] = { 0.1, 0.2, 0.3 };
+    assert_true(sl_vm_set_message(vm, SL_MSG_ATTRIBUTE, "displacementbound:sphere",
+                                  SL_TYPE_FLOAT, &bound, NULL));
+    assert_true(sl_vm_set_message(vm, SL_MSG_OPTION, "user:frequency", SL_TYPE_FLOAT, &freq,
+                                  NULL));
+    assert_true(sl_vm_set_message(vm, SL_MSG_ATTRIBUTE, "user:tint", SL_TYPE_COLOR, tint, NULL));
     const char *features[64];
     int nfeatures = 0;
     size_t ncases = sizeof cases / sizeof cases[0];
@@ -792,6 +1822,31 @@ static void test_conformance(void **state)
         sl_instance_destroy(&inst);
         sl_program_destroy(&p);
     }
+    size_t nsurfaces = sizeof surface_cases / sizeof surface_cases[0];
+    sl_vm_set_fixed_lights(vm, surface_lights, NSURFACE_LIGHTS);
+    if (nfeatures < 64)
+        features[nfeatures++] = "illuminance (surface shaders)";
+    if (nfeatures < 64)
+        features[nfeatures++] = "light shaders (illuminate, solar)";
+    for (size_t c = 0; c < nsurfaces; c++) {
+        char *diag = NULL;
+        sl_program *p = compile_file(surface_cases[c].file, &diag);
+        if (!p || diag[0]) {
+            t.failures++;
+            fprintf(stderr, "%s: does not compile cleanly:\n%s", surface_cases[c].file, diag);
+        }
+        free(diag);
+        if (!p)
+            continue;
+        sl_instance *inst = sl_instance_new(p);
+        check_surface(&surface_cases[c], vm, inst, &t, &rng);
+        if (c == 0)
+            check_light_callback(inst, vm, &t);
+        sl_instance_destroy(&inst);
+        sl_program_destroy(&p);
+    }
+    check_message_passing(vm, &t);
+    check_light_shaders(&t);
     size_t nerrors = sizeof errors / sizeof errors[0];
     for (size_t e = 0; e < nerrors; e++) {
         char *diag = NULL;
@@ -805,7 +1860,9 @@ static void test_conformance(void **state)
         free(diag);
     }
     sl_vm_destroy(&vm);
-    printf("conformance: %zu shaders and %zu error cases; features:", ncases, nerrors);
+    printf("conformance: %zu displacement, %zu surface and 4 light shaders, a "
+           "displacement-to-surface message pair and %zu error cases; features:", ncases,
+           nsurfaces, nerrors);
     for (int f = 0; f < nfeatures; f++)
         printf("%s %s", f ? "," : "", features[f]);
     printf("\nconformance: %d float checks, %d dual checks (%d derivatives against "

@@ -171,6 +171,51 @@ static void test_derivative_builtins(void **state)
     sl_program_destroy(&p);
 }
 
+/* filterstep over the filter width of x: with du = dv = 0.05 set by the
+ * renderer, fw = |Du(x)| du + |Dv(x)| dv; the box-filtered step is
+ * clamp((x - edge) / fw + 1/2, 0, 1). The interval run over a box holds
+ * the dual values at its points. */
+static void test_filterstep(void **state)
+{
+    (void)state;
+    sl_program *p = h_compile("displacement t() {\n"
+                              "  P = point(filterstep(0.5, u * 4 - 1.2),\n"
+                              "            filterstep(0.3, v, \"width\", 2), 0);\n"
+                              "}\n");
+    assert_non_null(p);
+    sl_instance *inst = sl_instance_new(p);
+    sl_vm *vm = sl_vm_new(NULL);
+    for (int k = 0; k < 4; k++) {
+        double u = 0.40 + 0.02 * k, v = 0.27 + 0.03 * k;
+        h_globals_dual(vm, H_PLANE, u, v);
+        sl_dual w = { 0.05, 0, 0 };
+        sl_vm_set_dual(vm, SL_G_du, &w);
+        sl_vm_set_dual(vm, SL_G_dv, &w);
+        assert_int_equal(sl_vm_run(vm, inst, SL_MODE_DUAL, NULL), SL_OK);
+        sl_dual P[3];
+        sl_vm_get_dual(vm, SL_G_P, P);
+        double a = (4 * u - 1.2 - 0.5) / (4 * 0.05) + 0.5, b = (v - 0.3) / (2 * 0.05) + 0.5;
+        a = a < 0 ? 0 : a > 1 ? 1 : a;
+        b = b < 0 ? 0 : b > 1 ? 1 : b;
+        assert_true(near(P[0].v, a));
+        assert_true(near(P[1].v, b));
+        /* an interval run over a box around (u, v) */
+        h_globals_interval(vm, H_PLANE, u - 0.01, u + 0.01, v - 0.01, v + 0.01);
+        ia_interval wi = ia_point(0.05);
+        sl_vm_set_interval(vm, SL_G_du, &wi);
+        sl_vm_set_interval(vm, SL_G_dv, &wi);
+        assert_int_equal(sl_vm_run(vm, inst, SL_MODE_INTERVAL, NULL), SL_OK);
+        ia_interval I[3];
+        sl_vm_get_interval(vm, SL_G_P, I);
+        assert_true(I[0].lo <= a + 1e-12 && a <= I[0].hi + 1e-12);
+        assert_true(I[1].lo <= b + 1e-12 && b <= I[1].hi + 1e-12);
+        assert_true(I[0].hi - I[0].lo < 1);    /* narrower than the step's [0, 1] */
+    }
+    sl_vm_destroy(&vm);
+    sl_instance_destroy(&inst);
+    sl_program_destroy(&p);
+}
+
 /* The displaced P and N = calculatenormal(P) of a library shader. */
 static void check_shader(const char *name)
 {
@@ -219,6 +264,7 @@ int main(void)
         cmocka_unit_test(test_noise),
         cmocka_unit_test(test_geometry),
         cmocka_unit_test(test_derivative_builtins),
+        cmocka_unit_test(test_filterstep),
         cmocka_unit_test(test_wave),
         cmocka_unit_test(test_ufo),
         cmocka_unit_test(test_threads),

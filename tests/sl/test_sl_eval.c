@@ -23,7 +23,10 @@
 #include <cmocka.h>
 
 #include "sl/noise.h"
+#include "sl/strmatch.h"
 #include "sl_harness.h"
+
+#include <unistd.h>
 
 static const double U = 0.25, V = 0.75;
 
@@ -518,6 +521,77 @@ static void test_vm_errors_and_counts(void **state)
     assert_null(inst);
     sl_program_destroy(&p);
     assert_null(p);
+    /* a matrix row past 3 with a varying index stops the run (it would
+     * otherwise name another element); rows 0..3 read what they name */
+    p = h_compile("displacement t() {\n"
+                  "  matrix m = matrix (1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16);\n"
+                  "  float row = floor(u * 8);\n"
+                  "  P = point(comp(m, row, 1), 0, 0);\n"
+                  "}\n");
+    assert_non_null(p);
+    inst = sl_instance_new(p);
+    vm = sl_vm_new(NULL);
+    h_globals_float(vm, H_PLANE, 0.3, 0.5);          /* row 2: element (2, 1) */
+    assert_int_equal(sl_vm_run(vm, inst, SL_MODE_FLOAT, NULL), SL_OK);
+    sl_vm_get_float(vm, SL_G_P, P);
+    assert_true(P[0] == 10);
+    h_globals_float(vm, H_PLANE, 0.55, 0.5);         /* row 4 */
+    assert_int_equal(sl_vm_run(vm, inst, SL_MODE_FLOAT, NULL), SL_ERR_RUNTIME);
+    assert_non_null(strstr(sl_vm_error(vm), "array index"));
+    sl_vm_destroy(&vm);
+    sl_instance_destroy(&inst);
+    sl_program_destroy(&p);
+}
+
+/* match()'s regular expressions, bounded on a hostile pattern; printf
+ * writes a line per float run to stderr, at most SL_VM_MAX_PRINTS (100)
+ * and then one note, and nothing in the other modes. */
+static void test_strings(void **state)
+{
+    (void)state;
+    assert_int_equal(sl_match("^a.c$", "abc"), 1);
+    assert_int_equal(sl_match("^a.c$", "abcd"), 0);
+    assert_int_equal(sl_match("a*", ""), 1);
+    assert_int_equal(sl_match("[^0-9]+$", "12ab"), 1);
+    assert_int_equal(sl_match("^[0-9]+$", "12ab"), 0);
+    assert_int_equal(sl_match("x+y?z", "wxxz"), 1);
+    assert_int_equal(sl_match("\\.tx$", "a.tx"), 1);
+    assert_int_equal(sl_match("\\.tx$", "atx"), 0);
+    assert_true(sl_match_check("[abc") != 0);
+    assert_true(sl_match_check("*a") != 0);
+    assert_int_equal(sl_match("a*a*a*a*a*a*a*a*a*a*a*a*a*b", "aaaaaaaaaaaaaaaaaaaaaaaaaaaaaa"), 0);
+    sl_program *p = h_compile("displacement t() { printf(\"u=%.2f %s\\n\", u, \"x\"); }");
+    assert_non_null(p);
+    sl_instance *inst = sl_instance_new(p);
+    sl_vm *vm = sl_vm_new(NULL);
+    fflush(stderr);
+    int saved = dup(2);
+    FILE *tmp = tmpfile();
+    assert_non_null(tmp);
+    dup2(fileno(tmp), 2);
+    for (int i = 0; i < 150; i++) {
+        h_globals_float(vm, H_PLANE, 0.25, 0.5);
+        assert_int_equal(sl_vm_run(vm, inst, SL_MODE_FLOAT, NULL), SL_OK);
+        h_globals_dual(vm, H_PLANE, 0.25, 0.5);
+        assert_int_equal(sl_vm_run(vm, inst, SL_MODE_DUAL, NULL), SL_OK);
+    }
+    fflush(stderr);
+    dup2(saved, 2);
+    close(saved);
+    rewind(tmp);
+    char line[256];
+    int lines = 0, notes = 0;
+    while (fgets(line, sizeof line, tmp)) {
+        lines++;
+        notes += strstr(line, "more than 100 printf lines") != NULL;
+        assert_true(strcmp(line, "u=0.25 x\n") == 0 || strstr(line, "printf lines"));
+    }
+    fclose(tmp);
+    assert_int_equal(lines, 101);
+    assert_int_equal(notes, 1);
+    sl_vm_destroy(&vm);
+    sl_instance_destroy(&inst);
+    sl_program_destroy(&p);
 }
 
 static void test_dump(void **state)
@@ -559,6 +633,7 @@ int main(void)
         cmocka_unit_test(test_lights),
         cmocka_unit_test(test_spaces_and_matrices),
         cmocka_unit_test(test_vm_errors_and_counts),
+        cmocka_unit_test(test_strings),
         cmocka_unit_test(test_dump),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

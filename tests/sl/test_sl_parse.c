@@ -125,15 +125,19 @@ static void test_error_in_macro(void **state)
 static void test_unsupported(void **state)
 {
     (void)state;
-    expect_errors("light l() { }\n",
-                  "t.sl:1:1: error: 'light' shaders are not supported (only 'surface' and "
-                  "'displacement')\n"
-                  "light l() { }\n"
+    expect_errors("volume l() { }\n",
+                  "t.sl:1:1: error: 'volume' shaders are not supported (only 'surface', "
+                  "'displacement' and 'light')\n"
+                  "volume l() { }\n"
                   "^\n");
-    expect_errors("surface s() {\n    illuminance(P) { }\n}\n",
-                  "t.sl:2:5: error: light loops are not supported (use ambient(), diffuse(), "
-                  "specular() or phong())\n"
-                  "    illuminance(P) { }\n"
+    expect_errors("surface s() {\n    illuminate(P) { }\n}\n",
+                  "t.sl:2:5: error: 'illuminate' is only allowed in light shaders\n"
+                  "    illuminate(P) { }\n"
+                  "    ^\n");
+    expect_errors("surface s() {\n    illuminance(P, N) { }\n}\n",
+                  "t.sl:2:5: error: illuminance takes [category,] position [, axis, angle], "
+                  "not 2 values\n"
+                  "    illuminance(P, N) { }\n"
                   "    ^\n");
     expect_errors("displacement t() {\n    output float x = 1;\n    void y;\n}\n",
                   "t.sl:2:12: error: 'output' is only allowed on parameters\n"
@@ -300,7 +304,7 @@ static void test_calls(void **state)
                   "float f(float a; float b) { return a + b; }\n"
                   "      ^\n");
     expect_errors("displacement t() {\n    P = transform(\"raster\", P);\n"
-                  "    P = point \"screen\" (0, 0, 0);\n    color c = color \"hsv\" (1, 0, 0);\n}\n",
+                  "    P = point \"screen\" (0, 0, 0);\n    color c = color \"cmyk\" (1, 0, 0);\n}\n",
                   "t.sl:2:19: error: unknown space 'raster' (known: \"current\", \"world\", "
                   "\"object\", \"shader\", \"camera\")\n"
                   "    P = transform(\"raster\", P);\n"
@@ -309,8 +313,9 @@ static void test_calls(void **state)
                   "\"object\", \"shader\", \"camera\")\n"
                   "    P = point \"screen\" (0, 0, 0);\n"
                   "        ^\n"
-                  "t.sl:4:15: error: unsupported color space 'hsv' (only \"rgb\")\n"
-                  "    color c = color \"hsv\" (1, 0, 0);\n"
+                  "t.sl:4:15: error: unknown color space 'cmyk' (known: \"rgb\", \"hsv\", "
+                  "\"hsl\", \"xyz\", \"XYZ\", \"xyY\", \"YIQ\")\n"
+                  "    color c = color \"cmyk\" (1, 0, 0);\n"
                   "              ^\n");
 }
 

@@ -37,7 +37,8 @@ static int compile_one(const char *path, const char *const *search, bool dump)
     int status = 0;
     if (prog) {
         printf("%s: %s shader '%s' compiled (%d parameter%s)\n", path,
-               sl_program_kind(prog) == SL_SHADER_SURFACE ? "surface" : "displacement",
+               sl_program_kind(prog) == SL_SHADER_SURFACE ? "surface"
+               : sl_program_kind(prog) == SL_SHADER_LIGHT ? "light" : "displacement",
                sl_program_name(prog), sl_program_param_count(prog),
                sl_program_param_count(prog) == 1 ? "" : "s");
         if (dump)
