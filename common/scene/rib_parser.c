@@ -29,8 +29,16 @@
 static void vreport(rib_parser *p, sl_diag_level level, const rib_request *req,
                     sl_pos pos, const char *fmt, va_list ap)
 {
-    char msg[1024];
+    char msg[2048];
     vsnprintf(msg, sizeof msg, fmt, ap);
+    /* inside an archive: name the chain, innermost first */
+    for (int i = p->narchive_chain - 1; i >= 0; i--) {
+        const rib_archive_link *l = &p->archive_chain[i];
+        size_t used = strlen(msg);
+        snprintf(msg + used, sizeof msg - used, "%s archive %s read at %s:%d:%d%s",
+                 i == p->narchive_chain - 1 ? " (in" : ",", l->file, l->read_at.file,
+                 l->read_at.line, l->read_at.col, i == 0 ? ")" : "");
+    }
     if (req)
         sl_diag_report(p->diag, level, pos, "%s: %s", req->name, msg);
     else
@@ -386,6 +394,7 @@ static const request_def requests[] = {
     { "Paraboloid", rib_paraboloid, PRIMITIVE },
     { "Polygon", rib_polygon, PRIMITIVE },
     { "Patch", rib_patch, PRIMITIVE },
+    { "ReadArchive", rib_read_archive, ANYWHERE },
 };
 
 enum { NREQUESTS = sizeof requests / sizeof requests[0] };
@@ -610,20 +619,38 @@ static void parser_free(rib_parser *p)
     for (int i = 0; i < p->nshader_path; i++)
         free(p->shader_path[i]);
     free(p->shader_path);
+    for (int i = 0; i < p->narchive_path; i++)
+        free(p->archive_path[i]);
+    free(p->archive_path);
     rib_decls_destroy(&p->decls);
     rib_reader_destroy(&p->reader);
 }
 
-static void parse_all(rib_parser *p)
+void rib_parser_run(rib_parser *p)
 {
     rib_request *req;
     while (!sl_diag_full(p->diag) && (req = rib_reader_next(p->reader)))
         dispatch(p, req);
+}
+
+static void parse_all(rib_parser *p)
+{
+    rib_parser_run(p);
     if (!sl_diag_full(p->diag))
         finish(p);
 }
 
 scene *scene_parse(const char *file, const char *text, size_t len, sl_diag *diag)
+{
+    sl_source_set *archives = sl_source_set_new();
+    sl_source_set_set_loader(archives, scene_archive_load_from_disk, NULL);
+    scene *s = scene_parse_archives(file, text, len, archives, diag);
+    sl_source_set_destroy(&archives);
+    return s;
+}
+
+scene *scene_parse_archives(const char *file, const char *text, size_t len,
+                            sl_source_set *archives, sl_diag *diag)
 {
     if (!file || !*file)
         file = "<scene>";
@@ -639,6 +666,8 @@ scene *scene_parse(const char *file, const char *text, size_t len, sl_diag *diag
     rib_parser p;
     memset(&p, 0, sizeof p);
     p.diag = diag;
+    p.archives = archives;
+    p.diag_sources = set;
     p.scene = scene_new(file);
     p.file = p.scene->file;
     p.decls = rib_decls_new();

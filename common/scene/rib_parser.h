@@ -10,6 +10,7 @@
  *   rib_attributes.c   attributes, transforms, shaders, lights, Declare
  *   rib_geometry.c     the base surfaces (Sphere ... Polygon, Patch)
  *   rib_params.c       parameter lists: typing and reading values
+ *   rib_archive.c      ReadArchive: archives found, loaded and read in place
  *
  * The graphics state follows RI Specification 3.2 §4: options are global
  * and frozen at WorldBegin; attributes (with the current transform) are
@@ -27,6 +28,7 @@
 #include "scene/rib_reader.h"
 #include "scene/scene.h"
 #include "sl/diag.h"
+#include "sl/source.h"
 
 /* The attributes of RI Spec §4.2 that aafarm records. */
 typedef struct rib_attributes {
@@ -57,6 +59,13 @@ typedef struct rib_block {
     rib_attributes saved;          /* restored when it closes */
 } rib_block;
 
+/* One archive being read: its (normalized) name and the ReadArchive that
+ * reads it. */
+typedef struct rib_archive_link {
+    const char *file;              /* interned */
+    sl_pos read_at;
+} rib_archive_link;
+
 typedef struct rib_parser {
     sl_diag *diag;
     const char *file;              /* owned by scene->file */
@@ -81,6 +90,12 @@ typedef struct rib_parser {
     int skip_depth;                /* FrameBegin nesting while skipping */
     char **shader_path;            /* Option "searchpath" "shader" dirs */
     int nshader_path;
+    char **archive_path;           /* Option "searchpath" "archive" dirs */
+    int narchive_path;
+    sl_source_set *archives;       /* where archive texts come from */
+    sl_source_set *diag_sources;   /* diag's set: archives added for carets */
+    rib_archive_link archive_chain[SCENE_ARCHIVE_MAX_DEPTH];
+    int narchive_chain;            /* archives being read, outermost first */
 } rib_parser;
 
 /* Reports an error / warning naming the request: "Sphere: <message>". */
@@ -105,6 +120,10 @@ const char *rib_read_string(rib_parser *p, const rib_request *req, int i, const 
 
 /* Fails (with an error) when arguments are left after index `i`. */
 bool rib_no_more_args(rib_parser *p, const rib_request *req, int i);
+
+/* Dispatches the requests of p->reader until its end (or the
+ * diagnostics' cap). */
+void rib_parser_run(rib_parser *p);
 
 /* ---- parameter lists (rib_params.c) ------------------------------------- */
 
@@ -179,6 +198,9 @@ void rib_hyperboloid(rib_parser *p, const rib_request *req);
 void rib_paraboloid(rib_parser *p, const rib_request *req);
 void rib_polygon(rib_parser *p, const rib_request *req);
 void rib_patch(rib_parser *p, const rib_request *req);
+
+/* rib_archive.c */
+void rib_read_archive(rib_parser *p, const rib_request *req);
 
 /* Growing the scene's arrays (rib_parser.c). */
 scene_light *rib_add_light(rib_parser *p);
