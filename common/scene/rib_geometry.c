@@ -101,23 +101,18 @@ static void object_lights(const rib_parser *p, scene_object *o)
             o->lights[o->nlights++] = i;
 }
 
-/* Validates the surface and adds the object with the current attributes. */
-static void add_object(rib_parser *p, const rib_request *req, geom_surface *surf)
+void rib_place_surface(rib_parser *p, const rib_request *req, const geom_surface *surf,
+                       mat4 ctm, sl_pos pos)
 {
-    char why[256] = "";
-    if (!prepare_surface(surf, why, sizeof why)) {
-        rib_error(p, req, req->pos, "%s", why[0] ? why : "invalid parameters");
-        return;
-    }
     const rib_attributes *a = &p->attr;
-    mat4 to_camera = mat4_mul(p->scene->camera.camera_from_world, a->ctm), inv;
+    mat4 to_camera = mat4_mul(p->scene->camera.camera_from_world, ctm), inv;
     if (!mat4_invert(&to_camera, &inv)) {
         rib_error(p, req, req->pos, "the current transform is singular (a Scale by 0?)");
         return;
     }
     scene_object *o = rib_add_object(p);
     o->surface = *surf;
-    o->object_to_world = a->ctm;
+    o->object_to_world = ctm;
     o->object_to_camera = to_camera;
     o->camera_to_object = inv;
     o->surface_shader = a->surface;
@@ -131,8 +126,23 @@ static void add_object(rib_parser *p, const rib_request *req, geom_surface *surf
     o->displacement_bound = a->displacement_bound;
     o->displacement_bound_space = sl_xstrndup(a->bound_space, strlen(a->bound_space));
     o->name = a->name ? sl_xstrndup(a->name, strlen(a->name)) : NULL;
-    o->pos = req->pos;
+    o->pos = pos;
     object_lights(p, o);
+}
+
+/* Validates the surface and adds the object with the current attributes
+ * (or records it in the object being defined, rib_instance.c). */
+static void add_object(rib_parser *p, const rib_request *req, geom_surface *surf)
+{
+    char why[256] = "";
+    if (!prepare_surface(surf, why, sizeof why)) {
+        rib_error(p, req, req->pos, "%s", why[0] ? why : "invalid parameters");
+        return;
+    }
+    if (rib_defining(p))
+        rib_record_surface(p, req, surf);
+    else
+        rib_place_surface(p, req, surf, p->attr.ctm, req->pos);
 }
 
 /* Reads the positional numbers, then the parameter list (typed, values

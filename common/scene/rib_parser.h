@@ -11,6 +11,7 @@
  *   rib_geometry.c     the base surfaces (Sphere ... Polygon, Patch)
  *   rib_params.c       parameter lists: typing and reading values
  *   rib_archive.c      ReadArchive: archives found, loaded and read in place
+ *   rib_instance.c     ObjectBegin/End, ObjectInstance: retained surfaces
  *
  * The graphics state follows RI Specification 3.2 §4: options are global
  * and frozen at WorldBegin; attributes (with the current transform) are
@@ -51,13 +52,31 @@ typedef enum rib_block_kind {
     RIB_BLOCK_WORLD,
     RIB_BLOCK_ATTRIBUTE,
     RIB_BLOCK_TRANSFORM,
+    RIB_BLOCK_OBJECT,              /* ObjectBegin: defs[object_def] */
 } rib_block_kind;
 
 typedef struct rib_block {
     rib_block_kind kind;
     sl_pos pos;                    /* where it opened */
     rib_attributes saved;          /* restored when it closes */
+    int object_def;                /* RIB_BLOCK_OBJECT: index into defs */
 } rib_block;
+
+/* A surface of an object definition, with the transform current inside
+ * the definition (relative to its ObjectBegin). */
+typedef struct rib_object_part {
+    geom_surface surface;          /* prepared */
+    mat4 ctm;
+    sl_pos pos;
+} rib_object_part;
+
+typedef struct rib_object_def {
+    char *handle;                  /* NULL: a malformed ObjectBegin */
+    sl_pos pos;
+    rib_object_part *parts;
+    int nparts;
+    bool warned;                   /* about attributes inside it */
+} rib_object_def;
 
 /* One archive being read: its (normalized) name and the ReadArchive that
  * reads it. */
@@ -96,6 +115,8 @@ typedef struct rib_parser {
     sl_source_set *diag_sources;   /* diag's set: archives added for carets */
     rib_archive_link archive_chain[SCENE_ARCHIVE_MAX_DEPTH];
     int narchive_chain;            /* archives being read, outermost first */
+    rib_object_def *defs;          /* ObjectBegin definitions, in order */
+    int ndefs;
 } rib_parser;
 
 /* Reports an error / warning naming the request: "Sphere: <message>". */
@@ -201,6 +222,26 @@ void rib_patch(rib_parser *p, const rib_request *req);
 
 /* rib_archive.c */
 void rib_read_archive(rib_parser *p, const rib_request *req);
+
+/* rib_instance.c */
+void rib_object_begin(rib_parser *p, const rib_request *req);
+void rib_object_end(rib_parser *p, const rib_request *req);
+void rib_object_instance(rib_parser *p, const rib_request *req);
+/* The definition being recorded (innermost ObjectBegin), or NULL. */
+rib_object_def *rib_defining(rib_parser *p);
+/* Records a prepared surface in the definition being recorded. */
+void rib_record_surface(rib_parser *p, const rib_request *req, const geom_surface *surf);
+void rib_object_defs_free(rib_parser *p);
+
+/* rib_geometry.c: adds an object for a prepared surface with the current
+ * attributes and the object-to-world transform ctm; pos is where the
+ * surface was written. */
+void rib_place_surface(rib_parser *p, const rib_request *req, const geom_surface *surf,
+                       mat4 ctm, sl_pos pos);
+
+/* rib_parser.c: blocks */
+void rib_push_block(rib_parser *p, rib_block_kind kind, sl_pos pos);
+void rib_close_block(rib_parser *p, const rib_request *req, rib_block_kind kind);
 
 /* Growing the scene's arrays (rib_parser.c). */
 scene_light *rib_add_light(rib_parser *p);
