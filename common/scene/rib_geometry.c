@@ -130,6 +130,14 @@ void rib_place_surface(rib_parser *p, const rib_request *req, const geom_surface
     object_lights(p, o);
 }
 
+void rib_add_surface(rib_parser *p, const rib_request *req, const geom_surface *surf)
+{
+    if (rib_defining(p))
+        rib_record_surface(p, req, surf);
+    else
+        rib_place_surface(p, req, surf, p->attr.ctm, req->pos);
+}
+
 /* Validates the surface and adds the object with the current attributes
  * (or records it in the object being defined, rib_instance.c). */
 static void add_object(rib_parser *p, const rib_request *req, geom_surface *surf)
@@ -139,10 +147,7 @@ static void add_object(rib_parser *p, const rib_request *req, geom_surface *surf
         rib_error(p, req, req->pos, "%s", why[0] ? why : "invalid parameters");
         return;
     }
-    if (rib_defining(p))
-        rib_record_surface(p, req, surf);
-    else
-        rib_place_surface(p, req, surf, p->attr.ctm, req->pos);
+    rib_add_surface(p, req, surf);
 }
 
 /* Reads the positional numbers, then the parameter list (typed, values

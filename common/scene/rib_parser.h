@@ -12,6 +12,7 @@
  *   rib_params.c       parameter lists: typing and reading values
  *   rib_archive.c      ReadArchive: archives found, loaded and read in place
  *   rib_instance.c     ObjectBegin/End, ObjectInstance: retained surfaces
+ *   rib_mesh.c         PointsPolygons, PointsGeneralPolygons, GeneralPolygon
  *
  * The graphics state follows RI Specification 3.2 §4: options are global
  * and frozen at WorldBegin; attributes (with the current transform) are
@@ -117,6 +118,7 @@ typedef struct rib_parser {
     int narchive_chain;            /* archives being read, outermost first */
     rib_object_def *defs;          /* ObjectBegin definitions, in order */
     int ndefs;
+    bool warned_mesh_vars;         /* primitive variables a mesh ignores */
 } rib_parser;
 
 /* Reports an error / warning naming the request: "Sphere: <message>". */
@@ -232,6 +234,15 @@ rib_object_def *rib_defining(rib_parser *p);
 /* Records a prepared surface in the definition being recorded. */
 void rib_record_surface(rib_parser *p, const rib_request *req, const geom_surface *surf);
 void rib_object_defs_free(rib_parser *p);
+
+/* rib_geometry.c: adds a prepared surface as an object with the current
+ * attributes and transform, or records it in the object being defined. */
+void rib_add_surface(rib_parser *p, const rib_request *req, const geom_surface *surf);
+
+/* rib_mesh.c */
+void rib_points_polygons(rib_parser *p, const rib_request *req);
+void rib_points_general_polygons(rib_parser *p, const rib_request *req);
+void rib_general_polygon(rib_parser *p, const rib_request *req);
 
 /* rib_geometry.c: adds an object for a prepared surface with the current
  * attributes and the object-to-world transform ctm; pos is where the
