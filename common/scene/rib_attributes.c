@@ -37,6 +37,8 @@ void rib_attributes_init(rib_attributes *a)
     a->orientation = SCENE_OUTSIDE;
     a->shading_rate = 1;
     a->bound_space = "object";
+    rib_basis_default(a->ubasis, &a->ustep);
+    rib_basis_default(a->vbasis, &a->vstep);
 }
 
 void rib_attributes_copy(rib_attributes *dst, const rib_attributes *src)

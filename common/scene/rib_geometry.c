@@ -298,16 +298,19 @@ void rib_patch(rib_parser *p, const rib_request *req)
     const char *type = rib_read_string(p, req, 0, "the patch type");
     if (!type)
         return;
-    if (strcmp(type, "bilinear") != 0) {
-        rib_error(p, req, req->args[0].pos, "only \"bilinear\" patches are supported, got "
-                  "\"%s\"", type);
+    bool cubic = strcmp(type, "bicubic") == 0;
+    if (!cubic && strcmp(type, "bilinear") != 0) {
+        rib_error(p, req, req->args[0].pos, "unknown patch type \"%s\" (expected \"bilinear\" "
+                  "or \"bicubic\")", type);
         return;
     }
     rib_params params;
     if (!rib_params_read(p, req, 1, RIB_PARAMS_VARYING, &params))
         return;
     const scene_param *P = find_P(p, req, &params);
-    if (P && P->count != 12)
+    if (P && cubic)
+        rib_patch_bicubic(p, req, P);
+    else if (P && P->count != 12)
         rib_error(p, req, P->pos, "a bilinear patch needs 4 points in \"P\" (12 numbers), "
                   "got %d numbers", P->count);
     else if (P) {

@@ -399,6 +399,8 @@ static const request_def requests[] = {
     { "PointsPolygons", rib_points_polygons, PRIMITIVE },
     { "PointsGeneralPolygons", rib_points_general_polygons, PRIMITIVE },
     { "GeneralPolygon", rib_general_polygon, PRIMITIVE },
+    { "PatchMesh", rib_patch_mesh, PRIMITIVE },
+    { "Basis", rib_basis, ANYWHERE },
     { "ReadArchive", rib_read_archive, ANYWHERE },
     { "ObjectBegin", rib_object_begin, BLOCK_WORLD },
     { "ObjectEnd", rib_object_end, BLOCK_WORLD },

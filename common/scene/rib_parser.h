@@ -13,6 +13,7 @@
  *   rib_archive.c      ReadArchive: archives found, loaded and read in place
  *   rib_instance.c     ObjectBegin/End, ObjectInstance: retained surfaces
  *   rib_mesh.c         PointsPolygons, PointsGeneralPolygons, GeneralPolygon
+ *   rib_patch.c        Basis, Patch "bicubic", PatchMesh
  *
  * The graphics state follows RI Specification 3.2 §4: options are global
  * and frozen at WorldBegin; attributes (with the current transform) are
@@ -46,6 +47,8 @@ typedef struct rib_attributes {
     bool shadows;                  /* Attribute "light" "shadows" */
     unsigned char *light_on;       /* per scene light: on for new objects */
     int nlight_on;
+    double ubasis[16], vbasis[16]; /* Basis (row-major, RIB order; bezier) */
+    int ustep, vstep;              /* Basis steps (3 3) */
 } rib_attributes;
 
 typedef enum rib_block_kind {
@@ -238,6 +241,12 @@ void rib_object_defs_free(rib_parser *p);
 /* rib_geometry.c: adds a prepared surface as an object with the current
  * attributes and transform, or records it in the object being defined. */
 void rib_add_surface(rib_parser *p, const rib_request *req, const geom_surface *surf);
+
+/* rib_patch.c */
+void rib_basis(rib_parser *p, const rib_request *req);
+void rib_patch_mesh(rib_parser *p, const rib_request *req);
+void rib_patch_bicubic(rib_parser *p, const rib_request *req, const scene_param *P);
+void rib_basis_default(double m[16], int *step);
 
 /* rib_mesh.c */
 void rib_points_polygons(rib_parser *p, const rib_request *req);

@@ -138,8 +138,12 @@ static const error_case cases[] = {
       "t.rib:4:13: Polygon: parameter \"P\" is a point and needs a multiple of 3 numbers, got 8" },
     { WORLD("Polygon \"N\" [0 0 1 0 0 1 0 0 1]\n"),
       "t.rib:4:1: Polygon: missing the vertices: add \"P\" [x y z x y z ...]" },
+    { WORLD("Patch \"biquadratic\" \"P\" [0 0 0 1 0 0 0 1 0 1 1 0]\n"),
+      "t.rib:4:7: Patch: unknown patch type \"biquadratic\" (expected \"bilinear\" or "
+      "\"bicubic\")" },
     { WORLD("Patch \"bicubic\" \"P\" [0 0 0 1 0 0 0 1 0 1 1 0]\n"),
-      "t.rib:4:7: Patch: only \"bilinear\" patches are supported, got \"bicubic\"" },
+      "t.rib:4:17: Patch: a bicubic patch needs 16 points in \"P\" (48 numbers), got 12 "
+      "numbers" },
     { WORLD("Patch \"bilinear\" \"P\" [0 0 0 1 0 0 0 1 0]\n"),
       "t.rib:4:18: Patch: a bilinear patch needs 4 points in \"P\" (12 numbers), got 9 numbers" },
     { WORLD("Attribute \"displacementbound\" \"sphere\" [-1]\n" SPHERE),
