@@ -498,7 +498,8 @@ static void dispatch(rib_parser *p, const rib_request *req)
         rib_no_more_args(p, req, 0);
     rib_object_def *defining = rib_defining(p);
     if (defining && !block && def->where != PRIMITIVE && def->fn != rib_read_archive &&
-        def->fn != rib_declare && !is_transform(def->fn) && !defining->warned) {
+        def->fn != rib_declare && def->fn != rib_basis && !is_transform(def->fn) &&
+        !defining->warned) {
         rib_warning(p, req, req->pos, "inside an object definition only surfaces and their "
                     "transforms are kept; instances take the attributes current at "
                     "ObjectInstance");
