@@ -45,7 +45,7 @@ static char *handle_of(rib_parser *p, const rib_request *req)
 static rib_object_def *find_def(rib_parser *p, const char *handle)
 {
     for (int i = p->ndefs - 1; i >= 0; i--)
-        if (strcmp(p->defs[i].handle, handle) == 0)
+        if (p->defs[i].handle && strcmp(p->defs[i].handle, handle) == 0)
             return &p->defs[i];
     return NULL;
 }
