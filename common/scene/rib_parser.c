@@ -401,6 +401,8 @@ static const request_def requests[] = {
     { "GeneralPolygon", rib_general_polygon, PRIMITIVE },
     { "PatchMesh", rib_patch_mesh, PRIMITIVE },
     { "Basis", rib_basis, ANYWHERE },
+    { "NuPatch", rib_nu_patch, PRIMITIVE },
+    { "TrimCurve", rib_trim_curve, ANYWHERE },
     { "ReadArchive", rib_read_archive, ANYWHERE },
     { "ObjectBegin", rib_object_begin, BLOCK_WORLD },
     { "ObjectEnd", rib_object_end, BLOCK_WORLD },

@@ -14,6 +14,7 @@
  *   rib_instance.c     ObjectBegin/End, ObjectInstance: retained surfaces
  *   rib_mesh.c         PointsPolygons, PointsGeneralPolygons, GeneralPolygon
  *   rib_patch.c        Basis, Patch "bicubic", PatchMesh
+ *   rib_nupatch.c      NuPatch (order <= 4, non-rational), TrimCurve (warned)
  *
  * The graphics state follows RI Specification 3.2 §4: options are global
  * and frozen at WorldBegin; attributes (with the current transform) are
@@ -122,6 +123,7 @@ typedef struct rib_parser {
     rib_object_def *defs;          /* ObjectBegin definitions, in order */
     int ndefs;
     bool warned_mesh_vars;         /* primitive variables a mesh ignores */
+    bool warned_trim;              /* TrimCurve */
 } rib_parser;
 
 /* Reports an error / warning naming the request: "Sphere: <message>". */
@@ -247,6 +249,10 @@ void rib_basis(rib_parser *p, const rib_request *req);
 void rib_patch_mesh(rib_parser *p, const rib_request *req);
 void rib_patch_bicubic(rib_parser *p, const rib_request *req, const scene_param *P);
 void rib_basis_default(double m[16], int *step);
+
+/* rib_nupatch.c */
+void rib_nu_patch(rib_parser *p, const rib_request *req);
+void rib_trim_curve(rib_parser *p, const rib_request *req);
 
 /* rib_mesh.c */
 void rib_points_polygons(rib_parser *p, const rib_request *req);
