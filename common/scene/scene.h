@@ -7,9 +7,12 @@
  * A scene is built from RenderMan Interface Bytestream text (a subset of
  * RI Specification 3.2, see docs/scenes.md for the table of requests):
  *
- *   scene_parse(file, text, len, diag)   from memory (a worker gets the
- *                                        scene text over the network)
- *   scene_load(path, diag)               from a file (the master, the CLI)
+ *   scene_parse(file, text, len, diag)   from memory (archives from disk)
+ *   scene_load(path, diag)               from a file (archives from disk)
+ *   scene_parse_archives(file, text, len, archives, diag)
+ *                                        archives from a source set: a
+ *                                        worker gets the scene text and
+ *                                        the archives over the network
  *
  * Both return NULL when there was any error; every error is in diag with
  * its file:line:col and names the RIB request. Warnings (unknown requests,
