@@ -14,7 +14,7 @@
  *                                        worker gets the scene text and
  *                                        the archives over the network
  *
- * Both return NULL when there was any error; every error is in diag with
+ * All return NULL when there was any error; every error is in diag with
  * its file:line:col and names the RIB request. Warnings (unknown requests,
  * ignored frames) may be reported on success.
  *
