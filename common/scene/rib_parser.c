@@ -376,7 +376,7 @@ static const request_def requests[] = {
     { "Transform", rib_transform, ANYWHERE },
     { "CoordinateSystem", rib_coordinate_system, WORLD },
     { "CoordSysTransform", rib_coord_sys_transform, WORLD },
-    { "LightSource", rib_light_source, WORLD },
+    { "LightSource", rib_light_source, ANYWHERE },   /* before WorldBegin: warned */
     { "Illuminate", rib_illuminate, WORLD },
     { "Surface", rib_surface, ANYWHERE },
     { "Displacement", rib_displacement, ANYWHERE },

@@ -124,6 +124,7 @@ typedef struct rib_parser {
     int ndefs;
     bool warned_mesh_vars;         /* primitive variables a mesh ignores */
     bool warned_trim;              /* TrimCurve */
+    bool warned_early_light;       /* a LightSource before WorldBegin */
 } rib_parser;
 
 /* Reports an error / warning naming the request: "Sphere: <message>". */

@@ -93,8 +93,8 @@ static const error_case cases[] = {
     { WORLD("Format 10 10 1\n" SPHERE),
       "t.rib:4:1: Format: must come before WorldBegin (options are fixed for the whole "
       "world)" },
-    { CAMERA "LightSource \"pointlight\" 1\nWorldBegin\n" SPHERE "WorldEnd\n",
-      "t.rib:3:1: LightSource: must come between WorldBegin and WorldEnd" },
+    { CAMERA "WorldBegin\n" SPHERE "WorldEnd\nLightSource \"pointlight\" 1\n",
+      "t.rib:6:1: LightSource: must come between WorldBegin and WorldEnd" },
     /* the scene as a whole */
     { "Format 64 32 1\nWorldBegin\n" SPHERE "WorldEnd\n",
       "t.rib:2:1: WorldBegin: the scene has no camera: add Projection \"perspective\" "
