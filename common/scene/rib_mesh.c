@@ -25,6 +25,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+enum { RIB_MAX_FACE_POINTS = 10000 };
+
 /* The integers of a numeric argument (an array of whole numbers >= min);
  * NULL with an error naming `what`. The caller frees. */
 static int *read_ints(rib_parser *p, const rib_request *req, int i, int min, int *count,
@@ -137,6 +139,11 @@ static bool add_face(rib_parser *p, mesh *m, int face, const int *loop_sizes, in
 #endif
     }
 #ifdef SCENE_HAVE_GEOM
+    if (total > RIB_MAX_FACE_POINTS) {      /* cutting is quadratic in them */
+        rib_error(p, m->req, m->vertices_pos, "face %d has %d points; faces to be cut into "
+                  "triangles may have at most %d", face, total, RIB_MAX_FACE_POINTS);
+        return false;
+    }
     vec3 *pts = sl_xrealloc(NULL, (size_t)total * sizeof *pts);
     for (int i = 0; i < total; i++)
         pts[i] = point(m, idx[i]);

@@ -152,6 +152,11 @@ void rib_nu_patch(rib_parser *p, const rib_request *req)
     rib_params params = { 0 };
     if (!read_dir(p, req, &i, "u", &du) || !read_dir(p, req, &i, "v", &dv))
         goto out;
+    if ((double)du.n * dv.n > 1e7) {
+        rib_error(p, req, req->pos, "at most 10000000 control points are supported, got "
+                  "%d x %d", du.n, dv.n);
+        goto out;
+    }
     if (!rib_params_read(p, req, i, RIB_PARAMS_VARYING, &params))
         goto out;
     const scene_param *P = rib_params_find(&params, "P");

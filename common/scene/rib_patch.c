@@ -231,9 +231,9 @@ void rib_patch_mesh(rib_parser *p, const rib_request *req)
         rib_read_numbers(p, req, 3, 1, &nv, "the number of points in v") < 0 ||
         !read_wrap(p, req, 4, "vwrap", &vper))
         return;
-    if (!(nu == floor(nu) && nu >= 1 && nu <= 1e6 && nv == floor(nv) && nv >= 1 && nv <= 1e6)) {
-        rib_error(p, req, req->args[1].pos, "the point counts must be whole numbers, got "
-                  "%g x %g", nu, nv);
+    if (!(nu == floor(nu) && nu >= 1 && nv == floor(nv) && nv >= 1 && nu * nv <= 1e7)) {
+        rib_error(p, req, req->args[1].pos, "the point counts must be whole numbers with at "
+                  "most 10000000 points in all, got %g x %g", nu, nv);
         return;
     }
     int nupatch = count_patches(p, req, req->args[1].pos, "u", (int)nu, uper, cubic,
