@@ -13,6 +13,7 @@ PACKAGES=(
   libzmq3-dev       # transport between master and workers
   libopenexr-dev    # OpenEXR 3 C API (OpenEXRCore) for tiles and images
   libpng-dev        # PNG previews
+  zlib1g-dev        # gzip-compressed RIB archives (ReadArchive)
   libcmocka-dev     # unit and property tests
   protobuf-c-compiler libprotobuf-c-dev  # wire protocol schema
   libsodium-dev     # CurveZMQ: Debian's libzmq5 has CURVE through libsodium

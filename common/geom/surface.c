@@ -21,7 +21,7 @@
 
 static const char *const kind_names[GEOM__COUNT] = {
     "sphere", "disk", "cylinder", "cone", "paraboloid",
-    "hyperboloid", "torus", "polygon", "patch",
+    "hyperboloid", "torus", "polygon", "patch", "bicubic patch",
 };
 
 const char *geom_kind_name(geom_kind kind)
@@ -269,6 +269,7 @@ bool geom_surface_prepare(geom_surface *s, char *why, int why_size)
     case GEOM_TORUS:       return prepare_torus(s, why, why_size);
     case GEOM_POLYGON:     return geom_polygon_prepare(s, why, why_size);
     case GEOM_PATCH:       return prepare_patch(s, why, why_size);
+    case GEOM_BICUBIC:     return geom_bicubic_prepare(s, why, why_size);
     default:
         return geom_fail(why, why_size, "unknown surface kind %d", (int)s->kind);
     }
@@ -308,6 +309,10 @@ void geom_bounds(const geom_surface *s, vec3 *lo, vec3 *hi)
     *hi = v3(-INFINITY, -INFINITY, -INFINITY);
     if (s->kind == GEOM_POLYGON) {
         polygon_bounds(s, lo, hi);
+        return;
+    }
+    if (s->kind == GEOM_BICUBIC) {      /* the control points' convex hull */
+        geom_bicubic_bounds(s, lo, hi);
         return;
     }
     enum { N = 8 };

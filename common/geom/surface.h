@@ -43,6 +43,7 @@ typedef enum geom_kind {
     GEOM_TORUS,         /* majorradius minorradius phimin phimax thetamax */
     GEOM_POLYGON,       /* convex planar polygon, nverts >= 3 */
     GEOM_PATCH,         /* bilinear patch, 4 corners in RIB order */
+    GEOM_BICUBIC,       /* bicubic Bezier patch, 16 control points, u fastest */
     GEOM__COUNT
 } geom_kind;
 
@@ -56,7 +57,8 @@ typedef struct geom_surface {
     double rmax;                           /* paraboloid */
     double majorrad, minorrad, phimin, phimax;   /* torus (radians) */
     vec3 point1, point2;                   /* hyperboloid */
-    /* polygon: vertices; patch: corners P00 P10 P01 P11 (RIB order) */
+    /* polygon: vertices; patch: corners P00 P10 P01 P11 (RIB order);
+     * bicubic: Bezier control points P_ij at verts[4 j + i] */
     int nverts;
     vec3 verts[GEOM_MAX_POLY_VERTS];
     /* derived by geom_surface_prepare (do not set by hand) */

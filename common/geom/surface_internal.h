@@ -57,6 +57,16 @@ bool geom_sweep_param(double angle, double sweep, double tol, double *t);
 /* The polygon part of geom_surface_prepare (surface_polygon.c). */
 bool geom_polygon_prepare(geom_surface *s, char *why, int why_size);
 
+/* The bicubic Bezier patch (surface_bicubic.c). */
+bool geom_bicubic_prepare(geom_surface *s, char *why, int why_size);
+void geom_bicubic_eval_dual(const geom_surface *s, double u, double v, geom_sample *out);
+void geom_bicubic_eval_ia(const geom_surface *s, ia_interval u, ia_interval v, geom_ia *out);
+void geom_bicubic_eval_aa(aa_context *ctx, const geom_surface *s, const aa_form *u,
+                          const aa_form *v, geom_aa *out);
+void geom_bicubic_bounds(const geom_surface *s, vec3 *lo, vec3 *hi);
+bool geom_bicubic_intersect(const geom_surface *s, vec3 o, vec3 d, double tmin, double tmax,
+                            geom_hit *hit);
+
 /* Formats a one-line reason into why (may be NULL) and returns false. */
 bool geom_fail(char *why, int why_size, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));

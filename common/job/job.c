@@ -196,13 +196,17 @@ job *job_load(const char *rib_path, const job_options *options, sl_diag *diag)
     size_t len = 0;
     char *text = read_file(rib_path, &len, diag);
     if (!text) return NULL;
-    scene *sc = scene_parse(rib_path, text, len, diag);
-    if (!sc) {
-        free(text);
-        return NULL;
-    }
+    /* the archives the scene reads land in the job's sources, from disk */
     job *self = job_new(rib_path, text, len, options);
     free(text);
+    sl_source_set_set_loader(self->sources, scene_archive_load_from_disk, NULL);
+    scene *sc = scene_parse_archives(rib_path, self->scene_text, self->scene_len,
+                                     self->sources, diag);
+    sl_source_set_set_loader(self->sources, NULL, NULL);
+    if (!sc) {
+        job_destroy(&self);
+        return NULL;
+    }
     char why[512];
     bool ok = true;
     for (int i = 0; i < sc->nshader_names; i++) {

@@ -172,7 +172,9 @@ job_scene *job_scene_new(const job *jb, size_t cache_bytes, bool render, sl_diag
     job_scene *self = calloc(1, sizeof *self);
     if (!self) abort();
     self->job = jb;
-    self->scene = scene_parse(jb->scene_file, jb->scene_text, jb->scene_len, diag);
+    /* archives come from the job, never from this machine's disk */
+    self->scene = scene_parse_archives(jb->scene_file, jb->scene_text, jb->scene_len,
+                                       jb->sources, diag);
     bool ok = self->scene != NULL;
     if (ok) ok = compile_programs(self, diag);
     if (ok) ok = build_objects(self, diag);

@@ -37,6 +37,8 @@ void rib_attributes_init(rib_attributes *a)
     a->orientation = SCENE_OUTSIDE;
     a->shading_rate = 1;
     a->bound_space = "object";
+    rib_basis_default(a->ubasis, &a->ustep);
+    rib_basis_default(a->vbasis, &a->vstep);
 }
 
 void rib_attributes_copy(rib_attributes *dst, const rib_attributes *src)
@@ -390,6 +392,14 @@ void rib_shaders_finish(rib_parser *p)
         scene_shader *sh = &p->scene->shaders[i];
         sh->shader_to_world = mat4_mul(*w, sh->shader_to_camera);
     }
+    /* lights declared before WorldBegin: their world placement is known
+     * now (every light that exists at WorldBegin is one) */
+    for (int i = 0; i < p->scene->nlights; i++) {
+        scene_light *l = &p->scene->lights[i];
+        l->light_to_world = mat4_mul(*w, l->light_to_camera);
+        l->from_world = mat4_xform_point(&l->light_to_world, l->from);
+        l->to_world = mat4_xform_point(&l->light_to_world, l->to);
+    }
 }
 
 /* ---------------------------------------------------------------------- */
@@ -506,9 +516,22 @@ static bool valid_handle(rib_parser *p, const rib_request *req, const rib_arg *a
 
 void rib_light_source(rib_parser *p, const rib_request *req)
 {
+    if (!p->in_world && p->world_done) {
+        rib_error(p, req, req->pos, "must come between WorldBegin and WorldEnd");
+        return;
+    }
     const char *name = rib_read_string(p, req, 0, "the light shader name");
     if (!name)
         return;
+    /* Other renderers accept lights before WorldBegin: the light is then
+     * in the space current there (the camera's, as built so far), and
+     * rib_shaders_finish places it in the world at WorldBegin. */
+    if (!p->in_world && !p->warned_early_light) {
+        rib_warning(p, req, req->pos, "a light before WorldBegin is placed where the camera "
+                    "transform built so far puts it (move it after WorldBegin to place it in "
+                    "world space)");
+        p->warned_early_light = true;
+    }
     int k = -1;
     for (int i = 0; i < 4; i++)
         if (strcmp(name, light_kinds[i].name) == 0)

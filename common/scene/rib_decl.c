@@ -198,6 +198,7 @@ bool rib_decl_is_inline(const char *text)
 static const struct { const char *name; sl_type type; int arraylen; } standard[] = {
     /* geometric primitive variables (Table 5.1) */
     { "P", SL_TYPE_POINT, 1 },      { "Pz", SL_TYPE_FLOAT, 1 },
+    { "Pw", SL_TYPE_FLOAT, 4 },     /* an hpoint, read as 4 floats (NuPatch) */
     { "N", SL_TYPE_NORMAL, 1 },     { "Np", SL_TYPE_NORMAL, 1 },
     { "Cs", SL_TYPE_COLOR, 1 },     { "Os", SL_TYPE_COLOR, 1 },
     { "s", SL_TYPE_FLOAT, 1 },      { "t", SL_TYPE_FLOAT, 1 },

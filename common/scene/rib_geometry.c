@@ -101,23 +101,18 @@ static void object_lights(const rib_parser *p, scene_object *o)
             o->lights[o->nlights++] = i;
 }
 
-/* Validates the surface and adds the object with the current attributes. */
-static void add_object(rib_parser *p, const rib_request *req, geom_surface *surf)
+void rib_place_surface(rib_parser *p, const rib_request *req, const geom_surface *surf,
+                       mat4 ctm, sl_pos pos)
 {
-    char why[256] = "";
-    if (!prepare_surface(surf, why, sizeof why)) {
-        rib_error(p, req, req->pos, "%s", why[0] ? why : "invalid parameters");
-        return;
-    }
     const rib_attributes *a = &p->attr;
-    mat4 to_camera = mat4_mul(p->scene->camera.camera_from_world, a->ctm), inv;
+    mat4 to_camera = mat4_mul(p->scene->camera.camera_from_world, ctm), inv;
     if (!mat4_invert(&to_camera, &inv)) {
         rib_error(p, req, req->pos, "the current transform is singular (a Scale by 0?)");
         return;
     }
     scene_object *o = rib_add_object(p);
     o->surface = *surf;
-    o->object_to_world = a->ctm;
+    o->object_to_world = ctm;
     o->object_to_camera = to_camera;
     o->camera_to_object = inv;
     o->surface_shader = a->surface;
@@ -131,8 +126,28 @@ static void add_object(rib_parser *p, const rib_request *req, geom_surface *surf
     o->displacement_bound = a->displacement_bound;
     o->displacement_bound_space = sl_xstrndup(a->bound_space, strlen(a->bound_space));
     o->name = a->name ? sl_xstrndup(a->name, strlen(a->name)) : NULL;
-    o->pos = req->pos;
+    o->pos = pos;
     object_lights(p, o);
+}
+
+void rib_add_surface(rib_parser *p, const rib_request *req, const geom_surface *surf)
+{
+    if (rib_defining(p))
+        rib_record_surface(p, req, surf);
+    else
+        rib_place_surface(p, req, surf, p->attr.ctm, req->pos);
+}
+
+/* Validates the surface and adds the object with the current attributes
+ * (or records it in the object being defined, rib_instance.c). */
+static void add_object(rib_parser *p, const rib_request *req, geom_surface *surf)
+{
+    char why[256] = "";
+    if (!prepare_surface(surf, why, sizeof why)) {
+        rib_error(p, req, req->pos, "%s", why[0] ? why : "invalid parameters");
+        return;
+    }
+    rib_add_surface(p, req, surf);
 }
 
 /* Reads the positional numbers, then the parameter list (typed, values
@@ -283,16 +298,19 @@ void rib_patch(rib_parser *p, const rib_request *req)
     const char *type = rib_read_string(p, req, 0, "the patch type");
     if (!type)
         return;
-    if (strcmp(type, "bilinear") != 0) {
-        rib_error(p, req, req->args[0].pos, "only \"bilinear\" patches are supported, got "
-                  "\"%s\"", type);
+    bool cubic = strcmp(type, "bicubic") == 0;
+    if (!cubic && strcmp(type, "bilinear") != 0) {
+        rib_error(p, req, req->args[0].pos, "unknown patch type \"%s\" (expected \"bilinear\" "
+                  "or \"bicubic\")", type);
         return;
     }
     rib_params params;
     if (!rib_params_read(p, req, 1, RIB_PARAMS_VARYING, &params))
         return;
     const scene_param *P = find_P(p, req, &params);
-    if (P && P->count != 12)
+    if (P && cubic)
+        rib_patch_bicubic(p, req, P);
+    else if (P && P->count != 12)
         rib_error(p, req, P->pos, "a bilinear patch needs 4 points in \"P\" (12 numbers), "
                   "got %d numbers", P->count);
     else if (P) {

@@ -206,7 +206,7 @@ void rib_exposure(rib_parser *p, const rib_request *req)
 }
 
 /* ---------------------------------------------------------------------- */
-/* Option "searchpath" "shader" ["dir:dir:&"]                              */
+/* Option "searchpath" "shader" / "archive" ["dir:dir:&"]                  */
 /* ---------------------------------------------------------------------- */
 
 static void path_push(char ***list, int *n, const char *s, size_t len)
@@ -216,7 +216,7 @@ static void path_push(char ***list, int *n, const char *s, size_t len)
 }
 
 /* Splits at ':'; "&" is the previous path, "@" the standard one (empty). */
-static void set_shader_path(rib_parser *p, const char *value)
+static void set_path(char ***path, int *npath, const char *value)
 {
     char **list = NULL;
     int n = 0;
@@ -225,8 +225,8 @@ static void set_shader_path(rib_parser *p, const char *value)
         const char *colon = strchr(s, ':');
         size_t len = colon ? (size_t)(colon - s) : strlen(s);
         if (len == 1 && s[0] == '&') {
-            for (int i = 0; i < p->nshader_path; i++)
-                path_push(&list, &n, p->shader_path[i], strlen(p->shader_path[i]));
+            for (int i = 0; i < *npath; i++)
+                path_push(&list, &n, (*path)[i], strlen((*path)[i]));
         } else if (len > 0 && !(len == 1 && s[0] == '@')) {
             path_push(&list, &n, s, len);
         }
@@ -234,11 +234,11 @@ static void set_shader_path(rib_parser *p, const char *value)
             break;
         s = colon + 1;
     }
-    for (int i = 0; i < p->nshader_path; i++)
-        free(p->shader_path[i]);
-    free(p->shader_path);
-    p->shader_path = list;
-    p->nshader_path = n;
+    for (int i = 0; i < *npath; i++)
+        free((*path)[i]);
+    free(*path);
+    *path = list;
+    *npath = n;
 }
 
 void rib_option(rib_parser *p, const rib_request *req)
@@ -250,8 +250,11 @@ void rib_option(rib_parser *p, const rib_request *req)
     if (!rib_params_read(p, req, 1, RIB_PARAMS_LOOSE, &params))
         return;
     const scene_param *shader = rib_params_find(&params, "shader");
-    if (shader)
-        set_shader_path(p, shader->string);
+    if (shader && shader->string)
+        set_path(&p->shader_path, &p->nshader_path, shader->string);
+    const scene_param *archive = rib_params_find(&params, "archive");
+    if (archive && archive->string)
+        set_path(&p->archive_path, &p->narchive_path, archive->string);
     rib_params_free(&params);
 }
 

@@ -29,8 +29,16 @@
 static void vreport(rib_parser *p, sl_diag_level level, const rib_request *req,
                     sl_pos pos, const char *fmt, va_list ap)
 {
-    char msg[1024];
+    char msg[2048];
     vsnprintf(msg, sizeof msg, fmt, ap);
+    /* inside an archive: name the chain, innermost first */
+    for (int i = p->narchive_chain - 1; i >= 0; i--) {
+        const rib_archive_link *l = &p->archive_chain[i];
+        size_t used = strlen(msg);
+        snprintf(msg + used, sizeof msg - used, "%s archive %s read at %s:%d:%d%s",
+                 i == p->narchive_chain - 1 ? " (in" : ",", l->file, l->read_at.file,
+                 l->read_at.line, l->read_at.col, i == 0 ? ")" : "");
+    }
     if (req)
         sl_diag_report(p->diag, level, pos, "%s: %s", req->name, msg);
     else
@@ -156,23 +164,24 @@ scene_space *rib_add_space(rib_parser *p)
 static const char *begin_name(rib_block_kind kind)
 {
     static const char *const names[] = { "FrameBegin", "WorldBegin", "AttributeBegin",
-                                         "TransformBegin" };
+                                         "TransformBegin", "ObjectBegin" };
     return names[kind];
 }
 
 static const char *end_name(rib_block_kind kind)
 {
     static const char *const names[] = { "FrameEnd", "WorldEnd", "AttributeEnd",
-                                         "TransformEnd" };
+                                         "TransformEnd", "ObjectEnd" };
     return names[kind];
 }
 
-static void push_block(rib_parser *p, rib_block_kind kind, sl_pos pos)
+void rib_push_block(rib_parser *p, rib_block_kind kind, sl_pos pos)
 {
     p->blocks = grow(p->blocks, p->nblocks, &p->blocks_cap, sizeof *p->blocks);
     rib_block *b = &p->blocks[p->nblocks++];
     b->kind = kind;
     b->pos = pos;
+    b->object_def = -1;
     rib_attributes_copy(&b->saved, &p->attr);
 }
 
@@ -208,15 +217,15 @@ static void pop_block(rib_parser *p, const char *who, sl_pos pos)
 static bool is_boundary(rib_block_kind kind, rib_block_kind inner)
 {
     if (kind == RIB_BLOCK_ATTRIBUTE || kind == RIB_BLOCK_TRANSFORM)
-        return inner == RIB_BLOCK_WORLD || inner == RIB_BLOCK_FRAME;
-    if (kind == RIB_BLOCK_WORLD)
-        return inner == RIB_BLOCK_FRAME;
+        return inner == RIB_BLOCK_WORLD || inner == RIB_BLOCK_FRAME || inner == RIB_BLOCK_OBJECT;
+    if (kind == RIB_BLOCK_WORLD || kind == RIB_BLOCK_OBJECT)
+        return inner == RIB_BLOCK_FRAME || (kind == RIB_BLOCK_OBJECT && inner == RIB_BLOCK_WORLD);
     return false;
 }
 
 /* An ...End request: closes the innermost open block of `kind`, with an
  * error for each block left open inside it. */
-static void close_block(rib_parser *p, const rib_request *req, rib_block_kind kind)
+void rib_close_block(rib_parser *p, const rib_request *req, rib_block_kind kind)
 {
     int i = p->nblocks - 1;
     while (i >= 0 && p->blocks[i].kind != kind && !is_boundary(kind, p->blocks[i].kind))
@@ -259,12 +268,12 @@ static void frame_begin(rib_parser *p, const rib_request *req)
                       begin_name(b->kind), b->pos.file, b->pos.line, b->pos.col);
             return;
         }
-    push_block(p, RIB_BLOCK_FRAME, req->pos);
+    rib_push_block(p, RIB_BLOCK_FRAME, req->pos);
 }
 
 static void frame_end(rib_parser *p, const rib_request *req)
 {
-    close_block(p, req, RIB_BLOCK_FRAME);
+    rib_close_block(p, req, RIB_BLOCK_FRAME);
     p->frame_done = true;
 }
 
@@ -289,7 +298,7 @@ static void world_begin(rib_parser *p, const rib_request *req)
                   "Transform and ConcatTransform requests before WorldBegin)");
     p->scene->shading_rate = p->attr.shading_rate;
     rib_shaders_finish(p);
-    push_block(p, RIB_BLOCK_WORLD, req->pos);
+    rib_push_block(p, RIB_BLOCK_WORLD, req->pos);
     p->attr.ctm = mat4_identity();
     p->in_world = p->world_seen = true;
     p->world_pos = req->pos;
@@ -297,27 +306,27 @@ static void world_begin(rib_parser *p, const rib_request *req)
 
 static void world_end(rib_parser *p, const rib_request *req)
 {
-    close_block(p, req, RIB_BLOCK_WORLD);
+    rib_close_block(p, req, RIB_BLOCK_WORLD);
 }
 
 static void attribute_begin(rib_parser *p, const rib_request *req)
 {
-    push_block(p, RIB_BLOCK_ATTRIBUTE, req->pos);
+    rib_push_block(p, RIB_BLOCK_ATTRIBUTE, req->pos);
 }
 
 static void attribute_end(rib_parser *p, const rib_request *req)
 {
-    close_block(p, req, RIB_BLOCK_ATTRIBUTE);
+    rib_close_block(p, req, RIB_BLOCK_ATTRIBUTE);
 }
 
 static void transform_begin(rib_parser *p, const rib_request *req)
 {
-    push_block(p, RIB_BLOCK_TRANSFORM, req->pos);
+    rib_push_block(p, RIB_BLOCK_TRANSFORM, req->pos);
 }
 
 static void transform_end(rib_parser *p, const rib_request *req)
 {
-    close_block(p, req, RIB_BLOCK_TRANSFORM);
+    rib_close_block(p, req, RIB_BLOCK_TRANSFORM);
 }
 
 /* ---------------------------------------------------------------------- */
@@ -330,6 +339,7 @@ typedef enum where {
     WORLD,          /* between WorldBegin and WorldEnd */
     PRIMITIVE,      /* a base surface: in the world */
     BLOCK,          /* block structure: run even when malformed */
+    BLOCK_WORLD,    /* block structure inside the world (ObjectBegin/End) */
 } where;
 
 typedef struct request_def {
@@ -366,7 +376,7 @@ static const request_def requests[] = {
     { "Transform", rib_transform, ANYWHERE },
     { "CoordinateSystem", rib_coordinate_system, WORLD },
     { "CoordSysTransform", rib_coord_sys_transform, WORLD },
-    { "LightSource", rib_light_source, WORLD },
+    { "LightSource", rib_light_source, ANYWHERE },   /* before WorldBegin: warned */
     { "Illuminate", rib_illuminate, WORLD },
     { "Surface", rib_surface, ANYWHERE },
     { "Displacement", rib_displacement, ANYWHERE },
@@ -386,6 +396,17 @@ static const request_def requests[] = {
     { "Paraboloid", rib_paraboloid, PRIMITIVE },
     { "Polygon", rib_polygon, PRIMITIVE },
     { "Patch", rib_patch, PRIMITIVE },
+    { "PointsPolygons", rib_points_polygons, PRIMITIVE },
+    { "PointsGeneralPolygons", rib_points_general_polygons, PRIMITIVE },
+    { "GeneralPolygon", rib_general_polygon, PRIMITIVE },
+    { "PatchMesh", rib_patch_mesh, PRIMITIVE },
+    { "Basis", rib_basis, ANYWHERE },
+    { "NuPatch", rib_nu_patch, PRIMITIVE },
+    { "TrimCurve", rib_trim_curve, ANYWHERE },
+    { "ReadArchive", rib_read_archive, ANYWHERE },
+    { "ObjectBegin", rib_object_begin, BLOCK_WORLD },
+    { "ObjectEnd", rib_object_end, BLOCK_WORLD },
+    { "ObjectInstance", rib_object_instance, WORLD },
 };
 
 enum { NREQUESTS = sizeof requests / sizeof requests[0] };
@@ -433,11 +454,18 @@ static bool allowed_here(rib_parser *p, const rib_request *req, where w)
                   "whole world)");
         return false;
     }
-    if ((w == WORLD || w == PRIMITIVE) && !p->in_world) {
+    if ((w == WORLD || w == PRIMITIVE || w == BLOCK_WORLD) && !p->in_world) {
         rib_error(p, req, req->pos, "must come between WorldBegin and WorldEnd");
         return false;
     }
     return true;
+}
+
+/* The requests that change only the current transform. */
+static bool is_transform(rib_request_fn fn)
+{
+    return fn == rib_identity || fn == rib_translate || fn == rib_rotate || fn == rib_scale ||
+           fn == rib_concat_transform || fn == rib_transform;
 }
 
 /* While skipping a later frame, only the frame nesting matters. */
@@ -462,12 +490,23 @@ static void dispatch(rib_parser *p, const rib_request *req)
     }
     if (def->where == PRIMITIVE && p->in_world)
         p->primitives_tried = true;
-    if (req->broken && def->where != BLOCK)
+    bool block = def->where == BLOCK || def->where == BLOCK_WORLD;
+    if (req->broken && !block)
         return;
     if (!allowed_here(p, req, def->where))
         return;
-    if (def->where == BLOCK && strcmp(req->name, "FrameBegin") != 0 && !req->broken)
+    if (block && strcmp(req->name, "FrameBegin") != 0 && strcmp(req->name, "ObjectBegin") != 0
+        && !req->broken)
         rib_no_more_args(p, req, 0);
+    rib_object_def *defining = rib_defining(p);
+    if (defining && !block && def->where != PRIMITIVE && def->fn != rib_read_archive &&
+        def->fn != rib_declare && def->fn != rib_basis && !is_transform(def->fn) &&
+        !defining->warned) {
+        rib_warning(p, req, req->pos, "inside an object definition only surfaces and their "
+                    "transforms are kept; instances take the attributes current at "
+                    "ObjectInstance");
+        defining->warned = true;
+    }
     def->fn(p, req);
 }
 
@@ -610,20 +649,39 @@ static void parser_free(rib_parser *p)
     for (int i = 0; i < p->nshader_path; i++)
         free(p->shader_path[i]);
     free(p->shader_path);
+    for (int i = 0; i < p->narchive_path; i++)
+        free(p->archive_path[i]);
+    free(p->archive_path);
+    rib_object_defs_free(p);
     rib_decls_destroy(&p->decls);
     rib_reader_destroy(&p->reader);
 }
 
-static void parse_all(rib_parser *p)
+void rib_parser_run(rib_parser *p)
 {
     rib_request *req;
     while (!sl_diag_full(p->diag) && (req = rib_reader_next(p->reader)))
         dispatch(p, req);
+}
+
+static void parse_all(rib_parser *p)
+{
+    rib_parser_run(p);
     if (!sl_diag_full(p->diag))
         finish(p);
 }
 
 scene *scene_parse(const char *file, const char *text, size_t len, sl_diag *diag)
+{
+    sl_source_set *archives = sl_source_set_new();
+    sl_source_set_set_loader(archives, scene_archive_load_from_disk, NULL);
+    scene *s = scene_parse_archives(file, text, len, archives, diag);
+    sl_source_set_destroy(&archives);
+    return s;
+}
+
+scene *scene_parse_archives(const char *file, const char *text, size_t len,
+                            sl_source_set *archives, sl_diag *diag)
 {
     if (!file || !*file)
         file = "<scene>";
@@ -639,6 +697,8 @@ scene *scene_parse(const char *file, const char *text, size_t len, sl_diag *diag
     rib_parser p;
     memset(&p, 0, sizeof p);
     p.diag = diag;
+    p.archives = archives;
+    p.diag_sources = set;
     p.scene = scene_new(file);
     p.file = p.scene->file;
     p.decls = rib_decls_new();

@@ -10,6 +10,11 @@
  *   rib_attributes.c   attributes, transforms, shaders, lights, Declare
  *   rib_geometry.c     the base surfaces (Sphere ... Polygon, Patch)
  *   rib_params.c       parameter lists: typing and reading values
+ *   rib_archive.c      ReadArchive: archives found, loaded and read in place
+ *   rib_instance.c     ObjectBegin/End, ObjectInstance: retained surfaces
+ *   rib_mesh.c         PointsPolygons, PointsGeneralPolygons, GeneralPolygon
+ *   rib_patch.c        Basis, Patch "bicubic", PatchMesh
+ *   rib_nupatch.c      NuPatch (order <= 4, non-rational), TrimCurve (warned)
  *
  * The graphics state follows RI Specification 3.2 §4: options are global
  * and frozen at WorldBegin; attributes (with the current transform) are
@@ -27,6 +32,7 @@
 #include "scene/rib_reader.h"
 #include "scene/scene.h"
 #include "sl/diag.h"
+#include "sl/source.h"
 
 /* The attributes of RI Spec §4.2 that aafarm records. */
 typedef struct rib_attributes {
@@ -42,6 +48,8 @@ typedef struct rib_attributes {
     bool shadows;                  /* Attribute "light" "shadows" */
     unsigned char *light_on;       /* per scene light: on for new objects */
     int nlight_on;
+    double ubasis[16], vbasis[16]; /* Basis (row-major, RIB order; bezier) */
+    int ustep, vstep;              /* Basis steps (3 3) */
 } rib_attributes;
 
 typedef enum rib_block_kind {
@@ -49,13 +57,38 @@ typedef enum rib_block_kind {
     RIB_BLOCK_WORLD,
     RIB_BLOCK_ATTRIBUTE,
     RIB_BLOCK_TRANSFORM,
+    RIB_BLOCK_OBJECT,              /* ObjectBegin: defs[object_def] */
 } rib_block_kind;
 
 typedef struct rib_block {
     rib_block_kind kind;
     sl_pos pos;                    /* where it opened */
     rib_attributes saved;          /* restored when it closes */
+    int object_def;                /* RIB_BLOCK_OBJECT: index into defs */
 } rib_block;
+
+/* A surface of an object definition, with the transform current inside
+ * the definition (relative to its ObjectBegin). */
+typedef struct rib_object_part {
+    geom_surface surface;          /* prepared */
+    mat4 ctm;
+    sl_pos pos;
+} rib_object_part;
+
+typedef struct rib_object_def {
+    char *handle;                  /* NULL: a malformed ObjectBegin */
+    sl_pos pos;
+    rib_object_part *parts;
+    int nparts;
+    bool warned;                   /* about attributes inside it */
+} rib_object_def;
+
+/* One archive being read: its (normalized) name and the ReadArchive that
+ * reads it. */
+typedef struct rib_archive_link {
+    const char *file;              /* interned */
+    sl_pos read_at;
+} rib_archive_link;
 
 typedef struct rib_parser {
     sl_diag *diag;
@@ -81,6 +114,17 @@ typedef struct rib_parser {
     int skip_depth;                /* FrameBegin nesting while skipping */
     char **shader_path;            /* Option "searchpath" "shader" dirs */
     int nshader_path;
+    char **archive_path;           /* Option "searchpath" "archive" dirs */
+    int narchive_path;
+    sl_source_set *archives;       /* where archive texts come from */
+    sl_source_set *diag_sources;   /* diag's set: archives added for carets */
+    rib_archive_link archive_chain[SCENE_ARCHIVE_MAX_DEPTH];
+    int narchive_chain;            /* archives being read, outermost first */
+    rib_object_def *defs;          /* ObjectBegin definitions, in order */
+    int ndefs;
+    bool warned_mesh_vars;         /* primitive variables a mesh ignores */
+    bool warned_trim;              /* TrimCurve */
+    bool warned_early_light;       /* a LightSource before WorldBegin */
 } rib_parser;
 
 /* Reports an error / warning naming the request: "Sphere: <message>". */
@@ -105,6 +149,10 @@ const char *rib_read_string(rib_parser *p, const rib_request *req, int i, const 
 
 /* Fails (with an error) when arguments are left after index `i`. */
 bool rib_no_more_args(rib_parser *p, const rib_request *req, int i);
+
+/* Dispatches the requests of p->reader until its end (or the
+ * diagnostics' cap). */
+void rib_parser_run(rib_parser *p);
 
 /* ---- parameter lists (rib_params.c) ------------------------------------- */
 
@@ -179,6 +227,48 @@ void rib_hyperboloid(rib_parser *p, const rib_request *req);
 void rib_paraboloid(rib_parser *p, const rib_request *req);
 void rib_polygon(rib_parser *p, const rib_request *req);
 void rib_patch(rib_parser *p, const rib_request *req);
+
+/* rib_archive.c */
+void rib_read_archive(rib_parser *p, const rib_request *req);
+
+/* rib_instance.c */
+void rib_object_begin(rib_parser *p, const rib_request *req);
+void rib_object_end(rib_parser *p, const rib_request *req);
+void rib_object_instance(rib_parser *p, const rib_request *req);
+/* The definition being recorded (innermost ObjectBegin), or NULL. */
+rib_object_def *rib_defining(rib_parser *p);
+/* Records a prepared surface in the definition being recorded. */
+void rib_record_surface(rib_parser *p, const rib_request *req, const geom_surface *surf);
+void rib_object_defs_free(rib_parser *p);
+
+/* rib_geometry.c: adds a prepared surface as an object with the current
+ * attributes and transform, or records it in the object being defined. */
+void rib_add_surface(rib_parser *p, const rib_request *req, const geom_surface *surf);
+
+/* rib_patch.c */
+void rib_basis(rib_parser *p, const rib_request *req);
+void rib_patch_mesh(rib_parser *p, const rib_request *req);
+void rib_patch_bicubic(rib_parser *p, const rib_request *req, const scene_param *P);
+void rib_basis_default(double m[16], int *step);
+
+/* rib_nupatch.c */
+void rib_nu_patch(rib_parser *p, const rib_request *req);
+void rib_trim_curve(rib_parser *p, const rib_request *req);
+
+/* rib_mesh.c */
+void rib_points_polygons(rib_parser *p, const rib_request *req);
+void rib_points_general_polygons(rib_parser *p, const rib_request *req);
+void rib_general_polygon(rib_parser *p, const rib_request *req);
+
+/* rib_geometry.c: adds an object for a prepared surface with the current
+ * attributes and the object-to-world transform ctm; pos is where the
+ * surface was written. */
+void rib_place_surface(rib_parser *p, const rib_request *req, const geom_surface *surf,
+                       mat4 ctm, sl_pos pos);
+
+/* rib_parser.c: blocks */
+void rib_push_block(rib_parser *p, rib_block_kind kind, sl_pos pos);
+void rib_close_block(rib_parser *p, const rib_request *req, rib_block_kind kind);
 
 /* Growing the scene's arrays (rib_parser.c). */
 scene_light *rib_add_light(rib_parser *p);

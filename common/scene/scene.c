@@ -56,6 +56,7 @@ void scene_destroy(scene **self_p)
     free(self->spaces);
     free_strings(self->search_path, self->nsearch_path);
     free_strings(self->shader_names, self->nshader_names);
+    free_strings(self->archives, self->narchives);
     free(self->display_name);
     free(self->display_type);
     free(self->display_mode);

@@ -7,11 +7,14 @@
  * A scene is built from RenderMan Interface Bytestream text (a subset of
  * RI Specification 3.2, see docs/scenes.md for the table of requests):
  *
- *   scene_parse(file, text, len, diag)   from memory (a worker gets the
- *                                        scene text over the network)
- *   scene_load(path, diag)               from a file (the master, the CLI)
+ *   scene_parse(file, text, len, diag)   from memory (archives from disk)
+ *   scene_load(path, diag)               from a file (archives from disk)
+ *   scene_parse_archives(file, text, len, archives, diag)
+ *                                        archives from a source set: a
+ *                                        worker gets the scene text and
+ *                                        the archives over the network
  *
- * Both return NULL when there was any error; every error is in diag with
+ * All return NULL when there was any error; every error is in diag with
  * its file:line:col and names the RIB request. Warnings (unknown requests,
  * ignored frames) may be reported on success.
  *
@@ -39,6 +42,7 @@
 #include "geom/surface.h"
 #include "sl/diag.h"
 #include "sl/shader.h"
+#include "sl/source.h"
 #include "util/vecmath.h"
 
 /* ---- camera and image options ------------------------------------------ */
@@ -187,6 +191,10 @@ typedef struct scene {
     int nsearch_path;
     char **shader_names;           /* distinct shaders the objects use */
     int nshader_names;
+    char **archives;               /* ReadArchive files read (normalized), in
+                                    * order of first reading; positions inside
+                                    * them point at these names */
+    int narchives;
 } scene;
 
 /* ---- building ------------------------------------------------------------ */
@@ -198,6 +206,23 @@ scene *scene_parse(const char *file, const char *text, size_t len, sl_diag *diag
 
 /* Reads the file at `path` and parses it under that name. */
 scene *scene_load(const char *path, sl_diag *diag);
+
+/* As scene_parse, with the texts of ReadArchive taken from `archives`
+ * (sl/source.h; its loader, if any, is asked for missing names). A worker
+ * passes the job's set without a loader; the master a set whose loader is
+ * scene_archive_load_from_disk, which leaves the archives read in the set
+ * to ship with the job. scene_parse and scene_load read archives from disk
+ * (a private set). `archives` NULL: ReadArchive finds nothing. */
+scene *scene_parse_archives(const char *file, const char *text, size_t len,
+                            sl_source_set *archives, sl_diag *diag);
+
+/* An sl_source_loader: reads file `name` from disk into the set,
+ * gunzipping it when gzip-compressed; 1 when it does not exist. */
+int scene_archive_load_from_disk(sl_source_set *set, const char *name, sl_diag *diag,
+                                 void *arg);
+
+/* How deep archives may read archives. */
+enum { SCENE_ARCHIVE_MAX_DEPTH = 16 };
 
 void scene_destroy(scene **self_p);
 

@@ -90,13 +90,19 @@ geom_surface fx_default(geom_kind kind)
         s.verts[0] = v3(0, 0, 0); s.verts[1] = v3(1, 0, 0);
         s.verts[2] = v3(0, 1, 0); s.verts[3] = v3(1, 1, 0);
         break;
+    case GEOM_BICUBIC:                            /* the flat unit square */
+        s.nverts = 16;
+        for (int j = 0; j < 4; j++)
+            for (int i = 0; i < 4; i++)
+                s.verts[4 * j + i] = v3(i / 3.0, j / 3.0, 0);
+        break;
     default:
         break;
     }
     return s;
 }
 
-enum { MAX_FX = 32 };
+enum { MAX_FX = 40 };
 static fx_surface g_fx[MAX_FX];
 static int g_nfx;
 
@@ -165,6 +171,22 @@ static void build(void)
     s = add("patch skew", GEOM_PATCH, 3);
     s->verts[0] = v3(-1, 0.2, 0.3); s->verts[1] = v3(1.2, -0.3, 0);
     s->verts[2] = v3(-0.6, 1.4, 1.1); s->verts[3] = v3(1.7, 2, -0.8);
+    /* bicubic Bezier patches: a wavy sheet, a dome, a twisted strip */
+    static const double wave[16] = { 0, 0.4, -0.3, 0.1,  0.5, -0.6, 0.8, 0.2,
+                                     -0.4, 0.9, -0.7, 0.3,  0.2, -0.1, 0.6, -0.5 };
+    s = add("bicubic wavy", GEOM_BICUBIC, 2);
+    for (int k = 0; k < 16; k++)
+        s->verts[k] = v3((k % 4) * 0.6 - 0.9, (k / 4) * 0.6 - 0.9, wave[k]);
+    s = add("bicubic dome", GEOM_BICUBIC, 2);
+    for (int k = 0; k < 16; k++) {
+        double x = (k % 4) / 1.5 - 1, y = (k / 4) / 1.5 - 1;
+        s->verts[k] = v3(x, y, 1.2 - 0.6 * (x * x + y * y));
+    }
+    s = add("bicubic twisted", GEOM_BICUBIC, 3);
+    for (int k = 0; k < 16; k++) {
+        double a = (k / 4) * 0.5, r = (k % 4) * 0.7 - 1.05;
+        s->verts[k] = v3(r * cos(a), r * sin(a), (k / 4) * 0.8 + 0.1 * (k % 3));
+    }
 }
 
 int fx_surfaces(fx_surface **out)
@@ -275,6 +297,42 @@ static void oracle_patch(const geom_surface *s, ld u, ld v, fx_exact *o)
     }
 }
 
+/* de Casteljau on 4 points (long double), and the curve's derivative */
+static ld casteljau(const ld *p, int n, ld t)
+{
+    ld q[4];
+    for (int i = 0; i < n; i++)
+        q[i] = p[i];
+    for (int k = n - 1; k > 0; k--)
+        for (int i = 0; i < k; i++)
+            q[i] = (1 - t) * q[i] + t * q[i + 1];
+    return q[0];
+}
+
+/* P by de Casteljau in v of the de Casteljau values in u; the derivatives
+ * from the hodographs 3 (p[i+1] - p[i]) (a form independent of the
+ * library's Bernstein sums) */
+static void oracle_bicubic(const geom_surface *s, ld u, ld v, fx_exact *o)
+{
+    for (int c = 0; c < 3; c++) {
+        ld row[4], drow[4], col[4];
+        for (int j = 0; j < 4; j++) {
+            ld p[4], dp[3];
+            for (int i = 0; i < 4; i++)
+                p[i] = v3_comp(s->verts[4 * j + i], c);
+            for (int i = 0; i < 3; i++)
+                dp[i] = 3 * (p[i + 1] - p[i]);
+            row[j] = casteljau(p, 4, u);
+            drow[j] = casteljau(dp, 3, u);
+        }
+        o->P[c] = casteljau(row, 4, v);
+        o->Pu[c] = casteljau(drow, 4, v);
+        for (int j = 0; j < 3; j++)
+            col[j] = 3 * (row[j + 1] - row[j]);
+        o->Pv[c] = casteljau(col, 3, v);
+    }
+}
+
 void fx_oracle(const geom_surface *s, double u, double v, fx_exact *o)
 {
     ld th = (ld)u * s->thetamax, c = cosl(th), sn = sinl(th);
@@ -284,6 +342,7 @@ void fx_oracle(const geom_surface *s, double u, double v, fx_exact *o)
     case GEOM_HYPERBOLOID: oracle_hyperboloid(s, c, sn, v, o); break;
     case GEOM_POLYGON:     oracle_polygon(s, u, v, o); break;
     case GEOM_PATCH:       oracle_patch(s, u, v, o); break;
+    case GEOM_BICUBIC:     oracle_bicubic(s, u, v, o); break;
     default:               oracle_radial(s, c, sn, v, o); break;
     }
     o->Ng[0] = o->Pu[1] * o->Pv[2] - o->Pu[2] * o->Pv[1];

@@ -156,7 +156,8 @@ static void test_orientation(void **state)
             geom_sample g;
             geom_eval(&s, u, v, &g);
             vec3 want = kind == GEOM_POLYGON ? newell(&s)
-                        : kind == GEOM_PATCH ? v3(0, 0, 1) : outward(&s, g.P);
+                        : kind == GEOM_PATCH || kind == GEOM_BICUBIC ? v3(0, 0, 1)
+                        : outward(&s, g.P);
             double c = v3_dot(v3_normalize(g.Ng), v3_normalize(want));
             if (!(c > 0.1))
                 fail_msg("%s: Ng (%g %g %g) does not point outward at (%g, %g)",

@@ -42,7 +42,7 @@ static double param_dist(const geom_surface *s, const geom_sample *g, double u1,
                          double v1, double u2, double v2)
 {
     double du = fabs(u1 - u2), dv = fabs(v1 - v2);
-    if (s->kind != GEOM_POLYGON && s->kind != GEOM_PATCH && full_sweep(s->thetamax))
+    if (s->kind != GEOM_POLYGON && s->kind != GEOM_PATCH && s->kind != GEOM_BICUBIC && full_sweep(s->thetamax))
         du = fmin(du, 1 - du);
     if (s->kind == GEOM_TORUS && full_sweep(s->phimax - s->phimin))
         dv = fmin(dv, 1 - dv);
@@ -119,7 +119,7 @@ static void walk(const fx_surface *f, double u, double v, const geom_sample *g,
  * (never a ruling), a random one for polygons and patches */
 static vec3 tangent(const geom_surface *s, const geom_sample *g, vec3 N)
 {
-    vec3 t = s->kind == GEOM_POLYGON || s->kind == GEOM_PATCH
+    vec3 t = s->kind == GEOM_POLYGON || s->kind == GEOM_PATCH || s->kind == GEOM_BICUBIC
              ? v3_add(v3_scale(v3_normalize(g->dPdu), fx_range(-1, 1)),
                       v3_scale(v3_normalize(g->dPdv), fx_range(-1, 1)))
              : g->dPdu;
@@ -251,7 +251,7 @@ static bool cut_point(const geom_surface *s, geom_surface *full, int mode, doubl
     const double m = 0.03;
     *full = *s;
     if (mode == 0) {                               /* theta */
-        if (s->kind == GEOM_POLYGON || s->kind == GEOM_PATCH || full_sweep(s->thetamax))
+        if (s->kind == GEOM_POLYGON || s->kind == GEOM_PATCH || s->kind == GEOM_BICUBIC || full_sweep(s->thetamax))
             return false;
         full->thetamax = s->thetamax > 0 ? TWO_PI : -TWO_PI;
         double a = fabs(s->thetamax) / TWO_PI;

@@ -145,7 +145,7 @@ static void test_accepted(void **state)
     }
     static const char *const names[] = { "sphere", "disk", "cylinder", "cone",
                                          "paraboloid", "hyperboloid", "torus",
-                                         "polygon", "patch" };
+                                         "polygon", "patch", "bicubic patch" };
     for (int k = 0; k < GEOM__COUNT; k++)
         assert_string_equal(geom_kind_name((geom_kind)k), names[k]);
     assert_string_equal(geom_kind_name(GEOM__COUNT), "unknown");

@@ -93,8 +93,8 @@ static const error_case cases[] = {
     { WORLD("Format 10 10 1\n" SPHERE),
       "t.rib:4:1: Format: must come before WorldBegin (options are fixed for the whole "
       "world)" },
-    { CAMERA "LightSource \"pointlight\" 1\nWorldBegin\n" SPHERE "WorldEnd\n",
-      "t.rib:3:1: LightSource: must come between WorldBegin and WorldEnd" },
+    { CAMERA "WorldBegin\n" SPHERE "WorldEnd\nLightSource \"pointlight\" 1\n",
+      "t.rib:6:1: LightSource: must come between WorldBegin and WorldEnd" },
     /* the scene as a whole */
     { "Format 64 32 1\nWorldBegin\n" SPHERE "WorldEnd\n",
       "t.rib:2:1: WorldBegin: the scene has no camera: add Projection \"perspective\" "
@@ -138,8 +138,12 @@ static const error_case cases[] = {
       "t.rib:4:13: Polygon: parameter \"P\" is a point and needs a multiple of 3 numbers, got 8" },
     { WORLD("Polygon \"N\" [0 0 1 0 0 1 0 0 1]\n"),
       "t.rib:4:1: Polygon: missing the vertices: add \"P\" [x y z x y z ...]" },
+    { WORLD("Patch \"biquadratic\" \"P\" [0 0 0 1 0 0 0 1 0 1 1 0]\n"),
+      "t.rib:4:7: Patch: unknown patch type \"biquadratic\" (expected \"bilinear\" or "
+      "\"bicubic\")" },
     { WORLD("Patch \"bicubic\" \"P\" [0 0 0 1 0 0 0 1 0 1 1 0]\n"),
-      "t.rib:4:7: Patch: only \"bilinear\" patches are supported, got \"bicubic\"" },
+      "t.rib:4:17: Patch: a bicubic patch needs 16 points in \"P\" (48 numbers), got 12 "
+      "numbers" },
     { WORLD("Patch \"bilinear\" \"P\" [0 0 0 1 0 0 0 1 0]\n"),
       "t.rib:4:18: Patch: a bilinear patch needs 4 points in \"P\" (12 numbers), got 9 numbers" },
     { WORLD("Attribute \"displacementbound\" \"sphere\" [-1]\n" SPHERE),

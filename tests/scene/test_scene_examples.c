@@ -286,11 +286,13 @@ static void test_surfaces(void **state)
 {
     (void)state;
     scene *s = load("surfaces.rib");
-    assert_int_equal(s->nobjects, GEOM__COUNT);
+    /* one of each kind up to the bilinear patch (bicubic patches have
+     * their own scene, bicubic.rib) */
+    assert_int_equal(s->nobjects, GEOM_BICUBIC);
     int seen[GEOM__COUNT] = { 0 };
     for (int i = 0; i < s->nobjects; i++)
         seen[s->objects[i].surface.kind]++;
-    for (int k = 0; k < GEOM__COUNT; k++)
+    for (int k = 0; k < GEOM_BICUBIC; k++)
         assert_int_equal(seen[k], 1);
     const scene_object *torus = object_named(s, "torus");
     assert_true(torus->surface.majorrad == 0.6 && torus->surface.minorrad == 0.25);
@@ -308,6 +310,47 @@ static void test_surfaces(void **state)
     scene_destroy(&s);
 }
 
+/* vase.rib: 8 x 4 b-spline patches from an archive, three instanced
+ * catmull-rom leaves, a ground patch; the body is closed around (periodic
+ * in u): each patch's u = 1 edge is its neighbour's u = 0 edge. */
+static void test_vase(void **state)
+{
+    (void)state;
+    scene *s = load("vase.rib");
+    assert_int_equal(s->nobjects, 32 + 3 + 1);
+    assert_int_equal(s->narchives, 1);
+    assert_non_null(strstr(s->archives[0], "scenes/archives/vase_body.rib"));
+    for (int i = 0; i < 35; i++)
+        assert_int_equal(s->objects[i].surface.kind, GEOM_BICUBIC);
+    for (int pv = 0; pv < 4; pv++)
+        for (int pu = 0; pu < 8; pu++) {
+            geom_sample a, b;
+            geom_eval(&s->objects[pv * 8 + pu].surface, 1, 0.5, &a);
+            geom_eval(&s->objects[pv * 8 + (pu + 1) % 8].surface, 0, 0.5, &b);
+            assert_true(vec_dist(a.P, b.P) < 1e-12);
+        }
+    assert_non_null(scene_object_displacement(s, &s->objects[0]));
+    assert_null(scene_object_displacement(s, &s->objects[32]));
+    scene_destroy(&s);
+}
+
+/* meshes.rib: 1920 terrain quads from an archive, three stars (a concave
+ * 10-gon with a pentagonal hole: 10 + 5 + 2 - 2 = 15 triangles each), a
+ * bent quad cut in two. */
+static void test_meshes(void **state)
+{
+    (void)state;
+    scene *s = load("meshes.rib");
+    assert_int_equal(s->nobjects, 1920 + 3 * 15 + 2);
+    for (int i = 0; i < s->nobjects; i++)
+        assert_int_equal(s->objects[i].surface.kind, GEOM_POLYGON);
+    for (int i = 0; i < 1920; i++)
+        assert_int_equal(s->objects[i].surface.nverts, 4);
+    for (int i = 1920; i < s->nobjects; i++)
+        assert_int_equal(s->objects[i].surface.nverts, 3);
+    scene_destroy(&s);
+}
+
 int main(int argc, char **argv)
 {
     if (argc > 1)
@@ -321,6 +364,8 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_ufo),
         cmocka_unit_test(test_gallery),
         cmocka_unit_test(test_surfaces),
+        cmocka_unit_test(test_vase),
+        cmocka_unit_test(test_meshes),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -54,6 +54,13 @@ static const char every_request[] =
     "  Hyperboloid 1 0 -1 0 1 1 360\n  Paraboloid 1 0 1 360\n"
     "  Polygon \"P\" [0 0 0 1 0 0 1 1 0 0 1 0]\n"
     "  Patch \"bilinear\" \"P\" [0 0 0 1 0 0 0 1 0 1 1 0]\n"
+    "  PointsGeneralPolygons [2] [4 3] [0 1 2 3 4 5 6] \"P\" [0 0 0 4 0 0 4 4 0 0 4 0 "
+    "1 1 0 2 1 0 1 2 0]\n"
+    "  ObjectBegin 3\n  PointsPolygons [3 3] [0 1 2 0 2 3] \"P\" [0 0 0 1 0 0 1 1 0 0 1 0]\n"
+    "  ObjectEnd\n  ObjectInstance 3\n"
+    "  Basis \"b-spline\" 1 \"catmull-rom\" 1\n"
+    "  PatchMesh \"bicubic\" 4 \"periodic\" 4 \"nonperiodic\" \"P\" [0 0 0 1 0 0 2 0 1 3 0 0 "
+    "0 1 0 1 1 1 2 1 1 3 1 0 0 2 0 1 2 1 2 2 1 3 2 0 0 3 0 1 3 0 2 3 1 3 3 0]\n"
     "AttributeEnd\n"
     "CoordSysTransform \"lamp\"\nIdentity\nTransform [1 0 0 0 0 1 0 0 0 0 1 0 0 0 0 1]\n"
     "Sphere 0.5 -0.5 0.5 180\n"
@@ -62,7 +69,8 @@ static const char every_request[] =
 static const char *const inserts[] = {
     "AttributeBegin ", "AttributeEnd ", "TransformBegin ", "TransformEnd ", "WorldBegin ",
     "WorldEnd ", "FrameBegin ", "FrameEnd ", "Sphere ", "Polygon ", "Patch ", "Declare ",
-    "LightSource ", "Illuminate ", "Surface ", "[", "]", "\"", "\n", "#", " 1e308 ",
+    "LightSource ", "Illuminate ", "Surface ", "ObjectBegin ", "ObjectEnd ", "ObjectInstance ",
+    "PointsPolygons ", "PatchMesh ", "Basis ", "[", "]", "\"", "\n", "#", " 1e308 ",
     " -0 ", " 1e-320 ", " \"P\" ", " \"uniform float[3] x\" ", " [ ] ", "\\", " nan ",
 };
 
@@ -196,7 +204,9 @@ static void test_valid_texts_parse(void **state)
     assert_non_null(s);
     /* the second frame is ignored with one warning */
     assert_int_equal(sl_diag_warning_count(d), 1);
-    assert_int_equal(s->nobjects, 10);
+    /* 10 surfaces, a square with a triangular hole (7 triangles), an
+     * instance of two triangles, a 4 x 1 b-spline patch mesh */
+    assert_int_equal(s->nobjects, 10 + 7 + 2 + 4);
     assert_int_equal(s->nlights, 4);
     scene_destroy(&s);
     sl_diag_destroy(&d);

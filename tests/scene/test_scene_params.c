@@ -414,6 +414,32 @@ static void test_camera_options_values(void **state)
     scene_destroy(&s);
 }
 
+/* A light before WorldBegin (accepted with one warning, as other renderers
+ * do) sits in the space current there: the camera transform built so far. */
+static void test_light_before_world(void **state)
+{
+    (void)state;
+    const char *text = CAMERA "Translate 0 0 5\n"
+        "LightSource \"pointlight\" 1 \"from\" [0 0 1]\nLightSource \"ambientlight\" 2\n"
+        "Rotate 90 0 1 0\nWorldBegin\nSphere 1 -1 1 360\nWorldEnd\n";
+    sl_diag *d;
+    scene *s = parse_rib(text, &d);
+    if (!s)
+        sl_diag_print(d, stderr);
+    assert_non_null(s);
+    assert_int_equal(sl_diag_warning_count(d), 1);
+    assert_non_null(strstr(diag_line(nth_diag(d, SL_DIAG_WARNING, 0)),
+                           "t.rib:4:1: LightSource: a light before WorldBegin is placed"));
+    assert_int_equal(s->nlights, 2);
+    const scene_light *l = &s->lights[0];
+    assert_true(vec_dist(l->from_camera, v3(0, 0, 6)) < 1e-12);
+    /* world = camera rotated back by -90 about y after the translation */
+    assert_true(vec_dist(l->from_world, v3(-1, 0, 0)) < 1e-12);
+    assert_int_equal(s->objects[0].nlights, 2);
+    scene_destroy(&s);
+    sl_diag_destroy(&d);
+}
+
 static void test_frames(void **state)
 {
     (void)state;
@@ -471,6 +497,7 @@ int main(void)
         cmocka_unit_test(test_search_path),
         cmocka_unit_test(test_camera_options_values),
         cmocka_unit_test(test_frames),
+        cmocka_unit_test(test_light_before_world),
         cmocka_unit_test(test_comments_and_layout),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -1,0 +1,106 @@
+/*
+ * bench/mesh_bench.c: how polygon meshes scale (common/scene/rib_mesh.c):
+ * a closed torus of nu x nv planar quads (PointsPolygons, shared points)
+ * at 1k, 10k and 100k faces; prints the CPU seconds of parsing (with
+ * geom_surface_prepare per face), of building the renderer's world (root
+ * boxes and BVH: job_scene_new), of rendering 128x128 at one sample per
+ * pixel with the default surface, and the peak resident memory. Never
+ * fails on timing.
+ *
+ *   mesh_bench [max_faces]     (default 100000)
+ */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <math.h>
+#include <time.h>
+#include <sys/resource.h>
+
+#include "job/job.h"
+#include "job/job_scene.h"
+
+static double cpu_now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return ts.tv_sec + ts.tv_nsec * 1e-9;
+}
+
+static long peak_mib(void)
+{
+    struct rusage ru;
+    getrusage(RUSAGE_SELF, &ru);
+    return ru.ru_maxrss / 1024;
+}
+
+/* The RIB text of a torus (radii 1 and 0.4) of nu x nv quads. */
+static char *torus_rib(int nu, int nv, size_t *len)
+{
+    size_t cap = (size_t)nu * nv * 80 + 4096, n = 0;
+    char *t = malloc(cap);
+    if (!t) abort();
+    n += (size_t)sprintf(t + n, "Format 128 128 1\nProjection \"perspective\" \"fov\" [40]\n"
+                         "Translate 0 0 4\nRotate 60 1 0 0\nWorldBegin\nPointsPolygons [");
+    for (int i = 0; i < nu * nv; i++) n += (size_t)sprintf(t + n, "4 ");
+    n += (size_t)sprintf(t + n, "]\n[");
+    for (int i = 0; i < nu; i++)
+        for (int j = 0; j < nv; j++) {
+            int i1 = (i + 1) % nu, j1 = (j + 1) % nv;
+            n += (size_t)sprintf(t + n, "%d %d %d %d ", i * nv + j, i * nv + j1, i1 * nv + j1,
+                                 i1 * nv + j);
+        }
+    n += (size_t)sprintf(t + n, "]\n\"P\" [");
+    for (int i = 0; i < nu; i++)
+        for (int j = 0; j < nv; j++) {
+            double a = 2 * M_PI * i / nu, b = 2 * M_PI * j / nv, r = 1 + 0.4 * cos(b);
+            n += (size_t)sprintf(t + n, "%.9g %.9g %.9g ", r * cos(a), r * sin(a), 0.4 * sin(b));
+        }
+    n += (size_t)sprintf(t + n, "]\nWorldEnd\n");
+    *len = n;
+    return t;
+}
+
+int main(int argc, char **argv)
+{
+    int max_faces = argc > 1 ? atoi(argv[1]) : 100000;
+    printf("%8s %10s %12s %12s %12s %10s\n", "faces", "parse s", "world s", "render s",
+           "objects", "peak MiB");
+    for (int faces = 1000; faces <= max_faces; faces *= 10) {
+        int nv = (int)sqrt(faces / 2.5), nu = faces / nv;
+        size_t len;
+        char *text = torus_rib(nu, nv, &len);
+        job_options opt;
+        job_options_default(&opt);
+        job *jb = job_new("torus.rib", text, len, &opt);
+        free(text);
+        char why[256];
+        if (!job_finish(jb, why, sizeof why)) { fprintf(stderr, "%s\n", why); return 1; }
+        sl_diag *d = sl_diag_new();
+        double t0 = cpu_now();
+        scene *s = scene_parse(jb->scene_file, jb->scene_text, jb->scene_len, d);
+        double parse = cpu_now() - t0;
+        int nobj = s ? s->nobjects : 0;
+        scene_destroy(&s);
+        t0 = cpu_now();
+        job_scene *js = job_scene_new(jb, 0, true, d);
+        double world = cpu_now() - t0;
+        if (!js) { sl_diag_print(d, stderr); return 1; }
+        t0 = cpu_now();
+        trace_thread *th = trace_thread_new(&js->world);
+        long hits = 0;
+        for (int y = 0; y < 128; y++)
+            for (int x = 0; x < 128; x++) {
+                double rgb[3], a, z;
+                trace_render_sample(js->renderer, th, x + 0.5, y + 0.5, rgb, &a, &z);
+                hits += a > 0;
+            }
+        double render = cpu_now() - t0;
+        trace_thread_destroy(&th);
+        printf("%8d %10.3f %12.3f %12.3f %12d %10ld   (%ld of 16384 pixels covered)\n",
+               nu * nv, parse, world - parse, render, nobj, peak_mib(), hits);
+        job_scene_destroy(&js);
+        job_destroy(&jb);
+        sl_diag_destroy(&d);
+    }
+    return 0;
+}

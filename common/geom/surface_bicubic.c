@@ -1,0 +1,427 @@
+/*
+ * surface_bicubic.c: the bicubic Bezier patch (GEOM_BICUBIC), the form
+ * every bicubic basis of RenderMan's Patch and PatchMesh is converted to
+ * (RI Specification 3.2 §5.3; the parser multiplies the basis matrices
+ * into Bezier control points, common/scene/rib_patch.c):
+ *
+ *     P(u,v) = sum_ij B_i(u) B_j(v) P_ij,   P_ij = verts[4 j + i]
+ *
+ * with the cubic Bernstein polynomials B_0..3 (u varies fastest, as in the
+ * RIB). Here: prepare, the float and dual evaluation, interval and affine
+ * enclosures over a (u,v) box (conservative including rounding: only
+ * common/aa operations, and the control points are exact doubles), and the
+ * ray intersection.
+ *
+ * The enclosures are the tensor form in both arithmetics: with s = 1 - u,
+ * the basis s^3, 3 s^2 u, 3 s u^2, u^3 and its derivative
+ * 3 (-s^2, s^2 - 2 s u, 2 s u - u^2, u^2) from the products s^2, s u, u^2,
+ * s^3, s^2 u, s u^2, u^3 (7 non-affine operations per parameter); the rows
+ * C_j = sum_i B_i(u) P_ij and D_j = sum_i B_i'(u) P_ij are affine in
+ * those; then P = sum_j B_j(v) C_j, dPdu = sum_j B_j(v) D_j,
+ * dPdv = sum_j B_j'(v) C_j (12 products per coordinate) and
+ * Ng = dPdu x dPdv (6): 56 non-affine operations in all.
+ *
+ * Intersection: recursive de Casteljau subdivision of the control net,
+ * each piece pruned by its net's box against the ray's slab interval (the
+ * piece lies in its net's hull). From pieces of side 1/8 (1/32 where the
+ * ray may touch the surface tangentially: the hodographs' bound on Ng.d
+ * holds 0) Newton's method on o + t d = P(u,v) from the box centre,
+ * accepted when it converges inside the box. A transversal box
+ * (Ng.d of one sign) holds at most one hit, so one found ends it; other
+ * boxes are split on (a grazing ray may cross twice, close together) down
+ * to side 2^-16. Newton's t varies by a few ulps with its
+ * start, so a hit within a relative 1e-9 of tmin counts as the one at
+ * tmin (a caller walking the hits along a ray gets each once). The bounds
+ * are the control points' box (the patch lies in their convex hull).
+ */
+#include "geom/surface.h"
+#include "geom/surface_internal.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+
+/* ---- float ---------------------------------------------------------- */
+
+static void bernstein(double u, double b[4], double d1[4], double d2[4])
+{
+    double s = 1 - u;
+    b[0] = s * s * s, b[1] = 3 * s * s * u, b[2] = 3 * s * u * u, b[3] = u * u * u;
+    d1[0] = -3 * s * s, d1[1] = 3 * (s * s - 2 * s * u), d1[2] = 3 * (2 * s * u - u * u);
+    d1[3] = 3 * u * u;
+    d2[0] = 6 * s, d2[1] = -12 * s + 6 * u, d2[2] = 6 * s - 12 * u, d2[3] = 6 * u;
+}
+
+static vec3 tensor(const vec3 *p, const double *bu, const double *bv)
+{
+    vec3 r = v3(0, 0, 0);
+    for (int j = 0; j < 4; j++)
+        for (int i = 0; i < 4; i++)
+            r = v3_add(r, v3_scale(p[4 * j + i], bu[i] * bv[j]));
+    return r;
+}
+
+void geom_bicubic_eval_dual(const geom_surface *s, double u, double v, geom_sample *out)
+{
+    double bu[4], du[4], ddu[4], bv[4], dv[4], ddv[4];
+    bernstein(u, bu, du, ddu);
+    bernstein(v, bv, dv, ddv);
+    const vec3 *p = s->verts;
+    out->P = tensor(p, bu, bv);
+    out->dPdu = tensor(p, du, bv);
+    out->dPdv = tensor(p, bu, dv);
+    vec3 Puu = tensor(p, ddu, bv), Puv = tensor(p, du, dv), Pvv = tensor(p, bu, ddv);
+    out->Ng = v3_cross(out->dPdu, out->dPdv);
+    out->dNgdu = v3_add(v3_cross(Puu, out->dPdv), v3_cross(out->dPdu, Puv));
+    out->dNgdv = v3_add(v3_cross(Puv, out->dPdv), v3_cross(out->dPdu, Pvv));
+}
+
+/* ---- interval ------------------------------------------------------- */
+
+static void basis_ia(ia_interval u, ia_interval b[4], ia_interval d[4])
+{
+    ia_interval s = ia_sub(ia_point(1), u);
+    ia_interval s2 = ia_mul(s, s), su = ia_mul(s, u), u2 = ia_mul(u, u);
+    b[0] = ia_mul(s2, s);
+    b[1] = ia_mul_s(ia_mul(s2, u), 3);
+    b[2] = ia_mul_s(ia_mul(s, u2), 3);
+    b[3] = ia_mul(u2, u);
+    d[0] = ia_mul_s(s2, -3);
+    d[1] = ia_mul_s(ia_sub(s2, ia_mul_s(su, 2)), 3);
+    d[2] = ia_mul_s(ia_sub(ia_mul_s(su, 2), u2), 3);
+    d[3] = ia_mul_s(u2, 3);
+}
+
+/* sum_i w[i] p[i] */
+static ia_interval dot4_ia(const ia_interval w[4], const double p[4])
+{
+    ia_interval r = ia_mul_s(w[0], p[0]);
+    for (int i = 1; i < 4; i++)
+        r = ia_add(r, ia_mul_s(w[i], p[i]));
+    return r;
+}
+
+static ia_interval sum4_ia(const ia_interval a[4], const ia_interval b[4])
+{
+    ia_interval r = ia_mul(a[0], b[0]);
+    for (int i = 1; i < 4; i++)
+        r = ia_add(r, ia_mul(a[i], b[i]));
+    return r;
+}
+
+void geom_bicubic_eval_ia(const geom_surface *s, ia_interval u, ia_interval v, geom_ia *o)
+{
+    ia_interval bu[4], du[4], bv[4], dv[4];
+    basis_ia(u, bu, du);
+    basis_ia(v, bv, dv);
+    for (int c = 0; c < 3; c++) {
+        ia_interval C[4], D[4];
+        for (int j = 0; j < 4; j++) {
+            double row[4];
+            for (int i = 0; i < 4; i++)
+                row[i] = v3_comp(s->verts[4 * j + i], c);
+            C[j] = dot4_ia(bu, row);
+            D[j] = dot4_ia(du, row);
+        }
+        o->P[c] = sum4_ia(bv, C);
+        o->dPdu[c] = sum4_ia(bv, D);
+        o->dPdv[c] = sum4_ia(dv, C);
+    }
+    for (int c = 0; c < 3; c++) {
+        int a = (c + 1) % 3, b = (c + 2) % 3;
+        o->Ng[c] = ia_sub(ia_mul(o->dPdu[a], o->dPdv[b]), ia_mul(o->dPdu[b], o->dPdv[a]));
+    }
+}
+
+/* ---- affine --------------------------------------------------------- */
+
+static void basis_aa(aa_context *ctx, const aa_form *u, aa_form b[4], aa_form d[4])
+{
+    aa_form s, s2, su, u2, t;
+    aa_lincomb(ctx, &s, -1, u, 0, u, 1);
+    aa_mul(ctx, &s2, &s, &s);
+    aa_mul(ctx, &su, &s, u);
+    aa_mul(ctx, &u2, u, u);
+    aa_mul(ctx, &b[0], &s2, &s);
+    aa_mul(ctx, &t, &s2, u);
+    aa_mul_s(ctx, &b[1], &t, 3);
+    aa_mul(ctx, &t, &s, &u2);
+    aa_mul_s(ctx, &b[2], &t, 3);
+    aa_mul(ctx, &b[3], &u2, u);
+    aa_mul_s(ctx, &d[0], &s2, -3);
+    aa_lincomb(ctx, &d[1], 3, &s2, -6, &su, 0);
+    aa_lincomb(ctx, &d[2], 6, &su, -3, &u2, 0);
+    aa_mul_s(ctx, &d[3], &u2, 3);
+}
+
+static void dot4_aa(aa_context *ctx, aa_form *z, const aa_form w[4], const double p[4])
+{
+    aa_form t;
+    aa_lincomb(ctx, z, p[0], &w[0], p[1], &w[1], 0);
+    aa_lincomb(ctx, &t, p[2], &w[2], p[3], &w[3], 0);
+    aa_add(ctx, z, z, &t);
+}
+
+static void sum4_aa(aa_context *ctx, aa_form *z, const aa_form a[4], const aa_form b[4])
+{
+    aa_form t;
+    aa_mul(ctx, z, &a[0], &b[0]);
+    for (int i = 1; i < 4; i++) {
+        aa_mul(ctx, &t, &a[i], &b[i]);
+        aa_add(ctx, z, z, &t);
+    }
+}
+
+void geom_bicubic_eval_aa(aa_context *ctx, const geom_surface *s, const aa_form *u,
+                          const aa_form *v, geom_aa *o)
+{
+    aa_form bu[4], du[4], bv[4], dv[4];
+    basis_aa(ctx, u, bu, du);
+    basis_aa(ctx, v, bv, dv);
+    for (int c = 0; c < 3; c++) {
+        aa_form C[4], D[4];
+        for (int j = 0; j < 4; j++) {
+            double row[4];
+            for (int i = 0; i < 4; i++)
+                row[i] = v3_comp(s->verts[4 * j + i], c);
+            dot4_aa(ctx, &C[j], bu, row);
+            dot4_aa(ctx, &D[j], du, row);
+        }
+        sum4_aa(ctx, &o->P[c], bv, C);
+        sum4_aa(ctx, &o->dPdu[c], bv, D);
+        sum4_aa(ctx, &o->dPdv[c], dv, C);
+    }
+    for (int c = 0; c < 3; c++) {
+        int a = (c + 1) % 3, b = (c + 2) % 3;
+        aa_form x, y;
+        aa_mul(ctx, &x, &o->dPdu[a], &o->dPdv[b]);
+        aa_mul(ctx, &y, &o->dPdu[b], &o->dPdv[a]);
+        aa_sub(ctx, &o->Ng[c], &x, &y);
+    }
+}
+
+/* ---- prepare and bounds --------------------------------------------- */
+
+bool geom_bicubic_prepare(geom_surface *s, char *why, int why_size)
+{
+    if (s->nverts != 16)
+        return geom_fail(why, why_size, "bicubic patch needs 16 control points, got %d",
+                         s->nverts);
+    double size = 0;
+    for (int i = 0; i < 16; i++) {
+        vec3 p = s->verts[i];
+        if (!isfinite(p.x) || !isfinite(p.y) || !isfinite(p.z))
+            return geom_fail(why, why_size, "bicubic patch control point %d is not finite", i);
+        size = fmax(size, v3_length(v3_sub(p, s->verts[0])));
+    }
+    if (!isfinite(size) || size > 1e150)
+        return geom_fail(why, why_size, "bicubic patch control points are too large");
+    /* degenerate: all control points on one line (no normal anywhere) */
+    double area = 0;
+    for (int i = 1; i < 16; i++)
+        for (int j = i + 1; j < 16; j++)
+            area = fmax(area, v3_length(v3_cross(v3_sub(s->verts[i], s->verts[0]),
+                                                 v3_sub(s->verts[j], s->verts[0]))));
+    if (!(area > 1e-12 * size * size))
+        return geom_fail(why, why_size, "bicubic patch is degenerate: its control points "
+                         "lie on one line");
+    return true;
+}
+
+void geom_bicubic_bounds(const geom_surface *s, vec3 *lo, vec3 *hi)
+{
+    *lo = *hi = s->verts[0];
+    for (int i = 1; i < 16; i++) {
+        vec3 p = s->verts[i];
+        lo->x = fmin(lo->x, p.x), lo->y = fmin(lo->y, p.y), lo->z = fmin(lo->z, p.z);
+        hi->x = fmax(hi->x, p.x), hi->y = fmax(hi->y, p.y), hi->z = fmax(hi->z, p.z);
+    }
+}
+
+/* ---- intersection --------------------------------------------------- */
+
+/* The ray's t interval inside the box [lo, hi] (slabs), within [t0, t1]. */
+static bool slab(vec3 o, vec3 d, vec3 lo, vec3 hi, double *t0, double *t1)
+{
+    double a = *t0, b = *t1;
+    for (int c = 0; c < 3; c++) {
+        double oc = v3_comp(o, c), dc = v3_comp(d, c);
+        double l = v3_comp(lo, c), h = v3_comp(hi, c);
+        if (dc == 0) {
+            if (oc < l || oc > h)
+                return false;
+            continue;
+        }
+        double ta = (l - oc) / dc, tb = (h - oc) / dc;
+        if (ta > tb) { double t = ta; ta = tb; tb = t; }
+        /* widen by a relative hair: the divisions round */
+        double w = 1e-12 * (fabs(ta) + fabs(tb)) + 1e-300;
+        a = fmax(a, ta - w);
+        b = fmin(b, tb + w);
+        if (a > b)
+            return false;
+    }
+    *t0 = a, *t1 = b;
+    return true;
+}
+
+/* A sub-patch's Bezier net (de Casteljau subdivision, in float: used to
+ * prune and start Newton, never to bound shading) and its (u,v) box. */
+typedef struct net { vec3 p[16]; double u0, v0; int depth; } net;
+
+/* Splits the 4 points p[0], p[k], p[2k], p[3k] at 1/2 into a and b. */
+static void split4(const vec3 *p, int k, vec3 *a, vec3 *b)
+{
+    vec3 p01 = v3_scale(v3_add(p[0], p[k]), 0.5), p12 = v3_scale(v3_add(p[k], p[2 * k]), 0.5);
+    vec3 p23 = v3_scale(v3_add(p[2 * k], p[3 * k]), 0.5);
+    vec3 q0 = v3_scale(v3_add(p01, p12), 0.5), q1 = v3_scale(v3_add(p12, p23), 0.5);
+    vec3 m = v3_scale(v3_add(q0, q1), 0.5);
+    a[0] = p[0], a[k] = p01, a[2 * k] = q0, a[3 * k] = m;
+    b[0] = m, b[k] = q1, b[2 * k] = p23, b[3 * k] = p[3 * k];
+}
+
+/* The four quarters of n (u halves, then v halves). */
+static void split_net(const net *n, net out[4])
+{
+    net half[2];
+    for (int j = 0; j < 4; j++)
+        split4(n->p + 4 * j, 1, half[0].p + 4 * j, half[1].p + 4 * j);
+    double h = ldexp(1, -(n->depth + 1));
+    for (int a = 0; a < 2; a++)
+        for (int i = 0; i < 4; i++)
+            split4(half[a].p + i, 4, out[a].p + i, out[2 + a].p + i);
+    for (int k = 0; k < 4; k++) {
+        out[k].u0 = n->u0 + (k & 1) * h;
+        out[k].v0 = n->v0 + (k >> 1) * h;
+        out[k].depth = n->depth + 1;
+    }
+}
+
+static void net_box(const net *n, double pad, vec3 *lo, vec3 *hi)
+{
+    *lo = *hi = n->p[0];
+    for (int i = 1; i < 16; i++) {
+        vec3 p = n->p[i];
+        lo->x = fmin(lo->x, p.x), lo->y = fmin(lo->y, p.y), lo->z = fmin(lo->z, p.z);
+        hi->x = fmax(hi->x, p.x), hi->y = fmax(hi->y, p.y), hi->z = fmax(hi->z, p.z);
+    }
+    *lo = v3_sub(*lo, v3(pad, pad, pad));
+    *hi = v3_add(*hi, v3(pad, pad, pad));
+}
+
+/* Whether det(Pu, Pv, d) keeps one sign over the net: Pu and Pv lie in the
+ * hulls of the nets' differences (the hodographs), and the determinant is
+ * bilinear in them, so its extremes are at pairs of hull points. */
+static bool transversal(const net *n, vec3 d)
+{
+    vec3 du[12], dv[12];
+    for (int j = 0; j < 4; j++)
+        for (int i = 0; i < 3; i++) {
+            du[3 * j + i] = v3_sub(n->p[4 * j + i + 1], n->p[4 * j + i]);
+            dv[3 * i + j] = v3_sub(n->p[4 * (i + 1) + j], n->p[4 * i + j]);
+        }
+    double lo = INFINITY, hi = -INFINITY;
+    for (int a = 0; a < 12; a++) {
+        vec3 c = v3_cross(dv[a], d);
+        for (int b = 0; b < 12; b++) {
+            double x = v3_dot(du[b], c);
+            lo = fmin(lo, x), hi = fmax(hi, x);
+        }
+    }
+    double tiny = 1e-9 * (fabs(lo) + fabs(hi));
+    return lo > tiny || hi < -tiny;
+}
+
+/* Newton's method on o + t d - P(u,v) = 0 from (t, u, v), run until the
+ * steps stop shrinking (near a tangent ray the root is double and the
+ * convergence only linear: stopping at a small residual would leave t off
+ * by its square root). */
+static bool newton(const geom_surface *s, vec3 o, vec3 d, double *t, double *u, double *v,
+                   double scale)
+{
+    double last = INFINITY;
+    for (int it = 0; it < 60; it++) {
+        geom_sample g;
+        geom_bicubic_eval_dual(s, *u, *v, &g);
+        vec3 f = v3_sub(v3_add(o, v3_scale(d, *t)), g.P);
+        /* [d, -Pu, -Pv] (dt, du, dv) = -f by Cramer's rule */
+        vec3 a = d, b = v3_neg(g.dPdu), c = v3_neg(g.dPdv);
+        double det = v3_dot(a, v3_cross(b, c));
+        if (!(fabs(det) > 0))
+            break;
+        vec3 r = v3_neg(f);
+        double dt = v3_dot(r, v3_cross(b, c)) / det;
+        double du = v3_dot(a, v3_cross(r, c)) / det, dv = v3_dot(a, v3_cross(b, r)) / det;
+        double step = fabs(du) + fabs(dv) + fabs(dt) * v3_length(d) / scale;
+        if (!isfinite(step) || (it > 2 && step > 0.9 * last) || (it > 40 && step > 1e-6))
+            break;
+        *t += dt, *u += du, *v += dv;
+        last = step;
+        if (step < 1e-16)
+            break;
+        if (fabs(*u - 0.5) > 2 || fabs(*v - 0.5) > 2)
+            return false;
+    }
+    geom_sample g;
+    geom_bicubic_eval_dual(s, *u, *v, &g);
+    return v3_length(v3_sub(v3_add(o, v3_scale(d, *t)), g.P)) <= 1e-9 * scale;
+}
+
+bool geom_bicubic_intersect(const geom_surface *s, vec3 o, vec3 d, double tmin, double tmax,
+                            geom_hit *hit)
+{
+    enum { MIN_DEPTH_TRANSVERSAL = 3, MIN_DEPTH = 5, MAX_DEPTH = 16,
+           STACK = 3 * MAX_DEPTH + 8 };
+    vec3 lo, hi;
+    geom_bicubic_bounds(s, &lo, &hi);
+    double size = v3_length(v3_sub(hi, lo));
+    double scale = size + v3_length(o) + 1e-300, pad = 1e-12 * scale;
+    net *stack = malloc(STACK * sizeof *stack);
+    if (!stack)
+        abort();
+    int n = 0;
+    for (int i = 0; i < 16; i++)
+        stack[0].p[i] = s->verts[i];
+    stack[0].u0 = stack[0].v0 = 0;
+    stack[0].depth = 0;
+    n = 1;
+    double best = tmax;
+    bool found = false;
+    while (n > 0) {
+        net cur = stack[--n];
+        double side = ldexp(1, -cur.depth), u0 = cur.u0, v0 = cur.v0;
+        vec3 blo, bhi;
+        net_box(&cur, pad, &blo, &bhi);
+        double t0 = tmin, t1 = best;
+        if (!slab(o, d, blo, bhi, &t0, &t1))
+            continue;
+        /* where Ng.d keeps one sign the ray crosses the piece at most
+         * once: a hit found there is the box's only one */
+        bool across = transversal(&cur, d);
+        if (cur.depth >= (across ? MIN_DEPTH_TRANSVERSAL : MIN_DEPTH)) {
+            double u = u0 + side / 2, v = v0 + side / 2;
+            geom_sample c;
+            geom_bicubic_eval_dual(s, u, v, &c);
+            double t = v3_dot(v3_sub(c.P, o), d) / v3_dot(d, d);
+            double slack = 1e-9;
+            bool inside = newton(s, o, d, &t, &u, &v, scale) && u >= u0 - slack &&
+                          u <= u0 + side + slack && v >= v0 - slack &&
+                          v <= v0 + side + slack && t >= t0 && t <= t1;
+            if (inside && t > tmin + 1e-9 * fabs(tmin) && t < best) {
+                best = t;
+                hit->t = t;
+                hit->u = fmin(fmax(u, 0), 1);
+                hit->v = fmin(fmax(v, 0), 1);
+                found = true;
+            }
+            if ((inside && across) || cur.depth >= MAX_DEPTH)
+                continue;      /* else the box may hold a nearer hit: split on */
+        }
+        if (n + 4 > STACK)
+            continue;
+        split_net(&cur, stack + n);
+        n += 4;
+    }
+    free(stack);
+    return found;
+}

@@ -1,0 +1,134 @@
+/*
+ * rib_instance.c: retained geometry (RI Specification 3.2 §5.6, "Objects"):
+ * ObjectBegin handle ... ObjectEnd records the surfaces between them, each
+ * with the transform current inside the block (relative to the block's
+ * start); ObjectInstance handle places them all with the attributes and
+ * the transform current at the ObjectInstance (shaders, color, sides,
+ * lights), as RenderMan does: attributes inside the block other than the
+ * transform do not travel with the object.
+ *
+ * The handle is a number (RIB's sequence number) or a string. Defining a
+ * handle again replaces the earlier object for the instances that follow.
+ * A definition may not nest another, and may only hold surfaces (they are
+ * recorded instead of placed: see rib_record_surface).
+ */
+#include "scene/rib_parser.h"
+#include "sl/strbuf.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* The handle as text ("7", "lamp"); NULL with an error when malformed. */
+static char *handle_of(rib_parser *p, const rib_request *req)
+{
+    if (req->nargs != 1 || (req->args[0].kind != RIB_ARG_NUMBER &&
+                            req->args[0].kind != RIB_ARG_STRING)) {
+        if (req->nargs == 0)
+            rib_error(p, req, req->pos, "missing the object handle (a number or a string)");
+        else
+            rib_error(p, req, req->nargs == 1 ? req->args[0].pos : req->args[1].pos,
+                      "takes one argument, the object handle (a number or a string)");
+        return NULL;
+    }
+    const rib_arg *arg = &req->args[0];
+    if (arg->kind == RIB_ARG_STRING) {
+        const char *s = rib_arg_string(req, arg);
+        return sl_xstrndup(s, strlen(s));
+    }
+    int n;
+    char buf[64];
+    snprintf(buf, sizeof buf, "%.17g", rib_arg_numbers(req, arg, &n)[0]);
+    return sl_xstrndup(buf, strlen(buf));
+}
+
+static rib_object_def *find_def(rib_parser *p, const char *handle)
+{
+    for (int i = p->ndefs - 1; i >= 0; i--)
+        if (p->defs[i].handle && strcmp(p->defs[i].handle, handle) == 0)
+            return &p->defs[i];
+    return NULL;
+}
+
+void rib_object_begin(rib_parser *p, const rib_request *req)
+{
+    for (int i = 0; i < p->nblocks; i++)
+        if (p->blocks[i].kind == RIB_BLOCK_OBJECT) {
+            const rib_block *b = &p->blocks[i];
+            rib_error(p, req, req->pos, "object definitions cannot nest: the ObjectBegin at "
+                      "%s:%d:%d is still open (missing ObjectEnd)", b->pos.file, b->pos.line,
+                      b->pos.col);
+            return;
+        }
+    char *handle = req->broken ? NULL : handle_of(p, req);
+    p->defs = sl_xrealloc(p->defs, (size_t)(p->ndefs + 1) * sizeof *p->defs);
+    rib_object_def *d = &p->defs[p->ndefs++];
+    memset(d, 0, sizeof *d);
+    d->handle = handle;              /* NULL: malformed, never found */
+    d->pos = req->pos;
+    rib_push_block(p, RIB_BLOCK_OBJECT, req->pos);
+    p->blocks[p->nblocks - 1].object_def = p->ndefs - 1;
+    p->attr.ctm = mat4_identity();
+}
+
+void rib_object_end(rib_parser *p, const rib_request *req)
+{
+    rib_close_block(p, req, RIB_BLOCK_OBJECT);
+}
+
+rib_object_def *rib_defining(rib_parser *p)
+{
+    for (int i = p->nblocks - 1; i >= 0; i--)
+        if (p->blocks[i].kind == RIB_BLOCK_OBJECT)
+            return &p->defs[p->blocks[i].object_def];
+    return NULL;
+}
+
+void rib_record_surface(rib_parser *p, const rib_request *req, const geom_surface *surf)
+{
+    rib_object_def *d = rib_defining(p);
+    d->parts = sl_xrealloc(d->parts, (size_t)(d->nparts + 1) * sizeof *d->parts);
+    rib_object_part *part = &d->parts[d->nparts++];
+    part->surface = *surf;
+    part->ctm = p->attr.ctm;
+    part->pos = req->pos;
+}
+
+void rib_object_instance(rib_parser *p, const rib_request *req)
+{
+    char *handle = handle_of(p, req);
+    if (!handle)
+        return;
+    if (rib_defining(p)) {
+        rib_error(p, req, req->pos, "cannot be used inside an object definition (instances "
+                  "of instances are not supported)");
+        free(handle);
+        return;
+    }
+    const rib_object_def *d = find_def(p, handle);
+    if (!d) {
+        rib_error(p, req, req->args[0].pos, "no object has the handle %s (define it first "
+                  "with ObjectBegin %s ... ObjectEnd)", handle, handle);
+        free(handle);
+        return;
+    }
+    free(handle);
+    if (d->nparts == 0)
+        rib_warning(p, req, req->pos, "the object defined at %s:%d:%d holds no surfaces",
+                    d->pos.file, d->pos.line, d->pos.col);
+    mat4 ctm = p->attr.ctm;
+    for (int i = 0; i < d->nparts; i++)
+        rib_place_surface(p, req, &d->parts[i].surface, mat4_mul(ctm, d->parts[i].ctm),
+                          d->parts[i].pos);
+}
+
+void rib_object_defs_free(rib_parser *p)
+{
+    for (int i = 0; i < p->ndefs; i++) {
+        free(p->defs[i].handle);
+        free(p->defs[i].parts);
+    }
+    free(p->defs);
+    p->defs = NULL;
+    p->ndefs = 0;
+}

@@ -1,0 +1,183 @@
+/*
+ * tests/scene/test_scene_mesh.c: polygon meshes (common/scene/rib_mesh.c).
+ * A cube of shared-point quads gives six convex polygons with the right
+ * corners; a non-planar quad, a concave face and a face with a hole are
+ * cut into triangles whose areas add up to the face's; primitive
+ * variables other than P give one warning per scene; faces without area
+ * are skipped with a warning; meshes work inside object definitions; and
+ * malformed meshes give errors with file:line:col.
+ */
+#include <stdarg.h>
+#include <stddef.h>
+#include <setjmp.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include "scene_testing.h"
+
+#define WORLD(body) CAMERA "WorldBegin\n" body "WorldEnd\n"
+
+#define CUBE_P "\"P\" [-1 -1 -1  1 -1 -1  -1 1 -1  1 1 -1  -1 -1 1  1 -1 1  -1 1 1  1 1 1]"
+#define CUBE "PointsPolygons [4 4 4 4 4 4]\n" \
+    "  [0 2 3 1  4 5 7 6  0 1 5 4  2 6 7 3  0 4 6 2  1 3 7 5]\n  " CUBE_P "\n"
+
+/* Sum of the areas of the objects' polygons. */
+static double polygon_area(const scene *s, int from, int to)
+{
+    double a = 0;
+    for (int i = from; i < to; i++) {
+        const geom_surface *g = &s->objects[i].surface;
+        assert_int_equal(g->kind, GEOM_POLYGON);
+        vec3 n = v3(0, 0, 0);
+        for (int k = 1; k + 1 < g->nverts; k++)
+            n = v3_add(n, v3_cross(v3_sub(g->verts[k], g->verts[0]),
+                                   v3_sub(g->verts[k + 1], g->verts[0])));
+        a += v3_length(n) / 2;
+    }
+    return a;
+}
+
+static void test_cube(void **state)
+{
+    (void)state;
+    sl_diag *d;
+    scene *s = parse_rib(WORLD(CUBE), &d);
+    if (!s)
+        sl_diag_print(d, stderr);
+    assert_non_null(s);
+    assert_int_equal(sl_diag_warning_count(d), 0);
+    assert_int_equal(s->nobjects, 6);
+    for (int i = 0; i < 6; i++) {
+        const geom_surface *g = &s->objects[i].surface;
+        assert_int_equal(g->kind, GEOM_POLYGON);
+        assert_int_equal(g->nverts, 4);
+        /* every corner is a cube corner, and the face is one side */
+        for (int k = 0; k < 4; k++)
+            assert_true(fabs(fabs(g->verts[k].x) - 1) + fabs(fabs(g->verts[k].y) - 1) +
+                        fabs(fabs(g->verts[k].z) - 1) == 0);
+        /* the corners keep the order written: every face of CUBE winds
+         * outward by the right-hand rule */
+        vec3 n = v3_cross(v3_sub(g->verts[1], g->verts[0]), v3_sub(g->verts[2], g->verts[0]));
+        vec3 c = v3_scale(v3_add(g->verts[0], g->verts[2]), 0.5);
+        assert_true(v3_dot(n, c) > 0);
+    }
+    assert_true(fabs(polygon_area(s, 0, 6) - 24) < 1e-12);
+    scene_destroy(&s);
+    sl_diag_destroy(&d);
+}
+
+static void test_cut_faces(void **state)
+{
+    (void)state;
+    sl_diag *d;
+    scene *s = parse_rib(WORLD(
+        /* a non-planar quad: two triangles */
+        "PointsPolygons [4] [0 1 2 3] \"P\" [0 0 0  1 0 0  1 1 0.5  0 1 0]\n"
+        /* an L (area 3) and a 4x4 square with a 2x2 hole (area 12) */
+        "PointsGeneralPolygons [1 2] [6 4 4] [0 1 2 3 4 5  6 7 8 9  10 11 12 13]\n"
+        "  \"P\" [0 0 0  2 0 0  2 1 0  1 1 0  1 2 0  0 2 0\n"
+        "        0 0 1  4 0 1  4 4 1  0 4 1  1 1 1  3 1 1  3 3 1  1 3 1]\n"
+        "GeneralPolygon [4 3] \"P\" [0 0 2  4 0 2  4 4 2  0 4 2  1 1 2  2 1 2  1 2 2]\n"), &d);
+    if (!s)
+        sl_diag_print(d, stderr);
+    assert_non_null(s);
+    assert_int_equal(s->nobjects, 2 + 4 + 8 + 7);
+    for (int i = 0; i < s->nobjects; i++)
+        assert_int_equal(s->objects[i].surface.nverts, 3);
+    assert_true(fabs(polygon_area(s, 2, 6) - 3) < 1e-12);
+    assert_true(fabs(polygon_area(s, 6, 14) - 12) < 1e-12);
+    assert_true(fabs(polygon_area(s, 14, 21) - 15.5) < 1e-12);
+    scene_destroy(&s);
+    sl_diag_destroy(&d);
+}
+
+static void test_variables_degenerate_instances(void **state)
+{
+    (void)state;
+    sl_diag *d;
+    scene *s = parse_rib(WORLD(
+        "ObjectBegin 1\n"
+        "PointsPolygons [3 3] [0 1 2  0 1 3] \"P\" [0 0 0  1 0 0  0 1 0  2 0 0]\n"
+        "  \"N\" [0 0 1  0 0 1  0 0 1  0 0 1] \"facevarying float[2] st\" [0 0 1 0 0 1 0 0 1 1 0 0]\n"
+        "ObjectEnd\n"
+        "ObjectInstance 1\nTranslate 0 0 5\nObjectInstance 1\n"
+        "PointsPolygons [3] [0 1 2] \"P\" [0 0 0 1 0 0 0 1 0] \"Cs\" [1 0 0 1 0 0 1 0 0]\n"), &d);
+    if (!s)
+        sl_diag_print(d, stderr);
+    assert_non_null(s);
+    assert_int_equal(s->nobjects, 3);
+    assert_int_equal(sl_diag_warning_count(d), 2);
+    assert_string_equal(diag_line(nth_diag(d, SL_DIAG_WARNING, 0)),
+                        "t.rib:5:1: PointsPolygons: only \"P\" is used on meshes: \"N\", "
+                        "\"st\" ignored (and on the meshes that follow)");
+    assert_string_equal(diag_line(nth_diag(d, SL_DIAG_WARNING, 1)),
+                        "t.rib:5:1: PointsPolygons: 1 face without area skipped");
+    vec3 o = mat4_xform_point(&s->objects[1].object_to_world, v3(0, 0, 0));
+    assert_true(vec_dist(o, v3(0, 0, 5)) < 1e-12);
+    scene_destroy(&s);
+    sl_diag_destroy(&d);
+}
+
+typedef struct error_case {
+    const char *text;
+    const char *first_error;
+} error_case;
+
+static const error_case cases[] = {
+    { WORLD("PointsPolygons [3 2] [0 1 2 0 1] \"P\" [0 0 0 1 0 0 0 1 0]\n"),
+      "t.rib:4:16: PointsPolygons: the vertex counts (nvertices): entry 1 is 2, expected a "
+      "whole number >= 3" },
+    { WORLD("PointsPolygons [3] [0 1 2 0] \"P\" [0 0 0 1 0 0 0 1 0]\n"),
+      "t.rib:4:20: PointsPolygons: the loops have 3 points in all, but 4 vertex indices are "
+      "given" },
+    { WORLD("PointsPolygons [3] [0 1 3] \"P\" [0 0 0 1 0 0 0 1 0]\n"),
+      "t.rib:4:28: PointsPolygons: \"P\" has 3 points, but the vertex indices go up to 3" },
+    { WORLD("PointsPolygons [3] [0 1 -2] \"P\" [0 0 0 1 0 0 0 1 0]\n"),
+      "t.rib:4:20: PointsPolygons: the vertex indices: entry 2 is -2, expected a whole "
+      "number >= 0" },
+    { WORLD("PointsPolygons [3] [0 1 2]\n"),
+      "t.rib:4:1: PointsPolygons: missing the points: add \"P\" [x y z x y z ...]" },
+    { WORLD("PointsPolygons [3] [0 1 2] \"P\" [0 0 0 1 0 0 0 1]\n"),
+      "t.rib:4:32: PointsPolygons: parameter \"P\" is a point and needs a multiple of 3 "
+      "numbers, got 8" },
+    { WORLD("PointsGeneralPolygons [2] [3] [0 1 2] \"P\" [0 0 0 1 0 0 0 1 0]\n"),
+      "t.rib:4:27: PointsGeneralPolygons: the faces have 2 loops in all, but 1 vertex counts "
+      "are given" },
+    /* a bow tie with its loops crossing: cannot be cut */
+    { WORLD("PointsGeneralPolygons [2] [4 3] [0 1 2 3 4 5 6] \"P\" [0 0 0  4 0 0  4 4 0  0 4 0"
+            "  -1 1 0  5 1 0  2 3 0]\n"),
+      "t.rib:4:33: PointsGeneralPolygons: face 0: the polygon cannot be cut into triangles "
+      "(do its edges cross?)" },
+    /* a hole outside its face */
+    { WORLD("GeneralPolygon [3 3] \"P\" [0 0 0  1 0 0  0 1 0   5 5 0  6 5 0  5 6 0]\n"),
+      "t.rib:4:16: GeneralPolygon: face 0: hole 1 cannot be joined to the boundary (does it "
+      "lie outside, or do loops cross?)" },
+};
+
+static void test_errors(void **state)
+{
+    (void)state;
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+        sl_diag *d;
+        scene *s = parse_rib(cases[i].text, &d);
+        const char *got = diag_line(nth_diag(d, SL_DIAG_ERROR, 0));
+        if (s || strcmp(got, cases[i].first_error) != 0) {
+            fprintf(stderr, "case %zu:\n%s\n", i, cases[i].text);
+            sl_diag_print(d, stderr);
+        }
+        assert_null(s);
+        assert_string_equal(got, cases[i].first_error);
+        sl_diag_destroy(&d);
+    }
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_cube),
+        cmocka_unit_test(test_cut_faces),
+        cmocka_unit_test(test_variables_degenerate_instances),
+        cmocka_unit_test(test_errors),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
