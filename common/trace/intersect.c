@@ -339,11 +339,12 @@ static bool over_limit(walk *w, const double r[4])
     if (th->failed) return true;           /* failed or cancelled: the tile ends */
     th->stats.limited_rays++;
     trace_object_work *ow = &th->work[w->obj->id];
-    if (!ow->probed) {                     /* converge.h: fail fast where hopeless */
+    if (!ow->probed || ow->diverges) {     /* converge.h: fail fast where hopeless */
         ow->probed = true;
         char why[400];
-        if (!trace_surface_converges(th, w->obj, why, sizeof why))
-            trace_thread_fail(th, why);
+        ow->diverges = !trace_surface_converges(th, w->obj, why, sizeof why);
+        if (ow->diverges)
+            trace_thread_fail(th, why);    /* again on every tile this thread retries */
     }
     if (ow->limited_rays++ == 0) {
         ow->u0 = r[0]; ow->u1 = r[1]; ow->v0 = r[2]; ow->v1 = r[3];

@@ -22,7 +22,8 @@
 /* Per object: the rays whose walk hit the work limit (intersect.c) and the
  * (u,v) region where those walks stopped, for one warning per object. */
 typedef struct trace_object_work {
-    bool probed;                   /* trace_surface_converges was asked */
+    bool probed;                   /* trace_surface_converges was asked ... */
+    bool diverges;                 /* ... and said no */
     long limited_rays;
     double u0, u1, v0, v1;         /* union of the stopped nodes' ranges */
 } trace_object_work;

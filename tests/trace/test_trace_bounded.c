@@ -123,6 +123,31 @@ static void test_extreme_frequency_fails_fast(void **state)
     check_fails_fast("hugefreq", HUGEFREQ_SL, "does not converge");
 }
 
+/* A farm worker retries a failed tile on the same thread (its box cache
+ * warm): the retry must fail as fast, not run every ray to the limit. */
+static void test_retry_on_the_same_thread_fails_fast(void **state)
+{
+    (void)state;
+    char rib[512];
+    snprintf(rib, sizeof rib, SPHERE_RIB("%s"), "hugefreq");
+    fixture f;
+    fixture_shader sh[] = {{"hugefreq", HUGEFREQ_SL}};
+    assert_true(fixture_open(&f, rib, sh, 1, NULL, 0));
+    f.js->world.options.max_nodes_per_ray = 300;
+    trace_thread *th = trace_thread_new(&f.js->world);
+    float rgba[12 * 8 * 4], z[12 * 8];
+    for (int attempt = 0; attempt < 3; attempt++) {
+        long before = th->stats.limited_rays;
+        assert_false(trace_render_tile(f.js->renderer, th, 0, 0, 12, 8, rgba, z));
+        assert_non_null(strstr(th->error, "does not converge"));
+        assert_int_equal(th->stats.limited_rays - before, 1);
+        th->failed = false;               /* as worker_render_tile does */
+        th->error[0] = '\0';
+    }
+    trace_thread_destroy(&th);
+    fixture_close(&f);
+}
+
 /* A surface that converges but needs more nodes than the limit allows:
  * the rays that reach it are counted on the object and keep what they
  * found; the render goes on. The counts are a pure function of the rays:
@@ -171,6 +196,7 @@ int main(void)
         cmocka_unit_test(test_nan_shader_fails_fast),
         cmocka_unit_test(test_sqrt_of_negative_fails_fast),
         cmocka_unit_test(test_extreme_frequency_fails_fast),
+        cmocka_unit_test(test_retry_on_the_same_thread_fails_fast),
         cmocka_unit_test(test_limited_rays_are_counted),
         cmocka_unit_test(test_cancel_stops_a_tile),
     };
