@@ -188,9 +188,22 @@ static bool add_face(rib_parser *p, mesh *m, int face, const int *loop_sizes, in
             s.verts[i] = point(m, idx[i]);
 #ifdef SCENE_HAVE_GEOM
         char why[256];
-        if (geom_surface_prepare(&s, why, sizeof why) &&
-            (m->ncls == MESH_N_NONE || corners_flat(m, &s, face, idx, total))) {
-            rib_add_surface(p, m->req, &s);
+        if (geom_surface_prepare(&s, why, sizeof why)) {
+            if (m->ncls == MESH_N_NONE || corners_flat(m, &s, face, idx, total)) {
+                rib_add_surface(p, m->req, &s);
+                return true;
+            }
+            /* convex and planar: a fan of triangles with corner normals */
+            int added = 0;
+            for (int i = 1; i + 1 < total; i++) {
+                int c[3] = {0, i, i + 1};
+                vec3 cn[3];
+                for (int k = 0; k < 3; k++)
+                    cn[k] = corner_normal(m, face, idx, c[k]);
+                added += add_triangle(p, m, s.verts[0], s.verts[i], s.verts[i + 1], cn);
+            }
+            if (added == 0)
+                m->skipped++;
             return true;
         }
 #else
