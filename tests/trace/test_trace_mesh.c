@@ -13,7 +13,7 @@
  * normals N is continuous across the faces' edges and no pixel inside the
  * (eroded) outline of the undisplaced dome has alpha < 1; the same dome
  * given one flat normal per face ("uniform" N) opens cracks there, which
- * shows the check sees them.
+ * shows the check sees them. Affine and interval arithmetic both.
  */
 #include <math.h>
 #include <setjmp.h>
@@ -177,12 +177,15 @@ static char *dome_rib(double km, bool flat)
 }
 
 /* The alpha channel of the dome rendered at RES x RES (caller frees). */
-static float *dome_alpha(double km, bool flat)
+static float *dome_alpha(double km, bool flat, int arith)
 {
     char *rib = dome_rib(km, flat);
+    job_options opt;
+    job_options_default(&opt);
+    opt.arith = arith;
     fixture f;
     fixture_shader sh[] = {{"lumpy", LUMPY_SL}};
-    assert_true(fixture_open(&f, rib, sh, 1, NULL, 0));
+    assert_true(fixture_open(&f, rib, sh, 1, &opt, 0));
     free(rib);
     trace_thread *th = trace_thread_new(&f.js->world);
     float *rgba = calloc((size_t)RES * RES * 4, sizeof *rgba), *z = calloc((size_t)RES * RES, sizeof *z);
@@ -219,20 +222,24 @@ static int dome_gaps(const float *base, const float *alpha, int *inside)
 static void test_displaced_curved_mesh_is_watertight(void **state)
 {
     (void)state;
-    float *base = dome_alpha(0, false);
-    float *smooth = dome_alpha(0.3, false);
-    float *flat = dome_alpha(0.3, true);
-    int inside, inside_flat;
-    int gaps = dome_gaps(base, smooth, &inside);
-    int gaps_flat = dome_gaps(base, flat, &inside_flat);
-    printf("dome of %d quads, Km 0.3: vertex normals %d, flat normals %d of %d inside "
-           "pixels with alpha < 1\n", DOME_N * DOME_N, gaps, gaps_flat, inside);
-    assert_true(inside > 500);
-    assert_int_equal(gaps, 0);
-    assert_true(gaps_flat > 0);
-    free(base);
-    free(smooth);
-    free(flat);
+    for (int a = 0; a < 2; a++) {
+        int arith = a == 0 ? TRACE_ARITH_AFFINE : TRACE_ARITH_INTERVAL;
+        float *base = dome_alpha(0, false, arith);
+        float *smooth = dome_alpha(0.3, false, arith);
+        float *flat = dome_alpha(0.3, true, arith);
+        int inside, inside_flat;
+        int gaps = dome_gaps(base, smooth, &inside);
+        int gaps_flat = dome_gaps(base, flat, &inside_flat);
+        printf("dome of %d quads, Km 0.3, %s: vertex normals %d, flat normals %d of %d "
+               "inside pixels with alpha < 1\n", DOME_N * DOME_N, trace_arith_name(arith),
+               gaps, gaps_flat, inside);
+        assert_true(inside > 500);
+        assert_int_equal(gaps, 0);
+        assert_true(gaps_flat > 0);
+        free(base);
+        free(smooth);
+        free(flat);
+    }
 }
 
 int main(void)
