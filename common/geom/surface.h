@@ -61,6 +61,10 @@ typedef struct geom_surface {
      * bicubic: Bezier control points P_ij at verts[4 j + i] */
     int nverts;
     vec3 verts[GEOM_MAX_POLY_VERTS];
+    /* triangle polygons only: corner normals vn[i] at verts[i] (nvn = 3), or
+     * none (nvn = 0, the shading normal is Ng); see geom_vertex_normal */
+    int nvn;
+    vec3 vn[3];
     /* derived by geom_surface_prepare (do not set by hand) */
     double phi0, phi1;                     /* sphere: phi range of zmin/zmax */
     vec3 origin, axis_u, axis_v, normal;   /* polygon: P = origin + u*axis_u + v*axis_v */
@@ -111,6 +115,19 @@ void geom_unit_normal_aa(aa_context *ctx, const geom_surface *s, const aa_form *
                          const aa_form *v, const geom_aa *g, aa_form Nn[3]);
 void geom_unit_normal_ia(const geom_surface *s, ia_interval u, ia_interval v,
                          const geom_ia *g, ia_interval Nn[3]);
+
+/* Vertex normals (meshes, surface_vertex_normal.c). A triangle polygon
+ * with nvn = 3 has the shading normal N(u,v) = the linear interpolation of
+ * its corner normals vn[] (barycentric in the triangle, extended linearly
+ * over the (u,v) rectangle): N = C + A u + B v. Along an edge it depends
+ * only on that edge's two corners, so faces that share the edge and its
+ * corner normals agree there (displacement along N stays continuous).
+ * geom_vertex_normal gives N and its (u,v)-derivatives A, B (not
+ * normalised) and returns true, or returns false for surfaces without
+ * vertex normals. geom_unit_normal_aa/_ia give N/|N| for such surfaces. */
+bool geom_has_vertex_normals(const geom_surface *s);
+bool geom_vertex_normal(const geom_surface *s, double u, double v, vec3 *N, vec3 *dNdu,
+                        vec3 *dNdv);
 
 /* Polygons only cover part of their (u,v) rectangle. For the other kinds
  * these say "inside" everywhere. */

@@ -15,6 +15,8 @@
  *   paraboloid      K_DZ, K_PK, K_PC  zmax - zmin, rmax^2/zmax, K_DZ*K_PK/2
  *   hyperboloid     K_D + 0..2        point2 - point1
  *   polygon         K_NG + 0..2       axis_u x axis_v
+ *                   K_VNC, K_VNU,     with vertex normals: the interpolated
+ *                   K_VNV + 0..2      normal is C + u A + v B (points)
  *   patch           K_B, K_C, K_A     P10-P00, P01-P00, P11-P10-P01+P00
  *                   K_N0, K_N1, K_N2  b x c, b x a, a x c: Ng = n0 + u n1 + v n2
  */
@@ -27,7 +29,7 @@ enum {
     K_DPHI = 0,
     K_DZ = 0, K_PK = 1, K_PC = 2,
     K_D = 0,
-    K_NG = 0,
+    K_NG = 0, K_VNC = 3, K_VNU = 6, K_VNV = 9,
     K_B = 0, K_C = 3, K_A = 6, K_N0 = 9, K_N1 = 12, K_N2 = 15,
 };
 
@@ -56,6 +58,9 @@ bool geom_sweep_param(double angle, double sweep, double tol, double *t);
 
 /* The polygon part of geom_surface_prepare (surface_polygon.c). */
 bool geom_polygon_prepare(geom_surface *s, char *why, int why_size);
+
+/* The vertex-normal part of polygon prepare (surface_vertex_normal.c). */
+bool geom_vertex_normal_prepare(geom_surface *s, char *why, int why_size);
 
 /* The bicubic Bezier patch (surface_bicubic.c). */
 bool geom_bicubic_prepare(geom_surface *s, char *why, int why_size);

@@ -14,7 +14,8 @@
  *   disk       (0, 0, 1)
  *   cylinder   (P.x, P.y, 0) / r
  *   cone       (h cos t, h sin t, r) / sqrt(h^2 + r^2)
- *   polygon    the constant Ng / |Ng|
+ *   polygon    the constant Ng / |Ng|; with vertex normals the interpolated
+ *              N = C + u A + v B (surface_vertex_normal.c), normalised
  *
  * each times the sign that makes it point along Ng. Paraboloids,
  * hyperboloids and patches normalise Ng. Constant factors are applied as
@@ -137,6 +138,14 @@ void geom_unit_normal_aa(aa_context *ctx, const geom_surface *s, const aa_form *
         return;
     }
     case GEOM_POLYGON: {
+        if (geom_has_vertex_normals(s)) {
+            aa_form Nv[3];
+            for (int i = 0; i < 3; i++)
+                aa_lincomb(ctx, &Nv[i], s->consts[K_VNU + i].lo, u, s->consts[K_VNV + i].lo,
+                           v, s->consts[K_VNC + i].lo);
+            normalize_aa(ctx, Nv, Nn);
+            return;
+        }
         ia_interval n[3];
         geom_ia gi;
         for (int i = 0; i < 3; i++) gi.Ng[i] = aa_range(&g->Ng[i]);
@@ -202,6 +211,17 @@ void geom_unit_normal_ia(const geom_surface *s, ia_interval u, ia_interval v,
         Nn[2] = ia_mul_s(k, s->radius);
         return;
     }
+    case GEOM_POLYGON:
+        if (geom_has_vertex_normals(s)) {
+            ia_interval Nv[3];
+            for (int i = 0; i < 3; i++)
+                Nv[i] = ia_add(ia_add(ia_mul(u, s->consts[K_VNU + i]),
+                                      ia_mul(v, s->consts[K_VNV + i])), s->consts[K_VNC + i]);
+            normalize_ia(Nv, Nn);
+            return;
+        }
+        normalize_ia(g->Ng, Nn);
+        return;
     default:
         normalize_ia(g->Ng, Nn);
         return;

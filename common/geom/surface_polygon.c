@@ -225,7 +225,7 @@ bool geom_polygon_prepare(geom_surface *s, char *why, int why_size)
     if (!check_planar(&w, nrm, c, why, why_size))
         return false;
     plane_basis(s, &w, nrm, c);
-    return check_convex(s, &w, why, why_size);
+    return check_convex(s, &w, why, why_size) && geom_vertex_normal_prepare(s, why, why_size);
 }
 
 /* ---------------------------------------------------------------------- */

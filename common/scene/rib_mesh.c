@@ -9,9 +9,19 @@
  * geometry.md); a concave, holed or non-planar face, or one with more than
  * GEOM_MAX_POLY_VERTS points, is cut into triangles (geom/triangulate.h),
  * each a GEOM_POLYGON. Faces without area are skipped, with one warning
- * per request. Only "P" is used: other primitive variables ("N", "st",
- * "Cs", ...) are read and checked like any parameter, then ignored with
- * one warning per scene.
+ * per request.
+ *
+ * Normals (crack-free displacement, issue 14): PointsPolygons and
+ * PointsGeneralPolygons give every face corner a normal: the "N" primitive
+ * variable where present (vertex/varying, facevarying, uniform or constant,
+ * told apart by its count: one per point, per face corner, per face, or
+ * one), else the area-weighted average of the (Newell) normals of the faces
+ * around the point. A face whose corner normals all equal its own normal
+ * stays one flat polygon; any other is cut into triangles that carry their
+ * corner normals (geom_vertex_normal), so N is continuous across shared
+ * edges and a shader displacing along N opens no crack. GeneralPolygon uses
+ * a given "N" only. Other primitive variables ("st", "Cs", ...) are read
+ * and checked like any parameter, then ignored with one warning per scene.
  */
 #include "scene/rib_parser.h"
 #include "sl/strbuf.h"
@@ -65,6 +75,11 @@ static long sum(const int *v, int n)
     return s;
 }
 
+/* How a mesh's "N" is given (or computed: MESH_N_VERTEX). */
+typedef enum mesh_nclass {
+    MESH_N_NONE, MESH_N_VERTEX, MESH_N_FACEVARYING, MESH_N_UNIFORM, MESH_N_CONSTANT
+} mesh_nclass;
+
 /* A mesh being cut into surfaces. */
 typedef struct mesh {
     const rib_request *req;
@@ -72,6 +87,9 @@ typedef struct mesh {
     int npoints;
     int skipped;                   /* faces without area */
     sl_pos vertices_pos;
+    mesh_nclass ncls;              /* corner normals: none, or N as the class says */
+    const double *N;
+    int fv0;                       /* the current face's first face-vertex */
 } mesh;
 
 static void warn_ignored(rib_parser *p, const rib_request *req, const rib_params *params)
@@ -80,7 +98,7 @@ static void warn_ignored(rib_parser *p, const rib_request *req, const rib_params
         return;
     char names[512] = "";
     for (int i = 0; i < params->count; i++) {
-        if (strcmp(params->items[i].name, "P") == 0)
+        if (strcmp(params->items[i].name, "P") == 0 || strcmp(params->items[i].name, "N") == 0)
             continue;
         size_t used = strlen(names);
         snprintf(names + used, sizeof names - used, "%s\"%s\"", used ? ", " : "",
@@ -88,8 +106,8 @@ static void warn_ignored(rib_parser *p, const rib_request *req, const rib_params
     }
     if (!names[0])
         return;
-    rib_warning(p, req, req->pos, "only \"P\" is used on meshes: %s ignored (and on the "
-                "meshes that follow)", names);
+    rib_warning(p, req, req->pos, "only \"P\" and \"N\" are used on meshes: %s ignored "
+                "(and on the meshes that follow)", names);
     p->warned_mesh_vars = true;
 }
 
@@ -98,22 +116,63 @@ static vec3 point(const mesh *m, int i)
     return v3(m->P[3 * i], m->P[3 * i + 1], m->P[3 * i + 2]);
 }
 
-/* Adds triangle (a, b, c) of points pts; false when it has no area. */
-static bool add_triangle(rib_parser *p, const mesh *m, vec3 a, vec3 b, vec3 c)
+/* The normal of corner i of the current face (point idx[i]). */
+static vec3 corner_normal(const mesh *m, int face, const int *idx, int i)
+{
+    int k = 0;
+    switch (m->ncls) {
+    case MESH_N_VERTEX:      k = idx[i]; break;
+    case MESH_N_FACEVARYING: k = m->fv0 + i; break;
+    case MESH_N_UNIFORM:     k = face; break;
+    default:                 k = 0; break;
+    }
+    return v3(m->N[3 * k], m->N[3 * k + 1], m->N[3 * k + 2]);
+}
+
+/* Adds triangle (a, b, c) with corner normals n (NULL: none); false when
+ * it has no area. */
+static bool add_triangle(rib_parser *p, const mesh *m, vec3 a, vec3 b, vec3 c,
+                         const vec3 *n)
 {
     geom_surface s;
     memset(&s, 0, sizeof s);
     s.kind = GEOM_POLYGON;
     s.nverts = 3;
     s.verts[0] = a, s.verts[1] = b, s.verts[2] = c;
+    if (n) {
+        s.nvn = 3;
+        s.vn[0] = n[0], s.vn[1] = n[1], s.vn[2] = n[2];
+    }
 #ifdef SCENE_HAVE_GEOM
     char why[256];
-    if (!geom_surface_prepare(&s, why, sizeof why))
-        return false;
+    if (!geom_surface_prepare(&s, why, sizeof why)) {
+        if (!n)
+            return false;
+        s.nvn = 0;                  /* normals it cannot interpolate: flat */
+        if (!geom_surface_prepare(&s, why, sizeof why))
+            return false;
+    }
 #endif
     rib_add_surface(p, m->req, &s);
     return true;
 }
+
+#ifdef SCENE_HAVE_GEOM
+/* Whether every corner normal of the prepared face s is its own normal
+ * (then the flat polygon is crack-free too: its neighbours interpolate
+ * that same normal along the shared edges). */
+static bool corners_flat(const mesh *m, const geom_surface *s, int face, const int *idx,
+                         int total)
+{
+    for (int i = 0; i < total; i++) {
+        vec3 n = corner_normal(m, face, idx, i);
+        double len = v3_length(n);
+        if (!(len > 0) || v3_length(v3_sub(v3_scale(n, 1 / len), s->normal)) > 1e-12)
+            return false;
+    }
+    return true;
+}
+#endif
 
 /* One face: loops[0..nloops) of point indices idx (outer loop first). */
 static bool add_face(rib_parser *p, mesh *m, int face, const int *loop_sizes, int nloops,
@@ -130,7 +189,21 @@ static bool add_face(rib_parser *p, mesh *m, int face, const int *loop_sizes, in
 #ifdef SCENE_HAVE_GEOM
         char why[256];
         if (geom_surface_prepare(&s, why, sizeof why)) {
-            rib_add_surface(p, m->req, &s);
+            if (m->ncls == MESH_N_NONE || corners_flat(m, &s, face, idx, total)) {
+                rib_add_surface(p, m->req, &s);
+                return true;
+            }
+            /* convex and planar: a fan of triangles with corner normals */
+            int added = 0;
+            for (int i = 1; i + 1 < total; i++) {
+                int c[3] = {0, i, i + 1};
+                vec3 cn[3];
+                for (int k = 0; k < 3; k++)
+                    cn[k] = corner_normal(m, face, idx, c[k]);
+                added += add_triangle(p, m, s.verts[0], s.verts[i], s.verts[i + 1], cn);
+            }
+            if (added == 0)
+                m->skipped++;
             return true;
         }
 #else
@@ -159,8 +232,14 @@ static bool add_face(rib_parser *p, mesh *m, int face, const int *loop_sizes, in
         ok = false;
     } else {
         int added = 0;
-        for (int t = 0; t < n; t++)
-            added += add_triangle(p, m, pts[tris[t][0]], pts[tris[t][1]], pts[tris[t][2]]);
+        for (int t = 0; t < n; t++) {
+            vec3 cn[3];
+            for (int k = 0; k < 3; k++)
+                cn[k] = m->ncls != MESH_N_NONE ? corner_normal(m, face, idx, tris[t][k])
+                                               : v3(0, 0, 0);
+            added += add_triangle(p, m, pts[tris[t][0]], pts[tris[t][1]], pts[tris[t][2]],
+                                  m->ncls != MESH_N_NONE ? cn : NULL);
+        }
         if (added == 0)
             m->skipped++;
     }
@@ -172,6 +251,54 @@ static bool add_face(rib_parser *p, mesh *m, int face, const int *loop_sizes, in
     m->skipped++;
     return true;
 #endif
+}
+
+/* Area-weighted vertex normals: every face adds its Newell normal (twice
+ * its vector area, outer loop) to each of its points. npoints * 3 doubles,
+ * the caller frees. */
+static double *smooth_normals(int npoints, const double *P, const int *nloops, int nfaces,
+                              const int *nverts, const int *idx)
+{
+    double *N = sl_xrealloc(NULL, (size_t)npoints * 3 * sizeof *N);
+    memset(N, 0, (size_t)npoints * 3 * sizeof *N);
+    const int *loop = nverts, *vi = idx;
+    for (int f = 0; f < nfaces; f++) {
+        int nl = nloops ? nloops[f] : 1;
+        int npts = (int)sum(loop, nl);
+        double nn[3] = {0, 0, 0};
+        for (int i = 0; i < loop[0]; i++) {
+            const double *a = P + 3 * vi[i], *b = P + 3 * vi[(i + 1) % loop[0]];
+            nn[0] += (a[1] - b[1]) * (a[2] + b[2]);
+            nn[1] += (a[2] - b[2]) * (a[0] + b[0]);
+            nn[2] += (a[0] - b[0]) * (a[1] + b[1]);
+        }
+        for (int i = 0; i < npts; i++)
+            for (int k = 0; k < 3; k++)
+                N[3 * vi[i] + k] += nn[k];
+        loop += nl;
+        vi += npts;
+    }
+    return N;
+}
+
+/* The class of a given "N" from its count; MESH_N_NONE with an error when
+ * the count fits none. */
+static mesh_nclass normal_class(rib_parser *p, const rib_request *req, const scene_param *N,
+                                int npoints, int nfv, int nfaces)
+{
+    if (N->type != SL_TYPE_NORMAL && N->type != SL_TYPE_VECTOR) {
+        rib_error(p, req, N->pos, "\"N\" must be declared as a normal, not a %s",
+                  rib_type_name(N->type));
+        return MESH_N_NONE;
+    }
+    int n = N->count / 3;
+    if (n == npoints) return MESH_N_VERTEX;
+    if (n == nfv) return MESH_N_FACEVARYING;
+    if (n == nfaces) return MESH_N_UNIFORM;
+    if (n == 1) return MESH_N_CONSTANT;
+    rib_error(p, req, N->pos, "\"N\" has %d normals; give one per point (%d), per face "
+              "corner (%d), per face (%d) or one", n, npoints, nfv, nfaces);
+    return MESH_N_NONE;
 }
 
 /* The shared part of both requests: nloops per face (NULL: one loop per
@@ -210,15 +337,28 @@ static void read_mesh(rib_parser *p, const rib_request *req, const int *nloops, 
         goto out;
     }
     warn_ignored(p, req, &params);
-    mesh m = { req, P->values, P->count / 3, 0, req->args[first_vertices].pos };
+    mesh m = { req, P->values, P->count / 3, 0, req->args[first_vertices].pos,
+               MESH_N_VERTEX, NULL, 0 };
+    double *smooth = NULL;
+    const scene_param *N = rib_params_find(&params, "N");
+    if (N) {
+        m.ncls = normal_class(p, req, N, m.npoints, nidx, nfaces);
+        if (m.ncls == MESH_N_NONE)
+            goto out;
+        m.N = N->values;
+    } else {
+        m.N = smooth = smooth_normals(m.npoints, P->values, nloops, nfaces, nverts, idx);
+    }
     const int *loop = nverts, *vi = idx;
     for (int f = 0; f < nfaces && !sl_diag_full(p->diag); f++) {
         int nl = nloops ? nloops[f] : 1;
         int npts = (int)sum(loop, nl);
+        m.fv0 = (int)(vi - idx);
         add_face(p, &m, f, loop, nl, vi);
         loop += nl;
         vi += npts;
     }
+    free(smooth);
     if (m.skipped > 0)
         rib_warning(p, req, req->pos, "%d face%s without area skipped", m.skipped,
                     m.skipped == 1 ? "" : "s");
@@ -262,7 +402,12 @@ void rib_general_polygon(rib_parser *p, const rib_request *req)
             int *idx = sl_xrealloc(NULL, (size_t)n * sizeof *idx);
             for (int i = 0; i < n; i++)
                 idx[i] = i;
-            mesh m = { req, P->values, (int)n, 0, req->args[0].pos };
+            mesh m = { req, P->values, (int)n, 0, req->args[0].pos, MESH_N_NONE, NULL, 0 };
+            const scene_param *N = rib_params_find(&params, "N");
+            if (N) {
+                m.ncls = normal_class(p, req, N, (int)n, (int)n, 1);
+                m.N = N->values;
+            }
             add_face(p, &m, 0, nverts, nloops, idx);
             if (m.skipped)
                 rib_warning(p, req, req->pos, "the polygon has no area: skipped");

@@ -109,6 +109,13 @@ static void box_from_affine(const aa_form P[3], trace_box *out)
     out->flags = box_flags(out, flags);
 }
 
+/* N is constant over the object (its d/du, d/dv are 0): polygons, unless
+ * they carry interpolated vertex normals (geom_vertex_normal) */
+static bool flat_normal(const trace_object *obj)
+{
+    return obj->surf.kind == GEOM_POLYGON && !geom_has_vertex_normals(&obj->surf);
+}
+
 static void box_affine(trace_thread *th, const trace_object *obj,
                        double u0, double u1, double v0, double v1, trace_box *out)
 {
@@ -139,7 +146,7 @@ static void box_affine(trace_thread *th, const trace_object *obj,
         Pd[1][i] = aa_range(&dPdv[i]);
     }
     bind_globals_affine(vm, obj, &obj->displacement_spaces, P, N, N, dPdu, dPdv, &u, &v,
-                        Pd, obj->surf.kind == GEOM_POLYGON);
+                        Pd, flat_normal(obj));
     if (sl_vm_run(vm, obj->displacement, SL_MODE_AFFINE, ctx) != SL_OK) {
         trace_thread_fail(th, sl_vm_error(vm));
         aa_unbounded(&P[0], AA_UNBOUNDED);
@@ -211,7 +218,7 @@ static void box_interval(trace_thread *th, const trace_object *obj,
     sl_vm *vm = th->vm;
     ia_interval Pd[2][3] = {{dPdu[0], dPdu[1], dPdu[2]}, {dPdv[0], dPdv[1], dPdv[2]}};
     bind_globals_interval(vm, obj, &obj->displacement_spaces, P, N, N, dPdu, dPdv, &u, &v,
-                          Pd, obj->surf.kind == GEOM_POLYGON);
+                          Pd, flat_normal(obj));
     if (sl_vm_run(vm, obj->displacement, SL_MODE_INTERVAL, NULL) != SL_OK) {
         trace_thread_fail(th, sl_vm_error(vm));
         P[0] = P[1] = P[2] = ia_entire();
@@ -263,6 +270,12 @@ void trace_surface_point_eval(trace_thread *th, const trace_object *obj,
     vec3 dPdv = mat4_xform_vector(&obj->to_camera, g.dPdv);
     vec3 Ng = mat4_xform_normal(&obj->from_camera, g.Ng);
     if (obj->flip) Ng = v3_neg(Ng);
+    /* the shading normal: Ng, or a mesh face's interpolated vertex normals
+     * (oriented like Ng, flipped with it) */
+    vec3 Ns = g.Ng, dNsdu = g.dNgdu, dNsdv = g.dNgdv;
+    bool smooth = geom_vertex_normal(&obj->surf, u, v, &Ns, &dNsdu, &dNsdv);
+    Ns = mat4_xform_normal(&obj->from_camera, Ns);
+    if (obj->flip) Ns = v3_neg(Ns);
     out->u = u;
     out->v = v;
     out->dPdu = dPdu;
@@ -271,16 +284,16 @@ void trace_surface_point_eval(trace_thread *th, const trace_object *obj,
     out->P = P;
     out->Pu = dPdu;
     out->Pv = dPdv;
-    out->N = out->Ng;
+    out->N = smooth ? v3_normalize(Ns) : out->Ng;
     if (!obj->displacement) return;
 
     /* N is the unit normal in every mode (see docs/renderer.md): here
-     * Nn = Ng/|Ng| with d(Nn) = (dNg - Nn (Nn . dNg)) / |Ng| */
-    vec3 dNdu = mat4_xform_normal(&obj->from_camera, g.dNgdu);
-    vec3 dNdv = mat4_xform_normal(&obj->from_camera, g.dNgdv);
+     * Nn = Ns/|Ns| with d(Nn) = (dNs - Nn (Nn . dNs)) / |Ns| */
+    vec3 dNdu = mat4_xform_normal(&obj->from_camera, dNsdu);
+    vec3 dNdv = mat4_xform_normal(&obj->from_camera, dNsdv);
     if (obj->flip) { dNdu = v3_neg(dNdu); dNdv = v3_neg(dNdv); }
-    double glen = v3_length(Ng);
-    vec3 Nn = out->Ng;
+    double glen = v3_length(Ns);
+    vec3 Nn = out->N;
     if (glen > 0) {
         dNdu = v3_scale(v3_sub(dNdu, v3_scale(Nn, v3_dot(Nn, dNdu))), 1.0 / glen);
         dNdv = v3_scale(v3_sub(dNdv, v3_scale(Nn, v3_dot(Nn, dNdv))), 1.0 / glen);

@@ -1,7 +1,11 @@
 /*
  * tests/scene/test_scene_mesh.c: polygon meshes (common/scene/rib_mesh.c).
- * A cube of shared-point quads gives six convex polygons with the right
- * corners; a non-planar quad, a concave face and a face with a hole are
+ * A cube of shared-point quads gives twelve triangles with the right
+ * corners, each carrying area-weighted vertex normals (the corner's
+ * direction from the centre, shared by every face at that corner); a flat
+ * mesh stays one polygon per face; a given "N" of each class (vertex,
+ * facevarying, uniform) lands on the right corners, and a wrong count is
+ * an error; a non-planar quad, a concave face and a face with a hole are
  * cut into triangles whose areas add up to the face's; primitive
  * variables other than P give one warning per scene; faces without area
  * are skipped with a warning; meshes work inside object definitions; and
@@ -46,22 +50,27 @@ static void test_cube(void **state)
         sl_diag_print(d, stderr);
     assert_non_null(s);
     assert_int_equal(sl_diag_warning_count(d), 0);
-    assert_int_equal(s->nobjects, 6);
-    for (int i = 0; i < 6; i++) {
+    assert_int_equal(s->nobjects, 12);
+    for (int i = 0; i < 12; i++) {
         const geom_surface *g = &s->objects[i].surface;
         assert_int_equal(g->kind, GEOM_POLYGON);
-        assert_int_equal(g->nverts, 4);
-        /* every corner is a cube corner, and the face is one side */
-        for (int k = 0; k < 4; k++)
+        assert_int_equal(g->nverts, 3);
+        assert_int_equal(g->nvn, 3);
+        /* every corner is a cube corner, and the face is one side; its
+         * normal is the average of the three sides there: the corner's
+         * own direction */
+        for (int k = 0; k < 3; k++) {
             assert_true(fabs(fabs(g->verts[k].x) - 1) + fabs(fabs(g->verts[k].y) - 1) +
                         fabs(fabs(g->verts[k].z) - 1) == 0);
+            assert_true(vec_dist(v3_normalize(g->vn[k]), v3_normalize(g->verts[k])) < 1e-12);
+        }
         /* the corners keep the order written: every face of CUBE winds
          * outward by the right-hand rule */
         vec3 n = v3_cross(v3_sub(g->verts[1], g->verts[0]), v3_sub(g->verts[2], g->verts[0]));
-        vec3 c = v3_scale(v3_add(g->verts[0], g->verts[2]), 0.5);
+        vec3 c = v3_scale(v3_add(v3_add(g->verts[0], g->verts[1]), g->verts[2]), 1 / 3.0);
         assert_true(v3_dot(n, c) > 0);
     }
-    assert_true(fabs(polygon_area(s, 0, 6) - 24) < 1e-12);
+    assert_true(fabs(polygon_area(s, 0, 12) - 24) < 1e-12);
     scene_destroy(&s);
     sl_diag_destroy(&d);
 }
@@ -91,6 +100,73 @@ static void test_cut_faces(void **state)
     sl_diag_destroy(&d);
 }
 
+/* The corner normals of the triangle objects [from, to) that hold point
+ * p: all equal n (up to length). Returns how many corners were found. */
+static int corners_at(const scene *s, int from, int to, vec3 p, vec3 n)
+{
+    int found = 0;
+    for (int i = from; i < to; i++) {
+        const geom_surface *g = &s->objects[i].surface;
+        assert_int_equal(g->nvn, 3);
+        for (int k = 0; k < 3; k++)
+            if (vec_dist(g->verts[k], p) == 0) {
+                assert_true(vec_dist(v3_normalize(g->vn[k]), v3_normalize(n)) < 1e-12);
+                found++;
+            }
+    }
+    return found;
+}
+
+static void test_normals(void **state)
+{
+    (void)state;
+    sl_diag *d;
+    scene *s = parse_rib(WORLD(
+        /* flat: two quads in z = 0 stay two polygons */
+        "PointsPolygons [4 4] [0 1 4 3  1 2 5 4]\n"
+        "  \"P\" [0 0 0  1 0 0  2 0 0  0 1 0  1 1 0  2 1 0]\n"
+        /* a roof folded along x = 1: vertex normals given */
+        "PointsPolygons [4 4] [0 1 4 3  1 2 5 4]\n"
+        "  \"P\" [0 0 0  1 0 1  2 0 0  0 1 0  1 1 1  2 1 0]\n"
+        "  \"N\" [-1 0 1  0 0 1  1 0 1  -1 0 1  0 0 1  1 0 1]\n"
+        /* the same roof, facevarying: every corner its face's normal */
+        "PointsPolygons [4 4] [0 1 4 3  1 2 5 4]\n"
+        "  \"P\" [0 0 0  1 0 1  2 0 0  0 1 0  1 1 1  2 1 0]\n"
+        "  \"facevarying normal N\" [-1 0 1  -1 0 1  -1 0 1  -1 0 1  1 0 1  1 0 1  1 0 1  1 0 1]\n"
+        /* the same roof, computed: the ridge gets (0 0 1) */
+        "PointsPolygons [4 4] [0 1 4 3  1 2 5 4]\n"
+        "  \"P\" [0 0 0  1 0 1  2 0 0  0 1 0  1 1 1  2 1 0]\n"), &d);
+    if (!s)
+        sl_diag_print(d, stderr);
+    assert_non_null(s);
+    assert_int_equal(sl_diag_warning_count(d), 0);
+    assert_int_equal(s->nobjects, 2 + 4 + 2 + 4);
+    for (int i = 0; i < 2; i++) {
+        assert_int_equal(s->objects[i].surface.nverts, 4);
+        assert_int_equal(s->objects[i].surface.nvn, 0);
+    }
+    assert_int_equal(corners_at(s, 2, 6, v3(1, 0, 1), v3(0, 0, 1)), 3);
+    assert_true(corners_at(s, 2, 6, v3(0, 0, 0), v3(-1, 0, 1)) >= 1);
+    assert_true(corners_at(s, 2, 6, v3(2, 1, 0), v3(1, 0, 1)) >= 1);
+    /* facevarying: flat faces stay polygons without corner normals */
+    for (int i = 6; i < 8; i++) {
+        assert_int_equal(s->objects[i].surface.nverts, 4);
+        assert_int_equal(s->objects[i].surface.nvn, 0);
+    }
+    assert_int_equal(corners_at(s, 8, 12, v3(1, 1, 1), v3(0, 0, 1)), 3);
+    assert_true(corners_at(s, 8, 12, v3(0, 1, 0), v3(-1, 0, 1)) >= 1);
+    scene_destroy(&s);
+    sl_diag_destroy(&d);
+
+    s = parse_rib(WORLD("PointsPolygons [3] [0 1 2] \"P\" [0 0 0  1 0 0  0 1 0]\n"
+                        "  \"N\" [0 0 1  0 0 1]\n"), &d);
+    assert_null(s);
+    assert_string_equal(diag_line(nth_diag(d, SL_DIAG_ERROR, 0)),
+                        "t.rib:5:3: PointsPolygons: \"N\" has 2 normals; give one per point "
+                        "(3), per face corner (3), per face (1) or one");
+    sl_diag_destroy(&d);
+}
+
 static void test_variables_degenerate_instances(void **state)
 {
     (void)state;
@@ -108,8 +184,8 @@ static void test_variables_degenerate_instances(void **state)
     assert_int_equal(s->nobjects, 3);
     assert_int_equal(sl_diag_warning_count(d), 2);
     assert_string_equal(diag_line(nth_diag(d, SL_DIAG_WARNING, 0)),
-                        "t.rib:5:1: PointsPolygons: only \"P\" is used on meshes: \"N\", "
-                        "\"st\" ignored (and on the meshes that follow)");
+                        "t.rib:5:1: PointsPolygons: only \"P\" and \"N\" are used on "
+                        "meshes: \"st\" ignored (and on the meshes that follow)");
     assert_string_equal(diag_line(nth_diag(d, SL_DIAG_WARNING, 1)),
                         "t.rib:5:1: PointsPolygons: 1 face without area skipped");
     vec3 o = mat4_xform_point(&s->objects[1].object_to_world, v3(0, 0, 0));
@@ -175,6 +251,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_cube),
+        cmocka_unit_test(test_normals),
         cmocka_unit_test(test_cut_faces),
         cmocka_unit_test(test_variables_degenerate_instances),
         cmocka_unit_test(test_errors),

@@ -8,6 +8,8 @@
  * (trace_surface_box), must contain the points the renderer's hit path
  * (trace_surface_point_eval) gives inside them, in affine and interval
  * arithmetic; and du/dv are per-object constants, the same in every mode.
+ * Mesh triangles with vertex normals (issue 14: N interpolated from the
+ * corners, geom_vertex_normal) hold the same containment.
  */
 #include <math.h>
 #include <setjmp.h>
@@ -179,6 +181,20 @@ static void test_filterwidth_idioms(void **state)
                 "filtered", FILTERED_SL);
 }
 
+/* A mesh triangle whose corners carry different normals: the shader's N
+ * is their interpolation in every mode (box and point agree). */
+#define VN_TRIANGLE "PointsPolygons [3] [0 1 2] \"P\" [-1 -1 0  1 -1 0.3  0 1 -0.2]\n" \
+    "  \"N\" [0.3 0 1  0 0.3 1  -0.2 -0.2 1]"
+
+static void test_vertex_normals_on_a_mesh(void **state)
+{
+    (void)state;
+    containment("raw N, vertex normals", SCENE("rawn", "Rotate 30 1 1 0 Scale 1 0.5 2",
+                VN_TRIANGLE), "rawn", RAWN_SL);
+    containment("filterwidth, vertex normals", SCENE("filtered", "Rotate 20 0 1 1",
+                VN_TRIANGLE), "filtered", FILTERED_SL);
+}
+
 /* du and dv: what the shader sees equals the object's constants, in a box
  * (a point range) and at a point, and they follow the projected size. */
 static void test_du_dv_are_per_object_constants(void **state)
@@ -224,6 +240,7 @@ int main(void)
         cmocka_unit_test(test_raw_n_on_an_ellipsoid),
         cmocka_unit_test(test_du_in_a_filter_width),
         cmocka_unit_test(test_filterwidth_idioms),
+        cmocka_unit_test(test_vertex_normals_on_a_mesh),
         cmocka_unit_test(test_du_dv_are_per_object_constants),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
