@@ -1,5 +1,6 @@
 /*
- * shade.c: surface shading, lights and shadows (see shade.h).
+ * shade.c: surface shading, lights (built-in and light shaders) and
+ * shadows (see shade.h).
  */
 #include "trace/shade.h"
 
@@ -64,6 +65,23 @@ static int light_samples(void *user, const double P[3], sl_light_sample *out, in
             L = v3_sub(l->from, c->P);
             atten = 1.0 / v3_dot(L, L);
             break;
+        case TRACE_LIGHT_SHADER: {
+            /* RI Spec 3.2 §9.3: the light shader at Ps (its own VM: this
+             * callback runs inside the surface shader's run) */
+            double Ps[3] = {c->P.x, c->P.y, c->P.z};
+            sl_vm *lvm = c->th->light_vm;
+            sl_vm_set_spaces(lvm, &l->shader_spaces);
+            if (sl_light_eval(lvm, l->shader, Ps, s) != SL_OK) {
+                trace_thread_fail(c->th, sl_vm_error(lvm));
+                continue;
+            }
+            if (s->ambient) { n++; continue; }
+            L = v3(s->L[0], s->L[1], s->L[2]);
+            if (!(s->Cl[0] != 0 || s->Cl[1] != 0 || s->Cl[2] != 0)) continue;
+            if (l->shadows && occluded(c, L, l->directional ? INFINITY : 1.0 - 1e-9)) continue;
+            n++;
+            continue;
+        }
         case TRACE_LIGHT_SPOT: {
             L = v3_sub(l->from, c->P);
             double d2 = v3_dot(L, L);

@@ -26,6 +26,7 @@ trace_thread *trace_thread_new(const trace_world *world)
                         .max_loop_iterations = 64};
     self->vm = sl_vm_new(&limits);
     self->shade_vm = sl_vm_new(&limits);
+    self->light_vm = sl_vm_new(&limits);
     aa_context_init(&self->ctx, world->options.aa_capacity);
     self->cache = trace_boxcache_new(world->options.cache_bytes, world->nobjects);
     self->work = calloc(world->nobjects > 0 ? (size_t)world->nobjects : 1, sizeof *self->work);
@@ -39,6 +40,7 @@ void trace_thread_destroy(trace_thread **self_p)
     if (!self) return;
     sl_vm_destroy(&self->vm);
     sl_vm_destroy(&self->shade_vm);
+    sl_vm_destroy(&self->light_vm);
     trace_boxcache_destroy(&self->cache);
     free(self->work);
     free(self);
