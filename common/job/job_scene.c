@@ -44,7 +44,37 @@ static void build_camera(const scene *sc, trace_world *w)
     t->world_from_camera = c->world_from_camera;
 }
 
-static void build_lights(const scene *sc, trace_world *w)
+/* A light shader's spaces: "shader" and "object" are the light's space
+ * (RI Spec 3.2 §9.3: a light's coordinate system is the one current at
+ * its LightSource). */
+static void light_spaces(const scene *sc, const scene_light *l, sl_spaces *sp)
+{
+    mat4 id = mat4_identity(), from_light;
+    mat4_invert(&l->light_to_camera, &from_light);
+    for (int i = 0; i < SL_SPACE__COUNT; i++) sp->to_current[i] = sp->from_current[i] = id;
+    sp->to_current[SL_SPACE_WORLD] = sc->camera.camera_from_world;
+    sp->from_current[SL_SPACE_WORLD] = sc->camera.world_from_camera;
+    sp->to_current[SL_SPACE_OBJECT] = sp->to_current[SL_SPACE_SHADER] = l->light_to_camera;
+    sp->from_current[SL_SPACE_OBJECT] = sp->from_current[SL_SPACE_SHADER] = from_light;
+}
+
+/* Is the light shader's L the same at two unrelated points (solar: a
+ * direction, so shadow rays go to infinity)? */
+static bool light_directional(const trace_light *t)
+{
+    static const double pa[3] = {0.0, 0.0, 1.0}, pb[3] = {0.37, -0.21, 2.3};
+    sl_vm *vm = sl_vm_new(NULL);
+    sl_vm_set_spaces(vm, &t->shader_spaces);
+    sl_light_sample a, b;
+    bool same = sl_light_eval(vm, t->shader, pa, &a) == SL_OK &&
+                sl_light_eval(vm, t->shader, pb, &b) == SL_OK;
+    for (int k = 0; k < 3 && same; k++)
+        same = fabs(a.L[k] - b.L[k]) <= 1e-12 * (1.0 + fabs(a.L[k]));
+    sl_vm_destroy(&vm);
+    return same;
+}
+
+static void build_lights(const scene *sc, sl_instance *const *instances, trace_world *w)
 {
     w->nlights = sc->nlights;
     w->lights = calloc((size_t)(sc->nlights > 0 ? sc->nlights : 1), sizeof *w->lights);
@@ -52,6 +82,14 @@ static void build_lights(const scene *sc, trace_world *w)
     for (int i = 0; i < sc->nlights; i++) {
         const scene_light *l = &sc->lights[i];
         trace_light *t = &w->lights[i];
+        if (l->kind == SCENE_SHADER_LIGHT) {
+            t->kind = TRACE_LIGHT_SHADER;
+            t->shader = instances[l->shader];
+            light_spaces(sc, l, &t->shader_spaces);
+            t->directional = light_directional(t);
+            t->shadows = l->shadows;
+            continue;
+        }
         static const trace_light_kind kinds[] = {
             [SCENE_AMBIENT_LIGHT] = TRACE_LIGHT_AMBIENT, [SCENE_DISTANT_LIGHT] = TRACE_LIGHT_DISTANT,
             [SCENE_POINT_LIGHT] = TRACE_LIGHT_POINT, [SCENE_SPOT_LIGHT] = TRACE_LIGHT_SPOT};
@@ -99,6 +137,16 @@ static bool compile_programs(job_scene *self, sl_diag *diag)
     return ok;
 }
 
+static const char *kind_name(sl_shader_kind k)
+{
+    switch (k) {
+    case SL_SHADER_SURFACE: return "surface";
+    case SL_SHADER_DISPLACEMENT: return "displacement";
+    case SL_SHADER_LIGHT: return "light";
+    default: return "shader of another kind";
+    }
+}
+
 static sl_instance *make_instance(job_scene *self, const scene_shader *call, sl_diag *diag)
 {
     int p = program_index(self->job, call->name);
@@ -108,10 +156,12 @@ static sl_instance *make_instance(job_scene *self, const scene_shader *call, sl_
     }
     const sl_program *prog = self->programs[p];
     if (sl_program_kind(prog) != call->kind) {
-        sl_diag_error(diag, call->pos, "'%s' is a %s shader, used here as a %s shader",
-                      call->name,
-                      sl_program_kind(prog) == SL_SHADER_SURFACE ? "surface" : "displacement",
-                      call->kind == SL_SHADER_SURFACE ? "surface" : "displacement");
+        sl_diag_error(diag, call->pos, "'%s' is a %s shader, used here as a %s shader "
+                      "(give it to %s instead)",
+                      call->name, kind_name(sl_program_kind(prog)), kind_name(call->kind),
+                      sl_program_kind(prog) == SL_SHADER_SURFACE ? "Surface"
+                      : sl_program_kind(prog) == SL_SHADER_LIGHT ? "LightSource"
+                      : "Displacement");
         return NULL;
     }
     sl_instance *inst = sl_instance_new(prog);
@@ -182,7 +232,7 @@ job_scene *job_scene_new(const job *jb, size_t cache_bytes, bool render, sl_diag
         const scene *sc = self->scene;
         trace_world *w = &self->world;
         build_camera(sc, w);
-        build_lights(sc, w);
+        build_lights(sc, self->instances, w);
         w->samples_x = sc->pixel_samples[0];
         w->samples_y = sc->pixel_samples[1];
         w->shading_rate = sc->shading_rate;

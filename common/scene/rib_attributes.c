@@ -340,7 +340,9 @@ static bool plain_name(const char *s)
     return true;
 }
 
-static int shader_call(rib_parser *p, const rib_request *req, sl_shader_kind kind)
+/* A shader call: the name in argument 0, the parameters from argument
+ * `first` on. Returns the index into scene.shaders, -2 after an error. */
+static int shader_call_at(rib_parser *p, const rib_request *req, sl_shader_kind kind, int first)
 {
     const char *name = rib_read_string(p, req, 0, "the shader name");
     if (!name)
@@ -352,7 +354,7 @@ static int shader_call(rib_parser *p, const rib_request *req, sl_shader_kind kin
         return -2;
     }
     rib_params params;
-    if (!rib_params_read(p, req, 1, RIB_PARAMS_UNIFORM, &params))
+    if (!rib_params_read(p, req, first, RIB_PARAMS_UNIFORM, &params))
         return -2;
     scene_shader *sh = rib_add_shader(p);
     sh->kind = kind;
@@ -367,6 +369,11 @@ static int shader_call(rib_parser *p, const rib_request *req, sl_shader_kind kin
         sh->shader_to_camera = p->attr.ctm;   /* to_world at WorldBegin */
     }
     return p->scene->nshaders - 1;
+}
+
+static int shader_call(rib_parser *p, const rib_request *req, sl_shader_kind kind)
+{
+    return shader_call_at(p, req, kind, 1);
 }
 
 void rib_surface(rib_parser *p, const rib_request *req)
@@ -417,7 +424,8 @@ static const struct { const char *name; scene_light_kind kind; int params; } lig
 
 const char *scene_light_kind_name(scene_light_kind kind)
 {
-    return (unsigned)kind < 4 ? light_kinds[kind].name : "?";
+    return (unsigned)kind < 4 ? light_kinds[kind].name
+           : kind == SCENE_SHADER_LIGHT ? "light shader" : "?";
 }
 
 static void light_defaults(scene_light *l)
@@ -536,21 +544,37 @@ void rib_light_source(rib_parser *p, const rib_request *req)
     for (int i = 0; i < 4; i++)
         if (strcmp(name, light_kinds[i].name) == 0)
             k = i;
-    if (k < 0) {
-        rib_error(p, req, req->args[0].pos, "unknown light \"%s\" (supported: ambientlight, "
-                  "distantlight, pointlight, spotlight)", name);
-        return;
-    }
     /* parameters come in pairs: an odd count left means a handle */
     bool has_handle = (req->nargs - 1) % 2 == 1;
     if (has_handle && !valid_handle(p, req, &req->args[1]))
         return;
+    if (k < 0) {
+        /* not a built-in: a light shader (RI Spec 3.2 §9.3), compiled with
+         * the job's shaders, its parameters set on its instance, shader
+         * space the light's space */
+        int sh = shader_call_at(p, req, SL_SHADER_LIGHT, has_handle ? 2 : 1);
+        if (sh < 0)
+            return;
+        scene_light l;
+        memset(&l, 0, sizeof l);
+        l.kind = SCENE_SHADER_LIGHT;
+        l.shader = sh;
+        l.shadows = p->attr.shadows;
+        light_defaults(&l);
+        l.handle = has_handle ? handle_text(req, &req->args[1]) : NULL;
+        l.pos = req->pos;
+        light_transforms(p, &l);
+        *rib_add_light(p) = l;
+        set_light_on(&p->attr, p->scene->nlights - 1, true);
+        return;
+    }
     rib_params params;
     if (!rib_params_read(p, req, has_handle ? 2 : 1, RIB_PARAMS_UNIFORM, &params))
         return;
     scene_light l;
     memset(&l, 0, sizeof l);
     l.kind = light_kinds[k].kind;
+    l.shader = -1;
     l.shadows = p->attr.shadows;
     light_defaults(&l);
     bool ok = light_params(p, req, light_kinds[k].params, &params, &l);

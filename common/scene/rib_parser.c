@@ -596,6 +596,9 @@ static void finish_shader_names(scene *s)
         if (disp)
             add_shader_name(s, disp->name);
     }
+    for (int i = 0; i < s->nlights; i++)
+        if (s->lights[i].kind == SCENE_SHADER_LIGHT)
+            add_shader_name(s, s->shaders[s->lights[i].shader].name);
 }
 
 static void finish(rib_parser *p)

@@ -92,7 +92,8 @@ typedef struct scene_param {
     sl_pos pos;                    /* where the name was written */
 } scene_param;
 
-/* One Surface or Displacement request. "shader" space is the transform
+/* One Surface or Displacement request, or a LightSource naming a light
+ * shader. "shader" space is the transform
  * current at the request. */
 typedef struct scene_shader {
     sl_shader_kind kind;
@@ -111,6 +112,7 @@ typedef enum scene_light_kind {
     SCENE_DISTANT_LIGHT,           /* + from to */
     SCENE_POINT_LIGHT,             /* + from */
     SCENE_SPOT_LIGHT,              /* + from to coneangle conedeltaangle beamdistribution */
+    SCENE_SHADER_LIGHT,            /* any other name: a light shader (shader) */
 } scene_light_kind;
 
 typedef struct scene_light {
@@ -125,6 +127,9 @@ typedef struct scene_light {
     vec3 from, to;
     double coneangle, conedeltaangle, beamdistribution;
     bool shadows;                  /* casts shadows (docs/scenes.md "Shadows") */
+    int shader;                    /* SCENE_SHADER_LIGHT: index into scene.shaders
+                                      (kind SL_SHADER_LIGHT, shader space = light
+                                      space, its parameters); else -1 */
     mat4 light_to_world, light_to_camera;
     vec3 from_world, to_world;     /* from / to transformed */
     vec3 from_camera, to_camera;
@@ -189,7 +194,7 @@ typedef struct scene {
     int nspaces;
     char **search_path;            /* NULL-terminated directories */
     int nsearch_path;
-    char **shader_names;           /* distinct shaders the objects use */
+    char **shader_names;           /* distinct shaders the objects and lights use */
     int nshader_names;
     char **archives;               /* ReadArchive files read (normalized), in
                                     * order of first reading; positions inside

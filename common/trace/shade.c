@@ -1,7 +1,10 @@
 /*
- * shade.c: surface shading, lights and shadows (see shade.h).
+ * shade.c: surface shading, lights (built-in and light shaders) and
+ * shadows (see shade.h).
  */
 #include "trace/shade.h"
+
+#include "trace/displace.h"
 
 #include <math.h>
 
@@ -64,6 +67,23 @@ static int light_samples(void *user, const double P[3], sl_light_sample *out, in
             L = v3_sub(l->from, c->P);
             atten = 1.0 / v3_dot(L, L);
             break;
+        case TRACE_LIGHT_SHADER: {
+            /* RI Spec 3.2 §9.3: the light shader at Ps (its own VM: this
+             * callback runs inside the surface shader's run) */
+            double Ps[3] = {c->P.x, c->P.y, c->P.z};
+            sl_vm *lvm = c->th->light_vm;
+            sl_vm_set_spaces(lvm, &l->shader_spaces);
+            if (sl_light_eval(lvm, l->shader, Ps, s) != SL_OK) {
+                trace_thread_fail(c->th, sl_vm_error(lvm));
+                continue;
+            }
+            if (s->ambient) { n++; continue; }
+            L = v3(s->L[0], s->L[1], s->L[2]);
+            if (!(s->Cl[0] != 0 || s->Cl[1] != 0 || s->Cl[2] != 0)) continue;
+            if (l->shadows && occluded(c, L, l->directional ? INFINITY : 1.0 - 1e-9)) continue;
+            n++;
+            continue;
+        }
         case TRACE_LIGHT_SPOT: {
             L = v3_sub(l->from, c->P);
             double d2 = v3_dot(L, L);
@@ -107,6 +127,39 @@ static void default_surface(const trace_object *obj, vec3 I, vec3 N,
     *alpha = (obj->Os[0] + obj->Os[1] + obj->Os[2]) / 3.0;
 }
 
+static bool has_outputs(const sl_instance *inst)
+{
+    const sl_program *p = sl_instance_program(inst);
+    for (int i = 0, n = sl_program_param_count(p); i < n; i++) {
+        sl_param_info info;
+        sl_program_param(p, i, &info);
+        if (info.output) return true;
+    }
+    return false;
+}
+
+/* Message passing (RI Spec 3.2 §15.7): the displacement shader's output
+ * parameters at this hit, for displacement("name", x) in the surface
+ * shader. The hit point's evaluation (dual mode, as the intersector's
+ * trace_surface_point_eval) runs again on the shading VM, where the
+ * captured values must live; only when the displacement shader has
+ * outputs. The object's attributes the surface can ask for with
+ * attribute() are set here too. */
+static void pass_messages(trace_thread *th, const trace_object *obj, double u, double v)
+{
+    sl_vm *vm = th->shade_vm;
+    sl_vm_clear_messages(vm, SL_MSG_DISPLACEMENT);
+    double sides = obj->sides;
+    sl_vm_set_message(vm, SL_MSG_ATTRIBUTE, "Sides", SL_TYPE_FLOAT, &sides, NULL);
+    if (!obj->displacement || !has_outputs(obj->displacement)) return;
+    trace_surface_point ignored;
+    sl_vm *displacement_vm = th->vm;
+    th->vm = vm;
+    trace_surface_point_eval(th, obj, u, v, &ignored);
+    th->vm = displacement_vm;
+    sl_vm_capture_outputs(vm, SL_MSG_DISPLACEMENT);
+}
+
 void trace_shade_hit(const trace_renderer *r, trace_thread *th,
                      const trace_ray *ray, const trace_hit *hit,
                      double rgb[3], double *alpha, vec3 *P_out)
@@ -132,6 +185,7 @@ void trace_shade_hit(const trace_renderer *r, trace_thread *th,
     shade_ctx c = {.r = r, .th = th, .obj = obj, .P = sp.P, .N = sp.N,
                    .offset = 2.0 * hit->leaf_size + 1e-9 * (1.0 + v3_length(sp.P)),
                    .tol = hit->leaf_size > pixel_tol ? hit->leaf_size : pixel_tol};
+    pass_messages(th, obj, sp.u, sp.v);
     sl_vm *vm = th->shade_vm;
     double P[3] = {sp.P.x, sp.P.y, sp.P.z}, N[3] = {sp.N.x, sp.N.y, sp.N.z};
     double Ng[3] = {sp.Ng.x, sp.Ng.y, sp.Ng.z};

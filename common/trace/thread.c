@@ -26,6 +26,18 @@ trace_thread *trace_thread_new(const trace_world *world)
                         .max_loop_iterations = 64};
     self->vm = sl_vm_new(&limits);
     self->shade_vm = sl_vm_new(&limits);
+    self->light_vm = sl_vm_new(&limits);
+    /* what every shader may ask of the scene: depth() (RIB Clipping) and
+     * option() (RI Spec 3.2 §15.7), the same for every run */
+    const trace_camera *cam = &world->camera;
+    double format[3] = {cam->xres, cam->yres, 1.0};
+    double clipping[3] = {cam->near_clip, cam->far_clip, 0.0};
+    sl_vm *vms[] = {self->vm, self->shade_vm, self->light_vm};
+    for (size_t i = 0; i < sizeof vms / sizeof vms[0]; i++) {
+        sl_vm_set_clipping(vms[i], cam->near_clip, cam->far_clip);
+        sl_vm_set_message(vms[i], SL_MSG_OPTION, "Format", SL_TYPE_POINT, format, NULL);
+        sl_vm_set_message(vms[i], SL_MSG_OPTION, "Clipping", SL_TYPE_POINT, clipping, NULL);
+    }
     aa_context_init(&self->ctx, world->options.aa_capacity);
     self->cache = trace_boxcache_new(world->options.cache_bytes, world->nobjects);
     self->work = calloc(world->nobjects > 0 ? (size_t)world->nobjects : 1, sizeof *self->work);
@@ -39,6 +51,7 @@ void trace_thread_destroy(trace_thread **self_p)
     if (!self) return;
     sl_vm_destroy(&self->vm);
     sl_vm_destroy(&self->shade_vm);
+    sl_vm_destroy(&self->light_vm);
     trace_boxcache_destroy(&self->cache);
     free(self->work);
     free(self);

@@ -33,6 +33,8 @@ typedef struct trace_thread {
     sl_vm *vm;                     /* displacement shaders (boxes, points) */
     sl_vm *shade_vm;               /* surface shaders: their light callbacks
                                       trace shadow rays, which use vm */
+    sl_vm *light_vm;               /* light shaders, run from shade_vm's
+                                      light callback (sl_light_eval) */
     aa_context ctx;
     trace_boxcache *cache;
     trace_stats stats;

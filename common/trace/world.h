@@ -49,6 +49,7 @@ typedef struct trace_object {
 
 typedef enum trace_light_kind {
     TRACE_LIGHT_AMBIENT, TRACE_LIGHT_DISTANT, TRACE_LIGHT_POINT, TRACE_LIGHT_SPOT,
+    TRACE_LIGHT_SHADER,            /* a light shader run by sl_light_eval */
 } trace_light_kind;
 
 /* RenderMan's standard light sources (RI Spec 3.2, Appendix A), in camera
@@ -61,6 +62,12 @@ typedef struct trace_light {
     double cos_outside, cos_inside;    /* spot: cos(coneangle), cos(coneangle - delta) */
     double beamdistribution;
     bool shadows;
+    /* TRACE_LIGHT_SHADER: the instance (not owned), its spaces (shader
+     * space = light space) and whether its L is the same at every point
+     * (solar: shadow rays go to infinity; else to Ps + L) */
+    const sl_instance *shader;
+    sl_spaces shader_spaces;
+    bool directional;
 } trace_light;
 
 /* RI Spec 3.2 §4.1.4 (and its filter functions in the appendix) */

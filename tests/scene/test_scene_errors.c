@@ -121,9 +121,10 @@ static const error_case cases[] = {
       "t.rib:4:9: Surface: the shader name \"../lib/plastic\" must be a plain name (letters, "
       "digits, '_'); put its folder on the search path with Option \"searchpath\" \"shader\" "
       "[\"dir:&\"]" },
-    { WORLD("LightSource \"arealight\" 1\n" SPHERE),
-      "t.rib:4:13: LightSource: unknown light \"arealight\" (supported: ambientlight, "
-      "distantlight, pointlight, spotlight)" },
+    { WORLD("LightSource \"../lamps/arealight\" 1\n" SPHERE),
+      "t.rib:4:13: LightSource: the shader name \"../lamps/arealight\" must be a plain name "
+      "(letters, digits, '_'); put its folder on the search path with Option \"searchpath\" "
+      "\"shader\" [\"dir:&\"]" },
     { WORLD("LightSource \"pointlight\" 1 \"from\" [1 2]\n" SPHERE),
       "t.rib:4:35: LightSource: parameter \"from\" is a point and needs 3 numbers, got 2" },
     { WORLD("Illuminate 7 1\n" SPHERE),

@@ -940,6 +940,56 @@ static void ref_strings_format(double u, double v, double o[3])
     o[0] = floor(u * 10) + 10; o[1] = 5 + v; o[2] = 15;
 }
 
+/* written for the renderer-wiring session (issue 15): pattern idioms and
+ * the math and geometry built-ins they lean on */
+static void ref_pattern_bricks(double u, double v, double o[3])
+{
+    double bw = 0.25 + 0.02, bh = 0.125 + 0.02, ss = u / bw, tt = v / bh;
+    if (fmodf_(tt * 0.5, 1) > 0.5) ss += 0.5;
+    double sb = floor(ss), tb = floor(tt);
+    ss -= sb;
+    tt -= tb;
+    double w = stepd(0.02 / bw, ss) * stepd(0.02 / bh, tt);
+    o[0] = ss; o[1] = tt; o[2] = w + 10 * sb + 100 * tb;
+}
+
+static void ref_pattern_stripes(double u, double v, double o[3])
+{
+    double ss = fmodf_(u * 5, 1), e = smooth(0.4, 0.6, ss);
+    double c0[3] = {0.1, 0.2, 0.3}, c1[3] = {0.9, 0.7, 0.5}, c[3];
+    for (int k = 0; k < 3; k++) c[k] = c0[k] * (1 - e) + c1[k] * e;
+    o[0] = c[0]; o[1] = c[1] + ss; o[2] = c[2] * v;
+}
+
+static void ref_math_clamp_mix(double u, double v, double o[3])
+{
+    double a[3] = {u, v, u * v}, b[3] = {1 - v, u * u, 0.5};
+    o[0] = u * 0.7 + v * 0.3 + clampd(2 * u - 0.5, 0, 1);
+    o[1] = fmax(a[0], b[0]) - fmin(a[0], b[0]) + (a[1] * 0.75 + b[1] * 0.25);
+    o[2] = clampd(a[2], 0.1, 0.4) + fmax(fmax(u, v), 0.6) - fmin(u, v);
+}
+
+static void ref_geom_distance_length(double u, double v, double o[3])
+{
+    double wx = u - 0.5, wy = v - 0.25, len = sqrt(wx * wx + wy * wy + 1);
+    o[0] = sqrt(wx * wx + wy * wy);
+    o[1] = len + sqrt((u - 1) * (u - 1) + (v - 1) * (v - 1));
+    o[2] = 1 / len;
+}
+
+static void ref_math_polar(double u, double v, double o[3])
+{
+    double x = u - 0.5, y = v - 0.6, r = sqrt(x * x + y * y), a = atan2(y, x);
+    o[0] = r; o[1] = sin(3 * a); o[2] = cos(a) * r + atan(u + 0.5);
+}
+
+static void ref_math_pow_exp_log(double u, double v, double o[3])
+{
+    o[0] = pow(u + 0.1, 1 / 2.2);
+    o[1] = exp(-2 * v) + log(1 + u);
+    o[2] = log(v + 2) / log(2) + sqrt(u + v);
+}
+
 /* ---------------------------------------------------------------------- */
 /* the cases                                                               */
 /* ---------------------------------------------------------------------- */
@@ -1039,6 +1089,12 @@ static const conf_case cases[] = {
     CASE(spline_octaves, "spline"),
     CASE(message_attribute, "message passing"),
     CASE(strings_format, "strings"),
+    CASE(pattern_bricks, "pattern idioms"),
+    CASE(pattern_stripes, "pattern idioms"),
+    CASE(math_clamp_mix, "math"),
+    CASE(geom_distance_length, "shading geometry"),
+    CASE(math_polar, "math"),
+    CASE(math_pow_exp_log, "math"),
 };
 #undef CASE
 #undef CASE_NO_DUAL
