@@ -262,6 +262,12 @@ static void dual3(vec3 v, vec3 du, vec3 dv, sl_dual out[3])
 void trace_surface_point_eval(trace_thread *th, const trace_object *obj,
                               double u, double v, trace_surface_point *out)
 {
+    trace_surface_point_eval_on(th, th->vm, obj, u, v, out);
+}
+
+void trace_surface_point_eval_on(trace_thread *th, sl_vm *vm, const trace_object *obj,
+                                 double u, double v, trace_surface_point *out)
+{
     geom_sample g;
     if (obj->displacement) geom_eval_dual(&obj->surf, u, v, &g);
     else geom_eval(&obj->surf, u, v, &g);
@@ -304,7 +310,6 @@ void trace_surface_point_eval(trace_thread *th, const trace_object *obj,
     dual3(dPdu, v3(0, 0, 0), v3(0, 0, 0), ddPdu);
     dual3(dPdv, v3(0, 0, 0), v3(0, 0, 0), ddPdv);
     sl_dual du_ = {u, 1, 0}, dv_ = {v, 0, 1};
-    sl_vm *vm = th->vm;
     bind_globals_dual(vm, obj, &obj->displacement_spaces, dP, dN, dN, ddPdu, ddPdv, &du_, &dv_,
                       NULL, false);
     th->stats.evals_dual++;

@@ -39,4 +39,9 @@ typedef struct trace_surface_point {
 void trace_surface_point_eval(trace_thread *th, const trace_object *obj,
                               double u, double v, trace_surface_point *out);
 
+/* The same on another VM of the thread (shade.c runs it on the shading VM
+ * to capture the displacement shader's outputs for message passing). */
+void trace_surface_point_eval_on(trace_thread *th, sl_vm *vm, const trace_object *obj,
+                                 double u, double v, trace_surface_point *out);
+
 #endif

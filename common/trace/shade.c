@@ -153,10 +153,7 @@ static void pass_messages(trace_thread *th, const trace_object *obj, double u, d
     sl_vm_set_message(vm, SL_MSG_ATTRIBUTE, "Sides", SL_TYPE_FLOAT, &sides, NULL);
     if (!obj->displacement || !has_outputs(obj->displacement)) return;
     trace_surface_point ignored;
-    sl_vm *displacement_vm = th->vm;
-    th->vm = vm;
-    trace_surface_point_eval(th, obj, u, v, &ignored);
-    th->vm = displacement_vm;
+    trace_surface_point_eval_on(th, vm, obj, u, v, &ignored);
     sl_vm_capture_outputs(vm, SL_MSG_DISPLACEMENT);
 }
 
