@@ -20,6 +20,8 @@ PACKAGES=(
   iproute2          # the multi-host test's network namespaces (ip netns)
   shellcheck        # lints deploy/'s scripts (test_deploy)
   python3-yaml      # checks deploy/'s compose and Kubernetes files (test_deploy)
+  clang             # builds the fuzz targets (tests/fuzz, test fuzz_brief)
+  libclang-rt-14-dev  # libFuzzer and the sanitizer runtimes for clang 14
 )
 
 missing=()

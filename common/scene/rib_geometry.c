@@ -110,6 +110,14 @@ void rib_place_surface(rib_parser *p, const rib_request *req, const geom_surface
         rib_error(p, req, req->pos, "the current transform is singular (a Scale by 0?)");
         return;
     }
+    if (p->scene->nobjects >= p->max_objects) {
+        if (!p->objects_overflow)
+            rib_error(p, req, req->pos, "too many objects (the limit is %d per scene): "
+                      "split the scene into several renders or use fewer, larger "
+                      "primitives", p->max_objects);
+        p->objects_overflow = true;
+        return;
+    }
     scene_object *o = rib_add_object(p);
     o->surface = *surf;
     o->object_to_world = ctm;

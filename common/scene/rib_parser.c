@@ -686,6 +686,12 @@ scene *scene_parse(const char *file, const char *text, size_t len, sl_diag *diag
 scene *scene_parse_archives(const char *file, const char *text, size_t len,
                             sl_source_set *archives, sl_diag *diag)
 {
+    return scene_parse_limited(file, text, len, archives, SCENE_MAX_OBJECTS, diag);
+}
+
+scene *scene_parse_limited(const char *file, const char *text, size_t len,
+                           sl_source_set *archives, int max_objects, sl_diag *diag)
+{
     if (!file || !*file)
         file = "<scene>";
     if (!text)
@@ -702,6 +708,7 @@ scene *scene_parse_archives(const char *file, const char *text, size_t len,
     p.diag = diag;
     p.archives = archives;
     p.diag_sources = set;
+    p.max_objects = max_objects;
     p.scene = scene_new(file);
     p.file = p.scene->file;
     p.decls = rib_decls_new();

@@ -125,6 +125,8 @@ typedef struct rib_parser {
     bool warned_mesh_vars;         /* primitive variables a mesh ignores */
     bool warned_trim;              /* TrimCurve */
     bool warned_early_light;       /* a LightSource before WorldBegin */
+    int max_objects;               /* SCENE_MAX_OBJECTS or the caller's */
+    bool objects_overflow;         /* that limit was reported */
 } rib_parser;
 
 /* Reports an error / warning naming the request: "Sphere: <message>". */

@@ -84,7 +84,8 @@ static bool read_basis(rib_parser *p, const rib_request *req, int *i, const char
         return false;
     }
     int n;
-    s = rib_arg_numbers(req, &req->args[*i], &n)[0];
+    const double *steps = rib_arg_numbers(req, &req->args[*i], &n);
+    s = n == 1 ? steps[0] : 0;              /* "[]" has no numbers at all */
     if (n != 1 || !(s == floor(s) && s >= 1 && s <= 4)) {
         rib_error(p, req, req->args[*i].pos, "the %s step must be a whole number from 1 to 4",
                   which);

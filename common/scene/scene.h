@@ -229,6 +229,18 @@ int scene_archive_load_from_disk(sl_source_set *set, const char *name, sl_diag *
 /* How deep archives may read archives. */
 enum { SCENE_ARCHIVE_MAX_DEPTH = 16 };
 
+/* The most objects a scene may place (primitives, mesh faces and
+ * instanced copies together), so that a scene received over the network
+ * cannot exhaust the memory of the master or a worker (issue 12). The
+ * scene text itself is bounded by the source size (4 MiB, sl/source.h)
+ * and archives are bounded the same way each. */
+enum { SCENE_MAX_OBJECTS = 1 << 20 };
+
+/* As scene_parse_archives, with at most max_objects objects (more is an
+ * error naming the request that passes the limit). */
+scene *scene_parse_limited(const char *file, const char *text, size_t len,
+                           sl_source_set *archives, int max_objects, sl_diag *diag);
+
 void scene_destroy(scene **self_p);
 
 /* ---- queries -------------------------------------------------------------- */

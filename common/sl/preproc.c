@@ -168,6 +168,7 @@ struct sl_preproc {
 
     arena_block *arena;
     size_t spent;             /* tokens scanned + produced, for the limit */
+    size_t stored;            /* bytes taken from the arena, for the limit */
     int arg_nesting;          /* recursion of argument pre-expansion */
     bool dead;                /* a limit was hit: only EOF from now on */
     sl_pos eof_pos;
@@ -188,6 +189,7 @@ static void *arena_alloc(sl_preproc *pp, size_t size)
     }
     void *p = (char *)b->data + b->used;
     b->used += size;
+    pp->stored += size;
     return p;
 }
 
@@ -310,18 +312,26 @@ static const char *spell_for_message(const sl_pptoken *t, char *buf)
     return buf;
 }
 
-/* Counts n tokens against SL_PP_MAX_TOKENS; false (reported once, and the
- * stream ends) when the limit is passed. */
+/* Counts n tokens against SL_PP_MAX_TOKENS and checks the storage taken so
+ * far against SL_PP_MAX_BYTES; false (reported once, at pos, and the stream
+ * ends) when a limit is passed. */
 static bool spend(sl_preproc *pp, size_t n, sl_pos pos)
 {
     if (pp->dead)
         return false;
     pp->spent += n;
-    if (pp->spent <= SL_PP_MAX_TOKENS)
+    if (pp->spent <= SL_PP_MAX_TOKENS && pp->stored <= SL_PP_MAX_BYTES)
         return true;
-    sl_diag_error(pp->diag, pos,
-                  "too many tokens (more than %d scanned or produced by macro expansion)",
-                  SL_PP_MAX_TOKENS);
+    if (pp->spent > SL_PP_MAX_TOKENS)
+        sl_diag_error(pp->diag, pos,
+                      "too many tokens (more than %d scanned or produced by macro "
+                      "expansion): simplify the macros expanded here",
+                      SL_PP_MAX_TOKENS);
+    else
+        sl_diag_error(pp->diag, pos,
+                      "macro expansion too large (more than %d bytes of preprocessor "
+                      "storage): simplify the macros expanded here",
+                      SL_PP_MAX_BYTES);
     pp->dead = true;
     if (pos.file)
         pp->eof_pos = pos;
@@ -710,8 +720,12 @@ typedef struct pp_subst {
     tokvec *out;
 } pp_subst;
 
+/* Every token an expansion appends is charged as it is appended, so that
+ * no expansion grows far beyond the budget before it is pushed back. */
 static void append_body(pp_subst *s, const sl_pptoken *t)
 {
+    if (!spend(s->pp, 1, s->name->pos))
+        return;
     sl_pptoken copy = *t;
     copy.pos = s->name->pos;
     copy.from = s->m;
@@ -722,7 +736,7 @@ static void append_body(pp_subst *s, const sl_pptoken *t)
 
 static void append_arg(pp_subst *s, const sl_pptoken *v, size_t n)
 {
-    for (size_t i = 0; i < n; i++) {
+    for (size_t i = 0; i < n && spend(s->pp, 1, s->name->pos); i++) {
         sl_pptoken copy = v[i];
         copy.hs = hs_union(s->pp, copy.hs, s->hs, s->name->pos);
         copy.flags &= ~SL_PPF_BOL;
@@ -865,10 +879,11 @@ static void substitute(sl_preproc *pp, const sl_macro *m, pp_arg *args,
     }
 }
 
-/* Pushes an expansion back onto the input so that it is rescanned. */
+/* Pushes an expansion back onto the input so that it is rescanned (its
+ * tokens were charged as they were appended). */
 static void push_back(sl_preproc *pp, pp_input *in, tokvec *out, const sl_pptoken *name)
 {
-    if (spend(pp, out->n, name->pos))
+    if (spend(pp, 0, name->pos))
         for (size_t k = out->n; k-- > 0;)
             tv_push(&in->pb, &out->v[k]);
     tv_free(out);

@@ -20,9 +20,12 @@
  * Limits, so that sources received over the network cannot exhaust a
  * worker: include depth SL_PP_MAX_INCLUDE_DEPTH (an include cycle is an
  * error at once), SL_PP_MAX_TOKENS tokens scanned plus produced by
- * expansion per preprocessor, #if expressions nested at most
- * SL_PP_MAX_EXPR_DEPTH deep. Memory is bounded by these and the source
- * sizes. Everything the preprocessor allocates is freed by
+ * expansion per preprocessor (charged as each expansion is built, before it
+ * is pushed back, so a macro bomb stops after at most that many tokens of
+ * work), SL_PP_MAX_BYTES bytes of preprocessor storage (token texts made
+ * by # and ##, hide sets, macro bodies) per preprocessor, #if expressions
+ * nested at most SL_PP_MAX_EXPR_DEPTH deep. Memory is bounded by these and
+ * the source sizes. Everything the preprocessor allocates is freed by
  * sl_preproc_destroy, and no sooner (token texts point into it).
  */
 #ifndef SL_PREPROC_H
@@ -37,7 +40,8 @@
 
 enum {
     SL_PP_MAX_INCLUDE_DEPTH = 64,        /* nested #include levels */
-    SL_PP_MAX_TOKENS        = 1 << 23,   /* scanned + expanded, per run */
+    SL_PP_MAX_TOKENS        = 1 << 21,   /* scanned + expanded, per run */
+    SL_PP_MAX_BYTES         = 64 << 20,  /* preprocessor storage, per run */
     SL_PP_MAX_EXPR_DEPTH    = 256,       /* nesting in #if expressions */
 };
 

@@ -44,6 +44,8 @@ static const error_case cases[] = {
     { "1 2 3\n" WORLD(SPHERE),
       "t.rib:1:1: expected a request name, got a number" },
     /* argument counts and values */
+    { WORLD("Basis \"bezier\" [] \"bezier\" 3\n" SPHERE),     /* found by fuzz_rib */
+      "t.rib:4:16: Basis: the u step must be a whole number from 1 to 4" },
     { WORLD("Sphere 1 -1 1\n"),
       "t.rib:4:1: Sphere: expected 4 numbers (radius zmin zmax thetamax), got 3" },
     { WORLD("Translate 1 2 3 4\n" SPHERE),

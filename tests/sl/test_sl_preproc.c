@@ -1096,10 +1096,68 @@ static void test_limit_exponential_expansion(void **state)
     assert_int_equal(sl_diag_count(diag), 1);
     const sl_diagnostic *d = sl_diag_get(diag, 0);
     assert_string_equal(d->message,
-                        "too many tokens (more than 8388608 scanned or produced by macro "
-                        "expansion)");
+                        "too many tokens (more than 2097152 scanned or produced by macro "
+                        "expansion): simplify the macros expanded here");
     assert_int_equal(d->line, 32);
     assert_int_equal(d->col, 3);
+}
+
+/* The bomb of issue 12: a chain of object-like macros, each expanding to
+ * two of the next, 30 deep (2^30 tokens), used where the parser would
+ * take every token. Each expansion is charged as it is built, so it stops
+ * at the budget; the error names the use. */
+static void test_limit_macro_bomb_chain(void **state)
+{
+    (void)state;
+    char src[4096];
+    size_t o = 0;
+    for (int i = 0; i < 30; i++)
+        o += (size_t)snprintf(src + o, sizeof src - o, "#define M%d M%d M%d\n", i, i + 1, i + 1);
+    o += (size_t)snprintf(src + o, sizeof src - o, "#define M30 +1\n");
+    snprintf(src + o, sizeof src - o, "float x = 0 M0;\n");
+    add("main.sl", src);
+    sl_lexer *lx = sl_lexer_new(set, "main.sl", NULL, diag);
+    sl_token t;
+    long n = 0;
+    while (sl_lexer_next(lx, &t))
+        n++;
+    sl_lexer_destroy(&lx);
+    assert_true(n <= SL_PP_MAX_TOKENS);
+    assert_int_equal(sl_diag_error_count(diag), 1);
+    const sl_diagnostic *d = sl_diag_get(diag, 0);
+    assert_non_null(strstr(d->message, "too many tokens"));
+    assert_non_null(strstr(d->message, "simplify the macros"));
+    assert_string_equal(d->file, "main.sl");
+    assert_int_equal(d->line, 32);
+    assert_int_equal(d->col, 13);
+}
+
+/* Pasting doubles a token's spelling at each level: 40 levels would make a
+ * terabyte-long identifier out of a few tokens, so the byte budget, not the
+ * token budget, stops it. */
+static void test_limit_paste_bomb_bytes(void **state)
+{
+    (void)state;
+    char src[1024];
+    size_t o = (size_t)snprintf(src, sizeof src, "#define C(x) x ## x\n#define E(x) C(x)\nfloat ");
+    for (int i = 0; i < 40; i++)
+        o += (size_t)snprintf(src + o, sizeof src - o, "E(");
+    o += (size_t)snprintf(src + o, sizeof src - o, "a");
+    for (int i = 0; i < 40; i++)
+        o += (size_t)snprintf(src + o, sizeof src - o, ")");
+    snprintf(src + o, sizeof src - o, " = 1;\n");
+    add("main.sl", src);
+    sl_lexer *lx = sl_lexer_new(set, "main.sl", NULL, diag);
+    sl_token t;
+    while (sl_lexer_next(lx, &t))
+        assert_true(t.len <= 2 * (size_t)SL_PP_MAX_BYTES);
+    sl_lexer_destroy(&lx);
+    assert_int_equal(sl_diag_error_count(diag), 1);
+    const sl_diagnostic *d = sl_diag_get(diag, 0);
+    assert_string_equal(d->message,
+                        "macro expansion too large (more than 67108864 bytes of preprocessor "
+                        "storage): simplify the macros expanded here");
+    assert_int_equal(d->line, 3);
 }
 
 static void test_limit_argument_nesting(void **state)
@@ -1414,6 +1472,8 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_error_unterminated_comment_in_skipped_group,
                                         setup, teardown),
         cmocka_unit_test_setup_teardown(test_limit_exponential_expansion, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_limit_macro_bomb_chain, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_limit_paste_bomb_bytes, setup, teardown),
         cmocka_unit_test_setup_teardown(test_limit_argument_nesting, setup, teardown),
         cmocka_unit_test_setup_teardown(test_limit_if_nesting, setup, teardown),
         cmocka_unit_test_setup_teardown(test_long_macro_chain, setup, teardown),

@@ -1,0 +1,4 @@
+surface broken( { float x = ; if ( Ci = 
+#if
+#define
+#include "nothere.h"
