@@ -72,4 +72,30 @@ static inline double vec_dist(vec3 a, vec3 b)
     return v3_length(v3_sub(a, b));
 }
 
+#ifdef cmocka_unit_test
+/* A table of scenes that must fail, each with its first error exactly
+ * ("file:line:col: message"); prints the scene and its diagnostics when one
+ * does not. */
+typedef struct error_case {
+    const char *text;
+    const char *first_error;
+} error_case;
+
+static inline void expect_first_errors(const error_case *cases, size_t n)
+{
+    for (size_t i = 0; i < n; i++) {
+        sl_diag *d;
+        scene *s = parse_rib(cases[i].text, &d);
+        const char *got = diag_line(nth_diag(d, SL_DIAG_ERROR, 0));
+        if (s || strcmp(got, cases[i].first_error) != 0) {
+            fprintf(stderr, "case %zu:\n%s\n", i, cases[i].text);
+            sl_diag_print(d, stderr);
+        }
+        assert_null(s);
+        assert_string_equal(got, cases[i].first_error);
+        sl_diag_destroy(&d);
+    }
+}
+#endif
+
 #endif

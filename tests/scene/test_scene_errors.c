@@ -18,11 +18,7 @@
 #define WORLD(body) CAMERA "WorldBegin\n" body "WorldEnd\n"
 #define SPHERE "Sphere 1 -1 1 360\n"
 
-typedef struct error_case {
-    const char *text;
-    const char *first_error;      /* "file:line:col: message" */
-} error_case;
-
+/* error_case: scene_testing.h */
 static const error_case cases[] = {
     /* lexical */
     { WORLD("Translate 1.2.3 0 0\n" SPHERE),

@@ -173,11 +173,6 @@ static void test_patch_mesh(void **state)
     sl_diag_destroy(&d);
 }
 
-typedef struct error_case {
-    const char *text;
-    const char *first_error;
-} error_case;
-
 static const error_case cases[] = {
     { WORLD("Basis \"bspline\" 1 \"b-spline\" 1\nSphere 1 -1 1 360\n"),
       "t.rib:4:7: Basis: unknown u basis \"bspline\" (expected \"bezier\", \"b-spline\", "
@@ -201,18 +196,7 @@ static const error_case cases[] = {
 static void test_errors(void **state)
 {
     (void)state;
-    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
-        sl_diag *d;
-        scene *s = parse_rib(cases[i].text, &d);
-        const char *got = diag_line(nth_diag(d, SL_DIAG_ERROR, 0));
-        if (s || strcmp(got, cases[i].first_error) != 0) {
-            fprintf(stderr, "case %zu:\n%s\n", i, cases[i].text);
-            sl_diag_print(d, stderr);
-        }
-        assert_null(s);
-        assert_string_equal(got, cases[i].first_error);
-        sl_diag_destroy(&d);
-    }
+    expect_first_errors(cases, sizeof cases / sizeof cases[0]);
 }
 
 int main(void)
