@@ -1,9 +1,9 @@
 /*
- * standalone.c: the standalone renderer (see standalone.h). Threads take
- * tiles from a shared counter in scanline order of tiles (neighbouring
- * tiles close in time, which keeps each thread's box cache warm, as Pharr
- * & Hanrahan's tile orders do), render them with their own trace_thread,
- * and hand them to the one writer under a mutex.
+ * standalone.c: the standalone renderer (see standalone.h). Each thread
+ * works through a contiguous run of tiles (tile_runs.h: neighbouring tiles
+ * one after the other keep its box cache warm, as Pharr & Hanrahan's tile
+ * orders do; idle threads steal half a run), renders them with its own
+ * trace_thread, and hands them to the one writer under a mutex.
  */
 #include "standalone.h"
 
@@ -21,6 +21,7 @@
 #include "image/writer.h"
 #include "job/job_scene.h"
 #include "tile_render.h"
+#include "tile_runs.h"
 #include "util/exitcodes.h"
 
 /* Set by SIGINT/SIGTERM (a lock-free atomic: safe in a handler); every
@@ -40,7 +41,8 @@ typedef struct shared {
     image_format fmt;
     image_writer *writer;
     float *preview;                /* full image RGBA, when a preview is wanted */
-    atomic_int next_tile;
+    tile_runs runs;                /* which tiles each thread renders next */
+    atomic_int next_thread;        /* hands out thread indexes */
     int ntiles;
     pthread_mutex_t lock;          /* writer, preview, progress, error */
     int done;
@@ -82,9 +84,10 @@ static void *render_thread(void *arg)
     trace_thread *th = trace_thread_new(&s->js->world);
     th->cancel = &interrupted;
     int tx_count = image_format_tiles_x(&s->fmt);
+    int me = atomic_fetch_add(&s->next_thread, 1);
     for (;;) {
-        int i = atomic_fetch_add(&s->next_tile, 1);
-        if (i >= s->ntiles || interrupted) break;
+        int i = tile_runs_take(&s->runs, me);
+        if (i < 0 || interrupted) break;
         pthread_mutex_lock(&s->lock);
         bool stop = s->failed;
         pthread_mutex_unlock(&s->lock);
@@ -199,9 +202,10 @@ int worker_standalone(const standalone_options *opt)
     s.ntiles = image_format_tile_count(&s.fmt);
     s.work = calloc((size_t)js->world.nobjects + 1, sizeof *s.work);
     if (!s.work) abort();
-    atomic_init(&s.next_tile, 0);
     pthread_mutex_init(&s.lock, NULL);
     int threads = opt->threads > 0 ? opt->threads : default_threads();
+    atomic_init(&s.next_thread, 0);
+    tile_runs_init(&s.runs, s.ntiles, threads);
     if (opt->verbosity >= 0)
         fprintf(stderr, "aafarm-worker: %s: %dx%d, %d tiles of %d, %d thread%s, %s arithmetic\n",
                 opt->scene_path, s.fmt.width, s.fmt.height, s.ntiles, s.fmt.tile_size,
@@ -253,6 +257,7 @@ int worker_standalone(const standalone_options *opt)
     }
     free(s.preview);
     free(s.work);
+    tile_runs_destroy(&s.runs);
     pthread_mutex_destroy(&s.lock);
     job_scene_destroy(&js);
     job_destroy(&jb);

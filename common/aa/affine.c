@@ -12,6 +12,7 @@
 #include "aa/affine_internal.h"
 #include "aa/rounding.h"
 
+#include <assert.h>
 #include <math.h>
 
 /* ---------------------------------------------------------------------- */
@@ -136,16 +137,32 @@ void aa_from_interval(aa_context *ctx, aa_form *z, ia_interval x)
     aa_set_interval(ctx, z, x, x.flags);
 }
 
-/* Sum of |xi| + err, rounded up: every addition is rounded upward exactly
- * (TwoSum), so a single term comes back unchanged. */
+/* Sum of |xi| + err, rounded up. The n terms are added in round-to-
+ * nearest; each addition errs by at most 2^-53 of its (nonnegative)
+ * result, so the exact sum is at most the computed one times (1 + 2^-53)^n,
+ * which (n + 1) * 2^-53 relative, stepped up, covers. A form with one term
+ * (an input, a fresh min-range result) comes back exactly. */
 double aa_radius(const aa_form *x)
 {
     if (x->flags & AA_UNBOUNDED)
         return INFINITY;
-    double r = x->err;
-    for (int i = 0; i < x->n; i++)
-        r = fp_add_up(r, fabs(x->c[i]));
-    return r;
+    int n = x->n;
+    double r = 0.0;
+    int terms = 0;
+    for (int i = 0; i < n; i++) {
+        double a = fabs(x->c[i]);
+        r += a;
+        terms += a != 0.0;
+    }
+    if (x->err != 0.0) {
+        r += x->err;
+        terms++;
+    }
+    if (terms <= 1)
+        return r;
+    if (!(r >= 0x1p-960))              /* no subnormal products (rounding.h) */
+        return r != r ? r : 0x1p-958;
+    return fp_next_up(r + r * ((double)(terms + 1) * 0x1p-53));
 }
 
 ia_interval aa_range(const aa_form *x)
@@ -192,6 +209,61 @@ static double sum_err_bound(double es)
     return es == 0.0 ? 0.0 : fp_next_up(es * (1.0 + 0x1p-45));
 }
 
+/*
+ * Bound on the rounding of the coefficients of a*x + b*y: each is
+ * s = RN(RN(a xi) + RN(b yi)), whose error is at most u|s| for the addition
+ * (an addition never errs in the subnormal range) plus u|a xi| + eta and
+ * u|b yi| + eta for products by a factor other than 0 and +-1 (u = 2^-53,
+ * eta = 2^-1075). With S = sum |s|, X = sum |xi|, Y = sum |yi| (in RN):
+ * err <= u (S + |a| X + |b| Y) + eta per product that underflowed (uflow
+ * counts those that may have), and fp_rounding_bound's 2u covers
+ * the RN error of the sums themselves. A combination of exact factors whose
+ * coefficients all cancel (x - x) adds nothing.
+ */
+static double coef_err_bound(double S, double X, double Y, double a, double b,
+                             bool ea, bool eb, int uflow)
+{
+    double acc = S;
+    if (!ea) acc += fp_mul_up(fabs(a), X);
+    if (!eb) acc += fp_mul_up(fabs(b), Y);
+    return fp_rounding_bound(acc, uflow);
+}
+
+/* a*[lo, hi] (a finite, a != 0) before rounding: ends for the hull below */
+static inline void scale_ends(double a, double lo, double hi, double *l, double *h)
+{
+    if (a > 0.0) { *l = a * lo; *h = a * hi; }
+    else { *l = a * hi; *h = a * lo; }
+}
+
+/*
+ * The hull of a*x + b*y + c from the operands' hulls, computed in RN and
+ * moved outward by a bound of its rounding: 2u times the sum of the
+ * magnitudes of every intermediate result, plus the products' underflow.
+ */
+static void lincomb_hull(aa_form *z, double a, const aa_form *x, double b,
+                         const aa_form *y, double c)
+{
+    double xl = 0.0, xh = 0.0, yl = 0.0, yh = 0.0;
+    if (a != 0.0) scale_ends(a, x->lo, x->hi, &xl, &xh);
+    if (b != 0.0) scale_ends(b, y->lo, y->hi, &yl, &yh);
+    double l1 = xl + yl, lo = l1 + c;
+    double h1 = xh + yh, hi = h1 + c;
+    double el = fabs(xl) + fabs(yl) + fabs(l1) + fabs(lo);
+    double eh = fabs(xh) + fabs(yh) + fabs(h1) + fabs(hi);
+    if (!exact_factor(a) || !exact_factor(b) || c != 0.0) {
+        int uf = (!exact_factor(a) && (fabs(xl) < 0x1p-1022 || fabs(xh) < 0x1p-1022)) +
+                 (!exact_factor(b) && (fabs(yl) < 0x1p-1022 || fabs(yh) < 0x1p-1022));
+        lo = fp_add_dn(lo, -fp_rounding_bound(el, uf));
+        hi = fp_add_up(hi, fp_rounding_bound(eh, uf));
+    } else {                          /* one addition: no underflow error */
+        if (el != 0.0) lo = fp_add_dn(lo, -fp_next_up(el * 0x1p-52));
+        if (eh != 0.0) hi = fp_add_up(hi, fp_next_up(eh * 0x1p-52));
+    }
+    z->lo = lo == lo ? lo : -INFINITY;
+    z->hi = hi == hi ? hi : INFINITY;
+}
+
 void aa_lincomb(aa_context *ctx, aa_form *z, double a, const aa_form *x,
                 double b, const aa_form *y, double c)
 {
@@ -211,46 +283,138 @@ void aa_lincomb(aa_context *ctx, aa_form *z, double a, const aa_form *x,
     flags &= ~AA_UNBOUNDED;
     bool ea = exact_factor(a), eb = exact_factor(b);
     int xn = (a == 0.0) ? 0 : x->n, yn = (b == 0.0) ? 0 : y->n;
-    int n = xn > yn ? xn : yn;
+    int n = xn > yn ? xn : yn, m = xn < yn ? xn : yn;
     double x0 = x->x0, y0 = y->x0;
     double xe = a == 0.0 ? 0.0 : x->err, ye = b == 0.0 ? 0.0 : y->err;
-    ia_interval hull = ia_add_s(ia_add(ia_mul_s(ia_make(x->lo, x->hi), a),
-                                       ia_mul_s(ia_make(y->lo, y->hi), b)), c);
+    lincomb_hull(z, a, x, b, y, c);
 
-    double es = 0.0;      /* sum of exact errors of the additions */
-    double ap = 0.0;      /* sum of |inexact products| */
-    int np = 0;
-    for (int i = 0; i < n; i++) {
-        double xi = i < xn ? x->c[i] : 0.0;
-        double yi = i < yn ? y->c[i] : 0.0;
+    /* coefficients: the common part, then the longer operand's tail */
+    double S = 0.0, X = 0.0, Y = 0.0;
+    int i = 0, uf = 0;
+    for (; i < m; i++) {
+        double xi = x->c[i], yi = y->c[i];
         double p = a * xi, q = b * yi, s = p + q;
-        es += fabs(fp_two_sum_err(p, q, s));
-        if (!ea) { ap += fabs(p); np++; }
-        if (!eb) { ap += fabs(q); np++; }
+        S += fabs(s);
+        X += fabs(xi);
+        Y += fabs(yi);
+        uf += fp_uflow(p, a, xi) + fp_uflow(q, b, yi);
         z->c[i] = s;
     }
+    for (; i < xn; i++) {
+        double xi = x->c[i], s = a * xi;
+        S += fabs(s);
+        X += fabs(xi);
+        uf += fp_uflow(s, a, xi);
+        z->c[i] = s;
+    }
+    for (; i < yn; i++) {
+        double yi = y->c[i], s = b * yi;
+        S += fabs(s);
+        Y += fabs(yi);
+        uf += fp_uflow(s, b, yi);
+        z->c[i] = s;
+    }
+    double err = coef_err_bound(S, X, Y, a, b, ea, eb, uf);
+
+    /* the centre: exact errors (TwoSum), so sums of points stay points */
     double p = a * x0, q = b * y0;
     double s1 = p + q, s2 = s1 + c;
-    es += fabs(fp_two_sum_err(p, q, s1)) + fabs(fp_two_sum_err(s1, c, s2));
-    if (!ea) { ap += fabs(p); np++; }
-    if (!eb) { ap += fabs(q); np++; }
+    double es = fabs(fp_two_sum_err(p, q, s1)) + fabs(fp_two_sum_err(s1, c, s2));
+    double ap = 0.0;
+    int np = 0, puf = 0;
+    if (!ea && x0 != 0.0) { ap += fabs(p); np++; puf += fp_uflow(p, a, x0); }
+    if (!eb && y0 != 0.0) { ap += fabs(q); np++; puf += fp_uflow(q, b, y0); }
 
-    double err = 0.0;
     if (xe != 0.0)
-        err = ea ? xe : fp_mul_up(fabs(a), xe);
+        err = fp_add_up(err, ea ? xe : fp_mul_up(fabs(a), xe));
     if (ye != 0.0)
         err = fp_add_up(err, eb ? ye : fp_mul_up(fabs(b), ye));
-    err = fp_add_up(err, sum_err_bound(es));
+    if (es != 0.0)
+        err = fp_add_up(err, sum_err_bound(es));
     if (np > 0)
-        err = fp_add_up(err, fp_rounding_bound(ap, np));
+        err = fp_add_up(err, fp_rounding_bound(ap, puf));
 
     z->x0 = s2;
     z->err = err;
-    z->lo = hull.lo;
-    z->hi = hull.hi;
     z->n = (unsigned short)n;
     z->flags = (unsigned short)flags;
-    if (!isfinite(s2) || !isfinite(err) || !isfinite(es) || !isfinite(ap))
+    if (!isfinite(s2) || !isfinite(err) || !isfinite(S) || !isfinite(ap))
+        aa_unbounded(z, flags);
+}
+
+/*
+ * One row of a transformation: every coefficient (and the centre) is a sum
+ * of at most three products (four terms with c) in RN, whose error is at
+ * most gamma_3 = 3u/(1 - 3u) times the sum of the terms' magnitudes plus
+ * the products' underflow (u = 2^-53). fp_rounding_bound(3 * sum) gives
+ * 6u * sum + 2^-1022, which covers both. The errors, all nonnegative, are
+ * added in RN and the total is raised by 2^-50 of itself (more than the RN
+ * error of those few additions) and one step: one rounding for the lot.
+ */
+void aa_lincomb3(aa_context *ctx, aa_form *z, const double m[3], const aa_form x[3],
+                 double c)
+{
+    (void)ctx;
+    assert(z < x || z >= x + 3);
+    unsigned flags = 0;
+    bool unbounded = !isfinite(c);
+    int n = 0;
+    for (int k = 0; k < 3; k++) {
+        flags |= x[k].flags;
+        if (!isfinite(m[k]) || (m[k] != 0.0 && (x[k].flags & AA_UNBOUNDED)))
+            unbounded = true;
+        if (m[k] != 0.0 && x[k].n > n)
+            n = x[k].n;
+    }
+    if (unbounded) {
+        aa_unbounded(z, flags);
+        return;
+    }
+    flags &= ~AA_UNBOUNDED;
+
+    for (int j = 0; j < n; j++)
+        z->c[j] = 0.0;
+    double terms = 0.0, x0 = c, centre = fabs(c), perr = 0.0;
+    double lo = c, hi = c, hull = fabs(c);
+    int uf = 0, cuf = 0, huf = 0;
+    for (int k = 0; k < 3; k++) {
+        double a = m[k];
+        if (a == 0.0)
+            continue;
+        const aa_form *xk = &x[k];
+        double R = 0.0;
+        for (int j = 0; j < xk->n; j++) {
+            double p = a * xk->c[j];
+            z->c[j] += p;
+            R += fabs(xk->c[j]);
+            uf += fp_uflow(p, a, xk->c[j]);
+        }
+        double fa = fabs(a);
+        terms += fa * R;
+        double p = a * xk->x0;
+        x0 += p;
+        centre += fabs(p);
+        cuf += fp_uflow(p, a, xk->x0);
+        perr += fa * xk->err;
+        double l, h;
+        scale_ends(a, xk->lo, xk->hi, &l, &h);
+        lo += l;
+        hi += h;
+        hull += fabs(l) + fabs(h);
+        huf += fabs(l) < 0x1p-1022 || fabs(h) < 0x1p-1022;
+    }
+    double e = perr + fp_rounding_bound(3.0 * terms, uf) +
+               fp_rounding_bound(3.0 * centre, cuf);
+    z->x0 = x0;
+    z->err = e == 0.0 ? 0.0 : fp_next_up(e + e * 0x1p-50);
+    double hb = fp_rounding_bound(3.0 * hull, huf);
+    lo = fp_add_dn(lo, -hb);
+    hi = fp_add_up(hi, hb);
+    z->lo = lo == lo ? lo : -INFINITY;
+    z->hi = hi == hi ? hi : INFINITY;
+    z->n = (unsigned short)n;
+    z->flags = (unsigned short)flags;
+    if (!isfinite(x0) || !isfinite(z->err))
         aa_unbounded(z, flags);
 }
 
@@ -341,6 +505,7 @@ void aa_mul(aa_context *ctx, aa_form *z, const aa_form *x, const aa_form *y)
     double x0 = x->x0, y0 = y->x0, xe = x->err, ye = y->err;
 
     double es = 0.0, ap = 0.0, dsum = 0.0, dabs = 0.0;
+    int uf = 0;
     for (int i = 0; i < n; i++) {
         double xi = i < xn ? x->c[i] : 0.0;
         double yi = i < yn ? y->c[i] : 0.0;
@@ -350,9 +515,11 @@ void aa_mul(aa_context *ctx, aa_form *z, const aa_form *x, const aa_form *y)
         ap += fabs(p) + fabs(q);
         dsum += d;
         dabs += fabs(d);
+        uf += fp_uflow(p, x0, yi) + fp_uflow(q, y0, xi) + fp_uflow(d, xi, yi);
         z->c[i] = s;
     }
     double p0 = x0 * y0, m = 0.5 * dsum, s0 = p0 + m;
+    uf += fp_uflow(p0, x0, y0) + (fabs(m) < 0x1p-1022 && dsum != 0.0);
     es += fabs(fp_two_sum_err(p0, m, s0));
     /* errors: 2n + 1 products above, the n products d and their RN sum
      * (at most (n+1) * 2^-53 * dabs), and the halving */
@@ -360,10 +527,10 @@ void aa_mul(aa_context *ctx, aa_form *z, const aa_form *x, const aa_form *y)
 
     double err = fp_add_up(fp_mul_up(fabs(x0), ye), fp_mul_up(fabs(y0), xe));
     err = fp_add_up(err, sum_err_bound(es));
-    err = fp_add_up(err, fp_rounding_bound(ap, 3 * n + 3));
+    err = fp_add_up(err, fp_rounding_bound(ap, uf));
 
     /* lower bound of sum|xi*yi|/2 */
-    double dlow = dabs - dabs * (double)(n + 2) * 0x1p-52 - (double)n * 0x1p-1074;
+    double dlow = dabs - dabs * (double)(n + 2) * 0x1p-52 - 0x1p-1022;   /* >= n * 2^-1074; normal */
     dlow = dlow > 0.0 ? fp_next_down(fp_next_down(dlow) * 0.5) : 0.0;
     double delta = fp_add_up(fp_mul_up(rx, ry), -(dlow > 0.0 ? dlow : 0.0));
     if (delta < 0.0)

@@ -51,7 +51,7 @@
 
 #include "aa/interval.h"
 
-#define AA_MAX_SYMBOLS 32
+#define AA_MAX_SYMBOLS 16
 #define AA_DEFAULT_CAPACITY 8
 
 typedef struct aa_form {
@@ -91,6 +91,11 @@ void aa_mul_s(aa_context *ctx, aa_form *z, const aa_form *x, double s);
 /* z = a*x + b*y + c, the building block of the above and of mix() */
 void aa_lincomb(aa_context *ctx, aa_form *z, double a, const aa_form *x,
                 double b, const aa_form *y, double c);
+
+/* z = m[0]*x[0] + m[1]*x[1] + m[2]*x[2] + c in one pass (a row of a 3x4
+ * transformation applied to a triple); z must not be one of x[0..2] */
+void aa_lincomb3(aa_context *ctx, aa_form *z, const double m[3], const aa_form x[3],
+                 double c);
 
 /* ---- non-affine operations: one new noise symbol each ---- */
 void aa_mul(aa_context *ctx, aa_form *z, const aa_form *x, const aa_form *y);

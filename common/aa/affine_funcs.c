@@ -202,14 +202,6 @@ static ia_interval operand_range(const aa_form *x, unsigned *flags)
 /* point enclosures and tangent points of the smooth functions             */
 /* ---------------------------------------------------------------------- */
 
-static ia_interval f_sqr(double t, const void *arg) { (void)arg; return ia_sqr(ia_point(t)); }
-static ia_interval d_sqr(double t, const void *arg) { (void)arg; return ia_mul_s(ia_point(t), 2.0); }
-static double t_sqr(double al, double p, double q, const void *arg)
-{
-    (void)p; (void)q; (void)arg;
-    return 0.5 * al;
-}
-
 static ia_interval f_recip(double t, const void *arg) { (void)arg; return ia_recip(ia_point(t)); }
 static ia_interval d_recip(double t, const void *arg)
 {
@@ -352,13 +344,29 @@ static double t_ramp(double al, double p, double q, const void *arg)
 /* smooth functions                                                        */
 /* ---------------------------------------------------------------------- */
 
+/*
+ * The square in closed form: the Chebyshev scheme above specialised to
+ * f(t) = t^2 on [a, b] (the most frequent non-affine operation: every
+ * length, dot product and distance). alpha = a + b (in RN; any alpha is
+ * sound), g(t) = t^2 - alpha t is convex with its least value -alpha^2/4 at
+ * alpha/2 and its largest on [a, b] at an end point, so g lies in
+ * [-alpha^2/4, max(g(a), g(b))], each end rounded outward.
+ */
 void aa_sqr(aa_context *ctx, aa_form *z, const aa_form *x)
 {
     unsigned fl;
     ia_interval r = operand_range(x, &fl);
-    static const convex_fn fn = { f_sqr, d_sqr, t_sqr, NULL };
-    piece pc = { r.lo, r.hi, +1 };
-    approx_convex(ctx, z, x, &fn, &pc, 1, r.lo, r.hi, ia_sqr(r), fl);
+    double a = r.lo, b = r.hi;
+    bool ok = isfinite(a) && isfinite(b) && a < b;
+    double alpha = 0.0, zeta = 0.0, delta = 0.0;
+    if (ok) {
+        alpha = a + b;
+        double ga = fp_add_up(fp_mul_up(a, a), -fp_mul_dn(alpha, a));
+        double gb = fp_add_up(fp_mul_up(b, b), -fp_mul_dn(alpha, b));
+        double glo = -fp_mul_up(fp_mul_up(alpha, alpha), 0.25);
+        ok = isfinite(alpha) && center_radius(ia_make(glo, fmax(ga, gb)), &zeta, &delta);
+    }
+    finish(ctx, z, x, ok, alpha, zeta, delta, ia_sqr(r), fl);
 }
 
 void aa_recip(aa_context *ctx, aa_form *z, const aa_form *x)

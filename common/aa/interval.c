@@ -22,16 +22,11 @@
 /* small helpers                                                           */
 /* ---------------------------------------------------------------------- */
 
-static double min2(double a, double b) { return a < b ? a : b; }
-static double max2(double a, double b) { return a > b ? a : b; }
-static double min4(double a, double b, double c, double d)
-{
-    return min2(min2(a, b), min2(c, d));
-}
-static double max4(double a, double b, double c, double d)
-{
-    return max2(max2(a, b), max2(c, d));
-}
+#define min2 ia_min2_
+#define max2 ia_max2_
+#define min4 ia_min4_
+#define max4 ia_max4_
+#define mk ia_mk_
 
 /* libm result v widened to an enclosure of the exact function value. */
 static double lm_dn(double v) { return fp_down_by(v, AA_LIBM_ULPS); }
@@ -41,29 +36,6 @@ static double lm_up(double v) { return fp_up_by(v, AA_LIBM_ULPS); }
 /* construction                                                            */
 /* ---------------------------------------------------------------------- */
 
-static ia_interval mk(double lo, double hi, unsigned flags)
-{
-    ia_interval r = { lo, hi, flags };
-    if (lo != lo || hi != hi) {
-        r.lo = -INFINITY;
-        r.hi = INFINITY;
-    }
-    if (r.lo == -INFINITY || r.hi == INFINITY)
-        r.flags |= AA_UNBOUNDED;
-    return r;
-}
-
-ia_interval ia_make(double lo, double hi) { return mk(lo, hi, 0); }
-ia_interval ia_point(double x) { return mk(x, x, 0); }
-ia_interval ia_entire(void) { return mk(-INFINITY, INFINITY, AA_UNBOUNDED); }
-
-ia_interval ia_empty(void)
-{
-    ia_interval r = { INFINITY, -INFINITY, 0 };
-    return r;
-}
-
-bool ia_is_empty(ia_interval x) { return !(x.lo <= x.hi); }
 bool ia_contains(ia_interval x, double v) { return x.lo <= v && v <= x.hi; }
 double ia_width(ia_interval x) { return fp_add_up(x.hi, -x.lo); }
 
@@ -75,12 +47,6 @@ double ia_mid(ia_interval x)
     return m;
 }
 
-ia_interval ia_hull(ia_interval x, ia_interval y)
-{
-    if (ia_is_empty(x)) { y.flags |= x.flags; return y; }
-    if (ia_is_empty(y)) { x.flags |= y.flags; return x; }
-    return mk(min2(x.lo, y.lo), max2(x.hi, y.hi), x.flags | y.flags);
-}
 
 ia_interval ia_merge(ia_interval x, ia_interval y)
 {
@@ -105,50 +71,9 @@ ia_interval ia_merge(ia_interval x, ia_interval y)
 /* affine operations                                                       */
 /* ---------------------------------------------------------------------- */
 
-ia_interval ia_add(ia_interval x, ia_interval y)
-{
-    RETURN_IF_EMPTY2(x, y);
-    return mk(fp_add_dn(x.lo, y.lo), fp_add_up(x.hi, y.hi), x.flags | y.flags);
-}
-
-ia_interval ia_sub(ia_interval x, ia_interval y)
-{
-    RETURN_IF_EMPTY2(x, y);
-    return mk(fp_add_dn(x.lo, -y.hi), fp_add_up(x.hi, -y.lo), x.flags | y.flags);
-}
-
-ia_interval ia_neg(ia_interval x)
-{
-    RETURN_IF_EMPTY1(x);
-    return mk(-x.hi, -x.lo, x.flags);
-}
-
-ia_interval ia_add_s(ia_interval x, double s)
-{
-    return ia_add(x, ia_point(s));
-}
-
-ia_interval ia_mul_s(ia_interval x, double s)
-{
-    RETURN_IF_EMPTY1(x);
-    if (s >= 0)
-        return mk(fp_mul_dn(x.lo, s), fp_mul_up(x.hi, s), x.flags);
-    return mk(fp_mul_dn(x.hi, s), fp_mul_up(x.lo, s), x.flags);
-}
-
 /* ---------------------------------------------------------------------- */
 /* products, quotients, powers                                             */
 /* ---------------------------------------------------------------------- */
-
-ia_interval ia_mul(ia_interval x, ia_interval y)
-{
-    RETURN_IF_EMPTY2(x, y);
-    double lo = min4(fp_mul_dn(x.lo, y.lo), fp_mul_dn(x.lo, y.hi),
-                     fp_mul_dn(x.hi, y.lo), fp_mul_dn(x.hi, y.hi));
-    double hi = max4(fp_mul_up(x.lo, y.lo), fp_mul_up(x.lo, y.hi),
-                     fp_mul_up(x.hi, y.lo), fp_mul_up(x.hi, y.hi));
-    return mk(lo, hi, x.flags | y.flags);
-}
 
 ia_interval ia_recip(ia_interval x)
 {

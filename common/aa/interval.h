@@ -22,7 +22,10 @@
 #ifndef AA_INTERVAL_H
 #define AA_INTERVAL_H
 
+#include <math.h>
 #include <stdbool.h>
+
+#include "aa/rounding.h"
 
 enum {
     AA_DISCONTINUOUS = 1u << 0,
@@ -35,26 +38,14 @@ typedef struct ia_interval {
 } ia_interval;
 
 /* ---- construction and queries ---- */
-ia_interval ia_make(double lo, double hi);  /* requires lo <= hi */
-ia_interval ia_point(double x);
-ia_interval ia_entire(void);                /* [-inf, +inf], AA_UNBOUNDED */
-ia_interval ia_empty(void);
-bool ia_is_empty(ia_interval x);
 bool ia_contains(ia_interval x, double v);
 double ia_width(ia_interval x);              /* rounded up */
 double ia_mid(ia_interval x);
-ia_interval ia_hull(ia_interval x, ia_interval y);    /* keeps flags of both */
 ia_interval ia_merge(ia_interval x, ia_interval y);   /* hull + AA_DISCONTINUOUS */
 
 /* ---- affine operations ---- */
-ia_interval ia_add(ia_interval x, ia_interval y);
-ia_interval ia_sub(ia_interval x, ia_interval y);
-ia_interval ia_neg(ia_interval x);
-ia_interval ia_add_s(ia_interval x, double s);
-ia_interval ia_mul_s(ia_interval x, double s);
 
 /* ---- non-affine operations ---- */
-ia_interval ia_mul(ia_interval x, ia_interval y);
 ia_interval ia_div(ia_interval x, ia_interval y);   /* 0 in y: entire, flagged */
 ia_interval ia_recip(ia_interval x);
 ia_interval ia_sqr(ia_interval x);
@@ -83,5 +74,108 @@ ia_interval ia_step(ia_interval edge, ia_interval x);   /* x < edge ? 0 : 1 */
 ia_interval ia_smoothstep(ia_interval e0, ia_interval e1, ia_interval x);
 ia_interval ia_clamp(ia_interval x, ia_interval lo, ia_interval hi);
 ia_interval ia_mix(ia_interval x, ia_interval y, ia_interval a);
+
+/* ---- the hot operations, inline (every affine operation keeps its
+ * interval hull with them): construction, hull, + - * by a scalar, * ---- */
+
+static inline double ia_min2_(double a, double b) { return a < b ? a : b; }
+static inline double ia_max2_(double a, double b) { return a > b ? a : b; }
+static inline double ia_min4_(double a, double b, double c, double d)
+{
+    return ia_min2_(ia_min2_(a, b), ia_min2_(c, d));
+}
+static inline double ia_max4_(double a, double b, double c, double d)
+{
+    return ia_max2_(ia_max2_(a, b), ia_max2_(c, d));
+}
+
+/* [lo, hi] with flags; a NaN end makes the whole line; an infinite end
+ * flags the result unbounded */
+static inline ia_interval ia_mk_(double lo, double hi, unsigned flags)
+{
+    ia_interval r = { lo, hi, flags };
+    if (lo != lo || hi != hi) {
+        r.lo = -INFINITY;
+        r.hi = INFINITY;
+    }
+    if (r.lo == -INFINITY || r.hi == INFINITY)
+        r.flags |= AA_UNBOUNDED;
+    return r;
+}
+
+static inline ia_interval ia_make(double lo, double hi) { return ia_mk_(lo, hi, 0); } /* lo <= hi */
+static inline ia_interval ia_point(double x) { return ia_mk_(x, x, 0); }
+static inline ia_interval ia_entire(void)    /* [-inf, +inf], AA_UNBOUNDED */
+{
+    return ia_mk_(-INFINITY, INFINITY, AA_UNBOUNDED);
+}
+static inline ia_interval ia_empty(void)
+{
+    ia_interval r = { INFINITY, -INFINITY, 0 };
+    return r;
+}
+static inline bool ia_is_empty(ia_interval x) { return !(x.lo <= x.hi); }
+
+/* keeps the flags of both */
+static inline ia_interval ia_hull(ia_interval x, ia_interval y)
+{
+    if (ia_is_empty(x)) { y.flags |= x.flags; return y; }
+    if (ia_is_empty(y)) { x.flags |= y.flags; return x; }
+    return ia_mk_(ia_min2_(x.lo, y.lo), ia_max2_(x.hi, y.hi), x.flags | y.flags);
+}
+
+/* an empty operand gives an empty result with the flags of both */
+static inline ia_interval ia_empty_of_(unsigned flags)
+{
+    ia_interval e = ia_empty();
+    e.flags = flags;
+    return e;
+}
+
+static inline ia_interval ia_add(ia_interval x, ia_interval y)
+{
+    if (ia_is_empty(x) || ia_is_empty(y))
+        return ia_empty_of_(x.flags | y.flags);
+    return ia_mk_(fp_add_dn(x.lo, y.lo), fp_add_up(x.hi, y.hi), x.flags | y.flags);
+}
+
+static inline ia_interval ia_sub(ia_interval x, ia_interval y)
+{
+    if (ia_is_empty(x) || ia_is_empty(y))
+        return ia_empty_of_(x.flags | y.flags);
+    return ia_mk_(fp_add_dn(x.lo, -y.hi), fp_add_up(x.hi, -y.lo), x.flags | y.flags);
+}
+
+static inline ia_interval ia_neg(ia_interval x)
+{
+    if (ia_is_empty(x))
+        return x;
+    return ia_mk_(-x.hi, -x.lo, x.flags);
+}
+
+static inline ia_interval ia_add_s(ia_interval x, double s)
+{
+    return ia_add(x, ia_point(s));
+}
+
+static inline ia_interval ia_mul_s(ia_interval x, double s)
+{
+    if (ia_is_empty(x))
+        return x;
+    if (s >= 0)
+        return ia_mk_(fp_mul_dn(x.lo, s), fp_mul_up(x.hi, s), x.flags);
+    return ia_mk_(fp_mul_dn(x.hi, s), fp_mul_up(x.lo, s), x.flags);
+}
+
+static inline ia_interval ia_mul(ia_interval x, ia_interval y)
+{
+    if (ia_is_empty(x) || ia_is_empty(y))
+        return ia_empty_of_(x.flags | y.flags);
+    double lo = ia_min4_(fp_mul_dn(x.lo, y.lo), fp_mul_dn(x.lo, y.hi),
+                         fp_mul_dn(x.hi, y.lo), fp_mul_dn(x.hi, y.hi));
+    double hi = ia_max4_(fp_mul_up(x.lo, y.lo), fp_mul_up(x.lo, y.hi),
+                         fp_mul_up(x.hi, y.lo), fp_mul_up(x.hi, y.hi));
+    return ia_mk_(lo, hi, x.flags | y.flags);
+}
 
 #endif

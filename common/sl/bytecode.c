@@ -79,6 +79,32 @@ bool sl_program_derivatives_reach_P(const sl_program *p)
     return false;
 }
 
+/* Conservative: does any instruction name a slot of global g (read or
+ * written, as the first slot of an operand of up to three, or in a merge
+ * table)? A program that never names dPdu need not be given it. */
+bool sl_program_reads_global(const sl_program *p, sl_global g)
+{
+    int first = sl_global_slot(g), last = first + sl_global_size(g) - 1;
+    for (int pc = 0; pc < p->ncode; pc++) {
+        const sl_insn *in = &p->code[pc];
+        const char *k = kinds[in->op];
+        const uint16_t ops[4] = { in->a, in->b, in->c, in->d };
+        for (int i = 0; i < 4; i++) {
+            if ((k[i] == 'x' || k[i] == 'z') && ops[i] <= last && ops[i] + 15 >= first)
+                return true;
+            if (k[i] == 't' && ops[i] < p->ntables) {
+                const uint16_t *t = &p->tables[ops[i]];
+                for (int e = 1; e <= t[0] && ops[i] + e < p->ntables; e++) {
+                    int slot = t[e] & SL_TABLE_SLOT;
+                    if (!(t[e] & SL_TABLE_STRING) && slot <= last && slot + 15 >= first)
+                        return true;
+                }
+            }
+        }
+    }
+    return false;
+}
+
 void sl_program_free(sl_program *p)
 {
     if (!p)

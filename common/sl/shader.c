@@ -46,6 +46,7 @@ void sl_program_destroy(sl_program **self_p)
 const char *sl_program_name(const sl_program *self) { return self->name; }
 sl_shader_kind sl_program_kind(const sl_program *self) { return self->kind; }
 int sl_program_param_count(const sl_program *self) { return self->nparams; }
+bool sl_program_takes_derivatives(const sl_program *self) { return self->takes_derivatives; }
 
 void sl_program_param(const sl_program *self, int index, sl_param_info *info)
 {

@@ -93,6 +93,11 @@ typedef struct sl_param_info {
     sl_type type;
     bool output;
 } sl_param_info;
+/* Whether the program may touch global g (conservative: an operand that
+ * could be a matrix or triple starting below g counts too). */
+bool sl_program_reads_global(const sl_program *self, sl_global g);
+/* Whether range runs carry derivative bounds (sl_program_derivatives_reach_P). */
+bool sl_program_takes_derivatives(const sl_program *self);
 int sl_program_param_count(const sl_program *self);
 void sl_program_param(const sl_program *self, int index, sl_param_info *info);
 int sl_program_find_param(const sl_program *self, const char *name); /* -1 */

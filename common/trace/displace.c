@@ -37,15 +37,12 @@ static inline void dual_const_(sl_dual *z, double k) { *z = (sl_dual){k, 0, 0}; 
 
 /* ---- affine ---- */
 
+/* out = m * in (a point: with m's translation); out must not alias in */
 static void aa_xform(aa_context *ctx, const mat4 *m, const aa_form in[3],
                      aa_form out[3], bool point)
 {
-    aa_form t;
-    for (int i = 0; i < 3; i++) {
-        aa_lincomb(ctx, &t, m->m[i][0], &in[0], m->m[i][1], &in[1],
-                   point ? m->m[i][3] : 0.0);
-        aa_lincomb(ctx, &out[i], 1.0, &t, m->m[i][2], &in[2], 0.0);
-    }
+    for (int i = 0; i < 3; i++)
+        aa_lincomb3(ctx, &out[i], m->m[i], in, point ? m->m[i][3] : 0.0);
 }
 
 /* The camera-space unit normal from the object-space one Nn: the inverse
@@ -136,17 +133,24 @@ static void box_affine(trace_thread *th, const trace_object *obj,
     aa_xform(ctx, &obj->to_camera, g.P, P, true);
     geom_unit_normal_aa(ctx, &obj->surf, &u, &v, &g, Nn);
     aa_camera_normal(ctx, obj, Nn, N);
-    aa_xform(ctx, &obj->to_camera, g.dPdu, dPdu, false);
-    aa_xform(ctx, &obj->to_camera, g.dPdv, dPdv, false);
+    ia_interval Pd[2][3];
+    if (obj->box_skip_tangents) {         /* never read: not computed */
+        for (int i = 0; i < 3; i++) {
+            aa_const(&dPdu[i], 0.0);
+            aa_const(&dPdv[i], 0.0);
+        }
+    } else {
+        aa_xform(ctx, &obj->to_camera, g.dPdu, dPdu, false);
+        aa_xform(ctx, &obj->to_camera, g.dPdv, dPdv, false);
+        for (int i = 0; i < 3; i++) {
+            Pd[0][i] = aa_range(&dPdu[i]);
+            Pd[1][i] = aa_range(&dPdv[i]);
+        }
+    }
 
     sl_vm *vm = th->vm;
-    ia_interval Pd[2][3];
-    for (int i = 0; i < 3; i++) {
-        Pd[0][i] = aa_range(&dPdu[i]);
-        Pd[1][i] = aa_range(&dPdv[i]);
-    }
     bind_globals_affine(vm, obj, &obj->displacement_spaces, P, N, N, dPdu, dPdv, &u, &v,
-                        Pd, flat_normal(obj));
+                        obj->box_skip_tangents ? NULL : Pd, flat_normal(obj));
     if (sl_vm_run(vm, obj->displacement, SL_MODE_AFFINE, ctx) != SL_OK) {
         trace_thread_fail(th, sl_vm_error(vm));
         aa_unbounded(&P[0], AA_UNBOUNDED);
@@ -212,13 +216,18 @@ static void box_interval(trace_thread *th, const trace_object *obj,
     ia_xform(&obj->to_camera, g.P, P, true);
     geom_unit_normal_ia(&obj->surf, u, v, &g, Nn);
     ia_camera_normal(obj, Nn, N);
-    ia_xform(&obj->to_camera, g.dPdu, dPdu, false);
-    ia_xform(&obj->to_camera, g.dPdv, dPdv, false);
+    if (obj->box_skip_tangents) {         /* never read: not computed */
+        for (int i = 0; i < 3; i++)
+            dPdu[i] = dPdv[i] = ia_point(0.0);
+    } else {
+        ia_xform(&obj->to_camera, g.dPdu, dPdu, false);
+        ia_xform(&obj->to_camera, g.dPdv, dPdv, false);
+    }
 
     sl_vm *vm = th->vm;
     ia_interval Pd[2][3] = {{dPdu[0], dPdu[1], dPdu[2]}, {dPdv[0], dPdv[1], dPdv[2]}};
     bind_globals_interval(vm, obj, &obj->displacement_spaces, P, N, N, dPdu, dPdv, &u, &v,
-                          Pd, flat_normal(obj));
+                          obj->box_skip_tangents ? NULL : Pd, flat_normal(obj));
     if (sl_vm_run(vm, obj->displacement, SL_MODE_INTERVAL, NULL) != SL_OK) {
         trace_thread_fail(th, sl_vm_error(vm));
         P[0] = P[1] = P[2] = ia_entire();

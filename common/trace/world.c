@@ -120,6 +120,10 @@ bool trace_world_prepare(trace_world *world, char *err, int errsz)
         obj->normal_len2[0] = lo * lo * (1.0 - 1e-9);
         obj->normal_len2[1] = si * si * (1.0 + 1e-9);
         grid_spacing(world, obj);
+        const sl_program *dp = obj->displacement ? sl_instance_program(obj->displacement) : NULL;
+        obj->box_skip_tangents = dp && !sl_program_takes_derivatives(dp) &&
+                                 !sl_program_reads_global(dp, SL_G_dPdu) &&
+                                 !sl_program_reads_global(dp, SL_G_dPdv);
     }
     return true;
 }

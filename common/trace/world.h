@@ -43,6 +43,9 @@ typedef struct trace_object {
     double normal_len2[2];         /* bounds of |from_camera^T n|^2, n unit */
     double du, dv;                 /* the shader globals du, dv: per-object
                                       constants (render.c, docs/renderer.md) */
+    bool box_skip_tangents;        /* the displacement shader never names dPdu,
+                                      dPdv nor takes derivatives: boxes need
+                                      not transform the tangents (world.c) */
     trace_box root;                /* OBJECT space box over the whole (u,v) square */
     trace_box bound;               /* camera space box of root (for the BVH) */
 } trace_object;
