@@ -209,59 +209,11 @@ static double sum_err_bound(double es)
     return es == 0.0 ? 0.0 : fp_next_up(es * (1.0 + 0x1p-45));
 }
 
-/*
- * Bound on the rounding of the coefficients of a*x + b*y: each is
- * s = RN(RN(a xi) + RN(b yi)), whose error is at most u|s| for the addition
- * (an addition never errs in the subnormal range) plus u|a xi| + eta and
- * u|b yi| + eta for products by a factor other than 0 and +-1 (u = 2^-53,
- * eta = 2^-1075). With S = sum |s|, X = sum |xi|, Y = sum |yi| (in RN):
- * err <= u (S + |a| X + |b| Y) + eta per product that underflowed (uflow
- * counts those that may have), and fp_rounding_bound's 2u covers
- * the RN error of the sums themselves. A combination of exact factors whose
- * coefficients all cancel (x - x) adds nothing.
- */
-static double coef_err_bound(double S, double X, double Y, double a, double b,
-                             bool ea, bool eb, int uflow)
-{
-    double acc = S;
-    if (!ea) acc += fp_mul_up(fabs(a), X);
-    if (!eb) acc += fp_mul_up(fabs(b), Y);
-    return fp_rounding_bound(acc, uflow);
-}
-
-/* a*[lo, hi] (a finite, a != 0) before rounding: ends for the hull below */
+/* a*[lo, hi] (a finite, a != 0) before rounding: the ends of a hull */
 static inline void scale_ends(double a, double lo, double hi, double *l, double *h)
 {
     if (a > 0.0) { *l = a * lo; *h = a * hi; }
     else { *l = a * hi; *h = a * lo; }
-}
-
-/*
- * The hull of a*x + b*y + c from the operands' hulls, computed in RN and
- * moved outward by a bound of its rounding: 2u times the sum of the
- * magnitudes of every intermediate result, plus the products' underflow.
- */
-static void lincomb_hull(aa_form *z, double a, const aa_form *x, double b,
-                         const aa_form *y, double c)
-{
-    double xl = 0.0, xh = 0.0, yl = 0.0, yh = 0.0;
-    if (a != 0.0) scale_ends(a, x->lo, x->hi, &xl, &xh);
-    if (b != 0.0) scale_ends(b, y->lo, y->hi, &yl, &yh);
-    double l1 = xl + yl, lo = l1 + c;
-    double h1 = xh + yh, hi = h1 + c;
-    double el = fabs(xl) + fabs(yl) + fabs(l1) + fabs(lo);
-    double eh = fabs(xh) + fabs(yh) + fabs(h1) + fabs(hi);
-    if (!exact_factor(a) || !exact_factor(b) || c != 0.0) {
-        int uf = (!exact_factor(a) && (fabs(xl) < 0x1p-1022 || fabs(xh) < 0x1p-1022)) +
-                 (!exact_factor(b) && (fabs(yl) < 0x1p-1022 || fabs(yh) < 0x1p-1022));
-        lo = fp_add_dn(lo, -fp_rounding_bound(el, uf));
-        hi = fp_add_up(hi, fp_rounding_bound(eh, uf));
-    } else {                          /* one addition: no underflow error */
-        if (el != 0.0) lo = fp_add_dn(lo, -fp_next_up(el * 0x1p-52));
-        if (eh != 0.0) hi = fp_add_up(hi, fp_next_up(eh * 0x1p-52));
-    }
-    z->lo = lo == lo ? lo : -INFINITY;
-    z->hi = hi == hi ? hi : INFINITY;
 }
 
 void aa_lincomb(aa_context *ctx, aa_form *z, double a, const aa_form *x,
@@ -283,62 +235,46 @@ void aa_lincomb(aa_context *ctx, aa_form *z, double a, const aa_form *x,
     flags &= ~AA_UNBOUNDED;
     bool ea = exact_factor(a), eb = exact_factor(b);
     int xn = (a == 0.0) ? 0 : x->n, yn = (b == 0.0) ? 0 : y->n;
-    int n = xn > yn ? xn : yn, m = xn < yn ? xn : yn;
+    int n = xn > yn ? xn : yn;
     double x0 = x->x0, y0 = y->x0;
     double xe = a == 0.0 ? 0.0 : x->err, ye = b == 0.0 ? 0.0 : y->err;
-    lincomb_hull(z, a, x, b, y, c);
+    ia_interval hull = ia_add_s(ia_add(ia_mul_s(ia_make(x->lo, x->hi), a),
+                                       ia_mul_s(ia_make(y->lo, y->hi), b)), c);
 
-    /* coefficients: the common part, then the longer operand's tail */
-    double S = 0.0, X = 0.0, Y = 0.0;
-    int i = 0, uf = 0;
-    for (; i < m; i++) {
-        double xi = x->c[i], yi = y->c[i];
+    double es = 0.0;      /* sum of exact errors of the additions */
+    double ap = 0.0;      /* sum of |inexact products| */
+    int uf = 0;           /* products that may have underflowed */
+    for (int i = 0; i < n; i++) {
+        double xi = i < xn ? x->c[i] : 0.0;
+        double yi = i < yn ? y->c[i] : 0.0;
         double p = a * xi, q = b * yi, s = p + q;
-        S += fabs(s);
-        X += fabs(xi);
-        Y += fabs(yi);
-        uf += fp_uflow(p, a, xi) + fp_uflow(q, b, yi);
+        es += fabs(fp_two_sum_err(p, q, s));
+        if (!ea) { ap += fabs(p); uf += fp_uflow(p, a, xi); }
+        if (!eb) { ap += fabs(q); uf += fp_uflow(q, b, yi); }
         z->c[i] = s;
     }
-    for (; i < xn; i++) {
-        double xi = x->c[i], s = a * xi;
-        S += fabs(s);
-        X += fabs(xi);
-        uf += fp_uflow(s, a, xi);
-        z->c[i] = s;
-    }
-    for (; i < yn; i++) {
-        double yi = y->c[i], s = b * yi;
-        S += fabs(s);
-        Y += fabs(yi);
-        uf += fp_uflow(s, b, yi);
-        z->c[i] = s;
-    }
-    double err = coef_err_bound(S, X, Y, a, b, ea, eb, uf);
-
-    /* the centre: exact errors (TwoSum), so sums of points stay points */
     double p = a * x0, q = b * y0;
     double s1 = p + q, s2 = s1 + c;
-    double es = fabs(fp_two_sum_err(p, q, s1)) + fabs(fp_two_sum_err(s1, c, s2));
-    double ap = 0.0;
-    int np = 0, puf = 0;
-    if (!ea && x0 != 0.0) { ap += fabs(p); np++; puf += fp_uflow(p, a, x0); }
-    if (!eb && y0 != 0.0) { ap += fabs(q); np++; puf += fp_uflow(q, b, y0); }
+    es += fabs(fp_two_sum_err(p, q, s1)) + fabs(fp_two_sum_err(s1, c, s2));
+    if (!ea) { ap += fabs(p); uf += fp_uflow(p, a, x0); }
+    if (!eb) { ap += fabs(q); uf += fp_uflow(q, b, y0); }
 
+    double err = 0.0;
     if (xe != 0.0)
-        err = fp_add_up(err, ea ? xe : fp_mul_up(fabs(a), xe));
+        err = ea ? xe : fp_mul_up(fabs(a), xe);
     if (ye != 0.0)
         err = fp_add_up(err, eb ? ye : fp_mul_up(fabs(b), ye));
     if (es != 0.0)
         err = fp_add_up(err, sum_err_bound(es));
-    if (np > 0)
-        err = fp_add_up(err, fp_rounding_bound(ap, puf));
+    err = fp_add_up(err, fp_rounding_bound(ap, uf));
 
     z->x0 = s2;
     z->err = err;
+    z->lo = hull.lo;
+    z->hi = hull.hi;
     z->n = (unsigned short)n;
     z->flags = (unsigned short)flags;
-    if (!isfinite(s2) || !isfinite(err) || !isfinite(S) || !isfinite(ap))
+    if (!isfinite(s2) || !isfinite(err) || !isfinite(es) || !isfinite(ap))
         aa_unbounded(z, flags);
 }
 
