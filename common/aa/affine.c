@@ -434,6 +434,13 @@ void aa_mul(aa_context *ctx, aa_form *z, const aa_form *x, const aa_form *y)
         aa_unbounded(z, flags);
         return;
     }
+    if (x->n == 0 && y->n == 0) {         /* no shared symbols: see affine_funcs.c */
+        aa_context none;
+        aa_context_init(&none, 0);
+        ia_interval r = ia_mul(aa_range(x), aa_range(y));
+        aa_set_interval(&none, z, r, r.flags);
+        return;
+    }
     double rx = aa_radius(x), ry = aa_radius(y);
     ia_interval hull = ia_mul(aa_range(x), aa_range(y));
     int n = x->n > y->n ? x->n : y->n;

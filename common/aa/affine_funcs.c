@@ -191,6 +191,37 @@ static void approx_taylor(aa_context *ctx, aa_form *z, const aa_form *x,
     finish(ctx, z, x, ok, alpha, zeta, delta, fallback, flags);
 }
 
+/*
+ * Operands without shared noise symbols (n == 0: x0 +- err, the error
+ * private) have no correlation a linear approximation could keep: whatever
+ * it would put on a new symbol stays unrelated to everything else. So the
+ * interval result, on the private error term, is as tight, spends no noise
+ * symbol and costs one interval operation. Constants, uniform values and
+ * the flat normal of a polygon (normalize(N) in most displacement shaders)
+ * go this way.
+ */
+static void private_result(aa_form *z, ia_interval r)
+{
+    aa_context none;
+    aa_context_init(&none, 0);
+    aa_set_interval(&none, z, r, r.flags);
+}
+
+#define PRIVATE1(z, x, f)                                                   \
+    do {                                                                    \
+        if ((x)->n == 0) {                                                  \
+            private_result((z), f(aa_range(x)));                            \
+            return;                                                         \
+        }                                                                   \
+    } while (0)
+#define PRIVATE2(z, x, y, f)                                                \
+    do {                                                                    \
+        if ((x)->n == 0 && (y)->n == 0) {                                   \
+            private_result((z), f(aa_range(x), aa_range(y)));               \
+            return;                                                         \
+        }                                                                   \
+    } while (0)
+
 /* The operand's range, with the flags the result inherits. */
 static ia_interval operand_range(const aa_form *x, unsigned *flags)
 {
@@ -354,6 +385,7 @@ static double t_ramp(double al, double p, double q, const void *arg)
  */
 void aa_sqr(aa_context *ctx, aa_form *z, const aa_form *x)
 {
+    PRIVATE1(z, x, ia_sqr);
     unsigned fl;
     ia_interval r = operand_range(x, &fl);
     double a = r.lo, b = r.hi;
@@ -371,6 +403,7 @@ void aa_sqr(aa_context *ctx, aa_form *z, const aa_form *x)
 
 void aa_recip(aa_context *ctx, aa_form *z, const aa_form *x)
 {
+    PRIVATE1(z, x, ia_recip);
     unsigned fl;
     ia_interval r = operand_range(x, &fl);
     static const convex_fn fn = { f_recip, d_recip, t_recip, NULL };
@@ -395,6 +428,7 @@ void aa_div(aa_context *ctx, aa_form *z, const aa_form *x, const aa_form *y)
 
 void aa_sqrt(aa_context *ctx, aa_form *z, const aa_form *x)
 {
+    PRIVATE1(z, x, ia_sqrt);
     unsigned fl;
     ia_interval r = operand_range(x, &fl);
     static const convex_fn fn = { f_sqrt, d_sqrt, t_sqrt, NULL };
@@ -409,6 +443,7 @@ void aa_sqrt(aa_context *ctx, aa_form *z, const aa_form *x)
 
 void aa_invsqrt(aa_context *ctx, aa_form *z, const aa_form *x)
 {
+    PRIVATE1(z, x, ia_invsqrt);
     unsigned fl;
     ia_interval r = operand_range(x, &fl);
     static const convex_fn fn = { f_invsqrt, d_invsqrt, t_invsqrt, NULL };
@@ -422,6 +457,7 @@ void aa_invsqrt(aa_context *ctx, aa_form *z, const aa_form *x)
 
 void aa_exp(aa_context *ctx, aa_form *z, const aa_form *x)
 {
+    PRIVATE1(z, x, ia_exp);
     unsigned fl;
     ia_interval r = operand_range(x, &fl);
     static const convex_fn fn = { f_exp, f_exp, t_exp, NULL };
@@ -431,6 +467,7 @@ void aa_exp(aa_context *ctx, aa_form *z, const aa_form *x)
 
 void aa_log(aa_context *ctx, aa_form *z, const aa_form *x)
 {
+    PRIVATE1(z, x, ia_log);
     unsigned fl;
     ia_interval r = operand_range(x, &fl);
     static const convex_fn fn = { f_log, d_log, t_log, NULL };
@@ -457,6 +494,10 @@ void aa_pow_int(aa_context *ctx, aa_form *z, const aa_form *x, int n)
     }
     if (n == 2) {
         aa_sqr(ctx, z, x);
+        return;
+    }
+    if (x->n == 0) {
+        private_result(z, ia_pow_int(aa_range(x), n));
         return;
     }
     unsigned fl;
@@ -495,6 +536,7 @@ void aa_pow(aa_context *ctx, aa_form *z, const aa_form *x, const aa_form *y)
         z->flags |= (unsigned short)(yf & ~AA_UNBOUNDED);
         return;
     }
+    PRIVATE2(z, x, y, ia_pow);
     unsigned fl = (x->flags | y->flags) & ~AA_UNBOUNDED;
     ia_interval rx = aa_range(x), ry = aa_range(y);
     ia_interval fallback = ia_pow(rx, ry);
@@ -528,6 +570,7 @@ static ia_interval neg_cos(ia_interval x) { return ia_neg(ia_cos(x)); }
 
 void aa_sin(aa_context *ctx, aa_form *z, const aa_form *x)
 {
+    PRIVATE1(z, x, ia_sin);
     unsigned fl;
     ia_interval r = operand_range(x, &fl);
     ia_interval fallback = ia_sin(r);
@@ -537,6 +580,7 @@ void aa_sin(aa_context *ctx, aa_form *z, const aa_form *x)
 
 void aa_cos(aa_context *ctx, aa_form *z, const aa_form *x)
 {
+    PRIVATE1(z, x, ia_cos);
     unsigned fl;
     ia_interval r = operand_range(x, &fl);
     ia_interval fallback = ia_cos(r);
@@ -552,6 +596,7 @@ static ia_interval d_tan(ia_interval x)
 
 void aa_tan(aa_context *ctx, aa_form *z, const aa_form *x)
 {
+    PRIVATE1(z, x, ia_tan);
     unsigned fl;
     ia_interval r = operand_range(x, &fl);
     ia_interval fallback = ia_tan(r);
@@ -566,6 +611,7 @@ void aa_tan(aa_context *ctx, aa_form *z, const aa_form *x)
 
 void aa_asin(aa_context *ctx, aa_form *z, const aa_form *x)
 {
+    PRIVATE1(z, x, ia_asin);
     unsigned fl;
     ia_interval r = operand_range(x, &fl);
     ia_interval fallback = ia_asin(r);
@@ -582,6 +628,7 @@ void aa_asin(aa_context *ctx, aa_form *z, const aa_form *x)
 
 void aa_acos(aa_context *ctx, aa_form *z, const aa_form *x)
 {
+    PRIVATE1(z, x, ia_acos);
     unsigned fl;
     ia_interval r = operand_range(x, &fl);
     ia_interval fallback = ia_acos(r);
@@ -598,6 +645,7 @@ void aa_acos(aa_context *ctx, aa_form *z, const aa_form *x)
 
 void aa_atan(aa_context *ctx, aa_form *z, const aa_form *x)
 {
+    PRIVATE1(z, x, ia_atan);
     unsigned fl;
     ia_interval r = operand_range(x, &fl);
     static const convex_fn fn = { f_atan, d_atan, t_atan, NULL };
@@ -623,6 +671,7 @@ static void add_interval_constant(aa_context *ctx, aa_form *z, const aa_form *w,
  * +-pi/2 - atan(x/y) for y > 0 or y < 0. */
 void aa_atan2(aa_context *ctx, aa_form *z, const aa_form *y, const aa_form *x)
 {
+    PRIVATE2(z, y, x, ia_atan2);
     unsigned fl = (x->flags | y->flags) & ~AA_UNBOUNDED;
     ia_interval rx = aa_range(x), ry = aa_range(y);
     ia_interval fallback = ia_atan2(ry, rx);
@@ -659,6 +708,7 @@ void aa_atan2(aa_context *ctx, aa_form *z, const aa_form *y, const aa_form *x)
  * and 0 at t = 0; its maximum is at an end point. */
 void aa_abs(aa_context *ctx, aa_form *z, const aa_form *x)
 {
+    PRIVATE1(z, x, ia_abs);
     unsigned fl;
     ia_interval r = operand_range(x, &fl);
     if (r.lo >= 0) {
@@ -689,6 +739,10 @@ void aa_abs(aa_context *ctx, aa_form *z, const aa_form *x)
 static void min_max(aa_context *ctx, aa_form *z, const aa_form *x,
                     const aa_form *y, double sign)
 {
+    if (x->n == 0 && y->n == 0) {
+        private_result(z, sign < 0 ? ia_min(aa_range(x), aa_range(y)) : ia_max(aa_range(x), aa_range(y)));
+        return;
+    }
     ia_interval rx = aa_range(x), ry = aa_range(y);
     unsigned fl = x->flags | y->flags;
     if (rx.hi <= ry.lo || ry.hi <= rx.lo) {   /* ordered: no new error */
@@ -744,6 +798,10 @@ void aa_clamp(aa_context *ctx, aa_form *z, const aa_form *x,
 void aa_mix(aa_context *ctx, aa_form *z, const aa_form *x, const aa_form *y,
             const aa_form *a)
 {
+    if (x->n == 0 && y->n == 0 && a->n == 0) {
+        private_result(z, ia_mix(aa_range(x), aa_range(y), aa_range(a)));
+        return;
+    }
     ia_interval hull = ia_mix(aa_range(x), aa_range(y), aa_range(a));
     aa_form d;
     aa_sub(ctx, &d, y, x);
@@ -764,6 +822,10 @@ void aa_mix(aa_context *ctx, aa_form *z, const aa_form *x, const aa_form *y,
 void aa_smoothstep(aa_context *ctx, aa_form *z, const aa_form *e0,
                    const aa_form *e1, const aa_form *x)
 {
+    if (e0->n == 0 && e1->n == 0 && x->n == 0) {
+        private_result(z, ia_smoothstep(aa_range(e0), aa_range(e1), aa_range(x)));
+        return;
+    }
     unsigned fl = (x->flags | e0->flags | e1->flags) & ~AA_UNBOUNDED;
     ia_interval r0 = aa_range(e0), r1 = aa_range(e1), rx = aa_range(x);
     ia_interval fallback = ia_smoothstep(r0, r1, rx);

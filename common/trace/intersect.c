@@ -183,6 +183,36 @@ static bool partial_leaf_point(walk *w, const double r[4], double *uc, double *v
     return true;
 }
 
+/*
+ * The hit point of a leaf the surface covers whole (issue 10, exact hit
+ * points): one Newton step from the cell's centre puts it where the ray
+ * meets the surface (to second order in the cell's size), clamped to the
+ * cell, and the hit is shaded there, not at the centre. Whether the leaf is
+ * a hit does not change: a step that leaves the surface's (u,v) domain may
+ * mean the ray passes beyond the surface's edge, or only that a steep
+ * displacement is poorly linearised over the cell; dropping such leaves
+ * lost real hits of steep shaders on meshes (tests/corpus), so they stay
+ * hits, at the clamped point. Fills sp.
+ */
+static void refine_leaf_point(walk *w, const double r[4], double *uc, double *vc,
+                              trace_surface_point *sp)
+{
+    const trace_object *obj = w->obj;
+    trace_surface_point_eval(w->th, obj, *uc, *vc, sp);
+    double u, v;
+    if (!v3_is_finite(sp->P) || !newton_uv(w->cam_ray, sp, r, &u, &v))
+        return;                        /* keep the centre's point */
+    if ((u == *uc && v == *vc) || !geom_uv_inside(&obj->surf, u, v))
+        return;
+    trace_surface_point moved;
+    trace_surface_point_eval(w->th, obj, u, v, &moved);
+    if (!v3_is_finite(moved.P))
+        return;
+    *uc = u;
+    *vc = v;
+    *sp = moved;
+}
+
 static void leaf_hit(walk *w, const trace_box *box, const double r[4],
                      const child_order *o, trace_leaf_kind kind, vec3 surface_normal)
 {
@@ -198,6 +228,9 @@ static void leaf_hit(walk *w, const trace_box *box, const double r[4],
         has_point = true;
     } else if (!geom_uv_inside(&obj->surf, uc, vc)) {
         return;
+    } else if (kind == TRACE_LEAF_SMALL) {
+        refine_leaf_point(w, r, &uc, &vc, &sp);
+        has_point = true;
     }
     trace_thread *th = w->th;
     th->stats.leaves++;

@@ -496,10 +496,15 @@ static void test_two_sum(void **state)
 static void test_rounding_bound_formula(void **state)
 {
     (void)state;
-    /* positive even for acc == 0, and monotone in acc and n */
-    assert_true(fp_rounding_bound(0.0, 0) > 0.0);
+    /* zero only for nothing to bound (acc == 0, no underflow), positive
+     * where a product may have underflowed, monotone in acc and n, and
+     * never a subnormal number (rounding.h: those cost microcode assists) */
+    assert_true(fp_rounding_bound(0.0, 0) == 0.0);
     assert_true(fp_rounding_bound(0.0, 1) >= 0x1p-1073);
     assert_true(fp_rounding_bound(0.0, 10) >= 10 * 0x1p-1073);
+    assert_true(fp_rounding_bound(0x1p-1074, 0) >= 0x1p-1022);
+    assert_true(fp_rounding_bound(0x1p-1000, 3) >= 0x1p-1022);
+    assert_true(fp_rounding_bound(1e-300, 0) >= 0x1p-1022);
     assert_true(fp_rounding_bound(1.0, 1) >= 0x1p-52);
     assert_true(fp_rounding_bound(1.0, 1) <= 0x1p-52 * (1 + 0x1p-40));
     assert_true(isfinite(fp_rounding_bound(DBL_MAX, 100)));
