@@ -162,55 +162,44 @@ static bool newton_uv(const trace_ray *ray, const trace_surface_point *sp,
     return true;
 }
 
-/* A leaf whose cell the polygon covers only in part (issue 9, watertight
- * meshes): the leaf is the polygon's only where the ray meets the surface
- * on the polygon, in (u,v) from one Newton step from the cell's centre.
- * Deciding by the cell's centre instead let both polygons of a shared
- * edge drop a ray near it: the cracks of the issue's finding 4. Fills sp
- * at the (u,v) used; false: not this polygon's. */
-static bool partial_leaf_point(walk *w, const double r[4], double *uc, double *vc,
-                               trace_surface_point *sp)
-{
-    const trace_object *obj = w->obj;
-    trace_surface_point_eval(w->th, obj, *uc, *vc, sp);
-    double u, v;
-    if (!v3_is_finite(sp->P) || !newton_uv(w->cam_ray, sp, r, &u, &v))
-        return geom_uv_inside(&obj->surf, *uc, *vc);
-    if (!geom_uv_inside(&obj->surf, u, v)) return false;
-    *uc = u;
-    *vc = v;
-    trace_surface_point_eval(w->th, obj, u, v, sp);
-    return true;
-}
-
 /*
- * The hit point of a leaf the surface covers whole (issue 10, exact hit
- * points): one Newton step from the cell's centre puts it where the ray
- * meets the surface (to second order in the cell's size), clamped to the
- * cell, and the hit is shaded there, not at the centre. Whether the leaf is
- * a hit does not change: a step that leaves the surface's (u,v) domain may
- * mean the ray passes beyond the surface's edge, or only that a steep
- * displacement is poorly linearised over the cell; dropping such leaves
- * lost real hits of steep shaders on meshes (tests/corpus), so they stay
- * hits, at the clamped point. Fills sp.
+ * The point of a leaf's cell where the ray meets the surface: one Newton
+ * step from the cell's centre (newton_uv), clamped to the cell. Fills sp at
+ * the (u,v) used.
+ *
+ * A cell the polygon covers only in part (partial; issue 9, watertight
+ * meshes) is the polygon's only where that point is on the polygon: false
+ * otherwise. Deciding by the cell's centre instead let both polygons of a
+ * shared edge drop a ray near it: the cracks of issue 9's finding 4.
+ *
+ * A cell the surface covers whole is a hit either way (issue 10, exact hit
+ * points): the step only moves the point the hit is placed and shaded at,
+ * to where the ray meets the surface to second order in the cell's size.
+ * A step that leaves the (u,v) domain can mean that the ray passes beyond
+ * the surface's edge, but also only that a steep displacement is poorly
+ * linearised over the cell; dropping such leaves lost real hits of steep
+ * shaders on meshes (tests/corpus), so the centre's point stays.
  */
-static void refine_leaf_point(walk *w, const double r[4], double *uc, double *vc,
-                              trace_surface_point *sp)
+static bool leaf_point(walk *w, const double r[4], bool partial, double *uc, double *vc,
+                       trace_surface_point *sp)
 {
     const trace_object *obj = w->obj;
     trace_surface_point_eval(w->th, obj, *uc, *vc, sp);
     double u, v;
     if (!v3_is_finite(sp->P) || !newton_uv(w->cam_ray, sp, r, &u, &v))
-        return;                        /* keep the centre's point */
-    if ((u == *uc && v == *vc) || !geom_uv_inside(&obj->surf, u, v))
-        return;
+        return partial ? geom_uv_inside(&obj->surf, *uc, *vc) : true;
+    if (!geom_uv_inside(&obj->surf, u, v))
+        return !partial;
+    if (u == *uc && v == *vc)
+        return true;
     trace_surface_point moved;
     trace_surface_point_eval(w->th, obj, u, v, &moved);
-    if (!v3_is_finite(moved.P))
-        return;
+    if (!partial && !v3_is_finite(moved.P))
+        return true;
     *uc = u;
     *vc = v;
     *sp = moved;
+    return true;
 }
 
 static void leaf_hit(walk *w, const trace_box *box, const double r[4],
@@ -224,12 +213,12 @@ static void leaf_hit(walk *w, const trace_box *box, const double r[4],
     trace_surface_point sp;
     bool has_point = false;
     if (cover == GEOM_PARTIAL && kind != TRACE_LEAF_WALL) {
-        if (!partial_leaf_point(w, r, &uc, &vc, &sp)) return;
+        if (!leaf_point(w, r, true, &uc, &vc, &sp)) return;
         has_point = true;
     } else if (!geom_uv_inside(&obj->surf, uc, vc)) {
         return;
     } else if (kind == TRACE_LEAF_SMALL) {
-        refine_leaf_point(w, r, &uc, &vc, &sp);
+        leaf_point(w, r, false, &uc, &vc, &sp);
         has_point = true;
     }
     trace_thread *th = w->th;
