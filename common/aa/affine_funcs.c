@@ -62,23 +62,38 @@ typedef struct piece {
     int convex;          /* +1 convex, -1 concave, 0 linear */
 } piece;
 
-/* enclosure of g(t) = f(t) - alpha*t */
-static ia_interval g_at(const convex_fn *fn, double alpha, double t)
+/* f at the ends of the operand range, computed once per approximation
+ * (the secant's slope needs them, and so do the bounds of the pieces that
+ * end there): libm calls are most of the cost of exp, log, atan, ... */
+typedef struct ends_memo {
+    double a, b;
+    ia_interval fa, fb;
+} ends_memo;
+
+static ia_interval f_memo(const convex_fn *fn, const ends_memo *m, double t)
 {
-    return ia_sub(fn->f(t, fn->arg), ia_mul_s(ia_point(t), alpha));
+    if (m && t == m->a) return m->fa;
+    if (m && t == m->b) return m->fb;
+    return fn->f(t, fn->arg);
 }
 
-static ia_interval g_bounds_on_piece(const convex_fn *fn, double alpha,
+/* enclosure of g(t) = f(t) - alpha*t */
+static ia_interval g_at(const convex_fn *fn, const ends_memo *m, double alpha, double t)
+{
+    return ia_sub(f_memo(fn, m, t), ia_mul_s(ia_point(t), alpha));
+}
+
+static ia_interval g_bounds_on_piece(const convex_fn *fn, const ends_memo *m, double alpha,
                                      const piece *pc)
 {
-    ia_interval gp = g_at(fn, alpha, pc->p), gq = g_at(fn, alpha, pc->q);
+    ia_interval gp = g_at(fn, m, alpha, pc->p), gq = g_at(fn, m, alpha, pc->q);
     ia_interval ends = ia_hull(gp, gq);
     if (pc->convex == 0 || pc->p == pc->q)
         return ends;
     double t0 = fn->tangent_point(alpha, pc->p, pc->q, fn->arg);
     if (!(t0 >= pc->p && t0 <= pc->q))    /* NaN or outside: clamp */
         t0 = t0 < pc->p ? pc->p : (t0 > pc->q ? pc->q : 0.5 * (pc->p + pc->q));
-    ia_interval g0 = g_at(fn, alpha, t0);
+    ia_interval g0 = g_at(fn, m, alpha, t0);
     ia_interval slope = ia_sub(fn->df(t0, fn->arg), ia_point(alpha));
     ia_interval lp = ia_add(g0, ia_mul(slope, ia_sub(ia_point(pc->p), ia_point(t0))));
     ia_interval lq = ia_add(g0, ia_mul(slope, ia_sub(ia_point(pc->q), ia_point(t0))));
@@ -137,9 +152,10 @@ static void approx_convex(aa_context *ctx, aa_form *z, const aa_form *x,
 {
     double alpha, zeta = 0.0, delta = 0.0;
     bool ok = isfinite(a) && isfinite(b) && a <= b;
+    ends_memo memo;
     if (ok && a < b) {
-        ia_interval fa = fn->f(a, fn->arg), fb = fn->f(b, fn->arg);
-        alpha = (ia_mid(fb) - ia_mid(fa)) / (b - a);
+        memo = (ends_memo){ a, b, fn->f(a, fn->arg), fn->f(b, fn->arg) };
+        alpha = (ia_mid(memo.fb) - ia_mid(memo.fa)) / (b - a);
     } else {
         alpha = 0.0;            /* a point: the interval is exact enough */
         ok = false;
@@ -147,7 +163,7 @@ static void approx_convex(aa_context *ctx, aa_form *z, const aa_form *x,
     if (ok && isfinite(alpha)) {
         ia_interval g = ia_empty();
         for (int i = 0; i < npieces; i++)
-            g = ia_hull(g, g_bounds_on_piece(fn, alpha, &pieces[i]));
+            g = ia_hull(g, g_bounds_on_piece(fn, &memo, alpha, &pieces[i]));
         ok = center_radius(g, &zeta, &delta);
     } else {
         ok = false;
@@ -566,7 +582,6 @@ void aa_pow(aa_context *ctx, aa_form *z, const aa_form *x, const aa_form *y)
 }
 
 static ia_interval neg_sin(ia_interval x) { return ia_neg(ia_sin(x)); }
-static ia_interval neg_cos(ia_interval x) { return ia_neg(ia_cos(x)); }
 
 void aa_sin(aa_context *ctx, aa_form *z, const aa_form *x)
 {
@@ -574,7 +589,7 @@ void aa_sin(aa_context *ctx, aa_form *z, const aa_form *x)
     unsigned fl;
     ia_interval r = operand_range(x, &fl);
     ia_interval fallback = ia_sin(r);
-    approx_taylor(ctx, z, x, ia_sin, ia_cos, neg_sin(r), r.lo, r.hi,
+    approx_taylor(ctx, z, x, ia_sin, ia_cos, ia_neg(fallback), r.lo, r.hi,
                   fallback, fl);
 }
 
@@ -584,7 +599,7 @@ void aa_cos(aa_context *ctx, aa_form *z, const aa_form *x)
     unsigned fl;
     ia_interval r = operand_range(x, &fl);
     ia_interval fallback = ia_cos(r);
-    approx_taylor(ctx, z, x, ia_cos, neg_sin, neg_cos(r), r.lo, r.hi,
+    approx_taylor(ctx, z, x, ia_cos, neg_sin, ia_neg(fallback), r.lo, r.hi,
                   fallback, fl);
 }
 
