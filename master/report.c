@@ -185,14 +185,15 @@ bool farm_report_json(const farm *f, const char *path, char *err, size_t errsz)
     fputs("{\n  \"scene\": ", out);
     json_string(out, f->opt->scene_path);
     fputs(", \"output\": ", out);
-    json_string(out, f->opt->output);
+    json_string(out, f->frames[0].output);
     fprintf(out, ", \"status\": \"%s\", \"error\": ", state_name(f->state));
     json_string(out, f->state == FARM_FAILED ? f->failure : "");
     fprintf(out, ",\n  \"width\": %d, \"height\": %d, \"tile_size\": %d, \"tiles\": %d, "
             "\"tiles_done\": %d, \"resumed_tiles\": %d, \"seconds\": %.6f, "
-            "\"job_hash\": \"%s\",\n",
+            "\"job_hash\": \"%s\", \"frames\": %d, \"frames_written\": %d,\n",
             f->fmt.width, f->fmt.height, f->fmt.tile_size, f->ntiles,
-            scheduler_tiles_done(f->sched), f->resumed_tiles, (double)(f->end_ms - f->start_ms) / 1000.0, f->jb->hash);
+            scheduler_tiles_done(f->sched), f->resumed_tiles, (double)(f->end_ms - f->start_ms) / 1000.0, f->frames[0].jb->hash,
+            f->nframes, f->frames_written);
     json_farm(out, f);
     json_totals(out, f);
     fputs("  \"workers\": [\n", out);

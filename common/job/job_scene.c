@@ -223,8 +223,8 @@ job_scene *job_scene_new(const job *jb, size_t cache_bytes, bool render, sl_diag
     if (!self) abort();
     self->job = jb;
     /* archives come from the job, never from this machine's disk */
-    self->scene = scene_parse_archives(jb->scene_file, jb->scene_text, jb->scene_len,
-                                       jb->sources, diag);
+    self->scene = scene_parse_frame(jb->scene_file, jb->scene_text, jb->scene_len,
+                                    jb->sources, SCENE_MAX_OBJECTS, jb->options.frame, diag);
     bool ok = self->scene != NULL;
     if (ok) ok = compile_programs(self, diag);
     if (ok) ok = build_objects(self, diag);

@@ -110,8 +110,11 @@ typedef struct rib_parser {
     bool in_world, world_seen, world_done;
     bool primitives_tried;         /* a base surface request was seen */
     sl_pos world_pos;
-    bool frame_done, skipping_frame, warned_frames;
+    bool skipping_frame;           /* inside a frame other than the chosen one */
     int skip_depth;                /* FrameBegin nesting while skipping */
+    int frame_select;              /* the index of the frame to read */
+    bool scanning;                 /* scene_scan_frames: read no frame */
+    int frames_cap;                /* of scene->frame_numbers */
     char **shader_path;            /* Option "searchpath" "shader" dirs */
     int nshader_path;
     char **archive_path;           /* Option "searchpath" "archive" dirs */
