@@ -298,7 +298,9 @@ frame_sequence *frame_sequence_load(const char *rib_path, const job_options *opt
         *usage = true;
         return NULL;
     }
-    job_options opt = *options;
+    job_options opt;
+    if (options) opt = *options;
+    else job_options_default(&opt);
     opt.frame = 0;
     int *numbers = NULL;
     int nframes = scan_frames(rib_path, &numbers, diag);

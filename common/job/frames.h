@@ -62,7 +62,8 @@ typedef struct frame_sequence {
 } frame_sequence;
 
 /* Loads the frames of rib_path that `frames` chooses (NULL: all), each with
- * job_load (errors in diag, file:line:col), and names their outputs from
+ * `options` (NULL: the defaults) and its frame index,
+ * by job_load (errors in diag, file:line:col), and names their outputs from
  * `output` (-o; NULL: each frame's Display). NULL on any error: bad spec,
  * a frame that does not load, a frame with no output name, two frames with
  * the same output. *usage says whether the command line is at fault (the
