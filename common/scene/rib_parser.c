@@ -468,8 +468,7 @@ static void unknown_request(rib_parser *p, const rib_request *req)
 static bool allowed_here(rib_parser *p, const rib_request *req, where w)
 {
     if (w == OPTIONS && (p->in_world || p->world_done)) {
-        rib_error(p, req, req->pos, "must come before WorldBegin (options are fixed for the "
-                  "whole world)");
+        rib_option_in_world(p, req);   /* warned, as other renderers do */
         return false;
     }
     if ((w == WORLD || w == PRIMITIVE || w == BLOCK_WORLD) && !p->in_world) {
@@ -501,9 +500,12 @@ static void dispatch(rib_parser *p, const rib_request *req)
         skip_frame_request(p, req);
         return;
     }
+    if (rib_motion_filter(p, req))
+        return;
     const request_def *def = find_request(req->name);
     if (!def) {
-        unknown_request(p, req);
+        if (!rib_ignored_request(p, req))
+            unknown_request(p, req);
         return;
     }
     if (def->where == PRIMITIVE && p->in_world)
@@ -623,6 +625,9 @@ static void finish(rib_parser *p)
 {
     if (p->skipping_frame)
         p->skipping_frame = false;
+    if (p->in_motion)
+        sl_diag_error(p->diag, p->motion_pos, "MotionBegin: this block is never closed "
+                      "(missing MotionEnd)");
     close_open_blocks(p);
     int nframes = p->scene->nframes;
     if (p->scanning)

@@ -15,6 +15,7 @@
  *   rib_mesh.c         PointsPolygons, PointsGeneralPolygons, GeneralPolygon
  *   rib_patch.c        Basis, Patch "bicubic", PatchMesh
  *   rib_nupatch.c      NuPatch (order <= 4, non-rational), TrimCurve (warned)
+ *   rib_ignored.c      requests read past with a warning, motion blocks
  *
  * The graphics state follows RI Specification 3.2 §4: options are global
  * and frozen at WorldBegin; attributes (with the current transform) are
@@ -128,6 +129,8 @@ typedef struct rib_parser {
     bool warned_mesh_vars;         /* primitive variables a mesh ignores */
     bool warned_trim;              /* TrimCurve */
     bool warned_early_light;       /* a LightSource before WorldBegin */
+    bool in_motion, motion_taken;  /* MotionBegin open; its first sample read */
+    sl_pos motion_pos;
     int max_objects;               /* SCENE_MAX_OBJECTS or the caller's */
     bool objects_overflow;         /* that limit was reported */
 } rib_parser;
@@ -264,6 +267,16 @@ void rib_trim_curve(rib_parser *p, const rib_request *req);
 void rib_points_polygons(rib_parser *p, const rib_request *req);
 void rib_points_general_polygons(rib_parser *p, const rib_request *req);
 void rib_general_polygon(rib_parser *p, const rib_request *req);
+
+/* rib_ignored.c: requests read past with one warning per name. True
+ * when req is one of them (warned about, nothing else done). */
+bool rib_ignored_request(rib_parser *p, const rib_request *req);
+/* An option inside the world or after it: warned about once, ignored. */
+void rib_option_in_world(rib_parser *p, const rib_request *req);
+/* MotionBegin/MotionEnd and the requests between them: true when req is
+ * taken care of (the block's bounds, or a later time sample, skipped);
+ * false for anything the caller should run. */
+bool rib_motion_filter(rib_parser *p, const rib_request *req);
 
 /* rib_geometry.c: adds an object for a prepared surface with the current
  * attributes and the object-to-world transform ctm; pos is where the
