@@ -40,6 +40,9 @@ static void build_camera(const scene *sc, trace_world *w)
     t->tan_half_fov = tan(c->fov * (M_PI / 360.0));
     t->near_clip = c->near_clip;
     t->far_clip = c->far_clip;
+    /* RenderMan's thin lens: its diameter is focallength / fstop */
+    t->lens_radius = c->fstop > 0 ? 0.5 * c->focal_length / c->fstop : 0.0;
+    t->focal_distance = c->focal_distance;
     t->camera_from_world = c->camera_from_world;
     t->world_from_camera = c->world_from_camera;
 }

@@ -425,6 +425,7 @@ static const request_def requests[] = {
     { "ObjectBegin", rib_object_begin, BLOCK_WORLD },
     { "ObjectEnd", rib_object_end, BLOCK_WORLD },
     { "ObjectInstance", rib_object_instance, WORLD },
+    { "DepthOfField", rib_depth_of_field, OPTIONS },
 };
 
 enum { NREQUESTS = sizeof requests / sizeof requests[0] };

@@ -193,6 +193,7 @@ void rib_format(rib_parser *p, const rib_request *req);
 void rib_projection(rib_parser *p, const rib_request *req);
 void rib_screen_window(rib_parser *p, const rib_request *req);
 void rib_clipping(rib_parser *p, const rib_request *req);
+void rib_depth_of_field(rib_parser *p, const rib_request *req);
 void rib_pixel_samples(rib_parser *p, const rib_request *req);
 void rib_pixel_filter(rib_parser *p, const rib_request *req);
 void rib_exposure(rib_parser *p, const rib_request *req);

@@ -59,6 +59,8 @@ typedef struct scene_camera {
     double fov;                    /* degrees, perspective only (default 90) */
     double screen[4];              /* ScreenWindow left right bottom top */
     double near_clip, far_clip;    /* Clipping (default 1e-10, 1e30) */
+    double fstop;                  /* DepthOfField; 0: a pinhole (the default) */
+    double focal_length, focal_distance;   /* camera-space units */
     mat4 camera_from_world;        /* the transform current at WorldBegin */
     mat4 world_from_camera;        /* its inverse */
 } scene_camera;
