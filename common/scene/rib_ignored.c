@@ -47,6 +47,14 @@ static const ignored_def ignored[] = {
     { "ArchiveRecord", NO_USE },
     { "AreaLightSource", "area lights are not rendered; ignored (its surfaces render as "
                          "ordinary surfaces)" },
+    { "CropWindow", "is not supported; ignored (the whole image is rendered)" },
+    { "FrameAspectRatio", "is not supported; ignored (the screen window follows Format, or "
+                          "give ScreenWindow)" },
+    { "ClippingPlane", "is not supported; ignored (nothing is clipped by it)" },
+    { "TextureCoordinates", "is not supported; ignored (surfaces keep their default s, t)" },
+    { "Skew", "is not supported; ignored, so the objects after it are placed without it" },
+    { "Perspective", "is not supported; ignored, so the objects after it are placed without "
+                     "it" },
     { "SolidBegin", "solids (CSG) are not rendered; their surfaces render as a union" },
     { "SolidEnd", "solids (CSG) are not rendered; their surfaces render as a union" },
     /* primitives aafarm does not render */
