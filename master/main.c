@@ -15,7 +15,6 @@
 #include "curve_cert.h"
 #include "farm.h"
 #include "job/frames.h"
-#include "job/job_scene.h"
 #include "util/exitcodes.h"
 
 static void usage(FILE *out)
@@ -284,14 +283,10 @@ static int load(cli *c, loaded *l)
     bool ok = l->seq != NULL;
     for (int i = 0; i < n && ok; i++) {
         const job *jb = l->seq->jobs[i];
-        job_scene *js = job_scene_new(jb, 0, false, diag);
-        ok = js != NULL;
-        if (!ok) break;
         farm_frame_in *fr = &l->frames[i];
         fr->jb = jb;
         fr->output = l->seq->outputs[i];
-        fr->fmt = (image_format){js->world.camera.xres, js->world.camera.yres, c->job.tile_size, 0};
-        job_scene_destroy(&js);
+        fr->fmt = (image_format){jb->xres, jb->yres, c->job.tile_size, 0};   /* job_load's */
         char err[300];
         if (!image_format_check(&fr->fmt, err, sizeof err)) {
             sl_diag_error(diag, (sl_pos){0}, "%s: %s", c->farm.scene_path, err);

@@ -266,6 +266,10 @@ job *job_load(const char *rib_path, const job_options *options, sl_diag *diag)
         job_scene *js = job_scene_new(self, 0, false, diag);
         sl_source_set_set_loader(self->sources, NULL, NULL);
         ok = js != NULL;
+        if (ok) {
+            self->xres = js->world.camera.xres;
+            self->yres = js->world.camera.yres;
+        }
         job_scene_destroy(&js);
     }
     if (ok && !job_finish(self, why, sizeof why)) {

@@ -57,6 +57,7 @@ typedef struct job {
     int nframes;                   /* FrameBegin blocks in the file (0: none) */
     int *frame_numbers;            /* their numbers, in order */
     char *display_name;            /* the frame's Display name, or NULL */
+    int xres, yres;                /* the frame's Format */
 } job;
 
 /* Reads and checks the RIB at rib_path and everything it needs. NULL when
