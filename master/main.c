@@ -306,6 +306,10 @@ static int load(cli *c, loaded *l)
     }
     sl_diag_print(diag, stderr);
     sl_diag_destroy(&diag);
+    if (ok && l->seq->numbered && c->farm.verbosity >= 0)
+        fprintf(stderr, "aafarm-master: %s has %d frames: each one's number goes before the "
+                "extension of %s (%s ...; put %%04d in the name to place it)\n",
+                c->farm.scene_path, l->seq->nframes, l->seq->numbered, l->seq->outputs[0]);
     return ok ? -1 : usage && !l->seq ? AAFARM_EXIT_USAGE : AAFARM_EXIT_INPUT;
 }
 

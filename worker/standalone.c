@@ -278,6 +278,10 @@ int worker_standalone(const standalone_options *opt)
     sl_diag_print(diag, stderr);
     sl_diag_destroy(&diag);
     if (!seq) return usage ? AAFARM_EXIT_USAGE : AAFARM_EXIT_INPUT;
+    if (seq->numbered && opt->verbosity >= 0)
+        fprintf(stderr, "aafarm-worker: %s has %d frames: each one's number goes before the "
+                "extension of %s (%s ...; put %%04d in the name to place it)\n",
+                opt->scene_path, seq->nframes, seq->numbered, seq->outputs[0]);
     int rc = AAFARM_EXIT_OK;
     for (int i = 0; i < seq->count && rc == AAFARM_EXIT_OK; i++) {
         const job *jb = seq->jobs[i];

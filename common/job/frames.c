@@ -255,6 +255,8 @@ static bool name_outputs(frame_sequence *seq, const char *output, bool *usage, s
             *usage = output != NULL;
             return false;
         }
+        if (!seq->numbered && !strchr(name, '%') && strcmp(seq->outputs[i], name) != 0)
+            seq->numbered = output ? output : jb->display_name;
         for (int k = 0; k < i; k++)
             if (strcmp(seq->outputs[k], seq->outputs[i]) == 0) {
                 sl_diag_error(diag, none, "%s: frames %d and %d would both be written to %s; "

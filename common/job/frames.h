@@ -59,6 +59,8 @@ typedef struct frame_sequence {
     char **outputs;
     int count;
     int nframes;                   /* frames in the file (0: no FrameBegin) */
+    const char *numbered;          /* a name that got the frame number inserted
+                                      (for a note to the user), or NULL */
 } frame_sequence;
 
 /* Loads the frames of rib_path that `frames` chooses (NULL: all), each with

@@ -170,6 +170,7 @@ static void test_one_job_per_frame(void **state)
     assert_string_equal(seq->outputs[0], "same.0001.exr");
     assert_string_equal(seq->outputs[1], "same.0002.exr");
     assert_string_equal(seq->outputs[2], "four.0004.exr");
+    assert_string_equal(seq->numbered, "same.exr");   /* for the note to the user */
     /* three jobs, three hashes; each parses to its own frame */
     assert_string_not_equal(seq->jobs[0]->hash, seq->jobs[1]->hash);
     assert_string_not_equal(seq->jobs[1]->hash, seq->jobs[2]->hash);
@@ -203,6 +204,7 @@ static void test_one_job_per_frame(void **state)
     assert_int_equal(seq->count, 2);
     assert_string_equal(seq->outputs[0], "o/x_002.exr");
     assert_string_equal(seq->outputs[1], "o/x_004.exr");
+    assert_null(seq->numbered);
     assert_int_equal(seq->jobs[1]->options.frame, 2);
     frame_sequence_destroy(&seq);
     assert_int_equal(sl_diag_error_count(d), 0);

@@ -121,6 +121,8 @@ static void test_sequence_equals_standalone(void **state)
     assert_int_equal(ft_count_files(dir, "seq."), 3);
     assert_int_equal(ft_count_files(dir, "seq.exr"), 0);
     assert_int_equal(ft_count(log, "3 frames (1 ... 3), 45 tiles of 32 in one queue"), 1);
+    assert_int_equal(ft_count(log, "has 3 frames: each one's number goes before the extension "
+                                   "of "), 1);
     assert_int_equal(ft_count(log, "frame 2: wrote "), 1);
     assert_int_equal(ft_count(log, "of 3 frames done"), 3);
     assert_int_equal(ft_count(log, "took frame "), 45);
