@@ -305,12 +305,18 @@ void farm_frame_complete(farm *f, farm_frame *fr)
     if (fr->preview) write_preview(f, fr);
 }
 
-/* A journaled tile goes into the new output file and is DONE. */
+/* What replay_tile works on: the farm and the frame whose journal it is. */
+typedef struct replay_ctx {
+    farm *f;
+    farm_frame *fr;
+} replay_ctx;
+
+/* A journaled tile goes into the frame's new output file and is DONE. */
 static bool replay_tile(void *arg, int tile, const void *chunk, size_t len, char *err,
                         size_t errsz)
 {
-    farm_frame *fr = ((farm_frame **)arg)[1];
-    farm *f = ((farm **)arg)[0];
+    farm *f = ((replay_ctx *)arg)->f;
+    farm_frame *fr = ((replay_ctx *)arg)->fr;
     if (!image_writer_put_chunk(fr->writer, tile % fr->tiles_x, tile / fr->tiles_x, chunk, len,
                                 err, errsz))
         return false;
@@ -338,8 +344,8 @@ static int open_journal(farm *f, farm_frame *fr, char *err, size_t errsz)
     bool missing = !f->opt->resume;
     if (f->opt->resume) {
         journal_replay info;
-        void *arg[2] = {f, fr};
-        fr->jnl = journal_resume(path, &id, replay_tile, arg, &info, &missing, err, errsz);
+        replay_ctx ctx = {f, fr};
+        fr->jnl = journal_resume(path, &id, replay_tile, &ctx, &info, &missing, err, errsz);
         if (fr->jnl) {
             console_log(f->con, CONSOLE_INFO, "resuming: %d of %d tiles taken from %s", info.tiles,
                         fr->ntiles, path);
@@ -588,8 +594,7 @@ static void tell_workers(farm *f, int64_t now)
  * or when it holds nothing; otherwise synced and kept. */
 static void close_journals(farm *f)
 {
-    int kept = 0;
-    const char *one = NULL;
+    bool told = false;   /* the --resume hint is given once */
     for (int i = 0; i < f->nframes; i++) {
         farm_frame *fr = &f->frames[i];
         if (!fr->jnl) continue;
@@ -600,13 +605,12 @@ static void close_journals(farm *f)
         char jerr[600];
         if (!journal_sync(fr->jnl, jerr, sizeof jerr))
             console_log(f->con, CONSOLE_ERROR, "%s", jerr);
-        else
-            kept++;
-        if (!one) one = journal_file(fr->jnl);
-        if (kept == 1 && one)
+        else if (!told)
             console_log(f->con, CONSOLE_ERROR, "%d of %d tiles kept in %s%s: the same command "
                         "with --resume renders only the others", scheduler_tiles_done(f->sched),
-                        f->ntiles, one, f->nframes > 1 ? " and the other frames' journals" : "");
+                        f->ntiles, journal_file(fr->jnl),
+                        f->nframes > 1 ? " and the other frames' journals" : "");
+        told = true;
         journal_close(&fr->jnl);
     }
 }
