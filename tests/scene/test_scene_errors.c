@@ -289,7 +289,7 @@ static void test_lenient_requests(void **state)
         "Points \"P\" [0 0 0 1 1 1] \"width\" [0.1 0.1]\n"                          /* 16 */
         "Blobby 1 [1001 0] [1 0 0 0 0 1 0 0 0 0 1 0 0 0 0 1] [\"\"]\n"              /* 17 */
         "MotionBegin [0 1]\nTranslate 1 0 0\nTranslate 5 0 0\nMotionEnd\n"       /* 18-21 */
-        "Sphere 1 -1 1 360\nWorldEnd\n", &d);                                     /* 22-23 */
+        "Sphere 1 -1 1 360\nSystem \"rm -rf /\"\nWorldEnd\n", &d);               /* 22-24 */
     if (!s) sl_diag_print(d, stderr);
     assert_non_null(s);
     assert_int_equal(sl_diag_error_count(d), 0);
@@ -315,6 +315,8 @@ static void test_lenient_requests(void **state)
         "t.rib:16:1: Points: point clouds are not rendered; skipped",
         "t.rib:18:1: MotionBegin: motion blur is not rendered: each motion block uses its "
         "first time sample",
+        "t.rib:23:1: System: runs no commands; ignored (a scene cannot run programs on the "
+        "farm)",
     };
     int n = (int)(sizeof want / sizeof want[0]);
     assert_int_equal(sl_diag_warning_count(d), n);   /* one per name */
