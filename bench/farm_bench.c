@@ -174,7 +174,8 @@ static bool bench_scene(const char *scene, int repeat, row *r)
     r->tiles = json_number(j, "tiles");
     double grants = json_number(j, "grants"), sent = json_number(j, "bytes_sent");
     r->job = json_number(j, "job_bytes");
-    r->out_per_tile = grants > 0 ? (sent - r->job * json_number(j, "jobs_sent")) / grants : 0;
+    /* every Job sent (of every frame, for a sequence) is not per tile */
+    r->out_per_tile = grants > 0 ? (sent - json_number(j, "job_bytes_sent")) / grants : 0;
     r->in_per_tile = r->tiles > 0 ? json_number(j, "result_bytes") / r->tiles : 0;
     r->master_cpu = json_number(tmp("farm1.json"), "master_cpu_seconds");
     return true;

@@ -16,7 +16,13 @@ struct console {
     int64_t last_ms;       /* last redraw or progress log */
     int last_tenth;        /* last tenth of the image logged */
     int resumed;           /* tiles done before the start (--resume): not in the rate */
+    char prefix[64];       /* before the tile counts: frames done in a sequence */
 };
+
+void console_set_prefix(console *self, const char *text)
+{
+    snprintf(self->prefix, sizeof self->prefix, "%s", text);
+}
 
 void console_set_resumed(console *self, int tiles)
 {
@@ -71,15 +77,15 @@ void console_log(console *self, console_level level, const char *fmt, ...)
     fflush(stderr);
 }
 
-static void format_progress(char *buf, size_t n, int done, int total, int resumed,
-                            int workers, double secs)
+static void format_progress(char *buf, size_t n, const char *prefix, int done, int total,
+                            int resumed, int workers, double secs)
 {
     double rate = secs > 0 ? (done - resumed) / secs : 0;
     char eta[32] = "-";
     if (rate > 0 && done < total) snprintf(eta, sizeof eta, "%.0f s", (total - done) / rate);
     else if (done == total) snprintf(eta, sizeof eta, "0 s");
-    snprintf(buf, n, "%d/%d tiles (%d%%), %.1f tiles/s, ETA %s, %d worker%s alive",
-             done, total, total ? (int)(100.0 * done / total) : 100, rate, eta, workers,
+    snprintf(buf, n, "%s%d/%d tiles (%d%%), %.1f tiles/s, ETA %s, %d worker%s alive",
+             prefix, done, total, total ? (int)(100.0 * done / total) : 100, rate, eta, workers,
              workers == 1 ? "" : "s");
 }
 
@@ -92,7 +98,8 @@ void console_progress(console *self, int done, int total, int workers, int64_t s
         if (!final && now_ms - self->last_ms < 100) return;
         self->last_ms = now_ms;
         char body[160];
-        format_progress(body, sizeof body, done, total, self->resumed, workers, secs);
+        format_progress(body, sizeof body, self->prefix, done, total, self->resumed, workers,
+                        secs);
         snprintf(self->line, sizeof self->line, "  %s", body);
         draw_line(self);
         if (final) {
@@ -107,7 +114,8 @@ void console_progress(console *self, int done, int total, int workers, int64_t s
     self->last_tenth = tenth;
     self->last_ms = now_ms;
     char body[160];
-    format_progress(body, sizeof body, done, total, self->resumed, workers, secs);
+    format_progress(body, sizeof body, self->prefix, done, total, self->resumed, workers,
+                        secs);
     fprintf(stderr, "aafarm-master: %s\n", body);
     fflush(stderr);
 }

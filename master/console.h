@@ -34,6 +34,8 @@ void console_log(console *self, console_level level, const char *fmt, ...)
 /* Tiles that were done before the render started (--resume): the rate
  * and the ETA count only the others. */
 void console_set_resumed(console *self, int tiles);
+/* Text shown before the tile counts ("2/3 frames, "), "" for none. */
+void console_set_prefix(console *self, const char *text);
 
 void console_progress(console *self, int done, int total, int workers, int64_t start_ms,
                       int64_t now_ms, bool final);

@@ -236,58 +236,119 @@ static int start_local_workers(farm *f, char *err, size_t errsz)
 
 /* The Job must pass the same checks a worker applies (names, sizes, no NUL
  * bytes): fail before contacting anyone rather than at the first grant. */
-static int check_job_message(farm *f, char *err, size_t errsz)
+static int check_job_message(farm *f, farm_frame *fr, char *err, size_t errsz)
 {
     Aafarm__Envelope env = AAFARM__ENVELOPE__INIT;
     env.body_case = AAFARM__ENVELOPE__BODY_JOB;
-    env.job = job_message_job(f->jobmsg);
+    env.job = job_message_job(fr->jobmsg);
     char why[300];
     if (proto_message_check(&env, false, 0, &f->send_limits, why, sizeof why) != 0) {
         snprintf(err, errsz, "the job cannot be sent to workers: %s", why);
         return AAFARM_EXIT_INPUT;
     }
-    f->job_bytes = job_message_packed_size(f->jobmsg);
-    if (f->job_bytes > f->send_limits.max_header_bytes) {
+    fr->job_bytes = job_message_packed_size(fr->jobmsg);
+    if (fr->job_bytes > f->send_limits.max_header_bytes) {
         snprintf(err, errsz, "the job is %zu bytes, more than the %zu a message may carry",
-                 f->job_bytes, f->send_limits.max_header_bytes);
+                 fr->job_bytes, f->send_limits.max_header_bytes);
         return AAFARM_EXIT_INPUT;
     }
+    f->job_bytes += fr->job_bytes;
     return AAFARM_EXIT_OK;
 }
 
-/* A journaled tile goes into the new output file and is DONE. */
+farm_frame *farm_frame_of(farm *f, int tile, int *local)
+{
+    int lo = 0, hi = f->nframes - 1;
+    while (lo < hi) {   /* the last frame whose first tile is <= tile */
+        int mid = (lo + hi + 1) / 2;
+        if (f->frames[mid].first <= tile) lo = mid;
+        else hi = mid - 1;
+    }
+    *local = tile - f->frames[lo].first;
+    return &f->frames[lo];
+}
+
+/* "frame 3: " in a sequence, "" for a single image (for messages). */
+static const char *frame_label(const farm *f, const farm_frame *fr, char *buf, size_t n)
+{
+    if (f->nframes > 1) snprintf(buf, n, "frame %d: ", fr->jb->frame_number);
+    else buf[0] = '\0';
+    return buf;
+}
+
+static void write_preview(farm *f, farm_frame *fr)
+{
+    char err[600];
+    image_buffer *buf = image_buffer_read_exr(fr->output, err, sizeof err);
+    if (!buf || !image_preview_write_png_buffer(fr->preview, buf, err, sizeof err))
+        console_log(f->con, CONSOLE_ERROR, "preview %s not written: %s", fr->preview, err);
+    image_buffer_destroy(&buf);
+}
+
+void farm_frame_complete(farm *f, farm_frame *fr)
+{
+    char err[600], label[40];
+    if (!image_writer_finish(&fr->writer, err, sizeof err)) {
+        farm_fail(f, "%s%s", frame_label(f, fr, label, sizeof label), err);
+        return;
+    }
+    fr->written = true;
+    f->frames_written++;
+    if (f->nframes > 1) {
+        console_log(f->con, CONSOLE_INFO, "frame %d: wrote %s (%dx%d, %d tiles; %d of %d "
+                    "frames done)", fr->jb->frame_number, fr->output, fr->fmt.width,
+                    fr->fmt.height, fr->ntiles, f->frames_written, f->nframes);
+        char line[64];
+        snprintf(line, sizeof line, "%d/%d frames, ", f->frames_written, f->nframes);
+        console_set_prefix(f->con, line);
+    }
+    if (fr->preview) write_preview(f, fr);
+}
+
+/* What replay_tile works on: the farm and the frame whose journal it is. */
+typedef struct replay_ctx {
+    farm *f;
+    farm_frame *fr;
+} replay_ctx;
+
+/* A journaled tile goes into the frame's new output file and is DONE. */
 static bool replay_tile(void *arg, int tile, const void *chunk, size_t len, char *err,
                         size_t errsz)
 {
-    farm *f = arg;
-    if (!image_writer_put_chunk(f->writer, tile % f->tiles_x, tile / f->tiles_x, chunk, len,
+    farm *f = ((replay_ctx *)arg)->f;
+    farm_frame *fr = ((replay_ctx *)arg)->fr;
+    if (!image_writer_put_chunk(fr->writer, tile % fr->tiles_x, tile / fr->tiles_x, chunk, len,
                                 err, errsz))
         return false;
-    if (scheduler_mark_done(f->sched, tile)) f->resumed_tiles++;
+    if (scheduler_mark_done(f->sched, fr->first + tile)) {
+        f->resumed_tiles++;
+        fr->done++;
+    }
     return true;
 }
 
 /* --resume: the journal's tiles are in; otherwise a new, empty journal. */
-static int open_journal(farm *f, char *err, size_t errsz)
+static int open_journal(farm *f, farm_frame *fr, char *err, size_t errsz)
 {
-    char *path = journal_path_for(f->opt->output);
+    char *path = journal_path_for(fr->output);
     if (!path) abort();
     journal_id id;
     memset(&id, 0, sizeof id);
-    snprintf(id.job_hash, sizeof id.job_hash, "%s", f->jb->hash);
-    id.width = (uint32_t)f->fmt.width;
-    id.height = (uint32_t)f->fmt.height;
-    id.tile_size = (uint32_t)f->fmt.tile_size;
-    id.layers = (uint32_t)f->fmt.layers;
-    id.tiles = (uint32_t)f->ntiles;
+    snprintf(id.job_hash, sizeof id.job_hash, "%s", fr->jb->hash);
+    id.width = (uint32_t)fr->fmt.width;
+    id.height = (uint32_t)fr->fmt.height;
+    id.tile_size = (uint32_t)fr->fmt.tile_size;
+    id.layers = (uint32_t)fr->fmt.layers;
+    id.tiles = (uint32_t)fr->ntiles;
     int rc = AAFARM_EXIT_OK;
     bool missing = !f->opt->resume;
     if (f->opt->resume) {
         journal_replay info;
-        f->jnl = journal_resume(path, &id, replay_tile, f, &info, &missing, err, errsz);
-        if (f->jnl) {
+        replay_ctx ctx = {f, fr};
+        fr->jnl = journal_resume(path, &id, replay_tile, &ctx, &info, &missing, err, errsz);
+        if (fr->jnl) {
             console_log(f->con, CONSOLE_INFO, "resuming: %d of %d tiles taken from %s", info.tiles,
-                        f->ntiles, path);
+                        fr->ntiles, path);
             if (info.dropped_bytes)
                 console_log(f->con, CONSOLE_INFO, "the journal ended in %s: dropped its last "
                             "%llu bytes (those tiles are rendered again)", info.dropped_why,
@@ -296,19 +357,34 @@ static int open_journal(farm *f, char *err, size_t errsz)
             console_log(f->con, CONSOLE_INFO, "--resume: no journal %s, rendering every tile",
                         path);
         } else {
-            rc = image_writer_failed(f->writer) ? AAFARM_EXIT_FAILURE : AAFARM_EXIT_USAGE;
+            rc = image_writer_failed(fr->writer) ? AAFARM_EXIT_FAILURE : AAFARM_EXIT_USAGE;
         }
     }
     if (missing) {
         bool replaced = false;
-        f->jnl = journal_create(path, &id, &replaced, err, errsz);
-        if (!f->jnl) rc = AAFARM_EXIT_FAILURE;
+        fr->jnl = journal_create(path, &id, &replaced, err, errsz);
+        if (!fr->jnl) rc = AAFARM_EXIT_FAILURE;
         else if (replaced)
             console_log(f->con, CONSOLE_INFO, "replaced the journal of an unfinished render "
                         "(%s): --resume would have continued it", path);
     }
     free(path);
     return rc;
+}
+
+/* Each frame's job message, output file and journal. */
+static int setup_frame(farm *f, farm_frame *fr, char *err, size_t errsz)
+{
+    fr->jobmsg = job_message_new(fr->jb, &fr->fmt);
+    int rc = check_job_message(f, fr, err, errsz);
+    if (rc != AAFARM_EXIT_OK) return rc;
+    stale_clean_outputs(fr->output, report_leftover, f);
+    if (fr->preview) stale_clean_outputs(fr->preview, report_leftover, f);
+    fr->writer = image_writer_new(fr->output, &fr->fmt, err, errsz);
+    if (!fr->writer) return AAFARM_EXIT_FAILURE;
+    rc = open_journal(f, fr, err, errsz);
+    if (rc == AAFARM_EXIT_OK && fr->done == fr->ntiles) farm_frame_complete(f, fr);
+    return f->state == FARM_FAILED ? AAFARM_EXIT_FAILURE : rc;
 }
 
 static void bound_limits(farm *f)
@@ -326,26 +402,36 @@ static int setup(farm *f, char *err, size_t errsz)
     bound_limits(f);
     f->session = random_session();
     if (gethostname(f->host, sizeof f->host - 1) != 0) snprintf(f->host, sizeof f->host, "master");
-    f->tiles_x = image_format_tiles_x(&f->fmt);
-    f->ntiles = image_format_tile_count(&f->fmt);
+    for (int i = 0; i < f->nframes; i++) {
+        farm_frame *fr = &f->frames[i];
+        fr->tiles_x = image_format_tiles_x(&fr->fmt);
+        fr->ntiles = image_format_tile_count(&fr->fmt);
+        fr->first = f->ntiles;
+        if (fr->ntiles > INT_MAX / 4 - f->ntiles) {
+            snprintf(err, errsz, "the %d frames have too many tiles to count", f->nframes);
+            return AAFARM_EXIT_INPUT;
+        }
+        f->ntiles += fr->ntiles;
+    }
     scheduler_options so;
     scheduler_options_default(&so);
     so.max_attempts = f->opt->max_attempts;
     so.max_duplicates = f->opt->max_duplicates;
     so.lease_ms = f->opt->lease_ms;
     so.lease_factor = f->opt->lease_factor;
-    f->sched = scheduler_new(f->tiles_x, image_format_tiles_y(&f->fmt), &so);
+    /* every frame's tiles in one row-major queue: a worker's run goes on
+     * into the next frame, and new runs start in the longest queued run */
+    f->sched = scheduler_new(f->ntiles, 1, &so);
+    if (!f->sched) {
+        snprintf(err, errsz, "the %d frames have too many tiles to count", f->nframes);
+        return AAFARM_EXIT_INPUT;
+    }
     f->reg = registry_new();
-    f->jobmsg = job_message_new(f->jb, &f->fmt);
-    int rc = check_job_message(f, err, errsz);
-    if (rc != AAFARM_EXIT_OK) return rc;
-    stale_clean_outputs(f->opt->output, report_leftover, f);
-    if (f->opt->preview) stale_clean_outputs(f->opt->preview, report_leftover, f);
-    f->writer = image_writer_new(f->opt->output, &f->fmt, err, errsz);
-    if (!f->writer) return AAFARM_EXIT_FAILURE;
-    rc = open_journal(f, err, errsz);
-    if (rc != AAFARM_EXIT_OK) return rc;
-    rc = open_socket(f, err, errsz);
+    for (int i = 0; i < f->nframes; i++) {
+        int rc = setup_frame(f, &f->frames[i], err, errsz);
+        if (rc != AAFARM_EXIT_OK) return rc;
+    }
+    int rc = open_socket(f, err, errsz);
     if (rc != AAFARM_EXIT_OK) return rc;
     return start_local_workers(f, err, errsz);
 }
@@ -383,7 +469,7 @@ static void drain(farm *f, int64_t now)
         }
         farm_handle(f, m, now);
         wire_msg_destroy(&m);
-        if (scheduler_finished(f->sched)) f->state = FARM_DONE;
+        if (f->state == FARM_RUNNING && scheduler_finished(f->sched)) f->state = FARM_DONE;
     }
 }
 
@@ -503,34 +589,36 @@ static void tell_workers(farm *f, int64_t now)
     }
 }
 
-static void write_preview(farm *f)
+/* Every frame's journal: deleted when the whole sequence is in place (so
+ * that --resume after a failure replays the frames already written too),
+ * or when it holds nothing; otherwise synced and kept. */
+static void close_journals(farm *f)
 {
-    char err[600];
-    image_buffer *buf = image_buffer_read_exr(f->opt->output, err, sizeof err);
-    if (!buf || !image_preview_write_png_buffer(f->opt->preview, buf, err, sizeof err))
-        console_log(f->con, CONSOLE_ERROR, "preview %s not written: %s", f->opt->preview, err);
-    image_buffer_destroy(&buf);
+    bool told = false;   /* the --resume hint is given once */
+    for (int i = 0; i < f->nframes; i++) {
+        farm_frame *fr = &f->frames[i];
+        if (!fr->jnl) continue;
+        if (f->state == FARM_DONE || fr->done == 0) {
+            journal_remove(&fr->jnl);   /* the image is in place, or nothing to resume */
+            continue;
+        }
+        char jerr[600];
+        if (!journal_sync(fr->jnl, jerr, sizeof jerr))
+            console_log(f->con, CONSOLE_ERROR, "%s", jerr);
+        else if (!told)
+            console_log(f->con, CONSOLE_ERROR, "%d of %d tiles kept in %s%s: the same command "
+                        "with --resume renders only the others", scheduler_tiles_done(f->sched),
+                        f->ntiles, journal_file(fr->jnl),
+                        f->nframes > 1 ? " and the other frames' journals" : "");
+        told = true;
+        journal_close(&fr->jnl);
+    }
 }
 
 static int finish(farm *f)
 {
     char err[600];
-    if (f->state == FARM_DONE && !image_writer_finish(&f->writer, err, sizeof err)) {
-        f->state = FARM_FAILED;
-        snprintf(f->failure, sizeof f->failure, "%s", err);
-    }
-    if (f->state == FARM_DONE || (f->jnl && scheduler_tiles_done(f->sched) == 0)) {
-        journal_remove(&f->jnl);   /* the image is in place, or nothing to resume */
-    } else if (f->jnl) {
-        char jerr[600];
-        if (journal_sync(f->jnl, jerr, sizeof jerr))
-            console_log(f->con, CONSOLE_ERROR, "%d of %d tiles kept in %s: the same command with "
-                        "--resume renders only the others", scheduler_tiles_done(f->sched),
-                        f->ntiles, journal_file(f->jnl));
-        else
-            console_log(f->con, CONSOLE_ERROR, "%s", jerr);
-        journal_close(&f->jnl);
-    }
+    close_journals(f);
     f->end_ms = farm_now_ms();
     if (f->state == FARM_DONE)
         console_progress(f->con, f->ntiles, f->ntiles, registry_alive(f->reg), f->start_ms,
@@ -538,23 +626,37 @@ static int finish(farm *f)
     tell_workers(f, f->end_ms);
     if (f->locals) local_workers_stop(f->locals, 2000);
     int rc = AAFARM_EXIT_OK;
+    const farm_frame *last = &f->frames[f->nframes - 1];
     switch (f->state) {
     case FARM_DONE:
         if (f->nonfinite_samples)
             console_log(f->con, CONSOLE_ERROR, "warning: %llu NaN/Inf samples in %d tiles were "
                         "written as 0 (Z: as no hit); a shader divides by zero or overflows "
                         "there", (unsigned long long)f->nonfinite_samples, f->nonfinite_tiles);
-        console_log(f->con, CONSOLE_INFO, "wrote %s (%dx%d, %d tiles, %.2f s)", f->opt->output,
-                    f->fmt.width, f->fmt.height, f->ntiles, (double)(f->end_ms - f->start_ms) / 1000.0);
-        if (f->opt->preview) write_preview(f);
+        if (f->nframes == 1)
+            console_log(f->con, CONSOLE_INFO, "wrote %s (%dx%d, %d tiles, %.2f s)", last->output,
+                        last->fmt.width, last->fmt.height, f->ntiles,
+                        (double)(f->end_ms - f->start_ms) / 1000.0);
+        else
+            console_log(f->con, CONSOLE_INFO, "wrote %d frames (%s ... %s, %d tiles, %.2f s)",
+                        f->nframes, f->frames[0].output, last->output, f->ntiles,
+                        (double)(f->end_ms - f->start_ms) / 1000.0);
         break;
     case FARM_INTERRUPTED:
-        console_log(f->con, CONSOLE_ERROR, "interrupted; %s not written", f->opt->output);
+        if (f->nframes == 1)
+            console_log(f->con, CONSOLE_ERROR, "interrupted; %s not written", last->output);
+        else
+            console_log(f->con, CONSOLE_ERROR, "interrupted; %d of %d frames written",
+                        f->frames_written, f->nframes);
         rc = AAFARM_EXIT_INTERRUPTED;
         break;
     default:
         console_log(f->con, CONSOLE_ERROR, "render failed: %s", f->failure);
-        console_log(f->con, CONSOLE_ERROR, "%s not written", f->opt->output);
+        if (f->nframes == 1)
+            console_log(f->con, CONSOLE_ERROR, "%s not written", last->output);
+        else
+            console_log(f->con, CONSOLE_ERROR, "%d of %d frames written", f->frames_written,
+                        f->nframes);
         rc = AAFARM_EXIT_FAILURE;
         break;
     }
@@ -568,28 +670,40 @@ static int finish(farm *f)
 
 static void teardown(farm *f)
 {
-    image_writer_destroy(&f->writer);   /* unfinished: removes the temporary file */
-    if (f->jnl && scheduler_tiles_done(f->sched) == 0) journal_remove(&f->jnl);
-    journal_close(&f->jnl);             /* kept for --resume */
+    for (int i = 0; i < f->nframes; i++) {
+        farm_frame *fr = &f->frames[i];
+        image_writer_destroy(&fr->writer);   /* unfinished: removes the temporary file */
+        if (fr->jnl && fr->done == 0) journal_remove(&fr->jnl);
+        journal_close(&fr->jnl);             /* kept for --resume */
+        job_message_destroy(&fr->jobmsg);
+    }
     local_workers_destroy(&f->locals);
     wire_monitor_destroy(&f->monitor);
     if (f->router) zmq_close(f->router);
     zap_destroy(&f->zap);
     if (f->ctx) zmq_ctx_term(f->ctx);
     remove_private_endpoint(f);
-    job_message_destroy(&f->jobmsg);
     registry_destroy(&f->reg);
     scheduler_destroy(&f->sched);
     console_destroy(&f->con);
+    free(f->frames);
 }
 
-int farm_run(const farm_options *opt, const job *jb, const image_format *fmt)
+int farm_run(const farm_options *opt, const farm_frame_in *frames, int nframes)
 {
     farm f;
     memset(&f, 0, sizeof f);
     f.opt = opt;
-    f.jb = jb;
-    f.fmt = *fmt;
+    f.nframes = nframes;
+    f.frames = calloc((size_t)nframes, sizeof *f.frames);
+    if (!f.frames) abort();
+    for (int i = 0; i < nframes; i++) {
+        f.frames[i].jb = frames[i].jb;
+        f.frames[i].fmt = frames[i].fmt;
+        f.frames[i].output = frames[i].output;
+        f.frames[i].preview = frames[i].preview;
+    }
+    f.fmt = frames[0].fmt;   /* the tile size (the same in every frame): limits */
     f.con = console_new(opt->verbosity, isatty(STDERR_FILENO));
 
     struct sigaction sa;
@@ -608,9 +722,21 @@ int farm_run(const farm_options *opt, const job *jb, const image_format *fmt)
     }
     f.start_ms = farm_now_ms();
     console_set_resumed(f.con, f.resumed_tiles);
-    console_log(f.con, CONSOLE_INFO, "%s: %dx%d, %d tiles of %d, job %.12s (%zu bytes)",
-                opt->scene_path, f.fmt.width, f.fmt.height, f.ntiles, f.fmt.tile_size, jb->hash,
-                f.job_bytes);
+    if (nframes > 1) {
+        char line[64];
+        snprintf(line, sizeof line, "%d/%d frames, ", f.frames_written, nframes);
+        console_set_prefix(f.con, line);
+    }
+    if (nframes == 1)
+        console_log(f.con, CONSOLE_INFO, "%s: %dx%d, %d tiles of %d, job %.12s (%zu bytes)",
+                    opt->scene_path, f.fmt.width, f.fmt.height, f.ntiles, f.fmt.tile_size,
+                    frames[0].jb->hash, f.job_bytes);
+    else
+        console_log(f.con, CONSOLE_INFO, "%s: %d frames (%d ... %d), %d tiles of %d in one "
+                    "queue, %zu job bytes", opt->scene_path, nframes,
+                    frames[0].jb->frame_number, frames[nframes - 1].jb->frame_number, f.ntiles,
+                    f.fmt.tile_size, f.job_bytes);
+    if (scheduler_finished(f.sched)) f.state = FARM_DONE;   /* all resumed */
     run_loop(&f);
     rc = finish(&f);
     teardown(&f);

@@ -21,7 +21,8 @@
 
 typedef struct farm_options {
     const char *scene_path;
-    const char *output;            /* OUT.exr */
+    const char *output;            /* -o: OUT.exr or a pattern (job/frames.h) */
+    const char *frames;            /* --frames "1,3,5-7", NULL: all */
     const char *preview;           /* OUT.png or NULL */
     const char *stats_json;        /* FILE or NULL */
     const char *bind;              /* endpoint; NULL: embedded (private ipc://) */
@@ -44,11 +45,23 @@ typedef struct farm_options {
 
 void farm_options_default(farm_options *opt);
 
-/* Renders `jb` (loaded and checked by job_load) into opt->output with the
- * image format `fmt`. Returns an AAFARM_EXIT_* code (util/exitcodes.h):
- * OK, FAILURE (a tile failed too often, no workers left, output not
- * writable), USAGE (an endpoint ZeroMQ cannot bind), INTERRUPTED
- * (SIGINT/SIGTERM: nothing written). */
-int farm_run(const farm_options *opt, const job *jb, const image_format *fmt);
+/* One frame of the render: its job (loaded and checked by job_load, its
+ * options.frame telling which FrameBegin block), its image format, and
+ * the files it goes to (job/frames.h names them). */
+typedef struct farm_frame_in {
+    const job *jb;
+    image_format fmt;
+    const char *output;            /* OUT.exr (or OUT.0002.exr ...) */
+    const char *preview;           /* its PNG, or NULL */
+} farm_frame_in;
+
+/* Renders the frames (at least one) with the tiles of all of them in one
+ * queue; each frame's EXR is renamed into place when its last tile is in.
+ * opt->output is not used here. Returns an AAFARM_EXIT_* code
+ * (util/exitcodes.h): OK, FAILURE (a tile failed too often, no workers
+ * left, output not writable), USAGE (an endpoint ZeroMQ cannot bind),
+ * INTERRUPTED (SIGINT/SIGTERM: nothing written but the frames already
+ * complete). */
+int farm_run(const farm_options *opt, const farm_frame_in *frames, int nframes);
 
 #endif

@@ -31,11 +31,27 @@ typedef enum farm_state {
     FARM_INTERRUPTED     /* SIGINT / SIGTERM */
 } farm_state;
 
-typedef struct farm {
-    const farm_options *opt;
+/* One frame of the sequence: its tiles are the scheduler's tiles
+ * first .. first + ntiles - 1 (all frames in one queue). */
+typedef struct farm_frame {
     const job *jb;
     image_format fmt;
-    int tiles_x, ntiles;
+    const char *output, *preview;
+    int tiles_x, ntiles, first;
+    job_message *jobmsg;
+    size_t job_bytes;              /* packed size of its Job envelope */
+    image_writer *writer;
+    journal *jnl;                  /* OUT.exr.journal: its tiles taken so far */
+    int done;                      /* its tiles in the output */
+    bool written;                  /* complete and renamed into place */
+} farm_frame;
+
+typedef struct farm {
+    const farm_options *opt;
+    farm_frame *frames;
+    int nframes, frames_written;
+    image_format fmt;              /* the first frame's (tile size, limits) */
+    int ntiles;                    /* of all frames */
     void *ctx, *router;
     wire_monitor *monitor;
     zap *zap;                      /* CURVE: the key check (NULL: plaintext) */
@@ -48,13 +64,10 @@ typedef struct farm {
     char ipc_dir[PATH_MAX];        /* embedded mode's private folder, or "" */
     scheduler *sched;
     registry *reg;
-    image_writer *writer;
-    journal *jnl;                  /* OUT.exr.journal: the tiles taken so far */
     int resumed_tiles;             /* tiles replayed from the journal (--resume) */
     local_workers *locals;
     console *con;
-    job_message *jobmsg;
-    size_t job_bytes;              /* packed size of the Job envelope */
+    size_t job_bytes;              /* packed sizes of the frames' Job envelopes */
     uint64_t session;              /* Welcome.master_session */
     char host[128];
     int64_t start_ms, end_ms;
@@ -70,6 +83,11 @@ typedef struct farm {
 } farm;
 
 int64_t farm_now_ms(void);
+
+/* The frame of scheduler tile `tile`, and its tile index in that frame. */
+farm_frame *farm_frame_of(farm *f, int tile, int *local);
+/* Its last tile is in: finish its EXR (rename into place), preview. */
+void farm_frame_complete(farm *f, farm_frame *fr);
 
 /* farm_messages.c */
 void farm_handle(farm *f, wire_msg *m, int64_t now);

@@ -86,32 +86,62 @@ static void send_welcome(farm *f, farm_worker *w, int64_t now)
     send_env(f, w, &env, now);
 }
 
-static int send_job(farm *f, farm_worker *w, int64_t now)
+/* Does the worker hold the frame's job (as far as the master knows: a
+ * worker that dropped it asks again with NeedJob)? */
+static bool holds_frame(const farm_worker *w, int frame)
+{
+    for (int i = 0; i < w->nheld; i++)
+        if (w->held[i] == frame) return true;
+    return false;
+}
+
+static void mark_held(farm_worker *w, int frame)
+{
+    int n = (int)(sizeof w->held / sizeof w->held[0]);
+    int keep = 0;
+    for (int i = 0; i < w->nheld; i++)
+        if (w->held[i] != frame) w->held[keep++] = w->held[i];
+    if (keep == n) {
+        memmove(&w->held[0], &w->held[1], sizeof w->held[0] * (size_t)(n - 1));
+        keep--;
+    }
+    w->held[keep++] = frame;
+    w->nheld = keep;
+    w->has_job = true;
+}
+
+static int send_job(farm *f, farm_worker *w, farm_frame *fr, int64_t now)
 {
     Aafarm__Envelope env = AAFARM__ENVELOPE__INIT;
     env.body_case = AAFARM__ENVELOPE__BODY_JOB;
-    env.job = job_message_job(f->jobmsg);
+    env.job = job_message_job(fr->jobmsg);
     int n = send_env(f, w, &env, now);
     if (n < 0) return -1;
-    w->has_job = true;
+    mark_held(w, (int)(fr - f->frames));
     w->job_bytes += (uint64_t)n;
     f->jobs_sent++;
-    console_log(f->con, CONSOLE_DETAIL, "sent the job (%d bytes) to %s", n, w->name);
+    if (f->nframes > 1)
+        console_log(f->con, CONSOLE_DETAIL, "sent the job of frame %d (%d bytes) to %s",
+                    fr->jb->frame_number, n, w->name);
+    else
+        console_log(f->con, CONSOLE_DETAIL, "sent the job (%d bytes) to %s", n, w->name);
     return 0;
 }
 
 static int send_grant(farm *f, farm_worker *w, const scheduler_lease *l, int64_t now)
 {
-    image_rect r = image_format_tile_rect(&f->fmt, l->tile % f->tiles_x, l->tile / f->tiles_x);
+    int local;
+    farm_frame *fr = farm_frame_of(f, l->tile, &local);
+    image_rect r = image_format_tile_rect(&fr->fmt, local % fr->tiles_x, local / fr->tiles_x);
     Aafarm__Rect rect = AAFARM__RECT__INIT;
     rect.x = (uint32_t)r.x0;
     rect.y = (uint32_t)r.y0;
     rect.width = (uint32_t)r.w;
     rect.height = (uint32_t)r.h;
     Aafarm__Grant g = AAFARM__GRANT__INIT;
-    g.job_hash = (char *)f->jb->hash;
+    g.job_hash = (char *)fr->jb->hash;
     g.lease_id = l->id;
-    g.tile_index = (uint32_t)l->tile;
+    g.tile_index = (uint32_t)local;
     g.tile = &rect;
     g.deadline_ms = (uint32_t)(l->deadline_ms - l->granted_ms);
     Aafarm__Envelope env = AAFARM__ENVELOPE__INIT;
@@ -120,8 +150,13 @@ static int send_grant(farm *f, farm_worker *w, const scheduler_lease *l, int64_t
     int n = send_env(f, w, &env, now);
     if (n < 0) return -1;
     f->grant_bytes += (uint64_t)n;
-    console_log(f->con, CONSOLE_DETAIL, "granted tile %d to %s (lease %llu%s)", l->tile, w->name,
-                (unsigned long long)l->id, l->duplicate ? ", duplicate" : "");
+    if (f->nframes > 1)
+        console_log(f->con, CONSOLE_DETAIL, "granted frame %d tile %d to %s (lease %llu%s)",
+                    fr->jb->frame_number, local, w->name, (unsigned long long)l->id,
+                    l->duplicate ? ", duplicate" : "");
+    else
+        console_log(f->con, CONSOLE_DETAIL, "granted tile %d to %s (lease %llu%s)", l->tile,
+                    w->name, (unsigned long long)l->id, l->duplicate ? ", duplicate" : "");
     return 0;
 }
 
@@ -134,18 +169,22 @@ void farm_send_heartbeat(farm *f, farm_worker *w, int64_t now)
     send_env(f, w, &env, now);
 }
 
+/* JobDone for each frame whose job the worker holds. */
 void farm_send_job_done(farm *f, farm_worker *w, int64_t now)
 {
-    Aafarm__JobDone d = AAFARM__JOB_DONE__INIT;
-    d.job_hash = (char *)f->jb->hash;
-    d.status = f->state == FARM_DONE     ? AAFARM__JOB_STATUS__JOB_STATUS_DONE
-               : f->state == FARM_FAILED ? AAFARM__JOB_STATUS__JOB_STATUS_FAILED
-                                         : AAFARM__JOB_STATUS__JOB_STATUS_CANCELLED;
-    d.message = f->state == FARM_DONE ? "" : f->state == FARM_FAILED ? f->failure : "interrupted";
-    Aafarm__Envelope env = AAFARM__ENVELOPE__INIT;
-    env.body_case = AAFARM__ENVELOPE__BODY_JOB_DONE;
-    env.job_done = &d;
-    send_env(f, w, &env, now);
+    for (int i = 0; i < w->nheld; i++) {
+        Aafarm__JobDone d = AAFARM__JOB_DONE__INIT;
+        d.job_hash = (char *)f->frames[w->held[i]].jb->hash;
+        d.status = f->state == FARM_DONE     ? AAFARM__JOB_STATUS__JOB_STATUS_DONE
+                   : f->state == FARM_FAILED ? AAFARM__JOB_STATUS__JOB_STATUS_FAILED
+                                             : AAFARM__JOB_STATUS__JOB_STATUS_CANCELLED;
+        d.message = f->state == FARM_DONE ? "" : f->state == FARM_FAILED ? f->failure
+                                                                          : "interrupted";
+        Aafarm__Envelope env = AAFARM__ENVELOPE__INIT;
+        env.body_case = AAFARM__ENVELOPE__BODY_JOB_DONE;
+        env.job_done = &d;
+        send_env(f, w, &env, now);
+    }
 }
 
 void farm_send_shutdown(farm *f, farm_worker *w, const char *reason, int64_t now)
@@ -227,12 +266,13 @@ static void on_hello(farm *f, const Aafarm__Hello *h, const uint8_t *id, size_t 
      * can have (aafarm-worker --threads 1..1024) buys a peer no more tiles */
     w->threads = h->threads ? (h->threads > 1024 ? 1024 : h->threads) : 1;
     w->slot = scheduler_worker_add(f->sched);
-    w->has_job = holds_job(h, f->jb->hash);
+    for (int i = 0; i < f->nframes; i++)
+        if (holds_job(h, f->frames[i].jb->hash)) mark_held(w, i);
     w->local = f->locals && strcmp(w->host, f->host) == 0 &&
                local_workers_has_pid(f->locals, (pid_t)w->pid);
     console_log(f->con, CONSOLE_INFO, "worker %s joined (%s, pid %u, %u thread%s%s)", w->name,
                 w->host, w->pid, w->threads, w->threads == 1 ? "" : "s",
-                w->has_job ? ", holds the job" : "");
+                !w->nheld ? "" : f->nframes == 1 ? ", holds the job" : ", holds frames' jobs");
     send_welcome(f, w, now);
 }
 
@@ -255,17 +295,21 @@ static void tile_failed(farm *f, farm_worker *w, uint64_t lease, int tile, const
     scheduler_failure r = scheduler_fail(f->sched, w->slot, lease, retryable);
     if (r == SCHEDULER_FAIL_IGNORED) return;
     w->failures++;
-    image_rect rect = image_format_tile_rect(&f->fmt, tile % f->tiles_x, tile / f->tiles_x);
+    int local;
+    farm_frame *fr = farm_frame_of(f, tile, &local);
+    image_rect rect = image_format_tile_rect(&fr->fmt, local % fr->tiles_x, local / fr->tiles_x);
     int attempts = scheduler_tile_attempts(f->sched, tile);
+    char frame[40] = "";
+    if (f->nframes > 1) snprintf(frame, sizeof frame, "frame %d ", fr->jb->frame_number);
     if (r == SCHEDULER_RETRY) {
         console_log(f->con, CONSOLE_INFO,
-                    "tile %d at (%d,%d) failed on %s (attempt %d of %d): %s; trying again",
-                    tile, rect.x0, rect.y0, w->name, attempts, f->opt->max_attempts, msg);
+                    "%stile %d at (%d,%d) failed on %s (attempt %d of %d): %s; trying again",
+                    frame, local, rect.x0, rect.y0, w->name, attempts, f->opt->max_attempts, msg);
         return;
     }
-    farm_fail(f, "tile %d at (%d,%d) failed on worker %s (%s): %s", tile, rect.x0, rect.y0,
-              w->name, retryable ? "attempts exhausted" : "not retryable, confirmed by a second "
-              "worker", msg);
+    farm_fail(f, "%stile %d at (%d,%d) failed on worker %s (%s): %s", frame, local, rect.x0,
+              rect.y0, w->name, retryable ? "attempts exhausted" : "not retryable, confirmed "
+              "by a second worker", msg);
 }
 
 static void add_stats(farm_worker *w, const Aafarm__TileStats *s)
@@ -290,7 +334,10 @@ static void on_result(farm *f, farm_worker *w, const Aafarm__Result *r, const wi
     const uint8_t *bulk = wire_msg_bulk(m, &len);
     w->bytes_in += len;
     f->result_bytes += len;
-    bool ours = strcmp(r->job_hash, f->jb->hash) == 0;
+    const scheduler_lease *held = scheduler_lease_find(f->sched, w->slot, r->lease_id);
+    int local = 0;
+    farm_frame *fr = held ? farm_frame_of(f, held->tile, &local) : NULL;
+    bool ours = fr && strcmp(r->job_hash, fr->jb->hash) == 0;
     scheduler_verdict v = ours ? scheduler_check_result(f->sched, w->slot, r->lease_id)
                                : SCHEDULER_STALE;
     if (v != SCHEDULER_TAKEN) {
@@ -301,21 +348,22 @@ static void on_result(farm *f, farm_worker *w, const Aafarm__Result *r, const wi
                     (unsigned long long)r->lease_id);
         return;
     }
-    int tile = scheduler_lease_find(f->sched, w->slot, r->lease_id)->tile;
+    int tile = held->tile;
     char err[600];
-    if (r->tile_index != (uint32_t)tile) {
+    if (r->tile_index != (uint32_t)local) {
         snprintf(err, sizeof err, "its result names tile %u, the lease was for tile %d",
-                 r->tile_index, tile);
+                 r->tile_index, local);
     } else {
-        image_rect rect = image_format_tile_rect(&f->fmt, tile % f->tiles_x, tile / f->tiles_x);
+        image_rect rect = image_format_tile_rect(&fr->fmt, local % fr->tiles_x,
+                                                 local / fr->tiles_x);
         const void *chunk = NULL;
         size_t chunk_len = 0;
-        if (image_tile_exr_chunk(bulk, len, &f->fmt, rect, &chunk, &chunk_len, err, sizeof err)) {
+        if (image_tile_exr_chunk(bulk, len, &fr->fmt, rect, &chunk, &chunk_len, err, sizeof err)) {
             /* journal first: a tile in the journal survives the master */
             char ioerr[700];
-            if (!journal_append(f->jnl, tile, chunk, chunk_len, now, ioerr, sizeof ioerr) ||
-                !image_writer_put_chunk(f->writer, tile % f->tiles_x, tile / f->tiles_x, chunk,
-                                        chunk_len, ioerr, sizeof ioerr)) {
+            if (!journal_append(fr->jnl, local, chunk, chunk_len, now, ioerr, sizeof ioerr) ||
+                !image_writer_put_chunk(fr->writer, local % fr->tiles_x, local / fr->tiles_x,
+                                        chunk, chunk_len, ioerr, sizeof ioerr)) {
                 /* the master's own output failed (disk full): not the
                  * worker's fault, and no other worker can do better */
                 farm_fail(f, "%s", ioerr);
@@ -328,12 +376,15 @@ static void on_result(farm *f, farm_worker *w, const Aafarm__Result *r, const wi
                 if (f->nonfinite_tiles++ == 0)
                     console_log(f->con, CONSOLE_INFO, "warning: tile %d at (%d,%d) from %s had %llu "
                                 "NaN/Inf samples, written as 0 (further ones are counted at the "
-                                "end)", tile, rect.x0, rect.y0, w->name,
+                                "end)", local, rect.x0, rect.y0, w->name,
                                 (unsigned long long)r->stats->nonfinite_samples);
                 f->nonfinite_samples += r->stats->nonfinite_samples;
             }
-            console_log(f->con, CONSOLE_DETAIL, "took tile %d from %s (lease %llu, %zu bytes)", tile,
-                        w->name, (unsigned long long)r->lease_id, len);
+            char frame[40] = "";
+            if (f->nframes > 1) snprintf(frame, sizeof frame, "frame %d ", fr->jb->frame_number);
+            console_log(f->con, CONSOLE_DETAIL, "took %stile %d from %s (lease %llu, %zu bytes)",
+                        frame, local, w->name, (unsigned long long)r->lease_id, len);
+            if (++fr->done == fr->ntiles) farm_frame_complete(f, fr);
             return;
         }
     }
@@ -346,8 +397,9 @@ static void on_result(farm *f, farm_worker *w, const Aafarm__Result *r, const wi
 
 static void on_failure(farm *f, farm_worker *w, const Aafarm__Failure *x)
 {
-    if (strcmp(x->job_hash, f->jb->hash) != 0) return;
     const scheduler_lease *l = scheduler_lease_find(f->sched, w->slot, x->lease_id);
+    int local;
+    if (l && strcmp(x->job_hash, farm_frame_of(f, l->tile, &local)->jb->hash) != 0) return;
     if (!l) {
         console_log(f->con, CONSOLE_DETAIL, "stale failure from %s (lease %llu) dropped",
                     w->name, (unsigned long long)x->lease_id);
@@ -358,12 +410,13 @@ static void on_failure(farm *f, farm_worker *w, const Aafarm__Failure *x)
 
 static void on_need_job(farm *f, farm_worker *w, const Aafarm__NeedJob *n, int64_t now)
 {
-    if (strcmp(n->job_hash, f->jb->hash) != 0) {
-        console_log(f->con, CONSOLE_DETAIL, "%s asked for job %.12s..., not this master's",
-                    w->name, n->job_hash);
-        return;
-    }
-    send_job(f, w, now);
+    for (int i = 0; i < f->nframes; i++)
+        if (strcmp(n->job_hash, f->frames[i].jb->hash) == 0) {
+            send_job(f, w, &f->frames[i], now);
+            return;
+        }
+    console_log(f->con, CONSOLE_DETAIL, "%s asked for job %.12s..., not this master's",
+                w->name, n->job_hash);
 }
 
 static void on_unknown_peer(farm *f, proto_kind kind, const uint8_t *id, size_t id_len,
@@ -419,7 +472,9 @@ static bool grant_one(farm *f, farm_worker *w, int64_t now)
 {
     scheduler_lease l;
     if (!scheduler_grant(f->sched, w->slot, now, &l)) return false;
-    if (!w->has_job && send_job(f, w, now) != 0) return false;
+    int local;
+    farm_frame *fr = farm_frame_of(f, l.tile, &local);
+    if (!holds_frame(w, (int)(fr - f->frames)) && send_job(f, w, fr, now) != 0) return false;
     if (send_grant(f, w, &l, now) != 0) return false;
     w->credits--;
     return true;

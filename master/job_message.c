@@ -62,6 +62,7 @@ job_message *job_message_new(const job *jb, const image_format *fmt)
                                    : AAFARM__ARITHMETIC__ARITHMETIC_AFFINE;
     self->options.cache_bytes = 0;   /* each worker's own --cache-bytes */
     self->options.instruction_budget = (uint64_t)jb->options.max_instructions;
+    self->options.frame = (uint32_t)jb->options.frame;
     self->job.options = &self->options;
     return self;
 }

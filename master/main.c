@@ -14,20 +14,25 @@
 
 #include "curve_cert.h"
 #include "farm.h"
-#include "job/job_scene.h"
+#include "job/frames.h"
 #include "util/exitcodes.h"
 
 static void usage(FILE *out)
 {
     fprintf(out,
-        "usage: aafarm-master SCENE.rib -o OUT.exr [options]\n"
+        "usage: aafarm-master SCENE.rib [-o OUT.exr] [--frames LIST] [options]\n"
         "\n"
         "Renders a RenderMan scene with procedural displacement shaders on a farm of\n"
         "aafarm-worker processes (ZeroMQ) and stitches their EXR tiles into OUT.exr.\n"
         "With no --bind it starts its own local workers and stops them at the end.\n"
         "\n"
         "  -o, --output OUT.exr       output file (tiled OpenEXR, written via a temporary\n"
-        "                             file, renamed only when complete)\n"
+        "                             file, renamed only when complete); default: the\n"
+        "                             frame's Display name. A file of several frames\n"
+        "                             writes one EXR per frame: %%04d in the name is the\n"
+        "                             frame number, else it goes before the extension\n"
+        "  --frames LIST              frames to render by FrameBegin number: 3, 1-10,\n"
+        "                             1,3,5-7 (default: all; their tiles share one queue)\n"
         "  --bind ENDPOINT            also wait for remote workers, e.g. tcp://*:5555\n"
         "  --local-workers N          worker processes to start here (default: the number\n"
         "                             of cores without --bind, 0 with it)\n"
@@ -94,7 +99,7 @@ static int bad_number(const char *opt, const char *what, const char *got)
 static int parse(int argc, char **argv, cli *c)
 {
     enum { O_BIND = 256, O_LOCAL, O_TPW, O_TILE, O_ARITH, O_BUDGET, O_PREVIEW, O_STATS_JSON,
-           O_HEARTBEAT, O_LIVENESS, O_RETRIES, O_LEASE, O_DUPS, O_WORKER_BIN, O_RESUME, O_MAX_WORKERS,
+           O_HEARTBEAT, O_LIVENESS, O_RETRIES, O_LEASE, O_DUPS, O_WORKER_BIN, O_RESUME, O_MAX_WORKERS, O_FRAMES,
            O_CURVE_SECRET, O_ALLOW_KEYS, O_INSECURE, O_LEASE_FACTOR };
     static const struct option longopts[] = {
         {"output", required_argument, 0, 'o'},
@@ -114,6 +119,7 @@ static int parse(int argc, char **argv, cli *c)
         {"duplicates", required_argument, 0, O_DUPS},
         {"worker-binary", required_argument, 0, O_WORKER_BIN},
         {"resume", no_argument, 0, O_RESUME},
+        {"frames", required_argument, 0, O_FRAMES},
         {"max-workers", required_argument, 0, O_MAX_WORKERS},
         {"curve-secret", required_argument, 0, O_CURVE_SECRET},
         {"allow-keys", required_argument, 0, O_ALLOW_KEYS},
@@ -178,6 +184,17 @@ static int parse(int argc, char **argv, cli *c)
             break;
         case O_WORKER_BIN: f->worker_binary = optarg; break;
         case O_RESUME: f->resume = true; break;
+        case O_FRAMES: {
+            frame_spec spec;
+            char err[600];
+            if (!frame_spec_parse(optarg, &spec, err, sizeof err)) {
+                fprintf(stderr, "aafarm-master: %s\n", err);
+                return AAFARM_EXIT_USAGE;
+            }
+            frame_spec_free(&spec);
+            f->frames = optarg;
+            break;
+        }
         case O_MAX_WORKERS:
             if (!parse_long(optarg, 1, 65536, &n)) return bad_number("--max-workers", "1..65536", optarg);
             f->max_workers = (int)n;
@@ -196,10 +213,9 @@ static int parse(int argc, char **argv, cli *c)
         fprintf(stderr, "aafarm-master: unexpected argument '%s' (see --help)\n", argv[optind]);
         return AAFARM_EXIT_USAGE;
     }
-    if (!f->scene_path || !f->output) {
-        fprintf(stderr, "aafarm-master: %s (see --help)\n",
-                !f->scene_path ? "which scene? usage: aafarm-master SCENE.rib -o OUT.exr"
-                               : "needs -o OUT.exr");
+    if (!f->scene_path) {
+        fprintf(stderr, "aafarm-master: which scene? usage: aafarm-master SCENE.rib -o OUT.exr "
+                "(see --help)\n");
         return AAFARM_EXIT_USAGE;
     }
     if (!f->curve_secret != !f->allow_keys) {
@@ -237,28 +253,64 @@ static int parse(int argc, char **argv, cli *c)
     return -1;
 }
 
-/* Loads and checks the job; finds the image size. Exit code or -1. */
-static int load(cli *c, job **jb_out, image_format *fmt)
+/* The loaded frames and their outputs. */
+typedef struct loaded {
+    frame_sequence *seq;
+    farm_frame_in *frames;
+    char **previews;
+} loaded;
+
+static void loaded_free(loaded *l)
+{
+    for (int i = 0; l->seq && l->previews && i < l->seq->count; i++) free(l->previews[i]);
+    free(l->previews);
+    free(l->frames);
+    frame_sequence_destroy(&l->seq);
+}
+
+/* Loads and checks the job of every chosen frame; finds their image
+ * sizes. Exit code or -1. */
+static int load(cli *c, loaded *l)
 {
     sl_diag *diag = sl_diag_new();
-    job *jb = job_load(c->farm.scene_path, &c->job, diag);
-    job_scene *js = jb ? job_scene_new(jb, 0, false, diag) : NULL;
+    bool usage = false;
+    l->seq = frame_sequence_load(c->farm.scene_path, &c->job, c->farm.frames, c->farm.output,
+                                 &usage, diag);
+    int n = l->seq ? l->seq->count : 0;
+    l->frames = calloc((size_t)(n ? n : 1), sizeof *l->frames);
+    l->previews = calloc((size_t)(n ? n : 1), sizeof *l->previews);
+    if (!l->frames || !l->previews) abort();
+    bool ok = l->seq != NULL;
+    for (int i = 0; i < n && ok; i++) {
+        const job *jb = l->seq->jobs[i];
+        farm_frame_in *fr = &l->frames[i];
+        fr->jb = jb;
+        fr->output = l->seq->outputs[i];
+        fr->fmt = (image_format){jb->xres, jb->yres, c->job.tile_size, 0};   /* job_load's */
+        char err[300];
+        if (!image_format_check(&fr->fmt, err, sizeof err)) {
+            sl_diag_error(diag, (sl_pos){0}, "%s: %s", c->farm.scene_path, err);
+            ok = false;
+            break;
+        }
+        if (c->farm.preview) {
+            l->previews[i] = frame_output_name(c->farm.preview, jb->frame_number,
+                                               l->seq->nframes, false, err, sizeof err);
+            if (!l->previews[i]) {
+                sl_diag_error(diag, (sl_pos){0}, "--preview: %s", err);
+                ok = false;
+                break;
+            }
+            fr->preview = l->previews[i];
+        }
+    }
     sl_diag_print(diag, stderr);
     sl_diag_destroy(&diag);
-    if (!js) {
-        job_destroy(&jb);
-        return AAFARM_EXIT_INPUT;
-    }
-    *fmt = (image_format){js->world.camera.xres, js->world.camera.yres, c->job.tile_size, 0};
-    job_scene_destroy(&js);
-    char err[300];
-    if (!image_format_check(fmt, err, sizeof err)) {
-        fprintf(stderr, "aafarm-master: %s: %s\n", c->farm.scene_path, err);
-        job_destroy(&jb);
-        return AAFARM_EXIT_INPUT;
-    }
-    *jb_out = jb;
-    return -1;
+    if (ok && l->seq->numbered && c->farm.verbosity >= 0)
+        fprintf(stderr, "aafarm-master: %s has %d frames: each one's number goes before the "
+                "extension of %s (%s ...; put %%04d in the name to place it)\n",
+                c->farm.scene_path, l->seq->nframes, l->seq->numbered, l->seq->outputs[0]);
+    return ok ? -1 : usage && !l->seq ? AAFARM_EXIT_USAGE : AAFARM_EXIT_INPUT;
 }
 
 int main(int argc, char **argv)
@@ -269,11 +321,9 @@ int main(int argc, char **argv)
     job_options_default(&c.job);
     int rc = parse(argc, argv, &c);
     if (rc >= 0) return rc;
-    job *jb = NULL;
-    image_format fmt;
-    rc = load(&c, &jb, &fmt);
-    if (rc >= 0) return rc;
-    rc = farm_run(&c.farm, jb, &fmt);
-    job_destroy(&jb);
+    loaded l = {0};
+    rc = load(&c, &l);
+    if (rc < 0) rc = farm_run(&c.farm, l.frames, l.seq->count);
+    loaded_free(&l);
     return rc;
 }

@@ -31,7 +31,10 @@ typedef struct farm_worker {
     uint32_t pid, threads;
     int slot;                      /* scheduler worker slot */
     uint32_t credits;              /* tiles it asked for and was not granted yet */
-    bool has_job;                  /* it holds the current job (sent, or in Hello) */
+    bool has_job;                  /* it holds a job of this render (sent, or in Hello) */
+    int held[8];                   /* frames whose job it holds, newest last
+                                      (farm_messages.c; a worker keeps 4) */
+    int nheld;
     bool local;                    /* a process this master started */
     bool alive;
     char gone[160];                /* why it was retired */

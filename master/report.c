@@ -153,7 +153,11 @@ static void json_farm(FILE *out, const farm *f)
     scheduler_counts c;
     scheduler_counts_get(f->sched, &c);
     double per_grant = c.grants ? (double)f->grant_bytes / (double)c.grants : 0;
-    fprintf(out, "  \"farm\": {\"job_bytes\": %zu, \"jobs_sent\": %llu, \"grant_bytes_per_tile\": "
+    uint64_t job_bytes_sent = 0;   /* every Job sent, of every frame */
+    for (size_t i = 0; i < registry_count(f->reg); i++)
+        job_bytes_sent += registry_at(f->reg, i)->job_bytes;
+    fprintf(out, "  \"farm\": {\"job_bytes\": %zu, \"job_bytes_sent\": %llu, "
+            "\"jobs_sent\": %llu, \"grant_bytes_per_tile\": "
             "%.1f, \"result_bytes\": %llu, \"bytes_sent\": %llu, \"grants\": %llu, "
             "\"duplicate_grants\": %llu, \"requeued\": %llu, \"expired_leases\": %llu, "
             "\"duplicate_results\": %llu, \"stale_results\": %llu, \"failures\": %llu, "
@@ -161,7 +165,8 @@ static void json_farm(FILE *out, const farm *f)
             "\"version_mismatches\": %llu, \"disconnects\": %llu, \"nonfinite_samples\": %llu, "
             "\"handshake_failures\": %llu, \"auth_refusals\": %llu, \"max_bulk_bytes\": %zu, "
             "\"master_cpu_seconds\": %.3f, \"master_peak_rss_kb\": %ld},\n",
-            f->job_bytes, (unsigned long long)f->jobs_sent, per_grant,
+            f->job_bytes, (unsigned long long)job_bytes_sent, (unsigned long long)f->jobs_sent,
+            per_grant,
             (unsigned long long)f->result_bytes, (unsigned long long)f->sent_bytes,
             (unsigned long long)c.grants, (unsigned long long)c.duplicate_grants,
             (unsigned long long)c.requeued, (unsigned long long)c.expired,
@@ -185,14 +190,15 @@ bool farm_report_json(const farm *f, const char *path, char *err, size_t errsz)
     fputs("{\n  \"scene\": ", out);
     json_string(out, f->opt->scene_path);
     fputs(", \"output\": ", out);
-    json_string(out, f->opt->output);
+    json_string(out, f->frames[0].output);
     fprintf(out, ", \"status\": \"%s\", \"error\": ", state_name(f->state));
     json_string(out, f->state == FARM_FAILED ? f->failure : "");
     fprintf(out, ",\n  \"width\": %d, \"height\": %d, \"tile_size\": %d, \"tiles\": %d, "
             "\"tiles_done\": %d, \"resumed_tiles\": %d, \"seconds\": %.6f, "
-            "\"job_hash\": \"%s\",\n",
+            "\"job_hash\": \"%s\", \"frames\": %d, \"frames_written\": %d,\n",
             f->fmt.width, f->fmt.height, f->fmt.tile_size, f->ntiles,
-            scheduler_tiles_done(f->sched), f->resumed_tiles, (double)(f->end_ms - f->start_ms) / 1000.0, f->jb->hash);
+            scheduler_tiles_done(f->sched), f->resumed_tiles, (double)(f->end_ms - f->start_ms) / 1000.0, f->frames[0].jb->hash,
+            f->nframes, f->frames_written);
     json_farm(out, f);
     json_totals(out, f);
     fputs("  \"workers\": [\n", out);

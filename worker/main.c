@@ -1,7 +1,7 @@
 /*
  * main.c: the aafarm-worker command line.
  *
- *   aafarm-worker --standalone SCENE.rib -o OUT.exr [options]
+ *   aafarm-worker --standalone SCENE.rib [-o OUT.exr] [--frames 1-3] [options]
  *   aafarm-worker --connect ENDPOINT [options]          (the farm: docs/farm.md)
  */
 #include <getopt.h>
@@ -9,6 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "job/frames.h"
 #include "standalone.h"
 #include "util/exitcodes.h"
 #include "worker_loop.h"
@@ -16,7 +17,7 @@
 static void usage(FILE *out)
 {
     fprintf(out,
-        "usage: aafarm-worker --standalone SCENE.rib -o OUT.exr [options]\n"
+        "usage: aafarm-worker --standalone SCENE.rib [-o OUT.exr] [--frames LIST] [options]\n"
         "       aafarm-worker --connect ENDPOINT [options]\n"
         "\n"
         "Renders RenderMan scenes with procedural displacement shaders, ray-traced\n"
@@ -24,7 +25,12 @@ static void usage(FILE *out)
         "\n"
         "  --standalone SCENE.rib  render the whole image in this process (the\n"
         "                          reference a farm render equals pixel for pixel)\n"
-        "  -o, --output OUT.exr    output file (tiled OpenEXR: RGBA half + Z float)\n"
+        "  -o, --output OUT.exr    output file (tiled OpenEXR: RGBA half + Z float);\n"
+        "                          default: the frame's Display name. In a file of\n"
+        "                          several frames, %%04d in the name is the frame\n"
+        "                          number, else it is put before the extension\n"
+        "  --frames LIST           frames to render by FrameBegin number: 3, 1-10,\n"
+        "                          1,3,5-7 (default: all; one EXR per frame)\n"
         "  --connect ENDPOINT      serve a master, e.g. tcp://render1:5555; serves one\n"
         "                          job after another, reconnects when the master goes\n"
         "                          away (docs/farm.md)\n"
@@ -96,7 +102,7 @@ int main(int argc, char **argv)
     const char *connect = NULL;
     enum { O_STANDALONE = 256, O_CONNECT, O_NAME, O_TILE, O_CACHE, O_ARITH, O_BUDGET,
            O_PREVIEW, O_STATS, O_STATS_JSON, O_TILE_DELAY, O_PREPARE_DELAY,
-           O_CURVE_SECRET, O_MASTER_KEY };
+           O_CURVE_SECRET, O_MASTER_KEY, O_FRAMES };
     static const struct option longopts[] = {
         {"standalone", required_argument, 0, O_STANDALONE},
         {"output", required_argument, 0, 'o'},
@@ -114,6 +120,7 @@ int main(int argc, char **argv)
         {"prepare-delay", required_argument, 0, O_PREPARE_DELAY},
         {"curve-secret", required_argument, 0, O_CURVE_SECRET},
         {"master-key", required_argument, 0, O_MASTER_KEY},
+        {"frames", required_argument, 0, O_FRAMES},
         {"quiet", no_argument, 0, 'q'},
         {"verbose", no_argument, 0, 'v'},
         {"help", no_argument, 0, 'h'},
@@ -179,6 +186,17 @@ int main(int argc, char **argv)
             break;
         case O_CURVE_SECRET: wo.curve_secret = optarg; break;
         case O_MASTER_KEY: wo.master_key = optarg; break;
+        case O_FRAMES: {
+            frame_spec spec;
+            char err[600];
+            if (!frame_spec_parse(optarg, &spec, err, sizeof err)) {
+                fprintf(stderr, "aafarm-worker: %s\n", err);
+                return AAFARM_EXIT_USAGE;
+            }
+            frame_spec_free(&spec);
+            so.frames = optarg;
+            break;
+        }
         case 'q': so.verbosity = wo.verbosity = -1; break;
         case 'v': so.verbosity = wo.verbosity = 1; break;
         case 'h': usage(stdout); return AAFARM_EXIT_OK;
@@ -193,13 +211,13 @@ int main(int argc, char **argv)
         fprintf(stderr, "aafarm-worker: --standalone and --connect exclude each other\n");
         return AAFARM_EXIT_USAGE;
     }
-    if (so.scene_path) {
-        if (!so.output) {
-            fprintf(stderr, "aafarm-worker: --standalone needs -o OUT.exr\n");
-            return AAFARM_EXIT_USAGE;
-        }
-        return worker_standalone(&so);
+    if (so.frames && !so.scene_path) {
+        fprintf(stderr, "aafarm-worker: --frames goes with --standalone (a farm's frames are "
+                "chosen by aafarm-master --frames)\n");
+        return AAFARM_EXIT_USAGE;
     }
+    if (so.scene_path)
+        return worker_standalone(&so);
     if (!wo.curve_secret != !wo.master_key) {
         fprintf(stderr, "aafarm-worker: --curve-secret and --master-key go together (this "
                 "worker's key pair, and the master's public key)\n");

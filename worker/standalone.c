@@ -19,6 +19,7 @@
 
 #include "image/preview.h"
 #include "image/writer.h"
+#include "job/frames.h"
 #include "job/job_scene.h"
 #include "tile_render.h"
 #include "tile_runs.h"
@@ -151,31 +152,27 @@ static bool write_stats_json(const char *path, const shared *s, int threads, dou
     return fclose(f) == 0;
 }
 
-int worker_standalone(const standalone_options *opt)
-{
-    /* first: a signal during preparation must not leave a temporary file */
-    struct sigaction sa = {0};
-    sa.sa_handler = on_signal;
-    sigaction(SIGINT, &sa, NULL);
-    sigaction(SIGTERM, &sa, NULL);
+/* The outputs of one frame. */
+typedef struct frame_out {
+    const char *output, *preview, *stats_json;
+} frame_out;
 
+/* Renders one frame's job (loaded and checked) into its outputs. */
+static int render_frame(const standalone_options *opt, const job *jb, const frame_out *fo)
+{
     sl_diag *diag = sl_diag_new();
-    job *jb = job_load(opt->scene_path, &opt->job, diag);
-    job_scene *js = jb ? job_scene_new(jb, opt->cache_bytes, true, diag) : NULL;
+    job_scene *js = job_scene_new(jb, opt->cache_bytes, true, diag);
     sl_diag_print(diag, stderr);
     sl_diag_destroy(&diag);
     if (!js || atomic_load(&interrupted)) {
         if (js && atomic_load(&interrupted)) {
-            fprintf(stderr, "aafarm-worker: interrupted; %s not written\n", opt->output);
+            fprintf(stderr, "aafarm-worker: interrupted; %s not written\n", fo->output);
             job_scene_destroy(&js);
-            job_destroy(&jb);
             return AAFARM_EXIT_INTERRUPTED;
         }
         /* job_load checked the scene and compiled the shaders; what fails
          * after it is a shader at run time (its budget): a render failure */
-        int rc = jb ? AAFARM_EXIT_FAILURE : AAFARM_EXIT_INPUT;
-        job_destroy(&jb);
-        return rc;
+        return AAFARM_EXIT_FAILURE;
     }
 
     shared s = {.opt = opt, .js = js};
@@ -185,17 +182,15 @@ int worker_standalone(const standalone_options *opt)
     if (!image_format_check(&s.fmt, err, sizeof err)) {
         fprintf(stderr, "aafarm-worker: %s\n", err);
         job_scene_destroy(&js);
-        job_destroy(&jb);
         return AAFARM_EXIT_INPUT;
     }
-    s.writer = image_writer_new(opt->output, &s.fmt, err, sizeof err);
+    s.writer = image_writer_new(fo->output, &s.fmt, err, sizeof err);
     if (!s.writer) {
         fprintf(stderr, "aafarm-worker: %s\n", err);
         job_scene_destroy(&js);
-        job_destroy(&jb);
         return AAFARM_EXIT_FAILURE;
     }
-    if (opt->preview) {
+    if (fo->preview) {
         s.preview = calloc((size_t)s.fmt.width * (size_t)s.fmt.height * 4, sizeof(float));
         if (!s.preview) abort();
     }
@@ -221,11 +216,11 @@ int worker_standalone(const standalone_options *opt)
 
     int rc = AAFARM_EXIT_OK;
     if (interrupted) {
-        fprintf(stderr, "\naafarm-worker: interrupted; %s not written\n", opt->output);
+        fprintf(stderr, "\naafarm-worker: interrupted; %s not written\n", fo->output);
         image_writer_destroy(&s.writer);
         rc = AAFARM_EXIT_INTERRUPTED;
     } else if (s.failed) {
-        fprintf(stderr, "aafarm-worker: %s\naafarm-worker: %s not written\n", s.error, opt->output);
+        fprintf(stderr, "aafarm-worker: %s\naafarm-worker: %s not written\n", s.error, fo->output);
         image_writer_destroy(&s.writer);
         rc = AAFARM_EXIT_FAILURE;
     } else if (!image_writer_finish(&s.writer, err, sizeof err)) {
@@ -233,8 +228,8 @@ int worker_standalone(const standalone_options *opt)
         image_writer_destroy(&s.writer);
         rc = AAFARM_EXIT_FAILURE;
     }
-    if (rc == AAFARM_EXIT_OK && opt->preview &&
-        !image_preview_write_png(opt->preview, s.preview, s.fmt.width, s.fmt.height, err, sizeof err)) {
+    if (rc == AAFARM_EXIT_OK && fo->preview &&
+        !image_preview_write_png(fo->preview, s.preview, s.fmt.width, s.fmt.height, err, sizeof err)) {
         fprintf(stderr, "aafarm-worker: %s\n", err);
         rc = AAFARM_EXIT_FAILURE;
     }
@@ -245,14 +240,14 @@ int worker_standalone(const standalone_options *opt)
                 s.nonfinite.y);
     if (rc == AAFARM_EXIT_OK && opt->verbosity >= 0) {
         trace_object_work_report(&js->world, s.work, "aafarm-worker", stderr);
-        fprintf(stderr, "aafarm-worker: wrote %s (%.2f s)\n", opt->output, secs);
+        fprintf(stderr, "aafarm-worker: wrote %s (%.2f s)\n", fo->output, secs);
     }
     if (opt->stats) {
         fprintf(stderr, "statistics:\n");
         trace_stats_print(&s.stats, stderr);
     }
-    if (opt->stats_json && !write_stats_json(opt->stats_json, &s, threads, secs)) {
-        fprintf(stderr, "aafarm-worker: cannot write %s: %s\n", opt->stats_json, strerror(errno));
+    if (fo->stats_json && !write_stats_json(fo->stats_json, &s, threads, secs)) {
+        fprintf(stderr, "aafarm-worker: cannot write %s: %s\n", fo->stats_json, strerror(errno));
         if (rc == AAFARM_EXIT_OK) rc = AAFARM_EXIT_FAILURE;
     }
     free(s.preview);
@@ -260,6 +255,59 @@ int worker_standalone(const standalone_options *opt)
     tile_runs_destroy(&s.runs);
     pthread_mutex_destroy(&s.lock);
     job_scene_destroy(&js);
-    job_destroy(&jb);
+    return rc;
+}
+
+/* A per-frame name for an optional output (the preview, the statistics). */
+static char *frame_name(const char *name, const job *jb, int nframes)
+{
+    if (!name) return NULL;
+    char err[300];
+    char *out = frame_output_name(name, jb->frame_number, nframes, false, err, sizeof err);
+    if (!out) fprintf(stderr, "aafarm-worker: %s\n", err);
+    return out;
+}
+
+int worker_standalone(const standalone_options *opt)
+{
+    /* first: a signal during preparation must not leave a temporary file */
+    struct sigaction sa = {0};
+    sa.sa_handler = on_signal;
+    sigaction(SIGINT, &sa, NULL);
+    sigaction(SIGTERM, &sa, NULL);
+
+    sl_diag *diag = sl_diag_new();
+    bool usage = false;
+    frame_sequence *seq = frame_sequence_load(opt->scene_path, &opt->job, opt->frames,
+                                              opt->output, &usage, diag);
+    sl_diag_print(diag, stderr);
+    sl_diag_destroy(&diag);
+    if (!seq) return usage ? AAFARM_EXIT_USAGE : AAFARM_EXIT_INPUT;
+    if (seq->numbered && opt->verbosity >= 0)
+        fprintf(stderr, "aafarm-worker: %s has %d frames: each one's number goes before the "
+                "extension of %s (%s ...; put %%04d in the name to place it)\n",
+                opt->scene_path, seq->nframes, seq->numbered, seq->outputs[0]);
+    int rc = AAFARM_EXIT_OK;
+    for (int i = 0; i < seq->count && rc == AAFARM_EXIT_OK; i++) {
+        const job *jb = seq->jobs[i];
+        if (atomic_load(&interrupted)) {
+            fprintf(stderr, "aafarm-worker: interrupted; %s not written\n", seq->outputs[i]);
+            rc = AAFARM_EXIT_INTERRUPTED;
+            break;
+        }
+        if (seq->count > 1 && opt->verbosity >= 0)
+            fprintf(stderr, "aafarm-worker: frame %d (%d of %d) -> %s\n", jb->frame_number,
+                    i + 1, seq->count, seq->outputs[i]);
+        char *preview = frame_name(opt->preview, jb, seq->nframes);
+        char *stats_json = frame_name(opt->stats_json, jb, seq->nframes);
+        frame_out fo = {seq->outputs[i], preview, stats_json};
+        if ((opt->preview && !preview) || (opt->stats_json && !stats_json))
+            rc = AAFARM_EXIT_USAGE;
+        else
+            rc = render_frame(opt, jb, &fo);
+        free(preview);
+        free(stats_json);
+    }
+    frame_sequence_destroy(&seq);
     return rc;
 }

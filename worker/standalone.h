@@ -14,7 +14,9 @@
 
 typedef struct standalone_options {
     const char *scene_path;
-    const char *output;            /* OUT.exr */
+    const char *output;            /* OUT.exr, a pattern (out.%04d.exr), or NULL:
+                                      each frame's Display (job/frames.h) */
+    const char *frames;            /* --frames "1,3,5-7", NULL: all */
     const char *preview;           /* OUT.png or NULL */
     const char *stats_json;        /* FILE or NULL */
     bool stats;                    /* print statistics */

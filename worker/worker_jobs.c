@@ -70,6 +70,8 @@ static job_options options_of(const Aafarm__RenderOptions *o)
     if (o->instruction_budget)
         jo.max_instructions = o->instruction_budget > (uint64_t)LONG_MAX ? LONG_MAX
                                                                           : (long)o->instruction_budget;
+    /* an index no scene can have is refused by job_finish */
+    jo.frame = o->frame > (uint32_t)INT_MAX / 2 ? -1 : (int)o->frame;
     return jo;
 }
 

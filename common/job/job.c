@@ -27,6 +27,7 @@ void job_options_default(job_options *opt)
     opt->arith = TRACE_ARITH_AFFINE;
     opt->tile_size = 32;
     opt->max_instructions = 1000000;
+    opt->frame = 0;
 }
 
 const char *trace_arith_name(trace_arith arith)
@@ -67,6 +68,8 @@ void job_destroy(job **self_p)
         free(self->shaders[i].file);
     }
     free(self->shaders);
+    free(self->frame_numbers);
+    free(self->display_name);
     free(self);
     *self_p = NULL;
 }
@@ -119,9 +122,13 @@ bool job_finish(job *self, char *why, int why_size)
                      self->shaders[i].name, self->shaders[i].file);
             return false;
         }
+    if (self->options.frame < 0) {
+        snprintf(why, (size_t)why_size, "frame index %d is out of range", self->options.frame);
+        return false;
+    }
     size_t nsrc = sl_source_set_count(self->sources);
     hash_shader *hs = calloc(nsrc + 1, sizeof *hs);
-    int nopt = 3 + self->nshaders;
+    int nopt = 3 + self->nshaders + (self->options.frame != 0);
     hash_option *ho = calloc((size_t)nopt, sizeof *ho);
     char (*keys)[160] = calloc((size_t)nopt, sizeof *keys);
     char (*vals)[600] = calloc((size_t)nopt, sizeof *vals);
@@ -139,6 +146,10 @@ bool job_finish(job *self, char *why, int why_size)
     for (int i = 0; i < self->nshaders; i++) {
         snprintf(keys[3 + i], sizeof keys[0], "shader:%s", self->shaders[i].name);
         snprintf(vals[3 + i], sizeof vals[0], "%s", self->shaders[i].file);
+    }
+    if (self->options.frame != 0) {   /* absent for frame 0: older hashes stay */
+        snprintf(keys[nopt - 1], sizeof keys[0], "frame");
+        snprintf(vals[nopt - 1], sizeof vals[0], "%d", self->options.frame);
     }
     for (int i = 0; i < nopt; i++) ho[i] = (hash_option){keys[i], vals[i]};
     hash_job_input in = {self->scene_file, self->scene_text, self->scene_len,
@@ -191,6 +202,11 @@ static char *read_file(const char *path, size_t *len, sl_diag *diag)
     return buf;
 }
 
+char *job_read_scene(const char *rib_path, size_t *len, sl_diag *diag)
+{
+    return read_file(rib_path, len, diag);
+}
+
 job *job_load(const char *rib_path, const job_options *options, sl_diag *diag)
 {
     size_t len = 0;
@@ -200,13 +216,22 @@ job *job_load(const char *rib_path, const job_options *options, sl_diag *diag)
     job *self = job_new(rib_path, text, len, options);
     free(text);
     sl_source_set_set_loader(self->sources, scene_archive_load_from_disk, NULL);
-    scene *sc = scene_parse_archives(rib_path, self->scene_text, self->scene_len,
-                                     self->sources, diag);
+    scene *sc = scene_parse_frame(rib_path, self->scene_text, self->scene_len,
+                                  self->sources, SCENE_MAX_OBJECTS, self->options.frame, diag);
     sl_source_set_set_loader(self->sources, NULL, NULL);
     if (!sc) {
         job_destroy(&self);
         return NULL;
     }
+    self->frame_number = sc->frame_number;
+    self->nframes = sc->nframes;
+    if (sc->nframes > 0) {
+        self->frame_numbers = malloc(sizeof *self->frame_numbers * (size_t)sc->nframes);
+        if (!self->frame_numbers) abort();
+        memcpy(self->frame_numbers, sc->frame_numbers,
+               sizeof *self->frame_numbers * (size_t)sc->nframes);
+    }
+    if (sc->display_name) self->display_name = dup_s(sc->display_name);
     char why[512];
     bool ok = true;
     for (int i = 0; i < sc->nshader_names; i++) {
@@ -241,6 +266,10 @@ job *job_load(const char *rib_path, const job_options *options, sl_diag *diag)
         job_scene *js = job_scene_new(self, 0, false, diag);
         sl_source_set_set_loader(self->sources, NULL, NULL);
         ok = js != NULL;
+        if (ok) {
+            self->xres = js->world.camera.xres;
+            self->yres = js->world.camera.yres;
+        }
         job_scene_destroy(&js);
     }
     if (ok && !job_finish(self, why, sizeof why)) {

@@ -31,6 +31,9 @@ typedef struct job_options {
     trace_arith arith;             /* bounding arithmetic (default affine) */
     int tile_size;                 /* pixels (default 32) */
     long max_instructions;         /* shader budget per evaluation (default 1e6) */
+    int frame;                     /* which FrameBegin block (0: the first, or
+                                      the whole file without frames); in the
+                                      hash when not 0 (docs/protocol.md) */
 } job_options;
 
 void job_options_default(job_options *opt);
@@ -49,11 +52,20 @@ typedef struct job {
     int nshaders;
     job_options options;
     char hash[HASH_HEX_SIZE];      /* set by job_finish / job_load */
+    /* set by job_load from the scene, for naming outputs (not hashed) */
+    int frame_number;              /* the frame's FrameBegin number (1 without) */
+    int nframes;                   /* FrameBegin blocks in the file (0: none) */
+    int *frame_numbers;            /* their numbers, in order */
+    char *display_name;            /* the frame's Display name, or NULL */
+    int xres, yres;                /* the frame's Format */
 } job;
 
 /* Reads and checks the RIB at rib_path and everything it needs. NULL when
  * anything is wrong; diag holds the errors. */
 job *job_load(const char *rib_path, const job_options *options, sl_diag *diag);
+
+/* The RIB at rib_path (at most 64 MiB), malloc'd; NULL with an error. */
+char *job_read_scene(const char *rib_path, size_t *len, sl_diag *diag);
 
 job *job_new(const char *scene_file, const char *scene_text, size_t scene_len,
              const job_options *options);

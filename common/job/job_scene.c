@@ -40,6 +40,9 @@ static void build_camera(const scene *sc, trace_world *w)
     t->tan_half_fov = tan(c->fov * (M_PI / 360.0));
     t->near_clip = c->near_clip;
     t->far_clip = c->far_clip;
+    /* RenderMan's thin lens: its diameter is focallength / fstop */
+    t->lens_radius = c->fstop > 0 ? 0.5 * c->focal_length / c->fstop : 0.0;
+    t->focal_distance = c->focal_distance;
     t->camera_from_world = c->camera_from_world;
     t->world_from_camera = c->world_from_camera;
 }
@@ -223,8 +226,8 @@ job_scene *job_scene_new(const job *jb, size_t cache_bytes, bool render, sl_diag
     if (!self) abort();
     self->job = jb;
     /* archives come from the job, never from this machine's disk */
-    self->scene = scene_parse_archives(jb->scene_file, jb->scene_text, jb->scene_len,
-                                       jb->sources, diag);
+    self->scene = scene_parse_frame(jb->scene_file, jb->scene_text, jb->scene_len,
+                                    jb->sources, SCENE_MAX_OBJECTS, jb->options.frame, diag);
     bool ok = self->scene != NULL;
     if (ok) ok = compile_programs(self, diag);
     if (ok) ok = build_objects(self, diag);

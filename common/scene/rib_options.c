@@ -1,7 +1,8 @@
 /*
  * rib_options.c: the camera and image options of RI Specification 3.2
- * §4.1 (Format, Projection, ScreenWindow, Clipping, PixelSamples,
- * PixelFilter, Exposure, Display), Option "searchpath", version; and the
+ * §4.1 (Format, Projection, ScreenWindow, Clipping, DepthOfField,
+ * PixelSamples, PixelFilter, Exposure, Display), Option "searchpath",
+ * version; and the
  * camera checks at WorldBegin.
  *
  * aafarm needs a camera to render: Format and Projection are required
@@ -141,6 +142,31 @@ void rib_clipping(rib_parser *p, const rib_request *req)
     }
     p->scene->camera.near_clip = v[0];
     p->scene->camera.far_clip = v[1];
+}
+
+/* DepthOfField fstop focallength focaldistance (RI Spec 3.2 §4.1.2): a
+ * thin lens of diameter focallength / fstop focused at focaldistance;
+ * without arguments, a pinhole again. */
+void rib_depth_of_field(rib_parser *p, const rib_request *req)
+{
+    scene_camera *c = &p->scene->camera;
+    if (req->nargs == 0) {
+        c->fstop = c->focal_length = c->focal_distance = 0;
+        return;
+    }
+    double v[3];
+    int next = rib_read_numbers(p, req, 0, 3, v, "fstop focallength focaldistance");
+    if (next < 0 || !rib_no_more_args(p, req, next))
+        return;
+    if (!(v[0] > 0 && v[1] > 0 && v[2] > 0 && isfinite(v[1]) && isfinite(v[2]))) {
+        rib_error(p, req, req->pos, "needs fstop, focallength and focaldistance > 0, got %g %g "
+                  "%g (DepthOfField with no arguments turns depth of field off)", v[0], v[1],
+                  v[2]);
+        return;
+    }
+    c->fstop = isfinite(v[0]) ? v[0] : 0;   /* an infinite f-stop is a pinhole */
+    c->focal_length = v[1];
+    c->focal_distance = v[2];
 }
 
 void rib_pixel_samples(rib_parser *p, const rib_request *req)

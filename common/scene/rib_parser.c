@@ -16,6 +16,8 @@
 #include "sl/strbuf.h"
 
 #include <ctype.h>
+#include <limits.h>
+#include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -247,20 +249,15 @@ void rib_close_block(rib_parser *p, const rib_request *req, rib_block_kind kind)
 /* block requests                                                          */
 /* ---------------------------------------------------------------------- */
 
+/* Every FrameBegin block is a frame; the one with index p->frame_select is
+ * read and the others are skipped whole (archives they read included).
+ * Each frame's number is recorded (scene.frame_numbers): the RIB's, or
+ * the previous one plus 1 when it gives none. */
 static void frame_begin(rib_parser *p, const rib_request *req)
 {
     bool one_number = req->nargs == 1 && req->args[0].kind == RIB_ARG_NUMBER;
     if (!req->broken && req->nargs > 0 && !one_number)
         rib_error(p, req, req->pos, "takes one argument, the frame number");
-    if (p->frame_done || p->world_done) {
-        if (!p->warned_frames)
-            rib_warning(p, req, req->pos, "only the first frame is rendered; this frame and "
-                        "the later ones are ignored");
-        p->warned_frames = true;
-        p->skipping_frame = true;
-        p->skip_depth = 0;
-        return;
-    }
     for (int i = 0; i < p->nblocks; i++)
         if (p->blocks[i].kind == RIB_BLOCK_FRAME || p->blocks[i].kind == RIB_BLOCK_WORLD) {
             const rib_block *b = &p->blocks[i];
@@ -268,13 +265,34 @@ static void frame_begin(rib_parser *p, const rib_request *req)
                       begin_name(b->kind), b->pos.file, b->pos.line, b->pos.col);
             return;
         }
+    scene *s = p->scene;
+    int number = s->nframes > 0 ? s->frame_numbers[s->nframes - 1] + 1 : 1;
+    if (one_number && !req->broken) {
+        double v = req->nums[req->args[0].first];
+        if (v != floor(v) || v < 0 || v > 99999999) {
+            rib_error(p, req, req->args[0].pos, "the frame number must be a whole number "
+                      "0..99999999, got %g", v);
+            return;
+        }
+        number = (int)v;
+    }
+    s->frame_numbers = grow(s->frame_numbers, s->nframes, &p->frames_cap,
+                            sizeof *s->frame_numbers);
+    int index = s->nframes;
+    s->frame_numbers[s->nframes++] = number;
+    if (index != p->frame_select) {
+        p->skipping_frame = true;
+        p->skip_depth = 0;
+        return;
+    }
+    s->frame = index;
+    s->frame_number = number;
     rib_push_block(p, RIB_BLOCK_FRAME, req->pos);
 }
 
 static void frame_end(rib_parser *p, const rib_request *req)
 {
     rib_close_block(p, req, RIB_BLOCK_FRAME);
-    p->frame_done = true;
 }
 
 static void world_begin(rib_parser *p, const rib_request *req)
@@ -407,6 +425,7 @@ static const request_def requests[] = {
     { "ObjectBegin", rib_object_begin, BLOCK_WORLD },
     { "ObjectEnd", rib_object_end, BLOCK_WORLD },
     { "ObjectInstance", rib_object_instance, WORLD },
+    { "DepthOfField", rib_depth_of_field, OPTIONS },
 };
 
 enum { NREQUESTS = sizeof requests / sizeof requests[0] };
@@ -450,8 +469,7 @@ static void unknown_request(rib_parser *p, const rib_request *req)
 static bool allowed_here(rib_parser *p, const rib_request *req, where w)
 {
     if (w == OPTIONS && (p->in_world || p->world_done)) {
-        rib_error(p, req, req->pos, "must come before WorldBegin (options are fixed for the "
-                  "whole world)");
+        rib_option_in_world(p, req);   /* warned, as other renderers do */
         return false;
     }
     if ((w == WORLD || w == PRIMITIVE || w == BLOCK_WORLD) && !p->in_world) {
@@ -483,9 +501,12 @@ static void dispatch(rib_parser *p, const rib_request *req)
         skip_frame_request(p, req);
         return;
     }
+    if (rib_motion_filter(p, req))
+        return;
     const request_def *def = find_request(req->name);
     if (!def) {
-        unknown_request(p, req);
+        if (!rib_ignored_request(p, req))
+            unknown_request(p, req);
         return;
     }
     if (def->where == PRIMITIVE && p->in_world)
@@ -605,7 +626,19 @@ static void finish(rib_parser *p)
 {
     if (p->skipping_frame)
         p->skipping_frame = false;
+    if (p->in_motion)
+        sl_diag_error(p->diag, p->motion_pos, "MotionBegin: this block is never closed "
+                      "(missing MotionEnd)");
     close_open_blocks(p);
+    int nframes = p->scene->nframes;
+    if (p->scanning)
+        return;
+    if (p->frame_select > 0 && p->frame_select >= nframes) {
+        sl_pos whole = { p->file, 0, 0 };
+        sl_diag_error(p->diag, whole, "frame index %d asked for, but the file has %d frame%s "
+                      "(FrameBegin blocks)", p->frame_select, nframes, nframes == 1 ? "" : "s");
+        return;
+    }
     if (!p->world_seen) {
         sl_pos whole = { p->file, 0, 0 };
         sl_diag_error(p->diag, whole, "the scene has no world (add WorldBegin, then the "
@@ -634,6 +667,7 @@ static scene *scene_new(const char *file)
     s->exposure_gain = s->exposure_gamma = 1;
     s->filter.kind = SCENE_FILTER_GAUSSIAN;
     s->filter.xwidth = s->filter.ywidth = 2;
+    s->frame_number = 1;
     return s;
 }
 
@@ -692,6 +726,37 @@ scene *scene_parse_archives(const char *file, const char *text, size_t len,
 scene *scene_parse_limited(const char *file, const char *text, size_t len,
                            sl_source_set *archives, int max_objects, sl_diag *diag)
 {
+    return scene_parse_frame(file, text, len, archives, max_objects, 0, diag);
+}
+
+static scene *parse_frame(const char *file, const char *text, size_t len,
+                          sl_source_set *archives, int max_objects, int frame, bool scanning,
+                          sl_diag *diag);
+
+scene *scene_parse_frame(const char *file, const char *text, size_t len,
+                         sl_source_set *archives, int max_objects, int frame, sl_diag *diag)
+{
+    return parse_frame(file, text, len, archives, max_objects, frame, false, diag);
+}
+
+int scene_scan_frames(const char *file, const char *text, size_t len,
+                      sl_source_set *archives, int **numbers, sl_diag *diag)
+{
+    *numbers = NULL;
+    scene *s = parse_frame(file, text, len, archives, SCENE_MAX_OBJECTS, INT_MAX, true, diag);
+    if (!s)
+        return -1;
+    int n = s->nframes;
+    *numbers = s->frame_numbers;
+    s->frame_numbers = NULL;
+    scene_destroy(&s);
+    return n;
+}
+
+static scene *parse_frame(const char *file, const char *text, size_t len,
+                          sl_source_set *archives, int max_objects, int frame, bool scanning,
+                          sl_diag *diag)
+{
     if (!file || !*file)
         file = "<scene>";
     if (!text)
@@ -709,6 +774,8 @@ scene *scene_parse_limited(const char *file, const char *text, size_t len,
     p.archives = archives;
     p.diag_sources = set;
     p.max_objects = max_objects;
+    p.frame_select = frame < 0 ? 0 : frame;
+    p.scanning = scanning;
     p.scene = scene_new(file);
     p.file = p.scene->file;
     p.decls = rib_decls_new();

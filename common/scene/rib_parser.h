@@ -15,6 +15,7 @@
  *   rib_mesh.c         PointsPolygons, PointsGeneralPolygons, GeneralPolygon
  *   rib_patch.c        Basis, Patch "bicubic", PatchMesh
  *   rib_nupatch.c      NuPatch (order <= 4, non-rational), TrimCurve (warned)
+ *   rib_ignored.c      requests read past with a warning, motion blocks
  *
  * The graphics state follows RI Specification 3.2 §4: options are global
  * and frozen at WorldBegin; attributes (with the current transform) are
@@ -110,8 +111,11 @@ typedef struct rib_parser {
     bool in_world, world_seen, world_done;
     bool primitives_tried;         /* a base surface request was seen */
     sl_pos world_pos;
-    bool frame_done, skipping_frame, warned_frames;
+    bool skipping_frame;           /* inside a frame other than the chosen one */
     int skip_depth;                /* FrameBegin nesting while skipping */
+    int frame_select;              /* the index of the frame to read */
+    bool scanning;                 /* scene_scan_frames: read no frame */
+    int frames_cap;                /* of scene->frame_numbers */
     char **shader_path;            /* Option "searchpath" "shader" dirs */
     int nshader_path;
     char **archive_path;           /* Option "searchpath" "archive" dirs */
@@ -125,6 +129,8 @@ typedef struct rib_parser {
     bool warned_mesh_vars;         /* primitive variables a mesh ignores */
     bool warned_trim;              /* TrimCurve */
     bool warned_early_light;       /* a LightSource before WorldBegin */
+    bool in_motion, motion_taken;  /* MotionBegin open; its first sample read */
+    sl_pos motion_pos;
     int max_objects;               /* SCENE_MAX_OBJECTS or the caller's */
     bool objects_overflow;         /* that limit was reported */
 } rib_parser;
@@ -187,6 +193,7 @@ void rib_format(rib_parser *p, const rib_request *req);
 void rib_projection(rib_parser *p, const rib_request *req);
 void rib_screen_window(rib_parser *p, const rib_request *req);
 void rib_clipping(rib_parser *p, const rib_request *req);
+void rib_depth_of_field(rib_parser *p, const rib_request *req);
 void rib_pixel_samples(rib_parser *p, const rib_request *req);
 void rib_pixel_filter(rib_parser *p, const rib_request *req);
 void rib_exposure(rib_parser *p, const rib_request *req);
@@ -261,6 +268,16 @@ void rib_trim_curve(rib_parser *p, const rib_request *req);
 void rib_points_polygons(rib_parser *p, const rib_request *req);
 void rib_points_general_polygons(rib_parser *p, const rib_request *req);
 void rib_general_polygon(rib_parser *p, const rib_request *req);
+
+/* rib_ignored.c: requests read past with one warning per name. True
+ * when req is one of them (warned about, nothing else done). */
+bool rib_ignored_request(rib_parser *p, const rib_request *req);
+/* An option inside the world or after it: warned about once, ignored. */
+void rib_option_in_world(rib_parser *p, const rib_request *req);
+/* MotionBegin/MotionEnd and the requests between them: true when req is
+ * taken care of (the block's bounds, or a later time sample, skipped);
+ * false for anything the caller should run. */
+bool rib_motion_filter(rib_parser *p, const rib_request *req);
 
 /* rib_geometry.c: adds an object for a prepared surface with the current
  * attributes and the object-to-world transform ctm; pos is where the

@@ -60,6 +60,7 @@ void scene_destroy(scene **self_p)
     free(self->display_name);
     free(self->display_type);
     free(self->display_mode);
+    free(self->frame_numbers);
     free(self->file);
     free(self);
     *self_p = NULL;

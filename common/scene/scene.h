@@ -59,6 +59,8 @@ typedef struct scene_camera {
     double fov;                    /* degrees, perspective only (default 90) */
     double screen[4];              /* ScreenWindow left right bottom top */
     double near_clip, far_clip;    /* Clipping (default 1e-10, 1e30) */
+    double fstop;                  /* DepthOfField; 0: a pinhole (the default) */
+    double focal_length, focal_distance;   /* camera-space units */
     mat4 camera_from_world;        /* the transform current at WorldBegin */
     mat4 world_from_camera;        /* its inverse */
 } scene_camera;
@@ -200,6 +202,13 @@ typedef struct scene {
                                     * order of first reading; positions inside
                                     * them point at these names */
     int narchives;
+    /* frames (docs/scenes.md "Frames"): the file's FrameBegin blocks, in
+     * order, and the one this scene was parsed from */
+    int frame;                     /* its index (0: the first, or the whole
+                                    * file when it has no FrameBegin) */
+    int frame_number;              /* its FrameBegin number (1 without one) */
+    int nframes;                   /* FrameBegin blocks in the file (0: none) */
+    int *frame_numbers;            /* each one's number, nframes of them */
 } scene;
 
 /* ---- building ------------------------------------------------------------ */
@@ -240,6 +249,21 @@ enum { SCENE_MAX_OBJECTS = 1 << 20 };
  * error naming the request that passes the limit). */
 scene *scene_parse_limited(const char *file, const char *text, size_t len,
                            sl_source_set *archives, int max_objects, sl_diag *diag);
+
+/* As scene_parse_limited, reading the frame with index `frame` (the
+ * frame-th FrameBegin block, from 0; RI Spec 3.2 §4: the requests outside
+ * every frame apply to all of them, those inside the other frames are
+ * skipped). Any parse tells the file's frames (scene.nframes,
+ * scene.frame_numbers); an index past the last frame is an error. */
+scene *scene_parse_frame(const char *file, const char *text, size_t len,
+                         sl_source_set *archives, int max_objects, int frame, sl_diag *diag);
+
+/* The frames of a RIB without reading any of them: their FrameBegin
+ * numbers into a malloc'd *numbers (NULL when there is none). Returns
+ * their count (0: no FrameBegin, the file is one frame), or -1 when the
+ * requests outside the frames have errors (in diag). */
+int scene_scan_frames(const char *file, const char *text, size_t len,
+                      sl_source_set *archives, int **numbers, sl_diag *diag);
 
 void scene_destroy(scene **self_p);
 

@@ -25,6 +25,45 @@ void trace_camera_ray(const trace_camera *cam, double x, double y, trace_ray *ra
                        cam->near_clip, cam->far_clip);
 }
 
+/* Shirley & Chiu's concentric map of the unit square onto the unit disk
+ * (it keeps strata compact, and (0.5, 0.5) -> the centre). */
+static void concentric_disk(double u, double v, double *x, double *y)
+{
+    double a = 2.0 * u - 1.0, b = 2.0 * v - 1.0;
+    if (a == 0 && b == 0) {
+        *x = *y = 0;
+        return;
+    }
+    double r, phi;
+    if (fabs(a) > fabs(b)) {
+        r = a;
+        phi = (M_PI / 4.0) * (b / a);
+    } else {
+        r = b;
+        phi = (M_PI / 2.0) - (M_PI / 4.0) * (a / b);
+    }
+    *x = r * cos(phi);
+    *y = r * sin(phi);
+}
+
+void trace_camera_lens_ray(const trace_camera *cam, double x, double y, double lu, double lv,
+                           trace_ray *ray)
+{
+    trace_camera_ray(cam, x, y, ray);
+    if (!(cam->lens_radius > 0))
+        return;
+    double dx, dy;
+    concentric_disk(lu, lv, &dx, &dy);
+    dx *= cam->lens_radius;
+    dy *= cam->lens_radius;
+    /* the pinhole ray's point at the focal distance (its direction has
+     * z = 1), reached from the lens point: direction (F - o') / fd */
+    double fd = cam->focal_distance;
+    vec3 o = v3(ray->o.x + dx, ray->o.y + dy, ray->o.z);
+    vec3 d = v3(ray->d.x - dx / fd, ray->d.y - dy / fd, ray->d.z);
+    trace_ray_init(ray, o, d, cam->near_clip, cam->far_clip);
+}
+
 trace_tolerance trace_camera_tolerance(const trace_camera *cam, double shading_rate,
                                        double leaf_fraction)
 {

@@ -81,8 +81,15 @@ void trace_render_sample(const trace_renderer *self, trace_thread *th,
                          double x, double y, double rgb[3], double *alpha,
                          double *z)
 {
+    trace_render_sample_lens(self, th, x, y, 0.5, 0.5, rgb, alpha, z);
+}
+
+void trace_render_sample_lens(const trace_renderer *self, trace_thread *th, double x,
+                              double y, double lu, double lv, double rgb[3], double *alpha,
+                              double *z)
+{
     trace_ray ray;
-    trace_camera_ray(&self->world->camera, x, y, &ray);
+    trace_camera_lens_ray(&self->world->camera, x, y, lu, lv, &ray);
     trace_hit hit = {.t = ray.tmax, .obj = NULL};
     th->stats.primary_rays++;
     if (!trace_bvh_intersect(self->bvh, th, &ray, &self->primary_tol, false, &hit)) {
@@ -152,9 +159,11 @@ bool trace_render_tile(const trace_renderer *self, trace_thread *th,
                     return false;
                 }
                 sample_rec *r = &smp[(((size_t)(qy - qy0) * (size_t)qw) + (size_t)(qx - qx0)) * (size_t)ns + (size_t)s];
-                double sx, sy, rgb[3], a, d;
+                double sx, sy, lu = 0.5, lv = 0.5, rgb[3], a, d;
                 trace_sample_position(qx, qy, s, nx, ny, &sx, &sy);
-                trace_render_sample(self, th, sx, sy, rgb, &a, &d);
+                if (world->camera.lens_radius > 0)
+                    trace_sample_lens(qx, qy, s, nx, ny, &lu, &lv);
+                trace_render_sample_lens(self, th, sx, sy, lu, lv, rgb, &a, &d);
                 /* the offset inside the pixel (exact), rounded to float the
                  * same way in every tile that traces this sample */
                 *r = (sample_rec){(float)(sx - qx), (float)(sy - qy), (float)rgb[0],

@@ -42,9 +42,14 @@ void trace_renderer_destroy(trace_renderer **self_p);
 bool trace_render_tile(const trace_renderer *self, trace_thread *th,
                        int x0, int y0, int w, int h, float *rgba, float *z);
 
-/* One primary sample at raster (x, y): colour, alpha, depth. For tests. */
+/* One primary sample at raster (x, y): colour, alpha, depth. For tests.
+ * Through the lens centre (a pinhole). */
 void trace_render_sample(const trace_renderer *self, trace_thread *th,
                          double x, double y, double rgb[3], double *alpha,
                          double *z);
+/* The same from lens position (lu, lv) in [0,1)^2 (camera.h). */
+void trace_render_sample_lens(const trace_renderer *self, trace_thread *th, double x,
+                              double y, double lu, double lv, double rgb[3], double *alpha,
+                              double *z);
 
 #endif

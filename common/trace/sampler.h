@@ -42,4 +42,21 @@ static inline void trace_sample_position(int64_t px, int64_t py, int s, int nx, 
     *y = (double)py + (oy < top ? oy : top);
 }
 
+/* The lens position of sample s of pixel (px, py), in [0,1)^2: stratified
+ * on the same nx * ny grid as the pixel samples, the strata handed out in
+ * an order rotated per pixel (so that a sample's lens stratum does not
+ * follow its pixel stratum), jittered by purposes 2 and 3. Deterministic
+ * like every sample: a farm render equals the standalone one. */
+static inline void trace_sample_lens(int64_t px, int64_t py, int s, int nx, int ny,
+                                     double *u, double *v)
+{
+    int ns = nx * ny;
+    int rot = (int)(trace_hash64(((uint64_t)px << 32) ^ (uint64_t)(uint32_t)py ^
+                                 0x6c656e73ull) % (uint64_t)ns);
+    int ls = (s + rot) % ns;
+    int sx = ls % nx, sy = ls / nx;
+    *u = (sx + trace_sample_1d(px, py, s, 2)) / nx;
+    *v = (sy + trace_sample_1d(px, py, s, 3)) / ny;
+}
+
 #endif

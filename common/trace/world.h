@@ -85,6 +85,8 @@ typedef struct trace_camera {
     double screen[4];              /* ScreenWindow left right bottom top */
     double tan_half_fov;           /* perspective: screen window at z = 1 is scaled by this */
     double near_clip, far_clip;
+    double lens_radius;            /* thin lens (DepthOfField); 0: a pinhole */
+    double focal_distance;         /* camera-space depth in focus */
     mat4 camera_from_world, world_from_camera;
 } trace_camera;
 

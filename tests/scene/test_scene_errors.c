@@ -88,9 +88,12 @@ static const error_case cases[] = {
     /* where requests may appear */
     { CAMERA SPHERE "WorldBegin\n" SPHERE "WorldEnd\n",
       "t.rib:3:1: Sphere: must come between WorldBegin and WorldEnd" },
-    { WORLD("Format 10 10 1\n" SPHERE),
-      "t.rib:4:1: Format: must come before WorldBegin (options are fixed for the whole "
-      "world)" },
+    { WORLD("MotionEnd\n" SPHERE),
+      "t.rib:4:1: MotionEnd: there is no open MotionBegin to close" },
+    { WORLD("MotionBegin [0 1]\nMotionBegin [0 1]\n" SPHERE "MotionEnd\n"),
+      "t.rib:5:1: MotionBegin: the MotionBegin at t.rib:4:1 is still open (missing MotionEnd)" },
+    { WORLD(SPHERE "MotionBegin [0 1]\n"),
+      "t.rib:5:1: MotionBegin: this block is never closed (missing MotionEnd)" },
     { CAMERA "WorldBegin\n" SPHERE "WorldEnd\nLightSource \"pointlight\" 1\n",
       "t.rib:6:1: LightSource: must come between WorldBegin and WorldEnd" },
     /* the scene as a whole */
@@ -241,25 +244,91 @@ static void test_rendered_diagnostic(void **state)
 }
 
 /* Unknown requests: one warning per name, skipped with their arguments;
- * the scene still parses. */
+ * the scene still parses. Requests a ray tracer has no use for say so. */
 static void test_unknown_requests(void **state)
 {
     (void)state;
     sl_diag *d;
     scene *s = parse_rib(CAMERA "Hider \"hidden\" \"jitter\" [1]\nWorldBegin\n"
-        "MakeTexture \"a.tif\" \"a.tx\" \"periodic\" [1 2 3]\nsphere 1 -1 1 360\n"
-        "MakeTexture \"b.tif\" \"b.tx\"\nSphere 1 -1 1 360\nHider \"x\"\nWorldEnd\n", &d);
+        "Frobnicate \"a.tif\" \"a.tx\" \"periodic\" [1 2 3]\nsphere 1 -1 1 360\n"
+        "Frobnicate \"b.tif\" \"b.tx\"\nSphere 1 -1 1 360\nHider \"x\"\nWorldEnd\n", &d);
     assert_non_null(s);
     assert_int_equal(sl_diag_error_count(d), 0);
     assert_int_equal(sl_diag_warning_count(d), 3);
     assert_string_equal(diag_line(nth_diag(d, SL_DIAG_WARNING, 0)),
-                        "t.rib:3:1: Hider: unknown request, ignored with its arguments");
+                        "t.rib:3:1: Hider: has no use in aafarm's ray tracer; ignored (every "
+                        "pixel is ray-traced)");
     assert_string_equal(diag_line(nth_diag(d, SL_DIAG_WARNING, 1)),
-                        "t.rib:5:1: MakeTexture: unknown request, ignored with its arguments");
+                        "t.rib:5:1: Frobnicate: unknown request, ignored with its arguments");
     assert_string_equal(diag_line(nth_diag(d, SL_DIAG_WARNING, 2)),
                         "t.rib:6:1: sphere: unknown request, ignored with its arguments "
                         "(did you mean Sphere?)");
     assert_int_equal(s->nobjects, 1);
+    scene_destroy(&s);
+    sl_diag_destroy(&d);
+}
+
+/* Lenient where other renderers are (issue 14): requests of scanline
+ * renderers and primitives aafarm does not render are warned about once
+ * per name with file:line and skipped; options inside the world are
+ * warned about and ignored; a motion block uses its first time sample. */
+static void test_lenient_requests(void **state)
+{
+    (void)state;
+    sl_diag *d;
+    scene *s = parse_rib(
+        "Format 64 32 1\nHider \"hidden\"\nProjection \"perspective\"\n"     /* 1-3 */
+        "MakeShadow \"a.z\" \"a.shd\"\nShadingInterpolation \"smooth\"\n"   /* 4-5 */
+        "WorldBegin\nGeometricApproximation \"motionfactor\" 1\n"               /* 6-7 */
+        "Format 10 10 1\nPixelSamples 9 9\nFormat 20 20 1\n"                     /* 8-10 */
+        "Atmosphere \"fog\"\nInterior \"x\"\nExterior \"y\"\n"                 /* 11-13 */
+        "Blobby 2 [1001 0 1001 16 0 2] [1 0 0 0 0 1 0 0 0 0 1 0 0 0 0 1  "
+        "1 0 0 0 0 1 0 0 0 0 1 0 1 0 0 1] [\"\"]\n"                                 /* 14 */
+        "Curves \"cubic\" [4] \"nonperiodic\" \"P\" [0 0 0 1 1 1 2 2 2 3 3 3] "
+        "\"constantwidth\" [0.1]\n"                                               /* 15 */
+        "Points \"P\" [0 0 0 1 1 1] \"width\" [0.1 0.1]\n"                          /* 16 */
+        "Blobby 1 [1001 0] [1 0 0 0 0 1 0 0 0 0 1 0 0 0 0 1] [\"\"]\n"              /* 17 */
+        "MotionBegin [0 1]\nTranslate 1 0 0\nTranslate 5 0 0\nMotionEnd\n"       /* 18-21 */
+        "Sphere 1 -1 1 360\nSystem \"rm -rf /\"\nWorldEnd\n", &d);               /* 22-24 */
+    if (!s) sl_diag_print(d, stderr);
+    assert_non_null(s);
+    assert_int_equal(sl_diag_error_count(d), 0);
+    static const char *const want[] = {
+        "t.rib:2:1: Hider: has no use in aafarm's ray tracer; ignored (every pixel is "
+        "ray-traced)",
+        "t.rib:4:1: MakeShadow: has no use in aafarm's ray tracer; ignored (shadows are "
+        "ray-traced)",
+        "t.rib:5:1: ShadingInterpolation: has no use in aafarm's ray tracer; ignored (shaders "
+        "run at every hit)",
+        "t.rib:7:1: GeometricApproximation: has no use in aafarm's ray tracer; ignored "
+        "(surfaces are intersected directly, not diced)",
+        "t.rib:8:1: Format: options are fixed at WorldBegin; ignored inside the world (move "
+        "it before WorldBegin)",
+        "t.rib:9:1: PixelSamples: options are fixed at WorldBegin; ignored inside the world "
+        "(move it before WorldBegin)",
+        "t.rib:11:1: Atmosphere: has no use in aafarm's ray tracer; ignored (no volume "
+        "shaders)",
+        "t.rib:12:1: Interior: has no use in aafarm's ray tracer; ignored (no volume shaders)",
+        "t.rib:13:1: Exterior: has no use in aafarm's ray tracer; ignored (no volume shaders)",
+        "t.rib:14:1: Blobby: blobby implicit surfaces are not rendered; skipped",
+        "t.rib:15:1: Curves: curves are not rendered; skipped",
+        "t.rib:16:1: Points: point clouds are not rendered; skipped",
+        "t.rib:18:1: MotionBegin: motion blur is not rendered: each motion block uses its "
+        "first time sample",
+        "t.rib:23:1: System: runs no commands; ignored (a scene cannot run programs on the "
+        "farm)",
+    };
+    int n = (int)(sizeof want / sizeof want[0]);
+    assert_int_equal(sl_diag_warning_count(d), n);   /* one per name */
+    for (int i = 0; i < n; i++)
+        assert_string_equal(diag_line(nth_diag(d, SL_DIAG_WARNING, i)), want[i]);
+    /* the options inside the world changed nothing */
+    assert_int_equal(s->camera.xres, 64);
+    assert_int_equal(s->pixel_samples[0], 2);
+    /* only the sphere is an object, moved by the first time sample */
+    assert_int_equal(s->nobjects, 1);
+    vec3 c = mat4_xform_point(&s->objects[0].object_to_world, v3(0, 0, 0));
+    assert_true(vec_dist(c, v3(1, 0, 0)) < 1e-15);
     scene_destroy(&s);
     sl_diag_destroy(&d);
 }
@@ -342,6 +411,7 @@ int main(void)
         cmocka_unit_test(test_invalid_surface_parameters),
         cmocka_unit_test(test_rendered_diagnostic),
         cmocka_unit_test(test_unknown_requests),
+        cmocka_unit_test(test_lenient_requests),
         cmocka_unit_test(test_many_unknown_requests),
         cmocka_unit_test(test_recovery),
         cmocka_unit_test(test_earlier_errors_and_sources),

@@ -351,6 +351,40 @@ static void test_meshes(void **state)
     scene_destroy(&s);
 }
 
+/* ripples.rib: three frames, each its own world, the wave's phase a third
+ * of a period further in each; the options before the frames hold in all */
+static void test_ripples_frames(void **state)
+{
+    (void)state;
+    char path[1024];
+    size_t len = 0;
+    snprintf(path, sizeof path, "%s/ripples.rib", scenes_dir);
+    char *text = read_whole_file(path, &len);
+    assert_non_null(text);
+    for (int k = 0; k < 3; k++) {
+        sl_diag *d = sl_diag_new();
+        scene *s = scene_parse_frame(path, text, len, NULL, SCENE_MAX_OBJECTS, k, d);
+        if (!s || sl_diag_count(d) > 0) sl_diag_print(d, stderr);
+        assert_non_null(s);
+        assert_int_equal(sl_diag_count(d), 0);
+        assert_int_equal(s->nframes, 3);
+        assert_int_equal(s->frame_number, k + 1);
+        assert_int_equal(s->camera.xres, 160);
+        assert_int_equal(s->nobjects, 1);
+        char want[32];
+        snprintf(want, sizeof want, "ripples.%04d.exr", k + 1);
+        assert_string_equal(s->display_name, want);
+        const scene_shader *disp = scene_object_displacement(s, &s->objects[0]);
+        assert_non_null(disp);
+        const scene_param *phase = scene_shader_param(disp, "phase");
+        assert_non_null(phase);
+        assert_true(fabs(phase->values[0] + k * 2 * M_PI / 3) < 1e-4);
+        scene_destroy(&s);
+        sl_diag_destroy(&d);
+    }
+    free(text);
+}
+
 int main(int argc, char **argv)
 {
     if (argc > 1)
@@ -366,6 +400,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_surfaces),
         cmocka_unit_test(test_vase),
         cmocka_unit_test(test_meshes),
+        cmocka_unit_test(test_ripples_frames),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -12,7 +12,7 @@
  *   attributes Sides, Orientation/ReverseOrientation and the normal flip,
  *              displacementbound, identifier, unknown attributes
  *   options    search path with '&' and '@', orthographic projection,
- *              ScreenWindow, frames (only the first, one warning)
+ *              ScreenWindow, frames (each one by its index)
  *
  * Expected values are written from the RIB text by hand.
  */
@@ -440,23 +440,78 @@ static void test_light_before_world(void **state)
     sl_diag_destroy(&d);
 }
 
+/* Every FrameBegin block is a frame: one parse reads the frame it is
+ * asked for (the options outside the frames hold for all of them, those
+ * inside the others are skipped) and tells every frame's number. */
 static void test_frames(void **state)
 {
     (void)state;
-    const char *text = "FrameBegin 1\n" CAMERA "WorldBegin\nSphere 1 -1 1 360\nWorldEnd\n"
-        "FrameEnd\nFrameBegin 2\nFormat 1 1 1\nWorldBegin\nSphere 2 -2 2 360\nWorldEnd\n"
-        "FrameEnd\nFrameBegin 3\nWorldBegin\nWorldEnd\nFrameEnd\n";
+    const char *text = "Declare \"k\" \"float\"\n" CAMERA "FrameBegin 1\n"
+        "WorldBegin\nSphere 1 -1 1 360\nWorldEnd\nFrameEnd\n"
+        "FrameBegin 5\nFormat 16 8 1\nWorldBegin\nSphere 2 -2 2 360\nWorldEnd\n"
+        "FrameEnd\nFrameBegin\nWorldBegin\nWorldEnd\nFrameEnd\n";
     sl_diag *d;
     scene *s = parse_rib(text, &d);
     assert_non_null(s);
-    assert_int_equal(sl_diag_warning_count(d), 1);
-    assert_string_equal(diag_line(nth_diag(d, SL_DIAG_WARNING, 0)),
-        "t.rib:8:1: FrameBegin: only the first frame is rendered; this frame and the later "
-        "ones are ignored");
+    assert_int_equal(sl_diag_count(d), 0);
+    assert_int_equal(s->frame, 0);
+    assert_int_equal(s->frame_number, 1);
+    assert_int_equal(s->nframes, 3);
+    /* a FrameBegin without a number follows the previous one */
+    assert_int_equal(s->frame_numbers[0], 1);
+    assert_int_equal(s->frame_numbers[1], 5);
+    assert_int_equal(s->frame_numbers[2], 6);
     assert_int_equal(s->nobjects, 1);
     assert_true(s->objects[0].surface.radius == 1);
     assert_int_equal(s->camera.xres, 64);
     scene_destroy(&s);
+    sl_diag_destroy(&d);
+
+    /* the second frame: its own Format and sphere, nothing of the first */
+    d = sl_diag_new();
+    s = scene_parse_frame("t.rib", text, strlen(text), NULL, SCENE_MAX_OBJECTS, 1, d);
+    assert_non_null(s);
+    assert_int_equal(s->frame, 1);
+    assert_int_equal(s->frame_number, 5);
+    assert_int_equal(s->nframes, 3);
+    assert_int_equal(s->nobjects, 1);
+    assert_true(s->objects[0].surface.radius == 2);
+    assert_int_equal(s->camera.xres, 16);
+    scene_destroy(&s);
+    sl_diag_destroy(&d);
+
+    /* the third frame's world is empty: that frame's error */
+    d = sl_diag_new();
+    s = scene_parse_frame("t.rib", text, strlen(text), NULL, SCENE_MAX_OBJECTS, 2, d);
+    assert_null(s);
+    assert_string_equal(diag_line(nth_diag(d, SL_DIAG_ERROR, 0)),
+        "t.rib:17:1: WorldEnd: the world has no objects (add a surface between WorldBegin "
+        "and WorldEnd, e.g. Sphere 1 -1 1 360)");
+    sl_diag_destroy(&d);
+
+    /* the frames, none read */
+    d = sl_diag_new();
+    int *numbers = NULL;
+    assert_int_equal(scene_scan_frames("t.rib", text, strlen(text), NULL, &numbers, d), 3);
+    assert_int_equal(sl_diag_count(d), 0);
+    assert_int_equal(numbers[1], 5);
+    free(numbers);
+    sl_diag_destroy(&d);
+
+    /* past the last frame */
+    d = sl_diag_new();
+    s = scene_parse_frame("t.rib", text, strlen(text), NULL, SCENE_MAX_OBJECTS, 3, d);
+    assert_null(s);
+    assert_string_equal(diag_line(nth_diag(d, SL_DIAG_ERROR, 0)),
+        "t.rib:0:0: frame index 3 asked for, but the file has 3 frames (FrameBegin blocks)");
+    sl_diag_destroy(&d);
+
+    /* a bad frame number */
+    s = parse_rib("FrameBegin 1.5\n" CAMERA "WorldBegin\nSphere 1 -1 1 360\nWorldEnd\n"
+                  "FrameEnd\n", &d);
+    assert_null(s);
+    assert_string_equal(diag_line(nth_diag(d, SL_DIAG_ERROR, 0)),
+        "t.rib:1:12: FrameBegin: the frame number must be a whole number 0..99999999, got 1.5");
     sl_diag_destroy(&d);
 }
 

@@ -81,8 +81,18 @@ static void test_help_and_usage(void **state)
     char out[8192];
     assert_int_equal(run("--help", out, sizeof out), 0);
     assert_non_null(strstr(out, "--standalone"));
-    assert_int_equal(run("--standalone x.rib", out, sizeof out), 2);
+    /* -o may be left out when the scene names its output with Display */
+    write_file("nodisplay.rib", "Format 8 8 1\nProjection \"perspective\"\nWorldBegin\n"
+               "Sphere 1 -1 1 360\nWorldEnd\n");
+    assert_int_equal(run("--standalone nodisplay.rib", out, sizeof out), 2);
     assert_non_null(strstr(out, "needs -o OUT.exr"));
+    assert_int_equal(run("--standalone nodisplay.rib --frames 1-", out, sizeof out), 2);
+    assert_non_null(strstr(out, "--frames: '1-' (at character 1 of '1-') is not a frame "
+                                "number 0..99999999 or a range like 5-7"));
+    assert_int_equal(run("--standalone nodisplay.rib --frames 2 -o x.exr", out, sizeof out), 2);
+    assert_non_null(strstr(out, "--frames: the scene has no frame 2 (its frames: 1; it has "
+                                "no FrameBegin)"));
+    assert_int_equal(count_files(".exr"), 0);
     assert_int_equal(run("--cache-bytes lots --standalone x.rib -o x.exr", out, sizeof out), 2);
     assert_non_null(strstr(out, "--cache-bytes"));
 }
