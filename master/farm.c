@@ -337,6 +337,7 @@ static int setup(farm *f, char *err, size_t errsz)
     f->sched = scheduler_new(f->tiles_x, image_format_tiles_y(&f->fmt), &so);
     f->reg = registry_new();
     f->jobmsg = job_message_new(f->jb, &f->fmt);
+    f->files = file_server_new(f->jb);
     int rc = check_job_message(f, err, errsz);
     if (rc != AAFARM_EXIT_OK) return rc;
     stale_clean_outputs(f->opt->output, report_leftover, f);
@@ -578,6 +579,7 @@ static void teardown(farm *f)
     if (f->ctx) zmq_ctx_term(f->ctx);
     remove_private_endpoint(f);
     job_message_destroy(&f->jobmsg);
+    file_server_destroy(&f->files);
     registry_destroy(&f->reg);
     scheduler_destroy(&f->sched);
     console_destroy(&f->con);
@@ -608,9 +610,15 @@ int farm_run(const farm_options *opt, const job *jb, const image_format *fmt)
     }
     f.start_ms = farm_now_ms();
     console_set_resumed(f.con, f.resumed_tiles);
-    console_log(f.con, CONSOLE_INFO, "%s: %dx%d, %d tiles of %d, job %.12s (%zu bytes)",
-                opt->scene_path, f.fmt.width, f.fmt.height, f.ntiles, f.fmt.tile_size, jb->hash,
-                f.job_bytes);
+    if (jb->nfiles == 0)
+        console_log(f.con, CONSOLE_INFO, "%s: %dx%d, %d tiles of %d, job %.12s (%zu bytes)",
+                    opt->scene_path, f.fmt.width, f.fmt.height, f.ntiles, f.fmt.tile_size,
+                    jb->hash, f.job_bytes);
+    else   /* the files go once per host, not with every Job */
+        console_log(f.con, CONSOLE_INFO, "%s: %dx%d, %d tiles of %d, job %.12s (%zu bytes + "
+                    "%d file%s of %llu bytes, once per host)", opt->scene_path, f.fmt.width,
+                    f.fmt.height, f.ntiles, f.fmt.tile_size, jb->hash, f.job_bytes, jb->nfiles,
+                    jb->nfiles == 1 ? "" : "s", (unsigned long long)job_files_bytes(jb));
     run_loop(&f);
     rc = finish(&f);
     teardown(&f);

@@ -4,6 +4,7 @@
  *
  *   farm.c           set-up, the poll loop, timers, the end of the job
  *   farm_messages.c  what each message from a worker does; sending
+ *                    (NeedFile: file_server.c reads the chunk)
  *   report.c         the summary per worker and the statistics file
  */
 #ifndef MASTER_FARM_INTERNAL_H
@@ -14,6 +15,7 @@
 #include <stdint.h>
 
 #include "console.h"
+#include "file_server.h"
 #include "farm.h"
 #include "image/writer.h"
 #include "job_message.h"
@@ -55,6 +57,8 @@ typedef struct farm {
     console *con;
     job_message *jobmsg;
     size_t job_bytes;              /* packed size of the Job envelope */
+    file_server *files;            /* the job's files, served from disk */
+    uint64_t file_bytes_sent, file_chunks_sent;
     uint64_t session;              /* Welcome.master_session */
     char host[128];
     int64_t start_ms, end_ms;

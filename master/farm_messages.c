@@ -13,6 +13,9 @@
  *              a non-retryable one fails it only when a second worker
  *              confirms it (scheduler.h: no single peer ends a render)
  *   NeedJob    the Job again
+ *   NeedFile   the chunk of the job's file, read from disk (FileChunk +
+ *              bulk); a file changed since job_load fails the render
+ *   FilesReady the worker's store statistics for the summary
  *   Heartbeat  liveness only (any message counts)
  *   Shutdown   the worker leaves: its tiles go back to the queue
  * Anything but Hello from a peer the master does not know gets Reject
@@ -28,19 +31,22 @@
 
 /* ---- sending ---- */
 
-static int send_to(farm *f, const uint8_t *id, size_t id_len, Aafarm__Envelope *env)
+static int send_to(farm *f, const uint8_t *id, size_t id_len, Aafarm__Envelope *env,
+                   const void *bulk, size_t bulk_len)
 {
-    if (wire_send_limited(f->router, &f->send_limits, id, id_len, env, NULL, 0) != 0) return -1;
+    if (wire_send_limited(f->router, &f->send_limits, id, id_len, env, bulk, bulk_len) != 0)
+        return -1;
     return 0;
 }
 
 /* Sends to a registered worker; a worker that cannot be reached any more
  * (connection gone, or its queue full because it stopped reading) is
- * lost. */
-static int send_env(farm *f, farm_worker *w, Aafarm__Envelope *env, int64_t now)
+ * lost. bulk: a FileChunk's bytes (NULL otherwise). */
+static int send_env_bulk(farm *f, farm_worker *w, Aafarm__Envelope *env, const void *bulk,
+                         size_t bulk_len, int64_t now)
 {
     size_t n = aafarm__envelope__get_packed_size(env);
-    if (send_to(f, w->id, w->id_len, env) != 0) {
+    if (send_to(f, w->id, w->id_len, env, bulk, bulk_len) != 0) {
         int e = errno;
         const char *what = proto_message_name(env->body_case);
         if (e == EHOSTUNREACH) {
@@ -54,9 +60,14 @@ static int send_env(farm *f, farm_worker *w, Aafarm__Envelope *env, int64_t now)
         return -1;
     }
     w->last_sent_ms = now;
-    w->bytes_out += n;
-    f->sent_bytes += n;
+    w->bytes_out += n + bulk_len;
+    f->sent_bytes += n + bulk_len;
     return (int)n;
+}
+
+static int send_env(farm *f, farm_worker *w, Aafarm__Envelope *env, int64_t now)
+{
+    return send_env_bulk(f, w, env, NULL, 0, now);
 }
 
 static void send_reject(farm *f, const uint8_t *id, size_t id_len, Aafarm__RejectCode code,
@@ -69,7 +80,7 @@ static void send_reject(farm *f, const uint8_t *id, size_t id_len, Aafarm__Rejec
     Aafarm__Envelope env = AAFARM__ENVELOPE__INIT;
     env.body_case = AAFARM__ENVELOPE__BODY_REJECT;
     env.reject = &r;
-    if (send_to(f, id, id_len, &env) == 0) f->rejects_sent++;
+    if (send_to(f, id, id_len, &env, NULL, 0) == 0) f->rejects_sent++;
 }
 
 static void send_welcome(farm *f, farm_worker *w, int64_t now)
@@ -366,6 +377,55 @@ static void on_need_job(farm *f, farm_worker *w, const Aafarm__NeedJob *n, int64
     send_job(f, w, now);
 }
 
+static void on_need_file(farm *f, farm_worker *w, const Aafarm__NeedFile *n, int64_t now)
+{
+    if (strcmp(n->job_hash, f->jb->hash) != 0) {
+        console_log(f->con, CONSOLE_DETAIL, "%s asked for a file of job %.12s..., not this "
+                    "master's", w->name, n->job_hash);
+        return;
+    }
+    const uint8_t *data = NULL;
+    const job_file *file = NULL;
+    char err[1200];
+    file_read r = file_server_read(f->files, n->sha256, n->offset, n->length, &data, &file, err,
+                                   sizeof err);
+    if (r == FILE_READ_UNKNOWN || r == FILE_READ_RANGE) {
+        console_log(f->con, CONSOLE_INFO, "%s asked for %s (bytes %llu..+%u of %.12s...): "
+                    "dropped", w->name, r == FILE_READ_UNKNOWN ? "a file the job does not have"
+                    : "bytes outside the file", (unsigned long long)n->offset, n->length,
+                    n->sha256);
+        return;
+    }
+    if (r == FILE_READ_CHANGED) {
+        farm_fail(f, "%s", err);
+        return;
+    }
+    Aafarm__FileChunk c = AAFARM__FILE_CHUNK__INIT;
+    c.sha256 = (char *)file->sha256;
+    c.offset = n->offset;
+    c.file_size = file->size;
+    c.length = n->length;
+    Aafarm__Envelope env = AAFARM__ENVELOPE__INIT;
+    env.body_case = AAFARM__ENVELOPE__BODY_FILE_CHUNK;
+    env.file_chunk = &c;
+    if (send_env_bulk(f, w, &env, data, n->length, now) < 0) return;
+    w->file_bytes += n->length;
+    w->file_chunks++;
+    f->file_bytes_sent += n->length;
+    f->file_chunks_sent++;
+}
+
+static void on_files_ready(farm *f, farm_worker *w, const Aafarm__FilesReady *r)
+{
+    if (strcmp(r->job_hash, f->jb->hash) != 0 || w->files_ready) return;
+    w->files_ready = true;
+    w->file_hits += r->hits;
+    w->file_misses += r->misses;
+    console_log(f->con, CONSOLE_DETAIL, "%s has the job's files (%u in its host's store, %u "
+                "fetched; %llu bytes received)", w->name, r->hits, r->misses,
+                (unsigned long long)r->fetched_bytes);
+}
+
 static void on_unknown_peer(farm *f, proto_kind kind, const uint8_t *id, size_t id_len,
                             int64_t now)
 {
@@ -400,6 +460,8 @@ void farm_handle(farm *f, wire_msg *m, int64_t now)
     case AAFARM__ENVELOPE__BODY_RESULT: on_result(f, w, env->result, m, now); break;
     case AAFARM__ENVELOPE__BODY_FAILURE: on_failure(f, w, env->failure); break;
     case AAFARM__ENVELOPE__BODY_NEED_JOB: on_need_job(f, w, env->need_job, now); break;
+    case AAFARM__ENVELOPE__BODY_NEED_FILE: on_need_file(f, w, env->need_file, now); break;
+    case AAFARM__ENVELOPE__BODY_FILES_READY: on_files_ready(f, w, env->files_ready); break;
     case AAFARM__ENVELOPE__BODY_SHUTDOWN: {
         char why[160];
         snprintf(why, sizeof why, "left (%s)",

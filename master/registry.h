@@ -43,6 +43,10 @@ typedef struct farm_worker {
     uint64_t rays, boxes, shader_evals, cache_hits, cache_misses, cache_evictions;
     uint64_t peak_cache_bytes;
     uint64_t nonfinite_samples;    /* NaN/Inf samples its tiles had (written as 0) */
+    /* job files (docs/textures.md): bytes sent to it, and from its FilesReady
+     * the files its host's store had (hits) and lacked (misses) */
+    uint64_t file_bytes, file_chunks, file_hits, file_misses;
+    bool files_ready;              /* it has every file of the job */
 } farm_worker;
 
 typedef struct registry registry;
