@@ -305,11 +305,28 @@ static void transfer_free(file_transfer *t)
 /* Reads the chunk map of an earlier attempt, or starts a fresh one. */
 static bool load_map(file_transfer *t)
 {
-    unsigned char head[MAP_HEADER];
+    unsigned char head[MAP_HEADER] = {0};
     struct stat st;
+    /* an earlier attempt's chunk size wins (another process may have been
+     * started with another --file-chunk): its chunks are what is written */
+    if (fstat(t->map_fd, &st) == 0 && pread(t->map_fd, head, MAP_HEADER, 0) == MAP_HEADER &&
+        get_be64(head + 8) == t->size && get_be64(head) >= 1 && get_be64(head) <= UINT32_MAX) {
+        uint32_t chunk = (uint32_t)get_be64(head);
+        size_t n = (size_t)((t->size + chunk - 1) / chunk);
+        if ((uint64_t)st.st_size == MAP_HEADER + n && n != t->nchunks) {
+            unsigned char *have = realloc(t->have, n + 1), *asked = realloc(t->asked, n + 1);
+            if (!have || !asked) abort();
+            t->have = have;
+            t->asked = asked;
+            memset(t->asked, 0, n + 1);
+        }
+        if ((uint64_t)st.st_size == MAP_HEADER + n) {
+            t->chunk = chunk;
+            t->nchunks = n;
+        }
+    }
     bool resume = fstat(t->map_fd, &st) == 0 &&
                   (uint64_t)st.st_size == MAP_HEADER + t->nchunks &&
-                  pread(t->map_fd, head, MAP_HEADER, 0) == MAP_HEADER &&
                   get_be64(head) == t->chunk && get_be64(head + 8) == t->size &&
                   (t->nchunks == 0 ||
                    pread(t->map_fd, t->have, t->nchunks, MAP_HEADER) == (ssize_t)t->nchunks);

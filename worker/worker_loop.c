@@ -469,6 +469,14 @@ static void job_ready(worker_loop *w, held_job *h)
     if (h->broken) wlog(w, -1, "%s", h->error);
     else wlog(w, 0, "job %.12s (%s, %dx%d) ready", h->hash, h->jb->scene_file, h->fmt.width,
               h->fmt.height);
+    /* where the texture module will open each file (through the resolver) */
+    for (int i = 0; !h->broken && w->opt->verbosity > 0 && i < h->jb->nfiles; i++) {
+        char path[4096], why[600];
+        if (job_file_resolve(h->jb, h->jb->files[i].name, path, sizeof path, why, sizeof why))
+            wlog(w, 1, "file '%s' resolves to %s", h->jb->files[i].name, path);
+        else
+            wlog(w, 1, "file '%s' does not resolve: %s", h->jb->files[i].name, why);
+    }
     start_pending(w, h);
 }
 
