@@ -25,6 +25,7 @@ typedef struct want {
     file_transfer *t;              /* ours; NULL: not started, or busy elsewhere */
     int64_t next_poll_ms;
     int attempts;                  /* transfers whose bytes did not hash right */
+    bool complete;                 /* every chunk written: to be checked (poll) */
     struct want *next;
 } want;
 
@@ -215,6 +216,8 @@ static void fail_file(file_fetch *self, const want *w, const char *why)
     }
 }
 
+static void finish(file_fetch *self, want *w, int64_t now_ms);
+
 /* Starts the transfer of a file nobody here fetches yet, or takes it from
  * the store when another process has finished it. */
 static void start(file_fetch *self, want *w, int64_t now_ms)
@@ -229,10 +232,7 @@ static void start(file_fetch *self, want *w, int64_t now_ms)
     switch (file_store_begin(self->store, w->sha256, w->size, self->opt.chunk, &w->t, err,
                              sizeof err)) {
     case FILE_BEGIN_STARTED:
-        if (file_transfer_complete(w->t)) {   /* a dead process wrote every chunk */
-            if (file_transfer_finish(&w->t, err, sizeof err) == 0) deliver(self, w->sha256);
-            else w->next_poll_ms = now_ms;
-        }
+        if (file_transfer_complete(w->t)) finish(self, w, now_ms);   /* a dead process wrote all */
         break;
     case FILE_BEGIN_PRESENT: deliver(self, w->sha256); break;
     case FILE_BEGIN_BUSY: w->next_poll_ms = now_ms + POLL_MS; break;
@@ -240,12 +240,35 @@ static void start(file_fetch *self, want *w, int64_t now_ms)
     }
 }
 
+bool file_fetch_poll_due(const file_fetch *self, int64_t now_ms)
+{
+    for (const want *w = self->wants; w; w = w->next)
+        if (w->complete || (!w->t && now_ms >= w->next_poll_ms)) return true;
+    return false;
+}
+
+/* A transfer with every chunk written: hashed, into the store. */
+static void finish(file_fetch *self, want *w, int64_t now_ms)
+{
+    char err[600];
+    w->complete = false;
+    if (file_transfer_finish(&w->t, err, sizeof err) == 0) deliver(self, w->sha256);
+    else if (++w->attempts >= MAX_ATTEMPTS) fail_file(self, w, err);
+    else w->next_poll_ms = now_ms;   /* fetched again from the start */
+}
+
+void file_fetch_poll(file_fetch *self, int64_t now_ms)
+{
+    for (want *w = self->wants; w; w = w->next) {
+        if (w->complete) finish(self, w, now_ms);
+        else if (!w->t && now_ms >= w->next_poll_ms) start(self, w, now_ms);
+    }
+    prune(self);
+}
+
 void file_fetch_pump(file_fetch *self, int64_t now_ms, file_fetch_send_fn send, void *arg)
 {
     if (!self->wants) return;
-    for (want *w = self->wants; w; w = w->next)
-        if (!w->t && now_ms >= w->next_poll_ms) start(self, w, now_ms);
-    prune(self);
     bool sent = true;
     while (sent && now_ms >= self->next_send_ms &&
            (self->inflight == 0 || self->inflight + self->opt.chunk <= self->opt.inflight)) {
@@ -253,7 +276,7 @@ void file_fetch_pump(file_fetch *self, int64_t now_ms, file_fetch_send_fn send, 
         for (want *w = self->wants; w && !sent; w = w->next) {
             uint64_t off;
             uint32_t len;
-            if (!w->t || !file_transfer_next(w->t, &off, &len)) continue;
+            if (!w->t || w->complete || !file_transfer_next(w->t, &off, &len)) continue;
             if (!send(arg, w->job_hash, w->sha256, off, len)) {
                 file_transfer_unask(w->t, off);
                 return;   /* the socket is full: later */
@@ -269,7 +292,7 @@ uint64_t file_fetch_chunk(file_fetch *self, const Aafarm__FileChunk *c, const ui
                           size_t len, int64_t now_ms)
 {
     want *w = find_want(self, c->sha256);
-    if (!w || !w->t || c->file_size != w->size) return 0;
+    if (!w || !w->t || w->complete || c->file_size != w->size) return 0;
     char err[600];
     long n = file_transfer_put(w->t, c->offset, data, len, err, sizeof err);
     if (n < 0) {
@@ -282,16 +305,8 @@ uint64_t file_fetch_chunk(file_fetch *self, const Aafarm__FileChunk *c, const ui
     if (n == 0) return 0;
     for (fetch_job *j = self->jobs; j; j = j->next)
         if (strcmp(j->hash, w->job_hash) == 0) j->fetched += (uint64_t)n;
-    if (file_transfer_complete(w->t)) {
-        if (file_transfer_finish(&w->t, err, sizeof err) == 0) {
-            deliver(self, w->sha256);
-        } else if (++w->attempts >= MAX_ATTEMPTS) {
-            fail_file(self, w, err);
-        } else {
-            w->next_poll_ms = now_ms;   /* fetched again from the start */
-        }
-        prune(self);
-    }
+    (void)now_ms;
+    if (file_transfer_complete(w->t)) w->complete = true;   /* checked by file_fetch_poll */
     return (uint64_t)n;
 }
 

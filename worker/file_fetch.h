@@ -52,22 +52,32 @@ typedef struct file_fetch file_fetch;
 file_fetch *file_fetch_new(const file_fetch_options *opt);
 void file_fetch_destroy(file_fetch **self_p);
 
-/* Takes a Job: looks its files up and keeps it until they are all present
- * (file_fetch_take_ready hands it back then, possibly at once). A job
- * already waiting is not added twice. */
+/* Takes a Job: looks its files up (hashing each the first time this
+ * process uses it: run it beside the loop) and keeps it until they are
+ * all present (file_fetch_take_ready hands it back then, possibly at
+ * once). A job already waiting is not added twice. */
 void file_fetch_add(file_fetch *self, const Aafarm__Job *m, int64_t now_ms);
 
 /* Is a job with this hash waiting for its files? */
 bool file_fetch_waiting(const file_fetch *self, const char *hash);
 
-/* Sends what may be sent now: send(arg, job_hash, sha256, offset, length)
- * for each chunk to ask for (false: the socket cannot take it now); polls
- * the files another process fetches. */
+/* The slow part, which may hash whole files (run it beside the loop):
+ * checks and stores the transfers whose chunks are all written, starts
+ * transfers, and looks again at the files another process fetches.
+ * file_fetch_poll_due says whether there is anything to do now. */
+bool file_fetch_poll_due(const file_fetch *self, int64_t now_ms);
+void file_fetch_poll(file_fetch *self, int64_t now_ms);
+
+/* Sends what may be sent now (cheap): send(arg, job_hash, sha256, offset,
+ * length) for each chunk to ask for (false: the socket cannot take it
+ * now). */
 typedef bool (*file_fetch_send_fn)(void *arg, const char *job_hash, const char *file_hash,
                                    uint64_t offset, uint32_t length);
 void file_fetch_pump(file_fetch *self, int64_t now_ms, file_fetch_send_fn send, void *arg);
 
-/* A FileChunk arrived. Returns the bytes it added (0: not wanted). */
+/* A FileChunk arrived: its bytes are written (cheap; the hash of a
+ * complete file is checked by file_fetch_poll). Returns the bytes it
+ * added (0: not wanted). */
 uint64_t file_fetch_chunk(file_fetch *self, const Aafarm__FileChunk *c, const uint8_t *data,
                           size_t len, int64_t now_ms);
 

@@ -386,48 +386,39 @@ static void on_reject(worker_loop *w, const Aafarm__Reject *m)
 
 static void send_finished(worker_loop *w);
 
-typedef struct preparation {
-    worker_jobs *jobs;
-    const Aafarm__Job *msg;
-    const fetch_job *files;        /* its files' paths and descriptors, or NULL */
-    int delay_ms;
-    held_job *result;
+/* Work that may take seconds (compiling a job, hashing a large file) runs
+ * on a helper thread while this one goes on heartbeating and sending
+ * finished tiles (only the helper touches the job list and the file store
+ * meanwhile; only this thread touches the socket). */
+typedef struct beside {
+    void (*fn)(void *arg);
+    void *arg;
     atomic_bool done;
-} preparation;
+} beside;
 
-static void *prepare_thread(void *arg)
+static void *beside_thread(void *arg)
 {
-    preparation *p = arg;
-    if (p->delay_ms > 0) {
-        struct timespec ts = {p->delay_ms / 1000, (long)(p->delay_ms % 1000) * 1000000L};
-        while (nanosleep(&ts, &ts) != 0 && errno == EINTR) {}
-    }
-    p->result = worker_jobs_add(p->jobs, p->msg, p->files ? p->files->paths : NULL,
-                                p->files ? p->files->fds : NULL);
-    atomic_store(&p->done, true);
+    beside *b = arg;
+    b->fn(b->arg);
+    atomic_store(&b->done, true);
     return NULL;
 }
 
-/* worker_jobs_add on a helper thread; this one heartbeats meanwhile (only
- * the helper touches w->jobs until it is done; only this thread touches
- * the socket). */
-static held_job *prepare_job(worker_loop *w, const Aafarm__Job *m, const fetch_job *files)
+static void run_beside(worker_loop *w, void (*fn)(void *arg), void *arg, const char *what)
 {
-    if (worker_jobs_find(w->jobs, m->job_hash))
-        return worker_jobs_add(w->jobs, m, files ? files->paths : NULL, files ? files->fds : NULL);
-    preparation p = {w->jobs, m, files, w->opt->prepare_delay_ms, NULL, false};
+    beside b = {fn, arg, false};
     pthread_t tid;
-    if (pthread_create(&tid, NULL, prepare_thread, &p) != 0) {
-        prepare_thread(&p);   /* no thread: prepare here, without heartbeats */
-        return p.result;
+    if (pthread_create(&tid, NULL, beside_thread, &b) != 0) {
+        fn(arg);   /* no thread: here, without heartbeats */
+        return;
     }
     long step = w->heartbeat_ms / 4 < 50 ? (w->heartbeat_ms / 4 > 0 ? w->heartbeat_ms / 4 : 1) : 50;
-    while (!atomic_load(&p.done)) {
+    while (!atomic_load(&b.done)) {
         if (interrupted) {
             /* the helper cannot be stopped and holds the job list: tell the
              * master (it requeues our tiles at once) and leave without
              * tearing anything down */
-            wlog(w, 0, "interrupted while preparing job %.12s; leaving", m->job_hash);
+            wlog(w, 0, "interrupted while %s; leaving", what);
             send_shutdown(w, "the worker was stopped (SIGINT/SIGTERM) while preparing a job");
             int linger = 500;
             wire_monitor_destroy(&w->monitor);   /* its socket would hold up zmq_ctx_term */
@@ -446,6 +437,39 @@ static held_job *prepare_job(worker_loop *w, const Aafarm__Job *m, const fetch_j
         if (w->welcomed && now_ms() - w->last_sent_ms >= w->heartbeat_ms) send_heartbeat(w);
     }
     pthread_join(tid, NULL);
+}
+
+typedef struct preparation {
+    worker_jobs *jobs;
+    const Aafarm__Job *msg;
+    const fetch_job *files;        /* its files' paths and descriptors, or NULL */
+    int delay_ms;
+    held_job *result;
+} preparation;
+
+static void prepare(void *arg)
+{
+    preparation *p = arg;
+    if (p->delay_ms > 0) {
+        struct timespec ts = {p->delay_ms / 1000, (long)(p->delay_ms % 1000) * 1000000L};
+        while (nanosleep(&ts, &ts) != 0 && errno == EINTR) {}
+    }
+    p->result = worker_jobs_add(p->jobs, p->msg, p->files ? p->files->paths : NULL,
+                                p->files ? p->files->fds : NULL);
+}
+
+/* worker_jobs_add beside the loop. */
+static held_job *prepare_job(worker_loop *w, const Aafarm__Job *m, const fetch_job *files)
+{
+    preparation p = {w->jobs, m, files, w->opt->prepare_delay_ms, NULL};
+    if (worker_jobs_find(w->jobs, m->job_hash)) {
+        p.delay_ms = 0;
+        prepare(&p);   /* held already: nothing to compile */
+        return p.result;
+    }
+    char what[80];
+    snprintf(what, sizeof what, "preparing job %.12s", m->job_hash);
+    run_beside(w, prepare, &p, what);
     return p.result;
 }
 
@@ -505,13 +529,34 @@ static void take_ready_jobs(worker_loop *w)
     }
 }
 
+typedef struct file_call {
+    file_fetch *files;
+    const Aafarm__Job *msg;        /* add this Job; NULL: poll */
+} file_call;
+
+static void file_work(void *arg)
+{
+    file_call *c = arg;
+    if (c->msg) file_fetch_add(c->files, c->msg, now_ms());
+    else file_fetch_poll(c->files, now_ms());
+}
+
+/* The file work that may hash whole files, beside the loop. */
+static void poll_files(worker_loop *w)
+{
+    if (!file_fetch_poll_due(w->files, now_ms())) return;
+    file_call c = {w->files, NULL};
+    run_beside(w, file_work, &c, "checking job files");
+}
+
 static void on_job(worker_loop *w, const Aafarm__Job *m)
 {
     if (m->n_files == 0 || worker_jobs_find(w->jobs, m->job_hash)) {
         job_ready(w, prepare_job(w, m, NULL));
         return;
     }
-    file_fetch_add(w->files, m, now_ms());
+    file_call c = {w->files, m};
+    run_beside(w, file_work, &c, "looking up job files");
     take_ready_jobs(w);   /* all in the store already: at once */
 }
 
@@ -522,6 +567,7 @@ static void on_file_chunk(worker_loop *w, const Aafarm__FileChunk *c, const wire
     uint64_t n = file_fetch_chunk(w->files, c, data, len, now_ms());
     wlog(w, 1, "file %.12s: bytes %llu..+%zu %s", c->sha256, (unsigned long long)c->offset, len,
          n ? "written" : "not wanted (dropped)");
+    poll_files(w);   /* the last chunk: the file is checked and stored */
     take_ready_jobs(w);
 }
 
@@ -705,6 +751,7 @@ static session_end session(worker_loop *w)
         }
         read_master(w);
         if (w->welcomed) {
+            poll_files(w);
             file_fetch_pump(w->files, now_ms(), send_need_file, w);
             take_ready_jobs(w);
         }
