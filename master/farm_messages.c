@@ -384,6 +384,15 @@ static void on_need_file(farm *f, farm_worker *w, const Aafarm__NeedFile *n, int
                     "master's", w->name, n->job_hash);
         return;
     }
+    /* what was sent to it and it has not received yet is bounded */
+    uint64_t received = n->received < w->file_bytes ? n->received : w->file_bytes;
+    if (w->file_bytes - received + n->length > PROTO_MAX_FILE_INFLIGHT) {
+        if (!w->file_overrun++)
+            console_log(f->con, CONSOLE_INFO, "%s asks for more file bytes than it has received "
+                        "plus %u MiB: dropped (a broken or hostile peer)", w->name,
+                        PROTO_MAX_FILE_INFLIGHT >> 20);
+        return;
+    }
     const uint8_t *data = NULL;
     const job_file *file = NULL;
     char err[1200];

@@ -46,6 +46,7 @@ typedef struct farm_worker {
     /* job files (docs/textures.md): bytes sent to it, and from its FilesReady
      * the files its host's store had (hits) and lacked (misses) */
     uint64_t file_bytes, file_chunks, file_hits, file_misses;
+    uint64_t file_overrun;         /* NeedFiles dropped: beyond the in-flight cap */
     bool files_ready;              /* it has every file of the job */
 } farm_worker;
 

@@ -58,6 +58,10 @@ proto_limits proto_limits_default(void);
  * at most the receiver's max_bulk_bytes). */
 #define PROTO_MAX_FILE_CHUNK (16u << 20)
 
+/* File bytes the master sends a worker beyond what the worker says it has
+ * received (NeedFile.received): a peer cannot make the master queue more. */
+#define PROTO_MAX_FILE_INFLIGHT (64u << 20)
+
 typedef Aafarm__Envelope__BodyCase proto_kind;
 
 /* "Hello", "Welcome", ..., "Shutdown"; "(no message)" for NOT_SET and

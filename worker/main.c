@@ -48,7 +48,7 @@ static void usage(FILE *out)
         "                          are removed beyond it (default 0 = unlimited)\n"
         "  --file-chunk B          (--connect) bytes asked per file chunk (default 1M)\n"
         "  --file-inflight B       (--connect) file bytes asked and not yet received, at\n"
-        "                          most (default 8M)\n"
+        "                          most (default 8M, at most 64M)\n"
         "  --file-delay MS         (--connect) wait MS between two file chunks asked: a\n"
         "                          testing aid that makes transfers slow enough to interrupt\n"
         "  --tile-delay MS          (--connect) sleep MS before each tile: a testing aid\n"
@@ -193,6 +193,11 @@ int main(int argc, char **argv)
             if (!parse_bytes(optarg, &b)) {
                 fprintf(stderr, "aafarm-worker: --%s wants e.g. 400K, 4M, 2G or 0, got '%s'\n",
                         c == O_FILE_INFLIGHT ? "file-inflight" : "file-cache-bytes", optarg);
+                return AAFARM_EXIT_USAGE;
+            }
+            if (c == O_FILE_INFLIGHT && (b < 1024 || b > (64u << 20))) {
+                fprintf(stderr, "aafarm-worker: --file-inflight wants 1K..64M (the master sends "
+                        "no more), got '%s'\n", optarg);
                 return AAFARM_EXIT_USAGE;
             }
             if (c == O_FILE_INFLIGHT) wo.file_inflight = b;

@@ -92,6 +92,7 @@ typedef struct worker_loop {
     bool curve;
     curve_cert own, master;
     wire_monitor *monitor;         /* handshake failures: refused keys */
+    uint64_t file_received;        /* FileChunk bytes since the last Welcome */
     bool handshake_said;           /* a failed handshake was reported this session */
 } worker_loop;
 
@@ -183,6 +184,7 @@ static bool send_need_file(void *arg, const char *job_hash, const char *file_has
     n.sha256 = (char *)file_hash;
     n.offset = offset;
     n.length = length;
+    n.received = w->file_received;
     Aafarm__Envelope env = AAFARM__ENVELOPE__INIT;
     env.body_case = AAFARM__ENVELOPE__BODY_NEED_FILE;
     env.need_file = &n;
@@ -359,6 +361,7 @@ static void on_welcome(worker_loop *w, const Aafarm__Welcome *m)
     /* and the jobs waiting for files: the master sends the Job again with
      * its next Grant, and the transfers resume from the chunks written */
     file_fetch_drop(w->files, NULL);
+    w->file_received = 0;
     if (w->master_session && w->master_session != m->master_session)
         wlog(w, 0, "a new master at %s", w->opt->endpoint);
     w->master_session = m->master_session;
@@ -564,6 +567,7 @@ static void on_file_chunk(worker_loop *w, const Aafarm__FileChunk *c, const wire
 {
     size_t len = 0;
     const uint8_t *data = wire_msg_bulk(m, &len);
+    w->file_received += len;
     uint64_t n = file_fetch_chunk(w->files, c, data, len, now_ms());
     wlog(w, 1, "file %.12s: bytes %llu..+%zu %s", c->sha256, (unsigned long long)c->offset, len,
          n ? "written" : "not wanted (dropped)");

@@ -15,7 +15,9 @@
  *     nothing: the next worker resumes from the chunks written;
  *   - a file changed on disk between jobs gets a new job hash and is
  *     fetched again; one changed after the master loaded the job fails the
- *     render with a message naming it.
+ *     render with a message naming it;
+ *   - a peer asking for more than 64 MiB beyond what it says it received
+ *     is not served beyond that.
  */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -30,8 +32,13 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <time.h>
+#include <zmq.h>
+
 #include "farm_testutil.h"
 #include "util/hash.h"
+#include "version.h"
+#include "wire.h"
 
 static char *dir;
 
@@ -401,6 +408,111 @@ static void test_changed_file(void **state)
     free(d);
 }
 
+/* ---- a greedy peer speaking the protocol by hand ---- */
+
+static void peer_send(void *s, Aafarm__Envelope *env)
+{
+    assert_int_equal(wire_send(s, NULL, 0, env, NULL, 0), 0);
+}
+
+static wire_msg *peer_wait(void *s, proto_kind kind, double timeout_s)
+{
+    struct timespec t0, t;
+    clock_gettime(CLOCK_MONOTONIC, &t0);
+    for (;;) {
+        zmq_pollitem_t it = {s, 0, ZMQ_POLLIN, 0};
+        zmq_poll(&it, 1, 50);
+        wire_msg *m;
+        while ((m = wire_recv(s, NULL, NULL, ZMQ_DONTWAIT))) {
+            if (wire_msg_kind(m) == kind) return m;
+            wire_msg_destroy(&m);
+        }
+        clock_gettime(CLOCK_MONOTONIC, &t);
+        if ((double)(t.tv_sec - t0.tv_sec) + (double)(t.tv_nsec - t0.tv_nsec) * 1e-9 > timeout_s)
+            return NULL;
+    }
+}
+
+static void peer_need(void *s, const char *job_hash, const char *sha, uint64_t received)
+{
+    Aafarm__NeedFile n = AAFARM__NEED_FILE__INIT;
+    n.job_hash = (char *)job_hash;
+    n.sha256 = (char *)sha;
+    n.offset = 0;
+    n.length = 16u << 20;
+    n.received = received;
+    Aafarm__Envelope env = AAFARM__ENVELOPE__INIT;
+    env.body_case = AAFARM__ENVELOPE__BODY_NEED_FILE;
+    env.need_file = &n;
+    peer_send(s, &env);
+}
+
+/* FileChunks arriving until none came for timeout_s (kept short: the
+ * peer sends no heartbeats, the master drops it after 3 s of silence). */
+static int peer_chunks(void *s, double timeout_s)
+{
+    int n = 0;
+    wire_msg *m;
+    while ((m = peer_wait(s, AAFARM__ENVELOPE__BODY_FILE_CHUNK, timeout_s))) {
+        n++;
+        wire_msg_destroy(&m);
+    }
+    return n;
+}
+
+static void test_greedy_peer_is_capped(void **state)
+{
+    (void)state;
+    char *d = make_case("greedy", 0.1);
+    write_data(ft_path(d, "maps/height.dat"), 16u << 20, 7);
+    char ep[256], job_hash[HASH_HEX_SIZE], sha[HASH_HEX_SIZE];
+    pid_t m = start_master(d, "1", ep, sizeof ep);
+    void *ctx = zmq_ctx_new();
+    void *s = zmq_socket(ctx, ZMQ_DEALER);
+    int linger = 0;
+    zmq_setsockopt(s, ZMQ_LINGER, &linger, sizeof linger);
+    assert_int_equal(zmq_connect(s, ep), 0);
+    Aafarm__Hello h = AAFARM__HELLO__INIT;
+    h.protocol_version = AAFARM_PROTOCOL_VERSION;
+    h.worker_name = "greedy";
+    h.host = "elsewhere";
+    h.threads = 1;
+    Aafarm__Envelope env = AAFARM__ENVELOPE__INIT;
+    env.body_case = AAFARM__ENVELOPE__BODY_HELLO;
+    env.hello = &h;
+    peer_send(s, &env);
+    wire_msg *w = peer_wait(s, AAFARM__ENVELOPE__BODY_WELCOME, 30);
+    assert_non_null(w);
+    wire_msg_destroy(&w);
+    Aafarm__Ask a = AAFARM__ASK__INIT;
+    a.credits = 1;
+    Aafarm__Envelope ask = AAFARM__ENVELOPE__INIT;
+    ask.body_case = AAFARM__ENVELOPE__BODY_ASK;
+    ask.ask = &a;
+    peer_send(s, &ask);
+    wire_msg *job = peer_wait(s, AAFARM__ENVELOPE__BODY_JOB, 30);
+    assert_non_null(job);
+    const Aafarm__Job *jm = wire_msg_envelope(job)->job;
+    assert_int_equal(jm->n_files, 1);
+    assert_int_equal(jm->files[0]->size, 16u << 20);
+    snprintf(job_hash, sizeof job_hash, "%s", jm->job_hash);
+    snprintf(sha, sizeof sha, "%s", jm->files[0]->sha256);
+    wire_msg_destroy(&job);
+
+    /* five 16 MiB chunks, saying nothing was received: four are sent */
+    for (int i = 0; i < 5; i++) peer_need(s, job_hash, sha, 0);
+    assert_true(ft_wait_for(ft_path(d, "master-1.log"), "asks for more file bytes", 1, 30));
+    assert_int_equal(peer_chunks(s, 1.0), 4);
+    /* having received them, it may have one more */
+    peer_need(s, job_hash, sha, 64u << 20);
+    assert_int_equal(peer_chunks(s, 1.0), 1);
+    zmq_close(s);
+    zmq_ctx_term(ctx);
+    kill(m, SIGINT);
+    assert_int_equal(ft_wait(m, 20), 130);
+    free(d);
+}
+
 int main(int argc, char **argv)
 {
     if (!ft_init(argc, argv))
@@ -410,6 +522,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_two_workers_share_one_store),
         cmocka_unit_test(test_killed_worker_loses_nothing),
         cmocka_unit_test(test_changed_file),
+        cmocka_unit_test(test_greedy_peer_is_capped),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }
