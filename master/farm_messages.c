@@ -418,16 +418,18 @@ static void on_need_file(farm *f, farm_worker *w, const Aafarm__NeedFile *n, int
     env.body_case = AAFARM__ENVELOPE__BODY_FILE_CHUNK;
     env.file_chunk = &c;
     if (send_env_bulk(f, w, &env, data, n->length, now) < 0) return;
+    if (w->file_chunks == 0) w->file_first_ms = now;
     w->file_bytes += n->length;
     w->file_chunks++;
     f->file_bytes_sent += n->length;
     f->file_chunks_sent++;
 }
 
-static void on_files_ready(farm *f, farm_worker *w, const Aafarm__FilesReady *r)
+static void on_files_ready(farm *f, farm_worker *w, const Aafarm__FilesReady *r, int64_t now)
 {
     if (strcmp(r->job_hash, f->jb->hash) != 0 || w->files_ready) return;
     w->files_ready = true;
+    w->file_ready_ms = now;
     w->file_hits += r->hits;
     w->file_misses += r->misses;
     console_log(f->con, CONSOLE_DETAIL, "%s has the job's files (%u in its host's store, %u "
@@ -470,7 +472,7 @@ void farm_handle(farm *f, wire_msg *m, int64_t now)
     case AAFARM__ENVELOPE__BODY_FAILURE: on_failure(f, w, env->failure); break;
     case AAFARM__ENVELOPE__BODY_NEED_JOB: on_need_job(f, w, env->need_job, now); break;
     case AAFARM__ENVELOPE__BODY_NEED_FILE: on_need_file(f, w, env->need_file, now); break;
-    case AAFARM__ENVELOPE__BODY_FILES_READY: on_files_ready(f, w, env->files_ready); break;
+    case AAFARM__ENVELOPE__BODY_FILES_READY: on_files_ready(f, w, env->files_ready, now); break;
     case AAFARM__ENVELOPE__BODY_SHUTDOWN: {
         char why[160];
         snprintf(why, sizeof why, "left (%s)",

@@ -4,11 +4,13 @@
  * from the master's disk, for the FileChunk answers.
  *
  * job_load hashed each file; the copy served must still be that content.
- * A file is opened and hashed again when it is first asked for, and its
- * size and modification time are compared before every later chunk (a
- * change: hashed again). A file whose content no longer matches the job's
- * hash fails the render with a message naming it: the job must be loaded
- * again (it then gets a new hash, so no worker keeps a stale copy).
+ * Before every chunk the open file's device, inode, size and modification
+ * time are compared with what job_load saw when it hashed it (and with
+ * the last re-hash here): any difference, and the file is hashed again. A
+ * file whose content no longer matches the job's hash fails the render
+ * with a message naming it: the job must be loaded again (it then gets a
+ * new hash, so no worker keeps a stale copy). Hashing runs on the master's
+ * loop, so it happens only then, not for every render of a large file.
  */
 #ifndef MASTER_FILE_SERVER_H
 #define MASTER_FILE_SERVER_H

@@ -47,6 +47,7 @@ typedef struct farm_worker {
      * the files its host's store had (hits) and lacked (misses) */
     uint64_t file_bytes, file_chunks, file_hits, file_misses;
     uint64_t file_overrun;         /* NeedFiles dropped: beyond the in-flight cap */
+    int64_t file_first_ms, file_ready_ms;   /* its first NeedFile served, its FilesReady */
     bool files_ready;              /* it has every file of the job */
 } farm_worker;
 

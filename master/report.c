@@ -116,14 +116,17 @@ static void json_worker(FILE *out, const farm_worker *w)
             "\"duplicates\": %llu, \"failures\": %llu, \"invalid_tiles\": %llu, "
             "\"render_seconds\": %.6f, \"cpu_seconds\": %.6f, \"bytes_in\": %llu, "
             "\"bytes_out\": %llu, \"job_bytes\": %llu, \"file_bytes\": %llu, "
-            "\"file_chunks\": %llu, \"file_hits\": %llu, \"file_misses\": %llu, \"state\": ",
+            "\"file_chunks\": %llu, \"file_hits\": %llu, \"file_misses\": %llu, "
+            "\"file_seconds\": %.3f, \"state\": ",
             w->pid, w->threads, w->local ? "true" : "false", (unsigned long long)w->tiles,
             (unsigned long long)w->duplicates, (unsigned long long)w->failures,
             (unsigned long long)w->invalid_tiles, w->render_seconds, w->cpu_seconds,
             (unsigned long long)w->bytes_in, (unsigned long long)w->bytes_out,
             (unsigned long long)w->job_bytes, (unsigned long long)w->file_bytes,
             (unsigned long long)w->file_chunks, (unsigned long long)w->file_hits,
-            (unsigned long long)w->file_misses);
+            (unsigned long long)w->file_misses,
+            w->file_chunks && w->files_ready ? (double)(w->file_ready_ms - w->file_first_ms) / 1000.0
+                                              : 0.0);
     json_string(out, w->alive ? "connected" : w->gone);
     fputc('}', out);
 }

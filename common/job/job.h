@@ -55,6 +55,12 @@ typedef struct job_file {
     uint64_t size;                 /* bytes */
     char *path;                    /* the local copy: on the master's disk, or in a
                                       worker's store; NULL while not present */
+    /* job_load: what stat said of `path` when its bytes were hashed (device,
+     * inode, size, mtime in ns); the master re-hashes a file it serves only
+     * when that changed. stamped false elsewhere. */
+    bool stamped;
+    uint64_t dev, ino;
+    int64_t mtime_ns;
 } job_file;
 
 typedef struct job {

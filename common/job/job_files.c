@@ -26,14 +26,25 @@
 
 enum { MAX_JOB_FILES = 4096, MAX_NAME = 4096 };
 
-/* Hashes the file at path; false (errno-based reason in why) on a read
- * error. */
-static bool hash_file(const char *path, char hex[HASH_HEX_SIZE], uint64_t *size, char *why,
-                      size_t why_size)
+static int64_t mtime_ns(const struct stat *st)
+{
+    return (int64_t)st->st_mtim.tv_sec * 1000000000 + st->st_mtim.tv_nsec;
+}
+
+/* Hashes the file at path and stamps it (stat before and after: a file
+ * written meanwhile is an error); false (the reason in why) otherwise. */
+static bool hash_file(const char *path, char hex[HASH_HEX_SIZE], uint64_t *size,
+                      struct stat *stamp, char *why, size_t why_size)
 {
     FILE *f = fopen(path, "rb");
     if (!f) {
         snprintf(why, why_size, "%s", strerror(errno));
+        return false;
+    }
+    struct stat after;
+    if (fstat(fileno(f), stamp) != 0) {
+        snprintf(why, why_size, "%s", strerror(errno));
+        fclose(f);
         return false;
     }
     enum { CHUNK = 1 << 20 };
@@ -49,10 +60,17 @@ static bool hash_file(const char *path, char hex[HASH_HEX_SIZE], uint64_t *size,
     }
     bool bad = ferror(f) != 0;
     int e = errno;
+    bool moved = fstat(fileno(f), &after) != 0 || mtime_ns(&after) != mtime_ns(stamp) ||
+                 after.st_size != stamp->st_size || (uint64_t)after.st_size != n;
     free(buf);
     fclose(f);
     if (bad) {
         snprintf(why, why_size, "read error: %s", strerror(e));
+        return false;
+    }
+    if (moved) {
+        snprintf(why, why_size, "it changed while it was read; load the scene again when it "
+                 "is written");
         return false;
     }
     uint8_t digest[SHA256_DIGEST_SIZE];
@@ -100,14 +118,22 @@ static bool consider(job *self, const scene *sc, const char *name, sl_pos pos, s
     }
     char hex[HASH_HEX_SIZE], why[300];
     uint64_t size = 0;
-    if (!hash_file(path, hex, &size, why, sizeof why)) {
+    struct stat st;
+    if (!hash_file(path, hex, &size, &st, why, sizeof why)) {
         sl_diag_error(diag, pos, "file '%s' (found as '%s' on the texture search path) cannot be "
                       "read: %s; fix its permissions or remove it", name, path, why);
         free(path);
         return false;
     }
     bool ok = job_add_file(self, name, hex, size, why, sizeof why);
-    if (ok) job_file_set_path(self, self->nfiles - 1, path);
+    if (ok) {
+        job_file *f = &self->files[self->nfiles - 1];
+        job_file_set_path(self, self->nfiles - 1, path);
+        f->stamped = true;
+        f->dev = (uint64_t)st.st_dev;
+        f->ino = (uint64_t)st.st_ino;
+        f->mtime_ns = mtime_ns(&st);
+    }
     else sl_diag_error(diag, pos, "%s", why);
     free(path);
     return ok;
