@@ -83,6 +83,15 @@ file_store *file_store_open(const char *dir, uint64_t budget, char *err, size_t 
             return NULL;
         }
     }
+    /* a store another user owns or may write could feed us any bytes under
+     * a hash we trust once checked: refuse it */
+    struct stat st;
+    if (stat(dir, &st) != 0 || st.st_uid != getuid() || (st.st_mode & 022)) {
+        snprintf(err, errsz, "the file cache folder '%s' is not this user's own (owner %u, mode "
+                 "%03o): give another with --file-cache DIR", dir, (unsigned)st.st_uid,
+                 (unsigned)(st.st_mode & 0777));
+        return NULL;
+    }
     file_store *self = calloc(1, sizeof *self);
     if (!self) abort();
     snprintf(self->dir, sizeof self->dir, "%s", dir);
@@ -420,7 +429,8 @@ long file_transfer_put(file_transfer *t, uint64_t offset, const void *data, size
     /* the bytes first, then the map: a crash in between costs one chunk */
     if (!write_all(t->data_fd, data, len, offset) ||
         !write_all(t->map_fd, &one, 1, MAP_HEADER + (uint64_t)i)) {
-        snprintf(err, errsz, "cannot write to the file cache (%s): %s", t->store->dir,
+        snprintf(err, errsz, "cannot write to the file cache %s: %s (free space there, or give "
+                 "another folder with --file-cache DIR)", t->store->dir,
                  strerror(errno ? errno : EIO));
         return -1;
     }

@@ -6,7 +6,7 @@
  * way resumes from the chunks written; a second fetcher of the same file
  * is told to wait (the lock); a corrupt object is found by its hash and
  * removed; eviction under a byte budget removes the least recently used
- * files first and never a file in use.
+ * files first and never a file in use; a folder others may write is refused.
  */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -306,6 +306,16 @@ static void test_unusable_folder_is_said(void **state)
     assert_null(file_store_open(sub, 0, err, sizeof err));
     assert_non_null(strstr(err, "--file-cache"));
     assert_non_null(strstr(err, "plainfile"));
+    /* a folder others may write is not trusted */
+    snprintf(sub, sizeof sub, "%s/open", dir);
+    assert_int_equal(mkdir(sub, 0700), 0);
+    assert_int_equal(chmod(sub, 0777), 0);
+    assert_null(file_store_open(sub, 0, err, sizeof err));
+    assert_non_null(strstr(err, "not this user's own"));
+    assert_int_equal(chmod(sub, 0700), 0);
+    file_store *st = file_store_open(sub, 0, err, sizeof err);
+    assert_non_null(st);
+    file_store_close(&st);
 }
 
 int main(void)
