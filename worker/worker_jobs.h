@@ -36,6 +36,7 @@ typedef struct held_job {
     char error[1024];          /* why it is broken */
     int *file_fds;             /* its files' "in use" descriptors (file_store.h) */
     int nfile_fds;
+    uint64_t files_said;       /* the master session told FilesReady for it */
     atomic_int refs;
 } held_job;
 

@@ -526,6 +526,7 @@ static void take_ready_jobs(worker_loop *w)
             for (int i = 0; i < j->nfiles; i++) j->fds[i] = -1;   /* the held job has them */
             aafarm__job__free_unpacked(m, NULL);
             send_files_ready(w, j);
+            h->files_said = w->master_session;
         }
         fetch_job_destroy(&j);
         job_ready(w, h);
@@ -581,6 +582,13 @@ static void on_grant(worker_loop *w, const Aafarm__Grant *g)
     image_rect rect = {(int)g->tile->x, (int)g->tile->y, (int)g->tile->width, (int)g->tile->height};
     held_job *h = worker_jobs_find(w->jobs, g->job_hash);
     if (h) {
+        if (!h->broken && h->jb->nfiles > 0 && h->files_said != w->master_session) {
+            /* held from an earlier session: every file is here */
+            fetch_job said = {.nfiles = h->jb->nfiles, .hits = (uint32_t)h->jb->nfiles};
+            snprintf(said.hash, sizeof said.hash, "%s", h->hash);
+            send_files_ready(w, &said);
+            h->files_said = w->master_session;
+        }
         start_tile(w, h, g->lease_id, g->tile_index, rect);
         return;
     }

@@ -10,6 +10,7 @@
  *     fetched exactly the file's bytes, and its resolver (job_file_resolve,
  *     logged with -v) gives a path whose bytes hash to the master's file;
  *     a second job with the same file moves 0 file bytes (a store hit);
+ *     the same job to a worker that still holds it moves neither;
  *   - two worker processes sharing one store fetch the file once;
  *   - a worker killed mid-transfer (small chunks, slowed down) loses
  *     nothing: the next worker resumes from the chunks written;
@@ -132,7 +133,8 @@ static void sha_of(const char *path, char hex[HASH_HEX_SIZE])
     hash_hex(d, hex);
 }
 
-static pid_t start_master(const char *d, const char *tag, char *ep, size_t epsz)
+static pid_t start_master_on(const char *d, const char *tag, const char *bind, char *ep,
+                             size_t epsz)
 {
     char log[64], out[64], stats[64];
     snprintf(log, sizeof log, "master-%s.log", tag);
@@ -140,13 +142,18 @@ static pid_t start_master(const char *d, const char *tag, char *ep, size_t epsz)
     snprintf(stats, sizeof stats, "stats-%s.json", tag);
     char *l = strdup(ft_path(d, log)), *o = strdup(ft_path(d, out)), *s = strdup(ft_path(d, stats));
     const char *argv[] = {ft_master, ft_path(d, "scene.rib"), "-o", o, "--bind",
-                          "tcp://127.0.0.1:*", "--tile", "8", "--stats-json", s, NULL};
+                          bind, "--tile", "8", "--stats-json", s, NULL};
     pid_t pid = ft_spawn(l, argv);
     assert_true(ft_master_endpoint(l, ep, epsz, 30));
     free(l);
     free(o);
     free(s);
     return pid;
+}
+
+static pid_t start_master(const char *d, const char *tag, char *ep, size_t epsz)
+{
+    return start_master_on(d, tag, "tcp://127.0.0.1:*", ep, epsz);
 }
 
 /* aafarm-worker --connect ep --name name --file-cache cache [extra...] */
@@ -268,7 +275,9 @@ static void test_files_travel_once_per_host(void **state)
     char rib[2048];
     snprintf(rib, sizeof rib, scene_fmt, 0.05);
     write_text(ft_path(d, "scene.rib"), rib);
-    m = start_master(d, "2", ep, sizeof ep);
+    char fixed[64];   /* one port for masters 2 and 3: w2 serves both */
+    snprintf(fixed, sizeof fixed, "tcp://127.0.0.1:%d", ft_free_port());
+    m = start_master_on(d, "2", fixed, ep, sizeof ep);
     w = start_worker(d, "w2", ep, cache, NULL);
     expect_master_ok(d, "2", m);
     stats = ft_path(d, "stats-2.json");
@@ -282,6 +291,16 @@ static void test_files_travel_once_per_host(void **state)
     resolved_path(ft_path(d, "worker-w2.log"), "height.dat", path, sizeof path);
     sha_of(path, got);
     assert_string_equal(got, want);
+
+    /* the same job again: w2 still holds it (its Hello says so), so neither
+     * the Job nor the file is sent, and it still reports its files */
+    m = start_master_on(d, "3", fixed, ep, sizeof ep);
+    expect_master_ok(d, "3", m);
+    stats = ft_path(d, "stats-3.json");
+    assert_true(ft_count(ft_path(d, "master-3.log"), "holds the job") >= 1);
+    assert_int_equal(ft_json_number(stats, "jobs_sent"), 0);
+    assert_int_equal(ft_json_number(stats, "file_bytes_sent"), 0);
+    assert_int_equal(worker_number(stats, "w2", "file_hits"), 1);
     stop_worker(w);
     free(cache);
     free(d);
