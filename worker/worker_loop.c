@@ -7,7 +7,8 @@
  *   READY       Welcome: Ask(credits = pipeline target - leases held)
  *   WORKING     Grant -> task on the pool (or NeedJob and wait for the
  *               Job, and for its files: NeedFile -> FileChunk until the
- *               host's store has them all, then FilesReady); each finished tile -> Result + EXR, or Failure;
+ *               host's store has them all, then FilesReady); each
+ *               finished tile -> Result + EXR, or Failure;
  *               Ask again as threads free up; Heartbeat when quiet
  *   BACKOFF     master silent for liveness x interval (or no Welcome):
  *               close, drop leases, wait 1, 2, 4 ... 32 s, reconnect

@@ -330,8 +330,10 @@ static void test_two_workers_share_one_store(void **state)
     long fa = worker_number(stats, "a", "file_bytes"), fb = worker_number(stats, "b", "file_bytes");
     assert_true((fa == SIZE && fb == 0) || (fa == 0 && fb == SIZE));
     /* and both had it for their tiles */
-    assert_int_equal(worker_number(stats, "a", "file_hits") + worker_number(stats, "a", "file_misses"), 1);
-    assert_int_equal(worker_number(stats, "b", "file_hits") + worker_number(stats, "b", "file_misses"), 1);
+    for (const char *const *n = (const char *const[]){"a", "b", NULL}; *n; n++)
+        assert_int_equal(worker_number(stats, *n, "file_hits") +
+                             worker_number(stats, *n, "file_misses"),
+                         1);
     stop_worker(a);
     stop_worker(b);
     free(cache);
