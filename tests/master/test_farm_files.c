@@ -15,7 +15,8 @@
  *   - a worker killed mid-transfer (small chunks, slowed down) loses
  *     nothing: the next worker resumes from the chunks written;
  *   - a file changed on disk between jobs gets a new job hash and is
- *     fetched again; one changed after the master loaded the job fails the
+ *     fetched again (and the old version leaves a store with a one-file
+ *     budget); one changed after the master loaded the job fails the
  *     render with a message naming it;
  *   - a peer asking for more than 64 MiB beyond what it says it received
  *     is not served beyond that.
@@ -403,8 +404,15 @@ static void test_changed_file(void **state)
     write_data(ft_path(d, "maps/height.dat"), SIZE, 5);
     sha_of(ft_path(d, "maps/height.dat"), want);
     m = start_master(d, "2", ep, sizeof ep);
-    w = start_worker(d, "w2", ep, cache, NULL);
+    /* a store budget of one file: the old version (no longer in use) goes */
+    const char *budget[] = {"--file-cache-bytes", "300000", NULL};
+    w = start_worker(d, "w2", ep, cache, budget);
     expect_master_ok(d, "2", m);
+    char objects[4200];
+    snprintf(objects, sizeof objects, "%s/objects", cache);
+    assert_int_equal(ft_count_files(objects, ""), 3);   /* ".", ".." and the new version */
+    snprintf(objects, sizeof objects, "%s/objects/%s", cache, want);
+    assert_int_equal(access(objects, F_OK), 0);
     job_hash_of(ft_path(d, "stats-2.json"), second);
     assert_string_not_equal(first, second);
     assert_int_equal(ft_json_number(ft_path(d, "stats-2.json"), "file_bytes_sent"), SIZE);
@@ -436,6 +444,26 @@ static void peer_send(void *s, Aafarm__Envelope *env)
     assert_int_equal(wire_send(s, NULL, 0, env, NULL, 0), 0);
 }
 
+static double mono_s(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec + (double)t.tv_nsec * 1e-9;
+}
+
+/* A Heartbeat at most every 0.4 s, so the master keeps the peer. */
+static void peer_alive(void *s)
+{
+    static double last;
+    if (mono_s() - last < 0.4) return;
+    Aafarm__Heartbeat hb = AAFARM__HEARTBEAT__INIT;
+    Aafarm__Envelope env = AAFARM__ENVELOPE__INIT;
+    env.body_case = AAFARM__ENVELOPE__BODY_HEARTBEAT;
+    env.heartbeat = &hb;
+    peer_send(s, &env);
+    last = mono_s();
+}
+
 static wire_msg *peer_wait(void *s, proto_kind kind, double timeout_s)
 {
     struct timespec t0, t;
@@ -443,6 +471,7 @@ static wire_msg *peer_wait(void *s, proto_kind kind, double timeout_s)
     for (;;) {
         zmq_pollitem_t it = {s, 0, ZMQ_POLLIN, 0};
         zmq_poll(&it, 1, 50);
+        peer_alive(s);
         wire_msg *m;
         while ((m = wire_recv(s, NULL, NULL, ZMQ_DONTWAIT))) {
             if (wire_msg_kind(m) == kind) return m;
@@ -468,8 +497,7 @@ static void peer_need(void *s, const char *job_hash, const char *sha, uint64_t r
     peer_send(s, &env);
 }
 
-/* FileChunks arriving until none came for timeout_s (kept short: the
- * peer sends no heartbeats, the master drops it after 3 s of silence). */
+/* FileChunks arriving until none came for timeout_s. */
 static int peer_chunks(void *s, double timeout_s)
 {
     int n = 0;
@@ -522,7 +550,11 @@ static void test_greedy_peer_is_capped(void **state)
 
     /* five 16 MiB chunks, saying nothing was received: four are sent */
     for (int i = 0; i < 5; i++) peer_need(s, job_hash, sha, 0);
-    assert_true(ft_wait_for(ft_path(d, "master-1.log"), "asks for more file bytes", 1, 30));
+    for (int i = 0; i < 300 && ft_count(ft_path(d, "master-1.log"), "asks for more") == 0; i++) {
+        ft_sleep_ms(50);
+        peer_alive(s);
+    }
+    assert_int_equal(ft_count(ft_path(d, "master-1.log"), "asks for more file bytes"), 1);
     assert_int_equal(peer_chunks(s, 1.0), 4);
     /* having received them, it may have one more */
     peer_need(s, job_hash, sha, 64u << 20);
