@@ -376,6 +376,7 @@ static int open_journal(farm *f, farm_frame *fr, char *err, size_t errsz)
 static int setup_frame(farm *f, farm_frame *fr, char *err, size_t errsz)
 {
     fr->jobmsg = job_message_new(fr->jb, &fr->fmt);
+    fr->files = file_server_new(fr->jb);
     int rc = check_job_message(f, fr, err, errsz);
     if (rc != AAFARM_EXIT_OK) return rc;
     stale_clean_outputs(fr->output, report_leftover, f);
@@ -676,6 +677,7 @@ static void teardown(farm *f)
         if (fr->jnl && fr->done == 0) journal_remove(&fr->jnl);
         journal_close(&fr->jnl);             /* kept for --resume */
         job_message_destroy(&fr->jobmsg);
+        file_server_destroy(&fr->files);
     }
     local_workers_destroy(&f->locals);
     wire_monitor_destroy(&f->monitor);
@@ -722,20 +724,19 @@ int farm_run(const farm_options *opt, const farm_frame_in *frames, int nframes)
     }
     f.start_ms = farm_now_ms();
     console_set_resumed(f.con, f.resumed_tiles);
-    if (nframes > 1) {
-        char line[64];
-        snprintf(line, sizeof line, "%d/%d frames, ", f.frames_written, nframes);
-        console_set_prefix(f.con, line);
-    }
     if (nframes == 1)
-        console_log(f.con, CONSOLE_INFO, "%s: %dx%d, %d tiles of %d, job %.12s (%zu bytes)",
+        console_log(f.con, CONSOLE_INFO, "%s: %dx%d, %d tiles of %d, job %.12s (%zu bytes%s)",
                     opt->scene_path, f.fmt.width, f.fmt.height, f.ntiles, f.fmt.tile_size,
-                    frames[0].jb->hash, f.job_bytes);
+                    frames[0].jb->hash, f.job_bytes, frames[0].jb->nfiles ? ", files below" : "");
     else
         console_log(f.con, CONSOLE_INFO, "%s: %d frames (%d ... %d), %d tiles of %d in one "
                     "queue, %zu job bytes", opt->scene_path, nframes,
                     frames[0].jb->frame_number, frames[nframes - 1].jb->frame_number, f.ntiles,
                     f.fmt.tile_size, f.job_bytes);
+    if (frames[0].jb->nfiles)   /* the files go once per host, not with every Job */
+        console_log(f.con, CONSOLE_INFO, "%d file%s of %llu bytes, sent once per host",
+                    frames[0].jb->nfiles, frames[0].jb->nfiles == 1 ? "" : "s",
+                    (unsigned long long)job_files_bytes(frames[0].jb));
     if (scheduler_finished(f.sched)) f.state = FARM_DONE;   /* all resumed */
     run_loop(&f);
     rc = finish(&f);

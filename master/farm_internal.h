@@ -4,6 +4,7 @@
  *
  *   farm.c           set-up, the poll loop, timers, the end of the job
  *   farm_messages.c  what each message from a worker does; sending
+ *                    (NeedFile: file_server.c reads the chunk)
  *   report.c         the summary per worker and the statistics file
  */
 #ifndef MASTER_FARM_INTERNAL_H
@@ -14,6 +15,7 @@
 #include <stdint.h>
 
 #include "console.h"
+#include "file_server.h"
 #include "farm.h"
 #include "image/writer.h"
 #include "job_message.h"
@@ -39,6 +41,7 @@ typedef struct farm_frame {
     const char *output, *preview;
     int tiles_x, ntiles, first;
     job_message *jobmsg;
+    file_server *files;            /* its job's files, served from disk */
     size_t job_bytes;              /* packed size of its Job envelope */
     image_writer *writer;
     journal *jnl;                  /* OUT.exr.journal: its tiles taken so far */
@@ -68,6 +71,7 @@ typedef struct farm {
     local_workers *locals;
     console *con;
     size_t job_bytes;              /* packed sizes of the frames' Job envelopes */
+    uint64_t file_bytes_sent, file_chunks_sent;
     uint64_t session;              /* Welcome.master_session */
     char host[128];
     int64_t start_ms, end_ms;

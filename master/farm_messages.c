@@ -13,6 +13,9 @@
  *              a non-retryable one fails it only when a second worker
  *              confirms it (scheduler.h: no single peer ends a render)
  *   NeedJob    the Job again
+ *   NeedFile   the chunk of the job's file, read from disk (FileChunk +
+ *              bulk); a file changed since job_load fails the render
+ *   FilesReady the worker's store statistics for the summary
  *   Heartbeat  liveness only (any message counts)
  *   Shutdown   the worker leaves: its tiles go back to the queue
  * Anything but Hello from a peer the master does not know gets Reject
@@ -28,19 +31,22 @@
 
 /* ---- sending ---- */
 
-static int send_to(farm *f, const uint8_t *id, size_t id_len, Aafarm__Envelope *env)
+static int send_to(farm *f, const uint8_t *id, size_t id_len, Aafarm__Envelope *env,
+                   const void *bulk, size_t bulk_len)
 {
-    if (wire_send_limited(f->router, &f->send_limits, id, id_len, env, NULL, 0) != 0) return -1;
+    if (wire_send_limited(f->router, &f->send_limits, id, id_len, env, bulk, bulk_len) != 0)
+        return -1;
     return 0;
 }
 
 /* Sends to a registered worker; a worker that cannot be reached any more
  * (connection gone, or its queue full because it stopped reading) is
- * lost. */
-static int send_env(farm *f, farm_worker *w, Aafarm__Envelope *env, int64_t now)
+ * lost. bulk: a FileChunk's bytes (NULL otherwise). */
+static int send_env_bulk(farm *f, farm_worker *w, Aafarm__Envelope *env, const void *bulk,
+                         size_t bulk_len, int64_t now)
 {
     size_t n = aafarm__envelope__get_packed_size(env);
-    if (send_to(f, w->id, w->id_len, env) != 0) {
+    if (send_to(f, w->id, w->id_len, env, bulk, bulk_len) != 0) {
         int e = errno;
         const char *what = proto_message_name(env->body_case);
         if (e == EHOSTUNREACH) {
@@ -54,9 +60,14 @@ static int send_env(farm *f, farm_worker *w, Aafarm__Envelope *env, int64_t now)
         return -1;
     }
     w->last_sent_ms = now;
-    w->bytes_out += n;
-    f->sent_bytes += n;
+    w->bytes_out += n + bulk_len;
+    f->sent_bytes += n + bulk_len;
     return (int)n;
+}
+
+static int send_env(farm *f, farm_worker *w, Aafarm__Envelope *env, int64_t now)
+{
+    return send_env_bulk(f, w, env, NULL, 0, now);
 }
 
 static void send_reject(farm *f, const uint8_t *id, size_t id_len, Aafarm__RejectCode code,
@@ -69,7 +80,7 @@ static void send_reject(farm *f, const uint8_t *id, size_t id_len, Aafarm__Rejec
     Aafarm__Envelope env = AAFARM__ENVELOPE__INIT;
     env.body_case = AAFARM__ENVELOPE__BODY_REJECT;
     env.reject = &r;
-    if (send_to(f, id, id_len, &env) == 0) f->rejects_sent++;
+    if (send_to(f, id, id_len, &env, NULL, 0) == 0) f->rejects_sent++;
 }
 
 static void send_welcome(farm *f, farm_worker *w, int64_t now)
@@ -408,15 +419,84 @@ static void on_failure(farm *f, farm_worker *w, const Aafarm__Failure *x)
     tile_failed(f, w, x->lease_id, l->tile, x->message, x->retryable);
 }
 
-static void on_need_job(farm *f, farm_worker *w, const Aafarm__NeedJob *n, int64_t now)
+/* the frame whose job has this hash, or NULL */
+static farm_frame *frame_of_job(farm *f, const char *hash)
 {
     for (int i = 0; i < f->nframes; i++)
-        if (strcmp(n->job_hash, f->frames[i].jb->hash) == 0) {
-            send_job(f, w, &f->frames[i], now);
-            return;
-        }
+        if (strcmp(hash, f->frames[i].jb->hash) == 0) return &f->frames[i];
+    return NULL;
+}
+
+static void on_need_job(farm *f, farm_worker *w, const Aafarm__NeedJob *n, int64_t now)
+{
+    farm_frame *fr = frame_of_job(f, n->job_hash);
+    if (fr) {
+        send_job(f, w, fr, now);
+        return;
+    }
     console_log(f->con, CONSOLE_DETAIL, "%s asked for job %.12s..., not this master's",
                 w->name, n->job_hash);
+}
+
+static void on_need_file(farm *f, farm_worker *w, const Aafarm__NeedFile *n, int64_t now)
+{
+    farm_frame *fr = frame_of_job(f, n->job_hash);
+    if (!fr) {
+        console_log(f->con, CONSOLE_DETAIL, "%s asked for a file of job %.12s..., not this "
+                    "master's", w->name, n->job_hash);
+        return;
+    }
+    /* what was sent to it and it has not received yet is bounded */
+    uint64_t received = n->received < w->file_bytes ? n->received : w->file_bytes;
+    if (w->file_bytes - received + n->length > PROTO_MAX_FILE_INFLIGHT) {
+        if (!w->file_overrun++)
+            console_log(f->con, CONSOLE_INFO, "%s asks for more file bytes than it has received "
+                        "plus %u MiB: dropped (a broken or hostile peer)", w->name,
+                        PROTO_MAX_FILE_INFLIGHT >> 20);
+        return;
+    }
+    const uint8_t *data = NULL;
+    const job_file *file = NULL;
+    char err[1200];
+    file_read r = file_server_read(fr->files, n->sha256, n->offset, n->length, &data, &file, err,
+                                   sizeof err);
+    if (r == FILE_READ_UNKNOWN || r == FILE_READ_RANGE) {
+        console_log(f->con, CONSOLE_INFO, "%s asked for %s (bytes %llu..+%u of %.12s...): "
+                    "dropped", w->name, r == FILE_READ_UNKNOWN ? "a file the job does not have"
+                    : "bytes outside the file", (unsigned long long)n->offset, n->length,
+                    n->sha256);
+        return;
+    }
+    if (r == FILE_READ_CHANGED) {
+        farm_fail(f, "%s", err);
+        return;
+    }
+    Aafarm__FileChunk c = AAFARM__FILE_CHUNK__INIT;
+    c.sha256 = (char *)file->sha256;
+    c.offset = n->offset;
+    c.file_size = file->size;
+    c.length = n->length;
+    Aafarm__Envelope env = AAFARM__ENVELOPE__INIT;
+    env.body_case = AAFARM__ENVELOPE__BODY_FILE_CHUNK;
+    env.file_chunk = &c;
+    if (send_env_bulk(f, w, &env, data, n->length, now) < 0) return;
+    if (w->file_chunks == 0) w->file_first_ms = now;
+    w->file_bytes += n->length;
+    w->file_chunks++;
+    f->file_bytes_sent += n->length;
+    f->file_chunks_sent++;
+}
+
+static void on_files_ready(farm *f, farm_worker *w, const Aafarm__FilesReady *r, int64_t now)
+{
+    if (!frame_of_job(f, r->job_hash) || w->files_ready) return;
+    w->files_ready = true;
+    w->file_ready_ms = now;
+    w->file_hits += r->hits;
+    w->file_misses += r->misses;
+    console_log(f->con, CONSOLE_DETAIL, "%s has the job's files (%u in its host's store, %u "
+                "fetched; %llu bytes received)", w->name, r->hits, r->misses,
+                (unsigned long long)r->fetched_bytes);
 }
 
 static void on_unknown_peer(farm *f, proto_kind kind, const uint8_t *id, size_t id_len,
@@ -453,6 +533,8 @@ void farm_handle(farm *f, wire_msg *m, int64_t now)
     case AAFARM__ENVELOPE__BODY_RESULT: on_result(f, w, env->result, m, now); break;
     case AAFARM__ENVELOPE__BODY_FAILURE: on_failure(f, w, env->failure); break;
     case AAFARM__ENVELOPE__BODY_NEED_JOB: on_need_job(f, w, env->need_job, now); break;
+    case AAFARM__ENVELOPE__BODY_NEED_FILE: on_need_file(f, w, env->need_file, now); break;
+    case AAFARM__ENVELOPE__BODY_FILES_READY: on_files_ready(f, w, env->files_ready, now); break;
     case AAFARM__ENVELOPE__BODY_SHUTDOWN: {
         char why[160];
         snprintf(why, sizeof why, "left (%s)",

@@ -3,7 +3,8 @@
  * the reverse in worker/worker_jobs.c and recomputes the hash, so every
  * field that enters the hash (common/job/job.c, job_finish) must be sent:
  * the scene name and text, each source's name and text, the shader
- * bindings, the arithmetic, the tile size and the instruction budget.
+ * bindings, the arithmetic, the tile size, the instruction budget and each
+ * file's name, SHA-256 and size.
  */
 #include "job_message.h"
 
@@ -16,6 +17,8 @@ struct job_message {
     Aafarm__Source **sources;
     Aafarm__ShaderBinding *binding;
     Aafarm__ShaderBinding **bindings;
+    Aafarm__FileRef *file;
+    Aafarm__FileRef **files;
 };
 
 job_message *job_message_new(const job *jb, const image_format *fmt)
@@ -52,6 +55,20 @@ job_message *job_message_new(const job *jb, const image_format *fmt)
     }
     self->job.n_shaders = nsh;
     self->job.shaders = self->bindings;
+    /* the files by name and hash only: their bytes go once per host */
+    size_t nf = (size_t)jb->nfiles;
+    self->file = calloc(nf + 1, sizeof *self->file);
+    self->files = calloc(nf + 1, sizeof *self->files);
+    if (!self->file || !self->files) abort();
+    for (size_t i = 0; i < nf; i++) {
+        aafarm__file_ref__init(&self->file[i]);
+        self->file[i].name = jb->files[i].name;
+        self->file[i].sha256 = (char *)jb->files[i].sha256;
+        self->file[i].size = jb->files[i].size;
+        self->files[i] = &self->file[i];
+    }
+    self->job.n_files = nf;
+    self->job.files = self->files;
 
     aafarm__render_options__init(&self->options);
     self->options.width = (uint32_t)fmt->width;
@@ -75,6 +92,8 @@ void job_message_destroy(job_message **self_p)
     free(self->sources);
     free(self->binding);
     free(self->bindings);
+    free(self->file);
+    free(self->files);
     free(self);
     *self_p = NULL;
 }

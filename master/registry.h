@@ -46,6 +46,12 @@ typedef struct farm_worker {
     uint64_t rays, boxes, shader_evals, cache_hits, cache_misses, cache_evictions;
     uint64_t peak_cache_bytes;
     uint64_t nonfinite_samples;    /* NaN/Inf samples its tiles had (written as 0) */
+    /* job files (docs/textures.md): bytes sent to it, and from its FilesReady
+     * the files its host's store had (hits) and lacked (misses) */
+    uint64_t file_bytes, file_chunks, file_hits, file_misses;
+    uint64_t file_overrun;         /* NeedFiles dropped: beyond the in-flight cap */
+    int64_t file_first_ms, file_ready_ms;   /* its first NeedFile served, its FilesReady */
+    bool files_ready;              /* it has every file of the job */
 } farm_worker;
 
 typedef struct registry registry;

@@ -33,17 +33,26 @@ void farm_report_summary(const farm *f)
 {
     if (f->opt->verbosity < 0 || registry_count(f->reg) == 0) return;
     fprintf(stderr, "aafarm-master: summary per worker\n");
-    fprintf(stderr, "  %-20s %-14s %6s %5s %5s %9s %9s %10s %10s  %s\n", "worker", "host", "tiles",
-            "dup", "fail", "render s", "cpu s", "bytes in", "bytes out", "state");
+    bool files = f->frames[0].jb->nfiles > 0;   /* the file columns only for a job with files */
+    fprintf(stderr, "  %-20s %-14s %6s %5s %5s %9s %9s %10s %10s", "worker", "host", "tiles",
+            "dup", "fail", "render s", "cpu s", "bytes in", "bytes out");
+    if (files) fprintf(stderr, " %10s %9s", "file bytes", "hit/miss");
+    fprintf(stderr, "  %s\n", "state");
     for (size_t i = 0; i < registry_count(f->reg); i++) {
         const farm_worker *w = registry_at(f->reg, i);
-        char in[32], out[32];
+        char in[32], out[32], fb[32], hm[32];
         human_bytes(w->bytes_in, in, sizeof in);
         human_bytes(w->bytes_out, out, sizeof out);
-        fprintf(stderr, "  %-20.20s %-14.14s %6llu %5llu %5llu %9.2f %9.2f %10s %10s  %s\n",
+        fprintf(stderr, "  %-20.20s %-14.14s %6llu %5llu %5llu %9.2f %9.2f %10s %10s",
                 w->name, w->host, (unsigned long long)w->tiles, (unsigned long long)w->duplicates,
-                (unsigned long long)w->failures, w->render_seconds, w->cpu_seconds, in, out,
-                w->alive ? "connected" : w->gone);
+                (unsigned long long)w->failures, w->render_seconds, w->cpu_seconds, in, out);
+        if (files) {
+            human_bytes(w->file_bytes, fb, sizeof fb);
+            snprintf(hm, sizeof hm, "%llu/%llu", (unsigned long long)w->file_hits,
+                     (unsigned long long)w->file_misses);
+            fprintf(stderr, " %10s %9s", fb, w->files_ready ? hm : "-");
+        }
+        fprintf(stderr, "  %s\n", w->alive ? "connected" : w->gone);
     }
     scheduler_counts c;
     scheduler_counts_get(f->sched, &c);
@@ -52,6 +61,14 @@ void farm_report_summary(const farm *f)
             (unsigned long long)c.grants, (unsigned long long)c.duplicate_grants,
             (unsigned long long)c.requeued, (unsigned long long)c.failures,
             (unsigned long long)f->wstats.dropped);
+    if (files) {
+        char total[32], sent[32];
+        human_bytes(job_files_bytes(f->frames[0].jb), total, sizeof total);
+        human_bytes(f->file_bytes_sent, sent, sizeof sent);
+        fprintf(stderr, "  files: %d of %s in the job, %s sent in %llu chunks (once per host; "
+                "a hit is a file the host's store had)\n", f->frames[0].jb->nfiles, total, sent,
+                (unsigned long long)f->file_chunks_sent);
+    }
 }
 
 /* A JSON string with the characters JSON requires escaped. */
@@ -98,12 +115,18 @@ static void json_worker(FILE *out, const farm_worker *w)
     fprintf(out, ", \"pid\": %u, \"threads\": %u, \"local\": %s, \"tiles\": %llu, "
             "\"duplicates\": %llu, \"failures\": %llu, \"invalid_tiles\": %llu, "
             "\"render_seconds\": %.6f, \"cpu_seconds\": %.6f, \"bytes_in\": %llu, "
-            "\"bytes_out\": %llu, \"job_bytes\": %llu, \"state\": ",
+            "\"bytes_out\": %llu, \"job_bytes\": %llu, \"file_bytes\": %llu, "
+            "\"file_chunks\": %llu, \"file_hits\": %llu, \"file_misses\": %llu, "
+            "\"file_seconds\": %.3f, \"state\": ",
             w->pid, w->threads, w->local ? "true" : "false", (unsigned long long)w->tiles,
             (unsigned long long)w->duplicates, (unsigned long long)w->failures,
             (unsigned long long)w->invalid_tiles, w->render_seconds, w->cpu_seconds,
             (unsigned long long)w->bytes_in, (unsigned long long)w->bytes_out,
-            (unsigned long long)w->job_bytes);
+            (unsigned long long)w->job_bytes, (unsigned long long)w->file_bytes,
+            (unsigned long long)w->file_chunks, (unsigned long long)w->file_hits,
+            (unsigned long long)w->file_misses,
+            w->file_chunks && w->files_ready ? (double)(w->file_ready_ms - w->file_first_ms) / 1000.0
+                                              : 0.0);
     json_string(out, w->alive ? "connected" : w->gone);
     fputc('}', out);
 }
@@ -164,7 +187,8 @@ static void json_farm(FILE *out, const farm *f)
             "\"invalid_tiles\": %llu, \"malformed_messages\": %llu, \"rejects_sent\": %llu, "
             "\"version_mismatches\": %llu, \"disconnects\": %llu, \"nonfinite_samples\": %llu, "
             "\"handshake_failures\": %llu, \"auth_refusals\": %llu, \"max_bulk_bytes\": %zu, "
-            "\"master_cpu_seconds\": %.3f, \"master_peak_rss_kb\": %ld},\n",
+            "\"master_cpu_seconds\": %.3f, \"master_peak_rss_kb\": %ld, \"files\": %d, "
+            "\"files_bytes\": %llu, \"file_bytes_sent\": %llu, \"file_chunks_sent\": %llu},\n",
             f->job_bytes, (unsigned long long)job_bytes_sent, (unsigned long long)f->jobs_sent,
             per_grant,
             (unsigned long long)f->result_bytes, (unsigned long long)f->sent_bytes,
@@ -177,7 +201,9 @@ static void json_farm(FILE *out, const farm *f)
             (unsigned long long)f->nonfinite_samples,
             (unsigned long long)f->wstats.handshake_failures,
             (unsigned long long)zap_refused(f->zap), f->limits.max_bulk_bytes,
-            master_cpu_seconds(), master_peak_rss_kb());
+            master_cpu_seconds(), master_peak_rss_kb(), f->frames[0].jb->nfiles,
+            (unsigned long long)job_files_bytes(f->frames[0].jb), (unsigned long long)f->file_bytes_sent,
+            (unsigned long long)f->file_chunks_sent);
 }
 
 bool farm_report_json(const farm *f, const char *path, char *err, size_t errsz)

@@ -57,6 +57,9 @@ const char *proto_message_name(proto_kind kind)
     case AAFARM__ENVELOPE__BODY_HEARTBEAT: return "Heartbeat";
     case AAFARM__ENVELOPE__BODY_JOB_DONE: return "JobDone";
     case AAFARM__ENVELOPE__BODY_SHUTDOWN: return "Shutdown";
+    case AAFARM__ENVELOPE__BODY_NEED_FILE: return "NeedFile";
+    case AAFARM__ENVELOPE__BODY_FILE_CHUNK: return "FileChunk";
+    case AAFARM__ENVELOPE__BODY_FILES_READY: return "FilesReady";
     default: return "(unknown message)";
     }
 }
@@ -71,6 +74,8 @@ bool proto_message_from_worker(proto_kind kind)
     case AAFARM__ENVELOPE__BODY_FAILURE:
     case AAFARM__ENVELOPE__BODY_HEARTBEAT:
     case AAFARM__ENVELOPE__BODY_SHUTDOWN:
+    case AAFARM__ENVELOPE__BODY_NEED_FILE:
+    case AAFARM__ENVELOPE__BODY_FILES_READY:
         return true;
     default:
         return false;
@@ -87,6 +92,7 @@ bool proto_message_from_master(proto_kind kind)
     case AAFARM__ENVELOPE__BODY_HEARTBEAT:
     case AAFARM__ENVELOPE__BODY_JOB_DONE:
     case AAFARM__ENVELOPE__BODY_SHUTDOWN:
+    case AAFARM__ENVELOPE__BODY_FILE_CHUNK:
         return true;
     default:
         return false;
@@ -95,7 +101,7 @@ bool proto_message_from_master(proto_kind kind)
 
 bool proto_message_has_bulk(proto_kind kind)
 {
-    return kind == AAFARM__ENVELOPE__BODY_RESULT;
+    return kind == AAFARM__ENVELOPE__BODY_RESULT || kind == AAFARM__ENVELOPE__BODY_FILE_CHUNK;
 }
 
 /* ---------------------------------------------------------------------- */
@@ -407,12 +413,37 @@ static int check_options(checker *c, const Aafarm__RenderOptions *o)
     return check_layers(c, o) || check_extra(c, o) ? -1 : 0;
 }
 
+/* The file references: names unique, hashes well formed. */
+static int check_files(checker *c, const Aafarm__Job *m)
+{
+    if (check_count(c, "Job.files", m->n_files))
+        return -1;
+    const char **names = malloc((m->n_files + 1) * sizeof *names);
+    if (!names)
+        return fail(c, "Job.files", "out of memory");
+    int rc = 0;
+    for (size_t i = 0; i < m->n_files && rc == 0; i++) {
+        const Aafarm__FileRef *f = m->files[i];
+        if (!f) {
+            rc = fail(c, "Job.files", "entry %zu is missing", i);
+            break;
+        }
+        rc = check_name(c, "Job.files.name", f->name, true) ||
+             check_hash(c, "Job.files.sha256", f->sha256);
+        names[i] = f->name;
+    }
+    if (rc == 0)
+        rc = check_unique(c, "Job.files.name", names, m->n_files);
+    free(names);
+    return rc ? -1 : 0;
+}
+
 static int check_job(checker *c, const Aafarm__Job *m)
 {
     return check_hash(c, "Job.job_hash", m->job_hash) ||
                    check_name(c, "Job.scene_name", m->scene_name, true) ||
                    check_source(c, "Job.scene_text", m->scene_text) || check_sources(c, m) ||
-                   check_bindings(c, m) || check_options(c, m->options)
+                   check_bindings(c, m) || check_options(c, m->options) || check_files(c, m)
                ? -1
                : 0;
 }
@@ -508,6 +539,45 @@ static int check_shutdown(checker *c, const Aafarm__Shutdown *m)
     return check_prose(c, "Shutdown.reason", m->reason, false);
 }
 
+static uint64_t max_chunk(const checker *c)
+{
+    return c->limits->max_bulk_bytes < PROTO_MAX_FILE_CHUNK ? c->limits->max_bulk_bytes
+                                                            : PROTO_MAX_FILE_CHUNK;
+}
+
+static int check_need_file(checker *c, const Aafarm__NeedFile *m)
+{
+    return check_hash(c, "NeedFile.job_hash", m->job_hash) ||
+                   check_hash(c, "NeedFile.sha256", m->sha256) ||
+                   check_range(c, "NeedFile.length", m->length, 1, PROTO_MAX_FILE_CHUNK)
+               ? -1
+               : 0;
+}
+
+static int check_file_chunk(checker *c, const Aafarm__FileChunk *m, bool has_bulk,
+                            size_t bulk_len)
+{
+    if (check_hash(c, "FileChunk.sha256", m->sha256) ||
+        check_range(c, "FileChunk.length", m->length, 1, max_chunk(c)))
+        return -1;
+    if (!has_bulk)
+        return fail(c, "FileChunk", "the bulk frame with the file's bytes is missing");
+    if (m->length != bulk_len)
+        return fail(c, "FileChunk.length", "says %llu but the bulk frame has %zu bytes",
+                    (unsigned long long)m->length, bulk_len);
+    if (m->offset > m->file_size || m->length > m->file_size - m->offset)
+        return fail(c, "FileChunk", "bytes %llu..%llu lie outside the file of %llu bytes",
+                    (unsigned long long)m->offset,
+                    (unsigned long long)(m->offset + m->length),
+                    (unsigned long long)m->file_size);
+    return 0;
+}
+
+static int check_files_ready(checker *c, const Aafarm__FilesReady *m)
+{
+    return check_hash(c, "FilesReady.job_hash", m->job_hash);
+}
+
 /* The body for its kind; a oneof member can still be NULL if a sender
  * built the struct by hand. */
 static const void *body_of(const Aafarm__Envelope *m)
@@ -525,6 +595,9 @@ static const void *body_of(const Aafarm__Envelope *m)
     case AAFARM__ENVELOPE__BODY_HEARTBEAT: return m->heartbeat;
     case AAFARM__ENVELOPE__BODY_JOB_DONE: return m->job_done;
     case AAFARM__ENVELOPE__BODY_SHUTDOWN: return m->shutdown;
+    case AAFARM__ENVELOPE__BODY_NEED_FILE: return m->need_file;
+    case AAFARM__ENVELOPE__BODY_FILE_CHUNK: return m->file_chunk;
+    case AAFARM__ENVELOPE__BODY_FILES_READY: return m->files_ready;
     default: return NULL;
     }
 }
@@ -544,6 +617,10 @@ static int check_body(checker *c, const Aafarm__Envelope *m, bool has_bulk, size
     case AAFARM__ENVELOPE__BODY_HEARTBEAT: return check_heartbeat(c, m->heartbeat);
     case AAFARM__ENVELOPE__BODY_JOB_DONE: return check_job_done(c, m->job_done);
     case AAFARM__ENVELOPE__BODY_SHUTDOWN: return check_shutdown(c, m->shutdown);
+    case AAFARM__ENVELOPE__BODY_NEED_FILE: return check_need_file(c, m->need_file);
+    case AAFARM__ENVELOPE__BODY_FILE_CHUNK:
+        return check_file_chunk(c, m->file_chunk, has_bulk, bulk_len);
+    case AAFARM__ENVELOPE__BODY_FILES_READY: return check_files_ready(c, m->files_ready);
     default: return fail(c, "Envelope", "unknown message kind %d", (int)m->body_case);
     }
 }
@@ -558,7 +635,7 @@ int proto_message_check(const Aafarm__Envelope *msg, bool has_bulk, size_t bulk_
     if (msg->body_case == AAFARM__ENVELOPE__BODY__NOT_SET)
         return fail(&c, "Envelope", "carries no message (an unknown kind from a newer peer?)");
     if (msg->body_case < AAFARM__ENVELOPE__BODY_HELLO ||
-        msg->body_case > AAFARM__ENVELOPE__BODY_SHUTDOWN)
+        msg->body_case > AAFARM__ENVELOPE__BODY_FILES_READY)
         return fail(&c, "Envelope", "unknown message kind %d", (int)msg->body_case);
     const char *name = proto_message_name(msg->body_case);
     if (!body_of(msg))

@@ -54,6 +54,14 @@ proto_limits proto_limits_default(void);
 #define PROTO_HEARTBEAT_MS_MAX 3600000u
 #define PROTO_LIVENESS_MAX 1000u
 
+/* NeedFile.length and FileChunk.length are at most this (FileChunk's also
+ * at most the receiver's max_bulk_bytes). */
+#define PROTO_MAX_FILE_CHUNK (16u << 20)
+
+/* File bytes the master sends a worker beyond what the worker says it has
+ * received (NeedFile.received): a peer cannot make the master queue more. */
+#define PROTO_MAX_FILE_INFLIGHT (64u << 20)
+
 typedef Aafarm__Envelope__BodyCase proto_kind;
 
 /* "Hello", "Welcome", ..., "Shutdown"; "(no message)" for NOT_SET and
@@ -61,12 +69,12 @@ typedef Aafarm__Envelope__BodyCase proto_kind;
 const char *proto_message_name(proto_kind kind);
 
 /* Which side may send a kind: workers send Hello, Ask, NeedJob, Result,
- * Failure, Heartbeat, Shutdown; the master sends Welcome, Reject, Job,
- * Grant, Heartbeat, JobDone, Shutdown. */
+ * Failure, Heartbeat, Shutdown, NeedFile, FilesReady; the master sends
+ * Welcome, Reject, Job, Grant, Heartbeat, JobDone, Shutdown, FileChunk. */
 bool proto_message_from_worker(proto_kind kind);
 bool proto_message_from_master(proto_kind kind);
 
-/* True for the kinds that carry a bulk frame (only Result). */
+/* True for the kinds that carry a bulk frame (Result, FileChunk). */
 bool proto_message_has_bulk(proto_kind kind);
 
 /* Checks one message. has_bulk/bulk_len describe the bulk frame that came

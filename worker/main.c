@@ -48,6 +48,16 @@ static void usage(FILE *out)
         "  --preview OUT.png       also write an sRGB PNG preview\n"
         "  --stats                 print render statistics\n"
         "  --stats-json FILE       write render statistics as JSON\n"
+        "  --file-cache DIR        (--connect) the host's store of job files (textures),\n"
+        "                          shared by its workers (default $XDG_CACHE_HOME/aafarm/\n"
+        "                          files, else /var/tmp/aafarm-$UID/files)\n"
+        "  --file-cache-bytes B    its byte budget: least recently used files not in use\n"
+        "                          are removed beyond it (default 0 = unlimited)\n"
+        "  --file-chunk B          (--connect) bytes asked per file chunk (default 1M)\n"
+        "  --file-inflight B       (--connect) file bytes asked and not yet received, at\n"
+        "                          most (default 8M, at most 64M)\n"
+        "  --file-delay MS         (--connect) wait MS between two file chunks asked: a\n"
+        "                          testing aid that makes transfers slow enough to interrupt\n"
         "  --tile-delay MS          (--connect) sleep MS before each tile: a testing aid\n"
         "                          that makes renders slow enough to interrupt\n"
         "  --prepare-delay MS       (--connect) sleep MS before compiling each job: a\n"
@@ -102,7 +112,8 @@ int main(int argc, char **argv)
     const char *connect = NULL;
     enum { O_STANDALONE = 256, O_CONNECT, O_NAME, O_TILE, O_CACHE, O_ARITH, O_BUDGET,
            O_PREVIEW, O_STATS, O_STATS_JSON, O_TILE_DELAY, O_PREPARE_DELAY,
-           O_CURVE_SECRET, O_MASTER_KEY, O_FRAMES };
+           O_CURVE_SECRET, O_MASTER_KEY, O_FRAMES, O_FILE_CACHE, O_FILE_CACHE_BYTES,
+           O_FILE_CHUNK, O_FILE_INFLIGHT, O_FILE_DELAY };
     static const struct option longopts[] = {
         {"standalone", required_argument, 0, O_STANDALONE},
         {"output", required_argument, 0, 'o'},
@@ -121,6 +132,11 @@ int main(int argc, char **argv)
         {"curve-secret", required_argument, 0, O_CURVE_SECRET},
         {"master-key", required_argument, 0, O_MASTER_KEY},
         {"frames", required_argument, 0, O_FRAMES},
+        {"file-cache", required_argument, 0, O_FILE_CACHE},
+        {"file-cache-bytes", required_argument, 0, O_FILE_CACHE_BYTES},
+        {"file-chunk", required_argument, 0, O_FILE_CHUNK},
+        {"file-inflight", required_argument, 0, O_FILE_INFLIGHT},
+        {"file-delay", required_argument, 0, O_FILE_DELAY},
         {"quiet", no_argument, 0, 'q'},
         {"verbose", no_argument, 0, 'v'},
         {"help", no_argument, 0, 'h'},
@@ -197,6 +213,40 @@ int main(int argc, char **argv)
             so.frames = optarg;
             break;
         }
+        case O_FILE_CACHE: wo.file_cache = optarg; break;
+        case O_FILE_CACHE_BYTES:
+        case O_FILE_INFLIGHT: {
+            size_t b;
+            if (!parse_bytes(optarg, &b)) {
+                fprintf(stderr, "aafarm-worker: --%s wants e.g. 400K, 4M, 2G or 0, got '%s'\n",
+                        c == O_FILE_INFLIGHT ? "file-inflight" : "file-cache-bytes", optarg);
+                return AAFARM_EXIT_USAGE;
+            }
+            if (c == O_FILE_INFLIGHT && (b < 1024 || b > (64u << 20))) {
+                fprintf(stderr, "aafarm-worker: --file-inflight wants 1K..64M (the master sends "
+                        "no more), got '%s'\n", optarg);
+                return AAFARM_EXIT_USAGE;
+            }
+            if (c == O_FILE_INFLIGHT) wo.file_inflight = b;
+            else wo.file_cache_bytes = b;
+            break;
+        }
+        case O_FILE_CHUNK: {
+            size_t b;
+            if (!parse_bytes(optarg, &b) || b < 1024 || b > (16u << 20)) {
+                fprintf(stderr, "aafarm-worker: --file-chunk wants 1K..16M, got '%s'\n", optarg);
+                return AAFARM_EXIT_USAGE;
+            }
+            wo.file_chunk = (uint32_t)b;
+            break;
+        }
+        case O_FILE_DELAY:
+            if (!parse_int(optarg, 0, 600000, &n)) {
+                fprintf(stderr, "aafarm-worker: --file-delay wants milliseconds 0..600000, got '%s'\n", optarg);
+                return AAFARM_EXIT_USAGE;
+            }
+            wo.file_delay_ms = (int)n;
+            break;
         case 'q': so.verbosity = wo.verbosity = -1; break;
         case 'v': so.verbosity = wo.verbosity = 1; break;
         case 'h': usage(stdout); return AAFARM_EXIT_OK;

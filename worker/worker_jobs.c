@@ -9,6 +9,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "file_store.h"
+
 struct worker_jobs {
     held_job **jobs;           /* newest first */
     int count, max;
@@ -29,6 +31,8 @@ void held_job_release(held_job **self_p)
     if (atomic_fetch_sub(&self->refs, 1) != 1) return;
     job_scene_destroy(&self->js);
     job_destroy(&self->jb);
+    for (int i = 0; i < self->nfile_fds; i++) file_store_release(self->file_fds[i]);
+    free(self->file_fds);
     free(self);
 }
 
@@ -87,6 +91,9 @@ static job *rebuild(const Aafarm__Job *m, char *err, size_t errsz)
                             m->sources[i]->text.len, why, sizeof why);
     for (size_t i = 0; ok && i < m->n_shaders; i++)
         ok = job_add_shader(jb, m->shaders[i]->name, m->shaders[i]->source, why, sizeof why);
+    for (size_t i = 0; ok && i < m->n_files; i++)
+        ok = job_add_file(jb, m->files[i]->name, m->files[i]->sha256, m->files[i]->size, why,
+                          sizeof why);
     if (ok) ok = job_finish(jb, why, sizeof why);
     if (!ok) {
         snprintf(err, errsz, "job %.12s... is inconsistent: %s", m->job_hash, why);
@@ -157,16 +164,48 @@ static void keep(worker_jobs *self, held_job *h)
     self->count++;
 }
 
-held_job *worker_jobs_add(worker_jobs *self, const Aafarm__Job *m)
+held_job *worker_jobs_add_broken(worker_jobs *self, const char *hash, const char *error)
 {
-    held_job *h = worker_jobs_find(self, m->job_hash);
+    held_job *h = worker_jobs_find(self, hash);
     if (h) return h;
     h = calloc(1, sizeof *h);
     if (!h) abort();
     atomic_init(&h->refs, 1);
+    snprintf(h->hash, sizeof h->hash, "%s", hash);
+    snprintf(h->error, sizeof h->error, "%s", error);
+    h->broken = true;
+    keep(self, h);
+    return h;
+}
+
+held_job *worker_jobs_add(worker_jobs *self, const Aafarm__Job *m, char *const *file_paths,
+                          const int *file_fds)
+{
+    held_job *h = worker_jobs_find(self, m->job_hash);
+    if (h) {
+        for (size_t i = 0; file_fds && i < m->n_files; i++) file_store_release(file_fds[i]);
+        return h;
+    }
+    h = calloc(1, sizeof *h);
+    if (!h) abort();
+    atomic_init(&h->refs, 1);
     snprintf(h->hash, sizeof h->hash, "%s", m->job_hash);
+    if (file_fds && m->n_files) {
+        h->nfile_fds = (int)m->n_files;
+        h->file_fds = malloc(sizeof *h->file_fds * m->n_files);
+        if (!h->file_fds) abort();
+        memcpy(h->file_fds, file_fds, sizeof *h->file_fds * m->n_files);
+    }
     size_t cache = self->cache_bytes ? self->cache_bytes : (size_t)m->options->cache_bytes;
     h->jb = rebuild(m, h->error, sizeof h->error);
+    /* the texture module opens the files through job_file_resolve */
+    for (size_t i = 0; h->jb && file_paths && i < m->n_files; i++)
+        job_file_set_path(h->jb, (int)i, file_paths[i]);
+    if (h->jb && m->n_files && !file_paths) {
+        snprintf(h->error, sizeof h->error, "job %.12s...: its files are not here",
+                 m->job_hash);
+        job_destroy(&h->jb);
+    }
     if (!h->jb || !prepare(h, m, cache)) {
         h->broken = true;
         job_scene_destroy(&h->js);

@@ -34,6 +34,9 @@ typedef struct held_job {
     image_format fmt;          /* the image the tiles belong to */
     bool broken;
     char error[1024];          /* why it is broken */
+    int *file_fds;             /* its files' "in use" descriptors (file_store.h) */
+    int nfile_fds;
+    uint64_t files_said;       /* the master session told FilesReady for it */
     atomic_int refs;
 } held_job;
 
@@ -53,8 +56,16 @@ held_job *worker_jobs_find(const worker_jobs *self, const char *hash);
 
 /* Verifies and compiles a Job. Returns the held job: ready, or broken
  * with the reason in ->error (never NULL). A job already held is
- * returned as it is. */
-held_job *worker_jobs_add(worker_jobs *self, const Aafarm__Job *msg);
+ * returned as it is. file_paths and file_fds (NULL when the Job has no
+ * files): per Job.files entry, the local copy and its open "in use"
+ * descriptor, which the held job takes over (a job already held: they
+ * are released). */
+held_job *worker_jobs_add(worker_jobs *self, const Aafarm__Job *msg,
+                          char *const *file_paths, const int *file_fds);
+
+/* Holds a job that cannot be had here (its files could not be fetched):
+ * broken, with the reason. */
+held_job *worker_jobs_add_broken(worker_jobs *self, const char *hash, const char *error);
 
 /* The hashes of the good jobs held, newest first (at most max). */
 size_t worker_jobs_hashes(const worker_jobs *self, char **out, size_t max);

@@ -6,7 +6,9 @@
  *   CONNECTING  new DEALER, connect, Hello
  *   READY       Welcome: Ask(credits = pipeline target - leases held)
  *   WORKING     Grant -> task on the pool (or NeedJob and wait for the
- *               Job); each finished tile -> Result + EXR, or Failure;
+ *               Job, and for its files: NeedFile -> FileChunk until the
+ *               host's store has them all, then FilesReady); each
+ *               finished tile -> Result + EXR, or Failure;
  *               Ask again as threads free up; Heartbeat when quiet
  *   BACKOFF     master silent for liveness x interval (or no Welcome):
  *               close, drop leases, wait 1, 2, 4 ... 32 s, reconnect
@@ -40,6 +42,7 @@
 #include <zmq.h>
 
 #include "curve_cert.h"
+#include "file_fetch.h"
 #include "util/exitcodes.h"
 #include "version.h"
 #include "wire.h"
@@ -71,6 +74,7 @@ typedef struct worker_loop {
     void *ctx, *dealer;
     worker_pool *pool;
     worker_jobs *jobs;
+    file_fetch *files;             /* jobs waiting for their files */
     proto_limits limits;
     wire_stats wstats;
     /* the current session */
@@ -89,6 +93,7 @@ typedef struct worker_loop {
     bool curve;
     curve_cert own, master;
     wire_monitor *monitor;         /* handshake failures: refused keys */
+    uint64_t file_received;        /* FileChunk bytes since the last Welcome */
     bool handshake_said;           /* a failed handshake was reported this session */
 } worker_loop;
 
@@ -167,6 +172,36 @@ static void send_need_job(worker_loop *w, const char *hash, uint64_t lease)
     Aafarm__Envelope env = AAFARM__ENVELOPE__INIT;
     env.body_case = AAFARM__ENVELOPE__BODY_NEED_JOB;
     env.need_job = &n;
+    send_env(w, &env, NULL, 0);
+}
+
+/* file_fetch's way out: one NeedFile. */
+static bool send_need_file(void *arg, const char *job_hash, const char *file_hash, uint64_t offset,
+                           uint32_t length)
+{
+    worker_loop *w = arg;
+    Aafarm__NeedFile n = AAFARM__NEED_FILE__INIT;
+    n.job_hash = (char *)job_hash;
+    n.sha256 = (char *)file_hash;
+    n.offset = offset;
+    n.length = length;
+    n.received = w->file_received;
+    Aafarm__Envelope env = AAFARM__ENVELOPE__INIT;
+    env.body_case = AAFARM__ENVELOPE__BODY_NEED_FILE;
+    env.need_file = &n;
+    return send_env(w, &env, NULL, 0) == 0;
+}
+
+static void send_files_ready(worker_loop *w, const fetch_job *j)
+{
+    Aafarm__FilesReady r = AAFARM__FILES_READY__INIT;
+    r.job_hash = (char *)j->hash;
+    r.hits = j->hits;
+    r.misses = j->misses;
+    r.fetched_bytes = j->fetched;
+    Aafarm__Envelope env = AAFARM__ENVELOPE__INIT;
+    env.body_case = AAFARM__ENVELOPE__BODY_FILES_READY;
+    env.files_ready = &r;
     send_env(w, &env, NULL, 0);
 }
 
@@ -324,6 +359,10 @@ static void on_welcome(worker_loop *w, const Aafarm__Welcome *m)
         return;
     }
     drop_all_leases(w);   /* a new registration at the master: old leases are void */
+    /* and the jobs waiting for files: the master sends the Job again with
+     * its next Grant, and the transfers resume from the chunks written */
+    file_fetch_drop(w->files, NULL);
+    w->file_received = 0;
     if (w->master_session && w->master_session != m->master_session)
         wlog(w, 0, "a new master at %s", w->opt->endpoint);
     w->master_session = m->master_session;
@@ -351,45 +390,39 @@ static void on_reject(worker_loop *w, const Aafarm__Reject *m)
 
 static void send_finished(worker_loop *w);
 
-typedef struct preparation {
-    worker_jobs *jobs;
-    const Aafarm__Job *msg;
-    int delay_ms;
-    held_job *result;
+/* Work that may take seconds (compiling a job, hashing a large file) runs
+ * on a helper thread while this one goes on heartbeating and sending
+ * finished tiles (only the helper touches the job list and the file store
+ * meanwhile; only this thread touches the socket). */
+typedef struct beside {
+    void (*fn)(void *arg);
+    void *arg;
     atomic_bool done;
-} preparation;
+} beside;
 
-static void *prepare_thread(void *arg)
+static void *beside_thread(void *arg)
 {
-    preparation *p = arg;
-    if (p->delay_ms > 0) {
-        struct timespec ts = {p->delay_ms / 1000, (long)(p->delay_ms % 1000) * 1000000L};
-        while (nanosleep(&ts, &ts) != 0 && errno == EINTR) {}
-    }
-    p->result = worker_jobs_add(p->jobs, p->msg);
-    atomic_store(&p->done, true);
+    beside *b = arg;
+    b->fn(b->arg);
+    atomic_store(&b->done, true);
     return NULL;
 }
 
-/* worker_jobs_add on a helper thread; this one heartbeats meanwhile (only
- * the helper touches w->jobs until it is done; only this thread touches
- * the socket). */
-static held_job *prepare_job(worker_loop *w, const Aafarm__Job *m)
+static void run_beside(worker_loop *w, void (*fn)(void *arg), void *arg, const char *what)
 {
-    if (worker_jobs_find(w->jobs, m->job_hash)) return worker_jobs_add(w->jobs, m);
-    preparation p = {w->jobs, m, w->opt->prepare_delay_ms, NULL, false};
+    beside b = {fn, arg, false};
     pthread_t tid;
-    if (pthread_create(&tid, NULL, prepare_thread, &p) != 0) {
-        prepare_thread(&p);   /* no thread: prepare here, without heartbeats */
-        return p.result;
+    if (pthread_create(&tid, NULL, beside_thread, &b) != 0) {
+        fn(arg);   /* no thread: here, without heartbeats */
+        return;
     }
     long step = w->heartbeat_ms / 4 < 50 ? (w->heartbeat_ms / 4 > 0 ? w->heartbeat_ms / 4 : 1) : 50;
-    while (!atomic_load(&p.done)) {
+    while (!atomic_load(&b.done)) {
         if (interrupted) {
             /* the helper cannot be stopped and holds the job list: tell the
              * master (it requeues our tiles at once) and leave without
              * tearing anything down */
-            wlog(w, 0, "interrupted while preparing job %.12s; leaving", m->job_hash);
+            wlog(w, 0, "interrupted while %s; leaving", what);
             send_shutdown(w, "the worker was stopped (SIGINT/SIGTERM) while preparing a job");
             int linger = 500;
             wire_monitor_destroy(&w->monitor);   /* its socket would hold up zmq_ctx_term */
@@ -408,15 +441,45 @@ static held_job *prepare_job(worker_loop *w, const Aafarm__Job *m)
         if (w->welcomed && now_ms() - w->last_sent_ms >= w->heartbeat_ms) send_heartbeat(w);
     }
     pthread_join(tid, NULL);
+}
+
+typedef struct preparation {
+    worker_jobs *jobs;
+    const Aafarm__Job *msg;
+    const fetch_job *files;        /* its files' paths and descriptors, or NULL */
+    int delay_ms;
+    held_job *result;
+} preparation;
+
+static void prepare(void *arg)
+{
+    preparation *p = arg;
+    if (p->delay_ms > 0) {
+        struct timespec ts = {p->delay_ms / 1000, (long)(p->delay_ms % 1000) * 1000000L};
+        while (nanosleep(&ts, &ts) != 0 && errno == EINTR) {}
+    }
+    p->result = worker_jobs_add(p->jobs, p->msg, p->files ? p->files->paths : NULL,
+                                p->files ? p->files->fds : NULL);
+}
+
+/* worker_jobs_add beside the loop. */
+static held_job *prepare_job(worker_loop *w, const Aafarm__Job *m, const fetch_job *files)
+{
+    preparation p = {w->jobs, m, files, w->opt->prepare_delay_ms, NULL};
+    if (worker_jobs_find(w->jobs, m->job_hash)) {
+        p.delay_ms = 0;
+        prepare(&p);   /* held already: nothing to compile */
+        return p.result;
+    }
+    char what[80];
+    snprintf(what, sizeof what, "preparing job %.12s", m->job_hash);
+    run_beside(w, prepare, &p, what);
     return p.result;
 }
 
-static void on_job(worker_loop *w, const Aafarm__Job *m)
+/* The grants that waited for the job (or its files) start. */
+static void start_pending(worker_loop *w, held_job *h)
 {
-    held_job *h = prepare_job(w, m);
-    if (h->broken) wlog(w, -1, "%s", h->error);
-    else wlog(w, 0, "job %.12s (%s, %dx%d) ready", h->hash, h->jb->scene_file, h->fmt.width,
-              h->fmt.height);
     for (pending_grant **at = &w->pending; *at;) {
         pending_grant *p = *at;
         if (strcmp(p->hash, h->hash) != 0) {
@@ -429,16 +492,108 @@ static void on_job(worker_loop *w, const Aafarm__Job *m)
     }
 }
 
+static void job_ready(worker_loop *w, held_job *h)
+{
+    if (h->broken) wlog(w, -1, "%s", h->error);
+    else wlog(w, 0, "job %.12s (%s, %dx%d) ready", h->hash, h->jb->scene_file, h->fmt.width,
+              h->fmt.height);
+    /* where the texture module will open each file (through the resolver) */
+    for (int i = 0; !h->broken && w->opt->verbosity > 0 && i < h->jb->nfiles; i++) {
+        char path[4096], why[600];
+        if (job_file_resolve(h->jb, h->jb->files[i].name, path, sizeof path, why, sizeof why))
+            wlog(w, 1, "file '%s' resolves to %s", h->jb->files[i].name, path);
+        else
+            wlog(w, 1, "file '%s' does not resolve: %s", h->jb->files[i].name, why);
+    }
+    start_pending(w, h);
+}
+
+/* Jobs whose files are all here now: compiled, announced, started. */
+static void take_ready_jobs(worker_loop *w)
+{
+    fetch_job *j;
+    while ((j = file_fetch_take_ready(w->files))) {
+        held_job *h;
+        Aafarm__Job *m = j->error[0] ? NULL
+                                     : aafarm__job__unpack(NULL, j->packed_len, j->packed);
+        if (!m) {
+            h = worker_jobs_add_broken(w->jobs, j->hash, j->error[0] ? j->error
+                                       : "its Job message cannot be read back");
+        } else {
+            if (j->misses)
+                wlog(w, 0, "job %.12s: its files are here (%d in all, %u fetched, %llu bytes "
+                     "received)", j->hash, j->nfiles, j->misses, (unsigned long long)j->fetched);
+            h = prepare_job(w, m, j);
+            for (int i = 0; i < j->nfiles; i++) j->fds[i] = -1;   /* the held job has them */
+            aafarm__job__free_unpacked(m, NULL);
+            send_files_ready(w, j);
+            h->files_said = w->master_session;
+        }
+        fetch_job_destroy(&j);
+        job_ready(w, h);
+    }
+}
+
+typedef struct file_call {
+    file_fetch *files;
+    const Aafarm__Job *msg;        /* add this Job; NULL: poll */
+} file_call;
+
+static void file_work(void *arg)
+{
+    file_call *c = arg;
+    if (c->msg) file_fetch_add(c->files, c->msg, now_ms());
+    else file_fetch_poll(c->files, now_ms());
+}
+
+/* The file work that may hash whole files, beside the loop. */
+static void poll_files(worker_loop *w)
+{
+    if (!file_fetch_poll_due(w->files, now_ms())) return;
+    file_call c = {w->files, NULL};
+    run_beside(w, file_work, &c, "checking job files");
+}
+
+static void on_job(worker_loop *w, const Aafarm__Job *m)
+{
+    if (m->n_files == 0 || worker_jobs_find(w->jobs, m->job_hash)) {
+        job_ready(w, prepare_job(w, m, NULL));
+        return;
+    }
+    file_call c = {w->files, m};
+    run_beside(w, file_work, &c, "looking up job files");
+    take_ready_jobs(w);   /* all in the store already: at once */
+}
+
+static void on_file_chunk(worker_loop *w, const Aafarm__FileChunk *c, const wire_msg *m)
+{
+    size_t len = 0;
+    const uint8_t *data = wire_msg_bulk(m, &len);
+    w->file_received += len;
+    uint64_t n = file_fetch_chunk(w->files, c, data, len, now_ms());
+    wlog(w, 1, "file %.12s: bytes %llu..+%zu %s", c->sha256, (unsigned long long)c->offset, len,
+         n ? "written" : "not wanted (dropped)");
+    poll_files(w);   /* the last chunk: the file is checked and stored */
+    take_ready_jobs(w);
+}
+
 static void on_grant(worker_loop *w, const Aafarm__Grant *g)
 {
     if (w->asked) w->asked--;
     image_rect rect = {(int)g->tile->x, (int)g->tile->y, (int)g->tile->width, (int)g->tile->height};
     held_job *h = worker_jobs_find(w->jobs, g->job_hash);
     if (h) {
+        if (!h->broken && h->jb->nfiles > 0 && h->files_said != w->master_session) {
+            /* held from an earlier session: every file is here */
+            fetch_job said = {.nfiles = h->jb->nfiles, .hits = (uint32_t)h->jb->nfiles};
+            snprintf(said.hash, sizeof said.hash, "%s", h->hash);
+            send_files_ready(w, &said);
+            h->files_said = w->master_session;
+        }
         start_tile(w, h, g->lease_id, g->tile_index, rect);
         return;
     }
-    bool asked_already = false;
+    bool asked_already = file_fetch_waiting(w->files, g->job_hash);   /* files on the way */
     for (pending_grant *p = w->pending; p; p = p->next)
         if (strcmp(p->hash, g->job_hash) == 0) asked_already = true;
     pending_grant *p = calloc(1, sizeof *p);
@@ -453,6 +608,7 @@ static void on_job_done(worker_loop *w, const Aafarm__JobDone *d)
 {
     worker_pool_cancel(w->pool, d->job_hash);
     drop_pending(w, d->job_hash);
+    file_fetch_drop(w->files, d->job_hash);   /* chunks written stay in the store */
     const char *how = d->status == AAFARM__JOB_STATUS__JOB_STATUS_DONE     ? "done"
                       : d->status == AAFARM__JOB_STATUS__JOB_STATUS_FAILED ? "failed"
                                                                             : "cancelled";
@@ -473,6 +629,7 @@ static void handle(worker_loop *w, const wire_msg *m)
     case AAFARM__ENVELOPE__BODY_JOB: on_job(w, env->job); break;
     case AAFARM__ENVELOPE__BODY_GRANT: on_grant(w, env->grant); break;
     case AAFARM__ENVELOPE__BODY_JOB_DONE: on_job_done(w, env->job_done); break;
+    case AAFARM__ENVELOPE__BODY_FILE_CHUNK: on_file_chunk(w, env->file_chunk, m); break;
     case AAFARM__ENVELOPE__BODY_SHUTDOWN:
         wlog(w, 0, "the master says shut down%s%s",
              env->shutdown->reason && *env->shutdown->reason ? ": " : "",
@@ -606,6 +763,11 @@ static session_end session(worker_loop *w)
             break;
         }
         read_master(w);
+        if (w->welcomed) {
+            poll_files(w);
+            file_fetch_pump(w->files, now_ms(), send_need_file, w);
+            take_ready_jobs(w);
+        }
         send_finished(w);
         ask_for_more(w);
         check_handshakes(w);
@@ -696,6 +858,9 @@ int worker_loop_run(const worker_loop_options *opt)
     w.ctx = zmq_ctx_new();
     w.pool = worker_pool_new(w.threads, opt->tile_delay_ms);
     w.jobs = worker_jobs_new(MAX_JOBS_HELD, opt->cache_bytes);
+    file_fetch_options fo = {opt->file_cache, opt->file_cache_bytes, opt->file_chunk,
+                             opt->file_inflight, opt->file_delay_ms};
+    w.files = file_fetch_new(&fo);
     int rc = AAFARM_EXIT_FAILURE;
     if (!w.ctx || !w.pool) {
         wlog(&w, -1, "cannot start: %s", strerror(errno));
@@ -707,6 +872,7 @@ int worker_loop_run(const worker_loop_options *opt)
     worker_pool_destroy(&w.pool);   /* before the jobs: threads hold references */
     free_outbox(&w);
     drop_pending(&w, NULL);
+    file_fetch_destroy(&w.files);
     worker_jobs_destroy(&w.jobs);
     if (w.ctx) zmq_ctx_term(w.ctx);
     memset(&w.own, 0, sizeof w.own);

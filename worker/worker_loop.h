@@ -4,7 +4,8 @@
  *
  * Long-lived: connects a DEALER to the master, says Hello, asks for
  * tiles, renders them on a pool of threads (worker_pool.h) with the jobs
- * it holds compiled (worker_jobs.h), sends the tiles back as EXR, and
+ * it holds compiled (worker_jobs.h) once their files are in the host's
+ * store (file_fetch.h), sends the tiles back as EXR, and
  * heartbeats meanwhile. When the master goes silent it reconnects with
  * exponential backoff (1 s, 2 s, ... 32 s) and serves the next master.
  * With a CURVE key pair and the master's public key every byte is
@@ -16,6 +17,7 @@
 #define WORKER_LOOP_H
 
 #include <stddef.h>
+#include <stdint.h>
 
 typedef struct worker_loop_options {
     const char *endpoint;          /* e.g. tcp://render1:5555 */
@@ -27,6 +29,12 @@ typedef struct worker_loop_options {
     int prepare_delay_ms;          /* testing aid: sleep before compiling a Job */
     const char *curve_secret;      /* CURVE: this worker's NAME.key_secret, or NULL */
     const char *master_key;        /* CURVE: the master's NAME.key */
+    /* job files (file_fetch.h, docs/textures.md) */
+    const char *file_cache;        /* the host's store; NULL: the default folder */
+    uint64_t file_cache_bytes;     /* its byte budget (0: unlimited) */
+    uint32_t file_chunk;           /* bytes per NeedFile (0: 1 MiB) */
+    uint64_t file_inflight;        /* bytes asked and not received (0: 8 MiB) */
+    int file_delay_ms;             /* testing aid: at least this between NeedFiles */
 } worker_loop_options;
 
 /* Serves masters until told to stop. Returns an AAFARM_EXIT_* code:

@@ -70,6 +70,11 @@ void job_destroy(job **self_p)
     free(self->shaders);
     free(self->frame_numbers);
     free(self->display_name);
+    for (int i = 0; i < self->nfiles; i++) {
+        free(self->files[i].name);
+        free(self->files[i].path);
+    }
+    free(self->files);
     free(self);
     *self_p = NULL;
 }
@@ -114,6 +119,77 @@ bool job_add_shader(job *self, const char *name, const char *file,
     return true;
 }
 
+job_file *job_file_find(const job *self, const char *name)
+{
+    for (int i = 0; i < self->nfiles; i++)
+        if (strcmp(self->files[i].name, name) == 0) return &self->files[i];
+    return NULL;
+}
+
+bool job_add_file(job *self, const char *name, const char *hex, uint64_t size,
+                  char *why, int why_size)
+{
+    if (!*name) {
+        snprintf(why, (size_t)why_size, "a file entry with an empty name");
+        return false;
+    }
+    if (!hash_hex_valid(hex)) {
+        snprintf(why, (size_t)why_size, "file '%s': its SHA-256 is not 64 lowercase hex digits",
+                 name);
+        return false;
+    }
+    if (job_file_find(self, name)) {
+        snprintf(why, (size_t)why_size, "file '%s' listed twice", name);
+        return false;
+    }
+    self->files = realloc(self->files, sizeof(job_file) * (size_t)(self->nfiles + 1));
+    if (!self->files) abort();
+    job_file *f = &self->files[self->nfiles++];
+    memset(f, 0, sizeof *f);
+    f->name = dup_s(name);
+    snprintf(f->sha256, sizeof f->sha256, "%s", hex);
+    f->size = size;
+    return true;
+}
+
+void job_file_set_path(job *self, int i, const char *path)
+{
+    free(self->files[i].path);
+    self->files[i].path = path ? dup_s(path) : NULL;
+}
+
+uint64_t job_files_bytes(const job *self)
+{
+    uint64_t n = 0;
+    for (int i = 0; i < self->nfiles; i++) n += self->files[i].size;
+    return n;
+}
+
+bool job_file_resolve(void *jb, const char *name, char *path, size_t path_size, char *why,
+                      int why_size)
+{
+    const job *self = jb;
+    const job_file *f = self ? job_file_find(self, name) : NULL;
+    if (!f) {
+        snprintf(why, (size_t)why_size, "'%s' is not one of the job's files (none of that name "
+                 "was found on the texture search path when the job was loaded: add its folder "
+                 "with Option \"searchpath\" \"texture\" [\"dir:&\"])", name);
+        return false;
+    }
+    if (!f->path) {
+        snprintf(why, (size_t)why_size, "file '%s' (%.12s...) is not present on this host yet",
+                 name, f->sha256);
+        return false;
+    }
+    if (strlen(f->path) >= path_size) {
+        snprintf(why, (size_t)why_size, "the path of file '%s' is longer than %zu bytes", name,
+                 path_size - 1);
+        return false;
+    }
+    memcpy(path, f->path, strlen(f->path) + 1);
+    return true;
+}
+
 bool job_finish(job *self, char *why, int why_size)
 {
     for (int i = 0; i < self->nshaders; i++)
@@ -128,8 +204,12 @@ bool job_finish(job *self, char *why, int why_size)
     }
     size_t nsrc = sl_source_set_count(self->sources);
     hash_shader *hs = calloc(nsrc + 1, sizeof *hs);
-    int nopt = 3 + self->nshaders + (self->options.frame != 0);
+    int nopt = 3 + self->nshaders + self->nfiles + (self->options.frame != 0);
     hash_option *ho = calloc((size_t)nopt, sizeof *ho);
+    /* a file enters the hash as option "file:<name>" = "<sha256>:<size>" */
+    char **file_keys = calloc((size_t)self->nfiles + 1, sizeof *file_keys);
+    char (*file_vals)[HASH_HEX_SIZE + 24] = calloc((size_t)self->nfiles + 1, sizeof *file_vals);
+    if (!file_keys || !file_vals) abort();
     char (*keys)[160] = calloc((size_t)nopt, sizeof *keys);
     char (*vals)[600] = calloc((size_t)nopt, sizeof *vals);
     if (!hs || !ho || !keys || !vals) abort();
@@ -147,14 +227,27 @@ bool job_finish(job *self, char *why, int why_size)
         snprintf(keys[3 + i], sizeof keys[0], "shader:%s", self->shaders[i].name);
         snprintf(vals[3 + i], sizeof vals[0], "%s", self->shaders[i].file);
     }
+    for (int i = 0; i < 3 + self->nshaders; i++) ho[i] = (hash_option){keys[i], vals[i]};
+    for (int i = 0; i < self->nfiles; i++) {
+        size_t n = strlen(self->files[i].name) + 6;
+        file_keys[i] = malloc(n);
+        if (!file_keys[i]) abort();
+        snprintf(file_keys[i], n, "file:%s", self->files[i].name);
+        snprintf(file_vals[i], sizeof file_vals[i], "%s:%llu", self->files[i].sha256,
+                 (unsigned long long)self->files[i].size);
+        ho[3 + self->nshaders + i] = (hash_option){file_keys[i], file_vals[i]};
+    }
     if (self->options.frame != 0) {   /* absent for frame 0: older hashes stay */
         snprintf(keys[nopt - 1], sizeof keys[0], "frame");
         snprintf(vals[nopt - 1], sizeof vals[0], "%d", self->options.frame);
+        ho[nopt - 1] = (hash_option){keys[nopt - 1], vals[nopt - 1]};
     }
-    for (int i = 0; i < nopt; i++) ho[i] = (hash_option){keys[i], vals[i]};
     hash_job_input in = {self->scene_file, self->scene_text, self->scene_len,
                          hs, nsrc, ho, (size_t)nopt};
     int rc = hash_job(&in, self->hash);
+    for (int i = 0; i < self->nfiles; i++) free(file_keys[i]);
+    free(file_keys);
+    free(file_vals);
     free(hs);
     free(ho);
     free(keys);
@@ -265,7 +358,7 @@ job *job_load(const char *rib_path, const job_options *options, sl_diag *diag)
         sl_source_set_set_loader(self->sources, sl_source_load_from_disk, NULL);
         job_scene *js = job_scene_new(self, 0, false, diag);
         sl_source_set_set_loader(self->sources, NULL, NULL);
-        ok = js != NULL;
+        ok = js != NULL && job_collect_files(self, js, diag);
         if (ok) {
             self->xres = js->world.camera.xres;
             self->yres = js->world.camera.yres;

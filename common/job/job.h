@@ -12,6 +12,14 @@
  *   job_scene_new  parse + compile + build the renderer's world: what a
  *                  worker renders tiles with (job_scene.h)
  *
+ * Files (textures): a job names the data files its shaders read (name,
+ * SHA-256, size), not their bytes. job_load finds them (job_files.c); the
+ * master ships them to each host once, a worker keeps them in its
+ * content-addressed store (docs/textures.md, "The wire and the cache").
+ * The hashes are part of the job hash, so a file changed on the master's
+ * disk makes a new job and a stale copy is never used. job_file_resolve
+ * turns a name into the local path (the texture module's resolver).
+ *
  * Options that change pixels (arithmetic, shader budget, tile size: the
  * tile grid of the output file) are part of the job and of its hash; per
  * worker settings (threads, cache budget) are not: they change speed only.
@@ -21,6 +29,7 @@
 
 #include <stdbool.h>
 #include <stddef.h>
+#include <stdint.h>
 
 #include "sl/diag.h"
 #include "sl/source.h"
@@ -43,6 +52,20 @@ typedef struct job_shader {
     char *file;                    /* its main source in job.sources */
 } job_shader;
 
+typedef struct job_file {
+    char *name;                    /* as the shader or the RIB writes it: "height.exr" */
+    char sha256[HASH_HEX_SIZE];    /* of its content (64 hex digits) */
+    uint64_t size;                 /* bytes */
+    char *path;                    /* the local copy: on the master's disk, or in a
+                                      worker's store; NULL while not present */
+    /* job_load: what stat said of `path` when its bytes were hashed (device,
+     * inode, size, mtime in ns); the master re-hashes a file it serves only
+     * when that changed. stamped false elsewhere. */
+    bool stamped;
+    uint64_t dev, ino;
+    int64_t mtime_ns;
+} job_file;
+
 typedef struct job {
     char *scene_file;              /* name of the RIB (for messages) */
     char *scene_text;
@@ -51,6 +74,8 @@ typedef struct job {
     job_shader *shaders;
     int nshaders;
     job_options options;
+    job_file *files;               /* the data files its shaders read, by name */
+    int nfiles;
     char hash[HASH_HEX_SIZE];      /* set by job_finish / job_load */
     /* set by job_load from the scene, for naming outputs (not hashed) */
     int frame_number;              /* the frame's FrameBegin number (1 without) */
@@ -75,6 +100,32 @@ bool job_add_source(job *self, const char *name, const char *text, size_t len,
                     char *why, int why_size);
 bool job_add_shader(job *self, const char *name, const char *file,
                     char *why, int why_size);
+/* Adds a file (name, SHA-256 as 64 lowercase hex digits, size) without a
+ * local path. False on an empty or duplicate name or a bad hash. */
+bool job_add_file(job *self, const char *name, const char *hex, uint64_t size,
+                  char *why, int why_size);
+/* The file named `name`, or NULL. */
+job_file *job_file_find(const job *self, const char *name);
+/* Sets (a copy of) the local path of file i (NULL: not present). */
+void job_file_set_path(job *self, int i, const char *path);
+/* Sum of the files' sizes. */
+uint64_t job_files_bytes(const job *self);
+
+/* The resolver the texture module opens files through: true and the local
+ * path of the job's file `name` in path[0..path_size), or false and why
+ * (not one of the job's files, not present here, the path too long).
+ * `job` is a const job *. */
+bool job_file_resolve(void *job, const char *name, char *path, size_t path_size, char *why,
+                      int why_size);
+
+/* Collects the job's files (job_files.c): every string constant of the
+ * compiled programs and every string parameter of the scene's shader calls
+ * that names a regular file on the scene's texture search path is hashed
+ * and added with its path on disk. False (errors in diag) when such a file
+ * cannot be read. */
+struct job_scene;
+bool job_collect_files(job *self, const struct job_scene *js, sl_diag *diag);
+
 /* Computes the hash; false if the job is inconsistent (why says so). */
 bool job_finish(job *self, char *why, int why_size);
 void job_destroy(job **self_p);

@@ -232,7 +232,7 @@ void rib_exposure(rib_parser *p, const rib_request *req)
 }
 
 /* ---------------------------------------------------------------------- */
-/* Option "searchpath" "shader" / "archive" ["dir:dir:&"]                  */
+/* Option "searchpath" "shader" / "archive" / "texture" ["dir:dir:&"]      */
 /* ---------------------------------------------------------------------- */
 
 static void path_push(char ***list, int *n, const char *s, size_t len)
@@ -281,6 +281,9 @@ void rib_option(rib_parser *p, const rib_request *req)
     const scene_param *archive = rib_params_find(&params, "archive");
     if (archive && archive->string)
         set_path(&p->archive_path, &p->narchive_path, archive->string);
+    const scene_param *texture = rib_params_find(&params, "texture");
+    if (texture && texture->string)
+        set_path(&p->texture_path, &p->ntexture_path, texture->string);
     rib_params_free(&params);
 }
 

@@ -558,43 +558,48 @@ static char *rib_folder(const char *file)
     return sl_xstrndup(file, (size_t)(slash - file));
 }
 
-static void add_path(scene *s, char *dir)
+static void add_path(char ***path, int *npath, char *dir)
 {
-    for (int i = 0; i < s->nsearch_path; i++)
-        if (strcmp(s->search_path[i], dir) == 0) {
+    for (int i = 0; i < *npath; i++)
+        if (strcmp((*path)[i], dir) == 0) {
             free(dir);
             return;
         }
-    s->search_path = sl_xrealloc(s->search_path,
-                                 (size_t)(s->nsearch_path + 2) * sizeof *s->search_path);
-    s->search_path[s->nsearch_path++] = dir;
-    s->search_path[s->nsearch_path] = NULL;
+    *path = sl_xrealloc(*path, (size_t)(*npath + 2) * sizeof **path);
+    (*path)[(*npath)++] = dir;
+    (*path)[*npath] = NULL;
 }
 
 /* The Option dirs (relative ones are relative to the RIB's folder), then
- * the RIB's folder itself. */
-static void finish_search_path(rib_parser *p)
+ * the RIB's folder itself: the shader path, and the same way the texture
+ * path. */
+static void finish_one_path(const char *folder, char **dirs, int ndirs, char ***path,
+                            int *npath)
 {
-    scene *s = p->scene;
-    char *folder = rib_folder(s->file);
-    for (int i = 0; i < p->nshader_path; i++) {
-        const char *dir = p->shader_path[i];
+    for (int i = 0; i < ndirs; i++) {
+        const char *dir = dirs[i];
         if (dir[0] == '/' || strcmp(folder, ".") == 0) {
-            add_path(s, sl_source_normalize(dir));
+            add_path(path, npath, sl_source_normalize(dir));
             continue;
         }
         size_t n = strlen(folder) + strlen(dir) + 2;
         char *joined = sl_xrealloc(NULL, n);
         snprintf(joined, n, "%s/%s", folder, dir);
-        add_path(s, sl_source_normalize(joined));
+        add_path(path, npath, sl_source_normalize(joined));
         free(joined);
     }
-    add_path(s, sl_source_normalize(folder));
+    add_path(path, npath, sl_source_normalize(folder));
+}
+
+static void finish_search_path(rib_parser *p)
+{
+    scene *s = p->scene;
+    char *folder = rib_folder(s->file);
+    finish_one_path(folder, p->shader_path, p->nshader_path, &s->search_path,
+                    &s->nsearch_path);
+    finish_one_path(folder, p->texture_path, p->ntexture_path, &s->texture_path,
+                    &s->ntexture_path);
     free(folder);
-    if (!s->search_path) {
-        s->search_path = sl_xrealloc(NULL, sizeof *s->search_path);
-        s->search_path[0] = NULL;
-    }
 }
 
 static void add_shader_name(scene *s, const char *name)
@@ -689,6 +694,9 @@ static void parser_free(rib_parser *p)
     for (int i = 0; i < p->narchive_path; i++)
         free(p->archive_path[i]);
     free(p->archive_path);
+    for (int i = 0; i < p->ntexture_path; i++)
+        free(p->texture_path[i]);
+    free(p->texture_path);
     rib_object_defs_free(p);
     rib_decls_destroy(&p->decls);
     rib_reader_destroy(&p->reader);

@@ -120,6 +120,8 @@ typedef struct rib_parser {
     int nshader_path;
     char **archive_path;           /* Option "searchpath" "archive" dirs */
     int narchive_path;
+    char **texture_path;           /* Option "searchpath" "texture" dirs */
+    int ntexture_path;
     sl_source_set *archives;       /* where archive texts come from */
     sl_source_set *diag_sources;   /* diag's set: archives added for carets */
     rib_archive_link archive_chain[SCENE_ARCHIVE_MAX_DEPTH];

@@ -196,6 +196,10 @@ typedef struct scene {
     int nspaces;
     char **search_path;            /* NULL-terminated directories */
     int nsearch_path;
+    char **texture_path;           /* Option "searchpath" "texture" dirs, then
+                                      the RIB's folder (NULL-terminated): where
+                                      the files a shader names are found */
+    int ntexture_path;
     char **shader_names;           /* distinct shaders the objects and lights use */
     int nshader_names;
     char **archives;               /* ReadArchive files read (normalized), in

@@ -16,13 +16,15 @@
 #include "samples.h"
 #include "version.h"
 
-const proto_kind sample_kinds[12] = {
+const proto_kind sample_kinds[SAMPLE_KINDS] = {
     AAFARM__ENVELOPE__BODY_HELLO,    AAFARM__ENVELOPE__BODY_WELCOME,
     AAFARM__ENVELOPE__BODY_REJECT,   AAFARM__ENVELOPE__BODY_ASK,
     AAFARM__ENVELOPE__BODY_JOB,      AAFARM__ENVELOPE__BODY_NEED_JOB,
     AAFARM__ENVELOPE__BODY_GRANT,    AAFARM__ENVELOPE__BODY_RESULT,
     AAFARM__ENVELOPE__BODY_FAILURE,  AAFARM__ENVELOPE__BODY_HEARTBEAT,
     AAFARM__ENVELOPE__BODY_JOB_DONE, AAFARM__ENVELOPE__BODY_SHUTDOWN,
+    AAFARM__ENVELOPE__BODY_NEED_FILE, AAFARM__ENVELOPE__BODY_FILE_CHUNK,
+    AAFARM__ENVELOPE__BODY_FILES_READY,
 };
 
 static const char scene_text[] =
@@ -106,7 +108,67 @@ static void make_job(sample *s)
     sha256_digest(scene_text, strlen(scene_text), digest);
     hash_hex(digest, s->job_hash);
     s->job.job_hash = s->job_hash;
+    /* two files, by name and content hash */
+    sha256_digest(wave_sl, strlen(wave_sl), digest);
+    hash_hex(digest, s->file_hash);
+    for (int i = 0; i < 2; i++) {
+        Aafarm__FileRef f = AAFARM__FILE_REF__INIT;
+        s->file_ref[i] = f;
+        s->file_ref[i].sha256 = s->file_hash;
+        s->file_ref[i].size = 1u << 20;
+        s->file_refs[i] = &s->file_ref[i];
+    }
+    s->file_ref[0].name = "maps/height.exr";
+    s->file_ref[1].name = "height copy.exr";
+    s->job.n_files = 2;
+    s->job.files = s->file_refs;
     s->env.job = &s->job;
+}
+
+static void fill_bulk(sample *s)
+{
+    uint32_t x = 2463534242u; /* xorshift32: bytes that compress badly */
+    s->bulk_len = sizeof s->bulk;
+    for (size_t i = 0; i < s->bulk_len; i++) {
+        x ^= x << 13;
+        x ^= x >> 17;
+        x ^= x << 5;
+        s->bulk[i] = (uint8_t)x;
+    }
+}
+
+static void make_need_file(sample *s)
+{
+    Aafarm__NeedFile m = AAFARM__NEED_FILE__INIT;
+    s->need_file = m;
+    s->need_file.job_hash = s->job_hash;
+    s->need_file.sha256 = s->file_hash;
+    s->need_file.offset = 3000;
+    s->need_file.length = 3000;
+    s->env.need_file = &s->need_file;
+}
+
+static void make_file_chunk(sample *s)
+{
+    Aafarm__FileChunk m = AAFARM__FILE_CHUNK__INIT;
+    s->file_chunk = m;
+    fill_bulk(s);
+    s->file_chunk.sha256 = s->file_hash;
+    s->file_chunk.offset = 3000;
+    s->file_chunk.file_size = 1u << 20;
+    s->file_chunk.length = s->bulk_len;
+    s->env.file_chunk = &s->file_chunk;
+}
+
+static void make_files_ready(sample *s)
+{
+    Aafarm__FilesReady m = AAFARM__FILES_READY__INIT;
+    s->files_ready = m;
+    s->files_ready.job_hash = s->job_hash;
+    s->files_ready.hits = 1;
+    s->files_ready.misses = 1;
+    s->files_ready.fetched_bytes = 1u << 20;
+    s->env.files_ready = &s->files_ready;
 }
 
 static void make_hello(sample *s)
@@ -278,6 +340,9 @@ void sample_make(sample *s, proto_kind kind)
     case AAFARM__ENVELOPE__BODY_HEARTBEAT: make_heartbeat(s); break;
     case AAFARM__ENVELOPE__BODY_JOB_DONE: make_job_done(s); break;
     case AAFARM__ENVELOPE__BODY_SHUTDOWN: make_shutdown(s); break;
+    case AAFARM__ENVELOPE__BODY_NEED_FILE: make_need_file(s); break;
+    case AAFARM__ENVELOPE__BODY_FILE_CHUNK: make_file_chunk(s); break;
+    case AAFARM__ENVELOPE__BODY_FILES_READY: make_files_ready(s); break;
     default: fail_msg("sample_make: kind %d", (int)kind);
     }
 }

@@ -44,18 +44,25 @@ typedef struct sample {
     uint64_t leases[3];
     Aafarm__JobDone job_done;
     Aafarm__Shutdown shutdown;
+    Aafarm__FileRef file_ref[2];
+    Aafarm__FileRef *file_refs[2];
+    Aafarm__NeedFile need_file;
+    Aafarm__FileChunk file_chunk;
+    Aafarm__FilesReady files_ready;
     char job_hash[HASH_HEX_SIZE];
-    uint8_t bulk[3000];  /* the Result's bulk frame (pseudo-random bytes) */
+    char file_hash[HASH_HEX_SIZE];
+    uint8_t bulk[3000];  /* the Result's / FileChunk's bulk frame (pseudo-random bytes) */
     size_t bulk_len;     /* 0 for every other kind */
 } sample;
 
-/* All twelve kinds, in schema order. */
-extern const proto_kind sample_kinds[12];
+/* All fifteen kinds, in schema order. */
+enum { SAMPLE_KINDS = 15 };
+extern const proto_kind sample_kinds[SAMPLE_KINDS];
 
 /* Fills s with a valid message of the kind (passes proto_message_check). */
 void sample_make(sample *s, proto_kind kind);
 
-/* The bulk pointer to send with s (NULL unless a Result). */
+/* The bulk pointer to send with s (NULL unless a Result or a FileChunk). */
 const void *sample_bulk(const sample *s);
 
 /* s packed with protobuf-c; *len receives the size. free() the result. */

@@ -38,7 +38,7 @@ static void test_valid_samples(void **state)
 {
     (void)state;
     sample *s = malloc(sizeof *s);
-    for (size_t k = 0; k < 12; k++) {
+    for (size_t k = 0; k < SAMPLE_KINDS; k++) {
         sample_make(s, sample_kinds[k]);
         if (check(s, NULL) != 0)
             fail_msg("%s: %s", proto_message_name(sample_kinds[k]), err);
@@ -118,6 +118,13 @@ static void mutate(sample *s, int id)
     case 46: s->job.shaders[1] = NULL; break;
     case 47: s->binding[0].source = ""; break;
     case 45: s->hello.worker_name = NULL; break;
+    case 48: s->file_ref[1].name = "maps/height.exr"; break;
+    case 49: s->file_ref[0].sha256 = "not a hash"; break;
+    case 50: s->need_file.length = 0; break;
+    case 51: s->need_file.length = (16u << 20) + 1; break;
+    case 52: s->file_chunk.length = 10; break;
+    case 53: s->file_chunk.offset = (1u << 20) - 100; break;
+    case 54: s->files_ready.job_hash = ""; break;
     default: fail_msg("mutate: no case %d", id);
     }
 }
@@ -173,6 +180,13 @@ static const bad_case bad_cases[] = {
     {K(ASK), 42, "Ask: missing"},
     {K(ASK), 43, "Envelope: unknown message kind 99"},
     {K(HELLO), 45, "Hello.worker_name: missing (must not be empty)"},
+    {K(JOB), 48, "Job.files.name: \"maps/height.exr\" appears twice"},
+    {K(JOB), 49, "Job.files.sha256: not a job hash (64 lowercase hex digits, got 10 bytes)"},
+    {K(NEED_FILE), 50, "NeedFile.length: 0 is outside 1..16777216"},
+    {K(NEED_FILE), 51, "NeedFile.length: 16777217 is outside 1..16777216"},
+    {K(FILE_CHUNK), 52, "FileChunk.length: says 10 but the bulk frame has 3000 bytes"},
+    {K(FILE_CHUNK), 53, "FileChunk: bytes 1048476..1051476 lie outside the file of 1048576 bytes"},
+    {K(FILES_READY), 54, "FilesReady.job_hash: missing (a job hash is 64 lowercase hex digits)"},
 };
 #undef K
 

@@ -177,7 +177,7 @@ static void test_flipped_bits(void **state)
     pair_open(&p, "inproc", NULL);
     sample *s = malloc(sizeof *s);
     size_t sent = 0;
-    for (size_t k = 0; k < 12; k++) {
+    for (size_t k = 0; k < SAMPLE_KINDS; k++) {
         sample_make(s, sample_kinds[k]);
         if (!proto_message_from_worker(s->env.body_case))
             continue;

@@ -1,0 +1,160 @@
+/*
+ * job_files.c: the data files a job needs (textures, height maps), found
+ * generically on the master's / standalone side (see job.h,
+ * job_collect_files; docs/textures.md, "The wire and the cache").
+ *
+ * A shader names a file by a string: a constant in its code
+ * (texture("height.exr", s, t)) or a string parameter set in the RIB
+ * (Displacement "heightmap" "string texname" "rock.exr"). Every such
+ * string that names an existing regular file on the scene's texture
+ * search path (Option "searchpath" "texture", then the RIB's folder) is a
+ * file of the job: its bytes are hashed (SHA-256, FIPS 180-4) here, once,
+ * and the job carries the name, hash and size. Strings that name no file
+ * ("rgb", "current") are not files; a false match costs one transfer of a
+ * file the shader never reads, never a wrong pixel.
+ */
+#include "job/job.h"
+
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "job/job_scene.h"
+#include "sl/bytecode.h"
+
+enum { MAX_JOB_FILES = 4096, MAX_NAME = 4096 };
+
+static int64_t mtime_ns(const struct stat *st)
+{
+    return (int64_t)st->st_mtim.tv_sec * 1000000000 + st->st_mtim.tv_nsec;
+}
+
+/* Hashes the file at path and stamps it (stat before and after: a file
+ * written meanwhile is an error); false (the reason in why) otherwise. */
+static bool hash_file(const char *path, char hex[HASH_HEX_SIZE], uint64_t *size,
+                      struct stat *stamp, char *why, size_t why_size)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f) {
+        snprintf(why, why_size, "%s", strerror(errno));
+        return false;
+    }
+    struct stat after;
+    if (fstat(fileno(f), stamp) != 0) {
+        snprintf(why, why_size, "%s", strerror(errno));
+        fclose(f);
+        return false;
+    }
+    enum { CHUNK = 1 << 20 };
+    unsigned char *buf = malloc(CHUNK);
+    if (!buf) abort();
+    sha256 h;
+    sha256_init(&h);
+    uint64_t n = 0;
+    size_t got;
+    while ((got = fread(buf, 1, CHUNK, f)) > 0) {
+        sha256_update(&h, buf, got);
+        n += got;
+    }
+    bool bad = ferror(f) != 0;
+    int e = errno;
+    bool moved = fstat(fileno(f), &after) != 0 || mtime_ns(&after) != mtime_ns(stamp) ||
+                 after.st_size != stamp->st_size || (uint64_t)after.st_size != n;
+    free(buf);
+    fclose(f);
+    if (bad) {
+        snprintf(why, why_size, "read error: %s", strerror(e));
+        return false;
+    }
+    if (moved) {
+        snprintf(why, why_size, "it changed while it was read; load the scene again when it "
+                 "is written");
+        return false;
+    }
+    uint8_t digest[SHA256_DIGEST_SIZE];
+    sha256_final(&h, digest);
+    hash_hex(digest, hex);
+    *size = n;
+    return true;
+}
+
+/* The first "<dir>/<name>" on the texture path that is a regular file
+ * (an absolute name: itself), malloc'd, or NULL. */
+static char *find_on_path(const scene *sc, const char *name)
+{
+    struct stat st;
+    if (name[0] == '/') {
+        if (stat(name, &st) == 0 && S_ISREG(st.st_mode)) return strdup(name);
+        return NULL;
+    }
+    for (int i = 0; i < sc->ntexture_path; i++) {
+        const char *dir = sc->texture_path[i];
+        size_t n = strlen(dir) + strlen(name) + 2;
+        char *path = malloc(n);
+        if (!path) abort();
+        if (strcmp(dir, ".") == 0) snprintf(path, n, "%s", name);
+        else snprintf(path, n, "%s%s%s", dir, dir[strlen(dir) - 1] == '/' ? "" : "/", name);
+        if (stat(path, &st) == 0 && S_ISREG(st.st_mode)) return path;
+        free(path);
+    }
+    return NULL;
+}
+
+/* One candidate string: a file of the job when it names one. */
+static bool consider(job *self, const scene *sc, const char *name, sl_pos pos, sl_diag *diag)
+{
+    size_t len = strlen(name);
+    if (len == 0 || len > MAX_NAME || job_file_find(self, name)) return true;
+    for (size_t i = 0; i < len; i++)
+        if ((unsigned char)name[i] < 0x20 || name[i] == 0x7f) return true;   /* not a file name */
+    char *path = find_on_path(sc, name);
+    if (!path) return true;
+    if (self->nfiles >= MAX_JOB_FILES) {
+        sl_diag_error(diag, pos, "file '%s': a job reads at most %d files", name, MAX_JOB_FILES);
+        free(path);
+        return false;
+    }
+    char hex[HASH_HEX_SIZE], why[300];
+    uint64_t size = 0;
+    struct stat st;
+    if (!hash_file(path, hex, &size, &st, why, sizeof why)) {
+        sl_diag_error(diag, pos, "file '%s' (found as '%s' on the texture search path) cannot be "
+                      "read: %s; fix its permissions or remove it", name, path, why);
+        free(path);
+        return false;
+    }
+    bool ok = job_add_file(self, name, hex, size, why, sizeof why);
+    if (ok) {
+        job_file *f = &self->files[self->nfiles - 1];
+        job_file_set_path(self, self->nfiles - 1, path);
+        f->stamped = true;
+        f->dev = (uint64_t)st.st_dev;
+        f->ino = (uint64_t)st.st_ino;
+        f->mtime_ns = mtime_ns(&st);
+    }
+    else sl_diag_error(diag, pos, "%s", why);
+    free(path);
+    return ok;
+}
+
+bool job_collect_files(job *self, const job_scene *js, sl_diag *diag)
+{
+    const scene *sc = js->scene;
+    bool ok = true;
+    for (int i = 0; i < self->nshaders && ok; i++) {
+        const sl_program *p = js->programs[i];
+        if (!p) continue;
+        sl_pos pos = {self->shaders[i].file, 0, 0};
+        for (int k = 0; k < p->nstrings && ok; k++)
+            ok = consider(self, sc, p->strings[k], pos, diag);
+    }
+    for (int i = 0; i < sc->nshaders && ok; i++) {
+        const scene_shader *sh = &sc->shaders[i];
+        for (int k = 0; k < sh->nparams && ok; k++)
+            if (sh->params[k].string)
+                ok = consider(self, sc, sh->params[k].string, sh->params[k].pos, diag);
+    }
+    return ok;
+}
