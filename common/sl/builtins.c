@@ -138,6 +138,14 @@ static const sl_builtin table[] = {
     LW("attribute", "f:sV", MESSAGE, MESSAGE, SL_MSG_ATTRIBUTE),
     LW("option", "f:sV", MESSAGE, MESSAGE, SL_MSG_OPTION),
     LW("rendererinfo", "f:sV", MESSAGE, MESSAGE, SL_MSG_RENDERERINFO),
+    /* rays (§15.8, §15.9): the renderer's tracer (shader.h, sl_tracer);
+     * shadow()'s optional parameters are accepted and ignored */
+    LW("trace", "c:pv", RAY, RAY, SL_RAY_TRACE),
+    LW("shadow", "f:sp", RAY, RAY, 1),
+    LW("shadow", "f:spsf", RAY, RAY, 1),
+    LW("shadow", "f:spsfsf", RAY, RAY, 1),
+    LW("shadow", "f:spsfsfsf", RAY, RAY, 1),
+    LW("shadow", "f:spsfsfsfsf", RAY, RAY, 1),
     /* spline (§15.1): variadic, checked by check_spline */
     LW("spline", "A:", SPLINE, END, 0),
 };

@@ -604,6 +604,22 @@ static void check_filter_param(checker *c, const sl_node *n, int i)
               "float, \"filter\" with a name)", arg->name);
 }
 
+/* shadow(name, P, "blur", 0.01, ...): the shadow map parameters of RI Spec
+ * 3.2 §15.9, accepted and ignored (the traced shadow ray is sharp). */
+static void check_shadow_param(checker *c, const sl_node *arg)
+{
+    static const char *const names[] = { "samples", "blur", "bias", "width", "swidth",
+                                         "twidth" };
+    if (arg->kind == SL_N_STR)
+        for (size_t k = 0; k < sizeof names / sizeof names[0]; k++)
+            if (strcmp(arg->name, names[k]) == 0)
+                return;
+    error(c, arg->pos, "unknown shadow() parameter%s%s%s (known: \"samples\", \"blur\", "
+          "\"bias\", \"width\", \"swidth\", \"twidth\", each with a float; they are "
+          "accepted and ignored)", arg->kind == SL_N_STR ? " '" : "",
+          arg->kind == SL_N_STR ? arg->name : "", arg->kind == SL_N_STR ? "'" : "");
+}
+
 /* A color space argument (ctransform): a constant string naming one. */
 static void check_color_space_arg(checker *c, const sl_node *arg)
 {
@@ -659,6 +675,13 @@ static sl_ty check_builtin_call(checker *c, sl_node *n, const sl_ty *args, sl_ty
             if (bad)
                 error(c, n->list[0]->pos, "malformed regular expression '%s' (at character "
                       "%d)", n->list[0]->name, bad);
+            continue;
+        }
+        if (sig[i] == 's' && b->lower == SL_LOWER_RAY) {
+            if (i > 0)
+                check_shadow_param(c, n->list[i]);
+            else
+                wrap_conv(c, &n->list[i], want[i]);
             continue;
         }
         if (sig[i] == 's' && b->lower == SL_LOWER_MESSAGE) {
@@ -1096,7 +1119,7 @@ static sl_ty check_call(checker *c, sl_node *n, sl_ty hint)
         for (int i = 0; i < n->nlist; i++)
             check_expr(c, &n->list[i], SL_TYPE_VOID);
         static const char *const later[] = {
-            "texture", "environment", "shadow", "bump", "textureinfo",
+            "texture", "environment", "bump", "textureinfo",
         };
         for (size_t k = 0; k < sizeof later / sizeof later[0]; k++) {
             if (strcmp(n->name, later[k]) == 0) {
@@ -1105,9 +1128,9 @@ static sl_ty check_call(checker *c, sl_node *n, sl_ty hint)
                 return set_ty(n, SL_TY_ERROR);
             }
         }
-        if (strcmp(n->name, "trace") == 0 || strcmp(n->name, "gather") == 0) {
-            error(c, n->pos, "'%s' is not supported yet: shaders cannot trace rays in "
-                             "aafarm's ray tracer", n->name);
+        if (strcmp(n->name, "gather") == 0) {
+            error(c, n->pos, "'gather' is not supported: shaders trace single rays with "
+                             "trace(P, R) and shadow(name, P)");
             return set_ty(n, SL_TY_ERROR);
         }
         if (lookup(c, n->name))

@@ -71,6 +71,7 @@ typedef struct cg {
     int nrets;
     sl_func *func;
     int shader_ret_flag;
+    bool solar;                          /* the last illuminate/solar was a solar */
     uint8_t death[SL_MAX_SLOTS / 8];     /* escape flags: their paths are saved */
     struct pending_escape { int pc, kind, id; } *escapes;
     int nescapes, escapes_cap, next_id;
@@ -298,6 +299,7 @@ static int written_count(const sl_insn *in, const sl_program *p)
     case SL_OP_MOVN: return in->c;
     case SL_OP_NOISE: return (in->c & SL_NOISE_VECTOR) ? 3 : 1;
     case SL_OP_RANDOM: return in->b;
+    case SL_OP_RAY: return (in->d & ((1 << SL_RAY_KIND_BITS) - 1)) == SL_RAY_TRACE ? 3 : 1;
     case SL_OP_CALCNORMAL: case SL_OP_AMBIENT: case SL_OP_DIFFUSE: case SL_OP_SPECULAR:
     case SL_OP_PHONG: case SL_OP_XPOINT: case SL_OP_XVECTOR: case SL_OP_XNORMAL:
     case SL_OP_SETCOMP:
@@ -1530,6 +1532,38 @@ static int gen_spline(cg *g, sl_node *e, int dst)
     return z;
 }
 
+/* trace(P, R) and shadow(name, P): one RAY instruction, answered by the
+ * renderer's tracer at points (vm.c sl_vm_ray). shadow() aims at the light
+ * through the L global: in a light shader at the light of the last
+ * illuminate (Ps - L) or solar (-L, to infinity), in a surface shader at
+ * the current light of the illuminance loop. A displacement shader runs
+ * over ranges of the surface, where a ray cannot be bounded: an error. */
+static int gen_ray(cg *g, sl_node *e, int *args, int dst)
+{
+    bool trace = e->builtin->k == SL_RAY_TRACE;
+    if (g->prog->kind == SL_SHADER_DISPLACEMENT) {
+        fail(g, "%s() cannot be used in a displacement shader: it runs over ranges of the "
+             "surface, where a traced ray has no bound (use it in a surface%s shader)",
+             trace ? "trace" : "shadow", trace ? "" : " or light");
+        return 0;
+    }
+    int kind = trace ? SL_RAY_TRACE
+             : g->prog->kind == SL_SHADER_LIGHT ? (g->solar ? SL_RAY_SHADOW_SOLAR
+                                                            : SL_RAY_SHADOW_ILLUMINATE)
+             : SL_RAY_SHADOW_SURFACE;
+    int n = trace ? 3 : 1;
+    int P = trace ? args[0] : args[1];
+    int D = trace ? args[1] : sl_global_slot(SL_G_L);
+    int map = 0;
+    if (!trace) {                 /* a slot of its own: a constant's is fixed up later */
+        map = alloc_string(g);
+        emit(g, SL_OP_SMOV, map, args[0], 0, 0);
+    }
+    int z = alloc_slots(g, n);
+    emit(g, SL_OP_RAY, z, P, D, kind | map << SL_RAY_KIND_BITS);
+    return into(g, z, dst, n);
+}
+
 static int gen_builtin(cg *g, sl_node *e, int dst)
 {
     const sl_builtin *b = e->builtin;
@@ -1609,6 +1643,7 @@ static int gen_builtin(cg *g, sl_node *e, int dst)
     case SL_LOWER_EMITTER: {      /* L = Ps - position / axis / 0 */
         int L = sl_global_slot(SL_G_L), P = sl_global_slot(SL_G_P);
         g->prog->emits_light = true;
+        g->solar = b->k != 0;
         for (int i = 0; i < 3; i++) {
             if (b->k == 0)
                 emit(g, SL_OP_SUB, L + i, P + i, args[0] + i, 0);
@@ -1628,6 +1663,7 @@ static int gen_builtin(cg *g, sl_node *e, int dst)
             record_write(g, args[1], size);
         return z;
     }
+    case SL_LOWER_RAY: return gen_ray(g, e, args, dst);
     case SL_LOWER_SPLINE: case SL_LOWER_STRINGS: break;     /* gen_spline, gen_strings */
     case SL_LOWER_MATCH: {
         int z = target(g, dst, 1);

@@ -28,6 +28,10 @@ typedef struct trace_object_work {
     double u0, u1, v0, v1;         /* union of the stopped nodes' ranges */
 } trace_object_work;
 
+/* trace() from surface shaders (RI Spec 3.2 §15.8): a hit seen through
+ * this many traced rays is shaded; a ray deeper than that sees black. */
+enum { TRACE_MAX_RAY_DEPTH = 4 };
+
 typedef struct trace_thread {
     const trace_world *world;
     sl_vm *vm;                     /* displacement shaders (boxes, points) */
@@ -35,6 +39,9 @@ typedef struct trace_thread {
                                       trace shadow rays, which use vm */
     sl_vm *light_vm;               /* light shaders, run from shade_vm's
                                       light callback (sl_light_eval) */
+    sl_vm *ray_vm[TRACE_MAX_RAY_DEPTH];    /* surface shaders of the hits of
+                                      trace() rays, one per depth (1..), made
+                                      on first use (trace_thread_shade_vm) */
     aa_context ctx;
     trace_boxcache *cache;
     trace_stats stats;
@@ -47,6 +54,10 @@ typedef struct trace_thread {
 
 trace_thread *trace_thread_new(const trace_world *world);
 void trace_thread_destroy(trace_thread **self_p);
+
+/* The VM that runs surface shaders at trace() depth `depth` (0: primary
+ * hits, shade_vm; 1..TRACE_MAX_RAY_DEPTH: made on first use). */
+sl_vm *trace_thread_shade_vm(trace_thread *self, int depth);
 
 /* Records the first error of this thread (later ones are dropped). */
 void trace_thread_fail(trace_thread *self, const char *message);

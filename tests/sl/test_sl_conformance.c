@@ -1196,10 +1196,10 @@ static const conf_error errors[] = {
  * fixed lights (three distant ones and an ambient one); Ci and Oi are
  * checked. */
 static const sl_light_sample surface_lights[] = {
-    { { 0.3, 0.2, -1 }, { 1, 0.8, 0.6 }, false },
-    { { -0.5, 0.1, 0.4 }, { 0.2, 0.3, 1 }, false },
-    { { 0.6, -0.7, 0.2 }, { 0.5, 0.5, 0.2 }, false },
-    { { 0, 0, 0 }, { 0.05, 0.05, 0.05 }, true },
+    { { 0.3, 0.2, -1 }, { 1, 0.8, 0.6 }, false, true },
+    { { -0.5, 0.1, 0.4 }, { 0.2, 0.3, 1 }, false, true },
+    { { 0.6, -0.7, 0.2 }, { 0.5, 0.5, 0.2 }, false, true },
+    { { 0, 0, 0 }, { 0.05, 0.05, 0.05 }, true, false },
 };
 enum { NSURFACE_LIGHTS = sizeof surface_lights / sizeof surface_lights[0] };
 
