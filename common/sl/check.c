@@ -903,6 +903,54 @@ static sl_ty check_arraylength(checker *c, sl_node *n)
     return set_ty(n, SL_TYPE_FLOAT);
 }
 
+/* RSL 2 resizable arrays: resize(a, n), reserve(a, n), push(a, v), pop(a)
+ * on a local declared 'float a[];' or an unsized array parameter (whose
+ * argument must then be resizable: checked where the call is inlined).
+ * The node's op: SL_RESIZE_*. */
+static const char *const resizable_ops[] = { "resize", "reserve", "push", "pop" };
+
+static int resizable_op(const char *name)
+{
+    for (int k = 0; k < 4; k++)
+        if (strcmp(name, resizable_ops[k]) == 0)
+            return k;
+    return -1;
+}
+
+static sl_ty check_resizable(checker *c, sl_node *n, int op)
+{
+    int want = op == SL_RESIZE_POP ? 1 : 2;
+    for (int i = 0; i < n->nlist; i++)
+        check_expr(c, &n->list[i], i == 0 ? SL_TYPE_VOID : SL_TYPE_FLOAT);
+    const sl_node *a = n->nlist > 0 ? n->list[0] : NULL;
+    bool ok = a && a->kind == SL_N_IDENT && a->sym && sl_ty_is_array(a->ty) &&
+              (a->sym->resizable || (a->sym->kind == SL_SYM_FPARAM && sl_ty_len(a->sym->ty) == 0));
+    if (a && a->ty == SL_TY_ERROR)
+        return set_ty(n, SL_TY_ERROR);
+    if (!ok || n->nlist != want) {
+        error(c, n->pos, "%s() takes a resizable array (a local declared without size or "
+              "initializer, as 'float a[];')%s", resizable_ops[op],
+              op == SL_RESIZE_POP ? "" : op == SL_RESIZE_PUSH ? " and a value"
+                                                              : " and a number of elements");
+        return set_ty(n, SL_TY_ERROR);
+    }
+    n->op = op;
+    sl_ty elem = sl_ty_elem(a->ty);
+    if (want == 2) {
+        sl_ty to = op == SL_RESIZE_PUSH ? elem : SL_TYPE_FLOAT;
+        sl_ty t = n->list[1]->ty;
+        if (t == SL_TY_ERROR)
+            return set_ty(n, SL_TY_ERROR);
+        if (!can_convert(t, to)) {
+            error(c, n->list[1]->pos, "argument 2 of '%s' must be a '%s', not a '%s'",
+                  resizable_ops[op], sl_ty_name(to), sl_ty_name(t));
+            return set_ty(n, SL_TY_ERROR);
+        }
+        wrap_conv(c, &n->list[1], to);
+    }
+    return set_ty(n, op == SL_RESIZE_POP ? elem : SL_TYPE_VOID);
+}
+
 /* spline([basis,] t, k0, k1, ...) and spline([basis,] t, knots[]) (RI
  * Spec 3.2 §15.1): the knots are floats, colors, points or vectors (the
  * first knot's type, or the context's for an untyped first knot); the
@@ -1105,6 +1153,8 @@ static sl_ty check_call(checker *c, sl_node *n, sl_ty hint)
     int ncands = find_funcs(c, n->name, cands, MAX_OVERLOADS);
     if (ncands == 0 && strcmp(n->name, "arraylength") == 0)
         return check_arraylength(c, n);
+    if (ncands == 0 && resizable_op(n->name) >= 0)
+        return check_resizable(c, n, resizable_op(n->name));
     if (ncands == 0 && strcmp(n->name, "spline") == 0)
         return check_spline(c, n, hint);
     if (ncands == 0) {
@@ -1127,6 +1177,12 @@ static sl_ty check_call(checker *c, sl_node *n, sl_ty hint)
                                  "shadow maps come with the texture work (issue 16)", n->name);
                 return set_ty(n, SL_TY_ERROR);
             }
+        }
+        if (strcmp(n->name, "getshader") == 0 || strcmp(n->name, "getshaders") == 0) {
+            error(c, n->pos, "'%s' (RSL 2 co-shaders) is not supported: aafarm compiles "
+                             "each shader on its own: put the co-shader's code in a function "
+                             "of this shader (or #include it)", n->name);
+            return set_ty(n, SL_TY_ERROR);
         }
         if (strcmp(n->name, "gather") == 0) {
             error(c, n->pos, "'gather' is not supported: shaders trace single rays with "
@@ -1365,8 +1421,12 @@ static void check_init(checker *c, sl_node *v, sl_sym *s)
         else
             wrap_conv(c, &v->a, s->ty);
     }
-    if (sl_ty_is_array(s->ty) && sl_ty_len(s->ty) == 0)
+    if (sl_ty_is_array(s->ty) && sl_ty_len(s->ty) == 0 && s->kind == SL_SYM_LOCAL && !init) {
+        s->resizable = true;          /* RSL 2: 'float a[];' grows with push/resize */
+        s->ty = sl_ty_array(sl_ty_elem(s->ty), SL_RESIZABLE_CAPACITY);
+    } else if (sl_ty_is_array(s->ty) && sl_ty_len(s->ty) == 0) {
         error(c, v->pos, "array '%s' needs a size or an initializer", s->name);
+    }
 }
 
 static void check_decl(checker *c, sl_node *n)

@@ -729,6 +729,52 @@ static int gen_store(cg *g, sl_node *x, sl_node *value, int dst)
     return into(g, v, dst, n);
 }
 
+/* RSL 2 resizable arrays (a local 'float a[];'): SL_RESIZABLE_CAPACITY
+ * elements and a length slot. push stores at a[length] (astore: in range
+ * modes merged into every element the length can reach) and adds 1; pop
+ * subtracts 1 and loads a[length]; resize sets the length (floor(n), at
+ * least 0); resize and reserve probe element n - 1 with aload, so a size
+ * beyond the capacity stops the run there ("array index out of range");
+ * arraylength reads the length. */
+static int gen_resizable(cg *g, sl_node *e, int dst)
+{
+    const sl_sym *s = e->list[0]->sym;
+    int L = s->cg_len_slot;
+    if (!L) {
+        fail(g, "%s() on '%s': the array passed for it is not resizable (declare it without "
+             "size or initializer, as 'float a[];')", e->name, s->name);
+        return 0;
+    }
+    int len = array_len(s), n = sl_ty_slots(sl_ty_elem(s->ty));
+    if (strcmp(e->name, "arraylength") == 0)
+        return into(g, L, dst, 1);
+    switch (e->op) {
+    case SL_RESIZE_RESIZE: case SL_RESIZE_RESERVE: {
+        int k = op1(g, SL_OP_FLOOR, gen_expr(g, e->list[1], -1));
+        int probe = op2(g, SL_OP_MAX, op2(g, SL_OP_SUB, k, const_slot(g, 1)), const_slot(g, 0));
+        emit(g, SL_OP_ALOAD, alloc_slots(g, 1), s->slot, probe, array_operand(len, n));
+        if (e->op == SL_RESIZE_RESIZE)
+            emit(g, SL_OP_MAX, L, k, const_slot(g, 0), 0);
+        return 0;
+    }
+    case SL_RESIZE_PUSH: {
+        int v = gen_expr(g, e->list[1], -1);
+        for (int k = 0; k < n; k++)
+            emit(g, SL_OP_ASTORE, s->slot + k, L, v + k, array_operand(len, n));
+        record_write(g, s->slot, len * n);
+        emit(g, SL_OP_ADD, L, L, const_slot(g, 1), 0);
+        return 0;
+    }
+    default: {               /* pop */
+        emit(g, SL_OP_SUB, L, L, const_slot(g, 1), 0);
+        int z = alloc_slots(g, n);
+        for (int k = 0; k < n; k++)
+            emit(g, SL_OP_ALOAD, z + k, s->slot + k, L, array_operand(len, n));
+        return into(g, z, dst, n);
+    }
+    }
+}
+
 /* { values } into the array at dst. */
 static int gen_array_init(cg *g, sl_node *e, int dst)
 {
@@ -1702,6 +1748,7 @@ static int gen_user_call(cg *g, sl_node *e, int dst)
                 return 0;
             }
             p->cg_len = len;
+            p->cg_len_slot = e->list[i]->sym->cg_len_slot;   /* resizable: its length */
         }
         p->slot = args[i];
     }
@@ -1768,7 +1815,9 @@ static int gen_expr(cg *g, sl_node *e, int dst)
             r = gen_strings(g, e, dst);
         else if (e->builtin)
             r = gen_builtin(g, e, dst);
-        else            /* arraylength(a) */
+        else if (strcmp(e->name, "arraylength") != 0 || e->list[0]->sym->cg_len_slot)
+            r = gen_resizable(g, e, dst);
+        else            /* arraylength(a) of a fixed-size array */
             r = into(g, const_slot(g, array_len(e->list[0]->sym)), dst, 1);
         break;
     case SL_N_INDEX: r = gen_index(g, e, dst); break;
@@ -1869,6 +1918,10 @@ static void gen_decl(cg *g, sl_node *n)
                 emit(g, SL_OP_MOV, s->slot + k, const_slot(g, 0), 0, 0);
         }
         g->sp = s->slot + size;
+        if (s->resizable) {       /* its length, after the elements */
+            s->cg_len_slot = alloc_slots(g, 1);
+            emit(g, SL_OP_MOV, s->cg_len_slot, const_slot(g, 0), 0, 0);
+        }
     }
 }
 

@@ -990,6 +990,41 @@ static void ref_math_pow_exp_log(double u, double v, double o[3])
     o[2] = log(v + 2) / log(2) + sqrt(u + v);
 }
 
+/* RSL 2 (issue 15): shader classes and resizable arrays */
+static void ref_class_displacement(double u, double v, double o[3])
+{
+    o[0] = sin(3 * u + 0.25); o[1] = sin(3 * v + 0.25) + 0.25; o[2] = 2;
+}
+
+static void ref_class_method_order(double u, double v, double o[3])
+{
+    o[0] = (u * u + 2 * u) * 2; o[1] = (v * v + 2 * v) * 2 + 0.75; o[2] = 2;
+}
+
+static double blend124(double x) { return 1 + 2 * x + 4 * x * x; }
+static void ref_class_member_array(double u, double v, double o[3])
+{
+    o[0] = blend124(u) * 0.5; o[1] = 0.25 + v; o[2] = 4 - blend124(v);
+}
+
+static void ref_resizable_push_pop(double u, double v, double o[3])
+{
+    o[0] = u + v; o[1] = u * v + 10; o[2] = 3;
+}
+
+static void ref_resizable_resize_loop(double u, double v, double o[3])
+{
+    double sum = 0;
+    for (int i = 0; i < 5; i++) sum += pow(u, i);
+    o[0] = sum; o[1] = 1 + u + v; o[2] = 2;
+}
+
+static void ref_resizable_colors(double u, double v, double o[3])
+{
+    bool two = u > 0.5;
+    o[0] = u + 0.5; o[1] = two ? 2 : 1; o[2] = two ? v : 1;
+}
+
 /* ---------------------------------------------------------------------- */
 /* the cases                                                               */
 /* ---------------------------------------------------------------------- */
@@ -1095,6 +1130,12 @@ static const conf_case cases[] = {
     CASE(geom_distance_length, "shading geometry"),
     CASE(math_polar, "math"),
     CASE(math_pow_exp_log, "math"),
+    CASE(class_displacement, "RSL 2 classes"),
+    CASE(class_method_order, "RSL 2 classes"),
+    CASE(class_member_array, "RSL 2 classes"),
+    CASE(resizable_push_pop, "RSL 2 resizable arrays"),
+    CASE(resizable_resize_loop, "RSL 2 resizable arrays"),
+    CASE(resizable_colors, "RSL 2 resizable arrays"),
 };
 #undef CASE
 #undef CASE_NO_DUAL
@@ -1186,6 +1227,49 @@ static const conf_error errors[] = {
       "(known: \"width\" with a float, \"filter\" with a name)\n"
       "    P += filterstep(0.5, s, \"blur\", 0.1) * N;\n"
       "                            ^\n" },
+    { "errors/class_two_shaders.sl",
+      "errors/class_two_shaders.sl:5:17: error: class 'twokinds' has both a 'surface' and "
+      "a 'displacement' method; aafarm compiles a class as one shader: split it into two "
+      "classes\n"
+      "    public void displacement(output point P; output normal N) { P += N; }\n"
+      "                ^\n"
+      "errors/class_two_shaders.sl:4:17: note: 'surface' defined here\n"
+      "    public void surface(output color Ci, Oi) { Ci = 1; }\n"
+      "                ^\n" },
+    { "errors/coshader.sl",
+      "errors/coshader.sl:4:5: error: 'shader' variables (RSL 2 co-shaders) are not "
+      "supported: aafarm compiles each shader on its own: put the co-shader's code in a "
+      "function of this shader (or #include it)\n"
+      "    shader base = getshader(layer);\n"
+      "    ^\n"
+      "errors/coshader.sl:5:14: error: method calls with '->' (RSL 2 co-shaders) are not "
+      "supported: aafarm compiles each shader on its own: put the co-shader's code in a "
+      "function of this shader (or #include it)\n"
+      "    P += base->height(s) * N;\n"
+      "             ^\n" },
+    { "errors/coshader_getshaders.sl",
+      "errors/coshader_getshaders.sl:4:27: error: 'getshaders' (RSL 2 co-shaders) is not "
+      "supported: aafarm compiles each shader on its own: put the co-shader's code in a "
+      "function of this shader (or #include it)\n"
+      "    float n = arraylength(getshaders());\n"
+      "                          ^\n" },
+    { "errors/resizable_fixed.sl",
+      "errors/resizable_fixed.sl:5:5: error: push() takes a resizable array (a local "
+      "declared without size or initializer, as 'float a[];') and a value\n"
+      "    push(a, s);\n"
+      "    ^\n" },
+    { "errors/trace_displacement.sl",
+      "errors/trace_displacement.sl:4:15: error: trace() cannot be used in a displacement "
+      "shader: it runs over ranges of the surface, where a traced ray has no bound (use it "
+      "in a surface shader)\n"
+      "    color c = trace(P, N);\n"
+      "              ^\n" },
+    { "errors/shadow_param.sl",
+      "errors/shadow_param.sl:6:34: error: unknown shadow() parameter 'bluur' (known: "
+      "\"samples\", \"blur\", \"bias\", \"width\", \"swidth\", \"twidth\", each with a "
+      "float; they are accepted and ignored)\n"
+      "        Cl = 1 - shadow(map, Ps, \"bluur\", 0.1);\n"
+      "                                 ^\n" },
 };
 
 /* ---------------------------------------------------------------------- */
@@ -1293,6 +1377,19 @@ static void ref_surface_illuminance_helper(const double N[3], double Ci[3], doub
     }
 }
 
+/* the same loop written as an RSL 2 class */
+static void ref_surface_class_matte(const double N[3], double Ci[3], double Oi[3])
+{
+    ref_surface_illuminance_diffuse(N, Ci, Oi);
+}
+
+/* no tracer: trace() black, shadow() 0, so the diffuse loop alone */
+static void ref_surface_trace_untraced(const double N[3], double Ci[3], double Oi[3])
+{
+    ref_surface_illuminance_diffuse(N, Ci, Oi);
+    Oi[0] = 1; Oi[1] = 0; Oi[2] = 0;
+}
+
 typedef struct surface_case {
     const char *file;
     void (*ref)(const double N[3], double Ci[3], double Oi[3]);
@@ -1304,6 +1401,8 @@ static const surface_case surface_cases[] = {
     SURFACE(surface_illuminance_specular),
     SURFACE(surface_illuminance_category),
     SURFACE(surface_illuminance_helper),
+    SURFACE(surface_class_matte),
+    SURFACE(surface_trace_untraced),
 };
 #undef SURFACE
 
