@@ -29,6 +29,7 @@
 #include <stddef.h>
 #include <setjmp.h>
 #include <stdint.h>
+#include <unistd.h>
 #include <cmocka.h>
 
 #include "sl/noise.h"
@@ -1025,6 +1026,160 @@ static void ref_resizable_colors(double u, double v, double o[3])
     o[0] = u + 0.5; o[1] = two ? 2 : 1; o[2] = two ? v : 1;
 }
 
+/* the noise family in every form, and the math the suite lacked */
+static void ref_noise_forms_vector(double u, double v, double o[3])
+{
+    double x5 = 5 * u, xy[2] = { 3 * u, 3 * v }, q[4] = { 2 * u, 2 * v, 1, 2 * v };
+    double a[3], b[3], c[3], d[3];
+    sl_vnoise(1, &x5, a);
+    sl_vnoise(2, xy, b);
+    sl_vnoise(3, q, c);
+    sl_vnoise(4, q, d);
+    o[0] = a[0] + b[1]; o[1] = c[2] + d[0]; o[2] = a[1] - d[2];
+}
+
+static void ref_pnoise_forms_color(double u, double v, double o[3])
+{
+    double x5 = 5 * u, xy[2] = { 3 * u, 3 * v }, q[4] = { 3 * u, 3 * v, 0, 2 * v };
+    int p4 = 4, p23[2] = { 2, 3 }, p444[3] = { 4, 4, 4 }, p2223[4] = { 2, 2, 2, 3 };
+    double a[3], b[3], c[3], d[3];
+    sl_vpnoise(1, &x5, &p4, a);
+    sl_vpnoise(2, xy, p23, b);
+    sl_vpnoise(3, q, p444, c);
+    sl_vpnoise(4, q, p2223, d);
+    o[0] = a[0] + b[1]; o[1] = c[2] + d[0]; o[2] = a[2] * d[1];
+}
+
+static void ref_cellnoise_forms_point(double u, double v, double o[3])
+{
+    double x4 = 4 * u, xy[2] = { 4 * u, 4 * v }, q[4] = { 4 * u, 4 * v, 0, 3 * v };
+    double a[3], b[3], c[3], d[3];
+    sl_vcellnoise(1, &x4, a);
+    sl_vcellnoise(2, xy, b);
+    sl_vcellnoise(3, q, c);
+    sl_vcellnoise(4, q, d);
+    o[0] = a[0] + b[1]; o[1] = c[2] + d[0]; o[2] = a[1] + d[2];
+}
+
+static void ref_noise_argument_types(double u, double v, double o[3])
+{
+    double p[3] = { 2 * (2 * u - 1), 2 * (2 * v - 1), 0 }, w[3] = { u, v, 1 };
+    double n4[4] = { 3 * v, 3 * u, 0, u };
+    o[0] = sl_noise(3, p) + noise1(1.5); o[1] = sl_noise(3, w); o[2] = sl_noise(4, n4);
+}
+
+/* the VM's random() (splitmix64 from the seed, 0 here) */
+static double splitmix(uint64_t *state)
+{
+    uint64_t z = (*state += 0x9e3779b97f4a7c15ull);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    z ^= z >> 31;
+    return (double)(z >> 11) * 0x1p-53;
+}
+static void ref_random_sequence(double u, double v, double o[3])
+{
+    uint64_t st = 0;
+    double r[5];
+    for (int i = 0; i < 5; i++) r[i] = splitmix(&st);
+    o[0] = r[0] + u; o[1] = r[1] + r[3]; o[2] = r[4] * v;
+}
+
+static void ref_math_inversesqrt(double u, double v, double o[3])
+{
+    o[0] = 1 / sqrt(u + 0.5); o[1] = v / sqrt(v * v + 1); o[2] = 0;
+}
+
+static void ref_math_trig_inverse(double u, double v, double o[3])
+{
+    o[0] = tan(u) + atan(v); o[1] = asin(u - 0.5) + acos(v - 0.5);
+    o[2] = atan2(v, u) * 180 / M_PI + 90 * u * M_PI / 180;
+}
+
+static void ref_math_mod_floor_ceil(double u, double v, double o[3])
+{
+    o[0] = fmodf_(7 * u, 2) + floor(5 * v); o[1] = ceil(3 * u) - fmodf_(-3 * v, 1);
+    o[2] = fmodf_(10 * u, 0.3) * 2;
+}
+
+static void ref_math_step_smoothstep(double u, double v, double o[3])
+{
+    o[0] = stepd(0.5, u) + smooth(0.2, 0.8, v); o[1] = smooth(0, 1, u * v);
+    o[2] = stepd(v, u) * 2;
+}
+
+static void ref_strings_concat_match(double u, double v, double o[3])
+{
+    o[0] = 1 + 0 + 4; o[1] = u + (floor(4 * u) <= 1 ? 1 : 0); o[2] = v;
+}
+
+static void ref_message_names(double u, double v, double o[3])
+{
+    (void)u;
+    (void)v;
+    o[0] = 16 + 32; o[1] = -1 + 0.25; o[2] = 1 + 2;
+}
+
+static void ref_geom_transform_matrix(double u, double v, double o[3])
+{
+    o[0] = 2 * (u + 1) + 3 * v; o[1] = 3 * v + v / 3; o[2] = 1 + 2 * u;
+}
+
+static void ref_spline_vector_normal(double u, double v, double o[3])
+{
+    static const double cr[4][4] = { { -0.5, 1.5, -1.5, 0.5 }, { 1, -2.5, 2, -0.5 },
+                                     { -0.5, 0, 0.5, 0 }, { 0, 1, 0, 0 } };
+    static const double kv[4][3] = { { 0, 0, 0 }, { 1, 0, 0 }, { 1, 1, 0 }, { 0, 1, 1 } };
+    static const double kn[5][3] = { { 0, 0, 0 }, { 1, 0, 0 }, { 0, 1, 0 }, { 0, 0, 1 },
+                                     { 1, 1, 1 } };
+    double x = clampd(u, 0, 1), y = clampd(v, 0, 1) * 2, seg = fmin(floor(y), 1);
+    y -= seg;
+    for (int c = 0; c < 3; c++) {
+        double val = 0;
+        for (int i = 0; i < 4; i++) {
+            double coef = 0;
+            for (int j = 0; j < 4; j++) coef += cr[i][j] * kv[j][c];
+            val += coef * pow(x, 3 - i);
+        }
+        int k = (int)seg;
+        o[c] = val + kn[k + 1][c] + y * (kn[k + 2][c] - kn[k + 1][c]);
+    }
+}
+
+static void ref_resizable_nested_extern(double u, double v, double o[3])
+{
+    double kept[3];
+    int n = 0;
+    double xs[3] = { u, v, 0.5 };
+    for (int i = 0; i < 3; i++)
+        if (xs[i] > 0.3) kept[n++] = xs[i];
+    o[0] = n; o[1] = 0.5; o[2] = kept[0];
+}
+
+static void ref_class_accumulate(double u, double v, double o[3])
+{
+    double sum = 0, amp = 1;
+    for (int i = 0; i < 4; i++) {
+        sum += amp * sin(pow(2, i) * u);
+        amp *= 0.5;
+    }
+    o[0] = sum; o[1] = amp; o[2] = v;
+}
+
+static void ref_voronoi_regular(double u, double v, double o[3])
+{
+    double x = 3 * u, y = 3 * v, cx = floor(x) + 0.5, cy = floor(y) + 0.5;
+    o[0] = sqrt((x - cx) * (x - cx) + (y - cy) * (y - cy)); o[1] = cx; o[2] = cy;
+}
+
+static void ref_noises_vsnoise(double u, double v, double o[3])
+{
+    double p[3] = { 3 * u, 3 * v, 0 }, d[3];
+    sl_vnoise(3, p, d);
+    for (int k = 0; k < 3; k++) d[k] = 2 * d[k] - 1;
+    o[0] = 0.2 * d[0]; o[1] = 0.2 * d[1] + 2 * noise1(4 * v) - 1; o[2] = d[2];
+}
+
 /* ---------------------------------------------------------------------- */
 /* the cases                                                               */
 /* ---------------------------------------------------------------------- */
@@ -1136,6 +1291,23 @@ static const conf_case cases[] = {
     CASE(resizable_push_pop, "RSL 2 resizable arrays"),
     CASE(resizable_resize_loop, "RSL 2 resizable arrays"),
     CASE(resizable_colors, "RSL 2 resizable arrays"),
+    CASE(noise_forms_vector, "noise family"),
+    CASE(pnoise_forms_color, "noise family"),
+    CASE(cellnoise_forms_point, "noise family"),
+    CASE(noise_argument_types, "noise family"),
+    CASE(random_sequence, "random"),
+    CASE(math_inversesqrt, "math"),
+    CASE(math_trig_inverse, "math"),
+    CASE(math_mod_floor_ceil, "math"),
+    CASE(math_step_smoothstep, "math"),
+    CASE(strings_concat_match, "strings"),
+    CASE(message_names, "message passing"),
+    CASE(geom_transform_matrix, "space transforms"),
+    CASE(spline_vector_normal, "spline"),
+    CASE(resizable_nested_extern, "RSL 2 resizable arrays"),
+    CASE(class_accumulate, "RSL 2 classes"),
+    CASE(voronoi_regular, "helper headers"),
+    CASE(noises_vsnoise, "helper headers"),
 };
 #undef CASE
 #undef CASE_NO_DUAL
@@ -1932,6 +2104,63 @@ done:
     sl_vm_destroy(&lvm);
 }
 
+/* printf_rate_limit.sl run 150 times in float mode (and in interval mode,
+ * which prints nothing) on a VM of its own, stderr caught in a file: 100
+ * lines, then one note, and the values are unaffected. */
+static void check_printf_limit(tally *t)
+{
+    char *diag = NULL;
+    sl_program *p = compile_file("printf_rate_limit.sl", &diag);
+    free(diag);
+    if (!p) {
+        t->failures++;
+        fprintf(stderr, "printf_rate_limit.sl: does not compile\n");
+        return;
+    }
+    sl_instance *inst = sl_instance_new(p);
+    sl_vm *vm = sl_vm_new(NULL);
+    FILE *log = tmpfile();
+    assert_non_null(log);
+    fflush(stderr);
+    int saved = dup(2);
+    assert_true(saved >= 0 && dup2(fileno(log), 2) >= 0);
+    int wrong = 0;
+    for (int i = 0; i < 150; i++) {
+        double u = (i + 0.5) / 150, v = 1 - u, P[3];
+        t->floats++;
+        if (!run_float(vm, inst, u, v, P) || !close_to(P[0], u) || !close_to(P[1], v) ||
+            P[2] != 1)
+            wrong++;
+        if (i % 15 == 0) {
+            h_globals_interval(vm, H_PLANE, u, u + 0.01, v, v + 0.01);
+            wrong += sl_vm_run(vm, inst, SL_MODE_INTERVAL, NULL) != SL_OK;
+        }
+    }
+    fflush(stderr);
+    dup2(saved, 2);
+    close(saved);
+    rewind(log);
+    char line[256];
+    int lines = 0, notes = 0;
+    while (fgets(line, sizeof line, log)) {
+        if (strncmp(line, "printf_rate_limit: s = ", 23) == 0)
+            lines++;
+        else if (strstr(line, "more than 100 printf lines; the rest are not shown"))
+            notes++;
+        else
+            wrong++;
+    }
+    fclose(log);
+    if (wrong || lines != 100 || notes != 1) {
+        t->failures++;
+        fprintf(stderr, "printf_rate_limit.sl: %d lines and %d notes logged (want 100 and 1), "
+                        "%d wrong values or other lines\n", lines, notes, wrong);
+    }
+    sl_vm_destroy(&vm);
+    sl_instance_destroy(&inst);
+    sl_program_destroy(&p);
+}
+
 static void test_conformance(void **state)
 {
     (void)state;
@@ -2002,6 +2231,9 @@ static void test_conformance(void **state)
     }
     check_message_passing(vm, &t);
     check_light_shaders(&t);
+    check_printf_limit(&t);
+    if (nfeatures < 64)
+        features[nfeatures++] = "printf's rate limit";
     size_t nerrors = sizeof errors / sizeof errors[0];
     for (size_t e = 0; e < nerrors; e++) {
         char *diag = NULL;
@@ -2015,9 +2247,9 @@ static void test_conformance(void **state)
         free(diag);
     }
     sl_vm_destroy(&vm);
-    printf("conformance: %zu displacement, %zu surface and 4 light shaders, a "
-           "displacement-to-surface message pair and %zu error cases; features:", ncases,
-           nsurfaces, nerrors);
+    printf("conformance: %zu shaders: %zu displacement, %zu surface and 4 light shaders, a "
+           "displacement-to-surface message pair, the printf limit and %zu error cases; "
+           "features:", ncases + nsurfaces + 4 + 2 + 1 + nerrors, ncases, nsurfaces, nerrors);
     for (int f = 0; f < nfeatures; f++)
         printf("%s %s", f ? "," : "", features[f]);
     printf("\nconformance: %d float checks, %d dual checks (%d derivatives against "
