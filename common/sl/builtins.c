@@ -63,6 +63,7 @@ static const sl_builtin table[] = {
     LW("fresnel", "0:SSfww", FRESNEL, END, 0),
     LW("fresnel", "0:SSfwwoo", FRESNEL, END, 0),
     LW("depth", "f:p", DEPTH, END, 0),
+    LW("ptlined", "f:ppp", EXTRA, END, 0),
     LW("transform", "p:sp", TRANSFORM, XPOINT, 0),
     LW("transform", "p:ssp", TRANSFORM, XPOINT, 0),
     LW("transform", "p:mp", TRANSFORM, XPOINT, 0),
@@ -98,6 +99,7 @@ static const sl_builtin table[] = {
     LW("determinant", "f:m", DETERMINANT, END, 0),
     LW("translate", "m:mv", MATRIX_XFORM, END, 0),
     LW("rotate", "m:mfv", MATRIX_XFORM, END, 1),
+    LW("rotate", "p:pfpp", EXTRA, END, 1),      /* §15.2: Q about the line P0 P1 */
     LW("scale", "m:mp", MATRIX_XFORM, END, 2),
     /* noise (§15.1) */
     LW("noise", "F:f", NOISE, NOISE, SL_NOISE_PLAIN),
@@ -118,6 +120,8 @@ static const sl_builtin table[] = {
     LW("diffuse", "c:n", LIGHT, DIFFUSE, 0),
     LW("specular", "c:nvf", LIGHT, SPECULAR, 0),
     LW("phong", "c:nvf", LIGHT, PHONG, 0),
+    LW("specularbrdf", "c:SSSf", EXTRA, END, 2),
+    LW("shadername", "s:", EXTRA, END, 3),
     /* the parts of an illuminance loop (parser.c builds the calls; their
      * names cannot be written in a source) */
     LW("illuminance start", "0:p", ILLUMINANCE, LSTART, 0),

@@ -1178,6 +1178,17 @@ static sl_ty check_call(checker *c, sl_node *n, sl_ty hint)
                 return set_ty(n, SL_TY_ERROR);
             }
         }
+        if (strcmp(n->name, "atmosphere") == 0 || strcmp(n->name, "incident") == 0 ||
+            strcmp(n->name, "opposite") == 0) {
+            error(c, n->pos, "'%s' reads the values of a volume shader, and volume shaders "
+                             "are not supported", n->name);
+            return set_ty(n, SL_TY_ERROR);
+        }
+        if (strcmp(n->name, "Dtime") == 0) {
+            error(c, n->pos, "'Dtime' is not supported: aafarm renders no motion blur, so "
+                             "nothing changes with time (use 0)");
+            return set_ty(n, SL_TY_ERROR);
+        }
         if (strcmp(n->name, "getshader") == 0 || strcmp(n->name, "getshaders") == 0) {
             error(c, n->pos, "'%s' (RSL 2 co-shaders) is not supported: aafarm compiles "
                              "each shader on its own: put the co-shader's code in a function "

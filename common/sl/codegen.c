@@ -1578,6 +1578,70 @@ static int gen_spline(cg *g, sl_node *e, int dst)
     return z;
 }
 
+/* The rest of RI Spec 3.2's built-ins, lowered to scalar operations:
+ * ptlined(P0, P1, Q), the distance from Q to the segment P0 P1 (t =
+ * clamp((Q - P0).(P1 - P0) / |P1 - P0|^2, 0, 1)); rotate(Q, angle, P0, P1),
+ * Q rotated by angle (radians) about the line through P0 and P1, as
+ * RiRotate and rotate(m, angle, axis) turn (Rodrigues' formula about the
+ * unit axis a: p cos + (a ^ p) sin + a (a.p)(1 - cos)); specularbrdf(L, N,
+ * V, roughness), the lobe specular() sums: pow(max(0, normalize(N) .
+ * normalize(normalize(L) + V)), 1 / roughness) as a grey colour;
+ * shadername(), the shader's name. */
+static int gen_extra(cg *g, const sl_builtin *b, const int *args, int dst)
+{
+    switch ((int)b->k) {
+    case 0: {
+        int v = alloc_slots(g, 3), w = alloc_slots(g, 3), d = alloc_slots(g, 3);
+        for (int i = 0; i < 3; i++) {
+            emit(g, SL_OP_SUB, v + i, args[1] + i, args[0] + i, 0);
+            emit(g, SL_OP_SUB, w + i, args[2] + i, args[0] + i, 0);
+        }
+        int vv = op2(g, SL_OP_MAX, gen_dot(g, v, v, 3, -1), const_slot(g, 1e-300));
+        int t = alloc_slots(g, 1);
+        emit(g, SL_OP_CLAMP, t, op2(g, SL_OP_DIV, gen_dot(g, w, v, 3, -1), vv),
+             const_slot(g, 0), const_slot(g, 1));
+        for (int i = 0; i < 3; i++)
+            emit(g, SL_OP_SUB, d + i, w + i, op2(g, SL_OP_MUL, t, v + i), 0);
+        int z = target(g, dst, 1);
+        emit(g, SL_OP_SQRT, z, gen_dot(g, d, d, 3, -1), 0, 0);
+        return z;
+    }
+    case 1: {
+        int axis = alloc_slots(g, 3), p = alloc_slots(g, 3), r = alloc_slots(g, 3);
+        for (int i = 0; i < 3; i++) {
+            emit(g, SL_OP_SUB, axis + i, args[3] + i, args[2] + i, 0);
+            emit(g, SL_OP_SUB, p + i, args[0] + i, args[2] + i, 0);
+        }
+        int a = gen_normalize(g, axis, -1);
+        int c = op1(g, SL_OP_COS, args[1]), sn = op1(g, SL_OP_SIN, args[1]);
+        int ap = op2(g, SL_OP_MUL, gen_dot(g, a, p, 3, -1),
+                     op2(g, SL_OP_SUB, const_slot(g, 1), c));
+        int x = gen_cross(g, a, p, -1);
+        for (int i = 0; i < 3; i++) {
+            int sum = op2(g, SL_OP_ADD, op2(g, SL_OP_MUL, p + i, c),
+                          op2(g, SL_OP_MUL, x + i, sn));
+            sum = op2(g, SL_OP_ADD, sum, op2(g, SL_OP_MUL, a + i, ap));
+            emit(g, SL_OP_ADD, r + i, args[2] + i, sum, 0);
+        }
+        return into(g, r, dst, 3);
+    }
+    case 2: {
+        int L = gen_normalize(g, args[0], -1), H = alloc_slots(g, 3);
+        for (int i = 0; i < 3; i++)
+            emit(g, SL_OP_ADD, H + i, L + i, args[2] + i, 0);
+        int Hn = gen_normalize(g, H, -1), Nn = gen_normalize(g, args[1], -1);
+        int c = op2(g, SL_OP_MAX, gen_dot(g, Nn, Hn, 3, -1), const_slot(g, 0));
+        int lobe = op2(g, SL_OP_POW, c, op2(g, SL_OP_DIV, const_slot(g, 1), args[3]));
+        int z = target(g, dst, 3);
+        for (int i = 0; i < 3; i++)
+            emit(g, SL_OP_MOV, z + i, lobe, 0, 0);
+        return z;
+    }
+    default:
+        return into_string(g, string_const(g, g->prog->name, strlen(g->prog->name)), dst);
+    }
+}
+
 /* trace(P, R) and shadow(name, P): one RAY instruction, answered by the
  * renderer's tracer at points (vm.c sl_vm_ray). shadow() aims at the light
  * through the L global: in a light shader at the light of the last
@@ -1710,6 +1774,7 @@ static int gen_builtin(cg *g, sl_node *e, int dst)
         return z;
     }
     case SL_LOWER_RAY: return gen_ray(g, e, args, dst);
+    case SL_LOWER_EXTRA: return gen_extra(g, b, args, dst);
     case SL_LOWER_SPLINE: case SL_LOWER_STRINGS: break;     /* gen_spline, gen_strings */
     case SL_LOWER_MATCH: {
         int z = target(g, dst, 1);

@@ -1180,6 +1180,66 @@ static void ref_noises_vsnoise(double u, double v, double o[3])
     o[0] = 0.2 * d[0]; o[1] = 0.2 * d[1] + 2 * noise1(4 * v) - 1; o[2] = d[2];
 }
 
+/* the rest of RI Spec 3.2's geometric and shading built-ins */
+static double dotv(const double a[3], const double b[3])
+{
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+static double seg_dist(const double a[3], const double b[3], const double q[3])
+{
+    double v[3], w[3], vv = 0, wv = 0, d2 = 0;
+    for (int k = 0; k < 3; k++) {
+        v[k] = b[k] - a[k];
+        w[k] = q[k] - a[k];
+        vv += v[k] * v[k];
+        wv += w[k] * v[k];
+    }
+    double t = vv > 0 ? clampd(wv / vv, 0, 1) : 0;
+    for (int k = 0; k < 3; k++) d2 += (w[k] - t * v[k]) * (w[k] - t * v[k]);
+    return sqrt(d2);
+}
+static void ref_geom_ptlined(double u, double v, double o[3])
+{
+    double a[3] = { 0.3, 0.2, 0 }, b[3] = { 0.6, 0.9, 0 }, c[3] = { 0.2, 0.2, 0 };
+    double z[3] = { 0, 0, 0 }, one[3] = { 1, 1, 1 }, q[3] = { u, v, 0 }, q1[3] = { u, v, 1 };
+    o[0] = seg_dist(a, b, q); o[1] = seg_dist(c, c, q); o[2] = seg_dist(z, one, q1);
+}
+
+static void ref_geom_rotate_point(double u, double v, double o[3])
+{
+    double P0[3] = { 0.1, 0.2, 0.3 }, ax[3] = { 0.4, 0.8, 1.7 };
+    double p[3] = { u - 0.1, v - 0.2, -0.3 }, ang = M_PI / 3 * u;
+    normalize3(ax);
+    double c = cos(ang), sn = sin(ang), ap = dotv(ax, p);
+    double x[3] = { ax[1] * p[2] - ax[2] * p[1], ax[2] * p[0] - ax[0] * p[2],
+                    ax[0] * p[1] - ax[1] * p[0] };
+    for (int k = 0; k < 3; k++)
+        o[k] = P0[k] + p[k] * c + x[k] * sn + ax[k] * ap * (1 - c);
+}
+
+static double lobe(const double L[3], const double N[3], const double V[3], double r)
+{
+    double Ln[3] = { L[0], L[1], L[2] }, Nn[3] = { N[0], N[1], N[2] }, H[3];
+    normalize3(Ln);
+    normalize3(Nn);
+    for (int k = 0; k < 3; k++) H[k] = Ln[k] + V[k];
+    normalize3(H);
+    double c = dotv(Nn, H);
+    return pow(c > 0 ? c : 0, 1 / r);
+}
+static void ref_shading_specularbrdf(double u, double v, double o[3])
+{
+    double L[3] = { u - 0.5, v - 0.5, 1 }, N[3] = { 0, 0.2, 1 }, V[3] = { 0, 0, 1 };
+    double L2[3] = { 1, 0, -1 }, N2[3] = { 0, 0, 1 };
+    o[0] = lobe(L, N, V, 0.2); o[1] = 0; o[2] = lobe(L2, N2, V, 0.5);
+}
+
+static void ref_strings_shadername(double u, double v, double o[3])
+{
+    (void)v;
+    o[0] = 1; o[1] = 1; o[2] = u;
+}
+
 /* ---------------------------------------------------------------------- */
 /* the cases                                                               */
 /* ---------------------------------------------------------------------- */
@@ -1308,6 +1368,10 @@ static const conf_case cases[] = {
     CASE(class_accumulate, "RSL 2 classes"),
     CASE(voronoi_regular, "helper headers"),
     CASE(noises_vsnoise, "helper headers"),
+    CASE(geom_ptlined, "shading geometry"),
+    CASE(geom_rotate_point, "shading geometry"),
+    CASE(shading_specularbrdf, "shading geometry"),
+    CASE(strings_shadername, "strings"),
 };
 #undef CASE
 #undef CASE_NO_DUAL
@@ -1562,6 +1626,14 @@ static void ref_surface_trace_untraced(const double N[3], double Ci[3], double O
     Oi[0] = 1; Oi[1] = 0; Oi[2] = 0;
 }
 
+/* specular() against its definition with specularbrdf over every light */
+static void ref_surface_specularbrdf(const double N[3], double Ci[3], double Oi[3])
+{
+    double unused[3];
+    ref_surface_illuminance_specular(N, unused, Oi);
+    for (int k = 0; k < 3; k++) Ci[k] = Oi[k];
+}
+
 typedef struct surface_case {
     const char *file;
     void (*ref)(const double N[3], double Ci[3], double Oi[3]);
@@ -1575,6 +1647,7 @@ static const surface_case surface_cases[] = {
     SURFACE(surface_illuminance_helper),
     SURFACE(surface_class_matte),
     SURFACE(surface_trace_untraced),
+    SURFACE(surface_specularbrdf),
 };
 #undef SURFACE
 
