@@ -41,6 +41,7 @@ typedef struct checker {
     sl_ast_file *file;
     sl_sym *globals[SL_G__COUNT];
     sl_sym *pi;
+    sl_sym *ncomps, *dtime;   /* RI Spec 3.2 §13: 3 color components; no motion blur */
     sl_sym **syms;                 /* scope stack */
     int nsyms, syms_cap;
     int scope_start;               /* first sym of the innermost scope */
@@ -99,6 +100,10 @@ static sl_sym *lookup(checker *c, const char *name)
         return c->globals[g];
     if (strcmp(name, "PI") == 0)
         return c->pi;
+    if (strcmp(name, "ncomps") == 0)
+        return c->ncomps;
+    if (strcmp(name, "dtime") == 0)
+        return c->dtime;
     return NULL;
 }
 
@@ -328,8 +333,8 @@ static sl_ty arith_type(checker *c, const sl_node *n, sl_ty a, sl_ty b)
     if (a == SL_TYPE_MATRIX || b == SL_TYPE_MATRIX) {
         if (op == SL_TOK_STAR && (a == b || a == SL_TYPE_FLOAT || b == SL_TYPE_FLOAT))
             return SL_TYPE_MATRIX;
-        if (op == SL_TOK_SLASH && a == SL_TYPE_MATRIX && b == SL_TYPE_FLOAT)
-            return SL_TYPE_MATRIX;
+        if (op == SL_TOK_SLASH && (a == SL_TYPE_MATRIX || a == SL_TYPE_FLOAT))
+            return SL_TYPE_MATRIX;      /* m / f; a / b = a * inverse(b) */
         goto bad;
     }
     if (a == SL_TYPE_FLOAT && sl_ty_is_triple(b))
@@ -1155,6 +1160,19 @@ static sl_ty check_call(checker *c, sl_node *n, sl_ty hint)
         return check_arraylength(c, n);
     if (ncands == 0 && resizable_op(n->name) >= 0)
         return check_resizable(c, n, resizable_op(n->name));
+    if (ncands == 0 && n->nlist > 2 && n->nlist <= 8 &&
+        (strcmp(n->name, "min") == 0 || strcmp(n->name, "max") == 0)) {
+        /* RI Spec 3.2 §15.1 min(a, b, ...): min(min(a, b, ...), last) */
+        sl_node *inner = sl_node_new(c->arena, SL_N_CALL, n->pos);
+        inner->name = n->name;
+        inner->list = n->list;
+        inner->nlist = n->nlist - 1;
+        sl_node **two = sl_arena_alloc(c->arena, 2 * sizeof *two);
+        two[0] = inner;
+        two[1] = n->list[n->nlist - 1];
+        n->list = two;
+        n->nlist = 2;
+    }
     if (ncands == 0 && strcmp(n->name, "spline") == 0)
         return check_spline(c, n, hint);
     if (ncands == 0) {
@@ -1751,6 +1769,14 @@ static void make_globals(checker *c)
     c->pi->kind = SL_SYM_CONST;
     c->pi->value = M_PI;
     c->pi->slot = -1;
+    c->ncomps = sl_arena_alloc(c->arena, sizeof *c->ncomps);
+    *c->ncomps = *c->pi;
+    c->ncomps->name = "ncomps";
+    c->ncomps->value = 3;
+    c->dtime = sl_arena_alloc(c->arena, sizeof *c->dtime);
+    *c->dtime = *c->pi;
+    c->dtime->name = "dtime";
+    c->dtime->value = 0;
 }
 
 static void check_shader(checker *c)

@@ -572,6 +572,18 @@ static int gen_binary(cg *g, sl_node *e, int dst)
         if (na == 16 && nb == 16)     /* RenderMan's a * b: a first, then b */
             return gen_matmul(g, y, x, dst);
         break;
+    case SL_TOK_SLASH:
+        if (nb == 16) {               /* a / b = a * inverse(b) (RI Spec 3.2 §12) */
+            int inv = alloc_slots(g, 16);
+            emit(g, SL_OP_MINVERT, inv, y, 0, 0);
+            if (na == 16)
+                return gen_matmul(g, inv, x, dst);
+            int z = target(g, dst, 16);
+            for (int i = 0; i < 16; i++)
+                emit(g, SL_OP_MUL, z + i, x, inv + i, 0);
+            return z;
+        }
+        break;
     case SL_TOK_EQ: case SL_TOK_NE:
         if (na > 1) {          /* all lanes equal / some lane differs */
             int z = target(g, dst, 1);

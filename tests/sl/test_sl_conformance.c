@@ -1240,6 +1240,11 @@ static void ref_strings_shadername(double u, double v, double o[3])
     o[0] = 1; o[1] = 1; o[2] = u;
 }
 
+static void ref_matrix_division(double u, double v, double o[3])
+{
+    o[0] = u; o[1] = v + 0.5; o[2] = fmin(fmin(u, v), 0.5) + 3;
+}
+
 /* ---------------------------------------------------------------------- */
 /* the cases                                                               */
 /* ---------------------------------------------------------------------- */
@@ -1372,6 +1377,7 @@ static const conf_case cases[] = {
     CASE(geom_rotate_point, "shading geometry"),
     CASE(shading_specularbrdf, "shading geometry"),
     CASE(strings_shadername, "strings"),
+    CASE(matrix_division, "matrices"),
 };
 #undef CASE
 #undef CASE_NO_DUAL
