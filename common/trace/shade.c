@@ -132,10 +132,28 @@ static int light_samples(void *user, const double P[3], sl_light_sample *out, in
  * texture work, issue 16), so every map is missing and the answer is a
  * traced shadow ray from P towards the light: 1 blocked, 0 lit; one
  * warning per light (per render) says so. */
+/* One more trace()/shadow() ray for this primary hit; false (the thread
+ * failed, with a message) beyond TRACE_MAX_SHADER_RAYS. */
+static bool count_shader_ray(shade_ctx *c, const char *what)
+{
+    trace_thread *th = c->th;
+    if (th->failed) return false;
+    if (++th->shader_rays <= TRACE_MAX_SHADER_RAYS) return true;
+    char msg[256];
+    snprintf(msg, sizeof msg, "surface shader '%s': more than %d rays traced by trace() and "
+             "shadow() for one sample (the limit; at %s)",
+             c->obj->surface ? sl_program_name(sl_instance_program(c->obj->surface)) : "",
+             TRACE_MAX_SHADER_RAYS, what);
+    trace_thread_fail(th, msg);
+    return false;
+}
+
 static double shadow_ray(void *user, const char *map, const double P[3], const double D[3],
                          double tmax)
 {
     shade_ctx *c = user;
+    if (!count_shader_ray(c, "shadow()"))
+        return 0;
     const trace_world *w = c->r->world;
     int slot = c->light >= 0 ? c->light : w->nlights;
     if (!atomic_exchange(&c->r->shadow_warned[slot], 1)) {
@@ -167,7 +185,7 @@ static void trace_ray_cb(void *user, const double P[3], const double R[3], doubl
     vec3 p = v3(P[0], P[1], P[2]), d = v3(R[0], R[1], R[2]);
     double d2 = v3_dot(d, d);
     if (c->depth >= TRACE_MAX_RAY_DEPTH || !(d2 > 0) || !isfinite(d2) ||
-        !isfinite(v3_dot(p, p)) || c->th->failed)
+        !isfinite(v3_dot(p, p)) || !count_shader_ray(c, "trace()"))
         return;
     vec3 side = v3_dot(c->N, d) >= 0 ? c->N : v3_neg(c->N);
     trace_ray ray;
@@ -237,6 +255,7 @@ void trace_shade_hit(const trace_renderer *r, trace_thread *th,
                      const trace_ray *ray, const trace_hit *hit,
                      double rgb[3], double *alpha, vec3 *P_out)
 {
+    th->shader_rays = 0;
     shade_hit(r, th, ray, hit, 0, rgb, alpha, P_out);
 }
 

@@ -31,6 +31,10 @@ typedef struct trace_object_work {
 /* trace() from surface shaders (RI Spec 3.2 §15.8): a hit seen through
  * this many traced rays is shaded; a ray deeper than that sees black. */
 enum { TRACE_MAX_RAY_DEPTH = 4 };
+/* Rays that trace() and shadow() may trace for one primary hit, all depths
+ * together: a shader calling them in loops at every depth cannot multiply
+ * its work without bound; beyond, the tile fails with a message. */
+enum { TRACE_MAX_SHADER_RAYS = 1024 };
 
 typedef struct trace_thread {
     const trace_world *world;
@@ -39,6 +43,7 @@ typedef struct trace_thread {
                                       trace shadow rays, which use vm */
     sl_vm *light_vm;               /* light shaders, run from shade_vm's
                                       light callback (sl_light_eval) */
+    long shader_rays;              /* trace()/shadow() rays of this primary hit */
     sl_vm *ray_vm[TRACE_MAX_RAY_DEPTH];    /* surface shaders of the hits of
                                       trace() rays, one per depth (1..), made
                                       on first use (trace_thread_shade_vm) */

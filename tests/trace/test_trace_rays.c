@@ -168,6 +168,42 @@ static void test_facing_mirrors_stop_at_the_depth_limit(void **state)
     fixture_close(&f);
 }
 
+static void test_rays_in_loops_at_every_depth_hit_the_limit(void **state)
+{
+    (void)state;
+    /* 40 rays per shading, 4 levels deep: 40^4 rays without the limit */
+    const char *greedy =
+        "surface greedy()\n"
+        "{\n"
+        "    color C = 0;\n"
+        "    float i;\n"
+        "    for (i = 0; i < 40; i += 1)\n"
+        "        C += trace(P, reflect(normalize(I), normalize(N))) / 40;\n"
+        "    Ci = 0.5 + 0.5 * C;\n"
+        "    Oi = 1;\n"
+        "}\n";
+    const char *rib =
+        "Format 4 4 1\nProjection \"perspective\" \"fov\" [20]\n"
+        "PixelSamples 1 1\nPixelFilter \"box\" 1 1\n"
+        "WorldBegin\n"
+        "Surface \"greedy\"\n"
+        "Polygon \"P\" [-100 -100 6  -100 100 6  100 100 6  100 -100 6]\n"
+        "Polygon \"P\" [-100 -100 -1  100 -100 -1  100 100 -1  -100 100 -1]\n"
+        "WorldEnd\n";
+    fixture_shader sh[] = {{"greedy", greedy}};
+    fixture f;
+    assert_true(fixture_open(&f, rib, sh, 1, NULL, 0));
+    trace_thread *th = trace_thread_new(&f.js->world);
+    double rgb[3], a, z;
+    trace_render_sample(f.js->renderer, th, 2, 2, rgb, &a, &z);
+    printf("greedy shader: %s\n", th->error);
+    assert_true(th->failed);
+    assert_non_null(strstr(th->error, "surface shader 'greedy': more than 1024 rays traced by "
+                                      "trace() and shadow() for one sample"));
+    trace_thread_destroy(&th);
+    fixture_close(&f);
+}
+
 /* ---- shadow() ---- */
 
 #define SHADER_SHADOWPOINT \
@@ -313,6 +349,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_mirror_floor_shows_the_sphere_where_a_direct_ray_finds_it),
         cmocka_unit_test(test_facing_mirrors_stop_at_the_depth_limit),
+        cmocka_unit_test(test_rays_in_loops_at_every_depth_hit_the_limit),
         cmocka_unit_test(test_shadow_in_a_light_shader_is_a_traced_shadow_ray),
         cmocka_unit_test(test_shadow_under_solar_goes_to_infinity),
         cmocka_unit_test(test_shadow_in_an_illuminance_loop),
