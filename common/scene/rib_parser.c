@@ -644,6 +644,7 @@ static scene *scene_new(const char *file)
     s->exposure_gain = s->exposure_gamma = 1;
     s->filter.kind = SCENE_FILTER_GAUSSIAN;
     s->filter.xwidth = s->filter.ywidth = 2;
+    s->trace_maxdepth = -1;
     return s;
 }
 

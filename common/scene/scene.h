@@ -200,7 +200,13 @@ typedef struct scene {
                                     * order of first reading; positions inside
                                     * them point at these names */
     int narchives;
+    int trace_maxdepth;            /* Option "trace" "maxdepth": nested trace()
+                                    * rays (-1: not given, the renderer's 4) */
 } scene;
+
+/* The largest Option "trace" "maxdepth" (each depth is a shading VM per
+ * thread). */
+enum { SCENE_MAX_TRACE_DEPTH = 16 };
 
 /* ---- building ------------------------------------------------------------ */
 

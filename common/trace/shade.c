@@ -175,8 +175,8 @@ static double shadow_ray(void *user, const char *map, const double P[3], const d
 
 /* trace(P, R) (RI Spec 3.2 §15.8): the colour the ray from P along R sees,
  * the hit shaded with its surface shader one level deeper (its own VM);
- * black where the ray leaves the scene or is deeper than
- * TRACE_MAX_RAY_DEPTH. The ray leaves P moved off the surface like a
+ * black where the ray leaves the scene or is deeper than the world's
+ * max_ray_depth (Option "trace" "maxdepth", default 4). The ray leaves P moved off the surface like a
  * shadow ray, with the shadow rays' tolerance. */
 static void trace_ray_cb(void *user, const double P[3], const double R[3], double Ci[3])
 {
@@ -184,7 +184,9 @@ static void trace_ray_cb(void *user, const double P[3], const double R[3], doubl
     Ci[0] = Ci[1] = Ci[2] = 0;
     vec3 p = v3(P[0], P[1], P[2]), d = v3(R[0], R[1], R[2]);
     double d2 = v3_dot(d, d);
-    if (c->depth >= TRACE_MAX_RAY_DEPTH || !(d2 > 0) || !isfinite(d2) ||
+    int maxdepth = c->r->world->options.max_ray_depth;
+    if (maxdepth > TRACE_RAY_DEPTH_LIMIT) maxdepth = TRACE_RAY_DEPTH_LIMIT;
+    if (c->depth >= maxdepth || !(d2 > 0) || !isfinite(d2) ||
         !isfinite(v3_dot(p, p)) || !count_shader_ray(c, "trace()"))
         return;
     vec3 side = v3_dot(c->N, d) >= 0 ? c->N : v3_neg(c->N);

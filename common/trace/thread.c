@@ -15,6 +15,7 @@ void trace_options_default(trace_options *opt)
     opt->max_instructions = 1000000;
     opt->leaf_fraction = 1.0;
     opt->max_nodes_per_ray = TRACE_DEFAULT_MAX_NODES_PER_RAY;
+    opt->max_ray_depth = TRACE_MAX_RAY_DEPTH;
 }
 
 /* A VM for this world's shaders, with what every shader may ask of the
@@ -56,7 +57,7 @@ void trace_thread_destroy(trace_thread **self_p)
     sl_vm_destroy(&self->vm);
     sl_vm_destroy(&self->shade_vm);
     sl_vm_destroy(&self->light_vm);
-    for (int d = 0; d < TRACE_MAX_RAY_DEPTH; d++)
+    for (int d = 0; d < TRACE_RAY_DEPTH_LIMIT; d++)
         sl_vm_destroy(&self->ray_vm[d]);
     trace_boxcache_destroy(&self->cache);
     free(self->work);
@@ -66,7 +67,7 @@ void trace_thread_destroy(trace_thread **self_p)
 
 sl_vm *trace_thread_shade_vm(trace_thread *self, int depth)
 {
-    if (depth <= 0 || depth > TRACE_MAX_RAY_DEPTH) return self->shade_vm;
+    if (depth <= 0 || depth > TRACE_RAY_DEPTH_LIMIT) return self->shade_vm;
     if (!self->ray_vm[depth - 1]) self->ray_vm[depth - 1] = new_vm(self->world);
     return self->ray_vm[depth - 1];
 }

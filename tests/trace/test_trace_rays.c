@@ -133,25 +133,26 @@ static void test_mirror_floor_shows_the_sphere_where_a_direct_ray_finds_it(void 
     fixture_close(&f);
 }
 
-static void test_facing_mirrors_stop_at_the_depth_limit(void **state)
+/* One mirror in front of the camera, one behind it: every camera ray
+ * bounces between them; each level adds 0.25 * 0.5^depth, and the ray one
+ * deeper than maxdepth (the RIB's Option "trace" "maxdepth", default
+ * TRACE_MAX_RAY_DEPTH) sees black. */
+static void facing_mirrors(const char *option, int maxdepth)
 {
-    (void)state;
-    /* one mirror in front of the camera, one behind it: every camera ray
-     * bounces between them; each level adds 0.25 * 0.5^depth, and the ray
-     * of depth TRACE_MAX_RAY_DEPTH + 1 sees black */
-    const char *rib =
-        "Format 8 8 1\nProjection \"perspective\" \"fov\" [20]\n"
-        "PixelSamples 1 1\nPixelFilter \"box\" 1 1\n"
-        "WorldBegin\n"
-        "Surface \"halfmirror\"\n"
-        "Polygon \"P\" [-100 -100 6  -100 100 6  100 100 6  100 -100 6]\n"
-        "Polygon \"P\" [-100 -100 -1  100 -100 -1  100 100 -1  -100 100 -1]\n"
-        "WorldEnd\n";
+    char rib[1024];
+    snprintf(rib, sizeof rib,
+             "Format 8 8 1\nProjection \"perspective\" \"fov\" [20]\n"
+             "PixelSamples 1 1\nPixelFilter \"box\" 1 1\n%s"
+             "WorldBegin\n"
+             "Surface \"halfmirror\"\n"
+             "Polygon \"P\" [-100 -100 6  -100 100 6  100 100 6  100 -100 6]\n"
+             "Polygon \"P\" [-100 -100 -1  100 -100 -1  100 100 -1  -100 100 -1]\n"
+             "WorldEnd\n", option);
     fixture_shader sh[] = {{"halfmirror", SHADER_HALFMIRROR}};
     fixture f;
     assert_true(fixture_open(&f, rib, sh, 1, NULL, 0));
     double want = 0;
-    for (int d = 0; d <= TRACE_MAX_RAY_DEPTH; d++) want += 0.25 * pow(0.5, d);
+    for (int d = 0; d <= maxdepth; d++) want += 0.25 * pow(0.5, d);
     trace_thread *th = trace_thread_new(&f.js->world);
     double worst = 0;
     for (int y = 0; y < 8; y++)
@@ -161,11 +162,20 @@ static void test_facing_mirrors_stop_at_the_depth_limit(void **state)
             for (int k = 0; k < 3; k++) worst = fmax(worst, fabs(rgb[k] - want));
         }
     printf("facing mirrors: %g expected (%d reflections), largest difference %.2g\n", want,
-           TRACE_MAX_RAY_DEPTH, worst);
+           maxdepth, worst);
     assert_false(th->failed);
     assert_true(worst < 1e-12);
     trace_thread_destroy(&th);
     fixture_close(&f);
+}
+
+static void test_facing_mirrors_stop_at_the_depth_limit(void **state)
+{
+    (void)state;
+    facing_mirrors("", TRACE_MAX_RAY_DEPTH);
+    facing_mirrors("Option \"trace\" \"maxdepth\" [2]\n", 2);
+    facing_mirrors("Option \"trace\" \"maxdepth\" [0]\n", 0);
+    facing_mirrors("Option \"trace\" \"maxdepth\" [9]\n", 9);
 }
 
 static void test_rays_in_loops_at_every_depth_hit_the_limit(void **state)
