@@ -142,7 +142,7 @@ static const sl_builtin table[] = {
     LW("attribute", "f:sV", MESSAGE, MESSAGE, SL_MSG_ATTRIBUTE),
     LW("option", "f:sV", MESSAGE, MESSAGE, SL_MSG_OPTION),
     LW("rendererinfo", "f:sV", MESSAGE, MESSAGE, SL_MSG_RENDERERINFO),
-    /* rays (§15.8, §15.9): the renderer's tracer (shader.h, sl_tracer);
+    /* rays (§15.6 trace, §15.7 shadow): the renderer's tracer (shader.h, sl_tracer);
      * shadow()'s optional parameters are accepted and ignored */
     LW("trace", "c:pv", RAY, RAY, SL_RAY_TRACE),
     LW("shadow", "f:sp", RAY, RAY, 1),

@@ -610,7 +610,7 @@ static void check_filter_param(checker *c, const sl_node *n, int i)
 }
 
 /* shadow(name, P, "blur", 0.01, ...): the shadow map parameters of RI Spec
- * 3.2 §15.9, accepted and ignored (the traced shadow ray is sharp). */
+ * 3.2 §15.7, accepted and ignored (the traced shadow ray is sharp). */
 static void check_shadow_param(checker *c, const sl_node *arg)
 {
     static const char *const names[] = { "samples", "blur", "bias", "width", "swidth",

@@ -243,7 +243,7 @@ void sl_vm_clear_messages(sl_vm *self, sl_message_scope scope);
 sl_status sl_light_eval(sl_vm *self, const sl_instance *inst, const double Ps[3],
                         sl_light_sample *out);
 
-/* Rays from shaders (RI Spec 3.2 §15.8 trace, §15.9 shadow): the
+/* Rays from shaders (RI Spec 3.2 §15.6 trace, §15.7 shadow): the
  * renderer's ray tracer, called in float and dual mode at the point of the
  * run (dual: derivatives 0). `trace` fills the colour seen from P along R.
  * `shadow` returns the fraction of light blocked on the segment from P

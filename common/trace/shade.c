@@ -128,7 +128,7 @@ static int light_samples(void *user, const double P[3], sl_light_sample *out, in
     return n;
 }
 
-/* shadow(map, P) (RI Spec 3.2 §15.9): aafarm has no shadow maps yet (the
+/* shadow(map, P) (RI Spec 3.2 §15.7): aafarm has no shadow maps yet (the
  * texture work, issue 16), so every map is missing and the answer is a
  * traced shadow ray from P towards the light: 1 blocked, 0 lit; one
  * warning per light (per render) says so. */
@@ -173,7 +173,7 @@ static double shadow_ray(void *user, const char *map, const double P[3], const d
     return occluded_from(c, p, d, isinf(tmax) ? INFINITY : tmax * (1.0 - 1e-9)) ? 1.0 : 0.0;
 }
 
-/* trace(P, R) (RI Spec 3.2 §15.8): the colour the ray from P along R sees,
+/* trace(P, R) (RI Spec 3.2 §15.6): the colour the ray from P along R sees,
  * the hit shaded with its surface shader one level deeper (its own VM);
  * black where the ray leaves the scene or is deeper than the world's
  * max_ray_depth (Option "trace" "maxdepth", default 4). The ray leaves P moved off the surface like a

@@ -10,7 +10,7 @@
  * (plus a relative epsilon): the displaced surface is only known to within
  * that box, so a smaller offset could find the surface itself.
  *
- * Shaders trace rays too (RI Spec 3.2 §15.8, §15.9, through the VM's
+ * Shaders trace rays too (RI Spec 3.2 §15.6, §15.7, through the VM's
  * sl_tracer): trace(P, R) in a surface shader shades the hit it finds with
  * that object's surface shader on the VM of the next depth (at most
  * TRACE_MAX_RAY_DEPTH deep, then black); shadow(map, P) in a light shader

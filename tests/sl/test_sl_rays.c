@@ -1,6 +1,6 @@
 /*
- * test_sl_rays.c: trace() and shadow() in the VM (RI Spec 3.2 §15.8,
- * §15.9), against a stand-in tracer that records what it was asked: the
+ * test_sl_rays.c: trace() and shadow() in the VM (RI Spec 3.2 §15.6,
+ * §15.7), against a stand-in tracer that records what it was asked: the
  * ray's origin and direction reach it as the shader computed them, the
  * colour comes back (dual: derivatives 0); shadow() aims at the light of
  * the last illuminate (Ps - L, tmax 1) or solar (-L, to infinity) in a

@@ -1,6 +1,6 @@
 /*
- * test_trace_rays.c: rays traced by shaders (RI Spec 3.2 §15.8 trace,
- * §15.9 shadow). A mirror floor (Ci = trace(P, reflect(I, N))) shows a
+ * test_trace_rays.c: rays traced by shaders (RI Spec 3.2 §15.6 trace,
+ * §15.7 shadow). A mirror floor (Ci = trace(P, reflect(I, N))) shows a
  * displaced sphere exactly where a ray traced directly from the floor point
  * finds it, with the sphere's own shading; two facing mirrors stop after
  * TRACE_MAX_RAY_DEPTH reflections; shadow() without a shadow map, in a
