@@ -271,8 +271,8 @@ int main(int argc, char **argv)
     };
     static const char *const modes[] = { "float", "dual", "interval", "affine" };
     sl_light_sample lights[2] = {
-        { { 0, 0, 0 }, { 0.2, 0.2, 0.2 }, true },
-        { { 1, 2, -2 }, { 0.8, 0.7, 0.6 }, false },
+        { { 0, 0, 0 }, { 0.2, 0.2, 0.2 }, true, false },
+        { { 1, 2, -2 }, { 0.8, 0.7, 0.6 }, false, true },
     };
     printf("sl_bench: evaluations per second (thousands) and instructions per evaluation\n"
            "(displacement shaders on the plane, surface shaders on the sphere; interval and\n"

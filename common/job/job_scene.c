@@ -248,6 +248,7 @@ job_scene *job_scene_new(const job *jb, size_t cache_bytes, bool render, sl_diag
         w->options.arith = jb->options.arith;
         w->options.max_instructions = jb->options.max_instructions;
         w->options.cache_bytes = cache_bytes;
+        if (sc->trace_maxdepth >= 0) w->options.max_ray_depth = sc->trace_maxdepth;
     }
     if (ok && !render) {
         char err[512];

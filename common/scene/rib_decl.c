@@ -222,6 +222,7 @@ static const struct { const char *name; sl_type type; int arraylen; } standard[]
     { "fov", SL_TYPE_FLOAT, 1 },    { "sphere", SL_TYPE_FLOAT, 1 },
     { "coordinatesystem", SL_TYPE_STRING, 1 },
     { "name", SL_TYPE_STRING, 1 },  { "shader", SL_TYPE_STRING, 1 },
+    { "maxdepth", SL_TYPE_FLOAT, 1 },       /* Option "trace" */
 };
 
 bool rib_decl_standard(const char *name, rib_decl *out)

@@ -267,9 +267,32 @@ static void set_path(char ***path, int *npath, const char *value)
     *npath = n;
 }
 
+/* Option "trace" "maxdepth" [n]: how deep trace() rays from shaders nest
+ * (docs/renderer.md, "Shading"). */
+static void trace_option(rib_parser *p, const rib_request *req)
+{
+    rib_params params;
+    if (!rib_params_read(p, req, 1, RIB_PARAMS_LOOSE, &params))
+        return;
+    const scene_param *depth = rib_params_find(&params, "maxdepth");
+    if (depth && depth->values && depth->count >= 1) {
+        double d = depth->values[0];
+        if (!(d >= 0 && d <= SCENE_MAX_TRACE_DEPTH && d == floor(d)))
+            rib_error(p, req, depth->pos, "\"maxdepth\" must be a whole number from 0 to %d, "
+                      "got %g", SCENE_MAX_TRACE_DEPTH, d);
+        else
+            p->scene->trace_maxdepth = (int)d;
+    }
+    rib_params_free(&params);
+}
+
 void rib_option(rib_parser *p, const rib_request *req)
 {
     const char *name = rib_read_string(p, req, 0, "the option name");
+    if (name && strcmp(name, "trace") == 0) {
+        trace_option(p, req);
+        return;
+    }
     if (!name || strcmp(name, "searchpath") != 0)
         return;   /* other options are ignored quietly */
     rib_params params;

@@ -366,6 +366,15 @@ typedef struct request_def {
     where where;
 } request_def;
 
+/* Shader "name" "handle" (RSL 2 co-shaders, PRMan 13.5): not supported;
+ * the shaders that would look the handle up cannot compile either. */
+static void rib_coshader(rib_parser *p, const rib_request *req)
+{
+    rib_error(p, req, req->pos, "RSL 2 co-shaders are not supported: aafarm compiles "
+              "each shader on its own; put the co-shader's code in a function of the shader "
+              "that uses it");
+}
+
 static const request_def requests[] = {
     { "version", rib_version, ANYWHERE },
     { "Display", rib_display, OPTIONS },
@@ -398,6 +407,7 @@ static const request_def requests[] = {
     { "Illuminate", rib_illuminate, WORLD },
     { "Surface", rib_surface, ANYWHERE },
     { "Displacement", rib_displacement, ANYWHERE },
+    { "Shader", rib_coshader, ANYWHERE },
     { "Color", rib_color, ANYWHERE },
     { "Opacity", rib_opacity, ANYWHERE },
     { "Attribute", rib_attribute, ANYWHERE },
@@ -673,6 +683,7 @@ static scene *scene_new(const char *file)
     s->filter.kind = SCENE_FILTER_GAUSSIAN;
     s->filter.xwidth = s->filter.ywidth = 2;
     s->frame_number = 1;
+    s->trace_maxdepth = -1;
     return s;
 }
 

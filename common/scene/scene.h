@@ -213,7 +213,13 @@ typedef struct scene {
     int frame_number;              /* its FrameBegin number (1 without one) */
     int nframes;                   /* FrameBegin blocks in the file (0: none) */
     int *frame_numbers;            /* each one's number, nframes of them */
+    int trace_maxdepth;            /* Option "trace" "maxdepth": nested trace()
+                                    * rays (-1: not given, the renderer's 4) */
 } scene;
+
+/* The largest Option "trace" "maxdepth" (each depth is a shading VM per
+ * thread). */
+enum { SCENE_MAX_TRACE_DEPTH = 16 };
 
 /* ---- building ------------------------------------------------------------ */
 

@@ -78,7 +78,15 @@ typedef struct sl_sym {
     int param_index;    /* SL_SYM_PARAM */
     int slot;           /* codegen: first slot (scalar or string file) */
     int cg_len;         /* codegen: the length bound to an unsized array parameter */
+    bool resizable;     /* RSL 2: a local 'float a[];' (SL_RESIZABLE_CAPACITY) */
+    int cg_len_slot;    /* codegen: the slot of a resizable array's length (0: none) */
 } sl_sym;
+
+/* RSL 2 resizable arrays (a local declared without size or initializer):
+ * the elements they can hold; their length lives in a slot of its own. */
+enum { SL_RESIZABLE_CAPACITY = 64 };
+/* The call node's op for resize(a, n), reserve(a, n), push(a, v), pop(a). */
+enum { SL_RESIZE_RESIZE, SL_RESIZE_RESERVE, SL_RESIZE_PUSH, SL_RESIZE_POP };
 
 typedef struct sl_node sl_node;
 

@@ -63,6 +63,7 @@ static const sl_builtin table[] = {
     LW("fresnel", "0:SSfww", FRESNEL, END, 0),
     LW("fresnel", "0:SSfwwoo", FRESNEL, END, 0),
     LW("depth", "f:p", DEPTH, END, 0),
+    LW("ptlined", "f:ppp", EXTRA, END, 0),
     LW("transform", "p:sp", TRANSFORM, XPOINT, 0),
     LW("transform", "p:ssp", TRANSFORM, XPOINT, 0),
     LW("transform", "p:mp", TRANSFORM, XPOINT, 0),
@@ -98,6 +99,7 @@ static const sl_builtin table[] = {
     LW("determinant", "f:m", DETERMINANT, END, 0),
     LW("translate", "m:mv", MATRIX_XFORM, END, 0),
     LW("rotate", "m:mfv", MATRIX_XFORM, END, 1),
+    LW("rotate", "p:pfpp", EXTRA, END, 1),      /* §15.2: Q about the line P0 P1 */
     LW("scale", "m:mp", MATRIX_XFORM, END, 2),
     /* noise (§15.1) */
     LW("noise", "F:f", NOISE, NOISE, SL_NOISE_PLAIN),
@@ -118,6 +120,8 @@ static const sl_builtin table[] = {
     LW("diffuse", "c:n", LIGHT, DIFFUSE, 0),
     LW("specular", "c:nvf", LIGHT, SPECULAR, 0),
     LW("phong", "c:nvf", LIGHT, PHONG, 0),
+    LW("specularbrdf", "c:SSSf", EXTRA, END, 2),
+    LW("shadername", "s:", EXTRA, END, 3),
     /* the parts of an illuminance loop (parser.c builds the calls; their
      * names cannot be written in a source) */
     LW("illuminance start", "0:p", ILLUMINANCE, LSTART, 0),
@@ -138,6 +142,14 @@ static const sl_builtin table[] = {
     LW("attribute", "f:sV", MESSAGE, MESSAGE, SL_MSG_ATTRIBUTE),
     LW("option", "f:sV", MESSAGE, MESSAGE, SL_MSG_OPTION),
     LW("rendererinfo", "f:sV", MESSAGE, MESSAGE, SL_MSG_RENDERERINFO),
+    /* rays (§15.6 trace, §15.7 shadow): the renderer's tracer (shader.h, sl_tracer);
+     * shadow()'s optional parameters are accepted and ignored */
+    LW("trace", "c:pv", RAY, RAY, SL_RAY_TRACE),
+    LW("shadow", "f:sp", RAY, RAY, 1),
+    LW("shadow", "f:spsf", RAY, RAY, 1),
+    LW("shadow", "f:spsfsf", RAY, RAY, 1),
+    LW("shadow", "f:spsfsfsf", RAY, RAY, 1),
+    LW("shadow", "f:spsfsfsfsf", RAY, RAY, 1),
     /* spline (§15.1): variadic, checked by check_spline */
     LW("spline", "A:", SPLINE, END, 0),
 };

@@ -54,6 +54,10 @@ typedef enum sl_lowering {
                              (check_strings); op SCAT / SFMT / SPRINT */
     SL_LOWER_MATCH,
     SL_LOWER_MESSAGE,     /* displacement("name", x) ...: k = sl_message_scope */
+    SL_LOWER_EXTRA,       /* k: 0 ptlined, 1 rotate(Q, angle, P0, P1),
+                             2 specularbrdf, 3 shadername() */
+    SL_LOWER_RAY,         /* trace(P, R), shadow(name, P [, "param", v ...]):
+                             op RAY, k = SL_RAY_TRACE or 1 (a shadow) */
     SL_LOWER_SPLINE,      /* spline([basis,] t, knots... | knots[]): checked
                              apart (variadic); node op = the basis index */
 } sl_lowering;

@@ -88,7 +88,8 @@ enum {
     X(LSTART, "lstart", "----") X(LNEXT, "lnext", "z---")          \
     X(MESSAGE, "message", "zskk")                                \
     X(SCAT, "scat", "sss-") X(SFMT, "sfmt", "sxsk")              \
-    X(SPRINT, "sprint", "s---") X(SMATCH, "smatch", "zss-")
+    X(SPRINT, "sprint", "s---") X(SMATCH, "smatch", "zss-")      \
+    X(RAY, "ray", "zxxk")
 
 typedef enum sl_opcode {
 #define SL_OPCODE_ENUM(name, text, operands) SL_OP_##name,
@@ -110,6 +111,20 @@ static inline int sl_array_stride(int d)
     int code = d >> SL_ARRAY_STRIDE_SHIFT;
     return code == 0 ? 1 : code == 1 ? 3 : 16;
 }
+
+/* RAY z, P, D, d: trace(P, D) (3 slots) or shadow(map, P) (1 slot), by
+ * the renderer's tracer (shader.h, sl_tracer); d = kind | the string slot
+ * of the map's name << 2. For shadow(), D is the L global: in a light
+ * shader it points from the light to Ps (illuminate: the light is at
+ * Ps - L; solar: L is its direction), in a surface shader's illuminance
+ * loop from P towards the current light. */
+enum {
+    SL_RAY_TRACE = 0,
+    SL_RAY_SHADOW_ILLUMINATE = 1,   /* light shader: towards Ps - L */
+    SL_RAY_SHADOW_SOLAR = 2,        /* light shader: along -L to infinity */
+    SL_RAY_SHADOW_SURFACE = 3,      /* surface shader: along L, the current light */
+    SL_RAY_KIND_BITS = 2,
+};
 
 typedef struct sl_insn {
     uint8_t op;

@@ -41,6 +41,7 @@ typedef struct checker {
     sl_ast_file *file;
     sl_sym *globals[SL_G__COUNT];
     sl_sym *pi;
+    sl_sym *ncomps, *dtime;   /* RI Spec 3.2 §13: 3 color components; no motion blur */
     sl_sym **syms;                 /* scope stack */
     int nsyms, syms_cap;
     int scope_start;               /* first sym of the innermost scope */
@@ -99,6 +100,10 @@ static sl_sym *lookup(checker *c, const char *name)
         return c->globals[g];
     if (strcmp(name, "PI") == 0)
         return c->pi;
+    if (strcmp(name, "ncomps") == 0)
+        return c->ncomps;
+    if (strcmp(name, "dtime") == 0)
+        return c->dtime;
     return NULL;
 }
 
@@ -328,8 +333,8 @@ static sl_ty arith_type(checker *c, const sl_node *n, sl_ty a, sl_ty b)
     if (a == SL_TYPE_MATRIX || b == SL_TYPE_MATRIX) {
         if (op == SL_TOK_STAR && (a == b || a == SL_TYPE_FLOAT || b == SL_TYPE_FLOAT))
             return SL_TYPE_MATRIX;
-        if (op == SL_TOK_SLASH && a == SL_TYPE_MATRIX && b == SL_TYPE_FLOAT)
-            return SL_TYPE_MATRIX;
+        if (op == SL_TOK_SLASH && (a == SL_TYPE_MATRIX || a == SL_TYPE_FLOAT))
+            return SL_TYPE_MATRIX;      /* m / f; a / b = a * inverse(b) */
         goto bad;
     }
     if (a == SL_TYPE_FLOAT && sl_ty_is_triple(b))
@@ -604,6 +609,22 @@ static void check_filter_param(checker *c, const sl_node *n, int i)
               "float, \"filter\" with a name)", arg->name);
 }
 
+/* shadow(name, P, "blur", 0.01, ...): the shadow map parameters of RI Spec
+ * 3.2 §15.7, accepted and ignored (the traced shadow ray is sharp). */
+static void check_shadow_param(checker *c, const sl_node *arg)
+{
+    static const char *const names[] = { "samples", "blur", "bias", "width", "swidth",
+                                         "twidth" };
+    if (arg->kind == SL_N_STR)
+        for (size_t k = 0; k < sizeof names / sizeof names[0]; k++)
+            if (strcmp(arg->name, names[k]) == 0)
+                return;
+    error(c, arg->pos, "unknown shadow() parameter%s%s%s (known: \"samples\", \"blur\", "
+          "\"bias\", \"width\", \"swidth\", \"twidth\", each with a float; they are "
+          "accepted and ignored)", arg->kind == SL_N_STR ? " '" : "",
+          arg->kind == SL_N_STR ? arg->name : "", arg->kind == SL_N_STR ? "'" : "");
+}
+
 /* A color space argument (ctransform): a constant string naming one. */
 static void check_color_space_arg(checker *c, const sl_node *arg)
 {
@@ -659,6 +680,13 @@ static sl_ty check_builtin_call(checker *c, sl_node *n, const sl_ty *args, sl_ty
             if (bad)
                 error(c, n->list[0]->pos, "malformed regular expression '%s' (at character "
                       "%d)", n->list[0]->name, bad);
+            continue;
+        }
+        if (sig[i] == 's' && b->lower == SL_LOWER_RAY) {
+            if (i > 0)
+                check_shadow_param(c, n->list[i]);
+            else
+                wrap_conv(c, &n->list[i], want[i]);
             continue;
         }
         if (sig[i] == 's' && b->lower == SL_LOWER_MESSAGE) {
@@ -880,6 +908,54 @@ static sl_ty check_arraylength(checker *c, sl_node *n)
     return set_ty(n, SL_TYPE_FLOAT);
 }
 
+/* RSL 2 resizable arrays: resize(a, n), reserve(a, n), push(a, v), pop(a)
+ * on a local declared 'float a[];' or an unsized array parameter (whose
+ * argument must then be resizable: checked where the call is inlined).
+ * The node's op: SL_RESIZE_*. */
+static const char *const resizable_ops[] = { "resize", "reserve", "push", "pop" };
+
+static int resizable_op(const char *name)
+{
+    for (int k = 0; k < 4; k++)
+        if (strcmp(name, resizable_ops[k]) == 0)
+            return k;
+    return -1;
+}
+
+static sl_ty check_resizable(checker *c, sl_node *n, int op)
+{
+    int want = op == SL_RESIZE_POP ? 1 : 2;
+    for (int i = 0; i < n->nlist; i++)
+        check_expr(c, &n->list[i], i == 0 ? SL_TYPE_VOID : SL_TYPE_FLOAT);
+    const sl_node *a = n->nlist > 0 ? n->list[0] : NULL;
+    bool ok = a && a->kind == SL_N_IDENT && a->sym && sl_ty_is_array(a->ty) &&
+              (a->sym->resizable || (a->sym->kind == SL_SYM_FPARAM && sl_ty_len(a->sym->ty) == 0));
+    if (a && a->ty == SL_TY_ERROR)
+        return set_ty(n, SL_TY_ERROR);
+    if (!ok || n->nlist != want) {
+        error(c, n->pos, "%s() takes a resizable array (a local declared without size or "
+              "initializer, as 'float a[];')%s", resizable_ops[op],
+              op == SL_RESIZE_POP ? "" : op == SL_RESIZE_PUSH ? " and a value"
+                                                              : " and a number of elements");
+        return set_ty(n, SL_TY_ERROR);
+    }
+    n->op = op;
+    sl_ty elem = sl_ty_elem(a->ty);
+    if (want == 2) {
+        sl_ty to = op == SL_RESIZE_PUSH ? elem : SL_TYPE_FLOAT;
+        sl_ty t = n->list[1]->ty;
+        if (t == SL_TY_ERROR)
+            return set_ty(n, SL_TY_ERROR);
+        if (!can_convert(t, to)) {
+            error(c, n->list[1]->pos, "argument 2 of '%s' must be a '%s', not a '%s'",
+                  resizable_ops[op], sl_ty_name(to), sl_ty_name(t));
+            return set_ty(n, SL_TY_ERROR);
+        }
+        wrap_conv(c, &n->list[1], to);
+    }
+    return set_ty(n, op == SL_RESIZE_POP ? elem : SL_TYPE_VOID);
+}
+
 /* spline([basis,] t, k0, k1, ...) and spline([basis,] t, knots[]) (RI
  * Spec 3.2 §15.1): the knots are floats, colors, points or vectors (the
  * first knot's type, or the context's for an untyped first knot); the
@@ -1082,6 +1158,21 @@ static sl_ty check_call(checker *c, sl_node *n, sl_ty hint)
     int ncands = find_funcs(c, n->name, cands, MAX_OVERLOADS);
     if (ncands == 0 && strcmp(n->name, "arraylength") == 0)
         return check_arraylength(c, n);
+    if (ncands == 0 && resizable_op(n->name) >= 0)
+        return check_resizable(c, n, resizable_op(n->name));
+    if (ncands == 0 && n->nlist > 2 && n->nlist <= 8 &&
+        (strcmp(n->name, "min") == 0 || strcmp(n->name, "max") == 0)) {
+        /* RI Spec 3.2 §15.1 min(a, b, ...): min(min(a, b, ...), last) */
+        sl_node *inner = sl_node_new(c->arena, SL_N_CALL, n->pos);
+        inner->name = n->name;
+        inner->list = n->list;
+        inner->nlist = n->nlist - 1;
+        sl_node **two = sl_arena_alloc(c->arena, 2 * sizeof *two);
+        two[0] = inner;
+        two[1] = n->list[n->nlist - 1];
+        n->list = two;
+        n->nlist = 2;
+    }
     if (ncands == 0 && strcmp(n->name, "spline") == 0)
         return check_spline(c, n, hint);
     if (ncands == 0) {
@@ -1096,7 +1187,7 @@ static sl_ty check_call(checker *c, sl_node *n, sl_ty hint)
         for (int i = 0; i < n->nlist; i++)
             check_expr(c, &n->list[i], SL_TYPE_VOID);
         static const char *const later[] = {
-            "texture", "environment", "shadow", "bump", "textureinfo",
+            "texture", "environment", "bump", "textureinfo",
         };
         for (size_t k = 0; k < sizeof later / sizeof later[0]; k++) {
             if (strcmp(n->name, later[k]) == 0) {
@@ -1105,9 +1196,26 @@ static sl_ty check_call(checker *c, sl_node *n, sl_ty hint)
                 return set_ty(n, SL_TY_ERROR);
             }
         }
-        if (strcmp(n->name, "trace") == 0 || strcmp(n->name, "gather") == 0) {
-            error(c, n->pos, "'%s' is not supported yet: shaders cannot trace rays in "
-                             "aafarm's ray tracer", n->name);
+        if (strcmp(n->name, "atmosphere") == 0 || strcmp(n->name, "incident") == 0 ||
+            strcmp(n->name, "opposite") == 0) {
+            error(c, n->pos, "'%s' reads the values of a volume shader, and volume shaders "
+                             "are not supported", n->name);
+            return set_ty(n, SL_TY_ERROR);
+        }
+        if (strcmp(n->name, "Dtime") == 0) {
+            error(c, n->pos, "'Dtime' is not supported: aafarm renders no motion blur, so "
+                             "nothing changes with time (use 0)");
+            return set_ty(n, SL_TY_ERROR);
+        }
+        if (strcmp(n->name, "getshader") == 0 || strcmp(n->name, "getshaders") == 0) {
+            error(c, n->pos, "'%s' (RSL 2 co-shaders) is not supported: aafarm compiles "
+                             "each shader on its own: put the co-shader's code in a function "
+                             "of this shader (or #include it)", n->name);
+            return set_ty(n, SL_TY_ERROR);
+        }
+        if (strcmp(n->name, "gather") == 0) {
+            error(c, n->pos, "'gather' is not supported: shaders trace single rays with "
+                             "trace(P, R) and shadow(name, P)");
             return set_ty(n, SL_TY_ERROR);
         }
         if (lookup(c, n->name))
@@ -1342,8 +1450,12 @@ static void check_init(checker *c, sl_node *v, sl_sym *s)
         else
             wrap_conv(c, &v->a, s->ty);
     }
-    if (sl_ty_is_array(s->ty) && sl_ty_len(s->ty) == 0)
+    if (sl_ty_is_array(s->ty) && sl_ty_len(s->ty) == 0 && s->kind == SL_SYM_LOCAL && !init) {
+        s->resizable = true;          /* RSL 2: 'float a[];' grows with push/resize */
+        s->ty = sl_ty_array(sl_ty_elem(s->ty), SL_RESIZABLE_CAPACITY);
+    } else if (sl_ty_is_array(s->ty) && sl_ty_len(s->ty) == 0) {
         error(c, v->pos, "array '%s' needs a size or an initializer", s->name);
+    }
 }
 
 static void check_decl(checker *c, sl_node *n)
@@ -1657,6 +1769,14 @@ static void make_globals(checker *c)
     c->pi->kind = SL_SYM_CONST;
     c->pi->value = M_PI;
     c->pi->slot = -1;
+    c->ncomps = sl_arena_alloc(c->arena, sizeof *c->ncomps);
+    *c->ncomps = *c->pi;
+    c->ncomps->name = "ncomps";
+    c->ncomps->value = 3;
+    c->dtime = sl_arena_alloc(c->arena, sizeof *c->dtime);
+    *c->dtime = *c->pi;
+    c->dtime->name = "dtime";
+    c->dtime->value = 0;
 }
 
 static void check_shader(checker *c)

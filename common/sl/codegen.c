@@ -71,6 +71,7 @@ typedef struct cg {
     int nrets;
     sl_func *func;
     int shader_ret_flag;
+    bool solar;                          /* the last illuminate/solar was a solar */
     uint8_t death[SL_MAX_SLOTS / 8];     /* escape flags: their paths are saved */
     struct pending_escape { int pc, kind, id; } *escapes;
     int nescapes, escapes_cap, next_id;
@@ -298,6 +299,7 @@ static int written_count(const sl_insn *in, const sl_program *p)
     case SL_OP_MOVN: return in->c;
     case SL_OP_NOISE: return (in->c & SL_NOISE_VECTOR) ? 3 : 1;
     case SL_OP_RANDOM: return in->b;
+    case SL_OP_RAY: return (in->d & ((1 << SL_RAY_KIND_BITS) - 1)) == SL_RAY_TRACE ? 3 : 1;
     case SL_OP_CALCNORMAL: case SL_OP_AMBIENT: case SL_OP_DIFFUSE: case SL_OP_SPECULAR:
     case SL_OP_PHONG: case SL_OP_XPOINT: case SL_OP_XVECTOR: case SL_OP_XNORMAL:
     case SL_OP_SETCOMP:
@@ -570,6 +572,18 @@ static int gen_binary(cg *g, sl_node *e, int dst)
         if (na == 16 && nb == 16)     /* RenderMan's a * b: a first, then b */
             return gen_matmul(g, y, x, dst);
         break;
+    case SL_TOK_SLASH:
+        if (nb == 16) {               /* a / b = a * inverse(b) (RI Spec 3.2 §12) */
+            int inv = alloc_slots(g, 16);
+            emit(g, SL_OP_MINVERT, inv, y, 0, 0);
+            if (na == 16)
+                return gen_matmul(g, inv, x, dst);
+            int z = target(g, dst, 16);
+            for (int i = 0; i < 16; i++)
+                emit(g, SL_OP_MUL, z + i, x, inv + i, 0);
+            return z;
+        }
+        break;
     case SL_TOK_EQ: case SL_TOK_NE:
         if (na > 1) {          /* all lanes equal / some lane differs */
             int z = target(g, dst, 1);
@@ -725,6 +739,52 @@ static int gen_store(cg *g, sl_node *x, sl_node *value, int dst)
         emit(g, SL_OP_ASTORE, s->slot + k, i, v + k, array_operand(len, n));
     record_write(g, s->slot, len * n);
     return into(g, v, dst, n);
+}
+
+/* RSL 2 resizable arrays (a local 'float a[];'): SL_RESIZABLE_CAPACITY
+ * elements and a length slot. push stores at a[length] (astore: in range
+ * modes merged into every element the length can reach) and adds 1; pop
+ * subtracts 1 and loads a[length]; resize sets the length (floor(n), at
+ * least 0); resize and reserve probe element n - 1 with aload, so a size
+ * beyond the capacity stops the run there ("array index out of range");
+ * arraylength reads the length. */
+static int gen_resizable(cg *g, sl_node *e, int dst)
+{
+    const sl_sym *s = e->list[0]->sym;
+    int L = s->cg_len_slot;
+    if (!L) {
+        fail(g, "%s() on '%s': the array passed for it is not resizable (declare it without "
+             "size or initializer, as 'float a[];')", e->name, s->name);
+        return 0;
+    }
+    int len = array_len(s), n = sl_ty_slots(sl_ty_elem(s->ty));
+    if (strcmp(e->name, "arraylength") == 0)
+        return into(g, L, dst, 1);
+    switch (e->op) {
+    case SL_RESIZE_RESIZE: case SL_RESIZE_RESERVE: {
+        int k = op1(g, SL_OP_FLOOR, gen_expr(g, e->list[1], -1));
+        int probe = op2(g, SL_OP_MAX, op2(g, SL_OP_SUB, k, const_slot(g, 1)), const_slot(g, 0));
+        emit(g, SL_OP_ALOAD, alloc_slots(g, 1), s->slot, probe, array_operand(len, n));
+        if (e->op == SL_RESIZE_RESIZE)
+            emit(g, SL_OP_MAX, L, k, const_slot(g, 0), 0);
+        return 0;
+    }
+    case SL_RESIZE_PUSH: {
+        int v = gen_expr(g, e->list[1], -1);
+        for (int k = 0; k < n; k++)
+            emit(g, SL_OP_ASTORE, s->slot + k, L, v + k, array_operand(len, n));
+        record_write(g, s->slot, len * n);
+        emit(g, SL_OP_ADD, L, L, const_slot(g, 1), 0);
+        return 0;
+    }
+    default: {               /* pop */
+        emit(g, SL_OP_SUB, L, L, const_slot(g, 1), 0);
+        int z = alloc_slots(g, n);
+        for (int k = 0; k < n; k++)
+            emit(g, SL_OP_ALOAD, z + k, s->slot + k, L, array_operand(len, n));
+        return into(g, z, dst, n);
+    }
+    }
 }
 
 /* { values } into the array at dst. */
@@ -1530,6 +1590,102 @@ static int gen_spline(cg *g, sl_node *e, int dst)
     return z;
 }
 
+/* The rest of RI Spec 3.2's built-ins, lowered to scalar operations:
+ * ptlined(P0, P1, Q), the distance from Q to the segment P0 P1 (t =
+ * clamp((Q - P0).(P1 - P0) / |P1 - P0|^2, 0, 1)); rotate(Q, angle, P0, P1),
+ * Q rotated by angle (radians) about the line through P0 and P1, as
+ * RiRotate and rotate(m, angle, axis) turn (Rodrigues' formula about the
+ * unit axis a: p cos + (a ^ p) sin + a (a.p)(1 - cos)); specularbrdf(L, N,
+ * V, roughness), the lobe specular() sums: pow(max(0, normalize(N) .
+ * normalize(normalize(L) + V)), 1 / roughness) as a grey colour;
+ * shadername(), the shader's name. */
+static int gen_extra(cg *g, const sl_builtin *b, const int *args, int dst)
+{
+    switch ((int)b->k) {
+    case 0: {
+        int v = alloc_slots(g, 3), w = alloc_slots(g, 3), d = alloc_slots(g, 3);
+        for (int i = 0; i < 3; i++) {
+            emit(g, SL_OP_SUB, v + i, args[1] + i, args[0] + i, 0);
+            emit(g, SL_OP_SUB, w + i, args[2] + i, args[0] + i, 0);
+        }
+        int vv = op2(g, SL_OP_MAX, gen_dot(g, v, v, 3, -1), const_slot(g, 1e-300));
+        int t = alloc_slots(g, 1);
+        emit(g, SL_OP_CLAMP, t, op2(g, SL_OP_DIV, gen_dot(g, w, v, 3, -1), vv),
+             const_slot(g, 0), const_slot(g, 1));
+        for (int i = 0; i < 3; i++)
+            emit(g, SL_OP_SUB, d + i, w + i, op2(g, SL_OP_MUL, t, v + i), 0);
+        int z = target(g, dst, 1);
+        emit(g, SL_OP_SQRT, z, gen_dot(g, d, d, 3, -1), 0, 0);
+        return z;
+    }
+    case 1: {
+        int axis = alloc_slots(g, 3), p = alloc_slots(g, 3), r = alloc_slots(g, 3);
+        for (int i = 0; i < 3; i++) {
+            emit(g, SL_OP_SUB, axis + i, args[3] + i, args[2] + i, 0);
+            emit(g, SL_OP_SUB, p + i, args[0] + i, args[2] + i, 0);
+        }
+        int a = gen_normalize(g, axis, -1);
+        int c = op1(g, SL_OP_COS, args[1]), sn = op1(g, SL_OP_SIN, args[1]);
+        int ap = op2(g, SL_OP_MUL, gen_dot(g, a, p, 3, -1),
+                     op2(g, SL_OP_SUB, const_slot(g, 1), c));
+        int x = gen_cross(g, a, p, -1);
+        for (int i = 0; i < 3; i++) {
+            int sum = op2(g, SL_OP_ADD, op2(g, SL_OP_MUL, p + i, c),
+                          op2(g, SL_OP_MUL, x + i, sn));
+            sum = op2(g, SL_OP_ADD, sum, op2(g, SL_OP_MUL, a + i, ap));
+            emit(g, SL_OP_ADD, r + i, args[2] + i, sum, 0);
+        }
+        return into(g, r, dst, 3);
+    }
+    case 2: {
+        int L = gen_normalize(g, args[0], -1), H = alloc_slots(g, 3);
+        for (int i = 0; i < 3; i++)
+            emit(g, SL_OP_ADD, H + i, L + i, args[2] + i, 0);
+        int Hn = gen_normalize(g, H, -1), Nn = gen_normalize(g, args[1], -1);
+        int c = op2(g, SL_OP_MAX, gen_dot(g, Nn, Hn, 3, -1), const_slot(g, 0));
+        int lobe = op2(g, SL_OP_POW, c, op2(g, SL_OP_DIV, const_slot(g, 1), args[3]));
+        int z = target(g, dst, 3);
+        for (int i = 0; i < 3; i++)
+            emit(g, SL_OP_MOV, z + i, lobe, 0, 0);
+        return z;
+    }
+    default:
+        return into_string(g, string_const(g, g->prog->name, strlen(g->prog->name)), dst);
+    }
+}
+
+/* trace(P, R) and shadow(name, P): one RAY instruction, answered by the
+ * renderer's tracer at points (vm.c sl_vm_ray). shadow() aims at the light
+ * through the L global: in a light shader at the light of the last
+ * illuminate (Ps - L) or solar (-L, to infinity), in a surface shader at
+ * the current light of the illuminance loop. A displacement shader runs
+ * over ranges of the surface, where a ray cannot be bounded: an error. */
+static int gen_ray(cg *g, sl_node *e, int *args, int dst)
+{
+    bool trace = e->builtin->k == SL_RAY_TRACE;
+    if (g->prog->kind == SL_SHADER_DISPLACEMENT) {
+        fail(g, "%s() cannot be used in a displacement shader: it runs over ranges of the "
+             "surface, where a traced ray has no bound (use it in a surface%s shader)",
+             trace ? "trace" : "shadow", trace ? "" : " or light");
+        return 0;
+    }
+    int kind = trace ? SL_RAY_TRACE
+             : g->prog->kind == SL_SHADER_LIGHT ? (g->solar ? SL_RAY_SHADOW_SOLAR
+                                                            : SL_RAY_SHADOW_ILLUMINATE)
+             : SL_RAY_SHADOW_SURFACE;
+    int n = trace ? 3 : 1;
+    int P = trace ? args[0] : args[1];
+    int D = trace ? args[1] : sl_global_slot(SL_G_L);
+    int map = 0;
+    if (!trace) {                 /* a slot of its own: a constant's is fixed up later */
+        map = alloc_string(g);
+        emit(g, SL_OP_SMOV, map, args[0], 0, 0);
+    }
+    int z = alloc_slots(g, n);
+    emit(g, SL_OP_RAY, z, P, D, kind | map << SL_RAY_KIND_BITS);
+    return into(g, z, dst, n);
+}
+
 static int gen_builtin(cg *g, sl_node *e, int dst)
 {
     const sl_builtin *b = e->builtin;
@@ -1609,6 +1765,7 @@ static int gen_builtin(cg *g, sl_node *e, int dst)
     case SL_LOWER_EMITTER: {      /* L = Ps - position / axis / 0 */
         int L = sl_global_slot(SL_G_L), P = sl_global_slot(SL_G_P);
         g->prog->emits_light = true;
+        g->solar = b->k != 0;
         for (int i = 0; i < 3; i++) {
             if (b->k == 0)
                 emit(g, SL_OP_SUB, L + i, P + i, args[0] + i, 0);
@@ -1628,6 +1785,8 @@ static int gen_builtin(cg *g, sl_node *e, int dst)
             record_write(g, args[1], size);
         return z;
     }
+    case SL_LOWER_RAY: return gen_ray(g, e, args, dst);
+    case SL_LOWER_EXTRA: return gen_extra(g, b, args, dst);
     case SL_LOWER_SPLINE: case SL_LOWER_STRINGS: break;     /* gen_spline, gen_strings */
     case SL_LOWER_MATCH: {
         int z = target(g, dst, 1);
@@ -1666,6 +1825,7 @@ static int gen_user_call(cg *g, sl_node *e, int dst)
                 return 0;
             }
             p->cg_len = len;
+            p->cg_len_slot = e->list[i]->sym->cg_len_slot;   /* resizable: its length */
         }
         p->slot = args[i];
     }
@@ -1732,7 +1892,9 @@ static int gen_expr(cg *g, sl_node *e, int dst)
             r = gen_strings(g, e, dst);
         else if (e->builtin)
             r = gen_builtin(g, e, dst);
-        else            /* arraylength(a) */
+        else if (strcmp(e->name, "arraylength") != 0 || e->list[0]->sym->cg_len_slot)
+            r = gen_resizable(g, e, dst);
+        else            /* arraylength(a) of a fixed-size array */
             r = into(g, const_slot(g, array_len(e->list[0]->sym)), dst, 1);
         break;
     case SL_N_INDEX: r = gen_index(g, e, dst); break;
@@ -1833,6 +1995,10 @@ static void gen_decl(cg *g, sl_node *n)
                 emit(g, SL_OP_MOV, s->slot + k, const_slot(g, 0), 0, 0);
         }
         g->sp = s->slot + size;
+        if (s->resizable) {       /* its length, after the elements */
+            s->cg_len_slot = alloc_slots(g, 1);
+            emit(g, SL_OP_MOV, s->cg_len_slot, const_slot(g, 0), 0, 0);
+        }
     }
 }
 

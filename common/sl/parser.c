@@ -2,7 +2,10 @@
  * parser.c: recursive descent over the grammar of RenderMan's Shading
  * Language (RI Spec 3.2 Appendix B), one function per rule.
  *
- *   file        := { shader | function }
+ *   file        := { shader | function | class }
+ *   class       := 'class' IDENT '(' [formals] ')' '{' { member } '}'   (RSL 2)
+ *   member      := ['public'] type IDENT '(' [formals] ')' block
+ *                | ['public'] type def {',' def} ';'
  *   shader      := ('surface' | 'displacement') IDENT '(' [formals] ')' block
  *   function    := [type] IDENT '(' [formals] ')' block
  *   formals     := formal { (';' | ',') formal } [';']
@@ -28,6 +31,8 @@
  * the same brace depth.
  */
 #include "sl/parser.h"
+
+#include "sl/class.h"
 
 #include <stdio.h>
 #include <string.h>
@@ -230,7 +235,7 @@ static sl_node *call(parser *p, sl_token name)
     return n;
 }
 
-static sl_node *primary(parser *p)
+static sl_node *primary_inner(parser *p)
 {
     sl_token t = p->cur;
     switch (t.kind) {
@@ -291,6 +296,23 @@ static sl_node *primary(parser *p)
     }
     error_at(p, t.pos, &t, "expected expression");
     return error_node(p, t.pos);
+}
+
+#define SL_COSHADER_HELP \
+    "aafarm compiles each shader on its own: put the co-shader's code in a function of " \
+    "this shader (or #include it)"
+
+/* A primary, and the RSL 2 method call 'x->method(...)' after it (the
+ * lexer gives '-' '>'): co-shaders are not supported, said here. */
+static sl_node *primary(parser *p)
+{
+    sl_node *n = primary_inner(p);
+    if (check(p, SL_TOK_MINUS) && peek_kind(p, 0) == SL_TOK_GT) {
+        error_at(p, p->cur.pos, &p->cur, "method calls with '->' (RSL 2 co-shaders) are not "
+                 "supported: " SL_COSHADER_HELP);
+        return error_node(p, p->cur.pos);
+    }
+    return n;
 }
 
 /* type [STRING] ( '(' list ')' | unary ): a cast or a constructor. */
@@ -484,6 +506,11 @@ static bool decl_spec(parser *p, declspec *spec, const char *context)
         if (p->cur.kind == SL_KW_EXTERN)
             spec->external = true;
         advance(p);
+    }
+    if (check(p, SL_TOK_IDENT) && strcmp(p->cur.text, "shader") == 0) {
+        error_at(p, p->cur.pos, &p->cur, "'shader' variables (RSL 2 co-shaders) are not "
+                 "supported: " SL_COSHADER_HELP);
+        return false;
     }
     if (!is_type_kw(p->cur.kind)) {
         error_at(p, p->cur.pos, &p->cur, "expected type name %s", context);
@@ -958,7 +985,9 @@ static sl_node *statement_inner(parser *p)
     default: break;
     }
     if (is_qualifier(p->cur.kind) ||
-        (is_type_kw(p->cur.kind) && peek_kind(p, 0) == SL_TOK_IDENT))
+        ((is_type_kw(p->cur.kind) ||
+          (check(p, SL_TOK_IDENT) && strcmp(p->cur.text, "shader") == 0)) &&
+         peek_kind(p, 0) == SL_TOK_IDENT))
         return declaration(p, true);
     sl_node *n = sl_node_new(p->arena, SL_N_EXPR, p->cur.pos);
     n->a = expression(p);
@@ -1015,6 +1044,84 @@ static void shader_definition(parser *p, sl_ast_file *file)
     file->body = block(p);
 }
 
+/* One member of a class body: a method (the shader methods are named
+ * 'surface', 'displacement', 'light': keywords) or member variables. */
+static void class_member(parser *p, sl_class *cls)
+{
+    if (check(p, SL_TOK_IDENT) && strcmp(p->cur.text, "public") == 0)
+        advance(p);
+    declspec spec;
+    if (!decl_spec(p, &spec, "in class body"))
+        return;
+    sl_token_kind k = p->cur.kind;
+    if ((k == SL_TOK_IDENT || k == SL_KW_SURFACE || k == SL_KW_DISPLACEMENT ||
+         k == SL_KW_LIGHT) && peek_kind(p, 0) == SL_TOK_LPAREN) {
+        sl_func *f = function_rest(p, spec.ty);
+        if (f)
+            sl_list_push(p->arena, (void ***)&cls->methods, &cls->nmethods,
+                         &cls->methods_cap, f);
+        return;
+    }
+    if (spec.output || spec.external) {
+        error_at(p, spec.type_tok.pos, &spec.type_tok, "'%s' is not allowed on member "
+                 "variables", spec.output ? "output" : "extern");
+        return;
+    }
+    sl_node *d = sl_node_new(p->arena, SL_N_DECL, spec.type_tok.pos);
+    int cap = 0;
+    do {
+        sl_node *v = declarator(p, &spec, SL_SYM_LOCAL, true);
+        if (!v)
+            return;
+        push_node(p, d, &cap, v);
+    } while (match(p, SL_TOK_COMMA));
+    if (expect_after(p, SL_TOK_SEMICOLON, "member declaration"))
+        sl_list_push(p->arena, (void ***)&cls->members, &cls->nmembers, &cls->members_cap, d);
+}
+
+/* RSL 2: 'class' name '(' params ')' '{' members '}', lowered to a shader
+ * by class.c. */
+static void class_definition(parser *p, sl_ast_file *file)
+{
+    advance(p);                                  /* 'class' */
+    sl_token name = p->cur;
+    advance(p);
+    if (file->has_shader) {
+        error_at(p, name.pos, &name, "more than one shader in one source ('%s' and '%s')",
+                 file->name, name.text);
+        sl_diag_note(p->diag, file->pos, "'%s' defined here", file->name);
+        return;
+    }
+    file->has_shader = true;
+    file->name = name.text;
+    file->pos = name.pos;
+    sl_class cls = { .name = name.text, .pos = name.pos };
+    sl_token open = p->cur;
+    if (!expect(p, SL_TOK_LPAREN, "after class name"))
+        return;
+    formals(p, &open, &file->params, &file->nparams, SL_SYM_PARAM);
+    for (int i = 0; i < file->nparams; i++)
+        file->params[i]->sym->param_index = i;
+    sl_token brace = p->cur;
+    if (!expect(p, SL_TOK_LBRACE, "to start the class body"))
+        return;
+    int errors = sl_diag_error_count(p->diag);
+    while (!check(p, SL_TOK_RBRACE) && !check(p, SL_TOK_EOF)) {
+        long start = p->consumed;
+        class_member(p, &cls);
+        if (p->panic) {
+            if (p->consumed > start &&
+                (p->prev.kind == SL_TOK_SEMICOLON || p->prev.kind == SL_TOK_RBRACE))
+                p->panic = false;
+            else
+                synchronize(p);
+        }
+    }
+    expect_closing(p, SL_TOK_RBRACE, &brace);
+    if (sl_diag_error_count(p->diag) == errors)
+        sl_class_lower(p->arena, p->diag, file, &cls);
+}
+
 static void function_definition(parser *p, sl_ast_file *file, int *funcs_cap)
 {
     sl_ty ret = SL_TYPE_VOID;
@@ -1063,6 +1170,9 @@ sl_ast_file *sl_parse(sl_lexer *lx, sl_arena *arena, sl_diag *diag)
         if (k == SL_KW_SURFACE || k == SL_KW_DISPLACEMENT || k == SL_KW_LIGHT ||
             k == SL_KW_VOLUME || k == SL_KW_IMAGER) {
             shader_definition(&p, file);
+        } else if (k == SL_TOK_IDENT && strcmp(p.cur.text, "class") == 0 &&
+                   peek_kind(&p, 0) == SL_TOK_IDENT) {
+            class_definition(&p, file);
         } else if (is_type_kw(k) || (k == SL_TOK_IDENT && peek_kind(&p, 0) == SL_TOK_LPAREN)) {
             function_definition(&p, file, &funcs_cap);
         } else {

@@ -146,6 +146,8 @@ typedef struct sl_light_sample {
     double L[3];
     double Cl[3];
     bool ambient;
+    bool directional;   /* L is a direction (distant, solar): the light is at
+                           infinity, for shadow() in an illuminance loop */
 } sl_light_sample;
 typedef int (*sl_light_fn)(void *user, const double P[3], sl_light_sample *out, int max);
 
@@ -245,6 +247,24 @@ void sl_vm_clear_messages(sl_vm *self, sl_message_scope scope);
  * surface shader's VM is busy), with the scene's spaces set on it. */
 sl_status sl_light_eval(sl_vm *self, const sl_instance *inst, const double Ps[3],
                         sl_light_sample *out);
+
+/* Rays from shaders (RI Spec 3.2 §15.6 trace, §15.7 shadow): the
+ * renderer's ray tracer, called in float and dual mode at the point of the
+ * run (dual: derivatives 0). `trace` fills the colour seen from P along R.
+ * `shadow` returns the fraction of light blocked on the segment from P
+ * towards the light, P + t D for t in (0, tmax): tmax 1 when the light is
+ * at P + D, INFINITY when D is a direction; `map` is the name the shader
+ * gave. Either may be NULL. Without a tracer trace() is black and shadow()
+ * 0 in every mode; with one, an interval or affine run reads trace() as
+ * unbounded and shadow() as [0, 1] (rays are traced at points only). */
+typedef struct sl_tracer {
+    void (*trace)(void *user, const double P[3], const double R[3], double Ci[3]);
+    double (*shadow)(void *user, const char *map, const double P[3], const double D[3],
+                     double tmax);
+    void *user;
+} sl_tracer;
+/* NULL: none. */
+void sl_vm_set_tracer(sl_vm *self, const sl_tracer *tracer);
 
 /* The camera's clipping planes (RIB Clipping), for depth(P) =
  * (z_camera - near) / (far - near). Default near 0, far 1: depth(P) is

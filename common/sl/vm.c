@@ -241,6 +241,50 @@ void sl_vm_set_fixed_lights(sl_vm *self, const sl_light_sample *samples, int cou
     self->nfixed_lights = count;
 }
 
+void sl_vm_set_tracer(sl_vm *self, const sl_tracer *tracer)
+{
+    if (tracer)
+        self->tracer = *tracer;
+    else
+        memset(&self->tracer, 0, sizeof self->tracer);
+}
+
+bool sl_vm_traces(const sl_vm *vm, int kind)
+{
+    return kind == SL_RAY_TRACE ? vm->tracer.trace != NULL : vm->tracer.shadow != NULL;
+}
+
+/* shadow(): the segment towards the light. In a light shader L points from
+ * the light to Ps (illuminate: the light is at Ps - L; solar: at infinity
+ * along -L); in a surface shader the current light of the illuminance loop
+ * gives L (towards it) and whether it is at infinity. */
+void sl_vm_ray(sl_vm *vm, int kind, const char *map, const double P[3], const double D[3],
+               double out[3])
+{
+    out[0] = out[1] = out[2] = 0;
+    if (!sl_vm_traces(vm, kind))
+        return;
+    if (kind == SL_RAY_TRACE) {
+        vm->tracer.trace(vm->tracer.user, P, D, out);
+        return;
+    }
+    double dir[3], tmax = 1.0;
+    for (int k = 0; k < 3; k++)
+        dir[k] = kind == SL_RAY_SHADOW_SURFACE ? D[k] : -D[k];
+    if (kind == SL_RAY_SHADOW_SOLAR) {
+        tmax = INFINITY;
+    } else if (kind == SL_RAY_SHADOW_SURFACE) {
+        if (vm->illum_next <= 0 || vm->illum_next > vm->nillum)
+            return;               /* outside an illuminance loop: no light */
+        if (vm->illum[vm->illum_next - 1].directional)
+            tmax = INFINITY;
+    }
+    if (!(dir[0] != 0 || dir[1] != 0 || dir[2] != 0))
+        return;
+    double f = vm->tracer.shadow(vm->tracer.user, map ? map : "", P, dir, tmax);
+    out[0] = f > 0 ? (f < 1 ? f : 1) : 0;
+}
+
 void sl_vm_set_seed(sl_vm *self, uint64_t seed) { self->seed = seed; }
 
 /* ---------------------------------------------------------------------- */
@@ -472,6 +516,7 @@ sl_status sl_vm_run(sl_vm *self, const sl_instance *inst, sl_mode mode, aa_conte
     self->acc_bottom = SL_VM_POOL_VALUES;
     self->sacc_bottom = SL_VM_POOL_VALUES;
     self->rng = self->seed;
+    self->nillum = self->illum_next = 0;
     ensure_clear(self, mode);
     load_strings(self, p);
     if (p->takes_derivatives && (mode == SL_MODE_INTERVAL || mode == SL_MODE_AFFINE))

@@ -98,6 +98,7 @@ struct sl_vm {
     mat4 depth;                   /* current -> camera, z to depth */
     sl_light_fn light_fn;
     void *light_user;
+    sl_tracer tracer;             /* trace() and shadow(); zeroed: none */
     sl_light_sample fixed_lights[SL_VM_MAX_LIGHTS];
     sl_light_sample illum[SL_VM_MAX_LIGHTS];   /* the illuminance loop's lights */
     int nillum, illum_next;
@@ -161,6 +162,15 @@ const mat4 *sl_vm_space_id(const sl_vm *vm, int space, int dir);
 /* Light samples at surface point P for float/dual runs: the callback's,
  * then the fixed lights. */
 int sl_vm_light_samples(sl_vm *vm, const double P[3], sl_light_sample *out);
+
+/* trace() / shadow() at one point (the RAY instruction in float and dual
+ * mode): kind SL_RAY_*, map the shadow map's name, P the ray's origin,
+ * D trace()'s direction or the L global for shadow(); out gets the colour
+ * (trace) or the blocked fraction (out[0], shadow). */
+void sl_vm_ray(sl_vm *vm, int kind, const char *map, const double P[3], const double D[3],
+               double out[3]);
+/* Does this VM's tracer answer rays of this kind? */
+bool sl_vm_traces(const sl_vm *vm, int kind);
 
 /* The next random number in [0, 1) of this run (splitmix64). */
 double sl_vm_random(sl_vm *vm);

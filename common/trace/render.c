@@ -63,6 +63,8 @@ trace_renderer *trace_renderer_new(trace_world *world, char *err, int errsz)
     if (!self) abort();
     self->world = world;
     self->bvh = trace_bvh_new(world);
+    self->shadow_warned = calloc((size_t)world->nlights + 1, sizeof *self->shadow_warned);
+    if (!self->shadow_warned) abort();
     self->primary_tol = trace_camera_tolerance(&world->camera, world->shading_rate,
                                                world->options.leaf_fraction);
     return self;
@@ -73,6 +75,7 @@ void trace_renderer_destroy(trace_renderer **self_p)
     trace_renderer *self = *self_p;
     if (!self) return;
     trace_bvh_destroy(&self->bvh);
+    free(self->shadow_warned);
     free(self);
     *self_p = NULL;
 }

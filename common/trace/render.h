@@ -16,6 +16,7 @@
 #ifndef TRACE_RENDER_H
 #define TRACE_RENDER_H
 
+#include <stdatomic.h>
 #include <stdbool.h>
 
 #include "trace/bvh.h"
@@ -26,6 +27,10 @@ typedef struct trace_renderer {
     const trace_world *world;
     trace_bvh *bvh;
     trace_tolerance primary_tol;
+    /* shadow() without a shadow map, answered by a traced ray: warned
+     * once per light (world->nlights entries, then one for surface
+     * shaders' illuminance loops), by whichever thread comes first */
+    atomic_uchar *shadow_warned;
 } trace_renderer;
 
 /* Computes every object's scale, root box (through its displacement

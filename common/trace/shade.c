@@ -1,12 +1,13 @@
 /*
- * shade.c: surface shading, lights (built-in and light shaders) and
- * shadows (see shade.h).
+ * shade.c: surface shading, lights (built-in and light shaders),
+ * shadows, and the rays shaders trace (trace(), shadow(); see shade.h).
  */
 #include "trace/shade.h"
 
 #include "trace/displace.h"
 
 #include <math.h>
+#include <stdio.h>
 
 typedef struct shade_ctx {
     const trace_renderer *r;
@@ -16,7 +17,15 @@ typedef struct shade_ctx {
     vec3 N;              /* unit normal used to offset shadow rays */
     double offset;       /* shadow ray offset (camera units) */
     double tol;          /* shadow ray leaf tolerance (camera units) */
+    int depth;           /* trace() rays that led here (0: a primary hit) */
+    int light;           /* the light shader being run (its index), or -1 */
 } shade_ctx;
+
+static void shade_hit(const trace_renderer *r, trace_thread *th, const trace_ray *ray,
+                      const trace_hit *hit, int depth, double rgb[3], double *alpha,
+                      vec3 *P_out);
+static double shadow_ray(void *user, const char *map, const double P[3], const double D[3],
+                         double tmax);
 
 static double smoothstep_d(double e0, double e1, double x)
 {
@@ -26,18 +35,25 @@ static double smoothstep_d(double e0, double e1, double x)
     return t * t * (3 - 2 * t);
 }
 
-/* Is the segment from the shaded point along L (to parameter tmax) blocked? */
-static bool occluded(shade_ctx *c, vec3 L, double tmax)
+/* Is the segment from P along L (to parameter tmax) blocked? It leaves
+ * from P moved off the surface on L's side. */
+static bool occluded_from(shade_ctx *c, vec3 P, vec3 L, double tmax)
 {
     trace_thread *th = c->th;
     vec3 side = v3_dot(c->N, L) >= 0 ? c->N : v3_neg(c->N);
-    vec3 o = v3_add(c->P, v3_scale(side, c->offset));
+    vec3 o = v3_add(P, v3_scale(side, c->offset));
     trace_ray ray;
     trace_ray_init(&ray, o, L, 0.0, tmax);
     trace_tolerance tol = {c->tol, 0.0};
     trace_hit hit = {.t = tmax, .obj = NULL};
     th->stats.shadow_rays++;
     return trace_bvh_intersect(c->r->bvh, th, &ray, &tol, true, &hit);
+}
+
+/* Is the segment from the shaded point along L (to parameter tmax) blocked? */
+static bool occluded(shade_ctx *c, vec3 L, double tmax)
+{
+    return occluded_from(c, c->P, L, tmax);
 }
 
 static int light_samples(void *user, const double P[3], sl_light_sample *out, int max)
@@ -73,10 +89,16 @@ static int light_samples(void *user, const double P[3], sl_light_sample *out, in
             double Ps[3] = {c->P.x, c->P.y, c->P.z};
             sl_vm *lvm = c->th->light_vm;
             sl_vm_set_spaces(lvm, &l->shader_spaces);
-            if (sl_light_eval(lvm, l->shader, Ps, s) != SL_OK) {
+            sl_tracer tracer = {.shadow = shadow_ray, .user = c};
+            sl_vm_set_tracer(lvm, &tracer);
+            c->light = c->obj->lights[i];
+            sl_status st = sl_light_eval(lvm, l->shader, Ps, s);
+            c->light = -1;
+            if (st != SL_OK) {
                 trace_thread_fail(c->th, sl_vm_error(lvm));
                 continue;
             }
+            s->directional = l->directional;
             if (s->ambient) { n++; continue; }
             L = v3(s->L[0], s->L[1], s->L[2]);
             if (!(s->Cl[0] != 0 || s->Cl[1] != 0 || s->Cl[2] != 0)) continue;
@@ -99,10 +121,84 @@ static int light_samples(void *user, const double P[3], sl_light_sample *out, in
         if (!(atten > 0) || !isfinite(atten)) continue;
         if (l->shadows && occluded(c, L, tmax * (1.0 - 1e-9))) continue;
         s->L[0] = L.x; s->L[1] = L.y; s->L[2] = L.z;
+        s->directional = l->kind == TRACE_LIGHT_DISTANT;
         for (int k = 0; k < 3; k++) s->Cl[k] = l->color[k] * atten;
         n++;
     }
     return n;
+}
+
+/* shadow(map, P) (RI Spec 3.2 §15.7): aafarm has no shadow maps yet (the
+ * texture work, issue 16), so every map is missing and the answer is a
+ * traced shadow ray from P towards the light: 1 blocked, 0 lit; one
+ * warning per light (per render) says so. */
+/* One more trace()/shadow() ray for this primary hit; false (the thread
+ * failed, with a message) beyond TRACE_MAX_SHADER_RAYS. */
+static bool count_shader_ray(shade_ctx *c, const char *what)
+{
+    trace_thread *th = c->th;
+    if (th->failed) return false;
+    if (++th->shader_rays <= TRACE_MAX_SHADER_RAYS) return true;
+    char msg[256];
+    snprintf(msg, sizeof msg, "surface shader '%s': more than %d rays traced by trace() and "
+             "shadow() for one sample (the limit; at %s)",
+             c->obj->surface ? sl_program_name(sl_instance_program(c->obj->surface)) : "",
+             TRACE_MAX_SHADER_RAYS, what);
+    trace_thread_fail(th, msg);
+    return false;
+}
+
+static double shadow_ray(void *user, const char *map, const double P[3], const double D[3],
+                         double tmax)
+{
+    shade_ctx *c = user;
+    if (!count_shader_ray(c, "shadow()"))
+        return 0;
+    const trace_world *w = c->r->world;
+    int slot = c->light >= 0 ? c->light : w->nlights;
+    if (!atomic_exchange(&c->r->shadow_warned[slot], 1)) {
+        if (c->light >= 0)
+            fprintf(stderr, "aafarm: warning: light %d (shader '%s'): shadow map '%s' does "
+                    "not exist; shadow() is answered by a traced shadow ray\n", c->light,
+                    sl_program_name(sl_instance_program(w->lights[c->light].shader)), map);
+        else
+            fprintf(stderr, "aafarm: warning: surface shader '%s': shadow map '%s' does not "
+                    "exist; shadow() is answered by a traced shadow ray\n",
+                    c->obj->surface ? sl_program_name(sl_instance_program(c->obj->surface))
+                                    : "", map);
+    }
+    vec3 p = v3(P[0], P[1], P[2]), d = v3(D[0], D[1], D[2]);
+    if (!isfinite(v3_dot(p, p)) || !isfinite(v3_dot(d, d)))
+        return 0;
+    return occluded_from(c, p, d, isinf(tmax) ? INFINITY : tmax * (1.0 - 1e-9)) ? 1.0 : 0.0;
+}
+
+/* trace(P, R) (RI Spec 3.2 §15.6): the colour the ray from P along R sees,
+ * the hit shaded with its surface shader one level deeper (its own VM);
+ * black where the ray leaves the scene or is deeper than the world's
+ * max_ray_depth (Option "trace" "maxdepth", default 4). The ray leaves P moved off the surface like a
+ * shadow ray, with the shadow rays' tolerance. */
+static void trace_ray_cb(void *user, const double P[3], const double R[3], double Ci[3])
+{
+    shade_ctx *c = user;
+    Ci[0] = Ci[1] = Ci[2] = 0;
+    vec3 p = v3(P[0], P[1], P[2]), d = v3(R[0], R[1], R[2]);
+    double d2 = v3_dot(d, d);
+    int maxdepth = c->r->world->options.max_ray_depth;
+    if (maxdepth > TRACE_RAY_DEPTH_LIMIT) maxdepth = TRACE_RAY_DEPTH_LIMIT;
+    if (c->depth >= maxdepth || !(d2 > 0) || !isfinite(d2) ||
+        !isfinite(v3_dot(p, p)) || !count_shader_ray(c, "trace()"))
+        return;
+    vec3 side = v3_dot(c->N, d) >= 0 ? c->N : v3_neg(c->N);
+    trace_ray ray;
+    trace_ray_init(&ray, v3_add(p, v3_scale(side, c->offset)), d, 0.0, INFINITY);
+    trace_tolerance tol = {c->tol, 0.0};
+    trace_hit hit = {.t = INFINITY, .obj = NULL};
+    if (!trace_bvh_intersect(c->r->bvh, c->th, &ray, &tol, false, &hit))
+        return;
+    double alpha;
+    vec3 at;
+    shade_hit(c->r, c->th, &ray, &hit, c->depth + 1, Ci, &alpha, &at);
 }
 
 static inline void float_const_(double *z, double k) { *z = k; }
@@ -145,9 +241,9 @@ static bool has_outputs(const sl_instance *inst)
  * captured values must live; only when the displacement shader has
  * outputs. The object's attributes the surface can ask for with
  * attribute() are set here too. */
-static void pass_messages(trace_thread *th, const trace_object *obj, double u, double v)
+static void pass_messages(trace_thread *th, sl_vm *vm, const trace_object *obj, double u,
+                          double v)
 {
-    sl_vm *vm = th->shade_vm;
     sl_vm_clear_messages(vm, SL_MSG_DISPLACEMENT);
     double sides = obj->sides;
     sl_vm_set_message(vm, SL_MSG_ATTRIBUTE, "Sides", SL_TYPE_FLOAT, &sides, NULL);
@@ -160,6 +256,16 @@ static void pass_messages(trace_thread *th, const trace_object *obj, double u, d
 void trace_shade_hit(const trace_renderer *r, trace_thread *th,
                      const trace_ray *ray, const trace_hit *hit,
                      double rgb[3], double *alpha, vec3 *P_out)
+{
+    th->shader_rays = 0;
+    shade_hit(r, th, ray, hit, 0, rgb, alpha, P_out);
+}
+
+/* A hit seen through `depth` trace() rays: its surface shader runs on the
+ * VM of that depth (the shallower ones are busy in their trace() calls). */
+static void shade_hit(const trace_renderer *r, trace_thread *th, const trace_ray *ray,
+                      const trace_hit *hit, int depth, double rgb[3], double *alpha,
+                      vec3 *P_out)
 {
     const trace_object *obj = hit->obj;
     trace_surface_point sp;
@@ -181,9 +287,10 @@ void trace_shade_hit(const trace_renderer *r, trace_thread *th,
     double pixel_tol = r->primary_tol.a + r->primary_tol.b * fabs(sp.P.z);
     shade_ctx c = {.r = r, .th = th, .obj = obj, .P = sp.P, .N = sp.N,
                    .offset = 2.0 * hit->leaf_size + 1e-9 * (1.0 + v3_length(sp.P)),
-                   .tol = hit->leaf_size > pixel_tol ? hit->leaf_size : pixel_tol};
-    pass_messages(th, obj, sp.u, sp.v);
-    sl_vm *vm = th->shade_vm;
+                   .tol = hit->leaf_size > pixel_tol ? hit->leaf_size : pixel_tol,
+                   .depth = depth, .light = -1};
+    sl_vm *vm = trace_thread_shade_vm(th, depth);
+    pass_messages(th, vm, obj, sp.u, sp.v);
     double P[3] = {sp.P.x, sp.P.y, sp.P.z}, N[3] = {sp.N.x, sp.N.y, sp.N.z};
     double Ng[3] = {sp.Ng.x, sp.Ng.y, sp.Ng.z};
     double dPdu[3] = {sp.dPdu.x, sp.dPdu.y, sp.dPdu.z};
@@ -194,6 +301,8 @@ void trace_shade_hit(const trace_renderer *r, trace_thread *th,
      * eye for perspective, the image plane for orthographic cameras) */
     set3(vm, SL_G_I, I);
     sl_vm_set_lights(vm, light_samples, &c);
+    sl_tracer tracer = {.trace = trace_ray_cb, .shadow = shadow_ray, .user = &c};
+    sl_vm_set_tracer(vm, &tracer);
     sl_vm_set_float(vm, SL_G_Cs, obj->Cs);
     sl_vm_set_float(vm, SL_G_Os, obj->Os);
     th->stats.evals_float++;

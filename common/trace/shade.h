@@ -9,6 +9,14 @@
  * on the light's side, by twice the size of the leaf box the hit came from
  * (plus a relative epsilon): the displaced surface is only known to within
  * that box, so a smaller offset could find the surface itself.
+ *
+ * Shaders trace rays too (RI Spec 3.2 §15.6, §15.7, through the VM's
+ * sl_tracer): trace(P, R) in a surface shader shades the hit it finds with
+ * that object's surface shader on the VM of the next depth (at most
+ * TRACE_MAX_RAY_DEPTH deep, then black); shadow(map, P) in a light shader
+ * or an illuminance loop traces a shadow ray towards the light (there are
+ * no shadow maps yet: one warning per light says so). Both leave the
+ * surface like shadow rays, with the shadow rays' tolerance.
  */
 #ifndef TRACE_SHADE_H
 #define TRACE_SHADE_H

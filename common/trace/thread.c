@@ -15,6 +15,24 @@ void trace_options_default(trace_options *opt)
     opt->max_instructions = 1000000;
     opt->leaf_fraction = 1.0;
     opt->max_nodes_per_ray = TRACE_DEFAULT_MAX_NODES_PER_RAY;
+    opt->max_ray_depth = TRACE_MAX_RAY_DEPTH;
+}
+
+/* A VM for this world's shaders, with what every shader may ask of the
+ * scene: depth() (RIB Clipping) and option() (RI Spec 3.2 §15.7), the
+ * same for every run. */
+static sl_vm *new_vm(const trace_world *world)
+{
+    sl_limits limits = {.max_instructions = world->options.max_instructions,
+                        .max_loop_iterations = 64};
+    sl_vm *vm = sl_vm_new(&limits);
+    const trace_camera *cam = &world->camera;
+    double format[3] = {cam->xres, cam->yres, 1.0};
+    double clipping[3] = {cam->near_clip, cam->far_clip, 0.0};
+    sl_vm_set_clipping(vm, cam->near_clip, cam->far_clip);
+    sl_vm_set_message(vm, SL_MSG_OPTION, "Format", SL_TYPE_POINT, format, NULL);
+    sl_vm_set_message(vm, SL_MSG_OPTION, "Clipping", SL_TYPE_POINT, clipping, NULL);
+    return vm;
 }
 
 trace_thread *trace_thread_new(const trace_world *world)
@@ -22,22 +40,9 @@ trace_thread *trace_thread_new(const trace_world *world)
     trace_thread *self = calloc(1, sizeof *self);
     if (!self) abort();
     self->world = world;
-    sl_limits limits = {.max_instructions = world->options.max_instructions,
-                        .max_loop_iterations = 64};
-    self->vm = sl_vm_new(&limits);
-    self->shade_vm = sl_vm_new(&limits);
-    self->light_vm = sl_vm_new(&limits);
-    /* what every shader may ask of the scene: depth() (RIB Clipping) and
-     * option() (RI Spec 3.2 §15.7), the same for every run */
-    const trace_camera *cam = &world->camera;
-    double format[3] = {cam->xres, cam->yres, 1.0};
-    double clipping[3] = {cam->near_clip, cam->far_clip, 0.0};
-    sl_vm *vms[] = {self->vm, self->shade_vm, self->light_vm};
-    for (size_t i = 0; i < sizeof vms / sizeof vms[0]; i++) {
-        sl_vm_set_clipping(vms[i], cam->near_clip, cam->far_clip);
-        sl_vm_set_message(vms[i], SL_MSG_OPTION, "Format", SL_TYPE_POINT, format, NULL);
-        sl_vm_set_message(vms[i], SL_MSG_OPTION, "Clipping", SL_TYPE_POINT, clipping, NULL);
-    }
+    self->vm = new_vm(world);
+    self->shade_vm = new_vm(world);
+    self->light_vm = new_vm(world);
     aa_context_init(&self->ctx, world->options.aa_capacity);
     self->cache = trace_boxcache_new(world->options.cache_bytes, world->nobjects);
     self->work = calloc(world->nobjects > 0 ? (size_t)world->nobjects : 1, sizeof *self->work);
@@ -52,10 +57,19 @@ void trace_thread_destroy(trace_thread **self_p)
     sl_vm_destroy(&self->vm);
     sl_vm_destroy(&self->shade_vm);
     sl_vm_destroy(&self->light_vm);
+    for (int d = 0; d < TRACE_RAY_DEPTH_LIMIT; d++)
+        sl_vm_destroy(&self->ray_vm[d]);
     trace_boxcache_destroy(&self->cache);
     free(self->work);
     free(self);
     *self_p = NULL;
+}
+
+sl_vm *trace_thread_shade_vm(trace_thread *self, int depth)
+{
+    if (depth <= 0 || depth > TRACE_RAY_DEPTH_LIMIT) return self->shade_vm;
+    if (!self->ray_vm[depth - 1]) self->ray_vm[depth - 1] = new_vm(self->world);
+    return self->ray_vm[depth - 1];
 }
 
 void trace_thread_fail(trace_thread *self, const char *message)

@@ -28,6 +28,15 @@ typedef struct trace_object_work {
     double u0, u1, v0, v1;         /* union of the stopped nodes' ranges */
 } trace_object_work;
 
+/* trace() from surface shaders (RI Spec 3.2 §15.6): a hit seen through
+ * max_ray_depth traced rays (trace_options; default TRACE_MAX_RAY_DEPTH,
+ * at most TRACE_RAY_DEPTH_LIMIT) is shaded; a ray deeper sees black. */
+enum { TRACE_MAX_RAY_DEPTH = 4, TRACE_RAY_DEPTH_LIMIT = 16 };
+/* Rays that trace() and shadow() may trace for one primary hit, all depths
+ * together: a shader calling them in loops at every depth cannot multiply
+ * its work without bound; beyond, the tile fails with a message. */
+enum { TRACE_MAX_SHADER_RAYS = 1024 };
+
 typedef struct trace_thread {
     const trace_world *world;
     sl_vm *vm;                     /* displacement shaders (boxes, points) */
@@ -35,6 +44,10 @@ typedef struct trace_thread {
                                       trace shadow rays, which use vm */
     sl_vm *light_vm;               /* light shaders, run from shade_vm's
                                       light callback (sl_light_eval) */
+    long shader_rays;              /* trace()/shadow() rays of this primary hit */
+    sl_vm *ray_vm[TRACE_RAY_DEPTH_LIMIT];  /* surface shaders of the hits of
+                                      trace() rays, one per depth (1..), made
+                                      on first use (trace_thread_shade_vm) */
     aa_context ctx;
     trace_boxcache *cache;
     trace_stats stats;
@@ -47,6 +60,10 @@ typedef struct trace_thread {
 
 trace_thread *trace_thread_new(const trace_world *world);
 void trace_thread_destroy(trace_thread **self_p);
+
+/* The VM that runs surface shaders at trace() depth `depth` (0: primary
+ * hits, shade_vm; 1..TRACE_RAY_DEPTH_LIMIT: made on first use). */
+sl_vm *trace_thread_shade_vm(trace_thread *self, int depth);
 
 /* Records the first error of this thread (later ones are dropped). */
 void trace_thread_fail(trace_thread *self, const char *message);

@@ -98,6 +98,9 @@ typedef struct trace_options {
     double leaf_fraction;          /* box size / pixel footprint at which to stop */
     long max_nodes_per_ray;        /* work limit of one ray against one object:
                                       quadtree nodes visited (intersect.c) */
+    int max_ray_depth;             /* nested trace() rays from shaders (RIB
+                                      Option "trace" "maxdepth"; at most
+                                      TRACE_RAY_DEPTH_LIMIT) */
 } trace_options;
 
 /* The default work limit: 20x the largest walk of the paper's scenes

@@ -42,6 +42,11 @@ static const error_case cases[] = {
     /* argument counts and values */
     { WORLD("Basis \"bezier\" [] \"bezier\" 3\n" SPHERE),     /* found by fuzz_rib */
       "t.rib:4:16: Basis: the u step must be a whole number from 1 to 4" },
+    { "Option \"trace\" \"maxdepth\" [40]\n" WORLD(SPHERE),
+      "t.rib:1:16: Option: \"maxdepth\" must be a whole number from 0 to 16, got 40" },
+    { WORLD("Shader \"layer\" \"base\"\n" SPHERE),
+      "t.rib:4:1: Shader: RSL 2 co-shaders are not supported: aafarm compiles each shader "
+      "on its own; put the co-shader's code in a function of the shader that uses it" },
     { WORLD("Sphere 1 -1 1\n"),
       "t.rib:4:1: Sphere: expected 4 numbers (radius zmin zmax thetamax), got 3" },
     { WORLD("Translate 1 2 3 4\n" SPHERE),

@@ -224,18 +224,19 @@ static void test_array_errors(void **state)
                   "t.sl:5:7: error: invalid operands to binary '+' ('point' and 'float[4]')\n"
                   "    P += a;\n"
                   "      ^\n");
-    expect_errors("displacement d() {\n"
+    /* (a local 'float b[];' is an RSL 2 resizable array; a shader
+     * parameter needs a size or a default) */
+    expect_errors("displacement d(float b[]) {\n"
                   "    float a[3] = {1, 2};\n"
-                  "    float b[];\n"
                   "    float c = {1};\n"
                   "}\n",
+                  "t.sl:1:22: error: array 'b' needs a size or an initializer\n"
+                  "displacement d(float b[]) {\n"
+                  "                     ^\n"
                   "t.sl:2:18: error: 'a' has 3 elements, but 2 values are given\n"
                   "    float a[3] = {1, 2};\n"
                   "                 ^\n"
-                  "t.sl:3:11: error: array 'b' needs a size or an initializer\n"
-                  "    float b[];\n"
-                  "          ^\n"
-                  "t.sl:4:15: error: cannot initialize 'c' (float) with a list in braces\n"
+                  "t.sl:3:15: error: cannot initialize 'c' (float) with a list in braces\n"
                   "    float c = {1};\n"
                   "              ^\n");
     expect_errors("displacement d() {\n    float a[0];\n}\n",

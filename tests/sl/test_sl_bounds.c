@@ -558,8 +558,8 @@ static double check_shader(const char *name, sl_global g)
     sl_vm *vm = sl_vm_new(NULL);
     /* fixed lights (all modes): an ambient and a distant light */
     sl_light_sample lights[2] = {
-        { { 0, 0, 0 }, { 0.2, 0.2, 0.2 }, true },
-        { { 1, 2, -2 }, { 0.8, 0.7, 0.6 }, false },
+        { { 0, 0, 0 }, { 0.2, 0.2, 0.2 }, true, false },
+        { { 1, 2, -2 }, { 0.8, 0.7, 0.6 }, false, true },
     };
     sl_vm_set_fixed_lights(vm, lights, 2);
     double ratio_sum = 0;

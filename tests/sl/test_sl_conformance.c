@@ -29,6 +29,7 @@
 #include <stddef.h>
 #include <setjmp.h>
 #include <stdint.h>
+#include <unistd.h>
 #include <cmocka.h>
 
 #include "sl/noise.h"
@@ -990,6 +991,260 @@ static void ref_math_pow_exp_log(double u, double v, double o[3])
     o[2] = log(v + 2) / log(2) + sqrt(u + v);
 }
 
+/* RSL 2 (issue 15): shader classes and resizable arrays */
+static void ref_class_displacement(double u, double v, double o[3])
+{
+    o[0] = sin(3 * u + 0.25); o[1] = sin(3 * v + 0.25) + 0.25; o[2] = 2;
+}
+
+static void ref_class_method_order(double u, double v, double o[3])
+{
+    o[0] = (u * u + 2 * u) * 2; o[1] = (v * v + 2 * v) * 2 + 0.75; o[2] = 2;
+}
+
+static double blend124(double x) { return 1 + 2 * x + 4 * x * x; }
+static void ref_class_member_array(double u, double v, double o[3])
+{
+    o[0] = blend124(u) * 0.5; o[1] = 0.25 + v; o[2] = 4 - blend124(v);
+}
+
+static void ref_resizable_push_pop(double u, double v, double o[3])
+{
+    o[0] = u + v; o[1] = u * v + 10; o[2] = 3;
+}
+
+static void ref_resizable_resize_loop(double u, double v, double o[3])
+{
+    double sum = 0;
+    for (int i = 0; i < 5; i++) sum += pow(u, i);
+    o[0] = sum; o[1] = 1 + u + v; o[2] = 2;
+}
+
+static void ref_resizable_colors(double u, double v, double o[3])
+{
+    bool two = u > 0.5;
+    o[0] = u + 0.5; o[1] = two ? 2 : 1; o[2] = two ? v : 1;
+}
+
+/* the noise family in every form, and the math the suite lacked */
+static void ref_noise_forms_vector(double u, double v, double o[3])
+{
+    double x5 = 5 * u, xy[2] = { 3 * u, 3 * v }, q[4] = { 2 * u, 2 * v, 1, 2 * v };
+    double a[3], b[3], c[3], d[3];
+    sl_vnoise(1, &x5, a);
+    sl_vnoise(2, xy, b);
+    sl_vnoise(3, q, c);
+    sl_vnoise(4, q, d);
+    o[0] = a[0] + b[1]; o[1] = c[2] + d[0]; o[2] = a[1] - d[2];
+}
+
+static void ref_pnoise_forms_color(double u, double v, double o[3])
+{
+    double x5 = 5 * u, xy[2] = { 3 * u, 3 * v }, q[4] = { 3 * u, 3 * v, 0, 2 * v };
+    int p4 = 4, p23[2] = { 2, 3 }, p444[3] = { 4, 4, 4 }, p2223[4] = { 2, 2, 2, 3 };
+    double a[3], b[3], c[3], d[3];
+    sl_vpnoise(1, &x5, &p4, a);
+    sl_vpnoise(2, xy, p23, b);
+    sl_vpnoise(3, q, p444, c);
+    sl_vpnoise(4, q, p2223, d);
+    o[0] = a[0] + b[1]; o[1] = c[2] + d[0]; o[2] = a[2] * d[1];
+}
+
+static void ref_cellnoise_forms_point(double u, double v, double o[3])
+{
+    double x4 = 4 * u, xy[2] = { 4 * u, 4 * v }, q[4] = { 4 * u, 4 * v, 0, 3 * v };
+    double a[3], b[3], c[3], d[3];
+    sl_vcellnoise(1, &x4, a);
+    sl_vcellnoise(2, xy, b);
+    sl_vcellnoise(3, q, c);
+    sl_vcellnoise(4, q, d);
+    o[0] = a[0] + b[1]; o[1] = c[2] + d[0]; o[2] = a[1] + d[2];
+}
+
+static void ref_noise_argument_types(double u, double v, double o[3])
+{
+    double p[3] = { 2 * (2 * u - 1), 2 * (2 * v - 1), 0 }, w[3] = { u, v, 1 };
+    double n4[4] = { 3 * v, 3 * u, 0, u };
+    o[0] = sl_noise(3, p) + noise1(1.5); o[1] = sl_noise(3, w); o[2] = sl_noise(4, n4);
+}
+
+/* the VM's random() (splitmix64 from the seed, 0 here) */
+static double splitmix(uint64_t *state)
+{
+    uint64_t z = (*state += 0x9e3779b97f4a7c15ull);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    z ^= z >> 31;
+    return (double)(z >> 11) * 0x1p-53;
+}
+static void ref_random_sequence(double u, double v, double o[3])
+{
+    uint64_t st = 0;
+    double r[5];
+    for (int i = 0; i < 5; i++) r[i] = splitmix(&st);
+    o[0] = r[0] + u; o[1] = r[1] + r[3]; o[2] = r[4] * v;
+}
+
+static void ref_math_inversesqrt(double u, double v, double o[3])
+{
+    o[0] = 1 / sqrt(u + 0.5); o[1] = v / sqrt(v * v + 1); o[2] = 0;
+}
+
+static void ref_math_trig_inverse(double u, double v, double o[3])
+{
+    o[0] = tan(u) + atan(v); o[1] = asin(u - 0.5) + acos(v - 0.5);
+    o[2] = atan2(v, u) * 180 / M_PI + 90 * u * M_PI / 180;
+}
+
+static void ref_math_mod_floor_ceil(double u, double v, double o[3])
+{
+    o[0] = fmodf_(7 * u, 2) + floor(5 * v); o[1] = ceil(3 * u) - fmodf_(-3 * v, 1);
+    o[2] = fmodf_(10 * u, 0.3) * 2;
+}
+
+static void ref_math_step_smoothstep(double u, double v, double o[3])
+{
+    o[0] = stepd(0.5, u) + smooth(0.2, 0.8, v); o[1] = smooth(0, 1, u * v);
+    o[2] = stepd(v, u) * 2;
+}
+
+static void ref_strings_concat_match(double u, double v, double o[3])
+{
+    o[0] = 1 + 0 + 4; o[1] = u + (floor(4 * u) <= 1 ? 1 : 0); o[2] = v;
+}
+
+static void ref_message_names(double u, double v, double o[3])
+{
+    (void)u;
+    (void)v;
+    o[0] = 16 + 32; o[1] = -1 + 0.25; o[2] = 1 + 2;
+}
+
+static void ref_geom_transform_matrix(double u, double v, double o[3])
+{
+    o[0] = 2 * (u + 1) + 3 * v; o[1] = 3 * v + v / 3; o[2] = 1 + 2 * u;
+}
+
+static void ref_spline_vector_normal(double u, double v, double o[3])
+{
+    static const double cr[4][4] = { { -0.5, 1.5, -1.5, 0.5 }, { 1, -2.5, 2, -0.5 },
+                                     { -0.5, 0, 0.5, 0 }, { 0, 1, 0, 0 } };
+    static const double kv[4][3] = { { 0, 0, 0 }, { 1, 0, 0 }, { 1, 1, 0 }, { 0, 1, 1 } };
+    static const double kn[5][3] = { { 0, 0, 0 }, { 1, 0, 0 }, { 0, 1, 0 }, { 0, 0, 1 },
+                                     { 1, 1, 1 } };
+    double x = clampd(u, 0, 1), y = clampd(v, 0, 1) * 2, seg = fmin(floor(y), 1);
+    y -= seg;
+    for (int c = 0; c < 3; c++) {
+        double val = 0;
+        for (int i = 0; i < 4; i++) {
+            double coef = 0;
+            for (int j = 0; j < 4; j++) coef += cr[i][j] * kv[j][c];
+            val += coef * pow(x, 3 - i);
+        }
+        int k = (int)seg;
+        o[c] = val + kn[k + 1][c] + y * (kn[k + 2][c] - kn[k + 1][c]);
+    }
+}
+
+static void ref_resizable_nested_extern(double u, double v, double o[3])
+{
+    double kept[3];
+    int n = 0;
+    double xs[3] = { u, v, 0.5 };
+    for (int i = 0; i < 3; i++)
+        if (xs[i] > 0.3) kept[n++] = xs[i];
+    o[0] = n; o[1] = 0.5; o[2] = kept[0];
+}
+
+static void ref_class_accumulate(double u, double v, double o[3])
+{
+    double sum = 0, amp = 1;
+    for (int i = 0; i < 4; i++) {
+        sum += amp * sin(pow(2, i) * u);
+        amp *= 0.5;
+    }
+    o[0] = sum; o[1] = amp; o[2] = v;
+}
+
+static void ref_voronoi_regular(double u, double v, double o[3])
+{
+    double x = 3 * u, y = 3 * v, cx = floor(x) + 0.5, cy = floor(y) + 0.5;
+    o[0] = sqrt((x - cx) * (x - cx) + (y - cy) * (y - cy)); o[1] = cx; o[2] = cy;
+}
+
+static void ref_noises_vsnoise(double u, double v, double o[3])
+{
+    double p[3] = { 3 * u, 3 * v, 0 }, d[3];
+    sl_vnoise(3, p, d);
+    for (int k = 0; k < 3; k++) d[k] = 2 * d[k] - 1;
+    o[0] = 0.2 * d[0]; o[1] = 0.2 * d[1] + 2 * noise1(4 * v) - 1; o[2] = d[2];
+}
+
+/* the rest of RI Spec 3.2's geometric and shading built-ins */
+static double dotv(const double a[3], const double b[3])
+{
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+static double seg_dist(const double a[3], const double b[3], const double q[3])
+{
+    double v[3], w[3], vv = 0, wv = 0, d2 = 0;
+    for (int k = 0; k < 3; k++) {
+        v[k] = b[k] - a[k];
+        w[k] = q[k] - a[k];
+        vv += v[k] * v[k];
+        wv += w[k] * v[k];
+    }
+    double t = vv > 0 ? clampd(wv / vv, 0, 1) : 0;
+    for (int k = 0; k < 3; k++) d2 += (w[k] - t * v[k]) * (w[k] - t * v[k]);
+    return sqrt(d2);
+}
+static void ref_geom_ptlined(double u, double v, double o[3])
+{
+    double a[3] = { 0.3, 0.2, 0 }, b[3] = { 0.6, 0.9, 0 }, c[3] = { 0.2, 0.2, 0 };
+    double z[3] = { 0, 0, 0 }, one[3] = { 1, 1, 1 }, q[3] = { u, v, 0 }, q1[3] = { u, v, 1 };
+    o[0] = seg_dist(a, b, q); o[1] = seg_dist(c, c, q); o[2] = seg_dist(z, one, q1);
+}
+
+static void ref_geom_rotate_point(double u, double v, double o[3])
+{
+    double P0[3] = { 0.1, 0.2, 0.3 }, ax[3] = { 0.4, 0.8, 1.7 };
+    double p[3] = { u - 0.1, v - 0.2, -0.3 }, ang = M_PI / 3 * u;
+    normalize3(ax);
+    double c = cos(ang), sn = sin(ang), ap = dotv(ax, p);
+    double x[3] = { ax[1] * p[2] - ax[2] * p[1], ax[2] * p[0] - ax[0] * p[2],
+                    ax[0] * p[1] - ax[1] * p[0] };
+    for (int k = 0; k < 3; k++)
+        o[k] = P0[k] + p[k] * c + x[k] * sn + ax[k] * ap * (1 - c);
+}
+
+static double lobe(const double L[3], const double N[3], const double V[3], double r)
+{
+    double Ln[3] = { L[0], L[1], L[2] }, Nn[3] = { N[0], N[1], N[2] }, H[3];
+    normalize3(Ln);
+    normalize3(Nn);
+    for (int k = 0; k < 3; k++) H[k] = Ln[k] + V[k];
+    normalize3(H);
+    double c = dotv(Nn, H);
+    return pow(c > 0 ? c : 0, 1 / r);
+}
+static void ref_shading_specularbrdf(double u, double v, double o[3])
+{
+    double L[3] = { u - 0.5, v - 0.5, 1 }, N[3] = { 0, 0.2, 1 }, V[3] = { 0, 0, 1 };
+    double L2[3] = { 1, 0, -1 }, N2[3] = { 0, 0, 1 };
+    o[0] = lobe(L, N, V, 0.2); o[1] = 0; o[2] = lobe(L2, N2, V, 0.5);
+}
+
+static void ref_strings_shadername(double u, double v, double o[3])
+{
+    (void)v;
+    o[0] = 1; o[1] = 1; o[2] = u;
+}
+
+static void ref_matrix_division(double u, double v, double o[3])
+{
+    o[0] = u; o[1] = v + 0.5; o[2] = fmin(fmin(u, v), 0.5) + 3;
+}
+
 /* ---------------------------------------------------------------------- */
 /* the cases                                                               */
 /* ---------------------------------------------------------------------- */
@@ -1095,6 +1350,34 @@ static const conf_case cases[] = {
     CASE(geom_distance_length, "shading geometry"),
     CASE(math_polar, "math"),
     CASE(math_pow_exp_log, "math"),
+    CASE(class_displacement, "RSL 2 classes"),
+    CASE(class_method_order, "RSL 2 classes"),
+    CASE(class_member_array, "RSL 2 classes"),
+    CASE(resizable_push_pop, "RSL 2 resizable arrays"),
+    CASE(resizable_resize_loop, "RSL 2 resizable arrays"),
+    CASE(resizable_colors, "RSL 2 resizable arrays"),
+    CASE(noise_forms_vector, "noise family"),
+    CASE(pnoise_forms_color, "noise family"),
+    CASE(cellnoise_forms_point, "noise family"),
+    CASE(noise_argument_types, "noise family"),
+    CASE(random_sequence, "random"),
+    CASE(math_inversesqrt, "math"),
+    CASE(math_trig_inverse, "math"),
+    CASE(math_mod_floor_ceil, "math"),
+    CASE(math_step_smoothstep, "math"),
+    CASE(strings_concat_match, "strings"),
+    CASE(message_names, "message passing"),
+    CASE(geom_transform_matrix, "space transforms"),
+    CASE(spline_vector_normal, "spline"),
+    CASE(resizable_nested_extern, "RSL 2 resizable arrays"),
+    CASE(class_accumulate, "RSL 2 classes"),
+    CASE(voronoi_regular, "helper headers"),
+    CASE(noises_vsnoise, "helper headers"),
+    CASE(geom_ptlined, "shading geometry"),
+    CASE(geom_rotate_point, "shading geometry"),
+    CASE(shading_specularbrdf, "shading geometry"),
+    CASE(strings_shadername, "strings"),
+    CASE(matrix_division, "matrices"),
 };
 #undef CASE
 #undef CASE_NO_DUAL
@@ -1186,6 +1469,49 @@ static const conf_error errors[] = {
       "(known: \"width\" with a float, \"filter\" with a name)\n"
       "    P += filterstep(0.5, s, \"blur\", 0.1) * N;\n"
       "                            ^\n" },
+    { "errors/class_two_shaders.sl",
+      "errors/class_two_shaders.sl:5:17: error: class 'twokinds' has both a 'surface' and "
+      "a 'displacement' method; aafarm compiles a class as one shader: split it into two "
+      "classes\n"
+      "    public void displacement(output point P; output normal N) { P += N; }\n"
+      "                ^\n"
+      "errors/class_two_shaders.sl:4:17: note: 'surface' defined here\n"
+      "    public void surface(output color Ci, Oi) { Ci = 1; }\n"
+      "                ^\n" },
+    { "errors/coshader.sl",
+      "errors/coshader.sl:4:5: error: 'shader' variables (RSL 2 co-shaders) are not "
+      "supported: aafarm compiles each shader on its own: put the co-shader's code in a "
+      "function of this shader (or #include it)\n"
+      "    shader base = getshader(layer);\n"
+      "    ^\n"
+      "errors/coshader.sl:5:14: error: method calls with '->' (RSL 2 co-shaders) are not "
+      "supported: aafarm compiles each shader on its own: put the co-shader's code in a "
+      "function of this shader (or #include it)\n"
+      "    P += base->height(s) * N;\n"
+      "             ^\n" },
+    { "errors/coshader_getshaders.sl",
+      "errors/coshader_getshaders.sl:4:27: error: 'getshaders' (RSL 2 co-shaders) is not "
+      "supported: aafarm compiles each shader on its own: put the co-shader's code in a "
+      "function of this shader (or #include it)\n"
+      "    float n = arraylength(getshaders());\n"
+      "                          ^\n" },
+    { "errors/resizable_fixed.sl",
+      "errors/resizable_fixed.sl:5:5: error: push() takes a resizable array (a local "
+      "declared without size or initializer, as 'float a[];') and a value\n"
+      "    push(a, s);\n"
+      "    ^\n" },
+    { "errors/trace_displacement.sl",
+      "errors/trace_displacement.sl:4:15: error: trace() cannot be used in a displacement "
+      "shader: it runs over ranges of the surface, where a traced ray has no bound (use it "
+      "in a surface shader)\n"
+      "    color c = trace(P, N);\n"
+      "              ^\n" },
+    { "errors/shadow_param.sl",
+      "errors/shadow_param.sl:6:34: error: unknown shadow() parameter 'bluur' (known: "
+      "\"samples\", \"blur\", \"bias\", \"width\", \"swidth\", \"twidth\", each with a "
+      "float; they are accepted and ignored)\n"
+      "        Cl = 1 - shadow(map, Ps, \"bluur\", 0.1);\n"
+      "                                 ^\n" },
 };
 
 /* ---------------------------------------------------------------------- */
@@ -1196,10 +1522,10 @@ static const conf_error errors[] = {
  * fixed lights (three distant ones and an ambient one); Ci and Oi are
  * checked. */
 static const sl_light_sample surface_lights[] = {
-    { { 0.3, 0.2, -1 }, { 1, 0.8, 0.6 }, false },
-    { { -0.5, 0.1, 0.4 }, { 0.2, 0.3, 1 }, false },
-    { { 0.6, -0.7, 0.2 }, { 0.5, 0.5, 0.2 }, false },
-    { { 0, 0, 0 }, { 0.05, 0.05, 0.05 }, true },
+    { { 0.3, 0.2, -1 }, { 1, 0.8, 0.6 }, false, true },
+    { { -0.5, 0.1, 0.4 }, { 0.2, 0.3, 1 }, false, true },
+    { { 0.6, -0.7, 0.2 }, { 0.5, 0.5, 0.2 }, false, true },
+    { { 0, 0, 0 }, { 0.05, 0.05, 0.05 }, true, false },
 };
 enum { NSURFACE_LIGHTS = sizeof surface_lights / sizeof surface_lights[0] };
 
@@ -1293,6 +1619,27 @@ static void ref_surface_illuminance_helper(const double N[3], double Ci[3], doub
     }
 }
 
+/* the same loop written as an RSL 2 class */
+static void ref_surface_class_matte(const double N[3], double Ci[3], double Oi[3])
+{
+    ref_surface_illuminance_diffuse(N, Ci, Oi);
+}
+
+/* no tracer: trace() black, shadow() 0, so the diffuse loop alone */
+static void ref_surface_trace_untraced(const double N[3], double Ci[3], double Oi[3])
+{
+    ref_surface_illuminance_diffuse(N, Ci, Oi);
+    Oi[0] = 1; Oi[1] = 0; Oi[2] = 0;
+}
+
+/* specular() against its definition with specularbrdf over every light */
+static void ref_surface_specularbrdf(const double N[3], double Ci[3], double Oi[3])
+{
+    double unused[3];
+    ref_surface_illuminance_specular(N, unused, Oi);
+    for (int k = 0; k < 3; k++) Ci[k] = Oi[k];
+}
+
 typedef struct surface_case {
     const char *file;
     void (*ref)(const double N[3], double Ci[3], double Oi[3]);
@@ -1304,6 +1651,9 @@ static const surface_case surface_cases[] = {
     SURFACE(surface_illuminance_specular),
     SURFACE(surface_illuminance_category),
     SURFACE(surface_illuminance_helper),
+    SURFACE(surface_class_matte),
+    SURFACE(surface_trace_untraced),
+    SURFACE(surface_specularbrdf),
 };
 #undef SURFACE
 
@@ -1833,6 +2183,63 @@ done:
     sl_vm_destroy(&lvm);
 }
 
+/* printf_rate_limit.sl run 150 times in float mode (and in interval mode,
+ * which prints nothing) on a VM of its own, stderr caught in a file: 100
+ * lines, then one note, and the values are unaffected. */
+static void check_printf_limit(tally *t)
+{
+    char *diag = NULL;
+    sl_program *p = compile_file("printf_rate_limit.sl", &diag);
+    free(diag);
+    if (!p) {
+        t->failures++;
+        fprintf(stderr, "printf_rate_limit.sl: does not compile\n");
+        return;
+    }
+    sl_instance *inst = sl_instance_new(p);
+    sl_vm *vm = sl_vm_new(NULL);
+    FILE *log = tmpfile();
+    assert_non_null(log);
+    fflush(stderr);
+    int saved = dup(2);
+    assert_true(saved >= 0 && dup2(fileno(log), 2) >= 0);
+    int wrong = 0;
+    for (int i = 0; i < 150; i++) {
+        double u = (i + 0.5) / 150, v = 1 - u, P[3];
+        t->floats++;
+        if (!run_float(vm, inst, u, v, P) || !close_to(P[0], u) || !close_to(P[1], v) ||
+            P[2] != 1)
+            wrong++;
+        if (i % 15 == 0) {
+            h_globals_interval(vm, H_PLANE, u, u + 0.01, v, v + 0.01);
+            wrong += sl_vm_run(vm, inst, SL_MODE_INTERVAL, NULL) != SL_OK;
+        }
+    }
+    fflush(stderr);
+    dup2(saved, 2);
+    close(saved);
+    rewind(log);
+    char line[256];
+    int lines = 0, notes = 0;
+    while (fgets(line, sizeof line, log)) {
+        if (strncmp(line, "printf_rate_limit: s = ", 23) == 0)
+            lines++;
+        else if (strstr(line, "more than 100 printf lines; the rest are not shown"))
+            notes++;
+        else
+            wrong++;
+    }
+    fclose(log);
+    if (wrong || lines != 100 || notes != 1) {
+        t->failures++;
+        fprintf(stderr, "printf_rate_limit.sl: %d lines and %d notes logged (want 100 and 1), "
+                        "%d wrong values or other lines\n", lines, notes, wrong);
+    }
+    sl_vm_destroy(&vm);
+    sl_instance_destroy(&inst);
+    sl_program_destroy(&p);
+}
+
 static void test_conformance(void **state)
 {
     (void)state;
@@ -1903,6 +2310,9 @@ static void test_conformance(void **state)
     }
     check_message_passing(vm, &t);
     check_light_shaders(&t);
+    check_printf_limit(&t);
+    if (nfeatures < 64)
+        features[nfeatures++] = "printf's rate limit";
     size_t nerrors = sizeof errors / sizeof errors[0];
     for (size_t e = 0; e < nerrors; e++) {
         char *diag = NULL;
@@ -1916,9 +2326,9 @@ static void test_conformance(void **state)
         free(diag);
     }
     sl_vm_destroy(&vm);
-    printf("conformance: %zu displacement, %zu surface and 4 light shaders, a "
-           "displacement-to-surface message pair and %zu error cases; features:", ncases,
-           nsurfaces, nerrors);
+    printf("conformance: %zu shaders: %zu displacement, %zu surface and 4 light shaders, a "
+           "displacement-to-surface message pair, the printf limit and %zu error cases; "
+           "features:", ncases + nsurfaces + 4 + 2 + 1 + nerrors, ncases, nsurfaces, nerrors);
     for (int f = 0; f < nfeatures; f++)
         printf("%s %s", f ? "," : "", features[f]);
     printf("\nconformance: %d float checks, %d dual checks (%d derivatives against "

@@ -359,8 +359,8 @@ static int test_lights_fn(void *user, const double P[3], sl_light_sample *out, i
     (void)user;
     (void)P;
     assert_true(max >= 2);
-    sl_light_sample amb = { { 0, 0, 0 }, { 0.1, 0.2, 0.3 }, true };
-    sl_light_sample dir = { { 0, 3, 4 }, { 1, 0.5, 0.25 }, false };   /* 5 long */
+    sl_light_sample amb = { { 0, 0, 0 }, { 0.1, 0.2, 0.3 }, true, false };
+    sl_light_sample dir = { { 0, 3, 4 }, { 1, 0.5, 0.25 }, false, false };   /* 5 long */
     out[0] = amb;
     out[1] = dir;
     return 2;
