@@ -217,6 +217,44 @@ static bool build_objects(job_scene *self, sl_diag *diag)
     return true;
 }
 
+/* The textures (docs/textures.md): a cache whose resolver finds names on
+ * the scene's texture search path and in the RIB's folder; every name the
+ * bound shaders use is resolved now (render: also opened), so that a
+ * missing map is an error naming the shader call, not a failed tile. */
+static bool open_textures(job_scene *self, sl_diag *diag, bool render)
+{
+    const scene *sc = self->scene;
+    self->textures = tex_cache_new(0);
+    if (!self->textures) abort();
+    tex_searchpath *tp = &self->texture_path;
+    snprintf(tp->path, sizeof tp->path, "%s", sc->texture_path ? sc->texture_path : "");
+    const char *file = self->job->scene_file ? self->job->scene_file : "";
+    const char *slash = strrchr(file, '/');
+    snprintf(tp->base, sizeof tp->base, "%.*s", slash ? (int)(slash - file) : 1,
+             slash ? file : ".");
+    tex_cache_set_resolver(self->textures, tex_searchpath_resolve, tp);
+    self->world.textures = self->textures;
+    bool ok = true;
+    for (int i = 0; i < sc->nshaders; i++) {
+        const char *names[32];
+        int n = sl_instance_texture_names(self->instances[i], names, 32);
+        for (int k = 0; k < n; k++) {
+            char err[1024], path[4096], why[512];
+            bool found = render ? tex_cache_get(self->textures, names[k], err, sizeof err) != NULL
+                                : tex_searchpath_resolve(tp, names[k], path, sizeof path, why,
+                                                         (int)sizeof why);
+            if (!found) {
+                if (!render)
+                    snprintf(err, sizeof err, "texture '%s': %s", names[k], why);
+                sl_diag_error(diag, sc->shaders[i].pos, "shader '%s': %s", sc->shaders[i].name,
+                              err);
+                ok = false;
+            }
+        }
+    }
+    return ok;
+}
+
 job_scene *job_scene_new(const job *jb, size_t cache_bytes, bool render, sl_diag *diag)
 {
     job_scene *self = calloc(1, sizeof *self);
@@ -228,6 +266,7 @@ job_scene *job_scene_new(const job *jb, size_t cache_bytes, bool render, sl_diag
     bool ok = self->scene != NULL;
     if (ok) ok = compile_programs(self, diag);
     if (ok) ok = build_objects(self, diag);
+    if (ok) ok = open_textures(self, diag, render);
     if (ok) {
         const scene *sc = self->scene;
         trace_world *w = &self->world;
@@ -279,6 +318,7 @@ void job_scene_destroy(job_scene **self_p)
     free(self->programs);
     free(self->world.objects);
     free(self->world.lights);
+    tex_cache_free(self->textures);
     scene_destroy(&self->scene);
     free(self);
     *self_p = NULL;

@@ -206,7 +206,7 @@ void rib_exposure(rib_parser *p, const rib_request *req)
 }
 
 /* ---------------------------------------------------------------------- */
-/* Option "searchpath" "shader" / "archive" ["dir:dir:&"]                  */
+/* Option "searchpath" "shader" / "archive" / "texture" ["dir:dir:&"]      */
 /* ---------------------------------------------------------------------- */
 
 static void path_push(char ***list, int *n, const char *s, size_t len)
@@ -252,6 +252,25 @@ void rib_option(rib_parser *p, const rib_request *req)
     const scene_param *shader = rib_params_find(&params, "shader");
     if (shader && shader->string)
         set_path(&p->shader_path, &p->nshader_path, shader->string);
+    const scene_param *texture = rib_params_find(&params, "texture");
+    if (texture && texture->string) {         /* "&": the previous texture path */
+        const char *prev = p->scene->texture_path ? p->scene->texture_path : "";
+        size_t n = strlen(texture->string), np = strlen(prev), cap = 1;
+        for (size_t k = 0; k < n; k++)
+            cap += texture->string[k] == '&' ? np : 1;
+        char *out = sl_xrealloc(NULL, cap), *o = out;
+        for (size_t k = 0; k < n; k++) {
+            if (texture->string[k] == '&') {
+                memcpy(o, prev, np);
+                o += np;
+            } else {
+                *o++ = texture->string[k];
+            }
+        }
+        *o = '\0';
+        free(p->scene->texture_path);
+        p->scene->texture_path = out;
+    }
     const scene_param *archive = rib_params_find(&params, "archive");
     if (archive && archive->string)
         set_path(&p->archive_path, &p->narchive_path, archive->string);

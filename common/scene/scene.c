@@ -55,6 +55,7 @@ void scene_destroy(scene **self_p)
         free(self->spaces[i].name);
     free(self->spaces);
     free_strings(self->search_path, self->nsearch_path);
+    free(self->texture_path);
     free_strings(self->shader_names, self->nshader_names);
     free_strings(self->archives, self->narchives);
     free(self->display_name);

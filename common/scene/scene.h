@@ -194,6 +194,8 @@ typedef struct scene {
     int nspaces;
     char **search_path;            /* NULL-terminated directories */
     int nsearch_path;
+    char *texture_path;            /* Option "searchpath" "texture", "dir:dir"
+                                      with "&" expanded (NULL: none) */
     char **shader_names;           /* distinct shaders the objects and lights use */
     int nshader_names;
     char **archives;               /* ReadArchive files read (normalized), in

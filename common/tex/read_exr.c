@@ -4,8 +4,9 @@
  * to float (half, float and uint channels; uint values as they are). The
  * channels come R, G, B, A first (by the last part of their names, so
  * "diffuse.R" counts as R) when the file has R, G and B, then the rest in
- * the file's (alphabetical) order; a single-channel file is channel 0
- * whatever its name ("Y", "Z", "height").
+ * the file's (alphabetical) order; without colour Y first, A last (so
+ * aafarm-maketx's "Y A" reads back in order); a single-channel file is
+ * channel 0 whatever its name ("Y", "Z", "height").
  */
 #include "tex/tex_internal.h"
 
@@ -43,14 +44,15 @@ static int rank_of(const char *name)
     return 4;
 }
 
+/* Decodes a chunk whose first pixel is (x, y) of the data window (tile
+ * chunks give tile indexes in start_x/start_y, scanline chunks rows). */
 static exr_result_t decode(exr_context_t ctx, const exr_chunk_info_t *ci, float *data, int w,
-                           int x0, int y0, int nch, const int *slot)
+                           int x, int y, int nch, const int *slot)
 {
     exr_decode_pipeline_t dec;
     memset(&dec, 0, sizeof dec);
     exr_result_t rv = exr_decoding_initialize(ctx, 0, ci, &dec);
-    float *base = data + ((size_t)(ci->start_y - y0) * (size_t)w + (size_t)(ci->start_x - x0)) *
-                             (size_t)nch;
+    float *base = data + ((size_t)y * (size_t)w + (size_t)x) * (size_t)nch;
     for (int c = 0; rv == EXR_ERR_SUCCESS && c < dec.channel_count; c++) {
         exr_coding_channel_info_t *info = &dec.channels[c];
         info->decode_to_ptr = (uint8_t *)(base + slot[c]);
@@ -113,11 +115,16 @@ bool tex_read_exr(const char *path, tex_pixels *out, char *err, size_t errsz)
         }
         rgb = rgb || rank_of(ch->entries[c].name.str) == 2;
     }
-    int n = 0;                        /* R G B A first when there is colour */
+    int n = 0;          /* R G B A first when there is colour, else Y, the rest, A */
     for (int r = 0; r <= 4; r++)
-        for (int c = 0; c < nch; c++)
-            if ((rgb ? (rank_of(ch->entries[c].name.str) == r) : r == 4))
+        for (int c = 0; c < nch; c++) {
+            const char *cn = ch->entries[c].name.str, *dot = strrchr(cn, '.');
+            const char *last = dot ? dot + 1 : cn;
+            int k = rgb ? rank_of(cn) : strcmp(last, "Y") == 0 ? 0
+                  : strcmp(last, "A") == 0 ? 4 : 1;
+            if (k == r)
                 slot[c] = n++;
+        }
     data = calloc((size_t)w * (size_t)h * (size_t)nch, sizeof *data);
     if (!data) {
         snprintf(err, errsz, "%s: out of memory for %d x %d x %d texels", path, w, h, nch);
@@ -130,7 +137,7 @@ bool tex_read_exr(const char *path, tex_pixels *out, char *err, size_t errsz)
         for (int y = box.min.y; rv == EXR_ERR_SUCCESS && y <= box.max.y; y += per) {
             rv = exr_read_scanline_chunk_info(ctx, 0, y, &ci);
             if (rv == EXR_ERR_SUCCESS)
-                rv = decode(ctx, &ci, data, w, box.min.x, box.min.y, nch, slot);
+                rv = decode(ctx, &ci, data, w, 0, ci.start_y - box.min.y, nch, slot);
         }
     } else {
         int32_t tw = 1, th = 1, cx = 0, cy = 0;
@@ -143,7 +150,7 @@ bool tex_read_exr(const char *path, tex_pixels *out, char *err, size_t errsz)
             for (int tx = 0; rv == EXR_ERR_SUCCESS && tx < cx; tx++) {
                 rv = exr_read_tile_chunk_info(ctx, 0, tx, ty, 0, 0, &ci);
                 if (rv == EXR_ERR_SUCCESS)
-                    rv = decode(ctx, &ci, data, w, box.min.x, box.min.y, nch, slot);
+                    rv = decode(ctx, &ci, data, w, tx * tw, ty * th, nch, slot);
             }
     }
     if (rv != EXR_ERR_SUCCESS) {

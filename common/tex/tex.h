@@ -95,6 +95,13 @@ bool tex_cell(const tex_texture *t, int c, const tex_range *r, tex_wrap swrap,
  * lookups at any footprint (0 for a missing channel). */
 void tex_lipschitz(const tex_texture *t, int c, double *ls, double *lt);
 
+/* Writes t as a tiled, mip-mapped OpenEXR file: part "mean" with the mean
+ * pyramid as its levels, and with minmax also parts "min" and "max"
+ * (write_exr.c; docs/textures.md). Atomic: a temporary file renamed into
+ * place. false with "path: reason" in err. */
+bool tex_write_exr(const char *path, const tex_texture *t, bool minmax, char *err,
+                   size_t errsz);
+
 /* ---- the per-process cache ---- */
 
 /* Finds the file of texture `name`: true with its path, or false with a

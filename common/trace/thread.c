@@ -35,6 +35,7 @@ trace_thread *trace_thread_new(const trace_world *world)
     sl_vm *vms[] = {self->vm, self->shade_vm, self->light_vm};
     for (size_t i = 0; i < sizeof vms / sizeof vms[0]; i++) {
         sl_vm_set_clipping(vms[i], cam->near_clip, cam->far_clip);
+        sl_vm_set_textures(vms[i], world->textures);
         sl_vm_set_message(vms[i], SL_MSG_OPTION, "Format", SL_TYPE_POINT, format, NULL);
         sl_vm_set_message(vms[i], SL_MSG_OPTION, "Clipping", SL_TYPE_POINT, clipping, NULL);
     }

@@ -2,7 +2,10 @@
  * tests/tex/test_tex_read.c: the image readers of common/tex. Each case
  * writes a small file with libpng or libtiff (random texels of a known
  * depth), opens it with tex_open and compares every texel with the value
- * written over 2^bits - 1 (floats as written); then broken inputs: a
+ * written over 2^bits - 1 (floats as written); OpenEXR files written by
+ * tex_write_exr (tiled, mip-mapped, 1 to 5 channels, odd sizes) and by
+ * OpenEXRCore here (scanline, half, channels B G R Z read as R G B Z)
+ * read back exactly; then broken inputs: a
  * missing file, a file of another format, a truncated PNG, an unsupported
  * TIFF sample format: NULL and a message naming the file.
  */
@@ -13,6 +16,7 @@
 
 #include <cmocka.h>
 
+#include <openexr.h>
 #include <png.h>
 #include <tiffio.h>
 
@@ -195,6 +199,98 @@ static void test_tiff(void **state)
     }
 }
 
+/* tex_write_exr (tiled, mip-mapped, three parts) read back by tex_open */
+static void test_exr_roundtrip(void **state)
+{
+    (void)state;
+    static const int cases[][3] = { { 1, 1, 1 }, { 70, 65, 1 }, { 33, 129, 3 }, { 64, 64, 4 },
+                                    { 9, 5, 5 }, { 130, 3, 2 } };
+    for (size_t n = 0; n < sizeof cases / sizeof cases[0]; n++) {
+        int w = cases[n][0], h = cases[n][1], nch = cases[n][2];
+        float *px = malloc((size_t)w * h * nch * sizeof *px);
+        for (int k = 0; k < w * h * nch; k++)
+            px[k] = (float)((int)(next() % 100000) - 50000) / 977.0f;
+        tex_texture *t = tex_from_pixels(px, w, h, nch, "mem");
+        char path[300], err[512];
+        snprintf(path, sizeof path, "%s/rt%zu.exr", dir, n);
+        if (!tex_write_exr(path, t, n % 2 == 0, err, sizeof err))
+            fail_msg("%s", err);
+        tex_texture *u = tex_open(path, err, sizeof err);
+        if (!u)
+            fail_msg("%s", err);
+        assert_int_equal(tex_width(u), w);
+        assert_int_equal(tex_height(u), h);
+        assert_int_equal(tex_channels(u), nch);
+        assert_int_equal(tex_levels(u), tex_levels(t));
+        assert_string_equal(tex_type(u), "float");
+        for (int k = 0; k < w * h * nch; k++)
+            assert_true(tex_texel(u, 0, k % nch, (k / nch) % w, k / nch / w) == px[k]);
+        tex_free(u);
+        tex_free(t);
+        free(px);
+    }
+}
+
+/* a scanline OpenEXR file of half channels named B, G, R, Z (stored in
+ * that order): read as R, G, B, then Z, rounded to half */
+static void test_exr_half_scanline(void **state)
+{
+    (void)state;
+    char path[300], err[512];
+    snprintf(path, sizeof path, "%s/half.exr", dir);
+    int w = 19, h = 23;
+    exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
+    exr_context_t ctx;
+    assert_int_equal(exr_start_write(&ctx, path, EXR_WRITE_FILE_DIRECTLY, &init), 0);
+    int part;
+    assert_int_equal(exr_add_part(ctx, "img", EXR_STORAGE_SCANLINE, &part), 0);
+    assert_int_equal(exr_initialize_required_attr_simple(ctx, part, w, h, EXR_COMPRESSION_ZIP),
+                     0);
+    const char *names[4] = { "B", "G", "R", "Z" };
+    for (int c = 0; c < 4; c++)
+        assert_int_equal(exr_add_channel(ctx, part, names[c], EXR_PIXEL_HALF,
+                                         EXR_PERCEPTUALLY_LOGARITHMIC, 1, 1), 0);
+    assert_int_equal(exr_write_header(ctx), 0);
+    float *px = malloc((size_t)w * h * 4 * sizeof *px);    /* B G R Z per pixel */
+    for (int k = 0; k < w * h * 4; k++)
+        px[k] = (float)(next() % 2048) / 256.0f;             /* exact in half */
+    int32_t per = 1;
+    exr_get_scanlines_per_chunk(ctx, part, &per);
+    for (int y = 0; y < h; y += per) {
+        exr_chunk_info_t ci;
+        assert_int_equal(exr_write_scanline_chunk_info(ctx, part, y, &ci), 0);
+        exr_encode_pipeline_t enc;
+        memset(&enc, 0, sizeof enc);
+        assert_int_equal(exr_encoding_initialize(ctx, part, &ci, &enc), 0);
+        for (int c = 0; c < enc.channel_count; c++) {
+            int src = 0;
+            for (int q = 0; q < 4; q++)
+                if (strcmp(names[q], enc.channels[c].channel_name) == 0)
+                    src = q;
+            enc.channels[c].encode_from_ptr = (const uint8_t *)(px + (size_t)y * w * 4 + src);
+            enc.channels[c].user_pixel_stride = 4 * sizeof(float);
+            enc.channels[c].user_line_stride = w * 4 * sizeof(float);
+            enc.channels[c].user_data_type = EXR_PIXEL_FLOAT;
+            enc.channels[c].user_bytes_per_element = sizeof(float);
+        }
+        assert_int_equal(exr_encoding_choose_default_routines(ctx, part, &enc), 0);
+        assert_int_equal(exr_encoding_run(ctx, part, &enc), 0);
+        exr_encoding_destroy(ctx, &enc);
+    }
+    assert_int_equal(exr_finish(&ctx), 0);
+    tex_texture *t = tex_open(path, err, sizeof err);
+    if (!t)
+        fail_msg("%s", err);
+    assert_int_equal(tex_channels(t), 4);
+    static const int from[4] = { 2, 1, 0, 3 };       /* R G B Z <- B G R Z */
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++)
+            for (int c = 0; c < 4; c++)
+                assert_true(tex_texel(t, 0, c, x, y) == px[((size_t)y * w + x) * 4 + from[c]]);
+    tex_free(t);
+    free(px);
+}
+
 static void expect_error(const char *path, const char *words)
 {
     char err[512] = "";
@@ -233,6 +329,8 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_png),
         cmocka_unit_test(test_tiff),
+        cmocka_unit_test(test_exr_roundtrip),
+        cmocka_unit_test(test_exr_half_scanline),
         cmocka_unit_test(test_errors),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
