@@ -196,11 +196,51 @@ static inline void VM_OP(span)(A *z, double lo, double hi)
     z->hi = hi;
 }
 
-/* texture lookups: where every lookup of the range is the bilinear form of
- * one level-0 cell (tex_cell), that form over the affine forms of s and t,
- * widened by a relative 1e-9 (the float mode's rounding), clamped to the
- * cell's texels; elsewhere the bound of the filter over the ranges
- * (tex_bound). The gradient (bump) within the derivative bounds. */
+/* texture lookups: where every lookup of the range blends the same
+ * bilinear cells (tex_cells), the sum of their bilinear forms over the
+ * affine forms of s and t, widened by a relative 1e-9 (the float mode's
+ * rounding) and clamped to the cells' texels; elsewhere the bound of the
+ * filter over the ranges (tex_bound). The gradient (bump) within the
+ * derivative bounds. */
+static inline void VM_OP(cells)(sl_vm *vm, A *z, const A *s, const A *t, const tex_cell *cell,
+                                int n)
+{
+    double lo = INFINITY, hi = -INFINITY;
+    for (int q = 0; q < n; q++) {
+        const tex_cell *c = &cell[q];
+        const double *v = c->v;
+        A fx, fy, k;
+        aa_mul_s(vm->ctx, &fx, s, (double)c->w);
+        aa_add_s(vm->ctx, &fx, &fx, -(0.5 + c->oi));
+        aa_mul_s(vm->ctx, &fy, t, (double)c->h);
+        aa_add_s(vm->ctx, &fy, &fy, -(0.5 + c->oj));
+        aa_mul(vm->ctx, &k, &fx, &fy);
+        aa_mul_s(vm->ctx, &k, &k, v[3] - v[2] - v[1] + v[0]);
+        aa_mul_s(vm->ctx, &fx, &fx, v[1] - v[0]);
+        aa_mul_s(vm->ctx, &fy, &fy, v[2] - v[0]);
+        aa_add(vm->ctx, &k, &k, &fx);
+        aa_add(vm->ctx, &k, &k, &fy);
+        aa_add_s(vm->ctx, &k, &k, v[0]);
+        if (c->weight != 1.0)
+            aa_mul_s(vm->ctx, &k, &k, c->weight);
+        if (q == 0)
+            VM_OP(mov)(vm, z, &k);
+        else
+            aa_add(vm->ctx, z, z, &k);
+        for (int i = 0; i < 4; i++) {
+            lo = fmin(lo, v[i]);
+            hi = fmax(hi, v[i]);
+        }
+    }
+    A e, flo, fhi;
+    double eps = 1e-9 * fmax(fabs(lo), fabs(hi)) + 0x1p-1000;
+    VM_OP(span)(&e, -eps, eps);
+    aa_add(vm->ctx, z, z, &e);
+    aa_const(&flo, lo);
+    aa_const(&fhi, hi);
+    aa_clamp(vm->ctx, z, z, &flo, &fhi);
+}
+
 static inline sl_status VM_OP(texture)(sl_vm *vm, A *S, const sl_insn *in, int pc)
 {
     sl_status st = SL_OK;
@@ -229,33 +269,14 @@ static inline sl_status VM_OP(texture)(sl_vm *vm, A *S, const sl_insn *in, int p
         }
         for (int i = 0; i < outs; i++) {
             int ch = c < 0 ? -1 : c + i;
-            double v[4], lo, hi;
-            int ci, cj;
+            tex_cell cells[2];
+            int n;
             if (ch < 0 || ch >= tex_channels(t)) {
                 VM_OP(mov)(vm, &out[i], &S[in->c + 5]);
-            } else if (tex_cell(t, ch, &r, sw, tw, v, &ci, &cj)) {
-                A fx, fy, k, e;
-                aa_mul_s(vm->ctx, &fx, &S[in->c], (double)tex_width(t));
-                aa_add_s(vm->ctx, &fx, &fx, -(0.5 + ci));
-                aa_mul_s(vm->ctx, &fy, &S[in->c + 1], (double)tex_height(t));
-                aa_add_s(vm->ctx, &fy, &fy, -(0.5 + cj));
-                aa_mul(vm->ctx, &k, &fx, &fy);
-                aa_mul_s(vm->ctx, &k, &k, v[3] - v[2] - v[1] + v[0]);
-                aa_mul_s(vm->ctx, &fx, &fx, v[1] - v[0]);
-                aa_mul_s(vm->ctx, &fy, &fy, v[2] - v[0]);
-                aa_add(vm->ctx, &k, &k, &fx);
-                aa_add(vm->ctx, &k, &k, &fy);
-                aa_add_s(vm->ctx, &k, &k, v[0]);
-                lo = fmin(fmin(v[0], v[1]), fmin(v[2], v[3]));
-                hi = fmax(fmax(v[0], v[1]), fmax(v[2], v[3]));
-                double eps = 1e-9 * fmax(fabs(lo), fabs(hi)) + 0x1p-1000;
-                VM_OP(span)(&e, -eps, eps);
-                aa_add(vm->ctx, &k, &k, &e);
-                A flo, fhi;
-                aa_const(&flo, lo);
-                aa_const(&fhi, hi);
-                aa_clamp(vm->ctx, &out[i], &k, &flo, &fhi);
+            } else if ((n = tex_cells(t, ch, &r, sw, tw, cells)) > 0) {
+                VM_OP(cells)(vm, &out[i], &S[in->c], &S[in->c + 1], cells, n);
             } else {
+                double lo, hi;
                 tex_bound(t, ch, &r, sw, tw, 0.0, &lo, &hi);
                 VM_OP(span)(&out[i], lo, hi);
             }

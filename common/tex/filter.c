@@ -195,34 +195,95 @@ static void minmax(const tex_texture *t, int c, int i0, int i1, int j0, int j1, 
         }
 }
 
-void tex_bound(const tex_texture *t, int c, const tex_range *r, tex_wrap swrap,
-               tex_wrap twrap, double fill, double *lo, double *hi)
+/* The bilinear cell of level k (n texels along the axis) under every s of
+ * [s0, s1]: true with its origin i (texel coordinate x = s n - 1/2, the
+ * cell spans [i, i + 1]); unreduced, the texels wrap when fetched. */
+static bool one_cell(double s0, double s1, int n, double *origin)
 {
-    if (c < 0 || c >= t->nch) {
-        *lo = *hi = fill;
+    double x0 = s0 * n - 0.5, x1 = s1 * n - 0.5;
+    if (!(fabs(x0) < 1e9 && fabs(x1) < 1e9))
+        return false;
+    double f = floor(x0);
+    if (x1 > f + 1.0)
+        return false;
+    *origin = f;
+    return true;
+}
+
+/* 1e-9 of the largest magnitude: covers the float lookup's rounding (its
+ * texel coordinate and blend are computed differently from the bound's) */
+static double slack(double a, double b)
+{
+    return 1e-9 * fmax(fabs(a), fabs(b)) + 0x1p-1000;
+}
+
+/* The cells of level k (n texels) under [s0, s1]: the first and last
+ * origin; false where there are more than `most` or the coordinates are
+ * too large to split. */
+static bool few_cells(double s0, double s1, int n, int most, double *first, double *last)
+{
+    double x0 = s0 * n - 0.5, x1 = s1 * n - 0.5;
+    if (!(fabs(x0) < 1e9 && fabs(x1) < 1e9))
+        return false;
+    *first = floor(x0);
+    *last = fmax(*first, ceil(x1) - 1.0);
+    return *last - *first < most;
+}
+
+/* lo <= level k's bilinear <= hi over the s and t of r: exact where r
+ * covers at most 3 x 3 cells (each cell's part of r is a rectangle, and a
+ * bilinear function takes its extremes at a rectangle's corners), so the
+ * bound shrinks with r even across cell edges; else the min-max pyramid
+ * over the texels the cells touch. */
+static void level_range(const tex_texture *t, int k, int c, const tex_range *r, tex_wrap sw,
+                        tex_wrap tw, double *lo, double *hi)
+{
+    double i0, i1, j0, j1;
+    int n = t->lw[k], m = t->lh[k];
+    if (few_cells(r->s[0], r->s[1], n, 3, &i0, &i1) &&
+        few_cells(r->t[0], r->t[1], m, 3, &j0, &j1)) {
+        double x0 = r->s[0] * n - 0.5, x1 = r->s[1] * n - 0.5;
+        double y0 = r->t[0] * m - 0.5, y1 = r->t[1] * m - 0.5;
+        double l = INFINITY, h = -INFINITY;
+        for (double cj = j0; cj <= j1; cj++)
+            for (double ci = i0; ci <= i1; ci++) {
+                int i = (int)ci, j = (int)cj;
+                double v00 = fetch(t, k, c, i, j, sw, tw), v10 = fetch(t, k, c, i + 1, j, sw, tw);
+                double v01 = fetch(t, k, c, i, j + 1, sw, tw);
+                double v11 = fetch(t, k, c, i + 1, j + 1, sw, tw);
+                double vmin = fmin(fmin(v00, v10), fmin(v01, v11));
+                double vmax = fmax(fmax(v00, v10), fmax(v01, v11));
+                double fs[2] = { fmax(x0, ci) - ci, fmin(x1, ci + 1) - ci };
+                double gs[2] = { fmax(y0, cj) - cj, fmin(y1, cj + 1) - cj };
+                double cl = INFINITY, ch = -INFINITY;
+                for (int a = 0; a < 2; a++)
+                    for (int b = 0; b < 2; b++) {
+                        double f = fs[a] < 0 ? 0 : fs[a] > 1 ? 1 : fs[a];
+                        double g = gs[b] < 0 ? 0 : gs[b] > 1 ? 1 : gs[b];
+                        double v = (1 - f) * (1 - g) * v00 + f * (1 - g) * v10 +
+                                   (1 - f) * g * v01 + f * g * v11;
+                        cl = fmin(cl, v);
+                        ch = fmax(ch, v);
+                    }
+                double e = slack(vmin, vmax);
+                l = fmin(l, fmax(cl - e, vmin));
+                h = fmax(h, fmin(ch + e, vmax));
+            }
+        *lo = l;
+        *hi = h;
         return;
     }
-    double wslo, wshi, wtlo, wthi;
-    abs_range(r->ws, &wslo, &wshi);
-    abs_range(r->wt, &wtlo, &wthi);
-    double lmax = tex_level_of(t, wshi, wthi);
-    int kmin = (int)floor(tex_level_of(t, wslo, wtlo));
-    int kmax = (int)floor(lmax) + (lmax > floor(lmax));   /* blends with the next */
-    if (kmax > t->nlevels - 1)
-        kmax = t->nlevels - 1;
+    bool zero = false;
     double l = INFINITY, h = -INFINITY;
-    bool zero = isnan(r->s[0]) || isnan(r->s[1]) || isnan(r->t[0]) || isnan(r->t[1]);
-    for (int k = kmin; k <= kmax; k++) {
-        int si[2][2], ti[2][2];
-        int ns = texel_ranges(r->s[0], r->s[1], t->lw[k], swrap, si, &zero);
-        int nt = texel_ranges(r->t[0], r->t[1], t->lh[k], twrap, ti, &zero);
-        for (int a = 0; a < ns; a++)
-            for (int b = 0; b < nt; b++) {
-                long i1 = ((long)si[a][1] + 1) << k, j1 = ((long)ti[b][1] + 1) << k;
-                minmax(t, c, si[a][0] << k, (int)(i1 < t->w ? i1 : t->w) - 1, ti[b][0] << k,
-                       (int)(j1 < t->h ? j1 : t->h) - 1, &l, &h);
-            }
-    }
+    int si[2][2], ti[2][2];
+    int ns = texel_ranges(r->s[0], r->s[1], t->lw[k], sw, si, &zero);
+    int nt = texel_ranges(r->t[0], r->t[1], t->lh[k], tw, ti, &zero);
+    for (int a = 0; a < ns; a++)
+        for (int b = 0; b < nt; b++) {
+            long ie = ((long)si[a][1] + 1) << k, je = ((long)ti[b][1] + 1) << k;
+            minmax(t, c, si[a][0] << k, (int)(ie < t->w ? ie : t->w) - 1, ti[b][0] << k,
+                   (int)(je < t->h ? je : t->h) - 1, &l, &h);
+        }
     if (zero) {
         l = fmin(l, 0.0);
         h = fmax(h, 0.0);
@@ -231,35 +292,85 @@ void tex_bound(const tex_texture *t, int c, const tex_range *r, tex_wrap swrap,
     *hi = h;
 }
 
-bool tex_cell(const tex_texture *t, int c, const tex_range *r, tex_wrap swrap,
-              tex_wrap twrap, double v[4], int *ci, int *cj)
+void tex_bound(const tex_texture *t, int c, const tex_range *r, tex_wrap swrap,
+               tex_wrap twrap, double fill, double *lo, double *hi)
 {
-    if (c < 0 || c >= t->nch)
-        return false;
+    if (c < 0 || c >= t->nch) {
+        *lo = *hi = fill;
+        return;
+    }
+    if (isnan(r->s[0]) || isnan(r->s[1]) || isnan(r->t[0]) || isnan(r->t[1])) {
+        tex_range all = { { 0, 2 }, { 0, 2 }, { INFINITY, INFINITY }, { INFINITY, INFINITY } };
+        tex_bound(t, c, &all, TEX_WRAP_BLACK, TEX_WRAP_BLACK, fill, lo, hi);
+        return;
+    }
     double wslo, wshi, wtlo, wthi;
     abs_range(r->ws, &wslo, &wshi);
     abs_range(r->wt, &wtlo, &wthi);
-    if (tex_level_of(t, wshi, wthi) != 0.0)
-        return false;
-    int idx[2];
-    const double *rg[2] = { r->s, r->t };
-    int n[2] = { t->w, t->h };
-    for (int a = 0; a < 2; a++) {
-        double x0 = rg[a][0] * n[a] - 0.5, x1 = rg[a][1] * n[a] - 0.5;
-        if (!(fabs(x0) < 1e9 && fabs(x1) < 1e9))
-            return false;
-        double f = floor(x0);
-        if (x1 > f + 1.0)
-            return false;
-        idx[a] = (int)f;
+    double lmin = tex_level_of(t, wslo, wtlo), lmax = tex_level_of(t, wshi, wthi);
+    int k0 = (int)floor(lmin), k1 = (int)floor(lmax);
+    double l, h;
+    if (k0 == k1) {              /* one pair of levels, blend f in [f0, f1] */
+        double f0 = lmin - k0, f1 = lmax - k0;
+        level_range(t, k0, c, r, swrap, twrap, &l, &h);
+        if (f1 > 0 && k0 + 1 < t->nlevels) {
+            double l1, h1;
+            level_range(t, k0 + 1, c, r, swrap, twrap, &l1, &h1);
+            double a = (1 - f0) * l + f0 * l1, b = (1 - f1) * l + f1 * l1;
+            double c0 = (1 - f0) * h + f0 * h1, d = (1 - f1) * h + f1 * h1;
+            double e = slack(fmin(l, l1), fmax(h, h1));
+            double lo2 = fmax(fmin(a, b) - e, fmin(l, l1));
+            double hi2 = fmin(fmax(c0, d) + e, fmax(h, h1));
+            l = lo2;
+            h = hi2;
+        }
+    } else {                     /* several levels: the hull of their ranges */
+        l = INFINITY;
+        h = -INFINITY;
+        for (int k = k0; k <= k1 + 1 && k < t->nlevels; k++) {
+            double a, b;
+            level_range(t, k, c, r, swrap, twrap, &a, &b);
+            l = fmin(l, a);
+            h = fmax(h, b);
+        }
     }
-    *ci = idx[0];
-    *cj = idx[1];
-    v[0] = fetch(t, 0, c, idx[0], idx[1], swrap, twrap);
-    v[1] = fetch(t, 0, c, idx[0] + 1, idx[1], swrap, twrap);
-    v[2] = fetch(t, 0, c, idx[0], idx[1] + 1, swrap, twrap);
-    v[3] = fetch(t, 0, c, idx[0] + 1, idx[1] + 1, swrap, twrap);
-    return true;
+    *lo = l;
+    *hi = h;
+}
+
+int tex_cells(const tex_texture *t, int c, const tex_range *r, tex_wrap swrap,
+              tex_wrap twrap, tex_cell out[2])
+{
+    if (c < 0 || c >= t->nch)
+        return 0;
+    double wslo, wshi, wtlo, wthi;
+    abs_range(r->ws, &wslo, &wshi);
+    abs_range(r->wt, &wtlo, &wthi);
+    double lmin = tex_level_of(t, wslo, wtlo), lmax = tex_level_of(t, wshi, wthi);
+    if (lmin != lmax)
+        return 0;                /* the blend varies: no single form */
+    int k = (int)floor(lmin);
+    double f = lmin - k;
+    int n = f > 0 && k + 1 < t->nlevels ? 2 : 1;
+    for (int q = 0; q < n; q++) {
+        int lv = k + q;
+        double oi, oj;
+        if (!one_cell(r->s[0], r->s[1], t->lw[lv], &oi) ||
+            !one_cell(r->t[0], r->t[1], t->lh[lv], &oj))
+            return 0;
+        tex_cell *cell = &out[q];
+        cell->weight = n == 1 ? 1.0 : q == 0 ? 1 - f : f;
+        cell->w = t->lw[lv];
+        cell->h = t->lh[lv];
+        cell->oi = oi;
+        cell->oj = oj;
+        int i = (int)oi, j = (int)oj;
+        cell->v[0] = fetch(t, lv, c, i, j, swrap, twrap);
+        cell->v[1] = fetch(t, lv, c, i + 1, j, swrap, twrap);
+        cell->v[2] = fetch(t, lv, c, i, j + 1, swrap, twrap);
+        cell->v[3] = fetch(t, lv, c, i + 1, j + 1, swrap, twrap);
+    }
+    return n;
 }
 
 void tex_lipschitz(const tex_texture *t, int c, double *ls, double *lt)

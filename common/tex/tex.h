@@ -83,13 +83,20 @@ typedef struct tex_range {
 void tex_bound(const tex_texture *t, int c, const tex_range *r, tex_wrap swrap,
                tex_wrap twrap, double fill, double *lo, double *hi);
 
-/* Where every lookup of r is the bilinear interpolation of ONE level-0 cell
- * (footprints of level 0 only, s and t inside one cell): true, with the
- * cell's texels v[0] = (i, j), v[1] = (i+1, j), v[2] = (i, j+1), v[3] =
- * (i+1, j+1) (wrapped) and the cell origin: the filter is
- * bilerp(v, s W - 1/2 - i, t H - 1/2 - j). */
-bool tex_cell(const tex_texture *t, int c, const tex_range *r, tex_wrap swrap,
-              tex_wrap twrap, double v[4], int *i, int *j);
+/* One bilinear cell of one level: the filter's part from it is weight *
+ * bilerp(v, s w - 1/2 - oi, t h - 1/2 - oj), v[0] = texel (oi, oj), v[1] =
+ * (oi+1, oj), v[2] = (oi, oj+1), v[3] = (oi+1, oj+1) (wrapped). */
+typedef struct tex_cell {
+    double weight, oi, oj, v[4];
+    int w, h;
+} tex_cell;
+
+/* Where every lookup of r blends the same cells (a footprint of one level
+ * blend, s and t inside one cell of each level used): their number (1 or
+ * 2) into out; 0 elsewhere. The filter is then the sum of the cells'
+ * parts, which affine runs write as an affine form of s and t. */
+int tex_cells(const tex_texture *t, int c, const tex_range *r, tex_wrap swrap,
+              tex_wrap twrap, tex_cell out[2]);
 
 /* Bounds of |d filter / ds| and |d filter / dt| of channel c over all
  * lookups at any footprint (0 for a missing channel). */

@@ -10,10 +10,12 @@
  *    (ends, corners, random points), for every wrap mode, including ranges
  *    across the periodic seam and footprints that blend levels;
  *  - the bound is tight where it can be: a point range at a texel centre
- *    gives that texel exactly; a range inside one texel's cells stays
- *    within the min and max of the texels around it;
- *  - tex_cell: inside one cell the bilinear form of its four texels is the
- *    filter;
+ *    stays within the texels around it; a huge footprint gives the mean
+ *    of the image; all lookups give the min and max of the texels;
+ *  - tex_cells: inside one cell (of one level, or of the two levels a
+ *    footprint blends) the weighted bilinear forms are the filter;
+ *  - inside one cell the bound converges: 1000 times smaller ranges give
+ *    bounds at least 100 times narrower;
  *  - the derivative bounds (tex_lipschitz) hold for difference quotients
  *    and for the filter's own derivatives at every sampled point.
  */
@@ -194,47 +196,86 @@ static void test_bound_is_tight(void **state)
             assert_true(lo >= mn && hi <= mx);
             assert_true(lo <= px[j * 16 + i] && hi >= px[j * 16 + i]);
         }
-    /* the whole texture at a huge footprint: the min and max of the texels */
-    double mn = INFINITY, mx = -INFINITY;
+    /* a huge footprint reads the top level, the mean of all texels: the
+     * bound is that mean; footprints from 0 to huge: the min and max */
+    double mn = INFINITY, mx = -INFINITY, mean = 0;
     for (int k = 0; k < 128; k++) {
         mn = fmin(mn, px[k]);
         mx = fmax(mx, px[k]);
+        mean += px[k] / 128.0;
     }
     tex_range all = { { 0.2, 0.3 }, { 0.2, 0.3 }, { 10, 10 }, { 10, 10 } };
     double lo, hi;
     tex_bound(t, 0, &all, TEX_WRAP_PERIODIC, TEX_WRAP_PERIODIC, 0, &lo, &hi);
+    assert_true(lo <= mean + 1e-6 && hi >= mean - 1e-6 && hi - lo < 1e-6);
+    tex_range any = { { 0, 1 }, { 0, 1 }, { 0, 10 }, { 0, 10 } };
+    tex_bound(t, 0, &any, TEX_WRAP_PERIODIC, TEX_WRAP_PERIODIC, 0, &lo, &hi);
     assert_true(lo == mn && hi == mx);
     tex_free(t);
     free(px);
 }
 
-static void test_cell_is_bilinear(void **state)
+static void test_cells_are_the_filter(void **state)
 {
     (void)state;
     float *px;
     tex_texture *t = random_texture(9, 6, 1, &px);
-    int found = 0;
-    for (int k = 0; k < 2000; k++) {
+    int found[3] = { 0, 0, 0 };
+    for (int k = 0; k < 4000; k++) {
         tex_wrap sw = (tex_wrap)(k % 3), tw = (tex_wrap)((k / 3) % 3);
         double s = range(-1.2, 2.2), tt = range(-1.2, 2.2);
-        tex_range r = { { s, s + range(0, 0.05) }, { tt, tt + range(0, 0.08) }, { 0, 0.01 },
-                        { 0, 0.01 } };
-        double v[4];
-        int i, j;
-        if (!tex_cell(t, 0, &r, sw, tw, v, &i, &j))
+        double w = k % 2 ? 0 : range(0, 0.4);         /* level 0, or a blend */
+        tex_range r = { { s, s + range(0, 0.02) }, { tt, tt + range(0, 0.03) }, { w, w },
+                        { w, w } };
+        tex_cell cells[2];
+        int n = tex_cells(t, 0, &r, sw, tw, cells);
+        found[n]++;
+        if (n == 0)
             continue;
-        found++;
         for (int q = 0; q < 10; q++) {
-            double ss = range(r.s[0], r.s[1]), ts = range(r.t[0], r.t[1]);
-            double fx = ss * 9 - 0.5 - i, fy = ts * 6 - 0.5 - j;
-            assert_true(fx >= -1e-12 && fx <= 1 + 1e-12 && fy >= -1e-12 && fy <= 1 + 1e-12);
-            double want = v[0] + (v[1] - v[0]) * fx + (v[2] - v[0]) * fy +
-                          (v[3] - v[2] - v[1] + v[0]) * fx * fy;
-            double got = tex_sample(t, 0, ss, ts, 0.005, 0.005, sw, tw, 0, NULL, NULL);
+            double ss = range(r.s[0], r.s[1]), ts = range(r.t[0], r.t[1]), want = 0;
+            for (int c = 0; c < n; c++) {
+                const tex_cell *e = &cells[c];
+                double fx = ss * e->w - 0.5 - e->oi, fy = ts * e->h - 0.5 - e->oj;
+                assert_true(fx >= -1e-12 && fx <= 1 + 1e-12 && fy >= -1e-12 && fy <= 1 + 1e-12);
+                want += e->weight * (e->v[0] + (e->v[1] - e->v[0]) * fx +
+                                     (e->v[2] - e->v[0]) * fy +
+                                     (e->v[3] - e->v[2] - e->v[1] + e->v[0]) * fx * fy);
+            }
+            double got = tex_sample(t, 0, ss, ts, w, w, sw, tw, 0, NULL, NULL);
             assert_true(fabs(got - want) < 1e-9);
         }
     }
-    assert_true(found > 100);
+    assert_true(found[1] > 100 && found[2] > 100);
+    /* a varying footprint gives no single form */
+    tex_range vary = { { 0.5, 0.5 }, { 0.5, 0.5 }, { 0.1, 0.2 }, { 0.1, 0.2 } };
+    tex_cell cells[2];
+    assert_int_equal(tex_cells(t, 0, &vary, TEX_WRAP_CLAMP, TEX_WRAP_CLAMP, cells), 0);
+    tex_free(t);
+    free(px);
+}
+
+/* The bound shrinks with the range (the subdivision of a ray tracer
+ * converges): a range 1000 times smaller gives a bound at least 100 times
+ * narrower, at level 0 and in a blend of two levels, inside a cell and
+ * across a cell edge. */
+static void test_bound_converges(void **state)
+{
+    (void)state;
+    float *px;
+    tex_texture *t = random_texture(16, 16, 1, &px);
+    for (int k = 0; k < 500; k++) {
+        double s = range(0.1, 0.9), tt = range(0.1, 0.9), w = k % 2 ? 0 : 0.09;
+        if (k % 3 == 0)                   /* straddling a cell edge (a texel centre) */
+            s = (floor(s * 16) + 0.5) / 16 - 5e-7;
+        tex_range big = { { s, s + 1e-3 }, { tt, tt + 1e-3 }, { w, w }, { w, w } };
+        tex_range small = { { s, s + 1e-6 }, { tt, tt + 1e-6 }, { w, w }, { w, w } };
+        double l0, h0, l1, h1;
+        tex_bound(t, 0, &big, TEX_WRAP_PERIODIC, TEX_WRAP_PERIODIC, 0, &l0, &h0);
+        tex_bound(t, 0, &small, TEX_WRAP_PERIODIC, TEX_WRAP_PERIODIC, 0, &l1, &h1);
+        if (h0 - l0 > 1e-6)
+            assert_true((h1 - l1) * 100 <= h0 - l0);
+    }
     tex_free(t);
     free(px);
 }
@@ -267,7 +308,8 @@ int main(void)
         cmocka_unit_test(test_level0_is_bilinear),
         cmocka_unit_test(test_bound_contains_filter),
         cmocka_unit_test(test_bound_is_tight),
-        cmocka_unit_test(test_cell_is_bilinear),
+        cmocka_unit_test(test_cells_are_the_filter),
+        cmocka_unit_test(test_bound_converges),
         cmocka_unit_test(test_lipschitz),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
