@@ -42,6 +42,7 @@ bool tex_read_png(const char *path, tex_pixels *out, char *err, size_t errsz)
     png_infop info = png ? png_create_info_struct(png) : NULL;
     float *volatile data = NULL;
     png_bytep volatile row = NULL;
+    png_bytep *volatile rows = NULL;
     if (!png || !info) {
         snprintf(err, errsz, "%s: out of memory reading PNG", path);
         png_destroy_read_struct(&png, &info, NULL);
@@ -52,6 +53,7 @@ bool tex_read_png(const char *path, tex_pixels *out, char *err, size_t errsz)
         snprintf(err, errsz, "%s: not a readable PNG image: %s", path, job.message);
         free(data);
         free(row);
+        free(rows);
         png_destroy_read_struct(&png, &info, NULL);
         fclose(f);
         return false;
@@ -70,7 +72,7 @@ bool tex_read_png(const char *path, tex_pixels *out, char *err, size_t errsz)
     row = malloc(rowbytes * (size_t)h);
     if (!data || !row)
         png_error(png, "out of memory for the pixels");
-    png_bytep *rows = malloc((size_t)h * sizeof *rows);
+    rows = malloc((size_t)h * sizeof *rows);
     if (!rows)
         png_error(png, "out of memory for the pixels");
     for (int y = 0; y < h; y++)
@@ -78,6 +80,7 @@ bool tex_read_png(const char *path, tex_pixels *out, char *err, size_t errsz)
     (void)passes;
     png_read_image(png, rows);
     free(rows);
+    rows = NULL;
     double scale = bits == 16 ? 1.0 / 65535.0 : 1.0 / 255.0;
     for (int y = 0; y < h; y++) {
         const png_byte *r = row + (size_t)y * rowbytes;
