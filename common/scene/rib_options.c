@@ -258,6 +258,12 @@ void rib_option(rib_parser *p, const rib_request *req)
         size_t n = strlen(texture->string), np = strlen(prev), cap = 1;
         for (size_t k = 0; k < n; k++)
             cap += texture->string[k] == '&' ? np : 1;
+        if (cap > 65536) {                     /* "&:&" repeated doubles it */
+            rib_error(p, req, req->pos, "the texture search path would be %zu bytes long; "
+                      "keep it under 64 KiB (each \"&\" repeats the previous path)", cap);
+            rib_params_free(&params);
+            return;
+        }
         char *out = sl_xrealloc(NULL, cap), *o = out;
         for (size_t k = 0; k < n; k++) {
             if (texture->string[k] == '&') {
