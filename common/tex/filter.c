@@ -81,8 +81,8 @@ double tex_sample(const tex_texture *t, int c, double s, double tt, double ws, d
     double ds = 0, dt = 0, v;
     if (c < 0 || c >= t->nch) {
         v = fill;
-    } else if (isnan(s) || isnan(tt)) {
-        v = 0;
+    } else if (!isfinite(s) || !isfinite(tt)) {
+        v = 0;                       /* no texel is there: as black */
     } else {
         double l = tex_level_of(t, ws, wt), k0 = floor(l), fr = l - k0;
         int k = (int)k0;
@@ -124,8 +124,8 @@ static int texel_ranges(double s0, double s1, int n, tex_wrap wrap, int out[2][2
 {
     if (!isfinite(s0) || !isfinite(s1) || (wrap == TEX_WRAP_PERIODIC && s1 - s0 >= 1.0)) {
         out[0][0] = 0;
-        out[0][1] = n - 1;
-        *zero = *zero || wrap == TEX_WRAP_BLACK;
+        out[0][1] = n - 1;         /* a non-finite coordinate reads 0 (tex_sample) */
+        *zero = *zero || wrap == TEX_WRAP_BLACK || !isfinite(s0) || !isfinite(s1);
         return 1;
     }
     if (wrap == TEX_WRAP_PERIODIC) {

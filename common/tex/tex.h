@@ -69,7 +69,8 @@ float tex_texel(const tex_texture *t, int level, int c, int i, int j);
 double tex_level_of(const tex_texture *t, double ws, double wt);
 
 /* The filter at (s, t) with footprint (ws, wt) for channel c, with d/ds
- * and d/dt (may be NULL). A channel the texture lacks gives `fill`. */
+ * and d/dt (may be NULL). A channel the texture lacks gives `fill`; a
+ * non-finite s or t gives 0. */
 double tex_sample(const tex_texture *t, int c, double s, double tt, double ws, double wt,
                   tex_wrap swrap, tex_wrap twrap, double fill, double *dds, double *ddt);
 

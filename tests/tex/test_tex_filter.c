@@ -103,6 +103,14 @@ static void test_level0_is_bilinear(void **state)
         }
         assert_true(tex_sample(t, 5, 0.3, 0.3, 0, 0, TEX_WRAP_CLAMP, TEX_WRAP_CLAMP, 0.25,
                                NULL, NULL) == 0.25);         /* missing channel: fill */
+        for (int k = 0; k < 3; k++) {                       /* non-finite: 0, bounded */
+            double bad = k == 0 ? INFINITY : k == 1 ? -INFINITY : NAN, lo, hi;
+            assert_true(tex_sample(t, 0, bad, 0.3, 0, 0, (tex_wrap)k, (tex_wrap)k, 0, NULL,
+                                   NULL) == 0.0);
+            tex_range r = { { 0.1, k == 2 ? NAN : INFINITY }, { 0.2, 0.3 }, { 0, 0 }, { 0, 0 } };
+            tex_bound(t, 0, &r, (tex_wrap)k, (tex_wrap)k, 0, &lo, &hi);
+            assert_true(lo <= 0 && hi >= 0);
+        }
         tex_free(t);
         free(px);
     }
