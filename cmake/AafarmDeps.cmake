@@ -20,6 +20,7 @@ endfunction()
 aafarm_require_pkgconfig(ZMQ libzmq libzmq3-dev)
 aafarm_require_pkgconfig(PNG libpng libpng-dev)
 aafarm_require_pkgconfig(ZLIB zlib zlib1g-dev)
+aafarm_require_pkgconfig(TIFF libtiff-4 libtiff-dev)
 
 find_package(OpenEXR 3 CONFIG QUIET)
 if(NOT OpenEXR_FOUND OR NOT TARGET OpenEXR::OpenEXRCore)

@@ -12,7 +12,8 @@ PACKAGES=(
   pkg-config        # finds libzmq
   libzmq3-dev       # transport between master and workers
   libopenexr-dev    # OpenEXR 3 C API (OpenEXRCore) for tiles and images
-  libpng-dev        # PNG previews
+  libpng-dev        # PNG previews and PNG textures
+  libtiff-dev       # TIFF textures (common/tex)
   zlib1g-dev        # gzip-compressed RIB archives (ReadArchive)
   libcmocka-dev     # unit and property tests
   protobuf-c-compiler libprotobuf-c-dev  # wire protocol schema

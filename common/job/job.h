@@ -118,6 +118,12 @@ uint64_t job_files_bytes(const job *self);
 bool job_file_resolve(void *job, const char *name, char *path, size_t path_size, char *why,
                       int why_size);
 
+/* The same lookup job_collect_files makes, for a name on the texture search
+ * path of `scene` (a const scene *), before the job's files are collected:
+ * the path found on disk, or false and why. */
+bool job_texture_path_resolve(void *scene, const char *name, char *path, size_t path_size,
+                              char *why, int why_size);
+
 /* Collects the job's files (job_files.c): every string constant of the
  * compiled programs and every string parameter of the scene's shader calls
  * that names a regular file on the scene's texture search path is hashed

@@ -102,6 +102,27 @@ static char *find_on_path(const scene *sc, const char *name)
     return NULL;
 }
 
+bool job_texture_path_resolve(void *scene_, const char *name, char *path, size_t path_size,
+                              char *why, int why_size)
+{
+    const scene *sc = scene_;
+    char *found = find_on_path(sc, name);
+    if (!found) {
+        snprintf(why, (size_t)why_size, "no file '%s' on the texture search path (add its folder "
+                 "with Option \"searchpath\" \"texture\" [\"dir:&\"]; the RIB's folder is "
+                 "searched last)", name);
+        return false;
+    }
+    bool fits = strlen(found) < path_size;
+    if (fits)
+        memcpy(path, found, strlen(found) + 1);
+    else
+        snprintf(why, (size_t)why_size, "the path of '%s' is longer than %zu bytes", name,
+                 path_size - 1);
+    free(found);
+    return fits;
+}
+
 /* One candidate string: a file of the job when it names one. */
 static bool consider(job *self, const scene *sc, const char *name, sl_pos pos, sl_diag *diag)
 {

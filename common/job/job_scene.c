@@ -220,6 +220,44 @@ static bool build_objects(job_scene *self, sl_diag *diag)
     return true;
 }
 
+/* The textures (docs/textures.md): a cache whose resolver finds names on
+ * the scene's texture search path and in the RIB's folder; every name the
+ * bound shaders use is resolved now (render: also opened), so that a
+ * missing map is an error naming the shader call, not a failed tile. */
+static bool open_textures(job_scene *self, sl_diag *diag, bool render)
+{
+    const scene *sc = self->scene;
+    self->textures = tex_cache_new(0);
+    if (!self->textures) abort();
+    /* the job's files (job_file_resolve: the disk on the master and
+     * standalone, the host's store on a worker); before job_load has
+     * collected them, the same search of the texture path */
+    if (render)
+        tex_cache_set_resolver(self->textures, job_file_resolve, (void *)self->job);
+    else
+        tex_cache_set_resolver(self->textures, job_texture_path_resolve, (void *)sc);
+    self->world.textures = self->textures;
+    bool ok = true;
+    for (int i = 0; i < sc->nshaders; i++) {
+        const char *names[32];
+        int n = sl_instance_texture_names(self->instances[i], names, 32);
+        for (int k = 0; k < n; k++) {
+            char err[1024], path[4096], why[512];
+            bool found = render ? tex_cache_get(self->textures, names[k], err, sizeof err) != NULL
+                                : job_texture_path_resolve((void *)sc, names[k], path, sizeof path,
+                                                           why, (int)sizeof why);
+            if (!found) {
+                if (!render)
+                    snprintf(err, sizeof err, "texture '%s': %s", names[k], why);
+                sl_diag_error(diag, sc->shaders[i].pos, "shader '%s': %s", sc->shaders[i].name,
+                              err);
+                ok = false;
+            }
+        }
+    }
+    return ok;
+}
+
 job_scene *job_scene_new(const job *jb, size_t cache_bytes, bool render, sl_diag *diag)
 {
     job_scene *self = calloc(1, sizeof *self);
@@ -231,6 +269,7 @@ job_scene *job_scene_new(const job *jb, size_t cache_bytes, bool render, sl_diag
     bool ok = self->scene != NULL;
     if (ok) ok = compile_programs(self, diag);
     if (ok) ok = build_objects(self, diag);
+    if (ok) ok = open_textures(self, diag, render);
     if (ok) {
         const scene *sc = self->scene;
         trace_world *w = &self->world;
@@ -283,6 +322,7 @@ void job_scene_destroy(job_scene **self_p)
     free(self->programs);
     free(self->world.objects);
     free(self->world.lights);
+    tex_cache_free(self->textures);
     scene_destroy(&self->scene);
     free(self);
     *self_p = NULL;

@@ -12,6 +12,7 @@
 
 #include "job/job.h"
 #include "scene/scene.h"
+#include "tex/tex.h"
 #include "trace/render.h"
 
 typedef struct job_scene {
@@ -21,6 +22,7 @@ typedef struct job_scene {
     sl_instance **instances;       /* per scene shader call (scene->shaders) */
     trace_world world;
     trace_renderer *renderer;      /* NULL when built with render = false */
+    tex_cache *textures;           /* the textures the shaders read (world.textures) */
 } job_scene;
 
 /* cache_bytes: this worker's box cache budget per thread (0: unlimited).

@@ -241,11 +241,32 @@ static void path_push(char ***list, int *n, const char *s, size_t len)
     (*list)[(*n)++] = sl_xstrndup(s, len);
 }
 
-/* Splits at ':'; "&" is the previous path, "@" the standard one (empty). */
-static void set_path(char ***path, int *npath, const char *value)
+/* At most this many folders in one search path: "&:&" repeated doubles a
+ * path, and twenty such Options would otherwise ask for millions. */
+#define RIB_MAX_PATH_FOLDERS 2048
+
+/* Splits at ':'; "&" is the previous path, "@" the standard one (empty).
+ * A path of more than RIB_MAX_PATH_FOLDERS folders is an error at the
+ * request (the path is left as it was). */
+static void set_path(rib_parser *p, const rib_request *req, const char *kind, char ***path,
+                     int *npath, const char *value)
 {
     char **list = NULL;
     int n = 0;
+    long want = 0;
+    for (const char *s = value;;) {           /* count first: no huge list */
+        const char *colon = strchr(s, ':');
+        size_t len = colon ? (size_t)(colon - s) : strlen(s);
+        want += (len == 1 && s[0] == '&') ? *npath : (len > 0 && !(len == 1 && s[0] == '@'));
+        if (!colon)
+            break;
+        s = colon + 1;
+    }
+    if (want > RIB_MAX_PATH_FOLDERS) {
+        rib_error(p, req, req->pos, "the %s search path would have %ld folders; keep it under "
+                  "%d (each \"&\" repeats the previous path)", kind, want, RIB_MAX_PATH_FOLDERS);
+        return;
+    }
     const char *s = value;
     for (;;) {
         const char *colon = strchr(s, ':');
@@ -300,13 +321,13 @@ void rib_option(rib_parser *p, const rib_request *req)
         return;
     const scene_param *shader = rib_params_find(&params, "shader");
     if (shader && shader->string)
-        set_path(&p->shader_path, &p->nshader_path, shader->string);
+        set_path(p, req, "shader", &p->shader_path, &p->nshader_path, shader->string);
     const scene_param *archive = rib_params_find(&params, "archive");
     if (archive && archive->string)
-        set_path(&p->archive_path, &p->narchive_path, archive->string);
+        set_path(p, req, "archive", &p->archive_path, &p->narchive_path, archive->string);
     const scene_param *texture = rib_params_find(&params, "texture");
     if (texture && texture->string)
-        set_path(&p->texture_path, &p->ntexture_path, texture->string);
+        set_path(p, req, "texture", &p->texture_path, &p->ntexture_path, texture->string);
     rib_params_free(&params);
 }
 

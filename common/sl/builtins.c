@@ -115,6 +115,11 @@ static const sl_builtin table[] = {
     LW("cellnoise", "F:p", NOISE, NOISE, SL_NOISE_CELL),
     LW("cellnoise", "F:pf", NOISE, NOISE, SL_NOISE_CELL),
     LW("random", "F:", RANDOM, RANDOM, 0),
+    /* textures (§15.7): variadic, checked apart (check_texture) */
+    LW("texture", "F:s", TEXTURE, TEXTURE, 0), LW("texture", "F:sff", TEXTURE, TEXTURE, 0),
+    LW("environment", "F:sv", TEXTURE, TEXTURE, 0),
+    LW("bump", "v:snvv", TEXTURE, TEXTURE, 0), LW("bump", "v:snvvff", TEXTURE, TEXTURE, 0),
+    LW("textureinfo", "f:ssV", TEXTURE, TEXINFO, 0),
     /* shading (§15.4) */
     LW("ambient", "c:", LIGHT, AMBIENT, 0),
     LW("diffuse", "c:n", LIGHT, DIFFUSE, 0),
@@ -457,3 +462,12 @@ static const unsigned char global_slots[SL_G__COUNT + 1] = {
 
 int sl_global_size(sl_global g) { return global_slots[g + 1] - global_slots[g]; }
 int sl_global_slot(sl_global g) { return global_slots[g]; }
+
+int sl_texinfo_find(const char *name)
+{
+    static const char *const names[] = { "resolution", "channels", "levels", "type" };
+    for (int k = 0; k < 4; k++)
+        if (strcmp(name, names[k]) == 0)
+            return k;
+    return -1;
+}

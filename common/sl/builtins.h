@@ -60,7 +60,14 @@ typedef enum sl_lowering {
                              op RAY, k = SL_RAY_TRACE or 1 (a shadow) */
     SL_LOWER_SPLINE,      /* spline([basis,] t, knots... | knots[]): checked
                              apart (variadic); node op = the basis index */
+    SL_LOWER_TEXTURE,     /* texture, environment, bump, textureinfo: checked
+                             apart (check_texture); node op = SL_TEX_* */
 } sl_lowering;
+
+/* The texture lookups (docs/textures.md) and textureinfo's data. */
+enum { SL_TEX_TEXTURE, SL_TEX_ENVIRONMENT, SL_TEX_BUMP, SL_TEX_INFO };
+/* "resolution", "channels", "levels", "type": the SL_TEXINFO_*, or -1. */
+int sl_texinfo_find(const char *name);
 
 typedef struct sl_builtin {
     const char *name;

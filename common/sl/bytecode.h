@@ -89,7 +89,8 @@ enum {
     X(MESSAGE, "message", "zskk")                                \
     X(SCAT, "scat", "sss-") X(SFMT, "sfmt", "sxsk")              \
     X(SPRINT, "sprint", "s---") X(SMATCH, "smatch", "zss-")      \
-    X(RAY, "ray", "zxxk")
+    X(RAY, "ray", "zxxk")                                        \
+    X(TEXTURE, "texture", "zsxk") X(TEXINFO, "texinfo", "zsxk")
 
 typedef enum sl_opcode {
 #define SL_OPCODE_ENUM(name, text, operands) SL_OP_##name,
@@ -182,6 +183,26 @@ enum {
 #define SL_NOISE_VARIANT(dim, kind, vec) ((dim) | ((kind) << 3) | ((vec) ? SL_NOISE_VECTOR : 0))
 #define SL_NOISE_DIM(v) ((v) & 7)
 #define SL_NOISE_KIND(v) (((v) >> 3) & 3)
+
+/* Textures (docs/textures.md): TEXTURE z, name, args, d looks texture
+ * vm->str[name] up with the arguments in 6 consecutive slots from args: s,
+ * t, the footprint widths ws and wt, the channel, the fill value; d packs
+ * what it writes (SL_TEXOP_FLOAT: 1 slot, the filter of the channel;
+ * SL_TEXOP_COLOR: 3, channels c..c+2; SL_TEXOP_GRAD: 2, d/ds and d/dt of
+ * the channel) and the wrap modes of s and t (tex_wrap).
+ * TEXINFO z, name, var, query: z = 1 and var set when the texture opens
+ * (query SL_TEXINFO_*, builtins.h: resolution writes 2 slots, channels and
+ * levels 1, type none), else z = 0. */
+enum { SL_TEXINFO_RESOLUTION, SL_TEXINFO_CHANNELS, SL_TEXINFO_LEVELS, SL_TEXINFO_TYPE };
+enum { SL_TEXOP_FLOAT = 0, SL_TEXOP_COLOR = 1, SL_TEXOP_GRAD = 2 };
+#define SL_TEXOP(kind, swrap, twrap) ((kind) | ((swrap) << 2) | ((twrap) << 4))
+#define SL_TEXOP_KIND(d) ((d) & 3)
+#define SL_TEXOP_SWRAP(d) (((d) >> 2) & 3)
+#define SL_TEXOP_TWRAP(d) (((d) >> 4) & 3)
+static inline int sl_texop_outs(int d)
+{
+    return SL_TEXOP_KIND(d) == SL_TEXOP_COLOR ? 3 : SL_TEXOP_KIND(d) == SL_TEXOP_GRAD ? 2 : 1;
+}
 
 /* SPACE/SPACEK direction (operand c): the matrix that takes points from the
  * named space to "current", or the one from "current" to it. */

@@ -30,6 +30,7 @@
 #include "sl/builtins.h"
 #include "sl/lexer.h"
 #include "sl/strmatch.h"
+#include "tex/tex.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -509,6 +510,11 @@ static bool const_index(const sl_node *x, double *k)
  * with the target of `a[i] op= e` and already checked. */
 static sl_ty check_index(checker *c, sl_node *n)
 {
+    if (n->a->kind == SL_N_STR) {
+        error(c, n->pos, "a channel index after a string is only allowed on the texture name "
+                         "of texture(), environment() or bump()");
+        return set_ty(n, SL_TY_ERROR);
+    }
     sl_ty at = check_ident(c, n->a);
     sl_ty it = n->num != 0 ? n->b->ty : check_expr(c, &n->b, SL_TYPE_FLOAT);
     if (at == SL_TY_ERROR || it == SL_TY_ERROR)
@@ -1152,6 +1158,175 @@ static sl_ty check_strings(checker *c, sl_node *n, const sl_builtin *b)
     return set_ty(n, b->op == SL_OP_SPRINT ? SL_TYPE_VOID : SL_TYPE_STRING);
 }
 
+/* The texture lookups (RI Spec 3.2 §15.7; docs/textures.md):
+ *   texture(name[channel] [, s, t | , s1, t1, s2, t2, s3, t3, s4, t4], params)
+ *   environment(name[channel], direction, params)
+ *   bump(name[channel], N, dPds, dPdt [, s, t], params)
+ *   textureinfo(name, "dataname", variable)
+ * name a string expression, [channel] an optional float index (after a
+ * string constant or a string variable), params pairs of a constant name
+ * and a value. n->op: SL_TEX_* (builtins.h); n->a the name, n->b the
+ * channel or NULL; texture and environment are float, or color where the
+ * context wants a color. */
+static const struct { const char *name; char type; } texture_params[] = {
+    { "blur", 'f' }, { "sblur", 'f' }, { "tblur", 'f' }, { "width", 'f' },
+    { "swidth", 'f' }, { "twidth", 'f' }, { "fill", 'f' }, { "samples", 'f' },
+    { "filter", 's' }, { "wrap", 'w' }, { "swrap", 'w' }, { "twrap", 'w' },
+};
+#define TEXTURE_PARAM_NAMES "\"blur\", \"sblur\", \"tblur\", \"width\", \"swidth\", " \
+    "\"twidth\", \"fill\", \"samples\", \"filter\", \"wrap\", \"swrap\", \"twrap\""
+
+static sl_ty check_texture_info(checker *c, sl_node *n)
+{
+    if (n->nlist != 3) {
+        error(c, n->pos, "textureinfo() takes a texture name, the name of the datum and a "
+                         "variable for it");
+        return set_ty(n, SL_TY_ERROR);
+    }
+    bool bad = check_expr(c, &n->list[0], SL_TYPE_STRING) != SL_TYPE_STRING;
+    sl_node *what = n->list[1], *var = n->list[2];
+    check_expr(c, &n->list[1], SL_TYPE_STRING);
+    if (what->kind != SL_N_STR) {
+        error(c, what->pos, "the datum of textureinfo() must be a constant string "
+                            "(\"resolution\", \"channels\", \"levels\" or \"type\")");
+        return set_ty(n, SL_TY_ERROR);
+    }
+    int q = sl_texinfo_find(what->name);
+    if (q < 0) {
+        error(c, what->pos, "unknown textureinfo() datum '%s' (known: \"resolution\", "
+                            "\"channels\", \"levels\", \"type\")", what->name);
+        return set_ty(n, SL_TY_ERROR);
+    }
+    sl_ty want = q == SL_TEXINFO_RESOLUTION ? sl_ty_array(SL_TYPE_FLOAT, 2)
+               : q == SL_TEXINFO_TYPE ? SL_TYPE_STRING : SL_TYPE_FLOAT;
+    sl_ty have = check_expr(c, &n->list[2], SL_TYPE_VOID);
+    if (bad || have == SL_TY_ERROR)
+        return set_ty(n, SL_TY_ERROR);
+    if (var->kind != SL_N_IDENT || have != want) {
+        error(c, var->pos, "textureinfo() writes \"%s\" into a variable of type '%s'",
+              what->name, sl_ty_name(want));
+        return set_ty(n, SL_TY_ERROR);
+    }
+    check_assignable(c, var, "modify");
+    int count;
+    n->builtin = sl_builtin_find("textureinfo", &count);
+    n->op = SL_TEX_INFO;
+    n->a = n->list[0];
+    n->num = q;
+    return set_ty(n, SL_TYPE_FLOAT);
+}
+
+static sl_ty check_texture(checker *c, sl_node *n, sl_ty hint)
+{
+    int kind = strcmp(n->name, "texture") == 0 ? SL_TEX_TEXTURE
+             : strcmp(n->name, "environment") == 0 ? SL_TEX_ENVIRONMENT
+             : strcmp(n->name, "bump") == 0 ? SL_TEX_BUMP : SL_TEX_INFO;
+    if (kind == SL_TEX_INFO)
+        return check_texture_info(c, n);
+    if (n->nlist < 1) {
+        error(c, n->pos, "%s() takes a texture name first", n->name);
+        return set_ty(n, SL_TY_ERROR);
+    }
+    bool bad = false;
+    sl_node *first = n->list[0];
+    n->a = first;
+    n->b = NULL;
+    sl_ty at = first->kind != SL_N_INDEX ? SL_TY_ERROR
+             : first->a->kind == SL_N_STR ? SL_TYPE_STRING : check_ident(c, first->a);
+    if (first->kind == SL_N_INDEX && first->a->kind == SL_N_IDENT && at == SL_TY_ERROR)
+        return set_ty(n, SL_TY_ERROR);
+    if (first->kind == SL_N_INDEX && at == SL_TYPE_STRING) {
+        n->a = first->a;                 /* name[channel] */
+        set_ty(n->a, SL_TYPE_STRING);
+        bad |= check_expr(c, &first->b, SL_TYPE_FLOAT) != SL_TYPE_FLOAT;
+        n->b = first->b;
+        set_ty(first, SL_TYPE_STRING);
+    } else if (check_expr(c, &n->list[0], SL_TYPE_STRING) != SL_TYPE_STRING) {
+        if (n->list[0]->ty != SL_TY_ERROR)
+            error(c, n->list[0]->pos, "the texture name of %s() must be a string, not '%s'",
+                  n->name, sl_ty_name(n->list[0]->ty));
+        return set_ty(n, SL_TY_ERROR);
+    } else {
+        n->a = n->list[0];
+    }
+    int npos = 0;
+    while (1 + npos < n->nlist && n->list[1 + npos]->kind != SL_N_STR)
+        npos++;
+    bool ok_count = kind == SL_TEX_TEXTURE ? (npos == 0 || npos == 2 || npos == 8)
+                  : kind == SL_TEX_ENVIRONMENT ? npos == 1 : (npos == 3 || npos == 5);
+    if (!ok_count) {
+        error(c, n->pos, "%s() takes %s after the texture name, then \"name\", value "
+              "parameters; got %d value%s", n->name,
+              kind == SL_TEX_TEXTURE ? "no coordinates (s and t), s and t, or four corners "
+                                       "s1, t1, ..., s4, t4"
+              : kind == SL_TEX_ENVIRONMENT ? "a direction"
+              : "N, dPds and dPdt, optionally then s and t", npos, npos == 1 ? "" : "s");
+        return set_ty(n, SL_TY_ERROR);
+    }
+    for (int i = 1; i <= npos; i++) {
+        bool spatial = (kind == SL_TEX_ENVIRONMENT) || (kind == SL_TEX_BUMP && i <= 3);
+        sl_ty want = spatial ? SL_TYPE_VECTOR : SL_TYPE_FLOAT;
+        sl_ty have = check_expr(c, &n->list[i], want);
+        if (have == SL_TY_ERROR) {
+            bad = true;
+            continue;
+        }
+        if (spatial ? !sl_ty_is_spatial(have) && !sl_ty_is_list(have) : have != SL_TYPE_FLOAT) {
+            error(c, n->list[i]->pos, "argument %d of %s() must be a %s, not '%s'", i + 1,
+                  n->name, spatial ? "point, vector or normal" : "float", sl_ty_name(have));
+            bad = true;
+            continue;
+        }
+        wrap_conv(c, &n->list[i], want);
+    }
+    for (int i = 1 + npos; i < n->nlist; i += 2) {
+        sl_node *pn = n->list[i];
+        check_expr(c, &n->list[i], SL_TYPE_STRING);
+        size_t k = 0, nk = sizeof texture_params / sizeof texture_params[0];
+        while (k < nk && strcmp(texture_params[k].name, pn->name) != 0)
+            k++;
+        if (pn->kind != SL_N_STR || k == nk) {
+            error(c, pn->pos, "unknown %s() parameter '%s' (known: " TEXTURE_PARAM_NAMES ")",
+                  n->name, pn->kind == SL_N_STR ? pn->name : "?");
+            bad = true;
+            continue;
+        }
+        if (i + 1 >= n->nlist) {
+            error(c, pn->pos, "%s() parameter '%s' has no value", n->name, pn->name);
+            bad = true;
+            break;
+        }
+        char type = texture_params[k].type;
+        sl_ty have = check_expr(c, &n->list[i + 1], type == 'f' ? SL_TYPE_FLOAT
+                                                                : SL_TYPE_STRING);
+        sl_node *v = n->list[i + 1];
+        if (have == SL_TY_ERROR) {
+            bad = true;
+        } else if (type == 'f' && have != SL_TYPE_FLOAT) {
+            error(c, v->pos, "%s() parameter '%s' takes a float, not '%s'", n->name, pn->name,
+                  sl_ty_name(have));
+            bad = true;
+        } else if (type != 'f' && v->kind != SL_N_STR) {
+            error(c, v->pos, "%s() parameter '%s' takes a constant string", n->name, pn->name);
+            bad = true;
+        } else if (type == 'w' && tex_wrap_find(v->name) < 0) {
+            error(c, v->pos, "unknown wrap mode '%s' (known: \"periodic\", \"clamp\", "
+                             "\"black\")", v->name);
+            bad = true;
+        }
+    }
+    if (bad)
+        return set_ty(n, SL_TY_ERROR);
+    int count;
+    n->builtin = sl_builtin_find(kind == SL_TEX_BUMP ? "bump" : kind == SL_TEX_ENVIRONMENT
+                                 ? "environment" : "texture", &count);
+    n->op = kind;
+    n->num = npos;
+    if (kind == SL_TEX_BUMP)
+        return set_ty(n, SL_TYPE_VECTOR);
+    return set_ty(n, hint == SL_TYPE_COLOR ? SL_TYPE_COLOR : SL_TYPE_FLOAT);
+}
+
 static sl_ty check_call(checker *c, sl_node *n, sl_ty hint)
 {
     sl_func *cands[MAX_OVERLOADS];
@@ -1175,6 +1350,9 @@ static sl_ty check_call(checker *c, sl_node *n, sl_ty hint)
     }
     if (ncands == 0 && strcmp(n->name, "spline") == 0)
         return check_spline(c, n, hint);
+    if (ncands == 0 && (strcmp(n->name, "texture") == 0 || strcmp(n->name, "environment") == 0 ||
+                        strcmp(n->name, "bump") == 0 || strcmp(n->name, "textureinfo") == 0))
+        return check_texture(c, n, hint);
     if (ncands == 0) {
         int count;
         const sl_builtin *b = sl_builtin_find(n->name, &count);
@@ -1186,16 +1364,6 @@ static sl_ty check_call(checker *c, sl_node *n, sl_ty hint)
     if (!ncands && !builtin) {
         for (int i = 0; i < n->nlist; i++)
             check_expr(c, &n->list[i], SL_TYPE_VOID);
-        static const char *const later[] = {
-            "texture", "environment", "bump", "textureinfo",
-        };
-        for (size_t k = 0; k < sizeof later / sizeof later[0]; k++) {
-            if (strcmp(n->name, later[k]) == 0) {
-                error(c, n->pos, "'%s' is not supported yet: texture, environment and "
-                                 "shadow maps come with the texture work (issue 16)", n->name);
-                return set_ty(n, SL_TY_ERROR);
-            }
-        }
         if (strcmp(n->name, "atmosphere") == 0 || strcmp(n->name, "incident") == 0 ||
             strcmp(n->name, "opposite") == 0) {
             error(c, n->pos, "'%s' reads the values of a volume shader, and volume shaders "

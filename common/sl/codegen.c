@@ -36,6 +36,7 @@
 #include "sl/check.h"
 #include "sl/lexer.h"
 #include "sl/strbuf.h"
+#include "tex/tex.h"
 
 #include <math.h>
 #include <stdarg.h>
@@ -300,6 +301,7 @@ static int written_count(const sl_insn *in, const sl_program *p)
     case SL_OP_NOISE: return (in->c & SL_NOISE_VECTOR) ? 3 : 1;
     case SL_OP_RANDOM: return in->b;
     case SL_OP_RAY: return (in->d & ((1 << SL_RAY_KIND_BITS) - 1)) == SL_RAY_TRACE ? 3 : 1;
+    case SL_OP_TEXTURE: return sl_texop_outs(in->d);
     case SL_OP_CALCNORMAL: case SL_OP_AMBIENT: case SL_OP_DIFFUSE: case SL_OP_SPECULAR:
     case SL_OP_PHONG: case SL_OP_XPOINT: case SL_OP_XVECTOR: case SL_OP_XNORMAL:
     case SL_OP_SETCOMP:
@@ -1509,6 +1511,121 @@ static int gen_strings(cg *g, sl_node *e, int dst)
     return into_string(g, job.cur, dst);
 }
 
+/* textureinfo(name, "datum", var): TEXINFO into var (its type string is
+ * "texture" whenever the texture opens). */
+static int gen_texture_info(cg *g, sl_node *e, int name, int dst)
+{
+    int q = (int)e->num;
+    sl_sym *var = e->list[2]->sym;
+    int z = target(g, dst, 1);
+    int size = q == SL_TEXINFO_RESOLUTION ? 2 : q == SL_TEXINFO_TYPE ? 0 : 1;
+    emit(g, SL_OP_TEXINFO, z, name, size ? var->slot : 0, q);
+    if (size)
+        record_write(g, var->slot, size);
+    else
+        emit(g, SL_OP_SMOV, var->slot, string_const(g, "texture", 7), 0, 0);
+    return z;
+}
+
+/* texture(), environment(), bump(), textureinfo() (check_texture; the
+ * lookups of docs/textures.md): the six argument slots of TEXTURE
+ * (bytecode.h) and the op. Footprint: the four-corner form's extent in s
+ * and t times "width" ("swidth", "twidth"), plus "blur" ("sblur",
+ * "tblur"); the other forms have the blur alone. environment() turns its
+ * direction D into lat-long coordinates s = 1/2 + atan2(D.y, D.x) / 2pi,
+ * t = acos(D.z / |D|) / pi (s periodic, t clamped); bump() returns
+ * dh/ds (N x dPdt) + dh/dt (dPds x N), the change of the normal that a
+ * displacement by h along N makes (to first order). */
+static int gen_texture(cg *g, sl_node *e, int dst)
+{
+    int kind = e->op, npos = (int)e->num;
+    int name = gen_expr(g, e->a, -1);
+    if (kind == SL_TEX_INFO)
+        return gen_texture_info(g, e, name, dst);
+    int chan = e->b ? gen_expr(g, e->b, -1) : const_slot(g, 0);
+    int pos[8];
+    for (int i = 0; i < npos; i++)
+        pos[i] = gen_expr(g, e->list[1 + i], -1);
+    int blur[2] = { -1, -1 }, width[2] = { -1, -1 }, fill = const_slot(g, 0);
+    int wrap[2] = { TEX_WRAP_PERIODIC, kind == SL_TEX_ENVIRONMENT ? TEX_WRAP_CLAMP
+                                                                  : TEX_WRAP_PERIODIC };
+    for (int i = 1 + npos; i + 1 < e->nlist; i += 2) {   /* "blur" before "sblur" */
+        const char *pn = e->list[i]->name;
+        sl_node *v = e->list[i + 1];
+        if (strcmp(pn, "filter") == 0 || strcmp(pn, "samples") == 0)
+            continue;
+        if (strstr(pn, "wrap")) {
+            int w = tex_wrap_find(v->name);
+            if (pn[0] != 't')
+                wrap[0] = w;
+            if (pn[0] != 's')
+                wrap[1] = w;
+            continue;
+        }
+        int x = gen_expr(g, v, -1);
+        if (strcmp(pn, "fill") == 0)
+            fill = x;
+        int *dstp = strstr(pn, "blur") ? blur : strstr(pn, "width") ? width : NULL;
+        if (!dstp)
+            continue;
+        if (pn[0] != 't')
+            dstp[0] = x;
+        if (pn[0] != 's')
+            dstp[1] = x;
+    }
+    int st[2], w[2];
+    int zero = const_slot(g, 0);
+    if (kind == SL_TEX_ENVIRONMENT) {
+        int d = gen_normalize(g, pos[0], -1);
+        int a = op2(g, SL_OP_ATAN2, d + 1, d);
+        st[0] = op2(g, SL_OP_ADD, op2(g, SL_OP_MUL, a, const_slot(g, 0.5 / M_PI)),
+                    const_slot(g, 0.5));
+        st[1] = op2(g, SL_OP_MUL, op1(g, SL_OP_ACOS, d + 2), const_slot(g, 1.0 / M_PI));
+    } else if (npos == 8) {
+        for (int k = 0; k < 2; k++) {
+            int sum = op2(g, SL_OP_ADD, op2(g, SL_OP_ADD, pos[k], pos[k + 2]),
+                          op2(g, SL_OP_ADD, pos[k + 4], pos[k + 6]));
+            st[k] = op2(g, SL_OP_MUL, sum, const_slot(g, 0.25));
+            int lo = op2(g, SL_OP_MIN, op2(g, SL_OP_MIN, pos[k], pos[k + 2]),
+                         op2(g, SL_OP_MIN, pos[k + 4], pos[k + 6]));
+            int hi = op2(g, SL_OP_MAX, op2(g, SL_OP_MAX, pos[k], pos[k + 2]),
+                         op2(g, SL_OP_MAX, pos[k + 4], pos[k + 6]));
+            w[k] = op2(g, SL_OP_SUB, hi, lo);
+            if (width[k] >= 0)
+                w[k] = op2(g, SL_OP_MUL, w[k], width[k]);
+        }
+    } else if ((kind == SL_TEX_TEXTURE && npos == 2) || (kind == SL_TEX_BUMP && npos == 5)) {
+        st[0] = pos[npos - 2];
+        st[1] = pos[npos - 1];
+    } else {
+        st[0] = sl_global_slot(SL_G_s);
+        st[1] = sl_global_slot(SL_G_t);
+    }
+    for (int k = 0; k < 2; k++) {
+        if (npos != 8 || kind != SL_TEX_TEXTURE)
+            w[k] = zero;
+        if (blur[k] >= 0)
+            w[k] = op2(g, SL_OP_ADD, w[k], op1(g, SL_OP_ABS, blur[k]));
+    }
+    int args = alloc_slots(g, 6);
+    int src[6] = { st[0], st[1], w[0], w[1], chan, fill };
+    for (int k = 0; k < 6; k++)
+        emit(g, SL_OP_MOV, args + k, src[k], 0, 0);
+    int op = kind == SL_TEX_BUMP ? SL_TEXOP_GRAD
+           : size_of(e) == 3 ? SL_TEXOP_COLOR : SL_TEXOP_FLOAT;
+    int outs = sl_texop_outs(SL_TEXOP(op, wrap[0], wrap[1]));
+    int z = alloc_slots(g, outs);
+    emit(g, SL_OP_TEXTURE, z, name, args, SL_TEXOP(op, wrap[0], wrap[1]));
+    if (kind != SL_TEX_BUMP)
+        return into(g, z, dst, outs);
+    int a = gen_cross(g, pos[0], pos[2], -1), b = gen_cross(g, pos[1], pos[0], -1);
+    int r = target(g, dst, 3);
+    for (int i = 0; i < 3; i++)
+        emit(g, SL_OP_ADD, r + i, op2(g, SL_OP_MUL, z, a + i), op2(g, SL_OP_MUL, z + 1, b + i),
+             0);
+    return r;
+}
+
 /* spline([basis,] t, knots): x = clamp(t, 0, 1) * segments; the segment
  * seg = min(floor(x), segments - 1) and its 4 knots are read with aload
  * (in interval/affine mode: the merge of every knot the segment range can
@@ -1788,6 +1905,7 @@ static int gen_builtin(cg *g, sl_node *e, int dst)
     case SL_LOWER_RAY: return gen_ray(g, e, args, dst);
     case SL_LOWER_EXTRA: return gen_extra(g, b, args, dst);
     case SL_LOWER_SPLINE: case SL_LOWER_STRINGS: break;     /* gen_spline, gen_strings */
+    case SL_LOWER_TEXTURE: break;                           /* gen_texture */
     case SL_LOWER_MATCH: {
         int z = target(g, dst, 1);
         emit(g, SL_OP_SMATCH, z, args[0], args[1], 0);
@@ -1890,6 +2008,8 @@ static int gen_expr(cg *g, sl_node *e, int dst)
             r = gen_spline(g, e, dst);
         else if (e->builtin && e->builtin->lower == SL_LOWER_STRINGS)
             r = gen_strings(g, e, dst);
+        else if (e->builtin && e->builtin->lower == SL_LOWER_TEXTURE)
+            r = gen_texture(g, e, dst);
         else if (e->builtin)
             r = gen_builtin(g, e, dst);
         else if (strcmp(e->name, "arraylength") != 0 || e->list[0]->sym->cg_len_slot)

@@ -251,6 +251,15 @@ static sl_node *primary_inner(parser *p)
         sl_node *n = sl_node_new(p->arena, SL_N_STR, t.pos);
         n->name = t.text;
         n->len = t.len;
+        if (check(p, SL_TOK_LBRACKET)) {         /* "map.tx"[channel] (texture) */
+            sl_token open = p->cur;
+            advance(p);
+            sl_node *x = sl_node_new(p->arena, SL_N_INDEX, open.pos);
+            x->a = n;
+            x->b = expression(p);
+            expect_closing(p, SL_TOK_RBRACKET, &open);
+            return x;
+        }
         return n;
     }
     case SL_TOK_IDENT: {

@@ -167,6 +167,16 @@ void sl_vm_destroy(sl_vm **self_p);
 
 void sl_vm_set_spaces(sl_vm *self, const sl_spaces *spaces);
 void sl_vm_set_lights(sl_vm *self, sl_light_fn fn, void *user);
+/* The textures that texture(), environment(), bump() and textureinfo()
+ * read (tex/tex.h; shared by the VMs of a process; NULL: none, a lookup is
+ * a runtime error). */
+struct tex_cache;
+void sl_vm_set_textures(sl_vm *self, struct tex_cache *textures);
+/* The texture names a program's lookups use that are known when it is
+ * bound: string constants and the instance's string parameter values
+ * (default or set) that reach a texture operation directly. Up to max
+ * names into names (duplicates removed); returns their number. */
+int sl_instance_texture_names(const sl_instance *inst, const char **names, int max);
 
 /* Globals, before a run, in the arithmetic of the coming run. Globals not
  * set since the last sl_vm_clear_globals are 0 (point values). */

@@ -186,6 +186,107 @@ static inline sl_status VM_OP(noise)(sl_vm *vm, A *S, const sl_insn *in, int pc)
     return SL_OK;
 }
 
+/* An affine form of [lo, hi] on a private error term (no symbol). */
+static inline void VM_OP(span)(A *z, double lo, double hi)
+{
+    aa_const(z, 0.5 * lo + 0.5 * hi);
+    double r = fmax(z->x0 - lo, hi - z->x0);
+    z->err = r * (1 + 0x1p-50) + 0x1p-1070;
+    z->lo = lo;
+    z->hi = hi;
+}
+
+/* texture lookups: where every lookup of the range blends the same
+ * bilinear cells (tex_cells), the sum of their bilinear forms over the
+ * affine forms of s and t, widened by a relative 1e-9 (the float mode's
+ * rounding) and clamped to the cells' texels; elsewhere the bound of the
+ * filter over the ranges (tex_bound). The gradient (bump) within the
+ * derivative bounds. */
+static inline void VM_OP(cells)(sl_vm *vm, A *z, const A *s, const A *t, const tex_cell *cell,
+                                int n)
+{
+    double lo = INFINITY, hi = -INFINITY;
+    for (int q = 0; q < n; q++) {
+        const tex_cell *c = &cell[q];
+        const double *v = c->v;
+        A fx, fy, k;
+        aa_mul_s(vm->ctx, &fx, s, (double)c->w);
+        aa_add_s(vm->ctx, &fx, &fx, -(0.5 + c->oi));
+        aa_mul_s(vm->ctx, &fy, t, (double)c->h);
+        aa_add_s(vm->ctx, &fy, &fy, -(0.5 + c->oj));
+        aa_mul(vm->ctx, &k, &fx, &fy);
+        aa_mul_s(vm->ctx, &k, &k, v[3] - v[2] - v[1] + v[0]);
+        aa_mul_s(vm->ctx, &fx, &fx, v[1] - v[0]);
+        aa_mul_s(vm->ctx, &fy, &fy, v[2] - v[0]);
+        aa_add(vm->ctx, &k, &k, &fx);
+        aa_add(vm->ctx, &k, &k, &fy);
+        aa_add_s(vm->ctx, &k, &k, v[0]);
+        if (c->weight != 1.0)
+            aa_mul_s(vm->ctx, &k, &k, c->weight);
+        if (q == 0)
+            VM_OP(mov)(vm, z, &k);
+        else
+            aa_add(vm->ctx, z, z, &k);
+        for (int i = 0; i < 4; i++) {
+            lo = fmin(lo, v[i]);
+            hi = fmax(hi, v[i]);
+        }
+    }
+    A e, flo, fhi;
+    double eps = 1e-9 * fmax(fabs(lo), fabs(hi)) + 0x1p-1000;
+    VM_OP(span)(&e, -eps, eps);
+    aa_add(vm->ctx, z, z, &e);
+    aa_const(&flo, lo);
+    aa_const(&fhi, hi);
+    aa_clamp(vm->ctx, z, z, &flo, &fhi);
+}
+
+static inline sl_status VM_OP(texture)(sl_vm *vm, A *S, const sl_insn *in, int pc)
+{
+    sl_status st = SL_OK;
+    const tex_texture *t = sl_vm_texture(vm, vm->str[in->b], pc, &st);
+    if (!t)
+        return st;
+    double q;
+    if (!VM_OP(is_const)(&S[in->c + 4], &q))
+        return sl_vm_texture_channel_error(vm, pc);
+    tex_wrap sw = (tex_wrap)SL_TEXOP_SWRAP(in->d), tw = (tex_wrap)SL_TEXOP_TWRAP(in->d);
+    int c = sl_tex_channel(q);
+    int outs = sl_texop_outs(in->d);
+    A out[3];
+    if (SL_TEXOP_KIND(in->d) == SL_TEXOP_GRAD) {
+        double ls, lt;
+        tex_lipschitz(t, c, &ls, &lt);
+        VM_OP(span)(&out[0], -ls, ls);
+        VM_OP(span)(&out[1], -lt, lt);
+    } else {
+        tex_range r;
+        double *ends[4] = { r.s, r.t, r.ws, r.wt };
+        for (int k = 0; k < 4; k++) {
+            ia_interval x = aa_range(&S[in->c + k]);
+            ends[k][0] = x.lo;
+            ends[k][1] = x.hi;
+        }
+        for (int i = 0; i < outs; i++) {
+            int ch = c < 0 ? -1 : c + i;
+            tex_cell cells[2];
+            int n;
+            if (ch < 0 || ch >= tex_channels(t)) {
+                VM_OP(mov)(vm, &out[i], &S[in->c + 5]);
+            } else if ((n = tex_cells(t, ch, &r, sw, tw, cells)) > 0) {
+                VM_OP(cells)(vm, &out[i], &S[in->c], &S[in->c + 1], cells, n);
+            } else {
+                double lo, hi;
+                tex_bound(t, ch, &r, sw, tw, 0.0, &lo, &hi);
+                VM_OP(span)(&out[i], lo, hi);
+            }
+        }
+    }
+    for (int i = 0; i < outs; i++)
+        VM_OP(mov)(vm, &S[in->a + i], &out[i]);
+    return SL_OK;
+}
+
 static inline void VM_OP(random)(sl_vm *vm, A *z)
 {
     VM_OP(bool)(vm, z, 2);               /* [0, 1] on a private error term */

@@ -266,6 +266,38 @@ static inline sl_status v_noise(sl_vm *vm, sl_dual *S, const sl_insn *in, int pc
     return SL_OK;
 }
 
+/* texture lookups: the filter of tex.h and its derivatives along s and t
+ * by the chain rule, at a fixed footprint (docs/textures.md); the
+ * gradient (bump) carries no second derivatives */
+static inline sl_status v_texture(sl_vm *vm, sl_dual *S, const sl_insn *in, int pc)
+{
+    sl_status st = SL_OK;
+    const tex_texture *t = sl_vm_texture(vm, vm->str[in->b], pc, &st);
+    if (!t)
+        return st;
+    sl_dual a[6];
+    memcpy(a, &S[in->c], sizeof a);
+    tex_wrap sw = (tex_wrap)SL_TEXOP_SWRAP(in->d), tw = (tex_wrap)SL_TEXOP_TWRAP(in->d);
+    int c = sl_tex_channel(a[4].v);
+    double ds, dt;
+    if (SL_TEXOP_KIND(in->d) == SL_TEXOP_GRAD) {
+        tex_sample(t, c, a[0].v, a[1].v, a[2].v, a[3].v, sw, tw, a[5].v, &ds, &dt);
+        S[in->a] = dd(ds, 0, 0);
+        S[in->a + 1] = dd(dt, 0, 0);
+        return SL_OK;
+    }
+    for (int i = 0; i < sl_texop_outs(in->d); i++) {
+        int ch = c < 0 ? -1 : c + i;
+        if (ch < 0 || ch >= tex_channels(t)) {
+            S[in->a + i] = a[5];
+            continue;
+        }
+        double v = tex_sample(t, ch, a[0].v, a[1].v, a[2].v, a[3].v, sw, tw, a[5].v, &ds, &dt);
+        S[in->a + i] = dd(v, ds * a[0].du + dt * a[1].du, ds * a[0].dv + dt * a[1].dv);
+    }
+    return SL_OK;
+}
+
 static inline void v_random(sl_vm *vm, sl_dual *z) { *z = dd(sl_vm_random(vm), 0, 0); }
 static inline void v_du(sl_vm *vm, sl_dual *z, const sl_dual *x) { (void)vm; *z = dd(x->du, 0, 0); }
 static inline void v_dv(sl_vm *vm, sl_dual *z, const sl_dual *x) { (void)vm; *z = dd(x->dv, 0, 0); }

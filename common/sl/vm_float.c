@@ -152,6 +152,27 @@ static inline sl_status v_noise(sl_vm *vm, double *S, const sl_insn *in, int pc)
     return SL_OK;
 }
 
+/* texture lookups (bytecode.h TEXTURE): the filter of tex.h at a point */
+static inline sl_status v_texture(sl_vm *vm, double *S, const sl_insn *in, int pc)
+{
+    sl_status st = SL_OK;
+    const tex_texture *t = sl_vm_texture(vm, vm->str[in->b], pc, &st);
+    if (!t)
+        return st;
+    double a[6];
+    memcpy(a, &S[in->c], sizeof a);
+    tex_wrap sw = (tex_wrap)SL_TEXOP_SWRAP(in->d), tw = (tex_wrap)SL_TEXOP_TWRAP(in->d);
+    int c = sl_tex_channel(a[4]);
+    if (SL_TEXOP_KIND(in->d) == SL_TEXOP_GRAD) {
+        tex_sample(t, c, a[0], a[1], a[2], a[3], sw, tw, a[5], &S[in->a], &S[in->a + 1]);
+        return SL_OK;
+    }
+    for (int i = 0; i < sl_texop_outs(in->d); i++)
+        S[in->a + i] = tex_sample(t, c < 0 ? -1 : c + i, a[0], a[1], a[2], a[3], sw, tw, a[5],
+                                  NULL, NULL);
+    return SL_OK;
+}
+
 static inline void v_random(sl_vm *vm, double *z) { *z = sl_vm_random(vm); }
 static inline void v_du(sl_vm *vm, double *z, const double *x) { (void)vm; (void)x; *z = 0.0; }
 static inline void v_dv(sl_vm *vm, double *z, const double *x) { (void)vm; (void)x; *z = 0.0; }

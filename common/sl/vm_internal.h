@@ -18,6 +18,7 @@
 #include "sl/bytecode.h"
 #include "sl/shader.h"
 #include "sl/strmatch.h"
+#include "tex/tex.h"
 
 #include <stdio.h>
 #include <string.h>
@@ -29,6 +30,7 @@ enum {
     SL_VM_MAX_MESSAGES = 64,      /* message-passing values (sl_vm_set_message) */
     SL_VM_STRING_SPACE = 16384,   /* bytes of strings made by one run (concat, format) */
     SL_VM_MAX_PRINTS = 100,       /* printf lines per VM, then one note */
+    SL_VM_TEX_MEMO = 16,          /* textures a VM remembers by name */
 };
 
 /* The instantiations of the dispatch loop (vm_exec.inc). The two _DERIV
@@ -109,6 +111,9 @@ struct sl_vm {
     int prints;
     int nfixed_lights;
     uint64_t seed;
+    tex_cache *textures;          /* sl_vm_set_textures */
+    struct { char name[256]; const tex_texture *tex; } tex_memo[SL_VM_TEX_MEMO];
+    int ntex_memo;
 
     double *f;                    /* slot files, SL_MAX_SLOTS each */
     sl_dual *d;
@@ -171,6 +176,20 @@ void sl_vm_ray(sl_vm *vm, int kind, const char *map, const double P[3], const do
                double out[3]);
 /* Does this VM's tracer answer rays of this kind? */
 bool sl_vm_traces(const sl_vm *vm, int kind);
+/* The texture called name for instruction pc: from the VM's memo, else
+ * from its cache (opened there on first use; sl_vm_set_textures). NULL
+ * with *st set and the error in vm->error when it cannot be had. */
+const tex_texture *sl_vm_texture(sl_vm *vm, const char *name, int pc, sl_status *st);
+/* The same without the error: err NULL remembers a texture that cannot be
+ * opened, and answers NULL for it from then on (textureinfo). */
+const tex_texture *sl_vm_texture_find(sl_vm *vm, const char *name, char *err, size_t errsz);
+
+/* A texture channel from a slot's value (rounded down; -1: none, so the
+ * lookup gives its fill value). */
+static inline int sl_tex_channel(double v) { return v >= 0 && v < 4096 ? (int)v : -1; }
+
+/* The error of a channel that varies over the range of a run. */
+sl_status sl_vm_texture_channel_error(sl_vm *vm, int pc);
 
 /* The next random number in [0, 1) of this run (splitmix64). */
 double sl_vm_random(sl_vm *vm);

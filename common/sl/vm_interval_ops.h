@@ -191,6 +191,44 @@ static inline sl_status VM_OP(noise)(sl_vm *vm, I *S, const sl_insn *in, int pc)
     return SL_OK;
 }
 
+/* texture lookups: the bound of the filter over the ranges of s, t and the
+ * footprint (tex_bound: the min-max pyramid); the gradient (bump) within
+ * the derivative bounds (tex_lipschitz) */
+static inline sl_status VM_OP(texture)(sl_vm *vm, I *S, const sl_insn *in, int pc)
+{
+    sl_status st = SL_OK;
+    const tex_texture *t = sl_vm_texture(vm, vm->str[in->b], pc, &st);
+    if (!t)
+        return st;
+    I a[6];
+    memcpy(a, &S[in->c], sizeof a);
+    double q;
+    if (!VM_OP(is_const)(&a[4], &q))
+        return sl_vm_texture_channel_error(vm, pc);
+    tex_wrap sw = (tex_wrap)SL_TEXOP_SWRAP(in->d), tw = (tex_wrap)SL_TEXOP_TWRAP(in->d);
+    int c = sl_tex_channel(q);
+    if (SL_TEXOP_KIND(in->d) == SL_TEXOP_GRAD) {
+        double ls, lt;
+        tex_lipschitz(t, c, &ls, &lt);
+        S[in->a] = ia_make(-ls, ls);
+        S[in->a + 1] = ia_make(-lt, lt);
+        return SL_OK;
+    }
+    tex_range r = { { a[0].lo, a[0].hi }, { a[1].lo, a[1].hi }, { a[2].lo, a[2].hi },
+                    { a[3].lo, a[3].hi } };
+    for (int i = 0; i < sl_texop_outs(in->d); i++) {
+        int ch = c < 0 ? -1 : c + i;
+        if (ch < 0 || ch >= tex_channels(t)) {
+            S[in->a + i] = a[5];
+            continue;
+        }
+        double lo, hi;
+        tex_bound(t, ch, &r, sw, tw, 0.0, &lo, &hi);
+        S[in->a + i] = ia_make(lo, hi);
+    }
+    return SL_OK;
+}
+
 static inline void VM_OP(random)(sl_vm *vm, I *z)
 {
     (void)vm;

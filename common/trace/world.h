@@ -122,6 +122,7 @@ typedef struct trace_world {
     trace_light *lights;
     int nlights;
     trace_options options;
+    struct tex_cache *textures;    /* what texture() reads (tex/tex.h); NULL: none */
 } trace_world;
 
 /* Derives each object's id, scale, normal bounds and du/dv (world.c);

@@ -8,6 +8,10 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
+
+#include "sl/noise.h"
+#include "tex/tex.h"
 
 #ifndef AAFARM_CORPUS_DIR
 #error "AAFARM_CORPUS_DIR must name tests/shaders/corpus"
@@ -85,16 +89,65 @@ static bool load_dir(const char *dir, const char *ext, bool strip, const char *p
     return true;
 }
 
+/* The maps of the tex_* shaders (corpus.h). */
+static bool write_textures(corpus *c)
+{
+    snprintf(c->texdir, sizeof c->texdir, "/tmp/aafarm_corpus_tex.XXXXXX");
+    if (!mkdtemp(c->texdir)) {
+        fprintf(stderr, "corpus: cannot make a folder for the texture maps\n");
+        c->texdir[0] = 0;
+        return false;
+    }
+    enum { HW = 96, HH = 64, CW = 24, CH = 16 };
+    static float height[HW * HH], rgb[CW * CH * 3];
+    for (int j = 0; j < HH; j++)
+        for (int i = 0; i < HW; i++) {
+            double sum = 0, amp = 0.5;
+            for (int o = 0, cells = 3; o < 4; o++, cells *= 2, amp *= 0.5) {
+                double p[2] = {(i + 0.5) / HW * cells, (j + 0.5) / HH * cells};
+                int per[2] = {cells, cells};
+                sum += amp * (2 * sl_pnoise(2, p, per) - 1);
+            }
+            height[j * HW + i] = (float)sum;
+        }
+    corpus_rng r = {77};
+    for (int k = 0; k < CW * CH * 3; k++) rgb[k] = (float)corpus_rng_uniform(&r);
+    const struct { const char *name; const float *px; int w, h, nch; } maps[] = {
+        {"corpus_height.exr", height, HW, HH, 1}, {"corpus_rgb.exr", rgb, CW, CH, 3}};
+    for (size_t m = 0; m < sizeof maps / sizeof maps[0]; m++) {
+        char path[256], err[512];
+        snprintf(path, sizeof path, "%s/%s", c->texdir, maps[m].name);
+        tex_texture *t = tex_from_pixels(maps[m].px, maps[m].w, maps[m].h, maps[m].nch, path);
+        bool ok = t && tex_write_exr(path, t, true, err, sizeof err);
+        tex_free(t);
+        if (!ok) {
+            fprintf(stderr, "corpus: %s\n", err);
+            return false;
+        }
+    }
+    return true;
+}
+
 bool corpus_load(corpus *c)
 {
     memset(c, 0, sizeof *c);
     return load_dir(AAFARM_CORPUS_DIR, ".sl", true, "", true, &c->shaders, &c->nshaders) &&
            load_dir(AAFARM_CORPUS_DIR "/include", ".h", false, "include/", false,
-                    &c->headers, &c->nheaders);
+                    &c->headers, &c->nheaders) &&
+           write_textures(c);
 }
 
 void corpus_free(corpus *c)
 {
+    if (c->texdir[0]) {
+        char path[256];
+        const char *names[] = {"corpus_height.exr", "corpus_rgb.exr"};
+        for (int k = 0; k < 2; k++) {
+            snprintf(path, sizeof path, "%s/%s", c->texdir, names[k]);
+            unlink(path);
+        }
+        rmdir(c->texdir);
+    }
     for (int i = 0; i < c->nshaders; i++) free(c->shaders[i].text);
     for (int i = 0; i < c->nheaders; i++) free(c->headers[i].text);
     free(c->shaders);
@@ -164,9 +217,10 @@ bool corpus_open(fixture *f, const corpus *c, const corpus_file *sh,
         return false;
     }
     snprintf(rib, sizeof rib,
+             "Option \"searchpath\" \"texture\" [\"%s\"]\n"
              "Format %d %d 1\nProjection \"perspective\" \"fov\" [35]\n"
              "WorldBegin\nAttributeBegin\n%sAttributeEnd\nWorldEnd\n",
-             xres, yres, geom);
+             c->texdir, xres, yres, geom);
 
     job_options opt;
     job_options_default(&opt);

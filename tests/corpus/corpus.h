@@ -23,10 +23,15 @@ typedef struct corpus {
     int nshaders;
     corpus_file *headers;    /* include/<x>.h */
     int nheaders;
+    char texdir[64];         /* the maps the texture shaders read (written by
+                                corpus_load, removed by corpus_free) */
 } corpus;
 
 /* Reads AAFARM_CORPUS_DIR (compile-time path of tests/shaders/corpus).
- * AAFARM_CORPUS_ONLY=name1,name2 keeps only those shaders. */
+ * AAFARM_CORPUS_ONLY=name1,name2 keeps only those shaders. Writes the maps
+ * of the tex_* shaders into a temporary folder that every job's texture
+ * search path names: corpus_height.exr (96 x 64 periodic fBm, one channel)
+ * and corpus_rgb.exr (24 x 16, three channels of random texels). */
 bool corpus_load(corpus *c);
 void corpus_free(corpus *c);
 

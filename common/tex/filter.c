@@ -1,0 +1,381 @@
+/*
+ * filter.c: the texture filter (trilinear mip-mapping over the mean
+ * pyramid, tex.h "The filter") at a point, and its bound over a range of
+ * lookups from the min-max pyramid (tex.h "The bound"; Thonat et al. 2021
+ * §4), plus the single bilinear cell that affine runs turn into an affine
+ * form with its linear part (issue 16).
+ *
+ * Periodic wrap reduces s to s - floor(s) before the lookup; clamp and
+ * black clamp the texel coordinate to [-2, n + 1] (which changes nothing:
+ * beyond the edge the texels repeat the edge or are 0), so no coordinate
+ * overflows an int. The bound widens every texel coordinate by a relative
+ * 1e-9 before rounding it down, so a lookup that rounds the other way
+ * still lands on a texel the bound covered.
+ */
+#include "tex/tex_internal.h"
+
+#include <float.h>
+#include <math.h>
+
+double tex_level_of(const tex_texture *t, double ws, double wt)
+{
+    double m = fmax(fabs(ws) * t->w, fabs(wt) * t->h);
+    if (isnan(ws) || isnan(wt))
+        return t->nlevels - 1;
+    if (!(m > 1.0))
+        return 0.0;
+    double l = log2(m);
+    return l < t->nlevels - 1 ? l : t->nlevels - 1;
+}
+
+static int wrap_index(int i, int n, tex_wrap wrap, bool *outside)
+{
+    *outside = false;
+    if (i >= 0 && i < n)
+        return i;
+    if (wrap == TEX_WRAP_PERIODIC)
+        return ((i % n) + n) % n;
+    if (wrap == TEX_WRAP_CLAMP)
+        return i < 0 ? 0 : n - 1;
+    *outside = true;
+    return 0;
+}
+
+static double fetch(const tex_texture *t, int k, int c, int i, int j, tex_wrap sw, tex_wrap tw)
+{
+    bool oi, oj;
+    i = wrap_index(i, t->lw[k], sw, &oi);
+    j = wrap_index(j, t->lh[k], tw, &oj);
+    if (oi || oj)
+        return 0.0;
+    return t->avg[k][((size_t)j * t->lw[k] + i) * t->nch + c];
+}
+
+/* The texel coordinate of s at a level of n texels. */
+static double coord(double s, int n, tex_wrap wrap)
+{
+    if (wrap == TEX_WRAP_PERIODIC)
+        s -= floor(s);
+    double x = s * n - 0.5;
+    return x < -2.0 ? -2.0 : x > n + 1.0 ? n + 1.0 : x;
+}
+
+static double bilinear(const tex_texture *t, int k, int c, double s, double tt, tex_wrap sw,
+                       tex_wrap tw, double *dds, double *ddt)
+{
+    double x = coord(s, t->lw[k], sw), y = coord(tt, t->lh[k], tw);
+    double fi = floor(x), fj = floor(y), f = x - fi, g = y - fj;
+    int i = (int)fi, j = (int)fj;
+    double v00 = fetch(t, k, c, i, j, sw, tw), v10 = fetch(t, k, c, i + 1, j, sw, tw);
+    double v01 = fetch(t, k, c, i, j + 1, sw, tw), v11 = fetch(t, k, c, i + 1, j + 1, sw, tw);
+    double v = (1 - f) * (1 - g) * v00 + f * (1 - g) * v10 + (1 - f) * g * v01 + f * g * v11;
+    double lo = fmin(fmin(v00, v10), fmin(v01, v11)), hi = fmax(fmax(v00, v10), fmax(v01, v11));
+    *dds = t->lw[k] * ((v10 - v00) * (1 - g) + (v11 - v01) * g);
+    *ddt = t->lh[k] * ((v01 - v00) * (1 - f) + (v11 - v10) * f);
+    return v < lo ? lo : v > hi ? hi : v;
+}
+
+double tex_sample(const tex_texture *t, int c, double s, double tt, double ws, double wt,
+                  tex_wrap swrap, tex_wrap twrap, double fill, double *dds, double *ddt)
+{
+    double ds = 0, dt = 0, v;
+    if (c < 0 || c >= t->nch) {
+        v = fill;
+    } else if (!isfinite(s) || !isfinite(tt)) {
+        v = 0;                       /* no texel is there: as black */
+    } else {
+        double l = tex_level_of(t, ws, wt), k0 = floor(l), fr = l - k0;
+        int k = (int)k0;
+        v = bilinear(t, k, c, s, tt, swrap, twrap, &ds, &dt);
+        if (fr > 0 && k + 1 < t->nlevels) {
+            double ds1, dt1, v1 = bilinear(t, k + 1, c, s, tt, swrap, twrap, &ds1, &dt1);
+            double m = (1 - fr) * v + fr * v1;
+            double lo = fmin(v, v1), hi = fmax(v, v1);
+            v = m < lo ? lo : m > hi ? hi : m;
+            ds = (1 - fr) * ds + fr * ds1;
+            dt = (1 - fr) * dt + fr * dt1;
+        }
+    }
+    if (dds)
+        *dds = ds;
+    if (ddt)
+        *ddt = dt;
+    return v;
+}
+
+/* ---- the bound ---- */
+
+/* |w| over w in [a, b]: [lo, hi] (NaN: [0, inf]) */
+static void abs_range(const double w[2], double *lo, double *hi)
+{
+    if (isnan(w[0]) || isnan(w[1])) {
+        *lo = 0;
+        *hi = INFINITY;
+        return;
+    }
+    *lo = (w[0] <= 0 && w[1] >= 0) ? 0 : fmin(fabs(w[0]), fabs(w[1]));
+    *hi = fmax(fabs(w[0]), fabs(w[1]));
+}
+
+/* The texels (of a level of n) under the bilinear cells of every s in
+ * [s0, s1], as up to two ranges of valid indexes; *zero when a black edge
+ * is among them. Returns the number of ranges. */
+static int texel_ranges(double s0, double s1, int n, tex_wrap wrap, int out[2][2], bool *zero)
+{
+    if (!isfinite(s0) || !isfinite(s1) || (wrap == TEX_WRAP_PERIODIC && s1 - s0 >= 1.0)) {
+        out[0][0] = 0;
+        out[0][1] = n - 1;         /* a non-finite coordinate reads 0 (tex_sample) */
+        *zero = *zero || wrap == TEX_WRAP_BLACK || !isfinite(s0) || !isfinite(s1);
+        return 1;
+    }
+    if (wrap == TEX_WRAP_PERIODIC) {
+        double fl = floor(s0);
+        s0 -= fl;
+        s1 -= fl;
+    }
+    double x0 = s0 * n - 0.5, x1 = s1 * n - 0.5;
+    x0 -= 1e-9 * (fabs(x0) + 1.0);
+    x1 += 1e-9 * (fabs(x1) + 1.0);
+    if (wrap != TEX_WRAP_PERIODIC) {
+        x0 = x0 < -2.0 ? -2.0 : x0 > n + 1.0 ? n + 1.0 : x0;
+        x1 = x1 < -2.0 ? -2.0 : x1 > n + 1.0 ? n + 1.0 : x1;
+    }
+    long i0 = (long)floor(x0), i1 = (long)floor(x1) + 1;
+    if (wrap == TEX_WRAP_PERIODIC) {
+        if (i1 - i0 + 1 >= n) {
+            out[0][0] = 0;
+            out[0][1] = n - 1;
+            return 1;
+        }
+        long a = ((i0 % n) + n) % n, b = a + (i1 - i0);
+        if (b < n) {
+            out[0][0] = (int)a;
+            out[0][1] = (int)b;
+            return 1;
+        }
+        out[0][0] = (int)a;
+        out[0][1] = n - 1;
+        out[1][0] = 0;
+        out[1][1] = (int)(b - n);
+        return 2;
+    }
+    if (i0 < 0 || i1 > n - 1) {
+        if (wrap == TEX_WRAP_BLACK)
+            *zero = true;
+        if (wrap == TEX_WRAP_CLAMP) {
+            i0 = i0 < 0 ? 0 : i0 > n - 1 ? n - 1 : i0;
+            i1 = i1 < 0 ? 0 : i1 > n - 1 ? n - 1 : i1;
+        }
+    }
+    if (i0 < 0)
+        i0 = 0;
+    if (i1 > n - 1)
+        i1 = n - 1;
+    if (i0 > i1)
+        return 0;
+    out[0][0] = (int)i0;
+    out[0][1] = (int)i1;
+    return 1;
+}
+
+/* min and max of channel c over the level-0 texels [i0, i1] x [j0, j1],
+ * from the level of the min-max pyramid where that spans <= 4 x 4 */
+static void minmax(const tex_texture *t, int c, int i0, int i1, int j0, int j1, double *lo,
+                   double *hi)
+{
+    int m = 0;
+    while (m + 1 < t->nlevels && (((i1 >> m) - (i0 >> m)) > 3 || ((j1 >> m) - (j0 >> m)) > 3))
+        m++;
+    int w = t->lw[m];
+    for (int j = j0 >> m; j <= j1 >> m; j++)
+        for (int i = i0 >> m; i <= i1 >> m; i++) {
+            size_t e = ((size_t)j * w + i) * t->nch + c;
+            *lo = fmin(*lo, t->mn[m][e]);
+            *hi = fmax(*hi, t->mx[m][e]);
+        }
+}
+
+/* The bilinear cell of level k (n texels along the axis) under every s of
+ * [s0, s1]: true with its origin i (texel coordinate x = s n - 1/2, the
+ * cell spans [i, i + 1]); unreduced, the texels wrap when fetched. */
+static bool one_cell(double s0, double s1, int n, double *origin)
+{
+    double x0 = s0 * n - 0.5, x1 = s1 * n - 0.5;
+    if (!(fabs(x0) < 1e9 && fabs(x1) < 1e9))
+        return false;
+    double f = floor(x0);
+    if (x1 > f + 1.0)
+        return false;
+    *origin = f;
+    return true;
+}
+
+/* 1e-9 of the largest magnitude: covers the float lookup's rounding (its
+ * texel coordinate and blend are computed differently from the bound's) */
+static double slack(double a, double b)
+{
+    return 1e-9 * fmax(fabs(a), fabs(b)) + 0x1p-1000;
+}
+
+/* The cells of level k (n texels) under [s0, s1]: the first and last
+ * origin; false where there are more than `most` or the coordinates are
+ * too large to split. */
+static bool few_cells(double s0, double s1, int n, int most, double *first, double *last)
+{
+    double x0 = s0 * n - 0.5, x1 = s1 * n - 0.5;
+    if (!(fabs(x0) < 1e9 && fabs(x1) < 1e9))
+        return false;
+    *first = floor(x0);
+    *last = fmax(*first, ceil(x1) - 1.0);
+    return *last - *first < most;
+}
+
+/* lo <= level k's bilinear <= hi over the s and t of r: exact where r
+ * covers at most 3 x 3 cells (each cell's part of r is a rectangle, and a
+ * bilinear function takes its extremes at a rectangle's corners), so the
+ * bound shrinks with r even across cell edges; else the min-max pyramid
+ * over the texels the cells touch. */
+static void level_range(const tex_texture *t, int k, int c, const tex_range *r, tex_wrap sw,
+                        tex_wrap tw, double *lo, double *hi)
+{
+    double i0, i1, j0, j1;
+    int n = t->lw[k], m = t->lh[k];
+    if (few_cells(r->s[0], r->s[1], n, 3, &i0, &i1) &&
+        few_cells(r->t[0], r->t[1], m, 3, &j0, &j1)) {
+        double x0 = r->s[0] * n - 0.5, x1 = r->s[1] * n - 0.5;
+        double y0 = r->t[0] * m - 0.5, y1 = r->t[1] * m - 0.5;
+        double l = INFINITY, h = -INFINITY;
+        for (double cj = j0; cj <= j1; cj++)
+            for (double ci = i0; ci <= i1; ci++) {
+                int i = (int)ci, j = (int)cj;
+                double v00 = fetch(t, k, c, i, j, sw, tw), v10 = fetch(t, k, c, i + 1, j, sw, tw);
+                double v01 = fetch(t, k, c, i, j + 1, sw, tw);
+                double v11 = fetch(t, k, c, i + 1, j + 1, sw, tw);
+                double vmin = fmin(fmin(v00, v10), fmin(v01, v11));
+                double vmax = fmax(fmax(v00, v10), fmax(v01, v11));
+                double fs[2] = { fmax(x0, ci) - ci, fmin(x1, ci + 1) - ci };
+                double gs[2] = { fmax(y0, cj) - cj, fmin(y1, cj + 1) - cj };
+                double cl = INFINITY, ch = -INFINITY;
+                for (int a = 0; a < 2; a++)
+                    for (int b = 0; b < 2; b++) {
+                        double f = fs[a] < 0 ? 0 : fs[a] > 1 ? 1 : fs[a];
+                        double g = gs[b] < 0 ? 0 : gs[b] > 1 ? 1 : gs[b];
+                        double v = (1 - f) * (1 - g) * v00 + f * (1 - g) * v10 +
+                                   (1 - f) * g * v01 + f * g * v11;
+                        cl = fmin(cl, v);
+                        ch = fmax(ch, v);
+                    }
+                double e = slack(vmin, vmax);
+                l = fmin(l, fmax(cl - e, vmin));
+                h = fmax(h, fmin(ch + e, vmax));
+            }
+        *lo = l;
+        *hi = h;
+        return;
+    }
+    bool zero = false;
+    double l = INFINITY, h = -INFINITY;
+    int si[2][2], ti[2][2];
+    int ns = texel_ranges(r->s[0], r->s[1], t->lw[k], sw, si, &zero);
+    int nt = texel_ranges(r->t[0], r->t[1], t->lh[k], tw, ti, &zero);
+    for (int a = 0; a < ns; a++)
+        for (int b = 0; b < nt; b++) {
+            long ie = ((long)si[a][1] + 1) << k, je = ((long)ti[b][1] + 1) << k;
+            minmax(t, c, si[a][0] << k, (int)(ie < t->w ? ie : t->w) - 1, ti[b][0] << k,
+                   (int)(je < t->h ? je : t->h) - 1, &l, &h);
+        }
+    if (zero) {
+        l = fmin(l, 0.0);
+        h = fmax(h, 0.0);
+    }
+    *lo = l;
+    *hi = h;
+}
+
+void tex_bound(const tex_texture *t, int c, const tex_range *r, tex_wrap swrap,
+               tex_wrap twrap, double fill, double *lo, double *hi)
+{
+    if (c < 0 || c >= t->nch) {
+        *lo = *hi = fill;
+        return;
+    }
+    if (isnan(r->s[0]) || isnan(r->s[1]) || isnan(r->t[0]) || isnan(r->t[1])) {
+        tex_range all = { { 0, 2 }, { 0, 2 }, { INFINITY, INFINITY }, { INFINITY, INFINITY } };
+        tex_bound(t, c, &all, TEX_WRAP_BLACK, TEX_WRAP_BLACK, fill, lo, hi);
+        return;
+    }
+    double wslo, wshi, wtlo, wthi;
+    abs_range(r->ws, &wslo, &wshi);
+    abs_range(r->wt, &wtlo, &wthi);
+    double lmin = tex_level_of(t, wslo, wtlo), lmax = tex_level_of(t, wshi, wthi);
+    int k0 = (int)floor(lmin), k1 = (int)floor(lmax);
+    double l, h;
+    if (k0 == k1) {              /* one pair of levels, blend f in [f0, f1] */
+        double f0 = lmin - k0, f1 = lmax - k0;
+        level_range(t, k0, c, r, swrap, twrap, &l, &h);
+        if (f1 > 0 && k0 + 1 < t->nlevels) {
+            double l1, h1;
+            level_range(t, k0 + 1, c, r, swrap, twrap, &l1, &h1);
+            double a = (1 - f0) * l + f0 * l1, b = (1 - f1) * l + f1 * l1;
+            double c0 = (1 - f0) * h + f0 * h1, d = (1 - f1) * h + f1 * h1;
+            double e = slack(fmin(l, l1), fmax(h, h1));
+            double lo2 = fmax(fmin(a, b) - e, fmin(l, l1));
+            double hi2 = fmin(fmax(c0, d) + e, fmax(h, h1));
+            l = lo2;
+            h = hi2;
+        }
+    } else {                     /* several levels: the hull of their ranges */
+        l = INFINITY;
+        h = -INFINITY;
+        for (int k = k0; k <= k1 + 1 && k < t->nlevels; k++) {
+            double a, b;
+            level_range(t, k, c, r, swrap, twrap, &a, &b);
+            l = fmin(l, a);
+            h = fmax(h, b);
+        }
+    }
+    *lo = l;
+    *hi = h;
+}
+
+int tex_cells(const tex_texture *t, int c, const tex_range *r, tex_wrap swrap,
+              tex_wrap twrap, tex_cell out[2])
+{
+    if (c < 0 || c >= t->nch)
+        return 0;
+    double wslo, wshi, wtlo, wthi;
+    abs_range(r->ws, &wslo, &wshi);
+    abs_range(r->wt, &wtlo, &wthi);
+    double lmin = tex_level_of(t, wslo, wtlo), lmax = tex_level_of(t, wshi, wthi);
+    if (lmin != lmax)
+        return 0;                /* the blend varies: no single form */
+    int k = (int)floor(lmin);
+    double f = lmin - k;
+    int n = f > 0 && k + 1 < t->nlevels ? 2 : 1;
+    for (int q = 0; q < n; q++) {
+        int lv = k + q;
+        double oi, oj;
+        if (!one_cell(r->s[0], r->s[1], t->lw[lv], &oi) ||
+            !one_cell(r->t[0], r->t[1], t->lh[lv], &oj))
+            return 0;
+        tex_cell *cell = &out[q];
+        cell->weight = n == 1 ? 1.0 : q == 0 ? 1 - f : f;
+        cell->w = t->lw[lv];
+        cell->h = t->lh[lv];
+        cell->oi = oi;
+        cell->oj = oj;
+        int i = (int)oi, j = (int)oj;
+        cell->v[0] = fetch(t, lv, c, i, j, swrap, twrap);
+        cell->v[1] = fetch(t, lv, c, i + 1, j, swrap, twrap);
+        cell->v[2] = fetch(t, lv, c, i, j + 1, swrap, twrap);
+        cell->v[3] = fetch(t, lv, c, i + 1, j + 1, swrap, twrap);
+    }
+    return n;
+}
+
+void tex_lipschitz(const tex_texture *t, int c, double *ls, double *lt)
+{
+    bool have = c >= 0 && c < t->nch;
+    *ls = have ? t->lips[c] : 0.0;
+    *lt = have ? t->lipt[c] : 0.0;
+}

@@ -1,0 +1,146 @@
+/*
+ * tex.h: textures for the shading language's texture(), environment(),
+ * bump() and textureinfo() (RI Spec 3.2 §15.7; issue 16): images read from
+ * OpenEXR, PNG and TIFF files, the two pyramids built from them, the one
+ * filter that float and dual lookups evaluate, the bound of that filter
+ * over a range of lookups that interval and affine runs use, and the
+ * per-process cache that opens textures by name through a resolver.
+ *
+ * The filter (docs/textures.md, "The filter"): a texture of W x H texels
+ * has levels k = 0, 1, ... of ceil(W / 2^k) x ceil(H / 2^k) texels, each
+ * texel of level k the mean of the level-0 texels of its 2^k x 2^k block
+ * (the block cut at the image's edge). A lookup at (s, t) with footprint
+ * (ws, wt) (widths in s and t units) takes l = log2(max(ws W, wt H)),
+ * clamped to [0, last level], and blends the bilinear interpolations of
+ * levels floor(l) and floor(l) + 1 (trilinear mip-mapping). Level k's
+ * texel (i, j) has its centre at s = (i + 1/2) / W_k; texels outside the
+ * image follow the wrap mode: periodic, clamp (the edge texel) or black
+ * (0). Derivatives (dual mode) are those of the blend at fixed footprint.
+ *
+ * The bound (Thonat et al. 2021, "Tessellation-free displacement mapping
+ * for ray tracing", §4: a min-max hierarchy; Logie 1995 bounds height
+ * fields the same way): level m of the min-max pyramid holds the min and
+ * max of the level-0 texels of each 2^m x 2^m block. A lookup at any (s, t)
+ * of a rectangle with any footprint of a range is a convex combination of
+ * the level-0 texels under the blocks of the texels its bilinear cells
+ * touch at the levels its footprints select (widened by the wrap mode: the
+ * other edge for periodic, 0 for black), so the min and max of those
+ * texels bound it; the min-max pyramid answers that at the level where
+ * the rectangle spans a few texels.
+ */
+#ifndef TEX_TEX_H
+#define TEX_TEX_H
+
+#include <stdbool.h>
+#include <stddef.h>
+
+typedef enum tex_wrap { TEX_WRAP_PERIODIC = 0, TEX_WRAP_CLAMP = 1, TEX_WRAP_BLACK = 2 } tex_wrap;
+
+/* "periodic" (also "repeat"), "clamp", "black": the mode, or -1. */
+int tex_wrap_find(const char *name);
+
+typedef struct tex_texture tex_texture;
+
+/* Reads an image file (OpenEXR half/float/uint, PNG 8/16 bit, TIFF 8/16/32
+ * bit integer or float, any number of channels; the format from the file's
+ * first bytes, not its name) and builds its pyramids. Integer texels map to
+ * [0, 1]; non-finite texels read as 0. On failure returns NULL and writes
+ * "path: what went wrong" into err. */
+tex_texture *tex_open(const char *path, char *err, size_t errsz);
+/* A texture from memory: w x h texels of nch channels, interleaved (for
+ * tests and tools). */
+tex_texture *tex_from_pixels(const float *pixels, int w, int h, int nch, const char *name);
+void tex_free(tex_texture *t);
+
+int tex_width(const tex_texture *t);
+int tex_height(const tex_texture *t);
+int tex_channels(const tex_texture *t);
+int tex_levels(const tex_texture *t);
+const char *tex_name(const tex_texture *t);
+/* "float" for float or half files, "uint8"/"uint16"/"uint32" else (the
+ * type the file stored). */
+const char *tex_type(const tex_texture *t);
+/* Bytes held by the texels of the two pyramids. */
+size_t tex_bytes(const tex_texture *t);
+/* Level k's texel (i, j) of channel c (no wrapping: in range only). */
+float tex_texel(const tex_texture *t, int level, int c, int i, int j);
+
+/* The footprint's level: log2(max(ws W, wt H)) clamped to [0, levels - 1]. */
+double tex_level_of(const tex_texture *t, double ws, double wt);
+
+/* The filter at (s, t) with footprint (ws, wt) for channel c, with d/ds
+ * and d/dt (may be NULL). A channel the texture lacks gives `fill`; a
+ * non-finite s or t gives 0. */
+double tex_sample(const tex_texture *t, int c, double s, double tt, double ws, double wt,
+                  tex_wrap swrap, tex_wrap twrap, double fill, double *dds, double *ddt);
+
+/* The ranges of a lookup: s, t, and the footprint widths (each [lo, hi];
+ * a NaN or infinite end means anything). */
+typedef struct tex_range {
+    double s[2], t[2], ws[2], wt[2];
+} tex_range;
+
+/* lo <= filter <= hi for every lookup of range r (channel c, or fill). */
+void tex_bound(const tex_texture *t, int c, const tex_range *r, tex_wrap swrap,
+               tex_wrap twrap, double fill, double *lo, double *hi);
+
+/* One bilinear cell of one level: the filter's part from it is weight *
+ * bilerp(v, s w - 1/2 - oi, t h - 1/2 - oj), v[0] = texel (oi, oj), v[1] =
+ * (oi+1, oj), v[2] = (oi, oj+1), v[3] = (oi+1, oj+1) (wrapped). */
+typedef struct tex_cell {
+    double weight, oi, oj, v[4];
+    int w, h;
+} tex_cell;
+
+/* Where every lookup of r blends the same cells (a footprint of one level
+ * blend, s and t inside one cell of each level used): their number (1 or
+ * 2) into out; 0 elsewhere. The filter is then the sum of the cells'
+ * parts, which affine runs write as an affine form of s and t. */
+int tex_cells(const tex_texture *t, int c, const tex_range *r, tex_wrap swrap,
+              tex_wrap twrap, tex_cell out[2]);
+
+/* Bounds of |d filter / ds| and |d filter / dt| of channel c over all
+ * lookups at any footprint (0 for a missing channel). */
+void tex_lipschitz(const tex_texture *t, int c, double *ls, double *lt);
+
+/* Writes t as a tiled, mip-mapped OpenEXR file: part "mean" with the mean
+ * pyramid as its levels, and with minmax also parts "min" and "max"
+ * (write_exr.c; docs/textures.md). Atomic: a temporary file renamed into
+ * place. false with "path: reason" in err. */
+bool tex_write_exr(const char *path, const tex_texture *t, bool minmax, char *err,
+                   size_t errsz);
+
+/* ---- the per-process cache ---- */
+
+/* Finds the file of texture `name`: true with its path, or false with a
+ * reason in why ("not found on the texture search path a:b"). */
+typedef bool (*tex_resolve_fn)(void *ctx, const char *name, char *path, size_t path_size,
+                               char *why, int why_size);
+
+typedef struct tex_cache tex_cache;
+
+/* A cache of open textures by name, shared by threads: resolve and open
+ * happen once per name, under a lock; lookups of open names take the lock
+ * only to read the table. budget: bytes of texels before opening another
+ * texture fails (0: no limit). */
+tex_cache *tex_cache_new(size_t budget);
+void tex_cache_free(tex_cache *self);
+/* Installs the resolver (NULL: names are paths). */
+void tex_cache_set_resolver(tex_cache *self, tex_resolve_fn fn, void *ctx);
+/* The texture called name, opening it on first use; NULL with err. */
+const tex_texture *tex_cache_get(tex_cache *self, const char *name, char *err, size_t errsz);
+/* Puts a texture (made in memory) under name; the cache owns it. */
+bool tex_cache_put(tex_cache *self, const char *name, tex_texture *t);
+size_t tex_cache_bytes(const tex_cache *self);
+
+/* The default resolver: a texture search path ("dir:dir"; "&" the
+ * previous path, here the base folder; "@" the base folder) and a base
+ * folder (the scene file's) for relative names. */
+typedef struct tex_searchpath {
+    char path[4096];
+    char base[4096];
+} tex_searchpath;
+bool tex_searchpath_resolve(void *ctx, const char *name, char *path, size_t path_size,
+                            char *why, int why_size);
+
+#endif
