@@ -94,6 +94,7 @@ static job *rebuild(const Aafarm__Job *m, char *err, size_t errsz)
     for (size_t i = 0; ok && i < m->n_files; i++)
         ok = job_add_file(jb, m->files[i]->name, m->files[i]->sha256, m->files[i]->size, why,
                           sizeof why);
+    jb->files_known = true;                 /* the master's list, even when empty */
     if (ok) ok = job_finish(jb, why, sizeof why);
     if (!ok) {
         snprintf(err, errsz, "job %.12s... is inconsistent: %s", m->job_hash, why);

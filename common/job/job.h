@@ -76,6 +76,11 @@ typedef struct job {
     job_options options;
     job_file *files;               /* the data files its shaders read, by name */
     int nfiles;
+    bool files_known;              /* files is the whole list (job_load collected
+                                      it, or a master sent it): textures come
+                                      only from there. false (a job built in
+                                      memory, as tests do): from the scene's
+                                      texture search path on disk */
     char hash[HASH_HEX_SIZE];      /* set by job_finish / job_load */
     /* set by job_load from the scene, for naming outputs (not hashed) */
     int frame_number;              /* the frame's FrameBegin number (1 without) */

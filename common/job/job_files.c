@@ -162,6 +162,7 @@ static bool consider(job *self, const scene *sc, const char *name, sl_pos pos, s
 
 bool job_collect_files(job *self, const job_scene *js, sl_diag *diag)
 {
+    self->files_known = true;
     const scene *sc = js->scene;
     bool ok = true;
     for (int i = 0; i < self->nshaders && ok; i++) {

@@ -231,8 +231,9 @@ static bool open_textures(job_scene *self, sl_diag *diag, bool render)
     if (!self->textures) abort();
     /* the job's files (job_file_resolve: the disk on the master and
      * standalone, the host's store on a worker); before job_load has
-     * collected them, the same search of the texture path */
-    if (render)
+     * collected them, and for jobs built in memory (tests), the same search
+     * of the texture path */
+    if (render && self->job->files_known)
         tex_cache_set_resolver(self->textures, job_file_resolve, (void *)self->job);
     else
         tex_cache_set_resolver(self->textures, job_texture_path_resolve, (void *)sc);

@@ -121,7 +121,7 @@ static void test_missing_map_named_at_the_call(void **state)
     char *text = sl_diag_to_string(d);
     char want[600];
     snprintf(want, sizeof want, "%s/main.rib:7:3: error: shader 'bumpy': texture 'nope.exr': "
-             "not found", dir);
+             "no file 'nope.exr' on the texture search path", dir);
     if (!strstr(text, want) || !strstr(text, "Option \"searchpath\" \"texture\""))
         fail_msg("diagnostics:\n%s\nwanted: %s", text, want);
     free(text);
