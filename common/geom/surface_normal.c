@@ -157,6 +157,18 @@ void geom_unit_normal_aa(aa_context *ctx, const geom_surface *s, const aa_form *
         }
         return;
     }
+    case GEOM_SUBDIV:
+        /* near an extraordinary point Ng may be unbounded or hold 0: the
+         * unit normal is then only known to lie in [-1,1]^3 */
+        normalize_aa(ctx, g->Ng, Nn);
+        for (int i = 0; i < 3; i++) {
+            ia_interval r = aa_range(&Nn[i]);
+            if (!isfinite(r.lo) || !isfinite(r.hi) || (Nn[i].flags & AA_UNBOUNDED)) {
+                for (int k = 0; k < 3; k++) const_form(&Nn[k], ia_make(-1, 1));
+                return;
+            }
+        }
+        return;
     default:
         normalize_aa(ctx, g->Ng, Nn);
         return;
@@ -221,6 +233,14 @@ void geom_unit_normal_ia(const geom_surface *s, ia_interval u, ia_interval v,
             return;
         }
         normalize_ia(g->Ng, Nn);
+        return;
+    case GEOM_SUBDIV:
+        normalize_ia(g->Ng, Nn);
+        for (int i = 0; i < 3; i++)
+            if (!isfinite(Nn[i].lo) || !isfinite(Nn[i].hi) || (Nn[i].flags & AA_UNBOUNDED)) {
+                for (int k = 0; k < 3; k++) Nn[k] = ia_make(-1, 1);
+                return;
+            }
         return;
     default:
         normalize_ia(g->Ng, Nn);

@@ -200,6 +200,9 @@ typedef struct scene {
                                     * order of first reading; positions inside
                                     * them point at these names */
     int narchives;
+    struct geom_subdiv **subdivs;  /* SubdivisionMesh meshes, shared by their
+                                    * faces' surfaces (geom/subdiv.h) */
+    int nsubdivs;
 } scene;
 
 /* ---- building ------------------------------------------------------------ */
