@@ -7,7 +7,8 @@
  * and the quadrant holding (u,v) becomes the face (u' = 2u or 2u - 1), so
  * the point ends in a regular sub-patch at some level d, evaluated as its
  * bicubic Bezier patch (surface_bicubic.c) with dP/du scaled by 2^d. A point
- * exactly on an extraordinary corner gets the limit mask of that corner
+ * exactly on a sub-face corner that stays irregular for 3 more levels (an
+ * extraordinary or tagged point) gets the limit mask of that corner
  * (sd_corner_limit) and the derivatives of a point 2^-30 inside the face.
  * After 48 levels (a point within 2^-48 of an irregular corner) the
  * sub-face's corner point stands for the limit.
@@ -120,6 +121,7 @@ static int eval_point(const geom_subdiv *sd, int f, double u, double v, geom_sam
     sd_local_from_shared(sd, f, &L);
     double s = u, t = v;
     vec3 net[16];
+    int at_corner = 0;
     for (int d = 0; d <= SD_MAX_LEVEL; d++) {
         if (sd_regular_net(&L.m, net)) {
             net_surface(net, &b);
@@ -133,7 +135,11 @@ static int eval_point(const geom_subdiv *sd, int f, double u, double v, geom_sam
             return 0;
         }
         bool cu = s == 0 || s == 1, cv = t == 0 || t == 1;
-        if ((cu && cv) || d == SD_MAX_LEVEL) {
+        /* on a corner: descend toward it (an irregularity elsewhere in the
+         * sub-face recedes in a level or two); if it stays irregular, the
+         * corner itself is, and its limit mask gives the point */
+        at_corner = cu && cv ? at_corner + 1 : 0;
+        if (at_corner > 3 || d == SD_MAX_LEVEL) {
             int q = QUADRANT[s >= 0.5][t >= 0.5];
             for (int i = 0; i < 12; i++) {
                 if (sd_corner_limit(&L.m, q, &out->P)) return 1;
@@ -186,6 +192,17 @@ static void hull(const sd_mesh *m, vec3 *lo, vec3 *hi)
     *hi = v3_add(*hi, v3(pad, pad, pad));
 }
 
+/* x - o rounded down (dir < 0) or up (dir > 0): exact when the difference
+ * is a double (TwoSum gives the rounding error) */
+static double sub_dir(double x, double o, int dir)
+{
+    double d = x - o, bb = d - x;
+    double e = (x - (d - bb)) + (-o - bb);
+    if (dir < 0 && e < 0) return nextafter(d, -INFINITY);
+    if (dir > 0 && e > 0) return nextafter(d, INFINITY);
+    return d;
+}
+
 /* The sub-face of face f that holds the box [u0,u1] x [v0,v1] whole. */
 static void find_range(const geom_subdiv *sd, int f, double u0, double u1, double v0,
                        double v1, sd_range *r)
@@ -206,11 +223,10 @@ static void find_range(const geom_subdiv *sd, int f, double u0, double u1, doubl
             return;
         }
         double k = ldexp(1, d);
-        /* the box in the sub-face's coordinates, rounded outward */
-        double s0 = nextafter((u0 - r->ou) * k, -INFINITY);
-        double s1 = nextafter((u1 - r->ou) * k, INFINITY);
-        double t0 = nextafter((v0 - r->ov) * k, -INFINITY);
-        double t1 = nextafter((v1 - r->ov) * k, INFINITY);
+        /* the box in the sub-face's coordinates, rounded outward (the
+         * scaling by 2^d is exact) */
+        double s0 = sub_dir(u0, r->ou, -1) * k, s1 = sub_dir(u1, r->ou, 1) * k;
+        double t0 = sub_dir(v0, r->ov, -1) * k, t1 = sub_dir(v1, r->ov, 1) * k;
         bool inu = s1 <= 0.5 || s0 >= 0.5, inv = t1 <= 0.5 || t0 >= 0.5;
         if (d == SD_MAX_LEVEL || !inu || !inv) {
             r->regular = false;
@@ -223,6 +239,105 @@ static void find_range(const geom_subdiv *sd, int f, double u0, double u1, doubl
         r->level = d + 1;
         sd_local_child(&L, QUADRANT[qu][qv], &big);
     }
+}
+
+/* The blossom f(t1, t2, t3) of the cubic Bezier p[0..3]. */
+static vec3 blossom(const vec3 p[4], double t1, double t2, double t3)
+{
+    vec3 q[3], r[2];
+    for (int i = 0; i < 3; i++) q[i] = v3_add(v3_scale(p[i], 1 - t1), v3_scale(p[i + 1], t1));
+    for (int i = 0; i < 2; i++) r[i] = v3_add(v3_scale(q[i], 1 - t2), v3_scale(q[i + 1], t2));
+    return v3_add(v3_scale(r[0], 1 - t3), v3_scale(r[1], t3));
+}
+
+/* Tighter enclosures of a regular sub-patch over [s0,s1] x [t0,t1] (in
+ * [0,1]^2) from its Bezier net there (blossoms; the patch lies in the hull
+ * of that net, its u-derivative in the hull of 3 (b_i+1,j - b_ij) /
+ * (s1 - s0), likewise in v, so Ng in their cross product): boxes that the
+ * enclosures are met with. The tensor-form enclosure of a whole sub-patch
+ * is many times wider than its net (near an extraordinary point the
+ * renderer's boxes are whole sub-patches). Widened by 1e-12 of the net's
+ * size for the rounding of the blossoms; k = 2^level scales to the face. */
+typedef struct net_boxes { ia_interval P[3], dPdu[3], dPdv[3], Ng[3]; } net_boxes;
+
+static ia_interval pad_iv(double lo, double hi, double pad)
+{
+    return ia_make(lo - pad, hi + pad);
+}
+
+static void net_bounds(const vec3 net[16], ia_interval su, ia_interval sv, double k,
+                       net_boxes *nb)
+{
+    double s0 = fmax(su.lo, 0), s1 = fmin(su.hi, 1), t0 = fmax(sv.lo, 0), t1 = fmin(sv.hi, 1);
+    if (!(s0 <= s1)) s0 = s1 = fmin(fmax(su.lo, 0), 1);
+    if (!(t0 <= t1)) t0 = t1 = fmin(fmax(sv.lo, 0), 1);
+    vec3 H[4][4], B[4][4];                 /* [j][i] */
+    for (int j = 0; j < 4; j++) {
+        const vec3 *row = net + 4 * j;
+        H[j][0] = blossom(row, s0, s0, s0), H[j][1] = blossom(row, s0, s0, s1);
+        H[j][2] = blossom(row, s0, s1, s1), H[j][3] = blossom(row, s1, s1, s1);
+    }
+    for (int i = 0; i < 4; i++) {
+        vec3 col[4] = { H[0][i], H[1][i], H[2][i], H[3][i] };
+        B[0][i] = blossom(col, t0, t0, t0), B[1][i] = blossom(col, t0, t0, t1);
+        B[2][i] = blossom(col, t0, t1, t1), B[3][i] = blossom(col, t1, t1, t1);
+    }
+    double big = 0;
+    for (int i = 0; i < 16; i++)
+        big = fmax(big, fmax(fabs(net[i].x), fmax(fabs(net[i].y), fabs(net[i].z))));
+    double pad = 1e-12 * big;
+    for (int c = 0; c < 3; c++) {
+        double lo = INFINITY, hi = -INFINITY, ulo = INFINITY, uhi = -INFINITY;
+        double vlo = INFINITY, vhi = -INFINITY;
+        for (int j = 0; j < 4; j++)
+            for (int i = 0; i < 4; i++) {
+                double x = v3_comp(B[j][i], c);
+                lo = fmin(lo, x), hi = fmax(hi, x);
+                if (i < 3) {
+                    double d = 3 * (v3_comp(B[j][i + 1], c) - x);
+                    ulo = fmin(ulo, d), uhi = fmax(uhi, d);
+                }
+                if (j < 3) {
+                    double d = 3 * (v3_comp(B[j + 1][i], c) - x);
+                    vlo = fmin(vlo, d), vhi = fmax(vhi, d);
+                }
+            }
+        nb->P[c] = pad_iv(lo, hi, pad);
+        /* d/du = k d/ds = k / (s1 - s0) d/dw */
+        if (s1 > s0) {
+            ia_interval ks = ia_div(ia_point(k), ia_sub(ia_point(s1), ia_point(s0)));
+            nb->dPdu[c] = ia_mul(pad_iv(ulo, uhi, 8 * pad), ks);
+        } else {
+            nb->dPdu[c] = ia_entire();
+        }
+        if (t1 > t0) {
+            ia_interval kt = ia_div(ia_point(k), ia_sub(ia_point(t1), ia_point(t0)));
+            nb->dPdv[c] = ia_mul(pad_iv(vlo, vhi, 8 * pad), kt);
+        } else {
+            nb->dPdv[c] = ia_entire();
+        }
+    }
+    for (int c = 0; c < 3; c++) {
+        int a = (c + 1) % 3, b = (c + 2) % 3;
+        nb->Ng[c] = ia_sub(ia_mul(nb->dPdu[a], nb->dPdv[b]), ia_mul(nb->dPdu[b], nb->dPdv[a]));
+    }
+}
+
+static ia_interval meet_ia(ia_interval x, ia_interval y)
+{
+    if (!isfinite(y.lo) || !isfinite(y.hi) || (y.flags & AA_UNBOUNDED)) return x;
+    if (y.lo > x.lo) x.lo = y.lo;
+    if (y.hi < x.hi) x.hi = y.hi;
+    return x;
+}
+
+static void meet_aa(aa_form *z, ia_interval y)
+{
+    if ((z->flags & AA_UNBOUNDED) || !isfinite(y.lo) || !isfinite(y.hi) ||
+        (y.flags & AA_UNBOUNDED))
+        return;
+    if (y.lo > z->lo) z->lo = y.lo;
+    if (y.hi < z->hi) z->hi = y.hi;
 }
 
 void geom_subdiv_eval_ia(const geom_surface *s, ia_interval u, ia_interval v, geom_ia *out)
@@ -241,10 +356,13 @@ void geom_subdiv_eval_ia(const geom_surface *s, ia_interval u, ia_interval v, ge
     geom_surface b;
     net_surface(r.net, &b);
     geom_bicubic_eval_ia(&b, su, sv, out);
+    net_boxes nb;
+    net_bounds(r.net, su, sv, k, &nb);
     for (int i = 0; i < 3; i++) {
-        out->dPdu[i] = ia_mul_s(out->dPdu[i], k);
-        out->dPdv[i] = ia_mul_s(out->dPdv[i], k);
-        out->Ng[i] = ia_mul_s(out->Ng[i], k * k);
+        out->P[i] = meet_ia(out->P[i], nb.P[i]);
+        out->dPdu[i] = meet_ia(ia_mul_s(out->dPdu[i], k), nb.dPdu[i]);
+        out->dPdv[i] = meet_ia(ia_mul_s(out->dPdv[i], k), nb.dPdv[i]);
+        out->Ng[i] = meet_ia(ia_mul_s(out->Ng[i], k * k), nb.Ng[i]);
     }
 }
 
@@ -274,10 +392,16 @@ void geom_subdiv_eval_aa(aa_context *ctx, const geom_surface *s, const aa_form *
     geom_surface b;
     net_surface(r.net, &b);
     geom_bicubic_eval_aa(ctx, &b, &su, &sv, out);
+    net_boxes nb;
+    net_bounds(r.net, aa_range(&su), aa_range(&sv), k, &nb);
     for (int i = 0; i < 3; i++) {
         aa_mul_s(ctx, &out->dPdu[i], &out->dPdu[i], k);
         aa_mul_s(ctx, &out->dPdv[i], &out->dPdv[i], k);
         aa_mul_s(ctx, &out->Ng[i], &out->Ng[i], k * k);
+        meet_aa(&out->P[i], nb.P[i]);
+        meet_aa(&out->dPdu[i], nb.dPdu[i]);
+        meet_aa(&out->dPdv[i], nb.dPdv[i]);
+        meet_aa(&out->Ng[i], nb.Ng[i]);
     }
 }
 

@@ -226,12 +226,14 @@ static double excess(double x, double lo, double hi, double slack)
     return 0;
 }
 
+static int which_q = -1;
 static void check_vec(vec3 p, const ia_interval r[3], double slack, tally *t)
 {
     double e = fmax(excess(p.x, r[0].lo, r[0].hi, slack),
                     fmax(excess(p.y, r[1].lo, r[1].hi, slack), excess(p.z, r[2].lo, r[2].hi, slack)));
     if (e > 0 || isnan(p.x + p.y + p.z)) {
         t->violations++;
+        if (getenv("SUBDIV_DEBUG")) printf("violation q=%d e=%g p %.17g %.17g %.17g r [%.17g %.17g] [%.17g %.17g] [%.17g %.17g]\n", which_q, e, p.x, p.y, p.z, r[0].lo, r[0].hi, r[1].lo, r[1].hi, r[2].lo, r[2].hi);
         t->worst = fmax(t->worst, e);
     }
 }
@@ -276,6 +278,8 @@ static void contain_face(const geom_surface *s, double u0, double u1, double v0,
         vec3 vals[4] = { g.P, g.dPdu, g.dPdv, g.Ng };
         for (int q = 0; q < 4; q++) {
             double slack = 1e-11 * (1 + v3_length(vals[q]));
+            which_q = q;
+            if (getenv("SUBDIV_DEBUG") && q == 0) printf("box %.17g %.17g %.17g %.17g at %.17g %.17g\n", u0, u1, v0, v1, u, v);
             if (finite3(ar[q])) check_vec(vals[q], ar[q], slack, t);
             if (finite3(ir[q])) check_vec(vals[q], ir[q], slack, t);
         }
