@@ -175,6 +175,8 @@ typedef struct sd_range {
     int level;
     double ou, ov;                 /* the sub-face's origin in the face's (u,v) */
     vec3 lo, hi;                   /* else: the hull of its 1-ring */
+    double split_u, split_v;       /* irregular, and the box crosses this line
+                                    * of the sub-face's quadrants (else NAN) */
 } sd_range;
 
 static void hull(const sd_mesh *m, vec3 *lo, vec3 *hi)
@@ -231,6 +233,14 @@ static void find_range(const geom_subdiv *sd, int f, double u0, double u1, doubl
         if (d == SD_MAX_LEVEL || !inu || !inv) {
             r->regular = false;
             hull(&L.m, &r->lo, &r->hi);
+            /* a box that only crosses a quadrant line (not the whole
+             * sub-face) is cut there by the caller */
+            bool whole = s0 <= 0 && s1 >= 1 && t0 <= 0 && t1 >= 1;
+            r->split_u = r->split_v = NAN;
+            if (d < SD_MAX_LEVEL && !whole) {
+                if (!inu) r->split_u = r->ou + 0.5 / k;
+                if (!inv) r->split_v = r->ov + 0.5 / k;
+            }
             return;
         }
         int qu = s0 >= 0.5, qv = t0 >= 0.5;
@@ -260,17 +270,23 @@ static vec3 blossom(const vec3 p[4], double t1, double t2, double t3)
  * size for the rounding of the blossoms; k = 2^level scales to the face. */
 typedef struct net_boxes { ia_interval P[3], dPdu[3], dPdv[3], Ng[3]; } net_boxes;
 
+static ia_interval meet_ia_(ia_interval x, ia_interval y)
+{
+    if (!isfinite(y.lo) || !isfinite(y.hi) || (y.flags & AA_UNBOUNDED)) return x;
+    if (!isfinite(x.lo) || !isfinite(x.hi) || (x.flags & AA_UNBOUNDED)) return y;
+    if (y.lo > x.lo) x.lo = y.lo;
+    if (y.hi < x.hi) x.hi = y.hi;
+    return x;
+}
+
 static ia_interval pad_iv(double lo, double hi, double pad)
 {
     return ia_make(lo - pad, hi + pad);
 }
 
-static void net_bounds(const vec3 net[16], ia_interval su, ia_interval sv, double k,
-                       net_boxes *nb)
+static void net_piece(const vec3 net[16], double s0, double s1, double t0, double t1,
+                      double k, net_boxes *nb)
 {
-    double s0 = fmax(su.lo, 0), s1 = fmin(su.hi, 1), t0 = fmax(sv.lo, 0), t1 = fmin(sv.hi, 1);
-    if (!(s0 <= s1)) s0 = s1 = fmin(fmax(su.lo, 0), 1);
-    if (!(t0 <= t1)) t0 = t1 = fmin(fmax(sv.lo, 0), 1);
     vec3 H[4][4], B[4][4];                 /* [j][i] */
     for (int j = 0; j < 4; j++) {
         const vec3 *row = net + 4 * j;
@@ -323,6 +339,32 @@ static void net_bounds(const vec3 net[16], ia_interval su, ia_interval sv, doubl
     }
 }
 
+/* The whole box, and Ng as the hull over 3 x 3 pieces of it: the cross
+ * product of derivative boxes loses the pairing of du and dv at one point,
+ * which costs most where the sub-patch is distorted (near extraordinary
+ * points); smaller pieces turn less. */
+static void net_bounds(const vec3 net[16], ia_interval su, ia_interval sv, double k,
+                       net_boxes *nb)
+{
+    double s0 = fmax(su.lo, 0), s1 = fmin(su.hi, 1), t0 = fmax(sv.lo, 0), t1 = fmin(sv.hi, 1);
+    if (!(s0 <= s1)) s0 = s1 = fmin(fmax(su.lo, 0), 1);
+    if (!(t0 <= t1)) t0 = t1 = fmin(fmax(sv.lo, 0), 1);
+    net_piece(net, s0, s1, t0, t1, k, nb);
+    if (!(s1 > s0 && t1 > t0)) return;
+    enum { NP = 3 };
+    ia_interval Ng[3];
+    for (int j = 0; j < NP; j++)
+        for (int i = 0; i < NP; i++) {
+            double a0 = s0 + (s1 - s0) * i / NP, a1 = i == NP - 1 ? s1 : s0 + (s1 - s0) * (i + 1) / NP;
+            double b0 = t0 + (t1 - t0) * j / NP, b1 = j == NP - 1 ? t1 : t0 + (t1 - t0) * (j + 1) / NP;
+            net_boxes piece;
+            net_piece(net, a0, a1, b0, b1, k, &piece);
+            for (int c = 0; c < 3; c++)
+                Ng[c] = i == 0 && j == 0 ? piece.Ng[c] : ia_hull(Ng[c], piece.Ng[c]);
+        }
+    for (int c = 0; c < 3; c++) nb->Ng[c] = meet_ia_(nb->Ng[c], Ng[c]);
+}
+
 static ia_interval meet_ia(ia_interval x, ia_interval y)
 {
     if (!isfinite(y.lo) || !isfinite(y.hi) || (y.flags & AA_UNBOUNDED)) return x;
@@ -340,10 +382,46 @@ static void meet_aa(aa_form *z, ia_interval y)
     if (y.hi < z->hi) z->hi = y.hi;
 }
 
+/* The hull of the enclosures of the pieces of a box cut at r's lines. */
+static void split_ia(const geom_surface *s, ia_interval u, ia_interval v, const sd_range *r,
+                     geom_ia *out)
+{
+    double cu[3] = { u.lo, u.hi, u.hi }, cv[3] = { v.lo, v.hi, v.hi };
+    int nu = 1, nv = 1;
+    if (!isnan(r->split_u) && r->split_u > u.lo && r->split_u < u.hi)
+        cu[1] = r->split_u, nu = 2;
+    if (!isnan(r->split_v) && r->split_v > v.lo && r->split_v < v.hi)
+        cv[1] = r->split_v, nv = 2;
+    bool first = true;
+    for (int i = 0; i < nu; i++)
+        for (int j = 0; j < nv; j++) {
+            geom_ia g;
+            geom_subdiv_eval_ia(s, ia_make(cu[i], nu == 1 ? u.hi : cu[i + 1]),
+                                ia_make(cv[j], nv == 1 ? v.hi : cv[j + 1]), &g);
+            for (int c = 0; c < 3; c++) {
+                out->P[c] = first ? g.P[c] : ia_hull(out->P[c], g.P[c]);
+                out->dPdu[c] = first ? g.dPdu[c] : ia_hull(out->dPdu[c], g.dPdu[c]);
+                out->dPdv[c] = first ? g.dPdv[c] : ia_hull(out->dPdv[c], g.dPdv[c]);
+                out->Ng[c] = first ? g.Ng[c] : ia_hull(out->Ng[c], g.Ng[c]);
+            }
+            first = false;
+        }
+}
+
+static bool can_split(const sd_range *r, ia_interval u, ia_interval v)
+{
+    return (!isnan(r->split_u) && r->split_u > u.lo && r->split_u < u.hi) ||
+           (!isnan(r->split_v) && r->split_v > v.lo && r->split_v < v.hi);
+}
+
 void geom_subdiv_eval_ia(const geom_surface *s, ia_interval u, ia_interval v, geom_ia *out)
 {
     sd_range r;
     find_range(s->subdiv, s->subdiv_face, u.lo, u.hi, v.lo, v.hi, &r);
+    if (!r.regular && can_split(&r, u, v)) {
+        split_ia(s, u, v, &r, out);
+        return;
+    }
     if (!r.regular) {
         out->P[0] = ia_make(r.lo.x, r.hi.x);
         out->P[1] = ia_make(r.lo.y, r.hi.y);
@@ -372,6 +450,25 @@ void geom_subdiv_eval_aa(aa_context *ctx, const geom_surface *s, const aa_form *
     ia_interval ur = aa_range(u), vr = aa_range(v);
     sd_range r;
     find_range(s->subdiv, s->subdiv_face, ur.lo, ur.hi, vr.lo, vr.hi, &r);
+    if (!r.regular && can_split(&r, ur, vr)) {
+        /* a box across quadrant lines (never one of the renderer's dyadic
+         * boxes): the hull of its pieces, without correlation */
+        geom_ia g;
+        split_ia(s, ur, vr, &r, &g);
+        aa_context none;
+        aa_context_init(&none, 0);
+        for (int c = 0; c < 3; c++) {
+            const ia_interval *src[4] = { &g.P[c], &g.dPdu[c], &g.dPdv[c], &g.Ng[c] };
+            aa_form *dst[4] = { &out->P[c], &out->dPdu[c], &out->dPdv[c], &out->Ng[c] };
+            for (int q = 0; q < 4; q++) {
+                if (!isfinite(src[q]->lo) || !isfinite(src[q]->hi))
+                    aa_unbounded(dst[q], AA_UNBOUNDED);
+                else
+                    aa_from_interval(&none, dst[q], *src[q]);
+            }
+        }
+        return;
+    }
     if (!r.regular) {
         aa_context none;
         aa_context_init(&none, 0);

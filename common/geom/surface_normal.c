@@ -67,6 +67,8 @@ static double dphi_sign(const geom_surface *s)
 
 /* ---- affine ---- */
 
+static void normalize_ia(const ia_interval Ng[3], ia_interval Nn[3]);
+
 static void normalize_aa(aa_context *ctx, const aa_form Ng[3], aa_form Nn[3])
 {
     aa_form n2, t, inv;
@@ -164,7 +166,16 @@ void geom_unit_normal_aa(aa_context *ctx, const geom_surface *s, const aa_form *
         for (int i = 0; i < 3; i++) {
             ia_interval r = aa_range(&Nn[i]);
             if (!isfinite(r.lo) || !isfinite(r.hi) || (Nn[i].flags & AA_UNBOUNDED)) {
-                for (int k = 0; k < 3; k++) const_form(&Nn[k], ia_make(-1, 1));
+                /* the ranges of Ng (met with the net's bounds) may still
+                 * keep away from 0 where the forms do not */
+                ia_interval ng[3], n[3];
+                for (int k = 0; k < 3; k++) ng[k] = aa_range(&g->Ng[k]);
+                normalize_ia(ng, n);
+                for (int k = 0; k < 3; k++) {
+                    if (!isfinite(n[k].lo) || !isfinite(n[k].hi) || (n[k].flags & AA_UNBOUNDED))
+                        n[k] = ia_make(-1, 1);
+                    const_form(&Nn[k], ia_make(fmax(n[k].lo, -1), fmin(n[k].hi, 1)));
+                }
                 return;
             }
         }
