@@ -351,14 +351,14 @@ static void test_meshes(void **state)
     scene_destroy(&s);
 }
 
-/* subdiv.rib: one SubdivisionMesh of 24 quads, refined once: 96
+/* subdiv.rib: one SubdivisionMesh of 96 quads, refined once: 384
  * Catmull-Clark faces, all sharing the scene's one mesh. */
 static void test_subdiv(void **state)
 {
     (void)state;
     scene *s = load("subdiv.rib");
     assert_int_equal(s->nsubdivs, 1);
-    assert_int_equal(s->nobjects, 96);
+    assert_int_equal(s->nobjects, 384);
     for (int i = 0; i < s->nobjects; i++) {
         assert_int_equal(s->objects[i].surface.kind, GEOM_SUBDIV);
         assert_ptr_equal(s->objects[i].surface.subdiv, s->subdivs[0]);

@@ -1,7 +1,7 @@
 /*
  * test_trace_example_scenes.c: the example scenes of issue 14's new
  * surfaces render: scenes/subdiv.rib (a displaced Catmull-Clark box with
- * creases, a corner and extraordinary points) and scenes/knot.rib (a
+ * creases and extraordinary points) and scenes/knot.rib (a
  * displaced closed mesh of 2304 quads), read from the source tree with
  * their shaders, rendered small (Format replaced) in affine arithmetic:
  * no error, the object covers the image as its framing says, and 0
