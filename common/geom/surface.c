@@ -14,6 +14,7 @@
  */
 #include "geom/surface.h"
 #include "geom/surface_internal.h"
+#include "geom/subdiv.h"
 
 #include <math.h>
 #include <stdarg.h>
@@ -22,6 +23,7 @@
 static const char *const kind_names[GEOM__COUNT] = {
     "sphere", "disk", "cylinder", "cone", "paraboloid",
     "hyperboloid", "torus", "polygon", "patch", "bicubic patch",
+    "subdivision face",
 };
 
 const char *geom_kind_name(geom_kind kind)
@@ -270,6 +272,10 @@ bool geom_surface_prepare(geom_surface *s, char *why, int why_size)
     case GEOM_POLYGON:     return geom_polygon_prepare(s, why, why_size);
     case GEOM_PATCH:       return prepare_patch(s, why, why_size);
     case GEOM_BICUBIC:     return geom_bicubic_prepare(s, why, why_size);
+    case GEOM_SUBDIV:
+        if (!s->subdiv || s->subdiv_face < 0 || s->subdiv_face >= geom_subdiv_nfaces(s->subdiv))
+            return geom_fail(why, why_size, "subdivision face without its mesh");
+        return true;
     default:
         return geom_fail(why, why_size, "unknown surface kind %d", (int)s->kind);
     }
@@ -309,6 +315,10 @@ void geom_bounds(const geom_surface *s, vec3 *lo, vec3 *hi)
     *hi = v3(-INFINITY, -INFINITY, -INFINITY);
     if (s->kind == GEOM_POLYGON) {
         polygon_bounds(s, lo, hi);
+        return;
+    }
+    if (s->kind == GEOM_SUBDIV) {       /* the 1-ring's convex hull */
+        geom_subdiv_bounds(s, lo, hi);
         return;
     }
     if (s->kind == GEOM_BICUBIC) {      /* the control points' convex hull */

@@ -44,6 +44,7 @@ typedef enum geom_kind {
     GEOM_POLYGON,       /* convex planar polygon, nverts >= 3 */
     GEOM_PATCH,         /* bilinear patch, 4 corners in RIB order */
     GEOM_BICUBIC,       /* bicubic Bezier patch, 16 control points, u fastest */
+    GEOM_SUBDIV,        /* a face of a Catmull-Clark mesh (geom/subdiv.h) */
     GEOM__COUNT
 } geom_kind;
 
@@ -75,6 +76,10 @@ typedef struct geom_surface {
     ia_interval consts[GEOM_NCONST];       /* enclosures of exact derived constants
                                             * (zmax - zmin, ...) for the interval and
                                             * affine evaluations; see surface_internal.h */
+    /* GEOM_SUBDIV: the mesh (shared by its faces, owned by whoever built it,
+     * geom/subdiv.h) and the face of its refined mesh */
+    const struct geom_subdiv *subdiv;
+    int subdiv_face;
 } geom_surface;
 
 /* Float evaluation at one (u,v). */

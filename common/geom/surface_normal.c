@@ -67,6 +67,8 @@ static double dphi_sign(const geom_surface *s)
 
 /* ---- affine ---- */
 
+static void normalize_ia(const ia_interval Ng[3], ia_interval Nn[3]);
+
 static void normalize_aa(aa_context *ctx, const aa_form Ng[3], aa_form Nn[3])
 {
     aa_form n2, t, inv;
@@ -157,6 +159,27 @@ void geom_unit_normal_aa(aa_context *ctx, const geom_surface *s, const aa_form *
         }
         return;
     }
+    case GEOM_SUBDIV:
+        /* near an extraordinary point Ng may be unbounded or hold 0: the
+         * unit normal is then only known to lie in [-1,1]^3 */
+        normalize_aa(ctx, g->Ng, Nn);
+        for (int i = 0; i < 3; i++) {
+            ia_interval r = aa_range(&Nn[i]);
+            if (!isfinite(r.lo) || !isfinite(r.hi) || (Nn[i].flags & AA_UNBOUNDED)) {
+                /* the ranges of Ng (met with the net's bounds) may still
+                 * keep away from 0 where the forms do not */
+                ia_interval ng[3], n[3];
+                for (int k = 0; k < 3; k++) ng[k] = aa_range(&g->Ng[k]);
+                normalize_ia(ng, n);
+                for (int k = 0; k < 3; k++) {
+                    if (!isfinite(n[k].lo) || !isfinite(n[k].hi) || (n[k].flags & AA_UNBOUNDED))
+                        n[k] = ia_make(-1, 1);
+                    const_form(&Nn[k], ia_make(fmax(n[k].lo, -1), fmin(n[k].hi, 1)));
+                }
+                return;
+            }
+        }
+        return;
     default:
         normalize_aa(ctx, g->Ng, Nn);
         return;
@@ -221,6 +244,14 @@ void geom_unit_normal_ia(const geom_surface *s, ia_interval u, ia_interval v,
             return;
         }
         normalize_ia(g->Ng, Nn);
+        return;
+    case GEOM_SUBDIV:
+        normalize_ia(g->Ng, Nn);
+        for (int i = 0; i < 3; i++)
+            if (!isfinite(Nn[i].lo) || !isfinite(Nn[i].hi) || (Nn[i].flags & AA_UNBOUNDED)) {
+                for (int k = 0; k < 3; k++) Nn[k] = ia_make(-1, 1);
+                return;
+            }
         return;
     default:
         normalize_ia(g->Ng, Nn);

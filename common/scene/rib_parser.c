@@ -425,6 +425,7 @@ static const request_def requests[] = {
     { "Polygon", rib_polygon, PRIMITIVE },
     { "Patch", rib_patch, PRIMITIVE },
     { "PointsPolygons", rib_points_polygons, PRIMITIVE },
+    { "SubdivisionMesh", rib_subdivision_mesh, PRIMITIVE },
     { "PointsGeneralPolygons", rib_points_general_polygons, PRIMITIVE },
     { "GeneralPolygon", rib_general_polygon, PRIMITIVE },
     { "PatchMesh", rib_patch_mesh, PRIMITIVE },

@@ -266,6 +266,9 @@ void rib_basis_default(double m[16], int *step);
 void rib_nu_patch(rib_parser *p, const rib_request *req);
 void rib_trim_curve(rib_parser *p, const rib_request *req);
 
+/* rib_subdiv.c */
+void rib_subdivision_mesh(rib_parser *p, const rib_request *req);
+
 /* rib_mesh.c */
 void rib_points_polygons(rib_parser *p, const rib_request *req);
 void rib_points_general_polygons(rib_parser *p, const rib_request *req);

@@ -6,6 +6,9 @@
  */
 #include "scene/scene.h"
 #include "sl/strbuf.h"
+#ifdef SCENE_HAVE_GEOM
+#include "geom/subdiv.h"
+#endif
 
 #include <stdlib.h>
 #include <string.h>
@@ -57,6 +60,11 @@ void scene_destroy(scene **self_p)
     free_strings(self->search_path, self->nsearch_path);
     free_strings(self->texture_path, self->ntexture_path);
     free_strings(self->shader_names, self->nshader_names);
+#ifdef SCENE_HAVE_GEOM
+    for (int i = 0; i < self->nsubdivs; i++)
+        geom_subdiv_free(&self->subdivs[i]);
+#endif
+    free(self->subdivs);
     free_strings(self->archives, self->narchives);
     free(self->display_name);
     free(self->display_type);

@@ -215,6 +215,9 @@ typedef struct scene {
     int *frame_numbers;            /* each one's number, nframes of them */
     int trace_maxdepth;            /* Option "trace" "maxdepth": nested trace()
                                     * rays (-1: not given, the renderer's 4) */
+    struct geom_subdiv **subdivs;  /* SubdivisionMesh meshes, shared by their
+                                    * faces' surfaces (geom/subdiv.h) */
+    int nsubdivs;
 } scene;
 
 /* The largest Option "trace" "maxdepth" (each depth is a shading VM per

@@ -157,7 +157,7 @@ void corpus_free(corpus *c)
 
 const char *corpus_surface_name(corpus_surface s)
 {
-    static const char *names[] = {"plane", "sphere", "ellipsoid", "cylinder", "patch", "mesh"};
+    static const char *names[] = {"plane", "sphere", "ellipsoid", "cylinder", "patch", "mesh", "subdiv"};
     return s < CORPUS_NSURFACES ? names[s] : "?";
 }
 
@@ -213,6 +213,33 @@ bool corpus_open(fixture *f, const corpus *c, const corpus_file *sh,
         mesh_rib(geom, sizeof geom, tmp);
         break;
     }
+    case CORPUS_SUBDIV:
+        /* a creased box (valence 3 extraordinary points, an infinitely
+         * sharp and a semi-sharp crease) and an open fan of five quads
+         * (valence 5, boundary with interpolateboundary). No corner tag:
+         * its point is a cone whose normals sweep a wide range close to
+         * it, which the idioms of 1 / length(ntransform(N)) turn into
+         * unbounded boxes (tests/geom/test_geom_subdiv covers corners) */
+        snprintf(geom, sizeof geom, "Translate 0 0 5\nRotate -40 1 0 0\nRotate 25 0 0 1\n%s"
+            "AttributeBegin\nTranslate -0.6 0 0\nScale 0.5 0.5 0.5\n"
+            "SubdivisionMesh \"catmull-clark\" [4 4 4 4 4 4 4 4 4 4 4 4 4 4 4 4 4 4 4 4 4 4 4 4]\n"
+            "  [0 1 2 3  3 2 4 5  1 6 7 2  2 7 8 4  12 11 10 9  14 13 11 12  11 16 15 10  "
+            "13 17 16 11  15 16 18 19  19 18 7 6  16 17 20 18  18 20 8 7  22 21 12 9  "
+            "0 3 21 22  21 23 14 12  3 5 23 21  14 23 24 13  13 24 20 17  23 5 4 24  "
+            "24 4 8 20  10 25 22 9  15 19 25 10  25 1 0 22  19 6 1 25]\n"
+            "  [\"crease\" \"crease\"] [9 1 3 1]\n"
+            "  [14 23 5 4 8 20 17 13 14  6 7 8] [10 2.5]\n"
+            "  \"P\" [1 -1 -1  1 0 -1  1 0 0  1 -1 0  1 0 1  1 -1 1  1 1 -1  1 1 0  1 1 1  "
+            "-1 -1 -1  -1 0 -1  -1 0 0  -1 -1 0  -1 0 1  -1 -1 1  -1 1 -1  -1 1 0  -1 1 1  "
+            "0 1 0  0 1 -1  0 1 1  0 -1 0  0 -1 -1  0 -1 1  0 0 1  0 0 -1]\n"
+            "AttributeEnd\nAttributeBegin\nTranslate 0.7 0 0\nScale 0.5 0.5 0.5\n"
+            "SubdivisionMesh \"catmull-clark\" [4 4 4 4 4] [0 1 2 3  0 3 4 5  0 5 6 7  "
+            "0 7 8 9  0 9 10 1] [\"interpolateboundary\"] [0 0] [] []\n"
+            "  \"P\" [0.1 0 0.3  1 0 0  1.133 0.823 -0.2  0.309 0.951 -0.118  -0.433 1.331 -0.1  "
+            "-0.809 0.588 0.19  -1.4 0 0  -0.809 -0.588 -0.19  -0.433 -1.331 0.1  "
+            "0.309 -0.951 0.118  1.133 -0.823 0.2]\n"
+            "AttributeEnd\n", disp);
+        break;
     default:
         return false;
     }

@@ -385,6 +385,37 @@ static void test_ripples_frames(void **state)
     free(text);
 }
 
+/* subdiv.rib: one SubdivisionMesh of 96 quads, refined once: 384
+ * Catmull-Clark faces, all sharing the scene's one mesh. */
+static void test_subdiv(void **state)
+{
+    (void)state;
+    scene *s = load("subdiv.rib");
+    assert_int_equal(s->nsubdivs, 1);
+    assert_int_equal(s->nobjects, 384);
+    for (int i = 0; i < s->nobjects; i++) {
+        assert_int_equal(s->objects[i].surface.kind, GEOM_SUBDIV);
+        assert_ptr_equal(s->objects[i].surface.subdiv, s->subdivs[0]);
+        assert_int_equal(s->objects[i].surface.subdiv_face, i);
+    }
+    assert_non_null(object_named(s, "box"));
+    scene_destroy(&s);
+}
+
+/* knot.rib: a closed tube of 192 x 12 quads; curved, so each quad is cut
+ * into two triangles with vertex normals. */
+static void test_knot(void **state)
+{
+    (void)state;
+    scene *s = load("knot.rib");
+    assert_int_equal(s->nobjects, 2 * 192 * 12);
+    for (int i = 0; i < s->nobjects; i++) {
+        assert_int_equal(s->objects[i].surface.kind, GEOM_POLYGON);
+        assert_int_equal(s->objects[i].surface.nvn, 3);
+    }
+    scene_destroy(&s);
+}
+
 int main(int argc, char **argv)
 {
     if (argc > 1)
@@ -401,6 +432,8 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_vase),
         cmocka_unit_test(test_meshes),
         cmocka_unit_test(test_ripples_frames),
+        cmocka_unit_test(test_subdiv),
+        cmocka_unit_test(test_knot),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -1,0 +1,81 @@
+/*
+ * subdiv.h: Catmull-Clark subdivision surfaces (RI Specification 3.2
+ * §5.5, SubdivisionMesh "catmull-clark") as base surfaces of common/geom.
+ *
+ * A geom_subdiv is one mesh, shared by all its faces: the control mesh
+ * refined once (so every face is a quad), with the tags applied (crease
+ * and corner sharpness as in DeRose, Kass & Truong 1998: semi-sharp
+ * sharpness decays by 1 per level; boundary edges are infinitely sharp
+ * with "interpolateboundary"; hole faces are kept as control but not
+ * drawn). Each drawable face of that mesh is one geom_surface of kind
+ * GEOM_SUBDIV pointing at the mesh (subdiv, subdiv_face), so a face costs
+ * no copy of control points.
+ *
+ * The surface of a face is its exact Catmull-Clark limit over the unit
+ * square (u along the face's first edge, v along its last): where the
+ * face's 1-ring is regular it is a uniform bicubic B-spline patch (boundary
+ * and infinitely sharp crease edges by mirrored "ghost" points); elsewhere
+ * the 1-ring is refined locally until the point or (u,v) box falls in a
+ * regular sub-patch (subdiv_eval.c). Docs: docs/geometry.md.
+ */
+#ifndef GEOM_SUBDIV_H
+#define GEOM_SUBDIV_H
+
+#include <stdbool.h>
+
+#include "geom/surface.h"
+
+/* A SubdivisionMesh as the RIB gives it (all indices checked by the
+ * caller to be in range). Tags: creases are vertex chains with one
+ * sharpness each; corners are vertices with a sharpness each; holes are
+ * face indices. Sharpness >= GEOM_SUBDIV_INFINITE (10) is infinitely
+ * sharp, as in RenderMan. */
+typedef struct geom_subdiv_desc {
+    int nfaces;
+    const int *nverts;             /* per face, >= 3 */
+    const int *verts;              /* sum(nverts) point indices */
+    int npoints;
+    const double *P;               /* 3 * npoints */
+    int ncreases;
+    const int *crease_len;         /* points per chain (>= 2) */
+    const int *crease_verts;       /* the chains, concatenated */
+    const double *crease_sharp;    /* one per chain */
+    int ncorners;
+    const int *corner_verts;
+    const double *corner_sharp;    /* one per corner */
+    int nholes;
+    const int *holes;
+    bool interpolateboundary;
+} geom_subdiv_desc;
+
+#define GEOM_SUBDIV_INFINITE 10.0
+enum { GEOM_SUBDIV_MAX_VALENCE = 16 };
+
+typedef struct geom_subdiv geom_subdiv;
+
+/* Builds the mesh; NULL with a one-line reason in why (a non-manifold
+ * edge, faces that disagree on orientation, a valence above 16, ...). */
+geom_subdiv *geom_subdiv_new(const geom_subdiv_desc *desc, char *why, int why_size);
+void geom_subdiv_free(geom_subdiv **self_p);
+
+/* Faces of the refined mesh, and whether face f is drawn: not a hole and
+ * (without interpolateboundary) not touching the boundary. */
+int geom_subdiv_nfaces(const geom_subdiv *self);
+bool geom_subdiv_face_drawn(const geom_subdiv *self, int f);
+/* The control face (of the RIB's faces) that refined face f comes from. */
+int geom_subdiv_face_origin(const geom_subdiv *self, int f);
+
+/* The points of refined face f in its corner order ((u,v) = (0,0),
+ * (1,0), (1,1), (0,1)), as indices of the refined mesh (its first
+ * npoints points are the control points' vertex points). */
+void geom_subdiv_face_points(const geom_subdiv *self, int f, int out[4]);
+
+/* A GEOM_SUBDIV surface for face f (prepared). */
+void geom_subdiv_surface(const geom_subdiv *self, int f, geom_surface *out);
+
+/* The limit position of control point i (after the tags), for tests:
+ * refines around it until no semi-sharp tag is left and applies the limit
+ * mask of its rule (smooth, crease or corner). */
+bool geom_subdiv_limit_point(const geom_subdiv *self, int point, vec3 *out);
+
+#endif

@@ -1,0 +1,588 @@
+/*
+ * subdiv_eval.c: the GEOM_SUBDIV surface of one face, in the four
+ * arithmetics, its bounds and its ray intersection.
+ *
+ * A point (u,v) of face f: the face's 1-ring is copied into a local mesh;
+ * while the face is not regular (subdiv_regular.c) it is refined locally
+ * and the quadrant holding (u,v) becomes the face (u' = 2u or 2u - 1), so
+ * the point ends in a regular sub-patch at some level d, evaluated as its
+ * bicubic Bezier patch (surface_bicubic.c) with dP/du scaled by 2^d. A point
+ * exactly on a sub-face corner that stays irregular for 3 more levels (an
+ * extraordinary or tagged point) gets the limit mask of that corner
+ * (sd_corner_limit) and the derivatives of a point 2^-30 inside the face.
+ * After 48 levels (a point within 2^-48 of an irregular corner) the
+ * sub-face's corner point stands for the limit.
+ *
+ * A (u,v) box: the same descent while the box lies in one quadrant; a
+ * regular sub-patch gives the bicubic enclosure (interval or affine, in
+ * the face's own u and v: u' = 2^d u - offset is affine, so the forms keep
+ * their correlation). A box that covers an irregular sub-face whole is
+ * bounded by the convex hull of that sub-face's 1-ring (Catmull-Clark
+ * masks are non-negative, so the limit surface lies in the hull of the
+ * points that define it), widened by 1e-12 of its size for the rounding of
+ * the refinement, with unbounded derivatives (near an extraordinary point
+ * dP/du may grow without bound and the normal is not bounded there:
+ * geom_unit_normal_* then give the cube [-1,1]^3).
+ */
+#include "geom/subdiv_local.h"
+#include "geom/surface_internal.h"
+
+#include <math.h>
+#include <string.h>
+
+enum { SD_MAX_LEVEL = 48 };
+
+void sd_local_take(sd_local *L, const sd_mesh *M, const int *list, int n)
+{
+    L->m = (sd_mesh){ 0, 0, L->P, L->vs, L->fo, L->fv, L->es };
+    int src[SD_LV];
+    int nc = 0;
+    L->fo[0] = 0;
+    for (int i = 0; i < n && i < SD_LF; i++) {
+        int f = list[i];
+        for (int c = M->fo[f]; c < M->fo[f + 1] && nc < SD_LC; c++) {
+            int v = M->fv[c], j = 0;
+            while (j < L->m.nv && src[j] != v) j++;
+            if (j == L->m.nv) {
+                src[j] = v;
+                L->P[j] = M->P[v];
+                L->vs[j] = M->vs[v];
+                L->m.nv++;
+            }
+            L->fv[nc] = j;
+            L->es[nc] = M->es[c];
+            nc++;
+        }
+        L->fo[++L->m.nf] = nc;
+    }
+}
+
+static void add_face(int *list, int *n, int f)
+{
+    for (int i = 0; i < *n; i++)
+        if (list[i] == f) return;
+    if (*n < SD_LF) list[(*n)++] = f;
+}
+
+void sd_local_from_shared(const geom_subdiv *sd, int f, sd_local *L)
+{
+    int list[SD_LF], n = 0;
+    add_face(list, &n, f);
+    for (int k = 0; k < 4; k++) {
+        int v = sd->m.fv[sd->m.fo[f] + k];
+        for (int i = sd->vf_off[v]; i < sd->vf_off[v + 1]; i++)
+            add_face(list, &n, sd->vf[i] / 4);
+    }
+    sd_local_take(L, &sd->m, list, n);
+}
+
+void sd_local_child(sd_local *L, int k, sd_big *big)
+{
+    big->m = (sd_mesh){ 0, 0, big->P, big->vs, big->fo, big->fv, big->es };
+    sd_refine(&L->m, &big->m);
+    int child = L->fo[0] + k;                  /* the child of face 0's corner k */
+    int cv[4];
+    for (int j = 0; j < 4; j++) cv[j] = big->fv[big->fo[child] + j];
+    int list[SD_LF], n = 0;
+    add_face(list, &n, child);
+    for (int f = 0; f < big->m.nf; f++)
+        for (int c = big->fo[f]; c < big->fo[f + 1]; c++)
+            if ((big->fv[c] == cv[0] || big->fv[c] == cv[1] ||
+                           big->fv[c] == cv[2] || big->fv[c] == cv[3])) {
+                add_face(list, &n, f);
+                break;
+            }
+    sd_local_take(L, &big->m, list, n);
+}
+
+static const int QUADRANT[2][2] = { { 0, 3 }, { 1, 2 } };   /* [u >= .5][v >= .5] */
+
+/* a temporary bicubic surface for a net (only kind, nverts, verts used) */
+static void net_surface(const vec3 net[16], geom_surface *b)
+{
+    b->kind = GEOM_BICUBIC;
+    b->nverts = 16;
+    memcpy(b->verts, net, 16 * sizeof *net);
+}
+
+/* ---- float and dual ---- */
+
+/* 0: out filled; 1: (u,v) is an irregular corner: out->P is its limit */
+static int eval_point(const geom_subdiv *sd, int f, double u, double v, geom_sample *out)
+{
+    geom_surface b;                    /* fields other than verts unused */
+    if (sd->net_of[f] >= 0) {
+        net_surface(sd->nets + 16 * sd->net_of[f], &b);
+        geom_bicubic_eval_dual(&b, u, v, out);
+        return 0;
+    }
+    sd_local L;
+    sd_big bigs, *big = &bigs;
+    sd_local_from_shared(sd, f, &L);
+    double s = u, t = v;
+    vec3 net[16];
+    int at_corner = 0;
+    for (int d = 0; d <= SD_MAX_LEVEL; d++) {
+        if (sd_regular_net(&L.m, net)) {
+            net_surface(net, &b);
+            geom_bicubic_eval_dual(&b, s, t, out);
+            double k = ldexp(1, d), k2 = k * k;
+            out->dPdu = v3_scale(out->dPdu, k);
+            out->dPdv = v3_scale(out->dPdv, k);
+            out->Ng = v3_scale(out->Ng, k2);
+            out->dNgdu = v3_scale(out->dNgdu, k2 * k);
+            out->dNgdv = v3_scale(out->dNgdv, k2 * k);
+            return 0;
+        }
+        bool cu = s == 0 || s == 1, cv = t == 0 || t == 1;
+        /* on a corner: descend toward it (an irregularity elsewhere in the
+         * sub-face recedes in a level or two); if it stays irregular, the
+         * corner itself is, and its limit mask gives the point */
+        at_corner = cu && cv ? at_corner + 1 : 0;
+        if (at_corner > 3 || d == SD_MAX_LEVEL) {
+            int q = QUADRANT[s >= 0.5][t >= 0.5];
+            for (int i = 0; i < 12; i++) {
+                if (sd_corner_limit(&L.m, q, &out->P)) return 1;
+                sd_local_child(&L, q, big);
+            }
+            out->P = L.P[L.fv[L.fo[0] + q]];
+            return 1;
+        }
+        int qu = s >= 0.5, qv = t >= 0.5;
+        s = 2 * s - qu;
+        t = 2 * t - qv;
+        sd_local_child(&L, QUADRANT[qu][qv], big);
+    }
+    return 1;
+}
+
+void geom_subdiv_eval_dual(const geom_surface *s, double u, double v, geom_sample *out)
+{
+    const geom_subdiv *sd = s->subdiv;
+    if (eval_point(sd, s->subdiv_face, u, v, out) == 1) {
+        vec3 P = out->P;
+        double e = ldexp(1, -30);
+        eval_point(sd, s->subdiv_face, u < 0.5 ? u + e : u - e, v < 0.5 ? v + e : v - e, out);
+        out->P = P;
+    }
+}
+
+/* ---- interval and affine ---- */
+
+typedef struct sd_range {
+    bool regular;
+    vec3 net[16];
+    int level;
+    double ou, ov;                 /* the sub-face's origin in the face's (u,v) */
+    vec3 lo, hi;                   /* else: the hull of its 1-ring */
+    double split_u, split_v;       /* irregular, and the box crosses this line
+                                    * of the sub-face's quadrants (else NAN) */
+} sd_range;
+
+static void hull(const sd_mesh *m, vec3 *lo, vec3 *hi)
+{
+    *lo = *hi = m->P[0];
+    double big = 0;
+    for (int i = 0; i < m->nv; i++) {
+        vec3 p = m->P[i];
+        lo->x = fmin(lo->x, p.x), lo->y = fmin(lo->y, p.y), lo->z = fmin(lo->z, p.z);
+        hi->x = fmax(hi->x, p.x), hi->y = fmax(hi->y, p.y), hi->z = fmax(hi->z, p.z);
+        big = fmax(big, fmax(fabs(p.x), fmax(fabs(p.y), fabs(p.z))));
+    }
+    double pad = 1e-12 * (big + v3_length(v3_sub(*hi, *lo)));
+    *lo = v3_sub(*lo, v3(pad, pad, pad));
+    *hi = v3_add(*hi, v3(pad, pad, pad));
+}
+
+/* x - o rounded down (dir < 0) or up (dir > 0): exact when the difference
+ * is a double (TwoSum gives the rounding error) */
+static double sub_dir(double x, double o, int dir)
+{
+    double d = x - o, bb = d - x;
+    double e = (x - (d - bb)) + (-o - bb);
+    if (dir < 0 && e < 0) return nextafter(d, -INFINITY);
+    if (dir > 0 && e > 0) return nextafter(d, INFINITY);
+    return d;
+}
+
+/* The sub-face of face f that holds the box [u0,u1] x [v0,v1] whole. */
+static void find_range(const geom_subdiv *sd, int f, double u0, double u1, double v0,
+                       double v1, sd_range *r)
+{
+    r->level = 0;
+    r->ou = r->ov = 0;
+    if (sd->net_of[f] >= 0) {
+        r->regular = true;
+        memcpy(r->net, sd->nets + 16 * sd->net_of[f], sizeof r->net);
+        return;
+    }
+    sd_local L;
+    sd_big big;
+    sd_local_from_shared(sd, f, &L);
+    for (int d = 0;; d++) {
+        if (sd_regular_net(&L.m, r->net)) {
+            r->regular = true;
+            return;
+        }
+        double k = ldexp(1, d);
+        /* the box in the sub-face's coordinates, rounded outward (the
+         * scaling by 2^d is exact) */
+        double s0 = sub_dir(u0, r->ou, -1) * k, s1 = sub_dir(u1, r->ou, 1) * k;
+        double t0 = sub_dir(v0, r->ov, -1) * k, t1 = sub_dir(v1, r->ov, 1) * k;
+        bool inu = s1 <= 0.5 || s0 >= 0.5, inv = t1 <= 0.5 || t0 >= 0.5;
+        if (d == SD_MAX_LEVEL || !inu || !inv) {
+            r->regular = false;
+            hull(&L.m, &r->lo, &r->hi);
+            /* a box that only crosses a quadrant line (not the whole
+             * sub-face) is cut there by the caller */
+            bool whole = s0 <= 0 && s1 >= 1 && t0 <= 0 && t1 >= 1;
+            r->split_u = r->split_v = NAN;
+            if (d < SD_MAX_LEVEL && !whole) {
+                if (!inu) r->split_u = r->ou + 0.5 / k;
+                if (!inv) r->split_v = r->ov + 0.5 / k;
+            }
+            return;
+        }
+        int qu = s0 >= 0.5, qv = t0 >= 0.5;
+        r->ou += qu * 0.5 / k;
+        r->ov += qv * 0.5 / k;
+        r->level = d + 1;
+        sd_local_child(&L, QUADRANT[qu][qv], &big);
+    }
+}
+
+/* The blossom f(t1, t2, t3) of the cubic Bezier p[0..3]. */
+static vec3 blossom(const vec3 p[4], double t1, double t2, double t3)
+{
+    vec3 q[3], r[2];
+    for (int i = 0; i < 3; i++) q[i] = v3_add(v3_scale(p[i], 1 - t1), v3_scale(p[i + 1], t1));
+    for (int i = 0; i < 2; i++) r[i] = v3_add(v3_scale(q[i], 1 - t2), v3_scale(q[i + 1], t2));
+    return v3_add(v3_scale(r[0], 1 - t3), v3_scale(r[1], t3));
+}
+
+/* Tighter enclosures of a regular sub-patch over [s0,s1] x [t0,t1] (in
+ * [0,1]^2) from its Bezier net there (blossoms; the patch lies in the hull
+ * of that net, its u-derivative in the hull of 3 (b_i+1,j - b_ij) /
+ * (s1 - s0), likewise in v, so Ng in their cross product): boxes that the
+ * enclosures are met with. The tensor-form enclosure of a whole sub-patch
+ * is many times wider than its net (near an extraordinary point the
+ * renderer's boxes are whole sub-patches). Widened by 1e-12 of the net's
+ * size for the rounding of the blossoms; k = 2^level scales to the face. */
+typedef struct net_boxes { ia_interval P[3], dPdu[3], dPdv[3], Ng[3]; } net_boxes;
+
+static ia_interval meet_ia_(ia_interval x, ia_interval y)
+{
+    if (!isfinite(y.lo) || !isfinite(y.hi) || (y.flags & AA_UNBOUNDED)) return x;
+    if (!isfinite(x.lo) || !isfinite(x.hi) || (x.flags & AA_UNBOUNDED)) return y;
+    if (y.lo > x.lo) x.lo = y.lo;
+    if (y.hi < x.hi) x.hi = y.hi;
+    return x;
+}
+
+static ia_interval pad_iv(double lo, double hi, double pad)
+{
+    return ia_make(lo - pad, hi + pad);
+}
+
+static void net_piece(const vec3 net[16], double s0, double s1, double t0, double t1,
+                      double k, net_boxes *nb)
+{
+    vec3 H[4][4], B[4][4];                 /* [j][i] */
+    for (int j = 0; j < 4; j++) {
+        const vec3 *row = net + 4 * j;
+        H[j][0] = blossom(row, s0, s0, s0), H[j][1] = blossom(row, s0, s0, s1);
+        H[j][2] = blossom(row, s0, s1, s1), H[j][3] = blossom(row, s1, s1, s1);
+    }
+    for (int i = 0; i < 4; i++) {
+        vec3 col[4] = { H[0][i], H[1][i], H[2][i], H[3][i] };
+        B[0][i] = blossom(col, t0, t0, t0), B[1][i] = blossom(col, t0, t0, t1);
+        B[2][i] = blossom(col, t0, t1, t1), B[3][i] = blossom(col, t1, t1, t1);
+    }
+    double big = 0;
+    for (int i = 0; i < 16; i++)
+        big = fmax(big, fmax(fabs(net[i].x), fmax(fabs(net[i].y), fabs(net[i].z))));
+    double pad = 1e-12 * big;
+    for (int c = 0; c < 3; c++) {
+        double lo = INFINITY, hi = -INFINITY, ulo = INFINITY, uhi = -INFINITY;
+        double vlo = INFINITY, vhi = -INFINITY;
+        for (int j = 0; j < 4; j++)
+            for (int i = 0; i < 4; i++) {
+                double x = v3_comp(B[j][i], c);
+                lo = fmin(lo, x), hi = fmax(hi, x);
+                if (i < 3) {
+                    double d = 3 * (v3_comp(B[j][i + 1], c) - x);
+                    ulo = fmin(ulo, d), uhi = fmax(uhi, d);
+                }
+                if (j < 3) {
+                    double d = 3 * (v3_comp(B[j + 1][i], c) - x);
+                    vlo = fmin(vlo, d), vhi = fmax(vhi, d);
+                }
+            }
+        nb->P[c] = pad_iv(lo, hi, pad);
+        /* d/du = k d/ds = k / (s1 - s0) d/dw */
+        if (s1 > s0) {
+            ia_interval ks = ia_div(ia_point(k), ia_sub(ia_point(s1), ia_point(s0)));
+            nb->dPdu[c] = ia_mul(pad_iv(ulo, uhi, 8 * pad), ks);
+        } else {
+            nb->dPdu[c] = ia_entire();
+        }
+        if (t1 > t0) {
+            ia_interval kt = ia_div(ia_point(k), ia_sub(ia_point(t1), ia_point(t0)));
+            nb->dPdv[c] = ia_mul(pad_iv(vlo, vhi, 8 * pad), kt);
+        } else {
+            nb->dPdv[c] = ia_entire();
+        }
+    }
+    for (int c = 0; c < 3; c++) {
+        int a = (c + 1) % 3, b = (c + 2) % 3;
+        nb->Ng[c] = ia_sub(ia_mul(nb->dPdu[a], nb->dPdv[b]), ia_mul(nb->dPdu[b], nb->dPdv[a]));
+    }
+}
+
+/* The whole box, and Ng as the hull over 3 x 3 pieces of it: the cross
+ * product of derivative boxes loses the pairing of du and dv at one point,
+ * which costs most where the sub-patch is distorted (near extraordinary
+ * points); smaller pieces turn less. */
+static void net_bounds(const vec3 net[16], ia_interval su, ia_interval sv, double k,
+                       net_boxes *nb)
+{
+    double s0 = fmax(su.lo, 0), s1 = fmin(su.hi, 1), t0 = fmax(sv.lo, 0), t1 = fmin(sv.hi, 1);
+    if (!(s0 <= s1)) s0 = s1 = fmin(fmax(su.lo, 0), 1);
+    if (!(t0 <= t1)) t0 = t1 = fmin(fmax(sv.lo, 0), 1);
+    net_piece(net, s0, s1, t0, t1, k, nb);
+    if (!(s1 > s0 && t1 > t0)) return;
+    enum { NP = 3 };
+    ia_interval Ng[3];
+    for (int j = 0; j < NP; j++)
+        for (int i = 0; i < NP; i++) {
+            double a0 = s0 + (s1 - s0) * i / NP, a1 = i == NP - 1 ? s1 : s0 + (s1 - s0) * (i + 1) / NP;
+            double b0 = t0 + (t1 - t0) * j / NP, b1 = j == NP - 1 ? t1 : t0 + (t1 - t0) * (j + 1) / NP;
+            net_boxes piece;
+            net_piece(net, a0, a1, b0, b1, k, &piece);
+            for (int c = 0; c < 3; c++)
+                Ng[c] = i == 0 && j == 0 ? piece.Ng[c] : ia_hull(Ng[c], piece.Ng[c]);
+        }
+    for (int c = 0; c < 3; c++) nb->Ng[c] = meet_ia_(nb->Ng[c], Ng[c]);
+}
+
+static ia_interval meet_ia(ia_interval x, ia_interval y)
+{
+    if (!isfinite(y.lo) || !isfinite(y.hi) || (y.flags & AA_UNBOUNDED)) return x;
+    if (y.lo > x.lo) x.lo = y.lo;
+    if (y.hi < x.hi) x.hi = y.hi;
+    return x;
+}
+
+static void meet_aa(aa_form *z, ia_interval y)
+{
+    if ((z->flags & AA_UNBOUNDED) || !isfinite(y.lo) || !isfinite(y.hi) ||
+        (y.flags & AA_UNBOUNDED))
+        return;
+    if (y.lo > z->lo) z->lo = y.lo;
+    if (y.hi < z->hi) z->hi = y.hi;
+}
+
+/* The hull of the enclosures of the pieces of a box cut at r's lines. */
+static void split_ia(const geom_surface *s, ia_interval u, ia_interval v, const sd_range *r,
+                     geom_ia *out)
+{
+    double cu[3] = { u.lo, u.hi, u.hi }, cv[3] = { v.lo, v.hi, v.hi };
+    int nu = 1, nv = 1;
+    if (!isnan(r->split_u) && r->split_u > u.lo && r->split_u < u.hi)
+        cu[1] = r->split_u, nu = 2;
+    if (!isnan(r->split_v) && r->split_v > v.lo && r->split_v < v.hi)
+        cv[1] = r->split_v, nv = 2;
+    bool first = true;
+    for (int i = 0; i < nu; i++)
+        for (int j = 0; j < nv; j++) {
+            geom_ia g;
+            geom_subdiv_eval_ia(s, ia_make(cu[i], nu == 1 ? u.hi : cu[i + 1]),
+                                ia_make(cv[j], nv == 1 ? v.hi : cv[j + 1]), &g);
+            for (int c = 0; c < 3; c++) {
+                out->P[c] = first ? g.P[c] : ia_hull(out->P[c], g.P[c]);
+                out->dPdu[c] = first ? g.dPdu[c] : ia_hull(out->dPdu[c], g.dPdu[c]);
+                out->dPdv[c] = first ? g.dPdv[c] : ia_hull(out->dPdv[c], g.dPdv[c]);
+                out->Ng[c] = first ? g.Ng[c] : ia_hull(out->Ng[c], g.Ng[c]);
+            }
+            first = false;
+        }
+}
+
+static bool can_split(const sd_range *r, ia_interval u, ia_interval v)
+{
+    return (!isnan(r->split_u) && r->split_u > u.lo && r->split_u < u.hi) ||
+           (!isnan(r->split_v) && r->split_v > v.lo && r->split_v < v.hi);
+}
+
+void geom_subdiv_eval_ia(const geom_surface *s, ia_interval u, ia_interval v, geom_ia *out)
+{
+    sd_range r;
+    find_range(s->subdiv, s->subdiv_face, u.lo, u.hi, v.lo, v.hi, &r);
+    if (!r.regular && can_split(&r, u, v)) {
+        split_ia(s, u, v, &r, out);
+        return;
+    }
+    if (!r.regular) {
+        out->P[0] = ia_make(r.lo.x, r.hi.x);
+        out->P[1] = ia_make(r.lo.y, r.hi.y);
+        out->P[2] = ia_make(r.lo.z, r.hi.z);
+        for (int i = 0; i < 3; i++) out->dPdu[i] = out->dPdv[i] = out->Ng[i] = ia_entire();
+        return;
+    }
+    double k = ldexp(1, r.level);
+    ia_interval su = ia_mul_s(ia_add_s(u, -r.ou), k), sv = ia_mul_s(ia_add_s(v, -r.ov), k);
+    geom_surface b;
+    net_surface(r.net, &b);
+    geom_bicubic_eval_ia(&b, su, sv, out);
+    net_boxes nb;
+    net_bounds(r.net, su, sv, k, &nb);
+    for (int i = 0; i < 3; i++) {
+        out->P[i] = meet_ia(out->P[i], nb.P[i]);
+        out->dPdu[i] = meet_ia(ia_mul_s(out->dPdu[i], k), nb.dPdu[i]);
+        out->dPdv[i] = meet_ia(ia_mul_s(out->dPdv[i], k), nb.dPdv[i]);
+        out->Ng[i] = meet_ia(ia_mul_s(out->Ng[i], k * k), nb.Ng[i]);
+    }
+}
+
+void geom_subdiv_eval_aa(aa_context *ctx, const geom_surface *s, const aa_form *u,
+                         const aa_form *v, geom_aa *out)
+{
+    ia_interval ur = aa_range(u), vr = aa_range(v);
+    sd_range r;
+    find_range(s->subdiv, s->subdiv_face, ur.lo, ur.hi, vr.lo, vr.hi, &r);
+    if (!r.regular && can_split(&r, ur, vr)) {
+        /* a box across quadrant lines (never one of the renderer's dyadic
+         * boxes): the hull of its pieces, without correlation */
+        geom_ia g;
+        split_ia(s, ur, vr, &r, &g);
+        aa_context none;
+        aa_context_init(&none, 0);
+        for (int c = 0; c < 3; c++) {
+            const ia_interval *src[4] = { &g.P[c], &g.dPdu[c], &g.dPdv[c], &g.Ng[c] };
+            aa_form *dst[4] = { &out->P[c], &out->dPdu[c], &out->dPdv[c], &out->Ng[c] };
+            for (int q = 0; q < 4; q++) {
+                if (!isfinite(src[q]->lo) || !isfinite(src[q]->hi))
+                    aa_unbounded(dst[q], AA_UNBOUNDED);
+                else
+                    aa_from_interval(&none, dst[q], *src[q]);
+            }
+        }
+        return;
+    }
+    if (!r.regular) {
+        aa_context none;
+        aa_context_init(&none, 0);
+        aa_from_interval(&none, &out->P[0], ia_make(r.lo.x, r.hi.x));
+        aa_from_interval(&none, &out->P[1], ia_make(r.lo.y, r.hi.y));
+        aa_from_interval(&none, &out->P[2], ia_make(r.lo.z, r.hi.z));
+        for (int i = 0; i < 3; i++) {
+            aa_unbounded(&out->dPdu[i], AA_UNBOUNDED);
+            aa_unbounded(&out->dPdv[i], AA_UNBOUNDED);
+            aa_unbounded(&out->Ng[i], AA_UNBOUNDED);
+        }
+        return;
+    }
+    double k = ldexp(1, r.level);
+    aa_form su, sv;
+    aa_lincomb(ctx, &su, k, u, 0, u, -r.ou * k);
+    aa_lincomb(ctx, &sv, k, v, 0, v, -r.ov * k);
+    geom_surface b;
+    net_surface(r.net, &b);
+    geom_bicubic_eval_aa(ctx, &b, &su, &sv, out);
+    net_boxes nb;
+    net_bounds(r.net, aa_range(&su), aa_range(&sv), k, &nb);
+    for (int i = 0; i < 3; i++) {
+        aa_mul_s(ctx, &out->dPdu[i], &out->dPdu[i], k);
+        aa_mul_s(ctx, &out->dPdv[i], &out->dPdv[i], k);
+        aa_mul_s(ctx, &out->Ng[i], &out->Ng[i], k * k);
+        meet_aa(&out->P[i], nb.P[i]);
+        meet_aa(&out->dPdu[i], nb.dPdu[i]);
+        meet_aa(&out->dPdv[i], nb.dPdv[i]);
+        meet_aa(&out->Ng[i], nb.Ng[i]);
+    }
+}
+
+/* ---- bounds and intersection ---- */
+
+void geom_subdiv_bounds(const geom_surface *s, vec3 *lo, vec3 *hi)
+{
+    sd_local L;
+    sd_local_from_shared(s->subdiv, s->subdiv_face, &L);
+    hull(&L.m, lo, hi);
+}
+
+static bool slab(vec3 o, vec3 d, vec3 lo, vec3 hi, double *t0, double *t1)
+{
+    double a[3] = { o.x, o.y, o.z }, b[3] = { d.x, d.y, d.z };
+    double l[3] = { lo.x, lo.y, lo.z }, h[3] = { hi.x, hi.y, hi.z };
+    for (int i = 0; i < 3; i++) {
+        if (b[i] == 0) {
+            if (a[i] < l[i] || a[i] > h[i]) return false;
+            continue;
+        }
+        double ta = (l[i] - a[i]) / b[i], tb = (h[i] - a[i]) / b[i];
+        if (ta > tb) { double x = ta; ta = tb; tb = x; }
+        if (ta > *t0) *t0 = ta;
+        if (tb < *t1) *t1 = tb;
+        if (*t0 > *t1) return false;
+    }
+    return true;
+}
+
+/* Dyadic cells of the face, nearest first is not needed: every hit found
+ * shrinks tmax. A regular sub-patch is intersected as its Bezier patch;
+ * an irregular cell is split down to 2^-20, where the hull's entry counts
+ * as the hit (within 2^-20 of an extraordinary point). */
+bool geom_subdiv_intersect(const geom_surface *s, vec3 o, vec3 d, double tmin, double tmax,
+                           geom_hit *hit)
+{
+    enum { MAX_CELL_LEVEL = 20, STACK = 3 * MAX_CELL_LEVEL + 8 };
+    struct { double u0, v0; int level; } stack[STACK];
+    int n = 0;
+    stack[n].u0 = stack[n].v0 = 0;
+    stack[n++].level = 0;
+    bool found = false;
+    double best = tmax;
+    while (n > 0) {
+        double u0 = stack[n - 1].u0, v0 = stack[n - 1].v0;
+        int level = stack[--n].level;
+        double side = ldexp(1, -level);
+        sd_range r;
+        find_range(s->subdiv, s->subdiv_face, u0, u0 + side, v0, v0 + side, &r);
+        if (r.regular) {
+            geom_surface b;
+            net_surface(r.net, &b);
+            geom_hit h;
+            if (geom_bicubic_intersect(&b, o, d, tmin, best, &h)) {
+                double k = ldexp(1, -r.level);
+                double hu = r.ou + h.u * k, hv = r.ov + h.v * k;
+                if (hu >= u0 && hu <= u0 + side && hv >= v0 && hv <= v0 + side) {
+                    best = h.t;
+                    hit->t = h.t;
+                    hit->u = hu;
+                    hit->v = hv;
+                    found = true;
+                }
+            }
+            continue;
+        }
+        double t0 = tmin, t1 = best;
+        if (!slab(o, d, r.lo, r.hi, &t0, &t1)) continue;
+        if (level >= MAX_CELL_LEVEL || n + 4 > STACK) {
+            if (t0 > tmin && t0 < best) {
+                best = t0;
+                hit->t = t0;
+                hit->u = u0 + side / 2;
+                hit->v = v0 + side / 2;
+                found = true;
+            }
+            continue;
+        }
+        for (int q = 0; q < 4; q++) {
+            stack[n].u0 = u0 + (q & 1) * side / 2;
+            stack[n].v0 = v0 + (q >> 1) * side / 2;
+            stack[n++].level = level + 1;
+        }
+    }
+    return found;
+}

@@ -1,0 +1,48 @@
+/*
+ * subdiv_internal.h: what the Catmull-Clark files share (subdiv_mesh.c
+ * builds, subdiv_refine.c refines, subdiv_eval.c evaluates): the mesh in
+ * face-corner form and one Catmull-Clark step with DeRose's sharpness
+ * rules.
+ */
+#ifndef GEOM_SUBDIV_INTERNAL_H
+#define GEOM_SUBDIV_INTERNAL_H
+
+#include "geom/subdiv.h"
+
+/* A polygon mesh with sharpness: face f has corners fo[f] .. fo[f+1]-1,
+ * corner c holds the point fv[c] and the sharpness es[c] of the edge from
+ * fv[c] to the next corner's point. vs[i]: corner sharpness of point i.
+ * INFINITY is infinitely sharp. The arrays belong to whoever made the
+ * mesh (heap for the shared mesh, fixed buffers for local refinement). */
+typedef struct sd_mesh {
+    int nv, nf;
+    vec3 *P;
+    double *vs;
+    int *fo;                       /* nf + 1 */
+    int *fv;
+    double *es;
+} sd_mesh;
+
+/* Sizes of one Catmull-Clark step of m: points nv + nf + nedges, faces =
+ * corners of m, corners = 4 * corners of m. */
+int sd_edge_count(const sd_mesh *m);
+
+/* One step: out's arrays must hold the sizes above. New points: the
+ * vertex points of m's points (same indices), then face points (nv + f),
+ * then edge points. Child faces are quads, one per corner, in corner
+ * order; a quad parent's child k covers the parent's quadrant k (0:
+ * [0,.5]^2, 1: u >= .5, 2: both >= .5, 3: v >= .5) with the parent's
+ * u, v directions (face corners 0..3 = (0,0) (1,0) (1,1) (0,1)).
+ * Points whose 1-ring is not complete in m get some value (unused). */
+void sd_refine(const sd_mesh *m, sd_mesh *out);
+
+struct geom_subdiv {
+    sd_mesh m;                     /* level 1: all quads */
+    int *vf_off, *vf;              /* point -> corners holding it (CSR) */
+    unsigned char *drawn;          /* per face */
+    int *origin;                   /* per face: the control face */
+    int *net_of;                   /* per face: index into nets, or -1 */
+    vec3 *nets;                    /* Bezier nets (16 each) of regular faces */
+};
+
+#endif

@@ -1,0 +1,59 @@
+/*
+ * subdiv_local.h: a face of a Catmull-Clark mesh with its 1-ring, copied
+ * into fixed buffers (no allocation while rendering), refined locally
+ * (subdiv_eval.c), tested for regularity and turned into a bicubic Bezier
+ * net where regular (subdiv_regular.c). Face 0 of a local mesh is the face
+ * of interest; the other faces are those that touch its corners.
+ */
+#ifndef GEOM_SUBDIV_LOCAL_H
+#define GEOM_SUBDIV_LOCAL_H
+
+#include "geom/subdiv_internal.h"
+
+enum {
+    SD_LF = 4 * GEOM_SUBDIV_MAX_VALENCE,   /* faces touching a quad's corners */
+    SD_LC = 4 * SD_LF,
+    SD_LV = SD_LC,
+    SD_BV = SD_LV + SD_LF + SD_LC,         /* after one step */
+    SD_BF = SD_LC,
+    SD_BC = 4 * SD_LC,
+};
+
+typedef struct sd_local {
+    sd_mesh m;
+    vec3 P[SD_LV];
+    double vs[SD_LV];
+    int fo[SD_LF + 1];
+    int fv[SD_LC];
+    double es[SD_LC];
+} sd_local;
+
+typedef struct sd_big {
+    sd_mesh m;
+    vec3 P[SD_BV];
+    double vs[SD_BV];
+    int fo[SD_BF + 1];
+    int fv[SD_BC];
+    double es[SD_BC];
+} sd_big;
+
+/* Copies faces list[0..n) of M into L (list[0] becomes face 0). */
+void sd_local_take(sd_local *L, const sd_mesh *M, const int *list, int n);
+
+/* Face f of the shared mesh with its 1-ring. */
+void sd_local_from_shared(const geom_subdiv *sd, int f, sd_local *L);
+
+/* Refines L and makes L the child k (quadrant, subdiv_internal.h) of its
+ * face 0 with that child's 1-ring. big is scratch. */
+void sd_local_child(sd_local *L, int k, sd_big *big);
+
+/* Whether face 0's limit is a uniform bicubic B-spline patch (its 1-ring a
+ * 4x4 grid, boundary and infinitely sharp edges by mirrored points); if so
+ * its Bezier net (verts[4 j + i] order, u along face 0's first edge). */
+bool sd_regular_net(const sd_mesh *L, vec3 net[16]);
+
+/* The limit position of face 0's corner k when no semi-sharp tag touches
+ * it (false otherwise): smooth, crease or corner mask. */
+bool sd_corner_limit(const sd_mesh *L, int k, vec3 *out);
+
+#endif

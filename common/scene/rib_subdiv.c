@@ -1,0 +1,296 @@
+/*
+ * rib_subdiv.c: SubdivisionMesh (RI Specification 3.2 §5.5):
+ *
+ *   SubdivisionMesh "catmull-clark" [nvertices] [vertices]
+ *       [tags] [nargs] [intargs] [floatargs] "P" [...]
+ *
+ * (the four tag arrays may be left out together). Tags: "crease" (a chain
+ * of points, one sharpness), "corner" (points, one sharpness or one each),
+ * "hole" (faces), "interpolateboundary" (no argument, or 1 / 0); other
+ * tags are warned about and ignored. Sharpness >= 10 is infinite.
+ *
+ * The mesh becomes one geom_subdiv (common/geom/subdiv.h), owned by the
+ * scene (scene.subdivs), and every drawn face of its once-refined mesh one
+ * GEOM_SUBDIV object. Primitive variables other than "P" are read and
+ * checked, then ignored with one warning per scene (as on polygon meshes).
+ */
+#include "scene/rib_parser.h"
+#include "sl/strbuf.h"
+
+#ifdef SCENE_HAVE_GEOM
+#include "geom/subdiv.h"
+#endif
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* The whole numbers >= min of array argument i (NULL with an error). An
+ * empty array gives a non-NULL result with *count 0 when allow_empty. */
+static int *ints_of(rib_parser *p, const rib_request *req, int i, int min, bool allow_empty,
+                    int *count, const char *what)
+{
+    if (i >= req->nargs || !rib_arg_is_numeric(&req->args[i])) {
+        rib_error(p, req, i < req->nargs ? req->args[i].pos : req->pos,
+                  "missing %s (an array of whole numbers)", what);
+        return NULL;
+    }
+    int n;
+    const double *v = rib_arg_numbers(req, &req->args[i], &n);
+    if (n == 0 && !allow_empty) {
+        rib_error(p, req, req->args[i].pos, "%s is empty", what);
+        return NULL;
+    }
+    int *out = sl_xrealloc(NULL, (size_t)(n + 1) * sizeof *out);
+    for (int k = 0; k < n; k++) {
+        if (!(v[k] == floor(v[k]) && v[k] >= min && v[k] <= 1e9)) {
+            rib_error(p, req, req->args[i].pos, "%s: entry %d is %g, expected a whole number "
+                      ">= %d", what, k, v[k], min);
+            free(out);
+            return NULL;
+        }
+        out[k] = (int)v[k];
+    }
+    *count = n;
+    return out;
+}
+
+static bool is_array(const rib_arg *a)
+{
+    return a->kind == RIB_ARG_NUMBERS || a->kind == RIB_ARG_STRINGS;
+}
+
+typedef struct subdiv_tags {
+    int *crease_len, *crease_verts, ncreases, ncrease_verts;
+    double *crease_sharp;
+    int *corner_verts, ncorners;
+    double *corner_sharp;
+    int *holes, nholes;
+    bool interpolateboundary;
+} subdiv_tags;
+
+static void tags_free(subdiv_tags *t)
+{
+    free(t->crease_len);
+    free(t->crease_verts);
+    free(t->crease_sharp);
+    free(t->corner_verts);
+    free(t->corner_sharp);
+    free(t->holes);
+}
+
+static void *grow(void *p, int n, size_t size)
+{
+    return sl_xrealloc(p, (size_t)(n + 1) * size);
+}
+
+/* Reads the tag arrays at args first .. first+3 into t; false after an
+ * error. npoints, nfaces check the indices. */
+static bool read_tags(rib_parser *p, const rib_request *req, int first, int npoints,
+                      int nfaces, subdiv_tags *t)
+{
+    const rib_arg *ta = &req->args[first];
+    int ntags = ta->kind == RIB_ARG_STRINGS ? ta->count : 0;
+    if (ta->kind == RIB_ARG_NUMBERS && ta->count > 0) {
+        rib_error(p, req, ta->pos, "the tags must be strings ([\"crease\" \"corner\" ...])");
+        return false;
+    }
+    if (first + 3 >= req->nargs) {
+        rib_error(p, req, ta->pos, "the tags need three more arrays: [nargs] [intargs] "
+                  "[floatargs]");
+        return false;
+    }
+    int nn = 0, ni = 0, nfl = 0;
+    int *nargs = ints_of(p, req, first + 1, 0, true, &nn, "the tag argument counts (nargs)");
+    int *iargs = nargs ? ints_of(p, req, first + 2, 0, true, &ni, "the tag integers (intargs)")
+                       : NULL;
+    bool ok = nargs && iargs;
+    const double *fargs = NULL;
+    if (ok) {
+        if (!rib_arg_is_numeric(&req->args[first + 3])) {
+            rib_error(p, req, req->args[first + 3].pos, "missing the tag floats (floatargs)");
+            ok = false;
+        } else {
+            fargs = rib_arg_numbers(req, &req->args[first + 3], &nfl);
+        }
+    }
+    if (ok && nn != 2 * ntags) {
+        rib_error(p, req, req->args[first + 1].pos, "nargs has %d numbers, expected 2 per tag "
+                  "(%d tags)", nn, ntags);
+        ok = false;
+    }
+    long si = 0, sf = 0;
+    for (int k = 0; ok && k < ntags; k++) si += nargs[2 * k], sf += nargs[2 * k + 1];
+    if (ok && (si != ni || sf != nfl)) {
+        rib_error(p, req, req->args[first + 1].pos, "nargs asks for %ld integers and %ld floats, "
+                  "but intargs has %d and floatargs %d", si, sf, ni, nfl);
+        ok = false;
+    }
+    const int *ip = iargs;
+    const double *fp = fargs;
+    for (int k = 0; ok && k < ntags; k++) {
+        const char *tag = req->strs[ta->first + k];
+        int in = nargs[2 * k], fn = nargs[2 * k + 1];
+        if (strcmp(tag, "crease") == 0) {
+            if (in < 2 || fn != 1) {
+                rib_error(p, req, ta->pos, "tag %d \"crease\" takes 2 or more points and one "
+                          "sharpness, got %d and %d", k, in, fn);
+                ok = false;
+                break;
+            }
+            t->crease_len = grow(t->crease_len, t->ncreases, sizeof(int));
+            t->crease_sharp = grow(t->crease_sharp, t->ncreases, sizeof(double));
+            t->crease_len[t->ncreases] = in;
+            t->crease_sharp[t->ncreases++] = fp[0];
+            t->crease_verts = sl_xrealloc(t->crease_verts,
+                                          (size_t)(t->ncrease_verts + in) * sizeof(int));
+            for (int i = 0; i < in; i++) t->crease_verts[t->ncrease_verts++] = ip[i];
+        } else if (strcmp(tag, "corner") == 0) {
+            if (fn != 1 && fn != in) {
+                rib_error(p, req, ta->pos, "tag %d \"corner\" takes one sharpness or one per "
+                          "point (%d points), got %d", k, in, fn);
+                ok = false;
+                break;
+            }
+            for (int i = 0; i < in; i++) {
+                t->corner_verts = grow(t->corner_verts, t->ncorners, sizeof(int));
+                t->corner_sharp = grow(t->corner_sharp, t->ncorners, sizeof(double));
+                t->corner_verts[t->ncorners] = ip[i];
+                t->corner_sharp[t->ncorners++] = fp[fn == 1 ? 0 : i];
+            }
+        } else if (strcmp(tag, "hole") == 0) {
+            for (int i = 0; i < in; i++) {
+                if (ip[i] >= nfaces) {
+                    rib_error(p, req, ta->pos, "tag %d \"hole\": face %d, but the mesh has %d "
+                              "faces", k, ip[i], nfaces);
+                    ok = false;
+                    break;
+                }
+                t->holes = grow(t->holes, t->nholes, sizeof(int));
+                t->holes[t->nholes++] = ip[i];
+            }
+        } else if (strcmp(tag, "interpolateboundary") == 0) {
+            t->interpolateboundary = in == 0 || ip[0] != 0;
+        } else {
+            rib_warning(p, req, ta->pos, "tag \"%s\" is not supported: ignored", tag);
+        }
+        if (ok && (strcmp(tag, "crease") == 0 || strcmp(tag, "corner") == 0))
+            for (int i = 0; i < in; i++)
+                if (ip[i] >= npoints) {
+                    rib_error(p, req, ta->pos, "tag %d \"%s\": point %d, but \"P\" has %d "
+                              "points", k, tag, ip[i], npoints);
+                    ok = false;
+                    break;
+                }
+        if (ok)
+            for (int i = 0; i < fn; i++)
+                if (!isfinite(fp[i]) || fp[i] < 0) {
+                    rib_error(p, req, ta->pos, "tag %d \"%s\": sharpness %g must be >= 0", k,
+                              tag, fp[i]);
+                    ok = false;
+                    break;
+                }
+        ip += in;
+        fp += fn;
+    }
+    free(nargs);
+    free(iargs);
+    return ok;
+}
+
+void rib_subdivision_mesh(rib_parser *p, const rib_request *req)
+{
+    const char *scheme = rib_read_string(p, req, 0, "the scheme (\"catmull-clark\")");
+    if (!scheme) return;
+    if (strcmp(scheme, "catmull-clark") != 0) {
+        rib_error(p, req, req->args[0].pos, "scheme \"%s\" is not supported (only "
+                  "\"catmull-clark\")", scheme);
+        return;
+    }
+    int nfaces = 0, nidx = 0;
+    int *nverts = ints_of(p, req, 1, 3, false, &nfaces, "the vertex counts (nvertices)");
+    if (!nverts) return;
+    int *idx = ints_of(p, req, 2, 0, false, &nidx, "the vertex indices");
+    subdiv_tags tags;
+    memset(&tags, 0, sizeof tags);
+    rib_params params = { 0 };
+    if (!idx) goto out;
+    long total = 0;
+    for (int f = 0; f < nfaces; f++) total += nverts[f];
+    if (total != nidx) {
+        rib_error(p, req, req->args[2].pos, "the faces have %ld points in all, but %d vertex "
+                  "indices are given", total, nidx);
+        goto out;
+    }
+    int first = 3;
+    bool have_tags = first < req->nargs && is_array(&req->args[first]);
+    if (!rib_params_read(p, req, have_tags ? first + 4 : first, RIB_PARAMS_VARYING, &params))
+        goto out;
+    const scene_param *P = rib_params_find(&params, "P");
+    if (!P) {
+        rib_error(p, req, req->pos, "missing the points: add \"P\" [x y z x y z ...]");
+        goto out;
+    }
+    if (P->type != SL_TYPE_POINT) {
+        rib_error(p, req, P->pos, "\"P\" must be declared as a point, not a %s",
+                  rib_type_name(P->type));
+        goto out;
+    }
+    int npoints = P->count / 3;
+    for (int i = 0; i < nidx; i++)
+        if (idx[i] >= npoints) {
+            rib_error(p, req, P->pos, "\"P\" has %d points, but the vertex indices go up to %d",
+                      npoints, idx[i]);
+            goto out;
+        }
+    if (have_tags && !read_tags(p, req, first, npoints, nfaces, &tags))
+        goto out;
+    if (!p->warned_mesh_vars) {
+        for (int i = 0; i < params.count; i++)
+            if (strcmp(params.items[i].name, "P") != 0) {
+                rib_warning(p, req, params.items[i].pos, "only \"P\" is used on subdivision "
+                            "meshes: \"%s\" ignored (and on the meshes that follow)",
+                            params.items[i].name);
+                p->warned_mesh_vars = true;
+                break;
+            }
+    }
+#ifdef SCENE_HAVE_GEOM
+    {
+        geom_subdiv_desc d = {
+            nfaces, nverts, idx, npoints, P->values,
+            tags.ncreases, tags.crease_len, tags.crease_verts, tags.crease_sharp,
+            tags.ncorners, tags.corner_verts, tags.corner_sharp,
+            tags.nholes, tags.holes, tags.interpolateboundary,
+        };
+        char why[256] = "";
+        geom_subdiv *sd = geom_subdiv_new(&d, why, sizeof why);
+        if (!sd) {
+            rib_error(p, req, req->pos, "%s", why);
+            goto out;
+        }
+        scene *sc = p->scene;
+        sc->subdivs = sl_xrealloc(sc->subdivs, (size_t)(sc->nsubdivs + 1) * sizeof *sc->subdivs);
+        sc->subdivs[sc->nsubdivs++] = sd;
+        int drawn = 0;
+        for (int f = 0; f < geom_subdiv_nfaces(sd) && !sl_diag_full(p->diag); f++) {
+            if (!geom_subdiv_face_drawn(sd, f)) continue;
+            geom_surface s;
+            geom_subdiv_surface(sd, f, &s);
+            rib_add_surface(p, req, &s);
+            drawn++;
+        }
+        if (drawn == 0)
+            rib_warning(p, req, req->pos, "no face to draw (every face is a hole or touches "
+                        "the boundary: add the tag \"interpolateboundary\")");
+    }
+#else
+    rib_error(p, req, req->pos, "subdivision meshes need common/geom");
+#endif
+out:
+    tags_free(&tags);
+    rib_params_free(&params);
+    free(nverts);
+    free(idx);
+}

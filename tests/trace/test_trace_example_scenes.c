@@ -1,0 +1,113 @@
+/*
+ * test_trace_example_scenes.c: the example scenes of issue 14's new
+ * surfaces render: scenes/subdiv.rib (a displaced Catmull-Clark box with
+ * creases and extraordinary points) and scenes/knot.rib (a
+ * displaced closed mesh of 2304 quads), read from the source tree with
+ * their shaders, rendered small (Format replaced) in affine arithmetic:
+ * no error, the object covers the image as its framing says, and 0
+ * pinholes (pinholes.h) on these closed objects.
+ *
+ * The scenes folder is AAFARM_SCENES_DIR (tests/trace/CMakeLists.txt), or
+ * the first argument.
+ */
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <cmocka.h>
+
+#include "fixture.h"
+#include "pinholes.h"
+#include "trace/render.h"
+
+static const char *scenes_dir = AAFARM_SCENES_DIR;
+
+static char *read_text(const char *dir, const char *name)
+{
+    char path[1024];
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    FILE *fp = fopen(path, "rb");
+    if (!fp) fail_msg("cannot read %s", path);
+    fseek(fp, 0, SEEK_END);
+    long n = ftell(fp);
+    fseek(fp, 0, SEEK_SET);
+    char *s = malloc((size_t)n + 1);
+    assert_non_null(s);
+    assert_int_equal(fread(s, 1, (size_t)n, fp), (size_t)n);
+    s[n] = '\0';
+    fclose(fp);
+    return s;
+}
+
+enum { W = 64, H = 48 };
+
+/* Renders scene `name` at W x H with shaders `names`; returns the opaque
+ * pixel count, *holes the pinholes. */
+static int render_scene(const char *name, const char *const *names, int nnames, int *holes)
+{
+    char *rib = read_text(scenes_dir, name);
+    char *fmt = strstr(rib, "Format 320 240 1");
+    assert_non_null(fmt);
+    char small[32];
+    int n = snprintf(small, sizeof small, "Format %d %d 1", W, H);
+    memset(fmt, ' ', strlen("Format 320 240 1"));
+    memcpy(fmt, small, (size_t)n);
+    char shader_dir[1024];
+    snprintf(shader_dir, sizeof shader_dir, "%s/shaders", scenes_dir);
+    fixture_shader sh[8];
+    char *src[8];
+    for (int i = 0; i < nnames; i++) {
+        char file[64];
+        snprintf(file, sizeof file, "%s.sl", names[i]);
+        src[i] = read_text(shader_dir, file);
+        sh[i] = (fixture_shader){names[i], src[i]};
+    }
+    fixture f;
+    assert_true(fixture_open(&f, rib, sh, nnames, NULL, 0));
+    trace_thread *th = trace_thread_new(&f.js->world);
+    float *rgba = calloc((size_t)W * H * 4, sizeof *rgba), *z = calloc((size_t)W * H, sizeof *z);
+    assert_true(trace_render_tile(f.js->renderer, th, 0, 0, W, H, rgba, z));
+    *holes = count_pinholes(rgba, W, H);
+    int opaque = count_opaque(rgba, W, H);
+    printf("%s at %dx%d: %d opaque pixels, %d pinholes\n", name, W, H, opaque, *holes);
+    free(rgba);
+    free(z);
+    trace_thread_destroy(&th);
+    fixture_close(&f);
+    for (int i = 0; i < nnames; i++) free(src[i]);
+    free(rib);
+    return opaque;
+}
+
+static void test_subdiv_scene(void **state)
+{
+    (void)state;
+    static const char *const names[] = {"plastic", "lumpy"};
+    int holes, opaque = render_scene("subdiv.rib", names, 2, &holes);
+    assert_int_equal(holes, 0);
+    assert_true(opaque > W * H / 6);      /* the box fills the middle of the frame */
+    assert_true(opaque < W * H / 2);
+}
+
+static void test_knot_scene(void **state)
+{
+    (void)state;
+    static const char *const names[] = {"plastic", "dented"};
+    int holes, opaque = render_scene("knot.rib", names, 2, &holes);
+    assert_int_equal(holes, 0);
+    assert_true(opaque > W * H / 8);
+    assert_true(opaque < W * H / 2);      /* a tube: the knot's holes show */
+}
+
+int main(int argc, char **argv)
+{
+    if (argc > 1) scenes_dir = argv[1];
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_subdiv_scene),
+        cmocka_unit_test(test_knot_scene),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
