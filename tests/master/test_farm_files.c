@@ -19,7 +19,10 @@
  *     budget); one changed after the master loaded the job fails the
  *     render with a message naming it;
  *   - a peer asking for more than 64 MiB beyond what it says it received
- *     is not served beyond that.
+ *     is not served beyond that;
+ *   - a shader that reads the file with texture() (a height map: an EXR
+ *     this test renders first) renders on the farm equal to standalone,
+ *     the worker reading the map from its store (issue 16).
  */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -307,6 +310,58 @@ static void test_files_travel_once_per_host(void **state)
     free(d);
 }
 
+/* A copy of file from to file to. */
+static void copy_file(const char *from, const char *to)
+{
+    size_t n = 0;
+    FILE *in = fopen(from, "rb"), *out = fopen(to, "wb");
+    assert_non_null(in);
+    assert_non_null(out);
+    char buf[65536];
+    size_t got;
+    while ((got = fread(buf, 1, sizeof buf, in)) > 0) n += fwrite(buf, 1, got, out);
+    fclose(in);
+    assert_int_equal(fclose(out), 0);
+    assert_true(n > 0);
+}
+
+static void test_texture_map_on_the_farm(void **state)
+{
+    (void)state;
+    /* the map: the first case's standalone render (an RGBA EXR), shipped
+     * under the name the scene gives, read through its first channel */
+    char *src = make_case("texsrc", 0.1);
+    assert_int_equal(ft_standalone(src, 8), 0);
+    char *d = make_case("texmap", 0.2);
+    write_text(ft_path(d, "shaders/hmap.sl"),
+               "/* a height map read with texture(): height times Km along N */\n"
+               "displacement hmap(float Km = 0.1; string texname = \"\")\n"
+               "{\n"
+               "    float h = float texture(texname, s, t, \"blur\", 0.01);\n"
+               "    P += Km * h * normalize(N);\n"
+               "    N = calculatenormal(P);\n"
+               "}\n");
+    copy_file(ft_path(src, "ref.exr"), ft_path(d, "maps/height.dat"));
+    struct stat st;
+    assert_int_equal(stat(ft_path(d, "maps/height.dat"), &st), 0);
+    assert_int_equal(ft_standalone(d, 8), 0);
+    char *cache = strdup(ft_path(d, "cache"));
+    char ep[256];
+    pid_t m = start_master(d, "1", ep, sizeof ep);
+    pid_t w = start_worker(d, "w1", ep, cache, NULL);
+    expect_master_ok(d, "1", m);
+    assert_int_equal(ft_exr_diff(ft_path(d, "ref.exr"), ft_path(d, "farm-1.exr")), 0);
+    const char *stats = ft_path(d, "stats-1.json");
+    assert_int_equal(ft_json_number(stats, "files"), 1);
+    assert_int_equal(ft_json_number(stats, "file_bytes_sent"), (long)st.st_size);
+    /* the map changes the surface: the render differs from one without it */
+    assert_true(ft_exr_diff(ft_path(src, "ref.exr"), ft_path(d, "ref.exr")) > 0);
+    stop_worker(w);
+    free(cache);
+    free(d);
+    free(src);
+}
+
 static void test_two_workers_share_one_store(void **state)
 {
     (void)state;
@@ -576,6 +631,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_killed_worker_loses_nothing),
         cmocka_unit_test(test_changed_file),
         cmocka_unit_test(test_greedy_peer_is_capped),
+        cmocka_unit_test(test_texture_map_on_the_farm),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }
