@@ -6,6 +6,8 @@
 #   QUICK=1 bash bench/peers/run.sh    the smoke run: wave only, 1 run each,
 #                                      coarser reference, Embree N <= 512
 #   SCENES="wave nail" RUNS=7 ...      override the scenes / runs
+#   RUNS_dented=1 ...                  the runs of one scene (the table's
+#                                      "runs" column says what was done)
 #
 # It installs the peers (deploy/install-bench-deps.sh), builds aafarm and
 # the helpers in build-bench/, and for each scene of bench/peers/scenes/:
@@ -92,8 +94,10 @@ field() { awk -v k="$1" '{for (i = 1; i < NF; i++) if ($i == k) {print $(i + 1);
 # median NAME [COL]: median of column COL (2: cpu, 3: rss) of $WORK/times rows NAME
 median() {
   awk -v n="$1" -v c="${2:-2}" '$1 == n && $4 == 0 {print $c}' "$WORK/times" | sort -g |
-    awk '{v[NR] = $1} END {if (NR == 0) print "-"; else if (NR % 2) print v[(NR + 1) / 2];
-                         else print (v[NR / 2] + v[NR / 2 + 1]) / 2}'
+    awk -v c="${2:-2}" '{v[NR] = $1} END {
+      if (NR == 0) {print "-"; exit}
+      m = NR % 2 ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2
+      if (c == 2) printf "%.3f\n", m; else print m}'
 }
 count() { awk -v n="$1" '$1 == n && $4 == 0' "$WORK/times" | wc -l; }
 
@@ -183,8 +187,10 @@ for s in $SCENES; do
   fi
 
   # the timed rounds: aafarm, then each peer once
-  for ((r = 1; r <= RUNS; r++)); do
-    say "$s: round $r of $RUNS"
+  runs_var=RUNS_$s
+  runs=${!runs_var:-$RUNS}
+  for ((r = 1; r <= runs; r++)); do
+    say "$s: round $r of $runs"
     run "$s.aafarm" "$D/worker.log" "$BIN/aafarm-worker" --standalone "$RIB" -o "$D/worker.exr" \
       --threads 1 --stats -q
     for i in "${!povs[@]}"; do
@@ -201,7 +207,7 @@ for s in $SCENES; do
   aa_cpu=$(median "$s.aafarm")
   ratio() { awk -v a="$aa_cpu" -v p="$1" 'BEGIN {if (p == "-" || a == "-" || p <= 0) print "-"; else printf "%.2fx", a / p}'; }
   mib() { awk -v k="$1" 'BEGIN {if (k == "-") print "-"; else printf "%.1f", k / 1024}'; }
-  echo "$s|aafarm|worker, 1 thread; image: same renderer at pixel centres|$aa_cpu|$(count "$s.aafarm")|1|$(mib "$(median "$s.aafarm" 3)")|$aa_data (box cache)|$aa_d ($aa_h/$aa_e/$aa_c)" >>"$WORK/table"
+  echo "$s|aafarm|worker, 1 thread; image: same renderer at pixel centres|$aa_cpu|$(count "$s.aafarm")|1.00x|$(mib "$(median "$s.aafarm" 3)")|$aa_data (box cache)|$aa_d ($aa_h/$aa_e/$aa_c)" >>"$WORK/table"
   for i in "${!povs[@]}"; do
     read -r d h e c < <(compare "$D/pov$i.png" "$povref")
     p=$(median "$s.pov$i")
