@@ -5,19 +5,18 @@
  *
  *   peers_compare TEST.png REF.png [--tol T] [--diff OUT.png]
  *
- * A pixel differs when its hit mask differs (alpha on different sides of
- * 1/2) or, hit in both, when a colour channel differs by more than T
- * (default 8/255, a visible step in an 8-bit image). Prints one line:
+ * A pixel differs as peers_diff.h says, with tol T (default 8/255, a
+ * visible step in an 8-bit image). Prints one line:
  * "differ D holes M extra E colour C pixels P", where holes are pixels the
  * reference hits and TEST misses, extra the reverse, colour the pixels hit
  * in both whose colour differs. --diff writes a picture of them: TEST's
  * grey level, holes red, extra pixels blue, colour differences yellow.
  */
-#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "peers_diff.h"
 #include "peers_png.h"
 
 int main(int argc, char **argv)
@@ -59,35 +58,16 @@ int main(int argc, char **argv)
         free(b);
         return 1;
     }
-    long holes = 0, extra = 0, colour = 0;
     float *pic = diff ? calloc((size_t)w * (size_t)h * 4, sizeof *pic) : NULL;
     if (diff && !pic) abort();
-    for (size_t i = 0; i < (size_t)w * (size_t)h; i++) {
-        const float *p = &a[i * 4], *q = &b[i * 4];
-        int hp = p[3] > 0.5f, hq = q[3] > 0.5f, kind = 0;
-        if (hq && !hp) holes++, kind = 1;
-        else if (hp && !hq) extra++, kind = 2;
-        else if (hp && hq) {
-            for (int k = 0; k < 3; k++)
-                if (fabs((double)p[k] - (double)q[k]) > tol) {
-                    colour++, kind = 3;
-                    break;
-                }
-        }
-        if (pic) {
-            static const float mark[4][3] = {{0, 0, 0}, {1, 0, 0}, {0, 0, 1}, {1, 1, 0}};
-            float grey = (p[0] + p[1] + p[2]) / 3;
-            for (int k = 0; k < 3; k++) pic[i * 4 + k] = kind ? mark[kind][k] : grey;
-            pic[i * 4 + 3] = 1;
-        }
-    }
+    peers_diff d = peers_diff_images(a, b, w, h, tol, pic);
     if (pic) {
         if (!peers_png_write(diff, w, h, pic, err, sizeof err))
             fprintf(stderr, "peers_compare: %s\n", err);
         free(pic);
     }
-    printf("differ %ld holes %ld extra %ld colour %ld pixels %ld\n", holes + extra + colour,
-           holes, extra, colour, (long)w * h);
+    printf("differ %ld holes %ld extra %ld colour %ld pixels %ld\n", d.holes + d.extra + d.colour,
+           d.holes, d.extra, d.colour, (long)w * h);
     free(a);
     free(b);
     return 0;
