@@ -123,6 +123,7 @@ pov() { # pov SCENE MG ACC OUT.png LOG -> timed through run by the caller
 : >"$WORK/table"      # scene|renderer|setting|cpu|runs|ratio|rss MiB|data MiB|differ (holes/extra/colour)
 : >"$WORK/sweep"      # scene N cpu tess build trace vertexMiB bvhMiB differ aafarm_cpu aafarm_data
 : >"$WORK/headline"
+: >"$WORK/leaves"
 
 for s in $SCENES; do
   D=$WORK/$s
@@ -207,6 +208,7 @@ for s in $SCENES; do
   aa_cpu=$(median "$s.aafarm")
   ratio() { awk -v a="$aa_cpu" -v p="$1" 'BEGIN {if (p == "-" || a == "-" || p <= 0) print "-"; else printf "%.2fx", a / p}'; }
   mib() { awk -v k="$1" 'BEGIN {if (k == "-") print "-"; else printf "%.1f", k / 1024}'; }
+  echo "$s $leaf" >>"$WORK/leaves"
   echo "$s|aafarm|worker, 1 thread; image: same renderer at pixel centres|$aa_cpu|$(count "$s.aafarm")|1.00x|$(mib "$(median "$s.aafarm" 3)")|$aa_data (box cache)|$aa_d ($aa_h/$aa_e/$aa_c)" >>"$WORK/table"
   for i in "${!povs[@]}"; do
     read -r d h e c < <(compare "$D/pov$i.png" "$povref")
@@ -279,6 +281,7 @@ done
   echo "colour (> 8/255) differs from the reference, as (holes/extra/colour); POV-Ray's"
   echo "dented against its own render at 4x the gradient, accuracy 1e-6 (its noise is"
   echo "not aafarm's). N\\*: the smallest N whose differ is at most aafarm's."
+  echo "Reference: aafarm (peers_aafarm) with boxes down to $(awk '{printf "%s%s %s", (NR > 1 ? ", " : ""), $1, $2}' "$WORK/leaves") pixel."
   echo
   echo "| scene | renderer | setting | CPU s | runs | aafarm / peer | peak RSS MiB | data MiB | differ (holes/extra/colour) |"
   echo "|---|---|---|---|---|---|---|---|---|"
@@ -320,12 +323,12 @@ if [ -z "$QUICK" ] || [ -n "${WRITE_DOCS:-}" ]; then
   if grep -q '<!-- bench-peers-headline:begin -->' "$readme"; then
     line=$(awk -F'|' -v d="$DATE" '
       $2 == "POV-Ray" {pov[$1] = $3; holes[$1] = $4; order[++n] = $1}
-      $2 == "Embree" {emb[$1] = $4 " at " $3; mem[$1] = $5 " MiB vertices+BVH vs " $6 " MiB box cache"}
+      $2 == "Embree" {emb[$1] = $4 " at " $3; mem[$1] = "Embree vertices+BVH " $5 " MiB, aafarm box cache " $6 " MiB"}
       END {
         printf "Measured on %s, this machine, one thread each; aafarm CPU / peer CPU (above 1x: aafarm is slower):", d
         for (i = 1; i <= n; i++) {
           s = order[i]
-          printf " **%s**: %s POV-Ray at its max_gradient (POV-Ray: %s pixels differ), %s Embree (%s)%s", s, pov[s], holes[s], emb[s], mem[s], i < n ? ";" : "."
+          printf " **%s**: POV-Ray at its max_gradient %s (%s of its pixels differ), Embree %s (%s)%s", s, pov[s], holes[s], emb[s], mem[s], (i < n ? ";" : ".")
         }
         print ""
       }' "$WORK/headline")
