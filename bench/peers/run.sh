@@ -13,10 +13,9 @@
 # the helpers in build-bench/, and for each scene of bench/peers/scenes/:
 #
 #   reference   aafarm's renderer at a fine setting (peers_aafarm --leaf:
-#               boxes of 1/16 pixel, 1/4 for dented to keep its cost
-#               bearable), one ray per pixel centre: the only method here
-#               that cannot miss surface (the nail's walls included), with
-#               shading within 1/32 (1/8) pixel of the true hit
+#               boxes of 1/16 pixel; QUICK: 1/4), one ray per pixel centre:
+#               the only method here that cannot miss surface (the nail's
+#               walls included), with shading within 1/32 pixel of the hit
 #   aafarm      aafarm-worker --standalone --threads 1 (timed), and the same
 #               renderer at pixel centres (peers_aafarm, compared)
 #   POV-Ray     bench/peers/pov/SCENE.pov, an isosurface of the same
@@ -131,7 +130,6 @@ for s in $SCENES; do
   cp "$ROOT/bench/peers/pov/$s.pov" "$ROOT/bench/peers/pov/peers_common.inc" "$D/"
   RIB=$ROOT/bench/peers/scenes/$s.rib
   leaf=$REF_LEAF
-  [ "$s" = dented ] && [ -z "$QUICK" ] && leaf=0.25
   say "$s: reference (aafarm, boxes of $leaf pixel)"
   run "$s.ref" "$D/ref.log" "$BIN/peers_aafarm" "$RIB" "$D/ref.png" --leaf "$leaf"
   say "$s: aafarm at pixel centres"
