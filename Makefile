@@ -3,11 +3,14 @@
 #   make test            install dependencies, build with -Werror, run every test
 #   make test-sanitize   the same tests under AddressSanitizer + UBSan
 #   make bench           build and run the benchmarks (figures, not tests)
+#   make bench-peers     aafarm against POV-Ray and Embree on the same surfaces:
+#                        installs them, prints the table, writes it into
+#                        docs/benchmarks.md (QUICK=1: a ~2 minute smoke run)
 # Everything else is plain CMake: cmake -S . -B build && cmake --build build
 MAKEFLAGS += --no-print-directory
 JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 
-.PHONY: all deps build demo test test-sanitize bench clean
+.PHONY: all deps build demo test test-sanitize bench bench-peers clean
 
 all: build
 
@@ -36,5 +39,8 @@ bench: build
 	@build/bin/aa_bench
 	@build/bin/render_bench
 
+bench-peers: deps
+	@QUICK=$(QUICK) bash bench/peers/run.sh
+
 clean:
-	rm -rf build build-test build-asan
+	rm -rf build build-test build-asan build-bench
