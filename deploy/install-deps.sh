@@ -3,7 +3,12 @@
 # tests and demo need. Idempotent: quiet when everything is present, one apt
 # transaction when something is missing, a clear message when it cannot
 # install (not root, no apt-get). Debian 12 (bookworm) is the reference.
+#
+#   deploy/install-deps.sh           the build, the tests, the demo, CI
+#   deploy/install-deps.sh --bench   the peer benchmark's packages instead
+#                                    (make bench-peers; never CI)
 set -euo pipefail
+NAME=install-deps
 
 # One list, one place. Keep README and docs/building.md in step with it.
 PACKAGES=(
@@ -25,6 +30,19 @@ PACKAGES=(
   libclang-rt-14-dev  # libFuzzer and the sanitizer runtimes for clang 14
 )
 
+if [ "${1:-}" = "--bench" ]; then
+  NAME=install-bench-deps
+  PACKAGES=(
+    povray            # POV-Ray 3.7: isosurface peer
+    povray-includes   # its functions.inc (f_noise3d of the dented scene)
+    libembree-dev     # Embree 3 C API: tessellation peer
+    gnuplot-nox       # the plot of docs/benchmarks.md
+  )
+elif [ $# -gt 0 ]; then
+  echo "$NAME: usage: $0 [--bench]" >&2
+  exit 2
+fi
+
 missing=()
 for p in "${PACKAGES[@]}"; do
   if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
@@ -36,19 +54,19 @@ if [ ${#missing[@]} -eq 0 ]; then
   exit 0
 fi
 
-echo "install-deps: missing Debian packages: ${missing[*]}"
+echo "$NAME: missing Debian packages: ${missing[*]}"
 if ! command -v apt-get >/dev/null 2>&1; then
-  echo "install-deps: error: apt-get not found; this script supports Debian 12 and derivatives." >&2
-  echo "install-deps: install the packages above with your system's package manager, then re-run." >&2
+  echo "$NAME: error: apt-get not found; this script supports Debian 12 and derivatives." >&2
+  echo "$NAME: install the packages above with your system's package manager, then re-run." >&2
   exit 1
 fi
 SUDO=""
 if [ "$(id -u)" -ne 0 ]; then
   if command -v sudo >/dev/null 2>&1 && { [ -t 0 ] || sudo -n true 2>/dev/null; }; then
     SUDO="sudo"
-    echo "install-deps: not root; using sudo"
+    echo "$NAME: not root; using sudo"
   else
-    echo "install-deps: error: installing packages needs root (and sudo is not usable here)." >&2
+    echo "$NAME: error: installing packages needs root (and sudo is not usable here)." >&2
     echo "  as root, run: apt-get install -y ${missing[*]}" >&2
     exit 1
   fi
@@ -56,4 +74,4 @@ fi
 export DEBIAN_FRONTEND=noninteractive
 $SUDO apt-get update -qq
 $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
-echo "install-deps: installed ${#missing[@]} package(s)."
+echo "$NAME: installed ${#missing[@]} package(s)."

@@ -49,32 +49,6 @@ void file_server_destroy(file_server **self_p)
     *self_p = NULL;
 }
 
-/* Hashes the whole open file; false on a read error. */
-static bool hash_fd(int fd, char hex[HASH_HEX_SIZE], uint64_t *len)
-{
-    enum { CHUNK = 1 << 20 };
-    unsigned char *buf = malloc(CHUNK);
-    if (!buf) abort();
-    sha256 h;
-    sha256_init(&h);
-    uint64_t off = 0;
-    bool ok = true;
-    for (;;) {
-        ssize_t n = pread(fd, buf, CHUNK, (off_t)off);
-        if (n < 0 && errno == EINTR) continue;
-        if (n < 0) { ok = false; break; }
-        if (n == 0) break;
-        sha256_update(&h, buf, (size_t)n);
-        off += (uint64_t)n;
-    }
-    free(buf);
-    uint8_t digest[SHA256_DIGEST_SIZE];
-    sha256_final(&h, digest);
-    hash_hex(digest, hex);
-    *len = off;
-    return ok;
-}
-
 static bool same_stat(const struct stat *a, const struct stat *b)
 {
     return a->st_size == b->st_size && a->st_mtim.tv_sec == b->st_mtim.tv_sec &&

@@ -110,32 +110,6 @@ void file_store_close(file_store **self_p)
 
 const char *file_store_dir(const file_store *self) { return self->dir; }
 
-/* SHA-256 of everything readable from fd, as hex; false on a read error. */
-static bool hash_fd(int fd, char hex[HASH_HEX_SIZE], uint64_t *len)
-{
-    enum { CHUNK = 1 << 20 };
-    unsigned char *buf = malloc(CHUNK);
-    if (!buf) abort();
-    sha256 h;
-    sha256_init(&h);
-    uint64_t off = 0;
-    bool ok = true;
-    for (;;) {
-        ssize_t n = pread(fd, buf, CHUNK, (off_t)off);
-        if (n < 0 && errno == EINTR) continue;
-        if (n < 0) { ok = false; break; }
-        if (n == 0) break;
-        sha256_update(&h, buf, (size_t)n);
-        off += (uint64_t)n;
-    }
-    free(buf);
-    uint8_t digest[SHA256_DIGEST_SIZE];
-    sha256_final(&h, digest);
-    hash_hex(digest, hex);
-    if (len) *len = off;
-    return ok;
-}
-
 static bool is_verified(const file_store *s, const char *sha)
 {
     for (size_t i = 0; i < s->nverified; i++)

@@ -10,8 +10,10 @@
  */
 #include "util/hash.h"
 
+#include <errno.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 /* ---------------------------------------------------------------------- */
 /* SHA-256                                                                 */
@@ -295,4 +297,29 @@ int hash_job(const hash_job_input *job, char hex[HASH_HEX_SIZE])
     sha256_final(&ctx, digest);
     hash_hex(digest, hex);
     return 0;
+}
+
+bool hash_fd(int fd, char hex[HASH_HEX_SIZE], uint64_t *len)
+{
+    enum { CHUNK = 1 << 20 };
+    unsigned char *buf = malloc(CHUNK);
+    if (!buf) abort();
+    sha256 h;
+    sha256_init(&h);
+    uint64_t off = 0;
+    bool ok = true;
+    for (;;) {
+        ssize_t n = pread(fd, buf, CHUNK, (off_t)off);
+        if (n < 0 && errno == EINTR) continue;
+        if (n < 0) { ok = false; break; }
+        if (n == 0) break;
+        sha256_update(&h, buf, (size_t)n);
+        off += (uint64_t)n;
+    }
+    free(buf);
+    uint8_t digest[SHA256_DIGEST_SIZE];
+    sha256_final(&h, digest);
+    hash_hex(digest, hex);
+    if (len) *len = off;
+    return ok;
 }

@@ -66,6 +66,11 @@ void hash_hex(const uint8_t digest[SHA256_DIGEST_SIZE], char hex[HASH_HEX_SIZE])
 /* True when s is exactly 64 lowercase hex digits (a hash_hex output). */
 bool hash_hex_valid(const char *s);
 
+/* SHA-256 of everything readable from the open file fd (read with pread
+ * from offset 0, in 1 MiB pieces), as hex; *len (may be NULL) gets the
+ * bytes read. False on a read error. */
+bool hash_fd(int fd, char hex[HASH_HEX_SIZE], uint64_t *len);
+
 /* ---- the job hash ---- */
 
 typedef struct hash_shader {

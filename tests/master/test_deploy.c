@@ -197,7 +197,8 @@ static void test_slurm_script_with_stand_in_srun(void **state)
     int rc = sh("slurm.log",
                 "cd %s && PATH=%s/slurmbin:$PATH SLURM_JOB_ID=4242 SLURM_JOB_NUM_NODES=2 "
                 "SLURM_JOB_NODELIST=127.0.0.1,127.0.0.1 SLURM_SUBMIT_DIR=%s AAFARM_BIN=%s "
-                "AAFARM_PORT=%d AAFARM_BIND_HOST=127.0.0.1 AAFARM_WORKER_OPTS=\"--threads 1\" "
+                "AAFARM_PORT=%d AAFARM_BIND_HOST=127.0.0.1 "
+                "AAFARM_WORKER_OPTS=\"--threads 1 --tile-delay 150\" "   /* both workers join */
                 "FAKE_SRUN_LOG=%s/srun.log bash %s/deploy/slurm/aafarm.sbatch scene.rib slurm.exr "
                 "--tile 16", dir, dir, dir, bindir, port, dir, src);
     const char *log = ft_path(dir, "slurm.log");
