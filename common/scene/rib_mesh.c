@@ -37,36 +37,6 @@
 
 enum { RIB_MAX_FACE_POINTS = 10000 };
 
-/* The integers of a numeric argument (an array of whole numbers >= min);
- * NULL with an error naming `what`. The caller frees. */
-static int *read_ints(rib_parser *p, const rib_request *req, int i, int min, int *count,
-                      const char *what)
-{
-    if (i >= req->nargs || !rib_arg_is_numeric(&req->args[i])) {
-        rib_error(p, req, i < req->nargs ? req->args[i].pos : req->pos,
-                  "missing %s (an array of whole numbers)", what);
-        return NULL;
-    }
-    int n;
-    const double *v = rib_arg_numbers(req, &req->args[i], &n);
-    if (n == 0) {
-        rib_error(p, req, req->args[i].pos, "%s is empty", what);
-        return NULL;
-    }
-    int *out = sl_xrealloc(NULL, (size_t)n * sizeof *out);
-    for (int k = 0; k < n; k++) {
-        if (!(v[k] == floor(v[k]) && v[k] >= min && v[k] <= 1e9)) {
-            rib_error(p, req, req->args[i].pos, "%s: entry %d is %g, expected a whole number "
-                      ">= %d", what, k, v[k], min);
-            free(out);
-            return NULL;
-        }
-        out[k] = (int)v[k];
-    }
-    *count = n;
-    return out;
-}
-
 static long sum(const int *v, int n)
 {
     long s = 0;
@@ -307,7 +277,7 @@ static void read_mesh(rib_parser *p, const rib_request *req, const int *nloops, 
                       const int *nverts, int nnverts, int first_vertices)
 {
     int nidx;
-    int *idx = read_ints(p, req, first_vertices, 0, &nidx, "the vertex indices");
+    int *idx = rib_read_ints(p, req, first_vertices, 0, false, &nidx, "the vertex indices");
     if (!idx)
         return;
     rib_params params = { 0 };
@@ -370,7 +340,7 @@ out:
 void rib_points_polygons(rib_parser *p, const rib_request *req)
 {
     int nfaces;
-    int *nverts = read_ints(p, req, 0, 3, &nfaces, "the vertex counts (nvertices)");
+    int *nverts = rib_read_ints(p, req, 0, 3, false, &nfaces, "the vertex counts (nvertices)");
     if (!nverts)
         return;
     read_mesh(p, req, NULL, nfaces, nverts, nfaces, 1);
@@ -382,7 +352,7 @@ void rib_points_polygons(rib_parser *p, const rib_request *req)
 void rib_general_polygon(rib_parser *p, const rib_request *req)
 {
     int nloops;
-    int *nverts = read_ints(p, req, 0, 3, &nloops, "the vertex counts (nvertices)");
+    int *nverts = rib_read_ints(p, req, 0, 3, false, &nloops, "the vertex counts (nvertices)");
     if (!nverts)
         return;
     rib_params params;
@@ -421,10 +391,10 @@ void rib_general_polygon(rib_parser *p, const rib_request *req)
 void rib_points_general_polygons(rib_parser *p, const rib_request *req)
 {
     int nfaces, nnverts;
-    int *nloops = read_ints(p, req, 0, 1, &nfaces, "the loop counts (nloops)");
+    int *nloops = rib_read_ints(p, req, 0, 1, false, &nfaces, "the loop counts (nloops)");
     if (!nloops)
         return;
-    int *nverts = read_ints(p, req, 1, 3, &nnverts, "the vertex counts (nvertices)");
+    int *nverts = rib_read_ints(p, req, 1, 3, false, &nnverts, "the vertex counts (nvertices)");
     if (nverts && sum(nloops, nfaces) != nnverts)
         rib_error(p, req, req->args[1].pos, "the faces have %ld loops in all, but %d vertex "
                   "counts are given", sum(nloops, nfaces), nnverts);

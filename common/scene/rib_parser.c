@@ -92,6 +92,36 @@ int rib_read_numbers(rib_parser *p, const rib_request *req, int first, int n,
     return i;
 }
 
+/* The whole numbers >= min of array argument i (NULL with an error). An
+ * empty array gives a non-NULL result with *count 0 when allow_empty. */
+int *rib_read_ints(rib_parser *p, const rib_request *req, int i, int min, bool allow_empty,
+                    int *count, const char *what)
+{
+    if (i >= req->nargs || !rib_arg_is_numeric(&req->args[i])) {
+        rib_error(p, req, i < req->nargs ? req->args[i].pos : req->pos,
+                  "missing %s (an array of whole numbers)", what);
+        return NULL;
+    }
+    int n;
+    const double *v = rib_arg_numbers(req, &req->args[i], &n);
+    if (n == 0 && !allow_empty) {
+        rib_error(p, req, req->args[i].pos, "%s is empty", what);
+        return NULL;
+    }
+    int *out = sl_xrealloc(NULL, (size_t)(n + 1) * sizeof *out);
+    for (int k = 0; k < n; k++) {
+        if (!(v[k] == floor(v[k]) && v[k] >= min && v[k] <= 1e9)) {
+            rib_error(p, req, req->args[i].pos, "%s: entry %d is %g, expected a whole number "
+                      ">= %d", what, k, v[k], min);
+            free(out);
+            return NULL;
+        }
+        out[k] = (int)v[k];
+    }
+    *count = n;
+    return out;
+}
+
 const char *rib_read_string(rib_parser *p, const rib_request *req, int i, const char *what)
 {
     if (i >= req->nargs) {

@@ -153,6 +153,12 @@ const char *rib_parser_intern(rib_parser *p, const char *s);
 int rib_read_numbers(rib_parser *p, const rib_request *req, int first, int n,
                      double *out, const char *what);
 
+/* The whole numbers >= min of array argument i, malloc'd (the caller
+ * frees), *count of them; NULL with an error naming `what`. An empty array
+ * gives a non-NULL result with *count 0 when allow_empty, else an error. */
+int *rib_read_ints(rib_parser *p, const rib_request *req, int i, int min, bool allow_empty,
+                   int *count, const char *what);
+
 /* Reads one string argument at index `i` named `what`; NULL after an
  * error. */
 const char *rib_read_string(rib_parser *p, const rib_request *req, int i, const char *what);

@@ -26,36 +26,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* The whole numbers >= min of array argument i (NULL with an error). An
- * empty array gives a non-NULL result with *count 0 when allow_empty. */
-static int *ints_of(rib_parser *p, const rib_request *req, int i, int min, bool allow_empty,
-                    int *count, const char *what)
-{
-    if (i >= req->nargs || !rib_arg_is_numeric(&req->args[i])) {
-        rib_error(p, req, i < req->nargs ? req->args[i].pos : req->pos,
-                  "missing %s (an array of whole numbers)", what);
-        return NULL;
-    }
-    int n;
-    const double *v = rib_arg_numbers(req, &req->args[i], &n);
-    if (n == 0 && !allow_empty) {
-        rib_error(p, req, req->args[i].pos, "%s is empty", what);
-        return NULL;
-    }
-    int *out = sl_xrealloc(NULL, (size_t)(n + 1) * sizeof *out);
-    for (int k = 0; k < n; k++) {
-        if (!(v[k] == floor(v[k]) && v[k] >= min && v[k] <= 1e9)) {
-            rib_error(p, req, req->args[i].pos, "%s: entry %d is %g, expected a whole number "
-                      ">= %d", what, k, v[k], min);
-            free(out);
-            return NULL;
-        }
-        out[k] = (int)v[k];
-    }
-    *count = n;
-    return out;
-}
-
 static bool is_array(const rib_arg *a)
 {
     return a->kind == RIB_ARG_NUMBERS || a->kind == RIB_ARG_STRINGS;
@@ -102,8 +72,8 @@ static bool read_tags(rib_parser *p, const rib_request *req, int first, int npoi
         return false;
     }
     int nn = 0, ni = 0, nfl = 0;
-    int *nargs = ints_of(p, req, first + 1, 0, true, &nn, "the tag argument counts (nargs)");
-    int *iargs = nargs ? ints_of(p, req, first + 2, 0, true, &ni, "the tag integers (intargs)")
+    int *nargs = rib_read_ints(p, req, first + 1, 0, true, &nn, "the tag argument counts (nargs)");
+    int *iargs = nargs ? rib_read_ints(p, req, first + 2, 0, true, &ni, "the tag integers (intargs)")
                        : NULL;
     bool ok = nargs && iargs;
     const double *fargs = NULL;
@@ -209,9 +179,9 @@ void rib_subdivision_mesh(rib_parser *p, const rib_request *req)
         return;
     }
     int nfaces = 0, nidx = 0;
-    int *nverts = ints_of(p, req, 1, 3, false, &nfaces, "the vertex counts (nvertices)");
+    int *nverts = rib_read_ints(p, req, 1, 3, false, &nfaces, "the vertex counts (nvertices)");
     if (!nverts) return;
-    int *idx = ints_of(p, req, 2, 0, false, &nidx, "the vertex indices");
+    int *idx = rib_read_ints(p, req, 2, 0, false, &nidx, "the vertex indices");
     subdiv_tags tags;
     memset(&tags, 0, sizeof tags);
     rib_params params = { 0 };
