@@ -331,7 +331,9 @@ void aa_lincomb3(aa_context *ctx, aa_form *z, const double m[3], const aa_form x
         x0 += p;
         centre += fabs(p);
         cuf += fp_uflow(p, a, xk->x0);
-        perr += fa * xk->err;
+        double pe = fa * xk->err;
+        perr += pe;
+        cuf += fp_uflow(pe, fa, xk->err);
         double l, h;
         scale_ends(a, xk->lo, xk->hi, &l, &h);
         lo += l;
@@ -339,6 +341,9 @@ void aa_lincomb3(aa_context *ctx, aa_form *z, const double m[3], const aa_form x
         hull += fabs(l) + fabs(h);
         huf += fabs(l) < 0x1p-1022 || fabs(h) < 0x1p-1022;
     }
+    /* (cuf also counts private errors whose product underflowed: their
+     * eta is in the centre's bound, the relative raise below does not
+     * cover an absolute loss) */
     double e = perr + fp_rounding_bound(3.0 * terms, uf) +
                fp_rounding_bound(3.0 * centre, cuf);
     z->x0 = x0;
