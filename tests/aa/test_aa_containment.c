@@ -212,7 +212,7 @@ enum op_id {
     OP_MUL, OP_DIV, OP_RECIP, OP_SQR, OP_SQRT, OP_INVSQRT, OP_EXP, OP_LOG,
     OP_POW_INT, OP_POW, OP_SIN, OP_COS, OP_TAN, OP_ASIN, OP_ACOS, OP_ATAN,
     OP_ATAN2, OP_ABS, OP_SIGN, OP_MIN, OP_MAX, OP_FLOOR, OP_CEIL, OP_ROUND,
-    OP_MOD, OP_STEP, OP_SMOOTHSTEP, OP_CLAMP, OP_MIX, OP_MERGE,
+    OP_MOD, OP_STEP, OP_SMOOTHSTEP, OP_CLAMP, OP_MIX, OP_MERGE, OP_LINCOMB3,
     OP_COUNT
 };
 
@@ -235,6 +235,7 @@ static const op_info OPS[OP_COUNT] = {
     [OP_ADD_S]         = {"add_s", 1, MODE_IA | MODE_AA},
     [OP_MUL_S]         = {"mul_s", 1, MODE_IA | MODE_AA},
     [OP_LINCOMB]       = {"lincomb", 2, MODE_AA},
+    [OP_LINCOMB3]      = {"lincomb3", 3, MODE_AA},
     [OP_MUL]           = {"mul", 2, MODE_IA | MODE_AA},
     [OP_DIV]           = {"div", 2, MODE_IA | MODE_AA},
     [OP_RECIP]         = {"recip", 1, MODE_IA | MODE_AA},
@@ -636,6 +637,10 @@ static int oracle(const tcase *tc, long double a, long double b, long double c,
         f = tc->la * a + tc->lb * b + tc->lc;
         mag = fabsl(tc->la * a) + fabsl(tc->lb * b) + fabs(tc->lc);
         break;
+    case OP_LINCOMB3:       /* a row of a transformation: la, lb, s; lc */
+        f = tc->la * a + tc->lb * b + tc->s * c + tc->lc;
+        mag = fabsl(tc->la * a) + fabsl(tc->lb * b) + fabsl(tc->s * c) + fabs(tc->lc);
+        break;
     case OP_MUL:     f = a * b; mag = fabsl(f); break;
     case OP_DIV:
         if (b == 0)
@@ -772,6 +777,9 @@ static void print_case(const tcase *tc)
     case OP_POW: if (tc->y_int) printf("    y is the integer point %d\n", tc->n); break;
     case OP_ADD_S: case OP_MUL_S: printf("    s = %a (%.17g)\n", tc->s, tc->s); break;
     case OP_LINCOMB: printf("    a = %a, b = %a, c = %a\n", tc->la, tc->lb, tc->lc); break;
+    case OP_LINCOMB3:
+        printf("    m = %a %a %a, c = %a\n", tc->la, tc->lb, tc->s, tc->lc);
+        break;
     default: break;
     }
 }
@@ -829,7 +837,7 @@ static bool surely_continuous(const tcase *tc, const ranges *rg)
     case OP_ADD: case OP_SUB: case OP_NEG: case OP_ADD_S: case OP_MUL_S:
     case OP_LINCOMB: case OP_MUL: case OP_SQR: case OP_EXP: case OP_SIN:
     case OP_COS: case OP_ATAN: case OP_ABS: case OP_MIN: case OP_MAX:
-    case OP_CLAMP: case OP_MIX:
+    case OP_CLAMP: case OP_MIX: case OP_LINCOMB3:
         return true;
     case OP_SQRT: case OP_LOG: case OP_INVSQRT:
         return lo[0] > 0;
@@ -1378,6 +1386,12 @@ static void aa_apply(aa_context *ctx, const tcase *tc, aa_form *z, const aa_form
     case OP_ADD_S:         aa_add_s(ctx, z, x, tc->s); break;
     case OP_MUL_S:         aa_mul_s(ctx, z, x, tc->s); break;
     case OP_LINCOMB:       aa_lincomb(ctx, z, tc->la, x, tc->lb, y, tc->lc); break;
+    case OP_LINCOMB3: {
+        const double m[3] = {tc->la, tc->lb, tc->s};
+        const aa_form in3[3] = {*x, *y, *w};
+        aa_lincomb3(ctx, z, m, in3, tc->lc);
+        break;
+    }
     case OP_MUL:           aa_mul(ctx, z, x, y); break;
     case OP_DIV:           aa_div(ctx, z, x, y); break;
     case OP_RECIP:         aa_recip(ctx, z, x); break;
