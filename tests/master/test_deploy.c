@@ -102,6 +102,7 @@ static void test_ssh_farm_renders_and_stops_its_workers(void **state)
     int rc = sh("ssh.log",
                 "cd %s && AAFARM_BIN=%s AAFARM_REMOTE_BIN=%s AAFARM_KEYS=%s/keys AAFARM_RUN=%s/run "
                 "AAFARM_PORT=%d AAFARM_BIND_HOST=127.0.0.1 AAFARM_MASTER_HOST=127.0.0.1 "
+                "AAFARM_WORKER_OPTS=\"--tile-delay 150\" "   /* both join before the end */
                 "SSH=%s/tests/master/deploy/fake-ssh SCP=%s/tests/master/deploy/fake-scp "
                 "%s/deploy/ssh/farm.sh hosts scene.rib -o ssh.exr --tile 16",
                 dir, bindir, bindir, dir, dir, port, src, src, src);
