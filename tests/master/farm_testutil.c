@@ -44,7 +44,7 @@ void ft_sleep_ms(int ms)
     while (nanosleep(&ts, &ts) != 0 && errno == EINTR) {}
 }
 
-static double now_s(void)
+double ft_now(void)
 {
     struct timespec ts;
     clock_gettime(CLOCK_MONOTONIC, &ts);
@@ -223,9 +223,9 @@ int ft_count(const char *path, const char *needle)
 
 bool ft_wait_for(const char *path, const char *needle, int n, double timeout_s)
 {
-    for (double until = now_s() + timeout_s;;) {
+    for (double until = ft_now() + timeout_s;;) {
         if (ft_count(path, needle) >= n) return true;
-        if (now_s() > until) return false;
+        if (ft_now() > until) return false;
         ft_sleep_ms(20);
     }
 }
@@ -310,7 +310,7 @@ pid_t ft_spawn(const char *log, const char *const *argv)
 
 int ft_wait(pid_t pid, double timeout_s)
 {
-    for (double until = now_s() + timeout_s;;) {
+    for (double until = ft_now() + timeout_s;;) {
         int status;
         pid_t r = waitpid(pid, &status, WNOHANG);
         if (r == pid) {
@@ -320,7 +320,7 @@ int ft_wait(pid_t pid, double timeout_s)
             return -1;
         }
         if (r < 0) return -1;
-        if (now_s() > until) return -1;
+        if (ft_now() > until) return -1;
         ft_sleep_ms(10);
     }
 }

@@ -63,6 +63,8 @@ int ft_count(const char *path, const char *needle);
 
 /* Waits until the file holds at least n occurrences of needle; false on
  * timeout. */
+/* Seconds on the monotonic clock. */
+double ft_now(void);
 bool ft_wait_for(const char *path, const char *needle, int n, double timeout_s);
 
 /* The endpoint from a master's "listening on ENDPOINT" log line, into

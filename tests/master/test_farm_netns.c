@@ -220,10 +220,12 @@ static int teardown(void **state)
     return 0;
 }
 
-/* Starts argv inside namespace h under timeout -k (bounded at 150 s). */
+/* Starts argv inside namespace h under timeout -k (bounded at 150 s; a
+ * process that outlives SIGTERM by 10 s is killed: 137). The 10 s leaves
+ * room for a sanitized worker's exit on a loaded machine. */
 static pid_t ns_spawn(int h, const char *log_name, const char *const *argv)
 {
-    const char *full[40] = {ip_bin, "netns", "exec", ns[h], timeout_bin, "-k", "2", "150"};
+    const char *full[40] = {ip_bin, "netns", "exec", ns[h], timeout_bin, "-k", "10", "150"};
     int n = 8;
     for (; *argv && n < 39; argv++) full[n++] = *argv;
     full[n] = NULL;
@@ -283,10 +285,23 @@ static long tiles_of(const char *log, const char *worker)
     return tiles;
 }
 
-static void stop(pid_t pid)
+/* timeout passes SIGTERM on; the worker says goodbye and exits 130. If it
+ * does not, its log says where it was. */
+static void stop(pid_t pid, const char *name)
 {
-    kill(pid, SIGTERM);   /* timeout passes it on; the worker says goodbye, exits 130 */
-    assert_int_equal(ft_wait(pid, 20), 130);
+    kill(pid, SIGTERM);
+    double t0 = ft_now();
+    int status = ft_wait(pid, 20);
+    if (status != 130) {
+        char log[128];
+        snprintf(log, sizeof log, "%s.log", name);
+        char *text = ft_read(p(log));
+        size_t len = strlen(text);
+        fprintf(stderr, "worker %s: status %d %.1f s after SIGTERM; its log ends:\n%s\n", name,
+                status, ft_now() - t0, text + (len > 3000 ? len - 3000 : 0));
+        free(text);
+    }
+    assert_int_equal(status, 130);
 }
 
 static void test_two_hosts_curve_strangers_refused(void **state)
@@ -314,10 +329,10 @@ static void test_two_hosts_curve_strangers_refused(void **state)
     assert_int_equal(ft_count(log, "refused a connection from 192.0.2.12: its public key is not "
                                    "in --allow-keys"), 1);
     assert_true(ft_count(log, "failed the CURVE handshake") >= 1);   /* the plaintext one */
-    stop(w1);
-    stop(w2);
-    stop(stranger);
-    stop(plain);
+    stop(w1, "w1");
+    stop(w2, "w2");
+    stop(stranger, "stranger");
+    stop(plain, "plain");
 }
 
 static bool netem_works(void)
@@ -354,8 +369,8 @@ static void test_delay_and_loss(void **state)
     char log[4096];
     snprintf(log, sizeof log, "%s", p("lossy.log"));
     assert_int_equal(tiles_of(log, "w1") + tiles_of(log, "w2"), 48);
-    stop(w1);
-    stop(w2);
+    stop(w1, "w1");
+    stop(w2, "w2");
     if (netem) {
         for (int h = M; h < NNS; h++) sh("ip netns exec %s tc qdisc del dev eth0 root", ns[h]);
     } else {
@@ -390,8 +405,8 @@ static void test_partition_then_heal(void **state)
     /* w2 came back: a second session, and it delivered after the heal */
     assert_int_equal(ft_count(log, "worker w2 joined"), 2);
     assert_true(ft_count(p("w2.log"), "connected to master") >= 2);
-    stop(w1);
-    stop(w2);
+    stop(w1, "w1");
+    stop(w2, "w2");
 }
 
 int main(int argc, char **argv)
