@@ -70,7 +70,8 @@
  * sub-boxes. On each sub-box an interval "jet" is evaluated: value,
  * gradient and Hessian of raw, from per-axis enclosures of s, s', s''
  * (s and s' have exact ranges from their monotonicity; s'' from its end
- * points and its extrema at (3 -+ sqrt 3)/6) and the product form above.
+ * points and its extrema at (3 -+ sqrt 3)/6) and the sum above written as
+ * nested linear interpolations, one axis at a time (cell_jet_d).
  * At the box centre c the same jet is taken at the point (a width of a few
  * ulps).
  *   interval: [0,1] ∩ natural extension (hull over sub-boxes)
@@ -478,41 +479,60 @@ double sl_noise_scale(int dim)
 /*
  * All quantities here are finite and small (|.| < 2^10): no overflow. Each
  * bound is the round-to-nearest result x of ONE operation (+ - *), moved
- * outward by out_dn/out_up, which is branch-free and always covers that
- * operation's rounding:
+ * outward by out_dn/out_up, which always covers that operation's rounding:
  *   x normal: the exact result v is within half an ulp of x, i.e. v >=
- *     pred(x). t = RN(|x| 2^-52 + 2^-1074) >= |x| 2^-52 >= ulp(x) (|x|
- *     2^-52 is exact: scaling a normal number by a power of two lands on a
- *     multiple of 2^-1074), so x - t <= x - ulp(x) <= pred(x), and by the
- *     monotonicity of rounding RN(x - t) <= pred(x) <= v.
+ *     pred(x). t = RN(|x| 2^-52 + 2^-600) >= ulp(x): for |x| >= 2^-548,
+ *     |x| 2^-52 is exact (a power-of-two scaling that stays normal) and
+ *     >= ulp(x); below, 2^-600 alone is >= ulp(x). So x - t <= x - ulp(x)
+ *     <= pred(x), and by the monotonicity of rounding RN(x - t) <=
+ *     pred(x) <= v.
  *   x subnormal or zero: v >= x - 2^-1075 (the underflow of a product; a
- *     sum is exact there), t >= 2^-1074, and x - t is computed exactly.
- * out_up is the mirror image. The cost is one or two ulps of width.
+ *     sum is exact there) and t >= 2^-600, so RN(x - t) <= x - 2^-1075.
+ * A result of magnitude below 2^-500 then becomes -2^-500 (it is above
+ * that, so this moves it further out). So every bound is 0 (iv_pt(0), a
+ * clipped weight) or at least 2^-500 in magnitude, products of two bounds
+ * are at least 2^-1000, and nothing here is subnormal: subnormal operands
+ * and results cost a microcode assist of ~100 cycles on x86, which made
+ * the jets 2-5x slower when the step added 2^-1074 (docs/noise.md).
+ * out_up is the mirror image. The cost is one or two ulps of width, and
+ * 2^-500 of absolute width near 0.
  */
 
 typedef struct iv {
     double lo, hi;
 } iv;
 
-static inline double out_dn(double x) { return x - (fabs(x) * 0x1p-52 + 0x1p-1074); }
-static inline double out_up(double x) { return x + (fabs(x) * 0x1p-52 + 0x1p-1074); }
+/* the kit's operations are a few instructions each: always inline them
+ * (the jets below are large enough that GCC would otherwise call them) */
+#define IV_INLINE static inline __attribute__((always_inline))
 
-static inline iv iv_mk(double lo, double hi)
+IV_INLINE double out_dn(double x)
+{
+    double t = x - (fabs(x) * 0x1p-52 + 0x1p-600);
+    return fabs(t) < 0x1p-500 ? -0x1p-500 : t;
+}
+IV_INLINE double out_up(double x)
+{
+    double t = x + (fabs(x) * 0x1p-52 + 0x1p-600);
+    return fabs(t) < 0x1p-500 ? 0x1p-500 : t;
+}
+
+IV_INLINE iv iv_mk(double lo, double hi)
 {
     iv r = { lo, hi };
     return r;
 }
-static inline iv iv_pt(double x) { return iv_mk(x, x); }
-static inline iv iv_add(iv a, iv b)
+IV_INLINE iv iv_pt(double x) { return iv_mk(x, x); }
+IV_INLINE iv iv_add(iv a, iv b)
 {
     return iv_mk(out_dn(a.lo + b.lo), out_up(a.hi + b.hi));
 }
-static inline iv iv_sub(iv a, iv b)
+IV_INLINE iv iv_sub(iv a, iv b)
 {
     return iv_mk(out_dn(a.lo - b.hi), out_up(a.hi - b.lo));
 }
-static inline iv iv_neg(iv a) { return iv_mk(-a.hi, -a.lo); }
-static inline iv iv_mul(iv a, iv b)
+IV_INLINE iv iv_neg(iv a) { return iv_mk(-a.hi, -a.lo); }
+IV_INLINE iv iv_mul(iv a, iv b)
 {
     double p1 = a.lo * b.lo, p2 = a.lo * b.hi, p3 = a.hi * b.lo, p4 = a.hi * b.hi;
     double lo = p1 < p2 ? p1 : p2, hi = p1 < p2 ? p2 : p1;
@@ -520,7 +540,7 @@ static inline iv iv_mul(iv a, iv b)
     return iv_mk(out_dn(lo < lo2 ? lo : lo2), out_up(hi > hi2 ? hi : hi2));
 }
 /* a times a small integer: exact for 0, +-1, +-2, +-4, +-8 */
-static inline iv iv_mul_int(iv a, int g)
+IV_INLINE iv iv_mul_int(iv a, int g)
 {
     switch (g) {
     case 0: return iv_pt(0.0);
@@ -538,20 +558,20 @@ static inline iv iv_mul_int(iv a, int g)
     }
 }
 /* a times a non-negative double */
-static inline iv iv_scale_pos(iv a, double k)
+IV_INLINE iv iv_scale_pos(iv a, double k)
 {
     return iv_mk(out_dn(a.lo * k), out_up(a.hi * k));
 }
-static inline iv iv_hull(iv a, iv b)
+IV_INLINE iv iv_hull(iv a, iv b)
 {
     return iv_mk(a.lo < b.lo ? a.lo : b.lo, a.hi > b.hi ? a.hi : b.hi);
 }
-static inline double iv_mag(iv a)
+IV_INLINE double iv_mag(iv a)
 {
     double l = fabs(a.lo), h = fabs(a.hi);
     return l > h ? l : h;
 }
-static inline double iv_mid(iv a) { return 0.5 * a.lo + 0.5 * a.hi; }
+IV_INLINE double iv_mid(iv a) { return 0.5 * a.lo + 0.5 * a.hi; }
 /* max |a - m| for a point m, rounded up */
 static inline double iv_rad_about(iv a, double m)
 {
@@ -612,7 +632,7 @@ static void axis_setup(axis_fade *a, iv F, int order)
     /* s is increasing on [0, 1] (s' = 30 t^2 (1-t)^2 >= 0) */
     iv s = clip01(iv_mk(fade_at(F.lo).lo, fade_at(F.hi).hi));
     a->w[1] = s;
-    a->w[0] = iv_sub(iv_pt(1.0), s);
+    a->w[0] = clip01(iv_sub(iv_pt(1.0), s));   /* 1 - s is in [0, 1] */
     if (order >= 1) {
         /* s' = 30 q^2, q = t(1-t) increasing below 1/2, decreasing above */
         iv qa = q_at(F.lo), qb = q_at(F.hi);
@@ -649,88 +669,115 @@ typedef struct jet {
     iv h[4][4];          /* j <= k used */
 } jet;
 
-/* product of the w[m] for m not j and not k (j, k may be -1) */
-static inline iv prod_except(const iv *w, int dim, int j, int k)
+/* a times b for a >= 0 (a.lo >= 0): two products, picked by b's signs */
+IV_INLINE iv iv_mul_pos(iv a, iv b)
 {
-    iv p = iv_pt(1.0);
-    bool first = true;
-    for (int m = 0; m < dim; m++) {
-        if (m == j || m == k)
-            continue;
-        p = first ? w[m] : iv_mul(p, w[m]);
-        first = false;
-    }
-    return p;
+    double lo = b.lo >= 0.0 ? a.lo * b.lo : a.hi * b.lo;
+    double hi = b.hi >= 0.0 ? a.hi * b.hi : a.lo * b.hi;
+    return iv_mk(out_dn(lo), out_up(hi));
+}
+
+/* a*x + b*y for a, b >= 0 */
+IV_INLINE iv iv_lerp_pos(iv a, iv x, iv b, iv y)
+{
+    return iv_add(iv_mul_pos(a, x), iv_mul_pos(b, y));
 }
 
 /*
  * Value (order 0), gradient (order >= 1) and Hessian (order 2) of raw
- * noise over the piece described by ax[], in the product form
- *   raw = sum_c W_c l_c,  l_c = g_c . (f - c),
- *   d_j raw = sum_c dW_c/df_j l_c + W_c g_cj,
- *   d_jk raw = sum_c d2W_c/df_j df_k l_c + dW_c/df_j g_ck + dW_c/df_k g_cj.
+ * noise over the piece described by ax[], as nested linear
+ * interpolations: raw = sum_c W_c l_c with W_c = prod_k w_k[c_k] is
+ *     raw = sum_{b_D} w_D[b_D] ( ... sum_{b_1} w_1[b_1] l_{b_1..b_D} ),
+ * one axis at a time. Each corner starts as the jet of its linear
+ * function l_c = g_c . (f - c) (value l_c, gradient g_c, Hessian 0); one
+ * step along axis k combines two jets A (c_k = 0) and B (c_k = 1) with
+ * the weights w_0 = 1 - s, w_1 = s of f_k (s' = D, s'' = DD) by the
+ * product rule:
+ *   v    = w_0 A + w_1 B
+ *   g_k  = w_0 A_k + w_1 B_k + D (B - A)
+ *   g_j  = w_0 A_j + w_1 B_j                                  (j != k)
+ *   h_kk = w_0 A_kk + w_1 B_kk + 2 D (B_k - A_k) + DD (B - A)
+ *   h_jk = w_0 A_jk + w_1 B_jk + D (B_j - A_j)                (j != k)
+ *   h_jl = w_0 A_jl + w_1 B_jl                                (j, l != k)
+ * 2^D - 1 steps instead of a product per corner, and the differences
+ * B - A keep the weights' derivatives from being counted twice. Every
+ * operation is an interval operation with outward rounding, so each part
+ * encloses the true one over the piece. Weights are >= 0 (clipped to
+ * [0, 1] in axis_setup), which halves their products (iv_mul_pos).
  */
-static inline void cell_jet_d(int dim, const axis_fade *ax, const uint32_t h[16],
-                              int order, jet *J)
+/* always inlined into cell_jet, once per (dim, order), so the loops unroll */
+static inline __attribute__((always_inline)) void
+cell_jet_d(int dim, const axis_fade *ax, const uint32_t h[16], int order, jet *J)
 {
-    J->v = iv_pt(0.0);
-    for (int j = 0; j < dim; j++) {
-        J->g[j] = iv_pt(0.0);
-        for (int k = j; k < dim; k++)
-            J->h[j][k] = iv_pt(0.0);
-    }
-    for (int c = 0; c < (1 << dim); c++) {
+    jet t[16];
+    int n = 1 << dim;
+    for (int c = 0; c < n; c++) {
         int g[4];
-        iv w[4], dw[4], ddw[4], pj[4], dW[4];
         gradient(dim, h[c], g);
-        iv l = iv_pt(0.0);
-        for (int k = 0; k < dim; k++) {
-            int b = (c >> k) & 1;
-            w[k] = ax[k].w[b];
-            l = iv_add(l, iv_mul_int(ax[k].d[b], g[k]));
-            if (order >= 1)
-                dw[k] = ax[k].dw[b];
-            if (order >= 2)
-                ddw[k] = ax[k].ddw[b];
-        }
-        for (int j = 0; j < dim; j++)
-            pj[j] = prod_except(w, dim, j, -1);
-        iv W = dim == 1 ? w[0] : iv_mul(pj[0], w[0]);
-        J->v = iv_add(J->v, iv_mul(W, l));
+        iv l = iv_mul_int(ax[0].d[c & 1], g[0]);
+        for (int k = 1; k < dim; k++)
+            if (g[k] != 0)
+                l = iv_add(l, iv_mul_int(ax[k].d[(c >> k) & 1], g[k]));
+        t[c].v = l;
         if (order < 1)
             continue;
-        for (int j = 0; j < dim; j++) {
-            dW[j] = dim == 1 ? dw[0] : iv_mul(dw[j], pj[j]);
-            J->g[j] = iv_add(J->g[j], iv_add(iv_mul(dW[j], l),
-                                             iv_mul_int(W, g[j])));
-        }
-        if (order < 2)
-            continue;
-        for (int j = 0; j < dim; j++) {
-            iv ddW = dim == 1 ? ddw[0] : iv_mul(ddw[j], pj[j]);
-            J->h[j][j] = iv_add(J->h[j][j],
-                                iv_add(iv_mul(ddW, l), iv_mul_int(dW[j], 2 * g[j])));
-            for (int k = j + 1; k < dim; k++) {
-                iv dd = iv_mul(dw[j], dw[k]);
-                if (dim > 2)
-                    dd = iv_mul(dd, prod_except(w, dim, j, k));
-                iv t = iv_add(iv_mul(dd, l), iv_add(iv_mul_int(dW[j], g[k]),
-                                                    iv_mul_int(dW[k], g[j])));
-                J->h[j][k] = iv_add(J->h[j][k], t);
+        for (int k = 0; k < dim; k++)
+            t[c].g[k] = iv_pt((double)g[k]);
+        /* the corners' Hessians are 0: the step along axis 0 knows it */
+    }
+    for (int k = 0; k < dim; k++) {
+        n >>= 1;
+        iv w0 = ax[k].w[0], w1 = ax[k].w[1];
+        iv D = ax[k].dw[1], DD = ax[k].ddw[1];
+        for (int i = 0; i < n; i++) {
+            const jet *A = &t[2 * i], *B = &t[2 * i + 1];
+            jet r;
+            r.v = iv_lerp_pos(w0, A->v, w1, B->v);
+            if (order >= 1) {
+                iv dv = iv_sub(B->v, A->v);
+                for (int j = 0; j < dim; j++)
+                    r.g[j] = iv_lerp_pos(w0, A->g[j], w1, B->g[j]);
+                r.g[k] = iv_add(r.g[k], iv_mul_pos(D, dv));
+                if (order >= 2) {
+                    for (int j = 0; j < dim; j++)
+                        for (int m = j; m < dim; m++)
+                            r.h[j][m] = k == 0 ? iv_pt(0.0)
+                                               : iv_lerp_pos(w0, A->h[j][m], w1, B->h[j][m]);
+                    iv dgk = iv_sub(B->g[k], A->g[k]);
+                    iv m = iv_mul_pos(D, dgk);
+                    iv kk = iv_add(iv_mk(2.0 * m.lo, 2.0 * m.hi), iv_mul(DD, dv));
+                    r.h[k][k] = iv_add(r.h[k][k], kk);
+                    for (int j = 0; j < dim; j++) {
+                        if (j == k)
+                            continue;
+                        iv t_jk = iv_mul_pos(D, iv_sub(B->g[j], A->g[j]));
+                        if (j < k) r.h[j][k] = iv_add(r.h[j][k], t_jk);
+                        else r.h[k][j] = iv_add(r.h[k][j], t_jk);
+                    }
+                }
             }
+            t[i] = r;
         }
     }
+    *J = t[0];
 }
 
 static void cell_jet(int dim, const axis_fade *ax, const uint32_t h[16],
                      int order, jet *J)
 {
-    switch (dim) {
-    case 1: cell_jet_d(1, ax, h, order, J); break;
-    case 2: cell_jet_d(2, ax, h, order, J); break;
-    case 3: cell_jet_d(3, ax, h, order, J); break;
-    default: cell_jet_d(4, ax, h, order, J); break;
+#define CELL_JET_ORDERS(D)                             \
+    switch (order) {                                   \
+    case 0: cell_jet_d(D, ax, h, 0, J); break;         \
+    case 1: cell_jet_d(D, ax, h, 1, J); break;         \
+    default: cell_jet_d(D, ax, h, 2, J); break;        \
     }
+    switch (dim) {
+    case 1: CELL_JET_ORDERS(1) break;
+    case 2: CELL_JET_ORDERS(2) break;
+    case 3: CELL_JET_ORDERS(3) break;
+    default: CELL_JET_ORDERS(4) break;
+    }
+#undef CELL_JET_ORDERS
 }
 
 /* ---------------------------------------------------------------------- */
