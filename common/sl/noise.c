@@ -127,6 +127,28 @@ static const double noise_scale[SL_NOISE_MAX_DIM + 1] = {
 #define NOISE_SPLIT_WIDTH 0.2
 #define NOISE_MAX_SUBBOXES 16
 
+/*
+ * Global bounds of the first, second and third partial derivatives of raw
+ * noise (every dimension, every hash), for merging slivers (enclose).
+ * With S(0) = 1, S(j) = 2 max|d^j s/dt^j| (S(1) = 3.75, S(2) = 20/sqrt 3 <
+ * 11.548, S(3) = 120, the third derivative being 60(6t^2 - 6t + 1)),
+ * G1 = max sum_k |g_k| (8, 2, 2, 3 for 1D-4D) and gm = max |g_k| (8, 1, 1,
+ * 1), the product rule on raw = sum_c W_c l_c (l_c linear; the sum over
+ * corners of |d^alpha W_c| is prod_k S(alpha_k)) gives
+ *   |d^alpha raw| <= G1 prod_k S(alpha_k)
+ *                    + sum_j alpha_j gm S(alpha_j - 1) prod_{k != j} S(alpha_k).
+ * The largest over |alpha| = 1, 2, 3 are 1D's: 38, 152.4 and 1237.2.
+ */
+#define NOISE_D1_BOUND 40.0
+#define NOISE_D2_BOUND 160.0
+#define NOISE_D3_BOUND 1300.0
+
+/* A box that crosses a lattice plane by at most this much (and by at most
+ * 2^-24 of its own largest width) is treated as the cell on the other side
+ * plus a sliver, bounded by the derivative bounds (enclose). */
+#define NOISE_SLIVER_MAX 0x1p-30
+#define NOISE_SLIVER_REL 0x1p-24
+
 /* Cellnoise enumerates at most this many cells of a box. */
 #define CELLNOISE_MAX_CELLS 64
 
@@ -466,6 +488,11 @@ void sl_vcellnoise(int dim, const double *p, double out[3])
 double sl_noise_raw_bound(int dim)
 {
     return dim_ok(dim) ? raw_bound[dim] : 0.0;
+}
+
+double sl_noise_raw_derivative_bound(int order)
+{
+    return order == 1 ? NOISE_D1_BOUND : order == 2 ? NOISE_D2_BOUND : NOISE_D3_BOUND;
 }
 
 double sl_noise_scale(int dim)
@@ -827,6 +854,43 @@ static bool enclose(const box_query *q, bool want_affine, box_result *res)
         ncell[k] = (int)(b - a) + 1;
     }
 
+    /*
+     * Slivers. A box that crosses a lattice plane by a sliver of width e
+     * (a plane at y = 0 in shader space, whose y range is a few rounding
+     * errors around 0, crosses one on every box) would cost a second cell
+     * piece and twice the jets. Instead the sliver's cell is dropped: a
+     * point x of the sliver and its projection x' on the plane (which is
+     * in the piece kept) are joined by a segment inside one cell, where
+     * the noise is a polynomial, and value, gradient and Hessian agree
+     * across the plane (C^2), so
+     *   |raw(x) - raw(x')| <= D1 e,  |d raw(x) - d raw(x')| <= D2 e,
+     *   |d2 raw(x) - d2 raw(x')| <= D3 e
+     * (the NOISE_D*_BOUND). The hulls over the piece kept, widened by
+     * these amounts, enclose the whole box; with slivers on several axes
+     * the widths add up (one projection per axis).
+     */
+    double widest = 0.0, sliver = 0.0;
+    for (int k = 0; k < dim; k++)
+        if (q->hi[k] - q->lo[k] > widest)
+            widest = q->hi[k] - q->lo[k];
+    double sliver_max = NOISE_SLIVER_REL * widest;
+    if (sliver_max > NOISE_SLIVER_MAX)
+        sliver_max = NOISE_SLIVER_MAX;
+    for (int k = 0; k < dim; k++) {
+        if (ncell[k] != 2)
+            continue;
+        double plane = (double)(i0[k] + 1);
+        double below = fp_add_up(plane, -q->lo[k]), above = fp_add_up(q->hi[k], -plane);
+        if (below <= sliver_max && below <= above) {
+            i0[k] += 1;                 /* keep the cell above the plane */
+            ncell[k] = 1;
+            sliver = fp_add_up(sliver, below);
+        } else if (above <= sliver_max) {
+            ncell[k] = 1;               /* keep the cell below */
+            sliver = fp_add_up(sliver, above);
+        }
+    }
+
     /* segments per axis: the cell pieces, each halved when wider than
      * NOISE_SPLIT_WIDTH, as long as there are at most NOISE_MAX_SUBBOXES
      * sub-boxes in all */
@@ -925,6 +989,19 @@ static bool enclose(const box_query *q, bool want_affine, box_result *res)
             if (order >= 2)
                 for (int k = j; k < dim; k++)
                     hull.h[j][k] = iv_hull(hull.h[j][k], J.h[j][k]);
+        }
+    }
+
+    if (sliver > 0.0) {
+        double a1 = fp_mul_up(NOISE_D1_BOUND, sliver), a2 = fp_mul_up(NOISE_D2_BOUND, sliver),
+               a3 = fp_mul_up(NOISE_D3_BOUND, sliver);
+        hull.v = iv_add(hull.v, iv_mk(-a1, a1));
+        subrange = iv_add(subrange, iv_mk(-a1, a1));
+        for (int j = 0; j < dim; j++) {
+            hull.g[j] = iv_add(hull.g[j], iv_mk(-a2, a2));
+            if (order >= 2)
+                for (int k = j; k < dim; k++)
+                    hull.h[j][k] = iv_add(hull.h[j][k], iv_mk(-a3, a3));
         }
     }
 

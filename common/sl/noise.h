@@ -110,6 +110,9 @@ void sl_vcellnoise_aa(aa_context *ctx, aa_form out[3], int dim,
 double sl_noise_raw_bound(int dim);
 /* The factor K_dim with noise = 0.5 + K_dim * raw; K_dim * B_dim <= 1/2. */
 double sl_noise_scale(int dim);
+/* Bounds of |any first, second, third partial derivative of raw noise|,
+ * every dimension (derived in noise.c; used for slivers). order 1..3. */
+double sl_noise_raw_derivative_bound(int order);
 
 /* ---- fixed-dimension spellings ---- */
 static inline double sl_noise1(double x) { return sl_noise(1, &x); }
