@@ -97,6 +97,12 @@ void aa_lincomb(aa_context *ctx, aa_form *z, double a, const aa_form *x,
 void aa_lincomb3(aa_context *ctx, aa_form *z, const double m[3], const aa_form x[3],
                  double c);
 
+/* Adds delta >= 0 (an upper bound, already rounded up) as a new error of z:
+ * on a fresh noise symbol while the context has one, else on z->err. The
+ * hull is left alone: the caller widens or replaces it (an enclosure of
+ * the same values). */
+void aa_add_new_error(aa_context *ctx, aa_form *z, double delta);
+
 /* ---- non-affine operations: one new noise symbol each ---- */
 void aa_mul(aa_context *ctx, aa_form *z, const aa_form *x, const aa_form *y);
 void aa_div(aa_context *ctx, aa_form *z, const aa_form *x, const aa_form *y);

@@ -7,10 +7,6 @@
 
 #include "aa/affine.h"
 
-/* Adds delta >= 0 (an upper bound, already rounded up) as a new error of z:
- * on a fresh noise symbol while the context has one, else on z->err. */
-void aa_add_new_error(aa_context *ctx, aa_form *z, double delta);
-
 /* z = alpha*x + zeta +- delta: the result of a linear approximation of a
  * non-affine function (Heidrich & Seidel §4: f^a plus a new noise symbol).
  * delta must already be an upper bound on the approximation error; the

@@ -1303,14 +1303,18 @@ static void noise_aa(aa_context *ctx, aa_form *out, int dim, const aa_form *p,
         aa_add_s(ctx, &y[k], &p[k], -p[k].x0);    /* x0 - x0: exact */
     if (dim == 1) {
         aa_lincomb(ctx, out, res.alpha[0], &y[0], 0.0, NULL, res.n0);
+    } else if (dim == 3) {
+        aa_lincomb3(ctx, out, res.alpha, y, res.n0);      /* one pass */
     } else {
         aa_lincomb(ctx, out, res.alpha[0], &y[0], res.alpha[1], &y[1], res.n0);
         for (int k = 2; k < dim; k++)
             aa_lincomb(ctx, out, 1.0, out, res.alpha[k], &y[k], 0.0);
     }
-    aa_form e;
-    aa_from_interval(ctx, &e, ia_make(-res.delta, res.delta));
-    aa_add(ctx, out, out, &e);
+    /* +- delta on a new symbol; the hull (of the linear part) widens by it */
+    double hull_lo = fp_add_dn(out->lo, -res.delta), hull_hi = fp_add_up(out->hi, res.delta);
+    aa_add_new_error(ctx, out, res.delta);
+    out->lo = hull_lo;
+    out->hi = hull_hi;
     if (out->flags & AA_UNBOUNDED) {    /* cannot happen: stay safe */
         aa_interval_result(ctx, out, res.range.lo, res.range.hi, flags);
         return;
