@@ -255,15 +255,19 @@ geom_cover geom_uv_box_cover(const geom_surface *s, double u0, double u1,
     const double margin = 1e-9;
     if (u1 < -margin || u0 > 1 + margin || v1 < -margin || v0 > 1 + margin)
         return GEOM_OUTSIDE;
+    /* An edge function e = a u + b v + c is largest and smallest over the
+     * box at the corners: e(centre) +- (|a| hu + |b| hv). One evaluation per
+     * edge (this runs for every child of every node visited); its rounding
+     * (a few ulps of values of order 1) is far inside the UV_TOL margins. */
+    double uc = 0.5 * (u0 + u1), vc = 0.5 * (v0 + v1);
+    double hu = 0.5 * (u1 - u0), hv = 0.5 * (v1 - v0);
     bool all_in = true;
     for (int i = 0; i < s->nuv; i++) {
-        double e00 = edge_eval(s, i, u0, v0), e10 = edge_eval(s, i, u1, v0);
-        double e01 = edge_eval(s, i, u0, v1), e11 = edge_eval(s, i, u1, v1);
-        double emax = fmax(fmax(e00, e10), fmax(e01, e11));
-        double emin = fmin(fmin(e00, e10), fmin(e01, e11));
-        if (emax < -2 * UV_TOL)           /* margins: rounding inside the box */
+        double ec = edge_eval(s, i, uc, vc);
+        double r = fabs(s->edge[i][0]) * hu + fabs(s->edge[i][1]) * hv;
+        if (ec + r < -2 * UV_TOL)          /* margins: rounding inside the box */
             return GEOM_OUTSIDE;
-        if (emin < -0.5 * UV_TOL)
+        if (ec - r < -0.5 * UV_TOL)
             all_in = false;
     }
     return all_in ? GEOM_INSIDE : GEOM_PARTIAL;
