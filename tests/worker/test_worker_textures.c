@@ -6,6 +6,9 @@
  *     and read again all the time; its --stats-json counts evictions > 0)
  *     equals the render with no budget (0 evictions) pixel for pixel, in
  *     every channel, in affine and in interval arithmetic, with 2 threads;
+ *   - and both equal the render of the same map without its stored
+ *     pyramids (aafarm-maketx --no-minmax: read as an image, pyramids
+ *     built in memory, no tiles loaded);
  *   - a malformed --texture-bytes is a usage error (exit 2) naming it.
  * Each run is bounded by `timeout -k`.
  *
@@ -74,6 +77,8 @@ static image_buffer *read_image(const char *name)
     return b;
 }
 
+static void terrain(const char *name, const char *map);
+
 static int setup(void **state)
 {
     (void)state;
@@ -86,7 +91,20 @@ static int setup(void **state)
     write_file("hmap.sl", "displacement hmap(float Km = 0.3; string map = \"\")\n{\n"
                           "    P += Km * texture(map[0], s, t) * normalize(N);\n"
                           "    N = calculatenormal(P);\n}\n");
-    write_file("terrain.rib",
+    /* the same map without its stored pyramids: read as an image, built */
+    if (run(maketx, "--no-minmax height.exr plain.exr", out, sizeof out) != 0) {
+        fprintf(stderr, "%s", out);
+        return -1;
+    }
+    terrain("terrain.rib", "height.exr");
+    terrain("plain.rib", "plain.exr");
+    return 0;
+}
+
+static void terrain(const char *name, const char *map)
+{
+    char text[2048];
+    snprintf(text, sizeof text,
                "Option \"searchpath\" \"shader\" [\".\"]\n"
                "Format 40 28 1\nPixelSamples 1 1\n"
                "Projection \"perspective\" \"fov\" [40]\n"
@@ -94,11 +112,11 @@ static int setup(void **state)
                "WorldBegin\n"
                "LightSource \"distantlight\" 1 \"from\" [-2 3 -1] \"to\" [0 0 0]\n"
                "Attribute \"displacementbound\" \"sphere\" [0.45]\n"
-               "Displacement \"hmap\" \"string map\" [\"height.exr\"]\n"
+               "Displacement \"hmap\" \"string map\" [\"%s\"]\n"
                "Rotate -90 1 0 0\n"
                "Patch \"bilinear\" \"P\" [-2 -2 0  2 -2 0  -2 2 0  2 2 0]\n"
-               "WorldEnd\n");
-    return 0;
+               "WorldEnd\n", map);
+    write_file(name, text);
 }
 
 static void same_pixels(const char *a_name, const char *b_name)
@@ -111,7 +129,10 @@ static void same_pixels(const char *a_name, const char *b_name)
         float *x = image_buffer_channel(a, channels[c]), *y = image_buffer_channel(b, channels[c]);
         assert_non_null(x);
         assert_non_null(y);
-        assert_memory_equal(x, y, (size_t)a->width * a->height * sizeof *x);
+        for (int k = 0; k < a->width * a->height; k++)
+            if (memcmp(&x[k], &y[k], sizeof *x) != 0)
+                fail_msg("%s and %s differ: channel %s, pixel %d,%d: %.9g vs %.9g", a_name,
+                         b_name, channels[c], k % a->width, k / a->width, x[k], y[k]);
     }
     float *alpha = image_buffer_channel(a, "A");
     int hit = 0;
@@ -142,6 +163,12 @@ static void test_tiny_budget_renders_the_same(void **state)
         assert_true(json_number("tiny.json", "texture_tile_loads") >
                     json_number("all.json", "texture_tile_loads"));
         same_pixels("all.exr", "tiny.exr");
+        /* the plain image, its pyramids built in memory: the same picture */
+        snprintf(args, sizeof args, "--standalone plain.rib -o plain_out.exr --threads 2 --arith %s "
+                 "--stats-json plain.json -q", arith[m]);
+        assert_int_equal(run(worker, args, out, sizeof out), 0);
+        assert_int_equal(json_number("plain.json", "texture_tile_loads"), 0);
+        same_pixels("all.exr", "plain_out.exr");
     }
 }
 
