@@ -13,11 +13,11 @@
 # --texture-bytes TEXTURE_BYTES) over tcp://127.0.0.1 twice:
 #   cold: the worker's store is empty, the map is shipped from the master;
 #   warm: another job (another Km) naming the same map, found in the store.
-# Printed per run: seconds from the worker's start to its files being
-# present ("files"), to its first tile sent ("first tile") and to the end
-# of the render ("done"); the map bytes the master sent; the worker's tile
-# loads and evictions are not on the wire, so its peak resident memory
-# (GNU time's %M) is what shows the budget. The master hashes the map
+# Printed per run: seconds from the worker's start to its job being ready
+# (files present, hashed, job compiled: "ready"), to its first tile sent
+# ("first tile", read from its -v log every 50 ms) and to the end of the
+# render ("done"); the map bytes the master sent; and the worker's peak
+# resident memory (GNU time's %M), which shows the budget. The master hashes the map
 # before it listens (not counted); a new worker process hashes a file it
 # uses once (counted: it is part of the time to the first tile).
 # Figures, never a pass/fail. Every process is bounded by timeout -k and
@@ -74,16 +74,12 @@ us() {   # microseconds now
     echo $((10#$t))
 }
 
-stamp() {   # each line of stdin prefixed with the seconds since $1 (microseconds)
-    local start=$1 line t
-    while IFS= read -r line; do
-        t=${EPOCHREALTIME/./}
-        t=$(( (10#$t - start) / 10000 ))
-        printf '%d.%02d %s\n' $((t / 100)) $((t % 100)) "$line"
-    done
+since() {   # seconds since $1 (microseconds), 2 decimals
+    local t=$(( ($(us) - $1) / 10000 ))
+    printf '%d.%02d' $((t / 100)) $((t % 100))
 }
 
-render() {   # $1 tag -> stats-$1.json, worker-$1.log, rss-$1.txt, done-$1.txt
+render() {   # $1 tag -> stats-$1.json, worker-$1.log, rss-$1.txt, times-$1.txt
     timeout -k 5 900 "$BIN/aafarm-master" scene.rib -o "out-$1.exr" --bind 'tcp://127.0.0.1:*' \
         --tile 16 --stats-json "stats-$1.json" > "master-$1.log" 2>&1 &
     local m=$!
@@ -94,34 +90,38 @@ render() {   # $1 tag -> stats-$1.json, worker-$1.log, rss-$1.txt, done-$1.txt
         sleep 0.1
     done
     [ -n "$ep" ] || { echo "tex_farm.sh: the master did not start" >&2; cat "master-$1.log" >&2; exit 1; }
-    local start
+    local start ready="-" first="-"
     start=$(us)
     /usr/bin/time -o "rss-$1.txt" -f '%M' timeout -k 5 900 "$BIN/aafarm-worker" --connect "$ep" \
         --threads 2 --file-cache "$WORK/store" --texture-bytes "$TEXBYTES" -v \
-        2> >(stamp "$start" > "worker-$1.log") > /dev/null &
+        > /dev/null 2> "worker-$1.log" &
     local w=$!
-    wait $m
-    local t=$(( ($(us) - start) / 10000 ))
-    printf '%d.%02d\n' $((t / 100)) $((t % 100)) > "done-$1.txt"
+    # the worker's log, read every 50 ms: when its job was ready (files
+    # present and the job compiled) and when it sent its first tile
+    while kill -0 "$m" 2> /dev/null; do
+        [ "$ready" = - ] && grep -q ') ready$' "worker-$1.log" && ready=$(since "$start")
+        [ "$first" = - ] && grep -q 'tile [0-9]* sent' "worker-$1.log" && first=$(since "$start")
+        sleep 0.05
+    done
+    wait "$m"
+    echo "$ready $first $(since "$start")" > "times-$1.txt"
     local tpid
     tpid=$(pgrep -P "$w" | head -1)          # timeout, GNU time's child: it passes TERM on
     [ -n "$tpid" ] && kill -TERM "$tpid" 2> /dev/null
-    wait $w 2> /dev/null
-    sleep 0.2                                 # the log's last lines
+    wait "$w" 2> /dev/null
 }
 
 printf "map %d x %d floats: %d MiB file (mean, min, max), made in %s s; worker --texture-bytes %s\n" \
     "$SIZE" "$SIZE" "$mib" "$gen" "$TEXBYTES"
-printf "%6s %8s %11s %8s %12s %14s\n" run "files s" "first tile s" "done s" "bytes sent" "worker peak MiB"
+printf "%6s %8s %12s %8s %12s %16s\n" run "ready s" "first tile s" "done s" "bytes sent" \
+    "worker peak MiB"
 scene 0.2
 render cold
 scene 0.15
 render warm
 for r in cold warm; do
-    files=$(sed -n 's/^\([0-9.]*\) .*its files are here.*/\1/p' "worker-$r.log" | head -1)
-    first=$(sed -n 's/^\([0-9.]*\) .*tile [0-9]* sent.*/\1/p' "worker-$r.log" | head -1)
+    read -r ready first done_s < "times-$r.txt"
     sent=$(json "stats-$r.json" file_bytes_sent)
-    rss=$(awk '{ printf "%.0f", $1 / 1024 }' "rss-$r.txt" 2> /dev/null)
-    printf "%6s %8s %11s %8s %12s %14s\n" "$r" "${files:--}" "${first:--}" "$(cat "done-$r.txt")" \
-        "${sent:--}" "${rss:--}"
+    rss=$(tail -1 "rss-$r.txt" | awk '{ printf "%.0f", $1 / 1024 }')
+    printf "%6s %8s %12s %8s %12s %16s\n" "$r" "$ready" "$first" "$done_s" "${sent:--}" "${rss:--}"
 done
