@@ -99,8 +99,8 @@ render() {   # $1 tag -> stats-$1.json, worker-$1.log, rss-$1.txt, times-$1.txt
     # the worker's log, read every 50 ms: when its job was ready (files
     # present and the job compiled) and when it sent its first tile
     while kill -0 "$m" 2> /dev/null; do
-        [ "$ready" = - ] && grep -q ') ready$' "worker-$1.log" && ready=$(since "$start")
-        [ "$first" = - ] && grep -q 'tile [0-9]* sent' "worker-$1.log" && first=$(since "$start")
+        [ "$ready" = - ] && grep -qs ') ready$' "worker-$1.log" && ready=$(since "$start")
+        [ "$first" = - ] && grep -qs 'tile [0-9]* sent' "worker-$1.log" && first=$(since "$start")
         sleep 0.05
     done
     wait "$m"
