@@ -129,6 +129,8 @@ static int send_job(farm *f, farm_worker *w, farm_frame *fr, int64_t now)
     int n = send_env(f, w, &env, now);
     if (n < 0) return -1;
     mark_held(w, (int)(fr - f->frames));
+    if (fr->jb->nfiles > 0 && !w->files_ready)   /* its leases wait for the files */
+        scheduler_worker_waiting(f->sched, w->slot, true, now);
     w->job_bytes += (uint64_t)n;
     f->jobs_sent++;
     if (f->nframes > 1)
@@ -481,6 +483,8 @@ static void on_need_file(farm *f, farm_worker *w, const Aafarm__NeedFile *n, int
     env.file_chunk = &c;
     if (send_env_bulk(f, w, &env, data, n->length, now) < 0) return;
     if (w->file_chunks == 0) w->file_first_ms = now;
+    if (!w->files_ready)   /* progress: its leases' clocks start again */
+        scheduler_worker_waiting(f->sched, w->slot, true, now);
     w->file_bytes += n->length;
     w->file_chunks++;
     f->file_bytes_sent += n->length;
@@ -492,6 +496,7 @@ static void on_files_ready(farm *f, farm_worker *w, const Aafarm__FilesReady *r,
     if (!frame_of_job(f, r->job_hash) || w->files_ready) return;
     w->files_ready = true;
     w->file_ready_ms = now;
+    scheduler_worker_waiting(f->sched, w->slot, false, now);   /* rendering from now */
     w->file_hits += r->hits;
     w->file_misses += r->misses;
     console_log(f->con, CONSOLE_DETAIL, "%s has the job's files (%u in its host's store, %u "

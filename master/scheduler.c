@@ -36,6 +36,7 @@ typedef struct worker_slot {
     int taken;         /* results taken from it, and their grant-to-result time */
     int64_t taken_ms_sum;
     int overdue;       /* its valid leases past their deadline */
+    bool waiting;      /* getting the job's files (scheduler_worker_waiting) */
 } worker_slot;
 
 typedef struct failed_pair {
@@ -235,7 +236,7 @@ static void lease_add(scheduler *self, int worker, int tile, int64_t now, bool d
     }
     scheduler_lease *l = &self->leases[self->nleases++];
     *l = (scheduler_lease){.id = self->next_id++, .worker = worker, .tile = tile,
-                           .granted_ms = now,
+                           .granted_ms = now, .from_ms = now,
                            .deadline_ms = now + scheduler_lease_limit(self, worker),
                            .duplicate = dup};
     self->tiles[tile].live++;
@@ -320,6 +321,7 @@ static int pick_duplicate(const scheduler *self, int worker, int64_t now)
         const scheduler_lease *l = &self->leases[i];
         if (!l->id || l->worker == worker) continue;
         if (now - l->granted_ms < wait) break;   /* the rest are younger still */
+        if (now - l->from_ms < wait) continue;   /* its worker was getting files */
         const tile_state *t = &self->tiles[l->tile];
         if (t->done || t->live == 0 || t->held > (uint32_t)self->opt.max_duplicates) continue;
         if (!worker_holds(self, worker, l->tile) && !failed_by(self, l->tile, worker))
@@ -381,7 +383,7 @@ scheduler_verdict scheduler_complete(scheduler *self, int worker, uint64_t lease
     }
     t->done = 1;
     self->done++;
-    int64_t took = now_ms > l->granted_ms ? now_ms - l->granted_ms : 0;
+    int64_t took = now_ms > l->from_ms ? now_ms - l->from_ms : 0;   /* files not counted */
     self->taken_ms_sum += took;
     self->taken++;
     self->workers[worker].taken++;
@@ -441,7 +443,7 @@ int scheduler_expire(scheduler *self, int64_t now_ms)
     for (size_t i = 0; i < self->nleases; i++) {
         scheduler_lease *l = &self->leases[i];
         if (!l->id || l->expired) continue;
-        l->deadline_ms = l->granted_ms + scheduler_lease_limit(self, l->worker);
+        l->deadline_ms = l->from_ms + scheduler_lease_limit(self, l->worker);
         if (l->deadline_ms > now_ms) continue;
         l->expired = true;
         if (l->worker >= 0 && l->worker < self->nworkers) self->workers[l->worker].overdue++;
@@ -451,8 +453,22 @@ int scheduler_expire(scheduler *self, int64_t now_ms)
     return (int)(self->counts.requeued - before);
 }
 
+void scheduler_worker_waiting(scheduler *self, int worker, bool waiting, int64_t now_ms)
+{
+    if (!worker_ok(self, worker)) return;
+    self->workers[worker].waiting = waiting;
+    for (size_t i = 0; i < self->nleases; i++) {
+        scheduler_lease *l = &self->leases[i];
+        if (!l->id || l->expired || l->worker != worker) continue;
+        l->from_ms = now_ms;
+        l->deadline_ms = now_ms + scheduler_lease_limit(self, worker);
+    }
+}
+
 int64_t scheduler_lease_limit(const scheduler *self, int worker)
 {
+    if (worker >= 0 && worker < self->nworkers && self->workers[worker].waiting)
+        return self->opt.lease_ms;
     int64_t sum = self->taken_ms_sum, n = self->taken;
     if (worker >= 0 && worker < self->nworkers && self->workers[worker].taken > 0) {
         sum = self->workers[worker].taken_ms_sum;

@@ -74,6 +74,8 @@ typedef struct scheduler_lease {
     int worker;            /* the slot it was granted to */
     int tile;              /* row-major tile index */
     int64_t granted_ms;
+    int64_t from_ms;       /* its clock: the grant, or its worker's last progress
+                              while that waited for the job's files */
     int64_t deadline_ms;
     bool duplicate;        /* granted while another live lease held the tile */
     bool expired;          /* its deadline passed (still valid) */
@@ -149,6 +151,16 @@ bool scheduler_mark_done(scheduler *self, int tile);
  * worker now) is <= now_ms as expired and requeues their tiles. Returns
  * the number of tiles requeued. */
 int scheduler_expire(scheduler *self, int64_t now_ms);
+
+/* The worker is getting the job's files (waiting: the Job was sent to it
+ * and its FilesReady has not come; docs/textures.md): its live leases'
+ * clocks start again now, and while it waits they last lease_ms (the
+ * longest), so a long fetch or hash does not requeue the tiles it holds.
+ * The master calls it when it sends such a worker the Job and each file
+ * chunk (waiting), and at FilesReady (not waiting: from then on the
+ * measured speed rules). A worker that stops making progress loses its
+ * leases lease_ms after its last chunk. */
+void scheduler_worker_waiting(scheduler *self, int worker, bool waiting, int64_t now_ms);
 
 /* How long a lease granted to this worker now would last (ms): see the
  * rule above. */

@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "job/frames.h"
+#include "tex/tex.h"
 #include "standalone.h"
 #include "util/exitcodes.h"
 #include "worker_loop.h"
@@ -48,6 +49,9 @@ static void usage(FILE *out)
         "  --preview OUT.png       also write an sRGB PNG preview\n"
         "  --stats                 print render statistics\n"
         "  --stats-json FILE       write render statistics as JSON\n"
+        "  --texture-bytes B       memory for texture tiles read on demand (maps made by\n"
+        "                          aafarm-maketx; least recently used tiles are evicted\n"
+        "                          beyond it; 0 = unlimited; default 512M)\n"
         "  --file-cache DIR        (--connect) the host's store of job files (textures),\n"
         "                          shared by its workers (default $XDG_CACHE_HOME/aafarm/\n"
         "                          files, else /var/tmp/aafarm-$UID/files)\n"
@@ -113,7 +117,7 @@ int main(int argc, char **argv)
     enum { O_STANDALONE = 256, O_CONNECT, O_NAME, O_TILE, O_CACHE, O_ARITH, O_BUDGET,
            O_PREVIEW, O_STATS, O_STATS_JSON, O_TILE_DELAY, O_PREPARE_DELAY,
            O_CURVE_SECRET, O_MASTER_KEY, O_FRAMES, O_FILE_CACHE, O_FILE_CACHE_BYTES,
-           O_FILE_CHUNK, O_FILE_INFLIGHT, O_FILE_DELAY };
+           O_FILE_CHUNK, O_FILE_INFLIGHT, O_FILE_DELAY, O_TEXTURE_BYTES };
     static const struct option longopts[] = {
         {"standalone", required_argument, 0, O_STANDALONE},
         {"output", required_argument, 0, 'o'},
@@ -137,6 +141,7 @@ int main(int argc, char **argv)
         {"file-chunk", required_argument, 0, O_FILE_CHUNK},
         {"file-inflight", required_argument, 0, O_FILE_INFLIGHT},
         {"file-delay", required_argument, 0, O_FILE_DELAY},
+        {"texture-bytes", required_argument, 0, O_TEXTURE_BYTES},
         {"quiet", no_argument, 0, 'q'},
         {"verbose", no_argument, 0, 'v'},
         {"help", no_argument, 0, 'h'},
@@ -247,6 +252,15 @@ int main(int argc, char **argv)
             }
             wo.file_delay_ms = (int)n;
             break;
+        case O_TEXTURE_BYTES: {
+            size_t b;
+            if (!parse_bytes(optarg, &b)) {
+                fprintf(stderr, "aafarm-worker: --texture-bytes wants e.g. 64M, 2G or 0, got '%s'\n", optarg);
+                return AAFARM_EXIT_USAGE;
+            }
+            tex_tiles_set_budget(tex_tiles_process(), b);   /* this process's textures */
+            break;
+        }
         case 'q': so.verbosity = wo.verbosity = -1; break;
         case 'v': so.verbosity = wo.verbosity = 1; break;
         case 'h': usage(stdout); return AAFARM_EXIT_OK;

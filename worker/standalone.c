@@ -21,6 +21,7 @@
 #include "image/writer.h"
 #include "job/frames.h"
 #include "job/job_scene.h"
+#include "tex/tex.h"
 #include "tile_render.h"
 #include "tile_runs.h"
 #include "util/exitcodes.h"
@@ -139,14 +140,19 @@ static bool write_stats_json(const char *path, const shared *s, int threads, dou
 {
     FILE *f = fopen(path, "w");
     if (!f) return false;
-    char extra[512];
+    char extra[768];
+    tex_tile_stats ts;
+    tex_tiles_stats(tex_tiles_process(), &ts);
     snprintf(extra, sizeof extra,
              "\"scene\": \"%s\", \"width\": %d, \"height\": %d, \"tiles\": %d, "
              "\"threads\": %d, \"arith\": \"%s\", \"cache_bytes\": %zu, \"seconds\": %.3f, "
-             "\"nonfinite_samples\": %llu",
+             "\"nonfinite_samples\": %llu, \"texture_bytes\": %zu, "
+             "\"texture_tile_loads\": %llu, \"texture_tile_evictions\": %llu, "
+             "\"texture_tile_peak_bytes\": %zu",
              s->opt->scene_path, s->fmt.width, s->fmt.height, s->ntiles, threads,
              trace_arith_name(s->opt->job.arith), s->opt->cache_bytes, secs,
-             (unsigned long long)s->nonfinite.count);
+             (unsigned long long)s->nonfinite.count, ts.budget, ts.loads, ts.evictions,
+             ts.peak_bytes);
     trace_stats_write_json(&s->stats, extra, f);
     fputc('\n', f);
     return fclose(f) == 0;
@@ -245,6 +251,13 @@ static int render_frame(const standalone_options *opt, const job *jb, const fram
     if (opt->stats) {
         fprintf(stderr, "statistics:\n");
         trace_stats_print(&s.stats, stderr);
+        tex_tile_stats ts;
+        tex_tiles_stats(tex_tiles_process(), &ts);
+        if (ts.loads)
+            fprintf(stderr, "  texture tiles (this process): %llu loaded, %llu evicted, peak "
+                    "%.1f MiB of a %.1f MiB budget%s\n", ts.loads, ts.evictions,
+                    ts.peak_bytes / 1048576.0, ts.budget / 1048576.0,
+                    ts.budget ? "" : " (unlimited)");
     }
     if (fo->stats_json && !write_stats_json(fo->stats_json, &s, threads, secs)) {
         fprintf(stderr, "aafarm-worker: cannot write %s: %s\n", fo->stats_json, strerror(errno));

@@ -8,6 +8,11 @@
  * wait rather than read the file twice). Textures are never freed before
  * the cache, so a pointer handed out stays valid: the shading VM keeps
  * them per run without the lock (sl_vm_set_textures).
+ *
+ * Memory: an aafarm-maketx file opens with its large levels in tiles
+ * (tiles.c) in a pool with a byte budget, the process's unless
+ * tex_cache_set_tiles says otherwise; the cache's own budget counts what
+ * stays in memory for good (tex_bytes).
  */
 #include "tex/tex_internal.h"
 
@@ -30,6 +35,7 @@ struct tex_cache {
     size_t bytes, budget;
     tex_resolve_fn resolve;
     void *resolve_ctx;
+    tex_tiles *tiles;        /* NULL: the process's pool */
 };
 
 tex_cache *tex_cache_new(size_t budget)
@@ -60,6 +66,13 @@ void tex_cache_set_resolver(tex_cache *self, tex_resolve_fn fn, void *ctx)
     pthread_mutex_lock(&self->lock);
     self->resolve = fn;
     self->resolve_ctx = ctx;
+    pthread_mutex_unlock(&self->lock);
+}
+
+void tex_cache_set_tiles(tex_cache *self, tex_tiles *pool)
+{
+    pthread_mutex_lock(&self->lock);
+    self->tiles = pool;
     pthread_mutex_unlock(&self->lock);
 }
 
@@ -111,7 +124,7 @@ const tex_texture *tex_cache_get(tex_cache *self, const char *name, char *err, s
     } else {
         snprintf(path, sizeof path, "%s", name);
     }
-    t = tex_open(path, err, errsz);
+    t = tex_open_in(path, self->tiles ? self->tiles : tex_tiles_process(), err, errsz);
     if (t && self->budget && self->bytes + tex_bytes(t) > self->budget) {
         snprintf(err, errsz, "texture '%s': its pyramids take %zu bytes and the textures "
                  "already open %zu, over the budget of %zu bytes; raise the texture memory "

@@ -11,6 +11,9 @@
  * overflows an int. The bound widens every texel coordinate by a relative
  * 1e-9 before rounding it down, so a lookup that rounds the other way
  * still lands on a texel the bound covered.
+ *
+ * Texels come through tex_at: from memory, or from a tile read on demand
+ * (tiles.c), which each public function lets go of when it returns.
  */
 #include "tex/tex_internal.h"
 
@@ -48,7 +51,7 @@ static double fetch(const tex_texture *t, int k, int c, int i, int j, tex_wrap s
     j = wrap_index(j, t->lh[k], tw, &oj);
     if (oi || oj)
         return 0.0;
-    return t->avg[k][((size_t)j * t->lw[k] + i) * t->nch + c];
+    return tex_at(t, 0, k, c, i, j);
 }
 
 /* The texel coordinate of s at a level of n texels. */
@@ -100,6 +103,8 @@ double tex_sample(const tex_texture *t, int c, double s, double tt, double ws, d
         *dds = ds;
     if (ddt)
         *ddt = dt;
+    if (t->tiled)
+        tex_tiles_unpin();
     return v;
 }
 
@@ -186,12 +191,10 @@ static void minmax(const tex_texture *t, int c, int i0, int i1, int j0, int j1, 
     int m = 0;
     while (m + 1 < t->nlevels && (((i1 >> m) - (i0 >> m)) > 3 || ((j1 >> m) - (j0 >> m)) > 3))
         m++;
-    int w = t->lw[m];
     for (int j = j0 >> m; j <= j1 >> m; j++)
         for (int i = i0 >> m; i <= i1 >> m; i++) {
-            size_t e = ((size_t)j * w + i) * t->nch + c;
-            *lo = fmin(*lo, t->mn[m][e]);
-            *hi = fmax(*hi, t->mx[m][e]);
+            *lo = fmin(*lo, tex_at(t, 1, m, c, i, j));
+            *hi = fmax(*hi, tex_at(t, 2, m, c, i, j));
         }
 }
 
@@ -336,10 +339,12 @@ void tex_bound(const tex_texture *t, int c, const tex_range *r, tex_wrap swrap,
     }
     *lo = l;
     *hi = h;
+    if (t->tiled)
+        tex_tiles_unpin();
 }
 
-int tex_cells(const tex_texture *t, int c, const tex_range *r, tex_wrap swrap,
-              tex_wrap twrap, tex_cell out[2])
+static int cells(const tex_texture *t, int c, const tex_range *r, tex_wrap swrap,
+                 tex_wrap twrap, tex_cell out[2])
 {
     if (c < 0 || c >= t->nch)
         return 0;
@@ -370,6 +375,15 @@ int tex_cells(const tex_texture *t, int c, const tex_range *r, tex_wrap swrap,
         cell->v[2] = fetch(t, lv, c, i, j + 1, swrap, twrap);
         cell->v[3] = fetch(t, lv, c, i + 1, j + 1, swrap, twrap);
     }
+    return n;
+}
+
+int tex_cells(const tex_texture *t, int c, const tex_range *r, tex_wrap swrap,
+              tex_wrap twrap, tex_cell out[2])
+{
+    int n = cells(t, c, r, swrap, twrap, out);
+    if (t->tiled)
+        tex_tiles_unpin();
     return n;
 }
 

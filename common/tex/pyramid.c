@@ -166,6 +166,7 @@ void tex_free(tex_texture *t)
 {
     if (!t)
         return;
+    tex_tiled_free(t->tiled);
     for (int k = 0; k < t->nlevels && t->avg; k++) {
         free(t->avg[k]);
         if (k > 0 && t->mn)
@@ -194,5 +195,8 @@ size_t tex_bytes(const tex_texture *t) { return t->bytes; }
 
 float tex_texel(const tex_texture *t, int level, int c, int i, int j)
 {
-    return t->avg[level][((size_t)j * t->lw[level] + i) * t->nch + c];
+    float v = tex_at(t, 0, level, c, i, j);
+    if (t->tiled)
+        tex_tiles_unpin();
+    return v;
 }

@@ -1,7 +1,9 @@
 /*
  * read.c: opening an image file as a texture: the format from the file's
  * first bytes (OpenEXR, PNG, TIFF), the reader of that format, then the
- * pyramids (pyramid.c). Errors name the file and say what to do.
+ * pyramids (pyramid.c); an aafarm-maketx file opens with its stored
+ * pyramids instead (read_tiled.c). Errors name the file and say what to
+ * do.
  */
 #include "tex/tex_internal.h"
 
@@ -11,6 +13,11 @@
 #include <string.h>
 
 tex_texture *tex_open(const char *path, char *err, size_t errsz)
+{
+    return tex_open_in(path, NULL, err, errsz);
+}
+
+tex_texture *tex_open_in(const char *path, tex_tiles *pool, char *err, size_t errsz)
 {
     unsigned char magic[8] = { 0 };
     FILE *f = fopen(path, "rb");
@@ -23,6 +30,11 @@ tex_texture *tex_open(const char *path, char *err, size_t errsz)
     tex_pixels px = { 0 };
     bool ok;
     if (n >= 4 && magic[0] == 0x76 && magic[1] == 0x2f && magic[2] == 0x31 && magic[3] == 0x01) {
+        tex_texture *tiled = NULL;
+        if (!tex_open_tiled(path, pool, &tiled, err, errsz))
+            return NULL;
+        if (tiled)
+            return tiled;        /* aafarm-maketx's, with its pyramids */
         ok = tex_read_exr(path, &px, err, errsz);
     } else if (n >= 8 && memcmp(magic, "\x89PNG\r\n\x1a\n", 8) == 0) {
         ok = tex_read_png(path, &px, err, errsz);

@@ -47,6 +47,37 @@ typedef struct tex_texture tex_texture;
  * [0, 1]; non-finite texels read as 0. On failure returns NULL and writes
  * "path: what went wrong" into err. */
 tex_texture *tex_open(const char *path, char *err, size_t errsz);
+
+/* Tiles loaded on demand (tiles.c; docs/textures.md "Memory"): an
+ * aafarm-maketx file (read_tiled.c) keeps its small levels (up to
+ * TEX_RESIDENT_TEXELS texels each) in memory and reads the texels of the
+ * larger ones, of the mean and the min-max pyramid, in the file's tiles on
+ * first touch. A pool holds the tiles of the textures opened with it under
+ * one byte budget: beyond it the least recently used tiles that no lookup
+ * is reading are evicted (a clock sweep), and read again when touched. */
+enum { TEX_RESIDENT_TEXELS = 256 * 256 };
+typedef struct tex_tiles tex_tiles;
+/* budget: bytes of loaded tiles (0: no limit). A tile some lookup is
+ * reading is never evicted, so the pool may pass its budget by the tiles
+ * being read at once (a few per thread). */
+tex_tiles *tex_tiles_new(size_t budget);
+/* Only after every texture opened with it is freed. */
+void tex_tiles_free(tex_tiles *pool);
+/* The pool a process's caches use unless told otherwise (budget
+ * TEX_DEFAULT_TILE_BYTES until set; aafarm-worker --texture-bytes). */
+#define TEX_DEFAULT_TILE_BYTES ((size_t)512 << 20)
+tex_tiles *tex_tiles_process(void);
+void tex_tiles_set_budget(tex_tiles *pool, size_t budget);
+typedef struct tex_tile_stats {
+    size_t budget, bytes, peak_bytes;   /* bytes of tiles: the budget, now, the most */
+    unsigned long long loads, evictions, failures;  /* failures: tiles that could not be read */
+} tex_tile_stats;
+void tex_tiles_stats(tex_tiles *pool, tex_tile_stats *out);
+/* tex_open with the tiles of an aafarm-maketx file in pool (NULL: a pool
+ * of its own without a budget). */
+tex_texture *tex_open_in(const char *path, tex_tiles *pool, char *err, size_t errsz);
+/* The levels read in tiles (0: all in memory). */
+int tex_tiled_levels(const tex_texture *t);
 /* A texture from memory: w x h texels of nch channels, interleaved (for
  * tests and tools). */
 tex_texture *tex_from_pixels(const float *pixels, int w, int h, int nch, const char *name);
@@ -60,7 +91,8 @@ const char *tex_name(const tex_texture *t);
 /* "float" for float or half files, "uint8"/"uint16"/"uint32" else (the
  * type the file stored). */
 const char *tex_type(const tex_texture *t);
-/* Bytes held by the texels of the two pyramids. */
+/* Bytes held by the texels of the two pyramids in memory for good (a
+ * texture read in tiles: its resident levels; the tiles are its pool's). */
 size_t tex_bytes(const tex_texture *t);
 /* Level k's texel (i, j) of channel c (no wrapping: in range only). */
 float tex_texel(const tex_texture *t, int level, int c, int i, int j);
@@ -122,9 +154,13 @@ typedef struct tex_cache tex_cache;
 /* A cache of open textures by name, shared by threads: resolve and open
  * happen once per name, under a lock; lookups of open names take the lock
  * only to read the table. budget: bytes of texels before opening another
- * texture fails (0: no limit). */
+ * texture fails (0: no limit); tiles loaded on demand count against their
+ * pool's budget instead (tex_cache_set_tiles). */
 tex_cache *tex_cache_new(size_t budget);
 void tex_cache_free(tex_cache *self);
+/* The tile pool of the textures it opens from now on (default: the
+ * process's, tex_tiles_process). */
+void tex_cache_set_tiles(tex_cache *self, tex_tiles *pool);
 /* Installs the resolver (NULL: names are paths). */
 void tex_cache_set_resolver(tex_cache *self, tex_resolve_fn fn, void *ctx);
 /* The texture called name, opening it on first use; NULL with err. */

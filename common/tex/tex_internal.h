@@ -1,7 +1,10 @@
 /*
  * tex_internal.h: what the files of common/tex share: the texture
- * structure (its two pyramids, tex.h) and the image readers' entry points
- * (read_exr.c, read_png.c, read_tiff.c), each filling a tex_pixels.
+ * structure (its two pyramids, tex.h), the image readers' entry points
+ * (read_exr.c, read_png.c, read_tiff.c), each filling a tex_pixels, the
+ * reader of aafarm-maketx files (read_tiled.c) and the texel access that
+ * goes to a tile loaded on demand where a level is not in memory
+ * (tiles.c).
  */
 #ifndef TEX_TEX_INTERNAL_H
 #define TEX_TEX_INTERNAL_H
@@ -11,6 +14,14 @@
 #include <stdint.h>
 
 enum { TEX_MAX_CHANNELS = 64, TEX_MAX_SIDE = 1 << 20 };
+
+/* The attributes of part 0 that mark an aafarm-maketx file with its
+ * min-max pyramid (write_exr.c, read_tiled.c) and the layout version this
+ * reader knows. */
+#define TEX_ATTR_VERSION "aafarmTexture"
+#define TEX_ATTR_LIPSCHITZ "aafarmLipschitz"
+#define TEX_ATTR_TYPE "aafarmType"
+enum { TEX_FILE_VERSION = 1 };
 
 /* An image as read: w x h texels of nch channels, interleaved, row 0 the
  * top of the image (t = 0). */
@@ -28,8 +39,37 @@ struct tex_texture {
     float **avg;          /* level k's texels, interleaved; avg[0] the image */
     float **mn, **mx;     /* min-max pyramid; level 0 is avg[0] itself */
     double *lips, *lipt;  /* per channel: bounds of |d/ds|, |d/dt| */
-    size_t bytes;
+    size_t bytes;         /* texels in memory for good (not the tiles) */
+    struct tex_tiled *tiled;  /* levels whose avg/mn/mx are NULL load in tiles */
 };
+
+/* Texel (i, j) of channel c of level k of part p (0 the mean pyramid, 1
+ * the min, 2 the max): from memory, or from its tile (tiles.c). */
+float tex_tile_texel(const tex_texture *t, int p, int k, int c, int i, int j);
+
+static inline float tex_at(const tex_texture *t, int p, int k, int c, int i, int j)
+{
+    const float *lv = p == 0 ? t->avg[k] : p == 1 ? t->mn[k] : t->mx[k];
+    if (lv)
+        return lv[((size_t)j * (size_t)t->lw[k] + (size_t)i) * (size_t)t->nch + (size_t)c];
+    return tex_tile_texel(t, p, k, c, i, j);
+}
+
+/* Lets go of the tiles this thread holds (tiles.c): each public lookup
+ * ends with it, so that a tile is pinned only while a lookup reads it. */
+void tex_tiles_unpin(void);
+
+/* An aafarm-maketx file (read_tiled.c): true with *out the texture (or
+ * NULL when the file is not one: no TEX_ATTR_VERSION, or no min-max
+ * pyramid; then read it as an image); false with err when it claims to be
+ * one and is not right. */
+bool tex_open_tiled(const char *path, struct tex_tiles *pool, tex_texture **out, char *err,
+                    size_t errsz);
+/* The name aafarm-maketx gives channel c of nch (write_exr.c): Y; Y A;
+ * R G B (A); c00 c01 ... */
+void tex_channel_name(int nch, int c, char *out, size_t size);
+/* Frees what tex_open_tiled added to a texture (tiles.c). */
+void tex_tiled_free(struct tex_tiled *tiled);
 
 bool tex_read_exr(const char *path, tex_pixels *out, char *err, size_t errsz);
 bool tex_read_png(const char *path, tex_pixels *out, char *err, size_t errsz);

@@ -14,6 +14,8 @@
  *   - two worker processes sharing one store fetch the file once;
  *   - a worker killed mid-transfer (small chunks, slowed down) loses
  *     nothing: the next worker resumes from the chunks written;
+ *   - a worker whose fetch lasts longer than a lease keeps the tiles it
+ *     was granted (no lease expires, no tile is requeued or granted twice);
  *   - a file changed on disk between jobs gets a new job hash and is
  *     fetched again (and the old version leaves a store with a one-file
  *     budget); one changed after the master loaded the job fails the
@@ -158,6 +160,26 @@ static pid_t start_master_on(const char *d, const char *tag, const char *bind, c
 static pid_t start_master(const char *d, const char *tag, char *ep, size_t epsz)
 {
     return start_master_on(d, tag, "tcp://127.0.0.1:*", ep, epsz);
+}
+
+/* start_master with leases of at most lease_s seconds (--lease) */
+static pid_t start_master_lease(const char *d, const char *tag, const char *lease_s, char *ep,
+                                size_t epsz)
+{
+    char log[64], out[64], stats[64];
+    snprintf(log, sizeof log, "master-%s.log", tag);
+    snprintf(out, sizeof out, "farm-%s.exr", tag);
+    snprintf(stats, sizeof stats, "stats-%s.json", tag);
+    char *l = strdup(ft_path(d, log)), *o = strdup(ft_path(d, out)), *s = strdup(ft_path(d, stats));
+    const char *argv[] = {ft_master, ft_path(d, "scene.rib"), "-o", o, "--bind",
+                          "tcp://127.0.0.1:*", "--tile", "8", "--stats-json", s, "--lease",
+                          lease_s, NULL};
+    pid_t pid = ft_spawn(l, argv);
+    assert_true(ft_master_endpoint(l, ep, epsz, 30));
+    free(l);
+    free(o);
+    free(s);
+    return pid;
 }
 
 /* aafarm-worker --connect ep --name name --file-cache cache [extra...] */
@@ -447,6 +469,36 @@ static void test_killed_worker_loses_nothing(void **state)
     free(d);
 }
 
+/* A worker fetching a file for longer than a lease lasts keeps its leases:
+ * the tiles it was granted are not requeued while the chunks flow (each
+ * chunk sent renews them, and FilesReady starts their clock again), and
+ * the render needs no second grant of any tile. */
+static void test_slow_fetch_keeps_its_leases(void **state)
+{
+    (void)state;
+    enum { SIZE = 2000000 };                  /* 31 chunks of 64K, 150 ms apart: 4.5 s */
+    char *d = make_case("slowfetch", 0.1);
+    write_data(ft_path(d, "maps/height.dat"), SIZE, 4);
+    assert_int_equal(ft_standalone(d, 8), 0);
+    char ep[256];
+    char *cache = strdup(ft_path(d, "cache"));
+    pid_t m = start_master_lease(d, "1", "2", ep, sizeof ep);    /* leases of 2 s at most */
+    const char *slow[] = {"--file-chunk", "64K", "--file-inflight", "64K", "--file-delay", "150",
+                          NULL};
+    pid_t a = start_worker(d, "a", ep, cache, slow);
+    expect_master_ok(d, "1", m);
+    assert_int_equal(ft_exr_diff(ft_path(d, "ref.exr"), ft_path(d, "farm-1.exr")), 0);
+    const char *stats = ft_path(d, "stats-1.json");
+    assert_int_equal(worker_number(stats, "a", "file_bytes"), SIZE);
+    assert_true(worker_number(stats, "a", "file_seconds") >= 3);  /* it outlasted a lease */
+    assert_int_equal(ft_json_number(stats, "expired_leases"), 0);
+    assert_int_equal(ft_json_number(stats, "requeued"), 0);
+    assert_int_equal(ft_json_number(stats, "grants"), 12);   /* 32x24 in 8x8 tiles, once each */
+    stop_worker(a);
+    free(cache);
+    free(d);
+}
+
 static void test_changed_file(void **state)
 {
     (void)state;
@@ -637,6 +689,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_files_travel_once_per_host),
         cmocka_unit_test(test_two_workers_share_one_store),
         cmocka_unit_test(test_killed_worker_loses_nothing),
+        cmocka_unit_test(test_slow_fetch_keeps_its_leases),
         cmocka_unit_test(test_changed_file),
         cmocka_unit_test(test_greedy_peer_is_capped),
         cmocka_unit_test(test_texture_map_on_the_farm),

@@ -1,7 +1,8 @@
 /*
  * test_farm_scheduler.c: the master's tile scheduler (master/scheduler.h)
  * without sockets: runs of neighbouring tiles per worker, requeue to the
- * front, deadlines, end-game duplicates, retries and the job failing, stale
+ * front, deadlines (and leases kept while a worker gets the job's files),
+ * end-game duplicates, retries and the job failing, stale
  * and duplicate results, tiles already DONE from a resumed journal, and a
  * randomised run in which workers come, go,
  * fail and time out while every tile must end up taken exactly once.
@@ -284,6 +285,51 @@ static void test_lease_deadline_follows_measured_rate(void **state)
     scheduler_destroy(&s);
 }
 
+/* A worker getting the job's files (scheduler_worker_waiting) keeps the
+ * leases it holds while it makes progress: they last the longest lease
+ * from its last progress, not the farm's measured rate from the grant;
+ * from FilesReady on, the measured rate from then; one that stops making
+ * progress loses them lease_ms after its last chunk; its fetch does not
+ * count in its speed. */
+static void test_waiting_for_files_keeps_leases(void **state)
+{
+    (void)state;
+    scheduler_options o;
+    scheduler_options_default(&o);
+    o.lease_ms = 10000;
+    o.lease_factor = 4;
+    o.lease_min_ms = 500;
+    o.max_duplicates = 0;
+    scheduler *s = scheduler_new(8, 1, &o);
+    int fast = scheduler_worker_add(s), fetcher = scheduler_worker_add(s);
+    scheduler_lease l, f1, f2;
+    for (int i = 0; i < 2; i++) {             /* the farm's rate: 300 ms a tile */
+        assert_true(scheduler_grant(s, fast, 1000 * i, &l));
+        assert_int_equal(scheduler_complete(s, fast, l.id, 1000 * i + 300), SCHEDULER_TAKEN);
+    }
+    assert_int_equal(scheduler_lease_limit(s, fetcher), 1200);
+    scheduler_worker_waiting(s, fetcher, true, 2000);   /* the Job went to it */
+    assert_int_equal(scheduler_lease_limit(s, fetcher), 10000);
+    assert_true(scheduler_grant(s, fetcher, 2000, &f1));
+    assert_true(scheduler_grant(s, fetcher, 2000, &f2));
+    for (int64_t now = 2000; now <= 30000; now += 1000) {   /* a chunk a second, 28 s */
+        scheduler_worker_waiting(s, fetcher, true, now);
+        assert_int_equal(scheduler_expire(s, now + 999), 0);
+    }
+    assert_false(scheduler_worker_overdue(s, fetcher));
+    scheduler_worker_waiting(s, fetcher, false, 31000); /* FilesReady */
+    assert_int_equal(scheduler_expire(s, 31000 + 1199), 0);
+    assert_int_equal(scheduler_complete(s, fetcher, f1.id, 31500), SCHEDULER_TAKEN);
+    assert_int_equal(scheduler_lease_limit(s, fetcher), 4 * 500);   /* not 4 x 29.5 s */
+    /* another fetch that stalls: the lease goes lease_ms after the last chunk */
+    scheduler_worker_waiting(s, fetcher, true, 40000);
+    assert_int_equal(scheduler_expire(s, 40000 + 9999), 0);
+    assert_int_equal(scheduler_expire(s, 40000 + 10000), 1);
+    assert_true(scheduler_worker_overdue(s, fetcher));
+    (void)f2;
+    scheduler_destroy(&s);
+}
+
 static void test_only_worker_gets_its_failed_tile_back(void **state)
 {
     (void)state;
@@ -409,6 +455,7 @@ int main(void)
         cmocka_unit_test(test_failures_retry_elsewhere_then_fail_job),
         cmocka_unit_test(test_not_retryable_needs_a_second_worker),
         cmocka_unit_test(test_lease_deadline_follows_measured_rate),
+        cmocka_unit_test(test_waiting_for_files_keeps_leases),
         cmocka_unit_test(test_only_worker_gets_its_failed_tile_back),
         cmocka_unit_test(test_stale_results),
         cmocka_unit_test(test_resumed_tiles_never_granted),
