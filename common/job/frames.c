@@ -9,6 +9,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 enum { FRAME_MAX_NUMBER = 99999999 };
 
@@ -288,6 +289,40 @@ static int scan_frames(const char *rib_path, int **numbers, sl_diag *diag)
     return n;
 }
 
+/* true when path a and file b are one file (an output not written yet is
+ * no file at all) */
+static bool same_file(const char *a, const char *b)
+{
+    struct stat sa, sb;
+    return a && b && stat(a, &sa) == 0 && stat(b, &sb) == 0 && sa.st_dev == sb.st_dev &&
+           sa.st_ino == sb.st_ino;
+}
+
+/* An output that is the scene or a file its shaders read (a texture, often
+ * an .exr itself) would be replaced by the image: refused, naming both. */
+static bool outputs_spare_inputs(const frame_sequence *seq, const char *rib_path, bool *usage,
+                                 sl_diag *diag)
+{
+    for (int i = 0; i < seq->count; i++) {
+        const char *out = seq->outputs[i];
+        const char *what = same_file(out, rib_path) ? "the scene file" : NULL, *name = rib_path;
+        const job *jb = seq->jobs[i];
+        for (int f = 0; !what && f < jb->nfiles; f++)
+            if (same_file(out, jb->files[f].path)) {
+                what = "the file its shaders read as";
+                name = jb->files[f].name;
+            }
+        if (what) {
+            sl_diag_error(diag, (sl_pos){0},
+                          "the output %s is %s '%s': writing the image would replace it; "
+                          "give another output name (-o)", out, what, name);
+            *usage = true;
+            return false;
+        }
+    }
+    return true;
+}
+
 frame_sequence *frame_sequence_load(const char *rib_path, const job_options *options,
                                     const char *frames, const char *output, bool *usage,
                                     sl_diag *diag)
@@ -341,6 +376,7 @@ frame_sequence *frame_sequence_load(const char *rib_path, const job_options *opt
     }
     free(indices);
     if (ok) ok = name_outputs(seq, output, usage, diag);
+    if (ok) ok = outputs_spare_inputs(seq, rib_path, usage, diag);
     if (!ok) frame_sequence_destroy(&seq);
     return seq;
 }

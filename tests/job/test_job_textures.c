@@ -20,6 +20,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "job/frames.h"
 #include "job/job.h"
 #include "job/job_scene.h"
 #include "tex/tex.h"
@@ -108,6 +109,54 @@ static void test_opened_when_bound(void **state)
     sl_diag_destroy(&d);
 }
 
+/* An output named like a map the scene reads (or like the scene) would
+ * replace it with the image: refused as a usage error, naming it; another
+ * name loads. */
+static void test_output_never_replaces_an_input(void **state)
+{
+    (void)state;
+    write_file("bumpy.sl", SHADER);
+    float px[4] = { 0.1f, 0.2f, 0.3f, 0.4f };
+    tex_texture *t = tex_from_pixels(px, 2, 2, 1, "h");
+    char map[512], rib[512], err[512];
+    snprintf(map, sizeof map, "%s/maps/h.exr", dir);
+    assert_true(tex_write_exr(map, t, true, err, sizeof err));
+    tex_free(t);
+    write_rib("h.exr");
+    snprintf(rib, sizeof rib, "%s/main.rib", dir);
+    struct stat before;
+    assert_int_equal(stat(map, &before), 0);
+    const char *outputs[2] = { map, rib };
+    const char *said[2] = { "the file its shaders read as 'h.exr'", "the scene file" };
+    for (int i = 0; i < 2; i++) {
+        sl_diag *d = sl_diag_new();
+        bool usage = false;
+        frame_sequence *seq = frame_sequence_load(rib, NULL, NULL, outputs[i], &usage, d);
+        assert_null(seq);
+        assert_true(usage);
+        char *text = NULL;
+        size_t len = 0;
+        FILE *m = open_memstream(&text, &len);
+        sl_diag_print(d, m);
+        fclose(m);
+        if (!strstr(text, said[i]) || !strstr(text, "give another output name"))
+            fail_msg("message: %s", text);
+        free(text);
+        sl_diag_destroy(&d);
+    }
+    char other[600];
+    snprintf(other, sizeof other, "%s/out.exr", dir);
+    sl_diag *d = sl_diag_new();
+    bool usage = false;
+    frame_sequence *seq = frame_sequence_load(rib, NULL, NULL, other, &usage, d);
+    assert_non_null(seq);
+    frame_sequence_destroy(&seq);
+    sl_diag_destroy(&d);
+    struct stat after;
+    assert_int_equal(stat(map, &after), 0);
+    assert_int_equal(after.st_size, before.st_size);
+}
+
 static void test_missing_map_named_at_the_call(void **state)
 {
     (void)state;
@@ -133,6 +182,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_opened_when_bound),
         cmocka_unit_test(test_missing_map_named_at_the_call),
+        cmocka_unit_test(test_output_never_replaces_an_input),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }
