@@ -21,7 +21,9 @@
  * > 0, so 1/W stays bounded over any box (Heidrich & Seidel §4: a range
  * holding 0 would make the box unbounded); P is met with the projected
  * points' hull. Where all weights are equal W is that constant exactly.
- * The affine forms share u's and v's noise symbols throughout.
+ * The affine forms share u's and v's noise symbols throughout. The
+ * interval enclosure is met with the affine one's ranges (plain interval
+ * arithmetic loses the correlation of H and W).
  *
  * Intersection (undisplaced pieces): the (u,v) square split into
  * quarters, each pruned by its affine box of P against the ray's slab
@@ -145,7 +147,7 @@ static ia_interval meet_ia(ia_interval x, ia_interval k)
     return x;
 }
 
-void geom_nurbs_eval_ia(const geom_surface *s, ia_interval u, ia_interval v, geom_ia *o)
+static void eval_ia_plain(const geom_surface *s, ia_interval u, ia_interval v, geom_ia *o)
 {
     const geom_nurbs_piece *pc = piece_of(s);
     ia_interval bu[MAXO], du[MAXO], bv[MAXO], dv[MAXO];
@@ -303,6 +305,31 @@ void geom_nurbs_eval_aa(aa_context *ctx, const geom_surface *s, const aa_form *u
         aa_mul(ctx, &x, &o->dPdu[a], &o->dPdv[b]);
         aa_mul(ctx, &y, &o->dPdu[b], &o->dPdv[a]);
         aa_sub(ctx, &o->Ng[c], &x, &y);
+    }
+}
+
+/* The interval enclosure: the plain interval evaluation met with the
+ * ranges of the affine one (both enclose the same values). Plain interval
+ * arithmetic loses the correlation of H and W: over boxes of side 1/100
+ * its normals still hold 0, where the affine ones are tight. */
+void geom_nurbs_eval_ia(const geom_surface *s, ia_interval u, ia_interval v, geom_ia *o)
+{
+    eval_ia_plain(s, u, v, o);
+    if (!(u.lo <= u.hi && v.lo <= v.hi && isfinite(u.lo) && isfinite(u.hi) &&
+          isfinite(v.lo) && isfinite(v.hi)))
+        return;
+    aa_context ctx;
+    aa_context_init(&ctx, AA_DEFAULT_CAPACITY);
+    aa_form U, V;
+    aa_input(&ctx, &U, u.lo, u.hi);
+    aa_input(&ctx, &V, v.lo, v.hi);
+    geom_aa g;
+    geom_nurbs_eval_aa(&ctx, s, &U, &V, &g);
+    for (int c = 0; c < 3; c++) {
+        o->P[c] = meet_ia(o->P[c], aa_range(&g.P[c]));
+        o->dPdu[c] = meet_ia(o->dPdu[c], aa_range(&g.dPdu[c]));
+        o->dPdv[c] = meet_ia(o->dPdv[c], aa_range(&g.dPdv[c]));
+        o->Ng[c] = meet_ia(o->Ng[c], aa_range(&g.Ng[c]));
     }
 }
 

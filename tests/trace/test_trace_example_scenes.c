@@ -2,7 +2,8 @@
  * test_trace_example_scenes.c: the example scenes of issue 14's new
  * surfaces render: scenes/subdiv.rib (a displaced Catmull-Clark box with
  * creases and extraordinary points) and scenes/knot.rib (a
- * displaced closed mesh of 2304 quads), read from the source tree with
+ * displaced closed mesh of 2304 quads), scenes/nurbs.rib (a displaced
+ * torus of one rational NuPatch), read from the source tree with
  * their shaders, rendered small (Format replaced) in affine arithmetic:
  * no error, the object covers the image as its framing says, and 0
  * pinholes (pinholes.h) on these closed objects.
@@ -92,6 +93,16 @@ static void test_subdiv_scene(void **state)
     assert_true(opaque < W * H / 2);
 }
 
+static void test_nurbs_scene(void **state)
+{
+    (void)state;
+    static const char *const names[] = {"plastic", "lumpy"};
+    int holes, opaque = render_scene("nurbs.rib", names, 2, &holes);
+    assert_int_equal(holes, 0);
+    assert_true(opaque > W * H / 8);
+    assert_true(opaque < W * H / 2);      /* a torus: its hole shows */
+}
+
 static void test_knot_scene(void **state)
 {
     (void)state;
@@ -108,6 +119,7 @@ int main(int argc, char **argv)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_subdiv_scene),
         cmocka_unit_test(test_knot_scene),
+        cmocka_unit_test(test_nurbs_scene),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
