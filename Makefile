@@ -40,7 +40,7 @@ bench: build
 	@build/bin/render_bench
 
 bench-peers: deps
-	@QUICK=$(QUICK) bash bench/peers/run.sh
+	@QUICK=$(QUICK) MESHES=$(MESHES) bash bench/peers/run.sh
 
 clean:
 	rm -rf build build-test build-asan build-bench
