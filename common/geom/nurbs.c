@@ -154,6 +154,13 @@ geom_nurbs *geom_nurbs_new(const geom_nurbs_desc *desc, char *why, int why_size)
     double *ub = ua + du.n, *va = ub + du.n, *vb = va + dv.n;
     int *us = xmalloc((size_t)(du.n + dv.n) * sizeof *us), *vs = us + du.n;
     int nui = intervals(&du, ua, ub, us), nvi = intervals(&dv, va, vb, vs);
+    if ((double)nui * nvi * 4 * du.order * dv.order > GEOM_NURBS_MAX_NET) {
+        geom_fail(why, why_size, "%d x %d pieces of orders %d x %d are too many: their nets "
+                  "would hold more than %d numbers (split the patch)", nui, nvi, du.order,
+                  dv.order, GEOM_NURBS_MAX_NET);
+        free(ua), free(us);
+        return NULL;
+    }
     geom_nurbs *self = xmalloc(sizeof *self);
     self->npieces = nui * nvi;
     self->pieces = xmalloc((size_t)self->npieces * sizeof *self->pieces);

@@ -34,6 +34,8 @@
 
 /* The largest order (degree + 1) in each direction. */
 enum { GEOM_NURBS_MAX_ORDER = 16 };
+/* The most numbers the pieces' nets of one patch may hold (256 MiB). */
+enum { GEOM_NURBS_MAX_NET = 1 << 25 };
 
 /* A NuPatch as the RIB gives it. Knots nondecreasing, n >= order,
  * knot[order-1] <= min < max <= knot[n]; Pw: 4 numbers per point (w x,
@@ -52,7 +54,7 @@ typedef struct geom_nurbs geom_nurbs;
 
 /* Builds the pieces; NULL with a one-line reason in why (an order out of
  * range, knots or a range that do not fit, a weight <= 0, a piece whose
- * points all lie on one line). */
+ * points all lie on one line, more than GEOM_NURBS_MAX_NET numbers). */
 geom_nurbs *geom_nurbs_new(const geom_nurbs_desc *desc, char *why, int why_size);
 void geom_nurbs_free(geom_nurbs **self_p);
 

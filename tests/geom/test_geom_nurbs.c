@@ -19,7 +19,8 @@
  *              range keeps 1/w finite); boxes of side <= 1e-3 bound P to
  *              within 1% of the patch size
  *   intersect  rays aimed at oracle points hit them; rays beside miss
- *   errors     weights <= 0, orders 1 and 17, collinear points
+ *   errors     weights <= 0, orders 1 and 17, collinear points, too many
+ *              pieces
  */
 #include <stdarg.h>
 #include <stddef.h>
@@ -31,6 +32,7 @@
 
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "geom/nurbs.h"
@@ -501,6 +503,21 @@ static void test_errors(void **state)
         p.Pw[4 * i + 0] = i * p.Pw[4 * i + 3];
     }
     expect_error(&p, "is degenerate: its points lie on one line");
+    /* 200 x 200 points of order 16, uniform knots: 185 x 185 pieces of
+     * 1024 numbers each, above the limit, refused before allocating */
+    enum { NP = 200, O = 16 };
+    double *knots = malloc(sizeof(double) * (NP + O)), *pw = malloc(sizeof(double) * 4 * NP * NP);
+    assert_non_null(knots);
+    assert_non_null(pw);
+    for (int k = 0; k < NP + O; k++) knots[k] = k;
+    for (int k = 0; k < NP * NP; k++)
+        pw[4 * k] = k % NP, pw[4 * k + 1] = k / NP, pw[4 * k + 2] = 0, pw[4 * k + 3] = 1;
+    geom_nurbs_desc big = { NP, O, knots, O - 1, NP, NP, O, knots, O - 1, NP, pw };
+    char why[256] = "";
+    assert_null(geom_nurbs_new(&big, why, sizeof why));
+    assert_non_null(strstr(why, "185 x 185 pieces of orders 16 x 16 are too many"));
+    free(knots);
+    free(pw);
 }
 
 int main(void)
