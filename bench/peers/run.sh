@@ -267,10 +267,11 @@ for s in $SCENES; do
     vb=$(field vertex_bytes "$L"); bb=$(field bvh_bytes "$L")
     phases=$(awk -v a="$tess" -v b="$build" -v c="$trace" 'BEGIN {if (a == "") print "-"; else printf "%.3f", a + b + c}')
     data=$(awk -v v="$vb" -v b="$bb" 'BEGIN {if (v == "") print "-"; else printf "%.1f", (v + b) / 1048576}')
-    [ -n "$tex_note" ] && data="$data; mesh to ship $(awk -v v="$vb" 'BEGIN {if (v == "") print "-"; else printf "%.1f", v / 1048576}')"
+    data_cell="$data (vertices+BVH)"
+    [ -n "$tex_note" ] && data_cell="$data_cell; mesh to ship $(awk -v v="$vb" 'BEGIN {if (v == "") print "-"; else printf "%.1f", v / 1048576}')"
     mark=""
     [ "$n" = "$nstar" ] && mark=" **N\\***"
-    echo "$s|Embree|N=$n$mark (tess+build+trace $phases s)|$p|$(count "$s.embree$n")|$(ratio "$p")|$(mib "$(median "$s.embree$n" 3)")|$data (vertices+BVH)|$d ($h/$e/$c)" >>"$WORK/table"
+    echo "$s|Embree|N=$n$mark (tess+build+trace $phases s)|$p|$(count "$s.embree$n")|$(ratio "$p")|$(mib "$(median "$s.embree$n" 3)")|$data_cell|$d ($h/$e/$c)" >>"$WORK/table"
     echo "$s $n $p $phases $data $d $aa_cpu $aa_data" >>"$WORK/sweep"
     if [ "$n" = "$nstar" ]; then
       echo "$s|Embree|N=$n ($nstar_note)|$(ratio "$p")|$data|$aa_data" >>"$WORK/headline"
