@@ -55,7 +55,7 @@ RSS=${RSS:-1}
 if [ -n "$MESHES" ]; then
   # a mesh of 2304 faces: N cells per face; the terrain: N per side
   SCENES=${SCENES:-mesh terrain}
-  CACHE_SCENES=${CACHE_SCENES:-}
+  CACHE_SCENES=${CACHE_SCENES-}      # set (empty: no box cache rounds)
   RSS=0
   DOC_BLOCK=bench-peers-meshes
   if [ -n "$QUICK" ]; then
@@ -73,14 +73,14 @@ if [ -n "$QUICK" ]; then
   RUNS=${RUNS:-1}
   NS=${NS:-"128 256 512"}
   REF_LEAF=0.25
-  CACHE_SCENES=${CACHE_SCENES:-}
+  CACHE_SCENES=${CACHE_SCENES-}
   BIG=${BIG:-0}
 else
   SCENES=${SCENES:-wave nail dented}
   RUNS=${RUNS:-5}
   NS=${NS:-"128 256 512 1024 2048 4096"}
   REF_LEAF=0.0625
-  CACHE_SCENES=${CACHE_SCENES:-wave nail ufo}
+  CACHE_SCENES=${CACHE_SCENES-wave nail ufo}
   BIG=${BIG:-1}
 fi
 
