@@ -1,7 +1,6 @@
 /*
  * nurbs_eval.c: one rational Bezier piece of a NuPatch (GEOM_NURBS,
- * geom/nurbs.h) in the four arithmetics, its bounds and its ray
- * intersection.
+ * geom/nurbs.h) in the four arithmetics, and its bounds.
  *
  * With H(u,v) = sum_ij B_i(u) B_j(v) Hw_ij (homogeneous, W = H.w) and
  * H.xyz = W P, differentiating gives
@@ -25,12 +24,7 @@
  * interval enclosure is met with the affine one's ranges (plain interval
  * arithmetic loses the correlation of H and W).
  *
- * Intersection (undisplaced pieces): the (u,v) square split into
- * quarters, each pruned by its affine box of P against the ray's slab
- * interval (the interval one is much wider: W and H lose their
- * correlation); from side 1/8 (1/32 unless the affine range of Ng.d
- * keeps one sign) Newton's method from the box centre, as for bicubic patches
- * (surface_bicubic.c), down to side 2^-16.
+ * The ray intersection is nurbs_intersect.c.
  */
 #include "geom/nurbs_internal.h"
 #include "geom/surface_internal.h"
@@ -347,124 +341,4 @@ void geom_nurbs_bounds(const geom_surface *s, vec3 *lo, vec3 *hi)
     const geom_nurbs_piece *pc = piece_of(s);
     *lo = v3(pc->hull[0].lo, pc->hull[1].lo, pc->hull[2].lo);
     *hi = v3(pc->hull[0].hi, pc->hull[1].hi, pc->hull[2].hi);
-}
-
-/* ---- intersection --------------------------------------------------- */
-
-/* The ray's t interval inside the box (slabs), within [*t0, *t1]. */
-static bool slab(vec3 o, vec3 d, const ia_interval *box, double *t0, double *t1)
-{
-    double a = *t0, b = *t1;
-    for (int c = 0; c < 3; c++) {
-        double oc = v3_comp(o, c), dc = v3_comp(d, c), l = box[c].lo, h = box[c].hi;
-        if (dc == 0) {
-            if (oc < l || oc > h)
-                return false;
-            continue;
-        }
-        double ta = (l - oc) / dc, tb = (h - oc) / dc;
-        if (ta > tb) { double t = ta; ta = tb; tb = t; }
-        double w = 1e-12 * (fabs(ta) + fabs(tb)) + 1e-300;
-        a = fmax(a, ta - w);
-        b = fmin(b, tb + w);
-        if (a > b)
-            return false;
-    }
-    *t0 = a, *t1 = b;
-    return true;
-}
-
-/* Newton's method on o + t d = P(u,v) from (t, u, v), until the steps stop
- * shrinking (as in surface_bicubic.c). */
-static bool newton(const geom_surface *s, vec3 o, vec3 d, double *t, double *u, double *v,
-                   double scale)
-{
-    double last = INFINITY;
-    geom_sample g;
-    for (int it = 0; it < 60; it++) {
-        geom_nurbs_eval_dual(s, *u, *v, &g);
-        vec3 f = v3_sub(v3_add(o, v3_scale(d, *t)), g.P);
-        vec3 a = d, b = v3_neg(g.dPdu), c = v3_neg(g.dPdv);
-        double det = v3_dot(a, v3_cross(b, c));
-        if (!(fabs(det) > 0))
-            break;
-        vec3 r = v3_neg(f);
-        double dt = v3_dot(r, v3_cross(b, c)) / det;
-        double du = v3_dot(a, v3_cross(r, c)) / det, dv = v3_dot(a, v3_cross(b, r)) / det;
-        double step = fabs(du) + fabs(dv) + fabs(dt) * v3_length(d) / scale;
-        if (!isfinite(step) || (it > 2 && step > 0.9 * last) || (it > 40 && step > 1e-6))
-            break;
-        *t += dt, *u += du, *v += dv;
-        last = step;
-        if (step < 1e-16)
-            break;
-        if (fabs(*u - 0.5) > 2 || fabs(*v - 0.5) > 2)
-            return false;
-    }
-    geom_nurbs_eval_dual(s, *u, *v, &g);
-    return v3_length(v3_sub(v3_add(o, v3_scale(d, *t)), g.P)) <= 1e-9 * scale;
-}
-
-bool geom_nurbs_intersect(const geom_surface *s, vec3 o, vec3 d, double tmin, double tmax,
-                          geom_hit *hit)
-{
-    enum { MIN_DEPTH_TRANSVERSAL = 3, MIN_DEPTH = 5, MAX_DEPTH = 16,
-           STACK = 3 * MAX_DEPTH + 8 };
-    typedef struct node { double u0, v0; int depth; } node;
-    vec3 lo, hi;
-    geom_nurbs_bounds(s, &lo, &hi);
-    double scale = v3_length(v3_sub(hi, lo)) + v3_length(o) + 1e-300, pad = 1e-12 * scale;
-    node stack[STACK];
-    int n = 1;
-    stack[0] = (node){ 0, 0, 0 };
-    double best = tmax;
-    bool found = false;
-    while (n > 0) {
-        node cur = stack[--n];
-        double side = ldexp(1, -cur.depth), u0 = cur.u0, v0 = cur.v0;
-        aa_context ctx;
-        aa_context_init(&ctx, AA_DEFAULT_CAPACITY);
-        aa_form U, V, ndf;
-        aa_input(&ctx, &U, u0, u0 + side);
-        aa_input(&ctx, &V, v0, v0 + side);
-        geom_aa g;
-        geom_nurbs_eval_aa(&ctx, s, &U, &V, &g);
-        ia_interval box[3];
-        for (int c = 0; c < 3; c++) {
-            ia_interval r = aa_range(&g.P[c]);
-            box[c] = ia_make(r.lo - pad, r.hi + pad);
-        }
-        double t0 = tmin, t1 = best;
-        if (!slab(o, d, box, &t0, &t1))
-            continue;
-        const double dd[3] = { d.x, d.y, d.z };
-        aa_lincomb3(&ctx, &ndf, dd, g.Ng, 0);
-        ia_interval nd = aa_range(&ndf);
-        bool across = nd.lo > 0 || nd.hi < 0;
-        if (cur.depth >= (across ? MIN_DEPTH_TRANSVERSAL : MIN_DEPTH)) {
-            double u = u0 + side / 2, v = v0 + side / 2;
-            geom_sample c;
-            geom_nurbs_eval_dual(s, u, v, &c);
-            double t = v3_dot(v3_sub(c.P, o), d) / v3_dot(d, d);
-            double slack = 1e-9;
-            bool inside = newton(s, o, d, &t, &u, &v, scale) && u >= u0 - slack &&
-                          u <= u0 + side + slack && v >= v0 - slack &&
-                          v <= v0 + side + slack && t >= t0 && t <= t1;
-            if (inside && t > tmin + 1e-9 * fabs(tmin) && t < best) {
-                best = t;
-                hit->t = t;
-                hit->u = fmin(fmax(u, 0), 1);
-                hit->v = fmin(fmax(v, 0), 1);
-                found = true;
-            }
-            if ((inside && across) || cur.depth >= MAX_DEPTH)
-                continue;
-        }
-        if (n + 4 > STACK)
-            continue;
-        double h = side / 2;
-        for (int k = 3; k >= 0; k--)
-            stack[n++] = (node){ u0 + (k & 1) * h, v0 + (k >> 1) * h, cur.depth + 1 };
-    }
-    return found;
 }
