@@ -6,12 +6,14 @@
  *
  *   peers_embree SCENE.rib N OUT.png [--normals grid|shader] [--ka KA] [--kd KD]
  *
- * 1. tessellate: the displaced surface of the scene's first object on an
- *    (N+1) x (N+1) vertex grid over its (u,v) square, each vertex from
+ * 1. tessellate: the displaced surface of every object of the scene on an
+ *    (N+1) x (N+1) vertex grid over its (u,v) square (a polygon: per
+ *    face, over its corners; a mesh thus gets N x N cells per face), each
+ *    vertex from
  *    aafarm's own point evaluation (trace_surface_point_eval: base surface
  *    + displacement shader in dual mode), so the surface is exactly
  *    aafarm's function, with the shader's shading normal N per vertex;
- * 2. build: one Embree grid geometry (RTC_GEOMETRY_TYPE_GRID, Embree's own
+ * 2. build: one Embree grid geometry per object (RTC_GEOMETRY_TYPE_GRID, Embree's own
  *    format for displaced tessellations: no index buffer) and its BVH;
  * 3. trace: one primary ray per pixel through the pixel centre, built by
  *    aafarm's camera (trace_camera_ray), shaded with RenderMan's matte
@@ -115,66 +117,101 @@ int main(int argc, char **argv)
         fprintf(stderr, "peers_embree: %s: no objects to tessellate\n", rib);
         return 3;
     }
-    const trace_object *obj = &w->objects[0];
     trace_thread *th = trace_thread_new(w);
 
-    /* 1. tessellate (one float3 of padding: Embree reads 16 bytes per vertex) */
-    long nv = (n + 1) * (n + 1);
+    /* 1. tessellate every object: one (N+1) x (N+1) grid per (u,v) square,
+     * or per face of a polygon (a quad: bilinear in its (u,v) corners; a
+     * triangle: a grid whose last row collapses to its third corner; more
+     * corners: a fan of such triangles); one float3 of padding: Embree
+     * reads 16 bytes per vertex */
+    typedef struct gpatch { int obj; double c[4][2]; } gpatch;
+    gpatch *gp = NULL;
+    long ngp = 0;
+    for (int o = 0; o < w->nobjects; o++) {
+        const geom_surface *sf = &w->objects[o].surf;
+        int parts = sf->kind == GEOM_POLYGON && sf->nuv > 4 ? sf->nuv - 2 : 1;
+        gp = realloc(gp, sizeof *gp * (size_t)(ngp + parts));
+        if (!gp) abort();
+        for (int k = 0; k < parts; k++) {
+            gpatch *g = &gp[ngp++];
+            g->obj = o;
+            if (sf->kind != GEOM_POLYGON) {
+                double sq[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+                memcpy(g->c, sq, sizeof sq);
+            } else if (sf->nuv == 4) {
+                for (int q = 0; q < 4; q++) g->c[q][0] = sf->uv[q][0], g->c[q][1] = sf->uv[q][1];
+            } else {
+                int id[4] = {0, k + 1, k + 2, k + 2};
+                for (int q = 0; q < 4; q++) g->c[q][0] = sf->uv[id[q]][0], g->c[q][1] = sf->uv[id[q]][1];
+            }
+        }
+    }
+    long per = (n + 1) * (n + 1), nv = per * ngp;
     float *P = malloc(sizeof(float) * 3 * (size_t)(nv + 1));
     float *N = malloc(sizeof(float) * 3 * (size_t)(nv + 1));
     if (!P || !N) {
-        fprintf(stderr, "peers_embree: out of memory for a %ldx%ld grid\n", n, n);
+        fprintf(stderr, "peers_embree: out of memory for %ld grids of %ldx%ld\n", ngp, n, n);
         return 1;
     }
     long outside = 0;
     double t0 = cpu_now();
-    for (long j = 0; j <= n; j++) {
-        double v = (double)j / (double)n;
-        for (int pass = 0; pass < 2; pass++) {
-            for (long i = 0; i <= n; i++) {
-                double u = (double)i / (double)n;
-                trace_surface_point sp;
-                trace_surface_point_eval(th, obj, u, v, &sp);
-                if (pass == 0) outside += !geom_uv_inside(&obj->surf, u, v);
-                float *p = &P[3 * (j * (n + 1) + i)], *q = &N[3 * (j * (n + 1) + i)];
-                p[0] = (float)sp.P.x, p[1] = (float)sp.P.y, p[2] = (float)sp.P.z;
-                q[0] = (float)sp.N.x, q[1] = (float)sp.N.y, q[2] = (float)sp.N.z;
-            }
-            /* A row that is one point (the pole of a disk or sphere) makes
-             * Embree's grid intersector report hits along a line through
-             * that point far outside the surface (seen on the nail): move
-             * such a row a thousandth of a cell inwards, a ring instead. */
-            const float *a = &P[3 * (j * (n + 1))], *b = &P[3 * (j * (n + 1) + n / 2)];
-            if (pass == 1 || n < 2 || a[0] != b[0] || a[1] != b[1] || a[2] != b[2]) break;
-            v += (j == n ? -1e-3 : 1e-3) / (double)n;
-        }
-    }
-    if (grid_normals) {
-        /* smooth normals from the grid: central differences of the vertex
-         * positions (one-sided at the borders), the shader's N where they
-         * vanish; shading turns them to face the eye, so the sign is free */
-        float *G = malloc(sizeof(float) * 3 * (size_t)nv);
-        if (!G) abort();
-        for (long j = 0; j <= n; j++)
-            for (long i = 0; i <= n; i++) {
-                long i0 = i > 0 ? i - 1 : i, i1 = i < n ? i + 1 : i;
-                long j0 = j > 0 ? j - 1 : j, j1 = j < n ? j + 1 : j;
-                const float *pu0 = &P[3 * (j * (n + 1) + i0)], *pu1 = &P[3 * (j * (n + 1) + i1)];
-                const float *pv0 = &P[3 * (j0 * (n + 1) + i)], *pv1 = &P[3 * (j1 * (n + 1) + i)];
-                vec3 du = v3(pu1[0] - pu0[0], pu1[1] - pu0[1], pu1[2] - pu0[2]);
-                vec3 dv = v3(pv1[0] - pv0[0], pv1[1] - pv0[1], pv1[2] - pv0[2]);
-                vec3 c = v3_cross(du, dv);
-                double len = v3_length(c);
-                float *g = &G[3 * (j * (n + 1) + i)];
-                const float *q = &N[3 * (j * (n + 1) + i)];
-                if (len > 0 && isfinite(len)) {
-                    g[0] = (float)(c.x / len), g[1] = (float)(c.y / len), g[2] = (float)(c.z / len);
-                } else {
-                    g[0] = q[0], g[1] = q[1], g[2] = q[2];
+    for (long gi = 0; gi < ngp; gi++) {
+        const gpatch *gq = &gp[gi];
+        const trace_object *obj = &w->objects[gq->obj];
+        float *GP = P + 3 * per * gi, *GN = N + 3 * per * gi;
+        for (long j = 0; j <= n; j++) {
+            double v = (double)j / (double)n;
+            for (int pass = 0; pass < 2; pass++) {
+                for (long i = 0; i <= n; i++) {
+                    double a = (double)i / (double)n, u, vv;
+                    /* bilinear in the corners c0 c1 c2 c3 (counter-clockwise) */
+                    u = (1 - v) * ((1 - a) * gq->c[0][0] + a * gq->c[1][0]) +
+                        v * ((1 - a) * gq->c[3][0] + a * gq->c[2][0]);
+                    vv = (1 - v) * ((1 - a) * gq->c[0][1] + a * gq->c[1][1]) +
+                         v * ((1 - a) * gq->c[3][1] + a * gq->c[2][1]);
+                    trace_surface_point sp;
+                    trace_surface_point_eval(th, obj, u, vv, &sp);
+                    if (pass == 0) outside += !geom_uv_inside(&obj->surf, u, vv);
+                    float *p = &GP[3 * (j * (n + 1) + i)], *q = &GN[3 * (j * (n + 1) + i)];
+                    p[0] = (float)sp.P.x, p[1] = (float)sp.P.y, p[2] = (float)sp.P.z;
+                    q[0] = (float)sp.N.x, q[1] = (float)sp.N.y, q[2] = (float)sp.N.z;
                 }
+                /* A row that is one point (the pole of a disk or sphere) makes
+                 * Embree's grid intersector report hits along a line through
+                 * that point far outside the surface (seen on the nail): move
+                 * such a row a thousandth of a cell inwards, a ring instead. */
+                const float *a = &GP[3 * (j * (n + 1))], *b = &GP[3 * (j * (n + 1) + n / 2)];
+                if (pass == 1 || n < 2 || a[0] != b[0] || a[1] != b[1] || a[2] != b[2]) break;
+                v += (j == n ? -1e-3 : 1e-3) / (double)n;
             }
-        memcpy(N, G, sizeof(float) * 3 * (size_t)nv);
-        free(G);
+        }
+        if (grid_normals) {
+            /* smooth normals from the grid: central differences of the vertex
+             * positions (one-sided at the borders), the shader's N where they
+             * vanish; shading turns them to face the eye, so the sign is free */
+            float *G = malloc(sizeof(float) * 3 * (size_t)per);
+            if (!G) abort();
+            for (long j = 0; j <= n; j++)
+                for (long i = 0; i <= n; i++) {
+                    long i0 = i > 0 ? i - 1 : i, i1 = i < n ? i + 1 : i;
+                    long j0 = j > 0 ? j - 1 : j, j1 = j < n ? j + 1 : j;
+                    const float *pu0 = &GP[3 * (j * (n + 1) + i0)], *pu1 = &GP[3 * (j * (n + 1) + i1)];
+                    const float *pv0 = &GP[3 * (j0 * (n + 1) + i)], *pv1 = &GP[3 * (j1 * (n + 1) + i)];
+                    vec3 du = v3(pu1[0] - pu0[0], pu1[1] - pu0[1], pu1[2] - pu0[2]);
+                    vec3 dv = v3(pv1[0] - pv0[0], pv1[1] - pv0[1], pv1[2] - pv0[2]);
+                    vec3 c = v3_cross(du, dv);
+                    double len = v3_length(c);
+                    float *g = &G[3 * (j * (n + 1) + i)];
+                    const float *q = &GN[3 * (j * (n + 1) + i)];
+                    if (len > 0 && isfinite(len)) {
+                        g[0] = (float)(c.x / len), g[1] = (float)(c.y / len), g[2] = (float)(c.z / len);
+                    } else {
+                        g[0] = q[0], g[1] = q[1], g[2] = q[2];
+                    }
+                }
+            memcpy(GN, G, sizeof(float) * 3 * (size_t)per);
+            free(G);
+        }
     }
     double t_tess = cpu_now() - t0;
     memset(&P[3 * nv], 0, 3 * sizeof(float));
@@ -184,10 +221,10 @@ int main(int argc, char **argv)
         return 1;
     }
     if (outside)
-        fprintf(stderr, "peers_embree: warning: %ld grid vertices lie outside the polygon; "
-                        "a grid covers the whole (u,v) square\n", outside);
+        fprintf(stderr, "peers_embree: warning: %ld grid vertices lie outside their polygon\n",
+                outside);
 
-    /* 2. build */
+    /* 2. build: one grid geometry per object (geomID = object index) */
     mem_monitor mon = {0, 0};
     RTCDevice dev = rtcNewDevice("threads=1,set_affinity=0");
     if (!dev) {
@@ -198,21 +235,28 @@ int main(int argc, char **argv)
     rtcSetDeviceMemoryMonitorFunction(dev, on_memory, &mon);
     t0 = cpu_now();
     RTCScene rscene = rtcNewScene(dev);
-    RTCGeometry g = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_GRID);
-    rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, P, 0,
-                               3 * sizeof(float), (size_t)nv);
-    rtcSetGeometryVertexAttributeCount(g, 1);
-    rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX_ATTRIBUTE, 0, RTC_FORMAT_FLOAT3, N, 0,
-                               3 * sizeof(float), (size_t)nv);
-    struct RTCGrid *grid = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_GRID, 0, RTC_FORMAT_GRID,
-                                                   sizeof(struct RTCGrid), 1);
-    grid->startVertexID = 0;
-    grid->stride = (unsigned)(n + 1);
-    grid->width = (unsigned short)(n + 1);
-    grid->height = (unsigned short)(n + 1);
-    rtcCommitGeometry(g);
-    rtcAttachGeometry(rscene, g);
-    rtcReleaseGeometry(g);
+    for (long gi = 0; gi < ngp;) {
+        long gend = gi;
+        while (gend < ngp && gp[gend].obj == gp[gi].obj) gend++;
+        RTCGeometry g = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_GRID);
+        rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, P + 3 * per * gi,
+                                   0, 3 * sizeof(float), (size_t)(per * (gend - gi)));
+        rtcSetGeometryVertexAttributeCount(g, 1);
+        rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX_ATTRIBUTE, 0, RTC_FORMAT_FLOAT3,
+                                   N + 3 * per * gi, 0, 3 * sizeof(float), (size_t)(per * (gend - gi)));
+        struct RTCGrid *grid = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_GRID, 0, RTC_FORMAT_GRID,
+                                                       sizeof(struct RTCGrid), (size_t)(gend - gi));
+        for (long k = 0; k < gend - gi; k++) {
+            grid[k].startVertexID = (unsigned)(k * per);
+            grid[k].stride = (unsigned)(n + 1);
+            grid[k].width = (unsigned short)(n + 1);
+            grid[k].height = (unsigned short)(n + 1);
+        }
+        rtcCommitGeometry(g);
+        rtcAttachGeometryByID(rscene, g, (unsigned)gp[gi].obj);
+        rtcReleaseGeometry(g);
+        gi = gend;
+    }
     rtcCommitScene(rscene);
     double t_build = cpu_now() - t0;
     long long bvh_bytes = mon.bytes;
@@ -239,6 +283,7 @@ int main(int argc, char **argv)
             rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
             rtcIntersect1(rscene, &ctx, &rh);
             if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) continue;
+            const trace_object *obj = &w->objects[rh.hit.geomID];
             float nf[3];
             rtcInterpolate0(rtcGetGeometry(rscene, rh.hit.geomID), rh.hit.primID, rh.hit.u, rh.hit.v,
                             RTC_BUFFER_TYPE_VERTEX_ATTRIBUTE, 0, nf, 3);
@@ -282,6 +327,7 @@ int main(int argc, char **argv)
     free(img);
     free(P);
     free(N);
+    free(gp);
     trace_thread_destroy(&th);
     job_scene_destroy(&js);
     job_destroy(&jb);

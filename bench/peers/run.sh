@@ -8,6 +8,13 @@
 #   SCENES="wave nail" RUNS=7 ...      override the scenes / runs
 #   RUNS_dented=1 ...                  the runs of one scene (the table's
 #                                      "runs" column says what was done)
+#   MESHES=1 bash bench/peers/run.sh   the displaced mesh (issue 14) and the
+#                                      terrain (issue 16) against Embree:
+#                                      scenes mesh terrain, no POV-Ray (no
+#                                      isosurface), N per face NS_mesh, over
+#                                      the patch NS_terrain; its own table
+#                                      (marker "bench-peers-meshes"); QUICK=1
+#                                      with it: fewer N, one run
 #
 # It installs the peers (deploy/install-bench-deps.sh), builds aafarm and
 # the helpers in build-bench/, and for each scene of bench/peers/scenes/:
@@ -35,25 +42,45 @@
 # prints figures: nothing here fails on time.
 set -euo pipefail
 
+MESHES=${MESHES:-0}
+[ "$MESHES" = "0" ] && MESHES=""
 ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)
 QUICK=${QUICK:-0}
 [ "$QUICK" = "0" ] && QUICK=""
 BUILD=${BUILD:-$ROOT/build-bench}
 WORK=$BUILD/peers-work
 LIMIT=${LIMIT:-1200}            # seconds: a run past this is killed and reported
+DOC_BLOCK=bench-peers
+RSS=${RSS:-1}
+if [ -n "$MESHES" ]; then
+  # a mesh of 2304 faces: N cells per face; the terrain: N per side
+  SCENES=${SCENES:-mesh terrain}
+  CACHE_SCENES=${CACHE_SCENES-}      # set (empty: no box cache rounds)
+  RSS=0
+  DOC_BLOCK=bench-peers-meshes
+  if [ -n "$QUICK" ]; then
+    NS_mesh=${NS_mesh:-"1 2 4"}
+    NS_terrain=${NS_terrain:-"128 256 512"}
+  else
+    NS_mesh=${NS_mesh:-"1 2 4 8 16 32"}
+    NS_terrain=${NS_terrain:-"128 256 512 1024 2048 4096"}
+  fi
+fi
+# the maps a scene reads, shipped to each worker host once (issue 16)
+TEX_terrain=$ROOT/scenes/textures/terrain_height.exr
 if [ -n "$QUICK" ]; then
   SCENES=${SCENES:-wave}
   RUNS=${RUNS:-1}
   NS=${NS:-"128 256 512"}
   REF_LEAF=0.25
-  CACHE_SCENES=${CACHE_SCENES:-}
+  CACHE_SCENES=${CACHE_SCENES-}
   BIG=${BIG:-0}
 else
   SCENES=${SCENES:-wave nail dented}
   RUNS=${RUNS:-5}
   NS=${NS:-"128 256 512 1024 2048 4096"}
   REF_LEAF=0.0625
-  CACHE_SCENES=${CACHE_SCENES:-wave nail ufo}
+  CACHE_SCENES=${CACHE_SCENES-wave nail ufo}
   BIG=${BIG:-1}
 fi
 
@@ -63,7 +90,7 @@ say() { printf 'bench-peers: %s\n' "$*" >&2; }
 bash "$ROOT/deploy/install-bench-deps.sh"
 cmake -S "$ROOT" -B "$BUILD" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DAAFARM_TESTS=OFF >/dev/null
 cmake --build "$BUILD" -j "$(nproc 2>/dev/null || echo 2)" \
-  --target aafarm-worker peers_aafarm peers_compare peers_rusage peers_embree >/dev/null
+  --target aafarm-worker aafarm-maketx peers_aafarm peers_compare peers_rusage peers_embree >/dev/null
 BIN=$BUILD/bin
 for b in aafarm-worker peers_aafarm peers_compare peers_rusage peers_embree; do
   if [ ! -x "$BIN/$b" ]; then
@@ -73,6 +100,9 @@ for b in aafarm-worker peers_aafarm peers_compare peers_rusage peers_embree; do
 done
 rm -rf "$WORK"
 mkdir -p "$WORK"
+case " $SCENES " in
+  *" terrain "*) [ -f "$TEX_terrain" ] || bash "$ROOT/scenes/make_textures.sh" "$BUILD" >&2 ;;
+esac
 DATE=$(date -u +%Y-%m-%d)
 HOST="$(nproc) cores, $(awk '/MemTotal/ {printf "%.0f GiB", $2 / 1048576}' /proc/meminfo), load $(cut -d' ' -f1 /proc/loadavg) at start"
 
@@ -127,7 +157,11 @@ pov() { # pov SCENE MG ACC OUT.png LOG -> timed through run by the caller
 for s in $SCENES; do
   D=$WORK/$s
   mkdir -p "$D"
-  cp "$ROOT/bench/peers/pov/$s.pov" "$ROOT/bench/peers/pov/peers_common.inc" "$D/"
+  has_pov=""
+  if [ -f "$ROOT/bench/peers/pov/$s.pov" ]; then
+    has_pov=1
+    cp "$ROOT/bench/peers/pov/$s.pov" "$ROOT/bench/peers/pov/peers_common.inc" "$D/"
+  fi
   RIB=$ROOT/bench/peers/scenes/$s.rib
   leaf=$REF_LEAF
   say "$s: reference (aafarm, boxes of $leaf pixel)"
@@ -136,6 +170,11 @@ for s in $SCENES; do
   run "$s.aacentre" "$D/aa.log" "$BIN/peers_aafarm" "$RIB" "$D/aa.png"
   read -r aa_d aa_h aa_e aa_c < <(compare "$D/aa.png" "$D/ref.png")
   aa_data=$(awk -v b="$(field cache_peak_bytes "$D/aa.log")" 'BEGIN {printf "%.1f", b / 1048576}')
+  tex_var=TEX_$s
+  tex_note=""
+  if [ -n "${!tex_var:-}" ] && [ -f "${!tex_var}" ]; then
+    tex_note=" + $(stat -c %s "${!tex_var}" | awk '{printf "%.1f", $1 / 1048576}') texture, once per host"
+  fi
 
   # POV-Ray's max_gradient: the analytic bound, or for dented (POV-Ray's
   # own noise, no closed form) the largest gradient POV-Ray reports
@@ -146,7 +185,7 @@ for s in $SCENES; do
   esac
   povref=$D/ref.png
   found=""
-  if [ "$s" != wave ]; then
+  if [ -n "$has_pov" ] && [ "$s" != wave ]; then
     # shellcheck disable=SC2046
     (cd "$D" || exit 1; "$BIN/peers_rusage" "$LIMIT" probe.log $(pov "$s" 20 0.001 probe.png) >/dev/null) || true
     found=$(tr '\n' ' ' <"$D/probe.log" | sed -n 's/.*maximum gradient found was \([0-9.]*\).*/\1/p')
@@ -169,10 +208,16 @@ for s in $SCENES; do
     povs+=("$found")
     povnames+=("max_gradient $found (POV-Ray's found)")
   fi
+  if [ -z "$has_pov" ]; then
+    povs=()
+    povnames=()
+  fi
+  ns_var=NS_$s
+  ns=${!ns_var:-$NS}
 
   # Embree sweep
   nstar=""
-  for n in $NS; do
+  for n in $ns; do
     say "$s: Embree N=$n"
     run "$s.embree$n" "$D/embree$n.log" "$BIN/peers_embree" "$RIB" "$n" "$D/embree$n.png"
     read -r d h e c < <(compare "$D/embree$n.png" "$D/ref.png")
@@ -181,7 +226,7 @@ for s in $SCENES; do
   done
   nstar_note="smallest N matching"
   if [ -z "$nstar" ]; then
-    nstar=$(echo "$NS" | awk '{print $NF}')
+    nstar=$(echo "$ns" | awk '{print $NF}')
     nstar_note="largest N; none matched"
   fi
 
@@ -207,14 +252,14 @@ for s in $SCENES; do
   ratio() { awk -v a="$aa_cpu" -v p="$1" 'BEGIN {if (p == "-" || a == "-" || p <= 0) print "-"; else printf "%.2fx", a / p}'; }
   mib() { awk -v k="$1" 'BEGIN {if (k == "-") print "-"; else printf "%.1f", k / 1024}'; }
   echo "$s $leaf" >>"$WORK/leaves"
-  echo "$s|aafarm|worker, 1 thread; image: same renderer at pixel centres|$aa_cpu|$(count "$s.aafarm")|1.00x|$(mib "$(median "$s.aafarm" 3)")|$aa_data (box cache)|$aa_d ($aa_h/$aa_e/$aa_c)" >>"$WORK/table"
+  echo "$s|aafarm|worker, 1 thread; image: same renderer at pixel centres|$aa_cpu|$(count "$s.aafarm")|1.00x|$(mib "$(median "$s.aafarm" 3)")|$aa_data (box cache)$tex_note|$aa_d ($aa_h/$aa_e/$aa_c)" >>"$WORK/table"
   for i in "${!povs[@]}"; do
     read -r d h e c < <(compare "$D/pov$i.png" "$povref")
     p=$(median "$s.pov$i")
     echo "$s|POV-Ray|${povnames[$i]}|$p|$(count "$s.pov$i")|$(ratio "$p")|$(mib "$(median "$s.pov$i" 3)")|-|$d ($h/$e/$c)" >>"$WORK/table"
     if [ "$i" = 0 ]; then echo "$s|POV-Ray|$(ratio "$p")|$d" >>"$WORK/headline"; fi
   done
-  for n in $NS; do
+  for n in $ns; do
     L=$D/embree$n.log
     p=$(median "$s.embree$n")
     read -r d h e c < <(awk -v s="$s" -v n="$n" '$1 == s && $2 == n {print $3, $4, $5, $6}' "$WORK/embree_diff")
@@ -222,9 +267,11 @@ for s in $SCENES; do
     vb=$(field vertex_bytes "$L"); bb=$(field bvh_bytes "$L")
     phases=$(awk -v a="$tess" -v b="$build" -v c="$trace" 'BEGIN {if (a == "") print "-"; else printf "%.3f", a + b + c}')
     data=$(awk -v v="$vb" -v b="$bb" 'BEGIN {if (v == "") print "-"; else printf "%.1f", (v + b) / 1048576}')
+    data_cell="$data (vertices+BVH)"
+    [ -n "$tex_note" ] && data_cell="$data_cell; mesh to ship $(awk -v v="$vb" 'BEGIN {if (v == "") print "-"; else printf "%.1f", v / 1048576}')"
     mark=""
     [ "$n" = "$nstar" ] && mark=" **N\\***"
-    echo "$s|Embree|N=$n$mark (tess+build+trace $phases s)|$p|$(count "$s.embree$n")|$(ratio "$p")|$(mib "$(median "$s.embree$n" 3)")|$data (vertices+BVH)|$d ($h/$e/$c)" >>"$WORK/table"
+    echo "$s|Embree|N=$n$mark (tess+build+trace $phases s)|$p|$(count "$s.embree$n")|$(ratio "$p")|$(mib "$(median "$s.embree$n" 3)")|$data_cell|$d ($h/$e/$c)" >>"$WORK/table"
     echo "$s $n $p $phases $data $d $aa_cpu $aa_data" >>"$WORK/sweep"
     if [ "$n" = "$nstar" ]; then
       echo "$s|Embree|N=$n ($nstar_note)|$(ratio "$p")|$data|$aa_data" >>"$WORK/headline"
@@ -252,6 +299,7 @@ done
 : >"$WORK/rss"
 sizes="512 256"
 [ "$BIG" = 1 ] && sizes="512 256 2048 1024"
+[ "$RSS" = 1 ] || sizes=""
 # shellcheck disable=SC2086
 set -- $sizes
 while [ $# -ge 2 ]; do
@@ -293,32 +341,34 @@ done
     echo "|---|---|---|---|---|---|---|---|---|"
     awk -F'|' '{printf "| %s | %s | %s | %s | %s | %s | %s | %s | %s |\n", $1, $2, $3, $4, $5, $6, $7, $8, $9}' "$WORK/cache"
   fi
-  echo
-  echo "Worker memory as the image grows (wave, 1 thread):"
-  echo
-  echo "| scene | pixels | cache | peak RSS MiB | box cache peak MiB | CPU s |"
-  echo "|---|---|---|---|---|---|"
-  awk -F'|' '{printf "| %s | %s | %s | %s | %s | %s |\n", $1, $2, $3, $4, $5, $6}' "$WORK/rss"
+  if [ -s "$WORK/rss" ]; then
+    echo
+    echo "Worker memory as the image grows (wave, 1 thread):"
+    echo
+    echo "| scene | pixels | cache | peak RSS MiB | box cache peak MiB | CPU s |"
+    echo "|---|---|---|---|---|---|"
+    awk -F'|' '{printf "| %s | %s | %s | %s | %s | %s |\n", $1, $2, $3, $4, $5, $6}' "$WORK/rss"
+  fi
 } >"$WORK/table.md"
 cat "$WORK/table.md"
 
 # ---- docs/benchmarks.md, the plot, README ----
 if [ -z "$QUICK" ] || [ -n "${WRITE_DOCS:-}" ]; then
   doc=$ROOT/docs/benchmarks.md
-  if grep -q '<!-- bench-peers:begin -->' "$doc"; then
-    awk -v f="$WORK/table.md" '
-      /<!-- bench-peers:begin -->/ {print; while ((getline l < f) > 0) print l; skip = 1; next}
-      /<!-- bench-peers:end -->/ {skip = 0}
+  if grep -q "<!-- $DOC_BLOCK:begin -->" "$doc"; then
+    awk -v f="$WORK/table.md" -v b="<!-- $DOC_BLOCK:begin -->" -v e="<!-- $DOC_BLOCK:end -->" '
+      $0 == b {print; while ((getline l < f) > 0) print l; skip = 1; next}
+      $0 == e {skip = 0}
       !skip' "$doc" >"$WORK/doc.md" && cp "$WORK/doc.md" "$doc"
     say "wrote the table into $doc"
   fi
-  if command -v gnuplot >/dev/null; then
+  if [ "$DOC_BLOCK" = bench-peers ] && command -v gnuplot >/dev/null; then
     awk '$3 != "-" && $4 != "-"' "$WORK/sweep" >"$WORK/sweep.dat"
     gnuplot -e "datafile='$WORK/sweep.dat'; outfile='$ROOT/docs/peers.png'; scenes='$SCENES'" \
       "$ROOT/bench/peers/plot.gp" && say "wrote $ROOT/docs/peers.png"
   fi
   readme=$ROOT/README.md
-  if grep -q '<!-- bench-peers-headline:begin -->' "$readme"; then
+  if [ "$DOC_BLOCK" = bench-peers ] && grep -q '<!-- bench-peers-headline:begin -->' "$readme"; then
     line=$(awk -F'|' -v d="$DATE" '
       $2 == "POV-Ray" {pov[$1] = $3; holes[$1] = $4; order[++n] = $1}
       $2 == "Embree" {emb[$1] = $4 " at " $3; mem[$1] = "Embree vertices+BVH " $5 " MiB, aafarm box cache " $6 " MiB"}

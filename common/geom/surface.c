@@ -23,7 +23,7 @@
 static const char *const kind_names[GEOM__COUNT] = {
     "sphere", "disk", "cylinder", "cone", "paraboloid",
     "hyperboloid", "torus", "polygon", "patch", "bicubic patch",
-    "subdivision face",
+    "subdivision face", "NuPatch piece",
 };
 
 const char *geom_kind_name(geom_kind kind)
@@ -276,6 +276,7 @@ bool geom_surface_prepare(geom_surface *s, char *why, int why_size)
         if (!s->subdiv || s->subdiv_face < 0 || s->subdiv_face >= geom_subdiv_nfaces(s->subdiv))
             return geom_fail(why, why_size, "subdivision face without its mesh");
         return true;
+    case GEOM_NURBS:       return geom_nurbs_prepare(s, why, why_size);
     default:
         return geom_fail(why, why_size, "unknown surface kind %d", (int)s->kind);
     }
@@ -319,6 +320,10 @@ void geom_bounds(const geom_surface *s, vec3 *lo, vec3 *hi)
     }
     if (s->kind == GEOM_SUBDIV) {       /* the 1-ring's convex hull */
         geom_subdiv_bounds(s, lo, hi);
+        return;
+    }
+    if (s->kind == GEOM_NURBS) {        /* the projected points' convex hull */
+        geom_nurbs_bounds(s, lo, hi);
         return;
     }
     if (s->kind == GEOM_BICUBIC) {      /* the control points' convex hull */

@@ -1,7 +1,8 @@
 /*
  * surface.h: the base surfaces of aafarm (RenderMan's quadrics, convex
  * planar polygons and bilinear patches) as parametric surfaces P(u,v) over
- * the unit square, evaluated in four arithmetics:
+ * the unit square (also bicubic patches, subdivision faces and NuPatch
+ * pieces), evaluated in four arithmetics:
  *
  *   float     P, dPdu, dPdv, Ng at one (u,v)                (shading)
  *   dual      the same plus the (u,v)-derivatives of Ng     (calculatenormal
@@ -45,6 +46,7 @@ typedef enum geom_kind {
     GEOM_PATCH,         /* bilinear patch, 4 corners in RIB order */
     GEOM_BICUBIC,       /* bicubic Bezier patch, 16 control points, u fastest */
     GEOM_SUBDIV,        /* a face of a Catmull-Clark mesh (geom/subdiv.h) */
+    GEOM_NURBS,         /* a rational Bezier piece of a NuPatch (geom/nurbs.h) */
     GEOM__COUNT
 } geom_kind;
 
@@ -80,6 +82,10 @@ typedef struct geom_surface {
      * geom/subdiv.h) and the face of its refined mesh */
     const struct geom_subdiv *subdiv;
     int subdiv_face;
+    /* GEOM_NURBS: the NuPatch (shared by its pieces, owned by whoever built
+     * it, geom/nurbs.h) and the piece */
+    const struct geom_nurbs *nurbs;
+    int nurbs_piece;
 } geom_surface;
 
 /* Float evaluation at one (u,v). */

@@ -317,6 +317,7 @@ void geom_eval_aa(aa_context *ctx, const geom_surface *s, const aa_form *u,
     case GEOM_PATCH:       eval_patch(ctx, s, u, v, out); break;
     case GEOM_BICUBIC:     geom_bicubic_eval_aa(ctx, s, u, v, out); break;
     case GEOM_SUBDIV:      geom_subdiv_eval_aa(ctx, s, u, v, out); break;
+    case GEOM_NURBS:       geom_nurbs_eval_aa(ctx, s, u, v, out); break;
     default:
         for (int i = 0; i < 3; i++) {
             aa_unbounded(&out->P[i], 0);

@@ -150,6 +150,9 @@ void geom_eval_dual(const geom_surface *s, double u, double v, geom_sample *out)
     case GEOM_SUBDIV:
         geom_subdiv_eval_dual(s, u, v, out);
         break;
+    case GEOM_NURBS:
+        geom_nurbs_eval_dual(s, u, v, out);
+        break;
     case GEOM_SPHERE: case GEOM_DISK: case GEOM_CYLINDER: case GEOM_CONE:
     case GEOM_PARABOLOID: case GEOM_HYPERBOLOID: case GEOM_TORUS:
         eval_revolution(s, u, v, out);

@@ -81,6 +81,16 @@ void geom_subdiv_bounds(const geom_surface *s, vec3 *lo, vec3 *hi);
 bool geom_subdiv_intersect(const geom_surface *s, vec3 o, vec3 d, double tmin, double tmax,
                            geom_hit *hit);
 
+/* NuPatch pieces (nurbs_eval.c). */
+bool geom_nurbs_prepare(geom_surface *s, char *why, int why_size);
+void geom_nurbs_eval_dual(const geom_surface *s, double u, double v, geom_sample *out);
+void geom_nurbs_eval_ia(const geom_surface *s, ia_interval u, ia_interval v, geom_ia *out);
+void geom_nurbs_eval_aa(aa_context *ctx, const geom_surface *s, const aa_form *u,
+                        const aa_form *v, geom_aa *out);
+void geom_nurbs_bounds(const geom_surface *s, vec3 *lo, vec3 *hi);
+bool geom_nurbs_intersect(const geom_surface *s, vec3 o, vec3 d, double tmin, double tmax,
+                          geom_hit *hit);
+
 /* Formats a one-line reason into why (may be NULL) and returns false. */
 bool geom_fail(char *why, int why_size, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));

@@ -482,6 +482,7 @@ bool geom_intersect(const geom_surface *s, vec3 o, vec3 d, double tmin,
     case GEOM_PATCH:       return hit_patch(s, &r, hit);
     case GEOM_BICUBIC:     return geom_bicubic_intersect(s, o, d, tmin, tmax, hit);
     case GEOM_SUBDIV:      return geom_subdiv_intersect(s, o, d, tmin, tmax, hit);
+    case GEOM_NURBS:       return geom_nurbs_intersect(s, o, d, tmin, tmax, hit);
     default:               return false;
     }
 }

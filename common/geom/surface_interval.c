@@ -188,6 +188,7 @@ void geom_eval_ia(const geom_surface *s, ia_interval u, ia_interval v, geom_ia *
     case GEOM_PATCH:       eval_patch(s, u, v, out); break;
     case GEOM_BICUBIC:     geom_bicubic_eval_ia(s, u, v, out); break;
     case GEOM_SUBDIV:      geom_subdiv_eval_ia(s, u, v, out); break;
+    case GEOM_NURBS:       geom_nurbs_eval_ia(s, u, v, out); break;
     default:
         for (int i = 0; i < 3; i++)
             out->P[i] = out->dPdu[i] = out->dPdv[i] = out->Ng[i] = ia_entire();

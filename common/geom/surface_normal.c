@@ -160,8 +160,10 @@ void geom_unit_normal_aa(aa_context *ctx, const geom_surface *s, const aa_form *
         return;
     }
     case GEOM_SUBDIV:
-        /* near an extraordinary point Ng may be unbounded or hold 0: the
-         * unit normal is then only known to lie in [-1,1]^3 */
+    case GEOM_NURBS:
+        /* near an extraordinary point (a collapsed edge of a NuPatch) Ng
+         * may be unbounded or hold 0: the unit normal is then only known
+         * to lie in [-1,1]^3 */
         normalize_aa(ctx, g->Ng, Nn);
         for (int i = 0; i < 3; i++) {
             ia_interval r = aa_range(&Nn[i]);
@@ -246,6 +248,7 @@ void geom_unit_normal_ia(const geom_surface *s, ia_interval u, ia_interval v,
         normalize_ia(g->Ng, Nn);
         return;
     case GEOM_SUBDIV:
+    case GEOM_NURBS:
         normalize_ia(g->Ng, Nn);
         for (int i = 0; i < 3; i++)
             if (!isfinite(Nn[i].lo) || !isfinite(Nn[i].hi) || (Nn[i].flags & AA_UNBOUNDED)) {

@@ -1,26 +1,36 @@
 /*
- * rib_nupatch.c: NuPatch (RI Specification 3.2 §5.4, non-uniform B-spline
- * patches) of order up to 4, non-rational, and TrimCurve (read and
+ * rib_nupatch.c: NuPatch (RI Specification 3.2 §5.4, non-uniform rational
+ * B-spline patches) of any order up to 16, and TrimCurve (read and
  * ignored with a warning: the whole patch is rendered).
  *
+ *   NuPatch nu uorder uknot umin umax nv vorder vknot vmin vmax "P" | "Pw"
+ *
  * Each knot interval pair inside [umin, umax] x [vmin, vmax] is one
- * polynomial piece of degree < 4, so one bicubic Bezier patch
- * (GEOM_BICUBIC) represents it exactly: the piece is evaluated by de
- * Boor's algorithm (in the interval's own span, also at its ends) on the
- * 4 x 4 grid t = 0, 1/3, 2/3, 1 of the interval, and the Bezier net
- * interpolating those values is B = C^-1 F C^-T with C the Bernstein
- * collocation matrix at those t. Lower orders are thereby raised to
- * cubic. "Pw" is accepted when every weight is the same (the patch is
- * then not rational); other weights are an error (rational patches are
- * not supported yet).
+ * piece. A polynomial patch ("P", or "Pw" with every weight the same) of
+ * orders up to 4 becomes bicubic Bezier patches (GEOM_BICUBIC): the piece
+ * is evaluated by de Boor's algorithm (in the interval's own span, also
+ * at its ends) on the 4 x 4 grid t = 0, 1/3, 2/3, 1 of the interval, and
+ * the Bezier net interpolating those values is B = C^-1 F C^-T with C the
+ * Bernstein collocation matrix at those t; lower orders are thereby
+ * raised to cubic. A rational patch (weights that differ) or a higher
+ * order becomes one geom_nurbs (common/geom/nurbs.h: rational Bezier
+ * pieces by knot insertion), owned by the scene (scene.nurbs), and one
+ * GEOM_NURBS object per piece. "Pw" is RenderMan's homogeneous point
+ * (w x, w y, w z, w); every weight must be > 0.
  */
 #include "scene/rib_parser.h"
 #include "sl/strbuf.h"
+
+#ifdef SCENE_HAVE_GEOM
+#include "geom/nurbs.h"
+#endif
 
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+enum { NUPATCH_MAX_ORDER = 16 };     /* GEOM_NURBS_MAX_ORDER */
 
 typedef struct nurbs_dir {
     int n, order;
@@ -56,11 +66,11 @@ static bool read_dir(rib_parser *p, const rib_request *req, int *i, const char *
     snprintf(what[3], sizeof what[3], "%smax", w);
     if (!one_number(p, req, *i, what[0], &no[0]) || !one_number(p, req, *i + 1, what[1], &no[1]))
         return false;
-    if (!(no[0] == floor(no[0]) && no[1] == floor(no[1]) && no[1] >= 2 && no[1] <= 4 &&
-          no[0] >= no[1] && no[0] <= 1e6)) {
-        rib_error(p, req, req->args[*i].pos, "%sorder must be 2, 3 or 4 (orders above 4 are "
+    if (!(no[0] == floor(no[0]) && no[1] == floor(no[1]) && no[1] >= 2 &&
+          no[1] <= NUPATCH_MAX_ORDER && no[0] >= no[1] && no[0] <= 1e6)) {
+        rib_error(p, req, req->args[*i].pos, "%sorder must be 2 to %d (orders above %d are "
                   "not supported) and n%s at least the order, got n%s %g, %sorder %g",
-                  w, w, w, no[0], w, no[1]);
+                  w, NUPATCH_MAX_ORDER, NUPATCH_MAX_ORDER, w, w, no[0], w, no[1]);
         return false;
     }
     d->n = (int)no[0], d->order = (int)no[1];
@@ -145,6 +155,41 @@ static void interpolate4(const double f[4], double b[4])
     b[3] = f[3];
 }
 
+/* A rational or high-order patch: one geom_nurbs, one object per piece. */
+static void add_nurbs(rib_parser *p, const rib_request *req, const nurbs_dir *du,
+                      const nurbs_dir *dv, const double *pts, int stride)
+{
+#ifdef SCENE_HAVE_GEOM
+    size_t npts = (size_t)du->n * (size_t)dv->n;
+    double *Pw = sl_xrealloc(NULL, 4 * npts * sizeof *Pw);
+    for (size_t k = 0; k < npts; k++) {
+        for (int c = 0; c < 3; c++)
+            Pw[4 * k + c] = pts[stride * k + c];
+        Pw[4 * k + 3] = stride == 4 ? pts[4 * k + 3] : 1;
+    }
+    geom_nurbs_desc d = { du->n, du->order, du->knots, du->lo, du->hi,
+                          dv->n, dv->order, dv->knots, dv->lo, dv->hi, Pw };
+    char why[256] = "";
+    geom_nurbs *nb = geom_nurbs_new(&d, why, sizeof why);
+    free(Pw);
+    if (!nb) {
+        rib_error(p, req, req->pos, "%s", why);
+        return;
+    }
+    scene *sc = p->scene;
+    sc->nurbs = sl_xrealloc(sc->nurbs, (size_t)(sc->nnurbs + 1) * sizeof *sc->nurbs);
+    sc->nurbs[sc->nnurbs++] = nb;
+    for (int k = 0; k < geom_nurbs_npieces(nb) && !sl_diag_full(p->diag); k++) {
+        geom_surface s;
+        geom_nurbs_surface(nb, k, &s);
+        rib_add_surface(p, req, &s);
+    }
+#else
+    (void)du, (void)dv, (void)pts, (void)stride;
+    rib_error(p, req, req->pos, "rational NuPatch needs common/geom");
+#endif
+}
+
 void rib_nu_patch(rib_parser *p, const rib_request *req)
 {
     nurbs_dir du = { 0 }, dv = { 0 };
@@ -162,6 +207,7 @@ void rib_nu_patch(rib_parser *p, const rib_request *req)
     const scene_param *P = rib_params_find(&params, "P");
     const scene_param *Pw = rib_params_find(&params, "Pw");
     int npts = du.n * dv.n, stride = 3;
+    bool rational = false;
     const double *pts = NULL;
     double w = 1;
     if (P && P->type == SL_TYPE_POINT) {
@@ -178,16 +224,23 @@ void rib_nu_patch(rib_parser *p, const rib_request *req)
             goto out;
         }
         pts = Pw->values, stride = 4, w = Pw->values[3];
-        for (int k = 0; k < npts; k++)
-            if (!(Pw->values[4 * k + 3] == w) || w == 0) {
-                rib_error(p, req, Pw->pos, "rational patches are not supported: every weight "
-                          "of \"Pw\" must be the same non-zero number (point %d has %g, point "
-                          "0 %g)", k, Pw->values[4 * k + 3], w);
+        for (int k = 0; k < npts; k++) {
+            double wk = Pw->values[4 * k + 3];
+            if (!(wk > 0) || !isfinite(wk)) {
+                rib_error(p, req, Pw->pos, "\"Pw\" point %d has weight %g: every weight must be "
+                          "a finite number > 0 (\"Pw\" is x*w y*w z*w w)", k, wk);
                 goto out;
             }
+            if (wk != w)
+                rational = true;
+        }
     } else {
         rib_error(p, req, req->pos, "missing the control points: add \"P\" [x y z ...] (or "
                   "\"Pw\" declared as \"vertex float[4] Pw\")");
+        goto out;
+    }
+    if (rational || du.order > 4 || dv.order > 4) {
+        add_nurbs(p, req, &du, &dv, pts, stride);
         goto out;
     }
     size_t nu = (size_t)du.n, nv = (size_t)dv.n;

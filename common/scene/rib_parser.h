@@ -14,7 +14,7 @@
  *   rib_instance.c     ObjectBegin/End, ObjectInstance: retained surfaces
  *   rib_mesh.c         PointsPolygons, PointsGeneralPolygons, GeneralPolygon
  *   rib_patch.c        Basis, Patch "bicubic", PatchMesh
- *   rib_nupatch.c      NuPatch (order <= 4, non-rational), TrimCurve (warned)
+ *   rib_nupatch.c      NuPatch (rational, order <= 16), TrimCurve (warned)
  *   rib_ignored.c      requests read past with a warning, motion blocks
  *
  * The graphics state follows RI Specification 3.2 §4: options are global

@@ -8,6 +8,7 @@
 #include "sl/strbuf.h"
 #ifdef SCENE_HAVE_GEOM
 #include "geom/subdiv.h"
+#include "geom/nurbs.h"
 #endif
 
 #include <stdlib.h>
@@ -63,8 +64,11 @@ void scene_destroy(scene **self_p)
 #ifdef SCENE_HAVE_GEOM
     for (int i = 0; i < self->nsubdivs; i++)
         geom_subdiv_free(&self->subdivs[i]);
+    for (int i = 0; i < self->nnurbs; i++)
+        geom_nurbs_free(&self->nurbs[i]);
 #endif
     free(self->subdivs);
+    free(self->nurbs);
     free_strings(self->archives, self->narchives);
     free(self->display_name);
     free(self->display_type);

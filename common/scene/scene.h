@@ -218,6 +218,9 @@ typedef struct scene {
     struct geom_subdiv **subdivs;  /* SubdivisionMesh meshes, shared by their
                                     * faces' surfaces (geom/subdiv.h) */
     int nsubdivs;
+    struct geom_nurbs **nurbs;     /* rational / high-order NuPatches, shared
+                                    * by their pieces' surfaces (geom/nurbs.h) */
+    int nnurbs;
 } scene;
 
 /* The largest Option "trace" "maxdepth" (each depth is a shading VM per

@@ -157,7 +157,7 @@ void corpus_free(corpus *c)
 
 const char *corpus_surface_name(corpus_surface s)
 {
-    static const char *names[] = {"plane", "sphere", "ellipsoid", "cylinder", "patch", "mesh", "subdiv"};
+    static const char *names[] = {"plane", "sphere", "ellipsoid", "cylinder", "patch", "mesh", "subdiv", "nurbs"};
     return s < CORPUS_NSURFACES ? names[s] : "?";
 }
 
@@ -179,6 +179,26 @@ static void mesh_rib(char *out, size_t size, const char *disp)
                                   x0, y0, Z(x0, y0), x1, y1, Z(x1, y1), x0, y1, Z(x0, y1));
 #undef Z
         }
+}
+
+/* The points of the corpus NuPatch: the half circle of radius 1 (two
+ * rational quadratic arcs, u) swept along a cubic profile (v): radius
+ * 0.6 + 0.1 j, height 0.5 (j - 2), weights wu * wv. */
+static const char *nurbs_points(void)
+{
+    static char out[2048];
+    static const double cx[5] = { 1, 1, 0, -1, -1 }, cy[5] = { 0, 1, 1, 1, 0 };
+    static const double wv[5] = { 1, 2, 0.5, 1, 2 };
+    size_t n = 0;
+    out[0] = '\0';
+    for (int j = 0; j < 5; j++)
+        for (int i = 0; i < 5; i++) {
+            double w = (i % 2 ? 0.70710678118654752 : 1) * wv[j];
+            double r = 0.6 + 0.1 * j;
+            n += (size_t)snprintf(out + n, sizeof out - n, "%.17g %.17g %.17g %.17g  ",
+                                  r * cx[i] * w, r * cy[i] * w, 0.5 * (j - 2) * w, w);
+        }
+    return out;
 }
 
 bool corpus_open(fixture *f, const corpus *c, const corpus_file *sh,
@@ -239,6 +259,14 @@ bool corpus_open(fixture *f, const corpus *c, const corpus_file *sh,
             "-0.809 0.588 0.19  -1.4 0 0  -0.809 -0.588 -0.19  -0.433 -1.331 0.1  "
             "0.309 -0.951 0.118  1.133 -0.823 0.2]\n"
             "AttributeEnd\n", disp);
+        break;
+    case CORPUS_NURBS:
+        /* a rational NuPatch of orders 3 x 4, 2 x 2 pieces: a quarter of a
+         * torus-like surface of revolution whose weights differ (the arcs'
+         * sqrt(2)/2 and a cubic profile weighted 1 2 0.5 1 2) */
+        snprintf(geom, sizeof geom, "Translate 0 0 5\nRotate -60 1 0 0\nRotate 20 0 0 1\n%s"
+            "NuPatch 5 3 [0 0 0 1 1 2 2 2] 0 2  5 4 [0 0 0 0 1 2 2 2 2] 0 2 \"Pw\" [%s]\n",
+            disp, nurbs_points());
         break;
     default:
         return false;

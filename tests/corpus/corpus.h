@@ -2,7 +2,8 @@
  * corpus.h: the shader corpus of issue 9 (tests/shaders/corpus) as the
  * corpus tests see it: every shader and header read from disk, the six
  * test surfaces (plane, sphere, ellipsoid, cylinder, bilinear patch, mesh
- * of triangles, Catmull-Clark subdivision surfaces) as RIB text, an in-memory job of one shader on one
+ * of triangles, Catmull-Clark subdivision surfaces, a rational NuPatch)
+ * as RIB text, an in-memory job of one shader on one
  * surface, and a small deterministic random generator.
  */
 #ifndef TESTS_CORPUS_CORPUS_H
@@ -37,7 +38,7 @@ void corpus_free(corpus *c);
 
 typedef enum corpus_surface {
     CORPUS_PLANE, CORPUS_SPHERE, CORPUS_ELLIPSOID, CORPUS_CYLINDER,
-    CORPUS_PATCH, CORPUS_MESH, CORPUS_SUBDIV, CORPUS_NSURFACES
+    CORPUS_PATCH, CORPUS_MESH, CORPUS_SUBDIV, CORPUS_NURBS, CORPUS_NSURFACES
 } corpus_surface;
 
 const char *corpus_surface_name(corpus_surface s);

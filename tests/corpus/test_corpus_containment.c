@@ -232,6 +232,7 @@ static void test_cylinder(void **state) { (void)state; run_surface(CORPUS_CYLIND
 static void test_patch(void **state) { (void)state; run_surface(CORPUS_PATCH); }
 static void test_mesh(void **state) { (void)state; run_surface(CORPUS_MESH); }
 static void test_subdiv(void **state) { (void)state; run_surface(CORPUS_SUBDIV); }
+static void test_nurbs(void **state) { (void)state; run_surface(CORPUS_NURBS); }
 
 int main(void)
 {
@@ -244,6 +245,7 @@ int main(void)
         cmocka_unit_test(test_patch),
         cmocka_unit_test(test_mesh),
         cmocka_unit_test(test_subdiv),
+        cmocka_unit_test(test_nurbs),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -149,6 +149,7 @@ static void test_orientation(void **state)
     fx_seed(3);
     for (int kind = 0; kind < GEOM__COUNT; kind++) {
         if (kind == GEOM_SUBDIV) continue;    /* needs a mesh: test_geom_subdiv */
+        if (kind == GEOM_NURBS) continue;     /* needs a NuPatch: test_geom_nurbs */
         geom_surface s = fx_default((geom_kind)kind);
         char why[200];
         assert_true(geom_surface_prepare(&s, why, sizeof why));

@@ -5,8 +5,11 @@
  * Cox-de Boor recursion (the textbook definition of the basis functions)
  * at random (u,v) of every piece: clamped and uniform knots, several
  * pieces, order 2 and 3 raised to cubic, a partial [umin, umax] range,
- * "Pw" with equal weights. Rational weights, bad orders, knots and ranges
- * are errors with file:line:col; TrimCurve warns once.
+ * "Pw" with equal weights; orders 5 and 6 (GEOM_NURBS pieces). A rational
+ * quarter circle lies on the exact circle. Weights <= 0, orders above 16,
+ * bad knots, ranges and degenerate pieces are errors with file:line:col;
+ * TrimCurve warns once. (tests/geom/test_geom_nurbs checks the rational
+ * pieces against de Boor.)
  */
 #include <stdarg.h>
 #include <stddef.h>
@@ -93,7 +96,7 @@ static void check(const spline *s, int want_pieces)
     for (int pv = 0; pv < nbv - 1; pv++)
         for (int pu = 0; pu < nbu - 1; pu++) {
             const geom_surface *g = &sc->objects[pv * (nbu - 1) + pu].surface;
-            assert_int_equal(g->kind, GEOM_BICUBIC);
+            assert_int_equal(g->kind, s->ou > 4 || s->ov > 4 ? GEOM_NURBS : GEOM_BICUBIC);
             for (int k = 0; k < 20; k++) {
                 seed = seed * 6364136223846793005ull + 1442695040888963407ull;
                 double lu = 0.02 + 0.96 * ((seed >> 11) & 0xffff) / 65536.0;
@@ -167,10 +170,52 @@ static void test_pw_and_trim(void **state)
     sl_diag_destroy(&d);
 }
 
+/* orders above 4 (GEOM_NURBS pieces) against the same de Boor */
+static void test_high_order(void **state)
+{
+    (void)state;
+    spline s = { 7, 5, 6, 6, { 0, 0, 0, 0, 0, 1, 2, 3, 3, 3, 3, 3 },
+                 { 0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11 }, 0, 3, 5, 6, { { 0, 0, 0 } } };
+    grid_points(&s);
+    check(&s, 3);
+}
+
+/* A rational quadratic quarter circle (middle weight sqrt(2)/2), extruded:
+ * one GEOM_NURBS piece on the exact unit circle. */
+static void test_rational_circle(void **state)
+{
+    (void)state;
+    sl_diag *d;
+    scene *s = parse_rib(WORLD(
+        "NuPatch 3 3 [0 0 0 1 1 1] 0 1 2 2 [0 0 1 1] 0 1 \"Pw\" [1 0 0 1  "
+        "0.70710678118654752 0.70710678118654752 0 0.70710678118654752  0 1 0 1  "
+        "1 0 2 1  0.70710678118654752 0.70710678118654752 1.4142135623730950 "
+        "0.70710678118654752  0 1 2 1]\n"), &d);
+    if (!s)
+        sl_diag_print(d, stderr);
+    assert_non_null(s);
+    assert_int_equal(s->nobjects, 1);
+    assert_int_equal(s->nnurbs, 1);
+    const geom_surface *g = &s->objects[0].surface;
+    assert_int_equal(g->kind, GEOM_NURBS);
+    for (int i = 0; i <= 20; i++)
+        for (int j = 0; j <= 4; j++) {
+            geom_sample e;
+            geom_eval(g, i / 20.0, j / 4.0, &e);
+            assert_true(fabs(hypot(e.P.x, e.P.y) - 1) < 1e-15);
+            assert_true(fabs(e.P.z - 2 * j / 4.0) < 1e-15);
+        }
+    geom_sample e;
+    geom_eval(g, 0.5, 0, &e);          /* the middle of the arc: 45 degrees */
+    assert_true(fabs(e.P.x - e.P.y) < 1e-15);
+    scene_destroy(&s);
+    sl_diag_destroy(&d);
+}
+
 static const error_case cases[] = {
-    { WORLD("NuPatch 5 5 [0 0 0 0 0 1 1 1 1 1] 0 1 2 2 [0 0 1 1] 0 1 \"P\" [0 0 0]\n"),
-      "t.rib:4:9: NuPatch: uorder must be 2, 3 or 4 (orders above 4 are not supported) and "
-      "nu at least the order, got nu 5, uorder 5" },
+    { WORLD("NuPatch 17 17 [0 0 0 0 0 1 1 1 1 1] 0 1 2 2 [0 0 1 1] 0 1 \"P\" [0 0 0]\n"),
+      "t.rib:4:9: NuPatch: uorder must be 2 to 16 (orders above 16 are not supported) and "
+      "nu at least the order, got nu 17, uorder 17" },
     { WORLD("NuPatch 2 2 [0 1 0 1] 0 1 2 2 [0 0 1 1] 0 1 \"P\" [0 0 0]\n"),
       "t.rib:4:13: NuPatch: uknot must be finite and nondecreasing (entry 2 is 0)" },
     { WORLD("NuPatch 2 2 [0 0 1] 0 1 2 2 [0 0 1 1] 0 1 \"P\" [0 0 0]\n"),
@@ -180,10 +225,18 @@ static const error_case cases[] = {
       "got -1 1" },
     { WORLD("NuPatch 2 2 [0 0 1 1] 0 1 2 2 [0 0 1 1] 0 1 \"P\" [0 0 0  1 0 0  0 1 0]\n"),
       "t.rib:4:45: NuPatch: \"P\" needs nu x nv = 4 points, got 3" },
-    { WORLD("NuPatch 2 2 [0 0 1 1] 0 1 2 2 [0 0 1 1] 0 1 \"Pw\" [0 0 0 1  1 0 0 1  0 1 0 2  "
+    { WORLD("NuPatch 2 2 [0 0 1 1] 0 1 2 2 [0 0 1 1] 0 1 \"Pw\" [0 0 0 1  1 0 0 1  0 1 0 -2  "
             "1 1 0 1]\n"),
-      "t.rib:4:45: NuPatch: rational patches are not supported: every weight of \"Pw\" must "
-      "be the same non-zero number (point 2 has 2, point 0 1)" },
+      "t.rib:4:45: NuPatch: \"Pw\" point 2 has weight -2: every weight must be a finite number "
+      "> 0 (\"Pw\" is x*w y*w z*w w)" },
+    { WORLD("NuPatch 2 2 [0 0 1 1] 0 1 2 2 [0 0 1 1] 0 1 \"Pw\" [0 0 0 0  1 0 0 1  0 1 0 1  "
+            "1 1 0 1]\n"),
+      "t.rib:4:45: NuPatch: \"Pw\" point 0 has weight 0: every weight must be a finite number "
+      "> 0 (\"Pw\" is x*w y*w z*w w)" },
+    { WORLD("NuPatch 3 3 [0 0 0 1 1 1] 0 1 2 2 [0 0 1 1] 0 1 \"Pw\" [0 0 0 1  1 0 0 0.5  2 0 0 1  "
+            "3 0 0 1  1 0 0 0.25  5 0 0 1]\n"),
+      "t.rib:4:1: NuPatch: piece (0, 0) over u [0, 1], v [0, 1] is degenerate: its points lie "
+      "on one line" },
 };
 
 static void test_errors(void **state)
@@ -197,6 +250,8 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_pieces),
         cmocka_unit_test(test_pw_and_trim),
+        cmocka_unit_test(test_high_order),
+        cmocka_unit_test(test_rational_circle),
         cmocka_unit_test(test_errors),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
