@@ -178,6 +178,13 @@ static void test_png_and_fbm(void **state)
             hi = fmax(hi, tex_texel(f, 0, 0, i, j));
         }
     assert_true(lo >= -2 && hi <= 2 && hi - lo > 0.1);
+    /* the range it prints is the texels' (within the bilinear filter's
+     * rounding), not the top level's mean */
+    double plo, phi;
+    const char *said = strstr(out, "channel 0 in [");
+    assert_non_null(said);
+    assert_int_equal(sscanf(said, "channel 0 in [%lf, %lf]", &plo, &phi), 2);
+    assert_true(fabs(plo - lo) <= 1e-6 * (1 + fabs(lo)) && fabs(phi - hi) <= 1e-6 * (1 + fabs(hi)));
     tex_free(f);
 }
 

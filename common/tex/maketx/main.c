@@ -128,7 +128,9 @@ int main(int argc, char **argv)
         return 1;
     }
     double lo, hi;
-    tex_range all = { { 0, 1 }, { 0, 1 }, { 1e9, 1e9 }, { 1e9, 1e9 } };
+    /* every lookup at the finest footprint: the texels' range (a footprint
+     * the size of the map would read the top level, the mean, alone) */
+    tex_range all = { { 0, 1 }, { 0, 1 }, { 0, 0 }, { 0, 0 } };
     tex_bound(t, 0, &all, TEX_WRAP_CLAMP, TEX_WRAP_CLAMP, 0, &lo, &hi);
     printf("%s: %d x %d, %d channel%s, %d levels, channel 0 in [%g, %g]\n", out, tex_width(t),
            tex_height(t), tex_channels(t), tex_channels(t) == 1 ? "" : "s", tex_levels(t), lo,
