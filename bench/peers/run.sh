@@ -271,6 +271,7 @@ for s in $SCENES; do
     [ -n "$tex_note" ] && data_cell="$data_cell; mesh to ship $(awk -v v="$vb" 'BEGIN {if (v == "") print "-"; else printf "%.1f", v / 1048576}')"
     mark=""
     [ "$n" = "$nstar" ] && mark=" **N\\***"
+    [ "$n" = "$nstar" ] && [ "$nstar_note" != "smallest N matching" ] && mark=" (largest; none matched)"
     echo "$s|Embree|N=$n$mark (tess+build+trace $phases s)|$p|$(count "$s.embree$n")|$(ratio "$p")|$(mib "$(median "$s.embree$n" 3)")|$data_cell|$d ($h/$e/$c)" >>"$WORK/table"
     echo "$s $n $p $phases $data $d $aa_cpu $aa_data" >>"$WORK/sweep"
     if [ "$n" = "$nstar" ]; then
