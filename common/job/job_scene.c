@@ -216,6 +216,9 @@ static bool build_objects(job_scene *self, sl_diag *diag)
         t->flip = o->reverse_normals;
         t->lights = o->lights;
         t->nlights = o->nlights;
+        /* an instance proposes sharing its prototype's boxes (trace/instance.c) */
+        if (o->instance_of >= 0 && o->instance_of < i)
+            t->box_proto = &w->objects[o->instance_of];
     }
     return true;
 }

@@ -74,6 +74,7 @@ typedef struct rib_object_part {
     geom_surface surface;          /* prepared */
     mat4 ctm;
     sl_pos pos;
+    int first_object;              /* the first object placed from it, -1: none yet */
 } rib_object_part;
 
 typedef struct rib_object_def {

@@ -165,6 +165,10 @@ typedef struct scene_object {
     int *lights;                   /* indices into scene.lights that are on */
     int nlights;
     sl_pos pos;                    /* the defining request (file = scene.file) */
+    int instance_of;               /* ObjectInstance: the index of the first object
+                                    * placed from the same recorded surface (its
+                                    * own index for that one); -1: not instanced.
+                                    * The renderer may share its boxes (Instances) */
 } scene_object;
 
 /* CoordinateSystem "name": a named space. */

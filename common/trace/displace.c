@@ -242,6 +242,7 @@ static void box_interval(trace_thread *th, const trace_object *obj,
 void trace_surface_box(trace_thread *th, const trace_object *obj,
                        double u0, double u1, double v0, double v1, trace_box *out)
 {
+    obj = trace_box_owner(obj);           /* an instance: its prototype's box */
     if (th->world->options.arith == TRACE_ARITH_INTERVAL)
         box_interval(th, obj, u0, u1, v0, v1, out);
     else
@@ -274,9 +275,29 @@ void trace_surface_point_eval(trace_thread *th, const trace_object *obj,
     trace_surface_point_eval_on(th, th->vm, obj, u, v, out);
 }
 
+/* An instance sharing its prototype's boxes (trace/instance.c): its
+ * surface is the prototype's, moved rigidly into its camera space. */
+static void point_of_instance(trace_thread *th, sl_vm *vm, const trace_object *obj,
+                              double u, double v, trace_surface_point *out)
+{
+    trace_surface_point_eval_on(th, vm, obj->box_proto, u, v, out);
+    const mat4 *m = &obj->from_proto, *inv = &obj->to_proto;
+    out->P = mat4_xform_point(m, out->P);
+    out->dPdu = mat4_xform_vector(m, out->dPdu);
+    out->dPdv = mat4_xform_vector(m, out->dPdv);
+    out->Pu = mat4_xform_vector(m, out->Pu);
+    out->Pv = mat4_xform_vector(m, out->Pv);
+    out->N = v3_normalize(mat4_xform_normal(inv, out->N));
+    out->Ng = v3_normalize(mat4_xform_normal(inv, out->Ng));
+}
+
 void trace_surface_point_eval_on(trace_thread *th, sl_vm *vm, const trace_object *obj,
                                  double u, double v, trace_surface_point *out)
 {
+    if (obj->box_proto) {
+        point_of_instance(th, vm, obj, u, v, out);
+        return;
+    }
     geom_sample g;
     if (obj->displacement) geom_eval_dual(&obj->surf, u, v, &g);
     else geom_eval(&obj->surf, u, v, &g);

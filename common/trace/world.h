@@ -48,7 +48,19 @@ typedef struct trace_object {
                                       not transform the tangents (world.c) */
     trace_box root;                /* OBJECT space box over the whole (u,v) square */
     trace_box bound;               /* camera space box of root (for the BVH) */
+    /* instances (trace/instance.c): the earlier instance of the same
+     * recorded surface whose object-space boxes (and displaced surface,
+     * moved rigidly) this object uses; NULL: its own. The adapter proposes
+     * it, trace_renderer_new keeps it only where that changes no surface */
+    const struct trace_object *box_proto;
+    mat4 from_proto, to_proto;     /* box_proto's camera space -> ours, and back */
 } trace_object;
+
+/* The object whose boxes (and box cache entries) stand for obj's. */
+static inline const trace_object *trace_box_owner(const trace_object *obj)
+{
+    return obj->box_proto ? obj->box_proto : obj;
+}
 
 typedef enum trace_light_kind {
     TRACE_LIGHT_AMBIENT, TRACE_LIGHT_DISTANT, TRACE_LIGHT_POINT, TRACE_LIGHT_SPOT,
