@@ -98,6 +98,13 @@ void rib_record_surface(rib_parser *p, const rib_request *req, const geom_surfac
     part->ctm = p->attr.ctm;
     part->pos = req->pos;
     part->first_object = -1;
+    part->nprimvars = p->nsurface_vars;
+    part->primvars = NULL;
+    if (p->nsurface_vars > 0) {
+        part->primvars = sl_xrealloc(NULL, (size_t)p->nsurface_vars * sizeof *part->primvars);
+        memcpy(part->primvars, p->surface_vars,
+               (size_t)p->nsurface_vars * sizeof *part->primvars);
+    }
 }
 
 void rib_object_instance(rib_parser *p, const rib_request *req)
@@ -126,7 +133,8 @@ void rib_object_instance(rib_parser *p, const rib_request *req)
     for (int i = 0; i < d->nparts; i++) {
         rib_object_part *part = &d->parts[i];
         int before = p->scene->nobjects;
-        rib_place_surface(p, req, &part->surface, mat4_mul(ctm, part->ctm), part->pos);
+        rib_place_surface(p, req, &part->surface, mat4_mul(ctm, part->ctm), part->pos,
+                          part->primvars, part->nprimvars);
         if (p->scene->nobjects == before)
             continue;                  /* not placed (an error said why) */
         if (part->first_object < 0)
@@ -139,6 +147,8 @@ void rib_object_defs_free(rib_parser *p)
 {
     for (int i = 0; i < p->ndefs; i++) {
         free(p->defs[i].handle);
+        for (int k = 0; k < p->defs[i].nparts; k++)
+            free(p->defs[i].parts[k].primvars);
         free(p->defs[i].parts);
     }
     free(p->defs);

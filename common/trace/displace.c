@@ -11,6 +11,7 @@
  * (globals.inc), so boxes and points see the same surface.
  */
 #include "trace/displace.h"
+#include "trace/primvar.h"
 
 #include <stdio.h>
 #include <string.h>
@@ -151,6 +152,7 @@ static void box_affine(trace_thread *th, const trace_object *obj,
     sl_vm *vm = th->vm;
     bind_globals_affine(vm, obj, &obj->displacement_spaces, P, N, N, dPdu, dPdv, &u, &v,
                         obj->box_skip_tangents ? NULL : Pd, flat_normal(obj));
+    trace_primvars_bind(vm, obj, false);
     if (sl_vm_run(vm, obj->displacement, SL_MODE_AFFINE, ctx) != SL_OK) {
         trace_thread_fail(th, sl_vm_error(vm));
         aa_unbounded(&P[0], AA_UNBOUNDED);
@@ -228,6 +230,7 @@ static void box_interval(trace_thread *th, const trace_object *obj,
     ia_interval Pd[2][3] = {{dPdu[0], dPdu[1], dPdu[2]}, {dPdv[0], dPdv[1], dPdv[2]}};
     bind_globals_interval(vm, obj, &obj->displacement_spaces, P, N, N, dPdu, dPdv, &u, &v,
                           obj->box_skip_tangents ? NULL : Pd, flat_normal(obj));
+    trace_primvars_bind(vm, obj, false);
     if (sl_vm_run(vm, obj->displacement, SL_MODE_INTERVAL, NULL) != SL_OK) {
         trace_thread_fail(th, sl_vm_error(vm));
         P[0] = P[1] = P[2] = ia_entire();
@@ -342,6 +345,7 @@ void trace_surface_point_eval_on(trace_thread *th, sl_vm *vm, const trace_object
     sl_dual du_ = {u, 1, 0}, dv_ = {v, 0, 1};
     bind_globals_dual(vm, obj, &obj->displacement_spaces, dP, dN, dN, ddPdu, ddPdv, &du_, &dv_,
                       NULL, false);
+    trace_primvars_bind(vm, obj, false);
     th->stats.evals_dual++;
     if (sl_vm_run(vm, obj->displacement, SL_MODE_DUAL, NULL) != SL_OK) {
         trace_thread_fail(th, sl_vm_error(vm));

@@ -23,6 +23,18 @@
 
 typedef enum trace_arith { TRACE_ARITH_AFFINE, TRACE_ARITH_INTERVAL } trace_arith;
 
+/* A primitive variable of an object (docs/scenes.md "Primitive
+ * variables"), in camera space: per component k, c[0][k] + u c[1][k] +
+ * v c[2][k] + u v c[3][k] over the object's (u,v). It sets a global (s,
+ * t, Cs, Os) and the shaders' parameters of its name (trace/primvar.c). */
+typedef struct trace_primvar {
+    sl_global global;              /* SL_G_s, SL_G_t, SL_G_Cs, SL_G_Os; SL_G__COUNT: none */
+    int displacement_param;        /* its index in the displacement program, -1: none */
+    int surface_param;             /* ... in the surface program, -1: none */
+    int size;                      /* 1 or 3 */
+    double c[4][3];
+} trace_primvar;
+
 typedef struct trace_object {
     int id;                        /* index in trace_world.objects */
     char name[64];                 /* for messages: "sphere at ufo.rib:12" */
@@ -52,6 +64,8 @@ typedef struct trace_object {
      * recorded surface whose object-space boxes (and displaced surface,
      * moved rigidly) this object uses; NULL: its own. The adapter proposes
      * it, trace_renderer_new keeps it only where that changes no surface */
+    const trace_primvar *primvars; /* its primitive variables (not owned) */
+    int nprimvars;
     const struct trace_object *box_proto;
     mat4 from_proto, to_proto;     /* box_proto's camera space -> ours, and back */
 } trace_object;
