@@ -209,3 +209,31 @@ void rib_primvars_bilinear(const rib_primvars *pv, const rib_corner c[4], scene_
         }
     }
 }
+
+void rib_primvars_mean(const rib_primvars *pv, const rib_corner *c, int n,
+                       double out[RIB_MAX_PRIMVARS][3])
+{
+    for (int k = 0; k < pv->n; k++)
+        for (int j = 0; j < 3; j++) {
+            double sum = 0;
+            for (int i = 0; i < n && j < pv->v[k].size; i++)
+                sum += value_at(&pv->v[k], &c[i])[j];
+            out[k][j] = j < pv->v[k].size ? sum / n : 0;
+        }
+}
+
+void rib_primvars_bilinear_values(const rib_primvars *pv,
+                                  double vals[4][RIB_MAX_PRIMVARS][3], scene_primvar *out)
+{
+    for (int k = 0; k < pv->n; k++) {
+        start(&pv->v[k], &out[k]);
+        for (int j = 0; j < pv->v[k].size; j++) {
+            double v00 = vals[0][k][j], v10 = vals[1][k][j], v01 = vals[2][k][j],
+                   v11 = vals[3][k][j];
+            out[k].c[0][j] = v00;
+            out[k].c[1][j] = v10 - v00;
+            out[k].c[2][j] = v01 - v00;
+            out[k].c[3][j] = v11 - v10 - v01 + v00;
+        }
+    }
+}

@@ -64,6 +64,15 @@ bool rib_primvars_triangle(const rib_primvars *pv, const rib_corner c[3],
  * (0,1), (1,1): bilinear. */
 void rib_primvars_bilinear(const rib_primvars *pv, const rib_corner c[4], scene_primvar *out);
 
+/* The mean of every variable over corners c[0..n): out[variable][component]. */
+void rib_primvars_mean(const rib_primvars *pv, const rib_corner *c, int n,
+                       double out[RIB_MAX_PRIMVARS][3]);
+
+/* The variables over a patch from their values at its corners (0,0),
+ * (1,0), (0,1), (1,1) (vals[corner] as rib_primvars_mean gives them). */
+void rib_primvars_bilinear_values(const rib_primvars *pv,
+                                  double vals[4][RIB_MAX_PRIMVARS][3], scene_primvar *out);
+
 /* The variables constant over an object: their values at corner c. */
 void rib_primvars_constant(const rib_primvars *pv, const rib_corner *c, scene_primvar *out);
 

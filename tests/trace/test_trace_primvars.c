@@ -11,12 +11,15 @@
  *     two faces differ along their shared edge);
  *   - "st" (facevarying), and "s" alone, through a surface shader that
  *     shows them as its colour;
+ *   - a subdivision mesh: varying Cs linear in the control points' x, y
+ *     (the flat, evenly spaced mesh's limit surface shows that function),
+ *     uniform Cs per control face;
  *   - a user variable ("vertex float height") read by a displacement
  *     shader's parameter of that name: the depth image follows it; the
  *     same on a bilinear Patch ("varying float height", 4 values);
  *   - containment: boxes of the displacement by a primitive variable over
- *     random (u,v) ranges, affine and interval, hold the points: 0
- *     violations.
+ *     random (u,v) ranges, affine and interval, on a mesh, a bilinear
+ *     patch and a subdivision mesh, hold the points: 0 violations.
  */
 #include <float.h>
 #include <math.h>
@@ -219,6 +222,63 @@ static void test_st_and_s(void **state)
             }
 }
 
+/* a flat 3 x 3-face subdivision mesh over the square (evenly spaced, so
+ * its limit surface is the square, linear in each refined face's (u,v)) */
+static void subdiv_rib(char *rib, size_t size, const char *pre, const char *var)
+{
+    size_t n = (size_t)snprintf(rib, size, CAMERA "%sSubdivisionMesh \"catmull-clark\" "
+                                "[4 4 4 4 4 4 4 4 4] [", pre);
+    for (int j = 0; j < 3; j++)
+        for (int i = 0; i < 3; i++)
+            n += (size_t)snprintf(rib + n, size - n, "%d %d %d %d  ", 4 * j + i, 4 * j + i + 1,
+                                  4 * (j + 1) + i + 1, 4 * (j + 1) + i);
+    n += (size_t)snprintf(rib + n, size - n, "] [\"interpolateboundary\"] [0 0] [] [] \"P\" [");
+    for (int j = 0; j < 4; j++)
+        for (int i = 0; i < 4; i++)
+            n += (size_t)snprintf(rib + n, size - n, "%g %g 0  ", -0.8 + 1.6 * i / 3,
+                                  -0.8 + 1.6 * j / 3);
+    snprintf(rib + n, size - n, "] %s\nWorldEnd\n", var);
+}
+
+static void test_subdivision_mesh(void **state)
+{
+    (void)state;
+    static image im;
+    static char rib[8192];
+    char vals[2048];
+    size_t n = 0;
+    for (int j = 0; j < 4; j++)
+        for (int i = 0; i < 4; i++) {
+            double c[3];
+            lin(-0.8 + 1.6 * i / 3, -0.8 + 1.6 * j / 3, c);
+            n += (size_t)snprintf(vals + n, sizeof vals - n, "%.17g %.17g %.17g ", c[0], c[1], c[2]);
+        }
+    char var[2200];
+    snprintf(var, sizeof var, "\"varying color Cs\" [%s]", vals);
+    subdiv_rib(rib, sizeof rib, "", var);
+    render(rib, &im);
+    double w = worst_colour(&im, lin, 0.5 * 2.0 / RES + 1e-3);
+    printf("subdivision mesh, varying Cs: worst %.4f\n", w);
+    /* uniform: one colour per control face (the middle column red) */
+    char uni[1024];
+    n = (size_t)snprintf(uni, sizeof uni, "\"uniform color Cs\" [");
+    for (int f = 0; f < 9; f++)
+        n += (size_t)snprintf(uni + n, sizeof uni - n, "%s", f % 3 == 1 ? "1 0 0 " : "0 0 1 ");
+    snprintf(uni + n, sizeof uni - n, "]");
+    subdiv_rib(rib, sizeof rib, "", uni);
+    render(rib, &im);
+    int red = 0;
+    for (int y = 0; y < RES; y++)
+        for (int x = 0; x < RES; x++) {
+            if (!interior(x, y) || fabs(fabs(wx(x)) - 0.8 / 3) < 0.12) continue;
+            const float *px = &im.rgba[((size_t)y * RES + x) * 4];
+            bool middle = fabs(wx(x)) < 0.8 / 3;
+            assert_true(fabs(px[0] - (middle ? 1 : 0)) < 1e-3 && fabs(px[2] - (middle ? 0 : 1)) < 1e-3);
+            red += middle;
+        }
+    assert_true(red > 50);
+}
+
 /* the depth of a displacement by a user variable: |z - 5| = 4 h^2, with h
  * linear in x (vertex class on the mesh, varying on a bilinear patch) */
 static double height_at(double x) { return 0.1 * (x + 0.8) / 1.6; }
@@ -264,13 +324,17 @@ static double vmax_abs(vec3 a)
 static void test_containment(void **state)
 {
     (void)state;
+    static char sub[8192];
+    subdiv_rib(sub, sizeof sub, "Displacement \"lift\"\n", "\"varying float height\" "
+               "[0 0.1 0.2 0.3  0.1 0.3 -0.2 0  0 0 0.2 0.1  -0.1 0 0.1 0.2]");
     const char *ribs[] = {
         CAMERA "Displacement \"lift\"\nPointsPolygons [4] [0 1 2 3] \"P\" [-0.8 -0.8 0  0.8 -0.8 0  "
         "0.8 0.8 0.3  -0.8 0.8 0] \"vertex float height\" [0 0.3 -0.2 0.1]\nWorldEnd\n",
         CAMERA "Displacement \"lift\"\nPatch \"bilinear\" \"P\" [-0.8 -0.8 0  0.8 -0.8 0.2  "
         "-0.8 0.8 0  0.8 0.8 0] \"varying float height\" [0 0.3 -0.2 0.1]\nWorldEnd\n",
+        sub,
     };
-    for (int r = 0; r < 2; r++)
+    for (int r = 0; r < 3; r++)
         for (int arith = 0; arith < 2; arith++) {
             job_options opt;
             job_options_default(&opt);
@@ -310,10 +374,11 @@ static void test_containment(void **state)
                 }
             }
             assert_false(th->failed);
-            printf("%s, %s: %ld points, %ld violations\n", r ? "patch" : "mesh",
+            printf("%s, %s: %ld points, %ld violations\n",
+                   r == 0 ? "mesh" : r == 1 ? "patch" : "subdivision mesh",
                    arith ? "interval" : "affine", points, violations);
             assert_true(points > 1000);
-            assert_true(spread > 0.1);      /* the variable did displace */
+            assert_true(spread > 0.05);     /* the variable did displace */
             assert_int_equal(violations, 0);
             trace_thread_destroy(&th);
             fixture_close(&f);
@@ -327,6 +392,7 @@ int main(void)
         cmocka_unit_test(test_cs_vertex_and_varying),
         cmocka_unit_test(test_cs_facevarying),
         cmocka_unit_test(test_st_and_s),
+        cmocka_unit_test(test_subdivision_mesh),
         cmocka_unit_test(test_user_variable_displaces),
         cmocka_unit_test(test_containment),
     };
