@@ -216,7 +216,7 @@ static void build_primvars(const scene_object *o, trace_object *t, trace_primvar
         if (v->size == 3 && strcmp(v->name, "Os") == 0) pv->global = SL_G_Os;
         pv->displacement_param = primvar_param(t->displacement, v);
         pv->surface_param = primvar_param(t->surface, v);
-        for (int k = 0; k < 4; k++) {
+        for (int k = 0; k < 16; k++) {
             vec3 c = v3(v->c[k][0], v->c[k][1], v->c[k][2]);
             if (v->type == SL_TYPE_POINT)
                 c = k == 0 ? mat4_xform_point(&t->to_camera, c) : mat4_xform_vector(&t->to_camera, c);

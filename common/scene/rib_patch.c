@@ -127,20 +127,8 @@ static void to_bezier(const double m[16], double t[16])
 bool rib_patch_primvars(rib_parser *p, const rib_request *req, const rib_params *params,
                         const int counts[6], bool cubic, rib_primvars *out)
 {
-    if (!rib_primvars_collect(p, req, params, counts, NULL, out))
-        return false;
-    int kept = 0;
-    for (int i = 0; i < out->n; i++) {
-        if (cubic && out->v[i].cls == SCENE_CLASS_VERTEX) {
-            rib_warning(p, req, req->pos, "\"%s\": vertex-class variables of bicubic patches "
-                        "are not interpolated with the basis yet: ignored (give one value per "
-                        "patch corner, \"varying\")", out->v[i].name);
-            continue;
-        }
-        out->v[kept++] = out->v[i];
-    }
-    out->n = kept;
-    return true;
+    (void)cubic;           /* bicubic vertex-class values: add_bicubic */
+    return rib_primvars_collect(p, req, params, counts, NULL, out);
 }
 
 void rib_patch_vars(rib_parser *p, const rib_primvars *pv, int uniform, int pu, int pv_,
@@ -160,10 +148,15 @@ void rib_patch_vars(rib_parser *p, const rib_primvars *pv, int uniform, int pu, 
 }
 
 /* Adds the bicubic patch whose geometry G[k][l] (u index k, v index l) is
- * point idx[4 l + k] of P (with the variables set by rib_patch_vars). */
+ * point idx[4 l + k] of P (with the variables set by rib_patch_vars, its
+ * vertex-class ones, of pv, into vars, interpolated with the basis as P
+ * is). */
 static void add_bicubic(rib_parser *p, const rib_request *req, const double *P,
-                        const int idx[16], sl_pos at)
+                        const int idx[16], sl_pos at, const rib_primvars *pv,
+                        scene_primvar *vars)
 {
+    if (pv && pv->n > 0)
+        rib_primvars_bicubic(pv, idx, p->attr.ubasis, p->attr.vbasis, vars);
     double tu[16], tv[16];
     to_bezier(p->attr.ubasis, tu);
     to_bezier(p->attr.vbasis, tv);
@@ -212,7 +205,7 @@ void rib_patch_bicubic(rib_parser *p, const rib_request *req, const scene_param 
     scene_primvar vars[RIB_MAX_PRIMVARS];
     if (pv)
         rib_patch_vars(p, pv, 0, 0, 0, 2, 2, NULL, vars);
-    add_bicubic(p, req, P->values, idx, req->pos);
+    add_bicubic(p, req, P->values, idx, req->pos, pv, vars);
     p->surface_vars = NULL;
     p->nsurface_vars = 0;
 }
@@ -316,7 +309,7 @@ void rib_patch_mesh(rib_parser *p, const rib_request *req)
                         for (int k = 0; k < 4; k++)
                             idx[4 * l + k] = ((pv * sv + l) % NV) * NU + (pu * su + k) % NU;
                     rib_patch_vars(p, &vars, pv * nupatch + pu, pu, pv, nuvar, nvvar, NULL, pvars);
-                    add_bicubic(p, req, P->values, idx, req->pos);
+                    add_bicubic(p, req, P->values, idx, req->pos, &vars, pvars);
                     continue;
                 }
                 int u0 = pu, u1 = (pu + 1) % NU, v0 = pv, v1 = (pv + 1) % NV;

@@ -8,7 +8,7 @@
  * as varying), facevarying (one per face corner of a mesh). Over a mesh
  * triangle the value is the linear interpolation of its corners' values,
  * over a patch the bilinear one of its four corners': both are
- * polynomials C + u A + v B + u v D of the object's (u,v), which the
+ * polynomials of the object's (u,v) (scene_primvar), which the
  * shading language's VM evaluates in every arithmetic (sl_vm_set_varying_*),
  * so a box over a (u,v) range bounds them exactly up to rounding (the
  * linear ones are affine forms of u and v).
@@ -187,8 +187,8 @@ bool rib_primvars_triangle(const rib_primvars *pv, const rib_corner c[3],
         for (int j = 0; j < pv->v[k].size; j++) {
             double e1 = v1[j] - v0[j], e2 = v2[j] - v0[j];
             double a = (e1 * d2v - e2 * d1v) / det, b = (e2 * d1u - e1 * d2u) / det;
-            out[k].c[1][j] = a;
-            out[k].c[2][j] = b;
+            out[k].c[1][j] = a;             /* u */
+            out[k].c[4][j] = b;             /* v */
             out[k].c[0][j] = v0[j] - uv[0][0] * a - uv[0][1] * b;
         }
     }
@@ -203,9 +203,9 @@ void rib_primvars_bilinear(const rib_primvars *pv, const rib_corner c[4], scene_
                      *v01 = value_at(&pv->v[k], &c[2]), *v11 = value_at(&pv->v[k], &c[3]);
         for (int j = 0; j < pv->v[k].size; j++) {
             out[k].c[0][j] = v00[j];
-            out[k].c[1][j] = v10[j] - v00[j];
-            out[k].c[2][j] = v01[j] - v00[j];
-            out[k].c[3][j] = v11[j] - v10[j] - v01[j] + v00[j];
+            out[k].c[1][j] = v10[j] - v00[j];                   /* u */
+            out[k].c[4][j] = v01[j] - v00[j];                   /* v */
+            out[k].c[5][j] = v11[j] - v10[j] - v01[j] + v00[j]; /* u v */
         }
     }
 }
@@ -232,8 +232,31 @@ void rib_primvars_bilinear_values(const rib_primvars *pv,
                    v11 = vals[3][k][j];
             out[k].c[0][j] = v00;
             out[k].c[1][j] = v10 - v00;
-            out[k].c[2][j] = v01 - v00;
-            out[k].c[3][j] = v11 - v10 - v01 + v00;
+            out[k].c[4][j] = v01 - v00;
+            out[k].c[5][j] = v11 - v10 - v01 + v00;
+        }
+    }
+}
+
+void rib_primvars_bicubic(const rib_primvars *pv, const int idx[16], const double mu[16],
+                          const double mv[16], scene_primvar *out)
+{
+    for (int n = 0; n < pv->n; n++) {
+        const rib_primvar_src *s = &pv->v[n];
+        if (s->cls != SCENE_CLASS_VERTEX) continue;
+        start(s, &out[n]);
+        for (int j = 0; j < s->size; j++) {
+            /* T = Mu G Mv^T; the term of u^a v^b is T[3 - a][3 - b] */
+            for (int r = 0; r < 4; r++)
+                for (int q = 0; q < 4; q++) {
+                    double t = 0;
+                    for (int k = 0; k < 4; k++)
+                        for (int l = 0; l < 4; l++)
+                            t += mu[4 * r + k] * mv[4 * q + l] *
+                                 s->values[(size_t)idx[4 * l + k] * (size_t)s->stride +
+                                           (size_t)s->offset + (size_t)j];
+                    out[n].c[(3 - r) + 4 * (3 - q)][j] = t;
+                }
         }
     }
 }

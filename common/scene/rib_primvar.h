@@ -73,6 +73,13 @@ void rib_primvars_mean(const rib_primvars *pv, const rib_corner *c, int n,
 void rib_primvars_bilinear_values(const rib_primvars *pv,
                                   double vals[4][RIB_MAX_PRIMVARS][3], scene_primvar *out);
 
+/* The vertex-class variables over a bicubic patch whose control point
+ * (u index k, v index l) is value idx[4 l + k], with the basis matrices mu,
+ * mv (rows as in the RI Spec: P = U Mu G Mv^T V^T, U = [u^3 u^2 u 1]):
+ * their bicubic polynomials replace out[i] for those variables only. */
+void rib_primvars_bicubic(const rib_primvars *pv, const int idx[16], const double mu[16],
+                          const double mv[16], scene_primvar *out);
+
 /* The variables constant over an object: their values at corner c. */
 void rib_primvars_constant(const rib_primvars *pv, const rib_corner *c, scene_primvar *out);
 

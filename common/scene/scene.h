@@ -104,15 +104,16 @@ typedef struct scene_param {
 
 /* A primitive variable over one object (docs/scenes.md "Primitive
  * variables"): per component k, the value at (u,v) of the object's own
- * parametrisation is c[0][k] + u c[1][k] + v c[2][k] + u v c[3][k] (linear
- * over a mesh triangle, bilinear over a patch, constant for the constant
- * and uniform classes). Points, vectors and normals are in object space.
+ * parametrisation is the polynomial sum over i, j < 4 of c[i + 4 j][k]
+ * u^i v^j (linear over a mesh triangle, bilinear over a patch, bicubic for
+ * the vertex class of a bicubic patch, constant for the constant and
+ * uniform classes). Points, vectors and normals are in object space.
  * "st" arrives as two floats "s" and "t". */
 typedef struct scene_primvar {
     char name[64];
     sl_type type;                  /* float, color, point, vector or normal */
     int size;                      /* components: 1 or 3 */
-    double c[4][3];
+    double c[16][3];               /* c[i + 4 j]: the term of u^i v^j */
 } scene_primvar;
 
 /* One Surface or Displacement request, or a LightSource naming a light

@@ -305,7 +305,7 @@ void sl_vm_clear_globals(sl_vm *self)
 }
 
 static bool add_varying(sl_vm *self, bool global, int target, int size,
-                        const double coef[4][3])
+                        const double coef[16][3])
 {
     if (self->nvarying >= SL_VM_MAX_VARYING || size < 1 || size > 3)
         return false;
@@ -317,14 +317,14 @@ static bool add_varying(sl_vm *self, bool global, int target, int size,
     return true;
 }
 
-bool sl_vm_set_varying_global(sl_vm *self, sl_global g, const double coef[4][3])
+bool sl_vm_set_varying_global(sl_vm *self, sl_global g, const double coef[16][3])
 {
     if (!global_ok(g))
         return false;
     return add_varying(self, true, sl_global_slot(g), sl_global_size(g), coef);
 }
 
-bool sl_vm_set_varying_param(sl_vm *self, int param, int size, const double coef[4][3])
+bool sl_vm_set_varying_param(sl_vm *self, int param, int size, const double coef[16][3])
 {
     return param >= 0 && add_varying(self, false, param, size, coef);
 }

@@ -87,12 +87,12 @@ typedef struct vm_message {
     char s[128];
 } vm_message;
 
-/* A varying global or parameter (sl_vm_set_varying_*): C + u A + v B + u v D. */
+/* A varying global or parameter (sl_vm_set_varying_*): sum c[i + 4 j] u^i v^j. */
 typedef struct vm_varying {
     bool global;
     int target;                    /* the global's first slot, or the parameter */
     int size;
-    double c[4][3];
+    double c[16][3];
 } vm_varying;
 
 typedef struct vm_accumulator {

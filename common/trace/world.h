@@ -24,15 +24,15 @@
 typedef enum trace_arith { TRACE_ARITH_AFFINE, TRACE_ARITH_INTERVAL } trace_arith;
 
 /* A primitive variable of an object (docs/scenes.md "Primitive
- * variables"), in camera space: per component k, c[0][k] + u c[1][k] +
- * v c[2][k] + u v c[3][k] over the object's (u,v). It sets a global (s,
+ * variables"), in camera space: per component k, the polynomial sum
+ * c[i + 4 j][k] u^i v^j over the object's (u,v). It sets a global (s,
  * t, Cs, Os) and the shaders' parameters of its name (trace/primvar.c). */
 typedef struct trace_primvar {
     sl_global global;              /* SL_G_s, SL_G_t, SL_G_Cs, SL_G_Os; SL_G__COUNT: none */
     int displacement_param;        /* its index in the displacement program, -1: none */
     int surface_param;             /* ... in the surface program, -1: none */
     int size;                      /* 1 or 3 */
-    double c[4][3];
+    double c[16][3];
 } trace_primvar;
 
 typedef struct trace_object {

@@ -195,7 +195,7 @@ static void test_variables_degenerate_instances(void **state)
     assert_int_equal(s->objects[2].nprimvars, 1);
     assert_string_equal(s->objects[2].primvars[0].name, "Cs");
     assert_true(s->objects[2].primvars[0].c[0][0] == 1 && s->objects[2].primvars[0].c[1][0] == 0 &&
-                s->objects[2].primvars[0].c[2][0] == 0);
+                s->objects[2].primvars[0].c[4][0] == 0);
     vec3 o = mat4_xform_point(&s->objects[1].object_to_world, v3(0, 0, 0));
     assert_true(vec_dist(o, v3(0, 0, 5)) < 1e-12);
     scene_destroy(&s);

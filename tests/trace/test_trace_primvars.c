@@ -11,6 +11,8 @@
  *     two faces differ along their shared edge);
  *   - "st" (facevarying), and "s" alone, through a surface shader that
  *     shows them as its colour;
+ *   - a bicubic patch's vertex-class Cs, interpolated with the basis (a
+ *     quadratic in u that its corners alone cannot give);
  *   - a subdivision mesh: varying Cs linear in the control points' x, y
  *     (the flat, evenly spaced mesh's limit surface shows that function),
  *     uniform Cs per control face;
@@ -19,7 +21,8 @@
  *     same on a bilinear Patch ("varying float height", 4 values);
  *   - containment: boxes of the displacement by a primitive variable over
  *     random (u,v) ranges, affine and interval, on a mesh, a bilinear
- *     patch and a subdivision mesh, hold the points: 0 violations.
+ *     patch, a subdivision mesh and a b-spline patch (vertex class,
+ *     bicubic), hold the points: 0 violations.
  */
 #include <float.h>
 #include <math.h>
@@ -298,6 +301,41 @@ static void check_lift(const image *im, const char *what)
     assert_true(worst < 0.01);
 }
 
+/* a flat Bezier patch over the square (evenly spaced control points: P is
+ * linear in u, v); vertex-class Cs.r with the Bernstein coefficients of
+ * u^2 (0, 0, 1/3, 1 along u) shows u^2, which a bilinear reading of the
+ * corners (u) would not */
+static void bezier_expect(double x, double y, double rgb[3])
+{
+    double u = (x + 0.8) / 1.6;
+    rgb[0] = u * u;
+    rgb[1] = 0.5 + 0.5 * y;
+    rgb[2] = 0.25;
+}
+
+static void test_bicubic_vertex_class(void **state)
+{
+    (void)state;
+    static image im;
+    static char rib[8192];
+    size_t n = (size_t)snprintf(rib, sizeof rib, CAMERA "Patch \"bicubic\" \"P\" [");
+    for (int l = 0; l < 4; l++)
+        for (int k = 0; k < 4; k++)
+            n += (size_t)snprintf(rib + n, sizeof rib - n, "%.17g %.17g 0  ", -0.8 + 1.6 * k / 3,
+                                  -0.8 + 1.6 * l / 3);
+    n += (size_t)snprintf(rib + n, sizeof rib - n, "] \"vertex color Cs\" [");
+    static const double bern[4] = {0, 0, 1 / 3.0, 1};
+    for (int l = 0; l < 4; l++)
+        for (int k = 0; k < 4; k++)
+            n += (size_t)snprintf(rib + n, sizeof rib - n, "%.17g %.17g 0.25  ", bern[k],
+                                  0.5 + 0.5 * (-0.8 + 1.6 * l / 3));
+    snprintf(rib + n, sizeof rib - n, "]\nWorldEnd\n");
+    render(rib, &im);
+    /* u^2 changes by at most 2 * (half a pixel) / 1.6 per half pixel */
+    double w = worst_colour(&im, bezier_expect, 2.0 / RES / 1.6 + 1e-3);
+    printf("bicubic Patch, vertex Cs: worst %.4f\n", w);
+}
+
 static void test_user_variable_displaces(void **state)
 {
     (void)state;
@@ -333,8 +371,13 @@ static void test_containment(void **state)
         CAMERA "Displacement \"lift\"\nPatch \"bilinear\" \"P\" [-0.8 -0.8 0  0.8 -0.8 0.2  "
         "-0.8 0.8 0  0.8 0.8 0] \"varying float height\" [0 0.3 -0.2 0.1]\nWorldEnd\n",
         sub,
+        CAMERA "Displacement \"lift\"\nBasis \"b-spline\" 1 \"b-spline\" 1\nPatch \"bicubic\" "
+        "\"P\" [-1 -1 0  -0.3 -1 0.2  0.3 -1 0  1 -1 0.1  -1 -0.3 0  -0.3 -0.3 0.4  0.3 -0.3 0  "
+        "1 -0.3 0  -1 0.3 0.2  -0.3 0.3 0  0.3 0.3 -0.3  1 0.3 0  -1 1 0  -0.3 1 0  0.3 1 0.2  "
+        "1 1 0] \"vertex float height\" [0 0.1 0.2 0.3  0.1 0.3 -0.2 0  0 0 0.2 0.1  -0.1 0 0.1 "
+        "0.2]\nWorldEnd\n",
     };
-    for (int r = 0; r < 3; r++)
+    for (int r = 0; r < 4; r++)
         for (int arith = 0; arith < 2; arith++) {
             job_options opt;
             job_options_default(&opt);
@@ -375,7 +418,8 @@ static void test_containment(void **state)
             }
             assert_false(th->failed);
             printf("%s, %s: %ld points, %ld violations\n",
-                   r == 0 ? "mesh" : r == 1 ? "patch" : "subdivision mesh",
+                   r == 0 ? "mesh" : r == 1 ? "patch" : r == 2 ? "subdivision mesh"
+                                                             : "bicubic b-spline patch",
                    arith ? "interval" : "affine", points, violations);
             assert_true(points > 1000);
             assert_true(spread > 0.05);     /* the variable did displace */
@@ -393,6 +437,7 @@ int main(void)
         cmocka_unit_test(test_cs_facevarying),
         cmocka_unit_test(test_st_and_s),
         cmocka_unit_test(test_subdivision_mesh),
+        cmocka_unit_test(test_bicubic_vertex_class),
         cmocka_unit_test(test_user_variable_displaces),
         cmocka_unit_test(test_containment),
     };
