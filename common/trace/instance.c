@@ -61,9 +61,11 @@ static double vmax_abs(vec3 a)
     return fmax(fabs(a.x), fmax(fabs(a.y), fabs(a.z)));
 }
 
-/* The instance's own points against the prototype's moved ones. */
+/* The instance's own points against the prototype's moved ones (at
+ * least one of the grid's points must be on the surface). */
 static bool same_surface(trace_thread *th, trace_object *obj, const trace_object *proto)
 {
+    int compared = 0;
     for (int j = 0; j < PROBE; j++)
         for (int i = 0; i < PROBE; i++) {
             double u = i / (double)(PROBE - 1), v = j / (double)(PROBE - 1);
@@ -78,8 +80,9 @@ static bool same_surface(trace_thread *th, trace_object *obj, const trace_object
             if (!(vmax_abs(v3_sub(own.P, moved.P)) <= 1e-9 * scale) ||
                 !(vmax_abs(v3_sub(own.N, moved.N)) <= 1e-7))
                 return false;
+            compared++;
         }
-    return true;
+    return compared > 0;
 }
 
 static bool can_share(trace_thread *th, trace_object *obj, const trace_object *proto)
