@@ -292,7 +292,8 @@ void rib_subdivision_mesh(rib_parser *p, const rib_request *req)
             geom_surface s;
             geom_subdiv_surface(sd, f, &s);
             scene_primvar pv[RIB_MAX_PRIMVARS];
-            if (vars.n > 0) {
+            int F = geom_subdiv_face_origin(sd, f);
+            if (vars.n > 0 && F >= 0 && F < nfaces && f >= fo[F] && f < fo[F + 1]) {
                 refined_face_vars(&vars, sd, f, nverts, fo, idx, pv);
                 p->surface_vars = pv;
                 p->nsurface_vars = vars.n;
