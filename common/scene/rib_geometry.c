@@ -303,7 +303,11 @@ void rib_polygon(rib_parser *p, const rib_request *req)
     else if (P) {
         geom_surface s = new_surface(GEOM_POLYGON);
         take_vertices(&s, P, n);
-        add_object(p, req, &s);
+        char why[256] = "";
+        if (!prepare_surface(&s, why, sizeof why))
+            rib_error(p, req, req->pos, "%s", why[0] ? why : "invalid parameters");
+        else if (!rib_polygon_vars(p, req, &params, P))   /* with primitive variables */
+            rib_add_surface(p, req, &s);
     }
     rib_params_free(&params);
 }

@@ -25,6 +25,7 @@
  * Other primitive variables ("st", "Cs", user-declared; every class) go
  * with each surface (rib_primvar.c): a face whose variables differ at its
  * corners is cut into triangles too, over each of which they are linear.
+ * A Polygon with variables is read as a one-face mesh (rib_polygon_vars).
  */
 #include "scene/rib_parser.h"
 #include "scene/rib_primvar.h"
@@ -188,7 +189,7 @@ static bool add_face(rib_parser *p, mesh *m, int face, const int *loop_sizes, in
             for (int i = 1; i + 1 < total; i++) {
                 int c[3] = {0, i, i + 1};
                 vec3 cn[3];
-                for (int k = 0; k < 3; k++)
+                for (int k = 0; k < 3 && m->ncls != MESH_N_NONE; k++)
                     cn[k] = corner_normal(m, face, idx, c[k]);
                 added += add_triangle(p, m, face, idx, c, m->ncls != MESH_N_NONE ? cn : NULL);
             }
@@ -432,4 +433,32 @@ void rib_points_general_polygons(rib_parser *p, const rib_request *req)
         read_mesh(p, req, nloops, nfaces, nverts, nnverts, 2);
     free(nloops);
     free(nverts);
+}
+
+bool rib_polygon_vars(rib_parser *p, const rib_request *req, const rib_params *params,
+                      const scene_param *P)
+{
+    static const char *const geometric[] = {"P", "Pw", "Pz", "N"};
+    bool any = false;
+    for (int i = 0; i < params->count; i++) {
+        bool g = false;
+        for (size_t k = 0; k < sizeof geometric / sizeof geometric[0]; k++)
+            g |= strcmp(params->items[i].name, geometric[k]) == 0;
+        any |= !g;
+    }
+    if (!any)
+        return false;
+    int n = P->count / 3;
+    int *idx = sl_xrealloc(NULL, (size_t)n * sizeof *idx);
+    for (int i = 0; i < n; i++)
+        idx[i] = i;
+    mesh m = { req, P->values, n, 0, req->pos, MESH_N_NONE, NULL, 0, { NULL, 0 } };
+    int counts[] = { 0, 1, 1, n, n, n };
+    if (rib_primvars_collect(p, req, params, counts, NULL, &m.pv)) {
+        int loop[1] = { n };
+        add_face(p, &m, 0, loop, 1, idx);
+    }
+    rib_primvars_free(&m.pv);
+    free(idx);
+    return true;
 }

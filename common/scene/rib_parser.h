@@ -297,6 +297,11 @@ void rib_subdivision_mesh(rib_parser *p, const rib_request *req);
 
 /* rib_mesh.c */
 void rib_points_polygons(rib_parser *p, const rib_request *req);
+/* A Polygon (checked: convex, planar) with primitive variables other than
+ * "P" and "N": added as a one-face mesh, true; false (nothing done) when
+ * it has none. */
+bool rib_polygon_vars(rib_parser *p, const rib_request *req, const rib_params *params,
+                      const scene_param *P);
 void rib_points_general_polygons(rib_parser *p, const rib_request *req);
 void rib_general_polygon(rib_parser *p, const rib_request *req);
 

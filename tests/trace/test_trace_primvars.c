@@ -7,8 +7,8 @@
  *   - Cs of each class through the default surface to the image: constant
  *     (every pixel), uniform (one colour per face), vertex and varying
  *     (a colour linear in x and y: every interior pixel shows the
- *     function at its centre, whatever the triangles), facevarying (the
- *     two faces differ along their shared edge);
+ *     function at its centre, whatever the triangles; on a Polygon too),
+ *     facevarying (the two faces differ along their shared edge);
  *   - "st" (facevarying), and "s" alone, through a surface shader that
  *     shows them as its colour;
  *   - a bicubic patch's vertex-class Cs, interpolated with the basis (a
@@ -169,6 +169,15 @@ static void test_cs_vertex_and_varying(void **state)
         double w = worst_colour(&im, lin, 0.5 * 2.0 / RES);
         printf("Cs \"%s\": worst |pixel - Cs(centre)| %.4f\n", decl[i], w);
     }
+    /* a Polygon (one face of four corners) the same */
+    double c[4][3];
+    lin(-0.8, -0.8, c[0]), lin(0.8, -0.8, c[1]), lin(0.8, 0.8, c[2]), lin(-0.8, 0.8, c[3]);
+    snprintf(rib, sizeof rib, CAMERA "Polygon \"P\" [-0.8 -0.8 0  0.8 -0.8 0  0.8 0.8 0  -0.8 0.8 0] "
+             "\"varying color Cs\" [%g %g %g  %g %g %g  %g %g %g  %g %g %g]\nWorldEnd\n",
+             c[0][0], c[0][1], c[0][2], c[1][0], c[1][1], c[1][2], c[2][0], c[2][1], c[2][2],
+             c[3][0], c[3][1], c[3][2]);
+    render(rib, &im);
+    printf("Polygon, varying Cs: worst %.4f\n", worst_colour(&im, lin, 0.5 * 2.0 / RES));
 }
 
 static void test_cs_facevarying(void **state)
