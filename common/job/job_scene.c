@@ -180,6 +180,61 @@ static sl_instance *make_instance(job_scene *self, const scene_shader *call, sl_
     return inst;
 }
 
+/* sl's parameter sizes: float 1, point/vector/normal/color 3 */
+static int param_size(sl_type t)
+{
+    return t == SL_TYPE_FLOAT ? 1 : (t == SL_TYPE_POINT || t == SL_TYPE_VECTOR ||
+                                     t == SL_TYPE_NORMAL || t == SL_TYPE_COLOR) ? 3 : 0;
+}
+
+/* The parameter of the instance's program that primitive variable v sets
+ * (same name and number of components, not an output), or -1. */
+static int primvar_param(const sl_instance *inst, const scene_primvar *v)
+{
+    if (!inst) return -1;
+    const sl_program *prog = sl_instance_program(inst);
+    int i = sl_program_find_param(prog, v->name);
+    if (i < 0) return -1;
+    sl_param_info info;
+    sl_program_param(prog, i, &info);
+    return !info.output && param_size(info.type) == v->size ? i : -1;
+}
+
+/* The object's primitive variables in camera space, with the globals and
+ * parameters they set (trace/primvar.c). */
+static void build_primvars(const scene_object *o, trace_object *t, trace_primvar *out)
+{
+    for (int i = 0; i < o->nprimvars; i++) {
+        const scene_primvar *v = &o->primvars[i];
+        trace_primvar *pv = &out[i];
+        memset(pv, 0, sizeof *pv);
+        pv->size = v->size;
+        pv->global = SL_G__COUNT;
+        if (v->size == 1 && strcmp(v->name, "s") == 0) pv->global = SL_G_s;
+        if (v->size == 1 && strcmp(v->name, "t") == 0) pv->global = SL_G_t;
+        if (v->size == 3 && strcmp(v->name, "Cs") == 0) pv->global = SL_G_Cs;
+        if (v->size == 3 && strcmp(v->name, "Os") == 0) pv->global = SL_G_Os;
+        pv->displacement_param = primvar_param(t->displacement, v);
+        pv->surface_param = primvar_param(t->surface, v);
+        for (int k = 0; k < 16; k++) {
+            vec3 c = v3(v->c[k][0], v->c[k][1], v->c[k][2]);
+            if (v->type == SL_TYPE_POINT)
+                c = k == 0 ? mat4_xform_point(&t->to_camera, c) : mat4_xform_vector(&t->to_camera, c);
+            else if (v->type == SL_TYPE_VECTOR)
+                c = mat4_xform_vector(&t->to_camera, c);
+            else if (v->type == SL_TYPE_NORMAL)
+                c = mat4_xform_normal(&t->from_camera, c);
+            else {
+                for (int j = 0; j < 3; j++) pv->c[k][j] = v->c[k][j];
+                continue;
+            }
+            pv->c[k][0] = c.x, pv->c[k][1] = c.y, pv->c[k][2] = c.z;
+        }
+    }
+    t->primvars = out;
+    t->nprimvars = o->nprimvars;
+}
+
 static bool build_objects(job_scene *self, sl_diag *diag)
 {
     const scene *sc = self->scene;
@@ -195,6 +250,11 @@ static bool build_objects(job_scene *self, sl_diag *diag)
     w->nobjects = sc->nobjects;
     w->objects = calloc((size_t)(sc->nobjects > 0 ? sc->nobjects : 1), sizeof *w->objects);
     if (!w->objects) abort();
+    size_t nprimvars = 0;
+    for (int i = 0; i < sc->nobjects; i++) nprimvars += (size_t)sc->objects[i].nprimvars;
+    self->primvars = calloc(nprimvars > 0 ? nprimvars : 1, sizeof *self->primvars);
+    if (!self->primvars) abort();
+    trace_primvar *next_primvar = self->primvars;
     for (int i = 0; i < sc->nobjects; i++) {
         const scene_object *o = &sc->objects[i];
         trace_object *t = &w->objects[i];
@@ -216,6 +276,11 @@ static bool build_objects(job_scene *self, sl_diag *diag)
         t->flip = o->reverse_normals;
         t->lights = o->lights;
         t->nlights = o->nlights;
+        build_primvars(o, t, next_primvar);
+        next_primvar += o->nprimvars;
+        /* an instance proposes sharing its prototype's boxes (trace/instance.c) */
+        if (o->instance_of >= 0 && o->instance_of < i)
+            t->box_proto = &w->objects[o->instance_of];
     }
     return true;
 }
@@ -323,6 +388,7 @@ void job_scene_destroy(job_scene **self_p)
     free(self->programs);
     free(self->world.objects);
     free(self->world.lights);
+    free(self->primvars);
     tex_cache_free(self->textures);
     scene_destroy(&self->scene);
     free(self);

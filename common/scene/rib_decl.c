@@ -133,12 +133,13 @@ static bool parse_type_word(word w, sl_type *type, char *why, int why_size)
     return false;
 }
 
-static bool is_class_word(word w)
+/* SCENE_CLASS_CONSTANT... for a class word, else SCENE_CLASS_NONE */
+static scene_class class_word(word w)
 {
     for (size_t i = 0; i < sizeof class_words / sizeof class_words[0]; i++)
         if (word_is(w, class_words[i]))
-            return true;
-    return false;
+            return (scene_class)(SCENE_CLASS_CONSTANT + (int)i);
+    return SCENE_CLASS_NONE;
 }
 
 bool rib_decl_parse(const char *text, bool with_name, rib_decl *out,
@@ -148,6 +149,7 @@ bool rib_decl_parse(const char *text, bool with_name, rib_decl *out,
     int n = split_words(text, w, 4), i = 0;
     out->type = SL_TYPE_FLOAT;
     out->arraylen = 1;
+    out->cls = SCENE_CLASS_NONE;
     if (n == 0) {
         snprintf(why, (size_t)why_size, "empty declaration");
         return false;
@@ -157,7 +159,7 @@ bool rib_decl_parse(const char *text, bool with_name, rib_decl *out,
                  with_name ? " name" : "");
         return false;
     }
-    if (is_class_word(w[i]))
+    if ((out->cls = class_word(w[i])) != SCENE_CLASS_NONE)
         i++;
     if (i == n) {
         snprintf(why, (size_t)why_size, "missing type after '%.*s'", w[0].len, w[0].s);
@@ -231,6 +233,7 @@ bool rib_decl_standard(const char *name, rib_decl *out)
         if (strcmp(name, standard[i].name) == 0) {
             out->type = standard[i].type;
             out->arraylen = standard[i].arraylen;
+            out->cls = SCENE_CLASS_NONE;
             return true;
         }
     return false;

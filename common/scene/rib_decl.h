@@ -10,8 +10,8 @@
  *      lightcolor from to coneangle ..., P N Cs Os s t st ...).
  *
  * A declaration reads "[class] type [ '[' n ']' ]": class is constant,
- * uniform, varying, vertex or facevarying (recorded nowhere: a shader call
- * is uniform); type is float, integer (read as float), point, vector,
+ * uniform, varying, vertex or facevarying (recorded for primitive
+ * variables; a shader call is uniform); type is float, integer (read as float), point, vector,
  * normal, color, string or matrix.
  */
 #ifndef SCENE_RIB_DECL_H
@@ -19,11 +19,13 @@
 
 #include <stdbool.h>
 
+#include "scene/scene.h"
 #include "sl/shader.h"
 
 typedef struct rib_decl {
     sl_type type;
     int arraylen;        /* 1 unless "[n]" */
+    scene_class cls;     /* the class word, SCENE_CLASS_NONE when not written */
 } rib_decl;
 
 /* Numbers one value of the type takes (float 1, color 3, matrix 16;

@@ -11,6 +11,7 @@
  * library is built without common/geom, basic checks here stand in.
  */
 #include "scene/rib_parser.h"
+#include "scene/rib_primvar.h"
 #include "sl/strbuf.h"
 
 #include <math.h>
@@ -102,7 +103,7 @@ static void object_lights(const rib_parser *p, scene_object *o)
 }
 
 void rib_place_surface(rib_parser *p, const rib_request *req, const geom_surface *surf,
-                       mat4 ctm, sl_pos pos)
+                       mat4 ctm, sl_pos pos, const scene_primvar *vars, int nvars)
 {
     const rib_attributes *a = &p->attr;
     mat4 to_camera = mat4_mul(p->scene->camera.camera_from_world, ctm), inv;
@@ -135,6 +136,11 @@ void rib_place_surface(rib_parser *p, const rib_request *req, const geom_surface
     o->displacement_bound_space = sl_xstrndup(a->bound_space, strlen(a->bound_space));
     o->name = a->name ? sl_xstrndup(a->name, strlen(a->name)) : NULL;
     o->pos = pos;
+    if (nvars > 0) {
+        o->primvars = sl_xrealloc(NULL, (size_t)nvars * sizeof *o->primvars);
+        memcpy(o->primvars, vars, (size_t)nvars * sizeof *o->primvars);
+        o->nprimvars = nvars;
+    }
     object_lights(p, o);
 }
 
@@ -143,7 +149,8 @@ void rib_add_surface(rib_parser *p, const rib_request *req, const geom_surface *
     if (rib_defining(p))
         rib_record_surface(p, req, surf);
     else
-        rib_place_surface(p, req, surf, p->attr.ctm, req->pos);
+        rib_place_surface(p, req, surf, p->attr.ctm, req->pos, p->surface_vars,
+                          p->nsurface_vars);
 }
 
 /* Validates the surface and adds the object with the current attributes
@@ -296,7 +303,11 @@ void rib_polygon(rib_parser *p, const rib_request *req)
     else if (P) {
         geom_surface s = new_surface(GEOM_POLYGON);
         take_vertices(&s, P, n);
-        add_object(p, req, &s);
+        char why[256] = "";
+        if (!prepare_surface(&s, why, sizeof why))
+            rib_error(p, req, req->pos, "%s", why[0] ? why : "invalid parameters");
+        else if (!rib_polygon_vars(p, req, &params, P))   /* with primitive variables */
+            rib_add_surface(p, req, &s);
     }
     rib_params_free(&params);
 }
@@ -316,15 +327,26 @@ void rib_patch(rib_parser *p, const rib_request *req)
     if (!rib_params_read(p, req, 1, RIB_PARAMS_VARYING, &params))
         return;
     const scene_param *P = find_P(p, req, &params);
+    int counts[] = { 0, 1, 1, 4, cubic ? 16 : 4, 0 };
+    rib_primvars pv;
+    if (P && !rib_patch_primvars(p, req, &params, counts, cubic, &pv))
+        P = NULL;
     if (P && cubic)
-        rib_patch_bicubic(p, req, P);
+        rib_patch_bicubic(p, req, P, &pv);
     else if (P && P->count != 12)
         rib_error(p, req, P->pos, "a bilinear patch needs 4 points in \"P\" (12 numbers), "
                   "got %d numbers", P->count);
     else if (P) {
         geom_surface s = new_surface(GEOM_PATCH);
         take_vertices(&s, P, 4);
+        static const int corner[4] = { 0, 1, 2, 3 };
+        scene_primvar vars[RIB_MAX_PRIMVARS];
+        rib_patch_vars(p, &pv, 0, 0, 0, 2, 2, corner, vars);
         add_object(p, req, &s);
+        p->surface_vars = NULL;
+        p->nsurface_vars = 0;
     }
+    if (P)
+        rib_primvars_free(&pv);
     rib_params_free(&params);
 }

@@ -11,6 +11,11 @@
  * handle again replaces the earlier object for the instances that follow.
  * A definition may not nest another, and may only hold surfaces (they are
  * recorded instead of placed: see rib_record_surface).
+ *
+ * Every object an instance places remembers the first object placed from
+ * the same recorded surface (scene_object.instance_of): the renderer then
+ * keeps one set of boxes per recorded surface, shared by its instances
+ * (trace/instance.c).
  */
 #include "scene/rib_parser.h"
 #include "sl/strbuf.h"
@@ -92,6 +97,14 @@ void rib_record_surface(rib_parser *p, const rib_request *req, const geom_surfac
     part->surface = *surf;
     part->ctm = p->attr.ctm;
     part->pos = req->pos;
+    part->first_object = -1;
+    part->nprimvars = p->nsurface_vars;
+    part->primvars = NULL;
+    if (p->nsurface_vars > 0) {
+        part->primvars = sl_xrealloc(NULL, (size_t)p->nsurface_vars * sizeof *part->primvars);
+        memcpy(part->primvars, p->surface_vars,
+               (size_t)p->nsurface_vars * sizeof *part->primvars);
+    }
 }
 
 void rib_object_instance(rib_parser *p, const rib_request *req)
@@ -105,7 +118,7 @@ void rib_object_instance(rib_parser *p, const rib_request *req)
         free(handle);
         return;
     }
-    const rib_object_def *d = find_def(p, handle);
+    rib_object_def *d = find_def(p, handle);
     if (!d) {
         rib_error(p, req, req->args[0].pos, "no object has the handle %s (define it first "
                   "with ObjectBegin %s ... ObjectEnd)", handle, handle);
@@ -117,15 +130,25 @@ void rib_object_instance(rib_parser *p, const rib_request *req)
         rib_warning(p, req, req->pos, "the object defined at %s:%d:%d holds no surfaces",
                     d->pos.file, d->pos.line, d->pos.col);
     mat4 ctm = p->attr.ctm;
-    for (int i = 0; i < d->nparts; i++)
-        rib_place_surface(p, req, &d->parts[i].surface, mat4_mul(ctm, d->parts[i].ctm),
-                          d->parts[i].pos);
+    for (int i = 0; i < d->nparts; i++) {
+        rib_object_part *part = &d->parts[i];
+        int before = p->scene->nobjects;
+        rib_place_surface(p, req, &part->surface, mat4_mul(ctm, part->ctm), part->pos,
+                          part->primvars, part->nprimvars);
+        if (p->scene->nobjects == before)
+            continue;                  /* not placed (an error said why) */
+        if (part->first_object < 0)
+            part->first_object = before;
+        p->scene->objects[before].instance_of = part->first_object;
+    }
 }
 
 void rib_object_defs_free(rib_parser *p)
 {
     for (int i = 0; i < p->ndefs; i++) {
         free(p->defs[i].handle);
+        for (int k = 0; k < p->defs[i].nparts; k++)
+            free(p->defs[i].parts[k].primvars);
         free(p->defs[i].parts);
     }
     free(p->defs);

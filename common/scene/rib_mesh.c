@@ -20,10 +20,15 @@
  * stays one flat polygon; any other is cut into triangles that carry their
  * corner normals (geom_vertex_normal), so N is continuous across shared
  * edges and a shader displacing along N opens no crack. GeneralPolygon uses
- * a given "N" only. Other primitive variables ("st", "Cs", ...) are read
- * and checked like any parameter, then ignored with one warning per scene.
+ * a given "N" only.
+ *
+ * Other primitive variables ("st", "Cs", user-declared; every class) go
+ * with each surface (rib_primvar.c): a face whose variables differ at its
+ * corners is cut into triangles too, over each of which they are linear.
+ * A Polygon with variables is read as a one-face mesh (rib_polygon_vars).
  */
 #include "scene/rib_parser.h"
+#include "scene/rib_primvar.h"
 #include "sl/strbuf.h"
 
 #ifdef SCENE_HAVE_GEOM
@@ -60,25 +65,24 @@ typedef struct mesh {
     mesh_nclass ncls;              /* corner normals: none, or N as the class says */
     const double *N;
     int fv0;                       /* the current face's first face-vertex */
+    rib_primvars pv;               /* the other primitive variables */
 } mesh;
 
-static void warn_ignored(rib_parser *p, const rib_request *req, const rib_params *params)
+/* Corner i of face `face` (point idx[i]) in the variables' classes. */
+static rib_corner corner_of(const mesh *m, int face, const int *idx, int i)
 {
-    if (p->warned_mesh_vars)
-        return;
-    char names[512] = "";
-    for (int i = 0; i < params->count; i++) {
-        if (strcmp(params->items[i].name, "P") == 0 || strcmp(params->items[i].name, "N") == 0)
-            continue;
-        size_t used = strlen(names);
-        snprintf(names + used, sizeof names - used, "%s\"%s\"", used ? ", " : "",
-                 params->items[i].name);
-    }
-    if (!names[0])
-        return;
-    rib_warning(p, req, req->pos, "only \"P\" and \"N\" are used on meshes: %s ignored "
-                "(and on the meshes that follow)", names);
-    p->warned_mesh_vars = true;
+    return (rib_corner){face, idx[i], idx[i], m->fv0 + i};
+}
+
+/* rib_add_surface with the variables pv_out[0..m->pv.n) */
+static void add_with_vars(rib_parser *p, const mesh *m, const geom_surface *s,
+                          const scene_primvar *vars)
+{
+    p->surface_vars = vars;
+    p->nsurface_vars = m->pv.n;
+    rib_add_surface(p, m->req, s);
+    p->surface_vars = NULL;
+    p->nsurface_vars = 0;
 }
 
 static vec3 point(const mesh *m, int i)
@@ -99,16 +103,18 @@ static vec3 corner_normal(const mesh *m, int face, const int *idx, int i)
     return v3(m->N[3 * k], m->N[3 * k + 1], m->N[3 * k + 2]);
 }
 
-/* Adds triangle (a, b, c) with corner normals n (NULL: none); false when
+/* Adds the triangle of corners k[0..3) of face `face` (points idx[k[i]])
+ * with corner normals n (NULL: none) and the face's variables; false when
  * it has no area. */
-static bool add_triangle(rib_parser *p, const mesh *m, vec3 a, vec3 b, vec3 c,
-                         const vec3 *n)
+static bool add_triangle(rib_parser *p, const mesh *m, int face, const int *idx,
+                         const int k[3], const vec3 *n)
 {
     geom_surface s;
     memset(&s, 0, sizeof s);
     s.kind = GEOM_POLYGON;
     s.nverts = 3;
-    s.verts[0] = a, s.verts[1] = b, s.verts[2] = c;
+    for (int i = 0; i < 3; i++)
+        s.verts[i] = point(m, idx[k[i]]);
     if (n) {
         s.nvn = 3;
         s.vn[0] = n[0], s.vn[1] = n[1], s.vn[2] = n[2];
@@ -123,7 +129,15 @@ static bool add_triangle(rib_parser *p, const mesh *m, vec3 a, vec3 b, vec3 c,
             return false;
     }
 #endif
-    rib_add_surface(p, m->req, &s);
+    scene_primvar vars[RIB_MAX_PRIMVARS];
+    if (m->pv.n > 0) {
+        rib_corner c[3];
+        for (int i = 0; i < 3; i++)
+            c[i] = corner_of(m, face, idx, k[i]);
+        if (s.nuv != 3 || !rib_primvars_triangle(&m->pv, c, (const double (*)[2])s.uv, vars))
+            return false;
+    }
+    add_with_vars(p, m, &s, vars);
     return true;
 }
 
@@ -159,24 +173,32 @@ static bool add_face(rib_parser *p, mesh *m, int face, const int *loop_sizes, in
 #ifdef SCENE_HAVE_GEOM
         char why[256];
         if (geom_surface_prepare(&s, why, sizeof why)) {
-            if (m->ncls == MESH_N_NONE || corners_flat(m, &s, face, idx, total)) {
-                rib_add_surface(p, m->req, &s);
+            rib_corner corners[GEOM_MAX_POLY_VERTS];
+            for (int i = 0; i < total; i++)
+                corners[i] = corner_of(m, face, idx, i);
+            if ((m->ncls == MESH_N_NONE || corners_flat(m, &s, face, idx, total)) &&
+                rib_primvars_same_at(&m->pv, corners, total)) {
+                scene_primvar vars[RIB_MAX_PRIMVARS];
+                rib_primvars_constant(&m->pv, &corners[0], vars);
+                add_with_vars(p, m, &s, vars);
                 return true;
             }
-            /* convex and planar: a fan of triangles with corner normals */
+            /* convex and planar: a fan of triangles with corner normals
+             * (and variables) */
             int added = 0;
             for (int i = 1; i + 1 < total; i++) {
                 int c[3] = {0, i, i + 1};
                 vec3 cn[3];
-                for (int k = 0; k < 3; k++)
+                for (int k = 0; k < 3 && m->ncls != MESH_N_NONE; k++)
                     cn[k] = corner_normal(m, face, idx, c[k]);
-                added += add_triangle(p, m, s.verts[0], s.verts[i], s.verts[i + 1], cn);
+                added += add_triangle(p, m, face, idx, c, m->ncls != MESH_N_NONE ? cn : NULL);
             }
             if (added == 0)
                 m->skipped++;
             return true;
         }
 #else
+        (void)face;
         rib_add_surface(p, m->req, &s);
         return true;
 #endif
@@ -207,8 +229,7 @@ static bool add_face(rib_parser *p, mesh *m, int face, const int *loop_sizes, in
             for (int k = 0; k < 3; k++)
                 cn[k] = m->ncls != MESH_N_NONE ? corner_normal(m, face, idx, tris[t][k])
                                                : v3(0, 0, 0);
-            added += add_triangle(p, m, pts[tris[t][0]], pts[tris[t][1]], pts[tris[t][2]],
-                                  m->ncls != MESH_N_NONE ? cn : NULL);
+            added += add_triangle(p, m, face, idx, tris[t], m->ncls != MESH_N_NONE ? cn : NULL);
         }
         if (added == 0)
             m->skipped++;
@@ -306,15 +327,19 @@ static void read_mesh(rib_parser *p, const rib_request *req, const int *nloops, 
                   P->count / 3, maxidx);
         goto out;
     }
-    warn_ignored(p, req, &params);
     mesh m = { req, P->values, P->count / 3, 0, req->args[first_vertices].pos,
-               MESH_N_VERTEX, NULL, 0 };
+               MESH_N_VERTEX, NULL, 0, { NULL, 0 } };
+    int counts[] = { 0, 1, nfaces, m.npoints, m.npoints, nidx };
+    if (!rib_primvars_collect(p, req, &params, counts, NULL, &m.pv))
+        goto out;
     double *smooth = NULL;
     const scene_param *N = rib_params_find(&params, "N");
     if (N) {
         m.ncls = normal_class(p, req, N, m.npoints, nidx, nfaces);
-        if (m.ncls == MESH_N_NONE)
+        if (m.ncls == MESH_N_NONE) {
+            rib_primvars_free(&m.pv);
             goto out;
+        }
         m.N = N->values;
     } else {
         m.N = smooth = smooth_normals(m.npoints, P->values, nloops, nfaces, nverts, idx);
@@ -329,6 +354,7 @@ static void read_mesh(rib_parser *p, const rib_request *req, const int *nloops, 
         vi += npts;
     }
     free(smooth);
+    rib_primvars_free(&m.pv);
     if (m.skipped > 0)
         rib_warning(p, req, req->pos, "%d face%s without area skipped", m.skipped,
                     m.skipped == 1 ? "" : "s");
@@ -368,19 +394,24 @@ void rib_general_polygon(rib_parser *p, const rib_request *req)
             rib_error(p, req, P->pos, "the loops have %ld points in all, but \"P\" has %d",
                       n, P->count / 3);
         else {
-            warn_ignored(p, req, &params);
             int *idx = sl_xrealloc(NULL, (size_t)n * sizeof *idx);
             for (int i = 0; i < n; i++)
                 idx[i] = i;
-            mesh m = { req, P->values, (int)n, 0, req->args[0].pos, MESH_N_NONE, NULL, 0 };
+            mesh m = { req, P->values, (int)n, 0, req->args[0].pos, MESH_N_NONE, NULL, 0,
+                       { NULL, 0 } };
+            int counts[] = { 0, 1, 1, (int)n, (int)n, (int)n };
             const scene_param *N = rib_params_find(&params, "N");
             if (N) {
                 m.ncls = normal_class(p, req, N, (int)n, (int)n, 1);
                 m.N = N->values;
             }
-            add_face(p, &m, 0, nverts, nloops, idx);
-            if (m.skipped)
-                rib_warning(p, req, req->pos, "the polygon has no area: skipped");
+            if ((!N || m.ncls != MESH_N_NONE) &&
+                rib_primvars_collect(p, req, &params, counts, NULL, &m.pv)) {
+                add_face(p, &m, 0, nverts, nloops, idx);
+                if (m.skipped)
+                    rib_warning(p, req, req->pos, "the polygon has no area: skipped");
+            }
+            rib_primvars_free(&m.pv);
             free(idx);
         }
         rib_params_free(&params);
@@ -402,4 +433,32 @@ void rib_points_general_polygons(rib_parser *p, const rib_request *req)
         read_mesh(p, req, nloops, nfaces, nverts, nnverts, 2);
     free(nloops);
     free(nverts);
+}
+
+bool rib_polygon_vars(rib_parser *p, const rib_request *req, const rib_params *params,
+                      const scene_param *P)
+{
+    static const char *const geometric[] = {"P", "Pw", "Pz", "N"};
+    bool any = false;
+    for (int i = 0; i < params->count; i++) {
+        bool g = false;
+        for (size_t k = 0; k < sizeof geometric / sizeof geometric[0]; k++)
+            g |= strcmp(params->items[i].name, geometric[k]) == 0;
+        any |= !g;
+    }
+    if (!any)
+        return false;
+    int n = P->count / 3;
+    int *idx = sl_xrealloc(NULL, (size_t)n * sizeof *idx);
+    for (int i = 0; i < n; i++)
+        idx[i] = i;
+    mesh m = { req, P->values, n, 0, req->pos, MESH_N_NONE, NULL, 0, { NULL, 0 } };
+    int counts[] = { 0, 1, 1, n, n, n };
+    if (rib_primvars_collect(p, req, params, counts, NULL, &m.pv)) {
+        int loop[1] = { n };
+        add_face(p, &m, 0, loop, 1, idx);
+    }
+    rib_primvars_free(&m.pv);
+    free(idx);
+    return true;
 }

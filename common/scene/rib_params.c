@@ -120,11 +120,12 @@ static bool read_one(rib_parser *p, const rib_request *req, int i, rib_params_mo
         rib_error(p, req, name->pos, "parameter \"%s\" has no value", rib_arg_string(req, name));
         return false;
     }
-    rib_decl decl;
+    rib_decl decl = { .type = SL_TYPE_VOID, .arraylen = 1, .cls = SCENE_CLASS_NONE };
     if (!resolve_name(p, req, name, mode, &out->name, &decl))
         return false;
     out->type = decl.type;
     out->arraylen = decl.arraylen;
+    out->cls = decl.cls;
     out->pos = name->pos;
     if (!take_value(p, req, &req->args[i + 1], mode, out)) {
         scene_param_free(out);

@@ -170,6 +170,7 @@ scene_object *rib_add_object(rib_parser *p)
     scene *s = p->scene;
     s->objects = grow(s->objects, s->nobjects, &p->objects_cap, sizeof *s->objects);
     memset(&s->objects[s->nobjects], 0, sizeof *s->objects);
+    s->objects[s->nobjects].instance_of = -1;
     return &s->objects[s->nobjects++];
 }
 

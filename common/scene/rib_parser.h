@@ -74,6 +74,9 @@ typedef struct rib_object_part {
     geom_surface surface;          /* prepared */
     mat4 ctm;
     sl_pos pos;
+    int first_object;              /* the first object placed from it, -1: none yet */
+    scene_primvar *primvars;       /* its primitive variables (owned) */
+    int nprimvars;
 } rib_object_part;
 
 typedef struct rib_object_def {
@@ -129,6 +132,9 @@ typedef struct rib_parser {
     rib_object_def *defs;          /* ObjectBegin definitions, in order */
     int ndefs;
     bool warned_mesh_vars;         /* primitive variables a mesh ignores */
+    const scene_primvar *surface_vars;   /* the primitive variables of the surface
+                                    * rib_add_surface adds next (rib_primvar.c) */
+    int nsurface_vars;
     bool warned_trim;              /* TrimCurve */
     bool warned_early_light;       /* a LightSource before WorldBegin */
     bool in_motion, motion_taken;  /* MotionBegin open; its first sample read */
@@ -259,13 +265,27 @@ void rib_record_surface(rib_parser *p, const rib_request *req, const geom_surfac
 void rib_object_defs_free(rib_parser *p);
 
 /* rib_geometry.c: adds a prepared surface as an object with the current
- * attributes and transform, or records it in the object being defined. */
+ * attributes and transform, or records it in the object being defined;
+ * with p->surface_vars, its primitive variables (copied). */
 void rib_add_surface(rib_parser *p, const rib_request *req, const geom_surface *surf);
 
 /* rib_patch.c */
 void rib_basis(rib_parser *p, const rib_request *req);
 void rib_patch_mesh(rib_parser *p, const rib_request *req);
-void rib_patch_bicubic(rib_parser *p, const rib_request *req, const scene_param *P);
+struct rib_primvars;
+/* pv: the patch's other primitive variables (rib_primvar.h), or NULL */
+void rib_patch_bicubic(rib_parser *p, const rib_request *req, const scene_param *P,
+                       struct rib_primvars *pv);
+/* The primitive variables of a Patch or PatchMesh: counts as rib_primvars_collect
+ * wants; vertex-class variables of bicubic patches are dropped with a warning */
+bool rib_patch_primvars(rib_parser *p, const rib_request *req, const rib_params *params,
+                        const int counts[6], bool cubic, struct rib_primvars *out);
+/* The variables of one patch (corners (0,0), (1,0), (0,1), (1,1)): patch
+ * `uniform`, varying values at (pu + du) mod nuvar, (pv + dv) mod nvvar of an
+ * nuvar x nvvar grid, vertex values at points vtx[4] (NULL: none), set as
+ * the next surface's (p->surface_vars, out holds them). */
+void rib_patch_vars(rib_parser *p, const struct rib_primvars *pv, int uniform, int pu, int pv_,
+                    int nuvar, int nvvar, const int *vtx, scene_primvar *out);
 void rib_basis_default(double m[16], int *step);
 
 /* rib_nupatch.c */
@@ -277,6 +297,11 @@ void rib_subdivision_mesh(rib_parser *p, const rib_request *req);
 
 /* rib_mesh.c */
 void rib_points_polygons(rib_parser *p, const rib_request *req);
+/* A Polygon (checked: convex, planar) with primitive variables other than
+ * "P" and "N": added as a one-face mesh, true; false (nothing done) when
+ * it has none. */
+bool rib_polygon_vars(rib_parser *p, const rib_request *req, const rib_params *params,
+                      const scene_param *P);
 void rib_points_general_polygons(rib_parser *p, const rib_request *req);
 void rib_general_polygon(rib_parser *p, const rib_request *req);
 
@@ -294,7 +319,7 @@ bool rib_motion_filter(rib_parser *p, const rib_request *req);
  * attributes and the object-to-world transform ctm; pos is where the
  * surface was written. */
 void rib_place_surface(rib_parser *p, const rib_request *req, const geom_surface *surf,
-                       mat4 ctm, sl_pos pos);
+                       mat4 ctm, sl_pos pos, const scene_primvar *vars, int nvars);
 
 /* rib_parser.c: blocks */
 void rib_push_block(rib_parser *p, rib_block_kind kind, sl_pos pos);

@@ -12,6 +12,7 @@
  * Each patch has its own (u,v) in [0,1]^2.
  */
 #include "scene/rib_parser.h"
+#include "scene/rib_primvar.h"
 #include "sl/strbuf.h"
 
 #include <math.h>
@@ -123,11 +124,39 @@ static void to_bezier(const double m[16], double t[16])
         }
 }
 
-/* Adds the bicubic patch whose geometry G[k][l] (u index k, v index l) is
- * point idx[4 l + k] of P. */
-static void add_bicubic(rib_parser *p, const rib_request *req, const double *P,
-                        const int idx[16], sl_pos at)
+bool rib_patch_primvars(rib_parser *p, const rib_request *req, const rib_params *params,
+                        const int counts[6], bool cubic, rib_primvars *out)
 {
+    (void)cubic;           /* bicubic vertex-class values: add_bicubic */
+    return rib_primvars_collect(p, req, params, counts, NULL, out);
+}
+
+void rib_patch_vars(rib_parser *p, const rib_primvars *pv, int uniform, int pu, int pv_,
+                    int nuvar, int nvvar, const int *vtx, scene_primvar *out)
+{
+    rib_corner c[4];
+    for (int i = 0; i < 4; i++) {
+        int du = i & 1, dv = i >> 1;
+        c[i].uniform = uniform;
+        c[i].varying = ((pv_ + dv) % nvvar) * nuvar + (pu + du) % nuvar;
+        c[i].vertex = vtx ? vtx[i] : 0;
+        c[i].facevarying = 0;
+    }
+    rib_primvars_bilinear(pv, c, out);
+    p->surface_vars = out;
+    p->nsurface_vars = pv->n;
+}
+
+/* Adds the bicubic patch whose geometry G[k][l] (u index k, v index l) is
+ * point idx[4 l + k] of P (with the variables set by rib_patch_vars, its
+ * vertex-class ones, of pv, into vars, interpolated with the basis as P
+ * is). */
+static void add_bicubic(rib_parser *p, const rib_request *req, const double *P,
+                        const int idx[16], sl_pos at, const rib_primvars *pv,
+                        scene_primvar *vars)
+{
+    if (pv && pv->n > 0)
+        rib_primvars_bicubic(pv, idx, p->attr.ubasis, p->attr.vbasis, vars);
     double tu[16], tv[16];
     to_bezier(p->attr.ubasis, tu);
     to_bezier(p->attr.vbasis, tv);
@@ -162,7 +191,8 @@ static void add_bicubic(rib_parser *p, const rib_request *req, const double *P,
 }
 
 /* Patch "bicubic" "P" [16 points] (rib_patch hands it over). */
-void rib_patch_bicubic(rib_parser *p, const rib_request *req, const scene_param *P)
+void rib_patch_bicubic(rib_parser *p, const rib_request *req, const scene_param *P,
+                       rib_primvars *pv)
 {
     if (P->count != 48) {
         rib_error(p, req, P->pos, "a bicubic patch needs 16 points in \"P\" (48 numbers), got "
@@ -172,7 +202,12 @@ void rib_patch_bicubic(rib_parser *p, const rib_request *req, const scene_param 
     int idx[16];
     for (int k = 0; k < 16; k++)
         idx[k] = k;
-    add_bicubic(p, req, P->values, idx, req->pos);
+    scene_primvar vars[RIB_MAX_PRIMVARS];
+    if (pv)
+        rib_patch_vars(p, pv, 0, 0, 0, 2, 2, NULL, vars);
+    add_bicubic(p, req, P->values, idx, req->pos, pv, vars);
+    p->surface_vars = NULL;
+    p->nsurface_vars = 0;
 }
 
 static bool read_wrap(rib_parser *p, const rib_request *req, int i, const char *which,
@@ -258,6 +293,14 @@ void rib_patch_mesh(rib_parser *p, const rib_request *req)
     else {
         int NU = (int)nu, NV = (int)nv;
         int su = cubic ? p->attr.ustep : 1, sv = cubic ? p->attr.vstep : 1;
+        int nuvar = uper ? nupatch : nupatch + 1, nvvar = vper ? nvpatch : nvpatch + 1;
+        int counts[] = { 0, 1, nupatch * nvpatch, nuvar * nvvar, NU * NV, 0 };
+        rib_primvars vars;
+        scene_primvar pvars[RIB_MAX_PRIMVARS];
+        if (!rib_patch_primvars(p, req, &params, counts, cubic, &vars)) {
+            rib_params_free(&params);
+            return;
+        }
         for (int pv = 0; pv < nvpatch; pv++)
             for (int pu = 0; pu < nupatch; pu++) {
                 if (cubic) {
@@ -265,7 +308,8 @@ void rib_patch_mesh(rib_parser *p, const rib_request *req)
                     for (int l = 0; l < 4; l++)
                         for (int k = 0; k < 4; k++)
                             idx[4 * l + k] = ((pv * sv + l) % NV) * NU + (pu * su + k) % NU;
-                    add_bicubic(p, req, P->values, idx, req->pos);
+                    rib_patch_vars(p, &vars, pv * nupatch + pu, pu, pv, nuvar, nvvar, NULL, pvars);
+                    add_bicubic(p, req, P->values, idx, req->pos, &vars, pvars);
                     continue;
                 }
                 int u0 = pu, u1 = (pu + 1) % NU, v0 = pv, v1 = (pv + 1) % NV;
@@ -284,8 +328,12 @@ void rib_patch_mesh(rib_parser *p, const rib_request *req)
                     continue;
                 }
 #endif
+                rib_patch_vars(p, &vars, pv * nupatch + pu, pu, pv, nuvar, nvvar, corner, pvars);
                 rib_add_surface(p, req, &s);
             }
+        p->surface_vars = NULL;
+        p->nsurface_vars = 0;
+        rib_primvars_free(&vars);
     }
     rib_params_free(&params);
 }

@@ -11,10 +11,12 @@
  *
  * The mesh becomes one geom_subdiv (common/geom/subdiv.h), owned by the
  * scene (scene.subdivs), and every drawn face of its once-refined mesh one
- * GEOM_SUBDIV object. Primitive variables other than "P" are read and
- * checked, then ignored with one warning per scene (as on polygon meshes).
+ * GEOM_SUBDIV object. Other primitive variables (rib_primvar.c) are
+ * interpolated bilinearly over each refined face from their values at its
+ * corners (refined_face_vars).
  */
 #include "scene/rib_parser.h"
+#include "scene/rib_primvar.h"
 #include "sl/strbuf.h"
 
 #ifdef SCENE_HAVE_GEOM
@@ -169,6 +171,49 @@ static bool read_tags(rib_parser *p, const rib_request *req, int first, int npoi
     return ok;
 }
 
+#ifdef SCENE_HAVE_GEOM
+/* The variables over refined face f. The refined mesh has one quad per
+ * corner of the control mesh, in the control corners' order (face f is
+ * corner f of control face F, its k-th); its corners are the control
+ * point, the edge point towards the next corner, the face point and the
+ * edge point from the previous corner, turned so that a quad face's
+ * children keep its (u,v) directions (geom/subdiv_refine.c). Their values
+ * are those of the control corner and the means of the edge's two and of
+ * the face's corners: the bilinear interpolation over the control face
+ * (RenderMan's varying class; facevarying per face corner the same;
+ * vertex-class values are interpolated so too, not by the subdivision
+ * rules). */
+static void refined_face_vars(const rib_primvars *vars, const geom_subdiv *sd, int f,
+                              const int *nverts, const int *fo, const int *idx,
+                              scene_primvar *out)
+{
+    int F = geom_subdiv_face_origin(sd, f), n = nverts[F], k = f - fo[F];
+    rib_corner *all = sl_xrealloc(NULL, (size_t)n * sizeof *all), c;
+    int m = n;
+    for (int i = 0; i < m; i++) {
+        int ci = fo[F] + i;
+        all[i] = (rib_corner){F, idx[ci], idx[ci], ci};
+    }
+    double g[4][RIB_MAX_PRIMVARS][3];
+    int here = fo[F] + k, next = fo[F] + (k + 1) % n, prev = fo[F] + (k + n - 1) % n;
+    c = (rib_corner){F, idx[here], idx[here], here};
+    rib_primvars_mean(vars, &c, 1, g[0]);
+    rib_corner e1[2] = {c, {F, idx[next], idx[next], next}};
+    rib_primvars_mean(vars, e1, 2, g[1]);
+    rib_primvars_mean(vars, all, m, g[2]);
+    rib_corner e3[2] = {{F, idx[prev], idx[prev], prev}, c};
+    rib_primvars_mean(vars, e3, 2, g[3]);
+    int start = n == 4 ? (4 - k) % 4 : 0;
+    /* corner j of the refined face sits at (0,0), (1,0), (1,1), (0,1) */
+    static const int slot[4] = {0, 1, 3, 2};
+    double vals[4][RIB_MAX_PRIMVARS][3];
+    for (int j = 0; j < 4; j++)
+        memcpy(vals[slot[j]], g[(j + start) % 4], sizeof vals[0]);
+    rib_primvars_bilinear_values(vars, vals, out);
+    free(all);
+}
+#endif
+
 void rib_subdivision_mesh(rib_parser *p, const rib_request *req)
 {
     const char *scheme = rib_read_string(p, req, 0, "the scheme (\"catmull-clark\")");
@@ -185,6 +230,8 @@ void rib_subdivision_mesh(rib_parser *p, const rib_request *req)
     subdiv_tags tags;
     memset(&tags, 0, sizeof tags);
     rib_params params = { 0 };
+    rib_primvars vars = { NULL, 0 };
+    int *fo = NULL;
     if (!idx) goto out;
     long total = 0;
     for (int f = 0; f < nfaces; f++) total += nverts[f];
@@ -216,16 +263,9 @@ void rib_subdivision_mesh(rib_parser *p, const rib_request *req)
         }
     if (have_tags && !read_tags(p, req, first, npoints, nfaces, &tags))
         goto out;
-    if (!p->warned_mesh_vars) {
-        for (int i = 0; i < params.count; i++)
-            if (strcmp(params.items[i].name, "P") != 0) {
-                rib_warning(p, req, params.items[i].pos, "only \"P\" is used on subdivision "
-                            "meshes: \"%s\" ignored (and on the meshes that follow)",
-                            params.items[i].name);
-                p->warned_mesh_vars = true;
-                break;
-            }
-    }
+    int counts[] = { 0, 1, nfaces, npoints, npoints, nidx };
+    if (!rib_primvars_collect(p, req, &params, counts, NULL, &vars))
+        goto out;
 #ifdef SCENE_HAVE_GEOM
     {
         geom_subdiv_desc d = {
@@ -244,11 +284,23 @@ void rib_subdivision_mesh(rib_parser *p, const rib_request *req)
         sc->subdivs = sl_xrealloc(sc->subdivs, (size_t)(sc->nsubdivs + 1) * sizeof *sc->subdivs);
         sc->subdivs[sc->nsubdivs++] = sd;
         int drawn = 0;
+        fo = sl_xrealloc(NULL, (size_t)(nfaces + 1) * sizeof *fo);
+        fo[0] = 0;
+        for (int f = 0; f < nfaces; f++) fo[f + 1] = fo[f] + nverts[f];
         for (int f = 0; f < geom_subdiv_nfaces(sd) && !sl_diag_full(p->diag); f++) {
             if (!geom_subdiv_face_drawn(sd, f)) continue;
             geom_surface s;
             geom_subdiv_surface(sd, f, &s);
+            scene_primvar pv[RIB_MAX_PRIMVARS];
+            int F = geom_subdiv_face_origin(sd, f);
+            if (vars.n > 0 && F >= 0 && F < nfaces && f >= fo[F] && f < fo[F + 1]) {
+                refined_face_vars(&vars, sd, f, nverts, fo, idx, pv);
+                p->surface_vars = pv;
+                p->nsurface_vars = vars.n;
+            }
             rib_add_surface(p, req, &s);
+            p->surface_vars = NULL;
+            p->nsurface_vars = 0;
             drawn++;
         }
         if (drawn == 0)
@@ -259,6 +311,8 @@ void rib_subdivision_mesh(rib_parser *p, const rib_request *req)
     rib_error(p, req, req->pos, "subdivision meshes need common/geom");
 #endif
 out:
+    free(fo);
+    rib_primvars_free(&vars);
     tags_free(&tags);
     rib_params_free(&params);
     free(nverts);

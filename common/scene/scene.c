@@ -50,6 +50,7 @@ void scene_destroy(scene **self_p)
         free(self->objects[i].displacement_bound_space);
         free(self->objects[i].name);
         free(self->objects[i].lights);
+        free(self->objects[i].primvars);
     }
     free(self->objects);
     for (int i = 0; i < self->nshaders; i++)

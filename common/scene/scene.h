@@ -80,6 +80,13 @@ typedef struct scene_filter {
 
 /* ---- shader references ------------------------------------------------- */
 
+/* Storage classes of primitive variables (RI Spec 3.2 §5.1), as declared
+ * ("vertex float foo"); SCENE_CLASS_NONE: not said (told by the count). */
+typedef enum scene_class {
+    SCENE_CLASS_NONE, SCENE_CLASS_CONSTANT, SCENE_CLASS_UNIFORM, SCENE_CLASS_VARYING,
+    SCENE_CLASS_VERTEX, SCENE_CLASS_FACEVARYING,
+} scene_class;
+
 /* One parameter of a Surface / Displacement call, typed from Declare, the
  * predeclared standard names or an inline declaration ("uniform float Km").
  * Numbers: values[0..count), count = components(type) * arraylen (float 1,
@@ -92,7 +99,22 @@ typedef struct scene_param {
     int count;
     char *string;                  /* string parameters only */
     sl_pos pos;                    /* where the name was written */
+    scene_class cls;               /* primitive variables: the declared class */
 } scene_param;
+
+/* A primitive variable over one object (docs/scenes.md "Primitive
+ * variables"): per component k, the value at (u,v) of the object's own
+ * parametrisation is the polynomial sum over i, j < 4 of c[i + 4 j][k]
+ * u^i v^j (linear over a mesh triangle, bilinear over a patch, bicubic for
+ * the vertex class of a bicubic patch, constant for the constant and
+ * uniform classes). Points, vectors and normals are in object space.
+ * "st" arrives as two floats "s" and "t". */
+typedef struct scene_primvar {
+    char name[64];
+    sl_type type;                  /* float, color, point, vector or normal */
+    int size;                      /* components: 1 or 3 */
+    double c[16][3];               /* c[i + 4 j]: the term of u^i v^j */
+} scene_primvar;
 
 /* One Surface or Displacement request, or a LightSource naming a light
  * shader. "shader" space is the transform
@@ -165,6 +187,12 @@ typedef struct scene_object {
     int *lights;                   /* indices into scene.lights that are on */
     int nlights;
     sl_pos pos;                    /* the defining request (file = scene.file) */
+    scene_primvar *primvars;       /* its primitive variables (other than P, N) */
+    int nprimvars;
+    int instance_of;               /* ObjectInstance: the index of the first object
+                                    * placed from the same recorded surface (its
+                                    * own index for that one); -1: not instanced.
+                                    * The renderer may share its boxes (Instances) */
 } scene_object;
 
 /* CoordinateSystem "name": a named space. */

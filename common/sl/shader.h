@@ -191,6 +191,19 @@ void sl_vm_set_affine(sl_vm *self, sl_global g, const aa_form *values);
 void sl_vm_set_derivs(sl_vm *self, sl_global g, const ia_interval *du,
                       const ia_interval *dv);
 
+/* Varying values (primitive variables, RI Spec 3.2 §5.1): from the next
+ * run until sl_vm_clear_globals, global g, or parameter `param` (an index
+ * of the program that runs), takes per component k the polynomial
+ *   sum over i, j < 4 of coef[i + 4 j][k] u^i v^j,
+ * u and v being the globals u, v, computed at the start of the run in its
+ * arithmetic (Horner's rule over the non-zero terms; so a range run bounds
+ * it over the range, with derivatives).
+ * size: 1 or 3 components (the parameter's must match). False when more
+ * than SL_VM_MAX_VARYING are set. */
+enum { SL_VM_MAX_VARYING = 32 };   /* 16 primitive variables, each a global and a parameter */
+bool sl_vm_set_varying_global(sl_vm *self, sl_global g, const double coef[16][3]);
+bool sl_vm_set_varying_param(sl_vm *self, int param, int size, const double coef[16][3]);
+
 /* Runs the instance. `ctx` is used (and required) in affine mode only. */
 sl_status sl_vm_run(sl_vm *self, const sl_instance *inst, sl_mode mode,
                     aa_context *ctx);

@@ -304,8 +304,34 @@ static bool global_ok(sl_global g) { return (unsigned)g < SL_G__COUNT; }
 void sl_vm_clear_globals(sl_vm *self)
 {
     self->clear_pending = 0xf;
+    self->nvarying = 0;
     for (int s = 0; s < SL_GLOBAL_SLOTS; s++)
         self->gderiv[s][0] = self->gderiv[s][1] = ia_entire();
+}
+
+static bool add_varying(sl_vm *self, bool global, int target, int size,
+                        const double coef[16][3])
+{
+    if (self->nvarying >= SL_VM_MAX_VARYING || size < 1 || size > 3)
+        return false;
+    vm_varying *v = &self->varying[self->nvarying++];
+    v->global = global;
+    v->target = target;
+    v->size = size;
+    memcpy(v->c, coef, sizeof v->c);
+    return true;
+}
+
+bool sl_vm_set_varying_global(sl_vm *self, sl_global g, const double coef[16][3])
+{
+    if (!global_ok(g))
+        return false;
+    return add_varying(self, true, sl_global_slot(g), sl_global_size(g), coef);
+}
+
+bool sl_vm_set_varying_param(sl_vm *self, int param, int size, const double coef[16][3])
+{
+    return param >= 0 && add_varying(self, false, param, size, coef);
 }
 
 void sl_vm_set_derivs(sl_vm *self, sl_global g, const ia_interval *du, const ia_interval *dv)

@@ -87,6 +87,14 @@ typedef struct vm_message {
     char s[128];
 } vm_message;
 
+/* A varying global or parameter (sl_vm_set_varying_*): sum c[i + 4 j] u^i v^j. */
+typedef struct vm_varying {
+    bool global;
+    int target;                    /* the global's first slot, or the parameter */
+    int size;
+    double c[16][3];
+} vm_varying;
+
 typedef struct vm_accumulator {
     int kind, id;
     int pool, spool;
@@ -106,6 +114,8 @@ struct sl_vm {
     int nillum, illum_next;
     vm_message messages[SL_VM_MAX_MESSAGES];
     int nmessages;
+    vm_varying varying[SL_VM_MAX_VARYING];   /* cleared with the globals */
+    int nvarying;
     char strings[SL_VM_STRING_SPACE];  /* strings made by this run */
     int strings_used;
     int prints;

@@ -11,6 +11,7 @@
  * (globals.inc), so boxes and points see the same surface.
  */
 #include "trace/displace.h"
+#include "trace/primvar.h"
 
 #include <stdio.h>
 #include <string.h>
@@ -151,6 +152,7 @@ static void box_affine(trace_thread *th, const trace_object *obj,
     sl_vm *vm = th->vm;
     bind_globals_affine(vm, obj, &obj->displacement_spaces, P, N, N, dPdu, dPdv, &u, &v,
                         obj->box_skip_tangents ? NULL : Pd, flat_normal(obj));
+    trace_primvars_bind(vm, obj, false);
     if (sl_vm_run(vm, obj->displacement, SL_MODE_AFFINE, ctx) != SL_OK) {
         trace_thread_fail(th, sl_vm_error(vm));
         aa_unbounded(&P[0], AA_UNBOUNDED);
@@ -228,6 +230,7 @@ static void box_interval(trace_thread *th, const trace_object *obj,
     ia_interval Pd[2][3] = {{dPdu[0], dPdu[1], dPdu[2]}, {dPdv[0], dPdv[1], dPdv[2]}};
     bind_globals_interval(vm, obj, &obj->displacement_spaces, P, N, N, dPdu, dPdv, &u, &v,
                           obj->box_skip_tangents ? NULL : Pd, flat_normal(obj));
+    trace_primvars_bind(vm, obj, false);
     if (sl_vm_run(vm, obj->displacement, SL_MODE_INTERVAL, NULL) != SL_OK) {
         trace_thread_fail(th, sl_vm_error(vm));
         P[0] = P[1] = P[2] = ia_entire();
@@ -242,6 +245,7 @@ static void box_interval(trace_thread *th, const trace_object *obj,
 void trace_surface_box(trace_thread *th, const trace_object *obj,
                        double u0, double u1, double v0, double v1, trace_box *out)
 {
+    obj = trace_box_owner(obj);           /* an instance: its prototype's box */
     if (th->world->options.arith == TRACE_ARITH_INTERVAL)
         box_interval(th, obj, u0, u1, v0, v1, out);
     else
@@ -274,9 +278,29 @@ void trace_surface_point_eval(trace_thread *th, const trace_object *obj,
     trace_surface_point_eval_on(th, th->vm, obj, u, v, out);
 }
 
+/* An instance sharing its prototype's boxes (trace/instance.c): its
+ * surface is the prototype's, moved rigidly into its camera space. */
+static void point_of_instance(trace_thread *th, sl_vm *vm, const trace_object *obj,
+                              double u, double v, trace_surface_point *out)
+{
+    trace_surface_point_eval_on(th, vm, obj->box_proto, u, v, out);
+    const mat4 *m = &obj->from_proto, *inv = &obj->to_proto;
+    out->P = mat4_xform_point(m, out->P);
+    out->dPdu = mat4_xform_vector(m, out->dPdu);
+    out->dPdv = mat4_xform_vector(m, out->dPdv);
+    out->Pu = mat4_xform_vector(m, out->Pu);
+    out->Pv = mat4_xform_vector(m, out->Pv);
+    out->N = v3_normalize(mat4_xform_normal(inv, out->N));
+    out->Ng = v3_normalize(mat4_xform_normal(inv, out->Ng));
+}
+
 void trace_surface_point_eval_on(trace_thread *th, sl_vm *vm, const trace_object *obj,
                                  double u, double v, trace_surface_point *out)
 {
+    if (obj->box_proto) {
+        point_of_instance(th, vm, obj, u, v, out);
+        return;
+    }
     geom_sample g;
     if (obj->displacement) geom_eval_dual(&obj->surf, u, v, &g);
     else geom_eval(&obj->surf, u, v, &g);
@@ -321,6 +345,7 @@ void trace_surface_point_eval_on(trace_thread *th, sl_vm *vm, const trace_object
     sl_dual du_ = {u, 1, 0}, dv_ = {v, 0, 1};
     bind_globals_dual(vm, obj, &obj->displacement_spaces, dP, dN, dN, ddPdu, ddPdv, &du_, &dv_,
                       NULL, false);
+    trace_primvars_bind(vm, obj, false);
     th->stats.evals_dual++;
     if (sl_vm_run(vm, obj->displacement, SL_MODE_DUAL, NULL) != SL_OK) {
         trace_thread_fail(th, sl_vm_error(vm));

@@ -15,7 +15,9 @@
  *                        calculatenormal(P) in the shader is exact
  *
  * Both are pure functions of (object, u, v): the box cache and every
- * determinism test rely on that.
+ * determinism test rely on that. An instance that shares its prototype's
+ * boxes (trace/instance.c) gets the prototype's box, and the prototype's
+ * point moved rigidly into its camera space.
  */
 #ifndef TRACE_DISPLACE_H
 #define TRACE_DISPLACE_H

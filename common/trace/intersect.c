@@ -332,19 +332,21 @@ static trace_brood_id children_of(walk *w, trace_brood_id parent, int slot,
                                   trace_box kids[4])
 {
     trace_thread *th = w->th;
-    trace_brood_id id = trace_boxcache_lookup(th->cache, w->obj->id, parent, slot, kids);
+    /* instances sharing a prototype's boxes share its cache entries */
+    const trace_object *owner = trace_box_owner(w->obj);
+    trace_brood_id id = trace_boxcache_lookup(th->cache, owner->id, parent, slot, kids);
     if (id != TRACE_BROOD_NONE) return id;
     double node_extent = trace_box_extent(node);
     for (int i = 0; i < 4; i++) {
         double c[4];
         child_range(i, r[0], r[1], r[2], r[3], c);
-        trace_surface_box(th, w->obj, c[0], c[1], c[2], c[3], &kids[i]);
+        trace_surface_box(th, owner, c[0], c[1], c[2], c[3], &kids[i]);
         if (depth >= TRACE_SAMPLE_DEPTH && (kids[i].flags & AA_DISCONTINUOUS) &&
             !(kids[i].flags & AA_UNBOUNDED) && !trace_box_is_empty(&kids[i]) &&
             trace_box_extent(&kids[i]) >= TRACE_NO_SHRINK * node_extent)
-            sample_stagnant(th, w->obj, c, &kids[i]);
+            sample_stagnant(th, owner, c, &kids[i]);
     }
-    return trace_boxcache_insert(th->cache, w->obj->id, parent, slot, kids);
+    return trace_boxcache_insert(th->cache, owner->id, parent, slot, kids);
 }
 
 /* Bounded work (issue 9): a walk ends after max_nodes_per_ray nodes, or

@@ -11,6 +11,7 @@
 #include <string.h>
 
 #include "trace/camera.h"
+#include "trace/instance.h"
 #include "trace/sampler.h"
 #include "trace/shade.h"
 
@@ -43,9 +44,12 @@ trace_renderer *trace_renderer_new(trace_world *world, char *err, int errsz)
     if (!trace_world_prepare(world, err, errsz))
         return NULL;
     trace_thread *th = trace_thread_new(world);
+    trace_instances_share(th, world);
     for (int i = 0; i < world->nobjects; i++) {
         trace_object *obj = &world->objects[i];
-        if (obj->displacement) {
+        if (obj->box_proto) {
+            obj->root = obj->box_proto->root;   /* an earlier object: computed */
+        } else if (obj->displacement) {
             trace_surface_box(th, obj, 0, 1, 0, 1, &obj->root);
         } else {
             geom_bounds(&obj->surf, &obj->root.lo, &obj->root.hi);

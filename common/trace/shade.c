@@ -5,6 +5,7 @@
 #include "trace/shade.h"
 
 #include "trace/displace.h"
+#include "trace/primvar.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -214,13 +215,19 @@ static void set3(sl_vm *vm, sl_global g, vec3 v)
     sl_vm_set_float(vm, g, a);
 }
 
-static void default_surface(const trace_object *obj, vec3 I, vec3 N,
+static void default_surface(const trace_object *obj, vec3 I, vec3 N, double u, double v,
                             double rgb[3], double *alpha)
 {
-    /* RenderMan's defaultsurface: a facing ratio, Ka 0.2, Kd 0.8 */
+    /* RenderMan's defaultsurface: a facing ratio, Ka 0.2, Kd 0.8; Cs and
+     * Os from the primitive variables where given */
+    double Cs[3], Os[3];
+    if (!trace_primvar_global(obj, SL_G_Cs, u, v, Cs))
+        for (int k = 0; k < 3; k++) Cs[k] = obj->Cs[k];
+    if (!trace_primvar_global(obj, SL_G_Os, u, v, Os))
+        for (int k = 0; k < 3; k++) Os[k] = obj->Os[k];
     double f = fabs(v3_dot(v3_normalize(I), N));
-    for (int k = 0; k < 3; k++) rgb[k] = obj->Os[k] * obj->Cs[k] * (0.2 + 0.8 * f);
-    *alpha = (obj->Os[0] + obj->Os[1] + obj->Os[2]) / 3.0;
+    for (int k = 0; k < 3; k++) rgb[k] = Os[k] * Cs[k] * (0.2 + 0.8 * f);
+    *alpha = (Os[0] + Os[1] + Os[2]) / 3.0;
 }
 
 static bool has_outputs(const sl_instance *inst)
@@ -281,7 +288,7 @@ static void shade_hit(const trace_renderer *r, trace_thread *th, const trace_ray
     vec3 I = v3_sub(sp.P, ray->o);
 
     if (!obj->surface) {
-        default_surface(obj, I, sp.N, rgb, alpha);
+        default_surface(obj, I, sp.N, sp.u, sp.v, rgb, alpha);
         return;
     }
     double pixel_tol = r->primary_tol.a + r->primary_tol.b * fabs(sp.P.z);
@@ -305,6 +312,7 @@ static void shade_hit(const trace_renderer *r, trace_thread *th, const trace_ray
     sl_vm_set_tracer(vm, &tracer);
     sl_vm_set_float(vm, SL_G_Cs, obj->Cs);
     sl_vm_set_float(vm, SL_G_Os, obj->Os);
+    trace_primvars_bind(vm, obj, true);     /* st, Cs, Os, the shader's own names */
     th->stats.evals_float++;
     if (sl_vm_run(vm, obj->surface, SL_MODE_FLOAT, NULL) != SL_OK) {
         trace_thread_fail(th, sl_vm_error(vm));

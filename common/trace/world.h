@@ -23,6 +23,18 @@
 
 typedef enum trace_arith { TRACE_ARITH_AFFINE, TRACE_ARITH_INTERVAL } trace_arith;
 
+/* A primitive variable of an object (docs/scenes.md "Primitive
+ * variables"), in camera space: per component k, the polynomial sum
+ * c[i + 4 j][k] u^i v^j over the object's (u,v). It sets a global (s,
+ * t, Cs, Os) and the shaders' parameters of its name (trace/primvar.c). */
+typedef struct trace_primvar {
+    sl_global global;              /* SL_G_s, SL_G_t, SL_G_Cs, SL_G_Os; SL_G__COUNT: none */
+    int displacement_param;        /* its index in the displacement program, -1: none */
+    int surface_param;             /* ... in the surface program, -1: none */
+    int size;                      /* 1 or 3 */
+    double c[16][3];
+} trace_primvar;
+
 typedef struct trace_object {
     int id;                        /* index in trace_world.objects */
     char name[64];                 /* for messages: "sphere at ufo.rib:12" */
@@ -48,7 +60,21 @@ typedef struct trace_object {
                                       not transform the tangents (world.c) */
     trace_box root;                /* OBJECT space box over the whole (u,v) square */
     trace_box bound;               /* camera space box of root (for the BVH) */
+    /* instances (trace/instance.c): the earlier instance of the same
+     * recorded surface whose object-space boxes (and displaced surface,
+     * moved rigidly) this object uses; NULL: its own. The adapter proposes
+     * it, trace_renderer_new keeps it only where that changes no surface */
+    const trace_primvar *primvars; /* its primitive variables (not owned) */
+    int nprimvars;
+    const struct trace_object *box_proto;
+    mat4 from_proto, to_proto;     /* box_proto's camera space -> ours, and back */
 } trace_object;
+
+/* The object whose boxes (and box cache entries) stand for obj's. */
+static inline const trace_object *trace_box_owner(const trace_object *obj)
+{
+    return obj->box_proto ? obj->box_proto : obj;
+}
 
 typedef enum trace_light_kind {
     TRACE_LIGHT_AMBIENT, TRACE_LIGHT_DISTANT, TRACE_LIGHT_POINT, TRACE_LIGHT_SPOT,

@@ -53,6 +53,11 @@ static void test_instances_compose(void **state)
     /* positions point at the definition's surfaces */
     assert_int_equal(s->objects[0].pos.line, 6);
     assert_int_equal(s->objects[3].pos.line, 9);
+    /* each placed surface names the first object placed from it */
+    assert_int_equal(s->objects[0].instance_of, 0);
+    assert_int_equal(s->objects[1].instance_of, 1);
+    assert_int_equal(s->objects[2].instance_of, 0);
+    assert_int_equal(s->objects[3].instance_of, 1);
     /* the definition's transform did not leak past ObjectEnd */
     scene_destroy(&s);
     sl_diag_destroy(&d);
@@ -72,6 +77,9 @@ static void test_string_handles_and_redefinition(void **state)
     assert_int_equal(s->nobjects, 3);
     assert_true(s->objects[0].surface.radius == 1);
     assert_true(s->objects[1].surface.radius == 2);
+    /* a redefined handle is another object; a plain surface no instance */
+    assert_int_equal(s->objects[1].instance_of, 1);
+    assert_int_equal(s->objects[2].instance_of, -1);
     /* Color inside the definition does not travel: a warning says so */
     assert_true(s->objects[1].Cs[1] == 1);
     assert_int_equal(sl_diag_warning_count(d), 1);

@@ -182,12 +182,20 @@ static void test_variables_degenerate_instances(void **state)
         sl_diag_print(d, stderr);
     assert_non_null(s);
     assert_int_equal(s->nobjects, 3);
-    assert_int_equal(sl_diag_warning_count(d), 2);
+    assert_int_equal(sl_diag_warning_count(d), 1);
     assert_string_equal(diag_line(nth_diag(d, SL_DIAG_WARNING, 0)),
-                        "t.rib:5:1: PointsPolygons: only \"P\" and \"N\" are used on "
-                        "meshes: \"st\" ignored (and on the meshes that follow)");
-    assert_string_equal(diag_line(nth_diag(d, SL_DIAG_WARNING, 1)),
                         "t.rib:5:1: PointsPolygons: 1 face without area skipped");
+    /* the variables travel with the recorded face to both instances: st
+     * as s and t; the vertex Cs, the same at every corner, is constant */
+    for (int i = 0; i < 2; i++) {
+        assert_int_equal(s->objects[i].nprimvars, 2);
+        assert_string_equal(s->objects[i].primvars[0].name, "s");
+        assert_string_equal(s->objects[i].primvars[1].name, "t");
+    }
+    assert_int_equal(s->objects[2].nprimvars, 1);
+    assert_string_equal(s->objects[2].primvars[0].name, "Cs");
+    assert_true(s->objects[2].primvars[0].c[0][0] == 1 && s->objects[2].primvars[0].c[1][0] == 0 &&
+                s->objects[2].primvars[0].c[4][0] == 0);
     vec3 o = mat4_xform_point(&s->objects[1].object_to_world, v3(0, 0, 0));
     assert_true(vec_dist(o, v3(0, 0, 5)) < 1e-12);
     scene_destroy(&s);
@@ -195,6 +203,11 @@ static void test_variables_degenerate_instances(void **state)
 }
 
 static const error_case cases[] = {
+    { WORLD("PointsPolygons [3] [0 1 2] \"P\" [0 0 0 1 0 0 0 1 0] \"vertex color Cs\" [1 0 0]\n"),
+      "t.rib:4:52: PointsPolygons: \"Cs\" is vertex: it needs 3 values, got 1" },
+    { WORLD("PointsPolygons [3] [0 1 2] \"P\" [0 0 0 1 0 0 0 1 0] \"float foo\" [1 2]\n"),
+      "t.rib:4:52: PointsPolygons: \"foo\" has 2 values; give one per vertex (3), per varying "
+      "point (3), per face corner (3), per face (1) or one" },
     { WORLD("PointsPolygons [3 2] [0 1 2 0 1] \"P\" [0 0 0 1 0 0 0 1 0]\n"),
       "t.rib:4:16: PointsPolygons: the vertex counts (nvertices): entry 1 is 2, expected a "
       "whole number >= 3" },

@@ -1,0 +1,112 @@
+/*
+ * instance.c: which instances share their prototype's boxes (instance.h).
+ *
+ * A box of Heidrich & Seidel §3 is an OBJECT-space box of the displaced
+ * surface over a (u,v) range, computed with the displacement shader run
+ * in camera ("current") space. Two instances of one recorded surface have
+ * the same base surface in object space; their displaced surfaces are the
+ * same in object space when the displacement shader is equivariant under
+ * the motion between their camera spaces: P + h N with h computed from
+ * "shader" or "object" space points, s, t or u, v (every displacement
+ * shader of scenes/), and the two transforms differing by a rigid motion
+ * (a scale would change the length of the camera-space unit normal in
+ * object units).
+ *
+ * That equivariance is not decided by analysing the shader: the instance's
+ * surface is DEFINED as the prototype's displaced surface moved rigidly
+ * (displace.c maps the prototype's points), so the prototype's boxes bound
+ * it by construction and the guarantee holds whatever the shader does. The
+ * test below only decides whether that definition is the one RenderMan
+ * gives (the shader run on the instance itself): the motion must be rigid
+ * (orientation kept), the shader instance the same, with no output
+ * parameters (their values would be the prototype's), and on a 5 x 5 grid
+ * of (u,v) the instance's own displaced points and normals must equal the
+ * prototype's moved ones within 1e-9 of the coordinates (1e-7 for unit
+ * normals). A shader that reads camera-space P directly (noise(P)), or
+ * the eye (I, E) or the per-object du, dv where they matter, fails the
+ * grid and the instance keeps its own boxes, as before.
+ */
+#include "trace/instance.h"
+
+#include <math.h>
+
+#include "trace/displace.h"
+
+enum { PROBE = 5 };
+
+/* the 3x3 part of m is a rotation (orthonormal columns, determinant > 0) */
+static bool rigid(const mat4 *m)
+{
+    vec3 c[3];
+    for (int i = 0; i < 3; i++) c[i] = v3(m->m[0][i], m->m[1][i], m->m[2][i]);
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            if (!(fabs(v3_dot(c[i], c[j]) - (i == j ? 1.0 : 0.0)) <= 1e-9)) return false;
+    return v3_dot(c[0], v3_cross(c[1], c[2])) > 0;
+}
+
+static bool shader_allows(const sl_instance *inst)
+{
+    const sl_program *prog = sl_instance_program(inst);
+    for (int i = 0; i < sl_program_param_count(prog); i++) {
+        sl_param_info info;
+        sl_program_param(prog, i, &info);
+        if (info.output) return false;
+    }
+    return true;
+}
+
+static double vmax_abs(vec3 a)
+{
+    return fmax(fabs(a.x), fmax(fabs(a.y), fabs(a.z)));
+}
+
+/* The instance's own points against the prototype's moved ones (at
+ * least one of the grid's points must be on the surface). */
+static bool same_surface(trace_thread *th, trace_object *obj, const trace_object *proto)
+{
+    int compared = 0;
+    for (int j = 0; j < PROBE; j++)
+        for (int i = 0; i < PROBE; i++) {
+            double u = i / (double)(PROBE - 1), v = j / (double)(PROBE - 1);
+            if (!geom_uv_inside(&obj->surf, u, v)) continue;
+            trace_surface_point own, moved;
+            obj->box_proto = NULL;
+            trace_surface_point_eval(th, obj, u, v, &own);
+            obj->box_proto = proto;
+            trace_surface_point_eval(th, obj, u, v, &moved);
+            if (th->failed) return false;
+            double scale = 1.0 + fmax(vmax_abs(own.P), vmax_abs(moved.P));
+            if (!(vmax_abs(v3_sub(own.P, moved.P)) <= 1e-9 * scale) ||
+                !(vmax_abs(v3_sub(own.N, moved.N)) <= 1e-7))
+                return false;
+            compared++;
+        }
+    return compared > 0;
+}
+
+static bool can_share(trace_thread *th, trace_object *obj, const trace_object *proto)
+{
+    if (proto->id >= obj->id || proto->box_proto || !obj->displacement ||
+        obj->displacement != proto->displacement || obj->flip != proto->flip ||
+        obj->surf.kind != proto->surf.kind || !shader_allows(obj->displacement))
+        return false;
+    obj->from_proto = mat4_mul(obj->to_camera, proto->from_camera);
+    obj->to_proto = mat4_mul(proto->to_camera, obj->from_camera);
+    if (!rigid(&obj->from_proto)) return false;
+    return same_surface(th, obj, proto);
+}
+
+int trace_instances_share(trace_thread *th, trace_world *world)
+{
+    int shared = 0;
+    for (int i = 0; i < world->nobjects; i++) {
+        trace_object *obj = &world->objects[i];
+        const trace_object *proto = obj->box_proto;
+        obj->box_proto = NULL;
+        bool share = proto && can_share(th, obj, proto);   /* sets box_proto meanwhile */
+        obj->box_proto = share ? proto : NULL;
+        shared += share;
+    }
+    return shared;
+}

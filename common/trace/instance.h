@@ -1,0 +1,26 @@
+/*
+ * instance.h: instances that share one set of boxes (issue 14, "no copy
+ * per instance"; docs/renderer.md "Instances").
+ *
+ * Every object an ObjectInstance places names the first object placed from
+ * the same recorded surface (scene_object.instance_of, which the adapter
+ * turns into trace_object.box_proto). trace_instances_share keeps that
+ * link only where the instance's displaced surface is the prototype's,
+ * moved rigidly; the object then uses the prototype's object-space boxes
+ * and box cache entries (trace_box_owner), and its points are the
+ * prototype's points moved into its camera space (displace.c).
+ */
+#ifndef TRACE_INSTANCE_H
+#define TRACE_INSTANCE_H
+
+#include "trace/thread.h"
+#include "trace/world.h"
+
+/* Decides, for every object of the world with a box_proto, whether it
+ * keeps it (and sets from_proto, to_proto) or gets its own boxes
+ * (box_proto = NULL). Runs the displacement shaders on th (a probe of the
+ * surface). Returns how many objects share a prototype's boxes. Called by
+ * trace_renderer_new after trace_world_prepare. */
+int trace_instances_share(trace_thread *th, trace_world *world);
+
+#endif
