@@ -80,8 +80,35 @@ bool sl_program_derivatives_reach_P(const sl_program *p)
 }
 
 /* Conservative: does any instruction name a slot of global g (read or
- * written, as the first slot of an operand of up to three, or in a merge
+ * written, as the first slot of an operand of its width, or in a merge
  * table)? A program that never names dPdu need not be given it. */
+/* How many slots past its first an operand of `op` may reach: 0 for the
+ * scalar operations (the VM runs them on one slot: vm_exec.inc), 15 for
+ * copies of n slots, parameter defaults, argument blocks and arrays, and
+ * 2 (a triple) for the rest. A matrix is never a global: it lives above
+ * them, so a block that starts below a global and spans it is at most a
+ * copy or an argument block. */
+static int operand_reach(int op)
+{
+    switch (op) {
+    case SL_OP_MOV: case SL_OP_ADD: case SL_OP_SUB: case SL_OP_MUL: case SL_OP_DIV:
+    case SL_OP_NEG: case SL_OP_SQRT: case SL_OP_INVSQRT: case SL_OP_EXP: case SL_OP_LOG:
+    case SL_OP_SIN: case SL_OP_COS: case SL_OP_TAN: case SL_OP_ASIN: case SL_OP_ACOS:
+    case SL_OP_ATAN: case SL_OP_ABS: case SL_OP_SIGN: case SL_OP_FLOOR: case SL_OP_CEIL:
+    case SL_OP_ROUND: case SL_OP_POW: case SL_OP_ATAN2: case SL_OP_MOD: case SL_OP_MIN:
+    case SL_OP_MAX: case SL_OP_STEP: case SL_OP_CLAMP: case SL_OP_SMOOTHSTEP: case SL_OP_MIX:
+    case SL_OP_LT: case SL_OP_LE: case SL_OP_GT: case SL_OP_GE: case SL_OP_EQ: case SL_OP_NE:
+    case SL_OP_AND: case SL_OP_OR: case SL_OP_NOT:
+        return 0;
+    case SL_OP_MOVN: case SL_OP_PARAM: case SL_OP_RAY: case SL_OP_TEXTURE:
+    case SL_OP_TEXINFO: case SL_OP_SFMT: case SL_OP_MESSAGE: case SL_OP_ALOAD:
+    case SL_OP_ASTORE: case SL_OP_ESCAPE:
+        return 15;
+    default:
+        return 2;
+    }
+}
+
 bool sl_program_reads_global(const sl_program *p, sl_global g)
 {
     int first = sl_global_slot(g), last = first + sl_global_size(g) - 1;
@@ -89,8 +116,10 @@ bool sl_program_reads_global(const sl_program *p, sl_global g)
         const sl_insn *in = &p->code[pc];
         const char *k = kinds[in->op];
         const uint16_t ops[4] = { in->a, in->b, in->c, in->d };
+        /* how far past its first slot an operand may reach */
+        int reach = operand_reach(in->op);
         for (int i = 0; i < 4; i++) {
-            if ((k[i] == 'x' || k[i] == 'z') && ops[i] <= last && ops[i] + 15 >= first)
+            if ((k[i] == 'x' || k[i] == 'z') && ops[i] <= last && ops[i] + reach >= first)
                 return true;
             if (k[i] == 't' && ops[i] < p->ntables) {
                 const uint16_t *t = &p->tables[ops[i]];
