@@ -10,6 +10,8 @@
 
 #include "geom/subdiv_internal.h"
 
+enum { SD_MAX_LEVEL = 48 };       /* local refinement stops here */
+
 enum {
     SD_LF = 4 * GEOM_SUBDIV_MAX_VALENCE,   /* faces touching a quad's corners */
     SD_LC = 4 * SD_LF,
@@ -56,4 +58,16 @@ bool sd_regular_net(const sd_mesh *L, vec3 net[16]);
  * it (false otherwise): smooth, crease or corner mask. */
 bool sd_corner_limit(const sd_mesh *L, int k, vec3 *out);
 
+/* The tree of local refinements of a face (subdiv_cache.c): a node is a
+ * sub-face at some level, immutable once built, shared by threads. The
+ * root is the face (level 0); child q is quadrant q (subdiv_internal.h),
+ * built on first use. */
+const sd_node *sd_node_root(const geom_subdiv *sd, int f);
+const sd_node *sd_node_child(const sd_node *n, int q);
+/* Whether the sub-face is regular, and its Bezier net. */
+bool sd_node_regular(const sd_node *n, const vec3 **net);
+/* An irregular sub-face: its 1-ring into L, and the hull of the points its
+ * limit depends on (its sectors: no infinitely sharp edge crossed). */
+void sd_node_local(const sd_node *n, sd_local *L);
+void sd_node_hull(const sd_node *n, vec3 *lo, vec3 *hi);
 #endif

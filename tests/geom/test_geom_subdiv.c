@@ -15,6 +15,9 @@
  *   enclosures of P, and of dPdu, dPdv, Ng where those are bounded, on a
  *   cube (valence 3), a fan (valence 5, boundary, interpolateboundary) and
  *   a cube with infinite, semi-sharp creases and a corner tag: 0 violations;
+ *   the same at the corners of every face (boxes 1 .. 2^-9 wide) of a cube
+ *   with a creased rim and semi-sharp edges, where the hull of an
+ *   irregular sub-face is that of its sectors' points (subdiv_cache.c);
  * - watertight: two faces sharing an edge give the same points along it
  *   (1e-12) and, off sharp edges, the same unit normal (1e-7);
  * - bad meshes (an edge with three faces, faces that disagree on the
@@ -337,6 +340,52 @@ static void test_containment(void **state)
     geom_subdiv_free(&sd);
 }
 
+/* The boxes at the corners of every face, 2^-level wide (level 0..9):
+ * the renderer's boxes around an irregular point, which the hull of the
+ * points the sub-face depends on (its sectors, subdiv_cache.c) bounds. */
+static void contain_corners(const char *name, geom_subdiv *sd)
+{
+    tally t = { 0, 0, 0, 0, 0 };
+    for (int f = 0; f < geom_subdiv_nfaces(sd); f++) {
+        if (!geom_subdiv_face_drawn(sd, f)) continue;
+        geom_surface s;
+        geom_subdiv_surface(sd, f, &s);
+        char why[100];
+        assert_true(geom_surface_prepare(&s, why, sizeof why));
+        for (int level = 0; level < 10; level++)
+            for (int k = 0; k < 4; k++) {
+                double side = ldexp(1, -level);
+                double u0 = k & 1 ? 1 - side : 0, v0 = k & 2 ? 1 - side : 0;
+                contain_face(&s, u0, u0 + side, v0, v0 + side, &t);
+            }
+    }
+    printf("%-14s %6ld boxes (%ld with unbounded derivatives) %7ld points, %ld violations "
+           "(worst %.3g)\n", name, t.boxes, t.unbounded, t.points, t.violations, t.worst);
+    assert_int_equal(t.violations, 0);
+    assert_true(t.unbounded > 0);              /* irregular sub-faces were met */
+}
+
+/* Sectors: infinitely sharp edges cut a vertex's faces into sectors that
+ * do not feed each other; finite sharpness does not cut. A cube whose top
+ * rim is infinitely sharp (its corners: crease points of valence 3, as in
+ * scenes/subdiv.rib) and whose vertical edges 4-0 and 6-2 are semi-sharp
+ * (2.5: still 1.5 and 0.5 after the first steps), and a corner tag: a hull
+ * that took a semi-sharp edge for a cut, or ignored a cut's far side where
+ * it feeds, leaves points outside. */
+static void test_sector_hulls(void **state)
+{
+    (void)state;
+    int clen[] = { 5, 2, 2 }, cv[] = { 4, 5, 6, 7, 4,  4, 0,  6, 2 }, corner[] = { 1 };
+    double cs[] = { 10, 2.5, 2.5 }, corner_s[] = { 10 };
+    geom_subdiv *sd = cube(3, clen, cv, cs, 1, corner, corner_s);
+    contain_corners("sectors", sd);
+    contain_mesh("sectors", sd, 60);
+    geom_subdiv_free(&sd);
+    sd = cube(0, NULL, NULL, NULL, 0, NULL, NULL);
+    contain_corners("cube corners", sd);
+    geom_subdiv_free(&sd);
+}
+
 /* ---- shared edges ---- */
 
 static void edge_param(int k, double t, double *u, double *v)
@@ -439,6 +488,7 @@ int main(void)
         cmocka_unit_test(test_regular_faces_are_bsplines),
         cmocka_unit_test(test_limit_points),
         cmocka_unit_test(test_containment),
+        cmocka_unit_test(test_sector_hulls),
         cmocka_unit_test(test_shared_edges),
         cmocka_unit_test(test_bad_meshes),
     };
