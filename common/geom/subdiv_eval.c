@@ -172,6 +172,7 @@ typedef struct sd_range {
     bool regular;
     const vec3 *net;               /* regular: its Bezier net (16) */
     const sd_node *node;           /* irregular: the sub-face */
+    const sd_node *normal_node;    /* its ancestor at level < SD_SIGN_LEVEL */
     int level;
     double ou, ov;                 /* the sub-face's origin in the face's (u,v) */
     vec3 lo, hi;                   /* else: the hull of its 1-ring */
@@ -212,7 +213,7 @@ static void find_range(const geom_subdiv *sd, int f, double u0, double u1, doubl
 {
     r->level = 0;
     r->ou = r->ov = 0;
-    r->node = NULL;
+    r->node = r->normal_node = NULL;
     if (sd->net_of[f] >= 0) {
         r->regular = true;
         r->net = sd->nets + 16 * sd->net_of[f];
@@ -220,6 +221,7 @@ static void find_range(const geom_subdiv *sd, int f, double u0, double u1, doubl
     }
     const sd_node *n = sd_node_root(sd, f);
     for (int d = 0;; d++) {
+        if (d < SD_SIGN_LEVEL) r->normal_node = n;
         if (sd_node_regular(n, &r->net)) {
             r->regular = true;
             return;
@@ -366,6 +368,13 @@ static void net_bounds(const vec3 net[16], ia_interval su, ia_interval sv, doubl
     for (int c = 0; c < 3; c++) nb->Ng[c] = meet_ia_(nb->Ng[c], Ng[c]);
 }
 
+ia_interval sd_net_normal_component(const vec3 net[16], int axis)
+{
+    net_boxes nb;
+    net_bounds(net, ia_make(0, 1), ia_make(0, 1), 1, &nb);
+    return nb.Ng[axis];
+}
+
 static ia_interval meet_ia(ia_interval x, ia_interval y)
 {
     if (!isfinite(y.lo) || !isfinite(y.hi) || (y.flags & AA_UNBOUNDED)) return x;
@@ -501,6 +510,24 @@ void geom_subdiv_eval_aa(aa_context *ctx, const geom_surface *s, const aa_form *
         meet_aa(&out->dPdv[i], nb.dPdv[i]);
         meet_aa(&out->Ng[i], nb.Ng[i]);
     }
+}
+
+bool geom_subdiv_unit_normal_box(const geom_surface *s, ia_interval u, ia_interval v,
+                                 ia_interval Nn[3])
+{
+    sd_range r;
+    find_range(s->subdiv, s->subdiv_face, u.lo, u.hi, v.lo, v.hi, &r);
+    vec3 N;
+    if (r.regular || can_split(&r, u, v) || !sd_node_unit_normal(r.normal_node, &N))
+        return false;
+    /* the exact normal, widened by 1e-6 for the float evaluation of points
+     * near the irregular corner, whose normals tilt by the refinement's
+     * rounding amplified by 2^level (1e-9 at 2^-22 from a crease point) */
+    for (int i = 0; i < 3; i++) {
+        double c = v3_comp(N, i);
+        Nn[i] = ia_make(fmax(c - 1e-6, -1), fmin(c + 1e-6, 1));
+    }
+    return true;
 }
 
 /* ---- bounds and intersection ---- */
