@@ -73,6 +73,13 @@ void geom_subdiv_face_points(const geom_subdiv *self, int f, int out[4]);
 /* A GEOM_SUBDIV surface for face f (prepared). */
 void geom_subdiv_surface(const geom_subdiv *self, int f, geom_surface *out);
 
+/* The unit normal over the (u,v) box of a GEOM_SUBDIV surface where its
+ * Ng cannot bound it (an irregular sub-face): true and Nn when the box
+ * lies in one irregular sub-face whose normal is proven constant
+ * (subdiv_cache.c); false otherwise ([-1,1]^3 is all that is known). */
+bool geom_subdiv_unit_normal_box(const geom_surface *s, ia_interval u, ia_interval v,
+                                 ia_interval Nn[3]);
+
 /* The limit position of control point i (after the tags), for tests:
  * refines around it until no semi-sharp tag is left and applies the limit
  * mask of its rule (smooth, crease or corner). */

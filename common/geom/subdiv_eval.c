@@ -30,8 +30,6 @@
 #include <math.h>
 #include <string.h>
 
-enum { SD_MAX_LEVEL = 48 };
-
 void sd_local_take(sd_local *L, const sd_mesh *M, const int *list, int n)
 {
     L->m = (sd_mesh){ 0, 0, L->P, L->vs, L->fo, L->fv, L->es };
@@ -116,14 +114,12 @@ static int eval_point(const geom_subdiv *sd, int f, double u, double v, geom_sam
         geom_bicubic_eval_dual(&b, u, v, out);
         return 0;
     }
-    sd_local L;
-    sd_big bigs, *big = &bigs;
-    sd_local_from_shared(sd, f, &L);
+    const sd_node *n = sd_node_root(sd, f);
     double s = u, t = v;
-    vec3 net[16];
     int at_corner = 0;
     for (int d = 0; d <= SD_MAX_LEVEL; d++) {
-        if (sd_regular_net(&L.m, net)) {
+        const vec3 *net;
+        if (sd_node_regular(n, &net)) {
             net_surface(net, &b);
             geom_bicubic_eval_dual(&b, s, t, out);
             double k = ldexp(1, d), k2 = k * k;
@@ -140,10 +136,13 @@ static int eval_point(const geom_subdiv *sd, int f, double u, double v, geom_sam
          * corner itself is, and its limit mask gives the point */
         at_corner = cu && cv ? at_corner + 1 : 0;
         if (at_corner > 3 || d == SD_MAX_LEVEL) {
+            sd_local L;
+            sd_big big;
+            sd_node_local(n, &L);
             int q = QUADRANT[s >= 0.5][t >= 0.5];
             for (int i = 0; i < 12; i++) {
                 if (sd_corner_limit(&L.m, q, &out->P)) return 1;
-                sd_local_child(&L, q, big);
+                sd_local_child(&L, q, &big);
             }
             out->P = L.P[L.fv[L.fo[0] + q]];
             return 1;
@@ -151,7 +150,7 @@ static int eval_point(const geom_subdiv *sd, int f, double u, double v, geom_sam
         int qu = s >= 0.5, qv = t >= 0.5;
         s = 2 * s - qu;
         t = 2 * t - qv;
-        sd_local_child(&L, QUADRANT[qu][qv], big);
+        n = sd_node_child(n, QUADRANT[qu][qv]);
     }
     return 1;
 }
@@ -171,7 +170,9 @@ void geom_subdiv_eval_dual(const geom_surface *s, double u, double v, geom_sampl
 
 typedef struct sd_range {
     bool regular;
-    vec3 net[16];
+    const vec3 *net;               /* regular: its Bezier net (16) */
+    const sd_node *node;           /* irregular: the sub-face */
+    const sd_node *normal_node;    /* its ancestor at level < SD_SIGN_LEVEL */
     int level;
     double ou, ov;                 /* the sub-face's origin in the face's (u,v) */
     vec3 lo, hi;                   /* else: the hull of its 1-ring */
@@ -205,22 +206,23 @@ static double sub_dir(double x, double o, int dir)
     return d;
 }
 
-/* The sub-face of face f that holds the box [u0,u1] x [v0,v1] whole. */
+/* The sub-face of face f that holds the box [u0,u1] x [v0,v1] whole
+ * (found in the face's tree of local refinements, subdiv_cache.c). */
 static void find_range(const geom_subdiv *sd, int f, double u0, double u1, double v0,
                        double v1, sd_range *r)
 {
     r->level = 0;
     r->ou = r->ov = 0;
+    r->node = r->normal_node = NULL;
     if (sd->net_of[f] >= 0) {
         r->regular = true;
-        memcpy(r->net, sd->nets + 16 * sd->net_of[f], sizeof r->net);
+        r->net = sd->nets + 16 * sd->net_of[f];
         return;
     }
-    sd_local L;
-    sd_big big;
-    sd_local_from_shared(sd, f, &L);
+    const sd_node *n = sd_node_root(sd, f);
     for (int d = 0;; d++) {
-        if (sd_regular_net(&L.m, r->net)) {
+        if (d < SD_SIGN_LEVEL) r->normal_node = n;
+        if (sd_node_regular(n, &r->net)) {
             r->regular = true;
             return;
         }
@@ -232,7 +234,8 @@ static void find_range(const geom_subdiv *sd, int f, double u0, double u1, doubl
         bool inu = s1 <= 0.5 || s0 >= 0.5, inv = t1 <= 0.5 || t0 >= 0.5;
         if (d == SD_MAX_LEVEL || !inu || !inv) {
             r->regular = false;
-            hull(&L.m, &r->lo, &r->hi);
+            r->node = n;
+            sd_node_hull(n, &r->lo, &r->hi);
             /* a box that only crosses a quadrant line (not the whole
              * sub-face) is cut there by the caller */
             bool whole = s0 <= 0 && s1 >= 1 && t0 <= 0 && t1 >= 1;
@@ -247,7 +250,7 @@ static void find_range(const geom_subdiv *sd, int f, double u0, double u1, doubl
         r->ou += qu * 0.5 / k;
         r->ov += qv * 0.5 / k;
         r->level = d + 1;
-        sd_local_child(&L, QUADRANT[qu][qv], &big);
+        n = sd_node_child(n, QUADRANT[qu][qv]);
     }
 }
 
@@ -363,6 +366,13 @@ static void net_bounds(const vec3 net[16], ia_interval su, ia_interval sv, doubl
                 Ng[c] = i == 0 && j == 0 ? piece.Ng[c] : ia_hull(Ng[c], piece.Ng[c]);
         }
     for (int c = 0; c < 3; c++) nb->Ng[c] = meet_ia_(nb->Ng[c], Ng[c]);
+}
+
+ia_interval sd_net_normal_component(const vec3 net[16], int axis)
+{
+    net_boxes nb;
+    net_bounds(net, ia_make(0, 1), ia_make(0, 1), 1, &nb);
+    return nb.Ng[axis];
 }
 
 static ia_interval meet_ia(ia_interval x, ia_interval y)
@@ -500,6 +510,24 @@ void geom_subdiv_eval_aa(aa_context *ctx, const geom_surface *s, const aa_form *
         meet_aa(&out->dPdv[i], nb.dPdv[i]);
         meet_aa(&out->Ng[i], nb.Ng[i]);
     }
+}
+
+bool geom_subdiv_unit_normal_box(const geom_surface *s, ia_interval u, ia_interval v,
+                                 ia_interval Nn[3])
+{
+    sd_range r;
+    find_range(s->subdiv, s->subdiv_face, u.lo, u.hi, v.lo, v.hi, &r);
+    vec3 N;
+    if (r.regular || can_split(&r, u, v) || !sd_node_unit_normal(r.normal_node, &N))
+        return false;
+    /* the exact normal, widened by 1e-6 for the float evaluation of points
+     * near the irregular corner, whose normals tilt by the refinement's
+     * rounding amplified by 2^level (1e-9 at 2^-22 from a crease point) */
+    for (int i = 0; i < 3; i++) {
+        double c = v3_comp(N, i);
+        Nn[i] = ia_make(fmax(c - 1e-6, -1), fmin(c + 1e-6, 1));
+    }
+    return true;
 }
 
 /* ---- bounds and intersection ---- */

@@ -7,6 +7,8 @@
 #ifndef GEOM_SUBDIV_INTERNAL_H
 #define GEOM_SUBDIV_INTERNAL_H
 
+#include <stdatomic.h>
+
 #include "geom/subdiv.h"
 
 /* A polygon mesh with sharpness: face f has corners fo[f] .. fo[f+1]-1,
@@ -36,6 +38,8 @@ int sd_edge_count(const sd_mesh *m);
  * Points whose 1-ring is not complete in m get some value (unused). */
 void sd_refine(const sd_mesh *m, sd_mesh *out);
 
+typedef struct sd_node sd_node;    /* subdiv_cache.c */
+
 struct geom_subdiv {
     sd_mesh m;                     /* level 1: all quads */
     int *vf_off, *vf;              /* point -> corners holding it (CSR) */
@@ -43,6 +47,11 @@ struct geom_subdiv {
     int *origin;                   /* per face: the control face */
     int *net_of;                   /* per face: index into nets, or -1 */
     vec3 *nets;                    /* Bezier nets (16 each) of regular faces */
+    _Atomic(sd_node *) *roots;     /* per face: its local refinements (subdiv_cache.c) */
 };
+
+/* The per-face trees of subdiv_cache.c: made empty, freed with the mesh. */
+void sd_cache_init(geom_subdiv *sd);
+void sd_cache_free(geom_subdiv *sd);
 
 #endif

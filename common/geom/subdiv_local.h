@@ -10,6 +10,14 @@
 
 #include "geom/subdiv_internal.h"
 
+enum { SD_MAX_LEVEL = 48 };       /* local refinement stops here */
+/* The normal of an irregular sub-face is checked on its rings down to
+ * this level (below it the nets near a crease vertex of valence 3 are
+ * slivers narrower than the hodographs' padding for rounding); a deeper
+ * sub-face takes its ancestor's at level SD_SIGN_LEVEL - 1
+ * (subdiv_cache.c). */
+enum { SD_SIGN_LEVEL = 16 };
+
 enum {
     SD_LF = 4 * GEOM_SUBDIV_MAX_VALENCE,   /* faces touching a quad's corners */
     SD_LC = 4 * SD_LF,
@@ -55,5 +63,25 @@ bool sd_regular_net(const sd_mesh *L, vec3 net[16]);
 /* The limit position of face 0's corner k when no semi-sharp tag touches
  * it (false otherwise): smooth, crease or corner mask. */
 bool sd_corner_limit(const sd_mesh *L, int k, vec3 *out);
+
+/* The tree of local refinements of a face (subdiv_cache.c): a node is a
+ * sub-face at some level, immutable once built, shared by threads. The
+ * root is the face (level 0); child q is quadrant q (subdiv_internal.h),
+ * built on first use. */
+const sd_node *sd_node_root(const geom_subdiv *sd, int f);
+const sd_node *sd_node_child(const sd_node *n, int q);
+/* Whether the sub-face is regular, and its Bezier net. */
+bool sd_node_regular(const sd_node *n, const vec3 **net);
+/* An irregular sub-face: its 1-ring into L, and the hull of the points its
+ * limit depends on (its sectors: no infinitely sharp edge crossed). */
+void sd_node_local(const sd_node *n, sd_local *L);
+void sd_node_hull(const sd_node *n, vec3 *lo, vec3 *hi);
+/* The unit normal of an irregular sub-face's limit where it is proven
+ * constant (a planar sector, subdiv_cache.c); false otherwise. */
+bool sd_node_unit_normal(const sd_node *n, vec3 *N);
+
+/* Component `axis` of Ng = dP/du x dP/dv over a whole regular sub-patch
+ * from its hodographs (subdiv_eval.c). */
+ia_interval sd_net_normal_component(const vec3 net[16], int axis);
 
 #endif

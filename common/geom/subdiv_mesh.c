@@ -168,6 +168,7 @@ geom_subdiv *geom_subdiv_new(const geom_subdiv_desc *d, char *why, int why_size)
         sd->vf_off = calloc((size_t)nv1 + 2, sizeof(int));
         sd->vf = malloc((size_t)(4 * nf1 + 1) * sizeof(int));
         if (!sd->origin || !sd->drawn || !sd->net_of || !sd->vf_off || !sd->vf) abort();
+        sd_cache_init(sd);
         for (int c = 0; c < 4 * nf1; c++) sd->vf_off[sd->m.fv[c] + 1]++;
         for (int i = 0; i < nv1; i++) sd->vf_off[i + 1] += sd->vf_off[i];
         int *fill = calloc((size_t)nv1 + 1, sizeof(int));
@@ -229,6 +230,7 @@ void geom_subdiv_free(geom_subdiv **self_p)
     free(sd->origin);
     free(sd->net_of);
     free(sd->nets);
+    sd_cache_free(sd);
     free(sd);
     *self_p = NULL;
 }

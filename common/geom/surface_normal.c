@@ -24,6 +24,7 @@
  */
 #include "geom/surface.h"
 #include "geom/surface_internal.h"
+#include "geom/subdiv.h"
 
 #include <math.h>
 
@@ -173,6 +174,8 @@ void geom_unit_normal_aa(aa_context *ctx, const geom_surface *s, const aa_form *
                 ia_interval ng[3], n[3];
                 for (int k = 0; k < 3; k++) ng[k] = aa_range(&g->Ng[k]);
                 normalize_ia(ng, n);
+                /* an irregular sub-face whose normal is proven constant */
+                geom_subdiv_unit_normal_box(s, aa_range(u), aa_range(v), n);
                 for (int k = 0; k < 3; k++) {
                     if (!isfinite(n[k].lo) || !isfinite(n[k].hi) || (n[k].flags & AA_UNBOUNDED))
                         n[k] = ia_make(-1, 1);
@@ -252,6 +255,7 @@ void geom_unit_normal_ia(const geom_surface *s, ia_interval u, ia_interval v,
         normalize_ia(g->Ng, Nn);
         for (int i = 0; i < 3; i++)
             if (!isfinite(Nn[i].lo) || !isfinite(Nn[i].hi) || (Nn[i].flags & AA_UNBOUNDED)) {
+                if (geom_subdiv_unit_normal_box(s, u, v, Nn)) return;
                 for (int k = 0; k < 3; k++) Nn[k] = ia_make(-1, 1);
                 return;
             }

@@ -15,6 +15,12 @@
  *   enclosures of P, and of dPdu, dPdv, Ng where those are bounded, on a
  *   cube (valence 3), a fan (valence 5, boundary, interpolateboundary) and
  *   a cube with infinite, semi-sharp creases and a corner tag: 0 violations;
+ *   the same at the corners of every face (boxes 1 .. 2^-9 wide) of a cube
+ *   with a creased rim and semi-sharp edges, where the hull of an
+ *   irregular sub-face is that of its sectors' points (subdiv_cache.c);
+ * - unit normals: at a creased rim's crease points of valence 3 the flat
+ *   top's irregular sub-faces get the proven normal (0,0,1) and samples of
+ *   Ng/|Ng| lie in the affine and interval unit normals;
  * - watertight: two faces sharing an edge give the same points along it
  *   (1e-12) and, off sharp edges, the same unit normal (1e-7);
  * - bad meshes (an edge with three faces, faces that disagree on the
@@ -337,6 +343,132 @@ static void test_containment(void **state)
     geom_subdiv_free(&sd);
 }
 
+/* The boxes at the corners of every face, 2^-level wide (level 0..9):
+ * the renderer's boxes around an irregular point, which the hull of the
+ * points the sub-face depends on (its sectors, subdiv_cache.c) bounds. */
+static void contain_corners(const char *name, geom_subdiv *sd)
+{
+    tally t = { 0, 0, 0, 0, 0 };
+    for (int f = 0; f < geom_subdiv_nfaces(sd); f++) {
+        if (!geom_subdiv_face_drawn(sd, f)) continue;
+        geom_surface s;
+        geom_subdiv_surface(sd, f, &s);
+        char why[100];
+        assert_true(geom_surface_prepare(&s, why, sizeof why));
+        for (int level = 0; level < 10; level++)
+            for (int k = 0; k < 4; k++) {
+                double side = ldexp(1, -level);
+                double u0 = k & 1 ? 1 - side : 0, v0 = k & 2 ? 1 - side : 0;
+                contain_face(&s, u0, u0 + side, v0, v0 + side, &t);
+            }
+    }
+    printf("%-14s %6ld boxes (%ld with unbounded derivatives) %7ld points, %ld violations "
+           "(worst %.3g)\n", name, t.boxes, t.unbounded, t.points, t.violations, t.worst);
+    assert_int_equal(t.violations, 0);
+    assert_true(t.unbounded > 0);              /* irregular sub-faces were met */
+}
+
+/* Sectors: infinitely sharp edges cut a vertex's faces into sectors that
+ * do not feed each other; finite sharpness does not cut. A cube whose top
+ * rim is infinitely sharp (its corners: crease points of valence 3, as in
+ * scenes/subdiv.rib) and whose vertical edges 4-0 and 6-2 are semi-sharp
+ * (2.5: still 1.5 and 0.5 after the first steps), and a corner tag: a hull
+ * that took a semi-sharp edge for a cut, or ignored a cut's far side where
+ * it feeds, leaves points outside. */
+static void test_sector_hulls(void **state)
+{
+    (void)state;
+    int clen[] = { 5, 2, 2 }, cv[] = { 4, 5, 6, 7, 4,  4, 0,  6, 2 }, corner[] = { 1 };
+    double cs[] = { 10, 2.5, 2.5 }, corner_s[] = { 10 };
+    geom_subdiv *sd = cube(3, clen, cv, cs, 1, corner, corner_s);
+    contain_corners("sectors", sd);
+    contain_mesh("sectors", sd, 60);
+    geom_subdiv_free(&sd);
+    sd = cube(0, NULL, NULL, NULL, 0, NULL, NULL);
+    contain_corners("cube corners", sd);
+    geom_subdiv_free(&sd);
+}
+
+/* The unit normal at the crease points of valence 3 of a cube's creased
+ * rim: the flat top is one face there, extraordinary at every level; its
+ * points all have z = 1, so the unit normal of its irregular sub-faces is
+ * proven to be (0,0,1) (subdiv_cache.c) where Ng is unbounded. Samples of
+ * Ng/|Ng| in corner boxes of every face (1 .. 2^-19 wide) lie in
+ * geom_unit_normal_aa and _ia, and the proven normal
+ * is used (a box whose Ng is unbounded gets a normal narrower than
+ * [-1,1]^3). A wrong sign, axis or a sector that takes in the sides fails. */
+static void test_corner_normals(void **state)
+{
+    (void)state;
+    int clen[] = { 5 }, cv[] = { 4, 5, 6, 7, 4 };
+    double cs[] = { 10 };
+    geom_subdiv *sd = cube(1, clen, cv, cs, 0, NULL, NULL);
+    tally t = { 0, 0, 0, 0, 0 };
+    long proven = 0;
+    for (int f = 0; f < geom_subdiv_nfaces(sd); f++) {
+        if (!geom_subdiv_face_drawn(sd, f)) continue;
+        geom_surface s;
+        geom_subdiv_surface(sd, f, &s);
+        char why[100];
+        assert_true(geom_surface_prepare(&s, why, sizeof why));
+        for (int level = 0; level < 20; level++)
+            for (int k = 0; k < 4; k++) {
+                double side = ldexp(1, -level);
+                double u0 = k & 1 ? 1 - side : 0, v0 = k & 2 ? 1 - side : 0;
+                double u1 = u0 + side, v1 = v0 + side;
+                aa_context ctx;
+                aa_context_init(&ctx, AA_DEFAULT_CAPACITY);
+                aa_form U, V, Nn[3];
+                aa_input(&ctx, &U, u0, u1);
+                aa_input(&ctx, &V, v0, v1);
+                geom_aa ga;
+                geom_eval_aa(&ctx, &s, &U, &V, &ga);
+                geom_unit_normal_aa(&ctx, &s, &U, &V, &ga, Nn);
+                geom_ia gi;
+                ia_interval Ni[3], Na[3];
+                geom_eval_ia(&s, ia_make(u0, u1), ia_make(v0, v1), &gi);
+                geom_unit_normal_ia(&s, ia_make(u0, u1), ia_make(v0, v1), &gi, Ni);
+                for (int i = 0; i < 3; i++) Na[i] = aa_range(&Nn[i]);
+                t.boxes++;
+                if (!finite3(gi.Ng)) {
+                    t.unbounded++;
+                    if (Ni[0].hi - Ni[0].lo < 1 && Na[0].hi - Na[0].lo < 1) proven++;
+                }
+                for (int n = 0; n < 12; n++) {
+                    double u = n < 4 ? (n & 1 ? u1 : u0) : u0 + side * urand();
+                    double v = n < 4 ? (n & 2 ? v1 : v0) : v0 + side * urand();
+                    geom_sample g;
+                    geom_eval(&s, u, v, &g);
+                    double len = v3_length(g.Ng);
+                    if (!(len > 0) || !isfinite(len)) continue;
+                    /* within 2^-20 of a corner a float sample comes from a
+                     * sub-patch deeper than level 20, whose derivatives
+                     * (scaled by 2^level) carry the refinement's rounding
+                     * amplified toward Ng's size near the crease point (its
+                     * normal tilts by 1e-9 at 2^-22, 1e-6 at 2^-26; past
+                     * 2^-28 Ng_z is noise of either sign): no reference */
+                    double cu = fmin(u, 1 - u), cvv = fmin(v, 1 - v);
+                    if (cu < 0x1p-20 && cvv < 0x1p-20) continue;
+                    /* and farther out it still tilts by up to ~1e-5 (deep
+                     * nets are planar only to rounding, and Ng is small):
+                     * a slack of 1e-4, far below what a wrong sign (2) or
+                     * axis (1) would miss by */
+                    double slack = 1e-4;
+                    vec3 N = v3_scale(g.Ng, 1 / len);
+                    check_vec(N, Na, slack, &t);
+                    check_vec(N, Ni, slack, &t);
+                    t.points++;
+                }
+            }
+    }
+    printf("%-14s %6ld boxes (%ld with unbounded Ng, %ld of them with a proven normal) "
+           "%7ld points, %ld violations (worst %.3g)\n", "corner normals", t.boxes,
+           t.unbounded, proven, t.points, t.violations, t.worst);
+    assert_int_equal(t.violations, 0);
+    assert_true(proven > 0);
+    geom_subdiv_free(&sd);
+}
+
 /* ---- shared edges ---- */
 
 static void edge_param(int k, double t, double *u, double *v)
@@ -439,6 +571,8 @@ int main(void)
         cmocka_unit_test(test_regular_faces_are_bsplines),
         cmocka_unit_test(test_limit_points),
         cmocka_unit_test(test_containment),
+        cmocka_unit_test(test_sector_hulls),
+        cmocka_unit_test(test_corner_normals),
         cmocka_unit_test(test_shared_edges),
         cmocka_unit_test(test_bad_meshes),
     };
