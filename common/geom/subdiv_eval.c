@@ -515,6 +515,8 @@ void geom_subdiv_eval_aa(aa_context *ctx, const geom_surface *s, const aa_form *
 bool geom_subdiv_unit_normal_box(const geom_surface *s, ia_interval u, ia_interval v,
                                  ia_interval Nn[3])
 {
+    if (s->kind != GEOM_SUBDIV || !s->subdiv)
+        return false;              /* other kinds come through the same callers */
     sd_range r;
     find_range(s->subdiv, s->subdiv_face, u.lo, u.hi, v.lo, v.hi, &r);
     vec3 N;
