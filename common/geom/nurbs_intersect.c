@@ -110,37 +110,6 @@ static bool transversal(const double *n, int ku, int kv)
     return lo > tiny || hi < -tiny;
 }
 
-/* Newton's method on o + t d = P(u,v) from (t, u, v), until the steps stop
- * shrinking (as in surface_bicubic.c). */
-static bool newton(const geom_surface *s, vec3 o, vec3 d, double *t, double *u, double *v,
-                   double scale)
-{
-    double last = INFINITY;
-    geom_sample g;
-    for (int it = 0; it < 60; it++) {
-        geom_nurbs_eval_dual(s, *u, *v, &g);
-        vec3 f = v3_sub(v3_add(o, v3_scale(d, *t)), g.P);
-        vec3 a = d, b = v3_neg(g.dPdu), c = v3_neg(g.dPdv);
-        double det = v3_dot(a, v3_cross(b, c));
-        if (!(fabs(det) > 0))
-            break;
-        vec3 r = v3_neg(f);
-        double dt = v3_dot(r, v3_cross(b, c)) / det;
-        double du = v3_dot(a, v3_cross(r, c)) / det, dv = v3_dot(a, v3_cross(b, r)) / det;
-        double step = fabs(du) + fabs(dv) + fabs(dt) * v3_length(d) / scale;
-        if (!isfinite(step) || (it > 2 && step > 0.9 * last) || (it > 40 && step > 1e-6))
-            break;
-        *t += dt, *u += du, *v += dv;
-        last = step;
-        if (step < 1e-16)
-            break;
-        if (fabs(*u - 0.5) > 2 || fabs(*v - 0.5) > 2)
-            return false;
-    }
-    geom_nurbs_eval_dual(s, *u, *v, &g);
-    return v3_length(v3_sub(v3_add(o, v3_scale(d, *t)), g.P)) <= 1e-9 * scale;
-}
-
 bool geom_nurbs_intersect(const geom_surface *s, vec3 o, vec3 d, double tmin, double tmax,
                           geom_hit *hit)
 {
@@ -201,8 +170,8 @@ bool geom_nurbs_intersect(const geom_surface *s, vec3 o, vec3 d, double tmin, do
             geom_nurbs_eval_dual(s, u, v, &c);
             double t = v3_dot(v3_sub(c.P, o), d) / dd;
             double slack = 1e-9;
-            bool inside = newton(s, o, d, &t, &u, &v, scale) && u >= u0 - slack &&
-                          u <= u0 + side + slack && v >= v0 - slack &&
+            bool inside = geom_patch_newton(s, geom_nurbs_eval_dual, o, d, &t, &u, &v, scale) &&
+                          u >= u0 - slack && u <= u0 + side + slack && v >= v0 - slack &&
                           v <= v0 + side + slack && t >= t0 && t <= t1;
             if (inside && t > tmin + 1e-9 * fabs(tmin) && t < best) {
                 best = t;

@@ -84,6 +84,14 @@ bool geom_subdiv_intersect(const geom_surface *s, vec3 o, vec3 d, double tmin, d
 /* NuPatch pieces (nurbs_eval.c). */
 bool geom_nurbs_prepare(geom_surface *s, char *why, int why_size);
 void geom_nurbs_eval_dual(const geom_surface *s, double u, double v, geom_sample *out);
+
+/* A surface's point with its first derivatives at (u, v) (the dual
+ * evaluations above), and Newton's method for a ray's hit on such a
+ * patch, shared by the bicubic and NuPatch intersections
+ * (surface_intersect.c). */
+typedef void (*geom_dual_eval_fn)(const geom_surface *s, double u, double v, geom_sample *out);
+bool geom_patch_newton(const geom_surface *s, geom_dual_eval_fn eval, vec3 o, vec3 d,
+                       double *t, double *u, double *v, double scale);
 void geom_nurbs_eval_ia(const geom_surface *s, ia_interval u, ia_interval v, geom_ia *out);
 void geom_nurbs_eval_aa(aa_context *ctx, const geom_surface *s, const aa_form *u,
                         const aa_form *v, geom_aa *out);

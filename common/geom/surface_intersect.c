@@ -486,3 +486,39 @@ bool geom_intersect(const geom_surface *s, vec3 o, vec3 d, double tmin,
     default:               return false;
     }
 }
+
+/* Newton's method on o + t d - P(u,v) = 0 from (t, u, v), for the patches
+ * whose hits are refined from a subdivided net (bicubic, NuPatch pieces),
+ * run until the steps stop shrinking (near a tangent ray the root is double
+ * and the convergence only linear: stopping at a small residual would leave
+ * t off by its square root). True when it lands on the surface within
+ * 1e-9 of `scale`. */
+bool geom_patch_newton(const geom_surface *s, geom_dual_eval_fn eval, vec3 o, vec3 d,
+                       double *t, double *u, double *v, double scale)
+{
+    double last = INFINITY;
+    geom_sample g;
+    for (int it = 0; it < 60; it++) {
+        eval(s, *u, *v, &g);
+        vec3 f = v3_sub(v3_add(o, v3_scale(d, *t)), g.P);
+        /* [d, -Pu, -Pv] (dt, du, dv) = -f by Cramer's rule */
+        vec3 a = d, b = v3_neg(g.dPdu), c = v3_neg(g.dPdv);
+        double det = v3_dot(a, v3_cross(b, c));
+        if (!(fabs(det) > 0))
+            break;
+        vec3 r = v3_neg(f);
+        double dt = v3_dot(r, v3_cross(b, c)) / det;
+        double du = v3_dot(a, v3_cross(r, c)) / det, dv = v3_dot(a, v3_cross(b, r)) / det;
+        double step = fabs(du) + fabs(dv) + fabs(dt) * v3_length(d) / scale;
+        if (!isfinite(step) || (it > 2 && step > 0.9 * last) || (it > 40 && step > 1e-6))
+            break;
+        *t += dt, *u += du, *v += dv;
+        last = step;
+        if (step < 1e-16)
+            break;
+        if (fabs(*u - 0.5) > 2 || fabs(*v - 0.5) > 2)
+            return false;
+    }
+    eval(s, *u, *v, &g);
+    return v3_length(v3_sub(v3_add(o, v3_scale(d, *t)), g.P)) <= 1e-9 * scale;
+}
