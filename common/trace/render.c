@@ -158,8 +158,21 @@ bool trace_render_tile(const trace_renderer *self, trace_thread *th,
         trace_thread_fail(th, "out of memory for the samples of a tile");
         return false;
     }
-    for (int qy = qy0; qy <= qy1; qy++)
-        for (int qx = qx0; qx <= qx1; qx++)
+    /* The pixels in Morton (Z) order over the smallest power-of-two square
+     * that holds them: consecutive rays stay close in both directions, so
+     * the box cache keeps what the next rays need (Heidrich & Seidel §6:
+     * neighbouring rays share the quadtree's boxes). Each sample is a pure
+     * function of its pixel and index, so the order changes no result. */
+    int side = 1;
+    while (side < qw || side < qh) side *= 2;
+    for (long m = 0; m < (long)side * side; m++) {
+        int mx = 0, my = 0;
+        for (int bit = 0; (1L << (2 * bit)) <= m; bit++) {
+            mx |= (int)((m >> (2 * bit)) & 1) << bit;
+            my |= (int)((m >> (2 * bit + 1)) & 1) << bit;
+        }
+        if (mx >= qw || my >= qh) continue;
+        int qx = qx0 + mx, qy = qy0 + my;
             for (int s = 0; s < ns; s++) {
                 if (th->failed || trace_thread_cancelled(th)) {
                     free(smp);
@@ -176,6 +189,7 @@ bool trace_render_tile(const trace_renderer *self, trace_thread *th,
                 *r = (sample_rec){(float)(sx - qx), (float)(sy - qy), (float)rgb[0],
                                   (float)rgb[1], (float)rgb[2], (float)a, (float)d};
             }
+    }
     double inv_gamma = world->gamma > 0 ? 1.0 / world->gamma : 1.0;
     for (int py = y0; py < y0 + h; py++)
         for (int px = x0; px < x0 + w; px++) {
