@@ -305,8 +305,15 @@ void sl_vm_clear_globals(sl_vm *self)
 {
     self->clear_pending = 0xf;
     self->nvarying = 0;
-    for (int s = 0; s < SL_GLOBAL_SLOTS; s++)
-        self->gderiv[s][0] = self->gderiv[s][1] = ia_entire();
+    self->gderiv_set = 0;              /* every global's derivatives unknown */
+}
+
+_Static_assert(SL_GLOBAL_SLOTS <= 64, "gderiv_set has a bit per global slot");
+
+/* d/du (k = 0) or d/dv (k = 1) of global slot s: given, or unknown */
+static ia_interval gderiv_of(const sl_vm *self, int s, int k)
+{
+    return (self->gderiv_set >> s) & 1 ? self->gderiv[s][k] : ia_entire();
 }
 
 static bool add_varying(sl_vm *self, bool global, int target, int size,
@@ -342,6 +349,7 @@ void sl_vm_set_derivs(sl_vm *self, sl_global g, const ia_interval *du, const ia_
     for (int k = 0; k < sl_global_size(g); k++) {
         self->gderiv[s + k][0] = du[k];
         self->gderiv[s + k][1] = dv[k];
+        self->gderiv_set |= (uint64_t)1 << (s + k);
     }
 }
 
@@ -504,8 +512,8 @@ static sl_status run_with_derivatives(sl_vm *self, sl_mode mode)
         for (int s = 0; s < SL_GLOBAL_SLOTS; s++) {
             const aa_form *x = &self->a[s];
             memcpy(&self->ad[s].v, x, offsetof(aa_form, c) + (size_t)x->n * sizeof x->c[0]);
-            self->ad[s].du = self->gderiv[s][0];
-            self->ad[s].dv = self->gderiv[s][1];
+            self->ad[s].du = gderiv_of(self, s, 0);
+            self->ad[s].dv = gderiv_of(self, s, 1);
         }
         st = sl_vm_exec_affine_deriv(self);
         for (int s = 0; s < SL_GLOBAL_SLOTS; s++) {
@@ -516,7 +524,7 @@ static sl_status run_with_derivatives(sl_vm *self, sl_mode mode)
         if (!self->id)
             self->id = xcalloc(SL_MAX_SLOTS, sizeof *self->id);
         for (int s = 0; s < SL_GLOBAL_SLOTS; s++)
-            self->id[s] = (sl_ideriv){self->i[s], self->gderiv[s][0], self->gderiv[s][1]};
+            self->id[s] = (sl_ideriv){self->i[s], gderiv_of(self, s, 0), gderiv_of(self, s, 1)};
         st = sl_vm_exec_interval_deriv(self);
         for (int s = 0; s < SL_GLOBAL_SLOTS; s++)
             self->i[s] = self->id[s].v;

@@ -132,7 +132,11 @@ struct sl_vm {
     sl_ideriv *id;                /* allocated on the first derivative run */
     sl_aderiv *ad;
     ia_interval gderiv[SL_GLOBAL_SLOTS][2];   /* d/du, d/dv of the globals for
-                                                 interval/affine runs */
+                                                 interval/affine runs; a slot
+                                                 not in gderiv_set is unknown */
+    uint64_t gderiv_set;          /* bit s: gderiv[s] was given since the last
+                                     sl_vm_clear_globals (the clear runs per box
+                                     and per point: 46 slots cleared lazily) */
     const char **str;             /* string file */
     unsigned long loaded[VM_VAR__COUNT];   /* program whose constants each file holds */
     unsigned clear_pending;       /* modes whose globals still have to be zeroed */
