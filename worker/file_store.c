@@ -15,6 +15,7 @@
 #include <string.h>
 #include <sys/file.h>
 #include <sys/stat.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "util/hash.h"
@@ -24,6 +25,7 @@ struct file_store {
     uint64_t budget;
     char (*verified)[HASH_HEX_SIZE];   /* hashes this process has checked */
     size_t nverified, cap;
+    unsigned long hashed, stamp_trusted;   /* acquire's checks: by hash, by stamp */
 };
 
 struct file_transfer {
@@ -74,8 +76,8 @@ static int make_dirs(const char *dir)
 file_store *file_store_open(const char *dir, uint64_t budget, char *err, size_t errsz)
 {
     char sub[PATH_MAX + 16];
-    const char *subs[] = {"objects", "partial"};
-    for (int i = 0; i < 2; i++) {
+    const char *subs[] = {"objects", "partial", "verified"};
+    for (int i = 0; i < 3; i++) {
         snprintf(sub, sizeof sub, "%s/%s", dir, subs[i]);
         if (make_dirs(sub) != 0 || access(sub, W_OK | X_OK) != 0) {
             snprintf(err, errsz, "cannot use the file cache folder '%s': %s (give another with "
@@ -110,6 +112,12 @@ void file_store_close(file_store **self_p)
 
 const char *file_store_dir(const file_store *self) { return self->dir; }
 
+void file_store_checks(const file_store *self, unsigned long *hashed, unsigned long *stamped)
+{
+    *hashed = self->hashed;
+    *stamped = self->stamp_trusted;
+}
+
 static bool is_verified(const file_store *s, const char *sha)
 {
     for (size_t i = 0; i < s->nverified; i++)
@@ -128,6 +136,68 @@ static void mark_verified(file_store *s, const char *sha)
     snprintf(s->verified[s->nverified++], HASH_HEX_SIZE, "%s", sha);
 }
 
+/*
+ * Stamps: verified/<sha> holds "inode size mtime-s mtime-ns" of the object
+ * as it was after this host last checked or used it (acquire touches the
+ * object for the LRU, then writes the stamp). A process that finds the
+ * object as stamped trusts it without hashing it again (a 4 GiB map costs
+ * ~12 s to hash); any write to the object changes its mtime, and a
+ * replaced object its inode, so a changed object is hashed (and, if
+ * corrupt, removed) as before. Stamps are written to a temporary name and
+ * renamed; a missing, stale or unreadable stamp only costs a hash.
+ */
+static bool stamp_matches(const file_store *s, const char *sha, const struct stat *st)
+{
+    char path[PATH_MAX + 100];
+    if (sub_path(s, path, sizeof path, "verified", sha, "") != 0) return false;
+    FILE *f = fopen(path, "r");
+    if (!f) return false;
+    unsigned long long ino, size;
+    long long sec, nsec;
+    bool ok = fscanf(f, "%llu %llu %lld %lld", &ino, &size, &sec, &nsec) == 4 &&
+              ino == (unsigned long long)st->st_ino && size == (unsigned long long)st->st_size &&
+              sec == (long long)st->st_mtim.tv_sec && nsec == (long long)st->st_mtim.tv_nsec;
+    fclose(f);
+    return ok;
+}
+
+static void stamp_write(const file_store *s, const char *sha, int fd)
+{
+    struct stat st;
+    char path[PATH_MAX + 100], tmp[PATH_MAX + 120];
+    if (fstat(fd, &st) != 0 || sub_path(s, path, sizeof path, "verified", sha, "") != 0 ||
+        snprintf(tmp, sizeof tmp, "%s.%d.tmp", path, (int)getpid()) >= (int)sizeof tmp)
+        return;
+    FILE *f = fopen(tmp, "w");
+    if (!f) return;
+    bool ok = fprintf(f, "%llu %llu %lld %lld\n", (unsigned long long)st.st_ino,
+                      (unsigned long long)st.st_size, (long long)st.st_mtim.tv_sec,
+                      (long long)st.st_mtim.tv_nsec) > 0;
+    ok = fclose(f) == 0 && ok;
+    if (!ok || rename(tmp, path) != 0) unlink(tmp);
+}
+
+/* Marks the object most recently used and stamps it. The mtime is set one
+ * second in the past: file times come from a coarse clock (a few ms), so a
+ * write right after a touch to "now" could leave the mtime unchanged and
+ * the stamp would still match; a write after this touch moves it forward.
+ * (Eviction only compares these times with each other.) */
+static void touch_and_stamp(const file_store *s, const char *sha, int fd)
+{
+    struct timespec ts[2];
+    clock_gettime(CLOCK_REALTIME, &ts[0]);
+    ts[0].tv_sec -= 1;
+    ts[1] = ts[0];
+    futimens(fd, ts);
+    stamp_write(s, sha, fd);
+}
+
+static void stamp_remove(const file_store *s, const char *sha)
+{
+    char path[PATH_MAX + 100];
+    if (sub_path(s, path, sizeof path, "verified", sha, "") == 0) unlink(path);
+}
+
 int file_store_acquire(file_store *self, const char *sha, uint64_t size, char *path,
                        size_t path_size)
 {
@@ -142,16 +212,22 @@ int file_store_acquire(file_store *self, const char *sha, uint64_t size, char *p
     }
     bool good = (uint64_t)a.st_size == size;
     if (good && !is_verified(self, sha)) {
-        char hex[HASH_HEX_SIZE];
-        good = hash_fd(fd, hex, NULL) && strcmp(hex, sha) == 0;
+        if (stamp_matches(self, sha, &a)) {
+            self->stamp_trusted++;     /* as this host last saw it */
+        } else {
+            char hex[HASH_HEX_SIZE];
+            good = hash_fd(fd, hex, NULL) && strcmp(hex, sha) == 0;
+            self->hashed++;
+        }
         if (good) mark_verified(self, sha);
     }
     if (!good) {
         unlink(path);              /* corrupt: fetched again */
+        stamp_remove(self, sha);
         close(fd);
         return -1;
     }
-    futimens(fd, NULL);            /* most recently used */
+    touch_and_stamp(self, sha, fd);   /* most recently used; the stamp for the next process */
     return fd;
 }
 
@@ -231,6 +307,7 @@ int file_store_evict(file_store *self)
             /* in use (a shared lock held) or replaced meanwhile: keep it */
             if (flock(fd, LOCK_EX | LOCK_NB) == 0 && fstat(fd, &a) == 0 && stat(path, &b) == 0 &&
                 a.st_ino == b.st_ino && unlink(path) == 0) {
+                stamp_remove(self, v[i].name);
                 total -= v[i].size;
                 removed++;
             }
@@ -461,6 +538,7 @@ int file_transfer_finish(file_transfer **self_p, char *err, size_t errsz)
         rc = -1;
     } else {
         mark_verified(t->store, t->sha256);
+        touch_and_stamp(t->store, t->sha256, t->data_fd);   /* the same inode, now the object */
     }
     unlink(map);
     unlink(lock);                  /* a process that locks the old inode finds the object */

@@ -11,6 +11,8 @@
  *   DIR/partial/<sha256>        a transfer under way: the bytes so far ...
  *   DIR/partial/<sha256>.have   ... and which chunks of them are written
  *   DIR/partial/<sha256>.lock   flock'd by the one process fetching it
+ *   DIR/verified/<sha256>       inode, size and mtime of the object as
+ *                               this host last checked or used it
  *
  * Processes coordinate through the file system only:
  *   - one fetcher per file: a transfer holds an exclusive flock on its
@@ -21,10 +23,13 @@
  *     objects open with a shared flock (file_store_acquire). Nobody ever
  *     waits on that lock: eviction only tries it (LOCK_NB) and skips files
  *     in use. No lock is held across renders that anyone waits for.
- *   - LRU: acquiring a file sets its mtime to now; eviction removes the
+ *   - LRU: acquiring a file sets its mtime to a second before now (see
+ *     touch_and_stamp); eviction removes the
  *     oldest files not in use until the store fits its byte budget.
- *   - a file is re-hashed the first time a process acquires it; a corrupt
- *     one is deleted and fetched again.
+ *   - a file is re-hashed the first time a process acquires it, unless it
+ *     is as its stamp in verified/ says (inode, size, mtime: any write or
+ *     replacement changes them); a corrupt one is deleted and fetched
+ *     again.
  */
 #ifndef WORKER_FILE_STORE_H
 #define WORKER_FILE_STORE_H
@@ -44,6 +49,9 @@ void file_store_default_dir(char *buf, size_t size);
 file_store *file_store_open(const char *dir, uint64_t budget, char *err, size_t errsz);
 void file_store_close(file_store **self_p);
 const char *file_store_dir(const file_store *self);
+/* How this process checked the objects it acquired: hashed, or trusted
+ * by their stamps. */
+void file_store_checks(const file_store *self, unsigned long *hashed, unsigned long *stamped);
 
 /* The file with this hash and size, if whole in the store: returns an
  * open descriptor holding the shared "in use" lock (release with

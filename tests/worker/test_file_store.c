@@ -234,6 +234,64 @@ static void test_corrupt_object_is_found_by_hash(void **state)
     file_store_close(&st);
 }
 
+/* A later process trusts an object as its stamp recorded it, without
+ * hashing it again; a stamp that does not match (changed object, broken
+ * stamp) costs a hash, never trust. */
+static void test_stamp_spares_the_hash(void **state)
+{
+    (void)state;
+    char err[600], hex[HASH_HEX_SIZE], path[PATH_MAX + 100];
+    unsigned long hashed, stamped;
+    file_store *st = file_store_open(dir, 0, err, sizeof err);
+    size_t n = 20000;
+    uint8_t *b = make_bytes(n, 47, hex);
+    fetch(st, b, n, hex, 4096);
+    file_store_close(&st);
+
+    st = file_store_open(dir, 0, err, sizeof err);   /* "another process" */
+    int fd = file_store_acquire(st, hex, n, path, sizeof path);
+    assert_true(fd >= 0);
+    file_store_release(fd);
+    file_store_checks(st, &hashed, &stamped);
+    assert_int_equal(hashed, 0);
+    assert_int_equal(stamped, 1);
+    file_store_close(&st);
+
+    /* a broken stamp: hashed, found good, stamped anew */
+    char stamp[PATH_MAX];
+    snprintf(stamp, sizeof stamp, "%s/verified/%s", dir, hex);
+    FILE *f = fopen(stamp, "w");
+    assert_non_null(f);
+    fputs("not a stamp\n", f);
+    fclose(f);
+    st = file_store_open(dir, 0, err, sizeof err);
+    fd = file_store_acquire(st, hex, n, path, sizeof path);
+    assert_true(fd >= 0);
+    file_store_release(fd);
+    file_store_checks(st, &hashed, &stamped);
+    assert_int_equal(hashed, 1);
+    assert_int_equal(stamped, 0);
+    file_store_close(&st);
+
+    /* a write right after the last use (same size): the mtime moves, the
+     * stamp no longer matches, the hash finds it, the object goes */
+    char obj[PATH_MAX];
+    snprintf(obj, sizeof obj, "%s/objects/%s", dir, hex);
+    int w = open(obj, O_WRONLY);
+    assert_true(w >= 0);
+    uint8_t x = (uint8_t)(b[77] ^ 0x01);
+    assert_int_equal(pwrite(w, &x, 1, 77), 1);
+    close(w);
+    st = file_store_open(dir, 0, err, sizeof err);
+    assert_int_equal(file_store_acquire(st, hex, n, path, sizeof path), -1);
+    file_store_checks(st, &hashed, &stamped);
+    assert_int_equal(hashed, 1);
+    assert_int_equal(access(obj, F_OK), -1);
+    assert_int_equal(access(stamp, F_OK), -1);       /* the stamp went with it */
+    file_store_close(&st);
+    free(b);
+}
+
 static void set_age(const char *folder, const char *hex, time_t seconds_ago)
 {
     char obj[PATH_MAX];
@@ -325,6 +383,7 @@ int main(void)
         cmocka_unit_test(test_wrong_bytes_are_discarded),
         cmocka_unit_test(test_abandoned_transfer_resumes_and_locks),
         cmocka_unit_test(test_corrupt_object_is_found_by_hash),
+        cmocka_unit_test(test_stamp_spares_the_hash),
         cmocka_unit_test(test_eviction_is_lru_and_spares_files_in_use),
         cmocka_unit_test(test_unusable_folder_is_said),
     };
