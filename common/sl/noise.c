@@ -646,10 +646,11 @@ static iv clip01(iv a)
     return iv_mk(a.lo < 0.0 ? 0.0 : a.lo, a.hi > 1.0 ? 1.0 : a.hi);
 }
 
-/* Per axis: the weights w_b, their derivatives and the offsets f - b over
- * an interval F within [0, 1]. */
+/* Per axis, over an interval F within [0, 1]: the weights w_0 = 1 - s and
+ * w_1 = s, the derivatives s' (>= 0) and s'' (those of w_0 are their
+ * negatives), and the offsets f - b. */
 typedef struct axis_fade {
-    iv w[2], dw[2], ddw[2], d[2];
+    iv w[2], ds, dds, d[2];
 } axis_fade;
 
 static void axis_setup(axis_fade *a, iv F, int order)
@@ -672,8 +673,7 @@ static void axis_setup(axis_fade *a, iv F, int order)
         iv ds = iv_scale_pos(iv_mul(q, q), 30.0);
         if (ds.lo < 0.0)
             ds.lo = 0.0;
-        a->dw[1] = ds;
-        a->dw[0] = iv_neg(ds);
+        a->ds = ds;
     }
     if (order >= 2) {
         iv dd = iv_hull(dds_at(F.lo), dds_at(F.hi));
@@ -681,8 +681,7 @@ static void axis_setup(axis_fade *a, iv F, int order)
             dd.hi = DDS_MAX;
         if (F.lo <= DDS_T2_HI && F.hi >= DDS_T2_LO && dd.lo > -DDS_MAX)
             dd.lo = -DDS_MAX;
-        a->ddw[1] = dd;
-        a->ddw[0] = iv_neg(dd);
+        a->dds = dd;
     }
 }
 
@@ -755,7 +754,7 @@ cell_jet_d(int dim, const axis_fade *ax, const uint32_t h[16], int order, jet *J
     for (int k = 0; k < dim; k++) {
         n >>= 1;
         iv w0 = ax[k].w[0], w1 = ax[k].w[1];
-        iv D = ax[k].dw[1], DD = ax[k].ddw[1];
+        iv D = ax[k].ds, DD = ax[k].dds;
         for (int i = 0; i < n; i++) {
             const jet *A = &t[2 * i], *B = &t[2 * i + 1];
             jet r;
