@@ -1017,6 +1017,22 @@ static sl_node *statement(parser *p)
 /* definitions                                                             */
 /* ---------------------------------------------------------------------- */
 
+/* The source's one shader (or class) is `name`: false, with the error,
+ * when it already has one. */
+static bool claim_shader(parser *p, sl_ast_file *file, const sl_token *name)
+{
+    if (file->has_shader) {
+        error_at(p, name->pos, name, "more than one shader in one source ('%s' and '%s')",
+                 file->name, name->text);
+        sl_diag_note(p->diag, file->pos, "'%s' defined here", file->name);
+        return false;
+    }
+    file->has_shader = true;
+    file->name = name->text;
+    file->pos = name->pos;
+    return true;
+}
+
 static void shader_definition(parser *p, sl_ast_file *file)
 {
     sl_token kw = p->cur;
@@ -1033,17 +1049,10 @@ static void shader_definition(parser *p, sl_ast_file *file)
     }
     sl_token name = p->cur;
     advance(p);
-    if (file->has_shader) {
-        error_at(p, name.pos, &name, "more than one shader in one source ('%s' and '%s')",
-                 file->name, name.text);
-        sl_diag_note(p->diag, file->pos, "'%s' defined here", file->name);
+    if (!claim_shader(p, file, &name))
         return;
-    }
-    file->has_shader = true;
     file->kind = kw.kind == SL_KW_SURFACE ? SL_SHADER_SURFACE
                : kw.kind == SL_KW_LIGHT ? SL_SHADER_LIGHT : SL_SHADER_DISPLACEMENT;
-    file->name = name.text;
-    file->pos = name.pos;
     sl_token open = p->cur;
     if (!expect(p, SL_TOK_LPAREN, "after shader name"))
         return;
@@ -1095,15 +1104,8 @@ static void class_definition(parser *p, sl_ast_file *file)
     advance(p);                                  /* 'class' */
     sl_token name = p->cur;
     advance(p);
-    if (file->has_shader) {
-        error_at(p, name.pos, &name, "more than one shader in one source ('%s' and '%s')",
-                 file->name, name.text);
-        sl_diag_note(p->diag, file->pos, "'%s' defined here", file->name);
+    if (!claim_shader(p, file, &name))
         return;
-    }
-    file->has_shader = true;
-    file->name = name.text;
-    file->pos = name.pos;
     sl_class cls = { .name = name.text, .pos = name.pos };
     sl_token open = p->cur;
     if (!expect(p, SL_TOK_LPAREN, "after class name"))
