@@ -211,6 +211,21 @@ sl_status sl_vm_run(sl_vm *self, const sl_instance *inst, sl_mode mode,
  * exceeded" and the like. */
 const char *sl_vm_error(const sl_vm *self);
 
+/* A run in interval arithmetic whose derivative bounds are SLOPE bounds:
+ * for every global, in every component, the d/du and d/dv bounds of
+ * sl_vm_get_slopes enclose the true partial derivatives of the value as a
+ * function of (u, v) at every point of the range where it is
+ * differentiable, given that the globals' bounds (sl_vm_set_derivs) do.
+ * Where the program's own definitions are first-order or jump (Du, Dv,
+ * Deriv, calculatenormal, area, a texture's gradient, an undecided
+ * comparison used as a value), the bound is the whole line; functions that
+ * jump inside the range flag their values AA_DISCONTINUOUS, and a caller
+ * that needs a continuous function refuses those. Used by the hit proof
+ * (trace/prove.c); sl_vm_get_interval reads the values as after
+ * sl_vm_run. */
+sl_status sl_vm_run_slopes(sl_vm *self, const sl_instance *inst);
+void sl_vm_get_slopes(const sl_vm *self, sl_global g, ia_interval *du, ia_interval *dv);
+
 /* Globals after a run (P and N of a displacement shader, Ci and Oi of a
  * surface shader), in the arithmetic of the run. */
 void sl_vm_get_float(const sl_vm *self, sl_global g, double *values);

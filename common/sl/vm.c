@@ -532,7 +532,33 @@ static sl_status run_with_derivatives(sl_vm *self, sl_mode mode)
     return st;
 }
 
+static sl_status run(sl_vm *self, const sl_instance *inst, sl_mode mode, aa_context *ctx,
+                     bool slopes);
+
 sl_status sl_vm_run(sl_vm *self, const sl_instance *inst, sl_mode mode, aa_context *ctx)
+{
+    return run(self, inst, mode, ctx, false);
+}
+
+sl_status sl_vm_run_slopes(sl_vm *self, const sl_instance *inst)
+{
+    self->slopes = true;
+    sl_status st = run(self, inst, SL_MODE_INTERVAL, NULL, true);
+    self->slopes = false;
+    return st;
+}
+
+void sl_vm_get_slopes(const sl_vm *self, sl_global g, ia_interval *du, ia_interval *dv)
+{
+    int n = global_ok(g) ? sl_global_size(g) : 0, s = global_ok(g) ? sl_global_slot(g) : 0;
+    for (int k = 0; k < n; k++) {
+        du[k] = self->id ? self->id[s + k].du : ia_entire();
+        dv[k] = self->id ? self->id[s + k].dv : ia_entire();
+    }
+}
+
+static sl_status run(sl_vm *self, const sl_instance *inst, sl_mode mode, aa_context *ctx,
+                     bool slopes)
 {
     self->error[0] = '\0';
     self->executed = 0;
@@ -558,7 +584,7 @@ sl_status sl_vm_run(sl_vm *self, const sl_instance *inst, sl_mode mode, aa_conte
     self->nillum = self->illum_next = 0;
     ensure_clear(self, mode);
     load_strings(self, p);
-    if (p->takes_derivatives && (mode == SL_MODE_INTERVAL || mode == SL_MODE_AFFINE))
+    if (slopes || (p->takes_derivatives && (mode == SL_MODE_INTERVAL || mode == SL_MODE_AFFINE)))
         return run_with_derivatives(self, mode);
     switch (mode) {
     case SL_MODE_FLOAT: return sl_vm_exec_float(self);

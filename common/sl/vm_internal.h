@@ -154,6 +154,8 @@ struct sl_vm {
     const sl_instance *inst;
     aa_context *ctx;
     sl_mode mode;
+    bool slopes;                  /* sl_vm_run_slopes: derivative bounds must be
+                                     true slope bounds (vm_deriv.inc) */
     long executed;
     uint64_t rng;
     char error[512];

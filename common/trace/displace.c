@@ -242,6 +242,52 @@ static void box_interval(trace_thread *th, const trace_object *obj,
     box_from_interval(P, out);
 }
 
+/* ---- slopes: interval bounds of the displaced P and of its derivatives ---- */
+
+bool trace_surface_slopes(trace_thread *th, const trace_object *obj,
+                          double u0, double u1, double v0, double v1,
+                          ia_interval P[3], ia_interval Pu[3], ia_interval Pv[3])
+{
+    if (!obj->displacement || obj->box_proto) return false;
+    ia_interval u = ia_make(u0, u1), v = ia_make(v0, v1);
+    geom_ia g;
+    geom_eval_ia(&obj->surf, u, v, &g);
+    ia_interval Pb[3], N[3], dPdu[3], dPdv[3], Nn[3];
+    ia_xform(&obj->to_camera, g.P, Pb, true);
+    geom_unit_normal_ia(&obj->surf, u, v, &g, Nn);
+    ia_camera_normal(obj, Nn, N);
+    ia_xform(&obj->to_camera, g.dPdu, dPdu, false);
+    ia_xform(&obj->to_camera, g.dPdv, dPdv, false);
+    sl_vm *vm = th->vm;
+    ia_interval Pd[2][3] = {{dPdu[0], dPdu[1], dPdu[2]}, {dPdv[0], dPdv[1], dPdv[2]}};
+    bool flat = flat_normal(obj);
+    bind_globals_interval(vm, obj, &obj->displacement_spaces, Pb, N, N, dPdu, dPdv, &u, &v,
+                          Pd, flat);
+    if (!flat) {
+        /* the bind's tangents are constants to the shader, true only where
+         * the base surface's tangents are (a plane): else unknown slopes */
+        ia_interval any[3] = {ia_entire(), ia_entire(), ia_entire()};
+        sl_vm_set_derivs(vm, SL_G_dPdu, any, any);
+        sl_vm_set_derivs(vm, SL_G_dPdv, any, any);
+    }
+    trace_primvars_bind(vm, obj, false);
+    th->stats.evals_slopes++;
+    if (sl_vm_run_slopes(vm, obj->displacement) != SL_OK) {
+        trace_thread_fail(th, sl_vm_error(vm));
+        return false;
+    }
+    sl_vm_get_interval(vm, SL_G_P, P);
+    sl_vm_get_slopes(vm, SL_G_P, Pu, Pv);
+    unsigned flags = 0;
+    for (int i = 0; i < 3; i++) {
+        flags |= P[i].flags | Pu[i].flags | Pv[i].flags;
+        if (!isfinite(P[i].lo) || !isfinite(P[i].hi) || !isfinite(Pu[i].lo) ||
+            !isfinite(Pu[i].hi) || !isfinite(Pv[i].lo) || !isfinite(Pv[i].hi))
+            return false;
+    }
+    return !(flags & (AA_DISCONTINUOUS | AA_UNBOUNDED));
+}
+
 void trace_surface_box(trace_thread *th, const trace_object *obj,
                        double u0, double u1, double v0, double v1, trace_box *out)
 {

@@ -29,6 +29,16 @@ void trace_surface_box(trace_thread *th, const trace_object *obj,
                        double u0, double u1, double v0, double v1,
                        trace_box *out);
 
+/* Interval bounds, over a (u,v) range, of the displaced P in CAMERA space
+ * and of its true partial derivatives d/du, d/dv (sl_vm_run_slopes): the
+ * Jacobian the hit proof (trace/prove.c) needs. False where they are not
+ * known to be finite slope bounds of a continuous function: an instance,
+ * no displacement, a failed run, an unbounded or discontinuous value. A
+ * range of one point gives an enclosure of P there. */
+bool trace_surface_slopes(trace_thread *th, const trace_object *obj,
+                          double u0, double u1, double v0, double v1,
+                          ia_interval P[3], ia_interval Pu[3], ia_interval Pv[3]);
+
 typedef struct trace_surface_point {
     vec3 P;              /* displaced, camera space */
     vec3 N;              /* shading normal (unit), after the displacement shader */

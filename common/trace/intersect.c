@@ -8,6 +8,7 @@
 
 #include "aa/interval.h"
 #include "trace/converge.h"
+#include "trace/prove.h"
 
 /* §5: a discontinuous box "stopped shrinking" when a child keeps more than
  * this fraction of its parent's size (smooth boxes halve, roughly). */
@@ -15,6 +16,10 @@
 
 /* The first depth at which stagnant flagged boxes may be sampled. */
 #define TRACE_SAMPLE_DEPTH 6
+
+/* Hit proofs (prove.h) are tried on cells whose box is at most this many
+ * leaf tolerances (pixel footprints, for primary rays) wide. */
+#define TRACE_PROVE_CELLS 16.0
 
 typedef struct walk {
     trace_thread *th;
@@ -25,6 +30,7 @@ typedef struct walk {
     bool any;
     bool found;
     bool stopped;                  /* the work limit or a cancel ended the walk */
+    bool prove;                    /* hit proofs may succeed on this object */
     long nodes;                    /* quadtree nodes visited so far */
     trace_hit *best;
 } walk;
@@ -277,6 +283,24 @@ static void leaf_hit(walk *w, const trace_box *box, const double r[4],
     w->found = true;
 }
 
+/* A hit proven unique in the cell (prove.h): the surface's own point */
+static void proven_hit(walk *w, double t, double tol, const trace_surface_point *sp)
+{
+    if (!(t > w->ray.tmin) || !(t < w->best->t)) return;
+    w->th->stats.leaves++;
+    trace_hit *b = w->best;
+    b->t = t;
+    b->obj = w->obj;
+    b->u = sp->u;
+    b->v = sp->v;
+    b->leaf_size = tol;             /* offsets secondary rays as a pixel leaf's */
+    b->kind = TRACE_LEAF_PROVEN;
+    b->wall_normal = v3(0, 0, 0);
+    b->has_point = true;
+    b->point = *sp;
+    w->found = true;
+}
+
 /* The stagnant-box fallback (issue 9; docs/renderer.md "Stagnant boxes").
  * Range arithmetic loses the correlation of some continuous idioms, and
  * their boxes then stop shrinking along a curve of (u,v): a box-filtered
@@ -416,6 +440,21 @@ static void visit(walk *w, const trace_box *node, const double r[4],
         int d = depth + 1;
         bool unbounded = (kid->flags & AA_UNBOUNDED) != 0;
         vec3 wall_n = v3(0, 0, 0);
+        /* proofs only on cells a cell's width or more inside the base
+         * polygon: near its edges the leaves stay, which a shared edge's
+         * two polygons apply alike (an exact miss on one side next to an
+         * estimate on the other opened cracks: tests/corpus, mesh) */
+        if (w->prove && order[k].cover == GEOM_INSIDE && !unbounded &&
+            !(kid->flags & AA_DISCONTINUOUS) && size <= TRACE_PROVE_CELLS * tol &&
+            geom_uv_box_cover(&w->obj->surf, 2 * c[0] - c[1], 2 * c[1] - c[0],
+                              2 * c[2] - c[3], 2 * c[3] - c[2]) == GEOM_INSIDE) {
+            double t;
+            trace_surface_point sp;
+            trace_proof pr = trace_prove_hit(w->th, w->obj, w->cam_ray, c, w->ray.tmin,
+                                             w->best->t, &t, &sp);
+            if (pr == TRACE_PROOF_HIT) proven_hit(w, t, tol, &sp);
+            if (pr != TRACE_PROOF_UNKNOWN) continue;
+        }
         if (d >= TRACE_MAX_DEPTH)
             leaf_hit(w, kid, c, &order[k], TRACE_LEAF_DEPTH, wall_n);
         else if (!unbounded && size <= tol)
@@ -443,7 +482,8 @@ static bool intersect_displaced(trace_thread *th, const trace_object *obj,
                                 bool any, trace_hit *best)
 {
     walk w = {.th = th, .obj = obj, .cam_ray = ray, .tol = *tol, .any = any,
-              .found = false, .best = best};
+              .found = false, .prove = th->world->options.prove_hits && trace_prove_eligible(obj),
+              .best = best};
     object_ray(obj, ray, best->t, &w.ray);
     double t0, t1;
     if (!trace_box_hit(&obj->root, &w.ray, ray->tmin, best->t, &t0, &t1, NULL))

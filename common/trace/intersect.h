@@ -8,6 +8,10 @@
  *   visit(node): get the four child boxes (box cache, or evaluate them);
  *     intersect the ray with each; in order of entry distance, skipping
  *     any child that starts beyond the best hit so far:
+ *       a small child (at most 16 tolerances) well inside a polygon is
+ *       first put to the hit proof (prove.h): a proven miss drops it, a
+ *       proven hit is the surface's own point, and only an undecided
+ *       child goes on;
  *       the child is a LEAF if its size is below the tolerance at its
  *       distance (primary rays: a pixel footprint scaled by ShadingRate;
  *       shadow rays: a fixed world size from the pixel footprint at the
@@ -40,6 +44,7 @@ typedef enum trace_leaf_kind {
     TRACE_LEAF_WALL,       /* §5: discontinuous and no longer shrinking */
     TRACE_LEAF_DEPTH,      /* depth cap */
     TRACE_LEAF_EXACT,      /* analytic intersection, no boxes */
+    TRACE_LEAF_PROVEN,     /* a cell with one hit, proven (prove.h) */
 } trace_leaf_kind;
 
 typedef struct trace_hit {

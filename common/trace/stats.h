@@ -14,7 +14,12 @@ typedef struct trace_stats {
     long primary_rays, shadow_rays;
     long boxes;                    /* boxes computed (root + 4 per cache miss) */
     long evals_affine, evals_interval, evals_dual, evals_float;
+    long evals_slopes;             /* interval runs with slope bounds (prove.c) */
     long leaves, wall_leaves, depth_cap_leaves;
+    long proofs;                   /* hit proofs tried (prove.c) */
+    long proven_hits;              /* leaves whose hit was proven unique and
+                                      placed at the root */
+    long proven_misses;            /* cells proven free of any hit */
     long rejected_leaves;          /* leaves whose surface point was not on the
                                       ray (depth cap) or not finite: no hit */
     long nodes;                    /* quadtree nodes visited by all rays */

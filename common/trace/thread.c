@@ -16,6 +16,7 @@ void trace_options_default(trace_options *opt)
     opt->leaf_fraction = 1.0;
     opt->max_nodes_per_ray = TRACE_DEFAULT_MAX_NODES_PER_RAY;
     opt->max_ray_depth = TRACE_MAX_RAY_DEPTH;
+    opt->prove_hits = true;
 }
 
 /* A VM for this world's shaders, with what every shader may ask of the
@@ -61,6 +62,7 @@ void trace_thread_destroy(trace_thread **self_p)
     for (int d = 0; d < TRACE_RAY_DEPTH_LIMIT; d++)
         sl_vm_destroy(&self->ray_vm[d]);
     trace_boxcache_destroy(&self->cache);
+    free(self->slopes);
     free(self->work);
     free(self);
     *self_p = NULL;

@@ -50,6 +50,7 @@ typedef struct trace_thread {
                                       on first use (trace_thread_shade_vm) */
     aa_context ctx;
     trace_boxcache *cache;
+    struct trace_slope_cache *slopes;  /* prove.c's, made on first use */
     trace_stats stats;
     trace_object_work *work;       /* world->nobjects entries */
     const atomic_int *cancel;      /* non-zero: stop tracing at once (a signal,

@@ -127,6 +127,8 @@ typedef struct trace_options {
     int max_ray_depth;             /* nested trace() rays from shaders (RIB
                                       Option "trace" "maxdepth"; at most
                                       TRACE_RAY_DEPTH_LIMIT) */
+    bool prove_hits;               /* try hit proofs on small cells
+                                      (trace/prove.h); off: leaves only */
 } trace_options;
 
 /* The default work limit: 20x the largest walk of the paper's scenes

@@ -1,0 +1,238 @@
+/*
+ * test_trace_prove.c: proven hits (common/trace/prove.c, issue 10). The
+ * Krawczyk test settles small cells of a displaced polygon: a proven miss
+ * must never hide a real intersection, a proven hit must be one, and the
+ * slope bounds it rests on (sl_vm_run_slopes) must enclose the surface's
+ * true derivatives.
+ *
+ *   - slopes: over random cells of a polygon displaced by smooth shaders
+ *     (the paper's wave, noise, a clamp and a smoothstep), the dual mode's
+ *     derivatives at random points of the cell lie in the slope bounds,
+ *     and a shader whose P depends on Du() gets no slope bounds at all;
+ *   - walks: every primary ray of a small wave image is traced twice, with
+ *     proofs and without (leaves only). A proven hit lies on the ray (its
+ *     surface point within 1/1000 of a pixel footprint of it) and within the leaf tolerance
+ *     of the leaves' hit, or behind it where the leaves' was a near miss
+ *     (a ray grazing a crest within the leaf tolerance); where the leaves
+ *     hit nearer than the proofs (or the proofs not at all), Newton's
+ *     iteration from the leaf's point must find no real intersection of
+ *     the ray inside the polygon nearer than the proofs' hit (else a
+ *     proof lost it). Both verdicts must occur (the test exercises them).
+ */
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <cmocka.h>
+
+#include "fixture.h"
+#include "trace/camera.h"
+#include "trace/intersect.h"
+#include "trace/render.h"
+
+static const char *WAVE_SL =
+    "displacement wave(float Km = 0.1; float frequency = 4; float decay = 2)\n"
+    "{\n"
+    "    float ds = s - 0.5, dt = t - 0.5;\n"
+    "    float r = sqrt(ds * ds + dt * dt);\n"
+    "    float h = Km * exp(-decay * r) * sin(2 * PI * frequency * r);\n"
+    "    P += h * normalize(N);\n"
+    "    N = calculatenormal(P);\n"
+    "}\n";
+
+static const char *BUMPS_SL =
+    "displacement bumps(float Km = 0.05)\n"
+    "{\n"
+    "    float n = noise(point(s * 6, t * 6, 0.5)) - 0.5;\n"
+    "    float c = clamp(3 * sin(7 * s) * cos(5 * t), -0.8, 0.9);\n"
+    "    float m = smoothstep(0.2, 0.7, s * t + 0.3 * s);\n"
+    "    P += Km * (n + 0.3 * c + 0.5 * m) * normalize(N);\n"
+    "}\n";
+
+static const char *DU_SL =
+    "displacement dudep(float Km = 0.05)\n"
+    "{\n"
+    "    float h = sin(10 * s);\n"
+    "    P += Km * (h + Du(h)) * normalize(N);\n"
+    "}\n";
+
+/* a tilted square under a perspective camera */
+#define SQUARE_RIB(shader)                                                   \
+    "Format 40 30 1\nProjection \"perspective\" \"fov\" [30]\n"              \
+    "WorldBegin\nTranslate 0 0 4\nRotate -50 1 0 0\nDisplacement \"" shader "\"\n" \
+    "Polygon \"P\" [-1 -1 0  1 -1 0  1 1 0  -1 1 0]\nWorldEnd\n"
+
+static double urand(unsigned *s)
+{
+    *s = *s * 1664525u + 1013904223u;
+    return (double)(*s >> 8) / 16777216.0;
+}
+
+static bool in(double x, ia_interval r) { return x >= r.lo && x <= r.hi; }
+
+static void check_slopes(const char *name, const char *src, bool expect_bounds)
+{
+    fixture f;
+    fixture_shader sh[] = {{name, src}};
+    char rib[512];
+    snprintf(rib, sizeof rib, SQUARE_RIB("%s"), name);
+    assert_true(fixture_open(&f, rib, sh, 1, NULL, 0));
+    trace_thread *th = trace_thread_new(&f.js->world);
+    const trace_object *obj = &f.js->world.objects[0];
+    unsigned seed = 12345;
+    int cells = 0, bounded = 0, points = 0, outside = 0;
+    for (int k = 0; k < 300; k++) {
+        double size = ldexp(1.0, -(1 + (int)(urand(&seed) * 7)));
+        double u0 = urand(&seed) * (1 - size), v0 = urand(&seed) * (1 - size);
+        ia_interval P[3], Pu[3], Pv[3];
+        cells++;
+        if (!trace_surface_slopes(th, obj, u0, u0 + size, v0, v0 + size, P, Pu, Pv)) continue;
+        bounded++;
+        for (int q = 0; q < 20; q++) {
+            double u = u0 + size * urand(&seed), v = v0 + size * urand(&seed);
+            trace_surface_point sp;
+            trace_surface_point_eval(th, obj, u, v, &sp);
+            double pu[3] = {sp.Pu.x, sp.Pu.y, sp.Pu.z}, pv[3] = {sp.Pv.x, sp.Pv.y, sp.Pv.z};
+            double p[3] = {sp.P.x, sp.P.y, sp.P.z};
+            for (int i = 0; i < 3; i++) {
+                points++;
+                if (!in(pu[i], Pu[i]) || !in(pv[i], Pv[i]) || !in(p[i], P[i])) {
+                    if (outside++ < 5)
+                        printf("  %s: (%.6f, %.6f) in cell %.6f+%.6f: P %g Pu %g Pv %g not in "
+                               "[%g, %g] [%g, %g] [%g, %g]\n", name, u, v, u0, size, p[i], pu[i],
+                               pv[i], P[i].lo, P[i].hi, Pu[i].lo, Pu[i].hi, Pv[i].lo, Pv[i].hi);
+                }
+            }
+        }
+    }
+    printf("%-6s %d cells, %d with slope bounds, %d derivative samples, %d outside\n", name,
+           cells, bounded, points, outside);
+    assert_int_equal(outside, 0);
+    if (expect_bounds)
+        assert_true(bounded > cells / 2);
+    else
+        assert_int_equal(bounded, 0);
+    trace_thread_destroy(&th);
+    fixture_close(&f);
+}
+
+static void test_slopes_enclose_derivatives(void **state)
+{
+    (void)state;
+    check_slopes("wave", WAVE_SL, true);
+    check_slopes("bumps", BUMPS_SL, true);
+}
+
+static void test_first_order_derivatives_give_no_slopes(void **state)
+{
+    (void)state;
+    check_slopes("dudep", DU_SL, false);
+}
+
+/* Newton's iteration for the ray against the object from (u, v): true
+ * when it converges to a point of the ray inside the polygon at t > tmin,
+ * *t then being its ray parameter */
+static bool newton_finds_hit(trace_thread *th, const trace_object *obj, const trace_ray *ray,
+                             double u, double v, double *t_hit)
+{
+    for (int it = 0; it < 30; it++) {
+        trace_surface_point sp;
+        trace_surface_point_eval(th, obj, u, v, &sp);
+        vec3 nd = v3_neg(ray->d);
+        double t = v3_dot(v3_sub(sp.P, ray->o), ray->d) / v3_dot(ray->d, ray->d);
+        vec3 f = v3_sub(sp.P, trace_ray_at(ray, t));
+        if (v3_length(f) < 1e-11 * (1 + v3_length(sp.P))) {
+            *t_hit = t;
+            return t > ray->tmin && geom_uv_inside(&obj->surf, u, v);
+        }
+        double det = v3_dot(sp.Pu, v3_cross(sp.Pv, nd));
+        if (!(fabs(det) > 0)) return false;
+        vec3 rhs = v3_sub(ray->o, sp.P);
+        double du = v3_dot(rhs, v3_cross(sp.Pv, nd)) / det;
+        double dv = v3_dot(sp.Pu, v3_cross(rhs, nd)) / det;
+        u += du;
+        v += dv;
+        if (!isfinite(u) || !isfinite(v) || fabs(u - 0.5) > 2 || fabs(v - 0.5) > 2) return false;
+    }
+    return false;
+}
+
+static void test_proven_walks_agree_with_leaves(void **state)
+{
+    (void)state;
+    fixture f;
+    fixture_shader sh[] = {{"wave", WAVE_SL}};
+    assert_true(fixture_open(&f, SQUARE_RIB("wave"), sh, 1, NULL, 0));
+    trace_world *world = &f.js->world;
+    trace_thread *th = trace_thread_new(world);
+    const trace_object *obj = &world->objects[0];
+    const trace_camera *cam = &world->camera;
+    trace_tolerance tol = f.js->renderer->primary_tol;
+    int both = 0, leaves_only = 0, proofs_only = 0, nearer_leaf = 0, lost = 0, off_ray = 0;
+    double worst = 0;
+    for (int y = 0; y < cam->yres; y++)
+        for (int x = 0; x < cam->xres; x++) {
+            trace_ray ray;
+            trace_camera_ray(cam, x + 0.5, y + 0.5, &ray);
+            trace_hit on = {.t = ray.tmax}, off = {.t = ray.tmax};
+            world->options.prove_hits = true;
+            bool hit_on = trace_intersect_object(th, obj, &ray, &tol, false, &on);
+            world->options.prove_hits = false;
+            bool hit_off = trace_intersect_object(th, obj, &ray, &tol, false, &off);
+            if (hit_on && on.kind == TRACE_LEAF_PROVEN) {
+                /* on the ray to a thousandth of the pixel footprint */
+                vec3 miss = v3_sub(on.point.P, trace_ray_at(&ray, on.t));
+                double foot = tol.a + tol.b * on.t;
+                worst = fmax(worst, v3_length(miss) / foot);
+                if (!(v3_length(miss) <= 1e-3 * foot)) off_ray++;
+            }
+            /* a real intersection the leaves found nearer than the
+             * proofs' hit (or where they found none): lost by a proof */
+            double t_tol = 2 * (tol.a + tol.b * off.t) / v3_length(ray.d), t_real;
+            if (hit_off && (!hit_on || off.t < on.t - t_tol) &&
+                newton_finds_hit(th, obj, &ray, off.u, off.v, &t_real) &&
+                (!hit_on || t_real < on.t - t_tol)) {
+                if (lost++ < 5)
+                    printf("  pixel (%d, %d): a hit at t %.9f the proofs lost (leaf at %.6f "
+                           "%.6f, t %.9f; proofs: %s %.9f)\n", x, y, t_real, off.u, off.v, off.t,
+                           hit_on ? "hit at" : "none", on.t);
+            }
+            if (hit_on && hit_off) {
+                both++;
+                /* the same hit, or the leaves' was a near miss within their
+                 * tolerance (a ray grazing a crest) and the proofs' is
+                 * behind it */
+                if (fabs(on.t - off.t) > t_tol) nearer_leaf++;
+            } else if (hit_off) {
+                leaves_only++;
+            } else if (hit_on) {
+                proofs_only++;
+            }
+        }
+    printf("rays hit by both %d (%d of them nearer by the leaves: near misses), by leaves "
+           "only %d, by proofs only %d; proofs %ld: %ld hits, %ld misses\n", both, nearer_leaf,
+           leaves_only, proofs_only,
+           th->stats.proofs, th->stats.proven_hits, th->stats.proven_misses);
+    printf("proven hit points: at most %.2g pixel footprints off their ray\n", worst);
+    assert_int_equal(lost, 0);
+    assert_int_equal(off_ray, 0);
+    assert_true(nearer_leaf < both / 10);
+    assert_int_equal(proofs_only, 0);      /* leaves are conservative: a superset */
+    assert_true(both > 200);
+    assert_true(th->stats.proven_hits > 100);
+    assert_true(th->stats.proven_misses > 10);
+    trace_thread_destroy(&th);
+    fixture_close(&f);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_slopes_enclose_derivatives),
+        cmocka_unit_test(test_first_order_derivatives_give_no_slopes),
+        cmocka_unit_test(test_proven_walks_agree_with_leaves),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
