@@ -107,11 +107,10 @@ static void box_from_affine(const aa_form P[3], trace_box *out)
     out->flags = box_flags(out, flags);
 }
 
-/* N is constant over the object (its d/du, d/dv are 0): polygons, unless
- * they carry interpolated vertex normals (geom_vertex_normal) */
-static bool flat_normal(const trace_object *obj)
+bool trace_surface_flat(const trace_object *obj)
 {
-    return obj->surf.kind == GEOM_POLYGON && !geom_has_vertex_normals(&obj->surf);
+    return (obj->surf.kind == GEOM_POLYGON && !geom_has_vertex_normals(&obj->surf)) ||
+           obj->surf.kind == GEOM_DISK;
 }
 
 static void box_affine(trace_thread *th, const trace_object *obj,
@@ -151,7 +150,7 @@ static void box_affine(trace_thread *th, const trace_object *obj,
 
     sl_vm *vm = th->vm;
     bind_globals_affine(vm, obj, &obj->displacement_spaces, P, N, N, dPdu, dPdv, &u, &v,
-                        obj->box_skip_tangents ? NULL : Pd, flat_normal(obj));
+                        obj->box_skip_tangents ? NULL : Pd, trace_surface_flat(obj));
     trace_primvars_bind(vm, obj, false);
     if (sl_vm_run(vm, obj->displacement, SL_MODE_AFFINE, ctx) != SL_OK) {
         trace_thread_fail(th, sl_vm_error(vm));
@@ -229,7 +228,7 @@ static void box_interval(trace_thread *th, const trace_object *obj,
     sl_vm *vm = th->vm;
     ia_interval Pd[2][3] = {{dPdu[0], dPdu[1], dPdu[2]}, {dPdv[0], dPdv[1], dPdv[2]}};
     bind_globals_interval(vm, obj, &obj->displacement_spaces, P, N, N, dPdu, dPdv, &u, &v,
-                          obj->box_skip_tangents ? NULL : Pd, flat_normal(obj));
+                          obj->box_skip_tangents ? NULL : Pd, trace_surface_flat(obj));
     trace_primvars_bind(vm, obj, false);
     if (sl_vm_run(vm, obj->displacement, SL_MODE_INTERVAL, NULL) != SL_OK) {
         trace_thread_fail(th, sl_vm_error(vm));
@@ -260,12 +259,13 @@ bool trace_surface_slopes(trace_thread *th, const trace_object *obj,
     ia_xform(&obj->to_camera, g.dPdv, dPdv, false);
     sl_vm *vm = th->vm;
     ia_interval Pd[2][3] = {{dPdu[0], dPdu[1], dPdu[2]}, {dPdv[0], dPdv[1], dPdv[2]}};
-    bool flat = flat_normal(obj);
+    bool flat = trace_surface_flat(obj);
     bind_globals_interval(vm, obj, &obj->displacement_spaces, Pb, N, N, dPdu, dPdv, &u, &v,
                           Pd, flat);
-    if (!flat) {
+    if (obj->surf.kind != GEOM_POLYGON) {
         /* the bind's tangents are constants to the shader, true only where
-         * the base surface's tangents are (a plane): else unknown slopes */
+         * the base surface's tangents are (a polygon's parametrisation is
+         * affine; a disk's is polar): else unknown slopes */
         ia_interval any[3] = {ia_entire(), ia_entire(), ia_entire()};
         sl_vm_set_derivs(vm, SL_G_dPdu, any, any);
         sl_vm_set_derivs(vm, SL_G_dPdv, any, any);

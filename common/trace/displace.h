@@ -29,6 +29,11 @@ void trace_surface_box(trace_thread *th, const trace_object *obj,
                        double u0, double u1, double v0, double v1,
                        trace_box *out);
 
+/* N is constant over the object (its d/du, d/dv are 0): disks, and
+ * polygons unless they carry interpolated vertex normals
+ * (geom_vertex_normal). */
+bool trace_surface_flat(const trace_object *obj);
+
 /* Interval bounds, over a (u,v) range, of the displaced P in CAMERA space
  * and of its true partial derivatives d/du, d/dv (sl_vm_run_slopes): the
  * Jacobian the hit proof (trace/prove.c) needs. False where they are not

@@ -84,8 +84,7 @@ static const slope_entry *cell_slopes(trace_thread *th, const trace_object *obj,
 
 bool trace_prove_eligible(const trace_object *obj)
 {
-    return obj->displacement && !obj->box_proto && obj->surf.kind == GEOM_POLYGON &&
-           !geom_has_vertex_normals(&obj->surf);
+    return obj->displacement && !obj->box_proto && trace_surface_flat(obj);
 }
 
 static double mid(ia_interval x) { return 0.5 * x.lo + 0.5 * x.hi; }

@@ -58,11 +58,21 @@ static const char *DU_SL =
     "    P += Km * (h + Du(h)) * normalize(N);\n"
     "}\n";
 
-/* a tilted square under a perspective camera */
+static const char *TANGENT_SL =
+    "displacement tangent(float Km = 0.05)\n"
+    "{\n"
+    "    P += Km * (sin(9 * s) * normalize(N) + 0.5 * normalize(dPdu));\n"
+    "}\n";
+
+/* a tilted square (or disk) under a perspective camera */
 #define SQUARE_RIB(shader)                                                   \
     "Format 40 30 1\nProjection \"perspective\" \"fov\" [30]\n"              \
     "WorldBegin\nTranslate 0 0 4\nRotate -50 1 0 0\nDisplacement \"" shader "\"\n" \
     "Polygon \"P\" [-1 -1 0  1 -1 0  1 1 0  -1 1 0]\nWorldEnd\n"
+#define DISK_RIB(shader)                                                     \
+    "Format 40 30 1\nProjection \"perspective\" \"fov\" [30]\n"              \
+    "WorldBegin\nTranslate 0 0 4\nRotate -50 1 0 0\nDisplacement \"" shader "\"\n" \
+    "Disk 0 1.1 360\nWorldEnd\n"
 
 static double urand(unsigned *s)
 {
@@ -72,12 +82,12 @@ static double urand(unsigned *s)
 
 static bool in(double x, ia_interval r) { return x >= r.lo && x <= r.hi; }
 
-static void check_slopes(const char *name, const char *src, bool expect_bounds)
+static void check_slopes(const char *name, const char *src, bool disk, bool expect_bounds)
 {
     fixture f;
     fixture_shader sh[] = {{name, src}};
     char rib[512];
-    snprintf(rib, sizeof rib, SQUARE_RIB("%s"), name);
+    snprintf(rib, sizeof rib, disk ? DISK_RIB("%s") : SQUARE_RIB("%s"), name);
     assert_true(fixture_open(&f, rib, sh, 1, NULL, 0));
     trace_thread *th = trace_thread_new(&f.js->world);
     const trace_object *obj = &f.js->world.objects[0];
@@ -121,18 +131,22 @@ static void check_slopes(const char *name, const char *src, bool expect_bounds)
 static void test_slopes_enclose_derivatives(void **state)
 {
     (void)state;
-    check_slopes("wave", WAVE_SL, true);
-    check_slopes("bumps", BUMPS_SL, true);
+    check_slopes("wave", WAVE_SL, false, true);
+    check_slopes("bumps", BUMPS_SL, false, true);
+    check_slopes("wave", WAVE_SL, true, true);       /* a disk: polar (u, v) */
+    check_slopes("tangent", TANGENT_SL, false, true); /* a polygon's dPdu is constant */
 }
 
 static void test_first_order_derivatives_give_no_slopes(void **state)
 {
     (void)state;
-    check_slopes("dudep", DU_SL, false);
+    check_slopes("dudep", DU_SL, false, false);
+    check_slopes("tangent", TANGENT_SL, true, false); /* a disk's dPdu turns */
 }
 
 /* Newton's iteration for the ray against the object from (u, v): true
- * when it converges to a point of the ray inside the polygon at t > tmin,
+ * when it converges to a point of the ray on the surface's domain (the
+ * (u, v) square, and inside a polygon) at t > tmin,
  * *t then being its ray parameter */
 static bool newton_finds_hit(trace_thread *th, const trace_object *obj, const trace_ray *ray,
                              double u, double v, double *t_hit)
@@ -145,7 +159,8 @@ static bool newton_finds_hit(trace_thread *th, const trace_object *obj, const tr
         vec3 f = v3_sub(sp.P, trace_ray_at(ray, t));
         if (v3_length(f) < 1e-11 * (1 + v3_length(sp.P))) {
             *t_hit = t;
-            return t > ray->tmin && geom_uv_inside(&obj->surf, u, v);
+            return t > ray->tmin && u >= 0 && u <= 1 && v >= 0 && v <= 1 &&
+                   geom_uv_inside(&obj->surf, u, v);
         }
         double det = v3_dot(sp.Pu, v3_cross(sp.Pv, nd));
         if (!(fabs(det) > 0)) return false;
@@ -159,12 +174,11 @@ static bool newton_finds_hit(trace_thread *th, const trace_object *obj, const tr
     return false;
 }
 
-static void test_proven_walks_agree_with_leaves(void **state)
+static void check_walks(const char *rib)
 {
-    (void)state;
     fixture f;
     fixture_shader sh[] = {{"wave", WAVE_SL}};
-    assert_true(fixture_open(&f, SQUARE_RIB("wave"), sh, 1, NULL, 0));
+    assert_true(fixture_open(&f, rib, sh, 1, NULL, 0));
     trace_world *world = &f.js->world;
     trace_thread *th = trace_thread_new(world);
     const trace_object *obj = &world->objects[0];
@@ -225,6 +239,13 @@ static void test_proven_walks_agree_with_leaves(void **state)
     assert_true(th->stats.proven_misses > 10);
     trace_thread_destroy(&th);
     fixture_close(&f);
+}
+
+static void test_proven_walks_agree_with_leaves(void **state)
+{
+    (void)state;
+    check_walks(SQUARE_RIB("wave"));
+    check_walks(DISK_RIB("wave"));
 }
 
 int main(void)
