@@ -820,6 +820,7 @@ typedef struct box_query {
 
 typedef struct box_result {
     iv range;                  /* encloses N over the box, within [0, 1] */
+    iv grad[4];                /* encloses dN/dp_k over the box */
     double n0, alpha[4], delta;   /* affine: N(x) in n0 + sum alpha (x-c) +- delta */
 } box_result;
 
@@ -1046,6 +1047,8 @@ static bool enclose(const box_query *q, bool want_affine, box_result *res)
     if (!(range.lo <= range.hi))       /* cannot happen; stay safe */
         range = iv_mk(0.0, 1.0);
     res->range = range;
+    for (int k = 0; k < dim; k++)
+        res->grad[k] = iv_scale_pos(hull.g[k], K);
 
     if (!want_affine)
         return true;
@@ -1136,6 +1139,25 @@ static ia_interval noise_ia(int dim, const ia_interval *p, const int *period,
     if (!ok || !enclose(&q, false, &res))
         return ia_with(0.0, 1.0, flags);
     return ia_with(res.range.lo, res.range.hi, flags);
+}
+
+bool sl_noise_gradient_ia(int dim, const ia_interval *p, const int *period, int component,
+                          ia_interval *grad)
+{
+    if (!dim_ok(dim) || component < -1 || component > 2)
+        return false;
+    box_query q;
+    unsigned flags;
+    bool empty;
+    q.dim = dim;
+    q.seed = channel_seed(component < 0 ? CH_NOISE : CH_VNOISE + (unsigned)component);
+    q.period = period;
+    box_result res;
+    if (!box_from_ia(&q, dim, p, &flags, &empty) || empty || !enclose(&q, false, &res))
+        return false;
+    for (int k = 0; k < dim; k++)
+        grad[k] = ia_make(res.grad[k].lo, res.grad[k].hi);
+    return true;
 }
 
 ia_interval sl_noise_ia(int dim, const ia_interval *p)

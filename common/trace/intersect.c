@@ -31,6 +31,8 @@ typedef struct walk {
     bool found;
     bool stopped;                  /* the work limit or a cancel ended the walk */
     bool prove;                    /* hit proofs may succeed on this object */
+    double prove_below;            /* ... on cells of at most this size (a
+                                      failed test's estimate, visit) */
     long nodes;                    /* quadtree nodes visited so far */
     trace_hit *best;
 } walk;
@@ -446,14 +448,19 @@ static void visit(walk *w, const trace_box *node, const double r[4],
          * estimate on the other opened cracks: tests/corpus, mesh) */
         if (w->prove && order[k].cover == GEOM_INSIDE && !unbounded &&
             !(kid->flags & AA_DISCONTINUOUS) && size <= TRACE_PROVE_CELLS * tol &&
+            size <= w->prove_below &&
             geom_uv_box_cover(&w->obj->surf, 2 * c[0] - c[1], 2 * c[1] - c[0],
                               2 * c[2] - c[3], 2 * c[3] - c[2]) == GEOM_INSIDE) {
-            double t;
+            double t, spread;
             trace_surface_point sp;
             trace_proof pr = trace_prove_hit(w->th, w->obj, w->cam_ray, c, w->ray.tmin,
-                                             w->best->t, &t, &sp);
+                                             w->best->t, &t, &sp, &spread);
             if (pr == TRACE_PROOF_HIT) proven_hit(w, t, tol, &sp);
             if (pr != TRACE_PROOF_UNKNOWN) continue;
+            /* an undecided test: this walk tries again only on cells small
+             * enough for K to fit (prove.h, spread); none after a cell
+             * without slopes (a jump, a singularity) */
+            if (spread > 1.0) w->prove_below = fmin(w->prove_below, size / spread);
         }
         if (d >= TRACE_MAX_DEPTH)
             leaf_hit(w, kid, c, &order[k], TRACE_LEAF_DEPTH, wall_n);
@@ -483,6 +490,7 @@ static bool intersect_displaced(trace_thread *th, const trace_object *obj,
 {
     walk w = {.th = th, .obj = obj, .cam_ray = ray, .tol = *tol, .any = any,
               .found = false, .prove = th->world->options.prove_hits && trace_prove_eligible(obj),
+              .prove_below = INFINITY,
               .best = best};
     object_ray(obj, ray, best->t, &w.ray);
     double t0, t1;

@@ -144,9 +144,10 @@ static ia_interval plane_g(const ray_planes *rp, int a, const ia_interval P[3], 
 
 trace_proof trace_prove_hit(trace_thread *th, const trace_object *obj, const trace_ray *ray,
                             const double r[4], double tmin, double tmax,
-                            double *t_out, trace_surface_point *sp)
+                            double *t_out, trace_surface_point *sp, double *spread)
 {
     th->stats.proofs++;
+    *spread = INFINITY;
     ray_planes rp;
     if (!planes_of(ray, &rp)) return TRACE_PROOF_UNKNOWN;
     const slope_entry *e = cell_slopes(th, obj, r);
@@ -188,6 +189,7 @@ trace_proof trace_prove_hit(trace_thread *th, const trace_object *obj, const tra
         inside = inside && k.lo > X[a].lo && k.hi < X[a].hi;
         K[a] = k;
     }
+    *spread = fmax((K[0].hi - K[0].lo) / (r[1] - r[0]), (K[1].hi - K[1].lo) / (r[3] - r[2]));
     if (!inside) return TRACE_PROOF_UNKNOWN;
 
     /* The ray's line meets the surface over the cell exactly once, at a

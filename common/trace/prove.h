@@ -54,9 +54,13 @@ bool trace_prove_eligible(const trace_object *obj);
 /* The test on the cell r = {u0, u1, v0, v1} for the camera-space ray;
  * (tmin, tmax) is the range a hit must lie in. On TRACE_PROOF_HIT: *t,
  * and *sp, the surface point at the hit (dual mode, as
- * trace_surface_point_eval). */
+ * trace_surface_point_eval). *spread: the width of the operator's box K
+ * over the cell's, per (u, v) axis, the larger (infinite when the test
+ * had no slopes): K shrinks about as fast as the cell (its width goes as
+ * the cell's squared), so a test that failed with spread s is unlikely
+ * to succeed on cells more than 1/s of this one. */
 trace_proof trace_prove_hit(trace_thread *th, const trace_object *obj, const trace_ray *ray,
                             const double r[4], double tmin, double tmax,
-                            double *t, trace_surface_point *sp);
+                            double *t, trace_surface_point *sp, double *spread);
 
 #endif
