@@ -29,6 +29,7 @@
 #define GEOM_SURFACE_H
 
 #include <stdbool.h>
+#include <stdint.h>
 
 #include "aa/affine.h"
 #include "aa/interval.h"
@@ -146,6 +147,13 @@ typedef enum geom_cover { GEOM_OUTSIDE, GEOM_PARTIAL, GEOM_INSIDE } geom_cover;
 bool geom_uv_inside(const geom_surface *s, double u, double v);
 geom_cover geom_uv_box_cover(const geom_surface *s, double u0, double u1,
                              double v0, double v1);
+/* Polygons: whether every point of the (u,v) box lies inside each edge of
+ * the set (bit i: edge i, from uv[i] to uv[i+1]), by more than the
+ * rounding margin; other kinds: true. */
+bool geom_uv_box_clear_of(const geom_surface *s, double u0, double u1, double v0, double v1,
+                          uint64_t edges);
+/* Polygons: the object-space end points of edge i. */
+void geom_polygon_edge(const geom_surface *s, int i, vec3 *a, vec3 *b);
 
 /* Object-space bounds of the undisplaced surface (conservative). */
 void geom_bounds(const geom_surface *s, vec3 *lo, vec3 *hi);

@@ -247,6 +247,30 @@ bool geom_uv_inside(const geom_surface *s, double u, double v)
  * (u,v) extent; inside when all four corners are inside (the inside set,
  * tolerance included, is convex). Otherwise partial, which is also the
  * safe answer. */
+bool geom_uv_box_clear_of(const geom_surface *s, double u0, double u1, double v0, double v1,
+                          uint64_t edges)
+{
+    if (s->kind != GEOM_POLYGON)
+        return true;
+    double uc = 0.5 * (u0 + u1), vc = 0.5 * (v0 + v1);
+    double hu = 0.5 * (u1 - u0), hv = 0.5 * (v1 - v0);
+    for (int i = 0; i < s->nuv; i++) {
+        if (!((edges >> i) & 1))
+            continue;
+        double r = fabs(s->edge[i][0]) * hu + fabs(s->edge[i][1]) * hv;
+        if (!(edge_eval(s, i, uc, vc) - r > 2 * UV_TOL))
+            return false;
+    }
+    return true;
+}
+
+void geom_polygon_edge(const geom_surface *s, int i, vec3 *a, vec3 *b)
+{
+    const double *p = s->uv[i], *q = s->uv[(i + 1) % s->nuv];
+    *a = v3_add(s->origin, v3_add(v3_scale(s->axis_u, p[0]), v3_scale(s->axis_v, p[1])));
+    *b = v3_add(s->origin, v3_add(v3_scale(s->axis_u, q[0]), v3_scale(s->axis_v, q[1])));
+}
+
 geom_cover geom_uv_box_cover(const geom_surface *s, double u0, double u1,
                              double v0, double v1)
 {

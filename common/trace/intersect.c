@@ -442,15 +442,16 @@ static void visit(walk *w, const trace_box *node, const double r[4],
         int d = depth + 1;
         bool unbounded = (kid->flags & AA_UNBOUNDED) != 0;
         vec3 wall_n = v3(0, 0, 0);
-        /* proofs only on cells a cell's width or more inside the base
-         * polygon: near its edges the leaves stay, which a shared edge's
-         * two polygons apply alike (an exact miss on one side next to an
-         * estimate on the other opened cracks: tests/corpus, mesh) */
-        if (w->prove && order[k].cover == GEOM_INSIDE && !unbounded &&
-            !(kid->flags & AA_DISCONTINUOUS) && size <= TRACE_PROVE_CELLS * tol &&
-            size <= w->prove_below &&
-            geom_uv_box_cover(&w->obj->surf, 2 * c[0] - c[1], 2 * c[1] - c[0],
-                              2 * c[2] - c[3], 2 * c[3] - c[2]) == GEOM_INSIDE) {
+        /* proofs only on cells a cell's width or more away from the
+         * edges a polygon shares with another: there the leaves stay,
+         * which the two polygons apply alike (an exact miss on one side
+         * next to an estimate on the other opened cracks: tests/corpus,
+         * mesh); at an edge of its own a proof draws it exactly */
+        if (w->prove && !unbounded && !(kid->flags & AA_DISCONTINUOUS) &&
+            size <= TRACE_PROVE_CELLS * tol && size <= w->prove_below &&
+            (!w->obj->shared_edges ||
+             geom_uv_box_clear_of(&w->obj->surf, 2 * c[0] - c[1], 2 * c[1] - c[0],
+                                  2 * c[2] - c[3], 2 * c[3] - c[2], w->obj->shared_edges))) {
             double t, spread;
             trace_surface_point sp;
             trace_proof pr = trace_prove_hit(w->th, w->obj, w->cam_ray, c, w->ray.tmin,

@@ -10,6 +10,8 @@
 
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
 
 /* Spectral norm of the 3x3 part (largest stretch), by power iteration on
  * M^T M, rounded up a little: the leaf test multiplies object-space sizes
@@ -98,6 +100,75 @@ static bool matrix_finite(const mat4 *m)
     return true;
 }
 
+/* A polygon edge by the exact bits of its RIB vertices (the lower first)
+ * and of its object's transform, for finding shared ones. */
+typedef struct world_edge { double key[6 + 16]; int obj, edge; } world_edge;
+
+static int edge_cmp(const void *x, const void *y)
+{
+    const world_edge *a = x, *b = y;
+    int c = memcmp(a->key, b->key, sizeof a->key);
+    return c ? c : (a->obj > b->obj) - (a->obj < b->obj);
+}
+
+/* the RIB vertex of the polygon nearest to p (p is one of them, up to the
+ * rounding of its (u,v) round trip) */
+static vec3 rib_vertex(const geom_surface *s, vec3 p)
+{
+    int best = 0;
+    double d = INFINITY;
+    for (int j = 0; j < s->nverts; j++) {
+        double dj = v3_length(v3_sub(s->verts[j], p));
+        if (dj < d) { d = dj; best = j; }
+    }
+    return s->verts[best];
+}
+
+/* The edges polygons share (the meshes of Polygon and PointsPolygons
+ * calls, whose shared vertices are the same numbers under the same
+ * transform): the hit proofs (intersect.c) stay off near them, where the
+ * neighbour's leaves decide. Sorted by their exact bits, so equal edges
+ * are neighbours: O(n log n) for meshes of any size. */
+static void find_shared_edges(trace_world *world)
+{
+    size_t n = 0;
+    for (int i = 0; i < world->nobjects; i++) {
+        trace_object *obj = &world->objects[i];
+        obj->shared_edges = 0;
+        if (obj->surf.kind == GEOM_POLYGON) n += (size_t)obj->surf.nuv;
+    }
+    if (n < 2) return;
+    world_edge *e = calloc(n, sizeof *e);
+    if (!e) abort();
+    n = 0;
+    for (int i = 0; i < world->nobjects; i++) {
+        const trace_object *obj = &world->objects[i];
+        if (obj->surf.kind != GEOM_POLYGON) continue;
+        for (int k = 0; k < obj->surf.nuv && k < 64; k++) {
+            vec3 a, b;
+            geom_polygon_edge(&obj->surf, k, &a, &b);
+            a = rib_vertex(&obj->surf, a);
+            b = rib_vertex(&obj->surf, b);
+            double pa[3] = {a.x, a.y, a.z}, pb[3] = {b.x, b.y, b.z};
+            bool swap = memcmp(pb, pa, sizeof pa) < 0;
+            world_edge *w = &e[n++];
+            memcpy(w->key, swap ? pb : pa, sizeof pa);
+            memcpy(w->key + 3, swap ? pa : pb, sizeof pa);
+            memcpy(w->key + 6, obj->to_camera.m, sizeof obj->to_camera.m);
+            w->obj = i;
+            w->edge = k;
+        }
+    }
+    qsort(e, n, sizeof *e, edge_cmp);
+    for (size_t i = 0; i + 1 < n; i++) {
+        size_t j = i + 1;
+        if (memcmp(e[i].key, e[j].key, sizeof e[i].key) != 0 || e[i].obj == e[j].obj) continue;
+        world->objects[e[i].obj].shared_edges |= (uint64_t)1 << e[i].edge;
+        world->objects[e[j].obj].shared_edges |= (uint64_t)1 << e[j].edge;
+    }
+    free(e);
+}
+
 bool trace_world_prepare(trace_world *world, char *err, int errsz)
 {
     for (int i = 0; i < world->nobjects; i++) {
@@ -125,5 +196,6 @@ bool trace_world_prepare(trace_world *world, char *err, int errsz)
                                  !sl_program_reads_global(dp, SL_G_dPdu) &&
                                  !sl_program_reads_global(dp, SL_G_dPdv);
     }
+    find_shared_edges(world);
     return true;
 }

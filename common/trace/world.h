@@ -14,6 +14,7 @@
 #define TRACE_WORLD_H
 
 #include <stdbool.h>
+#include <stdint.h>
 #include <stddef.h>
 
 #include "geom/surface.h"
@@ -55,6 +56,8 @@ typedef struct trace_object {
     double normal_len2[2];         /* bounds of |from_camera^T n|^2, n unit */
     double du, dv;                 /* the shader globals du, dv: per-object
                                       constants (render.c, docs/renderer.md) */
+    uint64_t shared_edges;         /* polygons: bit i, edge i (geom_polygon_edge)
+                                      is also another polygon's (world.c) */
     bool box_skip_tangents;        /* the displacement shader never names dPdu,
                                       dPdv nor takes derivatives: boxes need
                                       not transform the tangents (world.c) */

@@ -17,7 +17,9 @@
  *     hit nearer than the proofs (or the proofs not at all), Newton's
  *     iteration from the leaf's point must find no real intersection of
  *     the ray inside the polygon nearer than the proofs' hit (else a
- *     proof lost it). Both verdicts must occur (the test exercises them).
+ *     proof lost it). Both verdicts must occur (the test exercises them);
+ *   - shared edges: the polygons of a mesh know which of their edges
+ *     another polygon shares (proofs stay off there, trace/world.c).
  */
 #include <math.h>
 #include <setjmp.h>
@@ -248,9 +250,49 @@ static void test_proven_walks_agree_with_leaves(void **state)
     check_walks(DISK_RIB("wave"));
 }
 
+/* A 2 x 2 grid of quads split into triangles (as tests/corpus's mesh):
+ * its 4 diagonals and 4 inner grid edges are shared, each by two of the
+ * 8 triangles (16 edge bits), its 8 border edges not; a lone square
+ * shares none. */
+static void test_shared_edges(void **state)
+{
+    (void)state;
+    char rib[4096];
+    size_t n = (size_t)snprintf(rib, sizeof rib, "Format 8 8 1\nProjection \"perspective\"\n"
+                                "WorldBegin\nTranslate 0 0 5\n"
+                                "Displacement \"wave\"\n");
+    double g[3] = {-1, 0, 1};
+    for (int j = 0; j < 2; j++)
+        for (int i = 0; i < 2; i++) {
+            double x0 = g[i], x1 = g[i + 1], y0 = g[j], y1 = g[j + 1];
+#define Z(x, y) (0.25 * (x) * (y) + 0.15 * (x))
+            n += (size_t)snprintf(rib + n, sizeof rib - n,
+                                  "Polygon \"P\" [%g %g %g  %g %g %g  %g %g %g]\n"
+                                  "Polygon \"P\" [%g %g %g  %g %g %g  %g %g %g]\n",
+                                  x0, y0, Z(x0, y0), x1, y0, Z(x1, y0), x1, y1, Z(x1, y1),
+                                  x0, y0, Z(x0, y0), x1, y1, Z(x1, y1), x0, y1, Z(x0, y1));
+#undef Z
+        }
+    snprintf(rib + n, sizeof rib - n, "WorldEnd\n");
+    fixture f;
+    fixture_shader sh[] = {{"wave", WAVE_SL}};
+    assert_true(fixture_open(&f, rib, sh, 1, NULL, 0));
+    int bits = 0;
+    for (int i = 0; i < f.js->world.nobjects; i++)
+        bits += __builtin_popcountll(f.js->world.objects[i].shared_edges);
+    printf("mesh of %d triangles: %d shared edge bits\n", f.js->world.nobjects, bits);
+    assert_int_equal(f.js->world.nobjects, 8);
+    assert_int_equal(bits, 16);
+    fixture_close(&f);
+    assert_true(fixture_open(&f, SQUARE_RIB("wave"), sh, 1, NULL, 0));
+    assert_int_equal(f.js->world.objects[0].shared_edges, 0);
+    fixture_close(&f);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_shared_edges),
         cmocka_unit_test(test_slopes_enclose_derivatives),
         cmocka_unit_test(test_first_order_derivatives_give_no_slopes),
         cmocka_unit_test(test_proven_walks_agree_with_leaves),
