@@ -271,18 +271,25 @@ bool trace_surface_slopes(trace_thread *th, const trace_object *obj,
         sl_vm_set_derivs(vm, SL_G_dPdv, any, any);
     }
     trace_primvars_bind(vm, obj, false);
-    th->stats.evals_slopes++;
-    if (sl_vm_run_slopes(vm, obj->displacement) != SL_OK) {
+    bool slopes = Pu && Pv;
+    if (slopes) th->stats.evals_slopes++;
+    else th->stats.evals_interval++;
+    sl_status st = slopes ? sl_vm_run_slopes(vm, obj->displacement)
+                          : sl_vm_run(vm, obj->displacement, SL_MODE_INTERVAL, NULL);
+    if (st != SL_OK) {
         trace_thread_fail(th, sl_vm_error(vm));
         return false;
     }
     sl_vm_get_interval(vm, SL_G_P, P);
-    sl_vm_get_slopes(vm, SL_G_P, Pu, Pv);
+    if (slopes) sl_vm_get_slopes(vm, SL_G_P, Pu, Pv);
     unsigned flags = 0;
     for (int i = 0; i < 3; i++) {
-        flags |= P[i].flags | Pu[i].flags | Pv[i].flags;
-        if (!isfinite(P[i].lo) || !isfinite(P[i].hi) || !isfinite(Pu[i].lo) ||
-            !isfinite(Pu[i].hi) || !isfinite(Pv[i].lo) || !isfinite(Pv[i].hi))
+        flags |= P[i].flags;
+        if (!isfinite(P[i].lo) || !isfinite(P[i].hi)) return false;
+        if (!slopes) continue;
+        flags |= Pu[i].flags | Pv[i].flags;
+        if (!isfinite(Pu[i].lo) || !isfinite(Pu[i].hi) || !isfinite(Pv[i].lo) ||
+            !isfinite(Pv[i].hi))
             return false;
     }
     return !(flags & (AA_DISCONTINUOUS | AA_UNBOUNDED));

@@ -39,7 +39,8 @@ bool trace_surface_flat(const trace_object *obj);
  * Jacobian the hit proof (trace/prove.c) needs. False where they are not
  * known to be finite slope bounds of a continuous function: an instance,
  * no displacement, a failed run, an unbounded or discontinuous value. A
- * range of one point gives an enclosure of P there. */
+ * range of one point gives an enclosure of P there; with Pu and Pv NULL,
+ * only P's (a plain interval run, cheaper). */
 bool trace_surface_slopes(trace_thread *th, const trace_object *obj,
                           double u0, double u1, double v0, double v1,
                           ia_interval P[3], ia_interval Pu[3], ia_interval Pv[3]);
