@@ -127,6 +127,11 @@ void geom_unit_normal_aa(aa_context *ctx, const geom_surface *s, const aa_form *
                          const aa_form *v, const geom_aa *g, aa_form Nn[3]);
 void geom_unit_normal_ia(const geom_surface *s, ia_interval u, ia_interval v,
                          const geom_ia *g, ia_interval Nn[3]);
+/* Bounds of d/du and d/dv of that unit normal over the box, from the
+ * same closed forms (sphere, cylinder, cone, torus, disk, a polygon
+ * without vertex normals); false for the other kinds. */
+bool geom_unit_normal_slopes_ia(const geom_surface *s, ia_interval u, ia_interval v,
+                                const geom_ia *g, ia_interval dNdu[3], ia_interval dNdv[3]);
 
 /* Vertex normals (meshes, surface_vertex_normal.c). A triangle polygon
  * with nvn = 3 has the shading normal N(u,v) = the linear interpolation of

@@ -193,6 +193,65 @@ void geom_unit_normal_aa(aa_context *ctx, const geom_surface *s, const aa_form *
 
 /* ---- interval ---- */
 
+bool geom_unit_normal_slopes_ia(const geom_surface *s, ia_interval u, ia_interval v,
+                                const geom_ia *g, ia_interval dNdu[3], ia_interval dNdv[3])
+{
+    ia_interval theta = ia_mul_s(u, s->thetamax), zero = ia_point(0);
+    switch (s->kind) {
+    case GEOM_SPHERE: {              /* Nn = k P */
+        ia_interval k = ia_mul_s(ia_recip(ia_point(s->radius)), sgn(s->thetamax) * dphi_sign(s));
+        for (int i = 0; i < 3; i++) {
+            dNdu[i] = ia_mul(g->dPdu[i], k);
+            dNdv[i] = ia_mul(g->dPdv[i], k);
+        }
+        return true;
+    }
+    case GEOM_CYLINDER: {            /* Nn = k (Px, Py, 0) */
+        ia_interval k = ia_mul_s(ia_recip(ia_point(s->radius)), sgn(s->thetamax) * sgn(s->zmax - s->zmin));
+        for (int i = 0; i < 2; i++) {
+            dNdu[i] = ia_mul(g->dPdu[i], k);
+            dNdv[i] = ia_mul(g->dPdv[i], k);
+        }
+        dNdu[2] = dNdv[2] = zero;
+        return true;
+    }
+    case GEOM_CONE: {                /* Nn = k (h cos theta, h sin theta, r) */
+        ia_interval kh = ia_mul_s(ia_mul_s(inv_hypot(s->height, s->radius), sgn(s->thetamax)),
+                                  s->height);
+        ia_interval kt = ia_mul_s(kh, s->thetamax);
+        dNdu[0] = ia_neg(ia_mul(ia_sin(theta), kt));
+        dNdu[1] = ia_mul(ia_cos(theta), kt);
+        dNdu[2] = zero;
+        dNdv[0] = dNdv[1] = dNdv[2] = zero;
+        return true;
+    }
+    case GEOM_TORUS: {               /* Nn = k (cos phi cos theta, cos phi sin theta, sin phi) */
+        double pa, pb;
+        geom_phi_range(s, &pa, &pb);
+        ia_interval phi = ia_add_s(ia_mul(v, s->consts[K_DPHI]), pa);
+        ia_interval cp = ia_cos(phi), sp = ia_sin(phi), ct = ia_cos(theta), st = ia_sin(theta);
+        double k = sgn(s->thetamax) * dphi_sign(s);
+        ia_interval ku = ia_point(k * s->thetamax), kv = ia_mul_s(s->consts[K_DPHI], k);
+        dNdu[0] = ia_neg(ia_mul(ia_mul(cp, st), ku));
+        dNdu[1] = ia_mul(ia_mul(cp, ct), ku);
+        dNdu[2] = zero;
+        dNdv[0] = ia_neg(ia_mul(ia_mul(sp, ct), kv));
+        dNdv[1] = ia_neg(ia_mul(ia_mul(sp, st), kv));
+        dNdv[2] = ia_mul(cp, kv);
+        return true;
+    }
+    case GEOM_DISK:
+        for (int i = 0; i < 3; i++) dNdu[i] = dNdv[i] = zero;
+        return true;
+    case GEOM_POLYGON:
+        if (geom_has_vertex_normals(s)) return false;
+        for (int i = 0; i < 3; i++) dNdu[i] = dNdv[i] = zero;
+        return true;
+    default:
+        return false;
+    }
+}
+
 static void normalize_ia(const ia_interval Ng[3], ia_interval Nn[3])
 {
     ia_interval n2 = ia_add(ia_add(ia_sqr(Ng[0]), ia_sqr(Ng[1])), ia_sqr(Ng[2]));

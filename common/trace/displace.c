@@ -107,6 +107,16 @@ static void box_from_affine(const aa_form P[3], trace_box *out)
     out->flags = box_flags(out, flags);
 }
 
+bool trace_surface_has_slopes(const trace_object *obj)
+{
+    switch (obj->surf.kind) {
+    case GEOM_SPHERE: case GEOM_CYLINDER: case GEOM_CONE: case GEOM_TORUS:
+        return obj->normal_scale > 0;
+    default:
+        return trace_surface_flat(obj);
+    }
+}
+
 bool trace_surface_flat(const trace_object *obj)
 {
     return (obj->surf.kind == GEOM_POLYGON && !geom_has_vertex_normals(&obj->surf)) ||
@@ -269,6 +279,20 @@ bool trace_surface_slopes(trace_thread *th, const trace_object *obj,
         ia_interval any[3] = {ia_entire(), ia_entire(), ia_entire()};
         sl_vm_set_derivs(vm, SL_G_dPdu, any, any);
         sl_vm_set_derivs(vm, SL_G_dPdv, any, any);
+    }
+    ia_interval dNn[2][3], dN[2][3];
+    if (!flat && obj->normal_scale > 0 &&
+        geom_unit_normal_slopes_ia(&obj->surf, u, v, &g, dNn[0], dNn[1])) {
+        /* N = k s M^T Nn (ia_camera_normal, a similarity): its slopes are
+         * those of the object's unit normal, mapped the same way */
+        mat4 t = mat4_transpose(obj->from_camera);
+        double k = (obj->flip ? -1.0 : 1.0) * obj->normal_scale;
+        for (int d = 0; d < 2; d++) {
+            ia_xform(&t, dNn[d], dN[d], false);
+            for (int i = 0; i < 3; i++) dN[d][i] = ia_mul_s(dN[d][i], k);
+        }
+        sl_vm_set_derivs(vm, SL_G_N, dN[0], dN[1]);
+        sl_vm_set_derivs(vm, SL_G_Ng, dN[0], dN[1]);
     }
     trace_primvars_bind(vm, obj, false);
     bool slopes = Pu && Pv;

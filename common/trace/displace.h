@@ -34,6 +34,11 @@ void trace_surface_box(trace_thread *th, const trace_object *obj,
  * (geom_vertex_normal). */
 bool trace_surface_flat(const trace_object *obj);
 
+/* Whether trace_surface_slopes can bound N's slopes on the object: flat
+ * ones, and spheres, cylinders, cones and tori under a similarity (their
+ * unit normals in closed form, geom_unit_normal_slopes_ia). */
+bool trace_surface_has_slopes(const trace_object *obj);
+
 /* Interval bounds, over a (u,v) range, of the displaced P in CAMERA space
  * and of its true partial derivatives d/du, d/dv (sl_vm_run_slopes): the
  * Jacobian the hit proof (trace/prove.c) needs. False where they are not

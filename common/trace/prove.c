@@ -135,7 +135,7 @@ static const slope_entry *cell_slopes(trace_thread *th, const trace_object *obj,
 
 bool trace_prove_eligible(const trace_object *obj)
 {
-    return obj->displacement && !obj->box_proto && trace_surface_flat(obj);
+    return obj->displacement && trace_surface_has_slopes(trace_box_owner(obj));
 }
 
 static double mid(ia_interval x) { return 0.5 * x.lo + 0.5 * x.hi; }
@@ -199,6 +199,18 @@ trace_proof trace_prove_hit(trace_thread *th, const trace_object *obj, const tra
 {
     th->stats.proofs++;
     *spread = INFINITY;
+    /* an instance sharing its prototype's boxes (trace/instance.c): the
+     * test runs on the prototype, the ray moved rigidly into its camera
+     * space (t is kept), and the hit's point is the instance's */
+    const trace_object *inst = obj;
+    trace_ray moved;
+    if (obj->box_proto) {
+        moved = *ray;
+        moved.o = mat4_xform_point(&obj->to_proto, ray->o);
+        moved.d = mat4_xform_vector(&obj->to_proto, ray->d);
+        ray = &moved;
+        obj = obj->box_proto;
+    }
     ray_planes rp;
     if (!planes_of(ray, &rp)) return TRACE_PROOF_UNKNOWN;
     const slope_entry *e = cell_slopes(th, obj, r);
@@ -297,6 +309,7 @@ trace_proof trace_prove_hit(trace_thread *th, const trace_object *obj, const tra
         x[1] = nx[1];
         trace_surface_point_eval(th, obj, x[0], x[1], sp);
     }
+    if (inst != obj) trace_surface_point_eval(th, inst, x[0], x[1], sp);
     th->stats.proven_hits++;
     *t_out = x[2];
     return TRACE_PROOF_HIT;

@@ -45,10 +45,9 @@ typedef enum trace_proof {
 } trace_proof;
 
 /* Whether proofs can succeed on this object at all: a displaced object
- * (not an instance) whose shader sees a constant N (trace_surface_flat:
- * a polygon without vertex normals, a disk), so that its slopes can be
- * bounded. Elsewhere the slope bounds would be the whole line and every
- * try wasted. */
+ * (not an instance) whose N has known slopes (trace_surface_has_slopes:
+ * flat ones, quadrics under a similarity). Elsewhere the slope bounds
+ * would be the whole line and every try wasted. */
 bool trace_prove_eligible(const trace_object *obj);
 
 /* The test on the cell r = {u0, u1, v0, v1} for the camera-space ray;

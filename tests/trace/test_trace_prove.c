@@ -27,6 +27,7 @@
 #include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 #include <cmocka.h>
 
 #include "fixture.h"
@@ -71,10 +72,19 @@ static const char *TANGENT_SL =
     "Format 40 30 1\nProjection \"perspective\" \"fov\" [30]\n"              \
     "WorldBegin\nTranslate 0 0 4\nRotate -50 1 0 0\nDisplacement \"" shader "\"\n" \
     "Polygon \"P\" [-1 -1 0  1 -1 0  1 1 0  -1 1 0]\nWorldEnd\n"
-#define DISK_RIB(shader)                                                     \
+#define DISK_RIB(shader) QUADRIC_RIB(shader, "Disk 0 1.1 360")
+#define QUADRIC_RIB(shader, quadric)                                         \
     "Format 40 30 1\nProjection \"perspective\" \"fov\" [30]\n"              \
     "WorldBegin\nTranslate 0 0 4\nRotate -50 1 0 0\nDisplacement \"" shader "\"\n" \
-    "Disk 0 1.1 360\nWorldEnd\n"
+    quadric "\nWorldEnd\n"
+
+/* curved bases whose unit normal has closed-form slopes */
+static const char *QUADRICS[] = {
+    QUADRIC_RIB("%s", "Sphere 1 -1 1 360"),
+    QUADRIC_RIB("%s", "Scale 1.5 1.5 1.5 Cylinder 0.6 -0.7 0.7 300"),
+    QUADRIC_RIB("%s", "Torus 0.8 0.3 0 360 360"),
+    QUADRIC_RIB("%s", "Cone 1.2 0.8 330"),
+};
 
 static double urand(unsigned *s)
 {
@@ -84,12 +94,13 @@ static double urand(unsigned *s)
 
 static bool in(double x, ia_interval r) { return x >= r.lo && x <= r.hi; }
 
-static void check_slopes(const char *name, const char *src, bool disk, bool expect_bounds)
+static void check_slopes_in(const char *fmt, const char *name, const char *src,
+                            bool expect_bounds)
 {
     fixture f;
     fixture_shader sh[] = {{name, src}};
     char rib[512];
-    snprintf(rib, sizeof rib, disk ? DISK_RIB("%s") : SQUARE_RIB("%s"), name);
+    snprintf(rib, sizeof rib, fmt, name);
     assert_true(fixture_open(&f, rib, sh, 1, NULL, 0));
     trace_thread *th = trace_thread_new(&f.js->world);
     const trace_object *obj = &f.js->world.objects[0];
@@ -119,8 +130,8 @@ static void check_slopes(const char *name, const char *src, bool disk, bool expe
             }
         }
     }
-    printf("%-6s %d cells, %d with slope bounds, %d derivative samples, %d outside\n", name,
-           cells, bounded, points, outside);
+    printf("%-6s on %-8.8s %d cells, %d with slope bounds, %d derivative samples, %d outside\n",
+           name, strstr(fmt, "\"\n") + 2, cells, bounded, points, outside);
     assert_int_equal(outside, 0);
     if (expect_bounds)
         assert_true(bounded > cells / 2);
@@ -130,6 +141,11 @@ static void check_slopes(const char *name, const char *src, bool disk, bool expe
     fixture_close(&f);
 }
 
+static void check_slopes(const char *name, const char *src, bool disk, bool expect_bounds)
+{
+    check_slopes_in(disk ? DISK_RIB("%s") : SQUARE_RIB("%s"), name, src, expect_bounds);
+}
+
 static void test_slopes_enclose_derivatives(void **state)
 {
     (void)state;
@@ -137,6 +153,10 @@ static void test_slopes_enclose_derivatives(void **state)
     check_slopes("bumps", BUMPS_SL, false, true);
     check_slopes("wave", WAVE_SL, true, true);       /* a disk: polar (u, v) */
     check_slopes("tangent", TANGENT_SL, false, true); /* a polygon's dPdu is constant */
+    for (size_t i = 0; i < sizeof QUADRICS / sizeof QUADRICS[0]; i++) {
+        check_slopes_in(QUADRICS[i], "wave", WAVE_SL, true);
+        check_slopes_in(QUADRICS[i], "bumps", BUMPS_SL, true);
+    }
 }
 
 static void test_first_order_derivatives_give_no_slopes(void **state)
@@ -248,6 +268,9 @@ static void test_proven_walks_agree_with_leaves(void **state)
     (void)state;
     check_walks(SQUARE_RIB("wave"));
     check_walks(DISK_RIB("wave"));
+    char rib[512];
+    snprintf(rib, sizeof rib, QUADRICS[0], "wave");
+    check_walks(rib);
 }
 
 /* A 2 x 2 grid of quads split into triangles (as tests/corpus's mesh):
