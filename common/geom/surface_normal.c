@@ -243,10 +243,29 @@ bool geom_unit_normal_slopes_ia(const geom_surface *s, ia_interval u, ia_interva
     case GEOM_DISK:
         for (int i = 0; i < 3; i++) dNdu[i] = dNdv[i] = zero;
         return true;
-    case GEOM_POLYGON:
-        if (geom_has_vertex_normals(s)) return false;
-        for (int i = 0; i < 3; i++) dNdu[i] = dNdv[i] = zero;
+    case GEOM_POLYGON: {
+        if (!geom_has_vertex_normals(s)) {
+            for (int i = 0; i < 3; i++) dNdu[i] = dNdv[i] = zero;
+            return true;
+        }
+        /* Nn = Nv / |Nv| with Nv = A u + B v + C: d Nn = (dNv - Nn (Nn . dNv)) / |Nv| */
+        ia_interval Nv[3], Nn[3];
+        for (int i = 0; i < 3; i++)
+            Nv[i] = ia_add(ia_add(ia_mul(u, s->consts[K_VNU + i]),
+                                  ia_mul(v, s->consts[K_VNV + i])), s->consts[K_VNC + i]);
+        ia_interval n2 = ia_add(ia_add(ia_sqr(Nv[0]), ia_sqr(Nv[1])), ia_sqr(Nv[2]));
+        if (!(n2.lo > 0) || !isfinite(n2.hi)) return false;
+        ia_interval inv = ia_invsqrt(n2);
+        for (int i = 0; i < 3; i++) Nn[i] = ia_mul(Nv[i], inv);
+        for (int d = 0; d < 2; d++) {
+            const ia_interval *a = &s->consts[d == 0 ? K_VNU : K_VNV];
+            ia_interval dot = ia_add(ia_add(ia_mul(Nn[0], a[0]), ia_mul(Nn[1], a[1])),
+                                     ia_mul(Nn[2], a[2]));
+            ia_interval *out = d == 0 ? dNdu : dNdv;
+            for (int i = 0; i < 3; i++) out[i] = ia_mul(ia_sub(a[i], ia_mul(Nn[i], dot)), inv);
+        }
         return true;
+    }
     default:
         return false;
     }

@@ -78,12 +78,15 @@ static const char *TANGENT_SL =
     "WorldBegin\nTranslate 0 0 4\nRotate -50 1 0 0\nDisplacement \"" shader "\"\n" \
     quadric "\nWorldEnd\n"
 
-/* curved bases whose unit normal has closed-form slopes */
+/* curved bases (and a triangle with vertex normals) whose unit normal
+ * has closed-form slopes */
 static const char *QUADRICS[] = {
     QUADRIC_RIB("%s", "Sphere 1 -1 1 360"),
     QUADRIC_RIB("%s", "Scale 1.5 1.5 1.5 Cylinder 0.6 -0.7 0.7 300"),
     QUADRIC_RIB("%s", "Torus 0.8 0.3 0 360 360"),
     QUADRIC_RIB("%s", "Cone 1.2 0.8 330"),
+    QUADRIC_RIB("%s", "PointsPolygons [3] [0 1 2] \"P\" [-1 -1 0  1 -1 0  0 1 0] "
+                      "\"N\" [-1 -0.8 1  1.2 -0.5 1  0 1.5 1]"),
 };
 
 static double urand(unsigned *s)
