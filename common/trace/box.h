@@ -29,6 +29,9 @@
 typedef struct trace_box {
     vec3 lo, hi;
     unsigned flags;          /* AA_DISCONTINUOUS | AA_UNBOUNDED | TRACE_BOX_SAMPLED */
+    float bend;              /* how far from linear in (u,v) the surface is over
+                                the box: the affine forms' other terms over
+                                their u and v terms (displace.c); 0: unknown */
 } trace_box;
 
 typedef struct trace_ray {

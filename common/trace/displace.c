@@ -98,13 +98,21 @@ static void box_from_affine(const aa_form P[3], trace_box *out)
 {
     ia_interval r[3];
     unsigned flags = 0;
+    double lin = 0, other = 0;
     for (int i = 0; i < 3; i++) {
         r[i] = aa_range(&P[i]);
         flags |= P[i].flags | r[i].flags;
+        /* symbols 0 and 1 are u and v (box_affine's first two inputs) */
+        for (int k = 0; k < P[i].n; k++) {
+            if (k < 2) lin += fabs(P[i].c[k]);
+            else other += fabs(P[i].c[k]);
+        }
+        other += P[i].err;
     }
     out->lo = v3(r[0].lo, r[1].lo, r[2].lo);
     out->hi = v3(r[0].hi, r[1].hi, r[2].hi);
     out->flags = box_flags(out, flags);
+    out->bend = other == 0 ? 0.0f : lin > 0 ? (float)fmin(other / lin, 1e30) : 1e30f;
 }
 
 bool trace_surface_has_slopes(const trace_object *obj)
@@ -209,6 +217,7 @@ static void ia_camera_normal(const trace_object *obj, const ia_interval Nn[3],
 
 static void box_from_interval(const ia_interval P[3], trace_box *out)
 {
+    out->bend = 0.0f;
     out->lo = v3(P[0].lo, P[1].lo, P[2].lo);
     out->hi = v3(P[0].hi, P[1].hi, P[2].hi);
     out->flags = box_flags(out, P[0].flags | P[1].flags | P[2].flags);

@@ -18,8 +18,13 @@
 #define TRACE_SAMPLE_DEPTH 6
 
 /* Hit proofs (prove.h) are tried on cells whose box is at most this many
- * leaf tolerances (pixel footprints, for primary rays) wide. */
+ * leaf tolerances (pixel footprints, for primary rays) wide, and where the
+ * surface is nearly linear over the cell: its affine box's other terms at
+ * most this fraction of its u and v terms (trace_box.bend). Cells that
+ * bend more rarely pass the test (the wave: a few; dented: 1 in 10) and
+ * cost a slope run each (measured: docs/benchmarks.md, step 3). */
 #define TRACE_PROVE_CELLS 16.0
+#define TRACE_PROVE_BEND 0.05
 
 typedef struct walk {
     trace_thread *th;
@@ -349,6 +354,7 @@ static bool sample_stagnant(trace_thread *th, const trace_object *obj, const dou
     box->hi = v3_add(hi, v3(m, m, m));
     box->flags &= ~(unsigned)AA_DISCONTINUOUS;
     box->flags |= TRACE_BOX_SAMPLED;
+    box->bend = 1e30f;                /* no slopes there: no hit proofs */
     th->stats.sampled_boxes++;
     return true;
 }
@@ -448,6 +454,7 @@ static void visit(walk *w, const trace_box *node, const double r[4],
          * next to an estimate on the other opened cracks: tests/corpus,
          * mesh); at an edge of its own a proof draws it exactly */
         if (w->prove && !unbounded && !(kid->flags & AA_DISCONTINUOUS) &&
+            kid->bend <= TRACE_PROVE_BEND &&
             size <= TRACE_PROVE_CELLS * tol && size <= w->prove_below &&
             (!w->obj->shared_edges ||
              geom_uv_box_clear_of(&w->obj->surf, 2 * c[0] - c[1], 2 * c[1] - c[0],

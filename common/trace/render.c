@@ -17,6 +17,7 @@
 
 static void camera_bound(const trace_object *obj, const trace_box *b, trace_box *out)
 {
+    out->bend = 0.0f;
     if (b->flags & AA_UNBOUNDED || !isfinite(b->lo.x + b->lo.y + b->lo.z + b->hi.x + b->hi.y + b->hi.z)) {
         out->lo = v3(-INFINITY, -INFINITY, -INFINITY);
         out->hi = v3(INFINITY, INFINITY, INFINITY);
