@@ -1142,7 +1142,7 @@ static ia_interval noise_ia(int dim, const ia_interval *p, const int *period,
 }
 
 bool sl_noise_gradient_ia(int dim, const ia_interval *p, const int *period, int component,
-                          ia_interval *grad)
+                          ia_interval *value, ia_interval *grad)
 {
     if (!dim_ok(dim) || component < -1 || component > 2)
         return false;
@@ -1157,6 +1157,7 @@ bool sl_noise_gradient_ia(int dim, const ia_interval *p, const int *period, int 
         return false;
     for (int k = 0; k < dim; k++)
         grad[k] = ia_make(res.grad[k].lo, res.grad[k].hi);
+    *value = ia_with(res.range.lo, res.range.hi, flags);
     return true;
 }
 

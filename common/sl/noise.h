@@ -93,13 +93,15 @@ void sl_vnoise_ia(int dim, const ia_interval *p, ia_interval out[3]);
 void sl_vpnoise_ia(int dim, const ia_interval *p, const int *period,
                    ia_interval out[3]);
 void sl_vcellnoise_ia(int dim, const ia_interval *p, ia_interval out[3]);
-/* Bounds of d noise / d p[k] (k < dim) over the box p: noise or pnoise
- * (period NULL or not), component -1 for the scalar noise, 0..2 for those
- * of the vector noise. False where none are known (an unbounded or empty
- * input, a box over more than two lattice cells on an axis). The hull of
- * the jets' gradients over the box's cell pieces, as the range is made. */
+/* Bounds of d noise / d p[k] (k < dim) over the box p, and the value's
+ * (*value: as sl_noise_ia / sl_pnoise_ia / sl_vnoise_ia give it): noise or
+ * pnoise (period NULL or not), component -1 for the scalar noise, 0..2 for
+ * those of the vector noise. False where none are known (an unbounded or
+ * empty input, a box over more than two lattice cells on an axis). The
+ * hull of the jets' gradients over the box's cell pieces, as the range is
+ * made. */
 bool sl_noise_gradient_ia(int dim, const ia_interval *p, const int *period, int component,
-                          ia_interval *grad);
+                          ia_interval *value, ia_interval *grad);
 
 /* ---- affine mode (out may not alias p) ---- */
 void sl_noise_aa(aa_context *ctx, aa_form *out, int dim, const aa_form *p);
