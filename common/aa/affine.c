@@ -255,13 +255,55 @@ static inline int uflow_k(int k, double p, double v)
     return (k != FACTOR_EXACT) & (fabs(p) < 0x1p-1022) & (v != 0.0);
 }
 
+/* The coefficient loops of aa_lincomb: the symbols both operands use, then
+ * the rest of the longer one (no per-coefficient selects). track (a
+ * constant at each call) says whether any factor needs the products'
+ * rounding bookkeeping; add, sub and neg do without it. */
+static inline __attribute__((always_inline)) void
+lincomb_loops(int track, double a, const double *xc, int xn, double b,
+              const double *yc, int yn, double *zc, int ka, int kb,
+              double wa, double wb, double *es_out, double *ap_out, int *uf_out)
+{
+    int m = xn < yn ? xn : yn;
+    double es = 0.0, ap = 0.0;
+    int uf = 0;
+    for (int i = 0; i < m; i++) {
+        double xi = xc[i], yi = yc[i];
+        double p = a * xi, q = b * yi, s = p + q;
+        es += fabs(fp_two_sum_err(p, q, s));
+        if (track) {
+            ap += wa * fabs(p) + wb * fabs(q);
+            uf |= uflow_k(ka, p, xi) | uflow_k(kb, q, yi);
+        }
+        zc[i] = s;
+    }
+    for (int i = m; i < xn; i++) {
+        double xi = xc[i], p = a * xi;
+        if (track) {
+            ap += wa * fabs(p);
+            uf |= uflow_k(ka, p, xi);
+        }
+        zc[i] = p;
+    }
+    for (int i = m; i < yn; i++) {
+        double yi = yc[i], q = b * yi;
+        if (track) {
+            ap += wb * fabs(q);
+            uf |= uflow_k(kb, q, yi);
+        }
+        zc[i] = q;
+    }
+    *es_out = es;
+    *ap_out = ap;
+    *uf_out = uf;
+}
+
 /*
  * z = a*x + b*y + c. Coefficients in RN: the exact error of each sum from
  * TwoSum (so x - x is exactly 0), 2^-53 of each product by an inexact
  * factor, 2^-1075 per product that underflowed, all summed and bounded from
- * above once. The loops run over the symbols both operands use, then over
- * the rest of the longer one (no per-coefficient selects), and the rounding
- * bookkeeping a factor does not need is multiplied away (wa, wb are 0 or 1).
+ * above once (lincomb_loops; the bookkeeping a factor does not need is
+ * multiplied away: wa, wb are 0 or 1).
  */
 void aa_lincomb(aa_context *ctx, aa_form *z, double a, const aa_form *x,
                 double b, const aa_form *y, double c)
@@ -283,7 +325,7 @@ void aa_lincomb(aa_context *ctx, aa_form *z, double a, const aa_form *x,
     int ka = factor_kind(a), kb = factor_kind(b);
     double wa = ka == FACTOR_INEXACT ? 1.0 : 0.0, wb = kb == FACTOR_INEXACT ? 1.0 : 0.0;
     int xn = (a == 0.0) ? 0 : x->n, yn = (b == 0.0) ? 0 : y->n;
-    int m = xn < yn ? xn : yn, n = xn > yn ? xn : yn;
+    int n = xn > yn ? xn : yn;
     double x0 = x->x0, y0 = y->x0;
     double xe = a == 0.0 ? 0.0 : x->err, ye = b == 0.0 ? 0.0 : y->err;
     /* the hull a*[x] + b*[y] + c in RN: two products and two sums err by
@@ -308,28 +350,10 @@ void aa_lincomb(aa_context *ctx, aa_form *z, double a, const aa_form *x,
     double es = 0.0;      /* sum of exact errors of the additions */
     double ap = 0.0;      /* sum of |inexact products| */
     int uf = 0;           /* a product may have underflowed */
-    const double *xc = x->c, *yc = y->c;
-    double *zc = z->c;
-    for (int i = 0; i < m; i++) {
-        double xi = xc[i], yi = yc[i];
-        double p = a * xi, q = b * yi, s = p + q;
-        es += fabs(fp_two_sum_err(p, q, s));
-        ap += wa * fabs(p) + wb * fabs(q);
-        uf |= uflow_k(ka, p, xi) | uflow_k(kb, q, yi);
-        zc[i] = s;
-    }
-    for (int i = m; i < xn; i++) {
-        double xi = xc[i], p = a * xi;
-        ap += wa * fabs(p);
-        uf |= uflow_k(ka, p, xi);
-        zc[i] = p;
-    }
-    for (int i = m; i < yn; i++) {
-        double yi = yc[i], q = b * yi;
-        ap += wb * fabs(q);
-        uf |= uflow_k(kb, q, yi);
-        zc[i] = q;
-    }
+    if (ka == FACTOR_EXACT && kb == FACTOR_EXACT)      /* add, sub, neg */
+        lincomb_loops(0, a, x->c, xn, b, y->c, yn, z->c, 0, 0, 0, 0, &es, &ap, &uf);
+    else
+        lincomb_loops(1, a, x->c, xn, b, y->c, yn, z->c, ka, kb, wa, wb, &es, &ap, &uf);
     double p = a * x0, q = b * y0;
     double s1 = p + q, s2 = s1 + c;
     es += fabs(fp_two_sum_err(p, q, s1)) + fabs(fp_two_sum_err(s1, c, s2));

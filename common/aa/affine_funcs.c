@@ -93,8 +93,11 @@ static ia_interval g_bounds_on_piece(const convex_fn *fn, const ends_memo *m, do
     double t0 = fn->tangent_point(alpha, pc->p, pc->q, fn->arg);
     if (!(t0 >= pc->p && t0 <= pc->q))    /* NaN or outside: clamp */
         t0 = t0 < pc->p ? pc->p : (t0 > pc->q ? pc->q : 0.5 * (pc->p + pc->q));
-    ia_interval g0 = g_at(fn, m, alpha, t0);
-    ia_interval slope = ia_sub(fn->df(t0, fn->arg), ia_point(alpha));
+    ia_interval f0 = f_memo(fn, m, t0);
+    ia_interval g0 = ia_sub(f0, ia_mul_s(ia_point(t0), alpha));
+    /* exp is its own derivative: one libm call, not two */
+    ia_interval d0 = fn->df == fn->f ? f0 : fn->df(t0, fn->arg);
+    ia_interval slope = ia_sub(d0, ia_point(alpha));
     ia_interval lp = ia_add(g0, ia_mul(slope, ia_sub(ia_point(pc->p), ia_point(t0))));
     ia_interval lq = ia_add(g0, ia_mul(slope, ia_sub(ia_point(pc->q), ia_point(t0))));
     if (pc->convex > 0) {
@@ -260,18 +263,6 @@ static double t_recip(double al, double p, double q, const void *arg)
     (void)arg; (void)p;
     double m = sqrt(-1.0 / al);
     return q <= 0 ? -m : m;
-}
-
-static ia_interval f_sqrt(double t, const void *arg) { (void)arg; return ia_sqrt(ia_point(t)); }
-static ia_interval d_sqrt(double t, const void *arg)
-{
-    (void)arg;
-    return ia_recip(ia_mul_s(ia_sqrt(ia_point(t)), 2.0));
-}
-static double t_sqrt(double al, double p, double q, const void *arg)
-{
-    (void)p; (void)q; (void)arg;
-    return 0.25 / (al * al);
 }
 
 static ia_interval f_invsqrt(double t, const void *arg) { (void)arg; return ia_invsqrt(ia_point(t)); }
@@ -442,19 +433,37 @@ void aa_div(aa_context *ctx, aa_form *z, const aa_form *x, const aa_form *y)
     aa_mul(ctx, z, x, &inv);
 }
 
+/*
+ * sqrt in closed form (the Chebyshev scheme specialised, as aa_sqr): on
+ * [a, b], 0 <= a < b, alpha = 1/(sqrt(a) + sqrt(b)) (the secant slope, in
+ * RN; any alpha > 0 is sound). g(t) = sqrt(t) - alpha*t is concave, so its
+ * least value on [a, b] is at an end, and its largest over all t >= 0 is
+ * 1/(4 alpha), at t = 1/(4 alpha^2) (g' = 1/(2 sqrt t) - alpha = 0). sqrt
+ * is correctly rounded: one step each way encloses it.
+ */
 void aa_sqrt(aa_context *ctx, aa_form *z, const aa_form *x)
 {
     PRIVATE1(z, x, ia_sqrt);
     unsigned fl;
     ia_interval r = operand_range(x, &fl);
-    static const convex_fn fn = { f_sqrt, d_sqrt, t_sqrt, NULL };
     if (r.hi < 0 || !isfinite(r.hi)) {
         aa_set_interval(ctx, z, ia_sqrt(r), fl);
         return;
     }
-    double a = fmax(r.lo, 0.0);
-    piece pc = { a, r.hi, -1 };
-    approx_convex(ctx, z, x, &fn, &pc, 1, a, r.hi, ia_sqrt(r), fl);
+    double a = fmax(r.lo, 0.0), b = r.hi;
+    ia_interval fallback = ia_sqrt(r);
+    bool ok = a < b;
+    double alpha = 0.0, zeta = 0.0, delta = 0.0;
+    if (ok) {
+        double sa = sqrt(a), sb = sqrt(b);
+        alpha = 1.0 / (sa + sb);
+        double sa_dn = sa == 0.0 ? 0.0 : fp_next_down(sa), sb_dn = fp_next_down(sb);
+        double ga = fp_add_dn(sa_dn, -fp_mul_up(alpha, a));
+        double gb = fp_add_dn(sb_dn, -fp_mul_up(alpha, b));
+        ok = isfinite(alpha) && alpha > 0.0 &&
+             center_radius(ia_make(fmin(ga, gb), fp_div_up(0.25, alpha)), &zeta, &delta);
+    }
+    finish(ctx, z, x, ok, alpha, zeta, delta, fallback, fl);
 }
 
 void aa_invsqrt(aa_context *ctx, aa_form *z, const aa_form *x)
@@ -471,14 +480,39 @@ void aa_invsqrt(aa_context *ctx, aa_form *z, const aa_form *x)
     approx_convex(ctx, z, x, &fn, &pc, 1, r.lo, r.hi, ia_invsqrt(r), fl);
 }
 
+/*
+ * exp in closed form on finite [a, b], a < b: alpha = the secant slope (RN;
+ * any alpha > 0 is sound). g(t) = e^t - alpha*t is convex, so its largest
+ * value on [a, b] is at an end, and its least over all t is
+ * alpha*(1 - ln alpha), at t = ln alpha; ln alpha is enclosed as a libm
+ * result (AA_LIBM_ULPS). exp is increasing and ia_exp bounds each end on
+ * its own (the same libm call and clipping at a point as in the interval),
+ * so ia_exp([a, b]) is [exp(a).lo, exp(b).hi]: three libm calls in all.
+ */
 void aa_exp(aa_context *ctx, aa_form *z, const aa_form *x)
 {
     PRIVATE1(z, x, ia_exp);
     unsigned fl;
     ia_interval r = operand_range(x, &fl);
-    static const convex_fn fn = { f_exp, f_exp, t_exp, NULL };
-    piece pc = { r.lo, r.hi, +1 };
-    approx_convex(ctx, z, x, &fn, &pc, 1, r.lo, r.hi, ia_exp(r), fl);
+    if (!(isfinite(r.lo) && isfinite(r.hi) && r.lo < r.hi)) {
+        static const convex_fn fn = { f_exp, f_exp, t_exp, NULL };
+        piece pc = { r.lo, r.hi, +1 };
+        approx_convex(ctx, z, x, &fn, &pc, 1, r.lo, r.hi, ia_exp(r), fl);
+        return;
+    }
+    double a = r.lo, b = r.hi;
+    ia_interval fa = f_exp(a, NULL), fb = f_exp(b, NULL);
+    ia_interval fallback = ia_mk_(fa.lo, fb.hi, r.flags);
+    double alpha = (ia_mid(fb) - ia_mid(fa)) / (b - a), zeta = 0.0, delta = 0.0;
+    bool ok = isfinite(alpha) && alpha > 0.0;
+    if (ok) {
+        double ga = fp_add_up(fa.hi, -fp_mul_dn(alpha, a));
+        double gb = fp_add_up(fb.hi, -fp_mul_dn(alpha, b));
+        double ln_hi = fp_up_by(log(alpha), AA_LIBM_ULPS);
+        double glo = fp_mul_dn(alpha, fp_add_dn(1.0, -ln_hi));
+        ok = center_radius(ia_make(glo, fmax(ga, gb)), &zeta, &delta);
+    }
+    finish(ctx, z, x, ok, alpha, zeta, delta, fallback, fl);
 }
 
 void aa_log(aa_context *ctx, aa_form *z, const aa_form *x)

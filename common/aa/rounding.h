@@ -58,9 +58,21 @@ static inline double fp_next_down(double x)
     return -fp_next_up(-x);
 }
 
-/* x stepped k representable numbers up (k >= 0). */
+/* x stepped k representable numbers up (k >= 0). Binary64 numbers of one
+ * sign are ordered as their bit patterns, so for a finite nonzero x whose k
+ * steps cross neither 0 nor the largest double the result is k added to
+ * (x > 0) or taken from (x < 0) the bits: the same number as k single steps,
+ * without the loop (libm results take AA_LIBM_ULPS = 4 steps each way). */
 static inline double fp_up_by(double x, int k)
 {
+    uint64_t bits, mag;
+    memcpy(&bits, &x, sizeof bits);
+    mag = bits & 0x7fffffffffffffffull;
+    if (k > 0 && mag >= (uint64_t)k && mag + (uint64_t)k < 0x7ff0000000000000ull) {
+        bits = (bits >> 63) ? bits - (uint64_t)k : bits + (uint64_t)k;
+        memcpy(&x, &bits, sizeof bits);
+        return x;
+    }
     while (k-- > 0)
         x = fp_next_up(x);
     return x;
@@ -69,9 +81,7 @@ static inline double fp_up_by(double x, int k)
 /* x stepped k representable numbers down (k >= 0). */
 static inline double fp_down_by(double x, int k)
 {
-    while (k-- > 0)
-        x = fp_next_down(x);
-    return x;
+    return -fp_up_by(-x, k);
 }
 
 /*
