@@ -134,10 +134,10 @@ static bool center_radius(ia_interval g, double *zeta, double *delta)
  */
 static void finish(aa_context *ctx, aa_form *z, const aa_form *x, bool ok,
                    double alpha, double zeta, double delta,
-                   ia_interval fallback, unsigned flags)
+                   ia_interval fallback, unsigned flags, double xr)
 {
     if (ok) {
-        double w_aff = fp_add_up(fp_mul_up(fabs(alpha), aa_radius(x)), delta);
+        double w_aff = fp_add_up(fp_mul_up(fabs(alpha), xr), delta);
         double w_int = 0.5 * ia_width(fallback);
         if (isfinite(w_aff) && !(w_int * AA_MINRANGE_RATIO < w_aff)) {
             aa_apply_linear(ctx, z, x, alpha, zeta, delta, fallback, flags);
@@ -151,7 +151,7 @@ static void finish(aa_context *ctx, aa_form *z, const aa_form *x, bool ok,
 static void approx_convex(aa_context *ctx, aa_form *z, const aa_form *x,
                           const convex_fn *fn, const piece *pieces, int npieces,
                           double a, double b, ia_interval fallback,
-                          unsigned flags)
+                          unsigned flags, double xr)
 {
     double alpha, zeta = 0.0, delta = 0.0;
     bool ok = isfinite(a) && isfinite(b) && a <= b;
@@ -171,7 +171,7 @@ static void approx_convex(aa_context *ctx, aa_form *z, const aa_form *x,
     } else {
         ok = false;
     }
-    finish(ctx, z, x, ok, alpha, zeta, delta, fallback, flags);
+    finish(ctx, z, x, ok, alpha, zeta, delta, fallback, flags, xr);
 }
 
 /* Splits [a, b] at an exact inflection point s: convexity `below` left of
@@ -191,7 +191,7 @@ static void approx_taylor(aa_context *ctx, aa_form *z, const aa_form *x,
                           ia_interval (*f)(ia_interval),
                           ia_interval (*df)(ia_interval), ia_interval f2,
                           double a, double b, ia_interval fallback,
-                          unsigned flags)
+                          unsigned flags, double xr)
 {
     bool ok = isfinite(a) && isfinite(b) && a < b && isfinite(f2.lo) &&
               isfinite(f2.hi);
@@ -202,12 +202,19 @@ static void approx_taylor(aa_context *ctx, aa_form *z, const aa_form *x,
         ia_interval dc = df(ia_point(c));
         alpha = ia_mid(dc);
         ia_interval gc = ia_sub(f(ia_point(c)), ia_mul_s(ia_point(c), alpha));
-        ia_interval lin = ia_mul(ia_sub(dc, ia_point(alpha)), ia_make(-r, r));
-        ia_interval half_sq = ia_make(0.0, fp_mul_up(0.5, fp_mul_up(r, r)));
-        ia_interval g = ia_add(ia_add(gc, lin), ia_mul(f2, half_sq));
+        /* the two interval products of the remainder in closed form, the
+         * same numbers ia_mul gives: d*[-r, r] = +-r*max|d|, and
+         * f2*[0, h] = [min(0, f2.lo*h), max(0, f2.hi*h)] (directed
+         * products are monotone in each factor) */
+        ia_interval d = ia_sub(dc, ia_point(alpha));
+        double lr = fp_mul_up(fmax(fabs(d.lo), fabs(d.hi)), r);
+        double h = fp_mul_up(0.5, fp_mul_up(r, r));
+        ia_interval rem = ia_make(f2.lo < 0.0 ? fp_mul_dn(f2.lo, h) : 0.0,
+                                  f2.hi > 0.0 ? fp_mul_up(f2.hi, h) : 0.0);
+        ia_interval g = ia_add(ia_add(gc, ia_make(-lr, lr)), rem);
         ok = isfinite(alpha) && center_radius(g, &zeta, &delta);
     }
-    finish(ctx, z, x, ok, alpha, zeta, delta, fallback, flags);
+    finish(ctx, z, x, ok, alpha, zeta, delta, fallback, flags, xr);
 }
 
 /*
@@ -242,10 +249,11 @@ static void private_result(aa_form *z, ia_interval r)
     } while (0)
 
 /* The operand's range, with the flags the result inherits. */
-static ia_interval operand_range(const aa_form *x, unsigned *flags)
+static ia_interval operand_range(const aa_form *x, unsigned *flags, double *rad)
 {
     *flags = x->flags & ~AA_UNBOUNDED;
-    return aa_range(x);
+    *rad = aa_radius(x);
+    return aa_range_r(x, *rad);
 }
 
 /* ---------------------------------------------------------------------- */
@@ -394,7 +402,8 @@ void aa_sqr(aa_context *ctx, aa_form *z, const aa_form *x)
 {
     PRIVATE1(z, x, ia_sqr);
     unsigned fl;
-    ia_interval r = operand_range(x, &fl);
+    double xr;
+    ia_interval r = operand_range(x, &fl, &xr);
     double a = r.lo, b = r.hi;
     bool ok = isfinite(a) && isfinite(b) && a < b;
     double alpha = 0.0, zeta = 0.0, delta = 0.0;
@@ -405,21 +414,22 @@ void aa_sqr(aa_context *ctx, aa_form *z, const aa_form *x)
         double glo = -fp_mul_up(fp_mul_up(alpha, alpha), 0.25);
         ok = isfinite(alpha) && center_radius(ia_make(glo, fmax(ga, gb)), &zeta, &delta);
     }
-    finish(ctx, z, x, ok, alpha, zeta, delta, ia_sqr(r), fl);
+    finish(ctx, z, x, ok, alpha, zeta, delta, ia_sqr(r), fl, xr);
 }
 
 void aa_recip(aa_context *ctx, aa_form *z, const aa_form *x)
 {
     PRIVATE1(z, x, ia_recip);
     unsigned fl;
-    ia_interval r = operand_range(x, &fl);
+    double xr;
+    ia_interval r = operand_range(x, &fl, &xr);
     static const convex_fn fn = { f_recip, d_recip, t_recip, NULL };
     if (r.lo <= 0 && r.hi >= 0) {
         aa_unbounded(z, fl);
         return;
     }
     piece pc = { r.lo, r.hi, r.lo > 0 ? +1 : -1 };
-    approx_convex(ctx, z, x, &fn, &pc, 1, r.lo, r.hi, ia_recip(r), fl);
+    approx_convex(ctx, z, x, &fn, &pc, 1, r.lo, r.hi, ia_recip(r), fl, xr);
 }
 
 void aa_div(aa_context *ctx, aa_form *z, const aa_form *x, const aa_form *y)
@@ -445,7 +455,8 @@ void aa_sqrt(aa_context *ctx, aa_form *z, const aa_form *x)
 {
     PRIVATE1(z, x, ia_sqrt);
     unsigned fl;
-    ia_interval r = operand_range(x, &fl);
+    double xr;
+    ia_interval r = operand_range(x, &fl, &xr);
     if (r.hi < 0 || !isfinite(r.hi)) {
         aa_set_interval(ctx, z, ia_sqrt(r), fl);
         return;
@@ -463,21 +474,22 @@ void aa_sqrt(aa_context *ctx, aa_form *z, const aa_form *x)
         ok = isfinite(alpha) && alpha > 0.0 &&
              center_radius(ia_make(fmin(ga, gb), fp_div_up(0.25, alpha)), &zeta, &delta);
     }
-    finish(ctx, z, x, ok, alpha, zeta, delta, fallback, fl);
+    finish(ctx, z, x, ok, alpha, zeta, delta, fallback, fl, xr);
 }
 
 void aa_invsqrt(aa_context *ctx, aa_form *z, const aa_form *x)
 {
     PRIVATE1(z, x, ia_invsqrt);
     unsigned fl;
-    ia_interval r = operand_range(x, &fl);
+    double xr;
+    ia_interval r = operand_range(x, &fl, &xr);
     static const convex_fn fn = { f_invsqrt, d_invsqrt, t_invsqrt, NULL };
     if (r.lo <= 0) {                       /* pole at 0 or out of domain */
         aa_set_interval(ctx, z, ia_invsqrt(r), fl);
         return;
     }
     piece pc = { r.lo, r.hi, +1 };
-    approx_convex(ctx, z, x, &fn, &pc, 1, r.lo, r.hi, ia_invsqrt(r), fl);
+    approx_convex(ctx, z, x, &fn, &pc, 1, r.lo, r.hi, ia_invsqrt(r), fl, xr);
 }
 
 /*
@@ -493,11 +505,12 @@ void aa_exp(aa_context *ctx, aa_form *z, const aa_form *x)
 {
     PRIVATE1(z, x, ia_exp);
     unsigned fl;
-    ia_interval r = operand_range(x, &fl);
+    double xr;
+    ia_interval r = operand_range(x, &fl, &xr);
     if (!(isfinite(r.lo) && isfinite(r.hi) && r.lo < r.hi)) {
         static const convex_fn fn = { f_exp, f_exp, t_exp, NULL };
         piece pc = { r.lo, r.hi, +1 };
-        approx_convex(ctx, z, x, &fn, &pc, 1, r.lo, r.hi, ia_exp(r), fl);
+        approx_convex(ctx, z, x, &fn, &pc, 1, r.lo, r.hi, ia_exp(r), fl, xr);
         return;
     }
     double a = r.lo, b = r.hi;
@@ -512,21 +525,22 @@ void aa_exp(aa_context *ctx, aa_form *z, const aa_form *x)
         double glo = fp_mul_dn(alpha, fp_add_dn(1.0, -ln_hi));
         ok = center_radius(ia_make(glo, fmax(ga, gb)), &zeta, &delta);
     }
-    finish(ctx, z, x, ok, alpha, zeta, delta, fallback, fl);
+    finish(ctx, z, x, ok, alpha, zeta, delta, fallback, fl, xr);
 }
 
 void aa_log(aa_context *ctx, aa_form *z, const aa_form *x)
 {
     PRIVATE1(z, x, ia_log);
     unsigned fl;
-    ia_interval r = operand_range(x, &fl);
+    double xr;
+    ia_interval r = operand_range(x, &fl, &xr);
     static const convex_fn fn = { f_log, d_log, t_log, NULL };
     if (r.lo <= 0) {
         aa_set_interval(ctx, z, ia_log(r), fl);
         return;
     }
     piece pc = { r.lo, r.hi, -1 };
-    approx_convex(ctx, z, x, &fn, &pc, 1, r.lo, r.hi, ia_log(r), fl);
+    approx_convex(ctx, z, x, &fn, &pc, 1, r.lo, r.hi, ia_log(r), fl, xr);
 }
 
 void aa_pow_int(aa_context *ctx, aa_form *z, const aa_form *x, int n)
@@ -551,7 +565,8 @@ void aa_pow_int(aa_context *ctx, aa_form *z, const aa_form *x, int n)
         return;
     }
     unsigned fl;
-    ia_interval r = operand_range(x, &fl);
+    double xr;
+    ia_interval r = operand_range(x, &fl, &xr);
     ia_interval fallback = ia_pow_int(r, n);
     if (n < -(1 << 20) || n > (1 << 20) || (n < 0 && r.lo <= 0 && r.hi >= 0)) {
         aa_set_interval(ctx, z, fallback, fl);
@@ -566,7 +581,7 @@ void aa_pow_int(aa_context *ctx, aa_form *z, const aa_form *x, int n)
                  : split_at(r.lo, r.hi, 0.0, -1, pcs);
     else              /* t > 0 convex; t < 0: convex if even, concave if odd */
         k = (pcs[0] = (piece){ r.lo, r.hi, (r.lo > 0 || even) ? +1 : -1 }, 1);
-    approx_convex(ctx, z, x, &fn, pcs, k, r.lo, r.hi, fallback, fl);
+    approx_convex(ctx, z, x, &fn, pcs, k, r.lo, r.hi, fallback, fl, xr);
 }
 
 static bool is_int_value(double v, int *n)
@@ -588,7 +603,8 @@ void aa_pow(aa_context *ctx, aa_form *z, const aa_form *x, const aa_form *y)
     }
     PRIVATE2(z, x, y, ia_pow);
     unsigned fl = (x->flags | y->flags) & ~AA_UNBOUNDED;
-    ia_interval rx = aa_range(x), ry = aa_range(y);
+    double xr = aa_radius(x);
+    ia_interval rx = aa_range_r(x, xr), ry = aa_range(y);
     ia_interval fallback = ia_pow(rx, ry);
     if (aa_is_point(y)) {
         double e = y->x0;
@@ -599,7 +615,7 @@ void aa_pow(aa_context *ctx, aa_form *z, const aa_form *x, const aa_form *y)
         double a = fmax(rx.lo, 0.0);
         convex_fn fn = { f_powr, d_powr, t_powr, &e };
         piece pc = { a, rx.hi, (e > 1.0 || e < 0.0) ? +1 : -1 };
-        approx_convex(ctx, z, x, &fn, &pc, 1, a, rx.hi, fallback, fl);
+        approx_convex(ctx, z, x, &fn, &pc, 1, a, rx.hi, fallback, fl, xr);
         return;
     }
     if (rx.lo > 0 && isfinite(rx.hi)) {   /* x^y = exp(y log x) */
@@ -621,20 +637,22 @@ void aa_sin(aa_context *ctx, aa_form *z, const aa_form *x)
 {
     PRIVATE1(z, x, ia_sin);
     unsigned fl;
-    ia_interval r = operand_range(x, &fl);
+    double xr;
+    ia_interval r = operand_range(x, &fl, &xr);
     ia_interval fallback = ia_sin(r);
     approx_taylor(ctx, z, x, ia_sin, ia_cos, ia_neg(fallback), r.lo, r.hi,
-                  fallback, fl);
+                  fallback, fl, xr);
 }
 
 void aa_cos(aa_context *ctx, aa_form *z, const aa_form *x)
 {
     PRIVATE1(z, x, ia_cos);
     unsigned fl;
-    ia_interval r = operand_range(x, &fl);
+    double xr;
+    ia_interval r = operand_range(x, &fl, &xr);
     ia_interval fallback = ia_cos(r);
     approx_taylor(ctx, z, x, ia_cos, neg_sin, ia_neg(fallback), r.lo, r.hi,
-                  fallback, fl);
+                  fallback, fl, xr);
 }
 
 /* tan' = 1 + tan^2 */
@@ -647,7 +665,8 @@ void aa_tan(aa_context *ctx, aa_form *z, const aa_form *x)
 {
     PRIVATE1(z, x, ia_tan);
     unsigned fl;
-    ia_interval r = operand_range(x, &fl);
+    double xr;
+    ia_interval r = operand_range(x, &fl, &xr);
     ia_interval fallback = ia_tan(r);
     if (fallback.flags & AA_UNBOUNDED) {  /* a pole: whole line, flagged */
         aa_unbounded(z, fl | fallback.flags);
@@ -655,14 +674,15 @@ void aa_tan(aa_context *ctx, aa_form *z, const aa_form *x)
     }
     /* tan'' = 2 tan (1 + tan^2) */
     ia_interval f2 = ia_mul_s(ia_mul(fallback, d_tan(r)), 2.0);
-    approx_taylor(ctx, z, x, ia_tan, d_tan, f2, r.lo, r.hi, fallback, fl);
+    approx_taylor(ctx, z, x, ia_tan, d_tan, f2, r.lo, r.hi, fallback, fl, xr);
 }
 
 void aa_asin(aa_context *ctx, aa_form *z, const aa_form *x)
 {
     PRIVATE1(z, x, ia_asin);
     unsigned fl;
-    ia_interval r = operand_range(x, &fl);
+    double xr;
+    ia_interval r = operand_range(x, &fl, &xr);
     ia_interval fallback = ia_asin(r);
     if (ia_is_empty(fallback)) {
         aa_unbounded(z, fl);
@@ -672,14 +692,15 @@ void aa_asin(aa_context *ctx, aa_form *z, const aa_form *x)
     static const convex_fn fn = { f_asin, d_asin, t_asin, NULL };
     piece pcs[2];
     int k = split_at(a, b, 0.0, -1, pcs);   /* concave below 0 */
-    approx_convex(ctx, z, x, &fn, pcs, k, a, b, fallback, fl);
+    approx_convex(ctx, z, x, &fn, pcs, k, a, b, fallback, fl, xr);
 }
 
 void aa_acos(aa_context *ctx, aa_form *z, const aa_form *x)
 {
     PRIVATE1(z, x, ia_acos);
     unsigned fl;
-    ia_interval r = operand_range(x, &fl);
+    double xr;
+    ia_interval r = operand_range(x, &fl, &xr);
     ia_interval fallback = ia_acos(r);
     if (ia_is_empty(fallback)) {
         aa_unbounded(z, fl);
@@ -689,18 +710,19 @@ void aa_acos(aa_context *ctx, aa_form *z, const aa_form *x)
     static const convex_fn fn = { f_acos, d_acos, t_asin, NULL };
     piece pcs[2];
     int k = split_at(a, b, 0.0, +1, pcs);   /* convex below 0 */
-    approx_convex(ctx, z, x, &fn, pcs, k, a, b, fallback, fl);
+    approx_convex(ctx, z, x, &fn, pcs, k, a, b, fallback, fl, xr);
 }
 
 void aa_atan(aa_context *ctx, aa_form *z, const aa_form *x)
 {
     PRIVATE1(z, x, ia_atan);
     unsigned fl;
-    ia_interval r = operand_range(x, &fl);
+    double xr;
+    ia_interval r = operand_range(x, &fl, &xr);
     static const convex_fn fn = { f_atan, d_atan, t_atan, NULL };
     piece pcs[2];
     int k = split_at(r.lo, r.hi, 0.0, +1, pcs);  /* convex below 0 */
-    approx_convex(ctx, z, x, &fn, pcs, k, r.lo, r.hi, ia_atan(r), fl);
+    approx_convex(ctx, z, x, &fn, pcs, k, r.lo, r.hi, ia_atan(r), fl, xr);
 }
 
 /* z = w + [c.lo, c.hi] for a constant known only as an interval (pi/2) */
@@ -759,7 +781,8 @@ void aa_abs(aa_context *ctx, aa_form *z, const aa_form *x)
 {
     PRIVATE1(z, x, ia_abs);
     unsigned fl;
-    ia_interval r = operand_range(x, &fl);
+    double xr;
+    ia_interval r = operand_range(x, &fl, &xr);
     if (r.lo >= 0) {
         if (z != x)
             *z = *x;
@@ -781,7 +804,7 @@ void aa_abs(aa_context *ctx, aa_form *z, const aa_form *x)
     ia_interval g = ia_make(0.0, fmax(ga.hi, gb.hi));
     double zeta, delta;
     bool ok = center_radius(g, &zeta, &delta);
-    finish(ctx, z, x, ok, alpha, zeta, delta, fallback, fl);
+    finish(ctx, z, x, ok, alpha, zeta, delta, fallback, fl, xr);
 }
 
 /* min(x, y) = (x + y - |x - y|)/2, max(x, y) = (x + y + |x - y|)/2 */
@@ -888,11 +911,12 @@ void aa_smoothstep(aa_context *ctx, aa_form *z, const aa_form *e0,
     aa_const(&w, e1->x0);
     aa_add_s(ctx, &w, &w, -e0->x0);      /* e1 - e0, rounding in w.err */
     aa_div(ctx, &t, &t, &w);
-    ia_interval rt = aa_range(&t);
+    double tr = aa_radius(&t);
+    ia_interval rt = aa_range_r(&t, tr);
     static const convex_fn fn = { f_ramp, d_ramp, t_ramp, NULL };
     piece pcs[2];
     int k = split_at(rt.lo, rt.hi, 0.5, +1, pcs);   /* convex below 1/2 */
-    approx_convex(ctx, z, &t, &fn, pcs, k, rt.lo, rt.hi, fallback, fl);
+    approx_convex(ctx, z, &t, &fn, pcs, k, rt.lo, rt.hi, fallback, fl, tr);
 }
 
 /* ---------------------------------------------------------------------- */
@@ -909,7 +933,8 @@ static void stepped(aa_context *ctx, aa_form *z, const aa_form *x,
                     ia_interval (*fi)(ia_interval), double offset)
 {
     unsigned fl;
-    ia_interval r = operand_range(x, &fl);
+    double xr;
+    ia_interval r = operand_range(x, &fl, &xr);
     ia_interval v = fi(r);
     if (v.lo == v.hi && isfinite(v.lo)) {      /* no jump inside */
         aa_const(z, v.lo);
@@ -930,7 +955,8 @@ void aa_round(aa_context *ctx, aa_form *z, const aa_form *x) { stepped(ctx, z, x
 void aa_sign(aa_context *ctx, aa_form *z, const aa_form *x)
 {
     unsigned fl;
-    ia_interval r = operand_range(x, &fl);
+    double xr;
+    ia_interval r = operand_range(x, &fl, &xr);
     ia_interval v = ia_sign(r);
     if (v.lo == v.hi) {
         aa_const(z, v.lo);

@@ -317,10 +317,12 @@ ia_interval ia_sin(ia_interval x)
         return mk(-1.0, 1.0, x.flags & ~AA_UNBOUNDED);
     double sa = sin(x.lo), sb = x.hi == x.lo ? sa : sin(x.hi);
     double lo = lm_dn(min2(sa, sb)), hi = lm_up(max2(sa, sb));
-    if (may_contain_lattice(x.lo, x.hi, M_PI_2, 2 * M_PI))
-        hi = 1.0;
-    if (may_contain_lattice(x.lo, x.hi, -M_PI_2, 2 * M_PI))
-        lo = -1.0;
+    if (x.lo != x.hi) {   /* a point has no inner extremum: libm's value, widened */
+        if (may_contain_lattice(x.lo, x.hi, M_PI_2, 2 * M_PI))
+            hi = 1.0;
+        if (may_contain_lattice(x.lo, x.hi, -M_PI_2, 2 * M_PI))
+            lo = -1.0;
+    }
     return mk(max2(lo, -1.0), min2(hi, 1.0), x.flags);
 }
 
@@ -332,10 +334,12 @@ ia_interval ia_cos(ia_interval x)
         return mk(-1.0, 1.0, x.flags & ~AA_UNBOUNDED);
     double ca = cos(x.lo), cb = x.hi == x.lo ? ca : cos(x.hi);
     double lo = lm_dn(min2(ca, cb)), hi = lm_up(max2(ca, cb));
-    if (may_contain_lattice(x.lo, x.hi, 0.0, 2 * M_PI))
-        hi = 1.0;
-    if (may_contain_lattice(x.lo, x.hi, M_PI, 2 * M_PI))
-        lo = -1.0;
+    if (x.lo != x.hi) {   /* a point has no inner extremum: libm's value, widened */
+        if (may_contain_lattice(x.lo, x.hi, 0.0, 2 * M_PI))
+            hi = 1.0;
+        if (may_contain_lattice(x.lo, x.hi, M_PI, 2 * M_PI))
+            lo = -1.0;
+    }
     return mk(max2(lo, -1.0), min2(hi, 1.0), x.flags);
 }
 
