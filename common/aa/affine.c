@@ -303,12 +303,13 @@ lincomb_loops(int track, double a, const double *xc, int xn, double b,
  * TwoSum (so x - x is exactly 0), 2^-53 of each product by an inexact
  * factor, 2^-1075 per product that underflowed, all summed and bounded from
  * above once (lincomb_loops; the bookkeeping a factor does not need is
- * multiplied away: wa, wb are 0 or 1).
+ * multiplied away: wa, wb are 0 or 1). want_hull false leaves the hull
+ * [-inf, inf] for a caller that sets its own (aa_apply_linear, aa_merge).
  */
-void aa_lincomb(aa_context *ctx, aa_form *z, double a, const aa_form *x,
-                double b, const aa_form *y, double c)
+static inline __attribute__((always_inline)) void
+lincomb(aa_form *z, double a, const aa_form *x, double b, const aa_form *y, double c,
+        bool want_hull)
 {
-    (void)ctx;
     static const aa_form zero = { .x0 = 0.0 };
     if (y == NULL) {
         y = &zero;
@@ -333,19 +334,25 @@ void aa_lincomb(aa_context *ctx, aa_form *z, double a, const aa_form *x,
      * underflow; hb = fp_rounding_bound(3 * that) is at least twice it.
      * Moving the RN end out by 2*hb, itself in RN, errs by at most
      * u*(|end| + 2*hb) <= hb more, so the end moves out by >= hb. */
-    double l1 = 0.0, h1 = 0.0, l2 = 0.0, h2 = 0.0;
-    int huf = 0;
-    if (a != 0.0) {
-        scale_ends(a, x->lo, x->hi, &l1, &h1);
-        huf |= uflow_k(ka, l1, a > 0.0 ? x->lo : x->hi) | uflow_k(ka, h1, a > 0.0 ? x->hi : x->lo);
+    double hlo = -INFINITY, hhi = INFINITY;
+    if (want_hull) {
+        double l1 = 0.0, h1 = 0.0, l2 = 0.0, h2 = 0.0;
+        int huf = 0;
+        if (a != 0.0) {
+            scale_ends(a, x->lo, x->hi, &l1, &h1);
+            huf |= uflow_k(ka, l1, a > 0.0 ? x->lo : x->hi) |
+                   uflow_k(ka, h1, a > 0.0 ? x->hi : x->lo);
+        }
+        if (b != 0.0) {
+            scale_ends(b, y->lo, y->hi, &l2, &h2);
+            huf |= uflow_k(kb, l2, b > 0.0 ? y->lo : y->hi) |
+                   uflow_k(kb, h2, b > 0.0 ? y->hi : y->lo);
+        }
+        double hb = 2.0 * fp_rounding_bound(3.0 * (fabs(l1) + fabs(h1) + fabs(l2) + fabs(h2) +
+                                                   fabs(c)), huf);
+        hlo = (l1 + l2 + c) - hb;
+        hhi = (h1 + h2 + c) + hb;
     }
-    if (b != 0.0) {
-        scale_ends(b, y->lo, y->hi, &l2, &h2);
-        huf |= uflow_k(kb, l2, b > 0.0 ? y->lo : y->hi) | uflow_k(kb, h2, b > 0.0 ? y->hi : y->lo);
-    }
-    double hb = 2.0 * fp_rounding_bound(3.0 * (fabs(l1) + fabs(h1) + fabs(l2) + fabs(h2) + fabs(c)),
-                                        huf);
-    double hlo = (l1 + l2 + c) - hb, hhi = (h1 + h2 + c) + hb;
 
     double es = 0.0;      /* sum of exact errors of the additions */
     double ap = 0.0;      /* sum of |inexact products| */
@@ -375,6 +382,13 @@ void aa_lincomb(aa_context *ctx, aa_form *z, double a, const aa_form *x,
     z->flags = (unsigned short)flags;
     if (!isfinite(s2) || !isfinite(err))
         aa_unbounded(z, flags);
+}
+
+void aa_lincomb(aa_context *ctx, aa_form *z, double a, const aa_form *x,
+                double b, const aa_form *y, double c)
+{
+    (void)ctx;
+    lincomb(z, a, x, b, y, c, true);
 }
 
 /*
@@ -493,7 +507,7 @@ void aa_apply_linear(aa_context *ctx, aa_form *z, const aa_form *x,
                      double alpha, double zeta, double delta, ia_interval hull,
                      unsigned flags)
 {
-    aa_lincomb(ctx, z, alpha, x, 0.0, NULL, zeta);
+    lincomb(z, alpha, x, 0.0, NULL, zeta, false);    /* the hull is given */
     if (!(z->flags & AA_UNBOUNDED)) {
         z->lo = hull.lo;
         z->hi = hull.hi;
@@ -628,8 +642,8 @@ void aa_merge(aa_context *ctx, aa_form *z, const aa_form *x, const aa_form *y)
     }
     aa_form d;
     ia_interval hull = ia_hull(aa_range(x), aa_range(y));
-    aa_lincomb(ctx, &d, 0.5, x, -0.5, y, 0.0);
-    aa_lincomb(ctx, z, 0.5, x, 0.5, y, 0.0);
+    lincomb(&d, 0.5, x, -0.5, y, 0.0, false);
+    lincomb(z, 0.5, x, 0.5, y, 0.0, false);
     z->lo = hull.lo;
     z->hi = hull.hi;
     z->flags = (unsigned short)(flags & ~AA_UNBOUNDED);
