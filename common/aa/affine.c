@@ -421,23 +421,33 @@ void aa_lincomb3(aa_context *ctx, aa_form *z, const double m[3], const aa_form x
     }
     flags &= ~AA_UNBOUNDED;
 
-    for (int j = 0; j < n; j++)
-        z->c[j] = 0.0;
     double terms = 0.0, x0 = c, centre = fabs(c), perr = 0.0;
     double lo = c, hi = c, hull = fabs(c);
     int uf = 0, cuf = 0, huf = 0;
+    int zn = 0;                   /* z->c[0..zn) hold partial sums; n at the end */
+    double *zc = z->c;
     for (int k = 0; k < 3; k++) {
         double a = m[k];
         if (a == 0.0)
             continue;
         const aa_form *xk = &x[k];
+        const double *xc = xk->c;
+        int xn = xk->n, both = xn < zn ? xn : zn;
         double R = 0.0;
-        for (int j = 0; j < xk->n; j++) {
-            double p = a * xk->c[j];
-            z->c[j] += p;
-            R += fabs(xk->c[j]);
-            uf += fp_uflow(p, a, xk->c[j]);
+        for (int j = 0; j < both; j++) {        /* add to the partial sums */
+            double v = xc[j], p = a * v;
+            zc[j] += p;
+            R += fabs(v);
+            uf |= (fabs(p) < 0x1p-1022) & (v != 0.0);
         }
+        for (int j = both; j < xn; j++) {       /* the first term of these */
+            double v = xc[j], p = a * v;
+            zc[j] = p;
+            R += fabs(v);
+            uf |= (fabs(p) < 0x1p-1022) & (v != 0.0);
+        }
+        if (xn > zn)
+            zn = xn;
         double fa = fabs(a);
         terms += fa * R;
         double p = a * xk->x0;

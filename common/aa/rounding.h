@@ -35,10 +35,19 @@
 #define AA_PI_2_LO 0x1.921fb54442d18p+0
 #define AA_PI_2_HI 0x1.921fb54442d19p+0
 
-/* The next representable double above x (+inf stays +inf, NaN stays NaN). */
+/* The next representable double above x (+inf stays +inf, NaN stays NaN).
+ * Doubles of one sign are ordered as their bit patterns, so for finite
+ * nonzero x the answer is the bits plus one (x > 0) or minus one (x < 0):
+ * one integer test for the usual case instead of three comparisons. */
 static inline double fp_next_up(double x)
 {
     uint64_t bits;
+    memcpy(&bits, &x, sizeof bits);
+    if ((bits & 0x7fffffffffffffffull) - 1u < 0x7fefffffffffffffull) {
+        bits += (bits >> 63) ? ~(uint64_t)0 : 1u;
+        memcpy(&x, &bits, sizeof bits);
+        return x;
+    }
     if (x != x || x == INFINITY)
         return x;
     if (x == 0.0)
