@@ -132,9 +132,17 @@ static inline double fp_add_up(double a, double b)
 
 static inline double fp_mul_dn(double a, double b)
 {
+    double p = a * b;
+    uint64_t bits;
+    memcpy(&bits, &p, sizeof bits);
+    if ((bits & 0x7fffffffffffffffull) - 1u < 0x7fefffffffffffffull) {
+        /* finite nonzero: no zero operand, no overflow; one step down */
+        bits += (bits >> 63) ? 1u : ~(uint64_t)0;
+        memcpy(&p, &bits, sizeof bits);
+        return p;
+    }
     if (a == 0.0 || b == 0.0)
         return 0.0;
-    double p = a * b;
     if (isinf(p) && isfinite(a) && isfinite(b))
         return p > 0 ? 0x1.fffffffffffffp+1023 : -INFINITY;
     return fp_next_down(p);
