@@ -144,6 +144,22 @@ void aa_from_interval(aa_context *ctx, aa_form *z, ia_interval x)
  * result, so the exact sum is at most the computed one times (1 + 2^-53)^n,
  * which (n + 1) * 2^-53 relative, stepped up, covers. A form with one term
  * (an input, a fresh min-range result) comes back exactly. */
+/* The end of aa_radius, from the RN sum r of the |xi| (in symbol order)
+ * and the count of nonzero ones; shared with aa_mul, which sums them in
+ * its own loop. */
+static double radius_from_sum(const aa_form *x, double r, int terms)
+{
+    if (x->err != 0.0) {
+        r += x->err;
+        terms++;
+    }
+    if (terms <= 1)
+        return r;
+    if (!(r >= 0x1p-960))              /* no subnormal products (rounding.h) */
+        return r != r ? r : 0x1p-958;
+    return fp_next_up(r + r * ((double)(terms + 1) * 0x1p-53));
+}
+
 double aa_radius(const aa_form *x)
 {
     if (x->flags & AA_UNBOUNDED)
@@ -156,15 +172,7 @@ double aa_radius(const aa_form *x)
         r += a;
         terms += a != 0.0;
     }
-    if (x->err != 0.0) {
-        r += x->err;
-        terms++;
-    }
-    if (terms <= 1)
-        return r;
-    if (!(r >= 0x1p-960))              /* no subnormal products (rounding.h) */
-        return r != r ? r : 0x1p-958;
-    return fp_next_up(r + r * ((double)(terms + 1) * 0x1p-53));
+    return radius_from_sum(x, r, terms);
 }
 
 ia_interval aa_range_r(const aa_form *x, double r)
@@ -563,12 +571,11 @@ void aa_mul(aa_context *ctx, aa_form *z, const aa_form *x, const aa_form *y)
         aa_unbounded(z, flags);
         return;
     }
-    double rx = aa_radius(x), ry = aa_radius(y);
-    ia_interval hull = ia_mul(aa_range_r(x, rx), aa_range_r(y, ry));
     if (x->n == 0 && y->n == 0) {         /* no shared symbols: see affine_funcs.c */
+        ia_interval r = ia_mul(aa_range(x), aa_range(y));
         aa_context none;
         aa_context_init(&none, 0);
-        aa_set_interval(&none, z, hull, hull.flags);
+        aa_set_interval(&none, z, r, r.flags);
         return;
     }
     int xn = x->n, yn = y->n;
@@ -577,9 +584,11 @@ void aa_mul(aa_context *ctx, aa_form *z, const aa_form *x, const aa_form *y)
     const double *xc = x->c, *yc = y->c;
     double *zc = z->c;
 
-    /* as aa_lincomb: the symbols both use, then the rest of the longer */
-    double es = 0.0, ap = 0.0, dsum = 0.0, dabs = 0.0;
-    int uf = 0;
+    /* as aa_lincomb: the symbols both use, then the rest of the longer;
+     * the operands' radii are summed on the way (in symbol order, the
+     * same numbers as aa_radius) */
+    double es = 0.0, ap = 0.0, dsum = 0.0, dabs = 0.0, sx = 0.0, sy = 0.0;
+    int uf = 0, tx = 0, ty = 0;
     for (int i = 0; i < m; i++) {
         double xi = xc[i], yi = yc[i];
         double p = x0 * yi, q = y0 * xi, s = p + q;
@@ -588,21 +597,32 @@ void aa_mul(aa_context *ctx, aa_form *z, const aa_form *x, const aa_form *y)
         ap += fabs(p) + fabs(q);
         dsum += d;
         dabs += fabs(d);
+        sx += fabs(xi);
+        sy += fabs(yi);
+        tx += xi != 0.0;
+        ty += yi != 0.0;
         uf |= fp_uflow(p, x0, yi) | fp_uflow(q, y0, xi) | fp_uflow(d, xi, yi);
         zc[i] = s;
     }
     for (int i = m; i < xn; i++) {        /* yi = 0: p = 0, d = 0 */
         double xi = xc[i], q = y0 * xi;
         ap += fabs(q);
+        sx += fabs(xi);
+        tx += xi != 0.0;
         uf |= fp_uflow(q, y0, xi);
         zc[i] = q;
     }
     for (int i = m; i < yn; i++) {        /* xi = 0 */
         double yi = yc[i], p = x0 * yi;
         ap += fabs(p);
+        sy += fabs(yi);
+        ty += yi != 0.0;
         uf |= fp_uflow(p, x0, yi);
         zc[i] = p;
     }
+    /* z's coefficients are written, x's and y's other fields not yet */
+    double rx = radius_from_sum(x, sx, tx), ry = radius_from_sum(y, sy, ty);
+    ia_interval hull = ia_mul(aa_range_r(x, rx), aa_range_r(y, ry));
     double p0 = x0 * y0, mid = 0.5 * dsum, s0 = p0 + mid;
     uf |= fp_uflow(p0, x0, y0) | (fabs(mid) < 0x1p-1022 && dsum != 0.0);
     es += fabs(fp_two_sum_err(p0, mid, s0));
