@@ -191,8 +191,11 @@ ia_interval aa_range_r(const aa_form *x, double r)
         lo = x->lo;
         hi = x->hi;
     }
-    ia_interval out = ia_make(lo, hi);
-    out.flags |= x->flags;
+    ia_interval out = { lo, hi, x->flags };
+    if (!(lo > -INFINITY && hi < INFINITY)) {     /* infinite or NaN ends */
+        out = ia_make(lo, hi);
+        out.flags |= x->flags;
+    }
     return out;
 }
 
