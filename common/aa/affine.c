@@ -139,11 +139,6 @@ void aa_from_interval(aa_context *ctx, aa_form *z, ia_interval x)
     aa_set_interval(ctx, z, x, x.flags);
 }
 
-/* Sum of |xi| + err, rounded up. The n terms are added in round-to-
- * nearest; each addition errs by at most 2^-53 of its (nonnegative)
- * result, so the exact sum is at most the computed one times (1 + 2^-53)^n,
- * which (n + 1) * 2^-53 relative, stepped up, covers. A form with one term
- * (an input, a fresh min-range result) comes back exactly. */
 /* The end of aa_radius, from the RN sum r of the |xi| (in symbol order)
  * and the count of nonzero ones; shared with aa_mul, which sums them in
  * its own loop. */
@@ -160,6 +155,11 @@ static double radius_from_sum(const aa_form *x, double r, int terms)
     return fp_next_up(r + r * ((double)(terms + 1) * 0x1p-53));
 }
 
+/* Sum of |xi| + err, rounded up. The n terms are added in round-to-
+ * nearest; each addition errs by at most 2^-53 of its (nonnegative)
+ * result, so the exact sum is at most the computed one times (1 + 2^-53)^n,
+ * which (n + 1) * 2^-53 relative, stepped up, covers. A form with one term
+ * (an input, a fresh min-range result) comes back exactly. */
 double aa_radius(const aa_form *x)
 {
     if (x->flags & AA_UNBOUNDED)
