@@ -94,10 +94,21 @@ ia_interval ia_div(ia_interval x, ia_interval y)
         r.flags |= x.flags | y.flags;
         return r;
     }
-    double lo = min4(fp_div_dn(x.lo, y.lo), fp_div_dn(x.lo, y.hi),
-                     fp_div_dn(x.hi, y.lo), fp_div_dn(x.hi, y.hi));
-    double hi = max4(fp_div_up(x.lo, y.lo), fp_div_up(x.lo, y.hi),
-                     fp_div_up(x.hi, y.lo), fp_div_up(x.hi, y.hi));
+    /* y has one sign: the signs of x's ends pick the extreme corners, as
+     * for exact quotients; each picked corner's directed quotient bounds
+     * that corner (an infinity over an infinity by the whole line), so
+     * the result is sound, and it is the four corners' hull unless a
+     * corner is such an inf/inf or a nonzero quotient that rounds to 0 */
+    double lo, hi;
+    if (y.lo > 0.0) {
+        if (x.lo >= 0.0)      { lo = fp_div_dn(x.lo, y.hi); hi = fp_div_up(x.hi, y.lo); }
+        else if (x.hi <= 0.0) { lo = fp_div_dn(x.lo, y.lo); hi = fp_div_up(x.hi, y.hi); }
+        else                  { lo = fp_div_dn(x.lo, y.lo); hi = fp_div_up(x.hi, y.lo); }
+    } else {
+        if (x.lo >= 0.0)      { lo = fp_div_dn(x.hi, y.hi); hi = fp_div_up(x.lo, y.lo); }
+        else if (x.hi <= 0.0) { lo = fp_div_dn(x.hi, y.lo); hi = fp_div_up(x.lo, y.hi); }
+        else                  { lo = fp_div_dn(x.hi, y.hi); hi = fp_div_up(x.lo, y.hi); }
+    }
     return mk(lo, hi, x.flags | y.flags);
 }
 
@@ -537,7 +548,8 @@ ia_interval ia_smoothstep(ia_interval e0, ia_interval e1, ia_interval x)
     RETURN_IF_EMPTY1(x);
     unsigned flags = (x.flags | e0.flags | e1.flags) & ~AA_UNBOUNDED;
     ia_interval lo = smoothstep_point(x.lo, e0.hi, e1.hi);
-    ia_interval hi = smoothstep_point(x.hi, e0.lo, e1.lo);
+    ia_interval hi = x.lo == x.hi && e0.lo == e0.hi && e1.lo == e1.hi
+                         ? lo : smoothstep_point(x.hi, e0.lo, e1.lo);   /* all points: once */
     ia_interval r = mk(lo.lo, hi.hi, flags);
     /* where e1 <= e0 is possible, smoothstep degenerates to a step */
     if (e0.hi >= e1.lo && r.lo != r.hi)

@@ -18,9 +18,10 @@
  *                            error of the best linear approximation, computed
  *                            in long double, within 1e-9 of it; their slope
  *                            is the secant's
- *   ia_mul                   the sign-case product equals the four-corner
- *                            product of directed roundings (never wider; the
- *                            same numbers unless a corner underflows to 0)
+ *   ia_mul, ia_div           the sign-case product and quotient equal the
+ *                            four corners' directed roundings (never wider;
+ *                            the same numbers unless a corner underflows to
+ *                            0 or is inf/inf)
  */
 #include <stdarg.h>
 #include <stddef.h>
@@ -547,6 +548,22 @@ static void test_ia_mul_corners(void **state)
             tiny |= p[k][0] != 0.0 && p[k][1] != 0.0 && p[k][0] * p[k][1] == 0.0;
         }
         /* never wider than the corners (which are sound) */
+        assert_true(got.lo >= lo && got.hi <= hi);
+        if (!tiny && !(got.lo == lo && got.hi == hi))
+            differ++;
+        /* the same for ia_div, whose divisor has one sign */
+        if (!(y.lo > 0.0 || y.hi < 0.0))
+            continue;
+        got = ia_div(x, y);
+        lo = INFINITY;
+        hi = -INFINITY;
+        tiny = 0;
+        for (int k = 0; k < 4; k++) {
+            lo = fmin(lo, fp_div_dn(p[k][0], p[k][1]));
+            hi = fmax(hi, fp_div_up(p[k][0], p[k][1]));
+            tiny |= (p[k][0] != 0.0 && p[k][0] / p[k][1] == 0.0) ||
+                    (isinf(p[k][0]) && isinf(p[k][1]));
+        }
         assert_true(got.lo >= lo && got.hi <= hi);
         if (!tiny && !(got.lo == lo && got.hi == hi))
             differ++;
