@@ -477,6 +477,31 @@ void aa_sqrt(aa_context *ctx, aa_form *z, const aa_form *x)
     finish(ctx, z, x, ok, alpha, zeta, delta, fallback, fl, xr);
 }
 
+/*
+ * inversesqrt in closed form on finite [a, b], 0 < a < b: alpha = the
+ * secant slope (RN, < 0; any alpha is sound). g(t) = t^(-1/2) - alpha*t is
+ * convex, so its largest value on [a, b] is at an end, and its least over
+ * all t > 0 is 1.5 s at t = s^-2, s = (-2 alpha)^(1/3) (g' = -t^(-3/2)/2 -
+ * alpha = 0 there, and g = s - alpha s^-2 = s + s/2). s is bounded below
+ * without trusting cbrt's accuracy: its result stepped 16 ulps down is used
+ * once its cube, rounded up, is at most -2 alpha (else the generic scheme).
+ * ia_invsqrt([a, b]) is [f(b).lo, f(a).hi], from the same two evaluations.
+ */
+static bool invsqrt_closed(double a, double b, ia_interval fa, ia_interval fb,
+                           double *alpha, double *zeta, double *delta)
+{
+    *alpha = (ia_mid(fb) - ia_mid(fa)) / (b - a);
+    double m = -2.0 * *alpha;
+    if (!(isfinite(*alpha) && *alpha < 0.0 && isfinite(m)))
+        return false;
+    double s = fp_down_by(cbrt(m), 16);
+    if (!(s > 0.0 && fp_mul_up(fp_mul_up(s, s), s) <= m))
+        return false;
+    double ga = fp_add_up(fa.hi, -fp_mul_dn(*alpha, a));
+    double gb = fp_add_up(fb.hi, -fp_mul_dn(*alpha, b));
+    return center_radius(ia_make(fp_mul_dn(1.5, s), fmax(ga, gb)), zeta, delta);
+}
+
 void aa_invsqrt(aa_context *ctx, aa_form *z, const aa_form *x)
 {
     PRIVATE1(z, x, ia_invsqrt);
@@ -487,6 +512,14 @@ void aa_invsqrt(aa_context *ctx, aa_form *z, const aa_form *x)
     if (r.lo <= 0) {                       /* pole at 0 or out of domain */
         aa_set_interval(ctx, z, ia_invsqrt(r), fl);
         return;
+    }
+    if (isfinite(r.hi) && r.lo < r.hi) {
+        ia_interval fa = f_invsqrt(r.lo, NULL), fb = f_invsqrt(r.hi, NULL);
+        double alpha, zeta, delta;
+        if (invsqrt_closed(r.lo, r.hi, fa, fb, &alpha, &zeta, &delta)) {
+            finish(ctx, z, x, true, alpha, zeta, delta, ia_mk_(fb.lo, fa.hi, r.flags), fl, xr);
+            return;
+        }
     }
     piece pc = { r.lo, r.hi, +1 };
     approx_convex(ctx, z, x, &fn, &pc, 1, r.lo, r.hi, ia_invsqrt(r), fl, xr);

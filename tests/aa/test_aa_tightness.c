@@ -14,10 +14,10 @@
  *                            capacity 2 (fully reduced) stays conservative,
  *                            also symbol by symbol, and capacity 16 is never
  *                            wider than capacity 2
- *   closed forms             aa_sqrt and aa_exp reach the Chebyshev (minimax)
- *                            error of the best linear approximation, computed
- *                            in long double, within 1e-9 of it; their slope
- *                            is the secant's
+ *   closed forms             aa_sqrt, aa_exp and aa_invsqrt reach the
+ *                            Chebyshev (minimax) error of the best linear
+ *                            approximation, computed in long double, within
+ *                            1e-9 of it; their slope is the secant's
  *   ia_mul, ia_div           the sign-case product and quotient equal the
  *                            four corners' directed roundings (never wider;
  *                            the same numbers unless a corner underflows to
@@ -460,7 +460,8 @@ static void test_condensation(void **state)
  * g(t) = f(t) - alpha*t: between g at the ends and g at the tangent point.
  * sqrt: g(a) = sqrt(a) - alpha a, g max = 1/(4 alpha) with
  * alpha = 1/(sqrt a + sqrt b); exp: g(a) = e^a - alpha a, g min =
- * alpha (1 - ln alpha). The new symbol's coefficient must be within 1e-9
+ * alpha (1 - ln alpha); inversesqrt: g(a) = a^(-1/2) - alpha a, g min =
+ * 1.5 (-2 alpha)^(1/3). The new symbol's coefficient must be within 1e-9
  * (relative, plus a few ulps of the values) of that half spread: not
  * smaller (unsound) and not wider (the closed form lost tightness).
  * The tolerance allows for the rounding of f's values (64 ulps of the
@@ -472,12 +473,18 @@ static void check_minimax(const char *name, double a, double b, int is_exp)
     aa_context_init(&ctx, AA_DEFAULT_CAPACITY);
     aa_form x, z;
     aa_input(&ctx, &x, a, b);
-    if (is_exp)
+    if (is_exp == 2)
+        aa_invsqrt(&ctx, &z, &x);
+    else if (is_exp)
         aa_exp(&ctx, &z, &x);
     else
         aa_sqrt(&ctx, &z, &x);
     long double la = a, lb = b, alpha, gend, gext;
-    if (is_exp) {
+    if (is_exp == 2) {
+        alpha = (1.0L / sqrtl(lb) - 1.0L / sqrtl(la)) / (lb - la);
+        gend = 1.0L / sqrtl(la) - alpha * la;
+        gext = 1.5L * cbrtl(-2.0L * alpha);
+    } else if (is_exp) {
         alpha = (expl(lb) - expl(la)) / (lb - la);
         gend = expl(la) - alpha * la;
         gext = alpha * (1.0L - logl(alpha));
@@ -487,7 +494,7 @@ static void check_minimax(const char *name, double a, double b, int is_exp)
         gext = 1.0L / (4.0L * alpha);
     }
     long double want = fabsl(gext - gend) / 2.0L;
-    long double scale = is_exp ? expl(lb) : sqrtl(lb);
+    long double scale = is_exp == 2 ? 1.0L / sqrtl(la) : is_exp ? expl(lb) : sqrtl(lb);
     /* the linear approximation is kept (one new symbol after the input) */
     assert_int_equal(z.n, 2);
     double delta = z.c[1];
@@ -498,7 +505,7 @@ static void check_minimax(const char *name, double a, double b, int is_exp)
     assert_true((long double)delta >= want - tol);
     assert_true((long double)delta <= want + tol);
     /* the slope is the secant's, up to the rounding of f at the ends */
-    assert_true(fabsl(slope - alpha) <= 1e-12L * alpha + 16.0L * 0x1p-53L * scale / (lb - la));
+    assert_true(fabsl(slope - alpha) <= 1e-12L * fabsl(alpha) + 16.0L * 0x1p-53L * scale / (lb - la));
 }
 
 static void test_closed_form_minimax(void **state)
@@ -514,6 +521,11 @@ static void test_closed_form_minimax(void **state)
     };
     for (size_t i = 0; i < sizeof e / sizeof e[0]; i++)
         check_minimax("exp", e[i][0], e[i][1], 1);
+    static const double q[][2] = {
+        {0.25, 0.5}, {1.0, 4.0}, {1e-6, 2e-6}, {100.0, 100.5}, {3.0, 3.0 + 1e-6}, {0.5, 5.0},
+    };
+    for (size_t i = 0; i < sizeof q / sizeof q[0]; i++)
+        check_minimax("inversesqrt", q[i][0], q[i][1], 2);
 }
 
 /* ---- ia_mul: the sign cases against the four corners ---- */
