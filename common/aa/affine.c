@@ -14,6 +14,8 @@
 
 #include <assert.h>
 #include <math.h>
+#include <stdint.h>
+#include <string.h>
 
 /* ---------------------------------------------------------------------- */
 /* context                                                                 */
@@ -137,6 +139,22 @@ void aa_from_interval(aa_context *ctx, aa_form *z, ia_interval x)
     aa_set_interval(ctx, z, x, x.flags);
 }
 
+/* The end of aa_radius, from the RN sum r of the |xi| (in symbol order)
+ * and the count of nonzero ones; shared with aa_mul, which sums them in
+ * its own loop. */
+static double radius_from_sum(const aa_form *x, double r, int terms)
+{
+    if (x->err != 0.0) {
+        r += x->err;
+        terms++;
+    }
+    if (terms <= 1)
+        return r;
+    if (!(r >= 0x1p-960))              /* no subnormal products (rounding.h) */
+        return r != r ? r : 0x1p-958;
+    return fp_next_up(r + r * ((double)(terms + 1) * 0x1p-53));
+}
+
 /* Sum of |xi| + err, rounded up. The n terms are added in round-to-
  * nearest; each addition errs by at most 2^-53 of its (nonnegative)
  * result, so the exact sum is at most the computed one times (1 + 2^-53)^n,
@@ -154,25 +172,16 @@ double aa_radius(const aa_form *x)
         r += a;
         terms += a != 0.0;
     }
-    if (x->err != 0.0) {
-        r += x->err;
-        terms++;
-    }
-    if (terms <= 1)
-        return r;
-    if (!(r >= 0x1p-960))              /* no subnormal products (rounding.h) */
-        return r != r ? r : 0x1p-958;
-    return fp_next_up(r + r * ((double)(terms + 1) * 0x1p-53));
+    return radius_from_sum(x, r, terms);
 }
 
-ia_interval aa_range(const aa_form *x)
+ia_interval aa_range_r(const aa_form *x, double r)
 {
     if (x->flags & AA_UNBOUNDED) {
         ia_interval e = ia_entire();
         e.flags |= x->flags;
         return e;
     }
-    double r = aa_radius(x);
     double lo = fp_add_dn(x->x0, -r), hi = fp_add_up(x->x0, r);
     if (x->lo > lo)
         lo = x->lo;
@@ -182,9 +191,17 @@ ia_interval aa_range(const aa_form *x)
         lo = x->lo;
         hi = x->hi;
     }
-    ia_interval out = ia_make(lo, hi);
-    out.flags |= x->flags;
+    ia_interval out = { lo, hi, x->flags };
+    if (!(lo > -INFINITY && hi < INFINITY)) {     /* infinite or NaN ends */
+        out = ia_make(lo, hi);
+        out.flags |= x->flags;
+    }
     return out;
+}
+
+ia_interval aa_range(const aa_form *x)
+{
+    return aa_range_r(x, aa_radius(x));
 }
 
 bool aa_is_point(const aa_form *x)
@@ -201,12 +218,38 @@ bool aa_is_point(const aa_form *x)
 /* linear combinations                                                     */
 /* ---------------------------------------------------------------------- */
 
-static bool exact_factor(double a) { return a == 0.0 || a == 1.0 || a == -1.0; }
+/* How a product by the factor a rounds (every case sound for any operand):
+ * FACTOR_EXACT: 0, +-1 and powers of two of magnitude >= 1 change at most
+ * the sign and exponent, so the product is exact (overflow aside, which
+ * gives infinity and an unbounded result); FACTOR_POW2: powers of two below
+ * 1 are exact unless the product underflows; FACTOR_INEXACT: any other
+ * factor errs by at most 2^-53 of the product's magnitude, plus 2^-1075 when
+ * it underflows (rounding.h). Classifying the factor once per operation
+ * takes the per-coefficient bookkeeping out of add, sub, neg and x*2. */
+enum { FACTOR_EXACT, FACTOR_POW2, FACTOR_INEXACT };
+
+static inline int factor_kind(double a)
+{
+    uint64_t bits;
+    memcpy(&bits, &a, sizeof bits);
+    unsigned e = (unsigned)(bits >> 52) & 0x7ffu;
+    if (a == 0.0)
+        return FACTOR_EXACT;
+    if ((bits & 0xfffffffffffffull) != 0 || e == 0 || e == 0x7ffu)
+        return FACTOR_INEXACT;
+    return e >= 0x3ffu ? FACTOR_EXACT : FACTOR_POW2;
+}
 
 /* Upper bound on a sum of |TwoSum errors| accumulated in RN. */
 static double sum_err_bound(double es)
 {
     return es == 0.0 ? 0.0 : fp_next_up(es * (1.0 + 0x1p-45));
+}
+
+/* a + b for a, b >= 0, rounded up; exact when either is 0 */
+static inline double add_up_nn(double a, double b)
+{
+    return a == 0.0 ? b : b == 0.0 ? a : fp_add_up(a, b);
 }
 
 /* a*[lo, hi] (a finite, a != 0) before rounding: the ends of a hull */
@@ -216,10 +259,68 @@ static inline void scale_ends(double a, double lo, double hi, double *l, double 
     else { *l = a * hi; *h = a * lo; }
 }
 
-void aa_lincomb(aa_context *ctx, aa_form *z, double a, const aa_form *x,
-                double b, const aa_form *y, double c)
+/* 1 when the product p = RN(a*v) of a factor of kind k may have underflowed
+ * (branch-free, for the loops below) */
+static inline int uflow_k(int k, double p, double v)
 {
-    (void)ctx;
+    return (k != FACTOR_EXACT) & (fabs(p) < 0x1p-1022) & (v != 0.0);
+}
+
+/* The coefficient loops of aa_lincomb: the symbols both operands use, then
+ * the rest of the longer one (no per-coefficient selects). track (a
+ * constant at each call) says whether any factor needs the products'
+ * rounding bookkeeping; add, sub and neg do without it. */
+static inline __attribute__((always_inline)) void
+lincomb_loops(int track, double a, const double *xc, int xn, double b,
+              const double *yc, int yn, double *zc, int ka, int kb,
+              double wa, double wb, double *es_out, double *ap_out, int *uf_out)
+{
+    int m = xn < yn ? xn : yn;
+    double es = 0.0, ap = 0.0;
+    int uf = 0;
+    for (int i = 0; i < m; i++) {
+        double xi = xc[i], yi = yc[i];
+        double p = a * xi, q = b * yi, s = p + q;
+        es += fabs(fp_two_sum_err(p, q, s));
+        if (track) {
+            ap += wa * fabs(p) + wb * fabs(q);
+            uf |= uflow_k(ka, p, xi) | uflow_k(kb, q, yi);
+        }
+        zc[i] = s;
+    }
+    for (int i = m; i < xn; i++) {
+        double xi = xc[i], p = a * xi;
+        if (track) {
+            ap += wa * fabs(p);
+            uf |= uflow_k(ka, p, xi);
+        }
+        zc[i] = p;
+    }
+    for (int i = m; i < yn; i++) {
+        double yi = yc[i], q = b * yi;
+        if (track) {
+            ap += wb * fabs(q);
+            uf |= uflow_k(kb, q, yi);
+        }
+        zc[i] = q;
+    }
+    *es_out = es;
+    *ap_out = ap;
+    *uf_out = uf;
+}
+
+/*
+ * z = a*x + b*y + c. Coefficients in RN: the exact error of each sum from
+ * TwoSum (so x - x is exactly 0), 2^-53 of each product by an inexact
+ * factor, 2^-1075 per product that underflowed, all summed and bounded from
+ * above once (lincomb_loops; the bookkeeping a factor does not need is
+ * multiplied away: wa, wb are 0 or 1). want_hull false leaves the hull
+ * [-inf, inf] for a caller that sets its own (aa_apply_linear, aa_merge).
+ */
+static inline __attribute__((always_inline)) void
+lincomb(aa_form *z, double a, const aa_form *x, double b, const aa_form *y, double c,
+        bool want_hull)
+{
     static const aa_form zero = { .x0 = 0.0 };
     if (y == NULL) {
         y = &zero;
@@ -233,55 +334,56 @@ void aa_lincomb(aa_context *ctx, aa_form *z, double a, const aa_form *x,
         return;
     }
     flags &= ~AA_UNBOUNDED;
-    bool ea = exact_factor(a), eb = exact_factor(b);
+    int ka = factor_kind(a), kb = factor_kind(b);
+    double wa = ka == FACTOR_INEXACT ? 1.0 : 0.0, wb = kb == FACTOR_INEXACT ? 1.0 : 0.0;
     int xn = (a == 0.0) ? 0 : x->n, yn = (b == 0.0) ? 0 : y->n;
     int n = xn > yn ? xn : yn;
     double x0 = x->x0, y0 = y->x0;
     double xe = a == 0.0 ? 0.0 : x->err, ye = b == 0.0 ? 0.0 : y->err;
-    /* the hull a*[x] + b*[y] + c in RN, then widened once by a bound of
-     * its rounding (two products and two sums: at most 3u times the sum of
-     * the magnitudes, plus the products' underflow), as aa_lincomb3 does:
-     * a few flops instead of six directed-rounding interval operations */
-    double l1 = 0.0, h1 = 0.0, l2 = 0.0, h2 = 0.0;
-    int huf = 0;
-    if (a != 0.0) {
-        scale_ends(a, x->lo, x->hi, &l1, &h1);
-        huf += fp_uflow(l1, a, a > 0.0 ? x->lo : x->hi) + fp_uflow(h1, a, a > 0.0 ? x->hi : x->lo);
+    /* the hull a*[x] + b*[y] + c in RN: two products and two sums err by
+     * at most 3u times the sum of the magnitudes, plus the products'
+     * underflow; hb = fp_rounding_bound(3 * that) is at least twice it.
+     * Moving the RN end out by 2*hb, itself in RN, errs by at most
+     * u*(|end| + 2*hb) <= hb more, so the end moves out by >= hb. */
+    double hlo = -INFINITY, hhi = INFINITY;
+    if (want_hull) {
+        double l1 = 0.0, h1 = 0.0, l2 = 0.0, h2 = 0.0;
+        int huf = 0;
+        if (a != 0.0) {
+            scale_ends(a, x->lo, x->hi, &l1, &h1);
+            huf |= uflow_k(ka, l1, a > 0.0 ? x->lo : x->hi) |
+                   uflow_k(ka, h1, a > 0.0 ? x->hi : x->lo);
+        }
+        if (b != 0.0) {
+            scale_ends(b, y->lo, y->hi, &l2, &h2);
+            huf |= uflow_k(kb, l2, b > 0.0 ? y->lo : y->hi) |
+                   uflow_k(kb, h2, b > 0.0 ? y->hi : y->lo);
+        }
+        double hb = 2.0 * fp_rounding_bound(3.0 * (fabs(l1) + fabs(h1) + fabs(l2) + fabs(h2) +
+                                                   fabs(c)), huf);
+        hlo = (l1 + l2 + c) - hb;
+        hhi = (h1 + h2 + c) + hb;
     }
-    if (b != 0.0) {
-        scale_ends(b, y->lo, y->hi, &l2, &h2);
-        huf += fp_uflow(l2, b, b > 0.0 ? y->lo : y->hi) + fp_uflow(h2, b, b > 0.0 ? y->hi : y->lo);
-    }
-    double hb = fp_rounding_bound(3.0 * (fabs(l1) + fabs(h1) + fabs(l2) + fabs(h2) + fabs(c)),
-                                  huf);
-    double hlo = fp_add_dn(l1 + l2 + c, -hb), hhi = fp_add_up(h1 + h2 + c, hb);
 
     double es = 0.0;      /* sum of exact errors of the additions */
     double ap = 0.0;      /* sum of |inexact products| */
-    int uf = 0;           /* products that may have underflowed */
-    for (int i = 0; i < n; i++) {
-        double xi = i < xn ? x->c[i] : 0.0;
-        double yi = i < yn ? y->c[i] : 0.0;
-        double p = a * xi, q = b * yi, s = p + q;
-        es += fabs(fp_two_sum_err(p, q, s));
-        if (!ea) { ap += fabs(p); uf += fp_uflow(p, a, xi); }
-        if (!eb) { ap += fabs(q); uf += fp_uflow(q, b, yi); }
-        z->c[i] = s;
-    }
+    int uf = 0;           /* a product may have underflowed */
+    if (ka == FACTOR_EXACT && kb == FACTOR_EXACT)      /* add, sub, neg */
+        lincomb_loops(0, a, x->c, xn, b, y->c, yn, z->c, 0, 0, 0, 0, &es, &ap, &uf);
+    else
+        lincomb_loops(1, a, x->c, xn, b, y->c, yn, z->c, ka, kb, wa, wb, &es, &ap, &uf);
     double p = a * x0, q = b * y0;
     double s1 = p + q, s2 = s1 + c;
     es += fabs(fp_two_sum_err(p, q, s1)) + fabs(fp_two_sum_err(s1, c, s2));
-    if (!ea) { ap += fabs(p); uf += fp_uflow(p, a, x0); }
-    if (!eb) { ap += fabs(q); uf += fp_uflow(q, b, y0); }
+    ap += wa * fabs(p) + wb * fabs(q);
+    uf |= uflow_k(ka, p, x0) | uflow_k(kb, q, y0);
 
     double err = 0.0;
     if (xe != 0.0)
-        err = ea ? xe : fp_mul_up(fabs(a), xe);
+        err = ka == FACTOR_EXACT ? xe * fabs(a) : fp_mul_up(fabs(a), xe);
     if (ye != 0.0)
-        err = fp_add_up(err, eb ? ye : fp_mul_up(fabs(b), ye));
-    if (es != 0.0)
-        err = fp_add_up(err, sum_err_bound(es));
-    err = fp_add_up(err, fp_rounding_bound(ap, uf));
+        err = add_up_nn(err, kb == FACTOR_EXACT ? ye * fabs(b) : fp_mul_up(fabs(b), ye));
+    err = add_up_nn(err, add_up_nn(sum_err_bound(es), fp_rounding_bound(ap, uf)));
 
     z->x0 = s2;
     z->err = err;
@@ -289,8 +391,15 @@ void aa_lincomb(aa_context *ctx, aa_form *z, double a, const aa_form *x,
     z->hi = hhi == hhi ? hhi : INFINITY;
     z->n = (unsigned short)n;
     z->flags = (unsigned short)flags;
-    if (!isfinite(s2) || !isfinite(err) || !isfinite(es) || !isfinite(ap))
+    if (!isfinite(s2) || !isfinite(err))
         aa_unbounded(z, flags);
+}
+
+void aa_lincomb(aa_context *ctx, aa_form *z, double a, const aa_form *x,
+                double b, const aa_form *y, double c)
+{
+    (void)ctx;
+    lincomb(z, a, x, b, y, c, true);
 }
 
 /*
@@ -323,23 +432,33 @@ void aa_lincomb3(aa_context *ctx, aa_form *z, const double m[3], const aa_form x
     }
     flags &= ~AA_UNBOUNDED;
 
-    for (int j = 0; j < n; j++)
-        z->c[j] = 0.0;
     double terms = 0.0, x0 = c, centre = fabs(c), perr = 0.0;
     double lo = c, hi = c, hull = fabs(c);
     int uf = 0, cuf = 0, huf = 0;
+    int zn = 0;                   /* z->c[0..zn) hold partial sums; n at the end */
+    double *zc = z->c;
     for (int k = 0; k < 3; k++) {
         double a = m[k];
         if (a == 0.0)
             continue;
         const aa_form *xk = &x[k];
+        const double *xc = xk->c;
+        int xn = xk->n, both = xn < zn ? xn : zn;
         double R = 0.0;
-        for (int j = 0; j < xk->n; j++) {
-            double p = a * xk->c[j];
-            z->c[j] += p;
-            R += fabs(xk->c[j]);
-            uf += fp_uflow(p, a, xk->c[j]);
+        for (int j = 0; j < both; j++) {        /* add to the partial sums */
+            double v = xc[j], p = a * v;
+            zc[j] += p;
+            R += fabs(v);
+            uf |= (fabs(p) < 0x1p-1022) & (v != 0.0);
         }
+        for (int j = both; j < xn; j++) {       /* the first term of these */
+            double v = xc[j], p = a * v;
+            zc[j] = p;
+            R += fabs(v);
+            uf |= (fabs(p) < 0x1p-1022) & (v != 0.0);
+        }
+        if (xn > zn)
+            zn = xn;
         double fa = fabs(a);
         terms += fa * R;
         double p = a * xk->x0;
@@ -409,7 +528,7 @@ void aa_apply_linear(aa_context *ctx, aa_form *z, const aa_form *x,
                      double alpha, double zeta, double delta, ia_interval hull,
                      unsigned flags)
 {
-    aa_lincomb(ctx, z, alpha, x, 0.0, NULL, zeta);
+    lincomb(z, alpha, x, 0.0, NULL, zeta, false);    /* the hull is given */
     if (!(z->flags & AA_UNBOUNDED)) {
         z->lo = hull.lo;
         z->hi = hull.hi;
@@ -437,9 +556,10 @@ void aa_mul(aa_context *ctx, aa_form *z, const aa_form *x, const aa_form *y)
         aa_sqr(ctx, z, x);
         return;
     }
-    if (aa_is_point(x) || aa_is_point(y)) {
-        const aa_form *p = aa_is_point(x) ? x : y;
-        const aa_form *o = p == x ? y : x;
+    bool xp = aa_is_point(x), yp = !xp && aa_is_point(y);
+    if (xp || yp) {
+        const aa_form *p = xp ? x : y;
+        const aa_form *o = xp ? y : x;
         if (p->x0 == 0.0) {
             aa_const(z, 0.0);
             z->flags = (unsigned short)(flags & ~AA_UNBOUNDED);
@@ -455,35 +575,60 @@ void aa_mul(aa_context *ctx, aa_form *z, const aa_form *x, const aa_form *y)
         return;
     }
     if (x->n == 0 && y->n == 0) {         /* no shared symbols: see affine_funcs.c */
+        ia_interval r = ia_mul(aa_range(x), aa_range(y));
         aa_context none;
         aa_context_init(&none, 0);
-        ia_interval r = ia_mul(aa_range(x), aa_range(y));
         aa_set_interval(&none, z, r, r.flags);
         return;
     }
-    double rx = aa_radius(x), ry = aa_radius(y);
-    ia_interval hull = ia_mul(aa_range(x), aa_range(y));
-    int n = x->n > y->n ? x->n : y->n;
     int xn = x->n, yn = y->n;
+    int m = xn < yn ? xn : yn, n = xn > yn ? xn : yn;
     double x0 = x->x0, y0 = y->x0, xe = x->err, ye = y->err;
+    const double *xc = x->c, *yc = y->c;
+    double *zc = z->c;
 
-    double es = 0.0, ap = 0.0, dsum = 0.0, dabs = 0.0;
-    int uf = 0;
-    for (int i = 0; i < n; i++) {
-        double xi = i < xn ? x->c[i] : 0.0;
-        double yi = i < yn ? y->c[i] : 0.0;
+    /* as aa_lincomb: the symbols both use, then the rest of the longer;
+     * the operands' radii are summed on the way (in symbol order, the
+     * same numbers as aa_radius) */
+    double es = 0.0, ap = 0.0, dsum = 0.0, dabs = 0.0, sx = 0.0, sy = 0.0;
+    int uf = 0, tx = 0, ty = 0;
+    for (int i = 0; i < m; i++) {
+        double xi = xc[i], yi = yc[i];
         double p = x0 * yi, q = y0 * xi, s = p + q;
         double d = xi * yi;
         es += fabs(fp_two_sum_err(p, q, s));
         ap += fabs(p) + fabs(q);
         dsum += d;
         dabs += fabs(d);
-        uf += fp_uflow(p, x0, yi) + fp_uflow(q, y0, xi) + fp_uflow(d, xi, yi);
-        z->c[i] = s;
+        sx += fabs(xi);
+        sy += fabs(yi);
+        tx += xi != 0.0;
+        ty += yi != 0.0;
+        uf |= fp_uflow(p, x0, yi) | fp_uflow(q, y0, xi) | fp_uflow(d, xi, yi);
+        zc[i] = s;
     }
-    double p0 = x0 * y0, m = 0.5 * dsum, s0 = p0 + m;
-    uf += fp_uflow(p0, x0, y0) + (fabs(m) < 0x1p-1022 && dsum != 0.0);
-    es += fabs(fp_two_sum_err(p0, m, s0));
+    for (int i = m; i < xn; i++) {        /* yi = 0: p = 0, d = 0 */
+        double xi = xc[i], q = y0 * xi;
+        ap += fabs(q);
+        sx += fabs(xi);
+        tx += xi != 0.0;
+        uf |= fp_uflow(q, y0, xi);
+        zc[i] = q;
+    }
+    for (int i = m; i < yn; i++) {        /* xi = 0 */
+        double yi = yc[i], p = x0 * yi;
+        ap += fabs(p);
+        sy += fabs(yi);
+        ty += yi != 0.0;
+        uf |= fp_uflow(p, x0, yi);
+        zc[i] = p;
+    }
+    /* z's coefficients are written, x's and y's other fields not yet */
+    double rx = radius_from_sum(x, sx, tx), ry = radius_from_sum(y, sy, ty);
+    ia_interval hull = ia_mul(aa_range_r(x, rx), aa_range_r(y, ry));
+    double p0 = x0 * y0, mid = 0.5 * dsum, s0 = p0 + mid;
+    uf |= fp_uflow(p0, x0, y0) | (fabs(mid) < 0x1p-1022 && dsum != 0.0);
+    es += fabs(fp_two_sum_err(p0, mid, s0));
     /* errors: 2n + 1 products above, the n products d and their RN sum
      * (at most (n+1) * 2^-53 * dabs), and the halving */
     ap += fabs(p0) + (double)(n + 2) * dabs;
@@ -530,8 +675,8 @@ void aa_merge(aa_context *ctx, aa_form *z, const aa_form *x, const aa_form *y)
     }
     aa_form d;
     ia_interval hull = ia_hull(aa_range(x), aa_range(y));
-    aa_lincomb(ctx, &d, 0.5, x, -0.5, y, 0.0);
-    aa_lincomb(ctx, z, 0.5, x, 0.5, y, 0.0);
+    lincomb(&d, 0.5, x, -0.5, y, 0.0, false);
+    lincomb(z, 0.5, x, 0.5, y, 0.0, false);
     z->lo = hull.lo;
     z->hi = hull.hi;
     z->flags = (unsigned short)(flags & ~AA_UNBOUNDED);

@@ -93,8 +93,11 @@ static ia_interval g_bounds_on_piece(const convex_fn *fn, const ends_memo *m, do
     double t0 = fn->tangent_point(alpha, pc->p, pc->q, fn->arg);
     if (!(t0 >= pc->p && t0 <= pc->q))    /* NaN or outside: clamp */
         t0 = t0 < pc->p ? pc->p : (t0 > pc->q ? pc->q : 0.5 * (pc->p + pc->q));
-    ia_interval g0 = g_at(fn, m, alpha, t0);
-    ia_interval slope = ia_sub(fn->df(t0, fn->arg), ia_point(alpha));
+    ia_interval f0 = f_memo(fn, m, t0);
+    ia_interval g0 = ia_sub(f0, ia_mul_s(ia_point(t0), alpha));
+    /* exp is its own derivative: one libm call, not two */
+    ia_interval d0 = fn->df == fn->f ? f0 : fn->df(t0, fn->arg);
+    ia_interval slope = ia_sub(d0, ia_point(alpha));
     ia_interval lp = ia_add(g0, ia_mul(slope, ia_sub(ia_point(pc->p), ia_point(t0))));
     ia_interval lq = ia_add(g0, ia_mul(slope, ia_sub(ia_point(pc->q), ia_point(t0))));
     if (pc->convex > 0) {
@@ -131,10 +134,10 @@ static bool center_radius(ia_interval g, double *zeta, double *delta)
  */
 static void finish(aa_context *ctx, aa_form *z, const aa_form *x, bool ok,
                    double alpha, double zeta, double delta,
-                   ia_interval fallback, unsigned flags)
+                   ia_interval fallback, unsigned flags, double xr)
 {
     if (ok) {
-        double w_aff = fp_add_up(fp_mul_up(fabs(alpha), aa_radius(x)), delta);
+        double w_aff = fp_add_up(fp_mul_up(fabs(alpha), xr), delta);
         double w_int = 0.5 * ia_width(fallback);
         if (isfinite(w_aff) && !(w_int * AA_MINRANGE_RATIO < w_aff)) {
             aa_apply_linear(ctx, z, x, alpha, zeta, delta, fallback, flags);
@@ -148,7 +151,7 @@ static void finish(aa_context *ctx, aa_form *z, const aa_form *x, bool ok,
 static void approx_convex(aa_context *ctx, aa_form *z, const aa_form *x,
                           const convex_fn *fn, const piece *pieces, int npieces,
                           double a, double b, ia_interval fallback,
-                          unsigned flags)
+                          unsigned flags, double xr)
 {
     double alpha, zeta = 0.0, delta = 0.0;
     bool ok = isfinite(a) && isfinite(b) && a <= b;
@@ -168,7 +171,7 @@ static void approx_convex(aa_context *ctx, aa_form *z, const aa_form *x,
     } else {
         ok = false;
     }
-    finish(ctx, z, x, ok, alpha, zeta, delta, fallback, flags);
+    finish(ctx, z, x, ok, alpha, zeta, delta, fallback, flags, xr);
 }
 
 /* Splits [a, b] at an exact inflection point s: convexity `below` left of
@@ -188,7 +191,7 @@ static void approx_taylor(aa_context *ctx, aa_form *z, const aa_form *x,
                           ia_interval (*f)(ia_interval),
                           ia_interval (*df)(ia_interval), ia_interval f2,
                           double a, double b, ia_interval fallback,
-                          unsigned flags)
+                          unsigned flags, double xr)
 {
     bool ok = isfinite(a) && isfinite(b) && a < b && isfinite(f2.lo) &&
               isfinite(f2.hi);
@@ -199,12 +202,19 @@ static void approx_taylor(aa_context *ctx, aa_form *z, const aa_form *x,
         ia_interval dc = df(ia_point(c));
         alpha = ia_mid(dc);
         ia_interval gc = ia_sub(f(ia_point(c)), ia_mul_s(ia_point(c), alpha));
-        ia_interval lin = ia_mul(ia_sub(dc, ia_point(alpha)), ia_make(-r, r));
-        ia_interval half_sq = ia_make(0.0, fp_mul_up(0.5, fp_mul_up(r, r)));
-        ia_interval g = ia_add(ia_add(gc, lin), ia_mul(f2, half_sq));
+        /* the two interval products of the remainder in closed form, the
+         * same numbers ia_mul gives: d*[-r, r] = +-r*max|d|, and
+         * f2*[0, h] = [min(0, f2.lo*h), max(0, f2.hi*h)] (directed
+         * products are monotone in each factor) */
+        ia_interval d = ia_sub(dc, ia_point(alpha));
+        double lr = fp_mul_up(fmax(fabs(d.lo), fabs(d.hi)), r);
+        double h = fp_mul_up(0.5, fp_mul_up(r, r));
+        ia_interval rem = ia_make(f2.lo < 0.0 ? fp_mul_dn(f2.lo, h) : 0.0,
+                                  f2.hi > 0.0 ? fp_mul_up(f2.hi, h) : 0.0);
+        ia_interval g = ia_add(ia_add(gc, ia_make(-lr, lr)), rem);
         ok = isfinite(alpha) && center_radius(g, &zeta, &delta);
     }
-    finish(ctx, z, x, ok, alpha, zeta, delta, fallback, flags);
+    finish(ctx, z, x, ok, alpha, zeta, delta, fallback, flags, xr);
 }
 
 /*
@@ -239,10 +249,11 @@ static void private_result(aa_form *z, ia_interval r)
     } while (0)
 
 /* The operand's range, with the flags the result inherits. */
-static ia_interval operand_range(const aa_form *x, unsigned *flags)
+static ia_interval operand_range(const aa_form *x, unsigned *flags, double *rad)
 {
     *flags = x->flags & ~AA_UNBOUNDED;
-    return aa_range(x);
+    *rad = aa_radius(x);
+    return aa_range_r(x, *rad);
 }
 
 /* ---------------------------------------------------------------------- */
@@ -260,18 +271,6 @@ static double t_recip(double al, double p, double q, const void *arg)
     (void)arg; (void)p;
     double m = sqrt(-1.0 / al);
     return q <= 0 ? -m : m;
-}
-
-static ia_interval f_sqrt(double t, const void *arg) { (void)arg; return ia_sqrt(ia_point(t)); }
-static ia_interval d_sqrt(double t, const void *arg)
-{
-    (void)arg;
-    return ia_recip(ia_mul_s(ia_sqrt(ia_point(t)), 2.0));
-}
-static double t_sqrt(double al, double p, double q, const void *arg)
-{
-    (void)p; (void)q; (void)arg;
-    return 0.25 / (al * al);
 }
 
 static ia_interval f_invsqrt(double t, const void *arg) { (void)arg; return ia_invsqrt(ia_point(t)); }
@@ -403,7 +402,8 @@ void aa_sqr(aa_context *ctx, aa_form *z, const aa_form *x)
 {
     PRIVATE1(z, x, ia_sqr);
     unsigned fl;
-    ia_interval r = operand_range(x, &fl);
+    double xr;
+    ia_interval r = operand_range(x, &fl, &xr);
     double a = r.lo, b = r.hi;
     bool ok = isfinite(a) && isfinite(b) && a < b;
     double alpha = 0.0, zeta = 0.0, delta = 0.0;
@@ -414,21 +414,22 @@ void aa_sqr(aa_context *ctx, aa_form *z, const aa_form *x)
         double glo = -fp_mul_up(fp_mul_up(alpha, alpha), 0.25);
         ok = isfinite(alpha) && center_radius(ia_make(glo, fmax(ga, gb)), &zeta, &delta);
     }
-    finish(ctx, z, x, ok, alpha, zeta, delta, ia_sqr(r), fl);
+    finish(ctx, z, x, ok, alpha, zeta, delta, ia_sqr(r), fl, xr);
 }
 
 void aa_recip(aa_context *ctx, aa_form *z, const aa_form *x)
 {
     PRIVATE1(z, x, ia_recip);
     unsigned fl;
-    ia_interval r = operand_range(x, &fl);
+    double xr;
+    ia_interval r = operand_range(x, &fl, &xr);
     static const convex_fn fn = { f_recip, d_recip, t_recip, NULL };
     if (r.lo <= 0 && r.hi >= 0) {
         aa_unbounded(z, fl);
         return;
     }
     piece pc = { r.lo, r.hi, r.lo > 0 ? +1 : -1 };
-    approx_convex(ctx, z, x, &fn, &pc, 1, r.lo, r.hi, ia_recip(r), fl);
+    approx_convex(ctx, z, x, &fn, &pc, 1, r.lo, r.hi, ia_recip(r), fl, xr);
 }
 
 void aa_div(aa_context *ctx, aa_form *z, const aa_form *x, const aa_form *y)
@@ -442,57 +443,137 @@ void aa_div(aa_context *ctx, aa_form *z, const aa_form *x, const aa_form *y)
     aa_mul(ctx, z, x, &inv);
 }
 
+/*
+ * sqrt in closed form (the Chebyshev scheme specialised, as aa_sqr): on
+ * [a, b], 0 <= a < b, alpha = 1/(sqrt(a) + sqrt(b)) (the secant slope, in
+ * RN; any alpha > 0 is sound). g(t) = sqrt(t) - alpha*t is concave, so its
+ * least value on [a, b] is at an end, and its largest over all t >= 0 is
+ * 1/(4 alpha), at t = 1/(4 alpha^2) (g' = 1/(2 sqrt t) - alpha = 0). sqrt
+ * is correctly rounded: one step each way encloses it.
+ */
 void aa_sqrt(aa_context *ctx, aa_form *z, const aa_form *x)
 {
     PRIVATE1(z, x, ia_sqrt);
     unsigned fl;
-    ia_interval r = operand_range(x, &fl);
-    static const convex_fn fn = { f_sqrt, d_sqrt, t_sqrt, NULL };
+    double xr;
+    ia_interval r = operand_range(x, &fl, &xr);
     if (r.hi < 0 || !isfinite(r.hi)) {
         aa_set_interval(ctx, z, ia_sqrt(r), fl);
         return;
     }
-    double a = fmax(r.lo, 0.0);
-    piece pc = { a, r.hi, -1 };
-    approx_convex(ctx, z, x, &fn, &pc, 1, a, r.hi, ia_sqrt(r), fl);
+    double a = fmax(r.lo, 0.0), b = r.hi;
+    ia_interval fallback = ia_sqrt(r);
+    bool ok = a < b;
+    double alpha = 0.0, zeta = 0.0, delta = 0.0;
+    if (ok) {
+        double sa = sqrt(a), sb = sqrt(b);
+        alpha = 1.0 / (sa + sb);
+        double sa_dn = sa == 0.0 ? 0.0 : fp_next_down(sa), sb_dn = fp_next_down(sb);
+        double ga = fp_add_dn(sa_dn, -fp_mul_up(alpha, a));
+        double gb = fp_add_dn(sb_dn, -fp_mul_up(alpha, b));
+        ok = isfinite(alpha) && alpha > 0.0 &&
+             center_radius(ia_make(fmin(ga, gb), fp_div_up(0.25, alpha)), &zeta, &delta);
+    }
+    finish(ctx, z, x, ok, alpha, zeta, delta, fallback, fl, xr);
+}
+
+/*
+ * inversesqrt in closed form on finite [a, b], 0 < a < b: alpha = the
+ * secant slope (RN, < 0; any alpha is sound). g(t) = t^(-1/2) - alpha*t is
+ * convex, so its largest value on [a, b] is at an end, and its least over
+ * all t > 0 is 1.5 s at t = s^-2, s = (-2 alpha)^(1/3) (g' = -t^(-3/2)/2 -
+ * alpha = 0 there, and g = s - alpha s^-2 = s + s/2). s is bounded below
+ * without trusting cbrt's accuracy: its result stepped 16 ulps down is used
+ * once its cube, rounded up, is at most -2 alpha (else the generic scheme).
+ * ia_invsqrt([a, b]) is [f(b).lo, f(a).hi], from the same two evaluations.
+ */
+static bool invsqrt_closed(double a, double b, ia_interval fa, ia_interval fb,
+                           double *alpha, double *zeta, double *delta)
+{
+    *alpha = (ia_mid(fb) - ia_mid(fa)) / (b - a);
+    double m = -2.0 * *alpha;
+    if (!(isfinite(*alpha) && *alpha < 0.0 && isfinite(m)))
+        return false;
+    double s = fp_down_by(cbrt(m), 16);
+    if (!(s > 0.0 && fp_mul_up(fp_mul_up(s, s), s) <= m))
+        return false;
+    double ga = fp_add_up(fa.hi, -fp_mul_dn(*alpha, a));
+    double gb = fp_add_up(fb.hi, -fp_mul_dn(*alpha, b));
+    return center_radius(ia_make(fp_mul_dn(1.5, s), fmax(ga, gb)), zeta, delta);
 }
 
 void aa_invsqrt(aa_context *ctx, aa_form *z, const aa_form *x)
 {
     PRIVATE1(z, x, ia_invsqrt);
     unsigned fl;
-    ia_interval r = operand_range(x, &fl);
+    double xr;
+    ia_interval r = operand_range(x, &fl, &xr);
     static const convex_fn fn = { f_invsqrt, d_invsqrt, t_invsqrt, NULL };
     if (r.lo <= 0) {                       /* pole at 0 or out of domain */
         aa_set_interval(ctx, z, ia_invsqrt(r), fl);
         return;
     }
+    if (isfinite(r.hi) && r.lo < r.hi) {
+        ia_interval fa = f_invsqrt(r.lo, NULL), fb = f_invsqrt(r.hi, NULL);
+        double alpha, zeta, delta;
+        if (invsqrt_closed(r.lo, r.hi, fa, fb, &alpha, &zeta, &delta)) {
+            finish(ctx, z, x, true, alpha, zeta, delta, ia_mk_(fb.lo, fa.hi, r.flags), fl, xr);
+            return;
+        }
+    }
     piece pc = { r.lo, r.hi, +1 };
-    approx_convex(ctx, z, x, &fn, &pc, 1, r.lo, r.hi, ia_invsqrt(r), fl);
+    approx_convex(ctx, z, x, &fn, &pc, 1, r.lo, r.hi, ia_invsqrt(r), fl, xr);
 }
 
+/*
+ * exp in closed form on finite [a, b], a < b: alpha = the secant slope (RN;
+ * any alpha > 0 is sound). g(t) = e^t - alpha*t is convex, so its largest
+ * value on [a, b] is at an end, and its least over all t is
+ * alpha*(1 - ln alpha), at t = ln alpha; ln alpha is enclosed as a libm
+ * result (AA_LIBM_ULPS). exp is increasing and ia_exp bounds each end on
+ * its own (the same libm call and clipping at a point as in the interval),
+ * so ia_exp([a, b]) is [exp(a).lo, exp(b).hi]: three libm calls in all.
+ */
 void aa_exp(aa_context *ctx, aa_form *z, const aa_form *x)
 {
     PRIVATE1(z, x, ia_exp);
     unsigned fl;
-    ia_interval r = operand_range(x, &fl);
-    static const convex_fn fn = { f_exp, f_exp, t_exp, NULL };
-    piece pc = { r.lo, r.hi, +1 };
-    approx_convex(ctx, z, x, &fn, &pc, 1, r.lo, r.hi, ia_exp(r), fl);
+    double xr;
+    ia_interval r = operand_range(x, &fl, &xr);
+    if (!(isfinite(r.lo) && isfinite(r.hi) && r.lo < r.hi)) {
+        static const convex_fn fn = { f_exp, f_exp, t_exp, NULL };
+        piece pc = { r.lo, r.hi, +1 };
+        approx_convex(ctx, z, x, &fn, &pc, 1, r.lo, r.hi, ia_exp(r), fl, xr);
+        return;
+    }
+    double a = r.lo, b = r.hi;
+    ia_interval fa = f_exp(a, NULL), fb = f_exp(b, NULL);
+    ia_interval fallback = ia_mk_(fa.lo, fb.hi, r.flags);
+    double alpha = (ia_mid(fb) - ia_mid(fa)) / (b - a), zeta = 0.0, delta = 0.0;
+    bool ok = isfinite(alpha) && alpha > 0.0;
+    if (ok) {
+        double ga = fp_add_up(fa.hi, -fp_mul_dn(alpha, a));
+        double gb = fp_add_up(fb.hi, -fp_mul_dn(alpha, b));
+        double ln_hi = fp_up_by(log(alpha), AA_LIBM_ULPS);
+        double glo = fp_mul_dn(alpha, fp_add_dn(1.0, -ln_hi));
+        ok = center_radius(ia_make(glo, fmax(ga, gb)), &zeta, &delta);
+    }
+    finish(ctx, z, x, ok, alpha, zeta, delta, fallback, fl, xr);
 }
 
 void aa_log(aa_context *ctx, aa_form *z, const aa_form *x)
 {
     PRIVATE1(z, x, ia_log);
     unsigned fl;
-    ia_interval r = operand_range(x, &fl);
+    double xr;
+    ia_interval r = operand_range(x, &fl, &xr);
     static const convex_fn fn = { f_log, d_log, t_log, NULL };
     if (r.lo <= 0) {
         aa_set_interval(ctx, z, ia_log(r), fl);
         return;
     }
     piece pc = { r.lo, r.hi, -1 };
-    approx_convex(ctx, z, x, &fn, &pc, 1, r.lo, r.hi, ia_log(r), fl);
+    approx_convex(ctx, z, x, &fn, &pc, 1, r.lo, r.hi, ia_log(r), fl, xr);
 }
 
 void aa_pow_int(aa_context *ctx, aa_form *z, const aa_form *x, int n)
@@ -517,7 +598,8 @@ void aa_pow_int(aa_context *ctx, aa_form *z, const aa_form *x, int n)
         return;
     }
     unsigned fl;
-    ia_interval r = operand_range(x, &fl);
+    double xr;
+    ia_interval r = operand_range(x, &fl, &xr);
     ia_interval fallback = ia_pow_int(r, n);
     if (n < -(1 << 20) || n > (1 << 20) || (n < 0 && r.lo <= 0 && r.hi >= 0)) {
         aa_set_interval(ctx, z, fallback, fl);
@@ -532,7 +614,7 @@ void aa_pow_int(aa_context *ctx, aa_form *z, const aa_form *x, int n)
                  : split_at(r.lo, r.hi, 0.0, -1, pcs);
     else              /* t > 0 convex; t < 0: convex if even, concave if odd */
         k = (pcs[0] = (piece){ r.lo, r.hi, (r.lo > 0 || even) ? +1 : -1 }, 1);
-    approx_convex(ctx, z, x, &fn, pcs, k, r.lo, r.hi, fallback, fl);
+    approx_convex(ctx, z, x, &fn, pcs, k, r.lo, r.hi, fallback, fl, xr);
 }
 
 static bool is_int_value(double v, int *n)
@@ -554,7 +636,8 @@ void aa_pow(aa_context *ctx, aa_form *z, const aa_form *x, const aa_form *y)
     }
     PRIVATE2(z, x, y, ia_pow);
     unsigned fl = (x->flags | y->flags) & ~AA_UNBOUNDED;
-    ia_interval rx = aa_range(x), ry = aa_range(y);
+    double xr = aa_radius(x);
+    ia_interval rx = aa_range_r(x, xr), ry = aa_range(y);
     ia_interval fallback = ia_pow(rx, ry);
     if (aa_is_point(y)) {
         double e = y->x0;
@@ -565,7 +648,7 @@ void aa_pow(aa_context *ctx, aa_form *z, const aa_form *x, const aa_form *y)
         double a = fmax(rx.lo, 0.0);
         convex_fn fn = { f_powr, d_powr, t_powr, &e };
         piece pc = { a, rx.hi, (e > 1.0 || e < 0.0) ? +1 : -1 };
-        approx_convex(ctx, z, x, &fn, &pc, 1, a, rx.hi, fallback, fl);
+        approx_convex(ctx, z, x, &fn, &pc, 1, a, rx.hi, fallback, fl, xr);
         return;
     }
     if (rx.lo > 0 && isfinite(rx.hi)) {   /* x^y = exp(y log x) */
@@ -587,20 +670,22 @@ void aa_sin(aa_context *ctx, aa_form *z, const aa_form *x)
 {
     PRIVATE1(z, x, ia_sin);
     unsigned fl;
-    ia_interval r = operand_range(x, &fl);
+    double xr;
+    ia_interval r = operand_range(x, &fl, &xr);
     ia_interval fallback = ia_sin(r);
     approx_taylor(ctx, z, x, ia_sin, ia_cos, ia_neg(fallback), r.lo, r.hi,
-                  fallback, fl);
+                  fallback, fl, xr);
 }
 
 void aa_cos(aa_context *ctx, aa_form *z, const aa_form *x)
 {
     PRIVATE1(z, x, ia_cos);
     unsigned fl;
-    ia_interval r = operand_range(x, &fl);
+    double xr;
+    ia_interval r = operand_range(x, &fl, &xr);
     ia_interval fallback = ia_cos(r);
     approx_taylor(ctx, z, x, ia_cos, neg_sin, ia_neg(fallback), r.lo, r.hi,
-                  fallback, fl);
+                  fallback, fl, xr);
 }
 
 /* tan' = 1 + tan^2 */
@@ -613,7 +698,8 @@ void aa_tan(aa_context *ctx, aa_form *z, const aa_form *x)
 {
     PRIVATE1(z, x, ia_tan);
     unsigned fl;
-    ia_interval r = operand_range(x, &fl);
+    double xr;
+    ia_interval r = operand_range(x, &fl, &xr);
     ia_interval fallback = ia_tan(r);
     if (fallback.flags & AA_UNBOUNDED) {  /* a pole: whole line, flagged */
         aa_unbounded(z, fl | fallback.flags);
@@ -621,14 +707,15 @@ void aa_tan(aa_context *ctx, aa_form *z, const aa_form *x)
     }
     /* tan'' = 2 tan (1 + tan^2) */
     ia_interval f2 = ia_mul_s(ia_mul(fallback, d_tan(r)), 2.0);
-    approx_taylor(ctx, z, x, ia_tan, d_tan, f2, r.lo, r.hi, fallback, fl);
+    approx_taylor(ctx, z, x, ia_tan, d_tan, f2, r.lo, r.hi, fallback, fl, xr);
 }
 
 void aa_asin(aa_context *ctx, aa_form *z, const aa_form *x)
 {
     PRIVATE1(z, x, ia_asin);
     unsigned fl;
-    ia_interval r = operand_range(x, &fl);
+    double xr;
+    ia_interval r = operand_range(x, &fl, &xr);
     ia_interval fallback = ia_asin(r);
     if (ia_is_empty(fallback)) {
         aa_unbounded(z, fl);
@@ -638,14 +725,15 @@ void aa_asin(aa_context *ctx, aa_form *z, const aa_form *x)
     static const convex_fn fn = { f_asin, d_asin, t_asin, NULL };
     piece pcs[2];
     int k = split_at(a, b, 0.0, -1, pcs);   /* concave below 0 */
-    approx_convex(ctx, z, x, &fn, pcs, k, a, b, fallback, fl);
+    approx_convex(ctx, z, x, &fn, pcs, k, a, b, fallback, fl, xr);
 }
 
 void aa_acos(aa_context *ctx, aa_form *z, const aa_form *x)
 {
     PRIVATE1(z, x, ia_acos);
     unsigned fl;
-    ia_interval r = operand_range(x, &fl);
+    double xr;
+    ia_interval r = operand_range(x, &fl, &xr);
     ia_interval fallback = ia_acos(r);
     if (ia_is_empty(fallback)) {
         aa_unbounded(z, fl);
@@ -655,18 +743,19 @@ void aa_acos(aa_context *ctx, aa_form *z, const aa_form *x)
     static const convex_fn fn = { f_acos, d_acos, t_asin, NULL };
     piece pcs[2];
     int k = split_at(a, b, 0.0, +1, pcs);   /* convex below 0 */
-    approx_convex(ctx, z, x, &fn, pcs, k, a, b, fallback, fl);
+    approx_convex(ctx, z, x, &fn, pcs, k, a, b, fallback, fl, xr);
 }
 
 void aa_atan(aa_context *ctx, aa_form *z, const aa_form *x)
 {
     PRIVATE1(z, x, ia_atan);
     unsigned fl;
-    ia_interval r = operand_range(x, &fl);
+    double xr;
+    ia_interval r = operand_range(x, &fl, &xr);
     static const convex_fn fn = { f_atan, d_atan, t_atan, NULL };
     piece pcs[2];
     int k = split_at(r.lo, r.hi, 0.0, +1, pcs);  /* convex below 0 */
-    approx_convex(ctx, z, x, &fn, pcs, k, r.lo, r.hi, ia_atan(r), fl);
+    approx_convex(ctx, z, x, &fn, pcs, k, r.lo, r.hi, ia_atan(r), fl, xr);
 }
 
 /* z = w + [c.lo, c.hi] for a constant known only as an interval (pi/2) */
@@ -725,7 +814,8 @@ void aa_abs(aa_context *ctx, aa_form *z, const aa_form *x)
 {
     PRIVATE1(z, x, ia_abs);
     unsigned fl;
-    ia_interval r = operand_range(x, &fl);
+    double xr;
+    ia_interval r = operand_range(x, &fl, &xr);
     if (r.lo >= 0) {
         if (z != x)
             *z = *x;
@@ -747,7 +837,7 @@ void aa_abs(aa_context *ctx, aa_form *z, const aa_form *x)
     ia_interval g = ia_make(0.0, fmax(ga.hi, gb.hi));
     double zeta, delta;
     bool ok = center_radius(g, &zeta, &delta);
-    finish(ctx, z, x, ok, alpha, zeta, delta, fallback, fl);
+    finish(ctx, z, x, ok, alpha, zeta, delta, fallback, fl, xr);
 }
 
 /* min(x, y) = (x + y - |x - y|)/2, max(x, y) = (x + y + |x - y|)/2 */
@@ -854,11 +944,12 @@ void aa_smoothstep(aa_context *ctx, aa_form *z, const aa_form *e0,
     aa_const(&w, e1->x0);
     aa_add_s(ctx, &w, &w, -e0->x0);      /* e1 - e0, rounding in w.err */
     aa_div(ctx, &t, &t, &w);
-    ia_interval rt = aa_range(&t);
+    double tr = aa_radius(&t);
+    ia_interval rt = aa_range_r(&t, tr);
     static const convex_fn fn = { f_ramp, d_ramp, t_ramp, NULL };
     piece pcs[2];
     int k = split_at(rt.lo, rt.hi, 0.5, +1, pcs);   /* convex below 1/2 */
-    approx_convex(ctx, z, &t, &fn, pcs, k, rt.lo, rt.hi, fallback, fl);
+    approx_convex(ctx, z, &t, &fn, pcs, k, rt.lo, rt.hi, fallback, fl, tr);
 }
 
 /* ---------------------------------------------------------------------- */
@@ -875,7 +966,8 @@ static void stepped(aa_context *ctx, aa_form *z, const aa_form *x,
                     ia_interval (*fi)(ia_interval), double offset)
 {
     unsigned fl;
-    ia_interval r = operand_range(x, &fl);
+    double xr;
+    ia_interval r = operand_range(x, &fl, &xr);
     ia_interval v = fi(r);
     if (v.lo == v.hi && isfinite(v.lo)) {      /* no jump inside */
         aa_const(z, v.lo);
@@ -896,7 +988,8 @@ void aa_round(aa_context *ctx, aa_form *z, const aa_form *x) { stepped(ctx, z, x
 void aa_sign(aa_context *ctx, aa_form *z, const aa_form *x)
 {
     unsigned fl;
-    ia_interval r = operand_range(x, &fl);
+    double xr;
+    ia_interval r = operand_range(x, &fl, &xr);
     ia_interval v = ia_sign(r);
     if (v.lo == v.hi) {
         aa_const(z, v.lo);

@@ -16,6 +16,9 @@ void aa_apply_linear(aa_context *ctx, aa_form *z, const aa_form *x,
                      double alpha, double zeta, double delta, ia_interval hull,
                      unsigned flags);
 
+/* aa_range(x) for r = aa_radius(x), for callers that need both. */
+ia_interval aa_range_r(const aa_form *x, double r);
+
 /* Intersects z's hull with r (another enclosure of the same values). */
 void aa_meet_hull(aa_form *z, ia_interval r);
 

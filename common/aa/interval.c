@@ -94,10 +94,21 @@ ia_interval ia_div(ia_interval x, ia_interval y)
         r.flags |= x.flags | y.flags;
         return r;
     }
-    double lo = min4(fp_div_dn(x.lo, y.lo), fp_div_dn(x.lo, y.hi),
-                     fp_div_dn(x.hi, y.lo), fp_div_dn(x.hi, y.hi));
-    double hi = max4(fp_div_up(x.lo, y.lo), fp_div_up(x.lo, y.hi),
-                     fp_div_up(x.hi, y.lo), fp_div_up(x.hi, y.hi));
+    /* y has one sign: the signs of x's ends pick the extreme corners, as
+     * for exact quotients; each picked corner's directed quotient bounds
+     * that corner (an infinity over an infinity by the whole line), so
+     * the result is sound, and it is the four corners' hull unless a
+     * corner is such an inf/inf or a nonzero quotient that rounds to 0 */
+    double lo, hi;
+    if (y.lo > 0.0) {
+        if (x.lo >= 0.0)      { lo = fp_div_dn(x.lo, y.hi); hi = fp_div_up(x.hi, y.lo); }
+        else if (x.hi <= 0.0) { lo = fp_div_dn(x.lo, y.lo); hi = fp_div_up(x.hi, y.hi); }
+        else                  { lo = fp_div_dn(x.lo, y.lo); hi = fp_div_up(x.hi, y.lo); }
+    } else {
+        if (x.lo >= 0.0)      { lo = fp_div_dn(x.hi, y.hi); hi = fp_div_up(x.lo, y.lo); }
+        else if (x.hi <= 0.0) { lo = fp_div_dn(x.hi, y.lo); hi = fp_div_up(x.lo, y.hi); }
+        else                  { lo = fp_div_dn(x.hi, y.hi); hi = fp_div_up(x.lo, y.hi); }
+    }
     return mk(lo, hi, x.flags | y.flags);
 }
 
@@ -152,8 +163,9 @@ ia_interval ia_invsqrt(ia_interval x)
 ia_interval ia_exp(ia_interval x)
 {
     RETURN_IF_EMPTY1(x);
-    double lo = max2(0.0, lm_dn(exp(x.lo)));
-    double hi = x.hi == INFINITY ? INFINITY : lm_up(exp(x.hi));
+    double ea = exp(x.lo);     /* a point calls libm once (same values) */
+    double lo = max2(0.0, lm_dn(ea));
+    double hi = x.hi == INFINITY ? INFINITY : lm_up(x.hi == x.lo ? ea : exp(x.hi));
     if (x.hi <= 0 && hi > 1.0)
         hi = 1.0;                      /* exp(t) <= 1 for t <= 0 */
     if (x.lo >= 0 && lo < 1.0)
@@ -169,8 +181,9 @@ ia_interval ia_log(ia_interval x)
         e.flags = x.flags;
         return e;
     }
-    double lo = x.lo <= 0 ? -INFINITY : lm_dn(log(x.lo));
-    double hi = lm_up(log(x.hi));
+    double lb = log(x.hi);
+    double lo = x.lo <= 0 ? -INFINITY : lm_dn(x.lo == x.hi ? lb : log(x.lo));
+    double hi = lm_up(lb);
     if (x.hi <= 1.0 && hi > 0.0)
         hi = 0.0;                      /* log(t) <= 0 for t <= 1 */
     if (x.lo >= 1.0 && lo < 0.0)
@@ -313,12 +326,14 @@ ia_interval ia_sin(ia_interval x)
     if (!isfinite(x.lo) || !isfinite(x.hi) || x.hi - x.lo >= 2 * AA_PI_LO ||
         (x.lo != x.hi && max2(fabs(x.lo), fabs(x.hi)) > TRIG_EXACT_LIMIT))
         return mk(-1.0, 1.0, x.flags & ~AA_UNBOUNDED);
-    double sa = sin(x.lo), sb = sin(x.hi);
+    double sa = sin(x.lo), sb = x.hi == x.lo ? sa : sin(x.hi);
     double lo = lm_dn(min2(sa, sb)), hi = lm_up(max2(sa, sb));
-    if (may_contain_lattice(x.lo, x.hi, M_PI_2, 2 * M_PI))
-        hi = 1.0;
-    if (may_contain_lattice(x.lo, x.hi, -M_PI_2, 2 * M_PI))
-        lo = -1.0;
+    if (x.lo != x.hi) {   /* a point has no inner extremum: libm's value, widened */
+        if (may_contain_lattice(x.lo, x.hi, M_PI_2, 2 * M_PI))
+            hi = 1.0;
+        if (may_contain_lattice(x.lo, x.hi, -M_PI_2, 2 * M_PI))
+            lo = -1.0;
+    }
     return mk(max2(lo, -1.0), min2(hi, 1.0), x.flags);
 }
 
@@ -328,12 +343,14 @@ ia_interval ia_cos(ia_interval x)
     if (!isfinite(x.lo) || !isfinite(x.hi) || x.hi - x.lo >= 2 * AA_PI_LO ||
         (x.lo != x.hi && max2(fabs(x.lo), fabs(x.hi)) > TRIG_EXACT_LIMIT))
         return mk(-1.0, 1.0, x.flags & ~AA_UNBOUNDED);
-    double ca = cos(x.lo), cb = cos(x.hi);
+    double ca = cos(x.lo), cb = x.hi == x.lo ? ca : cos(x.hi);
     double lo = lm_dn(min2(ca, cb)), hi = lm_up(max2(ca, cb));
-    if (may_contain_lattice(x.lo, x.hi, 0.0, 2 * M_PI))
-        hi = 1.0;
-    if (may_contain_lattice(x.lo, x.hi, M_PI, 2 * M_PI))
-        lo = -1.0;
+    if (x.lo != x.hi) {   /* a point has no inner extremum: libm's value, widened */
+        if (may_contain_lattice(x.lo, x.hi, 0.0, 2 * M_PI))
+            hi = 1.0;
+        if (may_contain_lattice(x.lo, x.hi, M_PI, 2 * M_PI))
+            lo = -1.0;
+    }
     return mk(max2(lo, -1.0), min2(hi, 1.0), x.flags);
 }
 
@@ -347,7 +364,8 @@ ia_interval ia_tan(ia_interval x)
         r.flags |= x.flags | AA_DISCONTINUOUS;
         return r;
     }
-    return mk(lm_dn(tan(x.lo)), lm_up(tan(x.hi)), x.flags);  /* increasing */
+    double ta = tan(x.lo), tb = x.hi == x.lo ? ta : tan(x.hi);
+    return mk(lm_dn(ta), lm_up(tb), x.flags);  /* increasing */
 }
 
 ia_interval ia_asin(ia_interval x)
@@ -359,8 +377,8 @@ ia_interval ia_asin(ia_interval x)
         return e;
     }
     double a = max2(x.lo, -1.0), b = min2(x.hi, 1.0);
-    return mk(max2(lm_dn(asin(a)), -AA_PI_2_HI), min2(lm_up(asin(b)), AA_PI_2_HI),
-              x.flags);
+    double sa = asin(a), sb = b == a ? sa : asin(b);
+    return mk(max2(lm_dn(sa), -AA_PI_2_HI), min2(lm_up(sb), AA_PI_2_HI), x.flags);
 }
 
 ia_interval ia_acos(ia_interval x)
@@ -372,13 +390,15 @@ ia_interval ia_acos(ia_interval x)
         return e;
     }
     double a = max2(x.lo, -1.0), b = min2(x.hi, 1.0);
-    return mk(max2(lm_dn(acos(b)), 0.0), min2(lm_up(acos(a)), AA_PI_HI), x.flags);
+    double ca = acos(a), cb = b == a ? ca : acos(b);
+    return mk(max2(lm_dn(cb), 0.0), min2(lm_up(ca), AA_PI_HI), x.flags);
 }
 
 ia_interval ia_atan(ia_interval x)
 {
     RETURN_IF_EMPTY1(x);
-    return mk(max2(lm_dn(atan(x.lo)), -AA_PI_2_HI), min2(lm_up(atan(x.hi)), AA_PI_2_HI),
+    double ta = atan(x.lo), tb = x.hi == x.lo ? ta : atan(x.hi);
+    return mk(max2(lm_dn(ta), -AA_PI_2_HI), min2(lm_up(tb), AA_PI_2_HI),
               x.flags & ~AA_UNBOUNDED);
 }
 
@@ -528,7 +548,8 @@ ia_interval ia_smoothstep(ia_interval e0, ia_interval e1, ia_interval x)
     RETURN_IF_EMPTY1(x);
     unsigned flags = (x.flags | e0.flags | e1.flags) & ~AA_UNBOUNDED;
     ia_interval lo = smoothstep_point(x.lo, e0.hi, e1.hi);
-    ia_interval hi = smoothstep_point(x.hi, e0.lo, e1.lo);
+    ia_interval hi = x.lo == x.hi && e0.lo == e0.hi && e1.lo == e1.hi
+                         ? lo : smoothstep_point(x.hi, e0.lo, e1.lo);   /* all points: once */
     ia_interval r = mk(lo.lo, hi.hi, flags);
     /* where e1 <= e0 is possible, smoothstep degenerates to a step */
     if (e0.hi >= e1.lo && r.lo != r.hi)

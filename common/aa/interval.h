@@ -167,14 +167,34 @@ static inline ia_interval ia_mul_s(ia_interval x, double s)
     return ia_mk_(fp_mul_dn(x.hi, s), fp_mul_up(x.lo, s), x.flags);
 }
 
+/* The directed products are monotone in each factor (fp_mul_dn/up: RN
+ * stepped outward, 0 for a zero factor, the overflow conventions), so the
+ * signs of the ends tell which corners are extreme, as for exact products
+ * (the nine cases of interval multiplication); only two ranges that both
+ * straddle 0 need four products. */
 static inline ia_interval ia_mul(ia_interval x, ia_interval y)
 {
     if (ia_is_empty(x) || ia_is_empty(y))
         return ia_empty_of_(x.flags | y.flags);
-    double lo = ia_min4_(fp_mul_dn(x.lo, y.lo), fp_mul_dn(x.lo, y.hi),
-                         fp_mul_dn(x.hi, y.lo), fp_mul_dn(x.hi, y.hi));
-    double hi = ia_max4_(fp_mul_up(x.lo, y.lo), fp_mul_up(x.lo, y.hi),
-                         fp_mul_up(x.hi, y.lo), fp_mul_up(x.hi, y.hi));
+    double lo, hi;
+    if (x.lo >= 0.0) {
+        if (y.lo >= 0.0)      { lo = fp_mul_dn(x.lo, y.lo); hi = fp_mul_up(x.hi, y.hi); }
+        else if (y.hi <= 0.0) { lo = fp_mul_dn(x.hi, y.lo); hi = fp_mul_up(x.lo, y.hi); }
+        else                  { lo = fp_mul_dn(x.hi, y.lo); hi = fp_mul_up(x.hi, y.hi); }
+    } else if (x.hi <= 0.0) {
+        if (y.lo >= 0.0)      { lo = fp_mul_dn(x.lo, y.hi); hi = fp_mul_up(x.hi, y.lo); }
+        else if (y.hi <= 0.0) { lo = fp_mul_dn(x.hi, y.hi); hi = fp_mul_up(x.lo, y.lo); }
+        else                  { lo = fp_mul_dn(x.lo, y.hi); hi = fp_mul_up(x.lo, y.lo); }
+    } else if (y.lo >= 0.0) {
+        lo = fp_mul_dn(x.lo, y.hi);
+        hi = fp_mul_up(x.hi, y.hi);
+    } else if (y.hi <= 0.0) {
+        lo = fp_mul_dn(x.hi, y.lo);
+        hi = fp_mul_up(x.lo, y.lo);
+    } else {
+        lo = ia_min2_(fp_mul_dn(x.lo, y.hi), fp_mul_dn(x.hi, y.lo));
+        hi = ia_max2_(fp_mul_up(x.lo, y.lo), fp_mul_up(x.hi, y.hi));
+    }
     return ia_mk_(lo, hi, x.flags | y.flags);
 }
 

@@ -6,6 +6,9 @@
  *                               cases: +0, -0, the smallest subnormal, the
  *                               subnormal/normal boundary, DBL_MAX, +-inf, NaN
  *   fp_up_by / fp_down_by       k steps, k = 0
+ *   bit-step fast paths         fp_next_up, fp_up_by/fp_down_by and fp_mul_dn/up
+ *                               against their one-step definitions at zero,
+ *                               subnormal, exponent and overflow edges
  *   fp_add_dn / fp_add_up       exact directed roundings: checked against the
  *                               exact sum recovered with TwoSum, including at
  *                               overflow, in the subnormal range and at +-inf
@@ -228,6 +231,85 @@ static void test_up_by_down_by(void **state)
         assert_true(fp_up_by(x, k) == a);
         assert_true(fp_down_by(x, k) == b);
     }
+}
+
+/*
+ * The integer fast paths of fp_next_up, fp_up_by/fp_down_by and fp_mul_dn
+ * (bits plus or minus k for finite nonzero values) against their one-step
+ * definitions, at the places a bit step could go wrong: crossing zero, the
+ * subnormal/normal boundary, exponent boundaries, the largest double and the
+ * infinities.
+ */
+static double ref_up_by(double x, int k)
+{
+    while (k-- > 0)
+        x = x != x || x == INFINITY ? x : x == 0.0 ? SMALLEST_SUBNORMAL : nextafter(x, INFINITY);
+    return x;
+}
+
+/* fp_mul_dn's documented meaning: 0 for a zero factor, DBL_MAX for a
+ * positive overflow of finite factors, else RN stepped down once */
+static double ref_mul_dn(double a, double b)
+{
+    if (a == 0.0 || b == 0.0)
+        return 0.0;
+    double p = a * b;
+    if (isinf(p) && isfinite(a) && isfinite(b))
+        return p > 0 ? DBL_MAX : -INFINITY;
+    if (p != p || p == -INFINITY)
+        return p;
+    return p == 0.0 ? -SMALLEST_SUBNORMAL : nextafter(p, -INFINITY);
+}
+
+static void test_bit_steps_at_edges(void **state)
+{
+    (void)state;
+    double edges[64];
+    int ne = 0;
+    for (int k = 0; k <= 5; k++)
+        edges[ne++] = k * SMALLEST_SUBNORMAL;
+    edges[ne++] = LARGEST_SUBNORMAL;
+    edges[ne++] = DBL_MIN;
+    edges[ne++] = nextafter(DBL_MIN, INFINITY);
+    edges[ne++] = 1.0;
+    edges[ne++] = nextafter(1.0, 0.0);
+    edges[ne++] = 0x1p-1021;
+    for (int k = 0; k <= 4; k++)
+        edges[ne++] = DBL_MAX - k * 0x1p971;           /* the last few doubles */
+    edges[ne++] = INFINITY;
+    int n0 = ne;
+    for (int i = 0; i < n0; i++)
+        edges[ne++] = -edges[i];
+    long bad = 0;
+    for (int i = 0; i < ne; i++) {
+        double x = edges[i];
+        if (!same_double(fp_next_up(x), ref_up_by(x, 1)))
+            bad++;
+        for (int k = 0; k <= 6; k++) {
+            if (!same_double(fp_up_by(x, k), ref_up_by(x, k)))
+                bad++;
+            if (!same_double(fp_down_by(x, k), -ref_up_by(-x, k)))
+                bad++;
+        }
+    }
+    /* products at the same edges: zero factors, underflow to 0 and to
+     * subnormals, overflow, infinities, both signs */
+    static const double f[] = {0.0, -0.0, 0x1p-600, 0x1p-537, 0x1p-300, 0.5, 1.0, 3.0,
+                               0x1p500, 0x1p600, DBL_MAX, INFINITY};
+    int nf = (int)(sizeof f / sizeof f[0]);
+    for (int i = 0; i < nf; i++)
+        for (int j = 0; j < nf; j++)
+            for (int sg = 0; sg < 4; sg++) {
+                double a = (sg & 1) ? -f[i] : f[i], b = (sg & 2) ? -f[j] : f[j];
+                if (!same_double(fp_mul_dn(a, b), ref_mul_dn(a, b)) ||
+                    !same_double(fp_mul_up(a, b), -ref_mul_dn(-a, b))) {
+                    if (bad < 5)
+                        printf("fp_mul_dn(%a, %a) = %a, want %a\n", a, b, fp_mul_dn(a, b),
+                               ref_mul_dn(a, b));
+                    bad++;
+                }
+            }
+    assert_int_equal(bad, 0);
 }
 
 /* ---- directed operations ---- */
@@ -585,6 +667,7 @@ int main(void)
         cmocka_unit_test(test_next_edge_cases),
         cmocka_unit_test(test_next_matches_nextafter),
         cmocka_unit_test(test_up_by_down_by),
+        cmocka_unit_test(test_bit_steps_at_edges),
         cmocka_unit_test(test_add_directed),
         cmocka_unit_test(test_mul_directed),
         cmocka_unit_test(test_div_directed),

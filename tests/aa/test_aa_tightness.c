@@ -14,6 +14,14 @@
  *                            capacity 2 (fully reduced) stays conservative,
  *                            also symbol by symbol, and capacity 16 is never
  *                            wider than capacity 2
+ *   closed forms             aa_sqrt, aa_exp and aa_invsqrt reach the
+ *                            Chebyshev (minimax) error of the best linear
+ *                            approximation, computed in long double, within
+ *                            1e-9 of it; their slope is the secant's
+ *   ia_mul, ia_div           the sign-case product and quotient equal the
+ *                            four corners' directed roundings (never wider;
+ *                            the same numbers unless a corner underflows to
+ *                            0 or is inf/inf)
  */
 #include <stdarg.h>
 #include <stddef.h>
@@ -444,6 +452,137 @@ static void test_condensation(void **state)
     }
 }
 
+/* ---- closed-form sqrt and exp: the minimax error ---- */
+
+/*
+ * For a convex or concave f on [a, b] the best linear approximation has the
+ * secant's slope alpha, and its error is half the spread of
+ * g(t) = f(t) - alpha*t: between g at the ends and g at the tangent point.
+ * sqrt: g(a) = sqrt(a) - alpha a, g max = 1/(4 alpha) with
+ * alpha = 1/(sqrt a + sqrt b); exp: g(a) = e^a - alpha a, g min =
+ * alpha (1 - ln alpha); inversesqrt: g(a) = a^(-1/2) - alpha a, g min =
+ * 1.5 (-2 alpha)^(1/3). The new symbol's coefficient must be within 1e-9
+ * (relative, plus a few ulps of the values) of that half spread: not
+ * smaller (unsound) and not wider (the closed form lost tightness).
+ * The tolerance allows for the rounding of f's values (64 ulps of the
+ * largest), which dominates over ranges a millionth wide.
+ */
+static void check_minimax(const char *name, double a, double b, int is_exp)
+{
+    aa_context ctx;
+    aa_context_init(&ctx, AA_DEFAULT_CAPACITY);
+    aa_form x, z;
+    aa_input(&ctx, &x, a, b);
+    if (is_exp == 2)
+        aa_invsqrt(&ctx, &z, &x);
+    else if (is_exp)
+        aa_exp(&ctx, &z, &x);
+    else
+        aa_sqrt(&ctx, &z, &x);
+    long double la = a, lb = b, alpha, gend, gext;
+    if (is_exp == 2) {
+        alpha = (1.0L / sqrtl(lb) - 1.0L / sqrtl(la)) / (lb - la);
+        gend = 1.0L / sqrtl(la) - alpha * la;
+        gext = 1.5L * cbrtl(-2.0L * alpha);
+    } else if (is_exp) {
+        alpha = (expl(lb) - expl(la)) / (lb - la);
+        gend = expl(la) - alpha * la;
+        gext = alpha * (1.0L - logl(alpha));
+    } else {
+        alpha = 1.0L / (sqrtl(la) + sqrtl(lb));
+        gend = sqrtl(la) - alpha * la;
+        gext = 1.0L / (4.0L * alpha);
+    }
+    long double want = fabsl(gext - gend) / 2.0L;
+    long double scale = is_exp == 2 ? 1.0L / sqrtl(la) : is_exp ? expl(lb) : sqrtl(lb);
+    /* the linear approximation is kept (one new symbol after the input) */
+    assert_int_equal(z.n, 2);
+    double delta = z.c[1];
+    long double slope = (long double)z.c[0] / (long double)x.c[0];
+    printf("%s over [%g, %g]: delta %.17g, minimax %.17Lg, slope %.17Lg (secant %.17Lg)\n",
+           name, a, b, delta, want, slope, alpha);
+    long double tol = 1e-9L * want + 64.0L * 0x1p-53L * scale;
+    assert_true((long double)delta >= want - tol);
+    assert_true((long double)delta <= want + tol);
+    /* the slope is the secant's, up to the rounding of f at the ends */
+    assert_true(fabsl(slope - alpha) <= 1e-12L * fabsl(alpha) + 16.0L * 0x1p-53L * scale / (lb - la));
+}
+
+static void test_closed_form_minimax(void **state)
+{
+    (void)state;
+    static const double r[][2] = {
+        {0.25, 0.5}, {1.0, 4.0}, {0.0, 1.0}, {1e-6, 2e-6}, {100.0, 100.5}, {3.0, 3.0 + 1e-6},
+    };
+    for (size_t i = 0; i < sizeof r / sizeof r[0]; i++)
+        check_minimax("sqrt", r[i][0], r[i][1], 0);
+    static const double e[][2] = {
+        {-1.0, 1.0}, {0.0, 0.1}, {-20.0, -19.0}, {5.0, 5.5}, {-0.75, -0.5}, {2.0, 2.0 + 1e-6},
+    };
+    for (size_t i = 0; i < sizeof e / sizeof e[0]; i++)
+        check_minimax("exp", e[i][0], e[i][1], 1);
+    static const double q[][2] = {
+        {0.25, 0.5}, {1.0, 4.0}, {1e-6, 2e-6}, {100.0, 100.5}, {3.0, 3.0 + 1e-6}, {0.5, 5.0},
+    };
+    for (size_t i = 0; i < sizeof q / sizeof q[0]; i++)
+        check_minimax("inversesqrt", q[i][0], q[i][1], 2);
+}
+
+/* ---- ia_mul: the sign cases against the four corners ---- */
+
+static double random_end(void)
+{
+    switch (rng_next() % 8) {
+    case 0: return 0.0;
+    case 1: return (rng_next() & 1) ? INFINITY : -INFINITY;
+    case 2: return (rng_unit() - 0.5) * 0x1p-1060;          /* subnormal products */
+    case 3: return (rng_unit() - 0.5) * 0x1p1000;           /* overflowing ones */
+    default: return 20.0 * rng_unit() - 10.0;
+    }
+}
+
+static void test_ia_mul_corners(void **state)
+{
+    (void)state;
+    long differ = 0;
+    for (int i = 0; i < 200000; i++) {
+        double a = random_end(), b = random_end(), c = random_end(), d = random_end();
+        ia_interval x = ia_make(fmin(a, b), fmax(a, b)), y = ia_make(fmin(c, d), fmax(c, d));
+        if (i % 7 == 0)
+            y = x;
+        ia_interval got = ia_mul(x, y);
+        double p[4][2] = {{x.lo, y.lo}, {x.lo, y.hi}, {x.hi, y.lo}, {x.hi, y.hi}};
+        double lo = INFINITY, hi = -INFINITY;
+        int tiny = 0;           /* a corner of nonzero factors that rounds to 0 */
+        for (int k = 0; k < 4; k++) {
+            lo = fmin(lo, fp_mul_dn(p[k][0], p[k][1]));
+            hi = fmax(hi, fp_mul_up(p[k][0], p[k][1]));
+            tiny |= p[k][0] != 0.0 && p[k][1] != 0.0 && p[k][0] * p[k][1] == 0.0;
+        }
+        /* never wider than the corners (which are sound) */
+        assert_true(got.lo >= lo && got.hi <= hi);
+        if (!tiny && !(got.lo == lo && got.hi == hi))
+            differ++;
+        /* the same for ia_div, whose divisor has one sign */
+        if (!(y.lo > 0.0 || y.hi < 0.0))
+            continue;
+        got = ia_div(x, y);
+        lo = INFINITY;
+        hi = -INFINITY;
+        tiny = 0;
+        for (int k = 0; k < 4; k++) {
+            lo = fmin(lo, fp_div_dn(p[k][0], p[k][1]));
+            hi = fmax(hi, fp_div_up(p[k][0], p[k][1]));
+            tiny |= (p[k][0] != 0.0 && p[k][0] / p[k][1] == 0.0) ||
+                    (isinf(p[k][0]) && isinf(p[k][1]));
+        }
+        assert_true(got.lo >= lo && got.hi <= hi);
+        if (!tiny && !(got.lo == lo && got.hi == hi))
+            differ++;
+    }
+    assert_int_equal(differ, 0);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -454,6 +593,8 @@ int main(void)
         cmocka_unit_test(test_sin_cos_full_period),
         cmocka_unit_test(test_flags),
         cmocka_unit_test(test_condensation),
+        cmocka_unit_test(test_closed_form_minimax),
+        cmocka_unit_test(test_ia_mul_corners),
     };
     return cmocka_run_group_tests_name("aa_tightness", tests, NULL, NULL);
 }
