@@ -2,20 +2,22 @@
  * prove.c: the Krawczyk test of a quadtree cell against a ray, and the
  * Newton iteration that places a proven hit (see prove.h).
  *
- * With x = (u, v, t), X the cell's box in those three, x~ a point of X,
- * J(X) an interval matrix enclosing the Jacobian of F over X and Y any
- * real matrix (here the inverse of J's midpoint), the Krawczyk operator
+ * The ray as two planes through it (ray_planes): G(u, v) = 0 exactly where
+ * the displaced P(u, v) lies on the ray's line. With X the cell, c its
+ * centre, J(X) an interval matrix enclosing G's Jacobian over X (from the
+ * slope bounds of trace_surface_slopes) and Y any real matrix (here the
+ * inverse of J's midpoint), the Krawczyk operator
  *
- *     K(X) = x~ - Y F(x~) + (I - Y J(X)) (X - x~)
+ *     K(X) = c - Y G(c) + (I - Y J(X)) (X - c)
  *
- * contains every zero of F in X. Hence K(X) disjoint from X proves that X
+ * contains every zero of G in X. Hence K(X) disjoint from X proves that X
  * holds no zero, and K(X) inside the interior of X proves that it holds
  * exactly one (Krawczyk 1969; Neumaier 1990, Theorem 5.1.8; the operator
  * needs only slope bounds, so a function that is merely Lipschitz, as
- * min, max and clamp make it, is covered). Here J(X) = [P_u | P_v | -d],
- * the first two columns from trace_surface_slopes over the cell, the last
- * exact; F(x~) encloses P at the cell's centre minus o + t~ d. Every
- * operation is an outward-rounded interval operation (common/aa).
+ * min, max and clamp make it, is covered). G(c) comes from an enclosure of
+ * P at the centre. Every operation is rounding-safe: midpoint-radius
+ * arithmetic whose radii cover the round-to-nearest errors (mr_*, below),
+ * ends rounded outward exactly (common/aa/rounding.h).
  */
 #include "trace/prove.h"
 
@@ -31,11 +33,6 @@
  * proof's box, which is already a fraction of a pixel wide */
 #define PROVE_NEWTON_STEPS 4
 
-/* What a proof needs of a cell, computed once per cell and kept in a
- * direct-mapped per-thread cache (a pure function of object and cell, so
- * what it holds never changes an answer; fixed size, so memory stays flat):
- * the slope bounds over the cell and the enclosure of P at its centre. */
-enum { SLOPE_CACHE_ENTRIES = 2048 };
 /* Midpoint-radius arithmetic in round-to-nearest (Rump 1999, "Fast and
  * parallel interval arithmetic"): x is [m - r, m + r]. An operation takes
  * its midpoint in RN and a radius that covers the operands' radii, the
@@ -81,6 +78,11 @@ static inline mr mr_mul(mr x, mr y)
 static inline double mr_lo(mr x) { return fp_add_dn(x.m, -x.r); }
 static inline double mr_hi(mr x) { return fp_add_up(x.m, x.r); }
 
+/* What a proof needs of a cell, computed once per cell and kept in a
+ * direct-mapped per-thread cache (a pure function of object and cell, so
+ * what it holds never changes an answer; fixed size, so memory stays flat):
+ * the slope bounds over the cell and the enclosure of P at its centre. */
+enum { SLOPE_CACHE_ENTRIES = 2048 };
 typedef struct slope_entry {
     double r[4];                    /* the cell; r[0] > r[1]: empty */
     int obj;
