@@ -22,7 +22,7 @@
  * surface is nearly linear over the cell: its affine box's other terms at
  * most this fraction of its u and v terms (trace_box.bend). Cells that
  * bend more rarely pass the test (the wave: a few; dented: 1 in 10) and
- * cost a slope run each (measured: docs/benchmarks.md, step 3). */
+ * cost a slope run each (measured: docs/benchmarks.md, step 4). */
 #define TRACE_PROVE_CELLS 16.0
 #define TRACE_PROVE_BEND 0.05
 
