@@ -129,7 +129,8 @@ void geom_unit_normal_ia(const geom_surface *s, ia_interval u, ia_interval v,
                          const geom_ia *g, ia_interval Nn[3]);
 /* Bounds of d/du and d/dv of that unit normal over the box, from the
  * same closed forms (sphere, cylinder, cone, torus, disk, polygons with
- * or without vertex normals); false for the other kinds. */
+ * or without vertex normals, bilinear patches); false for the other
+ * kinds. */
 bool geom_unit_normal_slopes_ia(const geom_surface *s, ia_interval u, ia_interval v,
                                 const geom_ia *g, ia_interval dNdu[3], ia_interval dNdv[3]);
 

@@ -118,7 +118,7 @@ static void box_from_affine(const aa_form P[3], trace_box *out)
 bool trace_surface_has_slopes(const trace_object *obj)
 {
     switch (obj->surf.kind) {
-    case GEOM_SPHERE: case GEOM_CYLINDER: case GEOM_CONE: case GEOM_TORUS:
+    case GEOM_SPHERE: case GEOM_CYLINDER: case GEOM_CONE: case GEOM_TORUS: case GEOM_PATCH:
         return obj->normal_scale > 0;
     case GEOM_POLYGON:
         return !geom_has_vertex_normals(&obj->surf) || obj->normal_scale > 0;

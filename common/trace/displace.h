@@ -35,9 +35,9 @@ void trace_surface_box(trace_thread *th, const trace_object *obj,
 bool trace_surface_flat(const trace_object *obj);
 
 /* Whether trace_surface_slopes can bound N's slopes on the object: flat
- * ones, and spheres, cylinders, cones, tori and polygons with vertex
- * normals under a similarity (their unit normals in closed form,
- * geom_unit_normal_slopes_ia). */
+ * ones, and spheres, cylinders, cones, tori, bilinear patches and
+ * polygons with vertex normals under a similarity (their unit normals in
+ * closed form, geom_unit_normal_slopes_ia). */
 bool trace_surface_has_slopes(const trace_object *obj);
 
 /* Interval bounds, over a (u,v) range, of the displaced P in CAMERA space

@@ -78,8 +78,8 @@ static const char *TANGENT_SL =
     "WorldBegin\nTranslate 0 0 4\nRotate -50 1 0 0\nDisplacement \"" shader "\"\n" \
     quadric "\nWorldEnd\n"
 
-/* curved bases (and a triangle with vertex normals) whose unit normal
- * has closed-form slopes */
+/* curved bases (and a triangle with vertex normals, a bilinear patch)
+ * whose unit normal has closed-form slopes */
 static const char *QUADRICS[] = {
     QUADRIC_RIB("%s", "Sphere 1 -1 1 360"),
     QUADRIC_RIB("%s", "Scale 1.5 1.5 1.5 Cylinder 0.6 -0.7 0.7 300"),
@@ -87,6 +87,7 @@ static const char *QUADRICS[] = {
     QUADRIC_RIB("%s", "Cone 1.2 0.8 330"),
     QUADRIC_RIB("%s", "PointsPolygons [3] [0 1 2] \"P\" [-1 -1 0  1 -1 0  0 1 0] "
                       "\"N\" [-1 -0.8 1  1.2 -0.5 1  0 1.5 1]"),
+    QUADRIC_RIB("%s", "Patch \"bilinear\" \"P\" [-1 -1 0.5  1 -1 -0.4  -1 1 -0.6  1 1 0.8]"),
 };
 
 static double urand(unsigned *s)
