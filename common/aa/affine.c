@@ -270,6 +270,21 @@ static inline int uflow_k(int k, double p, double v)
  * the rest of the longer one (no per-coefficient selects). track (a
  * constant at each call) says whether any factor needs the products'
  * rounding bookkeeping; add, sub and neg do without it. */
+/* z[i] = a x[i] for the i in [from, to) that only one operand has */
+static inline __attribute__((always_inline)) void
+lincomb_tail(int track, double a, const double *xc, int from, int to, double *zc, int ka,
+             double wa, double *ap, int *uf)
+{
+    for (int i = from; i < to; i++) {
+        double xi = xc[i], p = a * xi;
+        if (track) {
+            *ap += wa * fabs(p);
+            *uf |= uflow_k(ka, p, xi);
+        }
+        zc[i] = p;
+    }
+}
+
 static inline __attribute__((always_inline)) void
 lincomb_loops(int track, double a, const double *xc, int xn, double b,
               const double *yc, int yn, double *zc, int ka, int kb,
@@ -288,22 +303,8 @@ lincomb_loops(int track, double a, const double *xc, int xn, double b,
         }
         zc[i] = s;
     }
-    for (int i = m; i < xn; i++) {
-        double xi = xc[i], p = a * xi;
-        if (track) {
-            ap += wa * fabs(p);
-            uf |= uflow_k(ka, p, xi);
-        }
-        zc[i] = p;
-    }
-    for (int i = m; i < yn; i++) {
-        double yi = yc[i], q = b * yi;
-        if (track) {
-            ap += wb * fabs(q);
-            uf |= uflow_k(kb, q, yi);
-        }
-        zc[i] = q;
-    }
+    lincomb_tail(track, a, xc, m, xn, zc, ka, wa, &ap, &uf);
+    lincomb_tail(track, b, yc, m, yn, zc, kb, wb, &ap, &uf);
     *es_out = es;
     *ap_out = ap;
     *uf_out = uf;

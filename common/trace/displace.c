@@ -223,6 +223,31 @@ static void box_from_interval(const ia_interval P[3], trace_box *out)
     out->flags = box_flags(out, P[0].flags | P[1].flags | P[2].flags);
 }
 
+/* The displacement shader's globals over the (u,v) box in interval
+ * arithmetic, from the base surface's g (geom_eval_ia over the box), in
+ * camera space: the one binding of box and slope runs. With tangents,
+ * dPdu, dPdv and P's derivative bounds (Pd) too; without, zeros and no
+ * bounds. */
+static void bind_interval(sl_vm *vm, const trace_object *obj, ia_interval u, ia_interval v,
+                          const geom_ia *g, bool tangents)
+{
+    ia_interval P[3], N[3], dPdu[3], dPdv[3], Nn[3];
+    ia_xform(&obj->to_camera, g->P, P, true);
+    geom_unit_normal_ia(&obj->surf, u, v, g, Nn);
+    ia_camera_normal(obj, Nn, N);
+    if (!tangents) {
+        for (int i = 0; i < 3; i++)
+            dPdu[i] = dPdv[i] = ia_point(0.0);
+    } else {
+        ia_xform(&obj->to_camera, g->dPdu, dPdu, false);
+        ia_xform(&obj->to_camera, g->dPdv, dPdv, false);
+    }
+    ia_interval Pd[2][3] = {{dPdu[0], dPdu[1], dPdu[2]}, {dPdv[0], dPdv[1], dPdv[2]}};
+    bind_globals_interval(vm, obj, &obj->displacement_spaces, P, N, N, dPdu, dPdv, &u, &v,
+                          tangents ? Pd : NULL, trace_surface_flat(obj));
+    trace_primvars_bind(vm, obj, false);
+}
+
 static void box_interval(trace_thread *th, const trace_object *obj,
                          double u0, double u1, double v0, double v1, trace_box *out)
 {
@@ -234,23 +259,9 @@ static void box_interval(trace_thread *th, const trace_object *obj,
         box_from_interval(g.P, out);
         return;
     }
-    ia_interval P[3], N[3], dPdu[3], dPdv[3], Nn[3];
-    ia_xform(&obj->to_camera, g.P, P, true);
-    geom_unit_normal_ia(&obj->surf, u, v, &g, Nn);
-    ia_camera_normal(obj, Nn, N);
-    if (obj->box_skip_tangents) {         /* never read: not computed */
-        for (int i = 0; i < 3; i++)
-            dPdu[i] = dPdv[i] = ia_point(0.0);
-    } else {
-        ia_xform(&obj->to_camera, g.dPdu, dPdu, false);
-        ia_xform(&obj->to_camera, g.dPdv, dPdv, false);
-    }
-
     sl_vm *vm = th->vm;
-    ia_interval Pd[2][3] = {{dPdu[0], dPdu[1], dPdu[2]}, {dPdv[0], dPdv[1], dPdv[2]}};
-    bind_globals_interval(vm, obj, &obj->displacement_spaces, P, N, N, dPdu, dPdv, &u, &v,
-                          obj->box_skip_tangents ? NULL : Pd, trace_surface_flat(obj));
-    trace_primvars_bind(vm, obj, false);
+    bind_interval(vm, obj, u, v, &g, !obj->box_skip_tangents);  /* never read: not computed */
+    ia_interval P[3];
     if (sl_vm_run(vm, obj->displacement, SL_MODE_INTERVAL, NULL) != SL_OK) {
         trace_thread_fail(th, sl_vm_error(vm));
         P[0] = P[1] = P[2] = ia_entire();
@@ -272,17 +283,8 @@ bool trace_surface_slopes(trace_thread *th, const trace_object *obj,
     ia_interval u = ia_make(u0, u1), v = ia_make(v0, v1);
     geom_ia g;
     geom_eval_ia(&obj->surf, u, v, &g);
-    ia_interval Pb[3], N[3], dPdu[3], dPdv[3], Nn[3];
-    ia_xform(&obj->to_camera, g.P, Pb, true);
-    geom_unit_normal_ia(&obj->surf, u, v, &g, Nn);
-    ia_camera_normal(obj, Nn, N);
-    ia_xform(&obj->to_camera, g.dPdu, dPdu, false);
-    ia_xform(&obj->to_camera, g.dPdv, dPdv, false);
     sl_vm *vm = th->vm;
-    ia_interval Pd[2][3] = {{dPdu[0], dPdu[1], dPdu[2]}, {dPdv[0], dPdv[1], dPdv[2]}};
-    bool flat = trace_surface_flat(obj);
-    bind_globals_interval(vm, obj, &obj->displacement_spaces, Pb, N, N, dPdu, dPdv, &u, &v,
-                          Pd, flat);
+    bind_interval(vm, obj, u, v, &g, true);
     if (obj->surf.kind != GEOM_POLYGON) {
         /* the bind's tangents are constants to the shader, true only where
          * the base surface's tangents are (a polygon's parametrisation is
@@ -292,7 +294,7 @@ bool trace_surface_slopes(trace_thread *th, const trace_object *obj,
         sl_vm_set_derivs(vm, SL_G_dPdv, any, any);
     }
     ia_interval dNn[2][3], dN[2][3];
-    if (!flat && obj->normal_scale > 0 &&
+    if (!trace_surface_flat(obj) && obj->normal_scale > 0 &&
         geom_unit_normal_slopes_ia(&obj->surf, u, v, &g, dNn[0], dNn[1])) {
         /* N = k s M^T Nn (ia_camera_normal, a similarity): its slopes are
          * those of the object's unit normal, mapped the same way */
@@ -305,7 +307,6 @@ bool trace_surface_slopes(trace_thread *th, const trace_object *obj,
         sl_vm_set_derivs(vm, SL_G_N, dN[0], dN[1]);
         sl_vm_set_derivs(vm, SL_G_Ng, dN[0], dN[1]);
     }
-    trace_primvars_bind(vm, obj, false);
     bool slopes = Pu && Pv;
     if (slopes) th->stats.evals_slopes++;
     else th->stats.evals_interval++;
@@ -366,12 +367,8 @@ void trace_surface_point_eval(trace_thread *th, const trace_object *obj,
     trace_surface_point_eval_on(th, th->vm, obj, u, v, out);
 }
 
-/* An instance sharing its prototype's boxes (trace/instance.c): its
- * surface is the prototype's, moved rigidly into its camera space. */
-static void point_of_instance(trace_thread *th, sl_vm *vm, const trace_object *obj,
-                              double u, double v, trace_surface_point *out)
+void trace_surface_point_move(const trace_object *obj, trace_surface_point *out)
 {
-    trace_surface_point_eval_on(th, vm, obj->box_proto, u, v, out);
     const mat4 *m = &obj->from_proto, *inv = &obj->to_proto;
     out->P = mat4_xform_point(m, out->P);
     out->dPdu = mat4_xform_vector(m, out->dPdu);
@@ -380,6 +377,15 @@ static void point_of_instance(trace_thread *th, sl_vm *vm, const trace_object *o
     out->Pv = mat4_xform_vector(m, out->Pv);
     out->N = v3_normalize(mat4_xform_normal(inv, out->N));
     out->Ng = v3_normalize(mat4_xform_normal(inv, out->Ng));
+}
+
+/* An instance sharing its prototype's boxes (trace/instance.c): its
+ * surface is the prototype's, moved rigidly into its camera space. */
+static void point_of_instance(trace_thread *th, sl_vm *vm, const trace_object *obj,
+                              double u, double v, trace_surface_point *out)
+{
+    trace_surface_point_eval_on(th, vm, obj->box_proto, u, v, out);
+    trace_surface_point_move(obj, out);
 }
 
 void trace_surface_point_eval_on(trace_thread *th, sl_vm *vm, const trace_object *obj,

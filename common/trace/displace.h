@@ -63,6 +63,11 @@ typedef struct trace_surface_point {
 void trace_surface_point_eval(trace_thread *th, const trace_object *obj,
                               double u, double v, trace_surface_point *out);
 
+/* An instance sharing its prototype's boxes (box_proto): the prototype's
+ * point at the same (u,v), moved rigidly into the instance's camera
+ * space (what trace_surface_point_eval gives for the instance). */
+void trace_surface_point_move(const trace_object *obj, trace_surface_point *out);
+
 /* The same on another VM of the thread (shade.c runs it on the shading VM
  * to capture the displacement shader's outputs for message passing). */
 void trace_surface_point_eval_on(trace_thread *th, sl_vm *vm, const trace_object *obj,

@@ -142,9 +142,7 @@ bool trace_prove_eligible(const trace_object *obj)
 
 static double mid(ia_interval x) { return 0.5 * x.lo + 0.5 * x.hi; }
 
-/* Solves [Pu | Pv | -d] s = -f for the Newton step s (Cramer's rule on
- * the float matrix); false when singular. */
-static bool newton_step(vec3 Pu, vec3 Pv, vec3 d, vec3 f, double s[3])
+bool trace_newton_step(vec3 Pu, vec3 Pv, vec3 d, vec3 f, double s[3])
 {
     vec3 nd = v3_neg(d);
     double det = v3_dot(Pu, v3_cross(Pv, nd));
@@ -153,7 +151,7 @@ static bool newton_step(vec3 Pu, vec3 Pv, vec3 d, vec3 f, double s[3])
     s[0] = v3_dot(rhs, v3_cross(Pv, nd)) / det;
     s[1] = v3_dot(Pu, v3_cross(rhs, nd)) / det;
     s[2] = v3_dot(Pu, v3_cross(Pv, rhs)) / det;
-    return isfinite(s[0]) && isfinite(s[1]) && isfinite(s[2]);
+    return isfinite(s[0]) && isfinite(s[1]);
 }
 
 static double clampd(double x, ia_interval r) { return x < r.lo ? r.lo : x > r.hi ? r.hi : x; }
@@ -298,7 +296,9 @@ trace_proof trace_prove_hit(trace_thread *th, const trace_object *obj, const tra
     for (int it = 0; it < PROVE_NEWTON_STEPS; it++) {
         vec3 f = v3_sub(sp->P, trace_ray_at(ray, x[2]));
         double s[3];
-        if (!v3_is_finite(sp->P) || !newton_step(sp->Pu, sp->Pv, ray->d, f, s)) break;
+        if (!v3_is_finite(sp->P) || !trace_newton_step(sp->Pu, sp->Pv, ray->d, f, s) ||
+            !isfinite(s[2]))
+            break;
         double nx[3];
         for (int i = 0; i < 3; i++) nx[i] = clampd(x[i] + s[i], B[i]);
         /* converged: the step moves the point by less than 2^-20 of the
@@ -311,7 +311,7 @@ trace_proof trace_prove_hit(trace_thread *th, const trace_object *obj, const tra
         x[1] = nx[1];
         trace_surface_point_eval(th, obj, x[0], x[1], sp);
     }
-    if (inst != obj) trace_surface_point_eval(th, inst, x[0], x[1], sp);
+    if (inst != obj) trace_surface_point_move(inst, sp);
     th->stats.proven_hits++;
     *t_out = x[2];
     return TRACE_PROOF_HIT;

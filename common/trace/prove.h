@@ -4,16 +4,18 @@
  * Newton; Moore, Krawczyk 1969, as in Neumaier, "Interval methods for
  * systems of equations", §5) is tried on the ray's equation over the cell:
  *
- *     F(u, v, t) = P(u, v) - (o + t d) = 0,   (u, v) in the cell,
- *                                              t in the cell's box's t range
+ *     P(u, v) on the line o + t d,   (u, v) in the cell,
  *
- * with P the displaced surface in camera space. The test needs bounds of
- * P's true derivatives over the cell (trace_surface_slopes) and an
- * enclosure of P at one point, and it answers
+ * with P the displaced surface in camera space (as two plane equations
+ * G(u, v) = 0, prove.c). The test needs bounds of P's true derivatives
+ * over the cell (trace_surface_slopes) and an enclosure of P at its
+ * centre, and it answers
  *
- *   TRACE_PROOF_MISS     F has no zero there: the ray misses the surface
- *                        over this cell (exactly, not within a tolerance)
- *   TRACE_PROOF_HIT      F has exactly one zero there: the ray meets the
+ *   TRACE_PROOF_MISS     G has no zero there, or its one zero is off the
+ *                        base surface or outside (tmin, tmax): the ray
+ *                        misses the surface over this cell (exactly, not
+ *                        within a tolerance)
+ *   TRACE_PROOF_HIT      G has exactly one zero there: the ray meets the
  *                        surface over this cell once, at a point enclosed
  *                        by the proof's box, which Newton's iteration then
  *                        finds to rounding (the hit and its shading point)
@@ -21,8 +23,8 @@
  *                        border, a grazing ray, no slope bounds): the
  *                        caller subdivides as before
  *
- * Both verdicts are proofs, rounding included (ia_* with outward
- * rounding), so a cell the test settles needs no further boxes and loses
+ * Both verdicts are proofs, rounding included (midpoint-radius arithmetic
+ * whose radii cover the rounding, prove.c), so a cell the test settles needs no further boxes and loses
  * no intersection: Heidrich & Seidel's guarantee (§3) is kept, and the hit
  * is the surface's own point rather than a leaf box's (issue 10, "exact
  * hit points"). A pure function of (object, cell, ray): images stay the
@@ -43,6 +45,13 @@ typedef enum trace_proof {
     TRACE_PROOF_MISS,
     TRACE_PROOF_HIT,
 } trace_proof;
+
+/* One Newton step for the ray against the tangent plane at a surface
+ * point: solves [Pu | Pv | -d] s = -f, f = P - (o + t d), by Cramer's
+ * rule for the steps of u, v and t. False when the ray runs along the
+ * plane or the steps of u or v are not finite (a caller using s[2] tests
+ * it itself). */
+bool trace_newton_step(vec3 Pu, vec3 Pv, vec3 d, vec3 f, double s[3]);
 
 /* Whether proofs can succeed on this object at all: a displaced object
  * (not an instance) whose N has known slopes (trace_surface_has_slopes:
