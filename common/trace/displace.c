@@ -284,8 +284,9 @@ bool trace_surface_slopes(trace_thread *th, const trace_object *obj,
     geom_ia g;
     geom_eval_ia(&obj->surf, u, v, &g);
     sl_vm *vm = th->vm;
-    bind_interval(vm, obj, u, v, &g, true);
-    if (obj->surf.kind != GEOM_POLYGON) {
+    bool slopes = Pu && Pv;
+    bind_interval(vm, obj, u, v, &g, slopes || !obj->box_skip_tangents);
+    if (slopes && obj->surf.kind != GEOM_POLYGON) {
         /* the bind's tangents are constants to the shader, true only where
          * the base surface's tangents are (a polygon's parametrisation is
          * affine; a disk's is polar): else unknown slopes */
@@ -294,7 +295,7 @@ bool trace_surface_slopes(trace_thread *th, const trace_object *obj,
         sl_vm_set_derivs(vm, SL_G_dPdv, any, any);
     }
     ia_interval dNn[2][3], dN[2][3];
-    if (!trace_surface_flat(obj) && obj->normal_scale > 0 &&
+    if (slopes && !trace_surface_flat(obj) && obj->normal_scale > 0 &&
         geom_unit_normal_slopes_ia(&obj->surf, u, v, &g, dNn[0], dNn[1])) {
         /* N = k s M^T Nn (ia_camera_normal, a similarity): its slopes are
          * those of the object's unit normal, mapped the same way */
@@ -307,7 +308,6 @@ bool trace_surface_slopes(trace_thread *th, const trace_object *obj,
         sl_vm_set_derivs(vm, SL_G_N, dN[0], dN[1]);
         sl_vm_set_derivs(vm, SL_G_Ng, dN[0], dN[1]);
     }
-    bool slopes = Pu && Pv;
     if (slopes) th->stats.evals_slopes++;
     else th->stats.evals_interval++;
     sl_status st = slopes ? sl_vm_run_slopes(vm, obj->displacement)

@@ -3,24 +3,38 @@
  * Newton iteration that places a proven hit (see prove.h).
  *
  * The ray as two planes through it (ray_planes): G(u, v) = 0 exactly where
- * the displaced P(u, v) lies on the ray's line. With X the cell, c its
+ * the displaced P(u, v) lies on the ray's line. With X the cell widened by
+ * a quarter of its width on each side (the slopes' box), c the cell's
  * centre, J(X) an interval matrix enclosing G's Jacobian over X (from the
  * slope bounds of trace_surface_slopes) and Y any real matrix (here the
  * inverse of J's midpoint), the Krawczyk operator
  *
  *     K(X) = c - Y G(c) + (I - Y J(X)) (X - c)
  *
- * contains every zero of G in X. Hence K(X) disjoint from X proves that X
- * holds no zero, and K(X) inside the interior of X proves that it holds
- * exactly one (Krawczyk 1969; Neumaier 1990, Theorem 5.1.8; the operator
- * needs only slope bounds, so a function that is merely Lipschitz, as
- * min, max and clamp make it, is covered). G(c) comes from an enclosure of
- * P at the centre. Every operation is rounding-safe: midpoint-radius
- * arithmetic whose radii cover the round-to-nearest errors (mr_*, below),
- * ends rounded outward exactly (common/aa/rounding.h).
+ * contains every zero of G in X (Krawczyk 1969; Neumaier 1990, Theorem
+ * 5.1.8; the operator needs only slope bounds, so a function that is
+ * merely Lipschitz, as min, max and clamp make it, is covered). Hence
+ * K(X) disjoint from the cell proves that the cell holds no zero, and K(X)
+ * inside the interior of X proves that X holds exactly one. That zero is
+ * the cell's only candidate: the answer is it, whether it lies in the cell
+ * or beside it (a real intersection found early only prunes the walk).
+ *
+ * Where K(X) is too wide for either (the zero near the cell's border, the
+ * common case on 16-pixel cells), the zero is placed per ray instead:
+ * Newton's iteration from K's centre settles at a point y, and the small
+ * box B about y (four times the last step) passes K(B, y) inside B's
+ * interior, with G(y) enclosed by an interval evaluation at y and J still
+ * over X. That proves a zero in B, and the only one in X: K(B, y) inside
+ * B with J over X makes |I - Y J| contract (Rump 1983: every matrix in J
+ * is regular, so G is one-to-one on X). G(c) comes from an enclosure of P
+ * at the centre, cached with the slopes per cell. Every operation is
+ * rounding-safe: midpoint-radius arithmetic whose radii cover the
+ * round-to-nearest errors (mr_*, below), ends rounded outward exactly
+ * (common/aa/rounding.h).
  */
 #include "trace/prove.h"
 
+#include <float.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
@@ -32,6 +46,11 @@
 /* Newton steps after a proof: quadratic convergence from inside the
  * proof's box, which is already a fraction of a pixel wide */
 #define PROVE_NEWTON_STEPS 4
+#define PROVE_SETTLED 0x1p-12
+
+/* The slopes are taken over the cell widened by this fraction of its
+ * width on each side (within the unit square) */
+#define PROVE_MARGIN 0.25
 
 /* Midpoint-radius arithmetic in round-to-nearest (Rump 1999, "Fast and
  * parallel interval arithmetic"): x is [m - r, m + r]. An operation takes
@@ -85,6 +104,7 @@ static inline double mr_hi(mr x) { return fp_add_up(x.m, x.r); }
 enum { SLOPE_CACHE_ENTRIES = 2048 };
 typedef struct slope_entry {
     double r[4];                    /* the cell; r[0] > r[1]: empty */
+    double X[4];                    /* the box the slopes hold over */
     int obj;
     bool ok;                        /* the slopes are known */
     mr Pu[3], Pv[3], Pc[3];
@@ -118,8 +138,18 @@ static const slope_entry *cell_slopes(trace_thread *th, const trace_object *obj,
         return e->ok ? e : NULL;
     ia_interval P[3], Pu[3], Pv[3], Pc[3];
     double uc = 0.5 * (r[0] + r[1]), vc = 0.5 * (r[2] + r[3]);
-    e->ok = trace_surface_slopes(th, obj, r[0], r[1], r[2], r[3], P, Pu, Pv) &&
-            trace_surface_slopes(th, obj, uc, uc, vc, vc, Pc, NULL, NULL);
+    double du = PROVE_MARGIN * (r[1] - r[0]), dv = PROVE_MARGIN * (r[3] - r[2]);
+    double *X = e->X;
+    X[0] = fmax(0.0, r[0] - du);
+    X[1] = fmin(1.0, r[1] + du);
+    X[2] = fmax(0.0, r[2] - dv);
+    X[3] = fmin(1.0, r[3] + dv);
+    e->ok = trace_surface_slopes(th, obj, X[0], X[1], X[2], X[3], P, Pu, Pv);
+    if (!e->ok && !th->failed && PROVE_MARGIN > 0) { /* a jump beside the cell */
+        memcpy(X, r, sizeof e->X);
+        e->ok = trace_surface_slopes(th, obj, r[0], r[1], r[2], r[3], P, Pu, Pv);
+    }
+    e->ok = e->ok && trace_surface_slopes(th, obj, uc, uc, vc, vc, Pc, NULL, NULL);
     for (int i = 0; e->ok && i < 3; i++) {
         e->Pu[i] = mr_of(Pu[i]);
         e->Pv[i] = mr_of(Pv[i]);
@@ -193,6 +223,102 @@ static mr plane_g(const ray_planes *rp, int a, const mr P[3], bool point)
     return mr_sub(mr_scale(xa, rp->d[rp->k]), mr_scale(xk, rp->d[a]));
 }
 
+/* P at a point of X from an enclosure at y and the slopes over X (the
+ * mean value theorem): t = (P - o) . d / d.d over the box B */
+static bool t_range(const ray_planes *rp, const mr Py[3], const mr Pu[3], const mr Pv[3],
+                    const double y[2], const double B[2][2], ia_interval *T)
+{
+    mr ku = mr_sub(mr_of(ia_make(B[0][0], B[0][1])), mr_pt(y[0]));
+    mr kv = mr_sub(mr_of(ia_make(B[1][0], B[1][1])), mr_pt(y[1]));
+    mr num = mr_pt(0.0), dd = mr_pt(0.0);
+    for (int a = 0; a < 3; a++) {
+        mr p = mr_add(Py[a], mr_add(mr_mul(Pu[a], ku), mr_mul(Pv[a], kv)));
+        num = mr_add(num, mr_scale(mr_sub(p, mr_pt(rp->o[a])), rp->d[a]));
+        dd = mr_add(dd, mr_mul(mr_pt(rp->d[a]), mr_pt(rp->d[a])));
+    }
+    /* t = num / dd: |num/dd - num.m/dd.m| <= (num.r + |t| dd.r) / (dd.m - dd.r) */
+    double dlo = dd.m - dd.r * MR_UP;
+    if (!(dlo > 0)) return false;
+    double tm = num.m / dd.m;
+    mr tq = {tm, mr_up((num.r + fabs(tm) * dd.r) / dlo * MR_UP + MR_U * fabs(tm))};
+    *T = ia_make(mr_lo(tq), mr_hi(tq));
+    return isfinite(T->lo) && isfinite(T->hi);
+}
+
+/* The Krawczyk operator about the point y with G(y) enclosed by Gy, over
+ * the box B (containing y, inside the slopes' box): K's ends per axis */
+static bool krawczyk(const mr Gy[2], mr J[2][2], double Y[2][2], const double y[2],
+                     double B[2][2], double K[2][2])
+{
+    mr dB[2] = {mr_sub(mr_of(ia_make(B[0][0], B[0][1])), mr_pt(y[0])),
+                mr_sub(mr_of(ia_make(B[1][0], B[1][1])), mr_pt(y[1]))};
+    for (int a = 0; a < 2; a++) {
+        mr k = mr_sub(mr_pt(y[a]), mr_add(mr_scale(Gy[0], Y[a][0]), mr_scale(Gy[1], Y[a][1])));
+        for (int b = 0; b < 2; b++) {
+            mr yj = mr_add(mr_scale(J[0][b], Y[a][0]), mr_scale(J[1][b], Y[a][1]));
+            k = mr_add(k, mr_mul(mr_sub(mr_pt(a == b ? 1.0 : 0.0), yj), dB[b]));
+        }
+        K[a][0] = mr_lo(k);
+        K[a][1] = mr_hi(k);
+        if (!isfinite(K[a][0]) || !isfinite(K[a][1])) return false;
+    }
+    return true;
+}
+
+/* Whether ||I - Y J||_inf < 1, rounding included: then every matrix in J
+ * is regular, so G is one-to-one on the slopes' box (G(a) - G(b) = M (a - b)
+ * with M, the mean of G' along the segment, inside J). The early test
+ * before Newton's iteration: K(B, y) inside B with J over the slopes' box
+ * proves as much (|I - Y J| rho < rho for B's radii rho > 0: |I - Y J|'s
+ * spectral radius is below 1), so the proof rests on both. */
+static bool contracts(mr J[2][2], double Y[2][2])
+{
+    for (int a = 0; a < 2; a++) {
+        double row = 0.0;
+        for (int b = 0; b < 2; b++) {
+            mr yj = mr_add(mr_scale(J[0][b], Y[a][0]), mr_scale(J[1][b], Y[a][1]));
+            mr e = mr_sub(mr_pt(a == b ? 1.0 : 0.0), yj);
+            row = fp_add_up(row, fp_add_up(fabs(e.m), e.r));
+        }
+        if (!(row < 1.0)) return false;
+    }
+    return true;
+}
+
+static bool box_inside(double K[2][2], double X[2][2])
+{
+    return K[0][0] > X[0][0] && K[0][1] < X[0][1] && K[1][0] > X[1][0] && K[1][1] < X[1][1];
+}
+
+/* Newton's iteration on F(u, v, t) = P - (o + t d) inside B (u, v) x T
+ * from x: on true, sp is the surface at x[0..1], whose step s to the
+ * root moved the point by at most 2^-20 of the cell (w) */
+static bool newton(trace_thread *th, const trace_object *obj, const trace_ray *ray,
+                   const double B[2][2], ia_interval T, const double w[2], double x[3],
+                   double s[3], trace_surface_point *sp)
+{
+    ia_interval R[3] = {ia_make(B[0][0], B[0][1]), ia_make(B[1][0], B[1][1]), T};
+    trace_surface_point_eval(th, obj, x[0], x[1], sp);
+    x[2] = clampd(v3_dot(v3_sub(sp->P, ray->o), ray->d) / v3_dot(ray->d, ray->d), T);
+    for (int it = 0; it < PROVE_NEWTON_STEPS; it++) {
+        vec3 f = v3_sub(sp->P, trace_ray_at(ray, x[2]));
+        if (!v3_is_finite(sp->P) || !trace_newton_step(sp->Pu, sp->Pv, ray->d, f, s) ||
+            !isfinite(s[2]))
+            return false;
+        double nx[3];
+        for (int i = 0; i < 3; i++) nx[i] = clampd(x[i] + s[i], R[i]);
+        /* converged: the step moves the point by less than 2^-20 of the
+         * cell, far below anything a pixel shows */
+        bool done = fabs(nx[0] - x[0]) <= PROVE_SETTLED * w[0] && fabs(nx[1] - x[1]) <= PROVE_SETTLED * w[1];
+        x[2] = nx[2];
+        if (done) return true;
+        x[0] = nx[0];
+        x[1] = nx[1];
+        trace_surface_point_eval(th, obj, x[0], x[1], sp);
+    }
+    return false;
+}
+
 trace_proof trace_prove_hit(trace_thread *th, const trace_object *obj, const trace_ray *ray,
                             const double r[4], double tmin, double tmax,
                             double *t_out, trace_surface_point *sp, double *spread)
@@ -215,10 +341,10 @@ trace_proof trace_prove_hit(trace_thread *th, const trace_object *obj, const tra
     if (!planes_of(ray, &rp)) return TRACE_PROOF_UNKNOWN;
     const slope_entry *e = cell_slopes(th, obj, r);
     if (!e) return TRACE_PROOF_UNKNOWN;
-    double uc = 0.5 * (r[0] + r[1]), vc = 0.5 * (r[2] + r[3]);
 
-    /* G at the centre, G's Jacobian over the cell, Y = inverse of its
-     * midpoint (any real matrix serves), then K = c - Y G(c) + (I - Y J) (X - c) */
+    /* G at the cell's centre c, G's Jacobian over the slopes' box X, Y =
+     * inverse of its midpoint (any real matrix serves), then
+     * K = c - Y G(c) + (I - Y J) (X - c) */
     int ax[2] = {rp.i, rp.j};
     mr G[2], J[2][2];
     for (int a = 0; a < 2; a++) {
@@ -228,88 +354,93 @@ trace_proof trace_prove_hit(trace_thread *th, const trace_object *obj, const tra
     }
     double det = J[0][0].m * J[1][1].m - J[0][1].m * J[1][0].m;
     if (!(fabs(det) > 0) || !isfinite(det)) return TRACE_PROOF_UNKNOWN;
-    double y[2][2] = {{J[1][1].m / det, -J[0][1].m / det}, {-J[1][0].m / det, J[0][0].m / det}};
-    if (!isfinite(y[0][0]) || !isfinite(y[0][1]) || !isfinite(y[1][0]) || !isfinite(y[1][1]))
+    double Y[2][2] = {{J[1][1].m / det, -J[0][1].m / det}, {-J[1][0].m / det, J[0][0].m / det}};
+    if (!isfinite(Y[0][0]) || !isfinite(Y[0][1]) || !isfinite(Y[1][0]) || !isfinite(Y[1][1]))
         return TRACE_PROOF_UNKNOWN;
-    double c[2] = {uc, vc}, X[2][2] = {{r[0], r[1]}, {r[2], r[3]}};
-    /* X - c: the cell about its centre (c is in RN: the radius covers it) */
-    mr dX[2] = {mr_sub(mr_of(ia_make(r[0], r[1])), mr_pt(uc)),
-                mr_sub(mr_of(ia_make(r[2], r[3])), mr_pt(vc))};
+    double c[2] = {0.5 * (r[0] + r[1]), 0.5 * (r[2] + r[3])};
+    double X[2][2] = {{e->X[0], e->X[1]}, {e->X[2], e->X[3]}};
+    double cell[2][2] = {{r[0], r[1]}, {r[2], r[3]}};
+    double w[2] = {r[1] - r[0], r[3] - r[2]};
     double K[2][2];
-    bool inside = true;
-    for (int a = 0; a < 2; a++) {
-        mr k = mr_sub(mr_pt(c[a]), mr_add(mr_scale(G[0], y[a][0]), mr_scale(G[1], y[a][1])));
-        for (int b = 0; b < 2; b++) {
-            mr yj = mr_add(mr_scale(J[0][b], y[a][0]), mr_scale(J[1][b], y[a][1]));
-            k = mr_add(k, mr_mul(mr_sub(mr_pt(a == b ? 1.0 : 0.0), yj), dX[b]));
-        }
-        double lo = mr_lo(k), hi = mr_hi(k);
-        if (!isfinite(lo) || !isfinite(hi)) return TRACE_PROOF_UNKNOWN;
-        if (hi < X[a][0] || lo > X[a][1]) {
+    if (!krawczyk(G, J, Y, c, X, K)) return TRACE_PROOF_UNKNOWN;
+    /* every zero in X lies in K: none in the cell */
+    for (int a = 0; a < 2; a++)
+        if (K[a][1] < cell[a][0] || K[a][0] > cell[a][1]) {
             th->stats.proven_misses++;
             return TRACE_PROOF_MISS;
         }
-        inside = inside && lo > X[a][0] && hi < X[a][1];
-        K[a][0] = lo;
-        K[a][1] = hi;
-    }
-    *spread = fmax((K[0][1] - K[0][0]) / (r[1] - r[0]), (K[1][1] - K[1][0]) / (r[3] - r[2]));
-    if (!inside) return TRACE_PROOF_UNKNOWN;
+    *spread = fmax((K[0][1] - K[0][0]) / (X[0][1] - X[0][0]),
+                   (K[1][1] - K[1][0]) / (X[1][1] - X[1][0]));
 
-    /* The ray's line meets the surface over the cell exactly once, at a
-     * (u, v) in K; there P lies in Pc + Pu (K_u - uc) + Pv (K_v - vc)
-     * (mean value theorem, slopes over the cell), so t = (P - o) . d / d.d
-     * in T. A hit only inside (tmin, tmax) and on the base surface's domain. */
-    mr ku = mr_sub(mr_of(ia_make(K[0][0], K[0][1])), mr_pt(uc));
-    mr kv = mr_sub(mr_of(ia_make(K[1][0], K[1][1])), mr_pt(vc));
-    mr num = mr_pt(0.0), dd = mr_pt(0.0);
-    for (int a = 0; a < 3; a++) {
-        mr p = mr_add(e->Pc[a], mr_add(mr_mul(e->Pu[a], ku), mr_mul(e->Pv[a], kv)));
-        num = mr_add(num, mr_scale(mr_sub(p, mr_pt(rp.o[a])), rp.d[a]));
-        dd = mr_add(dd, mr_mul(mr_pt(rp.d[a]), mr_pt(rp.d[a])));
+    /* One zero in X, in B; the cell's zeros are X's, so the answer is
+     * X's zero whether or not it lies in the cell itself. Either K inside
+     * X's interior (Krawczyk), or, where I - Y J contracts (G one-to-one
+     * on X), a box B about the point y where Newton's iteration from K's
+     * centre settled, with K(B, y) inside B's interior: B holds a zero */
+    ia_interval T = ia_make(tmin, tmax);
+    double x[3], s[3], B[2][2];
+    bool unique = box_inside(K, X), placed = false;
+    if (unique) {
+        memcpy(B, K, sizeof B);
+        if (!t_range(&rp, e->Pc, e->Pu, e->Pv, c, B, &T)) return TRACE_PROOF_UNKNOWN;
+        if (T.hi <= tmin || T.lo >= tmax) {
+            th->stats.proven_misses++;
+            return TRACE_PROOF_MISS;
+        }
     }
-    /* t = num / dd: |num/dd - num.m/dd.m| <= (num.r + |t| dd.r) / (dd.m - dd.r) */
-    double dlo = dd.m - dd.r * MR_UP;
-    if (!(dlo > 0)) return TRACE_PROOF_UNKNOWN;
-    double tm = num.m / dd.m;
-    mr tq = {tm, mr_up((num.r + fabs(tm) * dd.r) / dlo * MR_UP + MR_U * fabs(tm))};
-    ia_interval T = ia_make(mr_lo(tq), mr_hi(tq));
-    if (!isfinite(T.lo) || !isfinite(T.hi)) return TRACE_PROOF_UNKNOWN;
-    if (T.hi <= tmin || T.lo >= tmax) {
-        th->stats.proven_misses++;
-        return TRACE_PROOF_MISS;
+    geom_cover cover = GEOM_PARTIAL;
+    if (unique && T.lo > tmin && T.hi < tmax)
+        cover = geom_uv_box_cover(&obj->surf, B[0][0], B[0][1], B[1][0], B[1][1]);
+    if (cover == GEOM_PARTIAL) {
+        /* undecided: place the zero by Newton's iteration from K's centre
+         * and prove a small box B about it (y, its last point) to hold a
+         * zero, K(B, y) inside B; it is X's only zero where K was inside
+         * X or where I - Y J contracts */
+        if (!unique && !contracts(J, Y)) return TRACE_PROOF_UNKNOWN;
+        x[0] = clampd(0.5 * (K[0][0] + K[0][1]), ia_make(X[0][0], X[0][1]));
+        x[1] = clampd(0.5 * (K[1][0] + K[1][1]), ia_make(X[1][0], X[1][1]));
+        if (!isfinite(T.hi)) T.hi = DBL_MAX;
+        if (!newton(th, obj, ray, X, T, w, x, s, sp)) return TRACE_PROOF_UNKNOWN;
+        placed = true;
+        double y[2] = {x[0], x[1]}, Bt[2][2];
+        for (int a = 0; a < 2; a++) {
+            double rho = 4.0 * fabs(s[a]) + 0x1p-30 * w[a];
+            Bt[a][0] = y[a] - rho;
+            Bt[a][1] = y[a] + rho;
+            if (!(Bt[a][0] > X[a][0] && Bt[a][1] < X[a][1])) return TRACE_PROOF_UNKNOWN;
+        }
+        ia_interval Pi[3];
+        if (!trace_surface_slopes(th, obj, y[0], y[0], y[1], y[1], Pi, NULL, NULL))
+            return TRACE_PROOF_UNKNOWN;
+        mr Py[3] = {mr_of(Pi[0]), mr_of(Pi[1]), mr_of(Pi[2])}, Gy[2];
+        for (int a = 0; a < 2; a++) Gy[a] = plane_g(&rp, ax[a], Py, true);
+        if (!krawczyk(Gy, J, Y, y, Bt, B) || !box_inside(B, Bt)) return TRACE_PROOF_UNKNOWN;
+        if (!t_range(&rp, Py, e->Pu, e->Pv, y, B, &T)) return TRACE_PROOF_UNKNOWN;
+        /* outside (tmin, tmax), or a tie with the hit found so far: T is
+         * a few roundings wide, so nothing nearer is lost */
+        if (T.hi <= tmin || T.hi >= tmax) {
+            th->stats.proven_misses++;
+            return TRACE_PROOF_MISS;
+        }
+        if (!(T.lo > tmin)) return TRACE_PROOF_UNKNOWN;
+        cover = geom_uv_box_cover(&obj->surf, B[0][0], B[0][1], B[1][0], B[1][1]);
     }
-    if (!(T.lo > tmin && T.hi < tmax)) return TRACE_PROOF_UNKNOWN;
-    geom_cover cover = geom_uv_box_cover(&obj->surf, K[0][0], K[0][1], K[1][0], K[1][1]);
+    /* a hit only on the base surface's domain */
     if (cover == GEOM_OUTSIDE) {
         th->stats.proven_misses++;
         return TRACE_PROOF_MISS;
     }
     if (cover != GEOM_INSIDE) return TRACE_PROOF_UNKNOWN;
 
-    /* Newton's iteration on F(u, v, t) = P - (o + t d), inside K x T, from
-     * K's centre: the hit point to rounding, and its shading point */
-    ia_interval B[3] = {ia_make(K[0][0], K[0][1]), ia_make(K[1][0], K[1][1]), T};
-    double x[3] = {mid(B[0]), mid(B[1]), mid(T)};
-    trace_surface_point_eval(th, obj, x[0], x[1], sp);
-    x[2] = clampd(v3_dot(v3_sub(sp->P, ray->o), ray->d) / v3_dot(ray->d, ray->d), T);
-    for (int it = 0; it < PROVE_NEWTON_STEPS; it++) {
-        vec3 f = v3_sub(sp->P, trace_ray_at(ray, x[2]));
-        double s[3];
-        if (!v3_is_finite(sp->P) || !trace_newton_step(sp->Pu, sp->Pv, ray->d, f, s) ||
-            !isfinite(s[2]))
-            break;
-        double nx[3];
-        for (int i = 0; i < 3; i++) nx[i] = clampd(x[i] + s[i], B[i]);
-        /* converged: the step moves the point by less than 2^-20 of the
-         * cell, far below anything a pixel shows */
-        bool done = fabs(nx[0] - x[0]) <= 0x1p-20 * (r[1] - r[0]) &&
-                    fabs(nx[1] - x[1]) <= 0x1p-20 * (r[3] - r[2]);
-        x[2] = nx[2];
-        if (done) break;
-        x[0] = nx[0];
-        x[1] = nx[1];
-        trace_surface_point_eval(th, obj, x[0], x[1], sp);
+    /* Newton's iteration inside B x T, from B's centre: the hit point to
+     * rounding, and its shading point */
+    if (placed) {
+        x[2] = clampd(x[2], T);
+    } else {
+        x[0] = mid(ia_make(B[0][0], B[0][1]));
+        x[1] = mid(ia_make(B[1][0], B[1][1]));
+        x[2] = mid(T);
+        newton(th, obj, ray, B, T, w, x, s, sp);
     }
     if (inst != obj) trace_surface_point_move(inst, sp);
     th->stats.proven_hits++;

@@ -8,17 +8,21 @@
  *
  * with P the displaced surface in camera space (as two plane equations
  * G(u, v) = 0, prove.c). The test needs bounds of P's true derivatives
- * over the cell (trace_surface_slopes) and an enclosure of P at its
- * centre, and it answers
+ * over the cell widened by a quarter on each side (trace_surface_slopes)
+ * and an enclosure of P at its centre, both kept per cell; where the
+ * cell's test is too coarse, Newton's iteration places the zero and a
+ * second test on a small box about it, with an enclosure of P there,
+ * proves it (prove.c). It answers
  *
  *   TRACE_PROOF_MISS     G has no zero there, or its one zero is off the
  *                        base surface or outside (tmin, tmax): the ray
  *                        misses the surface over this cell (exactly, not
  *                        within a tolerance)
- *   TRACE_PROOF_HIT      G has exactly one zero there: the ray meets the
- *                        surface over this cell once, at a point enclosed
- *                        by the proof's box, which Newton's iteration then
- *                        finds to rounding (the hit and its shading point)
+ *   TRACE_PROOF_HIT      G has exactly one zero over the widened cell: the
+ *                        ray meets the surface there once (in the cell or
+ *                        just beside it: the cell holds no other), at a
+ *                        point enclosed by the proof's box, where Newton's
+ *                        iteration settles (the hit and its shading point)
  *   TRACE_PROOF_UNKNOWN  neither (too large a cell, a root near the cell's
  *                        border, a grazing ray, no slope bounds): the
  *                        caller subdivides as before
@@ -60,10 +64,12 @@ bool trace_newton_step(vec3 Pu, vec3 Pv, vec3 d, vec3 f, double s[3]);
 bool trace_prove_eligible(const trace_object *obj);
 
 /* The test on the cell r = {u0, u1, v0, v1} for the camera-space ray;
- * (tmin, tmax) is the range a hit must lie in. On TRACE_PROOF_HIT: *t,
- * and *sp, the surface point at the hit (dual mode, as
- * trace_surface_point_eval). *spread: the width of the operator's box K
- * over the cell's, per (u, v) axis, the larger (infinite when the test
+ * (tmin, tmax) is the range a hit must lie in (a zero whose t is proven
+ * to within rounding of tmax, a tie with the hit found so far, counts as
+ * outside it). On TRACE_PROOF_HIT: *t, and *sp, the surface point at the
+ * hit (dual mode, as trace_surface_point_eval), on the ray to 2^-12 of
+ * the cell or better. *spread: the width of the operator's box K over
+ * the widened cell's, per (u, v) axis, the larger (infinite when the test
  * had no slopes): K shrinks about as fast as the cell (its width goes as
  * the cell's squared), so a test that failed with spread s is unlikely
  * to succeed on cells more than 1/s of this one. */

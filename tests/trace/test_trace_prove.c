@@ -33,6 +33,7 @@
 #include "fixture.h"
 #include "trace/camera.h"
 #include "trace/intersect.h"
+#include "trace/prove.h"
 #include "trace/render.h"
 
 static const char *WAVE_SL =
@@ -52,6 +53,14 @@ static const char *BUMPS_SL =
     "    float c = clamp(3 * sin(7 * s) * cos(5 * t), -0.8, 0.9);\n"
     "    float m = smoothstep(0.2, 0.7, s * t + 0.3 * s);\n"
     "    P += Km * (n + 0.3 * c + 0.5 * m) * normalize(N);\n"
+    "}\n";
+
+/* a ridge across the square: a ray that grazes it crosses it twice */
+static const char *RIDGE_SL =
+    "displacement ridge(float Km = 0.3)\n"
+    "{\n"
+    "    float x = s - 0.5;\n"
+    "    P += Km * (1 - 16 * x * x) * normalize(N);\n"
     "}\n";
 
 static const char *DU_SL =
@@ -277,6 +286,125 @@ static void test_proven_walks_agree_with_leaves(void **state)
     check_walks(rib);
 }
 
+/* The ray's zeros along the line v = v0 of a surface displaced only in
+ * u (the ridge on the square facing the camera): where the ray, in the
+ * plane y = const, crosses P(u, v0), found by sign changes of the
+ * crossing's 2D cross product on a fine grid and bisection; their t and
+ * u in ts and us, sorted by t */
+static int ridge_zeros(trace_thread *th, const trace_object *obj, const trace_ray *ray,
+                       double v0, double ts[8], double us[8])
+{
+    int n = 0;
+    double prev = 0, uprev = 0;
+    for (int k = 0; k <= 4000 && n < 8; k++) {
+        double u = k / 4000.0;
+        trace_surface_point sp;
+        trace_surface_point_eval(th, obj, u, v0, &sp);
+        vec3 q = v3_sub(sp.P, ray->o);
+        double f = q.x * ray->d.z - q.z * ray->d.x;
+        if (k > 0 && (f == 0 || (f > 0) != (prev > 0))) {
+            double a = uprev, b = u, fa = prev;
+            for (int it = 0; it < 60; it++) {
+                double m = 0.5 * (a + b);
+                trace_surface_point_eval(th, obj, m, v0, &sp);
+                q = v3_sub(sp.P, ray->o);
+                double fm = q.x * ray->d.z - q.z * ray->d.x;
+                if ((fm > 0) == (fa > 0)) { a = m; fa = fm; } else b = m;
+            }
+            trace_surface_point_eval(th, obj, 0.5 * (a + b), v0, &sp);
+            us[n] = 0.5 * (a + b);
+            ts[n++] = v3_dot(v3_sub(sp.P, ray->o), ray->d) / v3_dot(ray->d, ray->d);
+        }
+        prev = f;
+        uprev = u;
+    }
+    for (int i = 1; i < n; i++)
+        for (int j = i; j > 0 && ts[j] < ts[j - 1]; j--) {
+            double x = ts[j]; ts[j] = ts[j - 1]; ts[j - 1] = x;
+            x = us[j]; us[j] = us[j - 1]; us[j - 1] = x;
+        }
+    return n;
+}
+
+/* Cells where the ray meets the surface twice (a ray grazing a ridge):
+ * the test may answer only with the nearest zero, or not at all. Rays in
+ * the plane y = const over the ridge, at heights and tilts that cross it
+ * twice, against cells around the crest: a hit must be a real zero with
+ * none of the cell's nearer (a proof that took one zero of its box for
+ * the only one would answer the farther one about half the time), a miss
+ * must hide none of the cell's. */
+static void test_cell_with_two_zeros(void **state)
+{
+    (void)state;
+    fixture f;
+    fixture_shader sh[] = {{"ridge", RIDGE_SL}};
+    assert_true(fixture_open(&f,
+                             "Format 16 16 1\nProjection \"perspective\" \"fov\" [30]\n"
+                             "WorldBegin\nDisplacement \"ridge\"\n"
+                             "Polygon \"P\" [-1 -1 5  1 -1 5  1 1 5  -1 1 5]\nWorldEnd\n",
+                             sh, 1, NULL, 0));
+    trace_thread *th = trace_thread_new(&f.js->world);
+    const trace_object *obj = &f.js->world.objects[0];
+    const double v0 = 0.5;
+    trace_surface_point a, b, top;
+    trace_surface_point_eval(th, obj, 0.2, v0, &a);
+    trace_surface_point_eval(th, obj, 0.8, v0, &b);
+    trace_surface_point_eval(th, obj, 0.5, v0, &top);
+    double base = a.P.z, peak = top.P.z;      /* P.z at the ridge's foot and crest */
+    const double cells[][4] = {{0.2, 0.8, 0.45, 0.55}, {0.25, 0.75, 0.48, 0.52},
+                               {0.3, 0.7, 0.49, 0.51}, {0.375, 0.625, 0.495, 0.505}};
+    int twice = 0, both_in = 0, hits = 0, misses = 0, wrong = 0;
+    for (int c = 0; c < 4; c++)
+        for (int i = 0; i < 24; i++)
+            for (int j = 0; j < 24; j++) {
+                /* the ray through (x(0.2), za) and (x(0.8), zb), both
+                 * between the foot and the crest */
+                double za = base + (peak - base) * (0.05 + 0.9 * i / 23.0);
+                double zb = base + (peak - base) * (0.05 + 0.9 * j / 23.0);
+                vec3 A = v3(a.P.x, a.P.y, za), B = v3(b.P.x, a.P.y, zb);
+                vec3 d = v3_sub(B, A);
+                trace_ray ray;
+                trace_ray_init(&ray, v3_sub(A, d), d, 0.0, INFINITY);
+                double ts[8], us[8];
+                int n = ridge_zeros(th, obj, &ray, v0, ts, us);
+                if (n < 2) continue;
+                twice++;
+                const double *r = cells[c];
+                double nearest = INFINITY;      /* the cell's nearest zero */
+                int in = 0;
+                for (int k = n - 1; k >= 0; k--)
+                    if (us[k] >= r[0] && us[k] <= r[1]) {
+                        nearest = ts[k];
+                        in++;
+                    }
+                both_in += in >= 2;
+                double t, spread;
+                trace_surface_point sp;
+                trace_proof pr = trace_prove_hit(th, obj, &ray, r, 0.0, INFINITY, &t, &sp,
+                                                 &spread);
+                bool bad = false;
+                if (pr == TRACE_PROOF_HIT) {
+                    hits++;
+                    bool real = false;
+                    for (int k = 0; k < n; k++) real = real || fabs(t - ts[k]) <= 1e-6 * ts[k];
+                    bad = !real || t > nearest * (1 + 1e-6);
+                } else if (pr == TRACE_PROOF_MISS) {
+                    misses++;
+                    bad = in > 0;
+                }
+                if (bad && wrong++ < 5)
+                    printf("  cell %d, ray %d %d: %s at t %.9f, zeros at t %.9f %.9f, u %.6f "
+                           "%.6f\n", c, i, j, pr == TRACE_PROOF_HIT ? "hit" : "miss", t, ts[0],
+                           ts[1], us[0], us[1]);
+            }
+    printf("%d rays meet the ridge twice (%d with both zeros in the cell): %d proven hits, %d "
+           "proven misses, %d wrong\n", twice, both_in, hits, misses, wrong);
+    assert_true(twice > 500 && both_in > 500);
+    assert_int_equal(wrong, 0);
+    trace_thread_destroy(&th);
+    fixture_close(&f);
+}
+
 /* A 2 x 2 grid of quads split into triangles (as tests/corpus's mesh):
  * its 4 diagonals and 4 inner grid edges are shared, each by two of the
  * 8 triangles (16 edge bits), its 8 border edges not; a lone square
@@ -323,6 +451,7 @@ int main(void)
         cmocka_unit_test(test_slopes_enclose_derivatives),
         cmocka_unit_test(test_first_order_derivatives_give_no_slopes),
         cmocka_unit_test(test_proven_walks_agree_with_leaves),
+        cmocka_unit_test(test_cell_with_two_zeros),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
