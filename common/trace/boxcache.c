@@ -8,6 +8,7 @@
  */
 #include "trace/boxcache.h"
 
+#include <assert.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -96,10 +97,12 @@ static void lru_touch(trace_boxcache *self, trace_brood_id id)
 static trace_brood_id *link_of(trace_boxcache *self, int object,
                                trace_brood_id parent, int slot)
 {
+    if (parent == TRACE_BROOD_UNCACHED) return NULL;
     if (parent == TRACE_BROOD_NONE) {
         if (object < 0 || object >= self->nobjects) return NULL;
         return &self->roots[object];
     }
+    assert(parent >= 0 && parent < self->used);
     return &self->pool[parent].child[slot];
 }
 
@@ -179,17 +182,17 @@ trace_brood_id trace_boxcache_insert(trace_boxcache *self, int object,
                                      trace_brood_id parent, int slot,
                                      const trace_box boxes[4])
 {
-    if (parent == TRACE_BROOD_NONE && (object < 0 || object >= self->nobjects)) {
+    if (!link_of(self, object, parent, slot)) {
         self->stats.not_stored++;
-        return TRACE_BROOD_NONE;
+        return TRACE_BROOD_UNCACHED;
     }
     /* the parent must stay put while we make room */
-    if (parent != TRACE_BROOD_NONE) self->pool[parent].pinned++;
+    if (parent >= 0) self->pool[parent].pinned++;
     trace_brood_id id = alloc_brood(self);
-    if (parent != TRACE_BROOD_NONE) self->pool[parent].pinned--;
+    if (parent >= 0) self->pool[parent].pinned--;
     if (id == TRACE_BROOD_NONE) {
         self->stats.not_stored++;
-        return TRACE_BROOD_NONE;
+        return TRACE_BROOD_UNCACHED;
     }
     trace_brood *b = &self->pool[id];
     memcpy(b->box, boxes, sizeof b->box);
@@ -206,10 +209,10 @@ trace_brood_id trace_boxcache_insert(trace_boxcache *self, int object,
 
 void trace_boxcache_pin(trace_boxcache *self, trace_brood_id id)
 {
-    if (id != TRACE_BROOD_NONE) self->pool[id].pinned++;
+    if (id >= 0) self->pool[id].pinned++;
 }
 
 void trace_boxcache_unpin(trace_boxcache *self, trace_brood_id id)
 {
-    if (id != TRACE_BROOD_NONE) self->pool[id].pinned--;
+    if (id >= 0) self->pool[id].pinned--;
 }

@@ -30,8 +30,12 @@
 
 #include "trace/box.h"
 
-typedef int32_t trace_brood_id;       /* -1: none */
+typedef int32_t trace_brood_id;       /* -1: none, -2: not stored */
 #define TRACE_BROOD_NONE (-1)
+/* A node whose brood could not be stored: its children's broods cannot
+ * be either (a lookup misses, an insert stores nothing), never confused
+ * with an object's root (NONE) */
+#define TRACE_BROOD_UNCACHED (-2)
 
 typedef struct trace_brood {
     trace_box box[4];
@@ -57,14 +61,15 @@ void trace_boxcache_destroy(trace_boxcache **self_p);
 /* The brood of the children of a node: the node is child `slot` of brood
  * `parent`, or the root of `object` when parent is TRACE_BROOD_NONE. On a
  * hit copies the four boxes into out and returns the brood id (and marks it
- * recently used); on a miss returns TRACE_BROOD_NONE. */
+ * recently used); on a miss returns TRACE_BROOD_NONE (always when parent is
+ * TRACE_BROOD_UNCACHED). */
 trace_brood_id trace_boxcache_lookup(trace_boxcache *self, int object,
                                      trace_brood_id parent, int slot,
                                      trace_box out[4]);
 
 /* Stores the four child boxes of that node; returns the new brood's id, or
- * TRACE_BROOD_NONE when it could not be stored (the parent is not cached,
- * or the budget is full of pinned broods). */
+ * TRACE_BROOD_UNCACHED when it could not be stored (the parent is not
+ * stored, or the budget is full of pinned broods). */
 trace_brood_id trace_boxcache_insert(trace_boxcache *self, int object,
                                      trace_brood_id parent, int slot,
                                      const trace_box boxes[4]);

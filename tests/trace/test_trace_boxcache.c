@@ -2,7 +2,8 @@
  * test_trace_boxcache.c: the box cache on its own: stored broods come back
  * unchanged, the byte budget is a hard limit, the least recently used
  * subtree goes first, pinned broods (the traversal's path) are never
- * evicted, and an unlimited cache never evicts.
+ * evicted (a brood that finds no room is not stored, and nothing below it
+ * is), and an unlimited cache never evicts.
  */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -41,7 +42,7 @@ static void test_store_and_lookup(void **state)
     assert_memory_equal(in, out, sizeof in);
     assert_int_equal(trace_boxcache_lookup(c, 0, root, 1, out), TRACE_BROOD_NONE);
     /* object ids out of range are refused, not a crash */
-    assert_int_equal(trace_boxcache_insert(c, 5, TRACE_BROOD_NONE, 0, in), TRACE_BROOD_NONE);
+    assert_int_equal(trace_boxcache_insert(c, 5, TRACE_BROOD_NONE, 0, in), TRACE_BROOD_UNCACHED);
     assert_int_equal(trace_boxcache_stats_get(c)->evictions, 0);
     trace_boxcache_destroy(&c);
     assert_null(c);
@@ -104,12 +105,22 @@ static void test_pinned_path_survives(void **state)
     trace_brood_id a = trace_boxcache_insert(c, 0, root, 0, in);
     trace_boxcache_pin(c, a);
     /* budget full and everything pinned: not stored, nothing evicted */
-    assert_int_equal(trace_boxcache_insert(c, 0, a, 3, in), TRACE_BROOD_NONE);
+    trace_brood_id lost = trace_boxcache_insert(c, 0, a, 3, in);
+    assert_int_equal(lost, TRACE_BROOD_UNCACHED);
     assert_int_equal(trace_boxcache_stats_get(c)->evictions, 0);
     assert_int_equal(trace_boxcache_stats_get(c)->not_stored, 1);
+    /* below a brood that was not stored nothing is found or stored, and the
+     * object's root brood is untouched (an unstored parent once read as the
+     * root: a deep node got the root's children as its boxes) */
+    trace_box deep[4];
+    fill(deep, 7);
+    assert_int_equal(trace_boxcache_lookup(c, 0, lost, 2, out), TRACE_BROOD_NONE);
+    assert_int_equal(trace_boxcache_insert(c, 0, lost, 2, deep), TRACE_BROOD_UNCACHED);
+    assert_int_equal(trace_boxcache_lookup(c, 0, TRACE_BROOD_NONE, 0, out), root);
+    assert_memory_equal(out, in, sizeof out);
     trace_boxcache_unpin(c, a);
     /* now a (unpinned, under the pinned root) can make room for a sibling */
-    assert_int_not_equal(trace_boxcache_insert(c, 0, root, 1, in), TRACE_BROOD_NONE);
+    assert_true(trace_boxcache_insert(c, 0, root, 1, in) >= 0);
     assert_int_equal(trace_boxcache_lookup(c, 0, root, 0, out), TRACE_BROOD_NONE);
     assert_int_not_equal(trace_boxcache_lookup(c, 0, TRACE_BROOD_NONE, 0, out), TRACE_BROOD_NONE);
     trace_boxcache_unpin(c, root);
