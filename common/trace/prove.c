@@ -46,7 +46,12 @@
 /* Newton steps after a proof: quadratic convergence from inside the
  * proof's box, which is already a fraction of a pixel wide */
 #define PROVE_NEWTON_STEPS 4
-#define PROVE_SETTLED 0x1p-12
+/* Newton's iteration has settled when its step is at most this fraction
+ * of the cell: the step is then taken to first order (settle), which
+ * leaves the point off the ray by the step's square, quadratic
+ * convergence's next step (2^-16 of a cell, a cell being at most 16
+ * pixels: below 1/4000 of a pixel) */
+#define PROVE_SETTLED 0x1p-8
 
 /* The slopes are taken over the cell widened by this fraction of its
  * width on each side (within the unit square) */
@@ -163,6 +168,12 @@ static const slope_entry *cell_slopes(trace_thread *th, const trace_object *obj,
     memcpy(e->r, r, sizeof e->r);
     e->obj = obj->id;
     return e->ok ? e : NULL;
+}
+
+bool trace_prove_cell_has_slopes(trace_thread *th, const trace_object *obj, const double r[4])
+{
+    if (obj->box_proto) obj = obj->box_proto;
+    return cell_slopes(th, obj, r) != NULL;
 }
 
 bool trace_prove_eligible(const trace_object *obj)
@@ -292,7 +303,8 @@ static bool box_inside(double K[2][2], double X[2][2])
 
 /* Newton's iteration on F(u, v, t) = P - (o + t d) inside B (u, v) x T
  * from x: on true, sp is the surface at x[0..1], whose step s to the
- * root moved the point by at most 2^-20 of the cell (w) */
+ * root moves the point by at most PROVE_SETTLED of the cell (w), and
+ * x[2] the ray parameter after that step */
 static bool newton(trace_thread *th, const trace_object *obj, const trace_ray *ray,
                    const double B[2][2], ia_interval T, const double w[2], double x[3],
                    double s[3], trace_surface_point *sp)
@@ -307,11 +319,14 @@ static bool newton(trace_thread *th, const trace_object *obj, const trace_ray *r
             return false;
         double nx[3];
         for (int i = 0; i < 3; i++) nx[i] = clampd(x[i] + s[i], R[i]);
-        /* converged: the step moves the point by less than 2^-20 of the
-         * cell, far below anything a pixel shows */
-        bool done = fabs(nx[0] - x[0]) <= PROVE_SETTLED * w[0] && fabs(nx[1] - x[1]) <= PROVE_SETTLED * w[1];
+        bool done = fabs(nx[0] - x[0]) <= PROVE_SETTLED * w[0] &&
+                    fabs(nx[1] - x[1]) <= PROVE_SETTLED * w[1];
+        if (done) {
+            for (int i = 0; i < 3; i++) s[i] = nx[i] - x[i];
+            x[2] = nx[2];
+            return true;
+        }
         x[2] = nx[2];
-        if (done) return true;
         x[0] = nx[0];
         x[1] = nx[1];
         trace_surface_point_eval(th, obj, x[0], x[1], sp);
@@ -319,12 +334,21 @@ static bool newton(trace_thread *th, const trace_object *obj, const trace_ray *r
     return false;
 }
 
+/* The settled step s taken to first order: the point and its (u, v) */
+static void settle(trace_surface_point *sp, const double s[3])
+{
+    sp->P = v3_add(sp->P, v3_add(v3_scale(sp->Pu, s[0]), v3_scale(sp->Pv, s[1])));
+    sp->u += s[0];
+    sp->v += s[1];
+}
+
 trace_proof trace_prove_hit(trace_thread *th, const trace_object *obj, const trace_ray *ray,
                             const double r[4], double tmin, double tmax,
-                            double *t_out, trace_surface_point *sp, double *spread)
+                            double *t_out, trace_surface_point *sp, trace_proof_detail *why)
 {
     th->stats.proofs++;
-    *spread = INFINITY;
+    why->spread = INFINITY;
+    why->fold = false;
     /* an instance sharing its prototype's boxes (trace/instance.c): the
      * test runs on the prototype, the ray moved rigidly into its camera
      * space (t is kept), and the hit's point is the instance's */
@@ -352,6 +376,8 @@ trace_proof trace_prove_hit(trace_thread *th, const trace_object *obj, const tra
         J[a][0] = plane_g(&rp, ax[a], e->Pu, false);
         J[a][1] = plane_g(&rp, ax[a], e->Pv, false);
     }
+    mr detJ = mr_sub(mr_mul(J[0][0], J[1][1]), mr_mul(J[0][1], J[1][0]));
+    why->fold = !(fabs(detJ.m) > detJ.r);
     double det = J[0][0].m * J[1][1].m - J[0][1].m * J[1][0].m;
     if (!(fabs(det) > 0) || !isfinite(det)) return TRACE_PROOF_UNKNOWN;
     double Y[2][2] = {{J[1][1].m / det, -J[0][1].m / det}, {-J[1][0].m / det, J[0][0].m / det}};
@@ -369,7 +395,7 @@ trace_proof trace_prove_hit(trace_thread *th, const trace_object *obj, const tra
             th->stats.proven_misses++;
             return TRACE_PROOF_MISS;
         }
-    *spread = fmax((K[0][1] - K[0][0]) / (X[0][1] - X[0][0]),
+    why->spread = fmax((K[0][1] - K[0][0]) / (X[0][1] - X[0][0]),
                    (K[1][1] - K[1][0]) / (X[1][1] - X[1][0]));
 
     /* One zero in X, in B; the cell's zeros are X's, so the answer is
@@ -407,7 +433,11 @@ trace_proof trace_prove_hit(trace_thread *th, const trace_object *obj, const tra
             double rho = 4.0 * fabs(s[a]) + 0x1p-30 * w[a];
             Bt[a][0] = y[a] - rho;
             Bt[a][1] = y[a] + rho;
-            if (!(Bt[a][0] > X[a][0] && Bt[a][1] < X[a][1])) return TRACE_PROOF_UNKNOWN;
+            if (!(Bt[a][0] > X[a][0] && Bt[a][1] < X[a][1])) {
+                /* at the unit square's edge: the base surface's edge */
+                why->fold = X[a][0] == 0.0 || X[a][1] == 1.0;
+                return TRACE_PROOF_UNKNOWN;
+            }
         }
         ia_interval Pi[3];
         if (!trace_surface_slopes(th, obj, y[0], y[0], y[1], y[1], Pi, NULL, NULL))
@@ -430,17 +460,21 @@ trace_proof trace_prove_hit(trace_thread *th, const trace_object *obj, const tra
         th->stats.proven_misses++;
         return TRACE_PROOF_MISS;
     }
-    if (cover != GEOM_INSIDE) return TRACE_PROOF_UNKNOWN;
+    if (cover != GEOM_INSIDE) {
+        why->fold = true;            /* the zero on the base surface's edge */
+        return TRACE_PROOF_UNKNOWN;
+    }
 
     /* Newton's iteration inside B x T, from B's centre: the hit point to
      * rounding, and its shading point */
     if (placed) {
+        settle(sp, s);
         x[2] = clampd(x[2], T);
     } else {
         x[0] = mid(ia_make(B[0][0], B[0][1]));
         x[1] = mid(ia_make(B[1][0], B[1][1]));
         x[2] = mid(T);
-        newton(th, obj, ray, B, T, w, x, s, sp);
+        if (newton(th, obj, ray, B, T, w, x, s, sp)) settle(sp, s);
     }
     if (inst != obj) trace_surface_point_move(inst, sp);
     th->stats.proven_hits++;

@@ -63,18 +63,35 @@ bool trace_newton_step(vec3 Pu, vec3 Pv, vec3 d, vec3 f, double s[3]);
  * would be the whole line and every try wasted. */
 bool trace_prove_eligible(const trace_object *obj);
 
+/* Whether the test would have slope bounds over the cell (kept for the
+ * test, as the test's own): false where the displacement jumps, reads a
+ * texture or a first derivative over it */
+bool trace_prove_cell_has_slopes(trace_thread *th, const trace_object *obj, const double r[4]);
+
+/* What an undecided test tells the walk (prove.h, intersect.c) */
+typedef struct trace_proof_detail {
+    /* the width of the operator's box K over the widened cell's, per
+     * (u, v) axis, the larger (infinite when the test had no slopes): K
+     * shrinks about as fast as the cell (its width goes as the cell's
+     * squared), so a test that failed with spread s is unlikely to
+     * succeed on cells more than 1/s of this one */
+    double spread;
+    /* G's Jacobian may be singular over the cell (its determinant's
+     * bounds hold 0): the ray may run along the surface there, a fold at
+     * a silhouette, where no test succeeds however small the cell; or the
+     * zero lies across the base surface's edge. Finer leaves tell a hit
+     * from a near miss there. */
+    bool fold;
+} trace_proof_detail;
+
 /* The test on the cell r = {u0, u1, v0, v1} for the camera-space ray;
  * (tmin, tmax) is the range a hit must lie in (a zero whose t is proven
  * to within rounding of tmax, a tie with the hit found so far, counts as
  * outside it). On TRACE_PROOF_HIT: *t, and *sp, the surface point at the
- * hit (dual mode, as trace_surface_point_eval), on the ray to 2^-12 of
- * the cell or better. *spread: the width of the operator's box K over
- * the widened cell's, per (u, v) axis, the larger (infinite when the test
- * had no slopes): K shrinks about as fast as the cell (its width goes as
- * the cell's squared), so a test that failed with spread s is unlikely
- * to succeed on cells more than 1/s of this one. */
+ * hit (dual mode, as trace_surface_point_eval), on the ray to 2^-16 of
+ * the cell or better. On TRACE_PROOF_UNKNOWN: *why. */
 trace_proof trace_prove_hit(trace_thread *th, const trace_object *obj, const trace_ray *ray,
                             const double r[4], double tmin, double tmax,
-                            double *t, trace_surface_point *sp, double *spread);
+                            double *t, trace_surface_point *sp, trace_proof_detail *why);
 
 #endif

@@ -142,9 +142,11 @@ static void test_nurbs_scene(void **state)
     }
     printf("NuPatch torus against the quadric torus: %d of %d opaque pixels differ by more "
            "than 8/255, %d in coverage (quadric: %d opaque)\n", differ, opaque, coverage, topaque);
-    /* measured: 33 and 14 of 769, silhouette pixels where the renderer's
-     * sub-pixel refinement lands differently */
-    assert_true(differ <= opaque / 12);
+    /* measured: 76 and 22 of 769, silhouette pixels: the quadric's are
+     * exact (hit proofs, and leaves of 1/16 pixel where a fold defeats
+     * them, intersect.c), the NuPatch's leaves of a pixel take near
+     * misses (33 and 14 when both took them) */
+    assert_true(differ <= opaque / 8);
     assert_true(coverage <= opaque / 25);
     free(a);
     free(b);
