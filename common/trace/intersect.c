@@ -436,7 +436,7 @@ static bool grazes(walk *w, const double r[4], trace_surface_point *centre)
 }
 
 static void visit(walk *w, const trace_box *node, const double r[4],
-                  trace_brood_id parent, int slot, int depth, bool fine)
+                  trace_brood_id parent, int slot, int depth, bool fine, geom_cover node_cover)
 {
     if (over_limit(w, r)) return;
     trace_box kids[4];
@@ -450,7 +450,10 @@ static void visit(walk *w, const trace_box *node, const double r[4],
         double c[4];
         child_range(i, r[0], r[1], r[2], r[3], c);
         if (trace_box_is_empty(&kids[i]) && !(kids[i].flags & AA_UNBOUNDED)) continue;
-        geom_cover cover = geom_uv_box_cover(&w->obj->surf, c[0], c[1], c[2], c[3]);
+        /* inside the base surface's domain: so are the node's parts */
+        geom_cover cover = node_cover == GEOM_INSIDE
+                               ? GEOM_INSIDE
+                               : geom_uv_box_cover(&w->obj->surf, c[0], c[1], c[2], c[3]);
         if (cover == GEOM_OUTSIDE) continue;
         double t0, t1;
         int axis;
@@ -515,7 +518,7 @@ static void visit(walk *w, const trace_box *node, const double r[4],
                  box_min_extent(kid) * w->obj->scale <= tol && real_wall(w, c, tol, &wall_n))
             leaf_hit(w, kid, c, &order[k], TRACE_LEAF_WALL, wall_n, NULL);
         else
-            visit(w, kid, c, brood, order[k].i, d, kid_fine);
+            visit(w, kid, c, brood, order[k].i, d, kid_fine, order[k].cover);
     }
     trace_boxcache_unpin(w->th->cache, brood);
 }
@@ -541,7 +544,7 @@ static bool intersect_displaced(trace_thread *th, const trace_object *obj,
     if (!trace_box_hit(&obj->root, &w.ray, ray->tmin, best->t, &t0, &t1, NULL))
         return false;
     double r[4] = {0, 1, 0, 1};
-    visit(&w, &obj->root, r, TRACE_BROOD_NONE, 0, 0, false);
+    visit(&w, &obj->root, r, TRACE_BROOD_NONE, 0, 0, false, GEOM_PARTIAL);
     th->stats.nodes += w.nodes;
     if (w.nodes > th->stats.max_nodes_per_ray) th->stats.max_nodes_per_ray = w.nodes;
     return w.found;
