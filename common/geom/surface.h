@@ -109,6 +109,10 @@ void geom_eval_dual(const geom_surface *s, double u, double v, geom_sample *out)
 /* Enclosures over the box [u0,u1] x [v0,v1]. */
 typedef struct geom_ia { ia_interval P[3], dPdu[3], dPdv[3], Ng[3]; } geom_ia;
 void geom_eval_ia(const geom_surface *s, ia_interval u, ia_interval v, geom_ia *out);
+/* The same, tighter and dearer where a kind allows it (a bicubic patch:
+ * met with the bounds of its piece over the box as a Bezier net of its
+ * own), for the few evaluations that need it (hit proofs' slopes) */
+void geom_eval_ia_tight(const geom_surface *s, ia_interval u, ia_interval v, geom_ia *out);
 
 /* u and v are affine forms the caller made with aa_input (so they own the
  * query's first two noise symbols); results share them. */
@@ -129,8 +133,9 @@ void geom_unit_normal_ia(const geom_surface *s, ia_interval u, ia_interval v,
                          const geom_ia *g, ia_interval Nn[3]);
 /* Bounds of d/du and d/dv of that unit normal over the box, from the
  * same closed forms (sphere, cylinder, cone, torus, disk, polygons with
- * or without vertex normals, bilinear patches); false for the other
- * kinds. */
+ * or without vertex normals, bilinear patches) or the second derivatives
+ * (bicubic patches); false for the other kinds and where the normal's
+ * length may vanish. */
 bool geom_unit_normal_slopes_ia(const geom_surface *s, ia_interval u, ia_interval v,
                                 const geom_ia *g, ia_interval dNdu[3], ia_interval dNdv[3]);
 

@@ -19,7 +19,10 @@
  * C_j = sum_i B_i(u) P_ij and D_j = sum_i B_i'(u) P_ij are affine in
  * those; then P = sum_j B_j(v) C_j, dPdu = sum_j B_j(v) D_j,
  * dPdv = sum_j B_j'(v) C_j (12 products per coordinate) and
- * Ng = dPdu x dPdv (6): 56 non-affine operations in all.
+ * Ng = dPdu x dPdv (6): 56 non-affine operations in all. The slopes of
+ * the unit normal over a box (for hit proofs, trace/prove.c) come from
+ * the piece of the patch over the box, as a Bezier net of its own, whose
+ * first and second differences bound the derivatives.
  *
  * Intersection: recursive de Casteljau subdivision of the control net,
  * each piece pruned by its net's box against the ray's slab interval (the
@@ -109,6 +112,90 @@ static ia_interval sum4_ia(const ia_interval a[4], const ia_interval b[4])
     return r;
 }
 
+/* The cubic's blossom f(t1, t2, t3) (de Casteljau with t1, t2, t3 at its
+ * three levels): the control points of the piece over [a, b] are
+ * f(a,a,a), f(a,a,b), f(a,b,b), f(b,b,b) */
+static ia_interval blossom_ia(const ia_interval p[4], ia_interval t1, ia_interval t2,
+                              ia_interval t3)
+{
+    ia_interval r[4] = {p[0], p[1], p[2], p[3]}, t[3] = {t1, t2, t3};
+    for (int l = 0; l < 3; l++)
+        for (int i = 0; i < 3 - l; i++)
+            r[i] = ia_add(r[i], ia_mul(ia_sub(r[i + 1], r[i]), t[l]));
+    return r[0];
+}
+
+static void piece_ia(const ia_interval p[4], ia_interval a, ia_interval b, ia_interval q[4])
+{
+    q[0] = blossom_ia(p, a, a, a);
+    q[1] = blossom_ia(p, a, a, b);
+    q[2] = blossom_ia(p, a, b, b);
+    q[3] = blossom_ia(p, b, b, b);
+}
+
+static void cross_ia(const ia_interval a[3], const ia_interval b[3], ia_interval out[3])
+{
+    for (int c = 0; c < 3; c++) {
+        int i = (c + 1) % 3, j = (c + 2) % 3;
+        out[c] = ia_sub(ia_mul(a[i], b[j]), ia_mul(a[j], b[i]));
+    }
+}
+
+/* The piece of the patch over the box as a Bezier patch of its own,
+ * q[c][j][i] for coordinate c (blossoms in interval arithmetic): it and
+ * its derivatives (Bezier patches whose control points are the net's
+ * differences) lie in the hulls of their control points (Farin, "Curves
+ * and Surfaces for CAGD", §4.3, §16.2) */
+static void piece_net(const geom_surface *s, ia_interval u, ia_interval v,
+                      ia_interval q[3][4][4])
+{
+    for (int c = 0; c < 3; c++) {
+        for (int j = 0; j < 4; j++) {
+            ia_interval row[4];
+            for (int i = 0; i < 4; i++) row[i] = ia_point(v3_comp(s->verts[4 * j + i], c));
+            piece_ia(row, ia_point(u.lo), ia_point(u.hi), q[c][j]);
+        }
+        for (int i = 0; i < 4; i++) {
+            ia_interval col[4] = {q[c][0][i], q[c][1][i], q[c][2][i], q[c][3][i]}, r[4];
+            piece_ia(col, ia_point(v.lo), ia_point(v.hi), r);
+            for (int j = 0; j < 4; j++) q[c][j][i] = r[j];
+        }
+    }
+}
+
+/* Over the piece, with the net q of one coordinate: the hull of the
+ * k-th differences along u (ku) and v (kv), times the derivative's
+ * factors (3, 6, 9: d^(ku+kv)/ds^ku dt^kv of the Bernstein form) */
+static ia_interval net_diff(ia_interval q[4][4], int ku, int kv)
+{
+    static const double factor[3][3] = {{1, 3, 6}, {3, 9, 0}, {6, 0, 0}};
+    ia_interval h = ia_empty();
+    for (int j = 0; j + kv < 4; j++)
+        for (int i = 0; i + ku < 4; i++) {
+            ia_interval d;
+            if (ku == 2)
+                d = ia_add(ia_sub(q[j][i + 2], ia_mul_s(q[j][i + 1], 2)), q[j][i]);
+            else if (kv == 2)
+                d = ia_add(ia_sub(q[j + 2][i], ia_mul_s(q[j + 1][i], 2)), q[j][i]);
+            else if (ku == 1 && kv == 1)
+                d = ia_add(ia_sub(q[j + 1][i + 1], q[j + 1][i]), ia_sub(q[j][i], q[j][i + 1]));
+            else if (ku == 1)
+                d = ia_sub(q[j][i + 1], q[j][i]);
+            else if (kv == 1)
+                d = ia_sub(q[j + 1][i], q[j][i]);
+            else
+                d = q[j][i];
+            h = i == 0 && j == 0 ? d : ia_hull(h, d);
+        }
+    return ia_mul_s(h, factor[ku][kv]);
+}
+
+static ia_interval meet(ia_interval a, ia_interval b)
+{
+    double lo = fmax(a.lo, b.lo), hi = fmin(a.hi, b.hi);
+    return lo <= hi ? ia_make(lo, hi) : a;
+}
+
 void geom_bicubic_eval_ia(const geom_surface *s, ia_interval u, ia_interval v, geom_ia *o)
 {
     ia_interval bu[4], du[4], bv[4], dv[4];
@@ -131,6 +218,72 @@ void geom_bicubic_eval_ia(const geom_surface *s, ia_interval u, ia_interval v, g
         int a = (c + 1) % 3, b = (c + 2) % 3;
         o->Ng[c] = ia_sub(ia_mul(o->dPdu[a], o->dPdv[b]), ia_mul(o->dPdu[b], o->dPdv[a]));
     }
+}
+
+void geom_bicubic_tighten_ia(const geom_surface *s, ia_interval u, ia_interval v, geom_ia *o)
+{
+    if (!(u.hi - u.lo > 0x1p-20) || !(v.hi - v.lo > 0x1p-20)) return;
+    ia_interval q[3][4][4];
+    piece_net(s, u, v, q);
+    ia_interval iu = ia_recip(ia_sub(ia_point(u.hi), ia_point(u.lo)));
+    ia_interval iv = ia_recip(ia_sub(ia_point(v.hi), ia_point(v.lo)));
+    for (int c = 0; c < 3; c++) {
+        o->P[c] = meet(o->P[c], net_diff(q[c], 0, 0));
+        o->dPdu[c] = meet(o->dPdu[c], ia_mul(net_diff(q[c], 1, 0), iu));
+        o->dPdv[c] = meet(o->dPdv[c], ia_mul(net_diff(q[c], 0, 1), iv));
+    }
+    for (int c = 0; c < 3; c++) {
+        int a = (c + 1) % 3, b = (c + 2) % 3;
+        o->Ng[c] = meet(o->Ng[c], ia_sub(ia_mul(o->dPdu[a], o->dPdv[b]),
+                                         ia_mul(o->dPdu[b], o->dPdv[a])));
+    }
+}
+
+/* ---- slopes of the unit normal -------------------------------------- */
+
+bool geom_bicubic_normal_slopes_ia(const geom_surface *s, ia_interval u, ia_interval v,
+                                   ia_interval dNdu[3], ia_interval dNdv[3])
+{
+    /* the derivatives from the piece's net: d/du = d/ds / (u1 - u0), and
+     * likewise for v */
+    if (!(u.hi - u.lo > 0x1p-20) || !(v.hi - v.lo > 0x1p-20)) return false;
+    ia_interval q[3][4][4];
+    piece_net(s, u, v, q);
+    ia_interval iu = ia_recip(ia_sub(ia_point(u.hi), ia_point(u.lo)));
+    ia_interval iv = ia_recip(ia_sub(ia_point(v.hi), ia_point(v.lo)));
+    ia_interval Pu[3], Pv[3], Puu[3], Puv[3], Pvv[3];
+    for (int c = 0; c < 3; c++) {
+        Pu[c] = ia_mul(net_diff(q[c], 1, 0), iu);
+        Pv[c] = ia_mul(net_diff(q[c], 0, 1), iv);
+        Puu[c] = ia_mul(ia_mul(net_diff(q[c], 2, 0), iu), iu);
+        Puv[c] = ia_mul(ia_mul(net_diff(q[c], 1, 1), iu), iv);
+        Pvv[c] = ia_mul(ia_mul(net_diff(q[c], 0, 2), iv), iv);
+    }
+    /* Ng = Pu x Pv, its derivatives Puu x Pv + Pu x Puv and Puv x Pv +
+     * Pu x Pvv; the unit normal's, (dNg - Nn (Nn . dNg)) / |Ng| */
+    ia_interval N[3], a[3], b[3], Nu[3], Nv[3], Nn[3];
+    cross_ia(Pu, Pv, N);
+    cross_ia(Puu, Pv, a);
+    cross_ia(Pu, Puv, b);
+    for (int c = 0; c < 3; c++) Nu[c] = ia_add(a[c], b[c]);
+    cross_ia(Puv, Pv, a);
+    cross_ia(Pu, Pvv, b);
+    for (int c = 0; c < 3; c++) Nv[c] = ia_add(a[c], b[c]);
+    ia_interval n2 = ia_add(ia_add(ia_sqr(N[0]), ia_sqr(N[1])), ia_sqr(N[2]));
+    if (!(n2.lo > 0) || !isfinite(n2.hi)) return false;
+    ia_interval inv = ia_invsqrt(n2);
+    for (int c = 0; c < 3; c++) Nn[c] = ia_mul(N[c], inv);
+    for (int d = 0; d < 2; d++) {
+        const ia_interval *dn = d == 0 ? Nu : Nv;
+        ia_interval dot = ia_add(ia_add(ia_mul(Nn[0], dn[0]), ia_mul(Nn[1], dn[1])),
+                                 ia_mul(Nn[2], dn[2]));
+        ia_interval *out = d == 0 ? dNdu : dNdv;
+        for (int c = 0; c < 3; c++) {
+            out[c] = ia_mul(ia_sub(dn[c], ia_mul(Nn[c], dot)), inv);
+            if (!isfinite(out[c].lo) || !isfinite(out[c].hi)) return false;
+        }
+    }
+    return true;
 }
 
 /* ---- affine --------------------------------------------------------- */

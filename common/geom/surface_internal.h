@@ -66,6 +66,14 @@ bool geom_vertex_normal_prepare(geom_surface *s, char *why, int why_size);
 bool geom_bicubic_prepare(geom_surface *s, char *why, int why_size);
 void geom_bicubic_eval_dual(const geom_surface *s, double u, double v, geom_sample *out);
 void geom_bicubic_eval_ia(const geom_surface *s, ia_interval u, ia_interval v, geom_ia *out);
+/* geom_eval_ia's bounds met with those of the piece of the patch over
+ * the box, a Bezier net of its own (tighter on wide boxes, where the
+ * tensor form loses the basis functions' correlation, and dearer) */
+void geom_bicubic_tighten_ia(const geom_surface *s, ia_interval u, ia_interval v, geom_ia *out);
+/* Bounds of d/du, d/dv of the unit normal Ng/|Ng| over the box; false
+ * where |Ng| may vanish there */
+bool geom_bicubic_normal_slopes_ia(const geom_surface *s, ia_interval u, ia_interval v,
+                                   ia_interval dNdu[3], ia_interval dNdv[3]);
 void geom_bicubic_eval_aa(aa_context *ctx, const geom_surface *s, const aa_form *u,
                           const aa_form *v, geom_aa *out);
 void geom_bicubic_bounds(const geom_surface *s, vec3 *lo, vec3 *hi);

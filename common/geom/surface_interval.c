@@ -195,3 +195,9 @@ void geom_eval_ia(const geom_surface *s, ia_interval u, ia_interval v, geom_ia *
         break;
     }
 }
+
+void geom_eval_ia_tight(const geom_surface *s, ia_interval u, ia_interval v, geom_ia *out)
+{
+    geom_eval_ia(s, u, v, out);
+    if (s->kind == GEOM_BICUBIC) geom_bicubic_tighten_ia(s, u, v, out);
+}

@@ -277,6 +277,8 @@ bool geom_unit_normal_slopes_ia(const geom_surface *s, ia_interval u, ia_interva
     case GEOM_PATCH:                 /* Ng = Pu x Pv is linear in (u, v) */
         return linear_normal_slopes(u, v, &s->consts[K_N0], &s->consts[K_N1], &s->consts[K_N2],
                                     dNdu, dNdv);
+    case GEOM_BICUBIC:
+        return geom_bicubic_normal_slopes_ia(s, u, v, dNdu, dNdv);
     default:
         return false;
     }

@@ -119,6 +119,7 @@ bool trace_surface_has_slopes(const trace_object *obj)
 {
     switch (obj->surf.kind) {
     case GEOM_SPHERE: case GEOM_CYLINDER: case GEOM_CONE: case GEOM_TORUS: case GEOM_PATCH:
+    case GEOM_BICUBIC:
         return obj->normal_scale > 0;
     case GEOM_POLYGON:
         return !geom_has_vertex_normals(&obj->surf) || obj->normal_scale > 0;
@@ -282,7 +283,7 @@ bool trace_surface_slopes(trace_thread *th, const trace_object *obj,
     if (!obj->displacement || obj->box_proto) return false;
     ia_interval u = ia_make(u0, u1), v = ia_make(v0, v1);
     geom_ia g;
-    geom_eval_ia(&obj->surf, u, v, &g);
+    geom_eval_ia_tight(&obj->surf, u, v, &g);
     sl_vm *vm = th->vm;
     bool slopes = Pu && Pv;
     bind_interval(vm, obj, u, v, &g, slopes || !obj->box_skip_tangents);
