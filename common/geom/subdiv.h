@@ -73,6 +73,12 @@ void geom_subdiv_face_points(const geom_subdiv *self, int f, int out[4]);
 /* A GEOM_SUBDIV surface for face f (prepared). */
 void geom_subdiv_surface(const geom_subdiv *self, int f, geom_surface *out);
 
+/* Bounds of d/du, d/dv of the unit normal over the box where it lies in
+ * one regular sub-patch (a bicubic's, surface_bicubic.c); false
+ * elsewhere (near an extraordinary point, a crease's irregular corner) */
+bool geom_subdiv_normal_slopes_ia(const geom_surface *s, ia_interval u, ia_interval v,
+                                  ia_interval dNdu[3], ia_interval dNdv[3]);
+
 /* The unit normal over the (u,v) box of a GEOM_SUBDIV surface where its
  * Ng cannot bound it (an irregular sub-face): true and Nn when the box
  * lies in one irregular sub-face whose normal is proven constant

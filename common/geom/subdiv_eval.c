@@ -454,6 +454,30 @@ void geom_subdiv_eval_ia(const geom_surface *s, ia_interval u, ia_interval v, ge
     }
 }
 
+bool geom_subdiv_normal_slopes_ia(const geom_surface *s, ia_interval u, ia_interval v,
+                                  ia_interval dNdu[3], ia_interval dNdv[3])
+{
+    sd_range r;
+    find_range(s->subdiv, s->subdiv_face, u.lo, u.hi, v.lo, v.hi, &r);
+    if (!r.regular) return false;
+    /* the regular sub-patch's Bezier net over the box, in its own
+     * coordinates s = k (u - ou): d/du = k d/ds (k a power of 2: exact) */
+    double k = ldexp(1, r.level);
+    ia_interval su = ia_mul_s(ia_add_s(u, -r.ou), k), sv = ia_mul_s(ia_add_s(v, -r.ov), k);
+    su = ia_make(fmax(su.lo, 0), fmin(su.hi, 1));
+    sv = ia_make(fmax(sv.lo, 0), fmin(sv.hi, 1));
+    geom_surface b;
+    net_surface(r.net, &b);
+    if (!(su.lo <= su.hi && sv.lo <= sv.hi) ||
+        !geom_bicubic_normal_slopes_ia(&b, su, sv, dNdu, dNdv))
+        return false;
+    for (int i = 0; i < 3; i++) {
+        dNdu[i] = ia_mul_s(dNdu[i], k);
+        dNdv[i] = ia_mul_s(dNdv[i], k);
+    }
+    return true;
+}
+
 void geom_subdiv_eval_aa(aa_context *ctx, const geom_surface *s, const aa_form *u,
                          const aa_form *v, geom_aa *out)
 {

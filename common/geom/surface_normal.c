@@ -279,6 +279,8 @@ bool geom_unit_normal_slopes_ia(const geom_surface *s, ia_interval u, ia_interva
                                     dNdu, dNdv);
     case GEOM_BICUBIC:
         return geom_bicubic_normal_slopes_ia(s, u, v, dNdu, dNdv);
+    case GEOM_SUBDIV:
+        return geom_subdiv_normal_slopes_ia(s, u, v, dNdu, dNdv);
     default:
         return false;
     }

@@ -107,6 +107,15 @@ static const char *QUADRICS[] = {
                       "-1 -0.3 0.1  -0.3 -0.3 0.4  0.3 -0.3 0.2  1 -0.3 -0.1  "
                       "-1 0.3 -0.2  -0.3 0.3 0.1  0.3 0.3 0.3  1 0.3 0.1  "
                       "-1 1 0  -0.3 1 -0.2  0.3 1 0.1  1 1 0]"),
+    /* a 3 x 3 grid of quads, Catmull-Clark: its middle face is a regular
+     * bicubic B-spline patch, its rim faces are refined near the border */
+    QUADRIC_RIB("%s", "SubdivisionMesh \"catmull-clark\" [4 4 4 4 4 4 4 4 4] "
+                      "[0 1 5 4  1 2 6 5  2 3 7 6  4 5 9 8  5 6 10 9  6 7 11 10  "
+                      "8 9 13 12  9 10 14 13  10 11 15 14] [\"interpolateboundary\"] [0 0] "
+                      "[] [] \"P\" [-1.5 -1.5 0  -0.5 -1.5 0.2  0.5 -1.5 -0.1  1.5 -1.5 0  "
+                      "-1.5 -0.5 0.1  -0.5 -0.5 0.4  0.5 -0.5 0.2  1.5 -0.5 -0.1  "
+                      "-1.5 0.5 -0.2  -0.5 0.5 0.1  0.5 0.5 0.3  1.5 0.5 0.1  "
+                      "-1.5 1.5 0  -0.5 1.5 -0.2  0.5 1.5 0.1  1.5 1.5 0]"),
 };
 
 static double urand(unsigned *s)
@@ -122,7 +131,7 @@ static void check_slopes_in(const char *fmt, const char *name, const char *src,
 {
     fixture f;
     fixture_shader sh[] = {{name, src}};
-    char rib[512];
+    char rib[2048];
     snprintf(rib, sizeof rib, fmt, name);
     assert_true(fixture_open(&f, rib, sh, 1, NULL, 0));
     trace_thread *th = trace_thread_new(&f.js->world);
@@ -294,7 +303,7 @@ static void test_proven_walks_agree_with_leaves(void **state)
     (void)state;
     check_walks(SQUARE_RIB("wave"));
     check_walks(DISK_RIB("wave"));
-    char rib[512];
+    char rib[2048];
     snprintf(rib, sizeof rib, QUADRICS[0], "wave");
     check_walks(rib);
 }
