@@ -123,6 +123,19 @@ double sl_noise_scale(int dim);
  * every dimension (derived in noise.c; used for slivers). order 1..3. */
 double sl_noise_raw_derivative_bound(int order);
 
+/* The rounding error of the float jet (value, gradient, Hessian of raw
+ * noise) at a point that the box bounds start from: derived[0..2] the
+ * bounds the derivation in noise.c gives, used[0..2] those noise.c uses
+ * (a table that must not be below them; the tests check it). */
+void sl_noise_point_jet_error(int dim, double derived[3], double used[3]);
+
+/* How noise over a box is bounded, for tests and benchmarks (the calling
+ * thread only; default SL_NOISE_BOX_AUTO): the Taylor model at the box's
+ * centre where its remainder is small, else also the interval jets over
+ * the box's cell pieces, the two met; or either alone. */
+enum { SL_NOISE_BOX_AUTO = 0, SL_NOISE_BOX_JETS = 1, SL_NOISE_BOX_TAYLOR = 2 };
+void sl_noise_set_box_method(int method);
+
 /* ---- fixed-dimension spellings ---- */
 static inline double sl_noise1(double x) { return sl_noise(1, &x); }
 static inline double sl_noise2(double x, double y)
