@@ -1351,13 +1351,14 @@ static inline double m3_of(int dim, double S[4][4], double L, double gm, const i
 
 /* The Taylor model's parts: range, gradient and the affine n0, alpha,
  * delta of res (as enclose_jets fills them), and the third-order
- * remainder rem3 (raw units), which the rule in enclose weighs. */
-static void taylor_model(const box_query *q, const point_jet *P, box_result *res,
-                         double *rem3)
+ * remainder rem3 (raw units), which the rule in enclose weighs. Always
+ * inlined once per dim (taylor_model), so the loops unroll. */
+static inline __attribute__((always_inline)) void
+taylor_model_d(int dim, const box_query *q, const point_jet *P, box_result *res,
+               double *rem3)
 {
     static const double gmax_of[5] = { 0, 8, 1, 1, 1 }, gm_of[5] = { 0, 8, 1, 1, 1 };
     static const int m_of[5] = { 0, 1, 2, 2, 3 };
-    int dim = q->dim;
     const double *e = point_jet_err[dim];
     double r[4], S[4][4], dmax[4];
     for (int k = 0; k < dim; k++) {
@@ -1481,6 +1482,17 @@ static void taylor_model(const box_query *q, const point_jet *P, box_result *res
     if (!(range.lo <= range.hi))
         range = iv_mk(0.0, 1.0);
     res->range = range;
+}
+
+static void taylor_model(const box_query *q, const point_jet *P, box_result *res,
+                         double *rem3)
+{
+    switch (q->dim) {
+    case 1: taylor_model_d(1, q, P, res, rem3); break;
+    case 2: taylor_model_d(2, q, P, res, rem3); break;
+    case 3: taylor_model_d(3, q, P, res, rem3); break;
+    default: taylor_model_d(4, q, P, res, rem3); break;
+    }
 }
 
 /* The box methods (sl_noise_set_box_method): per thread, for tests and
