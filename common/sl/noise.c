@@ -1332,24 +1332,6 @@ static void fade_derivative_max(double a, double b, double out[3])
         out[j] = out[j] * TAYLOR_SUM_SCALE + TAYLOR_POLY_SLACK;
 }
 
-/* the bound of |d^alpha raw| over the box (alpha[k] = order along k) */
-static inline double m3_of(int dim, double S[4][4], double L, double gm, const int alpha[4])
-{
-    double p = L;
-    for (int k = 0; k < dim; k++)
-        p *= S[k][alpha[k]];
-    for (int j = 0; j < dim; j++) {
-        if (alpha[j] == 0)
-            continue;
-        double t = alpha[j] * gm * S[j][alpha[j] - 1];
-        for (int k = 0; k < dim; k++)
-            if (k != j)
-                t *= S[k][alpha[k]];
-        p += t;
-    }
-    return p;
-}
-
 /* The Taylor model's parts: range, gradient and the affine n0, alpha,
  * delta of res (as enclose_jets fills them), and the third-order
  * remainder rem3 (raw units), which the rule in enclose weighs. Always
@@ -1404,30 +1386,33 @@ taylor_model_d(int dim, const box_query *q, const point_jet *P, box_result *res,
     }
     double gm = gm_of[dim];
 
-    /* 1/6 sum over ordered triples ijk of M3_ijk r_i r_j r_k, as a sum over
-     * multisets i <= j <= k with their multiplicities 1, 3, 6; and for each
-     * component j, 1/2 sum over ordered pairs kl of M3_jkl r_k r_l (from
-     * each multiset, each distinct member j once, the other two as a pair:
-     * both orders unless equal) */
+    /* The bounds of the third partials by pattern: d^3/dx_i^3, d^3/dx_i^2
+     * dx_j, d^3/dx_i dx_j dx_k (distinct); then 1/6 sum over ordered triples
+     * ijk of M3_ijk r_i r_j r_k (multiplicities 1, 3, 6) and, for each
+     * component a, 1/2 sum over ordered pairs kl of M3_akl r_k r_l. */
     double c3 = 0.0, gr[4] = { 0.0, 0.0, 0.0, 0.0 };
-    for (int i = 0; i < dim; i++)
-        for (int j = i; j < dim; j++)
-            for (int k = j; k < dim; k++) {
-                int alpha[4] = { 0, 0, 0, 0 };
-                alpha[i]++;
-                alpha[j]++;
-                alpha[k]++;
-                double M = m3_of(dim, S, L, gm, alpha);
-                double mult = (i == j && j == k) ? 1.0 : (i == j || j == k) ? 3.0 : 6.0;
-                c3 += mult * M * (r[i] * r[j] * r[k]);
-                int idx[3] = { i, j, k };
-                for (int t = 0; t < 3; t++) {
-                    if (t > 0 && idx[t] == idx[t - 1])
-                        continue;
-                    int u1 = idx[(t + 1) % 3], u2 = idx[(t + 2) % 3];
-                    gr[idx[t]] += (u1 == u2 ? 0.5 : 1.0) * M * (r[u1] * r[u2]);
-                }
+    for (int i = 0; i < dim; i++) {
+        double Miii = L * S[i][3] + 3.0 * gm * S[i][2];
+        c3 += Miii * (r[i] * r[i] * r[i]);
+        gr[i] += 0.5 * Miii * (r[i] * r[i]);
+        for (int j = 0; j < dim; j++) {
+            if (j == i)
+                continue;
+            double Miij = L * S[i][2] * S[j][1] + 2.0 * gm * S[i][1] * S[j][1] + gm * S[i][2];
+            c3 += 3.0 * Miij * (r[i] * r[i] * r[j]);
+            gr[i] += Miij * (r[i] * r[j]);           /* pairs (i, j), (j, i) */
+            gr[j] += 0.5 * Miij * (r[i] * r[i]);     /* pair (i, i) */
+        }
+        for (int j = i + 1; j < dim; j++)
+            for (int k = j + 1; k < dim; k++) {
+                double Mijk = L * S[i][1] * S[j][1] * S[k][1] +
+                              gm * (S[j][1] * S[k][1] + S[i][1] * S[k][1] + S[i][1] * S[j][1]);
+                c3 += 6.0 * Mijk * (r[i] * r[j] * r[k]);
+                gr[i] += Mijk * (r[j] * r[k]);
+                gr[j] += Mijk * (r[i] * r[k]);
+                gr[k] += Mijk * (r[i] * r[j]);
             }
+    }
     c3 = c3 / 6.0 * TAYLOR_SUM_SCALE;
     *rem3 = c3;
 
