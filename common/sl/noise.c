@@ -128,14 +128,12 @@ static const double noise_scale[SL_NOISE_MAX_DIM + 1] = {
 #define NOISE_MAX_SUBBOXES 16
 
 /* Bounds over a box (enclose): the Taylor model alone is the answer where
- * its third-order remainder is at most NOISE_TAYLOR_SHARE of its radius or
- * more than NOISE_JETS_SHARE_MAX of it; between the two the interval jets'
- * range and gradient are met with it. Measured on dented and the knot
- * (docs/benchmarks.md, "noise: Taylor models"): the jets cost more than
- * they save below 0.5 and above 1 (where the box's range is most of
- * [0, 1] either way); between, dented needs a sixth fewer boxes. */
+ * its third-order remainder is at most this share of its radius; above,
+ * the interval jets' range and gradient are met with it. Measured on
+ * dented and the knot (docs/benchmarks.md, "noise: Taylor models"): below
+ * 0.5 the jets cost more than they save; above, dented needs a sixth fewer
+ * boxes with them, and boxes a third of a cell wide get half the width. */
 #define NOISE_TAYLOR_SHARE 0.5
-#define NOISE_JETS_SHARE_MAX 1.0
 
 /*
  * Global bounds of the first, second and third partial derivatives of raw
@@ -1026,7 +1024,8 @@ static iv piece_of(double lo, double hi, int64_t i)
 
 /*
  * Encloses N = 0.5 + K raw over the box (and, with want_affine, its
- * linearisation at the centre). Returns false when only the global range
+ * linearisation at the centre; with want_grad, its gradient is what the
+ * caller wants most). Returns false when only the global range
  * [0, 1] is known (non-finite or huge box, or 3+ cells along an axis).
  */
 static bool enclose_jets(const box_query *q, bool want_affine, const point_jet *P,
@@ -1333,12 +1332,13 @@ static void fade_derivative_max(double a, double b, double out[3])
 }
 
 /* The Taylor model's parts: range, gradient and the affine n0, alpha,
- * delta of res (as enclose_jets fills them), and the third-order
- * remainder rem3 (raw units), which the rule in enclose weighs. Always
+ * delta of res (as enclose_jets fills them), the third-order remainder
+ * rem3 (raw units) and the largest share of a gradient component's
+ * radius that its remainder takes, which the rule in enclose weighs. Always
  * inlined once per dim (taylor_model), so the loops unroll. */
 static inline __attribute__((always_inline)) void
 taylor_model_d(int dim, const box_query *q, const point_jet *P, box_result *res,
-               double *rem3)
+               double *rem3, double *grad_share)
 {
     static const double gmax_of[5] = { 0, 8, 1, 1, 1 }, gm_of[5] = { 0, 8, 1, 1, 1 };
     static const int m_of[5] = { 0, 1, 2, 2, 3 };
@@ -1421,6 +1421,7 @@ taylor_model_d(int dim, const box_query *q, const point_jet *P, box_result *res,
     point_jet_enclosure(dim, P, &C);
 
     /* gradient over the box: g_j + sum_k H_jk d_k + R_j */
+    *grad_share = 0.0;
     for (int j = 0; j < dim; j++) {
         double w = e[1];
         for (int k = 0; k < dim; k++) {
@@ -1428,6 +1429,8 @@ taylor_model_d(int dim, const box_query *q, const point_jet *P, box_result *res,
             w += (fabs(h) + e[2]) * r[k];
         }
         w = (w + gr[j]) * TAYLOR_SUM_SCALE;
+        if (gr[j] > *grad_share * w)
+            *grad_share = gr[j] / w;
         res->grad[j] = iv_scale_pos(iv_mk(out_dn(P->g[j] - w), out_up(P->g[j] + w)), K);
     }
 
@@ -1471,13 +1474,13 @@ taylor_model_d(int dim, const box_query *q, const point_jet *P, box_result *res,
 }
 
 static void taylor_model(const box_query *q, const point_jet *P, box_result *res,
-                         double *rem3)
+                         double *rem3, double *grad_share)
 {
     switch (q->dim) {
-    case 1: taylor_model_d(1, q, P, res, rem3); break;
-    case 2: taylor_model_d(2, q, P, res, rem3); break;
-    case 3: taylor_model_d(3, q, P, res, rem3); break;
-    default: taylor_model_d(4, q, P, res, rem3); break;
+    case 1: taylor_model_d(1, q, P, res, rem3, grad_share); break;
+    case 2: taylor_model_d(2, q, P, res, rem3, grad_share); break;
+    case 3: taylor_model_d(3, q, P, res, rem3, grad_share); break;
+    default: taylor_model_d(4, q, P, res, rem3, grad_share); break;
     }
 }
 
@@ -1492,19 +1495,23 @@ void sl_noise_set_box_method(int method)
 
 /*
  * Encloses N = 0.5 + K raw over the box (and, with want_affine, its
- * linearisation at the centre). Returns false when only the global range
+ * linearisation at the centre; with want_grad, its gradient is what the
+ * caller wants most). Returns false when only the global range
  * [0, 1] is known (non-finite or huge box, or 3+ cells along an axis).
  *
  * The Taylor model first (one float jet at the centre); where its
- * third-order remainder is between NOISE_TAYLOR_SHARE and
- * NOISE_JETS_SHARE_MAX of its radius, the interval jets over the box's
- * cell pieces (to first order) are taken too and the range and gradient
- * intervals met (both enclose the same sets, so their meet does). The
- * affine part stays the Taylor model's: meeting the jets' own (to second
- * order) too changed dented's boxes per ray by under 1 % at a tenth more
- * time (docs/benchmarks.md, "noise: Taylor models").
+ * third-order remainder is more than NOISE_TAYLOR_SHARE of its radius
+ * (or, with want_grad, that of a gradient component of its radius),
+ * the interval jets over the box's cell pieces (to first order) are taken
+ * too and the range and gradient intervals met (both enclose the same
+ * sets, so their meet does). The affine part stays the Taylor model's:
+ * meeting the jets' own (to second order) too changed dented's boxes per
+ * ray by under 1 % at a tenth more time (docs/benchmarks.md, "noise:
+ * Taylor models"); where it is much wider than the range, noise_aa puts
+ * the range on a new symbol instead.
  */
-static bool enclose(const box_query *q, bool want_affine, box_result *res)
+static bool enclose(const box_query *q, bool want_affine, bool want_grad,
+                    box_result *res)
 {
     int dim = q->dim;
     for (int k = 0; k < dim; k++) {
@@ -1522,13 +1529,13 @@ static bool enclose(const box_query *q, bool want_affine, box_result *res)
     if (box_method == SL_NOISE_BOX_JETS)
         return enclose_jets(q, want_affine, &P, res);
 
-    double rem3;
-    taylor_model(q, &P, res, &rem3);
+    double rem3, grad_share;
+    taylor_model(q, &P, res, &rem3, &grad_share);
     double K = noise_scale[dim];
     double rho = 0.5 * (res->range.hi - res->range.lo);
     double rem = K * rem3;
-    if (box_method == SL_NOISE_BOX_TAYLOR || rem <= NOISE_TAYLOR_SHARE * rho ||
-        rem > NOISE_JETS_SHARE_MAX * rho)
+    if (box_method == SL_NOISE_BOX_TAYLOR ||
+        (rem <= NOISE_TAYLOR_SHARE * rho && !(want_grad && grad_share > NOISE_TAYLOR_SHARE)))
         return true;
 
     /* the interval jets (to first order: the natural extension, the centred
@@ -1609,7 +1616,7 @@ static ia_interval noise_ia(int dim, const ia_interval *p, const int *period,
         return e;
     }
     box_result res;
-    if (!ok || !enclose(&q, false, &res))
+    if (!ok || !enclose(&q, false, false, &res))
         return ia_with(0.0, 1.0, flags);
     return ia_with(res.range.lo, res.range.hi, flags);
 }
@@ -1626,7 +1633,8 @@ bool sl_noise_gradient_ia(int dim, const ia_interval *p, const int *period, int 
     q.seed = channel_seed(component < 0 ? CH_NOISE : CH_VNOISE + (unsigned)component);
     q.period = period;
     box_result res;
-    if (!box_from_ia(&q, dim, p, &flags, &empty) || empty || !enclose(&q, false, &res))
+    if (!box_from_ia(&q, dim, p, &flags, &empty) || empty ||
+        !enclose(&q, false, true, &res))
         return false;
     for (int k = 0; k < dim; k++)
         grad[k] = ia_make(res.grad[k].lo, res.grad[k].hi);
@@ -1776,7 +1784,7 @@ static void noise_aa(aa_context *ctx, aa_form *out, int dim, const aa_form *p,
     }
     flags &= ~(unsigned)AA_UNBOUNDED;
     box_result res;
-    if (!ok || !enclose(&q, true, &res)) {
+    if (!ok || !enclose(&q, true, false, &res)) {
         aa_interval_result(ctx, out, 0.0, 1.0, flags);
         return;
     }

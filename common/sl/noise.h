@@ -44,14 +44,16 @@
  *
  * Bounds (interval and affine modes; docs/noise.md):
  *   - across at most two lattice cells along every axis (the noise is C^2
- *     everywhere, so one Taylor expansion spans the cell faces):
- *     affine: the linearisation at the box centre, value and gradient
- *     enclosed at that point, plus the Lagrange remainder bounded by an
- *     interval enclosure of the Hessian over the box; falls back to the
- *     interval result on a new symbol when that is much narrower.
- *     interval: the centred (mean-value) form with the gradient enclosed
- *     over the box, intersected with the natural interval extension; wide
- *     boxes are cut into a few sub-boxes and the hull taken;
+ *     everywhere, so one Taylor expansion spans the cell faces): a Taylor
+ *     model at the box centre from one float evaluation of value,
+ *     gradient and Hessian there (with an a-priori bound of its rounding)
+ *     and a third-order remainder from bounds of the third derivatives
+ *     over the box; affine: its linear part plus the rest on one new
+ *     symbol (the interval result on a new symbol when that is much
+ *     narrower); interval: its range. Where the remainder is large, also
+ *     the interval jets over the box's cell pieces (the centred form with
+ *     the gradient enclosed over the box, met with the natural interval
+ *     extension; wide boxes cut into a few sub-boxes), the two met;
  *   - across three or more cells along some axis: the global range [0, 1].
  *   cellnoise: the hull of the values of the cells the box meets (at most
  *   64, else [0, 1)), flagged AA_DISCONTINUOUS when that is more than one.
@@ -94,12 +96,14 @@ void sl_vpnoise_ia(int dim, const ia_interval *p, const int *period,
                    ia_interval out[3]);
 void sl_vcellnoise_ia(int dim, const ia_interval *p, ia_interval out[3]);
 /* Bounds of d noise / d p[k] (k < dim) over the box p, and the value's
- * (*value: as sl_noise_ia / sl_pnoise_ia / sl_vnoise_ia give it): noise or
- * pnoise (period NULL or not), component -1 for the scalar noise, 0..2 for
- * those of the vector noise. False where none are known (an unbounded or
- * empty input, a box over more than two lattice cells on an axis). The
- * hull of the jets' gradients over the box's cell pieces, as the range is
- * made. */
+ * (*value: within what sl_noise_ia / sl_pnoise_ia / sl_vnoise_ia give,
+ * narrower where the gradient's bound took the interval jets too): noise
+ * or pnoise (period NULL or not), component -1 for the scalar noise, 0..2
+ * for those of the vector noise. False where none are known (an unbounded
+ * or empty input, a box over more than two lattice cells on an axis). The
+ * Taylor model's gradient (g(c) + H(c) d + a third-order remainder), met
+ * with the hull of the interval jets' gradients over the box's cell
+ * pieces where that remainder is large (docs/noise.md). */
 bool sl_noise_gradient_ia(int dim, const ia_interval *p, const int *period, int component,
                           ia_interval *value, ia_interval *grad);
 
