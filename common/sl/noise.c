@@ -64,7 +64,23 @@
  * every cell piece of the box.
  *
  * ---- bounds over a box ---------------------------------------------------
- * The box is cut at the lattice planes into pieces (at most 2 cells per
+ * Two methods (enclose picks; docs/noise.md "Two methods, one rule"):
+ *
+ * The Taylor model (taylor_model_d): value, gradient and Hessian of raw at
+ * the box centre c from ONE float evaluation (point_jet_at) with an
+ * a-priori bound of its rounding (point_jet_err, derived there), and the
+ * third-order remainder of Taylor's theorem (integral form, valid across
+ * cell faces since the noise is C^2 and piecewise polynomial) from bounds
+ * of the third partials over the box:
+ *   affine:   n0 + sum_k alpha_k (x_k - c_k) +- delta, alpha_k = K g_k(c),
+ *             delta = the errors of N(c), alpha + the quadratic term with
+ *             H(c) (diagonal terms only half: d_k^2 in [0, r_k^2] moves
+ *             the centre) + the cubic remainder;
+ *   interval: n0 +- (sum |alpha_k| r_k + delta);
+ *   gradient: K (g(c) +- (sum_k |H_jk(c)| r_k + the quadratic remainder)).
+ *
+ * The interval jets (enclose_jets), where the Taylor remainder is large:
+ * the box is cut at the lattice planes into pieces (at most 2 cells per
  * axis; 3 or more give the global range [0, 1]); a piece wider than
  * NOISE_SPLIT_WIDTH is halved while the box has at most NOISE_MAX_SUBBOXES
  * sub-boxes. On each sub-box an interval "jet" is evaluated: value,
@@ -72,8 +88,7 @@
  * (s and s' have exact ranges from their monotonicity; s'' from its end
  * points and its extrema at (3 -+ sqrt 3)/6) and the sum above written as
  * nested linear interpolations, one axis at a time (cell_jet_d).
- * At the box centre c the same jet is taken at the point (a width of a few
- * ulps).
+ * At the box centre c the float jet's value and gradient are used.
  *   interval: [0,1] ∩ natural extension (hull over sub-boxes)
  *             ∩ centred (mean-value) form N(c) + sum_k [dN/dx_k over box]
  *               [-r_k, r_k] (one sub-box), or the hull over sub-boxes of
@@ -81,16 +96,16 @@
  *   affine:   N(x) = n0 + sum_k alpha_k (x_k - c_k) +- delta with
  *             n0, alpha_k the midpoints of the enclosures of N(c), dN/dx_k(c),
  *             delta = rad N(c) + sum_k rad(dN/dx_k(c)) r_k
- *                     + 1/2 sum_jk mag(H_jk over box) r_j r_k,
- *             the x_k - c_k being the input forms less their centre values
- *             (so the result is an alpha-combination of the inputs' noise
- *             symbols plus one new symbol with coefficient delta). If its
- *             radius exceeds the interval result's by NOISE_MINRANGE_RATIO
- *             the interval result on a new symbol is used instead. The
- *             form's interval hull is met with the interval result.
- * Every value is an enclosure computed with outward rounding (interval
- * kit below, on rounding.h), so both results hold for the exact real
- * function, rounding included.
+ *                     + 1/2 sum_jk mag(H_jk over box) r_j r_k
+ *             (used alone only by SL_NOISE_BOX_JETS).
+ * In both, the x_k - c_k are the input forms less their centre values (so
+ * the result is an alpha-combination of the inputs' noise symbols plus one
+ * new symbol with coefficient delta). If its radius exceeds the interval
+ * result's by NOISE_MINRANGE_RATIO the interval result on a new symbol is
+ * used instead. The form's interval hull is met with the interval result.
+ * Every value is an enclosure (the interval kit below, on rounding.h,
+ * rounds outward; the float jet carries its proven error), so all results
+ * hold for the exact real function, rounding included.
  */
 #include "sl/noise.h"
 #include "aa/rounding.h"
