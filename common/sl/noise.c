@@ -936,7 +936,7 @@ static inline double ddfade(double t)
 
 /* always inlined once per dim, so the loops unroll */
 static inline __attribute__((always_inline)) void
-point_jet_d(int dim, const double f[4], const uint32_t hs[16], point_jet *J)
+point_jet_d(int dim, const double f[4], const uint32_t hs[16], int order, point_jet *J)
 {
     double w0[4], w1[4], D[4], DD[4], d[4][2];
     for (int k = 0; k < dim; k++) {
@@ -957,6 +957,8 @@ point_jet_d(int dim, const double f[4], const uint32_t hs[16], point_jet *J)
         for (int k = 1; k < dim; k++)
             l = l + (double)g[k] * d[k][(c >> k) & 1];
         t[c].v = l;
+        if (order == 0)
+            continue;
         for (int k = 0; k < dim; k++)
             t[c].g[k] = (double)g[k];
     }
@@ -967,6 +969,10 @@ point_jet_d(int dim, const double f[4], const uint32_t hs[16], point_jet *J)
             point_jet r;
             double dv = B->v - A->v;
             r.v = w0[k] * A->v + w1[k] * B->v;
+            if (order == 0) {
+                t[i] = r;
+                continue;
+            }
             for (int j = 0; j < dim; j++)
                 r.g[j] = w0[k] * A->g[j] + w1[k] * B->g[j];
             r.g[k] = r.g[k] + D[k] * dv;
@@ -996,11 +1002,26 @@ static void point_jet_at(int dim, const double *c, const int *period, uint32_t s
     uint32_t hs[16];
     lattice_at(dim, c, period, seed, f, hs);
     switch (dim) {
-    case 1: point_jet_d(1, f, hs, J); break;
-    case 2: point_jet_d(2, f, hs, J); break;
-    case 3: point_jet_d(3, f, hs, J); break;
-    default: point_jet_d(4, f, hs, J); break;
+    case 1: point_jet_d(1, f, hs, 2, J); break;
+    case 2: point_jet_d(2, f, hs, 2, J); break;
+    case 3: point_jet_d(3, f, hs, 2, J); break;
+    default: point_jet_d(4, f, hs, 2, J); break;
     }
+}
+
+/* The float value of raw noise at cell coordinates f (in [0, 1], exact)
+ * with the corners' hashes hs; within point_jet_err[dim][0] of the exact
+ * value (the value's part of the bound needs nothing of the others'). */
+static double point_value(int dim, const double f[4], const uint32_t hs[16])
+{
+    point_jet J;
+    switch (dim) {
+    case 1: point_jet_d(1, f, hs, 0, &J); break;
+    case 2: point_jet_d(2, f, hs, 0, &J); break;
+    case 3: point_jet_d(3, f, hs, 0, &J); break;
+    default: point_jet_d(4, f, hs, 0, &J); break;
+    }
+    return J.v;
 }
 
 /* The enclosures of value and gradient that the float jet gives. */
@@ -1167,19 +1188,17 @@ static bool enclose_jets(const box_query *q, bool want_affine, const point_jet *
         jet J;
         cell_jet(dim, pax, h, order, &J);
         if (nsub > 1) {
-            axis_fade max_[4];
-            double r[4];
+            double r[4], fm[4];
             rest = sb;
             for (int k = 0; k < dim; k++) {
                 iv F = segF[k][rest % nseg[k]];
                 rest /= nseg[k];
-                double m = iv_mid(F);
-                r[k] = iv_rad_about(F, m);
-                axis_setup(&max_[k], iv_pt(m), 0);
+                fm[k] = iv_mid(F);
+                r[k] = iv_rad_about(F, fm[k]);
             }
-            jet M;
-            cell_jet(dim, max_, h, 0, &M);
-            iv mv = M.v;
+            /* the value at the sub-box's midpoint: the float jet's */
+            double mvf = point_value(dim, fm, h), e0 = point_jet_err[dim][0];
+            iv mv = iv_mk(out_dn(mvf - e0), out_up(mvf + e0));
             for (int k = 0; k < dim; k++)
                 mv = iv_add(mv, iv_mul(J.g[k], iv_mk(-r[k], r[k])));
             iv sr = J.v;
