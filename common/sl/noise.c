@@ -1540,7 +1540,7 @@ void sl_noise_set_box_method(int method)
  * too and the range and gradient intervals met (both enclose the same
  * sets, so their meet does). The affine part stays the Taylor model's:
  * meeting the jets' own (to second order) too changed dented's boxes per
- * ray by under 1 % at a tenth more time (docs/benchmarks.md, "noise:
+ * ray by under 1 % at 8 % more time (docs/benchmarks.md, "noise:
  * Taylor models"); where it is much wider than the range, noise_aa puts
  * the range on a new symbol instead.
  */
