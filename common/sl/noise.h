@@ -44,14 +44,16 @@
  *
  * Bounds (interval and affine modes; docs/noise.md):
  *   - across at most two lattice cells along every axis (the noise is C^2
- *     everywhere, so one Taylor expansion spans the cell faces):
- *     affine: the linearisation at the box centre, value and gradient
- *     enclosed at that point, plus the Lagrange remainder bounded by an
- *     interval enclosure of the Hessian over the box; falls back to the
- *     interval result on a new symbol when that is much narrower.
- *     interval: the centred (mean-value) form with the gradient enclosed
- *     over the box, intersected with the natural interval extension; wide
- *     boxes are cut into a few sub-boxes and the hull taken;
+ *     everywhere, so one Taylor expansion spans the cell faces): a Taylor
+ *     model at the box centre from one float evaluation of value,
+ *     gradient and Hessian there (with an a-priori bound of its rounding)
+ *     and a third-order remainder from bounds of the third derivatives
+ *     over the box; affine: its linear part plus the rest on one new
+ *     symbol (the interval result on a new symbol when that is much
+ *     narrower); interval: its range. Where the remainder is large, also
+ *     the interval jets over the box's cell pieces (the centred form with
+ *     the gradient enclosed over the box, met with the natural interval
+ *     extension; wide boxes cut into a few sub-boxes), the two met;
  *   - across three or more cells along some axis: the global range [0, 1].
  *   cellnoise: the hull of the values of the cells the box meets (at most
  *   64, else [0, 1)), flagged AA_DISCONTINUOUS when that is more than one.
@@ -94,12 +96,14 @@ void sl_vpnoise_ia(int dim, const ia_interval *p, const int *period,
                    ia_interval out[3]);
 void sl_vcellnoise_ia(int dim, const ia_interval *p, ia_interval out[3]);
 /* Bounds of d noise / d p[k] (k < dim) over the box p, and the value's
- * (*value: as sl_noise_ia / sl_pnoise_ia / sl_vnoise_ia give it): noise or
- * pnoise (period NULL or not), component -1 for the scalar noise, 0..2 for
- * those of the vector noise. False where none are known (an unbounded or
- * empty input, a box over more than two lattice cells on an axis). The
- * hull of the jets' gradients over the box's cell pieces, as the range is
- * made. */
+ * (*value: within what sl_noise_ia / sl_pnoise_ia / sl_vnoise_ia give,
+ * narrower where the gradient's bound took the interval jets too): noise
+ * or pnoise (period NULL or not), component -1 for the scalar noise, 0..2
+ * for those of the vector noise. False where none are known (an unbounded
+ * or empty input, a box over more than two lattice cells on an axis). The
+ * Taylor model's gradient (g(c) + H(c) d + a third-order remainder), met
+ * with the hull of the interval jets' gradients over the box's cell
+ * pieces where that remainder is large (docs/noise.md). */
 bool sl_noise_gradient_ia(int dim, const ia_interval *p, const int *period, int component,
                           ia_interval *value, ia_interval *grad);
 
@@ -122,6 +126,19 @@ double sl_noise_scale(int dim);
 /* Bounds of |any first, second, third partial derivative of raw noise|,
  * every dimension (derived in noise.c; used for slivers). order 1..3. */
 double sl_noise_raw_derivative_bound(int order);
+
+/* The rounding error of the float jet (value, gradient, Hessian of raw
+ * noise) at a point that the box bounds start from: derived[0..2] the
+ * bounds the derivation in noise.c gives, used[0..2] those noise.c uses
+ * (a table that must not be below them; the tests check it). */
+void sl_noise_point_jet_error(int dim, double derived[3], double used[3]);
+
+/* How noise over a box is bounded, for tests and benchmarks (the calling
+ * thread only; default SL_NOISE_BOX_AUTO): the Taylor model at the box's
+ * centre where its remainder is small, else also the interval jets over
+ * the box's cell pieces, the two met; or either alone. */
+enum { SL_NOISE_BOX_AUTO = 0, SL_NOISE_BOX_JETS = 1, SL_NOISE_BOX_TAYLOR = 2 };
+void sl_noise_set_box_method(int method);
 
 /* ---- fixed-dimension spellings ---- */
 static inline double sl_noise1(double x) { return sl_noise(1, &x); }

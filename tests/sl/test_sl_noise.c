@@ -24,7 +24,13 @@
  *                   dense samples lie inside the interval result and inside
  *                   the affine result evaluated at the samples' noise
  *                   symbol values
- *   tightness       affine narrower than interval on small boxes; affine
+ *   box methods     the Taylor model, the interval jets and the rule that
+ *                   picks between them, each alone: values and gradients
+ *                   sampled in boxes of sides 1e-9 .. 2 (some across
+ *                   lattice planes) inside the results; the float jet's
+ *                   error table against its derivation; widths
+ *   tightness       affine never wider than interval, interval narrower
+ *                   than the interval jets alone on small boxes; affine
  *                   close to the true range on 1e-3 boxes
  *   correlation     noise(P) - noise(P) is small in affine arithmetic, and
  *                   P + N*noise(P) keeps its dependence on u and v
@@ -847,37 +853,47 @@ static void test_determinism(void **state)
 static void test_float_accuracy(void **state)
 {
     (void)state;
-    rng_seed(9);
-    long cases = 0, bad = 0;
-    double worst = 0.0, widest = 0.0;
-    for (int dim = 1; dim <= 4; dim++) {
-        for (int n = 0; n < 50000; n++) {
-            double p[4];
-            ia_interval P[4];
-            for (int k = 0; k < dim; k++) {
-                double scale = n % 3 == 0 ? 1.0 : (n % 3 == 1 ? 1e3 : 1e7);
-                p[k] = urange(-scale, scale);
-                if (n % 5 == 0)   /* next to a lattice plane, either side */
-                    p[k] = nearbyint(p[k]) + (n % 2 ? 1 : -1) * urange(0, 1e-12);
-                P[k] = ia_point(p[k]);
+    /* Both box methods: the interval jets' natural extension over a point
+     * box is an enclosure computed independently of the float code (the
+     * interval kit); the Taylor model's is the float jet within its
+     * a-priori error, which this also checks against the float value. */
+    static const int methods[2] = { SL_NOISE_BOX_JETS, SL_NOISE_BOX_AUTO };
+    static const char *const mname[2] = { "interval jets", "default" };
+    for (int m = 0; m < 2; m++) {
+        sl_noise_set_box_method(methods[m]);
+        rng_seed(9);
+        long cases = 0, bad = 0;
+        double worst = 0.0, widest = 0.0;
+        for (int dim = 1; dim <= 4; dim++) {
+            for (int n = 0; n < 25000; n++) {
+                double p[4];
+                ia_interval P[4];
+                for (int k = 0; k < dim; k++) {
+                    double scale = n % 3 == 0 ? 1.0 : (n % 3 == 1 ? 1e3 : 1e7);
+                    p[k] = urange(-scale, scale);
+                    if (n % 5 == 0)   /* next to a lattice plane, either side */
+                        p[k] = nearbyint(p[k]) + (n % 2 ? 1 : -1) * urange(0, 1e-12);
+                    P[k] = ia_point(p[k]);
+                }
+                double v = sl_noise(dim, p);
+                ia_interval r = sl_noise_ia(dim, P);
+                double e = v < r.lo ? r.lo - v : (v > r.hi ? v - r.hi : 0.0);
+                if (e > worst)
+                    worst = e;
+                if (r.hi - r.lo > widest)
+                    widest = r.hi - r.lo;
+                if (e > TOL)
+                    bad++;
+                cases++;
             }
-            double v = sl_noise(dim, p);
-            ia_interval r = sl_noise_ia(dim, P);
-            double e = v < r.lo ? r.lo - v : (v > r.hi ? v - r.hi : 0.0);
-            if (e > worst)
-                worst = e;
-            if (r.hi - r.lo > widest)
-                widest = r.hi - r.lo;
-            if (e > TOL)
-                bad++;
-            cases++;
         }
+        printf("float accuracy (%s): %ld points, max distance of the float result from "
+               "the point enclosure %.3g (TOL %.3g), widest point enclosure %.3g\n",
+               mname[m], cases, worst, TOL, widest);
+        assert_int_equal(bad, 0);
+        assert_true(widest < 1e-12);
     }
-    printf("float accuracy: %ld points, max distance of the float result from "
-           "the point enclosure %.3g (TOL %.3g), widest point enclosure %.3g\n",
-           cases, worst, TOL, widest);
-    assert_int_equal(bad, 0);
-    assert_true(widest < 1e-12);
+    sl_noise_set_box_method(SL_NOISE_BOX_AUTO);
 }
 
 /* ---------------------------------------------------------------------- */
@@ -1103,6 +1119,216 @@ static void test_containment(void **state)
 }
 
 /* ---------------------------------------------------------------------- */
+/* box methods: the Taylor model, the interval jets, and the rule          */
+/* ---------------------------------------------------------------------- */
+
+/*
+ * GTOL: a bound on the float gradient's own rounding (sl_noise_grad, u =
+ * 2^-53): f errs by at most u, moving the exact gradient by at most
+ * D2 * dim * u = 640u (raw); each of the <= 16 corners adds a term
+ * pdw * dot + pw * w * g of magnitude <= 1.875 * 8 + 8 = 23 computed with
+ * <= 12 operations (< 30u relative each, as the weights and dot products
+ * carry their own few-u errors), so the sum errs by < 16 * 23 * 30u +
+ * 16u * 16 * 23 < 17000u (raw); K <= 1/2 halves it. In all < 10^4 u ~
+ * 1.1e-12; GTOL = 2^-36 ~ 1.5e-11 leaves a factor 13.
+ */
+#define GTOL 0x1p-36
+
+typedef struct method_stats {
+    long boxes, points, ia_viol, aa_viol, grad_viol, grad_points;
+    double rem_used;          /* largest |value - linear part| / delta seen
+                               * (linear results with delta > 1e-6) */
+} method_stats;
+
+/* A box of side about 10^[-9, 0.3] (log-uniform, each axis 0.5..1 of it);
+ * with probability 1/3 per axis across a lattice plane. */
+static void scale_box(int dim, double lo[4], double hi[4])
+{
+    double w = pow(10.0, urange(-9.0, 0.3));
+    for (int k = 0; k < dim; k++) {
+        double wk = w * urange(0.5, 1.0), cell = (double)irange(-300, 300);
+        lo[k] = irange(0, 2) == 0 ? cell - wk * urand() : cell + urange(0.0, 1.0 - 1e-9);
+        hi[k] = lo[k] + wk;
+    }
+}
+
+static void check_method_box(int dim, int variant, method_stats *st)
+{
+    double lo[4], hi[4];
+    scale_box(dim, lo, hi);
+    int per[4];
+    for (int k = 0; k < dim; k++)
+        per[k] = irange(1, 6);
+    const int *period = variant == 1 ? per : NULL;
+    int chan = irange(0, 2);
+    ia_interval P[4], r, r3[3], gv, G[4];
+    aa_form in[4], outs[3];
+    aa_context ctx;
+    aa_context_init(&ctx, AA_DEFAULT_CAPACITY);
+    for (int k = 0; k < dim; k++) {
+        P[k] = ia_make(lo[k], hi[k]);
+        aa_input(&ctx, &in[k], lo[k], hi[k]);
+    }
+    const aa_form *z;
+    bool have_grad = false;
+    if (variant < 2) {
+        r = variant == 1 ? sl_pnoise_ia(dim, P, per) : sl_noise_ia(dim, P);
+        if (variant == 1)
+            sl_pnoise_aa(&ctx, &outs[0], dim, in, per);
+        else
+            sl_noise_aa(&ctx, &outs[0], dim, in);
+        z = &outs[0];
+        have_grad = sl_noise_gradient_ia(dim, P, period, -1, &gv, G);
+        if (have_grad && (gv.lo < r.lo || gv.hi > r.hi))
+            st->ia_viol++;            /* the value: the same bound, or met with more */
+    } else {
+        sl_vnoise_ia(dim, P, r3);
+        r = r3[chan];
+        sl_vnoise_aa(&ctx, outs, dim, in);
+        z = &outs[chan];
+    }
+    st->boxes++;
+    double slack = z->err, mag = fabs(z->x0);
+    for (int i = 0; i < z->n; i++) {
+        if (i >= dim)
+            slack += fabs(z->c[i]);
+        else
+            mag += fabs(z->c[i]);
+    }
+    double aa_tol = TOL + 0x1p-48 * mag;     /* as in check_box */
+    ia_interval zr = aa_range(z);
+    for (int s = 0; s < (1 << dim) + 40; s++) {
+        double x[4];
+        for (int k = 0; k < dim; k++) {
+            if (s < (1 << dim))
+                x[k] = ((s >> k) & 1) ? hi[k] : lo[k];
+            else if (s % 3 == 0 && floor(hi[k]) > lo[k])
+                x[k] = floor(hi[k]);          /* on a lattice plane */
+            else {
+                x[k] = urange(lo[k], hi[k]);
+                if (x[k] > hi[k]) x[k] = hi[k];
+            }
+        }
+        double v, v3[3], g[4];
+        if (variant < 2) {
+            v = sl_noise_grad(dim, x, period, g);
+        } else {
+            sl_vnoise(dim, x, v3);
+            v = v3[chan];
+        }
+        st->points++;
+        if (v < r.lo - TOL || v > r.hi + TOL)
+            st->ia_viol++;
+        double val = z->x0;
+        for (int k = 0; k < dim && k < z->n; k++) {
+            double rad = in[k].c[k];
+            double eps = rad > 0.0 ? (x[k] - in[k].x0) / rad : 0.0;
+            val += z->c[k] * eps;
+        }
+        double dev = fabs(v - val);
+        if (dev > slack + aa_tol || (z->flags & AA_UNBOUNDED))
+            st->aa_viol++;
+        if (z->n > 0 && z->c[0] != 0.0 && slack > 1e-6 && dev / slack > st->rem_used)
+            st->rem_used = dev / slack;
+        if (v < zr.lo - TOL || v > zr.hi + TOL)
+            st->aa_viol++;
+        if (have_grad) {
+            if (v < gv.lo - TOL || v > gv.hi + TOL)
+                st->ia_viol++;
+            st->grad_points++;
+            for (int k = 0; k < dim; k++)
+                if (g[k] < G[k].lo - GTOL || g[k] > G[k].hi + GTOL)
+                    st->grad_viol++;
+        }
+    }
+}
+
+static void test_box_methods(void **state)
+{
+    (void)state;
+    static const char *const mname[3] = { "auto", "jets", "taylor" };
+    static const int methods[3] = { SL_NOISE_BOX_AUTO, SL_NOISE_BOX_JETS,
+                                    SL_NOISE_BOX_TAYLOR };
+
+    /* the float jet's error table is not below its derivation */
+    for (int dim = 1; dim <= 4; dim++) {
+        double derived[3], used[3];
+        sl_noise_point_jet_error(dim, derived, used);
+        for (int j = 0; j < 3; j++) {
+            assert_true(derived[j] > 0.0);
+            assert_true(used[j] >= derived[j]);
+        }
+        printf("box methods: %dD float jet error bounds (value, gradient, Hessian) "
+               "%.3g %.3g %.3g, used %.3g %.3g %.3g\n", dim, derived[0], derived[1],
+               derived[2], used[0], used[1], used[2]);
+    }
+
+    /* containment of values and gradients, each method, boxes at all scales */
+    double t0 = now_s();
+    long total = 0;
+    for (int m = 0; m < 3; m++) {
+        sl_noise_set_box_method(methods[m]);
+        for (int dim = 1; dim <= 4; dim++) {
+            rng_seed(40 + (uint64_t)dim);      /* the same boxes for each method */
+            method_stats st = { 0 };
+            int n = dim <= 2 ? 3000 : 2000;
+            for (int i = 0; i < n; i++)
+                check_method_box(dim, i % 3, &st);
+            printf("box methods: %-6s %dD %5ld boxes %7ld points: %ld interval, %ld affine, "
+                   "%ld gradient violations (of %ld); largest deviation / new symbol %.3f\n",
+                   mname[m], dim, st.boxes, st.points, st.ia_viol, st.aa_viol, st.grad_viol,
+                   st.grad_points * dim, st.rem_used);
+            total += st.ia_viol + st.aa_viol + st.grad_viol;
+        }
+    }
+    printf("box methods: %.2f s\n", now_s() - t0);
+    assert_int_equal(total, 0);
+
+    /* widths: on small 3D boxes the Taylor model is at most the jets'
+     * (affine, interval, gradient), and the rule never wider than the
+     * Taylor model alone */
+    rng_seed(47);
+    double w[3][3] = { { 0 } };
+    long auto_wider = 0;
+    int n = 1500;
+    for (int i = 0; i < n; i++) {
+        ia_interval P[3];
+        double side = pow(10.0, urange(-3.0, log10(0.02)));
+        for (int k = 0; k < 3; k++) {
+            double a = urange(-100.0, 100.0);
+            P[k] = ia_make(a, a + side * urange(0.5, 1.0));
+        }
+        double iw[3];
+        for (int m = 0; m < 3; m++) {
+            sl_noise_set_box_method(methods[m]);
+            aa_context ctx;
+            aa_context_init(&ctx, AA_DEFAULT_CAPACITY);
+            aa_form in[3], out;
+            for (int k = 0; k < 3; k++)
+                aa_input(&ctx, &in[k], P[k].lo, P[k].hi);
+            sl_noise_aa(&ctx, &out, 3, in);
+            ia_interval ra = aa_range(&out), r = sl_noise_ia(3, P), gv, G[3];
+            assert_true(sl_noise_gradient_ia(3, P, NULL, -1, &gv, G));
+            w[m][0] += (ra.hi - ra.lo) / n;
+            w[m][1] += (r.hi - r.lo) / n;
+            iw[m] = r.hi - r.lo;
+            for (int k = 0; k < 3; k++)
+                w[m][2] += (G[k].hi - G[k].lo) / (3 * n);
+        }
+        if (iw[0] > iw[2])
+            auto_wider++;
+    }
+    sl_noise_set_box_method(SL_NOISE_BOX_AUTO);
+    for (int m = 0; m < 3; m++)
+        printf("box methods: 3D, %d boxes of side 1e-3..0.02: %-6s mean widths affine %.5f, "
+               "interval %.5f, gradient %.5f\n", n, mname[m], w[m][0], w[m][1], w[m][2]);
+    assert_true(w[2][0] <= w[1][0]);
+    assert_true(w[2][1] < w[1][1]);
+    assert_true(w[2][2] < w[1][2]);
+    assert_int_equal(auto_wider, 0);
+}
+
+/* ---------------------------------------------------------------------- */
 /* tightness                                                               */
 /* ---------------------------------------------------------------------- */
 
@@ -1110,10 +1336,13 @@ static void test_tightness(void **state)
 {
     (void)state;
     rng_seed(11);
-    /* small boxes inside one cell, widths 0.01 .. 0.3 */
+    /* small boxes inside one cell, widths 0.01 .. 0.3: the affine range is
+     * never wider than the interval result (it is met with it); the widths
+     * of the interval jets alone (the method before the Taylor model, which
+     * is tighter on the widest of these boxes) are printed beside */
     for (int dim = 1; dim <= 4; dim++) {
-        double ratio = 0.0, wia = 0.0, waa = 0.0;
-        int n = 4000;
+        double ratio = 0.0, wia = 0.0, waa = 0.0, wjets = 0.0, waj = 0.0;
+        int n = 4000, wider = 0;
         for (int i = 0; i < n; i++) {
             ia_interval P[4];
             aa_form in[4], out;
@@ -1127,17 +1356,27 @@ static void test_tightness(void **state)
             }
             ia_interval r = sl_noise_ia(dim, P);
             sl_noise_aa(&ctx, &out, dim, in);
+            sl_noise_set_box_method(SL_NOISE_BOX_JETS);
+            ia_interval rj = sl_noise_ia(dim, P);
+            aa_form outj;
+            sl_noise_aa(&ctx, &outj, dim, in);
+            ia_interval raj = aa_range(&outj);
+            waj += raj.hi - raj.lo;
+            sl_noise_set_box_method(SL_NOISE_BOX_AUTO);
             ia_interval ra = aa_range(&out);
             double a_w = ra.hi - ra.lo, i_w = r.hi - r.lo;
+            if (a_w > i_w)
+                wider++;
             ratio += a_w / i_w;
             wia += i_w;
             waa += a_w;
+            wjets += rj.hi - rj.lo;
         }
         ratio /= n;
         printf("tightness: %dD, %d boxes of width 0.01..0.3 in one cell: mean "
-               "affine/interval width %.3f (mean widths %.4f / %.4f)\n", dim, n,
-               ratio, waa / n, wia / n);
-        assert_true(ratio < 1.0);
+               "affine/interval width %.3f (mean widths %.4f / %.4f; interval jets "
+               "alone %.4f / %.4f)\n", dim, n, ratio, waa / n, wia / n, waj / n, wjets / n);
+        assert_int_equal(wider, 0);
     }
 
     /* boxes of width 1e-3: affine range against the sampled true range */
@@ -1289,13 +1528,14 @@ static void test_special_inputs(void **state)
     r = sl_noise_ia(2, W);
     assert_true(r.lo == 0.0 && r.hi == 1.0);
 
-    /* a point box gives a tiny enclosure of the float value; an empty
-     * input an empty result */
+    /* a point box gives a tiny enclosure of the float value (the float
+     * jet's a-priori error, noise.c: below 1e-12 wide); an empty input an
+     * empty result */
     ia_interval Q[3] = { ia_point(0.25), ia_point(-7.5), ia_point(3.125) };
     double q[3] = { 0.25, -7.5, 3.125 };
     r = sl_noise3_ia(Q);
     assert_true(r.lo <= sl_noise3(q) + TOL && sl_noise3(q) - TOL <= r.hi);
-    assert_true(r.hi - r.lo < 1e-14);
+    assert_true(r.hi - r.lo < 1e-12);
     Q[1] = ia_empty();
     assert_true(ia_is_empty(sl_noise3_ia(Q)));
 
@@ -1325,6 +1565,7 @@ int main(void)
         cmocka_unit_test(test_determinism),
         cmocka_unit_test(test_float_accuracy),
         cmocka_unit_test(test_containment),
+        cmocka_unit_test(test_box_methods),
         cmocka_unit_test(test_tightness),
         cmocka_unit_test(test_correlation),
         cmocka_unit_test(test_special_inputs),
