@@ -29,9 +29,9 @@
  * there: a silhouette, where the ray grazes a crest) or across the base
  * surface's edge, and at a leaf where the ray grazes the surface (|cos|
  * of its angle to the normal below TRACE_PROVE_GRAZE) and the cell has
- * slope bounds, leaves are taken at
- * TRACE_PROVE_LEAF of the tolerance: the hits and misses around are
- * exact, so the leaves' near misses there are the image's only error
+ * slope bounds, leaves are taken at TRACE_PROVE_LEAF of the tolerance:
+ * the hits and misses around are exact, so the leaves' near misses there
+ * are the image's only error
  * (peers_compare against the 1/16-pixel reference, one ray per pixel: the
  * wave 4 pixels instead of 24, the UFO 10 instead of 42; 6 % more CPU on
  * the dented plane, whose far bumps graze). Not where a test fails for
