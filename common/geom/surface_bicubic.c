@@ -260,8 +260,8 @@ bool geom_bicubic_normal_slopes_ia(const geom_surface *s, ia_interval u, ia_inte
         Pvv[c] = ia_mul(ia_mul(net_diff(q[c], 0, 2), iv), iv);
     }
     /* Ng = Pu x Pv, its derivatives Puu x Pv + Pu x Puv and Puv x Pv +
-     * Pu x Pvv; the unit normal's, (dNg - Nn (Nn . dNg)) / |Ng| */
-    ia_interval N[3], a[3], b[3], Nu[3], Nv[3], Nn[3];
+     * Pu x Pvv */
+    ia_interval N[3], a[3], b[3], Nu[3], Nv[3];
     cross_ia(Pu, Pv, N);
     cross_ia(Puu, Pv, a);
     cross_ia(Pu, Puv, b);
@@ -269,21 +269,7 @@ bool geom_bicubic_normal_slopes_ia(const geom_surface *s, ia_interval u, ia_inte
     cross_ia(Puv, Pv, a);
     cross_ia(Pu, Pvv, b);
     for (int c = 0; c < 3; c++) Nv[c] = ia_add(a[c], b[c]);
-    ia_interval n2 = ia_add(ia_add(ia_sqr(N[0]), ia_sqr(N[1])), ia_sqr(N[2]));
-    if (!(n2.lo > 0) || !isfinite(n2.hi)) return false;
-    ia_interval inv = ia_invsqrt(n2);
-    for (int c = 0; c < 3; c++) Nn[c] = ia_mul(N[c], inv);
-    for (int d = 0; d < 2; d++) {
-        const ia_interval *dn = d == 0 ? Nu : Nv;
-        ia_interval dot = ia_add(ia_add(ia_mul(Nn[0], dn[0]), ia_mul(Nn[1], dn[1])),
-                                 ia_mul(Nn[2], dn[2]));
-        ia_interval *out = d == 0 ? dNdu : dNdv;
-        for (int c = 0; c < 3; c++) {
-            out[c] = ia_mul(ia_sub(dn[c], ia_mul(Nn[c], dot)), inv);
-            if (!isfinite(out[c].lo) || !isfinite(out[c].hi)) return false;
-        }
-    }
-    return true;
+    return geom_unit_slopes_ia(N, Nu, Nv, dNdu, dNdv);
 }
 
 /* ---- affine --------------------------------------------------------- */

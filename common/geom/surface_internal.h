@@ -66,6 +66,11 @@ bool geom_vertex_normal_prepare(geom_surface *s, char *why, int why_size);
 bool geom_bicubic_prepare(geom_surface *s, char *why, int why_size);
 void geom_bicubic_eval_dual(const geom_surface *s, double u, double v, geom_sample *out);
 void geom_bicubic_eval_ia(const geom_surface *s, ia_interval u, ia_interval v, geom_ia *out);
+/* The slopes of the unit normal Nn = N / |N| from bounds of N and of its
+ * derivatives dN/du, dN/dv over a box: d Nn = (dN - Nn (Nn . dN)) / |N|;
+ * false where |N| may vanish or a bound is not finite */
+bool geom_unit_slopes_ia(const ia_interval N[3], const ia_interval dNu[3],
+                         const ia_interval dNv[3], ia_interval dNdu[3], ia_interval dNdv[3]);
 /* geom_eval_ia's bounds met with those of the piece of the patch over
  * the box, a Bezier net of its own (tighter on wide boxes, where the
  * tensor form loses the basis functions' correlation, and dearer) */

@@ -193,28 +193,36 @@ void geom_unit_normal_aa(aa_context *ctx, const geom_surface *s, const aa_form *
 
 /* ---- interval ---- */
 
+bool geom_unit_slopes_ia(const ia_interval N[3], const ia_interval dNu[3],
+                         const ia_interval dNv[3], ia_interval dNdu[3], ia_interval dNdv[3])
+{
+    ia_interval n2 = ia_add(ia_add(ia_sqr(N[0]), ia_sqr(N[1])), ia_sqr(N[2]));
+    if (!(n2.lo > 0) || !isfinite(n2.hi)) return false;
+    ia_interval inv = ia_invsqrt(n2), Nn[3];
+    for (int i = 0; i < 3; i++) Nn[i] = ia_mul(N[i], inv);
+    for (int d = 0; d < 2; d++) {
+        const ia_interval *a = d == 0 ? dNu : dNv;
+        ia_interval dot = ia_add(ia_add(ia_mul(Nn[0], a[0]), ia_mul(Nn[1], a[1])),
+                                 ia_mul(Nn[2], a[2]));
+        ia_interval *out = d == 0 ? dNdu : dNdv;
+        for (int i = 0; i < 3; i++) {
+            out[i] = ia_mul(ia_sub(a[i], ia_mul(Nn[i], dot)), inv);
+            if (!isfinite(out[i].lo) || !isfinite(out[i].hi)) return false;
+        }
+    }
+    return true;
+}
+
 /* The slopes of Nn = Nv / |Nv| with Nv = C + A u + B v (interpolated
- * vertex normals; a bilinear patch's Pu x Pv): d Nn = (dNv - Nn (Nn . dNv))
- * / |Nv|; false where |Nv| may vanish over the box */
+ * vertex normals; a bilinear patch's Pu x Pv) */
 static bool linear_normal_slopes(ia_interval u, ia_interval v, const ia_interval C[3],
                                  const ia_interval A[3], const ia_interval B[3],
                                  ia_interval dNdu[3], ia_interval dNdv[3])
 {
-    ia_interval Nv[3], Nn[3];
+    ia_interval Nv[3];
     for (int i = 0; i < 3; i++)
         Nv[i] = ia_add(ia_add(ia_mul(u, A[i]), ia_mul(v, B[i])), C[i]);
-    ia_interval n2 = ia_add(ia_add(ia_sqr(Nv[0]), ia_sqr(Nv[1])), ia_sqr(Nv[2]));
-    if (!(n2.lo > 0) || !isfinite(n2.hi)) return false;
-    ia_interval inv = ia_invsqrt(n2);
-    for (int i = 0; i < 3; i++) Nn[i] = ia_mul(Nv[i], inv);
-    for (int d = 0; d < 2; d++) {
-        const ia_interval *a = d == 0 ? A : B;
-        ia_interval dot = ia_add(ia_add(ia_mul(Nn[0], a[0]), ia_mul(Nn[1], a[1])),
-                                 ia_mul(Nn[2], a[2]));
-        ia_interval *out = d == 0 ? dNdu : dNdv;
-        for (int i = 0; i < 3; i++) out[i] = ia_mul(ia_sub(a[i], ia_mul(Nn[i], dot)), inv);
-    }
-    return true;
+    return geom_unit_slopes_ia(Nv, A, B, dNdu, dNdv);
 }
 
 bool geom_unit_normal_slopes_ia(const geom_surface *s, ia_interval u, ia_interval v,
