@@ -354,6 +354,11 @@ static void net_bounds(const vec3 net[16], ia_interval su, ia_interval sv, doubl
     if (!(t0 <= t1)) t0 = t1 = fmin(fmax(sv.lo, 0), 1);
     net_piece(net, s0, s1, t0, t1, k, nb);
     if (!(s1 > s0 && t1 > t0)) return;
+    /* not where the whole box's Ng already keeps well away from 0 (|Ng|^2
+     * within a factor 1.25): there the pieces narrow it little (on
+     * scenes/subdiv.rib 0.6 % fewer boxes, for a third of the time) */
+    ia_interval n2 = ia_add(ia_add(ia_sqr(nb->Ng[0]), ia_sqr(nb->Ng[1])), ia_sqr(nb->Ng[2]));
+    if (n2.lo > 0.8 * n2.hi) return;
     enum { NP = 3 };
     ia_interval Ng[3];
     for (int j = 0; j < NP; j++)
