@@ -527,7 +527,8 @@ void geom_subdiv_eval_aa(aa_context *ctx, const geom_surface *s, const aa_form *
     aa_lincomb(ctx, &sv, k, v, 0, v, -r.ov * k);
     geom_surface b;
     net_surface(r.net, &b);
-    geom_bicubic_eval_aa(ctx, &b, &su, &sv, out);
+    if (!geom_bicubic_net_aa(ctx, &b, &su, &sv, out))
+        geom_bicubic_eval_aa(ctx, &b, &su, &sv, out);
     net_boxes nb;
     net_bounds(r.net, aa_range(&su), aa_range(&sv), k, &nb);
     for (int i = 0; i < 3; i++) {

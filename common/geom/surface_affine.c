@@ -315,7 +315,9 @@ void geom_eval_aa(aa_context *ctx, const geom_surface *s, const aa_form *u,
     case GEOM_HYPERBOLOID: eval_hyperboloid(ctx, s, u, v, out); break;
     case GEOM_POLYGON:     eval_polygon(ctx, s, u, v, out); break;
     case GEOM_PATCH:       eval_patch(ctx, s, u, v, out); break;
-    case GEOM_BICUBIC:     geom_bicubic_eval_aa(ctx, s, u, v, out); break;
+    case GEOM_BICUBIC:
+        if (!geom_bicubic_net_aa(ctx, s, u, v, out)) geom_bicubic_eval_aa(ctx, s, u, v, out);
+        break;
     case GEOM_SUBDIV:      geom_subdiv_eval_aa(ctx, s, u, v, out); break;
     case GEOM_NURBS:       geom_nurbs_eval_aa(ctx, s, u, v, out); break;
     default:

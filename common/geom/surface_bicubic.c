@@ -190,6 +190,8 @@ static ia_interval net_diff(ia_interval q[4][4], int ku, int kv)
     return ia_mul_s(h, factor[ku][kv]);
 }
 
+static double mid_ia(ia_interval x) { return 0.5 * x.lo + 0.5 * x.hi; }
+
 static ia_interval meet(ia_interval a, ia_interval b)
 {
     double lo = fmax(a.lo, b.lo), hi = fmin(a.hi, b.hi);
@@ -337,6 +339,87 @@ void geom_bicubic_eval_aa(aa_context *ctx, const geom_surface *s, const aa_form 
         aa_mul(ctx, &y, &o->dPdu[b], &o->dPdv[a]);
         aa_sub(ctx, &o->Ng[c], &x, &y);
     }
+}
+
+/* One affine form from a Bezier net w[j][i] (nu x nv control points at
+ * (i/(nu-1), j/(nv-1)) of the piece [s0,s1] x [t0,t1], times `scale`): the
+ * plane alpha s + beta t + gamma fitted to the net (its mean slopes), as
+ * a linear combination of the inputs s and t, plus a new symbol for the
+ * largest distance of the net's points from the plane's (the difference
+ * is a Bezier patch too, so it lies in their hull; computed in interval
+ * arithmetic) and the net's hull for the form's hull */
+static void net_form(aa_context *ctx, aa_form *z, ia_interval w[4][4], int nu, int nv,
+                     ia_interval scale, const aa_form *s, const aa_form *t, double s0,
+                     double s1, double t0, double t1)
+{
+    double ds = 0, dt = 0, mean = 0;
+    for (int j = 0; j < nv; j++) ds += mid_ia(w[j][nu - 1]) - mid_ia(w[j][0]);
+    for (int i = 0; i < nu; i++) dt += mid_ia(w[nv - 1][i]) - mid_ia(w[0][i]);
+    for (int j = 0; j < nv; j++)
+        for (int i = 0; i < nu; i++) mean += mid_ia(w[j][i]);
+    double sc = mid_ia(scale);
+    ds = ds / nv * sc;
+    dt = dt / nu * sc;
+    mean = mean / (nu * nv) * sc;
+    double alpha = ds / (s1 - s0), beta = dt / (t1 - t0);
+    double gamma = mean - alpha * (0.5 * s0 + 0.5 * s1) - beta * (0.5 * t0 + 0.5 * t1);
+    if (!isfinite(alpha) || !isfinite(beta) || !isfinite(gamma)) alpha = beta = gamma = 0;
+    double rmax = 0;
+    ia_interval hull = ia_empty();
+    for (int j = 0; j < nv; j++)
+        for (int i = 0; i < nu; i++) {
+            ia_interval x = ia_mul(w[j][i], scale);
+            ia_interval si = ia_add(ia_point(s0), ia_mul_s(ia_sub(ia_point(s1), ia_point(s0)),
+                                                           (double)i / (nu - 1)));
+            ia_interval tj = ia_add(ia_point(t0), ia_mul_s(ia_sub(ia_point(t1), ia_point(t0)),
+                                                           (double)j / (nv - 1)));
+            ia_interval plane = ia_add(ia_add(ia_mul_s(si, alpha), ia_mul_s(tj, beta)),
+                                       ia_point(gamma));
+            ia_interval d = ia_sub(x, plane);
+            rmax = fmax(rmax, fmax(-d.lo, d.hi));
+            hull = i == 0 && j == 0 ? x : ia_hull(hull, x);
+        }
+    aa_lincomb(ctx, z, alpha, s, beta, t, gamma);
+    if (!(rmax < INFINITY) || !isfinite(hull.lo) || !isfinite(hull.hi)) {
+        aa_unbounded(z, AA_UNBOUNDED);
+        return;
+    }
+    aa_add_new_error(ctx, z, rmax);
+    z->lo = hull.lo;
+    z->hi = hull.hi;
+}
+
+bool geom_bicubic_net_aa(aa_context *ctx, const geom_surface *b, const aa_form *s,
+                         const aa_form *t, geom_aa *o)
+{
+    ia_interval sr = aa_range(s), tr = aa_range(t);
+    double s0 = sr.lo, s1 = sr.hi, t0 = tr.lo, t1 = tr.hi;
+    /* below 2^-12 the rounding of the net's differences over the box's
+     * width (~ulp(P) / width) would outgrow the quadratic term */
+    if (!(s1 - s0 > 0x1p-12) || !(t1 - t0 > 0x1p-12) || (s->flags | t->flags))
+        return false;
+    ia_interval q[3][4][4];
+    piece_net(b, sr, tr, q);
+    ia_interval is = ia_recip(ia_sub(ia_point(s1), ia_point(s0)));
+    ia_interval it = ia_recip(ia_sub(ia_point(t1), ia_point(t0)));
+    for (int c = 0; c < 3; c++) {
+        ia_interval du[4][4], dv[4][4];
+        for (int j = 0; j < 4; j++)
+            for (int i = 0; i < 3; i++) du[j][i] = ia_mul_s(ia_sub(q[c][j][i + 1], q[c][j][i]), 3);
+        for (int j = 0; j < 3; j++)
+            for (int i = 0; i < 4; i++) dv[j][i] = ia_mul_s(ia_sub(q[c][j + 1][i], q[c][j][i]), 3);
+        net_form(ctx, &o->P[c], q[c], 4, 4, ia_point(1), s, t, s0, s1, t0, t1);
+        net_form(ctx, &o->dPdu[c], du, 3, 4, is, s, t, s0, s1, t0, t1);
+        net_form(ctx, &o->dPdv[c], dv, 4, 3, it, s, t, s0, s1, t0, t1);
+    }
+    for (int c = 0; c < 3; c++) {
+        int a = (c + 1) % 3, e = (c + 2) % 3;
+        aa_form x, y;
+        aa_mul(ctx, &x, &o->dPdu[a], &o->dPdv[e]);
+        aa_mul(ctx, &y, &o->dPdu[e], &o->dPdv[a]);
+        aa_sub(ctx, &o->Ng[c], &x, &y);
+    }
+    return true;
 }
 
 /* ---- prepare and bounds --------------------------------------------- */

@@ -66,6 +66,13 @@ bool geom_vertex_normal_prepare(geom_surface *s, char *why, int why_size);
 bool geom_bicubic_prepare(geom_surface *s, char *why, int why_size);
 void geom_bicubic_eval_dual(const geom_surface *s, double u, double v, geom_sample *out);
 void geom_bicubic_eval_ia(const geom_surface *s, ia_interval u, ia_interval v, geom_ia *out);
+/* Affine forms of P, dPdu, dPdv (and Ng from them) over the box of the
+ * inputs s, t from the Bezier net of the patch's piece there: a plane in
+ * s and t plus one symbol for the net's distance from it (cheaper than
+ * the tensor form, and tighter on boxes of a few pixels); false on
+ * boxes thinner than 2^-12 (tensor form there) */
+bool geom_bicubic_net_aa(aa_context *ctx, const geom_surface *b, const aa_form *s,
+                         const aa_form *t, geom_aa *out);
 /* The slopes of the unit normal Nn = N / |N| from bounds of N and of its
  * derivatives dN/du, dN/dv over a box: d Nn = (dN - Nn (Nn . dN)) / |N|;
  * false where |N| may vanish or a bound is not finite */
