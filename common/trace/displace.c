@@ -119,7 +119,7 @@ bool trace_surface_has_slopes(const trace_object *obj)
 {
     switch (obj->surf.kind) {
     case GEOM_SPHERE: case GEOM_CYLINDER: case GEOM_CONE: case GEOM_TORUS: case GEOM_PATCH:
-    case GEOM_BICUBIC:
+    case GEOM_BICUBIC: case GEOM_SUBDIV:
         return obj->normal_scale > 0;
     case GEOM_POLYGON:
         return !geom_has_vertex_normals(&obj->surf) || obj->normal_scale > 0;

@@ -36,11 +36,9 @@ bool trace_surface_flat(const trace_object *obj);
 
 /* Whether hit proofs should try the object, trace_surface_slopes
  * bounding N's slopes on it: flat ones, and spheres, cylinders, cones,
- * tori, bilinear and bicubic patches and polygons with vertex normals
- * under a similarity (geom_unit_normal_slopes_ia). Subdivision faces
- * have slopes on their regular sub-patches too, but their boxes stay too
- * fat for a test at 16 pixels (none succeeded on scenes/subdiv.rib), so
- * they are not tried. */
+ * tori, bilinear and bicubic patches, subdivision faces (their regular
+ * sub-patches) and polygons with vertex normals under a similarity
+ * (geom_unit_normal_slopes_ia). */
 bool trace_surface_has_slopes(const trace_object *obj);
 
 /* Interval bounds, over a (u,v) range, of the displaced P in CAMERA space
