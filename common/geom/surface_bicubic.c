@@ -113,24 +113,26 @@ static ia_interval sum4_ia(const ia_interval a[4], const ia_interval b[4])
 }
 
 /* The cubic's blossom f(t1, t2, t3) (de Casteljau with t1, t2, t3 at its
- * three levels): the control points of the piece over [a, b] are
- * f(a,a,a), f(a,a,b), f(a,b,b), f(b,b,b) */
-static ia_interval blossom_ia(const ia_interval p[4], ia_interval t1, ia_interval t2,
-                              ia_interval t3)
+ * three levels), in float: the control points of the piece over [a, b]
+ * are f(a,a,a), f(a,a,b), f(a,b,b), f(b,b,b). Its rounding: each level's
+ * r + (r' - r) t carries the errors of r and r' in the convex combination
+ * (1 - t) e + t e' (t in [0, 1]) and adds three roundings of at most
+ * u |x|, |x| <= 3 B for B the largest |control point|: under 10 u B a
+ * level, 30 u B a curve, 60 u B for the net (rows, then columns) */
+static double blossom(const double p[4], double t1, double t2, double t3)
 {
-    ia_interval r[4] = {p[0], p[1], p[2], p[3]}, t[3] = {t1, t2, t3};
+    double r[4] = {p[0], p[1], p[2], p[3]}, t[3] = {t1, t2, t3};
     for (int l = 0; l < 3; l++)
-        for (int i = 0; i < 3 - l; i++)
-            r[i] = ia_add(r[i], ia_mul(ia_sub(r[i + 1], r[i]), t[l]));
+        for (int i = 0; i < 3 - l; i++) r[i] = r[i] + (r[i + 1] - r[i]) * t[l];
     return r[0];
 }
 
-static void piece_ia(const ia_interval p[4], ia_interval a, ia_interval b, ia_interval q[4])
+static void piece_f(const double p[4], double a, double b, double q[4])
 {
-    q[0] = blossom_ia(p, a, a, a);
-    q[1] = blossom_ia(p, a, a, b);
-    q[2] = blossom_ia(p, a, b, b);
-    q[3] = blossom_ia(p, b, b, b);
+    q[0] = blossom(p, a, a, a);
+    q[1] = blossom(p, a, a, b);
+    q[2] = blossom(p, a, b, b);
+    q[3] = blossom(p, b, b, b);
 }
 
 static void cross_ia(const ia_interval a[3], const ia_interval b[3], ia_interval out[3])
@@ -142,25 +144,37 @@ static void cross_ia(const ia_interval a[3], const ia_interval b[3], ia_interval
 }
 
 /* The piece of the patch over the box as a Bezier patch of its own,
- * q[c][j][i] for coordinate c (blossoms in interval arithmetic): it and
- * its derivatives (Bezier patches whose control points are the net's
- * differences) lie in the hulls of their control points (Farin, "Curves
- * and Surfaces for CAGD", §4.3, §16.2) */
-static void piece_net(const geom_surface *s, ia_interval u, ia_interval v,
+ * q[c][j][i] for coordinate c (float blossoms, each widened by 2^-40 of
+ * the net's largest coordinate: over 100 times their rounding, above):
+ * it and its derivatives (Bezier patches whose control points are the
+ * net's differences) lie in the hulls of their control points (Farin,
+ * "Curves and Surfaces for CAGD", §4.3, §16.2). False unless the box lies
+ * in [0, 1]^2, but for 2^-20 (the bound above needs t in [0, 1]; that
+ * much beyond adds a factor 1 + 2^-19 a level). */
+static bool piece_net(const geom_surface *s, ia_interval u, ia_interval v,
                       ia_interval q[3][4][4])
 {
+    const double e = 0x1p-20;          /* a rounding's worth past the square */
+    if (!(u.lo >= -e && u.hi <= 1 + e && v.lo >= -e && v.hi <= 1 + e)) return false;
+    double big = 0;
+    for (int i = 0; i < 16; i++)
+        big = fmax(big, fmax(fabs(s->verts[i].x), fmax(fabs(s->verts[i].y), fabs(s->verts[i].z))));
+    double pad = 0x1p-40 * big;
+    if (!isfinite(pad)) return false;
     for (int c = 0; c < 3; c++) {
+        double h[4][4], col[4], r[4];
         for (int j = 0; j < 4; j++) {
-            ia_interval row[4];
-            for (int i = 0; i < 4; i++) row[i] = ia_point(v3_comp(s->verts[4 * j + i], c));
-            piece_ia(row, ia_point(u.lo), ia_point(u.hi), q[c][j]);
+            double row[4];
+            for (int i = 0; i < 4; i++) row[i] = v3_comp(s->verts[4 * j + i], c);
+            piece_f(row, u.lo, u.hi, h[j]);
         }
         for (int i = 0; i < 4; i++) {
-            ia_interval col[4] = {q[c][0][i], q[c][1][i], q[c][2][i], q[c][3][i]}, r[4];
-            piece_ia(col, ia_point(v.lo), ia_point(v.hi), r);
-            for (int j = 0; j < 4; j++) q[c][j][i] = r[j];
+            for (int j = 0; j < 4; j++) col[j] = h[j][i];
+            piece_f(col, v.lo, v.hi, r);
+            for (int j = 0; j < 4; j++) q[c][j][i] = ia_make(r[j] - pad, r[j] + pad);
         }
     }
+    return true;
 }
 
 /* Over the piece, with the net q of one coordinate: the hull of the
@@ -224,9 +238,8 @@ void geom_bicubic_eval_ia(const geom_surface *s, ia_interval u, ia_interval v, g
 
 void geom_bicubic_tighten_ia(const geom_surface *s, ia_interval u, ia_interval v, geom_ia *o)
 {
-    if (!(u.hi - u.lo > 0x1p-20) || !(v.hi - v.lo > 0x1p-20)) return;
     ia_interval q[3][4][4];
-    piece_net(s, u, v, q);
+    if (!(u.hi - u.lo > 0x1p-20) || !(v.hi - v.lo > 0x1p-20) || !piece_net(s, u, v, q)) return;
     ia_interval iu = ia_recip(ia_sub(ia_point(u.hi), ia_point(u.lo)));
     ia_interval iv = ia_recip(ia_sub(ia_point(v.hi), ia_point(v.lo)));
     for (int c = 0; c < 3; c++) {
@@ -248,9 +261,9 @@ bool geom_bicubic_normal_slopes_ia(const geom_surface *s, ia_interval u, ia_inte
 {
     /* the derivatives from the piece's net: d/du = d/ds / (u1 - u0), and
      * likewise for v */
-    if (!(u.hi - u.lo > 0x1p-20) || !(v.hi - v.lo > 0x1p-20)) return false;
     ia_interval q[3][4][4];
-    piece_net(s, u, v, q);
+    if (!(u.hi - u.lo > 0x1p-20) || !(v.hi - v.lo > 0x1p-20) || !piece_net(s, u, v, q))
+        return false;
     ia_interval iu = ia_recip(ia_sub(ia_point(u.hi), ia_point(u.lo)));
     ia_interval iv = ia_recip(ia_sub(ia_point(v.hi), ia_point(v.lo)));
     ia_interval Pu[3], Pv[3], Puu[3], Puv[3], Pvv[3];
@@ -399,7 +412,7 @@ bool geom_bicubic_net_aa(aa_context *ctx, const geom_surface *b, const aa_form *
     if (!(s1 - s0 > 0x1p-12) || !(t1 - t0 > 0x1p-12) || (s->flags | t->flags))
         return false;
     ia_interval q[3][4][4];
-    piece_net(b, sr, tr, q);
+    if (!piece_net(b, sr, tr, q)) return false;
     ia_interval is = ia_recip(ia_sub(ia_point(s1), ia_point(s0)));
     ia_interval it = ia_recip(ia_sub(ia_point(t1), ia_point(t0)));
     for (int c = 0; c < 3; c++) {
