@@ -1058,6 +1058,26 @@ static iv piece_of(double lo, double hi, int64_t i)
     return clip01(iv_mk(fp_add_dn(lo, -di), fp_add_up(hi, -di)));
 }
 
+/* The lattice cells the box meets along each axis: the first, i0[k],
+ * and how many, ncell[k] (1 or 2); false for a non-finite or huge box or
+ * one that meets 3 or more cells along an axis (only [0, 1] is known) */
+static bool box_cells(const box_query *q, int64_t i0[4], int ncell[4])
+{
+    for (int k = 0; k < q->dim; k++) {
+        double lo = q->lo[k], hi = q->hi[k];
+        if (!(lo <= hi) || !(lo > -NOISE_BOX_LIMIT) || !(hi < NOISE_BOX_LIMIT))
+            return false;
+        int64_t a = lat_floor(lo), b = lat_floor(hi);
+        if (b > a && (double)b == hi)
+            b--;                       /* the face f = 0 of cell b is in cell b-1 */
+        if (b - a >= 2)
+            return false;
+        i0[k] = a;
+        ncell[k] = (int)(b - a) + 1;
+    }
+    return true;
+}
+
 /*
  * Encloses N = 0.5 + K raw over the box (and, with want_affine, its
  * linearisation at the centre; with want_grad, its gradient is what the
@@ -1070,18 +1090,7 @@ static bool enclose_jets(const box_query *q, bool want_affine, const point_jet *
     int dim = q->dim;
     int64_t i0[4];
     int ncell[4];
-    for (int k = 0; k < dim; k++) {
-        double lo = q->lo[k], hi = q->hi[k];
-        if (!(lo <= hi) || !(lo > -NOISE_BOX_LIMIT) || !(hi < NOISE_BOX_LIMIT))
-            return false;
-        int64_t a = lat_floor(lo), b = lat_floor(hi);
-        if (b > a && (double)b == hi)
-            b--;                       /* the face f = 0 of cell b is in cell b-1 */
-        if (b - a >= 2)
-            return false;
-        i0[k] = a;
-        ncell[k] = (int)(b - a) + 1;
-    }
+    if (!box_cells(q, i0, ncell)) return false;
 
     /*
      * Slivers. A box that crosses a lattice plane by a sliver of width e
@@ -1548,16 +1557,9 @@ static bool enclose(const box_query *q, bool want_affine, bool want_grad,
                     box_result *res)
 {
     int dim = q->dim;
-    for (int k = 0; k < dim; k++) {
-        double lo = q->lo[k], hi = q->hi[k];
-        if (!(lo <= hi) || !(lo > -NOISE_BOX_LIMIT) || !(hi < NOISE_BOX_LIMIT))
-            return false;
-        int64_t a = lat_floor(lo), b = lat_floor(hi);
-        if (b > a && (double)b == hi)
-            b--;
-        if (b - a >= 2)
-            return false;
-    }
+    int64_t i0[4];
+    int ncell[4];
+    if (!box_cells(q, i0, ncell)) return false;
     point_jet P;
     point_jet_at(dim, q->c, q->period, q->seed, &P);
     if (box_method == SL_NOISE_BOX_JETS)
