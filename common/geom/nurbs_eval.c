@@ -239,15 +239,61 @@ static void dot_aa(aa_context *ctx, aa_form *z, const aa_form *w, const double *
         aa_lincomb(ctx, z, 1, z, x[i * stride], &w[i], 0);
 }
 
+/* The homogeneous numerator and weight (H[0]), and their derivatives in
+ * u (H[1]) and v (H[2]), over the box of u and v from the piece's Bezier
+ * net there (bezier_net.c): false on boxes thinner than 2^-12 or beyond
+ * the unit square (the tensor form there) */
+static bool net_forms(aa_context *ctx, const geom_nurbs_piece *pc, const aa_form *u,
+                      const aa_form *v, int ncoord, aa_form H[3][4])
+{
+    ia_interval ur = aa_range(u), vr = aa_range(v);
+    double s0 = ur.lo, s1 = ur.hi, t0 = vr.lo, t1 = vr.hi, e = 0x1p-20;
+    if (!(s1 - s0 > 0x1p-12) || !(t1 - t0 > 0x1p-12) || (u->flags | v->flags) ||
+        !(s0 >= -e && s1 <= 1 + e && t0 >= -e && t1 <= 1 + e))
+        return false;
+    int ku = pc->ku, kv = pc->kv;
+    double big = 0;
+    for (int i = 0; i < 4 * ku * kv; i++) big = fmax(big, fabs(pc->H[i]));
+    double pad = GEOM_NET_PAD * big;
+    if (!isfinite(pad)) return false;
+    ia_interval is = ia_recip(ia_sub(ia_point(s1), ia_point(s0)));
+    ia_interval it = ia_recip(ia_sub(ia_point(t1), ia_point(t0)));
+    for (int c = 0; c < ncoord; c++) {
+        double h[MAXO][MAXO], r[MAXO];
+        ia_interval q[MAXO][MAXO], d[MAXO][MAXO];
+        for (int j = 0; j < kv; j++)
+            geom_bezier_piece(pc->H + 4 * j * ku + c, 4, ku, s0, s1, h[j], 1);
+        for (int i = 0; i < ku; i++) {
+            double col[MAXO];
+            for (int j = 0; j < kv; j++) col[j] = h[j][i];
+            geom_bezier_piece(col, 1, kv, t0, t1, r, 1);
+            for (int j = 0; j < kv; j++) q[j][i] = ia_make(r[j] - pad, r[j] + pad);
+        }
+        geom_net_form(ctx, &H[0][c], &q[0][0], MAXO, ku, kv, ia_point(1), u, v, s0, s1, t0, t1);
+        /* d/ds: (ku - 1) times the differences along u, a net of ku - 1 */
+        for (int j = 0; j < kv; j++)
+            for (int i = 0; i + 1 < ku; i++)
+                d[j][i] = ia_mul_s(ia_sub(q[j][i + 1], q[j][i]), ku - 1);
+        geom_net_form(ctx, &H[1][c], &d[0][0], MAXO, ku - 1, kv, is, u, v, s0, s1, t0, t1);
+        for (int j = 0; j + 1 < kv; j++)
+            for (int i = 0; i < ku; i++)
+                d[j][i] = ia_mul_s(ia_sub(q[j + 1][i], q[j][i]), kv - 1);
+        geom_net_form(ctx, &H[2][c], &d[0][0], MAXO, ku, kv - 1, it, u, v, s0, s1, t0, t1);
+    }
+    return true;
+}
+
 void geom_nurbs_eval_aa(aa_context *ctx, const geom_surface *s, const aa_form *u,
                         const aa_form *v, geom_aa *o)
 {
     const geom_nurbs_piece *pc = piece_of(s);
+    bool poly = pc->wmin == pc->wmax;
+    aa_form H[3][4], t;
+    if (pc->ku >= 3 && pc->kv >= 3 && net_forms(ctx, pc, u, v, poly ? 3 : 4, H))
+        goto divide;
     aa_form bu[MAXO], du[MAXO], bv[MAXO], dv[MAXO];
     basis_aa(ctx, pc->ku - 1, u, bu, du);
     basis_aa(ctx, pc->kv - 1, v, bv, dv);
-    bool poly = pc->wmin == pc->wmax;
-    aa_form H[3][4], t;
     for (int c = 0; c < (poly ? 3 : 4); c++) {
         aa_const(&H[0][c], 0);
         aa_const(&H[1][c], 0);
@@ -265,6 +311,7 @@ void geom_nurbs_eval_aa(aa_context *ctx, const geom_surface *s, const aa_form *u
             aa_add(ctx, &H[2][c], &H[2][c], &t);
         }
     }
+divide:;
     aa_form W, Wu, Wv, r;
     if (poly) {
         aa_context none;

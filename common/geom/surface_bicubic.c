@@ -112,29 +112,6 @@ static ia_interval sum4_ia(const ia_interval a[4], const ia_interval b[4])
     return r;
 }
 
-/* The cubic's blossom f(t1, t2, t3) (de Casteljau with t1, t2, t3 at its
- * three levels), in float: the control points of the piece over [a, b]
- * are f(a,a,a), f(a,a,b), f(a,b,b), f(b,b,b). Its rounding: each level's
- * r + (r' - r) t carries the errors of r and r' in the convex combination
- * (1 - t) e + t e' (t in [0, 1]) and adds three roundings of at most
- * u |x|, |x| <= 3 B for B the largest |control point|: under 10 u B a
- * level, 30 u B a curve, 60 u B for the net (rows, then columns) */
-static double blossom(const double p[4], double t1, double t2, double t3)
-{
-    double r[4] = {p[0], p[1], p[2], p[3]}, t[3] = {t1, t2, t3};
-    for (int l = 0; l < 3; l++)
-        for (int i = 0; i < 3 - l; i++) r[i] = r[i] + (r[i + 1] - r[i]) * t[l];
-    return r[0];
-}
-
-static void piece_f(const double p[4], double a, double b, double q[4])
-{
-    q[0] = blossom(p, a, a, a);
-    q[1] = blossom(p, a, a, b);
-    q[2] = blossom(p, a, b, b);
-    q[3] = blossom(p, b, b, b);
-}
-
 static void cross_ia(const ia_interval a[3], const ia_interval b[3], ia_interval out[3])
 {
     for (int c = 0; c < 3; c++) {
@@ -144,12 +121,12 @@ static void cross_ia(const ia_interval a[3], const ia_interval b[3], ia_interval
 }
 
 /* The piece of the patch over the box as a Bezier patch of its own,
- * q[c][j][i] for coordinate c (float blossoms, each widened by 2^-40 of
- * the net's largest coordinate: over 100 times their rounding, above):
+ * q[c][j][i] for coordinate c (float blossoms, each widened by
+ * GEOM_NET_PAD of the net's largest coordinate, bezier_net.c):
  * it and its derivatives (Bezier patches whose control points are the
  * net's differences) lie in the hulls of their control points (Farin,
  * "Curves and Surfaces for CAGD", §4.3, §16.2). False unless the box lies
- * in [0, 1]^2, but for 2^-20 (the bound above needs t in [0, 1]; that
+ * in [0, 1]^2, but for 2^-20 (the pad's bound needs t in [0, 1]; that
  * much beyond adds a factor 1 + 2^-19 a level). */
 static bool piece_net(const geom_surface *s, ia_interval u, ia_interval v,
                       ia_interval q[3][4][4])
@@ -159,18 +136,18 @@ static bool piece_net(const geom_surface *s, ia_interval u, ia_interval v,
     double big = 0;
     for (int i = 0; i < 16; i++)
         big = fmax(big, fmax(fabs(s->verts[i].x), fmax(fabs(s->verts[i].y), fabs(s->verts[i].z))));
-    double pad = 0x1p-40 * big;
+    double pad = GEOM_NET_PAD * big;
     if (!isfinite(pad)) return false;
     for (int c = 0; c < 3; c++) {
         double h[4][4], col[4], r[4];
         for (int j = 0; j < 4; j++) {
             double row[4];
             for (int i = 0; i < 4; i++) row[i] = v3_comp(s->verts[4 * j + i], c);
-            piece_f(row, u.lo, u.hi, h[j]);
+            geom_bezier_piece(row, 1, 4, u.lo, u.hi, h[j], 1);
         }
         for (int i = 0; i < 4; i++) {
             for (int j = 0; j < 4; j++) col[j] = h[j][i];
-            piece_f(col, v.lo, v.hi, r);
+            geom_bezier_piece(col, 1, 4, v.lo, v.hi, r, 1);
             for (int j = 0; j < 4; j++) q[c][j][i] = ia_make(r[j] - pad, r[j] + pad);
         }
     }
@@ -204,7 +181,6 @@ static ia_interval net_diff(ia_interval q[4][4], int ku, int kv)
     return ia_mul_s(h, factor[ku][kv]);
 }
 
-static double mid_ia(ia_interval x) { return 0.5 * x.lo + 0.5 * x.hi; }
 
 static ia_interval meet(ia_interval a, ia_interval b)
 {
@@ -354,54 +330,6 @@ void geom_bicubic_eval_aa(aa_context *ctx, const geom_surface *s, const aa_form 
     }
 }
 
-/* One affine form from a Bezier net w[j][i] (nu x nv control points at
- * (i/(nu-1), j/(nv-1)) of the piece [s0,s1] x [t0,t1], times `scale`): the
- * plane alpha s + beta t + gamma fitted to the net (its mean slopes), as
- * a linear combination of the inputs s and t, plus a new symbol for the
- * largest distance of the net's points from the plane's (the difference
- * is a Bezier patch too, so it lies in their hull; computed in interval
- * arithmetic) and the net's hull for the form's hull */
-static void net_form(aa_context *ctx, aa_form *z, ia_interval w[4][4], int nu, int nv,
-                     ia_interval scale, const aa_form *s, const aa_form *t, double s0,
-                     double s1, double t0, double t1)
-{
-    double ds = 0, dt = 0, mean = 0;
-    for (int j = 0; j < nv; j++) ds += mid_ia(w[j][nu - 1]) - mid_ia(w[j][0]);
-    for (int i = 0; i < nu; i++) dt += mid_ia(w[nv - 1][i]) - mid_ia(w[0][i]);
-    for (int j = 0; j < nv; j++)
-        for (int i = 0; i < nu; i++) mean += mid_ia(w[j][i]);
-    double sc = mid_ia(scale);
-    ds = ds / nv * sc;
-    dt = dt / nu * sc;
-    mean = mean / (nu * nv) * sc;
-    double alpha = ds / (s1 - s0), beta = dt / (t1 - t0);
-    double gamma = mean - alpha * (0.5 * s0 + 0.5 * s1) - beta * (0.5 * t0 + 0.5 * t1);
-    if (!isfinite(alpha) || !isfinite(beta) || !isfinite(gamma)) alpha = beta = gamma = 0;
-    double rmax = 0;
-    ia_interval hull = ia_empty();
-    for (int j = 0; j < nv; j++)
-        for (int i = 0; i < nu; i++) {
-            ia_interval x = ia_mul(w[j][i], scale);
-            ia_interval si = ia_add(ia_point(s0), ia_mul_s(ia_sub(ia_point(s1), ia_point(s0)),
-                                                           (double)i / (nu - 1)));
-            ia_interval tj = ia_add(ia_point(t0), ia_mul_s(ia_sub(ia_point(t1), ia_point(t0)),
-                                                           (double)j / (nv - 1)));
-            ia_interval plane = ia_add(ia_add(ia_mul_s(si, alpha), ia_mul_s(tj, beta)),
-                                       ia_point(gamma));
-            ia_interval d = ia_sub(x, plane);
-            rmax = fmax(rmax, fmax(-d.lo, d.hi));
-            hull = i == 0 && j == 0 ? x : ia_hull(hull, x);
-        }
-    aa_lincomb(ctx, z, alpha, s, beta, t, gamma);
-    if (!(rmax < INFINITY) || !isfinite(hull.lo) || !isfinite(hull.hi)) {
-        aa_unbounded(z, AA_UNBOUNDED);
-        return;
-    }
-    aa_add_new_error(ctx, z, rmax);
-    z->lo = hull.lo;
-    z->hi = hull.hi;
-}
-
 bool geom_bicubic_net_aa(aa_context *ctx, const geom_surface *b, const aa_form *s,
                          const aa_form *t, geom_aa *o)
 {
@@ -421,9 +349,9 @@ bool geom_bicubic_net_aa(aa_context *ctx, const geom_surface *b, const aa_form *
             for (int i = 0; i < 3; i++) du[j][i] = ia_mul_s(ia_sub(q[c][j][i + 1], q[c][j][i]), 3);
         for (int j = 0; j < 3; j++)
             for (int i = 0; i < 4; i++) dv[j][i] = ia_mul_s(ia_sub(q[c][j + 1][i], q[c][j][i]), 3);
-        net_form(ctx, &o->P[c], q[c], 4, 4, ia_point(1), s, t, s0, s1, t0, t1);
-        net_form(ctx, &o->dPdu[c], du, 3, 4, is, s, t, s0, s1, t0, t1);
-        net_form(ctx, &o->dPdv[c], dv, 4, 3, it, s, t, s0, s1, t0, t1);
+        geom_net_form(ctx, &o->P[c], &q[c][0][0], 4, 4, 4, ia_point(1), s, t, s0, s1, t0, t1);
+        geom_net_form(ctx, &o->dPdu[c], &du[0][0], 4, 3, 4, is, s, t, s0, s1, t0, t1);
+        geom_net_form(ctx, &o->dPdv[c], &dv[0][0], 4, 4, 3, it, s, t, s0, s1, t0, t1);
     }
     for (int c = 0; c < 3; c++) {
         int a = (c + 1) % 3, e = (c + 2) % 3;

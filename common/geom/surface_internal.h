@@ -66,6 +66,19 @@ bool geom_vertex_normal_prepare(geom_surface *s, char *why, int why_size);
 bool geom_bicubic_prepare(geom_surface *s, char *why, int why_size);
 void geom_bicubic_eval_dual(const geom_surface *s, double u, double v, geom_sample *out);
 void geom_bicubic_eval_ia(const geom_surface *s, ia_interval u, ia_interval v, geom_ia *out);
+/* Bezier nets of pieces, and affine forms from them (bezier_net.c). */
+#define GEOM_NET_PAD 0x1p-40
+/* The n control points (stride apart) of a curve of degree n - 1 over
+ * [a, b] (in [0, 1]), in float: q[k * qstride] */
+void geom_bezier_piece(const double *p, int stride, int n, double a, double b, double *q,
+                       int qstride);
+/* An affine form of the patch with net w[j * ld + i] (nu x nv points at
+ * (i/(nu-1), j/(nv-1)) of the piece [s0,s1] x [t0,t1] of the inputs s, t),
+ * times scale: a plane in s and t plus a new symbol for the net's largest
+ * distance from it; the net's hull for the form's hull */
+void geom_net_form(aa_context *ctx, aa_form *z, const ia_interval *w, int ld, int nu, int nv,
+                   ia_interval scale, const aa_form *s, const aa_form *t, double s0,
+                   double s1, double t0, double t1);
 /* Affine forms of P, dPdu, dPdv (and Ng from them) over the box of the
  * inputs s, t from the Bezier net of the patch's piece there: a plane in
  * s and t plus one symbol for the net's distance from it (cheaper than

@@ -1,0 +1,92 @@
+/*
+ * bezier_net.c: Bezier nets of a piece of a polynomial patch, and affine
+ * forms from them (bicubic patches, subdivision sub-patches and NuPatch
+ * pieces, docs/geometry.md "Affine operations per evaluation").
+ *
+ * The piece of a Bezier curve over [a, b] is a Bezier curve of its own,
+ * whose control points are the blossoms f(a, .., a, b, .., b) (de
+ * Casteljau with a at the first levels and b at the rest; Farin, "Curves
+ * and Surfaces for CAGD", §4.3); a patch's, rows then columns. Computed
+ * in float, each point is widened by GEOM_NET_PAD of the net's largest
+ * coordinate B: a level's r + (r' - r) t carries the earlier errors in
+ * the convex combination (1 - t) e + t e' (t in [0, 1]) and adds three
+ * roundings of at most u |x|, |x| <= 3 B, so under 10 u B a level, 10 n u B
+ * for a curve of degree n, 20 n u B for a net (rows, then columns): at
+ * degree 15, 300 u B, and GEOM_NET_PAD = 2^-40 = 8192 u.
+ *
+ * geom_net_form: the patch over the piece lies in the hull of its net,
+ * and so does the patch minus any plane, whose net is the control points
+ * minus the plane's values at the net's abscissae (a plane is a Bezier
+ * patch of any degree with those control points). So a plane fitted to
+ * the net plus one new noise symbol for the largest such difference is an
+ * affine form of the patch over the piece, linear in the inputs' symbols.
+ */
+#include "geom/nurbs.h"
+#include "geom/surface.h"
+#include "geom/surface_internal.h"
+
+#include <assert.h>
+#include <math.h>
+
+void geom_bezier_piece(const double *p, int stride, int n, double a, double b, double *q,
+                       int qstride)
+{
+    assert(n >= 1 && n <= GEOM_NURBS_MAX_ORDER);
+    for (int k = 0; k < n; k++) {
+        double r[GEOM_NURBS_MAX_ORDER];
+        for (int i = 0; i < n; i++) r[i] = p[i * stride];
+        /* n - 1 levels: a at the first n - 1 - k, b at the last k */
+        for (int l = 0; l < n - 1; l++) {
+            double t = l < n - 1 - k ? a : b;
+            for (int i = 0; i < n - 1 - l; i++) r[i] = r[i] + (r[i + 1] - r[i]) * t;
+        }
+        q[k * qstride] = r[0];
+    }
+}
+
+static double mid_ia(ia_interval x) { return 0.5 * x.lo + 0.5 * x.hi; }
+
+void geom_net_form(aa_context *ctx, aa_form *z, const ia_interval *w, int ld, int nu, int nv,
+                   ia_interval scale, const aa_form *s, const aa_form *t, double s0,
+                   double s1, double t0, double t1)
+{
+    assert(nu >= 2 && nv >= 2 && ld >= nu);
+#define W(j, i) w[(j) * ld + (i)]
+    double ds = 0, dt = 0, mean = 0;
+    for (int j = 0; j < nv; j++) ds += mid_ia(W(j, nu - 1)) - mid_ia(W(j, 0));
+    for (int i = 0; i < nu; i++) dt += mid_ia(W(nv - 1, i)) - mid_ia(W(0, i));
+    for (int j = 0; j < nv; j++)
+        for (int i = 0; i < nu; i++) mean += mid_ia(W(j, i));
+    double sc = mid_ia(scale);
+    ds = ds / nv * sc;
+    dt = dt / nu * sc;
+    mean = mean / (nu * nv) * sc;
+    /* any plane serves: the distances below are taken from this one */
+    double alpha = ds / (s1 - s0), beta = dt / (t1 - t0);
+    double gamma = mean - alpha * (0.5 * s0 + 0.5 * s1) - beta * (0.5 * t0 + 0.5 * t1);
+    if (!isfinite(alpha) || !isfinite(beta) || !isfinite(gamma)) alpha = beta = gamma = 0;
+    double rmax = 0;
+    ia_interval hull = ia_empty();
+    for (int j = 0; j < nv; j++)
+        for (int i = 0; i < nu; i++) {
+            ia_interval x = ia_mul(W(j, i), scale);
+            ia_interval si = ia_add(ia_point(s0), ia_mul_s(ia_sub(ia_point(s1), ia_point(s0)),
+                                                           (double)i / (nu - 1)));
+            ia_interval tj = ia_add(ia_point(t0), ia_mul_s(ia_sub(ia_point(t1), ia_point(t0)),
+                                                           (double)j / (nv - 1)));
+            ia_interval plane = ia_add(ia_add(ia_mul_s(si, alpha), ia_mul_s(tj, beta)),
+                                       ia_point(gamma));
+            ia_interval d = ia_sub(x, plane);
+            rmax = fmax(rmax, fmax(-d.lo, d.hi));
+            hull = i == 0 && j == 0 ? x : ia_hull(hull, x);
+        }
+#undef W
+    aa_lincomb(ctx, z, alpha, s, beta, t, gamma);
+    if (!(rmax < INFINITY) || !isfinite(hull.lo) || !isfinite(hull.hi)) {
+        aa_unbounded(z, AA_UNBOUNDED);
+        return;
+    }
+    aa_add_new_error(ctx, z, rmax);
+    z->lo = hull.lo;
+    z->hi = hull.hi;
+}
