@@ -44,6 +44,23 @@ void geom_bezier_piece(const double *p, int stride, int n, double a, double b, d
     }
 }
 
+bool geom_net_piece(const double *p, int stride, int ku, int kv, double s0, double s1,
+                    double t0, double t1, double pad, ia_interval *q, int ld)
+{
+    const double e = 0x1p-20;          /* a rounding's worth past the square */
+    if (!(s0 >= -e && s1 <= 1 + e && t0 >= -e && t1 <= 1 + e) || !isfinite(pad)) return false;
+    assert(ku <= GEOM_NURBS_MAX_ORDER && kv <= GEOM_NURBS_MAX_ORDER);
+    double h[GEOM_NURBS_MAX_ORDER][GEOM_NURBS_MAX_ORDER];
+    for (int j = 0; j < kv; j++) geom_bezier_piece(p + j * ku * stride, stride, ku, s0, s1, h[j], 1);
+    for (int i = 0; i < ku; i++) {
+        double col[GEOM_NURBS_MAX_ORDER], r[GEOM_NURBS_MAX_ORDER];
+        for (int j = 0; j < kv; j++) col[j] = h[j][i];
+        geom_bezier_piece(col, 1, kv, t0, t1, r, 1);
+        for (int j = 0; j < kv; j++) q[j * ld + i] = ia_make(r[j] - pad, r[j] + pad);
+    }
+    return true;
+}
+
 static double mid_ia(ia_interval x) { return 0.5 * x.lo + 0.5 * x.hi; }
 
 void geom_net_form(aa_context *ctx, aa_form *z, const ia_interval *w, int ld, int nu, int nv,

@@ -247,28 +247,18 @@ static bool net_forms(aa_context *ctx, const geom_nurbs_piece *pc, const aa_form
                       const aa_form *v, int ncoord, aa_form H[3][4])
 {
     ia_interval ur = aa_range(u), vr = aa_range(v);
-    double s0 = ur.lo, s1 = ur.hi, t0 = vr.lo, t1 = vr.hi, e = 0x1p-20;
-    if (!(s1 - s0 > 0x1p-12) || !(t1 - t0 > 0x1p-12) || (u->flags | v->flags) ||
-        !(s0 >= -e && s1 <= 1 + e && t0 >= -e && t1 <= 1 + e))
-        return false;
+    double s0 = ur.lo, s1 = ur.hi, t0 = vr.lo, t1 = vr.hi;
+    if (!(s1 - s0 > 0x1p-12) || !(t1 - t0 > 0x1p-12) || (u->flags | v->flags)) return false;
     int ku = pc->ku, kv = pc->kv;
     double big = 0;
     for (int i = 0; i < 4 * ku * kv; i++) big = fmax(big, fabs(pc->H[i]));
     double pad = GEOM_NET_PAD * big;
-    if (!isfinite(pad)) return false;
     ia_interval is = ia_recip(ia_sub(ia_point(s1), ia_point(s0)));
     ia_interval it = ia_recip(ia_sub(ia_point(t1), ia_point(t0)));
     for (int c = 0; c < ncoord; c++) {
-        double h[MAXO][MAXO], r[MAXO];
         ia_interval q[MAXO][MAXO], d[MAXO][MAXO];
-        for (int j = 0; j < kv; j++)
-            geom_bezier_piece(pc->H + 4 * j * ku + c, 4, ku, s0, s1, h[j], 1);
-        for (int i = 0; i < ku; i++) {
-            double col[MAXO];
-            for (int j = 0; j < kv; j++) col[j] = h[j][i];
-            geom_bezier_piece(col, 1, kv, t0, t1, r, 1);
-            for (int j = 0; j < kv; j++) q[j][i] = ia_make(r[j] - pad, r[j] + pad);
-        }
+        if (!geom_net_piece(pc->H + c, 4, ku, kv, s0, s1, t0, t1, pad, &q[0][0], MAXO))
+            return false;
         geom_net_form(ctx, &H[0][c], &q[0][0], MAXO, ku, kv, ia_point(1), u, v, s0, s1, t0, t1);
         /* d/ds: (ku - 1) times the differences along u, a net of ku - 1 */
         for (int j = 0; j < kv; j++)
@@ -340,13 +330,7 @@ divide:;
         aa_sub(ctx, &t, &H[2][c], &t);
         aa_mul(ctx, &o->dPdv[c], &t, &r);
     }
-    for (int c = 0; c < 3; c++) {
-        int a = (c + 1) % 3, b = (c + 2) % 3;
-        aa_form x, y;
-        aa_mul(ctx, &x, &o->dPdu[a], &o->dPdv[b]);
-        aa_mul(ctx, &y, &o->dPdu[b], &o->dPdv[a]);
-        aa_sub(ctx, &o->Ng[c], &x, &y);
-    }
+    geom_ng_aa(ctx, o);
 }
 
 /* The interval enclosure: the plain interval evaluation met with the

@@ -330,3 +330,14 @@ void geom_eval_aa(aa_context *ctx, const geom_surface *s, const aa_form *u,
         break;
     }
 }
+
+void geom_ng_aa(aa_context *ctx, geom_aa *o)
+{
+    for (int c = 0; c < 3; c++) {
+        int a = (c + 1) % 3, b = (c + 2) % 3;
+        aa_form x, y;
+        aa_mul(ctx, &x, &o->dPdu[a], &o->dPdv[b]);
+        aa_mul(ctx, &y, &o->dPdu[b], &o->dPdv[a]);
+        aa_sub(ctx, &o->Ng[c], &x, &y);
+    }
+}

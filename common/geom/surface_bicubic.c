@@ -121,36 +121,23 @@ static void cross_ia(const ia_interval a[3], const ia_interval b[3], ia_interval
 }
 
 /* The piece of the patch over the box as a Bezier patch of its own,
- * q[c][j][i] for coordinate c (float blossoms, each widened by
- * GEOM_NET_PAD of the net's largest coordinate, bezier_net.c):
- * it and its derivatives (Bezier patches whose control points are the
- * net's differences) lie in the hulls of their control points (Farin,
- * "Curves and Surfaces for CAGD", §4.3, §16.2). False unless the box lies
- * in [0, 1]^2, but for 2^-20 (the pad's bound needs t in [0, 1]; that
- * much beyond adds a factor 1 + 2^-19 a level). */
+ * q[c][j][i] for coordinate c (geom_net_piece): it and its derivatives
+ * (Bezier patches whose control points are the net's differences) lie in
+ * the hulls of their control points (Farin, "Curves and Surfaces for
+ * CAGD", §4.3, §16.2) */
 static bool piece_net(const geom_surface *s, ia_interval u, ia_interval v,
                       ia_interval q[3][4][4])
 {
-    const double e = 0x1p-20;          /* a rounding's worth past the square */
-    if (!(u.lo >= -e && u.hi <= 1 + e && v.lo >= -e && v.hi <= 1 + e)) return false;
-    double big = 0;
+    double p[48], big = 0;
     for (int i = 0; i < 16; i++)
-        big = fmax(big, fmax(fabs(s->verts[i].x), fmax(fabs(s->verts[i].y), fabs(s->verts[i].z))));
-    double pad = GEOM_NET_PAD * big;
-    if (!isfinite(pad)) return false;
-    for (int c = 0; c < 3; c++) {
-        double h[4][4], col[4], r[4];
-        for (int j = 0; j < 4; j++) {
-            double row[4];
-            for (int i = 0; i < 4; i++) row[i] = v3_comp(s->verts[4 * j + i], c);
-            geom_bezier_piece(row, 1, 4, u.lo, u.hi, h[j], 1);
+        for (int c = 0; c < 3; c++) {
+            p[3 * i + c] = v3_comp(s->verts[i], c);
+            big = fmax(big, fabs(p[3 * i + c]));
         }
-        for (int i = 0; i < 4; i++) {
-            for (int j = 0; j < 4; j++) col[j] = h[j][i];
-            geom_bezier_piece(col, 1, 4, v.lo, v.hi, r, 1);
-            for (int j = 0; j < 4; j++) q[c][j][i] = ia_make(r[j] - pad, r[j] + pad);
-        }
-    }
+    for (int c = 0; c < 3; c++)
+        if (!geom_net_piece(p + c, 3, 4, 4, u.lo, u.hi, v.lo, v.hi, GEOM_NET_PAD * big,
+                            &q[c][0][0], 4))
+            return false;
     return true;
 }
 
@@ -180,7 +167,6 @@ static ia_interval net_diff(ia_interval q[4][4], int ku, int kv)
         }
     return ia_mul_s(h, factor[ku][kv]);
 }
-
 
 static ia_interval meet(ia_interval a, ia_interval b)
 {
@@ -223,11 +209,9 @@ void geom_bicubic_tighten_ia(const geom_surface *s, ia_interval u, ia_interval v
         o->dPdu[c] = meet(o->dPdu[c], ia_mul(net_diff(q[c], 1, 0), iu));
         o->dPdv[c] = meet(o->dPdv[c], ia_mul(net_diff(q[c], 0, 1), iv));
     }
-    for (int c = 0; c < 3; c++) {
-        int a = (c + 1) % 3, b = (c + 2) % 3;
-        o->Ng[c] = meet(o->Ng[c], ia_sub(ia_mul(o->dPdu[a], o->dPdv[b]),
-                                         ia_mul(o->dPdu[b], o->dPdv[a])));
-    }
+    ia_interval Ng[3];
+    cross_ia(o->dPdu, o->dPdv, Ng);
+    for (int c = 0; c < 3; c++) o->Ng[c] = meet(o->Ng[c], Ng[c]);
 }
 
 /* ---- slopes of the unit normal -------------------------------------- */
@@ -321,13 +305,7 @@ void geom_bicubic_eval_aa(aa_context *ctx, const geom_surface *s, const aa_form 
         sum4_aa(ctx, &o->dPdu[c], bv, D);
         sum4_aa(ctx, &o->dPdv[c], dv, C);
     }
-    for (int c = 0; c < 3; c++) {
-        int a = (c + 1) % 3, b = (c + 2) % 3;
-        aa_form x, y;
-        aa_mul(ctx, &x, &o->dPdu[a], &o->dPdv[b]);
-        aa_mul(ctx, &y, &o->dPdu[b], &o->dPdv[a]);
-        aa_sub(ctx, &o->Ng[c], &x, &y);
-    }
+    geom_ng_aa(ctx, o);
 }
 
 bool geom_bicubic_net_aa(aa_context *ctx, const geom_surface *b, const aa_form *s,
@@ -353,13 +331,7 @@ bool geom_bicubic_net_aa(aa_context *ctx, const geom_surface *b, const aa_form *
         geom_net_form(ctx, &o->dPdu[c], &du[0][0], 4, 3, 4, is, s, t, s0, s1, t0, t1);
         geom_net_form(ctx, &o->dPdv[c], &dv[0][0], 4, 4, 3, it, s, t, s0, s1, t0, t1);
     }
-    for (int c = 0; c < 3; c++) {
-        int a = (c + 1) % 3, e = (c + 2) % 3;
-        aa_form x, y;
-        aa_mul(ctx, &x, &o->dPdu[a], &o->dPdv[e]);
-        aa_mul(ctx, &y, &o->dPdu[e], &o->dPdv[a]);
-        aa_sub(ctx, &o->Ng[c], &x, &y);
-    }
+    geom_ng_aa(ctx, o);
     return true;
 }
 

@@ -66,12 +66,23 @@ bool geom_vertex_normal_prepare(geom_surface *s, char *why, int why_size);
 bool geom_bicubic_prepare(geom_surface *s, char *why, int why_size);
 void geom_bicubic_eval_dual(const geom_surface *s, double u, double v, geom_sample *out);
 void geom_bicubic_eval_ia(const geom_surface *s, ia_interval u, ia_interval v, geom_ia *out);
+/* o->Ng = o->dPdu x o->dPdv in affine arithmetic (surface_affine.c) */
+void geom_ng_aa(aa_context *ctx, geom_aa *o);
+
 /* Bezier nets of pieces, and affine forms from them (bezier_net.c). */
 #define GEOM_NET_PAD 0x1p-40
 /* The n control points (stride apart) of a curve of degree n - 1 over
  * [a, b] (in [0, 1]), in float: q[k * qstride] */
 void geom_bezier_piece(const double *p, int stride, int n, double a, double b, double *q,
                        int qstride);
+/* The net of one coordinate of the patch with ku x kv points p (point
+ * (i, j) at p[(j ku + i) stride]) over [s0,s1] x [t0,t1], each point
+ * widened by pad (GEOM_NET_PAD of the largest coordinate): q[j ld + i].
+ * False unless the box lies in the unit square but for 2^-20 (the pad's
+ * bound needs t in [0, 1]; that much beyond adds a factor 1 + 2^-19 a
+ * level) or with a non-finite pad. */
+bool geom_net_piece(const double *p, int stride, int ku, int kv, double s0, double s1,
+                    double t0, double t1, double pad, ia_interval *q, int ld);
 /* An affine form of the patch with net w[j * ld + i] (nu x nv points at
  * (i/(nu-1), j/(nv-1)) of the piece [s0,s1] x [t0,t1] of the inputs s, t),
  * times scale: a plane in s and t plus a new symbol for the net's largest

@@ -423,6 +423,15 @@ static bool over_limit(walk *w, const double r[4])
     return true;
 }
 
+/* Proofs only on cells a cell's width or more away from the edges a
+ * polygon shares with another (see visit) */
+static bool clear_of_shared_edges(const walk *w, const double c[4])
+{
+    return !w->obj->shared_edges ||
+           geom_uv_box_clear_of(&w->obj->surf, 2 * c[0] - c[1], 2 * c[1] - c[0], 2 * c[2] - c[3],
+                                2 * c[3] - c[2], w->obj->shared_edges);
+}
+
 /* Whether the ray grazes the surface at the cell's centre (its point in
  * *centre): |cos| of the angle between the ray and the displaced
  * surface's normal Pu x Pv below TRACE_PROVE_GRAZE. A leaf there may be a
@@ -482,12 +491,11 @@ static void visit(walk *w, const trace_box *node, const double r[4],
          * next to an estimate on the other opened cracks: tests/corpus,
          * mesh); at an edge of its own a proof draws it exactly */
         bool provable = w->prove && !unbounded && !(kid->flags & AA_DISCONTINUOUS) &&
-                        size <= TRACE_PROVE_CELLS * tol &&
-                        (!w->obj->shared_edges ||
-                         geom_uv_box_clear_of(&w->obj->surf, 2 * c[0] - c[1], 2 * c[1] - c[0],
-                                              2 * c[2] - c[3], 2 * c[3] - c[2],
-                                              w->obj->shared_edges));
-        if (provable && kid->bend <= TRACE_PROVE_BEND && size <= w->prove_below) {
+                        size <= TRACE_PROVE_CELLS * tol;
+        bool try_proof = provable && kid->bend <= TRACE_PROVE_BEND && size <= w->prove_below;
+        bool at_leaf = provable && size <= tol && d < TRACE_MAX_DEPTH;
+        if ((try_proof || at_leaf) && !clear_of_shared_edges(w, c)) try_proof = at_leaf = false;
+        if (try_proof) {
             double t;
             trace_surface_point sp;
             trace_proof_detail why;
@@ -505,7 +513,7 @@ static void visit(walk *w, const trace_box *node, const double r[4],
         /* a leaf where the ray grazes the surface: finer leaves */
         trace_surface_point centre;
         bool centred = false;
-        if (!kid_fine && provable && !unbounded && size <= tol && d < TRACE_MAX_DEPTH) {
+        if (!kid_fine && at_leaf) {
             centred = true;
             kid_fine = grazes(w, c, &centre) && trace_prove_cell_has_slopes(w->th, w->obj, c);
         }
