@@ -165,6 +165,9 @@ typedef struct sl_vm sl_vm;
 sl_vm *sl_vm_new(const sl_limits *limits);    /* NULL: defaults */
 void sl_vm_destroy(sl_vm **self_p);
 
+/* The named spaces the next runs read: kept by pointer (the binding of
+ * every evaluation sets them), so *spaces must stay alive and unchanged
+ * until the VM's last run with them or the next call; NULL: identity. */
 void sl_vm_set_spaces(sl_vm *self, const sl_spaces *spaces);
 void sl_vm_set_lights(sl_vm *self, sl_light_fn fn, void *user);
 /* The textures that texture(), environment(), bump() and textureinfo()

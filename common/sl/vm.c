@@ -38,8 +38,6 @@ static void *xcalloc(size_t n, size_t size)
     return p;
 }
 
-static void update_depth(sl_vm *self);
-
 sl_vm *sl_vm_new(const sl_limits *limits)
 {
     sl_vm *self = xcalloc(1, sizeof *self);
@@ -49,12 +47,13 @@ sl_vm *sl_vm_new(const sl_limits *limits)
     if (self->limits.max_loop_iterations <= 0)
         self->limits.max_loop_iterations = default_limits.max_loop_iterations;
     for (int s = 0; s < SL_SPACE__COUNT; s++) {
-        self->spaces.to_current[s] = mat4_identity();
-        self->spaces.from_current[s] = mat4_identity();
+        self->identity.to_current[s] = mat4_identity();
+        self->identity.from_current[s] = mat4_identity();
     }
+    self->spaces = &self->identity;
     self->near = 0;
     self->far = 1;
-    update_depth(self);
+    self->depth_stale = true;
     sl_vm_set_message(self, SL_MSG_RENDERERINFO, "renderer", SL_TYPE_STRING, NULL, "aafarm");
     self->f = xcalloc(SL_MAX_SLOTS, sizeof *self->f);
     self->d = xcalloc(SL_MAX_SLOTS, sizeof *self->d);
@@ -96,17 +95,18 @@ void sl_vm_destroy(sl_vm **self_p)
  * products instead of 128: this runs at every box's binding of spaces) */
 static void update_depth(sl_vm *self)
 {
-    const mat4 *cam = &self->spaces.from_current[SL_SPACE_CAMERA];
+    const mat4 *cam = &self->spaces->from_current[SL_SPACE_CAMERA];
     double s = 1 / (self->far - self->near), t = s * -self->near;
     self->depth = *cam;
     for (int j = 0; j < 4; j++)
         self->depth.m[2][j] = s * cam->m[2][j] + t * cam->m[3][j];
+    self->depth_stale = false;
 }
 
 void sl_vm_set_spaces(sl_vm *self, const sl_spaces *spaces)
 {
-    self->spaces = *spaces;
-    update_depth(self);
+    self->spaces = spaces ? spaces : &self->identity;
+    self->depth_stale = true;           /* made when a shader asks for it */
 }
 
 /* ---- light shaders ---- */
@@ -226,7 +226,7 @@ void sl_vm_set_clipping(sl_vm *self, double near, double far)
         return;
     self->near = near;
     self->far = far;
-    update_depth(self);
+    self->depth_stale = true;
 }
 
 void sl_vm_set_lights(sl_vm *self, sl_light_fn fn, void *user)
@@ -450,17 +450,19 @@ sl_status sl_vm_fail(sl_vm *vm, sl_status st, const char *fmt, ...)
     return st;
 }
 
-const mat4 *sl_vm_space_id(const sl_vm *vm, int space, int dir)
+const mat4 *sl_vm_space_id(sl_vm *vm, int space, int dir)
 {
-    if (space == SL_SPACE_DEPTH)
+    if (space == SL_SPACE_DEPTH) {
+        if (vm->depth_stale) update_depth(vm);
         return &vm->depth;
+    }
     if (space < 0 || space >= SL_SPACE__COUNT)
         return NULL;
-    return dir == SL_SPACE_TO_CURRENT ? &vm->spaces.to_current[space]
-                                      : &vm->spaces.from_current[space];
+    return dir == SL_SPACE_TO_CURRENT ? &vm->spaces->to_current[space]
+                                      : &vm->spaces->from_current[space];
 }
 
-const mat4 *sl_vm_space(const sl_vm *vm, const char *name, int dir)
+const mat4 *sl_vm_space(sl_vm *vm, const char *name, int dir)
 {
     return sl_vm_space_id(vm, name ? sl_space_find(name) : -1, dir);
 }

@@ -103,9 +103,13 @@ typedef struct vm_accumulator {
 
 struct sl_vm {
     sl_limits limits;
-    sl_spaces spaces;
+    /* the caller's spaces, read in place (sl_vm_set_spaces: a pointer, not
+     * a copy, since every evaluation binds them); identity until set */
+    const sl_spaces *spaces;
+    sl_spaces identity;
     double near, far;             /* clipping planes, for depth() */
     mat4 depth;                   /* current -> camera, z to depth */
+    bool depth_stale;             /* depth not yet made from spaces, near, far */
     sl_light_fn light_fn;
     void *light_user;
     sl_tracer tracer;             /* trace() and shadow(); zeroed: none */
@@ -177,8 +181,8 @@ sl_status sl_vm_fail(sl_vm *vm, sl_status st, const char *fmt, ...)
 
 /* The matrix of space `name` (SL_SPACE_TO_CURRENT or _FROM_CURRENT), or
  * NULL for an unknown name. */
-const mat4 *sl_vm_space(const sl_vm *vm, const char *name, int dir);
-const mat4 *sl_vm_space_id(const sl_vm *vm, int space, int dir);
+const mat4 *sl_vm_space(sl_vm *vm, const char *name, int dir);
+const mat4 *sl_vm_space_id(sl_vm *vm, int space, int dir);
 
 /* Light samples at surface point P for float/dual runs: the callback's,
  * then the fixed lights. */

@@ -39,6 +39,7 @@
  * there below the tolerance (converge.h), and there is no fold to resolve. */
 #define TRACE_PROVE_LEAF 0.125
 #define TRACE_PROVE_GRAZE 0.1
+#define TRACE_WALL_GRAZE 0.5
 
 typedef struct walk {
     trace_thread *th;
@@ -134,9 +135,14 @@ static void sample_cell(trace_thread *th, const trace_object *obj, const double 
  * At a wall the samples fall into the two sides of the jump (nearer to one
  * or the other of the two farthest samples); the wall's normal is the step
  * between the sides' base-surface centroids, made perpendicular to the
- * jump of their displacements: for a nail, the radius. */
-static bool real_wall(walk *w, const double r[4], double tol, vec3 *normal)
+ * jump of their displacements: for a nail, the radius. *capped says
+ * whether the ray, between t0 and t1, comes within tol of the highest or
+ * lowest sample along the jump: where the wall meets the surface on its
+ * sides (the nail's rim and foot), whose hits a wall leaf would take. */
+static bool real_wall(walk *w, const double r[4], double tol, double t0, double t1,
+                      vec3 *normal, bool *capped)
 {
+    *capped = false;
     cell_samples cs;
     sample_cell(w->th, w->obj, r, &cs);
     if (!(cs.residual > 2.0 * tol)) return false;
@@ -150,9 +156,12 @@ static bool real_wall(walk *w, const double r[4], double tol, vec3 *normal)
         }
     vec3 sum_base[2] = {v3(0, 0, 0), v3(0, 0, 0)}, sum_disp[2] = {v3(0, 0, 0), v3(0, 0, 0)};
     int count[2] = {0, 0};
+    int side_of[CELL_N];
     for (int i = 0; i < CELL_N; i++) {
+        side_of[i] = 0;
         if (!cs.ok[i]) continue;
         int side = v3_length(v3_sub(cs.P[i], cs.P[b])) < v3_length(v3_sub(cs.P[i], cs.P[a]));
+        side_of[i] = side;
         sum_base[side] = v3_add(sum_base[side], cs.base[i]);
         sum_disp[side] = v3_add(sum_disp[side], v3_sub(cs.P[i], cs.base[i]));
         count[side]++;
@@ -160,6 +169,21 @@ static bool real_wall(walk *w, const double r[4], double tol, vec3 *normal)
     vec3 step = v3_sub(v3_scale(sum_base[1], 1.0 / count[1]), v3_scale(sum_base[0], 1.0 / count[0]));
     vec3 jump = v3_sub(v3_scale(sum_disp[1], 1.0 / count[1]), v3_scale(sum_disp[0], 1.0 / count[0]));
     double jj = v3_dot(jump, jump);
+    if (jj > 0 && isfinite(jj)) {
+        /* along the jump: the high side's lowest sample, the low side's
+         * highest; between them only the wall */
+        vec3 j = v3_scale(jump, 1.0 / sqrt(jj));
+        double high = INFINITY, low = -INFINITY;
+        for (int i = 0; i < CELL_N; i++) {
+            if (!cs.ok[i]) continue;
+            double h = v3_dot(cs.P[i], j);
+            if (side_of[i]) high = fmin(high, h);
+            else low = fmax(low, h);
+        }
+        double h0 = v3_dot(trace_ray_at(w->cam_ray, t0), j);
+        double h1 = v3_dot(trace_ray_at(w->cam_ray, t1), j);
+        *capped = fmax(h0, h1) >= high - tol || fmin(h0, h1) <= low + tol;
+    }
     vec3 nrm = jj > 0 ? v3_sub(step, v3_scale(jump, v3_dot(step, jump) / jj)) : step;
     double len = v3_length(nrm);
     if (!(len > 0) || !isfinite(len)) {
@@ -186,27 +210,43 @@ static bool newton_uv(const trace_ray *ray, const trace_surface_point *sp,
 }
 
 /*
- * The point of a leaf's cell where the ray meets the surface: one Newton
- * step from the cell's centre (newton_uv), clamped to the cell. Fills sp at
- * the (u,v) used.
+ * The point of a leaf's cell where the ray meets the surface: Newton's
+ * iteration from the cell's centre (newton_uv, each step clamped to the
+ * cell). Fills sp at the (u,v) used.
  *
  * A cell the polygon covers only in part (partial; issue 9, watertight
- * meshes) is the polygon's only where that point is on the polygon: false
- * otherwise. Deciding by the cell's centre instead let both polygons of a
- * shared edge drop a ray near it: the cracks of issue 9's finding 4.
+ * meshes) takes one step, and is the polygon's only where that point is
+ * on the polygon: false otherwise. Deciding by the cell's centre instead
+ * let both polygons of a shared edge drop a ray near it: the cracks of
+ * issue 9's finding 4.
  *
  * A cell the surface covers whole is a hit either way (issue 10, exact hit
- * points): the step only moves the point the hit is placed and shaded at,
- * to where the ray meets the surface to second order in the cell's size.
- * A step that leaves the (u,v) domain can mean that the ray passes beyond
- * the surface's edge, but also only that a steep displacement is poorly
- * linearised over the cell; dropping such leaves lost real hits of steep
- * shaders on meshes (tests/corpus), so the centre's point stays.
+ * points): the steps only move the point the hit is placed and shaded at,
+ * up to LEAF_NEWTON_STEPS of them, to where the ray meets the surface.
+ * *settled says whether they converged inside the cell (a step of at most
+ * 2^-8 of the cell that the cell did not clamp): where they did not, the
+ * ray may pass the surface within the leaf's tolerance without meeting it
+ * (a near miss, drawn a pixel too fat at a crest's silhouette), which
+ * visit settles with a hit test. A step that leaves the (u,v) domain can
+ * mean that the ray passes beyond the surface's edge, but also only that a
+ * steep displacement is poorly linearised over the cell; dropping such
+ * leaves lost real hits of steep shaders on meshes (tests/corpus), so the
+ * last point inside stays.
  */
-static bool leaf_point(walk *w, const double r[4], bool partial, double *uc, double *vc,
-                       const trace_surface_point *centre, trace_surface_point *sp)
+#define LEAF_NEWTON_STEPS 4
+#define LEAF_SETTLED 0x1p-7             /* of the widened cell: 1/64 of the cell */
+static bool leaf_point(walk *w, const double *r, bool partial, double *uc, double *vc,
+                       const trace_surface_point *centre, trace_surface_point *sp,
+                       bool *settled)
 {
     const trace_object *obj = w->obj;
+    *settled = false;
+    /* beyond the partial cell, the steps may reach the cell's neighbours
+     * (half its width on each side) */
+    double hu = partial ? 0.0 : 0.5 * (r[1] - r[0]), hv = partial ? 0.0 : 0.5 * (r[3] - r[2]);
+    double rw[4] = {fmax(0.0, r[0] - hu), fmin(1.0, r[1] + hu), fmax(0.0, r[2] - hv),
+                    fmin(1.0, r[3] + hv)};
+    r = rw;
     if (centre) *sp = *centre;
     else trace_surface_point_eval(w->th, obj, *uc, *vc, sp);
     double u, v;
@@ -214,21 +254,43 @@ static bool leaf_point(walk *w, const double r[4], bool partial, double *uc, dou
         return partial ? geom_uv_inside(&obj->surf, *uc, *vc) : true;
     if (!geom_uv_inside(&obj->surf, u, v))
         return !partial;
-    if (u == *uc && v == *vc)
-        return true;
-    trace_surface_point moved;
-    trace_surface_point_eval(w->th, obj, u, v, &moved);
-    if (!partial && !v3_is_finite(moved.P))
-        return true;
-    *uc = u;
-    *vc = v;
-    *sp = moved;
-    return true;
+    double last = INFINITY;
+    for (int it = 0;; it++) {
+        double su = u - *uc, sv = v - *vc;
+        double step = fmax(fabs(su) / (r[1] - r[0]), fabs(sv) / (r[3] - r[2]));
+        if (step <= LEAF_SETTLED) {
+            *settled = u > r[0] && u < r[1] && v > r[2] && v < r[3];
+            if (su == 0 && sv == 0) return true;
+            if (*settled && !partial) {
+                /* the last step to first order: the point where the ray
+                 * meets the tangent plane, a square of the step off the
+                 * surface (no evaluation) */
+                sp->P = v3_add(sp->P, v3_add(v3_scale(sp->Pu, su), v3_scale(sp->Pv, sv)));
+                sp->u = *uc = u;
+                sp->v = *vc = v;
+                return true;
+            }
+        }
+        if (!(step < 0.5 * last)) return true;      /* not converging */
+        last = step;
+        trace_surface_point moved;
+        trace_surface_point_eval(w->th, obj, u, v, &moved);
+        if (!partial && !v3_is_finite(moved.P)) return true;
+        *uc = u;
+        *vc = v;
+        *sp = moved;
+        if (partial || *settled || it + 1 == LEAF_NEWTON_STEPS) return true;
+        if (!newton_uv(w->cam_ray, sp, r, &u, &v) || !geom_uv_inside(&obj->surf, u, v))
+            return true;
+    }
 }
 
-static void leaf_hit(walk *w, const trace_box *box, const double r[4],
+/* The hit a leaf stands for, recorded in w->best when nearer. With
+ * may_test, a leaf whose point did not settle (leaf_point) records
+ * nothing and returns true: the caller tests the cell first. */
+static bool leaf_hit(walk *w, const trace_box *box, const double r[4],
                      const child_order *o, trace_leaf_kind kind, vec3 surface_normal,
-                     const trace_surface_point *centre)
+                     const trace_surface_point *centre, bool may_test)
 {
     double t0 = o->t0, t1 = o->t1;
     int axis = o->axis;
@@ -237,13 +299,15 @@ static void leaf_hit(walk *w, const trace_box *box, const double r[4],
     double uc = 0.5 * (r[0] + r[1]), vc = 0.5 * (r[2] + r[3]);
     trace_surface_point sp;
     bool has_point = false;
+    bool settled;
     if (cover == GEOM_PARTIAL && kind != TRACE_LEAF_WALL) {
-        if (!leaf_point(w, r, true, &uc, &vc, centre, &sp)) return;
+        if (!leaf_point(w, r, true, &uc, &vc, centre, &sp, &settled)) return false;
         has_point = true;
     } else if (!geom_uv_inside(&obj->surf, uc, vc)) {
-        return;
+        return false;
     } else if (kind == TRACE_LEAF_SMALL) {
-        leaf_point(w, r, false, &uc, &vc, centre, &sp);
+        leaf_point(w, r, false, &uc, &vc, centre, &sp, &settled);
+        if (may_test && !settled) return true;
         has_point = true;
     }
     trace_thread *th = w->th;
@@ -271,7 +335,7 @@ static void leaf_hit(walk *w, const trace_box *box, const double r[4],
         double dd = v3_dot(cr->d, cr->d);
         if (!v3_is_finite(sp.P) || !(dd > 0)) {
             th->stats.rejected_leaves++;   /* no surface point to place a hit */
-            return;
+            return false;
         }
         t = v3_dot(v3_sub(sp.P, cr->o), cr->d) / dd;
         if (kind == TRACE_LEAF_DEPTH) {
@@ -282,13 +346,13 @@ static void leaf_hit(walk *w, const trace_box *box, const double r[4],
             double tol = w->tol.a + w->tol.b * (t > 0 ? t : 0);
             if (!(v3_length(off) <= tol)) {
                 th->stats.rejected_leaves++;
-                return;
+                return false;
             }
         }
         if (!(t >= t0)) t = t0;
         if (t > t1) t = t1;
     }
-    if (!(t > w->ray.tmin) || !(t < w->best->t)) return;
+    if (!(t > w->ray.tmin) || !(t < w->best->t)) return false;
     trace_hit *b = w->best;
     b->t = t;
     b->obj = obj;
@@ -300,6 +364,7 @@ static void leaf_hit(walk *w, const trace_box *box, const double r[4],
     b->has_point = has_point;
     if (has_point) b->point = sp;
     w->found = true;
+    return false;
 }
 
 /* A hit proven unique in the cell (prove.h): the surface's own point */
@@ -444,6 +509,15 @@ static bool grazes(walk *w, const double r[4], trace_surface_point *centre)
     return !(nd * nd > TRACE_PROVE_GRAZE * TRACE_PROVE_GRAZE * nn * dd);
 }
 
+/* Whether the ray grazes a wall of camera-space normal n (|cos| below
+ * TRACE_PROVE_GRAZE) */
+static bool wall_grazed(const walk *w, vec3 n)
+{
+    vec3 d = w->cam_ray->d;
+    double nn = v3_dot(n, n), dd = v3_dot(d, d), nd = v3_dot(n, d);
+    return nn > 0 && !(nd * nd > TRACE_WALL_GRAZE * TRACE_WALL_GRAZE * nn * dd);
+}
+
 static void visit(walk *w, const trace_box *node, const double r[4],
                   trace_brood_id parent, int slot, int depth, bool fine, geom_cover node_cover)
 {
@@ -484,7 +558,7 @@ static void visit(walk *w, const trace_box *node, const double r[4],
         int d = depth + 1;
         bool unbounded = (kid->flags & AA_UNBOUNDED) != 0;
         vec3 wall_n = v3(0, 0, 0);
-        bool kid_fine = false;
+        bool kid_fine = false, capped = false;
         /* proofs only on cells a cell's width or more away from the
          * edges a polygon shares with another: there the leaves stay,
          * which the two polygons apply alike (an exact miss on one side
@@ -517,16 +591,46 @@ static void visit(walk *w, const trace_box *node, const double r[4],
             centred = true;
             kid_fine = grazes(w, c, &centre) && trace_prove_cell_has_slopes(w->th, w->obj, c);
         }
-        if (d >= TRACE_MAX_DEPTH)
-            leaf_hit(w, kid, c, &order[k], TRACE_LEAF_DEPTH, wall_n, NULL);
-        else if (!unbounded && size <= (kid_fine ? tol * TRACE_PROVE_LEAF : tol))
-            leaf_hit(w, kid, c, &order[k], TRACE_LEAF_SMALL, wall_n, centred ? &centre : NULL);
-        else if (!unbounded && (kid->flags & AA_DISCONTINUOUS) &&
-                 trace_box_extent(kid) >= TRACE_NO_SHRINK * node_extent &&
-                 box_min_extent(kid) * w->obj->scale <= tol && real_wall(w, c, tol, &wall_n))
-            leaf_hit(w, kid, c, &order[k], TRACE_LEAF_WALL, wall_n, NULL);
-        else
-            visit(w, kid, c, brood, order[k].i, d, kid_fine, order[k].cover);
+        if (d >= TRACE_MAX_DEPTH) {
+            leaf_hit(w, kid, c, &order[k], TRACE_LEAF_DEPTH, wall_n, NULL, false);
+            continue;
+        }
+        if (!unbounded && size <= (kid_fine ? tol * TRACE_PROVE_LEAF : tol)) {
+            /* a leaf whose point did not settle in the cell, tested here if
+             * it was not above: a proven miss drops it, a proven hit is
+             * exact, a fold takes finer leaves */
+            bool may_test = at_leaf && !try_proof && !kid_fine;
+            if (!leaf_hit(w, kid, c, &order[k], TRACE_LEAF_SMALL, wall_n,
+                          centred ? &centre : NULL, may_test))
+                continue;
+            double t;
+            trace_surface_point sp;
+            trace_proof_detail why;
+            w->th->stats.leaf_tests++;
+            trace_proof pr = trace_prove_hit(w->th, w->obj, w->cam_ray, c, w->ray.tmin,
+                                             w->best->t, &t, &sp, &why);
+            if (pr == TRACE_PROOF_HIT) proven_hit(w, t, tol, &sp);
+            if (pr != TRACE_PROOF_UNKNOWN) continue;
+            if (!why.fold) {
+                leaf_hit(w, kid, c, &order[k], TRACE_LEAF_SMALL, wall_n, NULL, false);
+                continue;
+            }
+            kid_fine = true;
+        } else if (!unbounded && (kid->flags & AA_DISCONTINUOUS) &&
+                   trace_box_extent(kid) >= TRACE_NO_SHRINK * node_extent &&
+                   box_min_extent(kid) * w->obj->scale <= (kid_fine ? tol * TRACE_PROVE_LEAF : tol) &&
+                   real_wall(w, c, tol, order[k].t0, order[k].t1, &wall_n, &capped)) {
+            /* a wall the ray grazes (the shaft's silhouette), or meets
+             * near where it joins the surface (capped: the nail's rim and
+             * foot): finer leaves, as at a fold, so that the wall is drawn
+             * neither a leaf too wide nor over the surface beside it */
+            if (kid_fine || !(capped || wall_grazed(w, wall_n))) {
+                leaf_hit(w, kid, c, &order[k], TRACE_LEAF_WALL, wall_n, NULL, false);
+                continue;
+            }
+            kid_fine = true;
+        }
+        visit(w, kid, c, brood, order[k].i, d, kid_fine, order[k].cover);
     }
     trace_boxcache_unpin(w->th->cache, brood);
 }

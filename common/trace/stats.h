@@ -20,6 +20,7 @@ typedef struct trace_stats {
     long proven_hits;              /* leaves whose hit was proven unique and
                                       placed at the root */
     long proven_misses;            /* cells proven free of any hit */
+    long leaf_tests;               /* of the proofs, on leaves whose point did not settle */
     long rejected_leaves;          /* leaves whose surface point was not on the
                                       ray (depth cap) or not finite: no hit */
     long nodes;                    /* quadtree nodes visited by all rays */
