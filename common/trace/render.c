@@ -150,9 +150,14 @@ bool trace_render_tile(const trace_renderer *self, trace_thread *th,
     int nx = world->samples_x > 0 ? world->samples_x : 1;
     int ny = world->samples_y > 0 ? world->samples_y : 1;
     int ns = nx * ny;
-    /* pixels whose samples can reach the tile's pixels through the filter */
-    int qx0 = (int)floor(x0 + 0.5 - rx), qx1 = (int)floor(x0 + w - 0.5 + rx);
-    int qy0 = (int)floor(y0 + 0.5 - ry), qy1 = (int)floor(y0 + h - 0.5 + ry);
+    /* pixels whose samples can reach the tile's pixels through the filter:
+     * pixel q's samples lie in [q, q + 1) (trace_sample_position), and one
+     * at s counts for the pixel centred at c where c - r <= s < c + r
+     * (below), so the first is floor(x0 + 0.5 - r) and the last
+     * ceil(x0 + w - 0.5 + r) - 1 (a box filter of width 1: the tile's own
+     * pixels, no ring of neighbours whose samples would all get weight 0) */
+    int qx0 = (int)floor(x0 + 0.5 - rx), qx1 = (int)ceil(x0 + w - 0.5 + rx) - 1;
+    int qy0 = (int)floor(y0 + 0.5 - ry), qy1 = (int)ceil(y0 + h - 0.5 + ry) - 1;
     int qw = qx1 - qx0 + 1, qh = qy1 - qy0 + 1;
     sample_rec *smp = malloc(sizeof(sample_rec) * (size_t)qw * (size_t)qh * (size_t)ns);
     if (!smp) {
