@@ -12,6 +12,17 @@
  * Rendering" 3rd ed., §3.9.2), so a ray that truly meets the box is never
  * reported as a miss. Boxes themselves are conservative (common/aa), so
  * together no hit is lost to floating point.
+ *
+ * A box of a displaced surface may also carry one more slab (issue 10):
+ * the surface over the cell lies between the planes n . P = slo and
+ * n . P = shi, n the unit normal of the plane spanned by the affine forms'
+ * u and v terms (the cell's mean tangent plane), [slo, shi] the range of
+ * the affine form n . P (rounded outward: displace.c). A box is as thick as
+ * the cell is tilted against the axes; the slab only as thick as the
+ * surface is bumpy, so a grazing ray leaves it far sooner (the paper's
+ * wave: 2.4x fewer boxes computed, the nodes a ray visits -12 %). It is
+ * tested after the box (trace_box_slab_hit), and only kept where it is
+ * under half the box's own extent along n.
  */
 #ifndef TRACE_BOX_H
 #define TRACE_BOX_H
@@ -32,7 +43,21 @@ typedef struct trace_box {
     float bend;              /* how far from linear in (u,v) the surface is over
                                 the box: the affine forms' other terms over
                                 their u and v terms (displace.c); 0: unknown */
+    float sn[3];             /* the slab's unit normal; all 0: no slab */
+    float pad;               /* (no padding bytes of unknown value) */
+    double slo, shi;         /* n . P over the cell, rounded outward */
 } trace_box;
+
+static inline void trace_box_no_slab(trace_box *b)
+{
+    b->sn[0] = b->sn[1] = b->sn[2] = b->pad = 0.0f;
+    b->slo = b->shi = 0.0;
+}
+
+static inline bool trace_box_has_slab(const trace_box *b)
+{
+    return b->sn[0] != 0.0f || b->sn[1] != 0.0f || b->sn[2] != 0.0f;
+}
 
 typedef struct trace_ray {
     vec3 o, d;               /* origin, direction (not necessarily unit) */
@@ -99,6 +124,45 @@ static inline bool trace_box_hit(const trace_box *b, const trace_ray *r,
     *t1 = hi;
     if (axis) *axis = ax;
     return true;
+}
+
+/* The box's slab (if any) against the ray: narrows [*t0, *t1] to where
+ * o + t d lies between its planes; false when that leaves nothing.
+ * Conservative under rounding: n . o and n . d are sums of three products,
+ * within gamma(3) < 2^-50 of the sums of their magnitudes (om, dm); the
+ * planes are moved out by 2^-48 of om + |slo| + |shi|, which also covers
+ * the subtractions, and n . d is kept as the interval den -+ 2^-48 dm. A
+ * ray that may run along the planes (that interval holds 0) is not
+ * narrowed. The quotients are moved out by 2^-50 of themselves. */
+static inline bool trace_box_slab_hit(const trace_box *b, const trace_ray *r, double *t0,
+                                      double *t1)
+{
+    if (!trace_box_has_slab(b)) return true;
+    const double n[3] = {b->sn[0], b->sn[1], b->sn[2]};
+    const double *o = &r->o.x, *d = &r->d.x;
+    double num = 0.0, den = 0.0, om = 0.0, dm = 0.0;
+    for (int i = 0; i < 3; i++) {
+        num += n[i] * o[i];
+        den += n[i] * d[i];
+        om += fabs(n[i] * o[i]);
+        dm += fabs(n[i] * d[i]);
+    }
+    double e = 0x1p-48 * (om + fabs(b->slo) + fabs(b->shi)) + 0x1p-1000;
+    double a = (b->slo - num) - e, c = (b->shi - num) + e;   /* t den in [a, c] */
+    double ed = 0x1p-48 * dm + 0x1p-1000, dlo = den - ed, dhi = den + ed;
+    if (!(dlo > 0.0 || dhi < 0.0)) return true;
+    if (dhi < 0.0) {                     /* t in [c, a] / den */
+        double s = a;
+        a = c;
+        c = s;
+    }
+    double lo = fmin(a / dlo, a / dhi), hi = fmax(c / dlo, c / dhi);
+    lo -= 0x1p-50 * fabs(lo) + 0x1p-1000;
+    hi += 0x1p-50 * fabs(hi) + 0x1p-1000;
+    if (!(lo == lo) || !(hi == hi)) return true;    /* NaN: no narrowing */
+    if (lo > *t0) *t0 = lo;
+    if (hi < *t1) *t1 = hi;
+    return *t0 <= *t1;
 }
 
 #endif

@@ -13,6 +13,7 @@
 #include "trace/displace.h"
 #include "trace/primvar.h"
 
+#include <stdint.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -94,6 +95,49 @@ static unsigned box_flags(const trace_box *b, unsigned flags)
     return f;
 }
 
+/* x cut to a float's 24 significant bits (0 below 2^-100): exactly a
+ * float. By bits, not by (double)(float)x: GCC 12's vectoriser at -O2 has
+ * been seen to drop that round trip when the float and the double are
+ * stored side by side, which gave a slab for one normal and the box
+ * another (test_corpus_containment found it). */
+static double float_grid(double x)
+{
+    if (!(fabs(x) >= 0x1p-100)) return 0.0;
+    uint64_t b;
+    memcpy(&b, &x, sizeof b);
+    b &= ~((UINT64_C(1) << 29) - 1);
+    memcpy(&x, &b, sizeof x);
+    return x;
+}
+
+/* The slab of a box (box.h): n the unit normal of the u and v terms
+ * (symbols 0 and 1, box_affine's first two inputs), rounded to float (the
+ * slab holds for the n stored), [slo, shi] the outward-rounded range of the
+ * affine form n . P; kept where under half the box's extent along n */
+static void box_slab(const aa_form P[3], const ia_interval r[3], trace_box *out)
+{
+    trace_box_no_slab(out);
+    vec3 cu = v3(P[0].n > 0 ? P[0].c[0] : 0, P[1].n > 0 ? P[1].c[0] : 0, P[2].n > 0 ? P[2].c[0] : 0);
+    vec3 cv = v3(P[0].n > 1 ? P[0].c[1] : 0, P[1].n > 1 ? P[1].c[1] : 0, P[2].n > 1 ? P[2].c[1] : 0);
+    vec3 n = v3_cross(cu, cv);
+    double len = v3_length(n);
+    if (!(len > 0) || !isfinite(len)) return;
+    n = v3_scale(n, 1.0 / len);
+    double m[3] = {float_grid(n.x), float_grid(n.y), float_grid(n.z)};
+    float f[3] = {(float)m[0], (float)m[1], (float)m[2]};     /* exact */
+    aa_context ctx;                      /* an affine combination: no new symbol */
+    aa_context_init(&ctx, 0);
+    aa_form s;
+    aa_lincomb3(&ctx, &s, m, P, 0.0);
+    ia_interval sr = aa_range(&s);
+    double ext = fabs(m[0]) * (r[0].hi - r[0].lo) + fabs(m[1]) * (r[1].hi - r[1].lo) +
+                 fabs(m[2]) * (r[2].hi - r[2].lo);
+    if (!isfinite(sr.lo) || !isfinite(sr.hi) || !(sr.hi - sr.lo < 0.5 * ext)) return;
+    memcpy(out->sn, f, sizeof f);
+    out->slo = sr.lo;
+    out->shi = sr.hi;
+}
+
 static void box_from_affine(const aa_form P[3], trace_box *out)
 {
     ia_interval r[3];
@@ -113,6 +157,8 @@ static void box_from_affine(const aa_form P[3], trace_box *out)
     out->hi = v3(r[0].hi, r[1].hi, r[2].hi);
     out->flags = box_flags(out, flags);
     out->bend = other == 0 ? 0.0f : lin > 0 ? (float)fmin(other / lin, 1e30) : 1e30f;
+    if (out->flags) trace_box_no_slab(out);
+    else box_slab(P, r, out);
 }
 
 bool trace_surface_has_slopes(const trace_object *obj)
@@ -222,6 +268,7 @@ static void box_from_interval(const ia_interval P[3], trace_box *out)
     out->lo = v3(P[0].lo, P[1].lo, P[2].lo);
     out->hi = v3(P[0].hi, P[1].hi, P[2].hi);
     out->flags = box_flags(out, P[0].flags | P[1].flags | P[2].flags);
+    trace_box_no_slab(out);
 }
 
 /* The displacement shader's globals over the (u,v) box in interval
@@ -349,6 +396,7 @@ void trace_surface_box(trace_thread *th, const trace_object *obj,
         out->lo = v3(INFINITY, INFINITY, INFINITY);
         out->hi = v3(-INFINITY, -INFINITY, -INFINITY);
         out->flags &= ~(unsigned)AA_UNBOUNDED;
+        trace_box_no_slab(out);
         th->stats.empty_boxes++;
     }
 }

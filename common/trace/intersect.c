@@ -438,6 +438,7 @@ static bool sample_stagnant(trace_thread *th, const trace_object *obj, const dou
     box->hi = v3_add(hi, v3(m, m, m));
     box->flags &= ~(unsigned)AA_DISCONTINUOUS;
     box->flags |= TRACE_BOX_SAMPLED;
+    trace_box_no_slab(box);
     box->bend = 1e30f;                /* no slopes there: no hit proofs */
     th->stats.sampled_boxes++;
     return true;
@@ -547,7 +548,9 @@ static void visit(walk *w, const trace_box *node, const double r[4],
         if (cover == GEOM_OUTSIDE) continue;
         double t0, t1;
         int axis;
-        if (!trace_box_hit(&kids[i], &w->ray, w->ray.tmin, w->best->t, &t0, &t1, &axis)) continue;
+        if (!trace_box_hit(&kids[i], &w->ray, w->ray.tmin, w->best->t, &t0, &t1, &axis) ||
+            !trace_box_slab_hit(&kids[i], &w->ray, &t0, &t1))
+            continue;
         child_order o = {t0, t1, i, axis, cover};
         int k = n++;
         while (k > 0 && order[k - 1].t0 > o.t0) { order[k] = order[k - 1]; k--; }

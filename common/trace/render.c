@@ -18,6 +18,7 @@
 static void camera_bound(const trace_object *obj, const trace_box *b, trace_box *out)
 {
     out->bend = 0.0f;
+    trace_box_no_slab(out);
     if (b->flags & AA_UNBOUNDED || !isfinite(b->lo.x + b->lo.y + b->lo.z + b->hi.x + b->hi.y + b->hi.z)) {
         out->lo = v3(-INFINITY, -INFINITY, -INFINITY);
         out->hi = v3(INFINITY, INFINITY, INFINITY);
@@ -55,6 +56,7 @@ trace_renderer *trace_renderer_new(trace_world *world, char *err, int errsz)
         } else {
             geom_bounds(&obj->surf, &obj->root.lo, &obj->root.hi);
             obj->root.flags = 0;
+            trace_box_no_slab(&obj->root);
         }
         camera_bound(obj, &obj->root, &obj->bound);
     }

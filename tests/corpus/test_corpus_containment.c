@@ -48,6 +48,7 @@ enum { GRID = 4, RANDOM_POINTS = 16 };   /* samples per range: 4x4 grid (corners
 
 typedef struct tally {
     long cases, points, violations, unbounded, unbounded_wide, box_errors, point_errors;
+    long slab_points;               /* points also checked against a slab (box.h) */
     double worst;                   /* largest excess outside the box, object units */
     double unb_side;                /* smallest range (larger side) with an unbounded box */
     char error[512];                /* the first shader error */
@@ -102,6 +103,11 @@ static void check_point(trace_thread *th, const trace_object *obj, const trace_b
     double e = fmax(excess(p.x, b->lo.x, b->hi.x, slack),
                     fmax(excess(p.y, b->lo.y, b->hi.y, slack),
                          excess(p.z, b->lo.z, b->hi.z, slack)));
+    if (trace_box_has_slab(b)) {          /* and between the slab's planes */
+        double s = (double)b->sn[0] * p.x + (double)b->sn[1] * p.y + (double)b->sn[2] * p.z;
+        t->slab_points++;
+        e = fmax(e, excess(s, b->slo, b->shi, 2 * slack));
+    }
     t->points++;
     if (e > 0 || isnan(p.x) || isnan(p.y) || isnan(p.z)) {
         t->violations++;
@@ -193,6 +199,7 @@ static void run_surface(corpus_surface s)
             bad_rows += bad;
             total.cases += t.cases;
             total.points += t.points;
+            total.slab_points += t.slab_points;
             total.violations += t.violations;
             total.unbounded += t.unbounded;
             total.unbounded_wide += t.unbounded_wide;
@@ -202,15 +209,18 @@ static void run_surface(corpus_surface s)
             trace_thread_destroy(&th);
             fixture_close(&f);
         }
-    printf("%s total: %ld cases, %ld points, %ld violations (worst %.2e), %ld unbounded boxes "
+    printf("%s total: %ld cases, %ld points (%ld also against a slab), %ld violations (worst "
+           "%.2e), %ld unbounded boxes "
            "(+ %ld of ranges wider than 1/32, counted), %ld/%ld shader errors (box/point), "
            "%ld failing rows, %ld scenes not opened\n",
-           corpus_surface_name(s), total.cases, total.points, total.violations, total.worst,
+           corpus_surface_name(s), total.cases, total.points, total.slab_points,
+           total.violations, total.worst,
            total.unbounded, total.unbounded_wide, total.box_errors, total.point_errors,
            bad_rows, failed_opens);
     fflush(stdout);
     assert_int_equal(failed_opens, 0);
     assert_true(total.points > 0);
+    assert_true(total.slab_points > total.points / 20);
     assert_int_equal(total.violations, 0);
     assert_int_equal(total.unbounded, 0);
     assert_int_equal(total.box_errors + total.point_errors, 0);
