@@ -343,7 +343,7 @@ static void settle(trace_surface_point *sp, const double s[3])
 }
 
 trace_proof trace_prove_hit(trace_thread *th, const trace_object *obj, const trace_ray *ray,
-                            const double r[4], double tmin, double tmax,
+                            const double r[4], double tmin, double tmax, trace_zero *zero,
                             double *t_out, trace_surface_point *sp, trace_proof_detail *why)
 {
     th->stats.proofs++;
@@ -406,6 +406,13 @@ trace_proof trace_prove_hit(trace_thread *th, const trace_object *obj, const tra
     ia_interval T = ia_make(tmin, tmax);
     double x[3], s[3], B[2][2];
     bool unique = box_inside(K, X), placed = false;
+    /* a zero this walk has proven lies in X, and X holds one zero at most:
+     * the cell has nothing nearer than the best hit */
+    if (zero->set && zero->uv[0][0] >= X[0][0] && zero->uv[0][1] <= X[0][1] &&
+        zero->uv[1][0] >= X[1][0] && zero->uv[1][1] <= X[1][1] && (unique || contracts(J, Y))) {
+        th->stats.proven_misses++;
+        return TRACE_PROOF_MISS;
+    }
     if (unique) {
         memcpy(B, K, sizeof B);
         if (!t_range(&rp, e->Pc, e->Pu, e->Pv, c, B, &T)) return TRACE_PROOF_UNKNOWN;
@@ -477,6 +484,8 @@ trace_proof trace_prove_hit(trace_thread *th, const trace_object *obj, const tra
         if (newton(th, obj, ray, B, T, w, x, s, sp)) settle(sp, s);
     }
     if (inst != obj) trace_surface_point_move(inst, sp);
+    zero->set = true;
+    memcpy(zero->uv, B, sizeof zero->uv);
     th->stats.proven_hits++;
     *t_out = x[2];
     return TRACE_PROOF_HIT;

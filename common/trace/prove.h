@@ -84,14 +84,26 @@ typedef struct trace_proof_detail {
     bool fold;
 } trace_proof_detail;
 
+/* A zero of one ray's equations on one object, proven by an earlier test
+ * of the same walk: a (u, v) box holding it (set: known). Its t is at
+ * least the walk's best hit, so a cell whose widened box holds it and
+ * where G is one-to-one has nothing better: a miss without Newton's
+ * iteration (the cells beside a proven hit, whose tests found the same
+ * zero again and lost it as a tie). */
+typedef struct trace_zero {
+    bool set;
+    double uv[2][2];
+} trace_zero;
+
 /* The test on the cell r = {u0, u1, v0, v1} for the camera-space ray;
  * (tmin, tmax) is the range a hit must lie in (a zero whose t is proven
  * to within rounding of tmax, a tie with the hit found so far, counts as
- * outside it). On TRACE_PROOF_HIT: *t, and *sp, the surface point at the
- * hit (dual mode, as trace_surface_point_eval), on the ray to 2^-16 of
- * the cell or better. On TRACE_PROOF_UNKNOWN: *why. */
+ * outside it); *zero a zero known from this walk, if set, and on
+ * TRACE_PROOF_HIT the new one's box. On TRACE_PROOF_HIT: *t, and *sp, the
+ * surface point at the hit (dual mode, as trace_surface_point_eval), on
+ * the ray to 2^-16 of the cell or better. On TRACE_PROOF_UNKNOWN: *why. */
 trace_proof trace_prove_hit(trace_thread *th, const trace_object *obj, const trace_ray *ray,
-                            const double r[4], double tmin, double tmax,
+                            const double r[4], double tmin, double tmax, trace_zero *zero,
                             double *t, trace_surface_point *sp, trace_proof_detail *why);
 
 #endif

@@ -63,6 +63,7 @@ void trace_thread_destroy(trace_thread **self_p)
         sl_vm_destroy(&self->ray_vm[d]);
     trace_boxcache_destroy(&self->cache);
     free(self->slopes);
+    free(self->walls);
     free(self->work);
     free(self);
     *self_p = NULL;

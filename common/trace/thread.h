@@ -51,6 +51,7 @@ typedef struct trace_thread {
     aa_context ctx;
     trace_boxcache *cache;
     struct trace_slope_cache *slopes;  /* prove.c's, made on first use */
+    struct trace_wall_cache *walls;    /* intersect.c's, made on first use */
     trace_stats stats;
     trace_object_work *work;       /* world->nobjects entries */
     const atomic_int *cancel;      /* non-zero: stop tracing at once (a signal,

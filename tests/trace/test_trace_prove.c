@@ -452,8 +452,8 @@ static void test_cell_with_two_zeros(void **state)
                 double t;
                 trace_surface_point sp;
                 trace_proof_detail why;
-                trace_proof pr = trace_prove_hit(th, obj, &ray, r, 0.0, INFINITY, &t, &sp,
-                                                 &why);
+                trace_proof pr = trace_prove_hit(th, obj, &ray, r, 0.0, INFINITY,
+                                                 &(trace_zero){.set = false}, &t, &sp, &why);
                 bool bad = false;
                 if (pr == TRACE_PROOF_HIT) {
                     hits++;
