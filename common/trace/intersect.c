@@ -5,11 +5,11 @@
 #include "trace/intersect.h"
 
 #include <math.h>
-#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "aa/interval.h"
+#include "trace/cellkey.h"
 #include "trace/converge.h"
 #include "trace/prove.h"
 
@@ -151,7 +151,7 @@ static void sample_cell(trace_thread *th, const trace_object *obj, const double 
  * memory stays flat, and what it holds never changes an answer): every
  * ray near a wall tests the same cells, and sampling one costs 9 dual
  * evaluations (a nail without its cache: 3 times the evaluations). */
-enum { WALL_CACHE_ENTRIES = 1024 };
+enum { WALL_CACHE_LOG2 = 10, WALL_CACHE_ENTRIES = 1 << WALL_CACHE_LOG2 };
 typedef struct wall_entry {
     double r[4];                  /* the cell; r[0] > r[1]: empty */
     int obj;
@@ -164,13 +164,6 @@ typedef struct wall_entry {
                                      the low side's highest */
 } wall_entry;
 struct trace_wall_cache { wall_entry e[WALL_CACHE_ENTRIES]; };
-
-static uint64_t bits_of(double x)
-{
-    uint64_t b;
-    memcpy(&b, &x, sizeof b);
-    return b;
-}
 
 /* the samples' verdict on the cell: residual, normal, sides */
 static void analyse_wall(trace_thread *th, const trace_object *obj, const double r[4],
@@ -226,21 +219,12 @@ static void analyse_wall(trace_thread *th, const trace_object *obj, const double
 
 static const wall_entry *wall_cell(trace_thread *th, const trace_object *obj, const double r[4])
 {
-    if (!th->walls) {
-        th->walls = malloc(sizeof *th->walls);
+    if (!th->walls) {                   /* zeroed: empty (cellkey.h) */
+        th->walls = calloc(1, sizeof *th->walls);
         if (!th->walls) abort();
-        for (int i = 0; i < WALL_CACHE_ENTRIES; i++) {
-            th->walls->e[i].r[0] = 1.0;
-            th->walls->e[i].r[1] = 0.0;
-        }
     }
-    uint64_t h = bits_of(r[0]) * 0x9e3779b97f4a7c15ull ^ bits_of(r[2]) * 0xbf58476d1ce4e5b9ull ^
-                 bits_of(r[1] - r[0]) * 0x94d049bb133111ebull ^ (uint64_t)obj->id;
-    h ^= h >> 29;
-    wall_entry *e = &th->walls->e[(h * 0x9e3779b97f4a7c15ull) >> 54 & (WALL_CACHE_ENTRIES - 1)];
-    if (e->obj == obj->id && e->r[0] == r[0] && e->r[1] == r[1] && e->r[2] == r[2] &&
-        e->r[3] == r[3])
-        return e;
+    wall_entry *e = &th->walls->e[trace_cell_slot(r, obj->id, WALL_CACHE_LOG2)];
+    if (trace_cell_is(e->r, e->obj, r, obj->id)) return e;
     analyse_wall(th, obj, r, e);
     if (th->failed) {                   /* a failed run: nothing to keep */
         e->r[0] = 1.0;

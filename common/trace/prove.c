@@ -42,6 +42,7 @@
 
 #include "aa/interval.h"
 #include "aa/rounding.h"
+#include "trace/cellkey.h"
 
 /* Newton steps after a proof: quadratic convergence from inside the
  * proof's box, which is already a fraction of a pixel wide */
@@ -106,7 +107,7 @@ static inline double mr_hi(mr x) { return fp_add_up(x.m, x.r); }
  * direct-mapped per-thread cache (a pure function of object and cell, so
  * what it holds never changes an answer; fixed size, so memory stays flat):
  * the slope bounds over the cell and the enclosure of P at its centre. */
-enum { SLOPE_CACHE_ENTRIES = 2048 };
+enum { SLOPE_CACHE_LOG2 = 11, SLOPE_CACHE_ENTRIES = 1 << SLOPE_CACHE_LOG2 };
 typedef struct slope_entry {
     double r[4];                    /* the cell; r[0] > r[1]: empty */
     double X[4];                    /* the box the slopes hold over */
@@ -116,31 +117,15 @@ typedef struct slope_entry {
 } slope_entry;
 struct trace_slope_cache { slope_entry e[SLOPE_CACHE_ENTRIES]; };
 
-static uint64_t bits_of(double x)
-{
-    uint64_t b;
-    memcpy(&b, &x, sizeof b);
-    return b;
-}
-
 static const slope_entry *cell_slopes(trace_thread *th, const trace_object *obj,
                                       const double r[4])
 {
-    if (!th->slopes) {
-        th->slopes = malloc(sizeof *th->slopes);
+    if (!th->slopes) {                   /* zeroed: empty (cellkey.h) */
+        th->slopes = calloc(1, sizeof *th->slopes);
         if (!th->slopes) abort();
-        for (int i = 0; i < SLOPE_CACHE_ENTRIES; i++) {
-            th->slopes->e[i].r[0] = 1.0;
-            th->slopes->e[i].r[1] = 0.0;
-        }
     }
-    uint64_t h = bits_of(r[0]) * 0x9e3779b97f4a7c15ull ^ bits_of(r[2]) * 0xbf58476d1ce4e5b9ull ^
-                 bits_of(r[1] - r[0]) * 0x94d049bb133111ebull ^ (uint64_t)obj->id;
-    h ^= h >> 29;
-    slope_entry *e = &th->slopes->e[(h * 0x9e3779b97f4a7c15ull) >> 53 & (SLOPE_CACHE_ENTRIES - 1)];
-    if (e->obj == obj->id && e->r[0] == r[0] && e->r[1] == r[1] && e->r[2] == r[2] &&
-        e->r[3] == r[3])
-        return e->ok ? e : NULL;
+    slope_entry *e = &th->slopes->e[trace_cell_slot(r, obj->id, SLOPE_CACHE_LOG2)];
+    if (trace_cell_is(e->r, e->obj, r, obj->id)) return e->ok ? e : NULL;
     ia_interval P[3], Pu[3], Pv[3], Pc[3];
     double uc = 0.5 * (r[0] + r[1]), vc = 0.5 * (r[2] + r[3]);
     double du = PROVE_MARGIN * (r[1] - r[0]), dv = PROVE_MARGIN * (r[3] - r[2]);
