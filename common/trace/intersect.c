@@ -153,7 +153,7 @@ static void sample_cell(trace_thread *th, const trace_object *obj, const double 
  * evaluations (a nail without its cache: 3 times the evaluations). */
 enum { WALL_CACHE_LOG2 = 10, WALL_CACHE_ENTRIES = 1 << WALL_CACHE_LOG2 };
 typedef struct wall_entry {
-    double r[4];                  /* the cell; r[0] > r[1]: empty */
+    double r[4];                  /* the cell; r[0] >= r[1]: empty */
     int obj;
     double residual;              /* cs.residual */
     bool sided;                   /* the normal and the sides below are known */
@@ -274,8 +274,9 @@ static bool newton_uv(const trace_ray *ray, const trace_surface_point *sp,
 /*
  * The point of a leaf's cell where the ray meets the surface: Newton's
  * iteration from the cell's centre (newton_uv, each step clamped to the
- * cell grown by half its width on each side: the ray's hit may lie just
- * beside the cell whose box it entered). Fills sp at the (u,v) used.
+ * cell grown by half its width on each side, within the unit square: the
+ * ray's hit may lie just beside the cell whose box it entered). Fills sp
+ * at the (u,v) used.
  *
  * A cell the polygon covers only in part (partial; issue 9, watertight
  * meshes) takes one step, and is the polygon's only where that point is

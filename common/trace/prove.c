@@ -109,7 +109,7 @@ static inline double mr_hi(mr x) { return fp_add_up(x.m, x.r); }
  * the slope bounds over the cell and the enclosure of P at its centre. */
 enum { SLOPE_CACHE_LOG2 = 11, SLOPE_CACHE_ENTRIES = 1 << SLOPE_CACHE_LOG2 };
 typedef struct slope_entry {
-    double r[4];                    /* the cell; r[0] > r[1]: empty */
+    double r[4];                    /* the cell; r[0] >= r[1]: empty */
     double X[4];                    /* the box the slopes hold over */
     int obj;
     bool ok;                        /* the slopes are known */
