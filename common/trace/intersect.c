@@ -306,8 +306,8 @@ static bool leaf_point(walk *w, const double *r, bool partial, double *uc, doubl
 {
     const trace_object *obj = w->obj;
     *settled = false;
-    /* beyond the partial cell, the steps may reach the cell's neighbours
-     * (half its width on each side) */
+    /* a whole cell's steps may reach its neighbours (half its width on
+     * each side); a partial cell's stay in it */
     double hu = partial ? 0.0 : 0.5 * (r[1] - r[0]), hv = partial ? 0.0 : 0.5 * (r[3] - r[2]);
     double rw[4] = {fmax(0.0, r[0] - hu), fmin(1.0, r[1] + hu), fmax(0.0, r[2] - hv),
                     fmin(1.0, r[3] + hv)};
@@ -563,25 +563,34 @@ static bool clear_of_shared_edges(const walk *w, const double c[4])
                                 2 * c[3] - c[2], w->obj->shared_edges);
 }
 
-/* Whether the ray grazes the surface at the cell's centre (its point in
- * *centre): |cos| of the angle between the ray and the displaced
- * surface's normal Pu x Pv below TRACE_PROVE_GRAZE. A leaf there may be a
- * near miss at a fold (a silhouette), which finer leaves resolve. */
-static bool grazes(walk *w, const double r[4], trace_surface_point *centre)
-{
-    trace_surface_point_eval(w->th, w->obj, 0.5 * (r[0] + r[1]), 0.5 * (r[2] + r[3]), centre);
-    vec3 n = v3_cross(centre->Pu, centre->Pv), d = w->cam_ray->d;
-    double nn = v3_dot(n, n), dd = v3_dot(d, d), nd = v3_dot(n, d);
-    return !(nd * nd > TRACE_PROVE_GRAZE * TRACE_PROVE_GRAZE * nn * dd);
-}
-
-/* Whether the ray grazes a wall of camera-space normal n (|cos| below
- * TRACE_WALL_GRAZE) */
-static bool wall_grazed(const walk *w, vec3 n)
+/* Whether the ray meets a surface of camera-space normal n at |cos| of
+ * their angle below cos_max (a zero n: true) */
+static bool ray_grazes(const walk *w, vec3 n, double cos_max)
 {
     vec3 d = w->cam_ray->d;
     double nn = v3_dot(n, n), dd = v3_dot(d, d), nd = v3_dot(n, d);
-    return nn > 0 && !(nd * nd > TRACE_WALL_GRAZE * TRACE_WALL_GRAZE * nn * dd);
+    return !(nd * nd > cos_max * cos_max * nn * dd);
+}
+
+/* Whether the ray grazes the surface at the cell's centre (its point in
+ * *centre): the displaced surface's normal Pu x Pv at TRACE_PROVE_GRAZE.
+ * A leaf there may be a near miss at a fold (a silhouette), which finer
+ * leaves resolve. */
+static bool grazes(walk *w, const double r[4], trace_surface_point *centre)
+{
+    trace_surface_point_eval(w->th, w->obj, 0.5 * (r[0] + r[1]), 0.5 * (r[2] + r[3]), centre);
+    return ray_grazes(w, v3_cross(centre->Pu, centre->Pv), TRACE_PROVE_GRAZE);
+}
+
+/* The hit test on the cell c (prove.h), a proven hit recorded */
+static trace_proof test_cell(walk *w, const double c[4], double tol, trace_proof_detail *why)
+{
+    double t;
+    trace_surface_point sp;
+    trace_proof pr = trace_prove_hit(w->th, w->obj, w->cam_ray, c, w->ray.tmin, w->best->t,
+                                     &w->zero, &t, &sp, why);
+    if (pr == TRACE_PROOF_HIT) proven_hit(w, t, tol, &sp);
+    return pr;
 }
 
 static void visit(walk *w, const trace_box *node, const double r[4],
@@ -638,13 +647,8 @@ static void visit(walk *w, const trace_box *node, const double r[4],
         bool at_leaf = provable && size <= tol && d < TRACE_MAX_DEPTH;
         if ((try_proof || at_leaf) && !clear_of_shared_edges(w, c)) try_proof = at_leaf = false;
         if (try_proof) {
-            double t;
-            trace_surface_point sp;
             trace_proof_detail why;
-            trace_proof pr = trace_prove_hit(w->th, w->obj, w->cam_ray, c, w->ray.tmin,
-                                             w->best->t, &w->zero, &t, &sp, &why);
-            if (pr == TRACE_PROOF_HIT) proven_hit(w, t, tol, &sp);
-            if (pr != TRACE_PROOF_UNKNOWN) continue;
+            if (test_cell(w, c, tol, &why) != TRACE_PROOF_UNKNOWN) continue;
             /* an undecided test: this walk tries again only on cells small
              * enough for K to fit (prove.h, spread); none after a cell
              * without slopes (a jump, a singularity) */
@@ -671,14 +675,9 @@ static void visit(walk *w, const trace_box *node, const double r[4],
             if (!leaf_hit(w, kid, c, &order[k], TRACE_LEAF_SMALL, wall_n,
                           centred ? &centre : NULL, may_test))
                 continue;
-            double t;
-            trace_surface_point sp;
             trace_proof_detail why;
             w->th->stats.leaf_tests++;
-            trace_proof pr = trace_prove_hit(w->th, w->obj, w->cam_ray, c, w->ray.tmin,
-                                             w->best->t, &w->zero, &t, &sp, &why);
-            if (pr == TRACE_PROOF_HIT) proven_hit(w, t, tol, &sp);
-            if (pr != TRACE_PROOF_UNKNOWN) continue;
+            if (test_cell(w, c, tol, &why) != TRACE_PROOF_UNKNOWN) continue;
             if (!why.fold) {
                 leaf_hit(w, kid, c, &order[k], TRACE_LEAF_SMALL, wall_n, NULL, false);
                 continue;
@@ -692,7 +691,8 @@ static void visit(walk *w, const trace_box *node, const double r[4],
              * near where it joins the surface (capped: the nail's rim and
              * foot): finer leaves, as at a fold, so that the wall is drawn
              * neither a leaf too wide nor over the surface beside it */
-            if (kid_fine || !(capped || wall_grazed(w, wall_n))) {
+            bool grazed = v3_dot(wall_n, wall_n) > 0 && ray_grazes(w, wall_n, TRACE_WALL_GRAZE);
+            if (kid_fine || !(capped || grazed)) {
                 leaf_hit(w, kid, c, &order[k], TRACE_LEAF_WALL, wall_n, NULL, false);
                 continue;
             }
