@@ -1,6 +1,7 @@
 # Makefile: the two commands of the README's Quick start, and a few more.
 #   make demo            install dependencies, build, run the demo
-#   make test            install dependencies, build with -Werror, run every test
+#   make test            install dependencies, build with -Werror and asserts on,
+#                        run every test
 #   make test-sanitize   the same tests under AddressSanitizer + UBSan
 #   make bench           build and run the benchmarks (figures, not tests)
 #   make bench-peers     aafarm against POV-Ray and Embree on the same surfaces:
@@ -27,12 +28,12 @@ demo: build
 	@bash deploy/demo.sh build
 
 test: deps
-	@cmake -S . -B build-test -DCMAKE_BUILD_TYPE=RelWithDebInfo -DAAFARM_WERROR=ON >/dev/null
+	@cmake -S . -B build-test -DCMAKE_BUILD_TYPE=RelWithDebInfo -DAAFARM_WERROR=ON -DAAFARM_ASSERTS=ON >/dev/null
 	@cmake --build build-test -j $(JOBS)
 	@cd build-test && ctest --output-on-failure -j $(JOBS)
 
 test-sanitize: deps
-	@cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DAAFARM_WERROR=ON -DAAFARM_SANITIZE=ON >/dev/null
+	@cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DAAFARM_WERROR=ON -DAAFARM_ASSERTS=ON -DAAFARM_SANITIZE=ON >/dev/null
 	@cmake --build build-asan -j $(JOBS)
 	@cd build-asan && ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
 		ctest --output-on-failure -j $(JOBS)

@@ -49,7 +49,7 @@ bool geom_net_piece(const double *p, int stride, int ku, int kv, double s0, doub
 {
     const double e = 0x1p-20;          /* a rounding's worth past the square */
     if (!(s0 >= -e && s1 <= 1 + e && t0 >= -e && t1 <= 1 + e) || !isfinite(pad)) return false;
-    assert(ku <= GEOM_NURBS_MAX_ORDER && kv <= GEOM_NURBS_MAX_ORDER);
+    assert(ku >= 1 && kv >= 1 && ku <= GEOM_NURBS_MAX_ORDER && kv <= GEOM_NURBS_MAX_ORDER);
     double h[GEOM_NURBS_MAX_ORDER][GEOM_NURBS_MAX_ORDER];
     for (int j = 0; j < kv; j++) geom_bezier_piece(p + j * ku * stride, stride, ku, s0, s1, h[j], 1);
     for (int i = 0; i < ku; i++) {

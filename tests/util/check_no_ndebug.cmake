@@ -1,0 +1,15 @@
+# check_no_ndebug.cmake: fails when any compile command of this build
+# defines NDEBUG (asserts compiled away). Run by CTest as test_build_asserts.
+file(READ "${COMMANDS}" text)
+string(REGEX MATCHALL "\"command\": \"[^\"]*-DNDEBUG[^\"]*\"" hits "${text}")
+list(LENGTH hits n)
+if(n GREATER 0)
+  list(GET hits 0 first)
+  message(FATAL_ERROR "${n} compile commands define NDEBUG, the first: ${first}")
+endif()
+string(REGEX MATCHALL "\"command\"" all "${text}")
+list(LENGTH all total)
+if(total EQUAL 0)
+  message(FATAL_ERROR "no compile commands in ${COMMANDS}")
+endif()
+message(STATUS "${total} compile commands, none defines NDEBUG")
