@@ -180,13 +180,13 @@ static int open_socket(farm *f, char *err, size_t errsz)
     f->ctx = zmq_ctx_new();
     f->router = f->ctx ? zmq_socket(f->ctx, ZMQ_ROUTER) : NULL;
     int rcvhwm = FARM_RCVHWM, sndhwm = FARM_SNDHWM;
-    if (!f->router || wire_socket_setup(f->router, &f->limits) != 0 ||
+    if (!f->router || wire_socket_setup(f->router, &f->limits, NULL, 0) != 0 ||
         zmq_setsockopt(f->router, ZMQ_RCVHWM, &rcvhwm, sizeof rcvhwm) != 0 ||
         zmq_setsockopt(f->router, ZMQ_SNDHWM, &sndhwm, sizeof sndhwm) != 0) {
         snprintf(err, errsz, "cannot create the master's socket: %s", zmq_strerror(errno));
         return AAFARM_EXIT_FAILURE;
     }
-    f->monitor = wire_monitor_new(f->ctx, f->router);
+    f->monitor = wire_monitor_new(f->ctx, f->router, NULL, 0);
     if (f->opt->local_workers > 0) {   /* private, plaintext: bound before CURVE is on */
         char ep[PATH_MAX + 32];
         if (!make_private_endpoint(f, ep, sizeof ep, err, errsz)) return AAFARM_EXIT_FAILURE;
@@ -238,18 +238,16 @@ static int start_local_workers(farm *f, char *err, size_t errsz)
  * bytes): fail before contacting anyone rather than at the first grant. */
 static int check_job_message(farm *f, farm_frame *fr, char *err, size_t errsz)
 {
-    Aafarm__Envelope env = AAFARM__ENVELOPE__INIT;
-    env.body_case = AAFARM__ENVELOPE__BODY_JOB;
-    env.job = job_message_job(fr->jobmsg);
-    char why[300];
-    if (proto_message_check(&env, false, 0, &f->send_limits, why, sizeof why) != 0) {
-        snprintf(err, errsz, "the job cannot be sent to workers: %s", why);
+    proto_msg msg = {.kind = PROTO_JOB, .job = *job_message_job(fr->jobmsg)};
+    char why[ERR_LEN];
+    if (!proto_msg_check(&msg, false, 0, &f->send_limits, why, sizeof why)) {
+        err_set(err, errsz, "the job cannot be sent to workers: %s", why);
         return AAFARM_EXIT_INPUT;
     }
     fr->job_bytes = job_message_packed_size(fr->jobmsg);
     if (fr->job_bytes > f->send_limits.max_header_bytes) {
-        snprintf(err, errsz, "the job is %zu bytes, more than the %zu a message may carry",
-                 fr->job_bytes, f->send_limits.max_header_bytes);
+        err_set(err, errsz, "the job is %zu bytes, more than the %zu a message may carry",
+                fr->job_bytes, f->send_limits.max_header_bytes);
         return AAFARM_EXIT_INPUT;
     }
     f->job_bytes += fr->job_bytes;
@@ -447,9 +445,9 @@ static void log_drop(farm *f, int64_t now)
     }
     if (f->drops_unlogged)
         console_log(f->con, CONSOLE_INFO, "%s (and %llu more malformed messages dropped)",
-                    wire_last_error(), (unsigned long long)f->drops_unlogged);
+                    f->wstats.last_error, (unsigned long long)f->drops_unlogged);
     else
-        console_log(f->con, CONSOLE_INFO, "%s", wire_last_error());
+        console_log(f->con, CONSOLE_INFO, "%s", f->wstats.last_error);
     f->drops_unlogged = 0;
     f->drop_logged_ms = now;
 }
@@ -458,7 +456,7 @@ static void log_drop(farm *f, int64_t now)
 static void drain(farm *f, int64_t now)
 {
     for (int i = 0; i < 1000 && f->state == FARM_RUNNING; i++) {
-        wire_msg *m = wire_recv(f->router, &f->limits, &f->wstats, ZMQ_DONTWAIT);
+        wire_msg *m = wire_recv(f->router, &f->limits, &f->wstats, ZMQ_DONTWAIT, NULL, 0);
         if (!m) {
             if (errno == EPROTO) {
                 log_drop(f, now);
@@ -533,7 +531,7 @@ static void timers(farm *f, int64_t now)
                     "queue", n, n == 1 ? "" : "s", n == 1 ? "its" : "their",
                     f->opt->lease_factor, (double)f->opt->lease_ms / 1000.0, n == 1 ? "" : "s");
     if (f->monitor) {
-        wire_monitor_poll(f->monitor, &f->wstats);
+        wire_monitor_poll(f->monitor, &f->wstats, NULL, 0);
         log_handshakes(f, now);
     }
     if (f->locals) {

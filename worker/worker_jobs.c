@@ -64,12 +64,11 @@ held_job *worker_jobs_find(const worker_jobs *self, const char *hash)
     return NULL;
 }
 
-static job_options options_of(const Aafarm__RenderOptions *o)
+static job_options options_of(const proto_render_options *o)
 {
     job_options jo;
     job_options_default(&jo);
-    jo.arith = o->arithmetic == AAFARM__ARITHMETIC__ARITHMETIC_INTERVAL ? TRACE_ARITH_INTERVAL
-                                                                         : TRACE_ARITH_AFFINE;
+    jo.arith = o->arithmetic == PROTO_ARITH_INTERVAL ? TRACE_ARITH_INTERVAL : TRACE_ARITH_AFFINE;
     jo.tile_size = (int)o->tile_size;
     if (o->instruction_budget)
         jo.max_instructions = o->instruction_budget > (uint64_t)LONG_MAX ? LONG_MAX
@@ -80,19 +79,19 @@ static job_options options_of(const Aafarm__RenderOptions *o)
 }
 
 /* The job from the message's fields, hashed again and compared. */
-static job *rebuild(const Aafarm__Job *m, char *err, size_t errsz)
+static job *rebuild(const proto_job *m, char *err, size_t errsz)
 {
-    job_options jo = options_of(m->options);
-    job *jb = job_new(m->scene_name, (const char *)m->scene_text.data, m->scene_text.len, &jo);
+    job_options jo = options_of(&m->options);
+    job *jb = job_new(m->scene_name, (const char *)m->scene_text, m->scene_len, &jo);
     char why[600];
     bool ok = true;
     for (size_t i = 0; ok && i < m->n_sources; i++)
-        ok = job_add_source(jb, m->sources[i]->name, (const char *)m->sources[i]->text.data,
-                            m->sources[i]->text.len, why, sizeof why);
+        ok = job_add_source(jb, m->sources[i].name, (const char *)m->sources[i].text,
+                            m->sources[i].text_len, why, sizeof why);
     for (size_t i = 0; ok && i < m->n_shaders; i++)
-        ok = job_add_shader(jb, m->shaders[i]->name, m->shaders[i]->source, why, sizeof why);
+        ok = job_add_shader(jb, m->shaders[i].name, m->shaders[i].source, why, sizeof why);
     for (size_t i = 0; ok && i < m->n_files; i++)
-        ok = job_add_file(jb, m->files[i]->name, m->files[i]->sha256, m->files[i]->size, why,
+        ok = job_add_file(jb, m->files[i].name, m->files[i].sha256, m->files[i].size, why,
                           sizeof why);
     jb->files_known = true;                 /* the master's list, even when empty */
     if (ok) ok = job_finish(jb, why, sizeof why);
@@ -110,7 +109,7 @@ static job *rebuild(const Aafarm__Job *m, char *err, size_t errsz)
     return jb;
 }
 
-static bool layers_of(const Aafarm__RenderOptions *o, unsigned *layers, char *err, size_t errsz)
+static bool layers_of(const proto_render_options *o, unsigned *layers, char *err, size_t errsz)
 {
     *layers = 0;
     for (size_t i = 0; i < o->n_layers; i++) {
@@ -126,7 +125,7 @@ static bool layers_of(const Aafarm__RenderOptions *o, unsigned *layers, char *er
 }
 
 /* Compiles the job and checks the image it describes. */
-static bool prepare(held_job *h, const Aafarm__Job *m, size_t cache_bytes)
+static bool prepare(held_job *h, const proto_job *m, size_t cache_bytes)
 {
     sl_diag *diag = sl_diag_new();
     h->js = job_scene_new(h->jb, cache_bytes, true, diag);
@@ -140,7 +139,7 @@ static bool prepare(held_job *h, const Aafarm__Job *m, size_t cache_bytes)
         return false;
     }
     sl_diag_destroy(&diag);
-    const Aafarm__RenderOptions *o = m->options;
+    const proto_render_options *o = &m->options;
     h->fmt = (image_format){(int)o->width, (int)o->height, (int)o->tile_size, 0};
     if (!layers_of(o, &h->fmt.layers, h->error, sizeof h->error)) return false;
     if (h->js->world.camera.xres != h->fmt.width || h->js->world.camera.yres != h->fmt.height) {
@@ -179,7 +178,7 @@ held_job *worker_jobs_add_broken(worker_jobs *self, const char *hash, const char
     return h;
 }
 
-held_job *worker_jobs_add(worker_jobs *self, const Aafarm__Job *m, char *const *file_paths,
+held_job *worker_jobs_add(worker_jobs *self, const proto_job *m, char *const *file_paths,
                           const int *file_fds)
 {
     held_job *h = worker_jobs_find(self, m->job_hash);
@@ -197,7 +196,7 @@ held_job *worker_jobs_add(worker_jobs *self, const Aafarm__Job *m, char *const *
         if (!h->file_fds) abort();
         memcpy(h->file_fds, file_fds, sizeof *h->file_fds * m->n_files);
     }
-    size_t cache = self->cache_bytes ? self->cache_bytes : (size_t)m->options->cache_bytes;
+    size_t cache = self->cache_bytes ? self->cache_bytes : (size_t)m->options.cache_bytes;
     h->jb = rebuild(m, h->error, sizeof h->error);
     /* the texture module opens the files through job_file_resolve */
     for (size_t i = 0; h->jb && file_paths && i < m->n_files; i++)
