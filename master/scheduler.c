@@ -17,6 +17,7 @@
  *   failed[]  (tile, worker) pairs of failures, to prefer other workers.
  */
 #include "scheduler.h"
+#include "util/xalloc.h"
 
 #include <limits.h>
 #include <stdlib.h>
@@ -63,13 +64,6 @@ struct scheduler {
     scheduler_counts counts;
 };
 
-static void *xrealloc(void *p, size_t n)
-{
-    p = realloc(p, n ? n : 1);
-    if (!p) abort();
-    return p;
-}
-
 void scheduler_options_default(scheduler_options *opt)
 {
     opt->max_attempts = 3;
@@ -84,8 +78,7 @@ scheduler *scheduler_new(int tiles_x, int tiles_y, const scheduler_options *opt)
 {
     if (tiles_x < 1 || tiles_y < 1 || tiles_x > INT_MAX / 2 / tiles_y)
         return NULL;
-    scheduler *self = calloc(1, sizeof *self);
-    if (!self) abort();
+    scheduler *self = xcalloc(1, sizeof *self);
     if (opt) self->opt = *opt;
     else scheduler_options_default(&self->opt);
     if (self->opt.max_attempts < 1) self->opt.max_attempts = 1;
@@ -93,9 +86,8 @@ scheduler *scheduler_new(int tiles_x, int tiles_y, const scheduler_options *opt)
     if (self->opt.max_duplicates < 0) self->opt.max_duplicates = 0;
     if (self->opt.lease_ms < 1) self->opt.lease_ms = 1;
     self->ntiles = tiles_x * tiles_y;
-    self->tiles = calloc((size_t)self->ntiles, sizeof *self->tiles);
-    self->rq = calloc((size_t)self->ntiles, sizeof *self->rq);
-    if (!self->tiles || !self->rq) abort();
+    self->tiles = xcalloc((size_t)self->ntiles, sizeof *self->tiles);
+    self->rq = xcalloc((size_t)self->ntiles, sizeof *self->rq);
     self->next_id = 1;
     self->counts.tiles = self->ntiles;
     return self;

@@ -17,6 +17,7 @@
 #include <string.h>
 
 #include "util/err.h"
+#include "util/xalloc.h"
 #include "util/hash.h"
 #include "version.h"
 
@@ -237,7 +238,7 @@ static int check_unique(checker *c, const char *field, const char *const *names,
 {
     if (n < 2)
         return 0;
-    const char **v = malloc(n * sizeof *v);
+    const char **v = try_malloc(n * sizeof *v);
     if (!v)
         return fail(c, field, "out of memory checking %zu names", n);
     memcpy(v, names, n * sizeof *v);
@@ -307,7 +308,7 @@ static int check_sources(checker *c, const Aafarm__Job *m)
 {
     if (check_count(c, "Job.sources", m->n_sources))
         return -1;
-    const char **names = malloc((m->n_sources + 1) * sizeof *names);
+    const char **names = try_malloc((m->n_sources + 1) * sizeof *names);
     if (!names)
         return fail(c, "Job.sources", "out of memory");
     int rc = 0;
@@ -341,7 +342,7 @@ static int check_bindings(checker *c, const Aafarm__Job *m)
 {
     if (check_count(c, "Job.shaders", m->n_shaders))
         return -1;
-    const char **names = malloc((m->n_shaders + 1) * sizeof *names);
+    const char **names = try_malloc((m->n_shaders + 1) * sizeof *names);
     if (!names)
         return fail(c, "Job.shaders", "out of memory");
     int rc = 0;
@@ -368,7 +369,7 @@ static int check_extra(checker *c, const Aafarm__RenderOptions *o)
 {
     if (check_count(c, "Job.options.extra", o->n_extra))
         return -1;
-    const char **keys = malloc((o->n_extra + 1) * sizeof *keys);
+    const char **keys = try_malloc((o->n_extra + 1) * sizeof *keys);
     if (!keys)
         return fail(c, "Job.options.extra", "out of memory");
     int rc = 0;
@@ -418,7 +419,7 @@ static int check_files(checker *c, const Aafarm__Job *m)
 {
     if (check_count(c, "Job.files", m->n_files))
         return -1;
-    const char **names = malloc((m->n_files + 1) * sizeof *names);
+    const char **names = try_malloc((m->n_files + 1) * sizeof *names);
     if (!names)
         return fail(c, "Job.files", "out of memory");
     int rc = 0;

@@ -42,8 +42,7 @@ struct file_fetch {
 
 file_fetch *file_fetch_new(const file_fetch_options *opt)
 {
-    file_fetch *self = calloc(1, sizeof *self);
-    if (!self) abort();
+    file_fetch *self = xcalloc(1, sizeof *self);
     self->opt = *opt;
     if (!self->opt.chunk) self->opt.chunk = 1u << 20;
     if (!self->opt.inflight) self->opt.inflight = 8u << 20;
@@ -108,14 +107,12 @@ void file_fetch_add(file_fetch *self, const proto_job *m, int64_t now_ms)
 {
     (void)now_ms;
     if (file_fetch_waiting(self, m->job_hash)) return;
-    fetch_job *j = calloc(1, sizeof *j);
-    if (!j) abort();
+    fetch_job *j = xcalloc(1, sizeof *j);
     snprintf(j->hash, sizeof j->hash, "%s", m->job_hash);
     j->msg = proto_saved_job_new(m);
     j->nfiles = (int)m->n_files;
-    j->paths = calloc((size_t)j->nfiles + 1, sizeof *j->paths);
-    j->fds = calloc((size_t)j->nfiles + 1, sizeof *j->fds);
-    if (!j->paths || !j->fds) abort();
+    j->paths = xcalloc((size_t)j->nfiles + 1, sizeof *j->paths);
+    j->fds = xcalloc((size_t)j->nfiles + 1, sizeof *j->fds);
     for (int i = 0; i < j->nfiles; i++) j->fds[i] = -1;
     fetch_job **tail = &self->jobs;
     while (*tail) tail = &(*tail)->next;
@@ -132,14 +129,13 @@ void file_fetch_add(file_fetch *self, const proto_job *m, int64_t now_ms)
         char path[PATH_MAX + 100];
         j->fds[i] = file_store_acquire(self->store, f->sha256, f->size, path, sizeof path);
         if (j->fds[i] >= 0) {
-            j->paths[i] = strdup(path);
+            j->paths[i] = xstrdup(path);
             j->hits++;
             continue;
         }
         j->misses++;
         if (find_want(self, f->sha256)) continue;
-        want *w = calloc(1, sizeof *w);
-        if (!w) abort();
+        want *w = xcalloc(1, sizeof *w);
         snprintf(w->sha256, sizeof w->sha256, "%s", f->sha256);
         w->size = f->size;
         snprintf(w->job_hash, sizeof w->job_hash, "%s", j->hash);

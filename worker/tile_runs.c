@@ -4,6 +4,7 @@
  * and a tile takes milliseconds to render.
  */
 #include "tile_runs.h"
+#include "util/xalloc.h"
 
 #include <assert.h>
 #include <stdlib.h>
@@ -14,8 +15,7 @@ void tile_runs_init(tile_runs *self, int ntiles, int nthreads)
     assert(ntiles >= 0 && nthreads >= 1);
     pthread_mutex_init(&self->lock, NULL);
     self->nthreads = nthreads;
-    self->runs = calloc((size_t)nthreads, sizeof *self->runs);
-    if (!self->runs) abort();
+    self->runs = xcalloc((size_t)nthreads, sizeof *self->runs);
     for (int t = 0; t < nthreads; t++) {
         self->runs[t].next = (int)((long)ntiles * t / nthreads);
         self->runs[t].end = (int)((long)ntiles * (t + 1) / nthreads);

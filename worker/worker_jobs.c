@@ -10,6 +10,8 @@
 #include <string.h>
 
 #include "file_store.h"
+#include "util/err.h"
+#include "util/xalloc.h"
 
 struct worker_jobs {
     held_job **jobs;           /* newest first */
@@ -38,11 +40,9 @@ void held_job_release(held_job **self_p)
 
 worker_jobs *worker_jobs_new(int max_held, size_t cache_bytes)
 {
-    worker_jobs *self = calloc(1, sizeof *self);
-    if (!self) abort();
+    worker_jobs *self = xcalloc(1, sizeof *self);
     self->max = max_held < 1 ? 1 : max_held;
-    self->jobs = calloc((size_t)self->max, sizeof *self->jobs);
-    if (!self->jobs) abort();
+    self->jobs = xcalloc((size_t)self->max, sizeof *self->jobs);
     self->cache_bytes = cache_bytes;
     return self;
 }
@@ -96,13 +96,13 @@ static job *rebuild(const proto_job *m, char *err, size_t errsz)
     jb->files_known = true;                 /* the master's list, even when empty */
     if (ok) ok = job_finish(jb, why, sizeof why);
     if (!ok) {
-        snprintf(err, errsz, "job %.12s... is inconsistent: %s", m->job_hash, why);
+        err_set(err, errsz, "job %.12s... is inconsistent: %s", m->job_hash, why);
         job_destroy(&jb);
         return NULL;
     }
     if (strcmp(jb->hash, m->job_hash) != 0) {
-        snprintf(err, errsz, "job %.12s...: its content hashes to %.12s... here (the master "
-                 "and this worker run different aafarm versions?)", m->job_hash, jb->hash);
+        err_set(err, errsz, "job %.12s...: its content hashes to %.12s... here (the master "
+                "and this worker run different aafarm versions?)", m->job_hash, jb->hash);
         job_destroy(&jb);
         return NULL;
     }
@@ -116,8 +116,8 @@ static bool layers_of(const proto_render_options *o, unsigned *layers, char *err
         if (strcmp(o->layers[i], "N") == 0) *layers |= IMAGE_LAYER_N;
         else if (strcmp(o->layers[i], "P") == 0) *layers |= IMAGE_LAYER_P;
         else if (strcmp(o->layers[i], "RGBA") != 0) {
-            snprintf(err, errsz, "unknown EXR layer '%s' (this worker writes RGBA, Z, N, P)",
-                     o->layers[i]);
+            err_set(err, errsz, "unknown EXR layer '%s' (this worker writes RGBA, Z, N, P)",
+                    o->layers[i]);
             return false;
         }
     }
@@ -168,8 +168,7 @@ held_job *worker_jobs_add_broken(worker_jobs *self, const char *hash, const char
 {
     held_job *h = worker_jobs_find(self, hash);
     if (h) return h;
-    h = calloc(1, sizeof *h);
-    if (!h) abort();
+    h = xcalloc(1, sizeof *h);
     atomic_init(&h->refs, 1);
     snprintf(h->hash, sizeof h->hash, "%s", hash);
     snprintf(h->error, sizeof h->error, "%s", error);
@@ -186,14 +185,12 @@ held_job *worker_jobs_add(worker_jobs *self, const proto_job *m, char *const *fi
         for (size_t i = 0; file_fds && i < m->n_files; i++) file_store_release(file_fds[i]);
         return h;
     }
-    h = calloc(1, sizeof *h);
-    if (!h) abort();
+    h = xcalloc(1, sizeof *h);
     atomic_init(&h->refs, 1);
     snprintf(h->hash, sizeof h->hash, "%s", m->job_hash);
     if (file_fds && m->n_files) {
         h->nfile_fds = (int)m->n_files;
-        h->file_fds = malloc(sizeof *h->file_fds * m->n_files);
-        if (!h->file_fds) abort();
+        h->file_fds = xmalloc(sizeof *h->file_fds * m->n_files);
         memcpy(h->file_fds, file_fds, sizeof *h->file_fds * m->n_files);
     }
     size_t cache = self->cache_bytes ? self->cache_bytes : (size_t)m->options.cache_bytes;

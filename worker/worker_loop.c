@@ -48,6 +48,7 @@
 #include "wire.h"
 #include "worker_jobs.h"
 #include "worker_pool.h"
+#include "util/xalloc.h"
 
 enum { MAX_JOBS_HELD = 4, BACKOFF_FIRST_MS = 1000, BACKOFF_MAX_MS = 32000 };
 
@@ -556,8 +557,7 @@ static void on_grant(worker_loop *w, const proto_grant *g)
     bool asked_already = file_fetch_waiting(w->files, g->job_hash);   /* files on the way */
     for (pending_grant *p = w->pending; p; p = p->next)
         if (strcmp(p->hash, g->job_hash) == 0) asked_already = true;
-    pending_grant *p = calloc(1, sizeof *p);
-    if (!p) abort();
+    pending_grant *p = xcalloc(1, sizeof *p);
     *p = (pending_grant){g->lease_id, g->tile_index, rect, "", w->pending};
     snprintf(p->hash, sizeof p->hash, "%s", g->job_hash);
     w->pending = p;
