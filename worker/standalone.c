@@ -263,7 +263,7 @@ static int render_frame(const standalone_options *opt, const job *jb, const fram
     }
     free(s.preview);
     free(s.work);
-    tile_runs_destroy(&s.runs);
+    tile_runs_clear(&s.runs);
     pthread_mutex_destroy(&s.lock);
     job_scene_destroy(&js);
     return rc;
