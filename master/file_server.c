@@ -5,6 +5,7 @@
 #define _GNU_SOURCE
 #include "file_server.h"
 #include "util/err.h"
+#include "util/fdio.h"
 #include "util/xalloc.h"
 
 #include <errno.h>
@@ -120,16 +121,11 @@ file_read file_server_read(file_server *self, const char *sha, uint64_t offset, 
         self->buf_size = length;
     }
     size_t got = 0;
-    while (got < length) {
-        ssize_t n = pread(s->fd, self->buf + got, length - got, (off_t)(offset + got));
-        if (n < 0 && errno == EINTR) continue;
-        if (n <= 0) {
-            err_set(err, errsz, "file '%s' ('%s') cannot be read at byte %llu: %s", f->name,
-                    f->path, (unsigned long long)(offset + got),
-                    n == 0 ? "it is shorter than when the job was loaded" : strerror(errno));
-            return FILE_READ_CHANGED;
-        }
-        got += (size_t)n;
+    if (!fd_pread_all(s->fd, self->buf, length, offset, &got)) {
+        err_set(err, errsz, "file '%s' ('%s') cannot be read at byte %llu: %s", f->name,
+                f->path, (unsigned long long)(offset + got),
+                errno == 0 ? "it is shorter than when the job was loaded" : strerror(errno));
+        return FILE_READ_CHANGED;
     }
     *data = self->buf;
     return FILE_READ_OK;

@@ -4,6 +4,7 @@
  */
 #include "journal.h"
 #include "util/err.h"
+#include "util/fdio.h"
 #include "util/xalloc.h"
 
 #include <errno.h>
@@ -97,36 +98,6 @@ const char *journal_file(const journal *self)
     return self->path;
 }
 
-static bool write_all(int fd, const void *buf, size_t len)
-{
-    const char *p = buf;
-    while (len > 0) {
-        ssize_t n = write(fd, p, len);
-        if (n < 0 && errno == EINTR) continue;
-        if (n <= 0) {
-            if (n == 0) errno = EIO;
-            return false;
-        }
-        p += n;
-        len -= (size_t)n;
-    }
-    return true;
-}
-
-static bool read_at(int fd, void *buf, size_t len, uint64_t off)
-{
-    char *p = buf;
-    while (len > 0) {
-        ssize_t n = pread(fd, p, len, (off_t)off);
-        if (n < 0 && errno == EINTR) continue;
-        if (n <= 0) return false;
-        p += n;
-        len -= (size_t)n;
-        off += (uint64_t)n;
-    }
-    return true;
-}
-
 static const char *space_hint(int e)
 {
     return e == ENOSPC || e == EDQUOT ? " (free some space on that file system, then run "
@@ -173,7 +144,7 @@ journal *journal_create(const char *path, const journal_id *id, bool *replaced, 
     if (fstat(fd, &st) == 0 && st.st_size > HEADER_BYTES) *replaced = true;
     uint8_t h[HEADER_BYTES];
     encode_header(h, id);
-    if (ftruncate(fd, 0) != 0 || !write_all(fd, h, sizeof h) || fdatasync(fd) != 0) {
+    if (ftruncate(fd, 0) != 0 || !fd_write_all(fd, h, sizeof h) || fdatasync(fd) != 0) {
         int e = errno;
         err_set(err, errsz, "cannot write the journal %s: %s%s", path, strerror(e),
                 space_hint(e));
@@ -188,7 +159,7 @@ static bool check_header(const char *path, int fd, const journal_id *id, char *e
                          size_t errsz)
 {
     uint8_t h[HEADER_BYTES], want[HEADER_BYTES];
-    if (!read_at(fd, h, sizeof h, 0) || memcmp(h, magic, 8) != 0 ||
+    if (!fd_pread_all(fd, h, sizeof h, 0, NULL) || memcmp(h, magic, 8) != 0 ||
         get_u32(h + 92) != journal_crc32(0, h, 92)) {
         err_set(err, errsz, "cannot resume: %s is not an aafarm journal or its header is "
                 "damaged (remove it and render without --resume)", path);
@@ -217,7 +188,7 @@ static bool read_record(int fd, uint64_t off, uint64_t file_size, const journal_
                         size_t errsz)
 {
     uint8_t rec[RECORD_BYTES];
-    if (file_size - off < RECORD_BYTES || !read_at(fd, rec, sizeof rec, off)) {
+    if (file_size - off < RECORD_BYTES || !fd_pread_all(fd, rec, sizeof rec, off, NULL)) {
         err_set(err, errsz, "a torn record header");
         return false;
     }
@@ -236,7 +207,8 @@ static bool read_record(int fd, uint64_t off, uint64_t file_size, const journal_
         *buf = p;
         *cap = n;
     }
-    if (!read_at(fd, *buf, n, off + RECORD_BYTES) || record_crc(rec, *buf, n) != get_u32(rec + 12)) {
+    if (!fd_pread_all(fd, *buf, n, off + RECORD_BYTES, NULL) ||
+        record_crc(rec, *buf, n) != get_u32(rec + 12)) {
         err_set(err, errsz, "a record with a bad checksum (tile %u)", index);
         return false;
     }

@@ -20,6 +20,7 @@
 
 #include "util/hash.h"
 #include "util/err.h"
+#include "util/fdio.h"
 #include "util/xalloc.h"
 
 struct file_store {
@@ -337,20 +338,6 @@ static uint64_t get_be64(const unsigned char *p)
     return v;
 }
 
-static bool write_all(int fd, const void *data, size_t len, uint64_t off)
-{
-    const unsigned char *p = data;
-    while (len > 0) {
-        ssize_t n = pwrite(fd, p, len, (off_t)off);
-        if (n < 0 && errno == EINTR) continue;
-        if (n <= 0) return false;
-        p += n;
-        len -= (size_t)n;
-        off += (uint64_t)n;
-    }
-    return true;
-}
-
 static void transfer_free(file_transfer *t)
 {
     if (t->data_fd >= 0) close(t->data_fd);
@@ -397,8 +384,8 @@ static bool load_map(file_transfer *t)
     put_be64(head + 8, t->size);
     return ftruncate(t->map_fd, 0) == 0 && ftruncate(t->data_fd, 0) == 0 &&
            ftruncate(t->data_fd, (off_t)t->size) == 0 &&
-           write_all(t->map_fd, head, MAP_HEADER, 0) &&
-           (t->nchunks == 0 || write_all(t->map_fd, t->have, t->nchunks, MAP_HEADER));
+           fd_pwrite_all(t->map_fd, head, MAP_HEADER, 0) &&
+           (t->nchunks == 0 || fd_pwrite_all(t->map_fd, t->have, t->nchunks, MAP_HEADER));
 }
 
 file_begin file_store_begin(file_store *self, const char *sha, uint64_t size, uint32_t chunk,
@@ -474,8 +461,8 @@ long file_transfer_put(file_transfer *t, uint64_t offset, const void *data, size
     if (len != (left < t->chunk ? left : t->chunk) || t->have[i]) return 0;
     static const unsigned char one = 1;
     /* the bytes first, then the map: a crash in between costs one chunk */
-    if (!write_all(t->data_fd, data, len, offset) ||
-        !write_all(t->map_fd, &one, 1, MAP_HEADER + (uint64_t)i)) {
+    if (!fd_pwrite_all(t->data_fd, data, len, offset) ||
+        !fd_pwrite_all(t->map_fd, &one, 1, MAP_HEADER + (uint64_t)i)) {
         err_set(err, errsz, "cannot write to the file cache %s: %s (free space there, or give "
                 "another folder with --file-cache DIR)", t->store->dir,
                 strerror(errno ? errno : EIO));
