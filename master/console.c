@@ -2,6 +2,7 @@
  * console.c: the master's log lines and progress display (see console.h).
  */
 #include "console.h"
+#include "util/xalloc.h"
 
 #include <stdarg.h>
 #include <stdio.h>
@@ -31,8 +32,7 @@ void console_set_resumed(console *self, int tiles)
 
 console *console_new(int verbosity, bool tty)
 {
-    console *self = calloc(1, sizeof *self);
-    if (!self) abort();
+    console *self = xcalloc(1, sizeof *self);
     self->verbosity = verbosity;
     self->tty = tty;
     self->last_ms = INT64_MIN / 2;

@@ -36,6 +36,8 @@
 #include "image/preview.h"
 #include "stale.h"
 #include "util/exitcodes.h"
+#include "util/err.h"
+#include "util/xalloc.h"
 
 /* What one peer can make the master hold (issue 11): a message from a
  * worker has a header of at most FARM_MAX_HEADER bytes (a Hello, a
@@ -114,8 +116,8 @@ static bool make_private_endpoint(farm *f, char *ep, size_t n, char *err, size_t
     stale_clean_ipc_dirs(tmp, report_leftover, f);
     snprintf(f->ipc_dir, sizeof f->ipc_dir, "%s/aafarm-XXXXXX", tmp);
     if (!mkdtemp(f->ipc_dir)) {
-        snprintf(err, errsz, "cannot create a private folder in %s for the local workers' "
-                 "socket: %s", tmp, strerror(errno));
+        err_set(err, errsz, "cannot create a private folder in %s for the local workers' "
+                "socket: %s", tmp, strerror(errno));
         f->ipc_dir[0] = '\0';
         return false;
     }
@@ -146,7 +148,7 @@ static int bind_endpoint(farm *f, const char *ep, char *err, size_t errsz)
 {
     if (zmq_bind(f->router, ep) == 0) return AAFARM_EXIT_OK;
     int e = errno;
-    snprintf(err, errsz, "cannot bind %s: %s", ep, zmq_strerror(e));
+    err_set(err, errsz, "cannot bind %s: %s", ep, zmq_strerror(e));
     return e == EINVAL || e == EPROTONOSUPPORT || e == ENOCOMPATPROTO ? AAFARM_EXIT_USAGE
                                                                        : AAFARM_EXIT_FAILURE;
 }
@@ -164,8 +166,8 @@ static int enable_curve(farm *f, char *err, size_t errsz)
     if (zmq_setsockopt(f->router, ZMQ_CURVE_SERVER, &on, sizeof on) != 0 ||
         zmq_setsockopt(f->router, ZMQ_CURVE_SECRETKEY, cert.secret_key, CURVE_Z85_LEN) != 0 ||
         zmq_setsockopt(f->router, ZMQ_ZAP_DOMAIN, "aafarm", 6) != 0) {
-        snprintf(err, errsz, "cannot turn CURVE on: %s (does this libzmq have CURVE?)",
-                 zmq_strerror(errno));
+        err_set(err, errsz, "cannot turn CURVE on: %s (does this libzmq have CURVE?)",
+                zmq_strerror(errno));
         memset(&cert, 0, sizeof cert);
         return AAFARM_EXIT_FAILURE;
     }
@@ -180,13 +182,13 @@ static int open_socket(farm *f, char *err, size_t errsz)
     f->ctx = zmq_ctx_new();
     f->router = f->ctx ? zmq_socket(f->ctx, ZMQ_ROUTER) : NULL;
     int rcvhwm = FARM_RCVHWM, sndhwm = FARM_SNDHWM;
-    if (!f->router || wire_socket_setup(f->router, &f->limits) != 0 ||
+    if (!f->router || wire_socket_setup(f->router, &f->limits, NULL, 0) != 0 ||
         zmq_setsockopt(f->router, ZMQ_RCVHWM, &rcvhwm, sizeof rcvhwm) != 0 ||
         zmq_setsockopt(f->router, ZMQ_SNDHWM, &sndhwm, sizeof sndhwm) != 0) {
-        snprintf(err, errsz, "cannot create the master's socket: %s", zmq_strerror(errno));
+        err_set(err, errsz, "cannot create the master's socket: %s", zmq_strerror(errno));
         return AAFARM_EXIT_FAILURE;
     }
-    f->monitor = wire_monitor_new(f->ctx, f->router);
+    f->monitor = wire_monitor_new(f->ctx, f->router, NULL, 0);
     if (f->opt->local_workers > 0) {   /* private, plaintext: bound before CURVE is on */
         char ep[PATH_MAX + 32];
         if (!make_private_endpoint(f, ep, sizeof ep, err, errsz)) return AAFARM_EXIT_FAILURE;
@@ -238,18 +240,16 @@ static int start_local_workers(farm *f, char *err, size_t errsz)
  * bytes): fail before contacting anyone rather than at the first grant. */
 static int check_job_message(farm *f, farm_frame *fr, char *err, size_t errsz)
 {
-    Aafarm__Envelope env = AAFARM__ENVELOPE__INIT;
-    env.body_case = AAFARM__ENVELOPE__BODY_JOB;
-    env.job = job_message_job(fr->jobmsg);
-    char why[300];
-    if (proto_message_check(&env, false, 0, &f->send_limits, why, sizeof why) != 0) {
-        snprintf(err, errsz, "the job cannot be sent to workers: %s", why);
+    proto_msg msg = {.kind = PROTO_JOB, .job = *job_message_job(fr->jobmsg)};
+    char why[ERR_LEN];
+    if (!proto_msg_check(&msg, false, 0, &f->send_limits, why, sizeof why)) {
+        err_set(err, errsz, "the job cannot be sent to workers: %s", why);
         return AAFARM_EXIT_INPUT;
     }
     fr->job_bytes = job_message_packed_size(fr->jobmsg);
     if (fr->job_bytes > f->send_limits.max_header_bytes) {
-        snprintf(err, errsz, "the job is %zu bytes, more than the %zu a message may carry",
-                 fr->job_bytes, f->send_limits.max_header_bytes);
+        err_set(err, errsz, "the job is %zu bytes, more than the %zu a message may carry",
+                fr->job_bytes, f->send_limits.max_header_bytes);
         return AAFARM_EXIT_INPUT;
     }
     f->job_bytes += fr->job_bytes;
@@ -331,7 +331,6 @@ static bool replay_tile(void *arg, int tile, const void *chunk, size_t len, char
 static int open_journal(farm *f, farm_frame *fr, char *err, size_t errsz)
 {
     char *path = journal_path_for(fr->output);
-    if (!path) abort();
     journal_id id;
     memset(&id, 0, sizeof id);
     snprintf(id.job_hash, sizeof id.job_hash, "%s", fr->jb->hash);
@@ -409,7 +408,7 @@ static int setup(farm *f, char *err, size_t errsz)
         fr->ntiles = image_format_tile_count(&fr->fmt);
         fr->first = f->ntiles;
         if (fr->ntiles > INT_MAX / 4 - f->ntiles) {
-            snprintf(err, errsz, "the %d frames have too many tiles to count", f->nframes);
+            err_set(err, errsz, "the %d frames have too many tiles to count", f->nframes);
             return AAFARM_EXIT_INPUT;
         }
         f->ntiles += fr->ntiles;
@@ -424,7 +423,7 @@ static int setup(farm *f, char *err, size_t errsz)
      * into the next frame, and new runs start in the longest queued run */
     f->sched = scheduler_new(f->ntiles, 1, &so);
     if (!f->sched) {
-        snprintf(err, errsz, "the %d frames have too many tiles to count", f->nframes);
+        err_set(err, errsz, "the %d frames have too many tiles to count", f->nframes);
         return AAFARM_EXIT_INPUT;
     }
     f->reg = registry_new();
@@ -447,9 +446,9 @@ static void log_drop(farm *f, int64_t now)
     }
     if (f->drops_unlogged)
         console_log(f->con, CONSOLE_INFO, "%s (and %llu more malformed messages dropped)",
-                    wire_last_error(), (unsigned long long)f->drops_unlogged);
+                    f->wstats.last_error, (unsigned long long)f->drops_unlogged);
     else
-        console_log(f->con, CONSOLE_INFO, "%s", wire_last_error());
+        console_log(f->con, CONSOLE_INFO, "%s", f->wstats.last_error);
     f->drops_unlogged = 0;
     f->drop_logged_ms = now;
 }
@@ -458,7 +457,7 @@ static void log_drop(farm *f, int64_t now)
 static void drain(farm *f, int64_t now)
 {
     for (int i = 0; i < 1000 && f->state == FARM_RUNNING; i++) {
-        wire_msg *m = wire_recv(f->router, &f->limits, &f->wstats, ZMQ_DONTWAIT);
+        wire_msg *m = wire_recv(f->router, &f->limits, &f->wstats, ZMQ_DONTWAIT, NULL, 0);
         if (!m) {
             if (errno == EPROTO) {
                 log_drop(f, now);
@@ -533,7 +532,7 @@ static void timers(farm *f, int64_t now)
                     "queue", n, n == 1 ? "" : "s", n == 1 ? "its" : "their",
                     f->opt->lease_factor, (double)f->opt->lease_ms / 1000.0, n == 1 ? "" : "s");
     if (f->monitor) {
-        wire_monitor_poll(f->monitor, &f->wstats);
+        wire_monitor_poll(f->monitor, &f->wstats, NULL, 0);
         log_handshakes(f, now);
     }
     if (f->locals) {
@@ -697,8 +696,7 @@ int farm_run(const farm_options *opt, const farm_frame_in *frames, int nframes)
     memset(&f, 0, sizeof f);
     f.opt = opt;
     f.nframes = nframes;
-    f.frames = calloc((size_t)nframes, sizeof *f.frames);
-    if (!f.frames) abort();
+    f.frames = xcalloc((size_t)nframes, sizeof *f.frames);
     for (int i = 0; i < nframes; i++) {
         f.frames[i].jb = frames[i].jb;
         f.frames[i].fmt = frames[i].fmt;

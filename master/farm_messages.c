@@ -31,31 +31,31 @@
 
 /* ---- sending ---- */
 
-static int send_to(farm *f, const uint8_t *id, size_t id_len, Aafarm__Envelope *env,
-                   const void *bulk, size_t bulk_len)
+static int send_to(farm *f, const uint8_t *id, size_t id_len, const proto_msg *msg,
+                   const void *bulk, size_t bulk_len, char *err, size_t errsz)
 {
-    if (wire_send_limited(f->router, &f->send_limits, id, id_len, env, bulk, bulk_len) != 0)
-        return -1;
-    return 0;
+    return wire_send_limited(f->router, &f->send_limits, id, id_len, msg, bulk, bulk_len, err,
+                             errsz);
 }
 
 /* Sends to a registered worker; a worker that cannot be reached any more
  * (connection gone, or its queue full because it stopped reading) is
  * lost. bulk: a FileChunk's bytes (NULL otherwise). */
-static int send_env_bulk(farm *f, farm_worker *w, Aafarm__Envelope *env, const void *bulk,
+static int send_msg_bulk(farm *f, farm_worker *w, const proto_msg *msg, const void *bulk,
                          size_t bulk_len, int64_t now)
 {
-    size_t n = aafarm__envelope__get_packed_size(env);
-    if (send_to(f, w->id, w->id_len, env, bulk, bulk_len) != 0) {
+    size_t n = proto_msg_packed_size(msg);
+    char err[ERR_LEN];
+    if (send_to(f, w->id, w->id_len, msg, bulk, bulk_len, err, sizeof err) != 0) {
         int e = errno;
-        const char *what = proto_message_name(env->body_case);
+        const char *what = proto_message_name(msg->kind);
         if (e == EHOSTUNREACH) {
             farm_lose_worker(f, w, "disconnected", now);
         } else if (e == EAGAIN) {
             farm_lose_worker(f, w, "stopped reading its messages", now);
         } else {
             console_log(f->con, CONSOLE_ERROR, "cannot send %s to worker %s: %s", what,
-                        w->name, wire_last_error());
+                        w->name, err);
         }
         return -1;
     }
@@ -65,36 +65,28 @@ static int send_env_bulk(farm *f, farm_worker *w, Aafarm__Envelope *env, const v
     return (int)n;
 }
 
-static int send_env(farm *f, farm_worker *w, Aafarm__Envelope *env, int64_t now)
+static int send_msg(farm *f, farm_worker *w, const proto_msg *msg, int64_t now)
 {
-    return send_env_bulk(f, w, env, NULL, 0, now);
+    return send_msg_bulk(f, w, msg, NULL, 0, now);
 }
 
-static void send_reject(farm *f, const uint8_t *id, size_t id_len, Aafarm__RejectCode code,
+static void send_reject(farm *f, const uint8_t *id, size_t id_len, proto_reject_code code,
                         const char *reason)
 {
-    Aafarm__Reject r = AAFARM__REJECT__INIT;
-    r.code = code;
-    r.reason = (char *)reason;
-    r.protocol_version = AAFARM_PROTOCOL_VERSION;
-    Aafarm__Envelope env = AAFARM__ENVELOPE__INIT;
-    env.body_case = AAFARM__ENVELOPE__BODY_REJECT;
-    env.reject = &r;
-    if (send_to(f, id, id_len, &env, NULL, 0) == 0) f->rejects_sent++;
+    proto_msg msg = {.kind = PROTO_REJECT,
+                     .reject = {code, reason, AAFARM_PROTOCOL_VERSION}};
+    if (send_to(f, id, id_len, &msg, NULL, 0, NULL, 0) == 0) f->rejects_sent++;
 }
 
 static void send_welcome(farm *f, farm_worker *w, int64_t now)
 {
-    Aafarm__Welcome wel = AAFARM__WELCOME__INIT;
-    wel.protocol_version = AAFARM_PROTOCOL_VERSION;
-    wel.master_name = f->host;
-    wel.master_session = f->session;
-    wel.heartbeat_ms = (uint32_t)f->opt->heartbeat_ms;
-    wel.heartbeat_liveness = (uint32_t)f->opt->liveness;
-    Aafarm__Envelope env = AAFARM__ENVELOPE__INIT;
-    env.body_case = AAFARM__ENVELOPE__BODY_WELCOME;
-    env.welcome = &wel;
-    send_env(f, w, &env, now);
+    proto_msg msg = {.kind = PROTO_WELCOME,
+                     .welcome = {.protocol_version = AAFARM_PROTOCOL_VERSION,
+                                 .master_name = f->host,
+                                 .master_session = f->session,
+                                 .heartbeat_ms = (uint32_t)f->opt->heartbeat_ms,
+                                 .heartbeat_liveness = (uint32_t)f->opt->liveness}};
+    send_msg(f, w, &msg, now);
 }
 
 /* Does the worker hold the frame's job (as far as the master knows: a
@@ -123,10 +115,8 @@ static void mark_held(farm_worker *w, int frame)
 
 static int send_job(farm *f, farm_worker *w, farm_frame *fr, int64_t now)
 {
-    Aafarm__Envelope env = AAFARM__ENVELOPE__INIT;
-    env.body_case = AAFARM__ENVELOPE__BODY_JOB;
-    env.job = job_message_job(fr->jobmsg);
-    int n = send_env(f, w, &env, now);
+    proto_msg msg = {.kind = PROTO_JOB, .job = *job_message_job(fr->jobmsg)};
+    int n = send_msg(f, w, &msg, now);
     if (n < 0) return -1;
     mark_held(w, (int)(fr - f->frames));
     if (fr->jb->nfiles > 0 && !w->files_ready)   /* its leases wait for the files */
@@ -146,21 +136,14 @@ static int send_grant(farm *f, farm_worker *w, const scheduler_lease *l, int64_t
     int local;
     farm_frame *fr = farm_frame_of(f, l->tile, &local);
     image_rect r = image_format_tile_rect(&fr->fmt, local % fr->tiles_x, local / fr->tiles_x);
-    Aafarm__Rect rect = AAFARM__RECT__INIT;
-    rect.x = (uint32_t)r.x0;
-    rect.y = (uint32_t)r.y0;
-    rect.width = (uint32_t)r.w;
-    rect.height = (uint32_t)r.h;
-    Aafarm__Grant g = AAFARM__GRANT__INIT;
-    g.job_hash = (char *)fr->jb->hash;
-    g.lease_id = l->id;
-    g.tile_index = (uint32_t)local;
-    g.tile = &rect;
-    g.deadline_ms = (uint32_t)(l->deadline_ms - l->granted_ms);
-    Aafarm__Envelope env = AAFARM__ENVELOPE__INIT;
-    env.body_case = AAFARM__ENVELOPE__BODY_GRANT;
-    env.grant = &g;
-    int n = send_env(f, w, &env, now);
+    proto_msg msg = {.kind = PROTO_GRANT,
+                     .grant = {.job_hash = fr->jb->hash,
+                               .lease_id = l->id,
+                               .tile_index = (uint32_t)local,
+                               .tile = {(uint32_t)r.x0, (uint32_t)r.y0, (uint32_t)r.w,
+                                        (uint32_t)r.h},
+                               .deadline_ms = (uint32_t)(l->deadline_ms - l->granted_ms)}};
+    int n = send_msg(f, w, &msg, now);
     if (n < 0) return -1;
     f->grant_bytes += (uint64_t)n;
     if (f->nframes > 1)
@@ -175,39 +158,30 @@ static int send_grant(farm *f, farm_worker *w, const scheduler_lease *l, int64_t
 
 void farm_send_heartbeat(farm *f, farm_worker *w, int64_t now)
 {
-    Aafarm__Heartbeat hb = AAFARM__HEARTBEAT__INIT;
-    Aafarm__Envelope env = AAFARM__ENVELOPE__INIT;
-    env.body_case = AAFARM__ENVELOPE__BODY_HEARTBEAT;
-    env.heartbeat = &hb;
-    send_env(f, w, &env, now);
+    proto_msg msg = {.kind = PROTO_HEARTBEAT};
+    send_msg(f, w, &msg, now);
 }
 
 /* JobDone for each frame whose job the worker holds. */
 void farm_send_job_done(farm *f, farm_worker *w, int64_t now)
 {
     for (int i = 0; i < w->nheld; i++) {
-        Aafarm__JobDone d = AAFARM__JOB_DONE__INIT;
-        d.job_hash = (char *)f->frames[w->held[i]].jb->hash;
-        d.status = f->state == FARM_DONE     ? AAFARM__JOB_STATUS__JOB_STATUS_DONE
-                   : f->state == FARM_FAILED ? AAFARM__JOB_STATUS__JOB_STATUS_FAILED
-                                             : AAFARM__JOB_STATUS__JOB_STATUS_CANCELLED;
-        d.message = f->state == FARM_DONE ? "" : f->state == FARM_FAILED ? f->failure
-                                                                          : "interrupted";
-        Aafarm__Envelope env = AAFARM__ENVELOPE__INIT;
-        env.body_case = AAFARM__ENVELOPE__BODY_JOB_DONE;
-        env.job_done = &d;
-        send_env(f, w, &env, now);
+        proto_msg msg = {.kind = PROTO_JOB_DONE};
+        proto_job_done *d = &msg.job_done;
+        d->job_hash = f->frames[w->held[i]].jb->hash;
+        d->status = f->state == FARM_DONE     ? PROTO_JOB_STATUS_DONE
+                    : f->state == FARM_FAILED ? PROTO_JOB_STATUS_FAILED
+                                              : PROTO_JOB_STATUS_CANCELLED;
+        d->message = f->state == FARM_DONE ? "" : f->state == FARM_FAILED ? f->failure
+                                                                           : "interrupted";
+        send_msg(f, w, &msg, now);
     }
 }
 
 void farm_send_shutdown(farm *f, farm_worker *w, const char *reason, int64_t now)
 {
-    Aafarm__Shutdown s = AAFARM__SHUTDOWN__INIT;
-    s.reason = (char *)reason;
-    Aafarm__Envelope env = AAFARM__ENVELOPE__INIT;
-    env.body_case = AAFARM__ENVELOPE__BODY_SHUTDOWN;
-    env.shutdown = &s;
-    send_env(f, w, &env, now);
+    proto_msg msg = {.kind = PROTO_SHUTDOWN, .shutdown = {reason}};
+    send_msg(f, w, &msg, now);
 }
 
 /* ---- bookkeeping ---- */
@@ -231,7 +205,7 @@ void farm_lose_worker(farm *f, farm_worker *w, const char *why, int64_t now)
                 requeued, requeued == 1 ? "" : "s");
 }
 
-static bool holds_job(const Aafarm__Hello *h, const char *hash)
+static bool holds_job(const proto_hello *h, const char *hash)
 {
     for (size_t i = 0; i < h->n_jobs_held; i++)
         if (strcmp(h->jobs_held[i], hash) == 0) return true;
@@ -245,7 +219,7 @@ static void copy_name(char *dst, size_t n, const char *src)
 
 /* ---- incoming messages ---- */
 
-static void on_hello(farm *f, const Aafarm__Hello *h, const uint8_t *id, size_t id_len,
+static void on_hello(farm *f, const proto_hello *h, const uint8_t *id, size_t id_len,
                      int64_t now)
 {
     char why[200], hex[24];
@@ -255,7 +229,7 @@ static void on_hello(farm *f, const Aafarm__Hello *h, const uint8_t *id, size_t 
                     h->worker_name && *h->worker_name ? h->worker_name : "?",
                     h->host && *h->host ? h->host : "?", registry_id_hex(id, id_len, hex, sizeof hex),
                     why);
-        send_reject(f, id, id_len, AAFARM__REJECT_CODE__REJECT_CODE_VERSION_MISMATCH, why);
+        send_reject(f, id, id_len, PROTO_REJECT_VERSION_MISMATCH, why);
         return;
     }
     farm_worker *w = registry_find(f->reg, id, id_len);
@@ -267,7 +241,7 @@ static void on_hello(farm *f, const Aafarm__Hello *h, const uint8_t *id, size_t 
                     h->worker_name && *h->worker_name ? h->worker_name : "?",
                     h->host && *h->host ? h->host : "?", registry_id_hex(id, id_len, hex, sizeof hex),
                     why);
-        send_reject(f, id, id_len, AAFARM__REJECT_CODE__REJECT_CODE_REFUSED, why);
+        send_reject(f, id, id_len, PROTO_REJECT_REFUSED, why);
         return;
     }
     w = registry_add(f->reg, id, id_len, now);
@@ -289,7 +263,7 @@ static void on_hello(farm *f, const Aafarm__Hello *h, const uint8_t *id, size_t 
     send_welcome(f, w, now);
 }
 
-static void on_ask(farm *f, farm_worker *w, const Aafarm__Ask *a)
+static void on_ask(farm *f, farm_worker *w, const proto_ask *a)
 {
     (void)f;
     /* a worker asks for about two tiles per thread; more is a broken peer */
@@ -325,9 +299,8 @@ static void tile_failed(farm *f, farm_worker *w, uint64_t lease, int tile, const
               "by a second worker", msg);
 }
 
-static void add_stats(farm_worker *w, const Aafarm__TileStats *s)
+static void add_stats(farm_worker *w, const proto_tile_stats *s)
 {
-    if (!s) return;
     w->rays += s->rays;
     w->boxes += s->boxes;
     w->shader_evals += s->shader_evals;
@@ -340,7 +313,7 @@ static void add_stats(farm_worker *w, const Aafarm__TileStats *s)
     w->cpu_seconds += s->cpu_seconds;
 }
 
-static void on_result(farm *f, farm_worker *w, const Aafarm__Result *r, const wire_msg *m,
+static void on_result(farm *f, farm_worker *w, const proto_result *r, const wire_msg *m,
                       int64_t now)
 {
     size_t len = 0;
@@ -384,14 +357,14 @@ static void on_result(farm *f, farm_worker *w, const Aafarm__Result *r, const wi
             }
             scheduler_complete(f->sched, w->slot, r->lease_id, now);
             w->tiles++;
-            add_stats(w, r->stats);
-            if (r->stats && r->stats->nonfinite_samples) {
+            add_stats(w, &r->stats);
+            if (r->stats.nonfinite_samples) {
                 if (f->nonfinite_tiles++ == 0)
                     console_log(f->con, CONSOLE_INFO, "warning: tile %d at (%d,%d) from %s had %llu "
                                 "NaN/Inf samples, written as 0 (further ones are counted at the "
                                 "end)", local, rect.x0, rect.y0, w->name,
-                                (unsigned long long)r->stats->nonfinite_samples);
-                f->nonfinite_samples += r->stats->nonfinite_samples;
+                                (unsigned long long)r->stats.nonfinite_samples);
+                f->nonfinite_samples += r->stats.nonfinite_samples;
             }
             char frame[40] = "";
             if (f->nframes > 1) snprintf(frame, sizeof frame, "frame %d ", fr->jb->frame_number);
@@ -408,7 +381,7 @@ static void on_result(farm *f, farm_worker *w, const Aafarm__Result *r, const wi
     tile_failed(f, w, r->lease_id, tile, msg, true);
 }
 
-static void on_failure(farm *f, farm_worker *w, const Aafarm__Failure *x)
+static void on_failure(farm *f, farm_worker *w, const proto_failure *x)
 {
     const scheduler_lease *l = scheduler_lease_find(f->sched, w->slot, x->lease_id);
     int local;
@@ -429,7 +402,7 @@ static farm_frame *frame_of_job(farm *f, const char *hash)
     return NULL;
 }
 
-static void on_need_job(farm *f, farm_worker *w, const Aafarm__NeedJob *n, int64_t now)
+static void on_need_job(farm *f, farm_worker *w, const proto_need_job *n, int64_t now)
 {
     farm_frame *fr = frame_of_job(f, n->job_hash);
     if (fr) {
@@ -440,7 +413,7 @@ static void on_need_job(farm *f, farm_worker *w, const Aafarm__NeedJob *n, int64
                 w->name, n->job_hash);
 }
 
-static void on_need_file(farm *f, farm_worker *w, const Aafarm__NeedFile *n, int64_t now)
+static void on_need_file(farm *f, farm_worker *w, const proto_need_file *n, int64_t now)
 {
     farm_frame *fr = frame_of_job(f, n->job_hash);
     if (!fr) {
@@ -473,15 +446,9 @@ static void on_need_file(farm *f, farm_worker *w, const Aafarm__NeedFile *n, int
         farm_fail(f, "%s", err);
         return;
     }
-    Aafarm__FileChunk c = AAFARM__FILE_CHUNK__INIT;
-    c.sha256 = (char *)file->sha256;
-    c.offset = n->offset;
-    c.file_size = file->size;
-    c.length = n->length;
-    Aafarm__Envelope env = AAFARM__ENVELOPE__INIT;
-    env.body_case = AAFARM__ENVELOPE__BODY_FILE_CHUNK;
-    env.file_chunk = &c;
-    if (send_env_bulk(f, w, &env, data, n->length, now) < 0) return;
+    proto_msg msg = {.kind = PROTO_FILE_CHUNK,
+                     .file_chunk = {file->sha256, n->offset, file->size, n->length}};
+    if (send_msg_bulk(f, w, &msg, data, n->length, now) < 0) return;
     if (w->file_chunks == 0) w->file_first_ms = now;
     if (!w->files_ready)   /* progress: its leases' clocks start again */
         scheduler_worker_waiting(f->sched, w->slot, true, now);
@@ -491,7 +458,7 @@ static void on_need_file(farm *f, farm_worker *w, const Aafarm__NeedFile *n, int
     f->file_chunks_sent++;
 }
 
-static void on_files_ready(farm *f, farm_worker *w, const Aafarm__FilesReady *r, int64_t now)
+static void on_files_ready(farm *f, farm_worker *w, const proto_files_ready *r, int64_t now)
 {
     if (!frame_of_job(f, r->job_hash) || w->files_ready) return;
     w->files_ready = true;
@@ -507,12 +474,12 @@ static void on_files_ready(farm *f, farm_worker *w, const Aafarm__FilesReady *r,
 static void on_unknown_peer(farm *f, proto_kind kind, const uint8_t *id, size_t id_len,
                             int64_t now)
 {
-    if (kind == AAFARM__ENVELOPE__BODY_SHUTDOWN) return;
+    if (kind == PROTO_SHUTDOWN) return;
     if (!registry_reject_due(f->reg, id, id_len, now, f->opt->heartbeat_ms)) return;
     char hex[24];
     console_log(f->con, CONSOLE_DETAIL, "%s from unknown peer %s: asking it to say Hello",
                 proto_message_name(kind), registry_id_hex(id, id_len, hex, sizeof hex));
-    send_reject(f, id, id_len, AAFARM__REJECT_CODE__REJECT_CODE_HELLO_FIRST,
+    send_reject(f, id, id_len, PROTO_REJECT_HELLO_FIRST,
                 "the master does not know this connection (it restarted, or the "
                 "connection was renewed): say Hello again");
 }
@@ -521,10 +488,10 @@ void farm_handle(farm *f, wire_msg *m, int64_t now)
 {
     size_t id_len = 0;
     const uint8_t *id = wire_msg_identity(m, &id_len);
-    const Aafarm__Envelope *env = wire_msg_envelope(m);
-    proto_kind kind = wire_msg_kind(m);
-    if (kind == AAFARM__ENVELOPE__BODY_HELLO) {
-        on_hello(f, env->hello, id, id_len, now);
+    const proto_msg *msg = wire_msg_body(m);
+    proto_kind kind = msg->kind;
+    if (kind == PROTO_HELLO) {
+        on_hello(f, &msg->hello, id, id_len, now);
         return;
     }
     farm_worker *w = registry_find(f->reg, id, id_len);
@@ -534,17 +501,17 @@ void farm_handle(farm *f, wire_msg *m, int64_t now)
     }
     w->last_seen_ms = now;
     switch (kind) {
-    case AAFARM__ENVELOPE__BODY_ASK: on_ask(f, w, env->ask); break;
-    case AAFARM__ENVELOPE__BODY_RESULT: on_result(f, w, env->result, m, now); break;
-    case AAFARM__ENVELOPE__BODY_FAILURE: on_failure(f, w, env->failure); break;
-    case AAFARM__ENVELOPE__BODY_NEED_JOB: on_need_job(f, w, env->need_job, now); break;
-    case AAFARM__ENVELOPE__BODY_NEED_FILE: on_need_file(f, w, env->need_file, now); break;
-    case AAFARM__ENVELOPE__BODY_FILES_READY: on_files_ready(f, w, env->files_ready, now); break;
-    case AAFARM__ENVELOPE__BODY_SHUTDOWN: {
+    case PROTO_ASK: on_ask(f, w, &msg->ask); break;
+    case PROTO_RESULT: on_result(f, w, &msg->result, m, now); break;
+    case PROTO_FAILURE: on_failure(f, w, &msg->failure); break;
+    case PROTO_NEED_JOB: on_need_job(f, w, &msg->need_job, now); break;
+    case PROTO_NEED_FILE: on_need_file(f, w, &msg->need_file, now); break;
+    case PROTO_FILES_READY: on_files_ready(f, w, &msg->files_ready, now); break;
+    case PROTO_SHUTDOWN: {
         char why[160];
         snprintf(why, sizeof why, "left (%s)",
-                 env->shutdown->reason && *env->shutdown->reason ? env->shutdown->reason
-                                                                 : "no reason given");
+                 msg->shutdown.reason && *msg->shutdown.reason ? msg->shutdown.reason
+                                                               : "no reason given");
         farm_lose_worker(f, w, why, now);
         break;
     }

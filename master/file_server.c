@@ -4,6 +4,9 @@
  */
 #define _GNU_SOURCE
 #include "file_server.h"
+#include "util/err.h"
+#include "util/fdio.h"
+#include "util/xalloc.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -28,11 +31,9 @@ struct file_server {
 
 file_server *file_server_new(const job *jb)
 {
-    file_server *self = calloc(1, sizeof *self);
-    if (!self) abort();
+    file_server *self = xcalloc(1, sizeof *self);
     self->jb = jb;
-    self->files = calloc((size_t)jb->nfiles + 1, sizeof *self->files);
-    if (!self->files) abort();
+    self->files = xcalloc((size_t)jb->nfiles + 1, sizeof *self->files);
     for (int i = 0; i < jb->nfiles; i++) self->files[i].fd = -1;
     return self;
 }
@@ -72,15 +73,15 @@ static bool check(served *s, const job_file *f, char *err, size_t errsz)
     if (s->fd < 0) {
         s->fd = open(f->path, O_RDONLY | O_CLOEXEC);
         if (s->fd < 0) {
-            snprintf(err, errsz, "file '%s' ('%s' on the master's disk) cannot be opened any "
-                     "more: %s; restore it and render again", f->name, f->path, strerror(errno));
+            err_set(err, errsz, "file '%s' ('%s' on the master's disk) cannot be opened any "
+                    "more: %s; restore it and render again", f->name, f->path, strerror(errno));
             return false;
         }
         memset(&s->verified, 0, sizeof s->verified);
     }
     struct stat st;
     if (fstat(s->fd, &st) != 0) {
-        snprintf(err, errsz, "file '%s': %s", f->name, strerror(errno));
+        err_set(err, errsz, "file '%s': %s", f->name, strerror(errno));
         return false;
     }
     if (as_loaded(&st, f) || (s->verified.st_ino != 0 && same_stat(&st, &s->verified)))
@@ -88,15 +89,15 @@ static bool check(served *s, const job_file *f, char *err, size_t errsz)
     char hex[HASH_HEX_SIZE];
     uint64_t len = 0;
     if (!hash_fd(s->fd, hex, &len)) {
-        snprintf(err, errsz, "file '%s' ('%s') cannot be read: %s", f->name, f->path,
-                 strerror(errno));
+        err_set(err, errsz, "file '%s' ('%s') cannot be read: %s", f->name, f->path,
+                strerror(errno));
         return false;
     }
     if (len != f->size || strcmp(hex, f->sha256) != 0) {
-        snprintf(err, errsz, "file '%s' ('%s') changed on the master's disk since the job was "
-                 "loaded (%llu bytes, SHA-256 %.12s... then; %llu bytes, %.12s... now): render "
-                 "again to ship the new version", f->name, f->path,
-                 (unsigned long long)f->size, f->sha256, (unsigned long long)len, hex);
+        err_set(err, errsz, "file '%s' ('%s') changed on the master's disk since the job was "
+                "loaded (%llu bytes, SHA-256 %.12s... then; %llu bytes, %.12s... now): render "
+                "again to ship the new version", f->name, f->path,
+                (unsigned long long)f->size, f->sha256, (unsigned long long)len, hex);
         return false;
     }
     s->verified = st;
@@ -116,21 +117,15 @@ file_read file_server_read(file_server *self, const char *sha, uint64_t offset, 
     if (!check(s, f, err, errsz)) return FILE_READ_CHANGED;
     if (self->buf_size < length) {
         free(self->buf);
-        self->buf = malloc(length);
-        if (!self->buf) abort();
+        self->buf = xmalloc(length);
         self->buf_size = length;
     }
     size_t got = 0;
-    while (got < length) {
-        ssize_t n = pread(s->fd, self->buf + got, length - got, (off_t)(offset + got));
-        if (n < 0 && errno == EINTR) continue;
-        if (n <= 0) {
-            snprintf(err, errsz, "file '%s' ('%s') cannot be read at byte %llu: %s", f->name,
-                     f->path, (unsigned long long)(offset + got),
-                     n == 0 ? "it is shorter than when the job was loaded" : strerror(errno));
-            return FILE_READ_CHANGED;
-        }
-        got += (size_t)n;
+    if (!fd_pread_all(s->fd, self->buf, length, offset, &got)) {
+        err_set(err, errsz, "file '%s' ('%s') cannot be read at byte %llu: %s", f->name,
+                f->path, (unsigned long long)(offset + got),
+                errno == 0 ? "it is shorter than when the job was loaded" : strerror(errno));
+        return FILE_READ_CHANGED;
     }
     *data = self->buf;
     return FILE_READ_OK;

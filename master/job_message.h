@@ -10,19 +10,19 @@
 
 #include <stddef.h>
 
-#include "aafarm.pb-c.h"
 #include "image/format.h"
 #include "job/job.h"
+#include "message.h"
 
 typedef struct job_message job_message;
 
 job_message *job_message_new(const job *jb, const image_format *fmt);
 void job_message_destroy(job_message **self_p);
 
-/* The Job, ready to put in an Envelope. */
-Aafarm__Job *job_message_job(job_message *self);
+/* The Job, ready to put in a proto_msg. */
+const proto_job *job_message_job(const job_message *self);
 
 /* Bytes of the packed Envelope carrying it (what one worker receives). */
-size_t job_message_packed_size(job_message *self);
+size_t job_message_packed_size(const job_message *self);
 
 #endif

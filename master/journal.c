@@ -3,6 +3,9 @@
  * the fsync policy and what a resume drops).
  */
 #include "journal.h"
+#include "util/err.h"
+#include "util/fdio.h"
+#include "util/xalloc.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -85,44 +88,14 @@ static uint32_t record_crc(const uint8_t rec[RECORD_BYTES], const void *chunk, s
 char *journal_path_for(const char *output)
 {
     size_t n = strlen(output) + sizeof ".journal";
-    char *p = malloc(n);
-    if (p) snprintf(p, n, "%s.journal", output);
+    char *p = xmalloc(n);
+    snprintf(p, n, "%s.journal", output);
     return p;
 }
 
 const char *journal_file(const journal *self)
 {
     return self->path;
-}
-
-static bool write_all(int fd, const void *buf, size_t len)
-{
-    const char *p = buf;
-    while (len > 0) {
-        ssize_t n = write(fd, p, len);
-        if (n < 0 && errno == EINTR) continue;
-        if (n <= 0) {
-            if (n == 0) errno = EIO;
-            return false;
-        }
-        p += n;
-        len -= (size_t)n;
-    }
-    return true;
-}
-
-static bool read_at(int fd, void *buf, size_t len, uint64_t off)
-{
-    char *p = buf;
-    while (len > 0) {
-        ssize_t n = pread(fd, p, len, (off_t)off);
-        if (n < 0 && errno == EINTR) continue;
-        if (n <= 0) return false;
-        p += n;
-        len -= (size_t)n;
-        off += (uint64_t)n;
-    }
-    return true;
 }
 
 static const char *space_hint(int e)
@@ -137,13 +110,13 @@ static int open_locked(const char *path, bool create, char *err, size_t errsz)
     int fd = open(path, O_RDWR | O_APPEND | O_CLOEXEC | (create ? O_CREAT : 0), 0644);
     if (fd < 0) {
         if (errno != ENOENT || create)
-            snprintf(err, errsz, "cannot open the journal %s: %s", path, strerror(errno));
+            err_set(err, errsz, "cannot open the journal %s: %s", path, strerror(errno));
         return -1;
     }
     if (flock(fd, LOCK_EX | LOCK_NB) != 0) {
         int e = errno;
-        snprintf(err, errsz, "the journal %s is locked: %s", path,
-                 e == EWOULDBLOCK ? "another master is rendering into the same output"
+        err_set(err, errsz, "the journal %s is locked: %s", path,
+                e == EWOULDBLOCK ? "another master is rendering into the same output"
                                   : strerror(e));
         close(fd);
         return -1;
@@ -153,8 +126,8 @@ static int open_locked(const char *path, bool create, char *err, size_t errsz)
 
 static journal *wrap(const char *path, int fd, uint64_t size)
 {
-    journal *self = calloc(1, sizeof *self);
-    if (!self || !(self->path = strdup(path))) abort();
+    journal *self = xcalloc(1, sizeof *self);
+    self->path = xstrdup(path);
     self->fd = fd;
     self->size = size;
     self->synced_ms = -1;
@@ -171,10 +144,10 @@ journal *journal_create(const char *path, const journal_id *id, bool *replaced, 
     if (fstat(fd, &st) == 0 && st.st_size > HEADER_BYTES) *replaced = true;
     uint8_t h[HEADER_BYTES];
     encode_header(h, id);
-    if (ftruncate(fd, 0) != 0 || !write_all(fd, h, sizeof h) || fdatasync(fd) != 0) {
+    if (ftruncate(fd, 0) != 0 || !fd_write_all(fd, h, sizeof h) || fdatasync(fd) != 0) {
         int e = errno;
-        snprintf(err, errsz, "cannot write the journal %s: %s%s", path, strerror(e),
-                 space_hint(e));
+        err_set(err, errsz, "cannot write the journal %s: %s%s", path, strerror(e),
+                space_hint(e));
         close(fd);
         unlink(path);
         return NULL;
@@ -186,57 +159,57 @@ static bool check_header(const char *path, int fd, const journal_id *id, char *e
                          size_t errsz)
 {
     uint8_t h[HEADER_BYTES], want[HEADER_BYTES];
-    if (!read_at(fd, h, sizeof h, 0) || memcmp(h, magic, 8) != 0 ||
+    if (!fd_pread_all(fd, h, sizeof h, 0, NULL) || memcmp(h, magic, 8) != 0 ||
         get_u32(h + 92) != journal_crc32(0, h, 92)) {
-        snprintf(err, errsz, "cannot resume: %s is not an aafarm journal or its header is "
-                 "damaged (remove it and render without --resume)", path);
+        err_set(err, errsz, "cannot resume: %s is not an aafarm journal or its header is "
+                "damaged (remove it and render without --resume)", path);
         return false;
     }
     encode_header(want, id);
     if (memcmp(h + 28, want + 28, 64) != 0) {
-        snprintf(err, errsz, "cannot resume: %s belongs to job %.12s, this render is job %.12s "
-                 "(the scene, a shader or an option changed; remove the journal or render "
-                 "without --resume)", path, (const char *)h + 28, id->job_hash);
+        err_set(err, errsz, "cannot resume: %s belongs to job %.12s, this render is job %.12s "
+                "(the scene, a shader or an option changed; remove the journal or render "
+                "without --resume)", path, (const char *)h + 28, id->job_hash);
         return false;
     }
     if (memcmp(h, want, 28) != 0) {
-        snprintf(err, errsz, "cannot resume: %s is for a %ux%u image in tiles of %u, this "
-                 "render is %ux%u in tiles of %u", path, get_u32(h + 8), get_u32(h + 12),
-                 get_u32(h + 16), id->width, id->height, id->tile_size);
+        err_set(err, errsz, "cannot resume: %s is for a %ux%u image in tiles of %u, this "
+                "render is %ux%u in tiles of %u", path, get_u32(h + 8), get_u32(h + 12),
+                get_u32(h + 16), id->width, id->height, id->tile_size);
         return false;
     }
     return true;
 }
 
 /* Reads the record at off: its chunk into *buf (grown as needed). False
- * with why when it is torn or corrupt. */
+ * with err saying how when it is torn or corrupt. */
 static bool read_record(int fd, uint64_t off, uint64_t file_size, const journal_id *id,
-                        uint8_t **buf, size_t *cap, int *tile, size_t *len, char *why,
-                        size_t whysz)
+                        uint8_t **buf, size_t *cap, int *tile, size_t *len, char *err,
+                        size_t errsz)
 {
     uint8_t rec[RECORD_BYTES];
-    if (file_size - off < RECORD_BYTES || !read_at(fd, rec, sizeof rec, off)) {
-        snprintf(why, whysz, "a torn record header");
+    if (file_size - off < RECORD_BYTES || !fd_pread_all(fd, rec, sizeof rec, off, NULL)) {
+        err_set(err, errsz, "a torn record header");
         return false;
     }
     uint32_t index = get_u32(rec + 4), n = get_u32(rec + 8);
     if (memcmp(rec, record_magic, 4) != 0 || index >= id->tiles || n == 0 ||
         n > JOURNAL_MAX_CHUNK) {
-        snprintf(why, whysz, "a corrupt record header");
+        err_set(err, errsz, "a corrupt record header");
         return false;
     }
     if (file_size - off - RECORD_BYTES < n) {
-        snprintf(why, whysz, "a torn record (tile %u)", index);
+        err_set(err, errsz, "a torn record (tile %u)", index);
         return false;
     }
     if (n > *cap) {
-        uint8_t *p = realloc(*buf, n);
-        if (!p) abort();
+        uint8_t *p = xrealloc(*buf, n);
         *buf = p;
         *cap = n;
     }
-    if (!read_at(fd, *buf, n, off + RECORD_BYTES) || record_crc(rec, *buf, n) != get_u32(rec + 12)) {
-        snprintf(why, whysz, "a record with a bad checksum (tile %u)", index);
+    if (!fd_pread_all(fd, *buf, n, off + RECORD_BYTES, NULL) ||
+        record_crc(rec, *buf, n) != get_u32(rec + 12)) {
+        err_set(err, errsz, "a record with a bad checksum (tile %u)", index);
         return false;
     }
     *tile = (int)index;
@@ -266,9 +239,8 @@ journal *journal_resume(const char *path, const journal_id *id, journal_tile_fn 
         return NULL;
     }
     uint64_t file_size = (uint64_t)st.st_size, off = HEADER_BYTES;
-    uint8_t *seen = calloc(id->tiles ? id->tiles : 1, 1), *buf = NULL;
+    uint8_t *seen = xcalloc(id->tiles ? id->tiles : 1, 1), *buf = NULL;
     size_t cap = 0;
-    if (!seen) abort();
     bool ok = true;
     while (ok && off < file_size) {
         int tile;
@@ -291,8 +263,8 @@ journal *journal_resume(const char *path, const journal_id *id, journal_tile_fn 
     }
     info->dropped_bytes = file_size - off;
     if (off < file_size && ftruncate(fd, (off_t)off) != 0) {
-        snprintf(err, errsz, "cannot cut the damaged end off the journal %s: %s", path,
-                 strerror(errno));
+        err_set(err, errsz, "cannot cut the damaged end off the journal %s: %s", path,
+                strerror(errno));
         close(fd);
         return NULL;
     }
@@ -304,8 +276,8 @@ bool journal_sync(journal *self, char *err, size_t errsz)
     if (!self->dirty) return true;
     if (fdatasync(self->fd) != 0) {
         int e = errno;
-        snprintf(err, errsz, "cannot write the journal %s: %s%s", self->path, strerror(e),
-                 space_hint(e));
+        err_set(err, errsz, "cannot write the journal %s: %s%s", self->path, strerror(e),
+                space_hint(e));
         return false;
     }
     self->dirty = false;
@@ -316,8 +288,8 @@ bool journal_append(journal *self, int tile, const void *chunk, size_t len, int6
                     char *err, size_t errsz)
 {
     if (tile < 0 || len == 0 || len > JOURNAL_MAX_CHUNK) {
-        snprintf(err, errsz, "journal: tile %d with a %zu-byte chunk cannot be journaled", tile,
-                 len);
+        err_set(err, errsz, "journal: tile %d with a %zu-byte chunk cannot be journaled", tile,
+                len);
         return false;
     }
     uint8_t rec[RECORD_BYTES];
@@ -333,8 +305,8 @@ bool journal_append(journal *self, int tile, const void *chunk, size_t len, int6
     } while (n < 0 && errno == EINTR);
     if (n != (ssize_t)want) {
         int e = n < 0 ? errno : ENOSPC;   /* a short write: the file system is full */
-        snprintf(err, errsz, "cannot write the journal %s: %s%s", self->path, strerror(e),
-                 space_hint(e));
+        err_set(err, errsz, "cannot write the journal %s: %s%s", self->path, strerror(e),
+                space_hint(e));
         if (n > 0) (void)!ftruncate(self->fd, (off_t)self->size);   /* no torn tail */
         return false;
     }

@@ -4,6 +4,8 @@
  * fork/execv, waitpid(pid, WNOHANG), kill(pid, ...).
  */
 #include "local_workers.h"
+#include "util/err.h"
+#include "util/xalloc.h"
 
 #include <errno.h>
 #include <limits.h>
@@ -28,20 +30,20 @@ bool local_workers_find_binary(char *buf, size_t bufsz, char *err, size_t errsz)
     char self[PATH_MAX];
     ssize_t len = readlink("/proc/self/exe", self, sizeof self - 1);
     if (len <= 0) {
-        snprintf(err, errsz, "cannot find this program's folder (/proc/self/exe: %s)",
-                 strerror(errno));
+        err_set(err, errsz, "cannot find this program's folder (/proc/self/exe: %s)",
+                strerror(errno));
         return false;
     }
     self[len] = '\0';
     char *slash = strrchr(self, '/');
     if (slash) *slash = '\0';
     if ((size_t)snprintf(buf, bufsz, "%s/aafarm-worker", self) >= bufsz) {
-        snprintf(err, errsz, "path of aafarm-worker too long");
+        err_set(err, errsz, "path of aafarm-worker too long");
         return false;
     }
     if (access(buf, X_OK) != 0) {
-        snprintf(err, errsz, "cannot start local workers: %s: %s (it is built next to "
-                 "aafarm-master)", buf, strerror(errno));
+        err_set(err, errsz, "cannot start local workers: %s: %s (it is built next to "
+                "aafarm-master)", buf, strerror(errno));
         return false;
     }
     return true;
@@ -82,16 +84,14 @@ static void exec_worker(const char *binary, const char *endpoint, int k, int thr
 local_workers *local_workers_start(const char *binary, const char *endpoint, int n,
                                    int threads, int verbosity, char *err, size_t errsz)
 {
-    local_workers *self = calloc(1, sizeof *self);
-    if (!self) abort();
-    self->pids = calloc((size_t)(n > 0 ? n : 1), sizeof *self->pids);
-    if (!self->pids) abort();
+    local_workers *self = xcalloc(1, sizeof *self);
+    self->pids = xcalloc((size_t)(n > 0 ? n : 1), sizeof *self->pids);
     pid_t parent = getpid();
     fflush(NULL);
     for (int k = 0; k < n; k++) {
         pid_t pid = fork();
         if (pid < 0) {
-            snprintf(err, errsz, "cannot start local worker %d: fork: %s", k + 1, strerror(errno));
+            err_set(err, errsz, "cannot start local worker %d: fork: %s", k + 1, strerror(errno));
             local_workers_stop(self, 0);
             local_workers_destroy(&self);
             return NULL;

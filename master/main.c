@@ -16,6 +16,7 @@
 #include "farm.h"
 #include "job/frames.h"
 #include "util/exitcodes.h"
+#include "util/xalloc.h"
 
 static void usage(FILE *out)
 {
@@ -277,9 +278,8 @@ static int load(cli *c, loaded *l)
     l->seq = frame_sequence_load(c->farm.scene_path, &c->job, c->farm.frames, c->farm.output,
                                  &usage, diag);
     int n = l->seq ? l->seq->count : 0;
-    l->frames = calloc((size_t)(n ? n : 1), sizeof *l->frames);
-    l->previews = calloc((size_t)(n ? n : 1), sizeof *l->previews);
-    if (!l->frames || !l->previews) abort();
+    l->frames = xcalloc((size_t)(n ? n : 1), sizeof *l->frames);
+    l->previews = xcalloc((size_t)(n ? n : 1), sizeof *l->previews);
     bool ok = l->seq != NULL;
     for (int i = 0; i < n && ok; i++) {
         const job *jb = l->seq->jobs[i];

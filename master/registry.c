@@ -4,6 +4,7 @@
  * plain array searched linearly is enough and keeps the code obvious.
  */
 #include "registry.h"
+#include "util/xalloc.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -29,8 +30,7 @@ struct registry {
 
 registry *registry_new(void)
 {
-    registry *self = calloc(1, sizeof *self);
-    if (!self) abort();
+    registry *self = xcalloc(1, sizeof *self);
     return self;
 }
 
@@ -64,11 +64,9 @@ farm_worker *registry_add(registry *self, const uint8_t *id, size_t id_len, int6
     drop_old_retired(self);
     if (self->count == self->cap) {
         self->cap = self->cap ? self->cap * 2 : 16;
-        self->workers = realloc(self->workers, sizeof *self->workers * self->cap);
-        if (!self->workers) abort();
+        self->workers = xrealloc(self->workers, sizeof *self->workers * self->cap);
     }
-    farm_worker *w = calloc(1, sizeof *w);
-    if (!w) abort();
+    farm_worker *w = xcalloc(1, sizeof *w);
     memcpy(w->id, id, id_len);
     w->id_len = id_len;
     w->alive = true;

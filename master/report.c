@@ -11,6 +11,7 @@
 #include <sys/resource.h>
 
 #include "farm_internal.h"
+#include "util/err.h"
 
 static const char *state_name(farm_state s)
 {
@@ -210,7 +211,7 @@ bool farm_report_json(const farm *f, const char *path, char *err, size_t errsz)
 {
     FILE *out = fopen(path, "w");
     if (!out) {
-        snprintf(err, errsz, "cannot write %s: %s", path, strerror(errno));
+        err_set(err, errsz, "cannot write %s: %s", path, strerror(errno));
         return false;
     }
     fputs("{\n  \"scene\": ", out);
@@ -235,8 +236,8 @@ bool farm_report_json(const farm *f, const char *path, char *err, size_t errsz)
     fputs("  ]\n}\n", out);
     bool failed = ferror(out) != 0;
     if (fclose(out) != 0 || failed) {
-        snprintf(err, errsz, "cannot write %s: %s", path,
-                 strerror(errno ? errno : EIO));
+        err_set(err, errsz, "cannot write %s: %s", path,
+                strerror(errno ? errno : EIO));
         unlink(path);   /* no half-written statistics file */
         return false;
     }

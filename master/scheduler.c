@@ -17,7 +17,9 @@
  *   failed[]  (tile, worker) pairs of failures, to prefer other workers.
  */
 #include "scheduler.h"
+#include "util/xalloc.h"
 
+#include <assert.h>
 #include <limits.h>
 #include <stdlib.h>
 #include <string.h>
@@ -63,13 +65,6 @@ struct scheduler {
     scheduler_counts counts;
 };
 
-static void *xrealloc(void *p, size_t n)
-{
-    p = realloc(p, n ? n : 1);
-    if (!p) abort();
-    return p;
-}
-
 void scheduler_options_default(scheduler_options *opt)
 {
     opt->max_attempts = 3;
@@ -84,8 +79,7 @@ scheduler *scheduler_new(int tiles_x, int tiles_y, const scheduler_options *opt)
 {
     if (tiles_x < 1 || tiles_y < 1 || tiles_x > INT_MAX / 2 / tiles_y)
         return NULL;
-    scheduler *self = calloc(1, sizeof *self);
-    if (!self) abort();
+    scheduler *self = xcalloc(1, sizeof *self);
     if (opt) self->opt = *opt;
     else scheduler_options_default(&self->opt);
     if (self->opt.max_attempts < 1) self->opt.max_attempts = 1;
@@ -93,9 +87,8 @@ scheduler *scheduler_new(int tiles_x, int tiles_y, const scheduler_options *opt)
     if (self->opt.max_duplicates < 0) self->opt.max_duplicates = 0;
     if (self->opt.lease_ms < 1) self->opt.lease_ms = 1;
     self->ntiles = tiles_x * tiles_y;
-    self->tiles = calloc((size_t)self->ntiles, sizeof *self->tiles);
-    self->rq = calloc((size_t)self->ntiles, sizeof *self->rq);
-    if (!self->tiles || !self->rq) abort();
+    self->tiles = xcalloc((size_t)self->ntiles, sizeof *self->tiles);
+    self->rq = xcalloc((size_t)self->ntiles, sizeof *self->rq);
     self->next_id = 1;
     self->counts.tiles = self->ntiles;
     return self;
@@ -159,6 +152,7 @@ static void rq_push(scheduler *self, int tile)
 
 static void rq_take(scheduler *self, int i)
 {
+    assert(self->rq[i] >= 0 && self->tiles[self->rq[i]].in_rq);
     self->tiles[self->rq[i]].in_rq = 0;
     self->rq[i] = -1;
     while (self->rq_head < self->rq_len && self->rq[self->rq_head] < 0) self->rq_head++;
@@ -168,6 +162,7 @@ static void rq_take(scheduler *self, int i)
 static void tile_lost_live(scheduler *self, int tile)
 {
     tile_state *t = &self->tiles[tile];
+    assert(t->live > 0);   /* lease counts balance: a live lease was counted */
     t->live--;
     if (!t->done && t->live == 0) rq_push(self, tile);
 }
@@ -218,8 +213,11 @@ static void lease_remove(scheduler *self, scheduler_lease *l)
 {
     int tile = l->tile;
     bool was_live = !l->expired;
-    if (l->expired && l->worker >= 0 && l->worker < self->nworkers)
+    if (l->expired && l->worker >= 0 && l->worker < self->nworkers) {
+        assert(self->workers[l->worker].overdue > 0);
         self->workers[l->worker].overdue--;
+    }
+    assert(l->id != 0 && self->tiles[tile].held > 0);   /* a lease is held once */
     l->id = 0;
     self->holes++;
     self->tiles[tile].held--;
@@ -241,6 +239,7 @@ static void lease_add(scheduler *self, int worker, int tile, int64_t now, bool d
                            .duplicate = dup};
     self->tiles[tile].live++;
     self->tiles[tile].held++;
+    assert(self->tiles[tile].live <= self->tiles[tile].held);
     self->counts.grants++;
     if (dup) self->counts.duplicate_grants++;
     *out = *l;
@@ -370,6 +369,7 @@ scheduler_verdict scheduler_check_result(const scheduler *self, int worker, uint
 scheduler_verdict scheduler_complete(scheduler *self, int worker, uint64_t lease_id,
                                      int64_t now_ms)
 {
+    assert(worker >= 0 && worker < self->nworkers);   /* a slot of scheduler_worker_add */
     scheduler_lease *l = (scheduler_lease *)scheduler_lease_find(self, worker, lease_id);
     if (!l) {
         self->counts.stale_results++;
@@ -383,6 +383,7 @@ scheduler_verdict scheduler_complete(scheduler *self, int worker, uint64_t lease
     }
     t->done = 1;
     self->done++;
+    assert(self->done <= self->ntiles);
     int64_t took = now_ms > l->from_ms ? now_ms - l->from_ms : 0;   /* files not counted */
     self->taken_ms_sum += took;
     self->taken++;
@@ -394,6 +395,7 @@ scheduler_verdict scheduler_complete(scheduler *self, int worker, uint64_t lease
 
 scheduler_failure scheduler_fail(scheduler *self, int worker, uint64_t lease_id, bool retryable)
 {
+    assert(worker >= 0 && worker < self->nworkers);   /* a slot of scheduler_worker_add */
     scheduler_lease *l = (scheduler_lease *)scheduler_lease_find(self, worker, lease_id);
     if (!l) return SCHEDULER_FAIL_IGNORED;
     int tile = l->tile;

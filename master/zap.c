@@ -12,6 +12,8 @@
 #include <zmq.h>
 
 #include "curve_cert.h"
+#include "util/err.h"
+#include "util/xalloc.h"
 
 enum { ZAP_MAX_KEYS = 65536, ZAP_LOGGED_PEERS = 256, ZAP_FRAMES = 8 };
 
@@ -40,14 +42,14 @@ static bool load_keys(zap *z, const char *dir, char *err, size_t errsz)
 {
     DIR *d = opendir(dir);
     if (!d) {
-        snprintf(err, errsz, "--allow-keys %s: %s", dir, strerror(errno));
+        err_set(err, errsz, "--allow-keys %s: %s", dir, strerror(errno));
         return false;
     }
     bool ok = true;
     for (struct dirent *e; ok && (e = readdir(d));) {
         if (!has_suffix(e->d_name, ".key")) continue;
         if (z->nkeys >= ZAP_MAX_KEYS) {
-            snprintf(err, errsz, "--allow-keys %s: more than %d keys", dir, ZAP_MAX_KEYS);
+            err_set(err, errsz, "--allow-keys %s: more than %d keys", dir, ZAP_MAX_KEYS);
             ok = false;
             break;
         }
@@ -58,15 +60,14 @@ static bool load_keys(zap *z, const char *dir, char *err, size_t errsz)
             ok = false;
             break;
         }
-        uint8_t (*grown)[32] = realloc(z->keys, sizeof *z->keys * (size_t)(z->nkeys + 1));
-        if (!grown) abort();
+        uint8_t (*grown)[32] = xrealloc(z->keys, sizeof *z->keys * (size_t)(z->nkeys + 1));
         z->keys = grown;
         zmq_z85_decode(z->keys[z->nkeys++], c.public_key);
     }
     closedir(d);
     if (ok && z->nkeys == 0) {
-        snprintf(err, errsz, "--allow-keys %s: no NAME.key file in it (copy each worker's "
-                 "public key there; make them with aafarm-keygen NAME)", dir);
+        err_set(err, errsz, "--allow-keys %s: no NAME.key file in it (copy each worker's "
+                "public key there; make them with aafarm-keygen NAME)", dir);
         ok = false;
     }
     return ok;
@@ -74,8 +75,7 @@ static bool load_keys(zap *z, const char *dir, char *err, size_t errsz)
 
 zap *zap_new(void *ctx, const char *allow_dir, console *con, char *err, size_t errsz)
 {
-    zap *z = calloc(1, sizeof *z);
-    if (!z) abort();
+    zap *z = xcalloc(1, sizeof *z);
     z->con = con;
     if (!load_keys(z, allow_dir, err, errsz)) {
         zap_destroy(&z);
@@ -85,7 +85,7 @@ zap *zap_new(void *ctx, const char *allow_dir, console *con, char *err, size_t e
     int linger = 0;
     if (!z->rep || zmq_setsockopt(z->rep, ZMQ_LINGER, &linger, sizeof linger) != 0 ||
         zmq_bind(z->rep, "inproc://zeromq.zap.01") != 0) {
-        snprintf(err, errsz, "cannot start the authentication handler: %s", zmq_strerror(errno));
+        err_set(err, errsz, "cannot start the authentication handler: %s", zmq_strerror(errno));
         zap_destroy(&z);
         return NULL;
     }

@@ -4,6 +4,7 @@
  * rule for endpoints that stay on this host.
  */
 #include "curve_cert.h"
+#include "util/err.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -36,15 +37,15 @@ static bool create_file(const char *path, mode_t mode, const char *text, char *e
 {
     int fd = open(path, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, mode);
     if (fd < 0) {
-        snprintf(err, errsz, "cannot create %s: %s%s", path, strerror(errno),
-                 errno == EEXIST ? " (remove it first if you mean to replace the key)" : "");
+        err_set(err, errsz, "cannot create %s: %s%s", path, strerror(errno),
+                errno == EEXIST ? " (remove it first if you mean to replace the key)" : "");
         return false;
     }
     bool ok = fchmod(fd, mode) == 0 && write_all(fd, text) && fsync(fd) == 0;
     int e = errno;
     if (close(fd) != 0) ok = false;
     if (!ok) {
-        snprintf(err, errsz, "cannot write %s: %s", path, strerror(e));
+        err_set(err, errsz, "cannot write %s: %s", path, strerror(e));
         unlink(path);
     }
     return ok;
@@ -77,25 +78,25 @@ bool curve_cert_generate(const char *base, const char *name, char *err, size_t e
     char pub_path[4096], sec_path[4096];
     if (snprintf(pub_path, sizeof pub_path, "%s.key", base) >= (int)sizeof pub_path ||
         snprintf(sec_path, sizeof sec_path, "%s.key_secret", base) >= (int)sizeof sec_path) {
-        snprintf(err, errsz, "the name '%.200s...' is too long", base);
+        err_set(err, errsz, "the name '%.200s...' is too long", base);
         return false;
     }
     for (const char *p = name; *p; p++)
         if (*p == '"' || *p == '\n' || *p == '\\') {
-            snprintf(err, errsz, "the name '%s' has a quote, backslash or line break", name);
+            err_set(err, errsz, "the name '%s' has a quote, backslash or line break", name);
             return false;
         }
     struct stat st;
     if (lstat(pub_path, &st) == 0 || lstat(sec_path, &st) == 0) {
-        snprintf(err, errsz, "%s already exists: not overwriting a key (remove %s and %s "
-                 "first if you mean to replace it)", lstat(pub_path, &st) == 0 ? pub_path : sec_path,
-                 pub_path, sec_path);
+        err_set(err, errsz, "%s already exists: not overwriting a key (remove %s and %s "
+                "first if you mean to replace it)", lstat(pub_path, &st) == 0 ? pub_path : sec_path,
+                pub_path, sec_path);
         return false;
     }
     char pub[CURVE_Z85_LEN + 1], sec[CURVE_Z85_LEN + 1];
     if (zmq_curve_keypair(pub, sec) != 0) {
-        snprintf(err, errsz, "cannot make a key pair: %s (is libzmq built with CURVE, i.e. "
-                 "libsodium?)", zmq_strerror(errno));
+        err_set(err, errsz, "cannot make a key pair: %s (is libzmq built with CURVE, i.e. "
+                "libsodium?)", zmq_strerror(errno));
         return false;
     }
     char head[1024], text[1400];
@@ -156,14 +157,14 @@ bool curve_cert_read(const char *path, bool want_secret, curve_cert *out, char *
     memset(out, 0, sizeof *out);
     FILE *fp = fopen(path, "r");
     if (!fp) {
-        snprintf(err, errsz, "cannot read %s: %s%s", path, strerror(errno),
-                 errno == ENOENT ? " (make a key pair with aafarm-keygen NAME)" : "");
+        err_set(err, errsz, "cannot read %s: %s%s", path, strerror(errno),
+                errno == ENOENT ? " (make a key pair with aafarm-keygen NAME)" : "");
         return false;
     }
     struct stat st;
     if (want_secret && fstat(fileno(fp), &st) == 0 && (st.st_mode & 077)) {
-        snprintf(err, errsz, "%s: permissions %04o are too open for a secret key: others could "
-                 "read it (chmod 600 %s)", path, (unsigned)(st.st_mode & 07777), path);
+        err_set(err, errsz, "%s: permissions %04o are too open for a secret key: others could "
+                "read it (chmod 600 %s)", path, (unsigned)(st.st_mode & 07777), path);
         fclose(fp);
         return false;
     }
@@ -182,21 +183,21 @@ bool curve_cert_read(const char *path, bool want_secret, curve_cert *out, char *
         int col = 0;
         const char *why = "";
         if (!parse_value(line, p + skip, target, &col, &why)) {
-            snprintf(err, errsz, "%s:%d:%d: %s (is this a certificate from aafarm-keygen?)", path,
-                     lineno, col, why);
+            err_set(err, errsz, "%s:%d:%d: %s (is this a certificate from aafarm-keygen?)", path,
+                    lineno, col, why);
             ok = false;
         }
     }
     fclose(fp);
     if (!ok) return false;
     if (!out->public_key[0]) {
-        snprintf(err, errsz, "%s: no public-key line: not a ZeroMQ certificate (make one with "
-                 "aafarm-keygen NAME)", path);
+        err_set(err, errsz, "%s: no public-key line: not a ZeroMQ certificate (make one with "
+                "aafarm-keygen NAME)", path);
         return false;
     }
     if (want_secret && !out->secret_key[0]) {
-        snprintf(err, errsz, "%s: no secret-key line: this is a public key; give the "
-                 "NAME.key_secret file", path);
+        err_set(err, errsz, "%s: no secret-key line: this is a public key; give the "
+                "NAME.key_secret file", path);
         return false;
     }
     if (out->secret_key[0]) {
@@ -204,8 +205,8 @@ bool curve_cert_read(const char *path, bool want_secret, curve_cert *out, char *
         char derived[CURVE_Z85_LEN + 1];
         if (zmq_curve_public(derived, out->secret_key) != 0 ||
             strcmp(derived, out->public_key) != 0) {
-            snprintf(err, errsz, "%s: its public-key does not belong to its secret-key (the file "
-                     "was edited; make a new pair with aafarm-keygen)", path);
+            err_set(err, errsz, "%s: its public-key does not belong to its secret-key (the file "
+                    "was edited; make a new pair with aafarm-keygen)", path);
             return false;
         }
     }

@@ -8,7 +8,7 @@
  * sentence "<Message>.<field>: <problem>" and returns -1; nothing here
  * trusts a length or a count that it has not compared with a limit.
  */
-#include "message.h"
+#include "message_pb.h"
 
 #include <math.h>
 #include <stdarg.h>
@@ -16,6 +16,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "util/err.h"
+#include "util/xalloc.h"
 #include "util/hash.h"
 #include "version.h"
 
@@ -44,22 +46,22 @@ proto_limits proto_limits_default(void)
 const char *proto_message_name(proto_kind kind)
 {
     switch (kind) {
-    case AAFARM__ENVELOPE__BODY__NOT_SET: return "(no message)";
-    case AAFARM__ENVELOPE__BODY_HELLO: return "Hello";
-    case AAFARM__ENVELOPE__BODY_WELCOME: return "Welcome";
-    case AAFARM__ENVELOPE__BODY_REJECT: return "Reject";
-    case AAFARM__ENVELOPE__BODY_ASK: return "Ask";
-    case AAFARM__ENVELOPE__BODY_JOB: return "Job";
-    case AAFARM__ENVELOPE__BODY_NEED_JOB: return "NeedJob";
-    case AAFARM__ENVELOPE__BODY_GRANT: return "Grant";
-    case AAFARM__ENVELOPE__BODY_RESULT: return "Result";
-    case AAFARM__ENVELOPE__BODY_FAILURE: return "Failure";
-    case AAFARM__ENVELOPE__BODY_HEARTBEAT: return "Heartbeat";
-    case AAFARM__ENVELOPE__BODY_JOB_DONE: return "JobDone";
-    case AAFARM__ENVELOPE__BODY_SHUTDOWN: return "Shutdown";
-    case AAFARM__ENVELOPE__BODY_NEED_FILE: return "NeedFile";
-    case AAFARM__ENVELOPE__BODY_FILE_CHUNK: return "FileChunk";
-    case AAFARM__ENVELOPE__BODY_FILES_READY: return "FilesReady";
+    case PROTO_NONE: return "(no message)";
+    case PROTO_HELLO: return "Hello";
+    case PROTO_WELCOME: return "Welcome";
+    case PROTO_REJECT: return "Reject";
+    case PROTO_ASK: return "Ask";
+    case PROTO_JOB: return "Job";
+    case PROTO_NEED_JOB: return "NeedJob";
+    case PROTO_GRANT: return "Grant";
+    case PROTO_RESULT: return "Result";
+    case PROTO_FAILURE: return "Failure";
+    case PROTO_HEARTBEAT: return "Heartbeat";
+    case PROTO_JOB_DONE: return "JobDone";
+    case PROTO_SHUTDOWN: return "Shutdown";
+    case PROTO_NEED_FILE: return "NeedFile";
+    case PROTO_FILE_CHUNK: return "FileChunk";
+    case PROTO_FILES_READY: return "FilesReady";
     default: return "(unknown message)";
     }
 }
@@ -67,15 +69,15 @@ const char *proto_message_name(proto_kind kind)
 bool proto_message_from_worker(proto_kind kind)
 {
     switch (kind) {
-    case AAFARM__ENVELOPE__BODY_HELLO:
-    case AAFARM__ENVELOPE__BODY_ASK:
-    case AAFARM__ENVELOPE__BODY_NEED_JOB:
-    case AAFARM__ENVELOPE__BODY_RESULT:
-    case AAFARM__ENVELOPE__BODY_FAILURE:
-    case AAFARM__ENVELOPE__BODY_HEARTBEAT:
-    case AAFARM__ENVELOPE__BODY_SHUTDOWN:
-    case AAFARM__ENVELOPE__BODY_NEED_FILE:
-    case AAFARM__ENVELOPE__BODY_FILES_READY:
+    case PROTO_HELLO:
+    case PROTO_ASK:
+    case PROTO_NEED_JOB:
+    case PROTO_RESULT:
+    case PROTO_FAILURE:
+    case PROTO_HEARTBEAT:
+    case PROTO_SHUTDOWN:
+    case PROTO_NEED_FILE:
+    case PROTO_FILES_READY:
         return true;
     default:
         return false;
@@ -85,14 +87,14 @@ bool proto_message_from_worker(proto_kind kind)
 bool proto_message_from_master(proto_kind kind)
 {
     switch (kind) {
-    case AAFARM__ENVELOPE__BODY_WELCOME:
-    case AAFARM__ENVELOPE__BODY_REJECT:
-    case AAFARM__ENVELOPE__BODY_JOB:
-    case AAFARM__ENVELOPE__BODY_GRANT:
-    case AAFARM__ENVELOPE__BODY_HEARTBEAT:
-    case AAFARM__ENVELOPE__BODY_JOB_DONE:
-    case AAFARM__ENVELOPE__BODY_SHUTDOWN:
-    case AAFARM__ENVELOPE__BODY_FILE_CHUNK:
+    case PROTO_WELCOME:
+    case PROTO_REJECT:
+    case PROTO_JOB:
+    case PROTO_GRANT:
+    case PROTO_HEARTBEAT:
+    case PROTO_JOB_DONE:
+    case PROTO_SHUTDOWN:
+    case PROTO_FILE_CHUNK:
         return true;
     default:
         return false;
@@ -101,7 +103,7 @@ bool proto_message_from_master(proto_kind kind)
 
 bool proto_message_has_bulk(proto_kind kind)
 {
-    return kind == AAFARM__ENVELOPE__BODY_RESULT || kind == AAFARM__ENVELOPE__BODY_FILE_CHUNK;
+    return kind == PROTO_RESULT || kind == PROTO_FILE_CHUNK;
 }
 
 /* ---------------------------------------------------------------------- */
@@ -112,7 +114,7 @@ bool proto_message_has_bulk(proto_kind kind)
 typedef struct checker {
     const proto_limits *limits;
     char *err;
-    size_t errlen;
+    size_t errsz;
 } checker;
 
 #if defined(__GNUC__)
@@ -120,14 +122,13 @@ __attribute__((format(printf, 3, 4)))
 #endif
 static int fail(checker *c, const char *field, const char *fmt, ...)
 {
-    if (c->err && c->errlen > 0) {
-        int n = snprintf(c->err, c->errlen, "%s: ", field);
-        if (n >= 0 && (size_t)n < c->errlen) {
-            va_list ap;
-            va_start(ap, fmt);
-            vsnprintf(c->err + n, c->errlen - (size_t)n, fmt, ap);
-            va_end(ap);
-        }
+    if (c->err && c->errsz > 0) {
+        char what[ERR_LEN];
+        va_list ap;
+        va_start(ap, fmt);
+        vsnprintf(what, sizeof what, fmt, ap);
+        va_end(ap);
+        err_set(c->err, c->errsz, "%s: %s", field, what);
     }
     return -1;
 }
@@ -237,7 +238,7 @@ static int check_unique(checker *c, const char *field, const char *const *names,
 {
     if (n < 2)
         return 0;
-    const char **v = malloc(n * sizeof *v);
+    const char **v = try_malloc(n * sizeof *v);
     if (!v)
         return fail(c, field, "out of memory checking %zu names", n);
     memcpy(v, names, n * sizeof *v);
@@ -307,7 +308,7 @@ static int check_sources(checker *c, const Aafarm__Job *m)
 {
     if (check_count(c, "Job.sources", m->n_sources))
         return -1;
-    const char **names = malloc((m->n_sources + 1) * sizeof *names);
+    const char **names = try_malloc((m->n_sources + 1) * sizeof *names);
     if (!names)
         return fail(c, "Job.sources", "out of memory");
     int rc = 0;
@@ -341,7 +342,7 @@ static int check_bindings(checker *c, const Aafarm__Job *m)
 {
     if (check_count(c, "Job.shaders", m->n_shaders))
         return -1;
-    const char **names = malloc((m->n_shaders + 1) * sizeof *names);
+    const char **names = try_malloc((m->n_shaders + 1) * sizeof *names);
     if (!names)
         return fail(c, "Job.shaders", "out of memory");
     int rc = 0;
@@ -368,7 +369,7 @@ static int check_extra(checker *c, const Aafarm__RenderOptions *o)
 {
     if (check_count(c, "Job.options.extra", o->n_extra))
         return -1;
-    const char **keys = malloc((o->n_extra + 1) * sizeof *keys);
+    const char **keys = try_malloc((o->n_extra + 1) * sizeof *keys);
     if (!keys)
         return fail(c, "Job.options.extra", "out of memory");
     int rc = 0;
@@ -418,7 +419,7 @@ static int check_files(checker *c, const Aafarm__Job *m)
 {
     if (check_count(c, "Job.files", m->n_files))
         return -1;
-    const char **names = malloc((m->n_files + 1) * sizeof *names);
+    const char **names = try_malloc((m->n_files + 1) * sizeof *names);
     if (!names)
         return fail(c, "Job.files", "out of memory");
     int rc = 0;
@@ -625,26 +626,39 @@ static int check_body(checker *c, const Aafarm__Envelope *m, bool has_bulk, size
     }
 }
 
-int proto_message_check(const Aafarm__Envelope *msg, bool has_bulk, size_t bulk_len,
-                        const proto_limits *limits, char *err, size_t errlen)
+bool proto_message_check(const Aafarm__Envelope *msg, bool has_bulk, size_t bulk_len,
+                         const proto_limits *limits, char *err, size_t errsz)
 {
     proto_limits defaults = proto_limits_default();
-    checker c = {limits ? limits : &defaults, err, errlen};
+    checker c = {limits ? limits : &defaults, err, errsz};
     if (!msg)
-        return fail(&c, "Envelope", "missing");
+        return fail(&c, "Envelope", "missing") == 0;
     if (msg->body_case == AAFARM__ENVELOPE__BODY__NOT_SET)
-        return fail(&c, "Envelope", "carries no message (an unknown kind from a newer peer?)");
+        return fail(&c, "Envelope", "carries no message (an unknown kind from a newer peer?)") == 0;
     if (msg->body_case < AAFARM__ENVELOPE__BODY_HELLO ||
         msg->body_case > AAFARM__ENVELOPE__BODY_FILES_READY)
-        return fail(&c, "Envelope", "unknown message kind %d", (int)msg->body_case);
-    const char *name = proto_message_name(msg->body_case);
+        return fail(&c, "Envelope", "unknown message kind %d", (int)msg->body_case) == 0;
+    proto_kind kind = (proto_kind)msg->body_case;
+    const char *name = proto_message_name(kind);
     if (!body_of(msg))
-        return check_present(&c, name, NULL);
-    if (has_bulk && !proto_message_has_bulk(msg->body_case))
+        return check_present(&c, name, NULL) == 0;
+    if (has_bulk && !proto_message_has_bulk(kind))
         return fail(&c, name, "comes with a bulk frame of %zu bytes; only Result has one",
-                    bulk_len);
+                    bulk_len) == 0;
     if (has_bulk && bulk_len > c.limits->max_bulk_bytes)
         return fail(&c, name, "bulk frame of %zu bytes, the limit is %zu", bulk_len,
-                    c.limits->max_bulk_bytes);
-    return check_body(&c, msg, has_bulk, bulk_len);
+                    c.limits->max_bulk_bytes) == 0;
+    return check_body(&c, msg, has_bulk, bulk_len) == 0;
+}
+
+bool proto_msg_check(const proto_msg *msg, bool has_bulk, size_t bulk_len,
+                     const proto_limits *limits, char *err, size_t errsz)
+{
+    if (!msg)
+        return proto_message_check(NULL, has_bulk, bulk_len, limits, err, errsz);
+    envelope_out out;
+    envelope_out_init(&out, msg);
+    bool ok = proto_message_check(&out.env, has_bulk, bulk_len, limits, err, errsz);
+    envelope_out_clear(&out);
+    return ok;
 }

@@ -18,9 +18,9 @@
 
 /* Compares the master's and the worker's protocol versions. Returns 0 when
  * they are equal; otherwise -1 and, when err is not NULL, writes (at most
- * errlen bytes, NUL included) e.g.
+ * errsz bytes, NUL included) e.g.
  *     "master speaks protocol 1, worker 2: upgrade the older side"
  * A version 0 means the peer sent none (a Hello without a version). */
-int proto_version_check(uint32_t master, uint32_t worker, char *err, size_t errlen);
+int proto_version_check(uint32_t master, uint32_t worker, char *err, size_t errsz);
 
 #endif

@@ -18,7 +18,7 @@
  * zmq_socket_monitor: a 6-byte frame with the event number and value,
  * then a frame with the endpoint).
  */
-#include "wire.h"
+#include "wire_pb.h"
 
 #include <errno.h>
 #include <stdarg.h>
@@ -26,6 +26,8 @@
 #include <stdlib.h>
 #include <string.h>
 #include <zmq.h>
+
+#include "util/xalloc.h"
 
 #define MAX_ROUTING_ID 255 /* ZeroMQ routing ids are 1..255 bytes */
 #define LINGER_MS 200
@@ -35,21 +37,15 @@
 /* errors                                                                  */
 /* ---------------------------------------------------------------------- */
 
-static _Thread_local char last_error[256];
-
-const char *wire_last_error(void)
-{
-    return last_error;
-}
-
+/* err_set that also sets errno (callers tell EAGAIN from the rest). */
 #if defined(__GNUC__)
-__attribute__((format(printf, 2, 3)))
+__attribute__((format(printf, 4, 5)))
 #endif
-static void set_error(int errnum, const char *fmt, ...)
+static void set_error(char *err, size_t errsz, int errnum, const char *fmt, ...)
 {
     va_list ap;
     va_start(ap, fmt);
-    vsnprintf(last_error, sizeof last_error, fmt, ap);
+    err_vset(err, errsz, fmt, ap);
     va_end(ap);
     errno = errnum;
 }
@@ -67,7 +63,7 @@ static int socket_type(void *socket)
 /* setup                                                                   */
 /* ---------------------------------------------------------------------- */
 
-int wire_socket_setup(void *socket, const proto_limits *limits)
+int wire_socket_setup(void *socket, const proto_limits *limits, char *err, size_t errsz)
 {
     proto_limits defaults = proto_limits_default();
     const proto_limits *l = limits ? limits : &defaults;
@@ -77,14 +73,14 @@ int wire_socket_setup(void *socket, const proto_limits *limits)
     int linger = LINGER_MS, on = 1;
     int type = socket_type(socket);
     if (type < 0) {
-        set_error(errno, "not a ZeroMQ socket: %s", zmq_strerror(errno));
+        set_error(err, errsz, errno, "not a ZeroMQ socket: %s", zmq_strerror(errno));
         return -1;
     }
     if (zmq_setsockopt(socket, ZMQ_MAXMSGSIZE, &maxmsg, sizeof maxmsg) != 0 ||
         zmq_setsockopt(socket, ZMQ_LINGER, &linger, sizeof linger) != 0 ||
         (type == ZMQ_ROUTER &&
          zmq_setsockopt(socket, ZMQ_ROUTER_MANDATORY, &on, sizeof on) != 0)) {
-        set_error(errno, "setting socket options: %s", zmq_strerror(errno));
+        set_error(err, errsz, errno, "setting socket options: %s", zmq_strerror(errno));
         return -1;
     }
     return 0;
@@ -102,52 +98,49 @@ static void free_packed(void *data, void *hint)
 
 /* Arguments and direction: a ROUTER is the master, a DEALER a worker. */
 static int check_send_args(int type, const void *identity, size_t id_len,
-                           const Aafarm__Envelope *msg)
+                           const Aafarm__Envelope *msg, char *err, size_t errsz)
 {
     if (!msg) {
-        set_error(EINVAL, "wire_send: no message");
+        set_error(err, errsz, EINVAL, "wire_send: no message");
         return -1;
     }
     if (type != ZMQ_ROUTER && type != ZMQ_DEALER) {
-        set_error(EINVAL, "wire_send: the socket is neither ROUTER nor DEALER");
+        set_error(err, errsz, EINVAL, "wire_send: the socket is neither ROUTER nor DEALER");
         return -1;
     }
     if (type == ZMQ_ROUTER && (!identity || id_len == 0 || id_len > MAX_ROUTING_ID)) {
-        set_error(EINVAL, "wire_send: a ROUTER needs the worker's routing id (1..255 bytes)");
+        set_error(err, errsz, EINVAL, "wire_send: a ROUTER needs the worker's routing id (1..255 bytes)");
         return -1;
     }
     if (type == ZMQ_DEALER && identity) {
-        set_error(EINVAL, "wire_send: a DEALER sends no routing id");
+        set_error(err, errsz, EINVAL, "wire_send: a DEALER sends no routing id");
         return -1;
     }
     bool master = type == ZMQ_ROUTER;
-    if (master ? !proto_message_from_master(msg->body_case)
-               : !proto_message_from_worker(msg->body_case)) {
-        set_error(EPROTO, "wire_send: %s is not a message the %s sends",
-                  proto_message_name(msg->body_case), master ? "master" : "worker");
+    proto_kind kind = (proto_kind)msg->body_case;
+    if (master ? !proto_message_from_master(kind) : !proto_message_from_worker(kind)) {
+        set_error(err, errsz, EPROTO, "wire_send: %s is not a message the %s sends",
+                  proto_message_name(kind), master ? "master" : "worker");
         return -1;
     }
     return 0;
 }
 
 /* The packed header as a zero-copy ZeroMQ frame. */
-static int pack_header(const Aafarm__Envelope *msg, const proto_limits *l, zmq_msg_t *frame)
+static int pack_header(const Aafarm__Envelope *msg, const proto_limits *l, zmq_msg_t *frame,
+                       char *err, size_t errsz)
 {
     size_t size = aafarm__envelope__get_packed_size(msg);
     if (size > l->max_header_bytes) {
-        set_error(EMSGSIZE, "wire_send: %s header is %zu bytes, the limit is %zu",
-                  proto_message_name(msg->body_case), size, l->max_header_bytes);
+        set_error(err, errsz, EMSGSIZE, "wire_send: %s header is %zu bytes, the limit is %zu",
+                  proto_message_name((proto_kind)msg->body_case), size, l->max_header_bytes);
         return -1;
     }
-    uint8_t *buf = malloc(size ? size : 1);
-    if (!buf) {
-        set_error(ENOMEM, "wire_send: out of memory");
-        return -1;
-    }
+    uint8_t *buf = xmalloc(size ? size : 1);   /* our own message: never fails */
     aafarm__envelope__pack(msg, buf);
     if (zmq_msg_init_data(frame, buf, size, free_packed, NULL) != 0) {
         free(buf);
-        set_error(errno, "wire_send: %s", zmq_strerror(errno));
+        set_error(err, errsz, errno, "wire_send: %s", zmq_strerror(errno));
         return -1;
     }
     return 0;
@@ -170,35 +163,51 @@ static int send_frames(void *socket, const void *identity, size_t id_len, zmq_ms
     return 0;
 }
 
-int wire_send_limited(void *socket, const proto_limits *limits, const void *identity,
-                      size_t id_len, const Aafarm__Envelope *msg, const void *bulk,
-                      size_t bulk_len)
+int wire_send_envelope(void *socket, const proto_limits *limits, const void *identity,
+                       size_t id_len, const Aafarm__Envelope *msg, const void *bulk,
+                       size_t bulk_len, char *err, size_t errsz)
 {
     proto_limits defaults = proto_limits_default();
     const proto_limits *l = limits ? limits : &defaults;
-    last_error[0] = '\0';
-    if (check_send_args(socket_type(socket), identity, id_len, msg) != 0)
+    if (check_send_args(socket_type(socket), identity, id_len, msg, err, errsz) != 0)
         return -1;
-    char why[200];
-    if (proto_message_check(msg, bulk != NULL, bulk_len, l, why, sizeof why) != 0) {
-        set_error(EPROTO, "wire_send: %s", why);
+    char why[ERR_LEN];
+    if (!proto_message_check(msg, bulk != NULL, bulk_len, l, why, sizeof why)) {
+        set_error(err, errsz, EPROTO, "wire_send: %s", why);
         return -1;
     }
     zmq_msg_t header;
-    if (pack_header(msg, l, &header) != 0)
+    if (pack_header(msg, l, &header, err, errsz) != 0)
         return -1;
     if (send_frames(socket, identity, id_len, &header, bulk, bulk_len) != 0) {
-        set_error(errno, "wire_send: %s: %s", proto_message_name(msg->body_case),
-                  zmq_strerror(errno));
+        set_error(err, errsz, errno, "wire_send: %s: %s",
+                  proto_message_name((proto_kind)msg->body_case), zmq_strerror(errno));
         return -1;
     }
     return 0;
 }
 
-int wire_send(void *socket, const void *identity, size_t id_len, const Aafarm__Envelope *msg,
-              const void *bulk, size_t bulk_len)
+int wire_send_limited(void *socket, const proto_limits *limits, const void *identity,
+                      size_t id_len, const proto_msg *msg, const void *bulk, size_t bulk_len,
+                      char *err, size_t errsz)
 {
-    return wire_send_limited(socket, NULL, identity, id_len, msg, bulk, bulk_len);
+    if (!msg)
+        return wire_send_envelope(socket, limits, identity, id_len, NULL, bulk, bulk_len, err,
+                                  errsz);
+    envelope_out out;
+    envelope_out_init(&out, msg);
+    int rc = wire_send_envelope(socket, limits, identity, id_len, &out.env, bulk, bulk_len, err,
+                                errsz);
+    int e = errno;
+    envelope_out_clear(&out);
+    errno = e;
+    return rc;
+}
+
+int wire_send(void *socket, const void *identity, size_t id_len, const proto_msg *msg,
+              const void *bulk, size_t bulk_len, char *err, size_t errsz)
+{
+    return wire_send_limited(socket, NULL, identity, id_len, msg, bulk, bulk_len, err, errsz);
 }
 
 /* ---------------------------------------------------------------------- */
@@ -213,6 +222,8 @@ typedef struct unpack_budget {
 
 struct wire_msg {
     Aafarm__Envelope *env;
+    proto_msg body;     /* the plain view of env */
+    void *body_block;   /* its arrays (proto_msg_view) */
     zmq_msg_t bulk;
     bool has_bulk;
     uint8_t identity[MAX_ROUTING_ID];
@@ -221,6 +232,8 @@ struct wire_msg {
     ProtobufCAllocator allocator;
 };
 
+/* A peer chose the sizes: past the budget, or out of memory, protobuf-c
+ * gets NULL and the message is refused (never an abort). */
 static void *budget_alloc(void *data, size_t size)
 {
     unpack_budget *b = data;
@@ -229,7 +242,7 @@ static void *budget_alloc(void *data, size_t size)
         return NULL;
     }
     b->left -= size;
-    return malloc(size ? size : 1);
+    return try_malloc(size ? size : 1);
 }
 
 static void budget_free(void *data, void *p)
@@ -247,6 +260,7 @@ void wire_msg_destroy(wire_msg **self_p)
         protobuf_c_message_free_unpacked(&self->env->base, &self->allocator);
     if (self->has_bulk)
         zmq_msg_close(&self->bulk);
+    free(self->body_block);
     free(self);
     *self_p = NULL;
 }
@@ -256,9 +270,14 @@ const Aafarm__Envelope *wire_msg_envelope(const wire_msg *self)
     return self ? self->env : NULL;
 }
 
+const proto_msg *wire_msg_body(const wire_msg *self)
+{
+    return self && self->env ? &self->body : NULL;
+}
+
 proto_kind wire_msg_kind(const wire_msg *self)
 {
-    return self && self->env ? self->env->body_case : AAFARM__ENVELOPE__BODY__NOT_SET;
+    return self && self->env ? (proto_kind)self->env->body_case : PROTO_NONE;
 }
 
 const uint8_t *wire_msg_bulk(const wire_msg *self, size_t *len)
@@ -334,7 +353,7 @@ typedef struct receiver {
     bool router;
     frames f;
     wire_msg *msg;
-    char why[200];
+    char why[ERR_LEN];
 } receiver;
 
 #if defined(__GNUC__)
@@ -399,14 +418,17 @@ static verdict unpack(receiver *r, zmq_msg_t *header)
 static verdict judge(receiver *r, bool has_bulk, size_t bulk_len)
 {
     const Aafarm__Envelope *env = r->msg->env;
-    if (proto_message_check(env, has_bulk, bulk_len, r->limits, r->why, sizeof r->why) != 0)
+    if (!proto_message_check(env, has_bulk, bulk_len, r->limits, r->why, sizeof r->why))
         return V_INVALID;
-    bool ok = r->router ? proto_message_from_worker(env->body_case)
-                        : proto_message_from_master(env->body_case);
+    proto_kind kind = (proto_kind)env->body_case;
+    bool ok = r->router ? proto_message_from_worker(kind) : proto_message_from_master(kind);
     if (!ok)
         return reject(r, V_INVALID, "%s is a %s's message; it cannot arrive at the %s",
-                      proto_message_name(env->body_case), r->router ? "master" : "worker",
+                      proto_message_name(kind), r->router ? "master" : "worker",
                       r->router ? "master" : "worker");
+    if (!proto_msg_view(env, &r->msg->body, &r->msg->body_block))
+        return reject(r, V_UNDECODABLE, "out of memory for the %s's arrays",
+                      proto_message_name(kind));
     return V_OK;
 }
 
@@ -450,7 +472,7 @@ static void count(wire_stats *stats, verdict v)
 }
 
 /* "from peer 00 6b 8b 45 67: <why>" (ROUTER) or "from the master: <why>". */
-static void explain(receiver *r, wire_stats *stats)
+static void explain(receiver *r, wire_stats *stats, char *err, size_t errsz)
 {
     char peer[2 * 16 + 16] = "the master";
     if (r->router && r->f.kept > 0) {
@@ -462,33 +484,33 @@ static void explain(receiver *r, wire_stats *stats)
         if (n > 16)
             snprintf(peer + at, sizeof peer - (size_t)at, "...");
     }
-    set_error(EPROTO, "dropped a message from %s: %s", peer, r->why);
+    set_error(err, errsz, EPROTO, "dropped a message from %s: %s", peer, r->why);
     if (stats)
-        snprintf(stats->last_error, sizeof stats->last_error, "%s", last_error);
+        err_set(stats->last_error, sizeof stats->last_error, "dropped a message from %s: %s",
+                peer, r->why);
 }
 
-wire_msg *wire_recv(void *socket, const proto_limits *limits, wire_stats *stats, int flags)
+wire_msg *wire_recv(void *socket, const proto_limits *limits, wire_stats *stats, int flags,
+                    char *err, size_t errsz)
 {
     proto_limits defaults = proto_limits_default();
     receiver r = {.limits = limits ? limits : &defaults};
     int type = socket_type(socket);
     if (type != ZMQ_ROUTER && type != ZMQ_DEALER) {
-        set_error(type < 0 ? errno : ENOTSUP, "wire_recv: the socket is neither ROUTER nor DEALER");
+        set_error(err, errsz, type < 0 ? errno : ENOTSUP, "wire_recv: the socket is neither ROUTER nor DEALER");
         return NULL;
     }
     r.router = type == ZMQ_ROUTER;
     if (frames_read(socket, flags, &r.f) != 0) {
-        set_error(errno, "wire_recv: %s", zmq_strerror(errno));
+        set_error(err, errsz, errno, "wire_recv: %s", zmq_strerror(errno));
         return NULL;
     }
-    r.msg = calloc(1, sizeof *r.msg);
+    r.msg = try_calloc(1, sizeof *r.msg);
     verdict v = r.msg ? receive_stages(&r) : reject(&r, V_INVALID, "out of memory");
     count(stats, v);
     if (v != V_OK) {
-        explain(&r, stats);
+        explain(&r, stats, err, errsz);
         wire_msg_destroy(&r.msg);
-    } else {
-        last_error[0] = '\0';
     }
     frames_close(&r.f);
     if (v != V_OK)
@@ -505,23 +527,19 @@ struct wire_monitor {
     void *pair;     /* where its events arrive */
 };
 
-wire_monitor *wire_monitor_new(void *ctx, void *socket)
+wire_monitor *wire_monitor_new(void *ctx, void *socket, char *err, size_t errsz)
 {
     static _Atomic unsigned long serial;
     char endpoint[64];
     snprintf(endpoint, sizeof endpoint, "inproc://wire-monitor-%lu", ++serial);
-    wire_monitor *self = calloc(1, sizeof *self);
-    if (!self) {
-        set_error(ENOMEM, "wire_monitor_new: out of memory");
-        return NULL;
-    }
+    wire_monitor *self = xcalloc(1, sizeof *self);
     int events = ZMQ_EVENT_CONNECTED | ZMQ_EVENT_ACCEPTED | ZMQ_EVENT_DISCONNECTED |
                  ZMQ_EVENT_HANDSHAKE_FAILED_NO_DETAIL | ZMQ_EVENT_HANDSHAKE_FAILED_PROTOCOL |
                  ZMQ_EVENT_HANDSHAKE_FAILED_AUTH;
     self->watched = socket;
     if (zmq_socket_monitor(socket, endpoint, events) != 0 ||
         !(self->pair = zmq_socket(ctx, ZMQ_PAIR)) || zmq_connect(self->pair, endpoint) != 0) {
-        set_error(errno, "wire_monitor_new: %s", zmq_strerror(errno));
+        set_error(err, errsz, errno, "wire_monitor_new: %s", zmq_strerror(errno));
         wire_monitor_destroy(&self);
         return NULL;
     }
@@ -566,10 +584,10 @@ static int read_event(void *pair, char *where_out, size_t wheresz)
     return event;
 }
 
-int wire_monitor_poll(wire_monitor *self, wire_stats *stats)
+int wire_monitor_poll(wire_monitor *self, wire_stats *stats, char *err, size_t errsz)
 {
     if (!self || !self->pair) {
-        set_error(EINVAL, "wire_monitor_poll: no monitor");
+        set_error(err, errsz, EINVAL, "wire_monitor_poll: no monitor");
         return -1;
     }
     int n = 0;
@@ -594,7 +612,7 @@ int wire_monitor_poll(wire_monitor *self, wire_stats *stats)
         }
     }
     if (errno != EAGAIN) {
-        set_error(errno, "wire_monitor_poll: %s", zmq_strerror(errno));
+        set_error(err, errsz, errno, "wire_monitor_poll: %s", zmq_strerror(errno));
         return -1;
     }
     return n;

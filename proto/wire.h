@@ -20,8 +20,11 @@
  * wire_send() checks the outgoing message the same way, so a bug on one
  * side shows up where it is made and not as a dropped message at the other.
  *
- * Errors: functions that fail return -1 or NULL and set errno; the words
- * for the last failure in this thread are in wire_last_error().
+ * The master and the worker send and receive proto_msg (message.h); the
+ * Envelope they travel in is proto's business (wire_pb.h, internal).
+ *
+ * Errors: functions that fail return -1 or NULL, set errno, and write
+ * the words into err (err_set, util/err.h; err may be NULL).
  */
 #ifndef PROTO_WIRE_H
 #define PROTO_WIRE_H
@@ -31,6 +34,7 @@
 #include <stdint.h>
 
 #include "message.h"
+#include "util/err.h"
 
 /* Counters of one socket's traffic (zero-initialise; share one per socket). */
 typedef struct wire_stats {
@@ -47,7 +51,7 @@ typedef struct wire_stats {
     uint64_t auth_failures;      /* of those: refused by authentication (CURVE
                                     key not allowed, ZAP status 400) */
     char last_handshake[160];    /* the last failure: its kind and endpoint */
-    char last_error[256];  /* why the last message was dropped */
+    char last_error[ERR_LEN];  /* why the last message was dropped */
 } wire_stats;
 
 /* Sets the options aafarm relies on: ZMQ_MAXMSGSIZE to the largest frame
@@ -56,23 +60,23 @@ typedef struct wire_stats {
  * ZMQ_ROUTER_MANDATORY (sending to an unknown worker fails with
  * EHOSTUNREACH instead of vanishing). Call before bind/connect. limits NULL
  * means proto_limits_default(). Returns 0, or -1 with errno set. */
-int wire_socket_setup(void *socket, const proto_limits *limits);
+int wire_socket_setup(void *socket, const proto_limits *limits, char *err, size_t errsz);
 
 /* Sends one message and never blocks. On a ROUTER, identity[0..id_len) is
  * the worker's routing id (1..255 bytes); on a DEALER identity must be NULL.
  * bulk[0..bulk_len) becomes the bulk frame (Result only; NULL otherwise).
  * The message is checked with proto_message_check() and for its direction
  * first. Returns 0, or -1 with errno: EINVAL (bad arguments or socket type),
- * EPROTO (the message fails the checks; see wire_last_error()), EMSGSIZE
+ * EPROTO (the message fails the checks; err says how), EMSGSIZE
  * (the header exceeds max_header_bytes), or ZeroMQ's (EAGAIN: the peer's
  * queue is full; EHOSTUNREACH: no such worker on this ROUTER). */
-int wire_send(void *socket, const void *identity, size_t id_len, const Aafarm__Envelope *msg,
-              const void *bulk, size_t bulk_len);
+int wire_send(void *socket, const void *identity, size_t id_len, const proto_msg *msg,
+              const void *bulk, size_t bulk_len, char *err, size_t errsz);
 
 /* wire_send with explicit limits (NULL: the defaults). */
 int wire_send_limited(void *socket, const proto_limits *limits, const void *identity,
-                      size_t id_len, const Aafarm__Envelope *msg, const void *bulk,
-                      size_t bulk_len);
+                      size_t id_len, const proto_msg *msg, const void *bulk,
+                      size_t bulk_len, char *err, size_t errsz);
 
 /* One received, checked message. */
 typedef struct wire_msg wire_msg;
@@ -82,18 +86,20 @@ typedef struct wire_msg wire_msg;
  * or NULL with errno:
  *   EAGAIN  nothing queued (ZMQ_DONTWAIT), or the socket's ZMQ_RCVTIMEO ran out;
  *   EPROTO  one malformed message was read, counted in stats (when not
- *           NULL) and dropped; stats->last_error and wire_last_error() say
- *           why and from which peer. The socket is fine: call again;
+ *           NULL) and dropped; stats->last_error and err say why and
+ *           from which peer. The socket is fine: call again;
  *   ENOTSUP the socket is neither ROUTER nor DEALER;
  *   otherwise ZeroMQ's error (ETERM, EINTR, ...).
  * limits NULL means proto_limits_default(). */
-wire_msg *wire_recv(void *socket, const proto_limits *limits, wire_stats *stats, int flags);
+wire_msg *wire_recv(void *socket, const proto_limits *limits, wire_stats *stats, int flags,
+                    char *err, size_t errsz);
 
 /* Frees the message and everything it points to; sets *self_p to NULL. */
 void wire_msg_destroy(wire_msg **self_p);
 
-/* The checked header; valid until the message is destroyed. */
-const Aafarm__Envelope *wire_msg_envelope(const wire_msg *self);
+/* The checked message; valid until the wire_msg is destroyed (its strings
+ * and arrays point into it). */
+const proto_msg *wire_msg_body(const wire_msg *self);
 
 /* The kind of message (the Envelope's oneof case). */
 proto_kind wire_msg_kind(const wire_msg *self);
@@ -103,10 +109,6 @@ const uint8_t *wire_msg_bulk(const wire_msg *self, size_t *len);
 
 /* The sender's routing id (ROUTER side), or NULL and 0 (DEALER side). */
 const uint8_t *wire_msg_identity(const wire_msg *self, size_t *len);
-
-/* The words for the last failure of a wire_ function in this thread
- * ("" when there was none). */
-const char *wire_last_error(void);
 
 /* ---- socket monitor: what ZeroMQ does without telling the socket ----
  *
@@ -118,11 +120,11 @@ typedef struct wire_monitor wire_monitor;
 
 /* Starts monitoring socket (created in ctx). Returns NULL with errno on
  * failure. Destroy the monitor before closing the socket. */
-wire_monitor *wire_monitor_new(void *ctx, void *socket);
+wire_monitor *wire_monitor_new(void *ctx, void *socket, char *err, size_t errsz);
 
 /* Reads every pending event without waiting and adds it to stats. Returns
  * the number of events read, or -1 with errno. */
-int wire_monitor_poll(wire_monitor *self, wire_stats *stats);
+int wire_monitor_poll(wire_monitor *self, wire_stats *stats, char *err, size_t errsz);
 
 /* The PAIR socket the events arrive on, to include in a zmq_poll set. */
 void *wire_monitor_socket(wire_monitor *self);

@@ -15,6 +15,7 @@
 #include <string.h>
 
 #include "file_store.h"
+#include "util/xalloc.h"
 
 enum { POLL_MS = 100, MAX_ATTEMPTS = 3 };
 
@@ -41,8 +42,7 @@ struct file_fetch {
 
 file_fetch *file_fetch_new(const file_fetch_options *opt)
 {
-    file_fetch *self = calloc(1, sizeof *self);
-    if (!self) abort();
+    file_fetch *self = xcalloc(1, sizeof *self);
     self->opt = *opt;
     if (!self->opt.chunk) self->opt.chunk = 1u << 20;
     if (!self->opt.inflight) self->opt.inflight = 8u << 20;
@@ -61,7 +61,7 @@ void fetch_job_destroy(fetch_job **self_p)
     }
     free(j->paths);
     free(j->fds);
-    free(j->packed);
+    proto_saved_job_destroy(&j->msg);
     free(j);
     *self_p = NULL;
 }
@@ -103,21 +103,16 @@ static void job_fail(fetch_job *j, const char *fmt, const char *a, const char *b
     if (n < 0) j->error[0] = '?';
 }
 
-void file_fetch_add(file_fetch *self, const Aafarm__Job *m, int64_t now_ms)
+void file_fetch_add(file_fetch *self, const proto_job *m, int64_t now_ms)
 {
     (void)now_ms;
     if (file_fetch_waiting(self, m->job_hash)) return;
-    fetch_job *j = calloc(1, sizeof *j);
-    if (!j) abort();
+    fetch_job *j = xcalloc(1, sizeof *j);
     snprintf(j->hash, sizeof j->hash, "%s", m->job_hash);
-    j->packed_len = aafarm__job__get_packed_size(m);
-    j->packed = malloc(j->packed_len + 1);
-    if (!j->packed) abort();
-    aafarm__job__pack(m, j->packed);
+    j->msg = proto_saved_job_new(m);
     j->nfiles = (int)m->n_files;
-    j->paths = calloc((size_t)j->nfiles + 1, sizeof *j->paths);
-    j->fds = calloc((size_t)j->nfiles + 1, sizeof *j->fds);
-    if (!j->paths || !j->fds) abort();
+    j->paths = xcalloc((size_t)j->nfiles + 1, sizeof *j->paths);
+    j->fds = xcalloc((size_t)j->nfiles + 1, sizeof *j->fds);
     for (int i = 0; i < j->nfiles; i++) j->fds[i] = -1;
     fetch_job **tail = &self->jobs;
     while (*tail) tail = &(*tail)->next;
@@ -130,18 +125,17 @@ void file_fetch_add(file_fetch *self, const Aafarm__Job *m, int64_t now_ms)
         return;
     }
     for (int i = 0; i < j->nfiles; i++) {
-        const Aafarm__FileRef *f = m->files[i];
+        const proto_file_ref *f = &m->files[i];
         char path[PATH_MAX + 100];
         j->fds[i] = file_store_acquire(self->store, f->sha256, f->size, path, sizeof path);
         if (j->fds[i] >= 0) {
-            j->paths[i] = strdup(path);
+            j->paths[i] = xstrdup(path);
             j->hits++;
             continue;
         }
         j->misses++;
         if (find_want(self, f->sha256)) continue;
-        want *w = calloc(1, sizeof *w);
-        if (!w) abort();
+        want *w = xcalloc(1, sizeof *w);
         snprintf(w->sha256, sizeof w->sha256, "%s", f->sha256);
         w->size = f->size;
         snprintf(w->job_hash, sizeof w->job_hash, "%s", j->hash);
@@ -155,18 +149,13 @@ static void deliver(file_fetch *self, const char *sha)
 {
     for (fetch_job *j = self->jobs; j; j = j->next) {
         if (j->error[0]) continue;
-        Aafarm__Job *m = aafarm__job__unpack(NULL, j->packed_len, j->packed);
-        if (!m) {
-            job_fail(j, "job %.12s...: %s", j->hash, "its Job message cannot be read back");
-            continue;
-        }
+        const proto_job *m = proto_saved_job_get(j->msg);
         for (int i = 0; i < j->nfiles; i++) {
-            if (j->fds[i] >= 0 || strcmp(m->files[i]->sha256, sha) != 0) continue;
+            if (j->fds[i] >= 0 || strcmp(m->files[i].sha256, sha) != 0) continue;
             char path[PATH_MAX + 100];
-            j->fds[i] = file_store_acquire(self->store, sha, m->files[i]->size, path, sizeof path);
-            if (j->fds[i] >= 0) j->paths[i] = strdup(path);
+            j->fds[i] = file_store_acquire(self->store, sha, m->files[i].size, path, sizeof path);
+            if (j->fds[i] >= 0) j->paths[i] = xstrdup(path);
         }
-        aafarm__job__free_unpacked(m, NULL);
     }
     file_store_evict(self->store);
 }
@@ -176,11 +165,10 @@ static const fetch_job *needing(const file_fetch *self, const want *w)
 {
     for (const fetch_job *j = self->jobs; j; j = j->next) {
         if (j->error[0]) continue;
-        Aafarm__Job *m = aafarm__job__unpack(NULL, j->packed_len, j->packed);
+        const proto_job *m = proto_saved_job_get(j->msg);
         bool needs = false;
-        for (int i = 0; m && i < j->nfiles && !needs; i++)
-            needs = j->fds[i] < 0 && strcmp(m->files[i]->sha256, w->sha256) == 0;
-        if (m) aafarm__job__free_unpacked(m, NULL);
+        for (int i = 0; i < j->nfiles && !needs; i++)
+            needs = j->fds[i] < 0 && strcmp(m->files[i].sha256, w->sha256) == 0;
         if (needs) return j;
     }
     return NULL;
@@ -208,11 +196,10 @@ static void fail_file(file_fetch *self, const want *w, const char *why)
 {
     for (fetch_job *j = self->jobs; j; j = j->next) {
         if (j->error[0]) continue;
-        Aafarm__Job *m = aafarm__job__unpack(NULL, j->packed_len, j->packed);
-        for (int i = 0; m && i < j->nfiles; i++)
-            if (j->fds[i] < 0 && strcmp(m->files[i]->sha256, w->sha256) == 0)
+        const proto_job *m = proto_saved_job_get(j->msg);
+        for (int i = 0; i < j->nfiles; i++)
+            if (j->fds[i] < 0 && strcmp(m->files[i].sha256, w->sha256) == 0)
                 job_fail(j, "a file of this job (%.12s...) cannot be had: %s", w->sha256, why);
-        if (m) aafarm__job__free_unpacked(m, NULL);
     }
 }
 
@@ -288,7 +275,7 @@ void file_fetch_pump(file_fetch *self, int64_t now_ms, file_fetch_send_fn send, 
     }
 }
 
-uint64_t file_fetch_chunk(file_fetch *self, const Aafarm__FileChunk *c, const uint8_t *data,
+uint64_t file_fetch_chunk(file_fetch *self, const proto_file_chunk *c, const uint8_t *data,
                           size_t len, int64_t now_ms)
 {
     want *w = find_want(self, c->sha256);

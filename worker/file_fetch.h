@@ -5,7 +5,7 @@
  *
  * A Job names its files by SHA-256. file_fetch_add looks each one up in
  * the host's store (file_store.h); the job is ready when all are there.
- * Otherwise the job waits here (its Job message kept packed) while the
+ * Otherwise the job waits here (a copy of its Job message kept) while the
  * missing files are fetched from the master in chunks (NeedFile ->
  * FileChunk), with at most `inflight` bytes asked for and not received at
  * any time, or while another worker process of the host fetches them
@@ -22,7 +22,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "aafarm.pb-c.h"
+#include "message.h"
 #include "util/hash.h"
 
 typedef struct file_fetch_options {
@@ -36,8 +36,7 @@ typedef struct file_fetch_options {
 /* A job whose files are being gathered, or are all present. */
 typedef struct fetch_job {
     char hash[HASH_HEX_SIZE];
-    uint8_t *packed;               /* the Job message */
-    size_t packed_len;
+    proto_saved_job *msg;          /* the Job message */
     int nfiles;
     char **paths;                  /* per Job.files entry: its path in the store */
     int *fds;                      /* ... and its "in use" descriptor (-1: absent) */
@@ -56,7 +55,7 @@ void file_fetch_destroy(file_fetch **self_p);
  * process uses it: run it beside the loop) and keeps it until they are
  * all present (file_fetch_take_ready hands it back then, possibly at
  * once). A job already waiting is not added twice. */
-void file_fetch_add(file_fetch *self, const Aafarm__Job *m, int64_t now_ms);
+void file_fetch_add(file_fetch *self, const proto_job *m, int64_t now_ms);
 
 /* Is a job with this hash waiting for its files? */
 bool file_fetch_waiting(const file_fetch *self, const char *hash);
@@ -78,7 +77,7 @@ void file_fetch_pump(file_fetch *self, int64_t now_ms, file_fetch_send_fn send, 
 /* A FileChunk arrived: its bytes are written (cheap; the hash of a
  * complete file is checked by file_fetch_poll). Returns the bytes it
  * added (0: not wanted). */
-uint64_t file_fetch_chunk(file_fetch *self, const Aafarm__FileChunk *c, const uint8_t *data,
+uint64_t file_fetch_chunk(file_fetch *self, const proto_file_chunk *c, const uint8_t *data,
                           size_t len, int64_t now_ms);
 
 /* A job whose files are all present (or that failed: ->error), removed

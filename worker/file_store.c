@@ -19,6 +19,9 @@
 #include <unistd.h>
 
 #include "util/hash.h"
+#include "util/err.h"
+#include "util/fdio.h"
+#include "util/xalloc.h"
 
 struct file_store {
     char dir[PATH_MAX];
@@ -80,8 +83,8 @@ file_store *file_store_open(const char *dir, uint64_t budget, char *err, size_t 
     for (int i = 0; i < 3; i++) {
         snprintf(sub, sizeof sub, "%s/%s", dir, subs[i]);
         if (make_dirs(sub) != 0 || access(sub, W_OK | X_OK) != 0) {
-            snprintf(err, errsz, "cannot use the file cache folder '%s': %s (give another with "
-                     "--file-cache DIR)", sub, strerror(errno));
+            err_set(err, errsz, "cannot use the file cache folder '%s': %s (give another with "
+                    "--file-cache DIR)", sub, strerror(errno));
             return NULL;
         }
     }
@@ -89,13 +92,12 @@ file_store *file_store_open(const char *dir, uint64_t budget, char *err, size_t 
      * a hash we trust once checked: refuse it */
     struct stat st;
     if (stat(dir, &st) != 0 || st.st_uid != getuid() || (st.st_mode & 022)) {
-        snprintf(err, errsz, "the file cache folder '%s' is not this user's own (owner %u, mode "
-                 "%03o): give another with --file-cache DIR", dir, (unsigned)st.st_uid,
-                 (unsigned)(st.st_mode & 0777));
+        err_set(err, errsz, "the file cache folder '%s' is not this user's own (owner %u, mode "
+                "%03o): give another with --file-cache DIR", dir, (unsigned)st.st_uid,
+                (unsigned)(st.st_mode & 0777));
         return NULL;
     }
-    file_store *self = calloc(1, sizeof *self);
-    if (!self) abort();
+    file_store *self = xcalloc(1, sizeof *self);
     snprintf(self->dir, sizeof self->dir, "%s", dir);
     self->budget = budget;
     return self;
@@ -130,8 +132,7 @@ static void mark_verified(file_store *s, const char *sha)
     if (is_verified(s, sha)) return;
     if (s->nverified == s->cap) {
         s->cap = s->cap ? 2 * s->cap : 16;
-        s->verified = realloc(s->verified, s->cap * sizeof *s->verified);
-        if (!s->verified) abort();
+        s->verified = xrealloc(s->verified, s->cap * sizeof *s->verified);
     }
     snprintf(s->verified[s->nverified++], HASH_HEX_SIZE, "%s", sha);
 }
@@ -268,8 +269,7 @@ static entry *list_objects(const file_store *s, size_t *n, uint64_t *total)
         if (fstatat(dirfd(d), de->d_name, &st, 0) != 0 || !S_ISREG(st.st_mode)) continue;
         if (*n == cap) {
             cap = cap ? 2 * cap : 32;
-            v = realloc(v, cap * sizeof *v);
-            if (!v) abort();
+            v = xrealloc(v, cap * sizeof *v);
         }
         memcpy(v[*n].name, de->d_name, HASH_HEX_SIZE);   /* 64 hex digits and the NUL */
         v[*n].size = (uint64_t)st.st_size;
@@ -338,20 +338,6 @@ static uint64_t get_be64(const unsigned char *p)
     return v;
 }
 
-static bool write_all(int fd, const void *data, size_t len, uint64_t off)
-{
-    const unsigned char *p = data;
-    while (len > 0) {
-        ssize_t n = pwrite(fd, p, len, (off_t)off);
-        if (n < 0 && errno == EINTR) continue;
-        if (n <= 0) return false;
-        p += n;
-        len -= (size_t)n;
-        off += (uint64_t)n;
-    }
-    return true;
-}
-
 static void transfer_free(file_transfer *t)
 {
     if (t->data_fd >= 0) close(t->data_fd);
@@ -374,8 +360,7 @@ static bool load_map(file_transfer *t)
         uint32_t chunk = (uint32_t)get_be64(head);
         size_t n = (size_t)((t->size + chunk - 1) / chunk);
         if ((uint64_t)st.st_size == MAP_HEADER + n && n != t->nchunks) {
-            unsigned char *have = realloc(t->have, n + 1), *asked = realloc(t->asked, n + 1);
-            if (!have || !asked) abort();
+            unsigned char *have = xrealloc(t->have, n + 1), *asked = xrealloc(t->asked, n + 1);
             t->have = have;
             t->asked = asked;
             memset(t->asked, 0, n + 1);
@@ -399,8 +384,8 @@ static bool load_map(file_transfer *t)
     put_be64(head + 8, t->size);
     return ftruncate(t->map_fd, 0) == 0 && ftruncate(t->data_fd, 0) == 0 &&
            ftruncate(t->data_fd, (off_t)t->size) == 0 &&
-           write_all(t->map_fd, head, MAP_HEADER, 0) &&
-           (t->nchunks == 0 || write_all(t->map_fd, t->have, t->nchunks, MAP_HEADER));
+           fd_pwrite_all(t->map_fd, head, MAP_HEADER, 0) &&
+           (t->nchunks == 0 || fd_pwrite_all(t->map_fd, t->have, t->nchunks, MAP_HEADER));
 }
 
 file_begin file_store_begin(file_store *self, const char *sha, uint64_t size, uint32_t chunk,
@@ -412,23 +397,21 @@ file_begin file_store_begin(file_store *self, const char *sha, uint64_t size, ui
     if (sub_path(self, lock, sizeof lock, "partial", sha, ".lock") != 0 ||
         sub_path(self, data, sizeof data, "partial", sha, "") != 0 ||
         sub_path(self, map, sizeof map, "partial", sha, ".have") != 0) {
-        snprintf(err, errsz, "the file cache folder's name is too long");
+        err_set(err, errsz, "the file cache folder's name is too long");
         return FILE_BEGIN_ERROR;
     }
-    file_transfer *t = calloc(1, sizeof *t);
-    if (!t) abort();
+    file_transfer *t = xcalloc(1, sizeof *t);
     t->store = self;
     t->data_fd = t->map_fd = -1;
     snprintf(t->sha256, sizeof t->sha256, "%s", sha);
     t->size = size;
     t->chunk = chunk ? chunk : 1;
     t->nchunks = (size_t)((size + t->chunk - 1) / t->chunk);
-    t->have = calloc(t->nchunks + 1, 1);
-    t->asked = calloc(t->nchunks + 1, 1);
-    if (!t->have || !t->asked) abort();
+    t->have = xcalloc(t->nchunks + 1, 1);
+    t->asked = xcalloc(t->nchunks + 1, 1);
     t->lock_fd = open(lock, O_RDWR | O_CREAT | O_CLOEXEC, 0600);
     if (t->lock_fd < 0) {
-        snprintf(err, errsz, "cannot create '%s': %s", lock, strerror(errno));
+        err_set(err, errsz, "cannot create '%s': %s", lock, strerror(errno));
         transfer_free(t);
         return FILE_BEGIN_ERROR;
     }
@@ -443,7 +426,7 @@ file_begin file_store_begin(file_store *self, const char *sha, uint64_t size, ui
     t->data_fd = open(data, O_RDWR | O_CREAT | O_CLOEXEC, 0600);
     t->map_fd = open(map, O_RDWR | O_CREAT | O_CLOEXEC, 0600);
     if (t->data_fd < 0 || t->map_fd < 0 || !load_map(t)) {
-        snprintf(err, errsz, "cannot write the file cache's '%s': %s", data, strerror(errno));
+        err_set(err, errsz, "cannot write the file cache's '%s': %s", data, strerror(errno));
         transfer_free(t);
         return FILE_BEGIN_ERROR;
     }
@@ -478,11 +461,11 @@ long file_transfer_put(file_transfer *t, uint64_t offset, const void *data, size
     if (len != (left < t->chunk ? left : t->chunk) || t->have[i]) return 0;
     static const unsigned char one = 1;
     /* the bytes first, then the map: a crash in between costs one chunk */
-    if (!write_all(t->data_fd, data, len, offset) ||
-        !write_all(t->map_fd, &one, 1, MAP_HEADER + (uint64_t)i)) {
-        snprintf(err, errsz, "cannot write to the file cache %s: %s (free space there, or give "
-                 "another folder with --file-cache DIR)", t->store->dir,
-                 strerror(errno ? errno : EIO));
+    if (!fd_pwrite_all(t->data_fd, data, len, offset) ||
+        !fd_pwrite_all(t->map_fd, &one, 1, MAP_HEADER + (uint64_t)i)) {
+        err_set(err, errsz, "cannot write to the file cache %s: %s (free space there, or give "
+                "another folder with --file-cache DIR)", t->store->dir,
+                strerror(errno ? errno : EIO));
         return -1;
     }
     t->have[i] = 1;
@@ -528,12 +511,12 @@ int file_transfer_finish(file_transfer **self_p, char *err, size_t errsz)
     uint64_t len = 0;
     int rc = 0;
     if (!hash_fd(t->data_fd, hex, &len) || len != t->size || strcmp(hex, t->sha256) != 0) {
-        snprintf(err, errsz, "the %llu bytes received hash to %.12s..., not %.12s...: "
-                 "discarded, to be fetched again", (unsigned long long)len, hex, t->sha256);
+        err_set(err, errsz, "the %llu bytes received hash to %.12s..., not %.12s...: "
+                "discarded, to be fetched again", (unsigned long long)len, hex, t->sha256);
         unlink(data);
         rc = -1;
     } else if (rename(data, obj) != 0) {   /* atomic: whole or absent */
-        snprintf(err, errsz, "cannot move '%s' into the file cache: %s", data, strerror(errno));
+        err_set(err, errsz, "cannot move '%s' into the file cache: %s", data, strerror(errno));
         unlink(data);
         rc = -1;
     } else {

@@ -25,6 +25,7 @@
 #include "tile_render.h"
 #include "tile_runs.h"
 #include "util/exitcodes.h"
+#include "util/xalloc.h"
 
 /* Set by SIGINT/SIGTERM (a lock-free atomic: safe in a handler); every
  * render thread's trace_thread watches it, so a render stops within one
@@ -197,12 +198,10 @@ static int render_frame(const standalone_options *opt, const job *jb, const fram
         return AAFARM_EXIT_FAILURE;
     }
     if (fo->preview) {
-        s.preview = calloc((size_t)s.fmt.width * (size_t)s.fmt.height * 4, sizeof(float));
-        if (!s.preview) abort();
+        s.preview = xcalloc((size_t)s.fmt.width * (size_t)s.fmt.height * 4, sizeof(float));
     }
     s.ntiles = image_format_tile_count(&s.fmt);
-    s.work = calloc((size_t)js->world.nobjects + 1, sizeof *s.work);
-    if (!s.work) abort();
+    s.work = xcalloc((size_t)js->world.nobjects + 1, sizeof *s.work);
     pthread_mutex_init(&s.lock, NULL);
     int threads = opt->threads > 0 ? opt->threads : default_threads();
     atomic_init(&s.next_thread, 0);
@@ -213,8 +212,7 @@ static int render_frame(const standalone_options *opt, const job *jb, const fram
                 threads, threads == 1 ? "" : "s", trace_arith_name(opt->job.arith));
 
     s.t_start = now_s();
-    pthread_t *tids = calloc((size_t)threads, sizeof *tids);
-    if (!tids) abort();
+    pthread_t *tids = xcalloc((size_t)threads, sizeof *tids);
     for (int i = 0; i < threads; i++) pthread_create(&tids[i], NULL, render_thread, &s);
     for (int i = 0; i < threads; i++) pthread_join(tids[i], NULL);
     free(tids);
@@ -265,7 +263,7 @@ static int render_frame(const standalone_options *opt, const job *jb, const fram
     }
     free(s.preview);
     free(s.work);
-    tile_runs_destroy(&s.runs);
+    tile_runs_clear(&s.runs);
     pthread_mutex_destroy(&s.lock);
     job_scene_destroy(&js);
     return rc;

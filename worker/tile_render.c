@@ -2,6 +2,7 @@
  * tile_render.c: one tile through the renderer into an image_tile.
  */
 #include "tile_render.h"
+#include "util/err.h"
 
 #include <stdio.h>
 
@@ -13,12 +14,12 @@ image_tile *worker_render_tile(const job_scene *js, trace_thread *th,
     nonfinite->count = 0;
     image_tile *tile = image_tile_new(rect.x0, rect.y0, rect.w, rect.h, layers);
     if (!tile) {
-        snprintf(err, errsz, "cannot allocate a %dx%d tile", rect.w, rect.h);
+        err_set(err, errsz, "cannot allocate a %dx%d tile", rect.w, rect.h);
         return NULL;
     }
     if (!trace_render_tile(js->renderer, th, rect.x0, rect.y0, rect.w, rect.h,
                            tile->rgba, tile->z)) {
-        snprintf(err, errsz, "tile at (%d,%d): %s", rect.x0, rect.y0, th->error);
+        err_set(err, errsz, "tile at (%d,%d): %s", rect.x0, rect.y0, th->error);
         th->failed = false;
         th->error[0] = '\0';
         image_tile_destroy(&tile);

@@ -7,26 +7,27 @@
 
 #include <assert.h>
 #include <stdlib.h>
+#include <string.h>
 
+#include "util/xalloc.h"
 
 void tile_runs_init(tile_runs *self, int ntiles, int nthreads)
 {
     assert(ntiles >= 0 && nthreads >= 1);
     pthread_mutex_init(&self->lock, NULL);
     self->nthreads = nthreads;
-    self->runs = calloc((size_t)nthreads, sizeof *self->runs);
-    if (!self->runs) abort();
+    self->runs = xcalloc((size_t)nthreads, sizeof *self->runs);
     for (int t = 0; t < nthreads; t++) {
         self->runs[t].next = (int)((long)ntiles * t / nthreads);
         self->runs[t].end = (int)((long)ntiles * (t + 1) / nthreads);
     }
 }
 
-void tile_runs_destroy(tile_runs *self)
+void tile_runs_clear(tile_runs *self)
 {
     pthread_mutex_destroy(&self->lock);
     free(self->runs);
-    self->runs = NULL;
+    memset(self, 0, sizeof *self);
 }
 
 int tile_runs_take(tile_runs *self, int t)
@@ -48,11 +49,14 @@ int tile_runs_take(tile_runs *self, int t)
             tile_run *r = &self->runs[victim];
             int mid = r->next + (most + 1) / 2;   /* a run of 1 goes whole */
             if (most == 1) mid = r->next;
+            assert(r->next <= mid && mid < r->end);   /* the thief takes at least one */
             mine->next = mid;
             mine->end = r->end;
             r->end = mid;
         }
     }
+    /* a run never runs backwards: next passes end only by being empty */
+    assert(mine->next <= mine->end);
     int tile = mine->next < mine->end ? mine->next++ : -1;
     pthread_mutex_unlock(&self->lock);
     return tile;

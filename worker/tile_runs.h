@@ -26,7 +26,8 @@ typedef struct tile_runs {
 
 /* Splits tiles [0, ntiles) into nthreads runs as equal as can be. */
 void tile_runs_init(tile_runs *self, int ntiles, int nthreads);
-void tile_runs_destroy(tile_runs *self);
+/* Frees the runs and zeroes the struct (the struct itself is the caller's). */
+void tile_runs_clear(tile_runs *self);
 /* The next tile for thread t (0 <= t < nthreads), or -1 when all are taken. */
 int tile_runs_take(tile_runs *self, int t);
 

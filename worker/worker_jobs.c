@@ -10,6 +10,8 @@
 #include <string.h>
 
 #include "file_store.h"
+#include "util/err.h"
+#include "util/xalloc.h"
 
 struct worker_jobs {
     held_job **jobs;           /* newest first */
@@ -38,11 +40,9 @@ void held_job_release(held_job **self_p)
 
 worker_jobs *worker_jobs_new(int max_held, size_t cache_bytes)
 {
-    worker_jobs *self = calloc(1, sizeof *self);
-    if (!self) abort();
+    worker_jobs *self = xcalloc(1, sizeof *self);
     self->max = max_held < 1 ? 1 : max_held;
-    self->jobs = calloc((size_t)self->max, sizeof *self->jobs);
-    if (!self->jobs) abort();
+    self->jobs = xcalloc((size_t)self->max, sizeof *self->jobs);
     self->cache_bytes = cache_bytes;
     return self;
 }
@@ -64,12 +64,11 @@ held_job *worker_jobs_find(const worker_jobs *self, const char *hash)
     return NULL;
 }
 
-static job_options options_of(const Aafarm__RenderOptions *o)
+static job_options options_of(const proto_render_options *o)
 {
     job_options jo;
     job_options_default(&jo);
-    jo.arith = o->arithmetic == AAFARM__ARITHMETIC__ARITHMETIC_INTERVAL ? TRACE_ARITH_INTERVAL
-                                                                         : TRACE_ARITH_AFFINE;
+    jo.arith = o->arithmetic == PROTO_ARITH_INTERVAL ? TRACE_ARITH_INTERVAL : TRACE_ARITH_AFFINE;
     jo.tile_size = (int)o->tile_size;
     if (o->instruction_budget)
         jo.max_instructions = o->instruction_budget > (uint64_t)LONG_MAX ? LONG_MAX
@@ -80,45 +79,45 @@ static job_options options_of(const Aafarm__RenderOptions *o)
 }
 
 /* The job from the message's fields, hashed again and compared. */
-static job *rebuild(const Aafarm__Job *m, char *err, size_t errsz)
+static job *rebuild(const proto_job *m, char *err, size_t errsz)
 {
-    job_options jo = options_of(m->options);
-    job *jb = job_new(m->scene_name, (const char *)m->scene_text.data, m->scene_text.len, &jo);
+    job_options jo = options_of(&m->options);
+    job *jb = job_new(m->scene_name, (const char *)m->scene_text, m->scene_len, &jo);
     char why[600];
     bool ok = true;
     for (size_t i = 0; ok && i < m->n_sources; i++)
-        ok = job_add_source(jb, m->sources[i]->name, (const char *)m->sources[i]->text.data,
-                            m->sources[i]->text.len, why, sizeof why);
+        ok = job_add_source(jb, m->sources[i].name, (const char *)m->sources[i].text,
+                            m->sources[i].text_len, why, sizeof why);
     for (size_t i = 0; ok && i < m->n_shaders; i++)
-        ok = job_add_shader(jb, m->shaders[i]->name, m->shaders[i]->source, why, sizeof why);
+        ok = job_add_shader(jb, m->shaders[i].name, m->shaders[i].source, why, sizeof why);
     for (size_t i = 0; ok && i < m->n_files; i++)
-        ok = job_add_file(jb, m->files[i]->name, m->files[i]->sha256, m->files[i]->size, why,
+        ok = job_add_file(jb, m->files[i].name, m->files[i].sha256, m->files[i].size, why,
                           sizeof why);
     jb->files_known = true;                 /* the master's list, even when empty */
     if (ok) ok = job_finish(jb, why, sizeof why);
     if (!ok) {
-        snprintf(err, errsz, "job %.12s... is inconsistent: %s", m->job_hash, why);
+        err_set(err, errsz, "job %.12s... is inconsistent: %s", m->job_hash, why);
         job_destroy(&jb);
         return NULL;
     }
     if (strcmp(jb->hash, m->job_hash) != 0) {
-        snprintf(err, errsz, "job %.12s...: its content hashes to %.12s... here (the master "
-                 "and this worker run different aafarm versions?)", m->job_hash, jb->hash);
+        err_set(err, errsz, "job %.12s...: its content hashes to %.12s... here (the master "
+                "and this worker run different aafarm versions?)", m->job_hash, jb->hash);
         job_destroy(&jb);
         return NULL;
     }
     return jb;
 }
 
-static bool layers_of(const Aafarm__RenderOptions *o, unsigned *layers, char *err, size_t errsz)
+static bool layers_of(const proto_render_options *o, unsigned *layers, char *err, size_t errsz)
 {
     *layers = 0;
     for (size_t i = 0; i < o->n_layers; i++) {
         if (strcmp(o->layers[i], "N") == 0) *layers |= IMAGE_LAYER_N;
         else if (strcmp(o->layers[i], "P") == 0) *layers |= IMAGE_LAYER_P;
         else if (strcmp(o->layers[i], "RGBA") != 0) {
-            snprintf(err, errsz, "unknown EXR layer '%s' (this worker writes RGBA, Z, N, P)",
-                     o->layers[i]);
+            err_set(err, errsz, "unknown EXR layer '%s' (this worker writes RGBA, Z, N, P)",
+                    o->layers[i]);
             return false;
         }
     }
@@ -126,7 +125,7 @@ static bool layers_of(const Aafarm__RenderOptions *o, unsigned *layers, char *er
 }
 
 /* Compiles the job and checks the image it describes. */
-static bool prepare(held_job *h, const Aafarm__Job *m, size_t cache_bytes)
+static bool prepare(held_job *h, const proto_job *m, size_t cache_bytes)
 {
     sl_diag *diag = sl_diag_new();
     h->js = job_scene_new(h->jb, cache_bytes, true, diag);
@@ -140,7 +139,7 @@ static bool prepare(held_job *h, const Aafarm__Job *m, size_t cache_bytes)
         return false;
     }
     sl_diag_destroy(&diag);
-    const Aafarm__RenderOptions *o = m->options;
+    const proto_render_options *o = &m->options;
     h->fmt = (image_format){(int)o->width, (int)o->height, (int)o->tile_size, 0};
     if (!layers_of(o, &h->fmt.layers, h->error, sizeof h->error)) return false;
     if (h->js->world.camera.xres != h->fmt.width || h->js->world.camera.yres != h->fmt.height) {
@@ -169,8 +168,7 @@ held_job *worker_jobs_add_broken(worker_jobs *self, const char *hash, const char
 {
     held_job *h = worker_jobs_find(self, hash);
     if (h) return h;
-    h = calloc(1, sizeof *h);
-    if (!h) abort();
+    h = xcalloc(1, sizeof *h);
     atomic_init(&h->refs, 1);
     snprintf(h->hash, sizeof h->hash, "%s", hash);
     snprintf(h->error, sizeof h->error, "%s", error);
@@ -179,7 +177,7 @@ held_job *worker_jobs_add_broken(worker_jobs *self, const char *hash, const char
     return h;
 }
 
-held_job *worker_jobs_add(worker_jobs *self, const Aafarm__Job *m, char *const *file_paths,
+held_job *worker_jobs_add(worker_jobs *self, const proto_job *m, char *const *file_paths,
                           const int *file_fds)
 {
     held_job *h = worker_jobs_find(self, m->job_hash);
@@ -187,17 +185,15 @@ held_job *worker_jobs_add(worker_jobs *self, const Aafarm__Job *m, char *const *
         for (size_t i = 0; file_fds && i < m->n_files; i++) file_store_release(file_fds[i]);
         return h;
     }
-    h = calloc(1, sizeof *h);
-    if (!h) abort();
+    h = xcalloc(1, sizeof *h);
     atomic_init(&h->refs, 1);
     snprintf(h->hash, sizeof h->hash, "%s", m->job_hash);
     if (file_fds && m->n_files) {
         h->nfile_fds = (int)m->n_files;
-        h->file_fds = malloc(sizeof *h->file_fds * m->n_files);
-        if (!h->file_fds) abort();
+        h->file_fds = xmalloc(sizeof *h->file_fds * m->n_files);
         memcpy(h->file_fds, file_fds, sizeof *h->file_fds * m->n_files);
     }
-    size_t cache = self->cache_bytes ? self->cache_bytes : (size_t)m->options->cache_bytes;
+    size_t cache = self->cache_bytes ? self->cache_bytes : (size_t)m->options.cache_bytes;
     h->jb = rebuild(m, h->error, sizeof h->error);
     /* the texture module opens the files through job_file_resolve */
     for (size_t i = 0; h->jb && file_paths && i < m->n_files; i++)

@@ -23,9 +23,9 @@
 #include <stdbool.h>
 #include <stddef.h>
 
-#include "aafarm.pb-c.h"
 #include "image/format.h"
 #include "job/job_scene.h"
+#include "message.h"
 
 typedef struct held_job {
     char hash[HASH_HEX_SIZE];
@@ -60,7 +60,7 @@ held_job *worker_jobs_find(const worker_jobs *self, const char *hash);
  * files): per Job.files entry, the local copy and its open "in use"
  * descriptor, which the held job takes over (a job already held: they
  * are released). */
-held_job *worker_jobs_add(worker_jobs *self, const Aafarm__Job *msg,
+held_job *worker_jobs_add(worker_jobs *self, const proto_job *msg,
                           char *const *file_paths, const int *file_fds);
 
 /* Holds a job that cannot be had here (its files could not be fetched):

@@ -48,6 +48,7 @@
 #include "wire.h"
 #include "worker_jobs.h"
 #include "worker_pool.h"
+#include "util/xalloc.h"
 
 enum { MAX_JOBS_HELD = 4, BACKOFF_FIRST_MS = 1000, BACKOFF_MAX_MS = 32000 };
 
@@ -128,9 +129,11 @@ static void wlog(const worker_loop *w, int level, const char *fmt, ...)
 
 /* ---- sending ---- */
 
-static int send_env(worker_loop *w, Aafarm__Envelope *env, const void *bulk, size_t len)
+static int send_msg(worker_loop *w, const proto_msg *msg, const void *bulk, size_t len,
+                    char *err, size_t errsz)
 {
-    if (wire_send_limited(w->dealer, &w->limits, NULL, 0, env, bulk, len) != 0) return -1;
+    if (wire_send_limited(w->dealer, &w->limits, NULL, 0, msg, bulk, len, err, errsz) != 0)
+        return -1;
     w->last_sent_ms = now_ms();
     return 0;
 }
@@ -138,41 +141,31 @@ static int send_env(worker_loop *w, Aafarm__Envelope *env, const void *bulk, siz
 static void send_hello(worker_loop *w)
 {
     char *held[MAX_JOBS_HELD];
-    Aafarm__Hello h = AAFARM__HELLO__INIT;
-    h.protocol_version = AAFARM_PROTOCOL_VERSION;
-    h.worker_name = w->name;
-    h.host = w->host;
-    h.pid = (uint32_t)getpid();
-    h.threads = (uint32_t)w->threads;
-    h.n_jobs_held = worker_jobs_hashes(w->jobs, held, MAX_JOBS_HELD);
-    h.jobs_held = held;
-    h.software = "aafarm 0.1.0";
-    Aafarm__Envelope env = AAFARM__ENVELOPE__INIT;
-    env.body_case = AAFARM__ENVELOPE__BODY_HELLO;
-    env.hello = &h;
-    if (send_env(w, &env, NULL, 0) != 0)
-        wlog(w, -1, "cannot send Hello: %s", wire_last_error());
+    proto_msg msg = {.kind = PROTO_HELLO};
+    proto_hello *h = &msg.hello;
+    h->protocol_version = AAFARM_PROTOCOL_VERSION;
+    h->worker_name = w->name;
+    h->host = w->host;
+    h->pid = (uint32_t)getpid();
+    h->threads = (uint32_t)w->threads;
+    h->n_jobs_held = worker_jobs_hashes(w->jobs, held, MAX_JOBS_HELD);
+    h->jobs_held = (const char *const *)held;
+    h->software = "aafarm 0.1.0";
+    char err[ERR_LEN];
+    if (send_msg(w, &msg, NULL, 0, err, sizeof err) != 0)
+        wlog(w, -1, "cannot send Hello: %s", err);
 }
 
 static void send_ask(worker_loop *w, uint32_t credits)
 {
-    Aafarm__Ask a = AAFARM__ASK__INIT;
-    a.credits = credits;
-    Aafarm__Envelope env = AAFARM__ENVELOPE__INIT;
-    env.body_case = AAFARM__ENVELOPE__BODY_ASK;
-    env.ask = &a;
-    if (send_env(w, &env, NULL, 0) == 0) w->asked += credits;
+    proto_msg msg = {.kind = PROTO_ASK, .ask = {credits}};
+    if (send_msg(w, &msg, NULL, 0, NULL, 0) == 0) w->asked += credits;
 }
 
 static void send_need_job(worker_loop *w, const char *hash, uint64_t lease)
 {
-    Aafarm__NeedJob n = AAFARM__NEED_JOB__INIT;
-    n.job_hash = (char *)hash;
-    n.lease_id = lease;
-    Aafarm__Envelope env = AAFARM__ENVELOPE__INIT;
-    env.body_case = AAFARM__ENVELOPE__BODY_NEED_JOB;
-    env.need_job = &n;
-    send_env(w, &env, NULL, 0);
+    proto_msg msg = {.kind = PROTO_NEED_JOB, .need_job = {hash, lease}};
+    send_msg(w, &msg, NULL, 0, NULL, 0);
 }
 
 /* file_fetch's way out: one NeedFile. */
@@ -180,45 +173,26 @@ static bool send_need_file(void *arg, const char *job_hash, const char *file_has
                            uint32_t length)
 {
     worker_loop *w = arg;
-    Aafarm__NeedFile n = AAFARM__NEED_FILE__INIT;
-    n.job_hash = (char *)job_hash;
-    n.sha256 = (char *)file_hash;
-    n.offset = offset;
-    n.length = length;
-    n.received = w->file_received;
-    Aafarm__Envelope env = AAFARM__ENVELOPE__INIT;
-    env.body_case = AAFARM__ENVELOPE__BODY_NEED_FILE;
-    env.need_file = &n;
-    return send_env(w, &env, NULL, 0) == 0;
+    proto_msg msg = {.kind = PROTO_NEED_FILE,
+                     .need_file = {job_hash, file_hash, offset, length, w->file_received}};
+    return send_msg(w, &msg, NULL, 0, NULL, 0) == 0;
 }
 
 static void send_files_ready(worker_loop *w, const fetch_job *j)
 {
-    Aafarm__FilesReady r = AAFARM__FILES_READY__INIT;
-    r.job_hash = (char *)j->hash;
-    r.hits = j->hits;
-    r.misses = j->misses;
-    r.fetched_bytes = j->fetched;
-    Aafarm__Envelope env = AAFARM__ENVELOPE__INIT;
-    env.body_case = AAFARM__ENVELOPE__BODY_FILES_READY;
-    env.files_ready = &r;
-    send_env(w, &env, NULL, 0);
+    proto_msg msg = {.kind = PROTO_FILES_READY,
+                     .files_ready = {j->hash, j->hits, j->misses, j->fetched}};
+    send_msg(w, &msg, NULL, 0, NULL, 0);
 }
 
 static void send_failure(worker_loop *w, const char *hash, uint64_t lease, uint32_t tile,
                          const char *message, bool retryable)
 {
-    Aafarm__Failure f = AAFARM__FAILURE__INIT;
-    f.job_hash = (char *)hash;
-    f.lease_id = lease;
-    f.tile_index = tile;
-    f.message = (char *)(message && *message ? message : "unknown error");
-    f.retryable = retryable;
-    Aafarm__Envelope env = AAFARM__ENVELOPE__INIT;
-    env.body_case = AAFARM__ENVELOPE__BODY_FAILURE;
-    env.failure = &f;
-    if (send_env(w, &env, NULL, 0) == 0) w->failures_sent++;
-    wlog(w, 0, "tile %u failed: %s", tile, f.message);
+    const char *text = message && *message ? message : "unknown error";
+    proto_msg msg = {.kind = PROTO_FAILURE,
+                     .failure = {hash, lease, tile, text, retryable}};
+    if (send_msg(w, &msg, NULL, 0, NULL, 0) == 0) w->failures_sent++;
+    wlog(w, 0, "tile %u failed: %s", tile, text);
 }
 
 static void send_heartbeat(worker_loop *w)
@@ -226,23 +200,14 @@ static void send_heartbeat(worker_loop *w)
     uint64_t leases[4096];
     size_t n = worker_pool_leases(w->pool, leases, 4096);
     for (pending_grant *p = w->pending; p && n < 4096; p = p->next) leases[n++] = p->lease_id;
-    Aafarm__Heartbeat hb = AAFARM__HEARTBEAT__INIT;
-    hb.n_leases = n;
-    hb.leases = leases;
-    Aafarm__Envelope env = AAFARM__ENVELOPE__INIT;
-    env.body_case = AAFARM__ENVELOPE__BODY_HEARTBEAT;
-    env.heartbeat = &hb;
-    send_env(w, &env, NULL, 0);
+    proto_msg msg = {.kind = PROTO_HEARTBEAT, .heartbeat = {n, leases}};
+    send_msg(w, &msg, NULL, 0, NULL, 0);
 }
 
 static void send_shutdown(worker_loop *w, const char *reason)
 {
-    Aafarm__Shutdown s = AAFARM__SHUTDOWN__INIT;
-    s.reason = (char *)reason;
-    Aafarm__Envelope env = AAFARM__ENVELOPE__INIT;
-    env.body_case = AAFARM__ENVELOPE__BODY_SHUTDOWN;
-    env.shutdown = &s;
-    send_env(w, &env, NULL, 0);
+    proto_msg msg = {.kind = PROTO_SHUTDOWN, .shutdown = {reason}};
+    send_msg(w, &msg, NULL, 0, NULL, 0);
 }
 
 /* A finished task: Result + EXR, or Failure. False when the socket's queue
@@ -253,29 +218,28 @@ static bool send_task(worker_loop *w, worker_task *t)
         send_failure(w, t->job->hash, t->lease_id, t->tile_index, t->error, true);
         return true;
     }
-    Aafarm__TileStats st = AAFARM__TILE_STATS__INIT;
-    st.rays = t->stats.rays;
-    st.boxes = t->stats.boxes;
-    st.shader_evals = t->stats.shader_evals;
-    st.cache_hits = t->stats.cache_hits;
-    st.cache_misses = t->stats.cache_misses;
-    st.cache_evictions = t->stats.cache_evictions;
-    st.peak_cache_bytes = t->stats.peak_cache_bytes;
-    st.cpu_seconds = t->stats.cpu_seconds;
-    st.wall_seconds = t->stats.wall_seconds;
-    st.nonfinite_samples = t->stats.nonfinite_samples;
-    Aafarm__Result r = AAFARM__RESULT__INIT;
-    r.job_hash = t->job->hash;
-    r.lease_id = t->lease_id;
-    r.tile_index = t->tile_index;
-    r.stats = &st;
-    r.exr_bytes = t->exr_len;
-    Aafarm__Envelope env = AAFARM__ENVELOPE__INIT;
-    env.body_case = AAFARM__ENVELOPE__BODY_RESULT;
-    env.result = &r;
-    if (send_env(w, &env, t->exr, t->exr_len) != 0) {
+    proto_msg msg = {.kind = PROTO_RESULT};
+    proto_result *r = &msg.result;
+    r->stats = (proto_tile_stats){
+        .rays = t->stats.rays,
+        .boxes = t->stats.boxes,
+        .shader_evals = t->stats.shader_evals,
+        .cache_hits = t->stats.cache_hits,
+        .cache_misses = t->stats.cache_misses,
+        .cache_evictions = t->stats.cache_evictions,
+        .peak_cache_bytes = t->stats.peak_cache_bytes,
+        .cpu_seconds = t->stats.cpu_seconds,
+        .wall_seconds = t->stats.wall_seconds,
+        .nonfinite_samples = t->stats.nonfinite_samples,
+    };
+    r->job_hash = t->job->hash;
+    r->lease_id = t->lease_id;
+    r->tile_index = t->tile_index;
+    r->exr_bytes = t->exr_len;
+    char err[ERR_LEN];
+    if (send_msg(w, &msg, t->exr, t->exr_len, err, sizeof err) != 0) {
         if (errno == EAGAIN) return false;
-        wlog(w, -1, "cannot send tile %u: %s", t->tile_index, wire_last_error());
+        wlog(w, -1, "cannot send tile %u: %s", t->tile_index, err);
         return true;
     }
     w->tiles_sent++;
@@ -349,7 +313,7 @@ static void start_tile(worker_loop *w, held_job *h, uint64_t lease, uint32_t til
 
 /* ---- messages from the master ---- */
 
-static void on_welcome(worker_loop *w, const Aafarm__Welcome *m)
+static void on_welcome(worker_loop *w, const proto_welcome *m)
 {
     char why[200];
     if (proto_version_check(m->protocol_version, AAFARM_PROTOCOL_VERSION, why, sizeof why) != 0) {
@@ -374,9 +338,9 @@ static void on_welcome(worker_loop *w, const Aafarm__Welcome *m)
          w->heartbeat_ms, w->liveness);
 }
 
-static void on_reject(worker_loop *w, const Aafarm__Reject *m)
+static void on_reject(worker_loop *w, const proto_reject *m)
 {
-    if (m->code == AAFARM__REJECT_CODE__REJECT_CODE_HELLO_FIRST) {
+    if (m->code == PROTO_REJECT_HELLO_FIRST) {
         wlog(w, 0, "the master does not know this connection: saying Hello again");
         drop_all_leases(w);
         w->welcomed = false;
@@ -445,7 +409,7 @@ static void run_beside(worker_loop *w, void (*fn)(void *arg), void *arg, const c
 
 typedef struct preparation {
     worker_jobs *jobs;
-    const Aafarm__Job *msg;
+    const proto_job *msg;
     const fetch_job *files;        /* its files' paths and descriptors, or NULL */
     int delay_ms;
     held_job *result;
@@ -463,7 +427,7 @@ static void prepare(void *arg)
 }
 
 /* worker_jobs_add beside the loop. */
-static held_job *prepare_job(worker_loop *w, const Aafarm__Job *m, const fetch_job *files)
+static held_job *prepare_job(worker_loop *w, const proto_job *m, const fetch_job *files)
 {
     preparation p = {w->jobs, m, files, w->opt->prepare_delay_ms, NULL};
     if (worker_jobs_find(w->jobs, m->job_hash)) {
@@ -514,18 +478,15 @@ static void take_ready_jobs(worker_loop *w)
     fetch_job *j;
     while ((j = file_fetch_take_ready(w->files))) {
         held_job *h;
-        Aafarm__Job *m = j->error[0] ? NULL
-                                     : aafarm__job__unpack(NULL, j->packed_len, j->packed);
-        if (!m) {
-            h = worker_jobs_add_broken(w->jobs, j->hash, j->error[0] ? j->error
-                                       : "its Job message cannot be read back");
+        if (j->error[0]) {
+            h = worker_jobs_add_broken(w->jobs, j->hash, j->error);
         } else {
+            const proto_job *m = proto_saved_job_get(j->msg);
             if (j->misses)
                 wlog(w, 0, "job %.12s: its files are here (%d in all, %u fetched, %llu bytes "
                      "received)", j->hash, j->nfiles, j->misses, (unsigned long long)j->fetched);
             h = prepare_job(w, m, j);
             for (int i = 0; i < j->nfiles; i++) j->fds[i] = -1;   /* the held job has them */
-            aafarm__job__free_unpacked(m, NULL);
             send_files_ready(w, j);
             h->files_said = w->master_session;
         }
@@ -536,7 +497,7 @@ static void take_ready_jobs(worker_loop *w)
 
 typedef struct file_call {
     file_fetch *files;
-    const Aafarm__Job *msg;        /* add this Job; NULL: poll */
+    const proto_job *msg;          /* add this Job; NULL: poll */
 } file_call;
 
 static void file_work(void *arg)
@@ -554,7 +515,7 @@ static void poll_files(worker_loop *w)
     run_beside(w, file_work, &c, "checking job files");
 }
 
-static void on_job(worker_loop *w, const Aafarm__Job *m)
+static void on_job(worker_loop *w, const proto_job *m)
 {
     if (m->n_files == 0 || worker_jobs_find(w->jobs, m->job_hash)) {
         job_ready(w, prepare_job(w, m, NULL));
@@ -565,7 +526,7 @@ static void on_job(worker_loop *w, const Aafarm__Job *m)
     take_ready_jobs(w);   /* all in the store already: at once */
 }
 
-static void on_file_chunk(worker_loop *w, const Aafarm__FileChunk *c, const wire_msg *m)
+static void on_file_chunk(worker_loop *w, const proto_file_chunk *c, const wire_msg *m)
 {
     size_t len = 0;
     const uint8_t *data = wire_msg_bulk(m, &len);
@@ -577,10 +538,10 @@ static void on_file_chunk(worker_loop *w, const Aafarm__FileChunk *c, const wire
     take_ready_jobs(w);
 }
 
-static void on_grant(worker_loop *w, const Aafarm__Grant *g)
+static void on_grant(worker_loop *w, const proto_grant *g)
 {
     if (w->asked) w->asked--;
-    image_rect rect = {(int)g->tile->x, (int)g->tile->y, (int)g->tile->width, (int)g->tile->height};
+    image_rect rect = {(int)g->tile.x, (int)g->tile.y, (int)g->tile.width, (int)g->tile.height};
     held_job *h = worker_jobs_find(w->jobs, g->job_hash);
     if (h) {
         if (!h->broken && h->jb->nfiles > 0 && h->files_said != w->master_session) {
@@ -596,44 +557,42 @@ static void on_grant(worker_loop *w, const Aafarm__Grant *g)
     bool asked_already = file_fetch_waiting(w->files, g->job_hash);   /* files on the way */
     for (pending_grant *p = w->pending; p; p = p->next)
         if (strcmp(p->hash, g->job_hash) == 0) asked_already = true;
-    pending_grant *p = calloc(1, sizeof *p);
-    if (!p) abort();
+    pending_grant *p = xcalloc(1, sizeof *p);
     *p = (pending_grant){g->lease_id, g->tile_index, rect, "", w->pending};
     snprintf(p->hash, sizeof p->hash, "%s", g->job_hash);
     w->pending = p;
     if (!asked_already) send_need_job(w, g->job_hash, g->lease_id);
 }
 
-static void on_job_done(worker_loop *w, const Aafarm__JobDone *d)
+static void on_job_done(worker_loop *w, const proto_job_done *d)
 {
     worker_pool_cancel(w->pool, d->job_hash);
     drop_pending(w, d->job_hash);
     file_fetch_drop(w->files, d->job_hash);   /* chunks written stay in the store */
-    const char *how = d->status == AAFARM__JOB_STATUS__JOB_STATUS_DONE     ? "done"
-                      : d->status == AAFARM__JOB_STATUS__JOB_STATUS_FAILED ? "failed"
-                                                                            : "cancelled";
+    const char *how = d->status == PROTO_JOB_STATUS_DONE     ? "done"
+                      : d->status == PROTO_JOB_STATUS_FAILED ? "failed"
+                                                              : "cancelled";
     wlog(w, 0, "job %.12s %s%s%s", d->job_hash, how, d->message && *d->message ? ": " : "",
          d->message ? d->message : "");
 }
 
 static void handle(worker_loop *w, const wire_msg *m)
 {
-    const Aafarm__Envelope *env = wire_msg_envelope(m);
-    proto_kind kind = wire_msg_kind(m);
-    if (!w->welcomed && kind != AAFARM__ENVELOPE__BODY_WELCOME &&
-        kind != AAFARM__ENVELOPE__BODY_REJECT && kind != AAFARM__ENVELOPE__BODY_SHUTDOWN)
+    const proto_msg *msg = wire_msg_body(m);
+    proto_kind kind = msg->kind;
+    if (!w->welcomed && kind != PROTO_WELCOME && kind != PROTO_REJECT && kind != PROTO_SHUTDOWN)
         return;   /* from before our Hello was answered: ignore */
     switch (kind) {
-    case AAFARM__ENVELOPE__BODY_WELCOME: on_welcome(w, env->welcome); break;
-    case AAFARM__ENVELOPE__BODY_REJECT: on_reject(w, env->reject); break;
-    case AAFARM__ENVELOPE__BODY_JOB: on_job(w, env->job); break;
-    case AAFARM__ENVELOPE__BODY_GRANT: on_grant(w, env->grant); break;
-    case AAFARM__ENVELOPE__BODY_JOB_DONE: on_job_done(w, env->job_done); break;
-    case AAFARM__ENVELOPE__BODY_FILE_CHUNK: on_file_chunk(w, env->file_chunk, m); break;
-    case AAFARM__ENVELOPE__BODY_SHUTDOWN:
+    case PROTO_WELCOME: on_welcome(w, &msg->welcome); break;
+    case PROTO_REJECT: on_reject(w, &msg->reject); break;
+    case PROTO_JOB: on_job(w, &msg->job); break;
+    case PROTO_GRANT: on_grant(w, &msg->grant); break;
+    case PROTO_JOB_DONE: on_job_done(w, &msg->job_done); break;
+    case PROTO_FILE_CHUNK: on_file_chunk(w, &msg->file_chunk, m); break;
+    case PROTO_SHUTDOWN:
         wlog(w, 0, "the master says shut down%s%s",
-             env->shutdown->reason && *env->shutdown->reason ? ": " : "",
-             env->shutdown->reason ? env->shutdown->reason : "");
+             msg->shutdown.reason && *msg->shutdown.reason ? ": " : "",
+             msg->shutdown.reason ? msg->shutdown.reason : "");
         w->end = SESSION_SHUTDOWN;
         break;
     default: break;   /* Heartbeat: liveness only */
@@ -645,12 +604,12 @@ static void handle(worker_loop *w, const wire_msg *m)
 static void read_master(worker_loop *w)
 {
     for (int i = 0; i < 1000 && w->end == SESSION_LOST; i++) {
-        wire_msg *m = wire_recv(w->dealer, &w->limits, &w->wstats, ZMQ_DONTWAIT);
+        wire_msg *m = wire_recv(w->dealer, &w->limits, &w->wstats, ZMQ_DONTWAIT, NULL, 0);
         if (!m) {
             if (errno != EPROTO) return;
             int64_t now = now_ms();
             if (now - w->drop_logged_ms >= 1000) {
-                wlog(w, 0, "%s (%llu dropped so far)", wire_last_error(),
+                wlog(w, 0, "%s (%llu dropped so far)", w->wstats.last_error,
                      (unsigned long long)w->wstats.dropped);
                 w->drop_logged_ms = now;
             }
@@ -690,7 +649,7 @@ static void ask_for_more(worker_loop *w)
 static bool open_socket(worker_loop *w)
 {
     w->dealer = zmq_socket(w->ctx, ZMQ_DEALER);
-    if (!w->dealer || wire_socket_setup(w->dealer, &w->limits) != 0) {
+    if (!w->dealer || wire_socket_setup(w->dealer, &w->limits, NULL, 0) != 0) {
         snprintf(w->fatal, sizeof w->fatal, "cannot create a socket: %s", zmq_strerror(errno));
         return false;
     }
@@ -701,7 +660,7 @@ static bool open_socket(worker_loop *w)
         snprintf(w->fatal, sizeof w->fatal, "cannot turn CURVE on: %s", zmq_strerror(errno));
         return false;
     }
-    w->monitor = wire_monitor_new(w->ctx, w->dealer);
+    w->monitor = wire_monitor_new(w->ctx, w->dealer, NULL, 0);
     if (zmq_connect(w->dealer, w->opt->endpoint) != 0) {
         snprintf(w->fatal, sizeof w->fatal, "cannot connect to '%s': %s", w->opt->endpoint,
                  zmq_strerror(errno));
@@ -724,7 +683,7 @@ static void close_socket(worker_loop *w, int linger_ms)
 static void check_handshakes(worker_loop *w)
 {
     if (!w->monitor) return;
-    wire_monitor_poll(w->monitor, &w->wstats);
+    wire_monitor_poll(w->monitor, &w->wstats, NULL, 0);
     if (w->wstats.handshake_failures == 0 || w->handshake_said || w->welcomed) return;
     w->handshake_said = true;
     if (w->wstats.auth_failures)

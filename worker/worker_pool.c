@@ -18,6 +18,7 @@
 
 #include "tile_render.h"
 #include "trace/thread.h"
+#include "util/xalloc.h"
 
 typedef struct render_thread {
     struct worker_pool *pool;
@@ -43,8 +44,7 @@ struct worker_pool {
 worker_task *worker_task_new(uint64_t lease_id, uint32_t tile_index, image_rect rect,
                              held_job *held)
 {
-    worker_task *t = calloc(1, sizeof *t);
-    if (!t) abort();
+    worker_task *t = xcalloc(1, sizeof *t);
     t->lease_id = lease_id;
     t->tile_index = tile_index;
     t->rect = rect;
@@ -194,13 +194,11 @@ static void *render_main(void *arg)
 
 worker_pool *worker_pool_new(int threads, int tile_delay_ms)
 {
-    worker_pool *p = calloc(1, sizeof *p);
-    if (!p) abort();
+    worker_pool *p = xcalloc(1, sizeof *p);
     atomic_init(&p->abort_render, 0);
     p->nthreads = threads < 1 ? 1 : threads;
     p->tile_delay_ms = tile_delay_ms;
-    p->threads = calloc((size_t)p->nthreads, sizeof *p->threads);
-    if (!p->threads) abort();
+    p->threads = xcalloc((size_t)p->nthreads, sizeof *p->threads);
     pthread_mutex_init(&p->lock, NULL);
     pthread_cond_init(&p->wake, NULL);
     p->pipe_fd[0] = p->pipe_fd[1] = -1;

@@ -16,7 +16,9 @@
 
 #include "fuzz_target.h"
 #include "message.h"
-#include "wire.h"
+#include "wire_pb.h"
+
+static char wire_err[ERR_LEN];
 
 static void *ctx, *router, *dealer;
 
@@ -28,7 +30,7 @@ static void setup(void)
     router = zmq_socket(ctx, ZMQ_ROUTER);
     dealer = zmq_socket(ctx, ZMQ_DEALER);
     fuzz_check(router && dealer);
-    fuzz_check(wire_socket_setup(router, NULL) == 0);
+    fuzz_check(wire_socket_setup(router, NULL, wire_err, sizeof wire_err) == 0);
     fuzz_check(zmq_setsockopt(router, ZMQ_RCVTIMEO, &timeout, sizeof timeout) == 0);
     fuzz_check(zmq_setsockopt(router, ZMQ_LINGER, &linger, sizeof linger) == 0);
     fuzz_check(zmq_setsockopt(dealer, ZMQ_LINGER, &linger, sizeof linger) == 0);
@@ -53,7 +55,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 
     wire_stats stats;
     memset(&stats, 0, sizeof stats);
-    wire_msg *m = wire_recv(router, NULL, &stats, 0);
+    wire_msg *m = wire_recv(router, NULL, &stats, 0, wire_err, sizeof wire_err);
     if (m) {
         proto_kind kind = wire_msg_kind(m);
         fuzz_check(proto_message_from_worker(kind));
@@ -65,7 +67,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         wire_msg_destroy(&m);
     } else {
         fuzz_check(errno == EPROTO);
-        const char *why = wire_last_error();
+        const char *why = wire_err;
         fuzz_check(why != NULL && why[0] != '\0');
     }
     return 0;

@@ -32,7 +32,7 @@
 
 #include "farm_testutil.h"
 #include "version.h"
-#include "wire.h"
+#include "wire_pb.h"
 
 static char *dir;
 
@@ -67,7 +67,7 @@ static void *test_socket(void *ctx, int type)
     int linger = 0, timeout = 20000;
     zmq_setsockopt(s, ZMQ_LINGER, &linger, sizeof linger);
     zmq_setsockopt(s, ZMQ_RCVTIMEO, &timeout, sizeof timeout);
-    assert_int_equal(wire_socket_setup(s, NULL), 0);
+    assert_int_equal(wire_socket_setup(s, NULL, NULL, 0), 0);
     zmq_setsockopt(s, ZMQ_LINGER, &linger, sizeof linger);
     return s;
 }
@@ -92,10 +92,10 @@ static void test_farm_master_rejects_other_version(void **state)
     Aafarm__Envelope env = AAFARM__ENVELOPE__INIT;
     env.body_case = AAFARM__ENVELOPE__BODY_HELLO;
     env.hello = &h;
-    assert_int_equal(wire_send(d, NULL, 0, &env, NULL, 0), 0);
-    wire_msg *m = wire_recv(d, NULL, NULL, 0);
+    assert_int_equal(wire_send_envelope(d, NULL, NULL, 0, &env, NULL, 0, NULL, 0), 0);
+    wire_msg *m = wire_recv(d, NULL, NULL, 0, NULL, 0);
     assert_non_null(m);
-    assert_int_equal(wire_msg_kind(m), AAFARM__ENVELOPE__BODY_REJECT);
+    assert_int_equal(wire_msg_kind(m), PROTO_REJECT);
     const Aafarm__Reject *r = wire_msg_envelope(m)->reject;
     assert_int_equal(r->code, AAFARM__REJECT_CODE__REJECT_CODE_VERSION_MISMATCH);
     assert_int_equal(r->protocol_version, AAFARM_PROTOCOL_VERSION);
@@ -132,9 +132,9 @@ static void worker_refused(const Aafarm__Envelope *answer, const char *log_name,
     const char *log = ft_path(dir, log_name);
     const char *argv[] = {ft_worker, "--connect", ep, "--name", "w", "--threads", "1", NULL};
     pid_t worker = ft_spawn(log, argv);
-    wire_msg *m = wire_recv(r, NULL, NULL, 0);
+    wire_msg *m = wire_recv(r, NULL, NULL, 0, NULL, 0);
     assert_non_null(m);
-    assert_int_equal(wire_msg_kind(m), AAFARM__ENVELOPE__BODY_HELLO);
+    assert_int_equal(wire_msg_kind(m), PROTO_HELLO);
     const Aafarm__Hello *h = wire_msg_envelope(m)->hello;
     assert_int_equal(h->protocol_version, AAFARM_PROTOCOL_VERSION);
     assert_string_equal(h->worker_name, "w");
@@ -142,7 +142,7 @@ static void worker_refused(const Aafarm__Envelope *answer, const char *log_name,
     assert_int_equal(h->pid, (uint32_t)worker);
     size_t id_len;
     const uint8_t *id = wire_msg_identity(m, &id_len);
-    assert_int_equal(wire_send(r, id, id_len, answer, NULL, 0), 0);
+    assert_int_equal(wire_send_envelope(r, NULL, id, id_len, answer, NULL, 0, NULL, 0), 0);
     wire_msg_destroy(&m);
     assert_int_equal(ft_wait(worker, 20), 2);
     assert_int_equal(ft_count(log, why), 1);
@@ -181,9 +181,9 @@ static void test_farm_worker_refused_by_master(void **state)
 static wire_msg *recv_skipping_heartbeats(void *router)
 {
     for (;;) {
-        wire_msg *m = wire_recv(router, NULL, NULL, 0);
+        wire_msg *m = wire_recv(router, NULL, NULL, 0, NULL, 0);
         assert_non_null(m);
-        if (wire_msg_kind(m) != AAFARM__ENVELOPE__BODY_HEARTBEAT) return m;
+        if (wire_msg_kind(m) != PROTO_HEARTBEAT) return m;
         wire_msg_destroy(&m);
     }
 }
@@ -192,7 +192,7 @@ static void send_to_worker(void *router, const wire_msg *from, Aafarm__Envelope 
 {
     size_t id_len;
     const uint8_t *id = wire_msg_identity(from, &id_len);
-    assert_int_equal(wire_send(router, id, id_len, env, NULL, 0), 0);
+    assert_int_equal(wire_send_envelope(router, NULL, id, id_len, env, NULL, 0, NULL, 0), 0);
 }
 
 /* A fake master walks a worker through its state machine: Welcome -> Ask,
@@ -213,7 +213,7 @@ static void test_farm_worker_follows_the_protocol(void **state)
     pid_t worker = ft_spawn(log, argv);
 
     wire_msg *hello = recv_skipping_heartbeats(r);
-    assert_int_equal(wire_msg_kind(hello), AAFARM__ENVELOPE__BODY_HELLO);
+    assert_int_equal(wire_msg_kind(hello), PROTO_HELLO);
     Aafarm__Welcome wel = AAFARM__WELCOME__INIT;
     wel.protocol_version = AAFARM_PROTOCOL_VERSION;
     wel.master_session = 7;
@@ -225,7 +225,7 @@ static void test_farm_worker_follows_the_protocol(void **state)
     send_to_worker(r, hello, &env);
 
     wire_msg *m = recv_skipping_heartbeats(r);
-    assert_int_equal(wire_msg_kind(m), AAFARM__ENVELOPE__BODY_ASK);
+    assert_int_equal(wire_msg_kind(m), PROTO_ASK);
     assert_int_equal(wire_msg_envelope(m)->ask->credits, 2);   /* two per thread */
     wire_msg_destroy(&m);
 
@@ -243,7 +243,7 @@ static void test_farm_worker_follows_the_protocol(void **state)
     genv.grant = &g;
     send_to_worker(r, hello, &genv);
     m = recv_skipping_heartbeats(r);
-    assert_int_equal(wire_msg_kind(m), AAFARM__ENVELOPE__BODY_NEED_JOB);
+    assert_int_equal(wire_msg_kind(m), PROTO_NEED_JOB);
     assert_string_equal(wire_msg_envelope(m)->need_job->job_hash, hash);
     assert_int_equal(wire_msg_envelope(m)->need_job->lease_id, 1);
     wire_msg_destroy(&m);
@@ -263,7 +263,7 @@ static void test_farm_worker_follows_the_protocol(void **state)
     jenv.job = &job;
     send_to_worker(r, hello, &jenv);
     m = recv_skipping_heartbeats(r);
-    assert_int_equal(wire_msg_kind(m), AAFARM__ENVELOPE__BODY_FAILURE);
+    assert_int_equal(wire_msg_kind(m), PROTO_FAILURE);
     const Aafarm__Failure *f = wire_msg_envelope(m)->failure;
     assert_int_equal(f->lease_id, 1);
     assert_true(f->retryable);
@@ -278,11 +278,11 @@ static void test_farm_worker_follows_the_protocol(void **state)
     renv.reject = &rej;
     send_to_worker(r, hello, &renv);
     m = recv_skipping_heartbeats(r);
-    while (wire_msg_kind(m) == AAFARM__ENVELOPE__BODY_ASK) {   /* sent after the Failure */
+    while (wire_msg_kind(m) == PROTO_ASK) {   /* sent after the Failure */
         wire_msg_destroy(&m);
         m = recv_skipping_heartbeats(r);
     }
-    assert_int_equal(wire_msg_kind(m), AAFARM__ENVELOPE__BODY_HELLO);
+    assert_int_equal(wire_msg_kind(m), PROTO_HELLO);
     wire_msg_destroy(&m);
 
     Aafarm__Shutdown sd = AAFARM__SHUTDOWN__INIT;

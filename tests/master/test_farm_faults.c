@@ -39,7 +39,7 @@
 
 #include "farm_testutil.h"
 #include "version.h"
-#include "wire.h"
+#include "wire_pb.h"
 
 static char *dir;
 
@@ -314,10 +314,10 @@ static int dealer_garbage(const char *ep)
     Aafarm__Envelope env = AAFARM__ENVELOPE__INIT;
     env.body_case = AAFARM__ENVELOPE__BODY_HEARTBEAT;
     env.heartbeat = &hb;
-    assert_int_equal(wire_send(d, NULL, 0, &env, NULL, 0), 0);
-    wire_msg *m = wire_recv(d, NULL, NULL, 0);
+    assert_int_equal(wire_send_envelope(d, NULL, NULL, 0, &env, NULL, 0, NULL, 0), 0);
+    wire_msg *m = wire_recv(d, NULL, NULL, 0, NULL, 0);
     assert_non_null(m);
-    assert_int_equal(wire_msg_kind(m), AAFARM__ENVELOPE__BODY_REJECT);
+    assert_int_equal(wire_msg_kind(m), PROTO_REJECT);
     assert_int_equal(wire_msg_envelope(m)->reject->code,
                      AAFARM__REJECT_CODE__REJECT_CODE_HELLO_FIRST);
     wire_msg_destroy(&m);

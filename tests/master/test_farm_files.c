@@ -45,7 +45,7 @@
 #include "farm_testutil.h"
 #include "util/hash.h"
 #include "version.h"
-#include "wire.h"
+#include "wire_pb.h"
 
 static char *dir;
 
@@ -556,7 +556,7 @@ static void test_changed_file(void **state)
 
 static void peer_send(void *s, Aafarm__Envelope *env)
 {
-    assert_int_equal(wire_send(s, NULL, 0, env, NULL, 0), 0);
+    assert_int_equal(wire_send_envelope(s, NULL, NULL, 0, env, NULL, 0, NULL, 0), 0);
 }
 
 static double mono_s(void)
@@ -588,7 +588,7 @@ static wire_msg *peer_wait(void *s, proto_kind kind, double timeout_s)
         zmq_poll(&it, 1, 50);
         peer_alive(s);
         wire_msg *m;
-        while ((m = wire_recv(s, NULL, NULL, ZMQ_DONTWAIT))) {
+        while ((m = wire_recv(s, NULL, NULL, ZMQ_DONTWAIT, NULL, 0))) {
             if (wire_msg_kind(m) == kind) return m;
             wire_msg_destroy(&m);
         }
@@ -617,7 +617,7 @@ static int peer_chunks(void *s, double timeout_s)
 {
     int n = 0;
     wire_msg *m;
-    while ((m = peer_wait(s, AAFARM__ENVELOPE__BODY_FILE_CHUNK, timeout_s))) {
+    while ((m = peer_wait(s, PROTO_FILE_CHUNK, timeout_s))) {
         n++;
         wire_msg_destroy(&m);
     }
@@ -645,7 +645,7 @@ static void test_greedy_peer_is_capped(void **state)
     env.body_case = AAFARM__ENVELOPE__BODY_HELLO;
     env.hello = &h;
     peer_send(s, &env);
-    wire_msg *w = peer_wait(s, AAFARM__ENVELOPE__BODY_WELCOME, 30);
+    wire_msg *w = peer_wait(s, PROTO_WELCOME, 30);
     assert_non_null(w);
     wire_msg_destroy(&w);
     Aafarm__Ask a = AAFARM__ASK__INIT;
@@ -654,7 +654,7 @@ static void test_greedy_peer_is_capped(void **state)
     ask.body_case = AAFARM__ENVELOPE__BODY_ASK;
     ask.ask = &a;
     peer_send(s, &ask);
-    wire_msg *job = peer_wait(s, AAFARM__ENVELOPE__BODY_JOB, 30);
+    wire_msg *job = peer_wait(s, PROTO_JOB, 30);
     assert_non_null(job);
     const Aafarm__Job *jm = wire_msg_envelope(job)->job;
     assert_int_equal(jm->n_files, 1);

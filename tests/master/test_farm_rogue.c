@@ -27,7 +27,7 @@
 
 #include "farm_testutil.h"
 #include "version.h"
-#include "wire.h"
+#include "wire_pb.h"
 
 static char *dir;
 
@@ -96,7 +96,7 @@ static int64_t now_ms(void)
 
 static void send_env(void *s, Aafarm__Envelope *env)
 {
-    wire_send(s, NULL, 0, env, NULL, 0);   /* best effort, never blocks */
+    wire_send_envelope(s, NULL, NULL, 0, env, NULL, 0, NULL, 0);   /* best effort, never blocks */
 }
 
 static void rogue_hello(rogue *r, void *ctx, const char *ep, const char *name)
@@ -143,11 +143,11 @@ static void rogue_heartbeat(rogue *r)
 static void rogue_serve(rogue *r, bool fail)
 {
     for (;;) {
-        wire_msg *m = wire_recv(r->s, NULL, NULL, ZMQ_DONTWAIT);
+        wire_msg *m = wire_recv(r->s, NULL, NULL, ZMQ_DONTWAIT, NULL, 0);
         if (!m) return;
         const Aafarm__Envelope *env = wire_msg_envelope(m);
-        if (wire_msg_kind(m) == AAFARM__ENVELOPE__BODY_WELCOME) rogue_ask(r, 4);
-        if (wire_msg_kind(m) == AAFARM__ENVELOPE__BODY_GRANT) {
+        if (wire_msg_kind(m) == PROTO_WELCOME) rogue_ask(r, 4);
+        if (wire_msg_kind(m) == PROTO_GRANT) {
             r->grants++;
             if (fail) {
                 Aafarm__Failure x = AAFARM__FAILURE__INIT;

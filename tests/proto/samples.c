@@ -16,15 +16,17 @@
 #include "samples.h"
 #include "version.h"
 
+char wire_err[ERR_LEN];
+
 const proto_kind sample_kinds[SAMPLE_KINDS] = {
-    AAFARM__ENVELOPE__BODY_HELLO,    AAFARM__ENVELOPE__BODY_WELCOME,
-    AAFARM__ENVELOPE__BODY_REJECT,   AAFARM__ENVELOPE__BODY_ASK,
-    AAFARM__ENVELOPE__BODY_JOB,      AAFARM__ENVELOPE__BODY_NEED_JOB,
-    AAFARM__ENVELOPE__BODY_GRANT,    AAFARM__ENVELOPE__BODY_RESULT,
-    AAFARM__ENVELOPE__BODY_FAILURE,  AAFARM__ENVELOPE__BODY_HEARTBEAT,
-    AAFARM__ENVELOPE__BODY_JOB_DONE, AAFARM__ENVELOPE__BODY_SHUTDOWN,
-    AAFARM__ENVELOPE__BODY_NEED_FILE, AAFARM__ENVELOPE__BODY_FILE_CHUNK,
-    AAFARM__ENVELOPE__BODY_FILES_READY,
+    PROTO_HELLO,    PROTO_WELCOME,
+    PROTO_REJECT,   PROTO_ASK,
+    PROTO_JOB,      PROTO_NEED_JOB,
+    PROTO_GRANT,    PROTO_RESULT,
+    PROTO_FAILURE,  PROTO_HEARTBEAT,
+    PROTO_JOB_DONE, PROTO_SHUTDOWN,
+    PROTO_NEED_FILE, PROTO_FILE_CHUNK,
+    PROTO_FILES_READY,
 };
 
 static const char scene_text[] =
@@ -326,23 +328,23 @@ void sample_make(sample *s, proto_kind kind)
     memset(s, 0, sizeof *s);
     s->env = env;
     make_job(s); /* every kind refers to the job's hash */
-    s->env.body_case = kind;
+    s->env.body_case = (Aafarm__Envelope__BodyCase)kind;
     switch (kind) {
-    case AAFARM__ENVELOPE__BODY_HELLO: make_hello(s); break;
-    case AAFARM__ENVELOPE__BODY_WELCOME: make_welcome(s); break;
-    case AAFARM__ENVELOPE__BODY_REJECT: make_reject(s); break;
-    case AAFARM__ENVELOPE__BODY_ASK: make_ask(s); break;
-    case AAFARM__ENVELOPE__BODY_JOB: break;
-    case AAFARM__ENVELOPE__BODY_NEED_JOB: make_need_job(s); break;
-    case AAFARM__ENVELOPE__BODY_GRANT: make_grant(s); break;
-    case AAFARM__ENVELOPE__BODY_RESULT: make_result(s); break;
-    case AAFARM__ENVELOPE__BODY_FAILURE: make_failure(s); break;
-    case AAFARM__ENVELOPE__BODY_HEARTBEAT: make_heartbeat(s); break;
-    case AAFARM__ENVELOPE__BODY_JOB_DONE: make_job_done(s); break;
-    case AAFARM__ENVELOPE__BODY_SHUTDOWN: make_shutdown(s); break;
-    case AAFARM__ENVELOPE__BODY_NEED_FILE: make_need_file(s); break;
-    case AAFARM__ENVELOPE__BODY_FILE_CHUNK: make_file_chunk(s); break;
-    case AAFARM__ENVELOPE__BODY_FILES_READY: make_files_ready(s); break;
+    case PROTO_HELLO: make_hello(s); break;
+    case PROTO_WELCOME: make_welcome(s); break;
+    case PROTO_REJECT: make_reject(s); break;
+    case PROTO_ASK: make_ask(s); break;
+    case PROTO_JOB: break;
+    case PROTO_NEED_JOB: make_need_job(s); break;
+    case PROTO_GRANT: make_grant(s); break;
+    case PROTO_RESULT: make_result(s); break;
+    case PROTO_FAILURE: make_failure(s); break;
+    case PROTO_HEARTBEAT: make_heartbeat(s); break;
+    case PROTO_JOB_DONE: make_job_done(s); break;
+    case PROTO_SHUTDOWN: make_shutdown(s); break;
+    case PROTO_NEED_FILE: make_need_file(s); break;
+    case PROTO_FILE_CHUNK: make_file_chunk(s); break;
+    case PROTO_FILES_READY: make_files_ready(s); break;
     default: fail_msg("sample_make: kind %d", (int)kind);
     }
 }
@@ -374,8 +376,8 @@ void pair_open(sock_pair *p, const char *transport, const proto_limits *limits)
     p->dealer = zmq_socket(p->ctx, ZMQ_DEALER);
     assert_non_null(p->router);
     assert_non_null(p->dealer);
-    assert_int_equal(wire_socket_setup(p->router, limits), 0);
-    assert_int_equal(wire_socket_setup(p->dealer, limits), 0);
+    assert_int_equal(wire_socket_setup(p->router, limits, wire_err, sizeof wire_err), 0);
+    assert_int_equal(wire_socket_setup(p->dealer, limits, wire_err, sizeof wire_err), 0);
     assert_int_equal(zmq_setsockopt(p->router, ZMQ_RCVTIMEO, &timeout, sizeof timeout), 0);
     assert_int_equal(zmq_setsockopt(p->dealer, ZMQ_RCVTIMEO, &timeout, sizeof timeout), 0);
     if (strcmp(transport, "tcp") == 0) {

@@ -16,7 +16,10 @@
 
 #include "message.h"
 #include "util/hash.h"
-#include "wire.h"
+#include "wire_pb.h"
+
+/* Where the tests' wire_ calls write their error (err_set, util/err.h). */
+extern char wire_err[ERR_LEN];
 
 typedef struct sample {
     Aafarm__Envelope env;

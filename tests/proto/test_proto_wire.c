@@ -25,7 +25,7 @@
 #include <zmq.h>
 
 #include "samples.h"
-#include "wire.h"
+#include "wire_pb.h"
 
 /* ---------------------------------------------------------------------- */
 /* helpers                                                                 */
@@ -35,13 +35,13 @@
 static void assert_fields(const sample *s, const Aafarm__Envelope *got)
 {
     switch (s->env.body_case) {
-    case AAFARM__ENVELOPE__BODY_HELLO:
+    case PROTO_HELLO:
         assert_string_equal(got->hello->worker_name, "render07-w1");
         assert_int_equal(got->hello->threads, 8);
         assert_int_equal(got->hello->n_jobs_held, 2);
         assert_string_equal(got->hello->jobs_held[0], s->job_hash);
         break;
-    case AAFARM__ENVELOPE__BODY_JOB:
+    case PROTO_JOB:
         assert_string_equal(got->job->job_hash, s->job_hash);
         assert_int_equal(got->job->n_sources, 2);
         assert_memory_equal(got->job->sources[0]->text.data, s->source[0].text.data,
@@ -51,21 +51,21 @@ static void assert_fields(const sample *s, const Aafarm__Envelope *got)
         assert_int_equal(got->job->options->arithmetic, AAFARM__ARITHMETIC__ARITHMETIC_INTERVAL);
         assert_string_equal(got->job->options->extra[0]->key, "seed");
         break;
-    case AAFARM__ENVELOPE__BODY_GRANT:
+    case PROTO_GRANT:
         assert_int_equal(got->grant->lease_id, 0x100000001ull);
         assert_int_equal(got->grant->tile->x, 48);
         assert_int_equal(got->grant->tile->height, 16);
         break;
-    case AAFARM__ENVELOPE__BODY_RESULT:
+    case PROTO_RESULT:
         assert_int_equal(got->result->stats->boxes, 174);
         assert_true(got->result->stats->cpu_seconds == 1.25);
         assert_int_equal(got->result->exr_bytes, s->bulk_len);
         break;
-    case AAFARM__ENVELOPE__BODY_HEARTBEAT:
+    case PROTO_HEARTBEAT:
         assert_int_equal(got->heartbeat->n_leases, 3);
         assert_int_equal(got->heartbeat->leases[2], 0xffffffffffffffffull);
         break;
-    case AAFARM__ENVELOPE__BODY_FAILURE:
+    case PROTO_FAILURE:
         assert_string_equal(got->failure->message, s->failure.message);
         assert_true(got->failure->retryable);
         break;
@@ -102,9 +102,9 @@ static void assert_same(const sample *s, const wire_msg *m)
 static size_t hello(sock_pair *p, wire_stats *st, uint8_t id[256])
 {
     sample *s = malloc(sizeof *s);
-    sample_make(s, AAFARM__ENVELOPE__BODY_HELLO);
-    assert_int_equal(wire_send(p->dealer, NULL, 0, &s->env, NULL, 0), 0);
-    wire_msg *m = wire_recv(p->router, NULL, st, 0);
+    sample_make(s, PROTO_HELLO);
+    assert_int_equal(wire_send_envelope(p->dealer, NULL, NULL, 0, &s->env, NULL, 0, wire_err, sizeof wire_err), 0);
+    wire_msg *m = wire_recv(p->router, NULL, st, 0, wire_err, sizeof wire_err);
     assert_same(s, m);
     size_t len;
     const uint8_t *who = wire_msg_identity(m, &len);
@@ -129,9 +129,9 @@ static void roundtrip_all(const char *transport)
 
     for (size_t k = 0; k < SAMPLE_KINDS; k++) {
         sample_make(s, sample_kinds[k]);
-        if (proto_message_from_worker(s->env.body_case)) {
-            assert_int_equal(wire_send(p.dealer, NULL, 0, &s->env, sample_bulk(s), s->bulk_len), 0);
-            wire_msg *m = wire_recv(p.router, NULL, &to_master, 0);
+        if (proto_message_from_worker(sample_kinds[k])) {
+            assert_int_equal(wire_send_envelope(p.dealer, NULL, NULL, 0, &s->env, sample_bulk(s), s->bulk_len, wire_err, sizeof wire_err), 0);
+            wire_msg *m = wire_recv(p.router, NULL, &to_master, 0, wire_err, sizeof wire_err);
             assert_same(s, m);
             size_t len;
             const uint8_t *who = wire_msg_identity(m, &len);
@@ -140,10 +140,10 @@ static void roundtrip_all(const char *transport)
             wire_msg_destroy(&m);
             sent_up++;
         }
-        if (proto_message_from_master(s->env.body_case)) {
-            assert_int_equal(wire_send(p.router, id, id_len, &s->env, sample_bulk(s), s->bulk_len),
+        if (proto_message_from_master(sample_kinds[k])) {
+            assert_int_equal(wire_send_envelope(p.router, NULL, id, id_len, &s->env, sample_bulk(s), s->bulk_len, wire_err, sizeof wire_err),
                              0);
-            wire_msg *m = wire_recv(p.dealer, NULL, &to_worker, 0);
+            wire_msg *m = wire_recv(p.dealer, NULL, &to_worker, 0, wire_err, sizeof wire_err);
             assert_same(s, m);
             assert_null(wire_msg_identity(m, NULL));
             wire_msg_destroy(&m);
@@ -184,15 +184,15 @@ static void test_large_bulk_tcp(void **state)
     wire_stats st = {0};
     pair_open(&p, "tcp", NULL);
     sample *s = malloc(sizeof *s);
-    sample_make(s, AAFARM__ENVELOPE__BODY_RESULT);
+    sample_make(s, PROTO_RESULT);
     size_t n = proto_limits_default().max_bulk_bytes;
     uint8_t *big = malloc(n);
     assert_non_null(big);
     for (size_t i = 0; i < n; i++)
         big[i] = (uint8_t)(i * 2654435761u >> 24);
     s->result.exr_bytes = n;
-    assert_int_equal(wire_send(p.dealer, NULL, 0, &s->env, big, n), 0);
-    wire_msg *m = wire_recv(p.router, NULL, &st, 0);
+    assert_int_equal(wire_send_envelope(p.dealer, NULL, NULL, 0, &s->env, big, n, wire_err, sizeof wire_err), 0);
+    wire_msg *m = wire_recv(p.router, NULL, &st, 0, wire_err, sizeof wire_err);
     assert_non_null(m);
     size_t len;
     const uint8_t *got = wire_msg_bulk(m, &len);
@@ -208,10 +208,10 @@ static void expect_send_error(void *socket, const void *id, size_t id_len, const
                               const void *bulk, size_t bulk_len, int err, const char *words)
 {
     errno = 0;
-    assert_int_equal(wire_send(socket, id, id_len, &s->env, bulk, bulk_len), -1);
+    assert_int_equal(wire_send_envelope(socket, NULL, id, id_len, &s->env, bulk, bulk_len, wire_err, sizeof wire_err), -1);
     assert_int_equal(errno, err);
     if (words)
-        assert_non_null(strstr(wire_last_error(), words));
+        assert_non_null(strstr(wire_err, words));
 }
 
 static void test_send_refusals(void **state)
@@ -224,7 +224,7 @@ static void test_send_refusals(void **state)
     size_t id_len = hello(&p, &st, id);
     sample *s = malloc(sizeof *s);
 
-    sample_make(s, AAFARM__ENVELOPE__BODY_GRANT); /* a master's message */
+    sample_make(s, PROTO_GRANT); /* a master's message */
     expect_send_error(p.dealer, NULL, 0, s, NULL, 0, EPROTO,
                       "wire_send: Grant is not a message the worker sends");
     expect_send_error(p.router, NULL, 0, s, NULL, 0, EINVAL, "routing id");
@@ -234,22 +234,22 @@ static void test_send_refusals(void **state)
     expect_send_error(p.router, id, id_len, s, NULL, 0, EPROTO,
                       "Grant.tile.width: 0 is outside 1..8192");
 
-    sample_make(s, AAFARM__ENVELOPE__BODY_ASK);
+    sample_make(s, PROTO_ASK);
     expect_send_error(p.router, id, id_len, s, NULL, 0, EPROTO,
                       "Ask is not a message the master sends");
     expect_send_error(p.dealer, id, id_len, s, NULL, 0, EINVAL, "DEALER sends no routing id");
     expect_send_error(p.dealer, NULL, 0, s, "x", 1, EPROTO, "only Result has one");
 
-    sample_make(s, AAFARM__ENVELOPE__BODY_RESULT);
+    sample_make(s, PROTO_RESULT);
     expect_send_error(p.dealer, NULL, 0, s, NULL, 0, EPROTO, "bulk frame");
     expect_send_error(p.dealer, NULL, 0, s, s->bulk, s->bulk_len - 1, EPROTO,
                       "Result.exr_bytes: says 3000 but the bulk frame has 2999 bytes");
 
     /* nothing of the above reached either side */
-    wire_msg *m = wire_recv(p.router, NULL, &st, ZMQ_DONTWAIT);
+    wire_msg *m = wire_recv(p.router, NULL, &st, ZMQ_DONTWAIT, wire_err, sizeof wire_err);
     assert_null(m);
     assert_int_equal(errno, EAGAIN);
-    m = wire_recv(p.dealer, NULL, &st, ZMQ_DONTWAIT);
+    m = wire_recv(p.dealer, NULL, &st, ZMQ_DONTWAIT, wire_err, sizeof wire_err);
     assert_null(m);
     assert_int_equal(errno, EAGAIN);
     assert_int_equal(st.dropped, 0);
@@ -266,23 +266,23 @@ static void test_socket_setup(void **state)
     proto_limits l = proto_limits_default();
     l.max_header_bytes = 1000;
     l.max_bulk_bytes = 5000;
-    assert_int_equal(wire_socket_setup(router, &l), 0);
+    assert_int_equal(wire_socket_setup(router, &l, wire_err, sizeof wire_err), 0);
     int64_t maxmsg = 0;
     size_t size = sizeof maxmsg;
     assert_int_equal(zmq_getsockopt(router, ZMQ_MAXMSGSIZE, &maxmsg, &size), 0);
     assert_int_equal(maxmsg, 5000);
     l.max_header_bytes = 9000;
-    assert_int_equal(wire_socket_setup(router, &l), 0);
+    assert_int_equal(wire_socket_setup(router, &l, wire_err, sizeof wire_err), 0);
     assert_int_equal(zmq_getsockopt(router, ZMQ_MAXMSGSIZE, &maxmsg, &size), 0);
     assert_int_equal(maxmsg, 9000);
 
     /* wire_recv/wire_send refuse sockets that are neither ROUTER nor DEALER */
     errno = 0;
-    assert_null(wire_recv(pub, NULL, NULL, ZMQ_DONTWAIT));
+    assert_null(wire_recv(pub, NULL, NULL, ZMQ_DONTWAIT, wire_err, sizeof wire_err));
     assert_int_equal(errno, ENOTSUP);
     sample *s = malloc(sizeof *s);
-    sample_make(s, AAFARM__ENVELOPE__BODY_SHUTDOWN);
-    assert_int_equal(wire_send(pub, NULL, 0, &s->env, NULL, 0), -1);
+    sample_make(s, PROTO_SHUTDOWN);
+    assert_int_equal(wire_send_envelope(pub, NULL, NULL, 0, &s->env, NULL, 0, wire_err, sizeof wire_err), -1);
     assert_int_equal(errno, EINVAL);
     free(s);
     zmq_close(pub);
