@@ -14,6 +14,7 @@
 #include <unistd.h>
 
 #include "image/exr_io.h"
+#include "util/xalloc.h"
 
 /* Largest image read: 2^31 samples over all channels (8 GiB of floats). */
 #define BUFFER_MAX_SAMPLES ((size_t) 1 << 31)
@@ -25,19 +26,19 @@ image_buffer *image_buffer_new(int width, int height, int channel_count,
         || (size_t) width * (size_t) height * (size_t) (channel_count + 1)
            > BUFFER_MAX_SAMPLES)
         return NULL;
-    image_buffer *self = calloc(1, sizeof *self);
+    image_buffer *self = try_calloc(1, sizeof *self);
     if (!self)
         return NULL;
     self->width = width;
     self->height = height;
     self->channel_count = channel_count;
-    self->names = calloc((size_t) channel_count + 1, sizeof(char *));
-    self->planes = calloc((size_t) channel_count + 1, sizeof(float *));
+    self->names = try_calloc((size_t) channel_count + 1, sizeof(char *));
+    self->planes = try_calloc((size_t) channel_count + 1, sizeof(float *));
     bool ok = self->names && self->planes;
     size_t px = (size_t) width * (size_t) height;
     for (int c = 0; ok && c < channel_count; c++) {
-        self->names[c] = strdup(names[c]);
-        self->planes[c] = calloc(px, sizeof(float));
+        self->names[c] = try_strdup(names[c]);
+        self->planes[c] = try_calloc(px, sizeof(float));
         ok = self->names[c] && self->planes[c];
     }
     if (!ok)

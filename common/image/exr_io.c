@@ -27,6 +27,8 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "util/xalloc.h"
+
 /* ---- streams ---- */
 
 static void stream_reset(image_exr_stream *self)
@@ -151,29 +153,28 @@ static int64_t stream_size(exr_const_context_t ctxt, void *user)
     return (int64_t) st.st_size;
 }
 
-static bool grow_memory(image_exr_stream *self, size_t need)
+/* The buffer of a tile being encoded (a few MB at most): out of memory
+ * aborts (util/xalloc.h). */
+static void grow_memory(image_exr_stream *self, size_t need)
 {
     if (need <= self->out_cap)
-        return true;
+        return;
     size_t cap = self->out_cap ? self->out_cap : 4096;
     while (cap < need)
         cap = cap > SIZE_MAX / 2 ? need : cap * 2;
-    uint8_t *p = realloc(self->out, cap);
-    if (!p)
-        return false;
-    memset(p + self->out_cap, 0, cap - self->out_cap);
-    self->out = p;
+    self->out = xrealloc(self->out, cap);
+    memset(self->out + self->out_cap, 0, cap - self->out_cap);
     self->out_cap = cap;
-    return true;
 }
 
 static int64_t write_memory(image_exr_stream *self, const void *buffer,
                             uint64_t sz, uint64_t offset)
 {
-    if (offset > SIZE_MAX - sz || !grow_memory(self, (size_t) (offset + sz))) {
+    if (offset > SIZE_MAX - sz) {
         self->sys_errno = ENOMEM;
         return -1;
     }
+    grow_memory(self, (size_t) (offset + sz));
     memcpy(self->out + offset, buffer, (size_t) sz);
     if (offset + sz > self->out_len)
         self->out_len = (size_t) (offset + sz);

@@ -14,6 +14,8 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "util/xalloc.h"
+
 struct image_outfile {
     char *path;        /* final name */
     char *temp_path;   /* path.tmp-<pid> */
@@ -23,9 +25,8 @@ struct image_outfile {
 static char *temp_name(const char *path)
 {
     size_t n = strlen(path) + 32;
-    char *s = malloc(n);
-    if (s)
-        snprintf(s, n, "%s.tmp-%ld", path, (long) getpid());
+    char *s = xmalloc(n);
+    snprintf(s, n, "%s.tmp-%ld", path, (long) getpid());
     return s;
 }
 
@@ -35,17 +36,10 @@ image_outfile *image_outfile_new(const char *path, char *err, size_t errsz)
         snprintf(err, errsz, "no output file name given");
         return NULL;
     }
-    image_outfile *self = calloc(1, sizeof *self);
-    if (self) {
-        self->fd = -1;
-        self->path = strdup(path);
-        self->temp_path = temp_name(path);
-    }
-    if (!self || !self->path || !self->temp_path) {
-        snprintf(err, errsz, "out of memory creating output file %s", path);
-        image_outfile_destroy(&self);
-        return NULL;
-    }
+    image_outfile *self = xcalloc(1, sizeof *self);
+    self->fd = -1;
+    self->path = xstrdup(path);
+    self->temp_path = temp_name(path);
     self->fd = open(self->temp_path, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC,
                     0666);
     if (self->fd < 0) {
@@ -90,9 +84,7 @@ const char *image_outfile_temp_path(const image_outfile *self)
 
 static void sync_directory(const char *path)
 {
-    char *dir = strdup(path);
-    if (!dir)
-        return;
+    char *dir = xstrdup(path);
     char *slash = strrchr(dir, '/');
     const char *name = dir;
     if (!slash)

@@ -16,6 +16,7 @@
 #include <unistd.h>
 
 #include "image/outfile.h"
+#include "util/xalloc.h"
 
 uint8_t image_preview_srgb8(float linear)
 {
@@ -112,9 +113,9 @@ static bool write_png(image_outfile *file, const pixel_source *src,
     png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &ctx,
                                               on_png_error, on_png_warning);
     png_infop info = png ? png_create_info_struct(png) : NULL;
-    uint8_t *row = malloc((size_t) src->width * 3);
+    uint8_t *row = xmalloc((size_t) src->width * 3);
     int rc = 1;
-    if (png && info && row) {
+    if (png && info) {
         png_set_write_fn(png, &ctx, on_png_write, on_png_flush);
         rc = write_rows(png, info, src, row);
     } else {

@@ -27,37 +27,28 @@
 #include <string.h>
 
 #include "image/exr_io.h"
+#include "util/xalloc.h"
 
 /* ---- the tile ---- */
-
-static float *alloc_floats(size_t n)
-{
-    return calloc(n, sizeof(float));
-}
 
 image_tile *image_tile_new(int x0, int y0, int w, int h, unsigned layers)
 {
     if (w < 1 || h < 1 || w > IMAGE_MAX_TILE_SIZE || h > IMAGE_MAX_TILE_SIZE
         || (layers & ~(unsigned) IMAGE_LAYERS_ALL) != 0)
         return NULL;
-    image_tile *self = calloc(1, sizeof *self);
-    if (!self)
-        return NULL;
+    image_tile *self = xcalloc(1, sizeof *self);
     size_t px = (size_t) w * (size_t) h;
     self->x0 = x0;
     self->y0 = y0;
     self->w = w;
     self->h = h;
     self->layers = layers;
-    self->rgba = alloc_floats(4 * px);
-    self->z = alloc_floats(px);
+    self->rgba = xcalloc(4 * px, sizeof(float));
+    self->z = xcalloc(px, sizeof(float));
     if (layers & IMAGE_LAYER_N)
-        self->n = alloc_floats(3 * px);
+        self->n = xcalloc(3 * px, sizeof(float));
     if (layers & IMAGE_LAYER_P)
-        self->p = alloc_floats(3 * px);
-    if (!self->rgba || !self->z || (layers & IMAGE_LAYER_N && !self->n)
-        || (layers & IMAGE_LAYER_P && !self->p))
-        image_tile_destroy(&self);
+        self->p = xcalloc(3 * px, sizeof(float));
     return self;
 }
 

@@ -21,6 +21,7 @@
 
 #include "image/exr_io.h"
 #include "image/outfile.h"
+#include "util/xalloc.h"
 
 struct image_writer {
     image_format fmt;
@@ -37,16 +38,9 @@ image_writer *image_writer_new(const char *path, const image_format *fmt,
 {
     if (!image_format_check(fmt, err, errsz))
         return NULL;
-    image_writer *self = calloc(1, sizeof *self);
-    uint8_t *written = calloc((size_t) image_format_tile_count(fmt), 1);
-    if (!self || !written) {
-        snprintf(err, errsz, "out of memory creating output image %s", path);
-        free(self);
-        free(written);
-        return NULL;
-    }
+    image_writer *self = xcalloc(1, sizeof *self);
     self->fmt = *fmt;
-    self->written = written;
+    self->written = xcalloc((size_t) image_format_tile_count(fmt), 1);
     self->file = image_outfile_new(path, err, errsz);
     if (!self->file) {
         image_writer_destroy(&self);

@@ -3,6 +3,7 @@
  * frame, and loading one job per chosen frame (see frames.h).
  */
 #include "job/frames.h"
+#include "util/xalloc.h"
 #include "scene/scene.h"
 
 #include <ctype.h>
@@ -63,8 +64,7 @@ bool frame_spec_parse(const char *text, frame_spec *out, char *err, size_t errsz
             frame_spec_free(out);
             return false;
         }
-        out->ranges = realloc(out->ranges, sizeof *out->ranges * (size_t)(out->count + 1));
-        if (!out->ranges) abort();
+        out->ranges = xrealloc(out->ranges, sizeof *out->ranges * (size_t)(out->count + 1));
         out->ranges[out->count][0] = lo;
         out->ranges[out->count][1] = hi;
         out->count++;
@@ -109,8 +109,7 @@ bool frame_choose(const int *numbers, int n, const frame_spec *spec, int **indic
     static const int one = 1;
     int total = n > 0 ? n : 1;
     if (n == 0) numbers = &one;
-    *indices = malloc(sizeof **indices * (size_t)total);
-    if (!*indices) abort();
+    *indices = xmalloc(sizeof **indices * (size_t)total);
     *count = 0;
     for (int i = 0; spec && i < spec->count; i++) {
         bool any = false;
@@ -163,14 +162,12 @@ static bool holds_number(const char *name, int number)
 static char *substitute(const char *name, int number, int *patterns, char *err, size_t errsz)
 {
     size_t cap = strlen(name) + 64, used = 0;
-    char *out = malloc(cap);
-    if (!out) abort();
+    char *out = xmalloc(cap);
     *patterns = 0;
     for (const char *p = name; *p;) {
         if (used + 40 >= cap) {
             cap *= 2;
-            out = realloc(out, cap);
-            if (!out) abort();
+            out = xrealloc(out, cap);
         }
         if (*p != '%') {
             out[used++] = *p++;
@@ -212,8 +209,7 @@ char *frame_output_name(const char *name, int number, int nframes, bool display,
     base = base ? base + 1 : out;
     const char *dot = strrchr(base, '.');
     size_t at = dot && dot != base ? (size_t)(dot - out) : strlen(out);
-    char *named = malloc(strlen(out) + 24);
-    if (!named) abort();
+    char *named = xmalloc(strlen(out) + 24);
     snprintf(named, strlen(out) + 24, "%.*s.%04d%s", (int)at, out, number, out + at);
     free(out);
     return named;
@@ -362,12 +358,10 @@ frame_sequence *frame_sequence_load(const char *rib_path, const job_options *opt
     if (frames) frame_spec_free(&spec);
     if (!ok) *usage = true;
     if (!ok) return NULL;
-    frame_sequence *seq = calloc(1, sizeof *seq);
-    if (!seq) abort();
+    frame_sequence *seq = xcalloc(1, sizeof *seq);
     seq->nframes = nframes;
-    seq->jobs = calloc((size_t)count, sizeof *seq->jobs);
-    seq->outputs = calloc((size_t)count, sizeof *seq->outputs);
-    if (!seq->jobs || !seq->outputs) abort();
+    seq->jobs = xcalloc((size_t)count, sizeof *seq->jobs);
+    seq->outputs = xcalloc((size_t)count, sizeof *seq->outputs);
     seq->count = count;
     for (int i = 0; i < count && ok; i++) {
         opt.frame = indices[i];

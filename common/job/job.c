@@ -2,6 +2,7 @@
  * job.c: building, checking and hashing render jobs (see job.h).
  */
 #include "job/job.h"
+#include "util/xalloc.h"
 
 #include <errno.h>
 #include <stdio.h>
@@ -10,17 +11,6 @@
 
 #include "job/job_scene.h"
 #include "scene/scene.h"
-
-static char *dup_n(const char *s, size_t n)
-{
-    char *p = malloc(n + 1);
-    if (!p) abort();
-    memcpy(p, s, n);
-    p[n] = '\0';
-    return p;
-}
-
-static char *dup_s(const char *s) { return dup_n(s, strlen(s)); }
 
 void job_options_default(job_options *opt)
 {
@@ -45,10 +35,9 @@ bool trace_arith_parse(const char *text, trace_arith *out)
 job *job_new(const char *scene_file, const char *scene_text, size_t scene_len,
              const job_options *options)
 {
-    job *self = calloc(1, sizeof *self);
-    if (!self) abort();
-    self->scene_file = dup_s(scene_file);
-    self->scene_text = dup_n(scene_text, scene_len);
+    job *self = xcalloc(1, sizeof *self);
+    self->scene_file = xstrdup(scene_file);
+    self->scene_text = xstrndup(scene_text, scene_len);
     self->scene_len = scene_len;
     self->sources = sl_source_set_new();
     if (options) self->options = *options;
@@ -111,10 +100,9 @@ bool job_add_shader(job *self, const char *name, const char *file,
         snprintf(why, (size_t)why_size, "shader '%s' listed twice", name);
         return false;
     }
-    self->shaders = realloc(self->shaders, sizeof(job_shader) * (size_t)(self->nshaders + 1));
-    if (!self->shaders) abort();
-    self->shaders[self->nshaders].name = dup_s(name);
-    self->shaders[self->nshaders].file = dup_s(file);
+    self->shaders = xrealloc(self->shaders, sizeof(job_shader) * (size_t)(self->nshaders + 1));
+    self->shaders[self->nshaders].name = xstrdup(name);
+    self->shaders[self->nshaders].file = xstrdup(file);
     self->nshaders++;
     return true;
 }
@@ -142,11 +130,10 @@ bool job_add_file(job *self, const char *name, const char *hex, uint64_t size,
         snprintf(why, (size_t)why_size, "file '%s' listed twice", name);
         return false;
     }
-    self->files = realloc(self->files, sizeof(job_file) * (size_t)(self->nfiles + 1));
-    if (!self->files) abort();
+    self->files = xrealloc(self->files, sizeof(job_file) * (size_t)(self->nfiles + 1));
     job_file *f = &self->files[self->nfiles++];
     memset(f, 0, sizeof *f);
-    f->name = dup_s(name);
+    f->name = xstrdup(name);
     snprintf(f->sha256, sizeof f->sha256, "%s", hex);
     f->size = size;
     return true;
@@ -155,7 +142,7 @@ bool job_add_file(job *self, const char *name, const char *hex, uint64_t size,
 void job_file_set_path(job *self, int i, const char *path)
 {
     free(self->files[i].path);
-    self->files[i].path = path ? dup_s(path) : NULL;
+    self->files[i].path = path ? xstrdup(path) : NULL;
 }
 
 uint64_t job_files_bytes(const job *self)
@@ -203,16 +190,14 @@ bool job_finish(job *self, char *why, int why_size)
         return false;
     }
     size_t nsrc = sl_source_set_count(self->sources);
-    hash_shader *hs = calloc(nsrc + 1, sizeof *hs);
+    hash_shader *hs = xcalloc(nsrc + 1, sizeof *hs);
     int nopt = 3 + self->nshaders + self->nfiles + (self->options.frame != 0);
-    hash_option *ho = calloc((size_t)nopt, sizeof *ho);
+    hash_option *ho = xcalloc((size_t)nopt, sizeof *ho);
     /* a file enters the hash as option "file:<name>" = "<sha256>:<size>" */
-    char **file_keys = calloc((size_t)self->nfiles + 1, sizeof *file_keys);
-    char (*file_vals)[HASH_HEX_SIZE + 24] = calloc((size_t)self->nfiles + 1, sizeof *file_vals);
-    if (!file_keys || !file_vals) abort();
-    char (*keys)[160] = calloc((size_t)nopt, sizeof *keys);
-    char (*vals)[600] = calloc((size_t)nopt, sizeof *vals);
-    if (!hs || !ho || !keys || !vals) abort();
+    char **file_keys = xcalloc((size_t)self->nfiles + 1, sizeof *file_keys);
+    char (*file_vals)[HASH_HEX_SIZE + 24] = xcalloc((size_t)self->nfiles + 1, sizeof *file_vals);
+    char (*keys)[160] = xcalloc((size_t)nopt, sizeof *keys);
+    char (*vals)[600] = xcalloc((size_t)nopt, sizeof *vals);
     for (size_t i = 0; i < nsrc; i++) {
         const sl_source *s = sl_source_set_at(self->sources, i);
         hs[i] = (hash_shader){s->name, s->text, s->len};
@@ -230,8 +215,7 @@ bool job_finish(job *self, char *why, int why_size)
     for (int i = 0; i < 3 + self->nshaders; i++) ho[i] = (hash_option){keys[i], vals[i]};
     for (int i = 0; i < self->nfiles; i++) {
         size_t n = strlen(self->files[i].name) + 6;
-        file_keys[i] = malloc(n);
-        if (!file_keys[i]) abort();
+        file_keys[i] = xmalloc(n);
         snprintf(file_keys[i], n, "file:%s", self->files[i].name);
         snprintf(file_vals[i], sizeof file_vals[i], "%s:%llu", self->files[i].sha256,
                  (unsigned long long)self->files[i].size);
@@ -267,8 +251,7 @@ static char *read_file(const char *path, size_t *len, sl_diag *diag)
         return NULL;
     }
     size_t cap = 1 << 16, n = 0;
-    char *buf = malloc(cap);
-    if (!buf) abort();
+    char *buf = xmalloc(cap);
     size_t got;
     while ((got = fread(buf + n, 1, cap - n, f)) > 0) {
         n += got;
@@ -280,8 +263,7 @@ static char *read_file(const char *path, size_t *len, sl_diag *diag)
                 return NULL;
             }
             cap *= 2;
-            buf = realloc(buf, cap);
-            if (!buf) abort();
+            buf = xrealloc(buf, cap);
         }
     }
     bool bad = ferror(f);
@@ -319,12 +301,11 @@ job *job_load(const char *rib_path, const job_options *options, sl_diag *diag)
     self->frame_number = sc->frame_number;
     self->nframes = sc->nframes;
     if (sc->nframes > 0) {
-        self->frame_numbers = malloc(sizeof *self->frame_numbers * (size_t)sc->nframes);
-        if (!self->frame_numbers) abort();
+        self->frame_numbers = xmalloc(sizeof *self->frame_numbers * (size_t)sc->nframes);
         memcpy(self->frame_numbers, sc->frame_numbers,
                sizeof *self->frame_numbers * (size_t)sc->nframes);
     }
-    if (sc->display_name) self->display_name = dup_s(sc->display_name);
+    if (sc->display_name) self->display_name = xstrdup(sc->display_name);
     char why[512];
     bool ok = true;
     for (int i = 0; i < sc->nshader_names; i++) {

@@ -14,6 +14,7 @@
  * file the shader never reads, never a wrong pixel.
  */
 #include "job/job.h"
+#include "util/xalloc.h"
 
 #include <errno.h>
 #include <stdio.h>
@@ -48,8 +49,7 @@ static bool hash_file(const char *path, char hex[HASH_HEX_SIZE], uint64_t *size,
         return false;
     }
     enum { CHUNK = 1 << 20 };
-    unsigned char *buf = malloc(CHUNK);
-    if (!buf) abort();
+    unsigned char *buf = xmalloc(CHUNK);
     sha256 h;
     sha256_init(&h);
     uint64_t n = 0;
@@ -86,14 +86,13 @@ static char *find_on_path(const scene *sc, const char *name)
 {
     struct stat st;
     if (name[0] == '/') {
-        if (stat(name, &st) == 0 && S_ISREG(st.st_mode)) return strdup(name);
+        if (stat(name, &st) == 0 && S_ISREG(st.st_mode)) return xstrdup(name);
         return NULL;
     }
     for (int i = 0; i < sc->ntexture_path; i++) {
         const char *dir = sc->texture_path[i];
         size_t n = strlen(dir) + strlen(name) + 2;
-        char *path = malloc(n);
-        if (!path) abort();
+        char *path = xmalloc(n);
         if (strcmp(dir, ".") == 0) snprintf(path, n, "%s", name);
         else snprintf(path, n, "%s%s%s", dir, dir[strlen(dir) - 1] == '/' ? "" : "/", name);
         if (stat(path, &st) == 0 && S_ISREG(st.st_mode)) return path;

@@ -15,6 +15,7 @@
  * stays in memory for good (tex_bytes).
  */
 #include "tex/tex_internal.h"
+#include "util/xalloc.h"
 
 #include <errno.h>
 #include <pthread.h>
@@ -40,9 +41,7 @@ struct tex_cache {
 
 tex_cache *tex_cache_new(size_t budget)
 {
-    tex_cache *self = calloc(1, sizeof *self);
-    if (!self)
-        return NULL;
+    tex_cache *self = xcalloc(1, sizeof *self);
     pthread_mutex_init(&self->lock, NULL);
     self->budget = budget;
     return self;
@@ -84,26 +83,16 @@ static tex_texture *find(const tex_cache *self, const char *name)
     return NULL;
 }
 
-static bool add(tex_cache *self, const char *name, tex_texture *t)
+static void add(tex_cache *self, const char *name, tex_texture *t)
 {
     if (self->n == self->cap) {
-        int cap = self->cap ? 2 * self->cap : 8;
-        tex_entry *e = realloc(self->entries, (size_t)cap * sizeof *e);
-        if (!e)
-            return false;
-        self->entries = e;
-        self->cap = cap;
+        self->cap = self->cap ? 2 * self->cap : 8;
+        self->entries = xreallocarray(self->entries, (size_t)self->cap, sizeof *self->entries);
     }
-    size_t len = strlen(name) + 1;
-    char *copy = malloc(len);
-    if (!copy)
-        return false;
-    memcpy(copy, name, len);
-    self->entries[self->n].name = copy;
+    self->entries[self->n].name = xstrdup(name);
     self->entries[self->n].tex = t;
     self->n++;
     self->bytes += tex_bytes(t);
-    return true;
 }
 
 const tex_texture *tex_cache_get(tex_cache *self, const char *name, char *err, size_t errsz)
@@ -132,11 +121,8 @@ const tex_texture *tex_cache_get(tex_cache *self, const char *name, char *err, s
         tex_free(t);
         t = NULL;
     }
-    if (t && !add(self, name, t)) {
-        snprintf(err, errsz, "texture '%s': out of memory", name);
-        tex_free(t);
-        t = NULL;
-    }
+    if (t)
+        add(self, name, t);
     pthread_mutex_unlock(&self->lock);
     return t;
 }
@@ -144,7 +130,9 @@ const tex_texture *tex_cache_get(tex_cache *self, const char *name, char *err, s
 bool tex_cache_put(tex_cache *self, const char *name, tex_texture *t)
 {
     pthread_mutex_lock(&self->lock);
-    bool ok = !find(self, name) && add(self, name, t);
+    bool ok = !find(self, name);
+    if (ok)
+        add(self, name, t);
     pthread_mutex_unlock(&self->lock);
     if (!ok)
         tex_free(t);

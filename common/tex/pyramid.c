@@ -12,19 +12,11 @@
  * never takes it outside the min-max pyramid's bound.
  */
 #include "tex/tex_internal.h"
+#include "util/xalloc.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-
-static char *dup_string(const char *s)
-{
-    size_t n = strlen(s) + 1;
-    char *r = malloc(n);
-    if (r)
-        memcpy(r, s, n);
-    return r;
-}
 
 /* Level-0 texels covered by index q of level k along a side of n texels. */
 static double covered(int q, int k, int n)
@@ -54,13 +46,8 @@ static double level_lipschitz(const float *v, int w, int h, int nch, int c, bool
 
 tex_texture *tex_build(tex_pixels *px, const char *name)
 {
-    tex_texture *t = calloc(1, sizeof *t);
-    if (!t) {
-        free(px->data);
-        px->data = NULL;
-        return NULL;
-    }
-    t->name = dup_string(name);
+    tex_texture *t = xcalloc(1, sizeof *t);
+    t->name = xstrdup(name);
     t->type = px->type ? px->type : "float";
     t->w = px->w;
     t->h = px->h;
@@ -71,22 +58,13 @@ tex_texture *tex_build(tex_pixels *px, const char *name)
         h = (h + 1) / 2;
     }
     t->nlevels = n;
-    t->lw = calloc((size_t)n, sizeof *t->lw);
-    t->lh = calloc((size_t)n, sizeof *t->lh);
-    t->avg = calloc((size_t)n, sizeof *t->avg);
-    t->mn = calloc((size_t)n, sizeof *t->mn);
-    t->mx = calloc((size_t)n, sizeof *t->mx);
-    t->lips = calloc((size_t)t->nch, sizeof *t->lips);
-    t->lipt = calloc((size_t)t->nch, sizeof *t->lipt);
-    if (!t->name || !t->lw || !t->lh || !t->avg || !t->mn || !t->mx || !t->lips || !t->lipt) {
-        if (t->avg)
-            t->avg[0] = px->data;
-        else
-            free(px->data);
-        px->data = NULL;
-        tex_free(t);
-        return NULL;
-    }
+    t->lw = xcalloc((size_t)n, sizeof *t->lw);
+    t->lh = xcalloc((size_t)n, sizeof *t->lh);
+    t->avg = xcalloc((size_t)n, sizeof *t->avg);
+    t->mn = xcalloc((size_t)n, sizeof *t->mn);
+    t->mx = xcalloc((size_t)n, sizeof *t->mx);
+    t->lips = xcalloc((size_t)t->nch, sizeof *t->lips);
+    t->lipt = xcalloc((size_t)t->nch, sizeof *t->lipt);
     int nch = t->nch;
     float *img = px->data;
     px->data = NULL;
@@ -104,13 +82,9 @@ tex_texture *tex_build(tex_pixels *px, const char *name)
         t->lw[k] = w;
         t->lh[k] = h;
         size_t sz = (size_t)w * (size_t)h * (size_t)nch;
-        t->avg[k] = malloc(sz * sizeof(float));
-        t->mn[k] = malloc(sz * sizeof(float));
-        t->mx[k] = malloc(sz * sizeof(float));
-        if (!t->avg[k] || !t->mn[k] || !t->mx[k]) {
-            tex_free(t);
-            return NULL;
-        }
+        t->avg[k] = xmalloc(sz * sizeof(float));
+        t->mn[k] = xmalloc(sz * sizeof(float));
+        t->mx[k] = xmalloc(sz * sizeof(float));
         t->bytes += 3 * sz * sizeof(float);
         const float *pa = t->avg[k - 1], *pmn = t->mn[k - 1], *pmx = t->mx[k - 1];
         for (int j = 0; j < h; j++)
@@ -155,9 +129,7 @@ tex_texture *tex_from_pixels(const float *pixels, int w, int h, int nch, const c
         nch > TEX_MAX_CHANNELS)
         return NULL;
     size_t count = (size_t)w * (size_t)h * (size_t)nch;
-    tex_pixels px = { malloc(count * sizeof(float)), w, h, nch, "float" };
-    if (!px.data)
-        return NULL;
+    tex_pixels px = { xmalloc(count * sizeof(float)), w, h, nch, "float" };
     memcpy(px.data, pixels, count * sizeof(float));
     return tex_build(&px, name);
 }

@@ -54,11 +54,7 @@ tex_texture *tex_open_in(const char *path, tex_tiles *pool, char *err, size_t er
         free(px.data);
         return NULL;
     }
-    tex_texture *t = tex_build(&px, path);
-    if (!t)
-        snprintf(err, errsz, "%s: out of memory building the texture's pyramids (%d x %d, "
-                 "%d channels)", path, px.w, px.h, px.nch);
-    return t;
+    return tex_build(&px, path);
 }
 
 int tex_wrap_find(const char *name)

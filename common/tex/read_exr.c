@@ -9,6 +9,7 @@
  * channel 0 whatever its name ("Y", "Z", "height").
  */
 #include "tex/tex_internal.h"
+#include "util/xalloc.h"
 
 #include <openexr.h>
 
@@ -125,7 +126,7 @@ bool tex_read_exr(const char *path, tex_pixels *out, char *err, size_t errsz)
             if (k == r)
                 slot[c] = n++;
         }
-    data = calloc((size_t)w * (size_t)h * (size_t)nch, sizeof *data);
+    data = try_calloc((size_t)w * (size_t)h * (size_t)nch, sizeof *data);
     if (!data) {
         snprintf(err, errsz, "%s: out of memory for %d x %d x %d texels", path, w, h, nch);
         goto done;

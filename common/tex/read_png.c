@@ -5,6 +5,7 @@
  * no gamma decoding: a height map's 65535 is 1.0 exactly.
  */
 #include "tex/tex_internal.h"
+#include "util/xalloc.h"
 
 #include <png.h>
 
@@ -68,11 +69,11 @@ bool tex_read_png(const char *path, tex_pixels *out, char *err, size_t errsz)
     int nch = png_get_channels(png, info), bits = png_get_bit_depth(png, info);
     int passes = png_set_interlace_handling(png);
     size_t rowbytes = png_get_rowbytes(png, info);
-    data = calloc((size_t)w * (size_t)h * (size_t)nch, sizeof(float));
-    row = malloc(rowbytes * (size_t)h);
+    data = try_calloc((size_t)w * (size_t)h * (size_t)nch, sizeof(float));
+    row = try_malloc(rowbytes * (size_t)h);
     if (!data || !row)
         png_error(png, "out of memory for the pixels");
-    rows = malloc((size_t)h * sizeof *rows);
+    rows = try_malloc((size_t)h * sizeof *rows);
     if (!rows)
         png_error(png, "out of memory for the pixels");
     for (int y = 0; y < h; y++)

@@ -6,6 +6,7 @@
  * libtiff's warnings are silenced and its errors become the message.
  */
 #include "tex/tex_internal.h"
+#include "util/xalloc.h"
 
 #include <tiffio.h>
 
@@ -84,7 +85,7 @@ bool tex_read_tiff(const char *path, tex_pixels *out, char *err, size_t errsz)
         goto done;
     }
     int nch = spp, bps = bits / 8;
-    data = calloc((size_t)w * h * (size_t)nch, sizeof *data);
+    data = try_calloc((size_t)w * h * (size_t)nch, sizeof *data);
     if (!data) {
         snprintf(err, errsz, "%s: out of memory for %u x %u x %d texels", path, w, h, nch);
         goto done;
@@ -95,7 +96,7 @@ bool tex_read_tiff(const char *path, tex_pixels *out, char *err, size_t errsz)
         uint32_t tw = 0, th = 0;
         TIFFGetField(tif, TIFFTAG_TILEWIDTH, &tw);
         TIFFGetField(tif, TIFFTAG_TILELENGTH, &th);
-        buf = malloc((size_t)TIFFTileSize(tif));
+        buf = try_malloc((size_t)TIFFTileSize(tif));
         if (!buf || tw == 0 || th == 0) {
             snprintf(err, errsz, "%s: bad tile size %u x %u", path, tw, th);
             goto done;
@@ -117,7 +118,7 @@ bool tex_read_tiff(const char *path, tex_pixels *out, char *err, size_t errsz)
                             }
                 }
     } else {
-        buf = malloc((size_t)TIFFScanlineSize(tif));
+        buf = try_malloc((size_t)TIFFScanlineSize(tif));
         if (!buf) {
             snprintf(err, errsz, "%s: out of memory", path);
             goto done;

@@ -14,6 +14,7 @@
  */
 #include "tex/tex_internal.h"
 #include "tex/tiles.h"
+#include "util/xalloc.h"
 
 #include <openexr.h>
 
@@ -91,9 +92,7 @@ static float *read_level(const tex_tiled *tl, const tex_texture *t, int p, int k
 {
     int w = t->lw[k], h = t->lh[k];
     size_t count = (size_t)w * (size_t)h * (size_t)t->nch;
-    float *v = malloc(count * sizeof *v);
-    if (!v)
-        return NULL;
+    float *v = xmalloc(count * sizeof *v);
     for (int ty = 0; ty * tl->th < h; ty++)
         for (int tx = 0; tx * tl->tw < w; tx++) {
             float *dst = v + ((size_t)ty * tl->th * (size_t)w + (size_t)tx * tl->tw) * t->nch;
@@ -185,10 +184,8 @@ bool tex_open_tiled(const char *path, tex_tiles *pool, tex_texture **out, char *
     double lips[TEX_MAX_CHANNELS], lipt[TEX_MAX_CHANNELS];
     bool lip_ok = exr_attr_get_string(ctx, 0, TEX_ATTR_LIPSCHITZ, &liplen, &lip) ==
                   EXR_ERR_SUCCESS && lip;
-    char *buf = lip_ok ? malloc((size_t)liplen + 1) : NULL;
+    char *buf = lip_ok ? xstrndup(lip, (size_t)liplen) : NULL;
     if (buf) {
-        memcpy(buf, lip, (size_t)liplen);
-        buf[liplen] = '\0';
         char *s = buf, *end;
         for (int c = 0; lip_ok && c < 2 * nch; c++) {
             double v = strtod(s, &end);
@@ -218,33 +215,20 @@ bool tex_open_tiled(const char *path, tex_tiles *pool, tex_texture **out, char *
                       "of float, uint8, uint16, uint32");
     }
 
-    tex_texture *t = calloc(1, sizeof *t);
-    size_t namelen = strlen(path) + 1;
-    if (!t || !(t->name = malloc(namelen))) {
-        free(t);
-        exr_finish(&ctx);
-        snprintf(err, errsz, "%s: out of memory", path);
-        return false;
-    }
-    memcpy(t->name, path, namelen);
+    tex_texture *t = xcalloc(1, sizeof *t);
+    t->name = xstrdup(path);
     t->type = ttype;
     t->w = (int)w;
     t->h = (int)h;
     t->nch = nch;
     t->nlevels = nlevels;
-    t->lw = calloc((size_t)nlevels, sizeof *t->lw);
-    t->lh = calloc((size_t)nlevels, sizeof *t->lh);
-    t->avg = calloc((size_t)nlevels, sizeof *t->avg);
-    t->mn = calloc((size_t)nlevels, sizeof *t->mn);
-    t->mx = calloc((size_t)nlevels, sizeof *t->mx);
-    t->lips = calloc((size_t)nch, sizeof *t->lips);
-    t->lipt = calloc((size_t)nch, sizeof *t->lipt);
-    if (!t->lw || !t->lh || !t->avg || !t->mn || !t->mx || !t->lips || !t->lipt) {
-        tex_free(t);
-        exr_finish(&ctx);
-        snprintf(err, errsz, "%s: out of memory", path);
-        return false;
-    }
+    t->lw = xcalloc((size_t)nlevels, sizeof *t->lw);
+    t->lh = xcalloc((size_t)nlevels, sizeof *t->lh);
+    t->avg = xcalloc((size_t)nlevels, sizeof *t->avg);
+    t->mn = xcalloc((size_t)nlevels, sizeof *t->mn);
+    t->mx = xcalloc((size_t)nlevels, sizeof *t->mx);
+    t->lips = xcalloc((size_t)nch, sizeof *t->lips);
+    t->lipt = xcalloc((size_t)nch, sizeof *t->lipt);
     memcpy(t->lips, lips, (size_t)nch * sizeof *lips);
     memcpy(t->lipt, lipt, (size_t)nch * sizeof *lipt);
     int resident = nlevels;
@@ -255,12 +239,6 @@ bool tex_open_tiled(const char *path, tex_tiles *pool, tex_texture **out, char *
             resident = k;
     }
     tex_tiled *tl = tex_tiled_new(ctx, pool, t, (int)tw, (int)th, resident);
-    if (!tl) {
-        tex_free(t);
-        exr_finish(&ctx);
-        snprintf(err, errsz, "%s: out of memory", path);
-        return false;
-    }
     t->tiled = tl;
     for (int c = 0; c < nch; c++)
         for (int q = 0; q < nch; q++) {

@@ -27,6 +27,13 @@
  * other edge for periodic, 0 for black), so the min and max of those
  * texels bound it; the min-max pyramid answers that at the level where
  * the rectangle spans a few texels.
+ *
+ * Memory (util/xalloc.h): the image readers (read_exr.c, read_png.c,
+ * read_tiff.c) survive out of memory: the texel buffer of the size a file
+ * states is a try_* allocation, and when it fails tex_open returns NULL
+ * with "path: out of memory ..." (tests/tex/test_tex_read.c drives it with
+ * a PNG that claims 2^20 x 2^20 texels). Everything else (the pyramids, the
+ * tiles, the cache) aborts naming the size.
  */
 #ifndef TEX_TEX_H
 #define TEX_TEX_H

@@ -75,8 +75,7 @@ bool tex_read_exr(const char *path, tex_pixels *out, char *err, size_t errsz);
 bool tex_read_png(const char *path, tex_pixels *out, char *err, size_t errsz);
 bool tex_read_tiff(const char *path, tex_pixels *out, char *err, size_t errsz);
 
-/* Builds the pyramids of an image (taking its pixels). NULL when out of
- * memory. */
+/* Builds the pyramids of an image (taking its pixels). */
 tex_texture *tex_build(tex_pixels *px, const char *name);
 
 #endif

@@ -32,6 +32,8 @@
 
 #include <openexr.h>
 
+#include "util/xalloc.h"
+
 #include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -47,9 +49,7 @@ struct tex_tiles {
 
 tex_tiles *tex_tiles_new(size_t budget)
 {
-    tex_tiles *pool = calloc(1, sizeof *pool);
-    if (!pool)
-        return NULL;
+    tex_tiles *pool = xcalloc(1, sizeof *pool);
     pthread_mutex_init(&pool->lock, NULL);
     pool->budget = budget;
     return pool;
@@ -70,8 +70,6 @@ static pthread_once_t process_once = PTHREAD_ONCE_INIT;
 static void make_process_pool(void)
 {
     process_pool = tex_tiles_new(TEX_DEFAULT_TILE_BYTES);
-    if (!process_pool)
-        abort();
 }
 
 tex_tiles *tex_tiles_process(void)
@@ -107,9 +105,7 @@ void tex_tiles_stats(tex_tiles *pool, tex_tile_stats *out)
 tex_tiled *tex_tiled_new(void *exr, tex_tiles *pool, const tex_texture *t, int tw, int th,
                          int resident)
 {
-    tex_tiled *tl = calloc(1, sizeof *tl);
-    if (!tl)
-        return NULL;
+    tex_tiled *tl = xcalloc(1, sizeof *tl);
     tl->exr = exr;
     tl->own_pool = pool == NULL;
     tl->pool = pool ? pool : tex_tiles_new(0);
@@ -117,23 +113,15 @@ tex_tiled *tex_tiled_new(void *exr, tex_tiles *pool, const tex_texture *t, int t
     tl->tw = tw;
     tl->th = th;
     tl->resident = resident;
-    tl->ntx = calloc((size_t)resident + 1, sizeof *tl->ntx);
-    tl->tiles = calloc(3 * ((size_t)resident + 1), sizeof *tl->tiles);
-    if (!tl->pool || !tl->ntx || !tl->tiles) {
-        tex_tiled_free(tl);
-        return NULL;
-    }
+    tl->ntx = xcalloc((size_t)resident + 1, sizeof *tl->ntx);
+    tl->tiles = xcalloc(3 * ((size_t)resident + 1), sizeof *tl->tiles);
     for (int k = 0; k < resident; k++) {
         int nx = (t->lw[k] + tw - 1) / tw, ny = (t->lh[k] + th - 1) / th;
         tl->ntx[k] = nx;
         for (int p = 0; p < 3; p++) {
             if (k == 0 && p > 0)
                 continue;              /* level 0's min and max are the image */
-            tex_tile *v = calloc((size_t)nx * (size_t)ny, sizeof *v);
-            if (!v) {
-                tex_tiled_free(tl);
-                return NULL;
-            }
+            tex_tile *v = xcalloc((size_t)nx * (size_t)ny, sizeof *v);
             tl->tiles[p * resident + k] = v;
             for (int y = 0; y < ny; y++)
                 for (int x = 0; x < nx; x++) {
@@ -238,15 +226,13 @@ bool tex_tiled_decode(const tex_tiled *tl, int p, int k, int tx, int ty, float *
 }
 
 /* The tile's texels, read from the file (or the top level's where that
- * fails). NULL when out of memory. */
+ * fails). */
 static float *read_tile(tex_tiles *pool, tex_tile *tile)
 {
     tex_tiled *tl = tile->owner;
     const tex_texture *t = tl->tex;
     size_t count = (size_t)tl->tw * (size_t)tl->th * (size_t)t->nch;
-    float *d = malloc(count * sizeof *d);
-    if (!d)
-        return NULL;
+    float *d = xmalloc(count * sizeof *d);
     if (!tex_tiled_decode(tl, tile->part, tile->level, tile->tx, tile->ty, d, (size_t)tl->tw)) {
         const float *top = tile->part == 0 ? t->avg[t->nlevels - 1]
                          : tile->part == 1 ? t->mn[t->nlevels - 1] : t->mx[t->nlevels - 1];
@@ -299,15 +285,10 @@ static const float *load(tex_tile *tile)
     if (!d) {
         if (pool->n == pool->cap) {
             int cap = pool->cap ? 2 * pool->cap : 256;
-            tex_tile **v = realloc(pool->loaded, (size_t)cap * sizeof *v);
-            if (!v)
-                abort();
-            pool->loaded = v;
+            pool->loaded = xreallocarray(pool->loaded, (size_t)cap, sizeof *pool->loaded);
             pool->cap = cap;
         }
         d = read_tile(pool, tile);
-        if (!d)
-            abort();             /* out of memory for one tile: as malloc elsewhere */
         tile->at = pool->n;
         pool->loaded[pool->n++] = tile;
         pool->bytes += tile_bytes(tile->owner);

@@ -13,6 +13,7 @@
  * never leaves a half-written texture.
  */
 #include "tex/tex_internal.h"
+#include "util/xalloc.h"
 
 #include <openexr.h>
 
@@ -145,9 +146,7 @@ static exr_result_t write_level(exr_context_t ctx, int p, const tex_texture *t, 
 static exr_result_t mark_texture(exr_context_t ctx, const tex_texture *t)
 {
     size_t size = (size_t)t->nch * 2 * 32 + 1;
-    char *lip = malloc(size), *s = lip;
-    if (!lip)
-        return EXR_ERR_OUT_OF_MEMORY;
+    char *lip = xmalloc(size), *s = lip;
     lip[0] = '\0';
     for (int c = 0; c < t->nch; c++)
         s += snprintf(s, size - (size_t)(s - lip), "%s%a %a", c ? " " : "", t->lips[c],
@@ -188,9 +187,7 @@ bool tex_write_exr(const char *path, const tex_texture *t, bool minmax, char *er
                  "texture %d", levels, t->nlevels);
         rv = EXR_ERR_INVALID_ARGUMENT;
     }
-    float *buf = malloc((size_t)TILE * TILE * (size_t)t->nch * sizeof *buf);
-    if (!buf && rv == EXR_ERR_SUCCESS)
-        rv = EXR_ERR_OUT_OF_MEMORY;
+    float *buf = xmalloc((size_t)TILE * TILE * (size_t)t->nch * sizeof *buf);
     for (int part = 0; rv == EXR_ERR_SUCCESS && part < (minmax ? 3 : 1); part++)
         for (int k = 0; rv == EXR_ERR_SUCCESS && k < t->nlevels; k++)
             rv = write_level(ctx, part, t, k, buf);
