@@ -3,6 +3,7 @@
  * through OpenEXRCore, and the comparison used by determinism tests.
  */
 #include "image/buffer.h"
+#include "util/err.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -90,10 +91,9 @@ static bool fail(reader *r, const char *what, exr_result_t rv)
     return false;
 }
 
-static bool fail_plain(reader *r, const char *why)
+static bool fail_plain(reader *r, const char *what)
 {
-    snprintf(r->err, r->errsz, "%s: %s", r->path, why);
-    return false;
+    return err_set(r->err, r->errsz, "%s: %s", r->path, what);
 }
 
 /* Checks the part and allocates the buffer for its data window. */
@@ -201,7 +201,7 @@ image_buffer *image_buffer_read_exr(const char *path, char *err, size_t errsz)
     r.errsz = errsz;
     int fd = open(path, O_RDONLY | O_CLOEXEC);
     if (fd < 0) {
-        snprintf(err, errsz, "cannot open %s: %s", path, strerror(errno));
+        err_set(err, errsz, "cannot open %s: %s", path, strerror(errno));
         return NULL;
     }
     image_exr_stream_fd(&r.stream, fd);
@@ -228,21 +228,18 @@ static bool same_layout(const image_buffer *a, const image_buffer *b,
 {
     if (a->x0 != b->x0 || a->y0 != b->y0 || a->width != b->width
         || a->height != b->height) {
-        snprintf(err, errsz, "images differ in size: %dx%d at (%d,%d) vs "
-                 "%dx%d at (%d,%d)", a->width, a->height, a->x0, a->y0,
-                 b->width, b->height, b->x0, b->y0);
-        return false;
+        return err_set(err, errsz, "images differ in size: %dx%d at (%d,%d) vs "
+                       "%dx%d at (%d,%d)", a->width, a->height, a->x0, a->y0,
+                       b->width, b->height, b->x0, b->y0);
     }
     if (a->channel_count != b->channel_count) {
-        snprintf(err, errsz, "images differ in channels: %d vs %d channels",
-                 a->channel_count, b->channel_count);
-        return false;
+        return err_set(err, errsz, "images differ in channels: %d vs %d channels",
+                       a->channel_count, b->channel_count);
     }
     for (int c = 0; c < a->channel_count; c++) {
         if (strcmp(a->names[c], b->names[c]) != 0) {
-            snprintf(err, errsz, "images differ in channels: '%s' vs '%s'",
-                     a->names[c], b->names[c]);
-            return false;
+            return err_set(err, errsz, "images differ in channels: '%s' vs '%s'",
+                           a->names[c], b->names[c]);
         }
     }
     return true;

@@ -19,6 +19,7 @@
  * message (image_exr_stream_clear() empties both before an operation).
  */
 #include "image/exr_io.h"
+#include "util/err.h"
 
 #include <errno.h>
 #include <stdio.h>
@@ -394,9 +395,9 @@ exr_result_t image_exr_decode_chunk(exr_const_context_t ctxt,
 void image_exr_error(char *err, size_t errsz, const char *what,
                      exr_result_t rv, const image_exr_stream *stream)
 {
-    const char *why = stream && stream->message[0] ? stream->message
+    const char *reason = stream && stream->message[0] ? stream->message
                       : thread_message[0] ? thread_message
                       : exr_get_default_error_message(rv);
-    snprintf(err, errsz, "%s: %s", what, why);
+    err_set(err, errsz, "%s: %s", what, reason);
     thread_message[0] = '\0';
 }

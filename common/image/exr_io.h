@@ -26,6 +26,7 @@
 
 #include "image/format.h"
 #include "image/tile.h"
+#include "util/err.h"
 
 /* zlib level of every ZIP chunk aafarm writes. Fixed, so that a worker's
  * tile and the standalone renderer's chunk are byte-identical. */
@@ -39,7 +40,7 @@ typedef struct image_exr_stream {
     int fd;                /* file read/write; -1 for memory streams */
     bool discard;          /* drop writes (aborting an output file) */
     int sys_errno;         /* errno of the last failed system call */
-    char message[256];     /* last error reported through this stream */
+    char message[ERR_LEN];  /* last error reported through this stream */
 } image_exr_stream;
 
 void image_exr_stream_memory_reader(image_exr_stream *self, const void *bytes,

@@ -6,6 +6,7 @@
  * fsync a directory, which is not an error for us).
  */
 #include "image/outfile.h"
+#include "util/err.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -33,7 +34,7 @@ static char *temp_name(const char *path)
 image_outfile *image_outfile_new(const char *path, char *err, size_t errsz)
 {
     if (!path || !*path) {
-        snprintf(err, errsz, "no output file name given");
+        err_set(err, errsz, "no output file name given");
         return NULL;
     }
     image_outfile *self = xcalloc(1, sizeof *self);
@@ -43,10 +44,10 @@ image_outfile *image_outfile_new(const char *path, char *err, size_t errsz)
     self->fd = open(self->temp_path, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC,
                     0666);
     if (self->fd < 0) {
-        snprintf(err, errsz, "cannot create %s: %s (check that the directory "
-                 "exists and is writable%s)", self->temp_path,
-                 strerror(errno), errno == EEXIST ? "; remove the stale "
-                 "temporary file" : "");
+        err_set(err, errsz, "cannot create %s: %s (check that the directory "
+                "exists and is writable%s)", self->temp_path,
+                strerror(errno), errno == EEXIST ? "; remove the stale "
+                "temporary file" : "");
         image_outfile_destroy(&self);
     }
     return self;
@@ -110,11 +111,11 @@ bool image_outfile_commit(image_outfile **self_p, char *err, size_t errsz)
     self->fd = -1;
     bool ok = sync_rc == 0 && close_rc == 0;
     if (!ok)
-        snprintf(err, errsz, "cannot write %s: %s (disk full?)",
-                 self->temp_path, strerror(sync_rc ? sync_errno : errno));
+        err_set(err, errsz, "cannot write %s: %s (disk full?)",
+                self->temp_path, strerror(sync_rc ? sync_errno : errno));
     if (ok && rename(self->temp_path, self->path) != 0) {
-        snprintf(err, errsz, "cannot rename %s to %s: %s", self->temp_path,
-                 self->path, strerror(errno));
+        err_set(err, errsz, "cannot rename %s to %s: %s", self->temp_path,
+                self->path, strerror(errno));
         ok = false;
     }
     if (ok)

@@ -6,6 +6,7 @@
  * png_context so the caller gets one line naming the file.
  */
 #include "image/preview.h"
+#include "util/err.h"
 
 #include <errno.h>
 #include <math.h>
@@ -124,8 +125,8 @@ static bool write_png(image_outfile *file, const pixel_source *src,
     png_destroy_write_struct(&png, &info);
     free(row);
     if (rc != 0)
-        snprintf(err, errsz, "cannot write PNG %s: %s",
-                 image_outfile_temp_path(file), ctx.message);
+        err_set(err, errsz, "cannot write PNG %s: %s",
+                image_outfile_temp_path(file), ctx.message);
     return rc == 0;
 }
 
@@ -134,9 +135,8 @@ static bool write_preview(const char *path, const pixel_source *src,
 {
     if (src->width < 1 || src->height < 1
         || src->width > 1000000 || src->height > 1000000) {
-        snprintf(err, errsz, "cannot write PNG %s: image size %dx%d out of "
-                 "range", path, src->width, src->height);
-        return false;
+        return err_set(err, errsz, "cannot write PNG %s: image size %dx%d out of "
+                       "range", path, src->width, src->height);
     }
     image_outfile *file = image_outfile_new(path, err, errsz);
     if (!file)
@@ -152,8 +152,7 @@ bool image_preview_write_png(const char *path, const float *rgba, int width,
                              int height, char *err, size_t errsz)
 {
     if (!rgba) {
-        snprintf(err, errsz, "cannot write PNG %s: no pixels given", path);
-        return false;
+        return err_set(err, errsz, "cannot write PNG %s: no pixels given", path);
     }
     pixel_source src = {{rgba, rgba + 1, rgba + 2}, 4, width, height};
     return write_preview(path, &src, err, errsz);

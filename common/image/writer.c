@@ -13,6 +13,7 @@
  * is decompressed once, inside validation, to prove it intact.
  */
 #include "image/writer.h"
+#include "util/err.h"
 
 #include <stdint.h>
 #include <stdio.h>
@@ -30,7 +31,7 @@ struct image_writer {
     exr_context_t ctxt;
     uint8_t *written;           /* one flag per tile, row-major */
     int tiles_written;
-    char failure[256];          /* set once a write failed: writer unusable */
+    char failure[ERR_LEN];      /* set once a write failed: writer unusable */
 };
 
 image_writer *image_writer_new(const char *path, const image_format *fmt,
@@ -80,8 +81,7 @@ static bool usable(const image_writer *self, char *err, size_t errsz)
 {
     if (self->failure[0] == '\0')
         return true;
-    snprintf(err, errsz, "%s", self->failure);
-    return false;
+    return err_set(err, errsz, "%s", self->failure);
 }
 
 static uint8_t *written_flag(const image_writer *self, int tx, int ty)
@@ -105,8 +105,7 @@ static bool record_write(image_writer *self, int tx, int ty, exr_result_t rv,
              image_outfile_temp_path(self->file));
     image_exr_error(self->failure, sizeof self->failure, what, rv,
                     &self->stream);
-    snprintf(err, errsz, "%s", self->failure);
-    return false;
+    return err_set(err, errsz, "%s", self->failure);
 }
 
 bool image_writer_put_tile(image_writer *self, const image_tile *tile,
@@ -120,9 +119,8 @@ bool image_writer_put_tile(image_writer *self, const image_tile *tile,
     if (tile->layers != self->fmt.layers || !tile->rgba || !tile->z
         || (tile->layers & IMAGE_LAYER_N && !tile->n)
         || (tile->layers & IMAGE_LAYER_P && !tile->p)) {
-        snprintf(err, errsz, "tile at (%d,%d) does not have the image's "
-                 "layers 0x%x", tile->x0, tile->y0, self->fmt.layers);
-        return false;
+        return err_set(err, errsz, "tile at (%d,%d) does not have the image's "
+                       "layers 0x%x", tile->x0, tile->y0, self->fmt.layers);
     }
     if (*written_flag(self, tx, ty))
         return true;
@@ -154,8 +152,7 @@ bool image_writer_put_chunk(image_writer *self, int tx, int ty, const void *chun
         return false;
     if (tx < 0 || ty < 0 || tx >= image_format_tiles_x(&self->fmt)
         || ty >= image_format_tiles_y(&self->fmt)) {
-        snprintf(err, errsz, "tile (%d,%d) is not in the image", tx, ty);
-        return false;
+        return err_set(err, errsz, "tile (%d,%d) is not in the image", tx, ty);
     }
     if (*written_flag(self, tx, ty))
         return true;
@@ -198,9 +195,9 @@ static bool report_missing(const image_writer *self, char *err, size_t errsz)
     int nx = image_format_tiles_x(&self->fmt);
     for (int i = 0; i < total; i++) {
         if (!self->written[i]) {
-            snprintf(err, errsz, "cannot finish %s: %d of %d tiles missing, "
-                     "first tile (%d,%d)", image_outfile_path(self->file),
-                     total - self->tiles_written, total, i % nx, i / nx);
+            err_set(err, errsz, "cannot finish %s: %d of %d tiles missing, "
+                    "first tile (%d,%d)", image_outfile_path(self->file),
+                    total - self->tiles_written, total, i % nx, i / nx);
             return true;
         }
     }

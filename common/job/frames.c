@@ -3,6 +3,7 @@
  * frame, and loading one job per chosen frame (see frames.h).
  */
 #include "job/frames.h"
+#include "util/err.h"
 #include "util/xalloc.h"
 #include "scene/scene.h"
 
@@ -35,8 +36,8 @@ bool frame_spec_parse(const char *text, frame_spec *out, char *err, size_t errsz
 {
     memset(out, 0, sizeof *out);
     if (!text || !*text) {
-        snprintf(err, errsz, "--frames wants frame numbers, e.g. 3, 1-10 or 1,3,5-7; got an "
-                 "empty list");
+        err_set(err, errsz, "--frames wants frame numbers, e.g. 3, 1-10 or 1,3,5-7; got an "
+                "empty list");
         return false;
     }
     const char *p = text;
@@ -52,15 +53,15 @@ bool frame_spec_parse(const char *text, frame_spec *out, char *err, size_t errsz
         if (!ok || (*p != ',' && *p != '\0')) {
             const char *end = strchr(item, ',');
             int n = end ? (int)(end - item) : (int)strlen(item);
-            snprintf(err, errsz, "--frames: '%.*s' (at character %d of '%s') is not a frame "
-                     "number 0..%d or a range like 5-7", n, item, (int)(item - text) + 1, text,
-                     FRAME_MAX_NUMBER);
+            err_set(err, errsz, "--frames: '%.*s' (at character %d of '%s') is not a frame "
+                    "number 0..%d or a range like 5-7", n, item, (int)(item - text) + 1, text,
+                    FRAME_MAX_NUMBER);
             frame_spec_free(out);
             return false;
         }
         if (hi < lo) {
-            snprintf(err, errsz, "--frames: the range %d-%d runs backwards (write %d-%d)", lo,
-                     hi, hi, lo);
+            err_set(err, errsz, "--frames: the range %d-%d runs backwards (write %d-%d)", lo,
+                    hi, hi, lo);
             frame_spec_free(out);
             return false;
         }
@@ -119,12 +120,12 @@ bool frame_choose(const int *numbers, int n, const frame_spec *spec, int **indic
             char have[200];
             describe_numbers(numbers, total, have, sizeof have);
             if (spec->ranges[i][0] == spec->ranges[i][1])
-                snprintf(err, errsz, "--frames: the scene has no frame %d (its frames: %s%s)",
-                         spec->ranges[i][0], have, n == 0 ? "; it has no FrameBegin" : "");
+                err_set(err, errsz, "--frames: the scene has no frame %d (its frames: %s%s)",
+                        spec->ranges[i][0], have, n == 0 ? "; it has no FrameBegin" : "");
             else
-                snprintf(err, errsz, "--frames: the scene has no frame in %d-%d (its frames: %s%s)",
-                         spec->ranges[i][0], spec->ranges[i][1], have,
-                         n == 0 ? "; it has no FrameBegin" : "");
+                err_set(err, errsz, "--frames: the scene has no frame in %d-%d (its frames: %s%s)",
+                        spec->ranges[i][0], spec->ranges[i][1], have,
+                        n == 0 ? "; it has no FrameBegin" : "");
             free(*indices);
             *indices = NULL;
             return false;
@@ -184,8 +185,8 @@ static char *substitute(const char *name, int number, int *patterns, char *err, 
         int width = 0;
         while (isdigit((unsigned char)*q) && width < 100) width = width * 10 + (*q++ - '0');
         if (*q != 'd' || width > 16) {
-            snprintf(err, errsz, "output name '%s': only %%d, %%4d, %%04d (the frame number) "
-                     "and %%%% may follow a %% sign", name);
+            err_set(err, errsz, "output name '%s': only %%d, %%4d, %%04d (the frame number) "
+                    "and %%%% may follow a %% sign", name);
             free(out);
             return NULL;
         }
@@ -233,7 +234,7 @@ void frame_sequence_destroy(frame_sequence **self_p)
 
 static bool name_outputs(frame_sequence *seq, const char *output, bool *usage, sl_diag *diag)
 {
-    char err[600];
+    char err[ERR_LEN];
     sl_pos none = {0};
     for (int i = 0; i < seq->count; i++) {
         const job *jb = seq->jobs[i];
@@ -324,7 +325,7 @@ frame_sequence *frame_sequence_load(const char *rib_path, const job_options *opt
                                     sl_diag *diag)
 {
     *usage = false;
-    char err[600];
+    char err[ERR_LEN];
     frame_spec spec;
     if (frames && !frame_spec_parse(frames, &spec, err, sizeof err)) {
         sl_diag_error(diag, (sl_pos){0}, "%s", err);

@@ -2,6 +2,7 @@
  * job.c: building, checking and hashing render jobs (see job.h).
  */
 #include "job/job.h"
+#include "util/err.h"
 #include "util/xalloc.h"
 
 #include <errno.h>
@@ -69,16 +70,16 @@ void job_destroy(job **self_p)
 }
 
 bool job_add_source(job *self, const char *name, const char *text, size_t len,
-                    char *why, int why_size)
+                    char *err, size_t errsz)
 {
     if (sl_source_set_add(self->sources, name, text, len) == 0) return true;
     if (errno == EFBIG)
-        snprintf(why, (size_t)why_size, "shader source '%s' is larger than %zu bytes",
-                 name, sl_source_set_max_size(self->sources));
+        err_set(err, errsz, "shader source '%s' is larger than %zu bytes",
+                name, sl_source_set_max_size(self->sources));
     else if (errno == EEXIST)
-        snprintf(why, (size_t)why_size, "two different shader sources named '%s'", name);
+        err_set(err, errsz, "two different shader sources named '%s'", name);
     else
-        snprintf(why, (size_t)why_size, "invalid shader source name '%s'", name);
+        err_set(err, errsz, "invalid shader source name '%s'", name);
     return false;
 }
 
@@ -90,15 +91,13 @@ const char *job_shader_file(const job *self, const char *name)
 }
 
 bool job_add_shader(job *self, const char *name, const char *file,
-                    char *why, int why_size)
+                    char *err, size_t errsz)
 {
     if (!*name || !*file) {
-        snprintf(why, (size_t)why_size, "a shader entry with an empty name or file");
-        return false;
+        return err_set(err, errsz, "a shader entry with an empty name or file");
     }
     if (job_shader_file(self, name)) {
-        snprintf(why, (size_t)why_size, "shader '%s' listed twice", name);
-        return false;
+        return err_set(err, errsz, "shader '%s' listed twice", name);
     }
     self->shaders = xrealloc(self->shaders, sizeof(job_shader) * (size_t)(self->nshaders + 1));
     self->shaders[self->nshaders].name = xstrdup(name);
@@ -115,20 +114,17 @@ job_file *job_file_find(const job *self, const char *name)
 }
 
 bool job_add_file(job *self, const char *name, const char *hex, uint64_t size,
-                  char *why, int why_size)
+                  char *err, size_t errsz)
 {
     if (!*name) {
-        snprintf(why, (size_t)why_size, "a file entry with an empty name");
-        return false;
+        return err_set(err, errsz, "a file entry with an empty name");
     }
     if (!hash_hex_valid(hex)) {
-        snprintf(why, (size_t)why_size, "file '%s': its SHA-256 is not 64 lowercase hex digits",
-                 name);
-        return false;
+        return err_set(err, errsz, "file '%s': its SHA-256 is not 64 lowercase hex digits",
+                       name);
     }
     if (job_file_find(self, name)) {
-        snprintf(why, (size_t)why_size, "file '%s' listed twice", name);
-        return false;
+        return err_set(err, errsz, "file '%s' listed twice", name);
     }
     self->files = xrealloc(self->files, sizeof(job_file) * (size_t)(self->nfiles + 1));
     job_file *f = &self->files[self->nfiles++];
@@ -152,42 +148,37 @@ uint64_t job_files_bytes(const job *self)
     return n;
 }
 
-bool job_file_resolve(void *jb, const char *name, char *path, size_t path_size, char *why,
-                      int why_size)
+bool job_file_resolve(void *jb, const char *name, char *path, size_t path_size, char *err,
+                      size_t errsz)
 {
     const job *self = jb;
     const job_file *f = self ? job_file_find(self, name) : NULL;
     if (!f) {
-        snprintf(why, (size_t)why_size, "'%s' is not one of the job's files (none of that name "
-                 "was found on the texture search path when the job was loaded: add its folder "
-                 "with Option \"searchpath\" \"texture\" [\"dir:&\"])", name);
-        return false;
+        return err_set(err, errsz, "'%s' is not one of the job's files (none of that name "
+                       "was found on the texture search path when the job was loaded: add its folder "
+                       "with Option \"searchpath\" \"texture\" [\"dir:&\"])", name);
     }
     if (!f->path) {
-        snprintf(why, (size_t)why_size, "file '%s' (%.12s...) is not present on this host yet",
-                 name, f->sha256);
-        return false;
+        return err_set(err, errsz, "file '%s' (%.12s...) is not present on this host yet",
+                       name, f->sha256);
     }
     if (strlen(f->path) >= path_size) {
-        snprintf(why, (size_t)why_size, "the path of file '%s' is longer than %zu bytes", name,
-                 path_size - 1);
-        return false;
+        return err_set(err, errsz, "the path of file '%s' is longer than %zu bytes", name,
+                       path_size - 1);
     }
     memcpy(path, f->path, strlen(f->path) + 1);
     return true;
 }
 
-bool job_finish(job *self, char *why, int why_size)
+bool job_finish(job *self, char *err, size_t errsz)
 {
     for (int i = 0; i < self->nshaders; i++)
         if (!sl_source_set_find(self->sources, self->shaders[i].file)) {
-            snprintf(why, (size_t)why_size, "shader '%s': its source '%s' is missing from the job",
-                     self->shaders[i].name, self->shaders[i].file);
-            return false;
+            return err_set(err, errsz, "shader '%s': its source '%s' is missing from the job",
+                           self->shaders[i].name, self->shaders[i].file);
         }
     if (self->options.frame < 0) {
-        snprintf(why, (size_t)why_size, "frame index %d is out of range", self->options.frame);
-        return false;
+        return err_set(err, errsz, "frame index %d is out of range", self->options.frame);
     }
     size_t nsrc = sl_source_set_count(self->sources);
     hash_shader *hs = xcalloc(nsrc + 1, sizeof *hs);
@@ -237,8 +228,7 @@ bool job_finish(job *self, char *why, int why_size)
     free(keys);
     free(vals);
     if (rc != 0) {
-        snprintf(why, (size_t)why_size, "the job cannot be hashed (duplicate names)");
-        return false;
+        return err_set(err, errsz, "the job cannot be hashed (duplicate names)");
     }
     return true;
 }
@@ -306,7 +296,7 @@ job *job_load(const char *rib_path, const job_options *options, sl_diag *diag)
                sizeof *self->frame_numbers * (size_t)sc->nframes);
     }
     if (sc->display_name) self->display_name = xstrdup(sc->display_name);
-    char why[512];
+    char err[ERR_LEN];
     bool ok = true;
     for (int i = 0; i < sc->nshader_names; i++) {
         const char *name = sc->shader_names[i];
@@ -328,7 +318,7 @@ job *job_load(const char *rib_path, const job_options *options, sl_diag *diag)
             continue;
         }
         if (sl_source_set_load_file(self->sources, path, path, diag) != 0 ||
-            !job_add_shader(self, name, path, why, sizeof why)) {
+            !job_add_shader(self, name, path, err, sizeof err)) {
             ok = false;
         }
         free(path);
@@ -346,8 +336,8 @@ job *job_load(const char *rib_path, const job_options *options, sl_diag *diag)
         }
         job_scene_destroy(&js);
     }
-    if (ok && !job_finish(self, why, sizeof why)) {
-        sl_diag_error(diag, (sl_pos){0}, "%s", why);
+    if (ok && !job_finish(self, err, sizeof err)) {
+        sl_diag_error(diag, (sl_pos){0}, "%s", err);
         ok = false;
     }
     if (!ok) job_destroy(&self);

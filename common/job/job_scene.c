@@ -5,6 +5,7 @@
  * terms) into the renderer's camera-space world (trace/world.h).
  */
 #include "job/job_scene.h"
+#include "util/err.h"
 #include "util/xalloc.h"
 
 #include <math.h>
@@ -169,12 +170,12 @@ static sl_instance *make_instance(job_scene *self, const scene_shader *call, sl_
     sl_instance *inst = sl_instance_new(prog);
     for (int k = 0; k < call->nparams; k++) {
         const scene_param *pa = &call->params[k];
-        char why[256];
+        char err[ERR_LEN];
         bool ok = pa->type == SL_TYPE_STRING
-                      ? sl_instance_set_string(inst, pa->name, pa->string, why, sizeof why)
+                      ? sl_instance_set_string(inst, pa->name, pa->string, err, sizeof err)
                       : sl_instance_set(inst, pa->name, pa->type, pa->values, pa->count,
-                                        why, sizeof why);
-        if (!ok) sl_diag_warning(diag, pa->pos, "shader '%s': %s (parameter ignored)", call->name, why);
+                                        err, sizeof err);
+        if (!ok) sl_diag_warning(diag, pa->pos, "shader '%s': %s (parameter ignored)", call->name, err);
     }
     return inst;
 }
@@ -303,13 +304,13 @@ static bool open_textures(job_scene *self, sl_diag *diag, bool render)
         const char *names[32];
         int n = sl_instance_texture_names(self->instances[i], names, 32);
         for (int k = 0; k < n; k++) {
-            char err[1024], path[4096], why[512];
+            char err[ERR_LEN], path[4096], reason[ERR_LEN];
             bool found = render ? tex_cache_get(self->textures, names[k], err, sizeof err) != NULL
                                 : job_texture_path_resolve((void *)sc, names[k], path, sizeof path,
-                                                           why, (int)sizeof why);
+                                                           reason, sizeof reason);
             if (!found) {
                 if (!render)
-                    snprintf(err, sizeof err, "texture '%s': %s", names[k], why);
+                    err_set(err, sizeof err, "texture '%s': %s", names[k], reason);
                 sl_diag_error(diag, sc->shaders[i].pos, "shader '%s': %s", sc->shaders[i].name,
                               err);
                 ok = false;
@@ -350,14 +351,14 @@ job_scene *job_scene_new(const job *jb, size_t cache_bytes, bool render, sl_diag
         if (sc->trace_maxdepth >= 0) w->options.max_ray_depth = sc->trace_maxdepth;
     }
     if (ok && !render) {
-        char err[512];
+        char err[ERR_LEN];
         if (!trace_world_prepare(&self->world, err, sizeof err)) {
             sl_diag_error(diag, (sl_pos){0}, "%s", err);
             ok = false;
         }
     }
     if (ok && render) {
-        char err[512];
+        char err[ERR_LEN];
         self->renderer = trace_renderer_new(&self->world, err, sizeof err);
         if (!self->renderer) {
             sl_diag_error(diag, (sl_pos){0}, "%s", err);

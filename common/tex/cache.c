@@ -15,6 +15,7 @@
  * stays in memory for good (tex_bytes).
  */
 #include "tex/tex_internal.h"
+#include "util/err.h"
 #include "util/xalloc.h"
 
 #include <errno.h>
@@ -103,10 +104,10 @@ const tex_texture *tex_cache_get(tex_cache *self, const char *name, char *err, s
         pthread_mutex_unlock(&self->lock);
         return t;
     }
-    char path[4096], why[512] = "";
+    char path[4096], reason[ERR_LEN] = "";
     if (self->resolve) {
-        if (!self->resolve(self->resolve_ctx, name, path, sizeof path, why, (int)sizeof why)) {
-            snprintf(err, errsz, "texture '%s': %s", name, why);
+        if (!self->resolve(self->resolve_ctx, name, path, sizeof path, reason, sizeof reason)) {
+            err_set(err, errsz, "texture '%s': %s", name, reason);
             pthread_mutex_unlock(&self->lock);
             return NULL;
         }
@@ -115,9 +116,9 @@ const tex_texture *tex_cache_get(tex_cache *self, const char *name, char *err, s
     }
     t = tex_open_in(path, self->tiles ? self->tiles : tex_tiles_process(), err, errsz);
     if (t && self->budget && self->bytes + tex_bytes(t) > self->budget) {
-        snprintf(err, errsz, "texture '%s': its pyramids take %zu bytes and the textures "
-                 "already open %zu, over the budget of %zu bytes; raise the texture memory "
-                 "budget or use smaller maps", name, tex_bytes(t), self->bytes, self->budget);
+        err_set(err, errsz, "texture '%s': its pyramids take %zu bytes and the textures "
+                "already open %zu, over the budget of %zu bytes; raise the texture memory "
+                "budget or use smaller maps", name, tex_bytes(t), self->bytes, self->budget);
         tex_free(t);
         t = NULL;
     }
@@ -153,7 +154,7 @@ static bool is_file(const char *path)
 }
 
 bool tex_searchpath_resolve(void *ctx, const char *name, char *path, size_t path_size,
-                            char *why, int why_size)
+                            char *err, size_t errsz)
 {
     const tex_searchpath *sp = ctx;
     const char *base = sp && sp->base[0] ? sp->base : ".";
@@ -161,8 +162,7 @@ bool tex_searchpath_resolve(void *ctx, const char *name, char *path, size_t path
         snprintf(path, path_size, "%s", name);
         if (is_file(path))
             return true;
-        snprintf(why, (size_t)why_size, "no file %s", name);
-        return false;
+        return err_set(err, errsz, "no file %s", name);
     }
     const char *s = sp ? sp->path : "";
     for (;;) {               /* each folder of the path; "&" and "@" are the base */
@@ -186,8 +186,8 @@ bool tex_searchpath_resolve(void *ctx, const char *name, char *path, size_t path
     snprintf(path, path_size, "%s/%s", base, name);   /* the scene's folder last */
     if (is_file(path))
         return true;
-    snprintf(why, (size_t)why_size, "not found in the scene's folder %s nor on the texture "
-             "search path \"%s\"; add its folder with Option \"searchpath\" \"texture\" "
-             "[\"dir:&\"]", base, sp ? sp->path : "");
+    err_set(err, errsz, "not found in the scene's folder %s nor on the texture "
+            "search path \"%s\"; add its folder with Option \"searchpath\" \"texture\" "
+            "[\"dir:&\"]", base, sp ? sp->path : "");
     return false;
 }

@@ -5,6 +5,7 @@
  * no gamma decoding: a height map's 65535 is 1.0 exactly.
  */
 #include "tex/tex_internal.h"
+#include "util/err.h"
 #include "util/xalloc.h"
 
 #include <png.h>
@@ -35,8 +36,7 @@ bool tex_read_png(const char *path, tex_pixels *out, char *err, size_t errsz)
 {
     FILE *f = fopen(path, "rb");
     if (!f) {
-        snprintf(err, errsz, "%s: cannot open the texture", path);
-        return false;
+        return err_set(err, errsz, "%s: cannot open the texture", path);
     }
     png_job job = { "" };
     png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, &job, on_error, on_warning);
@@ -45,13 +45,13 @@ bool tex_read_png(const char *path, tex_pixels *out, char *err, size_t errsz)
     png_bytep volatile row = NULL;
     png_bytep *volatile rows = NULL;
     if (!png || !info) {
-        snprintf(err, errsz, "%s: out of memory reading PNG", path);
+        err_set(err, errsz, "%s: out of memory reading PNG", path);
         png_destroy_read_struct(&png, &info, NULL);
         fclose(f);
         return false;
     }
     if (setjmp(png_jmpbuf(png))) {
-        snprintf(err, errsz, "%s: not a readable PNG image: %s", path, job.message);
+        err_set(err, errsz, "%s: not a readable PNG image: %s", path, job.message);
         free(data);
         free(row);
         free(rows);

@@ -13,6 +13,7 @@
  * other way is refused with what is wrong and what to do (make it again).
  */
 #include "tex/tex_internal.h"
+#include "util/err.h"
 #include "tex/tiles.h"
 #include "util/xalloc.h"
 
@@ -36,7 +37,7 @@ static const char *const part_names[3] = { "mean", "min", "max" };
 
 /* Checks part p's layout against part 0's (w, h, tw, th, levels, nch). */
 static bool check_part(exr_context_t ctx, int p, int w, int h, uint32_t tw, uint32_t th,
-                       int nlevels, int nch, char *what, size_t wsz)
+                       int nlevels, int nch, char *err, size_t errsz)
 {
     const char *name = NULL;
     exr_storage_t storage;
@@ -48,26 +49,22 @@ static bool check_part(exr_context_t ctx, int p, int w, int h, uint32_t tw, uint
     const exr_attr_chlist_t *ch = NULL;
     if (exr_get_name(ctx, p, &name) != EXR_ERR_SUCCESS || !name ||
         strcmp(name, part_names[p]) != 0) {
-        snprintf(what, wsz, "part %d is not named \"%s\"", p, part_names[p]);
-        return false;
+        return err_set(err, errsz, "part %d is not named \"%s\"", p, part_names[p]);
     }
     if (exr_get_storage(ctx, p, &storage) != EXR_ERR_SUCCESS || storage != EXR_STORAGE_TILED ||
         exr_get_tile_descriptor(ctx, p, &x, &y, &mode, &round) != EXR_ERR_SUCCESS ||
         mode != EXR_TILE_MIPMAP_LEVELS || round != EXR_TILE_ROUND_UP || x != tw || y != th ||
         exr_get_tile_levels(ctx, p, &lx, &ly) != EXR_ERR_SUCCESS || lx != nlevels) {
-        snprintf(what, wsz, "part \"%s\" is not tiled in %u x %u mip-map levels rounded up "
-                 "(%d levels)", name, tw, th, nlevels);
-        return false;
+        return err_set(err, errsz, "part \"%s\" is not tiled in %u x %u mip-map levels rounded up "
+                       "(%d levels)", name, tw, th, nlevels);
     }
     if (exr_get_data_window(ctx, p, &box) != EXR_ERR_SUCCESS || box.min.x != 0 ||
         box.min.y != 0 || box.max.x != w - 1 || box.max.y != h - 1) {
-        snprintf(what, wsz, "part \"%s\"'s data window is not [0, %d] x [0, %d]", name, w - 1,
-                 h - 1);
-        return false;
+        return err_set(err, errsz, "part \"%s\"'s data window is not [0, %d] x [0, %d]", name, w - 1,
+                       h - 1);
     }
     if (exr_get_channels(ctx, p, &ch) != EXR_ERR_SUCCESS || ch->num_channels != nch) {
-        snprintf(what, wsz, "part \"%s\" has not the %d channels of part \"mean\"", name, nch);
-        return false;
+        return err_set(err, errsz, "part \"%s\" has not the %d channels of part \"mean\"", name, nch);
     }
     for (int c = 0; c < nch; c++) {
         bool known = false;
@@ -78,10 +75,9 @@ static bool check_part(exr_context_t ctx, int p, int w, int h, uint32_t tw, uint
         }
         if (!known || ch->entries[c].pixel_type != EXR_PIXEL_FLOAT ||
             ch->entries[c].x_sampling != 1 || ch->entries[c].y_sampling != 1) {
-            snprintf(what, wsz, "part \"%s\"'s channel '%s' is not one aafarm-maketx writes "
-                     "(32-bit float, full resolution, named for %d channels)", name,
-                     ch->entries[c].name.str, nch);
-            return false;
+            return err_set(err, errsz, "part \"%s\"'s channel '%s' is not one aafarm-maketx writes "
+                           "(32-bit float, full resolution, named for %d channels)", name,
+                           ch->entries[c].name.str, nch);
         }
     }
     return true;
@@ -111,9 +107,9 @@ static float *read_level(const tex_tiled *tl, const tex_texture *t, int p, int k
 
 static bool refuse(char *err, size_t errsz, const char *path, const char *what)
 {
-    snprintf(err, errsz, "%s: an aafarm-maketx texture (version %d) whose %s%s%s; make it "
-             "again with aafarm-maketx", path, TEX_FILE_VERSION, what,
-             tiled_message[0] ? ": " : "", tiled_message);
+    err_set(err, errsz, "%s: an aafarm-maketx texture (version %d) whose %s%s%s; make it "
+            "again with aafarm-maketx", path, TEX_FILE_VERSION, what,
+            tiled_message[0] ? ": " : "", tiled_message);
     tiled_message[0] = '\0';
     return false;
 }
@@ -133,11 +129,11 @@ bool tex_open_tiled(const char *path, tex_tiles *pool, tex_texture **out, char *
         tiled_message[0] = '\0';
         return true;
     }
-    char what[512];
+    char what[ERR_LEN];
     if (version != TEX_FILE_VERSION) {
-        snprintf(err, errsz, "%s: made by an aafarm-maketx of texture layout version %d; this "
-                 "aafarm reads version %d: make it again with this aafarm-maketx", path,
-                 (int)version, TEX_FILE_VERSION);
+        err_set(err, errsz, "%s: made by an aafarm-maketx of texture layout version %d; this "
+                "aafarm reads version %d: make it again with this aafarm-maketx", path,
+                (int)version, TEX_FILE_VERSION);
         exr_finish(&ctx);
         return false;
     }

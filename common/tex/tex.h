@@ -80,6 +80,14 @@ typedef struct tex_tile_stats {
     unsigned long long loads, evictions, failures;  /* failures: tiles that could not be read */
 } tex_tile_stats;
 void tex_tiles_stats(tex_tiles *pool, tex_tile_stats *out);
+/* Where the pool reports a tile that cannot be read (a damaged or
+ * truncated file after it was opened; its texels are then the map's mean
+ * and bounds), once per texture: one line without a newline. Called with
+ * the pool's lock held (it must not call into the pool). NULL (the
+ * default): only counted in tex_tile_stats.failures; the worker prints
+ * them on stderr. */
+typedef void (*tex_warn_fn)(void *ctx, const char *message);
+void tex_tiles_set_warn(tex_tiles *pool, tex_warn_fn fn, void *ctx);
 /* tex_open with the tiles of an aafarm-maketx file in pool (NULL: a pool
  * of its own without a budget). */
 tex_texture *tex_open_in(const char *path, tex_tiles *pool, char *err, size_t errsz);
@@ -152,9 +160,9 @@ bool tex_write_exr(const char *path, const tex_texture *t, bool minmax, char *er
 /* ---- the per-process cache ---- */
 
 /* Finds the file of texture `name`: true with its path, or false with a
- * reason in why ("not found on the texture search path a:b"). */
+ * reason in err ("not found on the texture search path a:b"). */
 typedef bool (*tex_resolve_fn)(void *ctx, const char *name, char *path, size_t path_size,
-                               char *why, int why_size);
+                               char *err, size_t errsz);
 
 typedef struct tex_cache tex_cache;
 
@@ -184,6 +192,6 @@ typedef struct tex_searchpath {
     char base[4096];
 } tex_searchpath;
 bool tex_searchpath_resolve(void *ctx, const char *name, char *path, size_t path_size,
-                            char *why, int why_size);
+                            char *err, size_t errsz);
 
 #endif

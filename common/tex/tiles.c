@@ -25,17 +25,18 @@
  * A tile that cannot be read (a disk error after the file was opened and
  * its hash checked) holds the top level's texels (the map's mean, min and
  * max: its bound stays true); the pool counts it, and the first one of a
- * texture is reported on stderr.
+ * texture is handed to the pool's warning callback (tex_tiles_set_warn:
+ * the program decides where it goes; this library prints nothing).
  */
 #include "tex/tex_internal.h"
 #include "tex/tiles.h"
 
 #include <openexr.h>
 
+#include "util/err.h"
 #include "util/xalloc.h"
 
 #include <pthread.h>
-#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -45,6 +46,8 @@ struct tex_tiles {
     unsigned long long loads, evictions, failures;
     tex_tile **loaded;       /* the tiles with data, in no order; the clock's ring */
     int n, cap, hand;
+    tex_warn_fn warn;        /* a tile that cannot be read; NULL: counted only */
+    void *warn_ctx;
 };
 
 tex_tiles *tex_tiles_new(size_t budget)
@@ -85,6 +88,14 @@ void tex_tiles_set_budget(tex_tiles *pool, size_t budget)
     pthread_mutex_lock(&pool->lock);
     pool->budget = budget;
     evict_to_budget(pool, NULL);
+    pthread_mutex_unlock(&pool->lock);
+}
+
+void tex_tiles_set_warn(tex_tiles *pool, tex_warn_fn fn, void *ctx)
+{
+    pthread_mutex_lock(&pool->lock);
+    pool->warn = fn;
+    pool->warn_ctx = ctx;
     pthread_mutex_unlock(&pool->lock);
 }
 
@@ -239,11 +250,14 @@ static float *read_tile(tex_tiles *pool, tex_tile *tile)
         for (size_t e = 0; e < count; e++)
             d[e] = top[e % (size_t)t->nch];
         pool->failures++;
-        if (!atomic_exchange(&tl->warned, true))
-            fprintf(stderr, "aafarm: texture %s: tile %d,%d of level %d (part %d) cannot be "
+        if (pool->warn && !atomic_exchange(&tl->warned, true)) {
+            char msg[ERR_LEN];
+            err_set(msg, sizeof msg, "texture %s: tile %d,%d of level %d (part %d) cannot be "
                     "read (damaged or truncated file?); its texels are the map's mean and "
-                    "bounds; check the disk and make the file again with aafarm-maketx\n",
+                    "bounds; check the disk and make the file again with aafarm-maketx",
                     t->name, tile->tx, tile->ty, tile->level, tile->part);
+            pool->warn(pool->warn_ctx, msg);
+        }
     }
     return d;
 }

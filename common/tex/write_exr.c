@@ -13,6 +13,7 @@
  * never leaves a half-written texture.
  */
 #include "tex/tex_internal.h"
+#include "util/err.h"
 #include "util/xalloc.h"
 
 #include <openexr.h>
@@ -196,13 +197,13 @@ bool tex_write_exr(const char *path, const tex_texture *t, bool minmax, char *er
     if (rv == EXR_ERR_SUCCESS)
         rv = fin;
     if (rv != EXR_ERR_SUCCESS) {
-        snprintf(err, errsz, "%s: cannot write the texture: %s", path,
-                 write_message[0] ? write_message : exr_get_default_error_message(rv));
+        err_set(err, errsz, "%s: cannot write the texture: %s", path,
+                write_message[0] ? write_message : exr_get_default_error_message(rv));
         unlink(tmp);
         return false;
     }
     if (rename(tmp, path) != 0) {
-        snprintf(err, errsz, "%s: cannot put the texture in place: %s", path, strerror(errno));
+        err_set(err, errsz, "%s: cannot put the texture in place: %s", path, strerror(errno));
         unlink(tmp);
         return false;
     }
