@@ -14,8 +14,9 @@
  * same non-recursive lock, so asking it from the handler deadlocks the
  * process the first time a header write fails (a full disk). Instead the
  * stream callbacks, which get their stream as an argument, note I/O errors
- * themselves (with errno), and the handler keeps OpenEXRCore's own text in
- * a per-thread buffer that image_exr_error() reads when the stream has no
+ * themselves (with errno), and the handler (tex_exr_on_error, shared with
+ * common/tex: tex/codec_err.h) keeps OpenEXRCore's own text in a
+ * per-thread buffer that image_exr_error() reads when the stream has no
  * message (image_exr_stream_clear() empties both before an operation).
  */
 #include "image/exr_io.h"
@@ -28,6 +29,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "tex/codec_err.h"
 #include "util/xalloc.h"
 
 /* ---- streams ---- */
@@ -72,25 +74,11 @@ static void stream_note(image_exr_stream *self, const char *msg)
         snprintf(self->message, sizeof self->message, "%s", msg);
 }
 
-/* OpenEXRCore's text for the current operation of this thread (first one
- * wins, like stream_note); see the comment at the top. */
-static _Thread_local char thread_message[256];
-
-static void capture_error(exr_const_context_t ctxt, exr_result_t code,
-                          const char *msg)
-{
-    (void) ctxt;    /* locked by the caller: never call back into it here */
-    (void) code;
-    if (thread_message[0] == '\0')
-        snprintf(thread_message, sizeof thread_message, "%s",
-                 msg ? msg : "unknown OpenEXR error");
-}
-
 void image_exr_stream_clear(image_exr_stream *self)
 {
     self->message[0] = '\0';
     self->sys_errno = 0;
-    thread_message[0] = '\0';
+    tex_exr_clear();
 }
 
 static int64_t read_memory(image_exr_stream *self, void *buffer, uint64_t sz,
@@ -226,7 +214,7 @@ static int64_t stream_write(exr_const_context_t ctxt, void *user,
 static exr_context_initializer_t initializer(image_exr_stream *stream)
 {
     exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
-    init.error_handler_fn = capture_error;
+    init.error_handler_fn = tex_exr_on_error;
     init.user_data = stream;
     init.zip_level = IMAGE_EXR_ZIP_LEVEL;
     return init;
@@ -396,8 +384,7 @@ void image_exr_error(char *err, size_t errsz, const char *what,
                      exr_result_t rv, const image_exr_stream *stream)
 {
     const char *reason = stream && stream->message[0] ? stream->message
-                      : thread_message[0] ? thread_message
-                      : exr_get_default_error_message(rv);
+                                                      : tex_exr_reason(rv);
     err_set(err, errsz, "%s: %s", what, reason);
-    thread_message[0] = '\0';
+    tex_exr_clear();
 }

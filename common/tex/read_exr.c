@@ -8,6 +8,7 @@
  * aafarm-maketx's "Y A" reads back in order); a single-channel file is
  * channel 0 whatever its name ("Y", "Z", "height").
  */
+#include "tex/codec_err.h"
 #include "tex/tex_internal.h"
 #include "util/err.h"
 #include "util/xalloc.h"
@@ -18,20 +19,10 @@
 #include <stdlib.h>
 #include <string.h>
 
-static _Thread_local char exr_message[256];
-
-static void on_error(exr_const_context_t ctxt, exr_result_t code, const char *msg)
-{
-    (void)ctxt;
-    (void)code;
-    snprintf(exr_message, sizeof exr_message, "%s", msg ? msg : "");
-}
-
 static void fail(char *err, size_t errsz, const char *path, const char *what, exr_result_t rv)
 {
-    err_set(err, errsz, "%s: %s: %s", path, what,
-            exr_message[0] ? exr_message : exr_get_default_error_message(rv));
-    exr_message[0] = '\0';
+    err_set(err, errsz, "%s: %s: %s", path, what, tex_exr_reason(rv));
+    tex_exr_clear();
 }
 
 /* The order rank of a channel name: R G B A first, then the rest. */
@@ -74,9 +65,9 @@ static exr_result_t decode(exr_context_t ctx, const exr_chunk_info_t *ci, float 
 bool tex_read_exr(const char *path, tex_pixels *out, char *err, size_t errsz)
 {
     exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
-    init.error_handler_fn = on_error;
+    init.error_handler_fn = tex_exr_on_error;
     exr_context_t ctx = NULL;
-    exr_message[0] = '\0';
+    tex_exr_clear();
     exr_result_t rv = exr_start_read(&ctx, path, &init);
     if (rv != EXR_ERR_SUCCESS) {
         fail(err, errsz, path, "cannot read the OpenEXR header", rv);

@@ -4,6 +4,7 @@
  * expanded to 8 bits). Texels are the stored values over 2^bits - 1, with
  * no gamma decoding: a height map's 65535 is 1.0 exactly.
  */
+#include "tex/codec_err.h"
 #include "tex/tex_internal.h"
 #include "util/err.h"
 #include "util/xalloc.h"
@@ -15,31 +16,15 @@
 #include <stdlib.h>
 #include <string.h>
 
-typedef struct png_job {
-    char message[200];
-} png_job;
-
-static void on_error(png_structp png, png_const_charp msg)
-{
-    png_job *job = png_get_error_ptr(png);
-    snprintf(job->message, sizeof job->message, "%s", msg);
-    png_longjmp(png, 1);
-}
-
-static void on_warning(png_structp png, png_const_charp msg)
-{
-    (void)png;
-    (void)msg;
-}
-
 bool tex_read_png(const char *path, tex_pixels *out, char *err, size_t errsz)
 {
     FILE *f = fopen(path, "rb");
     if (!f) {
         return err_set(err, errsz, "%s: cannot open the texture", path);
     }
-    png_job job = { "" };
-    png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, &job, on_error, on_warning);
+    tex_png_error job = { "" };
+    png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, &job, tex_png_on_error,
+                                             tex_png_on_warning);
     png_infop info = png ? png_create_info_struct(png) : NULL;
     float *volatile data = NULL;
     png_bytep volatile row = NULL;

@@ -12,6 +12,7 @@
  * image and builds the pyramids. A file that has it and is wrong in any
  * other way is refused with what is wrong and what to do (make it again).
  */
+#include "tex/codec_err.h"
 #include "tex/tex_internal.h"
 #include "util/err.h"
 #include "tex/tiles.h"
@@ -23,15 +24,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
-static _Thread_local char tiled_message[256];
-
-static void on_error(exr_const_context_t ctxt, exr_result_t code, const char *msg)
-{
-    (void)ctxt;
-    (void)code;
-    snprintf(tiled_message, sizeof tiled_message, "%s", msg ? msg : "");
-}
 
 static const char *const part_names[3] = { "mean", "min", "max" };
 
@@ -109,8 +101,8 @@ static bool refuse(char *err, size_t errsz, const char *path, const char *what)
 {
     err_set(err, errsz, "%s: an aafarm-maketx texture (version %d) whose %s%s%s; make it "
             "again with aafarm-maketx", path, TEX_FILE_VERSION, what,
-            tiled_message[0] ? ": " : "", tiled_message);
-    tiled_message[0] = '\0';
+            tex_exr_message()[0] ? ": " : "", tex_exr_message());
+    tex_exr_clear();
     return false;
 }
 
@@ -119,14 +111,14 @@ bool tex_open_tiled(const char *path, tex_tiles *pool, tex_texture **out, char *
 {
     *out = NULL;
     exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
-    init.error_handler_fn = on_error;
+    init.error_handler_fn = tex_exr_on_error;
     exr_context_t ctx = NULL;
-    tiled_message[0] = '\0';
+    tex_exr_clear();
     int32_t version = 0;
     if (exr_start_read(&ctx, path, &init) != EXR_ERR_SUCCESS ||
         exr_attr_get_int(ctx, 0, TEX_ATTR_VERSION, &version) != EXR_ERR_SUCCESS) {
         exr_finish(&ctx);            /* not ours: read as an image (read.c) */
-        tiled_message[0] = '\0';
+        tex_exr_clear();
         return true;
     }
     char what[ERR_LEN];

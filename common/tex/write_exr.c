@@ -12,6 +12,7 @@
  * is written under a temporary name and renamed into place, so a failure
  * never leaves a half-written texture.
  */
+#include "tex/codec_err.h"
 #include "tex/tex_internal.h"
 #include "util/err.h"
 #include "util/xalloc.h"
@@ -25,15 +26,6 @@
 #include <unistd.h>
 
 enum { TILE = 64 };
-
-static _Thread_local char write_message[256];
-
-static void on_error(exr_const_context_t ctxt, exr_result_t code, const char *msg)
-{
-    (void)ctxt;
-    (void)code;
-    snprintf(write_message, sizeof write_message, "%s", msg ? msg : "");
-}
 
 void tex_channel_name(int nch, int c, char *out, size_t size)
 {
@@ -166,9 +158,9 @@ bool tex_write_exr(const char *path, const tex_texture *t, bool minmax, char *er
     char tmp[4200];
     snprintf(tmp, sizeof tmp, "%s.tmp%ld", path, (long)getpid());
     exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
-    init.error_handler_fn = on_error;
+    init.error_handler_fn = tex_exr_on_error;
     exr_context_t ctx = NULL;
-    write_message[0] = '\0';
+    tex_exr_clear();
     exr_result_t rv = exr_start_write(&ctx, tmp, EXR_WRITE_FILE_DIRECTLY, &init);
     if (rv == EXR_ERR_SUCCESS)
         rv = define_part(ctx, "mean", t);
@@ -184,8 +176,10 @@ bool tex_write_exr(const char *path, const tex_texture *t, bool minmax, char *er
     if (rv == EXR_ERR_SUCCESS)
         rv = exr_get_tile_levels(ctx, 0, &levels, NULL);
     if (rv == EXR_ERR_SUCCESS && levels != t->nlevels) {
-        snprintf(write_message, sizeof write_message, "OpenEXR counts %d mip-map levels, the "
-                 "texture %d", levels, t->nlevels);
+        char msg[96];
+        snprintf(msg, sizeof msg, "OpenEXR counts %d mip-map levels, the texture %d", levels,
+                 t->nlevels);
+        tex_exr_note(msg);
         rv = EXR_ERR_INVALID_ARGUMENT;
     }
     float *buf = xmalloc((size_t)TILE * TILE * (size_t)t->nch * sizeof *buf);
@@ -197,8 +191,7 @@ bool tex_write_exr(const char *path, const tex_texture *t, bool minmax, char *er
     if (rv == EXR_ERR_SUCCESS)
         rv = fin;
     if (rv != EXR_ERR_SUCCESS) {
-        err_set(err, errsz, "%s: cannot write the texture: %s", path,
-                write_message[0] ? write_message : exr_get_default_error_message(rv));
+        err_set(err, errsz, "%s: cannot write the texture: %s", path, tex_exr_reason(rv));
         unlink(tmp);
         return false;
     }
