@@ -14,6 +14,7 @@
 #include "tex/tex_internal.h"
 #include "util/xalloc.h"
 
+#include <assert.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -44,18 +45,20 @@ static double level_lipschitz(const float *v, int w, int h, int nch, int c, bool
     return m * n;
 }
 
-tex_texture *tex_build(tex_pixels *px, const char *name)
+tex_texture *tex_new_levels(const char *name, const char *type, int w, int h, int nch)
 {
+    assert(w >= 1 && h >= 1 && w <= TEX_MAX_SIDE && h <= TEX_MAX_SIDE);
+    assert(nch >= 1 && nch <= TEX_MAX_CHANNELS);
     tex_texture *t = xcalloc(1, sizeof *t);
     t->name = xstrdup(name);
-    t->type = px->type ? px->type : "float";
-    t->w = px->w;
-    t->h = px->h;
-    t->nch = px->nch;
+    t->type = type;
+    t->w = w;
+    t->h = h;
+    t->nch = nch;
     int n = 1;
-    for (int w = t->w, h = t->h; w > 1 || h > 1; n++) {
-        w = (w + 1) / 2;
-        h = (h + 1) / 2;
+    for (int a = w, b = h; a > 1 || b > 1; n++) {
+        a = (a + 1) / 2;
+        b = (b + 1) / 2;
     }
     t->nlevels = n;
     t->lw = xcalloc((size_t)n, sizeof *t->lw);
@@ -63,8 +66,20 @@ tex_texture *tex_build(tex_pixels *px, const char *name)
     t->avg = xcalloc((size_t)n, sizeof *t->avg);
     t->mn = xcalloc((size_t)n, sizeof *t->mn);
     t->mx = xcalloc((size_t)n, sizeof *t->mx);
-    t->lips = xcalloc((size_t)t->nch, sizeof *t->lips);
-    t->lipt = xcalloc((size_t)t->nch, sizeof *t->lipt);
+    t->lips = xcalloc((size_t)nch, sizeof *t->lips);
+    t->lipt = xcalloc((size_t)nch, sizeof *t->lipt);
+    for (int k = 0; k < n; k++) {
+        t->lw[k] = k ? (t->lw[k - 1] + 1) / 2 : w;
+        t->lh[k] = k ? (t->lh[k - 1] + 1) / 2 : h;
+    }
+    assert(t->lw[n - 1] == 1 && t->lh[n - 1] == 1);   /* the top level is one texel */
+    return t;
+}
+
+tex_texture *tex_build(tex_pixels *px, const char *name)
+{
+    tex_texture *t = tex_new_levels(name, px->type ? px->type : "float", px->w, px->h, px->nch);
+    int n = t->nlevels;
     int nch = t->nch;
     float *img = px->data;
     px->data = NULL;
@@ -72,15 +87,11 @@ tex_texture *tex_build(tex_pixels *px, const char *name)
     for (size_t k = 0; k < count; k++)
         if (!isfinite(img[k]))
             img[k] = 0.0f;
-    t->lw[0] = t->w;
-    t->lh[0] = t->h;
     t->avg[0] = t->mn[0] = t->mx[0] = img;
     t->bytes = count * sizeof(float);
     for (int k = 1; k < n; k++) {
         int pw = t->lw[k - 1], ph = t->lh[k - 1];
-        int w = (pw + 1) / 2, h = (ph + 1) / 2;
-        t->lw[k] = w;
-        t->lh[k] = h;
+        int w = t->lw[k], h = t->lh[k];
         size_t sz = (size_t)w * (size_t)h * (size_t)nch;
         t->avg[k] = xmalloc(sz * sizeof(float));
         t->mn[k] = xmalloc(sz * sizeof(float));

@@ -20,6 +20,7 @@
 
 #include <openexr.h>
 
+#include <assert.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -203,26 +204,12 @@ bool tex_open_tiled(const char *path, tex_tiles *pool, tex_texture **out, char *
                       "of float, uint8, uint16, uint32");
     }
 
-    tex_texture *t = xcalloc(1, sizeof *t);
-    t->name = xstrdup(path);
-    t->type = ttype;
-    t->w = (int)w;
-    t->h = (int)h;
-    t->nch = nch;
-    t->nlevels = nlevels;
-    t->lw = xcalloc((size_t)nlevels, sizeof *t->lw);
-    t->lh = xcalloc((size_t)nlevels, sizeof *t->lh);
-    t->avg = xcalloc((size_t)nlevels, sizeof *t->avg);
-    t->mn = xcalloc((size_t)nlevels, sizeof *t->mn);
-    t->mx = xcalloc((size_t)nlevels, sizeof *t->mx);
-    t->lips = xcalloc((size_t)nch, sizeof *t->lips);
-    t->lipt = xcalloc((size_t)nch, sizeof *t->lipt);
+    tex_texture *t = tex_new_levels(path, ttype, (int)w, (int)h, nch);
+    assert(t->nlevels == nlevels);
     memcpy(t->lips, lips, (size_t)nch * sizeof *lips);
     memcpy(t->lipt, lipt, (size_t)nch * sizeof *lipt);
     int resident = nlevels;
     for (int k = 0; k < nlevels; k++) {
-        t->lw[k] = k ? (t->lw[k - 1] + 1) / 2 : t->w;
-        t->lh[k] = k ? (t->lh[k - 1] + 1) / 2 : t->h;
         if (resident == nlevels && (size_t)t->lw[k] * (size_t)t->lh[k] <= TEX_RESIDENT_TEXELS)
             resident = k;
     }

@@ -75,6 +75,11 @@ bool tex_read_exr(const char *path, tex_pixels *out, char *err, size_t errsz);
 bool tex_read_png(const char *path, tex_pixels *out, char *err, size_t errsz);
 bool tex_read_tiff(const char *path, tex_pixels *out, char *err, size_t errsz);
 
+/* A texture of w x h texels of nch channels with its levels' sizes
+ * (ceil(w / 2^k) x ceil(h / 2^k), down to 1 x 1) and empty level tables
+ * (pyramid.c; tex_build and read_tiled.c fill them). */
+tex_texture *tex_new_levels(const char *name, const char *type, int w, int h, int nch);
+
 /* Builds the pyramids of an image (taking its pixels). */
 tex_texture *tex_build(tex_pixels *px, const char *name);
 
