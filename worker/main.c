@@ -222,7 +222,7 @@ int main(int argc, char **argv)
                 fprintf(stderr, "aafarm-worker: %s\n", err);
                 return AAFARM_EXIT_USAGE;
             }
-            frame_spec_free(&spec);
+            frame_spec_clear(&spec);
             so.frames = optarg;
             break;
         }

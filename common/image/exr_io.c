@@ -17,7 +17,7 @@
  * themselves (with errno), and the handler (tex_exr_on_error, shared with
  * common/tex: tex/codec_err.h) keeps OpenEXRCore's own text in a
  * per-thread buffer that image_exr_error() reads when the stream has no
- * message (image_exr_stream_clear() empties both before an operation).
+ * message (image_exr_stream_reset_errors() empties both before an operation).
  */
 #include "image/exr_io.h"
 #include "util/err.h"
@@ -59,7 +59,7 @@ void image_exr_stream_fd(image_exr_stream *self, int fd)
     self->fd = fd;
 }
 
-void image_exr_stream_release(image_exr_stream *self)
+void image_exr_stream_clear(image_exr_stream *self)
 {
     free(self->out);
     self->out = NULL;
@@ -74,7 +74,7 @@ static void stream_note(image_exr_stream *self, const char *msg)
         snprintf(self->message, sizeof self->message, "%s", msg);
 }
 
-void image_exr_stream_clear(image_exr_stream *self)
+void image_exr_stream_reset_errors(image_exr_stream *self)
 {
     self->message[0] = '\0';
     self->sys_errno = 0;
@@ -224,7 +224,7 @@ exr_result_t image_exr_start_read(exr_context_t *ctxt, const char *name,
                                   image_exr_stream *stream)
 {
     exr_context_initializer_t init = initializer(stream);
-    image_exr_stream_clear(stream);
+    image_exr_stream_reset_errors(stream);
     init.read_fn = stream_read;
     init.size_fn = stream_size;
     init.flags = EXR_CONTEXT_FLAG_DISABLE_CHUNK_RECONSTRUCTION;
@@ -235,7 +235,7 @@ exr_result_t image_exr_start_write(exr_context_t *ctxt, const char *name,
                                    image_exr_stream *stream)
 {
     exr_context_initializer_t init = initializer(stream);
-    image_exr_stream_clear(stream);
+    image_exr_stream_reset_errors(stream);
     init.write_fn = stream_write;
     return exr_start_write(ctxt, name, EXR_WRITE_FILE_DIRECTLY, &init);
 }

@@ -49,9 +49,10 @@ void image_exr_stream_memory_writer(image_exr_stream *self);
 void image_exr_stream_fd(image_exr_stream *self, int fd);
 /* Forgets the error messages of earlier operations (call before each
  * OpenEXRCore operation whose failure image_exr_error() will report). */
+void image_exr_stream_reset_errors(image_exr_stream *self);
+/* Frees a memory writer's buffer (unless taken by setting out to NULL)
+ * and zeroes its length and capacity. */
 void image_exr_stream_clear(image_exr_stream *self);
-/* Frees a memory writer's buffer (unless taken by setting out to NULL). */
-void image_exr_stream_release(image_exr_stream *self);
 
 /* Open contexts over a stream (name is used in messages only). */
 exr_result_t image_exr_start_read(exr_context_t *ctxt, const char *name,

@@ -146,7 +146,7 @@ bool image_tile_encode_exr(const image_tile *self, const image_format *fmt,
         snprintf(what, sizeof what, "cannot encode tile at (%d,%d) as EXR",
                  self->x0, self->y0);
         image_exr_error(err, errsz, what, rv, &out);
-        image_exr_stream_release(&out);
+        image_exr_stream_clear(&out);
         return false;
     }
     *bytes = out.out;
@@ -435,7 +435,7 @@ static bool expected_file(const image_format *fmt, image_rect r, void **bytes,
     if (rv != EXR_ERR_SUCCESS || header_length(out.out, out.out_len) == 0) {
         image_exr_error(err, errsz, "cannot make the expected tile header", rv,
                         &out);
-        image_exr_stream_release(&out);
+        image_exr_stream_clear(&out);
         return false;
     }
     *bytes = out.out;

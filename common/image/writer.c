@@ -124,7 +124,7 @@ bool image_writer_put_tile(image_writer *self, const image_tile *tile,
     }
     if (*written_flag(self, tx, ty))
         return true;
-    image_exr_stream_clear(&self->stream);
+    image_exr_stream_reset_errors(&self->stream);
     exr_result_t rv = image_exr_write_tile(self->ctxt, &self->fmt, tx, ty,
                                            tile);
     return record_write(self, tx, ty, rv, err, errsz);
@@ -156,7 +156,7 @@ bool image_writer_put_chunk(image_writer *self, int tx, int ty, const void *chun
     }
     if (*written_flag(self, tx, ty))
         return true;
-    image_exr_stream_clear(&self->stream);
+    image_exr_stream_reset_errors(&self->stream);
     exr_result_t rv = exr_write_tile_chunk(self->ctxt, 0, tx, ty, 0, 0, chunk,
                                            chunk_len);
     return record_write(self, tx, ty, rv, err, errsz);
@@ -213,7 +213,7 @@ bool image_writer_finish(image_writer **self_p, char *err, size_t errsz)
         image_writer_destroy(self_p);
         return false;
     }
-    image_exr_stream_clear(&self->stream);
+    image_exr_stream_reset_errors(&self->stream);
     exr_result_t rv = exr_finish(&self->ctxt);
     self->ctxt = NULL;
     if (rv != EXR_ERR_SUCCESS) {

@@ -56,13 +56,13 @@ bool frame_spec_parse(const char *text, frame_spec *out, char *err, size_t errsz
             err_set(err, errsz, "--frames: '%.*s' (at character %d of '%s') is not a frame "
                     "number 0..%d or a range like 5-7", n, item, (int)(item - text) + 1, text,
                     FRAME_MAX_NUMBER);
-            frame_spec_free(out);
+            frame_spec_clear(out);
             return false;
         }
         if (hi < lo) {
             err_set(err, errsz, "--frames: the range %d-%d runs backwards (write %d-%d)", lo,
                     hi, hi, lo);
-            frame_spec_free(out);
+            frame_spec_clear(out);
             return false;
         }
         out->ranges = xrealloc(out->ranges, sizeof *out->ranges * (size_t)(out->count + 1));
@@ -74,7 +74,7 @@ bool frame_spec_parse(const char *text, frame_spec *out, char *err, size_t errsz
     }
 }
 
-void frame_spec_free(frame_spec *spec)
+void frame_spec_clear(frame_spec *spec)
 {
     free(spec->ranges);
     spec->ranges = NULL;
@@ -339,7 +339,7 @@ frame_sequence *frame_sequence_load(const char *rib_path, const job_options *opt
     int *numbers = NULL;
     int nframes = scan_frames(rib_path, &numbers, diag);
     if (nframes == -2) {   /* unreadable: said so */
-        if (frames) frame_spec_free(&spec);
+        if (frames) frame_spec_clear(&spec);
         return NULL;
     }
     if (nframes < 0) {
@@ -348,7 +348,7 @@ frame_sequence *frame_sequence_load(const char *rib_path, const job_options *opt
         job *first = job_load(rib_path, &opt, diag);
         if (first) sl_diag_error(diag, (sl_pos){0}, "%s: cannot tell its frames", rib_path);
         job_destroy(&first);
-        if (frames) frame_spec_free(&spec);
+        if (frames) frame_spec_clear(&spec);
         return NULL;
     }
     int *indices = NULL, count = 0;
@@ -356,7 +356,7 @@ frame_sequence *frame_sequence_load(const char *rib_path, const job_options *opt
                            sizeof err);
     free(numbers);
     if (!ok) sl_diag_error(diag, (sl_pos){0}, "%s", err);
-    if (frames) frame_spec_free(&spec);
+    if (frames) frame_spec_clear(&spec);
     if (!ok) *usage = true;
     if (!ok) return NULL;
     frame_sequence *seq = xcalloc(1, sizeof *seq);

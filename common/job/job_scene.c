@@ -384,7 +384,7 @@ void job_scene_destroy(job_scene **self_p)
     free(self->world.objects);
     free(self->world.lights);
     free(self->primvars);
-    tex_cache_free(self->textures);
+    tex_cache_destroy(&self->textures);
     scene_destroy(&self->scene);
     free(self);
     *self_p = NULL;

@@ -48,17 +48,19 @@ tex_cache *tex_cache_new(size_t budget)
     return self;
 }
 
-void tex_cache_free(tex_cache *self)
+void tex_cache_destroy(tex_cache **self_p)
 {
+    tex_cache *self = *self_p;
     if (!self)
         return;
     for (int i = 0; i < self->n; i++) {
         free(self->entries[i].name);
-        tex_free(self->entries[i].tex);
+        tex_destroy(&self->entries[i].tex);
     }
     free(self->entries);
     pthread_mutex_destroy(&self->lock);
     free(self);
+    *self_p = NULL;
 }
 
 void tex_cache_set_resolver(tex_cache *self, tex_resolve_fn fn, void *ctx)
@@ -119,7 +121,7 @@ const tex_texture *tex_cache_get(tex_cache *self, const char *name, char *err, s
         err_set(err, errsz, "texture '%s': its pyramids take %zu bytes and the textures "
                 "already open %zu, over the budget of %zu bytes; raise the texture memory "
                 "budget or use smaller maps", name, tex_bytes(t), self->bytes, self->budget);
-        tex_free(t);
+        tex_destroy(&t);
         t = NULL;
     }
     if (t)
@@ -136,7 +138,7 @@ bool tex_cache_put(tex_cache *self, const char *name, tex_texture *t)
         add(self, name, t);
     pthread_mutex_unlock(&self->lock);
     if (!ok)
-        tex_free(t);
+        tex_destroy(&t);
     return ok;
 }
 

@@ -145,11 +145,12 @@ tex_texture *tex_from_pixels(const float *pixels, int w, int h, int nch, const c
     return tex_build(&px, name);
 }
 
-void tex_free(tex_texture *t)
+void tex_destroy(tex_texture **t_p)
 {
+    tex_texture *t = *t_p;
     if (!t)
         return;
-    tex_tiled_free(t->tiled);
+    tex_tiled_destroy(&t->tiled);
     for (int k = 0; k < t->nlevels && t->avg; k++) {
         free(t->avg[k]);
         if (k > 0 && t->mn)
@@ -166,6 +167,7 @@ void tex_free(tex_texture *t)
     free(t->lipt);
     free(t->name);
     free(t);
+    *t_p = NULL;
 }
 
 int tex_width(const tex_texture *t) { return t->w; }

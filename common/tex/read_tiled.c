@@ -228,7 +228,7 @@ bool tex_open_tiled(const char *path, tex_tiles *pool, tex_texture **out, char *
             if (!v) {
                 snprintf(what, sizeof what, "level %d of part \"%s\" cannot be read (damaged "
                          "or truncated file, or non-finite texels)", k, part_names[p]);
-                tex_free(t);
+                tex_destroy(&t);
                 return refuse(err, errsz, path, what);
             }
             (p == 0 ? t->avg : p == 1 ? t->mn : t->mx)[k] = v;
@@ -236,8 +236,7 @@ bool tex_open_tiled(const char *path, tex_tiles *pool, tex_texture **out, char *
                 t->bytes += (size_t)t->lw[k] * (size_t)t->lh[k] * (size_t)nch * sizeof(float);
         }
     if (resident == 0) {             /* all of it in memory: the file is done with */
-        tex_tiled_free(tl);
-        t->tiled = NULL;
+        tex_tiled_destroy(&t->tiled);
     }
     *out = t;
     return true;

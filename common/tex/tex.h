@@ -69,7 +69,7 @@ typedef struct tex_tiles tex_tiles;
  * being read at once (a few per thread). */
 tex_tiles *tex_tiles_new(size_t budget);
 /* Only after every texture opened with it is freed. */
-void tex_tiles_free(tex_tiles *pool);
+void tex_tiles_destroy(tex_tiles **pool_p);
 /* The pool a process's caches use unless told otherwise (budget
  * TEX_DEFAULT_TILE_BYTES until set; aafarm-worker --texture-bytes). */
 #define TEX_DEFAULT_TILE_BYTES ((size_t)512 << 20)
@@ -96,7 +96,7 @@ int tex_tiled_levels(const tex_texture *t);
 /* A texture from memory: w x h texels of nch channels, interleaved (for
  * tests and tools). */
 tex_texture *tex_from_pixels(const float *pixels, int w, int h, int nch, const char *name);
-void tex_free(tex_texture *t);
+void tex_destroy(tex_texture **t_p);
 
 int tex_width(const tex_texture *t);
 int tex_height(const tex_texture *t);
@@ -172,7 +172,7 @@ typedef struct tex_cache tex_cache;
  * texture fails (0: no limit); tiles loaded on demand count against their
  * pool's budget instead (tex_cache_set_tiles). */
 tex_cache *tex_cache_new(size_t budget);
-void tex_cache_free(tex_cache *self);
+void tex_cache_destroy(tex_cache **self_p);
 /* The tile pool of the textures it opens from now on (default: the
  * process's, tex_tiles_process). */
 void tex_cache_set_tiles(tex_cache *self, tex_tiles *pool);

@@ -68,8 +68,9 @@ bool tex_open_tiled(const char *path, struct tex_tiles *pool, tex_texture **out,
 /* The name aafarm-maketx gives channel c of nch (write_exr.c): Y; Y A;
  * R G B (A); c00 c01 ... */
 void tex_channel_name(int nch, int c, char *out, size_t size);
-/* Frees what tex_open_tiled added to a texture (tiles.c). */
-void tex_tiled_free(struct tex_tiled *tiled);
+/* Frees what tex_open_tiled added to a texture (tiles.c) and sets
+ * *tiled_p to NULL. */
+void tex_tiled_destroy(struct tex_tiled **tiled_p);
 
 bool tex_read_exr(const char *path, tex_pixels *out, char *err, size_t errsz);
 bool tex_read_png(const char *path, tex_pixels *out, char *err, size_t errsz);

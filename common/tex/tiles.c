@@ -58,13 +58,15 @@ tex_tiles *tex_tiles_new(size_t budget)
     return pool;
 }
 
-void tex_tiles_free(tex_tiles *pool)
+void tex_tiles_destroy(tex_tiles **pool_p)
 {
+    tex_tiles *pool = *pool_p;
     if (!pool)
         return;
     free(pool->loaded);
     pthread_mutex_destroy(&pool->lock);
     free(pool);
+    *pool_p = NULL;
 }
 
 static tex_tiles *process_pool;
@@ -169,8 +171,9 @@ static void drop(tex_tiles *pool, tex_tile *tile)
     pool->bytes -= tile_bytes(tile->owner);
 }
 
-void tex_tiled_free(tex_tiled *tl)
+void tex_tiled_destroy(tex_tiled **tl_p)
 {
+    tex_tiled *tl = *tl_p;
     if (!tl)
         return;
     if (tl->pool && tl->tiles) {
@@ -189,7 +192,7 @@ void tex_tiled_free(tex_tiled *tl)
         pthread_mutex_unlock(&tl->pool->lock);
     }
     if (tl->own_pool)
-        tex_tiles_free(tl->pool);
+        tex_tiles_destroy(&tl->pool);
     if (tl->exr) {
         exr_context_t ctx = tl->exr;
         exr_finish(&ctx);
@@ -197,6 +200,7 @@ void tex_tiled_free(tex_tiled *tl)
     free(tl->tiles);
     free(tl->ntx);
     free(tl);
+    *tl_p = NULL;
 }
 
 int tex_tiled_levels(const tex_texture *t)

@@ -38,7 +38,7 @@ struct tex_tiled {
 };
 
 /* A texture's tiled levels 0 .. resident - 1 over the open file exr (taken:
- * closed by tex_tiled_free); pool NULL: a pool of its own without budget.
+ * closed by tex_tiled_destroy); pool NULL: a pool of its own without budget.
  * Fill slot[] before the first read. */
 tex_tiled *tex_tiled_new(void *exr, struct tex_tiles *pool, const tex_texture *t, int tw,
                          int th, int resident);

@@ -112,7 +112,7 @@ static void test_png(void **state)
                 for (int c = 0; c < nch; c++)
                     assert_float_equal(tex_texel(t, 0, c, x, y),
                                        vals[(y * w + x) * nch + c] / scale, 1e-7);
-        tex_free(t);
+        tex_destroy(&t);
     }
 }
 
@@ -198,7 +198,7 @@ static void test_tiff(void **state)
             if (fabs(got - want) > 1e-6 * (1 + fabs(want)))
                 fail_msg("case %zu texel %d: %g, wrote %g", n, k, got, want);
         }
-        tex_free(t);
+        tex_destroy(&t);
         free(vals);
     }
 }
@@ -229,8 +229,8 @@ static void test_exr_roundtrip(void **state)
         assert_string_equal(tex_type(u), "float");
         for (int k = 0; k < w * h * nch; k++)
             assert_true(tex_texel(u, 0, k % nch, (k / nch) % w, k / nch / w) == px[k]);
-        tex_free(u);
-        tex_free(t);
+        tex_destroy(&u);
+        tex_destroy(&t);
         free(px);
     }
 }
@@ -291,7 +291,7 @@ static void test_exr_half_scanline(void **state)
         for (int x = 0; x < w; x++)
             for (int c = 0; c < 4; c++)
                 assert_true(tex_texel(t, 0, c, x, y) == px[((size_t)y * w + x) * 4 + from[c]]);
-    tex_free(t);
+    tex_destroy(&t);
     free(px);
 }
 

@@ -124,7 +124,7 @@ int main(int argc, char **argv)
     }
     if (!tex_write_exr(out, t, minmax, err, sizeof err)) {
         fprintf(stderr, "aafarm-maketx: %s\n", err);
-        tex_free(t);
+        tex_destroy(&t);
         return 1;
     }
     double lo, hi;
@@ -135,6 +135,6 @@ int main(int argc, char **argv)
     printf("%s: %d x %d, %d channel%s, %d levels, channel 0 in [%g, %g]\n", out, tex_width(t),
            tex_height(t), tex_channels(t), tex_channels(t) == 1 ? "" : "s", tex_levels(t), lo,
            hi);
-    tex_free(t);
+    tex_destroy(&t);
     return 0;
 }
