@@ -21,6 +21,7 @@
 #include "image/tile.h"
 #include "util/err.h"
 
+#include <assert.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -111,6 +112,10 @@ static size_t clear_plane(const image_tile *t, float *v, int per_pixel, bool dep
 
 size_t image_tile_clear_nonfinite(image_tile *self, int *first_x, int *first_y)
 {
+    /* a tile has the buffers of its layers and no others (image_tile_new) */
+    assert(self->rgba && self->z);
+    assert(!(self->layers & IMAGE_LAYER_N) == !self->n);
+    assert(!(self->layers & IMAGE_LAYER_P) == !self->p);
     size_t first = SIZE_MAX;
     size_t n = clear_plane(self, self->rgba, 4, false, &first)
                + clear_plane(self, self->z, 1, true, &first)
@@ -467,6 +472,8 @@ bool image_tile_exr_chunk(const void *bytes, size_t len,
                                    errsz)
               && check_decodes(b, len, fmt, expect, data_len, err, errsz);
     free(want);
+    /* the chunk is the file's tail, after header, offset table and leader */
+    assert(!ok || hlen + 8 + 20 + data_len == len);
     if (ok && chunk) {
         *chunk = b + hlen + 8 + 20;
         *chunk_len = data_len;

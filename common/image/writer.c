@@ -15,6 +15,7 @@
 #include "image/writer.h"
 #include "util/err.h"
 
+#include <assert.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -86,6 +87,8 @@ static bool usable(const image_writer *self, char *err, size_t errsz)
 
 static uint8_t *written_flag(const image_writer *self, int tx, int ty)
 {
+    assert(tx >= 0 && ty >= 0 && tx < image_format_tiles_x(&self->fmt)
+           && ty < image_format_tiles_y(&self->fmt));
     return &self->written[(size_t) ty * (size_t) image_format_tiles_x(&self->fmt)
                           + (size_t) tx];
 }
@@ -96,8 +99,10 @@ static bool record_write(image_writer *self, int tx, int ty, exr_result_t rv,
                          char *err, size_t errsz)
 {
     if (rv == EXR_ERR_SUCCESS) {
+        assert(!*written_flag(self, tx, ty));    /* each tile written once */
         *written_flag(self, tx, ty) = 1;
         self->tiles_written++;
+        assert(self->tiles_written <= image_format_tile_count(&self->fmt));
         return true;
     }
     char what[320];

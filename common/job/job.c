@@ -5,6 +5,7 @@
 #include "util/err.h"
 #include "util/xalloc.h"
 
+#include <assert.h>
 #include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -137,6 +138,7 @@ bool job_add_file(job *self, const char *name, const char *hex, uint64_t size,
 
 void job_file_set_path(job *self, int i, const char *path)
 {
+    assert(i >= 0 && i < self->nfiles);
     free(self->files[i].path);
     self->files[i].path = path ? xstrdup(path) : NULL;
 }
@@ -212,6 +214,7 @@ bool job_finish(job *self, char *err, size_t errsz)
                  (unsigned long long)self->files[i].size);
         ho[3 + self->nshaders + i] = (hash_option){file_keys[i], file_vals[i]};
     }
+    assert(3 + self->nshaders + self->nfiles + (self->options.frame != 0) == nopt);
     if (self->options.frame != 0) {   /* absent for frame 0: older hashes stay */
         snprintf(keys[nopt - 1], sizeof keys[0], "frame");
         snprintf(vals[nopt - 1], sizeof vals[0], "%d", self->options.frame);

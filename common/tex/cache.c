@@ -18,6 +18,7 @@
 #include "util/err.h"
 #include "util/xalloc.h"
 
+#include <assert.h>
 #include <errno.h>
 #include <pthread.h>
 #include <stdio.h>
@@ -92,6 +93,7 @@ static void add(tex_cache *self, const char *name, tex_texture *t)
         self->cap = self->cap ? 2 * self->cap : 8;
         self->entries = xreallocarray(self->entries, (size_t)self->cap, sizeof *self->entries);
     }
+    assert(self->n < self->cap && !find(self, name));   /* one entry per name */
     self->entries[self->n].name = xstrdup(name);
     self->entries[self->n].tex = t;
     self->n++;

@@ -36,6 +36,7 @@
 #include "util/err.h"
 #include "util/xalloc.h"
 
+#include <assert.h>
 #include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
@@ -63,6 +64,8 @@ void tex_tiles_destroy(tex_tiles **pool_p)
     tex_tiles *pool = *pool_p;
     if (!pool)
         return;
+    /* every texture opened with it is gone, and with it its tiles */
+    assert(pool->n == 0 && pool->bytes == 0);
     free(pool->loaded);
     pthread_mutex_destroy(&pool->lock);
     free(pool);
@@ -162,6 +165,8 @@ static size_t tile_bytes(const tex_tiled *tl)
 
 static void drop(tex_tiles *pool, tex_tile *tile)
 {
+    assert(tile->at >= 0 && tile->at < pool->n && pool->loaded[tile->at] == tile);
+    assert(pool->bytes >= tile_bytes(tile->owner));
     pool->loaded[tile->at] = pool->loaded[pool->n - 1];
     pool->loaded[tile->at]->at = tile->at;
     pool->n--;
@@ -287,6 +292,7 @@ static void evict_to_budget(tex_tiles *pool, const tex_tile *keep)
             pool->hand++;
             continue;
         }
+        assert(d != NULL);                       /* a loaded tile has its texels */
         free(d);
         drop(pool, tile);
         pool->evictions++;
@@ -307,6 +313,7 @@ static const float *load(tex_tile *tile)
             pool->cap = cap;
         }
         d = read_tile(pool, tile);
+        assert(tile->at == -1 && pool->n < pool->cap);
         tile->at = pool->n;
         pool->loaded[pool->n++] = tile;
         pool->bytes += tile_bytes(tile->owner);
@@ -332,8 +339,11 @@ static _Thread_local struct {
 
 void tex_tiles_unpin(void)
 {
-    for (int q = 0; q < pinned.n; q++)
-        atomic_fetch_sub(&pinned.tile[q]->pins, 1);
+    for (int q = 0; q < pinned.n; q++) {
+        unsigned before = atomic_fetch_sub(&pinned.tile[q]->pins, 1);
+        assert(before > 0);                      /* each pin taken once, let go once */
+        (void)before;
+    }
     pinned.n = 0;
 }
 
