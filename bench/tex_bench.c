@@ -70,7 +70,7 @@ static bool write_map(const char *path, int n)
     bool ok = t && tex_write_exr(path, t, true, err, sizeof err);
     if (t && !ok)
         fprintf(stderr, "tex_bench: %s\n", err);
-    tex_free(t);
+    tex_destroy(&t);
     return ok;
 }
 
@@ -131,8 +131,8 @@ static void measure(const char *path, double file_mib, size_t budget)
     else
         phase(t, pool, "zoom", n / 4 > 16 ? n / 4 : 16, 0.3, 0.25, 0.0);
     fflush(stdout);
-    tex_free(t);
-    tex_tiles_free(pool);
+    tex_destroy(&t);
+    tex_tiles_destroy(&pool);
 }
 
 static bool parse_bytes(const char *s, size_t *out)

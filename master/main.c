@@ -192,7 +192,7 @@ static int parse(int argc, char **argv, cli *c)
                 fprintf(stderr, "aafarm-master: %s\n", err);
                 return AAFARM_EXIT_USAGE;
             }
-            frame_spec_free(&spec);
+            frame_spec_clear(&spec);
             f->frames = optarg;
             break;
         }

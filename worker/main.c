@@ -107,8 +107,16 @@ static bool parse_int(const char *s, long lo, long hi, long *out)
  * docs/benchmarks.md). It changes speed, never pixels. */
 #define WORKER_DEFAULT_CACHE_BYTES ((size_t)4 << 20)
 
+/* A texture tile that cannot be read (tex_tiles_set_warn). */
+static void print_texture_warning(void *ctx, const char *message)
+{
+    (void)ctx;
+    fprintf(stderr, "aafarm: %s\n", message);
+}
+
 int main(int argc, char **argv)
 {
+    tex_tiles_set_warn(tex_tiles_process(), print_texture_warning, NULL);
     standalone_options so = {0};
     worker_loop_options wo = {0};
     job_options_default(&so.job);
@@ -214,7 +222,7 @@ int main(int argc, char **argv)
                 fprintf(stderr, "aafarm-worker: %s\n", err);
                 return AAFARM_EXIT_USAGE;
             }
-            frame_spec_free(&spec);
+            frame_spec_clear(&spec);
             so.frames = optarg;
             break;
         }

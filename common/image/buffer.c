@@ -3,6 +3,7 @@
  * through OpenEXRCore, and the comparison used by determinism tests.
  */
 #include "image/buffer.h"
+#include "util/err.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -14,6 +15,7 @@
 #include <unistd.h>
 
 #include "image/exr_io.h"
+#include "util/xalloc.h"
 
 /* Largest image read: 2^31 samples over all channels (8 GiB of floats). */
 #define BUFFER_MAX_SAMPLES ((size_t) 1 << 31)
@@ -25,19 +27,19 @@ image_buffer *image_buffer_new(int width, int height, int channel_count,
         || (size_t) width * (size_t) height * (size_t) (channel_count + 1)
            > BUFFER_MAX_SAMPLES)
         return NULL;
-    image_buffer *self = calloc(1, sizeof *self);
+    image_buffer *self = try_calloc(1, sizeof *self);
     if (!self)
         return NULL;
     self->width = width;
     self->height = height;
     self->channel_count = channel_count;
-    self->names = calloc((size_t) channel_count + 1, sizeof(char *));
-    self->planes = calloc((size_t) channel_count + 1, sizeof(float *));
+    self->names = try_calloc((size_t) channel_count + 1, sizeof(char *));
+    self->planes = try_calloc((size_t) channel_count + 1, sizeof(float *));
     bool ok = self->names && self->planes;
     size_t px = (size_t) width * (size_t) height;
     for (int c = 0; ok && c < channel_count; c++) {
-        self->names[c] = strdup(names[c]);
-        self->planes[c] = calloc(px, sizeof(float));
+        self->names[c] = try_strdup(names[c]);
+        self->planes[c] = try_calloc(px, sizeof(float));
         ok = self->names[c] && self->planes[c];
     }
     if (!ok)
@@ -89,10 +91,9 @@ static bool fail(reader *r, const char *what, exr_result_t rv)
     return false;
 }
 
-static bool fail_plain(reader *r, const char *why)
+static bool fail_plain(reader *r, const char *what)
 {
-    snprintf(r->err, r->errsz, "%s: %s", r->path, why);
-    return false;
+    return err_set(r->err, r->errsz, "%s: %s", r->path, what);
 }
 
 /* Checks the part and allocates the buffer for its data window. */
@@ -200,7 +201,7 @@ image_buffer *image_buffer_read_exr(const char *path, char *err, size_t errsz)
     r.errsz = errsz;
     int fd = open(path, O_RDONLY | O_CLOEXEC);
     if (fd < 0) {
-        snprintf(err, errsz, "cannot open %s: %s", path, strerror(errno));
+        err_set(err, errsz, "cannot open %s: %s", path, strerror(errno));
         return NULL;
     }
     image_exr_stream_fd(&r.stream, fd);
@@ -227,21 +228,18 @@ static bool same_layout(const image_buffer *a, const image_buffer *b,
 {
     if (a->x0 != b->x0 || a->y0 != b->y0 || a->width != b->width
         || a->height != b->height) {
-        snprintf(err, errsz, "images differ in size: %dx%d at (%d,%d) vs "
-                 "%dx%d at (%d,%d)", a->width, a->height, a->x0, a->y0,
-                 b->width, b->height, b->x0, b->y0);
-        return false;
+        return err_set(err, errsz, "images differ in size: %dx%d at (%d,%d) vs "
+                       "%dx%d at (%d,%d)", a->width, a->height, a->x0, a->y0,
+                       b->width, b->height, b->x0, b->y0);
     }
     if (a->channel_count != b->channel_count) {
-        snprintf(err, errsz, "images differ in channels: %d vs %d channels",
-                 a->channel_count, b->channel_count);
-        return false;
+        return err_set(err, errsz, "images differ in channels: %d vs %d channels",
+                       a->channel_count, b->channel_count);
     }
     for (int c = 0; c < a->channel_count; c++) {
         if (strcmp(a->names[c], b->names[c]) != 0) {
-            snprintf(err, errsz, "images differ in channels: '%s' vs '%s'",
-                     a->names[c], b->names[c]);
-            return false;
+            return err_set(err, errsz, "images differ in channels: '%s' vs '%s'",
+                           a->names[c], b->names[c]);
         }
     }
     return true;

@@ -14,6 +14,14 @@
  * converted to float. Deep files and subsampled channels are rejected
  * with a message. Planes cover the data window: plane[c][y*width + x] is
  * pixel (x0 + x, y0 + y). Channels keep the file's (sorted) order.
+ *
+ * Memory: this is the one part of common/image that survives out of
+ * memory (util/xalloc.h try_*): the size of a buffer comes from a file's
+ * header, so an image too large for this process is refused with a message
+ * ("image too large to read into memory") instead of aborting the reader;
+ * tests/image/test_image_buffer.c drives it. The rest of common/image
+ * (tiles, the writer, the output file, the preview) holds a few MB whose
+ * size the image format bounds, and aborts naming the size (x*).
  */
 #ifndef IMAGE_BUFFER_H
 #define IMAGE_BUFFER_H
@@ -29,8 +37,8 @@ typedef struct image_buffer {
     float **planes;        /* channel_count planes of width*height floats */
 } image_buffer;
 
-/* A zero-filled buffer with the given channels; NULL on bad sizes or when
- * memory runs out. */
+/* A zero-filled buffer with the given channels; NULL on bad sizes
+ * (more than 2^31 samples) or when memory runs out. */
 image_buffer *image_buffer_new(int width, int height, int channel_count,
                                const char *const *names);
 void image_buffer_destroy(image_buffer **self_p);

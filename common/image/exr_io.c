@@ -14,11 +14,13 @@
  * same non-recursive lock, so asking it from the handler deadlocks the
  * process the first time a header write fails (a full disk). Instead the
  * stream callbacks, which get their stream as an argument, note I/O errors
- * themselves (with errno), and the handler keeps OpenEXRCore's own text in
- * a per-thread buffer that image_exr_error() reads when the stream has no
- * message (image_exr_stream_clear() empties both before an operation).
+ * themselves (with errno), and the handler (tex_exr_on_error, shared with
+ * common/tex: tex/codec_err.h) keeps OpenEXRCore's own text in a
+ * per-thread buffer that image_exr_error() reads when the stream has no
+ * message (image_exr_stream_reset_errors() empties both before an operation).
  */
 #include "image/exr_io.h"
+#include "util/err.h"
 
 #include <errno.h>
 #include <stdio.h>
@@ -26,6 +28,9 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <unistd.h>
+
+#include "tex/codec_err.h"
+#include "util/xalloc.h"
 
 /* ---- streams ---- */
 
@@ -54,7 +59,7 @@ void image_exr_stream_fd(image_exr_stream *self, int fd)
     self->fd = fd;
 }
 
-void image_exr_stream_release(image_exr_stream *self)
+void image_exr_stream_clear(image_exr_stream *self)
 {
     free(self->out);
     self->out = NULL;
@@ -69,25 +74,11 @@ static void stream_note(image_exr_stream *self, const char *msg)
         snprintf(self->message, sizeof self->message, "%s", msg);
 }
 
-/* OpenEXRCore's text for the current operation of this thread (first one
- * wins, like stream_note); see the comment at the top. */
-static _Thread_local char thread_message[256];
-
-static void capture_error(exr_const_context_t ctxt, exr_result_t code,
-                          const char *msg)
-{
-    (void) ctxt;    /* locked by the caller: never call back into it here */
-    (void) code;
-    if (thread_message[0] == '\0')
-        snprintf(thread_message, sizeof thread_message, "%s",
-                 msg ? msg : "unknown OpenEXR error");
-}
-
-void image_exr_stream_clear(image_exr_stream *self)
+void image_exr_stream_reset_errors(image_exr_stream *self)
 {
     self->message[0] = '\0';
     self->sys_errno = 0;
-    thread_message[0] = '\0';
+    tex_exr_clear();
 }
 
 static int64_t read_memory(image_exr_stream *self, void *buffer, uint64_t sz,
@@ -151,29 +142,28 @@ static int64_t stream_size(exr_const_context_t ctxt, void *user)
     return (int64_t) st.st_size;
 }
 
-static bool grow_memory(image_exr_stream *self, size_t need)
+/* The buffer of a tile being encoded (a few MB at most): out of memory
+ * aborts (util/xalloc.h). */
+static void grow_memory(image_exr_stream *self, size_t need)
 {
     if (need <= self->out_cap)
-        return true;
+        return;
     size_t cap = self->out_cap ? self->out_cap : 4096;
     while (cap < need)
         cap = cap > SIZE_MAX / 2 ? need : cap * 2;
-    uint8_t *p = realloc(self->out, cap);
-    if (!p)
-        return false;
-    memset(p + self->out_cap, 0, cap - self->out_cap);
-    self->out = p;
+    self->out = xrealloc(self->out, cap);
+    memset(self->out + self->out_cap, 0, cap - self->out_cap);
     self->out_cap = cap;
-    return true;
 }
 
 static int64_t write_memory(image_exr_stream *self, const void *buffer,
                             uint64_t sz, uint64_t offset)
 {
-    if (offset > SIZE_MAX - sz || !grow_memory(self, (size_t) (offset + sz))) {
+    if (offset > SIZE_MAX - sz) {
         self->sys_errno = ENOMEM;
         return -1;
     }
+    grow_memory(self, (size_t) (offset + sz));
     memcpy(self->out + offset, buffer, (size_t) sz);
     if (offset + sz > self->out_len)
         self->out_len = (size_t) (offset + sz);
@@ -224,7 +214,7 @@ static int64_t stream_write(exr_const_context_t ctxt, void *user,
 static exr_context_initializer_t initializer(image_exr_stream *stream)
 {
     exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
-    init.error_handler_fn = capture_error;
+    init.error_handler_fn = tex_exr_on_error;
     init.user_data = stream;
     init.zip_level = IMAGE_EXR_ZIP_LEVEL;
     return init;
@@ -234,7 +224,7 @@ exr_result_t image_exr_start_read(exr_context_t *ctxt, const char *name,
                                   image_exr_stream *stream)
 {
     exr_context_initializer_t init = initializer(stream);
-    image_exr_stream_clear(stream);
+    image_exr_stream_reset_errors(stream);
     init.read_fn = stream_read;
     init.size_fn = stream_size;
     init.flags = EXR_CONTEXT_FLAG_DISABLE_CHUNK_RECONSTRUCTION;
@@ -245,7 +235,7 @@ exr_result_t image_exr_start_write(exr_context_t *ctxt, const char *name,
                                    image_exr_stream *stream)
 {
     exr_context_initializer_t init = initializer(stream);
-    image_exr_stream_clear(stream);
+    image_exr_stream_reset_errors(stream);
     init.write_fn = stream_write;
     return exr_start_write(ctxt, name, EXR_WRITE_FILE_DIRECTLY, &init);
 }
@@ -393,9 +383,8 @@ exr_result_t image_exr_decode_chunk(exr_const_context_t ctxt,
 void image_exr_error(char *err, size_t errsz, const char *what,
                      exr_result_t rv, const image_exr_stream *stream)
 {
-    const char *why = stream && stream->message[0] ? stream->message
-                      : thread_message[0] ? thread_message
-                      : exr_get_default_error_message(rv);
-    snprintf(err, errsz, "%s: %s", what, why);
-    thread_message[0] = '\0';
+    const char *reason = stream && stream->message[0] ? stream->message
+                                                      : tex_exr_reason(rv);
+    err_set(err, errsz, "%s: %s", what, reason);
+    tex_exr_clear();
 }

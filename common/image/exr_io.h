@@ -26,6 +26,7 @@
 
 #include "image/format.h"
 #include "image/tile.h"
+#include "util/err.h"
 
 /* zlib level of every ZIP chunk aafarm writes. Fixed, so that a worker's
  * tile and the standalone renderer's chunk are byte-identical. */
@@ -39,7 +40,7 @@ typedef struct image_exr_stream {
     int fd;                /* file read/write; -1 for memory streams */
     bool discard;          /* drop writes (aborting an output file) */
     int sys_errno;         /* errno of the last failed system call */
-    char message[256];     /* last error reported through this stream */
+    char message[ERR_LEN];  /* last error reported through this stream */
 } image_exr_stream;
 
 void image_exr_stream_memory_reader(image_exr_stream *self, const void *bytes,
@@ -48,9 +49,10 @@ void image_exr_stream_memory_writer(image_exr_stream *self);
 void image_exr_stream_fd(image_exr_stream *self, int fd);
 /* Forgets the error messages of earlier operations (call before each
  * OpenEXRCore operation whose failure image_exr_error() will report). */
+void image_exr_stream_reset_errors(image_exr_stream *self);
+/* Frees a memory writer's buffer (unless taken by setting out to NULL)
+ * and zeroes its length and capacity. */
 void image_exr_stream_clear(image_exr_stream *self);
-/* Frees a memory writer's buffer (unless taken by setting out to NULL). */
-void image_exr_stream_release(image_exr_stream *self);
 
 /* Open contexts over a stream (name is used in messages only). */
 exr_result_t image_exr_start_read(exr_context_t *ctxt, const char *name,

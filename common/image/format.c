@@ -8,6 +8,7 @@
  * chunk for chunk.
  */
 #include "image/format.h"
+#include "util/err.h"
 
 #include <stdio.h>
 
@@ -39,27 +40,23 @@ bool image_format_check(const image_format *self, char *err, size_t errsz)
 {
     if (self->width < 1 || self->height < 1 || self->width > IMAGE_MAX_SIZE
         || self->height > IMAGE_MAX_SIZE) {
-        snprintf(err, errsz, "image size %dx%d is out of range: width and "
-                 "height must be 1..%d", self->width, self->height,
-                 IMAGE_MAX_SIZE);
-        return false;
+        return err_set(err, errsz, "image size %dx%d is out of range: width and "
+                       "height must be 1..%d", self->width, self->height,
+                       IMAGE_MAX_SIZE);
     }
     if (self->tile_size < 1 || self->tile_size > IMAGE_MAX_TILE_SIZE) {
-        snprintf(err, errsz, "tile size %d is out of range: use 1..%d",
-                 self->tile_size, IMAGE_MAX_TILE_SIZE);
-        return false;
+        return err_set(err, errsz, "tile size %d is out of range: use 1..%d",
+                       self->tile_size, IMAGE_MAX_TILE_SIZE);
     }
     if ((self->layers & ~(unsigned) IMAGE_LAYERS_ALL) != 0) {
-        snprintf(err, errsz, "unknown image layer flags 0x%x",
-                 self->layers & ~(unsigned) IMAGE_LAYERS_ALL);
-        return false;
+        return err_set(err, errsz, "unknown image layer flags 0x%x",
+                       self->layers & ~(unsigned) IMAGE_LAYERS_ALL);
     }
     if ((long long) image_format_tiles_x(self) * image_format_tiles_y(self)
         > IMAGE_MAX_TILES) {
-        snprintf(err, errsz, "image %dx%d with tile size %d has more than %d "
-                 "tiles: use a larger tile size", self->width, self->height,
-                 self->tile_size, IMAGE_MAX_TILES);
-        return false;
+        return err_set(err, errsz, "image %dx%d with tile size %d has more than %d "
+                       "tiles: use a larger tile size", self->width, self->height,
+                       self->tile_size, IMAGE_MAX_TILES);
     }
     return true;
 }
@@ -100,17 +97,15 @@ bool image_format_tile_index(const image_format *self, image_rect rect,
     int t = self->tile_size;
     if (rect.x0 < 0 || rect.y0 < 0 || rect.x0 >= self->width
         || rect.y0 >= self->height || rect.x0 % t != 0 || rect.y0 % t != 0) {
-        snprintf(err, errsz, "rectangle at (%d,%d) is not the corner of a "
-                 "%dx%d tile of a %dx%d image", rect.x0, rect.y0, t, t,
-                 self->width, self->height);
-        return false;
+        return err_set(err, errsz, "rectangle at (%d,%d) is not the corner of a "
+                       "%dx%d tile of a %dx%d image", rect.x0, rect.y0, t, t,
+                       self->width, self->height);
     }
     image_rect want = image_format_tile_rect(self, rect.x0 / t, rect.y0 / t);
     if (rect.w != want.w || rect.h != want.h) {
-        snprintf(err, errsz, "tile at (%d,%d) is %dx%d, expected %dx%d "
-                 "(tile size %d, image %dx%d)", rect.x0, rect.y0, rect.w,
-                 rect.h, want.w, want.h, t, self->width, self->height);
-        return false;
+        return err_set(err, errsz, "tile at (%d,%d) is %dx%d, expected %dx%d "
+                       "(tile size %d, image %dx%d)", rect.x0, rect.y0, rect.w,
+                       rect.h, want.w, want.h, t, self->width, self->height);
     }
     *tx = rect.x0 / t;
     *ty = rect.y0 / t;

@@ -6,6 +6,7 @@
  * fsync a directory, which is not an error for us).
  */
 #include "image/outfile.h"
+#include "util/err.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -13,6 +14,8 @@
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
+
+#include "util/xalloc.h"
 
 struct image_outfile {
     char *path;        /* final name */
@@ -23,36 +26,28 @@ struct image_outfile {
 static char *temp_name(const char *path)
 {
     size_t n = strlen(path) + 32;
-    char *s = malloc(n);
-    if (s)
-        snprintf(s, n, "%s.tmp-%ld", path, (long) getpid());
+    char *s = xmalloc(n);
+    snprintf(s, n, "%s.tmp-%ld", path, (long) getpid());
     return s;
 }
 
 image_outfile *image_outfile_new(const char *path, char *err, size_t errsz)
 {
     if (!path || !*path) {
-        snprintf(err, errsz, "no output file name given");
+        err_set(err, errsz, "no output file name given");
         return NULL;
     }
-    image_outfile *self = calloc(1, sizeof *self);
-    if (self) {
-        self->fd = -1;
-        self->path = strdup(path);
-        self->temp_path = temp_name(path);
-    }
-    if (!self || !self->path || !self->temp_path) {
-        snprintf(err, errsz, "out of memory creating output file %s", path);
-        image_outfile_destroy(&self);
-        return NULL;
-    }
+    image_outfile *self = xcalloc(1, sizeof *self);
+    self->fd = -1;
+    self->path = xstrdup(path);
+    self->temp_path = temp_name(path);
     self->fd = open(self->temp_path, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC,
                     0666);
     if (self->fd < 0) {
-        snprintf(err, errsz, "cannot create %s: %s (check that the directory "
-                 "exists and is writable%s)", self->temp_path,
-                 strerror(errno), errno == EEXIST ? "; remove the stale "
-                 "temporary file" : "");
+        err_set(err, errsz, "cannot create %s: %s (check that the directory "
+                "exists and is writable%s)", self->temp_path,
+                strerror(errno), errno == EEXIST ? "; remove the stale "
+                "temporary file" : "");
         image_outfile_destroy(&self);
     }
     return self;
@@ -90,9 +85,7 @@ const char *image_outfile_temp_path(const image_outfile *self)
 
 static void sync_directory(const char *path)
 {
-    char *dir = strdup(path);
-    if (!dir)
-        return;
+    char *dir = xstrdup(path);
     char *slash = strrchr(dir, '/');
     const char *name = dir;
     if (!slash)
@@ -118,11 +111,11 @@ bool image_outfile_commit(image_outfile **self_p, char *err, size_t errsz)
     self->fd = -1;
     bool ok = sync_rc == 0 && close_rc == 0;
     if (!ok)
-        snprintf(err, errsz, "cannot write %s: %s (disk full?)",
-                 self->temp_path, strerror(sync_rc ? sync_errno : errno));
+        err_set(err, errsz, "cannot write %s: %s (disk full?)",
+                self->temp_path, strerror(sync_rc ? sync_errno : errno));
     if (ok && rename(self->temp_path, self->path) != 0) {
-        snprintf(err, errsz, "cannot rename %s to %s: %s", self->temp_path,
-                 self->path, strerror(errno));
+        err_set(err, errsz, "cannot rename %s to %s: %s", self->temp_path,
+                self->path, strerror(errno));
         ok = false;
     }
     if (ok)

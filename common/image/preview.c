@@ -6,6 +6,7 @@
  * png_context so the caller gets one line naming the file.
  */
 #include "image/preview.h"
+#include "util/err.h"
 
 #include <errno.h>
 #include <math.h>
@@ -16,6 +17,8 @@
 #include <unistd.h>
 
 #include "image/outfile.h"
+#include "tex/codec_err.h"
+#include "util/xalloc.h"
 
 uint8_t image_preview_srgb8(float linear)
 {
@@ -38,21 +41,8 @@ typedef struct pixel_source {
 
 typedef struct png_context {
     int fd;
-    char message[200];
+    tex_png_error error;   /* libpng's error pointer (tex/codec_err.h) */
 } png_context;
-
-static void on_png_error(png_structp png, png_const_charp msg)
-{
-    png_context *ctx = png_get_error_ptr(png);
-    snprintf(ctx->message, sizeof ctx->message, "%s", msg);
-    png_longjmp(png, 1);
-}
-
-static void on_png_warning(png_structp png, png_const_charp msg)
-{
-    (void) png;
-    (void) msg;
-}
 
 static void on_png_write(png_structp png, png_bytep data, size_t len)
 {
@@ -108,23 +98,24 @@ static int write_rows(png_structp png, png_infop info,
 static bool write_png(image_outfile *file, const pixel_source *src,
                       char *err, size_t errsz)
 {
-    png_context ctx = {image_outfile_fd(file), ""};
-    png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &ctx,
-                                              on_png_error, on_png_warning);
+    png_context ctx = {image_outfile_fd(file), {""}};
+    png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING,
+                                              &ctx.error, tex_png_on_error,
+                                              tex_png_on_warning);
     png_infop info = png ? png_create_info_struct(png) : NULL;
-    uint8_t *row = malloc((size_t) src->width * 3);
+    uint8_t *row = xmalloc((size_t) src->width * 3);
     int rc = 1;
-    if (png && info && row) {
+    if (png && info) {
         png_set_write_fn(png, &ctx, on_png_write, on_png_flush);
         rc = write_rows(png, info, src, row);
     } else {
-        snprintf(ctx.message, sizeof ctx.message, "out of memory");
+        snprintf(ctx.error.message, sizeof ctx.error.message, "out of memory");
     }
     png_destroy_write_struct(&png, &info);
     free(row);
     if (rc != 0)
-        snprintf(err, errsz, "cannot write PNG %s: %s",
-                 image_outfile_temp_path(file), ctx.message);
+        err_set(err, errsz, "cannot write PNG %s: %s",
+                image_outfile_temp_path(file), ctx.error.message);
     return rc == 0;
 }
 
@@ -133,9 +124,8 @@ static bool write_preview(const char *path, const pixel_source *src,
 {
     if (src->width < 1 || src->height < 1
         || src->width > 1000000 || src->height > 1000000) {
-        snprintf(err, errsz, "cannot write PNG %s: image size %dx%d out of "
-                 "range", path, src->width, src->height);
-        return false;
+        return err_set(err, errsz, "cannot write PNG %s: image size %dx%d out of "
+                       "range", path, src->width, src->height);
     }
     image_outfile *file = image_outfile_new(path, err, errsz);
     if (!file)
@@ -151,8 +141,7 @@ bool image_preview_write_png(const char *path, const float *rgba, int width,
                              int height, char *err, size_t errsz)
 {
     if (!rgba) {
-        snprintf(err, errsz, "cannot write PNG %s: no pixels given", path);
-        return false;
+        return err_set(err, errsz, "cannot write PNG %s: no pixels given", path);
     }
     pixel_source src = {{rgba, rgba + 1, rgba + 2}, 4, width, height};
     return write_preview(path, &src, err, errsz);

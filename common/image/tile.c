@@ -19,7 +19,9 @@
  * compressed data is intact.
  */
 #include "image/tile.h"
+#include "util/err.h"
 
+#include <assert.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -27,37 +29,28 @@
 #include <string.h>
 
 #include "image/exr_io.h"
+#include "util/xalloc.h"
 
 /* ---- the tile ---- */
-
-static float *alloc_floats(size_t n)
-{
-    return calloc(n, sizeof(float));
-}
 
 image_tile *image_tile_new(int x0, int y0, int w, int h, unsigned layers)
 {
     if (w < 1 || h < 1 || w > IMAGE_MAX_TILE_SIZE || h > IMAGE_MAX_TILE_SIZE
         || (layers & ~(unsigned) IMAGE_LAYERS_ALL) != 0)
         return NULL;
-    image_tile *self = calloc(1, sizeof *self);
-    if (!self)
-        return NULL;
+    image_tile *self = xcalloc(1, sizeof *self);
     size_t px = (size_t) w * (size_t) h;
     self->x0 = x0;
     self->y0 = y0;
     self->w = w;
     self->h = h;
     self->layers = layers;
-    self->rgba = alloc_floats(4 * px);
-    self->z = alloc_floats(px);
+    self->rgba = xcalloc(4 * px, sizeof(float));
+    self->z = xcalloc(px, sizeof(float));
     if (layers & IMAGE_LAYER_N)
-        self->n = alloc_floats(3 * px);
+        self->n = xcalloc(3 * px, sizeof(float));
     if (layers & IMAGE_LAYER_P)
-        self->p = alloc_floats(3 * px);
-    if (!self->rgba || !self->z || (layers & IMAGE_LAYER_N && !self->n)
-        || (layers & IMAGE_LAYER_P && !self->p))
-        image_tile_destroy(&self);
+        self->p = xcalloc(3 * px, sizeof(float));
     return self;
 }
 
@@ -91,15 +84,13 @@ static bool tile_fits_format(const image_tile *self, const image_format *fmt,
                                     err, errsz))
         return false;
     if (self->layers != fmt->layers) {
-        snprintf(err, errsz, "tile has layers 0x%x but the image has 0x%x",
-                 self->layers, fmt->layers);
-        return false;
+        return err_set(err, errsz, "tile has layers 0x%x but the image has 0x%x",
+                       self->layers, fmt->layers);
     }
     if (!self->rgba || !self->z || (fmt->layers & IMAGE_LAYER_N && !self->n)
         || (fmt->layers & IMAGE_LAYER_P && !self->p)) {
-        snprintf(err, errsz, "tile at (%d,%d) lacks a buffer for one of its "
-                 "layers", self->x0, self->y0);
-        return false;
+        return err_set(err, errsz, "tile at (%d,%d) lacks a buffer for one of its "
+                       "layers", self->x0, self->y0);
     }
     return true;
 }
@@ -121,6 +112,10 @@ static size_t clear_plane(const image_tile *t, float *v, int per_pixel, bool dep
 
 size_t image_tile_clear_nonfinite(image_tile *self, int *first_x, int *first_y)
 {
+    /* a tile has the buffers of its layers and no others (image_tile_new) */
+    assert(self->rgba && self->z);
+    assert(!(self->layers & IMAGE_LAYER_N) == !self->n);
+    assert(!(self->layers & IMAGE_LAYER_P) == !self->p);
     size_t first = SIZE_MAX;
     size_t n = clear_plane(self, self->rgba, 4, false, &first)
                + clear_plane(self, self->z, 1, true, &first)
@@ -156,7 +151,7 @@ bool image_tile_encode_exr(const image_tile *self, const image_format *fmt,
         snprintf(what, sizeof what, "cannot encode tile at (%d,%d) as EXR",
                  self->x0, self->y0);
         image_exr_error(err, errsz, what, rv, &out);
-        image_exr_stream_release(&out);
+        image_exr_stream_clear(&out);
         return false;
     }
     *bytes = out.out;
@@ -296,24 +291,24 @@ static void explain_header(const uint8_t *got, size_t got_len,
         if (gr != 1 && wr != 1)
             break;
         if (gr != 1) {
-            snprintf(err, errsz, "header lacks attribute '%s'", wa.name);
+            err_set(err, errsz, "header lacks attribute '%s'", wa.name);
             return;
         }
         if (wr != 1 || strcmp(ga.name, wa.name) != 0) {
-            snprintf(err, errsz, "header has unexpected attribute '%s'",
-                     ga.name);
+            err_set(err, errsz, "header has unexpected attribute '%s'",
+                    ga.name);
             return;
         }
         if (!attrs_equal(&ga, &wa)) {
             char g[160], w[160];
             describe_attr(&ga, g, sizeof g);
             describe_attr(&wa, w, sizeof w);
-            snprintf(err, errsz, "header attribute '%s' is %s, expected %s",
-                     ga.name, g, w);
+            err_set(err, errsz, "header attribute '%s' is %s, expected %s",
+                    ga.name, g, w);
             return;
         }
     }
-    snprintf(err, errsz, "header differs from the one aafarm writes");
+    err_set(err, errsz, "header differs from the one aafarm writes");
 }
 
 /* ---- validation ---- */
@@ -324,24 +319,20 @@ static bool check_preamble(const uint8_t *b, size_t len, const uint8_t *want,
                            char *err, size_t errsz)
 {
     if (len < 4) {
-        snprintf(err, errsz, "truncated: %zu bytes cannot hold an EXR magic "
-                 "number", len);
-        return false;
+        return err_set(err, errsz, "truncated: %zu bytes cannot hold an EXR magic "
+                       "number", len);
     }
     if (memcmp(b, exr_magic, 4) != 0) {
-        snprintf(err, errsz, "not an OpenEXR file (bad magic number)");
-        return false;
+        return err_set(err, errsz, "not an OpenEXR file (bad magic number)");
     }
     if (len < 8) {
-        snprintf(err, errsz, "truncated: %zu bytes, the EXR version field "
-                 "is missing", len);
-        return false;
+        return err_set(err, errsz, "truncated: %zu bytes, the EXR version field "
+                       "is missing", len);
     }
     if (memcmp(b + 4, want + 4, 4) != 0) {
-        snprintf(err, errsz, "EXR version/flags 0x%08x, expected 0x%08x "
-                 "(version 2, single-part tiled)", read_u32(b + 4),
-                 read_u32(want + 4));
-        return false;
+        return err_set(err, errsz, "EXR version/flags 0x%08x, expected 0x%08x "
+                       "(version 2, single-part tiled)", read_u32(b + 4),
+                       read_u32(want + 4));
     }
     return true;
 }
@@ -353,9 +344,8 @@ static bool check_header(const uint8_t *b, size_t len, const uint8_t *want,
     size_t want_hlen = header_length(want, want_len);
     *hlen = header_length(b, len);
     if (*hlen == 0) {
-        snprintf(err, errsz, "truncated: the EXR header does not end within "
-                 "the %zu bytes received", len);
-        return false;
+        return err_set(err, errsz, "truncated: the EXR header does not end within "
+                       "the %zu bytes received", len);
     }
     if (*hlen != want_hlen || memcmp(b, want, want_hlen) != 0) {
         explain_header(b, len, want, want_len, err, errsz);
@@ -371,36 +361,31 @@ static bool check_chunk_frame(const uint8_t *b, size_t len, size_t hlen,
                               size_t errsz)
 {
     if (len - hlen < 8 + 20) {
-        snprintf(err, errsz, "truncated: %zu bytes end before the chunk "
-                 "offset table and chunk header", len);
-        return false;
+        return err_set(err, errsz, "truncated: %zu bytes end before the chunk "
+                       "offset table and chunk header", len);
     }
     uint64_t offset = read_u64(b + hlen);
     if (offset != hlen + 8) {
-        snprintf(err, errsz, "chunk offset table points at byte %llu, "
-                 "expected %zu", (unsigned long long) offset, hlen + 8);
-        return false;
+        return err_set(err, errsz, "chunk offset table points at byte %llu, "
+                       "expected %zu", (unsigned long long) offset, hlen + 8);
     }
     const uint8_t *leader = b + hlen + 8;
     int32_t tx = (int32_t) read_u32(leader), ty = (int32_t) read_u32(leader + 4);
     int32_t lx = (int32_t) read_u32(leader + 8),
             ly = (int32_t) read_u32(leader + 12);
     if (tx != 0 || ty != 0 || lx != 0 || ly != 0) {
-        snprintf(err, errsz, "chunk is for tile (%d,%d) level (%d,%d), "
-                 "expected tile (0,0) level (0,0)", tx, ty, lx, ly);
-        return false;
+        return err_set(err, errsz, "chunk is for tile (%d,%d) level (%d,%d), "
+                       "expected tile (0,0) level (0,0)", tx, ty, lx, ly);
     }
     uint32_t size = read_u32(leader + 16);
     size_t rest = len - hlen - 8 - 20;
     if (size != rest || size == 0) {
-        snprintf(err, errsz, "chunk data is %u bytes but %zu bytes follow "
-                 "its header (truncated or trailing bytes)", size, rest);
-        return false;
+        return err_set(err, errsz, "chunk data is %u bytes but %zu bytes follow "
+                       "its header (truncated or trailing bytes)", size, rest);
     }
     if (size > unpacked) {
-        snprintf(err, errsz, "chunk data of %u bytes is larger than the "
-                 "uncompressed tile (%zu bytes)", size, unpacked);
-        return false;
+        return err_set(err, errsz, "chunk data of %u bytes is larger than the "
+                       "uncompressed tile (%zu bytes)", size, unpacked);
     }
     *data_len = size;
     return true;
@@ -455,7 +440,7 @@ static bool expected_file(const image_format *fmt, image_rect r, void **bytes,
     if (rv != EXR_ERR_SUCCESS || header_length(out.out, out.out_len) == 0) {
         image_exr_error(err, errsz, "cannot make the expected tile header", rv,
                         &out);
-        image_exr_stream_release(&out);
+        image_exr_stream_clear(&out);
         return false;
     }
     *bytes = out.out;
@@ -473,8 +458,7 @@ bool image_tile_exr_chunk(const void *bytes, size_t len,
         || !image_format_tile_index(fmt, expect, &tx, &ty, err, errsz))
         return false;
     if (!bytes && len > 0) {
-        snprintf(err, errsz, "no tile bytes given");
-        return false;
+        return err_set(err, errsz, "no tile bytes given");
     }
     const uint8_t *b = bytes;
     void *want = NULL;
@@ -488,6 +472,8 @@ bool image_tile_exr_chunk(const void *bytes, size_t len,
                                    errsz)
               && check_decodes(b, len, fmt, expect, data_len, err, errsz);
     free(want);
+    /* the chunk is the file's tail, after header, offset table and leader */
+    assert(!ok || hlen + 8 + 20 + data_len == len);
     if (ok && chunk) {
         *chunk = b + hlen + 8 + 20;
         *chunk_len = data_len;

@@ -50,15 +50,16 @@ typedef struct image_tile {
 } image_tile;
 
 /* A tile with zeroed buffers; NULL when the size is not 1..
- * IMAGE_MAX_TILE_SIZE, the layers are unknown or memory runs out. */
+ * IMAGE_MAX_TILE_SIZE or the layers are unknown (a few MB at most: out of
+ * memory aborts, util/xalloc.h). */
 image_tile *image_tile_new(int x0, int y0, int w, int h, unsigned layers);
 void image_tile_destroy(image_tile **self_p);
 
 image_rect image_tile_rect(const image_tile *self);
 
 /* Encodes the tile as a one-tile EXR file of image `fmt` (the tile must be
- * a tile of fmt's grid and have fmt's layers). On success *bytes (malloc'd,
- * the caller frees) and *len hold the file. Same pixels, same bytes. */
+ * a tile of fmt's grid and have fmt's layers). On success *bytes (the
+ * caller frees) and *len hold the file. Same pixels, same bytes. */
 /* Non-finite samples (a surface shader dividing by zero, overflowing...)
  * made safe before the tile is written: NaN, +Inf and -Inf in RGBA, N and P
  * become 0; in Z, NaN and -Inf become +Inf ("nothing hit", what Z holds

@@ -13,7 +13,9 @@
  * is decompressed once, inside validation, to prove it intact.
  */
 #include "image/writer.h"
+#include "util/err.h"
 
+#include <assert.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -21,6 +23,7 @@
 
 #include "image/exr_io.h"
 #include "image/outfile.h"
+#include "util/xalloc.h"
 
 struct image_writer {
     image_format fmt;
@@ -29,7 +32,7 @@ struct image_writer {
     exr_context_t ctxt;
     uint8_t *written;           /* one flag per tile, row-major */
     int tiles_written;
-    char failure[256];          /* set once a write failed: writer unusable */
+    char failure[ERR_LEN];      /* set once a write failed: writer unusable */
 };
 
 image_writer *image_writer_new(const char *path, const image_format *fmt,
@@ -37,16 +40,9 @@ image_writer *image_writer_new(const char *path, const image_format *fmt,
 {
     if (!image_format_check(fmt, err, errsz))
         return NULL;
-    image_writer *self = calloc(1, sizeof *self);
-    uint8_t *written = calloc((size_t) image_format_tile_count(fmt), 1);
-    if (!self || !written) {
-        snprintf(err, errsz, "out of memory creating output image %s", path);
-        free(self);
-        free(written);
-        return NULL;
-    }
+    image_writer *self = xcalloc(1, sizeof *self);
     self->fmt = *fmt;
-    self->written = written;
+    self->written = xcalloc((size_t) image_format_tile_count(fmt), 1);
     self->file = image_outfile_new(path, err, errsz);
     if (!self->file) {
         image_writer_destroy(&self);
@@ -86,12 +82,13 @@ static bool usable(const image_writer *self, char *err, size_t errsz)
 {
     if (self->failure[0] == '\0')
         return true;
-    snprintf(err, errsz, "%s", self->failure);
-    return false;
+    return err_set(err, errsz, "%s", self->failure);
 }
 
 static uint8_t *written_flag(const image_writer *self, int tx, int ty)
 {
+    assert(tx >= 0 && ty >= 0 && tx < image_format_tiles_x(&self->fmt)
+           && ty < image_format_tiles_y(&self->fmt));
     return &self->written[(size_t) ty * (size_t) image_format_tiles_x(&self->fmt)
                           + (size_t) tx];
 }
@@ -102,8 +99,10 @@ static bool record_write(image_writer *self, int tx, int ty, exr_result_t rv,
                          char *err, size_t errsz)
 {
     if (rv == EXR_ERR_SUCCESS) {
+        assert(!*written_flag(self, tx, ty));    /* each tile written once */
         *written_flag(self, tx, ty) = 1;
         self->tiles_written++;
+        assert(self->tiles_written <= image_format_tile_count(&self->fmt));
         return true;
     }
     char what[320];
@@ -111,8 +110,7 @@ static bool record_write(image_writer *self, int tx, int ty, exr_result_t rv,
              image_outfile_temp_path(self->file));
     image_exr_error(self->failure, sizeof self->failure, what, rv,
                     &self->stream);
-    snprintf(err, errsz, "%s", self->failure);
-    return false;
+    return err_set(err, errsz, "%s", self->failure);
 }
 
 bool image_writer_put_tile(image_writer *self, const image_tile *tile,
@@ -126,13 +124,12 @@ bool image_writer_put_tile(image_writer *self, const image_tile *tile,
     if (tile->layers != self->fmt.layers || !tile->rgba || !tile->z
         || (tile->layers & IMAGE_LAYER_N && !tile->n)
         || (tile->layers & IMAGE_LAYER_P && !tile->p)) {
-        snprintf(err, errsz, "tile at (%d,%d) does not have the image's "
-                 "layers 0x%x", tile->x0, tile->y0, self->fmt.layers);
-        return false;
+        return err_set(err, errsz, "tile at (%d,%d) does not have the image's "
+                       "layers 0x%x", tile->x0, tile->y0, self->fmt.layers);
     }
     if (*written_flag(self, tx, ty))
         return true;
-    image_exr_stream_clear(&self->stream);
+    image_exr_stream_reset_errors(&self->stream);
     exr_result_t rv = image_exr_write_tile(self->ctxt, &self->fmt, tx, ty,
                                            tile);
     return record_write(self, tx, ty, rv, err, errsz);
@@ -160,12 +157,11 @@ bool image_writer_put_chunk(image_writer *self, int tx, int ty, const void *chun
         return false;
     if (tx < 0 || ty < 0 || tx >= image_format_tiles_x(&self->fmt)
         || ty >= image_format_tiles_y(&self->fmt)) {
-        snprintf(err, errsz, "tile (%d,%d) is not in the image", tx, ty);
-        return false;
+        return err_set(err, errsz, "tile (%d,%d) is not in the image", tx, ty);
     }
     if (*written_flag(self, tx, ty))
         return true;
-    image_exr_stream_clear(&self->stream);
+    image_exr_stream_reset_errors(&self->stream);
     exr_result_t rv = exr_write_tile_chunk(self->ctxt, 0, tx, ty, 0, 0, chunk,
                                            chunk_len);
     return record_write(self, tx, ty, rv, err, errsz);
@@ -204,9 +200,9 @@ static bool report_missing(const image_writer *self, char *err, size_t errsz)
     int nx = image_format_tiles_x(&self->fmt);
     for (int i = 0; i < total; i++) {
         if (!self->written[i]) {
-            snprintf(err, errsz, "cannot finish %s: %d of %d tiles missing, "
-                     "first tile (%d,%d)", image_outfile_path(self->file),
-                     total - self->tiles_written, total, i % nx, i / nx);
+            err_set(err, errsz, "cannot finish %s: %d of %d tiles missing, "
+                    "first tile (%d,%d)", image_outfile_path(self->file),
+                    total - self->tiles_written, total, i % nx, i / nx);
             return true;
         }
     }
@@ -222,7 +218,7 @@ bool image_writer_finish(image_writer **self_p, char *err, size_t errsz)
         image_writer_destroy(self_p);
         return false;
     }
-    image_exr_stream_clear(&self->stream);
+    image_exr_stream_reset_errors(&self->stream);
     exr_result_t rv = exr_finish(&self->ctxt);
     self->ctxt = NULL;
     if (rv != EXR_ERR_SUCCESS) {

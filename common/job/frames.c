@@ -3,6 +3,8 @@
  * frame, and loading one job per chosen frame (see frames.h).
  */
 #include "job/frames.h"
+#include "util/err.h"
+#include "util/xalloc.h"
 #include "scene/scene.h"
 
 #include <ctype.h>
@@ -34,8 +36,8 @@ bool frame_spec_parse(const char *text, frame_spec *out, char *err, size_t errsz
 {
     memset(out, 0, sizeof *out);
     if (!text || !*text) {
-        snprintf(err, errsz, "--frames wants frame numbers, e.g. 3, 1-10 or 1,3,5-7; got an "
-                 "empty list");
+        err_set(err, errsz, "--frames wants frame numbers, e.g. 3, 1-10 or 1,3,5-7; got an "
+                "empty list");
         return false;
     }
     const char *p = text;
@@ -51,20 +53,19 @@ bool frame_spec_parse(const char *text, frame_spec *out, char *err, size_t errsz
         if (!ok || (*p != ',' && *p != '\0')) {
             const char *end = strchr(item, ',');
             int n = end ? (int)(end - item) : (int)strlen(item);
-            snprintf(err, errsz, "--frames: '%.*s' (at character %d of '%s') is not a frame "
-                     "number 0..%d or a range like 5-7", n, item, (int)(item - text) + 1, text,
-                     FRAME_MAX_NUMBER);
-            frame_spec_free(out);
+            err_set(err, errsz, "--frames: '%.*s' (at character %d of '%s') is not a frame "
+                    "number 0..%d or a range like 5-7", n, item, (int)(item - text) + 1, text,
+                    FRAME_MAX_NUMBER);
+            frame_spec_clear(out);
             return false;
         }
         if (hi < lo) {
-            snprintf(err, errsz, "--frames: the range %d-%d runs backwards (write %d-%d)", lo,
-                     hi, hi, lo);
-            frame_spec_free(out);
+            err_set(err, errsz, "--frames: the range %d-%d runs backwards (write %d-%d)", lo,
+                    hi, hi, lo);
+            frame_spec_clear(out);
             return false;
         }
-        out->ranges = realloc(out->ranges, sizeof *out->ranges * (size_t)(out->count + 1));
-        if (!out->ranges) abort();
+        out->ranges = xrealloc(out->ranges, sizeof *out->ranges * (size_t)(out->count + 1));
         out->ranges[out->count][0] = lo;
         out->ranges[out->count][1] = hi;
         out->count++;
@@ -73,7 +74,7 @@ bool frame_spec_parse(const char *text, frame_spec *out, char *err, size_t errsz
     }
 }
 
-void frame_spec_free(frame_spec *spec)
+void frame_spec_clear(frame_spec *spec)
 {
     free(spec->ranges);
     spec->ranges = NULL;
@@ -109,8 +110,7 @@ bool frame_choose(const int *numbers, int n, const frame_spec *spec, int **indic
     static const int one = 1;
     int total = n > 0 ? n : 1;
     if (n == 0) numbers = &one;
-    *indices = malloc(sizeof **indices * (size_t)total);
-    if (!*indices) abort();
+    *indices = xmalloc(sizeof **indices * (size_t)total);
     *count = 0;
     for (int i = 0; spec && i < spec->count; i++) {
         bool any = false;
@@ -120,12 +120,12 @@ bool frame_choose(const int *numbers, int n, const frame_spec *spec, int **indic
             char have[200];
             describe_numbers(numbers, total, have, sizeof have);
             if (spec->ranges[i][0] == spec->ranges[i][1])
-                snprintf(err, errsz, "--frames: the scene has no frame %d (its frames: %s%s)",
-                         spec->ranges[i][0], have, n == 0 ? "; it has no FrameBegin" : "");
+                err_set(err, errsz, "--frames: the scene has no frame %d (its frames: %s%s)",
+                        spec->ranges[i][0], have, n == 0 ? "; it has no FrameBegin" : "");
             else
-                snprintf(err, errsz, "--frames: the scene has no frame in %d-%d (its frames: %s%s)",
-                         spec->ranges[i][0], spec->ranges[i][1], have,
-                         n == 0 ? "; it has no FrameBegin" : "");
+                err_set(err, errsz, "--frames: the scene has no frame in %d-%d (its frames: %s%s)",
+                        spec->ranges[i][0], spec->ranges[i][1], have,
+                        n == 0 ? "; it has no FrameBegin" : "");
             free(*indices);
             *indices = NULL;
             return false;
@@ -163,14 +163,12 @@ static bool holds_number(const char *name, int number)
 static char *substitute(const char *name, int number, int *patterns, char *err, size_t errsz)
 {
     size_t cap = strlen(name) + 64, used = 0;
-    char *out = malloc(cap);
-    if (!out) abort();
+    char *out = xmalloc(cap);
     *patterns = 0;
     for (const char *p = name; *p;) {
         if (used + 40 >= cap) {
             cap *= 2;
-            out = realloc(out, cap);
-            if (!out) abort();
+            out = xrealloc(out, cap);
         }
         if (*p != '%') {
             out[used++] = *p++;
@@ -187,8 +185,8 @@ static char *substitute(const char *name, int number, int *patterns, char *err, 
         int width = 0;
         while (isdigit((unsigned char)*q) && width < 100) width = width * 10 + (*q++ - '0');
         if (*q != 'd' || width > 16) {
-            snprintf(err, errsz, "output name '%s': only %%d, %%4d, %%04d (the frame number) "
-                     "and %%%% may follow a %% sign", name);
+            err_set(err, errsz, "output name '%s': only %%d, %%4d, %%04d (the frame number) "
+                    "and %%%% may follow a %% sign", name);
             free(out);
             return NULL;
         }
@@ -212,8 +210,7 @@ char *frame_output_name(const char *name, int number, int nframes, bool display,
     base = base ? base + 1 : out;
     const char *dot = strrchr(base, '.');
     size_t at = dot && dot != base ? (size_t)(dot - out) : strlen(out);
-    char *named = malloc(strlen(out) + 24);
-    if (!named) abort();
+    char *named = xmalloc(strlen(out) + 24);
     snprintf(named, strlen(out) + 24, "%.*s.%04d%s", (int)at, out, number, out + at);
     free(out);
     return named;
@@ -237,7 +234,7 @@ void frame_sequence_destroy(frame_sequence **self_p)
 
 static bool name_outputs(frame_sequence *seq, const char *output, bool *usage, sl_diag *diag)
 {
-    char err[600];
+    char err[ERR_LEN];
     sl_pos none = {0};
     for (int i = 0; i < seq->count; i++) {
         const job *jb = seq->jobs[i];
@@ -328,7 +325,7 @@ frame_sequence *frame_sequence_load(const char *rib_path, const job_options *opt
                                     sl_diag *diag)
 {
     *usage = false;
-    char err[600];
+    char err[ERR_LEN];
     frame_spec spec;
     if (frames && !frame_spec_parse(frames, &spec, err, sizeof err)) {
         sl_diag_error(diag, (sl_pos){0}, "%s", err);
@@ -342,7 +339,7 @@ frame_sequence *frame_sequence_load(const char *rib_path, const job_options *opt
     int *numbers = NULL;
     int nframes = scan_frames(rib_path, &numbers, diag);
     if (nframes == -2) {   /* unreadable: said so */
-        if (frames) frame_spec_free(&spec);
+        if (frames) frame_spec_clear(&spec);
         return NULL;
     }
     if (nframes < 0) {
@@ -351,7 +348,7 @@ frame_sequence *frame_sequence_load(const char *rib_path, const job_options *opt
         job *first = job_load(rib_path, &opt, diag);
         if (first) sl_diag_error(diag, (sl_pos){0}, "%s: cannot tell its frames", rib_path);
         job_destroy(&first);
-        if (frames) frame_spec_free(&spec);
+        if (frames) frame_spec_clear(&spec);
         return NULL;
     }
     int *indices = NULL, count = 0;
@@ -359,15 +356,13 @@ frame_sequence *frame_sequence_load(const char *rib_path, const job_options *opt
                            sizeof err);
     free(numbers);
     if (!ok) sl_diag_error(diag, (sl_pos){0}, "%s", err);
-    if (frames) frame_spec_free(&spec);
+    if (frames) frame_spec_clear(&spec);
     if (!ok) *usage = true;
     if (!ok) return NULL;
-    frame_sequence *seq = calloc(1, sizeof *seq);
-    if (!seq) abort();
+    frame_sequence *seq = xcalloc(1, sizeof *seq);
     seq->nframes = nframes;
-    seq->jobs = calloc((size_t)count, sizeof *seq->jobs);
-    seq->outputs = calloc((size_t)count, sizeof *seq->outputs);
-    if (!seq->jobs || !seq->outputs) abort();
+    seq->jobs = xcalloc((size_t)count, sizeof *seq->jobs);
+    seq->outputs = xcalloc((size_t)count, sizeof *seq->outputs);
     seq->count = count;
     for (int i = 0; i < count && ok; i++) {
         opt.frame = indices[i];

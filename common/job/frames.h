@@ -37,7 +37,7 @@ typedef struct frame_spec {
 /* Parses text ("3", "1-10", "1,3,5-7"); false with a message naming the
  * bad part in err. Numbers are 0..99999999, ranges low-high. */
 bool frame_spec_parse(const char *text, frame_spec *out, char *err, size_t errsz);
-void frame_spec_free(frame_spec *spec);
+void frame_spec_clear(frame_spec *spec);
 bool frame_spec_has(const frame_spec *spec, int number);
 
 /* The indices (into numbers[0..n)) of the frames spec chooses (spec NULL:

@@ -2,7 +2,10 @@
  * job.c: building, checking and hashing render jobs (see job.h).
  */
 #include "job/job.h"
+#include "util/err.h"
+#include "util/xalloc.h"
 
+#include <assert.h>
 #include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -10,17 +13,6 @@
 
 #include "job/job_scene.h"
 #include "scene/scene.h"
-
-static char *dup_n(const char *s, size_t n)
-{
-    char *p = malloc(n + 1);
-    if (!p) abort();
-    memcpy(p, s, n);
-    p[n] = '\0';
-    return p;
-}
-
-static char *dup_s(const char *s) { return dup_n(s, strlen(s)); }
 
 void job_options_default(job_options *opt)
 {
@@ -45,10 +37,9 @@ bool trace_arith_parse(const char *text, trace_arith *out)
 job *job_new(const char *scene_file, const char *scene_text, size_t scene_len,
              const job_options *options)
 {
-    job *self = calloc(1, sizeof *self);
-    if (!self) abort();
-    self->scene_file = dup_s(scene_file);
-    self->scene_text = dup_n(scene_text, scene_len);
+    job *self = xcalloc(1, sizeof *self);
+    self->scene_file = xstrdup(scene_file);
+    self->scene_text = xstrndup(scene_text, scene_len);
     self->scene_len = scene_len;
     self->sources = sl_source_set_new();
     if (options) self->options = *options;
@@ -80,16 +71,16 @@ void job_destroy(job **self_p)
 }
 
 bool job_add_source(job *self, const char *name, const char *text, size_t len,
-                    char *why, int why_size)
+                    char *err, size_t errsz)
 {
     if (sl_source_set_add(self->sources, name, text, len) == 0) return true;
     if (errno == EFBIG)
-        snprintf(why, (size_t)why_size, "shader source '%s' is larger than %zu bytes",
-                 name, sl_source_set_max_size(self->sources));
+        err_set(err, errsz, "shader source '%s' is larger than %zu bytes",
+                name, sl_source_set_max_size(self->sources));
     else if (errno == EEXIST)
-        snprintf(why, (size_t)why_size, "two different shader sources named '%s'", name);
+        err_set(err, errsz, "two different shader sources named '%s'", name);
     else
-        snprintf(why, (size_t)why_size, "invalid shader source name '%s'", name);
+        err_set(err, errsz, "invalid shader source name '%s'", name);
     return false;
 }
 
@@ -101,20 +92,17 @@ const char *job_shader_file(const job *self, const char *name)
 }
 
 bool job_add_shader(job *self, const char *name, const char *file,
-                    char *why, int why_size)
+                    char *err, size_t errsz)
 {
     if (!*name || !*file) {
-        snprintf(why, (size_t)why_size, "a shader entry with an empty name or file");
-        return false;
+        return err_set(err, errsz, "a shader entry with an empty name or file");
     }
     if (job_shader_file(self, name)) {
-        snprintf(why, (size_t)why_size, "shader '%s' listed twice", name);
-        return false;
+        return err_set(err, errsz, "shader '%s' listed twice", name);
     }
-    self->shaders = realloc(self->shaders, sizeof(job_shader) * (size_t)(self->nshaders + 1));
-    if (!self->shaders) abort();
-    self->shaders[self->nshaders].name = dup_s(name);
-    self->shaders[self->nshaders].file = dup_s(file);
+    self->shaders = xrealloc(self->shaders, sizeof(job_shader) * (size_t)(self->nshaders + 1));
+    self->shaders[self->nshaders].name = xstrdup(name);
+    self->shaders[self->nshaders].file = xstrdup(file);
     self->nshaders++;
     return true;
 }
@@ -127,26 +115,22 @@ job_file *job_file_find(const job *self, const char *name)
 }
 
 bool job_add_file(job *self, const char *name, const char *hex, uint64_t size,
-                  char *why, int why_size)
+                  char *err, size_t errsz)
 {
     if (!*name) {
-        snprintf(why, (size_t)why_size, "a file entry with an empty name");
-        return false;
+        return err_set(err, errsz, "a file entry with an empty name");
     }
     if (!hash_hex_valid(hex)) {
-        snprintf(why, (size_t)why_size, "file '%s': its SHA-256 is not 64 lowercase hex digits",
-                 name);
-        return false;
+        return err_set(err, errsz, "file '%s': its SHA-256 is not 64 lowercase hex digits",
+                       name);
     }
     if (job_file_find(self, name)) {
-        snprintf(why, (size_t)why_size, "file '%s' listed twice", name);
-        return false;
+        return err_set(err, errsz, "file '%s' listed twice", name);
     }
-    self->files = realloc(self->files, sizeof(job_file) * (size_t)(self->nfiles + 1));
-    if (!self->files) abort();
+    self->files = xrealloc(self->files, sizeof(job_file) * (size_t)(self->nfiles + 1));
     job_file *f = &self->files[self->nfiles++];
     memset(f, 0, sizeof *f);
-    f->name = dup_s(name);
+    f->name = xstrdup(name);
     snprintf(f->sha256, sizeof f->sha256, "%s", hex);
     f->size = size;
     return true;
@@ -154,8 +138,9 @@ bool job_add_file(job *self, const char *name, const char *hex, uint64_t size,
 
 void job_file_set_path(job *self, int i, const char *path)
 {
+    assert(i >= 0 && i < self->nfiles);
     free(self->files[i].path);
-    self->files[i].path = path ? dup_s(path) : NULL;
+    self->files[i].path = path ? xstrdup(path) : NULL;
 }
 
 uint64_t job_files_bytes(const job *self)
@@ -165,54 +150,47 @@ uint64_t job_files_bytes(const job *self)
     return n;
 }
 
-bool job_file_resolve(void *jb, const char *name, char *path, size_t path_size, char *why,
-                      int why_size)
+bool job_file_resolve(void *jb, const char *name, char *path, size_t path_size, char *err,
+                      size_t errsz)
 {
     const job *self = jb;
     const job_file *f = self ? job_file_find(self, name) : NULL;
     if (!f) {
-        snprintf(why, (size_t)why_size, "'%s' is not one of the job's files (none of that name "
-                 "was found on the texture search path when the job was loaded: add its folder "
-                 "with Option \"searchpath\" \"texture\" [\"dir:&\"])", name);
-        return false;
+        return err_set(err, errsz, "'%s' is not one of the job's files (none of that name "
+                       "was found on the texture search path when the job was loaded: add its folder "
+                       "with Option \"searchpath\" \"texture\" [\"dir:&\"])", name);
     }
     if (!f->path) {
-        snprintf(why, (size_t)why_size, "file '%s' (%.12s...) is not present on this host yet",
-                 name, f->sha256);
-        return false;
+        return err_set(err, errsz, "file '%s' (%.12s...) is not present on this host yet",
+                       name, f->sha256);
     }
     if (strlen(f->path) >= path_size) {
-        snprintf(why, (size_t)why_size, "the path of file '%s' is longer than %zu bytes", name,
-                 path_size - 1);
-        return false;
+        return err_set(err, errsz, "the path of file '%s' is longer than %zu bytes", name,
+                       path_size - 1);
     }
     memcpy(path, f->path, strlen(f->path) + 1);
     return true;
 }
 
-bool job_finish(job *self, char *why, int why_size)
+bool job_finish(job *self, char *err, size_t errsz)
 {
     for (int i = 0; i < self->nshaders; i++)
         if (!sl_source_set_find(self->sources, self->shaders[i].file)) {
-            snprintf(why, (size_t)why_size, "shader '%s': its source '%s' is missing from the job",
-                     self->shaders[i].name, self->shaders[i].file);
-            return false;
+            return err_set(err, errsz, "shader '%s': its source '%s' is missing from the job",
+                           self->shaders[i].name, self->shaders[i].file);
         }
     if (self->options.frame < 0) {
-        snprintf(why, (size_t)why_size, "frame index %d is out of range", self->options.frame);
-        return false;
+        return err_set(err, errsz, "frame index %d is out of range", self->options.frame);
     }
     size_t nsrc = sl_source_set_count(self->sources);
-    hash_shader *hs = calloc(nsrc + 1, sizeof *hs);
+    hash_shader *hs = xcalloc(nsrc + 1, sizeof *hs);
     int nopt = 3 + self->nshaders + self->nfiles + (self->options.frame != 0);
-    hash_option *ho = calloc((size_t)nopt, sizeof *ho);
+    hash_option *ho = xcalloc((size_t)nopt, sizeof *ho);
     /* a file enters the hash as option "file:<name>" = "<sha256>:<size>" */
-    char **file_keys = calloc((size_t)self->nfiles + 1, sizeof *file_keys);
-    char (*file_vals)[HASH_HEX_SIZE + 24] = calloc((size_t)self->nfiles + 1, sizeof *file_vals);
-    if (!file_keys || !file_vals) abort();
-    char (*keys)[160] = calloc((size_t)nopt, sizeof *keys);
-    char (*vals)[600] = calloc((size_t)nopt, sizeof *vals);
-    if (!hs || !ho || !keys || !vals) abort();
+    char **file_keys = xcalloc((size_t)self->nfiles + 1, sizeof *file_keys);
+    char (*file_vals)[HASH_HEX_SIZE + 24] = xcalloc((size_t)self->nfiles + 1, sizeof *file_vals);
+    char (*keys)[160] = xcalloc((size_t)nopt, sizeof *keys);
+    char (*vals)[600] = xcalloc((size_t)nopt, sizeof *vals);
     for (size_t i = 0; i < nsrc; i++) {
         const sl_source *s = sl_source_set_at(self->sources, i);
         hs[i] = (hash_shader){s->name, s->text, s->len};
@@ -230,13 +208,13 @@ bool job_finish(job *self, char *why, int why_size)
     for (int i = 0; i < 3 + self->nshaders; i++) ho[i] = (hash_option){keys[i], vals[i]};
     for (int i = 0; i < self->nfiles; i++) {
         size_t n = strlen(self->files[i].name) + 6;
-        file_keys[i] = malloc(n);
-        if (!file_keys[i]) abort();
+        file_keys[i] = xmalloc(n);
         snprintf(file_keys[i], n, "file:%s", self->files[i].name);
         snprintf(file_vals[i], sizeof file_vals[i], "%s:%llu", self->files[i].sha256,
                  (unsigned long long)self->files[i].size);
         ho[3 + self->nshaders + i] = (hash_option){file_keys[i], file_vals[i]};
     }
+    assert(3 + self->nshaders + self->nfiles + (self->options.frame != 0) == nopt);
     if (self->options.frame != 0) {   /* absent for frame 0: older hashes stay */
         snprintf(keys[nopt - 1], sizeof keys[0], "frame");
         snprintf(vals[nopt - 1], sizeof vals[0], "%d", self->options.frame);
@@ -253,8 +231,7 @@ bool job_finish(job *self, char *why, int why_size)
     free(keys);
     free(vals);
     if (rc != 0) {
-        snprintf(why, (size_t)why_size, "the job cannot be hashed (duplicate names)");
-        return false;
+        return err_set(err, errsz, "the job cannot be hashed (duplicate names)");
     }
     return true;
 }
@@ -267,8 +244,7 @@ static char *read_file(const char *path, size_t *len, sl_diag *diag)
         return NULL;
     }
     size_t cap = 1 << 16, n = 0;
-    char *buf = malloc(cap);
-    if (!buf) abort();
+    char *buf = xmalloc(cap);
     size_t got;
     while ((got = fread(buf + n, 1, cap - n, f)) > 0) {
         n += got;
@@ -280,8 +256,7 @@ static char *read_file(const char *path, size_t *len, sl_diag *diag)
                 return NULL;
             }
             cap *= 2;
-            buf = realloc(buf, cap);
-            if (!buf) abort();
+            buf = xrealloc(buf, cap);
         }
     }
     bool bad = ferror(f);
@@ -319,13 +294,12 @@ job *job_load(const char *rib_path, const job_options *options, sl_diag *diag)
     self->frame_number = sc->frame_number;
     self->nframes = sc->nframes;
     if (sc->nframes > 0) {
-        self->frame_numbers = malloc(sizeof *self->frame_numbers * (size_t)sc->nframes);
-        if (!self->frame_numbers) abort();
+        self->frame_numbers = xmalloc(sizeof *self->frame_numbers * (size_t)sc->nframes);
         memcpy(self->frame_numbers, sc->frame_numbers,
                sizeof *self->frame_numbers * (size_t)sc->nframes);
     }
-    if (sc->display_name) self->display_name = dup_s(sc->display_name);
-    char why[512];
+    if (sc->display_name) self->display_name = xstrdup(sc->display_name);
+    char err[ERR_LEN];
     bool ok = true;
     for (int i = 0; i < sc->nshader_names; i++) {
         const char *name = sc->shader_names[i];
@@ -347,7 +321,7 @@ job *job_load(const char *rib_path, const job_options *options, sl_diag *diag)
             continue;
         }
         if (sl_source_set_load_file(self->sources, path, path, diag) != 0 ||
-            !job_add_shader(self, name, path, why, sizeof why)) {
+            !job_add_shader(self, name, path, err, sizeof err)) {
             ok = false;
         }
         free(path);
@@ -365,8 +339,8 @@ job *job_load(const char *rib_path, const job_options *options, sl_diag *diag)
         }
         job_scene_destroy(&js);
     }
-    if (ok && !job_finish(self, why, sizeof why)) {
-        sl_diag_error(diag, (sl_pos){0}, "%s", why);
+    if (ok && !job_finish(self, err, sizeof err)) {
+        sl_diag_error(diag, (sl_pos){0}, "%s", err);
         ok = false;
     }
     if (!ok) job_destroy(&self);

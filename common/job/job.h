@@ -100,15 +100,15 @@ char *job_read_scene(const char *rib_path, size_t *len, sl_diag *diag);
 job *job_new(const char *scene_file, const char *scene_text, size_t scene_len,
              const job_options *options);
 /* Adds a shader source (name, text) / a shader (RIB name -> main source).
- * Return false on a duplicate or invalid entry, with a reason in why. */
+ * Return false on a duplicate or invalid entry, with a reason in err. */
 bool job_add_source(job *self, const char *name, const char *text, size_t len,
-                    char *why, int why_size);
+                    char *err, size_t errsz);
 bool job_add_shader(job *self, const char *name, const char *file,
-                    char *why, int why_size);
+                    char *err, size_t errsz);
 /* Adds a file (name, SHA-256 as 64 lowercase hex digits, size) without a
  * local path. False on an empty or duplicate name or a bad hash. */
 bool job_add_file(job *self, const char *name, const char *hex, uint64_t size,
-                  char *why, int why_size);
+                  char *err, size_t errsz);
 /* The file named `name`, or NULL. */
 job_file *job_file_find(const job *self, const char *name);
 /* Sets (a copy of) the local path of file i (NULL: not present). */
@@ -117,17 +117,17 @@ void job_file_set_path(job *self, int i, const char *path);
 uint64_t job_files_bytes(const job *self);
 
 /* The resolver the texture module opens files through: true and the local
- * path of the job's file `name` in path[0..path_size), or false and why
+ * path of the job's file `name` in path[0..path_size), or false and the reason
  * (not one of the job's files, not present here, the path too long).
  * `job` is a const job *. */
-bool job_file_resolve(void *job, const char *name, char *path, size_t path_size, char *why,
-                      int why_size);
+bool job_file_resolve(void *job, const char *name, char *path, size_t path_size, char *err,
+                      size_t errsz);
 
 /* The same lookup job_collect_files makes, for a name on the texture search
  * path of `scene` (a const scene *), before the job's files are collected:
- * the path found on disk, or false and why. */
+ * the path found on disk, or false and the reason in err. */
 bool job_texture_path_resolve(void *scene, const char *name, char *path, size_t path_size,
-                              char *why, int why_size);
+                              char *err, size_t errsz);
 
 /* Collects the job's files (job_files.c): every string constant of the
  * compiled programs and every string parameter of the scene's shader calls
@@ -137,8 +137,8 @@ bool job_texture_path_resolve(void *scene, const char *name, char *path, size_t 
 struct job_scene;
 bool job_collect_files(job *self, const struct job_scene *js, sl_diag *diag);
 
-/* Computes the hash; false if the job is inconsistent (why says so). */
-bool job_finish(job *self, char *why, int why_size);
+/* Computes the hash; false if the job is inconsistent (err says so). */
+bool job_finish(job *self, char *err, size_t errsz);
 void job_destroy(job **self_p);
 
 /* The main source of shader `name`, or NULL. */

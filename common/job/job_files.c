@@ -14,6 +14,8 @@
  * file the shader never reads, never a wrong pixel.
  */
 #include "job/job.h"
+#include "util/err.h"
+#include "util/xalloc.h"
 
 #include <errno.h>
 #include <stdio.h>
@@ -32,24 +34,22 @@ static int64_t mtime_ns(const struct stat *st)
 }
 
 /* Hashes the file at path and stamps it (stat before and after: a file
- * written meanwhile is an error); false (the reason in why) otherwise. */
+ * written meanwhile is an error); false (the reason in err) otherwise. */
 static bool hash_file(const char *path, char hex[HASH_HEX_SIZE], uint64_t *size,
-                      struct stat *stamp, char *why, size_t why_size)
+                      struct stat *stamp, char *err, size_t errsz)
 {
     FILE *f = fopen(path, "rb");
     if (!f) {
-        snprintf(why, why_size, "%s", strerror(errno));
-        return false;
+        return err_set(err, errsz, "%s", strerror(errno));
     }
     struct stat after;
     if (fstat(fileno(f), stamp) != 0) {
-        snprintf(why, why_size, "%s", strerror(errno));
+        err_set(err, errsz, "%s", strerror(errno));
         fclose(f);
         return false;
     }
     enum { CHUNK = 1 << 20 };
-    unsigned char *buf = malloc(CHUNK);
-    if (!buf) abort();
+    unsigned char *buf = xmalloc(CHUNK);
     sha256 h;
     sha256_init(&h);
     uint64_t n = 0;
@@ -65,12 +65,11 @@ static bool hash_file(const char *path, char hex[HASH_HEX_SIZE], uint64_t *size,
     free(buf);
     fclose(f);
     if (bad) {
-        snprintf(why, why_size, "read error: %s", strerror(e));
-        return false;
+        return err_set(err, errsz, "read error: %s", strerror(e));
     }
     if (moved) {
-        snprintf(why, why_size, "it changed while it was read; load the scene again when it "
-                 "is written");
+        err_set(err, errsz, "it changed while it was read; load the scene again when it "
+                "is written");
         return false;
     }
     uint8_t digest[SHA256_DIGEST_SIZE];
@@ -86,14 +85,13 @@ static char *find_on_path(const scene *sc, const char *name)
 {
     struct stat st;
     if (name[0] == '/') {
-        if (stat(name, &st) == 0 && S_ISREG(st.st_mode)) return strdup(name);
+        if (stat(name, &st) == 0 && S_ISREG(st.st_mode)) return xstrdup(name);
         return NULL;
     }
     for (int i = 0; i < sc->ntexture_path; i++) {
         const char *dir = sc->texture_path[i];
         size_t n = strlen(dir) + strlen(name) + 2;
-        char *path = malloc(n);
-        if (!path) abort();
+        char *path = xmalloc(n);
         if (strcmp(dir, ".") == 0) snprintf(path, n, "%s", name);
         else snprintf(path, n, "%s%s%s", dir, dir[strlen(dir) - 1] == '/' ? "" : "/", name);
         if (stat(path, &st) == 0 && S_ISREG(st.st_mode)) return path;
@@ -103,22 +101,22 @@ static char *find_on_path(const scene *sc, const char *name)
 }
 
 bool job_texture_path_resolve(void *scene_, const char *name, char *path, size_t path_size,
-                              char *why, int why_size)
+                              char *err, size_t errsz)
 {
     const scene *sc = scene_;
     char *found = find_on_path(sc, name);
     if (!found) {
-        snprintf(why, (size_t)why_size, "no file '%s' on the texture search path (add its folder "
-                 "with Option \"searchpath\" \"texture\" [\"dir:&\"]; the RIB's folder is "
-                 "searched last)", name);
+        err_set(err, errsz, "no file '%s' on the texture search path (add its folder "
+                "with Option \"searchpath\" \"texture\" [\"dir:&\"]; the RIB's folder is "
+                "searched last)", name);
         return false;
     }
     bool fits = strlen(found) < path_size;
     if (fits)
         memcpy(path, found, strlen(found) + 1);
     else
-        snprintf(why, (size_t)why_size, "the path of '%s' is longer than %zu bytes", name,
-                 path_size - 1);
+        err_set(err, errsz, "the path of '%s' is longer than %zu bytes", name,
+                path_size - 1);
     free(found);
     return fits;
 }
@@ -137,16 +135,16 @@ static bool consider(job *self, const scene *sc, const char *name, sl_pos pos, s
         free(path);
         return false;
     }
-    char hex[HASH_HEX_SIZE], why[300];
+    char hex[HASH_HEX_SIZE], err[ERR_LEN];
     uint64_t size = 0;
     struct stat st;
-    if (!hash_file(path, hex, &size, &st, why, sizeof why)) {
+    if (!hash_file(path, hex, &size, &st, err, sizeof err)) {
         sl_diag_error(diag, pos, "file '%s' (found as '%s' on the texture search path) cannot be "
-                      "read: %s; fix its permissions or remove it", name, path, why);
+                      "read: %s; fix its permissions or remove it", name, path, err);
         free(path);
         return false;
     }
-    bool ok = job_add_file(self, name, hex, size, why, sizeof why);
+    bool ok = job_add_file(self, name, hex, size, err, sizeof err);
     if (ok) {
         job_file *f = &self->files[self->nfiles - 1];
         job_file_set_path(self, self->nfiles - 1, path);
@@ -155,7 +153,7 @@ static bool consider(job *self, const scene *sc, const char *name, sl_pos pos, s
         f->ino = (uint64_t)st.st_ino;
         f->mtime_ns = mtime_ns(&st);
     }
-    else sl_diag_error(diag, pos, "%s", why);
+    else sl_diag_error(diag, pos, "%s", err);
     free(path);
     return ok;
 }

@@ -5,6 +5,8 @@
  * terms) into the renderer's camera-space world (trace/world.h).
  */
 #include "job/job_scene.h"
+#include "util/err.h"
+#include "util/xalloc.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -80,8 +82,7 @@ static bool light_directional(const trace_light *t)
 static void build_lights(const scene *sc, sl_instance *const *instances, trace_world *w)
 {
     w->nlights = sc->nlights;
-    w->lights = calloc((size_t)(sc->nlights > 0 ? sc->nlights : 1), sizeof *w->lights);
-    if (!w->lights) abort();
+    w->lights = xcalloc((size_t)(sc->nlights > 0 ? sc->nlights : 1), sizeof *w->lights);
     for (int i = 0; i < sc->nlights; i++) {
         const scene_light *l = &sc->lights[i];
         trace_light *t = &w->lights[i];
@@ -130,8 +131,7 @@ static bool compile_programs(job_scene *self, sl_diag *diag)
 {
     const job *jb = self->job;
     bool ok = true;
-    self->programs = calloc((size_t)(jb->nshaders > 0 ? jb->nshaders : 1), sizeof *self->programs);
-    if (!self->programs) abort();
+    self->programs = xcalloc((size_t)(jb->nshaders > 0 ? jb->nshaders : 1), sizeof *self->programs);
     for (int i = 0; i < jb->nshaders; i++) {
         self->programs[i] = sl_compile(jb->sources, jb->shaders[i].file,
                                        scene_search_path(self->scene), diag);
@@ -170,12 +170,12 @@ static sl_instance *make_instance(job_scene *self, const scene_shader *call, sl_
     sl_instance *inst = sl_instance_new(prog);
     for (int k = 0; k < call->nparams; k++) {
         const scene_param *pa = &call->params[k];
-        char why[256];
+        char err[ERR_LEN];
         bool ok = pa->type == SL_TYPE_STRING
-                      ? sl_instance_set_string(inst, pa->name, pa->string, why, sizeof why)
+                      ? sl_instance_set_string(inst, pa->name, pa->string, err, sizeof err)
                       : sl_instance_set(inst, pa->name, pa->type, pa->values, pa->count,
-                                        why, sizeof why);
-        if (!ok) sl_diag_warning(diag, pa->pos, "shader '%s': %s (parameter ignored)", call->name, why);
+                                        err, sizeof err);
+        if (!ok) sl_diag_warning(diag, pa->pos, "shader '%s': %s (parameter ignored)", call->name, err);
     }
     return inst;
 }
@@ -240,20 +240,17 @@ static bool build_objects(job_scene *self, sl_diag *diag)
     const scene *sc = self->scene;
     trace_world *w = &self->world;
     bool ok = true;
-    self->instances = calloc((size_t)(sc->nshaders > 0 ? sc->nshaders : 1), sizeof *self->instances);
-    if (!self->instances) abort();
+    self->instances = xcalloc((size_t)(sc->nshaders > 0 ? sc->nshaders : 1), sizeof *self->instances);
     for (int i = 0; i < sc->nshaders; i++) {
         self->instances[i] = make_instance(self, &sc->shaders[i], diag);
         if (!self->instances[i]) ok = false;
     }
     if (!ok) return false;
     w->nobjects = sc->nobjects;
-    w->objects = calloc((size_t)(sc->nobjects > 0 ? sc->nobjects : 1), sizeof *w->objects);
-    if (!w->objects) abort();
+    w->objects = xcalloc((size_t)(sc->nobjects > 0 ? sc->nobjects : 1), sizeof *w->objects);
     size_t nprimvars = 0;
     for (int i = 0; i < sc->nobjects; i++) nprimvars += (size_t)sc->objects[i].nprimvars;
-    self->primvars = calloc(nprimvars > 0 ? nprimvars : 1, sizeof *self->primvars);
-    if (!self->primvars) abort();
+    self->primvars = xcalloc(nprimvars > 0 ? nprimvars : 1, sizeof *self->primvars);
     trace_primvar *next_primvar = self->primvars;
     for (int i = 0; i < sc->nobjects; i++) {
         const scene_object *o = &sc->objects[i];
@@ -293,7 +290,6 @@ static bool open_textures(job_scene *self, sl_diag *diag, bool render)
 {
     const scene *sc = self->scene;
     self->textures = tex_cache_new(0);
-    if (!self->textures) abort();
     /* the job's files (job_file_resolve: the disk on the master and
      * standalone, the host's store on a worker); before job_load has
      * collected them, and for jobs built in memory (tests), the same search
@@ -308,13 +304,13 @@ static bool open_textures(job_scene *self, sl_diag *diag, bool render)
         const char *names[32];
         int n = sl_instance_texture_names(self->instances[i], names, 32);
         for (int k = 0; k < n; k++) {
-            char err[1024], path[4096], why[512];
+            char err[ERR_LEN], path[4096], reason[ERR_LEN];
             bool found = render ? tex_cache_get(self->textures, names[k], err, sizeof err) != NULL
                                 : job_texture_path_resolve((void *)sc, names[k], path, sizeof path,
-                                                           why, (int)sizeof why);
+                                                           reason, sizeof reason);
             if (!found) {
                 if (!render)
-                    snprintf(err, sizeof err, "texture '%s': %s", names[k], why);
+                    err_set(err, sizeof err, "texture '%s': %s", names[k], reason);
                 sl_diag_error(diag, sc->shaders[i].pos, "shader '%s': %s", sc->shaders[i].name,
                               err);
                 ok = false;
@@ -326,8 +322,7 @@ static bool open_textures(job_scene *self, sl_diag *diag, bool render)
 
 job_scene *job_scene_new(const job *jb, size_t cache_bytes, bool render, sl_diag *diag)
 {
-    job_scene *self = calloc(1, sizeof *self);
-    if (!self) abort();
+    job_scene *self = xcalloc(1, sizeof *self);
     self->job = jb;
     /* archives come from the job, never from this machine's disk */
     self->scene = scene_parse_frame(jb->scene_file, jb->scene_text, jb->scene_len,
@@ -356,14 +351,14 @@ job_scene *job_scene_new(const job *jb, size_t cache_bytes, bool render, sl_diag
         if (sc->trace_maxdepth >= 0) w->options.max_ray_depth = sc->trace_maxdepth;
     }
     if (ok && !render) {
-        char err[512];
+        char err[ERR_LEN];
         if (!trace_world_prepare(&self->world, err, sizeof err)) {
             sl_diag_error(diag, (sl_pos){0}, "%s", err);
             ok = false;
         }
     }
     if (ok && render) {
-        char err[512];
+        char err[ERR_LEN];
         self->renderer = trace_renderer_new(&self->world, err, sizeof err);
         if (!self->renderer) {
             sl_diag_error(diag, (sl_pos){0}, "%s", err);
@@ -389,7 +384,7 @@ void job_scene_destroy(job_scene **self_p)
     free(self->world.objects);
     free(self->world.lights);
     free(self->primvars);
-    tex_cache_free(self->textures);
+    tex_cache_destroy(&self->textures);
     scene_destroy(&self->scene);
     free(self);
     *self_p = NULL;

@@ -15,7 +15,10 @@
  * stays in memory for good (tex_bytes).
  */
 #include "tex/tex_internal.h"
+#include "util/err.h"
+#include "util/xalloc.h"
 
+#include <assert.h>
 #include <errno.h>
 #include <pthread.h>
 #include <stdio.h>
@@ -40,25 +43,25 @@ struct tex_cache {
 
 tex_cache *tex_cache_new(size_t budget)
 {
-    tex_cache *self = calloc(1, sizeof *self);
-    if (!self)
-        return NULL;
+    tex_cache *self = xcalloc(1, sizeof *self);
     pthread_mutex_init(&self->lock, NULL);
     self->budget = budget;
     return self;
 }
 
-void tex_cache_free(tex_cache *self)
+void tex_cache_destroy(tex_cache **self_p)
 {
+    tex_cache *self = *self_p;
     if (!self)
         return;
     for (int i = 0; i < self->n; i++) {
         free(self->entries[i].name);
-        tex_free(self->entries[i].tex);
+        tex_destroy(&self->entries[i].tex);
     }
     free(self->entries);
     pthread_mutex_destroy(&self->lock);
     free(self);
+    *self_p = NULL;
 }
 
 void tex_cache_set_resolver(tex_cache *self, tex_resolve_fn fn, void *ctx)
@@ -84,26 +87,17 @@ static tex_texture *find(const tex_cache *self, const char *name)
     return NULL;
 }
 
-static bool add(tex_cache *self, const char *name, tex_texture *t)
+static void add(tex_cache *self, const char *name, tex_texture *t)
 {
     if (self->n == self->cap) {
-        int cap = self->cap ? 2 * self->cap : 8;
-        tex_entry *e = realloc(self->entries, (size_t)cap * sizeof *e);
-        if (!e)
-            return false;
-        self->entries = e;
-        self->cap = cap;
+        self->cap = self->cap ? 2 * self->cap : 8;
+        self->entries = xreallocarray(self->entries, (size_t)self->cap, sizeof *self->entries);
     }
-    size_t len = strlen(name) + 1;
-    char *copy = malloc(len);
-    if (!copy)
-        return false;
-    memcpy(copy, name, len);
-    self->entries[self->n].name = copy;
+    assert(self->n < self->cap && !find(self, name));   /* one entry per name */
+    self->entries[self->n].name = xstrdup(name);
     self->entries[self->n].tex = t;
     self->n++;
     self->bytes += tex_bytes(t);
-    return true;
 }
 
 const tex_texture *tex_cache_get(tex_cache *self, const char *name, char *err, size_t errsz)
@@ -114,10 +108,10 @@ const tex_texture *tex_cache_get(tex_cache *self, const char *name, char *err, s
         pthread_mutex_unlock(&self->lock);
         return t;
     }
-    char path[4096], why[512] = "";
+    char path[4096], reason[ERR_LEN] = "";
     if (self->resolve) {
-        if (!self->resolve(self->resolve_ctx, name, path, sizeof path, why, (int)sizeof why)) {
-            snprintf(err, errsz, "texture '%s': %s", name, why);
+        if (!self->resolve(self->resolve_ctx, name, path, sizeof path, reason, sizeof reason)) {
+            err_set(err, errsz, "texture '%s': %s", name, reason);
             pthread_mutex_unlock(&self->lock);
             return NULL;
         }
@@ -126,17 +120,14 @@ const tex_texture *tex_cache_get(tex_cache *self, const char *name, char *err, s
     }
     t = tex_open_in(path, self->tiles ? self->tiles : tex_tiles_process(), err, errsz);
     if (t && self->budget && self->bytes + tex_bytes(t) > self->budget) {
-        snprintf(err, errsz, "texture '%s': its pyramids take %zu bytes and the textures "
-                 "already open %zu, over the budget of %zu bytes; raise the texture memory "
-                 "budget or use smaller maps", name, tex_bytes(t), self->bytes, self->budget);
-        tex_free(t);
+        err_set(err, errsz, "texture '%s': its pyramids take %zu bytes and the textures "
+                "already open %zu, over the budget of %zu bytes; raise the texture memory "
+                "budget or use smaller maps", name, tex_bytes(t), self->bytes, self->budget);
+        tex_destroy(&t);
         t = NULL;
     }
-    if (t && !add(self, name, t)) {
-        snprintf(err, errsz, "texture '%s': out of memory", name);
-        tex_free(t);
-        t = NULL;
-    }
+    if (t)
+        add(self, name, t);
     pthread_mutex_unlock(&self->lock);
     return t;
 }
@@ -144,10 +135,12 @@ const tex_texture *tex_cache_get(tex_cache *self, const char *name, char *err, s
 bool tex_cache_put(tex_cache *self, const char *name, tex_texture *t)
 {
     pthread_mutex_lock(&self->lock);
-    bool ok = !find(self, name) && add(self, name, t);
+    bool ok = !find(self, name);
+    if (ok)
+        add(self, name, t);
     pthread_mutex_unlock(&self->lock);
     if (!ok)
-        tex_free(t);
+        tex_destroy(&t);
     return ok;
 }
 
@@ -165,7 +158,7 @@ static bool is_file(const char *path)
 }
 
 bool tex_searchpath_resolve(void *ctx, const char *name, char *path, size_t path_size,
-                            char *why, int why_size)
+                            char *err, size_t errsz)
 {
     const tex_searchpath *sp = ctx;
     const char *base = sp && sp->base[0] ? sp->base : ".";
@@ -173,8 +166,7 @@ bool tex_searchpath_resolve(void *ctx, const char *name, char *path, size_t path
         snprintf(path, path_size, "%s", name);
         if (is_file(path))
             return true;
-        snprintf(why, (size_t)why_size, "no file %s", name);
-        return false;
+        return err_set(err, errsz, "no file %s", name);
     }
     const char *s = sp ? sp->path : "";
     for (;;) {               /* each folder of the path; "&" and "@" are the base */
@@ -198,8 +190,8 @@ bool tex_searchpath_resolve(void *ctx, const char *name, char *path, size_t path
     snprintf(path, path_size, "%s/%s", base, name);   /* the scene's folder last */
     if (is_file(path))
         return true;
-    snprintf(why, (size_t)why_size, "not found in the scene's folder %s nor on the texture "
-             "search path \"%s\"; add its folder with Option \"searchpath\" \"texture\" "
-             "[\"dir:&\"]", base, sp ? sp->path : "");
+    err_set(err, errsz, "not found in the scene's folder %s nor on the texture "
+            "search path \"%s\"; add its folder with Option \"searchpath\" \"texture\" "
+            "[\"dir:&\"]", base, sp ? sp->path : "");
     return false;
 }

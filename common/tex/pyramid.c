@@ -12,19 +12,12 @@
  * never takes it outside the min-max pyramid's bound.
  */
 #include "tex/tex_internal.h"
+#include "util/xalloc.h"
 
+#include <assert.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-
-static char *dup_string(const char *s)
-{
-    size_t n = strlen(s) + 1;
-    char *r = malloc(n);
-    if (r)
-        memcpy(r, s, n);
-    return r;
-}
 
 /* Level-0 texels covered by index q of level k along a side of n texels. */
 static double covered(int q, int k, int n)
@@ -52,41 +45,41 @@ static double level_lipschitz(const float *v, int w, int h, int nch, int c, bool
     return m * n;
 }
 
-tex_texture *tex_build(tex_pixels *px, const char *name)
+tex_texture *tex_new_levels(const char *name, const char *type, int w, int h, int nch)
 {
-    tex_texture *t = calloc(1, sizeof *t);
-    if (!t) {
-        free(px->data);
-        px->data = NULL;
-        return NULL;
-    }
-    t->name = dup_string(name);
-    t->type = px->type ? px->type : "float";
-    t->w = px->w;
-    t->h = px->h;
-    t->nch = px->nch;
+    assert(w >= 1 && h >= 1 && w <= TEX_MAX_SIDE && h <= TEX_MAX_SIDE);
+    assert(nch >= 1 && nch <= TEX_MAX_CHANNELS);
+    tex_texture *t = xcalloc(1, sizeof *t);
+    t->name = xstrdup(name);
+    t->type = type;
+    t->w = w;
+    t->h = h;
+    t->nch = nch;
     int n = 1;
-    for (int w = t->w, h = t->h; w > 1 || h > 1; n++) {
-        w = (w + 1) / 2;
-        h = (h + 1) / 2;
+    for (int a = w, b = h; a > 1 || b > 1; n++) {
+        a = (a + 1) / 2;
+        b = (b + 1) / 2;
     }
     t->nlevels = n;
-    t->lw = calloc((size_t)n, sizeof *t->lw);
-    t->lh = calloc((size_t)n, sizeof *t->lh);
-    t->avg = calloc((size_t)n, sizeof *t->avg);
-    t->mn = calloc((size_t)n, sizeof *t->mn);
-    t->mx = calloc((size_t)n, sizeof *t->mx);
-    t->lips = calloc((size_t)t->nch, sizeof *t->lips);
-    t->lipt = calloc((size_t)t->nch, sizeof *t->lipt);
-    if (!t->name || !t->lw || !t->lh || !t->avg || !t->mn || !t->mx || !t->lips || !t->lipt) {
-        if (t->avg)
-            t->avg[0] = px->data;
-        else
-            free(px->data);
-        px->data = NULL;
-        tex_free(t);
-        return NULL;
+    t->lw = xcalloc((size_t)n, sizeof *t->lw);
+    t->lh = xcalloc((size_t)n, sizeof *t->lh);
+    t->avg = xcalloc((size_t)n, sizeof *t->avg);
+    t->mn = xcalloc((size_t)n, sizeof *t->mn);
+    t->mx = xcalloc((size_t)n, sizeof *t->mx);
+    t->lips = xcalloc((size_t)nch, sizeof *t->lips);
+    t->lipt = xcalloc((size_t)nch, sizeof *t->lipt);
+    for (int k = 0; k < n; k++) {
+        t->lw[k] = k ? (t->lw[k - 1] + 1) / 2 : w;
+        t->lh[k] = k ? (t->lh[k - 1] + 1) / 2 : h;
     }
+    assert(t->lw[n - 1] == 1 && t->lh[n - 1] == 1);   /* the top level is one texel */
+    return t;
+}
+
+tex_texture *tex_build(tex_pixels *px, const char *name)
+{
+    tex_texture *t = tex_new_levels(name, px->type ? px->type : "float", px->w, px->h, px->nch);
+    int n = t->nlevels;
     int nch = t->nch;
     float *img = px->data;
     px->data = NULL;
@@ -94,23 +87,15 @@ tex_texture *tex_build(tex_pixels *px, const char *name)
     for (size_t k = 0; k < count; k++)
         if (!isfinite(img[k]))
             img[k] = 0.0f;
-    t->lw[0] = t->w;
-    t->lh[0] = t->h;
     t->avg[0] = t->mn[0] = t->mx[0] = img;
     t->bytes = count * sizeof(float);
     for (int k = 1; k < n; k++) {
         int pw = t->lw[k - 1], ph = t->lh[k - 1];
-        int w = (pw + 1) / 2, h = (ph + 1) / 2;
-        t->lw[k] = w;
-        t->lh[k] = h;
+        int w = t->lw[k], h = t->lh[k];
         size_t sz = (size_t)w * (size_t)h * (size_t)nch;
-        t->avg[k] = malloc(sz * sizeof(float));
-        t->mn[k] = malloc(sz * sizeof(float));
-        t->mx[k] = malloc(sz * sizeof(float));
-        if (!t->avg[k] || !t->mn[k] || !t->mx[k]) {
-            tex_free(t);
-            return NULL;
-        }
+        t->avg[k] = xmalloc(sz * sizeof(float));
+        t->mn[k] = xmalloc(sz * sizeof(float));
+        t->mx[k] = xmalloc(sz * sizeof(float));
         t->bytes += 3 * sz * sizeof(float);
         const float *pa = t->avg[k - 1], *pmn = t->mn[k - 1], *pmx = t->mx[k - 1];
         for (int j = 0; j < h; j++)
@@ -155,18 +140,17 @@ tex_texture *tex_from_pixels(const float *pixels, int w, int h, int nch, const c
         nch > TEX_MAX_CHANNELS)
         return NULL;
     size_t count = (size_t)w * (size_t)h * (size_t)nch;
-    tex_pixels px = { malloc(count * sizeof(float)), w, h, nch, "float" };
-    if (!px.data)
-        return NULL;
+    tex_pixels px = { xmalloc(count * sizeof(float)), w, h, nch, "float" };
     memcpy(px.data, pixels, count * sizeof(float));
     return tex_build(&px, name);
 }
 
-void tex_free(tex_texture *t)
+void tex_destroy(tex_texture **t_p)
 {
+    tex_texture *t = *t_p;
     if (!t)
         return;
-    tex_tiled_free(t->tiled);
+    tex_tiled_destroy(&t->tiled);
     for (int k = 0; k < t->nlevels && t->avg; k++) {
         free(t->avg[k]);
         if (k > 0 && t->mn)
@@ -183,6 +167,7 @@ void tex_free(tex_texture *t)
     free(t->lipt);
     free(t->name);
     free(t);
+    *t_p = NULL;
 }
 
 int tex_width(const tex_texture *t) { return t->w; }

@@ -6,6 +6,7 @@
  * do.
  */
 #include "tex/tex_internal.h"
+#include "util/err.h"
 
 #include <errno.h>
 #include <stdio.h>
@@ -22,7 +23,7 @@ tex_texture *tex_open_in(const char *path, tex_tiles *pool, char *err, size_t er
     unsigned char magic[8] = { 0 };
     FILE *f = fopen(path, "rb");
     if (!f) {
-        snprintf(err, errsz, "%s: cannot open the texture: %s", path, strerror(errno));
+        err_set(err, errsz, "%s: cannot open the texture: %s", path, strerror(errno));
         return NULL;
     }
     size_t n = fread(magic, 1, sizeof magic, f);
@@ -42,23 +43,19 @@ tex_texture *tex_open_in(const char *path, tex_tiles *pool, char *err, size_t er
                           memcmp(magic, "II+\0", 4) == 0 || memcmp(magic, "MM\0+", 4) == 0)) {
         ok = tex_read_tiff(path, &px, err, errsz);
     } else {
-        snprintf(err, errsz, "%s: not an OpenEXR, PNG or TIFF file (its first bytes say "
-                 "neither); textures must be one of those", path);
+        err_set(err, errsz, "%s: not an OpenEXR, PNG or TIFF file (its first bytes say "
+                "neither); textures must be one of those", path);
         return NULL;
     }
     if (!ok)
         return NULL;
     if (px.w < 1 || px.h < 1 || px.nch < 1 || px.w > TEX_MAX_SIDE || px.h > TEX_MAX_SIDE) {
-        snprintf(err, errsz, "%s: the image is %d x %d with %d channels; a texture needs at "
-                 "least 1 x 1 and one channel", path, px.w, px.h, px.nch);
+        err_set(err, errsz, "%s: the image is %d x %d with %d channels; a texture needs at "
+                "least 1 x 1 and one channel", path, px.w, px.h, px.nch);
         free(px.data);
         return NULL;
     }
-    tex_texture *t = tex_build(&px, path);
-    if (!t)
-        snprintf(err, errsz, "%s: out of memory building the texture's pyramids (%d x %d, "
-                 "%d channels)", path, px.w, px.h, px.nch);
-    return t;
+    return tex_build(&px, path);
 }
 
 int tex_wrap_find(const char *name)

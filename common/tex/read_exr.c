@@ -8,7 +8,10 @@
  * aafarm-maketx's "Y A" reads back in order); a single-channel file is
  * channel 0 whatever its name ("Y", "Z", "height").
  */
+#include "tex/codec_err.h"
 #include "tex/tex_internal.h"
+#include "util/err.h"
+#include "util/xalloc.h"
 
 #include <openexr.h>
 
@@ -16,20 +19,10 @@
 #include <stdlib.h>
 #include <string.h>
 
-static _Thread_local char exr_message[256];
-
-static void on_error(exr_const_context_t ctxt, exr_result_t code, const char *msg)
-{
-    (void)ctxt;
-    (void)code;
-    snprintf(exr_message, sizeof exr_message, "%s", msg ? msg : "");
-}
-
 static void fail(char *err, size_t errsz, const char *path, const char *what, exr_result_t rv)
 {
-    snprintf(err, errsz, "%s: %s: %s", path, what,
-             exr_message[0] ? exr_message : exr_get_default_error_message(rv));
-    exr_message[0] = '\0';
+    err_set(err, errsz, "%s: %s: %s", path, what, tex_exr_reason(rv));
+    tex_exr_clear();
 }
 
 /* The order rank of a channel name: R G B A first, then the rest. */
@@ -72,9 +65,9 @@ static exr_result_t decode(exr_context_t ctx, const exr_chunk_info_t *ci, float 
 bool tex_read_exr(const char *path, tex_pixels *out, char *err, size_t errsz)
 {
     exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
-    init.error_handler_fn = on_error;
+    init.error_handler_fn = tex_exr_on_error;
     exr_context_t ctx = NULL;
-    exr_message[0] = '\0';
+    tex_exr_clear();
     exr_result_t rv = exr_start_read(&ctx, path, &init);
     if (rv != EXR_ERR_SUCCESS) {
         fail(err, errsz, path, "cannot read the OpenEXR header", rv);
@@ -95,22 +88,22 @@ bool tex_read_exr(const char *path, tex_pixels *out, char *err, size_t errsz)
     }
     int w = box.max.x - box.min.x + 1, h = box.max.y - box.min.y + 1, nch = ch->num_channels;
     if (storage != EXR_STORAGE_SCANLINE && storage != EXR_STORAGE_TILED) {
-        snprintf(err, errsz, "%s: deep OpenEXR images are not textures; write a flat "
-                 "(scanline or tiled) image", path);
+        err_set(err, errsz, "%s: deep OpenEXR images are not textures; write a flat "
+                "(scanline or tiled) image", path);
         goto done;
     }
     if (w < 1 || h < 1 || w > TEX_MAX_SIDE || h > TEX_MAX_SIDE || nch < 1 ||
         nch > TEX_MAX_CHANNELS) {
-        snprintf(err, errsz, "%s: the image is %d x %d with %d channels (a texture has 1 to "
-                 "%d channels and sides of 1 to %d texels)", path, w, h, nch, TEX_MAX_CHANNELS,
-                 TEX_MAX_SIDE);
+        err_set(err, errsz, "%s: the image is %d x %d with %d channels (a texture has 1 to "
+                "%d channels and sides of 1 to %d texels)", path, w, h, nch, TEX_MAX_CHANNELS,
+                TEX_MAX_SIDE);
         goto done;
     }
     bool rgb = false;
     for (int c = 0; c < nch; c++) {
         if (ch->entries[c].x_sampling != 1 || ch->entries[c].y_sampling != 1) {
-            snprintf(err, errsz, "%s: channel '%s' is subsampled; textures need every channel "
-                     "at full resolution", path, ch->entries[c].name.str);
+            err_set(err, errsz, "%s: channel '%s' is subsampled; textures need every channel "
+                    "at full resolution", path, ch->entries[c].name.str);
             goto done;
         }
         rgb = rgb || rank_of(ch->entries[c].name.str) == 2;
@@ -125,9 +118,9 @@ bool tex_read_exr(const char *path, tex_pixels *out, char *err, size_t errsz)
             if (k == r)
                 slot[c] = n++;
         }
-    data = calloc((size_t)w * (size_t)h * (size_t)nch, sizeof *data);
+    data = try_calloc((size_t)w * (size_t)h * (size_t)nch, sizeof *data);
     if (!data) {
-        snprintf(err, errsz, "%s: out of memory for %d x %d x %d texels", path, w, h, nch);
+        err_set(err, errsz, "%s: out of memory for %d x %d x %d texels", path, w, h, nch);
         goto done;
     }
     exr_chunk_info_t ci;

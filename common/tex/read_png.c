@@ -4,7 +4,10 @@
  * expanded to 8 bits). Texels are the stored values over 2^bits - 1, with
  * no gamma decoding: a height map's 65535 is 1.0 exactly.
  */
+#include "tex/codec_err.h"
 #include "tex/tex_internal.h"
+#include "util/err.h"
+#include "util/xalloc.h"
 
 #include <png.h>
 
@@ -13,44 +16,27 @@
 #include <stdlib.h>
 #include <string.h>
 
-typedef struct png_job {
-    char message[200];
-} png_job;
-
-static void on_error(png_structp png, png_const_charp msg)
-{
-    png_job *job = png_get_error_ptr(png);
-    snprintf(job->message, sizeof job->message, "%s", msg);
-    png_longjmp(png, 1);
-}
-
-static void on_warning(png_structp png, png_const_charp msg)
-{
-    (void)png;
-    (void)msg;
-}
-
 bool tex_read_png(const char *path, tex_pixels *out, char *err, size_t errsz)
 {
     FILE *f = fopen(path, "rb");
     if (!f) {
-        snprintf(err, errsz, "%s: cannot open the texture", path);
-        return false;
+        return err_set(err, errsz, "%s: cannot open the texture", path);
     }
-    png_job job = { "" };
-    png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, &job, on_error, on_warning);
+    tex_png_error job = { "" };
+    png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, &job, tex_png_on_error,
+                                             tex_png_on_warning);
     png_infop info = png ? png_create_info_struct(png) : NULL;
     float *volatile data = NULL;
     png_bytep volatile row = NULL;
     png_bytep *volatile rows = NULL;
     if (!png || !info) {
-        snprintf(err, errsz, "%s: out of memory reading PNG", path);
+        err_set(err, errsz, "%s: out of memory reading PNG", path);
         png_destroy_read_struct(&png, &info, NULL);
         fclose(f);
         return false;
     }
     if (setjmp(png_jmpbuf(png))) {
-        snprintf(err, errsz, "%s: not a readable PNG image: %s", path, job.message);
+        err_set(err, errsz, "%s: not a readable PNG image: %s", path, job.message);
         free(data);
         free(row);
         free(rows);
@@ -68,11 +54,11 @@ bool tex_read_png(const char *path, tex_pixels *out, char *err, size_t errsz)
     int nch = png_get_channels(png, info), bits = png_get_bit_depth(png, info);
     int passes = png_set_interlace_handling(png);
     size_t rowbytes = png_get_rowbytes(png, info);
-    data = calloc((size_t)w * (size_t)h * (size_t)nch, sizeof(float));
-    row = malloc(rowbytes * (size_t)h);
+    data = try_calloc((size_t)w * (size_t)h * (size_t)nch, sizeof(float));
+    row = try_malloc(rowbytes * (size_t)h);
     if (!data || !row)
         png_error(png, "out of memory for the pixels");
-    rows = malloc((size_t)h * sizeof *rows);
+    rows = try_malloc((size_t)h * sizeof *rows);
     if (!rows)
         png_error(png, "out of memory for the pixels");
     for (int y = 0; y < h; y++)

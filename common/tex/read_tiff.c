@@ -6,6 +6,8 @@
  * libtiff's warnings are silenced and its errors become the message.
  */
 #include "tex/tex_internal.h"
+#include "util/err.h"
+#include "util/xalloc.h"
 
 #include <tiffio.h>
 
@@ -55,8 +57,7 @@ bool tex_read_tiff(const char *path, tex_pixels *out, char *err, size_t errsz)
     tiff_message[0] = '\0';
     TIFF *tif = TIFFOpen(path, "r");
     if (!tif) {
-        snprintf(err, errsz, "%s: not a readable TIFF image: %s", path, tiff_message);
-        return false;
+        return err_set(err, errsz, "%s: not a readable TIFF image: %s", path, tiff_message);
     }
     uint32_t w = 0, h = 0;
     uint16_t spp = 1, bits = 8, format = SAMPLEFORMAT_UINT, planar = PLANARCONFIG_CONTIG;
@@ -72,21 +73,21 @@ bool tex_read_tiff(const char *path, tex_pixels *out, char *err, size_t errsz)
     bool supported = (format == SAMPLEFORMAT_UINT && (bits == 8 || bits == 16 || bits == 32)) ||
                      (format == SAMPLEFORMAT_IEEEFP && bits == 32);
     if (!supported) {
-        snprintf(err, errsz, "%s: TIFF samples of %u bits, format %u are not supported; "
-                 "textures take 8, 16 or 32 bit unsigned integers or 32 bit floats", path,
-                 bits, format);
+        err_set(err, errsz, "%s: TIFF samples of %u bits, format %u are not supported; "
+                "textures take 8, 16 or 32 bit unsigned integers or 32 bit floats", path,
+                bits, format);
         goto done;
     }
     if (w < 1 || h < 1 || w > TEX_MAX_SIDE || h > TEX_MAX_SIDE || spp < 1 ||
         spp > TEX_MAX_CHANNELS) {
-        snprintf(err, errsz, "%s: the image is %u x %u with %u samples per pixel", path, w, h,
-                 spp);
+        err_set(err, errsz, "%s: the image is %u x %u with %u samples per pixel", path, w, h,
+                spp);
         goto done;
     }
     int nch = spp, bps = bits / 8;
-    data = calloc((size_t)w * h * (size_t)nch, sizeof *data);
+    data = try_calloc((size_t)w * h * (size_t)nch, sizeof *data);
     if (!data) {
-        snprintf(err, errsz, "%s: out of memory for %u x %u x %d texels", path, w, h, nch);
+        err_set(err, errsz, "%s: out of memory for %u x %u x %d texels", path, w, h, nch);
         goto done;
     }
     int planes = planar == PLANARCONFIG_SEPARATE ? nch : 1;
@@ -95,17 +96,17 @@ bool tex_read_tiff(const char *path, tex_pixels *out, char *err, size_t errsz)
         uint32_t tw = 0, th = 0;
         TIFFGetField(tif, TIFFTAG_TILEWIDTH, &tw);
         TIFFGetField(tif, TIFFTAG_TILELENGTH, &th);
-        buf = malloc((size_t)TIFFTileSize(tif));
+        buf = try_malloc((size_t)TIFFTileSize(tif));
         if (!buf || tw == 0 || th == 0) {
-            snprintf(err, errsz, "%s: bad tile size %u x %u", path, tw, th);
+            err_set(err, errsz, "%s: bad tile size %u x %u", path, tw, th);
             goto done;
         }
         for (int p = 0; p < planes; p++)
             for (uint32_t y0 = 0; y0 < h; y0 += th)
                 for (uint32_t x0 = 0; x0 < w; x0 += tw) {
                     if (TIFFReadTile(tif, buf, x0, y0, 0, (uint16_t)p) < 0) {
-                        snprintf(err, errsz, "%s: cannot read the tile at (%u, %u): %s", path,
-                                 x0, y0, tiff_message);
+                        err_set(err, errsz, "%s: cannot read the tile at (%u, %u): %s", path,
+                                x0, y0, tiff_message);
                         goto done;
                     }
                     for (uint32_t y = y0; y < y0 + th && y < h; y++)
@@ -117,15 +118,15 @@ bool tex_read_tiff(const char *path, tex_pixels *out, char *err, size_t errsz)
                             }
                 }
     } else {
-        buf = malloc((size_t)TIFFScanlineSize(tif));
+        buf = try_malloc((size_t)TIFFScanlineSize(tif));
         if (!buf) {
-            snprintf(err, errsz, "%s: out of memory", path);
+            err_set(err, errsz, "%s: out of memory", path);
             goto done;
         }
         for (int p = 0; p < planes; p++)
             for (uint32_t y = 0; y < h; y++) {
                 if (TIFFReadScanline(tif, buf, y, (uint16_t)p) < 0) {
-                    snprintf(err, errsz, "%s: cannot read row %u: %s", path, y, tiff_message);
+                    err_set(err, errsz, "%s: cannot read row %u: %s", path, y, tiff_message);
                     goto done;
                 }
                 for (uint32_t x = 0; x < w; x++)

@@ -12,30 +12,25 @@
  * image and builds the pyramids. A file that has it and is wrong in any
  * other way is refused with what is wrong and what to do (make it again).
  */
+#include "tex/codec_err.h"
 #include "tex/tex_internal.h"
+#include "util/err.h"
 #include "tex/tiles.h"
+#include "util/xalloc.h"
 
 #include <openexr.h>
 
+#include <assert.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-static _Thread_local char tiled_message[256];
-
-static void on_error(exr_const_context_t ctxt, exr_result_t code, const char *msg)
-{
-    (void)ctxt;
-    (void)code;
-    snprintf(tiled_message, sizeof tiled_message, "%s", msg ? msg : "");
-}
-
 static const char *const part_names[3] = { "mean", "min", "max" };
 
 /* Checks part p's layout against part 0's (w, h, tw, th, levels, nch). */
 static bool check_part(exr_context_t ctx, int p, int w, int h, uint32_t tw, uint32_t th,
-                       int nlevels, int nch, char *what, size_t wsz)
+                       int nlevels, int nch, char *err, size_t errsz)
 {
     const char *name = NULL;
     exr_storage_t storage;
@@ -47,26 +42,22 @@ static bool check_part(exr_context_t ctx, int p, int w, int h, uint32_t tw, uint
     const exr_attr_chlist_t *ch = NULL;
     if (exr_get_name(ctx, p, &name) != EXR_ERR_SUCCESS || !name ||
         strcmp(name, part_names[p]) != 0) {
-        snprintf(what, wsz, "part %d is not named \"%s\"", p, part_names[p]);
-        return false;
+        return err_set(err, errsz, "part %d is not named \"%s\"", p, part_names[p]);
     }
     if (exr_get_storage(ctx, p, &storage) != EXR_ERR_SUCCESS || storage != EXR_STORAGE_TILED ||
         exr_get_tile_descriptor(ctx, p, &x, &y, &mode, &round) != EXR_ERR_SUCCESS ||
         mode != EXR_TILE_MIPMAP_LEVELS || round != EXR_TILE_ROUND_UP || x != tw || y != th ||
         exr_get_tile_levels(ctx, p, &lx, &ly) != EXR_ERR_SUCCESS || lx != nlevels) {
-        snprintf(what, wsz, "part \"%s\" is not tiled in %u x %u mip-map levels rounded up "
-                 "(%d levels)", name, tw, th, nlevels);
-        return false;
+        return err_set(err, errsz, "part \"%s\" is not tiled in %u x %u mip-map levels rounded up "
+                       "(%d levels)", name, tw, th, nlevels);
     }
     if (exr_get_data_window(ctx, p, &box) != EXR_ERR_SUCCESS || box.min.x != 0 ||
         box.min.y != 0 || box.max.x != w - 1 || box.max.y != h - 1) {
-        snprintf(what, wsz, "part \"%s\"'s data window is not [0, %d] x [0, %d]", name, w - 1,
-                 h - 1);
-        return false;
+        return err_set(err, errsz, "part \"%s\"'s data window is not [0, %d] x [0, %d]", name, w - 1,
+                       h - 1);
     }
     if (exr_get_channels(ctx, p, &ch) != EXR_ERR_SUCCESS || ch->num_channels != nch) {
-        snprintf(what, wsz, "part \"%s\" has not the %d channels of part \"mean\"", name, nch);
-        return false;
+        return err_set(err, errsz, "part \"%s\" has not the %d channels of part \"mean\"", name, nch);
     }
     for (int c = 0; c < nch; c++) {
         bool known = false;
@@ -77,10 +68,9 @@ static bool check_part(exr_context_t ctx, int p, int w, int h, uint32_t tw, uint
         }
         if (!known || ch->entries[c].pixel_type != EXR_PIXEL_FLOAT ||
             ch->entries[c].x_sampling != 1 || ch->entries[c].y_sampling != 1) {
-            snprintf(what, wsz, "part \"%s\"'s channel '%s' is not one aafarm-maketx writes "
-                     "(32-bit float, full resolution, named for %d channels)", name,
-                     ch->entries[c].name.str, nch);
-            return false;
+            return err_set(err, errsz, "part \"%s\"'s channel '%s' is not one aafarm-maketx writes "
+                           "(32-bit float, full resolution, named for %d channels)", name,
+                           ch->entries[c].name.str, nch);
         }
     }
     return true;
@@ -91,9 +81,7 @@ static float *read_level(const tex_tiled *tl, const tex_texture *t, int p, int k
 {
     int w = t->lw[k], h = t->lh[k];
     size_t count = (size_t)w * (size_t)h * (size_t)t->nch;
-    float *v = malloc(count * sizeof *v);
-    if (!v)
-        return NULL;
+    float *v = xmalloc(count * sizeof *v);
     for (int ty = 0; ty * tl->th < h; ty++)
         for (int tx = 0; tx * tl->tw < w; tx++) {
             float *dst = v + ((size_t)ty * tl->th * (size_t)w + (size_t)tx * tl->tw) * t->nch;
@@ -112,10 +100,10 @@ static float *read_level(const tex_tiled *tl, const tex_texture *t, int p, int k
 
 static bool refuse(char *err, size_t errsz, const char *path, const char *what)
 {
-    snprintf(err, errsz, "%s: an aafarm-maketx texture (version %d) whose %s%s%s; make it "
-             "again with aafarm-maketx", path, TEX_FILE_VERSION, what,
-             tiled_message[0] ? ": " : "", tiled_message);
-    tiled_message[0] = '\0';
+    err_set(err, errsz, "%s: an aafarm-maketx texture (version %d) whose %s%s%s; make it "
+            "again with aafarm-maketx", path, TEX_FILE_VERSION, what,
+            tex_exr_message()[0] ? ": " : "", tex_exr_message());
+    tex_exr_clear();
     return false;
 }
 
@@ -124,21 +112,21 @@ bool tex_open_tiled(const char *path, tex_tiles *pool, tex_texture **out, char *
 {
     *out = NULL;
     exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
-    init.error_handler_fn = on_error;
+    init.error_handler_fn = tex_exr_on_error;
     exr_context_t ctx = NULL;
-    tiled_message[0] = '\0';
+    tex_exr_clear();
     int32_t version = 0;
     if (exr_start_read(&ctx, path, &init) != EXR_ERR_SUCCESS ||
         exr_attr_get_int(ctx, 0, TEX_ATTR_VERSION, &version) != EXR_ERR_SUCCESS) {
         exr_finish(&ctx);            /* not ours: read as an image (read.c) */
-        tiled_message[0] = '\0';
+        tex_exr_clear();
         return true;
     }
-    char what[512];
+    char what[ERR_LEN];
     if (version != TEX_FILE_VERSION) {
-        snprintf(err, errsz, "%s: made by an aafarm-maketx of texture layout version %d; this "
-                 "aafarm reads version %d: make it again with this aafarm-maketx", path,
-                 (int)version, TEX_FILE_VERSION);
+        err_set(err, errsz, "%s: made by an aafarm-maketx of texture layout version %d; this "
+                "aafarm reads version %d: make it again with this aafarm-maketx", path,
+                (int)version, TEX_FILE_VERSION);
         exr_finish(&ctx);
         return false;
     }
@@ -185,10 +173,8 @@ bool tex_open_tiled(const char *path, tex_tiles *pool, tex_texture **out, char *
     double lips[TEX_MAX_CHANNELS], lipt[TEX_MAX_CHANNELS];
     bool lip_ok = exr_attr_get_string(ctx, 0, TEX_ATTR_LIPSCHITZ, &liplen, &lip) ==
                   EXR_ERR_SUCCESS && lip;
-    char *buf = lip_ok ? malloc((size_t)liplen + 1) : NULL;
+    char *buf = lip_ok ? xstrndup(lip, (size_t)liplen) : NULL;
     if (buf) {
-        memcpy(buf, lip, (size_t)liplen);
-        buf[liplen] = '\0';
         char *s = buf, *end;
         for (int c = 0; lip_ok && c < 2 * nch; c++) {
             double v = strtod(s, &end);
@@ -218,49 +204,16 @@ bool tex_open_tiled(const char *path, tex_tiles *pool, tex_texture **out, char *
                       "of float, uint8, uint16, uint32");
     }
 
-    tex_texture *t = calloc(1, sizeof *t);
-    size_t namelen = strlen(path) + 1;
-    if (!t || !(t->name = malloc(namelen))) {
-        free(t);
-        exr_finish(&ctx);
-        snprintf(err, errsz, "%s: out of memory", path);
-        return false;
-    }
-    memcpy(t->name, path, namelen);
-    t->type = ttype;
-    t->w = (int)w;
-    t->h = (int)h;
-    t->nch = nch;
-    t->nlevels = nlevels;
-    t->lw = calloc((size_t)nlevels, sizeof *t->lw);
-    t->lh = calloc((size_t)nlevels, sizeof *t->lh);
-    t->avg = calloc((size_t)nlevels, sizeof *t->avg);
-    t->mn = calloc((size_t)nlevels, sizeof *t->mn);
-    t->mx = calloc((size_t)nlevels, sizeof *t->mx);
-    t->lips = calloc((size_t)nch, sizeof *t->lips);
-    t->lipt = calloc((size_t)nch, sizeof *t->lipt);
-    if (!t->lw || !t->lh || !t->avg || !t->mn || !t->mx || !t->lips || !t->lipt) {
-        tex_free(t);
-        exr_finish(&ctx);
-        snprintf(err, errsz, "%s: out of memory", path);
-        return false;
-    }
+    tex_texture *t = tex_new_levels(path, ttype, (int)w, (int)h, nch);
+    assert(t->nlevels == nlevels);
     memcpy(t->lips, lips, (size_t)nch * sizeof *lips);
     memcpy(t->lipt, lipt, (size_t)nch * sizeof *lipt);
     int resident = nlevels;
     for (int k = 0; k < nlevels; k++) {
-        t->lw[k] = k ? (t->lw[k - 1] + 1) / 2 : t->w;
-        t->lh[k] = k ? (t->lh[k - 1] + 1) / 2 : t->h;
         if (resident == nlevels && (size_t)t->lw[k] * (size_t)t->lh[k] <= TEX_RESIDENT_TEXELS)
             resident = k;
     }
     tex_tiled *tl = tex_tiled_new(ctx, pool, t, (int)tw, (int)th, resident);
-    if (!tl) {
-        tex_free(t);
-        exr_finish(&ctx);
-        snprintf(err, errsz, "%s: out of memory", path);
-        return false;
-    }
     t->tiled = tl;
     for (int c = 0; c < nch; c++)
         for (int q = 0; q < nch; q++) {
@@ -275,7 +228,7 @@ bool tex_open_tiled(const char *path, tex_tiles *pool, tex_texture **out, char *
             if (!v) {
                 snprintf(what, sizeof what, "level %d of part \"%s\" cannot be read (damaged "
                          "or truncated file, or non-finite texels)", k, part_names[p]);
-                tex_free(t);
+                tex_destroy(&t);
                 return refuse(err, errsz, path, what);
             }
             (p == 0 ? t->avg : p == 1 ? t->mn : t->mx)[k] = v;
@@ -283,8 +236,7 @@ bool tex_open_tiled(const char *path, tex_tiles *pool, tex_texture **out, char *
                 t->bytes += (size_t)t->lw[k] * (size_t)t->lh[k] * (size_t)nch * sizeof(float);
         }
     if (resident == 0) {             /* all of it in memory: the file is done with */
-        tex_tiled_free(tl);
-        t->tiled = NULL;
+        tex_tiled_destroy(&t->tiled);
     }
     *out = t;
     return true;

@@ -27,6 +27,13 @@
  * other edge for periodic, 0 for black), so the min and max of those
  * texels bound it; the min-max pyramid answers that at the level where
  * the rectangle spans a few texels.
+ *
+ * Memory (util/xalloc.h): the image readers (read_exr.c, read_png.c,
+ * read_tiff.c) survive out of memory: the texel buffer of the size a file
+ * states is a try_* allocation, and when it fails tex_open returns NULL
+ * with "path: out of memory ..." (tests/tex/test_tex_read.c drives it with
+ * a PNG that claims 2^20 x 2^20 texels). Everything else (the pyramids, the
+ * tiles, the cache) aborts naming the size.
  */
 #ifndef TEX_TEX_H
 #define TEX_TEX_H
@@ -62,7 +69,7 @@ typedef struct tex_tiles tex_tiles;
  * being read at once (a few per thread). */
 tex_tiles *tex_tiles_new(size_t budget);
 /* Only after every texture opened with it is freed. */
-void tex_tiles_free(tex_tiles *pool);
+void tex_tiles_destroy(tex_tiles **pool_p);
 /* The pool a process's caches use unless told otherwise (budget
  * TEX_DEFAULT_TILE_BYTES until set; aafarm-worker --texture-bytes). */
 #define TEX_DEFAULT_TILE_BYTES ((size_t)512 << 20)
@@ -73,6 +80,14 @@ typedef struct tex_tile_stats {
     unsigned long long loads, evictions, failures;  /* failures: tiles that could not be read */
 } tex_tile_stats;
 void tex_tiles_stats(tex_tiles *pool, tex_tile_stats *out);
+/* Where the pool reports a tile that cannot be read (a damaged or
+ * truncated file after it was opened; its texels are then the map's mean
+ * and bounds), once per texture: one line without a newline. Called with
+ * the pool's lock held (it must not call into the pool). NULL (the
+ * default): only counted in tex_tile_stats.failures; the worker prints
+ * them on stderr. */
+typedef void (*tex_warn_fn)(void *ctx, const char *message);
+void tex_tiles_set_warn(tex_tiles *pool, tex_warn_fn fn, void *ctx);
 /* tex_open with the tiles of an aafarm-maketx file in pool (NULL: a pool
  * of its own without a budget). */
 tex_texture *tex_open_in(const char *path, tex_tiles *pool, char *err, size_t errsz);
@@ -81,7 +96,7 @@ int tex_tiled_levels(const tex_texture *t);
 /* A texture from memory: w x h texels of nch channels, interleaved (for
  * tests and tools). */
 tex_texture *tex_from_pixels(const float *pixels, int w, int h, int nch, const char *name);
-void tex_free(tex_texture *t);
+void tex_destroy(tex_texture **t_p);
 
 int tex_width(const tex_texture *t);
 int tex_height(const tex_texture *t);
@@ -145,9 +160,9 @@ bool tex_write_exr(const char *path, const tex_texture *t, bool minmax, char *er
 /* ---- the per-process cache ---- */
 
 /* Finds the file of texture `name`: true with its path, or false with a
- * reason in why ("not found on the texture search path a:b"). */
+ * reason in err ("not found on the texture search path a:b"). */
 typedef bool (*tex_resolve_fn)(void *ctx, const char *name, char *path, size_t path_size,
-                               char *why, int why_size);
+                               char *err, size_t errsz);
 
 typedef struct tex_cache tex_cache;
 
@@ -157,7 +172,7 @@ typedef struct tex_cache tex_cache;
  * texture fails (0: no limit); tiles loaded on demand count against their
  * pool's budget instead (tex_cache_set_tiles). */
 tex_cache *tex_cache_new(size_t budget);
-void tex_cache_free(tex_cache *self);
+void tex_cache_destroy(tex_cache **self_p);
 /* The tile pool of the textures it opens from now on (default: the
  * process's, tex_tiles_process). */
 void tex_cache_set_tiles(tex_cache *self, tex_tiles *pool);
@@ -177,6 +192,6 @@ typedef struct tex_searchpath {
     char base[4096];
 } tex_searchpath;
 bool tex_searchpath_resolve(void *ctx, const char *name, char *path, size_t path_size,
-                            char *why, int why_size);
+                            char *err, size_t errsz);
 
 #endif

@@ -68,15 +68,20 @@ bool tex_open_tiled(const char *path, struct tex_tiles *pool, tex_texture **out,
 /* The name aafarm-maketx gives channel c of nch (write_exr.c): Y; Y A;
  * R G B (A); c00 c01 ... */
 void tex_channel_name(int nch, int c, char *out, size_t size);
-/* Frees what tex_open_tiled added to a texture (tiles.c). */
-void tex_tiled_free(struct tex_tiled *tiled);
+/* Frees what tex_open_tiled added to a texture (tiles.c) and sets
+ * *tiled_p to NULL. */
+void tex_tiled_destroy(struct tex_tiled **tiled_p);
 
 bool tex_read_exr(const char *path, tex_pixels *out, char *err, size_t errsz);
 bool tex_read_png(const char *path, tex_pixels *out, char *err, size_t errsz);
 bool tex_read_tiff(const char *path, tex_pixels *out, char *err, size_t errsz);
 
-/* Builds the pyramids of an image (taking its pixels). NULL when out of
- * memory. */
+/* A texture of w x h texels of nch channels with its levels' sizes
+ * (ceil(w / 2^k) x ceil(h / 2^k), down to 1 x 1) and empty level tables
+ * (pyramid.c; tex_build and read_tiled.c fill them). */
+tex_texture *tex_new_levels(const char *name, const char *type, int w, int h, int nch);
+
+/* Builds the pyramids of an image (taking its pixels). */
 tex_texture *tex_build(tex_pixels *px, const char *name);
 
 #endif

@@ -25,15 +25,19 @@
  * A tile that cannot be read (a disk error after the file was opened and
  * its hash checked) holds the top level's texels (the map's mean, min and
  * max: its bound stays true); the pool counts it, and the first one of a
- * texture is reported on stderr.
+ * texture is handed to the pool's warning callback (tex_tiles_set_warn:
+ * the program decides where it goes; this library prints nothing).
  */
 #include "tex/tex_internal.h"
 #include "tex/tiles.h"
 
 #include <openexr.h>
 
+#include "util/err.h"
+#include "util/xalloc.h"
+
+#include <assert.h>
 #include <pthread.h>
-#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -43,25 +47,29 @@ struct tex_tiles {
     unsigned long long loads, evictions, failures;
     tex_tile **loaded;       /* the tiles with data, in no order; the clock's ring */
     int n, cap, hand;
+    tex_warn_fn warn;        /* a tile that cannot be read; NULL: counted only */
+    void *warn_ctx;
 };
 
 tex_tiles *tex_tiles_new(size_t budget)
 {
-    tex_tiles *pool = calloc(1, sizeof *pool);
-    if (!pool)
-        return NULL;
+    tex_tiles *pool = xcalloc(1, sizeof *pool);
     pthread_mutex_init(&pool->lock, NULL);
     pool->budget = budget;
     return pool;
 }
 
-void tex_tiles_free(tex_tiles *pool)
+void tex_tiles_destroy(tex_tiles **pool_p)
 {
+    tex_tiles *pool = *pool_p;
     if (!pool)
         return;
+    /* every texture opened with it is gone, and with it its tiles */
+    assert(pool->n == 0 && pool->bytes == 0);
     free(pool->loaded);
     pthread_mutex_destroy(&pool->lock);
     free(pool);
+    *pool_p = NULL;
 }
 
 static tex_tiles *process_pool;
@@ -70,8 +78,6 @@ static pthread_once_t process_once = PTHREAD_ONCE_INIT;
 static void make_process_pool(void)
 {
     process_pool = tex_tiles_new(TEX_DEFAULT_TILE_BYTES);
-    if (!process_pool)
-        abort();
 }
 
 tex_tiles *tex_tiles_process(void)
@@ -87,6 +93,14 @@ void tex_tiles_set_budget(tex_tiles *pool, size_t budget)
     pthread_mutex_lock(&pool->lock);
     pool->budget = budget;
     evict_to_budget(pool, NULL);
+    pthread_mutex_unlock(&pool->lock);
+}
+
+void tex_tiles_set_warn(tex_tiles *pool, tex_warn_fn fn, void *ctx)
+{
+    pthread_mutex_lock(&pool->lock);
+    pool->warn = fn;
+    pool->warn_ctx = ctx;
     pthread_mutex_unlock(&pool->lock);
 }
 
@@ -107,9 +121,7 @@ void tex_tiles_stats(tex_tiles *pool, tex_tile_stats *out)
 tex_tiled *tex_tiled_new(void *exr, tex_tiles *pool, const tex_texture *t, int tw, int th,
                          int resident)
 {
-    tex_tiled *tl = calloc(1, sizeof *tl);
-    if (!tl)
-        return NULL;
+    tex_tiled *tl = xcalloc(1, sizeof *tl);
     tl->exr = exr;
     tl->own_pool = pool == NULL;
     tl->pool = pool ? pool : tex_tiles_new(0);
@@ -117,23 +129,15 @@ tex_tiled *tex_tiled_new(void *exr, tex_tiles *pool, const tex_texture *t, int t
     tl->tw = tw;
     tl->th = th;
     tl->resident = resident;
-    tl->ntx = calloc((size_t)resident + 1, sizeof *tl->ntx);
-    tl->tiles = calloc(3 * ((size_t)resident + 1), sizeof *tl->tiles);
-    if (!tl->pool || !tl->ntx || !tl->tiles) {
-        tex_tiled_free(tl);
-        return NULL;
-    }
+    tl->ntx = xcalloc((size_t)resident + 1, sizeof *tl->ntx);
+    tl->tiles = xcalloc(3 * ((size_t)resident + 1), sizeof *tl->tiles);
     for (int k = 0; k < resident; k++) {
         int nx = (t->lw[k] + tw - 1) / tw, ny = (t->lh[k] + th - 1) / th;
         tl->ntx[k] = nx;
         for (int p = 0; p < 3; p++) {
             if (k == 0 && p > 0)
                 continue;              /* level 0's min and max are the image */
-            tex_tile *v = calloc((size_t)nx * (size_t)ny, sizeof *v);
-            if (!v) {
-                tex_tiled_free(tl);
-                return NULL;
-            }
+            tex_tile *v = xcalloc((size_t)nx * (size_t)ny, sizeof *v);
             tl->tiles[p * resident + k] = v;
             for (int y = 0; y < ny; y++)
                 for (int x = 0; x < nx; x++) {
@@ -161,6 +165,8 @@ static size_t tile_bytes(const tex_tiled *tl)
 
 static void drop(tex_tiles *pool, tex_tile *tile)
 {
+    assert(tile->at >= 0 && tile->at < pool->n && pool->loaded[tile->at] == tile);
+    assert(pool->bytes >= tile_bytes(tile->owner));
     pool->loaded[tile->at] = pool->loaded[pool->n - 1];
     pool->loaded[tile->at]->at = tile->at;
     pool->n--;
@@ -170,8 +176,9 @@ static void drop(tex_tiles *pool, tex_tile *tile)
     pool->bytes -= tile_bytes(tile->owner);
 }
 
-void tex_tiled_free(tex_tiled *tl)
+void tex_tiled_destroy(tex_tiled **tl_p)
 {
+    tex_tiled *tl = *tl_p;
     if (!tl)
         return;
     if (tl->pool && tl->tiles) {
@@ -190,7 +197,7 @@ void tex_tiled_free(tex_tiled *tl)
         pthread_mutex_unlock(&tl->pool->lock);
     }
     if (tl->own_pool)
-        tex_tiles_free(tl->pool);
+        tex_tiles_destroy(&tl->pool);
     if (tl->exr) {
         exr_context_t ctx = tl->exr;
         exr_finish(&ctx);
@@ -198,6 +205,7 @@ void tex_tiled_free(tex_tiled *tl)
     free(tl->tiles);
     free(tl->ntx);
     free(tl);
+    *tl_p = NULL;
 }
 
 int tex_tiled_levels(const tex_texture *t)
@@ -238,26 +246,27 @@ bool tex_tiled_decode(const tex_tiled *tl, int p, int k, int tx, int ty, float *
 }
 
 /* The tile's texels, read from the file (or the top level's where that
- * fails). NULL when out of memory. */
+ * fails). */
 static float *read_tile(tex_tiles *pool, tex_tile *tile)
 {
     tex_tiled *tl = tile->owner;
     const tex_texture *t = tl->tex;
     size_t count = (size_t)tl->tw * (size_t)tl->th * (size_t)t->nch;
-    float *d = malloc(count * sizeof *d);
-    if (!d)
-        return NULL;
+    float *d = xmalloc(count * sizeof *d);
     if (!tex_tiled_decode(tl, tile->part, tile->level, tile->tx, tile->ty, d, (size_t)tl->tw)) {
         const float *top = tile->part == 0 ? t->avg[t->nlevels - 1]
                          : tile->part == 1 ? t->mn[t->nlevels - 1] : t->mx[t->nlevels - 1];
         for (size_t e = 0; e < count; e++)
             d[e] = top[e % (size_t)t->nch];
         pool->failures++;
-        if (!atomic_exchange(&tl->warned, true))
-            fprintf(stderr, "aafarm: texture %s: tile %d,%d of level %d (part %d) cannot be "
+        if (pool->warn && !atomic_exchange(&tl->warned, true)) {
+            char msg[ERR_LEN];
+            err_set(msg, sizeof msg, "texture %s: tile %d,%d of level %d (part %d) cannot be "
                     "read (damaged or truncated file?); its texels are the map's mean and "
-                    "bounds; check the disk and make the file again with aafarm-maketx\n",
+                    "bounds; check the disk and make the file again with aafarm-maketx",
                     t->name, tile->tx, tile->ty, tile->level, tile->part);
+            pool->warn(pool->warn_ctx, msg);
+        }
     }
     return d;
 }
@@ -283,6 +292,7 @@ static void evict_to_budget(tex_tiles *pool, const tex_tile *keep)
             pool->hand++;
             continue;
         }
+        assert(d != NULL);                       /* a loaded tile has its texels */
         free(d);
         drop(pool, tile);
         pool->evictions++;
@@ -299,15 +309,11 @@ static const float *load(tex_tile *tile)
     if (!d) {
         if (pool->n == pool->cap) {
             int cap = pool->cap ? 2 * pool->cap : 256;
-            tex_tile **v = realloc(pool->loaded, (size_t)cap * sizeof *v);
-            if (!v)
-                abort();
-            pool->loaded = v;
+            pool->loaded = xreallocarray(pool->loaded, (size_t)cap, sizeof *pool->loaded);
             pool->cap = cap;
         }
         d = read_tile(pool, tile);
-        if (!d)
-            abort();             /* out of memory for one tile: as malloc elsewhere */
+        assert(tile->at == -1 && pool->n < pool->cap);
         tile->at = pool->n;
         pool->loaded[pool->n++] = tile;
         pool->bytes += tile_bytes(tile->owner);
@@ -333,8 +339,11 @@ static _Thread_local struct {
 
 void tex_tiles_unpin(void)
 {
-    for (int q = 0; q < pinned.n; q++)
-        atomic_fetch_sub(&pinned.tile[q]->pins, 1);
+    for (int q = 0; q < pinned.n; q++) {
+        unsigned before = atomic_fetch_sub(&pinned.tile[q]->pins, 1);
+        assert(before > 0);                      /* each pin taken once, let go once */
+        (void)before;
+    }
     pinned.n = 0;
 }
 

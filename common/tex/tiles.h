@@ -38,8 +38,8 @@ struct tex_tiled {
 };
 
 /* A texture's tiled levels 0 .. resident - 1 over the open file exr (taken:
- * closed by tex_tiled_free); pool NULL: a pool of its own without budget.
- * Fill slot[] before the first read. NULL when out of memory. */
+ * closed by tex_tiled_destroy); pool NULL: a pool of its own without budget.
+ * Fill slot[] before the first read. */
 tex_tiled *tex_tiled_new(void *exr, struct tex_tiles *pool, const tex_texture *t, int tw,
                          int th, int resident);
 /* Decodes tile (tx, ty) of level k of part p into dst (its first texel;

@@ -12,7 +12,10 @@
  * is written under a temporary name and renamed into place, so a failure
  * never leaves a half-written texture.
  */
+#include "tex/codec_err.h"
 #include "tex/tex_internal.h"
+#include "util/err.h"
+#include "util/xalloc.h"
 
 #include <openexr.h>
 
@@ -23,15 +26,6 @@
 #include <unistd.h>
 
 enum { TILE = 64 };
-
-static _Thread_local char write_message[256];
-
-static void on_error(exr_const_context_t ctxt, exr_result_t code, const char *msg)
-{
-    (void)ctxt;
-    (void)code;
-    snprintf(write_message, sizeof write_message, "%s", msg ? msg : "");
-}
 
 void tex_channel_name(int nch, int c, char *out, size_t size)
 {
@@ -145,9 +139,7 @@ static exr_result_t write_level(exr_context_t ctx, int p, const tex_texture *t, 
 static exr_result_t mark_texture(exr_context_t ctx, const tex_texture *t)
 {
     size_t size = (size_t)t->nch * 2 * 32 + 1;
-    char *lip = malloc(size), *s = lip;
-    if (!lip)
-        return EXR_ERR_OUT_OF_MEMORY;
+    char *lip = xmalloc(size), *s = lip;
     lip[0] = '\0';
     for (int c = 0; c < t->nch; c++)
         s += snprintf(s, size - (size_t)(s - lip), "%s%a %a", c ? " " : "", t->lips[c],
@@ -166,9 +158,9 @@ bool tex_write_exr(const char *path, const tex_texture *t, bool minmax, char *er
     char tmp[4200];
     snprintf(tmp, sizeof tmp, "%s.tmp%ld", path, (long)getpid());
     exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
-    init.error_handler_fn = on_error;
+    init.error_handler_fn = tex_exr_on_error;
     exr_context_t ctx = NULL;
-    write_message[0] = '\0';
+    tex_exr_clear();
     exr_result_t rv = exr_start_write(&ctx, tmp, EXR_WRITE_FILE_DIRECTLY, &init);
     if (rv == EXR_ERR_SUCCESS)
         rv = define_part(ctx, "mean", t);
@@ -184,13 +176,13 @@ bool tex_write_exr(const char *path, const tex_texture *t, bool minmax, char *er
     if (rv == EXR_ERR_SUCCESS)
         rv = exr_get_tile_levels(ctx, 0, &levels, NULL);
     if (rv == EXR_ERR_SUCCESS && levels != t->nlevels) {
-        snprintf(write_message, sizeof write_message, "OpenEXR counts %d mip-map levels, the "
-                 "texture %d", levels, t->nlevels);
+        char msg[96];
+        snprintf(msg, sizeof msg, "OpenEXR counts %d mip-map levels, the texture %d", levels,
+                 t->nlevels);
+        tex_exr_note(msg);
         rv = EXR_ERR_INVALID_ARGUMENT;
     }
-    float *buf = malloc((size_t)TILE * TILE * (size_t)t->nch * sizeof *buf);
-    if (!buf && rv == EXR_ERR_SUCCESS)
-        rv = EXR_ERR_OUT_OF_MEMORY;
+    float *buf = xmalloc((size_t)TILE * TILE * (size_t)t->nch * sizeof *buf);
     for (int part = 0; rv == EXR_ERR_SUCCESS && part < (minmax ? 3 : 1); part++)
         for (int k = 0; rv == EXR_ERR_SUCCESS && k < t->nlevels; k++)
             rv = write_level(ctx, part, t, k, buf);
@@ -199,13 +191,12 @@ bool tex_write_exr(const char *path, const tex_texture *t, bool minmax, char *er
     if (rv == EXR_ERR_SUCCESS)
         rv = fin;
     if (rv != EXR_ERR_SUCCESS) {
-        snprintf(err, errsz, "%s: cannot write the texture: %s", path,
-                 write_message[0] ? write_message : exr_get_default_error_message(rv));
+        err_set(err, errsz, "%s: cannot write the texture: %s", path, tex_exr_reason(rv));
         unlink(tmp);
         return false;
     }
     if (rename(tmp, path) != 0) {
-        snprintf(err, errsz, "%s: cannot put the texture in place: %s", path, strerror(errno));
+        err_set(err, errsz, "%s: cannot put the texture in place: %s", path, strerror(errno));
         unlink(tmp);
         return false;
     }

@@ -9,6 +9,7 @@
  * hash, not a fast table hash.
  */
 #include "util/hash.h"
+#include "util/xalloc.h"
 
 #include <errno.h>
 #include <stdlib.h>
@@ -219,12 +220,10 @@ static int by_option_key(const void *a, const void *b)
 }
 
 /* The shaders in name order as an array of pointers (free it), or NULL
- * when a field is missing, two names repeat or memory runs out. */
+ * when a field is missing or two names repeat. */
 static const hash_shader **sorted_shaders(const hash_job_input *job)
 {
-    const hash_shader **v = malloc((job->shader_count + 1) * sizeof *v);
-    if (!v)
-        return NULL;
+    const hash_shader **v = xmalloc((job->shader_count + 1) * sizeof *v);
     for (size_t i = 0; i < job->shader_count; i++) {
         v[i] = &job->shaders[i];
         if (!v[i]->name || (!v[i]->text && v[i]->len > 0)) {
@@ -244,9 +243,7 @@ static const hash_shader **sorted_shaders(const hash_job_input *job)
 
 static const hash_option **sorted_options(const hash_job_input *job)
 {
-    const hash_option **v = malloc((job->option_count + 1) * sizeof *v);
-    if (!v)
-        return NULL;
+    const hash_option **v = xmalloc((job->option_count + 1) * sizeof *v);
     for (size_t i = 0; i < job->option_count; i++) {
         v[i] = &job->options[i];
         if (!v[i]->key || !v[i]->value) {
@@ -302,8 +299,7 @@ int hash_job(const hash_job_input *job, char hex[HASH_HEX_SIZE])
 bool hash_fd(int fd, char hex[HASH_HEX_SIZE], uint64_t *len)
 {
     enum { CHUNK = 1 << 20 };
-    unsigned char *buf = malloc(CHUNK);
-    if (!buf) abort();
+    unsigned char *buf = xmalloc(CHUNK);
     sha256 h;
     sha256_init(&h);
     uint64_t off = 0;

@@ -119,7 +119,7 @@ static bool write_textures(corpus *c)
         snprintf(path, sizeof path, "%s/%s", c->texdir, maps[m].name);
         tex_texture *t = tex_from_pixels(maps[m].px, maps[m].w, maps[m].h, maps[m].nch, path);
         bool ok = t && tex_write_exr(path, t, true, err, sizeof err);
-        tex_free(t);
+        tex_destroy(&t);
         if (!ok) {
             fprintf(stderr, "corpus: %s\n", err);
             return false;

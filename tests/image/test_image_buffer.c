@@ -8,10 +8,14 @@
  *                   chunk) reads back to the values written
  *   read errors     missing file, not an EXR, every truncation of a real
  *                   output file: NULL with a message naming the file
+ *   out of memory   a file whose header asks for more memory than the
+ *                   process may have (a child under RLIMIT_AS) is refused
+ *                   with a message, not an abort (buffer.h "Memory")
  *   compare         equal images; one changed sample found with its
  *                   channel, pixel and size; NaN equals NaN, NaN vs number
  *                   is infinite; tolerance; layouts that differ refused
  */
+#define _GNU_SOURCE
 #include <stdarg.h>
 #include <stddef.h>
 #include <setjmp.h>
@@ -23,6 +27,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include "image/buffer.h"
 #include "image/writer.h"
@@ -173,6 +180,66 @@ static void test_read_errors(void **state)
     free(bytes);
 }
 
+/* Under AddressSanitizer an allocation that fails returns NULL as malloc
+ * does, instead of ending the process (the path tested below). */
+const char *__asan_default_options(void);
+const char *__asan_default_options(void)
+{
+    return "allocator_may_return_null=1";
+}
+
+/* The scanline file of test_scanline_file with its data window grown to
+ * w x h in the header (the pixels are never reached). */
+static void write_huge_header(const char *path, int w, int h)
+{
+    write_scanline_file(path);
+    size_t len;
+    uint8_t *bytes = tu_read_file(path, &len);
+    assert_non_null(bytes);
+    static const char key[] = "dataWindow\0box2i\0";
+    uint8_t *at = memmem(bytes, len, key, sizeof key - 1);
+    assert_non_null(at);
+    int32_t box[4] = {SX0, SY0, SX0 + w - 1, SY0 + h - 1};   /* little-endian host */
+    memcpy(at + sizeof key - 1 + 4, box, sizeof box);
+    assert_true(tu_write_file(path, bytes, len));
+    free(bytes);
+}
+
+/* In a child limited to 256 MiB more address space than it has: reading
+ * a 16384 x 16384 file of three channels (3 GiB of planes) fails its
+ * allocation, and the reader says so instead of aborting. */
+static void test_out_of_memory(void **state)
+{
+    const char *path = tu_path(*state, "huge.exr");
+    write_huge_header(path, 16384, 16384);
+    fflush(NULL);
+    pid_t pid = fork();
+    assert_true(pid >= 0);
+    if (pid == 0) {
+        long pages = 0;
+        FILE *f = fopen("/proc/self/statm", "r");
+        if (!f || fscanf(f, "%ld", &pages) != 1)
+            _exit(3);
+        fclose(f);
+        struct rlimit rl;
+        getrlimit(RLIMIT_AS, &rl);
+        rl.rlim_cur = (rlim_t) pages * (rlim_t) sysconf(_SC_PAGESIZE) + ((rlim_t) 256 << 20);
+        if (setrlimit(RLIMIT_AS, &rl) != 0)
+            _exit(3);
+        char msg[512] = "";
+        image_buffer *img = image_buffer_read_exr(path, msg, sizeof msg);
+        fprintf(stderr, "child: %s\n", img ? "read the image" : msg);
+        _exit(img ? 1 : strstr(msg, path) && strstr(msg, "image too large to read into "
+                                                     "memory") ? 0 : 2);
+    }
+    int status = 0;
+    assert_int_equal(waitpid(pid, &status, 0), pid);
+    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
+        fail_msg("the child %s %d (0: refused with the message)",
+                 WIFEXITED(status) ? "exited with" : "died of signal",
+                 WIFEXITED(status) ? WEXITSTATUS(status) : WTERMSIG(status));
+}
+
 static image_buffer *small_image(void)
 {
     const char *names[] = {"G", "R"};
@@ -249,6 +316,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         T(test_scanline_file),
         T(test_read_errors),
+        T(test_out_of_memory),
         T(test_compare),
     };
     return cmocka_run_group_tests_name("image_buffer", tests, NULL, NULL);

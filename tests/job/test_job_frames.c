@@ -41,14 +41,14 @@ static void test_spec_parse(void **state)
     assert_int_equal(s.count, 1);
     assert_int_equal(s.ranges[0][0], 3);
     assert_int_equal(s.ranges[0][1], 3);
-    frame_spec_free(&s);
+    frame_spec_clear(&s);
     assert_true(frame_spec_parse("1,3,5-7", &s, err, sizeof err));
     assert_int_equal(s.count, 3);
     assert_true(frame_spec_has(&s, 6));
     assert_true(frame_spec_has(&s, 3));
     assert_false(frame_spec_has(&s, 4));
     assert_false(frame_spec_has(&s, 8));
-    frame_spec_free(&s);
+    frame_spec_clear(&s);
 
     static const struct { const char *text, *message; } bad[] = {
         { "", "--frames wants frame numbers, e.g. 3, 1-10 or 1,3,5-7; got an empty list" },
@@ -91,22 +91,22 @@ static void test_choose(void **state)
     assert_int_equal(idx[1], 2);
     assert_int_equal(idx[2], 3);
     free(idx);
-    frame_spec_free(&s);
+    frame_spec_clear(&s);
     assert_true(frame_spec_parse("2,7", &s, err, sizeof err));
     assert_false(frame_choose(numbers, 4, &s, &idx, &n, err, sizeof err));
     assert_string_equal(err, "--frames: the scene has no frame 7 (its frames: 1-3, 10)");
-    frame_spec_free(&s);
+    frame_spec_clear(&s);
     assert_true(frame_spec_parse("4-9", &s, err, sizeof err));
     assert_false(frame_choose(numbers, 4, &s, &idx, &n, err, sizeof err));
     assert_string_equal(err, "--frames: the scene has no frame in 4-9 (its frames: 1-3, 10)");
-    frame_spec_free(&s);
+    frame_spec_clear(&s);
     /* no FrameBegin: one frame, number 1 */
     assert_true(frame_spec_parse("1", &s, err, sizeof err));
     assert_true(frame_choose(NULL, 0, &s, &idx, &n, err, sizeof err));
     assert_int_equal(n, 1);
     assert_int_equal(idx[0], 0);
     free(idx);
-    frame_spec_free(&s);
+    frame_spec_clear(&s);
 }
 
 static void expect_name(const char *name, int number, int nframes, bool display,

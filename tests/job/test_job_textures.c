@@ -86,7 +86,7 @@ static void test_opened_when_bound(void **state)
     char path[512], err[512];
     snprintf(path, sizeof path, "%s/maps/h.exr", dir);
     assert_true(tex_write_exr(path, t, true, err, sizeof err));
-    tex_free(t);
+    tex_destroy(&t);
     write_rib("h.exr");
     snprintf(path, sizeof path, "%s/main.rib", dir);
     sl_diag *d = sl_diag_new();
@@ -121,7 +121,7 @@ static void test_output_never_replaces_an_input(void **state)
     char map[512], rib[512], err[512];
     snprintf(map, sizeof map, "%s/maps/h.exr", dir);
     assert_true(tex_write_exr(map, t, true, err, sizeof err));
-    tex_free(t);
+    tex_destroy(&t);
     write_rib("h.exr");
     snprintf(rib, sizeof rib, "%s/main.rib", dir);
     struct stat before;

@@ -53,7 +53,7 @@ static int setup(void **state)
 static int teardown(void **state)
 {
     (void)state;
-    tex_cache_free(cache);
+    tex_cache_destroy(&cache);
     return 0;
 }
 

@@ -41,7 +41,7 @@ static void write_map(const char *rel, int w, int h)
     char path[400], err[512];
     snprintf(path, sizeof path, "%s/%s", dir, rel);
     assert_true(tex_write_exr(path, t, false, err, sizeof err));
-    tex_free(t);
+    tex_destroy(&t);
     free(px);
 }
 
@@ -125,7 +125,7 @@ static void test_one_copy_per_process(void **state)
     assert_int_equal(tex_width(jobs[0].got[1]), 17);
     assert_int_equal(tex_cache_bytes(cache),
                      tex_bytes(jobs[0].got[0]) + tex_bytes(jobs[0].got[1]));
-    tex_cache_free(cache);
+    tex_cache_destroy(&cache);
 }
 
 static void test_budget(void **state)
@@ -140,7 +140,7 @@ static void test_budget(void **state)
     tex_texture *one = tex_open(path, err, sizeof err);
     assert_non_null(one);
     tex_cache *cache = tex_cache_new(tex_bytes(one) + 100);    /* one.exr fits, not both */
-    tex_free(one);
+    tex_destroy(&one);
     tex_cache_set_resolver(cache, tex_searchpath_resolve, &sp);
     assert_non_null(tex_cache_get(cache, "one.exr", err, sizeof err));
     size_t before = tex_cache_bytes(cache);
@@ -148,7 +148,7 @@ static void test_budget(void **state)
     if (!strstr(err, "over the budget of"))
         fail_msg("message: %s", err);
     assert_int_equal(tex_cache_bytes(cache), before);
-    tex_cache_free(cache);
+    tex_cache_destroy(&cache);
 }
 
 static void test_resolver(void **state)

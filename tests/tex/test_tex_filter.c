@@ -111,7 +111,7 @@ static void test_level0_is_bilinear(void **state)
             tex_bound(t, 0, &r, (tex_wrap)k, (tex_wrap)k, 0, &lo, &hi);
             assert_true(lo <= 0 && hi >= 0);
         }
-        tex_free(t);
+        tex_destroy(&t);
         free(px);
     }
 }
@@ -175,7 +175,7 @@ static void test_bound_contains_filter(void **state)
             random_range(&r, w, h);
             check_range(t, k % 3, &r, (tex_wrap)(k % 3), (tex_wrap)((k / 3) % 3), &checked);
         }
-        tex_free(t);
+        tex_destroy(&t);
         free(px);
     }
     assert_true(checked > 500000);
@@ -219,7 +219,7 @@ static void test_bound_is_tight(void **state)
     tex_range any = { { 0, 1 }, { 0, 1 }, { 0, 10 }, { 0, 10 } };
     tex_bound(t, 0, &any, TEX_WRAP_PERIODIC, TEX_WRAP_PERIODIC, 0, &lo, &hi);
     assert_true(lo == mn && hi == mx);
-    tex_free(t);
+    tex_destroy(&t);
     free(px);
 }
 
@@ -259,7 +259,7 @@ static void test_cells_are_the_filter(void **state)
     tex_range vary = { { 0.5, 0.5 }, { 0.5, 0.5 }, { 0.1, 0.2 }, { 0.1, 0.2 } };
     tex_cell cells[2];
     assert_int_equal(tex_cells(t, 0, &vary, TEX_WRAP_CLAMP, TEX_WRAP_CLAMP, cells), 0);
-    tex_free(t);
+    tex_destroy(&t);
     free(px);
 }
 
@@ -284,7 +284,7 @@ static void test_bound_converges(void **state)
         if (h0 - l0 > 1e-6)
             assert_true((h1 - l1) * 100 <= h0 - l0);
     }
-    tex_free(t);
+    tex_destroy(&t);
     free(px);
 }
 
@@ -306,7 +306,7 @@ static void test_lipschitz(void **state)
         double v2 = tex_sample(t, 0, s + h, tt, w, w, sw, tw, 0, NULL, NULL);
         assert_true(fabs(v2 - v) <= ls * h * (1 + 1e-9) + 1e-12);
     }
-    tex_free(t);
+    tex_destroy(&t);
     free(px);
 }
 

@@ -161,8 +161,8 @@ static void test_png_and_fbm(void **state)
         for (int i = 0; i < 37; i++)
             for (int c = 0; c < 3; c++)
                 assert_true(tex_texel(a, 0, c, i, j) == tex_texel(b, 0, c, i, j));
-    tex_free(a);
-    tex_free(b);
+    tex_destroy(&a);
+    tex_destroy(&b);
 
     snprintf(dst, sizeof dst, "%s/fbm.exr", dir);
     assert_int_equal(run(out, sizeof out, "--fbm", "48", "20", "--octaves", "4", dst, NULL), 0);
@@ -185,7 +185,7 @@ static void test_png_and_fbm(void **state)
     assert_non_null(said);
     assert_int_equal(sscanf(said, "channel 0 in [%lf, %lf]", &plo, &phi), 2);
     assert_true(fabs(plo - lo) <= 1e-6 * (1 + fabs(lo)) && fabs(phi - hi) <= 1e-6 * (1 + fabs(hi)));
-    tex_free(f);
+    tex_destroy(&f);
 }
 
 int main(void)

@@ -7,7 +7,9 @@
  * OpenEXRCore here (scanline, half, channels B G R Z read as R G B Z)
  * read back exactly; then broken inputs: a
  * missing file, a file of another format, a truncated PNG, an unsupported
- * TIFF sample format: NULL and a message naming the file.
+ * TIFF sample format: NULL and a message naming the file; a PNG that
+ * claims 10^6 x 10^6 texels read in a child process with little address
+ * space left: NULL and "out of memory", not an abort (tex.h "Memory").
  */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -24,6 +26,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include "tex/tex.h"
@@ -108,7 +112,7 @@ static void test_png(void **state)
                 for (int c = 0; c < nch; c++)
                     assert_float_equal(tex_texel(t, 0, c, x, y),
                                        vals[(y * w + x) * nch + c] / scale, 1e-7);
-        tex_free(t);
+        tex_destroy(&t);
     }
 }
 
@@ -194,7 +198,7 @@ static void test_tiff(void **state)
             if (fabs(got - want) > 1e-6 * (1 + fabs(want)))
                 fail_msg("case %zu texel %d: %g, wrote %g", n, k, got, want);
         }
-        tex_free(t);
+        tex_destroy(&t);
         free(vals);
     }
 }
@@ -225,8 +229,8 @@ static void test_exr_roundtrip(void **state)
         assert_string_equal(tex_type(u), "float");
         for (int k = 0; k < w * h * nch; k++)
             assert_true(tex_texel(u, 0, k % nch, (k / nch) % w, k / nch / w) == px[k]);
-        tex_free(u);
-        tex_free(t);
+        tex_destroy(&u);
+        tex_destroy(&t);
         free(px);
     }
 }
@@ -287,7 +291,7 @@ static void test_exr_half_scanline(void **state)
         for (int x = 0; x < w; x++)
             for (int c = 0; c < 4; c++)
                 assert_true(tex_texel(t, 0, c, x, y) == px[((size_t)y * w + x) * 4 + from[c]]);
-    tex_free(t);
+    tex_destroy(&t);
     free(px);
 }
 
@@ -324,6 +328,90 @@ static void test_errors(void **state)
     expect_error(path, "not supported");
 }
 
+/* Under AddressSanitizer an allocation that fails returns NULL as malloc
+ * does, instead of ending the process (the path test_out_of_memory takes). */
+const char *__asan_default_options(void);
+const char *__asan_default_options(void)
+{
+    return "allocator_may_return_null=1";
+}
+
+/* PNG's CRC-32 (ISO 3309) of n bytes. */
+static uint32_t png_crc(const uint8_t *p, size_t n)
+{
+    uint32_t c = 0xffffffffu;
+    for (size_t i = 0; i < n; i++) {
+        c ^= p[i];
+        for (int k = 0; k < 8; k++)
+            c = c & 1 ? 0xedb88320u ^ (c >> 1) : c >> 1;
+    }
+    return c ^ 0xffffffffu;
+}
+
+static void put_be32(uint8_t *p, uint32_t v)
+{
+    p[0] = (uint8_t)(v >> 24);
+    p[1] = (uint8_t)(v >> 16);
+    p[2] = (uint8_t)(v >> 8);
+    p[3] = (uint8_t)v;
+}
+
+/* A PNG of w x h grey 8-bit texels cut in its first IDAT: the header the
+ * reader sizes its buffers by, and the start of its pixels. */
+static void write_png_start(const char *path, uint32_t w, uint32_t h)
+{
+    uint8_t b[8 + 25 + 12 + 4];
+    memcpy(b, "\x89PNG\r\n\x1a\n", 8);
+    uint8_t *ihdr = b + 8;              /* length, type, 13 bytes, CRC */
+    put_be32(ihdr, 13);
+    memcpy(ihdr + 4, "IHDR", 4);
+    put_be32(ihdr + 8, w);
+    put_be32(ihdr + 12, h);
+    memcpy(ihdr + 16, "\x08\x00\x00\x00\x00", 5);   /* 8 bits, grey, no interlace */
+    put_be32(ihdr + 21, png_crc(ihdr + 4, 17));
+    uint8_t *idat = ihdr + 25;          /* 4 bytes of zlib stream, CRC */
+    put_be32(idat, 4);
+    memcpy(idat + 4, "IDAT\x78\x9c\x00\x00", 8);
+    put_be32(idat + 12, png_crc(idat + 4, 8));
+    FILE *f = fopen(path, "wb");
+    assert_non_null(f);
+    assert_int_equal(fwrite(b, 1, sizeof b, f), sizeof b);
+    fclose(f);
+}
+
+static void test_out_of_memory(void **state)
+{
+    (void)state;
+    char path[300];
+    snprintf(path, sizeof path, "%s/huge.png", dir);
+    write_png_start(path, 1000000, 1000000);
+    fflush(NULL);
+    pid_t pid = fork();
+    assert_true(pid >= 0);
+    if (pid == 0) {              /* 256 MiB more address space than it has */
+        long pages = 0;
+        FILE *f = fopen("/proc/self/statm", "r");
+        if (!f || fscanf(f, "%ld", &pages) != 1)
+            _exit(3);
+        fclose(f);
+        struct rlimit rl;
+        getrlimit(RLIMIT_AS, &rl);
+        rl.rlim_cur = (rlim_t)pages * (rlim_t)sysconf(_SC_PAGESIZE) + ((rlim_t)256 << 20);
+        if (setrlimit(RLIMIT_AS, &rl) != 0)
+            _exit(3);
+        char err[512] = "";
+        tex_texture *t = tex_open(path, err, sizeof err);
+        fprintf(stderr, "child: %s\n", t ? "opened the texture" : err);
+        _exit(t ? 1 : strstr(err, path) && strstr(err, "out of memory") ? 0 : 2);
+    }
+    int status = 0;
+    assert_int_equal(waitpid(pid, &status, 0), pid);
+    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
+        fail_msg("the child %s %d (0: refused with the message)",
+                 WIFEXITED(status) ? "exited with" : "died of signal",
+                 WIFEXITED(status) ? WEXITSTATUS(status) : WTERMSIG(status));
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -332,6 +420,7 @@ int main(void)
         cmocka_unit_test(test_exr_roundtrip),
         cmocka_unit_test(test_exr_half_scanline),
         cmocka_unit_test(test_errors),
+        cmocka_unit_test(test_out_of_memory),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

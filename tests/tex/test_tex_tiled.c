@@ -158,9 +158,9 @@ static void test_stored_equals_built(void **state)
         assert_non_null(file2);
         for (int n = 0; n < 5000; n++)
             assert_int_equal(compare_once(mem, file2, &r), 0);
-        tex_free(file2);
-        tex_free(file);
-        tex_free(mem);
+        tex_destroy(&file2);
+        tex_destroy(&file);
+        tex_destroy(&mem);
     }
 }
 
@@ -219,13 +219,13 @@ static void test_tiny_budget_same_results(void **state)
     tex_tiles_stats(all, &st);
     assert_true(st.evictions == 0 && st.loads > 0);
     assert_true(st.loads <= (size_t)(15 * 11 + 8 * 6 + 8 * 6 + 8 * 6));  /* each tile once */
-    tex_free(file2);
-    tex_tiles_free(all);
-    tex_free(file);
+    tex_destroy(&file2);
+    tex_tiles_destroy(&all);
+    tex_destroy(&file);
     tex_tiles_stats(pool, &st);
     assert_true(st.bytes == 0);                     /* freeing a texture frees its tiles */
-    tex_tiles_free(pool);
-    tex_free(mem);
+    tex_tiles_destroy(&pool);
+    tex_destroy(&mem);
 }
 
 /* Writes n bytes `to` at `skip` bytes after the first `from` (of nf
@@ -281,11 +281,11 @@ static void test_bad_files_refused(void **state)
     err[0] = '\0';
     tex_texture *t = tex_open(path, err, sizeof err);
     if (t) {
-        tex_free(t);
+        tex_destroy(&t);
         fail_msg("a truncated texture opened");
     }
     assert_non_null(strstr(err, path));
-    tex_free(mem);
+    tex_destroy(&mem);
 }
 
 int main(void)

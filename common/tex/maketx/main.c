@@ -16,6 +16,8 @@
 
 #include "sl/noise.h"
 #include "tex/tex.h"
+#include "util/err.h"
+#include "util/xalloc.h"
 
 static void usage(FILE *out)
 {
@@ -46,9 +48,7 @@ static bool parse_int(const char *s, long lo, long hi, long *out)
  * across the map, each octave periodic over the map (so it tiles). */
 static tex_texture *fbm(int w, int h, int octaves, long seed)
 {
-    float *px = malloc((size_t)w * h * sizeof *px);
-    if (!px)
-        return NULL;
+    float *px = xmalloc((size_t)w * h * sizeof *px);
     double off = 17.31 * (double)seed;
     for (int j = 0; j < h; j++)
         for (int i = 0; i < w; i++) {
@@ -115,7 +115,7 @@ int main(int argc, char **argv)
         return 2;
     }
     const char *out = files[want - 1];
-    char err[1024];
+    char err[ERR_LEN];
     tex_texture *t = fbm_w ? fbm((int)fbm_w, (int)fbm_h, (int)octaves, seed)
                            : tex_open(files[0], err, sizeof err);
     if (!t) {
@@ -124,7 +124,7 @@ int main(int argc, char **argv)
     }
     if (!tex_write_exr(out, t, minmax, err, sizeof err)) {
         fprintf(stderr, "aafarm-maketx: %s\n", err);
-        tex_free(t);
+        tex_destroy(&t);
         return 1;
     }
     double lo, hi;
@@ -135,6 +135,6 @@ int main(int argc, char **argv)
     printf("%s: %d x %d, %d channel%s, %d levels, channel 0 in [%g, %g]\n", out, tex_width(t),
            tex_height(t), tex_channels(t), tex_channels(t) == 1 ? "" : "s", tex_levels(t), lo,
            hi);
-    tex_free(t);
+    tex_destroy(&t);
     return 0;
 }
