@@ -1,5 +1,6 @@
 /*
- * death.c: fork-and-wait death tests (see death.h).
+ * death.c: fork-and-wait death tests, and runs in a child starved of
+ * memory (see death.h).
  */
 #include "death.h"
 
@@ -8,6 +9,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -64,4 +66,36 @@ bool death_run(void (*fn)(void *), void *arg, const char *expect, char *why, int
         return false;
     }
     return true;
+}
+
+bool starved_run(int (*fn)(void *), void *arg, unsigned long headroom, char *why, int whylen)
+{
+    fflush(NULL);
+    pid_t pid = fork();
+    if (pid < 0) {
+        snprintf(why, (size_t)whylen, "fork: %s", strerror(errno));
+        return false;
+    }
+    if (pid == 0) {
+        long pages = 0;
+        FILE *f = fopen("/proc/self/statm", "r");
+        if (!f || fscanf(f, "%ld", &pages) != 1)
+            _exit(3);
+        fclose(f);
+        struct rlimit rl;
+        getrlimit(RLIMIT_AS, &rl);
+        rl.rlim_cur = (rlim_t)pages * (rlim_t)sysconf(_SC_PAGESIZE) + (rlim_t)headroom;
+        if (setrlimit(RLIMIT_AS, &rl) != 0)
+            _exit(3);
+        _exit(fn(arg));
+    }
+    int status = 0;
+    while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+    }
+    if (WIFEXITED(status) && WEXITSTATUS(status) == 0)
+        return true;
+    snprintf(why, (size_t)whylen, "the child %s %d (0: refused with the message; 3: no limit set)",
+             WIFEXITED(status) ? "exited with" : "died of signal",
+             WIFEXITED(status) ? WEXITSTATUS(status) : WTERMSIG(status));
+    return false;
 }

@@ -26,4 +26,19 @@ bool death_run(void (*fn)(void *), void *arg, const char *expect, char *why, int
             fail_msg("%s", death_why_);                                      \
     } while (0)
 
+/* The other side of xalloc.h's try_*: fn(arg) runs in a forked child whose
+ * address space is limited to what it already has plus `headroom` bytes,
+ * so a large allocation really fails. fn returns 0 when it met that
+ * failure as it should (an error message, not an abort). True when the
+ * child exited 0; else why says how it ended. (ASan builds: the test sets
+ * ASAN_OPTIONS=allocator_may_return_null=1 through __asan_default_options.) */
+bool starved_run(int (*fn)(void *), void *arg, unsigned long headroom, char *why, int whylen);
+
+#define assert_starved_ok(fn, arg, headroom)                                        \
+    do {                                                                            \
+        char starved_why_[512];                                                     \
+        if (!starved_run((fn), (arg), (headroom), starved_why_, sizeof starved_why_)) \
+            fail_msg("%s", starved_why_);                                           \
+    } while (0)
+
 #endif
