@@ -3,7 +3,7 @@
  *
  * What lives here, top to bottom:
  *
- *   memory        an arena (everything token texts point into lives until
+ *   memory        an sl_arena (everything token texts point into lives until
  *                 sl_preproc_destroy), a string-keyed hash map (macros,
  *                 interned strings, cleaned source texts), token vectors;
  *   hide sets     Prosser's algorithm: each token carries the set of macros
@@ -61,33 +61,14 @@ void pp_tv_free(tokvec *tv)
     tv->n = tv->cap = 0;
 }
 
-static void *arena_alloc(sl_preproc *pp, size_t size)
-{
-    size_t unit = sizeof(max_align_t);
-    size = (size + unit - 1) / unit * unit;
-    arena_block *b = pp->arena;
-    if (!b || b->cap - b->used < size) {
-        size_t cap = size > ARENA_BLOCK ? size : ARENA_BLOCK;
-        b = sl_xrealloc(NULL, sizeof *b + cap);
-        b->next = pp->arena;
-        b->used = 0;
-        b->cap = cap;
-        pp->arena = b;
-    }
-    void *p = (char *)b->data + b->used;
-    b->used += size;
-    pp->stored += size;
-    return p;
-}
-
 void *sl_preproc_alloc(sl_preproc *self, size_t size)
 {
-    return arena_alloc(self, size);
+    return sl_arena_alloc(self->arena, size);
 }
 
 static char *arena_strndup(sl_preproc *pp, const char *s, size_t len)
 {
-    char *copy = arena_alloc(pp, len + 1);
+    char *copy = sl_arena_alloc(pp->arena, len + 1);
     if (len)
         memcpy(copy, s, len);
     copy[len] = '\0';
@@ -207,7 +188,7 @@ static bool spend(sl_preproc *pp, size_t n, sl_pos pos)
     if (pp->dead)
         return false;
     pp->spent += n;
-    if (pp->spent <= SL_PP_MAX_TOKENS && pp->stored <= SL_PP_MAX_BYTES)
+    if (pp->spent <= SL_PP_MAX_TOKENS && sl_arena_bytes(pp->arena) <= SL_PP_MAX_BYTES)
         return true;
     if (pp->spent > SL_PP_MAX_TOKENS)
         sl_diag_error(pp->diag, pos,
@@ -259,7 +240,7 @@ static const sl_hideset *hs_add(sl_preproc *pp, const sl_hideset *hs, const sl_m
 {
     if (hs_has(hs, m))
         return hs;
-    sl_hideset *node = arena_alloc(pp, sizeof *node);
+    sl_hideset *node = sl_arena_alloc(pp->arena, sizeof *node);
     node->macro = m;
     node->next = hs;
     spend(pp, 1, pos);
@@ -334,7 +315,7 @@ static sl_macro *parse_define(sl_preproc *pp, const sl_pptoken *v, size_t n,
         sl_diag_error(pp->diag, v[0].pos, "'defined' cannot be used as a macro name");
         return NULL;
     }
-    sl_macro *m = arena_alloc(pp, sizeof *m);
+    sl_macro *m = sl_arena_alloc(pp->arena, sizeof *m);
     memset(m, 0, sizeof *m);
     m->name = sl_preproc_intern(pp, v[0].text, v[0].len);
     m->pos = v[0].pos;
@@ -343,7 +324,7 @@ static sl_macro *parse_define(sl_preproc *pp, const sl_pptoken *v, size_t n,
     if (i < n && v[i].kind == SL_TOK_LPAREN && !(v[i].flags & SL_PPF_SPACE)) {
         m->funclike = true;
         i++;
-        m->params = arena_alloc(pp, n * sizeof *m->params);
+        m->params = sl_arena_alloc(pp->arena, n * sizeof *m->params);
         if (i < n && v[i].kind == SL_TOK_RPAREN) {
             i++;
         } else {
@@ -382,8 +363,8 @@ static sl_macro *parse_define(sl_preproc *pp, const sl_pptoken *v, size_t n,
     }
 
     m->nbody = n - i;
-    m->body = arena_alloc(pp, m->nbody * sizeof *m->body);
-    m->param = arena_alloc(pp, m->nbody * sizeof *m->param);
+    m->body = sl_arena_alloc(pp->arena, m->nbody * sizeof *m->body);
+    m->param = sl_arena_alloc(pp->arena, m->nbody * sizeof *m->param);
     for (size_t k = 0; k < m->nbody; k++) {
         m->body[k] = v[i + k];
         m->body[k].flags &= ~SL_PPF_BOL;
@@ -426,7 +407,7 @@ bool sl_preproc_define(sl_preproc *self, const char *definition)
 {
     /* "NAME=VALUE" is "#define NAME VALUE", "NAME" is "#define NAME 1" */
     size_t len = strlen(definition);
-    char *text = arena_alloc(self, len + 3);
+    char *text = sl_arena_alloc(self->arena, len + 3);
     memcpy(text, definition, len + 1);
     char *eq = strchr(text, '=');
     if (eq) {
@@ -468,13 +449,13 @@ static const pp_text *text_of(sl_preproc *pp, const sl_source *src)
                            strlen(src->name));
     if (e->value)
         return e->value;
-    pp_text *t = arena_alloc(pp, sizeof *t);
+    pp_text *t = sl_arena_alloc(pp->arena, sizeof *t);
     size_t *splices = sl_xrealloc(NULL, (src->len / 2 + 1) * sizeof *splices);
     t->src = src;
     t->name = e->key;
-    t->text = arena_alloc(pp, src->len + 1);
+    t->text = sl_arena_alloc(pp->arena, src->len + 1);
     t->len = sl_scanner_clean(src->text, src->len, t->text, splices, &t->nsplices);
-    t->splices = arena_alloc(pp, t->nsplices * sizeof *t->splices);
+    t->splices = sl_arena_alloc(pp->arena, t->nsplices * sizeof *t->splices);
     if (t->nsplices)
         memcpy(t->splices, splices, t->nsplices * sizeof *splices);
     free(splices);
@@ -702,7 +683,7 @@ static bool paste(pp_subst *s, sl_pptoken *lhs, const sl_pptoken *rhs)
 {
     sl_preproc *pp = s->pp;
     size_t len = lhs->len + rhs->len;
-    char *text = arena_alloc(pp, len + 1);
+    char *text = sl_arena_alloc(pp->arena, len + 1);
     memcpy(text, lhs->text, lhs->len);
     memcpy(text + lhs->len, rhs->text, rhs->len);
     text[len] = '\0';
@@ -1166,6 +1147,7 @@ sl_preproc *sl_preproc_new(sl_source_set *set, const char *main_file,
     memset(self, 0, sizeof *self);
     self->set = set;
     self->diag = diag;
+    self->arena = sl_arena_new();
     sl_diag_set_sources(diag, set);
 
     size_t n = 0;
@@ -1207,11 +1189,7 @@ void sl_preproc_destroy(sl_preproc **self_p)
     free(self->texts.slots);
     pp_tv_free(&self->main.pb);
     pp_tv_free(&self->line);
-    while (self->arena) {
-        arena_block *next = self->arena->next;
-        free(self->arena);
-        self->arena = next;
-    }
+    sl_arena_destroy(&self->arena);
     free(self);
     *self_p = NULL;
 }

@@ -7,19 +7,12 @@
 #ifndef SL_PREPROC_INTERNAL_H
 #define SL_PREPROC_INTERNAL_H
 
+#include "sl/arena.h"
 #include "sl/preproc.h"
 
 #include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
-
-enum { ARENA_BLOCK = 64 * 1024 };
-
-typedef struct arena_block {
-    struct arena_block *next;
-    size_t used, cap;
-    max_align_t data[];
-} arena_block;
 
 typedef struct map_entry {
     const char *key;          /* NULL: empty slot */
@@ -123,9 +116,8 @@ struct sl_preproc {
     tokvec line;              /* scratch: the tokens of a directive line */
     sl_pos eol;               /* position of the end of that line */
 
-    arena_block *arena;
+    sl_arena *arena;          /* everything token texts point into */
     size_t spent;             /* tokens scanned + produced, for the limit */
-    size_t stored;            /* bytes taken from the arena, for the limit */
     int arg_nesting;          /* recursion of argument pre-expansion */
     bool dead;                /* a limit was hit: only EOF from now on */
     sl_pos eof_pos;
