@@ -166,8 +166,9 @@ enum { SL_ESCAPE_LOOP = 0, SL_ESCAPE_FUNC = 1 };
 /* Strings (RI Spec 3.2 §15.6): SCAT z, a, b concatenates; SFMT z, x, spec,
  * size formats size numbers from slot x with the C conversion spec (checked
  * when compiling: flags, width, precision, one of f e g or lld), a range
- * as "[lo hi]"; SPRINT s prints a line to stderr (float mode only, at most
- * SL_VM_MAX_PRINTS lines per VM); SMATCH z, pattern, subject is match().
+ * as "[lo hi]"; SPRINT s hands a line to the VM's print callback (float
+ * mode only, at most SL_VM_MAX_PRINTS lines per VM); SMATCH z, pattern,
+ * subject is match().
  * Results live in the VM's string space, reset at each run. */
 
 /* illuminance loops (RI Spec 3.2 §15.4): LSTART takes the non-ambient

@@ -8,6 +8,7 @@
 #include "sl/vm_internal.h"
 #include "sl/check.h"
 #include "sl/strbuf.h"
+#include "util/err.h"
 
 #include <math.h>
 #include <stdarg.h>
@@ -218,6 +219,12 @@ const vm_message *sl_vm_message(const sl_vm *vm, int scope, const char *name, in
             return m;
     }
     return NULL;
+}
+
+void sl_vm_set_print(sl_vm *self, sl_print_fn fn, void *ctx)
+{
+    self->print = fn;
+    self->print_ctx = ctx;
 }
 
 void sl_vm_set_clipping(sl_vm *self, double near, double far)
@@ -439,14 +446,11 @@ void sl_vm_get_affine(const sl_vm *self, sl_global g, aa_form *values)
 
 sl_status sl_vm_fail(sl_vm *vm, sl_status st, const char *fmt, ...)
 {
-    int n = snprintf(vm->error, sizeof vm->error, "shader '%s': ",
-                     vm->prog ? vm->prog->name : "?");
-    if (n < 0 || (size_t)n >= sizeof vm->error)
-        n = 0;
     va_list ap;
     va_start(ap, fmt);
-    vsnprintf(vm->error + n, sizeof vm->error - (size_t)n, fmt, ap);
+    err_vset(vm->error, sizeof vm->error, fmt, ap);
     va_end(ap);
+    err_prefix(vm->error, sizeof vm->error, "shader '%s'", vm->prog ? vm->prog->name : "?");
     return st;
 }
 
