@@ -3,7 +3,7 @@
  * arena.h).
  */
 #include "sl/arena.h"
-#include "sl/strbuf.h"
+#include "util/xalloc.h"
 
 #include <assert.h>
 #include <stdlib.h>
@@ -24,7 +24,7 @@ enum { CHUNK_SIZE = 64 * 1024 };
 
 sl_arena *sl_arena_new(void)
 {
-    sl_arena *self = sl_xrealloc(NULL, sizeof *self);
+    sl_arena *self = xmalloc(sizeof *self);
     self->head = NULL;
     self->bytes = 0;
     return self;
@@ -51,7 +51,7 @@ void *sl_arena_alloc(sl_arena *self, size_t size)
     chunk *c = self->head;
     if (!c || c->used + size > c->size) {
         size_t cap = size > CHUNK_SIZE ? size : CHUNK_SIZE;
-        c = sl_xrealloc(NULL, sizeof *c + cap);
+        c = xmalloc(sizeof *c + cap);
         c->used = 0;
         c->size = cap;
         c->next = self->head;

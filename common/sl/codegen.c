@@ -39,7 +39,7 @@
 #include "sl/builtins.h"
 #include "sl/check.h"
 #include "sl/lexer.h"
-#include "sl/strbuf.h"
+#include "util/xalloc.h"
 #include "tex/tex.h"
 
 #include <math.h>
@@ -103,7 +103,7 @@ int cg_const_slot(cg *g, double value)
     }
     if (p->nconsts == g->consts_cap) {
         g->consts_cap = g->consts_cap ? 2 * g->consts_cap : 16;
-        p->consts = sl_xrealloc(p->consts, (size_t)g->consts_cap * sizeof *p->consts);
+        p->consts = xrealloc(p->consts, (size_t)g->consts_cap * sizeof *p->consts);
     }
     p->consts[p->nconsts] = value;
     return CONST_TAG | p->nconsts++;
@@ -121,11 +121,11 @@ int cg_string_const(cg *g, const char *text, size_t len)
     }
     if (p->nstrings == g->strings_cap) {
         g->strings_cap = g->strings_cap ? 2 * g->strings_cap : 8;
-        p->strings = sl_xrealloc(p->strings, (size_t)g->strings_cap * sizeof *p->strings);
-        p->string_slots = sl_xrealloc(p->string_slots,
+        p->strings = xrealloc(p->strings, (size_t)g->strings_cap * sizeof *p->strings);
+        p->string_slots = xrealloc(p->string_slots,
                                       (size_t)g->strings_cap * sizeof *p->string_slots);
     }
-    p->strings[p->nstrings] = sl_xstrndup(text, len);
+    p->strings[p->nstrings] = xstrndup(text, len);
     return CONST_TAG | p->nstrings++;
 }
 
@@ -139,9 +139,9 @@ static int file_index(cg *g, const char *file)
             return i;
     if (p->nfiles == g->files_cap) {
         g->files_cap = g->files_cap ? 2 * g->files_cap : 4;
-        p->files = sl_xrealloc(p->files, (size_t)g->files_cap * sizeof *p->files);
+        p->files = xrealloc(p->files, (size_t)g->files_cap * sizeof *p->files);
     }
-    p->files[p->nfiles] = sl_xstrndup(file, strlen(file));
+    p->files[p->nfiles] = xstrndup(file, strlen(file));
     return p->nfiles++;
 }
 
@@ -153,7 +153,7 @@ static void region_begin(cg *g)
 {
     if (g->nregions == g->regions_cap) {
         g->regions_cap = g->regions_cap ? 2 * g->regions_cap : 8;
-        g->regions = sl_xrealloc(g->regions, (size_t)g->regions_cap * sizeof *g->regions);
+        g->regions = xrealloc(g->regions, (size_t)g->regions_cap * sizeof *g->regions);
     }
     region *r = &g->regions[g->nregions++];
     memset(r, 0, sizeof *r);
@@ -184,7 +184,7 @@ static int push_table_entry(cg *g, uint16_t value)
     sl_program *p = g->prog;
     if (p->ntables == g->tables_cap) {
         g->tables_cap = g->tables_cap ? 2 * g->tables_cap : 64;
-        p->tables = sl_xrealloc(p->tables, (size_t)g->tables_cap * sizeof *p->tables);
+        p->tables = xrealloc(p->tables, (size_t)g->tables_cap * sizeof *p->tables);
     }
     p->tables[p->ntables] = value;
     return p->ntables++;
@@ -296,8 +296,8 @@ int cg_emit(cg *g, sl_opcode op, int a, int b, int c, int d)
     }
     if (p->ncode == g->code_cap) {
         g->code_cap = g->code_cap ? 2 * g->code_cap : 256;
-        p->code = sl_xrealloc(p->code, (size_t)g->code_cap * sizeof *p->code);
-        p->pos = sl_xrealloc(p->pos, (size_t)g->code_cap * sizeof *p->pos);
+        p->code = xrealloc(p->code, (size_t)g->code_cap * sizeof *p->code);
+        p->pos = xrealloc(p->pos, (size_t)g->code_cap * sizeof *p->pos);
     }
     sl_insn *in = &p->code[p->ncode];
     in->op = (uint8_t)op;
@@ -327,7 +327,7 @@ static void emit_escape(cg *g, int flag, int kind, int id)
         return;
     if (g->nescapes == g->escapes_cap) {
         g->escapes_cap = g->escapes_cap ? 2 * g->escapes_cap : 16;
-        g->escapes = sl_xrealloc(g->escapes, (size_t)g->escapes_cap * sizeof *g->escapes);
+        g->escapes = xrealloc(g->escapes, (size_t)g->escapes_cap * sizeof *g->escapes);
     }
     g->escapes[g->nescapes++] = (struct pending_escape){ pc, kind, id };
 }
@@ -1213,13 +1213,13 @@ static void gen_params(cg *g)
 {
     const sl_ast_file *f = g->file;
     sl_program *p = g->prog;
-    p->params = sl_xrealloc(NULL, (size_t)(f->nparams + 1) * sizeof *p->params);
+    p->params = xmalloc((size_t)(f->nparams + 1) * sizeof *p->params);
     p->nparams = f->nparams;
     for (int i = 0; i < f->nparams; i++) {
         sl_node *v = f->params[i];
         sl_sym *s = v->sym;
         sl_param *pp = &p->params[i];
-        pp->name = sl_xstrndup(s->name, strlen(s->name));
+        pp->name = xstrndup(s->name, strlen(s->name));
         pp->type = (sl_type)sl_ty_elem(s->ty);     /* arrays: the element type */
         pp->output = s->output;
         pp->size = sl_ty_slots(s->ty);
@@ -1292,10 +1292,10 @@ static unsigned long next_serial(void)
 sl_program *sl_codegen(const sl_ast_file *file, sl_diag *diag)
 {
     cg g = { .file = file, .diag = diag };
-    g.prog = sl_xrealloc(NULL, sizeof *g.prog);
+    g.prog = xmalloc(sizeof *g.prog);
     memset(g.prog, 0, sizeof *g.prog);
     sl_program *p = g.prog;
-    p->name = sl_xstrndup(file->name, strlen(file->name));
+    p->name = xstrndup(file->name, strlen(file->name));
     p->kind = file->kind;
     p->serial = next_serial();
     g.sp = g.max_sp = SL_GLOBAL_SLOTS;

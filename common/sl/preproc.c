@@ -33,6 +33,7 @@
 #include "sl/preproc.h"
 #include "sl/preproc_internal.h"
 #include "sl/strbuf.h"
+#include "util/xalloc.h"
 
 #include <limits.h>
 #include <stdarg.h>
@@ -49,7 +50,7 @@ void pp_tv_push(tokvec *tv, const sl_pptoken *t)
 {
     if (tv->n == tv->cap) {
         tv->cap = tv->cap ? 2 * tv->cap : 16;
-        tv->v = sl_xrealloc(tv->v, tv->cap * sizeof *tv->v);
+        tv->v = xrealloc(tv->v, tv->cap * sizeof *tv->v);
     }
     tv->v[tv->n++] = *t;
 }
@@ -112,7 +113,7 @@ static map_entry *map_put(pp_map *m, const char *key, size_t len)
     if (2 * (m->count + 1) > m->cap) {
         pp_map bigger = { 0 };
         bigger.cap = m->cap ? 2 * m->cap : 64;
-        bigger.slots = sl_xrealloc(NULL, bigger.cap * sizeof *bigger.slots);
+        bigger.slots = xmalloc(bigger.cap * sizeof *bigger.slots);
         memset(bigger.slots, 0, bigger.cap * sizeof *bigger.slots);
         for (size_t i = 0; i < m->cap; i++) {
             map_entry *e = &m->slots[i];
@@ -450,7 +451,7 @@ static const pp_text *text_of(sl_preproc *pp, const sl_source *src)
     if (e->value)
         return e->value;
     pp_text *t = sl_arena_alloc(pp->arena, sizeof *t);
-    size_t *splices = sl_xrealloc(NULL, (src->len / 2 + 1) * sizeof *splices);
+    size_t *splices = xmalloc((src->len / 2 + 1) * sizeof *splices);
     t->src = src;
     t->name = e->key;
     t->text = sl_arena_alloc(pp->arena, src->len + 1);
@@ -763,7 +764,7 @@ static void expand_call(sl_preproc *pp, pp_input *in, const sl_macro *m,
                         const sl_pptoken *name)
 {
     tokvec toks = { 0 };
-    size_t *starts = sl_xrealloc(NULL, 8 * sizeof *starts);
+    size_t *starts = xmalloc(8 * sizeof *starts);
     size_t nargs = 1, cap = 8;
     starts[0] = 0;
     int depth = 0;
@@ -786,7 +787,7 @@ static void expand_call(sl_preproc *pp, pp_input *in, const sl_macro *m,
         } else if (t.kind == SL_TOK_COMMA && depth == 0) {
             if (nargs == cap) {
                 cap *= 2;
-                starts = sl_xrealloc(starts, cap * sizeof *starts);
+                starts = xrealloc(starts, cap * sizeof *starts);
             }
             starts[nargs++] = toks.n;
             continue;
@@ -809,7 +810,7 @@ static void expand_call(sl_preproc *pp, pp_input *in, const sl_macro *m,
         goto done;
     }
 
-    pp_arg *args = sl_xrealloc(NULL, (nargs ? nargs : 1) * sizeof *args);
+    pp_arg *args = xmalloc((nargs ? nargs : 1) * sizeof *args);
     for (size_t a = 0; a < nargs; a++) {
         size_t end = a + 1 < nargs ? starts[a + 1] : toks.n;
         args[a].raw = toks.v ? toks.v + starts[a] : NULL;
@@ -871,7 +872,7 @@ static void push_cond(sl_preproc *pp, const sl_pptoken *hash, const char *direct
 {
     if (pp->nconds == pp->capconds) {
         pp->capconds = pp->capconds ? 2 * pp->capconds : 16;
-        pp->conds = sl_xrealloc(pp->conds, pp->capconds * sizeof *pp->conds);
+        pp->conds = xrealloc(pp->conds, pp->capconds * sizeof *pp->conds);
     }
     bool parent = !skipping(pp);
     pp_cond c = { hash->pos, directive, parent, parent && value, parent && value, false };
@@ -1049,7 +1050,7 @@ static void do_include(sl_preproc *pp)
         sl_diag_error(pp->diag, file.pos, "empty filename in '#include'");
         return;
     }
-    char *name = sl_xrealloc(NULL, file.len - 1);
+    char *name = xmalloc(file.len - 1);
     memcpy(name, file.text + 1, file.len - 2);
     name[file.len - 2] = '\0';
 
@@ -1143,7 +1144,7 @@ static void directive(sl_preproc *pp, const sl_pptoken *hash)
 sl_preproc *sl_preproc_new(sl_source_set *set, const char *main_file,
                            const char *const *search_path, sl_diag *diag)
 {
-    sl_preproc *self = sl_xrealloc(NULL, sizeof *self);
+    sl_preproc *self = xmalloc(sizeof *self);
     memset(self, 0, sizeof *self);
     self->set = set;
     self->diag = diag;
@@ -1153,10 +1154,10 @@ sl_preproc *sl_preproc_new(sl_source_set *set, const char *main_file,
     size_t n = 0;
     while (search_path && search_path[n])
         n++;
-    self->search_path = sl_xrealloc(NULL, (n + 1) * sizeof *self->search_path);
+    self->search_path = xmalloc((n + 1) * sizeof *self->search_path);
     for (size_t i = 0; i < n; i++) {
         size_t len = strlen(search_path[i]);
-        self->search_path[i] = sl_xrealloc(NULL, len + 1);
+        self->search_path[i] = xmalloc(len + 1);
         memcpy(self->search_path[i], search_path[i], len + 1);
     }
     self->search_path[n] = NULL;

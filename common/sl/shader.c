@@ -9,7 +9,7 @@
 #include "sl/codegen.h"
 #include "sl/lexer.h"
 #include "sl/parser.h"
-#include "sl/strbuf.h"
+#include "util/xalloc.h"
 #include "sl/vm_internal.h"
 #include "util/err.h"
 
@@ -74,10 +74,10 @@ int sl_program_find_param(const sl_program *self, const char *name)
 
 sl_instance *sl_instance_new(const sl_program *program)
 {
-    sl_instance *self = sl_xrealloc(NULL, sizeof *self);
+    sl_instance *self = xmalloc(sizeof *self);
     self->program = program;
     size_t n = (size_t)program->nparams + 1;
-    self->values = sl_xrealloc(NULL, n * sizeof *self->values);
+    self->values = xmalloc(n * sizeof *self->values);
     memset(self->values, 0, n * sizeof *self->values);
     return self;
 }
@@ -146,7 +146,7 @@ bool sl_instance_set_string(sl_instance *self, const char *name, const char *val
         return err_set(err, errsz, "parameter '%s' of shader '%s' is a %s, not a string",
                         name, p->name, sl_ty_name(p->params[i].type));
     free(self->values[i].s);
-    self->values[i].s = sl_xstrndup(value, strlen(value));
+    self->values[i].s = xstrndup(value, strlen(value));
     self->values[i].set = true;
     return true;
 }

@@ -9,6 +9,7 @@
 #include "sl/check.h"
 #include "sl/strbuf.h"
 #include "util/err.h"
+#include "util/xalloc.h"
 
 #include <math.h>
 #include <stdarg.h>
@@ -27,16 +28,6 @@ const char *sl_mode_name(sl_mode mode)
     case SL_MODE_AFFINE: return "affine";
     }
     return "?";
-}
-
-static void *xcalloc(size_t n, size_t size)
-{
-    void *p = calloc(n, size);
-    if (!p) {
-        fputs("sl: out of memory\n", stderr);
-        abort();
-    }
-    return p;
 }
 
 sl_vm *sl_vm_new(const sl_limits *limits)
