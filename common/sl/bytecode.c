@@ -134,8 +134,9 @@ bool sl_program_reads_global(const sl_program *p, sl_global g)
     return false;
 }
 
-void sl_program_free(sl_program *p)
+void sl_program_destroy(sl_program **self_p)
 {
+    sl_program *p = *self_p;
     if (!p)
         return;
     free(p->name);
@@ -154,6 +155,7 @@ void sl_program_free(sl_program *p)
         free(p->files[i]);
     free(p->files);
     free(p);
+    *self_p = NULL;
 }
 
 void sl_program_pos_string(const sl_program *self, int pc, char *buf, size_t size)

@@ -267,10 +267,6 @@ const char *sl_global_name(sl_global g);
  * case), range runs need no derivative bounds to bound P. */
 bool sl_program_derivatives_reach_P(const sl_program *p);
 
-/* Frees a program and everything it owns (sl_program_destroy without the
- * pointer reset; used by the code generator on failure). */
-void sl_program_free(sl_program *p);
-
 /* Source position of instruction pc as "file:line:col". */
 void sl_program_pos_string(const sl_program *self, int pc, char *buf, size_t size);
 

@@ -1320,7 +1320,7 @@ sl_program *sl_codegen(const sl_ast_file *file, sl_diag *diag)
     free(g.regions);
     free(g.escapes);
     if (g.failed) {
-        sl_program_free(p);
+        sl_program_destroy(&p);
         return NULL;
     }
     return p;

@@ -55,7 +55,7 @@ void pp_tv_push(tokvec *tv, const sl_pptoken *t)
     tv->v[tv->n++] = *t;
 }
 
-void pp_tv_free(tokvec *tv)
+void pp_tv_clear(tokvec *tv)
 {
     free(tv->v);
     tv->v = NULL;
@@ -427,7 +427,7 @@ bool sl_preproc_define(sl_preproc *self, const char *definition)
         pp_tv_push(&v, &t);
     sl_pos start = { "<command line>", 1, 1 };
     sl_macro *m = parse_define(self, v.v, v.n, start, t.pos);
-    pp_tv_free(&v);
+    pp_tv_clear(&v);
     if (m)
         install_macro(self, m);
     return m != NULL;
@@ -574,7 +574,7 @@ void pp_expand_list(sl_preproc *pp, const sl_pptoken *v, size_t n, sl_pos end, t
             break;
         pp_tv_push(out, &t);
     }
-    pp_tv_free(&in.pb);
+    pp_tv_clear(&in.pb);
 }
 
 /* What an expansion appends: body tokens take the invocation's position
@@ -744,7 +744,7 @@ static void substitute(sl_preproc *pp, const sl_macro *m, pp_arg *args,
             pp_tv_push(out, &rhs.v[k]);
         if (rhs.n > 0)
             last_empty = false;
-        pp_tv_free(&rhs);
+        pp_tv_clear(&rhs);
     }
 }
 
@@ -755,7 +755,7 @@ static void push_back(sl_preproc *pp, pp_input *in, tokvec *out, const sl_pptoke
     if (spend(pp, 0, name->pos))
         for (size_t k = out->n; k-- > 0;)
             pp_tv_push(&in->pb, &out->v[k]);
-    pp_tv_free(out);
+    pp_tv_clear(out);
 }
 
 /* Collects the arguments of an invocation of m (the '(' has been read)
@@ -824,10 +824,10 @@ static void expand_call(sl_preproc *pp, pp_input *in, const sl_macro *m,
     substitute(pp, m, args, hs, name, &out);
     push_back(pp, in, &out, name);
     for (size_t a = 0; a < nargs; a++)
-        pp_tv_free(&args[a].expanded);
+        pp_tv_clear(&args[a].expanded);
     free(args);
 done:
-    pp_tv_free(&toks);
+    pp_tv_clear(&toks);
     free(starts);
 }
 
@@ -1188,8 +1188,8 @@ void sl_preproc_destroy(sl_preproc **self_p)
     free(self->macros.slots);
     free(self->interned.slots);
     free(self->texts.slots);
-    pp_tv_free(&self->main.pb);
-    pp_tv_free(&self->line);
+    pp_tv_clear(&self->main.pb);
+    pp_tv_clear(&self->line);
     sl_arena_destroy(&self->arena);
     free(self);
     *self_p = NULL;

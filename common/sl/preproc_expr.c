@@ -279,8 +279,8 @@ bool pp_eval_if(sl_preproc *pp, const sl_pptoken *name)
                          pp_spell_for_message(rest, buf));
         }
         ok = !e.failed;
-        pp_tv_free(&expanded);
+        pp_tv_clear(&expanded);
     }
-    pp_tv_free(&pre);
+    pp_tv_clear(&pre);
     return ok && value != 0;
 }

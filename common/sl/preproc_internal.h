@@ -125,7 +125,7 @@ struct sl_preproc {
 
 /* preproc.c: token vectors */
 void pp_tv_push(tokvec *tv, const sl_pptoken *t);
-void pp_tv_free(tokvec *tv);
+void pp_tv_clear(tokvec *tv);
 
 /* preproc.c: small helpers */
 bool pp_is_word(const sl_pptoken *t, const char *word);

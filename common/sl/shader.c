@@ -30,18 +30,12 @@ sl_program *sl_compile(sl_source_set *set, const char *main_file,
     sl_arena_destroy(&arena);
     sl_lexer_destroy(&lx);
     if (sl_diag_error_count(diag) != errors) {
-        sl_program_free(program);
+        sl_program_destroy(&program);
         return NULL;
     }
     if (program)
         program->takes_derivatives = sl_program_derivatives_reach_P(program);
     return program;
-}
-
-void sl_program_destroy(sl_program **self_p)
-{
-    sl_program_free(*self_p);
-    *self_p = NULL;
 }
 
 const char *sl_program_name(const sl_program *self) { return self->name; }
