@@ -267,6 +267,11 @@ const char *sl_global_name(sl_global g);
  * case), range runs need no derivative bounds to bound P. */
 bool sl_program_derivatives_reach_P(const sl_program *p);
 
+/* Asserts the invariants of a generated program (every slot, string slot,
+ * jump and table operand inside the program's bounds, END last), once when
+ * the code generator hands it out, so the VM's loop need not check them. */
+void sl_program_assert_valid(const sl_program *p);
+
 /* Source position of instruction pc as "file:line:col". */
 void sl_program_pos_string(const sl_program *self, int pc, char *buf, size_t size);
 

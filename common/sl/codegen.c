@@ -42,6 +42,7 @@
 #include "util/xalloc.h"
 #include "tex/tex.h"
 
+#include <assert.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdatomic.h>
@@ -205,7 +206,9 @@ static int ret_guard(const cg *g, int s)
  * region. */
 static int region_end(cg *g)
 {
+    assert(g->nregions > 0);
     region *r = &g->regions[g->nregions - 1];
+    assert(g->sp >= r->start_sp && g->ssp >= r->start_ssp);
     int count = 0;
     for (int s = 0; s < r->start_sp; s++)
         if ((r->bits[s / 8] >> (s % 8)) & 1)
@@ -1323,5 +1326,8 @@ sl_program *sl_codegen(const sl_ast_file *file, sl_diag *diag)
         sl_program_destroy(&p);
         return NULL;
     }
+    /* every region closed, every inlined call returned */
+    assert(g.nregions == 0 && g.nrets == 0 && g.inline_depth == 0);
+    sl_program_assert_valid(p);
     return p;
 }

@@ -11,6 +11,7 @@
 #include "util/err.h"
 #include "util/xalloc.h"
 
+#include <assert.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -508,6 +509,7 @@ static sl_status run_with_derivatives(sl_vm *self, sl_mode mode)
             self->ad = xcalloc(SL_MAX_SLOTS, sizeof *self->ad);
         for (int s = 0; s < SL_GLOBAL_SLOTS; s++) {
             const aa_form *x = &self->a[s];
+            assert(x->n <= AA_MAX_SYMBOLS);
             memcpy(&self->ad[s].v, x, offsetof(aa_form, c) + (size_t)x->n * sizeof x->c[0]);
             self->ad[s].du = gderiv_of(self, s, 0);
             self->ad[s].dv = gderiv_of(self, s, 1);
@@ -515,6 +517,7 @@ static sl_status run_with_derivatives(sl_vm *self, sl_mode mode)
         st = sl_vm_exec_affine_deriv(self);
         for (int s = 0; s < SL_GLOBAL_SLOTS; s++) {
             const aa_form *x = &self->ad[s].v;
+            assert(x->n <= AA_MAX_SYMBOLS);
             memcpy(&self->a[s], x, offsetof(aa_form, c) + (size_t)x->n * sizeof x->c[0]);
         }
     } else {

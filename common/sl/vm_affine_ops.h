@@ -16,6 +16,7 @@ static inline void VM_OP(v_const, b_const)(sl_vm *vm, A *z, double k) { (void)vm
 static inline void VM_OP(v_mov, b_mov)(sl_vm *vm, A *z, const A *x)
 {
     (void)vm;
+    assert(x->n <= AA_MAX_SYMBOLS);      /* a form's symbol count fits its array */
     if (z != x)
         memcpy(z, x, offsetof(aa_form, c) + (size_t)x->n * sizeof x->c[0]);
 }

@@ -12,6 +12,7 @@
 #ifndef SL_VM_INTERNAL_H
 #define SL_VM_INTERNAL_H
 
+#include <assert.h>
 #include <math.h>
 #include <stdint.h>
 
