@@ -5,7 +5,7 @@
  * a scene is the RIB parser's job (rib_parser.c and the files it names).
  */
 #include "scene/scene.h"
-#include "sl/strbuf.h"
+#include "util/xalloc.h"
 #ifdef SCENE_HAVE_GEOM
 #include "geom/subdiv.h"
 #include "geom/nurbs.h"
@@ -120,7 +120,7 @@ char *scene_find_shader(const scene *self, const char *name,
         const char *dir = self->search_path[i];
         bool here = strcmp(dir, ".") == 0;
         size_t n = strlen(dir) + strlen(name) + 5;
-        char *path = sl_xrealloc(NULL, n);
+        char *path = xmalloc(n);
         if (here)
             snprintf(path, n, "%s.sl", name);
         else

@@ -1,6 +1,6 @@
 /*
- * ast.c: the arena the syntax tree lives in, node construction and the
- * small facts about types (names, slot counts) that every stage shares.
+ * ast.c: node construction and the small facts about types (names, slot
+ * counts) that every stage shares. The tree lives in an sl_arena (arena.c).
  */
 #include "sl/ast.h"
 #include "sl/strbuf.h"
@@ -64,62 +64,6 @@ bool sl_ty_is_triple(sl_ty ty)
 bool sl_ty_is_spatial(sl_ty ty)
 {
     return ty == SL_TYPE_POINT || ty == SL_TYPE_VECTOR || ty == SL_TYPE_NORMAL;
-}
-
-/* ---------------------------------------------------------------------- */
-/* arena: a list of chunks, each allocation zeroed                         */
-/* ---------------------------------------------------------------------- */
-
-typedef struct chunk {
-    struct chunk *next;
-    size_t used, size;
-    max_align_t data[];
-} chunk;
-
-struct sl_arena {
-    chunk *head;
-};
-
-enum { CHUNK_SIZE = 64 * 1024 };
-
-sl_arena *sl_arena_new(void)
-{
-    sl_arena *self = sl_xrealloc(NULL, sizeof *self);
-    self->head = NULL;
-    return self;
-}
-
-void sl_arena_destroy(sl_arena **self_p)
-{
-    if (!*self_p)
-        return;
-    chunk *c = (*self_p)->head;
-    while (c) {
-        chunk *next = c->next;
-        free(c);
-        c = next;
-    }
-    free(*self_p);
-    *self_p = NULL;
-}
-
-void *sl_arena_alloc(sl_arena *self, size_t size)
-{
-    size_t align = sizeof(max_align_t);
-    size = (size + align - 1) / align * align;
-    chunk *c = self->head;
-    if (!c || c->used + size > c->size) {
-        size_t cap = size > CHUNK_SIZE ? size : CHUNK_SIZE;
-        c = sl_xrealloc(NULL, sizeof *c + cap);
-        c->used = 0;
-        c->size = cap;
-        c->next = self->head;
-        self->head = c;
-    }
-    void *p = (char *)c->data + c->used;
-    c->used += size;
-    memset(p, 0, size);
-    return p;
 }
 
 /* ---------------------------------------------------------------------- */

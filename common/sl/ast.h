@@ -22,6 +22,7 @@
 #include <stdbool.h>
 #include <stddef.h>
 
+#include "sl/arena.h"
 #include "sl/diag.h"
 #include "sl/shader.h"
 
@@ -47,13 +48,6 @@ const char *sl_ty_name(sl_ty ty);            /* "float", "point", "bool", "float
 int sl_ty_slots(sl_ty ty);                   /* scalar slots: 1, 3, 16, n * those; 0 */
 bool sl_ty_is_triple(sl_ty ty);              /* point vector normal color */
 bool sl_ty_is_spatial(sl_ty ty);             /* point vector normal */
-
-/* ---- arena ---- */
-
-typedef struct sl_arena sl_arena;
-sl_arena *sl_arena_new(void);
-void sl_arena_destroy(sl_arena **self_p);
-void *sl_arena_alloc(sl_arena *self, size_t size);     /* zeroed */
 
 /* ---- symbols and functions ---- */
 

@@ -8,6 +8,7 @@
 #include "sl/bytecode.h"
 #include "sl/ast.h"
 
+#include <assert.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -109,6 +110,29 @@ static int operand_reach(int op)
     }
 }
 
+void sl_program_assert_valid(const sl_program *p)
+{
+    assert(p->nslots <= SL_MAX_SLOTS && p->nstring_slots <= SL_MAX_STRING_SLOTS);
+    assert(p->const_base + p->nconsts == p->nslots);
+    assert(p->ncode > 0 && p->code[p->ncode - 1].op == SL_OP_END);
+    for (int pc = 0; pc < p->ncode; pc++) {
+        const sl_insn *in = &p->code[pc];
+        assert(in->op < SL_OP__COUNT);
+        const char *k = kinds[in->op];
+        const uint16_t ops[4] = { in->a, in->b, in->c, in->d };
+        for (int i = 0; i < 4; i++) {
+            if (k[i] == 'x' || k[i] == 'z')
+                assert(ops[i] < p->nslots && "a slot operand lies inside the program's slots");
+            else if (k[i] == 's')
+                assert(ops[i] < p->nstring_slots && "a string slot lies inside the program's");
+            else if (k[i] == 'j')
+                assert(ops[i] <= p->ncode && "a jump lands inside the program");
+            else if (k[i] == 't')
+                assert(ops[i] < p->ntables && "a merge table lies inside the program's");
+        }
+    }
+}
+
 bool sl_program_reads_global(const sl_program *p, sl_global g)
 {
     int first = sl_global_slot(g), last = first + sl_global_size(g) - 1;
@@ -134,8 +158,9 @@ bool sl_program_reads_global(const sl_program *p, sl_global g)
     return false;
 }
 
-void sl_program_free(sl_program *p)
+void sl_program_destroy(sl_program **self_p)
 {
+    sl_program *p = *self_p;
     if (!p)
         return;
     free(p->name);
@@ -154,6 +179,7 @@ void sl_program_free(sl_program *p)
         free(p->files[i]);
     free(p->files);
     free(p);
+    *self_p = NULL;
 }
 
 void sl_program_pos_string(const sl_program *self, int pc, char *buf, size_t size)

@@ -166,8 +166,9 @@ enum { SL_ESCAPE_LOOP = 0, SL_ESCAPE_FUNC = 1 };
 /* Strings (RI Spec 3.2 §15.6): SCAT z, a, b concatenates; SFMT z, x, spec,
  * size formats size numbers from slot x with the C conversion spec (checked
  * when compiling: flags, width, precision, one of f e g or lld), a range
- * as "[lo hi]"; SPRINT s prints a line to stderr (float mode only, at most
- * SL_VM_MAX_PRINTS lines per VM); SMATCH z, pattern, subject is match().
+ * as "[lo hi]"; SPRINT s hands a line to the VM's print callback (float
+ * mode only, at most SL_VM_MAX_PRINTS lines per VM); SMATCH z, pattern,
+ * subject is match().
  * Results live in the VM's string space, reset at each run. */
 
 /* illuminance loops (RI Spec 3.2 §15.4): LSTART takes the non-ambient
@@ -266,9 +267,10 @@ const char *sl_global_name(sl_global g);
  * case), range runs need no derivative bounds to bound P. */
 bool sl_program_derivatives_reach_P(const sl_program *p);
 
-/* Frees a program and everything it owns (sl_program_destroy without the
- * pointer reset; used by the code generator on failure). */
-void sl_program_free(sl_program *p);
+/* Asserts the invariants of a generated program (every slot, string slot,
+ * jump and table operand inside the program's bounds, END last), once when
+ * the code generator hands it out, so the VM's loop need not check them. */
+void sl_program_assert_valid(const sl_program *p);
 
 /* Source position of instruction pc as "file:line:col". */
 void sl_program_pos_string(const sl_program *self, int pc, char *buf, size_t size);

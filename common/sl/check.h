@@ -21,12 +21,4 @@ bool sl_check(sl_ast_file *file, sl_arena *arena, sl_diag *diag);
 /* The spaces transform() and the casts know, by name: SL_SPACE_* or -1. */
 int sl_space_find(const char *name);
 
-/* Walks a format string (format, printf): fn gets each conversion's spec
- * ("%5.2f", its length and conversion letter) with the literal text before
- * it, and once more the trailing literal (spec NULL, conv 0); "%%" comes as
- * a literal ending in one '%' (spec NULL, conv '%'). Returns the number of
- * conversions, -1 for a malformed one. */
-int sl_format_walk(const char *fmt, void (*fn)(void *, const char *spec, size_t len, char conv,
-                                              const char *lit, size_t litlen), void *arg);
-
 #endif

@@ -10,6 +10,7 @@
 #include "sl/diag.h"
 #include "sl/strbuf.h"
 #include "sl/source.h"
+#include "util/xalloc.h"
 
 #include <stdint.h>
 #include <stdlib.h>
@@ -79,7 +80,7 @@ static void format_one(sl_strbuf *b, const sl_diagnostic *d)
 
 sl_diag *sl_diag_new(void)
 {
-    sl_diag *self = sl_xrealloc(NULL, sizeof *self);
+    sl_diag *self = xmalloc(sizeof *self);
     memset(self, 0, sizeof *self);
     self->max_errors = SL_DIAG_DEFAULT_MAX_ERRORS;
     return self;
@@ -128,11 +129,11 @@ static void store(sl_diag *self, sl_diag_level level, sl_pos pos, char *message)
 {
     if (self->count == self->cap) {
         self->cap = self->cap ? 2 * self->cap : 16;
-        self->items = sl_xrealloc(self->items, self->cap * sizeof *self->items);
+        self->items = xrealloc(self->items, self->cap * sizeof *self->items);
     }
     sl_diagnostic *d = &self->items[self->count++];
     d->level = level;
-    d->file = pos.file ? sl_xstrndup(pos.file, strlen(pos.file)) : NULL;
+    d->file = pos.file ? xstrndup(pos.file, strlen(pos.file)) : NULL;
     d->line = pos.file ? pos.line : 0;
     d->col = pos.file && pos.line > 0 ? pos.col : 0;
     d->message = message;
@@ -141,7 +142,7 @@ static void store(sl_diag *self, sl_diag_level level, sl_pos pos, char *message)
         size_t len;
         const char *text = sl_source_set_line(self->sources, pos.file, pos.line, &len);
         if (text && len <= SL_DIAG_MAX_LINE)
-            d->source_line = sl_xstrndup(text, len);
+            d->source_line = xstrndup(text, len);
     }
     if (level != SL_DIAG_ERROR)
         self->others_stored++;
@@ -172,7 +173,7 @@ void sl_diag_vreport(sl_diag *self, sl_diag_level level, sl_pos pos,
     va_end(ap2);
     if (n < 0)
         n = 0;
-    char *message = sl_xrealloc(NULL, (size_t)n + 1);
+    char *message = xmalloc((size_t)n + 1);
     vsnprintf(message, (size_t)n + 1, fmt, ap);
     store(self, level, pos, message);
 
@@ -183,7 +184,7 @@ void sl_diag_vreport(sl_diag *self, sl_diag_level level, sl_pos pos,
         snprintf(note, sizeof note,
                  "too many errors emitted, stopping now (limit %d)", self->max_errors);
         sl_pos none = { NULL, 0, 0 };
-        store(self, SL_DIAG_NOTE, none, sl_xstrndup(note, strlen(note)));
+        store(self, SL_DIAG_NOTE, none, xstrndup(note, strlen(note)));
         self->dropped_last = true;   /* notes of the last error go too */
     }
 }

@@ -16,6 +16,7 @@
  */
 #include "sl/lexer.h"
 #include "sl/preproc.h"
+#include "util/xalloc.h"
 
 #include <locale.h>
 #include <math.h>
@@ -468,11 +469,7 @@ struct sl_lexer {
 sl_lexer *sl_lexer_new(sl_source_set *set, const char *main_file,
                        const char *const *search_path, sl_diag *diag)
 {
-    sl_lexer *self = calloc(1, sizeof *self);
-    if (!self) {
-        fputs("sl: out of memory\n", stderr);
-        abort();
-    }
+    sl_lexer *self = xcalloc(1, sizeof *self);
     self->diag = diag;
     self->pp = sl_preproc_new(set, main_file, search_path, diag);
     self->c_locale = newlocale(LC_ALL_MASK, "C", (locale_t)0);

@@ -3,7 +3,7 @@
  *
  * What lives here, top to bottom:
  *
- *   memory        an arena (everything token texts point into lives until
+ *   memory        an sl_arena (everything token texts point into lives until
  *                 sl_preproc_destroy), a string-keyed hash map (macros,
  *                 interned strings, cleaned source texts), token vectors;
  *   hide sets     Prosser's algorithm: each token carries the set of macros
@@ -15,7 +15,8 @@
  *   directives    #define #undef #if #ifdef #ifndef #elif #else #endif
  *                 #include #error #warning #pragma;
  *   #if           `defined`, macro expansion, then an integer expression
- *                 evaluator (long long, wrapping, C precedence);
+ *                 evaluator (long long, wrapping, C precedence): in
+ *                 preproc_expr.c;
  *   expansion     expand_next() pulls a token from an input (the raw input
  *                 with a push-back stack, or a token list for macro
  *                 arguments and #if lines); a macro invocation is replaced
@@ -25,9 +26,14 @@
  * invocation (the outermost one, since a nested invocation token itself
  * carries it) and records the macro in `from`; argument tokens keep their
  * own positions.
+ *
+ * The state and the helpers preproc.c and preproc_expr.c share are
+ * declared in preproc_internal.h.
  */
 #include "sl/preproc.h"
+#include "sl/preproc_internal.h"
 #include "sl/strbuf.h"
+#include "util/xalloc.h"
 
 #include <limits.h>
 #include <stdarg.h>
@@ -40,167 +46,30 @@
 /* memory                                                                  */
 /* ---------------------------------------------------------------------- */
 
-enum { ARENA_BLOCK = 64 * 1024 };
-
-typedef struct arena_block {
-    struct arena_block *next;
-    size_t used, cap;
-    max_align_t data[];
-} arena_block;
-
-typedef struct map_entry {
-    const char *key;          /* NULL: empty slot */
-    size_t len;
-    uint32_t hash;
-    void *value;
-} map_entry;
-
-typedef struct pp_map {
-    map_entry *slots;
-    size_t cap, count;        /* cap is 0 or a power of two */
-} pp_map;
-
-typedef struct tokvec {
-    sl_pptoken *v;
-    size_t n, cap;
-} tokvec;
-
-static void tv_push(tokvec *tv, const sl_pptoken *t)
+void pp_tv_push(tokvec *tv, const sl_pptoken *t)
 {
     if (tv->n == tv->cap) {
         tv->cap = tv->cap ? 2 * tv->cap : 16;
-        tv->v = sl_xrealloc(tv->v, tv->cap * sizeof *tv->v);
+        tv->v = xrealloc(tv->v, tv->cap * sizeof *tv->v);
     }
     tv->v[tv->n++] = *t;
 }
 
-static void tv_free(tokvec *tv)
+void pp_tv_clear(tokvec *tv)
 {
     free(tv->v);
     tv->v = NULL;
     tv->n = tv->cap = 0;
 }
 
-/* ---------------------------------------------------------------------- */
-/* the preprocessor's state                                                */
-/* ---------------------------------------------------------------------- */
-
-struct sl_hideset {
-    const sl_macro *macro;
-    const struct sl_hideset *next;
-};
-typedef struct sl_hideset sl_hideset;
-
-struct sl_macro {
-    const char *name;         /* interned */
-    sl_pos pos;               /* of its name in the #define */
-    bool funclike;
-    int nparams;
-    const char **params;      /* interned parameter names */
-    sl_pptoken *body;
-    int *param;               /* per body token: parameter index or -1 */
-    size_t nbody;
-};
-
-/* A source text with its line splices removed, kept for the preprocessor's
- * lifetime (token texts point into it); one per distinct source. */
-typedef struct pp_text {
-    const sl_source *src;
-    const char *name;         /* interned */
-    char *text;
-    size_t len;
-    size_t *splices;
-    size_t nsplices;
-} pp_text;
-
-typedef struct pp_frame {
-    sl_scanner sc;
-    const pp_text *text;
-    size_t cond_base;         /* its conditionals start here */
-} pp_frame;
-
-typedef struct pp_cond {
-    sl_pos pos;               /* the '#' of the #if / #ifdef / #ifndef */
-    const char *directive;    /* "#if", "#ifdef", "#ifndef" */
-    bool was_active;          /* the enclosing group is active */
-    bool taken;               /* a branch has been chosen */
-    bool active;              /* the current branch is being read */
-    bool seen_else;
-} pp_cond;
-
-/* Where expand_next reads from: a push-back stack in front of either the
- * raw input (raw) or a token list that ends in an EOF at end_pos. */
-typedef struct pp_input {
-    tokvec pb;
-    bool raw;
-    const sl_pptoken *list;
-    size_t n, i;
-    sl_pos end_pos;
-} pp_input;
-
-/* A macro argument: its tokens as written, and fully expanded (lazily). */
-typedef struct pp_arg {
-    const sl_pptoken *raw;
-    size_t nraw;
-    tokvec expanded;
-    bool has_expanded;
-} pp_arg;
-
-enum { PP_MAX_ARG_NESTING = 200 };
-
-struct sl_preproc {
-    sl_source_set *set;
-    sl_diag *diag;
-    char **search_path;       /* NULL-terminated copy */
-
-    pp_frame frames[SL_PP_MAX_INCLUDE_DEPTH + 1];
-    int nframes;
-    pp_cond *conds;
-    size_t nconds, capconds;
-
-    pp_map macros;            /* name -> sl_macro * (NULL once #undef'd) */
-    pp_map interned;          /* string -> itself */
-    pp_map texts;             /* source name -> pp_text * */
-
-    pp_input main;
-    tokvec line;              /* scratch: the tokens of a directive line */
-    sl_pos eol;               /* position of the end of that line */
-
-    arena_block *arena;
-    size_t spent;             /* tokens scanned + produced, for the limit */
-    size_t stored;            /* bytes taken from the arena, for the limit */
-    int arg_nesting;          /* recursion of argument pre-expansion */
-    bool dead;                /* a limit was hit: only EOF from now on */
-    sl_pos eof_pos;
-};
-
-static void *arena_alloc(sl_preproc *pp, size_t size)
-{
-    size_t unit = sizeof(max_align_t);
-    size = (size + unit - 1) / unit * unit;
-    arena_block *b = pp->arena;
-    if (!b || b->cap - b->used < size) {
-        size_t cap = size > ARENA_BLOCK ? size : ARENA_BLOCK;
-        b = sl_xrealloc(NULL, sizeof *b + cap);
-        b->next = pp->arena;
-        b->used = 0;
-        b->cap = cap;
-        pp->arena = b;
-    }
-    void *p = (char *)b->data + b->used;
-    b->used += size;
-    pp->stored += size;
-    return p;
-}
-
 void *sl_preproc_alloc(sl_preproc *self, size_t size)
 {
-    return arena_alloc(self, size);
+    return sl_arena_alloc(self->arena, size);
 }
 
 static char *arena_strndup(sl_preproc *pp, const char *s, size_t len)
 {
-    char *copy = arena_alloc(pp, len + 1);
+    char *copy = sl_arena_alloc(pp->arena, len + 1);
     if (len)
         memcpy(copy, s, len);
     copy[len] = '\0';
@@ -244,7 +113,7 @@ static map_entry *map_put(pp_map *m, const char *key, size_t len)
     if (2 * (m->count + 1) > m->cap) {
         pp_map bigger = { 0 };
         bigger.cap = m->cap ? 2 * m->cap : 64;
-        bigger.slots = sl_xrealloc(NULL, bigger.cap * sizeof *bigger.slots);
+        bigger.slots = xmalloc(bigger.cap * sizeof *bigger.slots);
         memset(bigger.slots, 0, bigger.cap * sizeof *bigger.slots);
         for (size_t i = 0; i < m->cap; i++) {
             map_entry *e = &m->slots[i];
@@ -288,7 +157,7 @@ static sl_pos no_pos(void)
     return pos;
 }
 
-static bool is_word(const sl_pptoken *t, const char *word)
+bool pp_is_word(const sl_pptoken *t, const char *word)
 {
     size_t n = strlen(word);
     return t->kind == SL_TOK_IDENT && t->len == n && memcmp(t->text, word, n) == 0;
@@ -296,7 +165,7 @@ static bool is_word(const sl_pptoken *t, const char *word)
 
 /* The spelling of a token for a message, at most 64 bytes of it; the
  * buffer holds 4 * 64 + 8 bytes. */
-static const char *spell_for_message(const sl_pptoken *t, char *buf)
+const char *pp_spell_for_message(const sl_pptoken *t, char *buf)
 {
     if (t->kind == SL_TOK_EOF || t->kind == SL_TOK_NEWLINE)
         return "end of line";
@@ -320,7 +189,7 @@ static bool spend(sl_preproc *pp, size_t n, sl_pos pos)
     if (pp->dead)
         return false;
     pp->spent += n;
-    if (pp->spent <= SL_PP_MAX_TOKENS && pp->stored <= SL_PP_MAX_BYTES)
+    if (pp->spent <= SL_PP_MAX_TOKENS && sl_arena_bytes(pp->arena) <= SL_PP_MAX_BYTES)
         return true;
     if (pp->spent > SL_PP_MAX_TOKENS)
         sl_diag_error(pp->diag, pos,
@@ -338,7 +207,7 @@ static bool spend(sl_preproc *pp, size_t n, sl_pos pos)
     return false;
 }
 
-static void eof_token(const sl_preproc *pp, sl_pptoken *tok)
+void pp_eof_token(const sl_preproc *pp, sl_pptoken *tok)
 {
     memset(tok, 0, sizeof *tok);
     tok->kind = SL_TOK_EOF;
@@ -372,7 +241,7 @@ static const sl_hideset *hs_add(sl_preproc *pp, const sl_hideset *hs, const sl_m
 {
     if (hs_has(hs, m))
         return hs;
-    sl_hideset *node = arena_alloc(pp, sizeof *node);
+    sl_hideset *node = sl_arena_alloc(pp->arena, sizeof *node);
     node->macro = m;
     node->next = hs;
     spend(pp, 1, pos);
@@ -406,7 +275,7 @@ static const sl_hideset *hs_intersect(sl_preproc *pp, const sl_hideset *a,
 const char *sl_macro_name(const sl_macro *macro) { return macro->name; }
 sl_pos sl_macro_pos(const sl_macro *macro) { return macro->pos; }
 
-static sl_macro *find_macro(sl_preproc *pp, const char *name, size_t len)
+sl_macro *pp_find_macro(sl_preproc *pp, const char *name, size_t len)
 {
     map_entry *e = map_get(&pp->macros, name, len);
     return e ? e->value : NULL;
@@ -443,11 +312,11 @@ static sl_macro *parse_define(sl_preproc *pp, const sl_pptoken *v, size_t n,
         sl_diag_error(pp->diag, v[0].pos, "macro names must be identifiers");
         return NULL;
     }
-    if (is_word(&v[0], "defined")) {
+    if (pp_is_word(&v[0], "defined")) {
         sl_diag_error(pp->diag, v[0].pos, "'defined' cannot be used as a macro name");
         return NULL;
     }
-    sl_macro *m = arena_alloc(pp, sizeof *m);
+    sl_macro *m = sl_arena_alloc(pp->arena, sizeof *m);
     memset(m, 0, sizeof *m);
     m->name = sl_preproc_intern(pp, v[0].text, v[0].len);
     m->pos = v[0].pos;
@@ -456,7 +325,7 @@ static sl_macro *parse_define(sl_preproc *pp, const sl_pptoken *v, size_t n,
     if (i < n && v[i].kind == SL_TOK_LPAREN && !(v[i].flags & SL_PPF_SPACE)) {
         m->funclike = true;
         i++;
-        m->params = arena_alloc(pp, n * sizeof *m->params);
+        m->params = sl_arena_alloc(pp->arena, n * sizeof *m->params);
         if (i < n && v[i].kind == SL_TOK_RPAREN) {
             i++;
         } else {
@@ -495,8 +364,8 @@ static sl_macro *parse_define(sl_preproc *pp, const sl_pptoken *v, size_t n,
     }
 
     m->nbody = n - i;
-    m->body = arena_alloc(pp, m->nbody * sizeof *m->body);
-    m->param = arena_alloc(pp, m->nbody * sizeof *m->param);
+    m->body = sl_arena_alloc(pp->arena, m->nbody * sizeof *m->body);
+    m->param = sl_arena_alloc(pp->arena, m->nbody * sizeof *m->param);
     for (size_t k = 0; k < m->nbody; k++) {
         m->body[k] = v[i + k];
         m->body[k].flags &= ~SL_PPF_BOL;
@@ -539,7 +408,7 @@ bool sl_preproc_define(sl_preproc *self, const char *definition)
 {
     /* "NAME=VALUE" is "#define NAME VALUE", "NAME" is "#define NAME 1" */
     size_t len = strlen(definition);
-    char *text = arena_alloc(self, len + 3);
+    char *text = sl_arena_alloc(self->arena, len + 3);
     memcpy(text, definition, len + 1);
     char *eq = strchr(text, '=');
     if (eq) {
@@ -555,10 +424,10 @@ bool sl_preproc_define(sl_preproc *self, const char *definition)
     sl_pptoken t;
     for (sl_scanner_scan(&sc, &t); t.kind != SL_TOK_EOF && t.kind != SL_TOK_NEWLINE;
          sl_scanner_scan(&sc, &t))
-        tv_push(&v, &t);
+        pp_tv_push(&v, &t);
     sl_pos start = { "<command line>", 1, 1 };
     sl_macro *m = parse_define(self, v.v, v.n, start, t.pos);
-    tv_free(&v);
+    pp_tv_clear(&v);
     if (m)
         install_macro(self, m);
     return m != NULL;
@@ -581,13 +450,13 @@ static const pp_text *text_of(sl_preproc *pp, const sl_source *src)
                            strlen(src->name));
     if (e->value)
         return e->value;
-    pp_text *t = arena_alloc(pp, sizeof *t);
-    size_t *splices = sl_xrealloc(NULL, (src->len / 2 + 1) * sizeof *splices);
+    pp_text *t = sl_arena_alloc(pp->arena, sizeof *t);
+    size_t *splices = xmalloc((src->len / 2 + 1) * sizeof *splices);
     t->src = src;
     t->name = e->key;
-    t->text = arena_alloc(pp, src->len + 1);
+    t->text = sl_arena_alloc(pp->arena, src->len + 1);
     t->len = sl_scanner_clean(src->text, src->len, t->text, splices, &t->nsplices);
-    t->splices = arena_alloc(pp, t->nsplices * sizeof *t->splices);
+    t->splices = sl_arena_alloc(pp->arena, t->nsplices * sizeof *t->splices);
     if (t->nsplices)
         memcpy(t->splices, splices, t->nsplices * sizeof *splices);
     free(splices);
@@ -629,14 +498,14 @@ static void read_raw(sl_preproc *pp, sl_pptoken *tok)
 {
     for (;;) {
         if (pp->dead || pp->nframes == 0 || sl_diag_full(pp->diag)) {
-            eof_token(pp, tok);
+            pp_eof_token(pp, tok);
             return;
         }
         pp_frame *f = &pp->frames[pp->nframes - 1];
         f->sc.quiet = skipping(pp);
         sl_scanner_scan(&f->sc, tok);
         if (!spend(pp, 1, tok->pos)) {
-            eof_token(pp, tok);
+            pp_eof_token(pp, tok);
             return;
         }
         if (tok->kind == SL_TOK_EOF) {
@@ -666,7 +535,7 @@ static void read_line(sl_preproc *pp, sl_scanner *sc)
         }
         if (!spend(pp, 1, t.pos))
             return;
-        tv_push(&pp->line, &t);
+        pp_tv_push(&pp->line, &t);
     }
 }
 
@@ -683,7 +552,7 @@ static void input_get(sl_preproc *pp, pp_input *in, sl_pptoken *tok)
     } else if (in->i < in->n) {
         *tok = in->list[in->i++];
     } else {
-        eof_token(pp, tok);
+        pp_eof_token(pp, tok);
         tok->pos = in->end_pos;
     }
 }
@@ -692,7 +561,7 @@ static void expand_next(sl_preproc *pp, pp_input *in, sl_pptoken *tok);
 
 /* Fully macro-expands a token list on its own (a macro argument, an #if
  * line) into out. */
-static void expand_list(sl_preproc *pp, const sl_pptoken *v, size_t n, sl_pos end, tokvec *out)
+void pp_expand_list(sl_preproc *pp, const sl_pptoken *v, size_t n, sl_pos end, tokvec *out)
 {
     pp_input in = { 0 };
     in.list = v;
@@ -703,9 +572,9 @@ static void expand_list(sl_preproc *pp, const sl_pptoken *v, size_t n, sl_pos en
         expand_next(pp, &in, &t);
         if (t.kind == SL_TOK_EOF)
             break;
-        tv_push(out, &t);
+        pp_tv_push(out, &t);
     }
-    tv_free(&in.pb);
+    pp_tv_clear(&in.pb);
 }
 
 /* What an expansion appends: body tokens take the invocation's position
@@ -731,7 +600,7 @@ static void append_body(pp_subst *s, const sl_pptoken *t)
     copy.from = s->m;
     copy.hs = s->hs;
     copy.flags &= ~SL_PPF_BOL;
-    tv_push(s->out, &copy);
+    pp_tv_push(s->out, &copy);
 }
 
 static void append_arg(pp_subst *s, const sl_pptoken *v, size_t n)
@@ -740,7 +609,7 @@ static void append_arg(pp_subst *s, const sl_pptoken *v, size_t n)
         sl_pptoken copy = v[i];
         copy.hs = hs_union(s->pp, copy.hs, s->hs, s->name->pos);
         copy.flags &= ~SL_PPF_BOL;
-        tv_push(s->out, &copy);
+        pp_tv_push(s->out, &copy);
     }
 }
 
@@ -799,7 +668,7 @@ static size_t append_operand(pp_subst *s, size_t i)
                                   PP_MAX_ARG_NESTING);
                 s->pp->dead = true;
             } else {
-                expand_list(s->pp, a->raw, a->nraw, s->name->pos, &a->expanded);
+                pp_expand_list(s->pp, a->raw, a->nraw, s->name->pos, &a->expanded);
             }
             s->pp->arg_nesting--;
             a->has_expanded = true;
@@ -815,7 +684,7 @@ static bool paste(pp_subst *s, sl_pptoken *lhs, const sl_pptoken *rhs)
 {
     sl_preproc *pp = s->pp;
     size_t len = lhs->len + rhs->len;
-    char *text = arena_alloc(pp, len + 1);
+    char *text = sl_arena_alloc(pp->arena, len + 1);
     memcpy(text, lhs->text, lhs->len);
     memcpy(text + lhs->len, rhs->text, rhs->len);
     text[len] = '\0';
@@ -835,7 +704,7 @@ static bool paste(pp_subst *s, sl_pptoken *lhs, const sl_pptoken *rhs)
         char a[4 * 64 + 8], b[4 * 64 + 8];
         sl_diag_error(pp->diag, s->name->pos,
                       "pasting '%s' and '%s' does not give a valid preprocessing token",
-                      spell_for_message(lhs, a), spell_for_message(rhs, b));
+                      pp_spell_for_message(lhs, a), pp_spell_for_message(rhs, b));
         return false;
     }
     lhs->kind = t.kind;
@@ -872,10 +741,10 @@ static void substitute(sl_preproc *pp, const sl_macro *m, pp_arg *args,
                 k = 1;
         }
         for (; k < rhs.n; k++)
-            tv_push(out, &rhs.v[k]);
+            pp_tv_push(out, &rhs.v[k]);
         if (rhs.n > 0)
             last_empty = false;
-        tv_free(&rhs);
+        pp_tv_clear(&rhs);
     }
 }
 
@@ -885,8 +754,8 @@ static void push_back(sl_preproc *pp, pp_input *in, tokvec *out, const sl_pptoke
 {
     if (spend(pp, 0, name->pos))
         for (size_t k = out->n; k-- > 0;)
-            tv_push(&in->pb, &out->v[k]);
-    tv_free(out);
+            pp_tv_push(&in->pb, &out->v[k]);
+    pp_tv_clear(out);
 }
 
 /* Collects the arguments of an invocation of m (the '(' has been read)
@@ -895,7 +764,7 @@ static void expand_call(sl_preproc *pp, pp_input *in, const sl_macro *m,
                         const sl_pptoken *name)
 {
     tokvec toks = { 0 };
-    size_t *starts = sl_xrealloc(NULL, 8 * sizeof *starts);
+    size_t *starts = xmalloc(8 * sizeof *starts);
     size_t nargs = 1, cap = 8;
     starts[0] = 0;
     int depth = 0;
@@ -906,7 +775,7 @@ static void expand_call(sl_preproc *pp, pp_input *in, const sl_macro *m,
             if (!pp->dead)
                 sl_diag_error(pp->diag, name->pos,
                               "unterminated argument list invoking macro '%s'", m->name);
-            tv_push(&in->pb, &t);          /* the caller sees the end too */
+            pp_tv_push(&in->pb, &t);          /* the caller sees the end too */
             goto done;
         }
         if (t.kind == SL_TOK_LPAREN) {
@@ -918,12 +787,12 @@ static void expand_call(sl_preproc *pp, pp_input *in, const sl_macro *m,
         } else if (t.kind == SL_TOK_COMMA && depth == 0) {
             if (nargs == cap) {
                 cap *= 2;
-                starts = sl_xrealloc(starts, cap * sizeof *starts);
+                starts = xrealloc(starts, cap * sizeof *starts);
             }
             starts[nargs++] = toks.n;
             continue;
         }
-        tv_push(&toks, &t);
+        pp_tv_push(&toks, &t);
     }
 
     if (m->nparams == 0 && nargs == 1 && toks.n == 0)
@@ -941,7 +810,7 @@ static void expand_call(sl_preproc *pp, pp_input *in, const sl_macro *m,
         goto done;
     }
 
-    pp_arg *args = sl_xrealloc(NULL, (nargs ? nargs : 1) * sizeof *args);
+    pp_arg *args = xmalloc((nargs ? nargs : 1) * sizeof *args);
     for (size_t a = 0; a < nargs; a++) {
         size_t end = a + 1 < nargs ? starts[a + 1] : toks.n;
         args[a].raw = toks.v ? toks.v + starts[a] : NULL;
@@ -955,10 +824,10 @@ static void expand_call(sl_preproc *pp, pp_input *in, const sl_macro *m,
     substitute(pp, m, args, hs, name, &out);
     push_back(pp, in, &out, name);
     for (size_t a = 0; a < nargs; a++)
-        tv_free(&args[a].expanded);
+        pp_tv_clear(&args[a].expanded);
     free(args);
 done:
-    tv_free(&toks);
+    pp_tv_clear(&toks);
     free(starts);
 }
 
@@ -968,20 +837,20 @@ static void expand_next(sl_preproc *pp, pp_input *in, sl_pptoken *tok)
 {
     for (;;) {
         if (pp->dead || sl_diag_full(pp->diag)) {
-            eof_token(pp, tok);
+            pp_eof_token(pp, tok);
             return;
         }
         input_get(pp, in, tok);
         if (tok->kind != SL_TOK_IDENT)
             return;
-        const sl_macro *m = find_macro(pp, tok->text, tok->len);
+        const sl_macro *m = pp_find_macro(pp, tok->text, tok->len);
         if (!m || hs_has(tok->hs, m))
             return;
         if (m->funclike) {
             sl_pptoken next;
             input_get(pp, in, &next);
             if (next.kind != SL_TOK_LPAREN) {
-                tv_push(&in->pb, &next);   /* a name, not an invocation */
+                pp_tv_push(&in->pb, &next);   /* a name, not an invocation */
                 return;
             }
             sl_pptoken name = *tok;
@@ -996,283 +865,6 @@ static void expand_next(sl_preproc *pp, pp_input *in, sl_pptoken *tok)
 }
 
 /* ---------------------------------------------------------------------- */
-/* #if expressions                                                         */
-/* ---------------------------------------------------------------------- */
-
-typedef struct pp_expr {
-    sl_preproc *pp;
-    const sl_pptoken *t;      /* the expanded line, ending in an EOF token */
-    size_t i;
-    int depth;
-    bool failed;              /* an error was reported: stop reporting */
-} pp_expr;
-
-static void ex_error(pp_expr *e, sl_pos pos, const char *fmt, ...) SL_PRINTF(3, 4);
-static void ex_error(pp_expr *e, sl_pos pos, const char *fmt, ...)
-{
-    if (e->failed)
-        return;
-    e->failed = true;
-    va_list ap;
-    va_start(ap, fmt);
-    sl_diag_vreport(e->pp->diag, SL_DIAG_ERROR, pos, fmt, ap);
-    va_end(ap);
-}
-
-static const sl_pptoken *ex_peek(const pp_expr *e) { return &e->t[e->i]; }
-
-static const sl_pptoken *ex_take(pp_expr *e)
-{
-    const sl_pptoken *t = &e->t[e->i];
-    if (t->kind != SL_TOK_EOF)
-        e->i++;
-    return t;
-}
-
-static long long ex_cond(pp_expr *e, bool eval);
-
-static long long ex_number(pp_expr *e, const sl_pptoken *t)
-{
-    char buf[4 * 64 + 8];
-    sl_token_kind kind = sl_number_kind(t->text, t->len);
-    if (kind == SL_TOK_FLOAT) {
-        ex_error(e, t->pos, "floating constant in preprocessor expression");
-        return 0;
-    }
-    if (kind != SL_TOK_INT) {
-        ex_error(e, t->pos, "malformed number '%s'", spell_for_message(t, buf));
-        return 0;
-    }
-    unsigned long long v = 0;
-    for (size_t i = 0; i < t->len; i++) {
-        unsigned d = (unsigned)(t->text[i] - '0');
-        if (v > ((unsigned long long)LLONG_MAX - d) / 10) {
-            ex_error(e, t->pos, "integer constant is too large");
-            return 0;
-        }
-        v = v * 10 + d;
-    }
-    return (long long)v;
-}
-
-static long long ex_unary(pp_expr *e, bool eval)
-{
-    char buf[4 * 64 + 8];
-    if (++e->depth > SL_PP_MAX_EXPR_DEPTH) {
-        ex_error(e, ex_peek(e)->pos, "#if expression nested too deeply");
-        e->depth--;
-        return 0;
-    }
-    const sl_pptoken *t = ex_take(e);
-    long long v = 0;
-    switch (t->kind) {
-    case SL_TOK_LPAREN:
-        v = ex_cond(e, eval);
-        if (ex_peek(e)->kind == SL_TOK_RPAREN)
-            ex_take(e);
-        else
-            ex_error(e, ex_peek(e)->pos, "missing ')' in expression");
-        break;
-    case SL_TOK_PLUS:  v = ex_unary(e, eval); break;
-    case SL_TOK_MINUS: v = (long long)(0ull - (unsigned long long)ex_unary(e, eval)); break;
-    case SL_TOK_NOT:   v = !ex_unary(e, eval); break;
-    case SL_TOK_TILDE: v = ~ex_unary(e, eval); break;
-    case SL_TOK_PPNUMBER: v = ex_number(e, t); break;
-    case SL_TOK_IDENT: v = 0; break;       /* not a macro: 0 */
-    case SL_TOK_EOF:
-        ex_error(e, t->pos, "expected value in expression");
-        break;
-    case SL_TOK_STRING:
-    case SL_TOK_OTHER:
-    case SL_TOK_HASH:
-    case SL_TOK_HASHHASH:
-        ex_error(e, t->pos, "token '%s' is not valid in preprocessor expressions",
-                 spell_for_message(t, buf));
-        break;
-    default:
-        ex_error(e, t->pos, "expected value in expression before '%s'",
-                 spell_for_message(t, buf));
-        break;
-    }
-    e->depth--;
-    return v;
-}
-
-static int ex_precedence(sl_token_kind kind)
-{
-    switch (kind) {
-    case SL_TOK_OR:      return 1;
-    case SL_TOK_AND:     return 2;
-    case SL_TOK_PIPE:    return 3;
-    case SL_TOK_CARET:   return 4;
-    case SL_TOK_AMP:     return 5;
-    case SL_TOK_EQ: case SL_TOK_NE: return 6;
-    case SL_TOK_LT: case SL_TOK_GT: case SL_TOK_LE: case SL_TOK_GE: return 7;
-    case SL_TOK_SHL: case SL_TOK_SHR: return 8;
-    case SL_TOK_PLUS: case SL_TOK_MINUS: return 9;
-    case SL_TOK_STAR: case SL_TOK_SLASH: case SL_TOK_PERCENT: return 10;
-    default:             return 0;
-    }
-}
-
-/* a op b with C semantics on long long, wrapping instead of overflowing. */
-static long long ex_apply(pp_expr *e, const sl_pptoken *op, long long a, long long b, bool eval)
-{
-    typedef unsigned long long ull;
-    switch (op->kind) {
-    case SL_TOK_OR:    return a || b;
-    case SL_TOK_AND:   return a && b;
-    case SL_TOK_PIPE:  return a | b;
-    case SL_TOK_CARET: return a ^ b;
-    case SL_TOK_AMP:   return a & b;
-    case SL_TOK_EQ:    return a == b;
-    case SL_TOK_NE:    return a != b;
-    case SL_TOK_LT:    return a < b;
-    case SL_TOK_GT:    return a > b;
-    case SL_TOK_LE:    return a <= b;
-    case SL_TOK_GE:    return a >= b;
-    case SL_TOK_SHL:   return b < 0 || b > 63 ? 0 : (long long)((ull)a << b);
-    case SL_TOK_SHR:
-        if (b < 0 || b > 63)
-            return a < 0 ? -1 : 0;
-        return a < 0 ? ~(~a >> b) : a >> b;
-    case SL_TOK_PLUS:  return (long long)((ull)a + (ull)b);
-    case SL_TOK_MINUS: return (long long)((ull)a - (ull)b);
-    case SL_TOK_STAR:  return (long long)((ull)a * (ull)b);
-    case SL_TOK_SLASH:
-    case SL_TOK_PERCENT:
-        if (b == 0) {
-            if (eval)
-                ex_error(e, op->pos, "division by zero in #if");
-            return 0;
-        }
-        if (a == LLONG_MIN && b == -1)
-            return op->kind == SL_TOK_SLASH ? LLONG_MIN : 0;
-        return op->kind == SL_TOK_SLASH ? a / b : a % b;
-    default:
-        return 0;
-    }
-}
-
-static long long ex_binary(pp_expr *e, int min_prec, bool eval)
-{
-    long long lhs = ex_unary(e, eval);
-    for (;;) {
-        const sl_pptoken *op = ex_peek(e);
-        int prec = ex_precedence(op->kind);
-        if (prec == 0 || prec < min_prec || e->failed)
-            return lhs;
-        ex_take(e);
-        bool eval_rhs = eval;
-        if (op->kind == SL_TOK_AND)
-            eval_rhs = eval && lhs != 0;
-        else if (op->kind == SL_TOK_OR)
-            eval_rhs = eval && lhs == 0;
-        long long rhs = ex_binary(e, prec + 1, eval_rhs);
-        lhs = ex_apply(e, op, lhs, rhs, eval);
-    }
-}
-
-static long long ex_cond(pp_expr *e, bool eval)
-{
-    if (++e->depth > SL_PP_MAX_EXPR_DEPTH) {
-        ex_error(e, ex_peek(e)->pos, "#if expression nested too deeply");
-        e->depth--;
-        return 0;
-    }
-    long long c = ex_binary(e, 1, eval);
-    if (ex_peek(e)->kind == SL_TOK_QUESTION && !e->failed) {
-        ex_take(e);
-        long long a = ex_cond(e, eval && c);
-        if (ex_peek(e)->kind != SL_TOK_COLON) {
-            ex_error(e, ex_peek(e)->pos, "'?' without following ':'");
-            e->depth--;
-            return 0;
-        }
-        ex_take(e);
-        long long b = ex_cond(e, eval && !c);
-        c = c ? a : b;
-    }
-    e->depth--;
-    return c;
-}
-
-/* Evaluates the #if / #elif line in pp->line. */
-static bool eval_if(sl_preproc *pp, const sl_pptoken *name)
-{
-    const sl_pptoken *v = pp->line.v;
-    size_t n = pp->line.n;
-    if (n == 0) {
-        sl_diag_error(pp->diag, name->pos, "'#%.*s' with no expression",
-                      (int)name->len, name->text);
-        return false;
-    }
-    /* defined X, defined(X) -> 1 or 0, before any expansion */
-    tokvec pre = { 0 };
-    bool ok = true;
-    for (size_t i = 0; i < n && ok; i++) {
-        if (!is_word(&v[i], "defined")) {
-            tv_push(&pre, &v[i]);
-            continue;
-        }
-        size_t j = i + 1;
-        bool paren = j < n && v[j].kind == SL_TOK_LPAREN;
-        if (paren)
-            j++;
-        if (j >= n || v[j].kind != SL_TOK_IDENT) {
-            sl_diag_error(pp->diag, j < n ? v[j].pos : pp->eol,
-                          "operator 'defined' requires an identifier");
-            ok = false;
-            break;
-        }
-        bool defined = find_macro(pp, v[j].text, v[j].len) != NULL;
-        j++;
-        if (paren) {
-            if (j >= n || v[j].kind != SL_TOK_RPAREN) {
-                sl_diag_error(pp->diag, j < n ? v[j].pos : pp->eol,
-                              "missing ')' after 'defined'");
-                ok = false;
-                break;
-            }
-            j++;
-        }
-        sl_pptoken num = v[i];
-        num.kind = SL_TOK_PPNUMBER;
-        num.text = defined ? "1" : "0";
-        num.len = 1;
-        tv_push(&pre, &num);
-        i = j - 1;
-    }
-    long long value = 0;
-    if (ok) {
-        tokvec expanded = { 0 };
-        expand_list(pp, pre.v, pre.n, pp->eol, &expanded);
-        sl_pptoken end;
-        eof_token(pp, &end);
-        end.pos = pp->eol;
-        tv_push(&expanded, &end);
-
-        pp_expr e = { pp, expanded.v, 0, 0, false };
-        if (expanded.n == 1) {
-            ex_error(&e, name->pos, "'#%.*s' with no expression", (int)name->len, name->text);
-        } else {
-            value = ex_cond(&e, true);
-            const sl_pptoken *rest = ex_peek(&e);
-            char buf[4 * 64 + 8];
-            if (rest->kind == SL_TOK_RPAREN)
-                ex_error(&e, rest->pos, "missing '(' in expression");
-            else if (rest->kind != SL_TOK_EOF)
-                ex_error(&e, rest->pos, "missing binary operator before token '%s'",
-                         spell_for_message(rest, buf));
-        }
-        ok = !e.failed;
-        tv_free(&expanded);
-    }
-    tv_free(&pre);
-    return ok && value != 0;
-}
-
-/* ---------------------------------------------------------------------- */
 /* directives                                                              */
 /* ---------------------------------------------------------------------- */
 
@@ -1280,7 +872,7 @@ static void push_cond(sl_preproc *pp, const sl_pptoken *hash, const char *direct
 {
     if (pp->nconds == pp->capconds) {
         pp->capconds = pp->capconds ? 2 * pp->capconds : 16;
-        pp->conds = sl_xrealloc(pp->conds, pp->capconds * sizeof *pp->conds);
+        pp->conds = xrealloc(pp->conds, pp->capconds * sizeof *pp->conds);
     }
     bool parent = !skipping(pp);
     pp_cond c = { hash->pos, directive, parent, parent && value, parent && value, false };
@@ -1314,7 +906,7 @@ static bool ifdef_name(sl_preproc *pp, const sl_pptoken *name, const char *direc
         sl_diag_error(pp->diag, id->pos, "macro names must be identifiers");
         return false;
     }
-    *defined = find_macro(pp, id->text, id->len) != NULL;
+    *defined = pp_find_macro(pp, id->text, id->len) != NULL;
     if (pp->line.n > 1)
         sl_diag_warning(pp->diag, pp->line.v[1].pos,
                         "extra tokens at end of '%s' directive", directive);
@@ -1347,7 +939,7 @@ static void do_elif(sl_preproc *pp, const sl_pptoken *hash, const sl_pptoken *na
         c->active = false;
         return;
     }
-    c->active = eval_if(pp, name);
+    c->active = pp_eval_if(pp, name);
     c->taken = c->active;
 }
 
@@ -1400,7 +992,7 @@ static void do_undef(sl_preproc *pp, const sl_pptoken *name)
         sl_diag_error(pp->diag, id->pos, "macro names must be identifiers");
         return;
     }
-    if (is_word(id, "defined")) {
+    if (pp_is_word(id, "defined")) {
         sl_diag_error(pp->diag, id->pos, "'defined' cannot be used as a macro name");
         return;
     }
@@ -1458,7 +1050,7 @@ static void do_include(sl_preproc *pp)
         sl_diag_error(pp->diag, file.pos, "empty filename in '#include'");
         return;
     }
-    char *name = sl_xrealloc(NULL, file.len - 1);
+    char *name = xmalloc(file.len - 1);
     memcpy(name, file.text + 1, file.len - 2);
     name[file.len - 2] = '\0';
 
@@ -1507,41 +1099,41 @@ static void directive(sl_preproc *pp, const sl_pptoken *hash)
         f->sc.directive = false;           /* the null directive */
         return;
     }
-    if (!skip && is_word(&name, "include")) {
+    if (!skip && pp_is_word(&name, "include")) {
         do_include(pp);
         return;
     }
     read_line(pp, &f->sc);
     f->sc.directive = false;
 
-    if (is_word(&name, "if")) {
-        push_cond(pp, hash, "#if", !skip && eval_if(pp, &name));
-    } else if (is_word(&name, "ifdef")) {
+    if (pp_is_word(&name, "if")) {
+        push_cond(pp, hash, "#if", !skip && pp_eval_if(pp, &name));
+    } else if (pp_is_word(&name, "ifdef")) {
         do_ifdef(pp, hash, &name, false);
-    } else if (is_word(&name, "ifndef")) {
+    } else if (pp_is_word(&name, "ifndef")) {
         do_ifdef(pp, hash, &name, true);
-    } else if (is_word(&name, "elif")) {
+    } else if (pp_is_word(&name, "elif")) {
         do_elif(pp, hash, &name);
-    } else if (is_word(&name, "else")) {
+    } else if (pp_is_word(&name, "else")) {
         do_else(pp, hash);
-    } else if (is_word(&name, "endif")) {
+    } else if (pp_is_word(&name, "endif")) {
         do_endif(pp, hash);
     } else if (skip) {
         return;                            /* anything goes in a skipped group */
-    } else if (is_word(&name, "define")) {
+    } else if (pp_is_word(&name, "define")) {
         do_define(pp, &name);
-    } else if (is_word(&name, "undef")) {
+    } else if (pp_is_word(&name, "undef")) {
         do_undef(pp, &name);
-    } else if (is_word(&name, "error")) {
+    } else if (pp_is_word(&name, "error")) {
         do_message(pp, hash, SL_DIAG_ERROR);
-    } else if (is_word(&name, "warning")) {
+    } else if (pp_is_word(&name, "warning")) {
         do_message(pp, hash, SL_DIAG_WARNING);
-    } else if (is_word(&name, "pragma")) {
+    } else if (pp_is_word(&name, "pragma")) {
         /* pragmas are accepted and ignored */
     } else {
         char buf[4 * 64 + 8];
         sl_diag_error(pp->diag, name.pos, "invalid preprocessing directive '#%s'",
-                      spell_for_message(&name, buf));
+                      pp_spell_for_message(&name, buf));
     }
 }
 
@@ -1552,19 +1144,20 @@ static void directive(sl_preproc *pp, const sl_pptoken *hash)
 sl_preproc *sl_preproc_new(sl_source_set *set, const char *main_file,
                            const char *const *search_path, sl_diag *diag)
 {
-    sl_preproc *self = sl_xrealloc(NULL, sizeof *self);
+    sl_preproc *self = xmalloc(sizeof *self);
     memset(self, 0, sizeof *self);
     self->set = set;
     self->diag = diag;
+    self->arena = sl_arena_new();
     sl_diag_set_sources(diag, set);
 
     size_t n = 0;
     while (search_path && search_path[n])
         n++;
-    self->search_path = sl_xrealloc(NULL, (n + 1) * sizeof *self->search_path);
+    self->search_path = xmalloc((n + 1) * sizeof *self->search_path);
     for (size_t i = 0; i < n; i++) {
         size_t len = strlen(search_path[i]);
-        self->search_path[i] = sl_xrealloc(NULL, len + 1);
+        self->search_path[i] = xmalloc(len + 1);
         memcpy(self->search_path[i], search_path[i], len + 1);
     }
     self->search_path[n] = NULL;
@@ -1595,13 +1188,9 @@ void sl_preproc_destroy(sl_preproc **self_p)
     free(self->macros.slots);
     free(self->interned.slots);
     free(self->texts.slots);
-    tv_free(&self->main.pb);
-    tv_free(&self->line);
-    while (self->arena) {
-        arena_block *next = self->arena->next;
-        free(self->arena);
-        self->arena = next;
-    }
+    pp_tv_clear(&self->main.pb);
+    pp_tv_clear(&self->line);
+    sl_arena_destroy(&self->arena);
     free(self);
     *self_p = NULL;
 }
@@ -1613,7 +1202,7 @@ bool sl_preproc_next(sl_preproc *self, sl_pptoken *tok)
         if (tok->kind != SL_TOK_EOF)
             return true;
         if (!(tok->flags & SL_PPF_INCLUDE_END)) {
-            eof_token(self, tok);
+            pp_eof_token(self, tok);
             return false;
         }
     }

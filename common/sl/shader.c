@@ -9,8 +9,9 @@
 #include "sl/codegen.h"
 #include "sl/lexer.h"
 #include "sl/parser.h"
-#include "sl/strbuf.h"
+#include "util/xalloc.h"
 #include "sl/vm_internal.h"
+#include "util/err.h"
 
 #include <stdarg.h>
 #include <stdlib.h>
@@ -29,18 +30,12 @@ sl_program *sl_compile(sl_source_set *set, const char *main_file,
     sl_arena_destroy(&arena);
     sl_lexer_destroy(&lx);
     if (sl_diag_error_count(diag) != errors) {
-        sl_program_free(program);
+        sl_program_destroy(&program);
         return NULL;
     }
     if (program)
         program->takes_derivatives = sl_program_derivatives_reach_P(program);
     return program;
-}
-
-void sl_program_destroy(sl_program **self_p)
-{
-    sl_program_free(*self_p);
-    *self_p = NULL;
 }
 
 const char *sl_program_name(const sl_program *self) { return self->name; }
@@ -73,10 +68,10 @@ int sl_program_find_param(const sl_program *self, const char *name)
 
 sl_instance *sl_instance_new(const sl_program *program)
 {
-    sl_instance *self = sl_xrealloc(NULL, sizeof *self);
+    sl_instance *self = xmalloc(sizeof *self);
     self->program = program;
     size_t n = (size_t)program->nparams + 1;
-    self->values = sl_xrealloc(NULL, n * sizeof *self->values);
+    self->values = xmalloc(n * sizeof *self->values);
     memset(self->values, 0, n * sizeof *self->values);
     return self;
 }
@@ -95,18 +90,6 @@ void sl_instance_destroy(sl_instance **self_p)
 
 const sl_program *sl_instance_program(const sl_instance *self) { return self->program; }
 
-static bool why_fail(char *why, int why_size, const char *fmt, ...) SL_PRINTF(3, 4);
-static bool why_fail(char *why, int why_size, const char *fmt, ...)
-{
-    if (why && why_size > 0) {
-        va_list ap;
-        va_start(ap, fmt);
-        vsnprintf(why, (size_t)why_size, fmt, ap);
-        va_end(ap);
-    }
-    return false;
-}
-
 static bool types_match(sl_type param, sl_type given)
 {
     if (param == given)
@@ -117,29 +100,29 @@ static bool types_match(sl_type param, sl_type given)
 }
 
 bool sl_instance_set(sl_instance *self, const char *name, sl_type type,
-                     const double *values, int count, char *why, int why_size)
+                     const double *values, int count, char *err, size_t errsz)
 {
     const sl_program *p = self->program;
     int i = sl_program_find_param(p, name);
     if (i < 0)
-        return why_fail(why, why_size, "shader '%s' has no parameter '%s'", p->name, name);
+        return err_set(err, errsz, "shader '%s' has no parameter '%s'", p->name, name);
     const sl_param *pp = &p->params[i];
     if (pp->type == SL_TYPE_STRING)
-        return why_fail(why, why_size, "parameter '%s' of shader '%s' is a string", name,
+        return err_set(err, errsz, "parameter '%s' of shader '%s' is a string", name,
                         p->name);
     if (!types_match(pp->type, type))
-        return why_fail(why, why_size, "parameter '%s' of shader '%s' is a %s, not a %s",
+        return err_set(err, errsz, "parameter '%s' of shader '%s' is a %s, not a %s",
                         name, p->name, sl_ty_name(pp->type), sl_ty_name(type));
     if (pp->size > 16)       /* the instance holds 16 values per parameter */
-        return why_fail(why, why_size, "parameter '%s' of shader '%s' is an array of more "
+        return err_set(err, errsz, "parameter '%s' of shader '%s' is an array of more "
                         "than 16 values, which cannot be set from the scene yet", name,
                         p->name);
     if (count != pp->size)
-        return why_fail(why, why_size, "parameter '%s' of shader '%s' takes %d value%s, "
+        return err_set(err, errsz, "parameter '%s' of shader '%s' takes %d value%s, "
                         "got %d", name, p->name, pp->size, pp->size == 1 ? "" : "s", count);
     for (int k = 0; k < count; k++)
         if (!isfinite(values[k]))
-            return why_fail(why, why_size, "parameter '%s' of shader '%s': value %d is not "
+            return err_set(err, errsz, "parameter '%s' of shader '%s': value %d is not "
                             "a finite number", name, p->name, k + 1);
     memcpy(self->values[i].v, values, (size_t)count * sizeof *values);
     self->values[i].set = true;
@@ -147,17 +130,17 @@ bool sl_instance_set(sl_instance *self, const char *name, sl_type type,
 }
 
 bool sl_instance_set_string(sl_instance *self, const char *name, const char *value,
-                            char *why, int why_size)
+                            char *err, size_t errsz)
 {
     const sl_program *p = self->program;
     int i = sl_program_find_param(p, name);
     if (i < 0)
-        return why_fail(why, why_size, "shader '%s' has no parameter '%s'", p->name, name);
+        return err_set(err, errsz, "shader '%s' has no parameter '%s'", p->name, name);
     if (p->params[i].type != SL_TYPE_STRING)
-        return why_fail(why, why_size, "parameter '%s' of shader '%s' is a %s, not a string",
+        return err_set(err, errsz, "parameter '%s' of shader '%s' is a %s, not a string",
                         name, p->name, sl_ty_name(p->params[i].type));
     free(self->values[i].s);
-    self->values[i].s = sl_xstrndup(value, strlen(value));
+    self->values[i].s = xstrndup(value, strlen(value));
     self->values[i].set = true;
     return true;
 }

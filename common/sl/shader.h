@@ -113,11 +113,11 @@ const sl_program *sl_instance_program(const sl_instance *self);
 /* Sets parameter `name` from RIB values: `type` is what the RIB declared
  * (float: 1 value, point/vector/normal/color: 3, matrix: 16, string: use
  * sl_instance_set_string). On a mismatch (unknown name, wrong type or
- * count) returns false with a one-line reason in why. */
+ * count) returns false with a one-line reason in err. */
 bool sl_instance_set(sl_instance *self, const char *name, sl_type type,
-                     const double *values, int count, char *why, int why_size);
+                     const double *values, int count, char *err, size_t errsz);
 bool sl_instance_set_string(sl_instance *self, const char *name,
-                            const char *value, char *why, int why_size);
+                            const char *value, char *err, size_t errsz);
 
 /* ---- the virtual machine ------------------------------------------------ */
 
@@ -175,6 +175,12 @@ void sl_vm_set_lights(sl_vm *self, sl_light_fn fn, void *user);
  * a runtime error). */
 struct tex_cache;
 void sl_vm_set_textures(sl_vm *self, struct tex_cache *textures);
+/* Where the shader's printf lines go: fn(ctx, text) once per line (float
+ * mode only, at most 100 lines per VM, then one note that the rest are not
+ * shown). With none installed (the default) they are dropped: the library
+ * never prints; a program that wants them in its log installs one. */
+typedef void (*sl_print_fn)(void *ctx, const char *text);
+void sl_vm_set_print(sl_vm *self, sl_print_fn fn, void *ctx);
 /* The texture names a program's lookups use that are known when it is
  * bound: string constants and the instance's string parameter values
  * (default or set) that reach a texture operation directly. Up to max

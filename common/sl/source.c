@@ -7,7 +7,7 @@
  * valid until the set is destroyed (entries are never moved or replaced).
  */
 #include "sl/source.h"
-#include "sl/strbuf.h"
+#include "util/xalloc.h"
 
 #include <errno.h>
 #include <stdio.h>
@@ -31,7 +31,7 @@ char *sl_source_normalize(const char *name)
     size_t n = strlen(name);
     bool absolute = n > 0 && name[0] == '/';
     /* the result is never longer than the input, except "." and "/" */
-    char *out = sl_xrealloc(NULL, n + 2);
+    char *out = xmalloc(n + 2);
     size_t len = 0;
     size_t depth = 0;     /* components in out that a ".." may cancel */
     if (absolute)
@@ -80,7 +80,7 @@ static char *dir_of(const char *name)
     size_t len = slash ? (size_t)(slash - name) : 0;
     if (slash == name)
         len = 1;                           /* "/x" lives in "/" */
-    char *dir = sl_xrealloc(NULL, len + 1);
+    char *dir = xmalloc(len + 1);
     memcpy(dir, name, len);
     dir[len] = '\0';
     return dir;
@@ -90,7 +90,7 @@ static char *dir_of(const char *name)
 static char *join(const char *dir, const char *name)
 {
     size_t dl = strlen(dir), nl = strlen(name);
-    char *tmp = sl_xrealloc(NULL, dl + nl + 2);
+    char *tmp = xmalloc(dl + nl + 2);
     memcpy(tmp, dir, dl);
     tmp[dl] = '/';
     memcpy(tmp + dl + 1, name, nl + 1);
@@ -105,7 +105,7 @@ static char *join(const char *dir, const char *name)
 
 sl_source_set *sl_source_set_new(void)
 {
-    sl_source_set *self = sl_xrealloc(NULL, sizeof *self);
+    sl_source_set *self = xmalloc(sizeof *self);
     memset(self, 0, sizeof *self);
     self->max_size = SL_SOURCE_DEFAULT_MAX_SIZE;
     return self;
@@ -168,8 +168,8 @@ int sl_source_set_add(sl_source_set *self, const char *name, const char *text, s
         errno = EEXIST;
         return -1;
     }
-    sl_source *src = sl_xrealloc(NULL, sizeof *src);
-    char *copy = sl_xrealloc(NULL, len + 1);
+    sl_source *src = xmalloc(sizeof *src);
+    char *copy = xmalloc(len + 1);
     if (len)
         memcpy(copy, text, len);
     copy[len] = '\0';
@@ -178,7 +178,7 @@ int sl_source_set_add(sl_source_set *self, const char *name, const char *text, s
     src->len = len;
     if (self->count == self->cap) {
         self->cap = self->cap ? 2 * self->cap : 8;
-        self->items = sl_xrealloc(self->items, self->cap * sizeof *self->items);
+        self->items = xrealloc(self->items, self->cap * sizeof *self->items);
     }
     self->items[self->count++] = src;
     return 0;
@@ -237,11 +237,11 @@ static int read_file(const char *path, size_t max, char **text, size_t *len,
         return -1;
     }
     size_t cap = 4096, n = 0;
-    char *buf = sl_xrealloc(NULL, cap);
+    char *buf = xmalloc(cap);
     for (;;) {
         if (n == cap) {
             cap *= 2;
-            buf = sl_xrealloc(buf, cap);
+            buf = xrealloc(buf, cap);
         }
         size_t got = fread(buf + n, 1, cap - n, f);
         n += got;
@@ -340,7 +340,7 @@ static void list_add(char **list, size_t *len, const char *dir)
 {
     const char *shown = *dir ? dir : ".";
     size_t add = strlen(shown) + (*len ? 2 : 0);
-    *list = sl_xrealloc(*list, *len + add + 1);
+    *list = xrealloc(*list, *len + add + 1);
     if (*len) {
         memcpy(*list + *len, ", ", 2);
         *len += 2;

@@ -1,30 +1,11 @@
 /*
- * strbuf.c: the never-failing allocator and the growing string buffer of
- * strbuf.h.
+ * strbuf.c: the growing string buffer of strbuf.h.
  */
 #include "sl/strbuf.h"
 
-#include <stdio.h>
-#include <stdlib.h>
+#include "util/xalloc.h"
+
 #include <string.h>
-
-void *sl_xrealloc(void *p, size_t size)
-{
-    void *q = realloc(p, size ? size : 1);
-    if (!q) {
-        fputs("sl: out of memory\n", stderr);
-        abort();
-    }
-    return q;
-}
-
-char *sl_xstrndup(const char *s, size_t len)
-{
-    char *copy = sl_xrealloc(NULL, len + 1);
-    memcpy(copy, s, len);
-    copy[len] = '\0';
-    return copy;
-}
 
 void sl_strbuf_put(sl_strbuf *b, const char *s, size_t n)
 {
@@ -32,7 +13,7 @@ void sl_strbuf_put(sl_strbuf *b, const char *s, size_t n)
         size_t cap = b->cap ? b->cap : 64;
         while (cap < b->len + n + 1)
             cap *= 2;
-        b->data = sl_xrealloc(b->data, cap);
+        b->data = xrealloc(b->data, cap);
         b->cap = cap;
     }
     memcpy(b->data + b->len, s, n);

@@ -1,19 +1,12 @@
 /*
- * strbuf.h: memory helpers shared by the shading language's front end:
- * an allocator that never returns NULL (out of memory aborts with a message:
- * the compiler has no sensible way to go on), and a growing NUL-terminated
- * string buffer used for diagnostics, stringizing and #error texts.
+ * strbuf.h: a growing NUL-terminated string buffer, used by the shading
+ * language's front end for diagnostics, stringizing and #error texts
+ * (memory from util/xalloc.h: out of memory aborts).
  */
 #ifndef SL_STRBUF_H
 #define SL_STRBUF_H
 
 #include <stddef.h>
-
-/* realloc that aborts with "sl: out of memory" instead of returning NULL. */
-void *sl_xrealloc(void *p, size_t size);
-
-/* A copy of s[0..len) with a terminating NUL. */
-char *sl_xstrndup(const char *s, size_t len);
 
 /* A growing string; zero-initialise, append, free(data) when done. data is
  * always NUL-terminated once anything was appended. */

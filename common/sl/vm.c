@@ -8,7 +8,10 @@
 #include "sl/vm_internal.h"
 #include "sl/check.h"
 #include "sl/strbuf.h"
+#include "util/err.h"
+#include "util/xalloc.h"
 
+#include <assert.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -26,16 +29,6 @@ const char *sl_mode_name(sl_mode mode)
     case SL_MODE_AFFINE: return "affine";
     }
     return "?";
-}
-
-static void *xcalloc(size_t n, size_t size)
-{
-    void *p = calloc(n, size);
-    if (!p) {
-        fputs("sl: out of memory\n", stderr);
-        abort();
-    }
-    return p;
 }
 
 sl_vm *sl_vm_new(const sl_limits *limits)
@@ -218,6 +211,12 @@ const vm_message *sl_vm_message(const sl_vm *vm, int scope, const char *name, in
             return m;
     }
     return NULL;
+}
+
+void sl_vm_set_print(sl_vm *self, sl_print_fn fn, void *ctx)
+{
+    self->print = fn;
+    self->print_ctx = ctx;
 }
 
 void sl_vm_set_clipping(sl_vm *self, double near, double far)
@@ -439,14 +438,11 @@ void sl_vm_get_affine(const sl_vm *self, sl_global g, aa_form *values)
 
 sl_status sl_vm_fail(sl_vm *vm, sl_status st, const char *fmt, ...)
 {
-    int n = snprintf(vm->error, sizeof vm->error, "shader '%s': ",
-                     vm->prog ? vm->prog->name : "?");
-    if (n < 0 || (size_t)n >= sizeof vm->error)
-        n = 0;
     va_list ap;
     va_start(ap, fmt);
-    vsnprintf(vm->error + n, sizeof vm->error - (size_t)n, fmt, ap);
+    err_vset(vm->error, sizeof vm->error, fmt, ap);
     va_end(ap);
+    err_prefix(vm->error, sizeof vm->error, "shader '%s'", vm->prog ? vm->prog->name : "?");
     return st;
 }
 
@@ -513,6 +509,7 @@ static sl_status run_with_derivatives(sl_vm *self, sl_mode mode)
             self->ad = xcalloc(SL_MAX_SLOTS, sizeof *self->ad);
         for (int s = 0; s < SL_GLOBAL_SLOTS; s++) {
             const aa_form *x = &self->a[s];
+            assert(x->n <= AA_MAX_SYMBOLS);
             memcpy(&self->ad[s].v, x, offsetof(aa_form, c) + (size_t)x->n * sizeof x->c[0]);
             self->ad[s].du = gderiv_of(self, s, 0);
             self->ad[s].dv = gderiv_of(self, s, 1);
@@ -520,6 +517,7 @@ static sl_status run_with_derivatives(sl_vm *self, sl_mode mode)
         st = sl_vm_exec_affine_deriv(self);
         for (int s = 0; s < SL_GLOBAL_SLOTS; s++) {
             const aa_form *x = &self->ad[s].v;
+            assert(x->n <= AA_MAX_SYMBOLS);
             memcpy(&self->a[s], x, offsetof(aa_form, c) + (size_t)x->n * sizeof x->c[0]);
         }
     } else {

@@ -21,7 +21,7 @@
 #define VM_SUFFIX affine
 #define VM_FILE(vm) ((vm)->a)
 #define VM_VARIANT VM_VAR_AFFINE
-#define VM_OP(name) v_##name
+#define VM_OP(plain, deriv) plain
 #include "vm_affine_ops.h"
 
 #include "vm_exec.inc"

@@ -11,7 +11,7 @@
 #include <stddef.h>
 #include <string.h>
 
-#define VM_OP(name) b_##name
+#define VM_OP(plain, deriv) deriv
 #include "vm_affine_ops.h"
 #undef VM_OP
 

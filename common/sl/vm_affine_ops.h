@@ -2,36 +2,38 @@
  * vm_affine_ops.h: the scalar operations of the VM in affine arithmetic,
  * shared by two instantiations of the dispatch loop: vm_affine.c (names
  * v_*, the plain mode) and vm_affine_deriv.c (names b_*, the values of the
- * mode that also carries derivative bounds, vm_deriv.inc). The including
- * file defines VM_OP(name) to give the names.
+ * mode that also carries derivative bounds, vm_deriv.inc). Each operation
+ * spells both its names, VM_OP(v_add, b_add), so that grep finds either;
+ * the including file defines VM_OP(plain, deriv) to pick one.
  */
 #ifndef VM_OP
-#error "define VM_OP(name) before including this file"
+#error "define VM_OP(plain, deriv) before including this file"
 #endif
 
 typedef aa_form A;
 
-static inline void VM_OP(const)(sl_vm *vm, A *z, double k) { (void)vm; aa_const(z, k); }
-static inline void VM_OP(mov)(sl_vm *vm, A *z, const A *x)
+static inline void VM_OP(v_const, b_const)(sl_vm *vm, A *z, double k) { (void)vm; aa_const(z, k); }
+static inline void VM_OP(v_mov, b_mov)(sl_vm *vm, A *z, const A *x)
 {
     (void)vm;
+    assert(x->n <= AA_MAX_SYMBOLS);      /* a form's symbol count fits its array */
     if (z != x)
         memcpy(z, x, offsetof(aa_form, c) + (size_t)x->n * sizeof x->c[0]);
 }
-static inline void VM_OP(swap)(sl_vm *vm, A *a, A *b)
+static inline void VM_OP(v_swap, b_swap)(sl_vm *vm, A *a, A *b)
 {
     A t;
-    VM_OP(mov)(vm, &t, a);
-    VM_OP(mov)(vm, a, b);
-    VM_OP(mov)(vm, b, &t);
+    VM_OP(v_mov, b_mov)(vm, &t, a);
+    VM_OP(v_mov, b_mov)(vm, a, b);
+    VM_OP(v_mov, b_mov)(vm, b, &t);
 }
-static inline void VM_OP(unbounded)(sl_vm *vm, A *z) { (void)vm; aa_unbounded(z, 0); }
-static inline bool VM_OP(is_const)(const A *x, double *k)
+static inline void VM_OP(v_unbounded, b_unbounded)(sl_vm *vm, A *z) { (void)vm; aa_unbounded(z, 0); }
+static inline bool VM_OP(v_is_const, b_is_const)(const A *x, double *k)
 {
     *k = x->x0;
     return aa_is_point(x);
 }
-static inline void VM_OP(range)(const A *x, double *lo, double *hi)
+static inline void VM_OP(v_range, b_range)(const A *x, double *lo, double *hi)
 {
     ia_interval r = aa_range(x);
     *lo = r.lo;
@@ -61,51 +63,51 @@ static inline bool exact(int op, A *z, const A *x, const A *y)
         if (!exact(op, z, x, y))                                             \
             f(vm->ctx, z, x, y);                                             \
     }
-EXACT_BIN(VM_OP(add), SL_OP_ADD, aa_add)
-EXACT_BIN(VM_OP(sub), SL_OP_SUB, aa_sub)
-EXACT_BIN(VM_OP(mul), SL_OP_MUL, aa_mul)
-EXACT_BIN(VM_OP(div), SL_OP_DIV, aa_div)
-BIN(VM_OP(pow), aa_pow)
-BIN(VM_OP(atan2), aa_atan2)
-EXACT_BIN(VM_OP(mod), SL_OP_MOD, aa_mod)
-BIN(VM_OP(min), aa_min)
-BIN(VM_OP(max), aa_max)
-BIN(VM_OP(step), aa_step)
-UN(VM_OP(neg), aa_neg)
-UN(VM_OP(sqrt), aa_sqrt)
-UN(VM_OP(invsqrt), aa_invsqrt)
-UN(VM_OP(exp), aa_exp)
-UN(VM_OP(log), aa_log)
-UN(VM_OP(sin), aa_sin)
-UN(VM_OP(cos), aa_cos)
-UN(VM_OP(tan), aa_tan)
-UN(VM_OP(asin), aa_asin)
-UN(VM_OP(acos), aa_acos)
-UN(VM_OP(atan), aa_atan)
-UN(VM_OP(abs), aa_abs)
-UN(VM_OP(sign), aa_sign)
-UN(VM_OP(floor), aa_floor)
-UN(VM_OP(ceil), aa_ceil)
-UN(VM_OP(round), aa_round)
+EXACT_BIN(VM_OP(v_add, b_add), SL_OP_ADD, aa_add)
+EXACT_BIN(VM_OP(v_sub, b_sub), SL_OP_SUB, aa_sub)
+EXACT_BIN(VM_OP(v_mul, b_mul), SL_OP_MUL, aa_mul)
+EXACT_BIN(VM_OP(v_div, b_div), SL_OP_DIV, aa_div)
+BIN(VM_OP(v_pow, b_pow), aa_pow)
+BIN(VM_OP(v_atan2, b_atan2), aa_atan2)
+EXACT_BIN(VM_OP(v_mod, b_mod), SL_OP_MOD, aa_mod)
+BIN(VM_OP(v_min, b_min), aa_min)
+BIN(VM_OP(v_max, b_max), aa_max)
+BIN(VM_OP(v_step, b_step), aa_step)
+UN(VM_OP(v_neg, b_neg), aa_neg)
+UN(VM_OP(v_sqrt, b_sqrt), aa_sqrt)
+UN(VM_OP(v_invsqrt, b_invsqrt), aa_invsqrt)
+UN(VM_OP(v_exp, b_exp), aa_exp)
+UN(VM_OP(v_log, b_log), aa_log)
+UN(VM_OP(v_sin, b_sin), aa_sin)
+UN(VM_OP(v_cos, b_cos), aa_cos)
+UN(VM_OP(v_tan, b_tan), aa_tan)
+UN(VM_OP(v_asin, b_asin), aa_asin)
+UN(VM_OP(v_acos, b_acos), aa_acos)
+UN(VM_OP(v_atan, b_atan), aa_atan)
+UN(VM_OP(v_abs, b_abs), aa_abs)
+UN(VM_OP(v_sign, b_sign), aa_sign)
+UN(VM_OP(v_floor, b_floor), aa_floor)
+UN(VM_OP(v_ceil, b_ceil), aa_ceil)
+UN(VM_OP(v_round, b_round), aa_round)
 #undef BIN
 #undef UN
 #undef EXACT_BIN
 
-static inline void VM_OP(clamp)(sl_vm *vm, A *z, const A *x, const A *lo, const A *hi)
+static inline void VM_OP(v_clamp, b_clamp)(sl_vm *vm, A *z, const A *x, const A *lo, const A *hi)
 {
     aa_clamp(vm->ctx, z, x, lo, hi);
 }
-static inline void VM_OP(smoothstep)(sl_vm *vm, A *z, const A *e0, const A *e1, const A *x)
+static inline void VM_OP(v_smoothstep, b_smoothstep)(sl_vm *vm, A *z, const A *e0, const A *e1, const A *x)
 {
     aa_smoothstep(vm->ctx, z, e0, e1, x);
 }
-static inline void VM_OP(mix)(sl_vm *vm, A *z, const A *x, const A *y, const A *a)
+static inline void VM_OP(v_mix, b_mix)(sl_vm *vm, A *z, const A *x, const A *y, const A *a)
 {
     aa_mix(vm->ctx, z, x, y, a);
 }
 
 /* Tri-state comparison through the range of x - y (keeps correlations). */
-static inline int VM_OP(cmp)(sl_vm *vm, int op, const A *x, const A *y)
+static inline int VM_OP(v_cmp, b_cmp)(sl_vm *vm, int op, const A *x, const A *y)
 {
     A d;
     aa_sub(vm->ctx, &d, x, y);
@@ -123,7 +125,7 @@ static inline int VM_OP(cmp)(sl_vm *vm, int op, const A *x, const A *y)
 }
 
 /* 0, 1, or the form 0.5 +- 0.5 (no noise symbol: a private error) */
-static inline void VM_OP(bool)(sl_vm *vm, A *z, int t)
+static inline void VM_OP(v_bool, b_bool)(sl_vm *vm, A *z, int t)
 {
     (void)vm;
     aa_const(z, t == 1 ? 1.0 : 0.0);
@@ -134,24 +136,24 @@ static inline void VM_OP(bool)(sl_vm *vm, A *z, int t)
         z->hi = 1.0;
     }
 }
-static inline int VM_OP(truth)(const A *x)
+static inline int VM_OP(v_truth, b_truth)(const A *x)
 {
     ia_interval r = aa_range(x);
     return r.lo > 0.5 ? 1 : r.hi < 0.5 ? 0 : 2;
 }
-static inline bool VM_OP(same)(const A *x, const A *y)
+static inline bool VM_OP(v_same, b_same)(const A *x, const A *y)
 {
     if (x->x0 != y->x0 || x->err != y->err || x->n != y->n || x->flags != y->flags ||
         x->lo != y->lo || x->hi != y->hi)
         return false;
     return memcmp(x->c, y->c, (size_t)x->n * sizeof x->c[0]) == 0;
 }
-static inline void VM_OP(merge)(sl_vm *vm, A *z, const A *x, const A *y)
+static inline void VM_OP(v_merge, b_merge)(sl_vm *vm, A *z, const A *x, const A *y)
 {
     aa_merge(vm->ctx, z, x, y);
 }
 
-static inline sl_status VM_OP(noise)(sl_vm *vm, A *S, const sl_insn *in, int pc)
+static inline sl_status VM_OP(v_noise, b_noise)(sl_vm *vm, A *S, const sl_insn *in, int pc)
 {
     int v = in->c, dim = SL_NOISE_DIM(v), kind = SL_NOISE_KIND(v);
     const A *p = &S[in->b];
@@ -159,7 +161,7 @@ static inline sl_status VM_OP(noise)(sl_vm *vm, A *S, const sl_insn *in, int pc)
     if (kind == SL_NOISE_PERIODIC) {
         for (int k = 0; k < dim; k++) {
             double q;
-            if (!VM_OP(is_const)(&S[in->d + k], &q)) {
+            if (!VM_OP(v_is_const, b_is_const)(&S[in->d + k], &q)) {
                 char where[256];
                 sl_program_pos_string(vm->prog, pc, where, sizeof where);
                 return sl_vm_fail(vm, SL_ERR_RUNTIME, "the period of pnoise must not vary "
@@ -182,12 +184,12 @@ static inline sl_status VM_OP(noise)(sl_vm *vm, A *S, const sl_insn *in, int pc)
         sl_pnoise_aa(vm->ctx, out, dim, p, per);
     }
     for (int i = 0; i < outs; i++)
-        VM_OP(mov)(vm, &S[in->a + i], &out[i]);
+        VM_OP(v_mov, b_mov)(vm, &S[in->a + i], &out[i]);
     return SL_OK;
 }
 
 /* An affine form of [lo, hi] on a private error term (no symbol). */
-static inline void VM_OP(span)(A *z, double lo, double hi)
+static inline void VM_OP(v_span, b_span)(A *z, double lo, double hi)
 {
     aa_const(z, 0.5 * lo + 0.5 * hi);
     double r = fmax(z->x0 - lo, hi - z->x0);
@@ -202,7 +204,7 @@ static inline void VM_OP(span)(A *z, double lo, double hi)
  * rounding) and clamped to the cells' texels; elsewhere the bound of the
  * filter over the ranges (tex_bound). The gradient (bump) within the
  * derivative bounds. */
-static inline void VM_OP(cells)(sl_vm *vm, A *z, const A *s, const A *t, const tex_cell *cell,
+static inline void VM_OP(v_cells, b_cells)(sl_vm *vm, A *z, const A *s, const A *t, const tex_cell *cell,
                                 int n)
 {
     double lo = INFINITY, hi = -INFINITY;
@@ -224,7 +226,7 @@ static inline void VM_OP(cells)(sl_vm *vm, A *z, const A *s, const A *t, const t
         if (c->weight != 1.0)
             aa_mul_s(vm->ctx, &k, &k, c->weight);
         if (q == 0)
-            VM_OP(mov)(vm, z, &k);
+            VM_OP(v_mov, b_mov)(vm, z, &k);
         else
             aa_add(vm->ctx, z, z, &k);
         for (int i = 0; i < 4; i++) {
@@ -234,21 +236,21 @@ static inline void VM_OP(cells)(sl_vm *vm, A *z, const A *s, const A *t, const t
     }
     A e, flo, fhi;
     double eps = 1e-9 * fmax(fabs(lo), fabs(hi)) + 0x1p-1000;
-    VM_OP(span)(&e, -eps, eps);
+    VM_OP(v_span, b_span)(&e, -eps, eps);
     aa_add(vm->ctx, z, z, &e);
     aa_const(&flo, lo);
     aa_const(&fhi, hi);
     aa_clamp(vm->ctx, z, z, &flo, &fhi);
 }
 
-static inline sl_status VM_OP(texture)(sl_vm *vm, A *S, const sl_insn *in, int pc)
+static inline sl_status VM_OP(v_texture, b_texture)(sl_vm *vm, A *S, const sl_insn *in, int pc)
 {
     sl_status st = SL_OK;
     const tex_texture *t = sl_vm_texture(vm, vm->str[in->b], pc, &st);
     if (!t)
         return st;
     double q;
-    if (!VM_OP(is_const)(&S[in->c + 4], &q))
+    if (!VM_OP(v_is_const, b_is_const)(&S[in->c + 4], &q))
         return sl_vm_texture_channel_error(vm, pc);
     tex_wrap sw = (tex_wrap)SL_TEXOP_SWRAP(in->d), tw = (tex_wrap)SL_TEXOP_TWRAP(in->d);
     int c = sl_tex_channel(q);
@@ -257,8 +259,8 @@ static inline sl_status VM_OP(texture)(sl_vm *vm, A *S, const sl_insn *in, int p
     if (SL_TEXOP_KIND(in->d) == SL_TEXOP_GRAD) {
         double ls, lt;
         tex_lipschitz(t, c, &ls, &lt);
-        VM_OP(span)(&out[0], -ls, ls);
-        VM_OP(span)(&out[1], -lt, lt);
+        VM_OP(v_span, b_span)(&out[0], -ls, ls);
+        VM_OP(v_span, b_span)(&out[1], -lt, lt);
     } else {
         tex_range r;
         double *ends[4] = { r.s, r.t, r.ws, r.wt };
@@ -272,53 +274,29 @@ static inline sl_status VM_OP(texture)(sl_vm *vm, A *S, const sl_insn *in, int p
             tex_cell cells[2];
             int n;
             if (ch < 0 || ch >= tex_channels(t)) {
-                VM_OP(mov)(vm, &out[i], &S[in->c + 5]);
+                VM_OP(v_mov, b_mov)(vm, &out[i], &S[in->c + 5]);
             } else if ((n = tex_cells(t, ch, &r, sw, tw, cells)) > 0) {
-                VM_OP(cells)(vm, &out[i], &S[in->c], &S[in->c + 1], cells, n);
+                VM_OP(v_cells, b_cells)(vm, &out[i], &S[in->c], &S[in->c + 1], cells, n);
             } else {
                 double lo, hi;
                 tex_bound(t, ch, &r, sw, tw, 0.0, &lo, &hi);
-                VM_OP(span)(&out[i], lo, hi);
+                VM_OP(v_span, b_span)(&out[i], lo, hi);
             }
         }
     }
     for (int i = 0; i < outs; i++)
-        VM_OP(mov)(vm, &S[in->a + i], &out[i]);
+        VM_OP(v_mov, b_mov)(vm, &S[in->a + i], &out[i]);
     return SL_OK;
 }
 
-static inline void VM_OP(random)(sl_vm *vm, A *z)
+static inline void VM_OP(v_random, b_random)(sl_vm *vm, A *z)
 {
-    VM_OP(bool)(vm, z, 2);               /* [0, 1] on a private error term */
+    VM_OP(v_bool, b_bool)(vm, z, 2);               /* [0, 1] on a private error term */
     z->flags |= AA_DISCONTINUOUS;
 }
 
-static inline void VM_OP(unknown)(A *z) { aa_unbounded(z, 0); }
-static inline void VM_OP(du)(sl_vm *vm, A *z, const A *x) { (void)vm; (void)x; VM_OP(unknown)(z); }
-static inline void VM_OP(dv)(sl_vm *vm, A *z, const A *x) { (void)vm; (void)x; VM_OP(unknown)(z); }
-static inline void VM_OP(deriv)(sl_vm *vm, A *z, const A *x, const A *y)
-{
-    (void)vm; (void)x; (void)y;
-    VM_OP(unknown)(z);
-}
-static inline void VM_OP(calcnormal)(sl_vm *vm, A *S, int z, int p)
-{
-    (void)vm; (void)p;
-    for (int i = 0; i < 3; i++)
-        VM_OP(unknown)(&S[z + i]);
-}
-static inline void VM_OP(area)(sl_vm *vm, A *S, int z, int p)
-{
-    (void)vm; (void)p;
-    VM_OP(unknown)(&S[z]);
-}
-
-static inline int VM_OP(light_samples)(sl_vm *vm, A *S, sl_light_sample *out, bool *unbounded)
-{
-    (void)S;
-    *unbounded = vm->light_fn != NULL;
-    for (int k = 0; k < vm->nfixed_lights; k++)
-        out[k] = vm->fixed_lights[k];
-    return vm->nfixed_lights;
-}
+static inline void VM_OP(v_unknown, b_unknown)(A *z) { aa_unbounded(z, 0); }
+#define VM_OPS_T A
+#include "vm_stub_ops.inc"
+#undef VM_OPS_T
 

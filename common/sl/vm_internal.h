@@ -12,6 +12,7 @@
 #ifndef SL_VM_INTERNAL_H
 #define SL_VM_INTERNAL_H
 
+#include <assert.h>
 #include <math.h>
 #include <stdint.h>
 
@@ -19,6 +20,7 @@
 #include "sl/shader.h"
 #include "sl/strmatch.h"
 #include "tex/tex.h"
+#include "util/err.h"
 
 #include <stdio.h>
 #include <string.h>
@@ -126,6 +128,8 @@ struct sl_vm {
     int nfixed_lights;
     uint64_t seed;
     tex_cache *textures;          /* sl_vm_set_textures */
+    sl_print_fn print;            /* sl_vm_set_print (NULL: printf dropped) */
+    void *print_ctx;
     struct { char name[256]; const tex_texture *tex; } tex_memo[SL_VM_TEX_MEMO];
     int ntex_memo;
 
@@ -162,7 +166,7 @@ struct sl_vm {
                                      true slope bounds (vm_deriv.inc) */
     long executed;
     uint64_t rng;
-    char error[512];
+    char error[ERR_LEN];
 };
 
 sl_status sl_vm_exec_float(sl_vm *vm);

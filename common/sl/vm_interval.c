@@ -17,7 +17,7 @@
 #define VM_SUFFIX interval
 #define VM_FILE(vm) ((vm)->i)
 #define VM_VARIANT VM_VAR_INTERVAL
-#define VM_OP(name) v_##name
+#define VM_OP(plain, deriv) plain
 #include "vm_interval_ops.h"
 
 #include "vm_exec.inc"

@@ -10,7 +10,7 @@
 #include <math.h>
 #include <string.h>
 
-#define VM_OP(name) b_##name
+#define VM_OP(plain, deriv) deriv
 #include "vm_interval_ops.h"
 #undef VM_OP
 

@@ -7,6 +7,7 @@
  * world opens them before rendering (docs/textures.md).
  */
 #include "sl/vm_internal.h"
+#include "util/err.h"
 
 #include <stdio.h>
 #include <string.h>
@@ -26,13 +27,13 @@ const tex_texture *sl_vm_texture_find(sl_vm *vm, const char *name, char *err, si
             return vm->tex_memo[k].tex;  /* NULL: known missing (textureinfo) */
         break;
     }
-    char quiet[600];
+    char quiet[ERR_LEN];
     bool remember_missing = err == NULL;
     if (!err) {
         err = quiet;
         errsz = sizeof quiet;
     }
-    snprintf(err, errsz, "no texture cache: the renderer installed none");
+    err_set(err, errsz, "no texture cache: the renderer installed none");
     const tex_texture *t = vm->textures ? tex_cache_get(vm->textures, name, err, errsz) : NULL;
     if (strlen(name) < sizeof vm->tex_memo[0].name && (t || remember_missing)) {
         int k = vm->ntex_memo < SL_VM_TEX_MEMO ? vm->ntex_memo++ : (int)(vm->rng % SL_VM_TEX_MEMO);

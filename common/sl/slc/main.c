@@ -16,6 +16,7 @@
 #include "sl/diag.h"
 #include "sl/shader.h"
 #include "sl/source.h"
+#include "util/xalloc.h"
 
 static void usage(FILE *out)
 {
@@ -57,11 +58,9 @@ static int compile_one(const char *path, const char *const *search, bool dump)
 int main(int argc, char **argv)
 {
     bool dump = false;
-    const char **search = calloc((size_t)argc + 1, sizeof *search);
-    const char **files = calloc((size_t)argc + 1, sizeof *files);
+    const char **search = xcalloc((size_t)argc + 1, sizeof *search);
+    const char **files = xcalloc((size_t)argc + 1, sizeof *files);
     int nsearch = 0, nfiles = 0;
-    if (!search || !files)
-        return 2;
     for (int i = 1; i < argc; i++) {
         if (strcmp(argv[i], "--dump") == 0) {
             dump = true;

@@ -1,0 +1,121 @@
+/*
+ * noise_interval.h: the small inline interval kit of noise's proven bounds
+ * (noise_bound.c): [lo, hi] pairs whose every operation rounds outward by
+ * a relative step and never produces a subnormal (the argument below).
+ * It is not common/aa's interval type: that one steps one ulp with
+ * fp_next_up/fp_next_down and carries flags, and the jets' cost depends on
+ * these few always-inlined instructions (docs/noise.md).
+ */
+#ifndef SL_NOISE_INTERVAL_H
+#define SL_NOISE_INTERVAL_H
+
+#include "aa/rounding.h"
+
+#include <math.h>
+
+/*
+ * All quantities here are finite and small (|.| < 2^10): no overflow. Each
+ * bound is the round-to-nearest result x of ONE operation (+ - *), moved
+ * outward by out_dn/out_up, which always covers that operation's rounding:
+ *   x normal: the exact result v is within half an ulp of x, i.e. v >=
+ *     pred(x). t = RN(|x| 2^-52 + 2^-600) >= ulp(x): for |x| >= 2^-548,
+ *     |x| 2^-52 is exact (a power-of-two scaling that stays normal) and
+ *     >= ulp(x); below, 2^-600 alone is >= ulp(x). So x - t <= x - ulp(x)
+ *     <= pred(x), and by the monotonicity of rounding RN(x - t) <=
+ *     pred(x) <= v.
+ *   x subnormal or zero: v >= x - 2^-1075 (the underflow of a product; a
+ *     sum is exact there) and t >= 2^-600, so RN(x - t) <= x - 2^-1075.
+ * A result of magnitude below 2^-500 then becomes -2^-500 (it is above
+ * that, so this moves it further out). So every bound is 0 (iv_pt(0), a
+ * clipped weight) or at least 2^-500 in magnitude, products of two bounds
+ * are at least 2^-1000, and nothing here is subnormal: subnormal operands
+ * and results cost a microcode assist of ~100 cycles on x86, which made
+ * the jets 2-5x slower when the step added 2^-1074 (docs/noise.md).
+ * out_up is the mirror image. The cost is one or two ulps of width, and
+ * 2^-500 of absolute width near 0.
+ */
+
+typedef struct iv {
+    double lo, hi;
+} iv;
+
+/* the kit's operations are a few instructions each: always inline them
+ * (the jets of noise_bound.c are large enough that GCC would otherwise
+ * call them) */
+#define IV_INLINE static inline __attribute__((always_inline))
+
+IV_INLINE double out_dn(double x)
+{
+    double t = x - (fabs(x) * 0x1p-52 + 0x1p-600);
+    return fabs(t) < 0x1p-500 ? -0x1p-500 : t;
+}
+IV_INLINE double out_up(double x)
+{
+    double t = x + (fabs(x) * 0x1p-52 + 0x1p-600);
+    return fabs(t) < 0x1p-500 ? 0x1p-500 : t;
+}
+
+IV_INLINE iv iv_mk(double lo, double hi)
+{
+    iv r = { lo, hi };
+    return r;
+}
+IV_INLINE iv iv_pt(double x) { return iv_mk(x, x); }
+IV_INLINE iv iv_add(iv a, iv b)
+{
+    return iv_mk(out_dn(a.lo + b.lo), out_up(a.hi + b.hi));
+}
+IV_INLINE iv iv_sub(iv a, iv b)
+{
+    return iv_mk(out_dn(a.lo - b.hi), out_up(a.hi - b.lo));
+}
+IV_INLINE iv iv_neg(iv a) { return iv_mk(-a.hi, -a.lo); }
+IV_INLINE iv iv_mul(iv a, iv b)
+{
+    double p1 = a.lo * b.lo, p2 = a.lo * b.hi, p3 = a.hi * b.lo, p4 = a.hi * b.hi;
+    double lo = p1 < p2 ? p1 : p2, hi = p1 < p2 ? p2 : p1;
+    double lo2 = p3 < p4 ? p3 : p4, hi2 = p3 < p4 ? p4 : p3;
+    return iv_mk(out_dn(lo < lo2 ? lo : lo2), out_up(hi > hi2 ? hi : hi2));
+}
+/* a times a small integer: exact for 0, +-1, +-2, +-4, +-8 */
+IV_INLINE iv iv_mul_int(iv a, int g)
+{
+    switch (g) {
+    case 0: return iv_pt(0.0);
+    case 1: return a;
+    case -1: return iv_neg(a);
+    case 2: case 4: case 8:
+        return iv_mk(a.lo * g, a.hi * g);
+    case -2: case -4: case -8:
+        return iv_mk(a.hi * g, a.lo * g);
+    default: {
+        double x = a.lo * g, y = a.hi * g;
+        if (g < 0) { double t = x; x = y; y = t; }
+        return iv_mk(out_dn(x), out_up(y));
+    }
+    }
+}
+/* a times a non-negative double */
+IV_INLINE iv iv_scale_pos(iv a, double k)
+{
+    return iv_mk(out_dn(a.lo * k), out_up(a.hi * k));
+}
+IV_INLINE iv iv_hull(iv a, iv b)
+{
+    return iv_mk(a.lo < b.lo ? a.lo : b.lo, a.hi > b.hi ? a.hi : b.hi);
+}
+IV_INLINE double iv_mag(iv a)
+{
+    double l = fabs(a.lo), h = fabs(a.hi);
+    return l > h ? l : h;
+}
+IV_INLINE double iv_mid(iv a) { return 0.5 * a.lo + 0.5 * a.hi; }
+/* max |a - m| for a point m, rounded up */
+static inline double iv_rad_about(iv a, double m)
+{
+    double r1 = fp_add_up(a.hi, -m), r2 = fp_add_up(m, -a.lo);
+    double r = r1 > r2 ? r1 : r2;
+    return r > 0.0 ? r : 0.0;
+}
+
+#endif
