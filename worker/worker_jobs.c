@@ -4,6 +4,7 @@
  */
 #include "worker_jobs.h"
 
+#include <assert.h>
 #include <limits.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -21,7 +22,9 @@ struct worker_jobs {
 
 held_job *held_job_retain(held_job *self)
 {
-    atomic_fetch_add(&self->refs, 1);
+    int was = atomic_fetch_add(&self->refs, 1);
+    assert(was >= 1);   /* only a job someone still holds is retained */
+    (void)was;
     return self;
 }
 
@@ -30,7 +33,9 @@ void held_job_release(held_job **self_p)
     held_job *self = *self_p;
     if (!self) return;
     *self_p = NULL;
-    if (atomic_fetch_sub(&self->refs, 1) != 1) return;
+    int was = atomic_fetch_sub(&self->refs, 1);
+    assert(was >= 1);   /* never released more often than held */
+    if (was != 1) return;
     job_scene_destroy(&self->js);
     job_destroy(&self->jb);
     for (int i = 0; i < self->nfile_fds; i++) file_store_release(self->file_fds[i]);
