@@ -187,7 +187,7 @@ static int parse(int argc, char **argv, cli *c)
         case O_RESUME: f->resume = true; break;
         case O_FRAMES: {
             frame_spec spec;
-            char err[600];
+            char err[ERR_LEN];
             if (!frame_spec_parse(optarg, &spec, err, sizeof err)) {
                 fprintf(stderr, "aafarm-master: %s\n", err);
                 return AAFARM_EXIT_USAGE;
@@ -287,7 +287,7 @@ static int load(cli *c, loaded *l)
         fr->jb = jb;
         fr->output = l->seq->outputs[i];
         fr->fmt = (image_format){jb->xres, jb->yres, c->job.tile_size, 0};   /* job_load's */
-        char err[300];
+        char err[ERR_LEN];
         if (!image_format_check(&fr->fmt, err, sizeof err)) {
             sl_diag_error(diag, (sl_pos){0}, "%s: %s", c->farm.scene_path, err);
             ok = false;

@@ -181,7 +181,7 @@ int main(int argc, char **argv)
         case O_MASTER_KEY: wo.master_key = optarg; break;
         case O_FRAMES: {
             frame_spec spec;
-            char err[600];
+            char err[ERR_LEN];
             if (!frame_spec_parse(optarg, &spec, err, sizeof err)) {
                 fprintf(stderr, "aafarm-worker: %s\n", err);
                 return AAFARM_EXIT_USAGE;

@@ -88,7 +88,7 @@ static job *rebuild(const proto_job *m, char *err, size_t errsz)
 {
     job_options jo = options_of(&m->options);
     job *jb = job_new(m->scene_name, (const char *)m->scene_text, m->scene_len, &jo);
-    char why[600];
+    char why[ERR_LEN];
     bool ok = true;
     for (size_t i = 0; ok && i < m->n_sources; i++)
         ok = job_add_source(jb, m->sources[i].name, (const char *)m->sources[i].text,
@@ -153,9 +153,8 @@ static bool prepare(held_job *h, const proto_job *m, size_t cache_bytes)
                  h->js->world.camera.xres, h->js->world.camera.yres);
         return false;
     }
-    char err[300];
-    if (!image_format_check(&h->fmt, err, sizeof err)) {
-        snprintf(h->error, sizeof h->error, "job %.12s...: %s", h->hash, err);
+    if (!image_format_check(&h->fmt, h->error, sizeof h->error)) {
+        err_prefix(h->error, sizeof h->error, "job %.12s...", h->hash);
         return false;
     }
     return true;
