@@ -444,7 +444,7 @@ static void on_need_file(farm *f, farm_worker *w, const proto_need_file *n, int6
                     n->sha256);
         return;
     }
-    if (r == FILE_READ_CHANGED) {
+    if (r == FILE_READ_CHANGED || r == FILE_READ_NO_MEMORY) {
         farm_fail(f, "%s", err);
         return;
     }
