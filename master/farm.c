@@ -278,7 +278,7 @@ static const char *frame_label(const farm *f, const farm_frame *fr, char *buf, s
 
 static void write_preview(farm *f, farm_frame *fr)
 {
-    char err[600];
+    char err[ERR_LEN];
     image_buffer *buf = image_buffer_read_exr(fr->output, err, sizeof err);
     if (!buf || !image_preview_write_png_buffer(fr->preview, buf, err, sizeof err))
         console_log(f->con, CONSOLE_ERROR, "preview %s not written: %s", fr->preview, err);
@@ -287,7 +287,7 @@ static void write_preview(farm *f, farm_frame *fr)
 
 void farm_frame_complete(farm *f, farm_frame *fr)
 {
-    char err[600], label[40];
+    char err[ERR_LEN], label[40];
     if (!image_writer_finish(&fr->writer, err, sizeof err)) {
         farm_fail(f, "%s%s", frame_label(f, fr, label, sizeof label), err);
         return;
@@ -498,7 +498,7 @@ static void check_workers(farm *f, int64_t now)
         farm_worker *w = registry_at(f->reg, i);
         if (!w->alive) continue;
         if (now - w->last_seen_ms > dead_after) {
-            char why[120];
+            char why[ERR_LEN];
             snprintf(why, sizeof why, "missed %d heartbeats (silent for %.1f s)", f->opt->liveness,
                      (double)(now - w->last_seen_ms) / 1000.0);
             farm_lose_worker(f, w, why, now);
@@ -602,7 +602,7 @@ static void close_journals(farm *f)
             journal_remove(&fr->jnl);   /* the image is in place, or nothing to resume */
             continue;
         }
-        char jerr[600];
+        char jerr[ERR_LEN];
         if (!journal_sync(fr->jnl, jerr, sizeof jerr))
             console_log(f->con, CONSOLE_ERROR, "%s", jerr);
         else if (!told)
@@ -617,7 +617,7 @@ static void close_journals(farm *f)
 
 static int finish(farm *f)
 {
-    char err[600];
+    char err[ERR_LEN];
     close_journals(f);
     f->end_ms = farm_now_ms();
     if (f->state == FARM_DONE)
@@ -713,7 +713,7 @@ int farm_run(const farm_options *opt, const farm_frame_in *frames, int nframes)
     sigaction(SIGTERM, &sa, NULL);
     signal(SIGPIPE, SIG_IGN);
 
-    char err[1200];
+    char err[2 * ERR_LEN];   /* setup's messages: a prefix and a callee's ERR_LEN message */
     int rc = setup(&f, err, sizeof err);
     if (rc != AAFARM_EXIT_OK) {
         console_log(f.con, CONSOLE_ERROR, "%s", err);

@@ -76,7 +76,7 @@ typedef struct farm {
     char host[128];
     int64_t start_ms, end_ms;
     farm_state state;
-    char failure[1200];
+    char failure[2 * ERR_LEN];     /* a prefix (frame, tile, worker) and a message */
     /* counters beyond the scheduler's and the socket's */
     uint64_t invalid_tiles, rejects_sent, version_mismatches, jobs_sent;
     uint64_t grant_bytes, result_bytes, sent_bytes;

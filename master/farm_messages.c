@@ -27,6 +27,7 @@
 #include <string.h>
 
 #include "farm_internal.h"
+#include "util/err.h"
 #include "version.h"
 
 /* ---- sending ---- */
@@ -222,7 +223,7 @@ static void copy_name(char *dst, size_t n, const char *src)
 static void on_hello(farm *f, const proto_hello *h, const uint8_t *id, size_t id_len,
                      int64_t now)
 {
-    char why[200], hex[24];
+    char why[ERR_LEN], hex[24];
     if (proto_version_check(AAFARM_PROTOCOL_VERSION, h->protocol_version, why, sizeof why) != 0) {
         f->version_mismatches++;
         console_log(f->con, CONSOLE_INFO, "refused worker %s on %s (peer %s): %s",
@@ -275,7 +276,9 @@ static void on_ask(farm *f, farm_worker *w, const proto_ask *a)
 static void tile_failed(farm *f, farm_worker *w, uint64_t lease, int tile, const char *text,
                         bool retryable)
 {
-    char msg[1200];   /* the message without trailing line breaks, for one log line */
+    /* the message without trailing line breaks, for one log line (a worker's
+     * Failure text may be longer: it is cut here) */
+    char msg[2 * ERR_LEN];
     snprintf(msg, sizeof msg, "%s", text);
     for (size_t n = strlen(msg); n > 0 && (msg[n - 1] == '\n' || msg[n - 1] == ' ');)
         msg[--n] = '\0';
@@ -335,10 +338,10 @@ static void on_result(farm *f, farm_worker *w, const proto_result *r, const wire
         return;
     }
     int tile = held->tile;
-    char err[600];
+    char err[ERR_LEN];
     if (r->tile_index != (uint32_t)local) {
-        snprintf(err, sizeof err, "its result names tile %u, the lease was for tile %d",
-                 r->tile_index, local);
+        err_set(err, sizeof err, "its result names tile %u, the lease was for tile %d",
+                r->tile_index, local);
     } else {
         image_rect rect = image_format_tile_rect(&fr->fmt, local % fr->tiles_x,
                                                  local / fr->tiles_x);
@@ -346,7 +349,7 @@ static void on_result(farm *f, farm_worker *w, const proto_result *r, const wire
         size_t chunk_len = 0;
         if (image_tile_exr_chunk(bulk, len, &fr->fmt, rect, &chunk, &chunk_len, err, sizeof err)) {
             /* journal first: a tile in the journal survives the master */
-            char ioerr[700];
+            char ioerr[ERR_LEN];
             if (!journal_append(fr->jnl, local, chunk, chunk_len, now, ioerr, sizeof ioerr) ||
                 !image_writer_put_chunk(fr->writer, local % fr->tiles_x, local / fr->tiles_x,
                                         chunk, chunk_len, ioerr, sizeof ioerr)) {
@@ -376,9 +379,8 @@ static void on_result(farm *f, farm_worker *w, const proto_result *r, const wire
     }
     f->invalid_tiles++;
     w->invalid_tiles++;
-    char msg[700];
-    snprintf(msg, sizeof msg, "invalid tile from the worker: %s", err);
-    tile_failed(f, w, r->lease_id, tile, msg, true);
+    err_prefix(err, sizeof err, "invalid tile from the worker");
+    tile_failed(f, w, r->lease_id, tile, err, true);
 }
 
 static void on_failure(farm *f, farm_worker *w, const proto_failure *x)
@@ -432,7 +434,7 @@ static void on_need_file(farm *f, farm_worker *w, const proto_need_file *n, int6
     }
     const uint8_t *data = NULL;
     const job_file *file = NULL;
-    char err[1200];
+    char err[2 * ERR_LEN];   /* names the file and its path on the master's disk */
     file_read r = file_server_read(fr->files, n->sha256, n->offset, n->length, &data, &file, err,
                                    sizeof err);
     if (r == FILE_READ_UNKNOWN || r == FILE_READ_RANGE) {
@@ -442,7 +444,7 @@ static void on_need_file(farm *f, farm_worker *w, const proto_need_file *n, int6
                     n->sha256);
         return;
     }
-    if (r == FILE_READ_CHANGED) {
+    if (r == FILE_READ_CHANGED || r == FILE_READ_NO_MEMORY) {
         farm_fail(f, "%s", err);
         return;
     }
@@ -508,7 +510,7 @@ void farm_handle(farm *f, wire_msg *m, int64_t now)
     case PROTO_NEED_FILE: on_need_file(f, w, &msg->need_file, now); break;
     case PROTO_FILES_READY: on_files_ready(f, w, &msg->files_ready, now); break;
     case PROTO_SHUTDOWN: {
-        char why[160];
+        char why[ERR_LEN];
         snprintf(why, sizeof why, "left (%s)",
                  msg->shutdown.reason && *msg->shutdown.reason ? msg->shutdown.reason
                                                                : "no reason given");

@@ -116,8 +116,14 @@ file_read file_server_read(file_server *self, const char *sha, uint64_t offset, 
     served *s = &self->files[i];
     if (!check(s, f, err, errsz)) return FILE_READ_CHANGED;
     if (self->buf_size < length) {
+        uint8_t *buf = try_malloc(length);   /* a size the worker chose: refused, not fatal */
+        if (!buf) {
+            err_set(err, errsz, "file '%s': no memory for a chunk of %u bytes (the master is "
+                    "out of memory)", f->name, length);
+            return FILE_READ_NO_MEMORY;
+        }
         free(self->buf);
-        self->buf = xmalloc(length);
+        self->buf = buf;
         self->buf_size = length;
     }
     size_t got = 0;

@@ -11,6 +11,12 @@
  * with a message naming it: the job must be loaded again (it then gets a
  * new hash, so no worker keeps a stale copy). Hashing runs on the master's
  * loop, so it happens only then, not for every render of a large file.
+ *
+ * Out of memory: the chunk buffer has the size a worker asked for (at most
+ * PROTO_MAX_FILE_CHUNK, 16 MiB), so it is allocated with try_malloc
+ * (util/xalloc.h) and a failure is refused with FILE_READ_NO_MEMORY and a
+ * message instead of aborting the master: the render then ends as on a
+ * full disk, its journal kept for --resume (test_file_server drives it).
  */
 #ifndef MASTER_FILE_SERVER_H
 #define MASTER_FILE_SERVER_H
@@ -29,8 +35,9 @@ typedef enum file_read {
     FILE_READ_OK,
     FILE_READ_UNKNOWN,   /* no file of the job has that hash (a peer's mistake) */
     FILE_READ_RANGE,     /* the range lies outside the file (a peer's mistake) */
-    FILE_READ_CHANGED    /* the file on disk is not the job's any more, or cannot be
+    FILE_READ_CHANGED,   /* the file on disk is not the job's any more, or cannot be
                             read: the render fails (err says which and why) */
+    FILE_READ_NO_MEMORY  /* no memory for the chunk: the render fails (err says so) */
 } file_read;
 
 /* Reads bytes [offset, offset + length) of the job's file with this hash

@@ -7,6 +7,7 @@
 #include "util/fdio.h"
 #include "util/xalloc.h"
 
+#include <assert.h>
 #include <errno.h>
 #include <fcntl.h>
 #include <stdio.h>
@@ -25,7 +26,8 @@ static const char record_magic[4] = {'T', 'I', 'L', 'E'};
 struct journal {
     char *path;
     int fd;
-    uint64_t size;          /* end of the last whole record */
+    uint64_t size;          /* end of the last whole record (>= the header) */
+    uint32_t tiles;         /* the grid's tile count: every record's index is below it */
     int64_t synced_ms;      /* last fdatasync (-1: never) */
     bool dirty;             /* written since the last fdatasync */
 };
@@ -124,12 +126,14 @@ static int open_locked(const char *path, bool create, char *err, size_t errsz)
     return fd;
 }
 
-static journal *wrap(const char *path, int fd, uint64_t size)
+static journal *wrap(const char *path, int fd, uint64_t size, uint32_t tiles)
 {
+    assert(fd >= 0 && size >= HEADER_BYTES);   /* open, and the header whole */
     journal *self = xcalloc(1, sizeof *self);
     self->path = xstrdup(path);
     self->fd = fd;
     self->size = size;
+    self->tiles = tiles;
     self->synced_ms = -1;
     return self;
 }
@@ -152,7 +156,7 @@ journal *journal_create(const char *path, const journal_id *id, bool *replaced, 
         unlink(path);
         return NULL;
     }
-    return wrap(path, fd, HEADER_BYTES);
+    return wrap(path, fd, HEADER_BYTES, id->tiles);
 }
 
 static bool check_header(const char *path, int fd, const journal_id *id, char *err,
@@ -248,6 +252,7 @@ journal *journal_resume(const char *path, const journal_id *id, journal_tile_fn 
         if (!read_record(fd, off, file_size, id, &buf, &cap, &tile, &len, info->dropped_why,
                          sizeof info->dropped_why))
             break;
+        assert(tile >= 0 && (uint32_t)tile < id->tiles);   /* read_record checked it */
         if (!seen[tile]) {
             seen[tile] = 1;
             info->tiles++;
@@ -257,6 +262,9 @@ journal *journal_resume(const char *path, const journal_id *id, journal_tile_fn 
     }
     free(buf);
     free(seen);
+    /* the replay stopped at a record boundary inside the file, each tile
+     * counted once */
+    assert(off <= file_size && info->tiles >= 0 && (uint32_t)info->tiles <= id->tiles);
     if (!ok) {
         close(fd);
         return NULL;
@@ -268,7 +276,7 @@ journal *journal_resume(const char *path, const journal_id *id, journal_tile_fn 
         close(fd);
         return NULL;
     }
-    return wrap(path, fd, off);
+    return wrap(path, fd, off, id->tiles);
 }
 
 bool journal_sync(journal *self, char *err, size_t errsz)
@@ -292,6 +300,10 @@ bool journal_append(journal *self, int tile, const void *chunk, size_t len, int6
                 len);
         return false;
     }
+    /* the master journals only tiles of its own grid: a record its resume
+     * would call corrupt (and drop with everything after it) is a bug */
+    assert((uint32_t)tile < self->tiles);
+    assert(self->size >= HEADER_BYTES);
     uint8_t rec[RECORD_BYTES];
     memcpy(rec, record_magic, 4);
     put_u32(rec + 4, (uint32_t)tile);

@@ -42,6 +42,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "util/err.h"
 enum {
     JOURNAL_MAX_CHUNK = 64 << 20,   /* the largest tile frame the wire accepts */
     JOURNAL_SYNC_MS = 1000
@@ -57,7 +58,7 @@ typedef struct journal_id {
 typedef struct journal_replay {
     int tiles;                 /* intact records replayed (duplicates skipped) */
     uint64_t dropped_bytes;    /* torn or corrupt tail cut off */
-    char dropped_why[160];     /* why the tail was cut, "" when nothing was */
+    char dropped_why[ERR_LEN]; /* why the tail was cut, "" when nothing was */
 } journal_replay;
 
 typedef struct journal journal;

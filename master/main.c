@@ -15,7 +15,9 @@
 #include "curve_cert.h"
 #include "farm.h"
 #include "job/frames.h"
+#include "util/err.h"
 #include "util/exitcodes.h"
+#include "util/parse_num.h"
 #include "util/xalloc.h"
 
 static void usage(FILE *out)
@@ -75,25 +77,20 @@ static void usage(FILE *out)
         "is, for --resume). --resume with another job's journal is a usage error (2).\n");
 }
 
-static bool parse_long(const char *s, long lo, long hi, long *out)
-{
-    char *end;
-    long v = strtol(s, &end, 10);
-    if (end == s || *end || v < lo || v > hi) return false;
-    *out = v;
-    return true;
-}
-
 typedef struct cli {
     farm_options farm;
     job_options job;
     bool local_given;
 } cli;
 
-static int bad_number(const char *opt, const char *what, const char *got)
+/* optarg as a whole number of lo..hi into *n; false after printing
+ * "aafarm-master: OPT wants [NOUN ]LO..HI, got 'TEXT'". */
+static bool number_arg(const char *opt, const char *noun, long lo, long hi, long *n)
 {
-    fprintf(stderr, "aafarm-master: %s wants %s, got '%s'\n", opt, what, got);
-    return AAFARM_EXIT_USAGE;
+    char err[ERR_LEN];
+    if (parse_option_long(opt, noun, optarg, lo, hi, n, err, sizeof err)) return true;
+    fprintf(stderr, "aafarm-master: %s\n", err);
+    return false;
 }
 
 /* Returns -1 to go on, or an exit code. */
@@ -137,57 +134,60 @@ static int parse(int argc, char **argv, cli *c)
         case 'o': f->output = optarg; break;
         case O_BIND: f->bind = optarg; break;
         case O_LOCAL:
-            if (!parse_long(optarg, 0, 1024, &n)) return bad_number("--local-workers", "0..1024", optarg);
+            if (!number_arg("--local-workers", NULL, 0, 1024, &n)) return AAFARM_EXIT_USAGE;
             f->local_workers = (int)n;
             c->local_given = true;
             break;
         case O_TPW:
-            if (!parse_long(optarg, 1, 1024, &n)) return bad_number("--threads-per-worker", "1..1024", optarg);
+            if (!number_arg("--threads-per-worker", NULL, 1, 1024, &n)) return AAFARM_EXIT_USAGE;
             f->threads_per_worker = (int)n;
             break;
         case O_TILE:
-            if (!parse_long(optarg, 1, 1024, &n)) return bad_number("--tile", "a size 1..1024", optarg);
+            if (!number_arg("--tile", "a size", 1, 1024, &n)) return AAFARM_EXIT_USAGE;
             c->job.tile_size = (int)n;
             break;
         case O_ARITH:
-            if (!trace_arith_parse(optarg, &c->job.arith))
-                return bad_number("--arith", "'affine' or 'interval'", optarg);
+            if (!trace_arith_parse(optarg, &c->job.arith)) {
+                fprintf(stderr, "aafarm-master: --arith wants 'affine' or 'interval', got '%s'\n",
+                        optarg);
+                return AAFARM_EXIT_USAGE;
+            }
             break;
         case O_BUDGET:
-            if (!parse_long(optarg, 1000, 1000000000L, &n)) return bad_number("--budget", "a number >= 1000", optarg);
+            if (!number_arg("--budget", "a number", 1000, 1000000000L, &n)) return AAFARM_EXIT_USAGE;
             c->job.max_instructions = n;
             break;
         case O_PREVIEW: f->preview = optarg; break;
         case O_STATS_JSON: f->stats_json = optarg; break;
         case O_HEARTBEAT:
-            if (!parse_long(optarg, 10, 3600000, &n)) return bad_number("--heartbeat", "milliseconds 10..3600000", optarg);
+            if (!number_arg("--heartbeat", "milliseconds", 10, 3600000, &n)) return AAFARM_EXIT_USAGE;
             f->heartbeat_ms = (int)n;
             break;
         case O_LIVENESS:
-            if (!parse_long(optarg, 1, 1000, &n)) return bad_number("--liveness", "1..1000", optarg);
+            if (!number_arg("--liveness", NULL, 1, 1000, &n)) return AAFARM_EXIT_USAGE;
             f->liveness = (int)n;
             break;
         case O_RETRIES:
-            if (!parse_long(optarg, 1, 1000, &n)) return bad_number("--retries", "1..1000", optarg);
+            if (!number_arg("--retries", NULL, 1, 1000, &n)) return AAFARM_EXIT_USAGE;
             f->max_attempts = (int)n;
             break;
         case O_LEASE:
-            if (!parse_long(optarg, 1, 86400, &n)) return bad_number("--lease", "seconds 1..86400", optarg);
+            if (!number_arg("--lease", "seconds", 1, 86400, &n)) return AAFARM_EXIT_USAGE;
             f->lease_ms = n * 1000;
             break;
         case O_LEASE_FACTOR:
-            if (!parse_long(optarg, 0, 1000, &n)) return bad_number("--lease-factor", "0..1000", optarg);
+            if (!number_arg("--lease-factor", NULL, 0, 1000, &n)) return AAFARM_EXIT_USAGE;
             f->lease_factor = (int)n;
             break;
         case O_DUPS:
-            if (!parse_long(optarg, 0, 100, &n)) return bad_number("--duplicates", "0..100", optarg);
+            if (!number_arg("--duplicates", NULL, 0, 100, &n)) return AAFARM_EXIT_USAGE;
             f->max_duplicates = (int)n;
             break;
         case O_WORKER_BIN: f->worker_binary = optarg; break;
         case O_RESUME: f->resume = true; break;
         case O_FRAMES: {
             frame_spec spec;
-            char err[600];
+            char err[ERR_LEN];
             if (!frame_spec_parse(optarg, &spec, err, sizeof err)) {
                 fprintf(stderr, "aafarm-master: %s\n", err);
                 return AAFARM_EXIT_USAGE;
@@ -197,7 +197,7 @@ static int parse(int argc, char **argv, cli *c)
             break;
         }
         case O_MAX_WORKERS:
-            if (!parse_long(optarg, 1, 65536, &n)) return bad_number("--max-workers", "1..65536", optarg);
+            if (!number_arg("--max-workers", NULL, 1, 65536, &n)) return AAFARM_EXIT_USAGE;
             f->max_workers = (int)n;
             break;
         case O_CURVE_SECRET: f->curve_secret = optarg; break;
@@ -287,7 +287,7 @@ static int load(cli *c, loaded *l)
         fr->jb = jb;
         fr->output = l->seq->outputs[i];
         fr->fmt = (image_format){jb->xres, jb->yres, c->job.tile_size, 0};   /* job_load's */
-        char err[300];
+        char err[ERR_LEN];
         if (!image_format_check(&fr->fmt, err, sizeof err)) {
             sl_diag_error(diag, (sl_pos){0}, "%s: %s", c->farm.scene_path, err);
             ok = false;

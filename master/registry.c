@@ -6,6 +6,7 @@
 #include "registry.h"
 #include "util/xalloc.h"
 
+#include <assert.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -52,6 +53,7 @@ static void drop_old_retired(registry *self)
     for (size_t i = 0; i < self->count; i++)
         if (!self->workers[i]->alive && retired++ == 0) first = i;
     if (retired < KEEP_RETIRED) return;
+    assert(first < self->count && !self->workers[first]->alive);   /* never a live one */
     free(self->workers[first]);
     memmove(&self->workers[first], &self->workers[first + 1],
             sizeof *self->workers * (self->count - first - 1));
@@ -61,6 +63,8 @@ static void drop_old_retired(registry *self)
 farm_worker *registry_add(registry *self, const uint8_t *id, size_t id_len, int64_t now_ms)
 {
     if (id_len == 0 || id_len > REGISTRY_MAX_ID) return NULL;
+    /* one live worker per routing id: the old one was retired first */
+    assert(registry_find(self, id, id_len) == NULL);
     drop_old_retired(self);
     if (self->count == self->cap) {
         self->cap = self->cap ? self->cap * 2 : 16;
@@ -88,6 +92,7 @@ farm_worker *registry_find(const registry *self, const uint8_t *id, size_t id_le
 void registry_retire(registry *self, farm_worker *w, const char *why, int64_t now_ms)
 {
     (void)self;
+    assert(w->alive);   /* a worker is retired once (its slot's leases requeued once) */
     w->alive = false;
     w->credits = 0;
     w->left_ms = now_ms;

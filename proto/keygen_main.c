@@ -10,6 +10,7 @@
 #include <zmq.h>
 
 #include "curve_cert.h"
+#include "util/err.h"
 #include "util/exitcodes.h"
 
 static void usage(FILE *out)
@@ -45,7 +46,7 @@ int main(int argc, char **argv)
     const char *base = argv[1];
     const char *name = strrchr(base, '/');
     name = name ? name + 1 : base;
-    char err[1200];
+    char err[2 * ERR_LEN];   /* "already exists" names the key's path three times */
     if (!curve_cert_generate(base, name, err, sizeof err)) {
         fprintf(stderr, "aafarm-keygen: %s\n", err);
         return AAFARM_EXIT_FAILURE;

@@ -15,6 +15,7 @@
 #include <string.h>
 
 #include "file_store.h"
+#include "util/err.h"
 #include "util/xalloc.h"
 
 enum { POLL_MS = 100, MAX_ATTEMPTS = 3 };
@@ -118,7 +119,7 @@ void file_fetch_add(file_fetch *self, const proto_job *m, int64_t now_ms)
     while (*tail) tail = &(*tail)->next;
     *tail = j;
     if (j->nfiles == 0) return;
-    char err[600];
+    char err[ERR_LEN];
     if (!self->store && !(self->store = file_store_open(self->dir, self->opt.budget, err,
                                                          sizeof err))) {
         job_fail(j, "job %.12s...: %s", j->hash, err);
@@ -209,7 +210,7 @@ static void finish(file_fetch *self, want *w, int64_t now_ms);
  * the store when another process has finished it. */
 static void start(file_fetch *self, want *w, int64_t now_ms)
 {
-    char path[PATH_MAX + 100], err[600];
+    char path[PATH_MAX + 100], err[ERR_LEN];
     int fd = file_store_acquire(self->store, w->sha256, w->size, path, sizeof path);
     if (fd >= 0) {
         file_store_release(fd);
@@ -237,7 +238,7 @@ bool file_fetch_poll_due(const file_fetch *self, int64_t now_ms)
 /* A transfer with every chunk written: hashed, into the store. */
 static void finish(file_fetch *self, want *w, int64_t now_ms)
 {
-    char err[600];
+    char err[ERR_LEN];
     w->complete = false;
     if (file_transfer_finish(&w->t, err, sizeof err) == 0) deliver(self, w->sha256);
     else if (++w->attempts >= MAX_ATTEMPTS) fail_file(self, w, err);
@@ -280,7 +281,7 @@ uint64_t file_fetch_chunk(file_fetch *self, const proto_file_chunk *c, const uin
 {
     want *w = find_want(self, c->sha256);
     if (!w || !w->t || w->complete || c->file_size != w->size) return 0;
-    char err[600];
+    char err[ERR_LEN];
     long n = file_transfer_put(w->t, c->offset, data, len, err, sizeof err);
     if (n < 0) {
         file_transfer_abandon(&w->t);

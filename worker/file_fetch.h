@@ -23,6 +23,7 @@
 #include <stdint.h>
 
 #include "message.h"
+#include "util/err.h"
 #include "util/hash.h"
 
 typedef struct file_fetch_options {
@@ -42,7 +43,7 @@ typedef struct fetch_job {
     int *fds;                      /* ... and its "in use" descriptor (-1: absent) */
     uint32_t hits, misses;         /* present at arrival / fetched */
     uint64_t fetched;              /* file bytes this process received for it */
-    char error[1024];              /* non-empty: its files cannot be had */
+    char error[ERR_LEN];           /* non-empty: its files cannot be had */
     struct fetch_job *next;
 } fetch_job;
 

@@ -6,6 +6,7 @@
 #define _GNU_SOURCE
 #include "file_store.h"
 
+#include <assert.h>
 #include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
@@ -308,6 +309,7 @@ int file_store_evict(file_store *self)
             if (flock(fd, LOCK_EX | LOCK_NB) == 0 && fstat(fd, &a) == 0 && stat(path, &b) == 0 &&
                 a.st_ino == b.st_ino && unlink(path) == 0) {
                 stamp_remove(self, v[i].name);
+                assert(v[i].size <= total);   /* the total is the sum of the sizes listed */
                 total -= v[i].size;
                 removed++;
             }
@@ -375,6 +377,8 @@ static bool load_map(file_transfer *t)
                   get_be64(head) == t->chunk && get_be64(head + 8) == t->size &&
                   (t->nchunks == 0 ||
                    pread(t->map_fd, t->have, t->nchunks, MAP_HEADER) == (ssize_t)t->nchunks);
+    /* the map, read or fresh, covers the file in whole chunks */
+    assert(t->chunk >= 1 && t->nchunks == (size_t)((t->size + t->chunk - 1) / t->chunk));
     if (resume) {
         for (size_t i = 0; i < t->nchunks; i++) t->have[i] = t->have[i] == 1;
         return true;
@@ -407,6 +411,7 @@ file_begin file_store_begin(file_store *self, const char *sha, uint64_t size, ui
     t->size = size;
     t->chunk = chunk ? chunk : 1;
     t->nchunks = (size_t)((size + t->chunk - 1) / t->chunk);
+    assert((uint64_t)t->nchunks * t->chunk >= size);
     t->have = xcalloc(t->nchunks + 1, 1);
     t->asked = xcalloc(t->nchunks + 1, 1);
     t->lock_fd = open(lock, O_RDWR | O_CREAT | O_CLOEXEC, 0600);
@@ -461,6 +466,7 @@ long file_transfer_put(file_transfer *t, uint64_t offset, const void *data, size
     if (len != (left < t->chunk ? left : t->chunk) || t->have[i]) return 0;
     static const unsigned char one = 1;
     /* the bytes first, then the map: a crash in between costs one chunk */
+    assert(i < t->nchunks);   /* offset < size: a chunk of the map */
     if (!fd_pwrite_all(t->data_fd, data, len, offset) ||
         !fd_pwrite_all(t->map_fd, &one, 1, MAP_HEADER + (uint64_t)i)) {
         err_set(err, errsz, "cannot write to the file cache %s: %s (free space there, or give "
@@ -501,6 +507,7 @@ const char *file_transfer_sha256(const file_transfer *t) { return t->sha256; }
 int file_transfer_finish(file_transfer **self_p, char *err, size_t errsz)
 {
     file_transfer *t = *self_p;
+    assert(file_transfer_complete(t));   /* finished only with every chunk written */
     *self_p = NULL;
     char data[PATH_MAX + 100], map[PATH_MAX + 100], lock[PATH_MAX + 100], obj[PATH_MAX + 100];
     sub_path(t->store, data, sizeof data, "partial", t->sha256, "");

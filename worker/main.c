@@ -12,7 +12,9 @@
 #include "job/frames.h"
 #include "tex/tex.h"
 #include "standalone.h"
+#include "util/err.h"
 #include "util/exitcodes.h"
+#include "util/parse_num.h"
 #include "worker_loop.h"
 
 static void usage(FILE *out)
@@ -75,29 +77,14 @@ static void usage(FILE *out)
         "the master (protocol version mismatch), 130 after SIGINT/SIGTERM.\n");
 }
 
-/* "400K", "4M", "1G", "123" -> bytes; false on garbage */
-static bool parse_bytes(const char *s, size_t *out)
+/* optarg as a whole number of lo..hi into *n; false after printing
+ * "aafarm-worker: OPT wants NOUN LO..HI, got 'TEXT'". */
+static bool number_arg(const char *opt, const char *noun, long lo, long hi, long *n)
 {
-    char *end;
-    double v = strtod(s, &end);
-    if (end == s || v < 0) return false;
-    double mul = 1;
-    if (*end == 'K' || *end == 'k') { mul = 1024; end++; }
-    else if (*end == 'M' || *end == 'm') { mul = 1024.0 * 1024; end++; }
-    else if (*end == 'G' || *end == 'g') { mul = 1024.0 * 1024 * 1024; end++; }
-    if (*end == 'B' || *end == 'b') end++;
-    if (*end) return false;
-    *out = (size_t)(v * mul);
-    return true;
-}
-
-static bool parse_int(const char *s, long lo, long hi, long *out)
-{
-    char *end;
-    long v = strtol(s, &end, 10);
-    if (end == s || *end || v < lo || v > hi) return false;
-    *out = v;
-    return true;
+    char err[ERR_LEN];
+    if (parse_option_long(opt, noun, optarg, lo, hi, n, err, sizeof err)) return true;
+    fprintf(stderr, "aafarm-worker: %s\n", err);
+    return false;
 }
 
 /* The box cache budget per render thread when --cache-bytes is not given:
@@ -163,21 +150,15 @@ int main(int argc, char **argv)
         case O_CONNECT: connect = optarg; break;
         case O_NAME: wo.name = optarg; break;
         case 't':
-            if (!parse_int(optarg, 1, 1024, &n)) {
-                fprintf(stderr, "aafarm-worker: --threads wants a number 1..1024, got '%s'\n", optarg);
-                return AAFARM_EXIT_USAGE;
-            }
+            if (!number_arg("--threads", "a number", 1, 1024, &n)) return AAFARM_EXIT_USAGE;
             so.threads = wo.threads = (int)n;
             break;
         case O_TILE:
-            if (!parse_int(optarg, 1, 1024, &n)) {
-                fprintf(stderr, "aafarm-worker: --tile wants a size 1..1024, got '%s'\n", optarg);
-                return AAFARM_EXIT_USAGE;
-            }
+            if (!number_arg("--tile", "a size", 1, 1024, &n)) return AAFARM_EXIT_USAGE;
             so.job.tile_size = (int)n;
             break;
         case O_CACHE:
-            if (!parse_bytes(optarg, &so.cache_bytes)) {
+            if (!parse_byte_count(optarg, &so.cache_bytes)) {
                 fprintf(stderr, "aafarm-worker: --cache-bytes wants e.g. 40K, 4M or 0, got '%s'\n", optarg);
                 return AAFARM_EXIT_USAGE;
             }
@@ -190,34 +171,25 @@ int main(int argc, char **argv)
             }
             break;
         case O_BUDGET:
-            if (!parse_int(optarg, 1000, 1000000000L, &n)) {
-                fprintf(stderr, "aafarm-worker: --budget wants a number >= 1000, got '%s'\n", optarg);
-                return AAFARM_EXIT_USAGE;
-            }
+            if (!number_arg("--budget", "a number", 1000, 1000000000L, &n)) return AAFARM_EXIT_USAGE;
             so.job.max_instructions = n;
             break;
         case O_PREVIEW: so.preview = optarg; break;
         case O_STATS: so.stats = true; break;
         case O_STATS_JSON: so.stats_json = optarg; break;
         case O_TILE_DELAY:
-            if (!parse_int(optarg, 0, 600000, &n)) {
-                fprintf(stderr, "aafarm-worker: --tile-delay wants milliseconds 0..600000, got '%s'\n", optarg);
-                return AAFARM_EXIT_USAGE;
-            }
+            if (!number_arg("--tile-delay", "milliseconds", 0, 600000, &n)) return AAFARM_EXIT_USAGE;
             wo.tile_delay_ms = (int)n;
             break;
         case O_PREPARE_DELAY:
-            if (!parse_int(optarg, 0, 600000, &n)) {
-                fprintf(stderr, "aafarm-worker: --prepare-delay wants milliseconds 0..600000, got '%s'\n", optarg);
-                return AAFARM_EXIT_USAGE;
-            }
+            if (!number_arg("--prepare-delay", "milliseconds", 0, 600000, &n)) return AAFARM_EXIT_USAGE;
             wo.prepare_delay_ms = (int)n;
             break;
         case O_CURVE_SECRET: wo.curve_secret = optarg; break;
         case O_MASTER_KEY: wo.master_key = optarg; break;
         case O_FRAMES: {
             frame_spec spec;
-            char err[600];
+            char err[ERR_LEN];
             if (!frame_spec_parse(optarg, &spec, err, sizeof err)) {
                 fprintf(stderr, "aafarm-worker: %s\n", err);
                 return AAFARM_EXIT_USAGE;
@@ -230,7 +202,7 @@ int main(int argc, char **argv)
         case O_FILE_CACHE_BYTES:
         case O_FILE_INFLIGHT: {
             size_t b;
-            if (!parse_bytes(optarg, &b)) {
+            if (!parse_byte_count(optarg, &b)) {
                 fprintf(stderr, "aafarm-worker: --%s wants e.g. 400K, 4M, 2G or 0, got '%s'\n",
                         c == O_FILE_INFLIGHT ? "file-inflight" : "file-cache-bytes", optarg);
                 return AAFARM_EXIT_USAGE;
@@ -246,7 +218,7 @@ int main(int argc, char **argv)
         }
         case O_FILE_CHUNK: {
             size_t b;
-            if (!parse_bytes(optarg, &b) || b < 1024 || b > (16u << 20)) {
+            if (!parse_byte_count(optarg, &b) || b < 1024 || b > (16u << 20)) {
                 fprintf(stderr, "aafarm-worker: --file-chunk wants 1K..16M, got '%s'\n", optarg);
                 return AAFARM_EXIT_USAGE;
             }
@@ -254,15 +226,12 @@ int main(int argc, char **argv)
             break;
         }
         case O_FILE_DELAY:
-            if (!parse_int(optarg, 0, 600000, &n)) {
-                fprintf(stderr, "aafarm-worker: --file-delay wants milliseconds 0..600000, got '%s'\n", optarg);
-                return AAFARM_EXIT_USAGE;
-            }
+            if (!number_arg("--file-delay", "milliseconds", 0, 600000, &n)) return AAFARM_EXIT_USAGE;
             wo.file_delay_ms = (int)n;
             break;
         case O_TEXTURE_BYTES: {
             size_t b;
-            if (!parse_bytes(optarg, &b)) {
+            if (!parse_byte_count(optarg, &b)) {
                 fprintf(stderr, "aafarm-worker: --texture-bytes wants e.g. 64M, 2G or 0, got '%s'\n", optarg);
                 return AAFARM_EXIT_USAGE;
             }

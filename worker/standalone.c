@@ -24,6 +24,7 @@
 #include "tex/tex.h"
 #include "tile_render.h"
 #include "tile_runs.h"
+#include "util/err.h"
 #include "util/exitcodes.h"
 #include "util/xalloc.h"
 
@@ -50,7 +51,7 @@ typedef struct shared {
     pthread_mutex_t lock;          /* writer, preview, progress, error */
     int done;
     bool failed;
-    char error[600];
+    char error[ERR_LEN];
     trace_stats stats;
     trace_object_work *work;       /* per object, summed over the threads */
     worker_nonfinite nonfinite;    /* summed; x, y of the first tile's first */
@@ -96,7 +97,7 @@ static void *render_thread(void *arg)
         pthread_mutex_unlock(&s->lock);
         if (stop) break;
         image_rect r = image_format_tile_rect(&s->fmt, i % tx_count, i / tx_count);
-        char err[600];
+        char err[ERR_LEN];
         worker_nonfinite nf;
         image_tile *tile = worker_render_tile(s->js, th, r, s->fmt.layers, &nf, err, sizeof err);
         pthread_mutex_lock(&s->lock);
@@ -185,7 +186,7 @@ static int render_frame(const standalone_options *opt, const job *jb, const fram
     shared s = {.opt = opt, .js = js};
     s.fmt = (image_format){js->world.camera.xres, js->world.camera.yres,
                            opt->job.tile_size, 0};
-    char err[600];
+    char err[ERR_LEN];
     if (!image_format_check(&s.fmt, err, sizeof err)) {
         fprintf(stderr, "aafarm-worker: %s\n", err);
         job_scene_destroy(&js);
@@ -273,7 +274,7 @@ static int render_frame(const standalone_options *opt, const job *jb, const fram
 static char *frame_name(const char *name, const job *jb, int nframes)
 {
     if (!name) return NULL;
-    char err[300];
+    char err[ERR_LEN];
     char *out = frame_output_name(name, jb->frame_number, nframes, false, err, sizeof err);
     if (!out) fprintf(stderr, "aafarm-worker: %s\n", err);
     return out;

@@ -4,6 +4,7 @@
  */
 #include "worker_jobs.h"
 
+#include <assert.h>
 #include <limits.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -21,7 +22,9 @@ struct worker_jobs {
 
 held_job *held_job_retain(held_job *self)
 {
-    atomic_fetch_add(&self->refs, 1);
+    int was = atomic_fetch_add(&self->refs, 1);
+    assert(was >= 1);   /* only a job someone still holds is retained */
+    (void)was;
     return self;
 }
 
@@ -30,7 +33,9 @@ void held_job_release(held_job **self_p)
     held_job *self = *self_p;
     if (!self) return;
     *self_p = NULL;
-    if (atomic_fetch_sub(&self->refs, 1) != 1) return;
+    int was = atomic_fetch_sub(&self->refs, 1);
+    assert(was >= 1);   /* never released more often than held */
+    if (was != 1) return;
     job_scene_destroy(&self->js);
     job_destroy(&self->jb);
     for (int i = 0; i < self->nfile_fds; i++) file_store_release(self->file_fds[i]);
@@ -83,7 +88,7 @@ static job *rebuild(const proto_job *m, char *err, size_t errsz)
 {
     job_options jo = options_of(&m->options);
     job *jb = job_new(m->scene_name, (const char *)m->scene_text, m->scene_len, &jo);
-    char why[600];
+    char why[ERR_LEN];
     bool ok = true;
     for (size_t i = 0; ok && i < m->n_sources; i++)
         ok = job_add_source(jb, m->sources[i].name, (const char *)m->sources[i].text,
@@ -148,9 +153,8 @@ static bool prepare(held_job *h, const proto_job *m, size_t cache_bytes)
                  h->js->world.camera.xres, h->js->world.camera.yres);
         return false;
     }
-    char err[300];
-    if (!image_format_check(&h->fmt, err, sizeof err)) {
-        snprintf(h->error, sizeof h->error, "job %.12s...: %s", h->hash, err);
+    if (!image_format_check(&h->fmt, h->error, sizeof h->error)) {
+        err_prefix(h->error, sizeof h->error, "job %.12s...", h->hash);
         return false;
     }
     return true;

@@ -26,6 +26,7 @@
 #include "image/format.h"
 #include "job/job_scene.h"
 #include "message.h"
+#include "util/err.h"
 
 typedef struct held_job {
     char hash[HASH_HEX_SIZE];
@@ -33,7 +34,7 @@ typedef struct held_job {
     job_scene *js;             /* NULL when broken */
     image_format fmt;          /* the image the tiles belong to */
     bool broken;
-    char error[1024];          /* why it is broken */
+    char error[ERR_LEN];       /* why it is broken */
     int *file_fds;             /* its files' "in use" descriptors (file_store.h) */
     int nfile_fds;
     uint64_t files_said;       /* the master session told FilesReady for it */

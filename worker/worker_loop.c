@@ -43,6 +43,7 @@
 
 #include "curve_cert.h"
 #include "file_fetch.h"
+#include "util/err.h"
 #include "util/exitcodes.h"
 #include "version.h"
 #include "wire.h"
@@ -87,7 +88,7 @@ typedef struct worker_loop {
     pending_grant *pending;
     worker_task *outbox;           /* finished tiles the socket could not take yet */
     session_end end;
-    char fatal[600];
+    char fatal[ERR_LEN];
     int64_t drop_logged_ms;
     uint64_t tiles_sent, failures_sent;
     /* CURVE (opt->curve_secret): this worker's keys and the master's */
@@ -299,10 +300,10 @@ static void start_tile(worker_loop *w, held_job *h, uint64_t lease, uint32_t til
         return;
     }
     int tx, ty;
-    char err[300];
+    char err[ERR_LEN];
     if (!image_format_tile_index(&h->fmt, rect, &tx, &ty, err, sizeof err) ||
         (uint32_t)(ty * image_format_tiles_x(&h->fmt) + tx) != tile) {
-        char msg[400];
+        char msg[ERR_LEN];
         snprintf(msg, sizeof msg, "Grant for tile %u: the rectangle (%d,%d) %dx%d is not that "
                  "tile of the job's image", tile, rect.x0, rect.y0, rect.w, rect.h);
         send_failure(w, h->hash, lease, tile, msg, false);
@@ -315,10 +316,10 @@ static void start_tile(worker_loop *w, held_job *h, uint64_t lease, uint32_t til
 
 static void on_welcome(worker_loop *w, const proto_welcome *m)
 {
-    char why[200];
-    if (proto_version_check(m->protocol_version, AAFARM_PROTOCOL_VERSION, why, sizeof why) != 0) {
-        snprintf(w->fatal, sizeof w->fatal, "the master at %s cannot serve this worker: %s",
-                 w->opt->endpoint, why);
+    if (proto_version_check(m->protocol_version, AAFARM_PROTOCOL_VERSION, w->fatal,
+                            sizeof w->fatal) != 0) {
+        err_prefix(w->fatal, sizeof w->fatal, "the master at %s cannot serve this worker",
+                   w->opt->endpoint);
         w->end = SESSION_FATAL;
         return;
     }
@@ -463,7 +464,7 @@ static void job_ready(worker_loop *w, held_job *h)
               h->fmt.height);
     /* where the texture module will open each file (through the resolver) */
     for (int i = 0; !h->broken && w->opt->verbosity > 0 && i < h->jb->nfiles; i++) {
-        char path[4096], why[600];
+        char path[4096], why[ERR_LEN];
         if (job_file_resolve(h->jb, h->jb->files[i].name, path, sizeof path, why, sizeof why))
             wlog(w, 1, "file '%s' resolves to %s", h->jb->files[i].name, path);
         else
@@ -806,7 +807,7 @@ int worker_loop_run(const worker_loop_options *opt)
     signal(SIGPIPE, SIG_IGN);
 
     if (opt->curve_secret) {
-        char err[1200];
+        char err[ERR_LEN];
         if (!curve_cert_read(opt->curve_secret, true, &w.own, err, sizeof err) ||
             !curve_cert_read(opt->master_key, false, &w.master, err, sizeof err)) {
             wlog(&w, -1, "%s", err);

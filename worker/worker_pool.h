@@ -44,7 +44,7 @@ typedef struct worker_task {
     bool ok;
     void *exr;                 /* the tile file (malloc'd) when ok */
     size_t exr_len;
-    char error[1200];          /* why not ok */
+    char error[2 * ERR_LEN];   /* why not ok: a tile's place and a render thread's ERR_LEN message */
     worker_tile_stats stats;
     struct worker_task *next;
 } worker_task;

@@ -363,6 +363,10 @@ static void test_farm_usage_errors(void **state)
     const char *bad_tile[] = {ft_master, ft_path(dir, "scene.rib"), "-o", "x.exr", "--tile", "0",
                               NULL};
     assert_int_equal(ft_wait(ft_spawn(log, bad_tile), 30), 2);
+    /* an out-of-range number names both bounds (issue 27: --budget) */
+    const char *big_budget[] = {ft_master, ft_path(dir, "scene.rib"), "-o", "x.exr", "--budget",
+                                "2000000000", NULL};
+    assert_int_equal(ft_wait(ft_spawn(log, big_budget), 30), 2);
     const char *bad_bind[] = {ft_master, ft_path(dir, "scene.rib"), "-o", ft_path(dir, "x.exr"),
                               "--bind", "nonsense://here", NULL};
     assert_int_equal(ft_wait(ft_spawn(log, bad_bind), 30), 2);
@@ -371,6 +375,9 @@ static void test_farm_usage_errors(void **state)
     const char *bad_connect[] = {ft_worker, "--connect", "nonsense://here", NULL};
     assert_int_equal(ft_wait(ft_spawn(log, bad_connect), 30), 2);
     assert_int_equal(ft_count(log, "cannot bind nonsense://here"), 1);
+    assert_int_equal(ft_count(log, "aafarm-master: --tile wants a size 1..1024, got '0'"), 1);
+    assert_int_equal(ft_count(log, "aafarm-master: --budget wants a number 1000..1000000000, "
+                                   "got '2000000000'"), 1);
     assert_int_equal(ft_count(log, "cannot connect to 'nonsense://here'"), 1);
 }
 

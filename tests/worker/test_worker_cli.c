@@ -95,6 +95,10 @@ static void test_help_and_usage(void **state)
     assert_int_equal(count_files(".exr"), 0);
     assert_int_equal(run("--cache-bytes lots --standalone x.rib -o x.exr", out, sizeof out), 2);
     assert_non_null(strstr(out, "--cache-bytes"));
+    /* an out-of-range number: both bounds named (issue 27) */
+    assert_int_equal(run("--budget 2000000000 --standalone x.rib -o x.exr", out, sizeof out), 2);
+    assert_non_null(strstr(out, "aafarm-worker: --budget wants a number 1000..1000000000, got "
+                                "'2000000000'"));
 }
 
 static void test_bad_scene_and_bad_shader(void **state)

@@ -17,6 +17,7 @@
 #include "sl/noise.h"
 #include "tex/tex.h"
 #include "util/err.h"
+#include "util/parse_num.h"
 #include "util/xalloc.h"
 
 static void usage(FILE *out)
@@ -32,16 +33,6 @@ static void usage(FILE *out)
           "  --octaves N   fBm octaves (default 6)\n"
           "  --seed N      fBm seed (default 1)\n",
           out);
-}
-
-static bool parse_int(const char *s, long lo, long hi, long *out)
-{
-    char *end;
-    long v = strtol(s, &end, 10);
-    if (!*s || *end || v < lo || v > hi)
-        return false;
-    *out = v;
-    return true;
 }
 
 /* Periodic fBm: sum over octaves of 0.5^o (2 pnoise - 1) at 4 * 2^o cells
@@ -81,8 +72,8 @@ int main(int argc, char **argv)
         } else if (strcmp(a, "--no-minmax") == 0) {
             minmax = false;
         } else if (strcmp(a, "--fbm") == 0) {
-            if (i + 2 >= argc || !parse_int(argv[i + 1], 1, 1 << 16, &fbm_w) ||
-                !parse_int(argv[i + 2], 1, 1 << 16, &fbm_h)) {
+            if (i + 2 >= argc || !parse_long_within(argv[i + 1], 1, 1 << 16, &fbm_w) ||
+                !parse_long_within(argv[i + 2], 1, 1 << 16, &fbm_h)) {
                 fprintf(stderr, "aafarm-maketx: --fbm takes a width and a height of 1 to "
                                 "65536 texels\n");
                 return 2;
@@ -90,8 +81,8 @@ int main(int argc, char **argv)
             i += 2;
         } else if (strcmp(a, "--octaves") == 0 || strcmp(a, "--seed") == 0) {
             long *dst = a[2] == 'o' ? &octaves : &seed;
-            if (i + 1 >= argc || !parse_int(argv[i + 1], a[2] == 'o' ? 1 : 0,
-                                            a[2] == 'o' ? 16 : 1000000, dst)) {
+            if (i + 1 >= argc || !parse_long_within(argv[i + 1], a[2] == 'o' ? 1 : 0,
+                                                    a[2] == 'o' ? 16 : 1000000, dst)) {
                 fprintf(stderr, "aafarm-maketx: %s takes %s\n", a,
                         a[2] == 'o' ? "1 to 16 octaves" : "a seed from 0 to 1000000");
                 return 2;
