@@ -8,6 +8,7 @@
  */
 #include "geom/subdiv_local.h"
 #include "geom/surface_internal.h"
+#include "util/err.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -43,12 +44,12 @@ static int find_corner(const dir_edge *e, int ne, int a, int b)
     return lo;
 }
 
-geom_subdiv *geom_subdiv_new(const geom_subdiv_desc *d, char *why, int why_size)
+geom_subdiv *geom_subdiv_new(const geom_subdiv_desc *d, char *err, size_t errsz)
 {
     int nf = d->nfaces, nv = d->npoints, nc = 0;
     for (int f = 0; f < nf; f++) {
         if (d->nverts[f] < 3 || d->nverts[f] > GEOM_SUBDIV_MAX_VALENCE) {
-            geom_fail(why, why_size, "face %d has %d points (3 to %d are supported)", f,
+            err_set(err, errsz, "face %d has %d points (3 to %d are supported)", f,
                       d->nverts[f], GEOM_SUBDIV_MAX_VALENCE);
             return NULL;
         }
@@ -56,7 +57,7 @@ geom_subdiv *geom_subdiv_new(const geom_subdiv_desc *d, char *why, int why_size)
     }
     for (int i = 0; i < 3 * nv; i++)
         if (!isfinite(d->P[i]) || fabs(d->P[i]) > 1e150) {
-            geom_fail(why, why_size, "point %d is not finite", i / 3);
+            err_set(err, errsz, "point %d is not finite", i / 3);
             return NULL;
         }
     sd_mesh m0 = { nv, nf, malloc((size_t)(nv + 1) * sizeof(vec3)),
@@ -84,7 +85,7 @@ geom_subdiv *geom_subdiv_new(const geom_subdiv_desc *d, char *why, int why_size)
             int nx = c + 1 < m0.fo[f + 1] ? c + 1 : m0.fo[f];
             e[c] = (dir_edge){ m0.fv[c], m0.fv[nx], c };
             if (m0.fv[c] == m0.fv[nx]) {
-                ok = geom_fail(why, why_size, "face %d repeats point %d", f, m0.fv[c]);
+                ok = err_set(err, errsz, "face %d repeats point %d", f, m0.fv[c]);
                 break;
             }
         }
@@ -96,10 +97,10 @@ geom_subdiv *geom_subdiv_new(const geom_subdiv_desc *d, char *why, int why_size)
                           (e[j].a == e[i].b && e[j].b == e[i].a)))
             j++;
         if (j - i > 2)
-            ok = geom_fail(why, why_size, "the edge %d-%d has %d faces (at most 2: the mesh "
+            ok = err_set(err, errsz, "the edge %d-%d has %d faces (at most 2: the mesh "
                            "must be a manifold)", e[i].a, e[i].b, j - i);
         else if (j - i == 2 && e[i].a == e[i + 1].a)
-            ok = geom_fail(why, why_size, "faces %d and %d run the edge %d-%d the same way "
+            ok = err_set(err, errsz, "faces %d and %d run the edge %d-%d the same way "
                            "(orient all faces alike)", face_of[e[i].c], face_of[e[i + 1].c],
                            e[i].a, e[i].b);
         else if (j - i == 1) {
@@ -114,7 +115,7 @@ geom_subdiv *geom_subdiv_new(const geom_subdiv_desc *d, char *why, int why_size)
     for (int c = 0; c < nc; c++) val[m0.fv[c]]++;
     for (int i = 0; i < nv && ok; i++)
         if (val[i] > GEOM_SUBDIV_MAX_VALENCE)
-            ok = geom_fail(why, why_size, "point %d is in %d faces (at most %d are supported)",
+            ok = err_set(err, errsz, "point %d is in %d faces (at most %d are supported)",
                            i, val[i], GEOM_SUBDIV_MAX_VALENCE);
         else if (d->interpolateboundary && val[i] == 1 && count[i] == 2)
             m0.vs[i] = INFINITY;       /* a corner of the boundary */
@@ -135,7 +136,7 @@ geom_subdiv *geom_subdiv_new(const geom_subdiv_desc *d, char *why, int why_size)
                     }
             }
             if (!found)
-                ok = geom_fail(why, why_size, "crease %d: points %d and %d share no edge", k, a, b);
+                ok = err_set(err, errsz, "crease %d: points %d and %d share no edge", k, a, b);
         }
         cv += d->crease_len[k];
     }

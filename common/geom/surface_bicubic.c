@@ -39,6 +39,7 @@
  */
 #include "geom/surface.h"
 #include "geom/surface_internal.h"
+#include "util/err.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -337,20 +338,20 @@ bool geom_bicubic_net_aa(aa_context *ctx, const geom_surface *b, const aa_form *
 
 /* ---- prepare and bounds --------------------------------------------- */
 
-bool geom_bicubic_prepare(geom_surface *s, char *why, int why_size)
+bool geom_bicubic_prepare(geom_surface *s, char *err, size_t errsz)
 {
     if (s->nverts != 16)
-        return geom_fail(why, why_size, "bicubic patch needs 16 control points, got %d",
+        return err_set(err, errsz, "bicubic patch needs 16 control points, got %d",
                          s->nverts);
     double size = 0;
     for (int i = 0; i < 16; i++) {
         vec3 p = s->verts[i];
         if (!isfinite(p.x) || !isfinite(p.y) || !isfinite(p.z))
-            return geom_fail(why, why_size, "bicubic patch control point %d is not finite", i);
+            return err_set(err, errsz, "bicubic patch control point %d is not finite", i);
         size = fmax(size, v3_length(v3_sub(p, s->verts[0])));
     }
     if (!isfinite(size) || size > 1e150)
-        return geom_fail(why, why_size, "bicubic patch control points are too large");
+        return err_set(err, errsz, "bicubic patch control points are too large");
     /* degenerate: all control points on one line (no normal anywhere) */
     double area = 0;
     for (int i = 1; i < 16; i++)
@@ -358,7 +359,7 @@ bool geom_bicubic_prepare(geom_surface *s, char *why, int why_size)
             area = fmax(area, v3_length(v3_cross(v3_sub(s->verts[i], s->verts[0]),
                                                  v3_sub(s->verts[j], s->verts[0]))));
     if (!(area > 1e-12 * size * size))
-        return geom_fail(why, why_size, "bicubic patch is degenerate: its control points "
+        return err_set(err, errsz, "bicubic patch is degenerate: its control points "
                          "lie on one line");
     return true;
 }

@@ -16,6 +16,7 @@
  */
 #include "scene/rib_parser.h"
 #include "sl/strbuf.h"
+#include "util/err.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -219,10 +220,10 @@ void rib_declare(rib_parser *p, const rib_request *req)
         return;
     }
     rib_decl decl;
-    char why[160];
-    if (!rib_decl_parse(text, false, &decl, NULL, NULL, why, sizeof why)) {
+    char err[ERR_LEN];
+    if (!rib_decl_parse(text, false, &decl, NULL, NULL, err, sizeof err)) {
         rib_error(p, req, req->args[1].pos, "cannot read the declaration \"%s\": %s "
-                  "(expected [class] type [n], e.g. \"uniform float\")", text, why);
+                  "(expected [class] type [n], e.g. \"uniform float\")", text, err);
         return;
     }
     rib_decls_add(p->decls, name, decl);

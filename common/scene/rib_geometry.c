@@ -13,6 +13,7 @@
 #include "scene/rib_parser.h"
 #include "scene/rib_primvar.h"
 #include "sl/strbuf.h"
+#include "util/err.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -27,7 +28,7 @@ static double radians(double degrees) { return degrees * (M_PI / 180.0); }
 
 #ifndef SCENE_HAVE_GEOM
 /* Stand-in checks for builds without common/geom. */
-static bool basic_check(const geom_surface *s, char *why, int n)
+static bool basic_check(const geom_surface *s, char *err, size_t errsz)
 {
     const char *what = NULL;
     switch (s->kind) {
@@ -58,17 +59,17 @@ static bool basic_check(const geom_surface *s, char *why, int n)
     if (!what && s->kind < GEOM_POLYGON && !theta_ok)
         what = "thetamax must be non-zero and at most 360 degrees";
     if (what)
-        snprintf(why, (size_t)n, "%s", what);
+        err_set(err, errsz, "%s", what);
     return what == NULL;
 }
 #endif
 
-static bool prepare_surface(geom_surface *s, char *why, int n)
+static bool prepare_surface(geom_surface *s, char *err, size_t errsz)
 {
 #ifdef SCENE_HAVE_GEOM
-    return geom_surface_prepare(s, why, n);
+    return geom_surface_prepare(s, err, errsz);
 #else
-    return basic_check(s, why, n);
+    return basic_check(s, err, errsz);
 #endif
 }
 
@@ -157,9 +158,9 @@ void rib_add_surface(rib_parser *p, const rib_request *req, const geom_surface *
  * (or records it in the object being defined, rib_instance.c). */
 static void add_object(rib_parser *p, const rib_request *req, geom_surface *surf)
 {
-    char why[256] = "";
-    if (!prepare_surface(surf, why, sizeof why)) {
-        rib_error(p, req, req->pos, "%s", why[0] ? why : "invalid parameters");
+    char err[ERR_LEN] = "";
+    if (!prepare_surface(surf, err, sizeof err)) {
+        rib_error(p, req, req->pos, "%s", err[0] ? err : "invalid parameters");
         return;
     }
     rib_add_surface(p, req, surf);
@@ -303,9 +304,9 @@ void rib_polygon(rib_parser *p, const rib_request *req)
     else if (P) {
         geom_surface s = new_surface(GEOM_POLYGON);
         take_vertices(&s, P, n);
-        char why[256] = "";
-        if (!prepare_surface(&s, why, sizeof why))
-            rib_error(p, req, req->pos, "%s", why[0] ? why : "invalid parameters");
+        char err[ERR_LEN] = "";
+        if (!prepare_surface(&s, err, sizeof err))
+            rib_error(p, req, req->pos, "%s", err[0] ? err : "invalid parameters");
         else if (!rib_polygon_vars(p, req, &params, P))   /* with primitive variables */
             rib_add_surface(p, req, &s);
     }

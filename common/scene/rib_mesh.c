@@ -33,6 +33,7 @@
 
 #ifdef SCENE_HAVE_GEOM
 #include "geom/triangulate.h"
+#include "util/err.h"
 #endif
 
 #include <math.h>
@@ -120,12 +121,12 @@ static bool add_triangle(rib_parser *p, const mesh *m, int face, const int *idx,
         s.vn[0] = n[0], s.vn[1] = n[1], s.vn[2] = n[2];
     }
 #ifdef SCENE_HAVE_GEOM
-    char why[256];
-    if (!geom_surface_prepare(&s, why, sizeof why)) {
+    char err[ERR_LEN];
+    if (!geom_surface_prepare(&s, err, sizeof err)) {
         if (!n)
             return false;
         s.nvn = 0;                  /* normals it cannot interpolate: flat */
-        if (!geom_surface_prepare(&s, why, sizeof why))
+        if (!geom_surface_prepare(&s, err, sizeof err))
             return false;
     }
 #endif
@@ -171,8 +172,8 @@ static bool add_face(rib_parser *p, mesh *m, int face, const int *loop_sizes, in
         for (int i = 0; i < total; i++)
             s.verts[i] = point(m, idx[i]);
 #ifdef SCENE_HAVE_GEOM
-        char why[256];
-        if (geom_surface_prepare(&s, why, sizeof why)) {
+        char err[ERR_LEN];
+        if (geom_surface_prepare(&s, err, sizeof err)) {
             rib_corner corners[GEOM_MAX_POLY_VERTS];
             for (int i = 0; i < total; i++)
                 corners[i] = corner_of(m, face, idx, i);
@@ -214,13 +215,13 @@ static bool add_face(rib_parser *p, mesh *m, int face, const int *loop_sizes, in
         pts[i] = point(m, idx[i]);
     int max = total + 2 * nloops;
     int (*tris)[3] = sl_xrealloc(NULL, (size_t)max * sizeof *tris);
-    char why[256];
-    int n = geom_triangulate(pts, loop_sizes, nloops, tris, max, why, sizeof why);
+    char err[ERR_LEN];
+    int n = geom_triangulate(pts, loop_sizes, nloops, tris, max, err, sizeof err);
     bool ok = true;
-    if (n < 0 && strcmp(why, "the polygon has no area") == 0) {
+    if (n < 0 && strcmp(err, "the polygon has no area") == 0) {
         m->skipped++;
     } else if (n < 0) {
-        rib_error(p, m->req, m->vertices_pos, "face %d: %s", face, why);
+        rib_error(p, m->req, m->vertices_pos, "face %d: %s", face, err);
         ok = false;
     } else {
         int added = 0;

@@ -23,6 +23,7 @@
 
 #ifdef SCENE_HAVE_GEOM
 #include "geom/nurbs.h"
+#include "util/err.h"
 #endif
 
 #include <math.h>
@@ -169,11 +170,11 @@ static void add_nurbs(rib_parser *p, const rib_request *req, const nurbs_dir *du
     }
     geom_nurbs_desc d = { du->n, du->order, du->knots, du->lo, du->hi,
                           dv->n, dv->order, dv->knots, dv->lo, dv->hi, Pw };
-    char why[256] = "";
-    geom_nurbs *nb = geom_nurbs_new(&d, why, sizeof why);
+    char err[ERR_LEN] = "";
+    geom_nurbs *nb = geom_nurbs_new(&d, err, sizeof err);
     free(Pw);
     if (!nb) {
-        rib_error(p, req, req->pos, "%s", why);
+        rib_error(p, req, req->pos, "%s", err);
         return;
     }
     scene *sc = p->scene;
@@ -291,9 +292,9 @@ void rib_nu_patch(rib_parser *p, const rib_request *req)
                 for (int k = 0; k < 4; k++)
                     s.verts[4 * l + k] = v3(Bn[l][k][0], Bn[l][k][1], Bn[l][k][2]);
 #ifdef SCENE_HAVE_GEOM
-            char why[256];
-            if (!geom_surface_prepare(&s, why, sizeof why)) {
-                rib_error(p, req, req->pos, "piece (%d, %d): %s", b, a, why);
+            char err[ERR_LEN];
+            if (!geom_surface_prepare(&s, err, sizeof err)) {
+                rib_error(p, req, req->pos, "piece (%d, %d): %s", b, a, err);
                 continue;
             }
 #endif

@@ -12,6 +12,7 @@
  */
 #include "scene/rib_parser.h"
 #include "sl/strbuf.h"
+#include "util/err.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -40,12 +41,12 @@ static bool resolve_name(rib_parser *p, const rib_request *req, const rib_arg *a
                          rib_params_mode mode, char **name, rib_decl *decl)
 {
     const char *text = rib_arg_string(req, arg);
-    char why[160];
+    char err[ERR_LEN];
     if (rib_decl_is_inline(text)) {
         const char *n;
         int len;
-        if (!rib_decl_parse(text, true, decl, &n, &len, why, sizeof why)) {
-            rib_error(p, req, arg->pos, "cannot read the declaration \"%s\": %s", text, why);
+        if (!rib_decl_parse(text, true, decl, &n, &len, err, sizeof err)) {
+            rib_error(p, req, arg->pos, "cannot read the declaration \"%s\": %s", text, err);
             return false;
         }
         *name = sl_xstrndup(n, (size_t)len);

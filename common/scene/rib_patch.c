@@ -14,6 +14,7 @@
 #include "scene/rib_parser.h"
 #include "scene/rib_primvar.h"
 #include "sl/strbuf.h"
+#include "util/err.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -179,9 +180,9 @@ static void add_bicubic(rib_parser *p, const rib_request *req, const double *P,
             s.verts[4 * j + i] = v3(b[0], b[1], b[2]);
         }
 #ifdef SCENE_HAVE_GEOM
-    char why[256];
-    if (!geom_surface_prepare(&s, why, sizeof why)) {
-        rib_error(p, req, at, "%s", why);
+    char err[ERR_LEN];
+    if (!geom_surface_prepare(&s, err, sizeof err)) {
+        rib_error(p, req, at, "%s", err);
         return;
     }
 #else
@@ -322,9 +323,9 @@ void rib_patch_mesh(rib_parser *p, const rib_request *req)
                     s.verts[c] = v3(P->values[3 * corner[c]], P->values[3 * corner[c] + 1],
                                     P->values[3 * corner[c] + 2]);
 #ifdef SCENE_HAVE_GEOM
-                char why[256];
-                if (!geom_surface_prepare(&s, why, sizeof why)) {
-                    rib_error(p, req, req->pos, "patch (%d, %d): %s", pu, pv, why);
+                char err[ERR_LEN];
+                if (!geom_surface_prepare(&s, err, sizeof err)) {
+                    rib_error(p, req, req->pos, "patch (%d, %d): %s", pu, pv, err);
                     continue;
                 }
 #endif

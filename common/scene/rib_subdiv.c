@@ -21,6 +21,7 @@
 
 #ifdef SCENE_HAVE_GEOM
 #include "geom/subdiv.h"
+#include "util/err.h"
 #endif
 
 #include <math.h>
@@ -274,10 +275,10 @@ void rib_subdivision_mesh(rib_parser *p, const rib_request *req)
             tags.ncorners, tags.corner_verts, tags.corner_sharp,
             tags.nholes, tags.holes, tags.interpolateboundary,
         };
-        char why[256] = "";
-        geom_subdiv *sd = geom_subdiv_new(&d, why, sizeof why);
+        char err[ERR_LEN] = "";
+        geom_subdiv *sd = geom_subdiv_new(&d, err, sizeof err);
         if (!sd) {
-            rib_error(p, req, req->pos, "%s", why);
+            rib_error(p, req, req->pos, "%s", err);
             goto out;
         }
         scene *sc = p->scene;

@@ -14,6 +14,7 @@
 #include "trace/instance.h"
 #include "trace/sampler.h"
 #include "trace/shade.h"
+#include "util/err.h"
 
 static void camera_bound(const trace_object *obj, const trace_box *b, trace_box *out)
 {
@@ -41,7 +42,7 @@ static void camera_bound(const trace_object *obj, const trace_box *b, trace_box 
     out->hi = v3_add(out->hi, e);
 }
 
-trace_renderer *trace_renderer_new(trace_world *world, char *err, int errsz)
+trace_renderer *trace_renderer_new(trace_world *world, char *err, size_t errsz)
 {
     if (!trace_world_prepare(world, err, errsz))
         return NULL;
@@ -61,7 +62,7 @@ trace_renderer *trace_renderer_new(trace_world *world, char *err, int errsz)
         camera_bound(obj, &obj->root, &obj->bound);
     }
     if (th->failed) {
-        snprintf(err, (size_t)errsz, "%s", th->error);
+        err_set(err, errsz, "%s", th->error);
         trace_thread_destroy(&th);
         return NULL;
     }
@@ -85,6 +86,12 @@ void trace_renderer_destroy(trace_renderer **self_p)
     free(self->shadow_warned);
     free(self);
     *self_p = NULL;
+}
+
+void trace_renderer_set_log(trace_renderer *self, trace_log_fn fn, void *user)
+{
+    self->log = fn;
+    self->log_user = user;
 }
 
 void trace_render_sample(const trace_renderer *self, trace_thread *th,

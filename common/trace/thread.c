@@ -2,6 +2,7 @@
  * thread.c: per-thread rendering state (see thread.h).
  */
 #include "trace/thread.h"
+#include "util/err.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -80,7 +81,7 @@ void trace_thread_fail(trace_thread *self, const char *message)
 {
     if (self->failed) return;
     self->failed = true;
-    snprintf(self->error, sizeof self->error, "%s", message);
+    err_set(self->error, sizeof self->error, "%s", message);
 }
 
 void trace_object_work_add(trace_object_work *dst, const trace_object_work *src,
