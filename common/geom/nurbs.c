@@ -17,18 +17,11 @@
 #include "geom/nurbs_internal.h"
 #include "geom/surface_internal.h"
 #include "util/err.h"
+#include "util/xalloc.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-
-static void *xmalloc(size_t n)
-{
-    void *p = malloc(n ? n : 1);
-    if (!p)
-        abort();
-    return p;
-}
 
 /* The blossom f(args[0..p)) of the degree-p polynomial of span k of
  * knots U, control points d[0..p] (4 numbers each, d[0] = point k-p). */

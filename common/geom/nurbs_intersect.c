@@ -23,6 +23,7 @@
  */
 #include "geom/nurbs_internal.h"
 #include "geom/surface_internal.h"
+#include "util/xalloc.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -130,9 +131,7 @@ bool geom_nurbs_intersect(const geom_surface *s, vec3 o, vec3 d, double tmin, do
     double eps = 1e-12 * scale * pc->wmax;
     size_t sz = 4 * (size_t)count;
     /* the nets of the stack, a work area and four quarter slots */
-    double *mem = malloc(sizeof(double) * sz * (STACK + 2 + 4));
-    if (!mem)
-        abort();
+    double *mem = xmalloc(sizeof(double) * sz * (STACK + 2 + 4));
     node stack[STACK];
     double *root = mem;
     for (int k = 0; k < count; k++) {

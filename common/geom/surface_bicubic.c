@@ -40,6 +40,7 @@
 #include "geom/surface.h"
 #include "geom/surface_internal.h"
 #include "util/err.h"
+#include "util/xalloc.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -477,9 +478,7 @@ bool geom_bicubic_intersect(const geom_surface *s, vec3 o, vec3 d, double tmin, 
     geom_bicubic_bounds(s, &lo, &hi);
     double size = v3_length(v3_sub(hi, lo));
     double scale = size + v3_length(o) + 1e-300, pad = 1e-12 * scale;
-    net *stack = malloc(STACK * sizeof *stack);
-    if (!stack)
-        abort();
+    net *stack = xmalloc(STACK * sizeof *stack);
     int n = 0;
     for (int i = 0; i < 16; i++)
         stack[0].p[i] = s->verts[i];

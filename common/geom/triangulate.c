@@ -5,6 +5,7 @@
  */
 #include "geom/triangulate.h"
 #include "util/err.h"
+#include "util/xalloc.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -99,15 +100,13 @@ int geom_triangulate(const vec3 *pts, const int *loop_sizes, int nloops, int (*t
         err_set(err, errsz, "the polygon has no area");
         return -1;
     }
-    pt2 *p = malloc((size_t)total * sizeof *p);
+    pt2 *p = xmalloc((size_t)total * sizeof *p);
     /* the combined loop: the outer loop plus, per hole, its points and two
      * bridge ends, repeated */
     int cap = total + 2 * nloops + 2;
-    int *ring = malloc((size_t)cap * sizeof *ring);
-    int *tmp = malloc((size_t)cap * sizeof *tmp);
-    int *hole = malloc((size_t)total * sizeof *hole);
-    if (!p || !ring || !tmp || !hole)
-        abort();
+    int *ring = xmalloc((size_t)cap * sizeof *ring);
+    int *tmp = xmalloc((size_t)cap * sizeof *tmp);
+    int *hole = xmalloc((size_t)total * sizeof *hole);
     for (int i = 0; i < total; i++) {
         vec3 q = pts[i];
         if (az >= ax && az >= ay) p[i] = (pt2){ q.x, q.y };

@@ -19,6 +19,7 @@
 #include "scene/rib_parser.h"
 #include "sl/source.h"
 #include "sl/strbuf.h"
+#include "util/xalloc.h"
 
 #include <errno.h>
 #include <stdio.h>
@@ -42,11 +43,11 @@ int scene_archive_load_from_disk(sl_source_set *set, const char *name, sl_diag *
         return -1;
     }
     size_t max = sl_source_set_max_size(set), cap = 1 << 16, n = 0;
-    char *buf = sl_xrealloc(NULL, cap);
+    char *buf = xrealloc(NULL, cap);
     for (;;) {
         if (n == cap) {
             cap *= 2;
-            buf = sl_xrealloc(buf, cap);
+            buf = xrealloc(buf, cap);
         }
         unsigned want = cap - n > (1u << 30) ? 1u << 30 : (unsigned)(cap - n);
         int got = gzread(f, buf + n, want);
@@ -94,7 +95,7 @@ static char *join(const char *dir, const char *name)
     if (name[0] == '/' || !dir[0] || strcmp(dir, ".") == 0)
         return sl_source_normalize(name);
     size_t n = strlen(dir) + strlen(name) + 2;
-    char *joined = sl_xrealloc(NULL, n);
+    char *joined = xrealloc(NULL, n);
     snprintf(joined, n, "%s/%s", dir, name);
     char *norm = sl_source_normalize(joined);
     free(joined);
@@ -105,10 +106,10 @@ static char *folder_of(const char *file)
 {
     const char *slash = strrchr(file, '/');
     if (!slash)
-        return sl_xstrndup(".", 1);
+        return xstrndup(".", 1);
     if (slash == file)
-        return sl_xstrndup("/", 1);
-    return sl_xstrndup(file, (size_t)(slash - file));
+        return xstrndup("/", 1);
+    return xstrndup(file, (size_t)(slash - file));
 }
 
 /* The archive's source, trying the candidates in order; NULL when none
@@ -125,7 +126,7 @@ static const sl_source *find_archive(rib_parser *p, const char *name, const char
     for (int i = 0; i < ndirs && !src; i++) {
         char *dir;
         if (i == 0)
-            dir = sl_xstrndup(own_folder, strlen(own_folder));
+            dir = xstrndup(own_folder, strlen(own_folder));
         else
             dir = join(main_folder, p->archive_path[i - 1]);
         char *cand = join(dir, name);
@@ -150,8 +151,8 @@ static const char *archive_name(scene *s, const char *name)
     for (int i = 0; i < s->narchives; i++)
         if (strcmp(s->archives[i], name) == 0)
             return s->archives[i];
-    s->archives = sl_xrealloc(s->archives, (size_t)(s->narchives + 1) * sizeof *s->archives);
-    s->archives[s->narchives] = sl_xstrndup(name, strlen(name));
+    s->archives = xrealloc(s->archives, (size_t)(s->narchives + 1) * sizeof *s->archives);
+    s->archives[s->narchives] = xstrndup(name, strlen(name));
     return s->archives[s->narchives++];
 }
 

@@ -17,6 +17,7 @@
 #include "scene/rib_parser.h"
 #include "sl/strbuf.h"
 #include "util/err.h"
+#include "util/xalloc.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -46,7 +47,7 @@ void rib_attributes_copy(rib_attributes *dst, const rib_attributes *src)
 {
     *dst = *src;
     if (src->nlight_on > 0) {
-        dst->light_on = sl_xrealloc(NULL, (size_t)src->nlight_on);
+        dst->light_on = xrealloc(NULL, (size_t)src->nlight_on);
         memcpy(dst->light_on, src->light_on, (size_t)src->nlight_on);
     } else {
         dst->light_on = NULL;
@@ -63,7 +64,7 @@ void rib_attributes_free(rib_attributes *a)
 static void set_light_on(rib_attributes *a, int index, bool on)
 {
     if (index >= a->nlight_on) {
-        a->light_on = sl_xrealloc(a->light_on, (size_t)index + 1);
+        a->light_on = xrealloc(a->light_on, (size_t)index + 1);
         memset(a->light_on + a->nlight_on, 0, (size_t)(index + 1 - a->nlight_on));
         a->nlight_on = index + 1;
     }
@@ -296,7 +297,7 @@ void rib_coordinate_system(rib_parser *p, const rib_request *req)
     if (!name || !rib_no_more_args(p, req, 1))
         return;
     scene_space *space = rib_add_space(p);
-    space->name = sl_xstrndup(name, strlen(name));
+    space->name = xstrndup(name, strlen(name));
     space->to_world = p->attr.ctm;
     space->to_camera = ctm_to_camera(p);
     space->pos = req->pos;
@@ -359,7 +360,7 @@ static int shader_call_at(rib_parser *p, const rib_request *req, sl_shader_kind 
         return -2;
     scene_shader *sh = rib_add_shader(p);
     sh->kind = kind;
-    sh->name = sl_xstrndup(name, strlen(name));
+    sh->name = xstrndup(name, strlen(name));
     sh->params = params.items;
     sh->nparams = params.count;
     sh->pos = req->pos;
@@ -507,11 +508,11 @@ static char *handle_text(const rib_request *req, const rib_arg *arg)
 {
     char buf[64];
     if (rib_arg_is_string(arg))
-        return sl_xstrndup(rib_arg_string(req, arg), strlen(rib_arg_string(req, arg)));
+        return xstrndup(rib_arg_string(req, arg), strlen(rib_arg_string(req, arg)));
     int n;
     const double *v = rib_arg_numbers(req, arg, &n);
     snprintf(buf, sizeof buf, "%.17g", v[0]);
-    return sl_xstrndup(buf, strlen(buf));
+    return xstrndup(buf, strlen(buf));
 }
 
 static bool valid_handle(rib_parser *p, const rib_request *req, const rib_arg *arg)

@@ -10,6 +10,7 @@
 #include "scene/rib_decl.h"
 #include "sl/strbuf.h"
 #include "util/err.h"
+#include "util/xalloc.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -253,7 +254,7 @@ struct rib_decls {
 
 rib_decls *rib_decls_new(void)
 {
-    rib_decls *self = sl_xrealloc(NULL, sizeof *self);
+    rib_decls *self = xrealloc(NULL, sizeof *self);
     memset(self, 0, sizeof *self);
     return self;
 }
@@ -278,9 +279,9 @@ void rib_decls_add(rib_decls *self, const char *name, rib_decl decl)
         }
     if (self->count == self->cap) {
         self->cap = self->cap ? 2 * self->cap : 16;
-        self->items = sl_xrealloc(self->items, (size_t)self->cap * sizeof *self->items);
+        self->items = xrealloc(self->items, (size_t)self->cap * sizeof *self->items);
     }
-    self->items[self->count].name = sl_xstrndup(name, strlen(name));
+    self->items[self->count].name = xstrndup(name, strlen(name));
     self->items[self->count].decl = decl;
     self->count++;
 }

@@ -14,6 +14,7 @@
 #include "scene/rib_primvar.h"
 #include "sl/strbuf.h"
 #include "util/err.h"
+#include "util/xalloc.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -96,7 +97,7 @@ static bool reverse_normals(scene_orientation o, const mat4 *object_to_camera)
 static void object_lights(const rib_parser *p, scene_object *o)
 {
     const rib_attributes *a = &p->attr;
-    o->lights = sl_xrealloc(NULL, (size_t)(p->scene->nlights ? p->scene->nlights : 1) *
+    o->lights = xrealloc(NULL, (size_t)(p->scene->nlights ? p->scene->nlights : 1) *
                             sizeof *o->lights);
     for (int i = 0; i < p->scene->nlights && i < a->nlight_on; i++)
         if (a->light_on[i])
@@ -134,11 +135,11 @@ void rib_place_surface(rib_parser *p, const rib_request *req, const geom_surface
     o->reverse_normals = reverse_normals(a->orientation, &to_camera);
     o->shading_rate = a->shading_rate;
     o->displacement_bound = a->displacement_bound;
-    o->displacement_bound_space = sl_xstrndup(a->bound_space, strlen(a->bound_space));
-    o->name = a->name ? sl_xstrndup(a->name, strlen(a->name)) : NULL;
+    o->displacement_bound_space = xstrndup(a->bound_space, strlen(a->bound_space));
+    o->name = a->name ? xstrndup(a->name, strlen(a->name)) : NULL;
     o->pos = pos;
     if (nvars > 0) {
-        o->primvars = sl_xrealloc(NULL, (size_t)nvars * sizeof *o->primvars);
+        o->primvars = xrealloc(NULL, (size_t)nvars * sizeof *o->primvars);
         memcpy(o->primvars, vars, (size_t)nvars * sizeof *o->primvars);
         o->nprimvars = nvars;
     }

@@ -9,6 +9,7 @@
  */
 #include "scene/rib_parser.h"
 #include "sl/strbuf.h"
+#include "util/xalloc.h"
 
 #include <string.h>
 
@@ -82,8 +83,8 @@ static void warn_once(rib_parser *p, const rib_request *req, const char *what)
     for (int i = 0; i < p->nwarned; i++)
         if (strcmp(p->warned[i], req->name) == 0)
             return;
-    p->warned = sl_xrealloc(p->warned, (size_t)(p->nwarned + 1) * sizeof *p->warned);
-    p->warned[p->nwarned++] = sl_xstrndup(req->name, strlen(req->name));
+    p->warned = xrealloc(p->warned, (size_t)(p->nwarned + 1) * sizeof *p->warned);
+    p->warned[p->nwarned++] = xstrndup(req->name, strlen(req->name));
     rib_warning(p, req, req->pos, "%s", what);
 }
 

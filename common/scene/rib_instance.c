@@ -19,6 +19,7 @@
  */
 #include "scene/rib_parser.h"
 #include "sl/strbuf.h"
+#include "util/xalloc.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -39,12 +40,12 @@ static char *handle_of(rib_parser *p, const rib_request *req)
     const rib_arg *arg = &req->args[0];
     if (arg->kind == RIB_ARG_STRING) {
         const char *s = rib_arg_string(req, arg);
-        return sl_xstrndup(s, strlen(s));
+        return xstrndup(s, strlen(s));
     }
     int n;
     char buf[64];
     snprintf(buf, sizeof buf, "%.17g", rib_arg_numbers(req, arg, &n)[0]);
-    return sl_xstrndup(buf, strlen(buf));
+    return xstrndup(buf, strlen(buf));
 }
 
 static rib_object_def *find_def(rib_parser *p, const char *handle)
@@ -66,7 +67,7 @@ void rib_object_begin(rib_parser *p, const rib_request *req)
             return;
         }
     char *handle = req->broken ? NULL : handle_of(p, req);
-    p->defs = sl_xrealloc(p->defs, (size_t)(p->ndefs + 1) * sizeof *p->defs);
+    p->defs = xrealloc(p->defs, (size_t)(p->ndefs + 1) * sizeof *p->defs);
     rib_object_def *d = &p->defs[p->ndefs++];
     memset(d, 0, sizeof *d);
     d->handle = handle;              /* NULL: malformed, never found */
@@ -92,7 +93,7 @@ rib_object_def *rib_defining(rib_parser *p)
 void rib_record_surface(rib_parser *p, const rib_request *req, const geom_surface *surf)
 {
     rib_object_def *d = rib_defining(p);
-    d->parts = sl_xrealloc(d->parts, (size_t)(d->nparts + 1) * sizeof *d->parts);
+    d->parts = xrealloc(d->parts, (size_t)(d->nparts + 1) * sizeof *d->parts);
     rib_object_part *part = &d->parts[d->nparts++];
     part->surface = *surf;
     part->ctm = p->attr.ctm;
@@ -101,7 +102,7 @@ void rib_record_surface(rib_parser *p, const rib_request *req, const geom_surfac
     part->nprimvars = p->nsurface_vars;
     part->primvars = NULL;
     if (p->nsurface_vars > 0) {
-        part->primvars = sl_xrealloc(NULL, (size_t)p->nsurface_vars * sizeof *part->primvars);
+        part->primvars = xrealloc(NULL, (size_t)p->nsurface_vars * sizeof *part->primvars);
         memcpy(part->primvars, p->surface_vars,
                (size_t)p->nsurface_vars * sizeof *part->primvars);
     }

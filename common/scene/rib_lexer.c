@@ -11,6 +11,7 @@
 #include "scene/rib_lexer.h"
 #include "sl/strbuf.h"
 #include "util/err.h"
+#include "util/xalloc.h"
 
 #include <math.h>
 #include <stdarg.h>
@@ -30,7 +31,7 @@ struct rib_lexer {
 
 rib_lexer *rib_lexer_new(const char *file, const char *text, size_t len)
 {
-    rib_lexer *self = sl_xrealloc(NULL, sizeof *self);
+    rib_lexer *self = xrealloc(NULL, sizeof *self);
     memset(self, 0, sizeof *self);
     self->file = file;
     self->text = self->p = self->line_start = text;

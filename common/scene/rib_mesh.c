@@ -34,6 +34,7 @@
 #ifdef SCENE_HAVE_GEOM
 #include "geom/triangulate.h"
 #include "util/err.h"
+#include "util/xalloc.h"
 #endif
 
 #include <math.h>
@@ -210,11 +211,11 @@ static bool add_face(rib_parser *p, mesh *m, int face, const int *loop_sizes, in
                   "triangles may have at most %d", face, total, RIB_MAX_FACE_POINTS);
         return false;
     }
-    vec3 *pts = sl_xrealloc(NULL, (size_t)total * sizeof *pts);
+    vec3 *pts = xrealloc(NULL, (size_t)total * sizeof *pts);
     for (int i = 0; i < total; i++)
         pts[i] = point(m, idx[i]);
     int max = total + 2 * nloops;
-    int (*tris)[3] = sl_xrealloc(NULL, (size_t)max * sizeof *tris);
+    int (*tris)[3] = xrealloc(NULL, (size_t)max * sizeof *tris);
     char err[ERR_LEN];
     int n = geom_triangulate(pts, loop_sizes, nloops, tris, max, err, sizeof err);
     bool ok = true;
@@ -251,7 +252,7 @@ static bool add_face(rib_parser *p, mesh *m, int face, const int *loop_sizes, in
 static double *smooth_normals(int npoints, const double *P, const int *nloops, int nfaces,
                               const int *nverts, const int *idx)
 {
-    double *N = sl_xrealloc(NULL, (size_t)npoints * 3 * sizeof *N);
+    double *N = xrealloc(NULL, (size_t)npoints * 3 * sizeof *N);
     memset(N, 0, (size_t)npoints * 3 * sizeof *N);
     const int *loop = nverts, *vi = idx;
     for (int f = 0; f < nfaces; f++) {
@@ -395,7 +396,7 @@ void rib_general_polygon(rib_parser *p, const rib_request *req)
             rib_error(p, req, P->pos, "the loops have %ld points in all, but \"P\" has %d",
                       n, P->count / 3);
         else {
-            int *idx = sl_xrealloc(NULL, (size_t)n * sizeof *idx);
+            int *idx = xrealloc(NULL, (size_t)n * sizeof *idx);
             for (int i = 0; i < n; i++)
                 idx[i] = i;
             mesh m = { req, P->values, (int)n, 0, req->args[0].pos, MESH_N_NONE, NULL, 0,
@@ -450,7 +451,7 @@ bool rib_polygon_vars(rib_parser *p, const rib_request *req, const rib_params *p
     if (!any)
         return false;
     int n = P->count / 3;
-    int *idx = sl_xrealloc(NULL, (size_t)n * sizeof *idx);
+    int *idx = xrealloc(NULL, (size_t)n * sizeof *idx);
     for (int i = 0; i < n; i++)
         idx[i] = i;
     mesh m = { req, P->values, n, 0, req->pos, MESH_N_NONE, NULL, 0, { NULL, 0 } };

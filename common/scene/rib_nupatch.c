@@ -24,6 +24,7 @@
 #ifdef SCENE_HAVE_GEOM
 #include "geom/nurbs.h"
 #include "util/err.h"
+#include "util/xalloc.h"
 #endif
 
 #include <math.h>
@@ -104,7 +105,7 @@ static bool read_dir(rib_parser *p, const rib_request *req, int *i, const char *
                   mm[1]);
         return false;
     }
-    d->knots = sl_xrealloc(NULL, (size_t)nk * sizeof *d->knots);
+    d->knots = xrealloc(NULL, (size_t)nk * sizeof *d->knots);
     memcpy(d->knots, k, (size_t)nk * sizeof *k);
     d->lo = mm[0], d->hi = mm[1];
     *i = next + 3;
@@ -162,7 +163,7 @@ static void add_nurbs(rib_parser *p, const rib_request *req, const nurbs_dir *du
 {
 #ifdef SCENE_HAVE_GEOM
     size_t npts = (size_t)du->n * (size_t)dv->n;
-    double *Pw = sl_xrealloc(NULL, 4 * npts * sizeof *Pw);
+    double *Pw = xrealloc(NULL, 4 * npts * sizeof *Pw);
     for (size_t k = 0; k < npts; k++) {
         for (int c = 0; c < 3; c++)
             Pw[4 * k + c] = pts[stride * k + c];
@@ -178,7 +179,7 @@ static void add_nurbs(rib_parser *p, const rib_request *req, const nurbs_dir *du
         return;
     }
     scene *sc = p->scene;
-    sc->nurbs = sl_xrealloc(sc->nurbs, (size_t)(sc->nnurbs + 1) * sizeof *sc->nurbs);
+    sc->nurbs = xrealloc(sc->nurbs, (size_t)(sc->nnurbs + 1) * sizeof *sc->nurbs);
     sc->nurbs[sc->nnurbs++] = nb;
     for (int k = 0; k < geom_nurbs_npieces(nb) && !sl_diag_full(p->diag); k++) {
         geom_surface s;
@@ -245,9 +246,9 @@ void rib_nu_patch(rib_parser *p, const rib_request *req)
         goto out;
     }
     size_t nu = (size_t)du.n, nv = (size_t)dv.n;
-    double *ua = sl_xrealloc(NULL, 2 * (nu + nv) * sizeof *ua);
+    double *ua = xrealloc(NULL, 2 * (nu + nv) * sizeof *ua);
     double *ub = ua + nu, *va = ua + 2 * nu, *vb = va + nv;
-    int *us = sl_xrealloc(NULL, (nu + nv) * sizeof *us), *vs = us + nu;
+    int *us = xrealloc(NULL, (nu + nv) * sizeof *us), *vs = us + nu;
     int nui = intervals(&du, ua, ub, us, du.n), nvi = intervals(&dv, va, vb, vs, dv.n);
     for (int a = 0; a < nvi; a++)
         for (int b = 0; b < nui; b++) {

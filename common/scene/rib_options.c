@@ -12,6 +12,7 @@
  */
 #include "scene/rib_parser.h"
 #include "sl/strbuf.h"
+#include "util/xalloc.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -39,9 +40,9 @@ void rib_display(rib_parser *p, const rib_request *req)
     free(s->display_name);
     free(s->display_type);
     free(s->display_mode);
-    s->display_name = sl_xstrndup(name, strlen(name));
-    s->display_type = sl_xstrndup(type, strlen(type));
-    s->display_mode = sl_xstrndup(mode, strlen(mode));
+    s->display_name = xstrndup(name, strlen(name));
+    s->display_type = xstrndup(type, strlen(type));
+    s->display_mode = xstrndup(mode, strlen(mode));
 }
 
 static bool is_whole(double v) { return v == floor(v); }
@@ -237,8 +238,8 @@ void rib_exposure(rib_parser *p, const rib_request *req)
 
 static void path_push(char ***list, int *n, const char *s, size_t len)
 {
-    *list = sl_xrealloc(*list, (size_t)(*n + 1) * sizeof **list);
-    (*list)[(*n)++] = sl_xstrndup(s, len);
+    *list = xrealloc(*list, (size_t)(*n + 1) * sizeof **list);
+    (*list)[(*n)++] = xstrndup(s, len);
 }
 
 /* At most this many folders in one search path: "&:&" repeated doubles a

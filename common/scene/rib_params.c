@@ -13,6 +13,7 @@
 #include "scene/rib_parser.h"
 #include "sl/strbuf.h"
 #include "util/err.h"
+#include "util/xalloc.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -49,10 +50,10 @@ static bool resolve_name(rib_parser *p, const rib_request *req, const rib_arg *a
             rib_error(p, req, arg->pos, "cannot read the declaration \"%s\": %s", text, err);
             return false;
         }
-        *name = sl_xstrndup(n, (size_t)len);
+        *name = xstrndup(n, (size_t)len);
         return true;
     }
-    *name = sl_xstrndup(text, strlen(text));
+    *name = xstrndup(text, strlen(text));
     if (rib_decls_find(p->decls, text, decl))
         return true;
     if (mode == RIB_PARAMS_LOOSE) {
@@ -75,7 +76,7 @@ static bool take_value(rib_parser *p, const rib_request *req, const rib_arg *val
     const char *s = rib_arg_string(req, value);
     if (out->type == SL_TYPE_VOID) {
         if (s)
-            out->string = sl_xstrndup(s, strlen(s));
+            out->string = xstrndup(s, strlen(s));
         return true;
     }
     if (out->type == SL_TYPE_STRING) {
@@ -84,7 +85,7 @@ static bool take_value(rib_parser *p, const rib_request *req, const rib_arg *val
                       "string, got %s", out->name, rib_arg_describe(value));
             return false;
         }
-        out->string = sl_xstrndup(s, strlen(s));
+        out->string = xstrndup(s, strlen(s));
         out->count = 1;
         return true;
     }
@@ -101,7 +102,7 @@ static bool take_value(rib_parser *p, const rib_request *req, const rib_arg *val
                   per, per == 1 ? "" : "s", n);
         return false;
     }
-    out->values = sl_xrealloc(NULL, (size_t)n * sizeof *out->values);
+    out->values = xrealloc(NULL, (size_t)n * sizeof *out->values);
     memcpy(out->values, v, (size_t)n * sizeof *v);
     out->count = n;
     return true;
@@ -143,7 +144,7 @@ bool rib_params_read(rib_parser *p, const rib_request *req, int first,
     if (first >= req->nargs)
         return true;
     int max = (req->nargs - first + 1) / 2;
-    out->items = sl_xrealloc(NULL, (size_t)max * sizeof *out->items);
+    out->items = xrealloc(NULL, (size_t)max * sizeof *out->items);
     for (int i = first; i < req->nargs; i += 2) {
         if (!read_one(p, req, i, mode, &out->items[out->count])) {
             rib_params_free(out);

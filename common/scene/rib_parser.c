@@ -14,6 +14,7 @@
 #include "scene/rib_parser.h"
 #include "sl/source.h"
 #include "sl/strbuf.h"
+#include "util/xalloc.h"
 
 #include <ctype.h>
 #include <limits.h>
@@ -67,9 +68,9 @@ const char *rib_parser_intern(rib_parser *p, const char *s)
 {
     if (p->nstrings == p->strings_cap) {
         p->strings_cap = p->strings_cap ? 2 * p->strings_cap : 16;
-        p->strings = sl_xrealloc(p->strings, (size_t)p->strings_cap * sizeof *p->strings);
+        p->strings = xrealloc(p->strings, (size_t)p->strings_cap * sizeof *p->strings);
     }
-    p->strings[p->nstrings] = sl_xstrndup(s, strlen(s));
+    p->strings[p->nstrings] = xstrndup(s, strlen(s));
     return p->strings[p->nstrings++];
 }
 
@@ -108,7 +109,7 @@ int *rib_read_ints(rib_parser *p, const rib_request *req, int i, int min, bool a
         rib_error(p, req, req->args[i].pos, "%s is empty", what);
         return NULL;
     }
-    int *out = sl_xrealloc(NULL, (size_t)(n + 1) * sizeof *out);
+    int *out = xrealloc(NULL, (size_t)(n + 1) * sizeof *out);
     for (int k = 0; k < n; k++) {
         if (!(v[k] == floor(v[k]) && v[k] >= min && v[k] <= 1e9)) {
             rib_error(p, req, req->args[i].pos, "%s: entry %d is %g, expected a whole number "
@@ -154,7 +155,7 @@ static void *grow(void *items, int count, int *cap, size_t size)
     if (count < *cap)
         return items;
     *cap = *cap ? 2 * *cap : 8;
-    return sl_xrealloc(items, (size_t)*cap * size);
+    return xrealloc(items, (size_t)*cap * size);
 }
 
 scene_light *rib_add_light(rib_parser *p)
@@ -496,8 +497,8 @@ static void unknown_request(rib_parser *p, const rib_request *req)
         p->unknown_overflow = true;
         return;
     }
-    p->warned = sl_xrealloc(p->warned, (size_t)(p->nwarned + 1) * sizeof *p->warned);
-    p->warned[p->nwarned++] = sl_xstrndup(req->name, strlen(req->name));
+    p->warned = xrealloc(p->warned, (size_t)(p->nwarned + 1) * sizeof *p->warned);
+    p->warned[p->nwarned++] = xstrndup(req->name, strlen(req->name));
     for (int i = 0; i < NREQUESTS; i++)
         if (strcasecmp(requests[i].name, req->name) == 0) {
             rib_warning(p, req, req->pos, "unknown request, ignored with its arguments "
@@ -594,10 +595,10 @@ static char *rib_folder(const char *file)
 {
     const char *slash = strrchr(file, '/');
     if (!slash)
-        return sl_xstrndup(".", 1);
+        return xstrndup(".", 1);
     if (slash == file)
-        return sl_xstrndup("/", 1);
-    return sl_xstrndup(file, (size_t)(slash - file));
+        return xstrndup("/", 1);
+    return xstrndup(file, (size_t)(slash - file));
 }
 
 static void add_path(char ***path, int *npath, char *dir)
@@ -607,7 +608,7 @@ static void add_path(char ***path, int *npath, char *dir)
             free(dir);
             return;
         }
-    *path = sl_xrealloc(*path, (size_t)(*npath + 2) * sizeof **path);
+    *path = xrealloc(*path, (size_t)(*npath + 2) * sizeof **path);
     (*path)[(*npath)++] = dir;
     (*path)[*npath] = NULL;
 }
@@ -625,7 +626,7 @@ static void finish_one_path(const char *folder, char **dirs, int ndirs, char ***
             continue;
         }
         size_t n = strlen(folder) + strlen(dir) + 2;
-        char *joined = sl_xrealloc(NULL, n);
+        char *joined = xrealloc(NULL, n);
         snprintf(joined, n, "%s/%s", folder, dir);
         add_path(path, npath, sl_source_normalize(joined));
         free(joined);
@@ -649,9 +650,9 @@ static void add_shader_name(scene *s, const char *name)
     for (int i = 0; i < s->nshader_names; i++)
         if (strcmp(s->shader_names[i], name) == 0)
             return;
-    s->shader_names = sl_xrealloc(s->shader_names,
+    s->shader_names = xrealloc(s->shader_names,
                                   (size_t)(s->nshader_names + 1) * sizeof *s->shader_names);
-    s->shader_names[s->nshader_names++] = sl_xstrndup(name, strlen(name));
+    s->shader_names[s->nshader_names++] = xstrndup(name, strlen(name));
 }
 
 static void finish_shader_names(scene *s)
@@ -701,9 +702,9 @@ static void finish(rib_parser *p)
 
 static scene *scene_new(const char *file)
 {
-    scene *s = sl_xrealloc(NULL, sizeof *s);
+    scene *s = xrealloc(NULL, sizeof *s);
     memset(s, 0, sizeof *s);
-    s->file = sl_xstrndup(file, strlen(file));
+    s->file = xstrndup(file, strlen(file));
     s->camera.fov = 90;
     s->camera.near_clip = 1e-10;
     s->camera.far_clip = 1e30;

@@ -15,6 +15,7 @@
  */
 #include "scene/rib_primvar.h"
 #include "sl/strbuf.h"
+#include "util/xalloc.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -38,7 +39,7 @@ static bool skipped(const char *name, const char *const *skip)
 static void add_src(rib_primvars *out, const char *name, const scene_param *pa,
                     scene_class cls, int size, int stride, int offset)
 {
-    out->v = sl_xrealloc(out->v, (size_t)(out->n + 1) * sizeof *out->v);
+    out->v = xrealloc(out->v, (size_t)(out->n + 1) * sizeof *out->v);
     rib_primvar_src *s = &out->v[out->n++];
     memset(s, 0, sizeof *s);
     snprintf(s->name, sizeof s->name, "%s", name);

@@ -7,6 +7,7 @@
 #include "scene/rib_reader.h"
 #include "scene/rib_lexer.h"
 #include "sl/strbuf.h"
+#include "util/xalloc.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -20,7 +21,7 @@ struct rib_reader {
 
 rib_reader *rib_reader_new(const char *file, const char *text, size_t len, sl_diag *diag)
 {
-    rib_reader *self = sl_xrealloc(NULL, sizeof *self);
+    rib_reader *self = xrealloc(NULL, sizeof *self);
     memset(self, 0, sizeof *self);
     self->lexer = rib_lexer_new(file, text, len);
     self->diag = diag;
@@ -70,7 +71,7 @@ static void push_number(rib_request *req, double v)
 {
     if (req->nnums == req->nums_cap) {
         req->nums_cap = req->nums_cap ? 2 * req->nums_cap : 64;
-        req->nums = sl_xrealloc(req->nums, (size_t)req->nums_cap * sizeof *req->nums);
+        req->nums = xrealloc(req->nums, (size_t)req->nums_cap * sizeof *req->nums);
     }
     req->nums[req->nnums++] = v;
 }
@@ -79,16 +80,16 @@ static void push_string(rib_request *req, const char *s, size_t len)
 {
     if (req->nstrs == req->strs_cap) {
         req->strs_cap = req->strs_cap ? 2 * req->strs_cap : 16;
-        req->strs = sl_xrealloc(req->strs, (size_t)req->strs_cap * sizeof *req->strs);
+        req->strs = xrealloc(req->strs, (size_t)req->strs_cap * sizeof *req->strs);
     }
-    req->strs[req->nstrs++] = sl_xstrndup(s, len);
+    req->strs[req->nstrs++] = xstrndup(s, len);
 }
 
 static rib_arg *push_arg(rib_request *req, rib_arg_kind kind, sl_pos pos)
 {
     if (req->nargs == req->args_cap) {
         req->args_cap = req->args_cap ? 2 * req->args_cap : 16;
-        req->args = sl_xrealloc(req->args, (size_t)req->args_cap * sizeof *req->args);
+        req->args = xrealloc(req->args, (size_t)req->args_cap * sizeof *req->args);
     }
     rib_arg *arg = &req->args[req->nargs++];
     arg->kind = kind;
@@ -231,7 +232,7 @@ rib_request *rib_reader_next(rib_reader *self)
     skip_to_name(self);
     if (self->tok.kind == RIB_TOK_EOF)
         return NULL;
-    self->req.name = sl_xstrndup(self->tok.text, self->tok.len);
+    self->req.name = xstrndup(self->tok.text, self->tok.len);
     self->req.pos = self->tok.pos;
     advance(self);
     read_arguments(self);

@@ -22,6 +22,7 @@
 #ifdef SCENE_HAVE_GEOM
 #include "geom/subdiv.h"
 #include "util/err.h"
+#include "util/xalloc.h"
 #endif
 
 #include <math.h>
@@ -55,7 +56,7 @@ static void tags_free(subdiv_tags *t)
 
 static void *grow(void *p, int n, size_t size)
 {
-    return sl_xrealloc(p, (size_t)(n + 1) * size);
+    return xrealloc(p, (size_t)(n + 1) * size);
 }
 
 /* Reads the tag arrays at args first .. first+3 into t; false after an
@@ -116,7 +117,7 @@ static bool read_tags(rib_parser *p, const rib_request *req, int first, int npoi
             t->crease_sharp = grow(t->crease_sharp, t->ncreases, sizeof(double));
             t->crease_len[t->ncreases] = in;
             t->crease_sharp[t->ncreases++] = fp[0];
-            t->crease_verts = sl_xrealloc(t->crease_verts,
+            t->crease_verts = xrealloc(t->crease_verts,
                                           (size_t)(t->ncrease_verts + in) * sizeof(int));
             for (int i = 0; i < in; i++) t->crease_verts[t->ncrease_verts++] = ip[i];
         } else if (strcmp(tag, "corner") == 0) {
@@ -189,7 +190,7 @@ static void refined_face_vars(const rib_primvars *vars, const geom_subdiv *sd, i
                               scene_primvar *out)
 {
     int F = geom_subdiv_face_origin(sd, f), n = nverts[F], k = f - fo[F];
-    rib_corner *all = sl_xrealloc(NULL, (size_t)n * sizeof *all), c;
+    rib_corner *all = xrealloc(NULL, (size_t)n * sizeof *all), c;
     int m = n;
     for (int i = 0; i < m; i++) {
         int ci = fo[F] + i;
@@ -282,10 +283,10 @@ void rib_subdivision_mesh(rib_parser *p, const rib_request *req)
             goto out;
         }
         scene *sc = p->scene;
-        sc->subdivs = sl_xrealloc(sc->subdivs, (size_t)(sc->nsubdivs + 1) * sizeof *sc->subdivs);
+        sc->subdivs = xrealloc(sc->subdivs, (size_t)(sc->nsubdivs + 1) * sizeof *sc->subdivs);
         sc->subdivs[sc->nsubdivs++] = sd;
         int drawn = 0;
-        fo = sl_xrealloc(NULL, (size_t)(nfaces + 1) * sizeof *fo);
+        fo = xrealloc(NULL, (size_t)(nfaces + 1) * sizeof *fo);
         fo[0] = 0;
         for (int f = 0; f < nfaces; f++) fo[f + 1] = fo[f] + nverts[f];
         for (int f = 0; f < geom_subdiv_nfaces(sd) && !sl_diag_full(p->diag); f++) {

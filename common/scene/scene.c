@@ -9,6 +9,7 @@
 #ifdef SCENE_HAVE_GEOM
 #include "geom/subdiv.h"
 #include "geom/nurbs.h"
+#include "util/xalloc.h"
 #endif
 
 #include <stdlib.h>
@@ -120,7 +121,7 @@ char *scene_find_shader(const scene *self, const char *name,
         const char *dir = self->search_path[i];
         bool here = strcmp(dir, ".") == 0;
         size_t n = strlen(dir) + strlen(name) + 5;
-        char *path = sl_xrealloc(NULL, n);
+        char *path = xrealloc(NULL, n);
         if (here)
             snprintf(path, n, "%s.sl", name);
         else

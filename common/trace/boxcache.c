@@ -7,6 +7,7 @@
  * used (head) to least (tail).
  */
 #include "trace/boxcache.h"
+#include "util/xalloc.h"
 
 #include <assert.h>
 #include <stdlib.h>
@@ -25,19 +26,11 @@ struct trace_boxcache {
     trace_boxcache_stats stats;
 };
 
-static void *xrealloc(void *p, size_t n)
-{
-    void *q = realloc(p, n);
-    if (!q && n) abort();
-    return q;
-}
-
 size_t trace_boxcache_brood_bytes(void) { return sizeof(trace_brood); }
 
 trace_boxcache *trace_boxcache_new(size_t budget_bytes, int nobjects)
 {
-    trace_boxcache *self = calloc(1, sizeof *self);
-    if (!self) abort();
+    trace_boxcache *self = xcalloc(1, sizeof *self);
     size_t n = budget_bytes ? budget_bytes / sizeof(trace_brood) : (size_t)INT32_MAX;
     if (n > (size_t)INT32_MAX) n = INT32_MAX;
     self->limit = (int32_t)n;

@@ -2,6 +2,7 @@
  * bvh.c: median-split BVH over object root boxes (see bvh.h).
  */
 #include "trace/bvh.h"
+#include "util/xalloc.h"
 
 #include <stdlib.h>
 
@@ -64,13 +65,11 @@ static int build(trace_bvh *self, int first, int count)
 
 trace_bvh *trace_bvh_new(const trace_world *world)
 {
-    trace_bvh *self = calloc(1, sizeof *self);
-    if (!self) abort();
+    trace_bvh *self = xcalloc(1, sizeof *self);
     self->world = world;
     int n = world->nobjects;
-    self->idx = malloc(sizeof(int) * (size_t)(n > 0 ? n : 1));
-    self->nodes = malloc(sizeof(bvh_node) * (size_t)(2 * n + 1));
-    if (!self->idx || !self->nodes) abort();
+    self->idx = xmalloc(sizeof(int) * (size_t)(n > 0 ? n : 1));
+    self->nodes = xmalloc(sizeof(bvh_node) * (size_t)(2 * n + 1));
     for (int i = 0; i < n; i++) self->idx[i] = i;
     if (n > 0) build(self, 0, n);
     return self;

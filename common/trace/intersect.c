@@ -13,6 +13,7 @@
 #include "trace/converge.h"
 #include "trace/prove.h"
 #include "util/err.h"
+#include "util/xalloc.h"
 
 /* §5: a discontinuous box "stopped shrinking" when a child keeps more than
  * this fraction of its parent's size (smooth boxes halve, roughly). */
@@ -221,8 +222,7 @@ static void analyse_wall(trace_thread *th, const trace_object *obj, const double
 static const wall_entry *wall_cell(trace_thread *th, const trace_object *obj, const double r[4])
 {
     if (!th->walls) {                   /* zeroed: empty (cellkey.h) */
-        th->walls = calloc(1, sizeof *th->walls);
-        if (!th->walls) abort();
+        th->walls = xcalloc(1, sizeof *th->walls);
     }
     wall_entry *e = &th->walls->e[trace_cell_slot(r, obj->id, WALL_CACHE_LOG2)];
     if (trace_cell_is(e->r, e->obj, r, obj->id)) return e;

@@ -15,6 +15,7 @@
 #include "trace/sampler.h"
 #include "trace/shade.h"
 #include "util/err.h"
+#include "util/xalloc.h"
 
 static void camera_bound(const trace_object *obj, const trace_box *b, trace_box *out)
 {
@@ -67,12 +68,10 @@ trace_renderer *trace_renderer_new(trace_world *world, char *err, size_t errsz)
         return NULL;
     }
     trace_thread_destroy(&th);
-    trace_renderer *self = calloc(1, sizeof *self);
-    if (!self) abort();
+    trace_renderer *self = xcalloc(1, sizeof *self);
     self->world = world;
     self->bvh = trace_bvh_new(world);
-    self->shadow_warned = calloc((size_t)world->nlights + 1, sizeof *self->shadow_warned);
-    if (!self->shadow_warned) abort();
+    self->shadow_warned = xcalloc((size_t)world->nlights + 1, sizeof *self->shadow_warned);
     self->primary_tol = trace_camera_tolerance(&world->camera, world->shading_rate,
                                                world->options.leaf_fraction);
     return self;
@@ -168,11 +167,7 @@ bool trace_render_tile(const trace_renderer *self, trace_thread *th,
     int qx0 = (int)floor(x0 + 0.5 - rx), qx1 = (int)ceil(x0 + w - 0.5 + rx) - 1;
     int qy0 = (int)floor(y0 + 0.5 - ry), qy1 = (int)ceil(y0 + h - 0.5 + ry) - 1;
     int qw = qx1 - qx0 + 1, qh = qy1 - qy0 + 1;
-    sample_rec *smp = malloc(sizeof(sample_rec) * (size_t)qw * (size_t)qh * (size_t)ns);
-    if (!smp) {
-        trace_thread_fail(th, "out of memory for the samples of a tile");
-        return false;
-    }
+    sample_rec *smp = xmalloc(sizeof(sample_rec) * (size_t)qw * (size_t)qh * (size_t)ns);
     /* The pixels in Morton (Z) order over the smallest power-of-two square
      * that holds them: consecutive rays stay close in both directions, so
      * the box cache keeps what the next rays need (Heidrich & Seidel §6:

@@ -8,6 +8,7 @@
  */
 #include "trace/world.h"
 #include "util/err.h"
+#include "util/xalloc.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -139,8 +140,7 @@ static void find_shared_edges(trace_world *world)
         if (obj->surf.kind == GEOM_POLYGON) n += (size_t)obj->surf.nuv;
     }
     if (n < 2) return;
-    world_edge *e = calloc(n, sizeof *e);
-    if (!e) abort();
+    world_edge *e = xcalloc(n, sizeof *e);
     n = 0;
     for (int i = 0; i < world->nobjects; i++) {
         const trace_object *obj = &world->objects[i];
