@@ -4,6 +4,7 @@
 #include "trace/bvh.h"
 #include "util/xalloc.h"
 
+#include <assert.h>
 #include <stdlib.h>
 
 typedef struct bvh_node {
@@ -42,6 +43,9 @@ static int cmp_objects(const void *a, const void *b)
 
 static int build(trace_bvh *self, int first, int count)
 {
+    /* node ranges: a non-empty run of idx, inside it */
+    assert(count > 0 && first >= 0 && first + count <= self->world->nobjects);
+    assert(self->nnodes < 2 * self->world->nobjects);   /* a binary tree: 2n - 1 nodes */
     int id = self->nnodes++;
     bvh_node *n = &self->nodes[id];
     n->box = self->world->objects[self->idx[first]].bound;
@@ -60,6 +64,8 @@ static int build(trace_bvh *self, int first, int count)
     int r = build(self, first + half, count - half);
     self->nodes[id].left = l;
     self->nodes[id].right = r;
+    assert(self->nodes[l].first == first && self->nodes[r].first + self->nodes[r].count ==
+           first + count);
     return id;
 }
 
@@ -103,6 +109,7 @@ bool trace_bvh_intersect(const trace_bvh *self, trace_thread *th,
         const bvh_node *n = &self->nodes[stack[sp].node];
         if (!(stack[sp].t0 < best->t)) continue;
         if (n->left < 0) {
+            assert(n->first >= 0 && n->first + n->count <= self->world->nobjects);
             for (int i = 0; i < n->count; i++) {
                 const trace_object *o = &self->world->objects[self->idx[n->first + i]];
                 if (trace_intersect_object(th, o, ray, tol, any, best)) {
@@ -115,6 +122,7 @@ bool trace_bvh_intersect(const trace_bvh *self, trace_thread *th,
         double ta0 = 0, ta1 = 0, tb0 = 0, tb1 = 0;
         bool ha = trace_box_hit(&self->nodes[n->left].box, ray, ray->tmin, best->t, &ta0, &ta1, NULL);
         bool hb = trace_box_hit(&self->nodes[n->right].box, ray, ray->tmin, best->t, &tb0, &tb1, NULL);
+        assert(sp + 2 <= BVH_STACK);
         /* push the farther first so the nearer is visited first */
         if (ha && hb) {
             bool a_first = ta0 <= tb0;
