@@ -136,6 +136,27 @@ void geom_nurbs_eval_dual(const geom_surface *s, double u, double v, geom_sample
 typedef void (*geom_dual_eval_fn)(const geom_surface *s, double u, double v, geom_sample *out);
 bool geom_patch_newton(const geom_surface *s, geom_dual_eval_fn eval, vec3 o, vec3 d,
                        double *t, double *u, double *v, double scale);
+/* A patch's ray intersection by subdivision (surface_intersect.c), shared
+ * by bicubic patches and NuPatch pieces, which differ in their nets only:
+ * the walk keeps each sub-patch's (u,v) square on a stack of
+ * GEOM_PATCH_STACK slots, the patch keeps the net of slot k. clip gives
+ * the ray's t range [*t0, *t1] within [tmin, best] over slot k's net
+ * (false: the ray misses it); transversal says whether Ng.d keeps one sign
+ * over it; split writes its four quarters into slots k..k+3 (quarter i at
+ * slot k+i, or at k+3-i with quarter0_on_top). */
+enum { GEOM_PATCH_STACK = 3 * 16 + 8 };
+typedef struct geom_patch_walk {
+    const geom_surface *s;
+    geom_dual_eval_fn eval;
+    double scale;                 /* geom_patch_newton's */
+    bool (*clip)(void *user, int k, double tmin, double best, double *t0, double *t1);
+    bool (*transversal)(void *user, int k);
+    void (*split)(void *user, int k);
+    bool quarter0_on_top;
+    void *user;
+} geom_patch_walk;
+bool geom_patch_intersect(const geom_patch_walk *w, vec3 o, vec3 d, double tmin, double tmax,
+                          geom_hit *hit);
 void geom_nurbs_eval_ia(const geom_surface *s, ia_interval u, ia_interval v, geom_ia *out);
 void geom_nurbs_eval_aa(aa_context *ctx, const geom_surface *s, const aa_form *u,
                         const aa_form *v, geom_aa *out);
