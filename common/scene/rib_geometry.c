@@ -17,6 +17,7 @@
 #include "util/xalloc.h"
 
 #include <math.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -192,78 +193,59 @@ static geom_surface new_surface(geom_kind kind)
 /* quadrics (§5.2)                                                         */
 /* ---------------------------------------------------------------------- */
 
-void rib_sphere(rib_parser *p, const rib_request *req)
-{
-    double v[4];
-    if (!read_quadric(p, req, 4, v, "radius zmin zmax thetamax"))
-        return;
-    geom_surface s = new_surface(GEOM_SPHERE);
-    s.radius = v[0], s.zmin = v[1], s.zmax = v[2], s.thetamax = radians(v[3]);
-    add_object(p, req, &s);
-}
+/* One quadric request: its kind, its positional numbers (named in `what`
+ * for errors) and the surface field each goes to, angles in degrees. */
+typedef struct quadric_arg {
+    size_t offset;                /* of a double in geom_surface */
+    bool angle;                   /* given in degrees, kept in radians */
+} quadric_arg;
 
-void rib_disk(rib_parser *p, const rib_request *req)
-{
-    double v[3];
-    if (!read_quadric(p, req, 3, v, "height radius thetamax"))
-        return;
-    geom_surface s = new_surface(GEOM_DISK);
-    s.height = v[0], s.radius = v[1], s.thetamax = radians(v[2]);
-    add_object(p, req, &s);
-}
+typedef struct quadric_form {
+    geom_kind kind;
+    const char *what;
+    int n;
+    quadric_arg arg[7];
+} quadric_form;
 
-void rib_cylinder(rib_parser *p, const rib_request *req)
-{
-    double v[4];
-    if (!read_quadric(p, req, 4, v, "radius zmin zmax thetamax"))
-        return;
-    geom_surface s = new_surface(GEOM_CYLINDER);
-    s.radius = v[0], s.zmin = v[1], s.zmax = v[2], s.thetamax = radians(v[3]);
-    add_object(p, req, &s);
-}
+#define FIELD(f) { offsetof(geom_surface, f), false }
+#define ANGLE(f) { offsetof(geom_surface, f), true }
+static const quadric_form sphere = { GEOM_SPHERE, "radius zmin zmax thetamax", 4,
+    { FIELD(radius), FIELD(zmin), FIELD(zmax), ANGLE(thetamax) } };
+static const quadric_form disk = { GEOM_DISK, "height radius thetamax", 3,
+    { FIELD(height), FIELD(radius), ANGLE(thetamax) } };
+static const quadric_form cylinder = { GEOM_CYLINDER, "radius zmin zmax thetamax", 4,
+    { FIELD(radius), FIELD(zmin), FIELD(zmax), ANGLE(thetamax) } };
+static const quadric_form cone = { GEOM_CONE, "height radius thetamax", 3,
+    { FIELD(height), FIELD(radius), ANGLE(thetamax) } };
+static const quadric_form torus = { GEOM_TORUS,
+    "majorradius minorradius phimin phimax thetamax", 5,
+    { FIELD(majorrad), FIELD(minorrad), ANGLE(phimin), ANGLE(phimax), ANGLE(thetamax) } };
+static const quadric_form hyperboloid = { GEOM_HYPERBOLOID, "point1 point2 thetamax", 7,
+    { FIELD(point1.x), FIELD(point1.y), FIELD(point1.z), FIELD(point2.x), FIELD(point2.y),
+      FIELD(point2.z), ANGLE(thetamax) } };
+static const quadric_form paraboloid = { GEOM_PARABOLOID, "rmax zmin zmax thetamax", 4,
+    { FIELD(rmax), FIELD(zmin), FIELD(zmax), ANGLE(thetamax) } };
+#undef FIELD
+#undef ANGLE
 
-void rib_cone(rib_parser *p, const rib_request *req)
-{
-    double v[3];
-    if (!read_quadric(p, req, 3, v, "height radius thetamax"))
-        return;
-    geom_surface s = new_surface(GEOM_CONE);
-    s.height = v[0], s.radius = v[1], s.thetamax = radians(v[2]);
-    add_object(p, req, &s);
-}
-
-void rib_torus(rib_parser *p, const rib_request *req)
-{
-    double v[5];
-    if (!read_quadric(p, req, 5, v, "majorradius minorradius phimin phimax thetamax"))
-        return;
-    geom_surface s = new_surface(GEOM_TORUS);
-    s.majorrad = v[0], s.minorrad = v[1];
-    s.phimin = radians(v[2]), s.phimax = radians(v[3]), s.thetamax = radians(v[4]);
-    add_object(p, req, &s);
-}
-
-void rib_hyperboloid(rib_parser *p, const rib_request *req)
+static void quadric(rib_parser *p, const rib_request *req, const quadric_form *f)
 {
     double v[7];
-    if (!read_quadric(p, req, 7, v, "point1 point2 thetamax"))
+    if (!read_quadric(p, req, f->n, v, f->what))
         return;
-    geom_surface s = new_surface(GEOM_HYPERBOLOID);
-    s.point1 = v3(v[0], v[1], v[2]);
-    s.point2 = v3(v[3], v[4], v[5]);
-    s.thetamax = radians(v[6]);
+    geom_surface s = new_surface(f->kind);
+    for (int i = 0; i < f->n; i++)
+        *(double *)((char *)&s + f->arg[i].offset) = f->arg[i].angle ? radians(v[i]) : v[i];
     add_object(p, req, &s);
 }
 
-void rib_paraboloid(rib_parser *p, const rib_request *req)
-{
-    double v[4];
-    if (!read_quadric(p, req, 4, v, "rmax zmin zmax thetamax"))
-        return;
-    geom_surface s = new_surface(GEOM_PARABOLOID);
-    s.rmax = v[0], s.zmin = v[1], s.zmax = v[2], s.thetamax = radians(v[3]);
-    add_object(p, req, &s);
-}
+void rib_sphere(rib_parser *p, const rib_request *req) { quadric(p, req, &sphere); }
+void rib_disk(rib_parser *p, const rib_request *req) { quadric(p, req, &disk); }
+void rib_cylinder(rib_parser *p, const rib_request *req) { quadric(p, req, &cylinder); }
+void rib_cone(rib_parser *p, const rib_request *req) { quadric(p, req, &cone); }
+void rib_torus(rib_parser *p, const rib_request *req) { quadric(p, req, &torus); }
+void rib_hyperboloid(rib_parser *p, const rib_request *req) { quadric(p, req, &hyperboloid); }
+void rib_paraboloid(rib_parser *p, const rib_request *req) { quadric(p, req, &paraboloid); }
 
 /* ---------------------------------------------------------------------- */
 /* Polygon (§5.1), Patch "bilinear" (§5.3)                                 */
