@@ -298,15 +298,9 @@ void rib_polygon(rib_parser *p, const rib_request *req)
 
 void rib_patch(rib_parser *p, const rib_request *req)
 {
-    const char *type = rib_read_string(p, req, 0, "the patch type");
-    if (!type)
+    bool cubic;
+    if (!rib_read_patch_type(p, req, &cubic))
         return;
-    bool cubic = strcmp(type, "bicubic") == 0;
-    if (!cubic && strcmp(type, "bilinear") != 0) {
-        rib_error(p, req, req->args[0].pos, "unknown patch type \"%s\" (expected \"bilinear\" "
-                  "or \"bicubic\")", type);
-        return;
-    }
     rib_params params;
     if (!rib_params_read(p, req, 1, RIB_PARAMS_VARYING, &params))
         return;

@@ -272,6 +272,9 @@ void rib_add_surface(rib_parser *p, const rib_request *req, const geom_surface *
 /* rib_patch.c */
 void rib_basis(rib_parser *p, const rib_request *req);
 void rib_patch_mesh(rib_parser *p, const rib_request *req);
+/* The type argument of Patch and PatchMesh: *cubic for "bicubic", else
+ * "bilinear"; false with an error for anything else (rib_patch.c). */
+bool rib_read_patch_type(rib_parser *p, const rib_request *req, bool *cubic);
 struct rib_primvars;
 /* pv: the patch's other primitive variables (rib_primvar.h), or NULL */
 void rib_patch_bicubic(rib_parser *p, const rib_request *req, const scene_param *P,

@@ -249,18 +249,26 @@ static int count_patches(rib_parser *p, const rib_request *req, sl_pos at, const
     return (n - order) / step + 1;
 }
 
-/* PatchMesh type nu uwrap nv vwrap "P" [...] */
-void rib_patch_mesh(rib_parser *p, const rib_request *req)
+bool rib_read_patch_type(rib_parser *p, const rib_request *req, bool *cubic)
 {
     const char *type = rib_read_string(p, req, 0, "the patch type");
     if (!type)
-        return;
-    bool cubic = strcmp(type, "bicubic") == 0;
-    if (!cubic && strcmp(type, "bilinear") != 0) {
+        return false;
+    *cubic = strcmp(type, "bicubic") == 0;
+    if (!*cubic && strcmp(type, "bilinear") != 0) {
         rib_error(p, req, req->args[0].pos, "unknown patch type \"%s\" (expected \"bilinear\" "
                   "or \"bicubic\")", type);
-        return;
+        return false;
     }
+    return true;
+}
+
+/* PatchMesh type nu uwrap nv vwrap "P" [...] */
+void rib_patch_mesh(rib_parser *p, const rib_request *req)
+{
+    bool cubic;
+    if (!rib_read_patch_type(p, req, &cubic))
+        return;
     double nu, nv;
     bool uper, vper;
     if (rib_read_numbers(p, req, 1, 1, &nu, "the number of points in u") < 0 ||
