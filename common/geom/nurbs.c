@@ -190,7 +190,7 @@ geom_nurbs *geom_nurbs_new(const geom_nurbs_desc *desc, char *err, size_t errsz)
                           "degenerate: its points lie on one line", a, b, ua[a], ub[a], va[b],
                           vb[b]);
                 free(rows), free(ua), free(us);
-                geom_nurbs_free(&self);
+                geom_nurbs_destroy(&self);
                 return NULL;
             }
         }
@@ -200,7 +200,7 @@ geom_nurbs *geom_nurbs_new(const geom_nurbs_desc *desc, char *err, size_t errsz)
     return self;
 }
 
-void geom_nurbs_free(geom_nurbs **self_p)
+void geom_nurbs_destroy(geom_nurbs **self_p)
 {
     geom_nurbs *self = *self_p;
     if (!self)

@@ -210,11 +210,12 @@ void sd_cache_init(geom_subdiv *sd)
     sd->roots = xcalloc((size_t)sd->m.nf + 1, sizeof *sd->roots);
 }
 
-void sd_cache_free(geom_subdiv *sd)
+void sd_cache_clear(geom_subdiv *sd)
 {
     if (!sd->roots) return;
     for (int f = 0; f < sd->m.nf; f++) node_free(atomic_load(&sd->roots[f]));
     free(sd->roots);
+    sd->roots = NULL;
 }
 
 const sd_node *sd_node_root(const geom_subdiv *sd, int f)

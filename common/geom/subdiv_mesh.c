@@ -202,13 +202,13 @@ geom_subdiv *geom_subdiv_new(const geom_subdiv_desc *d, char *err, size_t errsz)
     free(hole0);
     free(open0);
     if (!ok) {
-        geom_subdiv_free(&sd);
+        geom_subdiv_destroy(&sd);
         return NULL;
     }
     return sd;
 }
 
-void geom_subdiv_free(geom_subdiv **self_p)
+void geom_subdiv_destroy(geom_subdiv **self_p)
 {
     geom_subdiv *sd = *self_p;
     if (!sd) return;
@@ -223,7 +223,7 @@ void geom_subdiv_free(geom_subdiv **self_p)
     free(sd->origin);
     free(sd->net_of);
     free(sd->nets);
-    sd_cache_free(sd);
+    sd_cache_clear(sd);
     free(sd);
     *self_p = NULL;
 }

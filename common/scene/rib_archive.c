@@ -164,7 +164,7 @@ void rib_read_archive(rib_parser *p, const rib_request *req)
     rib_params params;      /* RI Spec 3.2: a parameter list may follow */
     if (!rib_params_read(p, req, 1, RIB_PARAMS_LOOSE, &params))
         return;
-    rib_params_free(&params);
+    rib_params_clear(&params);
     if (!name[0]) {
         rib_error(p, req, req->args[0].pos, "the archive name is empty");
         return;

@@ -54,7 +54,7 @@ void rib_attributes_copy(rib_attributes *dst, const rib_attributes *src)
     }
 }
 
-void rib_attributes_free(rib_attributes *a)
+void rib_attributes_clear(rib_attributes *a)
 {
     free(a->light_on);
     a->light_on = NULL;
@@ -207,7 +207,7 @@ void rib_attribute(rib_parser *p, const rib_request *req)
     } else if (strcmp(name, "light") == 0 && (v = rib_params_find(&params, "shadows"))) {
         read_switch(p, req, v, &p->attr.shadows);
     }
-    rib_params_free(&params);
+    rib_params_clear(&params);
 }
 
 void rib_declare(rib_parser *p, const rib_request *req)
@@ -580,7 +580,7 @@ void rib_light_source(rib_parser *p, const rib_request *req)
     l.shadows = p->attr.shadows;
     light_defaults(&l);
     bool ok = light_params(p, req, light_kinds[k].params, &params, &l);
-    rib_params_free(&params);
+    rib_params_clear(&params);
     if (!ok)
         return;
     l.handle = has_handle ? handle_text(req, &req->args[1]) : NULL;

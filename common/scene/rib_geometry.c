@@ -177,7 +177,7 @@ static bool read_quadric(rib_parser *p, const rib_request *req, int n, double *v
     rib_params params;
     if (next < 0 || !rib_params_read(p, req, next, RIB_PARAMS_VARYING, &params))
         return false;
-    rib_params_free(&params);
+    rib_params_clear(&params);
     return true;
 }
 
@@ -293,7 +293,7 @@ void rib_polygon(rib_parser *p, const rib_request *req)
         else if (!rib_polygon_vars(p, req, &params, P))   /* with primitive variables */
             rib_add_surface(p, req, &s);
     }
-    rib_params_free(&params);
+    rib_params_clear(&params);
 }
 
 void rib_patch(rib_parser *p, const rib_request *req)
@@ -325,6 +325,6 @@ void rib_patch(rib_parser *p, const rib_request *req)
         p->nsurface_vars = 0;
     }
     if (P)
-        rib_primvars_free(&pv);
-    rib_params_free(&params);
+        rib_primvars_clear(&pv);
+    rib_params_clear(&params);
 }

@@ -144,7 +144,7 @@ void rib_object_instance(rib_parser *p, const rib_request *req)
     }
 }
 
-void rib_object_defs_free(rib_parser *p)
+void rib_object_defs_clear(rib_parser *p)
 {
     for (int i = 0; i < p->ndefs; i++) {
         free(p->defs[i].handle);

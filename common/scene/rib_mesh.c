@@ -339,7 +339,7 @@ static void read_mesh(rib_parser *p, const rib_request *req, const int *nloops, 
     if (N) {
         m.ncls = normal_class(p, req, N, m.npoints, nidx, nfaces);
         if (m.ncls == MESH_N_NONE) {
-            rib_primvars_free(&m.pv);
+            rib_primvars_clear(&m.pv);
             goto out;
         }
         m.N = N->values;
@@ -356,12 +356,12 @@ static void read_mesh(rib_parser *p, const rib_request *req, const int *nloops, 
         vi += npts;
     }
     free(smooth);
-    rib_primvars_free(&m.pv);
+    rib_primvars_clear(&m.pv);
     if (m.skipped > 0)
         rib_warning(p, req, req->pos, "%d face%s without area skipped", m.skipped,
                     m.skipped == 1 ? "" : "s");
 out:
-    rib_params_free(&params);
+    rib_params_clear(&params);
     free(idx);
 }
 
@@ -413,10 +413,10 @@ void rib_general_polygon(rib_parser *p, const rib_request *req)
                 if (m.skipped)
                     rib_warning(p, req, req->pos, "the polygon has no area: skipped");
             }
-            rib_primvars_free(&m.pv);
+            rib_primvars_clear(&m.pv);
             free(idx);
         }
-        rib_params_free(&params);
+        rib_params_clear(&params);
     }
     free(nverts);
 }
@@ -460,7 +460,7 @@ bool rib_polygon_vars(rib_parser *p, const rib_request *req, const rib_params *p
         int loop[1] = { n };
         add_face(p, &m, 0, loop, 1, idx);
     }
-    rib_primvars_free(&m.pv);
+    rib_primvars_clear(&m.pv);
     free(idx);
     return true;
 }

@@ -304,7 +304,7 @@ void rib_nu_patch(rib_parser *p, const rib_request *req)
     free(ua);
     free(us);
 out:
-    rib_params_free(&params);
+    rib_params_clear(&params);
     free(du.knots);
     free(dv.knots);
 }

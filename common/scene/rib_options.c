@@ -113,7 +113,7 @@ void rib_projection(rib_parser *p, const rib_request *req)
         rib_error(p, req, req->args[0].pos, "unsupported projection \"%s\" (supported: "
                   "\"perspective\", \"orthographic\")", name);
     }
-    rib_params_free(&params);
+    rib_params_clear(&params);
 }
 
 void rib_screen_window(rib_parser *p, const rib_request *req)
@@ -305,7 +305,7 @@ static void trace_option(rib_parser *p, const rib_request *req)
         else
             p->scene->trace_maxdepth = (int)d;
     }
-    rib_params_free(&params);
+    rib_params_clear(&params);
 }
 
 void rib_option(rib_parser *p, const rib_request *req)
@@ -329,7 +329,7 @@ void rib_option(rib_parser *p, const rib_request *req)
     const scene_param *texture = rib_params_find(&params, "texture");
     if (texture && texture->string)
         set_path(p, req, "texture", &p->texture_path, &p->ntexture_path, texture->string);
-    rib_params_free(&params);
+    rib_params_clear(&params);
 }
 
 /* ---------------------------------------------------------------------- */

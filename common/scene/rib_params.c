@@ -19,10 +19,10 @@
 #include <stdlib.h>
 #include <string.h>
 
-void rib_params_free(rib_params *params)
+void rib_params_clear(rib_params *params)
 {
     for (int i = 0; i < params->count; i++)
-        scene_param_free(&params->items[i]);
+        scene_param_clear(&params->items[i]);
     free(params->items);
     params->items = NULL;
     params->count = 0;
@@ -130,7 +130,7 @@ static bool read_one(rib_parser *p, const rib_request *req, int i, rib_params_mo
     out->cls = decl.cls;
     out->pos = name->pos;
     if (!take_value(p, req, &req->args[i + 1], mode, out)) {
-        scene_param_free(out);
+        scene_param_clear(out);
         return false;
     }
     return true;
@@ -147,7 +147,7 @@ bool rib_params_read(rib_parser *p, const rib_request *req, int first,
     out->items = xrealloc(NULL, (size_t)max * sizeof *out->items);
     for (int i = first; i < req->nargs; i += 2) {
         if (!read_one(p, req, i, mode, &out->items[out->count])) {
-            rib_params_free(out);
+            rib_params_clear(out);
             return false;
         }
         out->count++;

@@ -238,9 +238,9 @@ static void pop_block(rib_parser *p, const char *who, sl_pos pos)
     rib_block *b = &p->blocks[--p->nblocks];
     if (b->kind == RIB_BLOCK_TRANSFORM) {
         p->attr.ctm = b->saved.ctm;
-        rib_attributes_free(&b->saved);
+        rib_attributes_clear(&b->saved);
     } else {
-        rib_attributes_free(&p->attr);
+        rib_attributes_clear(&p->attr);
         p->attr = b->saved;
     }
     if (b->kind == RIB_BLOCK_WORLD)
@@ -723,9 +723,9 @@ static scene *scene_new(const char *file)
 static void parser_free(rib_parser *p)
 {
     while (p->nblocks > 0)
-        rib_attributes_free(&p->blocks[--p->nblocks].saved);
+        rib_attributes_clear(&p->blocks[--p->nblocks].saved);
     free(p->blocks);
-    rib_attributes_free(&p->attr);
+    rib_attributes_clear(&p->attr);
     for (int i = 0; i < p->nstrings; i++)
         free(p->strings[i]);
     free(p->strings);
@@ -741,7 +741,7 @@ static void parser_free(rib_parser *p)
     for (int i = 0; i < p->ntexture_path; i++)
         free(p->texture_path[i]);
     free(p->texture_path);
-    rib_object_defs_free(p);
+    rib_object_defs_clear(p);
     rib_decls_destroy(&p->decls);
     rib_reader_destroy(&p->reader);
 }

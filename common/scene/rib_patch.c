@@ -307,7 +307,7 @@ void rib_patch_mesh(rib_parser *p, const rib_request *req)
         rib_primvars vars;
         scene_primvar pvars[RIB_MAX_PRIMVARS];
         if (!rib_patch_primvars(p, req, &params, counts, cubic, &vars)) {
-            rib_params_free(&params);
+            rib_params_clear(&params);
             return;
         }
         for (int pv = 0; pv < nvpatch; pv++)
@@ -342,7 +342,7 @@ void rib_patch_mesh(rib_parser *p, const rib_request *req)
             }
         p->surface_vars = NULL;
         p->nsurface_vars = 0;
-        rib_primvars_free(&vars);
+        rib_primvars_clear(&vars);
     }
-    rib_params_free(&params);
+    rib_params_clear(&params);
 }

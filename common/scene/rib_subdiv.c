@@ -314,9 +314,9 @@ void rib_subdivision_mesh(rib_parser *p, const rib_request *req)
 #endif
 out:
     free(fo);
-    rib_primvars_free(&vars);
+    rib_primvars_clear(&vars);
     tags_free(&tags);
-    rib_params_free(&params);
+    rib_params_clear(&params);
     free(nverts);
     free(idx);
 }
