@@ -720,7 +720,7 @@ static scene *scene_new(const char *file)
     return s;
 }
 
-static void parser_free(rib_parser *p)
+static void parser_clear(rib_parser *p)
 {
     while (p->nblocks > 0)
         rib_attributes_clear(&p->blocks[--p->nblocks].saved);
@@ -834,7 +834,7 @@ static scene *parse_frame(const char *file, const char *text, size_t len,
     p.reader = rib_reader_new(p.file, text, len, diag);
     rib_attributes_init(&p.attr);
     parse_all(&p);
-    parser_free(&p);
+    parser_clear(&p);
 
     sl_diag_set_sources(diag, NULL);
     sl_source_set_destroy(&set);

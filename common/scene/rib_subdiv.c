@@ -44,7 +44,7 @@ typedef struct subdiv_tags {
     bool interpolateboundary;
 } subdiv_tags;
 
-static void tags_free(subdiv_tags *t)
+static void tags_clear(subdiv_tags *t)
 {
     free(t->crease_len);
     free(t->crease_verts);
@@ -315,7 +315,7 @@ void rib_subdivision_mesh(rib_parser *p, const rib_request *req)
 out:
     free(fo);
     rib_primvars_clear(&vars);
-    tags_free(&tags);
+    tags_clear(&tags);
     rib_params_clear(&params);
     free(nverts);
     free(idx);
