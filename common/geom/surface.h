@@ -99,7 +99,7 @@ typedef struct geom_sample {
 /* Checks the parameters (finite numbers, radius > 0, zmin < zmax,
  * thetamax != 0, polygon convex and planar with >= 3 distinct vertices,
  * ...), fills the derived fields. On failure returns false and writes a
- * one-line reason ("sphere radius must be > 0, got -1") into why. */
+ * one-line reason ("sphere radius must be > 0, got -1") into err. */
 bool geom_surface_prepare(geom_surface *s, char *err, size_t errsz);
 
 const char *geom_kind_name(geom_kind kind);    /* "sphere", "disk", ... */
