@@ -170,6 +170,7 @@ static int render_frame(const standalone_options *opt, const job *jb, const fram
 {
     sl_diag *diag = sl_diag_new();
     job_scene *js = job_scene_new(jb, opt->cache_bytes, true, diag);
+    if (js) trace_renderer_set_log(js->renderer, worker_log_warning, NULL);
     sl_diag_print(diag, stderr);
     sl_diag_destroy(&diag);
     if (!js || atomic_load(&interrupted)) {

@@ -28,3 +28,9 @@ image_tile *worker_render_tile(const job_scene *js, trace_thread *th,
     nonfinite->count = image_tile_clear_nonfinite(tile, &nonfinite->x, &nonfinite->y);
     return tile;
 }
+
+void worker_log_warning(void *user, const char *message)
+{
+    (void)user;
+    fprintf(stderr, "aafarm: warning: %s\n", message);
+}

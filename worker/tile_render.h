@@ -29,4 +29,8 @@ image_tile *worker_render_tile(const job_scene *js, trace_thread *th,
                                worker_nonfinite *nonfinite,
                                char *err, size_t errsz);
 
+/* The renderer's warnings (trace_renderer_set_log) on stderr, as
+ * "aafarm: warning: <message>". */
+void worker_log_warning(void *user, const char *message);
+
 #endif

@@ -11,6 +11,7 @@
 #include <string.h>
 
 #include "file_store.h"
+#include "tile_render.h"
 #include "util/err.h"
 #include "util/xalloc.h"
 
@@ -134,6 +135,7 @@ static bool prepare(held_job *h, const proto_job *m, size_t cache_bytes)
 {
     sl_diag *diag = sl_diag_new();
     h->js = job_scene_new(h->jb, cache_bytes, true, diag);
+    if (h->js) trace_renderer_set_log(h->js->renderer, worker_log_warning, NULL);
     if (!h->js) {
         char *text = sl_diag_to_string(diag);
         size_t n = strlen(text);

@@ -21,6 +21,14 @@
 /* context                                                                 */
 /* ---------------------------------------------------------------------- */
 
+/* The context's invariant: the symbols handed out fit its capacity, which
+ * fits a form (every form's n <= AA_MAX_SYMBOLS follows from it). */
+static inline void check_context(const aa_context *ctx)
+{
+    assert(ctx->used >= 0 && ctx->used <= ctx->capacity);
+    assert(ctx->capacity <= AA_MAX_SYMBOLS);
+}
+
 void aa_context_init(aa_context *ctx, int capacity)
 {
     if (capacity < 0)
@@ -30,6 +38,7 @@ void aa_context_init(aa_context *ctx, int capacity)
     ctx->used = 0;
     ctx->capacity = capacity;
     ctx->folded = 0;
+    check_context(ctx);
 }
 
 void aa_context_reset(aa_context *ctx)
@@ -40,6 +49,7 @@ void aa_context_reset(aa_context *ctx)
 /* A fresh noise symbol, or -1 when the context's capacity is spent. */
 static int fresh_symbol(aa_context *ctx)
 {
+    check_context(ctx);
     if (ctx->used >= ctx->capacity)
         return -1;
     return ctx->used++;
@@ -75,6 +85,8 @@ void aa_const(aa_form *z, double value)
 
 void aa_add_new_error(aa_context *ctx, aa_form *z, double delta)
 {
+    assert(!(delta < 0.0));                 /* an upper bound of an error */
+    assert(z->n <= AA_MAX_SYMBOLS);
     if (delta == 0.0 || (z->flags & AA_UNBOUNDED))
         return;
     if (!(delta < INFINITY)) {
@@ -87,6 +99,7 @@ void aa_add_new_error(aa_context *ctx, aa_form *z, double delta)
         ctx->folded++;
         return;
     }
+    assert(k < AA_MAX_SYMBOLS);
     for (int i = z->n; i < k; i++)
         z->c[i] = 0.0;
     z->c[k] = delta;

@@ -16,18 +16,12 @@
  */
 #include "geom/nurbs_internal.h"
 #include "geom/surface_internal.h"
+#include "util/err.h"
+#include "util/xalloc.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-
-static void *xmalloc(size_t n)
-{
-    void *p = malloc(n ? n : 1);
-    if (!p)
-        abort();
-    return p;
-}
 
 /* The blossom f(args[0..p)) of the degree-p polynomial of span k of
  * knots U, control points d[0..p] (4 numbers each, d[0] = point k-p). */
@@ -64,20 +58,20 @@ typedef struct dir {
     double lo, hi;
 } dir;
 
-static bool check_dir(const dir *d, const char *w, char *why, int why_size)
+static bool check_dir(const dir *d, const char *w, char *err, size_t errsz)
 {
     if (d->order < 2 || d->order > GEOM_NURBS_MAX_ORDER)
-        return geom_fail(why, why_size, "%sorder must be 2 to %d, got %d", w,
+        return err_set(err, errsz, "%sorder must be 2 to %d, got %d", w,
                          GEOM_NURBS_MAX_ORDER, d->order);
     if (d->n < d->order)
-        return geom_fail(why, why_size, "n%s must be at least %sorder (%d), got %d", w, w,
+        return err_set(err, errsz, "n%s must be at least %sorder (%d), got %d", w, w,
                          d->order, d->n);
     for (int j = 0; j < d->n + d->order; j++)
         if (!isfinite(d->U[j]) || (j > 0 && d->U[j] < d->U[j - 1]))
-            return geom_fail(why, why_size, "%sknot must be finite and nondecreasing (entry "
+            return err_set(err, errsz, "%sknot must be finite and nondecreasing (entry "
                              "%d is %g)", w, j, d->U[j]);
     if (!(d->lo < d->hi && d->lo >= d->U[d->order - 1] && d->hi <= d->U[d->n]))
-        return geom_fail(why, why_size, "%smin %smax must satisfy %g <= %smin < %smax <= %g, "
+        return err_set(err, errsz, "%smin %smax must satisfy %g <= %smin < %smax <= %g, "
                          "got %g %g", w, w, d->U[d->order - 1], w, w, d->U[d->n], d->lo, d->hi);
     return true;
 }
@@ -122,30 +116,30 @@ static bool finish_piece(geom_nurbs_piece *pc)
     return pc->wmin > 0 && isfinite(pc->wmax) && isfinite(size) && area > 1e-12 * size * size;
 }
 
-geom_nurbs *geom_nurbs_new(const geom_nurbs_desc *desc, char *why, int why_size)
+geom_nurbs *geom_nurbs_new(const geom_nurbs_desc *desc, char *err, size_t errsz)
 {
     dir du = { desc->nu, desc->uorder, desc->uknot, desc->umin, desc->umax };
     dir dv = { desc->nv, desc->vorder, desc->vknot, desc->vmin, desc->vmax };
-    if (!check_dir(&du, "u", why, why_size) || !check_dir(&dv, "v", why, why_size))
+    if (!check_dir(&du, "u", err, errsz) || !check_dir(&dv, "v", err, errsz))
         return NULL;
     if ((double)du.n * dv.n > 1e7) {
-        geom_fail(why, why_size, "at most 10000000 control points, got %d x %d", du.n, dv.n);
+        err_set(err, errsz, "at most 10000000 control points, got %d x %d", du.n, dv.n);
         return NULL;
     }
     for (int i = 0; i < du.n * dv.n; i++) {
         const double *h = desc->Pw + 4 * i;
         if (!isfinite(h[0]) || !isfinite(h[1]) || !isfinite(h[2]) || !isfinite(h[3])) {
-            geom_fail(why, why_size, "control point %d is not finite", i);
+            err_set(err, errsz, "control point %d is not finite", i);
             return NULL;
         }
         if (!(h[3] > 0)) {
-            geom_fail(why, why_size, "control point %d has weight %g: every weight must be "
+            err_set(err, errsz, "control point %d has weight %g: every weight must be "
                       "> 0", i, h[3]);
             return NULL;
         }
         if (!(fabs(h[0] / h[3]) < 1e150 && fabs(h[1] / h[3]) < 1e150 &&
               fabs(h[2] / h[3]) < 1e150)) {
-            geom_fail(why, why_size, "control point %d is too large", i);
+            err_set(err, errsz, "control point %d is too large", i);
             return NULL;
         }
     }
@@ -155,7 +149,7 @@ geom_nurbs *geom_nurbs_new(const geom_nurbs_desc *desc, char *why, int why_size)
     int *us = xmalloc((size_t)(du.n + dv.n) * sizeof *us), *vs = us + du.n;
     int nui = intervals(&du, ua, ub, us), nvi = intervals(&dv, va, vb, vs);
     if ((double)nui * nvi * 4 * du.order * dv.order > GEOM_NURBS_MAX_NET) {
-        geom_fail(why, why_size, "%d x %d pieces of orders %d x %d are too many: their nets "
+        err_set(err, errsz, "%d x %d pieces of orders %d x %d are too many: their nets "
                   "would hold more than %d numbers (split the patch)", nui, nvi, du.order,
                   dv.order, GEOM_NURBS_MAX_NET);
         free(ua), free(us);
@@ -192,11 +186,11 @@ geom_nurbs *geom_nurbs_new(const geom_nurbs_desc *desc, char *why, int why_size)
             pc->ku = du.order, pc->kv = dv.order, pc->H = H;
             pc->u0 = ua[a], pc->u1 = ub[a], pc->v0 = va[b], pc->v1 = vb[b];
             if (!finish_piece(pc)) {
-                geom_fail(why, why_size, "piece (%d, %d) over u [%g, %g], v [%g, %g] is "
+                err_set(err, errsz, "piece (%d, %d) over u [%g, %g], v [%g, %g] is "
                           "degenerate: its points lie on one line", a, b, ua[a], ub[a], va[b],
                           vb[b]);
                 free(rows), free(ua), free(us);
-                geom_nurbs_free(&self);
+                geom_nurbs_destroy(&self);
                 return NULL;
             }
         }
@@ -206,7 +200,7 @@ geom_nurbs *geom_nurbs_new(const geom_nurbs_desc *desc, char *why, int why_size)
     return self;
 }
 
-void geom_nurbs_free(geom_nurbs **self_p)
+void geom_nurbs_destroy(geom_nurbs **self_p)
 {
     geom_nurbs *self = *self_p;
     if (!self)

@@ -52,11 +52,11 @@ typedef struct geom_nurbs_desc {
 
 typedef struct geom_nurbs geom_nurbs;
 
-/* Builds the pieces; NULL with a one-line reason in why (an order out of
+/* Builds the pieces; NULL with a one-line reason in err (an order out of
  * range, knots or a range that do not fit, a weight <= 0, a piece whose
  * points all lie on one line, more than GEOM_NURBS_MAX_NET numbers). */
-geom_nurbs *geom_nurbs_new(const geom_nurbs_desc *desc, char *why, int why_size);
-void geom_nurbs_free(geom_nurbs **self_p);
+geom_nurbs *geom_nurbs_new(const geom_nurbs_desc *desc, char *err, size_t errsz);
+void geom_nurbs_destroy(geom_nurbs **self_p);
 
 /* Pieces, u intervals fastest. */
 int geom_nurbs_npieces(const geom_nurbs *self);

@@ -28,6 +28,7 @@
  */
 #include "geom/nurbs_internal.h"
 #include "geom/surface_internal.h"
+#include "util/err.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -360,10 +361,10 @@ void geom_nurbs_eval_ia(const geom_surface *s, ia_interval u, ia_interval v, geo
 
 /* ---- prepare and bounds --------------------------------------------- */
 
-bool geom_nurbs_prepare(geom_surface *s, char *why, int why_size)
+bool geom_nurbs_prepare(geom_surface *s, char *err, size_t errsz)
 {
     if (!s->nurbs || s->nurbs_piece < 0 || s->nurbs_piece >= geom_nurbs_npieces(s->nurbs))
-        return geom_fail(why, why_size, "NuPatch piece without its patch");
+        return err_set(err, errsz, "NuPatch piece without its patch");
     return true;
 }
 

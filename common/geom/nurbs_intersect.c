@@ -23,15 +23,13 @@
  */
 #include "geom/nurbs_internal.h"
 #include "geom/surface_internal.h"
+#include "util/xalloc.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
-enum { MIN_DEPTH_TRANSVERSAL = 3, MIN_DEPTH = 5, MAX_DEPTH = 16,
-       STACK = 3 * MAX_DEPTH + 8 };
-
-typedef struct node { double u0, v0; int depth; } node;
+enum { STACK = GEOM_PATCH_STACK };
 
 /* Splits the k points p[0], p[s], .. p[(k-1)s] (4 numbers each) at 1/2
  * into a and b (same stride). */
@@ -110,6 +108,51 @@ static bool transversal(const double *n, int ku, int kv)
     return lo > tiny || hi < -tiny;
 }
 
+/* The walk's view of the nets (geom_patch_walk): STACK nets of sz
+ * numbers in mem, then a work area of two and four quarter slots. */
+typedef struct nurbs_walk {
+    double *mem;
+    size_t sz;
+    int ku, kv, count;
+    double eps, wmin;
+} nurbs_walk;
+
+/* Pruned where F1 or F2 keeps one sign; else the range of T / w. */
+static bool nurbs_clip(void *user, int k, double tmin, double best, double *t0_out,
+                       double *t1_out)
+{
+    nurbs_walk *nw = user;
+    const double *net = nw->mem + nw->sz * (size_t)k;
+    if (one_sign(net, nw->count, 0, nw->eps) || one_sign(net, nw->count, 1, nw->eps))
+        return false;
+    double t0 = INFINITY, t1 = -INFINITY;
+    for (int i = 0; i < nw->count; i++) {
+        double t = net[4 * i + 2] / net[4 * i + 3];
+        t0 = fmin(t0, t), t1 = fmax(t1, t);
+    }
+    double tpad = 1e-12 * (fabs(t0) + fabs(t1)) + nw->eps / nw->wmin;
+    t0 = fmax(t0 - tpad, tmin), t1 = fmin(t1 + tpad, best);
+    *t0_out = t0, *t1_out = t1;
+    return t0 <= t1;
+}
+
+static bool nurbs_transversal(void *user, int k)
+{
+    nurbs_walk *nw = user;
+    return transversal(nw->mem + nw->sz * (size_t)k, nw->ku, nw->kv);
+}
+
+static void nurbs_split(void *user, int k)
+{
+    nurbs_walk *nw = user;
+    size_t sz = nw->sz;
+    double *half = nw->mem + sz * STACK, *quarter = half + 2 * sz;
+    double *q[4] = { quarter, quarter + sz, quarter + 2 * sz, quarter + 3 * sz };
+    split_net(nw->mem + sz * (size_t)k, nw->ku, nw->kv, half, q);
+    for (int i = 3; i >= 0; i--)     /* quarter 0 on top */
+        memcpy(nw->mem + sz * (size_t)(k + 3 - i), q[i], sizeof(double) * sz);
+}
+
 bool geom_nurbs_intersect(const geom_surface *s, vec3 o, vec3 d, double tmin, double tmax,
                           geom_hit *hit)
 {
@@ -127,14 +170,11 @@ bool geom_nurbs_intersect(const geom_surface *s, vec3 o, vec3 d, double tmin, do
     vec3 lo, hi;
     geom_nurbs_bounds(s, &lo, &hi);
     double scale = v3_length(v3_sub(hi, lo)) + v3_length(o) + 1e-300;
-    double eps = 1e-12 * scale * pc->wmax;
     size_t sz = 4 * (size_t)count;
     /* the nets of the stack, a work area and four quarter slots */
-    double *mem = malloc(sizeof(double) * sz * (STACK + 2 + 4));
-    if (!mem)
-        abort();
-    node stack[STACK];
-    double *root = mem;
+    nurbs_walk nw = { xmalloc(sizeof(double) * sz * (STACK + 2 + 4)), sz, ku, kv, count,
+                      1e-12 * scale * pc->wmax, pc->wmin };
+    double *root = nw.mem;
     for (int k = 0; k < count; k++) {
         const double *h = pc->H + 4 * k;
         vec3 q = v3_sub(v3(h[0], h[1], h[2]), v3_scale(o, h[3]));
@@ -143,56 +183,9 @@ bool geom_nurbs_intersect(const geom_surface *s, vec3 o, vec3 d, double tmin, do
         root[4 * k + 2] = v3_dot(d, q) / dd;
         root[4 * k + 3] = h[3];
     }
-    stack[0] = (node){ 0, 0, 0 };
-    int n = 1;
-    double *half = mem + sz * STACK, *quarter = half + 2 * sz;
-    double best = tmax;
-    bool found = false;
-    while (n > 0) {
-        node cur = stack[--n];
-        double *net = mem + sz * (size_t)n;
-        double side = ldexp(1, -cur.depth), u0 = cur.u0, v0 = cur.v0;
-        if (one_sign(net, count, 0, eps) || one_sign(net, count, 1, eps))
-            continue;
-        double t0 = INFINITY, t1 = -INFINITY;
-        for (int k = 0; k < count; k++) {
-            double t = net[4 * k + 2] / net[4 * k + 3];
-            t0 = fmin(t0, t), t1 = fmax(t1, t);
-        }
-        double tpad = 1e-12 * (fabs(t0) + fabs(t1)) + eps / pc->wmin;
-        t0 = fmax(t0 - tpad, tmin), t1 = fmin(t1 + tpad, best);
-        if (!(t0 <= t1))
-            continue;
-        bool across = transversal(net, ku, kv);
-        if (cur.depth >= (across ? MIN_DEPTH_TRANSVERSAL : MIN_DEPTH)) {
-            double u = u0 + side / 2, v = v0 + side / 2;
-            geom_sample c;
-            geom_nurbs_eval_dual(s, u, v, &c);
-            double t = v3_dot(v3_sub(c.P, o), d) / dd;
-            double slack = 1e-9;
-            bool inside = geom_patch_newton(s, geom_nurbs_eval_dual, o, d, &t, &u, &v, scale) &&
-                          u >= u0 - slack && u <= u0 + side + slack && v >= v0 - slack &&
-                          v <= v0 + side + slack && t >= t0 && t <= t1;
-            if (inside && t > tmin + 1e-9 * fabs(tmin) && t < best) {
-                best = t;
-                hit->t = t;
-                hit->u = fmin(fmax(u, 0), 1);
-                hit->v = fmin(fmax(v, 0), 1);
-                found = true;
-            }
-            if ((inside && across) || cur.depth >= MAX_DEPTH)
-                continue;
-        }
-        if (n + 4 > STACK)
-            continue;
-        double *q[4] = { quarter, quarter + sz, quarter + 2 * sz, quarter + 3 * sz };
-        split_net(net, ku, kv, half, q);
-        double h = side / 2;
-        for (int k = 3; k >= 0; k--) {     /* quarter 0 on top */
-            memcpy(mem + sz * (size_t)n, q[k], sizeof(double) * sz);
-            stack[n++] = (node){ u0 + (k & 1) * h, v0 + (k >> 1) * h, cur.depth + 1 };
-        }
-    }
-    free(mem);
+    geom_patch_walk w = { s, geom_nurbs_eval_dual, scale, nurbs_clip, nurbs_transversal,
+                          nurbs_split, true, &nw };
+    bool found = geom_patch_intersect(&w, o, d, tmin, tmax, hit);
+    free(nw.mem);
     return found;
 }

@@ -53,10 +53,10 @@ enum { GEOM_SUBDIV_MAX_VALENCE = 16 };
 
 typedef struct geom_subdiv geom_subdiv;
 
-/* Builds the mesh; NULL with a one-line reason in why (a non-manifold
+/* Builds the mesh; NULL with a one-line reason in err (a non-manifold
  * edge, faces that disagree on orientation, a valence above 16, ...). */
-geom_subdiv *geom_subdiv_new(const geom_subdiv_desc *desc, char *why, int why_size);
-void geom_subdiv_free(geom_subdiv **self_p);
+geom_subdiv *geom_subdiv_new(const geom_subdiv_desc *desc, char *err, size_t errsz);
+void geom_subdiv_destroy(geom_subdiv **self_p);
 
 /* Faces of the refined mesh, and whether face f is drawn: not a hole and
  * (without interpolateboundary) not touching the boundary. */

@@ -46,6 +46,7 @@
  * eigen-analysis of the subdivision matrix.
  */
 #include "geom/subdiv_local.h"
+#include "util/xalloc.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -154,17 +155,15 @@ static void sector_bounds(const sd_mesh *m, vec3 *lo, vec3 *hi, int *axis)
 
 static sd_node *node_new(const sd_local *L, int level)
 {
-    sd_node *n = calloc(1, sizeof *n);
-    if (!n) abort();
+    sd_node *n = xcalloc(1, sizeof *n);
     n->level = level;
     n->axis = -1;
     n->regular = sd_regular_net(&L->m, n->net);
     if (n->regular) return n;
     int nv = L->m.nv, nf = L->m.nf, nc = L->fo[nf];
-    n->m = (sd_mesh){ nv, nf, malloc((size_t)nv * sizeof(vec3)), malloc((size_t)nv * sizeof(double)),
-                      malloc((size_t)(nf + 1) * sizeof(int)), malloc((size_t)nc * sizeof(int)),
-                      malloc((size_t)nc * sizeof(double)) };
-    if (!n->m.P || !n->m.vs || !n->m.fo || !n->m.fv || !n->m.es) abort();
+    n->m = (sd_mesh){ nv, nf, xmalloc((size_t)nv * sizeof(vec3)), xmalloc((size_t)nv * sizeof(double)),
+                      xmalloc((size_t)(nf + 1) * sizeof(int)), xmalloc((size_t)nc * sizeof(int)),
+                      xmalloc((size_t)nc * sizeof(double)) };
     memcpy(n->m.P, L->P, (size_t)nv * sizeof(vec3));
     memcpy(n->m.vs, L->vs, (size_t)nv * sizeof(double));
     memcpy(n->m.fo, L->fo, (size_t)(nf + 1) * sizeof(int));
@@ -208,23 +207,22 @@ static const sd_node *publish(_Atomic(sd_node *) *slot, sd_node *n)
 
 void sd_cache_init(geom_subdiv *sd)
 {
-    sd->roots = calloc((size_t)sd->m.nf + 1, sizeof *sd->roots);
-    if (!sd->roots) abort();
+    sd->roots = xcalloc((size_t)sd->m.nf + 1, sizeof *sd->roots);
 }
 
-void sd_cache_free(geom_subdiv *sd)
+void sd_cache_clear(geom_subdiv *sd)
 {
     if (!sd->roots) return;
     for (int f = 0; f < sd->m.nf; f++) node_free(atomic_load(&sd->roots[f]));
     free(sd->roots);
+    sd->roots = NULL;
 }
 
 const sd_node *sd_node_root(const geom_subdiv *sd, int f)
 {
     sd_node *n = atomic_load(&sd->roots[f]);
     if (n) return n;
-    sd_local *L = malloc(sizeof *L);
-    if (!L) abort();
+    sd_local *L = xmalloc(sizeof *L);
     sd_local_from_shared(sd, f, L);
     n = node_new(L, 0);
     free(L);
@@ -235,9 +233,8 @@ const sd_node *sd_node_child(const sd_node *p, int q)
 {
     sd_node *n = atomic_load(&((sd_node *)p)->kid[q]);
     if (n) return n;
-    sd_local *L = malloc(sizeof *L);
-    sd_big *big = malloc(sizeof *big);
-    if (!L || !big) abort();
+    sd_local *L = xmalloc(sizeof *L);
+    sd_big *big = xmalloc(sizeof *big);
     sd_node_local(p, L);
     sd_local_child(L, q, big);
     n = node_new(L, p->level + 1);

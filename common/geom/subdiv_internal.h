@@ -52,6 +52,6 @@ struct geom_subdiv {
 
 /* The per-face trees of subdiv_cache.c: made empty, freed with the mesh. */
 void sd_cache_init(geom_subdiv *sd);
-void sd_cache_free(geom_subdiv *sd);
+void sd_cache_clear(geom_subdiv *sd);
 
 #endif

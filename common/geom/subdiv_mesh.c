@@ -8,6 +8,8 @@
  */
 #include "geom/subdiv_local.h"
 #include "geom/surface_internal.h"
+#include "util/err.h"
+#include "util/xalloc.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -43,12 +45,12 @@ static int find_corner(const dir_edge *e, int ne, int a, int b)
     return lo;
 }
 
-geom_subdiv *geom_subdiv_new(const geom_subdiv_desc *d, char *why, int why_size)
+geom_subdiv *geom_subdiv_new(const geom_subdiv_desc *d, char *err, size_t errsz)
 {
     int nf = d->nfaces, nv = d->npoints, nc = 0;
     for (int f = 0; f < nf; f++) {
         if (d->nverts[f] < 3 || d->nverts[f] > GEOM_SUBDIV_MAX_VALENCE) {
-            geom_fail(why, why_size, "face %d has %d points (3 to %d are supported)", f,
+            err_set(err, errsz, "face %d has %d points (3 to %d are supported)", f,
                       d->nverts[f], GEOM_SUBDIV_MAX_VALENCE);
             return NULL;
         }
@@ -56,19 +58,17 @@ geom_subdiv *geom_subdiv_new(const geom_subdiv_desc *d, char *why, int why_size)
     }
     for (int i = 0; i < 3 * nv; i++)
         if (!isfinite(d->P[i]) || fabs(d->P[i]) > 1e150) {
-            geom_fail(why, why_size, "point %d is not finite", i / 3);
+            err_set(err, errsz, "point %d is not finite", i / 3);
             return NULL;
         }
-    sd_mesh m0 = { nv, nf, malloc((size_t)(nv + 1) * sizeof(vec3)),
-                   calloc((size_t)nv + 1, sizeof(double)), malloc((size_t)(nf + 1) * sizeof(int)),
-                   malloc((size_t)(nc + 1) * sizeof(int)), calloc((size_t)nc + 1, sizeof(double)) };
-    dir_edge *e = malloc((size_t)(nc + 1) * sizeof *e);
-    int *face_of = malloc((size_t)(nc + 1) * sizeof *face_of);
-    int *count = calloc((size_t)nv + 1, sizeof *count);
-    unsigned char *hole0 = calloc((size_t)nf + 1, 1);
-    geom_subdiv *sd = calloc(1, sizeof *sd);
-    if (!m0.P || !m0.vs || !m0.fo || !m0.fv || !m0.es || !e || !face_of || !count || !hole0 || !sd)
-        abort();
+    sd_mesh m0 = { nv, nf, xmalloc((size_t)(nv + 1) * sizeof(vec3)),
+                   xcalloc((size_t)nv + 1, sizeof(double)), xmalloc((size_t)(nf + 1) * sizeof(int)),
+                   xmalloc((size_t)(nc + 1) * sizeof(int)), xcalloc((size_t)nc + 1, sizeof(double)) };
+    dir_edge *e = xmalloc((size_t)(nc + 1) * sizeof *e);
+    int *face_of = xmalloc((size_t)(nc + 1) * sizeof *face_of);
+    int *count = xcalloc((size_t)nv + 1, sizeof *count);
+    unsigned char *hole0 = xcalloc((size_t)nf + 1, 1);
+    geom_subdiv *sd = xcalloc(1, sizeof *sd);
     bool ok = true;
     for (int i = 0; i < nv; i++) m0.P[i] = v3(d->P[3 * i], d->P[3 * i + 1], d->P[3 * i + 2]);
     m0.fo[0] = 0;
@@ -84,7 +84,7 @@ geom_subdiv *geom_subdiv_new(const geom_subdiv_desc *d, char *why, int why_size)
             int nx = c + 1 < m0.fo[f + 1] ? c + 1 : m0.fo[f];
             e[c] = (dir_edge){ m0.fv[c], m0.fv[nx], c };
             if (m0.fv[c] == m0.fv[nx]) {
-                ok = geom_fail(why, why_size, "face %d repeats point %d", f, m0.fv[c]);
+                ok = err_set(err, errsz, "face %d repeats point %d", f, m0.fv[c]);
                 break;
             }
         }
@@ -96,10 +96,10 @@ geom_subdiv *geom_subdiv_new(const geom_subdiv_desc *d, char *why, int why_size)
                           (e[j].a == e[i].b && e[j].b == e[i].a)))
             j++;
         if (j - i > 2)
-            ok = geom_fail(why, why_size, "the edge %d-%d has %d faces (at most 2: the mesh "
+            ok = err_set(err, errsz, "the edge %d-%d has %d faces (at most 2: the mesh "
                            "must be a manifold)", e[i].a, e[i].b, j - i);
         else if (j - i == 2 && e[i].a == e[i + 1].a)
-            ok = geom_fail(why, why_size, "faces %d and %d run the edge %d-%d the same way "
+            ok = err_set(err, errsz, "faces %d and %d run the edge %d-%d the same way "
                            "(orient all faces alike)", face_of[e[i].c], face_of[e[i + 1].c],
                            e[i].a, e[i].b);
         else if (j - i == 1) {
@@ -109,12 +109,11 @@ geom_subdiv *geom_subdiv_new(const geom_subdiv_desc *d, char *why, int why_size)
         }
         i = j;
     }
-    int *val = calloc((size_t)nv + 1, sizeof *val);
-    if (!val) abort();
+    int *val = xcalloc((size_t)nv + 1, sizeof *val);
     for (int c = 0; c < nc; c++) val[m0.fv[c]]++;
     for (int i = 0; i < nv && ok; i++)
         if (val[i] > GEOM_SUBDIV_MAX_VALENCE)
-            ok = geom_fail(why, why_size, "point %d is in %d faces (at most %d are supported)",
+            ok = err_set(err, errsz, "point %d is in %d faces (at most %d are supported)",
                            i, val[i], GEOM_SUBDIV_MAX_VALENCE);
         else if (d->interpolateboundary && val[i] == 1 && count[i] == 2)
             m0.vs[i] = INFINITY;       /* a corner of the boundary */
@@ -135,7 +134,7 @@ geom_subdiv *geom_subdiv_new(const geom_subdiv_desc *d, char *why, int why_size)
                     }
             }
             if (!found)
-                ok = geom_fail(why, why_size, "crease %d: points %d and %d share no edge", k, a, b);
+                ok = err_set(err, errsz, "crease %d: points %d and %d share no edge", k, a, b);
         }
         cv += d->crease_len[k];
     }
@@ -146,8 +145,7 @@ geom_subdiv *geom_subdiv_new(const geom_subdiv_desc *d, char *why, int why_size)
     for (int k = 0; k < d->nholes && ok; k++) hole0[d->holes[k]] = 1;
     /* without interpolateboundary the faces at a boundary point are
      * control only (their 1-rings are not complete) */
-    unsigned char *open0 = calloc((size_t)nf + 1, 1);
-    if (!open0) abort();
+    unsigned char *open0 = xcalloc((size_t)nf + 1, 1);
     for (int c = 0; c < nc; c++)
         if (count[m0.fv[c]] > 0) open0[face_of[c]] = 1;
     free(e);
@@ -155,24 +153,21 @@ geom_subdiv *geom_subdiv_new(const geom_subdiv_desc *d, char *why, int why_size)
     if (ok) {
         int ne = sd_edge_count(&m0);
         int nv1 = nv + nf + ne, nf1 = nc;
-        sd->m = (sd_mesh){ 0, 0, malloc((size_t)nv1 * sizeof(vec3)),
-                           malloc((size_t)nv1 * sizeof(double)),
-                           malloc((size_t)(nf1 + 1) * sizeof(int)),
-                           malloc((size_t)(4 * nf1 + 1) * sizeof(int)),
-                           malloc((size_t)(4 * nf1 + 1) * sizeof(double)) };
-        if (!sd->m.P || !sd->m.vs || !sd->m.fo || !sd->m.fv || !sd->m.es) abort();
+        sd->m = (sd_mesh){ 0, 0, xmalloc((size_t)nv1 * sizeof(vec3)),
+                           xmalloc((size_t)nv1 * sizeof(double)),
+                           xmalloc((size_t)(nf1 + 1) * sizeof(int)),
+                           xmalloc((size_t)(4 * nf1 + 1) * sizeof(int)),
+                           xmalloc((size_t)(4 * nf1 + 1) * sizeof(double)) };
         sd_refine(&m0, &sd->m);
-        sd->origin = malloc((size_t)(nf1 + 1) * sizeof(int));
-        sd->drawn = calloc((size_t)nf1 + 1, 1);
-        sd->net_of = malloc((size_t)(nf1 + 1) * sizeof(int));
-        sd->vf_off = calloc((size_t)nv1 + 2, sizeof(int));
-        sd->vf = malloc((size_t)(4 * nf1 + 1) * sizeof(int));
-        if (!sd->origin || !sd->drawn || !sd->net_of || !sd->vf_off || !sd->vf) abort();
+        sd->origin = xmalloc((size_t)(nf1 + 1) * sizeof(int));
+        sd->drawn = xcalloc((size_t)nf1 + 1, 1);
+        sd->net_of = xmalloc((size_t)(nf1 + 1) * sizeof(int));
+        sd->vf_off = xcalloc((size_t)nv1 + 2, sizeof(int));
+        sd->vf = xmalloc((size_t)(4 * nf1 + 1) * sizeof(int));
         sd_cache_init(sd);
         for (int c = 0; c < 4 * nf1; c++) sd->vf_off[sd->m.fv[c] + 1]++;
         for (int i = 0; i < nv1; i++) sd->vf_off[i + 1] += sd->vf_off[i];
-        int *fill = calloc((size_t)nv1 + 1, sizeof(int));
-        if (!fill) abort();
+        int *fill = xcalloc((size_t)nv1 + 1, sizeof(int));
         for (int c = 0; c < 4 * nf1; c++) {
             int v = sd->m.fv[c];
             sd->vf[sd->vf_off[v] + fill[v]++] = c;
@@ -180,8 +175,7 @@ geom_subdiv *geom_subdiv_new(const geom_subdiv_desc *d, char *why, int why_size)
         free(fill);
         int nnets = 0;
         sd->nets = NULL;
-        sd_local *L = malloc(sizeof *L);
-        if (!L) abort();
+        sd_local *L = xmalloc(sizeof *L);
         for (int f = 0; f < nf1; f++) {
             sd->origin[f] = face_of[f];
             sd->drawn[f] = !hole0[face_of[f]] && (d->interpolateboundary || !open0[face_of[f]]);
@@ -191,8 +185,7 @@ geom_subdiv *geom_subdiv_new(const geom_subdiv_desc *d, char *why, int why_size)
             sd_local_from_shared(sd, f, L);
             if (sd_regular_net(&L->m, net)) {
                 if ((nnets & (nnets - 1)) == 0) {
-                    sd->nets = realloc(sd->nets, (size_t)(nnets ? 2 * nnets : 1) * 16 * sizeof(vec3));
-                    if (!sd->nets) abort();
+                    sd->nets = xrealloc(sd->nets, (size_t)(nnets ? 2 * nnets : 1) * 16 * sizeof(vec3));
                 }
                 memcpy(sd->nets + 16 * nnets, net, sizeof net);
                 sd->net_of[f] = nnets++;
@@ -209,13 +202,13 @@ geom_subdiv *geom_subdiv_new(const geom_subdiv_desc *d, char *why, int why_size)
     free(hole0);
     free(open0);
     if (!ok) {
-        geom_subdiv_free(&sd);
+        geom_subdiv_destroy(&sd);
         return NULL;
     }
     return sd;
 }
 
-void geom_subdiv_free(geom_subdiv **self_p)
+void geom_subdiv_destroy(geom_subdiv **self_p)
 {
     geom_subdiv *sd = *self_p;
     if (!sd) return;
@@ -230,7 +223,7 @@ void geom_subdiv_free(geom_subdiv **self_p)
     free(sd->origin);
     free(sd->net_of);
     free(sd->nets);
-    sd_cache_free(sd);
+    sd_cache_clear(sd);
     free(sd);
     *self_p = NULL;
 }

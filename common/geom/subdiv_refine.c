@@ -19,6 +19,7 @@
  * its (u,v) directions (subdiv_internal.h).
  */
 #include "geom/subdiv_internal.h"
+#include "util/xalloc.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -44,8 +45,7 @@ static int next_corner(const sd_mesh *m, int f, int c)
 static int build_edges(const sd_mesh *m, const int *face_of, int *cedge, int (*ec)[2])
 {
     int nc = m->fo[m->nf];
-    sd_ekey *k = malloc((size_t)(nc > 0 ? nc : 1) * sizeof *k);
-    if (!k) abort();
+    sd_ekey *k = xmalloc((size_t)(nc > 0 ? nc : 1) * sizeof *k);
     for (int c = 0; c < nc; c++) {
         int a = m->fv[c], b = m->fv[next_corner(m, face_of[c], c)];
         k[c] = (sd_ekey){ a < b ? a : b, a < b ? b : a, c };
@@ -69,10 +69,9 @@ static int build_edges(const sd_mesh *m, const int *face_of, int *cedge, int (*e
 int sd_edge_count(const sd_mesh *m)
 {
     int nc = m->fo[m->nf];
-    int *face_of = calloc((size_t)nc + 1, sizeof *face_of);
-    int *cedge = malloc((size_t)(nc + 1) * sizeof *cedge);
-    int (*ec)[2] = malloc((size_t)(nc + 1) * sizeof *ec);
-    if (!face_of || !cedge || !ec) abort();
+    int *face_of = xcalloc((size_t)nc + 1, sizeof *face_of);
+    int *cedge = xmalloc((size_t)(nc + 1) * sizeof *cedge);
+    int (*ec)[2] = xmalloc((size_t)(nc + 1) * sizeof *ec);
     for (int f = 0; f < m->nf; f++)
         for (int c = m->fo[f]; c < m->fo[f + 1]; c++) face_of[c] = f;
     int ne = build_edges(m, face_of, cedge, ec);
@@ -96,20 +95,18 @@ static vec3 lerp3(vec3 a, vec3 b, double t)
 void sd_refine(const sd_mesh *m, sd_mesh *out)
 {
     int nv = m->nv, nf = m->nf, nc = m->fo[nf];
-    int *face_of = calloc((size_t)nc + 1, sizeof *face_of);
-    int *cedge = malloc((size_t)(nc + 1) * sizeof *cedge);
-    int (*ec)[2] = malloc((size_t)(nc + 1) * sizeof *ec);
+    int *face_of = xcalloc((size_t)nc + 1, sizeof *face_of);
+    int *cedge = xmalloc((size_t)(nc + 1) * sizeof *cedge);
+    int (*ec)[2] = xmalloc((size_t)(nc + 1) * sizeof *ec);
     /* per point: face point sum, faces, midpoint sum, edges, sharp edges,
      * their sharpness sum, their far ends' sum */
-    vec3 *fsum = calloc((size_t)nv + 1, sizeof *fsum);
-    vec3 *rsum = calloc((size_t)nv + 1, sizeof *rsum);
-    vec3 *esum = calloc((size_t)nv + 1, sizeof *esum);
-    int *nfc = calloc((size_t)nv + 1, sizeof *nfc);
-    int *nec = calloc((size_t)nv + 1, sizeof *nec);
-    int *nsh = calloc((size_t)nv + 1, sizeof *nsh);
-    double *ssum = calloc((size_t)nv + 1, sizeof *ssum);
-    if (!face_of || !cedge || !ec || !fsum || !rsum || !esum || !nfc || !nec || !nsh || !ssum)
-        abort();
+    vec3 *fsum = xcalloc((size_t)nv + 1, sizeof *fsum);
+    vec3 *rsum = xcalloc((size_t)nv + 1, sizeof *rsum);
+    vec3 *esum = xcalloc((size_t)nv + 1, sizeof *esum);
+    int *nfc = xcalloc((size_t)nv + 1, sizeof *nfc);
+    int *nec = xcalloc((size_t)nv + 1, sizeof *nec);
+    int *nsh = xcalloc((size_t)nv + 1, sizeof *nsh);
+    double *ssum = xcalloc((size_t)nv + 1, sizeof *ssum);
     for (int f = 0; f < nf; f++)
         for (int c = m->fo[f]; c < m->fo[f + 1]; c++) face_of[c] = f;
     int ne = build_edges(m, face_of, cedge, ec);

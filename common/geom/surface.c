@@ -15,6 +15,7 @@
 #include "geom/surface.h"
 #include "geom/surface_internal.h"
 #include "geom/subdiv.h"
+#include "util/err.h"
 
 #include <math.h>
 #include <stdarg.h>
@@ -33,73 +34,62 @@ const char *geom_kind_name(geom_kind kind)
     return kind_names[kind];
 }
 
-bool geom_fail(char *why, int why_size, const char *fmt, ...)
-{
-    if (why && why_size > 0) {
-        va_list ap;
-        va_start(ap, fmt);
-        vsnprintf(why, (size_t)why_size, fmt, ap);
-        va_end(ap);
-    }
-    return false;
-}
-
 /* ---------------------------------------------------------------------- */
 /* parameter checks shared by the kinds                                    */
 /* ---------------------------------------------------------------------- */
 
 static bool need_finite(const geom_surface *s, const char *name, double x,
-                        char *why, int n)
+                        char *err, size_t errsz)
 {
     if (isfinite(x))
         return true;
-    return geom_fail(why, n, "%s %s must be a finite number, got %g",
+    return err_set(err, errsz, "%s %s must be a finite number, got %g",
                      geom_kind_name(s->kind), name, x);
 }
 
 static bool need_positive(const geom_surface *s, const char *name, double x,
-                          char *why, int n)
+                          char *err, size_t errsz)
 {
-    if (!need_finite(s, name, x, why, n))
+    if (!need_finite(s, name, x, err, errsz))
         return false;
     if (x > 0)
         return true;
-    return geom_fail(why, n, "%s %s must be > 0, got %g",
+    return err_set(err, errsz, "%s %s must be > 0, got %g",
                      geom_kind_name(s->kind), name, x);
 }
 
 static bool need_below(const geom_surface *s, const char *lo_name, double lo,
-                       const char *hi_name, double hi, char *why, int n)
+                       const char *hi_name, double hi, char *err, size_t errsz)
 {
-    if (!need_finite(s, lo_name, lo, why, n) || !need_finite(s, hi_name, hi, why, n))
+    if (!need_finite(s, lo_name, lo, err, errsz) || !need_finite(s, hi_name, hi, err, errsz))
         return false;
     if (lo < hi)
         return true;
-    return geom_fail(why, n, "%s %s must be < %s, got %s %g and %s %g",
+    return err_set(err, errsz, "%s %s must be < %s, got %s %g and %s %g",
                      geom_kind_name(s->kind), lo_name, hi_name, lo_name, lo,
                      hi_name, hi);
 }
 
 /* |thetamax| in (0, 2 pi]: RI spec §5.2 sweeps at most one revolution. */
-static bool need_sweep(const geom_surface *s, char *why, int n)
+static bool need_sweep(const geom_surface *s, char *err, size_t errsz)
 {
     double t = s->thetamax;
-    if (!need_finite(s, "thetamax", t, why, n))
+    if (!need_finite(s, "thetamax", t, err, errsz))
         return false;
     if (t == 0)
-        return geom_fail(why, n, "%s thetamax must not be 0", geom_kind_name(s->kind));
+        return err_set(err, errsz, "%s thetamax must not be 0", geom_kind_name(s->kind));
     if (fabs(t) > GEOM_TWO_PI * (1 + GEOM_SWEEP_SLACK))
-        return geom_fail(why, n,
+        return err_set(err, errsz,
                          "%s thetamax must be at most 2*pi (360 degrees) in magnitude, got %g",
                          geom_kind_name(s->kind), t);
     return true;
 }
 
-static bool need_vec(const geom_surface *s, const char *name, vec3 p, char *why, int n)
+static bool need_vec(const geom_surface *s, const char *name, vec3 p, char *err, size_t errsz)
 {
     if (isfinite(p.x) && isfinite(p.y) && isfinite(p.z))
         return true;
-    return geom_fail(why, n, "%s %s must be finite numbers, got (%g %g %g)",
+    return err_set(err, errsz, "%s %s must be finite numbers, got (%g %g %g)",
                      geom_kind_name(s->kind), name, p.x, p.y, p.z);
 }
 
@@ -114,60 +104,60 @@ static ia_interval diff(double hi, double lo)
 
 /* RI spec §5.2: phimin = asin(zmin/radius) (-90 degrees when zmin <=
  * -radius), phimax likewise. These two doubles then define the sphere. */
-static bool prepare_sphere(geom_surface *s, char *why, int n)
+static bool prepare_sphere(geom_surface *s, char *err, size_t errsz)
 {
     double r = s->radius;
-    if (!need_positive(s, "radius", r, why, n) ||
-        !need_below(s, "zmin", s->zmin, "zmax", s->zmax, why, n) || !need_sweep(s, why, n))
+    if (!need_positive(s, "radius", r, err, errsz) ||
+        !need_below(s, "zmin", s->zmin, "zmax", s->zmax, err, errsz) || !need_sweep(s, err, errsz))
         return false;
     if (s->zmin >= r)
-        return geom_fail(why, n, "sphere zmin must be < radius %g, got %g (nothing left)",
+        return err_set(err, errsz, "sphere zmin must be < radius %g, got %g (nothing left)",
                          r, s->zmin);
     if (s->zmax <= -r)
-        return geom_fail(why, n, "sphere zmax must be > -radius %g, got %g (nothing left)",
+        return err_set(err, errsz, "sphere zmax must be > -radius %g, got %g (nothing left)",
                          -r, s->zmax);
     s->phi0 = s->zmin <= -r ? -M_PI_2 : asin(s->zmin / r);
     s->phi1 = s->zmax >= r ? M_PI_2 : asin(s->zmax / r);
     if (!(s->phi0 < s->phi1))
-        return geom_fail(why, n, "sphere zmin %g and zmax %g are too close", s->zmin, s->zmax);
+        return err_set(err, errsz, "sphere zmin %g and zmax %g are too close", s->zmin, s->zmax);
     s->consts[K_DPHI] = diff(s->phi1, s->phi0);
     return true;
 }
 
-static bool prepare_disk(geom_surface *s, char *why, int n)
+static bool prepare_disk(geom_surface *s, char *err, size_t errsz)
 {
-    return need_positive(s, "radius", s->radius, why, n) &&
-           need_finite(s, "height", s->height, why, n) && need_sweep(s, why, n);
+    return need_positive(s, "radius", s->radius, err, errsz) &&
+           need_finite(s, "height", s->height, err, errsz) && need_sweep(s, err, errsz);
 }
 
-static bool prepare_cylinder(geom_surface *s, char *why, int n)
+static bool prepare_cylinder(geom_surface *s, char *err, size_t errsz)
 {
-    if (!need_positive(s, "radius", s->radius, why, n) ||
-        !need_below(s, "zmin", s->zmin, "zmax", s->zmax, why, n) || !need_sweep(s, why, n))
+    if (!need_positive(s, "radius", s->radius, err, errsz) ||
+        !need_below(s, "zmin", s->zmin, "zmax", s->zmax, err, errsz) || !need_sweep(s, err, errsz))
         return false;
     s->consts[K_DZ] = diff(s->zmax, s->zmin);
     return true;
 }
 
-static bool prepare_cone(geom_surface *s, char *why, int n)
+static bool prepare_cone(geom_surface *s, char *err, size_t errsz)
 {
-    if (!need_finite(s, "height", s->height, why, n))
+    if (!need_finite(s, "height", s->height, err, errsz))
         return false;
     if (s->height == 0)
-        return geom_fail(why, n, "cone height must not be 0");
-    return need_positive(s, "radius", s->radius, why, n) && need_sweep(s, why, n);
+        return err_set(err, errsz, "cone height must not be 0");
+    return need_positive(s, "radius", s->radius, err, errsz) && need_sweep(s, err, errsz);
 }
 
 /* RI spec §5.2: r = rmax*sqrt(z/zmax), z = zmin + v*(zmax - zmin). */
-static bool prepare_paraboloid(geom_surface *s, char *why, int n)
+static bool prepare_paraboloid(geom_surface *s, char *err, size_t errsz)
 {
-    if (!need_positive(s, "rmax", s->rmax, why, n) ||
-        !need_positive(s, "zmax", s->zmax, why, n) ||
-        !need_finite(s, "zmin", s->zmin, why, n))
+    if (!need_positive(s, "rmax", s->rmax, err, errsz) ||
+        !need_positive(s, "zmax", s->zmax, err, errsz) ||
+        !need_finite(s, "zmin", s->zmin, err, errsz))
         return false;
     if (s->zmin < 0)
-        return geom_fail(why, n, "paraboloid zmin must be >= 0, got %g", s->zmin);
-    if (!need_below(s, "zmin", s->zmin, "zmax", s->zmax, why, n) || !need_sweep(s, why, n))
+        return err_set(err, errsz, "paraboloid zmin must be >= 0, got %g", s->zmin);
+    if (!need_below(s, "zmin", s->zmin, "zmax", s->zmax, err, errsz) || !need_sweep(s, err, errsz))
         return false;
     s->consts[K_DZ] = diff(s->zmax, s->zmin);
     s->consts[K_PK] = ia_div(ia_sqr(ia_point(s->rmax)), ia_point(s->zmax));
@@ -175,17 +165,17 @@ static bool prepare_paraboloid(geom_surface *s, char *why, int n)
     return true;
 }
 
-static bool prepare_hyperboloid(geom_surface *s, char *why, int n)
+static bool prepare_hyperboloid(geom_surface *s, char *err, size_t errsz)
 {
     vec3 a = s->point1, b = s->point2;
-    if (!need_vec(s, "point1", a, why, n) || !need_vec(s, "point2", b, why, n) ||
-        !need_sweep(s, why, n))
+    if (!need_vec(s, "point1", a, err, errsz) || !need_vec(s, "point2", b, err, errsz) ||
+        !need_sweep(s, err, errsz))
         return false;
     if (a.x == b.x && a.y == b.y && a.z == b.z)
-        return geom_fail(why, n, "hyperboloid point1 and point2 must differ, both are (%g %g %g)",
+        return err_set(err, errsz, "hyperboloid point1 and point2 must differ, both are (%g %g %g)",
                          a.x, a.y, a.z);
     if (a.x == 0 && a.y == 0 && b.x == 0 && b.y == 0)
-        return geom_fail(why, n, "hyperboloid point1 and point2 both lie on the z axis: "
+        return err_set(err, errsz, "hyperboloid point1 and point2 both lie on the z axis: "
                          "the surface is a line");
     s->consts[K_D + 0] = diff(b.x, a.x);
     s->consts[K_D + 1] = diff(b.y, a.y);
@@ -193,15 +183,15 @@ static bool prepare_hyperboloid(geom_surface *s, char *why, int n)
     return true;
 }
 
-static bool prepare_torus(geom_surface *s, char *why, int n)
+static bool prepare_torus(geom_surface *s, char *err, size_t errsz)
 {
-    if (!need_positive(s, "majorradius", s->majorrad, why, n) ||
-        !need_positive(s, "minorradius", s->minorrad, why, n) ||
-        !need_below(s, "phimin", s->phimin, "phimax", s->phimax, why, n) ||
-        !need_sweep(s, why, n))
+    if (!need_positive(s, "majorradius", s->majorrad, err, errsz) ||
+        !need_positive(s, "minorradius", s->minorrad, err, errsz) ||
+        !need_below(s, "phimin", s->phimin, "phimax", s->phimax, err, errsz) ||
+        !need_sweep(s, err, errsz))
         return false;
     if (s->phimax - s->phimin > GEOM_TWO_PI * (1 + GEOM_SWEEP_SLACK))
-        return geom_fail(why, n, "torus phimax - phimin must be at most 2*pi (360 degrees), got %g",
+        return err_set(err, errsz, "torus phimax - phimin must be at most 2*pi (360 degrees), got %g",
                          s->phimax - s->phimin);
     s->consts[K_DPHI] = diff(s->phimax, s->phimin);
     return true;
@@ -224,14 +214,14 @@ static void ia_cross(const ia_interval *a, const ia_interval *b, ia_interval *c)
 /* Bilinear patch (RI spec §5.3 Patch "bilinear"): P = P00 + u b + v c +
  * uv a. Its Ng = (b + v a) x (c + u a) = b x c + u b x a + v a x c (a x a
  * = 0) is affine in (u,v): kept as three interval vectors. */
-static bool prepare_patch(geom_surface *s, char *why, int n)
+static bool prepare_patch(geom_surface *s, char *err, size_t errsz)
 {
     if (s->nverts != 4)
-        return geom_fail(why, n, "patch needs 4 corners (P00 P10 P01 P11), got %d", s->nverts);
+        return err_set(err, errsz, "patch needs 4 corners (P00 P10 P01 P11), got %d", s->nverts);
     for (int i = 0; i < 4; i++) {
         char name[16];
         snprintf(name, sizeof name, "corner %d", i);
-        if (!need_vec(s, name, s->verts[i], why, n))
+        if (!need_vec(s, name, s->verts[i], err, errsz))
             return false;
     }
     const vec3 *p = s->verts;
@@ -251,34 +241,34 @@ static bool prepare_patch(geom_surface *s, char *why, int n)
     for (int i = K_N0; i < K_N0 + 9; i++)
         area = fmax(area, fmax(fabs(s->consts[i].lo), fabs(s->consts[i].hi)));
     if (!isfinite(size) || !isfinite(area))
-        return geom_fail(why, n, "patch corners are too large");
+        return err_set(err, errsz, "patch corners are too large");
     if (!(area > 1e-12 * size * size))
-        return geom_fail(why, n, "patch is degenerate: its corners lie on one line");
+        return err_set(err, errsz, "patch is degenerate: its corners lie on one line");
     return true;
 }
 
-bool geom_surface_prepare(geom_surface *s, char *why, int why_size)
+bool geom_surface_prepare(geom_surface *s, char *err, size_t errsz)
 {
-    if (why && why_size > 0)
-        why[0] = '\0';
+    if (err && errsz > 0)
+        err[0] = '\0';
     switch (s->kind) {
-    case GEOM_SPHERE:      return prepare_sphere(s, why, why_size);
-    case GEOM_DISK:        return prepare_disk(s, why, why_size);
-    case GEOM_CYLINDER:    return prepare_cylinder(s, why, why_size);
-    case GEOM_CONE:        return prepare_cone(s, why, why_size);
-    case GEOM_PARABOLOID:  return prepare_paraboloid(s, why, why_size);
-    case GEOM_HYPERBOLOID: return prepare_hyperboloid(s, why, why_size);
-    case GEOM_TORUS:       return prepare_torus(s, why, why_size);
-    case GEOM_POLYGON:     return geom_polygon_prepare(s, why, why_size);
-    case GEOM_PATCH:       return prepare_patch(s, why, why_size);
-    case GEOM_BICUBIC:     return geom_bicubic_prepare(s, why, why_size);
+    case GEOM_SPHERE:      return prepare_sphere(s, err, errsz);
+    case GEOM_DISK:        return prepare_disk(s, err, errsz);
+    case GEOM_CYLINDER:    return prepare_cylinder(s, err, errsz);
+    case GEOM_CONE:        return prepare_cone(s, err, errsz);
+    case GEOM_PARABOLOID:  return prepare_paraboloid(s, err, errsz);
+    case GEOM_HYPERBOLOID: return prepare_hyperboloid(s, err, errsz);
+    case GEOM_TORUS:       return prepare_torus(s, err, errsz);
+    case GEOM_POLYGON:     return geom_polygon_prepare(s, err, errsz);
+    case GEOM_PATCH:       return prepare_patch(s, err, errsz);
+    case GEOM_BICUBIC:     return geom_bicubic_prepare(s, err, errsz);
     case GEOM_SUBDIV:
         if (!s->subdiv || s->subdiv_face < 0 || s->subdiv_face >= geom_subdiv_nfaces(s->subdiv))
-            return geom_fail(why, why_size, "subdivision face without its mesh");
+            return err_set(err, errsz, "subdivision face without its mesh");
         return true;
-    case GEOM_NURBS:       return geom_nurbs_prepare(s, why, why_size);
+    case GEOM_NURBS:       return geom_nurbs_prepare(s, err, errsz);
     default:
-        return geom_fail(why, why_size, "unknown surface kind %d", (int)s->kind);
+        return err_set(err, errsz, "unknown surface kind %d", (int)s->kind);
     }
 }
 

@@ -29,6 +29,7 @@
 #define GEOM_SURFACE_H
 
 #include <stdbool.h>
+#include <stddef.h>
 #include <stdint.h>
 
 #include "aa/affine.h"
@@ -98,8 +99,8 @@ typedef struct geom_sample {
 /* Checks the parameters (finite numbers, radius > 0, zmin < zmax,
  * thetamax != 0, polygon convex and planar with >= 3 distinct vertices,
  * ...), fills the derived fields. On failure returns false and writes a
- * one-line reason ("sphere radius must be > 0, got -1") into why. */
-bool geom_surface_prepare(geom_surface *s, char *why, int why_size);
+ * one-line reason ("sphere radius must be > 0, got -1") into err. */
+bool geom_surface_prepare(geom_surface *s, char *err, size_t errsz);
 
 const char *geom_kind_name(geom_kind kind);    /* "sphere", "disk", ... */
 

@@ -39,6 +39,8 @@
  */
 #include "geom/surface.h"
 #include "geom/surface_internal.h"
+#include "util/err.h"
+#include "util/xalloc.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -337,20 +339,20 @@ bool geom_bicubic_net_aa(aa_context *ctx, const geom_surface *b, const aa_form *
 
 /* ---- prepare and bounds --------------------------------------------- */
 
-bool geom_bicubic_prepare(geom_surface *s, char *why, int why_size)
+bool geom_bicubic_prepare(geom_surface *s, char *err, size_t errsz)
 {
     if (s->nverts != 16)
-        return geom_fail(why, why_size, "bicubic patch needs 16 control points, got %d",
+        return err_set(err, errsz, "bicubic patch needs 16 control points, got %d",
                          s->nverts);
     double size = 0;
     for (int i = 0; i < 16; i++) {
         vec3 p = s->verts[i];
         if (!isfinite(p.x) || !isfinite(p.y) || !isfinite(p.z))
-            return geom_fail(why, why_size, "bicubic patch control point %d is not finite", i);
+            return err_set(err, errsz, "bicubic patch control point %d is not finite", i);
         size = fmax(size, v3_length(v3_sub(p, s->verts[0])));
     }
     if (!isfinite(size) || size > 1e150)
-        return geom_fail(why, why_size, "bicubic patch control points are too large");
+        return err_set(err, errsz, "bicubic patch control points are too large");
     /* degenerate: all control points on one line (no normal anywhere) */
     double area = 0;
     for (int i = 1; i < 16; i++)
@@ -358,7 +360,7 @@ bool geom_bicubic_prepare(geom_surface *s, char *why, int why_size)
             area = fmax(area, v3_length(v3_cross(v3_sub(s->verts[i], s->verts[0]),
                                                  v3_sub(s->verts[j], s->verts[0]))));
     if (!(area > 1e-12 * size * size))
-        return geom_fail(why, why_size, "bicubic patch is degenerate: its control points "
+        return err_set(err, errsz, "bicubic patch is degenerate: its control points "
                          "lie on one line");
     return true;
 }
@@ -401,8 +403,9 @@ static bool slab(vec3 o, vec3 d, vec3 lo, vec3 hi, double *t0, double *t1)
 }
 
 /* A sub-patch's Bezier net (de Casteljau subdivision, in float: used to
- * prune and start Newton, never to bound shading) and its (u,v) box. */
-typedef struct net { vec3 p[16]; double u0, v0; int depth; } net;
+ * prune and start Newton, never to bound shading); its (u,v) square is the
+ * walk's (geom_patch_intersect). */
+typedef struct net { vec3 p[16]; } net;
 
 /* Splits the 4 points p[0], p[k], p[2k], p[3k] at 1/2 into a and b. */
 static void split4(const vec3 *p, int k, vec3 *a, vec3 *b)
@@ -421,15 +424,9 @@ static void split_net(const net *n, net out[4])
     net half[2];
     for (int j = 0; j < 4; j++)
         split4(n->p + 4 * j, 1, half[0].p + 4 * j, half[1].p + 4 * j);
-    double h = ldexp(1, -(n->depth + 1));
     for (int a = 0; a < 2; a++)
         for (int i = 0; i < 4; i++)
             split4(half[a].p + i, 4, out[a].p + i, out[2 + a].p + i);
-    for (int k = 0; k < 4; k++) {
-        out[k].u0 = n->u0 + (k & 1) * h;
-        out[k].v0 = n->v0 + (k >> 1) * h;
-        out[k].depth = n->depth + 1;
-    }
 }
 
 static void net_box(const net *n, double pad, vec3 *lo, vec3 *hi)
@@ -467,61 +464,48 @@ static bool transversal(const net *n, vec3 d)
     return lo > tiny || hi < -tiny;
 }
 
+/* The walk's view of the nets (geom_patch_walk): a stack of them. */
+typedef struct bicubic_walk {
+    net *stack;
+    vec3 o, d;
+    double pad;
+} bicubic_walk;
+
+static bool bicubic_clip(void *user, int k, double tmin, double best, double *t0, double *t1)
+{
+    bicubic_walk *bw = user;
+    vec3 blo, bhi;
+    net_box(&bw->stack[k], bw->pad, &blo, &bhi);
+    *t0 = tmin, *t1 = best;
+    return slab(bw->o, bw->d, blo, bhi, t0, t1);
+}
+
+static bool bicubic_transversal(void *user, int k)
+{
+    bicubic_walk *bw = user;
+    return transversal(&bw->stack[k], bw->d);
+}
+
+static void bicubic_split(void *user, int k)
+{
+    bicubic_walk *bw = user;
+    net cur = bw->stack[k];
+    split_net(&cur, bw->stack + k);
+}
+
 bool geom_bicubic_intersect(const geom_surface *s, vec3 o, vec3 d, double tmin, double tmax,
                             geom_hit *hit)
 {
-    enum { MIN_DEPTH_TRANSVERSAL = 3, MIN_DEPTH = 5, MAX_DEPTH = 16,
-           STACK = 3 * MAX_DEPTH + 8 };
     vec3 lo, hi;
     geom_bicubic_bounds(s, &lo, &hi);
     double size = v3_length(v3_sub(hi, lo));
-    double scale = size + v3_length(o) + 1e-300, pad = 1e-12 * scale;
-    net *stack = malloc(STACK * sizeof *stack);
-    if (!stack)
-        abort();
-    int n = 0;
+    double scale = size + v3_length(o) + 1e-300;
+    bicubic_walk bw = { xmalloc(GEOM_PATCH_STACK * sizeof(net)), o, d, 1e-12 * scale };
     for (int i = 0; i < 16; i++)
-        stack[0].p[i] = s->verts[i];
-    stack[0].u0 = stack[0].v0 = 0;
-    stack[0].depth = 0;
-    n = 1;
-    double best = tmax;
-    bool found = false;
-    while (n > 0) {
-        net cur = stack[--n];
-        double side = ldexp(1, -cur.depth), u0 = cur.u0, v0 = cur.v0;
-        vec3 blo, bhi;
-        net_box(&cur, pad, &blo, &bhi);
-        double t0 = tmin, t1 = best;
-        if (!slab(o, d, blo, bhi, &t0, &t1))
-            continue;
-        /* where Ng.d keeps one sign the ray crosses the piece at most
-         * once: a hit found there is the box's only one */
-        bool across = transversal(&cur, d);
-        if (cur.depth >= (across ? MIN_DEPTH_TRANSVERSAL : MIN_DEPTH)) {
-            double u = u0 + side / 2, v = v0 + side / 2;
-            geom_sample c;
-            geom_bicubic_eval_dual(s, u, v, &c);
-            double t = v3_dot(v3_sub(c.P, o), d) / v3_dot(d, d);
-            double slack = 1e-9;
-            bool inside = geom_patch_newton(s, geom_bicubic_eval_dual, o, d, &t, &u, &v, scale) &&
-                          u >= u0 - slack && u <= u0 + side + slack && v >= v0 - slack &&
-                          v <= v0 + side + slack && t >= t0 && t <= t1;
-            if (inside && t > tmin + 1e-9 * fabs(tmin) && t < best) {
-                best = t;
-                hit->t = t;
-                hit->u = fmin(fmax(u, 0), 1);
-                hit->v = fmin(fmax(v, 0), 1);
-                found = true;
-            }
-            if ((inside && across) || cur.depth >= MAX_DEPTH)
-                continue;      /* else the box may hold a nearer hit: split on */
-        }
-        if (n + 4 > STACK)
-            continue;
-        split_net(&cur, stack + n);
-        n += 4;
-    }
-    free(stack);
+        bw.stack[0].p[i] = s->verts[i];
+    geom_patch_walk w = { s, geom_bicubic_eval_dual, scale, bicubic_clip, bicubic_transversal,
+                          bicubic_split, false, &bw };
+    bool found = geom_patch_intersect(&w, o, d, tmin, tmax, hit);
+    free(bw.stack);
     return found;
 }

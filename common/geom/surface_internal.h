@@ -57,13 +57,13 @@ static inline void geom_phi_range(const geom_surface *s, double *a, double *b)
 bool geom_sweep_param(double angle, double sweep, double tol, double *t);
 
 /* The polygon part of geom_surface_prepare (surface_polygon.c). */
-bool geom_polygon_prepare(geom_surface *s, char *why, int why_size);
+bool geom_polygon_prepare(geom_surface *s, char *err, size_t errsz);
 
 /* The vertex-normal part of polygon prepare (surface_vertex_normal.c). */
-bool geom_vertex_normal_prepare(geom_surface *s, char *why, int why_size);
+bool geom_vertex_normal_prepare(geom_surface *s, char *err, size_t errsz);
 
 /* The bicubic Bezier patch (surface_bicubic.c). */
-bool geom_bicubic_prepare(geom_surface *s, char *why, int why_size);
+bool geom_bicubic_prepare(geom_surface *s, char *err, size_t errsz);
 void geom_bicubic_eval_dual(const geom_surface *s, double u, double v, geom_sample *out);
 void geom_bicubic_eval_ia(const geom_surface *s, ia_interval u, ia_interval v, geom_ia *out);
 /* o->Ng = o->dPdu x o->dPdv in affine arithmetic (surface_affine.c) */
@@ -126,7 +126,7 @@ bool geom_subdiv_intersect(const geom_surface *s, vec3 o, vec3 d, double tmin, d
                            geom_hit *hit);
 
 /* NuPatch pieces (nurbs_eval.c). */
-bool geom_nurbs_prepare(geom_surface *s, char *why, int why_size);
+bool geom_nurbs_prepare(geom_surface *s, char *err, size_t errsz);
 void geom_nurbs_eval_dual(const geom_surface *s, double u, double v, geom_sample *out);
 
 /* A surface's point with its first derivatives at (u, v) (the dual
@@ -136,15 +136,32 @@ void geom_nurbs_eval_dual(const geom_surface *s, double u, double v, geom_sample
 typedef void (*geom_dual_eval_fn)(const geom_surface *s, double u, double v, geom_sample *out);
 bool geom_patch_newton(const geom_surface *s, geom_dual_eval_fn eval, vec3 o, vec3 d,
                        double *t, double *u, double *v, double scale);
+/* A patch's ray intersection by subdivision (surface_intersect.c), shared
+ * by bicubic patches and NuPatch pieces, which differ in their nets only:
+ * the walk keeps each sub-patch's (u,v) square on a stack of
+ * GEOM_PATCH_STACK slots, the patch keeps the net of slot k. clip gives
+ * the ray's t range [*t0, *t1] within [tmin, best] over slot k's net
+ * (false: the ray misses it); transversal says whether Ng.d keeps one sign
+ * over it; split writes its four quarters into slots k..k+3 (quarter i at
+ * slot k+i, or at k+3-i with quarter0_on_top). */
+enum { GEOM_PATCH_STACK = 3 * 16 + 8 };
+typedef struct geom_patch_walk {
+    const geom_surface *s;
+    geom_dual_eval_fn eval;
+    double scale;                 /* geom_patch_newton's */
+    bool (*clip)(void *user, int k, double tmin, double best, double *t0, double *t1);
+    bool (*transversal)(void *user, int k);
+    void (*split)(void *user, int k);
+    bool quarter0_on_top;
+    void *user;
+} geom_patch_walk;
+bool geom_patch_intersect(const geom_patch_walk *w, vec3 o, vec3 d, double tmin, double tmax,
+                          geom_hit *hit);
 void geom_nurbs_eval_ia(const geom_surface *s, ia_interval u, ia_interval v, geom_ia *out);
 void geom_nurbs_eval_aa(aa_context *ctx, const geom_surface *s, const aa_form *u,
                         const aa_form *v, geom_aa *out);
 void geom_nurbs_bounds(const geom_surface *s, vec3 *lo, vec3 *hi);
 bool geom_nurbs_intersect(const geom_surface *s, vec3 o, vec3 d, double tmin, double tmax,
                           geom_hit *hit);
-
-/* Formats a one-line reason into why (may be NULL) and returns false. */
-bool geom_fail(char *why, int why_size, const char *fmt, ...)
-    __attribute__((format(printf, 3, 4)));
 
 #endif

@@ -522,3 +522,63 @@ bool geom_patch_newton(const geom_surface *s, geom_dual_eval_fn eval, vec3 o, ve
     eval(s, *u, *v, &g);
     return v3_length(v3_sub(v3_add(o, v3_scale(d, *t)), g.P)) <= 1e-9 * scale;
 }
+
+/* The subdivision walk shared by bicubic patches and NuPatch pieces (see
+ * geom_patch_walk in surface_internal.h): pop a sub-patch, clip the ray's t
+ * range against it, from side 1/8 (1/32 where it may hold two hits) run
+ * Newton from its centre, and split into quarters until a transversal
+ * sub-patch has given its hit or side 2^-16. */
+bool geom_patch_intersect(const geom_patch_walk *w, vec3 o, vec3 d, double tmin, double tmax,
+                          geom_hit *hit)
+{
+    enum { MIN_DEPTH_TRANSVERSAL = 3, MIN_DEPTH = 5, MAX_DEPTH = 16 };
+    struct { double u0, v0; int depth; } stack[GEOM_PATCH_STACK];
+    stack[0].u0 = stack[0].v0 = 0;
+    stack[0].depth = 0;
+    int n = 1;
+    double best = tmax;
+    bool found = false;
+    while (n > 0) {
+        n--;
+        double u0 = stack[n].u0, v0 = stack[n].v0;
+        int depth = stack[n].depth;
+        double side = ldexp(1, -depth);
+        double t0, t1;
+        if (!w->clip(w->user, n, tmin, best, &t0, &t1))
+            continue;
+        /* where the ray crosses the sub-patch transversally (Ng.d keeps one
+         * sign) it crosses at most once: a hit found there is its only one */
+        bool across = w->transversal(w->user, n);
+        if (depth >= (across ? MIN_DEPTH_TRANSVERSAL : MIN_DEPTH)) {
+            double u = u0 + side / 2, v = v0 + side / 2;
+            geom_sample c;
+            w->eval(w->s, u, v, &c);
+            double t = v3_dot(v3_sub(c.P, o), d) / v3_dot(d, d);
+            double slack = 1e-9;
+            bool inside = geom_patch_newton(w->s, w->eval, o, d, &t, &u, &v, w->scale) &&
+                          u >= u0 - slack && u <= u0 + side + slack && v >= v0 - slack &&
+                          v <= v0 + side + slack && t >= t0 && t <= t1;
+            if (inside && t > tmin + 1e-9 * fabs(tmin) && t < best) {
+                best = t;
+                hit->t = t;
+                hit->u = fmin(fmax(u, 0), 1);
+                hit->v = fmin(fmax(v, 0), 1);
+                found = true;
+            }
+            if ((inside && across) || depth >= MAX_DEPTH)
+                continue;      /* else the sub-patch may hold a nearer hit: split on */
+        }
+        if (n + 4 > GEOM_PATCH_STACK)
+            continue;
+        w->split(w->user, n);
+        double h = side / 2;
+        for (int j = 0; j < 4; j++) {
+            int k = w->quarter0_on_top ? 3 - j : j;
+            stack[n + j].u0 = u0 + (k & 1) * h;
+            stack[n + j].v0 = v0 + (k >> 1) * h;
+            stack[n + j].depth = depth + 1;
+        }
+        n += 4;
+    }
+    return found;
+}

@@ -16,6 +16,7 @@
  */
 #include "geom/surface.h"
 #include "geom/surface_internal.h"
+#include "util/err.h"
 
 #include <math.h>
 
@@ -34,22 +35,22 @@ typedef struct poly_work {
     double size;                            /* largest extent of the vertices */
 } poly_work;
 
-static bool check_vertices(const geom_surface *s, char *why, int n)
+static bool check_vertices(const geom_surface *s, char *err, size_t errsz)
 {
     if (s->nverts < 3 || s->nverts > GEOM_MAX_POLY_VERTS)
-        return geom_fail(why, n, "polygon needs 3 to %d vertices, got %d",
+        return err_set(err, errsz, "polygon needs 3 to %d vertices, got %d",
                          GEOM_MAX_POLY_VERTS, s->nverts);
     for (int i = 0; i < s->nverts; i++) {
         vec3 p = s->verts[i];
         if (!isfinite(p.x) || !isfinite(p.y) || !isfinite(p.z))
-            return geom_fail(why, n, "polygon vertex %d must be finite numbers, got (%g %g %g)",
+            return err_set(err, errsz, "polygon vertex %d must be finite numbers, got (%g %g %g)",
                              i, p.x, p.y, p.z);
     }
     return true;
 }
 
 /* Drops repeated consecutive vertices (and a last one equal to the first). */
-static bool distinct_vertices(const geom_surface *s, poly_work *w, char *why, int n)
+static bool distinct_vertices(const geom_surface *s, poly_work *w, char *err, size_t errsz)
 {
     vec3 lo = s->verts[0], hi = s->verts[0];
     for (int i = 1; i < s->nverts; i++) {
@@ -60,7 +61,7 @@ static bool distinct_vertices(const geom_surface *s, poly_work *w, char *why, in
     vec3 ext = v3_sub(hi, lo);
     w->size = fmax(ext.x, fmax(ext.y, ext.z));
     if (!isfinite(w->size))
-        return geom_fail(why, n, "polygon vertices are too large");
+        return err_set(err, errsz, "polygon vertices are too large");
     double same = 1e-12 * w->size;
     w->n = 0;
     for (int i = 0; i < s->nverts; i++) {
@@ -73,7 +74,7 @@ static bool distinct_vertices(const geom_surface *s, poly_work *w, char *why, in
         w->p[w->n++] = p;
     }
     if (w->n < 3)
-        return geom_fail(why, n, "polygon needs at least 3 distinct vertices, got %d", w->n);
+        return err_set(err, errsz, "polygon needs at least 3 distinct vertices, got %d", w->n);
     return true;
 }
 
@@ -155,30 +156,30 @@ static double edge_eval(const geom_surface *s, int i, double u, double v)
 /* Convex: every vertex turns left (counter-clockwise in (u,v)), and, so
  * that stars whose every turn is a left one are caught too, every vertex
  * lies inside every edge. */
-static bool check_convex(const geom_surface *s, const poly_work *w, char *why, int n)
+static bool check_convex(const geom_surface *s, const poly_work *w, char *err, size_t errsz)
 {
     for (int i = 0; i < s->nuv; i++) {
         int prev = (i + s->nuv - 1) % s->nuv, next = (i + 1) % s->nuv;
         if (edge_eval(s, prev, s->uv[next][0], s->uv[next][1]) < -CONVEX_TOL)
-            return geom_fail(why, n, "polygon is not convex: it turns the other way at vertex %d",
+            return err_set(err, errsz, "polygon is not convex: it turns the other way at vertex %d",
                              w->index[i]);
     }
     for (int i = 0; i < s->nuv; i++)
         for (int j = 0; j < s->nuv; j++)
             if (edge_eval(s, i, s->uv[j][0], s->uv[j][1]) < -CONVEX_TOL)
-                return geom_fail(why, n,
+                return err_set(err, errsz,
                                  "polygon is not convex: its edges cross (vertex %d lies "
                                  "outside the edge from vertex %d to vertex %d)",
                                  w->index[j], w->index[i], w->index[(i + 1) % w->n]);
     return true;
 }
 
-static bool check_planar(const poly_work *w, vec3 nrm, vec3 c, char *why, int n)
+static bool check_planar(const poly_work *w, vec3 nrm, vec3 c, char *err, size_t errsz)
 {
     for (int i = 0; i < w->n; i++) {
         double off = fabs(v3_dot(nrm, v3_sub(w->p[i], c)));
         if (off > PLANAR_TOL * w->size)
-            return geom_fail(why, n, "polygon is not planar: vertex %d lies %g off its plane",
+            return err_set(err, errsz, "polygon is not planar: vertex %d lies %g off its plane",
                              w->index[i], off);
     }
     return true;
@@ -212,20 +213,20 @@ static void plane_basis(geom_surface *s, const poly_work *w, vec3 nrm, vec3 c)
     }
 }
 
-bool geom_polygon_prepare(geom_surface *s, char *why, int why_size)
+bool geom_polygon_prepare(geom_surface *s, char *err, size_t errsz)
 {
     poly_work w;
-    if (!check_vertices(s, why, why_size) || !distinct_vertices(s, &w, why, why_size))
+    if (!check_vertices(s, err, errsz) || !distinct_vertices(s, &w, err, errsz))
         return false;
     vec3 nn = newell_normal(&w);
     double len = v3_length(nn);
     if (!(len > 1e-12 * w.size * w.size))
-        return geom_fail(why, why_size, "polygon has no area: its vertices lie on one line");
+        return err_set(err, errsz, "polygon has no area: its vertices lie on one line");
     vec3 nrm = v3_scale(nn, 1.0 / len), c = centroid(&w);
-    if (!check_planar(&w, nrm, c, why, why_size))
+    if (!check_planar(&w, nrm, c, err, errsz))
         return false;
     plane_basis(s, &w, nrm, c);
-    return check_convex(s, &w, why, why_size) && geom_vertex_normal_prepare(s, why, why_size);
+    return check_convex(s, &w, err, errsz) && geom_vertex_normal_prepare(s, err, errsz);
 }
 
 /* ---------------------------------------------------------------------- */

@@ -25,20 +25,21 @@
  */
 #include "geom/surface.h"
 #include "geom/surface_internal.h"
+#include "util/err.h"
 
 #include <math.h>
 
-bool geom_vertex_normal_prepare(geom_surface *s, char *why, int why_size)
+bool geom_vertex_normal_prepare(geom_surface *s, char *err, size_t errsz)
 {
     if (s->nvn == 0)
         return true;
     if (s->nvn != 3 || s->nverts != 3 || s->nuv != 3)
-        return geom_fail(why, why_size, "vertex normals need a triangle with 3 distinct "
+        return err_set(err, errsz, "vertex normals need a triangle with 3 distinct "
                          "corners and 3 normals (got %d corners, %d normals)", s->nuv, s->nvn);
     for (int i = 0; i < 3; i++) {
         vec3 n = s->vn[i];
         if (!isfinite(n.x) || !isfinite(n.y) || !isfinite(n.z))
-            return geom_fail(why, why_size, "vertex normal %d must be finite numbers, got "
+            return err_set(err, errsz, "vertex normal %d must be finite numbers, got "
                              "(%g %g %g)", i, n.x, n.y, n.z);
     }
     const double (*uv)[2] = (const double (*)[2])s->uv;
@@ -46,7 +47,7 @@ bool geom_vertex_normal_prepare(geom_surface *s, char *why, int why_size)
     double d2u = uv[2][0] - uv[0][0], d2v = uv[2][1] - uv[0][1];
     double det = d1u * d2v - d1v * d2u;
     if (!(fabs(det) > 0))
-        return geom_fail(why, why_size, "vertex normals: the triangle has no area in (u,v)");
+        return err_set(err, errsz, "vertex normals: the triangle has no area in (u,v)");
     for (int i = 0; i < 3; i++) {
         double n0 = v3_comp(s->vn[0], i);
         double e1 = v3_comp(s->vn[1], i) - n0, e2 = v3_comp(s->vn[2], i) - n0;
@@ -54,7 +55,7 @@ bool geom_vertex_normal_prepare(geom_surface *s, char *why, int why_size)
         double b = (e2 * d1u - e1 * d2u) / det;
         double c = n0 - uv[0][0] * a - uv[0][1] * b;
         if (!isfinite(a) || !isfinite(b) || !isfinite(c))
-            return geom_fail(why, why_size, "vertex normals: the triangle is too thin to "
+            return err_set(err, errsz, "vertex normals: the triangle is too thin to "
                              "interpolate them");
         s->consts[K_VNU + i] = ia_point(a);
         s->consts[K_VNV + i] = ia_point(b);

@@ -4,6 +4,8 @@
  * clipping. O(n^2) in the points of one face, which is small.
  */
 #include "geom/triangulate.h"
+#include "util/err.h"
+#include "util/xalloc.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -70,16 +72,16 @@ static bool in_wedge(const pt2 *p, const int *ring, int n, int r, pt2 q)
 }
 
 int geom_triangulate(const vec3 *pts, const int *loop_sizes, int nloops, int (*tris)[3],
-                     int max_tris, char *why, int why_size)
+                     int max_tris, char *err, size_t errsz)
 {
     if (nloops < 1) {
-        snprintf(why, (size_t)why_size, "no loops");
+        err_set(err, errsz, "no loops");
         return -1;
     }
     int total = 0;
     for (int l = 0; l < nloops; l++) {
         if (loop_sizes[l] < 3) {
-            snprintf(why, (size_t)why_size, "loop %d has %d points, at least 3 are needed",
+            err_set(err, errsz, "loop %d has %d points, at least 3 are needed",
                      l, loop_sizes[l]);
             return -1;
         }
@@ -95,18 +97,16 @@ int geom_triangulate(const vec3 *pts, const int *loop_sizes, int nloops, int (*t
     }
     double ax = fabs(nrm.x), ay = fabs(nrm.y), az = fabs(nrm.z);
     if (!(ax + ay + az > 0)) {
-        snprintf(why, (size_t)why_size, "the polygon has no area");
+        err_set(err, errsz, "the polygon has no area");
         return -1;
     }
-    pt2 *p = malloc((size_t)total * sizeof *p);
+    pt2 *p = xmalloc((size_t)total * sizeof *p);
     /* the combined loop: the outer loop plus, per hole, its points and two
      * bridge ends, repeated */
     int cap = total + 2 * nloops + 2;
-    int *ring = malloc((size_t)cap * sizeof *ring);
-    int *tmp = malloc((size_t)cap * sizeof *tmp);
-    int *hole = malloc((size_t)total * sizeof *hole);
-    if (!p || !ring || !tmp || !hole)
-        abort();
+    int *ring = xmalloc((size_t)cap * sizeof *ring);
+    int *tmp = xmalloc((size_t)cap * sizeof *tmp);
+    int *hole = xmalloc((size_t)total * sizeof *hole);
     for (int i = 0; i < total; i++) {
         vec3 q = pts[i];
         if (az >= ax && az >= ay) p[i] = (pt2){ q.x, q.y };
@@ -128,7 +128,7 @@ int geom_triangulate(const vec3 *pts, const int *loop_sizes, int nloops, int (*t
     bool flipped = outer < 0;       /* work counter-clockwise */
     int count = -1;
     if (!(fabs(outer) > eps)) {
-        snprintf(why, (size_t)why_size, "the polygon has no area");
+        err_set(err, errsz, "the polygon has no area");
         goto done;
     }
     if (flipped)
@@ -168,7 +168,7 @@ int geom_triangulate(const vec3 *pts, const int *loop_sizes, int nloops, int (*t
                     best_d = d, best_h = h, best_r = r;
             }
         if (best_h < 0) {
-            snprintf(why, (size_t)why_size, "hole %d cannot be joined to the boundary "
+            err_set(err, errsz, "hole %d cannot be joined to the boundary "
                      "(does it lie outside, or do loops cross?)", l);
             goto done;
         }
@@ -211,7 +211,7 @@ int geom_triangulate(const vec3 *pts, const int *loop_sizes, int nloops, int (*t
                                 p[ring[(i + 1) % n]])) <= eps)
                     ear = i;
             if (ear < 0) {
-                snprintf(why, (size_t)why_size, "the polygon cannot be cut into triangles "
+                err_set(err, errsz, "the polygon cannot be cut into triangles "
                          "(do its edges cross?)");
                 count = -1;
                 goto done;
@@ -221,7 +221,7 @@ int geom_triangulate(const vec3 *pts, const int *loop_sizes, int nloops, int (*t
             continue;
         }
         if (count >= max_tris) {
-            snprintf(why, (size_t)why_size, "more than %d triangles", max_tris);
+            err_set(err, errsz, "more than %d triangles", max_tris);
             count = -1;
             goto done;
         }
@@ -235,7 +235,7 @@ int geom_triangulate(const vec3 *pts, const int *loop_sizes, int nloops, int (*t
     }
     if (cross3(p[ring[0]], p[ring[1]], p[ring[2]]) > eps) {
         if (count >= max_tris) {
-            snprintf(why, (size_t)why_size, "more than %d triangles", max_tris);
+            err_set(err, errsz, "more than %d triangles", max_tris);
             count = -1;
             goto done;
         }

@@ -17,6 +17,7 @@
 #define GEOM_TRIANGULATE_H
 
 #include <stdbool.h>
+#include <stddef.h>
 
 #include "util/vecmath.h"
 
@@ -25,9 +26,9 @@
  * returns their count, n + 2h - 2 for n points and h holes (less where
  * corners are straight: slivers of relative area below 1e-12 are dropped,
  * never emitted); returns -1
- * (with a reason in why) when the polygon is degenerate (no area, fewer
+ * (with a reason in err) when the polygon is degenerate (no area, fewer
  * than 3 points in a loop) or cannot be cut (self-intersecting loops). */
 int geom_triangulate(const vec3 *pts, const int *loop_sizes, int nloops, int (*tris)[3],
-                     int max_tris, char *why, int why_size);
+                     int max_tris, char *err, size_t errsz);
 
 #endif

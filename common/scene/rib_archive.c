@@ -18,6 +18,7 @@
  */
 #include "scene/rib_parser.h"
 #include "sl/source.h"
+#include "sl/strbuf.h"
 #include "util/xalloc.h"
 
 #include <errno.h>
@@ -42,7 +43,7 @@ int scene_archive_load_from_disk(sl_source_set *set, const char *name, sl_diag *
         return -1;
     }
     size_t max = sl_source_set_max_size(set), cap = 1 << 16, n = 0;
-    char *buf = xmalloc(cap);
+    char *buf = xrealloc(NULL, cap);
     for (;;) {
         if (n == cap) {
             cap *= 2;
@@ -94,7 +95,7 @@ static char *join(const char *dir, const char *name)
     if (name[0] == '/' || !dir[0] || strcmp(dir, ".") == 0)
         return sl_source_normalize(name);
     size_t n = strlen(dir) + strlen(name) + 2;
-    char *joined = xmalloc(n);
+    char *joined = xrealloc(NULL, n);
     snprintf(joined, n, "%s/%s", dir, name);
     char *norm = sl_source_normalize(joined);
     free(joined);
@@ -163,7 +164,7 @@ void rib_read_archive(rib_parser *p, const rib_request *req)
     rib_params params;      /* RI Spec 3.2: a parameter list may follow */
     if (!rib_params_read(p, req, 1, RIB_PARAMS_LOOSE, &params))
         return;
-    rib_params_free(&params);
+    rib_params_clear(&params);
     if (!name[0]) {
         rib_error(p, req, req->args[0].pos, "the archive name is empty");
         return;

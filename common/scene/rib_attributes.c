@@ -15,6 +15,8 @@
  * the objects that follow. Each object records the lights on for it.
  */
 #include "scene/rib_parser.h"
+#include "sl/strbuf.h"
+#include "util/err.h"
 #include "util/xalloc.h"
 
 #include <math.h>
@@ -45,14 +47,14 @@ void rib_attributes_copy(rib_attributes *dst, const rib_attributes *src)
 {
     *dst = *src;
     if (src->nlight_on > 0) {
-        dst->light_on = xmalloc((size_t)src->nlight_on);
+        dst->light_on = xrealloc(NULL, (size_t)src->nlight_on);
         memcpy(dst->light_on, src->light_on, (size_t)src->nlight_on);
     } else {
         dst->light_on = NULL;
     }
 }
 
-void rib_attributes_free(rib_attributes *a)
+void rib_attributes_clear(rib_attributes *a)
 {
     free(a->light_on);
     a->light_on = NULL;
@@ -205,7 +207,7 @@ void rib_attribute(rib_parser *p, const rib_request *req)
     } else if (strcmp(name, "light") == 0 && (v = rib_params_find(&params, "shadows"))) {
         read_switch(p, req, v, &p->attr.shadows);
     }
-    rib_params_free(&params);
+    rib_params_clear(&params);
 }
 
 void rib_declare(rib_parser *p, const rib_request *req)
@@ -219,10 +221,10 @@ void rib_declare(rib_parser *p, const rib_request *req)
         return;
     }
     rib_decl decl;
-    char why[160];
-    if (!rib_decl_parse(text, false, &decl, NULL, NULL, why, sizeof why)) {
+    char err[ERR_LEN];
+    if (!rib_decl_parse(text, false, &decl, NULL, NULL, err, sizeof err)) {
         rib_error(p, req, req->args[1].pos, "cannot read the declaration \"%s\": %s "
-                  "(expected [class] type [n], e.g. \"uniform float\")", text, why);
+                  "(expected [class] type [n], e.g. \"uniform float\")", text, err);
         return;
     }
     rib_decls_add(p->decls, name, decl);
@@ -578,7 +580,7 @@ void rib_light_source(rib_parser *p, const rib_request *req)
     l.shadows = p->attr.shadows;
     light_defaults(&l);
     bool ok = light_params(p, req, light_kinds[k].params, &params, &l);
-    rib_params_free(&params);
+    rib_params_clear(&params);
     if (!ok)
         return;
     l.handle = has_handle ? handle_text(req, &req->args[1]) : NULL;

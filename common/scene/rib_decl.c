@@ -8,6 +8,8 @@
  * take.
  */
 #include "scene/rib_decl.h"
+#include "sl/strbuf.h"
+#include "util/err.h"
 #include "util/xalloc.h"
 
 #include <stdio.h>
@@ -96,12 +98,12 @@ static bool word_is(word w, const char *s)
     return (size_t)w.len == strlen(s) && memcmp(w.s, s, (size_t)w.len) == 0;
 }
 
-static bool parse_arraylen(word w, int *arraylen, char *why, int why_size)
+static bool parse_arraylen(word w, int *arraylen, char *err, size_t errsz)
 {
     char buf[32];
     int n = w.len - 2;
     if (w.len < 3 || w.s[w.len - 1] != ']' || n >= (int)sizeof buf) {
-        snprintf(why, (size_t)why_size, "bad array size '%.*s'", w.len > 40 ? 40 : w.len, w.s);
+        err_set(err, errsz, "bad array size '%.*s'", w.len > 40 ? 40 : w.len, w.s);
         return false;
     }
     memcpy(buf, w.s + 1, (size_t)n);
@@ -111,7 +113,7 @@ static bool parse_arraylen(word w, int *arraylen, char *why, int why_size)
     while (is_blank(*end))
         end++;
     if (*end || v < 1 || v > 4096) {
-        snprintf(why, (size_t)why_size, "bad array size '%.*s' (expected [1] to [4096])",
+        err_set(err, errsz, "bad array size '%.*s' (expected [1] to [4096])",
                  w.len > 40 ? 40 : w.len, w.s);
         return false;
     }
@@ -119,7 +121,7 @@ static bool parse_arraylen(word w, int *arraylen, char *why, int why_size)
     return true;
 }
 
-static bool parse_type_word(word w, sl_type *type, char *why, int why_size)
+static bool parse_type_word(word w, sl_type *type, char *err, size_t errsz)
 {
     for (size_t i = 0; i < sizeof type_words / sizeof type_words[0]; i++)
         if (word_is(w, type_words[i].name)) {
@@ -127,9 +129,9 @@ static bool parse_type_word(word w, sl_type *type, char *why, int why_size)
             return true;
         }
     if (word_is(w, "hpoint"))
-        snprintf(why, (size_t)why_size, "type 'hpoint' is not supported");
+        err_set(err, errsz, "type 'hpoint' is not supported");
     else
-        snprintf(why, (size_t)why_size, "unknown type '%.*s'", w.len > 40 ? 40 : w.len, w.s);
+        err_set(err, errsz, "unknown type '%.*s'", w.len > 40 ? 40 : w.len, w.s);
     return false;
 }
 
@@ -143,7 +145,7 @@ static scene_class class_word(word w)
 }
 
 bool rib_decl_parse(const char *text, bool with_name, rib_decl *out,
-                    const char **name, int *name_len, char *why, int why_size)
+                    const char **name, int *name_len, char *err, size_t errsz)
 {
     word w[5];
     int n = split_words(text, w, 4), i = 0;
@@ -151,27 +153,27 @@ bool rib_decl_parse(const char *text, bool with_name, rib_decl *out,
     out->arraylen = 1;
     out->cls = SCENE_CLASS_NONE;
     if (n == 0) {
-        snprintf(why, (size_t)why_size, "empty declaration");
+        err_set(err, errsz, "empty declaration");
         return false;
     }
     if (n > 4) {
-        snprintf(why, (size_t)why_size, "too many words (expected [class] type [n]%s)",
+        err_set(err, errsz, "too many words (expected [class] type [n]%s)",
                  with_name ? " name" : "");
         return false;
     }
     if ((out->cls = class_word(w[i])) != SCENE_CLASS_NONE)
         i++;
     if (i == n) {
-        snprintf(why, (size_t)why_size, "missing type after '%.*s'", w[0].len, w[0].s);
+        err_set(err, errsz, "missing type after '%.*s'", w[0].len, w[0].s);
         return false;
     }
-    if (!parse_type_word(w[i++], &out->type, why, why_size))
+    if (!parse_type_word(w[i++], &out->type, err, errsz))
         return false;
-    if (i < n && w[i].s[0] == '[' && !parse_arraylen(w[i++], &out->arraylen, why, why_size))
+    if (i < n && w[i].s[0] == '[' && !parse_arraylen(w[i++], &out->arraylen, err, errsz))
         return false;
     if (with_name) {
         if (i != n - 1) {
-            snprintf(why, (size_t)why_size, i == n ? "missing parameter name" :
+            err_set(err, errsz, i == n ? "missing parameter name" :
                      "too many words (expected [class] type [n] name)");
             return false;
         }
@@ -180,7 +182,7 @@ bool rib_decl_parse(const char *text, bool with_name, rib_decl *out,
         return true;
     }
     if (i != n) {
-        snprintf(why, (size_t)why_size, "unexpected '%.*s' after the type",
+        err_set(err, errsz, "unexpected '%.*s' after the type",
                  w[i].len > 40 ? 40 : w[i].len, w[i].s);
         return false;
     }
@@ -252,7 +254,7 @@ struct rib_decls {
 
 rib_decls *rib_decls_new(void)
 {
-    rib_decls *self = xmalloc(sizeof *self);
+    rib_decls *self = xrealloc(NULL, sizeof *self);
     memset(self, 0, sizeof *self);
     return self;
 }

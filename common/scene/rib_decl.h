@@ -18,6 +18,7 @@
 #define SCENE_RIB_DECL_H
 
 #include <stdbool.h>
+#include <stddef.h>
 
 #include "scene/scene.h"
 #include "sl/shader.h"
@@ -38,7 +39,7 @@ const char *rib_type_name(sl_type type);
  * receives a pointer into `text` and *name_len its length). On failure
  * returns false with a reason ("unknown type 'flaot'"). */
 bool rib_decl_parse(const char *text, bool with_name, rib_decl *out,
-                    const char **name, int *name_len, char *why, int why_size);
+                    const char **name, int *name_len, char *err, size_t errsz);
 
 /* True when the text has more than one word or a '[', i.e. it is an
  * inline declaration rather than a plain name. */

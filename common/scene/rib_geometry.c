@@ -12,9 +12,12 @@
  */
 #include "scene/rib_parser.h"
 #include "scene/rib_primvar.h"
+#include "sl/strbuf.h"
+#include "util/err.h"
 #include "util/xalloc.h"
 
 #include <math.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -27,7 +30,7 @@ static double radians(double degrees) { return degrees * (M_PI / 180.0); }
 
 #ifndef SCENE_HAVE_GEOM
 /* Stand-in checks for builds without common/geom. */
-static bool basic_check(const geom_surface *s, char *why, int n)
+static bool basic_check(const geom_surface *s, char *err, size_t errsz)
 {
     const char *what = NULL;
     switch (s->kind) {
@@ -58,17 +61,17 @@ static bool basic_check(const geom_surface *s, char *why, int n)
     if (!what && s->kind < GEOM_POLYGON && !theta_ok)
         what = "thetamax must be non-zero and at most 360 degrees";
     if (what)
-        snprintf(why, (size_t)n, "%s", what);
+        err_set(err, errsz, "%s", what);
     return what == NULL;
 }
 #endif
 
-static bool prepare_surface(geom_surface *s, char *why, int n)
+static bool prepare_surface(geom_surface *s, char *err, size_t errsz)
 {
 #ifdef SCENE_HAVE_GEOM
-    return geom_surface_prepare(s, why, n);
+    return geom_surface_prepare(s, err, errsz);
 #else
-    return basic_check(s, why, n);
+    return basic_check(s, err, errsz);
 #endif
 }
 
@@ -95,7 +98,7 @@ static bool reverse_normals(scene_orientation o, const mat4 *object_to_camera)
 static void object_lights(const rib_parser *p, scene_object *o)
 {
     const rib_attributes *a = &p->attr;
-    o->lights = xmalloc((size_t)(p->scene->nlights ? p->scene->nlights : 1) *
+    o->lights = xrealloc(NULL, (size_t)(p->scene->nlights ? p->scene->nlights : 1) *
                             sizeof *o->lights);
     for (int i = 0; i < p->scene->nlights && i < a->nlight_on; i++)
         if (a->light_on[i])
@@ -137,7 +140,7 @@ void rib_place_surface(rib_parser *p, const rib_request *req, const geom_surface
     o->name = a->name ? xstrndup(a->name, strlen(a->name)) : NULL;
     o->pos = pos;
     if (nvars > 0) {
-        o->primvars = xmalloc((size_t)nvars * sizeof *o->primvars);
+        o->primvars = xrealloc(NULL, (size_t)nvars * sizeof *o->primvars);
         memcpy(o->primvars, vars, (size_t)nvars * sizeof *o->primvars);
         o->nprimvars = nvars;
     }
@@ -157,9 +160,9 @@ void rib_add_surface(rib_parser *p, const rib_request *req, const geom_surface *
  * (or records it in the object being defined, rib_instance.c). */
 static void add_object(rib_parser *p, const rib_request *req, geom_surface *surf)
 {
-    char why[256] = "";
-    if (!prepare_surface(surf, why, sizeof why)) {
-        rib_error(p, req, req->pos, "%s", why[0] ? why : "invalid parameters");
+    char err[ERR_LEN] = "";
+    if (!prepare_surface(surf, err, sizeof err)) {
+        rib_error(p, req, req->pos, "%s", err[0] ? err : "invalid parameters");
         return;
     }
     rib_add_surface(p, req, surf);
@@ -174,7 +177,7 @@ static bool read_quadric(rib_parser *p, const rib_request *req, int n, double *v
     rib_params params;
     if (next < 0 || !rib_params_read(p, req, next, RIB_PARAMS_VARYING, &params))
         return false;
-    rib_params_free(&params);
+    rib_params_clear(&params);
     return true;
 }
 
@@ -190,78 +193,59 @@ static geom_surface new_surface(geom_kind kind)
 /* quadrics (§5.2)                                                         */
 /* ---------------------------------------------------------------------- */
 
-void rib_sphere(rib_parser *p, const rib_request *req)
-{
-    double v[4];
-    if (!read_quadric(p, req, 4, v, "radius zmin zmax thetamax"))
-        return;
-    geom_surface s = new_surface(GEOM_SPHERE);
-    s.radius = v[0], s.zmin = v[1], s.zmax = v[2], s.thetamax = radians(v[3]);
-    add_object(p, req, &s);
-}
+/* One quadric request: its kind, its positional numbers (named in `what`
+ * for errors) and the surface field each goes to, angles in degrees. */
+typedef struct quadric_arg {
+    size_t offset;                /* of a double in geom_surface */
+    bool angle;                   /* given in degrees, kept in radians */
+} quadric_arg;
 
-void rib_disk(rib_parser *p, const rib_request *req)
-{
-    double v[3];
-    if (!read_quadric(p, req, 3, v, "height radius thetamax"))
-        return;
-    geom_surface s = new_surface(GEOM_DISK);
-    s.height = v[0], s.radius = v[1], s.thetamax = radians(v[2]);
-    add_object(p, req, &s);
-}
+typedef struct quadric_form {
+    geom_kind kind;
+    const char *what;
+    int n;
+    quadric_arg arg[7];
+} quadric_form;
 
-void rib_cylinder(rib_parser *p, const rib_request *req)
-{
-    double v[4];
-    if (!read_quadric(p, req, 4, v, "radius zmin zmax thetamax"))
-        return;
-    geom_surface s = new_surface(GEOM_CYLINDER);
-    s.radius = v[0], s.zmin = v[1], s.zmax = v[2], s.thetamax = radians(v[3]);
-    add_object(p, req, &s);
-}
+#define FIELD(f) { offsetof(geom_surface, f), false }
+#define ANGLE(f) { offsetof(geom_surface, f), true }
+static const quadric_form sphere = { GEOM_SPHERE, "radius zmin zmax thetamax", 4,
+    { FIELD(radius), FIELD(zmin), FIELD(zmax), ANGLE(thetamax) } };
+static const quadric_form disk = { GEOM_DISK, "height radius thetamax", 3,
+    { FIELD(height), FIELD(radius), ANGLE(thetamax) } };
+static const quadric_form cylinder = { GEOM_CYLINDER, "radius zmin zmax thetamax", 4,
+    { FIELD(radius), FIELD(zmin), FIELD(zmax), ANGLE(thetamax) } };
+static const quadric_form cone = { GEOM_CONE, "height radius thetamax", 3,
+    { FIELD(height), FIELD(radius), ANGLE(thetamax) } };
+static const quadric_form torus = { GEOM_TORUS,
+    "majorradius minorradius phimin phimax thetamax", 5,
+    { FIELD(majorrad), FIELD(minorrad), ANGLE(phimin), ANGLE(phimax), ANGLE(thetamax) } };
+static const quadric_form hyperboloid = { GEOM_HYPERBOLOID, "point1 point2 thetamax", 7,
+    { FIELD(point1.x), FIELD(point1.y), FIELD(point1.z), FIELD(point2.x), FIELD(point2.y),
+      FIELD(point2.z), ANGLE(thetamax) } };
+static const quadric_form paraboloid = { GEOM_PARABOLOID, "rmax zmin zmax thetamax", 4,
+    { FIELD(rmax), FIELD(zmin), FIELD(zmax), ANGLE(thetamax) } };
+#undef FIELD
+#undef ANGLE
 
-void rib_cone(rib_parser *p, const rib_request *req)
-{
-    double v[3];
-    if (!read_quadric(p, req, 3, v, "height radius thetamax"))
-        return;
-    geom_surface s = new_surface(GEOM_CONE);
-    s.height = v[0], s.radius = v[1], s.thetamax = radians(v[2]);
-    add_object(p, req, &s);
-}
-
-void rib_torus(rib_parser *p, const rib_request *req)
-{
-    double v[5];
-    if (!read_quadric(p, req, 5, v, "majorradius minorradius phimin phimax thetamax"))
-        return;
-    geom_surface s = new_surface(GEOM_TORUS);
-    s.majorrad = v[0], s.minorrad = v[1];
-    s.phimin = radians(v[2]), s.phimax = radians(v[3]), s.thetamax = radians(v[4]);
-    add_object(p, req, &s);
-}
-
-void rib_hyperboloid(rib_parser *p, const rib_request *req)
+static void quadric(rib_parser *p, const rib_request *req, const quadric_form *f)
 {
     double v[7];
-    if (!read_quadric(p, req, 7, v, "point1 point2 thetamax"))
+    if (!read_quadric(p, req, f->n, v, f->what))
         return;
-    geom_surface s = new_surface(GEOM_HYPERBOLOID);
-    s.point1 = v3(v[0], v[1], v[2]);
-    s.point2 = v3(v[3], v[4], v[5]);
-    s.thetamax = radians(v[6]);
+    geom_surface s = new_surface(f->kind);
+    for (int i = 0; i < f->n; i++)
+        *(double *)((char *)&s + f->arg[i].offset) = f->arg[i].angle ? radians(v[i]) : v[i];
     add_object(p, req, &s);
 }
 
-void rib_paraboloid(rib_parser *p, const rib_request *req)
-{
-    double v[4];
-    if (!read_quadric(p, req, 4, v, "rmax zmin zmax thetamax"))
-        return;
-    geom_surface s = new_surface(GEOM_PARABOLOID);
-    s.rmax = v[0], s.zmin = v[1], s.zmax = v[2], s.thetamax = radians(v[3]);
-    add_object(p, req, &s);
-}
+void rib_sphere(rib_parser *p, const rib_request *req) { quadric(p, req, &sphere); }
+void rib_disk(rib_parser *p, const rib_request *req) { quadric(p, req, &disk); }
+void rib_cylinder(rib_parser *p, const rib_request *req) { quadric(p, req, &cylinder); }
+void rib_cone(rib_parser *p, const rib_request *req) { quadric(p, req, &cone); }
+void rib_torus(rib_parser *p, const rib_request *req) { quadric(p, req, &torus); }
+void rib_hyperboloid(rib_parser *p, const rib_request *req) { quadric(p, req, &hyperboloid); }
+void rib_paraboloid(rib_parser *p, const rib_request *req) { quadric(p, req, &paraboloid); }
 
 /* ---------------------------------------------------------------------- */
 /* Polygon (§5.1), Patch "bilinear" (§5.3)                                 */
@@ -303,26 +287,20 @@ void rib_polygon(rib_parser *p, const rib_request *req)
     else if (P) {
         geom_surface s = new_surface(GEOM_POLYGON);
         take_vertices(&s, P, n);
-        char why[256] = "";
-        if (!prepare_surface(&s, why, sizeof why))
-            rib_error(p, req, req->pos, "%s", why[0] ? why : "invalid parameters");
+        char err[ERR_LEN] = "";
+        if (!prepare_surface(&s, err, sizeof err))
+            rib_error(p, req, req->pos, "%s", err[0] ? err : "invalid parameters");
         else if (!rib_polygon_vars(p, req, &params, P))   /* with primitive variables */
             rib_add_surface(p, req, &s);
     }
-    rib_params_free(&params);
+    rib_params_clear(&params);
 }
 
 void rib_patch(rib_parser *p, const rib_request *req)
 {
-    const char *type = rib_read_string(p, req, 0, "the patch type");
-    if (!type)
+    bool cubic;
+    if (!rib_read_patch_type(p, req, &cubic))
         return;
-    bool cubic = strcmp(type, "bicubic") == 0;
-    if (!cubic && strcmp(type, "bilinear") != 0) {
-        rib_error(p, req, req->args[0].pos, "unknown patch type \"%s\" (expected \"bilinear\" "
-                  "or \"bicubic\")", type);
-        return;
-    }
     rib_params params;
     if (!rib_params_read(p, req, 1, RIB_PARAMS_VARYING, &params))
         return;
@@ -347,6 +325,6 @@ void rib_patch(rib_parser *p, const rib_request *req)
         p->nsurface_vars = 0;
     }
     if (P)
-        rib_primvars_free(&pv);
-    rib_params_free(&params);
+        rib_primvars_clear(&pv);
+    rib_params_clear(&params);
 }

@@ -8,6 +8,7 @@
  * the file:line of its first use and what aafarm does instead.
  */
 #include "scene/rib_parser.h"
+#include "sl/strbuf.h"
 #include "util/xalloc.h"
 
 #include <string.h>

@@ -18,6 +18,7 @@
  * (trace/instance.c).
  */
 #include "scene/rib_parser.h"
+#include "sl/strbuf.h"
 #include "util/xalloc.h"
 
 #include <stdio.h>
@@ -101,7 +102,7 @@ void rib_record_surface(rib_parser *p, const rib_request *req, const geom_surfac
     part->nprimvars = p->nsurface_vars;
     part->primvars = NULL;
     if (p->nsurface_vars > 0) {
-        part->primvars = xmalloc((size_t)p->nsurface_vars * sizeof *part->primvars);
+        part->primvars = xrealloc(NULL, (size_t)p->nsurface_vars * sizeof *part->primvars);
         memcpy(part->primvars, p->surface_vars,
                (size_t)p->nsurface_vars * sizeof *part->primvars);
     }
@@ -143,7 +144,7 @@ void rib_object_instance(rib_parser *p, const rib_request *req)
     }
 }
 
-void rib_object_defs_free(rib_parser *p)
+void rib_object_defs_clear(rib_parser *p)
 {
     for (int i = 0; i < p->ndefs; i++) {
         free(p->defs[i].handle);

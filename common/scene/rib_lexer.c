@@ -10,6 +10,7 @@
  */
 #include "scene/rib_lexer.h"
 #include "sl/strbuf.h"
+#include "util/err.h"
 #include "util/xalloc.h"
 
 #include <math.h>
@@ -25,12 +26,12 @@ struct rib_lexer {
     const char *line_start;
     int line;
     sl_strbuf str;          /* the last decoded string */
-    char why[160];          /* the last bad token's reason */
+    char err[ERR_LEN];      /* the last bad token's reason */
 };
 
 rib_lexer *rib_lexer_new(const char *file, const char *text, size_t len)
 {
-    rib_lexer *self = xmalloc(sizeof *self);
+    rib_lexer *self = xrealloc(NULL, sizeof *self);
     memset(self, 0, sizeof *self);
     self->file = file;
     self->text = self->p = self->line_start = text;
@@ -117,10 +118,10 @@ static void bad(rib_lexer *self, rib_token *t, const char *fmt, ...)
 {
     va_list ap;
     va_start(ap, fmt);
-    vsnprintf(self->why, sizeof self->why, fmt, ap);
+    err_vset(self->err, sizeof self->err, fmt, ap);
     va_end(ap);
     t->kind = RIB_TOK_BAD;
-    t->error = self->why;
+    t->error = self->err;
 }
 
 static rib_token make(rib_lexer *self, rib_token_kind kind, const char *start)

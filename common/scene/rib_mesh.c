@@ -29,10 +29,12 @@
  */
 #include "scene/rib_parser.h"
 #include "scene/rib_primvar.h"
-#include "util/xalloc.h"
+#include "sl/strbuf.h"
 
 #ifdef SCENE_HAVE_GEOM
 #include "geom/triangulate.h"
+#include "util/err.h"
+#include "util/xalloc.h"
 #endif
 
 #include <math.h>
@@ -120,12 +122,12 @@ static bool add_triangle(rib_parser *p, const mesh *m, int face, const int *idx,
         s.vn[0] = n[0], s.vn[1] = n[1], s.vn[2] = n[2];
     }
 #ifdef SCENE_HAVE_GEOM
-    char why[256];
-    if (!geom_surface_prepare(&s, why, sizeof why)) {
+    char err[ERR_LEN];
+    if (!geom_surface_prepare(&s, err, sizeof err)) {
         if (!n)
             return false;
         s.nvn = 0;                  /* normals it cannot interpolate: flat */
-        if (!geom_surface_prepare(&s, why, sizeof why))
+        if (!geom_surface_prepare(&s, err, sizeof err))
             return false;
     }
 #endif
@@ -171,8 +173,8 @@ static bool add_face(rib_parser *p, mesh *m, int face, const int *loop_sizes, in
         for (int i = 0; i < total; i++)
             s.verts[i] = point(m, idx[i]);
 #ifdef SCENE_HAVE_GEOM
-        char why[256];
-        if (geom_surface_prepare(&s, why, sizeof why)) {
+        char err[ERR_LEN];
+        if (geom_surface_prepare(&s, err, sizeof err)) {
             rib_corner corners[GEOM_MAX_POLY_VERTS];
             for (int i = 0; i < total; i++)
                 corners[i] = corner_of(m, face, idx, i);
@@ -209,18 +211,18 @@ static bool add_face(rib_parser *p, mesh *m, int face, const int *loop_sizes, in
                   "triangles may have at most %d", face, total, RIB_MAX_FACE_POINTS);
         return false;
     }
-    vec3 *pts = xmalloc((size_t)total * sizeof *pts);
+    vec3 *pts = xrealloc(NULL, (size_t)total * sizeof *pts);
     for (int i = 0; i < total; i++)
         pts[i] = point(m, idx[i]);
     int max = total + 2 * nloops;
-    int (*tris)[3] = xmalloc((size_t)max * sizeof *tris);
-    char why[256];
-    int n = geom_triangulate(pts, loop_sizes, nloops, tris, max, why, sizeof why);
+    int (*tris)[3] = xrealloc(NULL, (size_t)max * sizeof *tris);
+    char err[ERR_LEN];
+    int n = geom_triangulate(pts, loop_sizes, nloops, tris, max, err, sizeof err);
     bool ok = true;
-    if (n < 0 && strcmp(why, "the polygon has no area") == 0) {
+    if (n < 0 && strcmp(err, "the polygon has no area") == 0) {
         m->skipped++;
     } else if (n < 0) {
-        rib_error(p, m->req, m->vertices_pos, "face %d: %s", face, why);
+        rib_error(p, m->req, m->vertices_pos, "face %d: %s", face, err);
         ok = false;
     } else {
         int added = 0;
@@ -250,7 +252,7 @@ static bool add_face(rib_parser *p, mesh *m, int face, const int *loop_sizes, in
 static double *smooth_normals(int npoints, const double *P, const int *nloops, int nfaces,
                               const int *nverts, const int *idx)
 {
-    double *N = xmalloc((size_t)npoints * 3 * sizeof *N);
+    double *N = xrealloc(NULL, (size_t)npoints * 3 * sizeof *N);
     memset(N, 0, (size_t)npoints * 3 * sizeof *N);
     const int *loop = nverts, *vi = idx;
     for (int f = 0; f < nfaces; f++) {
@@ -337,7 +339,7 @@ static void read_mesh(rib_parser *p, const rib_request *req, const int *nloops, 
     if (N) {
         m.ncls = normal_class(p, req, N, m.npoints, nidx, nfaces);
         if (m.ncls == MESH_N_NONE) {
-            rib_primvars_free(&m.pv);
+            rib_primvars_clear(&m.pv);
             goto out;
         }
         m.N = N->values;
@@ -354,12 +356,12 @@ static void read_mesh(rib_parser *p, const rib_request *req, const int *nloops, 
         vi += npts;
     }
     free(smooth);
-    rib_primvars_free(&m.pv);
+    rib_primvars_clear(&m.pv);
     if (m.skipped > 0)
         rib_warning(p, req, req->pos, "%d face%s without area skipped", m.skipped,
                     m.skipped == 1 ? "" : "s");
 out:
-    rib_params_free(&params);
+    rib_params_clear(&params);
     free(idx);
 }
 
@@ -394,7 +396,7 @@ void rib_general_polygon(rib_parser *p, const rib_request *req)
             rib_error(p, req, P->pos, "the loops have %ld points in all, but \"P\" has %d",
                       n, P->count / 3);
         else {
-            int *idx = xmalloc((size_t)n * sizeof *idx);
+            int *idx = xrealloc(NULL, (size_t)n * sizeof *idx);
             for (int i = 0; i < n; i++)
                 idx[i] = i;
             mesh m = { req, P->values, (int)n, 0, req->args[0].pos, MESH_N_NONE, NULL, 0,
@@ -411,10 +413,10 @@ void rib_general_polygon(rib_parser *p, const rib_request *req)
                 if (m.skipped)
                     rib_warning(p, req, req->pos, "the polygon has no area: skipped");
             }
-            rib_primvars_free(&m.pv);
+            rib_primvars_clear(&m.pv);
             free(idx);
         }
-        rib_params_free(&params);
+        rib_params_clear(&params);
     }
     free(nverts);
 }
@@ -449,7 +451,7 @@ bool rib_polygon_vars(rib_parser *p, const rib_request *req, const rib_params *p
     if (!any)
         return false;
     int n = P->count / 3;
-    int *idx = xmalloc((size_t)n * sizeof *idx);
+    int *idx = xrealloc(NULL, (size_t)n * sizeof *idx);
     for (int i = 0; i < n; i++)
         idx[i] = i;
     mesh m = { req, P->values, n, 0, req->pos, MESH_N_NONE, NULL, 0, { NULL, 0 } };
@@ -458,7 +460,7 @@ bool rib_polygon_vars(rib_parser *p, const rib_request *req, const rib_params *p
         int loop[1] = { n };
         add_face(p, &m, 0, loop, 1, idx);
     }
-    rib_primvars_free(&m.pv);
+    rib_primvars_clear(&m.pv);
     free(idx);
     return true;
 }

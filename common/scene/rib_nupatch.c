@@ -19,10 +19,12 @@
  * (w x, w y, w z, w); every weight must be > 0.
  */
 #include "scene/rib_parser.h"
-#include "util/xalloc.h"
+#include "sl/strbuf.h"
 
 #ifdef SCENE_HAVE_GEOM
 #include "geom/nurbs.h"
+#include "util/err.h"
+#include "util/xalloc.h"
 #endif
 
 #include <math.h>
@@ -103,7 +105,7 @@ static bool read_dir(rib_parser *p, const rib_request *req, int *i, const char *
                   mm[1]);
         return false;
     }
-    d->knots = xmalloc((size_t)nk * sizeof *d->knots);
+    d->knots = xrealloc(NULL, (size_t)nk * sizeof *d->knots);
     memcpy(d->knots, k, (size_t)nk * sizeof *k);
     d->lo = mm[0], d->hi = mm[1];
     *i = next + 3;
@@ -161,7 +163,7 @@ static void add_nurbs(rib_parser *p, const rib_request *req, const nurbs_dir *du
 {
 #ifdef SCENE_HAVE_GEOM
     size_t npts = (size_t)du->n * (size_t)dv->n;
-    double *Pw = xmalloc(4 * npts * sizeof *Pw);
+    double *Pw = xrealloc(NULL, 4 * npts * sizeof *Pw);
     for (size_t k = 0; k < npts; k++) {
         for (int c = 0; c < 3; c++)
             Pw[4 * k + c] = pts[stride * k + c];
@@ -169,11 +171,11 @@ static void add_nurbs(rib_parser *p, const rib_request *req, const nurbs_dir *du
     }
     geom_nurbs_desc d = { du->n, du->order, du->knots, du->lo, du->hi,
                           dv->n, dv->order, dv->knots, dv->lo, dv->hi, Pw };
-    char why[256] = "";
-    geom_nurbs *nb = geom_nurbs_new(&d, why, sizeof why);
+    char err[ERR_LEN] = "";
+    geom_nurbs *nb = geom_nurbs_new(&d, err, sizeof err);
     free(Pw);
     if (!nb) {
-        rib_error(p, req, req->pos, "%s", why);
+        rib_error(p, req, req->pos, "%s", err);
         return;
     }
     scene *sc = p->scene;
@@ -244,9 +246,9 @@ void rib_nu_patch(rib_parser *p, const rib_request *req)
         goto out;
     }
     size_t nu = (size_t)du.n, nv = (size_t)dv.n;
-    double *ua = xmalloc(2 * (nu + nv) * sizeof *ua);
+    double *ua = xrealloc(NULL, 2 * (nu + nv) * sizeof *ua);
     double *ub = ua + nu, *va = ua + 2 * nu, *vb = va + nv;
-    int *us = xmalloc((nu + nv) * sizeof *us), *vs = us + nu;
+    int *us = xrealloc(NULL, (nu + nv) * sizeof *us), *vs = us + nu;
     int nui = intervals(&du, ua, ub, us, du.n), nvi = intervals(&dv, va, vb, vs, dv.n);
     for (int a = 0; a < nvi; a++)
         for (int b = 0; b < nui; b++) {
@@ -291,9 +293,9 @@ void rib_nu_patch(rib_parser *p, const rib_request *req)
                 for (int k = 0; k < 4; k++)
                     s.verts[4 * l + k] = v3(Bn[l][k][0], Bn[l][k][1], Bn[l][k][2]);
 #ifdef SCENE_HAVE_GEOM
-            char why[256];
-            if (!geom_surface_prepare(&s, why, sizeof why)) {
-                rib_error(p, req, req->pos, "piece (%d, %d): %s", b, a, why);
+            char err[ERR_LEN];
+            if (!geom_surface_prepare(&s, err, sizeof err)) {
+                rib_error(p, req, req->pos, "piece (%d, %d): %s", b, a, err);
                 continue;
             }
 #endif
@@ -302,7 +304,7 @@ void rib_nu_patch(rib_parser *p, const rib_request *req)
     free(ua);
     free(us);
 out:
-    rib_params_free(&params);
+    rib_params_clear(&params);
     free(du.knots);
     free(dv.knots);
 }

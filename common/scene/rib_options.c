@@ -11,6 +11,7 @@
  * side spans [-1, 1], the longer one [-a, a] with a the frame aspect ratio.
  */
 #include "scene/rib_parser.h"
+#include "sl/strbuf.h"
 #include "util/xalloc.h"
 
 #include <math.h>
@@ -112,7 +113,7 @@ void rib_projection(rib_parser *p, const rib_request *req)
         rib_error(p, req, req->args[0].pos, "unsupported projection \"%s\" (supported: "
                   "\"perspective\", \"orthographic\")", name);
     }
-    rib_params_free(&params);
+    rib_params_clear(&params);
 }
 
 void rib_screen_window(rib_parser *p, const rib_request *req)
@@ -304,7 +305,7 @@ static void trace_option(rib_parser *p, const rib_request *req)
         else
             p->scene->trace_maxdepth = (int)d;
     }
-    rib_params_free(&params);
+    rib_params_clear(&params);
 }
 
 void rib_option(rib_parser *p, const rib_request *req)
@@ -328,7 +329,7 @@ void rib_option(rib_parser *p, const rib_request *req)
     const scene_param *texture = rib_params_find(&params, "texture");
     if (texture && texture->string)
         set_path(p, req, "texture", &p->texture_path, &p->ntexture_path, texture->string);
-    rib_params_free(&params);
+    rib_params_clear(&params);
 }
 
 /* ---------------------------------------------------------------------- */

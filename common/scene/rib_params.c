@@ -11,16 +11,18 @@
  * unchecked: unknown attributes and options are ignored quietly.
  */
 #include "scene/rib_parser.h"
+#include "sl/strbuf.h"
+#include "util/err.h"
 #include "util/xalloc.h"
 
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-void rib_params_free(rib_params *params)
+void rib_params_clear(rib_params *params)
 {
     for (int i = 0; i < params->count; i++)
-        scene_param_free(&params->items[i]);
+        scene_param_clear(&params->items[i]);
     free(params->items);
     params->items = NULL;
     params->count = 0;
@@ -40,12 +42,12 @@ static bool resolve_name(rib_parser *p, const rib_request *req, const rib_arg *a
                          rib_params_mode mode, char **name, rib_decl *decl)
 {
     const char *text = rib_arg_string(req, arg);
-    char why[160];
+    char err[ERR_LEN];
     if (rib_decl_is_inline(text)) {
         const char *n;
         int len;
-        if (!rib_decl_parse(text, true, decl, &n, &len, why, sizeof why)) {
-            rib_error(p, req, arg->pos, "cannot read the declaration \"%s\": %s", text, why);
+        if (!rib_decl_parse(text, true, decl, &n, &len, err, sizeof err)) {
+            rib_error(p, req, arg->pos, "cannot read the declaration \"%s\": %s", text, err);
             return false;
         }
         *name = xstrndup(n, (size_t)len);
@@ -100,7 +102,7 @@ static bool take_value(rib_parser *p, const rib_request *req, const rib_arg *val
                   per, per == 1 ? "" : "s", n);
         return false;
     }
-    out->values = xmalloc((size_t)n * sizeof *out->values);
+    out->values = xrealloc(NULL, (size_t)n * sizeof *out->values);
     memcpy(out->values, v, (size_t)n * sizeof *v);
     out->count = n;
     return true;
@@ -128,7 +130,7 @@ static bool read_one(rib_parser *p, const rib_request *req, int i, rib_params_mo
     out->cls = decl.cls;
     out->pos = name->pos;
     if (!take_value(p, req, &req->args[i + 1], mode, out)) {
-        scene_param_free(out);
+        scene_param_clear(out);
         return false;
     }
     return true;
@@ -142,10 +144,10 @@ bool rib_params_read(rib_parser *p, const rib_request *req, int first,
     if (first >= req->nargs)
         return true;
     int max = (req->nargs - first + 1) / 2;
-    out->items = xmalloc((size_t)max * sizeof *out->items);
+    out->items = xrealloc(NULL, (size_t)max * sizeof *out->items);
     for (int i = first; i < req->nargs; i += 2) {
         if (!read_one(p, req, i, mode, &out->items[out->count])) {
-            rib_params_free(out);
+            rib_params_clear(out);
             return false;
         }
         out->count++;

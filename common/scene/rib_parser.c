@@ -13,6 +13,7 @@
  */
 #include "scene/rib_parser.h"
 #include "sl/source.h"
+#include "sl/strbuf.h"
 #include "util/xalloc.h"
 
 #include <ctype.h>
@@ -108,7 +109,7 @@ int *rib_read_ints(rib_parser *p, const rib_request *req, int i, int min, bool a
         rib_error(p, req, req->args[i].pos, "%s is empty", what);
         return NULL;
     }
-    int *out = xmalloc((size_t)(n + 1) * sizeof *out);
+    int *out = xrealloc(NULL, (size_t)(n + 1) * sizeof *out);
     for (int k = 0; k < n; k++) {
         if (!(v[k] == floor(v[k]) && v[k] >= min && v[k] <= 1e9)) {
             rib_error(p, req, req->args[i].pos, "%s: entry %d is %g, expected a whole number "
@@ -237,9 +238,9 @@ static void pop_block(rib_parser *p, const char *who, sl_pos pos)
     rib_block *b = &p->blocks[--p->nblocks];
     if (b->kind == RIB_BLOCK_TRANSFORM) {
         p->attr.ctm = b->saved.ctm;
-        rib_attributes_free(&b->saved);
+        rib_attributes_clear(&b->saved);
     } else {
-        rib_attributes_free(&p->attr);
+        rib_attributes_clear(&p->attr);
         p->attr = b->saved;
     }
     if (b->kind == RIB_BLOCK_WORLD)
@@ -625,7 +626,7 @@ static void finish_one_path(const char *folder, char **dirs, int ndirs, char ***
             continue;
         }
         size_t n = strlen(folder) + strlen(dir) + 2;
-        char *joined = xmalloc(n);
+        char *joined = xrealloc(NULL, n);
         snprintf(joined, n, "%s/%s", folder, dir);
         add_path(path, npath, sl_source_normalize(joined));
         free(joined);
@@ -701,7 +702,7 @@ static void finish(rib_parser *p)
 
 static scene *scene_new(const char *file)
 {
-    scene *s = xmalloc(sizeof *s);
+    scene *s = xrealloc(NULL, sizeof *s);
     memset(s, 0, sizeof *s);
     s->file = xstrndup(file, strlen(file));
     s->camera.fov = 90;
@@ -719,12 +720,12 @@ static scene *scene_new(const char *file)
     return s;
 }
 
-static void parser_free(rib_parser *p)
+static void parser_clear(rib_parser *p)
 {
     while (p->nblocks > 0)
-        rib_attributes_free(&p->blocks[--p->nblocks].saved);
+        rib_attributes_clear(&p->blocks[--p->nblocks].saved);
     free(p->blocks);
-    rib_attributes_free(&p->attr);
+    rib_attributes_clear(&p->attr);
     for (int i = 0; i < p->nstrings; i++)
         free(p->strings[i]);
     free(p->strings);
@@ -740,7 +741,7 @@ static void parser_free(rib_parser *p)
     for (int i = 0; i < p->ntexture_path; i++)
         free(p->texture_path[i]);
     free(p->texture_path);
-    rib_object_defs_free(p);
+    rib_object_defs_clear(p);
     rib_decls_destroy(&p->decls);
     rib_reader_destroy(&p->reader);
 }
@@ -833,7 +834,7 @@ static scene *parse_frame(const char *file, const char *text, size_t len,
     p.reader = rib_reader_new(p.file, text, len, diag);
     rib_attributes_init(&p.attr);
     parse_all(&p);
-    parser_free(&p);
+    parser_clear(&p);
 
     sl_diag_set_sources(diag, NULL);
     sl_source_set_destroy(&set);

@@ -193,7 +193,7 @@ typedef struct rib_params {
  * an error (reported); *out is then empty. */
 bool rib_params_read(rib_parser *p, const rib_request *req, int first,
                      rib_params_mode mode, rib_params *out);
-void rib_params_free(rib_params *params);
+void rib_params_clear(rib_params *params);
 const scene_param *rib_params_find(const rib_params *params, const char *name);
 
 /* ---- the requests -------------------------------------------------------- */
@@ -237,7 +237,7 @@ void rib_orientation(rib_parser *p, const rib_request *req);
 void rib_reverse_orientation(rib_parser *p, const rib_request *req);
 void rib_attributes_init(rib_attributes *a);
 void rib_attributes_copy(rib_attributes *dst, const rib_attributes *src);
-void rib_attributes_free(rib_attributes *a);
+void rib_attributes_clear(rib_attributes *a);
 void rib_shaders_finish(rib_parser *p);           /* at WorldBegin */
 
 /* rib_geometry.c */
@@ -262,7 +262,7 @@ void rib_object_instance(rib_parser *p, const rib_request *req);
 rib_object_def *rib_defining(rib_parser *p);
 /* Records a prepared surface in the definition being recorded. */
 void rib_record_surface(rib_parser *p, const rib_request *req, const geom_surface *surf);
-void rib_object_defs_free(rib_parser *p);
+void rib_object_defs_clear(rib_parser *p);
 
 /* rib_geometry.c: adds a prepared surface as an object with the current
  * attributes and transform, or records it in the object being defined;
@@ -272,6 +272,9 @@ void rib_add_surface(rib_parser *p, const rib_request *req, const geom_surface *
 /* rib_patch.c */
 void rib_basis(rib_parser *p, const rib_request *req);
 void rib_patch_mesh(rib_parser *p, const rib_request *req);
+/* The type argument of Patch and PatchMesh: *cubic for "bicubic", else
+ * "bilinear"; false with an error for anything else (rib_patch.c). */
+bool rib_read_patch_type(rib_parser *p, const rib_request *req, bool *cubic);
 struct rib_primvars;
 /* pv: the patch's other primitive variables (rib_primvar.h), or NULL */
 void rib_patch_bicubic(rib_parser *p, const rib_request *req, const scene_param *P,

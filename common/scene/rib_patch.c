@@ -14,6 +14,7 @@
 #include "scene/rib_parser.h"
 #include "scene/rib_primvar.h"
 #include "sl/strbuf.h"
+#include "util/err.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -179,9 +180,9 @@ static void add_bicubic(rib_parser *p, const rib_request *req, const double *P,
             s.verts[4 * j + i] = v3(b[0], b[1], b[2]);
         }
 #ifdef SCENE_HAVE_GEOM
-    char why[256];
-    if (!geom_surface_prepare(&s, why, sizeof why)) {
-        rib_error(p, req, at, "%s", why);
+    char err[ERR_LEN];
+    if (!geom_surface_prepare(&s, err, sizeof err)) {
+        rib_error(p, req, at, "%s", err);
         return;
     }
 #else
@@ -248,18 +249,26 @@ static int count_patches(rib_parser *p, const rib_request *req, sl_pos at, const
     return (n - order) / step + 1;
 }
 
-/* PatchMesh type nu uwrap nv vwrap "P" [...] */
-void rib_patch_mesh(rib_parser *p, const rib_request *req)
+bool rib_read_patch_type(rib_parser *p, const rib_request *req, bool *cubic)
 {
     const char *type = rib_read_string(p, req, 0, "the patch type");
     if (!type)
-        return;
-    bool cubic = strcmp(type, "bicubic") == 0;
-    if (!cubic && strcmp(type, "bilinear") != 0) {
+        return false;
+    *cubic = strcmp(type, "bicubic") == 0;
+    if (!*cubic && strcmp(type, "bilinear") != 0) {
         rib_error(p, req, req->args[0].pos, "unknown patch type \"%s\" (expected \"bilinear\" "
                   "or \"bicubic\")", type);
-        return;
+        return false;
     }
+    return true;
+}
+
+/* PatchMesh type nu uwrap nv vwrap "P" [...] */
+void rib_patch_mesh(rib_parser *p, const rib_request *req)
+{
+    bool cubic;
+    if (!rib_read_patch_type(p, req, &cubic))
+        return;
     double nu, nv;
     bool uper, vper;
     if (rib_read_numbers(p, req, 1, 1, &nu, "the number of points in u") < 0 ||
@@ -298,7 +307,7 @@ void rib_patch_mesh(rib_parser *p, const rib_request *req)
         rib_primvars vars;
         scene_primvar pvars[RIB_MAX_PRIMVARS];
         if (!rib_patch_primvars(p, req, &params, counts, cubic, &vars)) {
-            rib_params_free(&params);
+            rib_params_clear(&params);
             return;
         }
         for (int pv = 0; pv < nvpatch; pv++)
@@ -322,9 +331,9 @@ void rib_patch_mesh(rib_parser *p, const rib_request *req)
                     s.verts[c] = v3(P->values[3 * corner[c]], P->values[3 * corner[c] + 1],
                                     P->values[3 * corner[c] + 2]);
 #ifdef SCENE_HAVE_GEOM
-                char why[256];
-                if (!geom_surface_prepare(&s, why, sizeof why)) {
-                    rib_error(p, req, req->pos, "patch (%d, %d): %s", pu, pv, why);
+                char err[ERR_LEN];
+                if (!geom_surface_prepare(&s, err, sizeof err)) {
+                    rib_error(p, req, req->pos, "patch (%d, %d): %s", pu, pv, err);
                     continue;
                 }
 #endif
@@ -333,7 +342,7 @@ void rib_patch_mesh(rib_parser *p, const rib_request *req)
             }
         p->surface_vars = NULL;
         p->nsurface_vars = 0;
-        rib_primvars_free(&vars);
+        rib_primvars_clear(&vars);
     }
-    rib_params_free(&params);
+    rib_params_clear(&params);
 }

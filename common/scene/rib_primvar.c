@@ -14,6 +14,7 @@
  * linear ones are affine forms of u and v).
  */
 #include "scene/rib_primvar.h"
+#include "sl/strbuf.h"
 #include "util/xalloc.h"
 
 #include <math.h>
@@ -63,7 +64,7 @@ bool rib_primvars_collect(rib_parser *p, const rib_request *req, const rib_param
         if (out->n + 2 > RIB_MAX_PRIMVARS) {
             rib_error(p, req, pa->pos, "\"%s\": more than %d primitive variables on one "
                       "primitive", pa->name, RIB_MAX_PRIMVARS);
-            rib_primvars_free(out);
+            rib_primvars_clear(out);
             return false;
         }
         bool st = strcmp(pa->name, "st") == 0 && pa->type == SL_TYPE_FLOAT &&
@@ -88,7 +89,7 @@ bool rib_primvars_collect(rib_parser *p, const rib_request *req, const rib_param
                 rib_error(p, req, pa->pos, "\"%s\" is %s: it needs %d value%s, got %d",
                           pa->name, class_names[cls], counts[cls], counts[cls] == 1 ? "" : "s",
                           n);
-            rib_primvars_free(out);
+            rib_primvars_clear(out);
             return false;
         }
         static const scene_class order[] = {SCENE_CLASS_VERTEX, SCENE_CLASS_VARYING,
@@ -102,7 +103,7 @@ bool rib_primvars_collect(rib_parser *p, const rib_request *req, const rib_param
                       "varying point (%d), per face corner (%d), per face (%d) or one", pa->name,
                       n, counts[SCENE_CLASS_VERTEX], counts[SCENE_CLASS_VARYING],
                       counts[SCENE_CLASS_FACEVARYING], counts[SCENE_CLASS_UNIFORM]);
-            rib_primvars_free(out);
+            rib_primvars_clear(out);
             return false;
         }
         if (st) {
@@ -118,7 +119,7 @@ bool rib_primvars_collect(rib_parser *p, const rib_request *req, const rib_param
     return true;
 }
 
-void rib_primvars_free(rib_primvars *pv)
+void rib_primvars_clear(rib_primvars *pv)
 {
     free(pv->v);
     pv->v = NULL;

@@ -48,7 +48,7 @@ typedef struct rib_corner {
 bool rib_primvars_collect(rib_parser *p, const rib_request *req, const rib_params *params,
                           const int counts[SCENE_CLASS_FACEVARYING + 1],
                           const char *const *skip, rib_primvars *out);
-void rib_primvars_free(rib_primvars *pv);
+void rib_primvars_clear(rib_primvars *pv);
 
 /* Whether every variable has one value at all n corners (the face may
  * stay one polygon, its variables constant). */

@@ -6,6 +6,7 @@
  */
 #include "scene/rib_reader.h"
 #include "scene/rib_lexer.h"
+#include "sl/strbuf.h"
 #include "util/xalloc.h"
 
 #include <stdlib.h>
@@ -20,7 +21,7 @@ struct rib_reader {
 
 rib_reader *rib_reader_new(const char *file, const char *text, size_t len, sl_diag *diag)
 {
-    rib_reader *self = xmalloc(sizeof *self);
+    rib_reader *self = xrealloc(NULL, sizeof *self);
     memset(self, 0, sizeof *self);
     self->lexer = rib_lexer_new(file, text, len);
     self->diag = diag;

@@ -17,10 +17,12 @@
  */
 #include "scene/rib_parser.h"
 #include "scene/rib_primvar.h"
-#include "util/xalloc.h"
+#include "sl/strbuf.h"
 
 #ifdef SCENE_HAVE_GEOM
 #include "geom/subdiv.h"
+#include "util/err.h"
+#include "util/xalloc.h"
 #endif
 
 #include <math.h>
@@ -42,7 +44,7 @@ typedef struct subdiv_tags {
     bool interpolateboundary;
 } subdiv_tags;
 
-static void tags_free(subdiv_tags *t)
+static void tags_clear(subdiv_tags *t)
 {
     free(t->crease_len);
     free(t->crease_verts);
@@ -188,7 +190,7 @@ static void refined_face_vars(const rib_primvars *vars, const geom_subdiv *sd, i
                               scene_primvar *out)
 {
     int F = geom_subdiv_face_origin(sd, f), n = nverts[F], k = f - fo[F];
-    rib_corner *all = xmalloc((size_t)n * sizeof *all), c;
+    rib_corner *all = xrealloc(NULL, (size_t)n * sizeof *all), c;
     int m = n;
     for (int i = 0; i < m; i++) {
         int ci = fo[F] + i;
@@ -274,17 +276,17 @@ void rib_subdivision_mesh(rib_parser *p, const rib_request *req)
             tags.ncorners, tags.corner_verts, tags.corner_sharp,
             tags.nholes, tags.holes, tags.interpolateboundary,
         };
-        char why[256] = "";
-        geom_subdiv *sd = geom_subdiv_new(&d, why, sizeof why);
+        char err[ERR_LEN] = "";
+        geom_subdiv *sd = geom_subdiv_new(&d, err, sizeof err);
         if (!sd) {
-            rib_error(p, req, req->pos, "%s", why);
+            rib_error(p, req, req->pos, "%s", err);
             goto out;
         }
         scene *sc = p->scene;
         sc->subdivs = xrealloc(sc->subdivs, (size_t)(sc->nsubdivs + 1) * sizeof *sc->subdivs);
         sc->subdivs[sc->nsubdivs++] = sd;
         int drawn = 0;
-        fo = xmalloc((size_t)(nfaces + 1) * sizeof *fo);
+        fo = xrealloc(NULL, (size_t)(nfaces + 1) * sizeof *fo);
         fo[0] = 0;
         for (int f = 0; f < nfaces; f++) fo[f + 1] = fo[f] + nverts[f];
         for (int f = 0; f < geom_subdiv_nfaces(sd) && !sl_diag_full(p->diag); f++) {
@@ -312,9 +314,9 @@ void rib_subdivision_mesh(rib_parser *p, const rib_request *req)
 #endif
 out:
     free(fo);
-    rib_primvars_free(&vars);
-    tags_free(&tags);
-    rib_params_free(&params);
+    rib_primvars_clear(&vars);
+    tags_clear(&tags);
+    rib_params_clear(&params);
     free(nverts);
     free(idx);
 }

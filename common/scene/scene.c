@@ -5,17 +5,18 @@
  * a scene is the RIB parser's job (rib_parser.c and the files it names).
  */
 #include "scene/scene.h"
-#include "util/xalloc.h"
+#include "sl/strbuf.h"
 #ifdef SCENE_HAVE_GEOM
 #include "geom/subdiv.h"
 #include "geom/nurbs.h"
+#include "util/xalloc.h"
 #endif
 
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
 
-void scene_param_free(scene_param *param)
+void scene_param_clear(scene_param *param)
 {
     free(param->name);
     free(param->values);
@@ -27,7 +28,7 @@ static void free_shader(scene_shader *sh)
 {
     free(sh->name);
     for (int i = 0; i < sh->nparams; i++)
-        scene_param_free(&sh->params[i]);
+        scene_param_clear(&sh->params[i]);
     free(sh->params);
 }
 
@@ -64,9 +65,9 @@ void scene_destroy(scene **self_p)
     free_strings(self->shader_names, self->nshader_names);
 #ifdef SCENE_HAVE_GEOM
     for (int i = 0; i < self->nsubdivs; i++)
-        geom_subdiv_free(&self->subdivs[i]);
+        geom_subdiv_destroy(&self->subdivs[i]);
     for (int i = 0; i < self->nnurbs; i++)
-        geom_nurbs_free(&self->nurbs[i]);
+        geom_nurbs_destroy(&self->nurbs[i]);
 #endif
     free(self->subdivs);
     free(self->nurbs);
@@ -120,7 +121,7 @@ char *scene_find_shader(const scene *self, const char *name,
         const char *dir = self->search_path[i];
         bool here = strcmp(dir, ".") == 0;
         size_t n = strlen(dir) + strlen(name) + 5;
-        char *path = xmalloc(n);
+        char *path = xrealloc(NULL, n);
         if (here)
             snprintf(path, n, "%s.sl", name);
         else

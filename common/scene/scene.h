@@ -318,7 +318,7 @@ const scene_shader *scene_object_surface(const scene *self, const scene_object *
 const scene_shader *scene_object_displacement(const scene *self, const scene_object *object);
 
 /* Frees a parameter's strings and values (and zeroes it). */
-void scene_param_free(scene_param *param);
+void scene_param_clear(scene_param *param);
 
 /* A parameter of a shader call by name, or NULL. */
 const scene_param *scene_shader_param(const scene_shader *shader, const char *name);

@@ -7,6 +7,7 @@
  * used (head) to least (tail).
  */
 #include "trace/boxcache.h"
+#include "util/xalloc.h"
 
 #include <assert.h>
 #include <stdlib.h>
@@ -25,19 +26,11 @@ struct trace_boxcache {
     trace_boxcache_stats stats;
 };
 
-static void *xrealloc(void *p, size_t n)
-{
-    void *q = realloc(p, n);
-    if (!q && n) abort();
-    return q;
-}
-
 size_t trace_boxcache_brood_bytes(void) { return sizeof(trace_brood); }
 
 trace_boxcache *trace_boxcache_new(size_t budget_bytes, int nobjects)
 {
-    trace_boxcache *self = calloc(1, sizeof *self);
-    if (!self) abort();
+    trace_boxcache *self = xcalloc(1, sizeof *self);
     size_t n = budget_bytes ? budget_bytes / sizeof(trace_brood) : (size_t)INT32_MAX;
     if (n > (size_t)INT32_MAX) n = INT32_MAX;
     self->limit = (int32_t)n;
@@ -108,17 +101,25 @@ static trace_brood_id *link_of(trace_boxcache *self, int object,
 
 /* ---- eviction ---- */
 
+/* Pins lie on the traversal's path, so below an unpinned brood nothing is
+ * pinned: an evicted brood and its whole subtree are unpinned. */
 static void free_subtree(trace_boxcache *self, trace_brood_id id)
 {
     trace_brood *b = &self->pool[id];
+    assert(b->pinned == 0);
     for (int i = 0; i < 4; i++)
-        if (b->child[i] != TRACE_BROOD_NONE) free_subtree(self, b->child[i]);
+        if (b->child[i] != TRACE_BROOD_NONE) {
+            /* brood links: a child's parent is this brood, at slot i */
+            assert(self->pool[b->child[i]].parent == id && self->pool[b->child[i]].slot == i);
+            free_subtree(self, b->child[i]);
+        }
     b = &self->pool[id];
     lru_unlink(self, id);
     b->lru_next = self->free_head;
     self->free_head = id;
     b->parent = TRACE_BROOD_NONE;
     self->live--;
+    assert(self->live >= 0);
     self->stats.evictions++;
 }
 
@@ -154,6 +155,7 @@ static trace_brood_id alloc_brood(trace_boxcache *self)
         id = self->used++;
     }
     self->live++;
+    assert(self->live <= self->limit && id < self->capacity);   /* the budget is hard */
     size_t bytes = (size_t)self->live * sizeof(trace_brood);
     self->stats.bytes = bytes;
     if (bytes > self->stats.peak_bytes) self->stats.peak_bytes = bytes;
@@ -172,6 +174,7 @@ trace_brood_id trace_boxcache_lookup(trace_boxcache *self, int object,
         return TRACE_BROOD_NONE;
     }
     trace_brood_id id = *link;
+    assert(id >= 0 && id < self->used && self->pool[id].parent == parent);
     memcpy(out, self->pool[id].box, sizeof self->pool[id].box);
     lru_touch(self, id);
     self->stats.hits++;
@@ -189,7 +192,10 @@ trace_brood_id trace_boxcache_insert(trace_boxcache *self, int object,
     /* the parent must stay put while we make room */
     if (parent >= 0) self->pool[parent].pinned++;
     trace_brood_id id = alloc_brood(self);
-    if (parent >= 0) self->pool[parent].pinned--;
+    if (parent >= 0) {
+        assert(self->pool[parent].pinned > 0);
+        self->pool[parent].pinned--;
+    }
     if (id == TRACE_BROOD_NONE) {
         self->stats.not_stored++;
         return TRACE_BROOD_UNCACHED;
@@ -209,10 +215,15 @@ trace_brood_id trace_boxcache_insert(trace_boxcache *self, int object,
 
 void trace_boxcache_pin(trace_boxcache *self, trace_brood_id id)
 {
-    if (id >= 0) self->pool[id].pinned++;
+    if (id < 0) return;
+    assert(id < self->used && self->pool[id].pinned < UINT8_MAX);
+    self->pool[id].pinned++;
 }
 
 void trace_boxcache_unpin(trace_boxcache *self, trace_brood_id id)
 {
-    if (id >= 0) self->pool[id].pinned--;
+    if (id < 0) return;
+    assert(id < self->used);
+    assert(self->pool[id].pinned > 0 && "box cache: unpinning a brood that is not pinned");
+    self->pool[id].pinned--;
 }

@@ -2,7 +2,9 @@
  * bvh.c: median-split BVH over object root boxes (see bvh.h).
  */
 #include "trace/bvh.h"
+#include "util/xalloc.h"
 
+#include <assert.h>
 #include <stdlib.h>
 
 typedef struct bvh_node {
@@ -41,6 +43,9 @@ static int cmp_objects(const void *a, const void *b)
 
 static int build(trace_bvh *self, int first, int count)
 {
+    /* node ranges: a non-empty run of idx, inside it */
+    assert(count > 0 && first >= 0 && first + count <= self->world->nobjects);
+    assert(self->nnodes < 2 * self->world->nobjects);   /* a binary tree: 2n - 1 nodes */
     int id = self->nnodes++;
     bvh_node *n = &self->nodes[id];
     n->box = self->world->objects[self->idx[first]].bound;
@@ -59,18 +64,18 @@ static int build(trace_bvh *self, int first, int count)
     int r = build(self, first + half, count - half);
     self->nodes[id].left = l;
     self->nodes[id].right = r;
+    assert(self->nodes[l].first == first && self->nodes[r].first + self->nodes[r].count ==
+           first + count);
     return id;
 }
 
 trace_bvh *trace_bvh_new(const trace_world *world)
 {
-    trace_bvh *self = calloc(1, sizeof *self);
-    if (!self) abort();
+    trace_bvh *self = xcalloc(1, sizeof *self);
     self->world = world;
     int n = world->nobjects;
-    self->idx = malloc(sizeof(int) * (size_t)(n > 0 ? n : 1));
-    self->nodes = malloc(sizeof(bvh_node) * (size_t)(2 * n + 1));
-    if (!self->idx || !self->nodes) abort();
+    self->idx = xmalloc(sizeof(int) * (size_t)(n > 0 ? n : 1));
+    self->nodes = xmalloc(sizeof(bvh_node) * (size_t)(2 * n + 1));
     for (int i = 0; i < n; i++) self->idx[i] = i;
     if (n > 0) build(self, 0, n);
     return self;
@@ -104,6 +109,7 @@ bool trace_bvh_intersect(const trace_bvh *self, trace_thread *th,
         const bvh_node *n = &self->nodes[stack[sp].node];
         if (!(stack[sp].t0 < best->t)) continue;
         if (n->left < 0) {
+            assert(n->first >= 0 && n->first + n->count <= self->world->nobjects);
             for (int i = 0; i < n->count; i++) {
                 const trace_object *o = &self->world->objects[self->idx[n->first + i]];
                 if (trace_intersect_object(th, o, ray, tol, any, best)) {
@@ -116,6 +122,7 @@ bool trace_bvh_intersect(const trace_bvh *self, trace_thread *th,
         double ta0 = 0, ta1 = 0, tb0 = 0, tb1 = 0;
         bool ha = trace_box_hit(&self->nodes[n->left].box, ray, ray->tmin, best->t, &ta0, &ta1, NULL);
         bool hb = trace_box_hit(&self->nodes[n->right].box, ray, ray->tmin, best->t, &tb0, &tb1, NULL);
+        assert(sp + 2 <= BVH_STACK);
         /* push the farther first so the nearer is visited first */
         if (ha && hb) {
             bool a_first = ta0 <= tb0;

@@ -8,6 +8,7 @@
 #include <stdlib.h>
 
 #include "trace/displace.h"
+#include "util/err.h"
 
 enum { PROBES = 16, COARSE = 14, FINE = 20 };
 
@@ -25,8 +26,8 @@ static int compare_doubles(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-bool trace_surface_converges(trace_thread *th, const trace_object *obj, char *why,
-                             size_t whysz)
+bool trace_surface_converges(trace_thread *th, const trace_object *obj, char *err,
+                             size_t errsz)
 {
     double ratio[PROBES];
     int n = 0, probes = 0;
@@ -47,7 +48,7 @@ bool trace_surface_converges(trace_thread *th, const trace_object *obj, char *wh
     const char *shader = obj->displacement
         ? sl_program_name(sl_instance_program(obj->displacement)) : "(none)";
     if (probes > 0 && n == 0) {
-        snprintf(why, whysz, "%s: displacement shader '%s' gives no finite surface: its "
+        err_set(err, errsz, "%s: displacement shader '%s' gives no finite surface: its "
                  "bounds are infinite at every (u,v) sampled; it computes NaN or infinity "
                  "(0/0, a division by zero, sqrt or log of a negative number, an overflow)",
                  obj->name, shader);
@@ -57,7 +58,7 @@ bool trace_surface_converges(trace_thread *th, const trace_object *obj, char *wh
     qsort(ratio, (size_t)n, sizeof ratio[0], compare_doubles);
     double median = ratio[n / 2];
     if (median > 0.5) {
-        snprintf(why, whysz, "%s: displacement shader '%s' does not converge: its bounds "
+        err_set(err, errsz, "%s: displacement shader '%s' does not converge: its bounds "
                  "over (u,v) cells of 2^-%d are %.0f%% as wide as over cells of 2^-%d (a "
                  "continuous surface: about 2%%), so no ray can resolve it; is a parameter "
                  "extreme (a frequency of 1e308?) or the result NaN or infinite?",

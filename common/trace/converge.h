@@ -24,7 +24,7 @@
 #include "trace/thread.h"
 #include "trace/world.h"
 
-bool trace_surface_converges(trace_thread *th, const trace_object *obj, char *why,
-                             size_t whysz);
+bool trace_surface_converges(trace_thread *th, const trace_object *obj, char *err,
+                             size_t errsz);
 
 #endif

@@ -12,6 +12,8 @@
 #include "trace/cellkey.h"
 #include "trace/converge.h"
 #include "trace/prove.h"
+#include "util/err.h"
+#include "util/xalloc.h"
 
 /* §5: a discontinuous box "stopped shrinking" when a child keeps more than
  * this fraction of its parent's size (smooth boxes halve, roughly). */
@@ -220,8 +222,7 @@ static void analyse_wall(trace_thread *th, const trace_object *obj, const double
 static const wall_entry *wall_cell(trace_thread *th, const trace_object *obj, const double r[4])
 {
     if (!th->walls) {                   /* zeroed: empty (cellkey.h) */
-        th->walls = calloc(1, sizeof *th->walls);
-        if (!th->walls) abort();
+        th->walls = xcalloc(1, sizeof *th->walls);
     }
     wall_entry *e = &th->walls->e[trace_cell_slot(r, obj->id, WALL_CACHE_LOG2)];
     if (trace_cell_is(e->r, e->obj, r, obj->id)) return e;
@@ -540,10 +541,10 @@ static bool over_limit(walk *w, const double r[4])
     trace_object_work *ow = &th->work[w->obj->id];
     if (!ow->probed || ow->diverges) {     /* converge.h: fail fast where hopeless */
         ow->probed = true;
-        char why[400];
-        ow->diverges = !trace_surface_converges(th, w->obj, why, sizeof why);
+        char err[ERR_LEN];
+        ow->diverges = !trace_surface_converges(th, w->obj, err, sizeof err);
         if (ow->diverges)
-            trace_thread_fail(th, why);    /* again on every tile this thread retries */
+            trace_thread_fail(th, err);    /* again on every tile this thread retries */
     }
     if (ow->limited_rays++ == 0) {
         ow->u0 = r[0]; ow->u1 = r[1]; ow->v0 = r[2]; ow->v1 = r[3];

@@ -43,6 +43,7 @@
 #include "aa/interval.h"
 #include "aa/rounding.h"
 #include "trace/cellkey.h"
+#include "util/xalloc.h"
 
 /* Newton steps after a proof: quadratic convergence from inside the
  * proof's box, which is already a fraction of a pixel wide */
@@ -121,8 +122,7 @@ static const slope_entry *cell_slopes(trace_thread *th, const trace_object *obj,
                                       const double r[4])
 {
     if (!th->slopes) {                   /* zeroed: empty (cellkey.h) */
-        th->slopes = calloc(1, sizeof *th->slopes);
-        if (!th->slopes) abort();
+        th->slopes = xcalloc(1, sizeof *th->slopes);
     }
     slope_entry *e = &th->slopes->e[trace_cell_slot(r, obj->id, SLOPE_CACHE_LOG2)];
     if (trace_cell_is(e->r, e->obj, r, obj->id)) return e->ok ? e : NULL;

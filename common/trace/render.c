@@ -14,6 +14,8 @@
 #include "trace/instance.h"
 #include "trace/sampler.h"
 #include "trace/shade.h"
+#include "util/err.h"
+#include "util/xalloc.h"
 
 static void camera_bound(const trace_object *obj, const trace_box *b, trace_box *out)
 {
@@ -41,7 +43,7 @@ static void camera_bound(const trace_object *obj, const trace_box *b, trace_box 
     out->hi = v3_add(out->hi, e);
 }
 
-trace_renderer *trace_renderer_new(trace_world *world, char *err, int errsz)
+trace_renderer *trace_renderer_new(trace_world *world, char *err, size_t errsz)
 {
     if (!trace_world_prepare(world, err, errsz))
         return NULL;
@@ -61,17 +63,15 @@ trace_renderer *trace_renderer_new(trace_world *world, char *err, int errsz)
         camera_bound(obj, &obj->root, &obj->bound);
     }
     if (th->failed) {
-        snprintf(err, (size_t)errsz, "%s", th->error);
+        err_set(err, errsz, "%s", th->error);
         trace_thread_destroy(&th);
         return NULL;
     }
     trace_thread_destroy(&th);
-    trace_renderer *self = calloc(1, sizeof *self);
-    if (!self) abort();
+    trace_renderer *self = xcalloc(1, sizeof *self);
     self->world = world;
     self->bvh = trace_bvh_new(world);
-    self->shadow_warned = calloc((size_t)world->nlights + 1, sizeof *self->shadow_warned);
-    if (!self->shadow_warned) abort();
+    self->shadow_warned = xcalloc((size_t)world->nlights + 1, sizeof *self->shadow_warned);
     self->primary_tol = trace_camera_tolerance(&world->camera, world->shading_rate,
                                                world->options.leaf_fraction);
     return self;
@@ -85,6 +85,12 @@ void trace_renderer_destroy(trace_renderer **self_p)
     free(self->shadow_warned);
     free(self);
     *self_p = NULL;
+}
+
+void trace_renderer_set_log(trace_renderer *self, trace_log_fn fn, void *user)
+{
+    self->log = fn;
+    self->log_user = user;
 }
 
 void trace_render_sample(const trace_renderer *self, trace_thread *th,
@@ -161,11 +167,7 @@ bool trace_render_tile(const trace_renderer *self, trace_thread *th,
     int qx0 = (int)floor(x0 + 0.5 - rx), qx1 = (int)ceil(x0 + w - 0.5 + rx) - 1;
     int qy0 = (int)floor(y0 + 0.5 - ry), qy1 = (int)ceil(y0 + h - 0.5 + ry) - 1;
     int qw = qx1 - qx0 + 1, qh = qy1 - qy0 + 1;
-    sample_rec *smp = malloc(sizeof(sample_rec) * (size_t)qw * (size_t)qh * (size_t)ns);
-    if (!smp) {
-        trace_thread_fail(th, "out of memory for the samples of a tile");
-        return false;
-    }
+    sample_rec *smp = xmalloc(sizeof(sample_rec) * (size_t)qw * (size_t)qh * (size_t)ns);
     /* The pixels in Morton (Z) order over the smallest power-of-two square
      * that holds them: consecutive rays stay close in both directions, so
      * the box cache keeps what the next rays need (Heidrich & Seidel §6:

@@ -23,6 +23,11 @@
 #include "trace/thread.h"
 #include "trace/world.h"
 
+/* Where the renderer's warnings go (a line without the program's prefix,
+ * e.g. "light 0 (shader 'spot'): shadow map 'spot.shd' does not exist; ...").
+ * Called from any render thread; the library never prints itself. */
+typedef void (*trace_log_fn)(void *user, const char *message);
+
 typedef struct trace_renderer {
     const trace_world *world;
     trace_bvh *bvh;
@@ -31,14 +36,19 @@ typedef struct trace_renderer {
      * once per light (world->nlights entries, then one for surface
      * shaders' illuminance loops), by whichever thread comes first */
     atomic_uchar *shadow_warned;
+    trace_log_fn log;     /* warnings (NULL: dropped); trace_renderer_set_log */
+    void *log_user;
 } trace_renderer;
 
 /* Computes every object's scale, root box (through its displacement
  * shader, in the world's arithmetic) and camera-space bound, then builds
  * the BVH. The world must stay alive and unchanged while the renderer
  * exists. On a shader failure returns NULL with the message in err. */
-trace_renderer *trace_renderer_new(trace_world *world, char *err, int errsz);
+trace_renderer *trace_renderer_new(trace_world *world, char *err, size_t errsz);
 void trace_renderer_destroy(trace_renderer **self_p);
+
+/* Hands the renderer's warnings to fn(user, message) (before rendering). */
+void trace_renderer_set_log(trace_renderer *self, trace_log_fn fn, void *user);
 
 /* Renders pixels [x0, x0+w) x [y0, y0+h): rgba gets 4 floats per pixel
  * (premultiplied, exposure applied), z one float (camera-space depth of the

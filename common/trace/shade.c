@@ -6,6 +6,7 @@
 
 #include "trace/displace.h"
 #include "trace/primvar.h"
+#include "util/err.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -140,7 +141,7 @@ static bool count_shader_ray(shade_ctx *c, const char *what)
     trace_thread *th = c->th;
     if (th->failed) return false;
     if (++th->shader_rays <= TRACE_MAX_SHADER_RAYS) return true;
-    char msg[256];
+    char msg[ERR_LEN];
     snprintf(msg, sizeof msg, "surface shader '%s': more than %d rays traced by trace() and "
              "shadow() for one sample (the limit; at %s)",
              c->obj->surface ? sl_program_name(sl_instance_program(c->obj->surface)) : "",
@@ -157,16 +158,18 @@ static double shadow_ray(void *user, const char *map, const double P[3], const d
         return 0;
     const trace_world *w = c->r->world;
     int slot = c->light >= 0 ? c->light : w->nlights;
-    if (!atomic_exchange(&c->r->shadow_warned[slot], 1)) {
+    if (!atomic_exchange(&c->r->shadow_warned[slot], 1) && c->r->log) {
+        char msg[ERR_LEN];
         if (c->light >= 0)
-            fprintf(stderr, "aafarm: warning: light %d (shader '%s'): shadow map '%s' does "
-                    "not exist; shadow() is answered by a traced shadow ray\n", c->light,
-                    sl_program_name(sl_instance_program(w->lights[c->light].shader)), map);
+            snprintf(msg, sizeof msg, "light %d (shader '%s'): shadow map '%s' does "
+                     "not exist; shadow() is answered by a traced shadow ray", c->light,
+                     sl_program_name(sl_instance_program(w->lights[c->light].shader)), map);
         else
-            fprintf(stderr, "aafarm: warning: surface shader '%s': shadow map '%s' does not "
-                    "exist; shadow() is answered by a traced shadow ray\n",
-                    c->obj->surface ? sl_program_name(sl_instance_program(c->obj->surface))
-                                    : "", map);
+            snprintf(msg, sizeof msg, "surface shader '%s': shadow map '%s' does not "
+                     "exist; shadow() is answered by a traced shadow ray",
+                     c->obj->surface ? sl_program_name(sl_instance_program(c->obj->surface))
+                                     : "", map);
+        c->r->log(c->r->log_user, msg);
     }
     vec3 p = v3(P[0], P[1], P[2]), d = v3(D[0], D[1], D[2]);
     if (!isfinite(v3_dot(p, p)) || !isfinite(v3_dot(d, d)))

@@ -2,6 +2,8 @@
  * thread.c: per-thread rendering state (see thread.h).
  */
 #include "trace/thread.h"
+#include "util/err.h"
+#include "util/xalloc.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -39,16 +41,14 @@ static sl_vm *new_vm(const trace_world *world)
 
 trace_thread *trace_thread_new(const trace_world *world)
 {
-    trace_thread *self = calloc(1, sizeof *self);
-    if (!self) abort();
+    trace_thread *self = xcalloc(1, sizeof *self);
     self->world = world;
     self->vm = new_vm(world);
     self->shade_vm = new_vm(world);
     self->light_vm = new_vm(world);
     aa_context_init(&self->ctx, world->options.aa_capacity);
     self->cache = trace_boxcache_new(world->options.cache_bytes, world->nobjects);
-    self->work = calloc(world->nobjects > 0 ? (size_t)world->nobjects : 1, sizeof *self->work);
-    if (!self->work) abort();
+    self->work = xcalloc(world->nobjects > 0 ? (size_t)world->nobjects : 1, sizeof *self->work);
     return self;
 }
 
@@ -80,7 +80,7 @@ void trace_thread_fail(trace_thread *self, const char *message)
 {
     if (self->failed) return;
     self->failed = true;
-    snprintf(self->error, sizeof self->error, "%s", message);
+    err_set(self->error, sizeof self->error, "%s", message);
 }
 
 void trace_object_work_add(trace_object_work *dst, const trace_object_work *src,

@@ -17,6 +17,7 @@
 #include "trace/world.h"
 
 #include "trace/stats.h"
+#include "util/err.h"
 #include <stdio.h>
 
 /* Per object: the rays whose walk hit the work limit (intersect.c) and the
@@ -57,7 +58,7 @@ typedef struct trace_thread {
     const atomic_int *cancel;      /* non-zero: stop tracing at once (a signal,
                                       the pool stopping); NULL: never */
     bool failed;
-    char error[512];
+    char error[ERR_LEN];
 } trace_thread;
 
 trace_thread *trace_thread_new(const trace_world *world);

@@ -7,6 +7,8 @@
  * so every worker derives the same values.
  */
 #include "trace/world.h"
+#include "util/err.h"
+#include "util/xalloc.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -138,8 +140,7 @@ static void find_shared_edges(trace_world *world)
         if (obj->surf.kind == GEOM_POLYGON) n += (size_t)obj->surf.nuv;
     }
     if (n < 2) return;
-    world_edge *e = calloc(n, sizeof *e);
-    if (!e) abort();
+    world_edge *e = xcalloc(n, sizeof *e);
     n = 0;
     for (int i = 0; i < world->nobjects; i++) {
         const trace_object *obj = &world->objects[i];
@@ -169,14 +170,14 @@ static void find_shared_edges(trace_world *world)
     free(e);
 }
 
-bool trace_world_prepare(trace_world *world, char *err, int errsz)
+bool trace_world_prepare(trace_world *world, char *err, size_t errsz)
 {
     for (int i = 0; i < world->nobjects; i++) {
         trace_object *obj = &world->objects[i];
         double s = stretch_of(&obj->to_camera), si = stretch_of(&obj->from_camera);
         if (!matrix_finite(&obj->to_camera) || !matrix_finite(&obj->from_camera) ||
             !(s > 0) || !isfinite(s * si) || s * si > 1e12) {
-            snprintf(err, (size_t)errsz, "%s: its transformation to camera space is not "
+            err_set(err, errsz, "%s: its transformation to camera space is not "
                      "finite or nearly singular (stretch %.3g, inverse stretch %.3g); check "
                      "the Translate/Scale/ConcatTransform values before it", obj->name, s, si);
             return false;

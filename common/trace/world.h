@@ -159,6 +159,6 @@ typedef struct trace_world {
 /* Derives each object's id, scale, normal bounds and du/dv (world.c);
  * false with a message naming the object when its transform is not finite
  * or nearly singular. Called by trace_renderer_new; idempotent. */
-bool trace_world_prepare(trace_world *world, char *err, int errsz);
+bool trace_world_prepare(trace_world *world, char *err, size_t errsz);
 
 #endif

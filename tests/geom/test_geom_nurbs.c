@@ -263,7 +263,7 @@ static void test_float(void **state)
         }
         printf("%-20s %3d pieces, worst relative difference from de Boor %.2Lg\n", P[k].name,
                geom_nurbs_npieces(nb), worst);
-        geom_nurbs_free(&nb);
+        geom_nurbs_destroy(&nb);
     }
 }
 
@@ -297,7 +297,7 @@ static void test_circle(void **state)
         }
         printf("%-20s largest | |P.xy| - 1 | = %.2g\n", P[k].name, worst);
         assert_true(worst < 1e-15);
-        geom_nurbs_free(&nb);
+        geom_nurbs_destroy(&nb);
     }
 }
 
@@ -412,7 +412,7 @@ static void test_containment(void **state)
                t.worst, t.unbounded, t.loose);
         all.violations += t.violations, all.unbounded += t.unbounded, all.loose += t.loose;
         all.boxes += t.boxes;
-        geom_nurbs_free(&nb);
+        geom_nurbs_destroy(&nb);
     }
     assert_true(all.boxes > 1000);
     assert_int_equal(all.violations, 0);
@@ -462,7 +462,7 @@ static void test_intersect(void **state)
                 misses++;
             }
         }
-        geom_nurbs_free(&nb);
+        geom_nurbs_destroy(&nb);
     }
     printf("intersect: %d rays hit their target, %d rays beside missed\n", hits, misses);
     assert_true(hits > 50);

@@ -163,7 +163,7 @@ static void test_regular_faces_are_bsplines(void **state)
     printf("regular faces: %d points, worst difference %.3g\n", checked, worst);
     assert_int_equal(checked, 20 * 4 * (G - 3) * (G - 3));
     assert_true(worst < 1e-12);
-    geom_subdiv_free(&sd);
+    geom_subdiv_destroy(&sd);
 }
 
 /* ---- limit points vs the masks ---- */
@@ -188,7 +188,7 @@ static void test_limit_points(void **state)
     printf("valence 3: limit (%.15g %.15g %.15g), mask (%.15g ...)\n", got.x, got.y, got.z,
            want.x);
     assert_true(dist(got, want) < 1e-14);
-    geom_subdiv_free(&sd);
+    geom_subdiv_destroy(&sd);
 
     /* valence 5 and 3 fans: the centre */
     for (int n = 3; n <= 5; n += 2) {
@@ -204,7 +204,7 @@ static void test_limit_points(void **state)
                                v3_scale(pt(fan_P, 1), 4)), 1.0 / 6);
         assert_true(geom_subdiv_limit_point(sd, 1, &got));
         assert_true(dist(got, want) < 1e-14);
-        geom_subdiv_free(&sd);
+        geom_subdiv_destroy(&sd);
     }
 
     /* an infinitely sharp crease 0-1-2-3 around the bottom face: point 1
@@ -218,7 +218,7 @@ static void test_limit_points(void **state)
     assert_true(dist(got, want) < 1e-14);
     assert_true(geom_subdiv_limit_point(sd, 6, &got));
     assert_true(dist(got, pt(CUBE_P, 6)) < 1e-14);
-    geom_subdiv_free(&sd);
+    geom_subdiv_destroy(&sd);
 }
 
 /* ---- containment ---- */
@@ -329,18 +329,18 @@ static void test_containment(void **state)
     (void)state;
     geom_subdiv *sd = cube(0, NULL, NULL, NULL, 0, NULL, NULL);
     contain_mesh("cube", sd, 60);
-    geom_subdiv_free(&sd);
+    geom_subdiv_destroy(&sd);
     sd = fan(5);
     contain_mesh("fan 5", sd, 60);
-    geom_subdiv_free(&sd);
+    geom_subdiv_destroy(&sd);
     sd = fan(3);
     contain_mesh("fan 3", sd, 60);
-    geom_subdiv_free(&sd);
+    geom_subdiv_destroy(&sd);
     int clen[] = { 5, 2 }, cv[] = { 0, 1, 2, 3, 0,  4, 5 }, corner[] = { 6 };
     double cs[] = { 10, 1.5 }, corner_s[] = { 10 };
     sd = cube(2, clen, cv, cs, 1, corner, corner_s);
     contain_mesh("creased cube", sd, 60);
-    geom_subdiv_free(&sd);
+    geom_subdiv_destroy(&sd);
 }
 
 /* The boxes at the corners of every face, 2^-level wide (level 0..9):
@@ -383,10 +383,10 @@ static void test_sector_hulls(void **state)
     geom_subdiv *sd = cube(3, clen, cv, cs, 1, corner, corner_s);
     contain_corners("sectors", sd);
     contain_mesh("sectors", sd, 60);
-    geom_subdiv_free(&sd);
+    geom_subdiv_destroy(&sd);
     sd = cube(0, NULL, NULL, NULL, 0, NULL, NULL);
     contain_corners("cube corners", sd);
-    geom_subdiv_free(&sd);
+    geom_subdiv_destroy(&sd);
 }
 
 /* The unit normal at the crease points of valence 3 of a cube's creased
@@ -466,7 +466,7 @@ static void test_corner_normals(void **state)
            t.unbounded, proven, t.points, t.violations, t.worst);
     assert_int_equal(t.violations, 0);
     assert_true(proven > 0);
-    geom_subdiv_free(&sd);
+    geom_subdiv_destroy(&sd);
 }
 
 /* ---- shared edges ---- */
@@ -528,20 +528,20 @@ static void test_shared_edges(void **state)
     assert_int_equal(pairs, 24 * 4);           /* 48 edges, each seen from both faces */
     assert_true(wp < 1e-12);
     assert_true(wn < 1e-7);
-    geom_subdiv_free(&sd);
+    geom_subdiv_destroy(&sd);
     sd = fan(5);
     pairs = 0, wp = wn = 0;
     watertight(sd, true, &pairs, &wp, &wn);
     printf("fan 5: %d shared edges, worst point gap %.3g, normal gap %.3g\n", pairs, wp, wn);
     assert_true(pairs > 0 && wp < 1e-12 && wn < 1e-7);
-    geom_subdiv_free(&sd);
+    geom_subdiv_destroy(&sd);
     int clen[] = { 5 }, cv[] = { 0, 1, 2, 3, 0 };
     double cs[] = { 10 };
     sd = cube(1, clen, cv, cs, 0, NULL, NULL);
     pairs = 0, wp = wn = 0;
     watertight(sd, false, &pairs, &wp, &wn);
     assert_true(pairs > 0 && wp < 1e-12);
-    geom_subdiv_free(&sd);
+    geom_subdiv_destroy(&sd);
 }
 
 /* ---- bad meshes ---- */

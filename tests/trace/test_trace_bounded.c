@@ -55,7 +55,7 @@ static const char *RIPPLE_SL =
 
 typedef struct outcome {
     bool ok;                     /* the tile rendered */
-    char error[512];
+    char error[ERR_LEN];
     trace_stats st;
     long object_rays;            /* limited rays counted on the object */
     double max_alpha;

@@ -269,6 +269,17 @@ static const char *SHADOW_RIB =
     "AttributeEnd\n"
     "WorldEnd\n";
 
+/* The renderer's warnings (trace_renderer_set_log) of the last render. */
+static int warnings;
+static char last_warning[1024];
+
+static void count_warning(void *user, const char *message)
+{
+    (void)user;
+    warnings++;
+    snprintf(last_warning, sizeof last_warning, "%s", message);
+}
+
 static float *render(const char *light, const char *surface)
 {
     char rib[2048];
@@ -279,6 +290,9 @@ static float *render(const char *light, const char *surface)
                            {"shadowmatte", SHADER_SHADOWMATTE}};
     fixture f;
     assert_true(fixture_open(&f, rib, sh, 5, NULL, 0));
+    warnings = 0;
+    last_warning[0] = '\0';
+    trace_renderer_set_log(f.js->renderer, count_warning, NULL);
     float *rgba = calloc(4 * W * H, sizeof *rgba), *z = calloc(W * H, sizeof *z);
     assert_non_null(rgba);
     assert_non_null(z);
@@ -327,6 +341,16 @@ static void test_shadow_in_a_light_shader_is_a_traced_shadow_ray(void **state)
                  "LightSource \"pointlight\" 1 \"intensity\" [9] \"lightcolor\" [1 0.5 0.25]",
                  "LightSource \"shadowpoint\" 1 \"intensity\" [9] \"lightcolor\" [1 0.5 0.25]",
                  "mymatte");
+    /* the missing map is said once per light and render, to the log the
+     * program gave (the library prints nothing itself) */
+    free(render("LightSource \"shadowpoint\" 1", "mymatte"));
+    assert_int_equal(warnings, 1);
+    assert_string_equal(last_warning, "light 0 (shader 'shadowpoint'): shadow map 'nosuchmap' "
+                        "does not exist; shadow() is answered by a traced shadow ray");
+    free(render("LightSource \"pointlight\" 1", "shadowmatte"));
+    assert_int_equal(warnings, 1);
+    assert_string_equal(last_warning, "surface shader 'shadowmatte': shadow map 'mapless' does "
+                        "not exist; shadow() is answered by a traced shadow ray");
 }
 
 static void test_shadow_under_solar_goes_to_infinity(void **state)
