@@ -87,6 +87,7 @@ static void *render_thread(void *arg)
     shared *s = arg;
     trace_thread *th = trace_thread_new(&s->js->world);
     th->cancel = &interrupted;
+    trace_thread_set_print(th, worker_print_shader_line, NULL);
     int tx_count = image_format_tiles_x(&s->fmt);
     int me = atomic_fetch_add(&s->next_thread, 1);
     for (;;) {

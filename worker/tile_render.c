@@ -29,6 +29,12 @@ image_tile *worker_render_tile(const job_scene *js, trace_thread *th,
     return tile;
 }
 
+void worker_print_shader_line(void *ctx, const char *text)
+{
+    (void)ctx;
+    fputs(text, stderr);
+}
+
 void worker_log_warning(void *user, const char *message)
 {
     (void)user;

@@ -33,4 +33,7 @@ image_tile *worker_render_tile(const job_scene *js, trace_thread *th,
  * "aafarm: warning: <message>". */
 void worker_log_warning(void *user, const char *message);
 
+/* Shaders' printf() lines (trace_thread_set_print) on stderr, as written. */
+void worker_print_shader_line(void *ctx, const char *text);
+
 #endif

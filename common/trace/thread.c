@@ -52,6 +52,17 @@ trace_thread *trace_thread_new(const trace_world *world)
     return self;
 }
 
+void trace_thread_set_print(trace_thread *self, sl_print_fn fn, void *ctx)
+{
+    self->print = fn;
+    self->print_ctx = ctx;
+    sl_vm_set_print(self->vm, fn, ctx);
+    sl_vm_set_print(self->shade_vm, fn, ctx);
+    sl_vm_set_print(self->light_vm, fn, ctx);
+    for (int d = 0; d < TRACE_RAY_DEPTH_LIMIT; d++)
+        if (self->ray_vm[d]) sl_vm_set_print(self->ray_vm[d], fn, ctx);
+}
+
 void trace_thread_destroy(trace_thread **self_p)
 {
     trace_thread *self = *self_p;
@@ -72,7 +83,10 @@ void trace_thread_destroy(trace_thread **self_p)
 sl_vm *trace_thread_shade_vm(trace_thread *self, int depth)
 {
     if (depth <= 0 || depth > TRACE_RAY_DEPTH_LIMIT) return self->shade_vm;
-    if (!self->ray_vm[depth - 1]) self->ray_vm[depth - 1] = new_vm(self->world);
+    if (!self->ray_vm[depth - 1]) {
+        self->ray_vm[depth - 1] = new_vm(self->world);
+        sl_vm_set_print(self->ray_vm[depth - 1], self->print, self->print_ctx);
+    }
     return self->ray_vm[depth - 1];
 }
 

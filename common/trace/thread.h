@@ -49,6 +49,8 @@ typedef struct trace_thread {
     sl_vm *ray_vm[TRACE_RAY_DEPTH_LIMIT];  /* surface shaders of the hits of
                                       trace() rays, one per depth (1..), made
                                       on first use (trace_thread_shade_vm) */
+    sl_print_fn print;             /* shaders' printf lines (NULL: dropped); */
+    void *print_ctx;               /* trace_thread_set_print */
     aa_context ctx;
     trace_boxcache *cache;
     struct trace_slope_cache *slopes;  /* prove.c's, made on first use */
@@ -62,6 +64,9 @@ typedef struct trace_thread {
 } trace_thread;
 
 trace_thread *trace_thread_new(const trace_world *world);
+/* Hands the shaders' printf() lines of every VM of this thread (those
+ * made later too) to fn(ctx, text); the library prints nothing itself. */
+void trace_thread_set_print(trace_thread *self, sl_print_fn fn, void *ctx);
 void trace_thread_destroy(trace_thread **self_p);
 
 /* The VM that runs surface shaders at trace() depth `depth` (0: primary

@@ -161,6 +161,21 @@ static void test_good_render_leaves_exactly_the_output(void **state)
     image_buffer_destroy(&b);
 }
 
+/* A surface shader's printf() lines reach the worker's stderr as written
+ * (the sl library prints nothing itself: the worker installs the VMs'
+ * print callback, trace_thread_set_print). */
+static void test_shader_printf_reaches_stderr(void **state)
+{
+    (void)state;
+    char out[8192];
+    write_file("say.sl", "surface say()\n{\n    printf(\"say %d\\n\", 7);\n    Ci = Cs;\n}\n");
+    write_file("say.rib", "Format 4 4 1\nProjection \"perspective\" \"fov\" [40]\n"
+                          "Option \"searchpath\" \"shader\" [\".\"]\nWorldBegin\nSurface \"say\"\n"
+                          "Polygon \"P\" [-1 -1 5  1 -1 5  1 1 5  -1 1 5]\nWorldEnd\n");
+    assert_int_equal(run("--standalone say.rib -o say.exr --threads 1 -q", out, sizeof out), 0);
+    assert_non_null(strstr(out, "say 7\n"));
+}
+
 /* A long render (400 octaves of noise per shader run) stops on SIGTERM
  * with exit 130 and leaves nothing, although each tile takes seconds. A
  * worker that ignored SIGTERM is killed by the watchdog after 10 s and
@@ -219,6 +234,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_bad_scene_and_bad_shader),
         cmocka_unit_test(test_budget_exceeded_leaves_nothing),
         cmocka_unit_test(test_good_render_leaves_exactly_the_output),
+        cmocka_unit_test(test_shader_printf_reaches_stderr),
         cmocka_unit_test(test_sigterm_stops_a_runaway_render),
     };
     int rc = cmocka_run_group_tests(tests, NULL, NULL);
