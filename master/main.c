@@ -11,10 +11,12 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "curve_cert.h"
 #include "farm.h"
 #include "job/frames.h"
+#include "message.h"
 #include "util/err.h"
 #include "util/exitcodes.h"
 #include "util/parse_num.h"
@@ -269,12 +271,35 @@ static void loaded_free(loaded *l)
     frame_sequence_destroy(&l->seq);
 }
 
+/* The scene text travels in the job message, whose limit a peer enforces
+ * (proto_limits): a file over it is refused here, from its size, before
+ * minutes of parsing, with the way out. false with the message in err. */
+static bool scene_fits_the_job(const char *path, char *err, size_t errsz)
+{
+    struct stat st;
+    size_t limit = proto_limits_default().max_text_bytes;
+    if (stat(path, &st) != 0 || !S_ISREG(st.st_mode) || (uint64_t)st.st_size <= limit)
+        return true;   /* not there or not a file: job_load says so */
+    return err_set(err, errsz,
+                   "%s: %llu bytes of scene text, the farm ships at most %zu (%zu MiB) in a job: "
+                   "render it on one host with aafarm-worker --standalone, which has no such "
+                   "limit, or make the file smaller",
+                   path, (unsigned long long)st.st_size, limit, limit >> 20);
+}
+
 /* Loads and checks the job of every chosen frame; finds their image
  * sizes. Exit code or -1. */
 static int load(cli *c, loaded *l)
 {
     sl_diag *diag = sl_diag_new();
     bool usage = false;
+    char too_big[ERR_LEN];
+    if (!scene_fits_the_job(c->farm.scene_path, too_big, sizeof too_big)) {
+        sl_diag_error(diag, (sl_pos){0}, "%s", too_big);
+        sl_diag_print(diag, stderr);
+        sl_diag_destroy(&diag);
+        return AAFARM_EXIT_INPUT;
+    }
     l->seq = frame_sequence_load(c->farm.scene_path, &c->job, c->farm.frames, c->farm.output,
                                  &usage, diag);
     int n = l->seq ? l->seq->count : 0;

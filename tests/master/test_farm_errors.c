@@ -351,6 +351,34 @@ static void test_farm_bad_shader_fails_fast(void **state)
     free(sub);
 }
 
+/* A scene file over the job's text limit (4 MiB) is refused from its
+ * size before it is parsed (issue 23: a 59 MB RIB was parsed for a minute
+ * first), with the way out; no worker is started, no output written. */
+static void test_farm_scene_too_large_refused_before_parsing(void **state)
+{
+    (void)state;
+    char *sub = ft_tempdir();
+    const char *rib = ft_path(sub, "big.rib");
+    FILE *f = fopen(rib, "w");
+    assert_non_null(f);
+    fputs("Format 8 8 1\nWorldBegin\n", f);
+    /* not even valid RIB after the first lines: parsing it would fail */
+    for (int i = 0; i < (5 << 20) / 64; i++)
+        fputs("NoSuchRequest 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0\n", f);
+    fclose(f);
+    const char *mlog = ft_path(sub, "master.log");
+    const char *margv[] = {ft_master, rib, "-o", ft_path(sub, "m.exr"), "--local-workers", "1",
+                           NULL};
+    assert_int_equal(ft_wait(ft_spawn(mlog, margv), 60), 3);
+    assert_int_equal(ft_count(mlog, "the farm ships at most 4194304 (4 MiB) in a job: render it "
+                                    "on one host with aafarm-worker --standalone"), 1);
+    assert_int_equal(ft_count(mlog, "NoSuchRequest"), 0);
+    assert_int_equal(ft_count(mlog, "joined"), 0);
+    assert_int_equal(access(ft_path(sub, "m.exr"), F_OK), -1);
+    ft_rmtree(sub);
+    free(sub);
+}
+
 static void test_farm_usage_errors(void **state)
 {
     (void)state;
@@ -390,6 +418,7 @@ int main(int argc, char **argv)
         cmocka_unit_test_teardown(test_farm_worker_follows_the_protocol, teardown),
         cmocka_unit_test_teardown(test_farm_shader_over_budget_fails_job, teardown),
         cmocka_unit_test_teardown(test_farm_bad_shader_fails_fast, teardown),
+        cmocka_unit_test_teardown(test_farm_scene_too_large_refused_before_parsing, teardown),
         cmocka_unit_test_teardown(test_farm_usage_errors, teardown),
     };
     return cmocka_run_group_tests(tests, group_setup, group_teardown);
