@@ -49,12 +49,12 @@ typedef struct geom_subdiv_desc {
 } geom_subdiv_desc;
 
 #define GEOM_SUBDIV_INFINITE 10.0
-enum { GEOM_SUBDIV_MAX_VALENCE = 16 };
 
 typedef struct geom_subdiv geom_subdiv;
 
 /* Builds the mesh; NULL with a one-line reason in err (a non-manifold
- * edge, faces that disagree on orientation, a valence above 16, ...). */
+ * edge, faces that disagree on orientation, ...; any valence and any
+ * face size are taken). */
 geom_subdiv *geom_subdiv_new(const geom_subdiv_desc *desc, char *err, size_t errsz);
 void geom_subdiv_destroy(geom_subdiv **self_p);
 

@@ -48,12 +48,14 @@
 #include "geom/subdiv_local.h"
 #include "util/xalloc.h"
 
+#include <assert.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
 struct sd_node {
     int level;
+    int maxval;                    /* the mesh's (sd_local_init) */
     bool regular;
     vec3 net[16];                  /* regular: the Bezier net */
     sd_mesh m;                     /* irregular: the 1-ring, face 0 first */
@@ -96,8 +98,7 @@ static double edge_to(const sd_mesh *m, int f, int cv, int w)
 /* Marks in[] the faces of face 0's sector around point v. */
 static void sector(const sd_mesh *m, int v, unsigned char *in)
 {
-    unsigned char here[SD_BF];
-    memset(here, 0, (size_t)m->nf);
+    unsigned char *here = xcalloc((size_t)m->nf, 1);
     here[0] = 1;
     for (bool grew = true; grew;) {
         grew = false;
@@ -119,14 +120,14 @@ static void sector(const sd_mesh *m, int v, unsigned char *in)
         }
     }
     for (int f = 0; f < m->nf; f++) in[f] |= here[f];
+    free(here);
 }
 
 /* The sector hull (padded by 1e-12 of its size, as subdiv_eval.c's hull)
  * and the axis whose coordinate all sector points share exactly (-1). */
 static void sector_bounds(const sd_mesh *m, vec3 *lo, vec3 *hi, int *axis)
 {
-    unsigned char in[SD_BF];
-    memset(in, 0, (size_t)m->nf);
+    unsigned char *in = xcalloc((size_t)m->nf, 1);
     for (int k = 0; k < 4; k++) sector(m, m->fv[m->fo[0] + k], in);
     bool first = true, same[3] = { true, true, true };
     double big = 0;
@@ -149,6 +150,7 @@ static void sector_bounds(const sd_mesh *m, vec3 *lo, vec3 *hi, int *axis)
     *lo = v3_sub(*lo, v3(pad, pad, pad));
     *hi = v3_add(*hi, v3(pad, pad, pad));
     *axis = same[0] ? 0 : same[1] ? 1 : same[2] ? 2 : -1;
+    free(in);
 }
 
 /* ---- nodes ---- */
@@ -157,6 +159,7 @@ static sd_node *node_new(const sd_local *L, int level)
 {
     sd_node *n = xcalloc(1, sizeof *n);
     n->level = level;
+    n->maxval = L->maxval;
     n->axis = -1;
     n->regular = sd_regular_net(&L->m, n->net);
     if (n->regular) return n;
@@ -185,8 +188,11 @@ static void node_free(sd_node *n)
     free(n);
 }
 
+int sd_node_maxval(const sd_node *n) { return n->maxval; }
+
 void sd_node_local(const sd_node *n, sd_local *L)
 {
+    assert(L->maxval == n->maxval);
     int nv = n->m.nv, nf = n->m.nf, nc = n->m.fo[nf];
     L->m = (sd_mesh){ nv, nf, L->P, L->vs, L->fo, L->fv, L->es };
     memcpy(L->P, n->m.P, (size_t)nv * sizeof(vec3));
@@ -222,10 +228,11 @@ const sd_node *sd_node_root(const geom_subdiv *sd, int f)
 {
     sd_node *n = atomic_load(&sd->roots[f]);
     if (n) return n;
-    sd_local *L = xmalloc(sizeof *L);
-    sd_local_from_shared(sd, f, L);
-    n = node_new(L, 0);
-    free(L);
+    sd_local L;
+    sd_local_init(&L, sd->maxval);
+    sd_local_from_shared(sd, f, &L);
+    n = node_new(&L, 0);
+    sd_local_clear(&L);
     return publish(&sd->roots[f], n);
 }
 
@@ -233,13 +240,15 @@ const sd_node *sd_node_child(const sd_node *p, int q)
 {
     sd_node *n = atomic_load(&((sd_node *)p)->kid[q]);
     if (n) return n;
-    sd_local *L = xmalloc(sizeof *L);
-    sd_big *big = xmalloc(sizeof *big);
-    sd_node_local(p, L);
-    sd_local_child(L, q, big);
-    n = node_new(L, p->level + 1);
-    free(L);
-    free(big);
+    sd_local L;
+    sd_big big;
+    sd_local_init(&L, p->maxval);
+    sd_big_init(&big, p->maxval);
+    sd_node_local(p, &L);
+    sd_local_child(&L, q, &big);
+    n = node_new(&L, p->level + 1);
+    sd_big_clear(&big);
+    sd_local_clear(&L);
     return publish(&((sd_node *)p)->kid[q], n);
 }
 

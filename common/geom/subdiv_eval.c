@@ -27,18 +27,70 @@
 #include "geom/subdiv_local.h"
 #include "geom/surface_internal.h"
 
+#include <assert.h>
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
+
+#include "util/xalloc.h"
+
+void sd_local_init(sd_local *L, int maxval)
+{
+    assert(maxval >= 4);
+    int lf = sd_lf(maxval), lc = sd_lc(maxval), lv = sd_lv(maxval);
+    *L = (sd_local){ .maxval = maxval };
+    L->P = xmalloc((size_t)lv * sizeof *L->P);
+    L->vs = xmalloc((size_t)lv * sizeof *L->vs);
+    L->fo = xmalloc((size_t)(lf + 1) * sizeof *L->fo);
+    L->fv = xmalloc((size_t)lc * sizeof *L->fv);
+    L->es = xmalloc((size_t)lc * sizeof *L->es);
+    L->list = xmalloc((size_t)lf * sizeof *L->list);
+    L->src = xmalloc((size_t)lv * sizeof *L->src);
+}
+
+void sd_local_clear(sd_local *L)
+{
+    free(L->P);
+    free(L->vs);
+    free(L->fo);
+    free(L->fv);
+    free(L->es);
+    free(L->list);
+    free(L->src);
+    *L = (sd_local){ 0 };
+}
+
+void sd_big_init(sd_big *big, int maxval)
+{
+    int lf = sd_lf(maxval), lc = sd_lc(maxval), lv = sd_lv(maxval);
+    int bv = lv + lf + lc, bf = lc, bc = 4 * lc;
+    *big = (sd_big){ { 0 }, xmalloc((size_t)bv * sizeof(vec3)), xmalloc((size_t)bv * sizeof(double)),
+                     xmalloc((size_t)(bf + 1) * sizeof(int)), xmalloc((size_t)bc * sizeof(int)),
+                     xmalloc((size_t)bc * sizeof(double)) };
+}
+
+void sd_big_clear(sd_big *big)
+{
+    free(big->P);
+    free(big->vs);
+    free(big->fo);
+    free(big->fv);
+    free(big->es);
+    *big = (sd_big){ { 0 }, NULL, NULL, NULL, NULL, NULL };
+}
 
 void sd_local_take(sd_local *L, const sd_mesh *M, const int *list, int n)
 {
     L->m = (sd_mesh){ 0, 0, L->P, L->vs, L->fo, L->fv, L->es };
-    int src[SD_LV];
+    int lf = sd_lf(L->maxval), lc = sd_lc(L->maxval);
+    int *src = L->src;
     int nc = 0;
     L->fo[0] = 0;
-    for (int i = 0; i < n && i < SD_LF; i++) {
+    assert(n <= lf);
+    for (int i = 0; i < n; i++) {
         int f = list[i];
-        for (int c = M->fo[f]; c < M->fo[f + 1] && nc < SD_LC; c++) {
+        assert(nc + M->fo[f + 1] - M->fo[f] <= lc);
+        for (int c = M->fo[f]; c < M->fo[f + 1]; c++) {
             int v = M->fv[c], j = 0;
             while (j < L->m.nv && src[j] != v) j++;
             if (j == L->m.nv) {
@@ -55,21 +107,23 @@ void sd_local_take(sd_local *L, const sd_mesh *M, const int *list, int n)
     }
 }
 
-static void add_face(int *list, int *n, int f)
+static void add_face(int *list, int *n, int cap, int f)
 {
     for (int i = 0; i < *n; i++)
         if (list[i] == f) return;
-    if (*n < SD_LF) list[(*n)++] = f;
+    assert(*n < cap);   /* a quad's corners have at most 4 maxval faces */
+    list[(*n)++] = f;
 }
 
 void sd_local_from_shared(const geom_subdiv *sd, int f, sd_local *L)
 {
-    int list[SD_LF], n = 0;
-    add_face(list, &n, f);
+    assert(L->maxval == sd->maxval);
+    int *list = L->list, n = 0, cap = sd_lf(L->maxval);
+    add_face(list, &n, cap, f);
     for (int k = 0; k < 4; k++) {
         int v = sd->m.fv[sd->m.fo[f] + k];
         for (int i = sd->vf_off[v]; i < sd->vf_off[v + 1]; i++)
-            add_face(list, &n, sd->vf[i] / 4);
+            add_face(list, &n, cap, sd->vf[i] / 4);
     }
     sd_local_take(L, &sd->m, list, n);
 }
@@ -81,13 +135,13 @@ void sd_local_child(sd_local *L, int k, sd_big *big)
     int child = L->fo[0] + k;                  /* the child of face 0's corner k */
     int cv[4];
     for (int j = 0; j < 4; j++) cv[j] = big->fv[big->fo[child] + j];
-    int list[SD_LF], n = 0;
-    add_face(list, &n, child);
+    int *list = L->list, n = 0, cap = sd_lf(L->maxval);
+    add_face(list, &n, cap, child);
     for (int f = 0; f < big->m.nf; f++)
         for (int c = big->fo[f]; c < big->fo[f + 1]; c++)
             if ((big->fv[c] == cv[0] || big->fv[c] == cv[1] ||
                            big->fv[c] == cv[2] || big->fv[c] == cv[3])) {
-                add_face(list, &n, f);
+                add_face(list, &n, cap, f);
                 break;
             }
     sd_local_take(L, &big->m, list, n);
@@ -138,13 +192,18 @@ static int eval_point(const geom_subdiv *sd, int f, double u, double v, geom_sam
         if (at_corner > 3 || d == SD_MAX_LEVEL) {
             sd_local L;
             sd_big big;
+            sd_local_init(&L, sd_node_maxval(n));
+            sd_big_init(&big, sd_node_maxval(n));
             sd_node_local(n, &L);
             int q = QUADRANT[s >= 0.5][t >= 0.5];
-            for (int i = 0; i < 12; i++) {
-                if (sd_corner_limit(&L.m, q, &out->P)) return 1;
-                sd_local_child(&L, q, &big);
+            bool limit = false;
+            for (int i = 0; i < 12 && !limit; i++) {
+                limit = sd_corner_limit(&L.m, q, &out->P);
+                if (!limit) sd_local_child(&L, q, &big);
             }
-            out->P = L.P[L.fv[L.fo[0] + q]];
+            if (!limit) out->P = L.P[L.fv[L.fo[0] + q]];
+            sd_big_clear(&big);
+            sd_local_clear(&L);
             return 1;
         }
         int qu = s >= 0.5, qv = t >= 0.5;
@@ -567,8 +626,10 @@ bool geom_subdiv_unit_normal_box(const geom_surface *s, ia_interval u, ia_interv
 void geom_subdiv_bounds(const geom_surface *s, vec3 *lo, vec3 *hi)
 {
     sd_local L;
+    sd_local_init(&L, s->subdiv->maxval);
     sd_local_from_shared(s->subdiv, s->subdiv_face, &L);
     hull(&L.m, lo, hi);
+    sd_local_clear(&L);
 }
 
 static bool slab(vec3 o, vec3 d, vec3 lo, vec3 hi, double *t0, double *t1)

@@ -43,6 +43,7 @@ typedef struct sd_node sd_node;    /* subdiv_cache.c */
 struct geom_subdiv {
     sd_mesh m;                     /* level 1: all quads */
     int *vf_off, *vf;              /* point -> corners holding it (CSR) */
+    int maxval;                    /* the largest valence (>= 4): local meshes' sizes */
     unsigned char *drawn;          /* per face */
     int *origin;                   /* per face: the control face */
     int *net_of;                   /* per face: index into nets, or -1 */

@@ -18,37 +18,44 @@ enum { SD_MAX_LEVEL = 48 };       /* local refinement stops here */
  * (subdiv_cache.c). */
 enum { SD_SIGN_LEVEL = 16 };
 
-enum {
-    SD_LF = 4 * GEOM_SUBDIV_MAX_VALENCE,   /* faces touching a quad's corners */
-    SD_LC = 4 * SD_LF,
-    SD_LV = SD_LC,
-    SD_BV = SD_LV + SD_LF + SD_LC,         /* after one step */
-    SD_BF = SD_LC,
-    SD_BC = 4 * SD_LC,
-};
+/* A local mesh's sizes follow the largest valence of the level-1 mesh it
+ * comes from (geom_subdiv.maxval: a point's faces, or a control face's
+ * points, at least 4); refinement keeps every valence, so the sizes hold
+ * at every level. */
+static inline int sd_lf(int maxval) { return 4 * maxval; }     /* faces touching a quad's corners */
+static inline int sd_lc(int maxval) { return 16 * maxval; }    /* their corners (quads) */
+static inline int sd_lv(int maxval) { return sd_lc(maxval); }  /* their points */
 
 typedef struct sd_local {
     sd_mesh m;
-    vec3 P[SD_LV];
-    double vs[SD_LV];
-    int fo[SD_LF + 1];
-    int fv[SD_LC];
-    double es[SD_LC];
+    int maxval;
+    vec3 *P;                       /* sd_lv */
+    double *vs;                    /* sd_lv */
+    int *fo;                       /* sd_lf + 1 */
+    int *fv;                       /* sd_lc */
+    double *es;                    /* sd_lc */
+    int *list, *src;               /* scratch: sd_lf faces, sd_lv points */
 } sd_local;
 
+/* After one refinement step (sd_local_child's scratch). */
 typedef struct sd_big {
     sd_mesh m;
-    vec3 P[SD_BV];
-    double vs[SD_BV];
-    int fo[SD_BF + 1];
-    int fv[SD_BC];
-    double es[SD_BC];
+    vec3 *P;                       /* points + face points + edge points */
+    double *vs;
+    int *fo;
+    int *fv;
+    double *es;
 } sd_big;
+
+void sd_local_init(sd_local *L, int maxval);
+void sd_local_clear(sd_local *L);
+void sd_big_init(sd_big *big, int maxval);
+void sd_big_clear(sd_big *big);
 
 /* Copies faces list[0..n) of M into L (list[0] becomes face 0). */
 void sd_local_take(sd_local *L, const sd_mesh *M, const int *list, int n);
 
-/* Face f of the shared mesh with its 1-ring. */
+/* Face f of the shared mesh with its 1-ring (L made with sd->maxval). */
 void sd_local_from_shared(const geom_subdiv *sd, int f, sd_local *L);
 
 /* Refines L and makes L the child k (quadrant, subdiv_internal.h) of its
@@ -72,6 +79,8 @@ const sd_node *sd_node_root(const geom_subdiv *sd, int f);
 const sd_node *sd_node_child(const sd_node *n, int q);
 /* Whether the sub-face is regular, and its Bezier net. */
 bool sd_node_regular(const sd_node *n, const vec3 **net);
+/* The largest valence of the mesh the node comes from (sd_local_init). */
+int sd_node_maxval(const sd_node *n);
 /* An irregular sub-face: its 1-ring into L, and the hull of the points its
  * limit depends on (its sectors: no infinitely sharp edge crossed). */
 void sd_node_local(const sd_node *n, sd_local *L);

@@ -49,9 +49,9 @@ geom_subdiv *geom_subdiv_new(const geom_subdiv_desc *d, char *err, size_t errsz)
 {
     int nf = d->nfaces, nv = d->npoints, nc = 0;
     for (int f = 0; f < nf; f++) {
-        if (d->nverts[f] < 3 || d->nverts[f] > GEOM_SUBDIV_MAX_VALENCE) {
-            err_set(err, errsz, "face %d has %d points (3 to %d are supported)", f,
-                      d->nverts[f], GEOM_SUBDIV_MAX_VALENCE);
+        if (d->nverts[f] < 3) {
+            err_set(err, errsz, "face %d has %d points (at least 3 are needed)", f,
+                    d->nverts[f]);
             return NULL;
         }
         nc += d->nverts[f];
@@ -112,10 +112,7 @@ geom_subdiv *geom_subdiv_new(const geom_subdiv_desc *d, char *err, size_t errsz)
     int *val = xcalloc((size_t)nv + 1, sizeof *val);
     for (int c = 0; c < nc; c++) val[m0.fv[c]]++;
     for (int i = 0; i < nv && ok; i++)
-        if (val[i] > GEOM_SUBDIV_MAX_VALENCE)
-            ok = err_set(err, errsz, "point %d is in %d faces (at most %d are supported)",
-                           i, val[i], GEOM_SUBDIV_MAX_VALENCE);
-        else if (d->interpolateboundary && val[i] == 1 && count[i] == 2)
+        if (d->interpolateboundary && val[i] == 1 && count[i] == 2)
             m0.vs[i] = INFINITY;       /* a corner of the boundary */
     free(val);
     /* tags */
@@ -173,17 +170,22 @@ geom_subdiv *geom_subdiv_new(const geom_subdiv_desc *d, char *err, size_t errsz)
             sd->vf[sd->vf_off[v] + fill[v]++] = c;
         }
         free(fill);
+        sd->maxval = 4;
+        for (int v = 0; v < nv1; v++)
+            if (sd->vf_off[v + 1] - sd->vf_off[v] > sd->maxval)
+                sd->maxval = sd->vf_off[v + 1] - sd->vf_off[v];
         int nnets = 0;
         sd->nets = NULL;
-        sd_local *L = xmalloc(sizeof *L);
+        sd_local L;
+        sd_local_init(&L, sd->maxval);
         for (int f = 0; f < nf1; f++) {
             sd->origin[f] = face_of[f];
             sd->drawn[f] = !hole0[face_of[f]] && (d->interpolateboundary || !open0[face_of[f]]);
             sd->net_of[f] = -1;
             if (!sd->drawn[f]) continue;
             vec3 net[16];
-            sd_local_from_shared(sd, f, L);
-            if (sd_regular_net(&L->m, net)) {
+            sd_local_from_shared(sd, f, &L);
+            if (sd_regular_net(&L.m, net)) {
                 if ((nnets & (nnets - 1)) == 0) {
                     sd->nets = xrealloc(sd->nets, (size_t)(nnets ? 2 * nnets : 1) * 16 * sizeof(vec3));
                 }
@@ -191,7 +193,7 @@ geom_subdiv *geom_subdiv_new(const geom_subdiv_desc *d, char *err, size_t errsz)
                 sd->net_of[f] = nnets++;
             }
         }
-        free(L);
+        sd_local_clear(&L);
     }
     free(m0.P);
     free(m0.vs);

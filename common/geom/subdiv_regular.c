@@ -29,7 +29,11 @@
  */
 #include "geom/subdiv_local.h"
 
+#include <assert.h>
 #include <math.h>
+#include <stdlib.h>
+
+#include "util/xalloc.h"
 
 static int next_of(const sd_mesh *m, int f, int c)
 {
@@ -66,17 +70,27 @@ static double edge_sharp(const sd_mesh *m, int a, int b)
 
 static bool tag_ok(double s) { return s == 0 || isinf(s); }
 
+/* The ring of point v: its faces, and the points across its edges
+ * (other, at most two per face: ring_clear frees it). */
 typedef struct vring {
     int nfaces, nedges, ninf;
     bool ok;                       /* every sharpness 0 or infinite */
-    int other[2 * GEOM_SUBDIV_MAX_VALENCE + 2];
+    int *other;
 } vring;
+
+static void ring_clear(vring *r)
+{
+    free(r->other);
+    r->other = NULL;
+}
 
 static void ring_of(const sd_mesh *m, int v, vring *r)
 {
     r->nfaces = r->nedges = r->ninf = 0;
     r->ok = tag_ok(m->vs[v]);
-    double sh[2 * GEOM_SUBDIV_MAX_VALENCE + 2];
+    int cap = 2 * m->nf;
+    r->other = xmalloc((size_t)cap * sizeof *r->other);
+    double *sh = xmalloc((size_t)cap * sizeof *sh);
     for (int f = 0; f < m->nf; f++)
         for (int c = m->fo[f]; c < m->fo[f + 1]; c++) {
             if (m->fv[c] != v) continue;
@@ -88,10 +102,7 @@ static void ring_of(const sd_mesh *m, int v, vring *r)
                 int i = 0;
                 while (i < r->nedges && r->other[i] != ends[k]) i++;
                 if (i == r->nedges) {
-                    if (r->nedges == 2 * GEOM_SUBDIV_MAX_VALENCE + 2) {
-                        r->ok = false;
-                        continue;
-                    }
+                    assert(r->nedges < cap);   /* two new ends at most per face */
                     r->other[r->nedges] = ends[k];
                     sh[r->nedges++] = s[k];
                 } else if (s[k] > sh[i]) {
@@ -103,6 +114,7 @@ static void ring_of(const sd_mesh *m, int v, vring *r)
         if (!tag_ok(sh[i])) r->ok = false;
         if (isinf(sh[i])) r->ninf++;
     }
+    free(sh);
 }
 
 /* grid positions (i along u, j along v) of the face's corners */
@@ -126,6 +138,7 @@ bool sd_regular_net(const sd_mesh *m, vec3 net[16])
     for (int k = 0; k < 4; k++) {
         vring r;
         ring_of(m, c[k], &r);
+        ring_clear(&r);    /* its counts are all this test needs */
         if (!r.ok) return false;
         bool sn = sharp[k], sp = sharp[(k + 3) % 4];
         double vs = m->vs[c[k]];
@@ -209,28 +222,26 @@ bool sd_regular_net(const sd_mesh *m, vec3 net[16])
     return true;
 }
 
-bool sd_corner_limit(const sd_mesh *m, int k, vec3 *out)
+/* The limit mask of point v given its ring (sd_corner_limit). */
+static bool corner_mask(const sd_mesh *m, int v, const vring *r, vec3 *out)
 {
-    int v = m->fv[m->fo[0] + k];
-    vring r;
-    ring_of(m, v, &r);
-    if (!r.ok) return false;
+    if (!r->ok) return false;
     vec3 S = m->P[v];
-    if (isinf(m->vs[v]) || r.ninf > 2) {
+    if (isinf(m->vs[v]) || r->ninf > 2) {
         *out = S;
         return true;
     }
-    if (r.ninf == 2) {
+    if (r->ninf == 2) {
         vec3 e = v3(0, 0, 0);
-        for (int i = 0; i < r.nedges; i++)
-            if (isinf(edge_sharp(m, v, r.other[i]))) e = v3_add(e, m->P[r.other[i]]);
+        for (int i = 0; i < r->nedges; i++)
+            if (isinf(edge_sharp(m, v, r->other[i]))) e = v3_add(e, m->P[r->other[i]]);
         *out = v3_scale(v3_add(e, v3_scale(S, 4)), 1.0 / 6);
         return true;
     }
-    if (r.nfaces != r.nedges) return false;      /* an open ring: no mask */
-    int n = r.nedges;
+    if (r->nfaces != r->nedges) return false;      /* an open ring: no mask */
+    int n = r->nedges;
     vec3 E = v3(0, 0, 0), F = v3(0, 0, 0);
-    for (int i = 0; i < n; i++) E = v3_add(E, m->P[r.other[i]]);
+    for (int i = 0; i < n; i++) E = v3_add(E, m->P[r->other[i]]);
     for (int f = 0; f < m->nf; f++)
         for (int c = m->fo[f]; c < m->fo[f + 1]; c++)
             if (m->fv[c] == v && m->fo[f + 1] - m->fo[f] == 4)
@@ -238,4 +249,14 @@ bool sd_corner_limit(const sd_mesh *m, int k, vec3 *out)
     *out = v3_scale(v3_add(v3_add(v3_scale(S, (double)n * n), v3_scale(E, 4)), F),
                     1.0 / (n * (n + 5.0)));
     return true;
+}
+
+bool sd_corner_limit(const sd_mesh *m, int k, vec3 *out)
+{
+    int v = m->fv[m->fo[0] + k];
+    vring r;
+    ring_of(m, v, &r);
+    bool ok = corner_mask(m, v, &r, out);
+    ring_clear(&r);
+    return ok;
 }

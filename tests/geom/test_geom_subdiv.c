@@ -65,7 +65,7 @@ static geom_subdiv *cube(int ncreases, const int *clen, const int *cverts, const
 }
 
 /* n quads around point 0: (0, E_i, F_i, E_i+1), E_i = 1 + 2i, F_i = 2 + 2i */
-enum { FAN_MAX = 8 };
+enum { FAN_MAX = 40 };   /* valences above 16 too (any valence is taken) */
 static double fan_P[3 * (2 * FAN_MAX + 1)];
 static int fan_V[4 * FAN_MAX], fan_NV[FAN_MAX];
 
@@ -85,6 +85,27 @@ static geom_subdiv *fan(int n)
                            0, NULL, NULL, 0, NULL, true };
     char why[200];
     geom_subdiv *sd = geom_subdiv_new(&d, why, sizeof why);
+    assert_non_null(sd);
+    return sd;
+}
+
+/* one face of n points (a bent disc): after the first step a face point
+ * of valence n */
+static double ngon_P[3 * FAN_MAX];
+static int ngon_V[FAN_MAX];
+
+static geom_subdiv *ngon(int n)
+{
+    for (int i = 0; i < n; i++) {
+        double a = 2 * M_PI * i / n;
+        ngon_P[3 * i] = cos(a), ngon_P[3 * i + 1] = sin(a), ngon_P[3 * i + 2] = 0.3 * cos(2 * a);
+        ngon_V[i] = i;
+    }
+    geom_subdiv_desc d = { 1, &n, ngon_V, n, ngon_P, 0, NULL, NULL, NULL,
+                           0, NULL, NULL, 0, NULL, true };
+    char why[200];
+    geom_subdiv *sd = geom_subdiv_new(&d, why, sizeof why);
+    if (!sd) fprintf(stderr, "ngon: %s\n", why);
     assert_non_null(sd);
     return sd;
 }
@@ -190,8 +211,11 @@ static void test_limit_points(void **state)
     assert_true(dist(got, want) < 1e-14);
     geom_subdiv_destroy(&sd);
 
-    /* valence 5 and 3 fans: the centre */
-    for (int n = 3; n <= 5; n += 2) {
+    /* valence 3, 5, 17 and 40 fans: the centre (above 16 a mesh used to
+     * be refused; the local meshes are sized by the mesh's valence) */
+    static const int valences[] = { 3, 5, 17, 40 };
+    for (int vi = 0; vi < 4; vi++) {
+        int n = valences[vi];
         sd = fan(n);
         vec3 e[FAN_MAX], f[FAN_MAX];
         for (int i = 0; i < n; i++) e[i] = pt(fan_P, 1 + 2 * i), f[i] = pt(fan_P, 2 + 2 * i);
@@ -324,25 +348,6 @@ static void contain_mesh(const char *name, geom_subdiv *sd, int boxes_per_face)
     assert_true(t.boxes > 0);
 }
 
-static void test_containment(void **state)
-{
-    (void)state;
-    geom_subdiv *sd = cube(0, NULL, NULL, NULL, 0, NULL, NULL);
-    contain_mesh("cube", sd, 60);
-    geom_subdiv_destroy(&sd);
-    sd = fan(5);
-    contain_mesh("fan 5", sd, 60);
-    geom_subdiv_destroy(&sd);
-    sd = fan(3);
-    contain_mesh("fan 3", sd, 60);
-    geom_subdiv_destroy(&sd);
-    int clen[] = { 5, 2 }, cv[] = { 0, 1, 2, 3, 0,  4, 5 }, corner[] = { 6 };
-    double cs[] = { 10, 1.5 }, corner_s[] = { 10 };
-    sd = cube(2, clen, cv, cs, 1, corner, corner_s);
-    contain_mesh("creased cube", sd, 60);
-    geom_subdiv_destroy(&sd);
-}
-
 /* The boxes at the corners of every face, 2^-level wide (level 0..9):
  * the renderer's boxes around an irregular point, which the hull of the
  * points the sub-face depends on (its sectors, subdiv_cache.c) bounds. */
@@ -366,6 +371,32 @@ static void contain_corners(const char *name, geom_subdiv *sd)
            "(worst %.3g)\n", name, t.boxes, t.unbounded, t.points, t.violations, t.worst);
     assert_int_equal(t.violations, 0);
     assert_true(t.unbounded > 0);              /* irregular sub-faces were met */
+}
+
+static void test_containment(void **state)
+{
+    (void)state;
+    geom_subdiv *sd = cube(0, NULL, NULL, NULL, 0, NULL, NULL);
+    contain_mesh("cube", sd, 60);
+    geom_subdiv_destroy(&sd);
+    sd = fan(5);
+    contain_mesh("fan 5", sd, 60);
+    geom_subdiv_destroy(&sd);
+    sd = fan(3);
+    contain_mesh("fan 3", sd, 60);
+    geom_subdiv_destroy(&sd);
+    sd = fan(24);
+    contain_mesh("fan 24", sd, 20);
+    contain_corners("fan 24", sd);
+    geom_subdiv_destroy(&sd);
+    sd = ngon(20);
+    contain_mesh("20-gon", sd, 20);
+    geom_subdiv_destroy(&sd);
+    int clen[] = { 5, 2 }, cv[] = { 0, 1, 2, 3, 0,  4, 5 }, corner[] = { 6 };
+    double cs[] = { 10, 1.5 }, corner_s[] = { 10 };
+    sd = cube(2, clen, cv, cs, 1, corner, corner_s);
+    contain_mesh("creased cube", sd, 60);
+    geom_subdiv_destroy(&sd);
 }
 
 /* Sectors: infinitely sharp edges cut a vertex's faces into sectors that
