@@ -279,10 +279,8 @@ static const char *frame_label(const farm *f, const farm_frame *fr, char *buf, s
 static void write_preview(farm *f, farm_frame *fr)
 {
     char err[ERR_LEN];
-    image_buffer *buf = image_buffer_read_exr(fr->output, err, sizeof err);
-    if (!buf || !image_preview_write_png_buffer(fr->preview, buf, err, sizeof err))
+    if (!image_preview_write_png_exr(fr->preview, fr->output, err, sizeof err))
         console_log(f->con, CONSOLE_ERROR, "preview %s not written: %s", fr->preview, err);
-    image_buffer_destroy(&buf);
 }
 
 void farm_frame_complete(farm *f, farm_frame *fr)
