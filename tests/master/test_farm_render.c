@@ -22,7 +22,6 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/prctl.h>
-#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -224,14 +223,9 @@ static void test_local_workers_end_with_their_master(void **state)
 {
     (void)state;
     assert_int_equal(prctl(PR_SET_CHILD_SUBREAPER, 1, 0, 0, 0), 0);
-    const char *wrapper = ft_path(dir, "slow-worker.sh");
-    FILE *f = fopen(wrapper, "w");
-    assert_non_null(f);
     /* each tile starts with 3 s the worker cannot be interrupted in (as a
      * long shader evaluation): an orderly exit on SIGTERM would wait it out */
-    fprintf(f, "#!/bin/sh\nexec '%s' --tile-delay 3000 \"$@\"\n", ft_worker);
-    fclose(f);
-    chmod(wrapper, 0755);
+    const char *wrapper = ft_slow_worker(dir, 3000);
     const char *log = ft_path(dir, "orphans.log");
     setenv("TMPDIR", dir, 1);
     const char *argv[] = {ft_master, ft_path(dir, "scene.rib"), "-o", ft_path(dir, "orphans.exr"),

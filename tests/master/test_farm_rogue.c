@@ -106,6 +106,31 @@ static pid_t spawn_worker(const char *where, const char *ep, const char *name)
     return ft_spawn(log, argv);
 }
 
+/* SIGTERM to each worker; each must exit 130. */
+static void stop_workers(const pid_t *w, int n)
+{
+    for (int i = 0; i < n; i++) kill(w[i], SIGTERM);
+    for (int i = 0; i < n; i++) assert_int_equal(ft_wait(w[i], 20), 130);
+}
+
+/* The worker's row of the master's summary: its "tiles" column, and
+ * whether the row ends in the given state. */
+static long summary_tiles(const char *log, const char *name, const char *state)
+{
+    char *text = ft_read(log), key[160];
+    snprintf(key, sizeof key, "  %s ", name);
+    const char *row = strstr(text, key);
+    assert_non_null(row);
+    long tiles = -1;
+    snprintf(key, sizeof key, " %s %%*s %%ld", name);
+    sscanf(row, key, &tiles);
+    const char *eol = strchr(row, '\n');
+    size_t n = strlen(state);
+    if (state[0]) assert_true(eol && (size_t)(eol - row) > n && memcmp(eol - n, state, n) == 0);
+    free(text);
+    return tiles;
+}
+
 static pid_t start_honest(const char *ep, const char *master_log)
 {
     pid_t w = spawn_worker(dir, ep, "honest");
@@ -222,8 +247,7 @@ static void test_nonretryable_failure_from_one_peer_does_not_end_render(void **s
     assert_int_equal(ft_exr_diff(ft_path(dir, "ref.exr"), ft_path(dir, "fail.exr")), 0);
     zmq_close(r.s);
     zmq_ctx_term(ctx);
-    kill(honest, SIGTERM);
-    assert_int_equal(ft_wait(honest, 20), 130);
+    stop_workers(&honest, 1);
 }
 
 static void test_hoarders_lose_their_tiles_and_get_no_more(void **state)
@@ -269,17 +293,10 @@ static void test_hoarders_lose_their_tiles_and_get_no_more(void **state)
     assert_int_equal(r[0].grants, snapshot[0]);
     assert_int_equal(r[1].grants, snapshot[1]);
     /* and the honest worker did everything */
-    char *text = ft_read(log);
-    const char *row = strstr(text, "  honest ");
-    assert_non_null(row);
-    long tiles = -1;
-    sscanf(row, " honest %*s %ld", &tiles);
-    assert_int_equal(tiles, 48);
-    free(text);
+    assert_int_equal(summary_tiles(log, "honest", ""), 48);
     for (int i = 0; i < 2; i++) zmq_close(r[i].s);
     zmq_ctx_term(ctx);
-    kill(honest, SIGTERM);
-    assert_int_equal(ft_wait(honest, 20), 130);
+    stop_workers(&honest, 1);
 }
 
 enum { PUSHERS = 8, PUSH_BYTES = 4 << 20 };
@@ -328,8 +345,7 @@ static void test_oversized_frames_are_cut_off(void **state)
     for (int i = 0; i < PUSHERS; i++) zmq_close(s[i]);
     zmq_ctx_term(ctx);
     free(junk);
-    kill(honest, SIGTERM);
-    assert_int_equal(ft_wait(honest, 20), 130);
+    stop_workers(&honest, 1);
 }
 
 /* ---- a proxy between a real worker and the master ---- */
@@ -442,20 +458,10 @@ static void test_rogue_alone_then_honest_worker(void **state)
     assert_int_equal(ft_count(log, "render failed"), 0);
     assert_int_equal(ft_exr_diff(ft_path(dir, "ref24.exr"), ft_path(dir, "alter.exr")), 0);
     /* the summary: the rogue took nothing and stayed connected, blocklisted */
-    char *text = ft_read(log);
-    const char *row = strstr(text, "  rogue-R ");
-    assert_non_null(row);
-    long tiles = -1;
-    sscanf(row, " rogue-R %*s %ld", &tiles);
-    assert_int_equal(tiles, 0);
-    assert_non_null(strstr(row, "blocklisted\n"));
-    free(text);
+    assert_int_equal(summary_tiles(log, "rogue-R", "blocklisted"), 0);
     proxy_close(&p);
     zmq_ctx_term(ctx);
-    kill(rw, SIGTERM);
-    kill(honest, SIGTERM);
-    assert_int_equal(ft_wait(rw, 20), 130);
-    assert_int_equal(ft_wait(honest, 20), 130);
+    stop_workers((pid_t[]){rw, honest}, 2);
 }
 
 /* A peer failing every grant non-retryably, alone: it gives each tile up
@@ -496,8 +502,7 @@ static void test_liar_alone_then_honest_worker(void **state)
     assert_int_equal(ft_exr_diff(ft_path(dir, "ref.exr"), ft_path(dir, "liar.exr")), 0);
     zmq_close(r.s);
     zmq_ctx_term(ctx);
-    kill(honest, SIGTERM);
-    assert_int_equal(ft_wait(honest, 20), 130);
+    stop_workers(&honest, 1);
 }
 
 /* Issue 27, item 7(c): a Result naming another tile than its lease's is
@@ -522,19 +527,10 @@ static void test_result_with_another_tiles_index_refused(void **state)
     assert_true(ft_count(log, "invalid tile from the worker: its result names tile ") >= 1);
     assert_true(ft_json_number(ft_path(dir, "index.json"), "invalid_tiles") >= 1);
     assert_int_equal(ft_exr_diff(ft_path(dir, "ref.exr"), ft_path(dir, "index.exr")), 0);
-    char *text = ft_read(log);
-    const char *row = strstr(text, "  rogue-I ");
-    assert_non_null(row);
-    long tiles = -1;
-    sscanf(row, " rogue-I %*s %ld", &tiles);
-    assert_int_equal(tiles, 0);   /* none of its results was taken */
-    free(text);
+    assert_int_equal(summary_tiles(log, "rogue-I", ""), 0);   /* none of its results taken */
     proxy_close(&p);
     zmq_ctx_term(ctx);
-    kill(rw, SIGTERM);
-    kill(honest, SIGTERM);
-    assert_int_equal(ft_wait(rw, 20), 130);
-    assert_int_equal(ft_wait(honest, 20), 130);
+    stop_workers((pid_t[]){rw, honest}, 2);
 }
 
 /* A shader over its instruction budget is a failure every worker agrees
@@ -578,11 +574,7 @@ static void test_deterministic_failure_agreed_or_alone(void **state)
     assert_non_null(strstr(fail, "shader 'spin': instruction budget of 1000 exceeded"));
     assert_non_null(strstr(fail, "no other worker could try it within 3 s (--lease)"));
     free(text);
-    pid_t ws[3] = {w1, w2, w3};
-    for (int i = 0; i < 3; i++) {
-        kill(ws[i], SIGTERM);
-        assert_int_equal(ft_wait(ws[i], 20), 130);
-    }
+    stop_workers((pid_t[]){w1, w2, w3}, 3);
     ft_rmtree(sub);
     free(sub);
 }
