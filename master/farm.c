@@ -279,10 +279,8 @@ static const char *frame_label(const farm *f, const farm_frame *fr, char *buf, s
 static void write_preview(farm *f, farm_frame *fr)
 {
     char err[ERR_LEN];
-    image_buffer *buf = image_buffer_read_exr(fr->output, err, sizeof err);
-    if (!buf || !image_preview_write_png_buffer(fr->preview, buf, err, sizeof err))
+    if (!image_preview_write_png_exr(fr->preview, fr->output, err, sizeof err))
         console_log(f->con, CONSOLE_ERROR, "preview %s not written: %s", fr->preview, err);
-    image_buffer_destroy(&buf);
 }
 
 void farm_frame_complete(farm *f, farm_frame *fr)
@@ -419,6 +417,9 @@ static int setup(farm *f, char *err, size_t errsz)
     so.max_duplicates = f->opt->max_duplicates;
     so.lease_ms = f->opt->lease_ms;
     so.lease_factor = f->opt->lease_factor;
+    /* a tile one worker alone gave up on waits for another one while one
+     * can join (--bind): as long as the longest lease */
+    so.join_window_ms = f->opt->bind ? f->opt->lease_ms : 0;
     /* every frame's tiles in one row-major queue: a worker's run goes on
      * into the next frame, and new runs start in the longest queued run */
     f->sched = scheduler_new(f->ntiles, 1, &so);
@@ -522,6 +523,19 @@ static void log_handshakes(farm *f, int64_t now)
     f->handshake_logged_ms = now;
 }
 
+/* Embedded mode: every local worker started joined and is blocklisted, so
+ * no one is left to render (none can join). */
+static bool all_blocked(const farm *f)
+{
+    int blocked = 0;
+    for (size_t i = 0; i < registry_count(f->reg); i++) {
+        const farm_worker *w = registry_at(f->reg, i);
+        if (w->alive && !w->blocked) return false;
+        if (w->alive) blocked++;
+    }
+    return blocked > 0 && local_workers_running(f->locals) <= blocked;
+}
+
 static void timers(farm *f, int64_t now)
 {
     check_workers(f, now);
@@ -535,10 +549,15 @@ static void timers(farm *f, int64_t now)
         wire_monitor_poll(f->monitor, &f->wstats, NULL, 0);
         log_handshakes(f, now);
     }
+    int given_up = scheduler_check_given_up(f->sched, now);
+    if (given_up >= 0) farm_fail_given_up(f, given_up);
     if (f->locals) {
         local_workers_reap(f->locals, on_child_exit, f);
         if (!f->opt->bind && local_workers_running(f->locals) == 0 && registry_alive(f->reg) == 0)
             farm_fail(f, "no workers left: all %d local workers exited", f->opt->local_workers);
+        else if (!f->opt->bind && all_blocked(f))
+            farm_fail(f, "no workers left: every local worker is blocklisted (its results "
+                      "were refused)");
     }
 }
 
@@ -686,6 +705,8 @@ static void teardown(farm *f)
     remove_private_endpoint(f);
     registry_destroy(&f->reg);
     scheduler_destroy(&f->sched);
+    free(f->given_up);
+    f->given_up = NULL;
     console_destroy(&f->con);
     free(f->frames);
 }

@@ -49,6 +49,13 @@ typedef struct farm_frame {
     bool written;                  /* complete and renamed into place */
 } farm_frame;
 
+/* A tile one worker alone gave up on (SCHEDULER_AWAIT_OTHER): the words
+ * of its failure, for the render's failure if no other worker comes. */
+typedef struct farm_given_up {
+    int tile;
+    char failure[2 * ERR_LEN];
+} farm_given_up;
+
 typedef struct farm {
     const farm_options *opt;
     farm_frame *frames;
@@ -77,6 +84,8 @@ typedef struct farm {
     int64_t start_ms, end_ms;
     farm_state state;
     char failure[2 * ERR_LEN];     /* a prefix (frame, tile, worker) and a message */
+    farm_given_up *given_up;       /* tiles waiting for a second worker */
+    size_t ngiven_up;
     /* counters beyond the scheduler's and the socket's */
     uint64_t invalid_tiles, rejects_sent, version_mismatches, jobs_sent;
     uint64_t grant_bytes, result_bytes, sent_bytes;
@@ -102,6 +111,9 @@ void farm_send_shutdown(farm *f, farm_worker *w, const char *reason, int64_t now
 /* Retires the worker and requeues its tiles (logged at INFO). */
 void farm_lose_worker(farm *f, farm_worker *w, const char *why, int64_t now);
 void farm_fail(farm *f, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+/* A tile one worker alone gave up on waited for another worker for the
+ * whole join window (--lease) in vain: the render fails with its words. */
+void farm_fail_given_up(farm *f, int tile);
 
 /* report.c */
 void farm_report_summary(const farm *f);

@@ -7,11 +7,13 @@
  *   Result     stale (unknown lease, other job) / duplicate (tile DONE) /
  *              taken: the EXR is validated, its chunk appended to the
  *              journal and copied into the output; an invalid EXR counts
- *              as a retryable failure of the worker, a write error of the
+ *              as a retryable failure of the worker (--retries of them:
+ *              the worker is blocklisted for the job), a write error of the
  *              journal or the output fails the render (the master's fault)
- *   Failure    retried elsewhere up to max_attempts, then the job fails;
- *              a non-retryable one fails it only when a second worker
- *              confirms it (scheduler.h: no single peer ends a render)
+ *   Failure    retried elsewhere up to max_attempts, then the job fails
+ *              when two workers agree; a tile one worker alone gave up on
+ *              waits --lease for another (scheduler.h, docs/farm.md
+ *              "Failures": no single peer ends a render)
  *   NeedJob    the Job again
  *   NeedFile   the chunk of the job's file, read from disk (FileChunk +
  *              bulk); a file changed since job_load fails the render
@@ -28,6 +30,7 @@
 
 #include "farm_internal.h"
 #include "util/err.h"
+#include "util/xalloc.h"
 #include "version.h"
 
 /* ---- sending ---- */
@@ -297,9 +300,46 @@ static void tile_failed(farm *f, farm_worker *w, uint64_t lease, int tile, const
                     frame, local, rect.x0, rect.y0, w->name, attempts, f->opt->max_attempts, msg);
         return;
     }
+    if (r == SCHEDULER_AWAIT_OTHER) {
+        /* one worker alone: the words are kept for the render's failure,
+         * should no other worker come within the window */
+        f->given_up = xreallocarray(f->given_up, f->ngiven_up + 1, sizeof *f->given_up);
+        farm_given_up *g = &f->given_up[f->ngiven_up++];
+        g->tile = tile;
+        snprintf(g->failure, sizeof g->failure, "%stile %d at (%d,%d) failed on worker %s only "
+                 "(attempts exhausted): %s", frame, local, rect.x0, rect.y0, w->name, msg);
+        console_log(f->con, CONSOLE_INFO, "%stile %d at (%d,%d) failed on %s (attempt %d of %d): "
+                    "%s; no other worker has tried it: waiting up to %.0f s for one (--lease)",
+                    frame, local, rect.x0, rect.y0, w->name, attempts, f->opt->max_attempts, msg,
+                    (double)f->opt->lease_ms / 1000.0);
+        return;
+    }
     farm_fail(f, "%stile %d at (%d,%d) failed on worker %s (%s): %s", frame, local, rect.x0,
               rect.y0, w->name, retryable ? "attempts exhausted" : "not retryable, confirmed "
               "by a second worker", msg);
+}
+
+void farm_fail_given_up(farm *f, int tile)
+{
+    for (size_t i = 0; i < f->ngiven_up; i++)
+        if (f->given_up[i].tile == tile) {
+            farm_fail(f, "%s; no other worker could try it within %.0f s (--lease)",
+                      f->given_up[i].failure, (double)f->opt->lease_ms / 1000.0);
+            return;
+        }
+    farm_fail(f, "tile %d: every worker gave it up", tile);   /* not reached */
+}
+
+/* A worker whose results were refused --retries times gets no more tiles
+ * of this job (its leases go back to the queue); it stays connected. */
+static void blocklist(farm *f, farm_worker *w)
+{
+    if (w->blocked) return;
+    w->blocked = true;
+    int requeued = scheduler_worker_remove(f->sched, w->slot);
+    console_log(f->con, CONSOLE_INFO, "worker %s blocklisted for this job: %llu of its results "
+                "refused; %d tile%s back in the queue", w->name,
+                (unsigned long long)w->invalid_tiles, requeued, requeued == 1 ? "" : "s");
 }
 
 static void add_stats(farm_worker *w, const proto_tile_stats *s)
@@ -381,6 +421,7 @@ static void on_result(farm *f, farm_worker *w, const proto_result *r, const wire
     w->invalid_tiles++;
     err_prefix(err, sizeof err, "invalid tile from the worker");
     tile_failed(f, w, r->lease_id, tile, err, true);
+    if (w->invalid_tiles >= (uint64_t)f->opt->max_attempts) blocklist(f, w);
 }
 
 static void on_failure(farm *f, farm_worker *w, const proto_failure *x)

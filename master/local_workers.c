@@ -54,7 +54,12 @@ static void exec_worker(const char *binary, const char *endpoint, int k, int thr
                         int verbosity, pid_t parent)
 {
 #ifdef __linux__
-    prctl(PR_SET_PDEATHSIG, SIGTERM);
+    /* the master's death ends it at once (issue 27): SIGKILL, not SIGTERM,
+     * whose orderly exit (Shutdown to a master that is gone, the socket's
+     * linger, render threads finishing their tile or evaluation) took
+     * seconds; nothing of a local worker outlives its master anyway. The
+     * setting survives execv. */
+    prctl(PR_SET_PDEATHSIG, SIGKILL);
     if (getppid() != parent) _exit(127);     /* the master died before prctl */
 #else
     (void)parent;

@@ -9,8 +9,10 @@
  * and stopped by PID: the farm first sends it Shutdown over the socket,
  * local_workers_stop() then waits a grace period, sends SIGTERM, waits
  * again, sends SIGKILL, and reaps every child. On Linux each child also
- * gets SIGTERM if the master dies without stopping it
- * (PR_SET_PDEATHSIG), so no orphan keeps retrying a vanished socket.
+ * gets SIGKILL the moment the master dies without stopping it
+ * (PR_SET_PDEATHSIG; a getppid() check after it closes the race with a
+ * master that died before), so no orphan keeps rendering or retrying a
+ * vanished socket.
  */
 #ifndef MASTER_LOCAL_WORKERS_H
 #define MASTER_LOCAL_WORKERS_H

@@ -37,6 +37,8 @@ typedef struct farm_worker {
     int nheld;
     bool local;                    /* a process this master started */
     bool alive;
+    bool blocked;                  /* blocklisted for the job: its results were
+                                      refused --retries times; it gets no tile */
     char gone[160];                /* why it was retired */
     int64_t joined_ms, last_seen_ms, last_sent_ms, left_ms;
     /* what it did */

@@ -23,6 +23,13 @@ static const char *state_name(farm_state s)
     }
 }
 
+/* The state column: connected, blocklisted (connected, given nothing), or
+ * why it was retired. */
+static const char *worker_state(const farm_worker *w)
+{
+    return !w->alive ? w->gone : w->blocked ? "blocklisted" : "connected";
+}
+
 static void human_bytes(uint64_t b, char *buf, size_t n)
 {
     if (b < 10u * 1024) snprintf(buf, n, "%llu B", (unsigned long long)b);
@@ -53,7 +60,7 @@ void farm_report_summary(const farm *f)
                      (unsigned long long)w->file_misses);
             fprintf(stderr, " %10s %9s", fb, w->files_ready ? hm : "-");
         }
-        fprintf(stderr, "  %s\n", w->alive ? "connected" : w->gone);
+        fprintf(stderr, "  %s\n", worker_state(w));
     }
     scheduler_counts c;
     scheduler_counts_get(f->sched, &c);
@@ -128,7 +135,7 @@ static void json_worker(FILE *out, const farm_worker *w)
             (unsigned long long)w->file_misses,
             w->file_chunks && w->files_ready ? (double)(w->file_ready_ms - w->file_first_ms) / 1000.0
                                               : 0.0);
-    json_string(out, w->alive ? "connected" : w->gone);
+    json_string(out, worker_state(w));
     fputc('}', out);
 }
 

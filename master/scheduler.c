@@ -15,6 +15,9 @@
  *             leased before and came back, oldest first, each at most once;
  *             entries that are no longer queued are skipped lazily.
  *   failed[]  (tile, worker) pairs of failures, to prefer other workers.
+ *   given_up[] tiles one worker alone failed max_attempts times, each with
+ *             the time since which no other worker could take it (0: one
+ *             can, or holds it), for join_window_ms.
  */
 #include "scheduler.h"
 #include "util/xalloc.h"
@@ -27,6 +30,7 @@
 typedef struct tile_state {
     uint8_t done;
     uint8_t in_rq;
+    uint8_t given_up;  /* its failers never get it again (scheduler.h) */
     uint16_t attempts;
     uint32_t live;     /* unexpired leases */
     uint32_t held;     /* valid leases, expired or not */
@@ -45,6 +49,11 @@ typedef struct failed_pair {
     int tile, worker;
 } failed_pair;
 
+typedef struct given_up_tile {
+    int tile;
+    int64_t since_ms;  /* no one else could take it since then; 0: someone can */
+} given_up_tile;
+
 struct scheduler {
     scheduler_options opt;
     int ntiles;
@@ -58,6 +67,8 @@ struct scheduler {
     int nworkers;
     failed_pair *failed;
     size_t nfailed;
+    given_up_tile *given_up;
+    size_t ngiven_up;
     bool job_failed;
     int done;
     int64_t taken_ms_sum;      /* grant-to-result time of taken leases */
@@ -73,6 +84,7 @@ void scheduler_options_default(scheduler_options *opt)
     opt->max_duplicates = 1;
     opt->lease_ms = 120000;
     opt->duplicate_after_ms = 1000;
+    opt->join_window_ms = 0;
 }
 
 scheduler *scheduler_new(int tiles_x, int tiles_y, const scheduler_options *opt)
@@ -103,6 +115,7 @@ void scheduler_destroy(scheduler **self_p)
     free(self->rq);
     free(self->workers);
     free(self->failed);
+    free(self->given_up);
     free(self);
     *self_p = NULL;
 }
@@ -174,12 +187,20 @@ static bool failed_by(const scheduler *self, int tile, int worker)
     return false;
 }
 
-/* Is there an active worker other than `worker` that has not failed tile? */
-static bool someone_else_for(const scheduler *self, int tile, int worker)
+/* Is there an active worker other than `worker` that has not failed tile
+ * (and, with ready, holds no overdue lease, so it would be granted it)? */
+static bool other_for(const scheduler *self, int tile, int worker, bool ready)
 {
     for (int w = 0; w < self->nworkers; w++)
-        if (w != worker && self->workers[w].active && !failed_by(self, tile, w)) return true;
+        if (w != worker && self->workers[w].active && !failed_by(self, tile, w) &&
+            (!ready || self->workers[w].overdue == 0))
+            return true;
     return false;
+}
+
+static bool someone_else_for(const scheduler *self, int tile, int worker)
+{
+    return other_for(self, tile, worker, false);
 }
 
 /* ---- leases ---- */
@@ -266,7 +287,9 @@ static int pick_requeued(scheduler *self, int worker)
             rq_take(self, i);
             continue;
         }
-        if (failed_by(self, t, worker) && someone_else_for(self, t, worker)) continue;
+        if (failed_by(self, t, worker) &&
+            (self->tiles[t].given_up || other_for(self, t, worker, true)))
+            continue;
         rq_take(self, i);
         return t;
     }
@@ -410,17 +433,47 @@ scheduler_failure scheduler_fail(scheduler *self, int worker, uint64_t lease_id,
         self->failed[self->nfailed++] = (failed_pair){tile, worker};
     }
     lease_remove(self, l);
-    /* one worker alone cannot fail the job while another could try */
+    /* only two workers' agreement fails the job (issues 11 and 27) */
     int failers = 0;
     for (size_t i = 0; i < self->nfailed; i++)
         if (self->failed[i].tile == tile) failers++;
-    bool confirmed = failers >= 2 || !someone_else_for(self, tile, worker);
-    if ((!retryable && failers >= 2) ||
-        (self->tiles[tile].attempts >= self->opt.max_attempts && confirmed)) {
+    bool exhausted = self->tiles[tile].attempts >= self->opt.max_attempts;
+    if (failers >= 2 && (!retryable || exhausted)) {
         self->job_failed = true;
         return SCHEDULER_JOB_FAILED;
     }
-    return SCHEDULER_RETRY;
+    if (!exhausted) return SCHEDULER_RETRY;
+    /* one worker alone used up the attempts: it gives the tile up */
+    if (!self->tiles[tile].given_up) {
+        self->tiles[tile].given_up = 1;
+        self->given_up = xrealloc(self->given_up, sizeof *self->given_up * (self->ngiven_up + 1));
+        self->given_up[self->ngiven_up++] = (given_up_tile){tile, 0};
+    }
+    if (someone_else_for(self, tile, worker)) return SCHEDULER_RETRY;
+    if (self->opt.join_window_ms <= 0) {   /* no other worker can come */
+        self->job_failed = true;
+        return SCHEDULER_JOB_FAILED;
+    }
+    return SCHEDULER_AWAIT_OTHER;
+}
+
+int scheduler_check_given_up(scheduler *self, int64_t now_ms)
+{
+    if (self->job_failed) return -1;
+    for (size_t i = 0; i < self->ngiven_up; i++) {
+        given_up_tile *g = &self->given_up[i];
+        const tile_state *t = &self->tiles[g->tile];
+        if (t->done || t->live > 0 || other_for(self, g->tile, -1, true)) {
+            g->since_ms = 0;   /* someone works on it (an unexpired lease), or could */
+            continue;
+        }
+        if (g->since_ms == 0) g->since_ms = now_ms;
+        if (now_ms - g->since_ms >= self->opt.join_window_ms) {
+            self->job_failed = true;
+            return g->tile;
+        }
+    }
+    return -1;
 }
 
 int scheduler_worker_remove(scheduler *self, int worker)

@@ -32,12 +32,16 @@
  *     first result wins, later ones are duplicates (results are
  *     deterministic);
  *   - a failed tile is requeued, avoiding the workers that failed it while
- *     another worker is there to take it. No single worker can fail the
- *     job while another one could take the tile (issue 11): the job fails
- *     on a non-retryable failure only once a second, different worker
- *     confirms it (until then it counts as a retryable one), and after
- *     max_attempts failures only when they came from two workers or no
- *     other active worker is left to try;
+ *     another worker is there to take it. The job fails only when two
+ *     different workers agree (issues 11 and 27): on a non-retryable
+ *     failure once a second, different worker confirms it (until then it
+ *     counts as a retryable one), and after max_attempts failures when
+ *     they came from two workers. A tile that one worker alone failed
+ *     max_attempts times is "given up" by it: it never gets that tile
+ *     again, and the tile waits for another worker; only when no active
+ *     worker that has not failed it is there for join_window_ms (0: at
+ *     once, when no other worker can join) does it fail the job
+ *     (scheduler_check_given_up);
  *   - lease deadlines follow the measured speed: a lease lasts
  *     lease_factor x the mean grant-to-result time of its worker (of all
  *     workers until this one has delivered a tile; lease_ms until anyone
@@ -65,6 +69,9 @@ typedef struct scheduler_options {
     int lease_factor;      /* a lease lasts lease_factor x the measured mean
                               grant-to-result time (4; 0: always lease_ms) */
     int64_t lease_min_ms;  /* but at least this long (2000) */
+    int64_t join_window_ms; /* how long a tile one worker alone gave up on
+                               waits for another worker before it fails the
+                               job (0: no other worker can join, fail at once) */
 } scheduler_options;
 
 void scheduler_options_default(scheduler_options *opt);
@@ -91,8 +98,12 @@ typedef enum scheduler_verdict {
 /* What became of a failure. */
 typedef enum scheduler_failure {
     SCHEDULER_RETRY,       /* the tile will be granted again */
-    SCHEDULER_JOB_FAILED,  /* attempts exhausted or not retryable */
-    SCHEDULER_FAIL_IGNORED /* stale lease, or the tile is DONE already */
+    SCHEDULER_JOB_FAILED,  /* two workers agree (attempts exhausted or not
+                              retryable), or one alone and none can join */
+    SCHEDULER_FAIL_IGNORED,/* stale lease, or the tile is DONE already */
+    SCHEDULER_AWAIT_OTHER  /* this worker alone exhausted the attempts and no
+                              other one is there: the tile waits for one
+                              (join_window_ms; scheduler_check_given_up) */
 } scheduler_failure;
 
 /* Counters for logs and the statistics file. */
@@ -115,7 +126,8 @@ void scheduler_destroy(scheduler **self_p);
 /* A new worker slot (0, 1, 2 ...; never reused). */
 int scheduler_worker_add(scheduler *self);
 
-/* The worker is gone: its leases become unknown (their results are stale)
+/* The worker is gone, or blocklisted for the job (the master stops
+ * granting to it while it stays connected): its leases become unknown (their results are stale)
  * and their tiles go back to the queue's front. Returns the number of
  * tiles requeued. */
 int scheduler_worker_remove(scheduler *self, int worker);
@@ -141,6 +153,13 @@ scheduler_verdict scheduler_complete(scheduler *self, int worker, uint64_t lease
 
 /* Resolves the lease with a failure. */
 scheduler_failure scheduler_fail(scheduler *self, int worker, uint64_t lease_id, bool retryable);
+
+/* The tiles one worker alone gave up on (SCHEDULER_AWAIT_OTHER): a tile
+ * that has had no active worker able to take it (one that has not failed
+ * it and holds no overdue lease) and no lease for join_window_ms fails the
+ * job now. Returns that tile (the job is failed), or -1. Call it from the
+ * timers. */
+int scheduler_check_given_up(scheduler *self, int64_t now_ms);
 
 /* A tile that is already in the output (a resumed render's journal):
  * DONE before any grant. False when the tile is out of range, DONE or

@@ -44,11 +44,10 @@ typedef struct shared {
     const job_scene *js;
     image_format fmt;
     image_writer *writer;
-    float *preview;                /* full image RGBA, when a preview is wanted */
     tile_runs runs;                /* which tiles each thread renders next */
     atomic_int next_thread;        /* hands out thread indexes */
     int ntiles;
-    pthread_mutex_t lock;          /* writer, preview, progress, error */
+    pthread_mutex_t lock;          /* writer, progress, error */
     int done;
     bool failed;
     char error[ERR_LEN];
@@ -73,13 +72,6 @@ static void progress(shared *s)
     fprintf(stderr, "\r  %d/%d tiles  %.1f s  ETA %.0f s   ", s->done, s->ntiles, el, eta);
     if (s->done == s->ntiles) fputc('\n', stderr);
     fflush(stderr);
-}
-
-static void copy_preview(shared *s, const image_tile *t)
-{
-    for (int y = 0; y < t->h; y++)
-        memcpy(&s->preview[(((size_t)(t->y0 + y)) * (size_t)s->fmt.width + (size_t)t->x0) * 4],
-               &t->rgba[(size_t)y * (size_t)t->w * 4], sizeof(float) * 4 * (size_t)t->w);
 }
 
 static void *render_thread(void *arg)
@@ -117,7 +109,6 @@ static void *render_thread(void *arg)
             if (!s->failed) snprintf(s->error, sizeof s->error, "%s", err);
             s->failed = true;
         } else {
-            if (s->preview) copy_preview(s, tile);
             s->done++;
             progress(s);
         }
@@ -200,9 +191,6 @@ static int render_frame(const standalone_options *opt, const job *jb, const fram
         job_scene_destroy(&js);
         return AAFARM_EXIT_FAILURE;
     }
-    if (fo->preview) {
-        s.preview = xcalloc((size_t)s.fmt.width * (size_t)s.fmt.height * 4, sizeof(float));
-    }
     s.ntiles = image_format_tile_count(&s.fmt);
     s.work = xcalloc((size_t)js->world.nobjects + 1, sizeof *s.work);
     pthread_mutex_init(&s.lock, NULL);
@@ -235,8 +223,10 @@ static int render_frame(const standalone_options *opt, const job *jb, const fram
         image_writer_destroy(&s.writer);
         rc = AAFARM_EXIT_FAILURE;
     }
+    /* the preview is read back from the finished EXR, as the farm's master
+     * makes it (one function, the same half samples: the same PNG bytes) */
     if (rc == AAFARM_EXIT_OK && fo->preview &&
-        !image_preview_write_png(fo->preview, s.preview, s.fmt.width, s.fmt.height, err, sizeof err)) {
+        !image_preview_write_png_exr(fo->preview, fo->output, err, sizeof err)) {
         fprintf(stderr, "aafarm-worker: %s\n", err);
         rc = AAFARM_EXIT_FAILURE;
     }
@@ -264,7 +254,6 @@ static int render_frame(const standalone_options *opt, const job *jb, const fram
         fprintf(stderr, "aafarm-worker: cannot write %s: %s\n", fo->stats_json, strerror(errno));
         if (rc == AAFARM_EXIT_OK) rc = AAFARM_EXIT_FAILURE;
     }
-    free(s.preview);
     free(s.work);
     tile_runs_clear(&s.runs);
     pthread_mutex_destroy(&s.lock);

@@ -156,3 +156,12 @@ bool image_preview_write_png_buffer(const char *path, const image_buffer *buf,
                         1, buf->width, buf->height};
     return write_preview(path, &src, err, errsz);
 }
+
+bool image_preview_write_png_exr(const char *png_path, const char *exr_path,
+                                 char *err, size_t errsz)
+{
+    image_buffer *buf = image_buffer_read_exr(exr_path, err, errsz);
+    bool ok = buf && image_preview_write_png_buffer(png_path, buf, err, errsz);
+    image_buffer_destroy(&buf);
+    return ok;
+}

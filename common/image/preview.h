@@ -36,4 +36,12 @@ bool image_preview_write_png(const char *path, const float *rgba, int width,
 bool image_preview_write_png_buffer(const char *path, const image_buffer *buf,
                                     char *err, size_t errsz);
 
+/* Writes the preview of a finished EXR file: its R, G and B as stored
+ * (half floats), read back. The farm's master and the standalone renderer
+ * both make their previews here, from the same samples, so the two PNGs
+ * are the same bytes (issue 27: a preview made from the renderer's floats
+ * differed by 1 LSB where rounding to half moved a value across a code). */
+bool image_preview_write_png_exr(const char *png_path, const char *exr_path,
+                                 char *err, size_t errsz);
+
 #endif

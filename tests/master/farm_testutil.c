@@ -399,3 +399,13 @@ int ft_standalone(const char *dir, int tile)
     pid_t pid = ft_spawn(ft_path(dir, "standalone.log"), argv);
     return ft_wait(pid, 120);
 }
+
+const char *ft_slow_worker(const char *dir, int delay_ms)
+{
+    const char *wrapper = ft_path(dir, "slow-worker.sh");
+    FILE *f = fopen(wrapper, "w");
+    if (!f) abort();
+    fprintf(f, "#!/bin/sh\nexec '%s' --tile-delay %d \"$@\"\n", ft_worker, delay_ms);
+    if (fclose(f) != 0 || chmod(wrapper, 0755) != 0) abort();
+    return wrapper;
+}

@@ -91,4 +91,9 @@ int ft_count_files(const char *dir, const char *prefix);
 
 void ft_sleep_ms(int ms);
 
+/* Writes dir/slow-worker.sh, which runs aafarm-worker with --tile-delay
+ * delay_ms and its own arguments (exec: the same pid), for a master's
+ * --worker-binary; returns its path (an ft_path buffer). */
+const char *ft_slow_worker(const char *dir, int delay_ms);
+
 #endif

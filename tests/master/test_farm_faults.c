@@ -354,12 +354,7 @@ static void test_farm_sigint_master_cleans_up(void **state)
 {
     (void)state;
     /* local workers slowed down through a wrapper the master starts */
-    const char *wrapper = ft_path(dir, "slow-worker.sh");
-    FILE *f = fopen(wrapper, "w");
-    assert_non_null(f);
-    fprintf(f, "#!/bin/sh\nexec '%s' --tile-delay 100 \"$@\"\n", ft_worker);
-    fclose(f);
-    chmod(wrapper, 0755);
+    const char *wrapper = ft_slow_worker(dir, 100);
     const char *log = ft_path(dir, "int.log"), *out = ft_path(dir, "int.exr");
     setenv("TMPDIR", dir, 1);
     const char *argv[] = {ft_master, ft_path(dir, "scene.rib"), "-o", out, "--tile", "8",

@@ -4,7 +4,10 @@
  *   - the local two-process test: one master, one worker, tcp://127.0.0.1;
  *   - three workers: one started before the master, one joining mid-render;
  *   - the embedded default (no --bind): local workers started and stopped
- *     by the master, preview and statistics written, nothing left behind.
+ *     by the master, preview and statistics written, nothing left behind;
+ *     the preview PNG is byte for byte the standalone renderer's;
+ *   - the master killed with SIGKILL mid-render: its local workers end at
+ *     once (issue 27; the test is their subreaper and reaps them by PID).
  * The reference is `aafarm-worker --standalone` of the same scene.
  */
 #include <setjmp.h>
@@ -18,6 +21,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/prctl.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include "farm_testutil.h"
 
@@ -143,6 +149,26 @@ static int local_pids(const char *log, pid_t *pids, int max)
     return n;
 }
 
+/* Bytes that differ between two files (the longer one's tail counts); -1
+ * when one cannot be read. */
+static long file_diff(const char *a, const char *b)
+{
+    FILE *fa = fopen(a, "rb"), *fb = fopen(b, "rb");
+    long diff = -1;
+    if (fa && fb) {
+        diff = 0;
+        int ca, cb;
+        do {
+            ca = fgetc(fa);
+            cb = fgetc(fb);
+            if (ca != cb) diff++;
+        } while (ca != EOF || cb != EOF);
+    }
+    if (fa) fclose(fa);
+    if (fb) fclose(fb);
+    return diff;
+}
+
 static void test_farm_embedded_default(void **state)
 {
     (void)state;
@@ -157,7 +183,7 @@ static void test_farm_embedded_default(void **state)
     unsetenv("TMPDIR");
     assert_int_equal(ft_wait(master, 120), 0);
     assert_int_equal(ft_exr_diff(ft_path(dir, "ref.exr"), ft_path(dir, "embedded.exr")), 0);
-    /* the preview is a PNG */
+    /* the preview is a PNG (byte for byte the standalone one's: below) */
     char *head = ft_read(png);
     assert_memory_equal(head, "\x89PNG", 4);
     free(head);
@@ -175,6 +201,73 @@ static void test_farm_embedded_default(void **state)
     }
     assert_int_equal(ft_count_files(dir, "aafarm-"), 0);
     assert_int_equal(ft_count_files(dir, "embedded.exr.tmp"), 0);
+    /* the preview is byte for byte the standalone renderer's (issue 27:
+     * both are made from the finished EXR by one function); last, as
+     * ft_path's buffers above are reused by now */
+    char sa_png[4096], farm_png[4096];   /* ft_path's buffers are reused */
+    snprintf(sa_png, sizeof sa_png, "%s", ft_path(dir, "standalone.png"));
+    snprintf(farm_png, sizeof farm_png, "%s", ft_path(dir, "embedded.png"));
+    const char *sargv[] = {ft_worker, "--standalone", ft_path(dir, "scene.rib"), "-o",
+                           ft_path(dir, "sa.exr"), "--tile", "8", "--threads", "2", "-q",
+                           "--preview", sa_png, NULL};
+    assert_int_equal(ft_wait(ft_spawn(ft_path(dir, "sa.log"), sargv), 120), 0);
+    assert_int_equal(file_diff(sa_png, farm_png), 0);
+}
+
+/* Issue 27: local workers end at once when their master dies (SIGKILL: it
+ * cannot stop them itself), even in the middle of a tile. The test becomes
+ * the orphans' subreaper, so it reaps them by PID; "at once" is bounded
+ * generously (2 s, less than what is left of the tile they are in) and the
+ * time measured is printed. */
+static void test_local_workers_end_with_their_master(void **state)
+{
+    (void)state;
+    assert_int_equal(prctl(PR_SET_CHILD_SUBREAPER, 1, 0, 0, 0), 0);
+    /* each tile starts with 3 s the worker cannot be interrupted in (as a
+     * long shader evaluation): an orderly exit on SIGTERM would wait it out */
+    const char *wrapper = ft_slow_worker(dir, 3000);
+    const char *log = ft_path(dir, "orphans.log");
+    setenv("TMPDIR", dir, 1);
+    const char *argv[] = {ft_master, ft_path(dir, "scene.rib"), "-o", ft_path(dir, "orphans.exr"),
+                          "--tile", "8", "--local-workers", "2", "--threads-per-worker", "2",
+                          "--worker-binary", wrapper, "-v", NULL};
+    pid_t master = ft_spawn(log, argv);
+    unsetenv("TMPDIR");
+    assert_true(ft_wait_for(log, "granted tile ", 4, 60));
+    ft_sleep_ms(300);   /* both are inside their first tiles now */
+    pid_t pids[2];
+    assert_int_equal(local_pids(log, pids, 2), 2);
+    double t0 = ft_now();
+    kill(master, SIGKILL);
+    assert_int_equal(ft_wait(master, 10), 128 + SIGKILL);
+    bool gone[2] = {false, false};
+    double took[2] = {-1, -1};
+    while (ft_now() - t0 < 2.0 && !(gone[0] && gone[1])) {
+        for (int i = 0; i < 2; i++) {
+            if (gone[i]) continue;
+            pid_t r = waitpid(pids[i], NULL, WNOHANG);
+            if (r == pids[i] || (r < 0 && errno == ECHILD && kill(pids[i], 0) != 0)) {
+                gone[i] = true;
+                took[i] = ft_now() - t0;
+            }
+        }
+        ft_sleep_ms(1);
+    }
+    for (int i = 0; i < 2; i++) {
+        if (!gone[i]) {   /* bounded: never leave one behind */
+            kill(pids[i], SIGKILL);
+            waitpid(pids[i], NULL, 0);
+        }
+        if (gone[i])
+            fprintf(stderr, "local worker %d (pid %d) ended %.0f ms after its master's "
+                    "SIGKILL\n", i + 1, (int)pids[i], took[i] * 1000.0);
+        else
+            fprintf(stderr, "local worker %d (pid %d) still ran 2 s after its master's "
+                    "SIGKILL\n", i + 1, (int)pids[i]);
+    }
+    assert_true(gone[0] && gone[1]);
+    prctl(PR_SET_CHILD_SUBREAPER, 0, 0, 0, 0);
+    /* the next master cleans what this one left (its private folder) */
 }
 
 int main(int argc, char **argv)
@@ -184,6 +277,7 @@ int main(int argc, char **argv)
         cmocka_unit_test_teardown(test_farm_two_processes_equal_standalone, teardown),
         cmocka_unit_test_teardown(test_farm_three_workers_early_and_late, teardown),
         cmocka_unit_test_teardown(test_farm_embedded_default, teardown),
+        cmocka_unit_test_teardown(test_local_workers_end_with_their_master, teardown),
     };
     return cmocka_run_group_tests(tests, group_setup, group_teardown);
 }

@@ -242,6 +242,126 @@ static void test_not_retryable_needs_a_second_worker(void **state)
     scheduler_destroy(&s);
 }
 
+/* Issue 27: while another worker can join (join_window_ms > 0), a tile that
+ * one worker alone failed max_attempts times does not end the job: that
+ * worker never gets it again, the tile waits for another one, and fails
+ * the job only after the window with no one able to take it, or when a
+ * second worker agrees. */
+static void test_one_worker_alone_waits_for_another(void **state)
+{
+    (void)state;
+    scheduler_options o;
+    scheduler_options_default(&o);
+    o.max_attempts = 3;
+    o.max_duplicates = 0;
+    o.lease_ms = 100000;
+    o.join_window_ms = 5000;
+    scheduler *s = scheduler_new(2, 1, &o);
+    int a = scheduler_worker_add(s);
+    uint64_t id;
+    for (int i = 0; i < 2; i++) {
+        assert_int_equal(grant_tile(s, a, 0, &id), 0);
+        assert_int_equal(scheduler_fail(s, a, id, i == 0), SCHEDULER_RETRY);
+    }
+    assert_int_equal(grant_tile(s, a, 0, &id), 0);
+    assert_int_equal(scheduler_fail(s, a, id, false), SCHEDULER_AWAIT_OTHER);
+    assert_false(scheduler_failed(s));
+    /* a never gets tile 0 again; it may render the other tile */
+    assert_int_equal(grant_tile(s, a, 0, &id), 1);
+    assert_int_equal(scheduler_complete(s, a, id, 10), SCHEDULER_TAKEN);
+    assert_int_equal(grant_tile(s, a, 20, NULL), -1);
+    /* the window runs from the first check with no one to take it */
+    assert_int_equal(scheduler_check_given_up(s, 1000), -1);
+    assert_int_equal(scheduler_check_given_up(s, 5999), -1);
+    /* b joins in time: it gets the tile, the clock stops, it delivers */
+    int b = scheduler_worker_add(s);
+    assert_int_equal(scheduler_check_given_up(s, 6000), -1);
+    assert_int_equal(grant_tile(s, b, 6001, &id), 0);
+    assert_int_equal(scheduler_check_given_up(s, 60000), -1);
+    assert_int_equal(scheduler_complete(s, b, id, 60001), SCHEDULER_TAKEN);
+    assert_true(scheduler_finished(s));
+    assert_false(scheduler_failed(s));
+    scheduler_destroy(&s);
+
+    /* nobody comes: the job fails once the window has passed */
+    s = scheduler_new(1, 1, &o);
+    a = scheduler_worker_add(s);
+    for (int i = 0; i < 3; i++) {
+        assert_int_equal(grant_tile(s, a, 0, &id), 0);
+        assert_int_equal(scheduler_fail(s, a, id, true), i < 2 ? SCHEDULER_RETRY
+                                                               : SCHEDULER_AWAIT_OTHER);
+    }
+    assert_int_equal(scheduler_check_given_up(s, 100), -1);
+    assert_int_equal(scheduler_check_given_up(s, 5099), -1);
+    assert_false(scheduler_failed(s));
+    assert_int_equal(scheduler_check_given_up(s, 5100), 0);
+    assert_true(scheduler_failed(s));
+    scheduler_destroy(&s);
+
+    /* a second worker that fails it too agrees: the job fails at once */
+    s = scheduler_new(1, 1, &o);
+    a = scheduler_worker_add(s);
+    for (int i = 0; i < 3; i++) {
+        assert_int_equal(grant_tile(s, a, 0, &id), 0);
+        scheduler_fail(s, a, id, true);
+    }
+    b = scheduler_worker_add(s);
+    assert_int_equal(grant_tile(s, b, 0, &id), 0);
+    assert_int_equal(scheduler_fail(s, b, id, true), SCHEDULER_JOB_FAILED);
+    scheduler_destroy(&s);
+
+    /* one that cannot be granted it (an overdue lease: a hoarder) does not
+     * stop the clock */
+    s = scheduler_new(2, 1, &o);
+    a = scheduler_worker_add(s);
+    b = scheduler_worker_add(s);
+    assert_int_equal(grant_tile(s, b, 0, NULL), 0);
+    assert_int_equal(scheduler_expire(s, 200000), 1);   /* b's lease is overdue */
+    assert_true(scheduler_worker_overdue(s, b));
+    assert_int_equal(grant_tile(s, a, 200000, &id), 0);
+    assert_int_equal(scheduler_complete(s, a, id, 200000), SCHEDULER_TAKEN);
+    for (int i = 0; i < 3; i++) {   /* b cannot take it: back to a */
+        assert_int_equal(grant_tile(s, a, 200000, &id), 1);
+        assert_int_equal(scheduler_fail(s, a, id, true), SCHEDULER_RETRY);
+    }
+    assert_int_equal(grant_tile(s, a, 200000, NULL), -1);   /* given up */
+    assert_int_equal(scheduler_check_given_up(s, 200000), -1);
+    assert_int_equal(scheduler_check_given_up(s, 205000), 1);
+    scheduler_destroy(&s);
+}
+
+/* Without a window (no other worker can join: embedded mode), a tile every
+ * worker there is gave up on fails the job at once, also when the worker
+ * that could have tried it left. */
+static void test_no_window_fails_when_no_one_is_left(void **state)
+{
+    (void)state;
+    /* a gives tile 0 up while b could take it: retried; b leaves before it
+     * does: the job fails at the next check */
+    scheduler *s = make(1, 1, 1, 0, 100000);
+    int a = scheduler_worker_add(s), b = scheduler_worker_add(s);
+    uint64_t id;
+    assert_int_equal(grant_tile(s, a, 0, &id), 0);
+    assert_int_equal(scheduler_fail(s, a, id, true), SCHEDULER_RETRY);
+    assert_int_equal(grant_tile(s, a, 0, NULL), -1);   /* never back to a */
+    assert_int_equal(scheduler_check_given_up(s, 1), -1);
+    scheduler_worker_remove(s, b);
+    assert_false(scheduler_failed(s));
+    assert_int_equal(scheduler_check_given_up(s, 2), 0);
+    assert_true(scheduler_failed(s));
+    scheduler_destroy(&s);
+    /* the only worker left exhausts the attempts: it fails at once */
+    s = make(1, 1, 2, 0, 100000);
+    a = scheduler_worker_add(s);
+    b = scheduler_worker_add(s);
+    assert_int_equal(grant_tile(s, a, 0, &id), 0);
+    assert_int_equal(scheduler_fail(s, a, id, true), SCHEDULER_RETRY);
+    scheduler_worker_remove(s, b);
+    assert_int_equal(grant_tile(s, a, 0, &id), 0);
+    assert_int_equal(scheduler_fail(s, a, id, true), SCHEDULER_JOB_FAILED);
+    scheduler_destroy(&s);
+}
+
 /* A lease lasts lease_factor x the measured grant-to-result time (the
  * worker's own once known), at least lease_min_ms: a worker that takes a
  * tile and never returns it loses it soon after the others' speed is
@@ -457,6 +577,8 @@ int main(void)
         cmocka_unit_test(test_lease_deadline_follows_measured_rate),
         cmocka_unit_test(test_waiting_for_files_keeps_leases),
         cmocka_unit_test(test_only_worker_gets_its_failed_tile_back),
+        cmocka_unit_test(test_one_worker_alone_waits_for_another),
+        cmocka_unit_test(test_no_window_fails_when_no_one_is_left),
         cmocka_unit_test(test_stale_results),
         cmocka_unit_test(test_resumed_tiles_never_granted),
         cmocka_unit_test(test_random_farm_takes_every_tile_once),
