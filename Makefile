@@ -24,7 +24,11 @@ build: deps
 	@cmake -S . -B build -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
 	@cmake --build build -j $(JOBS)
 
-demo: build
+# the demo builds only the two programs it runs (not the tests, fuzzers and
+# benchmarks that `make build` adds)
+demo: deps
+	@cmake -S . -B build -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
+	@cmake --build build -j $(JOBS) --target aafarm-master aafarm-worker
 	@bash deploy/demo.sh build
 
 test: deps

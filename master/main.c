@@ -17,6 +17,7 @@
 #include "farm.h"
 #include "job/frames.h"
 #include "message.h"
+#include "util/cli.h"
 #include "util/err.h"
 #include "util/exitcodes.h"
 #include "util/parse_num.h"
@@ -127,11 +128,13 @@ static int parse(int argc, char **argv, cli *c)
         {"quiet", no_argument, 0, 'q'},
         {"verbose", no_argument, 0, 'v'},
         {"help", no_argument, 0, 'h'},
+        {"version", no_argument, 0, 'V'},
         {0, 0, 0, 0}};
     farm_options *f = &c->farm;
     int ch;
     long n;
-    while ((ch = getopt_long(argc, argv, "o:qvh", longopts, NULL)) != -1) {
+    opterr = 0;
+    while ((ch = getopt_long(argc, argv, ":o:qvh", longopts, NULL)) != -1) {
         switch (ch) {
         case 'o': f->output = optarg; break;
         case O_BIND: f->bind = optarg; break;
@@ -208,7 +211,13 @@ static int parse(int argc, char **argv, cli *c)
         case 'q': f->verbosity = -1; break;
         case 'v': f->verbosity = 1; break;
         case 'h': usage(stdout); return AAFARM_EXIT_OK;
-        default: usage(stderr); return AAFARM_EXIT_USAGE;
+        case 'V': printf("aafarm-master %s\n", cli_version()); return AAFARM_EXIT_OK;
+        default: {
+            char line[512];
+            cli_option_problem(ch, optind, optopt, argv, line, sizeof line);
+            fprintf(stderr, "aafarm-master: %s\n", line);
+            return AAFARM_EXIT_USAGE;
+        }
         }
     }
     if (optind < argc) f->scene_path = argv[optind++];

@@ -10,6 +10,7 @@
 #include <zmq.h>
 
 #include "curve_cert.h"
+#include "util/cli.h"
 #include "util/err.h"
 #include "util/exitcodes.h"
 
@@ -33,6 +34,14 @@ int main(int argc, char **argv)
     if (argc == 2 && (strcmp(argv[1], "-h") == 0 || strcmp(argv[1], "--help") == 0)) {
         usage(stdout);
         return AAFARM_EXIT_OK;
+    }
+    if (argc == 2 && strcmp(argv[1], "--version") == 0) {
+        printf("aafarm-keygen %s\n", cli_version());
+        return AAFARM_EXIT_OK;
+    }
+    if (argc >= 2 && argv[1][0] == '-' && argv[1][1]) {
+        fprintf(stderr, "aafarm-keygen: unknown option '%s' (see --help)\n", argv[1]);
+        return AAFARM_EXIT_USAGE;
     }
     if (argc != 2 || !argv[1][0] || argv[1][0] == '-') {
         usage(stderr);

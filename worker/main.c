@@ -12,6 +12,7 @@
 #include "job/frames.h"
 #include "tex/tex.h"
 #include "standalone.h"
+#include "util/cli.h"
 #include "util/err.h"
 #include "util/exitcodes.h"
 #include "util/parse_num.h"
@@ -140,10 +141,12 @@ int main(int argc, char **argv)
         {"quiet", no_argument, 0, 'q'},
         {"verbose", no_argument, 0, 'v'},
         {"help", no_argument, 0, 'h'},
+        {"version", no_argument, 0, 'V'},
         {0, 0, 0, 0}};
     int c;
     long n;
-    while ((c = getopt_long(argc, argv, "o:t:qvh", longopts, NULL)) != -1) {
+    opterr = 0;
+    while ((c = getopt_long(argc, argv, ":o:t:qvh", longopts, NULL)) != -1) {
         switch (c) {
         case O_STANDALONE: so.scene_path = optarg; break;
         case 'o': so.output = optarg; break;
@@ -241,7 +244,13 @@ int main(int argc, char **argv)
         case 'q': so.verbosity = wo.verbosity = -1; break;
         case 'v': so.verbosity = wo.verbosity = 1; break;
         case 'h': usage(stdout); return AAFARM_EXIT_OK;
-        default: usage(stderr); return AAFARM_EXIT_USAGE;
+        case 'V': printf("aafarm-worker %s\n", cli_version()); return AAFARM_EXIT_OK;
+        default: {
+            char line[512];
+            cli_option_problem(c, optind, optopt, argv, line, sizeof line);
+            fprintf(stderr, "aafarm-worker: %s\n", line);
+            return AAFARM_EXIT_USAGE;
+        }
         }
     }
     if (optind < argc) {

@@ -16,6 +16,7 @@
 #include "sl/diag.h"
 #include "sl/shader.h"
 #include "sl/source.h"
+#include "util/cli.h"
 #include "util/xalloc.h"
 
 static void usage(FILE *out)
@@ -69,13 +70,17 @@ int main(int argc, char **argv)
             free(search);
             free(files);
             return 0;
+        } else if (strcmp(argv[i], "--version") == 0) {
+            printf("aafarm-slc %s\n", cli_version());
+            free(search);
+            free(files);
+            return 0;
         } else if (strcmp(argv[i], "-I") == 0 && i + 1 < argc) {
             search[nsearch++] = argv[++i];
         } else if (strncmp(argv[i], "-I", 2) == 0 && argv[i][2]) {
             search[nsearch++] = argv[i] + 2;
         } else if (argv[i][0] == '-' && argv[i][1]) {
-            fprintf(stderr, "aafarm-slc: unknown option '%s'\n", argv[i]);
-            usage(stderr);
+            fprintf(stderr, "aafarm-slc: unknown option '%s' (see --help)\n", argv[i]);
             free(search);
             free(files);
             return 2;

@@ -16,6 +16,7 @@
 
 #include "sl/noise.h"
 #include "tex/tex.h"
+#include "util/cli.h"
 #include "util/err.h"
 #include "util/parse_num.h"
 #include "util/xalloc.h"
@@ -68,6 +69,9 @@ int main(int argc, char **argv)
         const char *a = argv[i];
         if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
             usage(stdout);
+            return 0;
+        } else if (strcmp(a, "--version") == 0) {
+            printf("aafarm-maketx %s\n", cli_version());
             return 0;
         } else if (strcmp(a, "--no-minmax") == 0) {
             minmax = false;
