@@ -105,6 +105,13 @@ static bool have(const char *tool)
     return sh("which.log", "%s", cmd) == 0;
 }
 
+/* Waits up to 5 s for process pid to be gone; fails if it is not. */
+static void assert_gone(long pid)
+{
+    for (int i = 0; i < 100 && kill((pid_t)pid, 0) == 0; i++) ft_sleep_ms(50);
+    assert_int_equal(kill((pid_t)pid, 0), -1);
+}
+
 static void test_ssh_farm_renders_and_stops_its_workers(void **state)
 {
     (void)state;
@@ -136,8 +143,7 @@ static void test_ssh_farm_renders_and_stops_its_workers(void **state)
         assert_non_null(at);
         long pid = atol(at + strlen(needle));
         assert_true(pid > 1);
-        for (int i = 0; i < 100 && kill((pid_t)pid, 0) == 0; i++) ft_sleep_ms(50);
-        assert_int_equal(kill((pid_t)pid, 0), -1);
+        assert_gone(pid);
     }
     free(text);
     struct stat st;
@@ -197,8 +203,7 @@ static void test_ssh_farm_ctrl_c_stops_everything(void **state)
     long pid = at ? atol(at + strlen("hostC: stopped worker ")) : 0;
     free(text);
     assert_true(pid > 1);
-    for (int i = 0; i < 100 && kill((pid_t)pid, 0) == 0; i++) ft_sleep_ms(50);
-    assert_int_equal(kill((pid_t)pid, 0), -1);
+    assert_gone(pid);
 }
 
 /* ---- a real OpenSSH server on loopback ---- */
@@ -355,10 +360,20 @@ static int teardown_sshd(void **state)
     return 0;
 }
 
-#define REAL_SSH_ENV                                                                     \
-    "cd %s && AAFARM_BIN=%s AAFARM_KEYS=%s/keys3 AAFARM_RUN=%s/run3 AAFARM_PORT=%d "      \
-    "AAFARM_BIND_HOST=127.0.0.1 SSH=\"ssh -F %s/sshd/ssh_config\" "                       \
-    "SCP=\"scp -q -F %s/sshd/ssh_config\" "
+/* Runs farm.sh over the real sshd (hosts file hosts3, the wave scene into
+ * OUT); output in dir/LOG; its exit status. */
+static int real_farm(const char *log, const char *remote_bin, const char *master_host,
+                     const char *worker_opts, const char *out)
+{
+    return sh(log,
+              "cd %s && AAFARM_BIN=%s AAFARM_KEYS=%s/keys3 AAFARM_RUN=%s/run3 AAFARM_PORT=%d "
+              "AAFARM_BIND_HOST=127.0.0.1 SSH=\"ssh -F %s/sshd/ssh_config\" "
+              "SCP=\"scp -q -F %s/sshd/ssh_config\" AAFARM_REMOTE_BIN=%s "
+              "AAFARM_WORKER_OPTS=\"%s\" %s/deploy/ssh/farm.sh --master-host %s hosts3 "
+              "scene.rib -o %s --tile 16",
+              dir, bindir, dir, dir, ft_free_port(), dir, dir, remote_bin, worker_opts, src,
+              master_host, out);
+}
 
 static void test_ssh_farm_over_a_real_sshd(void **state)
 {
@@ -372,11 +387,8 @@ static void test_ssh_farm_over_a_real_sshd(void **state)
     assert_non_null(fp);
     fputs("realA 1\nrealB\n", fp);
     fclose(fp);
-    int rc = sh("real.log",
-                REAL_SSH_ENV "AAFARM_REMOTE_BIN=%s AAFARM_WORKER_OPTS=\"--tile-delay 150\" "
-                "%s/deploy/ssh/farm.sh --master-host 127.0.0.1 hosts3 scene.rib -o real.exr "
-                "--tile 16",
-                dir, bindir, dir, dir, ft_free_port(), dir, dir, bindir, src);
+    /* --tile-delay: both workers join before the end */
+    int rc = real_farm("real.log", bindir, "127.0.0.1", "--tile-delay 150", "real.exr");
     const char *log = ft_path(dir, "real.log");
     if (rc != 0) fprintf(stderr, "%s\n", ft_read(log));
     assert_int_equal(rc, 0);
@@ -391,19 +403,15 @@ static void test_ssh_farm_over_a_real_sshd(void **state)
         long pid = number_after(log, started);
         assert_true(pid > 1);
         assert_int_equal(number_after(log, stopped), pid);   /* the PID it started */
-        for (int i = 0; i < 100 && kill((pid_t)pid, 0) == 0; i++) ft_sleep_ms(50);
-        assert_int_equal(kill((pid_t)pid, 0), -1);
-        assert_int_equal(workers_named(hosts[h], false), 0);        /* nothing left behind */
+        assert_gone(pid);
+        assert_int_equal(workers_named(hosts[h], false), 0);   /* nothing left behind */
     }
     struct stat st;
     assert_int_equal(stat(ft_path(dir, "run3/realA/keys"), &st), -1);
     assert_int_equal(stat(ft_path(dir, "run3/realB/worker.pid"), &st), -1);
 
     /* aafarm-worker missing on the hosts: named, nothing renders */
-    rc = sh("missing.log",
-            REAL_SSH_ENV "AAFARM_REMOTE_BIN=%s/nowhere %s/deploy/ssh/farm.sh "
-            "--master-host 127.0.0.1 hosts3 scene.rib -o missing.exr",
-            dir, bindir, dir, dir, ft_free_port(), dir, dir, dir, src);
+    rc = real_farm("missing.log", ft_path(dir, "nowhere"), "127.0.0.1", "", "missing.exr");
     const char *mlog = ft_path(dir, "missing.log");
     assert_int_equal(rc, 1);
     char needle[512];
@@ -416,10 +424,7 @@ static void test_ssh_farm_over_a_real_sshd(void **state)
     assert_int_equal(stat(ft_path(dir, "missing.exr"), &st), -1);
 
     /* a master host the hosts cannot resolve: named before anything starts */
-    rc = sh("unresolved.log",
-            REAL_SSH_ENV "AAFARM_REMOTE_BIN=%s %s/deploy/ssh/farm.sh "
-            "--master-host no-such-host.invalid hosts3 scene.rib -o unresolved.exr",
-            dir, bindir, dir, dir, ft_free_port(), dir, dir, bindir, src);
+    rc = real_farm("unresolved.log", bindir, "no-such-host.invalid", "", "unresolved.exr");
     assert_int_equal(rc, 1);
     assert_int_equal(ft_count(ft_path(dir, "unresolved.log"),
                               "farm.sh: realA: cannot resolve the master host "
