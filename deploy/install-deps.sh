@@ -24,6 +24,7 @@ PACKAGES=(
   protobuf-c-compiler libprotobuf-c-dev  # wire protocol schema
   libsodium-dev     # CurveZMQ: Debian's libzmq5 has CURVE through libsodium
   iproute2          # the multi-host test's network namespaces (ip netns)
+  openssh-client openssh-server  # deploy/ssh/farm.sh over a real sshd (test_deploy)
   shellcheck        # lints deploy/'s scripts (test_deploy)
   python3-yaml      # checks deploy/'s compose and Kubernetes files (test_deploy)
   clang             # builds the fuzz targets (tests/fuzz, test fuzz_brief)

@@ -13,6 +13,7 @@
 
 #include "job/job_scene.h"
 #include "scene/scene.h"
+#include "sl/standard.h"
 
 void job_options_default(job_options *opt)
 {
@@ -304,6 +305,18 @@ job *job_load(const char *rib_path, const job_options *options, sl_diag *diag)
     for (int i = 0; i < sc->nshader_names; i++) {
         const char *name = sc->shader_names[i];
         char *path = scene_find_shader(sc, name, NULL, NULL);
+        const sl_standard_shader *std = path ? NULL : sl_standard_find(name);
+        if (std) {
+            /* after the search path: the built-in text, shipped like a file */
+            char file[64 + sizeof SL_STANDARD_DIR];
+            snprintf(file, sizeof file, "%s/%s.sl", SL_STANDARD_DIR, std->name);
+            if (!job_add_source(self, file, std->text, std->len, err, sizeof err) ||
+                !job_add_shader(self, name, file, err, sizeof err)) {
+                sl_diag_error(diag, (sl_pos){0}, "%s", err);
+                ok = false;
+            }
+            continue;
+        }
         if (!path) {
             /* point at the first call that names it */
             sl_pos pos = {0};

@@ -5,7 +5,8 @@
  * hash, so a worker that holds a job is not sent it again.
  *
  *   job_load       the master / standalone side: read a RIB file, find its
- *                  shaders on the scene's search path, load them, check
+ *                  shaders on the scene's search path (then among the built-in
+ *                  standard shaders, sl/standard.h), load them, check
  *                  everything compiles (fail fast, file:line:col), hash
  *   job_new + job_add_*   the worker side: rebuild the job from the
  *                  message fields, then job_finish computes the hash

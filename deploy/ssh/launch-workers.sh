@@ -7,10 +7,13 @@
 #
 # ENDPOINT is what the workers connect to, e.g. tcp://render-master:5555
 # (start the master with --bind tcp://*:5555). Each worker runs in the
-# background with nohup, uses all cores of its host, and is named after the
-# host; its pid goes to $AAFARM_RUN/aafarm-worker.pid on that host, its log
-# to $AAFARM_RUN/aafarm-worker.log. --stop sends it SIGTERM by that pid (it
-# says goodbye to the master, which requeues its tiles at once).
+# background with nohup (alone, so ssh returns at once: deploy/ssh/remote.sh),
+# uses all cores of its host, and is named after the host; its own pid goes
+# to $AAFARM_RUN/aafarm-worker.pid on that host, its log to
+# $AAFARM_RUN/aafarm-worker.log, and it is checked to be running a second
+# later (a host where it is missing or exits at once is named, exit 1).
+# --stop sends it SIGTERM by that pid (it says goodbye to the master, which
+# requeues its tiles at once), SIGKILL if it still runs 5 s later.
 #
 # Environment: AAFARM_WORKER  aafarm-worker on the hosts (default: on PATH)
 #              AAFARM_RUN     folder for pid and log files (default /tmp)
@@ -24,28 +27,36 @@ usage() {
   sed -n '5,6p' "$0" | sed 's/^# *//' >&2
   exit 2
 }
-q() { printf '%q' "$1"; }   # quote one word for the remote shell
+# shellcheck source=deploy/ssh/remote.sh
+. "$(dirname "$0")/remote.sh"   # q, remote_start, remote_stop
 
 stop_hosts() {
+  local host out
   for host in "$@"; do
-    $ssh_cmd "$host" "pid=\$(cat $(q "$run")/aafarm-worker.pid 2>/dev/null) &&
-      kill -TERM \"\$pid\" 2>/dev/null && rm -f $(q "$run")/aafarm-worker.pid && echo \"$host: stopped worker \$pid\" ||
-      echo \"$host: no worker running\"" || echo "$host: ssh failed" >&2
+    if out=$($ssh_cmd "$host" "$(remote_stop "$run/aafarm-worker.pid")" </dev/null); then
+      echo "$host: $out"
+    else
+      echo "launch-workers.sh: $host: ssh failed" >&2
+    fi
   done
 }
 
 start_hosts() {
   local endpoint=$1; shift
-  local hosts=() opts=""
+  local hosts=() host out rc=0
   while [ $# -gt 0 ] && [ "$1" != "--" ]; do hosts+=("$1"); shift; done
   [ $# -gt 0 ] && shift
-  for o in "$@"; do opts+=" $(q "$o")"; done
   [ ${#hosts[@]} -gt 0 ] || usage
   for host in "${hosts[@]}"; do
-    $ssh_cmd "$host" "nohup $(q "$worker") --connect $(q "$endpoint") --name $(q "$host")$opts \
-      >>$(q "$run")/aafarm-worker.log 2>&1 </dev/null & echo \$! >$(q "$run")/aafarm-worker.pid;
-      echo \"$host: worker \$(cat $(q "$run")/aafarm-worker.pid)\"" || echo "$host: ssh failed" >&2
+    if out=$($ssh_cmd "$host" "$(remote_start "$run/aafarm-worker.pid" "$run/aafarm-worker.log" \
+        "$worker" --connect "$endpoint" --name "$host" "$@")" </dev/null); then
+      echo "$host: worker ${out#pid }"
+    else
+      echo "launch-workers.sh: $host: ${out:-ssh failed}" >&2
+      rc=1
+    fi
   done
+  return "$rc"
 }
 
 [ $# -ge 2 ] || usage

@@ -7,6 +7,18 @@
  *     --standalone; every worker it started is stopped, the copied secret
  *     keys removed; Ctrl-C mid-render stops the master and every worker,
  *     exit 130, no image;
+ *   - the same over a REAL OpenSSH server the test starts: /usr/sbin/sshd
+ *     -D on 127.0.0.1:PORT with its own host key, client key and
+ *     authorized_keys in the test's folder (ssh -F a config of its own:
+ *     two host aliases for 127.0.0.1, StrictHostKeyChecking no, known_hosts
+ *     in the folder), bounded by timeout -k and stopped by PID: farm.sh
+ *     --master-host 127.0.0.1 renders an image equal to --standalone (so ssh
+ *     returned while its worker ran), stops the very PIDs it started, and no
+ *     aafarm-worker of those hosts is left (/proc scanned); an aafarm-worker
+ *     missing on the hosts and a master host they cannot resolve are errors
+ *     naming the host (exit 1, no master started, keys removed). Skipped with
+ *     a one-line reason where sshd cannot run (not installed; not root and
+ *     no /run/sshd);
  *   - deploy/slurm/aafarm.sbatch renders for real with stand-in srun and
  *     scontrol (two tasks for two nodes); equal image, the job's keys removed;
  *   - deploy/systemd: install.sh into a scratch root, and
@@ -28,6 +40,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <dirent.h>
+#include <pwd.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -91,6 +105,13 @@ static bool have(const char *tool)
     return sh("which.log", "%s", cmd) == 0;
 }
 
+/* Waits up to 5 s for process pid to be gone; fails if it is not. */
+static void assert_gone(long pid)
+{
+    for (int i = 0; i < 100 && kill((pid_t)pid, 0) == 0; i++) ft_sleep_ms(50);
+    assert_int_equal(kill((pid_t)pid, 0), -1);
+}
+
 static void test_ssh_farm_renders_and_stops_its_workers(void **state)
 {
     (void)state;
@@ -122,8 +143,7 @@ static void test_ssh_farm_renders_and_stops_its_workers(void **state)
         assert_non_null(at);
         long pid = atol(at + strlen(needle));
         assert_true(pid > 1);
-        for (int i = 0; i < 100 && kill((pid_t)pid, 0) == 0; i++) ft_sleep_ms(50);
-        assert_int_equal(kill((pid_t)pid, 0), -1);
+        assert_gone(pid);
     }
     free(text);
     struct stat st;
@@ -183,8 +203,233 @@ static void test_ssh_farm_ctrl_c_stops_everything(void **state)
     long pid = at ? atol(at + strlen("hostC: stopped worker ")) : 0;
     free(text);
     assert_true(pid > 1);
-    for (int i = 0; i < 100 && kill((pid_t)pid, 0) == 0; i++) ft_sleep_ms(50);
-    assert_int_equal(kill((pid_t)pid, 0), -1);
+    assert_gone(pid);
+}
+
+/* ---- a real OpenSSH server on loopback ---- */
+
+static pid_t sshd_pid;            /* timeout -k ... sshd -D: stopped by SIGTERM */
+static bool made_privsep_dir;     /* /run/sshd made here (removed again) */
+static int sshd_port;
+
+static void stop_sshd(void)
+{
+    if (sshd_pid > 0) {
+        kill(sshd_pid, SIGTERM);   /* timeout passes it on to sshd */
+        if (ft_wait(sshd_pid, 10) == -1) kill(sshd_pid, SIGKILL);
+        sshd_pid = 0;
+    }
+    char *text = ft_read(ft_path(dir, "sshd/sshd.pid"));
+    long pid = atol(text);
+    free(text);
+    if (pid > 1 && kill((pid_t)pid, 0) == 0) kill((pid_t)pid, SIGKILL);
+    if (made_privsep_dir) rmdir("/run/sshd");
+    made_privsep_dir = false;
+}
+
+/* Starts sshd; false with a one-line reason where it cannot run here. */
+static bool start_sshd(char *why, size_t whysz)
+{
+    if (access("/usr/sbin/sshd", X_OK) != 0 || !have("ssh-keygen") || !have("ssh") ||
+        !have("scp")) {
+        snprintf(why, whysz, "no /usr/sbin/sshd, ssh, scp or ssh-keygen (Debian packages "
+                 "openssh-server, openssh-client: deploy/install-deps.sh)");
+        return false;
+    }
+    struct stat st;
+    if (stat("/run/sshd", &st) != 0) {   /* sshd's privilege separation directory */
+        if (geteuid() != 0) {
+            snprintf(why, whysz, "not root and no /run/sshd (sshd's privilege separation "
+                     "directory) to run sshd with");
+            return false;
+        }
+        assert_int_equal(mkdir("/run/sshd", 0755), 0);
+        made_privsep_dir = true;
+    }
+    const char *d = ft_path(dir, "sshd");
+    char sd[1024];
+    snprintf(sd, sizeof sd, "%s", d);
+    assert_int_equal(mkdir(sd, 0700), 0);
+    assert_int_equal(sh("keys.log", "cd %s && ssh-keygen -q -t ed25519 -N \"\" -f host_key && "
+                        "ssh-keygen -q -t ed25519 -N \"\" -f id && cp id.pub authorized_keys",
+                        sd), 0);
+    sshd_port = ft_free_port();
+    char text[16384];
+    snprintf(text, sizeof text,
+             "ListenAddress 127.0.0.1:%d\nHostKey %s/host_key\n"
+             "AuthorizedKeysFile %s/authorized_keys\nPidFile %s/sshd.pid\n"
+             "UsePAM no\nStrictModes no\nPasswordAuthentication no\n"
+             "KbdInteractiveAuthentication no\nPubkeyAuthentication yes\n"
+             "PermitRootLogin prohibit-password\nSubsystem sftp internal-sftp\n"
+             "LogLevel VERBOSE\n", sshd_port, sd, sd, sd);
+    FILE *f = fopen(ft_path(sd, "sshd_config"), "w");
+    assert_non_null(f);
+    fputs(text, f);
+    fclose(f);
+    /* the client side: two host names for this sshd */
+    struct passwd *pw = getpwuid(geteuid());
+    assert_non_null(pw);
+    snprintf(text, sizeof text,
+             "Host realA realB\n  HostName 127.0.0.1\n  Port %d\n  User %s\n"
+             "  IdentityFile %s/id\n  IdentitiesOnly yes\n  BatchMode yes\n"
+             "  StrictHostKeyChecking no\n  UserKnownHostsFile %s/known_hosts\n"
+             "  LogLevel ERROR\n  ConnectTimeout 10\n", sshd_port, pw->pw_name, sd, sd);
+    f = fopen(ft_path(sd, "ssh_config"), "w");
+    assert_non_null(f);
+    fputs(text, f);
+    fclose(f);
+    if (sh("sshd-t.log", "/usr/sbin/sshd -t -f %s/sshd_config", sd) != 0) {
+        char *msg = ft_read(ft_path(dir, "sshd-t.log"));
+        char *nl = strchr(msg, '\n');
+        if (nl) *nl = '\0';
+        snprintf(why, whysz, "sshd -t refuses its configuration: %s", msg);
+        free(msg);
+        return false;
+    }
+    char cfg[1100];
+    snprintf(cfg, sizeof cfg, "%s/sshd_config", sd);
+    const char *argv[] = {"/usr/bin/timeout", "-k", "2", "240", "/usr/sbin/sshd", "-D", "-e", "-f", cfg,
+                          NULL};
+    sshd_pid = ft_spawn(ft_path(dir, "sshd.log"), argv);
+    if (!ft_wait_for(ft_path(dir, "sshd.log"), "Server listening on 127.0.0.1", 1, 10)) {
+        fprintf(stderr, "%s\n", ft_read(ft_path(dir, "sshd.log")));
+        fail_msg("sshd did not start listening");
+    }
+    return true;
+}
+
+/* Processes whose command line has aafarm-worker and "--name NAME"; with
+ * kill_them, each is sent SIGKILL (by its PID). */
+static int workers_named(const char *name, bool kill_them)
+{
+    DIR *d = opendir("/proc");
+    assert_non_null(d);
+    int n = 0;
+    struct dirent *e;
+    while ((e = readdir(d)) != NULL) {
+        if (e->d_name[0] < '0' || e->d_name[0] > '9') continue;
+        char path[300], buf[4096];
+        snprintf(path, sizeof path, "/proc/%s/cmdline", e->d_name);
+        FILE *f = fopen(path, "r");
+        if (!f) continue;
+        size_t len = fread(buf, 1, sizeof buf - 1, f);
+        fclose(f);
+        buf[len] = '\0';
+        bool worker = false, named = false;
+        for (size_t i = 0; i < len; i += strlen(buf + i) + 1) {
+            if (strstr(buf + i, "aafarm-worker") && !strstr(buf + i, "farm.sh")) worker = true;
+            if (strcmp(buf + i, "--name") == 0 && i + strlen(buf + i) + 1 < len &&
+                strcmp(buf + i + strlen(buf + i) + 1, name) == 0)
+                named = true;
+        }
+        if (worker && named) {
+            n++;
+            if (kill_them) kill((pid_t)atol(e->d_name), SIGKILL);
+        }
+    }
+    closedir(d);
+    return n;
+}
+
+/* The number after "needle" in the file; 0 if absent. */
+static long number_after(const char *log, const char *needle)
+{
+    char *text = ft_read(log);
+    const char *at = strstr(text, needle);
+    long v = at ? atol(at + strlen(needle)) : 0;
+    free(text);
+    return v;
+}
+
+static int teardown_sshd(void **state)
+{
+    (void)state;
+    /* a worker a failed assertion left: by the PID farm.sh recorded */
+    static const char *const pids[] = {"run3/realA/worker.pid", "run3/realB/worker.pid"};
+    for (int i = 0; i < 2; i++) {
+        char *text = ft_read(ft_path(dir, pids[i]));
+        long pid = atol(text);
+        free(text);
+        if (pid > 1) kill((pid_t)pid, SIGKILL);
+    }
+    /* and one whose recorded PID was not its own (the bug this test is for) */
+    workers_named("realA", true);
+    workers_named("realB", true);
+    ft_stop_all();
+    stop_sshd();
+    return 0;
+}
+
+/* Runs farm.sh over the real sshd (hosts file hosts3, the wave scene into
+ * OUT); output in dir/LOG; its exit status. */
+static int real_farm(const char *log, const char *remote_bin, const char *master_host,
+                     const char *worker_opts, const char *out)
+{
+    return sh(log,
+              "cd %s && AAFARM_BIN=%s AAFARM_KEYS=%s/keys3 AAFARM_RUN=%s/run3 AAFARM_PORT=%d "
+              "AAFARM_BIND_HOST=127.0.0.1 SSH=\"ssh -F %s/sshd/ssh_config\" "
+              "SCP=\"scp -q -F %s/sshd/ssh_config\" AAFARM_REMOTE_BIN=%s "
+              "AAFARM_WORKER_OPTS=\"%s\" %s/deploy/ssh/farm.sh --master-host %s hosts3 "
+              "scene.rib -o %s --tile 16",
+              dir, bindir, dir, dir, ft_free_port(), dir, dir, remote_bin, worker_opts, src,
+              master_host, out);
+}
+
+static void test_ssh_farm_over_a_real_sshd(void **state)
+{
+    (void)state;
+    char why[512];
+    if (!start_sshd(why, sizeof why)) {
+        fprintf(stderr, "real sshd test skipped: %s\n", why);
+        skip();
+    }
+    FILE *fp = fopen(ft_path(dir, "hosts3"), "w");
+    assert_non_null(fp);
+    fputs("realA 1\nrealB\n", fp);
+    fclose(fp);
+    /* --tile-delay: both workers join before the end */
+    int rc = real_farm("real.log", bindir, "127.0.0.1", "--tile-delay 150", "real.exr");
+    const char *log = ft_path(dir, "real.log");
+    if (rc != 0) fprintf(stderr, "%s\n", ft_read(log));
+    assert_int_equal(rc, 0);
+    assert_int_equal(ft_exr_diff(ft_path(dir, "ref.exr"), ft_path(dir, "real.exr")), 0);
+    assert_int_equal(ft_count(log, "worker realA joined"), 1);
+    assert_int_equal(ft_count(log, "worker realB joined"), 1);
+    static const char *const hosts[] = {"realA", "realB"};
+    for (int h = 0; h < 2; h++) {
+        char started[64], stopped[64];
+        snprintf(started, sizeof started, "%s: worker ", hosts[h]);
+        snprintf(stopped, sizeof stopped, "%s: stopped worker ", hosts[h]);
+        long pid = number_after(log, started);
+        assert_true(pid > 1);
+        assert_int_equal(number_after(log, stopped), pid);   /* the PID it started */
+        assert_gone(pid);
+        assert_int_equal(workers_named(hosts[h], false), 0);   /* nothing left behind */
+    }
+    struct stat st;
+    assert_int_equal(stat(ft_path(dir, "run3/realA/keys"), &st), -1);
+    assert_int_equal(stat(ft_path(dir, "run3/realB/worker.pid"), &st), -1);
+
+    /* aafarm-worker missing on the hosts: named, nothing renders */
+    rc = real_farm("missing.log", ft_path(dir, "nowhere"), "127.0.0.1", "", "missing.exr");
+    const char *mlog = ft_path(dir, "missing.log");
+    assert_int_equal(rc, 1);
+    char needle[512];
+    snprintf(needle, sizeof needle, "farm.sh: realA: %s/nowhere/aafarm-worker is not there or "
+             "not executable", dir);
+    assert_int_equal(ft_count(mlog, needle), 1);
+    assert_int_equal(ft_count(mlog, "not rendering: fix realA"), 1);
+    assert_int_equal(ft_count(mlog, "listening on"), 0);   /* no master started */
+    assert_int_equal(stat(ft_path(dir, "run3/realA/keys"), &st), -1);
+    assert_int_equal(stat(ft_path(dir, "missing.exr"), &st), -1);
+
+    /* a master host the hosts cannot resolve: named before anything starts */
+    rc = real_farm("unresolved.log", bindir, "no-such-host.invalid", "", "unresolved.exr");
+    assert_int_equal(rc, 1);
+    assert_int_equal(ft_count(ft_path(dir, "unresolved.log"),
+                              "farm.sh: realA: cannot resolve the master host "
+                              "'no-such-host.invalid' there"), 1);
+    assert_int_equal(ft_count(ft_path(dir, "unresolved.log"), "worker"), 0);
 }
 
 static void test_slurm_script_with_stand_in_srun(void **state)
@@ -281,6 +526,7 @@ int main(int argc, char **argv)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test_teardown(test_ssh_farm_renders_and_stops_its_workers, teardown),
         cmocka_unit_test_teardown(test_ssh_farm_ctrl_c_stops_everything, teardown),
+        cmocka_unit_test_teardown(test_ssh_farm_over_a_real_sshd, teardown_sshd),
         cmocka_unit_test_teardown(test_slurm_script_with_stand_in_srun, teardown),
         cmocka_unit_test_teardown(test_systemd_unit_and_install, teardown),
         cmocka_unit_test_teardown(test_scripts_and_manifests_checked, teardown),
