@@ -4,6 +4,7 @@
 #include "console.h"
 #include "util/xalloc.h"
 
+#include <inttypes.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -118,4 +119,74 @@ void console_progress(console *self, int done, int total, int workers, int64_t s
                         secs);
     fprintf(stderr, "aafarm-master: %s\n", body);
     fflush(stderr);
+}
+
+/* ---- repeated warnings of one kind, aggregated ---- */
+
+void console_tally_init(console_tally *self, const char *one, const char *many,
+                        const char *detail, int64_t interval_ms)
+{
+    memset(self, 0, sizeof *self);
+    snprintf(self->one, sizeof self->one, "%s", one);
+    snprintf(self->many, sizeof self->many, "%s", many);
+    snprintf(self->detail, sizeof self->detail, "%s", detail ? detail : "");
+    self->interval_ms = interval_ms;
+    self->said_ms = INT64_MIN / 2;
+}
+
+void console_tally_add(console_tally *self, int tile, const char *detail)
+{
+    self->count++;
+    if (tile >= 0) {
+        if (self->ntiles < CONSOLE_TALLY_TILES) self->tiles[self->ntiles] = tile;
+        self->ntiles++;
+    }
+    if (detail) snprintf(self->detail, sizeof self->detail, "%s", detail);
+}
+
+/* "4 s", "0.5 s", "12 s" */
+static void format_span(char *buf, size_t n, int64_t ms)
+{
+    if (ms < 10000 && ms % 1000) snprintf(buf, n, "%.1f s", (double)ms / 1000.0);
+    else snprintf(buf, n, "%.0f s", (double)ms / 1000.0);
+}
+
+bool console_tally_format(const console_tally *self, int64_t now_ms, char *buf, size_t n)
+{
+    if (!self->count || !n) return false;
+    char when[48] = "", span[24];
+    if (self->said) {
+        format_span(span, sizeof span, now_ms - self->said_ms);
+        snprintf(when, sizeof when, " in the last %s", span);
+    }
+    char tiles[160] = "";
+    if (self->ntiles) {
+        size_t len = (size_t)snprintf(tiles, sizeof tiles, " (tile%s", self->ntiles == 1 ? "" : "s");
+        uint64_t shown = self->ntiles < CONSOLE_TALLY_TILES ? self->ntiles : CONSOLE_TALLY_TILES;
+        for (uint64_t i = 0; i < shown && len < sizeof tiles; i++)
+            len += (size_t)snprintf(tiles + len, sizeof tiles - len, "%s %d", i ? "," : "",
+                                    self->tiles[i]);
+        if (self->ntiles > shown && len < sizeof tiles)
+            len += (size_t)snprintf(tiles + len, sizeof tiles - len, " and %" PRIu64 " more",
+                                    self->ntiles - shown);
+        if (len < sizeof tiles) snprintf(tiles + len, sizeof tiles - len, ")");
+    }
+    snprintf(buf, n, "%" PRIu64 " %s%s%s%s%s", self->count, self->count == 1 ? self->one : self->many,
+             when, tiles, self->detail[0] && !strchr(":,;", self->detail[0])
+             ? " " : "", self->detail);
+    return true;
+}
+
+bool console_tally_flush(console_tally *self, console *con, int64_t now_ms, bool force)
+{
+    if (!self->count) return false;
+    if (!force && self->said && now_ms - self->said_ms < self->interval_ms) return false;
+    char line[600];
+    console_tally_format(self, now_ms, line, sizeof line);
+    console_log(con, CONSOLE_INFO, "%s", line);
+    self->said = true;
+    self->said_ms = now_ms;
+    self->count = 0;
+    self->ntiles = 0;
+    return true;
 }

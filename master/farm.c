@@ -72,6 +72,7 @@ void farm_options_default(farm_options *opt)
     opt->lease_ms = 120000;
     opt->lease_factor = 4;
     opt->max_workers = 1024;
+    opt->wait_report_ms = 30000;
 }
 
 int64_t farm_now_ms(void)
@@ -210,8 +211,8 @@ static int open_socket(farm *f, char *err, size_t errsz)
         char last[600] = "";
         size_t len = sizeof last;
         zmq_getsockopt(f->router, ZMQ_LAST_ENDPOINT, last, &len);
-        console_log(f->con, CONSOLE_INFO, "listening on %s%s", last[0] ? last : f->opt->bind,
-                    f->zap ? " (CURVE)" : "");
+        snprintf(f->bound, sizeof f->bound, "%s", last[0] ? last : f->opt->bind);
+        console_log(f->con, CONSOLE_INFO, "listening on %s%s", f->bound, f->zap ? " (CURVE)" : "");
         if (!f->opt->local_workers)
             snprintf(f->endpoint, sizeof f->endpoint, "%s", last[0] ? last : f->opt->bind);
     }
@@ -536,15 +537,61 @@ static bool all_blocked(const farm *f)
     return blocked > 0 && local_workers_running(f->locals) <= blocked;
 }
 
+/* The command a worker host runs: the bound endpoint, with this host's
+ * name for a wildcard address (tcp://0.0.0.0:5555 -> tcp://HOST:5555). */
+static void worker_command(const farm *f, char *buf, size_t n)
+{
+    const char *ep = f->bound;
+    const char *wild[] = {"tcp://0.0.0.0:", "tcp://[::]:", "tcp://*:"};
+    char host_ep[700];
+    for (size_t i = 0; i < sizeof wild / sizeof *wild; i++)
+        if (strncmp(ep, wild[i], strlen(wild[i])) == 0) {
+            snprintf(host_ep, sizeof host_ep, "tcp://%s:%s", f->host, ep + strlen(wild[i]));
+            ep = host_ep;
+            break;
+        }
+    snprintf(buf, n, "aafarm-worker --connect %s%s", ep,
+             f->zap ? " --curve-secret NAME.key_secret --master-key MASTER.key" : "");
+}
+
+/* --bind and no worker alive: said when the render starts, then again
+ * every --wait-report interval with how long it has waited. A farm waits
+ * for its workers: this never ends the render. */
+static void say_waiting(farm *f, int64_t now)
+{
+    if (!f->opt->bind || !f->bound[0]) return;
+    if (registry_alive(f->reg) > 0 || (f->locals && local_workers_running(f->locals) > 0)) {
+        f->waiting = false;
+        return;
+    }
+    if (!f->waiting) {   /* the last worker was lost: from now on */
+        f->waiting = true;
+        f->waiting_since_ms = f->wait_said_ms = now;
+        return;
+    }
+    if (now - f->wait_said_ms < f->opt->wait_report_ms) return;
+    f->wait_said_ms = now;
+    char cmd[800], joined[64];
+    worker_command(f, cmd, sizeof cmd);
+    if (f->joined) snprintf(joined, sizeof joined, "%d joined, none alive now", f->joined);
+    else snprintf(joined, sizeof joined, "0 joined");
+    double secs = (double)(now - f->waiting_since_ms) / 1000.0;
+    console_log(f->con, CONSOLE_INFO, "still waiting for workers on %s after %.*f s: %s (start "
+                "one with: %s)", f->bound, secs < 10 ? 1 : 0, secs, joined, cmd);
+}
+
 static void timers(farm *f, int64_t now)
 {
     check_workers(f, now);
-    int n = scheduler_expire(f->sched, now);
-    if (n > 0)
-        console_log(f->con, CONSOLE_INFO, "%d lease%s passed %s deadline without a result "
-                    "(%d x the measured time per tile, at most %.0f s): tile%s back in the "
-                    "queue", n, n == 1 ? "" : "s", n == 1 ? "its" : "their",
-                    f->opt->lease_factor, (double)f->opt->lease_ms / 1000.0, n == 1 ? "" : "s");
+    int tiles[CONSOLE_TALLY_TILES];
+    int n = scheduler_expire_list(f->sched, now, tiles, CONSOLE_TALLY_TILES);
+    for (int i = 0; i < n; i++) {
+        int local = 0;   /* the tiles after the first few are only counted */
+        if (i < CONSOLE_TALLY_TILES) farm_frame_of(f, tiles[i], &local);
+        console_tally_add(&f->expired, local, NULL);
+    }
+    console_tally_flush(&f->expired, f->con, now, false);
+    say_waiting(f, now);
     if (f->monitor) {
         wire_monitor_poll(f->monitor, &f->wstats, NULL, 0);
         log_handshakes(f, now);
@@ -639,6 +686,7 @@ static int finish(farm *f)
     char err[ERR_LEN];
     close_journals(f);
     f->end_ms = farm_now_ms();
+    console_tally_flush(&f->expired, f->con, f->end_ms, true);   /* none left unsaid */
     if (f->state == FARM_DONE)
         console_progress(f->con, f->ntiles, f->ntiles, registry_alive(f->reg), f->start_ms,
                          f->end_ms, true);
@@ -726,6 +774,11 @@ int farm_run(const farm_options *opt, const farm_frame_in *frames, int nframes)
     }
     f.fmt = frames[0].fmt;   /* the tile size (the same in every frame): limits */
     f.con = console_new(opt->verbosity, isatty(STDERR_FILENO));
+    char detail[200];
+    snprintf(detail, sizeof detail, "without a result (%d x the measured time per tile, at most "
+             "%.0f s): back in the queue", opt->lease_factor, (double)opt->lease_ms / 1000.0);
+    console_tally_init(&f.expired, "lease passed its deadline", "leases passed their deadlines",
+                       detail, FARM_WARN_INTERVAL_MS);
 
     struct sigaction sa;
     memset(&sa, 0, sizeof sa);
@@ -757,6 +810,14 @@ int farm_run(const farm_options *opt, const farm_frame_in *frames, int nframes)
                     frames[0].jb->nfiles, frames[0].jb->nfiles == 1 ? "" : "s",
                     (unsigned long long)job_files_bytes(frames[0].jb));
     if (scheduler_finished(f.sched)) f.state = FARM_DONE;   /* all resumed */
+    if (opt->bind && !f.locals && f.state == FARM_RUNNING) {
+        char cmd[800];
+        worker_command(&f, cmd, sizeof cmd);
+        console_log(f.con, CONSOLE_INFO, "waiting for workers on %s (start one with: %s); 0 joined",
+                    f.bound, cmd);
+        f.waiting = true;
+        f.waiting_since_ms = f.wait_said_ms = farm_now_ms();
+    }
     run_loop(&f);
     rc = finish(&f);
     teardown(&f);

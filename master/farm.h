@@ -41,6 +41,8 @@ typedef struct farm_options {
     const char *curve_secret;      /* --curve-secret: the master's NAME.key_secret, or NULL */
     const char *allow_keys;        /* --allow-keys: folder of workers' NAME.key files */
     bool insecure;                 /* --insecure: plaintext on a network endpoint */
+    int64_t wait_report_ms;        /* --bind, no worker alive: said again this often (30000;
+                                    * AAFARM_WAIT_REPORT_MS, a testing aid) */
 } farm_options;
 
 void farm_options_default(farm_options *opt);

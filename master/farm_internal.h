@@ -93,7 +93,16 @@ typedef struct farm {
     uint64_t nonfinite_samples;    /* NaN/Inf samples in the tiles taken */
     int nonfinite_tiles;
     int64_t drop_logged_ms;
+    console_tally expired;         /* leases past their deadline, one line per interval */
+    /* --bind: saying what the master waits for while no worker is alive */
+    char bound[600];               /* the endpoint bound (the real port for '*') */
+    int joined;                    /* workers that said Hello (ever) */
+    bool waiting;                  /* no worker alive since waiting_since_ms */
+    int64_t waiting_since_ms, wait_said_ms;
 } farm;
+
+/* At most one line per interval for a repeated warning (console_tally). */
+enum { FARM_WARN_INTERVAL_MS = 10000 };
 
 int64_t farm_now_ms(void);
 

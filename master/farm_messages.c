@@ -261,6 +261,7 @@ static void on_hello(farm *f, const proto_hello *h, const uint8_t *id, size_t id
         if (holds_job(h, f->frames[i].jb->hash)) mark_held(w, i);
     w->local = f->locals && strcmp(w->host, f->host) == 0 &&
                local_workers_has_pid(f->locals, (pid_t)w->pid);
+    f->joined++;
     console_log(f->con, CONSOLE_INFO, "worker %s joined (%s, pid %u, %u thread%s%s)", w->name,
                 w->host, w->pid, w->threads, w->threads == 1 ? "" : "s",
                 !w->nheld ? "" : f->nframes == 1 ? ", holds the job" : ", holds frames' jobs");

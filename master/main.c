@@ -347,11 +347,27 @@ static int load(cli *c, loaded *l)
     return ok ? -1 : usage && !l->seq ? AAFARM_EXIT_USAGE : AAFARM_EXIT_INPUT;
 }
 
+/* AAFARM_WAIT_REPORT_MS: how often a master with --bind and no worker says
+ * it still waits (30 s); a testing aid, not in --help. */
+static void wait_report_from_env(farm_options *opt)
+{
+    const char *text = getenv("AAFARM_WAIT_REPORT_MS");
+    if (!text || !*text) return;
+    long n;
+    char err[ERR_LEN];
+    if (parse_option_long("AAFARM_WAIT_REPORT_MS", "milliseconds", text, 100, 86400000L, &n, err,
+                          sizeof err))
+        opt->wait_report_ms = n;
+    else
+        fprintf(stderr, "aafarm-master: %s (ignored)\n", err);
+}
+
 int main(int argc, char **argv)
 {
     cli c;
     memset(&c, 0, sizeof c);
     farm_options_default(&c.farm);
+    wait_report_from_env(&c.farm);
     job_options_default(&c.job);
     int rc = parse(argc, argv, &c);
     if (rc >= 0) return rc;

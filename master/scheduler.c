@@ -494,6 +494,11 @@ int scheduler_worker_remove(scheduler *self, int worker)
 
 int scheduler_expire(scheduler *self, int64_t now_ms)
 {
+    return scheduler_expire_list(self, now_ms, NULL, 0);
+}
+
+int scheduler_expire_list(scheduler *self, int64_t now_ms, int *tiles, int max)
+{
     uint64_t before = self->counts.requeued;
     for (size_t i = 0; i < self->nleases; i++) {
         scheduler_lease *l = &self->leases[i];
@@ -503,7 +508,10 @@ int scheduler_expire(scheduler *self, int64_t now_ms)
         l->expired = true;
         if (l->worker >= 0 && l->worker < self->nworkers) self->workers[l->worker].overdue++;
         self->counts.expired++;
+        uint64_t requeued = self->counts.requeued;
         tile_lost_live(self, l->tile);
+        int n = (int)(requeued - before);
+        if (self->counts.requeued > requeued && n < max) tiles[n] = l->tile;
     }
     return (int)(self->counts.requeued - before);
 }

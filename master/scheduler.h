@@ -170,6 +170,9 @@ bool scheduler_mark_done(scheduler *self, int tile);
  * worker now) is <= now_ms as expired and requeues their tiles. Returns
  * the number of tiles requeued. */
 int scheduler_expire(scheduler *self, int64_t now_ms);
+/* The same, and the first max of the requeued tiles into tiles (NULL when
+ * max is 0), for the master's log line. */
+int scheduler_expire_list(scheduler *self, int64_t now_ms, int *tiles, int max);
 
 /* The worker is getting the job's files (waiting: the Job was sent to it
  * and its FilesReady has not come; docs/textures.md): its live leases'

@@ -275,6 +275,17 @@ int main(int argc, char **argv)
     }
     if (connect) {
         wo.endpoint = connect;
+        /* how often a worker that cannot reach its master says so again
+         * (30 s); a testing aid, not in --help */
+        const char *report = getenv("AAFARM_WAIT_REPORT_MS");
+        if (report && *report) {
+            char err[ERR_LEN];
+            if (parse_option_long("AAFARM_WAIT_REPORT_MS", "milliseconds", report, 100, 86400000L,
+                                  &n, err, sizeof err))
+                wo.unreachable_report_ms = (int)n;
+            else
+                fprintf(stderr, "aafarm-worker: %s (ignored)\n", err);
+        }
         return worker_loop_run(&wo);
     }
     usage(stderr);

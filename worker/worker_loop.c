@@ -51,7 +51,8 @@
 #include "worker_pool.h"
 #include "util/xalloc.h"
 
-enum { MAX_JOBS_HELD = 4, BACKOFF_FIRST_MS = 1000, BACKOFF_MAX_MS = 32000 };
+enum { MAX_JOBS_HELD = 4, BACKOFF_FIRST_MS = 1000, BACKOFF_MAX_MS = 32000,
+       UNREACHABLE_REPORT_MS = 30000 };
 
 typedef enum session_end {
     SESSION_LOST,          /* the master went silent: back off, reconnect */
@@ -96,7 +97,12 @@ typedef struct worker_loop {
     curve_cert own, master;
     wire_monitor *monitor;         /* handshake failures: refused keys */
     uint64_t file_received;        /* FileChunk bytes since the last Welcome */
-    bool handshake_said;           /* a failed handshake was reported this session */
+    bool handshake_said;           /* a failed handshake was reported since the last Welcome */
+    /* no master: said once, then every report interval, not at each retry */
+    bool trying;                   /* no Welcome since trying_since_ms */
+    bool unreachable_said;         /* "cannot reach" was said for this stretch */
+    int64_t trying_since_ms, unreachable_said_ms;
+    int report_ms;                 /* opt->unreachable_report_ms or UNREACHABLE_REPORT_MS */
 } worker_loop;
 
 static volatile sig_atomic_t interrupted;
@@ -334,8 +340,14 @@ static void on_welcome(worker_loop *w, const proto_welcome *m)
     w->heartbeat_ms = (int)m->heartbeat_ms;
     w->liveness = (int)m->heartbeat_liveness;
     w->welcomed = w->ever_welcomed = true;
-    wlog(w, 0, "connected to master %s at %s (heartbeat %d ms x %d)",
-         m->master_name && *m->master_name ? m->master_name : "?", w->opt->endpoint,
+    char after[64] = "";
+    if (w->unreachable_said)   /* it said it could not: how long it took */
+        snprintf(after, sizeof after, " after %.0f s",
+                 (double)(now_ms() - w->trying_since_ms) / 1000.0);
+    w->trying = w->unreachable_said = false;
+    w->handshake_said = false;   /* a refusal after this one is news again */
+    wlog(w, 0, "connected to master %s at %s%s (heartbeat %d ms x %d)",
+         m->master_name && *m->master_name ? m->master_name : "?", w->opt->endpoint, after,
          w->heartbeat_ms, w->liveness);
 }
 
@@ -680,7 +692,8 @@ static void close_socket(worker_loop *w, int linger_ms)
 }
 
 /* A failed handshake means the master refused this worker's key, or one
- * side speaks CURVE and the other not: said once per session. */
+ * side speaks CURVE and the other not: said once until a master welcomes
+ * this worker (not at every retry). */
 static void check_handshakes(worker_loop *w)
 {
     if (!w->monitor) return;
@@ -698,6 +711,29 @@ static void check_handshakes(worker_loop *w)
                       : "the master may require CURVE (give --curve-secret and --master-key)");
 }
 
+/* No master yet: "cannot reach" once, when the first try ends without a
+ * Welcome; then every report interval how long it has tried. */
+static void say_unreachable(worker_loop *w, int64_t now, bool try_ended)
+{
+    if (!w->trying || w->welcomed) return;
+    if (!w->unreachable_said) {
+        if (!try_ended) return;
+        w->unreachable_said = true;
+        w->unreachable_said_ms = now;
+        char every[32];
+        if (w->report_ms % 1000) snprintf(every, sizeof every, "%.1f s", w->report_ms / 1000.0);
+        else snprintf(every, sizeof every, "%d s", w->report_ms / 1000);
+        wlog(w, 0, "cannot reach the master at %s: no answer for %.1f s; retrying (said again "
+             "every %s until it answers)", w->opt->endpoint,
+             (double)(now - w->trying_since_ms) / 1000.0, every);
+        return;
+    }
+    if (now - w->unreachable_said_ms < w->report_ms) return;
+    w->unreachable_said_ms = now;
+    wlog(w, 0, "still no master at %s after %.0f s of trying", w->opt->endpoint,
+         (double)(now - w->trying_since_ms) / 1000.0);
+}
+
 static session_end session(worker_loop *w)
 {
     w->end = SESSION_LOST;
@@ -711,7 +747,6 @@ static session_end session(worker_loop *w)
     send_hello(w);
     w->last_heard_ms = now_ms();
     w->wstats.handshake_failures = w->wstats.auth_failures = 0;
-    w->handshake_said = false;
     while (w->end == SESSION_LOST) {
         zmq_pollitem_t items[2] = {{w->dealer, 0, ZMQ_POLLIN, 0},
                                    {NULL, worker_pool_wake_fd(w->pool), ZMQ_POLLIN, 0}};
@@ -733,10 +768,19 @@ static session_end session(worker_loop *w)
         check_handshakes(w);
         int64_t now = now_ms();
         if (now - w->last_heard_ms > (int64_t)w->heartbeat_ms * w->liveness) {
-            wlog(w, 0, "%s at %s: no answer for %.1f s", w->welcomed ? "master" : "no master",
-                 w->opt->endpoint, (double)(now - w->last_heard_ms) / 1000.0);
+            if (w->welcomed) {   /* the master went away: from now on, it is tried again */
+                wlog(w, 0, "master at %s: no answer for %.1f s", w->opt->endpoint,
+                     (double)(now - w->last_heard_ms) / 1000.0);
+                w->trying = true;
+                w->trying_since_ms = now;
+            } else {
+                wlog(w, 1, "no master at %s: no answer for %.1f s", w->opt->endpoint,
+                     (double)(now - w->last_heard_ms) / 1000.0);
+                say_unreachable(w, now, true);
+            }
             break;
         }
+        say_unreachable(w, now, false);
         if (w->welcomed && now - w->last_sent_ms >= w->heartbeat_ms) send_heartbeat(w);
     }
     drop_all_leases(w);
@@ -753,6 +797,7 @@ static bool backoff_wait(worker_loop *w, int ms)
         zmq_poll(&item, 1, 100);
         if (interrupted) return false;
         send_finished(w);
+        say_unreachable(w, now_ms(), false);
     }
     return true;
 }
@@ -760,6 +805,8 @@ static bool backoff_wait(worker_loop *w, int ms)
 static int serve(worker_loop *w)
 {
     int backoff = BACKOFF_FIRST_MS;
+    w->trying = true;
+    w->trying_since_ms = now_ms();
     for (;;) {
         w->ever_welcomed = false;
         session_end end = session(w);
@@ -774,7 +821,8 @@ static int serve(worker_loop *w)
         default: break;
         }
         if (w->ever_welcomed) backoff = BACKOFF_FIRST_MS;
-        wlog(w, 0, "reconnecting in %d s", backoff / 1000);
+        /* after a lost master once; while none answers, only with -v */
+        wlog(w, w->ever_welcomed ? 0 : 1, "reconnecting in %d s", backoff / 1000);
         if (!backoff_wait(w, backoff)) return AAFARM_EXIT_INTERRUPTED;
         backoff = backoff * 2 > BACKOFF_MAX_MS ? BACKOFF_MAX_MS : backoff * 2;
     }
@@ -794,6 +842,8 @@ int worker_loop_run(const worker_loop_options *opt)
     w.limits = proto_limits_default();
     w.threads = opt->threads > 0 ? opt->threads : default_threads();
     w.target = 2 * w.threads;
+    w.report_ms = opt->unreachable_report_ms > 0 ? opt->unreachable_report_ms
+                                                 : UNREACHABLE_REPORT_MS;
     if (gethostname(w.host, 100) != 0 || !w.host[0]) snprintf(w.host, sizeof w.host, "localhost");
     w.host[100] = '\0';
     if (opt->name) snprintf(w.name, sizeof w.name, "%s", opt->name);

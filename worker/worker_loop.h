@@ -8,10 +8,12 @@
  * store (file_fetch.h), sends the tiles back as EXR, and
  * heartbeats meanwhile. When the master goes silent it reconnects with
  * exponential backoff (1 s, 2 s, ... 32 s) and serves the next master.
+ * While it cannot reach a master it says so once, then every 30 s with
+ * how long it has tried, and how long it took when it connects.
  * With a CURVE key pair and the master's public key every byte is
  * encrypted and the master checks this worker's key; a refusal is said
- * in plain words (once per session) and the worker keeps retrying with
- * the same backoff (the key may be allowed later).
+ * in plain words (once, until a master welcomes it) and the worker keeps
+ * retrying with the same backoff (the key may be allowed later).
  */
 #ifndef WORKER_LOOP_H
 #define WORKER_LOOP_H
@@ -35,6 +37,8 @@ typedef struct worker_loop_options {
     uint32_t file_chunk;           /* bytes per NeedFile (0: 1 MiB) */
     uint64_t file_inflight;        /* bytes asked and not received (0: 8 MiB) */
     int file_delay_ms;             /* testing aid: at least this between NeedFiles */
+    int unreachable_report_ms;     /* no master: said again this often (0: 30000;
+                                    * AAFARM_WAIT_REPORT_MS, a testing aid) */
 } worker_loop_options;
 
 /* Serves masters until told to stop. Returns an AAFARM_EXIT_* code:
