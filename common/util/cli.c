@@ -30,7 +30,7 @@ void cli_option_problem(int ch, int optind_now, int optopt_now, char *const *arg
      * optopt (it may sit in a cluster like -qZ) */
     const char *arg = optind_now > 0 ? argv[optind_now - 1] : "";
     char opt[256];
-    if (arg[0] == '-' && arg[1] == '-') {
+    if (strncmp(arg, "--", 2) == 0) {
         size_t n = strcspn(arg, "=");
         snprintf(opt, sizeof opt, "%.*s", (int)(n < 200 ? n : 200), arg);
     } else {
