@@ -132,6 +132,11 @@ void geom_unit_normal_aa(aa_context *ctx, const geom_surface *s, const aa_form *
                          const aa_form *v, const geom_aa *g, aa_form Nn[3]);
 void geom_unit_normal_ia(const geom_surface *s, ia_interval u, ia_interval v,
                          const geom_ia *g, ia_interval Nn[3]);
+/* The normal the point path (float and dual) gives a shader at one (u,v),
+ * and its (u,v)-derivatives, not of unit length: Ng and dNg/du, dNg/dv of
+ * g (geom_eval_dual's result at the same (u,v)) where Ng != 0. */
+void geom_normal_dual(const geom_surface *s, double u, double v, const geom_sample *g,
+                      vec3 *N, vec3 *dNdu, vec3 *dNdv);
 /* Bounds of d/du and d/dv of that unit normal over the box, from the
  * same closed forms (sphere, cylinder, cone, torus, disk, polygons with
  * or without vertex normals, bilinear patches) or the second derivatives

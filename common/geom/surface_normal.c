@@ -1,32 +1,54 @@
 /*
  * surface_normal.c: the unit normal of a base surface over a (u,v) box, in
- * affine and interval arithmetic (see geom_unit_normal_aa in surface.h).
+ * affine and interval arithmetic (see geom_unit_normal_aa in surface.h),
+ * and at one (u,v) for the point path (geom_normal_dual).
  *
  * Why: displacement shaders move P along normalize(N). Normalising Ng over
  * a box that touches a point where Ng = 0 (a sphere's pole, a disk's
  * centre, a cone's apex: RenderMan's parameterisations all have them)
  * divides by a range containing 0, the box becomes unbounded, and the
  * subdivision around that point never ends (Heidrich & Seidel §3 assume
- * bounded boxes). The closed forms below have no such points:
+ * bounded boxes). The closed forms of surface_normal.inc (sphere, torus,
+ * disk, cylinder, cone) have no such points; polygons use the constant
+ * Ng / |Ng|, or with vertex normals the interpolated N = C + u A + v B
+ * (surface_vertex_normal.c), normalised. Paraboloids, hyperboloids and
+ * patches normalise Ng. Constant factors are applied as intervals on a
+ * context of capacity 0, so rounding lands in the result's own error term
+ * and the enclosures hold for the exact real values.
  *
- *   sphere     P / r                         (P = r (cos t cos p, sin t cos p, sin p))
- *   torus      (cos p cos t, cos p sin t, sin p)
- *   disk       (0, 0, 1)
- *   cylinder   (P.x, P.y, 0) / r
- *   cone       (h cos t, h sin t, r) / sqrt(h^2 + r^2)
- *   polygon    the constant Ng / |Ng|; with vertex normals the interpolated
- *              N = C + u A + v B (surface_vertex_normal.c), normalised
- *
- * each times the sign that makes it point along Ng. Paraboloids,
- * hyperboloids and patches normalise Ng. Constant factors are applied as
- * intervals on a context of capacity 0, so rounding lands in the result's
- * own error term and the enclosures hold for the exact real values.
+ * Singular points (Ng = 0 exactly). The point path gives a shader Ng
+ * itself where Ng != 0 (normalised by the caller) and the LIMIT normal
+ * where Ng = 0: the closed form (surface_normal.inc, the same definition
+ * the boxes use) and its derivatives; for a kind without one, the limit
+ * of Ng/|Ng| as (u,v) moves into the square along v (or u), the direction
+ * of dNg/dv (or dNg/du), with derivatives 0. The boxes of those kinds
+ * bound it: a box holding such a point normalises a range of Ng that holds
+ * 0, which is unbounded, and one over which Ng is exactly 0 (a box of one
+ * point) is [-1, 1]^3.
  */
 #include "geom/surface.h"
 #include "geom/surface_internal.h"
 #include "geom/subdiv.h"
 
 #include <math.h>
+
+static double sgn(double x) { return x < 0 ? -1.0 : 1.0; }
+
+/* 1 / sqrt(a^2 + b^2) as an enclosing interval */
+static ia_interval inv_hypot(double a, double b)
+{
+    ia_interval n2 = ia_add(ia_sqr(ia_point(a)), ia_sqr(ia_point(b)));
+    return ia_recip(ia_sqrt(n2));
+}
+
+static double dphi_sign(const geom_surface *s)
+{
+    double a, b;
+    geom_phi_range(s, &a, &b);
+    return sgn(b - a);
+}
+
+/* ---- the closed forms, in each arithmetic (surface_normal.inc) ---- */
 
 /* z = x * k for every k in the interval k, no new noise symbol */
 static void scale_k(aa_form *z, const aa_form *x, ia_interval k)
@@ -50,21 +72,53 @@ static void const_form(aa_form *z, ia_interval k)
     else aa_from_interval(&none, z, k);
 }
 
-static double sgn(double x) { return x < 0 ? -1.0 : 1.0; }
+#define NT aa_form
+#define NT_FN(name) NT_CAT2(name, aa)
+#define NT_MUL_S(z, x, d) aa_mul_s(ctx, z, x, d)
+#define NT_MUL_S0(z, x, d) aa_mul_s(none, z, x, d)
+#define NT_SCALE_K(z, x, k) scale_k(z, x, k)
+#define NT_CONST_K(z, k) const_form(z, k)
+#define NT_ADD_S0(z, x, d) aa_add_s(none, z, x, d)
+#define NT_MUL(z, x, y) aa_mul(ctx, z, x, y)
+#define NT_COS(z, x) aa_cos(ctx, z, x)
+#define NT_SIN(z, x) aa_sin(ctx, z, x)
+#include "surface_normal.inc"
 
-/* 1 / sqrt(a^2 + b^2) as an enclosing interval */
-static ia_interval inv_hypot(double a, double b)
-{
-    ia_interval n2 = ia_add(ia_sqr(ia_point(a)), ia_sqr(ia_point(b)));
-    return ia_recip(ia_sqrt(n2));
-}
+#define NT ia_interval
+#define NT_FN(name) NT_CAT2(name, ia)
+#define NT_MUL_S(z, x, d) (*(z) = ia_mul_s(*(x), d))
+#define NT_MUL_S0 NT_MUL_S
+#define NT_SCALE_K(z, x, k) (*(z) = ia_mul(*(x), k))
+#define NT_CONST_K(z, k) (*(z) = (k))
+#define NT_ADD_S0(z, x, d) (*(z) = ia_add_s(*(x), d))
+#define NT_MUL(z, x, y) (*(z) = ia_mul(*(x), *(y)))
+#define NT_COS(z, x) (*(z) = ia_cos(*(x)))
+#define NT_SIN(z, x) (*(z) = ia_sin(*(x)))
+#include "surface_normal.inc"
 
-static double dphi_sign(const geom_surface *s)
+/* a value with its d/du and d/dv (forward-mode differentiation) */
+typedef struct dual { double v, du, dv; } dual;
+
+static double mid(ia_interval k) { return k.lo == k.hi ? k.lo : 0.5 * (k.lo + k.hi); }
+static dual d_mul_s(dual x, double d) { return (dual){x.v * d, x.du * d, x.dv * d}; }
+static dual d_mul(dual x, dual y)
 {
-    double a, b;
-    geom_phi_range(s, &a, &b);
-    return sgn(b - a);
+    return (dual){x.v * y.v, x.du * y.v + x.v * y.du, x.dv * y.v + x.v * y.dv};
 }
+static dual d_cos(dual x) { double s = -sin(x.v); return (dual){cos(x.v), s * x.du, s * x.dv}; }
+static dual d_sin(dual x) { double c = cos(x.v); return (dual){sin(x.v), c * x.du, c * x.dv}; }
+
+#define NT dual
+#define NT_FN(name) NT_CAT2(name, dual)
+#define NT_MUL_S(z, x, d) (*(z) = d_mul_s(*(x), d))
+#define NT_MUL_S0 NT_MUL_S
+#define NT_SCALE_K(z, x, k) (*(z) = d_mul_s(*(x), mid(k)))
+#define NT_CONST_K(z, k) (*(z) = (dual){mid(k), 0, 0})
+#define NT_ADD_S0(z, x, d) (*(z) = (dual){(x)->v + (d), (x)->du, (x)->dv})
+#define NT_MUL(z, x, y) (*(z) = d_mul(*(x), *(y)))
+#define NT_COS(z, x) (*(z) = d_cos(*(x)))
+#define NT_SIN(z, x) (*(z) = d_sin(*(x)))
+#include "surface_normal.inc"
 
 /* ---- affine ---- */
 
@@ -78,68 +132,21 @@ static void normalize_aa(aa_context *ctx, const aa_form Ng[3], aa_form Nn[3])
     aa_add(ctx, &n2, &n2, &t);
     aa_sqr(ctx, &t, &Ng[2]);
     aa_add(ctx, &n2, &n2, &t);
+    if (aa_range(&n2).hi == 0) {          /* Ng = 0 over the box: a limit */
+        for (int i = 0; i < 3; i++) const_form(&Nn[i], ia_make(-1, 1));
+        return;
+    }
     aa_invsqrt(ctx, &inv, &n2);
     for (int i = 0; i < 3; i++) aa_mul(ctx, &Nn[i], &Ng[i], &inv);
-}
-
-static void cos_sin_theta(aa_context *ctx, const geom_surface *s, const aa_form *u,
-                          aa_form *c, aa_form *sn)
-{
-    aa_form theta;
-    aa_mul_s(ctx, &theta, u, s->thetamax);
-    aa_cos(ctx, c, &theta);
-    aa_sin(ctx, sn, &theta);
 }
 
 void geom_unit_normal_aa(aa_context *ctx, const geom_surface *s, const aa_form *u,
                          const aa_form *v, const geom_aa *g, aa_form Nn[3])
 {
+    aa_context none;
+    aa_context_init(&none, 0);
+    if (closed_normal_aa(ctx, &none, s, u, v, g->P, Nn)) return;
     switch (s->kind) {
-    case GEOM_SPHERE: {
-        ia_interval k = ia_mul_s(ia_recip(ia_point(s->radius)), sgn(s->thetamax) * dphi_sign(s));
-        for (int i = 0; i < 3; i++) scale_k(&Nn[i], &g->P[i], k);
-        return;
-    }
-    case GEOM_TORUS: {
-        /* (cos p cos t, cos p sin t, sin p): the tube's own direction */
-        aa_form c, sn, phi, cp, sp;
-        double pa, pb;
-        geom_phi_range(s, &pa, &pb);
-        cos_sin_theta(ctx, s, u, &c, &sn);
-        aa_context none;
-        aa_context_init(&none, 0);
-        scale_k(&phi, v, s->consts[K_DPHI]);
-        aa_add_s(&none, &phi, &phi, pa);
-        aa_cos(ctx, &cp, &phi);
-        aa_sin(ctx, &sp, &phi);
-        double k = sgn(s->thetamax) * dphi_sign(s);
-        aa_mul(ctx, &Nn[0], &cp, &c);
-        aa_mul(ctx, &Nn[1], &cp, &sn);
-        Nn[2] = sp;
-        for (int i = 0; i < 3; i++) aa_mul_s(&none, &Nn[i], &Nn[i], k);
-        return;
-    }
-    case GEOM_DISK:
-        aa_const(&Nn[0], 0);
-        aa_const(&Nn[1], 0);
-        aa_const(&Nn[2], sgn(s->thetamax));
-        return;
-    case GEOM_CYLINDER: {
-        ia_interval k = ia_mul_s(ia_recip(ia_point(s->radius)), sgn(s->thetamax) * sgn(s->zmax - s->zmin));
-        scale_k(&Nn[0], &g->P[0], k);
-        scale_k(&Nn[1], &g->P[1], k);
-        aa_const(&Nn[2], 0);
-        return;
-    }
-    case GEOM_CONE: {
-        aa_form c, sn;
-        cos_sin_theta(ctx, s, u, &c, &sn);
-        ia_interval k = ia_mul_s(inv_hypot(s->height, s->radius), sgn(s->thetamax));
-        scale_k(&Nn[0], &c, ia_mul_s(k, s->height));
-        scale_k(&Nn[1], &sn, ia_mul_s(k, s->height));
-        const_form(&Nn[2], ia_mul_s(k, s->radius));
-        return;
-    }
     case GEOM_POLYGON: {
         if (geom_has_vertex_normals(s)) {
             aa_form Nv[3];
@@ -297,6 +304,10 @@ bool geom_unit_normal_slopes_ia(const geom_surface *s, ia_interval u, ia_interva
 static void normalize_ia(const ia_interval Ng[3], ia_interval Nn[3])
 {
     ia_interval n2 = ia_add(ia_add(ia_sqr(Ng[0]), ia_sqr(Ng[1])), ia_sqr(Ng[2]));
+    if (n2.hi == 0) {                     /* Ng = 0 over the box: a limit */
+        for (int i = 0; i < 3; i++) Nn[i] = ia_make(-1, 1);
+        return;
+    }
     ia_interval inv = ia_invsqrt(n2);
     for (int i = 0; i < 3; i++) Nn[i] = ia_mul(Ng[i], inv);
 }
@@ -304,42 +315,8 @@ static void normalize_ia(const ia_interval Ng[3], ia_interval Nn[3])
 void geom_unit_normal_ia(const geom_surface *s, ia_interval u, ia_interval v,
                          const geom_ia *g, ia_interval Nn[3])
 {
-    ia_interval theta = ia_mul_s(u, s->thetamax);
+    if (closed_normal_ia(NULL, NULL, s, &u, &v, g->P, Nn)) return;
     switch (s->kind) {
-    case GEOM_SPHERE: {
-        ia_interval k = ia_mul_s(ia_recip(ia_point(s->radius)), sgn(s->thetamax) * dphi_sign(s));
-        for (int i = 0; i < 3; i++) Nn[i] = ia_mul(g->P[i], k);
-        return;
-    }
-    case GEOM_TORUS: {
-        double pa, pb;
-        geom_phi_range(s, &pa, &pb);
-        ia_interval phi = ia_add_s(ia_mul(v, s->consts[K_DPHI]), pa);
-        ia_interval cp = ia_cos(phi);
-        double k = sgn(s->thetamax) * dphi_sign(s);
-        Nn[0] = ia_mul_s(ia_mul(cp, ia_cos(theta)), k);
-        Nn[1] = ia_mul_s(ia_mul(cp, ia_sin(theta)), k);
-        Nn[2] = ia_mul_s(ia_sin(phi), k);
-        return;
-    }
-    case GEOM_DISK:
-        Nn[0] = Nn[1] = ia_point(0);
-        Nn[2] = ia_point(sgn(s->thetamax));
-        return;
-    case GEOM_CYLINDER: {
-        ia_interval k = ia_mul_s(ia_recip(ia_point(s->radius)), sgn(s->thetamax) * sgn(s->zmax - s->zmin));
-        Nn[0] = ia_mul(g->P[0], k);
-        Nn[1] = ia_mul(g->P[1], k);
-        Nn[2] = ia_point(0);
-        return;
-    }
-    case GEOM_CONE: {
-        ia_interval k = ia_mul_s(inv_hypot(s->height, s->radius), sgn(s->thetamax));
-        Nn[0] = ia_mul(ia_cos(theta), ia_mul_s(k, s->height));
-        Nn[1] = ia_mul(ia_sin(theta), ia_mul_s(k, s->height));
-        Nn[2] = ia_mul_s(k, s->radius);
-        return;
-    }
     case GEOM_POLYGON:
         if (geom_has_vertex_normals(s)) {
             ia_interval Nv[3];
@@ -365,4 +342,38 @@ void geom_unit_normal_ia(const geom_surface *s, ia_interval u, ia_interval v,
         normalize_ia(g->Ng, Nn);
         return;
     }
+}
+
+/* ---- float and dual ---- */
+
+void geom_normal_dual(const geom_surface *s, double u, double v, const geom_sample *g,
+                      vec3 *N, vec3 *dNdu, vec3 *dNdv)
+{
+    *N = g->Ng;
+    *dNdu = g->dNgdu;
+    *dNdv = g->dNgdv;
+    double len = v3_length(g->Ng);
+    if (len > 0 && isfinite(len)) return;
+    /* a singular point: the limit normal */
+    dual U = {u, 1, 0}, V = {v, 0, 1}, P[3], Nn[3];
+    P[0] = (dual){g->P.x, g->dPdu.x, g->dPdv.x};
+    P[1] = (dual){g->P.y, g->dPdu.y, g->dPdv.y};
+    P[2] = (dual){g->P.z, g->dPdu.z, g->dPdv.z};
+    if (closed_normal_dual(NULL, NULL, s, &U, &V, P, Nn)) {
+        *N = v3(Nn[0].v, Nn[1].v, Nn[2].v);
+        *dNdu = v3(Nn[0].du, Nn[1].du, Nn[2].du);
+        *dNdv = v3(Nn[0].dv, Nn[1].dv, Nn[2].dv);
+        return;
+    }
+    /* Ng ~ (v - v*) dNg/dv near an edge v = v* where Ng vanishes: its
+     * direction moving into the square (then likewise along u); the
+     * derivatives of this limit are not known here (the boxes' are
+     * unknown too): 0 */
+    geom_sample d;
+    geom_eval_dual(s, u, v, &d);
+    vec3 dv = v3_scale(d.dNgdv, v < 1 ? 1.0 : -1.0), du = v3_scale(d.dNgdu, u < 1 ? 1.0 : -1.0);
+    double lv = v3_length(dv), lu = v3_length(du);
+    if (lv > 0 && isfinite(lv)) *N = v3_scale(dv, 1 / lv);
+    else if (lu > 0 && isfinite(lu)) *N = v3_scale(du, 1 / lu);
+    *dNdu = *dNdv = v3(0, 0, 0);
 }

@@ -450,11 +450,14 @@ void trace_surface_point_eval_on(trace_thread *th, sl_vm *vm, const trace_object
     vec3 P = mat4_xform_point(&obj->to_camera, g.P);
     vec3 dPdu = mat4_xform_vector(&obj->to_camera, g.dPdu);
     vec3 dPdv = mat4_xform_vector(&obj->to_camera, g.dPdv);
-    vec3 Ng = mat4_xform_normal(&obj->from_camera, g.Ng);
+    /* the base normal: Ng, or its limit where Ng = 0 (geom_normal_dual) */
+    vec3 Nb, dNbdu, dNbdv;
+    geom_normal_dual(&obj->surf, u, v, &g, &Nb, &dNbdu, &dNbdv);
+    vec3 Ng = mat4_xform_normal(&obj->from_camera, Nb);
     if (obj->flip) Ng = v3_neg(Ng);
-    /* the shading normal: Ng, or a mesh face's interpolated vertex normals
-     * (oriented like Ng, flipped with it) */
-    vec3 Ns = g.Ng, dNsdu = g.dNgdu, dNsdv = g.dNgdv;
+    /* the shading normal: that, or a mesh face's interpolated vertex
+     * normals (oriented like Ng, flipped with it) */
+    vec3 Ns = Nb, dNsdu = dNbdu, dNsdv = dNbdv;
     bool smooth = geom_vertex_normal(&obj->surf, u, v, &Ns, &dNsdu, &dNsdv);
     Ns = mat4_xform_normal(&obj->from_camera, Ns);
     if (obj->flip) Ns = v3_neg(Ns);

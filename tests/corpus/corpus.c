@@ -157,7 +157,8 @@ void corpus_free(corpus *c)
 
 const char *corpus_surface_name(corpus_surface s)
 {
-    static const char *names[] = {"plane", "sphere", "ellipsoid", "cylinder", "patch", "mesh", "subdiv", "nurbs"};
+    static const char *names[] = {"plane", "sphere", "ellipsoid", "cylinder", "patch", "mesh", "subdiv", "nurbs",
+                                  "apex", "collapsed"};
     return s < CORPUS_NSURFACES ? names[s] : "?";
 }
 
@@ -267,6 +268,35 @@ bool corpus_open(fixture *f, const corpus *c, const corpus_file *sh,
         snprintf(geom, sizeof geom, "Translate 0 0 5\nRotate -60 1 0 0\nRotate 20 0 0 1\n%s"
             "NuPatch 5 3 [0 0 0 1 1 2 2 2] 0 2  5 4 [0 0 0 0 1 2 2 2 2] 0 2 \"Pw\" [%s]\n",
             disp, nurbs_points());
+        break;
+    case CORPUS_APEX:
+        /* Ng = 0 at the disk's centre and the cone's apex (v = 1) and the
+         * paraboloid's apex (v = 0): their normals there are limits
+         * (docs/geometry.md, "Singular points"); the cone under a
+         * non-uniform scale (the camera normal's clamped path) */
+        snprintf(geom, sizeof geom, "Translate 0 0 5\nRotate -50 1 0 0\n%s"
+            "AttributeBegin\nTranslate -0.7 0 0\nDisk 0.1 0.5 360\nAttributeEnd\n"
+            "AttributeBegin\nTranslate 0.1 0.3 0\nScale 1 0.7 1.2\nCone 0.8 0.4 300\n"
+            "AttributeEnd\n"
+            "AttributeBegin\nTranslate 0.6 -0.4 -0.3\nParaboloid 0.4 0 0.7 360\n"
+            "AttributeEnd\n", disp);
+        break;
+    case CORPUS_COLLAPSED:
+        /* Ng = 0 along an edge (v = 0): a bilinear patch with P00 = P10 (a
+         * triangle), a bicubic patch whose first row is one point (a
+         * dome's cap) and a hyperboloid from a point on its axis */
+        snprintf(geom, sizeof geom, "Translate 0 0 5\nRotate -40 1 0 0\n%s"
+            "AttributeBegin\nTranslate -0.6 0 0\n"
+            "Patch \"bilinear\" \"P\" [0 -0.5 0.2  0 -0.5 0.2  -0.5 0.5 -0.1  0.5 0.5 0.3]\n"
+            "AttributeEnd\n"
+            "AttributeBegin\nTranslate 0.5 0 0\n"
+            "Patch \"bicubic\" \"P\" [0 -0.5 0.4  0 -0.5 0.4  0 -0.5 0.4  0 -0.5 0.4  "
+            "-0.5 -0.2 0.1  -0.2 -0.1 0.5  0.2 -0.1 0.5  0.5 -0.2 0.1  "
+            "-0.5 0.2 0  -0.2 0.2 0.3  0.2 0.2 0.3  0.5 0.2 0  "
+            "-0.5 0.5 -0.2  -0.2 0.5 0  0.2 0.5 0  0.5 0.5 -0.2]\n"
+            "AttributeEnd\n"
+            "AttributeBegin\nTranslate 0 -0.6 0\n"
+            "Hyperboloid 0 0 0  0.4 0.1 0.5  360\nAttributeEnd\n", disp);
         break;
     default:
         return false;

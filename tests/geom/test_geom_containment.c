@@ -30,6 +30,21 @@
  * interval hull, so it should never lose). The ratio is printed.
  *
  * Bounds: geom_bounds contains every sample's P (polygons: inside ones).
+ *
+ * Unit normals and singular points: a quarter of the boxes end at v = 1,
+ * a quarter start at v = 0 and a quarter hold a corner of the square, so
+ * the grid samples the singular parameter values of every base exactly:
+ * the sphere's poles, the disk's centre, the cone's and the paraboloid's
+ * apex, and (fixtures of this test) the collapsed edges of a bilinear and
+ * a bicubic patch and a hyperboloid's point on its axis, where Ng = 0. At
+ * every sample the point path's unit normal (geom_normal_dual, normalised:
+ * what a shader's N is) must lie inside geom_unit_normal_ia's interval and
+ * geom_unit_normal_aa's range (up to its own rounding, 16 double
+ * epsilons) and, on the kinds with a closed form (surface_normal.inc),
+ * agree with the oracle's unit normal (that closed form in long double,
+ * the limit included) to 1e-9; the oracle's (elsewhere Ng/|Ng| where
+ * Ng != 0) must lie inside both too. The sharing check skips boxes at a
+ * paraboloid's apex (P ~ sqrt(v) there has no first-order part).
  */
 #include <stdarg.h>
 #include <stddef.h>
@@ -49,6 +64,7 @@ enum { NQ = 12, BOXES = 300, GRID = 7, RANDOM_PTS = 16 };
 
 typedef struct stats {
     long samples, skipped, ia_bad, aa_bad, corr_bad, bounds_bad;
+    long normals, normal_bad, singular;
     long small, decorrelated;
     double wdiff, wratio_num, wratio_den;
     long nwidth;
@@ -145,6 +161,92 @@ static void report(const char *name, const char *what, int q, double u, double v
                   name, what, q_names[q / 3], q % 3, u, v, x, lo, hi);
 }
 
+#define PI_L 3.141592653589793238462643383279502884L
+
+static ld sgnl(ld x) { return x < 0 ? -1 : 1; }
+
+/* The exact unit normal at (u,v), its limit where Ng = 0: the closed
+ * forms of surface_normal.c (kinds that have one) in long double, else
+ * Ng/|Ng|; false where that is not defined (Ng = 0 of a kind without a
+ * closed form). */
+static bool oracle_unit_normal(const geom_surface *s, double u, double v, const fx_exact *e,
+                               ld n[3])
+{
+    ld th = (ld)u * s->thetamax, c = cosl(th), sn = sinl(th), k = sgnl(s->thetamax);
+    switch (s->kind) {
+    case GEOM_SPHERE: {
+        ld dphi = (ld)s->phi1 - s->phi0;
+        for (int i = 0; i < 3; i++) n[i] = e->P[i] / s->radius * k * sgnl(dphi);
+        return true;
+    }
+    case GEOM_DISK:
+        n[0] = n[1] = 0;
+        n[2] = k;
+        return true;
+    case GEOM_CYLINDER:
+        k *= sgnl((ld)s->zmax - s->zmin);
+        n[0] = c * k;
+        n[1] = sn * k;
+        n[2] = 0;
+        return true;
+    case GEOM_CONE: {
+        ld h = s->height, r = s->radius, l = sqrtl(h * h + r * r);
+        n[0] = k * h * c / l;
+        n[1] = k * h * sn / l;
+        n[2] = k * r / l;
+        return true;
+    }
+    case GEOM_TORUS: {
+        ld dphi = (ld)s->phimax - s->phimin, phi = s->phimin + v * dphi;
+        k *= sgnl(dphi);
+        n[0] = k * cosl(phi) * c;
+        n[1] = k * cosl(phi) * sn;
+        n[2] = k * sinl(phi);
+        return true;
+    }
+    default: {
+        ld l = sqrtl(e->Ng[0] * e->Ng[0] + e->Ng[1] * e->Ng[1] + e->Ng[2] * e->Ng[2]);
+        if (!(l > 1e-12L) || !isfinite((double)l)) return false;
+        for (int i = 0; i < 3; i++) n[i] = e->Ng[i] / l;
+        return true;
+    }
+    }
+}
+
+/* the point path's unit normal at (u,v) and the boxes' unit normals */
+static void check_normal(const fx_surface *f, double u, double v, const fx_exact *e,
+                         const ia_interval Ni[3], const ia_interval Na[3], stats *st)
+{
+    const geom_surface *s = &f->s;
+    geom_sample g;
+    geom_eval_dual(s, u, v, &g);
+    vec3 N, dNdu, dNdv;
+    geom_normal_dual(s, u, v, &g, &N, &dNdu, &dNdv);
+    vec3 n = v3_normalize(N);
+    ld x[3];
+    bool exact = oracle_unit_normal(s, u, v, e, x);
+    st->normals++;
+    if (!(v3_length(g.Ng) > 0)) st->singular++;
+    for (int i = 0; i < 3; i++) {
+        double p = v3_comp(n, i), slack = 16 * DBL_EPSILON;
+        bool bad = !(p >= Ni[i].lo - slack && p <= Ni[i].hi + slack) ||
+                   !(p >= Na[i].lo - slack && p <= Na[i].hi + slack);
+        if (exact) {
+            ld tol = 128 * LDBL_EPSILON;
+            bad |= outside(x[i], Ni[i].lo, Ni[i].hi, tol) || outside(x[i], Na[i].lo, Na[i].hi, tol);
+            /* Ng/|Ng| in float loses digits close to a collapsed edge
+             * (Ng's terms cancel): the direction is compared where the
+             * normal has a closed form */
+            if (s->kind <= GEOM_CONE || s->kind == GEOM_TORUS) bad |= fabsl((ld)p - x[i]) > 1e-9L;
+        }
+        if (bad && st->normal_bad++ < 5)
+            print_message("  %s: unit normal[%d] at (%.17g, %.17g): point path %.17g, exact "
+                          "%.20Lg; interval [%.17g, %.17g], affine [%.17g, %.17g]\n",
+                          f->name, i, u, v, p, exact ? x[i] : (ld)NAN, Ni[i].lo, Ni[i].hi,
+                          Na[i].lo, Na[i].hi);
+    }
+}
+
 static void check_box(const fx_surface *f, const double *S, double u0, double u1,
                       double v0, double v1, int capacity, stats *st)
 {
@@ -160,6 +262,11 @@ static void check_box(const fx_surface *f, const double *S, double u0, double u1
     geom_eval_aa(&ctx, s, &U, &V, &ga);
     vec3 blo, bhi;
     geom_bounds(s, &blo, &bhi);
+    ia_interval Ni[3], Na[3];
+    aa_form Nf[3];
+    geom_unit_normal_ia(s, ia_make(u0, u1), ia_make(v0, v1), &gi, Ni);
+    geom_unit_normal_aa(&ctx, s, &U, &V, &ga, Nf);
+    for (int i = 0; i < 3; i++) Na[i] = aa_range(&Nf[i]);
 
     for (int q = 0; q < NQ; q++) {
         ia_interval a = aa_range(aa_q(&ga, q)), b = ia_q(&gi, q);
@@ -171,7 +278,9 @@ static void check_box(const fx_surface *f, const double *S, double u0, double u1
             st->nwidth++;
         }
     }
-    if (u1 - u0 > 0 && u1 - u0 <= 1e-3 && v1 - v0 > 0 && v1 - v0 <= 1e-3 && capacity > 2)
+    /* (not at a paraboloid's apex, where P ~ sqrt(v) has no first order) */
+    bool apex = s->kind == GEOM_PARABOLOID && s->zmin == 0 && v0 == 0;
+    if (u1 - u0 > 0 && u1 - u0 <= 1e-3 && v1 - v0 > 0 && v1 - v0 <= 1e-3 && capacity > 2 && !apex)
         for (int q = 0; q < NQ; q++) {
             const aa_form *fq = aa_q(&ga, q);
             if (fq->flags & AA_UNBOUNDED)
@@ -198,6 +307,7 @@ static void check_box(const fx_surface *f, const double *S, double u0, double u1
         if (capacity < 2)
             eu = ev = 0;
         st->samples++;
+        if (fx_on_surface(s, u, v)) check_normal(f, u, v, &e, Ni, Na, st);
         for (int q = 0; q < NQ; q++) {
             ld x = *oracle_q(&e, q);
             if (!isfinite((double)x)) {
@@ -221,11 +331,66 @@ static void check_box(const fx_surface *f, const double *S, double u0, double u1
     }
 }
 
+/* A quarter of the boxes end at v = 1, a quarter start at v = 0, a quarter
+ * hold a corner (see the top of the file). */
+static void snap_to_border(int b, double *u0, double *u1, double *v0, double *v1)
+{
+    double wu = *u1 - *u0, wv = *v1 - *v0;
+    switch (b % 4) {
+    case 1: *v1 = 1; *v0 = 1 - wv; break;
+    case 2: *v0 = 0; *v1 = wv; break;
+    case 3:
+        if (b % 8 == 3) { *u0 = 0; *u1 = wu; *v1 = 1; *v0 = 1 - wv; }
+        else { *u1 = 1; *u0 = 1 - wu; *v0 = 0; *v1 = wv; }
+        break;
+    default: break;
+    }
+}
+
+/* the fixtures, and bases with collapsed edges (Ng = 0 along v = 0) */
+static int surfaces(fx_surface **out)
+{
+    static fx_surface all[64];
+    static int n;
+    if (n == 0) {
+        fx_surface *fx;
+        int m = fx_surfaces(&fx);
+        for (int k = 0; k < m; k++) all[n++] = fx[k];
+        fx_surface *f = &all[n++];
+        f->name = "patch collapsed";             /* P00 = P10: a triangle */
+        f->s = fx_default(GEOM_PATCH);
+        f->s.verts[1] = f->s.verts[0];
+        f->s.verts[3] = v3(1, 1, 0.4);
+        f->size = 1.5;
+        f = &all[n++];
+        f->name = "bicubic collapsed";           /* the first row one point */
+        f->s = fx_default(GEOM_BICUBIC);
+        for (int k = 0; k < 16; k++) {
+            double x = (k % 4) / 1.5 - 1, y = (k / 4) / 1.5 - 1;
+            f->s.verts[k] = k < 4 ? v3(0, -1, 0.3) : v3(x, y, 1.2 - 0.6 * (x * x + y * y));
+        }
+        f->size = 2;
+        f = &all[n++];
+        f->name = "hyperboloid from axis";       /* point1 on the z axis */
+        f->s = fx_default(GEOM_HYPERBOLOID);
+        f->s.point1 = v3(0, 0, -0.5);
+        f->s.point2 = v3(0.8, 0.3, 0.7);
+        f->size = 1.5;
+        for (int k = m; k < n; k++) {
+            char why[200];
+            if (!geom_surface_prepare(&all[k].s, why, sizeof why))
+                fail_msg("fixture %s: %s", all[k].name, why);
+        }
+    }
+    *out = all;
+    return n;
+}
+
 static void test_containment(void **state)
 {
     (void)state;
     fx_surface *fx;
-    int n = fx_surfaces(&fx);
+    int n = surfaces(&fx);
     const int caps[3] = { 2, AA_DEFAULT_CAPACITY, AA_MAX_SYMBOLS };
     stats all = { 0 };
     fx_seed(11);
@@ -238,13 +403,15 @@ static void test_containment(void **state)
             if (b > 0) {
                 random_side(&u0, &u1);
                 random_side(&v0, &v1);
+                snap_to_border(b, &u0, &u1, &v0, &v1);
             }
             check_box(&fx[k], S, u0, u1, v0, v1, caps[b % 3], &st);
         }
         printf("%-22s %6ld samples: violations interval %ld, affine range %ld, "
-               "affine form %ld, bounds %ld; width affine/interval %.3f; "
-               "decorrelated %ld/%ld\n",
+               "affine form %ld, bounds %ld, unit normal %ld (of %ld, %ld where Ng = 0); "
+               "width affine/interval %.3f; decorrelated %ld/%ld\n",
                fx[k].name, st.samples, st.ia_bad, st.aa_bad, st.corr_bad, st.bounds_bad,
+               st.normal_bad, st.normals, st.singular,
                st.wratio_num / st.wratio_den, st.decorrelated, st.small);
         all.samples += st.samples;
         all.skipped += st.skipped;
@@ -252,6 +419,9 @@ static void test_containment(void **state)
         all.aa_bad += st.aa_bad;
         all.corr_bad += st.corr_bad;
         all.bounds_bad += st.bounds_bad;
+        all.normals += st.normals;
+        all.normal_bad += st.normal_bad;
+        all.singular += st.singular;
         all.wdiff += st.wdiff;
         all.decorrelated += st.decorrelated;
         all.small += st.small;
@@ -267,7 +437,11 @@ static void test_containment(void **state)
     assert_int_equal(all.ia_bad, 0);
     assert_int_equal(all.aa_bad, 0);
     assert_int_equal(all.corr_bad, 0);
+    printf("unit normals: %ld samples (%ld where Ng = 0), %ld violations\n", all.normals,
+           all.singular, all.normal_bad);
     assert_int_equal(all.bounds_bad, 0);
+    assert_int_equal(all.normal_bad, 0);
+    assert_true(all.singular > 100);
     assert_int_equal(all.decorrelated, 0);
     assert_true(all.small > 1000);
     assert_true(all.samples > 100000);
