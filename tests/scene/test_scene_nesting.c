@@ -23,6 +23,20 @@ static void repeat(sl_strbuf *b, const char *s, int n)
         sl_strbuf_puts(b, s);
 }
 
+/* Parses text (freed) without errors into a scene of nobjects objects. */
+static scene *parse_ok(sl_strbuf *text, int nobjects)
+{
+    sl_diag *d;
+    scene *s = parse_rib(text->data, &d);
+    assert_int_equal(sl_diag_error_count(d), 0);
+    assert_non_null(s);
+    assert_int_equal(s->nobjects, nobjects);
+    sl_diag_destroy(&d);
+    free(text->data);
+    *text = (sl_strbuf){ 0 };
+    return s;
+}
+
 /* 10,000 attribute blocks, each moving, colouring and lighting: the
  * innermost sphere has them all, the one after the blocks none. */
 static void test_attributes_10000_deep(void **state)
@@ -40,11 +54,7 @@ static void test_attributes_10000_deep(void **state)
     sl_strbuf_puts(&text, "Sphere 1 -1 1 360\n");
     repeat(&text, "AttributeEnd\n", DEPTH);
     sl_strbuf_puts(&text, "Sphere 1 -1 1 360\nWorldEnd\n");
-    sl_diag *d;
-    scene *s = parse_rib(text.data, &d);
-    assert_int_equal(sl_diag_error_count(d), 0);
-    assert_non_null(s);
-    assert_int_equal(s->nobjects, 2);
+    scene *s = parse_ok(&text, 2);
     assert_int_equal(s->nlights, DEPTH);
     const scene_object *inner = &s->objects[0], *outer = &s->objects[1];
     assert_true(inner->object_to_world.m[2][3] == DEPTH);
@@ -54,8 +64,6 @@ static void test_attributes_10000_deep(void **state)
     assert_true(outer->Cs[0] == 0.1 && outer->Cs[1] == 0.2 && outer->Cs[2] == 0.3);
     assert_int_equal(outer->nlights, 0);
     scene_destroy(&s);
-    sl_diag_destroy(&d);
-    free(text.data);
 }
 
 /* Transform blocks restore the transform alone: the colour set inside
@@ -70,17 +78,11 @@ static void test_transforms_10000_deep(void **state)
     sl_strbuf_puts(&text, "Color [0 1 0]\nSphere 1 -1 1 360\n");
     repeat(&text, "TransformEnd\n", DEPTH);
     sl_strbuf_puts(&text, "Sphere 1 -1 1 360\nWorldEnd\n");
-    sl_diag *d;
-    scene *s = parse_rib(text.data, &d);
-    assert_int_equal(sl_diag_error_count(d), 0);
-    assert_non_null(s);
-    assert_int_equal(s->nobjects, 2);
+    scene *s = parse_ok(&text, 2);
     assert_true(s->objects[0].object_to_world.m[0][3] == DEPTH);
     assert_true(s->objects[1].object_to_world.m[0][3] == 0);
     assert_true(s->objects[1].Cs[1] == 1);
     scene_destroy(&s);
-    sl_diag_destroy(&d);
-    free(text.data);
 }
 
 /* An object definition inside deep blocks: found at once by each request
@@ -97,14 +99,8 @@ static void test_object_inside_deep_blocks(void **state)
     sl_strbuf_puts(&text, "Sphere 1 -1 1 360\nObjectEnd\n");
     repeat(&text, "AttributeEnd\n", DEPTH);
     sl_strbuf_puts(&text, "ObjectInstance 1\nWorldEnd\n");
-    sl_diag *d;
-    scene *s = parse_rib(text.data, &d);
-    assert_int_equal(sl_diag_error_count(d), 0);
-    assert_non_null(s);
-    assert_int_equal(s->nobjects, 1);
+    scene *s = parse_ok(&text, 1);
     scene_destroy(&s);
-    sl_diag_destroy(&d);
-    free(text.data);
 }
 
 /* A million nested blocks: one error at the block past the limit, and
@@ -144,14 +140,8 @@ static void test_at_the_limit(void **state)
     sl_strbuf_puts(&text, "Sphere 1 -1 1 360\n");
     repeat(&text, "TransformEnd\n", RIB_MAX_BLOCKS - 1);
     sl_strbuf_puts(&text, "WorldEnd\n");
-    sl_diag *d;
-    scene *s = parse_rib(text.data, &d);
-    assert_int_equal(sl_diag_error_count(d), 0);
-    assert_non_null(s);
-    assert_int_equal(s->nobjects, 1);
+    scene *s = parse_ok(&text, 1);
     scene_destroy(&s);
-    sl_diag_destroy(&d);
-    free(text.data);
 }
 
 int main(void)

@@ -36,35 +36,51 @@ static void repeat(sl_strbuf *b, const char *s, int n)
         sl_strbuf_puts(b, s);
 }
 
-/* `src` fails to compile and its first diagnostic is exactly `first`. */
-static void expect_first_error(sl_strbuf *src, const char *first)
+/* head, n times open, middle, n times close, tail. */
+static sl_strbuf nest(const char *head, const char *open, int n, const char *middle,
+                      const char *close, const char *tail)
 {
-    char *text = NULL;
-    sl_program *p = h_compile_named("t.sl", src->data, &text);
-    assert_null(p);
-    size_t len = strcspn(text, "\n");
-    if (strlen(first) != len || strncmp(text, first, len) != 0)
-        fprintf(stderr, "got: %.*s\nwanted: %s\n", (int)len, text, first);
-    assert_int_equal(len, strlen(first));
-    assert_memory_equal(text, first, len);
-    free(text);
-    free(src->data);
-    *src = (sl_strbuf){ 0 };
+    sl_strbuf b = { 0 };
+    sl_strbuf_puts(&b, head);
+    repeat(&b, open, n);
+    sl_strbuf_puts(&b, middle);
+    repeat(&b, close, n);
+    sl_strbuf_puts(&b, tail);
+    return b;
 }
 
-/* `src` compiles; the program has fewer than `max_code` instructions. */
-static void expect_compiled(sl_strbuf *src, int max_code)
+/* `src` (freed) fails to compile; its first diagnostic is exactly `first`,
+ * or with first NULL, some diagnostic holds `part`. */
+static void expect_error(sl_strbuf src, const char *first, const char *part)
 {
     char *text = NULL;
-    sl_program *p = h_compile_named("t.sl", src->data, &text);
+    sl_program *p = h_compile_named("t.sl", src.data, &text);
+    assert_null(p);
+    size_t len = strcspn(text, "\n");
+    if (first && (strlen(first) != len || strncmp(text, first, len) != 0))
+        fprintf(stderr, "got: %.*s\nwanted: %s\n", (int)len, text, first);
+    if (first) {
+        assert_int_equal(len, strlen(first));
+        assert_memory_equal(text, first, len);
+    } else {
+        assert_non_null(strstr(text, part));
+    }
+    free(text);
+    free(src.data);
+}
+
+/* `src` (freed) compiles; the program has fewer than `max_code` instructions. */
+static void expect_compiled(sl_strbuf src, int max_code)
+{
+    char *text = NULL;
+    sl_program *p = h_compile_named("t.sl", src.data, &text);
     if (!p)
         fprintf(stderr, "%.300s\n", text);
     assert_non_null(p);
     assert_true(p->ncode < max_code);
     sl_program_destroy(&p);
     free(text);
-    free(src->data);
-    *src = (sl_strbuf){ 0 };
+    free(src.data);
 }
 
 /* ---------------------------------------------------------------------- */
@@ -74,35 +90,25 @@ static void expect_compiled(sl_strbuf *src, int max_code)
 static void test_pp_if_chain(void **state)
 {
     (void)state;
-    sl_strbuf src = { 0 };
-    sl_strbuf_puts(&src, "#if 1");
-    repeat(&src, "+1", MILLION - 1);          /* iterative: precedence climbing */
-    sl_strbuf_puts(&src, " == 1000000\ndisplacement d() { }\n#endif\n");
-    expect_compiled(&src, 8);
+    /* iterative: precedence climbing */
+    expect_compiled(nest("#if 1", "+1", MILLION - 1, "", "",
+                         " == 1000000\ndisplacement d() { }\n#endif\n"), 8);
 }
 
 static void test_pp_if_parens(void **state)
 {
     (void)state;
-    sl_strbuf src = { 0 };
-    sl_strbuf_puts(&src, "#if ");
-    repeat(&src, "(", MILLION);
-    sl_strbuf_puts(&src, "1");
-    repeat(&src, ")", MILLION);
-    sl_strbuf_puts(&src, "\n#endif\ndisplacement d() { }\n");
     /* ex_cond and ex_unary count 2 levels a parenthesis: the 129th */
-    expect_first_error(&src, "t.sl:1:133: error: #if expression nested too deeply (more than "
-                             "256 levels): simplify it");
+    expect_error(nest("#if ", "(", MILLION, "1", ")", "\n#endif\ndisplacement d() { }\n"),
+                 "t.sl:1:133: error: #if expression nested too deeply (more than 256 levels): "
+                 "simplify it", NULL);
 }
 
 static void test_pp_nested_if(void **state)
 {
     (void)state;
-    sl_strbuf src = { 0 };
-    repeat(&src, "#if 1\n", 300000);           /* a stack of conditions, no recursion */
-    sl_strbuf_puts(&src, "displacement d() { }\n");
-    repeat(&src, "#endif\n", 300000);
-    expect_compiled(&src, 8);
+    /* a stack of conditions, no recursion */
+    expect_compiled(nest("", "#if 1\n", 300000, "displacement d() { }\n", "#endif\n", ""), 8);
 }
 
 /* ---------------------------------------------------------------------- */
@@ -112,77 +118,50 @@ static void test_pp_nested_if(void **state)
 static const char expr_deep[] = "error: expression nested too deeply (more than 200 levels): "
                                 "split it into statements with temporary variables";
 
-static void expect_expr_deep(sl_strbuf *src, int col)
+static void expect_expr_deep(sl_strbuf src, int col)
 {
     char want[256];
     snprintf(want, sizeof want, "t.sl:1:%d: %s", col, expr_deep);
-    expect_first_error(src, want);
+    expect_error(src, want, NULL);
 }
 
 static void test_parse_parens(void **state)
 {
     (void)state;
-    sl_strbuf src = { 0 };
-    sl_strbuf_puts(&src, "displacement d() { float x = ");
-    repeat(&src, "(", MILLION);
-    sl_strbuf_puts(&src, "s");
-    repeat(&src, ")", MILLION);
-    sl_strbuf_puts(&src, "; }\n");
     /* one level for the initializer, two per parenthesis (expression and
      * unary): the 100th parenthesis, at column 30 + 99 */
-    expect_expr_deep(&src, 129);
+    expect_expr_deep(nest("displacement d() { float x = ", "(", MILLION, "s", ")", "; }\n"),
+                     129);
 }
 
 static void test_parse_unary(void **state)
 {
     (void)state;
-    sl_strbuf src = { 0 };
-    sl_strbuf_puts(&src, "displacement d() { float x = ");
-    repeat(&src, "-", MILLION);
-    sl_strbuf_puts(&src, "s; }\n");
-    expect_expr_deep(&src, 29 + 199);
+    expect_expr_deep(nest("displacement d() { float x = ", "-", MILLION, "s; }\n", "", ""),
+                     29 + 199);
 }
 
 static void test_parse_assignments(void **state)
 {
     (void)state;
-    sl_strbuf src = { 0 };
-    sl_strbuf_puts(&src, "displacement d() { float x; ");
-    repeat(&src, "x=", MILLION);
-    sl_strbuf_puts(&src, "s; }\n");
-    char *text = NULL;
-    assert_null(h_compile_named("t.sl", src.data, &text));
-    assert_non_null(strstr(text, expr_deep));
-    free(text);
-    free(src.data);
+    expect_error(nest("displacement d() { float x; ", "x=", MILLION, "s; }\n", "", ""), NULL,
+                 expr_deep);
 }
 
 static void test_parse_conditionals(void **state)
 {
     (void)state;
-    sl_strbuf src = { 0 };
-    sl_strbuf_puts(&src, "displacement d() { float x = ");
-    repeat(&src, "s>0?1:", 600000);
-    sl_strbuf_puts(&src, "s; }\n");
-    char *text = NULL;
-    assert_null(h_compile_named("t.sl", src.data, &text));
-    assert_non_null(strstr(text, expr_deep));
-    free(text);
-    free(src.data);
+    expect_error(nest("displacement d() { float x = ", "s>0?1:", 600000, "s; }\n", "", ""),
+                 NULL, expr_deep);
 }
 
 static void test_parse_blocks(void **state)
 {
     (void)state;
-    sl_strbuf src = { 0 };
-    sl_strbuf_puts(&src, "displacement d() { ");
-    repeat(&src, "{", MILLION);
-    sl_strbuf_puts(&src, "float x = s;");
-    repeat(&src, "}", MILLION);
-    sl_strbuf_puts(&src, " }\n");
     /* the shader's own block is no statement: the 201st '{' */
-    expect_first_error(&src, "t.sl:1:220: error: statements nested too deeply (more than 200 "
-                             "levels): move the inner blocks into functions");
+    expect_error(nest("displacement d() { ", "{", MILLION, "float x = s;", "}", " }\n"),
+                 "t.sl:1:220: error: statements nested too deeply (more than 200 levels): "
+                 "move the inner blocks into functions", NULL);
 }
 
 /* ---------------------------------------------------------------------- */
@@ -192,75 +171,55 @@ static void test_parse_blocks(void **state)
 static void test_chain_folded(void **state)
 {
     (void)state;
-    sl_strbuf src = { 0 };
-    sl_strbuf_puts(&src, "displacement d() { P += (1");
-    repeat(&src, "*1", MILLION - 1);           /* folds to 1: every pass walks it */
-    sl_strbuf_puts(&src, ") * N; }\n");
-    expect_compiled(&src, 16);
+    /* folds to 1: every pass walks it */
+    expect_compiled(nest("displacement d() { P += (1", "*1", MILLION - 1, ") * N; }\n", "", ""),
+                    16);
 }
 
 static void test_chain_logical(void **state)
 {
     (void)state;
-    sl_strbuf src = { 0 };
-    sl_strbuf_puts(&src, "displacement d() { float x = 0; if (0");
-    repeat(&src, "+0", 400000);                 /* + binds tighter than && */
-    repeat(&src, "&&u>0", 100000);
-    sl_strbuf_puts(&src, ") x = 1; }\n");
-    char *text = NULL;
-    assert_null(h_compile_named("t.sl", src.data, &text));
-    assert_non_null(strstr(text, "error: shader needs more than 4096 registers (the limit per "
-                                 "shader)"));
-    free(text);
-    free(src.data);
+    /* + binds tighter than && */
+    expect_error(nest("displacement d() { float x = 0; if (0", "+0", 300000, "", "&&u>0",
+                      ") x = 1; }\n"),
+                 NULL, "error: shader needs more than 4096 registers (the limit per shader)");
 }
 
 static void test_chain_registers(void **state)
 {
     (void)state;
-    sl_strbuf src = { 0 };
-    sl_strbuf_puts(&src, "displacement d() { float x = s");
-    repeat(&src, "+s", MILLION - 1);
-    sl_strbuf_puts(&src, "; }\n");
     /* each partial sum takes a register: the 4096 are full at the 4050th '+' */
-    expect_first_error(&src, "t.sl:1:8129: error: shader needs more than 4096 registers (the "
-                             "limit per shader)");
+    expect_error(nest("displacement d() { float x = s", "+s", MILLION - 1, "; }\n", "", ""),
+                 "t.sl:1:8129: error: shader needs more than 4096 registers (the limit per "
+                 "shader)", NULL);
 }
 
 static void test_chain_checked(void **state)
 {
     (void)state;
-    sl_strbuf src = { 0 };
-    sl_strbuf_puts(&src, "displacement d() { float x = ");
-    repeat(&src, "0+", MILLION);
-    sl_strbuf_puts(&src, "q; }\n");
     char want[128];
     snprintf(want, sizeof want, "t.sl:1:%d: error: use of undeclared identifier 'q'",
              30 + 2 * MILLION);
-    expect_first_error(&src, want);
+    expect_error(nest("displacement d() { float x = ", "0+", MILLION, "q; }\n", "", ""), want,
+                 NULL);
 }
 
 static void test_chain_in_class(void **state)
 {
     (void)state;
-    sl_strbuf src = { 0 };
-    sl_strbuf_puts(&src, "class c() { public void displacement(output point P; output normal N) "
-                         "{ P += (0");
-    repeat(&src, "+0", MILLION - 1);
-    sl_strbuf_puts(&src, ") * N; } }\n");
-    expect_compiled(&src, 16);
+    expect_compiled(nest("class c() { public void displacement(output point P; output normal N) "
+                         "{ P += (0", "+0", MILLION - 1, ") * N; } }\n", "", ""), 16);
 }
 
 static void test_many_escapes(void **state)
 {
     (void)state;
-    sl_strbuf src = { 0 };
-    sl_strbuf_puts(&src, "float f(float a) { ");
-    repeat(&src, "if(a>0)return 1;", 200000);  /* each guards the rest */
-    sl_strbuf_puts(&src, "return 0; }\ndisplacement d() { P += f(u) * N; }\n");
-    /* thousands of guards open (not nested calls) when the code is full */
-    expect_first_error(&src, "t.sl:1:131076: error: shader too large: more than 65534 "
-                             "instructions (after inlining functions)");
+    /* each guards the rest: thousands of guards open (not nested calls)
+     * when the code is full */
+    expect_error(nest("float f(float a) { ", "if(a>0)return 1;", 200000,
+                      "return 0; }\ndisplacement d() { P += f(u) * N; }\n", "", ""),
+                 "t.sl:1:131076: error: shader too large: more than 65534 instructions (after "
+                 "inlining functions)", NULL);
 }
 
 /* 63 functions each calling the previous one from inside `blocks` nested
@@ -290,18 +249,12 @@ static void test_inlined_nesting(void **state)
     assert_true(SL_CG_MAX_DEPTH < SL_MAX_INLINE_DEPTH * SL_PARSE_MAX_DEPTH);
     sl_strbuf src = { 0 };
     nested_calls(&src, 150, 40);
-    char *text = NULL;
-    assert_null(h_compile_named("t.sl", src.data, &text));
-    assert_non_null(strstr(text, "error: expressions and statements nested too deeply once "
-                                 "function calls are inlined (more than 1000 levels): call the "
-                                 "functions here less deeply, or split their nested code into "
-                                 "statements"));
-    free(text);
-    free(src.data);
-
+    expect_error(src, NULL, "error: expressions and statements nested too deeply once function "
+                            "calls are inlined (more than 1000 levels): call the functions here "
+                            "less deeply, or split their nested code into statements");
     src = (sl_strbuf){ 0 };
     nested_calls(&src, 2, 2);                  /* the same calls, shallow: compiles */
-    expect_compiled(&src, 60000);
+    expect_compiled(src, 60000);
 }
 
 int main(void)
