@@ -19,6 +19,7 @@
 #include "util/err.h"
 #include "util/xalloc.h"
 
+#include <assert.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -46,29 +47,43 @@ void rib_attributes_init(rib_attributes *a)
 void rib_attributes_copy(rib_attributes *dst, const rib_attributes *src)
 {
     *dst = *src;
-    if (src->nlight_on > 0) {
-        dst->light_on = xrealloc(NULL, (size_t)src->nlight_on);
-        memcpy(dst->light_on, src->light_on, (size_t)src->nlight_on);
-    } else {
-        dst->light_on = NULL;
-    }
+    if (dst->lights_on)
+        dst->lights_on->refs++;       /* shared: copied when either changes it */
 }
 
 void rib_attributes_clear(rib_attributes *a)
 {
-    free(a->light_on);
-    a->light_on = NULL;
-    a->nlight_on = 0;
+    rib_light_set *s = a->lights_on;
+    if (s) {
+        assert(s->refs > 0);
+        if (--s->refs == 0)
+            free(s);
+    }
+    a->lights_on = NULL;
 }
 
 static void set_light_on(rib_attributes *a, int index, bool on)
 {
-    if (index >= a->nlight_on) {
-        a->light_on = xrealloc(a->light_on, (size_t)index + 1);
-        memset(a->light_on + a->nlight_on, 0, (size_t)(index + 1 - a->nlight_on));
-        a->nlight_on = index + 1;
+    rib_light_set *s = a->lights_on;
+    int n = s ? s->n : 0;
+    if (!s || s->refs > 1 || index >= s->cap) {     /* a copy of its own, with room */
+        int cap = s ? s->cap : 8;
+        while (cap <= index)
+            cap *= 2;
+        rib_light_set *t = xmalloc(sizeof *t + (size_t)cap);
+        t->refs = 1;
+        t->n = n;
+        t->cap = cap;
+        if (n > 0)
+            memcpy(t->on, s->on, (size_t)n);
+        rib_attributes_clear(a);
+        a->lights_on = s = t;
     }
-    a->light_on[index] = on;
+    if (index >= s->n) {
+        memset(s->on + s->n, 0, (size_t)(index + 1 - s->n));
+        s->n = index + 1;
+    }
+    s->on[index] = on;
 }
 
 /* ---------------------------------------------------------------------- */

@@ -100,8 +100,9 @@ static void object_lights(const rib_parser *p, scene_object *o)
     const rib_attributes *a = &p->attr;
     o->lights = xrealloc(NULL, (size_t)(p->scene->nlights ? p->scene->nlights : 1) *
                             sizeof *o->lights);
-    for (int i = 0; i < p->scene->nlights && i < a->nlight_on; i++)
-        if (a->light_on[i])
+    int n = a->lights_on ? a->lights_on->n : 0;
+    for (int i = 0; i < p->scene->nlights && i < n; i++)
+        if (a->lights_on->on[i])
             o->lights[o->nlights++] = i;
 }
 

@@ -58,21 +58,21 @@ static rib_object_def *find_def(rib_parser *p, const char *handle)
 
 void rib_object_begin(rib_parser *p, const rib_request *req)
 {
-    for (int i = 0; i < p->nblocks; i++)
-        if (p->blocks[i].kind == RIB_BLOCK_OBJECT) {
-            const rib_block *b = &p->blocks[i];
-            rib_error(p, req, req->pos, "object definitions cannot nest: the ObjectBegin at "
-                      "%s:%d:%d is still open (missing ObjectEnd)", b->pos.file, b->pos.line,
-                      b->pos.col);
-            return;
-        }
+    const rib_object_def *open = rib_defining(p);
+    if (open) {
+        rib_error(p, req, req->pos, "object definitions cannot nest: the ObjectBegin at "
+                  "%s:%d:%d is still open (missing ObjectEnd)", open->pos.file, open->pos.line,
+                  open->pos.col);
+        return;
+    }
     char *handle = req->broken ? NULL : handle_of(p, req);
     p->defs = xrealloc(p->defs, (size_t)(p->ndefs + 1) * sizeof *p->defs);
     rib_object_def *d = &p->defs[p->ndefs++];
     memset(d, 0, sizeof *d);
     d->handle = handle;              /* NULL: malformed, never found */
     d->pos = req->pos;
-    rib_push_block(p, RIB_BLOCK_OBJECT, req->pos);
+    if (!rib_push_block(p, req, RIB_BLOCK_OBJECT))
+        return;
     p->blocks[p->nblocks - 1].object_def = p->ndefs - 1;
     p->attr.ctm = mat4_identity();
 }
@@ -84,10 +84,8 @@ void rib_object_end(rib_parser *p, const rib_request *req)
 
 rib_object_def *rib_defining(rib_parser *p)
 {
-    for (int i = p->nblocks - 1; i >= 0; i--)
-        if (p->blocks[i].kind == RIB_BLOCK_OBJECT)
-            return &p->defs[p->blocks[i].object_def];
-    return NULL;
+    int i = p->nblocks > 0 ? p->blocks[p->nblocks - 1].object_block : -1;   /* O(1) */
+    return i >= 0 ? &p->defs[p->blocks[i].object_def] : NULL;
 }
 
 void rib_record_surface(rib_parser *p, const rib_request *req, const geom_surface *surf)

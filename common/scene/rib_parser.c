@@ -209,14 +209,28 @@ static const char *end_name(rib_block_kind kind)
     return names[kind];
 }
 
-void rib_push_block(rib_parser *p, rib_block_kind kind, sl_pos pos)
+bool rib_push_block(rib_parser *p, const rib_request *req, rib_block_kind kind)
 {
+    if (p->nblocks >= RIB_MAX_BLOCKS) {
+        if (!p->blocks_overflow)
+            rib_error(p, req, req->pos, "blocks nested too deeply (more than %d open at once): "
+                      "flatten the nesting of AttributeBegin/TransformBegin blocks",
+                      RIB_MAX_BLOCKS);
+        p->blocks_overflow = true;
+        return false;
+    }
     p->blocks = grow(p->blocks, p->nblocks, &p->blocks_cap, sizeof *p->blocks);
-    rib_block *b = &p->blocks[p->nblocks++];
+    const rib_block *outer = p->nblocks > 0 ? &p->blocks[p->nblocks - 1] : NULL;
+    int index = p->nblocks++;
+    rib_block *b = &p->blocks[index];
     b->kind = kind;
-    b->pos = pos;
+    b->pos = req->pos;
     b->object_def = -1;
+    b->object_block = kind == RIB_BLOCK_OBJECT ? index : outer ? outer->object_block : -1;
+    b->frame_world_block = outer && outer->frame_world_block >= 0 ? outer->frame_world_block
+                           : kind == RIB_BLOCK_FRAME || kind == RIB_BLOCK_WORLD ? index : -1;
     rib_attributes_copy(&b->saved, &p->attr);
+    return true;
 }
 
 /* The end of the world: it must hold an object (unless the objects it
@@ -290,13 +304,13 @@ static void frame_begin(rib_parser *p, const rib_request *req)
     bool one_number = req->nargs == 1 && req->args[0].kind == RIB_ARG_NUMBER;
     if (!req->broken && req->nargs > 0 && !one_number)
         rib_error(p, req, req->pos, "takes one argument, the frame number");
-    for (int i = 0; i < p->nblocks; i++)
-        if (p->blocks[i].kind == RIB_BLOCK_FRAME || p->blocks[i].kind == RIB_BLOCK_WORLD) {
-            const rib_block *b = &p->blocks[i];
-            rib_error(p, req, req->pos, "not allowed inside the %s opened at %s:%d:%d",
-                      begin_name(b->kind), b->pos.file, b->pos.line, b->pos.col);
-            return;
-        }
+    int fw = p->nblocks > 0 ? p->blocks[p->nblocks - 1].frame_world_block : -1;
+    if (fw >= 0) {
+        const rib_block *b = &p->blocks[fw];
+        rib_error(p, req, req->pos, "not allowed inside the %s opened at %s:%d:%d",
+                  begin_name(b->kind), b->pos.file, b->pos.line, b->pos.col);
+        return;
+    }
     scene *s = p->scene;
     int number = s->nframes > 0 ? s->frame_numbers[s->nframes - 1] + 1 : 1;
     if (one_number && !req->broken) {
@@ -319,7 +333,8 @@ static void frame_begin(rib_parser *p, const rib_request *req)
     }
     s->frame = index;
     s->frame_number = number;
-    rib_push_block(p, RIB_BLOCK_FRAME, req->pos);
+    if (!rib_push_block(p, req, RIB_BLOCK_FRAME))
+        return;
 }
 
 static void frame_end(rib_parser *p, const rib_request *req)
@@ -348,7 +363,8 @@ static void world_begin(rib_parser *p, const rib_request *req)
                   "Transform and ConcatTransform requests before WorldBegin)");
     p->scene->shading_rate = p->attr.shading_rate;
     rib_shaders_finish(p);
-    rib_push_block(p, RIB_BLOCK_WORLD, req->pos);
+    if (!rib_push_block(p, req, RIB_BLOCK_WORLD))
+        return;
     p->attr.ctm = mat4_identity();
     p->in_world = p->world_seen = true;
     p->world_pos = req->pos;
@@ -361,7 +377,8 @@ static void world_end(rib_parser *p, const rib_request *req)
 
 static void attribute_begin(rib_parser *p, const rib_request *req)
 {
-    rib_push_block(p, RIB_BLOCK_ATTRIBUTE, req->pos);
+    if (!rib_push_block(p, req, RIB_BLOCK_ATTRIBUTE))
+        return;
 }
 
 static void attribute_end(rib_parser *p, const rib_request *req)
@@ -371,7 +388,8 @@ static void attribute_end(rib_parser *p, const rib_request *req)
 
 static void transform_begin(rib_parser *p, const rib_request *req)
 {
-    rib_push_block(p, RIB_BLOCK_TRANSFORM, req->pos);
+    if (!rib_push_block(p, req, RIB_BLOCK_TRANSFORM))
+        return;
 }
 
 static void transform_end(rib_parser *p, const rib_request *req)
@@ -749,14 +767,14 @@ static void parser_clear(rib_parser *p)
 void rib_parser_run(rib_parser *p)
 {
     rib_request *req;
-    while (!sl_diag_full(p->diag) && (req = rib_reader_next(p->reader)))
+    while (!sl_diag_full(p->diag) && !p->blocks_overflow && (req = rib_reader_next(p->reader)))
         dispatch(p, req);
 }
 
 static void parse_all(rib_parser *p)
 {
     rib_parser_run(p);
-    if (!sl_diag_full(p->diag))
+    if (!sl_diag_full(p->diag) && !p->blocks_overflow)
         finish(p);
 }
 

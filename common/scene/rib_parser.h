@@ -35,6 +35,16 @@
 #include "sl/diag.h"
 #include "sl/source.h"
 
+/* The lights on for new objects, one byte per scene light (Illuminate),
+ * shared by the current attributes and the blocks that saved them and
+ * copied on write, so that AttributeBegin costs the same whatever the
+ * number of lights. */
+typedef struct rib_light_set {
+    int refs;
+    int n, cap;
+    unsigned char on[];
+} rib_light_set;
+
 /* The attributes of RI Spec §4.2 that aafarm records. */
 typedef struct rib_attributes {
     mat4 ctm;                      /* current transform (see above) */
@@ -47,8 +57,7 @@ typedef struct rib_attributes {
     const char *bound_space;       /* interned (rib_parser_intern) */
     const char *name;              /* interned, or NULL */
     bool shadows;                  /* Attribute "light" "shadows" */
-    unsigned char *light_on;       /* per scene light: on for new objects */
-    int nlight_on;
+    rib_light_set *lights_on;      /* NULL: none on */
     double ubasis[16], vbasis[16]; /* Basis (row-major, RIB order; bezier) */
     int ustep, vstep;              /* Basis steps (3 3) */
 } rib_attributes;
@@ -61,11 +70,20 @@ typedef enum rib_block_kind {
     RIB_BLOCK_OBJECT,              /* ObjectBegin: defs[object_def] */
 } rib_block_kind;
 
+/* At most this many blocks open at once (docs/scenes.md, Limits): each
+ * saves the attributes (about 500 bytes), and a deeper RIB is either an
+ * attack or a generator's bug. */
+enum { RIB_MAX_BLOCKS = 100000 };
+
+/* An open block. What the requests ask of the stack is kept per block, so
+ * that every push, pop and question costs O(1) at any depth. */
 typedef struct rib_block {
     rib_block_kind kind;
     sl_pos pos;                    /* where it opened */
     rib_attributes saved;          /* restored when it closes */
     int object_def;                /* RIB_BLOCK_OBJECT: index into defs */
+    int object_block;              /* the open ObjectBegin block at or below, -1: none */
+    int frame_world_block;         /* the outermost open Frame or World block, -1: none */
 } rib_block;
 
 /* A surface of an object definition, with the transform current inside
@@ -141,6 +159,7 @@ typedef struct rib_parser {
     sl_pos motion_pos;
     int max_objects;               /* SCENE_MAX_OBJECTS or the caller's */
     bool objects_overflow;         /* that limit was reported */
+    bool blocks_overflow;          /* RIB_MAX_BLOCKS was passed: the parse stops */
 } rib_parser;
 
 /* Reports an error / warning naming the request: "Sphere: <message>". */
@@ -325,7 +344,8 @@ void rib_place_surface(rib_parser *p, const rib_request *req, const geom_surface
                        mat4 ctm, sl_pos pos, const scene_primvar *vars, int nvars);
 
 /* rib_parser.c: blocks */
-void rib_push_block(rib_parser *p, rib_block_kind kind, sl_pos pos);
+/* False (reported, and the parse stops) past RIB_MAX_BLOCKS. */
+bool rib_push_block(rib_parser *p, const rib_request *req, rib_block_kind kind);
 void rib_close_block(rib_parser *p, const rib_request *req, rib_block_kind kind);
 
 /* Growing the scene's arrays (rib_parser.c). */

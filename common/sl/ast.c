@@ -5,6 +5,9 @@
 #include "sl/ast.h"
 #include "sl/strbuf.h"
 
+#include "util/xalloc.h"
+
+#include <assert.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -91,4 +94,31 @@ void sl_list_push(sl_arena *arena, void ***list, int *n, int *cap, void *item)
         *cap = ncap;
     }
     (*list)[(*n)++] = item;
+}
+
+void sl_spine_collect(sl_spine *s, sl_node *n)
+{
+    assert(n && n->kind == SL_N_BINARY);
+    s->v = s->inline_v;
+    s->n = 0;
+    s->cap = SL_SPINE_INLINE;
+    for (; n->kind == SL_N_BINARY; n = n->a) {
+        if (s->n == s->cap) {
+            s->cap *= 2;
+            if (s->v == s->inline_v) {
+                s->v = xreallocarray(NULL, (size_t)s->cap, sizeof *s->v);
+                memcpy(s->v, s->inline_v, sizeof s->inline_v);
+            } else {
+                s->v = xreallocarray(s->v, (size_t)s->cap, sizeof *s->v);
+            }
+        }
+        s->v[s->n++] = n;
+    }
+}
+
+void sl_spine_clear(sl_spine *s)
+{
+    if (s->v != s->inline_v)
+        free(s->v);
+    memset(s, 0, sizeof *s);
 }

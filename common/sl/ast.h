@@ -182,6 +182,25 @@ typedef struct sl_ast_file {
 } sl_ast_file;
 
 sl_node *sl_node_new(sl_arena *arena, sl_node_kind kind, sl_pos pos);
+
+/* The left spine of a chain of binary operators. `a + b + c` parses as
+ * `(a + b) + c`, so a chain of n terms is a tree n deep along `a`; the
+ * parser builds it with a loop, and every later pass walks it with a loop
+ * over the spine instead of recursing along `a` (the other edges of the
+ * tree are bounded by SL_PARSE_MAX_DEPTH: docs/shading-language.md,
+ * Limits). v[0] is the node given, v[i + 1] is v[i]->a, and v[n - 1]->a
+ * is not an SL_N_BINARY. Chains up to SL_SPINE_INLINE long need no heap. */
+enum { SL_SPINE_INLINE = 16 };
+typedef struct sl_spine {
+    sl_node **v;
+    int n, cap;
+    sl_node *inline_v[SL_SPINE_INLINE];
+} sl_spine;
+
+/* Fills *s (not initialised before) with the spine under n (an SL_N_BINARY);
+ * the struct must not be copied while in use. */
+void sl_spine_collect(sl_spine *s, sl_node *n);
+void sl_spine_clear(sl_spine *s);
 /* Appends to a growing pointer array kept in the arena. */
 void sl_list_push(sl_arena *arena, void ***list, int *n, int *cap, void *item);
 

@@ -203,15 +203,16 @@ bool ck_can_convert(sl_ty have, sl_ty want)
  * it) the triple or matrix type `want`. */
 static void retype_list(sl_node *e, sl_ty want)
 {
-    if (!e || !sl_ty_is_list(e->ty))
-        return;
-    e->ty = want;
-    switch (e->kind) {
-    case SL_N_CAST: e->cast_ty = want; break;
-    case SL_N_UNARY: retype_list(e->a, want); break;
-    case SL_N_BINARY: retype_list(e->a, want); retype_list(e->b, want); break;
-    case SL_N_COND: retype_list(e->b, want); retype_list(e->c, want); break;
-    default: break;
+    /* a loop along a (a chain of operators: ast.h, sl_spine) and c */
+    while (e && sl_ty_is_list(e->ty)) {
+        e->ty = want;
+        switch (e->kind) {
+        case SL_N_CAST: e->cast_ty = want; return;
+        case SL_N_UNARY: e = e->a; break;
+        case SL_N_BINARY: retype_list(e->b, want); e = e->a; break;
+        case SL_N_COND: retype_list(e->b, want); e = e->c; break;
+        default: return;
+        }
     }
 }
 
@@ -246,9 +247,9 @@ static sl_ty settle(checker *c, sl_node *e)
     return e->ty = SL_TY_ERROR;
 }
 
-static void check_cond(checker *c, sl_node **np)
+/* *np, of type ty (checked), used as a condition. */
+static void cond_of(checker *c, sl_node **np, sl_ty ty)
 {
-    sl_ty ty = ck_check_expr(c, np, SL_TY_BOOL);
     if (ty == SL_TY_BOOL || ty == SL_TY_ERROR)
         return;
     if (ty == SL_TYPE_FLOAT) {
@@ -258,6 +259,11 @@ static void check_cond(checker *c, sl_node **np)
     ck_error(c, (*np)->pos, "a value of type '%s' cannot be used as a condition",
           sl_ty_name(ty));
     (*np)->ty = SL_TY_ERROR;
+}
+
+static void check_cond(checker *c, sl_node **np)
+{
+    cond_of(c, np, ck_check_expr(c, np, SL_TY_BOOL));
 }
 
 /* ---------------------------------------------------------------------- */
@@ -356,15 +362,17 @@ static sl_ty compare_type(checker *c, const sl_node *n, sl_ty a, sl_ty b)
     return SL_TY_ERROR;
 }
 
-static sl_ty check_binary(checker *c, sl_node *n)
+static bool is_logical(int op) { return op == SL_TOK_AND || op == SL_TOK_OR; }
+
+/* Binary node n after its left operand n->a was checked (type a). */
+static sl_ty check_binary_rest(checker *c, sl_node *n, sl_ty a)
 {
     int op = n->op;
-    if (op == SL_TOK_AND || op == SL_TOK_OR) {
-        check_cond(c, &n->a);
+    if (is_logical(op)) {
+        cond_of(c, &n->a, a);
         check_cond(c, &n->b);
         return ck_set_ty(n, SL_TY_BOOL);
     }
-    sl_ty a = ck_check_expr(c, &n->a, SL_TYPE_VOID);
     sl_ty b = ck_check_expr(c, &n->b, SL_TYPE_VOID);
     if (a == SL_TY_ERROR || b == SL_TY_ERROR)
         return ck_set_ty(n, SL_TY_ERROR);
@@ -404,6 +412,21 @@ static sl_ty check_binary(checker *c, sl_node *n)
     ck_error(c, n->pos, "invalid operands to binary '%s' ('%s' and '%s')",
           sl_token_kind_spelling(op), sl_ty_name(a), sl_ty_name(b));
     return ck_set_ty(n, SL_TY_ERROR);
+}
+
+/* A chain of binary operators, left to right as the recursion over `a`
+ * would go, with a loop over its spine (ast.h). */
+static sl_ty check_binary(checker *c, sl_node *n)
+{
+    sl_spine spine;
+    sl_spine_collect(&spine, n);
+    sl_node *deepest = spine.v[spine.n - 1];
+    sl_ty ty = ck_check_expr(c, &deepest->a,
+                             is_logical(deepest->op) ? SL_TY_BOOL : SL_TYPE_VOID);
+    for (int i = spine.n - 1; i >= 0; i--)
+        ty = check_binary_rest(c, spine.v[i], ty);
+    sl_spine_clear(&spine);
+    return ty;
 }
 
 static sl_ty check_unary(checker *c, sl_node *n)
@@ -896,17 +919,16 @@ static void check_stmt(checker *c, sl_node *n)
  * return exists (the code generator then needs a "returned" flag). */
 static bool count_returns(const sl_node *n, int *count)
 {
-    if (!n)
-        return false;
-    if (n->kind == SL_N_RETURN)
-        (*count)++;
-    count_returns(n->a, count);
-    count_returns(n->b, count);
-    count_returns(n->c, count);
-    count_returns(n->d, count);
-    if (n->kind == SL_N_BLOCK)
-        for (int i = 0; i < n->nlist; i++)
-            count_returns(n->list[i], count);
+    for (; n; n = n->a) {       /* a loop along a: chains of operators (ast.h) */
+        if (n->kind == SL_N_RETURN)
+            (*count)++;
+        count_returns(n->b, count);
+        count_returns(n->c, count);
+        count_returns(n->d, count);
+        if (n->kind == SL_N_BLOCK)
+            for (int i = 0; i < n->nlist; i++)
+                count_returns(n->list[i], count);
+    }
     return *count > 0;
 }
 

@@ -28,17 +28,17 @@ static int shader_method_kind(const char *name)
 /* Does the tree under n call a function called `name`? */
 static bool calls(const sl_node *n, const char *name)
 {
-    if (!n)
-        return false;
-    if (n->kind == SL_N_CALL && n->name && strcmp(n->name, name) == 0)
-        return true;
-    if (n->kind == SL_N_FUNC && n->func && calls(n->func->body, name))
-        return true;
-    if (calls(n->a, name) || calls(n->b, name) || calls(n->c, name) || calls(n->d, name))
-        return true;
-    for (int i = 0; i < n->nlist; i++)
-        if (calls(n->list[i], name))
+    for (; n; n = n->a) {       /* a loop along a: chains of operators (ast.h) */
+        if (n->kind == SL_N_CALL && n->name && strcmp(n->name, name) == 0)
             return true;
+        if (n->kind == SL_N_FUNC && n->func && calls(n->func->body, name))
+            return true;
+        if (calls(n->b, name) || calls(n->c, name) || calls(n->d, name))
+            return true;
+        for (int i = 0; i < n->nlist; i++)
+            if (calls(n->list[i], name))
+                return true;
+    }
     return false;
 }
 

@@ -516,16 +516,16 @@ static int fold(cg *g, int op, int x, int y)
     return cg_const_slot(g, r);
 }
 
-static int gen_binary(cg *g, sl_node *e, int dst)
+/* Binary node e once its left operand e->a is in x. */
+static int gen_binary_rest(cg *g, sl_node *e, int x, int dst)
 {
     int na = cg_size_of(e->a), nb = cg_size_of(e->b);
     if (e->a->ty == SL_TYPE_STRING) {
-        int x = cg_gen_expr(g, e->a, -1), y = cg_gen_expr(g, e->b, -1);
+        int y = cg_gen_expr(g, e->b, -1);
         int z = cg_target(g, dst, 1);
         cg_emit(g, e->op == SL_TOK_EQ ? SL_OP_SEQ : SL_OP_SNE, z, x, y, 0);
         return z;
     }
-    int x = cg_gen_expr(g, e->a, -1);
     int y = cg_gen_expr(g, e->b, -1);
     int folded = fold(g, e->op, x, y);
     if (folded >= 0)
@@ -573,6 +573,23 @@ static int gen_binary(cg *g, sl_node *e, int dst)
     return cg_into(g, z, dst, n);
 }
 
+/* A chain of binary operators, in the order of the recursion over `a`
+ * (the same code), with a loop over its spine (ast.h). */
+static int gen_binary(cg *g, sl_node *e, int dst)
+{
+    sl_spine spine;
+    sl_spine_collect(&spine, e);
+    int x = cg_gen_expr(g, spine.v[spine.n - 1]->a, -1);
+    for (int i = spine.n - 1; i >= 0 && !g->failed; i--) {
+        g->cur = spine.v[i]->pos;
+        x = gen_binary_rest(g, spine.v[i], x, i == 0 ? dst : -1);
+    }
+    sl_spine_clear(&spine);
+    if (g->failed)
+        return dst >= 0 ? dst : SL_GLOBAL_SLOTS;
+    return x;
+}
+
 static int gen_unary(cg *g, sl_node *e, int dst)
 {
     int x = cg_gen_expr(g, e->a, -1);
@@ -585,28 +602,50 @@ static int gen_unary(cg *g, sl_node *e, int dst)
     return z;
 }
 
-/* BR_BEGIN cond ... BR_ELSE ... BR_END around two generators. */
-void cg_gen_branches(cg *g, int cond, branch_fn then_fn, void *then_arg,
-                         branch_fn else_fn, void *else_arg)
+/* A branch being generated: BR_BEGIN cond, then the then-part, BR_ELSE,
+ * the else-part, BR_END, in three calls. */
+typedef struct branch {
+    sl_pos at;                       /* the if: where merge errors point */
+    int begin, mid;
+} branch;
+
+static branch branch_begin(cg *g, int cond)
 {
-    sl_pos at = g->cur;              /* the if: where merge errors point */
-    int begin = cg_emit(g, SL_OP_BR_BEGIN, cond, 0, 0, 0);
+    branch b = { g->cur, cg_emit(g, SL_OP_BR_BEGIN, cond, 0, 0, 0), 0 };
     region_begin(g);
-    then_fn(g, then_arg);
-    g->cur = at;
-    int mid = cg_emit(g, SL_OP_BR_ELSE, 0, begin, 0, 0);
-    if (else_fn)
-        else_fn(g, else_arg);
-    g->cur = at;
-    int end = cg_emit(g, SL_OP_BR_END, begin, 0, 0, 0);
+    return b;
+}
+
+static void branch_else(cg *g, branch *b)
+{
+    g->cur = b->at;
+    b->mid = cg_emit(g, SL_OP_BR_ELSE, 0, b->begin, 0, 0);
+}
+
+static void branch_end(cg *g, const branch *b)
+{
+    g->cur = b->at;
+    int end = cg_emit(g, SL_OP_BR_END, b->begin, 0, 0, 0);
     int table = region_end(g);
     if (g->failed)
         return;
     sl_insn *code = g->prog->code;
-    code[begin].b = (uint16_t)(mid + 1);
-    code[begin].c = (uint16_t)table;
-    code[mid].a = (uint16_t)end;
+    code[b->begin].b = (uint16_t)(b->mid + 1);
+    code[b->begin].c = (uint16_t)table;
+    code[b->mid].a = (uint16_t)end;
     code[end].b = (uint16_t)table;
+}
+
+/* BR_BEGIN cond ... BR_ELSE ... BR_END around two generators. */
+void cg_gen_branches(cg *g, int cond, branch_fn then_fn, void *then_arg,
+                         branch_fn else_fn, void *else_arg)
+{
+    branch b = branch_begin(g, cond);
+    then_fn(g, then_arg);
+    branch_else(g, &b);
+    if (else_fn)
+        else_fn(g, else_arg);
+    branch_end(g, &b);
 }
 
 typedef struct value_job {
@@ -935,12 +974,27 @@ static int gen_user_call(cg *g, sl_node *e, int dst)
     return str ? cg_into_string(g, ret, dst) : cg_into(g, ret, dst, size);
 }
 
+/* One more level of nesting (SL_CG_MAX_DEPTH); false, reported, past it. */
+static bool cg_enter(cg *g)
+{
+    if (g->depth >= SL_CG_MAX_DEPTH) {
+        cg_fail(g, "expressions and statements nested too deeply once function calls are "
+                "inlined (more than %d levels): call the functions here less deeply, or "
+                "split their nested code into statements", SL_CG_MAX_DEPTH);
+        return false;
+    }
+    g->depth++;
+    return true;
+}
+
 int cg_gen_expr(cg *g, sl_node *e, int dst)
 {
     if (g->failed)
         return dst >= 0 ? dst : SL_GLOBAL_SLOTS;
     sl_pos saved = g->cur;
     g->cur = e->pos;
+    if (!cg_enter(g))
+        return dst >= 0 ? dst : SL_GLOBAL_SLOTS;
     int r = 0;
     switch (e->kind) {
     case SL_N_NUM: r = cg_into(g, cg_const_slot(g, e->num), dst, 1); break;
@@ -972,6 +1026,7 @@ int cg_gen_expr(cg *g, sl_node *e, int dst)
     case SL_N_CONV: r = gen_conv(g, e, dst); break;
     default: cg_fail(g, "internal error: unexpected expression"); break;
     }
+    g->depth--;
     g->cur = saved;
     return r;
 }
@@ -1002,22 +1057,14 @@ static int escape_flags(cg *g, const sl_node *n, const sl_node *loop, int *flags
     return count;
 }
 
-typedef struct list_job {
-    sl_node **list;
-    int from, n;
-} list_job;
-
-static void gen_list(cg *g, sl_node **list, int from, int n);
-
-static void gen_list_job(cg *g, void *arg)
-{
-    list_job *job = arg;
-    gen_list(g, job->list, job->from, job->n);
-}
-
-/* Statements list[from..n), the rest guarded after one that may escape. */
+/* Statements list[from..n), the rest guarded after one that may escape:
+ * each guard is a branch opened after that statement and closed after the
+ * last one, innermost first. A loop over the guards, not a recursion: a
+ * block may hold thousands of statements that escape. */
 static void gen_list(cg *g, sl_node **list, int from, int n)
 {
+    branch *guards = NULL;
+    int nguards = 0, cap = 0;
     for (int i = from; i < n && !g->failed; i++) {
         gen_stmt(g, list[i]);
         if (list[i]->nescapes == 0 || i == n - 1)
@@ -1030,10 +1077,18 @@ static void gen_list(cg *g, sl_node **list, int from, int n)
         g->cur = list[i + 1]->pos;
         int go = none_set(g, flags, count);
         g->sp = mark;
-        list_job job = { list, i + 1, n };
-        cg_gen_branches(g, go, gen_list_job, &job, NULL, NULL);
-        return;
+        if (nguards == cap) {
+            cap = cap ? 2 * cap : 8;
+            guards = xreallocarray(guards, (size_t)cap, sizeof *guards);
+        }
+        guards[nguards++] = branch_begin(g, go);
     }
+    while (nguards > 0) {
+        branch *b = &guards[--nguards];
+        branch_else(g, b);
+        branch_end(g, b);
+    }
+    free(guards);
 }
 
 static void gen_decl(cg *g, sl_node *n)
@@ -1177,6 +1232,8 @@ static void gen_stmt(cg *g, sl_node *n)
     if (!n || g->failed)
         return;
     g->cur = n->pos;
+    if (!cg_enter(g))
+        return;
     int mark = g->sp;
     switch (n->kind) {
     case SL_N_BLOCK: {
@@ -1185,7 +1242,7 @@ static void gen_stmt(cg *g, sl_node *n)
         g->ssp = ssp;
         break;
     }
-    case SL_N_DECL: gen_decl(g, n); return;
+    case SL_N_DECL: gen_decl(g, n); g->depth--; return;
     case SL_N_EXPR: cg_gen_expr(g, n->a, -1); break;
     case SL_N_IF: gen_if(g, n); break;
     case SL_N_WHILE: gen_loop(g, n, n->a, NULL, n->b); break;
@@ -1205,6 +1262,7 @@ static void gen_stmt(cg *g, sl_node *n)
     case SL_N_RETURN: gen_return(g, n); break;
     default: break;
     }
+    g->depth--;
     g->sp = mark;
 }
 

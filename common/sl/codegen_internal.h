@@ -37,6 +37,7 @@ typedef struct cg {
     int nregions, regions_cap;
     sl_pos cur;
     int inline_depth;
+    int depth;                           /* nesting of gen_stmt / cg_gen_expr */
     inline_ret rets[SL_MAX_INLINE_DEPTH + 1];
     int nrets;
     sl_func *func;

@@ -202,11 +202,16 @@ static sl_node *error_node(parser *p, sl_pos pos)
     return sl_node_new(p->arena, SL_N_ERROR, pos);
 }
 
+/* One more level of nesting (SL_PARSE_MAX_DEPTH): `what` is "expression"
+ * or "statements". Chains of binary operators do not nest (a loop). */
 static bool enter(parser *p, const char *what)
 {
     if (p->depth >= SL_PARSE_MAX_DEPTH) {
-        error_at(p, p->cur.pos, &p->cur, "%s nested too deeply (limit %d)", what,
-                 SL_PARSE_MAX_DEPTH);
+        bool expr = strcmp(what, "expression") == 0;
+        error_at(p, p->cur.pos, &p->cur, "%s nested too deeply (more than %d levels): %s", what,
+                 SL_PARSE_MAX_DEPTH,
+                 expr ? "split it into statements with temporary variables"
+                      : "move the inner blocks into functions");
         return false;
     }
     p->depth++;

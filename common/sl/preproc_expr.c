@@ -72,7 +72,8 @@ static long long ex_unary(pp_expr *e, bool eval)
 {
     char buf[4 * 64 + 8];
     if (++e->depth > SL_PP_MAX_EXPR_DEPTH) {
-        ex_error(e, ex_peek(e)->pos, "#if expression nested too deeply");
+        ex_error(e, ex_peek(e)->pos, "#if expression nested too deeply (more than %d levels): "
+                 "simplify it", SL_PP_MAX_EXPR_DEPTH);
         e->depth--;
         return 0;
     }
@@ -189,7 +190,8 @@ static long long ex_binary(pp_expr *e, int min_prec, bool eval)
 static long long ex_cond(pp_expr *e, bool eval)
 {
     if (++e->depth > SL_PP_MAX_EXPR_DEPTH) {
-        ex_error(e, ex_peek(e)->pos, "#if expression nested too deeply");
+        ex_error(e, ex_peek(e)->pos, "#if expression nested too deeply (more than %d levels): "
+                 "simplify it", SL_PP_MAX_EXPR_DEPTH);
         e->depth--;
         return 0;
     }

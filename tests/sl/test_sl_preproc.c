@@ -1203,7 +1203,7 @@ static void test_limit_if_nesting(void **state)
     strcpy(src + o, "\nx\n#endif\ny");
     assert_string_equal(expand(src), "y");
     static const expect_diag e[] = {
-        { SL_DIAG_ERROR, 1, 133, "#if expression nested too deeply" },
+        { SL_DIAG_ERROR, 1, 133, "#if expression nested too deeply (more than 256 levels): simplify it" },
     };
     check_diags(e, 1);
 
