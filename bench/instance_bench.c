@@ -88,7 +88,7 @@ static int run(int n, bool instanced)
     free(lumpy);
     free(plastic);
     sl_diag *d = sl_diag_new();
-    job_scene *js = job_scene_new(jb, 0, true, d);
+    job_scene *js = job_scene_new(jb, 0, true, NULL, d);
     if (!js) { sl_diag_print(d, stderr); return 1; }
     int shared = 0;
     for (int i = 0; i < js->world.nobjects; i++) shared += js->world.objects[i].box_proto != NULL;

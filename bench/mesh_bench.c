@@ -82,7 +82,7 @@ int main(int argc, char **argv)
         int nobj = s ? s->nobjects : 0;
         scene_destroy(&s);
         t0 = cpu_now();
-        job_scene *js = job_scene_new(jb, 0, true, d);
+        job_scene *js = job_scene_new(jb, 0, true, NULL, d);
         double world = cpu_now() - t0;
         if (!js) { sl_diag_print(d, stderr); return 1; }
         t0 = cpu_now();

@@ -44,7 +44,7 @@ static job_scene *open_scene(const char *dir, const char *name, trace_arith arit
     opt.arith = arith;
     sl_diag *diag = sl_diag_new();
     job *jb = job_load(path, &opt, diag);
-    job_scene *js = jb ? job_scene_new(jb, cache, true, diag) : NULL;
+    job_scene *js = jb ? job_scene_new(jb, cache, true, NULL, diag) : NULL;
     sl_diag_print(diag, stderr);
     sl_diag_destroy(&diag);
     if (!js) job_destroy(&jb);

@@ -78,7 +78,7 @@ static void *render_thread(void *arg)
 {
     shared *s = arg;
     trace_thread *th = trace_thread_new(&s->js->world);
-    th->cancel = &interrupted;
+    trace_thread_set_cancel(th, &interrupted);
     trace_thread_set_print(th, worker_print_shader_line, NULL);
     int tx_count = image_format_tiles_x(&s->fmt);
     int me = atomic_fetch_add(&s->next_thread, 1);
@@ -161,16 +161,17 @@ typedef struct frame_out {
 static int render_frame(const standalone_options *opt, const job *jb, const frame_out *fo)
 {
     sl_diag *diag = sl_diag_new();
-    job_scene *js = job_scene_new(jb, opt->cache_bytes, true, diag);
+    job_scene *js = job_scene_new(jb, opt->cache_bytes, true, &interrupted, diag);
+    if (atomic_load(&interrupted)) {   /* also while the world was built */
+        sl_diag_destroy(&diag);
+        fprintf(stderr, "aafarm-worker: interrupted; %s not written\n", fo->output);
+        job_scene_destroy(&js);
+        return AAFARM_EXIT_INTERRUPTED;
+    }
     if (js) trace_renderer_set_log(js->renderer, worker_log_warning, NULL);
     sl_diag_print(diag, stderr);
     sl_diag_destroy(&diag);
-    if (!js || atomic_load(&interrupted)) {
-        if (js && atomic_load(&interrupted)) {
-            fprintf(stderr, "aafarm-worker: interrupted; %s not written\n", fo->output);
-            job_scene_destroy(&js);
-            return AAFARM_EXIT_INTERRUPTED;
-        }
+    if (!js) {
         /* job_load checked the scene and compiled the shaders; what fails
          * after it is a shader at run time (its budget): a render failure */
         return AAFARM_EXIT_FAILURE;

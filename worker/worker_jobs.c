@@ -134,7 +134,7 @@ static bool layers_of(const proto_render_options *o, unsigned *layers, char *err
 static bool prepare(held_job *h, const proto_job *m, size_t cache_bytes)
 {
     sl_diag *diag = sl_diag_new();
-    h->js = job_scene_new(h->jb, cache_bytes, true, diag);
+    h->js = job_scene_new(h->jb, cache_bytes, true, NULL, diag);
     if (h->js) trace_renderer_set_log(h->js->renderer, worker_log_warning, NULL);
     if (!h->js) {
         char *text = sl_diag_to_string(diag);

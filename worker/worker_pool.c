@@ -175,7 +175,7 @@ static void *render_main(void *arg)
             held_job_release(&cur);
             cur = held_job_retain(t->job);
             th = trace_thread_new(&cur->js->world);
-            th->cancel = &p->abort_render;
+            trace_thread_set_cancel(th, &p->abort_render);
             trace_thread_set_print(th, worker_print_shader_line, NULL);
         }
         render_task(p, th, t);

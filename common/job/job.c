@@ -343,7 +343,7 @@ job *job_load(const char *rib_path, const job_options *options, sl_diag *diag)
     if (ok) {
         /* compiling pulls the #included files into the set, from disk */
         sl_source_set_set_loader(self->sources, sl_source_load_from_disk, NULL);
-        job_scene *js = job_scene_new(self, 0, false, diag);
+        job_scene *js = job_scene_new(self, 0, false, NULL, diag);
         sl_source_set_set_loader(self->sources, NULL, NULL);
         ok = js != NULL && job_collect_files(self, js, diag);
         if (ok) {

@@ -320,7 +320,8 @@ static bool open_textures(job_scene *self, sl_diag *diag, bool render)
     return ok;
 }
 
-job_scene *job_scene_new(const job *jb, size_t cache_bytes, bool render, sl_diag *diag)
+job_scene *job_scene_new(const job *jb, size_t cache_bytes, bool render,
+                         const atomic_int *cancel, sl_diag *diag)
 {
     job_scene *self = xcalloc(1, sizeof *self);
     self->job = jb;
@@ -348,6 +349,7 @@ job_scene *job_scene_new(const job *jb, size_t cache_bytes, bool render, sl_diag
         w->options.arith = jb->options.arith;
         w->options.max_instructions = jb->options.max_instructions;
         w->options.cache_bytes = cache_bytes;
+        w->options.cancel = cancel;
         if (sc->trace_maxdepth >= 0) w->options.max_ray_depth = sc->trace_maxdepth;
     }
     if (ok && !render) {

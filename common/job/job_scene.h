@@ -27,10 +27,12 @@ typedef struct job_scene {
 } job_scene;
 
 /* cache_bytes: this worker's box cache budget per thread (0: unlimited).
- * render: also prepare the renderer (root boxes and BVH). NULL on errors
- * (in diag). The job must outlive the job_scene. */
+ * render: also prepare the renderer (root boxes and BVH). cancel: the
+ * program's stop flag (trace_options.cancel) or NULL. NULL on errors
+ * (in diag; "interrupted" when cancel was set). The job must outlive the
+ * job_scene. */
 job_scene *job_scene_new(const job *job, size_t cache_bytes, bool render,
-                         sl_diag *diag);
+                         const atomic_int *cancel, sl_diag *diag);
 void job_scene_destroy(job_scene **self_p);
 
 #endif

@@ -35,6 +35,7 @@
 #ifndef SL_SHADER_H
 #define SL_SHADER_H
 
+#include <stdatomic.h>
 #include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -158,11 +159,18 @@ typedef enum sl_status {
     SL_ERR_BUDGET,       /* instruction budget exhausted */
     SL_ERR_LOOP_CAP,     /* interval/affine loop hit its iteration cap */
     SL_ERR_RUNTIME,      /* anything else the VM refuses */
+    SL_ERR_CANCELLED,    /* the cancel flag was set (sl_vm_set_cancel) */
 } sl_status;
 
 typedef struct sl_vm sl_vm;
 
 sl_vm *sl_vm_new(const sl_limits *limits);    /* NULL: defaults */
+/* A flag the program sets to stop (SIGINT/SIGTERM): a run that finds it
+ * non-zero (looked at every SL_VM_CANCEL_EVERY instructions) fails with
+ * SL_ERR_CANCELLED and "interrupted", so one long evaluation (a large
+ * --budget) does not hold a signal up. NULL: never. */
+enum { SL_VM_CANCEL_EVERY = 4096 };
+void sl_vm_set_cancel(sl_vm *self, const atomic_int *flag);
 void sl_vm_destroy(sl_vm **self_p);
 
 /* The named spaces the next runs read: kept by pointer (the binding of

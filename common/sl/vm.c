@@ -219,6 +219,11 @@ void sl_vm_set_print(sl_vm *self, sl_print_fn fn, void *ctx)
     self->print_ctx = ctx;
 }
 
+void sl_vm_set_cancel(sl_vm *self, const atomic_int *flag)
+{
+    self->cancel = flag;
+}
+
 void sl_vm_set_clipping(sl_vm *self, double near, double far)
 {
     if (!(far > near) || !isfinite(far) || !isfinite(near))

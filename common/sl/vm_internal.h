@@ -129,6 +129,7 @@ struct sl_vm {
     uint64_t seed;
     tex_cache *textures;          /* sl_vm_set_textures */
     sl_print_fn print;            /* sl_vm_set_print (NULL: printf dropped) */
+    const atomic_int *cancel;     /* sl_vm_set_cancel (NULL: never) */
     void *print_ctx;
     struct { char name[256]; const tex_texture *tex; } tex_memo[SL_VM_TEX_MEMO];
     int ntex_memo;

@@ -49,7 +49,8 @@ trace_renderer *trace_renderer_new(trace_world *world, char *err, size_t errsz)
         return NULL;
     trace_thread *th = trace_thread_new(world);
     trace_instances_share(th, world);
-    for (int i = 0; i < world->nobjects; i++) {
+    for (int i = 0; i < world->nobjects && !th->failed; i++) {
+        if (trace_thread_cancelled(th)) break;   /* a signal: stop between objects */
         trace_object *obj = &world->objects[i];
         if (obj->box_proto) {
             obj->root = obj->box_proto->root;   /* an earlier object: computed */

@@ -67,6 +67,9 @@ trace_thread *trace_thread_new(const trace_world *world);
 /* Hands the shaders' printf() lines of every VM of this thread (those
  * made later too) to fn(ctx, text); the library prints nothing itself. */
 void trace_thread_set_print(trace_thread *self, sl_print_fn fn, void *ctx);
+/* Sets the flag this thread and its shader VMs watch (default: the
+ * world's options.cancel): non-zero stops the walk and any shader run. */
+void trace_thread_set_cancel(trace_thread *self, const atomic_int *flag);
 void trace_thread_destroy(trace_thread **self_p);
 
 /* The VM that runs surface shaders at trace() depth `depth` (0: primary

@@ -13,6 +13,7 @@
 #ifndef TRACE_WORLD_H
 #define TRACE_WORLD_H
 
+#include <stdatomic.h>
 #include <stdbool.h>
 #include <stdint.h>
 #include <stddef.h>
@@ -132,6 +133,10 @@ typedef struct trace_options {
                                       TRACE_RAY_DEPTH_LIMIT) */
     bool prove_hits;               /* try hit proofs on small cells
                                       (trace/prove.h); off: leaves only */
+    const atomic_int *cancel;      /* the program's stop flag (a signal), or
+                                      NULL: every trace_thread and shader VM
+                                      of the world watches it, the root boxes
+                                      of trace_renderer_new too */
 } trace_options;
 
 /* The default work limit: 20x the largest walk of the paper's scenes

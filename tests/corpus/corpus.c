@@ -327,7 +327,7 @@ bool corpus_open(fixture *f, const corpus *c, const corpus_file *sh,
         fprintf(stderr, "corpus: %s: %s\n", sh->name, why);
         return false;
     }
-    f->js = job_scene_new(f->job, 0, render, f->diag);
+    f->js = job_scene_new(f->job, 0, render, NULL, f->diag);
     if (!f->js) {
         fprintf(stderr, "corpus: %s on the %s:\n", sh->name, corpus_surface_name(s));
         sl_diag_print(f->diag, stderr);

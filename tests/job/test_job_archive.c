@@ -87,7 +87,7 @@ static void test_archives_travel(void **state)
     char cmd[600];
     snprintf(cmd, sizeof cmd, "rm -f '%s/a.rib' '%s/b.rib.gz'", dir, dir);
     assert_int_equal(system(cmd), 0);
-    job_scene *js = job_scene_new(worker, 0, false, d);
+    job_scene *js = job_scene_new(worker, 0, false, NULL, d);
     if (!js)
         sl_diag_print(d, stderr);
     assert_non_null(js);

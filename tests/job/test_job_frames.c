@@ -176,7 +176,7 @@ static void test_one_job_per_frame(void **state)
     assert_string_not_equal(seq->jobs[1]->hash, seq->jobs[2]->hash);
     for (int i = 0; i < 3; i++) {
         assert_int_equal(seq->jobs[i]->options.frame, i);
-        job_scene *js = job_scene_new(seq->jobs[i], 0, false, d);
+        job_scene *js = job_scene_new(seq->jobs[i], 0, false, NULL, d);
         assert_non_null(js);
         assert_int_equal(js->scene->nobjects, i == 1 ? 2 : 1);
         assert_int_equal(js->scene->frame_number, i == 2 ? 4 : i + 1);

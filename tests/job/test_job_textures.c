@@ -94,7 +94,7 @@ static void test_opened_when_bound(void **state)
     if (!jb)
         sl_diag_print(d, stderr);
     assert_non_null(jb);
-    job_scene *js = job_scene_new(jb, 0, true, d);
+    job_scene *js = job_scene_new(jb, 0, true, NULL, d);
     if (!js)
         sl_diag_print(d, stderr);
     assert_non_null(js);

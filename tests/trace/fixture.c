@@ -27,7 +27,7 @@ bool fixture_open(fixture *f, const char *rib, const fixture_shader *shaders,
         fprintf(stderr, "fixture: %s\n", why);
         return false;
     }
-    f->js = job_scene_new(f->job, cache_bytes, true, f->diag);
+    f->js = job_scene_new(f->job, cache_bytes, true, NULL, f->diag);
     if (!f->js) {
         sl_diag_print(f->diag, stderr);
         return false;

@@ -161,6 +161,63 @@ static void test_good_render_leaves_exactly_the_output(void **state)
     image_buffer_destroy(&b);
 }
 
+/* SIGTERM during ONE long shader evaluation (a loop within a --budget of
+ * 1e9 instructions, run while the world's root boxes are made, before any
+ * tile) ends the worker with 130 at once, not after the budget runs out
+ * (a minute; issue 27 item 3): the VM looks at the cancel flag every
+ * SL_VM_CANCEL_EVERY instructions. */
+static void test_sigterm_stops_one_long_evaluation(void **state)
+{
+    (void)state;
+    /* each turn costs an affine noise (microseconds): the budget would
+     * last many minutes */
+    write_file("spin.sl", "displacement spin()\n{\n    float i = 0, sum = 0;\n"
+               "    while (i < 1e9) {\n        sum += noise(P * (i + 1));\n        i += 1;\n"
+               "    }\n    P += 0.01 * sum / 1e9 * normalize(N);\n}\n");
+    write_file("spin.rib",
+               "Format 32 24 1\nProjection \"perspective\" \"fov\" [40]\n"
+               "Option \"searchpath\" \"shader\" [\".\"]\nTranslate 0 0 5\nWorldBegin\n"
+               "Displacement \"spin\"\nSphere 1 -1 1 360\nWorldEnd\n");
+    char log[600];
+    snprintf(log, sizeof log, "%s/spin.log", dir);
+    pid_t pid = fork();
+    assert_true(pid >= 0);
+    if (pid == 0) {
+        if (chdir(dir) != 0) _exit(127);
+        if (!freopen(log, "w", stderr)) _exit(127);
+        execl(worker, worker, "--standalone", "spin.rib", "-o", "spin.exr", "-t", "1", "-q",
+              "--budget", "1000000000", (char *)NULL);
+        _exit(127);
+    }
+    struct timespec pause = {0, 500 * 1000000L};
+    nanosleep(&pause, NULL);
+    kill(pid, SIGTERM);
+    int status = 0, waited_ms = 0;
+    pid_t r;
+    while ((r = waitpid(pid, &status, WNOHANG)) == 0 && waited_ms < 10000) {
+        struct timespec tick = {0, 10 * 1000000L};
+        nanosleep(&tick, NULL);
+        waited_ms += 10;
+    }
+    if (r == 0) {
+        kill(pid, SIGKILL);
+        waitpid(pid, &status, 0);
+        fail_msg("aafarm-worker ignored SIGTERM for 10 s inside one shader evaluation");
+    }
+    printf("SIGTERM in one evaluation: exited after ~%d ms\n", waited_ms);
+    assert_true(WIFEXITED(status));
+    assert_int_equal(WEXITSTATUS(status), 130);
+    assert_int_equal(count_files("spin.exr"), 0);
+    FILE *f = fopen(log, "r");
+    assert_non_null(f);
+    char text[4096];
+    size_t n = fread(text, 1, sizeof text - 1, f);
+    text[n] = '\0';
+    fclose(f);
+    assert_non_null(strstr(text, "interrupted"));
+    assert_null(strstr(text, "budget"));
+}
+
 /* A surface shader's printf() lines reach the worker's stderr as written
  * (the sl library prints nothing itself: the worker installs the VMs'
  * print callback, trace_thread_set_print). */
@@ -236,6 +293,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_good_render_leaves_exactly_the_output),
         cmocka_unit_test(test_shader_printf_reaches_stderr),
         cmocka_unit_test(test_sigterm_stops_a_runaway_render),
+        cmocka_unit_test(test_sigterm_stops_one_long_evaluation),
     };
     int rc = cmocka_run_group_tests(tests, NULL, NULL);
     char cmd[512];
