@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "job/frames.h"
+#include "curve_cert.h"
 #include "tex/tex.h"
 #include "standalone.h"
 #include "util/cli.h"
@@ -272,6 +273,16 @@ int main(int argc, char **argv)
         fprintf(stderr, "aafarm-worker: --curve-secret and --master-key go together (this "
                 "worker's key pair, and the master's public key)\n");
         return AAFARM_EXIT_USAGE;
+    }
+    if (wo.master_key) {
+        /* the master's secret file holds its public key too, so it would
+         * work: warn (the secret is not used, but it should not be here);
+         * a file that cannot be read is reported by the loop */
+        curve_cert mkey;
+        if (curve_cert_read(wo.master_key, false, &mkey, NULL, 0) && mkey.secret_key[0])
+            fprintf(stderr, "aafarm-worker: warning: --master-key %s is a secret key (a "
+                    "NAME.key_secret); give the master's public key NAME.key\n", wo.master_key);
+        memset(&mkey, 0, sizeof mkey);
     }
     if (connect) {
         wo.endpoint = connect;

@@ -3,9 +3,11 @@
  */
 #include "job/job.h"
 #include "util/err.h"
+#include "util/suggest.h"
 #include "util/xalloc.h"
 
 #include <assert.h>
+#include <dirent.h>
 #include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -276,6 +278,38 @@ char *job_read_scene(const char *rib_path, size_t *len, sl_diag *diag)
     return read_file(rib_path, len, diag);
 }
 
+/* The shader name closest to an unknown one (util/suggest.h), among the
+ * NAME.sl files of the scene's shader search path and the standard
+ * shaders; written to out ("" when none is near). */
+static void closest_shader(const scene *sc, const char *name, char *out, size_t outsz)
+{
+    const char **names = NULL;
+    int n = 0, cap = 0;
+    for (int k = 0; k < sc->nsearch_path; k++) {
+        DIR *dir = opendir(sc->search_path[k]);
+        if (!dir) continue;
+        for (struct dirent *e; (e = readdir(dir)) != NULL;) {
+            size_t len = strlen(e->d_name);
+            if (len <= 3 || strcmp(e->d_name + len - 3, ".sl") != 0) continue;
+            if (n == cap) {
+                cap = cap ? 2 * cap : 16;
+                names = xreallocarray(names, (size_t)cap, sizeof *names);
+            }
+            names[n++] = xstrndup(e->d_name, len - 3);
+        }
+        closedir(dir);
+    }
+    int nfound = n;
+    names = xreallocarray(names, (size_t)(n + sl_standard_nshaders), sizeof *names);
+    for (int i = 0; i < sl_standard_nshaders; i++)
+        names[n++] = sl_standard_shaders[i].name;
+    const char *near = suggest_closest(name, names, n);
+    snprintf(out, outsz, "%s", near ? near : "");
+    for (int i = 0; i < nfound; i++)
+        free((char *)names[i]);
+    free(names);
+}
+
 job *job_load(const char *rib_path, const job_options *options, sl_diag *diag)
 {
     size_t len = 0;
@@ -327,9 +361,15 @@ job *job_load(const char *rib_path, const job_options *options, sl_diag *diag)
                 if (k) strncat(dirs, ", ", sizeof dirs - strlen(dirs) - 1);
                 strncat(dirs, sc->search_path[k], sizeof dirs - strlen(dirs) - 1);
             }
-            sl_diag_error(diag, pos, "shader '%s' not found: looked for '%s.sl' in %s; "
-                          "add its folder with Option \"searchpath\" \"shader\" [\"dir:&\"]",
-                          name, name, dirs);
+            char near[256];
+            closest_shader(sc, name, near, sizeof near);
+            if (near[0])
+                sl_diag_error(diag, pos, "shader '%s' not found (did you mean %s?): looked for "
+                              "'%s.sl' in %s", name, near, name, dirs);
+            else
+                sl_diag_error(diag, pos, "shader '%s' not found: looked for '%s.sl' in %s; "
+                              "add its folder with Option \"searchpath\" \"shader\" "
+                              "[\"dir:&\"]", name, name, dirs);
             ok = false;
             continue;
         }

@@ -14,6 +14,7 @@
 #include "scene/rib_parser.h"
 #include "sl/source.h"
 #include "sl/strbuf.h"
+#include "util/suggest.h"
 #include "util/xalloc.h"
 
 #include <ctype.h>
@@ -499,11 +500,22 @@ static const request_def *find_request(const char *name)
     return NULL;
 }
 
-/* One warning per unknown request name, with a suggestion when only the
- * case differs ("sphere" for "Sphere"); past RIB_MAX_UNKNOWN_NAMES names
- * (binary or garbage input) one last warning says that no more come. */
+/* The known request closest to an unknown name (util/suggest.h), or NULL. */
+static const request_def *closest_request(const char *name)
+{
+    const char *names[NREQUESTS];
+    for (int i = 0; i < NREQUESTS; i++)
+        names[i] = requests[i].name;
+    const char *near = suggest_closest(name, names, NREQUESTS);
+    return near ? find_request(near) : NULL;
+}
+
+/* One warning per unknown request name, with the closest known name when
+ * one is near ("Sphere" for "sphere" or "Spere"); past
+ * RIB_MAX_UNKNOWN_NAMES names (binary or garbage input) one last warning
+ * says that no more come. */
 enum { RIB_MAX_UNKNOWN_NAMES = 100 };
-static void unknown_request(rib_parser *p, const rib_request *req)
+static void unknown_request(rib_parser *p, const rib_request *req, const request_def *near)
 {
     for (int i = 0; i < p->nwarned; i++)
         if (strcmp(p->warned[i], req->name) == 0)
@@ -517,13 +529,11 @@ static void unknown_request(rib_parser *p, const rib_request *req)
     }
     p->warned = xrealloc(p->warned, (size_t)(p->nwarned + 1) * sizeof *p->warned);
     p->warned[p->nwarned++] = xstrndup(req->name, strlen(req->name));
-    for (int i = 0; i < NREQUESTS; i++)
-        if (strcasecmp(requests[i].name, req->name) == 0) {
-            rib_warning(p, req, req->pos, "unknown request, ignored with its arguments "
-                        "(did you mean %s?)", requests[i].name);
-            return;
-        }
-    rib_warning(p, req, req->pos, "unknown request, ignored with its arguments");
+    if (near)
+        rib_warning(p, req, req->pos, "unknown request, ignored with its arguments "
+                    "(did you mean %s?)", near->name);
+    else
+        rib_warning(p, req, req->pos, "unknown request, ignored with its arguments");
 }
 
 /* False (with an error) when the request may not appear here. */
@@ -565,10 +575,24 @@ static void dispatch(rib_parser *p, const rib_request *req)
     if (rib_motion_filter(p, req))
         return;
     const request_def *def = find_request(req->name);
+    rib_request misspelt;
     if (!def) {
-        if (!rib_ignored_request(p, req))
-            unknown_request(p, req);
-        return;
+        if (rib_ignored_request(p, req))
+            return;
+        const request_def *near = closest_request(req->name);
+        if (!near || (near->where != BLOCK && near->where != BLOCK_WORLD)) {
+            unknown_request(p, req, near);
+            return;
+        }
+        /* A misspelt block opener or closer ("WorldBegn") is an error, and
+         * is read as the block request it is closest to: skipping it would
+         * bury it under an error for every request of the block. */
+        rib_error(p, req, req->pos, "unknown request (did you mean %s?); read as %s for the "
+                  "rest of the checks", near->name, near->name);
+        misspelt = *req;
+        misspelt.name = (char *)near->name;
+        req = &misspelt;
+        def = near;
     }
     if (def->where == PRIMITIVE && p->in_world)
         p->primitives_tried = true;

@@ -218,12 +218,50 @@ static void test_search_path_order(void **state)
     write_scene();
 }
 
+/* "did you mean plastic?" (issue 26): a shader found nowhere names the
+ * closest of the shaders on the search path and the standard ones. */
+static void expect_shader_error(const char *call, const char *want)
+{
+    char rib[1024];
+    snprintf(rib, sizeof rib,
+             "Option \"searchpath\" \"shader\" [\"shaders\"]\n"
+             "Format 16 16 1\nProjection \"perspective\" \"fov\" [40]\nTranslate 0 0 5\n"
+             "WorldBegin\n%s\nSphere 1 -1 1 360\nWorldEnd\n", call);
+    write_file("typo.rib", rib);
+    sl_diag *d = sl_diag_new();
+    job *j = job_load(path_of("typo.rib"), NULL, d);
+    assert_null(j);
+    assert_true(sl_diag_count(d) >= 1);
+    const sl_diagnostic *x = sl_diag_get(d, 0);
+    char got[2048], expect[2048];
+    snprintf(got, sizeof got, "%d:%d: %s", x->line, x->col, x->message);
+    snprintf(expect, sizeof expect, want, dir, dir);
+    assert_string_equal(got, expect);
+    sl_diag_destroy(&d);
+}
+
+static void test_shader_did_you_mean(void **state)
+{
+    (void)state;
+    expect_shader_error("Surface \"plastc\"",
+                        "6:1: shader 'plastc' not found (did you mean plastic?): looked for "
+                        "'plastc.sl' in %s/shaders, %s");
+    expect_shader_error("Displacement \"Tx\"",
+                        "6:1: shader 'Tx' not found (did you mean tex?): looked for "
+                        "'Tx.sl' in %s/shaders, %s");
+    expect_shader_error("Surface \"velvet\"",
+                        "6:1: shader 'velvet' not found: looked for 'velvet.sl' in "
+                        "%s/shaders, %s; add its folder with Option \"searchpath\" "
+                        "\"shader\" [\"dir:&\"]");
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_files_found_and_hashed),
         cmocka_unit_test(test_hashes_enter_the_job_hash),
         cmocka_unit_test(test_search_path_order),
+        cmocka_unit_test(test_shader_did_you_mean),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

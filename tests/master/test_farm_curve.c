@@ -215,6 +215,23 @@ static void test_plaintext_network_bind_refused_and_bad_keys_named(void **state)
                            NULL};
     assert_int_equal(ft_wait(ft_spawn(ft_path(dir, "w.log"), wargv), 20), 2);
     assert_true(ft_count(ft_path(dir, "w.log"), "go together") >= 1);
+    /* a secret key given as --master-key: warned about (issue 26), then
+     * this run stops at its own secret, which others can read */
+    const char *sargv[] = {ft_worker, "--connect", "tcp://127.0.0.1:1", "--curve-secret", secret,
+                           "--master-key", secret, NULL};
+    assert_int_equal(ft_wait(ft_spawn(ft_path(dir, "ws.log"), sargv), 20), 2);
+    char line[8192];
+    snprintf(line, sizeof line, "aafarm-worker: warning: --master-key %s is a secret key (a "
+             "NAME.key_secret); give the master's public key NAME.key\n", secret);
+    assert_int_equal(ft_count(ft_path(dir, "ws.log"), line), 1);
+    /* the public key gets no warning */
+    char pub[4096];
+    snprintf(pub, sizeof pub, "%s", ft_path(dir, "m2.key"));
+    const char *pargv[] = {ft_worker, "--connect", "tcp://127.0.0.1:1", "--curve-secret", secret,
+                           "--master-key", pub, NULL};
+    assert_int_equal(ft_wait(ft_spawn(ft_path(dir, "wp.log"), pargv), 20), 2);
+    assert_int_equal(ft_count(ft_path(dir, "wp.log"), "warning"), 0);
+    assert_true(ft_count(ft_path(dir, "wp.log"), "are too open for a secret key") >= 1);
 }
 
 int main(int argc, char **argv)

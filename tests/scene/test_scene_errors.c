@@ -273,6 +273,46 @@ static void test_unknown_requests(void **state)
     sl_diag_destroy(&d);
 }
 
+/* "did you mean WorldBegin?" (issue 26): an unknown request near a known
+ * one names it; a misspelt block opener or closer is the first error and
+ * is read as the block it is closest to, so no cascade follows it. */
+static void test_did_you_mean(void **state)
+{
+    (void)state;
+    sl_diag *d;
+    scene *s = parse_rib(CAMERA "WorldBegn\nSpere 1 -1 1 360\nAttributeBegin\n"
+        "Sphere 1 -1 1 360\nAtributeEnd\nWorldEnd\n", &d);
+    assert_null(s);
+    assert_int_equal(sl_diag_error_count(d), 2);
+    assert_string_equal(diag_line(nth_diag(d, SL_DIAG_ERROR, 0)),
+                        "t.rib:3:1: WorldBegn: unknown request (did you mean WorldBegin?); "
+                        "read as WorldBegin for the rest of the checks");
+    assert_string_equal(diag_line(nth_diag(d, SL_DIAG_ERROR, 1)),
+                        "t.rib:7:1: AtributeEnd: unknown request (did you mean AttributeEnd?); "
+                        "read as AttributeEnd for the rest of the checks");
+    assert_int_equal(sl_diag_warning_count(d), 1);
+    assert_string_equal(diag_line(nth_diag(d, SL_DIAG_WARNING, 0)),
+                        "t.rib:4:1: Spere: unknown request, ignored with its arguments "
+                        "(did you mean Sphere?)");
+    sl_diag_destroy(&d);
+
+    /* a case-only difference of a block request is read as it too;
+     * Frobnicate is too far from every name for a suggestion (the one
+     * later error is the empty world's: the sphere was skipped) */
+    s = parse_rib(CAMERA "worldbegin\nSphear 1 -1 1 360\nFrobnicate\nWorldEnd\n", &d);
+    assert_null(s);
+    assert_int_equal(sl_diag_error_count(d), 2);
+    assert_string_equal(diag_line(nth_diag(d, SL_DIAG_ERROR, 0)),
+                        "t.rib:3:1: worldbegin: unknown request (did you mean WorldBegin?); "
+                        "read as WorldBegin for the rest of the checks");
+    assert_string_equal(diag_line(nth_diag(d, SL_DIAG_WARNING, 0)),
+                        "t.rib:4:1: Sphear: unknown request, ignored with its arguments "
+                        "(did you mean Sphere?)");
+    assert_string_equal(diag_line(nth_diag(d, SL_DIAG_WARNING, 1)),
+                        "t.rib:5:1: Frobnicate: unknown request, ignored with its arguments");
+    sl_diag_destroy(&d);
+}
+
 /* Lenient where other renderers are (issue 14): requests of scanline
  * renderers and primitives aafarm does not render are warned about once
  * per name with file:line and skipped; options inside the world are
@@ -416,6 +456,7 @@ int main(void)
         cmocka_unit_test(test_invalid_surface_parameters),
         cmocka_unit_test(test_rendered_diagnostic),
         cmocka_unit_test(test_unknown_requests),
+        cmocka_unit_test(test_did_you_mean),
         cmocka_unit_test(test_lenient_requests),
         cmocka_unit_test(test_many_unknown_requests),
         cmocka_unit_test(test_recovery),
