@@ -58,9 +58,10 @@ EOF
 }
 
 # remote_stop PIDFILE: the script that stops the worker of PIDFILE (SIGTERM,
-# SIGKILL if it still runs 5 s later) and prints "stopped worker PID",
-# "killed worker PID" or "no worker running".
+# SIGKILL if it still runs AAFARM_STOP_GRACE seconds later, default 5) and
+# prints "stopped worker PID", "killed worker PID" or "no worker running".
 remote_stop() {
+  local tenths=$(( ${AAFARM_STOP_GRACE:-5} * 10 ))
   cat <<EOF
 $remote_alive
 pidfile=$(q "$1")
@@ -68,7 +69,7 @@ pid=\$(cat "\$pidfile" 2>/dev/null) || pid=
 rm -f "\$pidfile"
 if [ -n "\$pid" ] && alive "\$pid" && kill -TERM "\$pid" 2>/dev/null; then
   i=0
-  while alive "\$pid" && [ \$i -lt 50 ]; do sleep 0.1; i=\$((i + 1)); done
+  while alive "\$pid" && [ \$i -lt $tenths ]; do sleep 0.1; i=\$((i + 1)); done
   if alive "\$pid"; then kill -KILL "\$pid"; echo "killed worker \$pid"; else echo "stopped worker \$pid"; fi
 else
   echo "no worker running"

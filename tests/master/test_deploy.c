@@ -105,6 +105,24 @@ static bool have(const char *tool)
     return sh("which.log", "%s", cmd) == 0;
 }
 
+/* The PID farm.sh says it stopped on HOST in the log: "HOST: stopped
+ * worker PID", or "HOST: killed worker PID" where the worker outlived
+ * SIGTERM's grace (a sanitized worker's exit can); 0 when it says neither
+ * or says it more than once. The caller then checks that PID is gone. */
+static long stopped_pid(const char *log, const char *host)
+{
+    char stopped[64], killed[64];
+    snprintf(stopped, sizeof stopped, "%s: stopped worker ", host);
+    snprintf(killed, sizeof killed, "%s: killed worker ", host);
+    if (ft_count(log, stopped) + ft_count(log, killed) != 1) return 0;
+    char *text = ft_read(log);
+    const char *at = strstr(text, stopped);
+    const char *k = strstr(text, killed);
+    long pid = at ? atol(at + strlen(stopped)) : k ? atol(k + strlen(killed)) : 0;
+    free(text);
+    return pid;
+}
+
 /* Waits up to 5 s for process pid to be gone; fails if it is not. */
 static void assert_gone(long pid)
 {
@@ -122,7 +140,7 @@ static void test_ssh_farm_renders_and_stops_its_workers(void **state)
     int port = ft_free_port();
     int rc = sh("ssh.log",
                 "cd %s && AAFARM_BIN=%s AAFARM_REMOTE_BIN=%s AAFARM_KEYS=%s/keys AAFARM_RUN=%s/run "
-                "AAFARM_PORT=%d AAFARM_BIND_HOST=127.0.0.1 AAFARM_MASTER_HOST=127.0.0.1 "
+                "AAFARM_PORT=%d AAFARM_BIND_HOST=127.0.0.1 AAFARM_MASTER_HOST=127.0.0.1 AAFARM_STOP_GRACE=10 "
                 "AAFARM_WORKER_OPTS=\"--tile-delay 150\" "   /* both join before the end */
                 "SSH=%s/tests/master/deploy/fake-ssh SCP=%s/tests/master/deploy/fake-scp "
                 "%s/deploy/ssh/farm.sh hosts scene.rib -o ssh.exr --tile 16",
@@ -135,17 +153,11 @@ static void test_ssh_farm_renders_and_stops_its_workers(void **state)
     assert_int_equal(ft_count(log, "worker hostA joined"), 1);
     assert_int_equal(ft_count(log, "worker hostB joined"), 1);
     /* both stopped, by the pids it printed; the copied secrets are gone */
-    char *text = ft_read(log);
-    for (const char *h = "hostA", *p = text; h; h = strcmp(h, "hostA") == 0 ? "hostB" : NULL) {
-        char needle[64];
-        snprintf(needle, sizeof needle, "%s: stopped worker ", h);
-        const char *at = strstr(p, needle);
-        assert_non_null(at);
-        long pid = atol(at + strlen(needle));
+    for (const char *h = "hostA"; h; h = strcmp(h, "hostA") == 0 ? "hostB" : NULL) {
+        long pid = stopped_pid(log, h);
         assert_true(pid > 1);
         assert_gone(pid);
     }
-    free(text);
     struct stat st;
     assert_int_equal(stat(ft_path(dir, "run/hostA/keys"), &st), -1);
     assert_int_equal(stat(ft_path(dir, "run/hostB/worker.pid"), &st), -1);
@@ -174,7 +186,7 @@ static void test_ssh_farm_ctrl_c_stops_everything(void **state)
     snprintf(log, sizeof log, "%s/ctrlc.log", dir);
     snprintf(cmd, sizeof cmd,
              "cd %s && AAFARM_BIN=%s AAFARM_REMOTE_BIN=%s AAFARM_KEYS=%s/keys2 AAFARM_RUN=%s/run2 "
-             "AAFARM_PORT=%d AAFARM_BIND_HOST=127.0.0.1 AAFARM_MASTER_HOST=127.0.0.1 "
+             "AAFARM_PORT=%d AAFARM_BIND_HOST=127.0.0.1 AAFARM_MASTER_HOST=127.0.0.1 AAFARM_STOP_GRACE=10 "
              "AAFARM_WORKER_OPTS=\"--tile-delay 300\" SSH=%s/tests/master/deploy/fake-ssh "
              "SCP=%s/tests/master/deploy/fake-scp exec timeout -k 2 120 %s/deploy/ssh/farm.sh "
              "hosts2 scene.rib -o ctrlc.exr --tile 16",
@@ -191,19 +203,16 @@ static void test_ssh_farm_ctrl_c_stops_everything(void **state)
     assert_true(script > 1);
     kill((pid_t)script, SIGINT);
     assert_int_equal(ft_wait(sh_pid, 60), 130);
-    assert_int_equal(ft_count(log, "hostC: stopped worker "), 1);
-    assert_int_equal(ft_count(log, "hostD: stopped worker "), 1);
+    long pid_c = stopped_pid(log, "hostC"), pid_d = stopped_pid(log, "hostD");
+    assert_true(pid_c > 1);
+    assert_true(pid_d > 1);
     assert_true(ft_count(log, "ctrlc.exr not written") >= 1);
     struct stat st;
     assert_int_equal(stat(ft_path(dir, "ctrlc.exr"), &st), -1);
     assert_int_equal(stat(ft_path(dir, "run2/hostC/keys"), &st), -1);
     assert_int_equal(stat(ft_path(dir, "run2/hostD/keys"), &st), -1);
-    char *text = ft_read(log);
-    const char *at = strstr(text, "hostC: stopped worker ");
-    long pid = at ? atol(at + strlen("hostC: stopped worker ")) : 0;
-    free(text);
-    assert_true(pid > 1);
-    assert_gone(pid);
+    assert_gone(pid_c);
+    assert_gone(pid_d);
 }
 
 /* ---- a real OpenSSH server on loopback ---- */
@@ -367,7 +376,7 @@ static int real_farm(const char *log, const char *remote_bin, const char *master
 {
     return sh(log,
               "cd %s && AAFARM_BIN=%s AAFARM_KEYS=%s/keys3 AAFARM_RUN=%s/run3 AAFARM_PORT=%d "
-              "AAFARM_BIND_HOST=127.0.0.1 SSH=\"ssh -F %s/sshd/ssh_config\" "
+              "AAFARM_BIND_HOST=127.0.0.1 AAFARM_STOP_GRACE=10 SSH=\"ssh -F %s/sshd/ssh_config\" "
               "SCP=\"scp -q -F %s/sshd/ssh_config\" AAFARM_REMOTE_BIN=%s "
               "AAFARM_WORKER_OPTS=\"%s\" %s/deploy/ssh/farm.sh --master-host %s hosts3 "
               "scene.rib -o %s --tile 16",
@@ -397,12 +406,11 @@ static void test_ssh_farm_over_a_real_sshd(void **state)
     assert_int_equal(ft_count(log, "worker realB joined"), 1);
     static const char *const hosts[] = {"realA", "realB"};
     for (int h = 0; h < 2; h++) {
-        char started[64], stopped[64];
+        char started[64];
         snprintf(started, sizeof started, "%s: worker ", hosts[h]);
-        snprintf(stopped, sizeof stopped, "%s: stopped worker ", hosts[h]);
         long pid = number_after(log, started);
         assert_true(pid > 1);
-        assert_int_equal(number_after(log, stopped), pid);   /* the PID it started */
+        assert_int_equal(stopped_pid(log, hosts[h]), pid);   /* the PID it started */
         assert_gone(pid);
         assert_int_equal(workers_named(hosts[h], false), 0);   /* nothing left behind */
     }
