@@ -161,6 +161,41 @@ static void test_good_render_leaves_exactly_the_output(void **state)
     image_buffer_destroy(&b);
 }
 
+/* Starts the worker in dir with argv (stderr into err_path, or dropped),
+ * sends SIGTERM after pause_ms, and waits up to 10 s for it; a worker
+ * that ignores the signal is killed (SIGKILL) and the test fails. Returns
+ * its exit status; *waited_ms: about how long it took to end. */
+static int sigterm_after(const char *const *args, const char *err_path, long pause_ms,
+                         int *waited_ms)
+{
+    pid_t pid = fork();
+    assert_true(pid >= 0);
+    if (pid == 0) {
+        if (chdir(dir) != 0) _exit(127);
+        if (!freopen(err_path ? err_path : "/dev/null", "w", stderr)) _exit(127);
+        execv(worker, (char *const *)args);
+        _exit(127);
+    }
+    struct timespec pause = {pause_ms / 1000, (pause_ms % 1000) * 1000000L};
+    nanosleep(&pause, NULL);
+    kill(pid, SIGTERM);
+    int status = 0;
+    pid_t r;
+    *waited_ms = 0;
+    while ((r = waitpid(pid, &status, WNOHANG)) == 0 && *waited_ms < 10000) {
+        struct timespec tick = {0, 10 * 1000000L};
+        nanosleep(&tick, NULL);
+        *waited_ms += 10;
+    }
+    if (r == 0) {
+        kill(pid, SIGKILL);
+        waitpid(pid, &status, 0);
+        fail_msg("aafarm-worker ignored SIGTERM for 10 s");
+    }
+    assert_true(WIFEXITED(status));
+    return WEXITSTATUS(status);
+}
+
 /* SIGTERM during ONE long shader evaluation (a loop within a --budget of
  * 1e9 instructions, run while the world's root boxes are made, before any
  * tile) ends the worker with 130 at once, not after the budget runs out
@@ -180,33 +215,12 @@ static void test_sigterm_stops_one_long_evaluation(void **state)
                "Displacement \"spin\"\nSphere 1 -1 1 360\nWorldEnd\n");
     char log[600];
     snprintf(log, sizeof log, "%s/spin.log", dir);
-    pid_t pid = fork();
-    assert_true(pid >= 0);
-    if (pid == 0) {
-        if (chdir(dir) != 0) _exit(127);
-        if (!freopen(log, "w", stderr)) _exit(127);
-        execl(worker, worker, "--standalone", "spin.rib", "-o", "spin.exr", "-t", "1", "-q",
-              "--budget", "1000000000", (char *)NULL);
-        _exit(127);
-    }
-    struct timespec pause = {0, 500 * 1000000L};
-    nanosleep(&pause, NULL);
-    kill(pid, SIGTERM);
-    int status = 0, waited_ms = 0;
-    pid_t r;
-    while ((r = waitpid(pid, &status, WNOHANG)) == 0 && waited_ms < 10000) {
-        struct timespec tick = {0, 10 * 1000000L};
-        nanosleep(&tick, NULL);
-        waited_ms += 10;
-    }
-    if (r == 0) {
-        kill(pid, SIGKILL);
-        waitpid(pid, &status, 0);
-        fail_msg("aafarm-worker ignored SIGTERM for 10 s inside one shader evaluation");
-    }
+    const char *args[] = {worker, "--standalone", "spin.rib", "-o", "spin.exr", "-t", "1", "-q",
+                          "--budget", "1000000000", NULL};
+    int waited_ms = 0;
+    int code = sigterm_after(args, log, 500, &waited_ms);
     printf("SIGTERM in one evaluation: exited after ~%d ms\n", waited_ms);
-    assert_true(WIFEXITED(status));
-    assert_int_equal(WEXITSTATUS(status), 130);
+    assert_int_equal(code, 130);
     assert_int_equal(count_files("spin.exr"), 0);
     FILE *f = fopen(log, "r");
     assert_non_null(f);
@@ -247,33 +261,12 @@ static void test_sigterm_stops_a_runaway_render(void **state)
                "Format 320 240 1\nProjection \"perspective\" \"fov\" [40]\n"
                "Option \"searchpath\" \"shader\" [\".\"]\nTranslate 0 0 5\nWorldBegin\n"
                "Displacement \"slow\"\nSphere 1 -1 1 360\nWorldEnd\n");
-    pid_t pid = fork();
-    assert_true(pid >= 0);
-    if (pid == 0) {
-        if (chdir(dir) != 0) _exit(127);
-        freopen("/dev/null", "w", stderr);
-        execl(worker, worker, "--standalone", "nanp.rib", "-o", "nanp.exr", "-t", "2", "-q",
-              (char *)NULL);
-        _exit(127);
-    }
-    struct timespec pause = {0, 300 * 1000000L};
-    nanosleep(&pause, NULL);
-    kill(pid, SIGTERM);
-    int status = 0, waited_ms = 0;
-    pid_t r;
-    while ((r = waitpid(pid, &status, WNOHANG)) == 0 && waited_ms < 10000) {
-        struct timespec tick = {0, 10 * 1000000L};
-        nanosleep(&tick, NULL);
-        waited_ms += 10;
-    }
-    if (r == 0) {
-        kill(pid, SIGKILL);
-        waitpid(pid, &status, 0);
-        fail_msg("aafarm-worker ignored SIGTERM for 10 s");
-    }
+    const char *args[] = {worker, "--standalone", "nanp.rib", "-o", "nanp.exr", "-t", "2", "-q",
+                          NULL};
+    int waited_ms = 0;
+    int code = sigterm_after(args, NULL, 300, &waited_ms);
     printf("SIGTERM: exited after ~%d ms\n", waited_ms);
-    assert_true(WIFEXITED(status));
-    assert_int_equal(WEXITSTATUS(status), 130);
+    assert_int_equal(code, 130);
     assert_int_equal(count_files("nanp.exr"), 0);
 }
 
