@@ -25,7 +25,7 @@ void trace_options_default(trace_options *opt)
 /* A VM for this world's shaders, with what every shader may ask of the
  * scene: depth() (RIB Clipping) and option() (RI Spec 3.2 §15.7), the
  * same for every run. */
-static sl_vm *new_vm(const trace_world *world, const atomic_int *cancel)
+static sl_vm *new_vm(const trace_world *world)
 {
     sl_limits limits = {.max_instructions = world->options.max_instructions,
                         .max_loop_iterations = 64};
@@ -35,10 +35,26 @@ static sl_vm *new_vm(const trace_world *world, const atomic_int *cancel)
     double clipping[3] = {cam->near_clip, cam->far_clip, 0.0};
     sl_vm_set_clipping(vm, cam->near_clip, cam->far_clip);
     sl_vm_set_textures(vm, world->textures);
-    sl_vm_set_cancel(vm, cancel);
     sl_vm_set_message(vm, SL_MSG_OPTION, "Format", SL_TYPE_POINT, format, NULL);
     sl_vm_set_message(vm, SL_MSG_OPTION, "Clipping", SL_TYPE_POINT, clipping, NULL);
     return vm;
+}
+
+/* What the thread hands each of its VMs: the print callback and the
+ * cancel flag (trace_thread_set_print, trace_thread_set_cancel). */
+static void hand_over(const trace_thread *self, sl_vm *vm)
+{
+    sl_vm_set_print(vm, self->print, self->print_ctx);
+    sl_vm_set_cancel(vm, self->cancel);
+}
+
+static void hand_over_all(const trace_thread *self)
+{
+    hand_over(self, self->vm);
+    hand_over(self, self->shade_vm);
+    hand_over(self, self->light_vm);
+    for (int d = 0; d < TRACE_RAY_DEPTH_LIMIT; d++)
+        if (self->ray_vm[d]) hand_over(self, self->ray_vm[d]);
 }
 
 trace_thread *trace_thread_new(const trace_world *world)
@@ -46,9 +62,10 @@ trace_thread *trace_thread_new(const trace_world *world)
     trace_thread *self = xcalloc(1, sizeof *self);
     self->world = world;
     self->cancel = world->options.cancel;
-    self->vm = new_vm(world, self->cancel);
-    self->shade_vm = new_vm(world, self->cancel);
-    self->light_vm = new_vm(world, self->cancel);
+    self->vm = new_vm(world);
+    self->shade_vm = new_vm(world);
+    self->light_vm = new_vm(world);
+    hand_over_all(self);
     aa_context_init(&self->ctx, world->options.aa_capacity);
     self->cache = trace_boxcache_new(world->options.cache_bytes, world->nobjects);
     self->work = xcalloc(world->nobjects > 0 ? (size_t)world->nobjects : 1, sizeof *self->work);
@@ -59,21 +76,13 @@ void trace_thread_set_print(trace_thread *self, sl_print_fn fn, void *ctx)
 {
     self->print = fn;
     self->print_ctx = ctx;
-    sl_vm_set_print(self->vm, fn, ctx);
-    sl_vm_set_print(self->shade_vm, fn, ctx);
-    sl_vm_set_print(self->light_vm, fn, ctx);
-    for (int d = 0; d < TRACE_RAY_DEPTH_LIMIT; d++)
-        if (self->ray_vm[d]) sl_vm_set_print(self->ray_vm[d], fn, ctx);
+    hand_over_all(self);
 }
 
 void trace_thread_set_cancel(trace_thread *self, const atomic_int *flag)
 {
     self->cancel = flag;
-    sl_vm_set_cancel(self->vm, flag);
-    sl_vm_set_cancel(self->shade_vm, flag);
-    sl_vm_set_cancel(self->light_vm, flag);
-    for (int d = 0; d < TRACE_RAY_DEPTH_LIMIT; d++)
-        if (self->ray_vm[d]) sl_vm_set_cancel(self->ray_vm[d], flag);
+    hand_over_all(self);
 }
 
 void trace_thread_destroy(trace_thread **self_p)
@@ -97,8 +106,8 @@ sl_vm *trace_thread_shade_vm(trace_thread *self, int depth)
 {
     if (depth <= 0 || depth > TRACE_RAY_DEPTH_LIMIT) return self->shade_vm;
     if (!self->ray_vm[depth - 1]) {
-        self->ray_vm[depth - 1] = new_vm(self->world, self->cancel);
-        sl_vm_set_print(self->ray_vm[depth - 1], self->print, self->print_ctx);
+        self->ray_vm[depth - 1] = new_vm(self->world);
+        hand_over(self, self->ray_vm[depth - 1]);
     }
     return self->ray_vm[depth - 1];
 }
