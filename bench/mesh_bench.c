@@ -4,10 +4,13 @@
  * at 1k, 10k and 100k faces; prints the CPU seconds of parsing (with
  * geom_surface_prepare per face), of building the renderer's world (root
  * boxes and BVH: job_scene_new), of rendering 128x128 at one sample per
- * pixel with the default surface, and the peak resident memory. Never
- * fails on timing.
+ * pixel with the default surface, and the peak resident memory; and the
+ * bytes a face costs (issue 23: a mesh is one object): the scene's shared
+ * arrays (points, indices, normals) and, beyond them, the pieces, their
+ * boxes, shared edges and BVH, per face. Never fails on timing.
  *
- *   mesh_bench [max_faces]     (default 100000)
+ *   mesh_bench [max_faces]     (default 100000; 1000000 and 10000000 run
+ *                               the production rows)
  */
 #include <stdio.h>
 #include <stdlib.h>
@@ -18,6 +21,7 @@
 
 #include "job/job.h"
 #include "job/job_scene.h"
+#include "trace/mesh.h"
 
 static double cpu_now(void)
 {
@@ -63,8 +67,8 @@ static char *torus_rib(int nu, int nv, size_t *len)
 int main(int argc, char **argv)
 {
     int max_faces = argc > 1 ? atoi(argv[1]) : 100000;
-    printf("%8s %10s %12s %12s %12s %10s\n", "faces", "parse s", "world s", "render s",
-           "objects", "peak MiB");
+    printf("%9s %8s %8s %8s %8s %9s %12s %12s %9s\n", "faces", "parse s", "world s",
+           "render s", "objects", "pieces", "shared B/f", "beyond B/f", "peak MiB");
     for (int faces = 1000; faces <= max_faces; faces *= 10) {
         int nv = (int)sqrt(faces / 2.5), nu = faces / nv;
         size_t len;
@@ -96,8 +100,23 @@ int main(int argc, char **argv)
             }
         double render = cpu_now() - t0;
         trace_thread_destroy(&th);
-        printf("%8d %10.3f %12.3f %12.3f %12d %10ld   (%ld of 16384 pixels covered)\n",
-               nu * nv, parse, world - parse, render, nobj, peak_mib(), hits);
+        /* bytes: the scene's meshes (shared arrays and 16-byte pieces), the
+         * world's per-piece arrays */
+        size_t shared = 0, beyond = 0;
+        long pieces = 0;
+        for (int i = 0; i < js->scene->nmeshes; i++) {
+            const scene_mesh *m = js->scene->meshes[i];
+            size_t pb = (size_t)scene_mesh_npieces(m) * sizeof(scene_mesh_piece);
+            shared += scene_mesh_bytes(m) - pb;
+            beyond += pb;
+            pieces += scene_mesh_npieces(m);
+        }
+        for (int i = 0; i < js->world.nobjects; i++)
+            if (js->world.objects[i].mesh) beyond += trace_mesh_bytes(js->world.objects[i].mesh);
+        int f = nu * nv;
+        printf("%9d %8.3f %8.3f %8.3f %8d %9ld %12.1f %12.1f %9ld   (%ld of 16384 pixels)\n",
+               f, parse, world - parse, render, nobj, pieces, (double)shared / f,
+               (double)beyond / f, peak_mib(), hits);
         job_scene_destroy(&js);
         job_destroy(&jb);
         sl_diag_destroy(&d);

@@ -5,6 +5,7 @@
  * terms) into the renderer's camera-space world (trace/world.h).
  */
 #include "job/job_scene.h"
+#include "trace/mesh.h"
 #include "util/err.h"
 #include "util/xalloc.h"
 
@@ -200,12 +201,13 @@ static int primvar_param(const sl_instance *inst, const scene_primvar *v)
     return !info.output && param_size(info.type) == v->size ? i : -1;
 }
 
-/* The object's primitive variables in camera space, with the globals and
- * parameters they set (trace/primvar.c). */
-static void build_primvars(const scene_object *o, trace_object *t, trace_primvar *out)
+/* Primitive variables vars[0..n) of object t in camera space, with the
+ * globals and parameters they set (trace/primvar.c). */
+static void convert_primvars(const scene_primvar *vars, int n, const trace_object *t,
+                             trace_primvar *out)
 {
-    for (int i = 0; i < o->nprimvars; i++) {
-        const scene_primvar *v = &o->primvars[i];
+    for (int i = 0; i < n; i++) {
+        const scene_primvar *v = &vars[i];
         trace_primvar *pv = &out[i];
         memset(pv, 0, sizeof *pv);
         pv->size = v->size;
@@ -231,8 +233,29 @@ static void build_primvars(const scene_object *o, trace_object *t, trace_primvar
             pv->c[k][0] = c.x, pv->c[k][1] = c.y, pv->c[k][2] = c.z;
         }
     }
+}
+
+static void build_primvars(const scene_object *o, trace_object *t, trace_primvar *out)
+{
+    convert_primvars(o->primvars, o->nprimvars, t, out);
     t->primvars = out;
     t->nprimvars = o->nprimvars;
+}
+
+_Static_assert((int)SCENE_MAX_PRIMVARS <= (int)TRACE_MAX_PRIMVARS, "a piece's variables fit a view");
+
+/* trace_mesh.piece: piece k of the scene object `user` (scene_mesh.h
+ * makes it again from the mesh's arrays), its variables in the camera
+ * space of the mesh object t. */
+static bool mesh_piece(const void *user, const trace_object *t, int k, geom_surface *s,
+                       trace_primvar *pv)
+{
+    const scene_object *o = user;
+    scene_primvar vars[TRACE_MAX_PRIMVARS];
+    int n = 0;
+    if (!scene_object_piece(o, k, s, vars, &n)) return false;
+    if (pv) convert_primvars(vars, n, t, pv);
+    return true;
 }
 
 static bool build_objects(job_scene *self, sl_diag *diag)
@@ -248,6 +271,9 @@ static bool build_objects(job_scene *self, sl_diag *diag)
     if (!ok) return false;
     w->nobjects = sc->nobjects;
     w->objects = xcalloc((size_t)(sc->nobjects > 0 ? sc->nobjects : 1), sizeof *w->objects);
+    int nmeshes = 0;
+    for (int i = 0; i < sc->nobjects; i++) nmeshes += sc->objects[i].mesh != NULL;
+    self->meshes = xcalloc((size_t)(nmeshes > 0 ? nmeshes : 1), sizeof *self->meshes);
     size_t nprimvars = 0;
     for (int i = 0; i < sc->nobjects; i++) nprimvars += (size_t)sc->objects[i].nprimvars;
     self->primvars = xcalloc(nprimvars > 0 ? nprimvars : 1, sizeof *self->primvars);
@@ -256,7 +282,8 @@ static bool build_objects(job_scene *self, sl_diag *diag)
         const scene_object *o = &sc->objects[i];
         trace_object *t = &w->objects[i];
         t->id = i;
-        snprintf(t->name, sizeof t->name, "%s at %s:%d", o->name ? o->name : geom_kind_name(o->surface.kind),
+        snprintf(t->name, sizeof t->name, "%s at %s:%d",
+                 o->name ? o->name : o->mesh ? "mesh" : geom_kind_name(o->surface.kind),
                  o->pos.file ? o->pos.file : sc->file, o->pos.line);
         t->surf = o->surface;
         t->to_camera = o->object_to_camera;
@@ -275,6 +302,15 @@ static bool build_objects(job_scene *self, sl_diag *diag)
         t->nlights = o->nlights;
         build_primvars(o, t, next_primvar);
         next_primvar += o->nprimvars;
+        if (o->mesh) {
+            trace_mesh *m = &self->meshes[self->nmeshes++];
+            m->npieces = scene_mesh_npieces(o->mesh);
+            m->nprimvars = scene_mesh_nprimvars(o->mesh);
+            m->piece = mesh_piece;
+            m->user = o;
+            t->mesh = m;
+            continue;     /* instances of a mesh keep boxes of their own (for now) */
+        }
         /* an instance proposes sharing its prototype's boxes (trace/instance.c) */
         if (o->instance_of >= 0 && o->instance_of < i)
             t->box_proto = &w->objects[o->instance_of];
@@ -386,6 +422,8 @@ void job_scene_destroy(job_scene **self_p)
     free(self->world.objects);
     free(self->world.lights);
     free(self->primvars);
+    for (int i = 0; i < self->nmeshes; i++) trace_mesh_clear(&self->meshes[i]);
+    free(self->meshes);
     tex_cache_destroy(&self->textures);
     scene_destroy(&self->scene);
     free(self);

@@ -24,6 +24,8 @@ typedef struct job_scene {
     trace_renderer *renderer;      /* NULL when built with render = false */
     tex_cache *textures;           /* the textures the shaders read (world.textures) */
     trace_primvar *primvars;       /* every object's primitive variables (world.objects[].primvars) */
+    trace_mesh *meshes;            /* the mesh objects' sources (world.objects[].mesh) */
+    int nmeshes;
 } job_scene;
 
 /* cache_bytes: this worker's box cache budget per thread (0: unlimited).

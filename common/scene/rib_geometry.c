@@ -107,7 +107,8 @@ static void object_lights(const rib_parser *p, scene_object *o)
 }
 
 void rib_place_surface(rib_parser *p, const rib_request *req, const geom_surface *surf,
-                       mat4 ctm, sl_pos pos, const scene_primvar *vars, int nvars)
+                       const scene_mesh *mesh, mat4 ctm, sl_pos pos,
+                       const scene_primvar *vars, int nvars)
 {
     const rib_attributes *a = &p->attr;
     mat4 to_camera = mat4_mul(p->scene->camera.camera_from_world, ctm), inv;
@@ -123,8 +124,20 @@ void rib_place_surface(rib_parser *p, const rib_request *req, const geom_surface
         p->objects_overflow = true;
         return;
     }
+    long pieces = mesh ? scene_mesh_npieces(mesh) : 1;
+    if (p->scene->npieces + pieces > SCENE_MAX_PIECES) {
+        if (!p->objects_overflow)
+            rib_error(p, req, req->pos, "too many mesh faces: %ld placed before this one's %ld "
+                      "(the limit is %ld pieces per scene, instances counting each time): "
+                      "split the scene into several renders or use fewer faces",
+                      p->scene->npieces, pieces, SCENE_MAX_PIECES);
+        p->objects_overflow = true;
+        return;
+    }
+    p->scene->npieces += pieces;
     scene_object *o = rib_add_object(p);
     o->surface = *surf;
+    o->mesh = mesh;
     o->object_to_world = ctm;
     o->object_to_camera = to_camera;
     o->camera_to_object = inv;
@@ -151,10 +164,24 @@ void rib_place_surface(rib_parser *p, const rib_request *req, const geom_surface
 void rib_add_surface(rib_parser *p, const rib_request *req, const geom_surface *surf)
 {
     if (rib_defining(p))
-        rib_record_surface(p, req, surf);
+        rib_record_surface(p, req, surf, NULL);
     else
-        rib_place_surface(p, req, surf, p->attr.ctm, req->pos, p->surface_vars,
+        rib_place_surface(p, req, surf, NULL, p->attr.ctm, req->pos, p->surface_vars,
                           p->nsurface_vars);
+}
+
+void rib_add_mesh(rib_parser *p, const rib_request *req, scene_mesh *mesh)
+{
+    scene *s = p->scene;
+    s->meshes = xreallocarray(s->meshes, (size_t)s->nmeshes + 1, sizeof *s->meshes);
+    s->meshes[s->nmeshes++] = mesh;
+    geom_surface none;
+    memset(&none, 0, sizeof none);
+    none.kind = GEOM_POLYGON;
+    if (rib_defining(p))
+        rib_record_surface(p, req, &none, mesh);
+    else
+        rib_place_surface(p, req, &none, mesh, p->attr.ctm, req->pos, NULL, 0);
 }
 
 /* Validates the surface and adds the object with the current attributes

@@ -88,12 +88,14 @@ rib_object_def *rib_defining(rib_parser *p)
     return i >= 0 ? &p->defs[p->blocks[i].object_def] : NULL;
 }
 
-void rib_record_surface(rib_parser *p, const rib_request *req, const geom_surface *surf)
+void rib_record_surface(rib_parser *p, const rib_request *req, const geom_surface *surf,
+                        const scene_mesh *mesh)
 {
     rib_object_def *d = rib_defining(p);
     d->parts = xrealloc(d->parts, (size_t)(d->nparts + 1) * sizeof *d->parts);
     rib_object_part *part = &d->parts[d->nparts++];
     part->surface = *surf;
+    part->mesh = mesh;
     part->ctm = p->attr.ctm;
     part->pos = req->pos;
     part->first_object = -1;
@@ -132,7 +134,7 @@ void rib_object_instance(rib_parser *p, const rib_request *req)
     for (int i = 0; i < d->nparts; i++) {
         rib_object_part *part = &d->parts[i];
         int before = p->scene->nobjects;
-        rib_place_surface(p, req, &part->surface, mat4_mul(ctm, part->ctm), part->pos,
+        rib_place_surface(p, req, &part->surface, part->mesh, mat4_mul(ctm, part->ctm), part->pos,
                           part->primvars, part->nprimvars);
         if (p->scene->nobjects == before)
             continue;                  /* not placed (an error said why) */

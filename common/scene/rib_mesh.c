@@ -4,6 +4,12 @@
  * be concave and hold holes: loops of points, the outer one first) and
  * GeneralPolygon (one such face with its own points).
  *
+ * PointsPolygons and PointsGeneralPolygons are each ONE scene object
+ * (issue 23): their arrays are kept once in a scene_mesh and each piece
+ * below is a 16-byte record there, its surface made again on demand
+ * (scene_mesh.c follows the same steps as add_triangle and add_face here).
+ * GeneralPolygon and a Polygon with variables add one object per piece.
+ *
  * Each face becomes base surfaces of common/geom: a convex planar face is
  * one GEOM_POLYGON (its parametrisation is the polygon's own, docs/
  * geometry.md); a concave, holed or non-planar face, or one with more than
@@ -53,9 +59,12 @@ static long sum(const int *v, int n)
 }
 
 /* How a mesh's "N" is given (or computed: MESH_N_VERTEX). */
-typedef enum mesh_nclass {
-    MESH_N_NONE, MESH_N_VERTEX, MESH_N_FACEVARYING, MESH_N_UNIFORM, MESH_N_CONSTANT
-} mesh_nclass;
+typedef scene_mesh_nclass mesh_nclass;
+#define MESH_N_NONE SCENE_MESH_N_NONE
+#define MESH_N_VERTEX SCENE_MESH_N_VERTEX
+#define MESH_N_FACEVARYING SCENE_MESH_N_FACEVARYING
+#define MESH_N_UNIFORM SCENE_MESH_N_UNIFORM
+#define MESH_N_CONSTANT SCENE_MESH_N_CONSTANT
 
 /* A mesh being cut into surfaces. */
 typedef struct mesh {
@@ -68,6 +77,9 @@ typedef struct mesh {
     const double *N;
     int fv0;                       /* the current face's first face-vertex */
     rib_primvars pv;               /* the other primitive variables */
+    scene_mesh *out;               /* PointsPolygons, PointsGeneralPolygons: the
+                                    * pieces go here (one object, issue 23);
+                                    * NULL: one object each */
 } mesh;
 
 /* Corner i of face `face` (point idx[i]) in the variables' classes. */
@@ -139,7 +151,11 @@ static bool add_triangle(rib_parser *p, const mesh *m, int face, const int *idx,
         if (s.nuv != 3 || !rib_primvars_triangle(&m->pv, c, (const double (*)[2])s.uv, vars))
             return false;
     }
-    add_with_vars(p, m, &s, vars);
+    if (m->out)      /* scene_mesh_piece_surface makes s and vars again */
+        scene_mesh_add_piece(m->out, n ? SCENE_PIECE_TRIANGLE_N : SCENE_PIECE_TRIANGLE, face,
+                             m->fv0, k, 3);
+    else
+        add_with_vars(p, m, &s, vars);
     return true;
 }
 
@@ -180,6 +196,10 @@ static bool add_face(rib_parser *p, mesh *m, int face, const int *loop_sizes, in
                 corners[i] = corner_of(m, face, idx, i);
             if ((m->ncls == MESH_N_NONE || corners_flat(m, &s, face, idx, total)) &&
                 rib_primvars_same_at(&m->pv, corners, total)) {
+                if (m->out) {
+                    scene_mesh_add_piece(m->out, SCENE_PIECE_POLYGON, face, m->fv0, NULL, total);
+                    return true;
+                }
                 scene_primvar vars[RIB_MAX_PRIMVARS];
                 rib_primvars_constant(&m->pv, &corners[0], vars);
                 add_with_vars(p, m, &s, vars);
@@ -330,7 +350,7 @@ static void read_mesh(rib_parser *p, const rib_request *req, const int *nloops, 
         goto out;
     }
     mesh m = { req, P->values, P->count / 3, 0, req->args[first_vertices].pos,
-               MESH_N_VERTEX, NULL, 0, { NULL, 0 } };
+               MESH_N_VERTEX, NULL, 0, { NULL, 0 }, NULL };
     int counts[] = { 0, 1, nfaces, m.npoints, m.npoints, nidx };
     if (!rib_primvars_collect(p, req, &params, counts, NULL, &m.pv))
         goto out;
@@ -346,6 +366,10 @@ static void read_mesh(rib_parser *p, const rib_request *req, const int *nloops, 
     } else {
         m.N = smooth = smooth_normals(m.npoints, P->values, nloops, nfaces, nverts, idx);
     }
+#ifdef SCENE_HAVE_GEOM
+    m.out = scene_mesh_new(P->values, m.npoints, idx, nidx, m.ncls, m.N,
+                           N ? N->count / 3 : m.npoints, &m.pv, &params);
+#endif
     const int *loop = nverts, *vi = idx;
     for (int f = 0; f < nfaces && !sl_diag_full(p->diag); f++) {
         int nl = nloops ? nloops[f] : 1;
@@ -356,6 +380,13 @@ static void read_mesh(rib_parser *p, const rib_request *req, const int *nloops, 
         vi += npts;
     }
     free(smooth);
+    if (m.out) {
+        scene_mesh_trim(m.out);
+        if (scene_mesh_npieces(m.out) > 0 && !sl_diag_full(p->diag))
+            rib_add_mesh(p, req, m.out);        /* the scene's from here */
+        else
+            scene_mesh_destroy(&m.out);
+    }
     rib_primvars_clear(&m.pv);
     if (m.skipped > 0)
         rib_warning(p, req, req->pos, "%d face%s without area skipped", m.skipped,
@@ -400,7 +431,7 @@ void rib_general_polygon(rib_parser *p, const rib_request *req)
             for (int i = 0; i < n; i++)
                 idx[i] = i;
             mesh m = { req, P->values, (int)n, 0, req->args[0].pos, MESH_N_NONE, NULL, 0,
-                       { NULL, 0 } };
+                       { NULL, 0 }, NULL };
             int counts[] = { 0, 1, 1, (int)n, (int)n, (int)n };
             const scene_param *N = rib_params_find(&params, "N");
             if (N) {
@@ -454,7 +485,7 @@ bool rib_polygon_vars(rib_parser *p, const rib_request *req, const rib_params *p
     int *idx = xrealloc(NULL, (size_t)n * sizeof *idx);
     for (int i = 0; i < n; i++)
         idx[i] = i;
-    mesh m = { req, P->values, n, 0, req->pos, MESH_N_NONE, NULL, 0, { NULL, 0 } };
+    mesh m = { req, P->values, n, 0, req->pos, MESH_N_NONE, NULL, 0, { NULL, 0 }, NULL };
     int counts[] = { 0, 1, 1, n, n, n };
     if (rib_primvars_collect(p, req, params, counts, NULL, &m.pv)) {
         int loop[1] = { n };

@@ -89,7 +89,8 @@ typedef struct rib_block {
 /* A surface of an object definition, with the transform current inside
  * the definition (relative to its ObjectBegin). */
 typedef struct rib_object_part {
-    geom_surface surface;          /* prepared */
+    geom_surface surface;          /* prepared (unused for a mesh) */
+    const scene_mesh *mesh;        /* a mesh (owned by the scene), or NULL */
     mat4 ctm;
     sl_pos pos;
     int first_object;              /* the first object placed from it, -1: none yet */
@@ -279,8 +280,10 @@ void rib_object_end(rib_parser *p, const rib_request *req);
 void rib_object_instance(rib_parser *p, const rib_request *req);
 /* The definition being recorded (innermost ObjectBegin), or NULL. */
 rib_object_def *rib_defining(rib_parser *p);
-/* Records a prepared surface in the definition being recorded. */
-void rib_record_surface(rib_parser *p, const rib_request *req, const geom_surface *surf);
+/* Records a prepared surface (or a mesh: mesh non-NULL, surf unused) in
+ * the definition being recorded. */
+void rib_record_surface(rib_parser *p, const rib_request *req, const geom_surface *surf,
+                        const scene_mesh *mesh);
 void rib_object_defs_clear(rib_parser *p);
 
 /* rib_geometry.c: adds a prepared surface as an object with the current
@@ -317,6 +320,24 @@ void rib_trim_curve(rib_parser *p, const rib_request *req);
 /* rib_subdiv.c */
 void rib_subdivision_mesh(rib_parser *p, const rib_request *req);
 
+/* scene_mesh.c: building a mesh (the parser's side of scene_mesh.h). The
+ * arrays are copied; the variables' values are found among params' arrays
+ * and copied too. */
+struct rib_primvars;
+scene_mesh *scene_mesh_new(const double *P, int npoints, const int *idx, int nidx,
+                           scene_mesh_nclass ncls, const double *N, int nN,
+                           const struct rib_primvars *pv, const rib_params *params);
+/* Adds a piece: a polygon of face `face`'s ncorners corners from
+ * face-vertex fv0 (k unused), or the triangle of its corners k[0..3). */
+void scene_mesh_add_piece(scene_mesh *self, scene_piece_kind kind, int face, int fv0,
+                          const int k[3], int ncorners);
+void scene_mesh_trim(scene_mesh *self);          /* frees the spare capacity */
+vec3 scene_mesh_corner_normal(scene_mesh_nclass ncls, const double *N, int face,
+                              const int *idx, int fv0, int i);
+/* Hands a mesh (with pieces) to the scene, placed as one object with the
+ * current attributes or recorded in the object being defined. */
+void rib_add_mesh(rib_parser *p, const rib_request *req, scene_mesh *mesh);
+
 /* rib_mesh.c */
 void rib_points_polygons(rib_parser *p, const rib_request *req);
 /* A Polygon (checked: convex, planar) with primitive variables other than
@@ -337,11 +358,12 @@ void rib_option_in_world(rib_parser *p, const rib_request *req);
  * false for anything the caller should run. */
 bool rib_motion_filter(rib_parser *p, const rib_request *req);
 
-/* rib_geometry.c: adds an object for a prepared surface with the current
- * attributes and the object-to-world transform ctm; pos is where the
- * surface was written. */
+/* rib_geometry.c: adds an object for a prepared surface (or a mesh: mesh
+ * non-NULL, surf unused) with the current attributes and the
+ * object-to-world transform ctm; pos is where the surface was written. */
 void rib_place_surface(rib_parser *p, const rib_request *req, const geom_surface *surf,
-                       mat4 ctm, sl_pos pos, const scene_primvar *vars, int nvars);
+                       const scene_mesh *mesh, mat4 ctm, sl_pos pos,
+                       const scene_primvar *vars, int nvars);
 
 /* rib_parser.c: blocks */
 /* False (reported, and the parse stops) past RIB_MAX_BLOCKS. */

@@ -22,7 +22,7 @@ typedef struct rib_primvar_src {
 } rib_primvar_src;
 
 /* The most variables one primitive hands to shaders (st counts two). */
-enum { RIB_MAX_PRIMVARS = 16 };
+enum { RIB_MAX_PRIMVARS = SCENE_MAX_PRIMVARS };
 
 typedef struct rib_primvars {
     rib_primvar_src *v;

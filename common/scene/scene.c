@@ -71,6 +71,9 @@ void scene_destroy(scene **self_p)
 #endif
     free(self->subdivs);
     free(self->nurbs);
+    for (int i = 0; i < self->nmeshes; i++)
+        scene_mesh_destroy(&self->meshes[i]);
+    free(self->meshes);
     free_strings(self->archives, self->narchives);
     free(self->display_name);
     free(self->display_type);
@@ -79,6 +82,27 @@ void scene_destroy(scene **self_p)
     free(self->file);
     free(self);
     *self_p = NULL;
+}
+
+int scene_object_npieces(const scene_object *object)
+{
+    return object->mesh ? scene_mesh_npieces(object->mesh) : 1;
+}
+
+bool scene_object_piece(const scene_object *object, int k, geom_surface *s,
+                        scene_primvar *vars, int *nvars)
+{
+    if (!object->mesh) {
+        if (k != 0) return false;
+        *s = object->surface;
+        if (object->nprimvars > 0)
+            memcpy(vars, object->primvars, (size_t)object->nprimvars * sizeof *vars);
+        *nvars = object->nprimvars;
+        return true;
+    }
+    if (k < 0 || k >= scene_mesh_npieces(object->mesh)) return false;
+    *nvars = scene_mesh_nprimvars(object->mesh);
+    return scene_mesh_piece_surface(object->mesh, k, s, vars);
 }
 
 const scene_shader *scene_object_surface(const scene *self, const scene_object *object)

@@ -40,6 +40,7 @@
 #include <stddef.h>
 
 #include "geom/surface.h"
+#include "scene/scene_mesh.h"
 #include "sl/diag.h"
 #include "sl/shader.h"
 #include "sl/source.h"
@@ -116,6 +117,9 @@ typedef struct scene_primvar {
     double c[16][3];               /* c[i + 4 j]: the term of u^i v^j */
 } scene_primvar;
 
+/* The most primitive variables one object carries ("st" counts two). */
+enum { SCENE_MAX_PRIMVARS = 16 };
+
 /* One Surface or Displacement request, or a LightSource naming a light
  * shader. "shader" space is the transform
  * current at the request. */
@@ -189,6 +193,9 @@ typedef struct scene_object {
     sl_pos pos;                    /* the defining request (file = scene.file) */
     scene_primvar *primvars;       /* its primitive variables (other than P, N) */
     int nprimvars;
+    const scene_mesh *mesh;        /* a polygon mesh (scene_mesh.h): its pieces stand
+                                    * for `surface` (unused) and `primvars` (none
+                                    * here); owned by scene.meshes. NULL: one surface */
     int instance_of;               /* ObjectInstance: the index of the first object
                                     * placed from the same recorded surface (its
                                     * own index for that one); -1: not instanced.
@@ -249,6 +256,11 @@ typedef struct scene {
     struct geom_nurbs **nurbs;     /* rational / high-order NuPatches, shared
                                     * by their pieces' surfaces (geom/nurbs.h) */
     int nnurbs;
+    scene_mesh **meshes;           /* polygon meshes, each placed by one or more
+                                    * objects (scene_object.mesh) */
+    int nmeshes;
+    long npieces;                  /* the pieces the objects place, meshes' pieces
+                                    * once per placing object, other objects one */
 } scene;
 
 /* The largest Option "trace" "maxdepth" (each depth is a shading VM per
@@ -288,6 +300,19 @@ enum { SCENE_ARCHIVE_MAX_DEPTH = 16 };
  * scene text itself is bounded by the source size (4 MiB, sl/source.h)
  * and archives are bounded the same way each. */
 enum { SCENE_MAX_OBJECTS = 1 << 20 };
+
+/* The most mesh pieces (a face, or a triangle of one) the objects of a
+ * scene may place in all, instances counting each time: ~100 bytes each
+ * in a worker (docs/renderer.md "Meshes"), so 2^25 of them fit a 24 GB
+ * worker with room for the box cache. */
+#define SCENE_MAX_PIECES (1L << 25)
+
+/* The pieces of an object: a mesh's, or 1. Piece k's surface and
+ * primitive variables (out: at most RIB's 16 per object) into s, vars,
+ * *nvars. */
+int scene_object_npieces(const scene_object *object);
+bool scene_object_piece(const scene_object *object, int k, geom_surface *s,
+                        scene_primvar *vars, int *nvars);
 
 /* As scene_parse_archives, with at most max_objects objects (more is an
  * error naming the request that passes the limit). */

@@ -538,7 +538,7 @@ static bool over_limit(walk *w, const double r[4])
     w->stopped = true;
     if (th->failed) return true;           /* failed or cancelled: the tile ends */
     th->stats.limited_rays++;
-    trace_object_work *ow = &th->work[w->obj->id];
+    trace_object_work *ow = &th->work[w->obj->top];
     if (!ow->probed || ow->diverges) {     /* converge.h: fail fast where hopeless */
         ow->probed = true;
         char err[ERR_LEN];

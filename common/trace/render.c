@@ -12,36 +12,11 @@
 
 #include "trace/camera.h"
 #include "trace/instance.h"
+#include "trace/mesh.h"
 #include "trace/sampler.h"
 #include "trace/shade.h"
 #include "util/err.h"
 #include "util/xalloc.h"
-
-static void camera_bound(const trace_object *obj, const trace_box *b, trace_box *out)
-{
-    out->bend = 0.0f;
-    trace_box_no_slab(out);
-    if (b->flags & AA_UNBOUNDED || !isfinite(b->lo.x + b->lo.y + b->lo.z + b->hi.x + b->hi.y + b->hi.z)) {
-        out->lo = v3(-INFINITY, -INFINITY, -INFINITY);
-        out->hi = v3(INFINITY, INFINITY, INFINITY);
-        out->flags = AA_UNBOUNDED;
-        return;
-    }
-    out->flags = b->flags;
-    for (int i = 0; i < 8; i++) {
-        vec3 c = v3((i & 1) ? b->hi.x : b->lo.x, (i & 2) ? b->hi.y : b->lo.y,
-                    (i & 4) ? b->hi.z : b->lo.z);
-        vec3 p = mat4_xform_point(&obj->to_camera, c);
-        if (i == 0) { out->lo = out->hi = p; continue; }
-        out->lo = v3(fmin(out->lo.x, p.x), fmin(out->lo.y, p.y), fmin(out->lo.z, p.z));
-        out->hi = v3(fmax(out->hi.x, p.x), fmax(out->hi.y, p.y), fmax(out->hi.z, p.z));
-    }
-    /* the corner transform rounds: widen by a relative hair */
-    vec3 e = v3_scale(v3(fabs(out->hi.x) + fabs(out->lo.x), fabs(out->hi.y) + fabs(out->lo.y),
-                         fabs(out->hi.z) + fabs(out->lo.z)), 1e-12);
-    out->lo = v3_sub(out->lo, e);
-    out->hi = v3_add(out->hi, e);
-}
 
 trace_renderer *trace_renderer_new(trace_world *world, char *err, size_t errsz)
 {
@@ -52,6 +27,10 @@ trace_renderer *trace_renderer_new(trace_world *world, char *err, size_t errsz)
     for (int i = 0; i < world->nobjects && !th->failed; i++) {
         if (trace_thread_cancelled(th)) break;   /* a signal: stop between objects */
         trace_object *obj = &world->objects[i];
+        if (obj->mesh) {
+            trace_mesh_build(th, obj);          /* its pieces' boxes and BVH */
+            continue;
+        }
         if (obj->box_proto) {
             obj->root = obj->box_proto->root;   /* an earlier object: computed */
         } else if (obj->displacement) {
@@ -61,7 +40,7 @@ trace_renderer *trace_renderer_new(trace_world *world, char *err, size_t errsz)
             obj->root.flags = 0;
             trace_box_no_slab(&obj->root);
         }
-        camera_bound(obj, &obj->root, &obj->bound);
+        trace_object_camera_bound(obj, &obj->root, &obj->bound);
     }
     if (th->failed) {
         err_set(err, errsz, "%s", th->error);

@@ -3,6 +3,7 @@
  * shadows, and the rays shaders trace (trace(), shadow(); see shade.h).
  */
 #include "trace/shade.h"
+#include "trace/mesh.h"
 
 #include "trace/displace.h"
 #include "trace/primvar.h"
@@ -277,7 +278,9 @@ static void shade_hit(const trace_renderer *r, trace_thread *th, const trace_ray
                       const trace_hit *hit, int depth, double rgb[3], double *alpha,
                       vec3 *P_out)
 {
-    const trace_object *obj = hit->obj;
+    /* a mesh piece's view: a copy of its own for this depth, which the
+     * shadow and trace() rays below cannot overwrite (mesh.h) */
+    const trace_object *obj = trace_view_hold(th, hit->obj, depth);
     trace_surface_point sp;
     if (hit->has_point) sp = hit->point;
     else trace_surface_point_eval(th, obj, hit->u, hit->v, &sp);

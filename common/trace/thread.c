@@ -2,6 +2,7 @@
  * thread.c: per-thread rendering state (see thread.h).
  */
 #include "trace/thread.h"
+#include "trace/mesh.h"
 #include "util/err.h"
 #include "util/xalloc.h"
 
@@ -67,7 +68,8 @@ trace_thread *trace_thread_new(const trace_world *world)
     self->light_vm = new_vm(world);
     hand_over_all(self);
     aa_context_init(&self->ctx, world->options.aa_capacity);
-    self->cache = trace_boxcache_new(world->options.cache_bytes, world->nobjects);
+    self->cache = trace_boxcache_new(world->options.cache_bytes,
+                                     world->nids > world->nobjects ? world->nids : world->nobjects);
     self->work = xcalloc(world->nobjects > 0 ? (size_t)world->nobjects : 1, sizeof *self->work);
     return self;
 }
@@ -97,6 +99,7 @@ void trace_thread_destroy(trace_thread **self_p)
     trace_boxcache_destroy(&self->cache);
     free(self->slopes);
     free(self->walls);
+    trace_views_free(self);
     free(self->work);
     free(self);
     *self_p = NULL;

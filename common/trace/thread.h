@@ -55,8 +55,9 @@ typedef struct trace_thread {
     trace_boxcache *cache;
     struct trace_slope_cache *slopes;  /* prove.c's, made on first use */
     struct trace_wall_cache *walls;    /* intersect.c's, made on first use */
+    struct trace_views *views;     /* mesh.c's views of pieces, made on first use */
     trace_stats stats;
-    trace_object_work *work;       /* world->nobjects entries */
+    trace_object_work *work;       /* world->nobjects entries (by trace_object.top) */
     const atomic_int *cancel;      /* non-zero: stop tracing at once (a signal,
                                       the pool stopping); NULL: never */
     bool failed;

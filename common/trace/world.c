@@ -7,10 +7,13 @@
  * so every worker derives the same values.
  */
 #include "trace/world.h"
+#include "trace/mesh.h"
 #include "util/err.h"
 #include "util/xalloc.h"
 
+#include <assert.h>
 #include <math.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -63,7 +66,7 @@ static double normal_scale_of(const trace_object *obj)
  * raster, in pixels), dv likewise, from a 9x9 grid of base-surface points;
  * between 2^-16 and 1. A pure function of the scene (no tile, thread or
  * worker enters it). Points behind the eye are measured at distance 1. */
-static void grid_spacing(const trace_world *world, trace_object *obj)
+void trace_object_grid_spacing(const trace_world *world, trace_object *obj)
 {
     const trace_camera *cam = &world->camera;
     double px = fabs(cam->screen[1] - cam->screen[0]) / cam->xres;
@@ -102,15 +105,21 @@ static bool matrix_finite(const mat4 *m)
     return true;
 }
 
-/* A polygon edge by the exact bits of its RIB vertices (the lower first)
- * and of its object's transform, for finding shared ones. */
-typedef struct world_edge { double key[6 + 16]; int obj, edge; } world_edge;
+/* A polygon edge by two independent 64-bit hashes of its exact key: the
+ * bits of its RIB vertices (the lower first) and of its object's
+ * transform; and where it is: its object id (a mesh piece's id for
+ * pieces) times 64 plus its index. 24 bytes an edge. Equal keys have
+ * equal hashes; two different keys whose 128 bits of hash agree would
+ * only turn the hit proofs off near one more edge (they decide nothing
+ * the leaves do not). */
+typedef struct world_edge { uint64_t h1, h2, ref; } world_edge;
 
-static int edge_cmp(const void *x, const void *y)
+static int world_edge_cmp(const void *x, const void *y)
 {
     const world_edge *a = x, *b = y;
-    int c = memcmp(a->key, b->key, sizeof a->key);
-    return c ? c : (a->obj > b->obj) - (a->obj < b->obj);
+    if (a->h1 != b->h1) return a->h1 < b->h1 ? -1 : 1;
+    if (a->h2 != b->h2) return a->h2 < b->h2 ? -1 : 1;
+    return (a->ref > b->ref) - (a->ref < b->ref);
 }
 
 /* the RIB vertex of the polygon nearest to p (p is one of them, up to the
@@ -126,48 +135,120 @@ static vec3 rib_vertex(const geom_surface *s, vec3 p)
     return s->verts[best];
 }
 
+static uint64_t mix(uint64_t h, uint64_t b, uint64_t m)
+{
+    h = (h ^ b) * m;
+    return h ^ (h >> 31);
+}
+
+static void edge_hash(const geom_surface *s, const mat4 *to_camera, int k, world_edge *out)
+{
+    vec3 a, b;
+    geom_polygon_edge(s, k, &a, &b);
+    a = rib_vertex(s, a);
+    b = rib_vertex(s, b);
+    double pa[3] = {a.x, a.y, a.z}, pb[3] = {b.x, b.y, b.z}, key[6 + 16];
+    bool swap = memcmp(pb, pa, sizeof pa) < 0;
+    memcpy(key, swap ? pb : pa, sizeof pa);
+    memcpy(key + 3, swap ? pa : pb, sizeof pa);
+    memcpy(key + 6, to_camera->m, sizeof to_camera->m);
+    uint64_t h1 = 0x243f6a8885a308d3ull, h2 = 0x13198a2e03707344ull;
+    for (int i = 0; i < 22; i++) {
+        uint64_t bits;
+        memcpy(&bits, &key[i], sizeof bits);
+        h1 = mix(h1, bits, 0x100000001b3ull);
+        h2 = mix(h2, bits, 0x9e3779b97f4a7c15ull);
+    }
+    out->h1 = h1;
+    out->h2 = h2;
+}
+
+/* The object of id `id`: a plain object, or the mesh of a piece (meshes:
+ * the mesh objects' indices, in order). */
+static trace_object *owner_of_id(trace_world *world, const int *meshes, int nmeshes, int id)
+{
+    if (id < world->nobjects) return &world->objects[id];
+    int lo = 0, hi = nmeshes - 1;      /* the last mesh whose first_id <= id */
+    while (lo < hi) {
+        int mid = (lo + hi + 1) / 2;
+        if (world->objects[meshes[mid]].mesh->first_id <= id) lo = mid; else hi = mid - 1;
+    }
+    return &world->objects[meshes[lo]];
+}
+
+static void mark_shared(trace_world *world, const int *meshes, int nmeshes, uint64_t ref)
+{
+    int id = (int)(ref / 64), edge = (int)(ref % 64);
+    trace_object *owner = owner_of_id(world, meshes, nmeshes, id);
+    if (owner->mesh)
+        owner->mesh->shared_edges[id - owner->mesh->first_id] |= (uint64_t)1 << edge;
+    else
+        owner->shared_edges |= (uint64_t)1 << edge;
+}
+
 /* The edges polygons share (the meshes of Polygon and PointsPolygons
  * calls, whose shared vertices are the same numbers under the same
  * transform): the hit proofs (intersect.c) stay off near them, where the
- * neighbour's leaves decide. Sorted by their exact bits, so equal edges
- * are neighbours: O(n log n) for meshes of any size. */
+ * neighbour's leaves decide. Sorted by their hashes, so equal edges are
+ * neighbours: O(n log n) for meshes of any size. The same pass over a
+ * mesh's pieces keeps the camera-space bounds of the undisplaced ones
+ * (trace_mesh_build needs no second one). */
 static void find_shared_edges(trace_world *world)
 {
+    int nmeshes = 0;
+    int *meshes = xmalloc(sizeof *meshes * (size_t)(world->nobjects > 0 ? world->nobjects : 1));
     size_t n = 0;
     for (int i = 0; i < world->nobjects; i++) {
         trace_object *obj = &world->objects[i];
         obj->shared_edges = 0;
-        if (obj->surf.kind == GEOM_POLYGON) n += (size_t)obj->surf.nuv;
-    }
-    if (n < 2) return;
-    world_edge *e = xcalloc(n, sizeof *e);
-    n = 0;
-    for (int i = 0; i < world->nobjects; i++) {
-        const trace_object *obj = &world->objects[i];
-        if (obj->surf.kind != GEOM_POLYGON) continue;
-        for (int k = 0; k < obj->surf.nuv && k < 64; k++) {
-            vec3 a, b;
-            geom_polygon_edge(&obj->surf, k, &a, &b);
-            a = rib_vertex(&obj->surf, a);
-            b = rib_vertex(&obj->surf, b);
-            double pa[3] = {a.x, a.y, a.z}, pb[3] = {b.x, b.y, b.z};
-            bool swap = memcmp(pb, pa, sizeof pa) < 0;
-            world_edge *w = &e[n++];
-            memcpy(w->key, swap ? pb : pa, sizeof pa);
-            memcpy(w->key + 3, swap ? pa : pb, sizeof pa);
-            memcpy(w->key + 6, obj->to_camera.m, sizeof obj->to_camera.m);
-            w->obj = i;
-            w->edge = k;
+        if (obj->mesh) {
+            trace_mesh *m = obj->mesh;
+            meshes[nmeshes++] = i;
+            free(m->shared_edges);
+            m->shared_edges = xcalloc((size_t)(m->npieces > 0 ? m->npieces : 1),
+                                      sizeof *m->shared_edges);
+            n += 3 * (size_t)m->npieces;           /* an estimate: grown below */
+        } else if (obj->surf.kind == GEOM_POLYGON) {
+            n += (size_t)obj->surf.nuv;
         }
     }
-    qsort(e, n, sizeof *e, edge_cmp);
+    size_t cap = n > 0 ? n : 1;
+    world_edge *e = xmalloc(cap * sizeof *e);
+    geom_surface *tmp = xmalloc(sizeof *tmp);
+    n = 0;
+    for (int i = 0; i < world->nobjects; i++) {
+        trace_object *obj = &world->objects[i];
+        trace_mesh *m = obj->mesh;
+        if (m && !obj->displacement && !m->bounds)
+            m->bounds = xmalloc(sizeof *m->bounds * (size_t)(m->npieces > 0 ? m->npieces : 1));
+        int npieces = m ? m->npieces : 1;
+        for (int k = 0; k < npieces; k++) {
+            const geom_surface *s = &obj->surf;
+            int id = i;
+            if (m) {
+                id = m->first_id + k;
+                if (!m->piece(m->user, obj, k, tmp, NULL)) continue;
+                s = tmp;
+                if (!obj->displacement) trace_mesh_piece_bounds(obj, s, m->bounds[k]);
+            }
+            if (s->kind != GEOM_POLYGON) continue;
+            for (int j = 0; j < s->nuv && j < 64; j++) {
+                if (n == cap) e = xreallocarray(e, cap *= 2, sizeof *e);
+                edge_hash(s, &obj->to_camera, j, &e[n]);
+                e[n++].ref = (uint64_t)id * 64 + (uint64_t)j;
+            }
+        }
+    }
+    qsort(e, n, sizeof *e, world_edge_cmp);
     for (size_t i = 0; i + 1 < n; i++) {
         size_t j = i + 1;
-        if (memcmp(e[i].key, e[j].key, sizeof e[i].key) != 0 || e[i].obj == e[j].obj) continue;
-        world->objects[e[i].obj].shared_edges |= (uint64_t)1 << e[i].edge;
-        world->objects[e[j].obj].shared_edges |= (uint64_t)1 << e[j].edge;
+        if (e[i].h1 != e[j].h1 || e[i].h2 != e[j].h2 || e[i].ref / 64 == e[j].ref / 64) continue;
+        mark_shared(world, meshes, nmeshes, e[i].ref);
+        mark_shared(world, meshes, nmeshes, e[j].ref);
     }
     free(e);
+    free(tmp);
+    free(meshes);
 }
 
 bool trace_world_prepare(trace_world *world, char *err, size_t errsz)
@@ -183,6 +264,7 @@ bool trace_world_prepare(trace_world *world, char *err, size_t errsz)
             return false;
         }
         obj->id = i;
+        obj->top = i;
         obj->scale = s;
         obj->normal_scale = normal_scale_of(obj);
         /* |from_camera^T n| lies between the smallest and the largest
@@ -191,12 +273,26 @@ bool trace_world_prepare(trace_world *world, char *err, size_t errsz)
         double lo = 1.0 / s;
         obj->normal_len2[0] = lo * lo * (1.0 - 1e-9);
         obj->normal_len2[1] = si * si * (1.0 + 1e-9);
-        grid_spacing(world, obj);
+        if (!obj->mesh) trace_object_grid_spacing(world, obj);   /* pieces: their views */
         const sl_program *dp = obj->displacement ? sl_instance_program(obj->displacement) : NULL;
         obj->box_skip_tangents = dp && !sl_program_takes_derivatives(dp) &&
                                  !sl_program_reads_global(dp, SL_G_dPdu) &&
                                  !sl_program_reads_global(dp, SL_G_dPdv);
     }
+    /* ids: the objects, then each mesh's pieces */
+    long next = world->nobjects;
+    for (int i = 0; i < world->nobjects; i++) {
+        trace_mesh *m = world->objects[i].mesh;
+        if (!m) continue;
+        if (next + m->npieces > INT32_MAX / 64) {
+            return err_set(err, errsz, "%s: too many mesh pieces in the scene (%ld before "
+                           "this mesh's %d)", world->objects[i].name, next - world->nobjects,
+                           m->npieces);
+        }
+        m->first_id = (int)next;
+        next += m->npieces;
+    }
+    world->nids = (int)next;
     find_shared_edges(world);
     return true;
 }

@@ -37,8 +37,46 @@ typedef struct trace_primvar {
     double c[16][3];
 } trace_primvar;
 
+/* The most primitive variables a surface hands to its shaders (RIB's
+ * RIB_MAX_PRIMVARS: "st" counts two). */
+enum { TRACE_MAX_PRIMVARS = 16 };
+
+struct trace_object;
+struct trace_mesh_bvh;
+
+/* A mesh (issue 23, trace/mesh.h): ONE world object that stands for many
+ * pieces (the faces of a PointsPolygons, or triangles of them), kept by
+ * whoever built the world as a source of pieces and made into a full
+ * trace_object (a "view") only where a ray reaches the piece. */
+typedef struct trace_mesh {
+    int npieces;
+    int nprimvars;                 /* each piece's primitive variables */
+    /* Piece k of the mesh object obj: its object-space surface (prepared)
+     * and, when pv is not NULL, its primitive variables in camera space
+     * (as trace_primvar, with obj's shaders' parameters); false if the
+     * piece cannot be made (never for a piece of a parsed mesh). A pure
+     * function, called from any thread. */
+    bool (*piece)(const void *user, const struct trace_object *obj, int k, geom_surface *s,
+                  trace_primvar *pv);
+    const void *user;
+    /* derived: trace_world_prepare, trace_renderer_new (trace_mesh_clear
+     * frees them) */
+    int first_id;                  /* piece k's object id is first_id + k */
+    uint64_t *shared_edges;        /* per piece, as trace_object.shared_edges */
+    float (*bounds)[6];            /* per piece: camera-space box (lo, hi),
+                                      rounded outward from its bound */
+    struct trace_mesh_bvh *bvh;    /* over the pieces' bounds */
+} trace_mesh;
+
 typedef struct trace_object {
-    int id;                        /* index in trace_world.objects */
+    int id;                        /* index in trace_world.objects; a mesh
+                                      piece's view: its mesh's first_id + k,
+                                      so caches tell pieces apart */
+    int top;                       /* index in trace_world.objects (the mesh
+                                      object of a piece's view) */
+    trace_mesh *mesh;              /* a mesh object (its surf, primvars and
+                                      root are unused); NULL: one surface
+                                      (and a piece's view) */
     char name[64];                 /* for messages: "sphere at ufo.rib:12" */
     geom_surface surf;
     mat4 to_camera, from_camera;   /* object space <-> camera space */
@@ -155,6 +193,8 @@ typedef struct trace_world {
     double gain, gamma;            /* Exposure */
     trace_object *objects;
     int nobjects;
+    int nids;                      /* object ids in use: the objects, then every
+                                      mesh's pieces (trace_world_prepare) */
     trace_light *lights;
     int nlights;
     trace_options options;
@@ -165,5 +205,8 @@ typedef struct trace_world {
  * false with a message naming the object when its transform is not finite
  * or nearly singular. Called by trace_renderer_new; idempotent. */
 bool trace_world_prepare(trace_world *world, char *err, size_t errsz);
+
+/* The object's du, dv (world.c; a mesh piece's view sets its own). */
+void trace_object_grid_spacing(const trace_world *world, trace_object *obj);
 
 #endif

@@ -43,6 +43,7 @@
 
 #include "corpus.h"
 #include "geom/surface.h"
+#include "trace/mesh.h"
 #include "trace/displace.h"
 
 enum { GRID = 4, RANDOM_POINTS = 16 };   /* samples per range: 4x4 grid (corners and
@@ -201,8 +202,15 @@ static void run_cases(trace_thread *th, const trace_world *w, long ncases, uint6
                       tally *t)
 {
     corpus_rng rng = {seed};
+    /* every surface: the objects, and each mesh's pieces (views) */
+    int nsurf = 0;
+    for (int o = 0; o < w->nobjects; o++) nsurf += trace_object_npieces(&w->objects[o]);
+    trace_view *view = malloc(sizeof *view);
     for (long k = 0; k < ncases; k++) {
-        const trace_object *obj = &w->objects[k % w->nobjects];
+        int s = (int)(k % nsurf), o = 0;
+        while (s >= trace_object_npieces(&w->objects[o])) s -= trace_object_npieces(&w->objects[o++]);
+        const trace_object *obj = trace_object_piece(th, &w->objects[o], s, view);
+        assert_non_null(obj);
         double su = side(&rng), sv = side(&rng);
         double u0 = (1 - su) * corpus_rng_uniform(&rng), v0 = (1 - sv) * corpus_rng_uniform(&rng);
         double u1 = u0 + su, v1 = v0 + sv;
@@ -242,6 +250,7 @@ static void run_cases(trace_thread *th, const trace_world *w, long ncases, uint6
             check_point(th, obj, &b, u, v, t);
         }
     }
+    free(view);
 }
 
 static void run_surface(corpus_surface s)

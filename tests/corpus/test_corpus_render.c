@@ -41,6 +41,7 @@
 
 #include "corpus.h"
 #include "geom/surface.h"
+#include "trace/mesh.h"
 #include "trace/displace.h"
 
 enum { W = 48, H = 36 };            /* image */
@@ -164,11 +165,15 @@ static void ref_triangle(trace_thread *th, const trace_object *obj, const trace_
  * that the tessellation reaches the polygon's edges exactly */
 static void reference(trace_thread *th, const trace_world *w, unsigned char *cover)
 {
-    const int G = (int)ceil(GRID / sqrt((double)w->nobjects));
+    int nsurf = 0;
+    for (int o = 0; o < w->nobjects; o++) nsurf += trace_object_npieces(&w->objects[o]);
+    const int G = (int)ceil(GRID / sqrt((double)nsurf));
     double (*xy)[2] = malloc(sizeof *xy * (size_t)(G + 1) * (size_t)(G + 1));
     bool *ok = malloc(sizeof *ok * (size_t)(G + 1) * (size_t)(G + 1));
-    for (int o = 0; o < w->nobjects; o++) {
-        const trace_object *obj = &w->objects[o];
+    trace_view *view = malloc(sizeof *view);
+    for (int o = 0; o < w->nobjects; o++)
+      for (int pc = 0; pc < trace_object_npieces(&w->objects[o]); pc++) {
+        const trace_object *obj = trace_object_piece(th, &w->objects[o], pc, view);
         if (obj->surf.kind == GEOM_POLYGON) {
             const geom_surface *g = &obj->surf;
             for (int k = 1; k + 1 < g->nuv; k++)
@@ -188,6 +193,7 @@ static void reference(trace_thread *th, const trace_world *w, unsigned char *cov
                 raster_triangle(xy[k00], xy[k11], xy[k01], cover);
             }
     }
+    free(view);
     free(xy);
     free(ok);
 }

@@ -13,6 +13,36 @@
 
 #include "scene/scene.h"
 
+/* One piece of a scene's objects: a mesh's face or triangle
+ * (scene_mesh_piece_surface), or an object's own surface, with its
+ * primitive variables and the object it belongs to. */
+typedef struct test_piece {
+    geom_surface surface;
+    scene_primvar primvars[SCENE_MAX_PRIMVARS];
+    int nprimvars;
+    int object;
+} test_piece;
+
+/* Every piece of every object of s, in order: what each object of a scene
+ * was before a mesh became one object (issue 23). *n of them; the caller
+ * frees. */
+static inline test_piece *scene_pieces(const scene *s, int *n)
+{
+    int total = 0;
+    for (int i = 0; i < s->nobjects; i++) total += scene_object_npieces(&s->objects[i]);
+    test_piece *pc = calloc((size_t)(total > 0 ? total : 1), sizeof *pc);
+    int k = 0;
+    for (int i = 0; i < s->nobjects; i++)
+        for (int j = 0; j < scene_object_npieces(&s->objects[i]); j++, k++) {
+            if (!scene_object_piece(&s->objects[i], j, &pc[k].surface, pc[k].primvars,
+                                    &pc[k].nprimvars))
+                abort();
+            pc[k].object = i;
+        }
+    *n = total;
+    return pc;
+}
+
 /* The smallest camera a scene needs. */
 #define CAMERA "Format 64 32 1\nProjection \"perspective\" \"fov\" [45]\n"
 

@@ -341,13 +341,19 @@ static void test_meshes(void **state)
 {
     (void)state;
     scene *s = load("meshes.rib");
-    assert_int_equal(s->nobjects, 1920 + 3 * 15 + 2);
-    for (int i = 0; i < s->nobjects; i++)
-        assert_int_equal(s->objects[i].surface.kind, GEOM_POLYGON);
+    /* each PointsPolygons is one object (issue 23): the terrain, three
+     * stars, the bent quad */
+    assert_int_equal(s->nobjects, 1 + 3 + 1);
+    int np;
+    test_piece *pc = scene_pieces(s, &np);
+    assert_int_equal(np, 1920 + 3 * 15 + 2);
+    for (int i = 0; i < np; i++)
+        assert_int_equal(pc[i].surface.kind, GEOM_POLYGON);
     for (int i = 0; i < 1920; i++)
-        assert_int_equal(s->objects[i].surface.nverts, 4);
-    for (int i = 1920; i < s->nobjects; i++)
-        assert_int_equal(s->objects[i].surface.nverts, 3);
+        assert_int_equal(pc[i].surface.nverts, 4);
+    for (int i = 1920; i < np; i++)
+        assert_int_equal(pc[i].surface.nverts, 3);
+    free(pc);
     scene_destroy(&s);
 }
 
@@ -408,11 +414,15 @@ static void test_knot(void **state)
 {
     (void)state;
     scene *s = load("knot.rib");
-    assert_int_equal(s->nobjects, 2 * 192 * 12);
-    for (int i = 0; i < s->nobjects; i++) {
-        assert_int_equal(s->objects[i].surface.kind, GEOM_POLYGON);
-        assert_int_equal(s->objects[i].surface.nvn, 3);
+    assert_int_equal(s->nobjects, 1);
+    int np;
+    test_piece *pc = scene_pieces(s, &np);
+    assert_int_equal(np, 2 * 192 * 12);
+    for (int i = 0; i < np; i++) {
+        assert_int_equal(pc[i].surface.kind, GEOM_POLYGON);
+        assert_int_equal(pc[i].surface.nvn, 3);
     }
+    free(pc);
     scene_destroy(&s);
 }
 

@@ -207,9 +207,11 @@ static void test_valid_texts_parse(void **state)
     /* the first frame is read; the second is skipped, and counted */
     assert_int_equal(sl_diag_warning_count(d), 0);
     assert_int_equal(s->nframes, 2);
-    /* 10 surfaces, a square with a triangular hole (7 triangles), an
-     * instance of two triangles, a 4 x 1 b-spline patch mesh */
-    assert_int_equal(s->nobjects, 10 + 7 + 2 + 4);
+    /* 10 surfaces, a square with a triangular hole (7 triangles: one
+     * mesh), an instance of two triangles (one mesh), a 4 x 1 b-spline
+     * patch mesh */
+    assert_int_equal(s->nobjects, 10 + 1 + 1 + 4);
+    assert_int_equal(s->npieces, 10 + 7 + 2 + 4);
     assert_int_equal(s->nlights, 4);
     scene_destroy(&s);
     sl_diag_destroy(&d);

@@ -1,6 +1,7 @@
 /*
  * tests/scene/test_scene_mesh.c: polygon meshes (common/scene/rib_mesh.c).
- * A cube of shared-point quads gives twelve triangles with the right
+ * A mesh is one scene object whose pieces (scene_pieces) are what the
+ * faces became. A cube of shared-point quads gives twelve triangles with the right
  * corners, each carrying area-weighted vertex normals (the corner's
  * direction from the centre, shared by every face at that corner); a flat
  * mesh stays one polygon per face; a given "N" of each class (vertex,
@@ -25,12 +26,12 @@
 #define CUBE "PointsPolygons [4 4 4 4 4 4]\n" \
     "  [0 2 3 1  4 5 7 6  0 1 5 4  2 6 7 3  0 4 6 2  1 3 7 5]\n  " CUBE_P "\n"
 
-/* Sum of the areas of the objects' polygons. */
-static double polygon_area(const scene *s, int from, int to)
+/* Sum of the areas of the pieces' polygons. */
+static double polygon_area(const test_piece *pc, int from, int to)
 {
     double a = 0;
     for (int i = from; i < to; i++) {
-        const geom_surface *g = &s->objects[i].surface;
+        const geom_surface *g = &pc[i].surface;
         assert_int_equal(g->kind, GEOM_POLYGON);
         vec3 n = v3(0, 0, 0);
         for (int k = 1; k + 1 < g->nverts; k++)
@@ -50,9 +51,15 @@ static void test_cube(void **state)
         sl_diag_print(d, stderr);
     assert_non_null(s);
     assert_int_equal(sl_diag_warning_count(d), 0);
-    assert_int_equal(s->nobjects, 12);
+    /* one object, twelve pieces (issue 23: a mesh is one object) */
+    assert_int_equal(s->nobjects, 1);
+    assert_non_null(s->objects[0].mesh);
+    assert_int_equal(s->npieces, 12);
+    int np;
+    test_piece *pc = scene_pieces(s, &np);
+    assert_int_equal(np, 12);
     for (int i = 0; i < 12; i++) {
-        const geom_surface *g = &s->objects[i].surface;
+        const geom_surface *g = &pc[i].surface;
         assert_int_equal(g->kind, GEOM_POLYGON);
         assert_int_equal(g->nverts, 3);
         assert_int_equal(g->nvn, 3);
@@ -70,7 +77,8 @@ static void test_cube(void **state)
         vec3 c = v3_scale(v3_add(v3_add(g->verts[0], g->verts[1]), g->verts[2]), 1 / 3.0);
         assert_true(v3_dot(n, c) > 0);
     }
-    assert_true(fabs(polygon_area(s, 0, 12) - 24) < 1e-12);
+    assert_true(fabs(polygon_area(pc, 0, 12) - 24) < 1e-12);
+    free(pc);
     scene_destroy(&s);
     sl_diag_destroy(&d);
 }
@@ -90,23 +98,28 @@ static void test_cut_faces(void **state)
     if (!s)
         sl_diag_print(d, stderr);
     assert_non_null(s);
-    assert_int_equal(s->nobjects, 2 + 4 + 8 + 7);
-    for (int i = 0; i < s->nobjects; i++)
-        assert_int_equal(s->objects[i].surface.nverts, 3);
-    assert_true(fabs(polygon_area(s, 2, 6) - 3) < 1e-12);
-    assert_true(fabs(polygon_area(s, 6, 14) - 12) < 1e-12);
-    assert_true(fabs(polygon_area(s, 14, 21) - 15.5) < 1e-12);
+    /* two meshes, then the GeneralPolygon's 7 triangles as objects */
+    assert_int_equal(s->nobjects, 2 + 7);
+    int np;
+    test_piece *pc = scene_pieces(s, &np);
+    assert_int_equal(np, 2 + 4 + 8 + 7);
+    for (int i = 0; i < np; i++)
+        assert_int_equal(pc[i].surface.nverts, 3);
+    assert_true(fabs(polygon_area(pc, 2, 6) - 3) < 1e-12);
+    assert_true(fabs(polygon_area(pc, 6, 14) - 12) < 1e-12);
+    assert_true(fabs(polygon_area(pc, 14, 21) - 15.5) < 1e-12);
+    free(pc);
     scene_destroy(&s);
     sl_diag_destroy(&d);
 }
 
-/* The corner normals of the triangle objects [from, to) that hold point
+/* The corner normals of the triangle pieces [from, to) that hold point
  * p: all equal n (up to length). Returns how many corners were found. */
-static int corners_at(const scene *s, int from, int to, vec3 p, vec3 n)
+static int corners_at(const test_piece *s, int from, int to, vec3 p, vec3 n)
 {
     int found = 0;
     for (int i = from; i < to; i++) {
-        const geom_surface *g = &s->objects[i].surface;
+        const geom_surface *g = &s[i].surface;
         assert_int_equal(g->nvn, 3);
         for (int k = 0; k < 3; k++)
             if (vec_dist(g->verts[k], p) == 0) {
@@ -140,21 +153,25 @@ static void test_normals(void **state)
         sl_diag_print(d, stderr);
     assert_non_null(s);
     assert_int_equal(sl_diag_warning_count(d), 0);
-    assert_int_equal(s->nobjects, 2 + 4 + 2 + 4);
+    assert_int_equal(s->nobjects, 4);
+    int np;
+    test_piece *pc = scene_pieces(s, &np);
+    assert_int_equal(np, 2 + 4 + 2 + 4);
     for (int i = 0; i < 2; i++) {
-        assert_int_equal(s->objects[i].surface.nverts, 4);
-        assert_int_equal(s->objects[i].surface.nvn, 0);
+        assert_int_equal(pc[i].surface.nverts, 4);
+        assert_int_equal(pc[i].surface.nvn, 0);
     }
-    assert_int_equal(corners_at(s, 2, 6, v3(1, 0, 1), v3(0, 0, 1)), 3);
-    assert_true(corners_at(s, 2, 6, v3(0, 0, 0), v3(-1, 0, 1)) >= 1);
-    assert_true(corners_at(s, 2, 6, v3(2, 1, 0), v3(1, 0, 1)) >= 1);
+    assert_int_equal(corners_at(pc, 2, 6, v3(1, 0, 1), v3(0, 0, 1)), 3);
+    assert_true(corners_at(pc, 2, 6, v3(0, 0, 0), v3(-1, 0, 1)) >= 1);
+    assert_true(corners_at(pc, 2, 6, v3(2, 1, 0), v3(1, 0, 1)) >= 1);
     /* facevarying: flat faces stay polygons without corner normals */
     for (int i = 6; i < 8; i++) {
-        assert_int_equal(s->objects[i].surface.nverts, 4);
-        assert_int_equal(s->objects[i].surface.nvn, 0);
+        assert_int_equal(pc[i].surface.nverts, 4);
+        assert_int_equal(pc[i].surface.nvn, 0);
     }
-    assert_int_equal(corners_at(s, 8, 12, v3(1, 1, 1), v3(0, 0, 1)), 3);
-    assert_true(corners_at(s, 8, 12, v3(0, 1, 0), v3(-1, 0, 1)) >= 1);
+    assert_int_equal(corners_at(pc, 8, 12, v3(1, 1, 1), v3(0, 0, 1)), 3);
+    assert_true(corners_at(pc, 8, 12, v3(0, 1, 0), v3(-1, 0, 1)) >= 1);
+    free(pc);
     scene_destroy(&s);
     sl_diag_destroy(&d);
 
@@ -182,20 +199,28 @@ static void test_variables_degenerate_instances(void **state)
         sl_diag_print(d, stderr);
     assert_non_null(s);
     assert_int_equal(s->nobjects, 3);
+    /* both instances place the one recorded mesh: no copy */
+    assert_true(s->objects[0].mesh && s->objects[0].mesh == s->objects[1].mesh);
+    assert_int_equal(s->nmeshes, 2);
     assert_int_equal(sl_diag_warning_count(d), 1);
     assert_string_equal(diag_line(nth_diag(d, SL_DIAG_WARNING, 0)),
                         "t.rib:5:1: PointsPolygons: 1 face without area skipped");
     /* the variables travel with the recorded face to both instances: st
      * as s and t; the vertex Cs, the same at every corner, is constant */
+    int np;
+    test_piece *pc = scene_pieces(s, &np);
+    assert_int_equal(np, 3);
     for (int i = 0; i < 2; i++) {
-        assert_int_equal(s->objects[i].nprimvars, 2);
-        assert_string_equal(s->objects[i].primvars[0].name, "s");
-        assert_string_equal(s->objects[i].primvars[1].name, "t");
+        assert_int_equal(pc[i].object, i);
+        assert_int_equal(pc[i].nprimvars, 2);
+        assert_string_equal(pc[i].primvars[0].name, "s");
+        assert_string_equal(pc[i].primvars[1].name, "t");
     }
-    assert_int_equal(s->objects[2].nprimvars, 1);
-    assert_string_equal(s->objects[2].primvars[0].name, "Cs");
-    assert_true(s->objects[2].primvars[0].c[0][0] == 1 && s->objects[2].primvars[0].c[1][0] == 0 &&
-                s->objects[2].primvars[0].c[4][0] == 0);
+    assert_int_equal(pc[2].nprimvars, 1);
+    assert_string_equal(pc[2].primvars[0].name, "Cs");
+    assert_true(pc[2].primvars[0].c[0][0] == 1 && pc[2].primvars[0].c[1][0] == 0 &&
+                pc[2].primvars[0].c[4][0] == 0);
+    free(pc);
     vec3 o = mat4_xform_point(&s->objects[1].object_to_world, v3(0, 0, 0));
     assert_true(vec_dist(o, v3(0, 0, 5)) < 1e-12);
     scene_destroy(&s);

@@ -21,6 +21,7 @@
 #include <cmocka.h>
 
 #include "fixture.h"
+#include "trace/mesh.h"
 #include "trace/displace.h"
 
 static const char *RAWN_SL =
@@ -85,8 +86,13 @@ typedef struct tally { long cases, points, violations, unbounded; double worst; 
 static void check_ranges(fixture *f, int cases, tally *t)
 {
     trace_thread *th = trace_thread_new(&f->js->world);
-    const trace_object *obj = &f->js->world.objects[0];
+    /* the first object, or each piece of a mesh in turn */
+    const trace_object *first = &f->js->world.objects[0];
+    trace_view *view = malloc(sizeof *view);
     for (int c = 0; c < cases; c++) {
+        const trace_object *obj =
+            trace_object_piece(th, first, c % trace_object_npieces(first), view);
+        assert_non_null(obj);
         double w = pow(2.0, -10.0 * rnd()), h = pow(2.0, -10.0 * rnd());
         double u0 = rnd() * (1 - w), v0 = rnd() * (1 - h);
         trace_box b;
@@ -118,6 +124,7 @@ static void check_ranges(fixture *f, int cases, tally *t)
         }
     }
     assert_false(th->failed);
+    free(view);
     trace_thread_destroy(&th);
 }
 

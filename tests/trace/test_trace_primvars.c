@@ -35,6 +35,7 @@
 #include <cmocka.h>
 
 #include "fixture.h"
+#include "trace/mesh.h"
 #include "trace/displace.h"
 #include "trace/render.h"
 
@@ -399,8 +400,11 @@ static void test_containment(void **state)
             unsigned seed = 777;
             long points = 0, violations = 0;
             double spread = 0;
-            for (int o = 0; o < w->nobjects; o++) {
-                const trace_object *obj = &w->objects[o];
+            trace_view *view = malloc(sizeof *view);
+            for (int o = 0; o < w->nobjects; o++)
+              for (int pc = 0; pc < trace_object_npieces(&w->objects[o]); pc++) {
+                const trace_object *obj = trace_object_piece(th, &w->objects[o], pc, view);
+                assert_non_null(obj);
                 assert_int_equal(obj->nprimvars, 1);
                 for (int c = 0; c < 400; c++) {
                     double side = ldexp(1.0, -(int)(c % 12));
@@ -425,6 +429,7 @@ static void test_containment(void **state)
                     }
                 }
             }
+            free(view);
             assert_false(th->failed);
             printf("%s, %s: %ld points, %ld violations\n",
                    r == 0 ? "mesh" : r == 1 ? "patch" : r == 2 ? "subdivision mesh"

@@ -31,6 +31,7 @@
 #include <cmocka.h>
 
 #include "fixture.h"
+#include "trace/mesh.h"
 #include "trace/camera.h"
 #include "trace/intersect.h"
 #include "trace/prove.h"
@@ -135,7 +136,9 @@ static void check_slopes_in(const char *fmt, const char *name, const char *src,
     snprintf(rib, sizeof rib, fmt, name);
     assert_true(fixture_open(&f, rib, sh, 1, NULL, 0));
     trace_thread *th = trace_thread_new(&f.js->world);
-    const trace_object *obj = &f.js->world.objects[0];
+    trace_view *view = malloc(sizeof *view);   /* a mesh: its first piece */
+    const trace_object *obj = trace_object_piece(th, &f.js->world.objects[0], 0, view);
+    assert_non_null(obj);
     unsigned seed = 12345;
     int cells = 0, bounded = 0, points = 0, outside = 0;
     for (int k = 0; k < 300; k++) {
@@ -169,6 +172,7 @@ static void check_slopes_in(const char *fmt, const char *name, const char *src,
         assert_true(bounded > cells / 3); /* 1/16 of its side, where |Ng| keeps from 0) */
     else
         assert_int_equal(bounded, 0);
+    free(view);
     trace_thread_destroy(&th);
     fixture_close(&f);
 }

@@ -1,0 +1,203 @@
+/*
+ * scene_mesh.c: a polygon mesh as one scene object (see scene_mesh.h):
+ * its shared arrays, its 16-byte pieces, and the piece's base surface made
+ * again on demand by the steps rib_mesh.c used to take once per piece.
+ */
+#include "scene/scene_mesh.h"
+#include "scene/rib_parser.h"
+#include "scene/rib_primvar.h"
+#include "util/err.h"
+#include "util/xalloc.h"
+
+#include <assert.h>
+#include <stdlib.h>
+#include <string.h>
+
+struct scene_mesh {
+    double *P;                     /* npoints * 3, object space */
+    int npoints;
+    int *idx;                      /* the face-vertices' points, nidx of them */
+    int nidx;
+    scene_mesh_nclass ncls;
+    double *N;                     /* corner normals as ncls says, nN * 3 */
+    int nN;
+    rib_primvars pv;               /* their values point into `values` */
+    double **values;               /* the variables' arrays (owned), nvalues */
+    int nvalues;
+    size_t values_bytes;
+    scene_mesh_piece *pieces;
+    int npieces, cap;
+};
+
+static void *copy_of(const void *src, size_t bytes)
+{
+    void *dst = xmalloc(bytes > 0 ? bytes : 1);
+    if (bytes > 0) memcpy(dst, src, bytes);
+    return dst;
+}
+
+scene_mesh *scene_mesh_new(const double *P, int npoints, const int *idx, int nidx,
+                           scene_mesh_nclass ncls, const double *N, int nN,
+                           const rib_primvars *pv, const rib_params *params)
+{
+    scene_mesh *self = xcalloc(1, sizeof *self);
+    self->P = copy_of(P, (size_t)npoints * 3 * sizeof *P);
+    self->npoints = npoints;
+    self->idx = copy_of(idx, (size_t)nidx * sizeof *idx);
+    self->nidx = nidx;
+    self->ncls = ncls;
+    self->N = N ? copy_of(N, (size_t)nN * 3 * sizeof *N) : NULL;
+    self->nN = N ? nN : 0;
+    /* the variables: each source points into a parameter's values, which
+     * go with the parameters; copy every parameter array a source uses
+     * (st's s and t share one) and point the sources at the copies */
+    self->pv.n = pv->n;
+    self->pv.v = pv->n > 0 ? copy_of(pv->v, (size_t)pv->n * sizeof *pv->v) : NULL;
+    self->values = xcalloc((size_t)(params->count > 0 ? params->count : 1), sizeof *self->values);
+    for (int k = 0; k < pv->n; k++) {
+        rib_primvar_src *v = &self->pv.v[k];
+        for (int i = 0; i < params->count; i++) {
+            const scene_param *pa = &params->items[i];
+            if (pa->values != v->values) continue;
+            if (!self->values[i]) {
+                size_t bytes = (size_t)pa->count * sizeof *pa->values;
+                self->values[i] = copy_of(pa->values, bytes);
+                self->values_bytes += bytes;
+            }
+            v->values = self->values[i];
+            break;
+        }
+        assert(v->values != pv->v[k].values || pv->v[k].values == NULL);
+    }
+    self->nvalues = params->count;
+    return self;
+}
+
+void scene_mesh_add_piece(scene_mesh *self, scene_piece_kind kind, int face, int fv0,
+                          const int k[3], int ncorners)
+{
+    if (self->npieces == self->cap) {
+        self->cap = self->cap ? 2 * self->cap : 64;
+        self->pieces = xreallocarray(self->pieces, (size_t)self->cap, sizeof *self->pieces);
+    }
+    scene_mesh_piece *pc = &self->pieces[self->npieces++];
+    memset(pc, 0, sizeof *pc);
+    pc->face = face;
+    pc->fv0 = fv0;
+    pc->kind = (uint8_t)kind;
+    if (kind == SCENE_PIECE_POLYGON) {
+        assert(ncorners >= 3 && ncorners <= GEOM_MAX_POLY_VERTS);
+        pc->k[0] = (uint16_t)ncorners;
+    } else {
+        for (int i = 0; i < 3; i++) {
+            assert(k[i] >= 0 && k[i] <= UINT16_MAX);
+            pc->k[i] = (uint16_t)k[i];
+        }
+    }
+}
+
+void scene_mesh_trim(scene_mesh *self)
+{
+    if (self->npieces > 0 && self->npieces < self->cap) {
+        self->pieces = xreallocarray(self->pieces, (size_t)self->npieces, sizeof *self->pieces);
+        self->cap = self->npieces;
+    }
+}
+
+int scene_mesh_npieces(const scene_mesh *self) { return self->npieces; }
+int scene_mesh_nprimvars(const scene_mesh *self) { return self->pv.n; }
+
+size_t scene_mesh_bytes(const scene_mesh *self)
+{
+    return sizeof *self + (size_t)self->npoints * 3 * sizeof(double) +
+           (size_t)self->nidx * sizeof(int) + (size_t)self->nN * 3 * sizeof(double) +
+           (size_t)self->pv.n * sizeof(rib_primvar_src) + self->values_bytes +
+           (size_t)self->cap * sizeof(scene_mesh_piece);
+}
+
+void scene_mesh_destroy(scene_mesh **self_p)
+{
+    scene_mesh *self = *self_p;
+    if (!self) return;
+    free(self->P);
+    free(self->idx);
+    free(self->N);
+    for (int i = 0; i < self->nvalues; i++) free(self->values[i]);
+    free(self->values);
+    free(self->pv.v);
+    free(self->pieces);
+    free(self);
+    *self_p = NULL;
+}
+
+/* ---- a piece's surface: rib_mesh.c's steps, in the same order ---------- */
+
+static vec3 point_at(const scene_mesh *m, int i)
+{
+    return v3(m->P[3 * i], m->P[3 * i + 1], m->P[3 * i + 2]);
+}
+
+vec3 scene_mesh_corner_normal(scene_mesh_nclass ncls, const double *N, int face,
+                              const int *idx, int fv0, int i)
+{
+    int k = 0;
+    switch (ncls) {
+    case SCENE_MESH_N_VERTEX:      k = idx[fv0 + i]; break;
+    case SCENE_MESH_N_FACEVARYING: k = fv0 + i; break;
+    case SCENE_MESH_N_UNIFORM:     k = face; break;
+    default:                       k = 0; break;
+    }
+    return v3(N[3 * k], N[3 * k + 1], N[3 * k + 2]);
+}
+
+static rib_corner corner_at(const scene_mesh *m, const scene_mesh_piece *pc, int i)
+{
+    int v = m->idx[pc->fv0 + i];
+    return (rib_corner){pc->face, v, v, pc->fv0 + i};
+}
+
+bool scene_mesh_piece_surface(const scene_mesh *self, int k, geom_surface *s,
+                              struct scene_primvar *vars)
+{
+    assert(k >= 0 && k < self->npieces);
+#ifndef SCENE_HAVE_GEOM
+    (void)s, (void)vars;
+    return false;
+#else
+    const scene_mesh_piece *pc = &self->pieces[k];
+    memset(s, 0, sizeof *s);
+    s->kind = GEOM_POLYGON;
+    char err[ERR_LEN];
+    if (pc->kind == SCENE_PIECE_POLYGON) {
+        int n = pc->k[0];
+        s->nverts = n;
+        for (int i = 0; i < n; i++) s->verts[i] = point_at(self, self->idx[pc->fv0 + i]);
+        if (!geom_surface_prepare(s, err, sizeof err)) return false;
+        if (self->pv.n > 0) {
+            rib_corner c0 = corner_at(self, pc, 0);
+            rib_primvars_constant(&self->pv, &c0, vars);
+        }
+        return true;
+    }
+    s->nverts = 3;
+    for (int i = 0; i < 3; i++) s->verts[i] = point_at(self, self->idx[pc->fv0 + pc->k[i]]);
+    if (pc->kind == SCENE_PIECE_TRIANGLE_N) {
+        s->nvn = 3;
+        for (int i = 0; i < 3; i++)
+            s->vn[i] = scene_mesh_corner_normal(self->ncls, self->N, pc->face, self->idx,
+                                                pc->fv0, pc->k[i]);
+    }
+    if (!geom_surface_prepare(s, err, sizeof err)) {
+        if (pc->kind != SCENE_PIECE_TRIANGLE_N) return false;
+        s->nvn = 0;                  /* normals it cannot interpolate: flat */
+        if (!geom_surface_prepare(s, err, sizeof err)) return false;
+    }
+    if (self->pv.n > 0) {
+        rib_corner c[3];
+        for (int i = 0; i < 3; i++) c[i] = corner_at(self, pc, pc->k[i]);
+        if (s->nuv != 3 || !rib_primvars_triangle(&self->pv, c, (const double (*)[2])s->uv, vars))
+            return false;
+    }
+    return true;
+#endif
+}

@@ -1,0 +1,504 @@
+/*
+ * mesh.c: mesh objects, their pieces' BVH and the views of pieces (see
+ * mesh.h).
+ *
+ * The BVH over a mesh's pieces is built once per world (by one thread,
+ * trace_renderer_new) and shared read-only by all threads: binned
+ * surface-area heuristic over the pieces' box centres (Wald, "On fast
+ * construction of SAH-based bounding volume hierarchies", 2007: 12 bins
+ * per axis, O(n log n)), a leaf holding up to 4 pieces, 32-byte nodes of
+ * float boxes rounded outward. Traversal visits the nearer child first
+ * and skips what lies beyond the best hit, as the object BVH (bvh.c).
+ */
+#include "trace/mesh.h"
+
+#include <assert.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "trace/displace.h"
+#include "util/xalloc.h"
+
+/* ---- views ---------------------------------------------------------- */
+
+enum { VIEW_SLOTS = 128 };
+
+typedef struct trace_views {
+    trace_view slot[VIEW_SLOTS];
+    int key[VIEW_SLOTS];               /* the view's id; -1: empty */
+    trace_view hit;                    /* the hit a traversal returns */
+    trace_view *held[TRACE_RAY_DEPTH_LIMIT + 1];   /* hits being shaded, per depth */
+} trace_views;
+
+void trace_object_camera_bound(const trace_object *obj, const trace_box *b, trace_box *out)
+{
+    out->bend = 0.0f;
+    trace_box_no_slab(out);
+    if (b->flags & AA_UNBOUNDED || !isfinite(b->lo.x + b->lo.y + b->lo.z + b->hi.x + b->hi.y + b->hi.z)) {
+        out->lo = v3(-INFINITY, -INFINITY, -INFINITY);
+        out->hi = v3(INFINITY, INFINITY, INFINITY);
+        out->flags = AA_UNBOUNDED;
+        return;
+    }
+    out->flags = b->flags;
+    for (int i = 0; i < 8; i++) {
+        vec3 c = v3((i & 1) ? b->hi.x : b->lo.x, (i & 2) ? b->hi.y : b->lo.y,
+                    (i & 4) ? b->hi.z : b->lo.z);
+        vec3 p = mat4_xform_point(&obj->to_camera, c);
+        if (i == 0) { out->lo = out->hi = p; continue; }
+        out->lo = v3(fmin(out->lo.x, p.x), fmin(out->lo.y, p.y), fmin(out->lo.z, p.z));
+        out->hi = v3(fmax(out->hi.x, p.x), fmax(out->hi.y, p.y), fmax(out->hi.z, p.z));
+    }
+    /* the corner transform rounds: widen by a relative hair */
+    vec3 e = v3_scale(v3(fabs(out->hi.x) + fabs(out->lo.x), fabs(out->hi.y) + fabs(out->lo.y),
+                         fabs(out->hi.z) + fabs(out->lo.z)), 1e-12);
+    out->lo = v3_sub(out->lo, e);
+    out->hi = v3_add(out->hi, e);
+}
+
+/* view_make with du, dv only where they may matter: a view for rays
+ * (shading) or a displaced piece's boxes; not an undisplaced piece's
+ * bounds (trace_mesh_build) */
+static bool make(trace_thread *th, const trace_object *mesh_obj, int k, bool boxes,
+                 bool grid, trace_view *out);
+
+bool trace_mesh_view_make(trace_thread *th, const trace_object *mesh_obj, int k, bool boxes,
+                          trace_view *out)
+{
+    return make(th, mesh_obj, k, boxes, true, out);
+}
+
+static bool make(trace_thread *th, const trace_object *mesh_obj, int k, bool boxes,
+                 bool grid, trace_view *out)
+{
+    const trace_mesh *m = mesh_obj->mesh;
+    assert(m && k >= 0 && k < m->npieces);
+    trace_object *v = &out->obj;
+    *v = *mesh_obj;
+    v->mesh = NULL;
+    v->id = m->first_id + k;
+    v->top = mesh_obj->id;
+    v->primvars = out->pv;
+    v->nprimvars = m->nprimvars;
+    assert(m->nprimvars <= TRACE_MAX_PRIMVARS);
+    if (!m->piece(m->user, mesh_obj, k, &v->surf, m->nprimvars > 0 ? out->pv : NULL)) {
+        trace_thread_fail(th, "a mesh piece could not be made again (internal error)");
+        return false;
+    }
+    v->shared_edges = m->shared_edges ? m->shared_edges[k] : 0;
+    if (grid || v->displacement) trace_object_grid_spacing(th->world, v);
+    if (boxes) {
+        if (v->displacement) {
+            trace_surface_box(th, v, 0, 1, 0, 1, &v->root);
+        } else {
+            geom_bounds(&v->surf, &v->root.lo, &v->root.hi);
+            v->root.flags = 0;
+            v->root.bend = 0.0f;
+            trace_box_no_slab(&v->root);
+        }
+        trace_object_camera_bound(v, &v->root, &v->bound);
+    }
+    return !th->failed;
+}
+
+const trace_object *trace_object_piece(trace_thread *th, const trace_object *obj, int k,
+                                       trace_view *storage)
+{
+    if (!obj->mesh) {
+        assert(k == 0);
+        return obj;
+    }
+    return trace_mesh_view_make(th, obj, k, true, storage) ? &storage->obj : NULL;
+}
+
+void trace_view_copy(trace_view *dst, const trace_view *src)
+{
+    dst->obj = src->obj;
+    int n = src->obj.nprimvars;
+    if (n > 0) memcpy(dst->pv, src->pv, (size_t)n * sizeof *dst->pv);
+    dst->obj.primvars = dst->pv;
+}
+
+static trace_views *views_of(trace_thread *th)
+{
+    if (!th->views) {
+        th->views = xmalloc(sizeof *th->views);
+        for (int i = 0; i < VIEW_SLOTS; i++) th->views->key[i] = -1;
+        memset(th->views->held, 0, sizeof th->views->held);
+    }
+    return th->views;
+}
+
+void trace_views_free(trace_thread *th)
+{
+    if (!th->views) return;
+    for (int d = 0; d <= TRACE_RAY_DEPTH_LIMIT; d++) free(th->views->held[d]);
+    free(th->views);
+    th->views = NULL;
+}
+
+const trace_object *trace_mesh_view(trace_thread *th, const trace_object *mesh_obj, int k)
+{
+    trace_views *vs = views_of(th);
+    int id = mesh_obj->mesh->first_id + k;
+    unsigned s = (unsigned)(((uint32_t)id * 0x9e3779b1u) >> 25);   /* 7 bits: VIEW_SLOTS */
+    assert(s < VIEW_SLOTS);
+    if (vs->key[s] != id) {
+        vs->key[s] = -1;
+        if (!trace_mesh_view_make(th, mesh_obj, k, true, &vs->slot[s])) return NULL;
+        vs->key[s] = id;
+        th->stats.views_made++;
+    }
+    return &vs->slot[s].obj;
+}
+
+const trace_object *trace_view_hold(trace_thread *th, const trace_object *obj, int depth)
+{
+    if (!th->views || obj != &th->views->hit.obj) return obj;
+    assert(depth >= 0 && depth <= TRACE_RAY_DEPTH_LIMIT);
+    trace_view **h = &th->views->held[depth];
+    if (!*h) *h = xmalloc(sizeof **h);
+    trace_view_copy(*h, &th->views->hit);
+    return &(*h)->obj;
+}
+
+/* ---- the pieces' BVH -------------------------------------------------- */
+
+typedef struct mesh_node {
+    float lo[3], hi[3];
+    int32_t a;                         /* leaf: first of idx; interior: left child */
+    int32_t n;                         /* leaf: pieces (> 0); interior: 0, right = a + 1 */
+} mesh_node;
+
+struct trace_mesh_bvh {
+    mesh_node *nodes;
+    int nnodes;
+    int32_t *idx;
+};
+
+enum { LEAF_MAX = 4, BINS = 12, SAH_DEPTH = 40, MESH_STACK = 128 };
+
+static float down(double x)
+{
+    float f = (float)x;
+    return (double)f > x ? nextafterf(f, -INFINITY) : f;
+}
+
+static float up(double x)
+{
+    float f = (float)x;
+    return (double)f < x ? nextafterf(f, INFINITY) : f;
+}
+
+static double area_of(const float lo[3], const float hi[3])
+{
+    double e[3];
+    for (int i = 0; i < 3; i++) e[i] = (double)hi[i] - lo[i];
+    return e[0] * e[1] + e[1] * e[2] + e[2] * e[0];
+}
+
+static void grow(float lo[3], float hi[3], const float b[6])
+{
+    for (int i = 0; i < 3; i++) {
+        lo[i] = fminf(lo[i], b[i]);
+        hi[i] = fmaxf(hi[i], b[3 + i]);
+    }
+}
+
+static double centre(const float b[6], int axis)
+{
+    double c = 0.5 * ((double)b[axis] + b[3 + axis]);
+    return isfinite(c) ? c : 0.0;
+}
+
+typedef struct build_ctx {
+    const float (*bounds)[6];
+    struct trace_mesh_bvh *bvh;
+} build_ctx;
+
+/* the SAH split of idx[first, first + count): axis and position (the
+ * count of the left part); false when none is found */
+static bool sah_split(build_ctx *c, int first, int count, double parent_area, int *mid)
+{
+    int32_t *idx = c->bvh->idx + first;
+    double clo[3] = {INFINITY, INFINITY, INFINITY}, chi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (int i = 0; i < count; i++)
+        for (int a = 0; a < 3; a++) {
+            double x = centre(c->bounds[idx[i]], a);
+            clo[a] = fmin(clo[a], x);
+            chi[a] = fmax(chi[a], x);
+        }
+    double best = (double)count * parent_area;   /* the leaf's cost, as an upper bound */
+    int best_axis = -1, best_bin = -1;
+    for (int a = 0; a < 3; a++) {
+        if (!(chi[a] > clo[a])) continue;
+        double scale = BINS / (chi[a] - clo[a]);
+        int cnt[BINS] = {0};
+        float blo[BINS][3], bhi[BINS][3];
+        for (int b = 0; b < BINS; b++)
+            for (int i = 0; i < 3; i++) blo[b][i] = INFINITY, bhi[b][i] = -INFINITY;
+        for (int i = 0; i < count; i++) {
+            int b = (int)((centre(c->bounds[idx[i]], a) - clo[a]) * scale);
+            b = b < 0 ? 0 : b >= BINS ? BINS - 1 : b;
+            cnt[b]++;
+            grow(blo[b], bhi[b], c->bounds[idx[i]]);
+        }
+        /* sweep: the right parts' areas from the right, then the left */
+        double rarea[BINS];
+        int rcnt[BINS];
+        float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+        int n = 0;
+        for (int b = BINS - 1; b > 0; b--) {
+            n += cnt[b];
+            if (cnt[b]) {
+                float bb[6] = {blo[b][0], blo[b][1], blo[b][2], bhi[b][0], bhi[b][1], bhi[b][2]};
+                grow(lo, hi, bb);
+            }
+            rcnt[b] = n;
+            rarea[b] = n ? area_of(lo, hi) : 0.0;
+        }
+        for (int i = 0; i < 3; i++) lo[i] = INFINITY, hi[i] = -INFINITY;
+        n = 0;
+        for (int b = 0; b < BINS - 1; b++) {
+            n += cnt[b];
+            if (cnt[b]) {
+                float bb[6] = {blo[b][0], blo[b][1], blo[b][2], bhi[b][0], bhi[b][1], bhi[b][2]};
+                grow(lo, hi, bb);
+            }
+            if (n == 0 || rcnt[b + 1] == 0) continue;
+            double cost = n * area_of(lo, hi) + rcnt[b + 1] * rarea[b + 1];
+            if (isfinite(cost) && cost < best) {
+                best = cost;
+                best_axis = a;
+                best_bin = b;
+            }
+        }
+    }
+    if (best_axis < 0) return false;
+    double scale = BINS / (chi[best_axis] - clo[best_axis]);
+    int i = 0, j = count - 1;
+    while (i <= j) {
+        int b = (int)((centre(c->bounds[idx[i]], best_axis) - clo[best_axis]) * scale);
+        b = b < 0 ? 0 : b >= BINS ? BINS - 1 : b;
+        if (b <= best_bin) {
+            i++;
+        } else {
+            int32_t t = idx[i];
+            idx[i] = idx[j];
+            idx[j--] = t;
+        }
+    }
+    *mid = i;
+    return i > 0 && i < count;
+}
+
+static int by_axis;
+static const float (*by_bounds)[6];
+
+static int cmp_centre(const void *x, const void *y)
+{
+    double a = centre(by_bounds[*(const int32_t *)x], by_axis);
+    double b = centre(by_bounds[*(const int32_t *)y], by_axis);
+    return (a > b) - (a < b) ? (a > b) - (a < b)
+                             : (*(const int32_t *)x > *(const int32_t *)y) -
+                                   (*(const int32_t *)x < *(const int32_t *)y);
+}
+
+static void build_node(build_ctx *c, int id, int first, int count, int depth)
+{
+    struct trace_mesh_bvh *t = c->bvh;
+    assert(count > 0 && id < t->nnodes);
+    mesh_node *n = &t->nodes[id];
+    for (int i = 0; i < 3; i++) n->lo[i] = INFINITY, n->hi[i] = -INFINITY;
+    for (int i = 0; i < count; i++) grow(n->lo, n->hi, c->bounds[t->idx[first + i]]);
+    if (count <= LEAF_MAX) {
+        n->a = first;
+        n->n = count;
+        return;
+    }
+    int mid = 0;
+    double area = area_of(n->lo, n->hi);
+    if (depth >= SAH_DEPTH || !isfinite(area) || !sah_split(c, first, count, area, &mid)) {
+        /* the median along the longest axis: depth stays logarithmic */
+        int axis = 0;
+        double e[3];
+        for (int i = 0; i < 3; i++) e[i] = (double)n->hi[i] - n->lo[i];
+        axis = (e[0] >= e[1] && e[0] >= e[2]) ? 0 : (e[1] >= e[2] ? 1 : 2);
+        by_axis = axis;
+        by_bounds = c->bounds;
+        qsort(t->idx + first, (size_t)count, sizeof *t->idx, cmp_centre);
+        mid = count / 2;
+    }
+    int left = t->nnodes;
+    t->nnodes += 2;
+    n = &t->nodes[id];
+    n->a = left;
+    n->n = 0;
+    build_node(c, left, first, mid, depth + 1);
+    build_node(c, left + 1, first + mid, count - mid, depth + 1);
+}
+
+static struct trace_mesh_bvh *bvh_build(const float (*bounds)[6], int n)
+{
+    struct trace_mesh_bvh *t = xcalloc(1, sizeof *t);
+    t->idx = xmalloc(sizeof *t->idx * (size_t)(n > 0 ? n : 1));
+    for (int i = 0; i < n; i++) t->idx[i] = i;
+    /* a binary tree with leaves of >= 1 piece: at most 2n - 1 nodes */
+    t->nodes = xmalloc(sizeof *t->nodes * (size_t)(2 * n > 0 ? 2 * n : 1));
+    build_ctx c = {bounds, t};
+    if (n > 0) {
+        t->nnodes = 1;
+        build_node(&c, 0, 0, n, 0);
+    }
+    t->nodes = xreallocarray(t->nodes, (size_t)(t->nnodes > 0 ? t->nnodes : 1), sizeof *t->nodes);
+    return t;
+}
+
+static void float_box(const trace_box *b, float f[6])
+{
+    f[0] = down(b->lo.x), f[1] = down(b->lo.y), f[2] = down(b->lo.z);
+    f[3] = up(b->hi.x), f[4] = up(b->hi.y), f[5] = up(b->hi.z);
+}
+
+void trace_mesh_piece_bounds(const trace_object *obj, const geom_surface *s, float out[6])
+{
+    trace_box root, bound;
+    geom_bounds(s, &root.lo, &root.hi);
+    root.flags = 0;
+    root.bend = 0.0f;
+    trace_box_no_slab(&root);
+    trace_object_camera_bound(obj, &root, &bound);
+    float_box(&bound, out);
+}
+
+bool trace_mesh_build(trace_thread *th, trace_object *obj)
+{
+    trace_mesh *m = obj->mesh;
+    assert(m);
+    trace_box all = {.lo = v3(INFINITY, INFINITY, INFINITY),
+                     .hi = v3(-INFINITY, -INFINITY, -INFINITY)};
+    trace_box_no_slab(&all);
+    if (obj->displacement || !m->bounds) {
+        /* displaced: each piece's root box runs its shader (undisplaced:
+         * trace_world_prepare's pass over the pieces made the bounds) */
+        free(m->bounds);
+        m->bounds = xmalloc(sizeof *m->bounds * (size_t)(m->npieces > 0 ? m->npieces : 1));
+        trace_view *v = xmalloc(sizeof *v);
+        for (int k = 0; k < m->npieces; k++) {
+            if ((k & 255) == 0 && trace_thread_cancelled(th)) break;
+            if (!make(th, obj, k, true, false, v)) break;
+            float_box(&v->obj.bound, m->bounds[k]);
+        }
+        free(v);
+    }
+    if (th->failed) return false;
+    for (int k = 0; k < m->npieces; k++) {
+        const float *f = m->bounds[k];
+        trace_box b = {.lo = v3(f[0], f[1], f[2]), .hi = v3(f[3], f[4], f[5])};
+        trace_box_union(&all, &b);
+    }
+    obj->bound = all;
+    obj->root = all;                   /* unused: a mesh object has no surface */
+    if (m->bvh) {
+        free(m->bvh->nodes);
+        free(m->bvh->idx);
+        free(m->bvh);
+    }
+    m->bvh = bvh_build((const float (*)[6])m->bounds, m->npieces);
+    return true;
+}
+
+static bool node_hit(const mesh_node *n, const trace_ray *ray, double tmax, double *t0)
+{
+    trace_box b = {.lo = v3(n->lo[0], n->lo[1], n->lo[2]), .hi = v3(n->hi[0], n->hi[1], n->hi[2])};
+    double t1;
+    return trace_box_hit(&b, ray, ray->tmin, tmax, t0, &t1, NULL);
+}
+
+static bool piece_hit(const float f[6], const trace_ray *ray, double tmax)
+{
+    trace_box b = {.lo = v3(f[0], f[1], f[2]), .hi = v3(f[3], f[4], f[5])};
+    double t0, t1;
+    return trace_box_hit(&b, ray, ray->tmin, tmax, &t0, &t1, NULL);
+}
+
+bool trace_mesh_intersect(trace_thread *th, const trace_object *obj, const trace_ray *ray,
+                          const trace_tolerance *tol, bool any, trace_hit *best)
+{
+    const trace_mesh *m = obj->mesh;
+    const struct trace_mesh_bvh *t = m->bvh;
+    if (!t || t->nnodes == 0) return false;
+    struct { int node; double t0; } stack[MESH_STACK];
+    int sp = 0;
+    double t0;
+    if (!node_hit(&t->nodes[0], ray, best->t, &t0)) return false;
+    stack[sp].node = 0;
+    stack[sp++].t0 = t0;
+    bool found = false;
+    while (sp > 0) {
+        sp--;
+        if (!(stack[sp].t0 < best->t)) continue;
+        const mesh_node *n = &t->nodes[stack[sp].node];
+        if (n->n > 0) {
+            for (int i = 0; i < n->n; i++) {
+                int k = t->idx[n->a + i];
+                if (!piece_hit(m->bounds[k], ray, best->t)) continue;
+                const trace_object *v = trace_mesh_view(th, obj, k);
+                if (!v) return found;
+                if (trace_intersect_object(th, v, ray, tol, any, best)) {
+                    /* the hit outlives the cache slot: a copy in the hit slot */
+                    trace_view_copy(&th->views->hit, (const trace_view *)v);
+                    best->obj = &th->views->hit.obj;
+                    found = true;
+                    if (any) return true;
+                }
+            }
+            continue;
+        }
+        double ta = 0, tb = 0;
+        bool ha = node_hit(&t->nodes[n->a], ray, best->t, &ta);
+        bool hb = node_hit(&t->nodes[n->a + 1], ray, best->t, &tb);
+        assert(sp + 2 <= MESH_STACK);
+        if (ha && hb) {
+            bool a_first = ta <= tb;
+            stack[sp].node = a_first ? n->a + 1 : n->a;
+            stack[sp++].t0 = a_first ? tb : ta;
+            stack[sp].node = a_first ? n->a : n->a + 1;
+            stack[sp++].t0 = a_first ? ta : tb;
+        } else if (ha) {
+            stack[sp].node = n->a;
+            stack[sp++].t0 = ta;
+        } else if (hb) {
+            stack[sp].node = n->a + 1;
+            stack[sp++].t0 = tb;
+        }
+    }
+    return found;
+}
+
+void trace_mesh_clear(trace_mesh *self)
+{
+    free(self->shared_edges);
+    free(self->bounds);
+    if (self->bvh) {
+        free(self->bvh->nodes);
+        free(self->bvh->idx);
+        free(self->bvh);
+    }
+    self->shared_edges = NULL;
+    self->bounds = NULL;
+    self->bvh = NULL;
+}
+
+size_t trace_mesh_bytes(const trace_mesh *self)
+{
+    size_t n = (size_t)self->npieces;
+    size_t b = 0;
+    if (self->shared_edges) b += n * sizeof *self->shared_edges;
+    if (self->bounds) b += n * sizeof *self->bounds;
+    if (self->bvh)
+        b += (size_t)self->bvh->nnodes * sizeof(mesh_node) + n * sizeof *self->bvh->idx;
+    return b;
+}

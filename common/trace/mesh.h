@@ -1,0 +1,90 @@
+/*
+ * mesh.h: mesh objects (issue 23): one world object for the many pieces
+ * of a polygon mesh (trace_mesh in world.h), a BVH over the pieces'
+ * camera-space boxes, and the "views" that make a piece a full
+ * trace_object where a ray reaches it.
+ *
+ * A view is piece k of mesh object M: M's transforms, shaders and
+ * attributes, the piece's surface and primitive variables, its own id
+ * (M's first_id + k: box cache and cell caches keep pieces apart), its
+ * du/dv, shared edges and root box, each a pure function of the scene,
+ * so a view made twice, on any thread or host, is the same object. A
+ * thread keeps the views it made last in a small direct-mapped cache;
+ * the hit a traversal returns is a copy in the thread's hit slot, and a
+ * hit being shaded is a copy per trace() depth (trace_view_hold), so the
+ * shadow and trace() rays its shader casts cannot overwrite it.
+ *
+ * Per piece, a worker holds the scene's 16-byte piece, a 24-byte float
+ * box, 8 bytes of shared edges and ~16 bytes of BVH (docs/renderer.md
+ * "Meshes"); the box cache holds the displaced pieces' refinement trees
+ * under its budget, as for any object.
+ */
+#ifndef TRACE_MESH_H
+#define TRACE_MESH_H
+
+#include "trace/intersect.h"
+#include "trace/thread.h"
+#include "trace/world.h"
+
+typedef struct trace_view {
+    trace_object obj;
+    trace_primvar pv[TRACE_MAX_PRIMVARS];
+} trace_view;
+
+/* Makes piece k of mesh object `mesh_obj` into *out, with its root and
+ * bound boxes when `boxes` (a displaced piece's root box runs its shader
+ * over the whole piece); false (the thread failed) when the piece cannot
+ * be made. */
+bool trace_mesh_view_make(trace_thread *th, const trace_object *mesh_obj, int k, bool boxes,
+                          trace_view *out);
+
+/* The view of piece k from the thread's cache (made on a miss). */
+const trace_object *trace_mesh_view(trace_thread *th, const trace_object *mesh_obj, int k);
+
+/* The pieces of an object: a mesh's, or 1 (the object itself). */
+static inline int trace_object_npieces(const trace_object *obj)
+{
+    return obj->mesh ? obj->mesh->npieces : 1;
+}
+
+/* Piece k of obj as an object: obj itself (k = 0) when it is not a mesh,
+ * else the piece's view made into *storage with its boxes (NULL: the
+ * thread failed). For tools and tests that visit every surface. */
+const trace_object *trace_object_piece(trace_thread *th, const trace_object *obj, int k,
+                                       trace_view *storage);
+
+/* Copies a view (its primitive variables point at its own copy). */
+void trace_view_copy(trace_view *dst, const trace_view *src);
+
+/* The camera-space float box of an undisplaced piece s of mesh object
+ * obj (its bounds, rounded outward). */
+void trace_mesh_piece_bounds(const trace_object *obj, const geom_surface *s, float out[6]);
+
+/* The pieces' boxes and BVH of mesh object obj, and its camera-space
+ * bound (their union); false when the thread failed or was cancelled. */
+bool trace_mesh_build(trace_thread *th, trace_object *obj);
+
+/* Nearest hit of the camera-space ray with the mesh's pieces in
+ * (ray->tmin, best->t) (trace_intersect_object's contract); a hit's
+ * object is the thread's hit slot (a view). */
+bool trace_mesh_intersect(trace_thread *th, const trace_object *obj, const trace_ray *ray,
+                          const trace_tolerance *tol, bool any, trace_hit *best);
+
+/* The object to shade for a hit at trace() depth `depth`: obj itself, or
+ * when it is the thread's hit slot, its copy for that depth. */
+const trace_object *trace_view_hold(trace_thread *th, const trace_object *obj, int depth);
+
+/* The per-thread view storage (thread.c frees it). */
+void trace_views_free(trace_thread *th);
+
+/* Frees the derived arrays (shared edges, boxes, BVH); the source stays. */
+void trace_mesh_clear(trace_mesh *self);
+
+/* Bytes of the derived arrays (boxes, BVH, shared edges). */
+size_t trace_mesh_bytes(const trace_mesh *self);
+
+/* The camera-space box of an object-space box b of obj (its 8 corners,
+ * widened by a relative hair for the rounding). */
+void trace_object_camera_bound(const trace_object *obj, const trace_box *b, trace_box *out);
+
+#endif

@@ -1,0 +1,316 @@
+/*
+ * test_trace_mesh_scale.c: a mesh is one object (issue 23).
+ *
+ * - Bytes per face, counted by the allocator (glibc's mallinfo2, not the
+ *   code's own accounting): a torus of 20,000 quads (40,000 triangles,
+ *   curved: each quad is cut in two with vertex normals), parsed and made
+ *   into a renderable world, must hold at most FACE_BYTES per face in all
+ *   (the shared points, indices and normals, the pieces, their boxes,
+ *   shared edges and BVH). When every piece was an object of its own the
+ *   same mesh took ~28 KB a face.
+ * - The mesh renders the same image as the same faces written as one
+ *   Polygon each (the old path: an object per face): a flat grid whose
+ *   faces stay polygons, so both give the same surfaces to the bit, seen
+ *   through the mesh's BVH, views and hit copies on one side and the
+ *   object BVH on the other.
+ * - Instances place the one recorded mesh: 50 instances of a 2,000-face
+ *   mesh cost a fraction of 50 copies.
+ * - A shadow ray cast while a piece's hit is being shaded cannot
+ *   overwrite it: a mesh lit through another mesh renders as the same
+ *   faces written one Polygon each.
+ */
+#include <malloc.h>
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <cmocka.h>
+
+#include "fixture.h"
+#include "trace/bvh.h"
+#include "trace/camera.h"
+#include "trace/mesh.h"
+#include "trace/render.h"
+
+/* the budget per face of a curved quad mesh, everything included; the
+ * shared arrays alone are ~70 bytes (a point, a normal, 4 indices) */
+enum { FACE_BYTES = 300 };
+
+static char *torus_rib(int nu, int nv, const char *head)
+{
+    size_t cap = (size_t)nu * nv * 90 + 4096, n = 0;
+    char *t = malloc(cap);
+    assert_non_null(t);
+    n += (size_t)snprintf(t + n, cap - n, "Format 32 32 1\nProjection \"perspective\" "
+                          "\"fov\" [40]\nTranslate 0 0 4\nRotate 60 1 0 0\nWorldBegin\n%s"
+                          "PointsPolygons [", head);
+    for (int i = 0; i < nu * nv; i++) n += (size_t)snprintf(t + n, cap - n, "4 ");
+    n += (size_t)snprintf(t + n, cap - n, "]\n[");
+    for (int i = 0; i < nu; i++)
+        for (int j = 0; j < nv; j++) {
+            int i1 = (i + 1) % nu, j1 = (j + 1) % nv;
+            n += (size_t)snprintf(t + n, cap - n, "%d %d %d %d ", i * nv + j, i * nv + j1,
+                                  i1 * nv + j1, i1 * nv + j);
+        }
+    n += (size_t)snprintf(t + n, cap - n, "]\n\"P\" [");
+    for (int i = 0; i < nu; i++)
+        for (int j = 0; j < nv; j++) {
+            double a = 2 * M_PI * i / nu, b = 2 * M_PI * j / nv, r = 1 + 0.4 * cos(b);
+            n += (size_t)snprintf(t + n, cap - n, "%.9g %.9g %.9g ", r * cos(a), r * sin(a),
+                                  0.4 * sin(b));
+        }
+    snprintf(t + n, cap - n, "]\nWorldEnd\n");
+    return t;
+}
+
+static size_t heap_bytes(void)
+{
+    struct mallinfo2 mi = mallinfo2();
+    return mi.uordblks + mi.hblkhd;
+}
+
+static void test_bytes_per_face(void **state)
+{
+    (void)state;
+    enum { NU = 200, NV = 100 };
+    char *rib = torus_rib(NU, NV, "");
+    job_options opt;
+    job_options_default(&opt);
+    job *jb = job_new("torus.rib", rib, strlen(rib), &opt);
+    free(rib);
+    char err[256];
+    assert_true(job_finish(jb, err, sizeof err));
+    sl_diag *d = sl_diag_new();
+    size_t before = heap_bytes();
+    job_scene *js = job_scene_new(jb, 0, true, NULL, d);
+    size_t after = heap_bytes();
+    if (!js) sl_diag_print(d, stderr);
+    assert_non_null(js);
+    assert_int_equal(js->scene->nobjects, 1);
+    assert_int_equal(js->world.nobjects, 1);
+    assert_int_equal(trace_object_npieces(&js->world.objects[0]), 2 * NU * NV);
+    double per_face = (double)(after - before) / (NU * NV);
+    printf("torus of %d quads (%d pieces): %zu bytes held, %.1f bytes per face "
+           "(budget %d)\n", NU * NV, 2 * NU * NV, after - before, per_face, FACE_BYTES);
+    assert_true(per_face <= FACE_BYTES);
+    /* and it renders: the torus covers the middle of the image */
+    trace_thread *th = trace_thread_new(&js->world);
+    double rgb[3], a, z;
+    trace_render_sample(js->renderer, th, 16.5, 12.5, rgb, &a, &z);
+    assert_true(a == 1.0);
+    assert_true(th->stats.views_made > 0);
+    trace_thread_destroy(&th);
+    job_scene_destroy(&js);
+    job_destroy(&jb);
+    sl_diag_destroy(&d);
+}
+
+/* A flat grid of n x n unit quads at z = 0, as one mesh or one Polygon
+ * each, with a point light and a sphere between them casting a shadow
+ * (shadow rays during shading), an optional displacement. */
+static char *grid_rib(int n, bool mesh, const char *disp)
+{
+    size_t cap = (size_t)n * n * 200 + 4096, len = 0;
+    char *t = malloc(cap);
+    assert_non_null(t);
+    len += (size_t)snprintf(t + len, cap - len,
+                            "Format 48 48 1\nProjection \"perspective\" \"fov\" [50]\n"
+                            "PixelSamples 2 2\nTranslate 0 0 %g\nRotate -30 1 0 0\nWorldBegin\n"
+                            "Attribute \"light\" \"shadows\" [\"on\"]\n"
+                            "LightSource \"pointlight\" 1 \"from\" [1 1 -3] \"intensity\" [12]\n"
+                            "LightSource \"ambientlight\" 2 \"intensity\" [0.1]\n"
+                            "Surface \"shiny\"\n"
+                            "AttributeBegin\nTranslate 0.2 0.1 -0.6\nSphere 0.35 -0.35 0.35 360\n"
+                            "AttributeEnd\n%s\n", 1.1 * n, disp);
+    double h = n / 2.0;
+    if (mesh) {
+        len += (size_t)snprintf(t + len, cap - len, "PointsPolygons [");
+        for (int i = 0; i < n * n; i++) len += (size_t)snprintf(t + len, cap - len, "4 ");
+        len += (size_t)snprintf(t + len, cap - len, "] [");
+        for (int j = 0; j < n; j++)
+            for (int i = 0; i < n; i++) {
+                int a = j * (n + 1) + i;
+                len += (size_t)snprintf(t + len, cap - len, "%d %d %d %d ", a, a + 1,
+                                        a + n + 2, a + n + 1);
+            }
+        len += (size_t)snprintf(t + len, cap - len, "] \"P\" [");
+        for (int j = 0; j <= n; j++)
+            for (int i = 0; i <= n; i++)
+                len += (size_t)snprintf(t + len, cap - len, "%g %g 0 ", i - h, j - h);
+        len += (size_t)snprintf(t + len, cap - len, "]\n");
+    } else {
+        for (int j = 0; j < n; j++)
+            for (int i = 0; i < n; i++)
+                len += (size_t)snprintf(t + len, cap - len,
+                                        "Polygon \"P\" [%g %g 0  %g %g 0  %g %g 0  %g %g 0]\n",
+                                        i - h, j - h, i + 1 - h, j - h, i + 1 - h, j + 1 - h,
+                                        i - h, j + 1 - h);
+    }
+    snprintf(t + len, cap - len, "WorldEnd\n");
+    return t;
+}
+
+static const char *LIFT_SL =
+    "displacement lift(float Km = 0.15)\n"
+    "{\n"
+    "    P += Km * sin(3 * xcomp(P)) * normalize(N);\n"
+    "    N = calculatenormal(P);\n"
+    "}\n";
+
+/* lit with shadows (the light's shadow rays run while the hit is shaded) */
+static const char *SHINY_SL =
+    "surface shiny(float Kd = 0.7, Ks = 0.4, roughness = 0.15)\n"
+    "{\n"
+    "    normal Nf = faceforward(normalize(N), I);\n"
+    "    vector V = -normalize(I);\n"
+    "    color c = 0;\n"
+    "    illuminance(P, Nf, PI / 2) {\n"
+    "        vector Ln = normalize(L);\n"
+    "        c += Cl * (Kd * (Nf . Ln) + Ks * pow(max(0, Nf . normalize(Ln + V)), 1 / roughness));\n"
+    "    }\n"
+    "    Oi = Os;\n"
+    "    Ci = Os * (Cs * (ambient() + c) + s * 0.2);\n"
+    "}\n";
+
+static void render_grid(int n, bool mesh, const char *disp, float *rgba)
+{
+    char *rib = grid_rib(n, mesh, disp);
+    fixture f;
+    fixture_shader sh[] = {{"lift", LIFT_SL}, {"shiny", SHINY_SL}};
+    assert_true(fixture_open(&f, rib, sh, 2, NULL, 0));
+    free(rib);
+    assert_int_equal(f.js->world.nobjects, mesh ? 2 : 1 + n * n);
+    float *z = malloc(sizeof *z * 48 * 48);
+    assert_true(fixture_render(&f, 16, 2, 0, rgba, z));
+    free(z);
+    fixture_close(&f);
+}
+
+static void compare_grids(const char *disp)
+{
+    enum { N = 24, PX = 48 * 48 * 4 };   /* more pieces than a thread keeps views */
+    float *a = malloc(sizeof *a * PX), *b = malloc(sizeof *b * PX);
+    render_grid(N, true, disp, a);
+    render_grid(N, false, disp, b);
+    int differ = 0, lit = 0, covered = 0;
+    for (int i = 0; i < PX; i++) differ += a[i] != b[i];
+    for (int i = 0; i < PX; i += 4) {
+        lit += a[i] > 0.2f;
+        covered += a[i + 3] == 1.0f;
+    }
+    printf("grid %dx%d%s: %d of %d values differ; %d pixels lit, %d covered\n", N, N,
+           disp[0] ? " (displaced)" : "", differ, PX, lit, covered);
+    assert_true(covered > 48 * 48 / 2);     /* the grid fills most of the image */
+    assert_true(lit > 100);
+    assert_int_equal(differ, 0);
+    free(a);
+    free(b);
+}
+
+static void test_mesh_renders_as_its_faces(void **state)
+{
+    (void)state;
+    compare_grids("");
+}
+
+static void test_displaced_mesh_renders_as_its_faces(void **state)
+{
+    (void)state;
+    /* a flat grid's faces stay polygons with one normal: the same
+     * displaced surfaces, box trees and hits on both sides */
+    compare_grids("Displacement \"lift\"");
+}
+
+/* The hit a traversal returns, and the hit being shaded, are copies: the
+ * thread's view cache turning over (every piece made once more) leaves
+ * both as they were. */
+static void test_hits_outlive_the_view_cache(void **state)
+{
+    (void)state;
+    char *rib = torus_rib(40, 30, "");
+    fixture f;
+    assert_true(fixture_open(&f, rib, NULL, 0, NULL, 0));
+    free(rib);
+    const trace_object *mesh = &f.js->world.objects[0];
+    assert_non_null(mesh->mesh);
+    trace_thread *th = trace_thread_new(&f.js->world);
+    trace_ray ray;
+    trace_camera_ray(&f.js->world.camera, 16.5, 12.5, &ray);
+    trace_hit hit = {.t = ray.tmax, .obj = NULL};
+    assert_true(trace_bvh_intersect(f.js->renderer->bvh, th, &ray, &f.js->renderer->primary_tol,
+                                    false, &hit));
+    int id = hit.obj->id;
+    assert_true(id >= mesh->mesh->first_id);
+    geom_surface *surf = malloc(sizeof *surf);
+    *surf = hit.obj->surf;
+    const trace_object *held = trace_view_hold(th, hit.obj, 0);
+    assert_ptr_not_equal(held, hit.obj);
+    for (int k = 0; k < trace_object_npieces(mesh); k++)
+        assert_non_null(trace_mesh_view(th, mesh, k));
+    assert_int_equal(hit.obj->id, id);
+    assert_memory_equal(&hit.obj->surf, surf, sizeof *surf);
+    /* another traversal overwrites the hit slot, never the held copy */
+    trace_camera_ray(&f.js->world.camera, 8.5, 20.5, &ray);
+    trace_hit other = {.t = ray.tmax, .obj = NULL};
+    assert_true(trace_bvh_intersect(f.js->renderer->bvh, th, &ray, &f.js->renderer->primary_tol,
+                                    false, &other));
+    assert_int_not_equal(other.obj->id, id);
+    assert_int_equal(held->id, id);
+    assert_memory_equal(&held->surf, surf, sizeof *surf);
+    free(surf);
+    trace_thread_destroy(&th);
+    fixture_close(&f);
+}
+
+static void test_instances_share_the_mesh(void **state)
+{
+    (void)state;
+    enum { NU = 50, NV = 40, COPIES = 50 };
+    /* the mesh recorded once, placed COPIES times */
+    size_t cap = (size_t)NU * NV * 90 + 4096 + COPIES * 64;
+    char *t = malloc(cap);
+    char *torus = torus_rib(NU, NV, "");
+    /* torus_rib's text from "PointsPolygons" to "WorldEnd" */
+    char *pp = strstr(torus, "PointsPolygons"), *we = strstr(torus, "WorldEnd");
+    *we = '\0';
+    size_t n = (size_t)snprintf(t, cap, "Format 32 32 1\nProjection \"perspective\" \"fov\" "
+                                "[40]\nTranslate 0 0 30\nWorldBegin\nObjectBegin 1\n%s"
+                                "ObjectEnd\n", pp);
+    for (int i = 0; i < COPIES; i++)
+        n += (size_t)snprintf(t + n, cap - n, "AttributeBegin\nTranslate %d %d 0\n"
+                              "ObjectInstance 1\nAttributeEnd\n", i % 10 * 3 - 14, i / 10 * 3 - 6);
+    snprintf(t + n, cap - n, "WorldEnd\n");
+    free(torus);
+    sl_diag *d = sl_diag_new();
+    size_t before = heap_bytes();
+    scene *s = scene_parse("inst.rib", t, strlen(t), d);
+    size_t after = heap_bytes();
+    if (!s) sl_diag_print(d, stderr);
+    assert_non_null(s);
+    assert_int_equal(s->nobjects, COPIES);
+    assert_int_equal(s->nmeshes, 1);
+    for (int i = 1; i < COPIES; i++) assert_ptr_equal(s->objects[i].mesh, s->objects[0].mesh);
+    assert_int_equal(s->npieces, (long)COPIES * 2 * NU * NV);
+    size_t one = scene_mesh_bytes(s->meshes[0]);
+    printf("%d instances of a %d-face mesh: %zu bytes held (one mesh: %zu)\n", COPIES, NU * NV,
+           after - before, one);
+    assert_true(after - before < 3 * one);
+    scene_destroy(&s);
+    sl_diag_destroy(&d);
+    free(t);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_bytes_per_face),
+        cmocka_unit_test(test_mesh_renders_as_its_faces),
+        cmocka_unit_test(test_displaced_mesh_renders_as_its_faces),
+        cmocka_unit_test(test_hits_outlive_the_view_cache),
+        cmocka_unit_test(test_instances_share_the_mesh),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
