@@ -43,7 +43,7 @@ static job_scene *open_scene(const char *dir, const char *name, trace_arith arit
     job_options_default(&opt);
     opt.arith = arith;
     sl_diag *diag = sl_diag_new();
-    job *jb = job_load(path, &opt, diag);
+    job *jb = job_load(path, &opt, NULL, diag);
     job_scene *js = jb ? job_scene_new(jb, cache, true, NULL, diag) : NULL;
     sl_diag_print(diag, stderr);
     sl_diag_destroy(&diag);

@@ -42,7 +42,7 @@ static sl_program *load(const char *dir, const char *name)
     sl_diag *diag = sl_diag_new();
     sl_program *p = NULL;
     if (sl_source_set_load_file(set, path, NULL, diag) == 0)
-        p = sl_compile(set, path, NULL, diag);
+        p = sl_compile(set, path, NULL, NULL, diag);
     sl_diag_print(diag, stderr);
     sl_diag_destroy(&diag);
     sl_source_set_destroy(&set);

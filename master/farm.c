@@ -51,12 +51,25 @@
  * (FARM_RCVHWM + 1) x that (the +1: the message being read). */
 enum { FARM_RCVHWM = 8, FARM_SNDHWM = 256, FARM_MAX_HEADER = 256 << 10 };
 
-static volatile sig_atomic_t interrupted;
+/* Set by SIGINT/SIGTERM (a lock-free atomic: safe in a handler); job
+ * loading (main.c), the run loop and the preview look at it. */
+static atomic_int interrupted;
 
 static void on_signal(int sig)
 {
     (void)sig;
-    interrupted = 1;
+    atomic_store(&interrupted, 1);
+}
+
+const atomic_int *farm_catch_signals(void)
+{
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_signal;   /* no SA_RESTART: zmq_poll returns EINTR */
+    sigaction(SIGINT, &sa, NULL);
+    sigaction(SIGTERM, &sa, NULL);
+    signal(SIGPIPE, SIG_IGN);
+    return &interrupted;
 }
 
 void farm_options_default(farm_options *opt)
@@ -280,8 +293,15 @@ static const char *frame_label(const farm *f, const farm_frame *fr, char *buf, s
 static void write_preview(farm *f, farm_frame *fr)
 {
     char err[ERR_LEN];
-    if (!image_preview_write_png_exr(fr->preview, fr->output, err, sizeof err))
-        console_log(f->con, CONSOLE_ERROR, "preview %s not written: %s", fr->preview, err);
+    if (image_preview_write_png_exr_cancel(fr->preview, fr->output, &interrupted, err,
+                                           sizeof err))
+        return;
+    if (atomic_load(&interrupted)) {   /* the signal ends the render, not only the preview */
+        console_log(f->con, CONSOLE_ERROR, "preview %s not written: interrupted", fr->preview);
+        f->state = FARM_INTERRUPTED;
+        return;
+    }
+    console_log(f->con, CONSOLE_ERROR, "preview %s not written: %s", fr->preview, err);
 }
 
 void farm_frame_complete(farm *f, farm_frame *fr)
@@ -620,7 +640,7 @@ static void run_loop(farm *f)
         if (f->zap) items[nitems++].socket = zap_socket(f->zap);
         int rc = zmq_poll(items, nitems, timeout);
         zap_answer(f->zap);
-        if (interrupted) {
+        if (atomic_load(&interrupted)) {
             f->state = FARM_INTERRUPTED;
             break;
         }
@@ -711,7 +731,8 @@ static int finish(farm *f)
         break;
     case FARM_INTERRUPTED:
         if (f->nframes == 1)
-            console_log(f->con, CONSOLE_ERROR, "interrupted; %s not written", last->output);
+            console_log(f->con, CONSOLE_ERROR, "interrupted; %s %s", last->output,
+                        last->written ? "written, its preview not" : "not written");
         else
             console_log(f->con, CONSOLE_ERROR, "interrupted; %d of %d frames written",
                         f->frames_written, f->nframes);
@@ -780,12 +801,7 @@ int farm_run(const farm_options *opt, const farm_frame_in *frames, int nframes)
     console_tally_init(&f.expired, "lease passed its deadline", "leases passed their deadlines",
                        detail, FARM_WARN_INTERVAL_MS);
 
-    struct sigaction sa;
-    memset(&sa, 0, sizeof sa);
-    sa.sa_handler = on_signal;   /* no SA_RESTART: zmq_poll returns EINTR */
-    sigaction(SIGINT, &sa, NULL);
-    sigaction(SIGTERM, &sa, NULL);
-    signal(SIGPIPE, SIG_IGN);
+    farm_catch_signals();
 
     char err[2 * ERR_LEN];   /* setup's messages: a prefix and a callee's ERR_LEN message */
     int rc = setup(&f, err, sizeof err);

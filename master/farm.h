@@ -12,6 +12,7 @@
 #ifndef MASTER_FARM_H
 #define MASTER_FARM_H
 
+#include <stdatomic.h>
 #include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -65,5 +66,10 @@ typedef struct farm_frame_in {
  * INTERRUPTED (SIGINT/SIGTERM: nothing written but the frames already
  * complete). */
 int farm_run(const farm_options *opt, const farm_frame_in *frames, int nframes);
+
+/* Installs the master's SIGINT/SIGTERM handler (and ignores SIGPIPE);
+ * returns the flag it sets, for the job loading that comes before
+ * farm_run (which installs it too; calling both is fine). */
+const atomic_int *farm_catch_signals(void);
 
 #endif

@@ -309,8 +309,15 @@ static int load(cli *c, loaded *l)
         sl_diag_destroy(&diag);
         return AAFARM_EXIT_INPUT;
     }
+    const atomic_int *stop = farm_catch_signals();
     l->seq = frame_sequence_load(c->farm.scene_path, &c->job, c->farm.frames, c->farm.output,
-                                 &usage, diag);
+                                 &usage, stop, diag);
+    if (atomic_load(stop)) {   /* while reading, compiling, checking */
+        sl_diag_destroy(&diag);
+        fprintf(stderr, "aafarm-master: interrupted while loading %s; nothing written\n",
+                c->farm.scene_path);
+        return AAFARM_EXIT_INTERRUPTED;
+    }
     int n = l->seq ? l->seq->count : 0;
     l->frames = xcalloc((size_t)(n ? n : 1), sizeof *l->frames);
     l->previews = xcalloc((size_t)(n ? n : 1), sizeof *l->previews);

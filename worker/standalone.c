@@ -227,9 +227,16 @@ static int render_frame(const standalone_options *opt, const job *jb, const fram
     /* the preview is read back from the finished EXR, as the farm's master
      * makes it (one function, the same half samples: the same PNG bytes) */
     if (rc == AAFARM_EXIT_OK && fo->preview &&
-        !image_preview_write_png_exr(fo->preview, fo->output, err, sizeof err)) {
-        fprintf(stderr, "aafarm-worker: %s\n", err);
-        rc = AAFARM_EXIT_FAILURE;
+        !image_preview_write_png_exr_cancel(fo->preview, fo->output, &interrupted, err,
+                                            sizeof err)) {
+        if (atomic_load(&interrupted)) {
+            fprintf(stderr, "aafarm-worker: interrupted; %s written, %s not written\n",
+                    fo->output, fo->preview);
+            rc = AAFARM_EXIT_INTERRUPTED;
+        } else {
+            fprintf(stderr, "aafarm-worker: %s\n", err);
+            rc = AAFARM_EXIT_FAILURE;
+        }
     }
     if (rc == AAFARM_EXIT_OK && s.nonfinite.count)
         fprintf(stderr, "aafarm-worker: warning: %llu NaN/Inf samples (the first at pixel "
@@ -283,7 +290,14 @@ int worker_standalone(const standalone_options *opt)
     sl_diag *diag = sl_diag_new();
     bool usage = false;
     frame_sequence *seq = frame_sequence_load(opt->scene_path, &opt->job, opt->frames,
-                                              opt->output, &usage, diag);
+                                              opt->output, &usage, &interrupted, diag);
+    if (atomic_load(&interrupted)) {   /* while reading, compiling, checking */
+        sl_diag_destroy(&diag);
+        frame_sequence_destroy(&seq);
+        fprintf(stderr, "aafarm-worker: interrupted while loading %s; nothing written\n",
+                opt->scene_path);
+        return AAFARM_EXIT_INTERRUPTED;
+    }
     sl_diag_print(diag, stderr);
     sl_diag_destroy(&diag);
     if (!seq) return usage ? AAFARM_EXIT_USAGE : AAFARM_EXIT_INPUT;

@@ -19,6 +19,7 @@ struct worker_jobs {
     held_job **jobs;           /* newest first */
     int count, max;
     size_t cache_bytes;
+    const atomic_int *cancel;  /* the worker's stop flag, or NULL */
 };
 
 held_job *held_job_retain(held_job *self)
@@ -44,9 +45,10 @@ void held_job_release(held_job **self_p)
     free(self);
 }
 
-worker_jobs *worker_jobs_new(int max_held, size_t cache_bytes)
+worker_jobs *worker_jobs_new(int max_held, size_t cache_bytes, const atomic_int *cancel)
 {
     worker_jobs *self = xcalloc(1, sizeof *self);
+    self->cancel = cancel;
     self->max = max_held < 1 ? 1 : max_held;
     self->jobs = xcalloc((size_t)self->max, sizeof *self->jobs);
     self->cache_bytes = cache_bytes;
@@ -131,10 +133,11 @@ static bool layers_of(const proto_render_options *o, unsigned *layers, char *err
 }
 
 /* Compiles the job and checks the image it describes. */
-static bool prepare(held_job *h, const proto_job *m, size_t cache_bytes)
+static bool prepare(held_job *h, const proto_job *m, size_t cache_bytes,
+                    const atomic_int *cancel)
 {
     sl_diag *diag = sl_diag_new();
-    h->js = job_scene_new(h->jb, cache_bytes, true, NULL, diag);
+    h->js = job_scene_new(h->jb, cache_bytes, true, cancel, diag);
     if (h->js) trace_renderer_set_log(h->js->renderer, worker_log_warning, NULL);
     if (!h->js) {
         char *text = sl_diag_to_string(diag);
@@ -209,7 +212,7 @@ held_job *worker_jobs_add(worker_jobs *self, const proto_job *m, char *const *fi
                  m->job_hash);
         job_destroy(&h->jb);
     }
-    if (!h->jb || !prepare(h, m, cache)) {
+    if (!h->jb || !prepare(h, m, cache, self->cancel)) {
         h->broken = true;
         job_scene_destroy(&h->js);
         job_destroy(&h->jb);

@@ -47,8 +47,11 @@ void held_job_release(held_job **self_p);
 typedef struct worker_jobs worker_jobs;
 
 /* max_held: compiled jobs kept (>= 1); cache_bytes: box cache budget per
- * render thread (0: the Job's, and unlimited when the Job says 0). */
-worker_jobs *worker_jobs_new(int max_held, size_t cache_bytes);
+ * render thread (0: the Job's, and unlimited when the Job says 0); cancel:
+ * the worker's stop flag (a signal) or NULL, handed to job_scene_new so
+ * that compiling and preparing a job stop when it is set (the job is then
+ * broken with "interrupted"; the caller is leaving anyway). */
+worker_jobs *worker_jobs_new(int max_held, size_t cache_bytes, const atomic_int *cancel);
 void worker_jobs_destroy(worker_jobs **self_p);
 
 /* The held job with this hash (broken or not), or NULL. No reference is

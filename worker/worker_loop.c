@@ -105,12 +105,14 @@ typedef struct worker_loop {
     int report_ms;                 /* opt->unreachable_report_ms or UNREACHABLE_REPORT_MS */
 } worker_loop;
 
-static volatile sig_atomic_t interrupted;
+/* Set by SIGINT/SIGTERM (a lock-free atomic: safe in a handler); the loop
+ * and a job's preparation (worker_jobs_new's cancel) look at it. */
+static atomic_int interrupted;
 
 static void on_signal(int sig)
 {
     (void)sig;
-    interrupted = 1;
+    atomic_store(&interrupted, 1);
 }
 
 static int64_t now_ms(void)
@@ -394,11 +396,14 @@ static void run_beside(worker_loop *w, void (*fn)(void *arg), void *arg, const c
         return;
     }
     long step = w->heartbeat_ms / 4 < 50 ? (w->heartbeat_ms / 4 > 0 ? w->heartbeat_ms / 4 : 1) : 50;
-    while (!atomic_load(&b.done)) {
-        if (interrupted) {
-            /* the helper cannot be stopped and holds the job list: tell the
-             * master (it requeues our tiles at once) and leave without
-             * tearing anything down */
+    for (;;) {
+        /* done is read before the flag: a helper the flag stopped (its job
+         * broken with "interrupted") is never taken for a finished one */
+        bool finished = atomic_load(&b.done);
+        if (atomic_load(&interrupted)) {
+            /* the helper stops at the flag too (job_scene_new's cancel)
+             * but holds the job list: tell the master (it requeues our
+             * tiles at once) and leave without tearing anything down */
             wlog(w, 0, "interrupted while %s; leaving", what);
             send_shutdown(w, "the worker was stopped (SIGINT/SIGTERM) while preparing a job");
             int linger = 500;
@@ -408,6 +413,7 @@ static void run_beside(worker_loop *w, void (*fn)(void *arg), void *arg, const c
             zmq_ctx_term(w->ctx);   /* sends what is queued, for at most 500 ms */
             _exit(AAFARM_EXIT_INTERRUPTED);
         }
+        if (finished) break;
         zmq_pollitem_t item = {NULL, worker_pool_wake_fd(w->pool), ZMQ_POLLIN, 0};
         zmq_poll(&item, 1, step);
         int events = 0;
@@ -752,7 +758,7 @@ static session_end session(worker_loop *w)
                                    {NULL, worker_pool_wake_fd(w->pool), ZMQ_POLLIN, 0}};
         long timeout = w->heartbeat_ms / 2 < 100 ? w->heartbeat_ms / 2 : 100;
         if (zmq_poll(items, 2, timeout) < 0 && errno != EINTR) break;
-        if (interrupted) {
+        if (atomic_load(&interrupted)) {
             send_shutdown(w, "the worker was stopped (SIGINT/SIGTERM)");
             w->end = SESSION_INTERRUPTED;
             break;
@@ -795,7 +801,7 @@ static bool backoff_wait(worker_loop *w, int ms)
     for (int64_t until = now_ms() + ms; now_ms() < until;) {
         zmq_pollitem_t item = {NULL, worker_pool_wake_fd(w->pool), ZMQ_POLLIN, 0};
         zmq_poll(&item, 1, 100);
-        if (interrupted) return false;
+        if (atomic_load(&interrupted)) return false;
         send_finished(w);
         say_unreachable(w, now_ms(), false);
     }
@@ -867,7 +873,7 @@ int worker_loop_run(const worker_loop_options *opt)
     }
     w.ctx = zmq_ctx_new();
     w.pool = worker_pool_new(w.threads, opt->tile_delay_ms);
-    w.jobs = worker_jobs_new(MAX_JOBS_HELD, opt->cache_bytes);
+    w.jobs = worker_jobs_new(MAX_JOBS_HELD, opt->cache_bytes, &interrupted);
     file_fetch_options fo = {opt->file_cache, opt->file_cache_bytes, opt->file_chunk,
                              opt->file_inflight, opt->file_delay_ms};
     w.files = file_fetch_new(&fo);

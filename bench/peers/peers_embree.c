@@ -104,7 +104,7 @@ int main(int argc, char **argv)
     job_options opt;
     job_options_default(&opt);
     sl_diag *diag = sl_diag_new();
-    job *jb = job_load(rib, &opt, diag);
+    job *jb = job_load(rib, &opt, NULL, diag);
     job_scene *js = jb ? job_scene_new(jb, 0, true, diag) : NULL;
     sl_diag_print(diag, stderr);
     sl_diag_destroy(&diag);

@@ -79,6 +79,7 @@ typedef struct reader {
     exr_context_t ctxt;
     image_exr_stream stream;
     image_buffer *buf;
+    const atomic_int *cancel;      /* looked at before each chunk, or NULL */
     char *err;
     size_t errsz;
 } reader;
@@ -135,6 +136,8 @@ static bool make_buffer(reader *r)
 static bool read_chunk(reader *r, const exr_chunk_info_t *ci, int x, int y)
 {
     image_buffer *b = r->buf;
+    if (r->cancel && atomic_load_explicit(r->cancel, memory_order_relaxed))
+        return fail_plain(r, "interrupted (SIGINT/SIGTERM) while reading");
     if (x < 0 || y < 0 || ci->width < 0 || ci->height < 0
         || x + ci->width > b->width || y + ci->height > b->height)
         return fail_plain(r, "chunk outside the data window");
@@ -194,9 +197,16 @@ static bool read_tiles(reader *r)
 
 image_buffer *image_buffer_read_exr(const char *path, char *err, size_t errsz)
 {
+    return image_buffer_read_exr_cancel(path, NULL, err, errsz);
+}
+
+image_buffer *image_buffer_read_exr_cancel(const char *path, const atomic_int *cancel,
+                                           char *err, size_t errsz)
+{
     reader r;
     memset(&r, 0, sizeof r);
     r.path = path;
+    r.cancel = cancel;
     r.err = err;
     r.errsz = errsz;
     int fd = open(path, O_RDONLY | O_CLOEXEC);

@@ -26,6 +26,7 @@
 #ifndef IMAGE_BUFFER_H
 #define IMAGE_BUFFER_H
 
+#include <stdatomic.h>
 #include <stdbool.h>
 #include <stddef.h>
 
@@ -45,6 +46,11 @@ void image_buffer_destroy(image_buffer **self_p);
 
 /* Reads `path`; NULL with a one-line reason in err. */
 image_buffer *image_buffer_read_exr(const char *path, char *err, size_t errsz);
+
+/* As image_buffer_read_exr, looking at cancel (the program's stop flag, or
+ * NULL) before each chunk: NULL with "interrupted" when it is set. */
+image_buffer *image_buffer_read_exr_cancel(const char *path, const atomic_int *cancel,
+                                           char *err, size_t errsz);
 
 /* The plane of channel `name`, or NULL. */
 float *image_buffer_channel(const image_buffer *self, const char *name);

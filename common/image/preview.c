@@ -37,6 +37,7 @@ typedef struct pixel_source {
     const float *ch[3];
     size_t stride;
     int width, height;
+    const atomic_int *cancel;      /* looked at before each row, or NULL */
 } pixel_source;
 
 typedef struct png_context {
@@ -88,6 +89,8 @@ static int write_rows(png_structp png, png_infop info,
     png_set_compression_level(png, 6);
     png_write_info(png, info);
     for (int y = 0; y < src->height; y++) {
+        if (src->cancel && atomic_load_explicit(src->cancel, memory_order_relaxed))
+            png_error(png, "interrupted (SIGINT/SIGTERM)");
         convert_row(src, y, row);
         png_write_row(png, row);
     }
@@ -143,25 +146,37 @@ bool image_preview_write_png(const char *path, const float *rgba, int width,
     if (!rgba) {
         return err_set(err, errsz, "cannot write PNG %s: no pixels given", path);
     }
-    pixel_source src = {{rgba, rgba + 1, rgba + 2}, 4, width, height};
+    pixel_source src = {{rgba, rgba + 1, rgba + 2}, 4, width, height, NULL};
+    return write_preview(path, &src, err, errsz);
+}
+
+static bool write_buffer(const char *path, const image_buffer *buf, const atomic_int *cancel,
+                         char *err, size_t errsz)
+{
+    pixel_source src = {{image_buffer_channel(buf, "R"),
+                         image_buffer_channel(buf, "G"),
+                         image_buffer_channel(buf, "B")},
+                        1, buf->width, buf->height, cancel};
     return write_preview(path, &src, err, errsz);
 }
 
 bool image_preview_write_png_buffer(const char *path, const image_buffer *buf,
                                     char *err, size_t errsz)
 {
-    pixel_source src = {{image_buffer_channel(buf, "R"),
-                         image_buffer_channel(buf, "G"),
-                         image_buffer_channel(buf, "B")},
-                        1, buf->width, buf->height};
-    return write_preview(path, &src, err, errsz);
+    return write_buffer(path, buf, NULL, err, errsz);
 }
 
 bool image_preview_write_png_exr(const char *png_path, const char *exr_path,
                                  char *err, size_t errsz)
 {
-    image_buffer *buf = image_buffer_read_exr(exr_path, err, errsz);
-    bool ok = buf && image_preview_write_png_buffer(png_path, buf, err, errsz);
+    return image_preview_write_png_exr_cancel(png_path, exr_path, NULL, err, errsz);
+}
+
+bool image_preview_write_png_exr_cancel(const char *png_path, const char *exr_path,
+                                        const atomic_int *cancel, char *err, size_t errsz)
+{
+    image_buffer *buf = image_buffer_read_exr_cancel(exr_path, cancel, err, errsz);
+    bool ok = buf && write_buffer(png_path, buf, cancel, err, errsz);
     image_buffer_destroy(&buf);
     return ok;
 }

@@ -17,6 +17,7 @@
 #ifndef IMAGE_PREVIEW_H
 #define IMAGE_PREVIEW_H
 
+#include <stdatomic.h>
 #include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -43,5 +44,11 @@ bool image_preview_write_png_buffer(const char *path, const image_buffer *buf,
  * differed by 1 LSB where rounding to half moved a value across a code). */
 bool image_preview_write_png_exr(const char *png_path, const char *exr_path,
                                  char *err, size_t errsz);
+
+/* As image_preview_write_png_exr, looking at cancel (the program's stop
+ * flag, or NULL) before each chunk read and each row written: when it is
+ * set, false with "interrupted" and no PNG (its temporary file removed). */
+bool image_preview_write_png_exr_cancel(const char *png_path, const char *exr_path,
+                                        const atomic_int *cancel, char *err, size_t errsz);
 
 #endif

@@ -271,7 +271,8 @@ static bool name_outputs(frame_sequence *seq, const char *output, bool *usage, s
 /* The file's frame numbers (scene_scan_frames, archives from disk);
  * -1 when the scan fails (its messages are dropped: the caller reports),
  * -2 when the file cannot be read (in diag). */
-static int scan_frames(const char *rib_path, int **numbers, sl_diag *diag)
+static int scan_frames(const char *rib_path, int **numbers, const atomic_int *cancel,
+                       sl_diag *diag)
 {
     size_t len = 0;
     char *text = job_read_scene(rib_path, &len, diag);
@@ -279,7 +280,7 @@ static int scan_frames(const char *rib_path, int **numbers, sl_diag *diag)
     sl_diag *quiet = sl_diag_new();
     sl_source_set *archives = sl_source_set_new();
     sl_source_set_set_loader(archives, scene_archive_load_from_disk, NULL);
-    int n = scene_scan_frames(rib_path, text, len, archives, numbers, quiet);
+    int n = scene_scan_frames(rib_path, text, len, archives, numbers, cancel, quiet);
     sl_source_set_destroy(&archives);
     sl_diag_destroy(&quiet);
     free(text);
@@ -322,7 +323,7 @@ static bool outputs_spare_inputs(const frame_sequence *seq, const char *rib_path
 
 frame_sequence *frame_sequence_load(const char *rib_path, const job_options *options,
                                     const char *frames, const char *output, bool *usage,
-                                    sl_diag *diag)
+                                    const atomic_int *cancel, sl_diag *diag)
 {
     *usage = false;
     char err[ERR_LEN];
@@ -337,7 +338,7 @@ frame_sequence *frame_sequence_load(const char *rib_path, const job_options *opt
     else job_options_default(&opt);
     opt.frame = 0;
     int *numbers = NULL;
-    int nframes = scan_frames(rib_path, &numbers, diag);
+    int nframes = scan_frames(rib_path, &numbers, cancel, diag);
     if (nframes == -2) {   /* unreadable: said so */
         if (frames) frame_spec_clear(&spec);
         return NULL;
@@ -345,7 +346,7 @@ frame_sequence *frame_sequence_load(const char *rib_path, const job_options *opt
     if (nframes < 0) {
         /* the file does not parse outside its frames: loading the first
          * frame reports why (with file:line:col) */
-        job *first = job_load(rib_path, &opt, diag);
+        job *first = job_load(rib_path, &opt, cancel, diag);
         if (first) sl_diag_error(diag, (sl_pos){0}, "%s: cannot tell its frames", rib_path);
         job_destroy(&first);
         if (frames) frame_spec_clear(&spec);
@@ -366,7 +367,7 @@ frame_sequence *frame_sequence_load(const char *rib_path, const job_options *opt
     seq->count = count;
     for (int i = 0; i < count && ok; i++) {
         opt.frame = indices[i];
-        seq->jobs[i] = job_load(rib_path, &opt, diag);
+        seq->jobs[i] = job_load(rib_path, &opt, cancel, diag);
         ok = seq->jobs[i] != NULL;
     }
     free(indices);

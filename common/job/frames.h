@@ -22,6 +22,7 @@
 #ifndef JOB_FRAMES_H
 #define JOB_FRAMES_H
 
+#include <stdatomic.h>
 #include <stdbool.h>
 #include <stddef.h>
 
@@ -70,10 +71,12 @@ typedef struct frame_sequence {
  * a frame that does not load, a frame with no output name, two frames with
  * the same output. *usage says whether the command line is at fault (the
  * spec, a frame it names that is not there, -o missing or not naming each
- * frame apart: exit 2) rather than the scene (exit 3). */
+ * frame apart: exit 2) rather than the scene (exit 3). cancel: the
+ * program's stop flag (a signal) or NULL, handed to every parse and
+ * job_load (a load it stops fails with "interrupted"). */
 frame_sequence *frame_sequence_load(const char *rib_path, const job_options *options,
                                     const char *frames, const char *output, bool *usage,
-                                    sl_diag *diag);
+                                    const atomic_int *cancel, sl_diag *diag);
 void frame_sequence_destroy(frame_sequence **self_p);
 
 #endif

@@ -310,7 +310,8 @@ static void closest_shader(const scene *sc, const char *name, char *out, size_t 
     free(names);
 }
 
-job *job_load(const char *rib_path, const job_options *options, sl_diag *diag)
+job *job_load(const char *rib_path, const job_options *options, const atomic_int *cancel,
+              sl_diag *diag)
 {
     size_t len = 0;
     char *text = read_file(rib_path, &len, diag);
@@ -320,7 +321,8 @@ job *job_load(const char *rib_path, const job_options *options, sl_diag *diag)
     free(text);
     sl_source_set_set_loader(self->sources, scene_archive_load_from_disk, NULL);
     scene *sc = scene_parse_frame(rib_path, self->scene_text, self->scene_len,
-                                  self->sources, SCENE_MAX_OBJECTS, self->options.frame, diag);
+                                  self->sources, SCENE_MAX_OBJECTS, self->options.frame, cancel,
+                                  diag);
     sl_source_set_set_loader(self->sources, NULL, NULL);
     if (!sc) {
         job_destroy(&self);
@@ -383,7 +385,7 @@ job *job_load(const char *rib_path, const job_options *options, sl_diag *diag)
     if (ok) {
         /* compiling pulls the #included files into the set, from disk */
         sl_source_set_set_loader(self->sources, sl_source_load_from_disk, NULL);
-        job_scene *js = job_scene_new(self, 0, false, NULL, diag);
+        job_scene *js = job_scene_new(self, 0, false, cancel, diag);
         sl_source_set_set_loader(self->sources, NULL, NULL);
         ok = js != NULL && job_collect_files(self, js, diag);
         if (ok) {

@@ -28,6 +28,7 @@
 #ifndef JOB_JOB_H
 #define JOB_JOB_H
 
+#include <stdatomic.h>
 #include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -92,8 +93,11 @@ typedef struct job {
 } job;
 
 /* Reads and checks the RIB at rib_path and everything it needs. NULL when
- * anything is wrong; diag holds the errors. */
-job *job_load(const char *rib_path, const job_options *options, sl_diag *diag);
+ * anything is wrong; diag holds the errors. cancel: the program's stop
+ * flag (a signal) or NULL: parsing, compiling and building the world look
+ * at it, and a load that finds it set fails with "interrupted". */
+job *job_load(const char *rib_path, const job_options *options, const atomic_int *cancel,
+              sl_diag *diag);
 
 /* The RIB at rib_path (at most 64 MiB), malloc'd; NULL with an error. */
 char *job_read_scene(const char *rib_path, size_t *len, sl_diag *diag);

@@ -128,14 +128,23 @@ static int program_index(const job *jb, const char *name)
     return -1;
 }
 
-static bool compile_programs(job_scene *self, sl_diag *diag)
+/* Was the program's stop flag set? Then "interrupted" goes into diag. */
+static bool interrupted(const atomic_int *cancel, sl_diag *diag)
+{
+    if (!cancel || !atomic_load_explicit(cancel, memory_order_relaxed)) return false;
+    sl_diag_error(diag, (sl_pos){0}, "interrupted (SIGINT/SIGTERM)");
+    return true;
+}
+
+static bool compile_programs(job_scene *self, const atomic_int *cancel, sl_diag *diag)
 {
     const job *jb = self->job;
     bool ok = true;
     self->programs = xcalloc((size_t)(jb->nshaders > 0 ? jb->nshaders : 1), sizeof *self->programs);
     for (int i = 0; i < jb->nshaders; i++) {
+        if (cancel && atomic_load_explicit(cancel, memory_order_relaxed)) return false;
         self->programs[i] = sl_compile(jb->sources, jb->shaders[i].file,
-                                       scene_search_path(self->scene), diag);
+                                       scene_search_path(self->scene), cancel, diag);
         if (!self->programs[i]) ok = false;
     }
     return ok;
@@ -363,11 +372,14 @@ job_scene *job_scene_new(const job *jb, size_t cache_bytes, bool render,
     self->job = jb;
     /* archives come from the job, never from this machine's disk */
     self->scene = scene_parse_frame(jb->scene_file, jb->scene_text, jb->scene_len,
-                                    jb->sources, SCENE_MAX_OBJECTS, jb->options.frame, diag);
+                                    jb->sources, SCENE_MAX_OBJECTS, jb->options.frame, cancel,
+                                    diag);
     bool ok = self->scene != NULL;
-    if (ok) ok = compile_programs(self, diag);
+    if (ok) ok = compile_programs(self, cancel, diag);
     if (ok) ok = build_objects(self, diag);
+    if (ok) ok = !interrupted(cancel, diag);
     if (ok) ok = open_textures(self, diag, render);
+    if (ok) ok = !interrupted(cancel, diag);
     if (ok) {
         const scene *sc = self->scene;
         trace_world *w = &self->world;

@@ -788,17 +788,30 @@ static void parser_clear(rib_parser *p)
     rib_reader_destroy(&p->reader);
 }
 
+/* Is the parse to stop for the program's flag (a signal)? Looked at every
+ * RIB_CANCEL_EVERY requests; once set, reported once (at req) and kept. */
+static bool cancelled(rib_parser *p, const rib_request *req)
+{
+    if (!p->cancelled && p->cancel && ++p->requests % RIB_CANCEL_EVERY == 0 &&
+        atomic_load_explicit(p->cancel, memory_order_relaxed)) {
+        sl_diag_error(p->diag, req->pos, "interrupted (SIGINT/SIGTERM) while reading the scene");
+        p->cancelled = true;
+    }
+    return p->cancelled;
+}
+
 void rib_parser_run(rib_parser *p)
 {
     rib_request *req;
-    while (!sl_diag_full(p->diag) && !p->blocks_overflow && (req = rib_reader_next(p->reader)))
+    while (!sl_diag_full(p->diag) && !p->blocks_overflow && !p->cancelled &&
+           (req = rib_reader_next(p->reader)) && !cancelled(p, req))
         dispatch(p, req);
 }
 
 static void parse_all(rib_parser *p)
 {
     rib_parser_run(p);
-    if (!sl_diag_full(p->diag) && !p->blocks_overflow)
+    if (!sl_diag_full(p->diag) && !p->blocks_overflow && !p->cancelled)
         finish(p);
 }
 
@@ -820,24 +833,27 @@ scene *scene_parse_archives(const char *file, const char *text, size_t len,
 scene *scene_parse_limited(const char *file, const char *text, size_t len,
                            sl_source_set *archives, int max_objects, sl_diag *diag)
 {
-    return scene_parse_frame(file, text, len, archives, max_objects, 0, diag);
+    return scene_parse_frame(file, text, len, archives, max_objects, 0, NULL, diag);
 }
 
 static scene *parse_frame(const char *file, const char *text, size_t len,
                           sl_source_set *archives, int max_objects, int frame, bool scanning,
-                          sl_diag *diag);
+                          const atomic_int *cancel, sl_diag *diag);
 
 scene *scene_parse_frame(const char *file, const char *text, size_t len,
-                         sl_source_set *archives, int max_objects, int frame, sl_diag *diag)
+                         sl_source_set *archives, int max_objects, int frame,
+                         const atomic_int *cancel, sl_diag *diag)
 {
-    return parse_frame(file, text, len, archives, max_objects, frame, false, diag);
+    return parse_frame(file, text, len, archives, max_objects, frame, false, cancel, diag);
 }
 
 int scene_scan_frames(const char *file, const char *text, size_t len,
-                      sl_source_set *archives, int **numbers, sl_diag *diag)
+                      sl_source_set *archives, int **numbers, const atomic_int *cancel,
+                      sl_diag *diag)
 {
     *numbers = NULL;
-    scene *s = parse_frame(file, text, len, archives, SCENE_MAX_OBJECTS, INT_MAX, true, diag);
+    scene *s = parse_frame(file, text, len, archives, SCENE_MAX_OBJECTS, INT_MAX, true, cancel,
+                           diag);
     if (!s)
         return -1;
     int n = s->nframes;
@@ -849,7 +865,7 @@ int scene_scan_frames(const char *file, const char *text, size_t len,
 
 static scene *parse_frame(const char *file, const char *text, size_t len,
                           sl_source_set *archives, int max_objects, int frame, bool scanning,
-                          sl_diag *diag)
+                          const atomic_int *cancel, sl_diag *diag)
 {
     if (!file || !*file)
         file = "<scene>";
@@ -870,6 +886,7 @@ static scene *parse_frame(const char *file, const char *text, size_t len,
     p.max_objects = max_objects;
     p.frame_select = frame < 0 ? 0 : frame;
     p.scanning = scanning;
+    p.cancel = cancel;
     p.scene = scene_new(file);
     p.file = p.scene->file;
     p.decls = rib_decls_new();

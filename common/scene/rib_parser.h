@@ -161,7 +161,15 @@ typedef struct rib_parser {
     int max_objects;               /* SCENE_MAX_OBJECTS or the caller's */
     bool objects_overflow;         /* that limit was reported */
     bool blocks_overflow;          /* RIB_MAX_BLOCKS was passed: the parse stops */
+    const atomic_int *cancel;      /* the program's stop flag (a signal), or NULL */
+    unsigned requests;             /* read so far (the flag is looked at every
+                                      RIB_CANCEL_EVERY) */
+    bool cancelled;                /* the flag was found set: the parse stops */
 } rib_parser;
+
+/* How many requests the parser reads between two looks at its cancel flag
+ * (a request costs well under a microsecond; archives included). */
+enum { RIB_CANCEL_EVERY = 256 };
 
 /* Reports an error / warning naming the request: "Sphere: <message>". */
 void rib_error(rib_parser *p, const rib_request *req, sl_pos pos, const char *fmt, ...)

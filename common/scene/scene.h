@@ -36,6 +36,7 @@
 #ifndef SCENE_SCENE_H
 #define SCENE_SCENE_H
 
+#include <stdatomic.h>
 #include <stdbool.h>
 #include <stddef.h>
 
@@ -323,16 +324,21 @@ scene *scene_parse_limited(const char *file, const char *text, size_t len,
  * frame-th FrameBegin block, from 0; RI Spec 3.2 §4: the requests outside
  * every frame apply to all of them, those inside the other frames are
  * skipped). Any parse tells the file's frames (scene.nframes,
- * scene.frame_numbers); an index past the last frame is an error. */
+ * scene.frame_numbers); an index past the last frame is an error.
+ * cancel: the program's stop flag (a signal) or NULL; the parser looks at
+ * it every RIB_CANCEL_EVERY requests (archives included) and, when it is
+ * set, stops with the error "interrupted" (NULL). */
 scene *scene_parse_frame(const char *file, const char *text, size_t len,
-                         sl_source_set *archives, int max_objects, int frame, sl_diag *diag);
+                         sl_source_set *archives, int max_objects, int frame,
+                         const atomic_int *cancel, sl_diag *diag);
 
 /* The frames of a RIB without reading any of them: their FrameBegin
  * numbers into a malloc'd *numbers (NULL when there is none). Returns
  * their count (0: no FrameBegin, the file is one frame), or -1 when the
- * requests outside the frames have errors (in diag). */
+ * requests outside the frames have errors (in diag; cancel as above). */
 int scene_scan_frames(const char *file, const char *text, size_t len,
-                      sl_source_set *archives, int **numbers, sl_diag *diag);
+                      sl_source_set *archives, int **numbers, const atomic_int *cancel,
+                      sl_diag *diag);
 
 void scene_destroy(scene **self_p);
 

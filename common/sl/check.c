@@ -1116,7 +1116,7 @@ static void check_shader(checker *c)
     }
 }
 
-bool sl_check(sl_ast_file *file, sl_arena *arena, sl_diag *diag)
+bool sl_check(sl_ast_file *file, sl_arena *arena, const atomic_int *cancel, sl_diag *diag)
 {
     checker c = { .arena = arena, .diag = diag, .file = file };
     int errors = sl_diag_error_count(diag);
@@ -1124,6 +1124,11 @@ bool sl_check(sl_ast_file *file, sl_arena *arena, sl_diag *diag)
     /* definitions in source order, so that messages come in that order */
     bool shader_done = !file->has_shader;
     for (int i = 0; i < file->nfuncs && !sl_diag_full(diag); i++) {
+        if (cancel && atomic_load_explicit(cancel, memory_order_relaxed)) {
+            sl_diag_error(diag, file->funcs[i]->pos, "interrupted (SIGINT/SIGTERM) while "
+                          "compiling");
+            return false;
+        }
         if (!shader_done && before(file->pos, file->funcs[i]->pos)) {
             check_shader(&c);
             shader_done = true;

@@ -12,11 +12,15 @@
 #ifndef SL_CHECK_H
 #define SL_CHECK_H
 
+#include <stdatomic.h>
+
 #include "sl/ast.h"
 #include "sl/diag.h"
 
-/* Returns true when the file has no errors. */
-bool sl_check(sl_ast_file *file, sl_arena *arena, sl_diag *diag);
+/* Returns true when the file has no errors. cancel: the program's stop
+ * flag (a signal) or NULL, looked at before each definition; when it is
+ * set, the check stops with the error "interrupted". */
+bool sl_check(sl_ast_file *file, sl_arena *arena, const atomic_int *cancel, sl_diag *diag);
 
 /* The spaces transform() and the casts know, by name: SL_SPACE_* or -1. */
 int sl_space_find(const char *name);

@@ -46,6 +46,8 @@ typedef struct parser {
     bool panic;
     int depth;
     long consumed;       /* tokens consumed so far: progress of the loops */
+    const atomic_int *cancel;   /* the program's stop flag, or NULL */
+    bool cancelled;      /* it was found set: the text "ends" here */
 } parser;
 
 /* ---------------------------------------------------------------------- */
@@ -56,6 +58,15 @@ static void advance(parser *p)
 {
     p->consumed++;
     p->prev = p->cur;
+    if (p->cancel && !p->cancelled && p->consumed % SL_PARSE_CANCEL_EVERY == 0 &&
+        atomic_load_explicit(p->cancel, memory_order_relaxed)) {
+        sl_diag_error(p->diag, p->cur.pos, "interrupted (SIGINT/SIGTERM) while compiling");
+        p->cancelled = true;
+    }
+    if (p->cancelled) {   /* no more tokens: every loop and rule unwinds */
+        p->cur.kind = SL_TOK_EOF;
+        return;
+    }
     sl_lexer_next(p->lx, &p->cur);
 }
 
@@ -75,7 +86,7 @@ static void error_at(parser *p, sl_pos pos, const sl_token *tok, const char *fmt
     SL_PRINTF(4, 5);
 static void error_at(parser *p, sl_pos pos, const sl_token *tok, const char *fmt, ...)
 {
-    if (p->panic)
+    if (p->panic || p->cancelled)
         return;
     p->panic = true;
     va_list ap;
@@ -1175,9 +1186,9 @@ static void skip_definition(parser *p)
     p->panic = false;
 }
 
-sl_ast_file *sl_parse(sl_lexer *lx, sl_arena *arena, sl_diag *diag)
+sl_ast_file *sl_parse(sl_lexer *lx, sl_arena *arena, const atomic_int *cancel, sl_diag *diag)
 {
-    parser p = { .lx = lx, .arena = arena, .diag = diag };
+    parser p = { .lx = lx, .arena = arena, .diag = diag, .cancel = cancel };
     sl_ast_file *file = sl_arena_alloc(arena, sizeof *file);
     sl_lexer_next(lx, &p.cur);
     int funcs_cap = 0;

@@ -18,14 +18,15 @@
 #include <string.h>
 
 sl_program *sl_compile(sl_source_set *set, const char *main_file,
-                       const char *const *search_path, sl_diag *diag)
+                       const char *const *search_path, const atomic_int *cancel,
+                       sl_diag *diag)
 {
     int errors = sl_diag_error_count(diag);
     sl_lexer *lx = sl_lexer_new(set, main_file, search_path, diag);
     sl_arena *arena = sl_arena_new();
-    sl_ast_file *file = sl_parse(lx, arena, diag);
+    sl_ast_file *file = sl_parse(lx, arena, cancel, diag);
     sl_program *program = NULL;
-    if (sl_diag_error_count(diag) == errors && sl_check(file, arena, diag))
+    if (sl_diag_error_count(diag) == errors && sl_check(file, arena, cancel, diag))
         program = sl_codegen(file, diag);
     sl_arena_destroy(&arena);
     sl_lexer_destroy(&lx);

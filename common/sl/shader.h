@@ -79,9 +79,13 @@ typedef struct sl_program sl_program;
 /* Compiles main_file (a name in `set`, or one its loader finds) with
  * #include search path `search_path` (NULL-terminated, may be NULL).
  * Returns NULL when there were errors; every error is in `diag` with its
- * file:line:col. Warnings may be reported on success too. */
+ * file:line:col. Warnings may be reported on success too. cancel: the
+ * program's stop flag (a signal) or NULL; the parser and the checker look
+ * at it as they go (every SL_PARSE_CANCEL_EVERY tokens, every definition),
+ * and a compile that finds it set ends with the error "interrupted". */
 sl_program *sl_compile(sl_source_set *set, const char *main_file,
-                       const char *const *search_path, sl_diag *diag);
+                       const char *const *search_path, const atomic_int *cancel,
+                       sl_diag *diag);
 void sl_program_destroy(sl_program **self_p);
 
 const char *sl_program_name(const sl_program *self);      /* "wave" */

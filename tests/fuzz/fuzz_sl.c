@@ -76,7 +76,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     sl_diag *diag = sl_diag_new();
     sl_program *p = NULL;
     if (sl_source_set_add(set, "main.sl", (const char *)data, size) == 0)
-        p = sl_compile(set, "main.sl", NULL, diag);
+        p = sl_compile(set, "main.sl", NULL, NULL, diag);
     else
         fuzz_check(size > sl_source_set_max_size(set));
     fuzz_check((p != NULL) == (sl_diag_error_count(diag) == 0) || size > sl_source_set_max_size(set));

@@ -48,7 +48,7 @@ static job *load(sl_diag *d)
 {
     char path[512];
     snprintf(path, sizeof path, "%s/main.rib", dir);
-    job *j = job_load(path, NULL, d);
+    job *j = job_load(path, NULL, NULL, d);
     if (!j)
         sl_diag_print(d, stderr);
     return j;

@@ -93,7 +93,7 @@ static int teardown(void **state)
 static job *load(void)
 {
     sl_diag *d = sl_diag_new();
-    job *j = job_load(path_of("scene.rib"), NULL, d);
+    job *j = job_load(path_of("scene.rib"), NULL, NULL, d);
     if (!j) sl_diag_print(d, stderr);
     sl_diag_destroy(&d);
     assert_non_null(j);
@@ -229,7 +229,7 @@ static void expect_shader_error(const char *call, const char *want)
              "WorldBegin\n%s\nSphere 1 -1 1 360\nWorldEnd\n", call);
     write_file("typo.rib", rib);
     sl_diag *d = sl_diag_new();
-    job *j = job_load(path_of("typo.rib"), NULL, d);
+    job *j = job_load(path_of("typo.rib"), NULL, NULL, d);
     assert_null(j);
     assert_true(sl_diag_count(d) >= 1);
     const sl_diagnostic *x = sl_diag_get(d, 0);

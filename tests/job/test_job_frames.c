@@ -160,7 +160,7 @@ static void test_one_job_per_frame(void **state)
     sl_diag *d = sl_diag_new();
     bool usage = true;
     frame_sequence *seq = frame_sequence_load(path, NULL,
-                                              NULL, NULL, &usage, d);
+                                              NULL, NULL, &usage, NULL, d);
     if (!seq) sl_diag_print(d, stderr);
     assert_non_null(seq);
     assert_false(usage);
@@ -199,7 +199,7 @@ static void test_one_job_per_frame(void **state)
     frame_sequence_destroy(&seq);
 
     /* --frames 2,4 with -o: two jobs, the names from the pattern */
-    seq = frame_sequence_load(path, NULL, "2,4", "o/x_%03d.exr", &usage, d);
+    seq = frame_sequence_load(path, NULL, "2,4", "o/x_%03d.exr", &usage, NULL, d);
     assert_non_null(seq);
     assert_int_equal(seq->count, 2);
     assert_string_equal(seq->outputs[0], "o/x_002.exr");
@@ -215,11 +215,11 @@ static void test_one_job_per_frame(void **state)
                      "FrameBegin 1\nWorldBegin\nWorldEnd\nFrameEnd\n"
                      "FrameBegin 2\nWorldBegin\nSphere 1 -1 1 360\nWorldEnd\nFrameEnd\n");
     d = sl_diag_new();
-    seq = frame_sequence_load(path, NULL, "2", "b.exr", &usage, d);
+    seq = frame_sequence_load(path, NULL, "2", "b.exr", &usage, NULL, d);
     assert_non_null(seq);
     assert_string_equal(seq->outputs[0], "b.0002.exr");
     frame_sequence_destroy(&seq);
-    seq = frame_sequence_load(path, NULL, NULL, "b.exr", &usage, d);
+    seq = frame_sequence_load(path, NULL, NULL, "b.exr", &usage, NULL, d);
     assert_null(seq);
     assert_false(usage);   /* the scene is at fault: exit 3 */
     assert_int_equal(sl_diag_error_count(d), 1);
@@ -229,7 +229,7 @@ static void test_one_job_per_frame(void **state)
     path = write_rib("nodisplay.rib", "Format 8 4 1\nProjection \"perspective\"\n"
                      "WorldBegin\nSphere 1 -1 1 360\nWorldEnd\n");
     d = sl_diag_new();
-    seq = frame_sequence_load(path, NULL, NULL, NULL, &usage, d);
+    seq = frame_sequence_load(path, NULL, NULL, NULL, &usage, NULL, d);
     assert_null(seq);
     assert_true(usage);
     assert_non_null(strstr(sl_diag_get(d, 0)->message, "needs -o OUT.exr: frame 1 has no "

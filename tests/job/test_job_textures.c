@@ -90,7 +90,7 @@ static void test_opened_when_bound(void **state)
     write_rib("h.exr");
     snprintf(path, sizeof path, "%s/main.rib", dir);
     sl_diag *d = sl_diag_new();
-    job *jb = job_load(path, NULL, d);
+    job *jb = job_load(path, NULL, NULL, d);
     if (!jb)
         sl_diag_print(d, stderr);
     assert_non_null(jb);
@@ -131,7 +131,7 @@ static void test_output_never_replaces_an_input(void **state)
     for (int i = 0; i < 2; i++) {
         sl_diag *d = sl_diag_new();
         bool usage = false;
-        frame_sequence *seq = frame_sequence_load(rib, NULL, NULL, outputs[i], &usage, d);
+        frame_sequence *seq = frame_sequence_load(rib, NULL, NULL, outputs[i], &usage, NULL, d);
         assert_null(seq);
         assert_true(usage);
         char *text = NULL;
@@ -148,7 +148,7 @@ static void test_output_never_replaces_an_input(void **state)
     snprintf(other, sizeof other, "%s/out.exr", dir);
     sl_diag *d = sl_diag_new();
     bool usage = false;
-    frame_sequence *seq = frame_sequence_load(rib, NULL, NULL, other, &usage, d);
+    frame_sequence *seq = frame_sequence_load(rib, NULL, NULL, other, &usage, NULL, d);
     assert_non_null(seq);
     frame_sequence_destroy(&seq);
     sl_diag_destroy(&d);
@@ -165,7 +165,7 @@ static void test_missing_map_named_at_the_call(void **state)
     char path[512];
     snprintf(path, sizeof path, "%s/main.rib", dir);
     sl_diag *d = sl_diag_new();
-    job *jb = job_load(path, NULL, d);
+    job *jb = job_load(path, NULL, NULL, d);
     assert_null(jb);
     char *text = sl_diag_to_string(d);
     char want[600];

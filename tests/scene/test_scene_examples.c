@@ -369,7 +369,7 @@ static void test_ripples_frames(void **state)
     assert_non_null(text);
     for (int k = 0; k < 3; k++) {
         sl_diag *d = sl_diag_new();
-        scene *s = scene_parse_frame(path, text, len, NULL, SCENE_MAX_OBJECTS, k, d);
+        scene *s = scene_parse_frame(path, text, len, NULL, SCENE_MAX_OBJECTS, k, NULL, d);
         if (!s || sl_diag_count(d) > 0) sl_diag_print(d, stderr);
         assert_non_null(s);
         assert_int_equal(sl_diag_count(d), 0);

@@ -469,7 +469,7 @@ static void test_frames(void **state)
 
     /* the second frame: its own Format and sphere, nothing of the first */
     d = sl_diag_new();
-    s = scene_parse_frame("t.rib", text, strlen(text), NULL, SCENE_MAX_OBJECTS, 1, d);
+    s = scene_parse_frame("t.rib", text, strlen(text), NULL, SCENE_MAX_OBJECTS, 1, NULL, d);
     assert_non_null(s);
     assert_int_equal(s->frame, 1);
     assert_int_equal(s->frame_number, 5);
@@ -482,7 +482,7 @@ static void test_frames(void **state)
 
     /* the third frame's world is empty: that frame's error */
     d = sl_diag_new();
-    s = scene_parse_frame("t.rib", text, strlen(text), NULL, SCENE_MAX_OBJECTS, 2, d);
+    s = scene_parse_frame("t.rib", text, strlen(text), NULL, SCENE_MAX_OBJECTS, 2, NULL, d);
     assert_null(s);
     assert_string_equal(diag_line(nth_diag(d, SL_DIAG_ERROR, 0)),
         "t.rib:17:1: WorldEnd: the world has no objects (add a surface between WorldBegin "
@@ -492,7 +492,7 @@ static void test_frames(void **state)
     /* the frames, none read */
     d = sl_diag_new();
     int *numbers = NULL;
-    assert_int_equal(scene_scan_frames("t.rib", text, strlen(text), NULL, &numbers, d), 3);
+    assert_int_equal(scene_scan_frames("t.rib", text, strlen(text), NULL, &numbers, NULL, d), 3);
     assert_int_equal(sl_diag_count(d), 0);
     assert_int_equal(numbers[1], 5);
     free(numbers);
@@ -500,7 +500,7 @@ static void test_frames(void **state)
 
     /* past the last frame */
     d = sl_diag_new();
-    s = scene_parse_frame("t.rib", text, strlen(text), NULL, SCENE_MAX_OBJECTS, 3, d);
+    s = scene_parse_frame("t.rib", text, strlen(text), NULL, SCENE_MAX_OBJECTS, 3, NULL, d);
     assert_null(s);
     assert_string_equal(diag_line(nth_diag(d, SL_DIAG_ERROR, 0)),
         "t.rib:0:0: frame index 3 asked for, but the file has 3 frames (FrameBegin blocks)");

@@ -32,7 +32,7 @@ static inline sl_program *h_compile_named(const char *name, const char *text, ch
     sl_source_set *set = sl_source_set_new();
     sl_diag *diag = sl_diag_new();
     sl_source_set_add(set, name, text, strlen(text));
-    sl_program *p = sl_compile(set, name, NULL, diag);
+    sl_program *p = sl_compile(set, name, NULL, NULL, diag);
     if (diag_out)
         *diag_out = sl_diag_to_string(diag);
     else if (!p)
@@ -53,7 +53,7 @@ static inline sl_program *h_compile_library(const char *name)
     sl_diag *diag = sl_diag_new();
     sl_program *p = NULL;
     if (sl_source_set_load_file(set, path, "lib.sl", diag) == 0)
-        p = sl_compile(set, "lib.sl", NULL, diag);
+        p = sl_compile(set, "lib.sl", NULL, NULL, diag);
     if (!p)
         sl_diag_print(diag, stderr);
     sl_diag_destroy(&diag);

@@ -1681,7 +1681,7 @@ static sl_program *compile_file(const char *name, char **diag_out)
     sl_diag *diag = sl_diag_new();
     sl_program *p = NULL;
     if (sl_source_set_get(set, name, diag))
-        p = sl_compile(set, name, NULL, diag);
+        p = sl_compile(set, name, NULL, NULL, diag);
     *diag_out = sl_diag_to_string(diag);
     sl_diag_destroy(&diag);
     sl_source_set_destroy(&set);

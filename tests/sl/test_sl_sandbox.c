@@ -269,7 +269,7 @@ static void test_mutated_sources(void **state)
         sl_source_set *set = sl_source_set_new();
         sl_diag *diag = sl_diag_new();
         sl_source_set_add(set, "m.sl", text, len);
-        sl_program *p = sl_compile(set, "m.sl", NULL, diag);
+        sl_program *p = sl_compile(set, "m.sl", NULL, NULL, diag);
         assert_true((p == NULL) == (sl_diag_error_count(diag) > 0));
         if (p) {
             compiled++;

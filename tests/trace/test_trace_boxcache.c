@@ -127,6 +127,36 @@ static void test_pinned_path_survives(void **state)
     trace_boxcache_destroy(&c);
 }
 
+/* The insert's own contract (issue 27, item 7d): the parent a new brood
+ * goes under stays in the cache while room is made for it, even when the
+ * caller has not pinned it and it is the least recently used brood (the
+ * walk pins its whole path, which would hide an insert that forgot). Two
+ * roots fill the budget, the parent root is the older: the other root
+ * must go, and the parent and its new child must both be found. */
+static void test_insert_keeps_its_parent(void **state)
+{
+    (void)state;
+    size_t per = trace_boxcache_brood_bytes();
+    trace_boxcache *c = trace_boxcache_new(2 * per, 2);
+    trace_box a_in[4], b_in[4], child_in[4], out[4];
+    fill(a_in, 1);
+    fill(b_in, 2);
+    fill(child_in, 3);
+    trace_brood_id a = trace_boxcache_insert(c, 0, TRACE_BROOD_NONE, 0, a_in);
+    trace_brood_id b = trace_boxcache_insert(c, 1, TRACE_BROOD_NONE, 0, b_in);
+    assert_true(a >= 0 && b >= 0);
+    /* a is the least recently used; nothing is pinned */
+    trace_brood_id child = trace_boxcache_insert(c, 0, a, 2, child_in);
+    assert_true(child >= 0);
+    assert_int_equal(trace_boxcache_stats_get(c)->evictions, 1);
+    assert_int_equal(trace_boxcache_lookup(c, 0, TRACE_BROOD_NONE, 0, out), a);
+    assert_memory_equal(out, a_in, sizeof out);
+    assert_int_equal(trace_boxcache_lookup(c, 0, a, 2, out), child);
+    assert_memory_equal(out, child_in, sizeof out);
+    assert_int_equal(trace_boxcache_lookup(c, 1, TRACE_BROOD_NONE, 0, out), TRACE_BROOD_NONE);
+    trace_boxcache_destroy(&c);
+}
+
 static void test_unlimited_never_evicts(void **state)
 {
     (void)state;
@@ -151,6 +181,7 @@ int main(void)
         cmocka_unit_test(test_budget_is_a_hard_limit_and_lru_goes_first),
         cmocka_unit_test(test_eviction_takes_the_subtree),
         cmocka_unit_test(test_pinned_path_survives),
+        cmocka_unit_test(test_insert_keeps_its_parent),
         cmocka_unit_test(test_unlimited_never_evicts),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

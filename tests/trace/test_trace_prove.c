@@ -483,6 +483,178 @@ static void test_cell_with_two_zeros(void **state)
     fixture_close(&f);
 }
 
+/* ---- the proof's soundness, directly (issue 27, item 7) ------------------ */
+
+/* The slopes' box X of cell r (prove.c: the cell widened by a quarter of
+ * its width on each side, within the unit square): a proven zero lies in
+ * it, whatever else the proof got wrong */
+static void slopes_box(const double r[4], double X[4])
+{
+    double du = 0.25 * (r[1] - r[0]), dv = 0.25 * (r[3] - r[2]);
+    X[0] = fmax(0.0, r[0] - du);
+    X[1] = fmin(1.0, r[1] + du);
+    X[2] = fmax(0.0, r[2] - dv);
+    X[3] = fmin(1.0, r[3] + dv);
+}
+
+/* The camera-space ray from the eye through the surface point (u, v) */
+static trace_ray ray_through(trace_thread *th, const trace_object *obj, double u, double v)
+{
+    trace_surface_point sp;
+    trace_surface_point_eval(th, obj, u, v, &sp);
+    trace_ray ray;
+    trace_ray_init(&ray, v3(0, 0, 0), sp.P, 0.0, INFINITY);
+    return ray;
+}
+
+/* Rays aimed at a zero just outside a cell's slopes' box X (0.1 % to 4 %
+ * of the cell beyond one of its sides, inside the unit square) and
+ * anywhere inside the cell. On a plane (a constant displacement: G is affine, J
+ * exact, K the zero itself to rounding) the one outside is never a hit
+ * and the one inside always is, at its (u, v); on the wave any proven
+ * hit's (u, v) lies in X. A test whose inclusion K in X were loosened by
+ * a few per cent of the cell would take the zero beyond X for X's. */
+static void check_zero_beside_the_box(const char *name, const char *src, bool plane)
+{
+    fixture f;
+    fixture_shader sh[] = {{name, src}};
+    char rib[512];
+    snprintf(rib, sizeof rib, SQUARE_RIB("%s"), name);
+    assert_true(fixture_open(&f, rib, sh, 1, NULL, 0));
+    trace_thread *th = trace_thread_new(&f.js->world);
+    const trace_object *obj = &f.js->world.objects[0];
+    unsigned seed = 27;
+    int outside_hits = 0, outside_tries = 0, inside_hits = 0, inside_tries = 0, escaped = 0;
+    for (int k = 0; k < 4000; k++) {
+        double w = 1.0 / (8 << (k % 4));       /* cells of 1/8 .. 1/64 */
+        double r[4], X[4];
+        r[0] = 0.1 + 0.7 * urand(&seed);
+        r[2] = 0.1 + 0.7 * urand(&seed);
+        r[1] = r[0] + w;
+        r[3] = r[2] + w;
+        slopes_box(r, X);
+        /* the target: beyond one side of X, or inside the cell */
+        bool beyond = k % 2 == 0;
+        double u, v;
+        if (beyond) {
+            double out = (0.001 + 0.039 * urand(&seed)) * w;
+            double along = urand(&seed);
+            switch ((k / 2) % 4) {
+            case 0: u = X[0] - out; v = X[2] + along * (X[3] - X[2]); break;
+            case 1: u = X[1] + out; v = X[2] + along * (X[3] - X[2]); break;
+            case 2: v = X[2] - out; u = X[0] + along * (X[1] - X[0]); break;
+            default: v = X[3] + out; u = X[0] + along * (X[1] - X[0]); break;
+            }
+            if (u <= 0 || u >= 1 || v <= 0 || v >= 1) continue;
+        } else {
+            /* anywhere in the cell, its border too (a miss test that took
+             * a sliver of the cell for outside would lose these) */
+            u = r[0] + (0.001 + 0.998 * urand(&seed)) * w;
+            v = r[2] + (0.001 + 0.998 * urand(&seed)) * w;
+        }
+        trace_ray ray = ray_through(th, obj, u, v);
+        double t;
+        trace_surface_point sp;
+        trace_proof_detail why;
+        trace_proof pr = trace_prove_hit(th, obj, &ray, r, 0.0, INFINITY,
+                                         &(trace_zero){.set = false}, &t, &sp, &why);
+        if (beyond) outside_tries++; else inside_tries++;
+        if (pr != TRACE_PROOF_HIT) continue;
+        if (beyond) outside_hits++; else inside_hits++;
+        bool in_box = sp.u >= X[0] && sp.u <= X[1] && sp.v >= X[2] && sp.v <= X[3];
+        if (!in_box && escaped++ < 5)
+            printf("  %s: cell [%.6f %.6f] x [%.6f %.6f]: a proven hit at (%.6f, %.6f), "
+                   "outside X [%.6f %.6f] x [%.6f %.6f]\n", name, r[0], r[1], r[2], r[3], sp.u,
+                   sp.v, X[0], X[1], X[2], X[3]);
+        if (plane && !beyond)   /* the zero aimed at, found */
+            assert_true(fabs(sp.u - u) <= 1e-6 * w && fabs(sp.v - v) <= 1e-6 * w);
+    }
+    printf("%s: zeros beside X: %d of %d proven hits; zeros in the cell: %d of %d; %d hits "
+           "outside X\n", name, outside_hits, outside_tries, inside_hits, inside_tries, escaped);
+    assert_int_equal(escaped, 0);
+    assert_true(outside_tries > 1000 && inside_tries > 1000);
+    if (plane) {
+        assert_int_equal(outside_hits, 0);
+        assert_int_equal(inside_hits, inside_tries);
+    } else {
+        assert_true(inside_hits > inside_tries / 4);   /* the test exercises hits */
+    }
+    trace_thread_destroy(&th);
+    fixture_close(&f);
+}
+
+static void test_zero_beside_the_box_is_never_taken(void **state)
+{
+    (void)state;
+    check_zero_beside_the_box("shell", SHELL_SL, true);
+    check_zero_beside_the_box("wave", WAVE_SL, false);
+}
+
+/* A fold: rays crossing the ridge twice, against cells whose slopes' box
+ * X holds both zeros, each 1 % to 5 % of X's width inside its border in
+ * u. X holds two zeros, so no proof of uniqueness may pass: never a hit
+ * (a proven miss is wrong too: the cell's own zeros would be lost). */
+static void test_fold_with_two_zeros_is_never_unique(void **state)
+{
+    (void)state;
+    fixture f;
+    fixture_shader sh[] = {{"ridge", RIDGE_SL}};
+    assert_true(fixture_open(&f,
+                             "Format 16 16 1\nProjection \"perspective\" \"fov\" [30]\n"
+                             "WorldBegin\nDisplacement \"ridge\"\n"
+                             "Polygon \"P\" [-1 -1 5  1 -1 5  1 1 5  -1 1 5]\nWorldEnd\n",
+                             sh, 1, NULL, 0));
+    trace_thread *th = trace_thread_new(&f.js->world);
+    const trace_object *obj = &f.js->world.objects[0];
+    const double v0 = 0.5;
+    trace_surface_point a, b, top;
+    trace_surface_point_eval(th, obj, 0.2, v0, &a);
+    trace_surface_point_eval(th, obj, 0.8, v0, &b);
+    trace_surface_point_eval(th, obj, 0.5, v0, &top);
+    double base = a.P.z, peak = top.P.z;
+    unsigned seed = 7;
+    int tried = 0, hits = 0, misses = 0;
+    for (int i = 0; i < 40; i++)
+        for (int j = 0; j < 40; j++) {
+            double za = base + (peak - base) * (0.05 + 0.9 * i / 39.0);
+            double zb = base + (peak - base) * (0.05 + 0.9 * j / 39.0);
+            vec3 A = v3(a.P.x, a.P.y, za), B = v3(b.P.x, a.P.y, zb);
+            vec3 d = v3_sub(B, A);
+            trace_ray ray;
+            trace_ray_init(&ray, v3_sub(A, d), d, 0.0, INFINITY);
+            double ts[8], us[8];
+            int n = ridge_zeros(th, obj, &ray, v0, ts, us);
+            if (n != 2) continue;
+            double u1 = fmin(us[0], us[1]), u2 = fmax(us[0], us[1]);
+            if (u2 - u1 < 0.02) continue;
+            /* X = [u1 - m, u2 + m] with m 1 % .. 5 % of X: the cell is X
+             * less a sixth of X on each side (X = cell + a quarter of it) */
+            double frac = 0.01 + 0.04 * urand(&seed);
+            double xw = (u2 - u1) / (1 - 2 * frac), x0 = u1 - frac * xw;
+            double w = xw / 1.5;
+            double r[4] = {x0 + 0.25 * w, x0 + 1.25 * w, v0 - 0.5 * w, v0 + 0.5 * w};
+            if (x0 < 0 || x0 + xw > 1 || r[2] - 0.25 * w < 0 || r[3] + 0.25 * w > 1) continue;
+            tried++;
+            double t;
+            trace_surface_point sp;
+            trace_proof_detail why;
+            trace_proof pr = trace_prove_hit(th, obj, &ray, r, 0.0, INFINITY,
+                                             &(trace_zero){.set = false}, &t, &sp, &why);
+            bool in_cell = (us[0] >= r[0] && us[0] <= r[1]) || (us[1] >= r[0] && us[1] <= r[1]);
+            if (pr == TRACE_PROOF_HIT && hits++ < 5)
+                printf("  zeros at u %.6f %.6f, cell [%.6f %.6f]: a proven hit at u %.6f\n", u1,
+                       u2, r[0], r[1], sp.u);
+            if (pr == TRACE_PROOF_MISS && in_cell) misses++;
+        }
+    printf("%d cells whose X holds two zeros near its border: %d proven hits, %d proven "
+           "misses of the cell's zeros\n", tried, hits, misses);
+    assert_true(tried > 300);
+    assert_int_equal(hits, 0);
+    assert_int_equal(misses, 0);
+    trace_thread_destroy(&th);
+    fixture_close(&f);
+}
+
 /* A 2 x 2 grid of quads split into triangles (as tests/corpus's mesh):
  * its 4 diagonals and 4 inner grid edges are shared, each by two of the
  * 8 triangles (16 edge bits), its 8 border edges not; a lone square
@@ -530,6 +702,8 @@ int main(void)
         cmocka_unit_test(test_first_order_derivatives_give_no_slopes),
         cmocka_unit_test(test_proven_walks_agree_with_leaves),
         cmocka_unit_test(test_cell_with_two_zeros),
+        cmocka_unit_test(test_zero_beside_the_box_is_never_taken),
+        cmocka_unit_test(test_fold_with_two_zeros_is_never_unique),
         cmocka_unit_test(test_silhouettes_match_a_finer_tolerance),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -161,6 +161,38 @@ static void test_good_render_leaves_exactly_the_output(void **state)
     image_buffer_destroy(&b);
 }
 
+/* An independent oracle of the tile renderer (issue 27, item 7): a plane
+ * far wider than the view covers every pixel, so every pixel's alpha is 1
+ * whatever the tile grid; partial tiles (37x23 in tiles of 8) and two
+ * threads. A tile renderer that left a row or a column of a tile unwritten
+ * (the farm's workers and the standalone share it: comparing the two
+ * cannot see it) leaves alpha 0 there. */
+static void test_covering_plane_gives_alpha_one_everywhere(void **state)
+{
+    (void)state;
+    char out[8192];
+    write_file("cover.rib", "Format 37 23 1\nProjection \"perspective\" \"fov\" [40]\n"
+               "WorldBegin\nPolygon \"P\" [-50 -50 5  50 -50 5  50 50 5  -50 50 5]\n"
+               "WorldEnd\n");
+    assert_int_equal(run("--standalone cover.rib -o cover.exr --tile 8 --threads 2 -q", out,
+                         sizeof out), 0);
+    char path[512], err[256];
+    snprintf(path, sizeof path, "%s/cover.exr", dir);
+    image_buffer *b = image_buffer_read_exr(path, err, sizeof err);
+    assert_non_null(b);
+    assert_int_equal(b->width, 37);
+    assert_int_equal(b->height, 23);
+    const float *a = image_buffer_channel(b, "A");
+    assert_non_null(a);
+    int off = 0;
+    for (int y = 0; y < 23; y++)
+        for (int x = 0; x < 37; x++)
+            if (!(a[y * 37 + x] == 1.0f) && off++ < 5)
+                printf("pixel (%d,%d): alpha %g\n", x, y, (double)a[y * 37 + x]);
+    assert_int_equal(off, 0);
+    image_buffer_destroy(&b);
+}
+
 /* Starts the worker in dir with argv (stderr into err_path, or dropped),
  * sends SIGTERM after pause_ms, and waits up to 10 s for it; a worker
  * that ignores the signal is killed (SIGKILL) and the test fails. Returns
@@ -284,6 +316,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_bad_scene_and_bad_shader),
         cmocka_unit_test(test_budget_exceeded_leaves_nothing),
         cmocka_unit_test(test_good_render_leaves_exactly_the_output),
+        cmocka_unit_test(test_covering_plane_gives_alpha_one_everywhere),
         cmocka_unit_test(test_shader_printf_reaches_stderr),
         cmocka_unit_test(test_sigterm_stops_a_runaway_render),
         cmocka_unit_test(test_sigterm_stops_one_long_evaluation),

@@ -7,8 +7,11 @@
  *   aafarm-slc [--dump] [-I DIR]... FILE.sl...
  *
  * Exit status 0 when every file compiled, 1 when one had errors, 2 on a
- * usage error.
+ * usage error, 130 when SIGINT/SIGTERM stopped it (the compiler looks at
+ * the flag as it goes: sl_compile's cancel).
  */
+#include <signal.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -17,6 +20,7 @@
 #include "sl/shader.h"
 #include "sl/source.h"
 #include "util/cli.h"
+#include "util/exitcodes.h"
 #include "util/xalloc.h"
 
 static void usage(FILE *out)
@@ -25,8 +29,18 @@ static void usage(FILE *out)
           "  Checks and compiles shaders (RenderMan Shading Language subset),\n"
           "  printing errors and warnings as file:line:col.\n"
           "  --dump    print the bytecode of each compiled shader\n"
-          "  -I DIR    add DIR to the #include search path\n",
+          "  -I DIR    add DIR to the #include search path\n"
+          "  Exit status: 0 compiled, 1 errors, 2 usage, 130 SIGINT/SIGTERM.\n",
           out);
+}
+
+/* Set by SIGINT/SIGTERM; the compiler looks at it (sl_compile's cancel). */
+static atomic_int interrupted;
+
+static void on_signal(int sig)
+{
+    (void)sig;
+    atomic_store(&interrupted, 1);
 }
 
 static int compile_one(const char *path, const char *const *search, bool dump)
@@ -34,7 +48,14 @@ static int compile_one(const char *path, const char *const *search, bool dump)
     sl_source_set *set = sl_source_set_new();
     sl_source_set_set_loader(set, sl_source_load_from_disk, NULL);
     sl_diag *diag = sl_diag_new();
-    sl_program *prog = sl_compile(set, path, search, diag);
+    sl_program *prog = sl_compile(set, path, search, &interrupted, diag);
+    if (atomic_load(&interrupted)) {
+        fprintf(stderr, "aafarm-slc: interrupted while compiling %s\n", path);
+        sl_program_destroy(&prog);
+        sl_diag_destroy(&diag);
+        sl_source_set_destroy(&set);
+        return AAFARM_EXIT_INTERRUPTED;
+    }
     sl_diag_print(diag, stderr);
     int status = 0;
     if (prog) {
@@ -94,9 +115,15 @@ int main(int argc, char **argv)
         free(files);
         return 2;
     }
+    struct sigaction sa = {0};
+    sa.sa_handler = on_signal;
+    sigaction(SIGINT, &sa, NULL);
+    sigaction(SIGTERM, &sa, NULL);
     int status = 0;
-    for (int i = 0; i < nfiles; i++)
-        status |= compile_one(files[i], search, dump);
+    for (int i = 0; i < nfiles && status != AAFARM_EXIT_INTERRUPTED; i++) {
+        int one = compile_one(files[i], search, dump);
+        status = one == AAFARM_EXIT_INTERRUPTED ? one : status | one;
+    }
     free(search);
     free(files);
     return status;
