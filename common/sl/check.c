@@ -54,12 +54,13 @@ void ck_error(checker *c, sl_pos pos, const char *fmt, ...)
 
 int sl_space_find(const char *name)
 {
-    static const char *const names[SL_SPACE__COUNT] = {
+    static const char *const names[SL_SPACE__NAMED] = {
         [SL_SPACE_CURRENT] = "current", [SL_SPACE_WORLD] = "world",
         [SL_SPACE_OBJECT] = "object", [SL_SPACE_SHADER] = "shader",
-        [SL_SPACE_CAMERA] = "camera",
+        [SL_SPACE_CAMERA] = "camera", [SL_SPACE_SCREEN] = "screen",
+        [SL_SPACE_NDC] = "NDC", [SL_SPACE_RASTER] = "raster",
     };
-    for (int i = 0; i < SL_SPACE__COUNT; i++)
+    for (int i = 0; i < SL_SPACE__NAMED; i++)
         if (strcmp(names[i], name) == 0)
             return i;
     return -1;
@@ -658,8 +659,7 @@ static sl_ty check_cast(checker *c, sl_node *n, sl_ty hint)
         return ck_set_ty(n, ty);
     if (sl_ty_is_spatial(ty)) {
         if (sl_space_find(n->name) < 0) {
-            ck_error(c, n->pos, "unknown space '%s' (known: \"current\", \"world\", "
-                             "\"object\", \"shader\", \"camera\")", n->name);
+            ck_error(c, n->pos, "unknown space '%s' (known: " SL_SPACE_NAMES ")", n->name);
             return ck_set_ty(n, SL_TY_ERROR);
         }
     } else if (ty == SL_TYPE_COLOR) {
@@ -670,8 +670,7 @@ static sl_ty check_cast(checker *c, sl_node *n, sl_ty hint)
         }
     } else if (ty == SL_TYPE_MATRIX) {
         if (sl_space_find(n->name) < 0) {
-            ck_error(c, n->pos, "unknown space '%s' (known: \"current\", \"world\", "
-                             "\"object\", \"shader\", \"camera\")", n->name);
+            ck_error(c, n->pos, "unknown space '%s' (known: " SL_SPACE_NAMES ")", n->name);
             return ck_set_ty(n, SL_TY_ERROR);
         }
     } else {

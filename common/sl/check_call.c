@@ -23,8 +23,7 @@
 static void check_space_arg(checker *c, const sl_node *arg)
 {
     if (arg->kind == SL_N_STR && sl_space_find(arg->name) < 0)
-        ck_error(c, arg->pos, "unknown space '%s' (known: \"current\", \"world\", "
-                           "\"object\", \"shader\", \"camera\")", arg->name);
+        ck_error(c, arg->pos, "unknown space '%s' (known: " SL_SPACE_NAMES ")", arg->name);
 }
 
 /* filterstep's optional parameters: "width", a float (the filter width's
@@ -213,6 +212,10 @@ static sl_ty check_builtin_call(checker *c, sl_node *n, const sl_ty *args, sl_ty
             continue;
         }
         if (sig[i] == 's' && b->lower == SL_LOWER_MESSAGE) {
+            ck_wrap_conv(c, &n->list[i], want[i]);
+            continue;
+        }
+        if (sig[i] == 's' && b->lower == SL_LOWER_RAY) {      /* shadow()'s map name */
             ck_wrap_conv(c, &n->list[i], want[i]);
             continue;
         }

@@ -548,7 +548,7 @@ static void test_cr_line_ends(void **state)
     assert_int_equal(s->camera.xres, 64);
     assert_true(s->camera.fov == 45);
     assert_string_equal(s->objects[0].name, "abc");
-    assert_int_equal(s->objects[0].pos.line, 8);
+    assert_int_equal(s->objects[0].pos.line, 9);
     assert_int_equal(s->objects[0].pos.col, 1);
     scene_destroy(&s);
     sl_diag *d;

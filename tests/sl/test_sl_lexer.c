@@ -322,8 +322,12 @@ static void test_positions_cr(void **state)
     (void)state;
     assert_string_equal(lex("x = 1;\ry\r  z"),
                         "x@1:1 =@1:3 1@1:5 ;@1:6 y@2:1 z@3:3");
+    teardown(NULL);
+    setup(NULL);
     assert_string_equal(lex("a\rb\r\nc\nd\r\re // f\rg"),
                         "a@1:1 b@2:1 c@3:1 d@4:1 e@6:1 g@7:1");
+    teardown(NULL);
+    setup(NULL);
     /* a splice before a lone CR, and a comment ended by one */
     assert_string_equal(lex("ab\\\rcd ef\\\r\ngh /* x\r */ i"),
                         "abcd@1:1 efgh@2:4 i@4:5");
