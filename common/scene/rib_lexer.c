@@ -98,13 +98,15 @@ static void skip_space_and_comments(rib_lexer *self)
 {
     while (self->p < self->end) {
         char c = *self->p;
-        if (c == '\n') {
+        if (c == '\n' || c == '\r') {      /* LF, CR-LF or a lone CR (classic Mac) */
             self->p++;
+            if (c == '\r' && self->p < self->end && *self->p == '\n')
+                self->p++;
             newline(self, self->p);
         } else if (is_space(c)) {
             self->p++;
         } else if (c == '#') {
-            while (self->p < self->end && *self->p != '\n')
+            while (self->p < self->end && *self->p != '\n' && *self->p != '\r')
                 self->p++;
         } else {
             return;
@@ -206,6 +208,11 @@ static void lex_escape(rib_lexer *self)
     case 't': sl_strbuf_putc(&self->str, '\t'); return;
     case 'b': sl_strbuf_putc(&self->str, '\b'); return;
     case 'f': sl_strbuf_putc(&self->str, '\f'); return;
+    case '\r':
+        if (self->p < self->end && *self->p == '\n')
+            self->p++;
+        newline(self, self->p);
+        return;
     case '\n': newline(self, self->p); return;
     default: break;
     }
@@ -225,7 +232,7 @@ static rib_token lex_string(rib_lexer *self)
     sl_pos pos = pos_at(self, start);
     self->str.len = 0;
     sl_strbuf_put(&self->str, "", 0);
-    while (self->p < self->end && *self->p != '"' && *self->p != '\n') {
+    while (self->p < self->end && *self->p != '"' && *self->p != '\n' && *self->p != '\r') {
         if (*self->p == '\\' && self->p + 1 < self->end) {
             self->p++;
             lex_escape(self);

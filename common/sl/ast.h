@@ -84,6 +84,10 @@ enum { SL_RESIZE_RESIZE, SL_RESIZE_RESERVE, SL_RESIZE_PUSH, SL_RESIZE_POP };
 
 typedef struct sl_node sl_node;
 
+/* The parameters of a user function, and so the arguments of a call of
+ * one (docs/shading-language.md, Limits): a checker error beyond it. */
+enum { SL_MAX_FUNC_PARAMS = 255 };
+
 typedef struct sl_func {
     const char *name;
     sl_ty ret;
@@ -93,6 +97,9 @@ typedef struct sl_func {
     sl_node *body;
     bool nested;                /* defined inside a function or the shader body */
     int depth;                  /* checker: block depth of a nested definition (0: file) */
+    bool declared;              /* checker: nested, in scope (its overload group's first
+                                   definition declares the whole group) */
+    bool defined;               /* checker: its body has been checked */
     /* checker */
     struct sl_func **calls;     /* user functions called, for the recursion check */
     int ncalls, calls_cap;

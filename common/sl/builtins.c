@@ -148,13 +148,10 @@ static const sl_builtin table[] = {
     LW("option", "f:sV", MESSAGE, MESSAGE, SL_MSG_OPTION),
     LW("rendererinfo", "f:sV", MESSAGE, MESSAGE, SL_MSG_RENDERERINFO),
     /* rays (§15.6 trace, §15.7 shadow): the renderer's tracer (shader.h, sl_tracer);
-     * shadow()'s optional parameters are accepted and ignored */
+     * shadow()'s optional parameters are checked, warned about and dropped by
+     * check_call.c before this entry is looked up */
     LW("trace", "c:pv", RAY, RAY, SL_RAY_TRACE),
     LW("shadow", "f:sp", RAY, RAY, 1),
-    LW("shadow", "f:spsf", RAY, RAY, 1),
-    LW("shadow", "f:spsfsf", RAY, RAY, 1),
-    LW("shadow", "f:spsfsfsf", RAY, RAY, 1),
-    LW("shadow", "f:spsfsfsfsf", RAY, RAY, 1),
     /* spline (§15.1): variadic, checked by check_spline */
     LW("spline", "A:", SPLINE, END, 0),
 };
@@ -291,8 +288,8 @@ const sl_builtin *sl_builtin_resolve(const char *name, const sl_ty *args, int na
     const sl_builtin *first = sl_builtin_find(name, &count);
     const sl_builtin *best = NULL;
     int best_cost = 0;
-    sl_ty want[8];
-    if (nargs > 8)
+    sl_ty want[SL_MAX_BUILTIN_ARGS];
+    if (nargs > SL_MAX_BUILTIN_ARGS)
         return NULL;
     for (int i = 0; i < count; i++) {
         int cost = candidate_cost(&first[i], args, nargs, hint, want);

@@ -81,6 +81,10 @@ typedef struct sl_builtin {
  * and their number, or NULL. */
 const sl_builtin *sl_builtin_find(const char *name, int *count);
 
+/* The most arguments a built-in of the table takes (the ones with
+ * "name", value lists, texture() and shadow(), are checked on their own). */
+enum { SL_MAX_BUILTIN_ARGS = 8 };
+
 /* Resolution of one call: the chosen entry, the type each argument must
  * be converted to, and the result type. hint: the type the context wants
  * (SL_TYPE_VOID: none), for 'F' results. Returns NULL when nothing

@@ -54,12 +54,13 @@ void ck_error(checker *c, sl_pos pos, const char *fmt, ...)
 
 int sl_space_find(const char *name)
 {
-    static const char *const names[SL_SPACE__COUNT] = {
+    static const char *const names[SL_SPACE__NAMED] = {
         [SL_SPACE_CURRENT] = "current", [SL_SPACE_WORLD] = "world",
         [SL_SPACE_OBJECT] = "object", [SL_SPACE_SHADER] = "shader",
-        [SL_SPACE_CAMERA] = "camera",
+        [SL_SPACE_CAMERA] = "camera", [SL_SPACE_SCREEN] = "screen",
+        [SL_SPACE_NDC] = "NDC", [SL_SPACE_RASTER] = "raster",
     };
-    for (int i = 0; i < SL_SPACE__COUNT; i++)
+    for (int i = 0; i < SL_SPACE__NAMED; i++)
         if (strcmp(names[i], name) == 0)
             return i;
     return -1;
@@ -658,8 +659,7 @@ static sl_ty check_cast(checker *c, sl_node *n, sl_ty hint)
         return ck_set_ty(n, ty);
     if (sl_ty_is_spatial(ty)) {
         if (sl_space_find(n->name) < 0) {
-            ck_error(c, n->pos, "unknown space '%s' (known: \"current\", \"world\", "
-                             "\"object\", \"shader\", \"camera\")", n->name);
+            ck_error(c, n->pos, "unknown space '%s' (known: " SL_SPACE_NAMES ")", n->name);
             return ck_set_ty(n, SL_TY_ERROR);
         }
     } else if (ty == SL_TYPE_COLOR) {
@@ -670,8 +670,7 @@ static sl_ty check_cast(checker *c, sl_node *n, sl_ty hint)
         }
     } else if (ty == SL_TYPE_MATRIX) {
         if (sl_space_find(n->name) < 0) {
-            ck_error(c, n->pos, "unknown space '%s' (known: \"current\", \"world\", "
-                             "\"object\", \"shader\", \"camera\")", n->name);
+            ck_error(c, n->pos, "unknown space '%s' (known: " SL_SPACE_NAMES ")", n->name);
             return ck_set_ty(n, SL_TY_ERROR);
         }
     } else {
@@ -867,7 +866,7 @@ static void check_return(checker *c, sl_node *n)
     add_escape(c, n, e);
 }
 
-static void check_nested_function(checker *c, sl_func *f);
+static void check_nested_function(checker *c, sl_func *f, const sl_node *block, int index);
 
 static void check_stmt(checker *c, sl_node *n)
 {
@@ -877,7 +876,10 @@ static void check_stmt(checker *c, sl_node *n)
     case SL_N_BLOCK: {
         scope_mark saved = push_scope(c);
         for (int i = 0; i < n->nlist; i++) {
-            check_stmt(c, n->list[i]);
+            if (n->list[i]->kind == SL_N_FUNC)
+                check_nested_function(c, n->list[i]->func, n, i);
+            else
+                check_stmt(c, n->list[i]);
             inherit(c, n, n->list[i], NULL);
         }
         pop_scope(c, saved);
@@ -910,7 +912,7 @@ static void check_stmt(checker *c, sl_node *n)
     }
     case SL_N_BREAK: case SL_N_CONTINUE: check_loop_mod(c, n); break;
     case SL_N_RETURN: check_return(c, n); break;
-    case SL_N_FUNC: check_nested_function(c, n->func); break;
+    case SL_N_FUNC: check_nested_function(c, n->func, NULL, 0); break;
     default: break;
     }
 }
@@ -955,6 +957,9 @@ static bool needs_ret_flag(sl_node *body)
 static void check_function_body(checker *c, sl_func *f)
 {
     sl_list_push(c->arena, (void ***)&c->allfuncs, &c->nallfuncs, &c->allfuncs_cap, f);
+    if (f->nparams > SL_MAX_FUNC_PARAMS)
+        ck_error(c, f->pos, "function '%s' has %d parameters; at most %d are supported: pass "
+              "some of them in arrays", f->name, f->nparams, SL_MAX_FUNC_PARAMS);
     c->func = f;
     c->func_base = c->nsyms;
     scope_mark saved = push_scope(c);
@@ -979,11 +984,8 @@ static void check_function(checker *c, sl_func *f)
     c->func_base = 0;
 }
 
-/* A function defined inside a function or the shader body: callable from
- * its definition to the end of the enclosing block (its own body
- * included, so that recursion is reported as such), seeing the enclosing
- * variables through 'extern' only. */
-static void check_nested_function(checker *c, sl_func *f)
+/* Puts nested function f in scope (false: a redefinition, reported). */
+static bool declare_nested(checker *c, sl_func *f)
 {
     f->depth = c->depth;
     for (int i = c->vfuncs_start; i < c->nvfuncs; i++) {
@@ -991,10 +993,34 @@ static void check_nested_function(checker *c, sl_func *f)
         if (strcmp(g->name, f->name) == 0 && same_params(f, g) && f->ret == g->ret) {
             ck_error(c, f->pos, "redefinition of function '%s'", f->name);
             sl_diag_note(c->diag, c->vfuncs[i]->pos, "previous definition is here");
-            return;
+            return false;
         }
     }
     sl_list_push(c->arena, (void ***)&c->vfuncs, &c->nvfuncs, &c->vfuncs_cap, f);
+    f->declared = true;
+    return true;
+}
+
+/* A function defined inside a function or the shader body: callable from
+ * its definition to the end of the enclosing block (its own body
+ * included, so that recursion is reported as such), seeing the enclosing
+ * variables through 'extern' only. The overloads of one name defined in
+ * one block (block->list from index on) come into scope together, at the
+ * first of them, so that each body may call the others (a point-returning
+ * helper calling the void one with output parameters, whichever comes
+ * first); code outside the group calls them once all are defined
+ * (ck_check_call). */
+static void check_nested_function(checker *c, sl_func *f, const sl_node *block, int index)
+{
+    if (!f->declared) {
+        if (!declare_nested(c, f))
+            return;
+        for (int i = index + 1; block && i < block->nlist; i++) {
+            sl_func *g = block->list[i]->kind == SL_N_FUNC ? block->list[i]->func : NULL;
+            if (g && !g->declared && strcmp(g->name, f->name) == 0 && !declare_nested(c, g))
+                g->declared = true;      /* reported; its body is still checked */
+        }
+    }
     sl_func *saved_func = c->func;
     int saved_base = c->func_base;
     sl_node **saved_loops = c->loops;           /* break cannot leave a function */
@@ -1002,6 +1028,7 @@ static void check_nested_function(checker *c, sl_func *f)
     c->loops = NULL;
     c->nloops = c->loops_cap = 0;
     check_function_body(c, f);
+    f->defined = true;
     c->loops = saved_loops;
     c->nloops = saved_nloops;
     c->loops_cap = saved_cap;

@@ -23,6 +23,8 @@
 bool sl_check(sl_ast_file *file, sl_arena *arena, const atomic_int *cancel, sl_diag *diag);
 
 /* The spaces transform() and the casts know, by name: SL_SPACE_* or -1. */
+#define SL_SPACE_NAMES "\"current\", \"world\", \"object\", \"shader\", \"camera\", " \
+    "\"screen\", \"NDC\", \"raster\""
 int sl_space_find(const char *name);
 
 #endif

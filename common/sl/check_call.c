@@ -23,8 +23,7 @@
 static void check_space_arg(checker *c, const sl_node *arg)
 {
     if (arg->kind == SL_N_STR && sl_space_find(arg->name) < 0)
-        ck_error(c, arg->pos, "unknown space '%s' (known: \"current\", \"world\", "
-                           "\"object\", \"shader\", \"camera\")", arg->name);
+        ck_error(c, arg->pos, "unknown space '%s' (known: " SL_SPACE_NAMES ")", arg->name);
 }
 
 /* filterstep's optional parameters: "width", a float (the filter width's
@@ -55,20 +54,104 @@ static void check_filter_param(checker *c, const sl_node *n, int i)
               "float, \"filter\" with a name)", arg->name);
 }
 
-/* shadow(name, P, "blur", 0.01, ...): the shadow map parameters of RI Spec
- * 3.2 §15.7, accepted and ignored (the traced shadow ray is sharp). */
-static void check_shadow_param(checker *c, const sl_node *arg)
+/* The optional "name", value parameters of texture(), environment(),
+ * bump() and shadow() (RI Spec 3.2 §15.7, and the ones shader libraries
+ * pass to PRMan): type 'f' a float, 's' a constant string, 'w' a wrap
+ * mode. Which ones each lookup uses: check_texture, cg_gen_texture. */
+static const struct { const char *name; char type; } optional_params[] = {
+    { "blur", 'f' }, { "sblur", 'f' }, { "tblur", 'f' }, { "width", 'f' },
+    { "swidth", 'f' }, { "twidth", 'f' }, { "fill", 'f' }, { "samples", 'f' },
+    { "filter", 's' }, { "wrap", 'w' }, { "swrap", 'w' }, { "twrap", 'w' },
+    { "lerp", 'f' }, { "bias", 'f' },
+};
+enum { NOPTIONAL = sizeof optional_params / sizeof optional_params[0] };
+#define TEXTURE_PARAM_NAMES "\"blur\", \"sblur\", \"tblur\", \"width\", \"swidth\", " \
+    "\"twidth\", \"fill\", \"samples\", \"filter\", \"wrap\", \"swrap\", \"twrap\", \"lerp\""
+#define SHADOW_PARAM_NAMES "\"samples\", \"blur\", \"sblur\", \"tblur\", \"bias\", " \
+    "\"width\", \"swidth\", \"twidth\", \"filter\", \"fill\""
+
+/* The index of name in optional_params when it is in the list `allowed`
+ * (quoted names), or -1. */
+static int optional_find(const char *name, const char *allowed)
 {
-    static const char *const names[] = { "samples", "blur", "bias", "width", "swidth",
-                                         "twidth" };
-    if (arg->kind == SL_N_STR)
-        for (size_t k = 0; k < sizeof names / sizeof names[0]; k++)
-            if (strcmp(arg->name, names[k]) == 0)
-                return;
-    ck_error(c, arg->pos, "unknown shadow() parameter%s%s%s (known: \"samples\", \"blur\", "
-          "\"bias\", \"width\", \"swidth\", \"twidth\", each with a float; they are "
-          "accepted and ignored)", arg->kind == SL_N_STR ? " '" : "",
-          arg->kind == SL_N_STR ? arg->name : "", arg->kind == SL_N_STR ? "'" : "");
+    char quoted[16];
+    for (int k = 0; k < NOPTIONAL; k++) {
+        if (strcmp(optional_params[k].name, name) != 0)
+            continue;
+        snprintf(quoted, sizeof quoted, "\"%s\"", name);
+        return strstr(allowed, quoted) ? k : -1;
+    }
+    return -1;
+}
+
+/* An accepted parameter that this lookup has no use for: one warning per
+ * name and function in a shader (fn: SL_TEX_* or SL_TEX_INFO for shadow). */
+static void warn_ignored(checker *c, const sl_node *pn, const char *fn_name, int fn, int k,
+                         const char *why)
+{
+    _Static_assert(NOPTIONAL * (SL_TEX_INFO + 1) <= 64, "one bit per name and function");
+    uint64_t bit = (uint64_t)1 << (fn * NOPTIONAL + k);
+    if (c->ignored_warned & bit)
+        return;
+    c->ignored_warned |= bit;
+    sl_diag_warning(c->diag, pn->pos, "%s() parameter '%s' is accepted and ignored: %s (said "
+                    "once per shader)", fn_name, pn->name, why);
+}
+
+/* One "name", value parameter at list[i] of a texture lookup or shadow()
+ * (allowed: its known names): false when reported. *k: its index. */
+static bool check_optional(checker *c, sl_node *n, int i, const char *allowed,
+                           const char *known, int *k)
+{
+    sl_node *pn = n->list[i];
+    ck_check_expr(c, &n->list[i], SL_TYPE_STRING);
+    *k = pn->kind == SL_N_STR ? optional_find(pn->name, allowed) : -1;
+    if (*k < 0) {
+        ck_error(c, pn->pos, "unknown %s() parameter%s%s%s (known: %s)", n->name,
+              pn->kind == SL_N_STR ? " '" : "", pn->kind == SL_N_STR ? pn->name : "",
+              pn->kind == SL_N_STR ? "'" : "", known);
+        return false;
+    }
+    if (i + 1 >= n->nlist) {
+        ck_error(c, pn->pos, "%s() parameter '%s' has no value", n->name, pn->name);
+        return false;
+    }
+    char type = optional_params[*k].type;
+    sl_ty have = ck_check_expr(c, &n->list[i + 1], type == 'f' ? SL_TYPE_FLOAT
+                                                               : SL_TYPE_STRING);
+    sl_node *v = n->list[i + 1];
+    if (have == SL_TY_ERROR)
+        return false;
+    if (type == 'f' && have != SL_TYPE_FLOAT)
+        ck_error(c, v->pos, "%s() parameter '%s' takes a float, not '%s'", n->name, pn->name,
+              sl_ty_name(have));
+    else if (type != 'f' && v->kind != SL_N_STR)
+        ck_error(c, v->pos, "%s() parameter '%s' takes a constant string", n->name, pn->name);
+    else if (type == 'w' && tex_wrap_find(v->name) < 0)
+        ck_error(c, v->pos, "unknown wrap mode '%s' (known: \"periodic\", \"clamp\", "
+                         "\"black\")", v->name);
+    else
+        return true;
+    return false;
+}
+
+/* shadow(name, P, "blur", 0.01, ...): the shadow map parameters, accepted
+ * with a warning (the traced shadow ray is sharp and has no map); the call
+ * keeps its first two arguments. False when reported. */
+static bool check_shadow_params(checker *c, sl_node *n)
+{
+    bool ok = true;
+    for (int i = 2; i < n->nlist; i += 2) {
+        int k;
+        if (!check_optional(c, n, i, SHADOW_PARAM_NAMES, SHADOW_PARAM_NAMES, &k)) {
+            ok = false;
+            continue;
+        }
+        warn_ignored(c, n->list[i], "shadow", SL_TEX_INFO, k, "shadows are traced rays, "
+                     "sharp, with no map to filter or bias");
+    }
+    n->nlist = 2;
+    return ok;
 }
 
 /* A color space argument (ctransform): a constant string naming one. */
@@ -83,7 +166,7 @@ static void check_color_space_arg(checker *c, const sl_node *arg)
 
 static sl_ty check_builtin_call(checker *c, sl_node *n, const sl_ty *args, sl_ty hint)
 {
-    sl_ty want[8], result;
+    sl_ty want[SL_MAX_BUILTIN_ARGS], result;
     const sl_builtin *b = sl_builtin_resolve(n->name, args, n->nlist, hint, want, &result);
     if (!b) {
         char list[256] = "";
@@ -128,14 +211,11 @@ static sl_ty check_builtin_call(checker *c, sl_node *n, const sl_ty *args, sl_ty
                       "%d)", n->list[0]->name, bad);
             continue;
         }
-        if (sig[i] == 's' && b->lower == SL_LOWER_RAY) {
-            if (i > 0)
-                check_shadow_param(c, n->list[i]);
-            else
-                ck_wrap_conv(c, &n->list[i], want[i]);
+        if (sig[i] == 's' && b->lower == SL_LOWER_MESSAGE) {
+            ck_wrap_conv(c, &n->list[i], want[i]);
             continue;
         }
-        if (sig[i] == 's' && b->lower == SL_LOWER_MESSAGE) {
+        if (sig[i] == 's' && b->lower == SL_LOWER_RAY) {      /* shadow()'s map name */
             ck_wrap_conv(c, &n->list[i], want[i]);
             continue;
         }
@@ -170,10 +250,34 @@ static bool array_arg_ok(sl_ty param, sl_ty arg)
     return sl_ty_len(param) == 0 || sl_ty_len(arg) == 0 || sl_ty_len(param) == sl_ty_len(arg);
 }
 
+/* A nested overload group (check.c, check_nested_function) still being
+ * defined, called from outside it: the later definitions may read
+ * variables not declared yet at this call. The first undefined one, or
+ * NULL. */
+static sl_func *undefined_overload(checker *c, const sl_func *f)
+{
+    if (!f->nested || (c->func && c->func->nested && c->func->depth == f->depth &&
+                       strcmp(c->func->name, f->name) == 0))
+        return NULL;
+    for (int i = 0; i < c->nvfuncs; i++) {
+        sl_func *g = c->vfuncs[i];
+        if (g->depth == f->depth && !g->defined && strcmp(g->name, f->name) == 0)
+            return g;
+    }
+    return NULL;
+}
+
 static sl_ty check_user_call(checker *c, sl_node *n, sl_func *f, const sl_ty *args)
 {
     n->func = f;
     add_call_edge(c, f);
+    sl_func *later = undefined_overload(c, f);
+    if (later) {
+        ck_error(c, n->pos, "'%s' is called before all its overloads in this block are "
+              "defined: move the call after the definition at line %d", f->name,
+              later->pos.line);
+        return ck_set_ty(n, SL_TY_ERROR);
+    }
     if (n->nlist != f->nparams) {
         ck_error(c, n->pos, "function '%s' takes %d argument%s, but %d %s given", f->name,
               f->nparams, f->nparams == 1 ? "" : "s", n->nlist, n->nlist == 1 ? "was" : "were");
@@ -569,14 +673,6 @@ static sl_ty check_strings(checker *c, sl_node *n, const sl_builtin *b)
  * and a value. n->op: SL_TEX_* (builtins.h); n->a the name, n->b the
  * channel or NULL; texture and environment are float, or color where the
  * context wants a color. */
-static const struct { const char *name; char type; } texture_params[] = {
-    { "blur", 'f' }, { "sblur", 'f' }, { "tblur", 'f' }, { "width", 'f' },
-    { "swidth", 'f' }, { "twidth", 'f' }, { "fill", 'f' }, { "samples", 'f' },
-    { "filter", 's' }, { "wrap", 'w' }, { "swrap", 'w' }, { "twrap", 'w' },
-};
-#define TEXTURE_PARAM_NAMES "\"blur\", \"sblur\", \"tblur\", \"width\", \"swidth\", " \
-    "\"twidth\", \"fill\", \"samples\", \"filter\", \"wrap\", \"swrap\", \"twrap\""
-
 static sl_ty check_texture_info(checker *c, sl_node *n)
 {
     if (n->nlist != 3) {
@@ -681,40 +777,21 @@ static sl_ty check_texture(checker *c, sl_node *n, sl_ty hint)
         ck_wrap_conv(c, &n->list[i], want);
     }
     for (int i = 1 + npos; i < n->nlist; i += 2) {
-        sl_node *pn = n->list[i];
-        ck_check_expr(c, &n->list[i], SL_TYPE_STRING);
-        size_t k = 0, nk = sizeof texture_params / sizeof texture_params[0];
-        while (k < nk && strcmp(texture_params[k].name, pn->name) != 0)
-            k++;
-        if (pn->kind != SL_N_STR || k == nk) {
-            ck_error(c, pn->pos, "unknown %s() parameter '%s' (known: " TEXTURE_PARAM_NAMES ")",
-                  n->name, pn->kind == SL_N_STR ? pn->name : "?");
+        int k;
+        if (!check_optional(c, n, i, TEXTURE_PARAM_NAMES, TEXTURE_PARAM_NAMES, &k)) {
             bad = true;
             continue;
         }
-        if (i + 1 >= n->nlist) {
-            ck_error(c, pn->pos, "%s() parameter '%s' has no value", n->name, pn->name);
-            bad = true;
-            break;
-        }
-        char type = texture_params[k].type;
-        sl_ty have = ck_check_expr(c, &n->list[i + 1], type == 'f' ? SL_TYPE_FLOAT
-                                                                : SL_TYPE_STRING);
-        sl_node *v = n->list[i + 1];
-        if (have == SL_TY_ERROR) {
-            bad = true;
-        } else if (type == 'f' && have != SL_TYPE_FLOAT) {
-            ck_error(c, v->pos, "%s() parameter '%s' takes a float, not '%s'", n->name, pn->name,
-                  sl_ty_name(have));
-            bad = true;
-        } else if (type != 'f' && v->kind != SL_N_STR) {
-            ck_error(c, v->pos, "%s() parameter '%s' takes a constant string", n->name, pn->name);
-            bad = true;
-        } else if (type == 'w' && tex_wrap_find(v->name) < 0) {
-            ck_error(c, v->pos, "unknown wrap mode '%s' (known: \"periodic\", \"clamp\", "
-                             "\"black\")", v->name);
-            bad = true;
-        }
+        /* what cg_gen_texture uses: blur, fill, wrap everywhere, width with
+         * the four corners' footprint */
+        const char *pname = optional_params[k].name;
+        if (strcmp(pname, "filter") == 0 || strcmp(pname, "samples") == 0 ||
+            strcmp(pname, "lerp") == 0)
+            warn_ignored(c, n->list[i], n->name, kind, k, "aafarm filters each lookup one "
+                         "way, over the footprint it bounds (docs/textures.md)");
+        else if (strstr(pname, "width") && !(kind == SL_TEX_TEXTURE && npos == 8))
+            warn_ignored(c, n->list[i], n->name, kind, k, "only the four-corner form of "
+                         "texture() has a footprint to widen (use \"blur\")");
     }
     if (bad)
         return ck_set_ty(n, SL_TY_ERROR);
@@ -749,6 +826,9 @@ sl_ty ck_check_call(checker *c, sl_node *n, sl_ty hint)
         n->list = two;
         n->nlist = 2;
     }
+    if (ncands == 0 && strcmp(n->name, "shadow") == 0 && n->nlist > 2 &&
+        !check_shadow_params(c, n))
+        return ck_set_ty(n, SL_TY_ERROR);
     if (ncands == 0 && strcmp(n->name, "spline") == 0)
         return check_spline(c, n, hint);
     if (ncands == 0 && (strcmp(n->name, "texture") == 0 || strcmp(n->name, "environment") == 0 ||
@@ -793,11 +873,13 @@ sl_ty ck_check_call(checker *c, sl_node *n, sl_ty hint)
             ck_error(c, n->pos, "use of undeclared function '%s'", n->name);
         return ck_set_ty(n, SL_TY_ERROR);
     }
-    if (n->nlist > 8) {
-        ck_error(c, n->pos, "too many arguments in call to '%s'", n->name);
+    if (n->nlist > SL_MAX_FUNC_PARAMS || (!ncands && n->nlist > SL_MAX_BUILTIN_ARGS)) {
+        ck_error(c, n->pos, "too many arguments in call to '%s' (%d; %s takes at most %d)",
+              n->name, n->nlist, ncands ? "a function" : "this built-in",
+              ncands ? SL_MAX_FUNC_PARAMS : SL_MAX_BUILTIN_ARGS);
         return ck_set_ty(n, SL_TY_ERROR);
     }
-    sl_ty args[8];
+    sl_ty args[SL_MAX_FUNC_PARAMS];
     bool bad = false;
     for (int i = 0; i < n->nlist; i++) {
         /* the parameter type as a hint, when the overloads of this arity agree */
@@ -823,8 +905,8 @@ sl_ty ck_check_call(checker *c, sl_node *n, sl_ty hint)
         if (f)
             return check_user_call(c, n, f, args);
     }
-    sl_ty want[8], result;
-    if (builtin && (!ncands || sl_builtin_resolve(n->name, args, n->nlist, hint, want, &result)))
+    sl_ty want[SL_MAX_BUILTIN_ARGS], result;
+    if (builtin && n->nlist <= SL_MAX_BUILTIN_ARGS && (!ncands || sl_builtin_resolve(n->name, args, n->nlist, hint, want, &result)))
         return check_builtin_call(c, n, args, hint);
     no_match(c, n, args, cands, ncands, builtin);
     return ck_set_ty(n, SL_TY_ERROR);

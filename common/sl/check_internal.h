@@ -11,6 +11,7 @@
 
 #include <stdbool.h>
 #include <stddef.h>
+#include <stdint.h>
 
 typedef struct checker {
     sl_arena *arena;
@@ -32,6 +33,8 @@ typedef struct checker {
     sl_func *func;                 /* function being checked (NULL: shader) */
     sl_node **loops;
     int nloops, loops_cap;
+    uint64_t ignored_warned;       /* optional texture()/shadow() parameters
+                                      warned about (check_call.c, warn_ignored) */
 } checker;
 
 enum { MAX_OVERLOADS = 32 };

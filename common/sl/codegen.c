@@ -910,11 +910,8 @@ static int gen_user_call(cg *g, sl_node *e, int dst)
         cg_fail(g, "function calls nested too deeply (limit %d)", SL_MAX_INLINE_DEPTH);
         return 0;
     }
-    int args[64];
-    if (e->nlist > 64) {
-        cg_fail(g, "too many arguments in call to '%s'", f->name);
-        return 0;
-    }
+    int args[SL_MAX_FUNC_PARAMS];
+    assert(e->nlist <= SL_MAX_FUNC_PARAMS);      /* the checker's limit */
     for (int i = 0; i < e->nlist; i++)
         args[i] = cg_gen_expr(g, e->list[i], -1);
     for (int i = 0; i < e->nlist; i++) {

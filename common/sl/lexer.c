@@ -141,14 +141,16 @@ size_t sl_scanner_clean(const char *src, size_t len, char *dst,
     size_t i = 0, o = 0, n = 0;
     while (i < len) {
         char c = src[i];
-        if (c == '\\' && i + 1 < len && src[i + 1] == '\n') {
+        /* a line ends in LF, CRLF or a lone CR (classic Mac): all become LF */
+        size_t eol = i + 1 < len && src[i + 1] == '\n' ? 1
+                   : i + 1 < len && src[i + 1] == '\r' ? (i + 2 < len && src[i + 2] == '\n' ? 2 : 1)
+                   : 0;
+        if (c == '\\' && eol) {
             splices[n++] = o;
-            i += 2;
-        } else if (c == '\\' && i + 2 < len && src[i + 1] == '\r' && src[i + 2] == '\n') {
-            splices[n++] = o;
-            i += 3;
-        } else if (c == '\r' && i + 1 < len && src[i + 1] == '\n') {
-            i++;
+            i += 1 + eol;
+        } else if (c == '\r') {
+            dst[o++] = '\n';
+            i += i + 1 < len && src[i + 1] == '\n' ? 2 : 1;
         } else {
             dst[o++] = c;
             i++;

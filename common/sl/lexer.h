@@ -205,8 +205,9 @@ typedef struct sl_scanner {
     sl_diag *diag;
 } sl_scanner;
 
-/* Removes backslash-newline (and backslash-CR-LF) line splices and the CR of
- * CR-LF line ends from src[0..len) into dst (at least len bytes); writes the
+/* Removes backslash-newline line splices and makes every line end (LF,
+ * CR-LF, or a lone CR as classic Mac files have) one LF, from src[0..len)
+ * into dst (at least len bytes); writes the
  * offsets of the splices in dst into splices (at least len / 2 + 1 entries)
  * and their number into *nsplices. Returns the cleaned length. */
 size_t sl_scanner_clean(const char *src, size_t len, char *dst,

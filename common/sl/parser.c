@@ -48,6 +48,7 @@ typedef struct parser {
     long consumed;       /* tokens consumed so far: progress of the loops */
     const atomic_int *cancel;   /* the program's stop flag, or NULL */
     bool cancelled;      /* it was found set: the text "ends" here */
+    bool coshader_said;  /* co-shaders reported once per source (coshader_error) */
 } parser;
 
 /* ---------------------------------------------------------------------- */
@@ -327,14 +328,27 @@ static sl_node *primary_inner(parser *p)
     "aafarm compiles each shader on its own: put the co-shader's code in a function of " \
     "this shader (or #include it)"
 
+/* An RSL 2 co-shader construct (what: "'shader' variables", ...) at the
+ * current token: said once per source, the first one; the others have
+ * the same cause and fix. */
+static void coshader_error(parser *p, const char *what)
+{
+    if (p->coshader_said) {
+        p->panic = true;
+        return;
+    }
+    p->coshader_said = true;
+    error_at(p, p->cur.pos, &p->cur, "%s (RSL 2 co-shaders) are not supported: "
+             SL_COSHADER_HELP, what);
+}
+
 /* A primary, and the RSL 2 method call 'x->method(...)' after it (the
  * lexer gives '-' '>'): co-shaders are not supported, said here. */
 static sl_node *primary(parser *p)
 {
     sl_node *n = primary_inner(p);
     if (check(p, SL_TOK_MINUS) && peek_kind(p, 0) == SL_TOK_GT) {
-        error_at(p, p->cur.pos, &p->cur, "method calls with '->' (RSL 2 co-shaders) are not "
-                 "supported: " SL_COSHADER_HELP);
+        coshader_error(p, "method calls with '->'");
         return error_node(p, p->cur.pos);
     }
     return n;
@@ -533,8 +547,8 @@ static bool decl_spec(parser *p, declspec *spec, const char *context)
         advance(p);
     }
     if (check(p, SL_TOK_IDENT) && strcmp(p->cur.text, "shader") == 0) {
-        error_at(p, p->cur.pos, &p->cur, "'shader' variables (RSL 2 co-shaders) are not "
-                 "supported: " SL_COSHADER_HELP);
+        coshader_error(p, strstr(context, "parameter") ? "'shader' parameters"
+                                                       : "'shader' variables");
         return false;
     }
     if (!is_type_kw(p->cur.kind)) {
@@ -665,10 +679,20 @@ static void formals(parser *p, const sl_token *open, sl_node ***list, int *n, sl
     int cap = 0;
     while (!check(p, SL_TOK_RPAREN) && !check(p, SL_TOK_EOF)) {
         if (!formal_group(p, list, n, &cap, kind)) {
-            /* skip to ')' */
+            /* skip to ')', over an array default '= { ... }' (a co-shader
+             * list 'shader layers[] = {}' says one thing, not two) */
             while (!check(p, SL_TOK_RPAREN) && !check(p, SL_TOK_EOF) &&
-                   !check(p, SL_TOK_LBRACE))
+                   !check(p, SL_TOK_LBRACE)) {
+                bool braces = check(p, SL_TOK_ASSIGN) && peek_kind(p, 0) == SL_TOK_LBRACE;
                 advance(p);
+                for (int depth = 0; braces && !check(p, SL_TOK_EOF); advance(p)) {
+                    depth += check(p, SL_TOK_LBRACE) - check(p, SL_TOK_RBRACE);
+                    if (depth == 0) {
+                        advance(p);
+                        break;
+                    }
+                }
+            }
             break;
         }
         if (!match(p, SL_TOK_SEMICOLON) && !match(p, SL_TOK_COMMA))

@@ -132,7 +132,10 @@ typedef struct sl_limits {
 } sl_limits;
 
 enum { SL_SPACE_CURRENT, SL_SPACE_WORLD, SL_SPACE_OBJECT, SL_SPACE_SHADER,
-       SL_SPACE_CAMERA, SL_SPACE__COUNT };
+       SL_SPACE_CAMERA, SL_SPACE__COUNT,
+       /* the projective spaces, made by the VM from "camera" and the
+        * camera's projection (sl_vm_set_projection), not in sl_spaces */
+       SL_SPACE_SCREEN = SL_SPACE__COUNT, SL_SPACE_NDC, SL_SPACE_RASTER, SL_SPACE__NAMED };
 
 /* For each named space, the matrix from that space to "current" and back
  * (util/vecmath.h conventions). transform("object", P) applies
@@ -181,6 +184,22 @@ void sl_vm_destroy(sl_vm **self_p);
  * every evaluation sets them), so *spaces must stay alive and unchanged
  * until the VM's last run with them or the next call; NULL: identity. */
 void sl_vm_set_spaces(sl_vm *self, const sl_spaces *spaces);
+/* The camera's projection, for the "screen", "NDC" and "raster" spaces (RI
+ * Spec 3.2 §4.1, RenderMan's conventions): "screen" is "camera" after
+ * screen_from_camera (projective: a perspective one divides by camera z,
+ * which interval and affine runs do with their conservative division),
+ * "NDC" maps the screen window (left, right, bottom, top) to [0, 1] x
+ * [0, 1] with y down, "raster" is NDC times the resolution; z is screen
+ * z throughout. Copied. Default: screen = camera, window [-1, 1]^2, 1 x 1
+ * pixels. sl_projection_perspective/_orthographic make the matrix of the
+ * RIB's Projection. */
+void sl_vm_set_projection(sl_vm *self, const mat4 *screen_from_camera,
+                          const double window[4], int xres, int yres);
+/* x and y divided by z tan(fov / 2), z from near..far to 0..1 (of 1/z):
+ * the standard homogeneous perspective (w = camera z). */
+mat4 sl_projection_perspective(double fov_degrees, double near, double far);
+/* x and y kept, z from near..far to 0..1. */
+mat4 sl_projection_orthographic(double near, double far);
 void sl_vm_set_lights(sl_vm *self, sl_light_fn fn, void *user);
 /* The textures that texture(), environment(), bump() and textureinfo()
  * read (tex/tex.h; shared by the VMs of a process; NULL: none, a lookup is

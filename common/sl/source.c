@@ -198,17 +198,17 @@ const char *sl_source_set_line(const sl_source_set *self, const char *name,
     if (!src || line < 1)
         return NULL;
     const char *p = src->text, *end = src->text + src->len;
+    /* a line ends in LF, CR-LF or a lone CR (as sl_scanner_clean reads it) */
     for (int l = 1; l < line; l++) {
-        p = memchr(p, '\n', (size_t)(end - p));
-        if (!p)
+        while (p < end && *p != '\n' && *p != '\r')
+            p++;
+        if (p == end)
             return NULL;
-        p++;
+        p += *p == '\r' && p + 1 < end && p[1] == '\n' ? 2 : 1;
     }
-    const char *eol = memchr(p, '\n', (size_t)(end - p));
-    if (!eol)
-        eol = end;
-    if (eol > p && eol[-1] == '\r')
-        eol--;
+    const char *eol = p;
+    while (eol < end && *eol != '\n' && *eol != '\r')
+        eol++;
     *len = (size_t)(eol - p);
     return p;
 }

@@ -47,6 +47,9 @@ sl_vm *sl_vm_new(const sl_limits *limits)
     self->near = 0;
     self->far = 1;
     self->depth_stale = true;
+    static const double unit_window[4] = { -1, 1, -1, 1 };
+    mat4 id = mat4_identity();
+    sl_vm_set_projection(self, &id, unit_window, 1, 1);
     sl_vm_set_message(self, SL_MSG_RENDERERINFO, "renderer", SL_TYPE_STRING, NULL, "aafarm");
     self->f = xcalloc(SL_MAX_SLOTS, sizeof *self->f);
     self->d = xcalloc(SL_MAX_SLOTS, sizeof *self->d);
@@ -100,6 +103,61 @@ void sl_vm_set_spaces(sl_vm *self, const sl_spaces *spaces)
 {
     self->spaces = spaces ? spaces : &self->identity;
     self->depth_stale = true;           /* made when a shader asks for it */
+    self->proj_stale = true;
+}
+
+void sl_vm_set_projection(sl_vm *self, const mat4 *screen_from_camera,
+                          const double window[4], int xres, int yres)
+{
+    double l = window[0], r = window[1], b = window[2], t = window[3];
+    self->screen_from_camera = *screen_from_camera;
+    mat4 n = mat4_identity();
+    n.m[0][0] = 1 / (r - l);
+    n.m[0][3] = -l / (r - l);
+    n.m[1][1] = -1 / (t - b);            /* y down: top is 0 */
+    n.m[1][3] = t / (t - b);
+    self->ndc_from_screen = n;
+    self->raster_from_ndc = mat4_scale(xres, yres, 1);
+    self->proj_stale = true;
+}
+
+mat4 sl_projection_perspective(double fov_degrees, double near, double far)
+{
+    double k = 1 / tan(fov_degrees * (M_PI / 360));
+    mat4 m = mat4_identity();
+    m.m[0][0] = m.m[1][1] = k;
+    m.m[2][2] = far / (far - near);
+    m.m[2][3] = -far * near / (far - near);
+    m.m[3][2] = 1;
+    m.m[3][3] = 0;
+    return m;
+}
+
+mat4 sl_projection_orthographic(double near, double far)
+{
+    mat4 m = mat4_identity();
+    m.m[2][2] = 1 / (far - near);
+    m.m[2][3] = -near / (far - near);
+    return m;
+}
+
+/* screen, NDC, raster from "current" (each the last one's, times its map)
+ * and back (the inverse of each map, then camera -> current). */
+static void update_projection(sl_vm *self)
+{
+    const mat4 *maps[3] = { &self->screen_from_camera, &self->ndc_from_screen,
+                            &self->raster_from_ndc };
+    mat4 from = self->spaces->from_current[SL_SPACE_CAMERA];
+    mat4 to = self->spaces->to_current[SL_SPACE_CAMERA];
+    for (int k = 0; k < 3; k++) {
+        mat4 inv;
+        mat4_invert(maps[k], &inv);         /* singular (a flat window): identity */
+        from = mat4_mul(*maps[k], from);
+        to = mat4_mul(to, inv);
+        self->proj_from[k] = from;
+        self->proj_to[k] = to;
+    }
+    self->proj_stale = false;
 }
 
 /* ---- light shaders ---- */
@@ -456,6 +514,11 @@ const mat4 *sl_vm_space_id(sl_vm *vm, int space, int dir)
     if (space == SL_SPACE_DEPTH) {
         if (vm->depth_stale) update_depth(vm);
         return &vm->depth;
+    }
+    if (space >= SL_SPACE_SCREEN && space < SL_SPACE__NAMED) {
+        if (vm->proj_stale) update_projection(vm);
+        return dir == SL_SPACE_TO_CURRENT ? &vm->proj_to[space - SL_SPACE_SCREEN]
+                                          : &vm->proj_from[space - SL_SPACE_SCREEN];
     }
     if (space < 0 || space >= SL_SPACE__COUNT)
         return NULL;

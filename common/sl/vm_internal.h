@@ -112,6 +112,12 @@ struct sl_vm {
     double near, far;             /* clipping planes, for depth() */
     mat4 depth;                   /* current -> camera, z to depth */
     bool depth_stale;             /* depth not yet made from spaces, near, far */
+    /* sl_vm_set_projection: camera -> screen -> NDC -> raster, and the
+     * three spaces from and to "current" made from them and "camera" when
+     * a shader first asks after the spaces change (proj_stale) */
+    mat4 screen_from_camera, ndc_from_screen, raster_from_ndc;
+    mat4 proj_from[3], proj_to[3];
+    bool proj_stale;
     sl_light_fn light_fn;
     void *light_user;
     sl_tracer tracer;             /* trace() and shadow(); zeroed: none */

@@ -35,6 +35,12 @@ static sl_vm *new_vm(const trace_world *world)
     double format[3] = {cam->xres, cam->yres, 1.0};
     double clipping[3] = {cam->near_clip, cam->far_clip, 0.0};
     sl_vm_set_clipping(vm, cam->near_clip, cam->far_clip);
+    /* "screen", "NDC", "raster": the projection trace_camera_ray inverts */
+    double fov = atan(cam->tan_half_fov) * (360.0 / M_PI);
+    mat4 screen = cam->orthographic ? sl_projection_orthographic(cam->near_clip, cam->far_clip)
+                                    : sl_projection_perspective(fov, cam->near_clip,
+                                                                cam->far_clip);
+    sl_vm_set_projection(vm, &screen, cam->screen, cam->xres, cam->yres);
     sl_vm_set_textures(vm, world->textures);
     sl_vm_set_message(vm, SL_MSG_OPTION, "Format", SL_TYPE_POINT, format, NULL);
     sl_vm_set_message(vm, SL_MSG_OPTION, "Clipping", SL_TYPE_POINT, clipping, NULL);

@@ -140,11 +140,12 @@ static void mutate(buffer *b)
     }
 }
 
+/* Lines end in LF, CR-LF or a lone CR (rib_lexer.c). */
 static int count_lines(const char *text, size_t len)
 {
     int n = 1;
     for (size_t i = 0; i < len; i++)
-        n += text[i] == '\n';
+        n += text[i] == '\n' || (text[i] == '\r' && (i + 1 == len || text[i + 1] != '\n'));
     return n;
 }
 

@@ -534,6 +534,31 @@ static void test_comments_and_layout(void **state)
     scene_destroy(&s);
 }
 
+/* Classic Mac RIB files end lines in a lone CR: comments end there, a
+ * string continues over a backslash before CR or CR-LF, and positions
+ * (line:col) count CR, CR-LF and LF alike. */
+static void test_cr_line_ends(void **state)
+{
+    (void)state;
+    const char *text = "##RenderMan RIB-Structure 1.1\r# a comment Format 1 1 1\r"
+        "Format 64 32 1\rProjection \"perspective\" \"fov\" 45\r\n"
+        "WorldBegin\rAttribute \"identifier\" \"name\" \"a\\\rb\\\r\nc\"\r"
+        "Sphere 1 -1 1 360\rWorldEnd\r";
+    scene *s = parse_ok(text);
+    assert_int_equal(s->camera.xres, 64);
+    assert_true(s->camera.fov == 45);
+    assert_string_equal(s->objects[0].name, "abc");
+    assert_int_equal(s->objects[0].pos.line, 9);
+    assert_int_equal(s->objects[0].pos.col, 1);
+    scene_destroy(&s);
+    sl_diag *d;
+    s = parse_rib("# frames\rFormat 64 32 1\r\n  FrameBegin 1.5\r", &d);
+    assert_null(s);
+    assert_string_equal(diag_line(nth_diag(d, SL_DIAG_ERROR, 0)),
+        "t.rib:3:14: FrameBegin: the frame number must be a whole number 0..99999999, got 1.5");
+    sl_diag_destroy(&d);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -554,6 +579,7 @@ int main(void)
         cmocka_unit_test(test_frames),
         cmocka_unit_test(test_light_before_world),
         cmocka_unit_test(test_comments_and_layout),
+        cmocka_unit_test(test_cr_line_ends),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -316,6 +316,23 @@ static void test_positions_crlf(void **state)
                         "x@1:1 =@1:3 1@1:5 ;@1:6 y@2:1 z@3:3");
 }
 
+/* classic Mac files end lines in a lone CR; a file may mix all three */
+static void test_positions_cr(void **state)
+{
+    (void)state;
+    assert_string_equal(lex("x = 1;\ry\r  z"),
+                        "x@1:1 =@1:3 1@1:5 ;@1:6 y@2:1 z@3:3");
+    teardown(NULL);
+    setup(NULL);
+    assert_string_equal(lex("a\rb\r\nc\nd\r\re // f\rg"),
+                        "a@1:1 b@2:1 c@3:1 d@4:1 e@6:1 g@7:1");
+    teardown(NULL);
+    setup(NULL);
+    /* a splice before a lone CR, and a comment ended by one */
+    assert_string_equal(lex("ab\\\rcd ef\\\r\ngh /* x\r */ i"),
+                        "abcd@1:1 efgh@2:4 i@4:5");
+}
+
 static void test_positions_line_splices(void **state)
 {
     (void)state;
@@ -767,6 +784,19 @@ static void test_source_set_lines(void **state)
     assert_null(sl_source_set_line(set, "l.sl", 5, &len));
     assert_null(sl_source_set_line(set, "l.sl", 0, &len));
     assert_null(sl_source_set_line(set, "m.sl", 1, &len));
+    add("cr.sl", "one\rtwo\r\rfour\r\nfive");
+    p = sl_source_set_line(set, "cr.sl", 2, &len);
+    assert_int_equal(len, 3);
+    assert_memory_equal(p, "two", 3);
+    p = sl_source_set_line(set, "cr.sl", 3, &len);
+    assert_int_equal(len, 0);
+    p = sl_source_set_line(set, "cr.sl", 4, &len);
+    assert_int_equal(len, 4);
+    assert_memory_equal(p, "four", 4);
+    p = sl_source_set_line(set, "cr.sl", 5, &len);
+    assert_int_equal(len, 4);
+    assert_memory_equal(p, "five", 4);
+    assert_null(sl_source_set_line(set, "cr.sl", 6, &len));
 }
 
 static void test_source_load_file(void **state)
@@ -894,6 +924,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_interned_identifiers, setup, teardown),
         cmocka_unit_test_setup_teardown(test_kind_names, setup, teardown),
         cmocka_unit_test_setup_teardown(test_positions_tabs_and_lines, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_positions_cr, setup, teardown),
         cmocka_unit_test_setup_teardown(test_positions_crlf, setup, teardown),
         cmocka_unit_test_setup_teardown(test_positions_line_splices, setup, teardown),
         cmocka_unit_test_setup_teardown(test_comments, setup, teardown),

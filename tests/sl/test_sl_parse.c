@@ -12,6 +12,7 @@
 #include <stdint.h>
 #include <cmocka.h>
 
+#include "sl/ast.h"
 #include "sl_harness.h"
 
 /* Compiling `src` fails with exactly `expected` as diagnostics. */
@@ -303,15 +304,15 @@ static void test_calls(void **state)
                   "t.sl:1:7: note: 'f' declared here\n"
                   "float f(float a; float b) { return a + b; }\n"
                   "      ^\n");
-    expect_errors("displacement t() {\n    P = transform(\"raster\", P);\n"
-                  "    P = point \"screen\" (0, 0, 0);\n    color c = color \"cmyk\" (1, 0, 0);\n}\n",
-                  "t.sl:2:19: error: unknown space 'raster' (known: \"current\", \"world\", "
-                  "\"object\", \"shader\", \"camera\")\n"
-                  "    P = transform(\"raster\", P);\n"
+    expect_errors("displacement t() {\n    P = transform(\"eye\", P);\n"
+                  "    P = point \"ndc\" (0, 0, 0);\n    color c = color \"cmyk\" (1, 0, 0);\n}\n",
+                  "t.sl:2:19: error: unknown space 'eye' (known: \"current\", \"world\", "
+                  "\"object\", \"shader\", \"camera\", \"screen\", \"NDC\", \"raster\")\n"
+                  "    P = transform(\"eye\", P);\n"
                   "                  ^\n"
-                  "t.sl:3:9: error: unknown space 'screen' (known: \"current\", \"world\", "
-                  "\"object\", \"shader\", \"camera\")\n"
-                  "    P = point \"screen\" (0, 0, 0);\n"
+                  "t.sl:3:9: error: unknown space 'ndc' (known: \"current\", \"world\", "
+                  "\"object\", \"shader\", \"camera\", \"screen\", \"NDC\", \"raster\")\n"
+                  "    P = point \"ndc\" (0, 0, 0);\n"
                   "        ^\n"
                   "t.sl:4:15: error: unknown color space 'cmyk' (known: \"rgb\", \"hsv\", "
                   "\"hsl\", \"xyz\", \"XYZ\", \"xyY\", \"YIQ\")\n"
@@ -363,6 +364,67 @@ static void test_recursion(void **state)
 /* what is accepted                                                        */
 /* ---------------------------------------------------------------------- */
 
+/* User functions take up to SL_MAX_FUNC_PARAMS parameters: a definition
+ * or a call beyond it is one clear error; a built-in's list is shorter. */
+static void test_parameter_limits(void **state)
+{
+    (void)state;
+    static char src[1 << 14];
+    size_t o = (size_t)snprintf(src, sizeof src, "float wide(float a0");
+    for (int i = 1; i < SL_MAX_FUNC_PARAMS + 1; i++)
+        o += (size_t)snprintf(src + o, sizeof src - o, ", a%d", i);
+    o += (size_t)snprintf(src + o, sizeof src - o, ") { return a0; }\n"
+                          "displacement t() {\n    P += wide(1");
+    for (int i = 1; i < SL_MAX_FUNC_PARAMS + 1; i++)
+        o += (size_t)snprintf(src + o, sizeof src - o, ", 1");
+    snprintf(src + o, sizeof src - o, ") * N;\n}\n");
+    char *text = NULL;
+    sl_program *p = h_compile_named("t.sl", src, &text);
+    assert_null(p);
+    assert_non_null(strstr(text, "t.sl:1:7: error: function 'wide' has 256 parameters; at "
+                                 "most 255 are supported: pass some of them in arrays\n"));
+    assert_non_null(strstr(text, "t.sl:3:10: error: too many arguments in call to 'wide' "
+                                 "(256; a function takes at most 255)\n"));
+    free(text);
+    expect_errors("displacement t() {\n    P += sin(1, 2, 3, 4, 5, 6, 7, 8, 9) * N;\n}\n",
+                  "t.sl:2:10: error: too many arguments in call to 'sin' (9; this built-in "
+                  "takes at most 8)\n"
+                  "    P += sin(1, 2, 3, 4, 5, 6, 7, 8, 9) * N;\n"
+                  "         ^\n");
+}
+
+/* The overloads of one name nested in one block come into scope together
+ * (each body may call the others); code outside them calls the group once
+ * all of it is defined. */
+static void test_nested_overload_group(void **state)
+{
+    (void)state;
+    expect_errors("displacement t() {\n"
+                  "    float h(float x) { float y; h(x, y); return y; }\n"
+                  "    float a = h(s);\n"
+                  "    void h(float x; output float y) { extern float a; y = x * a; }\n"
+                  "    P += a * N;\n}\n",
+                  "t.sl:3:15: error: 'h' is called before all its overloads in this block are "
+                  "defined: move the call after the definition at line 4\n"
+                  "    float a = h(s);\n"
+                  "              ^\n");
+    expect_ok("displacement t() {\n"
+              "    float h(float x) { float y; h(x, y); return y; }\n"
+              "    void h(float x; output float y) { y = x * 2; }\n"
+              "    P += h(s) * N;\n}\n");
+    /* a later definition with the same parameters is still a redefinition */
+    expect_errors("displacement t() {\n"
+                  "    float h(float x) { return x; }\n"
+                  "    float h(float y) { return y; }\n"
+                  "    P += h(s) * N;\n}\n",
+                  "t.sl:3:11: error: redefinition of function 'h'\n"
+                  "    float h(float y) { return y; }\n"
+                  "          ^\n"
+                  "t.sl:2:11: note: previous definition is here\n"
+                  "    float h(float x) { return x; }\n"
+                  "          ^\n");
+}
+
 static void test_accepted_forms(void **state)
 {
     (void)state;
@@ -408,6 +470,8 @@ int main(void)
         cmocka_unit_test(test_calls),
         cmocka_unit_test(test_control_flow_errors),
         cmocka_unit_test(test_recursion),
+        cmocka_unit_test(test_parameter_limits),
+        cmocka_unit_test(test_nested_overload_group),
         cmocka_unit_test(test_accepted_forms),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

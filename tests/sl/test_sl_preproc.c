@@ -627,6 +627,24 @@ static void test_include_nested_relative(void **state)
     assert_string_equal(diags(), "");
 }
 
+/* A classic Mac header (lone CR line ends) included from a CR-LF file:
+ * each directive ends at its line, a #define continues over a backslash
+ * before CR, and positions and the quoted source line stay right. */
+static void test_include_cr_line_ends(void **state)
+{
+    (void)state;
+    add("main.sl", "#include \"mac.h\"\r\n#define TWICE(x) \\\r\n    ((x) * 2)\r\n"
+                   "TWICE(HALF) after\r\n");
+    add("mac.h", "#ifndef MAC_H\r#define MAC_H\r#define HALF \\\r  0.5\r"
+                 "float mac;\r#endif\r  $\r");
+    assert_string_equal(run("main.sl", NULL, true),
+                        "float@mac.h:5:1 mac@mac.h:5:7 ;@mac.h:5:10 (@4:1 (@4:1 0.5@4:7 "
+                        ")@4:1 *@4:1 2@4:1 )@4:1 after@4:13");
+    assert_string_equal(diags(), "mac.h:7:3: error: unexpected character '$'\n"
+                                 "  $\n"
+                                 "  ^\n");
+}
+
 static void test_include_guard(void **state)
 {
     (void)state;
@@ -1450,6 +1468,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_pragma_ignored, setup, teardown),
         cmocka_unit_test_setup_teardown(test_include_relative_and_search_path, setup, teardown),
         cmocka_unit_test_setup_teardown(test_include_nested_relative, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_include_cr_line_ends, setup, teardown),
         cmocka_unit_test_setup_teardown(test_include_guard, setup, teardown),
         cmocka_unit_test_setup_teardown(test_include_macros_cross_files, setup, teardown),
         cmocka_unit_test_setup_teardown(test_include_missing, setup, teardown),

@@ -145,6 +145,49 @@ static void run_float_body(const char *body, double u, double v, double P[3])
     sl_program_destroy(&p);
 }
 
+/* The optional parameters as shader libraries pass them: the ones a
+ * lookup has no use for ("samples", "filter", "lerp"; "width" outside the
+ * four-corner form) compile with one warning per name and function in a
+ * shader; the used ones ("blur", "fill", "width" with four corners) with
+ * none; and the ignored ones change nothing. */
+static void test_optional_parameters(void **state)
+{
+    (void)state;
+    char *diag = NULL;
+    sl_program *p = compile_body(
+        "float a = texture(map, s, t, \"samples\", 16, \"filter\", \"gaussian\", "
+        "\"blur\", 0.01);\n"
+        "float b = texture(map, s, t, \"samples\", 4, \"width\", 2, \"lerp\", 1);\n"
+        "color c = environment(\"rgb.tx\", N, \"samples\", 4, \"fill\", 0);\n"
+        "float d = texture(map, s, t, s, t, s, t, s, t, \"width\", 2);\n"
+        "P = point(a, b, comp(c, 0) + d);", &diag);
+    assert_non_null(p);
+    static const char *const want[] = {
+        "t.sl:1:82: warning: texture() parameter 'samples' is accepted and ignored: aafarm "
+        "filters each lookup one way, over the footprint it bounds (docs/textures.md) (said "
+        "once per shader)\n",
+        "t.sl:1:97: warning: texture() parameter 'filter'",
+        "t.sl:2:44: warning: texture() parameter 'width' is accepted and ignored: only the "
+        "four-corner form of texture() has a footprint to widen (use \"blur\")",
+        "t.sl:2:56: warning: texture() parameter 'lerp'",
+        "t.sl:3:36: warning: environment() parameter 'samples'",
+    };
+    for (size_t k = 0; k < sizeof want / sizeof want[0]; k++)
+        if (!strstr(diag, want[k]))
+            fail_msg("wanted '%s' in:\n%s", want[k], diag);
+    int warnings = 0;
+    for (const char *q = diag; (q = strstr(q, "warning: ")) != NULL; q++)
+        warnings++;
+    assert_int_equal(warnings, 5);
+    free(diag);
+    sl_program_destroy(&p);
+    double P[3], Q[3];
+    run_float_body("P = point(0, 0, texture(map, s, t, \"samples\", 16, \"filter\", "
+                   "\"gaussian\", \"lerp\", 1));", 0.3, 0.6, P);
+    run_float_body("P = point(0, 0, texture(map, s, t));", 0.3, 0.6, Q);
+    assert_true(P[2] == Q[2]);
+}
+
 static void test_float(void **state)
 {
     (void)state;
@@ -359,6 +402,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_compile),
+        cmocka_unit_test(test_optional_parameters),
         cmocka_unit_test(test_float),
         cmocka_unit_test(test_dual),
         cmocka_unit_test(test_containment),

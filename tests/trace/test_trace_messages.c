@@ -42,24 +42,71 @@
     "    Oi = 1;\n" \
     "}\n"
 
+/* the camera's projective spaces at the hit: raster x / 24, raster y / 16,
+ * NDC z (screen z: 0 at the near plane, 1 at the far one) */
+#define SHADER_SHOWRASTER \
+    "surface showraster()\n" \
+    "{\n" \
+    "    point r = transform(\"raster\", P);\n" \
+    "    point ndc = transform(\"NDC\", P);\n" \
+    "    Ci = color(xcomp(r) / 24, ycomp(r) / 16, zcomp(ndc));\n" \
+    "    Oi = 1;\n" \
+    "}\n"
+
 enum { W = 24, H = 16 };
 
-static void render(const char *displacement, float *rgba, float *z)
+static void render_with(const char *surface, const char *displacement, float *rgba, float *z)
 {
     char rib[1024];
     snprintf(rib, sizeof rib,
              "Format 24 16 1\nProjection \"perspective\" \"fov\" [40]\nClipping 1 11\n"
              "PixelSamples 1 1\nPixelFilter \"box\" 1 1\n"
-             "WorldBegin\nSides 1\nSurface \"showmsg\"\nDisplacement \"%s\"\n"
+             "WorldBegin\nSides 1\nSurface \"%s\"\nDisplacement \"%s\"\n"
              "Attribute \"displacementbound\" \"sphere\" [0.3]\n"
              "Patch \"bilinear\" \"P\" [-4 -4 6  4 -4 6  -4 4 6  4 4 6]\n"
-             "WorldEnd\n", displacement);
+             "WorldEnd\n", surface, displacement);
     fixture_shader sh[] = {{"lift", SHADER_LIFT}, {"flat", SHADER_FLAT},
-                           {"showmsg", SHADER_SHOWMSG}};
+                           {"showmsg", SHADER_SHOWMSG}, {"showraster", SHADER_SHOWRASTER}};
     fixture f;
-    assert_true(fixture_open(&f, rib, sh, 3, NULL, 0));
+    assert_true(fixture_open(&f, rib, sh, 4, NULL, 0));
     assert_true(fixture_render(&f, 8, 2, 0, rgba, z));
     fixture_close(&f);
+}
+
+static void render(const char *displacement, float *rgba, float *z)
+{
+    render_with("showmsg", displacement, rgba, z);
+}
+
+/* transform("raster", P) at each pixel's hit is inside that pixel (its one
+ * sample's raster position, to within the hit's leaf: 0.01 camera units,
+ * 0.04 pixels here), and NDC z is the perspective's screen z of the
+ * z channel: 11 (z - 1) / (10 z) for Clipping 1 11. */
+static void test_raster_and_ndc_spaces_match_the_camera(void **state)
+{
+    (void)state;
+    float *rgba = calloc(4 * W * H, sizeof *rgba), *z = calloc(W * H, sizeof *z);
+    assert_non_null(rgba);
+    assert_non_null(z);
+    render_with("showraster", "flat", rgba, z);
+    double worst_xy = 0, worst_z = 0;
+    for (int j = 0; j < H; j++) {
+        for (int i = 0; i < W; i++) {
+            const float *px = &rgba[4 * (j * W + i)];
+            assert_true(px[3] > 0.99f);
+            double rx = px[0] * W - (i + 0.5), ry = px[1] * H - (j + 0.5);
+            double dxy = fmax(fabs(rx), fabs(ry));
+            double zc = z[j * W + i], sz = 11 * (zc - 1) / (10 * zc);
+            worst_xy = fmax(worst_xy, dxy);
+            worst_z = fmax(worst_z, fabs(px[2] - sz));
+        }
+    }
+    printf("raster position of the hit - pixel centre <= %.3f pixels, |NDC z - screen z of "
+           "the z channel| <= %.2g\n", worst_xy, worst_z);
+    assert_true(worst_xy < 0.55);
+    assert_true(worst_z < 1e-3);
+    free(rgba);
+    free(z);
 }
 
 static void test_surface_reads_displacement_outputs_attributes_options_depth(void **state)
@@ -110,6 +157,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_surface_reads_displacement_outputs_attributes_options_depth),
         cmocka_unit_test(test_no_output_no_message),
+        cmocka_unit_test(test_raster_and_ndc_spaces_match_the_camera),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

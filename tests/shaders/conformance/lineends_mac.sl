@@ -1,0 +1,1 @@
+/* classic Mac line ends (CR alone) in the shader, CR-LF in its header, a * #define continued over lines in both */#include "lineends_crlf.h"#define WAVE(x, f) \    (0.5 + 0.5 * sin((x) * (f)))displacement lineends_mac(float freq = 4){    float w = WAVE(s, freq) * RAMP(t);    P = point(w, RAMP(s), t);}
