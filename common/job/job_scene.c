@@ -283,6 +283,9 @@ static bool build_objects(job_scene *self, sl_diag *diag)
     int nmeshes = 0;
     for (int i = 0; i < sc->nobjects; i++) nmeshes += sc->objects[i].mesh != NULL;
     self->meshes = xcalloc((size_t)(nmeshes > 0 ? nmeshes : 1), sizeof *self->meshes);
+    /* per scene mesh: the trace_mesh its undisplaced placements share */
+    int *undisplaced = xmalloc(sizeof *undisplaced * (size_t)(sc->nmeshes > 0 ? sc->nmeshes : 1));
+    for (int i = 0; i < sc->nmeshes; i++) undisplaced[i] = -1;
     size_t nprimvars = 0;
     for (int i = 0; i < sc->nobjects; i++) nprimvars += (size_t)sc->objects[i].nprimvars;
     self->primvars = xcalloc(nprimvars > 0 ? nprimvars : 1, sizeof *self->primvars);
@@ -312,18 +315,28 @@ static bool build_objects(job_scene *self, sl_diag *diag)
         build_primvars(o, t, next_primvar);
         next_primvar += o->nprimvars;
         if (o->mesh) {
-            trace_mesh *m = &self->meshes[self->nmeshes++];
-            m->npieces = scene_mesh_npieces(o->mesh);
-            m->nprimvars = scene_mesh_nprimvars(o->mesh);
-            m->piece = mesh_piece;
-            m->user = o;
+            /* the objects placing one undisplaced mesh share its pieces'
+             * boxes and BVH (object space, trace/mesh.h); a displaced one
+             * has its own (its shader runs in each object's camera space) */
+            int si = scene_mesh_index(o->mesh);
+            trace_mesh *m = !t->displacement && undisplaced[si] >= 0
+                                ? &self->meshes[undisplaced[si]] : NULL;
+            if (!m) {
+                if (!t->displacement) undisplaced[si] = self->nmeshes;
+                m = &self->meshes[self->nmeshes++];
+                m->npieces = scene_mesh_npieces(o->mesh);
+                m->nprimvars = scene_mesh_nprimvars(o->mesh);
+                m->piece = mesh_piece;
+                m->user = o;
+            }
             t->mesh = m;
-            continue;     /* instances of a mesh keep boxes of their own (for now) */
+            continue;
         }
         /* an instance proposes sharing its prototype's boxes (trace/instance.c) */
         if (o->instance_of >= 0 && o->instance_of < i)
             t->box_proto = &w->objects[o->instance_of];
     }
+    free(undisplaced);
     return true;
 }
 

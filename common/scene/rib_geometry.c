@@ -174,6 +174,7 @@ void rib_add_mesh(rib_parser *p, const rib_request *req, scene_mesh *mesh)
 {
     scene *s = p->scene;
     s->meshes = xreallocarray(s->meshes, (size_t)s->nmeshes + 1, sizeof *s->meshes);
+    scene_mesh_set_index(mesh, s->nmeshes);
     s->meshes[s->nmeshes++] = mesh;
     geom_surface none;
     memset(&none, 0, sizeof none);

@@ -340,6 +340,7 @@ scene_mesh *scene_mesh_new(const double *P, int npoints, const int *idx, int nid
 void scene_mesh_add_piece(scene_mesh *self, scene_piece_kind kind, int face, int fv0,
                           const int k[3], int ncorners);
 void scene_mesh_trim(scene_mesh *self);          /* frees the spare capacity */
+void scene_mesh_set_index(scene_mesh *self, int index);
 vec3 scene_mesh_corner_normal(scene_mesh_nclass ncls, const double *N, int face,
                               const int *idx, int fv0, int i);
 /* Hands a mesh (with pieces) to the scene, placed as one object with the

@@ -27,6 +27,7 @@ struct scene_mesh {
     size_t values_bytes;
     scene_mesh_piece *pieces;
     int npieces, cap;
+    int index;                     /* in scene.meshes (rib_add_mesh) */
 };
 
 static void *copy_of(const void *src, size_t bytes)
@@ -105,6 +106,9 @@ void scene_mesh_trim(scene_mesh *self)
 }
 
 int scene_mesh_npieces(const scene_mesh *self) { return self->npieces; }
+int scene_mesh_index(const scene_mesh *self) { return self->index; }
+
+void scene_mesh_set_index(scene_mesh *self, int index) { self->index = index; }
 int scene_mesh_nprimvars(const scene_mesh *self) { return self->pv.n; }
 
 size_t scene_mesh_bytes(const scene_mesh *self)

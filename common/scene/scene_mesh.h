@@ -52,6 +52,9 @@ typedef struct scene_mesh_piece {
     uint8_t unused;
 } scene_mesh_piece;
 
+/* Its index in scene.meshes. */
+int scene_mesh_index(const scene_mesh *self);
+
 /* The number of pieces, and of primitive variables each piece carries. */
 int scene_mesh_npieces(const scene_mesh *self);
 int scene_mesh_nprimvars(const scene_mesh *self);

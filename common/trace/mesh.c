@@ -27,7 +27,7 @@ enum { VIEW_SLOTS = 128 };
 
 typedef struct trace_views {
     trace_view slot[VIEW_SLOTS];
-    int key[VIEW_SLOTS];               /* the view's id; -1: empty */
+    int64_t key[VIEW_SLOTS];           /* the view's object and piece; -1: empty */
     trace_view hit;                    /* the hit a traversal returns */
     trace_view *held[TRACE_RAY_DEPTH_LIMIT + 1];   /* hits being shaded, per depth */
 } trace_views;
@@ -142,13 +142,15 @@ void trace_views_free(trace_thread *th)
 const trace_object *trace_mesh_view(trace_thread *th, const trace_object *mesh_obj, int k)
 {
     trace_views *vs = views_of(th);
-    int id = mesh_obj->mesh->first_id + k;
-    unsigned s = (unsigned)(((uint32_t)id * 0x9e3779b1u) >> 25);   /* 7 bits: VIEW_SLOTS */
+    /* the object and the piece: objects sharing a mesh share its ids */
+    int64_t key = (int64_t)mesh_obj->id << 32 | (uint32_t)k;
+    uint64_t h = (uint64_t)key * 0x9e3779b97f4a7c15ull;
+    unsigned s = (unsigned)(h >> 57);  /* 7 bits: VIEW_SLOTS */
     assert(s < VIEW_SLOTS);
-    if (vs->key[s] != id) {
+    if (vs->key[s] != key) {
         vs->key[s] = -1;
         if (!trace_mesh_view_make(th, mesh_obj, k, true, &vs->slot[s])) return NULL;
-        vs->key[s] = id;
+        vs->key[s] = key;
         th->stats.views_made++;
     }
     return &vs->slot[s].obj;
@@ -362,51 +364,60 @@ static void float_box(const trace_box *b, float f[6])
     f[3] = up(b->hi.x), f[4] = up(b->hi.y), f[5] = up(b->hi.z);
 }
 
-void trace_mesh_piece_bounds(const trace_object *obj, const geom_surface *s, float out[6])
+void trace_mesh_piece_bounds(const geom_surface *s, float out[6])
 {
-    trace_box root, bound;
+    trace_box root;
     geom_bounds(s, &root.lo, &root.hi);
-    root.flags = 0;
-    root.bend = 0.0f;
-    trace_box_no_slab(&root);
-    trace_object_camera_bound(obj, &root, &bound);
-    float_box(&bound, out);
+    float_box(&root, out);
+}
+
+static void free_bvh(struct trace_mesh_bvh **t)
+{
+    if (!*t) return;
+    free((*t)->nodes);
+    free((*t)->idx);
+    free(*t);
+    *t = NULL;
+}
+
+void trace_mesh_clear_bvh(trace_mesh *self)
+{
+    free_bvh(&self->bvh);
 }
 
 bool trace_mesh_build(trace_thread *th, trace_object *obj)
 {
     trace_mesh *m = obj->mesh;
     assert(m);
-    trace_box all = {.lo = v3(INFINITY, INFINITY, INFINITY),
-                     .hi = v3(-INFINITY, -INFINITY, -INFINITY)};
-    trace_box_no_slab(&all);
-    if (obj->displacement || !m->bounds) {
-        /* displaced: each piece's root box runs its shader (undisplaced:
-         * trace_world_prepare's pass over the pieces made the bounds) */
-        free(m->bounds);
-        m->bounds = xmalloc(sizeof *m->bounds * (size_t)(m->npieces > 0 ? m->npieces : 1));
-        trace_view *v = xmalloc(sizeof *v);
-        for (int k = 0; k < m->npieces; k++) {
-            if ((k & 255) == 0 && trace_thread_cancelled(th)) break;
-            if (!make(th, obj, k, true, false, v)) break;
-            float_box(&v->obj.bound, m->bounds[k]);
+    if (!m->bvh) {                     /* not yet made for another object sharing m */
+        if (obj->displacement || !m->bounds) {
+            /* displaced: each piece's root box runs its shader (undisplaced:
+             * trace_world_prepare's pass over the pieces made the bounds) */
+            free(m->bounds);
+            m->bounds = xmalloc(sizeof *m->bounds * (size_t)(m->npieces > 0 ? m->npieces : 1));
+            trace_view *v = xmalloc(sizeof *v);
+            for (int k = 0; k < m->npieces; k++) {
+                if ((k & 255) == 0 && trace_thread_cancelled(th)) break;
+                if (!make(th, obj, k, true, false, v)) break;
+                float_box(&v->obj.root, m->bounds[k]);
+            }
+            free(v);
         }
-        free(v);
+        if (th->failed) return false;
+        m->bvh = bvh_build((const float (*)[6])m->bounds, m->npieces);
     }
-    if (th->failed) return false;
-    for (int k = 0; k < m->npieces; k++) {
-        const float *f = m->bounds[k];
-        trace_box b = {.lo = v3(f[0], f[1], f[2]), .hi = v3(f[3], f[4], f[5])};
-        trace_box_union(&all, &b);
+    /* the root: the union of the pieces' boxes (object space), the
+     * bound: its camera-space box, as any object's */
+    trace_box all = {.lo = v3(INFINITY, INFINITY, INFINITY),
+                     .hi = v3(-INFINITY, -INFINITY, -INFINITY), .flags = 0};
+    trace_box_no_slab(&all);
+    if (m->bvh->nnodes > 0) {
+        const mesh_node *r = &m->bvh->nodes[0];
+        all.lo = v3(r->lo[0], r->lo[1], r->lo[2]);
+        all.hi = v3(r->hi[0], r->hi[1], r->hi[2]);
     }
-    obj->bound = all;
-    obj->root = all;                   /* unused: a mesh object has no surface */
-    if (m->bvh) {
-        free(m->bvh->nodes);
-        free(m->bvh->idx);
-        free(m->bvh);
-    }
-    m->bvh = bvh_build((const float (*)[6])m->bounds, m->npieces);
+    obj->root = all;
+    trace_object_camera_bound(obj, &obj->root, &obj->bound);
     return true;
 }
 
@@ -424,12 +435,18 @@ static bool piece_hit(const float f[6], const trace_ray *ray, double tmax)
     return trace_box_hit(&b, ray, ray->tmin, tmax, &t0, &t1, NULL);
 }
 
-bool trace_mesh_intersect(trace_thread *th, const trace_object *obj, const trace_ray *ray,
+bool trace_mesh_intersect(trace_thread *th, const trace_object *obj, const trace_ray *cam_ray,
                           const trace_tolerance *tol, bool any, trace_hit *best)
 {
     const trace_mesh *m = obj->mesh;
     const struct trace_mesh_bvh *t = m->bvh;
     if (!t || t->nnodes == 0) return false;
+    /* the boxes are in object space: so is the ray (an affine map keeps
+     * its parameter t); the pieces take the camera-space ray */
+    trace_ray oray;
+    trace_ray_init(&oray, mat4_xform_point(&obj->from_camera, cam_ray->o),
+                   mat4_xform_vector(&obj->from_camera, cam_ray->d), cam_ray->tmin, cam_ray->tmax);
+    const trace_ray *ray = &oray;
     struct { int node; double t0; } stack[MESH_STACK];
     int sp = 0;
     double t0;
@@ -447,7 +464,7 @@ bool trace_mesh_intersect(trace_thread *th, const trace_object *obj, const trace
                 if (!piece_hit(m->bounds[k], ray, best->t)) continue;
                 const trace_object *v = trace_mesh_view(th, obj, k);
                 if (!v) return found;
-                if (trace_intersect_object(th, v, ray, tol, any, best)) {
+                if (trace_intersect_object(th, v, cam_ray, tol, any, best)) {
                     /* the hit outlives the cache slot: a copy in the hit slot */
                     trace_view_copy(&th->views->hit, (const trace_view *)v);
                     best->obj = &th->views->hit.obj;
@@ -482,14 +499,9 @@ void trace_mesh_clear(trace_mesh *self)
 {
     free(self->shared_edges);
     free(self->bounds);
-    if (self->bvh) {
-        free(self->bvh->nodes);
-        free(self->bvh->idx);
-        free(self->bvh);
-    }
+    free_bvh(&self->bvh);
     self->shared_edges = NULL;
     self->bounds = NULL;
-    self->bvh = NULL;
 }
 
 size_t trace_mesh_bytes(const trace_mesh *self)

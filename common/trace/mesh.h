@@ -1,7 +1,8 @@
 /*
  * mesh.h: mesh objects (issue 23): one world object for the many pieces
  * of a polygon mesh (trace_mesh in world.h), a BVH over the pieces'
- * camera-space boxes, and the "views" that make a piece a full
+ * object-space boxes (shared by the objects that place one undisplaced
+ * mesh: instances), and the "views" that make a piece a full
  * trace_object where a ray reaches it.
  *
  * A view is piece k of mesh object M: M's transforms, shaders and
@@ -56,12 +57,16 @@ const trace_object *trace_object_piece(trace_thread *th, const trace_object *obj
 /* Copies a view (its primitive variables point at its own copy). */
 void trace_view_copy(trace_view *dst, const trace_view *src);
 
-/* The camera-space float box of an undisplaced piece s of mesh object
- * obj (its bounds, rounded outward). */
-void trace_mesh_piece_bounds(const trace_object *obj, const geom_surface *s, float out[6]);
+/* The object-space float box of an undisplaced piece s (its bounds,
+ * rounded outward). */
+void trace_mesh_piece_bounds(const geom_surface *s, float out[6]);
 
-/* The pieces' boxes and BVH of mesh object obj, and its camera-space
- * bound (their union); false when the thread failed or was cancelled. */
+/* Frees the mesh's BVH (trace_mesh_build makes it again). */
+void trace_mesh_clear_bvh(trace_mesh *self);
+
+/* The pieces' boxes and BVH of mesh object obj's mesh (once for the
+ * objects that share it), and obj's root (their union, object space) and
+ * camera-space bound; false when the thread failed or was cancelled. */
 bool trace_mesh_build(trace_thread *th, trace_object *obj);
 
 /* Nearest hit of the camera-space ray with the mesh's pieces in

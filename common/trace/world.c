@@ -190,9 +190,10 @@ static void mark_shared(trace_world *world, const int *meshes, int nmeshes, uint
  * calls, whose shared vertices are the same numbers under the same
  * transform): the hit proofs (intersect.c) stay off near them, where the
  * neighbour's leaves decide. Sorted by their hashes, so equal edges are
- * neighbours: O(n log n) for meshes of any size. The same pass over a
- * mesh's pieces keeps the camera-space bounds of the undisplaced ones
- * (trace_mesh_build needs no second one). */
+ * neighbours: O(n log n) for meshes of any size. A mesh that several
+ * objects place is seen once, under its first object's transform. The
+ * same pass over a mesh's pieces keeps the object-space bounds of the
+ * undisplaced ones (trace_mesh_build needs no second one). */
 static void find_shared_edges(trace_world *world)
 {
     int nmeshes = 0;
@@ -201,7 +202,10 @@ static void find_shared_edges(trace_world *world)
     for (int i = 0; i < world->nobjects; i++) {
         trace_object *obj = &world->objects[i];
         obj->shared_edges = 0;
-        if (obj->mesh) {
+        if (obj->mesh && obj->mesh->first_id >= world->nobjects &&
+            (nmeshes == 0 || world->objects[meshes[nmeshes - 1]].mesh->first_id <
+                                 obj->mesh->first_id)) {
+            /* a mesh's first placing object (first_ids rise with them) */
             trace_mesh *m = obj->mesh;
             meshes[nmeshes++] = i;
             free(m->shared_edges);
@@ -219,6 +223,8 @@ static void find_shared_edges(trace_world *world)
     for (int i = 0; i < world->nobjects; i++) {
         trace_object *obj = &world->objects[i];
         trace_mesh *m = obj->mesh;
+        if (m && owner_of_id(world, meshes, nmeshes, m->first_id) != obj)
+            continue;                  /* a mesh another object placed first */
         if (m && !obj->displacement && !m->bounds)
             m->bounds = xmalloc(sizeof *m->bounds * (size_t)(m->npieces > 0 ? m->npieces : 1));
         int npieces = m ? m->npieces : 1;
@@ -229,7 +235,7 @@ static void find_shared_edges(trace_world *world)
                 id = m->first_id + k;
                 if (!m->piece(m->user, obj, k, tmp, NULL)) continue;
                 s = tmp;
-                if (!obj->displacement) trace_mesh_piece_bounds(obj, s, m->bounds[k]);
+                if (!obj->displacement) trace_mesh_piece_bounds(s, m->bounds[k]);
             }
             if (s->kind != GEOM_POLYGON) continue;
             for (int j = 0; j < s->nuv && j < 64; j++) {
@@ -279,11 +285,20 @@ bool trace_world_prepare(trace_world *world, char *err, size_t errsz)
                                  !sl_program_reads_global(dp, SL_G_dPdu) &&
                                  !sl_program_reads_global(dp, SL_G_dPdv);
     }
-    /* ids: the objects, then each mesh's pieces */
+    /* ids: the objects, then each mesh's pieces (once per mesh: the
+     * objects sharing it share them); its boxes and BVH made anew */
+    for (int i = 0; i < world->nobjects; i++)
+        if (world->objects[i].mesh) {
+            trace_mesh *m = world->objects[i].mesh;
+            m->first_id = -1;
+            free(m->bounds);
+            m->bounds = NULL;
+            trace_mesh_clear_bvh(m);
+        }
     long next = world->nobjects;
     for (int i = 0; i < world->nobjects; i++) {
         trace_mesh *m = world->objects[i].mesh;
-        if (!m) continue;
+        if (!m || m->first_id >= 0) continue;
         if (next + m->npieces > INT32_MAX / 64) {
             return err_set(err, errsz, "%s: too many mesh pieces in the scene (%ld before "
                            "this mesh's %d)", world->objects[i].name, next - world->nobjects,

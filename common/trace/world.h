@@ -47,7 +47,11 @@ struct trace_mesh_bvh;
 /* A mesh (issue 23, trace/mesh.h): ONE world object that stands for many
  * pieces (the faces of a PointsPolygons, or triangles of them), kept by
  * whoever built the world as a source of pieces and made into a full
- * trace_object (a "view") only where a ray reaches the piece. */
+ * trace_object (a "view") only where a ray reaches the piece. Its boxes
+ * and BVH are in the mesh's OBJECT space, so the objects that place one
+ * undisplaced mesh (instances) may share one trace_mesh: a displaced one
+ * has a trace_mesh per object (its boxes run its shader in that object's
+ * camera space). */
 typedef struct trace_mesh {
     int npieces;
     int nprimvars;                 /* each piece's primitive variables */
@@ -61,10 +65,13 @@ typedef struct trace_mesh {
     const void *user;
     /* derived: trace_world_prepare, trace_renderer_new (trace_mesh_clear
      * frees them) */
-    int first_id;                  /* piece k's object id is first_id + k */
-    uint64_t *shared_edges;        /* per piece, as trace_object.shared_edges */
-    float (*bounds)[6];            /* per piece: camera-space box (lo, hi),
-                                      rounded outward from its bound */
+    int first_id;                  /* piece k's object id is first_id + k (-1:
+                                      not given yet); shared by the objects
+                                      that share the mesh */
+    uint64_t *shared_edges;        /* per piece, as trace_object.shared_edges
+                                      (the first placing object's transform) */
+    float (*bounds)[6];            /* per piece: object-space box (lo, hi) of
+                                      its root box, rounded outward */
     struct trace_mesh_bvh *bvh;    /* over the pieces' bounds */
 } trace_mesh;
 
