@@ -23,6 +23,9 @@ PACKAGES=(
   libcmocka-dev     # unit and property tests
   protobuf-c-compiler libprotobuf-c-dev  # wire protocol schema
   libsodium-dev     # CurveZMQ: Debian's libzmq5 has CURVE through libsodium
+  libmicrohttpd-dev # the master's live monitor (--http)
+  libcurl4-openssl-dev libjson-c-dev  # the monitor's tests: HTTP requests, JSON
+  chromium          # the monitor's page in a headless browser (test_monitor_browser)
   iproute2          # the multi-host test's network namespaces (ip netns)
   openssh-client openssh-server  # deploy/ssh/farm.sh over a real sshd (test_deploy)
   shellcheck        # lints deploy/'s scripts (test_deploy)

@@ -19,7 +19,21 @@ struct console {
     int last_tenth;        /* last tenth of the image logged */
     int resumed;           /* tiles done before the start (--resume): not in the rate */
     char prefix[64];       /* before the tile counts: frames done in a sequence */
+    char tail[CONSOLE_TAIL][CONSOLE_TAIL_LINE];   /* a ring: the last lines logged */
+    int tail_next, tail_count;
 };
+
+int console_tail_count(const console *self)
+{
+    return self->tail_count;
+}
+
+const char *console_tail_line(const console *self, int i)
+{
+    if (i < 0 || i >= self->tail_count) return "";
+    int first = (self->tail_next - self->tail_count + CONSOLE_TAIL) % CONSOLE_TAIL;
+    return self->tail[(first + i) % CONSOLE_TAIL];
+}
 
 void console_set_prefix(console *self, const char *text)
 {
@@ -66,10 +80,23 @@ static void draw_line(console *self)
 
 void console_log(console *self, console_level level, const char *fmt, ...)
 {
-    if ((int)level > self->verbosity) return;
-    clear_line(self);
+    bool keep = level <= CONSOLE_INFO;
+    if ((int)level > self->verbosity && !keep) return;
     va_list ap;
     va_start(ap, fmt);
+    if (keep) {
+        va_list copy;
+        va_copy(copy, ap);
+        vsnprintf(self->tail[self->tail_next], CONSOLE_TAIL_LINE, fmt, copy);
+        va_end(copy);
+        self->tail_next = (self->tail_next + 1) % CONSOLE_TAIL;
+        if (self->tail_count < CONSOLE_TAIL) self->tail_count++;
+    }
+    if ((int)level > self->verbosity) {
+        va_end(ap);
+        return;
+    }
+    clear_line(self);
     fputs("aafarm-master: ", stderr);
     vfprintf(stderr, fmt, ap);
     fputc('\n', stderr);

@@ -36,6 +36,13 @@ void console_destroy(console **self_p);
 void console_log(console *self, console_level level, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));
 
+/* The log tail (the live monitor's, master/farm_monitor.c): the last
+ * CONSOLE_TAIL lines at CONSOLE_INFO or ERROR, kept whatever the
+ * verbosity, without the program's prefix; i = 0 is the oldest. */
+enum { CONSOLE_TAIL = 40, CONSOLE_TAIL_LINE = 400 };
+int console_tail_count(const console *self);
+const char *console_tail_line(const console *self, int i);
+
 /* The render's progress at time now_ms (elapsed since start_ms); redraws or
  * logs when due. final: the last call (always shown, ends the line). */
 /* Tiles that were done before the render started (--resume): the rate

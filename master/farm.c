@@ -313,6 +313,7 @@ void farm_frame_complete(farm *f, farm_frame *fr)
     }
     fr->written = true;
     f->frames_written++;
+    farm_monitor_frame_complete(f, fr);
     if (f->nframes > 1) {
         console_log(f->con, CONSOLE_INFO, "frame %d: wrote %s (%dx%d, %d tiles; %d of %d "
                     "frames done)", fr->jb->frame_number, fr->output, fr->fmt.width,
@@ -340,6 +341,7 @@ static bool replay_tile(void *arg, int tile, const void *chunk, size_t len, char
                                 err, errsz))
         return false;
     if (scheduler_mark_done(f->sched, fr->first + tile)) {
+        farm_monitor_tile(f, fr, tile, chunk, len, NULL);
         f->resumed_tiles++;
         fr->done++;
     }
@@ -449,11 +451,13 @@ static int setup(farm *f, char *err, size_t errsz)
         return AAFARM_EXIT_INPUT;
     }
     f->reg = registry_new();
+    farm_monitor_open(f);
     for (int i = 0; i < f->nframes; i++) {
         int rc = setup_frame(f, &f->frames[i], err, errsz);
         if (rc != AAFARM_EXIT_OK) return rc;
     }
     int rc = open_socket(f, err, errsz);
+    if (rc == AAFARM_EXIT_OK) rc = farm_monitor_serve(f, err, errsz);
     if (rc != AAFARM_EXIT_OK) return rc;
     return start_local_workers(f, err, errsz);
 }
@@ -655,6 +659,7 @@ static void run_loop(farm *f)
         farm_grant_all(f, now);
         console_progress(f->con, scheduler_tiles_done(f->sched), f->ntiles,
                          registry_alive(f->reg), f->start_ms, now, false);
+        farm_monitor_publish(f, now, false);
     }
 }
 
@@ -749,6 +754,7 @@ static int finish(farm *f)
         break;
     }
     farm_report_summary(f);
+    farm_monitor_publish(f, f->end_ms, true);
     if (f->opt->stats_json && !farm_report_json(f, f->opt->stats_json, err, sizeof err)) {
         console_log(f->con, CONSOLE_ERROR, "%s", err);
         if (rc == AAFARM_EXIT_OK) rc = AAFARM_EXIT_FAILURE;
@@ -758,6 +764,7 @@ static int finish(farm *f)
 
 static void teardown(farm *f)
 {
+    farm_monitor_close(f);   /* the HTTP thread ends first */
     for (int i = 0; i < f->nframes; i++) {
         farm_frame *fr = &f->frames[i];
         image_writer_destroy(&fr->writer);   /* unfinished: removes the temporary file */
@@ -836,6 +843,7 @@ int farm_run(const farm_options *opt, const farm_frame_in *frames, int nframes)
     }
     run_loop(&f);
     rc = finish(&f);
+    farm_monitor_linger(&f, &interrupted);
     teardown(&f);
     return rc;
 }

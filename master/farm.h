@@ -44,6 +44,9 @@ typedef struct farm_options {
     bool insecure;                 /* --insecure: plaintext on a network endpoint */
     int64_t wait_report_ms;        /* --bind, no worker alive: said again this often (30000;
                                     * AAFARM_WAIT_REPORT_MS, a testing aid) */
+    const char *http;              /* --http ADDR:PORT: the live monitor, or NULL */
+    const char *http_token;        /* its token (checked by main.c), or NULL */
+    int64_t http_linger_ms;        /* --http-linger: serve this long after the end */
 } farm_options;
 
 void farm_options_default(farm_options *opt);

@@ -6,11 +6,13 @@
  *   farm_messages.c  what each message from a worker does; sending
  *                    (NeedFile: file_server.c reads the chunk)
  *   report.c         the summary per worker and the statistics file
+ *   farm_monitor.c   what the live monitor shows (--http)
  */
 #ifndef MASTER_FARM_INTERNAL_H
 #define MASTER_FARM_INTERNAL_H
 
 #include <limits.h>
+#include <signal.h>
 #include <stdbool.h>
 #include <stdint.h>
 
@@ -21,6 +23,7 @@
 #include "job_message.h"
 #include "journal.h"
 #include "local_workers.h"
+#include "monitor.h"
 #include "registry.h"
 #include "scheduler.h"
 #include "wire.h"
@@ -99,6 +102,11 @@ typedef struct farm {
     int joined;                    /* workers that said Hello (ever) */
     bool waiting;                  /* no worker alive since waiting_since_ms */
     int64_t waiting_since_ms, wait_said_ms;
+    /* --http: the live monitor (farm_monitor.c) */
+    monitor *mon;                  /* NULL without --http */
+    struct http_server *http;
+    int *tile_slot;                /* per tile: the slot of the worker whose result was taken */
+    int64_t published_ms;
 } farm;
 
 /* At most one line per interval for a repeated warning (console_tally). */
@@ -123,6 +131,24 @@ void farm_fail(farm *f, const char *fmt, ...) __attribute__((format(printf, 2, 3
 /* A tile one worker alone gave up on waited for another worker for the
  * whole join window (--lease) in vain: the render fails with its words. */
 void farm_fail_given_up(farm *f, int tile);
+
+/* farm_monitor.c (each a no-op without --http) */
+/* The monitor and its frames, before any tile (the journal's included). */
+void farm_monitor_open(farm *f);
+/* Starts the HTTP server and says where: AAFARM_EXIT_OK or an exit code
+ * with the message in err. */
+int farm_monitor_serve(farm *f, char *err, size_t errsz);
+/* The tile's chunk was taken from w (NULL: replayed from the journal). */
+void farm_monitor_tile(farm *f, farm_frame *fr, int local, const void *chunk, size_t len,
+                       const farm_worker *w);
+/* Every tile of the frame is in. */
+void farm_monitor_frame_complete(farm *f, const farm_frame *fr);
+/* Publishes the status and the workers, at most every 250 ms unless force. */
+void farm_monitor_publish(farm *f, int64_t now, bool force);
+/* After the end: keeps serving for --http-linger, or until *interrupted. */
+void farm_monitor_linger(farm *f, const volatile sig_atomic_t *interrupted);
+/* Stops the server (its thread has ended on return), frees the monitor. */
+void farm_monitor_close(farm *f);
 
 /* report.c */
 void farm_report_summary(const farm *f);

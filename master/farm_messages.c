@@ -289,6 +289,7 @@ static void tile_failed(farm *f, farm_worker *w, uint64_t lease, int tile, const
     scheduler_failure r = scheduler_fail(f->sched, w->slot, lease, retryable);
     if (r == SCHEDULER_FAIL_IGNORED) return;
     w->failures++;
+    snprintf(w->last_error, sizeof w->last_error, "%s", msg);
     int local;
     farm_frame *fr = farm_frame_of(f, tile, &local);
     image_rect rect = image_format_tile_rect(&fr->fmt, local % fr->tiles_x, local / fr->tiles_x);
@@ -400,6 +401,7 @@ static void on_result(farm *f, farm_worker *w, const proto_result *r, const wire
                 return;
             }
             scheduler_complete(f->sched, w->slot, r->lease_id, now);
+            farm_monitor_tile(f, fr, local, chunk, chunk_len, w);
             w->tiles++;
             add_stats(w, &r->stats);
             if (r->stats.nonfinite_samples) {

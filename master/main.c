@@ -15,6 +15,7 @@
 
 #include "curve_cert.h"
 #include "farm.h"
+#include "http_access.h"
 #include "job/frames.h"
 #include "message.h"
 #include "util/cli.h"
@@ -64,6 +65,15 @@ static void usage(FILE *out)
         "                             connect; others are refused and logged\n"
         "  --insecure                 allow --bind on a network address without CURVE\n"
         "                             (anyone who reaches it can join; not recommended)\n"
+        "  --http [ADDR:]PORT         serve a live monitor of the render (a web page and a\n"
+        "                             JSON API: docs/farm.md) on 127.0.0.1:PORT, or ADDR\n"
+        "                             (0.0.0.0 or *: every interface; needs a token); port\n"
+        "                             0: any free one, named in the log\n"
+        "  --http-token-file FILE     the monitor's token, on the first line of FILE (16 to\n"
+        "                             256 printable characters); requests carry it as\n"
+        "                             ?token=TOKEN or Authorization: Bearer TOKEN\n"
+        "  --http-token TOKEN         the same on the command line (visible in ps)\n"
+        "  --http-linger S            keep serving the monitor S seconds after the end\n"
         "  --resume                   continue an unfinished render of the same job: the\n"
         "                             tiles in OUT.exr.journal are kept, only the others\n"
         "                             are rendered (every render journals its tiles there)\n"
@@ -82,6 +92,7 @@ static void usage(FILE *out)
 
 typedef struct cli {
     farm_options farm;
+    char http_token[HTTP_TOKEN_MAX + 2];   /* --http-token(-file) */
     job_options job;
     bool local_given;
 } cli;
@@ -96,12 +107,40 @@ static bool number_arg(const char *opt, const char *noun, long lo, long hi, long
     return false;
 }
 
+/* --http: a valid address; a token for one other hosts can reach (as
+ * --bind wants CURVE). False after printing why. */
+static bool check_http(const farm_options *f)
+{
+    if (!f->http) {
+        if (f->http_token || f->http_linger_ms)
+            fprintf(stderr, "aafarm-master: --http-token, --http-token-file and --http-linger go "
+                    "with --http [ADDR:]PORT\n");
+        return !f->http_token && !f->http_linger_ms;
+    }
+    http_addr addr;
+    char err[ERR_LEN];
+    if (!http_addr_parse(f->http, &addr, err, sizeof err)) {
+        fprintf(stderr, "aafarm-master: %s\n", err);
+        return false;
+    }
+    if (!addr.loopback && !f->http_token) {
+        fprintf(stderr, "aafarm-master: --http %s is reachable from other hosts, and without a "
+                "token anyone there could watch the render and take the image: give "
+                "--http-token-file FILE (a line of 16 or more random characters: head -c 24 "
+                "/dev/urandom | base64 > FILE), or serve a loopback address (--http "
+                "127.0.0.1:%d)\n", f->http, addr.port);
+        return false;
+    }
+    return true;
+}
+
 /* Returns -1 to go on, or an exit code. */
 static int parse(int argc, char **argv, cli *c)
 {
     enum { O_BIND = 256, O_LOCAL, O_TPW, O_TILE, O_ARITH, O_BUDGET, O_PREVIEW, O_STATS_JSON,
            O_HEARTBEAT, O_LIVENESS, O_RETRIES, O_LEASE, O_DUPS, O_WORKER_BIN, O_RESUME, O_MAX_WORKERS, O_FRAMES,
-           O_CURVE_SECRET, O_ALLOW_KEYS, O_INSECURE, O_LEASE_FACTOR };
+           O_CURVE_SECRET, O_ALLOW_KEYS, O_INSECURE, O_LEASE_FACTOR, O_HTTP, O_HTTP_TOKEN,
+           O_HTTP_TOKEN_FILE, O_HTTP_LINGER };
     static const struct option longopts[] = {
         {"output", required_argument, 0, 'o'},
         {"bind", required_argument, 0, O_BIND},
@@ -125,6 +164,10 @@ static int parse(int argc, char **argv, cli *c)
         {"curve-secret", required_argument, 0, O_CURVE_SECRET},
         {"allow-keys", required_argument, 0, O_ALLOW_KEYS},
         {"insecure", no_argument, 0, O_INSECURE},
+        {"http", required_argument, 0, O_HTTP},
+        {"http-token", required_argument, 0, O_HTTP_TOKEN},
+        {"http-token-file", required_argument, 0, O_HTTP_TOKEN_FILE},
+        {"http-linger", required_argument, 0, O_HTTP_LINGER},
         {"quiet", no_argument, 0, 'q'},
         {"verbose", no_argument, 0, 'v'},
         {"help", no_argument, 0, 'h'},
@@ -208,6 +251,25 @@ static int parse(int argc, char **argv, cli *c)
         case O_CURVE_SECRET: f->curve_secret = optarg; break;
         case O_ALLOW_KEYS: f->allow_keys = optarg; break;
         case O_INSECURE: f->insecure = true; break;
+        case O_HTTP: f->http = optarg; break;
+        case O_HTTP_TOKEN:
+        case O_HTTP_TOKEN_FILE: {
+            char err[ERR_LEN];
+            bool ok = ch == O_HTTP_TOKEN_FILE
+                ? http_token_read_file(optarg, c->http_token, sizeof c->http_token, err, sizeof err)
+                : http_token_check(optarg, err, sizeof err);
+            if (!ok) {
+                fprintf(stderr, "aafarm-master: %s\n", err);
+                return AAFARM_EXIT_USAGE;
+            }
+            if (ch == O_HTTP_TOKEN) snprintf(c->http_token, sizeof c->http_token, "%s", optarg);
+            f->http_token = c->http_token;
+            break;
+        }
+        case O_HTTP_LINGER:
+            if (!number_arg("--http-linger", "seconds", 0, 86400, &n)) return AAFARM_EXIT_USAGE;
+            f->http_linger_ms = n * 1000;
+            break;
         case 'q': f->verbosity = -1; break;
         case 'v': f->verbosity = 1; break;
         case 'h': usage(stdout); return AAFARM_EXIT_OK;
@@ -251,6 +313,7 @@ static int parse(int argc, char **argv, cli *c)
                 "(tcp://127.0.0.1:PORT), or say --insecure\n", f->bind);
         return AAFARM_EXIT_USAGE;
     }
+    if (!check_http(f)) return AAFARM_EXIT_USAGE;
     if (f->bind && !c->local_given) f->local_workers = 0;
     if (f->local_workers > f->max_workers) {
         fprintf(stderr, "aafarm-master: --local-workers %d is more than --max-workers %d\n",

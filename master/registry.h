@@ -40,6 +40,7 @@ typedef struct farm_worker {
     bool blocked;                  /* blocklisted for the job: its results were
                                       refused --retries times; it gets no tile */
     char gone[160];                /* why it was retired */
+    char last_error[200];          /* its last tile failure or refused result ("" none) */
     int64_t joined_ms, last_seen_ms, last_sent_ms, left_ms;
     /* what it did */
     uint64_t tiles, duplicates, failures, invalid_tiles;

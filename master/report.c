@@ -11,6 +11,7 @@
 #include <sys/resource.h>
 
 #include "farm_internal.h"
+#include "json_out.h"
 #include "util/err.h"
 
 static const char *state_name(farm_state s)
@@ -79,47 +80,12 @@ void farm_report_summary(const farm *f)
     }
 }
 
-/* A JSON string with the characters JSON requires escaped. */
-/* Length of the well-formed UTF-8 sequence at p (RFC 3629: no overlong
- * forms, no surrogates, at most U+10FFFF), 0 when it is not one. */
-static int utf8_length(const unsigned char *p)
-{
-    if (p[0] < 0x80) return 1;
-    int n = p[0] >= 0xC2 && p[0] <= 0xDF ? 2 : p[0] >= 0xE0 && p[0] <= 0xEF ? 3
-            : p[0] >= 0xF0 && p[0] <= 0xF4 ? 4 : 0;
-    for (int i = 1; i < n; i++)
-        if ((p[i] & 0xC0) != 0x80) return 0;   /* also stops at the NUL */
-    if ((p[0] == 0xE0 && p[1] < 0xA0) || (p[0] == 0xED && p[1] > 0x9F) ||
-        (p[0] == 0xF0 && p[1] < 0x90) || (p[0] == 0xF4 && p[1] > 0x8F))
-        return 0;
-    return n;
-}
-
-/* A JSON string with the characters JSON requires escaped; bytes that are
- * not UTF-8 (a worker may name itself anything) become U+FFFD, so the file
- * is always valid JSON. */
-static void json_string(FILE *out, const char *s)
-{
-    fputc('"', out);
-    for (const unsigned char *p = (const unsigned char *)s; *p;) {
-        int n = utf8_length(p);
-        if (n == 0) fputs("\\ufffd", out);
-        else if (*p == '"' || *p == '\\') fprintf(out, "\\%c", *p);
-        else if (*p == '\n') fputs("\\n", out);
-        else if (*p == '\t') fputs("\\t", out);
-        else if (*p < 0x20) fprintf(out, "\\u%04x", *p);
-        else fwrite(p, 1, (size_t)n, out);
-        p += n ? n : 1;
-    }
-    fputc('"', out);
-}
-
 static void json_worker(FILE *out, const farm_worker *w)
 {
     fputs("    {\"name\": ", out);
-    json_string(out, w->name);
+    json_out_string(out, w->name);
     fputs(", \"host\": ", out);
-    json_string(out, w->host);
+    json_out_string(out, w->host);
     fprintf(out, ", \"pid\": %u, \"threads\": %u, \"local\": %s, \"tiles\": %llu, "
             "\"duplicates\": %llu, \"failures\": %llu, \"invalid_tiles\": %llu, "
             "\"render_seconds\": %.6f, \"cpu_seconds\": %.6f, \"bytes_in\": %llu, "
@@ -135,7 +101,7 @@ static void json_worker(FILE *out, const farm_worker *w)
             (unsigned long long)w->file_misses,
             w->file_chunks && w->files_ready ? (double)(w->file_ready_ms - w->file_first_ms) / 1000.0
                                               : 0.0);
-    json_string(out, worker_state(w));
+    json_out_string(out, worker_state(w));
     fputc('}', out);
 }
 
@@ -222,11 +188,11 @@ bool farm_report_json(const farm *f, const char *path, char *err, size_t errsz)
         return false;
     }
     fputs("{\n  \"scene\": ", out);
-    json_string(out, f->opt->scene_path);
+    json_out_string(out, f->opt->scene_path);
     fputs(", \"output\": ", out);
-    json_string(out, f->frames[0].output);
+    json_out_string(out, f->frames[0].output);
     fprintf(out, ", \"status\": \"%s\", \"error\": ", state_name(f->state));
-    json_string(out, f->state == FARM_FAILED ? f->failure : "");
+    json_out_string(out, f->state == FARM_FAILED ? f->failure : "");
     fprintf(out, ",\n  \"width\": %d, \"height\": %d, \"tile_size\": %d, \"tiles\": %d, "
             "\"tiles_done\": %d, \"resumed_tiles\": %d, \"seconds\": %.6f, "
             "\"job_hash\": \"%s\", \"frames\": %d, \"frames_written\": %d,\n",

@@ -592,6 +592,13 @@ int scheduler_worker_leases(const scheduler *self, int worker)
     return n;
 }
 
+void scheduler_each_lease(const scheduler *self,
+                          void (*fn)(void *arg, const scheduler_lease *lease), void *arg)
+{
+    for (size_t i = 0; i < self->nleases; i++)
+        if (self->leases[i].id) fn(arg, &self->leases[i]);
+}
+
 void scheduler_counts_get(const scheduler *self, scheduler_counts *out)
 {
     *out = self->counts;

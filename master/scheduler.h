@@ -202,5 +202,9 @@ bool scheduler_tile_done(const scheduler *self, int tile);
 int scheduler_tile_attempts(const scheduler *self, int tile);  /* failures so far */
 int scheduler_worker_leases(const scheduler *self, int worker); /* live leases held */
 void scheduler_counts_get(const scheduler *self, scheduler_counts *out);
+/* Calls fn with every valid lease (expired or not), oldest grant first
+ * (the live monitor's tile states). fn must not change the scheduler. */
+void scheduler_each_lease(const scheduler *self,
+                          void (*fn)(void *arg, const scheduler_lease *lease), void *arg);
 
 #endif

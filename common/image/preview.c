@@ -32,22 +32,36 @@ uint8_t image_preview_srgb8(float linear)
     return (uint8_t) (code < 0 ? 0 : code > 255 ? 255 : code);
 }
 
-/* Where the R, G, B values of pixel i are: ch[c][i * stride], NULL = 0. */
+/* Where the R, G, B values of pixel i are: ch[c][i * stride], NULL = 0;
+ * or, when rgb8 is set, the 8-bit codes already converted (3 per pixel). */
 typedef struct pixel_source {
     const float *ch[3];
     size_t stride;
+    const uint8_t *rgb8;
     int width, height;
     const atomic_int *cancel;      /* looked at before each row, or NULL */
 } pixel_source;
 
+/* Where the PNG goes: the file descriptor fd, or (fd < 0) memory. */
 typedef struct png_context {
     int fd;
+    uint8_t *mem;
+    size_t len, cap;
     tex_png_error error;   /* libpng's error pointer (tex/codec_err.h) */
 } png_context;
 
 static void on_png_write(png_structp png, png_bytep data, size_t len)
 {
     png_context *ctx = png_get_io_ptr(png);
+    if (ctx->fd < 0) {
+        if (ctx->cap - ctx->len < len) {
+            ctx->cap = (ctx->cap + len) * 2;
+            ctx->mem = xrealloc(ctx->mem, ctx->cap);
+        }
+        memcpy(ctx->mem + ctx->len, data, len);
+        ctx->len += len;
+        return;
+    }
     while (len > 0) {
         ssize_t n = write(ctx->fd, data, len);
         if (n < 0 && errno == EINTR)
@@ -66,6 +80,11 @@ static void on_png_flush(png_structp png)
 
 static void convert_row(const pixel_source *src, int y, uint8_t *row)
 {
+    if (src->rgb8) {
+        memcpy(row, src->rgb8 + (size_t) y * (size_t) src->width * 3,
+               (size_t) src->width * 3);
+        return;
+    }
     for (int x = 0; x < src->width; x++) {
         size_t i = ((size_t) y * (size_t) src->width + (size_t) x)
                    * src->stride;
@@ -98,24 +117,32 @@ static int write_rows(png_structp png, png_infop info,
     return 0;
 }
 
-static bool write_png(image_outfile *file, const pixel_source *src,
-                      char *err, size_t errsz)
+/* Encodes src into ctx's file or memory; 0, or 1 with the message in
+ * ctx->error. */
+static int encode_png(png_context *ctx, const pixel_source *src)
 {
-    png_context ctx = {image_outfile_fd(file), {""}};
     png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING,
-                                              &ctx.error, tex_png_on_error,
+                                              &ctx->error, tex_png_on_error,
                                               tex_png_on_warning);
     png_infop info = png ? png_create_info_struct(png) : NULL;
     uint8_t *row = xmalloc((size_t) src->width * 3);
     int rc = 1;
     if (png && info) {
-        png_set_write_fn(png, &ctx, on_png_write, on_png_flush);
+        png_set_write_fn(png, ctx, on_png_write, on_png_flush);
         rc = write_rows(png, info, src, row);
     } else {
-        snprintf(ctx.error.message, sizeof ctx.error.message, "out of memory");
+        snprintf(ctx->error.message, sizeof ctx->error.message, "out of memory");
     }
     png_destroy_write_struct(&png, &info);
     free(row);
+    return rc;
+}
+
+static bool write_png(image_outfile *file, const pixel_source *src,
+                      char *err, size_t errsz)
+{
+    png_context ctx = {.fd = image_outfile_fd(file)};
+    int rc = encode_png(&ctx, src);
     if (rc != 0)
         err_set(err, errsz, "cannot write PNG %s: %s",
                 image_outfile_temp_path(file), ctx.error.message);
@@ -146,17 +173,18 @@ bool image_preview_write_png(const char *path, const float *rgba, int width,
     if (!rgba) {
         return err_set(err, errsz, "cannot write PNG %s: no pixels given", path);
     }
-    pixel_source src = {{rgba, rgba + 1, rgba + 2}, 4, width, height, NULL};
+    pixel_source src = {.ch = {rgba, rgba + 1, rgba + 2}, .stride = 4, .width = width,
+                        .height = height};
     return write_preview(path, &src, err, errsz);
 }
 
 static bool write_buffer(const char *path, const image_buffer *buf, const atomic_int *cancel,
                          char *err, size_t errsz)
 {
-    pixel_source src = {{image_buffer_channel(buf, "R"),
-                         image_buffer_channel(buf, "G"),
-                         image_buffer_channel(buf, "B")},
-                        1, buf->width, buf->height, cancel};
+    pixel_source src = {.ch = {image_buffer_channel(buf, "R"), image_buffer_channel(buf, "G"),
+                               image_buffer_channel(buf, "B")},
+                        .stride = 1, .width = buf->width, .height = buf->height,
+                        .cancel = cancel};
     return write_preview(path, &src, err, errsz);
 }
 
@@ -179,4 +207,23 @@ bool image_preview_write_png_exr_cancel(const char *png_path, const char *exr_pa
     bool ok = buf && write_buffer(png_path, buf, cancel, err, errsz);
     image_buffer_destroy(&buf);
     return ok;
+}
+
+bool image_preview_encode_png_rgb8(const uint8_t *rgb, int width, int height,
+                                   void **png, size_t *len, char *err,
+                                   size_t errsz)
+{
+    if (!rgb || width < 1 || height < 1 || width > 1000000 || height > 1000000) {
+        return err_set(err, errsz, "cannot encode PNG: image size %dx%d out of "
+                       "range", width, height);
+    }
+    pixel_source src = {.rgb8 = rgb, .width = width, .height = height};
+    png_context ctx = {.fd = -1};
+    if (encode_png(&ctx, &src) != 0) {
+        free(ctx.mem);
+        return err_set(err, errsz, "cannot encode PNG: %s", ctx.error.message);
+    }
+    *png = ctx.mem;
+    *len = ctx.len;
+    return true;
 }

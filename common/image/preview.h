@@ -50,5 +50,13 @@ bool image_preview_write_png_exr(const char *png_path, const char *exr_path,
  * set, false with "interrupted" and no PNG (its temporary file removed). */
 bool image_preview_write_png_exr_cancel(const char *png_path, const char *exr_path,
                                         const atomic_int *cancel, char *err, size_t errsz);
+/* Encodes width x height pixels already converted to 8-bit sRGB codes
+ * (image_preview_srgb8; 3 bytes a pixel, row-major, top row first) as a
+ * PNG in memory, with the settings of the files above, so the same pixels
+ * give the same bytes as image_preview_write_png(). *png (the caller
+ * frees) and *len hold it. For the master's live image (master/monitor.h). */
+bool image_preview_encode_png_rgb8(const uint8_t *rgb, int width, int height,
+                                   void **png, size_t *len, char *err,
+                                   size_t errsz);
 
 #endif

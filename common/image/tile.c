@@ -488,3 +488,68 @@ bool image_tile_validate_exr(const void *bytes, size_t len,
     return image_tile_exr_chunk(bytes, len, fmt, expect, NULL, NULL, err,
                                 errsz);
 }
+
+/* ---- decoding a chunk (the master's live image) ---- */
+
+static void put_le(uint8_t *p, uint64_t v, int bytes)
+{
+    for (int i = 0; i < bytes; i++)
+        p[i] = (uint8_t) (v >> (8 * i));
+}
+
+bool image_tile_decode_rgba(const image_format *fmt, image_rect r,
+                            const void *chunk, size_t chunk_len, float *rgba,
+                            char *err, size_t errsz)
+{
+    int tx, ty;
+    if (!image_format_check(fmt, err, errsz)
+        || !image_format_tile_index(fmt, r, &tx, &ty, err, errsz))
+        return false;
+    if (!chunk || chunk_len == 0 || chunk_len > UINT32_MAX)
+        return err_set(err, errsz, "no tile chunk to decode");
+    void *want = NULL;
+    size_t want_len = 0;
+    if (!expected_file(fmt, r, &want, &want_len, err, errsz))
+        return false;
+    /* the one-tile file around the chunk: header, offset table, leader */
+    size_t hlen = header_length(want, want_len);
+    size_t len = hlen + 8 + 20 + chunk_len;
+    uint8_t *file = xmalloc(len);
+    memcpy(file, want, hlen);
+    free(want);
+    put_le(file + hlen, hlen + 8, 8);
+    memset(file + hlen + 8, 0, 16);                 /* tile (0,0) level (0,0) */
+    put_le(file + hlen + 8 + 16, chunk_len, 4);
+    memcpy(file + hlen + 8 + 20, chunk, chunk_len);
+    size_t px = (size_t) r.w * (size_t) r.h;
+    float *planes = xcalloc(4 * px, sizeof(float));   /* R G B A */
+    float *dst[IMAGE_MAX_CHANNELS] = {NULL};
+    int nch = image_format_channel_count(fmt);
+    for (int c = 0; c < nch; c++) {
+        const image_channel *ch = image_format_channel(fmt, c);
+        if (ch->source == IMAGE_SOURCE_RGBA)
+            dst[c] = planes + (size_t) ch->component * px;
+    }
+    image_exr_stream in;
+    image_exr_stream_memory_reader(&in, file, len);
+    exr_context_t ctxt = NULL;
+    exr_chunk_info_t ci;
+    exr_result_t rv = image_exr_start_read(&ctxt, "tile", &in);
+    if (rv == EXR_ERR_SUCCESS)
+        rv = exr_read_tile_chunk_info(ctxt, 0, 0, 0, 0, 0, &ci);
+    if (rv == EXR_ERR_SUCCESS && (ci.width != r.w || ci.height != r.h))
+        rv = EXR_ERR_CORRUPT_CHUNK;
+    if (rv == EXR_ERR_SUCCESS)
+        rv = image_exr_decode_chunk(ctxt, &ci, dst, (size_t) r.w);
+    if (ctxt)
+        exr_finish(&ctxt);
+    if (rv != EXR_ERR_SUCCESS)
+        image_exr_error(err, errsz, "tile chunk does not decode", rv, &in);
+    else
+        for (size_t i = 0; i < px; i++)
+            for (int c = 0; c < 4; c++)
+                rgba[4 * i + (size_t) c] = planes[(size_t) c * px + i];
+    free(planes);
+    free(file);
+    return rv == EXR_ERR_SUCCESS;
+}

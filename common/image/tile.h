@@ -85,4 +85,14 @@ bool image_tile_exr_chunk(const void *bytes, size_t len,
                           const void **chunk, size_t *chunk_len,
                           char *err, size_t errsz);
 
+/* Decodes the R, G, B, A samples of the compressed chunk of tile rectangle
+ * r (a chunk image_tile_exr_chunk() pointed at, or one kept in the
+ * master's journal) into rgba: r.w x r.h pixels of 4 floats, row-major,
+ * the halves of the file converted exactly. For the master's live image
+ * (master/monitor.h); false with the reason in err when it does not
+ * decode. */
+bool image_tile_decode_rgba(const image_format *fmt, image_rect r,
+                            const void *chunk, size_t chunk_len, float *rgba,
+                            char *err, size_t errsz);
+
 #endif

@@ -61,6 +61,41 @@ static void test_one_worker_row_major(void **state)
     assert_null(s);
 }
 
+/* scheduler_each_lease: the live monitor's view of who holds what */
+typedef struct seen_leases {
+    int n, tiles[8], workers[8];
+} seen_leases;
+
+static void see_lease(void *arg, const scheduler_lease *l)
+{
+    seen_leases *s = arg;
+    assert_true(s->n < 8);
+    s->tiles[s->n] = l->tile;
+    s->workers[s->n++] = l->worker;
+}
+
+static void test_each_lease_visits_the_valid_ones(void **state)
+{
+    (void)state;
+    scheduler *s = make(4, 1, 3, 0, 1000);
+    int a = scheduler_worker_add(s), b = scheduler_worker_add(s);
+    uint64_t ida, idb;
+    int ta = grant_tile(s, a, 0, &ida), tb = grant_tile(s, b, 0, &idb);
+    seen_leases seen = {0};
+    scheduler_each_lease(s, see_lease, &seen);
+    assert_int_equal(seen.n, 2);
+    assert_int_equal(seen.tiles[0], ta);
+    assert_int_equal(seen.workers[0], a);
+    assert_int_equal(seen.tiles[1], tb);
+    assert_int_equal(seen.workers[1], b);
+    assert_int_equal(scheduler_complete(s, a, ida, 10), SCHEDULER_TAKEN);
+    memset(&seen, 0, sizeof seen);
+    scheduler_each_lease(s, see_lease, &seen);   /* the taken one is gone */
+    assert_int_equal(seen.n, 1);
+    assert_int_equal(seen.tiles[0], tb);
+    scheduler_destroy(&s);
+}
+
 static void test_second_worker_splits_longest_run(void **state)
 {
     (void)state;
@@ -580,6 +615,7 @@ int main(void)
         cmocka_unit_test(test_one_worker_alone_waits_for_another),
         cmocka_unit_test(test_no_window_fails_when_no_one_is_left),
         cmocka_unit_test(test_stale_results),
+        cmocka_unit_test(test_each_lease_visits_the_valid_ones),
         cmocka_unit_test(test_resumed_tiles_never_granted),
         cmocka_unit_test(test_random_farm_takes_every_tile_once),
     };

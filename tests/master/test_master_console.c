@@ -5,7 +5,8 @@
  * the first few tiles ("3 leases passed their deadlines in the last 10 s
  * (tiles 4, 9, 17) ..."); the rest of the tiles is counted, nothing is
  * lost at the end (force), and the line goes to stderr with the
- * program's prefix.
+ * program's prefix. The log tail of the live monitor keeps the last
+ * CONSOLE_TAIL lines at INFO and ERROR, also under -q, oldest first.
  */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -119,12 +120,35 @@ static void test_tally_prints_one_line(void **state)
         "and 95 more) without a result: back in the queue\n");
 }
 
+static void test_tail_keeps_the_last_lines(void **state)
+{
+    (void)state;
+    FILE *saved = stderr;
+    stderr = fopen("/dev/null", "w");   /* -q: nothing printed, all kept */
+    console *con = console_new(-1, false);
+    assert_int_equal(console_tail_count(con), 0);
+    assert_string_equal(console_tail_line(con, 0), "");
+    for (int i = 0; i < CONSOLE_TAIL + 5; i++)
+        console_log(con, i % 2 ? CONSOLE_ERROR : CONSOLE_INFO, "line %d", i);
+    console_log(con, CONSOLE_DETAIL, "a detail is not kept");
+    assert_int_equal(console_tail_count(con), CONSOLE_TAIL);
+    assert_string_equal(console_tail_line(con, 0), "line 5");
+    char last[32];
+    snprintf(last, sizeof last, "line %d", CONSOLE_TAIL + 4);
+    assert_string_equal(console_tail_line(con, CONSOLE_TAIL - 1), last);
+    assert_string_equal(console_tail_line(con, CONSOLE_TAIL), "");
+    console_destroy(&con);
+    fclose(stderr);
+    stderr = saved;
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_tally_counts_and_interval),
         cmocka_unit_test(test_tally_cuts_the_tile_list),
         cmocka_unit_test(test_tally_prints_one_line),
+        cmocka_unit_test(test_tail_keeps_the_last_lines),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
