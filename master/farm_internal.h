@@ -13,6 +13,7 @@
 
 #include <limits.h>
 #include <signal.h>
+#include <stdatomic.h>
 #include <stdbool.h>
 #include <stdint.h>
 
@@ -146,7 +147,7 @@ void farm_monitor_frame_complete(farm *f, const farm_frame *fr);
 /* Publishes the status and the workers, at most every 250 ms unless force. */
 void farm_monitor_publish(farm *f, int64_t now, bool force);
 /* After the end: keeps serving for --http-linger, or until *interrupted. */
-void farm_monitor_linger(farm *f, const volatile sig_atomic_t *interrupted);
+void farm_monitor_linger(farm *f, const atomic_int *interrupted);
 /* Stops the server (its thread has ended on return), frees the monitor. */
 void farm_monitor_close(farm *f);
 

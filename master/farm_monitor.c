@@ -270,14 +270,14 @@ void farm_monitor_publish(farm *f, int64_t now, bool force)
     if (text) monitor_publish(f->mon, MONITOR_WORKERS, text, len);
 }
 
-void farm_monitor_linger(farm *f, const volatile sig_atomic_t *interrupted)
+void farm_monitor_linger(farm *f, const atomic_int *interrupted)
 {
     if (!f->http || f->opt->http_linger_ms <= 0) return;
     farm_monitor_publish(f, farm_now_ms(), true);
     console_log(f->con, CONSOLE_INFO, "monitor stays up for %.0f s (--http-linger; Ctrl-C ends "
                 "it)", (double)f->opt->http_linger_ms / 1000.0);
     int64_t until = farm_now_ms() + f->opt->http_linger_ms;
-    while (!*interrupted && farm_now_ms() < until) {
+    while (!atomic_load(interrupted) && farm_now_ms() < until) {
         struct timespec ts = {0, 50 * 1000 * 1000};
         nanosleep(&ts, NULL);
     }
