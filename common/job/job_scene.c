@@ -257,13 +257,14 @@ _Static_assert((int)SCENE_MAX_PRIMVARS <= (int)TRACE_MAX_PRIMVARS, "a piece's va
  * makes it again from the mesh's arrays), its variables in the camera
  * space of the mesh object t. */
 static bool mesh_piece(const void *user, const trace_object *t, int k, geom_surface *s,
-                       trace_primvar *pv)
+                       trace_primvar *pv, int *npv)
 {
     const scene_object *o = user;
     scene_primvar vars[TRACE_MAX_PRIMVARS];
     int n = 0;
     if (!scene_object_piece(o, k, s, vars, &n)) return false;
     if (pv) convert_primvars(vars, n, t, pv);
+    *npv = n;
     return true;
 }
 

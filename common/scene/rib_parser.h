@@ -341,6 +341,11 @@ void scene_mesh_add_piece(scene_mesh *self, scene_piece_kind kind, int face, int
                           const int k[3], int ncorners);
 void scene_mesh_trim(scene_mesh *self);          /* frees the spare capacity */
 void scene_mesh_set_index(scene_mesh *self, int index);
+/* Makes the mesh a subdivision mesh's (its pieces SCENE_PIECE_SUBDIV):
+ * the refined mesh sd (the scene's) and the control faces' corner counts. */
+struct geom_subdiv;
+void scene_mesh_set_subdiv(scene_mesh *self, const struct geom_subdiv *sd, const int *nverts,
+                           int nfaces);
 vec3 scene_mesh_corner_normal(scene_mesh_nclass ncls, const double *N, int face,
                               const int *idx, int fv0, int i);
 /* Hands a mesh (with pieces) to the scene, placed as one object with the

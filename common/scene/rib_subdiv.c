@@ -10,10 +10,11 @@
  * tags are warned about and ignored. Sharpness >= 10 is infinite.
  *
  * The mesh becomes one geom_subdiv (common/geom/subdiv.h), owned by the
- * scene (scene.subdivs), and every drawn face of its once-refined mesh one
- * GEOM_SUBDIV object. Other primitive variables (rib_primvar.c) are
- * interpolated bilinearly over each refined face from their values at its
- * corners (refined_face_vars).
+ * scene (scene.subdivs), and ONE scene object (a scene_mesh, issue 23)
+ * whose pieces are the drawn faces of its once-refined mesh, GEOM_SUBDIV
+ * surfaces made when asked for. Other primitive variables (rib_primvar.c)
+ * are interpolated bilinearly over each refined face from their values at
+ * its corners (scene_mesh.c, refined_face_vars).
  */
 #include "scene/rib_parser.h"
 #include "scene/rib_primvar.h"
@@ -173,49 +174,6 @@ static bool read_tags(rib_parser *p, const rib_request *req, int first, int npoi
     return ok;
 }
 
-#ifdef SCENE_HAVE_GEOM
-/* The variables over refined face f. The refined mesh has one quad per
- * corner of the control mesh, in the control corners' order (face f is
- * corner f of control face F, its k-th); its corners are the control
- * point, the edge point towards the next corner, the face point and the
- * edge point from the previous corner, turned so that a quad face's
- * children keep its (u,v) directions (geom/subdiv_refine.c). Their values
- * are those of the control corner and the means of the edge's two and of
- * the face's corners: the bilinear interpolation over the control face
- * (RenderMan's varying class; facevarying per face corner the same;
- * vertex-class values are interpolated so too, not by the subdivision
- * rules). */
-static void refined_face_vars(const rib_primvars *vars, const geom_subdiv *sd, int f,
-                              const int *nverts, const int *fo, const int *idx,
-                              scene_primvar *out)
-{
-    int F = geom_subdiv_face_origin(sd, f), n = nverts[F], k = f - fo[F];
-    rib_corner *all = xrealloc(NULL, (size_t)n * sizeof *all), c;
-    int m = n;
-    for (int i = 0; i < m; i++) {
-        int ci = fo[F] + i;
-        all[i] = (rib_corner){F, idx[ci], idx[ci], ci};
-    }
-    double g[4][RIB_MAX_PRIMVARS][3];
-    int here = fo[F] + k, next = fo[F] + (k + 1) % n, prev = fo[F] + (k + n - 1) % n;
-    c = (rib_corner){F, idx[here], idx[here], here};
-    rib_primvars_mean(vars, &c, 1, g[0]);
-    rib_corner e1[2] = {c, {F, idx[next], idx[next], next}};
-    rib_primvars_mean(vars, e1, 2, g[1]);
-    rib_primvars_mean(vars, all, m, g[2]);
-    rib_corner e3[2] = {{F, idx[prev], idx[prev], prev}, c};
-    rib_primvars_mean(vars, e3, 2, g[3]);
-    int start = n == 4 ? (4 - k) % 4 : 0;
-    /* corner j of the refined face sits at (0,0), (1,0), (1,1), (0,1) */
-    static const int slot[4] = {0, 1, 3, 2};
-    double vals[4][RIB_MAX_PRIMVARS][3];
-    for (int j = 0; j < 4; j++)
-        memcpy(vals[slot[j]], g[(j + start) % 4], sizeof vals[0]);
-    rib_primvars_bilinear_values(vars, vals, out);
-    free(all);
-}
-#endif
-
 void rib_subdivision_mesh(rib_parser *p, const rib_request *req)
 {
     const char *scheme = rib_read_string(p, req, 0, "the scheme (\"catmull-clark\")");
@@ -233,7 +191,7 @@ void rib_subdivision_mesh(rib_parser *p, const rib_request *req)
     memset(&tags, 0, sizeof tags);
     rib_params params = { 0 };
     rib_primvars vars = { NULL, 0 };
-    int *fo = NULL;
+
     if (!idx) goto out;
     long total = 0;
     for (int f = 0; f < nfaces; f++) total += nverts[f];
@@ -285,35 +243,28 @@ void rib_subdivision_mesh(rib_parser *p, const rib_request *req)
         scene *sc = p->scene;
         sc->subdivs = xrealloc(sc->subdivs, (size_t)(sc->nsubdivs + 1) * sizeof *sc->subdivs);
         sc->subdivs[sc->nsubdivs++] = sd;
-        int drawn = 0;
-        fo = xrealloc(NULL, (size_t)(nfaces + 1) * sizeof *fo);
-        fo[0] = 0;
-        for (int f = 0; f < nfaces; f++) fo[f + 1] = fo[f] + nverts[f];
-        for (int f = 0; f < geom_subdiv_nfaces(sd) && !sl_diag_full(p->diag); f++) {
-            if (!geom_subdiv_face_drawn(sd, f)) continue;
-            geom_surface s;
-            geom_subdiv_surface(sd, f, &s);
-            scene_primvar pv[RIB_MAX_PRIMVARS];
-            int F = geom_subdiv_face_origin(sd, f);
-            if (vars.n > 0 && F >= 0 && F < nfaces && f >= fo[F] && f < fo[F + 1]) {
-                refined_face_vars(&vars, sd, f, nverts, fo, idx, pv);
-                p->surface_vars = pv;
-                p->nsurface_vars = vars.n;
-            }
-            rib_add_surface(p, req, &s);
-            p->surface_vars = NULL;
-            p->nsurface_vars = 0;
-            drawn++;
-        }
-        if (drawn == 0)
+        /* one object (issue 23): a piece per drawn face of the refined
+         * mesh, its surface and variables made on demand (scene_mesh.c) */
+        scene_mesh *m = scene_mesh_new(NULL, 0, idx, nidx, SCENE_MESH_N_NONE, NULL, 0, &vars,
+                                       &params);
+        scene_mesh_set_subdiv(m, sd, nverts, nfaces);
+        for (int f = 0; f < geom_subdiv_nfaces(sd); f++)
+            if (geom_subdiv_face_drawn(sd, f))
+                scene_mesh_add_piece(m, SCENE_PIECE_SUBDIV, f, 0, NULL, 0);
+        scene_mesh_trim(m);
+        if (scene_mesh_npieces(m) == 0) {
             rib_warning(p, req, req->pos, "no face to draw (every face is a hole or touches "
                         "the boundary: add the tag \"interpolateboundary\")");
+            scene_mesh_destroy(&m);
+        } else {
+            rib_add_mesh(p, req, m);
+        }
     }
 #else
     rib_error(p, req, req->pos, "subdivision meshes need common/geom");
 #endif
 out:
-    free(fo);
+
     rib_primvars_clear(&vars);
     tags_clear(&tags);
     rib_params_clear(&params);

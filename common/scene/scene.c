@@ -101,8 +101,7 @@ bool scene_object_piece(const scene_object *object, int k, geom_surface *s,
         return true;
     }
     if (k < 0 || k >= scene_mesh_npieces(object->mesh)) return false;
-    *nvars = scene_mesh_nprimvars(object->mesh);
-    return scene_mesh_piece_surface(object->mesh, k, s, vars);
+    return scene_mesh_piece_surface(object->mesh, k, s, vars, nvars);
 }
 
 const scene_shader *scene_object_surface(const scene *self, const scene_object *object)

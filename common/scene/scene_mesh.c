@@ -5,6 +5,9 @@
  */
 #include "scene/scene_mesh.h"
 #include "scene/rib_parser.h"
+#ifdef SCENE_HAVE_GEOM
+#include "geom/subdiv.h"
+#endif
 #include "scene/rib_primvar.h"
 #include "util/err.h"
 #include "util/xalloc.h"
@@ -28,6 +31,11 @@ struct scene_mesh {
     scene_mesh_piece *pieces;
     int npieces, cap;
     int index;                     /* in scene.meshes (rib_add_mesh) */
+    /* a subdivision mesh: the refined mesh, the control faces' corner
+     * counts and first face-vertices (nfaces + 1) */
+    const struct geom_subdiv *sd;
+    int *nverts, *fo;
+    int nfaces;
 };
 
 static void *copy_of(const void *src, size_t bytes)
@@ -74,6 +82,17 @@ scene_mesh *scene_mesh_new(const double *P, int npoints, const int *idx, int nid
     return self;
 }
 
+void scene_mesh_set_subdiv(scene_mesh *self, const struct geom_subdiv *sd, const int *nverts,
+                           int nfaces)
+{
+    self->sd = sd;
+    self->nfaces = nfaces;
+    self->nverts = copy_of(nverts, (size_t)nfaces * sizeof *nverts);
+    self->fo = xmalloc(sizeof *self->fo * (size_t)(nfaces + 1));
+    self->fo[0] = 0;
+    for (int f = 0; f < nfaces; f++) self->fo[f + 1] = self->fo[f] + nverts[f];
+}
+
 void scene_mesh_add_piece(scene_mesh *self, scene_piece_kind kind, int face, int fv0,
                           const int k[3], int ncorners)
 {
@@ -89,6 +108,8 @@ void scene_mesh_add_piece(scene_mesh *self, scene_piece_kind kind, int face, int
     if (kind == SCENE_PIECE_POLYGON) {
         assert(ncorners >= 3 && ncorners <= GEOM_MAX_POLY_VERTS);
         pc->k[0] = (uint16_t)ncorners;
+    } else if (kind == SCENE_PIECE_SUBDIV) {
+        assert(self->sd);
     } else {
         for (int i = 0; i < 3; i++) {
             assert(k[i] >= 0 && k[i] <= UINT16_MAX);
@@ -116,7 +137,8 @@ size_t scene_mesh_bytes(const scene_mesh *self)
     return sizeof *self + (size_t)self->npoints * 3 * sizeof(double) +
            (size_t)self->nidx * sizeof(int) + (size_t)self->nN * 3 * sizeof(double) +
            (size_t)self->pv.n * sizeof(rib_primvar_src) + self->values_bytes +
-           (size_t)self->cap * sizeof(scene_mesh_piece);
+           (size_t)self->cap * sizeof(scene_mesh_piece) +
+           (size_t)(2 * self->nfaces + (self->sd ? 1 : 0)) * sizeof(int);
 }
 
 void scene_mesh_destroy(scene_mesh **self_p)
@@ -130,6 +152,8 @@ void scene_mesh_destroy(scene_mesh **self_p)
     free(self->values);
     free(self->pv.v);
     free(self->pieces);
+    free(self->nverts);
+    free(self->fo);
     free(self);
     *self_p = NULL;
 }
@@ -160,15 +184,73 @@ static rib_corner corner_at(const scene_mesh *m, const scene_mesh_piece *pc, int
     return (rib_corner){pc->face, v, v, pc->fv0 + i};
 }
 
+#ifdef SCENE_HAVE_GEOM
+/* The variables of refined face f (RenderMan's varying class over the
+ * control face): its corners are the control corner, the edge point towards
+ * the next corner, the face point and the edge point from the previous
+ * corner, turned so that a quad face's children keep its (u,v) directions
+ * (geom/subdiv_refine.c). Their values are those of the control corner and
+ * the means of the edge's two and of the face's corners: the bilinear
+ * interpolation over the control face (facevarying per face corner the
+ * same; vertex-class values are interpolated so too, not by the
+ * subdivision rules). */
+static void refined_face_vars(const scene_mesh *m, int f, scene_primvar *out)
+{
+    const rib_primvars *vars = &m->pv;
+    const int *fo = m->fo, *idx = m->idx;
+    int F = geom_subdiv_face_origin(m->sd, f), n = m->nverts[F], k = f - fo[F];
+    rib_corner *all = xmalloc(sizeof *all * (size_t)n), c;
+    for (int i = 0; i < n; i++) {
+        int ci = fo[F] + i;
+        all[i] = (rib_corner){F, idx[ci], idx[ci], ci};
+    }
+    double g[4][RIB_MAX_PRIMVARS][3];
+    int here = fo[F] + k, next = fo[F] + (k + 1) % n, prev = fo[F] + (k + n - 1) % n;
+    c = (rib_corner){F, idx[here], idx[here], here};
+    rib_primvars_mean(vars, &c, 1, g[0]);
+    rib_corner e1[2] = {c, {F, idx[next], idx[next], next}};
+    rib_primvars_mean(vars, e1, 2, g[1]);
+    rib_primvars_mean(vars, all, n, g[2]);
+    rib_corner e3[2] = {{F, idx[prev], idx[prev], prev}, c};
+    rib_primvars_mean(vars, e3, 2, g[3]);
+    int start = n == 4 ? (4 - k) % 4 : 0;
+    /* corner j of the refined face sits at (0,0), (1,0), (1,1), (0,1) */
+    static const int slot[4] = {0, 1, 3, 2};
+    double vals[4][RIB_MAX_PRIMVARS][3];
+    for (int j = 0; j < 4; j++)
+        memcpy(vals[slot[j]], g[(j + start) % 4], sizeof vals[0]);
+    rib_primvars_bilinear_values(vars, vals, out);
+    free(all);
+}
+
+/* A refined face's surface, and its variables where its control face
+ * holds it (as rib_subdiv.c placed one object per face). */
+static bool subdiv_piece(const scene_mesh *m, const scene_mesh_piece *pc, geom_surface *s,
+                         struct scene_primvar *vars, int *nvars)
+{
+    int f = pc->face;
+    geom_subdiv_surface(m->sd, f, s);
+    int F = geom_subdiv_face_origin(m->sd, f);
+    *nvars = 0;
+    if (m->pv.n > 0 && F >= 0 && F < m->nfaces && f >= m->fo[F] && f < m->fo[F + 1]) {
+        refined_face_vars(m, f, vars);
+        *nvars = m->pv.n;
+    }
+    return true;
+}
+#endif
+
 bool scene_mesh_piece_surface(const scene_mesh *self, int k, geom_surface *s,
-                              struct scene_primvar *vars)
+                              struct scene_primvar *vars, int *nvars)
 {
     assert(k >= 0 && k < self->npieces);
 #ifndef SCENE_HAVE_GEOM
-    (void)s, (void)vars;
+    (void)s, (void)vars, (void)nvars;
     return false;
 #else
     const scene_mesh_piece *pc = &self->pieces[k];
+    if (pc->kind == SCENE_PIECE_SUBDIV) return subdiv_piece(self, pc, s, vars, nvars);
+    *nvars = self->pv.n;
     memset(s, 0, sizeof *s);
     s->kind = GEOM_POLYGON;
     char err[ERR_LEN];

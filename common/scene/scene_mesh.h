@@ -1,5 +1,6 @@
 /*
- * scene_mesh.h: a polygon mesh kept as ONE scene object (issue 23):
+ * scene_mesh.h: a polygon mesh, or a subdivision mesh, kept as ONE scene
+ * object (issue 23):
  * PointsPolygons and PointsGeneralPolygons keep their shared arrays once
  * (the points, the vertex indices, the corner normals, every primitive
  * variable's values) and each piece of a face (a convex planar face, or
@@ -9,6 +10,10 @@
  * same steps the parser once used to make one object per piece, so it is
  * the same surface to the bit: a renderer materialises the pieces a ray
  * reaches and keeps none of the others.
+ *
+ * A SubdivisionMesh (rib_subdiv.c) is such an object too: its pieces are
+ * the faces of its refined mesh (geom/subdiv.h, shared by the pieces, owned
+ * by the scene's subdivs), its variables the control faces' corners'.
  *
  * The pieces are decided when the mesh is read (rib_mesh.c: faces without
  * area are skipped, faces whose corner normals or variables differ are cut
@@ -40,6 +45,7 @@ typedef enum scene_piece_kind {
     SCENE_PIECE_POLYGON,           /* the whole face, one convex planar polygon */
     SCENE_PIECE_TRIANGLE,          /* corners k[0..3) of the face, flat */
     SCENE_PIECE_TRIANGLE_N,        /* the same with its corner normals */
+    SCENE_PIECE_SUBDIV,            /* face `face` of the refined subdivision mesh */
 } scene_piece_kind;
 
 /* One piece: 16 bytes. */
@@ -60,11 +66,11 @@ int scene_mesh_npieces(const scene_mesh *self);
 int scene_mesh_nprimvars(const scene_mesh *self);
 
 /* Piece k's base surface (object space, prepared) and its primitive
- * variables (scene_mesh_nprimvars of them into vars), as the parser made
- * them when the mesh was read; false only if that is no longer possible
- * (never for a piece the parser kept). */
+ * variables (*nvars of them, at most scene_mesh_nprimvars, into vars), as
+ * the parser made them when the mesh was read; false only if that is no
+ * longer possible (never for a piece the parser kept). */
 bool scene_mesh_piece_surface(const scene_mesh *self, int k, geom_surface *s,
-                              struct scene_primvar *vars);
+                              struct scene_primvar *vars, int *nvars);
 
 /* The bytes the mesh holds (arrays and pieces), for benchmarks and the
  * per-face budget's test. */

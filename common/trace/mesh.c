@@ -81,9 +81,8 @@ static bool make(trace_thread *th, const trace_object *mesh_obj, int k, bool box
     v->id = m->first_id + k;
     v->top = mesh_obj->id;
     v->primvars = out->pv;
-    v->nprimvars = m->nprimvars;
     assert(m->nprimvars <= TRACE_MAX_PRIMVARS);
-    if (!m->piece(m->user, mesh_obj, k, &v->surf, m->nprimvars > 0 ? out->pv : NULL)) {
+    if (!m->piece(m->user, mesh_obj, k, &v->surf, out->pv, &v->nprimvars)) {
         trace_thread_fail(th, "a mesh piece could not be made again (internal error)");
         return false;
     }

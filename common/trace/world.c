@@ -233,7 +233,8 @@ static void find_shared_edges(trace_world *world)
             int id = i;
             if (m) {
                 id = m->first_id + k;
-                if (!m->piece(m->user, obj, k, tmp, NULL)) continue;
+                int npv;
+                if (!m->piece(m->user, obj, k, tmp, NULL, &npv)) continue;
                 s = tmp;
                 if (!obj->displacement) trace_mesh_piece_bounds(s, m->bounds[k]);
             }

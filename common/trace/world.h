@@ -57,11 +57,11 @@ typedef struct trace_mesh {
     int nprimvars;                 /* each piece's primitive variables */
     /* Piece k of the mesh object obj: its object-space surface (prepared)
      * and, when pv is not NULL, its primitive variables in camera space
-     * (as trace_primvar, with obj's shaders' parameters); false if the
-     * piece cannot be made (never for a piece of a parsed mesh). A pure
-     * function, called from any thread. */
+     * (*npv of them, at most nprimvars; as trace_primvar, with obj's
+     * shaders' parameters); false if the piece cannot be made (never for a
+     * piece of a parsed mesh). A pure function, called from any thread. */
     bool (*piece)(const void *user, const struct trace_object *obj, int k, geom_surface *s,
-                  trace_primvar *pv);
+                  trace_primvar *pv, int *npv);
     const void *user;
     /* derived: trace_world_prepare, trace_renderer_new (trace_mesh_clear
      * frees them) */

@@ -398,12 +398,16 @@ static void test_subdiv(void **state)
     (void)state;
     scene *s = load("subdiv.rib");
     assert_int_equal(s->nsubdivs, 1);
-    assert_int_equal(s->nobjects, 384);
-    for (int i = 0; i < s->nobjects; i++) {
-        assert_int_equal(s->objects[i].surface.kind, GEOM_SUBDIV);
-        assert_ptr_equal(s->objects[i].surface.subdiv, s->subdivs[0]);
-        assert_int_equal(s->objects[i].surface.subdiv_face, i);
+    assert_int_equal(s->nobjects, 1);
+    int np;
+    test_piece *pc = scene_pieces(s, &np);
+    assert_int_equal(np, 384);
+    for (int i = 0; i < np; i++) {
+        assert_int_equal(pc[i].surface.kind, GEOM_SUBDIV);
+        assert_ptr_equal(pc[i].surface.subdiv, s->subdivs[0]);
+        assert_int_equal(pc[i].surface.subdiv_face, i);
     }
+    free(pc);
     assert_non_null(object_named(s, "box"));
     scene_destroy(&s);
 }

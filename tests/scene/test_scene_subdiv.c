@@ -22,10 +22,13 @@
 #define STRIP "[4 4 4] [0 1 5 4  1 2 6 5  2 3 7 6]"
 #define STRIP_P "\"P\" [0 0 0  1 0 0  2 0 0  3 0 0  0 1 0  1 1 0  2 1 0  3 1 0]"
 
+/* pieces of kind k (a subdivision mesh is one object, issue 23) */
 static int count_kind(const scene *s, geom_kind k)
 {
-    int n = 0;
-    for (int i = 0; i < s->nobjects; i++) n += s->objects[i].surface.kind == k;
+    int n = 0, np;
+    test_piece *pc = scene_pieces(s, &np);
+    for (int i = 0; i < np; i++) n += pc[i].surface.kind == k;
+    free(pc);
     return n;
 }
 
@@ -49,8 +52,12 @@ static void test_faces(void **state)
     assert_non_null(s);
     assert_int_equal(s->nsubdivs, 2);
     assert_int_equal(count_kind(s, GEOM_SUBDIV), 20 + 24);
-    assert_ptr_equal(s->objects[0].surface.subdiv, s->subdivs[0]);
-    assert_ptr_equal(s->objects[20].surface.subdiv, s->subdivs[1]);
+    assert_int_equal(s->nobjects, 2);
+    int np;
+    test_piece *pc = scene_pieces(s, &np);
+    assert_ptr_equal(pc[0].surface.subdiv, s->subdivs[0]);
+    assert_ptr_equal(pc[20].surface.subdiv, s->subdivs[1]);
+    free(pc);
     scene_destroy(&s);
     sl_diag_destroy(&d);
     /* an open strip: with interpolateboundary all 12 faces are drawn */
