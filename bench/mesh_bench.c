@@ -9,9 +9,12 @@
  * arrays (points, indices, normals) and, beyond them, the pieces, their
  * boxes, shared edges and BVH, per face. Never fails on timing.
  *
- *   mesh_bench [max_faces]     (default 100000; 1000000 and 10000000 run
- *                               the production rows)
+ *   mesh_bench [max_faces [subdiv]]   (default 100000; 1000000 and
+ *                                      10000000 run the production rows;
+ *                                      subdiv: the torus as a Catmull-Clark
+ *                                      cage, 4 limit pieces a face)
  */
+#include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -37,14 +40,16 @@ static long peak_mib(void)
     return ru.ru_maxrss / 1024;
 }
 
-/* The RIB text of a torus (radii 1 and 0.4) of nu x nv quads. */
-static char *torus_rib(int nu, int nv, size_t *len)
+/* The RIB text of a torus (radii 1 and 0.4) of nu x nv quads, a
+ * PointsPolygons or (subdiv) a SubdivisionMesh. */
+static char *torus_rib(int nu, int nv, bool subdiv, size_t *len)
 {
     size_t cap = (size_t)nu * nv * 80 + 4096, n = 0;
     char *t = malloc(cap);
     if (!t) abort();
     n += (size_t)sprintf(t + n, "Format 128 128 1\nProjection \"perspective\" \"fov\" [40]\n"
-                         "Translate 0 0 4\nRotate 60 1 0 0\nWorldBegin\nPointsPolygons [");
+                         "Translate 0 0 4\nRotate 60 1 0 0\nWorldBegin\n%s [",
+                         subdiv ? "SubdivisionMesh \"catmull-clark\"" : "PointsPolygons");
     for (int i = 0; i < nu * nv; i++) n += (size_t)sprintf(t + n, "4 ");
     n += (size_t)sprintf(t + n, "]\n[");
     for (int i = 0; i < nu; i++)
@@ -67,12 +72,14 @@ static char *torus_rib(int nu, int nv, size_t *len)
 int main(int argc, char **argv)
 {
     int max_faces = argc > 1 ? atoi(argv[1]) : 100000;
+    bool subdiv = argc > 2 && strcmp(argv[2], "subdiv") == 0;
+    printf("%s torus\n", subdiv ? "Catmull-Clark (SubdivisionMesh)" : "PointsPolygons");
     printf("%9s %8s %8s %8s %8s %9s %12s %12s %9s\n", "faces", "parse s", "world s",
            "render s", "objects", "pieces", "shared B/f", "beyond B/f", "peak MiB");
     for (int faces = 1000; faces <= max_faces; faces *= 10) {
         int nv = (int)sqrt(faces / 2.5), nu = faces / nv;
         size_t len;
-        char *text = torus_rib(nu, nv, &len);
+        char *text = torus_rib(nu, nv, subdiv, &len);
         job_options opt;
         job_options_default(&opt);
         job *jb = job_new("torus.rib", text, len, &opt);
