@@ -216,45 +216,71 @@ static double centre(const float b[6], int axis)
 
 typedef struct build_ctx {
     const float (*bounds)[6];
+    float (*centres)[3];               /* each piece's box centre (0 where not finite) */
     struct trace_mesh_bvh *bvh;
 } build_ctx;
 
-/* the SAH split of idx[first, first + count): axis and position (the
- * count of the left part); false when none is found */
+typedef struct sah_bin {
+    float lo[3], hi[3];
+    int n;
+} sah_bin;
+
+static int bin_of(float x, float lo, float scale)
+{
+    int b = (int)((x - lo) * scale);
+    return b < 0 ? 0 : b >= BINS ? BINS - 1 : b;
+}
+
+/* the SAH split of idx[first, first + count): the pieces are binned by
+ * their centres along the axis where the centres spread most; false when
+ * no split beats the leaf */
 static bool sah_split(build_ctx *c, int first, int count, double parent_area, int *mid)
 {
     int32_t *idx = c->bvh->idx + first;
-    double clo[3] = {INFINITY, INFINITY, INFINITY}, chi[3] = {-INFINITY, -INFINITY, -INFINITY};
-    for (int i = 0; i < count; i++)
+    float clo[3] = {INFINITY, INFINITY, INFINITY}, chi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (int i = 0; i < count; i++) {
+        const float *x = c->centres[idx[i]];
         for (int a = 0; a < 3; a++) {
-            double x = centre(c->bounds[idx[i]], a);
-            clo[a] = fmin(clo[a], x);
-            chi[a] = fmax(chi[a], x);
+            clo[a] = fminf(clo[a], x[a]);
+            chi[a] = fmaxf(chi[a], x[a]);
         }
+    }
+    float scale[3];
+    sah_bin bins[3][BINS];
+    int wide = 0;
+    for (int a = 1; a < 3; a++)
+        if (chi[a] - clo[a] > chi[wide] - clo[wide]) wide = a;
+    for (int a = 0; a < 3; a++) {
+        scale[a] = a == wide && chi[a] > clo[a] ? (float)BINS / (chi[a] - clo[a]) : 0.0f;
+        for (int b = 0; b < BINS; b++) {
+            sah_bin *bn = &bins[a][b];
+            bn->n = 0;
+            for (int i = 0; i < 3; i++) bn->lo[i] = INFINITY, bn->hi[i] = -INFINITY;
+        }
+    }
+    for (int i = 0; i < count; i++) {
+        const float *x = c->centres[idx[i]], *bb = c->bounds[idx[i]];
+        for (int a = 0; a < 3; a++) {
+            if (scale[a] == 0.0f) continue;
+            sah_bin *bn = &bins[a][bin_of(x[a], clo[a], scale[a])];
+            bn->n++;
+            grow(bn->lo, bn->hi, bb);
+        }
+    }
     double best = (double)count * parent_area;   /* the leaf's cost, as an upper bound */
     int best_axis = -1, best_bin = -1;
     for (int a = 0; a < 3; a++) {
-        if (!(chi[a] > clo[a])) continue;
-        double scale = BINS / (chi[a] - clo[a]);
-        int cnt[BINS] = {0};
-        float blo[BINS][3], bhi[BINS][3];
-        for (int b = 0; b < BINS; b++)
-            for (int i = 0; i < 3; i++) blo[b][i] = INFINITY, bhi[b][i] = -INFINITY;
-        for (int i = 0; i < count; i++) {
-            int b = (int)((centre(c->bounds[idx[i]], a) - clo[a]) * scale);
-            b = b < 0 ? 0 : b >= BINS ? BINS - 1 : b;
-            cnt[b]++;
-            grow(blo[b], bhi[b], c->bounds[idx[i]]);
-        }
+        if (scale[a] == 0.0f) continue;
         /* sweep: the right parts' areas from the right, then the left */
         double rarea[BINS];
         int rcnt[BINS];
         float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
         int n = 0;
         for (int b = BINS - 1; b > 0; b--) {
-            n += cnt[b];
-            if (cnt[b]) {
-                float bb[6] = {blo[b][0], blo[b][1], blo[b][2], bhi[b][0], bhi[b][1], bhi[b][2]};
+            const sah_bin *bn = &bins[a][b];
+            n += bn->n;
+            if (bn->n) {
+                float bb[6] = {bn->lo[0], bn->lo[1], bn->lo[2], bn->hi[0], bn->hi[1], bn->hi[2]};
                 grow(lo, hi, bb);
             }
             rcnt[b] = n;
@@ -263,9 +289,10 @@ static bool sah_split(build_ctx *c, int first, int count, double parent_area, in
         for (int i = 0; i < 3; i++) lo[i] = INFINITY, hi[i] = -INFINITY;
         n = 0;
         for (int b = 0; b < BINS - 1; b++) {
-            n += cnt[b];
-            if (cnt[b]) {
-                float bb[6] = {blo[b][0], blo[b][1], blo[b][2], bhi[b][0], bhi[b][1], bhi[b][2]};
+            const sah_bin *bn = &bins[a][b];
+            n += bn->n;
+            if (bn->n) {
+                float bb[6] = {bn->lo[0], bn->lo[1], bn->lo[2], bn->hi[0], bn->hi[1], bn->hi[2]};
                 grow(lo, hi, bb);
             }
             if (n == 0 || rcnt[b + 1] == 0) continue;
@@ -278,12 +305,9 @@ static bool sah_split(build_ctx *c, int first, int count, double parent_area, in
         }
     }
     if (best_axis < 0) return false;
-    double scale = BINS / (chi[best_axis] - clo[best_axis]);
     int i = 0, j = count - 1;
     while (i <= j) {
-        int b = (int)((centre(c->bounds[idx[i]], best_axis) - clo[best_axis]) * scale);
-        b = b < 0 ? 0 : b >= BINS ? BINS - 1 : b;
-        if (b <= best_bin) {
+        if (bin_of(c->centres[idx[i]][best_axis], clo[best_axis], scale[best_axis]) <= best_bin) {
             i++;
         } else {
             int32_t t = idx[i];
@@ -293,18 +317,6 @@ static bool sah_split(build_ctx *c, int first, int count, double parent_area, in
     }
     *mid = i;
     return i > 0 && i < count;
-}
-
-static int by_axis;
-static const float (*by_bounds)[6];
-
-static int cmp_centre(const void *x, const void *y)
-{
-    double a = centre(by_bounds[*(const int32_t *)x], by_axis);
-    double b = centre(by_bounds[*(const int32_t *)y], by_axis);
-    return (a > b) - (a < b) ? (a > b) - (a < b)
-                             : (*(const int32_t *)x > *(const int32_t *)y) -
-                                   (*(const int32_t *)x < *(const int32_t *)y);
 }
 
 static void build_node(build_ctx *c, int id, int first, int count, int depth)
@@ -322,14 +334,8 @@ static void build_node(build_ctx *c, int id, int first, int count, int depth)
     int mid = 0;
     double area = area_of(n->lo, n->hi);
     if (depth >= SAH_DEPTH || !isfinite(area) || !sah_split(c, first, count, area, &mid)) {
-        /* the median along the longest axis: depth stays logarithmic */
-        int axis = 0;
-        double e[3];
-        for (int i = 0; i < 3; i++) e[i] = (double)n->hi[i] - n->lo[i];
-        axis = (e[0] >= e[1] && e[0] >= e[2]) ? 0 : (e[1] >= e[2] ? 1 : 2);
-        by_axis = axis;
-        by_bounds = c->bounds;
-        qsort(t->idx + first, (size_t)count, sizeof *t->idx, cmp_centre);
+        /* no split worth its cost (or too deep, or boxes without end):
+         * halves by index, so the depth stays logarithmic */
         mid = count / 2;
     }
     int left = t->nnodes;
@@ -348,11 +354,14 @@ static struct trace_mesh_bvh *bvh_build(const float (*bounds)[6], int n)
     for (int i = 0; i < n; i++) t->idx[i] = i;
     /* a binary tree with leaves of >= 1 piece: at most 2n - 1 nodes */
     t->nodes = xmalloc(sizeof *t->nodes * (size_t)(2 * n > 0 ? 2 * n : 1));
-    build_ctx c = {bounds, t};
+    build_ctx c = {bounds, xmalloc(sizeof *c.centres * (size_t)(n > 0 ? n : 1)), t};
+    for (int i = 0; i < n; i++)
+        for (int a = 0; a < 3; a++) c.centres[i][a] = (float)centre(bounds[i], a);
     if (n > 0) {
         t->nnodes = 1;
         build_node(&c, 0, 0, n, 0);
     }
+    free(c.centres);
     t->nodes = xreallocarray(t->nodes, (size_t)(t->nnodes > 0 ? t->nnodes : 1), sizeof *t->nodes);
     return t;
 }
