@@ -47,6 +47,14 @@ static bool load_keys(zap *z, const char *dir, char *err, size_t errsz)
     }
     bool ok = true;
     for (struct dirent *e; ok && (e = readdir(d));) {
+        /* a secret key has no business here: only its owner may hold it */
+        if (has_suffix(e->d_name, ".key_secret")) {
+            err_set(err, errsz, "--allow-keys %s: %s/%s is a secret key; only the workers' "
+                    "public keys (NAME.key) belong there: move it out and keep it with "
+                    "its worker", dir, dir, e->d_name);
+            ok = false;
+            break;
+        }
         if (!has_suffix(e->d_name, ".key")) continue;
         if (z->nkeys >= ZAP_MAX_KEYS) {
             err_set(err, errsz, "--allow-keys %s: more than %d keys", dir, ZAP_MAX_KEYS);
@@ -57,6 +65,14 @@ static bool load_keys(zap *z, const char *dir, char *err, size_t errsz)
         snprintf(path, sizeof path, "%s/%s", dir, e->d_name);
         curve_cert c;
         if (!curve_cert_read(path, false, &c, err, errsz)) {
+            ok = false;
+            break;
+        }
+        if (c.secret_key[0]) {   /* a secret renamed NAME.key */
+            memset(&c, 0, sizeof c);
+            err_set(err, errsz, "--allow-keys %s: %s holds a secret key; only the workers' "
+                    "public keys (NAME.key) belong there: put the public key in its "
+                    "place", dir, path);
             ok = false;
             break;
         }

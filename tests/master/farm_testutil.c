@@ -409,3 +409,24 @@ const char *ft_slow_worker(const char *dir, int delay_ms)
     if (fclose(f) != 0 || chmod(wrapper, 0755) != 0) abort();
     return wrapper;
 }
+
+int ft_shv(const char *dir, const char *log, const char *fmt, va_list ap)
+{
+    char cmd[8192];
+    vsnprintf(cmd, sizeof cmd, fmt, ap);
+    char wrapped[8400];
+    snprintf(wrapped, sizeof wrapped, "exec timeout -k 2 120 /bin/sh -c '%s'", cmd);
+    char path[4300];
+    snprintf(path, sizeof path, "%s/%s", dir, log);
+    const char *argv[] = {"/bin/sh", "-c", wrapped, NULL};
+    return ft_wait(ft_spawn(path, argv), 130);
+}
+
+int ft_sh(const char *dir, const char *log, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    int rc = ft_shv(dir, log, fmt, ap);
+    va_end(ap);
+    return rc;
+}

@@ -11,6 +11,7 @@
 #ifndef TESTS_FARM_TESTUTIL_H
 #define TESTS_FARM_TESTUTIL_H
 
+#include <stdarg.h>
 #include <stdbool.h>
 #include <stddef.h>
 #include <sys/types.h>
@@ -85,6 +86,14 @@ long ft_exr_diff(const char *a, const char *b);
 /* Renders dir/scene.rib with aafarm-worker --standalone into dir/ref.exr
  * (tile size `tile`); returns its exit status. */
 int ft_standalone(const char *dir, int tile);
+
+/* Runs a shell command line (fmt, printf-style; no single quotes in it)
+ * under /bin/sh, bounded by timeout -k 2 120, its output appended to
+ * dir/log; returns its exit status (-1 when it outlived 130 s). */
+int ft_sh(const char *dir, const char *log, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+int ft_shv(const char *dir, const char *log, const char *fmt, va_list ap)
+    __attribute__((format(printf, 3, 0)));
 
 /* Files in dir whose name starts with prefix. */
 int ft_count_files(const char *dir, const char *prefix);

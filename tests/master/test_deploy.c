@@ -21,8 +21,10 @@
  *     no /run/sshd);
  *   - deploy/slurm/aafarm.sbatch renders for real with stand-in srun and
  *     scontrol (two tasks for two nodes); equal image, the job's keys removed;
- *   - deploy/systemd: install.sh into a scratch root, and
- *     systemd-analyze verify of the template unit;
+ *   - deploy/systemd: install.sh into a scratch root (run again, it keeps
+ *     the host's NAME.conf and writes a differing default beside it as
+ *     NAME.conf.new), the unit's store of job files in its StateDirectory,
+ *     and systemd-analyze verify of the template unit;
  *   - what cannot run here (containers, Kubernetes): shellcheck of every
  *     script, check_manifests.py (YAML parsed and cross-checked).
  * A check whose tool is missing (shellcheck, python3-yaml, systemd-analyze)
@@ -86,16 +88,11 @@ static int teardown(void **state)
 static int sh(const char *log, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 static int sh(const char *log, const char *fmt, ...)
 {
-    char cmd[8192];
     va_list ap;
     va_start(ap, fmt);
-    vsnprintf(cmd, sizeof cmd, fmt, ap);
+    int rc = ft_shv(dir, log, fmt, ap);
     va_end(ap);
-    char path[4300], wrapped[8400];
-    snprintf(path, sizeof path, "%s/%s", dir, log);
-    snprintf(wrapped, sizeof wrapped, "exec timeout -k 2 120 /bin/sh -c '%s'", cmd);
-    const char *argv[] = {"/bin/sh", "-c", wrapped, NULL};
-    return ft_wait(ft_spawn(path, argv), 130);
+    return rc;
 }
 
 static bool have(const char *tool)
@@ -487,6 +484,38 @@ static void test_systemd_unit_and_install(void **state)
     assert_int_equal(st.st_mode & 0777, 0600);
     assert_int_equal(stat(ft_path(dir, "root/etc/aafarm/keys/master.key"), &st), 0);
     assert_int_equal(stat(ft_path(dir, "root/etc/systemd/system/aafarm-worker@.service"), &st), 0);
+    /* run again: the host's options are kept; a different default goes
+     * beside them as .conf.new, said once; the same default adds nothing */
+    FILE *fp = fopen(ft_path(dir, "root/etc/aafarm/farm1.conf"), "w");
+    assert_non_null(fp);
+    fputs("AAFARM_MASTER=tcp://render-master:5555\nAAFARM_WORKER_OPTS=--threads 8\n", fp);
+    fclose(fp);
+    assert_int_equal(sh("install2.log", "AAFARM_ROOT=%s/root %s/deploy/systemd/install.sh farm1 "
+                        "tcp://render-master2:5555 %s.key %s", dir, src, key, bindir), 0);
+    conf = ft_read(ft_path(dir, "root/etc/aafarm/farm1.conf"));
+    assert_string_equal(conf, "AAFARM_MASTER=tcp://render-master:5555\nAAFARM_WORKER_OPTS=--threads 8\n");
+    free(conf);
+    conf = ft_read(ft_path(dir, "root/etc/aafarm/farm1.conf.new"));
+    assert_string_equal(conf, "AAFARM_MASTER=tcp://render-master2:5555\nAAFARM_WORKER_OPTS=\n");
+    free(conf);
+    char said[8400];
+    snprintf(said, sizeof said, "install.sh: kept your %s/root/etc/aafarm/farm1.conf; the new default "
+             "(AAFARM_MASTER=tcp://render-master2:5555) is in %s/root/etc/aafarm/farm1.conf.new", dir, dir);
+    assert_int_equal(ft_count(ft_path(dir, "install2.log"), said), 1);
+    assert_int_equal(unlink(ft_path(dir, "root/etc/aafarm/farm1.conf.new")), 0);
+    assert_int_equal(sh("install3.log", "AAFARM_ROOT=%s/root %s/deploy/systemd/install.sh farm2 "
+                        "tcp://render-master:5555 %s.key %s && AAFARM_ROOT=%s/root %s/deploy/systemd/"
+                        "install.sh farm2 tcp://render-master:5555 %s.key %s",
+                        dir, src, key, bindir, dir, src, key, bindir), 0);
+    assert_int_equal(ft_count(ft_path(dir, "install3.log"), "kept your"), 0);
+    assert_int_equal(ft_count_files(ft_path(dir, "root/etc/aafarm"), "farm2.conf.new"), 0);
+    /* the worker's store of job files: the unit's persistent state folder,
+     * shared by its instances (one user for all), not the private /tmp */
+    char *unit = ft_read(ft_path(dir, "root/etc/systemd/system/aafarm-worker@.service"));
+    assert_non_null(strstr(unit, "\nStateDirectory=aafarm\n"));
+    assert_non_null(strstr(unit, "\nUser=aafarm\n"));
+    assert_non_null(strstr(unit, " --file-cache ${STATE_DIRECTORY}/files "));
+    free(unit);
     if (!have("systemd-analyze")) {
         fprintf(stderr, "systemd-analyze not found: the unit is not verified\n");
         return;

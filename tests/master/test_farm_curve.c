@@ -209,6 +209,20 @@ static void test_plaintext_network_bind_refused_and_bad_keys_named(void **state)
     assert_int_equal(run_keygen("w3"), 0);
     assert_int_equal(rename(ft_path(dir, "w3.key"), ft_path(dir, "badallow/w3.key")), 0);
     assert_int_equal(master_usage("open.log", bad, "are too open for a secret key"), 2);
+    assert_int_equal(chmod(secret, 0600), 0);
+    /* a secret key in the allow folder is refused, named (issue 26): only
+     * public keys belong there; also one renamed NAME.key */
+    assert_int_equal(rename(ft_path(dir, "w3.key_secret"), ft_path(dir, "badallow/w3.key_secret")), 0);
+    char expect[9000];
+    snprintf(expect, sizeof expect, "aafarm-master: --allow-keys %s: %s/w3.key_secret is a secret "
+             "key; only the workers' public keys (NAME.key) belong there", allow, allow);
+    assert_int_equal(master_usage("secret.log", bad, expect), 2);
+    assert_int_equal(rename(ft_path(dir, "badallow/w3.key_secret"), ft_path(dir, "badallow/w4.key")), 0);
+    snprintf(expect, sizeof expect, "aafarm-master: --allow-keys %s: %s/w4.key holds a secret "
+             "key; only the workers' public keys (NAME.key) belong there", allow, allow);
+    assert_int_equal(master_usage("secret2.log", bad, expect), 2);
+    assert_int_equal(unlink(ft_path(dir, "badallow/w4.key")), 0);
+    assert_int_equal(chmod(secret, 0644), 0);
     assert_int_equal(ft_count_files(dir, "u.exr"), 0);
     /* the worker's own checks */
     const char *wargv[] = {ft_worker, "--connect", "tcp://127.0.0.1:1", "--curve-secret", secret,

@@ -89,6 +89,12 @@ for s, opts in (("master", ("--curve-secret", "--allow-keys")), ("worker", ("--c
     for o in opts:
         check(arg_after(svcs[s]["command"], o).startswith("/keys/"), f"compose: {s} {o} outside /keys")
 check(svcs["master"]["build"]["dockerfile"] == "deploy/container/Dockerfile", "compose: wrong Dockerfile")
+# the image follows the scene: no fixed -o, the master runs in its writable
+# output mount and writes the scene's Display name there
+check("-o" not in cm and "--output" not in cm, "compose: the master's -o names one image whatever the scene")
+out_mounts = [v.split(":")[1] for v in svcs["master"]["volumes"] if not v.endswith(":ro")]
+check(svcs["master"].get("working_dir") in out_mounts,
+      "compose: the master does not run in its writable output mount (working_dir)")
 print("compose: parsed; services, commands, key mounts and ports agree")
 
 # --- Dockerfile ---
@@ -101,7 +107,14 @@ check(re.search(r"^COPY --from=" + froms[0][1] + r"\s", df, re.M) is not None,
       "Dockerfile: the runtime stage copies nothing from the build stage")
 for src in re.findall(r"^COPY\s+(?!--from)(\S+)", df, re.M):
     check(src == "." or os.path.exists(os.path.join(root, src)), f"Dockerfile: COPY {src}: no such path")
-print(f"Dockerfile: stages {[f[0] for f in froms]}; COPY sources exist")
+programs = ("aafarm-master", "aafarm-worker", "aafarm-slc", "aafarm-maketx", "aafarm-keygen")
+targets = " ".join(re.findall(r"--target((?:\s+[\w-]+)+)", df))
+for prog in programs:
+    check(prog in targets.split(), f"Dockerfile: {prog} is not built (--target)")
+    check(prog in df[:df.index("FROM ")], f"Dockerfile: its comment does not name {prog}")
+check(re.search(r"cmake --install /build --prefix (\S+)", df) is not None,
+      "Dockerfile: the build stage does not cmake --install")
+print(f"Dockerfile: stages {[f[0] for f in froms]}; COPY sources exist; the five programs built and installed")
 
 if errors:
     print("\n".join("error: " + e for e in errors), file=sys.stderr)
