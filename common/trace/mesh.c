@@ -23,11 +23,14 @@
 
 /* ---- views ---------------------------------------------------------- */
 
-enum { VIEW_SLOTS = 128 };
+/* 2-way set-associative: a piece goes to one of the two slots of its set,
+ * the older of the two making room */
+enum { VIEW_SETS = 128, VIEW_SLOTS = 2 * VIEW_SETS };
 
 typedef struct trace_views {
     trace_view slot[VIEW_SLOTS];
     int64_t key[VIEW_SLOTS];           /* the view's object and piece; -1: empty */
+    unsigned char older[VIEW_SETS];    /* the set's slot to replace next (0, 1) */
     trace_view hit;                    /* the hit a traversal returns */
     trace_view *held[TRACE_RAY_DEPTH_LIMIT + 1];   /* hits being shaded, per depth */
 } trace_views;
@@ -87,9 +90,17 @@ static bool make(trace_thread *th, const trace_object *mesh_obj, int k, bool box
         return false;
     }
     v->shared_edges = m->shared_edges ? m->shared_edges[k] : 0;
-    if (grid || v->displacement) trace_object_grid_spacing(th->world, v);
+    if (m->dudv && m->roots) {
+        /* displaced: what trace_mesh_build found, once */
+        v->du = m->dudv[k][0];
+        v->dv = m->dudv[k][1];
+    } else if (grid || v->displacement) {
+        trace_object_grid_spacing(th->world, v);
+    }
     if (boxes) {
-        if (v->displacement) {
+        if (v->displacement && m->roots) {
+            v->root = m->roots[k];
+        } else if (v->displacement) {
             trace_surface_box(th, v, 0, 1, 0, 1, &v->root);
         } else {
             geom_bounds(&v->surf, &v->root.lo, &v->root.hi);
@@ -125,6 +136,7 @@ static trace_views *views_of(trace_thread *th)
     if (!th->views) {
         th->views = xmalloc(sizeof *th->views);
         for (int i = 0; i < VIEW_SLOTS; i++) th->views->key[i] = -1;
+        memset(th->views->older, 0, sizeof th->views->older);
         memset(th->views->held, 0, sizeof th->views->held);
     }
     return th->views;
@@ -144,14 +156,20 @@ const trace_object *trace_mesh_view(trace_thread *th, const trace_object *mesh_o
     /* the object and the piece: objects sharing a mesh share its ids */
     int64_t key = (int64_t)mesh_obj->id << 32 | (uint32_t)k;
     uint64_t h = (uint64_t)key * 0x9e3779b97f4a7c15ull;
-    unsigned s = (unsigned)(h >> 57);  /* 7 bits: VIEW_SLOTS */
-    assert(s < VIEW_SLOTS);
-    if (vs->key[s] != key) {
-        vs->key[s] = -1;
-        if (!trace_mesh_view_make(th, mesh_obj, k, true, &vs->slot[s])) return NULL;
-        vs->key[s] = key;
-        th->stats.views_made++;
-    }
+    unsigned set = (unsigned)(h >> 57);   /* 7 bits: VIEW_SETS */
+    assert(set < VIEW_SETS);
+    th->stats.views_asked++;
+    for (unsigned w = 0; w < 2; w++)
+        if (vs->key[2 * set + w] == key) {
+            vs->older[set] = (unsigned char)(1 - w);
+            return &vs->slot[2 * set + w].obj;
+        }
+    unsigned s = 2 * set + vs->older[set];
+    vs->key[s] = -1;
+    if (!trace_mesh_view_make(th, mesh_obj, k, true, &vs->slot[s])) return NULL;
+    vs->key[s] = key;
+    vs->older[set] = (unsigned char)(1 - vs->older[set]);
+    th->stats.views_made++;
     return &vs->slot[s].obj;
 }
 
@@ -401,15 +419,29 @@ bool trace_mesh_build(trace_thread *th, trace_object *obj)
         if (obj->displacement || !m->bounds) {
             /* displaced: each piece's root box runs its shader (undisplaced:
              * trace_world_prepare's pass over the pieces made the bounds) */
+            size_t n = (size_t)(m->npieces > 0 ? m->npieces : 1);
             free(m->bounds);
-            m->bounds = xmalloc(sizeof *m->bounds * (size_t)(m->npieces > 0 ? m->npieces : 1));
+            free(m->roots);
+            free(m->dudv);
+            m->roots = NULL;
+            m->dudv = NULL;
+            m->bounds = xmalloc(sizeof *m->bounds * n);
+            trace_box *roots = obj->displacement ? xmalloc(sizeof *roots * n) : NULL;
+            double (*dudv)[2] = obj->displacement ? xmalloc(sizeof *dudv * n) : NULL;
             trace_view *v = xmalloc(sizeof *v);
             for (int k = 0; k < m->npieces; k++) {
                 if ((k & 255) == 0 && trace_thread_cancelled(th)) break;
                 if (!make(th, obj, k, true, false, v)) break;
                 float_box(&v->obj.root, m->bounds[k]);
+                if (roots) {
+                    roots[k] = v->obj.root;
+                    dudv[k][0] = v->obj.du;
+                    dudv[k][1] = v->obj.dv;
+                }
             }
             free(v);
+            m->roots = roots;          /* from now on, views take these */
+            m->dudv = dudv;
         }
         if (th->failed) return false;
         m->bvh = bvh_build((const float (*)[6])m->bounds, m->npieces);
@@ -470,6 +502,9 @@ bool trace_mesh_intersect(trace_thread *th, const trace_object *obj, const trace
             for (int i = 0; i < n->n; i++) {
                 int k = t->idx[n->a + i];
                 if (!piece_hit(m->bounds[k], ray, best->t)) continue;
+                double r0, r1;         /* a displaced piece's root box, as its walk tests it */
+                if (m->roots && !trace_box_hit(&m->roots[k], ray, ray->tmin, best->t, &r0, &r1, NULL))
+                    continue;
                 const trace_object *v = trace_mesh_view(th, obj, k);
                 if (!v) return found;
                 if (trace_intersect_object(th, v, cam_ray, tol, any, best)) {
@@ -507,9 +542,13 @@ void trace_mesh_clear(trace_mesh *self)
 {
     free(self->shared_edges);
     free(self->bounds);
+    free(self->roots);
+    free(self->dudv);
     free_bvh(&self->bvh);
     self->shared_edges = NULL;
     self->bounds = NULL;
+    self->roots = NULL;
+    self->dudv = NULL;
 }
 
 size_t trace_mesh_bytes(const trace_mesh *self)
@@ -518,6 +557,7 @@ size_t trace_mesh_bytes(const trace_mesh *self)
     size_t b = 0;
     if (self->shared_edges) b += n * sizeof *self->shared_edges;
     if (self->bounds) b += n * sizeof *self->bounds;
+    if (self->roots) b += n * (sizeof *self->roots + sizeof *self->dudv);
     if (self->bvh)
         b += (size_t)self->bvh->nnodes * sizeof(mesh_node) + n * sizeof *self->bvh->idx;
     return b;

@@ -30,6 +30,7 @@ typedef struct trace_stats {
     long empty_boxes;              /* boxes that were NaN: no point of the
                                       range is defined (pruned, counted) */
     long views_made;               /* mesh pieces made into objects (mesh.c) */
+    long views_asked;              /* views asked of the thread's cache (mesh.c) */
     long max_nodes_per_ray;        /* the largest walk (a peak, not a sum) */
     long cache_hits, cache_misses, cache_evictions;
     size_t cache_peak_bytes;

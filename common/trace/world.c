@@ -290,7 +290,11 @@ bool trace_world_prepare(trace_world *world, char *err, size_t errsz)
             trace_mesh *m = world->objects[i].mesh;
             m->first_id = -1;
             free(m->bounds);
+            free(m->roots);
+            free(m->dudv);
             m->bounds = NULL;
+            m->roots = NULL;
+            m->dudv = NULL;
             trace_mesh_clear_bvh(m);
         }
     long next = world->nobjects;

@@ -72,6 +72,9 @@ typedef struct trace_mesh {
                                       (the first placing object's transform) */
     float (*bounds)[6];            /* per piece: object-space box (lo, hi) of
                                       its root box, rounded outward */
+    trace_box *roots;              /* displaced: per piece, its root box (its
+                                      shader run over the whole piece once) */
+    double (*dudv)[2];             /* displaced: per piece, its du and dv */
     struct trace_mesh_bvh *bvh;    /* over the pieces' bounds */
 } trace_mesh;
 

@@ -1,0 +1,199 @@
+/*
+ * bench/asset_gen.c: writes a production-style scene (issue 23): a
+ * displaced, textured terrain of N faces and rocks instanced K times, each
+ * rock a Catmull-Clark cage, their geometry in gzip-compressed archives
+ * that the top-level RIB reads, in the idioms exporters write (ReadArchive
+ * of .rib.gz files, ObjectBegin/ObjectInstance, facevarying "st",
+ * "displacementbound", the shaders and texture on search paths).
+ *
+ *   asset_gen [--faces N] [--rocks K] [--cage M] [--format W H]
+ *             [--shaders DIR] [--textures DIR] OUTDIR
+ *
+ * writes OUTDIR/asset.rib, OUTDIR/terrain.rib.gz (a PointsPolygons grid of
+ * about N quads: heights from a few sine octaves, "st" per point) and
+ * OUTDIR/rock.rib.gz (a cube cage of 6 M^2 faces, creased corners). The
+ * terrain is displaced by heightmap.sl with textures/terrain_height.exr
+ * (scenes/make_textures.sh writes it), the rocks by dented.sl. Defaults:
+ * 1,000,000 faces, 200 rocks, M = 6, 640 x 480, the source tree's scenes/
+ * shaders and textures.
+ */
+#include <math.h>
+#include <stdbool.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <zlib.h>
+
+static void die(const char *what, const char *path)
+{
+    fprintf(stderr, "asset_gen: %s %s\n", what, path);
+    exit(1);
+}
+
+static double height(double x, double y)
+{
+    return 0.25 * sin(1.3 * x + 0.4) * cos(1.1 * y) + 0.08 * sin(4.1 * x + 2.1 * y) +
+           0.03 * cos(9.7 * x - 7.3 * y);
+}
+
+static void write_terrain(const char *path, int n)
+{
+    gzFile f = gzopen(path, "wb6");
+    if (!f) die("cannot write", path);
+    const double size = 8.0;
+    gzprintf(f, "##RenderMan RIB-Structure 1.1 Entity\n# terrain: %d x %d quads\n"
+                "PointsPolygons [", n, n);
+    for (int i = 0; i < n * n; i++) gzputs(f, i % 32 == 31 ? "4\n" : "4 ");
+    gzputs(f, "]\n[");
+    for (int j = 0; j < n; j++)
+        for (int i = 0; i < n; i++) {
+            int a = j * (n + 1) + i;
+            gzprintf(f, "%d %d %d %d%s", a, a + n + 1, a + n + 2, a + 1, i % 8 == 7 ? "\n" : " ");
+        }
+    gzputs(f, "]\n\"P\" [");
+    for (int j = 0; j <= n; j++)
+        for (int i = 0; i <= n; i++) {
+            double x = size * (i / (double)n - 0.5), y = size * (j / (double)n - 0.5);
+            gzprintf(f, "%.6g %.6g %.6g%s", x, y, height(x, y), i % 4 == 3 ? "\n" : " ");
+        }
+    gzputs(f, "]\n\"float[2] st\" [");
+    for (int j = 0; j <= n; j++)
+        for (int i = 0; i <= n; i++)
+            gzprintf(f, "%.6g %.6g%s", i / (double)n, j / (double)n, i % 8 == 7 ? "\n" : " ");
+    gzputs(f, "]\n");
+    if (gzclose(f) != Z_OK) die("cannot finish", path);
+}
+
+/* a cube cage of 6 m^2 quads (points shared along the edges) */
+static void write_rock(const char *path, int m)
+{
+    gzFile f = gzopen(path, "wb6");
+    if (!f) die("cannot write", path);
+    /* the points of the cube's surface grid, by their integer coordinates */
+    int side = m + 1, npts = 0;
+    int *id = malloc(sizeof *id * (size_t)side * side * side);
+    if (!id) abort();
+    double *P = malloc(sizeof *P * 3 * (size_t)side * side * side);
+    if (!P) abort();
+    for (int z = 0; z < side; z++)
+        for (int y = 0; y < side; y++)
+            for (int x = 0; x < side; x++) {
+                int k = (z * side + y) * side + x;
+                bool surface = x == 0 || y == 0 || z == 0 || x == m || y == m || z == m;
+                id[k] = surface ? npts : -1;
+                if (!surface) continue;
+                P[3 * npts] = 2.0 * x / m - 1;
+                P[3 * npts + 1] = 2.0 * y / m - 1;
+                P[3 * npts + 2] = 2.0 * z / m - 1;
+                npts++;
+            }
+    gzprintf(f, "##RenderMan RIB-Structure 1.1 Entity\n# rock: a cube cage of %d faces\n"
+                "SubdivisionMesh \"catmull-clark\" [", 6 * m * m);
+    for (int i = 0; i < 6 * m * m; i++) gzputs(f, "4 ");
+    gzputs(f, "]\n[");
+    /* each face of the cube: axis a fixed at 0 or m, the other two (b, c)
+     * running; the winding outward */
+    for (int a = 0; a < 3; a++)
+        for (int s = 0; s < 2; s++)
+            for (int i = 0; i < m; i++)
+                for (int j = 0; j < m; j++) {
+                    int q[4][2] = {{i, j}, {i + 1, j}, {i + 1, j + 1}, {i, j + 1}};
+                    int out[4];
+                    for (int c = 0; c < 4; c++) {
+                        int v[3];
+                        v[a] = s ? m : 0;
+                        v[(a + 1) % 3] = q[c][0];
+                        v[(a + 2) % 3] = q[c][1];
+                        out[c] = id[(v[2] * side + v[1]) * side + v[0]];
+                    }
+                    if (s)
+                        gzprintf(f, "%d %d %d %d ", out[0], out[1], out[2], out[3]);
+                    else
+                        gzprintf(f, "%d %d %d %d ", out[0], out[3], out[2], out[1]);
+                }
+    gzputs(f, "]\n[\"interpolateboundary\"] [0 0] [] []\n\"P\" [");
+    for (int i = 0; i < npts; i++) gzprintf(f, "%.6g %.6g %.6g\n", P[3 * i], P[3 * i + 1], P[3 * i + 2]);
+    gzputs(f, "]\n");
+    free(id);
+    free(P);
+    if (gzclose(f) != Z_OK) die("cannot finish", path);
+}
+
+int main(int argc, char **argv)
+{
+    long faces = 1000000;
+    int rocks = 200, cage = 6, w = 640, h = 480;
+    const char *shaders = AAFARM_SCENES_DIR "/shaders", *textures = AAFARM_SCENES_DIR "/textures";
+    const char *out = NULL;
+    for (int i = 1; i < argc; i++) {
+        if (strcmp(argv[i], "--faces") == 0 && i + 1 < argc) faces = atol(argv[++i]);
+        else if (strcmp(argv[i], "--rocks") == 0 && i + 1 < argc) rocks = atoi(argv[++i]);
+        else if (strcmp(argv[i], "--cage") == 0 && i + 1 < argc) cage = atoi(argv[++i]);
+        else if (strcmp(argv[i], "--format") == 0 && i + 2 < argc) {
+            w = atoi(argv[++i]);
+            h = atoi(argv[++i]);
+        } else if (strcmp(argv[i], "--shaders") == 0 && i + 1 < argc) shaders = argv[++i];
+        else if (strcmp(argv[i], "--textures") == 0 && i + 1 < argc) textures = argv[++i];
+        else if (strcmp(argv[i], "--help") == 0) {
+            printf("usage: asset_gen [--faces N] [--rocks K] [--cage M] [--format W H] "
+                   "[--shaders DIR] [--textures DIR] OUTDIR\n");
+            return 0;
+        } else if (argv[i][0] != '-' && !out) out = argv[i];
+        else {
+            fprintf(stderr, "asset_gen: unknown option '%s' (see --help)\n", argv[i]);
+            return 2;
+        }
+    }
+    if (!out || faces < 1 || rocks < 0 || cage < 1 || w < 1 || h < 1) {
+        fprintf(stderr, "asset_gen: give OUTDIR (and positive sizes; see --help)\n");
+        return 2;
+    }
+    mkdir(out, 0777);
+    int n = (int)ceil(sqrt((double)faces));
+    char path[4096];
+    snprintf(path, sizeof path, "%s/terrain.rib.gz", out);
+    write_terrain(path, n);
+    snprintf(path, sizeof path, "%s/rock.rib.gz", out);
+    write_rock(path, cage);
+    snprintf(path, sizeof path, "%s/asset.rib", out);
+    FILE *f = fopen(path, "w");
+    if (!f) die("cannot write", path);
+    fprintf(f, "##RenderMan RIB\n# asset.rib (bench/asset_gen): a displaced, textured terrain of "
+               "%d quads and %d instanced subdivision rocks\nversion 3.04\n"
+               "Option \"searchpath\" \"shader\" [\"%s:&\"]\n"
+               "Option \"searchpath\" \"texture\" [\"%s:&\"]\n"
+               "Display \"asset.exr\" \"file\" \"rgba\"\nFormat %d %d 1\nPixelSamples 2 2\n"
+               "ShadingRate 1\nProjection \"perspective\" \"fov\" [40]\nClipping 0.1 100\n"
+               "Translate 0 -0.4 7\nRotate -35 1 0 0\n"
+               "WorldBegin\n"
+               "  LightSource \"ambientlight\" 1 \"intensity\" [0.2]\n"
+               "  LightSource \"distantlight\" 2 \"intensity\" [1.0] \"from\" [-2 3 -1] \"to\" [0 0 0]\n"
+               "  ObjectBegin \"rock\"\n    ReadArchive \"rock.rib.gz\"\n  ObjectEnd\n"
+               "  AttributeBegin\n    Attribute \"identifier\" \"name\" [\"terrain\"]\n"
+               "    Attribute \"displacementbound\" \"sphere\" [0.2]\n    Color [0.55 0.5 0.4]\n"
+               "    Surface \"plastic\" \"Ks\" [0.1] \"roughness\" [0.3]\n"
+               "    Displacement \"heightmap\" \"Km\" [0.15] \"string mapname\" "
+               "[\"terrain_height.exr\"]\n"
+               "    Rotate -90 1 0 0\n    ReadArchive \"terrain.rib.gz\"\n  AttributeEnd\n",
+            n * n, rocks, shaders, textures, w, h);
+    unsigned seed = 7;
+    for (int i = 0; i < rocks; i++) {
+        seed = seed * 1103515245u + 12345u;
+        double x = 7.0 * ((seed >> 8) / 16777216.0 - 0.5);
+        seed = seed * 1103515245u + 12345u;
+        double y = 7.0 * ((seed >> 8) / 16777216.0 - 0.5);
+        seed = seed * 1103515245u + 12345u;
+        double s = 0.06 + 0.12 * ((seed >> 8) / 16777216.0), a = 360.0 * ((seed >> 4) % 4096) / 4096;
+        fprintf(f, "  AttributeBegin\n    Color [0.45 0.43 0.4]\n    Surface \"plastic\" \"Ks\" "
+                   "[0.2]\n    Displacement \"dented\" \"Km\" [0.25]\n"
+                   "    Rotate -90 1 0 0\n    Translate %.4f %.4f %.4f\n    Rotate %.1f 0 0 1\n"
+                   "    Scale %.4f %.4f %.4f\n    ObjectInstance \"rock\"\n  AttributeEnd\n",
+                x, y, height(x, y) + 0.6 * s, a, s, s, 0.7 * s);
+    }
+    fprintf(f, "WorldEnd\n");
+    if (fclose(f) != 0) die("cannot finish", path);
+    printf("asset_gen: %s/asset.rib: %d terrain quads, %d rocks of %d cage faces\n", out, n * n,
+           rocks, 6 * cage * cage);
+    return 0;
+}
