@@ -1,0 +1,81 @@
+#!/usr/bin/env bash
+# bench/scale.sh: production scale (issue 23), the aims' figures:
+#   1. mesh_bench: a torus of PointsPolygons quads to FACES (default
+#      1,000,000; 10000000 is the opt-in row): parse, world, render CPU
+#      seconds, bytes per face, peak RSS; the same torus as a
+#      SubdivisionMesh cage to SUBDIV_FACES (default 100,000)
+#   2. a production-style asset (bench/asset_gen: a displaced, textured
+#      terrain of ASSET_FACES quads from a gzip archive and ROCKS instanced
+#      subdivision rocks) rendered at ASSET_W x ASSET_H by a master with
+#      two workers on this host (their peak RSS each) and standalone (the
+#      farm image must equal it)
+# Usage: bash bench/scale.sh [BUILD_DIR]   (default build; a Release or
+# RelWithDebInfo build of the whole tree). Prints tables; never fails on
+# timing. Environment: FACES, SUBDIV_FACES, ASSET_FACES, ROCKS, ASSET_W,
+# ASSET_H, THREADS (per worker, default 1).
+set -euo pipefail
+here="$(cd "$(dirname "$0")/.." && pwd)"
+build="$(cd "${1:-$here/build}" && pwd)"
+FACES=${FACES:-1000000}
+SUBDIV_FACES=${SUBDIV_FACES:-100000}
+ASSET_FACES=${ASSET_FACES:-1000000}
+ROCKS=${ROCKS:-200}
+ASSET_W=${ASSET_W:-640}
+ASSET_H=${ASSET_H:-480}
+THREADS=${THREADS:-1}
+for p in mesh_bench asset_gen aafarm-master aafarm-worker exrcmp; do
+  [ -x "$build/bin/$p" ] || { echo "scale.sh: $build/bin/$p missing: build the tree first" >&2; exit 1; }
+done
+echo "== machine: $(nproc) cores, $(free -g | awk '/Mem:/{print $2}') GiB, load $(cut -d' ' -f1 /proc/loadavg); aafarm $(git -C "$here" rev-parse --short HEAD 2>/dev/null || echo '?')"
+echo "== 1. mesh_bench (PointsPolygons torus)"
+/usr/bin/time -f "   (whole process: %e s wall, peak %M KB)" "$build/bin/mesh_bench" "$FACES"
+echo "== 1b. mesh_bench (SubdivisionMesh torus)"
+/usr/bin/time -f "   (whole process: %e s wall, peak %M KB)" "$build/bin/mesh_bench" "$SUBDIV_FACES" subdiv
+
+echo "== 2. asset: $ASSET_FACES terrain faces, $ROCKS rocks, ${ASSET_W}x${ASSET_H}"
+work=$(mktemp -d)
+pids=()
+cleanup() { for p in "${pids[@]}"; do kill -9 "$p" 2>/dev/null || true; done; rm -rf "$work"; }
+trap cleanup EXIT
+if [ ! -f "$here/scenes/textures/terrain_height.exr" ]; then
+  bash "$here/scenes/make_textures.sh" "$build" >/dev/null
+fi
+"$build/bin/asset_gen" --faces "$ASSET_FACES" --rocks "$ROCKS" --format "$ASSET_W" "$ASSET_H" "$work/asset"
+ls -l "$work/asset" | awk 'NR>1 {printf "   %s %d bytes\n", $9, $5}'
+cd "$work/asset"
+/usr/bin/time -f "standalone (1 process, $((2 * THREADS)) threads): %e s wall, %U s user, peak %M KB" \
+  timeout -k 10 3600 "$build/bin/aafarm-worker" --standalone asset.rib -o "$work/standalone.exr" \
+  -t $((2 * THREADS)) 2>&1 | tail -1
+port=$((20000 + RANDOM % 20000))
+timeout -k 10 3600 "$build/bin/aafarm-master" asset.rib -o "$work/farm.exr" \
+  --bind "tcp://127.0.0.1:$port" --local-workers 0 --insecure \
+  --stats-json "$work/stats.json" >"$work/master.log" 2>&1 &
+master=$!
+pids+=("$master")
+wpids=()
+for w in 1 2; do
+  (cd "$work" && exec timeout -k 10 3600 "$build/bin/aafarm-worker" --connect "tcp://127.0.0.1:$port" \
+     -t "$THREADS" --name "w$w" --file-cache "$work/store$w" >"$work/w$w.log" 2>&1) &
+  wpids+=("$!")
+  pids+=("$!")
+done
+start=$(date +%s.%N)
+rc=0
+wait "$master" || rc=$?
+echo "farm (master + 2 workers of $THREADS thread(s)): exit $rc, $(echo "$(date +%s.%N) - $start" | bc) s wall"
+for w in 1 2; do
+  # the worker (timeout's child): its peak resident memory, then stop it
+  wp=$(pgrep -P "${wpids[$((w - 1))]}" -f aafarm-worker | head -1 || true)
+  peak=$(awk '/VmHWM/ {print $2 " " $3}' "/proc/${wp:-0}/status" 2>/dev/null || echo "?")
+  echo "worker $w: peak RSS $peak"
+  grep -i -E "files are here|archive" "$work/w$w.log" | head -2 | sed 's/^/   /'
+  kill -TERM "${wpids[$((w - 1))]}" 2>/dev/null || true
+  wait "${wpids[$((w - 1))]}" 2>/dev/null || true
+done
+if [ "$rc" -eq 0 ] && "$build/bin/exrcmp" "$work/standalone.exr" "$work/farm.exr" 0 >/dev/null; then
+  echo "farm image = standalone image (exrcmp, tolerance 0)"
+else
+  echo "farm image differs from the standalone one, or the farm failed: see $work (kept)"
+  tail -5 "$work/master.log"
+  trap - EXIT
+fi
