@@ -265,6 +265,62 @@ static void test_hits_outlive_the_view_cache(void **state)
     fixture_close(&f);
 }
 
+/* Three instances of a recorded undisplaced mesh share one trace_mesh
+ * (its boxes and BVH in object space) and render as three copies of the
+ * mesh written out, each with its own. */
+static void test_instances_render_as_copies(void **state)
+{
+    (void)state;
+    char *torus = torus_rib(30, 20, "");
+    char *pp = strstr(torus, "PointsPolygons"), *we = strstr(torus, "WorldEnd");
+    *we = '\0';
+    static const char *const places[3] = {"Translate -1.2 0 0\nRotate 30 0 1 0",
+                                          "Translate 1.2 0.3 1\nRotate -50 1 0 0",
+                                          "Translate 0 -1.1 0.5\nScale 0.7 0.7 0.7"};
+    size_t cap = strlen(pp) * 4 + 4096;
+    char *inst = malloc(cap), *copies = malloc(cap);
+    const char *head = "Format 48 36 1\nProjection \"perspective\" \"fov\" [50]\n"
+                       "Translate 0 0 5\nWorldBegin\n"
+                       "LightSource \"distantlight\" 1 \"from\" [0 1 -1] \"to\" [0 0 0]\n";
+    size_t a = (size_t)snprintf(inst, cap, "%sObjectBegin 7\n%sObjectEnd\n", head, pp);
+    size_t b = (size_t)snprintf(copies, cap, "%s", head);
+    for (int i = 0; i < 3; i++) {
+        a += (size_t)snprintf(inst + a, cap - a, "AttributeBegin\n%s\nObjectInstance 7\n"
+                              "AttributeEnd\n", places[i]);
+        b += (size_t)snprintf(copies + b, cap - b, "AttributeBegin\n%s\n%sAttributeEnd\n",
+                              places[i], pp);
+    }
+    snprintf(inst + a, cap - a, "WorldEnd\n");
+    snprintf(copies + b, cap - b, "WorldEnd\n");
+    free(torus);
+    enum { PX = 48 * 36 * 4 };
+    float *img[2], *z = malloc(sizeof *z * 48 * 36);
+    for (int k = 0; k < 2; k++) {
+        fixture f;
+        assert_true(fixture_open(&f, k == 0 ? inst : copies, NULL, 0, NULL, 0));
+        const trace_world *w = &f.js->world;
+        assert_int_equal(w->nobjects, 3);
+        bool shared = w->objects[0].mesh == w->objects[1].mesh &&
+                      w->objects[1].mesh == w->objects[2].mesh;
+        assert_true(k == 0 ? shared : !shared && w->objects[0].mesh != w->objects[2].mesh);
+        img[k] = malloc(sizeof *img[k] * PX);
+        assert_true(fixture_render(&f, 16, 2, 0, img[k], z));
+        fixture_close(&f);
+    }
+    int differ = 0, covered = 0;
+    for (int i = 0; i < PX; i++) differ += img[0][i] != img[1][i];
+    for (int i = 3; i < PX; i += 4) covered += img[0][i] > 0;
+    printf("3 instances against 3 copies: %d of %d values differ, %d pixels covered\n", differ,
+           PX, covered);
+    assert_true(covered > 200);
+    assert_int_equal(differ, 0);
+    free(img[0]);
+    free(img[1]);
+    free(z);
+    free(inst);
+    free(copies);
+}
+
 static void test_instances_share_the_mesh(void **state)
 {
     (void)state;
@@ -310,6 +366,7 @@ int main(void)
         cmocka_unit_test(test_mesh_renders_as_its_faces),
         cmocka_unit_test(test_displaced_mesh_renders_as_its_faces),
         cmocka_unit_test(test_hits_outlive_the_view_cache),
+        cmocka_unit_test(test_instances_render_as_copies),
         cmocka_unit_test(test_instances_share_the_mesh),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
