@@ -14,7 +14,7 @@
 
 /* Bump whenever aafarm.proto changes in a way an older peer would
  * misread (docs/protocol.md says which changes those are). */
-#define AAFARM_PROTOCOL_VERSION 2   /* 2: job files (NeedFile, FileChunk, FilesReady) */
+#define AAFARM_PROTOCOL_VERSION 3   /* 2: job files (NeedFile, FileChunk, FilesReady); 3: archives are job files (archive:<path>), no longer sources */
 
 /* Compares the master's and the worker's protocol versions. Returns 0 when
  * they are equal; otherwise -1 and, when err is not NULL, writes (at most

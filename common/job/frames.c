@@ -278,8 +278,7 @@ static int scan_frames(const char *rib_path, int **numbers, const atomic_int *ca
     char *text = job_read_scene(rib_path, &len, diag);
     if (!text) return -2;
     sl_diag *quiet = sl_diag_new();
-    sl_source_set *archives = sl_source_set_new();
-    sl_source_set_set_loader(archives, scene_archive_load_from_disk, NULL);
+    sl_source_set *archives = scene_archive_set_new();
     int n = scene_scan_frames(rib_path, text, len, archives, numbers, cancel, quiet);
     sl_source_set_destroy(&archives);
     sl_diag_destroy(&quiet);

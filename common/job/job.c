@@ -13,6 +13,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "job/job_internal.h"
 #include "job/job_scene.h"
 #include "scene/scene.h"
 #include "sl/standard.h"
@@ -316,14 +317,16 @@ job *job_load(const char *rib_path, const job_options *options, const atomic_int
     size_t len = 0;
     char *text = read_file(rib_path, &len, diag);
     if (!text) return NULL;
-    /* the archives the scene reads land in the job's sources, from disk */
+    /* the archives the scene reads become files of the job (hashed on
+     * disk); their texts live only as long as this parse */
     job *self = job_new(rib_path, text, len, options);
     free(text);
-    sl_source_set_set_loader(self->sources, scene_archive_load_from_disk, NULL);
-    scene *sc = scene_parse_frame(rib_path, self->scene_text, self->scene_len,
-                                  self->sources, SCENE_MAX_OBJECTS, self->options.frame, cancel,
-                                  diag);
-    sl_source_set_set_loader(self->sources, NULL, NULL);
+    sl_source_set *archives = sl_source_set_new();
+    sl_source_set_set_max_size(archives, SCENE_ARCHIVE_MAX_BYTES);
+    sl_source_set_set_loader(archives, job_archive_load_from_disk, self);
+    scene *sc = scene_parse_frame(rib_path, self->scene_text, self->scene_len, archives,
+                                  SCENE_MAX_OBJECTS, self->options.frame, cancel, diag);
+    sl_source_set_destroy(&archives);
     if (!sc) {
         job_destroy(&self);
         return NULL;

@@ -21,6 +21,14 @@
  * disk makes a new job and a stale copy is never used. job_file_resolve
  * turns a name into the local path (the texture module's resolver).
  *
+ * Archives (ReadArchive, plain or gzip) are files of the job too, named
+ * JOB_ARCHIVE_PREFIX + the archive's normalized path ("archive:parts/
+ * obj.rib.gz"), hashed as they lie on disk (compressed). job_load adds
+ * them while it parses; every parse of the job reads their texts from the
+ * files' local paths, gunzipping them (job_archive.c). So the Job message
+ * carries the top-level RIB and the shader sources only, and an archive
+ * (up to SCENE_ARCHIVE_MAX_BYTES uncompressed) reaches each host once.
+ *
  * Options that change pixels (arithmetic, shader budget, tile size: the
  * tile grid of the output file) are part of the job and of its hash; per
  * worker settings (threads, cache budget) are not: they change speed only.
@@ -49,6 +57,9 @@ typedef struct job_options {
 
 void job_options_default(job_options *opt);
 
+/* The name prefix of the job files that are archives (see above). */
+#define JOB_ARCHIVE_PREFIX "archive:"
+
 typedef struct job_shader {
     char *name;                    /* as the RIB names it: "wave" */
     char *file;                    /* its main source in job.sources */
@@ -76,7 +87,8 @@ typedef struct job {
     job_shader *shaders;
     int nshaders;
     job_options options;
-    job_file *files;               /* the data files its shaders read, by name */
+    job_file *files;               /* the data files its shaders read and the
+                                      archives its scene reads, by name */
     int nfiles;
     bool files_known;              /* files is the whole list (job_load collected
                                       it, or a master sent it): textures come

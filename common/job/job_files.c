@@ -23,19 +23,19 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include "job/job_internal.h"
 #include "job/job_scene.h"
 #include "sl/bytecode.h"
 
-enum { MAX_JOB_FILES = 4096, MAX_NAME = 4096 };
+enum { MAX_NAME = 4096 };
 
 static int64_t mtime_ns(const struct stat *st)
 {
     return (int64_t)st->st_mtim.tv_sec * 1000000000 + st->st_mtim.tv_nsec;
 }
 
-/* Hashes the file at path and stamps it (stat before and after: a file
- * written meanwhile is an error); false (the reason in err) otherwise. */
-static bool hash_file(const char *path, char hex[HASH_HEX_SIZE], uint64_t *size,
+/* stat before and after: a file written meanwhile is an error */
+bool job_hash_file(const char *path, char hex[HASH_HEX_SIZE], uint64_t *size,
                       struct stat *stamp, char *err, size_t errsz)
 {
     FILE *f = fopen(path, "rb");
@@ -77,6 +77,27 @@ static bool hash_file(const char *path, char hex[HASH_HEX_SIZE], uint64_t *size,
     hash_hex(digest, hex);
     *size = n;
     return true;
+}
+
+bool job_add_disk_file(job *self, const char *name, const char *path, const char *hex,
+                       uint64_t size, const struct stat *st, char *err, size_t errsz)
+{
+    if (!job_add_file(self, name, hex, size, err, errsz)) return false;
+    job_file *f = &self->files[self->nfiles - 1];
+    job_file_set_path(self, self->nfiles - 1, path);
+    f->stamped = true;
+    f->dev = (uint64_t)st->st_dev;
+    f->ino = (uint64_t)st->st_ino;
+    f->mtime_ns = mtime_ns(st);
+    return true;
+}
+
+bool job_file_moved(const job_file *f, const char *path)
+{
+    struct stat st;
+    if (stat(path, &st) != 0) return true;
+    return (uint64_t)st.st_dev != f->dev || (uint64_t)st.st_ino != f->ino ||
+           mtime_ns(&st) != f->mtime_ns || (uint64_t)st.st_size != f->size;
 }
 
 /* The first "<dir>/<name>" on the texture path that is a regular file
@@ -130,30 +151,22 @@ static bool consider(job *self, const scene *sc, const char *name, sl_pos pos, s
         if ((unsigned char)name[i] < 0x20 || name[i] == 0x7f) return true;   /* not a file name */
     char *path = find_on_path(sc, name);
     if (!path) return true;
-    if (self->nfiles >= MAX_JOB_FILES) {
-        sl_diag_error(diag, pos, "file '%s': a job reads at most %d files", name, MAX_JOB_FILES);
+    if (self->nfiles >= JOB_MAX_FILES) {
+        sl_diag_error(diag, pos, "file '%s': a job reads at most %d files", name, JOB_MAX_FILES);
         free(path);
         return false;
     }
     char hex[HASH_HEX_SIZE], err[ERR_LEN];
     uint64_t size = 0;
     struct stat st;
-    if (!hash_file(path, hex, &size, &st, err, sizeof err)) {
+    if (!job_hash_file(path, hex, &size, &st, err, sizeof err)) {
         sl_diag_error(diag, pos, "file '%s' (found as '%s' on the texture search path) cannot be "
                       "read: %s; fix its permissions or remove it", name, path, err);
         free(path);
         return false;
     }
-    bool ok = job_add_file(self, name, hex, size, err, sizeof err);
-    if (ok) {
-        job_file *f = &self->files[self->nfiles - 1];
-        job_file_set_path(self, self->nfiles - 1, path);
-        f->stamped = true;
-        f->dev = (uint64_t)st.st_dev;
-        f->ino = (uint64_t)st.st_ino;
-        f->mtime_ns = mtime_ns(&st);
-    }
-    else sl_diag_error(diag, pos, "%s", err);
+    bool ok = job_add_disk_file(self, name, path, hex, size, &st, err, sizeof err);
+    if (!ok) sl_diag_error(diag, pos, "%s", err);
     free(path);
     return ok;
 }

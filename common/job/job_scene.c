@@ -5,6 +5,7 @@
  * terms) into the renderer's camera-space world (trace/world.h).
  */
 #include "job/job_scene.h"
+#include "job/job_internal.h"
 #include "trace/mesh.h"
 #include "util/err.h"
 #include "util/xalloc.h"
@@ -384,10 +385,13 @@ job_scene *job_scene_new(const job *jb, size_t cache_bytes, bool render,
 {
     job_scene *self = xcalloc(1, sizeof *self);
     self->job = jb;
-    /* archives come from the job, never from this machine's disk */
-    self->scene = scene_parse_frame(jb->scene_file, jb->scene_text, jb->scene_len,
-                                    jb->sources, SCENE_MAX_OBJECTS, jb->options.frame, cancel,
-                                    diag);
+    /* archives come from the job's files (the master's disk, this host's
+     * store), never from a folder of this machine; their texts are freed
+     * once parsed */
+    sl_source_set *archives = job_archive_set_new(jb);
+    self->scene = scene_parse_frame(jb->scene_file, jb->scene_text, jb->scene_len, archives,
+                                    SCENE_MAX_OBJECTS, jb->options.frame, cancel, diag);
+    sl_source_set_destroy(&archives);
     bool ok = self->scene != NULL;
     if (ok) ok = compile_programs(self, cancel, diag);
     if (ok) ok = build_objects(self, diag);

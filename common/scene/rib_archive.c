@@ -7,9 +7,11 @@
  * folder of the file that reads it, then each folder of Option
  * "searchpath" "archive" ["dir:&"] (relative folders are relative to the
  * main RIB's folder, like the shader path). The texts come from a source
- * set (sl/source.h) under their normalized names: the master fills it from
- * disk through scene_archive_load_from_disk (gunzipping on the way), the
- * job ships it, and a worker parses from the set alone, never from disk.
+ * set (sl/source.h) under their normalized names, filled on demand by its
+ * loader: from disk through scene_archive_read (gunzipping on the way) on
+ * the master and standalone; on a worker from the job's files in the
+ * host's store (common/job/job_archive.c), never from the master's disk.
+ * An archive is at most SCENE_ARCHIVE_MAX_BYTES uncompressed.
  *
  * Archives may read archives up to SCENE_ARCHIVE_MAX_DEPTH deep; a file
  * that reads itself, directly or through others, is an error. Every
@@ -27,13 +29,21 @@
 #include <string.h>
 #include <zlib.h>
 
-/* Reads `name` from disk into the set, gunzipping when it is
- * gzip-compressed (zlib reads plain files transparently). */
-int scene_archive_load_from_disk(sl_source_set *set, const char *name, sl_diag *diag,
-                                 void *arg)
+/* max as words for a message: "1 GiB", "4 MiB" or a count of bytes */
+static void size_words(size_t max, char *out, size_t outsz)
 {
-    (void)arg;
-    gzFile f = gzopen(name, "rb");
+    if (max >= ((size_t)1 << 30) && max % ((size_t)1 << 30) == 0)
+        snprintf(out, outsz, "%zu GiB", max >> 30);
+    else if (max >= ((size_t)1 << 20) && max % ((size_t)1 << 20) == 0)
+        snprintf(out, outsz, "%zu MiB", max >> 20);
+    else
+        snprintf(out, outsz, "%zu bytes", max);
+}
+
+int scene_archive_read(sl_source_set *set, const char *name, const char *path,
+                       sl_diag *diag)
+{
+    gzFile f = gzopen(path, "rb");
     if (!f) {
         if (errno == ENOENT || errno == ENOTDIR)
             return 1;
@@ -42,11 +52,16 @@ int scene_archive_load_from_disk(sl_source_set *set, const char *name, sl_diag *
                           errno ? strerror(errno) : "out of memory");
         return -1;
     }
+    gzbuffer(f, 1u << 18);
+    /* the buffer grows by doubling up to one byte past the limit, so that a
+     * file over it is seen without reading it all */
     size_t max = sl_source_set_max_size(set), cap = 1 << 16, n = 0;
+    if (cap > max + 1)
+        cap = max + 1;
     char *buf = xrealloc(NULL, cap);
     for (;;) {
         if (n == cap) {
-            cap *= 2;
+            cap = cap > (max + 1) / 2 ? max + 1 : 2 * cap;
             buf = xrealloc(buf, cap);
         }
         unsigned want = cap - n > (1u << 30) ? 1u << 30 : (unsigned)(cap - n);
@@ -63,9 +78,12 @@ int scene_archive_load_from_disk(sl_source_set *set, const char *name, sl_diag *
         }
         n += (size_t)got;
         if (n > max) {
+            char words[32];
+            size_words(max, words, sizeof words);
             if (diag)
-                sl_diag_error(diag, (sl_pos){0}, "archive '%s' is larger than %zu bytes "
-                              "(uncompressed): split it into several archives", name, max);
+                sl_diag_error(diag, (sl_pos){0}, "archive '%s' is larger than %s uncompressed "
+                              "(the limit is %zu bytes per archive): split it into several "
+                              "archives", name, words, max);
             free(buf);
             gzclose(f);
             return -1;
@@ -81,12 +99,30 @@ int scene_archive_load_from_disk(sl_source_set *set, const char *name, sl_diag *
         free(buf);
         return -1;
     }
-    int rc = sl_source_set_add(set, name, buf, n);
+    buf = xrealloc(buf, n + 1);   /* held once, at its size */
+    buf[n] = '\0';
+    int rc = sl_source_set_adopt(set, name, buf, n);
     if (rc < 0 && diag)
         sl_diag_error(diag, (sl_pos){0}, "cannot keep archive '%s': %s", name,
                       errno == EEXIST ? "a different file has that name" : strerror(errno));
-    free(buf);
     return rc == 0 ? 0 : -1;
+}
+
+/* Reads `name` from disk into the set, gunzipping when it is
+ * gzip-compressed (zlib reads plain files transparently). */
+int scene_archive_load_from_disk(sl_source_set *set, const char *name, sl_diag *diag,
+                                 void *arg)
+{
+    (void)arg;
+    return scene_archive_read(set, name, name, diag);
+}
+
+sl_source_set *scene_archive_set_new(void)
+{
+    sl_source_set *set = sl_source_set_new();
+    sl_source_set_set_max_size(set, SCENE_ARCHIVE_MAX_BYTES);
+    sl_source_set_set_loader(set, scene_archive_load_from_disk, NULL);
+    return set;
 }
 
 /* "dir/name" normalized; dir "." or "" gives the name alone. */
@@ -199,7 +235,9 @@ void rib_read_archive(rib_parser *p, const rib_request *req)
         return;
     }
     const char *file = archive_name(p->scene, src->name);
-    if (p->diag_sources)      /* for caret lines in messages */
+    /* for caret lines in messages: a copy, so only of archives of a
+     * shader source's size (a message in a bigger one has no caret) */
+    if (p->diag_sources && src->len <= SL_SOURCE_DEFAULT_MAX_SIZE)
         sl_source_set_add(p->diag_sources, file, src->text, src->len);
     p->archive_chain[p->narchive_chain].file = file;
     p->archive_chain[p->narchive_chain].read_at = req->pos;

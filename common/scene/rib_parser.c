@@ -817,8 +817,7 @@ static void parse_all(rib_parser *p)
 
 scene *scene_parse(const char *file, const char *text, size_t len, sl_diag *diag)
 {
-    sl_source_set *archives = sl_source_set_new();
-    sl_source_set_set_loader(archives, scene_archive_load_from_disk, NULL);
+    sl_source_set *archives = scene_archive_set_new();
     scene *s = scene_parse_archives(file, text, len, archives, diag);
     sl_source_set_destroy(&archives);
     return s;

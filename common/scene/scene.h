@@ -11,8 +11,9 @@
  *   scene_load(path, diag)               from a file (archives from disk)
  *   scene_parse_archives(file, text, len, archives, diag)
  *                                        archives from a source set: a
- *                                        worker gets the scene text and
- *                                        the archives over the network
+ *                                        worker gets the scene text in
+ *                                        the job and the archives as the
+ *                                        job's files
  *
  * All return NULL when there was any error; every error is in diag with
  * its file:line:col and names the RIB request. Warnings (unknown requests,
@@ -279,18 +280,36 @@ scene *scene_parse(const char *file, const char *text, size_t len, sl_diag *diag
 scene *scene_load(const char *path, sl_diag *diag);
 
 /* As scene_parse, with the texts of ReadArchive taken from `archives`
- * (sl/source.h; its loader, if any, is asked for missing names). A worker
- * passes the job's set without a loader; the master a set whose loader is
- * scene_archive_load_from_disk, which leaves the archives read in the set
- * to ship with the job. scene_parse and scene_load read archives from disk
- * (a private set). `archives` NULL: ReadArchive finds nothing. */
+ * (sl/source.h; its loader, if any, is asked for missing names). The
+ * master and standalone read archives from disk (scene_archive_set_new, or
+ * common/job's loader that also makes each archive a job file); a worker
+ * reads them from the job's files in its store (common/job/job_archive.c).
+ * scene_parse and scene_load read archives from disk (a private set).
+ * `archives` NULL: ReadArchive finds nothing. */
 scene *scene_parse_archives(const char *file, const char *text, size_t len,
                             sl_source_set *archives, sl_diag *diag);
+
+/* The largest archive, uncompressed: an archive travels as a file of the
+ * job (once per host, docs/farm.md), not inside the Job message, so its
+ * bound is what one parse may hold in memory. The top-level scene text
+ * keeps its own bound (the Job message's, 4 MiB). */
+#define SCENE_ARCHIVE_MAX_BYTES ((size_t)1 << 30)
+
+/* An empty set for archive texts: at most SCENE_ARCHIVE_MAX_BYTES each,
+ * read from disk by scene_archive_load_from_disk. */
+sl_source_set *scene_archive_set_new(void);
 
 /* An sl_source_loader: reads file `name` from disk into the set,
  * gunzipping it when gzip-compressed; 1 when it does not exist. */
 int scene_archive_load_from_disk(sl_source_set *set, const char *name, sl_diag *diag,
                                  void *arg);
+
+/* Reads the archive at `path` (plain or gzip) into the set under `name`
+ * (the name messages use): 0, 1 when there is no such file, -1 on another
+ * failure (in diag: unreadable, a damaged gzip stream, larger than the
+ * set's maximum size). */
+int scene_archive_read(sl_source_set *set, const char *name, const char *path,
+                       sl_diag *diag);
 
 /* How deep archives may read archives. */
 enum { SCENE_ARCHIVE_MAX_DEPTH = 16 };
@@ -298,8 +317,8 @@ enum { SCENE_ARCHIVE_MAX_DEPTH = 16 };
 /* The most objects a scene may place (primitives, mesh faces and
  * instanced copies together), so that a scene received over the network
  * cannot exhaust the memory of the master or a worker (issue 12). The
- * scene text itself is bounded by the source size (4 MiB, sl/source.h)
- * and archives are bounded the same way each. */
+ * scene text itself is bounded by the source size (4 MiB, sl/source.h),
+ * each archive by SCENE_ARCHIVE_MAX_BYTES. */
 enum { SCENE_MAX_OBJECTS = 1 << 20 };
 
 /* The most mesh pieces (a face, or a triangle of one) the objects of a

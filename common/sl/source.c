@@ -9,6 +9,7 @@
 #include "sl/source.h"
 #include "util/xalloc.h"
 
+#include <assert.h>
 #include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -149,6 +150,42 @@ const sl_source *sl_source_set_find(const sl_source_set *self, const char *name)
     return src;
 }
 
+/* Stores the entry; `text` (len + 1 bytes, NUL-terminated) becomes the set's. */
+static int add_owned(sl_source_set *self, const char *name, char *text, size_t len)
+{
+    if (!name || !*name) {
+        free(text);
+        errno = EINVAL;
+        return -1;
+    }
+    if (len > self->max_size) {
+        free(text);
+        errno = EFBIG;
+        return -1;
+    }
+    char *norm = sl_source_normalize(name);
+    const sl_source *old = find_normalized(self, norm);
+    if (old) {
+        free(norm);
+        bool same = old->len == len && memcmp(old->text, text, len) == 0;
+        free(text);
+        if (same)
+            return 0;
+        errno = EEXIST;
+        return -1;
+    }
+    sl_source *src = xmalloc(sizeof *src);
+    src->name = norm;
+    src->text = text;
+    src->len = len;
+    if (self->count == self->cap) {
+        self->cap = self->cap ? 2 * self->cap : 8;
+        self->items = xrealloc(self->items, self->cap * sizeof *self->items);
+    }
+    self->items[self->count++] = src;
+    return 0;
+}
+
 int sl_source_set_add(sl_source_set *self, const char *name, const char *text, size_t len)
 {
     if (!name || !*name) {
@@ -159,29 +196,17 @@ int sl_source_set_add(sl_source_set *self, const char *name, const char *text, s
         errno = EFBIG;
         return -1;
     }
-    char *norm = sl_source_normalize(name);
-    const sl_source *old = find_normalized(self, norm);
-    if (old) {
-        free(norm);
-        if (old->len == len && memcmp(old->text, text, len) == 0)
-            return 0;
-        errno = EEXIST;
-        return -1;
-    }
-    sl_source *src = xmalloc(sizeof *src);
     char *copy = xmalloc(len + 1);
     if (len)
         memcpy(copy, text, len);
     copy[len] = '\0';
-    src->name = norm;
-    src->text = copy;
-    src->len = len;
-    if (self->count == self->cap) {
-        self->cap = self->cap ? 2 * self->cap : 8;
-        self->items = xrealloc(self->items, self->cap * sizeof *self->items);
-    }
-    self->items[self->count++] = src;
-    return 0;
+    return add_owned(self, name, copy, len);
+}
+
+int sl_source_set_adopt(sl_source_set *self, const char *name, char *text, size_t len)
+{
+    assert(text && text[len] == '\0');   /* the caller's promise */
+    return add_owned(self, name, text, len);
 }
 
 size_t sl_source_set_count(const sl_source_set *self) { return self->count; }

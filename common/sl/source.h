@@ -65,6 +65,11 @@ size_t sl_source_set_max_size(const sl_source_set *self);
  * valid until it is destroyed. */
 int sl_source_set_add(sl_source_set *self, const char *name, const char *text, size_t len);
 
+/* As sl_source_set_add, but the set takes `text` itself (no copy: a big
+ * archive is held once): malloc'd, at least len + 1 bytes, text[len] ==
+ * '\0'. On failure, and when the same text is there already, it is freed. */
+int sl_source_set_adopt(sl_source_set *self, const char *name, char *text, size_t len);
+
 /* Reads the file at `path` into the set under `name` (NULL: the path
  * itself). Failures are reported to diag (if not NULL) as errors without
  * position, e.g. "cannot open 'x.sl': No such file or directory" or

@@ -4,7 +4,8 @@
  * including file (nested archives relative to their own folder), through
  * Option "searchpath" "archive", gzip-compressed; in the graphics state of
  * the ReadArchive; errors with file:line:col naming the archive chain (not
- * found, cycles, too deep); and a parse from a set without a loader (what
+ * found, cycles, too deep); the size limit (uncompressed, per archive,
+ * far over a shader source's); and a parse from a set without a loader (what
  * a worker does) never touches the disk.
  */
 #include <stdarg.h>
@@ -224,6 +225,50 @@ static void test_damaged_gzip(void **state)
     sl_diag_destroy(&d);
 }
 
+/* An archive is bounded by its set's size (SCENE_ARCHIVE_MAX_BYTES, 1 GiB,
+ * in the sets the parser, job_load and a worker use: far over the 4 MiB
+ * of a shader source), counted uncompressed: a 5 MiB archive gzipped to a
+ * few KiB reads whole under the default, and over a 1 MiB bound it is an
+ * error naming the archive and the limit, and ReadArchive's position. */
+static void test_archive_size_limit(void **state)
+{
+    (void)state;
+    enum { BIG = 5 << 20 };
+    char *text = malloc(BIG + 1);
+    assert_non_null(text);
+    const char *line = "Translate 0 0 0.000\n";   /* 20 bytes */
+    for (size_t i = 0; i + 20 <= BIG; i += 20) memcpy(text + i, line, 20);
+    memcpy(text + BIG - 20, "Sphere 1 -1 1 360  \n", 20);
+    text[BIG] = '\0';
+    write_gzip("parts/big.rib.gz", text);
+    free(text);
+    assert_true(SCENE_ARCHIVE_MAX_BYTES == (size_t)1 << 30);
+    sl_diag *d;
+    scene *s = load_main(CAMERA "WorldBegin\nReadArchive \"parts/big.rib.gz\"\nWorldEnd\n", &d);
+    if (!s) sl_diag_print(d, stderr);
+    assert_non_null(s);
+    assert_int_equal(s->nobjects, 1);
+    scene_destroy(&s);
+    sl_diag_destroy(&d);
+
+    sl_source_set *set = scene_archive_set_new();
+    sl_source_set_set_max_size(set, 1 << 20);
+    d = sl_diag_new();
+    const char *main_text = CAMERA "WorldBegin\nReadArchive \"parts/big.rib.gz\"\nWorldEnd\n";
+    s = scene_parse_archives(path_of("main.rib"), main_text, strlen(main_text), set, d);
+    assert_null(s);
+    char want[1024];
+    snprintf(want, sizeof want, "archive '%s' is larger than 1 MiB uncompressed (the limit "
+             "is 1048576 bytes per archive): split it into several archives",
+             path_of("parts/big.rib.gz"));
+    assert_non_null(strstr(diag_line(nth_diag(d, SL_DIAG_ERROR, 0)), want));
+    assert_non_null(strstr(diag_line(nth_diag(d, SL_DIAG_ERROR, 1)),
+                           "main.rib:4:13: ReadArchive: archive \"parts/big.rib.gz\" cannot be "
+                           "read"));
+    sl_diag_destroy(&d);
+    sl_source_set_destroy(&set);
+}
+
 /* A worker: archives only from the set it was given, none from disk. */
 static void test_from_set_only(void **state)
 {
@@ -260,6 +305,7 @@ int main(void)
         cmocka_unit_test(test_error_names_chain),
         cmocka_unit_test(test_cycle_and_depth),
         cmocka_unit_test(test_damaged_gzip),
+        cmocka_unit_test(test_archive_size_limit),
         cmocka_unit_test(test_from_set_only),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
