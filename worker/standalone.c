@@ -161,7 +161,9 @@ typedef struct frame_out {
 static int render_frame(const standalone_options *opt, const job *jb, const frame_out *fo)
 {
     sl_diag *diag = sl_diag_new();
-    job_scene *js = job_scene_new(jb, opt->cache_bytes, true, &interrupted, diag);
+    job_scene *js = job_scene_new_threads(jb, opt->cache_bytes, true,
+                                          opt->threads > 0 ? opt->threads : default_threads(),
+                                          &interrupted, diag);
     if (atomic_load(&interrupted)) {   /* also while the world was built */
         sl_diag_destroy(&diag);
         fprintf(stderr, "aafarm-worker: interrupted; %s not written\n", fo->output);

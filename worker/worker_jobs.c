@@ -19,6 +19,7 @@ struct worker_jobs {
     held_job **jobs;           /* newest first */
     int count, max;
     size_t cache_bytes;
+    int threads;                   /* for preparing a job (worker_jobs_set_threads) */
     const atomic_int *cancel;  /* the worker's stop flag, or NULL */
 };
 
@@ -52,7 +53,13 @@ worker_jobs *worker_jobs_new(int max_held, size_t cache_bytes, const atomic_int 
     self->max = max_held < 1 ? 1 : max_held;
     self->jobs = xcalloc((size_t)self->max, sizeof *self->jobs);
     self->cache_bytes = cache_bytes;
+    self->threads = 1;
     return self;
+}
+
+void worker_jobs_set_threads(worker_jobs *self, int threads)
+{
+    self->threads = threads > 0 ? threads : 1;
 }
 
 void worker_jobs_destroy(worker_jobs **self_p)
@@ -133,11 +140,11 @@ static bool layers_of(const proto_render_options *o, unsigned *layers, char *err
 }
 
 /* Compiles the job and checks the image it describes. */
-static bool prepare(held_job *h, const proto_job *m, size_t cache_bytes,
+static bool prepare(held_job *h, const proto_job *m, size_t cache_bytes, int threads,
                     const atomic_int *cancel)
 {
     sl_diag *diag = sl_diag_new();
-    h->js = job_scene_new(h->jb, cache_bytes, true, cancel, diag);
+    h->js = job_scene_new_threads(h->jb, cache_bytes, true, threads, cancel, diag);
     if (h->js) trace_renderer_set_log(h->js->renderer, worker_log_warning, NULL);
     if (!h->js) {
         char *text = sl_diag_to_string(diag);
@@ -212,7 +219,7 @@ held_job *worker_jobs_add(worker_jobs *self, const proto_job *m, char *const *fi
                  m->job_hash);
         job_destroy(&h->jb);
     }
-    if (!h->jb || !prepare(h, m, cache, self->cancel)) {
+    if (!h->jb || !prepare(h, m, cache, self->threads, self->cancel)) {
         h->broken = true;
         job_scene_destroy(&h->js);
         job_destroy(&h->jb);

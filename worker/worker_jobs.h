@@ -52,6 +52,9 @@ typedef struct worker_jobs worker_jobs;
  * that compiling and preparing a job stop when it is set (the job is then
  * broken with "interrupted"; the caller is leaving anyway). */
 worker_jobs *worker_jobs_new(int max_held, size_t cache_bytes, const atomic_int *cancel);
+/* The threads a job's preparation may use (the root boxes of displaced
+ * meshes: job_scene_new_threads); default 1. */
+void worker_jobs_set_threads(worker_jobs *self, int threads);
 void worker_jobs_destroy(worker_jobs **self_p);
 
 /* The held job with this hash (broken or not), or NULL. No reference is

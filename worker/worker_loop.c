@@ -874,6 +874,7 @@ int worker_loop_run(const worker_loop_options *opt)
     w.ctx = zmq_ctx_new();
     w.pool = worker_pool_new(w.threads, opt->tile_delay_ms);
     w.jobs = worker_jobs_new(MAX_JOBS_HELD, opt->cache_bytes, &interrupted);
+    worker_jobs_set_threads(w.jobs, w.threads);
     file_fetch_options fo = {opt->file_cache, opt->file_cache_bytes, opt->file_chunk,
                              opt->file_inflight, opt->file_delay_ms};
     w.files = file_fetch_new(&fo);

@@ -383,6 +383,12 @@ static bool open_textures(job_scene *self, sl_diag *diag, bool render)
 job_scene *job_scene_new(const job *jb, size_t cache_bytes, bool render,
                          const atomic_int *cancel, sl_diag *diag)
 {
+    return job_scene_new_threads(jb, cache_bytes, render, 1, cancel, diag);
+}
+
+job_scene *job_scene_new_threads(const job *jb, size_t cache_bytes, bool render, int threads,
+                                 const atomic_int *cancel, sl_diag *diag)
+{
     job_scene *self = xcalloc(1, sizeof *self);
     self->job = jb;
     /* archives come from the job's files (the master's disk, this host's
@@ -416,6 +422,7 @@ job_scene *job_scene_new(const job *jb, size_t cache_bytes, bool render,
         w->options.max_instructions = jb->options.max_instructions;
         w->options.cache_bytes = cache_bytes;
         w->options.cancel = cancel;
+        w->options.build_threads = threads;
         if (sc->trace_maxdepth >= 0) w->options.max_ray_depth = sc->trace_maxdepth;
     }
     if (ok && !render) {

@@ -35,6 +35,11 @@ typedef struct job_scene {
  * job_scene. */
 job_scene *job_scene_new(const job *job, size_t cache_bytes, bool render,
                          const atomic_int *cancel, sl_diag *diag);
+/* The same, the renderer's world built with `threads` threads (the root
+ * boxes of displaced meshes' pieces, trace_options.build_threads): a
+ * worker passes its rendering threads. */
+job_scene *job_scene_new_threads(const job *job, size_t cache_bytes, bool render, int threads,
+                                 const atomic_int *cancel, sl_diag *diag);
 void job_scene_destroy(job_scene **self_p);
 
 #endif

@@ -14,6 +14,7 @@
 
 #include <assert.h>
 #include <math.h>
+#include <pthread.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
@@ -411,6 +412,68 @@ void trace_mesh_clear_bvh(trace_mesh *self)
     free_bvh(&self->bvh);
 }
 
+/* One thread's share of the pieces' boxes: pieces [k0, k1) of obj with
+ * its own trace_thread (VM, affine context) on the shared arrays. */
+typedef struct box_share {
+    trace_thread *th;                  /* the caller's, or made for this share */
+    const trace_object *obj;
+    trace_box *roots;
+    double (*dudv)[2];
+    int k0, k1;
+} box_share;
+
+static void *box_range(void *arg)
+{
+    box_share *b = arg;
+    trace_mesh *m = b->obj->mesh;
+    trace_view *v = xmalloc(sizeof *v);
+    for (int k = b->k0; k < b->k1; k++) {
+        if (((k - b->k0) & 255) == 0 && trace_thread_cancelled(b->th)) break;
+        if (!make(b->th, b->obj, k, true, false, v)) break;
+        float_box(&v->obj.root, m->bounds[k]);
+        if (b->roots) {
+            b->roots[k] = v->obj.root;
+            b->dudv[k][0] = v->obj.du;
+            b->dudv[k][1] = v->obj.dv;
+        }
+    }
+    free(v);
+    return NULL;
+}
+
+/* The pieces' boxes over `threads` threads (world options.build_threads):
+ * each piece's box is a pure function of the piece, so the split changes
+ * no bit. False with th failed (the first share's error) when one failed. */
+static bool boxes_in_parallel(trace_thread *th, const trace_object *obj, trace_box *roots,
+                              double (*dudv)[2])
+{
+    const trace_mesh *m = obj->mesh;
+    int threads = th->world->options.build_threads;
+    /* a thread is worth its start for a few thousand pieces of shader work */
+    if (threads > m->npieces / 2048) threads = m->npieces / 2048;
+    if (threads < 1) threads = 1;
+    box_share *share = xcalloc((size_t)threads, sizeof *share);
+    pthread_t *tid = xcalloc((size_t)threads, sizeof *tid);
+    bool *started = xcalloc((size_t)threads, sizeof *started);
+    for (int i = 0; i < threads; i++) {
+        share[i] = (box_share){i == 0 ? th : trace_thread_new(th->world), obj, roots, dudv,
+                               (int)((long)m->npieces * i / threads),
+                               (int)((long)m->npieces * (i + 1) / threads)};
+        if (i > 0) started[i] = pthread_create(&tid[i], NULL, box_range, &share[i]) == 0;
+    }
+    box_range(&share[0]);
+    for (int i = 1; i < threads; i++) {
+        if (started[i]) pthread_join(tid[i], NULL);
+        else box_range(&share[i]);     /* no thread: this one does its share */
+        if (share[i].th->failed && !th->failed) trace_thread_fail(th, share[i].th->error);
+        trace_thread_destroy(&share[i].th);
+    }
+    free(started);
+    free(tid);
+    free(share);
+    return !th->failed;
+}
+
 bool trace_mesh_build(trace_thread *th, trace_object *obj)
 {
     trace_mesh *m = obj->mesh;
@@ -428,18 +491,7 @@ bool trace_mesh_build(trace_thread *th, trace_object *obj)
             m->bounds = xmalloc(sizeof *m->bounds * n);
             trace_box *roots = obj->displacement ? xmalloc(sizeof *roots * n) : NULL;
             double (*dudv)[2] = obj->displacement ? xmalloc(sizeof *dudv * n) : NULL;
-            trace_view *v = xmalloc(sizeof *v);
-            for (int k = 0; k < m->npieces; k++) {
-                if ((k & 255) == 0 && trace_thread_cancelled(th)) break;
-                if (!make(th, obj, k, true, false, v)) break;
-                float_box(&v->obj.root, m->bounds[k]);
-                if (roots) {
-                    roots[k] = v->obj.root;
-                    dudv[k][0] = v->obj.du;
-                    dudv[k][1] = v->obj.dv;
-                }
-            }
-            free(v);
+            boxes_in_parallel(th, obj, roots, dudv);
             m->roots = roots;          /* from now on, views take these */
             m->dudv = dudv;
         }

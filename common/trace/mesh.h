@@ -66,7 +66,9 @@ void trace_mesh_clear_bvh(trace_mesh *self);
 
 /* The pieces' boxes and BVH of mesh object obj's mesh (once for the
  * objects that share it), and obj's root (their union, object space) and
- * camera-space bound; false when the thread failed or was cancelled. */
+ * camera-space bound; false when the thread failed or was cancelled. A
+ * displaced mesh's root boxes are shared among world options.build_threads
+ * threads (the same boxes, to the bit, for any count). */
 bool trace_mesh_build(trace_thread *th, trace_object *obj);
 
 /* Nearest hit of the camera-space ray with the mesh's pieces in

@@ -179,6 +179,9 @@ typedef struct trace_options {
     int max_ray_depth;             /* nested trace() rays from shaders (RIB
                                       Option "trace" "maxdepth"; at most
                                       TRACE_RAY_DEPTH_LIMIT) */
+    int build_threads;             /* threads trace_renderer_new may use for
+                                      the boxes of displaced meshes' pieces
+                                      (0, 1: the calling thread alone) */
     bool prove_hits;               /* try hit proofs on small cells
                                       (trace/prove.h); off: leaves only */
     const atomic_int *cancel;      /* the program's stop flag (a signal), or
