@@ -426,8 +426,9 @@ job_scene *job_scene_new_threads(const job *jb, size_t cache_bytes, bool render,
         if (sc->trace_maxdepth >= 0) w->options.max_ray_depth = sc->trace_maxdepth;
     }
     if (ok && !render) {
+        /* a check (the master's): no pieces' shared edges or boxes */
         char err[ERR_LEN];
-        if (!trace_world_prepare(&self->world, err, sizeof err)) {
+        if (!trace_world_check(&self->world, err, sizeof err)) {
             sl_diag_error(diag, (sl_pos){0}, "%s", err);
             ok = false;
         }

@@ -255,7 +255,7 @@ static void find_shared_edges(trace_world *world)
     free(meshes);
 }
 
-bool trace_world_prepare(trace_world *world, char *err, size_t errsz)
+bool trace_world_check(trace_world *world, char *err, size_t errsz)
 {
     for (int i = 0; i < world->nobjects; i++) {
         trace_object *obj = &world->objects[i];
@@ -283,6 +283,12 @@ bool trace_world_prepare(trace_world *world, char *err, size_t errsz)
                                  !sl_program_reads_global(dp, SL_G_dPdu) &&
                                  !sl_program_reads_global(dp, SL_G_dPdv);
     }
+    return true;
+}
+
+bool trace_world_prepare(trace_world *world, char *err, size_t errsz)
+{
+    if (!trace_world_check(world, err, errsz)) return false;
     /* ids: the objects, then each mesh's pieces (once per mesh: the
      * objects sharing it share them); its boxes and BVH made anew */
     for (int i = 0; i < world->nobjects; i++)

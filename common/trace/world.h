@@ -219,6 +219,11 @@ typedef struct trace_world {
  * or nearly singular. Called by trace_renderer_new; idempotent. */
 bool trace_world_prepare(trace_world *world, char *err, size_t errsz);
 
+/* The per-object part of trace_world_prepare alone (the checks, scale,
+ * normal bounds, du, dv): what a world that is never rendered needs (the
+ * master's check of a job: no piece ids, shared edges or pieces' boxes). */
+bool trace_world_check(trace_world *world, char *err, size_t errsz);
+
 /* The object's du, dv (world.c; a mesh piece's view sets its own). */
 void trace_object_grid_spacing(const trace_world *world, trace_object *obj);
 
