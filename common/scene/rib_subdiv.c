@@ -229,6 +229,13 @@ static void subdivision_mesh(rib_parser *p, const rib_request *req, bool hier)
     int first = 3;
     bool have_tags = first < req->nargs && is_array(&req->args[first]);
     int after_tags = first + (hier ? 5 : 4);
+    for (int k = first; have_tags && k < after_tags; k++)
+        if (k >= req->nargs || !is_array(&req->args[k])) {     /* before the parameters */
+            rib_error(p, req, req->args[first].pos, hier ? "the tags need four more arrays: "
+                      "[nargs] [intargs] [floatargs] [stringargs]" : "the tags need three more "
+                      "arrays: [nargs] [intargs] [floatargs]");
+            goto out;
+        }
     if (!rib_params_read(p, req, have_tags ? after_tags : first, RIB_PARAMS_VARYING, &params))
         goto out;
     const scene_param *P = rib_params_find(&params, "P");
