@@ -58,16 +58,19 @@ static bool need_positive(const geom_surface *s, const char *name, double x,
                      geom_kind_name(s->kind), name, x);
 }
 
-static bool need_below(const geom_surface *s, const char *lo_name, double lo,
-                       const char *hi_name, double hi, char *err, size_t errsz)
+/* RI spec §5.2 gives the range's ends in either order: z = zmin + v (zmax
+ * - zmin) runs down when zmin > zmax, which (like a negative thetamax)
+ * turns the surface inside out ("the sense of a quadric can be reversed by
+ * giving negative parameters"). Only equal ends leave nothing. */
+static bool need_apart(const geom_surface *s, const char *a_name, double a,
+                       const char *b_name, double b, char *err, size_t errsz)
 {
-    if (!need_finite(s, lo_name, lo, err, errsz) || !need_finite(s, hi_name, hi, err, errsz))
+    if (!need_finite(s, a_name, a, err, errsz) || !need_finite(s, b_name, b, err, errsz))
         return false;
-    if (lo < hi)
+    if (a != b)
         return true;
-    return err_set(err, errsz, "%s %s must be < %s, got %s %g and %s %g",
-                     geom_kind_name(s->kind), lo_name, hi_name, lo_name, lo,
-                     hi_name, hi);
+    return err_set(err, errsz, "%s %s and %s must differ, both are %g (nothing left)",
+                   geom_kind_name(s->kind), a_name, b_name, a);
 }
 
 /* |thetamax| in (0, 2 pi]: RI spec §5.2 sweeps at most one revolution. */
@@ -103,22 +106,29 @@ static ia_interval diff(double hi, double lo)
 /* ---------------------------------------------------------------------- */
 
 /* RI spec §5.2: phimin = asin(zmin/radius) (-90 degrees when zmin <=
- * -radius), phimax likewise. These two doubles then define the sphere. */
+ * -radius, 90 when >= radius), phimax likewise. These two doubles then
+ * define the sphere; phimin > phimax (zmin > zmax) sweeps down. */
+static double sphere_phi(double z, double r)
+{
+    return z <= -r ? -M_PI_2 : z >= r ? M_PI_2 : asin(z / r);
+}
+
 static bool prepare_sphere(geom_surface *s, char *err, size_t errsz)
 {
     double r = s->radius;
     if (!need_positive(s, "radius", r, err, errsz) ||
-        !need_below(s, "zmin", s->zmin, "zmax", s->zmax, err, errsz) || !need_sweep(s, err, errsz))
+        !need_apart(s, "zmin", s->zmin, "zmax", s->zmax, err, errsz) || !need_sweep(s, err, errsz))
         return false;
-    if (s->zmin >= r)
-        return err_set(err, errsz, "sphere zmin must be < radius %g, got %g (nothing left)",
-                         r, s->zmin);
-    if (s->zmax <= -r)
-        return err_set(err, errsz, "sphere zmax must be > -radius %g, got %g (nothing left)",
-                         -r, s->zmax);
-    s->phi0 = s->zmin <= -r ? -M_PI_2 : asin(s->zmin / r);
-    s->phi1 = s->zmax >= r ? M_PI_2 : asin(s->zmax / r);
-    if (!(s->phi0 < s->phi1))
+    double lo = fmin(s->zmin, s->zmax), hi = fmax(s->zmin, s->zmax);
+    if (lo >= r)
+        return err_set(err, errsz, "sphere zmin and zmax must not both be >= radius %g, got "
+                       "%g and %g (nothing left)", r, s->zmin, s->zmax);
+    if (hi <= -r)
+        return err_set(err, errsz, "sphere zmin and zmax must not both be <= -radius %g, got "
+                       "%g and %g (nothing left)", -r, s->zmin, s->zmax);
+    s->phi0 = sphere_phi(s->zmin, r);
+    s->phi1 = sphere_phi(s->zmax, r);
+    if (s->phi0 == s->phi1)
         return err_set(err, errsz, "sphere zmin %g and zmax %g are too close", s->zmin, s->zmax);
     s->consts[K_DPHI] = diff(s->phi1, s->phi0);
     return true;
@@ -133,7 +143,7 @@ static bool prepare_disk(geom_surface *s, char *err, size_t errsz)
 static bool prepare_cylinder(geom_surface *s, char *err, size_t errsz)
 {
     if (!need_positive(s, "radius", s->radius, err, errsz) ||
-        !need_below(s, "zmin", s->zmin, "zmax", s->zmax, err, errsz) || !need_sweep(s, err, errsz))
+        !need_apart(s, "zmin", s->zmin, "zmax", s->zmax, err, errsz) || !need_sweep(s, err, errsz))
         return false;
     s->consts[K_DZ] = diff(s->zmax, s->zmin);
     return true;
@@ -148,7 +158,8 @@ static bool prepare_cone(geom_surface *s, char *err, size_t errsz)
     return need_positive(s, "radius", s->radius, err, errsz) && need_sweep(s, err, errsz);
 }
 
-/* RI spec §5.2: r = rmax*sqrt(z/zmax), z = zmin + v*(zmax - zmin). */
+/* RI spec §5.2: r = rmax*sqrt(z/zmax), z = zmin + v*(zmax - zmin) (zmin >
+ * zmax runs down: inside out); z >= 0 throughout. */
 static bool prepare_paraboloid(geom_surface *s, char *err, size_t errsz)
 {
     if (!need_positive(s, "rmax", s->rmax, err, errsz) ||
@@ -157,7 +168,7 @@ static bool prepare_paraboloid(geom_surface *s, char *err, size_t errsz)
         return false;
     if (s->zmin < 0)
         return err_set(err, errsz, "paraboloid zmin must be >= 0, got %g", s->zmin);
-    if (!need_below(s, "zmin", s->zmin, "zmax", s->zmax, err, errsz) || !need_sweep(s, err, errsz))
+    if (!need_apart(s, "zmin", s->zmin, "zmax", s->zmax, err, errsz) || !need_sweep(s, err, errsz))
         return false;
     s->consts[K_DZ] = diff(s->zmax, s->zmin);
     s->consts[K_PK] = ia_div(ia_sqr(ia_point(s->rmax)), ia_point(s->zmax));
@@ -187,12 +198,12 @@ static bool prepare_torus(geom_surface *s, char *err, size_t errsz)
 {
     if (!need_positive(s, "majorradius", s->majorrad, err, errsz) ||
         !need_positive(s, "minorradius", s->minorrad, err, errsz) ||
-        !need_below(s, "phimin", s->phimin, "phimax", s->phimax, err, errsz) ||
+        !need_apart(s, "phimin", s->phimin, "phimax", s->phimax, err, errsz) ||
         !need_sweep(s, err, errsz))
         return false;
-    if (s->phimax - s->phimin > GEOM_TWO_PI * (1 + GEOM_SWEEP_SLACK))
-        return err_set(err, errsz, "torus phimax - phimin must be at most 2*pi (360 degrees), got %g",
-                         s->phimax - s->phimin);
+    if (fabs(s->phimax - s->phimin) > GEOM_TWO_PI * (1 + GEOM_SWEEP_SLACK))
+        return err_set(err, errsz, "torus phimax - phimin must be at most 2*pi (360 degrees) in "
+                       "magnitude, got %g", s->phimax - s->phimin);
     s->consts[K_DPHI] = diff(s->phimax, s->phimin);
     return true;
 }

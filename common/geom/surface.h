@@ -96,7 +96,8 @@ typedef struct geom_sample {
     vec3 dNgdu, dNgdv;     /* filled by geom_eval_dual only */
 } geom_sample;
 
-/* Checks the parameters (finite numbers, radius > 0, zmin < zmax,
+/* Checks the parameters (finite numbers, radius > 0, zmin != zmax (either
+ * order: RI spec §5.2, zmin > zmax turns the surface inside out),
  * thetamax != 0, polygon convex and planar with >= 3 distinct vertices,
  * ...), fills the derived fields. On failure returns false and writes a
  * one-line reason ("sphere radius must be > 0, got -1") into err. */

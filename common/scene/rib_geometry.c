@@ -36,14 +36,14 @@ static bool basic_check(const geom_surface *s, char *err, size_t errsz)
     switch (s->kind) {
     case GEOM_SPHERE: case GEOM_CYLINDER:
         if (!(s->radius > 0)) what = "radius must be > 0";
-        else if (!(s->zmin < s->zmax)) what = "zmin must be < zmax";
+        else if (s->zmin == s->zmax) what = "zmin must differ from zmax";
         break;
     case GEOM_DISK: case GEOM_CONE:
         if (!(s->radius > 0)) what = "radius must be > 0";
         break;
     case GEOM_PARABOLOID:
         if (!(s->rmax > 0)) what = "rmax must be > 0";
-        else if (!(s->zmin < s->zmax)) what = "zmin must be < zmax";
+        else if (s->zmin == s->zmax) what = "zmin must differ from zmax";
         break;
     case GEOM_TORUS:
         if (!(s->minorrad > 0)) what = "minor radius must be > 0";
@@ -111,6 +111,12 @@ void rib_place_surface(rib_parser *p, const rib_request *req, const geom_surface
                        const scene_primvar *vars, int nvars)
 {
     const rib_attributes *a = &p->attr;
+    scene_primvar with_st[SCENE_MAX_PRIMVARS];     /* TextureCoordinates (rib_texcoord.c) */
+    int nst = mesh ? -1 : rib_texcoord_vars(p, surf, vars, nvars, with_st);
+    if (nst >= 0) {
+        vars = with_st;
+        nvars = nst;
+    }
     mat4 to_camera = mat4_mul(p->scene->camera.camera_from_world, ctm), inv;
     if (!mat4_invert(&to_camera, &inv)) {
         rib_error(p, req, req->pos, "the current transform is singular (a Scale by 0?)");

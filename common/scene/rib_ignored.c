@@ -60,7 +60,6 @@ static const ignored_def ignored[] = {
     { "FrameAspectRatio", "is not supported; ignored (the screen window follows Format, or "
                           "give ScreenWindow)" },
     { "ClippingPlane", "is not supported; ignored (nothing is clipped by it)" },
-    { "TextureCoordinates", "is not supported; ignored (surfaces keep their default s, t)" },
     { "Skew", "is not supported; ignored, so the objects after it are placed without it" },
     { "Perspective", "is not supported; ignored, so the objects after it are placed without "
                      "it" },

@@ -477,13 +477,17 @@ static const request_def requests[] = {
     { "Patch", rib_patch, PRIMITIVE },
     { "PointsPolygons", rib_points_polygons, PRIMITIVE },
     { "SubdivisionMesh", rib_subdivision_mesh, PRIMITIVE },
+    { "HierarchicalSubdivisionMesh", rib_hierarchical_subdivision_mesh, PRIMITIVE },
     { "PointsGeneralPolygons", rib_points_general_polygons, PRIMITIVE },
     { "GeneralPolygon", rib_general_polygon, PRIMITIVE },
     { "PatchMesh", rib_patch_mesh, PRIMITIVE },
     { "Basis", rib_basis, ANYWHERE },
+    { "TextureCoordinates", rib_texture_coordinates, ANYWHERE },
     { "NuPatch", rib_nu_patch, PRIMITIVE },
     { "TrimCurve", rib_trim_curve, ANYWHERE },
     { "ReadArchive", rib_read_archive, ANYWHERE },
+    { "ArchiveBegin", rib_archive_begin, BLOCK },     /* rib_inline_archive.c */
+    { "ArchiveEnd", rib_archive_end, BLOCK },
     { "ObjectBegin", rib_object_begin, BLOCK_WORLD },
     { "ObjectEnd", rib_object_end, BLOCK_WORLD },
     { "ObjectInstance", rib_object_instance, WORLD },
@@ -572,6 +576,8 @@ static void dispatch(rib_parser *p, const rib_request *req)
         skip_frame_request(p, req);
         return;
     }
+    if (rib_inline_archive_filter(p, req))   /* recorded, or an inline archive read */
+        return;
     if (rib_motion_filter(p, req))
         return;
     const request_def *def = find_request(req->name);
@@ -602,7 +608,7 @@ static void dispatch(rib_parser *p, const rib_request *req)
     if (!allowed_here(p, req, def->where))
         return;
     if (block && strcmp(req->name, "FrameBegin") != 0 && strcmp(req->name, "ObjectBegin") != 0
-        && !req->broken)
+        && strcmp(req->name, "ArchiveBegin") != 0 && !req->broken)
         rib_no_more_args(p, req, 0);
     rib_object_def *defining = rib_defining(p);
     if (defining && !block && def->where != PRIMITIVE && def->fn != rib_read_archive &&
@@ -719,6 +725,7 @@ static void finish(rib_parser *p)
     if (p->in_motion)
         sl_diag_error(p->diag, p->motion_pos, "MotionBegin: this block is never closed "
                       "(missing MotionEnd)");
+    rib_inline_archive_finish(p);
     close_open_blocks(p);
     int nframes = p->scene->nframes;
     if (p->scanning)
@@ -784,6 +791,7 @@ static void parser_clear(rib_parser *p)
         free(p->texture_path[i]);
     free(p->texture_path);
     rib_object_defs_clear(p);
+    rib_inline_archives_destroy(p);
     rib_decls_destroy(&p->decls);
     rib_reader_destroy(&p->reader);
 }
@@ -798,6 +806,14 @@ static bool cancelled(rib_parser *p, const rib_request *req)
         p->cancelled = true;
     }
     return p->cancelled;
+}
+
+bool rib_parser_step(rib_parser *p, const rib_request *req)
+{
+    if (sl_diag_full(p->diag) || p->blocks_overflow || p->cancelled || cancelled(p, req))
+        return false;
+    dispatch(p, req);
+    return true;
 }
 
 void rib_parser_run(rib_parser *p)

@@ -11,6 +11,8 @@
  *   rib_geometry.c     the base surfaces (Sphere ... Polygon, Patch)
  *   rib_params.c       parameter lists: typing and reading values
  *   rib_archive.c      ReadArchive: archives found, loaded and read in place
+ *   rib_inline_archive.c  ArchiveBegin/End: inline archives, recorded and
+ *                      replayed by ReadArchive of their names
  *   rib_instance.c     ObjectBegin/End, ObjectInstance: retained surfaces
  *   rib_mesh.c         PointsPolygons, PointsGeneralPolygons, GeneralPolygon
  *   rib_patch.c        Basis, Patch "bicubic", PatchMesh
@@ -60,6 +62,8 @@ typedef struct rib_attributes {
     rib_light_set *lights_on;      /* NULL: none on */
     double ubasis[16], vbasis[16]; /* Basis (row-major, RIB order; bezier) */
     int ustep, vstep;              /* Basis steps (3 3) */
+    bool texcoords;                /* TextureCoordinates other than the default */
+    double st[8];                  /* s1 t1 .. s4 t4 (rib_texcoord.c) */
 } rib_attributes;
 
 typedef enum rib_block_kind {
@@ -148,6 +152,8 @@ typedef struct rib_parser {
     sl_source_set *diag_sources;   /* diag's set: archives added for carets */
     rib_archive_link archive_chain[SCENE_ARCHIVE_MAX_DEPTH];
     int narchive_chain;            /* archives being read, outermost first */
+    struct rib_inline_archives *inline_archives;   /* ArchiveBegin definitions and
+                                    * the one being recorded (rib_inline_archive.c) */
     rib_object_def *defs;          /* ObjectBegin definitions, in order */
     int ndefs;
     bool warned_mesh_vars;         /* primitive variables a mesh ignores */
@@ -203,6 +209,11 @@ bool rib_no_more_args(rib_parser *p, const rib_request *req, int i);
 /* Dispatches the requests of p->reader until its end (or the
  * diagnostics' cap). */
 void rib_parser_run(rib_parser *p);
+
+/* Dispatches one request as the loop of rib_parser_run does; false
+ * (nothing done) once the parse is to stop (the diagnostics' cap, too many
+ * blocks, the cancel flag). */
+bool rib_parser_step(rib_parser *p, const rib_request *req);
 
 /* ---- parameter lists (rib_params.c) ------------------------------------- */
 
@@ -282,6 +293,16 @@ void rib_patch(rib_parser *p, const rib_request *req);
 /* rib_archive.c */
 void rib_read_archive(rib_parser *p, const rib_request *req);
 
+/* rib_inline_archive.c: ArchiveBegin starts recording; ArchiveEnd outside
+ * a recording is an error. The filter takes every request while one is
+ * recorded, and ReadArchive of an inline archive's name (replayed): true
+ * when it took req. finish reports a block never closed; destroy frees. */
+void rib_archive_begin(rib_parser *p, const rib_request *req);
+void rib_archive_end(rib_parser *p, const rib_request *req);
+bool rib_inline_archive_filter(rib_parser *p, const rib_request *req);
+void rib_inline_archive_finish(rib_parser *p);
+void rib_inline_archives_destroy(rib_parser *p);
+
 /* rib_instance.c */
 void rib_object_begin(rib_parser *p, const rib_request *req);
 void rib_object_end(rib_parser *p, const rib_request *req);
@@ -327,6 +348,7 @@ void rib_trim_curve(rib_parser *p, const rib_request *req);
 
 /* rib_subdiv.c */
 void rib_subdivision_mesh(rib_parser *p, const rib_request *req);
+void rib_hierarchical_subdivision_mesh(rib_parser *p, const rib_request *req);
 
 /* scene_mesh.c: building a mesh (the parser's side of scene_mesh.h). The
  * arrays are copied; the variables' values are found among params' arrays
@@ -361,6 +383,13 @@ bool rib_polygon_vars(rib_parser *p, const rib_request *req, const rib_params *p
                       const scene_param *P);
 void rib_points_general_polygons(rib_parser *p, const rib_request *req);
 void rib_general_polygon(rib_parser *p, const rib_request *req);
+
+/* rib_texcoord.c: TextureCoordinates; the variables of a surface placed
+ * with them (vars and the "s", "t" pair, into out): their count, or -1
+ * when the surface keeps vars as they are. */
+void rib_texture_coordinates(rib_parser *p, const rib_request *req);
+int rib_texcoord_vars(const rib_parser *p, const geom_surface *surf, const scene_primvar *vars,
+                      int nvars, scene_primvar out[SCENE_MAX_PRIMVARS]);
 
 /* rib_ignored.c: requests read past with one warning per name. True
  * when req is one of them (warned about, nothing else done). */

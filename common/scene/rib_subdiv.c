@@ -4,7 +4,15 @@
  *   SubdivisionMesh "catmull-clark" [nvertices] [vertices]
  *       [tags] [nargs] [intargs] [floatargs] "P" [...]
  *
- * (the four tag arrays may be left out together). Tags: "crease" (a chain
+ * (the four tag arrays may be left out together), and PRMan's
+ *
+ *   HierarchicalSubdivisionMesh "catmull-clark" [nvertices] [vertices]
+ *       [tags] [nargs] [intargs] [floatargs] [stringargs] "P" [...]
+ *
+ * read the same way: three counts per tag in nargs (integers, floats,
+ * strings), the strings in a fifth array; the hierarchical edits
+ * ("vertexedit", "edgeedit", "faceedit") are tags like any other aafarm
+ * does not support (warned, ignored). Tags: "crease" (a chain
  * of points, one sharpness), "corner" (points, one sharpness or one each),
  * "hole" (faces), "interpolateboundary" (no argument, or 1 / 0); other
  * tags are warned about and ignored. Sharpness >= 10 is infinite.
@@ -60,22 +68,31 @@ static void *grow(void *p, int n, size_t size)
     return xrealloc(p, (size_t)(n + 1) * size);
 }
 
-/* Reads the tag arrays at args first .. first+3 into t; false after an
- * error. npoints, nfaces check the indices. */
-static bool read_tags(rib_parser *p, const rib_request *req, int first, int npoints,
+/* Reads the tag arrays at args first .. first+3 (first+4 with the
+ * strings of a hierarchical mesh: hier) into t; false after an error.
+ * npoints, nfaces check the indices. */
+static bool read_tags(rib_parser *p, const rib_request *req, int first, bool hier, int npoints,
                       int nfaces, subdiv_tags *t)
 {
+    int per = hier ? 3 : 2;            /* counts per tag in nargs */
     const rib_arg *ta = &req->args[first];
     int ntags = ta->kind == RIB_ARG_STRINGS ? ta->count : 0;
     if (ta->kind == RIB_ARG_NUMBERS && ta->count > 0) {
         rib_error(p, req, ta->pos, "the tags must be strings ([\"crease\" \"corner\" ...])");
         return false;
     }
-    if (first + 3 >= req->nargs) {
-        rib_error(p, req, ta->pos, "the tags need three more arrays: [nargs] [intargs] "
-                  "[floatargs]");
+    if (first + per + 1 >= req->nargs || (hier && !is_array(&req->args[first + 4]))) {
+        rib_error(p, req, ta->pos, hier ? "the tags need four more arrays: [nargs] [intargs] "
+                  "[floatargs] [stringargs]" : "the tags need three more arrays: [nargs] "
+                  "[intargs] [floatargs]");
         return false;
     }
+    if (hier && req->args[first + 4].kind == RIB_ARG_NUMBERS && req->args[first + 4].count > 0) {
+        rib_error(p, req, req->args[first + 4].pos, "the tag strings (stringargs) must be "
+                  "strings");
+        return false;
+    }
+    int nstr = hier ? req->args[first + 4].count : 0;
     int nn = 0, ni = 0, nfl = 0;
     int *nargs = rib_read_ints(p, req, first + 1, 0, true, &nn, "the tag argument counts (nargs)");
     int *iargs = nargs ? rib_read_ints(p, req, first + 2, 0, true, &ni, "the tag integers (intargs)")
@@ -90,23 +107,32 @@ static bool read_tags(rib_parser *p, const rib_request *req, int first, int npoi
             fargs = rib_arg_numbers(req, &req->args[first + 3], &nfl);
         }
     }
-    if (ok && nn != 2 * ntags) {
-        rib_error(p, req, req->args[first + 1].pos, "nargs has %d numbers, expected 2 per tag "
-                  "(%d tags)", nn, ntags);
+    if (ok && nn != per * ntags) {
+        rib_error(p, req, req->args[first + 1].pos, "nargs has %d numbers, expected %d per tag "
+                  "(%d tags)", nn, per, ntags);
         ok = false;
     }
-    long si = 0, sf = 0;
-    for (int k = 0; ok && k < ntags; k++) si += nargs[2 * k], sf += nargs[2 * k + 1];
-    if (ok && (si != ni || sf != nfl)) {
-        rib_error(p, req, req->args[first + 1].pos, "nargs asks for %ld integers and %ld floats, "
-                  "but intargs has %d and floatargs %d", si, sf, ni, nfl);
+    long si = 0, sf = 0, ss = 0;
+    for (int k = 0; ok && k < ntags; k++) {
+        si += nargs[per * k];
+        sf += nargs[per * k + 1];
+        ss += hier ? nargs[per * k + 2] : 0;
+    }
+    if (ok && (si != ni || sf != nfl || ss != nstr)) {
+        if (hier)
+            rib_error(p, req, req->args[first + 1].pos, "nargs asks for %ld integers, %ld floats "
+                      "and %ld strings, but intargs has %d, floatargs %d and stringargs %d", si,
+                      sf, ss, ni, nfl, nstr);
+        else
+            rib_error(p, req, req->args[first + 1].pos, "nargs asks for %ld integers and %ld "
+                      "floats, but intargs has %d and floatargs %d", si, sf, ni, nfl);
         ok = false;
     }
     const int *ip = iargs;
     const double *fp = fargs;
     for (int k = 0; ok && k < ntags; k++) {
         const char *tag = req->strs[ta->first + k];
-        int in = nargs[2 * k], fn = nargs[2 * k + 1];
+        int in = nargs[per * k], fn = nargs[per * k + 1];
         if (strcmp(tag, "crease") == 0) {
             if (in < 2 || fn != 1) {
                 rib_error(p, req, ta->pos, "tag %d \"crease\" takes 2 or more points and one "
@@ -174,7 +200,7 @@ static bool read_tags(rib_parser *p, const rib_request *req, int first, int npoi
     return ok;
 }
 
-void rib_subdivision_mesh(rib_parser *p, const rib_request *req)
+static void subdivision_mesh(rib_parser *p, const rib_request *req, bool hier)
 {
     const char *scheme = rib_read_string(p, req, 0, "the scheme (\"catmull-clark\")");
     if (!scheme) return;
@@ -202,7 +228,15 @@ void rib_subdivision_mesh(rib_parser *p, const rib_request *req)
     }
     int first = 3;
     bool have_tags = first < req->nargs && is_array(&req->args[first]);
-    if (!rib_params_read(p, req, have_tags ? first + 4 : first, RIB_PARAMS_VARYING, &params))
+    int after_tags = first + (hier ? 5 : 4);
+    for (int k = first; have_tags && k < after_tags; k++)
+        if (k >= req->nargs || !is_array(&req->args[k])) {     /* before the parameters */
+            rib_error(p, req, req->args[first].pos, hier ? "the tags need four more arrays: "
+                      "[nargs] [intargs] [floatargs] [stringargs]" : "the tags need three more "
+                      "arrays: [nargs] [intargs] [floatargs]");
+            goto out;
+        }
+    if (!rib_params_read(p, req, have_tags ? after_tags : first, RIB_PARAMS_VARYING, &params))
         goto out;
     const scene_param *P = rib_params_find(&params, "P");
     if (!P) {
@@ -221,7 +255,7 @@ void rib_subdivision_mesh(rib_parser *p, const rib_request *req)
                       npoints, idx[i]);
             goto out;
         }
-    if (have_tags && !read_tags(p, req, first, npoints, nfaces, &tags))
+    if (have_tags && !read_tags(p, req, first, hier, npoints, nfaces, &tags))
         goto out;
     int counts[] = { 0, 1, nfaces, npoints, npoints, nidx };
     if (!rib_primvars_collect(p, req, &params, counts, NULL, &vars))
@@ -270,4 +304,14 @@ out:
     rib_params_clear(&params);
     free(nverts);
     free(idx);
+}
+
+void rib_subdivision_mesh(rib_parser *p, const rib_request *req)
+{
+    subdivision_mesh(p, req, false);
+}
+
+void rib_hierarchical_subdivision_mesh(rib_parser *p, const rib_request *req)
+{
+    subdivision_mesh(p, req, true);
 }

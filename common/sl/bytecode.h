@@ -190,7 +190,7 @@ enum {
  * t, the footprint widths ws and wt, the channel, the fill value; d packs
  * what it writes (SL_TEXOP_FLOAT: 1 slot, the filter of the channel;
  * SL_TEXOP_COLOR: 3, channels c..c+2; SL_TEXOP_GRAD: 2, d/ds and d/dt of
- * the channel) and the wrap modes of s and t (tex_wrap).
+ * the channel), the wrap modes of s and t (tex_wrap) and SL_TEXOP_FILL.
  * TEXINFO z, name, var, query: z = 1 and var set when the texture opens
  * (query SL_TEXINFO_*, builtins.h: resolution writes 2 slots, channels and
  * levels 1, type none), else z = 0. */
@@ -200,6 +200,9 @@ enum { SL_TEXOP_FLOAT = 0, SL_TEXOP_COLOR = 1, SL_TEXOP_GRAD = 2 };
 #define SL_TEXOP_KIND(d) ((d) & 3)
 #define SL_TEXOP_SWRAP(d) (((d) >> 2) & 3)
 #define SL_TEXOP_TWRAP(d) (((d) >> 4) & 3)
+/* The shader gave "fill": a channel the texture lacks reads the fill slot;
+ * without it, sl_tex_default_fill (vm_internal.h). */
+#define SL_TEXOP_FILL (1 << 6)
 static inline int sl_texop_outs(int d)
 {
     return SL_TEXOP_KIND(d) == SL_TEXOP_COLOR ? 3 : SL_TEXOP_KIND(d) == SL_TEXOP_GRAD ? 2 : 1;

@@ -663,6 +663,7 @@ int cg_gen_texture(cg *g, sl_node *e, int dst)
     for (int i = 0; i < npos; i++)
         pos[i] = cg_gen_expr(g, e->list[1 + i], -1);
     int blur[2] = { -1, -1 }, width[2] = { -1, -1 }, fill = cg_const_slot(g, 0);
+    int fill_given = 0;                  /* SL_TEXOP_FILL */
     int wrap[2] = { TEX_WRAP_PERIODIC, kind == SL_TEX_ENVIRONMENT ? TEX_WRAP_CLAMP
                                                                   : TEX_WRAP_PERIODIC };
     for (int i = 1 + npos; i + 1 < e->nlist; i += 2) {   /* "blur" before "sblur" */
@@ -679,8 +680,10 @@ int cg_gen_texture(cg *g, sl_node *e, int dst)
             continue;
         }
         int x = cg_gen_expr(g, v, -1);
-        if (strcmp(pn, "fill") == 0)
+        if (strcmp(pn, "fill") == 0) {
             fill = x;
+            fill_given = SL_TEXOP_FILL;
+        }
         int *dstp = strstr(pn, "blur") ? blur : strstr(pn, "width") ? width : NULL;
         if (!dstp)
             continue;
@@ -731,7 +734,7 @@ int cg_gen_texture(cg *g, sl_node *e, int dst)
            : cg_size_of(e) == 3 ? SL_TEXOP_COLOR : SL_TEXOP_FLOAT;
     int outs = sl_texop_outs(SL_TEXOP(op, wrap[0], wrap[1]));
     int z = cg_alloc_slots(g, outs);
-    cg_emit(g, SL_OP_TEXTURE, z, name, args, SL_TEXOP(op, wrap[0], wrap[1]));
+    cg_emit(g, SL_OP_TEXTURE, z, name, args, SL_TEXOP(op, wrap[0], wrap[1]) | fill_given);
     if (kind != SL_TEX_BUMP)
         return cg_into(g, z, dst, outs);
     int a = cg_gen_cross(g, pos[0], pos[2], -1), b = cg_gen_cross(g, pos[1], pos[0], -1);

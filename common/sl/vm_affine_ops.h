@@ -274,7 +274,10 @@ static inline sl_status VM_OP(v_texture, b_texture)(sl_vm *vm, A *S, const sl_in
             tex_cell cells[2];
             int n;
             if (ch < 0 || ch >= tex_channels(t)) {
-                VM_OP(v_mov, b_mov)(vm, &out[i], &S[in->c + 5]);
+                if (in->d & SL_TEXOP_FILL)
+                    VM_OP(v_mov, b_mov)(vm, &out[i], &S[in->c + 5]);
+                else
+                    aa_const(&out[i], sl_tex_default_fill(ch));
             } else if ((n = tex_cells(t, ch, &r, sw, tw, cells)) > 0) {
                 VM_OP(v_cells, b_cells)(vm, &out[i], &S[in->c], &S[in->c + 1], cells, n);
             } else {

@@ -289,7 +289,7 @@ static inline sl_status v_texture(sl_vm *vm, sl_dual *S, const sl_insn *in, int 
     for (int i = 0; i < sl_texop_outs(in->d); i++) {
         int ch = c < 0 ? -1 : c + i;
         if (ch < 0 || ch >= tex_channels(t)) {
-            S[in->a + i] = a[5];
+            S[in->a + i] = (in->d & SL_TEXOP_FILL) ? a[5] : dd(sl_tex_default_fill(ch), 0, 0);
             continue;
         }
         double v = tex_sample(t, ch, a[0].v, a[1].v, a[2].v, a[3].v, sw, tw, a[5].v, &ds, &dt);

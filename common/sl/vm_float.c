@@ -167,9 +167,11 @@ static inline sl_status v_texture(sl_vm *vm, double *S, const sl_insn *in, int p
         tex_sample(t, c, a[0], a[1], a[2], a[3], sw, tw, a[5], &S[in->a], &S[in->a + 1]);
         return SL_OK;
     }
-    for (int i = 0; i < sl_texop_outs(in->d); i++)
-        S[in->a + i] = tex_sample(t, c < 0 ? -1 : c + i, a[0], a[1], a[2], a[3], sw, tw, a[5],
-                                  NULL, NULL);
+    for (int i = 0; i < sl_texop_outs(in->d); i++) {
+        int ch = c < 0 ? -1 : c + i;
+        S[in->a + i] = tex_sample(t, ch, a[0], a[1], a[2], a[3], sw, tw,
+                                  sl_tex_fill(in->d, ch, a[5]), NULL, NULL);
+    }
     return SL_OK;
 }
 

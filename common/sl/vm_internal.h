@@ -219,6 +219,17 @@ const tex_texture *sl_vm_texture_find(sl_vm *vm, const char *name, char *err, si
  * lookup gives its fill value). */
 static inline int sl_tex_channel(double v) { return v >= 0 && v < 4096 ? (int)v : -1; }
 
+/* What a channel ch the texture lacks reads when the shader gave no
+ * "fill" (RI Spec 3.2, texture access parameters: a texture without an
+ * alpha channel answers requests for its alpha, channel 3 of RGBA, with
+ * 1: opaque); 0 for any other missing channel. */
+static inline double sl_tex_default_fill(int ch) { return ch == 3 ? 1.0 : 0.0; }
+/* The fill of channel ch for the TEXTURE operand d, `given` the fill slot's value */
+static inline double sl_tex_fill(int d, int ch, double given)
+{
+    return (d & SL_TEXOP_FILL) ? given : sl_tex_default_fill(ch);
+}
+
 /* The error of a channel that varies over the range of a run. */
 sl_status sl_vm_texture_channel_error(sl_vm *vm, int pc);
 

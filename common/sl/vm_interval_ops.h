@@ -220,7 +220,10 @@ static inline sl_status VM_OP(v_texture, b_texture)(sl_vm *vm, I *S, const sl_in
     for (int i = 0; i < sl_texop_outs(in->d); i++) {
         int ch = c < 0 ? -1 : c + i;
         if (ch < 0 || ch >= tex_channels(t)) {
-            S[in->a + i] = a[5];
+            if (in->d & SL_TEXOP_FILL)
+                S[in->a + i] = a[5];
+            else
+                S[in->a + i] = ia_point(sl_tex_default_fill(ch));
             continue;
         }
         double lo, hi;

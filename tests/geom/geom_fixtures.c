@@ -132,6 +132,17 @@ static void build(void)
     s->radius = 2; s->zmin = -0.5; s->zmax = 1.5; s->thetamax = 1.5 * PI;
     s = add("sphere negative sweep", GEOM_SPHERE, 1);
     s->zmin = -2; s->zmax = 0.3; s->thetamax = -0.8 * PI;
+    /* RI spec §5.2: the ends in either order (zmin > zmax, phimin > phimax:
+     * v runs the other way, the surface inside out) */
+    s = add("sphere reversed z", GEOM_SPHERE, 1.5);
+    s->radius = 1.5; s->zmin = 1.2; s->zmax = -0.4; s->thetamax = 1.1 * PI;
+    s = add("cylinder reversed z", GEOM_CYLINDER, 2);
+    s->radius = 0.7; s->zmin = 1.5; s->zmax = -0.5; s->thetamax = -1.4 * PI;
+    s = add("paraboloid reversed z", GEOM_PARABOLOID, 1.5);
+    s->rmax = 0.6; s->zmin = 1.2; s->zmax = 0.4; s->thetamax = 1.7 * PI;
+    s = add("torus reversed phi", GEOM_TORUS, 2);
+    s->majorrad = 1.2; s->minorrad = 0.4; s->phimin = PI; s->phimax = -PI / 3;
+    s->thetamax = 0.9 * PI;
     add("disk", GEOM_DISK, 1);
     s = add("disk partial", GEOM_DISK, 2);
     s->height = -1; s->radius = 2; s->thetamax = 0.75 * PI;

@@ -264,31 +264,37 @@ static bool cut_point(const geom_surface *s, geom_surface *full, int mode, doubl
     case GEOM_SPHERE: {                            /* outside zmin..zmax */
         full->zmin = -s->radius;
         full->zmax = s->radius;
-        double lo = (s->phi0 + M_PI_2) / M_PI, hi = (s->phi1 + M_PI_2) / M_PI;
+        /* the ends in either order (RI spec §5.2: zmin > zmax sweeps down) */
+        double lo = (fmin(s->phi0, s->phi1) + M_PI_2) / M_PI;
+        double hi = (fmax(s->phi0, s->phi1) + M_PI_2) / M_PI;
         if (lo < m && hi > 1 - m)
             return false;
         *v = lo >= m && (hi > 1 - m || fx_unit() < 0.5) ? fx_range(0, lo - m)
                                                           : fx_range(hi + m, 1);
         return *v >= 0 && *v <= 1;
     }
-    case GEOM_CYLINDER:                            /* beyond zmax, below zmin */
-        full->zmin = s->zmin - 1;
-        full->zmax = s->zmax + 1;
-        *v = fx_unit() < 0.5 ? fx_range(0, 1 / (s->zmax - s->zmin + 2) - m)
-                             : fx_range(1 - 1 / (s->zmax - s->zmin + 2) + m, 1);
+    case GEOM_CYLINDER: {                          /* beyond zmax, below zmin */
+        double lo = fmin(s->zmin, s->zmax), hi = fmax(s->zmin, s->zmax);
+        full->zmin = lo - 1;
+        full->zmax = hi + 1;
+        *v = fx_unit() < 0.5 ? fx_range(0, 1 / (hi - lo + 2) - m)
+                             : fx_range(1 - 1 / (hi - lo + 2) + m, 1);
         return true;
-    case GEOM_PARABOLOID:                          /* below zmin */
-        if (s->zmin == 0)
+    }
+    case GEOM_PARABOLOID: {                        /* below the lower end */
+        double lo = fmin(s->zmin, s->zmax);
+        if (lo == 0)
             return false;
         full->zmin = 0;
-        *v = fx_range(0.01, s->zmin / s->zmax - m);
+        *v = fx_range(0.01, lo / s->zmax - m);
         return true;
+    }
     case GEOM_TORUS: {                             /* outside phimin..phimax */
         if (full_sweep(s->phimax - s->phimin))
             return false;
         full->phimin = s->phimin;
-        full->phimax = s->phimin + TWO_PI;
-        double a = (s->phimax - s->phimin) / TWO_PI;
+        full->phimax = s->phimin + (s->phimax > s->phimin ? TWO_PI : -TWO_PI);
+        double a = fabs(s->phimax - s->phimin) / TWO_PI;
         *v = fx_range(a + m, 1 - m);
         return true;
     }

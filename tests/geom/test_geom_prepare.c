@@ -47,12 +47,16 @@ static void test_reasons(void **state)
     expect_reason(s, "sphere radius must be > 0, got -1");
     s = fx_default(GEOM_SPHERE); s.radius = NAN;
     expect_reason(s, "sphere radius must be a finite number, got nan");
-    s = fx_default(GEOM_SPHERE); s.zmin = 1; s.zmax = 0.5;
-    expect_reason(s, "sphere zmin must be < zmax, got zmin 1 and zmax 0.5");
+    s = fx_default(GEOM_SPHERE); s.zmin = 0.5; s.zmax = 0.5;
+    expect_reason(s, "sphere zmin and zmax must differ, both are 0.5 (nothing left)");
     s = fx_default(GEOM_SPHERE); s.zmin = 1; s.zmax = 2;
-    expect_reason(s, "sphere zmin must be < radius 1, got 1 (nothing left)");
+    expect_reason(s, "sphere zmin and zmax must not both be >= radius 1, got 1 and 2 (nothing left)");
+    s = fx_default(GEOM_SPHERE); s.zmin = 2; s.zmax = 1;       /* either order */
+    expect_reason(s, "sphere zmin and zmax must not both be >= radius 1, got 2 and 1 (nothing left)");
     s = fx_default(GEOM_SPHERE); s.zmin = -3; s.zmax = -1;
-    expect_reason(s, "sphere zmax must be > -radius -1, got -1 (nothing left)");
+    expect_reason(s, "sphere zmin and zmax must not both be <= -radius -1, got -3 and -1 (nothing left)");
+    s = fx_default(GEOM_SPHERE); s.zmin = 3; s.zmax = 2.5;     /* both clamped to the pole */
+    expect_reason(s, "sphere zmin and zmax must not both be >= radius 1, got 3 and 2.5 (nothing left)");
     s = fx_default(GEOM_SPHERE); s.thetamax = 0;
     expect_reason(s, "sphere thetamax must not be 0");
     s = fx_default(GEOM_SPHERE); s.thetamax = 7;
@@ -60,7 +64,7 @@ static void test_reasons(void **state)
     s = fx_default(GEOM_DISK); s.height = INFINITY;
     expect_reason(s, "disk height must be a finite number, got inf");
     s = fx_default(GEOM_CYLINDER); s.zmax = -1;
-    expect_reason(s, "cylinder zmin must be < zmax, got zmin -1 and zmax -1");
+    expect_reason(s, "cylinder zmin and zmax must differ, both are -1 (nothing left)");
     s = fx_default(GEOM_CONE); s.height = 0;
     expect_reason(s, "cone height must not be 0");
     s = fx_default(GEOM_CONE); s.radius = 0;
@@ -78,9 +82,13 @@ static void test_reasons(void **state)
     s = fx_default(GEOM_TORUS); s.minorrad = -0.5;
     expect_reason(s, "torus minorradius must be > 0, got -0.5");
     s = fx_default(GEOM_TORUS); s.phimin = 1; s.phimax = 1;
-    expect_reason(s, "torus phimin must be < phimax, got phimin 1 and phimax 1");
+    expect_reason(s, "torus phimin and phimax must differ, both are 1 (nothing left)");
     s = fx_default(GEOM_TORUS); s.phimin = -4; s.phimax = 4;
-    expect_reason(s, "torus phimax - phimin must be at most 2*pi (360 degrees), got 8");
+    expect_reason(s, "torus phimax - phimin must be at most 2*pi (360 degrees) in magnitude, got 8");
+    s = fx_default(GEOM_TORUS); s.phimin = 4; s.phimax = -4;
+    expect_reason(s, "torus phimax - phimin must be at most 2*pi (360 degrees) in magnitude, got -8");
+    s = fx_default(GEOM_PARABOLOID); s.zmin = 1; s.zmax = -0.5;
+    expect_reason(s, "paraboloid zmax must be > 0, got -0.5");
     s = fx_default(GEOM_POLYGON); s.nverts = 2;
     expect_reason(s, "polygon needs 3 to 64 vertices, got 2");
     s = fx_default(GEOM_POLYGON); s.nverts = 65;

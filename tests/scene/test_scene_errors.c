@@ -204,7 +204,7 @@ static void test_invalid_surface_parameters(void **state)
     (void)state;
     static const char *const texts[] = {
         WORLD("Sphere -1 -1 1 360\n"),
-        WORLD("Cylinder 1 1 -1 360\n"),
+        WORLD("Cylinder 1 1 1 360\n"),              /* equal ends: nothing */
         WORLD("Torus 1 0 0 360 360\n"),
         WORLD("Hyperboloid 1 0 0 1 0 0 360\n"),
         WORLD("Polygon \"P\" [0 0 0  1 0 0  1 1 1  0 1 0]\n"),   /* not planar */
