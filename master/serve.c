@@ -268,6 +268,7 @@ static void run_job(serve *s, farm *f, long id, bool resume)
     }
     farm_serve_end_job(f);
     s->job = -1;
+    s->opt.scene_path = NULL;   /* it points into the job freed now */
     loaded_job_clear(&l);
 }
 
