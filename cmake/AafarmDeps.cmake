@@ -22,6 +22,9 @@ aafarm_require_pkgconfig(PNG libpng libpng-dev)
 aafarm_require_pkgconfig(ZLIB zlib zlib1g-dev)
 aafarm_require_pkgconfig(TIFF libtiff-4 libtiff-dev)
 aafarm_require_pkgconfig(MHD libmicrohttpd libmicrohttpd-dev)   # the master's live monitor
+aafarm_require_pkgconfig(SQLITE sqlite3 libsqlite3-dev)          # the master's job queue (--serve)
+aafarm_require_pkgconfig(CURL libcurl libcurl4-openssl-dev)      # aafarm-submit (and tests)
+aafarm_require_pkgconfig(JSONC json-c libjson-c-dev)             # aafarm-submit's answers (and tests)
 
 find_package(OpenEXR 3 CONFIG QUIET)
 if(NOT OpenEXR_FOUND OR NOT TARGET OpenEXR::OpenEXRCore)
@@ -33,9 +36,6 @@ message(STATUS "Found OpenEXR ${OpenEXR_VERSION} (OpenEXRCore)")
 
 if(AAFARM_TESTS)
   aafarm_require_pkgconfig(CMOCKA cmocka libcmocka-dev)
-  # the live monitor's tests: real HTTP requests, its JSON parsed
-  aafarm_require_pkgconfig(CURL libcurl libcurl4-openssl-dev)
-  aafarm_require_pkgconfig(JSONC json-c libjson-c-dev)
 endif()
 
 find_library(MATH_LIBRARY m REQUIRED)

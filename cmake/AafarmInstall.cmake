@@ -10,12 +10,13 @@
 # beside it, so an installed tree works from any folder and any prefix.
 include(GNUInstallDirs)
 
-set(AAFARM_PROGRAMS aafarm-master aafarm-worker aafarm-slc aafarm-maketx aafarm-keygen)
+set(AAFARM_PROGRAMS aafarm-master aafarm-worker aafarm-slc aafarm-maketx aafarm-keygen aafarm-submit)
 set(AAFARM_SUMMARY_aafarm-master "render a RenderMan scene on a farm of workers")
 set(AAFARM_SUMMARY_aafarm-worker "render a RenderMan scene, alone or for a master")
 set(AAFARM_SUMMARY_aafarm-slc    "check and compile RenderMan shading language shaders")
 set(AAFARM_SUMMARY_aafarm-maketx "write tiled, mip-mapped OpenEXR textures")
 set(AAFARM_SUMMARY_aafarm-keygen "write a CurveZMQ key pair for a master or a worker")
+set(AAFARM_SUMMARY_aafarm-submit "submit, list and cancel jobs of a serving aafarm-master")
 
 set(man_pages "")
 foreach(prog IN LISTS AAFARM_PROGRAMS)
@@ -72,6 +73,7 @@ if(AAFARM_DPKG_SHLIBDEPS)
 else()
   # no dpkg-shlibdeps (Debian package dpkg-dev): Debian 12's names, by hand
   set(CPACK_DEBIAN_PACKAGE_DEPENDS
-      "libc6, libzmq5, libopenexr-3-1-30, libpng16-16, libtiff6, libprotobuf-c1, zlib1g")
+      "libc6, libzmq5, libopenexr-3-1-30, libpng16-16, libtiff6, libprotobuf-c1, zlib1g, "
+      "libmicrohttpd12, libsqlite3-0, libcurl4, libjson-c5")
 endif()
 include(CPack)

@@ -24,7 +24,8 @@ PACKAGES=(
   protobuf-c-compiler libprotobuf-c-dev  # wire protocol schema
   libsodium-dev     # CurveZMQ: Debian's libzmq5 has CURVE through libsodium
   libmicrohttpd-dev # the master's live monitor (--http)
-  libcurl4-openssl-dev libjson-c-dev  # the monitor's tests: HTTP requests, JSON
+  libsqlite3-dev    # the master's job queue (aafarm-master --serve)
+  libcurl4-openssl-dev libjson-c-dev  # aafarm-submit (HTTP, JSON) and the monitor's tests
   chromium          # the monitor's page in a headless browser (test_monitor_browser)
   iproute2          # the multi-host test's network namespaces (ip netns)
   openssh-client openssh-server  # deploy/ssh/farm.sh over a real sshd (test_deploy)

@@ -374,8 +374,9 @@ static int open_journal(farm *f, farm_frame *fr, char *err, size_t errsz)
                             "%llu bytes (those tiles are rendered again)", info.dropped_why,
                             (unsigned long long)info.dropped_bytes);
         } else if (missing) {
-            console_log(f->con, CONSOLE_INFO, "--resume: no journal %s, rendering every tile",
-                        path);
+            if (!f->serving)   /* a queue's new job has none */
+                console_log(f->con, CONSOLE_INFO, "--resume: no journal %s, rendering every tile",
+                            path);
         } else {
             rc = image_writer_failed(fr->writer) ? AAFARM_EXIT_FAILURE : AAFARM_EXIT_USAGE;
         }
@@ -418,11 +419,19 @@ static void bound_limits(farm *f)
     if (bound < f->limits.max_bulk_bytes) f->limits.max_bulk_bytes = bound;
 }
 
-static int setup(farm *f, char *err, size_t errsz)
+/* What every render of this master shares: limits, session, host name. */
+static void setup_common(farm *f)
 {
     bound_limits(f);
     f->session = random_session();
     if (gethostname(f->host, sizeof f->host - 1) != 0) snprintf(f->host, sizeof f->host, "master");
+}
+
+/* The frames' tiles, the scheduler (with a slot for every live worker:
+ * a serving master's next job), the registry the first time, the
+ * monitor's frames, and each frame's output and journal. */
+static int setup_job(farm *f, char *err, size_t errsz)
+{
     for (int i = 0; i < f->nframes; i++) {
         farm_frame *fr = &f->frames[i];
         fr->tiles_x = image_format_tiles_x(&fr->fmt);
@@ -445,19 +454,32 @@ static int setup(farm *f, char *err, size_t errsz)
     so.join_window_ms = f->opt->bind ? f->opt->lease_ms : 0;
     /* every frame's tiles in one row-major queue: a worker's run goes on
      * into the next frame, and new runs start in the longest queued run */
-    f->sched = scheduler_new(f->ntiles, 1, &so);
+    f->sched = scheduler_new(f->ntiles ? f->ntiles : 1, 1, &so);
     if (!f->sched) {
         err_set(err, errsz, "the %d frames have too many tiles to count", f->nframes);
         return AAFARM_EXIT_INPUT;
     }
-    f->reg = registry_new();
+    if (f->ntiles == 0) scheduler_mark_done(f->sched, 0);   /* a serving master, idle */
+    if (!f->reg) f->reg = registry_new();
+    for (size_t i = 0; i < registry_count(f->reg); i++) {
+        farm_worker *w = registry_at(f->reg, i);
+        if (w->alive) w->slot = scheduler_worker_add(f->sched);
+    }
     farm_monitor_open(f);
     for (int i = 0; i < f->nframes; i++) {
         int rc = setup_frame(f, &f->frames[i], err, errsz);
         if (rc != AAFARM_EXIT_OK) return rc;
     }
-    int rc = open_socket(f, err, errsz);
-    if (rc == AAFARM_EXIT_OK) rc = farm_monitor_serve(f, err, errsz);
+    return AAFARM_EXIT_OK;
+}
+
+static int setup(farm *f, char *err, size_t errsz)
+{
+    setup_common(f);
+    int rc = setup_job(f, err, errsz);
+    if (rc != AAFARM_EXIT_OK) return rc;
+    rc = open_socket(f, err, errsz);
+    if (rc == AAFARM_EXIT_OK) rc = farm_monitor_serve(f, NULL, err, errsz);
     if (rc != AAFARM_EXIT_OK) return rc;
     return start_local_workers(f, err, errsz);
 }
@@ -495,7 +517,8 @@ static void drain(farm *f, int64_t now)
         }
         farm_handle(f, m, now);
         wire_msg_destroy(&m);
-        if (f->state == FARM_RUNNING && scheduler_finished(f->sched)) f->state = FARM_DONE;
+        if (f->state == FARM_RUNNING && f->ntiles > 0 && scheduler_finished(f->sched))
+            f->state = FARM_DONE;
     }
 }
 
@@ -657,9 +680,11 @@ static void run_loop(farm *f)
         if (f->state != FARM_RUNNING) break;
         timers(f, now);
         farm_grant_all(f, now);
-        console_progress(f->con, scheduler_tiles_done(f->sched), f->ntiles,
-                         registry_alive(f->reg), f->start_ms, now, false);
+        if (f->ntiles > 0)
+            console_progress(f->con, scheduler_tiles_done(f->sched), f->ntiles,
+                             registry_alive(f->reg), f->start_ms, now, false);
         farm_monitor_publish(f, now, false);
+        if (f->tick) f->tick(f, now);   /* a serving master's queue (serve.c) */
     }
 }
 
@@ -689,14 +714,15 @@ static void close_journals(farm *f)
     for (int i = 0; i < f->nframes; i++) {
         farm_frame *fr = &f->frames[i];
         if (!fr->jnl) continue;
-        if (f->state == FARM_DONE || fr->done == 0) {
+        if (f->state == FARM_DONE || fr->done == 0 ||
+            (f->serving && f->state != FARM_INTERRUPTED)) {   /* failed, cancelled: no resume */
             journal_remove(&fr->jnl);   /* the image is in place, or nothing to resume */
             continue;
         }
         char jerr[ERR_LEN];
         if (!journal_sync(fr->jnl, jerr, sizeof jerr))
             console_log(f->con, CONSOLE_ERROR, "%s", jerr);
-        else if (!told)
+        else if (!told && !f->serving)
             console_log(f->con, CONSOLE_ERROR, "%d of %d tiles kept in %s%s: the same command "
                         "with --resume renders only the others", scheduler_tiles_done(f->sched),
                         f->ntiles, journal_file(fr->jnl),
@@ -846,4 +872,96 @@ int farm_run(const farm_options *opt, const farm_frame_in *frames, int nframes)
     farm_monitor_linger(&f, &interrupted);
     teardown(&f);
     return rc;
+}
+
+/* ---- a serving master (serve.c; see farm_internal.h) ---- */
+
+const atomic_int *farm_interrupted(void)
+{
+    return &interrupted;
+}
+
+int farm_serve_open(farm *f, char *err, size_t errsz)
+{
+    f->serving = true;
+    f->fmt.tile_size = 1024;   /* limits for a tile of any job (--tile at most 1024) */
+    setup_common(f);
+    f->reg = registry_new();
+    f->sched = NULL;
+    int rc = open_socket(f, err, errsz);
+    if (rc == AAFARM_EXIT_OK) rc = start_local_workers(f, err, errsz);
+    return rc;
+}
+
+int farm_serve_job(farm *f, const farm_frame_in *frames, int nframes, char *err, size_t errsz)
+{
+    f->frames = xcalloc((size_t)(nframes ? nframes : 1), sizeof *f->frames);
+    f->nframes = nframes;
+    for (int i = 0; i < nframes; i++) {
+        f->frames[i].jb = frames[i].jb;
+        f->frames[i].fmt = frames[i].fmt;
+        f->frames[i].output = frames[i].output;
+        f->frames[i].preview = frames[i].preview;
+    }
+    f->ntiles = 0;
+    f->frames_written = 0;
+    f->resumed_tiles = 0;
+    f->state = FARM_RUNNING;
+    f->failure[0] = '\0';
+    f->end_ms = 0;
+    f->nonfinite_samples = 0;
+    f->nonfinite_tiles = 0;
+    console_set_prefix(f->con, "");
+    int rc = setup_job(f, err, errsz);
+    f->start_ms = farm_now_ms();
+    console_set_resumed(f->con, f->resumed_tiles);
+    if (rc == AAFARM_EXIT_OK && f->ntiles > 0 && scheduler_finished(f->sched) &&
+        f->state == FARM_RUNNING)
+        f->state = FARM_DONE;   /* all resumed */
+    return rc;
+}
+
+void farm_serve_loop(farm *f)
+{
+    if (f->state == FARM_RUNNING) run_loop(f);
+}
+
+void farm_serve_end_job(farm *f)
+{
+    int64_t now = farm_now_ms();
+    close_journals(f);
+    f->end_ms = now;
+    console_tally_flush(&f->expired, f->con, now, true);
+    for (size_t i = 0; i < registry_count(f->reg); i++) {
+        farm_worker *w = registry_at(f->reg, i);
+        if (w->alive && w->has_job && f->nframes) farm_send_job_done(f, w, now);
+        w->has_job = false;   /* the next job starts afresh; the worker stays */
+        w->nheld = 0;
+        w->files_ready = false;
+        w->blocked = false;
+    }
+    farm_monitor_publish(f, now, true);
+    for (int i = 0; i < f->nframes; i++) {
+        farm_frame *fr = &f->frames[i];
+        image_writer_destroy(&fr->writer);   /* unfinished: removes the temporary file */
+        journal_close(&fr->jnl);
+        job_message_destroy(&fr->jobmsg);
+        file_server_destroy(&fr->files);
+    }
+    scheduler_destroy(&f->sched);
+    free(f->given_up);
+    f->given_up = NULL;
+    f->ngiven_up = 0;
+    free(f->frames);
+    f->frames = NULL;
+    f->nframes = 0;
+    f->ntiles = 0;
+}
+
+void farm_serve_close(farm *f)
+{
+    f->end_ms = farm_now_ms();
+    tell_workers(f, f->end_ms);
+    if (f->locals) local_workers_stop(f->locals, 2000);
+    teardown(f);
 }

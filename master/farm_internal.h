@@ -34,7 +34,8 @@ typedef enum farm_state {
     FARM_RUNNING,
     FARM_DONE,           /* every tile is in */
     FARM_FAILED,         /* a tile failed too often, or no workers are left */
-    FARM_INTERRUPTED     /* SIGINT / SIGTERM */
+    FARM_INTERRUPTED,    /* SIGINT / SIGTERM */
+    FARM_CANCELLED       /* a serving master's job, cancelled (serve.c) */
 } farm_state;
 
 /* One frame of the sequence: its tiles are the scheduler's tiles
@@ -59,6 +60,8 @@ typedef struct farm_given_up {
     int tile;
     char failure[2 * ERR_LEN];
 } farm_given_up;
+
+struct http_jobs;
 
 typedef struct farm {
     const farm_options *opt;
@@ -108,6 +111,12 @@ typedef struct farm {
     struct http_server *http;
     int *tile_slot;                /* per tile: the slot of the worker whose result was taken */
     int64_t published_ms;
+    int mon_base;                  /* the monitor's index of frames[0] (a serving master's
+                                      monitor holds the frames of every job) */
+    /* --serve (serve.c): the job queue */
+    bool serving;                  /* the render is one job of a queue */
+    void (*tick)(struct farm *f, int64_t now);   /* called once a loop turn, or NULL */
+    void *serve;                   /* serve.c's state */
 } farm;
 
 /* At most one line per interval for a repeated warning (console_tally). */
@@ -138,7 +147,7 @@ void farm_fail_given_up(farm *f, int tile);
 void farm_monitor_open(farm *f);
 /* Starts the HTTP server and says where: AAFARM_EXIT_OK or an exit code
  * with the message in err. */
-int farm_monitor_serve(farm *f, char *err, size_t errsz);
+int farm_monitor_serve(farm *f, const struct http_jobs *jobs, char *err, size_t errsz);
 /* The tile's chunk was taken from w (NULL: replayed from the journal). */
 void farm_monitor_tile(farm *f, farm_frame *fr, int local, const void *chunk, size_t len,
                        const farm_worker *w);
@@ -150,6 +159,20 @@ void farm_monitor_publish(farm *f, int64_t now, bool force);
 void farm_monitor_linger(farm *f, const atomic_int *interrupted);
 /* Stops the server (its thread has ended on return), frees the monitor. */
 void farm_monitor_close(farm *f);
+
+/* farm.c, for a serving master (serve.c): the socket, the local workers
+ * and the registry once; then each job (nframes 0: idle, waiting for
+ * one) opened, run until its state is no longer FARM_RUNNING, and ended
+ * (its journals removed unless interrupted, JobDone to its workers, its
+ * frames freed, the workers kept); at the end the local workers stopped
+ * and everything freed. */
+int farm_serve_open(farm *f, char *err, size_t errsz);
+int farm_serve_job(farm *f, const farm_frame_in *frames, int nframes, char *err, size_t errsz);
+void farm_serve_loop(farm *f);
+void farm_serve_end_job(farm *f);
+void farm_serve_close(farm *f);
+/* The flag SIGINT/SIGTERM set. */
+const atomic_int *farm_interrupted(void);
 
 /* report.c */
 void farm_report_summary(const farm *f);

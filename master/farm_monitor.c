@@ -43,19 +43,22 @@ enum { FARM_MONITOR_MS = 250 };
 void farm_monitor_open(farm *f)
 {
     if (!f->opt->http) return;
-    f->mon = monitor_new();
-    for (int i = 0; i < f->nframes; i++)
-        monitor_add_frame(f->mon, f->frames[i].fmt.width, f->frames[i].fmt.height);
-    f->tile_slot = xmalloc((size_t)f->ntiles * sizeof *f->tile_slot);
+    if (!f->mon) f->mon = monitor_new();   /* a serving master's: one for all its jobs */
+    for (int i = 0; i < f->nframes; i++) {
+        int index = monitor_add_frame(f->mon, f->frames[i].fmt.width, f->frames[i].fmt.height);
+        if (i == 0) f->mon_base = index;
+    }
+    free(f->tile_slot);
+    f->tile_slot = xmalloc(((size_t)f->ntiles + 1) * sizeof *f->tile_slot);
     for (int i = 0; i < f->ntiles; i++) f->tile_slot[i] = -1;
 }
 
-int farm_monitor_serve(farm *f, char *err, size_t errsz)
+int farm_monitor_serve(farm *f, const http_jobs *jobs, char *err, size_t errsz)
 {
     if (!f->mon) return AAFARM_EXIT_OK;
     http_addr addr;
     if (!http_addr_parse(f->opt->http, &addr, err, errsz)) return AAFARM_EXIT_USAGE;
-    f->http = http_server_start(&addr, f->opt->http_token, f->mon, err, errsz);
+    f->http = http_server_start(&addr, f->opt->http_token, f->mon, jobs, err, errsz);
     if (!f->http) return AAFARM_EXIT_FAILURE;
     farm_monitor_publish(f, farm_now_ms(), true);
     console_log(f->con, CONSOLE_INFO, "monitor on http://%s:%d/%s", addr.host,
@@ -71,7 +74,7 @@ void farm_monitor_tile(farm *f, farm_frame *fr, int local, const void *chunk, si
     image_rect r = image_format_tile_rect(&fr->fmt, local % fr->tiles_x, local / fr->tiles_x);
     float *rgba = xmalloc((size_t)r.w * (size_t)r.h * 4 * sizeof *rgba);
     char err[ERR_LEN];
-    int index = (int)(fr - f->frames);
+    int index = f->mon_base + (int)(fr - f->frames);
     if (image_tile_decode_rgba(&fr->fmt, r, chunk, len, rgba, err, sizeof err))
         monitor_put_tile(f->mon, index, r, rgba);
     else   /* the chunk was validated: not expected */
@@ -81,14 +84,16 @@ void farm_monitor_tile(farm *f, farm_frame *fr, int local, const void *chunk, si
 
 void farm_monitor_frame_complete(farm *f, const farm_frame *fr)
 {
-    if (f->mon) monitor_frame_complete(f->mon, (int)(fr - f->frames));
+    if (f->mon) monitor_frame_complete(f->mon, f->mon_base + (int)(fr - f->frames));
 }
 
 /* ---- the documents ---- */
 
-static const char *state_name(farm_state s)
+static const char *state_name(const farm *f)
 {
-    switch (s) {
+    if (f->serving && f->nframes == 0) return "idle";   /* a serving master between jobs */
+    switch (f->state) {
+    case FARM_CANCELLED: return "cancelled";
     case FARM_DONE: return "done";
     case FARM_FAILED: return "failed";
     case FARM_INTERRUPTED: return "interrupted";
@@ -114,7 +119,7 @@ static void mark_lease(void *arg, const scheduler_lease *l)
 static void json_frames(FILE *out, const farm *f)
 {
     char *state = xmalloc((size_t)f->ntiles + 1);
-    int *slot = xmalloc((size_t)f->ntiles * sizeof *slot);
+    int *slot = xmalloc(((size_t)f->ntiles + 1) * sizeof *slot);
     for (int t = 0; t < f->ntiles; t++) {
         bool done = scheduler_tile_done(f->sched, t);
         state[t] = done ? 'd' : 'q';
@@ -125,8 +130,8 @@ static void json_frames(FILE *out, const farm *f)
     fputs("\"frames\": [", out);
     for (int i = 0; i < f->nframes; i++) {
         const farm_frame *fr = &f->frames[i];
-        fprintf(out, "%s\n  {\"index\": %d, \"number\": %d, \"output\": ", i ? "," : "", i,
-                fr->jb->frame_number);
+        fprintf(out, "%s\n  {\"index\": %d, \"number\": %d, \"output\": ", i ? "," : "",
+                f->mon_base + i, fr->jb->frame_number);
         json_out_string(out, fr->output);
         fprintf(out, ", \"width\": %d, \"height\": %d, \"tile_size\": %d, \"tiles_x\": %d, "
                 "\"tiles_y\": %d, \"tiles\": %d, \"done\": %d, \"written\": %s, "
@@ -186,11 +191,11 @@ static char *build_status(const farm *f, int64_t now, size_t *len)
     scheduler_counts c;
     scheduler_counts_get(f->sched, &c);
     fputs("{\"job\": {\"scene\": ", out);
-    json_out_string(out, f->opt->scene_path);
-    fprintf(out, ", \"state\": \"%s\", \"error\": ", state_name(f->state));
+    json_out_string(out, f->opt->scene_path ? f->opt->scene_path : "");
+    fprintf(out, ", \"state\": \"%s\", \"error\": ", state_name(f));
     json_out_string(out, f->state == FARM_FAILED ? f->failure : "");
     fprintf(out, ", \"job_hash\": \"%.64s\", \"frames\": %d, \"frames_written\": %d, "
-            "\"elapsed_s\": %.3f, \"host\": ", f->frames[0].jb->hash, f->nframes,
+            "\"elapsed_s\": %.3f, \"host\": ", f->nframes ? f->frames[0].jb->hash : "", f->nframes,
             f->frames_written, secs);
     json_out_string(out, f->host);
     fprintf(out, "},\n\"tiles\": {\"total\": %d, \"done\": %d, \"leased\": %d, \"queued\": %d, "
@@ -261,7 +266,7 @@ static char *build_workers(const farm *f, int64_t now, size_t *len)
 
 void farm_monitor_publish(farm *f, int64_t now, bool force)
 {
-    if (!f->mon || (!force && now - f->published_ms < FARM_MONITOR_MS)) return;
+    if (!f->mon || !f->sched || (!force && now - f->published_ms < FARM_MONITOR_MS)) return;
     f->published_ms = now;
     size_t len = 0;
     char *text = build_status(f, now, &len);

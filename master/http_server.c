@@ -27,6 +27,8 @@ enum { HTTP_MAX_CONNECTIONS = 32, HTTP_IDLE_S = 10 };
 struct http_server {
     struct MHD_Daemon *daemon;
     monitor *mon;
+    http_jobs jobs;
+    bool has_jobs;
     char token[HTTP_TOKEN_MAX + 1];
     bool has_token;
     int port;
@@ -55,7 +57,7 @@ static enum MHD_Result send_bytes(struct MHD_Connection *c, unsigned status, con
     if (status == MHD_HTTP_UNAUTHORIZED)
         MHD_add_response_header(r, MHD_HTTP_HEADER_WWW_AUTHENTICATE, "Bearer realm=\"aafarm\"");
     if (status == MHD_HTTP_METHOD_NOT_ALLOWED)
-        MHD_add_response_header(r, MHD_HTTP_HEADER_ALLOW, "GET, HEAD");
+        MHD_add_response_header(r, MHD_HTTP_HEADER_ALLOW, "GET, HEAD, POST");
     enum MHD_Result ok = MHD_queue_response(c, status, r);
     MHD_destroy_response(r);
     return ok;
@@ -132,6 +134,98 @@ static const route api_routes[] = {
     {"/api/image.png", serve_image},
 };
 
+/* ---- the job queue (--serve) ---- */
+
+/* A POST's body, gathered over the calls libmicrohttpd makes. */
+typedef struct upload {
+    uint8_t *data;
+    size_t len, cap;
+    bool too_big;
+} upload;
+
+static enum MHD_Result send_answer(struct MHD_Connection *c, unsigned status, char *answer,
+                                   size_t len)
+{
+    if (!answer) return send_error(c, MHD_HTTP_INTERNAL_SERVER_ERROR, "no answer");
+    return send_bytes(c, status, "application/json", answer, len, MHD_RESPMEM_MUST_FREE, false);
+}
+
+/* "/api/jobs/ID" + rest: the id (-1: not that form). */
+static long job_id_of(const char *url, const char *rest)
+{
+    const char *p = url + strlen("/api/jobs/");
+    char *end = NULL;
+    if (*p < '0' || *p > '9') return -1;
+    long id = strtol(p, &end, 10);
+    return strcmp(end, rest) == 0 && id >= 0 ? id : -1;
+}
+
+static bool is_jobs_url(const char *url)
+{
+    return strcmp(url, "/api/jobs") == 0 || strncmp(url, "/api/jobs/", 10) == 0;
+}
+
+static enum MHD_Result serve_jobs(http_server *self, struct MHD_Connection *c, const char *url,
+                                  bool post, const upload *up)
+{
+    char *answer = NULL;
+    size_t len = 0;
+    unsigned status;
+    if (!post) {
+        long id = strcmp(url, "/api/jobs") == 0 ? -1 : job_id_of(url, "");
+        if (id < 0 && strcmp(url, "/api/jobs") != 0)
+            return send_error(c, MHD_HTTP_NOT_FOUND, "no such job path: /api/jobs or /api/jobs/ID");
+        status = self->jobs.list(self->jobs.arg, id, &answer, &len);
+    } else if (strcmp(url, "/api/jobs") == 0) {
+        if (up->too_big) {
+            char m[160];
+            snprintf(m, sizeof m, "the submission is over the %zu bytes this master takes",
+                     self->jobs.max_body);
+            return send_error(c, MHD_HTTP_CONTENT_TOO_LARGE, m);
+        }
+        status = self->jobs.submit(self->jobs.arg, up->data, up->len, &answer, &len);
+    } else {
+        long id = job_id_of(url, "/cancel");
+        if (id < 0)
+            return send_error(c, MHD_HTTP_NOT_FOUND, "POST /api/jobs (a submission) or "
+                              "/api/jobs/ID/cancel");
+        status = self->jobs.cancel(self->jobs.arg, id, &answer, &len);
+    }
+    return send_answer(c, status, answer, len);
+}
+
+/* Gathers a POST's body; true while more is to come (the answer waits). */
+static bool gather(http_server *self, upload *up, const char *data, size_t *size)
+{
+    if (!*size) return false;
+    if (!up->too_big && up->len + *size <= self->jobs.max_body) {
+        if (up->len + *size > up->cap) {
+            up->cap = (up->len + *size) * 2 > self->jobs.max_body ? self->jobs.max_body
+                                                                   : (up->len + *size) * 2;
+            up->data = xrealloc(up->data, up->cap);
+        }
+        memcpy(up->data + up->len, data, *size);
+        up->len += *size;
+    } else {
+        up->too_big = true;   /* read and dropped: 413 at the end */
+    }
+    *size = 0;
+    return true;
+}
+
+static void on_completed(void *cls, struct MHD_Connection *c, void **con_cls,
+                         enum MHD_RequestTerminationCode toe)
+{
+    (void)cls;
+    (void)c;
+    (void)toe;
+    upload *up = *con_cls;
+    if (!up) return;
+    free(up->data);
+    free(up);
+    *con_cls = NULL;
+}
+
 static bool authorized(const http_server *self, struct MHD_Connection *c)
 {
     if (!self->has_token) return true;
@@ -148,11 +242,23 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *c, const cha
                                   void **con_cls)
 {
     (void)version;
-    (void)upload_data;
-    (void)con_cls;
     http_server *self = cls;
+    bool post = strcmp(method, MHD_HTTP_METHOD_POST) == 0;
+    if (post && self->has_jobs && is_jobs_url(url)) {
+        if (!*con_cls) {   /* the first call: the headers only */
+            if (!authorized(self, c))
+                return send_error(c, MHD_HTTP_UNAUTHORIZED, "this master needs its token: "
+                                  "?token=TOKEN or Authorization: Bearer TOKEN (--http-token)");
+            *con_cls = xcalloc(1, sizeof(upload));
+            return MHD_YES;
+        }
+        if (gather(self, *con_cls, upload_data, upload_data_size)) return MHD_YES;
+        return serve_jobs(self, c, url, true, *con_cls);
+    }
     if (strcmp(method, MHD_HTTP_METHOD_GET) != 0 && strcmp(method, MHD_HTTP_METHOD_HEAD) != 0)
-        return send_error(c, MHD_HTTP_METHOD_NOT_ALLOWED, "the monitor answers GET and HEAD");
+        return send_error(c, MHD_HTTP_METHOD_NOT_ALLOWED,
+                          self->has_jobs ? "the master answers GET and HEAD, and POST on "
+                          "/api/jobs" : "the monitor answers GET and HEAD");
     if (*upload_data_size) *upload_data_size = 0;   /* a GET's body is ignored */
     for (size_t i = 0; i < sizeof api_routes / sizeof *api_routes; i++) {
         if (strcmp(url, api_routes[i].path) != 0) continue;
@@ -160,6 +266,12 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *c, const cha
             return send_error(c, MHD_HTTP_UNAUTHORIZED, "this monitor needs its token: "
                               "?token=TOKEN or Authorization: Bearer TOKEN (--http-token)");
         return api_routes[i].fn(self, c);
+    }
+    if (self->has_jobs && is_jobs_url(url)) {
+        if (!authorized(self, c))
+            return send_error(c, MHD_HTTP_UNAUTHORIZED, "this master needs its token: "
+                              "?token=TOKEN or Authorization: Bearer TOKEN (--http-token)");
+        return serve_jobs(self, c, url, false, NULL);
     }
     const char *path = strcmp(url, "/") == 0 ? "/index.html" : url;
     for (int i = 0; i < monitor_page_nfiles; i++)
@@ -202,7 +314,7 @@ static int listen_on(const http_addr *addr, int *port, char *err, size_t errsz)
 }
 
 http_server *http_server_start(const http_addr *addr, const char *token, monitor *mon,
-                               char *err, size_t errsz)
+                               const http_jobs *jobs, char *err, size_t errsz)
 {
     int port = 0;
     int fd = listen_on(addr, &port, err, errsz);
@@ -210,6 +322,10 @@ http_server *http_server_start(const http_addr *addr, const char *token, monitor
     http_server *self = xcalloc(1, sizeof *self);
     self->mon = mon;
     self->port = port;
+    if (jobs) {
+        self->jobs = *jobs;
+        self->has_jobs = true;
+    }
     if (token) {
         snprintf(self->token, sizeof self->token, "%s", token);
         self->has_token = true;
@@ -220,6 +336,7 @@ http_server *http_server_start(const http_addr *addr, const char *token, monitor
                                     MHD_OPTION_LISTEN_SOCKET, fd,
                                     MHD_OPTION_CONNECTION_LIMIT, (unsigned)HTTP_MAX_CONNECTIONS,
                                     MHD_OPTION_CONNECTION_TIMEOUT, (unsigned)HTTP_IDLE_S,
+                                    MHD_OPTION_NOTIFY_COMPLETED, on_completed, NULL,
                                     MHD_OPTION_END);
     if (!self->daemon) {
         err_set(err, errsz, "--http %s:%d: the HTTP server (libmicrohttpd) did not start",

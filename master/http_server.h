@@ -27,11 +27,28 @@
 
 typedef struct http_server http_server;
 
-/* Listens on addr and serves mon (which must outlive the server); token
- * NULL: none needed (loopback, main.c checks). NULL with a message when
- * the address cannot be bound. */
+/* A serving master's job queue (serve.c), answered on the server's thread:
+ *
+ *   GET  /api/jobs             list(-1): {"jobs": [...]}
+ *   GET  /api/jobs/ID          list(ID): the job
+ *   POST /api/jobs             submit(body): {"id": N} (body: bundle.h)
+ *   POST /api/jobs/ID/cancel   cancel(ID)
+ *
+ * Each returns the HTTP status and sets *answer to a JSON text (malloc'd). */
+typedef struct http_jobs {
+    void *arg;
+    size_t max_body;               /* bytes a submission may have (413 beyond) */
+    unsigned (*submit)(void *arg, const void *body, size_t len, char **answer, size_t *alen);
+    unsigned (*list)(void *arg, long id, char **answer, size_t *alen);
+    unsigned (*cancel)(void *arg, long id, char **answer, size_t *alen);
+} http_jobs;
+
+/* Listens on addr and serves mon (which must outlive the server) and,
+ * when jobs is not NULL, the job queue (copied; its arg must outlive the
+ * server); token NULL: none needed (loopback, main.c checks). NULL with a
+ * message when the address cannot be bound. */
 http_server *http_server_start(const http_addr *addr, const char *token, monitor *mon,
-                               char *err, size_t errsz);
+                               const http_jobs *jobs, char *err, size_t errsz);
 
 /* The port listened on (the one chosen for port 0). */
 int http_server_port(const http_server *self);

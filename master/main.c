@@ -18,6 +18,7 @@
 #include "http_access.h"
 #include "job/frames.h"
 #include "message.h"
+#include "serve.h"
 #include "util/cli.h"
 #include "util/err.h"
 #include "util/exitcodes.h"
@@ -28,6 +29,7 @@ static void usage(FILE *out)
 {
     fprintf(out,
         "usage: aafarm-master SCENE.rib [-o OUT.exr] [--frames LIST] [options]\n"
+        "       aafarm-master --serve [--db FILE] --http [ADDR:]PORT [options]\n"
         "\n"
         "Renders a RenderMan scene with procedural displacement shaders on a farm of\n"
         "aafarm-worker processes (ZeroMQ) and stitches their EXR tiles into OUT.exr.\n"
@@ -77,6 +79,13 @@ static void usage(FILE *out)
         "  --resume                   continue an unfinished render of the same job: the\n"
         "                             tiles in OUT.exr.journal are kept, only the others\n"
         "                             are rendered (every render journals its tiles there)\n"
+        "  --serve                    keep the workers and render a queue of jobs, submitted\n"
+        "                             with aafarm-submit --master http://ADDR:PORT (or POST\n"
+        "                             /api/jobs), one after another by priority, until\n"
+        "                             SIGINT/SIGTERM (docs/farm.md, \"A job queue\")\n"
+        "  --db FILE                  --serve: the queue's SQLite database (default\n"
+        "                             aafarm-queue.db); a master restarted on it resumes\n"
+        "                             every unfinished job\n"
         "  -q, --quiet                only errors;  -v, --verbose  every grant and tile\n"
         "  -h, --help                 this text\n"
         "\n"
@@ -95,6 +104,8 @@ typedef struct cli {
     char http_token[HTTP_TOKEN_MAX + 2];   /* --http-token(-file) */
     job_options job;
     bool local_given;
+    bool serve;                            /* --serve */
+    const char *db;                        /* --db */
 } cli;
 
 /* optarg as a whole number of lo..hi into *n; false after printing
@@ -140,7 +151,7 @@ static int parse(int argc, char **argv, cli *c)
     enum { O_BIND = 256, O_LOCAL, O_TPW, O_TILE, O_ARITH, O_BUDGET, O_PREVIEW, O_STATS_JSON,
            O_HEARTBEAT, O_LIVENESS, O_RETRIES, O_LEASE, O_DUPS, O_WORKER_BIN, O_RESUME, O_MAX_WORKERS, O_FRAMES,
            O_CURVE_SECRET, O_ALLOW_KEYS, O_INSECURE, O_LEASE_FACTOR, O_HTTP, O_HTTP_TOKEN,
-           O_HTTP_TOKEN_FILE, O_HTTP_LINGER };
+           O_HTTP_TOKEN_FILE, O_HTTP_LINGER, O_SERVE, O_DB };
     static const struct option longopts[] = {
         {"output", required_argument, 0, 'o'},
         {"bind", required_argument, 0, O_BIND},
@@ -168,6 +179,8 @@ static int parse(int argc, char **argv, cli *c)
         {"http-token", required_argument, 0, O_HTTP_TOKEN},
         {"http-token-file", required_argument, 0, O_HTTP_TOKEN_FILE},
         {"http-linger", required_argument, 0, O_HTTP_LINGER},
+        {"serve", no_argument, 0, O_SERVE},
+        {"db", required_argument, 0, O_DB},
         {"quiet", no_argument, 0, 'q'},
         {"verbose", no_argument, 0, 'v'},
         {"help", no_argument, 0, 'h'},
@@ -270,6 +283,8 @@ static int parse(int argc, char **argv, cli *c)
             if (!number_arg("--http-linger", "seconds", 0, 86400, &n)) return AAFARM_EXIT_USAGE;
             f->http_linger_ms = n * 1000;
             break;
+        case O_SERVE: c->serve = true; break;
+        case O_DB: c->db = optarg; break;
         case 'q': f->verbosity = -1; break;
         case 'v': f->verbosity = 1; break;
         case 'h': usage(stdout); return AAFARM_EXIT_OK;
@@ -287,7 +302,23 @@ static int parse(int argc, char **argv, cli *c)
         fprintf(stderr, "aafarm-master: unexpected argument '%s' (see --help)\n", argv[optind]);
         return AAFARM_EXIT_USAGE;
     }
-    if (!f->scene_path) {
+    if (c->db && !c->serve) {
+        fprintf(stderr, "aafarm-master: --db FILE goes with --serve (the job queue's database)\n");
+        return AAFARM_EXIT_USAGE;
+    }
+    if (c->serve) {
+        const char *what = f->scene_path ? f->scene_path : f->output ? "-o" : f->frames ? "--frames"
+                           : f->resume ? "--resume" : f->preview ? "--preview"
+                           : f->stats_json ? "--stats-json" : f->http_linger_ms ? "--http-linger"
+                           : NULL;
+        if (what) {
+            fprintf(stderr, "aafarm-master: --serve renders the jobs submitted to it: '%s' goes "
+                    "with one scene (aafarm-submit --master URL SCENE.rib -o OUT.exr sends "
+                    "one)\n", what);
+            return AAFARM_EXIT_USAGE;
+        }
+        if (!c->db) c->db = "aafarm-queue.db";
+    } else if (!f->scene_path) {
         fprintf(stderr, "aafarm-master: which scene? usage: aafarm-master SCENE.rib -o OUT.exr "
                 "(see --help)\n");
         return AAFARM_EXIT_USAGE;
@@ -441,6 +472,7 @@ int main(int argc, char **argv)
     job_options_default(&c.job);
     int rc = parse(argc, argv, &c);
     if (rc >= 0) return rc;
+    if (c.serve) return farm_serve(&c.farm, c.db);
     loaded l = {0};
     rc = load(&c, &l);
     if (rc < 0) rc = farm_run(&c.farm, l.frames, l.seq->count);

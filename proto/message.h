@@ -332,4 +332,12 @@ proto_saved_job *proto_saved_job_new(const proto_job *job);
 const proto_job *proto_saved_job_get(const proto_saved_job *self);
 void proto_saved_job_destroy(proto_saved_job **self_p);
 
+/* A Job as bytes outside ZeroMQ (packed.c; a job queue's submission): the
+ * packed Envelope, xmalloc'd, its size in *len. */
+uint8_t *proto_job_pack(const proto_job *job, size_t *len);
+/* The reverse, checked as a received message is (limits NULL: the
+ * defaults): NULL with the reason in err. */
+proto_saved_job *proto_job_unpack(const void *data, size_t len, const proto_limits *limits,
+                                  char *err, size_t errsz);
+
 #endif

@@ -1,7 +1,7 @@
 // monitor.js: the live monitor page (index.html) polls the master's API
 // once a second: /api/status (progress, tiles, warnings, log),
 // /api/workers (the table) and, when tiles came in, /api/image.png of the
-// frame shown. A token in the page's address (?token=...) goes with every
+// frame shown; a serving master's (--serve) /api/jobs, the queue. A token in the page's address (?token=...) goes with every
 // API request. No libraries, no build step.
 "use strict";
 
@@ -13,6 +13,7 @@ let imageBusy = false;
 let workers = [];        // by slot
 let lastStatus = null;
 let stopped = false;
+let serving = false;     // /api/jobs answers: a master with a job queue
 
 function apiUrl(path) {
   if (!token) return path;
@@ -139,6 +140,8 @@ function tileAt(ev) {
 // Loads the frame's image when tiles came in; counts its lit pixels
 // (data-lit-pixels) once it is decoded, for tests and for the curious.
 function loadImage(done) {
+  const index = lastStatus.frames[frame].index;   // the monitor's: every job's frames
+  done = index + ":" + done;
   if (imageBusy || done === shownDone) return;
   imageBusy = true;
   const next = new Image();
@@ -159,10 +162,10 @@ function loadImage(done) {
     imageBusy = false;
     requestAnimationFrame(drawOverlay);
     const now = lastStatus && lastStatus.frames[frame];
-    if (now && now.done !== done) loadImage(now.done);   // tiles came while it loaded
+    if (now && now.index + ":" + now.done !== done) loadImage(now.done);   // tiles came meanwhile
   };
   next.onerror = () => { imageBusy = false; };
-  next.src = apiUrl("/api/image.png?frame=" + frame + "&done=" + done);
+  next.src = apiUrl("/api/image.png?frame=" + index + "&done=" + done);
 }
 
 function showStatus(st) {
@@ -199,18 +202,40 @@ function showStatus(st) {
   const atEnd = log.scrollTop + log.clientHeight >= log.scrollHeight - 4;
   log.textContent = st.log.join("\n");
   if (atEnd) log.scrollTop = log.scrollHeight;
+  $("image-section").hidden = !st.frames.length;   // a serving master between jobs
+  if (!st.frames.length) return;
   loadImage(st.frames[frame].done);
   drawOverlay();
+}
+
+function showJobs(list) {
+  $("jobs-box").hidden = false;
+  const body = $("jobs").tBodies[0];
+  body.textContent = "";
+  for (const j of list.slice().reverse()) {   // the newest first
+    const tr = document.createElement("tr");
+    tr.className = j.state;
+    tr.dataset.job = j.id;
+    const pct = j.tiles ? Math.floor(100 * j.tiles_done / j.tiles) + "%" : "-";
+    tr.append(td(String(j.id)), td(j.state, "state " + j.state), td(String(j.priority)),
+              td(pct), td(j.scene), td(j.outputs[0] + (j.outputs.length > 1 ? " ..." : "")),
+              td(j.error || ""));
+    body.append(tr);
+  }
 }
 
 async function refresh() {
   if (stopped) return;
   try {
-    const [st, wk] = await Promise.all([getJson("/api/status"), getJson("/api/workers")]);
+    const [st, wk, jobs] = await Promise.all([getJson("/api/status"), getJson("/api/workers"),
+      getJson("/api/jobs").catch(() => null)]);
     $("problem").hidden = true;
+    serving = jobs !== null;
     showWorkers(wk.workers);
     showStatus(st);
-    if (st.job.state !== "running") stopped = true;   // the end: nothing more will change
+    if (serving) showJobs(jobs.jobs);
+    // the end of a one-shot render: nothing more will change
+    if (!serving && st.job.state !== "running") stopped = true;
   } catch (e) {
     $("problem").hidden = false;
     $("problem").textContent = "The master did not answer: " + e.message +
