@@ -321,14 +321,17 @@ static int workers_named(const char *name, bool kill_them)
         size_t len = fread(buf, 1, sizeof buf - 1, f);
         fclose(f);
         buf[len] = '\0';
-        bool worker = false, named = false;
+        /* ours: a worker of this test's hosts (its run folder is in the
+         * arguments), not one of another test_deploy running beside it */
+        bool worker = false, named = false, ours = false;
         for (size_t i = 0; i < len; i += strlen(buf + i) + 1) {
             if (strstr(buf + i, "aafarm-worker") && !strstr(buf + i, "farm.sh")) worker = true;
+            if (strstr(buf + i, dir)) ours = true;
             if (strcmp(buf + i, "--name") == 0 && i + strlen(buf + i) + 1 < len &&
                 strcmp(buf + i + strlen(buf + i) + 1, name) == 0)
                 named = true;
         }
-        if (worker && named) {
+        if (worker && named && ours) {
             n++;
             if (kill_them) kill((pid_t)atol(e->d_name), SIGKILL);
         }
