@@ -29,6 +29,7 @@ PACKAGES=(
   chromium          # the monitor's page in a headless browser (test_monitor_browser)
   iproute2          # the multi-host test's network namespaces (ip netns)
   openssh-client openssh-server  # deploy/ssh/farm.sh over a real sshd (test_deploy)
+  slurmctld slurmd slurm-client munge  # aafarm.sbatch on a real one-node Slurm (test_slurm)
   shellcheck        # lints deploy/'s scripts (test_deploy)
   python3-yaml      # checks deploy/'s compose and Kubernetes files (test_deploy)
   clang             # builds the fuzz targets (tests/fuzz, test fuzz_brief)

@@ -19,8 +19,11 @@
  *     naming the host (exit 1, no master started, keys removed). Skipped with
  *     a one-line reason where sshd cannot run (not installed; not root and
  *     no /run/sshd);
- *   - deploy/slurm/aafarm.sbatch renders for real with stand-in srun and
- *     scontrol (two tasks for two nodes); equal image, the job's keys removed;
+ *   - deploy/slurm/aafarm.sbatch renders for real with stand-in srun,
+ *     scontrol and scancel (two tasks for two nodes; scancel --signal=TERM
+ *     fails as without a controller, so the script falls back to SIGTERM
+ *     to srun); equal image, the job's keys removed (a real Slurm:
+ *     test_slurm);
  *   - deploy/systemd: install.sh into a scratch root (run again, it keeps
  *     the host's NAME.conf and writes a differing default beside it as
  *     NAME.conf.new), the unit's store of job files in its StateDirectory,
@@ -447,8 +450,9 @@ static void test_slurm_script_with_stand_in_srun(void **state)
     (void)state;
     assert_int_equal(mkdir(ft_path(dir, "slurmbin"), 0755), 0);
     assert_int_equal(sh("links.log", "ln -s %s/tests/master/deploy/fake-srun %s/slurmbin/srun && "
-                        "ln -s %s/tests/master/deploy/fake-scontrol %s/slurmbin/scontrol",
-                        src, dir, src, dir), 0);
+                        "ln -s %s/tests/master/deploy/fake-scontrol %s/slurmbin/scontrol && "
+                        "ln -s %s/tests/master/deploy/fake-scancel %s/slurmbin/scancel",
+                        src, dir, src, dir, src, dir), 0);
     int port = ft_free_port();
     int rc = sh("slurm.log",
                 "cd %s && PATH=%s/slurmbin:$PATH SLURM_JOB_ID=4242 SLURM_JOB_NUM_NODES=2 "
@@ -464,6 +468,7 @@ static void test_slurm_script_with_stand_in_srun(void **state)
     assert_int_equal(ft_count(ft_path(dir, "srun.log"), "step: 1 task(s) on 1 node(s): "), 1);
     assert_int_equal(ft_count(ft_path(dir, "srun.log"), "step: 2 task(s) on 2 node(s): "), 1);
     assert_int_equal(ft_count(log, "connected to master"), 2);
+    assert_int_equal(ft_count(ft_path(dir, "srun.log"), "scancel: --signal=TERM 4242"), 1);
     assert_int_equal(ft_count(log, "stopped ("), 2);   /* both workers ended by SIGTERM */
     assert_int_equal(ft_count(log, "master exited with status 0"), 1);
     assert_int_equal(ft_count_files(dir, ".aafarm-keys-4242"), 0);
