@@ -11,6 +11,9 @@
  *   - `cpack -G DEB`: aafarm_VERSION_ARCH.deb, whose control (dpkg-deb -I)
  *     names the package, its version and Depends on libzmq5 and OpenEXR,
  *     whose contents (dpkg-deb -c) hold the programs, man pages and scenes;
+ *     installed and removed by dpkg into a private root with its own
+ *     database (--root: the system's is never touched), its Depends all
+ *     installed on this system, and
  *     unpacked with dpkg -x into a scratch root (never installed into this
  *     system), the same checks and the same render. Skipped with one line
  *     where dpkg-deb is missing.
@@ -196,6 +199,29 @@ static void test_debian_package_unpacks_and_renders(void **state)
     char prefix[4300];
     snprintf(prefix, sizeof prefix, "%s/root/usr", dir);
     check_installed(prefix, "from-deb");
+
+    /* installed by dpkg itself, into a private root with its own package
+     * database (the system's is never touched): dpkg records it installed,
+     * it renders from there, and dpkg removes every file it put */
+    assert_int_equal(ft_sh(dir, "dpkg-i.log", "R=%s/dpkgroot && mkdir -p $R/var/lib/dpkg/info "
+                           "$R/var/lib/dpkg/updates && touch $R/var/lib/dpkg/status && "
+                           "dpkg --root=$R --force-not-root --force-depends --log=%s/dpkg.log "
+                           "-i %s", dir, dir, deb), 0);
+    assert_int_equal(ft_sh(dir, "dpkg-s.log", "dpkg --root=%s/dpkgroot -s aafarm", dir), 0);
+    assert_int_equal(count_in("dpkg-s.log", "Status: install ok installed"), 1);
+    snprintf(prefix, sizeof prefix, "%s/dpkgroot/usr", dir);
+    check_installed(prefix, "dpkg-installed");
+    /* --force-depends above only because the private database lists no
+     * library: on this system every Depends is installed */
+    assert_int_equal(ft_sh(dir, "deps-here.log", "dpkg-deb -f %s Depends | tr , \"\\n\" | "
+                           "sed \"s/(.*//; s/|.*//; s/ //g\" | grep . | while read p; do "
+                           "dpkg-query -W -f=\"\\${Status}\\n\" $p | grep -q \"install ok "
+                           "installed\" || { echo \"$p not installed\"; exit 1; }; done", deb), 0);
+    assert_int_equal(ft_sh(dir, "dpkg-r.log", "dpkg --root=%s/dpkgroot --force-not-root -r aafarm",
+                           dir), 0);
+    char gone[4400];
+    snprintf(gone, sizeof gone, "%s/dpkgroot/usr/bin/aafarm-master", dir);
+    assert_false(is_file(gone, true));
 }
 
 int main(int argc, char **argv)
