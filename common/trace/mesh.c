@@ -2,13 +2,15 @@
  * mesh.c: mesh objects, their pieces' BVH and the views of pieces (see
  * mesh.h).
  *
- * The BVH over a mesh's pieces is built once per world (by one thread,
- * trace_renderer_new) and shared read-only by all threads: binned
- * surface-area heuristic over the pieces' box centres (Wald, "On fast
- * construction of SAH-based bounding volume hierarchies", 2007: 12 bins
- * per axis, O(n log n)), a leaf holding up to 4 pieces, 32-byte nodes of
- * float boxes rounded outward. Traversal visits the nearer child first
- * and skips what lies beyond the best hit, as the object BVH (bvh.c).
+ * The BVH over a mesh's pieces is built once per world (trace_renderer_new:
+ * the displaced pieces' root boxes over build_threads threads, the tree by
+ * one) and shared read-only by all threads: binned surface-area heuristic
+ * over the pieces' box centres (Wald, "On fast construction of SAH-based
+ * bounding volume hierarchies", 2007: 12 bins along the axis where the
+ * centres spread most, O(n log n)), a leaf holding up to 4 pieces, 32-byte
+ * nodes of float boxes rounded outward, in the mesh's object space.
+ * Traversal visits the nearer child first and skips what lies beyond the
+ * best hit, as the object BVH (bvh.c).
  */
 #include "trace/mesh.h"
 
@@ -62,9 +64,9 @@ void trace_object_camera_bound(const trace_object *obj, const trace_box *b, trac
     out->hi = v3_add(out->hi, e);
 }
 
-/* view_make with du, dv only where they may matter: a view for rays
- * (shading) or a displaced piece's boxes; not an undisplaced piece's
- * bounds (trace_mesh_build) */
+/* trace_mesh_view_make, computing du and dv only where they matter (grid:
+ * a view that rays will shade; always for a displaced piece, whose
+ * shader reads them), not for an undisplaced piece's bounds alone */
 static bool make(trace_thread *th, const trace_object *mesh_obj, int k, bool boxes,
                  bool grid, trace_view *out);
 
