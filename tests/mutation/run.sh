@@ -76,8 +76,9 @@ for m in mutants:
         else:
             r = subprocess.run(["nice", "ctest", "-R", m["tests"], "--output-on-failure"], cwd=build,
                                capture_output=True, text=True)
-            failed = [l.split("-", 1)[1].split()[0] for l in r.stdout.splitlines()
-                      if "***" in l or "(Failed)" in l or "(Timeout)" in l or "Exception" in l]
+            # ctest's summary lines: "  12 - test_name (Failed)"
+            failed = [l.split(" - ", 1)[1].split()[0] for l in r.stdout.splitlines()
+                      if " - " in l and ("(Failed)" in l or "(Timeout)" in l or "Exception" in l)]
             ran = "No tests were found" not in r.stdout + r.stderr
             if not ran:
                 verdict, detail = "stale", "no test matches " + m["tests"]
