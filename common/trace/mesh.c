@@ -485,11 +485,7 @@ bool trace_mesh_build(trace_thread *th, trace_object *obj)
             /* displaced: each piece's root box runs its shader (undisplaced:
              * trace_world_prepare's pass over the pieces made the bounds) */
             size_t n = (size_t)(m->npieces > 0 ? m->npieces : 1);
-            free(m->bounds);
-            free(m->roots);
-            free(m->dudv);
-            m->roots = NULL;
-            m->dudv = NULL;
+            assert(!m->bounds && !m->roots && !m->dudv);   /* trace_world_prepare cleared them */
             m->bounds = xmalloc(sizeof *m->bounds * n);
             trace_box *roots = obj->displacement ? xmalloc(sizeof *roots * n) : NULL;
             double (*dudv)[2] = obj->displacement ? xmalloc(sizeof *dudv * n) : NULL;
@@ -515,18 +511,18 @@ bool trace_mesh_build(trace_thread *th, trace_object *obj)
     return true;
 }
 
-static bool node_hit(const mesh_node *n, const trace_ray *ray, double tmax, double *t0)
+/* the ray against a float box (lo, hi), as trace_box_hit */
+static bool float_box_hit(const float lo[3], const float hi[3], const trace_ray *ray,
+                          double tmax, double *t0)
 {
-    trace_box b = {.lo = v3(n->lo[0], n->lo[1], n->lo[2]), .hi = v3(n->hi[0], n->hi[1], n->hi[2])};
+    trace_box b = {.lo = v3(lo[0], lo[1], lo[2]), .hi = v3(hi[0], hi[1], hi[2])};
     double t1;
     return trace_box_hit(&b, ray, ray->tmin, tmax, t0, &t1, NULL);
 }
 
-static bool piece_hit(const float f[6], const trace_ray *ray, double tmax)
+static bool node_hit(const mesh_node *n, const trace_ray *ray, double tmax, double *t0)
 {
-    trace_box b = {.lo = v3(f[0], f[1], f[2]), .hi = v3(f[3], f[4], f[5])};
-    double t0, t1;
-    return trace_box_hit(&b, ray, ray->tmin, tmax, &t0, &t1, NULL);
+    return float_box_hit(n->lo, n->hi, ray, tmax, t0);
 }
 
 bool trace_mesh_intersect(trace_thread *th, const trace_object *obj, const trace_ray *cam_ray,
@@ -555,8 +551,9 @@ bool trace_mesh_intersect(trace_thread *th, const trace_object *obj, const trace
         if (n->n > 0) {
             for (int i = 0; i < n->n; i++) {
                 int k = t->idx[n->a + i];
-                if (!piece_hit(m->bounds[k], ray, best->t)) continue;
-                double r0, r1;         /* a displaced piece's root box, as its walk tests it */
+                double r0, r1;
+                if (!float_box_hit(m->bounds[k], m->bounds[k] + 3, ray, best->t, &r0)) continue;
+                /* a displaced piece's root box, as its walk tests it */
                 if (m->roots && !trace_box_hit(&m->roots[k], ray, ray->tmin, best->t, &r0, &r1, NULL))
                     continue;
                 const trace_object *v = trace_mesh_view(th, obj, k);

@@ -183,6 +183,18 @@ static void mark_shared(trace_world *world, const int *meshes, int nmeshes, uint
         owner->shared_edges |= (uint64_t)1 << edge;
 }
 
+/* Adds the edges of polygon s (object id `id`, transform of obj) to *e. */
+static void add_edges(world_edge **e, size_t *n, size_t *cap, const geom_surface *s,
+                      const trace_object *obj, int id)
+{
+    if (s->kind != GEOM_POLYGON) return;
+    for (int j = 0; j < s->nuv && j < 64; j++) {
+        if (*n == *cap) *e = xreallocarray(*e, *cap *= 2, sizeof **e);
+        edge_hash(s, &obj->to_camera, j, &(*e)[*n]);
+        (*e)[(*n)++].ref = (uint64_t)id * 64 + (uint64_t)j;
+    }
+}
+
 /* The edges polygons share (the meshes of Polygon and PointsPolygons
  * calls, whose shared vertices are the same numbers under the same
  * transform): the hit proofs (intersect.c) stay off near them, where the
@@ -190,57 +202,39 @@ static void mark_shared(trace_world *world, const int *meshes, int nmeshes, uint
  * neighbours: O(n log n) for meshes of any size. A mesh that several
  * objects place is seen once, under its first object's transform. The
  * same pass over a mesh's pieces keeps the object-space bounds of the
- * undisplaced ones (trace_mesh_build needs no second one). */
-static void find_shared_edges(trace_world *world)
+ * undisplaced ones (trace_mesh_build needs no second one). meshes[0..nmeshes):
+ * the objects that place a mesh first, in order. */
+static void find_shared_edges(trace_world *world, const int *meshes, int nmeshes)
 {
-    int nmeshes = 0;
-    int *meshes = xmalloc(sizeof *meshes * (size_t)(world->nobjects > 0 ? world->nobjects : 1));
     size_t n = 0;
     for (int i = 0; i < world->nobjects; i++) {
         trace_object *obj = &world->objects[i];
         obj->shared_edges = 0;
-        if (obj->mesh && obj->mesh->first_id >= world->nobjects &&
-            (nmeshes == 0 || world->objects[meshes[nmeshes - 1]].mesh->first_id <
-                                 obj->mesh->first_id)) {
-            /* a mesh's first placing object (first_ids rise with them) */
-            trace_mesh *m = obj->mesh;
-            meshes[nmeshes++] = i;
-            free(m->shared_edges);
-            m->shared_edges = xcalloc((size_t)(m->npieces > 0 ? m->npieces : 1),
-                                      sizeof *m->shared_edges);
-            n += 3 * (size_t)m->npieces;           /* an estimate: grown below */
-        } else if (obj->surf.kind == GEOM_POLYGON) {
-            n += (size_t)obj->surf.nuv;
-        }
+        if (!obj->mesh && obj->surf.kind == GEOM_POLYGON) n += (size_t)obj->surf.nuv;
+    }
+    for (int j = 0; j < nmeshes; j++) {
+        trace_mesh *m = world->objects[meshes[j]].mesh;
+        m->shared_edges = xcalloc((size_t)(m->npieces > 0 ? m->npieces : 1),
+                                  sizeof *m->shared_edges);
+        n += 3 * (size_t)m->npieces;               /* an estimate: grown below */
     }
     size_t cap = n > 0 ? n : 1;
     world_edge *e = xmalloc(cap * sizeof *e);
-    geom_surface *tmp = xmalloc(sizeof *tmp);
     n = 0;
-    for (int i = 0; i < world->nobjects; i++) {
-        trace_object *obj = &world->objects[i];
+    for (int i = 0; i < world->nobjects; i++)
+        if (!world->objects[i].mesh)
+            add_edges(&e, &n, &cap, &world->objects[i].surf, &world->objects[i], i);
+    geom_surface *tmp = xmalloc(sizeof *tmp);
+    for (int j = 0; j < nmeshes; j++) {
+        trace_object *obj = &world->objects[meshes[j]];
         trace_mesh *m = obj->mesh;
-        if (m && owner_of_id(world, meshes, nmeshes, m->first_id) != obj)
-            continue;                  /* a mesh another object placed first */
-        if (m && !obj->displacement && !m->bounds)
+        if (!obj->displacement)
             m->bounds = xmalloc(sizeof *m->bounds * (size_t)(m->npieces > 0 ? m->npieces : 1));
-        int npieces = m ? m->npieces : 1;
-        for (int k = 0; k < npieces; k++) {
-            const geom_surface *s = &obj->surf;
-            int id = i;
-            if (m) {
-                id = m->first_id + k;
-                int npv;
-                if (!m->piece(m->user, obj, k, tmp, NULL, &npv)) continue;
-                s = tmp;
-                if (!obj->displacement) trace_mesh_piece_bounds(s, m->bounds[k]);
-            }
-            if (s->kind != GEOM_POLYGON) continue;
-            for (int j = 0; j < s->nuv && j < 64; j++) {
-                if (n == cap) e = xreallocarray(e, cap *= 2, sizeof *e);
-                edge_hash(s, &obj->to_camera, j, &e[n]);
-                e[n++].ref = (uint64_t)id * 64 + (uint64_t)j;
-            }
+        for (int k = 0; k < m->npieces; k++) {
+            int npv;
+            if (!m->piece(m->user, obj, k, tmp, NULL, &npv)) continue;
+            if (!obj->displacement) trace_mesh_piece_bounds(tmp, m->bounds[k]);
+            add_edges(&e, &n, &cap, tmp, obj, m->first_id + k);
         }
     }
     qsort(e, n, sizeof *e, world_edge_cmp);
@@ -252,7 +246,6 @@ static void find_shared_edges(trace_world *world)
     }
     free(e);
     free(tmp);
-    free(meshes);
 }
 
 bool trace_world_check(trace_world *world, char *err, size_t errsz)
@@ -290,32 +283,30 @@ bool trace_world_prepare(trace_world *world, char *err, size_t errsz)
 {
     if (!trace_world_check(world, err, errsz)) return false;
     /* ids: the objects, then each mesh's pieces (once per mesh: the
-     * objects sharing it share them); its boxes and BVH made anew */
+     * objects sharing it share them); its derived arrays made anew */
     for (int i = 0; i < world->nobjects; i++)
         if (world->objects[i].mesh) {
-            trace_mesh *m = world->objects[i].mesh;
-            m->first_id = -1;
-            free(m->bounds);
-            free(m->roots);
-            free(m->dudv);
-            m->bounds = NULL;
-            m->roots = NULL;
-            m->dudv = NULL;
-            trace_mesh_clear_bvh(m);
+            trace_mesh_clear(world->objects[i].mesh);
+            world->objects[i].mesh->first_id = -1;
         }
+    int *meshes = xmalloc(sizeof *meshes * (size_t)(world->nobjects > 0 ? world->nobjects : 1));
+    int nmeshes = 0;
     long next = world->nobjects;
     for (int i = 0; i < world->nobjects; i++) {
         trace_mesh *m = world->objects[i].mesh;
         if (!m || m->first_id >= 0) continue;
         if (next + m->npieces > INT32_MAX / 64) {
+            free(meshes);
             return err_set(err, errsz, "%s: too many mesh pieces in the scene (%ld before "
                            "this mesh's %d)", world->objects[i].name, next - world->nobjects,
                            m->npieces);
         }
         m->first_id = (int)next;
         next += m->npieces;
+        meshes[nmeshes++] = i;                 /* the mesh's first placing object */
     }
     world->nids = (int)next;
-    find_shared_edges(world);
+    find_shared_edges(world, meshes, nmeshes);
+    free(meshes);
     return true;
 }
