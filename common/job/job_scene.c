@@ -297,9 +297,9 @@ static bool build_objects(job_scene *self, sl_diag *diag)
         trace_object *t = &w->objects[i];
         t->id = i;
         snprintf(t->name, sizeof t->name, "%s at %s:%d",
-                 o->name ? o->name : o->mesh ? "mesh" : geom_kind_name(o->surface.kind),
+                 o->name ? o->name : o->mesh ? "mesh" : geom_kind_name(o->surface->kind),
                  o->pos.file ? o->pos.file : sc->file, o->pos.line);
-        t->surf = o->surface;
+        if (o->surface) t->surf = *o->surface;
         t->to_camera = o->object_to_camera;
         t->from_camera = o->camera_to_object;
         const scene_shader *ds = scene_object_displacement(sc, o);

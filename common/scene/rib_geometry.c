@@ -16,6 +16,7 @@
 #include "util/err.h"
 #include "util/xalloc.h"
 
+#include <assert.h>
 #include <math.h>
 #include <stddef.h>
 #include <stdio.h>
@@ -95,27 +96,53 @@ static bool reverse_normals(scene_orientation o, const mat4 *object_to_camera)
     return false;
 }
 
-static void object_lights(const rib_parser *p, scene_object *o)
+/* The previous object's block when it equals block[0..size) (a run of
+ * instances with one set of attributes shares one copy), else a kept copy;
+ * NULL when size is 0. */
+static const void *shared_copy(rib_parser *p, const void *prev, size_t prev_size,
+                               const void *block, size_t size)
+{
+    if (size == 0) return NULL;
+    if (prev && prev_size == size && memcmp(prev, block, size) == 0) return prev;
+    void *copy = xmalloc(size);
+    memcpy(copy, block, size);
+    return scene_keep(p->scene, copy);
+}
+
+static const char *shared_string(rib_parser *p, const char *prev, const char *s)
+{
+    if (!s) return NULL;
+    return shared_copy(p, prev, prev ? strlen(prev) + 1 : 0, s, strlen(s) + 1);
+}
+
+/* the lights that are on, as indices into scene.lights */
+static void object_lights(rib_parser *p, const scene_object *prev, scene_object *o)
 {
     const rib_attributes *a = &p->attr;
-    o->lights = xrealloc(NULL, (size_t)(p->scene->nlights ? p->scene->nlights : 1) *
-                            sizeof *o->lights);
-    int n = a->lights_on ? a->lights_on->n : 0;
+    int *on = xmalloc((size_t)(p->scene->nlights ? p->scene->nlights : 1) * sizeof *on);
+    int n = a->lights_on ? a->lights_on->n : 0, non = 0;
     for (int i = 0; i < p->scene->nlights && i < n; i++)
         if (a->lights_on->on[i])
-            o->lights[o->nlights++] = i;
+            on[non++] = i;
+    o->lights = shared_copy(p, prev ? prev->lights : NULL,
+                            prev ? (size_t)prev->nlights * sizeof *on : 0, on,
+                            (size_t)non * sizeof *on);
+    o->nlights = non;
+    free(on);
 }
 
 void rib_place_surface(rib_parser *p, const rib_request *req, const geom_surface *surf,
                        const scene_mesh *mesh, mat4 ctm, sl_pos pos,
-                       const scene_primvar *vars, int nvars)
+                       const scene_primvar *vars, int nvars, bool vars_kept)
 {
+    assert(!surf == !!mesh);
     const rib_attributes *a = &p->attr;
     scene_primvar with_st[SCENE_MAX_PRIMVARS];     /* TextureCoordinates (rib_texcoord.c) */
     int nst = mesh ? -1 : rib_texcoord_vars(p, surf, vars, nvars, with_st);
     if (nst >= 0) {
         vars = with_st;
         nvars = nst;
+        vars_kept = false;
     }
     mat4 to_camera = mat4_mul(p->scene->camera.camera_from_world, ctm), inv;
     if (!mat4_invert(&to_camera, &inv)) {
@@ -130,19 +157,36 @@ void rib_place_surface(rib_parser *p, const rib_request *req, const geom_surface
         p->objects_overflow = true;
         return;
     }
+    /* what a renderer keeps per piece (trace/mesh.h): an undisplaced
+     * mesh's boxes once, whatever places it; a displaced mesh's per
+     * placement (its shader runs in each object's space) */
     long pieces = mesh ? scene_mesh_npieces(mesh) : 1;
+    int mi = mesh ? scene_mesh_index(mesh) : -1;
+    if (mi >= 0 && mi >= p->mesh_counted_cap) {
+        int cap = p->mesh_counted_cap;
+        p->mesh_counted_cap = mi + 1 > 2 * cap ? mi + 1 : 2 * cap;
+        p->mesh_counted = xrealloc(p->mesh_counted, (size_t)p->mesh_counted_cap);
+        memset(p->mesh_counted + cap, 0, (size_t)(p->mesh_counted_cap - cap));
+    }
+    bool shared = mi >= 0 && a->displacement < 0;
+    if (shared && p->mesh_counted[mi]) pieces = 0;
     if (p->scene->npieces + pieces > SCENE_MAX_PIECES) {
         if (!p->objects_overflow)
             rib_error(p, req, req->pos, "too many mesh faces: %ld placed before this one's %ld "
-                      "(the limit is %ld pieces per scene, instances counting each time): "
+                      "(the limit is %ld pieces per scene; a displaced mesh's count again for each "
+                      "instance): "
                       "split the scene into several renders or use fewer faces",
                       p->scene->npieces, pieces, SCENE_MAX_PIECES);
         p->objects_overflow = true;
         return;
     }
     p->scene->npieces += pieces;
+    if (shared) p->mesh_counted[mi] = 1;
+    const scene_object *prev = p->scene->nobjects > 0 ? &p->scene->objects[p->scene->nobjects - 1]
+                                                      : NULL;
     scene_object *o = rib_add_object(p);
-    o->surface = *surf;
+    if (prev) prev = &p->scene->objects[p->scene->nobjects - 2];   /* the array moved */
+    o->surface = surf;
     o->mesh = mesh;
     o->object_to_world = ctm;
     o->object_to_camera = to_camera;
@@ -156,24 +200,29 @@ void rib_place_surface(rib_parser *p, const rib_request *req, const geom_surface
     o->reverse_normals = reverse_normals(a->orientation, &to_camera);
     o->shading_rate = a->shading_rate;
     o->displacement_bound = a->displacement_bound;
-    o->displacement_bound_space = xstrndup(a->bound_space, strlen(a->bound_space));
-    o->name = a->name ? xstrndup(a->name, strlen(a->name)) : NULL;
+    o->displacement_bound_space = shared_string(p, prev ? prev->displacement_bound_space : NULL,
+                                                a->bound_space);
+    o->name = shared_string(p, prev ? prev->name : NULL, a->name);
     o->pos = pos;
-    if (nvars > 0) {
-        o->primvars = xrealloc(NULL, (size_t)nvars * sizeof *o->primvars);
-        memcpy(o->primvars, vars, (size_t)nvars * sizeof *o->primvars);
-        o->nprimvars = nvars;
-    }
-    object_lights(p, o);
+    o->primvars = vars_kept || nvars == 0
+        ? (nvars > 0 ? vars : NULL)
+        : shared_copy(p, prev ? prev->primvars : NULL,
+                      prev ? (size_t)prev->nprimvars * sizeof *vars : 0, vars,
+                      (size_t)nvars * sizeof *vars);
+    o->nprimvars = nvars;
+    object_lights(p, prev, o);
 }
 
 void rib_add_surface(rib_parser *p, const rib_request *req, const geom_surface *surf)
 {
-    if (rib_defining(p))
+    if (rib_defining(p)) {
         rib_record_surface(p, req, surf, NULL);
-    else
-        rib_place_surface(p, req, surf, NULL, p->attr.ctm, req->pos, p->surface_vars,
-                          p->nsurface_vars);
+        return;
+    }
+    geom_surface *kept = scene_keep(p->scene, xmalloc(sizeof *kept));
+    *kept = *surf;
+    rib_place_surface(p, req, kept, NULL, p->attr.ctm, req->pos, p->surface_vars,
+                      p->nsurface_vars, false);
 }
 
 void rib_add_mesh(rib_parser *p, const rib_request *req, scene_mesh *mesh)
@@ -182,13 +231,10 @@ void rib_add_mesh(rib_parser *p, const rib_request *req, scene_mesh *mesh)
     s->meshes = xreallocarray(s->meshes, (size_t)s->nmeshes + 1, sizeof *s->meshes);
     scene_mesh_set_index(mesh, s->nmeshes);
     s->meshes[s->nmeshes++] = mesh;
-    geom_surface none;
-    memset(&none, 0, sizeof none);
-    none.kind = GEOM_POLYGON;
     if (rib_defining(p))
-        rib_record_surface(p, req, &none, mesh);
+        rib_record_surface(p, req, NULL, mesh);
     else
-        rib_place_surface(p, req, &none, mesh, p->attr.ctm, req->pos, NULL, 0);
+        rib_place_surface(p, req, NULL, mesh, p->attr.ctm, req->pos, NULL, 0, false);
 }
 
 /* Validates the surface and adds the object with the current attributes

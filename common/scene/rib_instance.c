@@ -94,7 +94,13 @@ void rib_record_surface(rib_parser *p, const rib_request *req, const geom_surfac
     rib_object_def *d = rib_defining(p);
     d->parts = xrealloc(d->parts, (size_t)(d->nparts + 1) * sizeof *d->parts);
     rib_object_part *part = &d->parts[d->nparts++];
-    part->surface = *surf;
+    part->surface = NULL;
+    if (surf) {
+        /* kept by the scene: every instance's object points at it */
+        geom_surface *kept = scene_keep(p->scene, xmalloc(sizeof *kept));
+        *kept = *surf;
+        part->surface = kept;
+    }
     part->mesh = mesh;
     part->ctm = p->attr.ctm;
     part->pos = req->pos;
@@ -102,9 +108,8 @@ void rib_record_surface(rib_parser *p, const rib_request *req, const geom_surfac
     part->nprimvars = p->nsurface_vars;
     part->primvars = NULL;
     if (p->nsurface_vars > 0) {
-        part->primvars = xrealloc(NULL, (size_t)p->nsurface_vars * sizeof *part->primvars);
-        memcpy(part->primvars, p->surface_vars,
-               (size_t)p->nsurface_vars * sizeof *part->primvars);
+        size_t size = (size_t)p->nsurface_vars * sizeof *part->primvars;
+        part->primvars = memcpy(scene_keep(p->scene, xmalloc(size)), p->surface_vars, size);
     }
 }
 
@@ -134,8 +139,8 @@ void rib_object_instance(rib_parser *p, const rib_request *req)
     for (int i = 0; i < d->nparts; i++) {
         rib_object_part *part = &d->parts[i];
         int before = p->scene->nobjects;
-        rib_place_surface(p, req, &part->surface, part->mesh, mat4_mul(ctm, part->ctm), part->pos,
-                          part->primvars, part->nprimvars);
+        rib_place_surface(p, req, part->surface, part->mesh, mat4_mul(ctm, part->ctm), part->pos,
+                          part->primvars, part->nprimvars, true);
         if (p->scene->nobjects == before)
             continue;                  /* not placed (an error said why) */
         if (part->first_object < 0)
@@ -148,9 +153,7 @@ void rib_object_defs_clear(rib_parser *p)
 {
     for (int i = 0; i < p->ndefs; i++) {
         free(p->defs[i].handle);
-        for (int k = 0; k < p->defs[i].nparts; k++)
-            free(p->defs[i].parts[k].primvars);
-        free(p->defs[i].parts);
+        free(p->defs[i].parts);        /* their surfaces and variables: the scene's */
     }
     free(p->defs);
     p->defs = NULL;

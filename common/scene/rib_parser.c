@@ -791,6 +791,7 @@ static void parser_clear(rib_parser *p)
         free(p->texture_path[i]);
     free(p->texture_path);
     rib_object_defs_clear(p);
+    free(p->mesh_counted);
     rib_inline_archives_destroy(p);
     rib_decls_destroy(&p->decls);
     rib_reader_destroy(&p->reader);

@@ -93,12 +93,12 @@ typedef struct rib_block {
 /* A surface of an object definition, with the transform current inside
  * the definition (relative to its ObjectBegin). */
 typedef struct rib_object_part {
-    geom_surface surface;          /* prepared (unused for a mesh) */
+    const geom_surface *surface;   /* prepared, kept by the scene; NULL for a mesh */
     const scene_mesh *mesh;        /* a mesh (owned by the scene), or NULL */
     mat4 ctm;
     sl_pos pos;
     int first_object;              /* the first object placed from it, -1: none yet */
-    scene_primvar *primvars;       /* its primitive variables (owned) */
+    const scene_primvar *primvars; /* its primitive variables (kept by the scene) */
     int nprimvars;
 } rib_object_part;
 
@@ -166,6 +166,9 @@ typedef struct rib_parser {
     sl_pos motion_pos;
     int max_objects;               /* SCENE_MAX_OBJECTS or the caller's */
     bool objects_overflow;         /* that limit was reported */
+    unsigned char *mesh_counted;   /* per scene mesh (its index): its pieces are in
+                                      scene.npieces for its undisplaced placements */
+    int mesh_counted_cap;
     bool blocks_overflow;          /* RIB_MAX_BLOCKS was passed: the parse stops */
     const atomic_int *cancel;      /* the program's stop flag (a signal), or NULL */
     unsigned requests;             /* read so far (the flag is looked at every
@@ -401,12 +404,14 @@ void rib_option_in_world(rib_parser *p, const rib_request *req);
  * false for anything the caller should run. */
 bool rib_motion_filter(rib_parser *p, const rib_request *req);
 
-/* rib_geometry.c: adds an object for a prepared surface (or a mesh: mesh
- * non-NULL, surf unused) with the current attributes and the
- * object-to-world transform ctm; pos is where the surface was written. */
+/* rib_geometry.c: adds an object for a prepared surface (kept by the
+ * scene: scene_keep) or a mesh (mesh non-NULL, surf NULL) with the current
+ * attributes and the object-to-world transform ctm; pos is where the
+ * surface was written. vars_kept: vars[0..nvars) is kept by the scene too
+ * (a recorded part's) and the object may point at it. */
 void rib_place_surface(rib_parser *p, const rib_request *req, const geom_surface *surf,
                        const scene_mesh *mesh, mat4 ctm, sl_pos pos,
-                       const scene_primvar *vars, int nvars);
+                       const scene_primvar *vars, int nvars, bool vars_kept);
 
 /* rib_parser.c: blocks */
 /* False (reported, and the parse stops) past RIB_MAX_BLOCKS. */

@@ -47,13 +47,10 @@ void scene_destroy(scene **self_p)
     for (int i = 0; i < self->nlights; i++)
         free(self->lights[i].handle);
     free(self->lights);
-    for (int i = 0; i < self->nobjects; i++) {
-        free(self->objects[i].displacement_bound_space);
-        free(self->objects[i].name);
-        free(self->objects[i].lights);
-        free(self->objects[i].primvars);
-    }
     free(self->objects);
+    for (size_t i = 0; i < self->nkept; i++)
+        free(self->kept[i]);
+    free(self->kept);
     for (int i = 0; i < self->nshaders; i++)
         free_shader(&self->shaders[i]);
     free(self->shaders);
@@ -84,6 +81,16 @@ void scene_destroy(scene **self_p)
     *self_p = NULL;
 }
 
+void *scene_keep(scene *self, void *block)
+{
+    if (self->nkept == self->kept_cap) {
+        self->kept_cap = self->kept_cap ? 2 * self->kept_cap : 64;
+        self->kept = xreallocarray(self->kept, self->kept_cap, sizeof *self->kept);
+    }
+    self->kept[self->nkept++] = block;
+    return block;
+}
+
 int scene_object_npieces(const scene_object *object)
 {
     return object->mesh ? scene_mesh_npieces(object->mesh) : 1;
@@ -94,7 +101,7 @@ bool scene_object_piece(const scene_object *object, int k, geom_surface *s,
 {
     if (!object->mesh) {
         if (k != 0) return false;
-        *s = object->surface;
+        *s = *object->surface;
         if (object->nprimvars > 0)
             memcpy(vars, object->primvars, (size_t)object->nprimvars * sizeof *vars);
         *nvars = object->nprimvars;

@@ -176,7 +176,10 @@ typedef enum scene_orientation {
 } scene_orientation;
 
 typedef struct scene_object {
-    geom_surface surface;          /* object space, radians; prepared */
+    const geom_surface *surface;   /* object space, radians; prepared; kept by
+                                    * the scene (scene_keep) and shared by the
+                                    * objects placed from one recorded surface
+                                    * (instances); NULL for a mesh */
     mat4 object_to_world;
     mat4 object_to_camera;
     mat4 camera_to_object;
@@ -188,12 +191,15 @@ typedef struct scene_object {
     bool reverse_normals;          /* flip Ng (orientation vs handedness) */
     double shading_rate;
     double displacement_bound;     /* Attribute "displacementbound" "sphere" */
-    char *displacement_bound_space;   /* its "coordinatesystem" ("object") */
-    char *name;                    /* Attribute "identifier" "name", or NULL */
-    int *lights;                   /* indices into scene.lights that are on */
+    /* The arrays and strings below are kept by the scene (scene_keep) and
+     * shared with the previous object where equal: a run of instances with
+     * the same attributes costs one copy (issue 23). */
+    const char *displacement_bound_space;   /* its "coordinatesystem" ("object") */
+    const char *name;              /* Attribute "identifier" "name", or NULL */
+    const int *lights;             /* indices into scene.lights that are on */
     int nlights;
     sl_pos pos;                    /* the defining request (file = scene.file) */
-    scene_primvar *primvars;       /* its primitive variables (other than P, N) */
+    const scene_primvar *primvars; /* its primitive variables (other than P, N) */
     int nprimvars;
     const scene_mesh *mesh;        /* a polygon mesh (scene_mesh.h): its pieces stand
                                     * for `surface` (unused) and `primvars` (none
@@ -261,8 +267,11 @@ typedef struct scene {
     scene_mesh **meshes;           /* polygon meshes, each placed by one or more
                                     * objects (scene_object.mesh) */
     int nmeshes;
-    long npieces;                  /* the pieces the objects place, meshes' pieces
+    long npieces;                  /* the pieces a renderer keeps boxes for: an
+                                    * undisplaced mesh's once, a displaced mesh's
                                     * once per placing object, other objects one */
+    void **kept;                   /* what the objects share (scene_keep) */
+    size_t nkept, kept_cap;
 } scene;
 
 /* The largest Option "trace" "maxdepth" (each depth is a shading VM per
@@ -270,6 +279,11 @@ typedef struct scene {
 enum { SCENE_MAX_TRACE_DEPTH = 16 };
 
 /* ---- building ------------------------------------------------------------ */
+
+/* Hands `block` (from xalloc) to the scene, which frees it with itself;
+ * returns it. What objects point at and may share (surfaces, primitive
+ * variables, names, light lists) lives there. */
+void *scene_keep(scene *self, void *block);
 
 /* Parses RIB text[0..len) named `file` (for positions and the RIB folder
  * of the search path). While parsing, diag's source set is a private copy
@@ -321,8 +335,9 @@ enum { SCENE_ARCHIVE_MAX_DEPTH = 16 };
  * each archive by SCENE_ARCHIVE_MAX_BYTES. */
 enum { SCENE_MAX_OBJECTS = 1 << 20 };
 
-/* The most mesh pieces (a face, or a triangle of one) the objects of a
- * scene may place in all, instances counting each time: ~100 bytes each
+/* The most mesh pieces (a face, or a triangle of one) a scene may hold
+ * boxes for (scene.npieces: instances of an undisplaced mesh count its
+ * pieces once, displaced ones each time): ~100 bytes each
  * in a worker (docs/renderer.md "Meshes"), so 2^25 of them fit a 24 GB
  * worker with room for the box cache. */
 #define SCENE_MAX_PIECES (1L << 25)

@@ -93,9 +93,9 @@ static void test_nested_relative_and_gzip(void **state)
         sl_diag_print(d, stderr);
     assert_non_null(s);
     assert_int_equal(s->nobjects, 3);
-    assert_int_equal(s->objects[0].surface.kind, GEOM_SPHERE);
-    assert_int_equal(s->objects[1].surface.kind, GEOM_DISK);
-    assert_int_equal(s->objects[2].surface.kind, GEOM_CYLINDER);
+    assert_int_equal(s->objects[0].surface->kind, GEOM_SPHERE);
+    assert_int_equal(s->objects[1].surface->kind, GEOM_DISK);
+    assert_int_equal(s->objects[2].surface->kind, GEOM_CYLINDER);
     vec3 o1 = mat4_xform_point(&s->objects[1].object_to_world, v3(0, 0, 0));
     assert_true(vec_dist(o1, v3(1, 2, 0)) < 1e-12);
     assert_true(s->objects[1].Cs[0] == 0 && s->objects[1].Cs[1] == 1);
@@ -121,7 +121,7 @@ static void test_search_path(void **state)
         sl_diag_print(d, stderr);
     assert_non_null(s);
     assert_int_equal(s->nobjects, 1);
-    assert_true(s->objects[0].surface.radius == 0.5);
+    assert_true(s->objects[0].surface->radius == 0.5);
     scene_destroy(&s);
     sl_diag_destroy(&d);
 }
@@ -280,7 +280,7 @@ static void test_from_set_only(void **state)
     scene *s = scene_parse_archives("proj/main.rib", text, strlen(text), set, d);
     assert_non_null(s);
     assert_int_equal(s->nobjects, 1);
-    assert_true(s->objects[0].surface.radius == 3);
+    assert_true(s->objects[0].surface->radius == 3);
     scene_destroy(&s);
     sl_diag_destroy(&d);
 

@@ -97,10 +97,10 @@ static void test_wave_objects(void **state)
     assert_int_equal(s->nlights, 2);
     const scene_object *o = &s->objects[0];
     assert_string_equal(o->name, "wave");
-    assert_int_equal(o->surface.kind, GEOM_POLYGON);
-    assert_int_equal(o->surface.nverts, 4);
-    assert_vec(o->surface.verts[0], v3(-1, 0, -1), 0);
-    assert_vec(o->surface.verts[2], v3(1, 0, 1), 0);
+    assert_int_equal(o->surface->kind, GEOM_POLYGON);
+    assert_int_equal(o->surface->nverts, 4);
+    assert_vec(o->surface->verts[0], v3(-1, 0, -1), 0);
+    assert_vec(o->surface->verts[2], v3(1, 0, 1), 0);
     assert_int_equal(o->sides, 2);
     assert_true(o->displacement_bound == 0.25);
     assert_string_equal(o->displacement_bound_space, "object");
@@ -110,7 +110,7 @@ static void test_wave_objects(void **state)
     assert_string_equal(o->pos.file, s->file);
 
     /* the vertex (-1,0,-1) seen from the camera, by hand */
-    vec3 p = mat4_xform_point(&o->object_to_camera, o->surface.verts[0]);
+    vec3 p = mat4_xform_point(&o->object_to_camera, o->surface->verts[0]);
     assert_vec(p, v3(-1, 0.08 - sin(rad(35)), 3.5 - cos(rad(35))), eps);
     vec3 back = mat4_xform_point(&o->camera_to_object, p);
     assert_vec(back, v3(-1, 0, -1), 1e-12);
@@ -211,9 +211,9 @@ static void test_nail(void **state)
     assert_true(s->camera.screen[2] == -2 && s->camera.screen[3] == 2);
     assert_int_equal(s->nobjects, 1);
     const scene_object *o = &s->objects[0];
-    assert_int_equal(o->surface.kind, GEOM_DISK);
-    assert_true(o->surface.height == 0 && o->surface.radius == 0.5);
-    assert_true(fabs(o->surface.thetamax - 2 * M_PI) < 1e-15);
+    assert_int_equal(o->surface->kind, GEOM_DISK);
+    assert_true(o->surface->height == 0 && o->surface->radius == 0.5);
+    assert_true(fabs(o->surface->thetamax - 2 * M_PI) < 1e-15);
     /* Rotate -90 1 0 0: the disk's normal axis +z becomes world +y */
     assert_vec(mat4_xform_vector(&o->object_to_world, v3(0, 0, 1)), v3(0, 1, 0), 1e-15);
     assert_string_equal(scene_object_displacement(s, o)->name, "nail");
@@ -232,8 +232,8 @@ static void test_ufo(void **state)
     assert_int_equal(s->nobjects, 1);
     assert_int_equal(s->nlights, 3);
     const scene_object *o = &s->objects[0];
-    assert_int_equal(o->surface.kind, GEOM_SPHERE);
-    assert_true(o->surface.radius == 1 && o->surface.zmin == -1 && o->surface.zmax == 1);
+    assert_int_equal(o->surface->kind, GEOM_SPHERE);
+    assert_true(o->surface->radius == 1 && o->surface->zmin == -1 && o->surface->zmax == 1);
     const scene_shader *surf = scene_object_surface(s, o);
     assert_string_equal(surf->name, "wood");
     assert_int_equal(surf->nparams, 0);
@@ -255,12 +255,12 @@ static void test_gallery(void **state)
     assert_int_equal(s->nobjects, 6);
     assert_int_equal(s->nlights, 3);
     const scene_object *ground = object_named(s, "ground");
-    assert_int_equal(ground->surface.kind, GEOM_PATCH);
-    assert_int_equal(ground->surface.nverts, 4);
-    assert_vec(ground->surface.verts[3], v3(5, 0, -5), 0);
+    assert_int_equal(ground->surface->kind, GEOM_PATCH);
+    assert_int_equal(ground->surface->nverts, 4);
+    assert_vec(ground->surface->verts[3], v3(5, 0, -5), 0);
     int spheres = 0;
     for (int i = 0; i < s->nobjects; i++) {
-        spheres += s->objects[i].surface.kind == GEOM_SPHERE;
+        spheres += s->objects[i].surface->kind == GEOM_SPHERE;
         /* light 2 went off at its AttributeEnd and Illuminate turned it on */
         assert_int_equal(s->objects[i].nlights, 3);
     }
@@ -291,15 +291,15 @@ static void test_surfaces(void **state)
     assert_int_equal(s->nobjects, GEOM_BICUBIC);
     int seen[GEOM__COUNT] = { 0 };
     for (int i = 0; i < s->nobjects; i++)
-        seen[s->objects[i].surface.kind]++;
+        seen[s->objects[i].surface->kind]++;
     for (int k = 0; k < GEOM_BICUBIC; k++)
         assert_int_equal(seen[k], 1);
     const scene_object *torus = object_named(s, "torus");
-    assert_true(torus->surface.majorrad == 0.6 && torus->surface.minorrad == 0.25);
-    assert_true(fabs(torus->surface.phimax - 2 * M_PI) < 1e-15);
+    assert_true(torus->surface->majorrad == 0.6 && torus->surface->minorrad == 0.25);
+    assert_true(fabs(torus->surface->phimax - 2 * M_PI) < 1e-15);
     const scene_object *hyp = object_named(s, "hyperboloid");
-    assert_vec(hyp->surface.point1, v3(0.5, 0, -0.6), 0);
-    assert_vec(hyp->surface.point2, v3(0, 0.5, 0.6), 0);
+    assert_vec(hyp->surface->point1, v3(0.5, 0, -0.6), 0);
+    assert_vec(hyp->surface->point2, v3(0, 0.5, 0.6), 0);
     /* the shared Surface call before the objects */
     for (int i = 0; i < s->nobjects; i++) {
         assert_string_equal(scene_object_surface(s, &s->objects[i])->name, "plastic");
@@ -321,12 +321,12 @@ static void test_vase(void **state)
     assert_int_equal(s->narchives, 1);
     assert_non_null(strstr(s->archives[0], "scenes/archives/vase_body.rib"));
     for (int i = 0; i < 35; i++)
-        assert_int_equal(s->objects[i].surface.kind, GEOM_BICUBIC);
+        assert_int_equal(s->objects[i].surface->kind, GEOM_BICUBIC);
     for (int pv = 0; pv < 4; pv++)
         for (int pu = 0; pu < 8; pu++) {
             geom_sample a, b;
-            geom_eval(&s->objects[pv * 8 + pu].surface, 1, 0.5, &a);
-            geom_eval(&s->objects[pv * 8 + (pu + 1) % 8].surface, 0, 0.5, &b);
+            geom_eval(s->objects[pv * 8 + pu].surface, 1, 0.5, &a);
+            geom_eval(s->objects[pv * 8 + (pu + 1) % 8].surface, 0, 0.5, &b);
             assert_true(vec_dist(a.P, b.P) < 1e-12);
         }
     assert_non_null(scene_object_displacement(s, &s->objects[0]));

@@ -64,11 +64,11 @@ static void test_archive_replayed(void **state)
     scene *s = parse_ok(DEFINED_FIRST, &d);
     assert_int_equal(sl_diag_count(d), 0);
     assert_int_equal(s->nobjects, 3);
-    assert_int_equal(s->objects[0].surface.kind, GEOM_SPHERE);
-    assert_int_equal(s->objects[1].surface.kind, GEOM_SPHERE);
+    assert_int_equal(s->objects[0].surface->kind, GEOM_SPHERE);
+    assert_int_equal(s->objects[1].surface->kind, GEOM_SPHERE);
     assert_true(s->objects[0].Cs[1] == 0 && s->objects[1].Cs[1] == 0);
     assert_true(s->objects[1].object_to_world.m[0][3] == 2);
-    assert_int_equal(s->objects[2].surface.kind, GEOM_DISK);
+    assert_int_equal(s->objects[2].surface->kind, GEOM_DISK);
     assert_true(s->objects[2].Cs[1] == 1);
     /* positions stay inside the block */
     assert_int_equal(s->objects[0].pos.line, 6);
@@ -84,7 +84,7 @@ static void test_archive_replayed(void **state)
                        "ArchiveEnd\n"
                        "Sphere 1 -1 1 360\n"), &d);
     assert_int_equal(s->nobjects, 1);
-    assert_int_equal(s->objects[0].surface.kind, GEOM_SPHERE);
+    assert_int_equal(s->objects[0].surface->kind, GEOM_SPHERE);
     assert_true(s->objects[0].Cs[0] == 1 && s->objects[0].Cs[1] == 1);
     assert_true(s->objects[0].object_to_world.m[2][3] == 0);
     scene_destroy(&s);
@@ -105,9 +105,9 @@ static void test_archive_replayed(void **state)
                        "ArchiveEnd\n"
                        "ReadArchive \"inner\"\n"), &d);
     assert_int_equal(s->nobjects, 3);
-    assert_int_equal(s->objects[0].surface.kind, GEOM_SPHERE);
-    assert_int_equal(s->objects[1].surface.kind, GEOM_DISK);
-    assert_int_equal(s->objects[2].surface.kind, GEOM_CONE);
+    assert_int_equal(s->objects[0].surface->kind, GEOM_SPHERE);
+    assert_int_equal(s->objects[1].surface->kind, GEOM_DISK);
+    assert_int_equal(s->objects[2].surface->kind, GEOM_CONE);
     scene_destroy(&s);
     sl_diag_destroy(&d);
 }
@@ -128,8 +128,8 @@ static void test_archive_before_file(void **state)
     scene *s = scene_parse_archives("t.rib", text, strlen(text), set, d);
     assert_non_null(s);
     assert_int_equal(s->nobjects, 2);
-    assert_int_equal(s->objects[0].surface.kind, GEOM_DISK);
-    assert_int_equal(s->objects[1].surface.kind, GEOM_SPHERE);
+    assert_int_equal(s->objects[0].surface->kind, GEOM_DISK);
+    assert_int_equal(s->objects[1].surface->kind, GEOM_SPHERE);
     scene_destroy(&s);
     sl_diag_destroy(&d);
     sl_source_set_destroy(&set);
@@ -208,9 +208,9 @@ static void test_unknown_in_blocks(void **state)
                         "t.rib:5:3: Frobnicate: unknown request, ignored with its arguments");
     assert_int_equal(s->nobjects, 3);
     assert_true(s->objects[0].Cs[0] == 0);          /* green inside the block */
-    assert_int_equal(s->objects[1].surface.kind, GEOM_DISK);
+    assert_int_equal(s->objects[1].surface->kind, GEOM_DISK);
     assert_true(s->objects[1].Cs[0] == 1);          /* white after it */
-    assert_true(s->objects[2].Cs[0] == 1 && s->objects[2].surface.radius == 2);
+    assert_true(s->objects[2].Cs[0] == 1 && s->objects[2].surface->radius == 2);
     scene_destroy(&s);
     sl_diag_destroy(&d);
 }
@@ -353,7 +353,7 @@ static void test_quadrics_reversed(void **state)
                               "Hyperboloid 1 0 1  0.5 0 -1 -360\n"), &d);
     assert_int_equal(sl_diag_count(d), 0);
     assert_int_equal(s->nobjects, 5);
-    assert_true(s->objects[0].surface.zmin == 1 && s->objects[0].surface.zmax == -1);
+    assert_true(s->objects[0].surface->zmin == 1 && s->objects[0].surface->zmax == -1);
     scene_destroy(&s);
     sl_diag_destroy(&d);
     s = parse_rib(WORLD("Cylinder 0.5 1 1 360\n"), &d);

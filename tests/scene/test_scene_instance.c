@@ -40,9 +40,9 @@ static void test_instances_compose(void **state)
     assert_int_equal(sl_diag_warning_count(d), 0);
     assert_int_equal(s->nobjects, 4);
     /* instance 1: sphere centre at (10,1,0), disk: rotate then translate */
-    assert_int_equal(s->objects[0].surface.kind, GEOM_SPHERE);
+    assert_int_equal(s->objects[0].surface->kind, GEOM_SPHERE);
     assert_true(vec_dist(origin_of(&s->objects[0], v3(0, 0, 0)), v3(10, 1, 0)) < 1e-12);
-    assert_int_equal(s->objects[1].surface.kind, GEOM_DISK);
+    assert_int_equal(s->objects[1].surface->kind, GEOM_DISK);
     /* the disk's (1,0,0) is rotated to (0,1,0), then moved by (0,1,0) and (10,0,0) */
     assert_true(vec_dist(origin_of(&s->objects[1], v3(1, 0, 0)), v3(10, 2, 0)) < 1e-12);
     assert_true(s->objects[0].Cs[0] == 1 && s->objects[0].Cs[2] == 0);
@@ -75,8 +75,8 @@ static void test_string_handles_and_redefinition(void **state)
         "Translate 5 0 0\nSphere 3 -3 3 360\n"), &d);
     assert_non_null(s);
     assert_int_equal(s->nobjects, 3);
-    assert_true(s->objects[0].surface.radius == 1);
-    assert_true(s->objects[1].surface.radius == 2);
+    assert_true(s->objects[0].surface->radius == 1);
+    assert_true(s->objects[1].surface->radius == 2);
     /* a redefined handle is another object; a plain surface no instance */
     assert_int_equal(s->objects[1].instance_of, 1);
     assert_int_equal(s->objects[2].instance_of, -1);

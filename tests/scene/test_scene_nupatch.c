@@ -95,7 +95,7 @@ static void check(const spline *s, int want_pieces)
     uint64_t seed = 7;
     for (int pv = 0; pv < nbv - 1; pv++)
         for (int pu = 0; pu < nbu - 1; pu++) {
-            const geom_surface *g = &sc->objects[pv * (nbu - 1) + pu].surface;
+            const geom_surface *g = sc->objects[pv * (nbu - 1) + pu].surface;
             assert_int_equal(g->kind, s->ou > 4 || s->ov > 4 ? GEOM_NURBS : GEOM_BICUBIC);
             for (int k = 0; k < 20; k++) {
                 seed = seed * 6364136223846793005ull + 1442695040888963407ull;
@@ -162,9 +162,9 @@ static void test_pw_and_trim(void **state)
     assert_non_null(strstr(diag_line(nth_diag(d, SL_DIAG_WARNING, 0)),
                            "t.rib:4:1: TrimCurve: trim curves are not supported"));
     geom_sample g;
-    geom_eval(&s->objects[0].surface, 1, 1, &g);
+    geom_eval(s->objects[0].surface, 1, 1, &g);
     assert_true(vec_dist(g.P, v3(1, 1, 1)) < 1e-12);     /* (2 2 2) / 2 */
-    geom_eval(&s->objects[0].surface, 0.5, 0.5, &g);
+    geom_eval(s->objects[0].surface, 0.5, 0.5, &g);
     assert_true(vec_dist(g.P, v3(0.5, 0.5, 0.25)) < 1e-12);
     scene_destroy(&s);
     sl_diag_destroy(&d);
@@ -196,7 +196,7 @@ static void test_rational_circle(void **state)
     assert_non_null(s);
     assert_int_equal(s->nobjects, 1);
     assert_int_equal(s->nnurbs, 1);
-    const geom_surface *g = &s->objects[0].surface;
+    const geom_surface *g = s->objects[0].surface;
     assert_int_equal(g->kind, GEOM_NURBS);
     for (int i = 0; i <= 20; i++)
         for (int j = 0; j <= 4; j++) {

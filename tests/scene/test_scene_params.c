@@ -462,7 +462,7 @@ static void test_frames(void **state)
     assert_int_equal(s->frame_numbers[1], 5);
     assert_int_equal(s->frame_numbers[2], 6);
     assert_int_equal(s->nobjects, 1);
-    assert_true(s->objects[0].surface.radius == 1);
+    assert_true(s->objects[0].surface->radius == 1);
     assert_int_equal(s->camera.xres, 64);
     scene_destroy(&s);
     sl_diag_destroy(&d);
@@ -475,7 +475,7 @@ static void test_frames(void **state)
     assert_int_equal(s->frame_number, 5);
     assert_int_equal(s->nframes, 3);
     assert_int_equal(s->nobjects, 1);
-    assert_true(s->objects[0].surface.radius == 2);
+    assert_true(s->objects[0].surface->radius == 2);
     assert_int_equal(s->camera.xres, 16);
     scene_destroy(&s);
     sl_diag_destroy(&d);
@@ -528,8 +528,8 @@ static void test_comments_and_layout(void **state)
     assert_int_equal(s->camera.yres, 32);
     assert_true(s->camera.fov == 45);
     assert_string_equal(s->objects[0].name, "a\"bA");
-    assert_true(s->objects[0].surface.zmax == 1);
-    assert_true(fabs(s->objects[0].surface.thetamax - 2 * M_PI) < 1e-15);
+    assert_true(s->objects[0].surface->zmax == 1);
+    assert_true(fabs(s->objects[0].surface->thetamax - 2 * M_PI) < 1e-15);
     assert_int_equal(s->objects[0].pos.line, 8);
     scene_destroy(&s);
 }

@@ -82,7 +82,7 @@ static void check_basis(const char *basis, blend_fn blend)
         sl_diag_print(d, stderr);
     assert_non_null(s);
     assert_int_equal(s->nobjects, 1);
-    assert_int_equal(s->objects[0].surface.kind, GEOM_BICUBIC);
+    assert_int_equal(s->objects[0].surface->kind, GEOM_BICUBIC);
     for (int k = 0; k < 25; k++) {
         double u = (k % 5) / 4.0, v = (k / 5) / 4.0, wu[4], wv[4];
         blend(u, wu);
@@ -92,7 +92,7 @@ static void check_basis(const char *basis, blend_fn blend)
             for (int i = 0; i < 4; i++)
                 want = v3_add(want, v3_scale(g[4 * j + i], wu[i] * wv[j]));
         geom_sample got;
-        geom_eval(&s->objects[0].surface, u, v, &got);
+        geom_eval(s->objects[0].surface, u, v, &got);
         if (!(vec_dist(got.P, want) < 1e-12))
             fail_msg("%s at (%g, %g): got (%g %g %g), want (%g %g %g)", basis, u, v,
                      got.P.x, got.P.y, got.P.z, want.x, want.y, want.z);
@@ -143,31 +143,31 @@ static void test_patch_mesh(void **state)
     assert_non_null(s);
     assert_int_equal(s->nobjects, 15 + 3 + 1);
     for (int k = 0; k < 15; k++)
-        assert_int_equal(s->objects[k].surface.kind, GEOM_BICUBIC);
+        assert_int_equal(s->objects[k].surface->kind, GEOM_BICUBIC);
     /* u neighbours: patch (pu, pv) at u = 1 meets (pu+1, pv) at u = 0 */
     for (int pv = 0; pv < 5; pv++)
         for (int pu = 0; pu < 2; pu++)
             for (int k = 0; k <= 4; k++) {
                 geom_sample a, b;
-                geom_eval(&s->objects[pv * 3 + pu].surface, 1, k / 4.0, &a);
-                geom_eval(&s->objects[pv * 3 + pu + 1].surface, 0, k / 4.0, &b);
+                geom_eval(s->objects[pv * 3 + pu].surface, 1, k / 4.0, &a);
+                geom_eval(s->objects[pv * 3 + pu + 1].surface, 0, k / 4.0, &b);
                 assert_true(vec_dist(a.P, b.P) < 1e-12);
             }
     /* v wraps: the last row meets the first */
     for (int pu = 0; pu < 3; pu++) {
         geom_sample a, b;
-        geom_eval(&s->objects[4 * 3 + pu].surface, 0.5, 1, &a);
-        geom_eval(&s->objects[pu].surface, 0.5, 0, &b);
+        geom_eval(s->objects[4 * 3 + pu].surface, 0.5, 1, &a);
+        geom_eval(s->objects[pu].surface, 0.5, 0, &b);
         assert_true(vec_dist(a.P, b.P) < 1e-12);
     }
     /* bilinear, periodic in u: 3 patches, the last closes back to point 0 */
     for (int k = 15; k < 18; k++)
-        assert_int_equal(s->objects[k].surface.kind, GEOM_PATCH);
-    assert_true(vec_dist(s->objects[17].surface.verts[1], v3(0, 0, 0)) == 0);
+        assert_int_equal(s->objects[k].surface->kind, GEOM_PATCH);
+    assert_true(vec_dist(s->objects[17].surface->verts[1], v3(0, 0, 0)) == 0);
     /* the Basis ended with its AttributeEnd: the last patch is Bezier and
      * interpolates its corners */
     geom_sample c;
-    geom_eval(&s->objects[18].surface, 1, 1, &c);
+    geom_eval(s->objects[18].surface, 1, 1, &c);
     assert_true(vec_dist(c.P, v3(3, 3, 0)) < 1e-12);
     scene_destroy(&s);
     sl_diag_destroy(&d);
