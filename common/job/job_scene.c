@@ -6,6 +6,7 @@
  */
 #include "job/job_scene.h"
 #include "job/job_internal.h"
+#include "trace/group.h"
 #include "trace/mesh.h"
 #include "util/err.h"
 #include "util/xalloc.h"
@@ -269,6 +270,119 @@ static bool mesh_piece(const void *user, const trace_object *t, int k, geom_surf
     return true;
 }
 
+/* The instances of a prototype kept as references (trace/group.h): the
+ * scene objects they are, whose transforms, spaces, colours and primitive
+ * variables their views take. */
+typedef struct job_group {
+    trace_group group;
+    const scene *scene;
+    int *objects;                  /* placement k: scene.objects[objects[k]] */
+} job_group;
+
+static void group_transform(const void *user, int k, mat4 *to_camera, mat4 *from_camera)
+{
+    const job_group *g = user;
+    const scene_object *o = &g->scene->objects[g->objects[k]];
+    *to_camera = o->object_to_camera;
+    *from_camera = o->camera_to_object;
+}
+
+static bool group_place(const void *user, int k, trace_object *t, trace_primvar *pv)
+{
+    const job_group *g = user;
+    const scene *sc = g->scene;
+    const scene_object *o = &sc->objects[g->objects[k]];
+    spaces_for(sc, o, scene_object_displacement(sc, o), &t->displacement_spaces);
+    spaces_for(sc, o, scene_object_surface(sc, o), &t->surface_spaces);
+    memcpy(t->Cs, o->Cs, sizeof t->Cs);
+    memcpy(t->Os, o->Os, sizeof t->Os);
+    t->flip = o->reverse_normals;
+    convert_primvars(o->primvars, o->nprimvars, t, pv);
+    t->primvars = pv;
+    t->nprimvars = o->nprimvars;
+    return true;
+}
+
+static bool same_string(const char *a, const char *b)
+{
+    return a == b || (a && b && strcmp(a, b) == 0);
+}
+
+/* May object o (an instance) be a reference to its prototype p: the same
+ * surface in object space (undisplaced), the same shaders, sides, lights
+ * and primitive variables, only its transform and colour its own? */
+static bool placeable(const scene_object *o, const scene_object *p)
+{
+    return o->displacement_shader < 0 && p->displacement_shader < 0 && o->mesh == p->mesh &&
+           o->surface == p->surface && o->surface_shader == p->surface_shader &&
+           o->sides == p->sides && o->nlights == p->nlights &&
+           (o->lights == p->lights ||
+            memcmp(o->lights, p->lights, sizeof *o->lights * (size_t)o->nlights) == 0) &&
+           o->primvars == p->primvars && o->nprimvars == p->nprimvars &&
+           same_string(o->name, p->name);
+}
+
+/* Which objects are references (placements) and of which prototype:
+ * proto_of[i] is the prototype's scene index, or -1 for an object of its
+ * own; the count of each prototype's placements in nplaced[]. */
+static int find_placements(const scene *sc, int *proto_of, int *nplaced)
+{
+    int n = 0;
+    for (int i = 0; i < sc->nobjects; i++) {
+        const scene_object *o = &sc->objects[i];
+        int j = o->instance_of;
+        proto_of[i] = -1;
+        nplaced[i] = 0;
+        if (j < 0 || j >= i || proto_of[j] >= 0 || !placeable(o, &sc->objects[j])) continue;
+        proto_of[i] = j;
+        nplaced[j]++;
+        n++;
+    }
+    return n;
+}
+
+static void build_object(job_scene *self, const scene_object *o, trace_object *t,
+                         trace_primvar *pv, int *undisplaced)
+{
+    const scene *sc = self->scene;
+    snprintf(t->name, sizeof t->name, "%s at %s:%d",
+             o->name ? o->name : o->mesh ? "mesh" : geom_kind_name(o->surface->kind),
+             o->pos.file ? o->pos.file : sc->file, o->pos.line);
+    if (o->surface) t->surf = *o->surface;
+    t->to_camera = o->object_to_camera;
+    t->from_camera = o->camera_to_object;
+    const scene_shader *ds = scene_object_displacement(sc, o);
+    const scene_shader *ss = scene_object_surface(sc, o);
+    spaces_for(sc, o, ds, &t->displacement_spaces);
+    spaces_for(sc, o, ss, &t->surface_spaces);
+    t->displacement = o->displacement_shader >= 0 ? self->instances[o->displacement_shader] : NULL;
+    t->surface = o->surface_shader >= 0 ? self->instances[o->surface_shader] : NULL;
+    memcpy(t->Cs, o->Cs, sizeof t->Cs);
+    memcpy(t->Os, o->Os, sizeof t->Os);
+    t->sides = o->sides;
+    t->flip = o->reverse_normals;
+    t->lights = o->lights;
+    t->nlights = o->nlights;
+    build_primvars(o, t, pv);
+    if (o->mesh) {
+        /* the objects placing one undisplaced mesh share its pieces'
+         * boxes and BVH (object space, trace/mesh.h); a displaced one
+         * has its own (its shader runs in each object's camera space) */
+        int si = scene_mesh_index(o->mesh);
+        trace_mesh *m = !t->displacement && undisplaced[si] >= 0
+                            ? &self->meshes[undisplaced[si]] : NULL;
+        if (!m) {
+            if (!t->displacement) undisplaced[si] = self->nmeshes;
+            m = &self->meshes[self->nmeshes++];
+            m->npieces = scene_mesh_npieces(o->mesh);
+            m->nprimvars = scene_mesh_nprimvars(o->mesh);
+            m->piece = mesh_piece;
+            m->user = o;
+        }
+        t->mesh = m;
+    }
+}
+
 static bool build_objects(job_scene *self, sl_diag *diag)
 {
     const scene *sc = self->scene;
@@ -280,65 +394,73 @@ static bool build_objects(job_scene *self, sl_diag *diag)
         if (!self->instances[i]) ok = false;
     }
     if (!ok) return false;
-    w->nobjects = sc->nobjects;
-    w->objects = xcalloc((size_t)(sc->nobjects > 0 ? sc->nobjects : 1), sizeof *w->objects);
+    size_t nsc = (size_t)(sc->nobjects > 0 ? sc->nobjects : 1);
+    int *proto_of = xmalloc(sizeof *proto_of * nsc);
+    int *nplaced = xmalloc(sizeof *nplaced * nsc);
+    int *world_of = xmalloc(sizeof *world_of * nsc);    /* scene index -> world index */
+    int nplacements = find_placements(sc, proto_of, nplaced);
+    int nown = sc->nobjects - nplacements;
+    self->ngroups = 0;
+    for (int i = 0; i < sc->nobjects; i++) self->ngroups += nplaced[i] > 0;
+    /* the objects of their own, in scene order, then one group per
+     * prototype with placements (after it: trace_world_check) */
+    w->nobjects = nown + self->ngroups;
+    w->objects = xcalloc((size_t)(w->nobjects > 0 ? w->nobjects : 1), sizeof *w->objects);
+    self->groups = xcalloc((size_t)(self->ngroups > 0 ? self->ngroups : 1), sizeof *self->groups);
     int nmeshes = 0;
-    for (int i = 0; i < sc->nobjects; i++) nmeshes += sc->objects[i].mesh != NULL;
+    size_t nprimvars = 0;
+    for (int i = 0; i < sc->nobjects; i++)
+        if (proto_of[i] < 0) {
+            nmeshes += sc->objects[i].mesh != NULL;
+            nprimvars += (size_t)sc->objects[i].nprimvars;
+        }
     self->meshes = xcalloc((size_t)(nmeshes > 0 ? nmeshes : 1), sizeof *self->meshes);
     /* per scene mesh: the trace_mesh its undisplaced placements share */
     int *undisplaced = xmalloc(sizeof *undisplaced * (size_t)(sc->nmeshes > 0 ? sc->nmeshes : 1));
     for (int i = 0; i < sc->nmeshes; i++) undisplaced[i] = -1;
-    size_t nprimvars = 0;
-    for (int i = 0; i < sc->nobjects; i++) nprimvars += (size_t)sc->objects[i].nprimvars;
     self->primvars = xcalloc(nprimvars > 0 ? nprimvars : 1, sizeof *self->primvars);
     trace_primvar *next_primvar = self->primvars;
+    int next = 0, *group_of = nplaced;  /* reused: a prototype's group, then its fill */
     for (int i = 0; i < sc->nobjects; i++) {
+        world_of[i] = -1;
+        if (proto_of[i] >= 0) continue;
         const scene_object *o = &sc->objects[i];
-        trace_object *t = &w->objects[i];
-        t->id = i;
-        snprintf(t->name, sizeof t->name, "%s at %s:%d",
-                 o->name ? o->name : o->mesh ? "mesh" : geom_kind_name(o->surface->kind),
-                 o->pos.file ? o->pos.file : sc->file, o->pos.line);
-        if (o->surface) t->surf = *o->surface;
-        t->to_camera = o->object_to_camera;
-        t->from_camera = o->camera_to_object;
-        const scene_shader *ds = scene_object_displacement(sc, o);
-        const scene_shader *ss = scene_object_surface(sc, o);
-        spaces_for(sc, o, ds, &t->displacement_spaces);
-        spaces_for(sc, o, ss, &t->surface_spaces);
-        t->displacement = o->displacement_shader >= 0 ? self->instances[o->displacement_shader] : NULL;
-        t->surface = o->surface_shader >= 0 ? self->instances[o->surface_shader] : NULL;
-        memcpy(t->Cs, o->Cs, sizeof t->Cs);
-        memcpy(t->Os, o->Os, sizeof t->Os);
-        t->sides = o->sides;
-        t->flip = o->reverse_normals;
-        t->lights = o->lights;
-        t->nlights = o->nlights;
-        build_primvars(o, t, next_primvar);
+        trace_object *t = &w->objects[next];
+        world_of[i] = next++;
+        build_object(self, o, t, next_primvar, undisplaced);
         next_primvar += o->nprimvars;
-        if (o->mesh) {
-            /* the objects placing one undisplaced mesh share its pieces'
-             * boxes and BVH (object space, trace/mesh.h); a displaced one
-             * has its own (its shader runs in each object's camera space) */
-            int si = scene_mesh_index(o->mesh);
-            trace_mesh *m = !t->displacement && undisplaced[si] >= 0
-                                ? &self->meshes[undisplaced[si]] : NULL;
-            if (!m) {
-                if (!t->displacement) undisplaced[si] = self->nmeshes;
-                m = &self->meshes[self->nmeshes++];
-                m->npieces = scene_mesh_npieces(o->mesh);
-                m->nprimvars = scene_mesh_nprimvars(o->mesh);
-                m->piece = mesh_piece;
-                m->user = o;
-            }
-            t->mesh = m;
-            continue;
-        }
         /* an instance proposes sharing its prototype's boxes (trace/instance.c) */
-        if (o->instance_of >= 0 && o->instance_of < i)
-            t->box_proto = &w->objects[o->instance_of];
+        if (!o->mesh && o->instance_of >= 0 && o->instance_of < i && world_of[o->instance_of] >= 0)
+            t->box_proto = &w->objects[world_of[o->instance_of]];
     }
+    /* the groups: placement k of each in scene order */
+    int ng = 0;
+    for (int i = 0; i < sc->nobjects; i++) {
+        if (nplaced[i] == 0) { group_of[i] = -1; continue; }
+        job_group *g = &self->groups[ng];
+        g->scene = sc;
+        g->objects = xmalloc(sizeof *g->objects * (size_t)nplaced[i]);
+        g->group.proto = world_of[i];
+        g->group.transform = group_transform;
+        g->group.place = group_place;
+        g->group.user = g;
+        trace_object *t = &w->objects[nown + ng];
+        t->group = &g->group;
+        t->to_camera = t->from_camera = mat4_identity();
+        char proto_name[sizeof t->name];
+        memcpy(proto_name, w->objects[world_of[i]].name, sizeof proto_name);
+        snprintf(t->name, sizeof t->name, "%d instances of %.40s", nplaced[i], proto_name);
+        group_of[i] = ng++;
+    }
+    for (int i = 0; i < sc->nobjects; i++)
+        if (proto_of[i] >= 0) {
+            job_group *g = &self->groups[group_of[proto_of[i]]];
+            g->objects[g->group.n++] = i;
+        }
     free(undisplaced);
+    free(proto_of);
+    free(nplaced);
+    free(world_of);
     return true;
 }
 
@@ -462,6 +584,11 @@ void job_scene_destroy(job_scene **self_p)
     free(self->primvars);
     for (int i = 0; i < self->nmeshes; i++) trace_mesh_clear(&self->meshes[i]);
     free(self->meshes);
+    for (int i = 0; i < self->ngroups; i++) {
+        trace_group_clear(&self->groups[i].group);
+        free(self->groups[i].objects);
+    }
+    free(self->groups);
     tex_cache_destroy(&self->textures);
     scene_destroy(&self->scene);
     free(self);

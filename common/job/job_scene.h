@@ -26,6 +26,9 @@ typedef struct job_scene {
     trace_primvar *primvars;       /* every object's primitive variables (world.objects[].primvars) */
     trace_mesh *meshes;            /* the mesh objects' sources (world.objects[].mesh) */
     int nmeshes;
+    struct job_group *groups;      /* the instances kept as references
+                                      (world.objects[].group, job_scene.c) */
+    int ngroups;
 } job_scene;
 
 /* cache_bytes: this worker's box cache budget per thread (0: unlimited).

@@ -915,6 +915,9 @@ static scene *parse_frame(const char *file, const char *text, size_t len,
     sl_source_set_destroy(&set);
     if (sl_diag_error_count(diag) > errors_before)
         scene_destroy(&p.scene);
+    else if (p.scene->nobjects > 0)    /* the growth's slack: up to half a million instances' */
+        p.scene->objects = xreallocarray(p.scene->objects, (size_t)p.scene->nobjects,
+                                         sizeof *p.scene->objects);
     return p.scene;
 }
 

@@ -2,6 +2,7 @@
  * bvh.c: median-split BVH over object root boxes (see bvh.h).
  */
 #include "trace/bvh.h"
+#include "trace/group.h"
 #include "trace/mesh.h"
 #include "util/xalloc.h"
 
@@ -113,8 +114,9 @@ bool trace_bvh_intersect(const trace_bvh *self, trace_thread *th,
             assert(n->first >= 0 && n->first + n->count <= self->world->nobjects);
             for (int i = 0; i < n->count; i++) {
                 const trace_object *o = &self->world->objects[self->idx[n->first + i]];
-                if (o->mesh ? trace_mesh_intersect(th, o, ray, tol, any, best)
-                            : trace_intersect_object(th, o, ray, tol, any, best)) {
+                if (o->group  ? trace_group_intersect(th, o, ray, tol, any, best)
+                    : o->mesh ? trace_mesh_intersect(th, o, ray, tol, any, best)
+                              : trace_intersect_object(th, o, ray, tol, any, best)) {
                     found = true;
                     if (any) return true;
                 }

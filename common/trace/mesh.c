@@ -26,14 +26,21 @@
 
 /* ---- views ---------------------------------------------------------- */
 
-/* 2-way set-associative: a piece goes to one of the two slots of its set,
- * the older of the two making room */
-enum { VIEW_SETS = 128, VIEW_SLOTS = 2 * VIEW_SETS };
+/* 2-way set-associative: a view goes to one of the two slots of its set,
+ * the older of the two making room. Pieces and placements have a cache
+ * each: a placement's view stays put while its pieces' views are made. */
+enum { PIECE_SETS = 128, PLACE_SETS = 32 };
+
+typedef struct view_cache {
+    int sets;
+    trace_view *slot;                  /* 2 * sets */
+    int64_t *key;                      /* the view's object id and element; -1: empty */
+    int32_t *place;                    /* and its object's placement (trace_object.place) */
+    unsigned char *older;              /* per set: the slot to replace next (0, 1) */
+} view_cache;
 
 typedef struct trace_views {
-    trace_view slot[VIEW_SLOTS];
-    int64_t key[VIEW_SLOTS];           /* the view's object and piece; -1: empty */
-    unsigned char older[VIEW_SETS];    /* the set's slot to replace next (0, 1) */
+    view_cache cache[2];               /* trace_view_kind */
     trace_view hit;                    /* the hit a traversal returns */
     trace_view *held[TRACE_RAY_DEPTH_LIMIT + 1];   /* hits being shaded, per depth */
 } trace_views;
@@ -134,13 +141,30 @@ void trace_view_copy(trace_view *dst, const trace_view *src)
     dst->obj.primvars = dst->pv;
 }
 
+static void cache_init(view_cache *c, int sets)
+{
+    c->sets = sets;
+    c->slot = xmalloc(sizeof *c->slot * (size_t)(2 * sets));
+    c->key = xmalloc(sizeof *c->key * (size_t)(2 * sets));
+    c->place = xcalloc((size_t)(2 * sets), sizeof *c->place);
+    c->older = xcalloc((size_t)sets, sizeof *c->older);
+    for (int i = 0; i < 2 * sets; i++) c->key[i] = -1;
+}
+
+static void cache_free(view_cache *c)
+{
+    free(c->slot);
+    free(c->key);
+    free(c->place);
+    free(c->older);
+}
+
 static trace_views *views_of(trace_thread *th)
 {
     if (!th->views) {
-        th->views = xmalloc(sizeof *th->views);
-        for (int i = 0; i < VIEW_SLOTS; i++) th->views->key[i] = -1;
-        memset(th->views->older, 0, sizeof th->views->older);
-        memset(th->views->held, 0, sizeof th->views->held);
+        th->views = xcalloc(1, sizeof *th->views);
+        cache_init(&th->views->cache[TRACE_VIEWS_PIECES], PIECE_SETS);
+        cache_init(&th->views->cache[TRACE_VIEWS_PLACES], PLACE_SETS);
     }
     return th->views;
 }
@@ -149,31 +173,50 @@ void trace_views_free(trace_thread *th)
 {
     if (!th->views) return;
     for (int d = 0; d <= TRACE_RAY_DEPTH_LIMIT; d++) free(th->views->held[d]);
+    for (int i = 0; i < 2; i++) cache_free(&th->views->cache[i]);
     free(th->views);
     th->views = NULL;
 }
 
-const trace_object *trace_mesh_view(trace_thread *th, const trace_object *mesh_obj, int k)
+const trace_object *trace_view_get(trace_thread *th, trace_view_kind which, const trace_object *obj,
+                                   int k, trace_view_make_fn make_view)
 {
-    trace_views *vs = views_of(th);
-    /* the object and the piece: objects sharing a mesh share its ids */
-    int64_t key = (int64_t)mesh_obj->id << 32 | (uint32_t)k;
-    uint64_t h = (uint64_t)key * 0x9e3779b97f4a7c15ull;
-    unsigned set = (unsigned)(h >> 57);   /* 7 bits: VIEW_SETS */
-    assert(set < VIEW_SETS);
+    view_cache *c = &views_of(th)->cache[which];
+    /* the object and the element: objects sharing a mesh share its ids,
+     * placements tell them apart */
+    int64_t key = (int64_t)obj->id << 32 | (uint32_t)k;
+    uint64_t h = ((uint64_t)key ^ (uint64_t)obj->place << 40) * 0x9e3779b97f4a7c15ull;
+    unsigned set = (unsigned)((h >> 32) % (unsigned)c->sets);
     th->stats.views_asked++;
     for (unsigned w = 0; w < 2; w++)
-        if (vs->key[2 * set + w] == key) {
-            vs->older[set] = (unsigned char)(1 - w);
-            return &vs->slot[2 * set + w].obj;
+        if (c->key[2 * set + w] == key && c->place[2 * set + w] == obj->place) {
+            c->older[set] = (unsigned char)(1 - w);
+            return &c->slot[2 * set + w].obj;
         }
-    unsigned s = 2 * set + vs->older[set];
-    vs->key[s] = -1;
-    if (!trace_mesh_view_make(th, mesh_obj, k, true, &vs->slot[s])) return NULL;
-    vs->key[s] = key;
-    vs->older[set] = (unsigned char)(1 - vs->older[set]);
+    unsigned s = 2 * set + c->older[set];
+    c->key[s] = -1;
+    if (!make_view(th, obj, k, &c->slot[s])) return NULL;
+    c->key[s] = key;
+    c->place[s] = obj->place;
+    c->older[set] = (unsigned char)(1 - c->older[set]);
     th->stats.views_made++;
-    return &vs->slot[s].obj;
+    return &c->slot[s].obj;
+}
+
+static bool make_piece(trace_thread *th, const trace_object *mesh_obj, int k, trace_view *out)
+{
+    return trace_mesh_view_make(th, mesh_obj, k, true, out);
+}
+
+const trace_object *trace_mesh_view(trace_thread *th, const trace_object *mesh_obj, int k)
+{
+    return trace_view_get(th, TRACE_VIEWS_PIECES, mesh_obj, k, make_piece);
+}
+
+void trace_view_hit(trace_thread *th, const trace_object *v, trace_hit *best)
+{
+    trace_view_copy(&th->views->hit, (const trace_view *)v);
+    best->obj = &th->views->hit.obj;
 }
 
 const trace_object *trace_view_hold(trace_thread *th, const trace_object *obj, int depth)
@@ -368,7 +411,7 @@ static void build_node(build_ctx *c, int id, int first, int count, int depth)
     build_node(c, left + 1, first + mid, count - mid, depth + 1);
 }
 
-static struct trace_mesh_bvh *bvh_build(const float (*bounds)[6], int n)
+struct trace_mesh_bvh *trace_float_bvh_build(const float (*bounds)[6], int n)
 {
     struct trace_mesh_bvh *t = xcalloc(1, sizeof *t);
     t->idx = xmalloc(sizeof *t->idx * (size_t)(n > 0 ? n : 1));
@@ -387,7 +430,7 @@ static struct trace_mesh_bvh *bvh_build(const float (*bounds)[6], int n)
     return t;
 }
 
-static void float_box(const trace_box *b, float f[6])
+void trace_float_box(const trace_box *b, float f[6])
 {
     f[0] = down(b->lo.x), f[1] = down(b->lo.y), f[2] = down(b->lo.z);
     f[3] = up(b->hi.x), f[4] = up(b->hi.y), f[5] = up(b->hi.z);
@@ -397,10 +440,10 @@ void trace_mesh_piece_bounds(const geom_surface *s, float out[6])
 {
     trace_box root;
     geom_bounds(s, &root.lo, &root.hi);
-    float_box(&root, out);
+    trace_float_box(&root, out);
 }
 
-static void free_bvh(struct trace_mesh_bvh **t)
+void trace_float_bvh_free(struct trace_mesh_bvh **t)
 {
     if (!*t) return;
     free((*t)->nodes);
@@ -409,9 +452,26 @@ static void free_bvh(struct trace_mesh_bvh **t)
     *t = NULL;
 }
 
+size_t trace_float_bvh_bytes(const struct trace_mesh_bvh *t, int n)
+{
+    return t ? (size_t)t->nnodes * sizeof(mesh_node) + (size_t)n * sizeof *t->idx : 0;
+}
+
+bool trace_float_bvh_root(const struct trace_mesh_bvh *t, trace_box *out)
+{
+    *out = (trace_box){.lo = v3(INFINITY, INFINITY, INFINITY),
+                       .hi = v3(-INFINITY, -INFINITY, -INFINITY), .flags = 0};
+    trace_box_no_slab(out);
+    if (!t || t->nnodes == 0) return false;
+    const mesh_node *r = &t->nodes[0];
+    out->lo = v3(r->lo[0], r->lo[1], r->lo[2]);
+    out->hi = v3(r->hi[0], r->hi[1], r->hi[2]);
+    return true;
+}
+
 void trace_mesh_clear_bvh(trace_mesh *self)
 {
-    free_bvh(&self->bvh);
+    trace_float_bvh_free(&self->bvh);
 }
 
 /* One thread's share of the pieces' boxes: pieces [k0, k1) of obj with
@@ -432,7 +492,7 @@ static void *box_range(void *arg)
     for (int k = b->k0; k < b->k1; k++) {
         if (((k - b->k0) & 255) == 0 && trace_thread_cancelled(b->th)) break;
         if (!make(b->th, b->obj, k, true, false, v)) break;
-        float_box(&v->obj.root, m->bounds[k]);
+        trace_float_box(&v->obj.root, m->bounds[k]);
         if (b->roots) {
             b->roots[k] = v->obj.root;
             b->dudv[k][0] = v->obj.du;
@@ -494,19 +554,11 @@ bool trace_mesh_build(trace_thread *th, trace_object *obj)
             m->dudv = dudv;
         }
         if (th->failed) return false;
-        m->bvh = bvh_build((const float (*)[6])m->bounds, m->npieces);
+        m->bvh = trace_float_bvh_build((const float (*)[6])m->bounds, m->npieces);
     }
     /* the root: the union of the pieces' boxes (object space), the
      * bound: its camera-space box, as any object's */
-    trace_box all = {.lo = v3(INFINITY, INFINITY, INFINITY),
-                     .hi = v3(-INFINITY, -INFINITY, -INFINITY), .flags = 0};
-    trace_box_no_slab(&all);
-    if (m->bvh->nnodes > 0) {
-        const mesh_node *r = &m->bvh->nodes[0];
-        all.lo = v3(r->lo[0], r->lo[1], r->lo[2]);
-        all.hi = v3(r->hi[0], r->hi[1], r->hi[2]);
-    }
-    obj->root = all;
+    trace_float_bvh_root(m->bvh, &obj->root);
     trace_object_camera_bound(obj, &obj->root, &obj->bound);
     return true;
 }
@@ -525,18 +577,11 @@ static bool node_hit(const mesh_node *n, const trace_ray *ray, double tmax, doub
     return float_box_hit(n->lo, n->hi, ray, tmax, t0);
 }
 
-bool trace_mesh_intersect(trace_thread *th, const trace_object *obj, const trace_ray *cam_ray,
-                          const trace_tolerance *tol, bool any, trace_hit *best)
+bool trace_float_bvh_walk(const struct trace_mesh_bvh *t, const float (*bounds)[6],
+                          const trace_ray *ray, trace_hit *best, bool any,
+                          trace_float_bvh_leaf leaf, void *ctx)
 {
-    const trace_mesh *m = obj->mesh;
-    const struct trace_mesh_bvh *t = m->bvh;
     if (!t || t->nnodes == 0) return false;
-    /* the boxes are in object space: so is the ray (an affine map keeps
-     * its parameter t); the pieces take the camera-space ray */
-    trace_ray oray;
-    trace_ray_init(&oray, mat4_xform_point(&obj->from_camera, cam_ray->o),
-                   mat4_xform_vector(&obj->from_camera, cam_ray->d), cam_ray->tmin, cam_ray->tmax);
-    const trace_ray *ray = &oray;
     struct { int node; double t0; } stack[MESH_STACK];
     int sp = 0;
     double t0;
@@ -551,17 +596,11 @@ bool trace_mesh_intersect(trace_thread *th, const trace_object *obj, const trace
         if (n->n > 0) {
             for (int i = 0; i < n->n; i++) {
                 int k = t->idx[n->a + i];
-                double r0, r1;
-                if (!float_box_hit(m->bounds[k], m->bounds[k] + 3, ray, best->t, &r0)) continue;
-                /* a displaced piece's root box, as its walk tests it */
-                if (m->roots && !trace_box_hit(&m->roots[k], ray, ray->tmin, best->t, &r0, &r1, NULL))
-                    continue;
-                const trace_object *v = trace_mesh_view(th, obj, k);
-                if (!v) return found;
-                if (trace_intersect_object(th, v, cam_ray, tol, any, best)) {
-                    /* the hit outlives the cache slot: a copy in the hit slot */
-                    trace_view_copy(&th->views->hit, (const trace_view *)v);
-                    best->obj = &th->views->hit.obj;
+                double r0;
+                if (!float_box_hit(bounds[k], bounds[k] + 3, ray, best->t, &r0)) continue;
+                int got = leaf(ctx, k);
+                if (got < 0) return found;
+                if (got > 0) {
                     found = true;
                     if (any) return true;
                 }
@@ -589,13 +628,52 @@ bool trace_mesh_intersect(trace_thread *th, const trace_object *obj, const trace
     return found;
 }
 
+/* One mesh traversal: the pieces' leaf test (trace_float_bvh_leaf) */
+typedef struct mesh_walk {
+    trace_thread *th;
+    const trace_object *obj;
+    const trace_ray *cam_ray, *ray;    /* camera space, object space */
+    const trace_tolerance *tol;
+    bool any;
+    trace_hit *best;
+} mesh_walk;
+
+static int mesh_leaf(void *ctx, int k)
+{
+    mesh_walk *w = ctx;
+    const trace_mesh *m = w->obj->mesh;
+    double r0, r1;
+    /* a displaced piece's root box, as its walk tests it */
+    if (m->roots && !trace_box_hit(&m->roots[k], w->ray, w->ray->tmin, w->best->t, &r0, &r1, NULL))
+        return 0;
+    const trace_object *v = trace_mesh_view(w->th, w->obj, k);
+    if (!v) return -1;
+    if (!trace_intersect_object(w->th, v, w->cam_ray, w->tol, w->any, w->best)) return 0;
+    trace_view_hit(w->th, v, w->best);
+    return 1;
+}
+
+bool trace_mesh_intersect(trace_thread *th, const trace_object *obj, const trace_ray *cam_ray,
+                          const trace_tolerance *tol, bool any, trace_hit *best)
+{
+    const trace_mesh *m = obj->mesh;
+    /* the boxes are in object space: so is the ray (an affine map keeps
+     * its parameter t); the pieces take the camera-space ray */
+    trace_ray oray;
+    trace_ray_init(&oray, mat4_xform_point(&obj->from_camera, cam_ray->o),
+                   mat4_xform_vector(&obj->from_camera, cam_ray->d), cam_ray->tmin, cam_ray->tmax);
+    mesh_walk w = {th, obj, cam_ray, &oray, tol, any, best};
+    return trace_float_bvh_walk(m->bvh, (const float (*)[6])m->bounds, &oray, best, any,
+                                mesh_leaf, &w);
+}
+
 void trace_mesh_clear(trace_mesh *self)
 {
     free(self->shared_edges);
     free(self->bounds);
     free(self->roots);
     free(self->dudv);
-    free_bvh(&self->bvh);
+    trace_float_bvh_free(&self->bvh);
     self->shared_edges = NULL;
     self->bounds = NULL;
     self->roots = NULL;
@@ -609,7 +687,5 @@ size_t trace_mesh_bytes(const trace_mesh *self)
     if (self->shared_edges) b += n * sizeof *self->shared_edges;
     if (self->bounds) b += n * sizeof *self->bounds;
     if (self->roots) b += n * (sizeof *self->roots + sizeof *self->dudv);
-    if (self->bvh)
-        b += (size_t)self->bvh->nnodes * sizeof(mesh_node) + n * sizeof *self->bvh->idx;
-    return b;
+    return b + trace_float_bvh_bytes(self->bvh, self->npieces);
 }

@@ -42,10 +42,28 @@ bool trace_mesh_view_make(trace_thread *th, const trace_object *mesh_obj, int k,
 /* The view of piece k from the thread's cache (made on a miss). */
 const trace_object *trace_mesh_view(trace_thread *th, const trace_object *mesh_obj, int k);
 
-/* The pieces of an object: a mesh's, or 1 (the object itself). */
+/* The thread's view caches: pieces of meshes, placements of groups. */
+typedef enum trace_view_kind { TRACE_VIEWS_PIECES, TRACE_VIEWS_PLACES } trace_view_kind;
+typedef bool (*trace_view_make_fn)(trace_thread *th, const trace_object *obj, int k,
+                                   trace_view *out);
+
+/* The view of element k of obj (its id, its placement and k are the key)
+ * from the thread's cache `which`, made by `make` on a miss; NULL when
+ * that failed (the thread failed). Valid until the next call for the same
+ * cache. */
+const trace_object *trace_view_get(trace_thread *th, trace_view_kind which, const trace_object *obj,
+                                   int k, trace_view_make_fn make);
+
+/* A view the traversal found the nearest hit on: the hit outlives the
+ * cache slot, so best->obj becomes a copy of v in the thread's hit slot. */
+void trace_view_hit(trace_thread *th, const trace_object *v, trace_hit *best);
+
+/* The pieces of an object: a mesh's, or 1 (the object itself); a group
+ * has none of its own (its placements are its prototype's surfaces
+ * moved). */
 static inline int trace_object_npieces(const trace_object *obj)
 {
-    return obj->mesh ? obj->mesh->npieces : 1;
+    return obj->group ? 0 : obj->mesh ? obj->mesh->npieces : 1;
 }
 
 /* Piece k of obj as an object: obj itself (k = 0) when it is not a mesh,
@@ -89,6 +107,24 @@ void trace_mesh_clear(trace_mesh *self);
 
 /* Bytes of the derived arrays (boxes, BVH, shared edges). */
 size_t trace_mesh_bytes(const trace_mesh *self);
+
+/* A BVH over float boxes (a mesh's pieces, a group's placements): binned
+ * SAH, leaves of up to 4, 32-byte nodes (mesh.c). */
+struct trace_mesh_bvh *trace_float_bvh_build(const float (*bounds)[6], int n);
+void trace_float_bvh_free(struct trace_mesh_bvh **t);
+size_t trace_float_bvh_bytes(const struct trace_mesh_bvh *t, int n);
+/* Its root's box (all the boxes); false (an empty box) when it has none. */
+bool trace_float_bvh_root(const struct trace_mesh_bvh *t, trace_box *out);
+/* Visits, nearer nodes first, each element k whose box `ray` (in the
+ * boxes' space) meets before best->t: leaf(ctx, k) returns 1 when it
+ * found a hit (best updated), 0 when not, -1 to stop (a failure). True
+ * when a leaf found a hit; `any`: stops at the first. */
+typedef int (*trace_float_bvh_leaf)(void *ctx, int k);
+bool trace_float_bvh_walk(const struct trace_mesh_bvh *t, const float (*bounds)[6],
+                          const trace_ray *ray, trace_hit *best, bool any,
+                          trace_float_bvh_leaf leaf, void *ctx);
+/* b as a float box (lo, hi), rounded outward. */
+void trace_float_box(const trace_box *b, float f[6]);
 
 /* The camera-space box of an object-space box b of obj (its 8 corners,
  * widened by a relative hair for the rounding). */

@@ -12,6 +12,7 @@
 
 #include "trace/camera.h"
 #include "trace/instance.h"
+#include "trace/group.h"
 #include "trace/mesh.h"
 #include "trace/sampler.h"
 #include "trace/shade.h"
@@ -27,6 +28,11 @@ trace_renderer *trace_renderer_new(trace_world *world, char *err, size_t errsz)
     for (int i = 0; i < world->nobjects && !th->failed; i++) {
         if (trace_thread_cancelled(th)) break;   /* a signal: stop between objects */
         trace_object *obj = &world->objects[i];
+        if (obj->group) {
+            /* its placements' boxes (its prototype, before it, is built) */
+            trace_group_build(obj->group, world, obj);
+            continue;
+        }
         if (obj->mesh) {
             trace_mesh_build(th, obj);          /* its pieces' boxes and BVH */
             continue;

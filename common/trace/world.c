@@ -7,6 +7,7 @@
  * so every worker derives the same values.
  */
 #include "trace/world.h"
+#include "trace/group.h"
 #include "trace/mesh.h"
 #include "util/err.h"
 #include "util/xalloc.h"
@@ -210,7 +211,8 @@ static void find_shared_edges(trace_world *world, const int *meshes, int nmeshes
     for (int i = 0; i < world->nobjects; i++) {
         trace_object *obj = &world->objects[i];
         obj->shared_edges = 0;
-        if (!obj->mesh && obj->surf.kind == GEOM_POLYGON) n += (size_t)obj->surf.nuv;
+        if (!obj->mesh && !obj->group && obj->surf.kind == GEOM_POLYGON)
+            n += (size_t)obj->surf.nuv;
     }
     for (int j = 0; j < nmeshes; j++) {
         trace_mesh *m = world->objects[meshes[j]].mesh;
@@ -222,7 +224,7 @@ static void find_shared_edges(trace_world *world, const int *meshes, int nmeshes
     world_edge *e = xmalloc(cap * sizeof *e);
     n = 0;
     for (int i = 0; i < world->nobjects; i++)
-        if (!world->objects[i].mesh)
+        if (!world->objects[i].mesh && !world->objects[i].group)
             add_edges(&e, &n, &cap, &world->objects[i].surf, &world->objects[i], i);
     geom_surface *tmp = xmalloc(sizeof *tmp);
     for (int j = 0; j < nmeshes; j++) {
@@ -248,34 +250,67 @@ static void find_shared_edges(trace_world *world, const int *meshes, int nmeshes
     free(tmp);
 }
 
+bool trace_object_derive(const trace_world *world, trace_object *obj, bool grid, char *err,
+                         size_t errsz)
+{
+    double s = stretch_of(&obj->to_camera), si = stretch_of(&obj->from_camera);
+    if (!matrix_finite(&obj->to_camera) || !matrix_finite(&obj->from_camera) ||
+        !(s > 0) || !isfinite(s * si) || s * si > 1e12)
+        return err_set(err, errsz, "%s: its transformation to camera space is not "
+                       "finite or nearly singular (stretch %.3g, inverse stretch %.3g); check "
+                       "the Translate/Scale/ConcatTransform values before it", obj->name, s, si);
+    obj->scale = s;
+    obj->normal_scale = normal_scale_of(obj);
+    /* |from_camera^T n| lies between the smallest and the largest
+     * stretch of from_camera: 1/stretch(to_camera) and stretch(from),
+     * both rounded outward (stretch_of rounds up) */
+    double lo = 1.0 / s;
+    obj->normal_len2[0] = lo * lo * (1.0 - 1e-9);
+    obj->normal_len2[1] = si * si * (1.0 + 1e-9);
+    if (grid) trace_object_grid_spacing(world, obj);
+    return true;
+}
+
+/* Each placement of group object g passes the object checks (its view's
+ * transforms are the scene's). */
+static bool check_placements(const trace_world *world, const trace_object *g, char *err,
+                             size_t errsz)
+{
+    const trace_group *gr = g->group;
+    trace_object probe = world->objects[gr->proto];
+    for (int k = 0; k < gr->n; k++) {
+        gr->transform(gr->user, k, &probe.to_camera, &probe.from_camera);
+        if (!trace_object_derive(world, &probe, false, err, errsz)) return false;
+    }
+    return true;
+}
+
 bool trace_world_check(trace_world *world, char *err, size_t errsz)
 {
+    int places = 0;
     for (int i = 0; i < world->nobjects; i++) {
         trace_object *obj = &world->objects[i];
-        double s = stretch_of(&obj->to_camera), si = stretch_of(&obj->from_camera);
-        if (!matrix_finite(&obj->to_camera) || !matrix_finite(&obj->from_camera) ||
-            !(s > 0) || !isfinite(s * si) || s * si > 1e12) {
-            err_set(err, errsz, "%s: its transformation to camera space is not "
-                     "finite or nearly singular (stretch %.3g, inverse stretch %.3g); check "
-                     "the Translate/Scale/ConcatTransform values before it", obj->name, s, si);
-            return false;
-        }
         obj->id = i;
         obj->top = i;
-        obj->scale = s;
-        obj->normal_scale = normal_scale_of(obj);
-        /* |from_camera^T n| lies between the smallest and the largest
-         * stretch of from_camera: 1/stretch(to_camera) and stretch(from),
-         * both rounded outward (stretch_of rounds up) */
-        double lo = 1.0 / s;
-        obj->normal_len2[0] = lo * lo * (1.0 - 1e-9);
-        obj->normal_len2[1] = si * si * (1.0 + 1e-9);
-        if (!obj->mesh) trace_object_grid_spacing(world, obj);   /* pieces: their views */
+        if (obj->group) {
+            /* after its prototype (the adapter appends the groups) */
+            assert(obj->group->proto >= 0 && obj->group->proto < i &&
+                   !world->objects[obj->group->proto].group);
+            obj->group->first = places;
+            places += obj->group->n;
+            continue;
+        }
+        /* pieces: their views */
+        if (!trace_object_derive(world, obj, !obj->mesh, err, errsz)) return false;
         const sl_program *dp = obj->displacement ? sl_instance_program(obj->displacement) : NULL;
         obj->box_skip_tangents = dp && !sl_program_takes_derivatives(dp) &&
                                  !sl_program_reads_global(dp, SL_G_dPdu) &&
                                  !sl_program_reads_global(dp, SL_G_dPdv);
     }
+    for (int i = 0; i < world->nobjects; i++)
+        if (world->objects[i].group && !check_placements(world, &world->objects[i], err, errsz))
+            return false;
+    world->nplaces = places;
     return true;
 }
 
@@ -284,11 +319,14 @@ bool trace_world_prepare(trace_world *world, char *err, size_t errsz)
     if (!trace_world_check(world, err, errsz)) return false;
     /* ids: the objects, then each mesh's pieces (once per mesh: the
      * objects sharing it share them); its derived arrays made anew */
-    for (int i = 0; i < world->nobjects; i++)
+    for (int i = 0; i < world->nobjects; i++) {
+        if (world->objects[i].group)
+            trace_group_clear(world->objects[i].group);
         if (world->objects[i].mesh) {
             trace_mesh_clear(world->objects[i].mesh);
             world->objects[i].mesh->first_id = -1;
         }
+    }
     int *meshes = xmalloc(sizeof *meshes * (size_t)(world->nobjects > 0 ? world->nobjects : 1));
     int nmeshes = 0;
     long next = world->nobjects;

@@ -78,6 +78,32 @@ typedef struct trace_mesh {
     struct trace_mesh_bvh *bvh;    /* over the pieces' bounds */
 } trace_mesh;
 
+/* Instances kept as references (issue 23, trace/group.h): the objects
+ * that place one recorded surface or mesh again, undisplaced and with the
+ * prototype's shaders, each only a transform and a colour in the scene;
+ * ONE world object (a "group") stands for them, a BVH over their
+ * camera-space boxes, and a placement becomes a full trace_object (a view)
+ * only where a ray reaches it. */
+typedef struct trace_group {
+    int n;                         /* placements */
+    int proto;                     /* the prototype: its index in world.objects
+                                      (placement k is it moved) */
+    /* Placement k's transforms (object <-> camera space), as given by the
+     * scene; a pure function, called from any thread. */
+    void (*transform)(const void *user, int k, mat4 *to_camera, mat4 *from_camera);
+    /* Placement k as a full object into *out, a copy of the prototype with
+     * the transforms set: the rest that differs (its shaders' spaces,
+     * colour, orientation, primitive variables into pv); false if it
+     * cannot be made (never for a parsed scene). A pure function. */
+    bool (*place)(const void *user, int k, struct trace_object *out, trace_primvar *pv);
+    const void *user;
+    /* derived (trace_world_prepare, trace_renderer_new; trace_group_clear
+     * frees them) */
+    int first;                     /* placement k's number in the world: first + k */
+    float (*bounds)[6];            /* per placement: its camera-space box */
+    struct trace_mesh_bvh *bvh;    /* over the bounds */
+} trace_group;
+
 typedef struct trace_object {
     int id;                        /* index in trace_world.objects; a mesh
                                       piece's view: its mesh's first_id + k,
@@ -87,6 +113,12 @@ typedef struct trace_object {
     trace_mesh *mesh;              /* a mesh object (its surf, primvars and
                                       root are unused); NULL: one surface
                                       (and a piece's view) */
+    trace_group *group;            /* a group of placements (nothing else of the
+                                      object is used but its bound); NULL: none */
+    int place;                     /* a placement's view (or a piece of one): its
+                                      number in the world + 1; 0: not one. The
+                                      views of two placements share their ids
+                                      (the same object-space surface) */
     char name[64];                 /* for messages: "sphere at ufo.rib:12" */
     geom_surface surf;
     mat4 to_camera, from_camera;   /* object space <-> camera space */
@@ -208,6 +240,7 @@ typedef struct trace_world {
     int nobjects;
     int nids;                      /* object ids in use: the objects, then every
                                       mesh's pieces (trace_world_prepare) */
+    int nplaces;                   /* the groups' placements in all */
     trace_light *lights;
     int nlights;
     trace_options options;
@@ -226,5 +259,12 @@ bool trace_world_check(trace_world *world, char *err, size_t errsz);
 
 /* The object's du, dv (world.c; a mesh piece's view sets its own). */
 void trace_object_grid_spacing(const trace_world *world, trace_object *obj);
+
+/* What trace_world_check derives of one object from its transforms
+ * (scale, normal bounds, and du, dv when `grid`); false with a message
+ * naming it when they are not finite or nearly singular. A placement's
+ * view derives its own (trace/group.c). */
+bool trace_object_derive(const trace_world *world, trace_object *obj, bool grid, char *err,
+                         size_t errsz);
 
 #endif

@@ -15,6 +15,12 @@
  *   object BVH on the other.
  * - Instances place the one recorded mesh: 50 instances of a 2,000-face
  *   mesh cost a fraction of 50 copies.
+ * - Instances are references (trace/group.h): 300 instances of a mesh and
+ *   a sphere, each with its own colour, some scaled unevenly, some
+ *   mirrored, render as the same objects written out one by one (objects
+ *   of their own: the other path); 20,000 instances cost at most
+ *   INSTANCE_BYTES each in all (scene, world, renderer), counted by the
+ *   allocator (an instance was ~14 KB when each was a full object).
  * - A shadow ray cast while a piece's hit is being shaded cannot
  *   overwrite it: a mesh lit through another mesh renders as the same
  *   faces written one Polygon each.
@@ -38,6 +44,11 @@
 /* the budget per face of a curved quad mesh, everything included; the
  * shared arrays alone are ~70 bytes (a point, a normal, 4 indices) */
 enum { FACE_BYTES = 300 };
+
+/* the budget per instance of a recorded mesh, everything included: the
+ * scene's object (~560 bytes, its transforms in double) and the world's
+ * box, BVH share and index */
+enum { INSTANCE_BYTES = 1000 };
 
 static char *torus_rib(int nu, int nv, const char *head)
 {
@@ -305,7 +316,7 @@ static void render_places(const char *mesh, unsigned which, bool copies, float *
     const trace_world *w = &f.js->world;
     *nmeshes = 0;
     for (int i = 0; i < w->nobjects; i++) {
-        bool seen = false;
+        bool seen = !w->objects[i].mesh;       /* a group's placements: its prototype's */
         for (int j = 0; j < i; j++) seen |= w->objects[j].mesh == w->objects[i].mesh;
         *nmeshes += !seen;
     }
@@ -423,6 +434,161 @@ static void test_instances_share_the_mesh(void **state)
     free(t);
 }
 
+/* a 10 x 10 grid of quads with "st", bent a little, and a sphere */
+static const char *REF_OBJECT_GRID_HEAD = "PointsPolygons [";
+
+static char *ref_object(bool sphere)
+{
+    enum { G = 10 };
+    size_t cap = 64 * 1024, n = 0;
+    char *t = malloc(cap);
+    assert_non_null(t);
+    n += (size_t)snprintf(t + n, cap - n, "%s", REF_OBJECT_GRID_HEAD);
+    for (int i = 0; i < G * G; i++) n += (size_t)snprintf(t + n, cap - n, "4 ");
+    n += (size_t)snprintf(t + n, cap - n, "] [");
+    for (int j = 0; j < G; j++)
+        for (int i = 0; i < G; i++) {
+            int a = j * (G + 1) + i;
+            n += (size_t)snprintf(t + n, cap - n, "%d %d %d %d ", a, a + 1, a + G + 2, a + G + 1);
+        }
+    n += (size_t)snprintf(t + n, cap - n, "] \"P\" [");
+    for (int j = 0; j <= G; j++)
+        for (int i = 0; i <= G; i++)
+            n += (size_t)snprintf(t + n, cap - n, "%.6g %.6g %.6g ", i / (double)G - 0.5,
+                                  j / (double)G - 0.5, 0.15 * sin(3.0 * i / G) * cos(2.0 * j / G));
+    n += (size_t)snprintf(t + n, cap - n, "] \"varying float s\" [");
+    for (int j = 0; j <= G; j++)
+        for (int i = 0; i <= G; i++) n += (size_t)snprintf(t + n, cap - n, "%.6g ", i / (double)G);
+    n += (size_t)snprintf(t + n, cap - n, "] \"varying float t\" [");
+    for (int j = 0; j <= G; j++)
+        for (int i = 0; i <= G; i++) n += (size_t)snprintf(t + n, cap - n, "%.6g ", j / (double)G);
+    snprintf(t + n, cap - n, "]\n%s", sphere ? "Translate 0 0 -0.3\nSphere 0.2 -0.2 0.2 360\n" : "");
+    return t;
+}
+
+/* k of n instances on a grid, each its own colour and motion: every
+ * third scaled unevenly, every fifth mirrored (its normals flip) */
+static size_t instance_text(char *t, size_t cap, int k, int n, const char *object)
+{
+    int side = (int)ceil(sqrt(n));
+    double x = (k % side) - 0.5 * (side - 1), y = (k / side) - 0.5 * (side - 1);
+    x *= 0.8, y *= 0.8;
+    return (size_t)snprintf(t, cap, "AttributeBegin\nColor [%.3f %.3f %.3f]\nTranslate %g %g 0\n"
+                            "Rotate %d 0.3 1 0.2\nScale 1.3 1.3 1.3\n%s%s%s\nAttributeEnd\n",
+                            0.3 + 0.7 * (k % 7) / 6.0, 0.3 + 0.7 * (k % 5) / 4.0,
+                            0.3 + 0.7 * (k % 3) / 2.0, x * 1.1, y * 1.1, (k * 37) % 360,
+                            k % 3 == 0 ? "Scale 1 0.6 1.3\n" : "",
+                            k % 5 == 0 ? "Scale -1 1 1\n" : "", object);
+}
+
+static char *instances_rib(int n, int res, bool copies, bool sphere)
+{
+    char *object = ref_object(sphere);
+    size_t cap = (copies ? strlen(object) + 256 : 256) * (size_t)n + strlen(object) + 4096, m = 0;
+    char *t = malloc(cap);
+    assert_non_null(t);
+    int side = (int)ceil(sqrt(n));
+    m += (size_t)snprintf(t + m, cap - m, "Format %d %d 1\nProjection \"perspective\" \"fov\" "
+                          "[40]\nTranslate 0 0 %g\nWorldBegin\nLightSource \"distantlight\" 1 "
+                          "\"from\" [0 1 -1] \"to\" [0 0 0]\nSurface \"stc\"\nSides 1\nOrientation \"lh\"\n", res, res,
+                          1.2 * side + 1.0);
+    if (!copies) m += (size_t)snprintf(t + m, cap - m, "ObjectBegin \"ref\"\n%sObjectEnd\n", object);
+    for (int k = 0; k < n; k++)
+        m += instance_text(t + m, cap - m, k, n, copies ? object : "ObjectInstance \"ref\"");
+    snprintf(t + m, cap - m, "WorldEnd\n");
+    free(object);
+    return t;
+}
+
+/* N's side shows (no faceforward, one-sided: a face turned away is not
+ * seen), and with Orientation "lh" a mirrored instance's normals flip */
+#define STC_SL                                                                  \
+    "surface stc() {\n"                                                         \
+    "    float d = normalize(N) . normalize(-I);\n"                             \
+    "    Ci = Cs * color(s, t, 0.5) * (0.6 + 0.4 * d);\n"                       \
+    "    Oi = 1;\n"                                                             \
+    "}\n"
+
+static const fixture_shader STC[] = {{"stc", STC_SL}};
+
+/* the world's groups of placements (trace/group.h) and their placements */
+static int count_placements(const trace_world *w, int *ngroups)
+{
+    int n = 0;
+    *ngroups = 0;
+    for (int i = 0; i < w->nobjects; i++)
+        if (w->objects[i].group) {
+            (*ngroups)++;
+            n += w->objects[i].group->n;
+        }
+    return n;
+}
+
+static void render_instances(int n, bool copies, float *rgba, int *placements)
+{
+    enum { RES = 64 };
+    char *rib = instances_rib(n, RES, copies, true);
+    fixture f;
+    assert_true(fixture_open(&f, rib, STC, 1, NULL, 0));
+    free(rib);
+    int ngroups;
+    *placements = count_placements(&f.js->world, &ngroups);
+    float *z = malloc(sizeof *z * RES * RES);
+    assert_true(fixture_render(&f, 16, 2, 0, rgba, z));
+    free(z);
+    fixture_close(&f);
+}
+
+static void test_instances_are_references(void **state)
+{
+    (void)state;
+    enum { N = 300, PX = 64 * 64 * 4 };
+    float *inst = malloc(sizeof *inst * PX), *copies = malloc(sizeof *copies * PX);
+    int placed, placed_copies;
+    render_instances(N, false, inst, &placed);
+    render_instances(N, true, copies, &placed_copies);
+    /* both parts of every instance but the first are references */
+    assert_int_equal(placed, 2 * (N - 1));
+    assert_int_equal(placed_copies, 0);
+    int differ = 0, covered = 0, colours = 0;
+    for (int i = 0; i < PX; i++) differ += inst[i] != copies[i];
+    for (int i = 0; i < PX; i += 4) {
+        covered += inst[i + 3] > 0.0f;
+        colours += i >= 4 && fabsf(inst[i] - inst[i - 4]) > 0.05f;
+    }
+    printf("%d instances (%d references): %d of %d values differ from the copies; %d pixels "
+           "covered, %d colour changes\n", N, placed, differ, PX, covered, colours);
+    assert_true(covered > 64 * 64 / 3);
+    assert_true(colours > 200);
+    assert_int_equal(differ, 0);
+    free(inst);
+    free(copies);
+}
+
+/* heap bytes held by a world built (and prepared) from n instances */
+static size_t instances_bytes(int n)
+{
+    char *rib = instances_rib(n, 16, false, false);
+    size_t before = heap_bytes();
+    fixture f;
+    assert_true(fixture_open(&f, rib, STC, 1, NULL, 0));
+    size_t after = heap_bytes();
+    fixture_close(&f);
+    free(rib);
+    return after - before;
+}
+
+static void test_bytes_per_instance(void **state)
+{
+    (void)state;
+    enum { N = 20000 };
+    size_t one = instances_bytes(1), many = instances_bytes(N);
+    double per = (double)(many - one) / (N - 1);
+    printf("%d instances: %zu bytes held, %zu for one: %.0f bytes per instance (budget %d)\n", N,
+           many, one, per, INSTANCE_BYTES);
+    assert_true(per <= INSTANCE_BYTES);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -433,6 +599,8 @@ int main(void)
         cmocka_unit_test(test_instances_render_as_copies),
         cmocka_unit_test(test_boxes_by_threads),
         cmocka_unit_test(test_instances_share_the_mesh),
+        cmocka_unit_test(test_instances_are_references),
+        cmocka_unit_test(test_bytes_per_instance),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -1,0 +1,44 @@
+/*
+ * group.h: instances kept as references (issue 23; trace_group in
+ * world.h): one world object stands for the placements of a prototype,
+ * a BVH over their camera-space boxes, and a placement becomes a full
+ * trace_object (a view) only where a ray reaches it.
+ *
+ * A placement's view is the prototype with the placement's transforms,
+ * shaders' spaces, colour, orientation and primitive variables, its
+ * scale, normal bounds and du/dv derived again, and the prototype's ids:
+ * the placements of an undisplaced surface or mesh are the same surface
+ * in object space, where boxes and cell caches live, so they share them
+ * (its `place` keeps their views apart). A view is a pure function of the
+ * scene: the same on any thread or host.
+ *
+ * Per placement the world holds a 24-byte float box, ~16 bytes of BVH and
+ * what the adapter keeps to make it again (job_scene.c: its scene object's
+ * index); the scene holds the placement's scene_object.
+ */
+#ifndef TRACE_GROUP_H
+#define TRACE_GROUP_H
+
+#include "trace/mesh.h"
+
+/* The placements' boxes and BVH of group object g (its prototype's root
+ * must be known) and g's root and bound (their union, camera space). */
+void trace_group_build(trace_group *group, const trace_world *world, trace_object *g);
+
+/* Nearest hit of the camera-space ray with the placements in
+ * (ray->tmin, best->t) (trace_intersect_object's contract); a hit's
+ * object is the thread's hit slot (a view). */
+bool trace_group_intersect(trace_thread *th, const trace_object *g, const trace_ray *ray,
+                           const trace_tolerance *tol, bool any, trace_hit *best);
+
+/* Placement k of group object g as a full object into *out (with its
+ * root and bound); false (the thread failed) when it cannot be made. */
+bool trace_group_view_make(trace_thread *th, const trace_object *g, int k, trace_view *out);
+
+/* Frees the derived arrays (boxes, BVH). */
+void trace_group_clear(trace_group *group);
+
+/* Bytes of the derived arrays. */
+size_t trace_group_bytes(const trace_group *group);
+
+#endif
