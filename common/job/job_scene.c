@@ -400,6 +400,23 @@ static bool build_objects(job_scene *self, sl_diag *diag)
     int *world_of = xmalloc(sizeof *world_of * nsc);    /* scene index -> world index */
     int nplacements = find_placements(sc, proto_of, nplaced);
     int nown = sc->nobjects - nplacements;
+    if (nown > SCENE_MAX_OBJECTS) {
+        /* undisplaced instances that differ from their prototype are
+         * objects of their own (~14 KB each), not references */
+        int differ = 0;
+        for (int i = 0; i < sc->nobjects; i++)
+            differ += sc->objects[i].instance_of >= 0 && sc->objects[i].instance_of != i &&
+                      proto_of[i] < 0;
+        sl_diag_error(diag, (sl_pos){0}, "%s: %d objects of their own in the renderer (the "
+                      "limit is %d): %d of the instances differ from their first placement in "
+                      "shaders, sides, lights or primitive variables (a Surface call before each "
+                      "ObjectInstance?); give them the same ones, so they are kept as references",
+                      sc->file, nown, SCENE_MAX_OBJECTS, differ);
+        free(proto_of);
+        free(nplaced);
+        free(world_of);
+        return false;
+    }
     self->ngroups = 0;
     for (int i = 0; i < sc->nobjects; i++) self->ngroups += nplaced[i] > 0;
     /* the objects of their own, in scene order, then one group per

@@ -133,7 +133,7 @@ static void object_lights(rib_parser *p, const scene_object *prev, scene_object 
 
 void rib_place_surface(rib_parser *p, const rib_request *req, const geom_surface *surf,
                        const scene_mesh *mesh, mat4 ctm, sl_pos pos,
-                       const scene_primvar *vars, int nvars, bool vars_kept)
+                       const scene_primvar *vars, int nvars, bool vars_kept, bool again)
 {
     assert(!surf == !!mesh);
     const rib_attributes *a = &p->attr;
@@ -149,11 +149,21 @@ void rib_place_surface(rib_parser *p, const rib_request *req, const geom_surface
         rib_error(p, req, req->pos, "the current transform is singular (a Scale by 0?)");
         return;
     }
-    if (p->scene->nobjects >= p->max_objects) {
-        if (!p->objects_overflow)
-            rib_error(p, req, req->pos, "too many objects (the limit is %d per scene): "
-                      "split the scene into several renders or use fewer, larger "
-                      "primitives", p->max_objects);
+    /* an undisplaced instance is a reference in the renderer (trace/group.h):
+     * a few hundred bytes, where an object of its own takes ~14 KB */
+    bool reference = again && a->displacement < 0;
+    if (reference ? p->ninstances >= SCENE_MAX_INSTANCES : p->nown >= p->max_objects) {
+        if (!p->objects_overflow) {
+            if (reference)
+                rib_error(p, req, req->pos, "too many instances (the limit is %ld undisplaced "
+                          "instances per scene): split the scene into several renders",
+                          (long)SCENE_MAX_INSTANCES);
+            else
+                rib_error(p, req, req->pos, "too many objects (the limit is %d per scene, "
+                          "undisplaced instances apart): split the scene into several renders, "
+                          "use fewer, larger primitives, or place repeated ones with "
+                          "ObjectInstance", p->max_objects);
+        }
         p->objects_overflow = true;
         return;
     }
@@ -182,6 +192,7 @@ void rib_place_surface(rib_parser *p, const rib_request *req, const geom_surface
     }
     p->scene->npieces += pieces;
     if (shared) p->mesh_counted[mi] = 1;
+    if (reference) p->ninstances++; else p->nown++;
     const scene_object *prev = p->scene->nobjects > 0 ? &p->scene->objects[p->scene->nobjects - 1]
                                                       : NULL;
     scene_object *o = rib_add_object(p);
@@ -222,7 +233,7 @@ void rib_add_surface(rib_parser *p, const rib_request *req, const geom_surface *
     geom_surface *kept = scene_keep(p->scene, xmalloc(sizeof *kept));
     *kept = *surf;
     rib_place_surface(p, req, kept, NULL, p->attr.ctm, req->pos, p->surface_vars,
-                      p->nsurface_vars, false);
+                      p->nsurface_vars, false, false);
 }
 
 void rib_add_mesh(rib_parser *p, const rib_request *req, scene_mesh *mesh)
@@ -234,7 +245,7 @@ void rib_add_mesh(rib_parser *p, const rib_request *req, scene_mesh *mesh)
     if (rib_defining(p))
         rib_record_surface(p, req, NULL, mesh);
     else
-        rib_place_surface(p, req, NULL, mesh, p->attr.ctm, req->pos, NULL, 0, false);
+        rib_place_surface(p, req, NULL, mesh, p->attr.ctm, req->pos, NULL, 0, false, false);
 }
 
 /* Validates the surface and adds the object with the current attributes

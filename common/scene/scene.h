@@ -328,12 +328,20 @@ int scene_archive_read(sl_source_set *set, const char *name, const char *path,
 /* How deep archives may read archives. */
 enum { SCENE_ARCHIVE_MAX_DEPTH = 16 };
 
-/* The most objects a scene may place (primitives, mesh faces and
- * instanced copies together), so that a scene received over the network
+/* The most objects a scene may place (primitives, meshes, displaced
+ * instances: each an object of its own in the renderer, ~14 KB;
+ * undisplaced instances have their own limit below), so that a scene
+ * received over the network
  * cannot exhaust the memory of the master or a worker (issue 12). The
  * scene text itself is bounded by the source size (4 MiB, sl/source.h),
  * each archive by SCENE_ARCHIVE_MAX_BYTES. */
 enum { SCENE_MAX_OBJECTS = 1 << 20 };
+
+/* The most undisplaced ObjectInstance placements a scene may hold: each is
+ * a reference in a worker (trace/group.h: ~760 bytes with its scene
+ * object, docs/renderer.md "Instances as references"), so 2^24 of them fit
+ * a 24 GB worker; displaced instances count as objects. */
+enum { SCENE_MAX_INSTANCES = 1 << 24 };
 
 /* The most mesh pieces (a face, or a triangle of one) a scene may hold
  * boxes for (scene.npieces: instances of an undisplaced mesh count its

@@ -1,8 +1,8 @@
 /*
  * tests/scene/test_scene_limits.c: the limits on a scene received from
- * outside (issue 12): the number of objects (primitives and instanced
- * copies alike; more is one error naming the request that passes the
- * limit, with file:line:col, and no scene) and the size of the scene text
+ * outside (issue 12): the number of objects (primitives and displaced
+ * instances alike, undisplaced instances apart; more is one error naming
+ * the request that passes the limit, with file:line:col, and no scene) and the size of the scene text
  * read from disk (the source size limit, a clear error naming the file).
  */
 #include <stdarg.h>
@@ -43,40 +43,48 @@ static void test_objects_over_the_limit(void **state)
     assert_null(s);
     assert_int_equal(sl_diag_error_count(d), 1);      /* reported once */
     assert_string_equal(diag_line(nth_diag(d, SL_DIAG_ERROR, 0)),
-                        "t.rib:7:1: Sphere: too many objects (the limit is 3 per scene): "
-                        "split the scene into several renders or use fewer, larger "
-                        "primitives");
+                        "t.rib:7:1: Sphere: too many objects (the limit is 3 per scene, "
+                        "undisplaced instances apart): split the scene into several renders, "
+                        "use fewer, larger primitives, or place repeated ones with "
+                        "ObjectInstance");
     sl_diag_destroy(&d);
 }
 
 /* Instancing multiplies objects cheaply: ten instances of a definition
- * of four spheres are forty objects, and the limit counts every copy. */
+ * of four spheres are forty objects. Undisplaced, they are references in
+ * the renderer (a few hundred bytes each) and have their own limit
+ * (SCENE_MAX_INSTANCES): the objects' limit counts only the definition's
+ * first placement. Displaced, each is an object of its own and counts. */
 static void test_instances_count(void **state)
 {
     (void)state;
     char text[4096];
-    size_t o = (size_t)snprintf(text, sizeof text,
-                                CAMERA "WorldBegin\nObjectBegin 1\n" SPHERE SPHERE SPHERE
-                                SPHERE "ObjectEnd\n");
-    for (int i = 0; i < 10; i++)
-        o += (size_t)snprintf(text + o, sizeof text - o, "ObjectInstance 1\n");
-    snprintf(text + o, sizeof text - o, "WorldEnd\n");
-
-    sl_diag *d;
-    scene *s = parse_limited(text, 40, &d);
-    assert_non_null(s);
-    assert_int_equal(s->nobjects, 40);
-    scene_destroy(&s);
-    sl_diag_destroy(&d);
-
-    s = parse_limited(text, 39, &d);
-    assert_null(s);
-    assert_int_equal(sl_diag_error_count(d), 1);
-    const sl_diagnostic *e = nth_diag(d, SL_DIAG_ERROR, 0);
-    assert_non_null(e);
-    assert_int_equal(e->line, 19);                    /* the tenth instance */
-    assert_non_null(strstr(e->message, "ObjectInstance: too many objects (the limit is 39"));
-    sl_diag_destroy(&d);
+    for (int displaced = 0; displaced < 2; displaced++) {
+        size_t o = (size_t)snprintf(text, sizeof text,
+                                    CAMERA "WorldBegin\n%sObjectBegin 1\n" SPHERE SPHERE SPHERE
+                                    SPHERE "ObjectEnd\n",
+                                    displaced ? "Displacement \"dented\"\n" : "");
+        for (int i = 0; i < 10; i++)
+            o += (size_t)snprintf(text + o, sizeof text - o, "ObjectInstance 1\n");
+        snprintf(text + o, sizeof text - o, "WorldEnd\n");
+        sl_diag *d;
+        scene *s = parse_limited(text, displaced ? 40 : 4, &d);
+        assert_non_null(s);
+        assert_int_equal(s->nobjects, 40);
+        scene_destroy(&s);
+        sl_diag_destroy(&d);
+        /* undisplaced: the first placement's four are objects; displaced:
+         * all forty, the 40th passes a limit of 39 */
+        s = parse_limited(text, displaced ? 39 : 3, &d);
+        assert_null(s);
+        assert_int_equal(sl_diag_error_count(d), 1);
+        const sl_diagnostic *e = nth_diag(d, SL_DIAG_ERROR, 0);
+        assert_non_null(e);
+        assert_int_equal(e->line, displaced ? 20 : 10);   /* the tenth, the first instance */
+        assert_non_null(strstr(e->message, displaced ? "ObjectInstance: too many objects (the limit is 39"
+                                                      : "ObjectInstance: too many objects (the limit is 3"));
+        sl_diag_destroy(&d);
+    }
 }
 
 /* scene_parse uses the default limit. */
