@@ -8,6 +8,7 @@
  *
  *   asset_gen [--faces N] [--rocks K] [--cage M] [--format W H]
  *             [--shaders DIR] [--textures DIR] OUTDIR
+ *   asset_gen --instances K [--faces N] [--format W H] OUTDIR
  *
  * writes OUTDIR/asset.rib, OUTDIR/terrain.rib.gz (a PointsPolygons grid of
  * about N quads: heights from a few sine octaves, "st" per point) and
@@ -16,6 +17,12 @@
  * (scenes/make_textures.sh writes it), the rocks by dented.sl. Defaults:
  * 1,000,000 faces, 200 rocks, M = 6, 640 x 480, the source tree's scenes/
  * shaders and textures.
+ *
+ * --instances K writes instances.rib and instances_body.rib.gz instead:
+ * one undisplaced PointsPolygons grid of about N bent quads (default
+ * 1000), recorded once and placed K times on a square grid seen from
+ * above, each with its own colour, turn and tilt (the aim of issue 23:
+ * 1,000,000 instances of a 1000-face object at 256 x 256).
  */
 #include <math.h>
 #include <stdbool.h>
@@ -120,14 +127,62 @@ static void write_rock(const char *path, int m)
     if (gzclose(f) != Z_OK) die("cannot finish", path);
 }
 
+static void write_instances(const char *out, long instances, long faces, int w, int h)
+{
+    char path[4096];
+    snprintf(path, sizeof path, "%s/instances_body.rib.gz", out);
+    gzFile f = gzopen(path, "wb6");
+    if (!f) die("cannot write", path);
+    int gx = (int)ceil(sqrt((double)faces * 1.6)), gy = (int)ceil((double)faces / gx);
+    gzprintf(f, "# a %d x %d grid of bent quads, recorded once, placed %ld times\n"
+                "ObjectBegin \"tile\"\nPointsPolygons [", gx, gy, instances);
+    for (long i = 0; i < (long)gx * gy; i++) gzputs(f, i % 32 == 31 ? "4\n" : "4 ");
+    gzputs(f, "]\n[");
+    for (int j = 0; j < gy; j++)
+        for (int i = 0; i < gx; i++) {
+            int a = j * (gx + 1) + i;
+            gzprintf(f, "%d %d %d %d%s", a, a + 1, a + gx + 2, a + gx + 1, i % 8 == 7 ? "\n" : " ");
+        }
+    gzputs(f, "]\n\"P\" [");
+    for (int j = 0; j <= gy; j++)
+        for (int i = 0; i <= gx; i++)
+            gzprintf(f, "%.5g %.5g %.5g\n", 0.8 * i / gx - 0.4, 0.8 * j / gy - 0.4,
+                     0.05 * sin(7.0 * i / gx) * cos(5.0 * j / gy));
+    gzputs(f, "]\nObjectEnd\n");
+    int side = (int)ceil(sqrt((double)instances));
+    for (long k = 0; k < instances; k++)
+        gzprintf(f, "AttributeBegin Color [%.2f %.2f %.2f] Translate %g %g 0 Rotate %ld 0 0 1 "
+                    "Rotate %ld 1 0 0 ObjectInstance \"tile\" AttributeEnd\n",
+                 0.4 + 0.6 * (k % 7) / 6.0, 0.4 + 0.6 * (k % 5) / 4.0, 0.4 + 0.6 * (k % 3) / 2.0,
+                 (k % side) - 0.5 * (side - 1), (k / side) - 0.5 * (side - 1), (k * 37) % 360,
+                 (k * 11) % 40);
+    if (gzclose(f) != Z_OK) die("cannot finish", path);
+    snprintf(path, sizeof path, "%s/instances.rib", out);
+    FILE *r = fopen(path, "w");
+    if (!r) die("cannot write", path);
+    fprintf(r, "##RenderMan RIB\n# instances.rib (bench/asset_gen --instances): %ld instances of "
+               "a %d-face object\nversion 3.04\nDisplay \"instances.exr\" \"file\" \"rgba\"\n"
+               "Format %d %d 1\nPixelSamples 1 1\nProjection \"perspective\" \"fov\" [40]\n"
+               "Translate 0 0 %g\nWorldBegin\n"
+               "  LightSource \"distantlight\" 1 \"from\" [0 0 -1] \"to\" [0 0 0]\n"
+               "  Surface \"plastic\"\n  ReadArchive \"instances_body.rib.gz\"\nWorldEnd\n",
+            instances, gx * gy, w, h, 1.4 * side + 1.0);
+    if (fclose(r) != 0) die("cannot finish", path);
+}
+
 int main(int argc, char **argv)
 {
     long faces = 1000000;
     int rocks = 200, cage = 6, w = 640, h = 480;
     const char *shaders = AAFARM_SCENES_DIR "/shaders", *textures = AAFARM_SCENES_DIR "/textures";
     const char *out = NULL;
+    long instances = 0;
+    bool faces_given = false;
     for (int i = 1; i < argc; i++) {
-        if (strcmp(argv[i], "--faces") == 0 && i + 1 < argc) faces = atol(argv[++i]);
+        if (strcmp(argv[i], "--faces") == 0 && i + 1 < argc) {
+            faces = atol(argv[++i]);
+            faces_given = true;
+        } else if (strcmp(argv[i], "--instances") == 0 && i + 1 < argc) instances = atol(argv[++i]);
         else if (strcmp(argv[i], "--rocks") == 0 && i + 1 < argc) rocks = atoi(argv[++i]);
         else if (strcmp(argv[i], "--cage") == 0 && i + 1 < argc) cage = atoi(argv[++i]);
         else if (strcmp(argv[i], "--format") == 0 && i + 2 < argc) {
@@ -137,7 +192,8 @@ int main(int argc, char **argv)
         else if (strcmp(argv[i], "--textures") == 0 && i + 1 < argc) textures = argv[++i];
         else if (strcmp(argv[i], "--help") == 0) {
             printf("usage: asset_gen [--faces N] [--rocks K] [--cage M] [--format W H] "
-                   "[--shaders DIR] [--textures DIR] OUTDIR\n");
+                   "[--shaders DIR] [--textures DIR] OUTDIR\n"
+                   "       asset_gen --instances K [--faces N] [--format W H] OUTDIR\n");
             return 0;
         } else if (argv[i][0] != '-' && !out) out = argv[i];
         else {
@@ -150,6 +206,10 @@ int main(int argc, char **argv)
         return 2;
     }
     mkdir(out, 0777);
+    if (instances > 0) {
+        write_instances(out, instances, faces_given ? faces : 1000, w, h);
+        return 0;
+    }
     int n = (int)ceil(sqrt((double)faces));
     char path[4096];
     snprintf(path, sizeof path, "%s/terrain.rib.gz", out);

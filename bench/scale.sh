@@ -9,10 +9,14 @@
 #      subdivision rocks) rendered at ASSET_W x ASSET_H by a master with
 #      two workers on this host (their peak RSS each) and standalone (the
 #      farm image must equal it)
+#   3. INSTANCES (default 1,000,000) instances of a 1000-face undisplaced
+#      mesh (bench/asset_gen --instances: references, docs/renderer.md
+#      "Instances as references") rendered standalone at 256 x 256: wall
+#      seconds (parse + world + render) and peak RSS
 # Usage: bash bench/scale.sh [BUILD_DIR]   (default build; a Release or
 # RelWithDebInfo build of the whole tree). Prints tables; never fails on
 # timing. Environment: FACES, SUBDIV_FACES, ASSET_FACES, ROCKS, ASSET_W,
-# ASSET_H, THREADS (per worker, default 1).
+# ASSET_H, THREADS (per worker, default 1), INSTANCES.
 set -euo pipefail
 here="$(cd "$(dirname "$0")/.." && pwd)"
 build="$(cd "${1:-$here/build}" && pwd)"
@@ -23,6 +27,7 @@ ROCKS=${ROCKS:-200}
 ASSET_W=${ASSET_W:-640}
 ASSET_H=${ASSET_H:-480}
 THREADS=${THREADS:-1}
+INSTANCES=${INSTANCES:-1000000}
 for p in mesh_bench asset_gen aafarm-master aafarm-worker exrcmp; do
   [ -x "$build/bin/$p" ] || { echo "scale.sh: $build/bin/$p missing: build the tree first" >&2; exit 1; }
 done
@@ -79,3 +84,10 @@ else
   tail -5 "$work/master.log"
   trap - EXIT
 fi
+
+echo "== 3. $INSTANCES instances of a 1000-face mesh, 256x256"
+"$build/bin/asset_gen" --instances "$INSTANCES" --format 256 256 "$work/inst"
+ls -l "$work/inst" | awk 'NR>1 {printf "   %s %d bytes\n", $9, $5}'
+(cd "$work/inst" && /usr/bin/time -f "standalone ($((2 * THREADS)) threads): %e s wall, %U s user, peak %M KB" \
+  timeout -k 10 3600 "$build/bin/aafarm-worker" --standalone instances.rib -o "$work/inst.exr" \
+  -t $((2 * THREADS)) 2>&1 | tail -2)
