@@ -72,7 +72,7 @@ static bool file_sent(const frame_sequence *seq, int frame, int file)
 }
 
 uint8_t *job_bundle_encode(const frame_sequence *seq, const char *scene, int priority,
-                           size_t *len, char *err, size_t errsz)
+                           const char *pool, size_t *len, char *err, size_t errsz)
 {
     char *text = NULL;
     size_t n = 0;
@@ -82,7 +82,9 @@ uint8_t *job_bundle_encode(const frame_sequence *seq, const char *scene, int pri
         return NULL;
     }
     fputs(magic, out);
-    fprintf(out, "priority %d\nscene %s\n", priority, scene);
+    fprintf(out, "priority %d\n", priority);
+    if (pool && *pool) fprintf(out, "pool %s\n", pool);
+    fprintf(out, "scene %s\n", scene);
     for (int i = 0; i < seq->count; i++) {
         char *abs = absolute(seq->outputs[i]);
         fprintf(out, "frame %d %s\n", seq->jobs[i]->frame_number, abs);
@@ -166,6 +168,11 @@ static bool decode_header(job_bundle *b, const uint8_t *data, size_t len, size_t
         if (!line[0]) break;
         int number = 0, used = 0;
         if (sscanf(line, "priority %d%n", &b->priority, &used) == 1 && !line[used]) continue;
+        if (strncmp(line, "pool ", 5) == 0) {
+            if (!proto_pool_name_check(line + 5, err, errsz)) return false;
+            memcpy(b->pool, line + 5, strlen(line + 5) + 1);   /* checked: it fits */
+            continue;
+        }
         if (strncmp(line, "scene ", 6) == 0) {
             free(b->scene);
             b->scene = xstrdup(line + 6);
