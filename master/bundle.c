@@ -302,9 +302,10 @@ job *job_bundle_job(const job_bundle *b, int i, image_format *fmt, char *err, si
                           sizeof why);
     jb->files_known = true;
     if (ok) ok = job_finish(jb, why, sizeof why);
-    if (ok && strcmp(jb->hash, m->job_hash) != 0)
-        ok = !err_set(why, sizeof why, "its content hashes to %.12s... here, the submitter "
-                      "said %.12s... (different aafarm versions?)", jb->hash, m->job_hash);
+    if (ok && strcmp(jb->hash, m->job_hash) != 0) {   /* err_set returns false */
+        ok = err_set(why, sizeof why, "its content hashes to %.12s... here, the submitter "
+                     "said %.12s... (different aafarm versions?)", jb->hash, m->job_hash);
+    }
     if (!ok) {
         err_set(err, errsz, "frame %d: %s", b->frame_numbers[i], why);
         job_destroy(&jb);
