@@ -296,7 +296,7 @@ static void strike_failers(farm *f, const farm_worker *w, int tile, int local)
 {
     for (size_t i = 0; i < registry_count(f->reg); i++) {
         farm_worker *x = registry_at(f->reg, i);
-        if (x == w || !x->alive || x->benched) continue;
+        if (x == w || !x->alive || x->benched || x->blocked) continue;
         for (int k = 0; k < x->nfailed; k++) {
             if (x->failed_tiles[k] != tile) continue;
             x->failed_tiles[k] = x->failed_tiles[--x->nfailed];

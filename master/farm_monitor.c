@@ -225,8 +225,8 @@ static char *build_status(const farm *f, int64_t now, size_t *len)
 static const char *worker_state(const farm_worker *w)
 {
     return !w->alive       ? w->gone
-           : w->benched    ? "benched"
            : w->blocked    ? "blocklisted"
+           : w->benched    ? "benched"
            : w->other_pool ? "not in the job's pool"
                            : "connected";
 }

@@ -29,8 +29,8 @@ static const char *state_name(farm_state s)
 static const char *worker_state(const farm_worker *w)
 {
     return !w->alive       ? w->gone
-           : w->benched    ? "benched"
            : w->blocked    ? "blocklisted"
+           : w->benched    ? "benched"
            : w->other_pool ? "not in the job's pool"
                            : "connected";
 }
