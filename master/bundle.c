@@ -72,7 +72,7 @@ static bool file_sent(const frame_sequence *seq, int frame, int file)
 }
 
 uint8_t *job_bundle_encode(const frame_sequence *seq, const char *scene, int priority,
-                           size_t *len, char *err, size_t errsz)
+                           const char *pool, size_t *len, char *err, size_t errsz)
 {
     char *text = NULL;
     size_t n = 0;
@@ -82,7 +82,9 @@ uint8_t *job_bundle_encode(const frame_sequence *seq, const char *scene, int pri
         return NULL;
     }
     fputs(magic, out);
-    fprintf(out, "priority %d\nscene %s\n", priority, scene);
+    fprintf(out, "priority %d\n", priority);
+    if (pool && *pool) fprintf(out, "pool %s\n", pool);
+    fprintf(out, "scene %s\n", scene);
     for (int i = 0; i < seq->count; i++) {
         char *abs = absolute(seq->outputs[i]);
         fprintf(out, "frame %d %s\n", seq->jobs[i]->frame_number, abs);
@@ -166,6 +168,11 @@ static bool decode_header(job_bundle *b, const uint8_t *data, size_t len, size_t
         if (!line[0]) break;
         int number = 0, used = 0;
         if (sscanf(line, "priority %d%n", &b->priority, &used) == 1 && !line[used]) continue;
+        if (strncmp(line, "pool ", 5) == 0) {
+            if (!proto_pool_name_check(line + 5, err, errsz)) return false;
+            memcpy(b->pool, line + 5, strlen(line + 5) + 1);   /* checked: it fits */
+            continue;
+        }
         if (strncmp(line, "scene ", 6) == 0) {
             free(b->scene);
             b->scene = xstrdup(line + 6);
@@ -295,9 +302,10 @@ job *job_bundle_job(const job_bundle *b, int i, image_format *fmt, char *err, si
                           sizeof why);
     jb->files_known = true;
     if (ok) ok = job_finish(jb, why, sizeof why);
-    if (ok && strcmp(jb->hash, m->job_hash) != 0)
-        ok = !err_set(why, sizeof why, "its content hashes to %.12s... here, the submitter "
-                      "said %.12s... (different aafarm versions?)", jb->hash, m->job_hash);
+    if (ok && strcmp(jb->hash, m->job_hash) != 0) {   /* err_set returns false */
+        ok = err_set(why, sizeof why, "its content hashes to %.12s... here, the submitter "
+                     "said %.12s... (different aafarm versions?)", jb->hash, m->job_hash);
+    }
     if (!ok) {
         err_set(err, errsz, "frame %d: %s", b->frame_numbers[i], why);
         job_destroy(&jb);

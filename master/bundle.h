@@ -7,6 +7,7 @@
  *
  *     AAFARM-JOB 1\n
  *     priority N\n
+ *     pool NAME\n                   (only with --pool: the workers it goes to)
  *     scene NAME\n                  (for the list; the submitter's path)
  *     frame NUMBER OUTPUT\n         (one per frame, in order; OUTPUT absolute)
  *     \n
@@ -42,6 +43,7 @@ typedef struct bundle_file {
 
 typedef struct job_bundle {
     int priority;
+    char pool[PROTO_POOL_MAX + 1]; /* "" none: any worker */
     char *scene;
     int nframes;
     int *frame_numbers;
@@ -55,7 +57,7 @@ typedef struct job_bundle {
  * the current folder), xmalloc'd, its size in *len; NULL with the reason
  * (a file of the job that cannot be read). */
 uint8_t *job_bundle_encode(const frame_sequence *seq, const char *scene, int priority,
-                           size_t *len, char *err, size_t errsz);
+                           const char *pool, size_t *len, char *err, size_t errsz);
 
 /* Decodes and checks data[0..len) (which must outlive b: the files point
  * into it). False with the reason; b is then cleared. */

@@ -463,7 +463,9 @@ static int setup_job(farm *f, char *err, size_t errsz)
     if (!f->reg) f->reg = registry_new();
     for (size_t i = 0; i < registry_count(f->reg); i++) {
         farm_worker *w = registry_at(f->reg, i);
-        if (w->alive) w->slot = scheduler_worker_add(f->sched);
+        if (!w->alive) continue;
+        w->slot = scheduler_worker_add(f->sched);
+        farm_worker_fit(f, w);
     }
     farm_monitor_open(f);
     for (int i = 0; i < f->nframes; i++) {
@@ -627,6 +629,32 @@ static void say_waiting(farm *f, int64_t now)
                 "one with: %s)", f->bound, secs < 10 ? 1 : 0, secs, joined, cmd);
 }
 
+/* A serving master whose local workers all exited starts them again,
+ * after 1 s, then 2, 4 ... 30 s while they keep exiting (reset when a
+ * job is done). */
+static void restart_local_workers(farm *f, int64_t now)
+{
+    if (!f->restart_backoff_ms) f->restart_backoff_ms = 1000;
+    if (!f->restart_at_ms) {
+        f->restart_at_ms = now + f->restart_backoff_ms;
+        console_log(f->con, CONSOLE_INFO, "all %d local workers exited: starting them again in "
+                    "%.0f s", f->opt->local_workers, (double)f->restart_backoff_ms / 1000.0);
+        return;
+    }
+    if (now < f->restart_at_ms) return;
+    f->restart_at_ms = 0;
+    f->restart_backoff_ms = f->restart_backoff_ms * 2 > 30000 ? 30000 : f->restart_backoff_ms * 2;
+    local_workers_destroy(&f->locals);
+    char err[ERR_LEN];
+    if (start_local_workers(f, err, sizeof err) != AAFARM_EXIT_OK) {
+        console_log(f->con, CONSOLE_ERROR, "cannot start the local workers again: %s", err);
+        return;
+    }
+    f->restarts++;
+    console_log(f->con, CONSOLE_INFO, "started the %d local workers again (restart %d)",
+                f->opt->local_workers, f->restarts);
+}
+
 static void timers(farm *f, int64_t now)
 {
     check_workers(f, now);
@@ -647,7 +675,11 @@ static void timers(farm *f, int64_t now)
     if (given_up >= 0) farm_fail_given_up(f, given_up);
     if (f->locals) {
         local_workers_reap(f->locals, on_child_exit, f);
-        if (!f->opt->bind && local_workers_running(f->locals) == 0 && registry_alive(f->reg) == 0)
+        bool none = local_workers_running(f->locals) == 0 && registry_alive(f->reg) == 0;
+        if (f->serving && none) {   /* the job waits in the queue; the workers start again */
+            if (!f->opt->bind && f->ntiles > 0) f->state = FARM_REQUEUED;
+            restart_local_workers(f, now);
+        } else if (!f->opt->bind && none)
             farm_fail(f, "no workers left: all %d local workers exited", f->opt->local_workers);
         else if (!f->opt->bind && all_blocked(f))
             farm_fail(f, "no workers left: every local worker is blocklisted (its results "
@@ -715,7 +747,8 @@ static void close_journals(farm *f)
         farm_frame *fr = &f->frames[i];
         if (!fr->jnl) continue;
         if (f->state == FARM_DONE || fr->done == 0 ||
-            (f->serving && f->state != FARM_INTERRUPTED)) {   /* failed, cancelled: no resume */
+            (f->serving && f->state != FARM_INTERRUPTED &&
+             f->state != FARM_REQUEUED)) {   /* failed, cancelled: no resume */
             journal_remove(&fr->jnl);   /* the image is in place, or nothing to resume */
             continue;
         }
@@ -818,6 +851,7 @@ int farm_run(const farm_options *opt, const farm_frame_in *frames, int nframes)
     farm f;
     memset(&f, 0, sizeof f);
     f.opt = opt;
+    f.pool = opt->pool;
     f.nframes = nframes;
     f.frames = xcalloc((size_t)nframes, sizeof *f.frames);
     for (int i = 0; i < nframes; i++) {
@@ -931,6 +965,7 @@ void farm_serve_end_job(farm *f)
     int64_t now = farm_now_ms();
     close_journals(f);
     f->end_ms = now;
+    if (f->state == FARM_DONE && f->ntiles > 0) f->restart_backoff_ms = 1000;
     console_tally_flush(&f->expired, f->con, now, true);
     for (size_t i = 0; i < registry_count(f->reg); i++) {
         farm_worker *w = registry_at(f->reg, i);
@@ -939,6 +974,10 @@ void farm_serve_end_job(farm *f)
         w->nheld = 0;
         w->files_ready = false;
         w->blocked = false;
+        w->benched = false;
+        w->other_pool = false;
+        w->nfailed = 0;
+        w->strikes = 0;
     }
     farm_monitor_publish(f, now, true);
     for (int i = 0; i < f->nframes; i++) {

@@ -47,6 +47,7 @@ typedef struct farm_options {
     const char *http;              /* --http ADDR:PORT: the live monitor, or NULL */
     const char *http_token;        /* its token (checked by main.c), or NULL */
     int64_t http_linger_ms;        /* --http-linger: serve this long after the end */
+    const char *pool;              /* --pool NAME: only workers of that pool (NULL: any) */
 } farm_options;
 
 void farm_options_default(farm_options *opt);

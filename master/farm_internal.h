@@ -35,7 +35,9 @@ typedef enum farm_state {
     FARM_DONE,           /* every tile is in */
     FARM_FAILED,         /* a tile failed too often, or no workers are left */
     FARM_INTERRUPTED,    /* SIGINT / SIGTERM */
-    FARM_CANCELLED       /* a serving master's job, cancelled (serve.c) */
+    FARM_CANCELLED,      /* a serving master's job, cancelled (serve.c) */
+    FARM_REQUEUED        /* a serving master's job lost every worker: back in the
+                            queue, its journal kept (serve.c) */
 } farm_state;
 
 /* One frame of the sequence: its tiles are the scheduler's tiles
@@ -113,14 +115,27 @@ typedef struct farm {
     int64_t published_ms;
     int mon_base;                  /* the monitor's index of frames[0] (a serving master's
                                       monitor holds the frames of every job) */
+    const char *pool;              /* the job's pool: only its workers get tiles (NULL: any) */
     /* --serve (serve.c): the job queue */
     bool serving;                  /* the render is one job of a queue */
     void (*tick)(struct farm *f, int64_t now);   /* called once a loop turn, or NULL */
     void *serve;                   /* serve.c's state */
+    int64_t restart_at_ms;         /* every local worker exited: started again then (0: not
+                                      planned) */
+    int64_t restart_backoff_ms;    /* the wait before the next restart (1 s, doubling to 30 s) */
+    int restarts;                  /* times the local workers were started again */
 } farm;
 
 /* At most one line per interval for a repeated warning (console_tally). */
 enum { FARM_WARN_INTERVAL_MS = 10000 };
+
+/* A worker is benched for the job (no more of its tiles) once this many
+ * tiles it failed were finished by other workers. */
+enum { FARM_BENCH_AFTER = 2 };
+
+/* Can the worker take the job's tiles (its pool; farm_messages.c)? Gives
+ * a worker that cannot a slot that gets nothing. */
+void farm_worker_fit(farm *f, farm_worker *w);
 
 int64_t farm_now_ms(void);
 

@@ -176,8 +176,10 @@ void farm_send_job_done(farm *f, farm_worker *w, int64_t now)
         d->status = f->state == FARM_DONE     ? PROTO_JOB_STATUS_DONE
                     : f->state == FARM_FAILED ? PROTO_JOB_STATUS_FAILED
                                               : PROTO_JOB_STATUS_CANCELLED;
-        d->message = f->state == FARM_DONE ? "" : f->state == FARM_FAILED ? f->failure
-                                                                           : "interrupted";
+        d->message = f->state == FARM_DONE        ? ""
+                     : f->state == FARM_FAILED    ? f->failure
+                     : f->state == FARM_CANCELLED ? "cancelled"
+                                                  : "interrupted";
         send_msg(f, w, &msg, now);
     }
 }
@@ -256,16 +258,64 @@ static void on_hello(farm *f, const proto_hello *h, const uint8_t *id, size_t id
     /* its credits are capped by its threads: a claim of more than a worker
      * can have (aafarm-worker --threads 1..1024) buys a peer no more tiles */
     w->threads = h->threads ? (h->threads > 1024 ? 1024 : h->threads) : 1;
+    snprintf(w->pool, sizeof w->pool, "%s", h->pool ? h->pool : "");
     w->slot = scheduler_worker_add(f->sched);
+    farm_worker_fit(f, w);
     for (int i = 0; i < f->nframes; i++)
         if (holds_job(h, f->frames[i].jb->hash)) mark_held(w, i);
     w->local = f->locals && strcmp(w->host, f->host) == 0 &&
                local_workers_has_pid(f->locals, (pid_t)w->pid);
     f->joined++;
-    console_log(f->con, CONSOLE_INFO, "worker %s joined (%s, pid %u, %u thread%s%s)", w->name,
+    console_log(f->con, CONSOLE_INFO, "worker %s joined (%s, pid %u, %u thread%s%s%s%s)", w->name,
                 w->host, w->pid, w->threads, w->threads == 1 ? "" : "s",
+                w->pool[0] ? ", pool " : "", w->pool,
                 !w->nheld ? "" : f->nframes == 1 ? ", holds the job" : ", holds frames' jobs");
     send_welcome(f, w, now);
+}
+
+void farm_worker_fit(farm *f, farm_worker *w)
+{
+    w->other_pool = f->pool && *f->pool && strcmp(w->pool, f->pool) != 0;
+    if (w->other_pool) scheduler_worker_remove(f->sched, w->slot);
+}
+
+/* No more tiles of this job for a worker whose failed tiles others
+ * finish; it stays connected (the next job gives it tiles again). */
+static void bench(farm *f, farm_worker *w, int local)
+{
+    w->benched = true;
+    int requeued = scheduler_worker_remove(f->sched, w->slot);
+    console_log(f->con, CONSOLE_INFO, "worker %s benched for this job: %d tiles it failed were "
+                "finished by other workers (the last: tile %d; its error: %s); %d tile%s back in "
+                "the queue", w->name, w->strikes, local, w->last_error, requeued,
+                requeued == 1 ? "" : "s");
+}
+
+/* Tile `tile` was taken from w: a strike for each other worker that failed it. */
+static void strike_failers(farm *f, const farm_worker *w, int tile, int local)
+{
+    for (size_t i = 0; i < registry_count(f->reg); i++) {
+        farm_worker *x = registry_at(f->reg, i);
+        if (x == w || !x->alive || x->benched || x->blocked) continue;
+        for (int k = 0; k < x->nfailed; k++) {
+            if (x->failed_tiles[k] != tile) continue;
+            x->failed_tiles[k] = x->failed_tiles[--x->nfailed];
+            if (++x->strikes >= FARM_BENCH_AFTER) bench(f, x, local);
+            break;
+        }
+    }
+}
+
+/* w failed the tile: remembered (the last REGISTRY_FAILED) for its strikes. */
+static void remember_failed(farm_worker *w, int tile)
+{
+    for (int k = 0; k < w->nfailed; k++)
+        if (w->failed_tiles[k] == tile) return;
+    if (w->nfailed == REGISTRY_FAILED) {
+        memmove(w->failed_tiles, w->failed_tiles + 1, sizeof w->failed_tiles[0] * (REGISTRY_FAILED - 1));
+        w->nfailed--;
+    }
+    w->failed_tiles[w->nfailed++] = tile;
 }
 
 static void on_ask(farm *f, farm_worker *w, const proto_ask *a)
@@ -289,6 +339,7 @@ static void tile_failed(farm *f, farm_worker *w, uint64_t lease, int tile, const
     scheduler_failure r = scheduler_fail(f->sched, w->slot, lease, retryable);
     if (r == SCHEDULER_FAIL_IGNORED) return;
     w->failures++;
+    remember_failed(w, tile);
     snprintf(w->last_error, sizeof w->last_error, "%s", msg);
     int local;
     farm_frame *fr = farm_frame_of(f, tile, &local);
@@ -404,6 +455,7 @@ static void on_result(farm *f, farm_worker *w, const proto_result *r, const wire
             farm_monitor_tile(f, fr, local, chunk, chunk_len, w);
             w->tiles++;
             add_stats(w, &r->stats);
+            strike_failers(f, w, tile, local);
             if (r->stats.nonfinite_samples) {
                 if (f->nonfinite_tiles++ == 0)
                     console_log(f->con, CONSOLE_INFO, "warning: tile %d at (%d,%d) from %s had %llu "

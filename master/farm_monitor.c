@@ -97,6 +97,7 @@ static const char *state_name(const farm *f)
     case FARM_DONE: return "done";
     case FARM_FAILED: return "failed";
     case FARM_INTERRUPTED: return "interrupted";
+    case FARM_REQUEUED: return "requeued";
     default: return "running";
     }
 }
@@ -223,7 +224,11 @@ static char *build_status(const farm *f, int64_t now, size_t *len)
 
 static const char *worker_state(const farm_worker *w)
 {
-    return !w->alive ? w->gone : w->blocked ? "blocklisted" : "connected";
+    return !w->alive       ? w->gone
+           : w->blocked    ? "blocklisted"
+           : w->benched    ? "benched"
+           : w->other_pool ? "not in the job's pool"
+                           : "connected";
 }
 
 static char *build_workers(const farm *f, int64_t now, size_t *len)
@@ -240,6 +245,10 @@ static char *build_workers(const farm *f, int64_t now, size_t *len)
         json_out_string(out, w->name);
         fputs(", \"host\": ", out);
         json_out_string(out, w->host);
+        fputs(", \"pool\": ", out);
+        json_out_string(out, w->pool);
+        fprintf(out, ", \"benched\": %s, \"strikes\": %d", w->benched ? "true" : "false",
+                w->strikes);
         fprintf(out, ", \"pid\": %u, \"threads\": %u, \"local\": %s, \"alive\": %s, "
                 "\"tiles\": %llu, \"leases\": %d, \"rate_tiles_per_s\": %.3f, "
                 "\"render_seconds\": %.3f, \"cpu_seconds\": %.3f, \"failures\": %llu, "

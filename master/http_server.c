@@ -236,6 +236,18 @@ static bool authorized(const http_server *self, struct MHD_Connection *c)
     return auth && strncmp(auth, "Bearer ", 7) == 0 && http_token_equal(self->token, auth + 7);
 }
 
+/* A Content-Length over what a submission may be: refused at once. */
+static bool too_long(const http_server *self, struct MHD_Connection *c)
+{
+    const char *cl = MHD_lookup_connection_value(c, MHD_HEADER_KIND,
+                                                 MHD_HTTP_HEADER_CONTENT_LENGTH);
+    if (!cl) return false;
+    char *end = NULL;
+    errno = 0;
+    unsigned long long n = strtoull(cl, &end, 10);
+    return end != cl && (errno == ERANGE || n > self->jobs.max_body);
+}
+
 static enum MHD_Result on_request(void *cls, struct MHD_Connection *c, const char *url,
                                   const char *method, const char *version,
                                   const char *upload_data, size_t *upload_data_size,
@@ -249,6 +261,12 @@ static enum MHD_Result on_request(void *cls, struct MHD_Connection *c, const cha
             if (!authorized(self, c))
                 return send_error(c, MHD_HTTP_UNAUTHORIZED, "this master needs its token: "
                                   "?token=TOKEN or Authorization: Bearer TOKEN (--http-token)");
+            if (too_long(self, c)) {   /* said before the body is read */
+                char m[160];
+                snprintf(m, sizeof m, "the submission is over the %zu bytes this master takes",
+                         self->jobs.max_body);
+                return send_error(c, MHD_HTTP_CONTENT_TOO_LARGE, m);
+            }
             *con_cls = xcalloc(1, sizeof(upload));
             return MHD_YES;
         }

@@ -61,6 +61,8 @@ static void usage(FILE *out)
         "  --duplicates N             end-game duplicate leases per tile (default 1, 0: off)\n"
         "  --worker-binary PATH       aafarm-worker to start (default: next to this program)\n"
         "  --max-workers N            workers served at a time; more are refused (1024)\n"
+        "  --pool NAME                only workers started with --pool NAME get tiles (with\n"
+        "                             --bind; local workers have no pool)\n"
         "  --curve-secret FILE        CurveZMQ on --bind: this master's NAME.key_secret\n"
         "                             (aafarm-keygen NAME); needs --allow-keys\n"
         "  --allow-keys DIR           the workers' public keys (NAME.key files) that may\n"
@@ -151,7 +153,7 @@ static int parse(int argc, char **argv, cli *c)
     enum { O_BIND = 256, O_LOCAL, O_TPW, O_TILE, O_ARITH, O_BUDGET, O_PREVIEW, O_STATS_JSON,
            O_HEARTBEAT, O_LIVENESS, O_RETRIES, O_LEASE, O_DUPS, O_WORKER_BIN, O_RESUME, O_MAX_WORKERS, O_FRAMES,
            O_CURVE_SECRET, O_ALLOW_KEYS, O_INSECURE, O_LEASE_FACTOR, O_HTTP, O_HTTP_TOKEN,
-           O_HTTP_TOKEN_FILE, O_HTTP_LINGER, O_SERVE, O_DB };
+           O_HTTP_TOKEN_FILE, O_HTTP_LINGER, O_SERVE, O_DB, O_POOL };
     static const struct option longopts[] = {
         {"output", required_argument, 0, 'o'},
         {"bind", required_argument, 0, O_BIND},
@@ -181,6 +183,7 @@ static int parse(int argc, char **argv, cli *c)
         {"http-linger", required_argument, 0, O_HTTP_LINGER},
         {"serve", no_argument, 0, O_SERVE},
         {"db", required_argument, 0, O_DB},
+        {"pool", required_argument, 0, O_POOL},
         {"quiet", no_argument, 0, 'q'},
         {"verbose", no_argument, 0, 'v'},
         {"help", no_argument, 0, 'h'},
@@ -285,6 +288,15 @@ static int parse(int argc, char **argv, cli *c)
             break;
         case O_SERVE: c->serve = true; break;
         case O_DB: c->db = optarg; break;
+        case O_POOL: {
+            char err[ERR_LEN];
+            if (!proto_pool_name_check(optarg, err, sizeof err)) {
+                fprintf(stderr, "aafarm-master: --pool: %s\n", err);
+                return AAFARM_EXIT_USAGE;
+            }
+            f->pool = optarg;
+            break;
+        }
         case 'q': f->verbosity = -1; break;
         case 'v': f->verbosity = 1; break;
         case 'h': usage(stdout); return AAFARM_EXIT_OK;
@@ -310,7 +322,7 @@ static int parse(int argc, char **argv, cli *c)
         const char *what = f->scene_path ? f->scene_path : f->output ? "-o" : f->frames ? "--frames"
                            : f->resume ? "--resume" : f->preview ? "--preview"
                            : f->stats_json ? "--stats-json" : f->http_linger_ms ? "--http-linger"
-                           : NULL;
+                           : f->pool ? "--pool" : NULL;
         if (what) {
             fprintf(stderr, "aafarm-master: --serve renders the jobs submitted to it: '%s' goes "
                     "with one scene (aafarm-submit --master URL SCENE.rib -o OUT.exr sends "

@@ -32,7 +32,8 @@ static const char schema[] =
     " tiles INTEGER NOT NULL DEFAULT 0, tiles_done INTEGER NOT NULL DEFAULT 0,"
     " cancel INTEGER NOT NULL DEFAULT 0,"
     " exit_status INTEGER, error TEXT,"
-    " bundle BLOB NOT NULL);";
+    " bundle BLOB NOT NULL,"
+    " pool TEXT NOT NULL DEFAULT '');";
 
 static double now_s(void)
 {
@@ -47,6 +48,18 @@ static bool db_error(queue *self, const char *what, char *err, size_t errsz)
                    sqlite3_errmsg(self->db));
 }
 
+/* A database made before pools has no pool column: added (empty). */
+static bool add_pool_column(queue *self)
+{
+    sqlite3_stmt *st = NULL;
+    if (sqlite3_prepare_v2(self->db, "SELECT pool FROM jobs LIMIT 0", -1, &st, NULL) == SQLITE_OK) {
+        sqlite3_finalize(st);
+        return true;
+    }
+    return sqlite3_exec(self->db, "ALTER TABLE jobs ADD COLUMN pool TEXT NOT NULL DEFAULT ''",
+                        NULL, NULL, NULL) == SQLITE_OK;
+}
+
 queue *queue_open(const char *path, char *err, size_t errsz)
 {
     queue *self = xcalloc(1, sizeof *self);
@@ -55,7 +68,8 @@ queue *queue_open(const char *path, char *err, size_t errsz)
                         SQLITE_OPEN_FULLMUTEX, NULL) != SQLITE_OK ||
         sqlite3_busy_timeout(self->db, 10000) != SQLITE_OK ||
         sqlite3_exec(self->db, "PRAGMA journal_mode=WAL;", NULL, NULL, NULL) != SQLITE_OK ||
-        sqlite3_exec(self->db, schema, NULL, NULL, NULL) != SQLITE_OK) {
+        sqlite3_exec(self->db, schema, NULL, NULL, NULL) != SQLITE_OK ||
+        !add_pool_column(self)) {
         db_error(self, "cannot open it (is it an aafarm job database, and its folder writable?)",
                  err, errsz);
         queue_destroy(&self);
@@ -83,11 +97,13 @@ static sqlite3_stmt *prepare(queue *self, const char *sql, char *err, size_t err
     return st;
 }
 
-long queue_submit(queue *self, int priority, const char *scene, const char *outputs, int frames,
-                  const void *bundle, size_t len, char *err, size_t errsz)
+long queue_submit(queue *self, int priority, const char *pool, const char *scene,
+                  const char *outputs, int frames, const void *bundle, size_t len, char *err,
+                  size_t errsz)
 {
     sqlite3_stmt *st = prepare(self, "INSERT INTO jobs (state, priority, scene, outputs, frames, "
-                               "submitted, bundle) VALUES ('queued', ?, ?, ?, ?, ?, ?)", err, errsz);
+                               "submitted, bundle, pool) VALUES ('queued', ?, ?, ?, ?, ?, ?, ?)",
+                               err, errsz);
     if (!st) return -1;
     sqlite3_bind_int(st, 1, priority);
     sqlite3_bind_text(st, 2, scene, -1, SQLITE_STATIC);
@@ -95,6 +111,7 @@ long queue_submit(queue *self, int priority, const char *scene, const char *outp
     sqlite3_bind_int(st, 4, frames);
     sqlite3_bind_double(st, 5, now_s());
     sqlite3_bind_blob64(st, 6, bundle, len, SQLITE_STATIC);
+    sqlite3_bind_text(st, 7, pool ? pool : "", -1, SQLITE_STATIC);
     long id = -1;
     if (sqlite3_step(st) == SQLITE_DONE) id = (long)sqlite3_last_insert_rowid(self->db);
     else db_error(self, "insert", err, errsz);
@@ -182,6 +199,8 @@ static void json_job(FILE *out, sqlite3_stmt *st)
     fputs(", \"error\": ", out);
     if (sqlite3_column_type(st, 13) == SQLITE_NULL) fputs("null", out);
     else json_out_string(out, (const char *)sqlite3_column_text(st, 13));
+    fputs(", \"pool\": ", out);
+    json_out_string(out, (const char *)sqlite3_column_text(st, 14));
     fputc('}', out);
 }
 
@@ -189,7 +208,7 @@ char *queue_json(queue *self, long id, size_t *len, bool *missing, char *err, si
 {
     *missing = false;
     const char *cols = "SELECT id, state, priority, scene, outputs, frames, submitted, started, "
-                       "ended, tiles, tiles_done, cancel, exit_status, error FROM jobs";
+                       "ended, tiles, tiles_done, cancel, exit_status, error, pool FROM jobs";
     char sql[400];
     snprintf(sql, sizeof sql, "%s%s", cols, id < 0 ? " ORDER BY id" : " WHERE id = ?");
     sqlite3_stmt *st = prepare(self, sql, err, errsz);
@@ -266,6 +285,12 @@ bool queue_start(queue *self, long id, int tiles, char *err, size_t errsz)
     snprintf(sql, sizeof sql, "UPDATE jobs SET state = 'running', started = coalesce(started, ?2), "
              "tiles = %d WHERE id = ?1 AND state IN ('queued', 'running')", tiles);
     return update(self, sql, id, err, errsz) > 0;
+}
+
+bool queue_requeue(queue *self, long id, char *err, size_t errsz)
+{
+    return update(self, "UPDATE jobs SET state = 'queued' WHERE id = ?1 AND state = 'running' "
+                  "AND ?2 > 0", id, err, errsz) > 0;
 }
 
 bool queue_progress(queue *self, long id, int done, char *err, size_t errsz)

@@ -27,8 +27,9 @@ queue *queue_open(const char *path, char *err, size_t errsz);
 void queue_destroy(queue **self_p);
 
 /* A new queued job; its id, or -1 with the reason. outputs: one line each. */
-long queue_submit(queue *self, int priority, const char *scene, const char *outputs, int frames,
-                  const void *bundle, size_t len, char *err, size_t errsz);
+long queue_submit(queue *self, int priority, const char *pool, const char *scene,
+                  const char *outputs, int frames, const void *bundle, size_t len, char *err,
+                  size_t errsz);
 
 typedef enum queue_cancel_result {
     QUEUE_CANCELLED,     /* it was queued: cancelled now */
@@ -51,6 +52,9 @@ long queue_next(queue *self, bool *resume, char *err, size_t errsz);
 bool queue_bundle(queue *self, long id, uint8_t **data, size_t *len, char *err, size_t errsz);
 /* Running from now (false: it was cancelled meanwhile, or an error). */
 bool queue_start(queue *self, long id, int tiles, char *err, size_t errsz);
+/* Back to 'queued' (it ran and lost every worker): run again later,
+ * from its journal. */
+bool queue_requeue(queue *self, long id, char *err, size_t errsz);
 bool queue_progress(queue *self, long id, int done, char *err, size_t errsz);
 /* Was its cancellation asked for? */
 bool queue_cancel_asked(queue *self, long id);

@@ -21,13 +21,14 @@
 #include <stddef.h>
 #include <stdint.h>
 
-enum { REGISTRY_MAX_ID = 255, REGISTRY_NAME = 128 };
+enum { REGISTRY_MAX_ID = 255, REGISTRY_NAME = 128, REGISTRY_POOL = 64, REGISTRY_FAILED = 16 };
 
 typedef struct farm_worker {
     uint8_t id[REGISTRY_MAX_ID];   /* ZeroMQ routing id */
     size_t id_len;
     char name[REGISTRY_NAME];      /* from Hello */
     char host[REGISTRY_NAME];
+    char pool[REGISTRY_POOL];      /* its --pool ("" none) */
     uint32_t pid, threads;
     int slot;                      /* scheduler worker slot */
     uint32_t credits;              /* tiles it asked for and was not granted yet */
@@ -39,6 +40,12 @@ typedef struct farm_worker {
     bool alive;
     bool blocked;                  /* blocklisted for the job: its results were
                                       refused --retries times; it gets no tile */
+    bool other_pool;               /* the job has a pool it is not in: it gets no tile */
+    bool benched;                  /* it failed tiles that others finished
+                                      (FARM_BENCH_AFTER): no more tiles of the job */
+    int failed_tiles[REGISTRY_FAILED];   /* the job's tiles it failed, newest last */
+    int nfailed;
+    int strikes;                   /* tiles it failed that another worker finished */
     char gone[160];                /* why it was retired */
     char last_error[200];          /* its last tile failure or refused result ("" none) */
     int64_t joined_ms, last_seen_ms, last_sent_ms, left_ms;

@@ -28,7 +28,11 @@ static const char *state_name(farm_state s)
  * why it was retired. */
 static const char *worker_state(const farm_worker *w)
 {
-    return !w->alive ? w->gone : w->blocked ? "blocklisted" : "connected";
+    return !w->alive       ? w->gone
+           : w->blocked    ? "blocklisted"
+           : w->benched    ? "benched"
+           : w->other_pool ? "not in the job's pool"
+                           : "connected";
 }
 
 static void human_bytes(uint64_t b, char *buf, size_t n)

@@ -88,8 +88,8 @@ static unsigned on_submit(void *arg, const void *body, size_t len, char **answer
         err_prefix(err, sizeof err, "refused the submission");
         *answer = json_error(err, alen);
     } else {
-        long id = queue_submit(s->hq, b.priority, b.scene, outputs ? outputs : "", b.nframes,
-                               body, len, err, sizeof err);
+        long id = queue_submit(s->hq, b.priority, b.pool, b.scene, outputs ? outputs : "",
+                               b.nframes, body, len, err, sizeof err);
         if (id < 0) {
             *answer = json_error(err, alen);
             status = 500;
@@ -138,6 +138,14 @@ static unsigned on_cancel(void *arg, long id, char **answer, size_t *alen)
 
 /* ---- the loop ---- */
 
+/* Can a job start? Not while every local worker has exited and none can
+ * join from elsewhere (they are started again: farm.c). */
+static bool can_render(const farm *f)
+{
+    return f->opt->bind || !f->locals || local_workers_running(f->locals) > 0 ||
+           registry_alive(f->reg) > 0;
+}
+
 /* Once a loop turn: idle, is there a job? Running, was it cancelled? */
 static void tick(farm *f, int64_t now)
 {
@@ -146,7 +154,8 @@ static void tick(farm *f, int64_t now)
     s->checked_ms = now;
     if (s->job < 0) {
         bool resume;
-        if (queue_next(s->q, &resume, NULL, 0) >= 0) f->state = FARM_DONE;   /* idle ends */
+        if (can_render(f) && queue_next(s->q, &resume, NULL, 0) >= 0)
+            f->state = FARM_DONE;   /* idle ends */
         return;
     }
     if (queue_cancel_asked(s->q, s->job)) {
@@ -223,6 +232,17 @@ static bool load_job(serve *s, long id, loaded_job *l, char *err, size_t errsz)
     return true;
 }
 
+/* Live workers of the job's pool. */
+static int pool_workers(const farm *f)
+{
+    int n = 0;
+    for (size_t i = 0; i < registry_count(f->reg); i++) {
+        const farm_worker *w = registry_at(f->reg, i);
+        n += w->alive && !w->other_pool;
+    }
+    return n;
+}
+
 /* Runs job id to its end (or the master's); its state into the database. */
 static void run_job(serve *s, farm *f, long id, bool resume)
 {
@@ -231,6 +251,7 @@ static void run_job(serve *s, farm *f, long id, bool resume)
     bool ok = load_job(s, id, &l, err, sizeof err);
     s->opt.scene_path = ok ? l.b.scene : "?";
     s->job = id;
+    f->pool = ok && l.b.pool[0] ? l.b.pool : NULL;
     int rc = farm_serve_job(f, ok ? l.frames : NULL, ok ? l.b.nframes : 0, err, sizeof err);
     if (!ok || rc != AAFARM_EXIT_OK) {
         f->state = FARM_FAILED;
@@ -238,10 +259,13 @@ static void run_job(serve *s, farm *f, long id, bool resume)
     } else if (!queue_start(s->q, id, f->ntiles, err, sizeof err)) {
         f->state = FARM_CANCELLED;   /* cancelled between the look and now */
     } else {
-        console_log(f->con, CONSOLE_INFO, "job %ld: %s, %d frame%s, %d tiles (priority %d%s%s)",
+        console_log(f->con, CONSOLE_INFO, "job %ld: %s, %d frame%s, %d tiles (priority %d%s%s%s%s)",
                     id, l.b.scene, l.b.nframes, l.b.nframes == 1 ? "" : "s", f->ntiles,
-                    l.b.priority, resume ? "; resumed" : "",
-                    f->resumed_tiles ? ", tiles from its journal" : "");
+                    l.b.priority, f->pool ? ", pool " : "", f->pool ? f->pool : "",
+                    resume ? "; resumed" : "", f->resumed_tiles ? ", tiles from its journal" : "");
+        if (f->pool && !pool_workers(f))
+            console_log(f->con, CONSOLE_INFO, "job %ld waits for a worker of pool %s (aafarm-worker "
+                        "--connect ... --pool %s)", id, f->pool, f->pool);
         farm_serve_loop(f);
     }
     switch (f->state) {
@@ -256,6 +280,13 @@ static void run_job(serve *s, farm *f, long id, bool resume)
         queue_end(s->q, id, "cancelled", AAFARM_EXIT_INTERRUPTED, "cancelled while running",
                   NULL, 0);
         break;
+    case FARM_REQUEUED:   /* back in the queue: it resumes from its journal */
+        queue_progress(s->q, id, scheduler_tiles_done(f->sched), NULL, 0);
+        queue_requeue(s->q, id, NULL, 0);
+        console_log(f->con, CONSOLE_INFO, "job %ld requeued: every local worker exited (%d of %d "
+                    "tiles in its journal); it resumes when they are back", id,
+                    scheduler_tiles_done(f->sched), f->ntiles);
+        break;
     case FARM_INTERRUPTED:   /* stays 'running': the next master resumes it */
         queue_progress(s->q, id, scheduler_tiles_done(f->sched), NULL, 0);
         console_log(f->con, CONSOLE_INFO, "job %ld interrupted: a master started on the same "
@@ -267,16 +298,10 @@ static void run_job(serve *s, farm *f, long id, bool resume)
         break;
     }
     farm_serve_end_job(f);
+    f->pool = NULL;
     s->job = -1;
     s->opt.scene_path = NULL;   /* it points into the job freed now */
     loaded_job_clear(&l);
-}
-
-/* No worker left and none can come (local workers only): the master ends. */
-static bool workers_gone(const farm *f)
-{
-    return !f->opt->bind && f->locals && local_workers_running(f->locals) == 0 &&
-           registry_alive(f->reg) == 0;
 }
 
 int farm_serve(const farm_options *opt, const char *db_path)
@@ -331,7 +356,7 @@ int farm_serve(const farm_options *opt, const char *db_path)
                     opt->http ? "" : " (no --http: nothing can submit)");
         while (!atomic_load(interrupted)) {
             bool resume = false;
-            long id = queue_next(s.q, &resume, err, sizeof err);
+            long id = can_render(&f) ? queue_next(s.q, &resume, err, sizeof err) : -1;
             if (id >= 0) {
                 run_job(&s, &f, id, resume);
             } else {   /* idle until a job comes */
@@ -341,13 +366,6 @@ int farm_serve(const farm_options *opt, const char *db_path)
             }
             if (f.state == FARM_INTERRUPTED || atomic_load(interrupted)) {
                 rc = AAFARM_EXIT_INTERRUPTED;
-                break;
-            }
-            if (workers_gone(&f)) {
-                console_log(f.con, CONSOLE_ERROR, "no workers left: all %d local workers "
-                            "exited; the queue is kept for the next master",
-                            opt->local_workers);
-                rc = AAFARM_EXIT_FAILURE;
                 break;
             }
         }

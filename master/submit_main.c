@@ -3,7 +3,8 @@
  * (aafarm-master --serve; docs/farm.md "A job queue"), over its HTTP API
  * with libcurl:
  *
- *   aafarm-submit --master URL SCENE.rib -o OUT.exr [--priority N] [--frames LIST] [--wait]
+ *   aafarm-submit --master URL SCENE.rib -o OUT.exr [--priority N] [--frames LIST]
+ *                 [--pool NAME] [--wait]
  *   aafarm-submit --master URL --list
  *   aafarm-submit --master URL --cancel ID
  *
@@ -34,7 +35,7 @@ static void usage(FILE *out)
 {
     fprintf(out,
         "usage: aafarm-submit --master URL SCENE.rib -o OUT.exr [--priority N] [--frames LIST]\n"
-        "                     [--wait] [options]\n"
+        "                     [--pool NAME] [--wait] [options]\n"
         "       aafarm-submit --master URL --list\n"
         "       aafarm-submit --master URL --cancel ID\n"
         "\n"
@@ -49,6 +50,8 @@ static void usage(FILE *out)
         "  --priority N               higher runs first (default 0; -1000000..1000000);\n"
         "                             equal priorities run in the order submitted\n"
         "  --frames LIST              frames to render by FrameBegin number: 3, 1-10, 1,3,5-7\n"
+        "  --pool NAME                only workers started with --pool NAME render it\n"
+        "                             (default: any worker)\n"
         "  --tile S                   tile size in pixels (default 32)\n"
         "  --arith affine|interval    bounding arithmetic (default affine)\n"
         "  --budget N                 shader instruction budget per evaluation (default 1000000)\n"
@@ -68,7 +71,7 @@ static void usage(FILE *out)
 }
 
 typedef struct cli {
-    const char *master, *scene, *output, *frames;
+    const char *master, *scene, *output, *frames, *pool;
     char url[512];
     char token[HTTP_TOKEN_MAX + 2];
     bool has_token, wait, list, quiet;
@@ -135,9 +138,19 @@ static long request(const cli *c, const char *path, const void *body, size_t len
     return status;
 }
 
-/* The "error" of a JSON answer, or the text itself. */
-static void answer_error(const buf *b, long status, char *err, size_t errsz)
+/* The "error" of a JSON answer, or the text itself; for a refused token
+ * (401, 403) what to do about it. */
+static void answer_error(const cli *c, const buf *b, long status, char *err, size_t errsz)
 {
+    if (status == 401 || status == 403) {
+        if (c->has_token)
+            err_set(err, errsz, "the master at %s refused the token (answer %ld): give the "
+                    "line of its --http-token-file with --token-file FILE", c->url, status);
+        else
+            err_set(err, errsz, "the master at %s needs a token (answer %ld): give the line "
+                    "of its --http-token-file with --token-file FILE", c->url, status);
+        return;
+    }
     json_object *o = json_tokener_parse(b->data);
     json_object *e = NULL;
     if (o && json_object_object_get_ex(o, "error", &e))
@@ -172,7 +185,7 @@ static int list(const cli *c)
     if (status < 0) {
         fprintf(stderr, "aafarm-submit: %s\n", err);
     } else if (!o || !json_object_object_get_ex(o, "jobs", &jobs)) {
-        answer_error(&b, status, err, sizeof err);
+        answer_error(c, &b, status, err, sizeof err);
         fprintf(stderr, "aafarm-submit: %s\n", err);
     } else {
         printf("%6s  %-9s  %8s  %9s  %s\n", "ID", "STATE", "PRIORITY", "PROGRESS", "SCENE -> OUTPUT");
@@ -211,7 +224,7 @@ static int cancel(const cli *c)
                                                             : "is running: its master stops it");
         rc = AAFARM_EXIT_OK;
     } else {
-        answer_error(&b, status, err, sizeof err);
+        answer_error(c, &b, status, err, sizeof err);
         fprintf(stderr, "aafarm-submit: %s\n", err);
     }
     free(b.data);
@@ -238,7 +251,7 @@ static int wait_for(const cli *c, long id)
                 fprintf(stderr, "aafarm-submit: %s; still waiting for job %ld\n", err, id);
             said = true;
         } else if (status != 200) {
-            answer_error(&b, status, err, sizeof err);
+            answer_error(c, &b, status, err, sizeof err);
             fprintf(stderr, "aafarm-submit: %s\n", err);
             free(b.data);
             return AAFARM_EXIT_FAILURE;
@@ -274,7 +287,8 @@ static int submit(cli *c)
     if (!seq) return usage_error ? AAFARM_EXIT_USAGE : AAFARM_EXIT_INPUT;
     char err[2 * ERR_LEN];
     size_t len = 0;
-    uint8_t *body = job_bundle_encode(seq, c->scene, (int)c->priority, &len, err, sizeof err);
+    uint8_t *body = job_bundle_encode(seq, c->scene, (int)c->priority, c->pool, &len, err,
+                                      sizeof err);
     int nframes = seq->count;
     frame_sequence_destroy(&seq);
     if (!body) {
@@ -291,7 +305,7 @@ static int submit(cli *c)
         json_object_put(o);
     }
     if (id < 0) {
-        if (status >= 0) answer_error(&b, status, err, sizeof err);
+        if (status >= 0) answer_error(c, &b, status, err, sizeof err);
         fprintf(stderr, "aafarm-submit: %s\n", err);
         free(b.data);
         return AAFARM_EXIT_FAILURE;
@@ -318,11 +332,12 @@ static bool number_arg(const char *opt, long lo, long hi, long *n)
 static int parse(int argc, char **argv, cli *c)
 {
     enum { O_MASTER = 256, O_PRIORITY, O_FRAMES, O_WAIT, O_LIST, O_CANCEL, O_TOKEN,
-           O_TOKEN_FILE, O_TILE, O_ARITH, O_BUDGET };
+           O_TOKEN_FILE, O_TILE, O_ARITH, O_BUDGET, O_POOL };
     static const struct option longopts[] = {
         {"master", required_argument, 0, O_MASTER},
         {"output", required_argument, 0, 'o'},
         {"priority", required_argument, 0, O_PRIORITY},
+        {"pool", required_argument, 0, O_POOL},
         {"frames", required_argument, 0, O_FRAMES},
         {"wait", no_argument, 0, O_WAIT},
         {"list", no_argument, 0, O_LIST},
@@ -348,6 +363,13 @@ static int parse(int argc, char **argv, cli *c)
             if (!number_arg("--priority", -1000000, 1000000, &c->priority)) return AAFARM_EXIT_USAGE;
             break;
         case O_FRAMES: c->frames = optarg; break;
+        case O_POOL:
+            if (!proto_pool_name_check(optarg, err, sizeof err)) {
+                fprintf(stderr, "aafarm-submit: --pool: %s\n", err);
+                return AAFARM_EXIT_USAGE;
+            }
+            c->pool = optarg;
+            break;
         case O_WAIT: c->wait = true; break;
         case O_LIST: c->list = true; break;
         case O_CANCEL:
@@ -408,8 +430,9 @@ static int parse(int argc, char **argv, cli *c)
                 "(see --help)\n");
         return AAFARM_EXIT_USAGE;
     }
-    if (!c->scene && (c->wait || c->output || c->frames)) {
-        fprintf(stderr, "aafarm-submit: --wait, -o and --frames go with a scene to submit\n");
+    if (!c->scene && (c->wait || c->output || c->frames || c->pool)) {
+        fprintf(stderr, "aafarm-submit: --wait, -o, --frames and --pool go with a scene to "
+                "submit\n");
         return AAFARM_EXIT_USAGE;
     }
     const char *m = c->master;

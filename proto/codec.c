@@ -121,6 +121,7 @@ void envelope_out_init(envelope_out *out, const proto_msg *msg)
         b->n_jobs_held = m->n_jobs_held;
         b->jobs_held = (char **)m->jobs_held;
         b->software = str(m->software);
+        b->pool = str(m->pool);
         out->env.hello = b;
         break;
     }
@@ -351,7 +352,7 @@ bool proto_msg_view(const Aafarm__Envelope *env, proto_msg *msg, void **block)
         const Aafarm__Hello *b = env->hello;
         msg->hello = (proto_hello){b->protocol_version, b->worker_name, b->host, b->pid,
                                    b->threads, b->n_jobs_held,
-                                   (const char *const *)b->jobs_held, b->software};
+                                   (const char *const *)b->jobs_held, b->software, b->pool};
         break;
     }
     case AAFARM__ENVELOPE__BODY_WELCOME: {

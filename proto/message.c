@@ -255,6 +255,23 @@ static int check_unique(checker *c, const char *field, const char *const *names,
 /* one check per message kind                                              */
 /* ---------------------------------------------------------------------- */
 
+bool proto_pool_name_check(const char *name, char *err, size_t errsz)
+{
+    size_t len = strlen(name);
+    if (len == 0 || len > PROTO_POOL_MAX)
+        return err_set(err, errsz, "a pool name has 1 to %d characters, '%.80s' has %zu",
+                       PROTO_POOL_MAX, name, len);
+    for (size_t i = 0; i < len; i++) {
+        char ch = name[i];
+        bool ok = (ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z') || (ch >= '0' && ch <= '9') ||
+                  ch == '.' || ch == '_' || ch == '-';
+        if (!ok)
+            return err_set(err, errsz, "pool name '%.80s': character %zu is not a letter, digit, "
+                           "'.', '_' or '-'", name, i + 1);
+    }
+    return true;
+}
+
 static int check_hello(checker *c, const Aafarm__Hello *m)
 {
     if (m->protocol_version == 0)
@@ -265,6 +282,9 @@ static int check_hello(checker *c, const Aafarm__Hello *m)
         check_name(c, "Hello.host", m->host, true) ||
         check_range(c, "Hello.threads", m->threads, 1, c->limits->max_threads) ||
         check_name(c, "Hello.software", m->software, false) ||
+        (m->pool && *m->pool && !proto_pool_name_check(m->pool, NULL, 0) &&
+         fail(c, "Hello.pool", "not a pool name (letters, digits, '.', '_', '-'; at most %d)",
+              PROTO_POOL_MAX)) ||
         check_count(c, "Hello.jobs_held", m->n_jobs_held))
         return -1;
     for (size_t i = 0; i < m->n_jobs_held; i++)

@@ -101,6 +101,7 @@ typedef struct proto_hello {
     size_t n_jobs_held;
     const char *const *jobs_held;
     const char *software;
+    const char *pool;              /* "" or NULL: no pool */
 } proto_hello;
 
 typedef struct proto_welcome {
@@ -320,6 +321,11 @@ bool proto_message_has_bulk(proto_kind kind);
  * code that answers a mismatch clearly instead of being dropped. */
 bool proto_msg_check(const proto_msg *msg, bool has_bulk, size_t bulk_len,
                      const proto_limits *limits, char *err, size_t errsz);
+
+/* A worker pool's name (Hello.pool, a job's --pool): 1 to PROTO_POOL_MAX
+ * letters, digits, '.', '_' or '-'. False with the reason. */
+enum { PROTO_POOL_MAX = 63 };
+bool proto_pool_name_check(const char *name, char *err, size_t errsz);
 
 /* Bytes of the message packed (the header frame wire_send would send). */
 size_t proto_msg_packed_size(const proto_msg *msg);

@@ -11,6 +11,7 @@
 
 #include "job/frames.h"
 #include "curve_cert.h"
+#include "message.h"
 #include "tex/tex.h"
 #include "standalone.h"
 #include "util/cli.h"
@@ -43,6 +44,8 @@ static void usage(FILE *out)
         "                          NAME; the master must allow NAME.key); needs --master-key\n"
         "  --master-key FILE       CurveZMQ: the master's public key (its NAME.key)\n"
         "  --name NAME             worker name in the master's logs (default host:pid)\n"
+        "  --pool NAME             (--connect) this worker's pool: a job submitted to a\n"
+        "                          pool goes only to its workers; one without a pool, to any\n"
         "  -t, --threads N         rendering threads (default: number of cores)\n"
         "  --tile S                tile size in pixels (standalone; default 32)\n"
         "  --cache-bytes B         box cache budget per thread, e.g. 40K, 400K, 4M,\n"
@@ -70,6 +73,8 @@ static void usage(FILE *out)
         "                          that makes renders slow enough to interrupt\n"
         "  --prepare-delay MS       (--connect) sleep MS before compiling each job: a\n"
         "                          testing aid for slow preparations (heartbeats go on)\n"
+        "  --fail-tiles             (--connect) answer every tile with a failure: a testing\n"
+        "                          aid for the master's benching of failing workers\n"
         "  -q, --quiet             only errors;  -v, --verbose  more detail\n"
         "  -h, --help              this text\n"
         "\n"
@@ -114,12 +119,14 @@ int main(int argc, char **argv)
     enum { O_STANDALONE = 256, O_CONNECT, O_NAME, O_TILE, O_CACHE, O_ARITH, O_BUDGET,
            O_PREVIEW, O_STATS, O_STATS_JSON, O_TILE_DELAY, O_PREPARE_DELAY,
            O_CURVE_SECRET, O_MASTER_KEY, O_FRAMES, O_FILE_CACHE, O_FILE_CACHE_BYTES,
-           O_FILE_CHUNK, O_FILE_INFLIGHT, O_FILE_DELAY, O_TEXTURE_BYTES };
+           O_FILE_CHUNK, O_FILE_INFLIGHT, O_FILE_DELAY, O_TEXTURE_BYTES, O_POOL, O_FAIL_TILES };
     static const struct option longopts[] = {
         {"standalone", required_argument, 0, O_STANDALONE},
         {"output", required_argument, 0, 'o'},
         {"connect", required_argument, 0, O_CONNECT},
         {"name", required_argument, 0, O_NAME},
+        {"pool", required_argument, 0, O_POOL},
+        {"fail-tiles", no_argument, 0, O_FAIL_TILES},
         {"threads", required_argument, 0, 't'},
         {"tile", required_argument, 0, O_TILE},
         {"cache-bytes", required_argument, 0, O_CACHE},
@@ -153,6 +160,16 @@ int main(int argc, char **argv)
         case 'o': so.output = optarg; break;
         case O_CONNECT: connect = optarg; break;
         case O_NAME: wo.name = optarg; break;
+        case O_POOL: {
+            char err[ERR_LEN];
+            if (!proto_pool_name_check(optarg, err, sizeof err)) {
+                fprintf(stderr, "aafarm-worker: --pool: %s\n", err);
+                return AAFARM_EXIT_USAGE;
+            }
+            wo.pool = optarg;
+            break;
+        }
+        case O_FAIL_TILES: wo.fail_tiles = true; break;
         case 't':
             if (!number_arg("--threads", "a number", 1, 1024, &n)) return AAFARM_EXIT_USAGE;
             so.threads = wo.threads = (int)n;

@@ -160,6 +160,7 @@ static void send_hello(worker_loop *w)
     h->n_jobs_held = worker_jobs_hashes(w->jobs, held, MAX_JOBS_HELD);
     h->jobs_held = (const char *const *)held;
     h->software = "aafarm 0.1.0";
+    h->pool = w->opt->pool;
     char err[ERR_LEN];
     if (send_msg(w, &msg, NULL, 0, err, sizeof err) != 0)
         wlog(w, -1, "cannot send Hello: %s", err);
@@ -315,6 +316,10 @@ static void start_tile(worker_loop *w, held_job *h, uint64_t lease, uint32_t til
         snprintf(msg, sizeof msg, "Grant for tile %u: the rectangle (%d,%d) %dx%d is not that "
                  "tile of the job's image", tile, rect.x0, rect.y0, rect.w, rect.h);
         send_failure(w, h->hash, lease, tile, msg, false);
+        return;
+    }
+    if (w->opt->fail_tiles) {
+        send_failure(w, h->hash, lease, tile, "failing on purpose (--fail-tiles)", true);
         return;
     }
     worker_pool_submit(w->pool, worker_task_new(lease, tile, rect, h));

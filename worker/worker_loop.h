@@ -18,12 +18,15 @@
 #ifndef WORKER_LOOP_H
 #define WORKER_LOOP_H
 
+#include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
 
 typedef struct worker_loop_options {
     const char *endpoint;          /* e.g. tcp://render1:5555 */
     const char *name;              /* NULL: host:pid */
+    const char *pool;              /* --pool NAME: jobs of this pool only (NULL: none) */
+    bool fail_tiles;               /* testing aid: every tile answered with a Failure */
     int threads;                   /* 0: number of cores */
     size_t cache_bytes;            /* box cache per thread; 0: the job's (unlimited) */
     int verbosity;                 /* -1 quiet, 0 normal, 1 verbose */

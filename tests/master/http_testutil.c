@@ -26,6 +26,12 @@ static size_t on_body(char *data, size_t size, size_t n, void *arg)
 
 ht_response ht_request(const char *method, const char *url, const char *header)
 {
+    return ht_post_body(method, url, header, NULL, 0);
+}
+
+ht_response ht_post_body(const char *method, const char *url, const char *header,
+                         const void *body, size_t len)
+{
     ht_response r = {0};
     r.body = calloc(1, 1);
     CURL *c = curl_easy_init();
@@ -40,6 +46,12 @@ ht_response ht_request(const char *method, const char *url, const char *header)
     curl_easy_setopt(c, CURLOPT_TIMEOUT, 20L);
     curl_easy_setopt(c, CURLOPT_NOSIGNAL, 1L);
     curl_easy_setopt(c, CURLOPT_NOPROXY, "*");
+    if (body) {
+        headers = curl_slist_append(headers, "Expect:");
+        curl_easy_setopt(c, CURLOPT_HTTPHEADER, headers);
+        curl_easy_setopt(c, CURLOPT_POSTFIELDS, body);
+        curl_easy_setopt(c, CURLOPT_POSTFIELDSIZE_LARGE, (curl_off_t)len);
+    }
     if (curl_easy_perform(c) == CURLE_OK) {
         curl_easy_getinfo(c, CURLINFO_RESPONSE_CODE, &r.status);
         char *type = NULL;

@@ -25,6 +25,9 @@ typedef struct ht_response {
  * Bearer X", NULL: none); at most 20 s. */
 ht_response ht_request(const char *method, const char *url, const char *header);
 ht_response ht_get(const char *url);
+/* `method` (POST) with body[0..len) (NULL: none) and an optional header. */
+ht_response ht_post_body(const char *method, const char *url, const char *header,
+                         const void *body, size_t len);
 void ht_response_clear(ht_response *r);
 
 /* The body parsed as JSON (json_object_put it), or NULL. */
