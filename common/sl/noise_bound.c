@@ -1277,8 +1277,8 @@ static void noise_aa(aa_context *ctx, aa_form *out, int dim, const aa_form *p,
          * (the Taylor expansion runs from x0 to every value, so the
          * segment must lie in the box where the Hessian is enclosed).
          * |x - x0| is bounded both by the form's radius and by the box. */
-        ia_interval R = aa_range(&p[k]);
-        double c = p[k].x0, rad = aa_radius(&p[k]);
+        double c = p[k].x0, rad;
+        ia_interval R = aa_range_radius(&p[k], &rad);
         q.lo[k] = R.lo < c ? R.lo : c;
         q.hi[k] = R.hi > c ? R.hi : c;
         q.c[k] = c;
@@ -1306,18 +1306,21 @@ static void noise_aa(aa_context *ctx, aa_form *out, int dim, const aa_form *p,
 
     /* n0 + sum alpha_k (x_k - c_k): y_k is x_k with its centre removed
      * (exactly: the same coefficients, centre x0 - x0 = 0); the rounding of
-     * the combination goes to err in aa_lincomb. */
-    aa_form y[4];
-    for (int k = 0; k < dim; k++)
-        aa_add_s(ctx, &y[k], &p[k], -p[k].x0);    /* x0 - x0: exact */
-    if (dim == 1) {
-        aa_lincomb(ctx, out, res.alpha[0], &y[0], 0.0, NULL, res.n0);
-    } else if (dim == 3) {
-        aa_lincomb3(ctx, out, res.alpha, y, res.n0);      /* one pass */
+     * the combination goes to err in aa_lincomb. In 3D (point noise, the
+     * usual case) aa_lincomb3_centred does both in one pass, bit for bit. */
+    if (dim == 3) {
+        aa_lincomb3_centred(ctx, out, res.alpha, p, res.n0);   /* one pass */
     } else {
-        aa_lincomb(ctx, out, res.alpha[0], &y[0], res.alpha[1], &y[1], res.n0);
-        for (int k = 2; k < dim; k++)
-            aa_lincomb(ctx, out, 1.0, out, res.alpha[k], &y[k], 0.0);
+        aa_form y[4];
+        for (int k = 0; k < dim; k++)
+            aa_add_s(ctx, &y[k], &p[k], -p[k].x0);    /* x0 - x0: exact */
+        if (dim == 1) {
+            aa_lincomb(ctx, out, res.alpha[0], &y[0], 0.0, NULL, res.n0);
+        } else {
+            aa_lincomb(ctx, out, res.alpha[0], &y[0], res.alpha[1], &y[1], res.n0);
+            for (int k = 2; k < dim; k++)
+                aa_lincomb(ctx, out, 1.0, out, res.alpha[k], &y[k], 0.0);
+        }
     }
     /* +- delta on a new symbol; the hull (of the linear part) widens by it */
     double hull_lo = fp_add_dn(out->lo, -res.delta), hull_hi = fp_add_up(out->hi, res.delta);
