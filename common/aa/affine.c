@@ -217,6 +217,12 @@ ia_interval aa_range(const aa_form *x)
     return aa_range_r(x, aa_radius(x));
 }
 
+ia_interval aa_range_radius(const aa_form *x, double *radius)
+{
+    *radius = aa_radius(x);
+    return aa_range_r(x, *radius);
+}
+
 bool aa_is_point(const aa_form *x)
 {
     if ((x->flags & AA_UNBOUNDED) || x->err != 0.0)
@@ -425,10 +431,29 @@ void aa_lincomb(aa_context *ctx, aa_form *z, double a, const aa_form *x,
  * added in RN and the total is raised by 2^-50 of itself (more than the RN
  * error of those few additions) and one step: one rounding for the lot.
  */
-void aa_lincomb3(aa_context *ctx, aa_form *z, const double m[3], const aa_form x[3],
-                 double c)
+/*
+ * centred: x_k - centre(x_k) in place of x_k, bit for bit what
+ * aa_add_s(ctx, &y_k, &x_k, -x_k.x0) followed by the plain row gives
+ * (y_k: the same coefficients and err, centre 0, the hull x_k's moved by
+ * -x0 and widened as aa_lincomb widens it; centred_hull), without the
+ * three copies.
+ */
+static inline __attribute__((always_inline)) void
+centred_hull(const aa_form *x, double *lo, double *hi)
 {
-    (void)ctx;
+    /* lincomb(y, 1, x, 0, NULL, -x0): hull (x.lo + 0 + c) - hb, hb from
+     * the magnitudes |x.lo| + |x.hi| + 0 + 0 + |c| (a factor 1: exact) */
+    double c = -x->x0;
+    double hb = 2.0 * fp_rounding_bound(3.0 * (fabs(x->lo) + fabs(x->hi) + 0.0 + 0.0 +
+                                               fabs(c)), 0);
+    double l = (x->lo + 0.0 + c) - hb, h = (x->hi + 0.0 + c) + hb;
+    *lo = l == l ? l : -INFINITY;
+    *hi = h == h ? h : INFINITY;
+}
+
+static inline __attribute__((always_inline)) void
+lincomb3(aa_form *z, const double m[3], const aa_form x[3], double c, bool centred)
+{
     assert(z < x || z >= x + 3);
     unsigned flags = 0;
     bool unbounded = !isfinite(c);
@@ -475,15 +500,18 @@ void aa_lincomb3(aa_context *ctx, aa_form *z, const double m[3], const aa_form x
             zn = xn;
         double fa = fabs(a);
         terms += fa * R;
-        double p = a * xk->x0;
+        double xk0 = centred ? 0.0 : xk->x0, xklo = xk->lo, xkhi = xk->hi;
+        if (centred)
+            centred_hull(xk, &xklo, &xkhi);
+        double p = a * xk0;
         x0 += p;
         centre += fabs(p);
-        cuf += fp_uflow(p, a, xk->x0);
+        cuf += fp_uflow(p, a, xk0);
         double pe = fa * xk->err;
         perr += pe;
         cuf += fp_uflow(pe, fa, xk->err);
         double l, h;
-        scale_ends(a, xk->lo, xk->hi, &l, &h);
+        scale_ends(a, xklo, xkhi, &l, &h);
         lo += l;
         hi += h;
         hull += fabs(l) + fabs(h);
@@ -505,6 +533,20 @@ void aa_lincomb3(aa_context *ctx, aa_form *z, const double m[3], const aa_form x
     z->flags = (unsigned short)flags;
     if (!isfinite(x0) || !isfinite(z->err))
         aa_unbounded(z, flags);
+}
+
+void aa_lincomb3(aa_context *ctx, aa_form *z, const double m[3], const aa_form x[3],
+                 double c)
+{
+    (void)ctx;
+    lincomb3(z, m, x, c, false);
+}
+
+void aa_lincomb3_centred(aa_context *ctx, aa_form *z, const double m[3],
+                         const aa_form x[3], double c)
+{
+    (void)ctx;
+    lincomb3(z, m, x, c, true);
 }
 
 void aa_add(aa_context *ctx, aa_form *z, const aa_form *x, const aa_form *y)

@@ -80,6 +80,8 @@ void aa_from_interval(aa_context *ctx, aa_form *z, ia_interval x);
 void aa_unbounded(aa_form *z, unsigned flags);
 ia_interval aa_range(const aa_form *x);   /* affine range (rounded outward) meet hull */
 double aa_radius(const aa_form *x);                   /* sum |xi| + err, up */
+/* aa_range(x), and aa_radius(x) in *radius, the sum taken once */
+ia_interval aa_range_radius(const aa_form *x, double *radius);
 bool aa_is_point(const aa_form *x);                   /* no noise at all */
 
 /* ---- affine operations: exact up to rounding, no new symbol ---- */
@@ -96,6 +98,11 @@ void aa_lincomb(aa_context *ctx, aa_form *z, double a, const aa_form *x,
  * transformation applied to a triple); z must not be one of x[0..2] */
 void aa_lincomb3(aa_context *ctx, aa_form *z, const double m[3], const aa_form x[3],
                  double c);
+/* z = m[0]*(x[0] - x[0].x0) + m[1]*(x[1] - x[1].x0) + m[2]*(x[2] - x[2].x0) + c:
+ * bit for bit aa_lincomb3 of the three aa_add_s(x[k], -x[k].x0), without
+ * them (a linearisation about the inputs' centres: noise) */
+void aa_lincomb3_centred(aa_context *ctx, aa_form *z, const double m[3],
+                         const aa_form x[3], double c);
 
 /* Adds delta >= 0 (an upper bound, already rounded up) as a new error of z:
  * on a fresh noise symbol while the context has one, else on z->err. The

@@ -851,7 +851,7 @@ static void fade_derivative_max(double a, double b, double out[3])
  * inlined once per dim (taylor_model), so the loops unroll. */
 static inline __attribute__((always_inline)) void
 taylor_model_d(int dim, const box_query *q, const point_jet *P, box_result *res,
-               double *rem3, double *grad_share)
+               double *rem3, double *grad_share, bool want_grad)
 {
     static const double gmax_of[5] = { 0, 8, 1, 1, 1 }, gm_of[5] = { 0, 8, 1, 1, 1 };
     static const int m_of[5] = { 0, 1, 2, 2, 3 };
@@ -907,23 +907,28 @@ taylor_model_d(int dim, const box_query *q, const point_jet *P, box_result *res,
     for (int i = 0; i < dim; i++) {
         double Miii = L * S[i][3] + 3.0 * gm * S[i][2];
         c3 += Miii * (r[i] * r[i] * r[i]);
-        gr[i] += 0.5 * Miii * (r[i] * r[i]);
+        if (want_grad)
+            gr[i] += 0.5 * Miii * (r[i] * r[i]);
         for (int j = 0; j < dim; j++) {
             if (j == i)
                 continue;
             double Miij = L * S[i][2] * S[j][1] + 2.0 * gm * S[i][1] * S[j][1] + gm * S[i][2];
             c3 += 3.0 * Miij * (r[i] * r[i] * r[j]);
-            gr[i] += Miij * (r[i] * r[j]);           /* pairs (i, j), (j, i) */
-            gr[j] += 0.5 * Miij * (r[i] * r[i]);     /* pair (i, i) */
+            if (want_grad) {
+                gr[i] += Miij * (r[i] * r[j]);           /* pairs (i, j), (j, i) */
+                gr[j] += 0.5 * Miij * (r[i] * r[i]);     /* pair (i, i) */
+            }
         }
         for (int j = i + 1; j < dim; j++)
             for (int k = j + 1; k < dim; k++) {
                 double Mijk = L * S[i][1] * S[j][1] * S[k][1] +
                               gm * (S[j][1] * S[k][1] + S[i][1] * S[k][1] + S[i][1] * S[j][1]);
                 c3 += 6.0 * Mijk * (r[i] * r[j] * r[k]);
-                gr[i] += Mijk * (r[j] * r[k]);
-                gr[j] += Mijk * (r[i] * r[k]);
-                gr[k] += Mijk * (r[i] * r[j]);
+                if (want_grad) {
+                    gr[i] += Mijk * (r[j] * r[k]);
+                    gr[j] += Mijk * (r[i] * r[k]);
+                    gr[k] += Mijk * (r[i] * r[j]);
+                }
             }
     }
     c3 = c3 / 6.0 * TAYLOR_SUM_SCALE;
@@ -933,9 +938,12 @@ taylor_model_d(int dim, const box_query *q, const point_jet *P, box_result *res,
     jet C;
     point_jet_enclosure(dim, P, &C);
 
-    /* gradient over the box: g_j + sum_k H_jk d_k + R_j */
+    /* gradient over the box: g_j + sum_k H_jk d_k + R_j (only for a
+     * caller that wants it: noise_aa and noise_ia do not) */
     *grad_share = 0.0;
-    for (int j = 0; j < dim; j++) {
+    for (int j = 0; j < dim && !want_grad; j++)
+        res->grad[j] = iv_mk(-INFINITY, INFINITY);
+    for (int j = 0; j < dim && want_grad; j++) {
         double w = e[1];
         for (int k = 0; k < dim; k++) {
             double h = j <= k ? P->h[j][k] : P->h[k][j];
@@ -987,14 +995,18 @@ taylor_model_d(int dim, const box_query *q, const point_jet *P, box_result *res,
 }
 
 static void taylor_model(const box_query *q, const point_jet *P, box_result *res,
-                         double *rem3, double *grad_share)
+                         double *rem3, double *grad_share, bool want_grad)
 {
+#define TAYLOR_GRAD(D)                                                        \
+    if (want_grad) taylor_model_d(D, q, P, res, rem3, grad_share, true);      \
+    else taylor_model_d(D, q, P, res, rem3, grad_share, false);
     switch (q->dim) {
-    case 1: taylor_model_d(1, q, P, res, rem3, grad_share); break;
-    case 2: taylor_model_d(2, q, P, res, rem3, grad_share); break;
-    case 3: taylor_model_d(3, q, P, res, rem3, grad_share); break;
-    default: taylor_model_d(4, q, P, res, rem3, grad_share); break;
+    case 1: TAYLOR_GRAD(1) break;
+    case 2: TAYLOR_GRAD(2) break;
+    case 3: TAYLOR_GRAD(3) break;
+    default: TAYLOR_GRAD(4) break;
     }
+#undef TAYLOR_GRAD
 }
 
 /* The box methods (sl_noise_set_box_method): per thread, for tests and
@@ -1009,8 +1021,10 @@ void sl_noise_set_box_method(int method)
 /*
  * Encloses N = 0.5 + K raw over the box (and, with want_affine, its
  * linearisation at the centre; with want_grad, its gradient is what the
- * caller wants most). Returns false when only the global range
- * [0, 1] is known (non-finite or huge box, or 3+ cells along an axis).
+ * caller wants most: without it res->grad may be the whole line, the
+ * Taylor model skips the gradient's terms). Returns false when only the
+ * global range [0, 1] is known (non-finite or huge box, or 3+ cells
+ * along an axis).
  *
  * The Taylor model first (one float jet at the centre); where its
  * third-order remainder is more than NOISE_TAYLOR_SHARE of its radius
@@ -1036,7 +1050,7 @@ static bool enclose(const box_query *q, bool want_affine, bool want_grad,
         return enclose_jets(q, want_affine, &P, res);
 
     double rem3, grad_share;
-    taylor_model(q, &P, res, &rem3, &grad_share);
+    taylor_model(q, &P, res, &rem3, &grad_share, want_grad);
     double K = noise_scale[dim];
     double rho = 0.5 * (res->range.hi - res->range.lo);
     double rem = K * rem3;
@@ -1277,8 +1291,8 @@ static void noise_aa(aa_context *ctx, aa_form *out, int dim, const aa_form *p,
          * (the Taylor expansion runs from x0 to every value, so the
          * segment must lie in the box where the Hessian is enclosed).
          * |x - x0| is bounded both by the form's radius and by the box. */
-        ia_interval R = aa_range(&p[k]);
-        double c = p[k].x0, rad = aa_radius(&p[k]);
+        double c = p[k].x0, rad;
+        ia_interval R = aa_range_radius(&p[k], &rad);
         q.lo[k] = R.lo < c ? R.lo : c;
         q.hi[k] = R.hi > c ? R.hi : c;
         q.c[k] = c;
@@ -1306,18 +1320,21 @@ static void noise_aa(aa_context *ctx, aa_form *out, int dim, const aa_form *p,
 
     /* n0 + sum alpha_k (x_k - c_k): y_k is x_k with its centre removed
      * (exactly: the same coefficients, centre x0 - x0 = 0); the rounding of
-     * the combination goes to err in aa_lincomb. */
-    aa_form y[4];
-    for (int k = 0; k < dim; k++)
-        aa_add_s(ctx, &y[k], &p[k], -p[k].x0);    /* x0 - x0: exact */
-    if (dim == 1) {
-        aa_lincomb(ctx, out, res.alpha[0], &y[0], 0.0, NULL, res.n0);
-    } else if (dim == 3) {
-        aa_lincomb3(ctx, out, res.alpha, y, res.n0);      /* one pass */
+     * the combination goes to err in aa_lincomb. In 3D (point noise, the
+     * usual case) aa_lincomb3_centred does both in one pass, bit for bit. */
+    if (dim == 3) {
+        aa_lincomb3_centred(ctx, out, res.alpha, p, res.n0);   /* one pass */
     } else {
-        aa_lincomb(ctx, out, res.alpha[0], &y[0], res.alpha[1], &y[1], res.n0);
-        for (int k = 2; k < dim; k++)
-            aa_lincomb(ctx, out, 1.0, out, res.alpha[k], &y[k], 0.0);
+        aa_form y[4];
+        for (int k = 0; k < dim; k++)
+            aa_add_s(ctx, &y[k], &p[k], -p[k].x0);    /* x0 - x0: exact */
+        if (dim == 1) {
+            aa_lincomb(ctx, out, res.alpha[0], &y[0], 0.0, NULL, res.n0);
+        } else {
+            aa_lincomb(ctx, out, res.alpha[0], &y[0], res.alpha[1], &y[1], res.n0);
+            for (int k = 2; k < dim; k++)
+                aa_lincomb(ctx, out, 1.0, out, res.alpha[k], &y[k], 0.0);
+        }
     }
     /* +- delta on a new symbol; the hull (of the linear part) widens by it */
     double hull_lo = fp_add_dn(out->lo, -res.delta), hull_hi = fp_add_up(out->hi, res.delta);

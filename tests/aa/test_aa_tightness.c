@@ -4,6 +4,8 @@
  *
  *   x - x                    exactly [0, 0] in affine mode, for x from aa_input
  *                            over random ranges (tiny, huge, subnormal, ...)
+ *   lincomb3, centred        aa_lincomb3_centred equals aa_add_s(x, -x0) three
+ *                            times and aa_lincomb3, bit for bit
  *   x*(1-x) over [0,1]       affine range strictly narrower than interval's
  *   (x+1)*(x-1) - x*x        over [2,3]: affine near -1, width < 0.1 of IA's
  *   sqr over [-1,1]          [0, 1] in both modes (Chebyshev square in AA)
@@ -139,6 +141,67 @@ static void test_x_minus_x_is_zero(void **state)
         ia_interval r = aa_range(&z);
         printf("y - y for y = 2u - v/4 + 3 (aa_lincomb): [%a, %a]\n", r.lo, r.hi);
     }
+}
+
+/* ---- aa_lincomb3_centred is aa_lincomb3 of the centred inputs ---- */
+
+static bool same_bits(double a, double b)
+{
+    return memcmp(&a, &b, sizeof a) == 0;
+}
+
+static bool same_form(const aa_form *a, const aa_form *b)
+{
+    if (!same_bits(a->x0, b->x0) || !same_bits(a->err, b->err) || !same_bits(a->lo, b->lo) ||
+        !same_bits(a->hi, b->hi) || a->n != b->n || a->flags != b->flags)
+        return false;
+    for (int i = 0; i < a->n; i++)
+        if (!same_bits(a->c[i], b->c[i]))
+            return false;
+    return true;
+}
+
+/* noise's linearisation (common/sl/noise_bound.c) takes the one-pass
+ * form; it must be the three aa_add_s and aa_lincomb3 to the bit, over
+ * inputs with errors, hulls narrower than their affine ranges, flags and
+ * every scale random_range gives (an unbounded input included) */
+static void test_lincomb3_centred_bitwise(void **state)
+{
+    (void)state;
+    long bad = 0;
+    for (int i = 0; i < 40000; i++) {
+        aa_context ctx;
+        aa_context_init(&ctx, 2 + i % 7);
+        aa_form u, v, x[3], y[3], z1, z2;
+        double lo, hi;
+        random_range(i % 6, &lo, &hi);
+        aa_input(&ctx, &u, lo, hi);
+        random_range((i / 6) % 6, &lo, &hi);
+        aa_input(&ctx, &v, lo, hi);
+        aa_lincomb(&ctx, &x[0], rng_unit() * 4 - 2, &u, rng_unit() - 0.5, &v, rng_unit() * 8 - 4);
+        aa_mul(&ctx, &x[1], &u, &v);                 /* an error symbol, a hull */
+        aa_sin(&ctx, &x[2], &x[0]);                  /* a hull narrower than the form */
+        if (i % 97 == 0)
+            aa_floor(&ctx, &x[1], &x[1]);            /* AA_DISCONTINUOUS */
+        if (i % 101 == 0)
+            aa_unbounded(&x[2], 0);
+        double m[3] = { rng_unit() * 2 - 1, i % 5 == 0 ? 0.0 : rng_unit() * 100 - 50,
+                        ldexp(rng_unit(), (int)(rng_next() % 40) - 20) };
+        double c = rng_unit() * 2 - 1;
+        for (int k = 0; k < 3; k++)
+            aa_add_s(&ctx, &y[k], &x[k], -x[k].x0);
+        aa_lincomb3(&ctx, &z1, m, y, c);
+        aa_lincomb3_centred(&ctx, &z2, m, x, c);
+        if (!same_form(&z1, &z2)) {
+            if (bad < 5)
+                printf("case %d: centred x0 %a err %a [%a, %a] n %d / plain x0 %a err %a "
+                       "[%a, %a] n %d\n", i, z2.x0, z2.err, z2.lo, z2.hi, z2.n, z1.x0, z1.err,
+                       z1.lo, z1.hi, z1.n);
+            bad++;
+        }
+    }
+    printf("lincomb3 of centred inputs: %ld of 40000 differ from aa_add_s + aa_lincomb3\n", bad);
+    assert_int_equal(bad, 0);
 }
 
 /* ---- dependency: x*(1-x) ---- */
@@ -587,6 +650,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_x_minus_x_is_zero),
+        cmocka_unit_test(test_lincomb3_centred_bitwise),
         cmocka_unit_test(test_x_times_one_minus_x),
         cmocka_unit_test(test_difference_of_squares),
         cmocka_unit_test(test_sqr_symmetric),
