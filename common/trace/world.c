@@ -14,6 +14,7 @@
 
 #include <assert.h>
 #include <math.h>
+#include <pthread.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -196,6 +197,70 @@ static void add_edges(world_edge **e, size_t *n, size_t *cap, const geom_surface
     }
 }
 
+/* One thread's share of a mesh's pieces [k0, k1): their edges (in piece
+ * order) and, undisplaced, their bounds. */
+typedef struct edge_share {
+    const trace_object *obj;
+    int k0, k1;
+    world_edge *e;
+    size_t n, cap;
+} edge_share;
+
+static void *mesh_edges(void *arg)
+{
+    edge_share *sh = arg;
+    trace_mesh *m = sh->obj->mesh;
+    geom_surface *tmp = xmalloc(sizeof *tmp);
+    for (int k = sh->k0; k < sh->k1; k++) {
+        int npv;
+        if (!m->piece(m->user, sh->obj, k, tmp, NULL, &npv)) continue;
+        if (!sh->obj->displacement) trace_mesh_piece_bounds(tmp, m->bounds[k]);
+        add_edges(&sh->e, &sh->n, &sh->cap, tmp, sh->obj, m->first_id + k);
+    }
+    free(tmp);
+    return NULL;
+}
+
+/* The pass over mesh object obj's pieces, over the world's build threads:
+ * each share's edges are appended to *e in piece order, so the list (and
+ * everything after it) is the one a single thread makes. */
+static void mesh_edges_in_parallel(const trace_world *world, const trace_object *obj,
+                                   world_edge **e, size_t *n, size_t *cap)
+{
+    int npieces = obj->mesh->npieces;
+    int threads = world->options.build_threads;
+    /* a thread is worth its start for a few thousand pieces */
+    if (threads > npieces / 4096) threads = npieces / 4096;
+    if (threads < 1) threads = 1;
+    edge_share *share = xcalloc((size_t)threads, sizeof *share);
+    pthread_t *tid = xcalloc((size_t)threads, sizeof *tid);
+    bool *started = xcalloc((size_t)threads, sizeof *started);
+    for (int i = 0; i < threads; i++) {
+        share[i].obj = obj;
+        share[i].k0 = (int)((long)npieces * i / threads);
+        share[i].k1 = (int)((long)npieces * (i + 1) / threads);
+        share[i].cap = 3 * (size_t)(share[i].k1 - share[i].k0) + 1;
+        share[i].e = xmalloc(sizeof *share[i].e * share[i].cap);
+        if (i > 0) started[i] = pthread_create(&tid[i], NULL, mesh_edges, &share[i]) == 0;
+    }
+    mesh_edges(&share[0]);
+    for (int i = 1; i < threads; i++)
+        if (started[i]) pthread_join(tid[i], NULL);
+        else mesh_edges(&share[i]);    /* no thread: this one does its share */
+    for (int i = 0; i < threads; i++) {
+        if (*n + share[i].n > *cap) {
+            *cap = *n + share[i].n;
+            *e = xreallocarray(*e, *cap, sizeof **e);
+        }
+        memcpy(*e + *n, share[i].e, sizeof **e * share[i].n);
+        *n += share[i].n;
+        free(share[i].e);
+    }
+    free(started);
+    free(tid);
+    free(share);
+}
+
 /* The edges polygons share (the meshes of Polygon and PointsPolygons
  * calls, whose shared vertices are the same numbers under the same
  * transform): the hit proofs (intersect.c) stay off near them, where the
@@ -226,18 +291,12 @@ static void find_shared_edges(trace_world *world, const int *meshes, int nmeshes
     for (int i = 0; i < world->nobjects; i++)
         if (!world->objects[i].mesh && !world->objects[i].group)
             add_edges(&e, &n, &cap, &world->objects[i].surf, &world->objects[i], i);
-    geom_surface *tmp = xmalloc(sizeof *tmp);
     for (int j = 0; j < nmeshes; j++) {
         trace_object *obj = &world->objects[meshes[j]];
         trace_mesh *m = obj->mesh;
         if (!obj->displacement)
             m->bounds = xmalloc(sizeof *m->bounds * (size_t)(m->npieces > 0 ? m->npieces : 1));
-        for (int k = 0; k < m->npieces; k++) {
-            int npv;
-            if (!m->piece(m->user, obj, k, tmp, NULL, &npv)) continue;
-            if (!obj->displacement) trace_mesh_piece_bounds(tmp, m->bounds[k]);
-            add_edges(&e, &n, &cap, tmp, obj, m->first_id + k);
-        }
+        mesh_edges_in_parallel(world, obj, &e, &n, &cap);
     }
     qsort(e, n, sizeof *e, world_edge_cmp);
     for (size_t i = 0; i + 1 < n; i++) {
@@ -247,7 +306,6 @@ static void find_shared_edges(trace_world *world, const int *meshes, int nmeshes
         mark_shared(world, meshes, nmeshes, e[j].ref);
     }
     free(e);
-    free(tmp);
 }
 
 bool trace_object_derive(const trace_world *world, trace_object *obj, bool grid, char *err,

@@ -366,33 +366,47 @@ static void test_instances_render_as_copies(void **state)
 static void test_boxes_by_threads(void **state)
 {
     (void)state;
-    char *rib = torus_rib(80, 40, "Displacement \"lift\"\n");
-    job_options opt;
-    job_options_default(&opt);
-    job *jb = job_new("torus.rib", rib, strlen(rib), &opt);
-    free(rib);
-    char err[256];
-    assert_true(job_add_source(jb, "lift.sl", LIFT_SL, strlen(LIFT_SL), err, sizeof err));
-    assert_true(job_add_shader(jb, "lift", "lift.sl", err, sizeof err));
-    assert_true(job_finish(jb, err, sizeof err));
-    job_scene *js[2];
-    for (int i = 0; i < 2; i++) {
-        sl_diag *d = sl_diag_new();
-        js[i] = job_scene_new_threads(jb, 0, true, i == 0 ? 1 : 4, NULL, d);
-        if (!js[i]) sl_diag_print(d, stderr);
-        assert_non_null(js[i]);
-        sl_diag_destroy(&d);
+    /* 12,000 pieces: enough for the pieces' pass to take 2 threads of the 4
+     * (world.c), and for the displaced roots' */
+    enum { NU = 100, NV = 60 };
+    for (int displaced = 0; displaced < 2; displaced++) {
+        char *rib = torus_rib(NU, NV, displaced ? "Displacement \"lift\"\n" : "");
+        job_options opt;
+        job_options_default(&opt);
+        job *jb = job_new("torus.rib", rib, strlen(rib), &opt);
+        free(rib);
+        char err[256];
+        assert_true(job_add_source(jb, "lift.sl", LIFT_SL, strlen(LIFT_SL), err, sizeof err));
+        assert_true(job_add_shader(jb, "lift", "lift.sl", err, sizeof err));
+        assert_true(job_finish(jb, err, sizeof err));
+        job_scene *js[2];
+        for (int i = 0; i < 2; i++) {
+            sl_diag *d = sl_diag_new();
+            js[i] = job_scene_new_threads(jb, 0, true, i == 0 ? 1 : 4, NULL, d);
+            if (!js[i]) sl_diag_print(d, stderr);
+            assert_non_null(js[i]);
+            sl_diag_destroy(&d);
+        }
+        const trace_mesh *a = js[0]->world.objects[0].mesh, *b = js[1]->world.objects[0].mesh;
+        size_t n = (size_t)a->npieces;
+        assert_int_equal(a->npieces, 2 * NU * NV);
+        if (displaced) {
+            assert_non_null(a->roots);
+            assert_non_null(b->roots);
+            assert_memory_equal(a->roots, b->roots, sizeof *a->roots * n);
+            assert_memory_equal(a->dudv, b->dudv, sizeof *a->dudv * n);
+        }
+        assert_memory_equal(a->bounds, b->bounds, sizeof *a->bounds * n);
+        /* the closed torus: every piece's three edges are another's */
+        int shared = 0;
+        for (size_t k = 0; k < n; k++) shared += __builtin_popcountll(a->shared_edges[k]);
+        assert_int_equal(shared, 3 * a->npieces);
+        assert_memory_equal(a->shared_edges, b->shared_edges, sizeof *a->shared_edges * n);
+        printf("%d %s pieces: the same boxes and shared edges from 1 and 4 threads\n",
+               a->npieces, displaced ? "displaced" : "undisplaced");
+        for (int i = 0; i < 2; i++) job_scene_destroy(&js[i]);
+        job_destroy(&jb);
     }
-    const trace_mesh *a = js[0]->world.objects[0].mesh, *b = js[1]->world.objects[0].mesh;
-    assert_int_equal(a->npieces, 2 * 80 * 40);
-    assert_non_null(a->roots);
-    assert_non_null(b->roots);
-    assert_memory_equal(a->roots, b->roots, sizeof *a->roots * (size_t)a->npieces);
-    assert_memory_equal(a->dudv, b->dudv, sizeof *a->dudv * (size_t)a->npieces);
-    assert_memory_equal(a->bounds, b->bounds, sizeof *a->bounds * (size_t)a->npieces);
-    printf("%d displaced pieces: the same root boxes from 1 and 4 threads\n", a->npieces);
-    for (int i = 0; i < 2; i++) job_scene_destroy(&js[i]);
-    job_destroy(&jb);
 }
 
 static void test_instances_share_the_mesh(void **state)
