@@ -35,7 +35,13 @@ static double stretch_of(const mat4 *m)
         double l = v3_length(z);
         if (!(l > 0)) break;
         s = sqrt(l / v3_length(x));
-        x = v3_scale(z, 1.0 / l);
+        vec3 next = v3_scale(z, 1.0 / l);
+        /* a fixed point to the bit: every further step would repeat this
+         * one, so s is what the 64 steps give (a rotation times a uniform
+         * scale gets there in two or three) */
+        bool same = memcmp(&next, &x, sizeof x) == 0;
+        x = next;
+        if (same) break;
     }
     return s * (1.0 + 1e-6);
 }
