@@ -68,7 +68,10 @@ static int group_leaf(void *ctx, int k)
     const trace_object *v = trace_view_get(w->th, TRACE_VIEWS_PLACES, w->g, k,
                                            trace_group_view_make);
     if (!v) return -1;
-    if (v->mesh) return trace_mesh_intersect(w->th, v, w->ray, w->tol, w->any, w->best);
+    if (v->mesh) {
+        bool hit = trace_mesh_intersect(w->th, v, w->ray, w->tol, w->any, w->best);
+        return w->th->failed ? -1 : hit;
+    }
     if (!trace_intersect_object(w->th, v, w->ray, w->tol, w->any, w->best)) return 0;
     trace_view_hit(w->th, v, w->best);
     return 1;
