@@ -3,6 +3,8 @@
 #   make test            install dependencies, build with -Werror and asserts on,
 #                        run every test
 #   make test-sanitize   the same tests under AddressSanitizer + UBSan
+#   make check-release   a Release build without asserts, warnings as errors,
+#                        compiled only (nothing run)
 #   make bench           build and run the benchmarks (figures, not tests)
 #   make bench-peers     aafarm against POV-Ray and Embree on the same surfaces:
 #                        installs them, prints the table, writes it into
@@ -13,7 +15,7 @@
 MAKEFLAGS += --no-print-directory
 JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 
-.PHONY: all deps build demo test test-sanitize bench bench-peers clean
+.PHONY: all deps build demo test test-sanitize check-release bench bench-peers clean
 
 all: build
 
@@ -42,6 +44,13 @@ test-sanitize: deps
 	@cd build-asan && ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
 		ctest --output-on-failure -j $(JOBS)
 
+# what `make build` and the benchmarks compile (-DNDEBUG: no asserts), with
+# warnings as errors: a variable only an assert() reads must still compile
+# cleanly ((void)x), and -O3's maybe-uninitialized analysis must agree
+check-release: deps
+	@cmake -S . -B build-release -DCMAKE_BUILD_TYPE=Release -DAAFARM_ASSERTS=OFF -DAAFARM_WERROR=ON >/dev/null
+	@cmake --build build-release -j $(JOBS)
+
 bench: build
 	@build/bin/aa_bench
 	@build/bin/render_bench
@@ -50,4 +59,4 @@ bench-peers: deps
 	@QUICK=$(QUICK) MESHES=$(MESHES) bash bench/peers/run.sh
 
 clean:
-	rm -rf build build-test build-asan build-bench
+	rm -rf build build-test build-asan build-bench build-release

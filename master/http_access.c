@@ -108,6 +108,15 @@ bool http_token_read_file(const char *path, char *buf, size_t bufsz, char *err, 
     return true;
 }
 
+bool http_token_option(const char *text, bool from_file, char *buf, size_t bufsz, char *err,
+                       size_t errsz)
+{
+    if (from_file) return http_token_read_file(text, buf, bufsz, err, errsz);
+    if (!http_token_check(text, err, errsz)) return false;
+    snprintf(buf, bufsz, "%s", text);
+    return true;
+}
+
 bool http_token_equal(const char *token, const char *given)
 {
     if (!given) return false;

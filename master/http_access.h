@@ -44,6 +44,12 @@ bool http_token_check(const char *token, char *err, size_t errsz);
  * HTTP_TOKEN_MAX) and checks it; false with a message naming the file. */
 bool http_token_read_file(const char *path, char *buf, size_t bufsz, char *err, size_t errsz);
 
+/* A token option of a command line into buf (bufsz > HTTP_TOKEN_MAX):
+ * from_file, the file `text` names (http_token_read_file), else `text`
+ * itself, checked (http_token_check); false with a message. */
+bool http_token_option(const char *text, bool from_file, char *buf, size_t bufsz, char *err,
+                       size_t errsz);
+
 /* Does given equal token? Constant time in the token's length; NULL
  * given: no. */
 bool http_token_equal(const char *token, const char *given);

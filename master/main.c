@@ -120,6 +120,16 @@ static bool number_arg(const char *opt, const char *noun, long lo, long hi, long
     return false;
 }
 
+/* optarg as the job option opt (--tile, --arith, --budget) into *opts;
+ * false after printing why. */
+static bool job_arg(job_options *opts, const char *opt)
+{
+    char err[ERR_LEN];
+    if (job_options_parse_arg(opts, opt, optarg, err, sizeof err)) return true;
+    fprintf(stderr, "aafarm-master: %s\n", err);
+    return false;
+}
+
 /* --http: a valid address; a token for one other hosts can reach (as
  * --bind wants CURVE). False after printing why. */
 static bool check_http(const farm_options *f)
@@ -206,21 +216,9 @@ static int parse(int argc, char **argv, cli *c)
             if (!number_arg("--threads-per-worker", NULL, 1, 1024, &n)) return AAFARM_EXIT_USAGE;
             f->threads_per_worker = (int)n;
             break;
-        case O_TILE:
-            if (!number_arg("--tile", "a size", 1, 1024, &n)) return AAFARM_EXIT_USAGE;
-            c->job.tile_size = (int)n;
-            break;
-        case O_ARITH:
-            if (!trace_arith_parse(optarg, &c->job.arith)) {
-                fprintf(stderr, "aafarm-master: --arith wants 'affine' or 'interval', got '%s'\n",
-                        optarg);
-                return AAFARM_EXIT_USAGE;
-            }
-            break;
-        case O_BUDGET:
-            if (!number_arg("--budget", "a number", 1000, 1000000000L, &n)) return AAFARM_EXIT_USAGE;
-            c->job.max_instructions = n;
-            break;
+        case O_TILE: if (!job_arg(&c->job, "--tile")) return AAFARM_EXIT_USAGE; break;
+        case O_ARITH: if (!job_arg(&c->job, "--arith")) return AAFARM_EXIT_USAGE; break;
+        case O_BUDGET: if (!job_arg(&c->job, "--budget")) return AAFARM_EXIT_USAGE; break;
         case O_PREVIEW: f->preview = optarg; break;
         case O_STATS_JSON: f->stats_json = optarg; break;
         case O_HEARTBEAT:
@@ -271,14 +269,11 @@ static int parse(int argc, char **argv, cli *c)
         case O_HTTP_TOKEN:
         case O_HTTP_TOKEN_FILE: {
             char err[ERR_LEN];
-            bool ok = ch == O_HTTP_TOKEN_FILE
-                ? http_token_read_file(optarg, c->http_token, sizeof c->http_token, err, sizeof err)
-                : http_token_check(optarg, err, sizeof err);
-            if (!ok) {
+            if (!http_token_option(optarg, ch == O_HTTP_TOKEN_FILE, c->http_token,
+                                   sizeof c->http_token, err, sizeof err)) {
                 fprintf(stderr, "aafarm-master: %s\n", err);
                 return AAFARM_EXIT_USAGE;
             }
-            if (ch == O_HTTP_TOKEN) snprintf(c->http_token, sizeof c->http_token, "%s", optarg);
             f->http_token = c->http_token;
             break;
         }

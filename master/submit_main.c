@@ -329,6 +329,16 @@ static bool number_arg(const char *opt, long lo, long hi, long *n)
     return false;
 }
 
+/* optarg as the job option opt (--tile, --arith, --budget) into *opts;
+ * false after printing why. */
+static bool job_arg(job_options *opts, const char *opt)
+{
+    char err[ERR_LEN];
+    if (job_options_parse_arg(opts, opt, optarg, err, sizeof err)) return true;
+    fprintf(stderr, "aafarm-submit: %s\n", err);
+    return false;
+}
+
 static int parse(int argc, char **argv, cli *c)
 {
     enum { O_MASTER = 256, O_PRIORITY, O_FRAMES, O_WAIT, O_LIST, O_CANCEL, O_TOKEN,
@@ -352,7 +362,6 @@ static int parse(int argc, char **argv, cli *c)
         {"version", no_argument, 0, 'V'},
         {0, 0, 0, 0}};
     int ch;
-    long n;
     char err[ERR_LEN];
     opterr = 0;
     while ((ch = getopt_long(argc, argv, ":o:qh", longopts, NULL)) != -1) {
@@ -376,33 +385,17 @@ static int parse(int argc, char **argv, cli *c)
             if (!number_arg("--cancel", 1, 1000000000000L, &c->cancel)) return AAFARM_EXIT_USAGE;
             break;
         case O_TOKEN:
-        case O_TOKEN_FILE: {
-            bool ok = ch == O_TOKEN_FILE
-                ? http_token_read_file(optarg, c->token, sizeof c->token, err, sizeof err)
-                : http_token_check(optarg, err, sizeof err);
-            if (!ok) {
+        case O_TOKEN_FILE:
+            if (!http_token_option(optarg, ch == O_TOKEN_FILE, c->token, sizeof c->token, err,
+                                   sizeof err)) {
                 fprintf(stderr, "aafarm-submit: %s\n", err);
                 return AAFARM_EXIT_USAGE;
             }
-            if (ch == O_TOKEN) snprintf(c->token, sizeof c->token, "%s", optarg);
             c->has_token = true;
             break;
-        }
-        case O_TILE:
-            if (!number_arg("--tile", 1, 1024, &n)) return AAFARM_EXIT_USAGE;
-            c->job.tile_size = (int)n;
-            break;
-        case O_ARITH:
-            if (!trace_arith_parse(optarg, &c->job.arith)) {
-                fprintf(stderr, "aafarm-submit: --arith wants 'affine' or 'interval', got '%s'\n",
-                        optarg);
-                return AAFARM_EXIT_USAGE;
-            }
-            break;
-        case O_BUDGET:
-            if (!number_arg("--budget", 1000, 1000000000L, &n)) return AAFARM_EXIT_USAGE;
-            c->job.max_instructions = n;
-            break;
+        case O_TILE: if (!job_arg(&c->job, "--tile")) return AAFARM_EXIT_USAGE; break;
+        case O_ARITH: if (!job_arg(&c->job, "--arith")) return AAFARM_EXIT_USAGE; break;
+        case O_BUDGET: if (!job_arg(&c->job, "--budget")) return AAFARM_EXIT_USAGE; break;
         case 'q': c->quiet = true; break;
         case 'h': usage(stdout); return AAFARM_EXIT_OK;
         case 'V': printf("aafarm-submit %s\n", cli_version()); return AAFARM_EXIT_OK;

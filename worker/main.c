@@ -94,6 +94,16 @@ static bool number_arg(const char *opt, const char *noun, long lo, long hi, long
     return false;
 }
 
+/* optarg as the job option opt (--tile, --arith, --budget) into *opts;
+ * false after printing why. */
+static bool job_arg(job_options *opts, const char *opt)
+{
+    char err[ERR_LEN];
+    if (job_options_parse_arg(opts, opt, optarg, err, sizeof err)) return true;
+    fprintf(stderr, "aafarm-worker: %s\n", err);
+    return false;
+}
+
 /* The box cache budget per render thread when --cache-bytes is not given:
  * bounded, so a worker's memory does not grow with the image (unlimited
  * grows ~140 bytes per pixel), and large enough that the boxes computed
@@ -174,10 +184,7 @@ int main(int argc, char **argv)
             if (!number_arg("--threads", "a number", 1, 1024, &n)) return AAFARM_EXIT_USAGE;
             so.threads = wo.threads = (int)n;
             break;
-        case O_TILE:
-            if (!number_arg("--tile", "a size", 1, 1024, &n)) return AAFARM_EXIT_USAGE;
-            so.job.tile_size = (int)n;
-            break;
+        case O_TILE: if (!job_arg(&so.job, "--tile")) return AAFARM_EXIT_USAGE; break;
         case O_CACHE:
             if (!parse_byte_count(optarg, &so.cache_bytes)) {
                 fprintf(stderr, "aafarm-worker: --cache-bytes wants e.g. 40K, 4M or 0, got '%s'\n", optarg);
@@ -185,16 +192,8 @@ int main(int argc, char **argv)
             }
             wo.cache_bytes = so.cache_bytes;
             break;
-        case O_ARITH:
-            if (!trace_arith_parse(optarg, &so.job.arith)) {
-                fprintf(stderr, "aafarm-worker: --arith wants 'affine' or 'interval', got '%s'\n", optarg);
-                return AAFARM_EXIT_USAGE;
-            }
-            break;
-        case O_BUDGET:
-            if (!number_arg("--budget", "a number", 1000, 1000000000L, &n)) return AAFARM_EXIT_USAGE;
-            so.job.max_instructions = n;
-            break;
+        case O_ARITH: if (!job_arg(&so.job, "--arith")) return AAFARM_EXIT_USAGE; break;
+        case O_BUDGET: if (!job_arg(&so.job, "--budget")) return AAFARM_EXIT_USAGE; break;
         case O_PREVIEW: so.preview = optarg; break;
         case O_STATS: so.stats = true; break;
         case O_STATS_JSON: so.stats_json = optarg; break;

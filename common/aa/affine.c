@@ -25,6 +25,7 @@
  * fits a form (every form's n <= AA_MAX_SYMBOLS follows from it). */
 static inline void check_context(const aa_context *ctx)
 {
+    (void)ctx;   /* without asserts */
     assert(ctx->used >= 0 && ctx->used <= ctx->capacity);
     assert(ctx->capacity <= AA_MAX_SYMBOLS);
 }

@@ -83,6 +83,7 @@ void sd_local_take(sd_local *L, const sd_mesh *M, const int *list, int n)
 {
     L->m = (sd_mesh){ 0, 0, L->P, L->vs, L->fo, L->fv, L->es };
     int lf = sd_lf(L->maxval), lc = sd_lc(L->maxval);
+    (void)lf, (void)lc;   /* without asserts */
     int *src = L->src;
     int nc = 0;
     L->fo[0] = 0;
@@ -109,6 +110,7 @@ void sd_local_take(sd_local *L, const sd_mesh *M, const int *list, int n)
 
 static void add_face(int *list, int *n, int cap, int f)
 {
+    (void)cap;   /* without asserts */
     for (int i = 0; i < *n; i++)
         if (list[i] == f) return;
     assert(*n < cap);   /* a quad's corners have at most 4 maxval faces */

@@ -3,6 +3,7 @@
  */
 #include "job/job.h"
 #include "util/err.h"
+#include "util/parse_num.h"
 #include "util/suggest.h"
 #include "util/xalloc.h"
 
@@ -24,6 +25,28 @@ void job_options_default(job_options *opt)
     opt->tile_size = 32;
     opt->max_instructions = 1000000;
     opt->frame = 0;
+}
+
+bool job_options_parse_arg(job_options *self, const char *opt, const char *text, char *err,
+                           size_t errsz)
+{
+    long n;
+    if (strcmp(opt, "--arith") == 0) {
+        if (trace_arith_parse(text, &self->arith)) return true;
+        return err_set(err, errsz, "--arith wants 'affine' or 'interval', got '%s'", text);
+    }
+    if (strcmp(opt, "--tile") == 0) {
+        if (!parse_option_long(opt, "a size", text, JOB_TILE_SIZE_MIN, JOB_TILE_SIZE_MAX, &n, err,
+                               errsz))
+            return false;
+        self->tile_size = (int)n;
+        return true;
+    }
+    assert(strcmp(opt, "--budget") == 0);
+    if (!parse_option_long(opt, "a number", text, JOB_BUDGET_MIN, JOB_BUDGET_MAX, &n, err, errsz))
+        return false;
+    self->max_instructions = n;
+    return true;
 }
 
 const char *trace_arith_name(trace_arith arith)

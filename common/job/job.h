@@ -57,6 +57,20 @@ typedef struct job_options {
 
 void job_options_default(job_options *opt);
 
+/* The limits of the options that decide pixels, the same on every
+ * program's command line (--tile, --budget). */
+#define JOB_TILE_SIZE_MIN 1
+#define JOB_TILE_SIZE_MAX 1024
+#define JOB_BUDGET_MIN 1000L
+#define JOB_BUDGET_MAX 1000000000L
+
+/* One of the command-line options every program that makes a job takes:
+ * opt "--tile" (a size), "--arith" (affine|interval) or "--budget" (a
+ * number), its value text into *self. False with the message "OPT wants
+ * ..., got 'TEXT'" in err (the program prefixes its name). */
+bool job_options_parse_arg(job_options *self, const char *opt, const char *text, char *err,
+                           size_t errsz);
+
 /* The name prefix of the job files that are archives (see above). */
 #define JOB_ARCHIVE_PREFIX "archive:"
 

@@ -120,6 +120,7 @@ void sl_program_assert_valid(const sl_program *p)
         assert(in->op < SL_OP__COUNT);
         const char *k = kinds[in->op];
         const uint16_t ops[4] = { in->a, in->b, in->c, in->d };
+        (void)ops;   /* without asserts */
         for (int i = 0; i < 4; i++) {
             if (k[i] == 'x' || k[i] == 'z')
                 assert(ops[i] < p->nslots && "a slot operand lies inside the program's slots");

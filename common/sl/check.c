@@ -39,6 +39,7 @@
 
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 
@@ -1075,18 +1076,55 @@ static void check_recursion(checker *c)
     }
 }
 
-/* Reports f when an earlier function has its name. */
-static void check_duplicate(checker *c, int i)
+/* A function of the file and its place in it, sorted by signature. */
+typedef struct func_at {
+    const sl_func *f;
+    int index;
+} func_at;
+
+/* Name, parameters (type, output), return type, then place in the file. */
+static int compare_signature(const void *pa, const void *pb)
 {
-    sl_func *f = c->file->funcs[i];
-    for (int j = 0; j < i; j++) {
-        sl_func *g = c->file->funcs[j];
-        if (strcmp(f->name, g->name) == 0 && same_params(f, g) && f->ret == g->ret) {
-            ck_error(c, f->pos, "redefinition of function '%s'", f->name);
-            sl_diag_note(c->diag, c->file->funcs[j]->pos, "previous definition is here");
-            return;
-        }
+    const func_at *a = pa, *b = pb;
+    int d = strcmp(a->f->name, b->f->name);
+    if (d) return d;
+    if (a->f->nparams != b->f->nparams) return a->f->nparams < b->f->nparams ? -1 : 1;
+    for (int i = 0; i < a->f->nparams; i++) {
+        const sl_sym *p = a->f->params[i], *q = b->f->params[i];
+        if (p->ty != q->ty) return p->ty < q->ty ? -1 : 1;
+        if (p->output != q->output) return p->output ? 1 : -1;
     }
+    if (a->f->ret != b->f->ret) return a->f->ret < b->f->ret ? -1 : 1;
+    return a->index < b->index ? -1 : a->index > b->index;
+}
+
+/* first[i]: the earliest function of the file with the name, parameters
+ * and return type of function i (i itself when none comes before it).
+ * Sorting by signature makes it O(n log n) in the file's functions (a
+ * scan of the earlier ones for each took 37 s for 80,000 functions). */
+static int *first_definitions(checker *c)
+{
+    int n = c->file->nfuncs;
+    int *first = sl_arena_alloc(c->arena, (size_t)(n ? n : 1) * sizeof *first);
+    func_at *by_sig = sl_arena_alloc(c->arena, (size_t)(n ? n : 1) * sizeof *by_sig);
+    for (int i = 0; i < n; i++)
+        by_sig[i] = (func_at){c->file->funcs[i], i};
+    qsort(by_sig, (size_t)n, sizeof *by_sig, compare_signature);
+    for (int k = 0, start = 0; k < n; k++) {
+        const sl_func *f = by_sig[k].f, *g = by_sig[start].f;
+        if (strcmp(f->name, g->name) != 0 || !same_params(f, g) || f->ret != g->ret)
+            start = k;
+        first[by_sig[k].index] = by_sig[start].index;
+    }
+    return first;
+}
+
+/* Reports function i when an earlier one (first) has its signature. */
+static void check_duplicate(checker *c, int i, int first)
+{
+    if (first == i) return;
+    ck_error(c, c->file->funcs[i]->pos, "redefinition of function '%s'", c->file->funcs[i]->name);
+    sl_diag_note(c->diag, c->file->funcs[first]->pos, "previous definition is here");
 }
 
 /* Does position a come before b (same file, or the main file first)? */
@@ -1150,6 +1188,7 @@ bool sl_check(sl_ast_file *file, sl_arena *arena, const atomic_int *cancel, sl_d
     make_globals(&c);
     /* definitions in source order, so that messages come in that order */
     bool shader_done = !file->has_shader;
+    const int *first = first_definitions(&c);
     for (int i = 0; i < file->nfuncs && !sl_diag_full(diag); i++) {
         if (cancel && atomic_load_explicit(cancel, memory_order_relaxed)) {
             sl_diag_error(diag, file->funcs[i]->pos, "interrupted (SIGINT/SIGTERM) while "
@@ -1160,7 +1199,7 @@ bool sl_check(sl_ast_file *file, sl_arena *arena, const atomic_int *cancel, sl_d
             check_shader(&c);
             shader_done = true;
         }
-        check_duplicate(&c, i);
+        check_duplicate(&c, i, first[i]);
         check_function(&c, file->funcs[i]);
     }
     if (!shader_done)

@@ -429,8 +429,11 @@ point_jet_d(int dim, const double f[4], const uint32_t hs[16], int order, point_
         t[c].v = l;
         if (order == 0)
             continue;
-        for (int k = 0; k < dim; k++)
+        for (int k = 0; k < dim; k++) {
             t[c].g[k] = (double)g[k];
+            for (int m = k; m < dim; m++)
+                t[c].h[k][m] = 0.0;   /* not read (k == 0 below), but the compiler cannot tell */
+        }
     }
     for (int k = 0; k < dim; k++) {
         n >>= 1;

@@ -894,6 +894,65 @@ static sl_node *return_statement(parser *p)
     return n;
 }
 
+/* The parenthesized arguments of illuminance, illuminate or solar (the
+ * keyword kw just read), as the list of a call node; an empty list only
+ * where may_be_empty. NULL after an error. */
+static sl_node *light_args(parser *p, const sl_token *kw, const char *after, bool may_be_empty)
+{
+    sl_token open = p->cur;
+    sl_node *args = sl_node_new(p->arena, SL_N_CALL, kw->pos);
+    int cap = 0;
+    if (!expect(p, SL_TOK_LPAREN, after))
+        return NULL;
+    if (!may_be_empty || !check(p, SL_TOK_RPAREN)) {
+        do {
+            push_node(p, args, &cap, expression(p));
+        } while (!p->panic && match(p, SL_TOK_COMMA));
+    }
+    if (!expect_closing(p, SL_TOK_RPAREN, &open))
+        return NULL;
+    return args;
+}
+
+/* A call of the internal function `name` with the nargs nodes of args. */
+static sl_node *internal_call(parser *p, sl_pos pos, const char *name, sl_node *const *args,
+                              int nargs)
+{
+    sl_node *n = sl_node_new(p->arena, SL_N_CALL, pos);
+    n->name = name;
+    int cap = 0;
+    for (int i = 0; i < nargs; i++)
+        push_node(p, n, &cap, args[i]);
+    return n;
+}
+
+/* if ("illuminance cone"(axis, angle)) body */
+static sl_node *cone_test(parser *p, sl_pos pos, sl_node *const axis_angle[2], sl_node *body)
+{
+    sl_node *cone = internal_call(p, pos, "illuminance cone", axis_angle, 2);
+    sl_node *test = sl_node_new(p->arena, SL_N_IF, pos);
+    test->a = cone;
+    test->b = body;
+    return test;
+}
+
+/* The statement `call;` and the block { first second } */
+static sl_node *call_statement(parser *p, sl_pos pos, sl_node *call)
+{
+    sl_node *n = sl_node_new(p->arena, SL_N_EXPR, pos);
+    n->a = call;
+    return n;
+}
+
+static sl_node *block_of_two(parser *p, sl_pos pos, sl_node *first, sl_node *second)
+{
+    sl_node *b = sl_node_new(p->arena, SL_N_BLOCK, pos);
+    int cap = 0;
+    push_node(p, b, &cap, first);
+    push_node(p, b, &cap, second);
+    return b;
+}
+
 /* illuminance ([category,] position [, axis, angle]) statement (RI Spec 3.2
  * §15.4) becomes
  *   { "illuminance start"(position);
@@ -906,15 +965,8 @@ static sl_node *illuminance_statement(parser *p)
 {
     sl_token kw = p->cur;
     advance(p);
-    sl_token open = p->cur;
-    sl_node *args = sl_node_new(p->arena, SL_N_CALL, kw.pos);
-    int cap = 0;
-    if (!expect(p, SL_TOK_LPAREN, "after 'illuminance'"))
-        return NULL;
-    do {
-        push_node(p, args, &cap, expression(p));
-    } while (!p->panic && match(p, SL_TOK_COMMA));
-    if (!expect_closing(p, SL_TOK_RPAREN, &open))
+    sl_node *args = light_args(p, &kw, "after 'illuminance'", false);
+    if (!args)
         return NULL;
     int first = args->nlist > 0 && args->list[0]->kind == SL_N_STR ? 1 : 0;
     int n = args->nlist - first;
@@ -926,33 +978,13 @@ static sl_node *illuminance_statement(parser *p)
     sl_node *body = statement(p);
     if (!body)
         return NULL;
-    sl_node *start = sl_node_new(p->arena, SL_N_CALL, kw.pos);
-    start->name = "illuminance start";
-    int c1 = 0;
-    push_node(p, start, &c1, args->list[first]);
-    sl_node *start_stmt = sl_node_new(p->arena, SL_N_EXPR, kw.pos);
-    start_stmt->a = start;
-    sl_node *next = sl_node_new(p->arena, SL_N_CALL, kw.pos);
-    next->name = "illuminance next";
+    sl_node *start = internal_call(p, kw.pos, "illuminance start", &args->list[first], 1);
+    sl_node *start_stmt = call_statement(p, kw.pos, start);
+    sl_node *next = internal_call(p, kw.pos, "illuminance next", NULL, 0);
     sl_node *loop = sl_node_new(p->arena, SL_N_WHILE, kw.pos);
     loop->a = next;
-    loop->b = body;
-    if (n == 3) {
-        sl_node *cone = sl_node_new(p->arena, SL_N_CALL, kw.pos);
-        cone->name = "illuminance cone";
-        int c2 = 0;
-        push_node(p, cone, &c2, args->list[first + 1]);
-        push_node(p, cone, &c2, args->list[first + 2]);
-        sl_node *test = sl_node_new(p->arena, SL_N_IF, kw.pos);
-        test->a = cone;
-        test->b = body;
-        loop->b = test;
-    }
-    sl_node *b = sl_node_new(p->arena, SL_N_BLOCK, kw.pos);
-    int c3 = 0;
-    push_node(p, b, &c3, start_stmt);
-    push_node(p, b, &c3, loop);
-    return b;
+    loop->b = n == 3 ? cone_test(p, kw.pos, &args->list[first + 1], body) : body;
+    return block_of_two(p, kw.pos, start_stmt, loop);
 }
 
 /* illuminate (position [, axis, angle]) statement and solar ([axis,
@@ -966,17 +998,8 @@ static sl_node *emitter_statement(parser *p)
     sl_token kw = p->cur;
     bool solar = kw.kind == SL_KW_SOLAR;
     advance(p);
-    sl_token open = p->cur;
-    sl_node *args = sl_node_new(p->arena, SL_N_CALL, kw.pos);
-    int cap = 0;
-    if (!expect(p, SL_TOK_LPAREN, solar ? "after 'solar'" : "after 'illuminate'"))
-        return NULL;
-    if (!check(p, SL_TOK_RPAREN)) {
-        do {
-            push_node(p, args, &cap, expression(p));
-        } while (!p->panic && match(p, SL_TOK_COMMA));
-    }
-    if (!expect_closing(p, SL_TOK_RPAREN, &open))
+    sl_node *args = light_args(p, &kw, solar ? "after 'solar'" : "after 'illuminate'", true);
+    if (!args)
         return NULL;
     int n = args->nlist;
     if (solar ? (n != 0 && n != 2) : (n != 1 && n != 3)) {
@@ -988,29 +1011,12 @@ static sl_node *emitter_statement(parser *p)
     sl_node *body = statement(p);
     if (!body)
         return NULL;
-    sl_node *begin = sl_node_new(p->arena, SL_N_CALL, kw.pos);
-    begin->name = solar ? "solar begin" : "illuminate begin";
-    int c1 = 0;
-    if (n > 0)
-        push_node(p, begin, &c1, args->list[0]);
-    sl_node *begin_stmt = sl_node_new(p->arena, SL_N_EXPR, kw.pos);
-    begin_stmt->a = begin;
-    if (n == 3) {
-        sl_node *cone = sl_node_new(p->arena, SL_N_CALL, kw.pos);
-        cone->name = "illuminance cone";
-        int c2 = 0;
-        push_node(p, cone, &c2, args->list[1]);
-        push_node(p, cone, &c2, args->list[2]);
-        sl_node *test = sl_node_new(p->arena, SL_N_IF, kw.pos);
-        test->a = cone;
-        test->b = body;
-        body = test;
-    }
-    sl_node *b = sl_node_new(p->arena, SL_N_BLOCK, kw.pos);
-    int c3 = 0;
-    push_node(p, b, &c3, begin_stmt);
-    push_node(p, b, &c3, body);
-    return b;
+    sl_node *begin = internal_call(p, kw.pos, solar ? "solar begin" : "illuminate begin",
+                                   args->list, n > 0 ? 1 : 0);
+    sl_node *begin_stmt = call_statement(p, kw.pos, begin);
+    if (n == 3)
+        body = cone_test(p, kw.pos, &args->list[1], body);
+    return block_of_two(p, kw.pos, begin_stmt, body);
 }
 
 

@@ -25,7 +25,11 @@ static int write_seed(const char *dir, const char *name, const uint8_t *prefix,
                       size_t nprefix, const void *body, size_t len)
 {
     char path[4096];
-    snprintf(path, sizeof path, "%s/%s", dir, name);
+    int n = snprintf(path, sizeof path, "%s/%s", dir, name);
+    if (n < 0 || (size_t)n >= sizeof path) {
+        fprintf(stderr, "%s/%s: path too long\n", dir, name);
+        return -1;
+    }
     FILE *f = fopen(path, "wb");
     if (!f) {
         perror(path);

@@ -44,26 +44,10 @@ enum { NPROGRAMS = sizeof programs / sizeof programs[0] };
 static int group_setup(void **state)
 {
     (void)state;
-    dir = ft_tempdir();
+    if (ft_group_begin(&dir, FT_SCENE_NONE, 0) != 0) return -1;
     /* the reference: the build tree's worker on the repository's scene */
     return ft_sh(dir, "ref.log", "%s --standalone %s/scenes/wave.rib -o %s/ref.exr -q",
                  ft_worker, src, dir) == 0 ? 0 : -1;
-}
-
-static int group_teardown(void **state)
-{
-    (void)state;
-    ft_stop_all();
-    ft_rmtree(dir);
-    free(dir);
-    return 0;
-}
-
-static int teardown(void **state)
-{
-    (void)state;
-    ft_stop_all();
-    return 0;
 }
 
 static bool is_file(const char *path, bool executable)
@@ -236,8 +220,8 @@ int main(int argc, char **argv)
     cpack = argv[6];
     version = argv[7];
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test_teardown(test_cmake_install_renders_from_anywhere, teardown),
-        cmocka_unit_test_teardown(test_debian_package_unpacks_and_renders, teardown),
+        cmocka_unit_test_teardown(test_cmake_install_renders_from_anywhere, ft_teardown),
+        cmocka_unit_test_teardown(test_debian_package_unpacks_and_renders, ft_teardown),
     };
-    return cmocka_run_group_tests(tests, group_setup, group_teardown);
+    return cmocka_run_group_tests(tests, group_setup, ft_group_teardown);
 }

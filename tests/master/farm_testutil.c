@@ -170,6 +170,7 @@ static const char scene_rib[] =
 
 void ft_write_scene(const char *dir, ft_scene_kind kind)
 {
+    if (kind == FT_SCENE_NONE) return;
     char shaders[4096], rib[2048];
     snprintf(shaders, sizeof shaders, "%s/shaders", dir);
     mkdir(shaders, 0755);
@@ -397,7 +398,13 @@ int ft_standalone(const char *dir, int tile)
     const char *argv[] = {ft_worker, "--standalone", ft_path(dir, "scene.rib"), "-o",
                           ft_path(dir, "ref.exr"), "--tile", t, "--threads", "2", "-q", NULL};
     pid_t pid = ft_spawn(ft_path(dir, "standalone.log"), argv);
-    return ft_wait(pid, 120);
+    int rc = ft_wait(pid, 120);
+    if (rc != 0) {
+        char *log = ft_read(ft_path(dir, "standalone.log"));
+        fprintf(stderr, "the standalone reference render failed (exit %d):\n%s\n", rc, log);
+        free(log);
+    }
+    return rc;
 }
 
 const char *ft_slow_worker(const char *dir, int delay_ms)
@@ -429,4 +436,45 @@ int ft_sh(const char *dir, const char *log, const char *fmt, ...)
     int rc = ft_shv(dir, log, fmt, ap);
     va_end(ap);
     return rc;
+}
+
+bool ft_program_dir(char *buf, size_t bufsz)
+{
+    char *real = realpath(ft_master, NULL);
+    if (!real) return false;
+    char *slash = strrchr(real, '/');
+    int n = slash ? snprintf(buf, bufsz, "%.*s", (int)(slash - real), real) : -1;
+    free(real);
+    return n >= 0 && (size_t)n < bufsz;
+}
+
+/* ---- a test group's folder ---- */
+
+static char **group_dir;
+
+int ft_group_begin(char **dir_p, ft_scene_kind kind, int ref_tile)
+{
+    group_dir = dir_p;
+    *dir_p = ft_tempdir();
+    ft_write_scene(*dir_p, kind);
+    return ref_tile > 0 && ft_standalone(*dir_p, ref_tile) != 0 ? -1 : 0;
+}
+
+int ft_group_teardown(void **state)
+{
+    (void)state;
+    ft_stop_all();
+    if (group_dir && *group_dir) {
+        ft_rmtree(*group_dir);
+        free(*group_dir);
+        *group_dir = NULL;
+    }
+    return 0;
+}
+
+int ft_teardown(void **state)
+{
+    (void)state;
+    ft_stop_all();
+    return 0;
 }

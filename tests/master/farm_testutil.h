@@ -33,10 +33,12 @@ void ft_rmtree(const char *dir);
  *   FT_SCENE_WAVE    a displaced square and a matte floor, 64x48
  *   FT_SCENE_BUDGET  the same with a shader that loops far beyond any
  *                    instruction budget
- *   FT_SCENE_BROKEN  a shader with a syntax error (line 3) */
-/*   FT_SCENE_NAN     the wave with a surface shader writing NaN, +Inf
- *                    and -Inf into Ci on half of the square */
-typedef enum { FT_SCENE_WAVE, FT_SCENE_BUDGET, FT_SCENE_BROKEN, FT_SCENE_NAN } ft_scene_kind;
+ *   FT_SCENE_BROKEN  a shader with a syntax error (line 3)
+ *   FT_SCENE_NAN     the wave with a surface shader writing NaN, +Inf
+ *                    and -Inf into Ci on half of the square
+ *   FT_SCENE_NONE    nothing (the folder is left empty) */
+typedef enum { FT_SCENE_WAVE, FT_SCENE_BUDGET, FT_SCENE_BROKEN, FT_SCENE_NAN, FT_SCENE_NONE }
+    ft_scene_kind;
 void ft_write_scene(const char *dir, ft_scene_kind kind);
 
 /* "dir/name" in a static ring of buffers (valid for a few calls). */
@@ -84,7 +86,8 @@ int ft_free_port(void);
 long ft_exr_diff(const char *a, const char *b);
 
 /* Renders dir/scene.rib with aafarm-worker --standalone into dir/ref.exr
- * (tile size `tile`); returns its exit status. */
+ * (tile size `tile`); returns its exit status (when not 0, its log
+ * dir/standalone.log is printed). */
 int ft_standalone(const char *dir, int tile);
 
 /* Runs a shell command line (fmt, printf-style; no single quotes in it)
@@ -104,5 +107,28 @@ void ft_sleep_ms(int ms);
  * delay_ms and its own arguments (exec: the same pid), for a master's
  * --worker-binary; returns its path (an ft_path buffer). */
 const char *ft_slow_worker(const char *dir, int delay_ms);
+
+/* The folder of aafarm-master's real path (symbolic links resolved) into
+ * buf, where the build put the other programs too; false when it cannot be
+ * resolved or does not fit. */
+bool ft_program_dir(char *buf, size_t bufsz);
+
+/* ---- a test group's folder ----
+ * A group's setup calls ft_group_begin(&dir, ...) on its own static
+ * `char *dir`; the group's teardown is ft_group_teardown (or a function
+ * ending with it), each test's ft_teardown. */
+
+/* *dir_p becomes a new temporary folder (ft_tempdir) with the scene kind
+ * written into it; when ref_tile > 0 the standalone render of it is made
+ * into dir/ref.exr with tiles of ref_tile (ft_standalone). 0, or -1 when that render failed: what a cmocka group
+ * setup returns. ft_group_teardown frees the folder of the last call. */
+int ft_group_begin(char **dir_p, ft_scene_kind kind, int ref_tile);
+
+/* A cmocka group teardown: every child stopped (ft_stop_all), the folder
+ * of ft_group_begin removed (ft_rmtree), freed and its pointer NULL. */
+int ft_group_teardown(void **state);
+
+/* A cmocka test teardown: every child stopped (ft_stop_all). */
+int ft_teardown(void **state);
 
 #endif

@@ -59,32 +59,8 @@ static char bindir[4096];
 static int group_setup(void **state)
 {
     (void)state;
-    dir = ft_tempdir();
-    ft_write_scene(dir, FT_SCENE_WAVE);
-    char *real = realpath(ft_master, NULL);
-    if (!real) return -1;
-    snprintf(bindir, sizeof bindir, "%s", real);
-    free(real);
-    char *slash = strrchr(bindir, '/');
-    if (!slash) return -1;
-    *slash = '\0';
-    return ft_standalone(dir, 16) == 0 ? 0 : -1;
-}
-
-static int group_teardown(void **state)
-{
-    (void)state;
-    ft_stop_all();
-    ft_rmtree(dir);
-    free(dir);
-    return 0;
-}
-
-static int teardown(void **state)
-{
-    (void)state;
-    ft_stop_all();
-    return 0;
+    if (!ft_program_dir(bindir, sizeof bindir)) return -1;
+    return ft_group_begin(&dir, FT_SCENE_WAVE, 16);
 }
 
 /* Runs a shell command line bounded by timeout -k; output to dir/log. */
@@ -571,12 +547,12 @@ int main(int argc, char **argv)
     }
     src = argv[3];
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test_teardown(test_ssh_farm_renders_and_stops_its_workers, teardown),
-        cmocka_unit_test_teardown(test_ssh_farm_ctrl_c_stops_everything, teardown),
+        cmocka_unit_test_teardown(test_ssh_farm_renders_and_stops_its_workers, ft_teardown),
+        cmocka_unit_test_teardown(test_ssh_farm_ctrl_c_stops_everything, ft_teardown),
         cmocka_unit_test_teardown(test_ssh_farm_over_a_real_sshd, teardown_sshd),
-        cmocka_unit_test_teardown(test_slurm_script_with_stand_in_srun, teardown),
-        cmocka_unit_test_teardown(test_systemd_unit_and_install, teardown),
-        cmocka_unit_test_teardown(test_scripts_and_manifests_checked, teardown),
+        cmocka_unit_test_teardown(test_slurm_script_with_stand_in_srun, ft_teardown),
+        cmocka_unit_test_teardown(test_systemd_unit_and_install, ft_teardown),
+        cmocka_unit_test_teardown(test_scripts_and_manifests_checked, ft_teardown),
     };
-    return cmocka_run_group_tests(tests, group_setup, group_teardown);
+    return cmocka_run_group_tests(tests, group_setup, ft_group_teardown);
 }

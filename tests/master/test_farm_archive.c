@@ -95,7 +95,7 @@ static char *mesh_text(size_t *len)
 static int setup(void **state)
 {
     (void)state;
-    dir = ft_tempdir();
+    if (ft_group_begin(&dir, FT_SCENE_NONE, 0) != 0) return -1;
     if (mkdir(ft_path(dir, "parts"), 0700) != 0)
         return -1;
     gzip_text(ft_path(dir, "parts/obj.rib.gz"), small_text, strlen(small_text));
@@ -109,21 +109,7 @@ static int setup(void **state)
         return -1;
     fputs(scene_text, f);
     fclose(f);
-    if (ft_standalone(dir, 8) != 0) {
-        fprintf(stderr, "the standalone reference render failed:\n%s\n",
-                ft_read(ft_path(dir, "standalone.log")));
-        return -1;
-    }
-    return 0;
-}
-
-static int teardown(void **state)
-{
-    (void)state;
-    ft_stop_all();
-    ft_rmtree(dir);
-    free(dir);
-    return 0;
+    return ft_standalone(dir, 8) == 0 ? 0 : -1;
 }
 
 static long file_size(const char *path)
@@ -264,5 +250,5 @@ int main(int argc, char **argv)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_big_archive_reaches_each_host_once),
     };
-    return cmocka_run_group_tests(tests, setup, teardown);
+    return cmocka_run_group_tests(tests, setup, ft_group_teardown);
 }

@@ -31,26 +31,7 @@ static const char *keygen;
 static int group_setup(void **state)
 {
     (void)state;
-    dir = ft_tempdir();
-    ft_write_scene(dir, FT_SCENE_WAVE);
-    if (ft_standalone(dir, 8) != 0) return -1;
-    return 0;
-}
-
-static int group_teardown(void **state)
-{
-    (void)state;
-    ft_stop_all();
-    ft_rmtree(dir);
-    free(dir);
-    return 0;
-}
-
-static int teardown(void **state)
-{
-    (void)state;
-    ft_stop_all();
-    return 0;
+    return ft_group_begin(&dir, FT_SCENE_WAVE, 8);
 }
 
 static int run_keygen(const char *name)
@@ -256,9 +237,9 @@ int main(int argc, char **argv)
     }
     keygen = argv[3];
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test_teardown(test_keygen_writes_pair_and_never_overwrites, teardown),
-        cmocka_unit_test_teardown(test_curve_render_admits_only_allowed_keys, teardown),
-        cmocka_unit_test_teardown(test_plaintext_network_bind_refused_and_bad_keys_named, teardown),
+        cmocka_unit_test_teardown(test_keygen_writes_pair_and_never_overwrites, ft_teardown),
+        cmocka_unit_test_teardown(test_curve_render_admits_only_allowed_keys, ft_teardown),
+        cmocka_unit_test_teardown(test_plaintext_network_bind_refused_and_bad_keys_named, ft_teardown),
     };
-    return cmocka_run_group_tests(tests, group_setup, group_teardown);
+    return cmocka_run_group_tests(tests, group_setup, ft_group_teardown);
 }

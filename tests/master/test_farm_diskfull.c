@@ -45,9 +45,7 @@ static bool can_mount;
 static int group_setup(void **state)
 {
     (void)state;
-    dir = ft_tempdir();
-    ft_write_scene(dir, FT_SCENE_WAVE);
-    if (ft_standalone(dir, 8) != 0) return -1;
+    if (ft_group_begin(&dir, FT_SCENE_WAVE, 8) != 0) return -1;
     snprintf(mnt, sizeof mnt, "%s/mnt", dir);
     mkdir(mnt, 0755);
     if (geteuid() != 0) {
@@ -68,9 +66,7 @@ static int group_teardown(void **state)
     (void)state;
     ft_stop_all();
     if (can_mount) umount2(mnt, MNT_DETACH);
-    ft_rmtree(dir);
-    free(dir);
-    return 0;
+    return ft_group_teardown(state);
 }
 
 static int teardown(void **state)

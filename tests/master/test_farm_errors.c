@@ -39,25 +39,7 @@ static char *dir;
 static int group_setup(void **state)
 {
     (void)state;
-    dir = ft_tempdir();
-    ft_write_scene(dir, FT_SCENE_WAVE);
-    return ft_standalone(dir, 8) == 0 ? 0 : -1;
-}
-
-static int group_teardown(void **state)
-{
-    (void)state;
-    ft_stop_all();
-    ft_rmtree(dir);
-    free(dir);
-    return 0;
-}
-
-static int teardown(void **state)
-{
-    (void)state;
-    ft_stop_all();
-    return 0;
+    return ft_group_begin(&dir, FT_SCENE_WAVE, 8);
 }
 
 /* A ZeroMQ socket of the test with a receive timeout. */
@@ -413,13 +395,13 @@ int main(int argc, char **argv)
 {
     if (!ft_init(argc, argv)) return 2;
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test_teardown(test_farm_master_rejects_other_version, teardown),
-        cmocka_unit_test_teardown(test_farm_worker_refused_by_master, teardown),
-        cmocka_unit_test_teardown(test_farm_worker_follows_the_protocol, teardown),
-        cmocka_unit_test_teardown(test_farm_shader_over_budget_fails_job, teardown),
-        cmocka_unit_test_teardown(test_farm_bad_shader_fails_fast, teardown),
-        cmocka_unit_test_teardown(test_farm_scene_too_large_refused_before_parsing, teardown),
-        cmocka_unit_test_teardown(test_farm_usage_errors, teardown),
+        cmocka_unit_test_teardown(test_farm_master_rejects_other_version, ft_teardown),
+        cmocka_unit_test_teardown(test_farm_worker_refused_by_master, ft_teardown),
+        cmocka_unit_test_teardown(test_farm_worker_follows_the_protocol, ft_teardown),
+        cmocka_unit_test_teardown(test_farm_shader_over_budget_fails_job, ft_teardown),
+        cmocka_unit_test_teardown(test_farm_bad_shader_fails_fast, ft_teardown),
+        cmocka_unit_test_teardown(test_farm_scene_too_large_refused_before_parsing, ft_teardown),
+        cmocka_unit_test_teardown(test_farm_usage_errors, ft_teardown),
     };
-    return cmocka_run_group_tests(tests, group_setup, group_teardown);
+    return cmocka_run_group_tests(tests, group_setup, ft_group_teardown);
 }

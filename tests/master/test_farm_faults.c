@@ -46,25 +46,7 @@ static char *dir;
 static int group_setup(void **state)
 {
     (void)state;
-    dir = ft_tempdir();
-    ft_write_scene(dir, FT_SCENE_WAVE);
-    return ft_standalone(dir, 8) == 0 ? 0 : -1;
-}
-
-static int group_teardown(void **state)
-{
-    (void)state;
-    ft_stop_all();
-    ft_rmtree(dir);
-    free(dir);
-    return 0;
-}
-
-static int teardown(void **state)
-{
-    (void)state;
-    ft_stop_all();
-    return 0;
+    return ft_group_begin(&dir, FT_SCENE_WAVE, 8);
 }
 
 static pid_t start_worker(const char *endpoint, const char *name, const char *delay_ms)
@@ -386,14 +368,14 @@ int main(int argc, char **argv)
 {
     if (!ft_init(argc, argv)) return 2;
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test_teardown(test_farm_kill9_worker_mid_render, teardown),
-        cmocka_unit_test_teardown(test_farm_sigstop_worker_requeued, teardown),
-        cmocka_unit_test_teardown(test_farm_garbage_to_master_port, teardown),
-        cmocka_unit_test_teardown(test_farm_slow_preparation_keeps_heartbeating, teardown),
-        cmocka_unit_test_teardown(test_farm_raw_byte_worker_name, teardown),
-        cmocka_unit_test_teardown(test_farm_sigterm_during_preparation, teardown),
-        cmocka_unit_test_teardown(test_farm_max_workers, teardown),
-        cmocka_unit_test_teardown(test_farm_sigint_master_cleans_up, teardown),
+        cmocka_unit_test_teardown(test_farm_kill9_worker_mid_render, ft_teardown),
+        cmocka_unit_test_teardown(test_farm_sigstop_worker_requeued, ft_teardown),
+        cmocka_unit_test_teardown(test_farm_garbage_to_master_port, ft_teardown),
+        cmocka_unit_test_teardown(test_farm_slow_preparation_keeps_heartbeating, ft_teardown),
+        cmocka_unit_test_teardown(test_farm_raw_byte_worker_name, ft_teardown),
+        cmocka_unit_test_teardown(test_farm_sigterm_during_preparation, ft_teardown),
+        cmocka_unit_test_teardown(test_farm_max_workers, ft_teardown),
+        cmocka_unit_test_teardown(test_farm_sigint_master_cleans_up, ft_teardown),
     };
-    return cmocka_run_group_tests(tests, group_setup, group_teardown);
+    return cmocka_run_group_tests(tests, group_setup, ft_group_teardown);
 }

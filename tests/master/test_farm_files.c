@@ -71,17 +71,7 @@ static const char scene_fmt[] =
 static int setup(void **state)
 {
     (void)state;
-    dir = ft_tempdir();
-    return 0;
-}
-
-static int teardown(void **state)
-{
-    (void)state;
-    ft_stop_all();
-    ft_rmtree(dir);
-    free(dir);
-    return 0;
+    return ft_group_begin(&dir, FT_SCENE_NONE, 0);
 }
 
 /* ---- helpers ---- */
@@ -694,5 +684,5 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_greedy_peer_is_capped),
         cmocka_unit_test(test_texture_map_on_the_farm),
     };
-    return cmocka_run_group_tests(tests, setup, teardown);
+    return cmocka_run_group_tests(tests, setup, ft_group_teardown);
 }

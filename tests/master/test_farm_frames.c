@@ -35,13 +35,8 @@ static char wrapper[1024];
 static int group_setup(void **state)
 {
     (void)state;
-    dir = ft_tempdir();
-    snprintf(wrapper, sizeof wrapper, "%s", ft_path(dir, "slow-worker.sh"));
-    FILE *f = fopen(wrapper, "w");
-    if (!f) return -1;
-    fprintf(f, "#!/bin/sh\nexec '%s' --tile-delay 40 \"$@\"\n", ft_worker);
-    fclose(f);
-    chmod(wrapper, 0755);
+    if (ft_group_begin(&dir, FT_SCENE_NONE, 0) != 0) return -1;
+    snprintf(wrapper, sizeof wrapper, "%s", ft_slow_worker(dir, 40));
     /* the reference: every frame, standalone, named by a pattern */
     const char *argv[] = {ft_worker, "--standalone", scene, "-o", ft_path(dir, "ref.%04d.exr"),
                           "--threads", "2", "-q", NULL};
@@ -50,22 +45,6 @@ static int group_setup(void **state)
         fprintf(stderr, "the standalone reference render failed:\n%s\n",
                 ft_read(ft_path(dir, "standalone.log")));
     return rc == 0 ? 0 : -1;
-}
-
-static int group_teardown(void **state)
-{
-    (void)state;
-    ft_stop_all();
-    ft_rmtree(dir);
-    free(dir);
-    return 0;
-}
-
-static int teardown(void **state)
-{
-    (void)state;
-    ft_stop_all();
-    return 0;
 }
 
 /* The embedded master with 2 local workers (private ipc folder in the
@@ -200,9 +179,9 @@ int main(int argc, char **argv)
     }
     snprintf(scene, sizeof scene, "%s/ripples.rib", argv[3]);
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test_teardown(test_sequence_equals_standalone, teardown),
-        cmocka_unit_test_teardown(test_frames_choice_and_errors, teardown),
-        cmocka_unit_test_teardown(test_resume_sequence_after_kill9, teardown),
+        cmocka_unit_test_teardown(test_sequence_equals_standalone, ft_teardown),
+        cmocka_unit_test_teardown(test_frames_choice_and_errors, ft_teardown),
+        cmocka_unit_test_teardown(test_resume_sequence_after_kill9, ft_teardown),
     };
-    return cmocka_run_group_tests(tests, group_setup, group_teardown);
+    return cmocka_run_group_tests(tests, group_setup, ft_group_teardown);
 }

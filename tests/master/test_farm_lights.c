@@ -96,7 +96,7 @@ static void write_file(const char *path, const char *text)
 static int group_setup(void **state)
 {
     (void)state;
-    dir = ft_tempdir();
+    if (ft_group_begin(&dir, FT_SCENE_NONE, 0) != 0) return -1;
     char shaders[4096];
     snprintf(shaders, sizeof shaders, "%s/shaders", dir);
     mkdir(shaders, 0755);
@@ -105,21 +105,7 @@ static int group_setup(void **state)
     write_file(ft_path(shaders, "tmatte.sl"), matte_sl);
     write_file(ft_path(shaders, "tbumps.sl"), bumps_sl);
     write_file(ft_path(dir, "scene.rib"), scene_rib);
-    if (ft_standalone(dir, 8) != 0) {
-        fprintf(stderr, "the standalone reference render failed:\n%s\n",
-                ft_read(ft_path(dir, "standalone.log")));
-        return -1;
-    }
-    return 0;
-}
-
-static int group_teardown(void **state)
-{
-    (void)state;
-    ft_stop_all();
-    ft_rmtree(dir);
-    free(dir);
-    return 0;
+    return ft_standalone(dir, 8) == 0 ? 0 : -1;
 }
 
 static void test_light_shader_and_rays_render_on_workers_as_standalone(void **state)
@@ -152,5 +138,5 @@ int main(int argc, char **argv)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_light_shader_and_rays_render_on_workers_as_standalone),
     };
-    return cmocka_run_group_tests(tests, group_setup, group_teardown);
+    return cmocka_run_group_tests(tests, group_setup, ft_group_teardown);
 }

@@ -40,25 +40,7 @@ static char *dir;
 static int group_setup(void **state)
 {
     (void)state;
-    dir = ft_tempdir();
-    ft_write_scene(dir, FT_SCENE_WAVE);
-    return 0;
-}
-
-static int group_teardown(void **state)
-{
-    (void)state;
-    ft_stop_all();
-    ft_rmtree(dir);
-    free(dir);
-    return 0;
-}
-
-static int teardown(void **state)
-{
-    (void)state;
-    ft_stop_all();
-    return 0;
+    return ft_group_begin(&dir, FT_SCENE_WAVE, 0);
 }
 
 /* A master on 127.0.0.1:0 with one local worker taking delay_ms a tile,
@@ -327,9 +309,9 @@ int main(int argc, char **argv)
 {
     if (!ft_init(argc, argv)) return 2;
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test_teardown(test_status_workers_and_image, teardown),
-        cmocka_unit_test_teardown(test_network_address_needs_a_token, teardown),
-        cmocka_unit_test_teardown(test_token_refused_and_accepted, teardown),
+        cmocka_unit_test_teardown(test_status_workers_and_image, ft_teardown),
+        cmocka_unit_test_teardown(test_network_address_needs_a_token, ft_teardown),
+        cmocka_unit_test_teardown(test_token_refused_and_accepted, ft_teardown),
     };
-    return cmocka_run_group_tests(tests, group_setup, group_teardown);
+    return cmocka_run_group_tests(tests, group_setup, ft_group_teardown);
 }

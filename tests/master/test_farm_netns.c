@@ -162,7 +162,7 @@ static int run_keygen(const char *name, char *secret_out, char *pub_out)
 static int group_setup(void **state)
 {
     (void)state;
-    dir = ft_tempdir();
+    if (ft_group_begin(&dir, FT_SCENE_NONE, 0) != 0) return -1;
     for (int i = 0; i < NNS; i++)
         snprintf(ns[i], sizeof ns[i], "aafarm-t%ld-%s", (long)getpid(), role[i]);
     if (geteuid() != 0) {
@@ -205,9 +205,7 @@ static int group_teardown(void **state)
         snprintf(prefix, sizeof prefix, "aafarm-t%ld-", (long)getpid());
         remove_namespaces(prefix);
     }
-    ft_rmtree(dir);
-    free(dir);
-    return 0;
+    return ft_group_teardown(state);
 }
 
 static int teardown(void **state)

@@ -29,18 +29,7 @@ static char *dir;
 static int group_setup(void **state)
 {
     (void)state;
-    dir = ft_tempdir();
-    ft_write_scene(dir, FT_SCENE_NAN);
-    return 0;
-}
-
-static int group_teardown(void **state)
-{
-    (void)state;
-    ft_stop_all();
-    ft_rmtree(dir);
-    free(dir);
-    return 0;
+    return ft_group_begin(&dir, FT_SCENE_NAN, 0);
 }
 
 static int standalone(const char *scene, const char *out, const char *json, const char *log)
@@ -114,5 +103,5 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_nonfinite_counted_written_as_zero),
         cmocka_unit_test(test_finite_scene_counts_zero),
     };
-    return cmocka_run_group_tests(tests, group_setup, group_teardown);
+    return cmocka_run_group_tests(tests, group_setup, ft_group_teardown);
 }

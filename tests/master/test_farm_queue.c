@@ -54,23 +54,10 @@ static void write_scene(void)
 static int group_setup(void **state)
 {
     (void)state;
-    dir = ft_tempdir();
+    if (ft_group_begin(&dir, FT_SCENE_NONE, 0) != 0) return -1;
     write_scene();
-    if (ft_standalone(dir, 16) != 0) {
-        fprintf(stderr, "the standalone render failed:\n%s\n",
-                ft_read(ft_path(dir, "standalone.log")));
-        return -1;
-    }
+    if (ft_standalone(dir, 16) != 0) return -1;
     snprintf(url, sizeof url, "http://127.0.0.1:%d", ft_free_port());
-    return 0;
-}
-
-static int group_teardown(void **state)
-{
-    (void)state;
-    ft_stop_all();
-    ft_rmtree(dir);
-    free(dir);
     return 0;
 }
 
@@ -187,5 +174,5 @@ int main(int argc, char **argv)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_queue_priorities_cancel_and_restart),
     };
-    return cmocka_run_group_tests(tests, group_setup, group_teardown);
+    return cmocka_run_group_tests(tests, group_setup, ft_group_teardown);
 }

@@ -32,30 +32,7 @@ static char *dir;
 static int group_setup(void **state)
 {
     (void)state;
-    dir = ft_tempdir();
-    ft_write_scene(dir, FT_SCENE_WAVE);
-    if (ft_standalone(dir, 8) != 0) {
-        fprintf(stderr, "the standalone reference render failed:\n%s\n",
-                ft_read(ft_path(dir, "standalone.log")));
-        return -1;
-    }
-    return 0;
-}
-
-static int group_teardown(void **state)
-{
-    (void)state;
-    ft_stop_all();
-    ft_rmtree(dir);
-    free(dir);
-    return 0;
-}
-
-static int teardown(void **state)
-{
-    (void)state;
-    ft_stop_all();
-    return 0;
+    return ft_group_begin(&dir, FT_SCENE_WAVE, 8);
 }
 
 static pid_t start_worker(const char *endpoint, const char *name, const char *threads,
@@ -274,10 +251,10 @@ int main(int argc, char **argv)
 {
     if (!ft_init(argc, argv)) return 2;
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test_teardown(test_farm_two_processes_equal_standalone, teardown),
-        cmocka_unit_test_teardown(test_farm_three_workers_early_and_late, teardown),
-        cmocka_unit_test_teardown(test_farm_embedded_default, teardown),
-        cmocka_unit_test_teardown(test_local_workers_end_with_their_master, teardown),
+        cmocka_unit_test_teardown(test_farm_two_processes_equal_standalone, ft_teardown),
+        cmocka_unit_test_teardown(test_farm_three_workers_early_and_late, ft_teardown),
+        cmocka_unit_test_teardown(test_farm_embedded_default, ft_teardown),
+        cmocka_unit_test_teardown(test_local_workers_end_with_their_master, ft_teardown),
     };
-    return cmocka_run_group_tests(tests, group_setup, group_teardown);
+    return cmocka_run_group_tests(tests, group_setup, ft_group_teardown);
 }

@@ -37,30 +37,8 @@ static char wrapper[4096];
 static int group_setup(void **state)
 {
     (void)state;
-    dir = ft_tempdir();
-    ft_write_scene(dir, FT_SCENE_WAVE);
-    snprintf(wrapper, sizeof wrapper, "%s", ft_path(dir, "slow-worker.sh"));
-    FILE *f = fopen(wrapper, "w");
-    if (!f) return -1;
-    fprintf(f, "#!/bin/sh\nexec '%s' --tile-delay 60 \"$@\"\n", ft_worker);
-    fclose(f);
-    chmod(wrapper, 0755);
-    return ft_standalone(dir, 8) == 0 ? 0 : -1;
-}
-
-static int group_teardown(void **state)
-{
-    (void)state;
-    ft_stop_all();
-    ft_rmtree(dir);
-    free(dir);
-    return 0;
-}
-
-static int teardown(void **state)
-{
-    (void)state;
-    ft_stop_all();
+    if (ft_group_begin(&dir, FT_SCENE_WAVE, 8) != 0) return -1;
+    snprintf(wrapper, sizeof wrapper, "%s", ft_slow_worker(dir, 60));
     return 0;
 }
 
@@ -226,10 +204,10 @@ int main(int argc, char **argv)
 {
     if (!ft_init(argc, argv)) return 2;
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test_teardown(test_resume_after_kill9_at_three_moments, teardown),
-        cmocka_unit_test_teardown(test_resume_drops_torn_and_corrupt_tail, teardown),
-        cmocka_unit_test_teardown(test_resume_other_job_refused, teardown),
-        cmocka_unit_test_teardown(test_resume_without_journal_renders_all, teardown),
+        cmocka_unit_test_teardown(test_resume_after_kill9_at_three_moments, ft_teardown),
+        cmocka_unit_test_teardown(test_resume_drops_torn_and_corrupt_tail, ft_teardown),
+        cmocka_unit_test_teardown(test_resume_other_job_refused, ft_teardown),
+        cmocka_unit_test_teardown(test_resume_without_journal_renders_all, ft_teardown),
     };
-    return cmocka_run_group_tests(tests, group_setup, group_teardown);
+    return cmocka_run_group_tests(tests, group_setup, ft_group_teardown);
 }

@@ -47,30 +47,12 @@ static char *dir;
 static int group_setup(void **state)
 {
     (void)state;
-    dir = ft_tempdir();
-    ft_write_scene(dir, FT_SCENE_WAVE);
     /* ref24.exr: --tile 24 (6 tiles), the case; ref.exr: --tile 8 */
-    if (ft_standalone(dir, 24) != 0) return -1;
+    if (ft_group_begin(&dir, FT_SCENE_WAVE, 24) != 0) return -1;
     char ref24[4096];
     snprintf(ref24, sizeof ref24, "%s", ft_path(dir, "ref24.exr"));
     if (rename(ft_path(dir, "ref.exr"), ref24) != 0) return -1;
     return ft_standalone(dir, 8) == 0 ? 0 : -1;
-}
-
-static int group_teardown(void **state)
-{
-    (void)state;
-    ft_stop_all();
-    ft_rmtree(dir);
-    free(dir);
-    return 0;
-}
-
-static int teardown(void **state)
-{
-    (void)state;
-    ft_stop_all();
-    return 0;
 }
 
 /* Each render below takes a few seconds; the loops that play the rogue
@@ -584,13 +566,13 @@ int main(int argc, char **argv)
     if (!ft_init(argc, argv)) return 2;
     const struct CMUnitTest tests[] = {
         cmocka_unit_test_teardown(test_nonretryable_failure_from_one_peer_does_not_end_render,
-                                  teardown),
-        cmocka_unit_test_teardown(test_hoarders_lose_their_tiles_and_get_no_more, teardown),
-        cmocka_unit_test_teardown(test_oversized_frames_are_cut_off, teardown),
-        cmocka_unit_test_teardown(test_rogue_alone_then_honest_worker, teardown),
-        cmocka_unit_test_teardown(test_liar_alone_then_honest_worker, teardown),
-        cmocka_unit_test_teardown(test_result_with_another_tiles_index_refused, teardown),
-        cmocka_unit_test_teardown(test_deterministic_failure_agreed_or_alone, teardown),
+                                  ft_teardown),
+        cmocka_unit_test_teardown(test_hoarders_lose_their_tiles_and_get_no_more, ft_teardown),
+        cmocka_unit_test_teardown(test_oversized_frames_are_cut_off, ft_teardown),
+        cmocka_unit_test_teardown(test_rogue_alone_then_honest_worker, ft_teardown),
+        cmocka_unit_test_teardown(test_liar_alone_then_honest_worker, ft_teardown),
+        cmocka_unit_test_teardown(test_result_with_another_tiles_index_refused, ft_teardown),
+        cmocka_unit_test_teardown(test_deterministic_failure_agreed_or_alone, ft_teardown),
     };
-    return cmocka_run_group_tests(tests, group_setup, group_teardown);
+    return cmocka_run_group_tests(tests, group_setup, ft_group_teardown);
 }

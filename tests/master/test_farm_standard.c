@@ -120,17 +120,7 @@ static void expect_rgb(const char *attrs, double ambient, const double rgb[3], b
 static int group_setup(void **state)
 {
     (void)state;
-    dir = ft_tempdir();
-    return dir ? 0 : -1;
-}
-
-static int group_teardown(void **state)
-{
-    (void)state;
-    ft_stop_all();
-    ft_rmtree(dir);
-    free(dir);
-    return 0;
+    return ft_group_begin(&dir, FT_SCENE_NONE, 0);
 }
 
 static const char *const spec_names[] = {"constant", "matte", "metal", "shinymetal",
@@ -306,5 +296,5 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_a_plastic_sl_on_the_search_path_wins),
         cmocka_unit_test(test_the_farm_renders_standard_shaders_as_standalone),
     };
-    return cmocka_run_group_tests(tests, group_setup, group_teardown);
+    return cmocka_run_group_tests(tests, group_setup, ft_group_teardown);
 }

@@ -29,25 +29,7 @@ static char *dir;
 static int group_setup(void **state)
 {
     (void)state;
-    dir = ft_tempdir();
-    ft_write_scene(dir, FT_SCENE_WAVE);
-    return ft_standalone(dir, 16) == 0 ? 0 : -1;
-}
-
-static int group_teardown(void **state)
-{
-    (void)state;
-    ft_stop_all();
-    ft_rmtree(dir);
-    free(dir);
-    return 0;
-}
-
-static int teardown(void **state)
-{
-    (void)state;
-    ft_stop_all();
-    return 0;
+    return ft_group_begin(&dir, FT_SCENE_WAVE, 16);
 }
 
 static void test_master_without_workers_says_so(void **state)
@@ -132,8 +114,8 @@ int main(int argc, char **argv)
 {
     if (!ft_init(argc, argv)) return 2;
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test_teardown(test_master_without_workers_says_so, teardown),
-        cmocka_unit_test_teardown(test_worker_without_master_says_so, teardown),
+        cmocka_unit_test_teardown(test_master_without_workers_says_so, ft_teardown),
+        cmocka_unit_test_teardown(test_worker_without_master_says_so, ft_teardown),
     };
-    return cmocka_run_group_tests(tests, group_setup, group_teardown);
+    return cmocka_run_group_tests(tests, group_setup, ft_group_teardown);
 }

@@ -308,11 +308,7 @@ int main(int argc, char **argv)
         return 2;
     }
     src = argv[3];
-    char *real = realpath(ft_master, NULL);
-    if (!real) return 2;
-    snprintf(bindir, sizeof bindir, "%s", real);
-    free(real);
-    *strrchr(bindir, '/') = '\0';
+    if (!ft_program_dir(bindir, sizeof bindir)) return 2;
 
     dir = ft_tempdir();
     char why[4096] = "";
