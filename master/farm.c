@@ -663,7 +663,8 @@ static void check_gate(farm *f, int64_t now)
     }
     if (f->opt->wait_timeout_ms > 0 && now - f->gate_since_ms >= f->opt->wait_timeout_ms) {
         char what[120];
-        snprintf(what, sizeof what, "%d of %d worker%s joined", alive, need, need == 1 ? "" : "s");
+        if (need == 1) snprintf(what, sizeof what, "no worker joined");
+        else snprintf(what, sizeof what, "%d of %d workers joined", alive, need);
         give_up_waiting(f, what);
         return;
     }

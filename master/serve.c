@@ -281,7 +281,7 @@ static void say_started(serve *s, farm *f, const active_job *a, const char *more
     console_log(f->con, CONSOLE_INFO, "job %ld: %s, %d frame%s, %d tiles (priority %d%s%s%s%s)%s",
                 a->id, b->scene, b->nframes, b->nframes == 1 ? "" : "s", a->ntiles, b->priority,
                 f->pool ? ", pool " : "", f->pool ? f->pool : "", a->resume ? "; resumed" : "",
-                a->resume && job_tiles_done(f, a) ? ", tiles from its journal" : "", more);
+                job_tiles_done(f, a) ? ", tiles from its journal" : "", more);
     (void)s;
 }
 
