@@ -314,10 +314,13 @@ void farm_frame_complete(farm *f, farm_frame *fr)
     fr->written = true;
     f->frames_written++;
     farm_monitor_frame_complete(f, fr);
-    if (f->nframes > 1) {
+    int written = 0;   /* of its job's frames (a serving master's run holds several jobs) */
+    for (int i = 0; i < fr->job_frames; i++) written += f->frames[fr->job_first + i].written;
+    if (fr->job_frames > 1)
         console_log(f->con, CONSOLE_INFO, "frame %d: wrote %s (%dx%d, %d tiles; %d of %d "
                     "frames done)", fr->jb->frame_number, fr->output, fr->fmt.width,
-                    fr->fmt.height, fr->ntiles, f->frames_written, f->nframes);
+                    fr->fmt.height, fr->ntiles, written, fr->job_frames);
+    if (f->nframes > 1 && !f->serving) {
         char line[64];
         snprintf(line, sizeof line, "%d/%d frames, ", f->frames_written, f->nframes);
         console_set_prefix(f->con, line);
@@ -951,6 +954,7 @@ int farm_run(const farm_options *opt, const farm_frame_in *frames, int nframes)
         f.frames[i].fmt = frames[i].fmt;
         f.frames[i].output = frames[i].output;
         f.frames[i].preview = frames[i].preview;
+        f.frames[i].job_frames = nframes;
     }
     f.fmt = frames[0].fmt;   /* the tile size (the same in every frame): limits */
     f.con = console_new(opt->verbosity, isatty(STDERR_FILENO));
@@ -1033,6 +1037,7 @@ int farm_serve_job(farm *f, const farm_frame_in *frames, int nframes, char *err,
         f->frames[i].fmt = frames[i].fmt;
         f->frames[i].output = frames[i].output;
         f->frames[i].preview = frames[i].preview;
+        f->frames[i].job_frames = nframes;
     }
     f->ntiles = 0;
     f->frames_written = 0;
@@ -1065,6 +1070,8 @@ int farm_serve_append(farm *f, const farm_frame_in *frames, int nframes, char *e
         fr->output = frames[i].output;
         fr->preview = frames[i].preview;
         fr->first = f->ntiles;
+        fr->job_first = from;
+        fr->job_frames = nframes;
     }
     f->nframes += nframes;
     int resumed = f->resumed_tiles;

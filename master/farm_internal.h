@@ -56,6 +56,8 @@ typedef struct farm_frame {
     journal *jnl;                  /* OUT.exr.journal: its tiles taken so far */
     int done;                      /* its tiles in the output */
     bool written;                  /* complete and renamed into place */
+    int job_first, job_frames;     /* its job's frames in the farm's (a serving master's
+                                      run holds the frames of several jobs) */
     /* a serving master (serve.c), whose frames may belong to several jobs */
     bool keep_journal;             /* at the end: its job resumes later (requeued,
                                       interrupted), so its journal stays */
