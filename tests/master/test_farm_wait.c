@@ -15,7 +15,10 @@
  *     second joins it renders, equal to standalone;
  *   - --wait-timeout 2 with no worker: exit 4 with the reason, within a
  *     bounded time, no output; with --min-workers 2 and one worker: the
- *     same, naming "1 of 2 workers joined".
+ *     same, naming "1 of 2 workers joined"; more --min-workers than
+ *     local workers: exit 2;
+ *   - --wait-timeout 2 and the only worker killed mid-render: exit 4, the
+ *     journal kept; --resume completes the image, equal to standalone.
  */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -27,6 +30,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "farm_testutil.h"
 
@@ -215,6 +219,50 @@ static void test_wait_timeout_gives_up(void **state)
     assert_int_equal(ft_count_files(dir, "to.exr"), 0);
     kill(w, SIGTERM);
     assert_int_equal(ft_wait(w, 10), 130);
+
+    /* more than the local workers can ever be: a usage error, nothing started */
+    snprintf(log, sizeof log, "%s", ft_path(dir, "timeout-usage.log"));
+    const char *argv3[] = {ft_master, ft_path(dir, "scene.rib"), "-o", ft_path(dir, "to.exr"),
+                           "--local-workers", "2", "--min-workers", "3", NULL};
+    assert_int_equal(ft_wait(ft_spawn(log, argv3), 30), 2);
+    assert_int_equal(ft_count(log, "--min-workers 3 without --bind: only the 2 local workers can "
+                                   "join"), 1);
+}
+
+/* Every worker lost mid-render: --wait-timeout later the master gives up
+ * (exit 4) and keeps its journal; --resume with a worker completes it. */
+static void test_wait_timeout_after_every_worker_is_lost(void **state)
+{
+    (void)state;
+    char log[1024];
+    snprintf(log, sizeof log, "%s", ft_path(dir, "lost.log"));
+    const char *argv[] = {ft_master, ft_path(dir, "scene.rib"), "-o", ft_path(dir, "lost.exr"),
+                          "--bind", "tcp://127.0.0.1:*", "--tile", "16", "--wait-timeout", "2",
+                          "--heartbeat", "200", "-v", NULL};
+    pid_t m = ft_spawn(log, argv);
+    char ep[256];
+    assert_true(ft_master_endpoint(log, ep, sizeof ep, 20));
+    const char *wargv[] = {ft_worker, "--connect", ep, "--name", "doomed", "--threads", "1",
+                           "--tile-delay", "200", NULL};
+    pid_t w = ft_spawn(ft_path(dir, "lost-w.log"), wargv);
+    assert_true(ft_wait_for(log, "took tile", 2, 30));
+    kill(w, SIGKILL);
+    assert_int_equal(ft_wait(w, 10), 128 + SIGKILL);
+    assert_int_equal(ft_wait(m, 30), 4);
+    assert_int_equal(ft_count(log, " tiles back in the queue"), 1);   /* doomed lost */
+    assert_int_equal(ft_count(log, "gave up after --wait-timeout 2 s: no worker alive (1 joined, "
+                                   "none alive now) on "), 1);
+    assert_int_equal(ft_count(log, "the same command with --resume renders only the others"), 1);
+    assert_int_equal(ft_count_files(dir, "lost.exr.journal"), 1);
+    assert_int_equal(access(ft_path(dir, "lost.exr"), F_OK), -1);
+
+    /* resumed with a worker: equal to standalone */
+    snprintf(log, sizeof log, "%s", ft_path(dir, "lost-2.log"));
+    const char *argv2[] = {ft_master, ft_path(dir, "scene.rib"), "-o", ft_path(dir, "lost.exr"),
+                           "--tile", "16", "--local-workers", "1", "--resume", NULL};
+    assert_int_equal(ft_wait(ft_spawn(log, argv2), 120), 0);
+    assert_int_equal(ft_count(log, "resuming: "), 1);
+    assert_int_equal(ft_exr_diff(ft_path(dir, "lost.exr"), ft_path(dir, "ref.exr")), 0);
 }
 
 int main(int argc, char **argv)
@@ -225,6 +273,7 @@ int main(int argc, char **argv)
         cmocka_unit_test_teardown(test_worker_without_master_says_so, teardown),
         cmocka_unit_test_teardown(test_min_workers_waits_for_the_second, teardown),
         cmocka_unit_test_teardown(test_wait_timeout_gives_up, teardown),
+        cmocka_unit_test_teardown(test_wait_timeout_after_every_worker_is_lost, teardown),
     };
     return cmocka_run_group_tests(tests, group_setup, group_teardown);
 }
