@@ -5,7 +5,8 @@
  * fast (--tile-delay 100) and one slow (--tile-delay 1500), --duplicates 0
  * and --lease-factor 0 so that the slow worker's tiles stay its own. Each
  * job is scenes/wave.rib at 32x32 (X, 4 tiles of 16) or 48x32 (Y, 6
- * tiles): the slow worker takes two of X's tiles at once, the fast one
+ * tiles), both queued before the workers join (--min-workers holds X
+ * back): the slow worker takes two of X's tiles at once, the fast one
  * the two others; when the fast one asks again, nothing of X is left to
  * hand out, Y joins, and its tiles are leased while X's two are still
  * out (the master's log says so from its scheduler's leases), Y is done
@@ -115,6 +116,13 @@ static void test_next_job_joins_the_last_tiles(void **state)
     char ep[256];
     assert_true(ft_master_endpoint(log, ep, sizeof ep, 20));
     assert_true(ft_wait_for(log, "serving the job queue", 1, 20));
+
+    /* X and Y queued before the workers (--min-workers 2 holds X back) */
+    pid_t px = submit(sx, dir_x, "x.exr");
+    assert_true(ft_wait_for(sx, "job 1 queued", 1, 30));
+    pid_t py = submit(sy, dir_y, "y.exr");
+    assert_true(ft_wait_for(sy, "job 2 queued", 1, 30));
+    assert_true(ft_wait_for(log, "job 1: ", 1, 30));
     /* the slow one first: in the registry's order it is granted first */
     const char *slow[] = {ft_worker, "--connect", ep, "--name", "slow", "--threads", "1",
                           "--tile-delay", "1500", NULL};
@@ -124,11 +132,6 @@ static void test_next_job_joins_the_last_tiles(void **state)
     assert_true(ft_wait_for(log, "worker slow joined", 1, 20));
     pid_t wf = ft_spawn(ft_path(dir, "fast.log"), fast);
     assert_true(ft_wait_for(log, "2 of 2 workers joined (--min-workers): rendering", 1, 20));
-
-    /* X and Y: Y is queued while X runs, and joins X's last tiles */
-    pid_t px = submit(sx, dir_x, "x.exr");
-    assert_true(ft_wait_for(log, "job 1: ", 1, 30));
-    pid_t py = submit(sy, dir_y, "y.exr");
     assert_int_equal(ft_wait(py, 60), 0);
     assert_int_equal(ft_wait(px, 60), 0);
     assert_int_equal(ft_count(log, "job 2: "), 2);   /* it starts, and its overlap */
@@ -148,7 +151,7 @@ static void test_next_job_joins_the_last_tiles(void **state)
     snprintf(sx, sizeof sx, "%s", ft_path(dir, "submit-p.log"));
     snprintf(sy, sizeof sy, "%s", ft_path(dir, "submit-q.log"));
     pid_t pp = submit(sx, dir_x, "p.exr");
-    assert_true(ft_wait_for(log, "job 3: ", 1, 30));
+    assert_true(ft_wait_for(sx, "job 3 queued", 1, 30));
     pid_t pq = submit(sy, dir_y, "q.exr");
     assert_true(ft_wait_for(log, " tiles of job 3 are still out (overlap)", 1, 30));
     const char *cancel[] = {submit_bin, "--master", url, "--cancel", "3", NULL};
