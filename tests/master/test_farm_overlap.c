@@ -14,6 +14,9 @@
  * again, and the first job cancelled while the second has joined it: the
  * first ends cancelled (no output, no journal), the second goes back to
  * the queue with its journal, resumes, and equals its standalone render.
+ * Then a job whose output cannot be written (a missing folder) joins a
+ * run: it fails alone, the job it joined is requeued, resumes and equals
+ * its standalone render.
  *
  * argv: aafarm-master aafarm-worker aafarm-submit scenes-folder
  */
@@ -167,6 +170,22 @@ static void test_next_job_joins_the_last_tiles(void **state)
     assert_int_equal(access(ft_path(dir, "p.exr"), F_OK), -1);
     assert_int_equal(ft_count_files(dir, "p.exr"), 0);   /* nor its journal */
     assert_int_equal(ft_count_files(dir, "q.exr."), 0);
+
+    /* a job whose output cannot be written joins a run: it fails, the job
+     * it joined goes back to the queue with its journal and resumes */
+    snprintf(sx, sizeof sx, "%s", ft_path(dir, "submit-r.log"));
+    snprintf(sy, sizeof sy, "%s", ft_path(dir, "submit-f.log"));
+    pid_t pr = submit(sx, dir_x, "r.exr");
+    assert_true(ft_wait_for(sx, "job 5 queued", 1, 30));
+    pid_t pf = submit(sy, dir_y, "missing/f.exr");
+    assert_int_equal(ft_wait(pf, 60), 1);
+    assert_int_equal(ft_wait(pr, 60), 0);
+    assert_int_equal(ft_count(log, "job 6: "), 0);   /* it never started */
+    assert_int_equal(ft_count(log, "job 6 failed: "), 1);
+    assert_int_equal(ft_count(log, "job 5 requeued: the job beside it failed"), 1);
+    assert_int_equal(ft_count(log, "job 5 done"), 1);
+    assert_int_equal(ft_exr_diff(ft_path(dir_x, "ref.exr"), ft_path(dir, "r.exr")), 0);
+    assert_int_equal(ft_count_files(dir, "r.exr."), 0);
 
     kill(master, SIGTERM);
     assert_int_equal(ft_wait(master, 10), 130);
