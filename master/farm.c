@@ -308,16 +308,19 @@ void farm_frame_complete(farm *f, farm_frame *fr)
 {
     char err[ERR_LEN], label[40];
     if (!image_writer_finish(&fr->writer, err, sizeof err)) {
-        farm_fail(f, "%s%s", frame_label(f, fr, label, sizeof label), err);
+        farm_fail_tile(f, fr->first, "%s%s", frame_label(f, fr, label, sizeof label), err);
         return;
     }
     fr->written = true;
     f->frames_written++;
     farm_monitor_frame_complete(f, fr);
-    if (f->nframes > 1) {
+    int written = 0;   /* of its job's frames (a serving master's run holds several jobs) */
+    for (int i = 0; i < fr->job_frames; i++) written += f->frames[fr->job_first + i].written;
+    if (fr->job_frames > 1)
         console_log(f->con, CONSOLE_INFO, "frame %d: wrote %s (%dx%d, %d tiles; %d of %d "
                     "frames done)", fr->jb->frame_number, fr->output, fr->fmt.width,
-                    fr->fmt.height, fr->ntiles, f->frames_written, f->nframes);
+                    fr->fmt.height, fr->ntiles, written, fr->job_frames);
+    if (f->nframes > 1 && !f->serving) {
         char line[64];
         snprintf(line, sizeof line, "%d/%d frames, ", f->frames_written, f->nframes);
         console_set_prefix(f->con, line);
@@ -423,56 +426,77 @@ static void bound_limits(farm *f)
 static void setup_common(farm *f)
 {
     bound_limits(f);
+    f->failed_tile = -1;
+    f->gate_open = f->opt->min_workers <= 1 && f->opt->wait_timeout_ms <= 0;
+    f->gate_since_ms = f->gate_said_ms = farm_now_ms();
+    f->gate_said = -1;
     f->session = random_session();
     if (gethostname(f->host, sizeof f->host - 1) != 0) snprintf(f->host, sizeof f->host, "master");
 }
 
-/* The frames' tiles, the scheduler (with a slot for every live worker:
- * a serving master's next job), the registry the first time, the
- * monitor's frames, and each frame's output and journal. */
-static int setup_job(farm *f, char *err, size_t errsz)
+/* The tiles of frames from .. nframes - 1 after those before them; the
+ * scheduler (with a slot for every live worker: a serving master's next
+ * job) made, or extended (a serving master's job that joins the queue
+ * while the previous one's last tiles are out); the registry the first
+ * time; the monitor's frames; and each frame's output and journal. */
+static int add_frames(farm *f, int from, char *err, size_t errsz)
 {
-    for (int i = 0; i < f->nframes; i++) {
+    int added = 0;
+    for (int i = from; i < f->nframes; i++) {
         farm_frame *fr = &f->frames[i];
         fr->tiles_x = image_format_tiles_x(&fr->fmt);
         fr->ntiles = image_format_tile_count(&fr->fmt);
-        fr->first = f->ntiles;
-        if (fr->ntiles > INT_MAX / 4 - f->ntiles) {
+        fr->first = f->ntiles + added;
+        if (fr->ntiles > INT_MAX / 4 - fr->first) {
             err_set(err, errsz, "the %d frames have too many tiles to count", f->nframes);
             return AAFARM_EXIT_INPUT;
         }
-        f->ntiles += fr->ntiles;
+        added += fr->ntiles;
     }
-    scheduler_options so;
-    scheduler_options_default(&so);
-    so.max_attempts = f->opt->max_attempts;
-    so.max_duplicates = f->opt->max_duplicates;
-    so.lease_ms = f->opt->lease_ms;
-    so.lease_factor = f->opt->lease_factor;
-    /* a tile one worker alone gave up on waits for another one while one
-     * can join (--bind): as long as the longest lease */
-    so.join_window_ms = f->opt->bind ? f->opt->lease_ms : 0;
-    /* every frame's tiles in one row-major queue: a worker's run goes on
-     * into the next frame, and new runs start in the longest queued run */
-    f->sched = scheduler_new(f->ntiles ? f->ntiles : 1, 1, &so);
-    if (!f->sched) {
-        err_set(err, errsz, "the %d frames have too many tiles to count", f->nframes);
-        return AAFARM_EXIT_INPUT;
+    if (f->sched) {
+        if (added > 0 && !scheduler_extend(f->sched, added)) {
+            err_set(err, errsz, "the %d frames have too many tiles to count", f->nframes);
+            return AAFARM_EXIT_INPUT;
+        }
+        f->ntiles += added;
+    } else {
+        f->ntiles = added;
+        scheduler_options so;
+        scheduler_options_default(&so);
+        so.max_attempts = f->opt->max_attempts;
+        so.max_duplicates = f->opt->max_duplicates;
+        so.lease_ms = f->opt->lease_ms;
+        so.lease_factor = f->opt->lease_factor;
+        /* a tile one worker alone gave up on waits for another one while one
+         * can join (--bind): as long as the longest lease */
+        so.join_window_ms = f->opt->bind ? f->opt->lease_ms : 0;
+        /* every frame's tiles in one row-major queue: a worker's run goes on
+         * into the next frame, and new runs start in the longest queued run */
+        f->sched = scheduler_new(f->ntiles ? f->ntiles : 1, 1, &so);
+        if (!f->sched) {
+            err_set(err, errsz, "the %d frames have too many tiles to count", f->nframes);
+            return AAFARM_EXIT_INPUT;
+        }
+        if (f->ntiles == 0) scheduler_mark_done(f->sched, 0);   /* a serving master, idle */
+        if (!f->reg) f->reg = registry_new();
+        for (size_t i = 0; i < registry_count(f->reg); i++) {
+            farm_worker *w = registry_at(f->reg, i);
+            if (!w->alive) continue;
+            w->slot = scheduler_worker_add(f->sched);
+            farm_worker_fit(f, w);
+        }
     }
-    if (f->ntiles == 0) scheduler_mark_done(f->sched, 0);   /* a serving master, idle */
-    if (!f->reg) f->reg = registry_new();
-    for (size_t i = 0; i < registry_count(f->reg); i++) {
-        farm_worker *w = registry_at(f->reg, i);
-        if (!w->alive) continue;
-        w->slot = scheduler_worker_add(f->sched);
-        farm_worker_fit(f, w);
-    }
-    farm_monitor_open(f);
-    for (int i = 0; i < f->nframes; i++) {
+    farm_monitor_open(f, from);
+    for (int i = from; i < f->nframes; i++) {
         int rc = setup_frame(f, &f->frames[i], err, errsz);
         if (rc != AAFARM_EXIT_OK) return rc;
     }
     return AAFARM_EXIT_OK;
+}
+
+static int setup_job(farm *f, char *err, size_t errsz)
+{
+    return add_frames(f, 0, err, errsz);
 }
 
 static int setup(farm *f, char *err, size_t errsz)
@@ -603,9 +627,63 @@ static void worker_command(const farm *f, char *buf, size_t n)
              f->zap ? " --curve-secret NAME.key_secret --master-key MASTER.key" : "");
 }
 
+/* Where workers join: the bound endpoint, else the private one. */
+static const char *join_endpoint(const farm *f)
+{
+    return f->bound[0] ? f->bound : f->endpoint;
+}
+
+/* --wait-timeout passed: the master gives up (AAFARM_EXIT_NO_WORKERS). */
+static void give_up_waiting(farm *f, const char *what)
+{
+    char cmd[800] = "";
+    if (f->bound[0]) worker_command(f, cmd, sizeof cmd);
+    snprintf(f->failure, sizeof f->failure, "gave up after --wait-timeout %.0f s: %.120s on %.600s%s%.800s%s",
+             (double)f->opt->wait_timeout_ms / 1000.0, what, join_endpoint(f),
+             cmd[0] ? " (start workers with: " : "", cmd, cmd[0] ? ")" : "");
+    console_log(f->con, CONSOLE_ERROR, "%s", f->failure);
+    f->state = FARM_NO_WORKERS;
+}
+
+/* --min-workers N: no tile is granted before N workers are alive at once
+ * (the gate opens once; workers lost later do not close it). While it is
+ * closed the master says how many joined: when that changes, and every
+ * FARM_GATE_SAY_MS (or the shorter --wait-report interval). --wait-timeout:
+ * closed that long, the master gives up. */
+enum { FARM_GATE_SAY_MS = 5000 };
+
+static void check_gate(farm *f, int64_t now)
+{
+    if (f->gate_open || f->state != FARM_RUNNING) return;
+    int need = f->opt->min_workers > 1 ? f->opt->min_workers : 1;
+    int alive = registry_alive(f->reg);
+    if (alive >= need) {
+        f->gate_open = true;
+        if (need > 1)
+            console_log(f->con, CONSOLE_INFO, "%d of %d workers joined (--min-workers): "
+                        "rendering", alive, need);
+        return;
+    }
+    if (f->opt->wait_timeout_ms > 0 && now - f->gate_since_ms >= f->opt->wait_timeout_ms) {
+        char what[120];
+        if (need == 1) snprintf(what, sizeof what, "no worker joined");
+        else snprintf(what, sizeof what, "%d of %d workers joined", alive, need);
+        give_up_waiting(f, what);
+        return;
+    }
+    if (need <= 1) return;   /* no worker at all: say_waiting says so */
+    int64_t every = f->opt->wait_report_ms < FARM_GATE_SAY_MS ? f->opt->wait_report_ms
+                                                              : FARM_GATE_SAY_MS;
+    if (alive == f->gate_said && now - f->gate_said_ms < every) return;
+    f->gate_said = alive;
+    f->gate_said_ms = now;
+    console_log(f->con, CONSOLE_INFO, "waiting for workers on %s: %d of %d joined (--min-workers)",
+                join_endpoint(f), alive, need);
+}
+
 /* --bind and no worker alive: said when the render starts, then again
  * every --wait-report interval with how long it has waited. A farm waits
- * for its workers: this never ends the render. */
+ * for its workers unless --wait-timeout says how long. */
 static void say_waiting(farm *f, int64_t now)
 {
     if (!f->opt->bind || !f->bound[0]) return;
@@ -618,6 +696,14 @@ static void say_waiting(farm *f, int64_t now)
         f->waiting_since_ms = f->wait_said_ms = now;
         return;
     }
+    if (f->gate_open && f->opt->wait_timeout_ms > 0 && f->ntiles > 0 &&
+        !scheduler_finished(f->sched) && now - f->waiting_since_ms >= f->opt->wait_timeout_ms) {
+        char what[120];
+        snprintf(what, sizeof what, "no worker alive (%d joined, none alive now)", f->joined);
+        give_up_waiting(f, what);
+        return;
+    }
+    if (!f->gate_open && f->opt->min_workers > 1) return;   /* check_gate says it */
     if (now - f->wait_said_ms < f->opt->wait_report_ms) return;
     f->wait_said_ms = now;
     char cmd[800], joined[64];
@@ -658,6 +744,8 @@ static void restart_local_workers(farm *f, int64_t now)
 static void timers(farm *f, int64_t now)
 {
     check_workers(f, now);
+    check_gate(f, now);
+    if (f->state != FARM_RUNNING) return;
     int tiles[CONSOLE_TALLY_TILES];
     int n = scheduler_expire_list(f->sched, now, tiles, CONSOLE_TALLY_TILES);
     for (int i = 0; i < n; i++) {
@@ -747,8 +835,7 @@ static void close_journals(farm *f)
         farm_frame *fr = &f->frames[i];
         if (!fr->jnl) continue;
         if (f->state == FARM_DONE || fr->done == 0 ||
-            (f->serving && f->state != FARM_INTERRUPTED &&
-             f->state != FARM_REQUEUED)) {   /* failed, cancelled: no resume */
+            (f->serving && !fr->keep_journal)) {   /* failed, cancelled: no resume */
             journal_remove(&fr->jnl);   /* the image is in place, or nothing to resume */
             continue;
         }
@@ -801,6 +888,14 @@ static int finish(farm *f)
             console_log(f->con, CONSOLE_ERROR, "interrupted; %d of %d frames written",
                         f->frames_written, f->nframes);
         rc = AAFARM_EXIT_INTERRUPTED;
+        break;
+    case FARM_NO_WORKERS:   /* the reason was said when it gave up */
+        if (f->nframes == 1)
+            console_log(f->con, CONSOLE_ERROR, "%s not written", last->output);
+        else
+            console_log(f->con, CONSOLE_ERROR, "%d of %d frames written", f->frames_written,
+                        f->nframes);
+        rc = AAFARM_EXIT_NO_WORKERS;
         break;
     default:
         console_log(f->con, CONSOLE_ERROR, "render failed: %s", f->failure);
@@ -859,6 +954,7 @@ int farm_run(const farm_options *opt, const farm_frame_in *frames, int nframes)
         f.frames[i].fmt = frames[i].fmt;
         f.frames[i].output = frames[i].output;
         f.frames[i].preview = frames[i].preview;
+        f.frames[i].job_frames = nframes;
     }
     f.fmt = frames[0].fmt;   /* the tile size (the same in every frame): limits */
     f.con = console_new(opt->verbosity, isatty(STDERR_FILENO));
@@ -894,10 +990,15 @@ int farm_run(const farm_options *opt, const farm_frame_in *frames, int nframes)
                     (unsigned long long)job_files_bytes(frames[0].jb));
     if (scheduler_finished(f.sched)) f.state = FARM_DONE;   /* all resumed */
     if (opt->bind && !f.locals && f.state == FARM_RUNNING) {
-        char cmd[800];
+        char cmd[800], joined[64] = "0 joined";
         worker_command(&f, cmd, sizeof cmd);
-        console_log(f.con, CONSOLE_INFO, "waiting for workers on %s (start one with: %s); 0 joined",
-                    f.bound, cmd);
+        if (opt->min_workers > 1) {
+            snprintf(joined, sizeof joined, "0 of %d joined (--min-workers)", opt->min_workers);
+            f.gate_said = 0;
+            f.gate_said_ms = farm_now_ms();
+        }
+        console_log(f.con, CONSOLE_INFO, "waiting for workers on %s (start one with: %s); %s",
+                    f.bound, cmd, joined);
         f.waiting = true;
         f.waiting_since_ms = f.wait_said_ms = farm_now_ms();
     }
@@ -936,12 +1037,14 @@ int farm_serve_job(farm *f, const farm_frame_in *frames, int nframes, char *err,
         f->frames[i].fmt = frames[i].fmt;
         f->frames[i].output = frames[i].output;
         f->frames[i].preview = frames[i].preview;
+        f->frames[i].job_frames = nframes;
     }
     f->ntiles = 0;
     f->frames_written = 0;
     f->resumed_tiles = 0;
     f->state = FARM_RUNNING;
     f->failure[0] = '\0';
+    f->failed_tile = -1;
     f->end_ms = 0;
     f->nonfinite_samples = 0;
     f->nonfinite_tiles = 0;
@@ -952,6 +1055,30 @@ int farm_serve_job(farm *f, const farm_frame_in *frames, int nframes, char *err,
     if (rc == AAFARM_EXIT_OK && f->ntiles > 0 && scheduler_finished(f->sched) &&
         f->state == FARM_RUNNING)
         f->state = FARM_DONE;   /* all resumed */
+    return rc;
+}
+
+int farm_serve_append(farm *f, const farm_frame_in *frames, int nframes, char *err, size_t errsz)
+{
+    int from = f->nframes;
+    f->frames = xreallocarray(f->frames, (size_t)(from + nframes), sizeof *f->frames);
+    memset(&f->frames[from], 0, (size_t)nframes * sizeof *f->frames);
+    for (int i = 0; i < nframes; i++) {
+        farm_frame *fr = &f->frames[from + i];
+        fr->jb = frames[i].jb;
+        fr->fmt = frames[i].fmt;
+        fr->output = frames[i].output;
+        fr->preview = frames[i].preview;
+        fr->first = f->ntiles;
+        fr->job_first = from;
+        fr->job_frames = nframes;
+    }
+    f->nframes += nframes;
+    int resumed = f->resumed_tiles;
+    int rc = add_frames(f, from, err, errsz);
+    if (f->resumed_tiles != resumed) console_set_resumed(f->con, f->resumed_tiles);
+    if (rc == AAFARM_EXIT_OK && f->state == FARM_RUNNING && scheduler_finished(f->sched))
+        f->state = FARM_DONE;   /* every tile of every job is in (the new one's resumed) */
     return rc;
 }
 

@@ -48,6 +48,11 @@ typedef struct farm_options {
     const char *http_token;        /* its token (checked by main.c), or NULL */
     int64_t http_linger_ms;        /* --http-linger: serve this long after the end */
     const char *pool;              /* --pool NAME: only workers of that pool (NULL: any) */
+    int min_workers;               /* --min-workers: no tile granted before this many
+                                    * workers are alive at once (0: the first one) */
+    int64_t wait_timeout_ms;       /* --wait-timeout: give up (AAFARM_EXIT_NO_WORKERS) when
+                                    * too few workers joined, or none is alive, this
+                                    * long (0: wait for ever) */
 } farm_options;
 
 void farm_options_default(farm_options *opt);
@@ -67,6 +72,8 @@ typedef struct farm_frame_in {
  * opt->output is not used here. Returns an AAFARM_EXIT_* code
  * (util/exitcodes.h): OK, FAILURE (a tile failed too often, no workers
  * left, output not writable), USAGE (an endpoint ZeroMQ cannot bind),
+ * NO_WORKERS (--wait-timeout passed: too few workers joined, or none was
+ * alive that long; the journal is kept),
  * INTERRUPTED (SIGINT/SIGTERM: nothing written but the frames already
  * complete). */
 int farm_run(const farm_options *opt, const farm_frame_in *frames, int nframes);

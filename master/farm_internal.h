@@ -36,8 +36,10 @@ typedef enum farm_state {
     FARM_FAILED,         /* a tile failed too often, or no workers are left */
     FARM_INTERRUPTED,    /* SIGINT / SIGTERM */
     FARM_CANCELLED,      /* a serving master's job, cancelled (serve.c) */
-    FARM_REQUEUED        /* a serving master's job lost every worker: back in the
+    FARM_REQUEUED,       /* a serving master's job lost every worker: back in the
                             queue, its journal kept (serve.c) */
+    FARM_NO_WORKERS      /* --wait-timeout passed without enough workers: the
+                            master gives up (its journals kept) */
 } farm_state;
 
 /* One frame of the sequence: its tiles are the scheduler's tiles
@@ -54,6 +56,13 @@ typedef struct farm_frame {
     journal *jnl;                  /* OUT.exr.journal: its tiles taken so far */
     int done;                      /* its tiles in the output */
     bool written;                  /* complete and renamed into place */
+    int job_first, job_frames;     /* its job's frames in the farm's (a serving master's
+                                      run holds the frames of several jobs) */
+    /* a serving master (serve.c), whose frames may belong to several jobs */
+    bool keep_journal;             /* at the end: its job resumes later (requeued,
+                                      interrupted), so its journal stays */
+    farm_state end;                /* its job's end for JobDone (FARM_RUNNING: the
+                                      farm's state) */
 } farm_frame;
 
 /* A tile one worker alone gave up on (SCHEDULER_AWAIT_OTHER): the words
@@ -93,6 +102,8 @@ typedef struct farm {
     int64_t start_ms, end_ms;
     farm_state state;
     char failure[2 * ERR_LEN];     /* a prefix (frame, tile, worker) and a message */
+    int failed_tile;               /* the tile (of all frames) the failure is about, or
+                                      -1 (the master's own: every frame's) */
     farm_given_up *given_up;       /* tiles waiting for a second worker */
     size_t ngiven_up;
     /* counters beyond the scheduler's and the socket's */
@@ -108,6 +119,11 @@ typedef struct farm {
     int joined;                    /* workers that said Hello (ever) */
     bool waiting;                  /* no worker alive since waiting_since_ms */
     int64_t waiting_since_ms, wait_said_ms;
+    /* --min-workers: no grant until that many are alive at once (the gate
+     * opens once for the master's life); --wait-timeout bounds the wait */
+    bool gate_open;
+    int gate_said;                 /* workers alive when the gate's wait was last said */
+    int64_t gate_since_ms, gate_said_ms;
     /* --http: the live monitor (farm_monitor.c) */
     monitor *mon;                  /* NULL without --http */
     struct http_server *http;
@@ -153,13 +169,17 @@ void farm_send_shutdown(farm *f, farm_worker *w, const char *reason, int64_t now
 /* Retires the worker and requeues its tiles (logged at INFO). */
 void farm_lose_worker(farm *f, farm_worker *w, const char *why, int64_t now);
 void farm_fail(farm *f, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+/* The same for a failure of one tile (of all frames), or of one frame's
+ * output (its first tile): a serving master fails that tile's job only. */
+void farm_fail_tile(farm *f, int tile, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
 /* A tile one worker alone gave up on waited for another worker for the
  * whole join window (--lease) in vain: the render fails with its words. */
 void farm_fail_given_up(farm *f, int tile);
 
 /* farm_monitor.c (each a no-op without --http) */
-/* The monitor and its frames, before any tile (the journal's included). */
-void farm_monitor_open(farm *f);
+/* The monitor and the frames from .. nframes - 1 (a serving master's next
+ * job adds its own), before any of their tiles (the journal's included). */
+void farm_monitor_open(farm *f, int from);
 /* Starts the HTTP server and says where: AAFARM_EXIT_OK or an exit code
  * with the message in err. */
 int farm_monitor_serve(farm *f, const struct http_jobs *jobs, char *err, size_t errsz);
@@ -183,6 +203,10 @@ void farm_monitor_close(farm *f);
  * and everything freed. */
 int farm_serve_open(farm *f, char *err, size_t errsz);
 int farm_serve_job(farm *f, const farm_frame_in *frames, int nframes, char *err, size_t errsz);
+/* Another job's frames join the running one's (their tiles after its
+ * tiles in the one queue: workers take them while its last tiles are
+ * out); an error (their output, their journal) is the caller's to fail. */
+int farm_serve_append(farm *f, const farm_frame_in *frames, int nframes, char *err, size_t errsz);
 void farm_serve_loop(farm *f);
 void farm_serve_end_job(farm *f);
 void farm_serve_close(farm *f);

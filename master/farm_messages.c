@@ -94,11 +94,15 @@ static void send_welcome(farm *f, farm_worker *w, int64_t now)
 }
 
 /* Does the worker hold the frame's job (as far as the master knows: a
- * worker that dropped it asks again with NeedJob)? */
-static bool holds_frame(const farm_worker *w, int frame)
+ * worker that dropped it asks again with NeedJob)? A serving master's
+ * run may hold the same job twice (one scene submitted twice, to two
+ * outputs): the worker holds it by its hash. */
+static bool holds_frame(const farm *f, const farm_worker *w, int frame)
 {
     for (int i = 0; i < w->nheld; i++)
-        if (w->held[i] == frame) return true;
+        if (w->held[i] == frame ||
+            strcmp(f->frames[w->held[i]].jb->hash, f->frames[frame].jb->hash) == 0)
+            return true;
     return false;
 }
 
@@ -172,14 +176,17 @@ void farm_send_job_done(farm *f, farm_worker *w, int64_t now)
     for (int i = 0; i < w->nheld; i++) {
         proto_msg msg = {.kind = PROTO_JOB_DONE};
         proto_job_done *d = &msg.job_done;
-        d->job_hash = f->frames[w->held[i]].jb->hash;
-        d->status = f->state == FARM_DONE     ? PROTO_JOB_STATUS_DONE
-                    : f->state == FARM_FAILED ? PROTO_JOB_STATUS_FAILED
-                                              : PROTO_JOB_STATUS_CANCELLED;
-        d->message = f->state == FARM_DONE        ? ""
-                     : f->state == FARM_FAILED    ? f->failure
-                     : f->state == FARM_CANCELLED ? "cancelled"
-                                                  : "interrupted";
+        const farm_frame *fr = &f->frames[w->held[i]];
+        farm_state st = fr->end != FARM_RUNNING ? fr->end : f->state;   /* its job's end */
+        d->job_hash = fr->jb->hash;
+        d->status = st == FARM_DONE     ? PROTO_JOB_STATUS_DONE
+                    : st == FARM_FAILED ? PROTO_JOB_STATUS_FAILED
+                                        : PROTO_JOB_STATUS_CANCELLED;
+        d->message = st == FARM_DONE         ? ""
+                     : st == FARM_FAILED     ? f->failure
+                     : st == FARM_CANCELLED  ? "cancelled"
+                     : st == FARM_NO_WORKERS ? "the master gave up waiting for workers"
+                                             : "interrupted";
         send_msg(f, w, &msg, now);
     }
 }
@@ -192,14 +199,28 @@ void farm_send_shutdown(farm *f, farm_worker *w, const char *reason, int64_t now
 
 /* ---- bookkeeping ---- */
 
-void farm_fail(farm *f, const char *fmt, ...)
+static void fail_v(farm *f, int tile, const char *fmt, va_list ap)
 {
     if (f->state != FARM_RUNNING) return;
+    vsnprintf(f->failure, sizeof f->failure, fmt, ap);
+    f->failed_tile = tile;
+    f->state = FARM_FAILED;
+}
+
+void farm_fail(farm *f, const char *fmt, ...)
+{
     va_list ap;
     va_start(ap, fmt);
-    vsnprintf(f->failure, sizeof f->failure, fmt, ap);
+    fail_v(f, -1, fmt, ap);
     va_end(ap);
-    f->state = FARM_FAILED;
+}
+
+void farm_fail_tile(farm *f, int tile, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    fail_v(f, tile, fmt, ap);
+    va_end(ap);
 }
 
 void farm_lose_worker(farm *f, farm_worker *w, const char *why, int64_t now)
@@ -367,7 +388,7 @@ static void tile_failed(farm *f, farm_worker *w, uint64_t lease, int tile, const
                     (double)f->opt->lease_ms / 1000.0);
         return;
     }
-    farm_fail(f, "%stile %d at (%d,%d) failed on worker %s (%s): %s", frame, local, rect.x0,
+    farm_fail_tile(f, tile, "%stile %d at (%d,%d) failed on worker %s (%s): %s", frame, local, rect.x0,
               rect.y0, w->name, retryable ? "attempts exhausted" : "not retryable, confirmed "
               "by a second worker", msg);
 }
@@ -376,11 +397,11 @@ void farm_fail_given_up(farm *f, int tile)
 {
     for (size_t i = 0; i < f->ngiven_up; i++)
         if (f->given_up[i].tile == tile) {
-            farm_fail(f, "%s; no other worker could try it within %.0f s (--lease)",
+            farm_fail_tile(f, tile, "%s; no other worker could try it within %.0f s (--lease)",
                       f->given_up[i].failure, (double)f->opt->lease_ms / 1000.0);
             return;
         }
-    farm_fail(f, "tile %d: every worker gave it up", tile);   /* not reached */
+    farm_fail_tile(f, tile, "tile %d: every worker gave it up", tile);   /* not reached */
 }
 
 /* A worker whose results were refused --retries times gets no more tiles
@@ -448,7 +469,7 @@ static void on_result(farm *f, farm_worker *w, const proto_result *r, const wire
                                         chunk, chunk_len, ioerr, sizeof ioerr)) {
                 /* the master's own output failed (disk full): not the
                  * worker's fault, and no other worker can do better */
-                farm_fail(f, "%s", ioerr);
+                farm_fail_tile(f, tile, "%s", ioerr);
                 return;
             }
             scheduler_complete(f->sched, w->slot, r->lease_id, now);
@@ -541,7 +562,7 @@ static void on_need_file(farm *f, farm_worker *w, const proto_need_file *n, int6
         return;
     }
     if (r == FILE_READ_CHANGED || r == FILE_READ_NO_MEMORY) {
-        farm_fail(f, "%s", err);
+        farm_fail_tile(f, fr->first, "%s", err);
         return;
     }
     proto_msg msg = {.kind = PROTO_FILE_CHUNK,
@@ -626,7 +647,7 @@ static bool grant_one(farm *f, farm_worker *w, int64_t now)
     if (!scheduler_grant(f->sched, w->slot, now, &l)) return false;
     int local;
     farm_frame *fr = farm_frame_of(f, l.tile, &local);
-    if (!holds_frame(w, (int)(fr - f->frames)) && send_job(f, w, fr, now) != 0) return false;
+    if (!holds_frame(f, w, (int)(fr - f->frames)) && send_job(f, w, fr, now) != 0) return false;
     if (send_grant(f, w, &l, now) != 0) return false;
     w->credits--;
     return true;
@@ -634,6 +655,7 @@ static bool grant_one(farm *f, farm_worker *w, int64_t now)
 
 void farm_grant_all(farm *f, int64_t now)
 {
+    if (!f->gate_open) return;   /* --min-workers: not yet */
     bool granted = true;
     while (granted && f->state == FARM_RUNNING) {
         granted = false;

@@ -23,6 +23,7 @@
  * it or holds its newest lease (-1: none; slots name the workers of
  * /api/workers).
  */
+#include <assert.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -40,17 +41,22 @@
 
 enum { FARM_MONITOR_MS = 250 };
 
-void farm_monitor_open(farm *f)
+void farm_monitor_open(farm *f, int from)
 {
     if (!f->opt->http) return;
     if (!f->mon) f->mon = monitor_new();   /* a serving master's: one for all its jobs */
-    for (int i = 0; i < f->nframes; i++) {
+    for (int i = from; i < f->nframes; i++) {
         int index = monitor_add_frame(f->mon, f->frames[i].fmt.width, f->frames[i].fmt.height);
         if (i == 0) f->mon_base = index;
+        assert(index == f->mon_base + i);   /* the frames' monitor indices follow each other */
     }
-    free(f->tile_slot);
-    f->tile_slot = xmalloc(((size_t)f->ntiles + 1) * sizeof *f->tile_slot);
-    for (int i = 0; i < f->ntiles; i++) f->tile_slot[i] = -1;
+    int kept = from > 0 && from < f->nframes ? f->frames[from].first : 0;
+    if (from == 0) {   /* a new render (a serving master's next job on its own) */
+        free(f->tile_slot);
+        f->tile_slot = NULL;
+    }
+    f->tile_slot = xreallocarray(f->tile_slot, (size_t)f->ntiles + 1, sizeof *f->tile_slot);
+    for (int i = kept; i < f->ntiles; i++) f->tile_slot[i] = -1;
 }
 
 int farm_monitor_serve(farm *f, const http_jobs *jobs, char *err, size_t errsz)
@@ -98,6 +104,7 @@ static const char *state_name(const farm *f)
     case FARM_FAILED: return "failed";
     case FARM_INTERRUPTED: return "interrupted";
     case FARM_REQUEUED: return "requeued";
+    case FARM_NO_WORKERS: return "no workers";
     default: return "running";
     }
 }
@@ -194,7 +201,7 @@ static char *build_status(const farm *f, int64_t now, size_t *len)
     fputs("{\"job\": {\"scene\": ", out);
     json_out_string(out, f->opt->scene_path ? f->opt->scene_path : "");
     fprintf(out, ", \"state\": \"%s\", \"error\": ", state_name(f));
-    json_out_string(out, f->state == FARM_FAILED ? f->failure : "");
+    json_out_string(out, f->state == FARM_FAILED || f->state == FARM_NO_WORKERS ? f->failure : "");
     fprintf(out, ", \"job_hash\": \"%.64s\", \"frames\": %d, \"frames_written\": %d, "
             "\"elapsed_s\": %.3f, \"host\": ", f->nframes ? f->frames[0].jb->hash : "", f->nframes,
             f->frames_written, secs);

@@ -63,6 +63,12 @@ static void usage(FILE *out)
         "  --max-workers N            workers served at a time; more are refused (1024)\n"
         "  --pool NAME                only workers started with --pool NAME get tiles (with\n"
         "                             --bind; local workers have no pool)\n"
+        "  --min-workers N            grant no tile before N workers have joined (alive at\n"
+        "                             once); says \"K of N joined\" meanwhile (default 1)\n"
+        "  --wait-timeout S           give up with exit status 4 when fewer than\n"
+        "                             --min-workers (or no worker at all) joined within S\n"
+        "                             seconds, or no worker was alive for S seconds\n"
+        "                             (default: wait for ever; the journal is kept)\n"
         "  --curve-secret FILE        CurveZMQ on --bind: this master's NAME.key_secret\n"
         "                             (aafarm-keygen NAME); needs --allow-keys\n"
         "  --allow-keys DIR           the workers' public keys (NAME.key files) that may\n"
@@ -83,8 +89,10 @@ static void usage(FILE *out)
         "                             are rendered (every render journals its tiles there)\n"
         "  --serve                    keep the workers and render a queue of jobs, submitted\n"
         "                             with aafarm-submit --master http://ADDR:PORT (or POST\n"
-        "                             /api/jobs), one after another by priority, until\n"
-        "                             SIGINT/SIGTERM (docs/farm.md, \"A job queue\")\n"
+        "                             /api/jobs), one after another by priority (the next\n"
+        "                             job's tiles go out while the last ones of the job\n"
+        "                             before are rendered), until SIGINT/SIGTERM\n"
+        "                             (docs/farm.md, \"A job queue\")\n"
         "  --db FILE                  --serve: the queue's SQLite database (default\n"
         "                             aafarm-queue.db); a master restarted on it resumes\n"
         "                             every unfinished job\n"
@@ -97,7 +105,8 @@ static void usage(FILE *out)
         "Exit status: 0 the image is complete, 1 the render failed (a tile failed on\n"
         "--retries workers, no workers left, output not writable), 2 usage (bad options\n"
         "or endpoint), 3 bad scene or shader (diagnostics printed, no worker contacted),\n"
-        "130 interrupted by SIGINT/SIGTERM (no output file is left behind; the journal\n"
+        "4 --wait-timeout passed without enough workers (the journal is kept), 130\n"
+        "interrupted by SIGINT/SIGTERM (no output file is left behind; the journal\n"
         "is, for --resume). --resume with another job's journal is a usage error (2).\n");
 }
 
@@ -163,7 +172,8 @@ static int parse(int argc, char **argv, cli *c)
     enum { O_BIND = 256, O_LOCAL, O_TPW, O_TILE, O_ARITH, O_BUDGET, O_PREVIEW, O_STATS_JSON,
            O_HEARTBEAT, O_LIVENESS, O_RETRIES, O_LEASE, O_DUPS, O_WORKER_BIN, O_RESUME, O_MAX_WORKERS, O_FRAMES,
            O_CURVE_SECRET, O_ALLOW_KEYS, O_INSECURE, O_LEASE_FACTOR, O_HTTP, O_HTTP_TOKEN,
-           O_HTTP_TOKEN_FILE, O_HTTP_LINGER, O_SERVE, O_DB, O_POOL };
+           O_HTTP_TOKEN_FILE, O_HTTP_LINGER, O_SERVE, O_DB, O_POOL, O_MIN_WORKERS,
+           O_WAIT_TIMEOUT };
     static const struct option longopts[] = {
         {"output", required_argument, 0, 'o'},
         {"bind", required_argument, 0, O_BIND},
@@ -194,6 +204,8 @@ static int parse(int argc, char **argv, cli *c)
         {"serve", no_argument, 0, O_SERVE},
         {"db", required_argument, 0, O_DB},
         {"pool", required_argument, 0, O_POOL},
+        {"min-workers", required_argument, 0, O_MIN_WORKERS},
+        {"wait-timeout", required_argument, 0, O_WAIT_TIMEOUT},
         {"quiet", no_argument, 0, 'q'},
         {"verbose", no_argument, 0, 'v'},
         {"help", no_argument, 0, 'h'},
@@ -292,6 +304,14 @@ static int parse(int argc, char **argv, cli *c)
             f->pool = optarg;
             break;
         }
+        case O_MIN_WORKERS:
+            if (!number_arg("--min-workers", NULL, 1, 65536, &n)) return AAFARM_EXIT_USAGE;
+            f->min_workers = (int)n;
+            break;
+        case O_WAIT_TIMEOUT:
+            if (!number_arg("--wait-timeout", "seconds", 1, 31536000L, &n)) return AAFARM_EXIT_USAGE;
+            f->wait_timeout_ms = n * 1000;
+            break;
         case 'q': f->verbosity = -1; break;
         case 'v': f->verbosity = 1; break;
         case 'h': usage(stdout); return AAFARM_EXIT_OK;
@@ -356,6 +376,18 @@ static int parse(int argc, char **argv, cli *c)
     if (f->local_workers > f->max_workers) {
         fprintf(stderr, "aafarm-master: --local-workers %d is more than --max-workers %d\n",
                 f->local_workers, f->max_workers);
+        return AAFARM_EXIT_USAGE;
+    }
+    if (f->min_workers > f->max_workers) {
+        fprintf(stderr, "aafarm-master: --min-workers %d is more than --max-workers %d: the "
+                "render could never start\n", f->min_workers, f->max_workers);
+        return AAFARM_EXIT_USAGE;
+    }
+    if (!f->bind && f->min_workers > f->local_workers) {
+        fprintf(stderr, "aafarm-master: --min-workers %d without --bind: only the %d local "
+                "workers can join, so the render could never start (give --bind ENDPOINT for "
+                "remote workers, or --local-workers %d)\n", f->min_workers, f->local_workers,
+                f->min_workers);
         return AAFARM_EXIT_USAGE;
     }
     if (!f->bind && f->local_workers == 0) {

@@ -246,9 +246,20 @@ char *queue_json(queue *self, long id, size_t *len, bool *missing, char *err, si
 
 long queue_next(queue *self, bool *resume, char *err, size_t errsz)
 {
-    sqlite3_stmt *st = prepare(self, "SELECT id, state FROM jobs WHERE state IN ('running', "
-                               "'queued') ORDER BY state = 'running' DESC, priority DESC, id "
-                               "LIMIT 1", err, errsz);
+    return queue_next_except(self, NULL, 0, resume, err, errsz);
+}
+
+long queue_next_except(queue *self, const long *skip, int nskip, bool *resume, char *err,
+                       size_t errsz)
+{
+    char sql[600], *at = sql;
+    at += snprintf(sql, sizeof sql, "SELECT id, state FROM jobs WHERE state IN ('running', "
+                   "'queued')");
+    for (int i = 0; i < nskip && at < sql + sizeof sql - 200; i++)
+        at += snprintf(at, (size_t)(sql + sizeof sql - at), " AND id != %ld", skip[i]);
+    snprintf(at, (size_t)(sql + sizeof sql - at), " ORDER BY state = 'running' DESC, priority "
+             "DESC, id LIMIT 1");
+    sqlite3_stmt *st = prepare(self, sql, err, errsz);
     if (!st) return -1;
     long id = -1;
     int rc = sqlite3_step(st);

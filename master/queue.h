@@ -48,6 +48,9 @@ char *queue_json(queue *self, long id, size_t *len, bool *missing, char *err, si
 
 /* The job to run next (-1: none); *resume: it was running already. */
 long queue_next(queue *self, bool *resume, char *err, size_t errsz);
+/* The same, but none of the nskip jobs in skip (those running already). */
+long queue_next_except(queue *self, const long *skip, int nskip, bool *resume, char *err,
+                       size_t errsz);
 /* Its submission (malloc'd). */
 bool queue_bundle(queue *self, long id, uint8_t **data, size_t *len, char *err, size_t errsz);
 /* Running from now (false: it was cancelled meanwhile, or an error). */

@@ -20,6 +20,7 @@ static const char *state_name(farm_state s)
     case FARM_DONE: return "done";
     case FARM_FAILED: return "failed";
     case FARM_INTERRUPTED: return "interrupted";
+    case FARM_NO_WORKERS: return "no workers";
     default: return "running";
     }
 }

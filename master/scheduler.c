@@ -120,6 +120,19 @@ void scheduler_destroy(scheduler **self_p)
     *self_p = NULL;
 }
 
+bool scheduler_extend(scheduler *self, int more)
+{
+    assert(more >= 1);   /* a job has tiles */
+    if (more > INT_MAX / 2 - self->ntiles) return false;
+    int n = self->ntiles + more;
+    self->tiles = xreallocarray(self->tiles, (size_t)n, sizeof *self->tiles);
+    memset(&self->tiles[self->ntiles], 0, (size_t)more * sizeof *self->tiles);
+    self->rq = xreallocarray(self->rq, (size_t)n, sizeof *self->rq);
+    self->ntiles = n;
+    self->counts.tiles = n;
+    return true;
+}
+
 int scheduler_worker_add(scheduler *self)
 {
     self->workers = xrealloc(self->workers, sizeof *self->workers * (size_t)(self->nworkers + 1));

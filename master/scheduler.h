@@ -123,6 +123,13 @@ typedef struct scheduler scheduler;
 scheduler *scheduler_new(int tiles_x, int tiles_y, const scheduler_options *opt);
 void scheduler_destroy(scheduler **self_p);
 
+/* Appends `more` (>= 1) PENDING tiles after the last one (a serving
+ * master's next job joins the queue while the last tiles of the previous
+ * one are out: docs/farm.md "A job queue"); numbers, leases and workers
+ * stay as they are. False (nothing changed) when the total would be too
+ * large to count. */
+bool scheduler_extend(scheduler *self, int more);
+
 /* A new worker slot (0, 1, 2 ...; never reused). */
 int scheduler_worker_add(scheduler *self);
 

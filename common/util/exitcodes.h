@@ -12,6 +12,8 @@ enum {
                                      a disk error, no workers left ...) */
     AAFARM_EXIT_USAGE = 2,        /* bad command line */
     AAFARM_EXIT_INPUT = 3,        /* bad scene or shader (diagnostics printed) */
+    AAFARM_EXIT_NO_WORKERS = 4,   /* aafarm-master --wait-timeout: too few workers
+                                     joined in time (the journal is kept) */
     AAFARM_EXIT_INTERRUPTED = 130 /* SIGINT / SIGTERM: nothing written */
 };
 

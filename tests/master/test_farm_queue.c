@@ -143,7 +143,8 @@ static void test_queue_priorities_cancel_and_restart(void **state)
     assert_true(ft_wait_for(log2, "job 2 done", 1, 60));
     assert_true(ft_wait_for(log2, "job 3: ", 1, 1));
     assert_true(ft_count(log2, "; resumed, tiles from its journal") == 1);
-    assert_true(position(log2, "job 3 done") < position(log2, "job 2: "));
+    /* job 2 starts after job 3 (it may join job 3's last tiles: overlap) */
+    assert_true(position(log2, "job 3: ") < position(log2, "job 2: "));
     assert_int_equal(ft_count(log1, "job 4: ") + ft_count(log2, "job 4: "), 0);
 
     /* the list says so */

@@ -3,7 +3,8 @@
  * without sockets: runs of neighbouring tiles per worker, requeue to the
  * front, deadlines (and leases kept while a worker gets the job's files),
  * end-game duplicates, retries and the job failing, stale
- * and duplicate results, tiles already DONE from a resumed journal, and a
+ * and duplicate results, tiles already DONE from a resumed journal, tiles
+ * appended while leases are out (a serving master's next job), and a
  * randomised run in which workers come, go,
  * fail and time out while every tile must end up taken exactly once.
  */
@@ -13,6 +14,7 @@
 #include <stdint.h>
 #include <cmocka.h>
 
+#include <limits.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -598,6 +600,37 @@ static void test_resumed_tiles_never_granted(void **state)
     scheduler_destroy(&s);
 }
 
+/* A serving master's next job joins the queue while the last tiles of
+ * the previous one are leased: its tiles go to the idle worker at once
+ * (before any duplicate), the old leases' results are still taken, and
+ * the queue is finished only when both jobs' tiles are in. */
+static void test_extend_while_leases_are_out(void **state)
+{
+    (void)state;
+    scheduler *s = make(4, 1, 3, 1, 1000);
+    int a = scheduler_worker_add(s), b = scheduler_worker_add(s);
+    uint64_t ids[4];
+    for (int i = 0; i < 4; i++) assert_true(grant_tile(s, i < 2 ? a : b, 0, &ids[i]) >= 0);
+    assert_int_equal(scheduler_complete(s, a, ids[0], 10), SCHEDULER_TAKEN);
+    assert_true(scheduler_extend(s, 3));
+    scheduler_counts c;
+    scheduler_counts_get(s, &c);
+    assert_int_equal(c.tiles, 7);
+    assert_int_equal(c.queued, 3);
+    assert_int_equal(c.leased, 3);
+    uint64_t more[3];
+    for (int i = 0; i < 3; i++) assert_int_equal(grant_tile(s, a, 20, &more[i]), 4 + i);
+    assert_int_equal(scheduler_complete(s, a, ids[1], 30), SCHEDULER_TAKEN);
+    assert_int_equal(scheduler_complete(s, b, ids[2], 30), SCHEDULER_TAKEN);
+    assert_int_equal(scheduler_complete(s, b, ids[3], 30), SCHEDULER_TAKEN);
+    assert_false(scheduler_finished(s));
+    for (int i = 0; i < 3; i++) assert_int_equal(scheduler_complete(s, a, more[i], 40), SCHEDULER_TAKEN);
+    assert_true(scheduler_finished(s));
+    assert_false(scheduler_extend(s, INT_MAX / 2));   /* too many to count: unchanged */
+    assert_true(scheduler_finished(s));
+    scheduler_destroy(&s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -618,6 +651,7 @@ int main(void)
         cmocka_unit_test(test_each_lease_visits_the_valid_ones),
         cmocka_unit_test(test_resumed_tiles_never_granted),
         cmocka_unit_test(test_random_farm_takes_every_tile_once),
+        cmocka_unit_test(test_extend_while_leases_are_out),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
