@@ -347,8 +347,11 @@ job *job_load(const char *rib_path, const job_options *options, const atomic_int
     sl_source_set *archives = sl_source_set_new();
     sl_source_set_set_max_size(archives, SCENE_ARCHIVE_MAX_BYTES);
     sl_source_set_set_loader(archives, job_archive_load_from_disk, self);
-    scene *sc = scene_parse_frame(rib_path, self->scene_text, self->scene_len, archives,
-                                  SCENE_MAX_OBJECTS, self->options.frame, cancel, diag);
+    /* one parse, a check's (issue 23): the master keeps no mesh arrays
+     * and no references, and checks those as it reads them */
+    scene *sc = scene_check_frame(rib_path, self->scene_text, self->scene_len, archives,
+                                  SCENE_MAX_OBJECTS, self->options.frame, job_scene_checker(),
+                                  cancel, diag);
     sl_source_set_destroy(&archives);
     if (!sc) {
         job_destroy(&self);
@@ -407,11 +410,11 @@ job *job_load(const char *rib_path, const job_options *options, const atomic_int
         }
         free(path);
     }
-    scene_destroy(&sc);
     if (ok) {
         /* compiling pulls the #included files into the set, from disk */
         sl_source_set_set_loader(self->sources, sl_source_load_from_disk, NULL);
-        job_scene *js = job_scene_new(self, 0, false, cancel, diag);
+        job_scene *js = job_scene_check(self, sc, cancel, diag);
+        sc = NULL;                     /* the job_scene's */
         sl_source_set_set_loader(self->sources, NULL, NULL);
         ok = js != NULL && job_collect_files(self, js, diag);
         if (ok) {
@@ -420,6 +423,7 @@ job *job_load(const char *rib_path, const job_options *options, const atomic_int
         }
         job_scene_destroy(&js);
     }
+    scene_destroy(&sc);
     if (ok && !job_finish(self, err, sizeof err)) {
         sl_diag_error(diag, (sl_pos){0}, "%s", err);
         ok = false;

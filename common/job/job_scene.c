@@ -11,6 +11,7 @@
 #include "util/err.h"
 #include "util/xalloc.h"
 
+#include <assert.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -303,25 +304,6 @@ static bool group_place(const void *user, int k, trace_object *t, trace_primvar 
     return true;
 }
 
-static bool same_string(const char *a, const char *b)
-{
-    return a == b || (a && b && strcmp(a, b) == 0);
-}
-
-/* May object o (an instance) be a reference to its prototype p: the same
- * surface in object space (undisplaced), the same shaders, sides, lights
- * and primitive variables, only its transform and colour its own? */
-static bool placeable(const scene_object *o, const scene_object *p)
-{
-    return o->displacement_shader < 0 && p->displacement_shader < 0 && o->mesh == p->mesh &&
-           o->surface == p->surface && o->surface_shader == p->surface_shader &&
-           o->sides == p->sides && o->nlights == p->nlights &&
-           (o->lights == p->lights ||
-            memcmp(o->lights, p->lights, sizeof *o->lights * (size_t)o->nlights) == 0) &&
-           o->primvars == p->primvars && o->nprimvars == p->nprimvars &&
-           same_string(o->name, p->name);
-}
-
 /* Which objects are references (placements) and of which prototype:
  * proto_of[i] is the prototype's scene index, or -1 for an object of its
  * own; the count of each prototype's placements in nplaced[]. */
@@ -333,7 +315,8 @@ static int find_placements(const scene *sc, int *proto_of, int *nplaced)
         int j = o->instance_of;
         proto_of[i] = -1;
         nplaced[i] = 0;
-        if (j < 0 || j >= i || proto_of[j] >= 0 || !placeable(o, &sc->objects[j])) continue;
+        if (j < 0 || j >= i || proto_of[j] >= 0 || !scene_object_placeable(o, &sc->objects[j]))
+            continue;
         proto_of[i] = j;
         nplaced[j]++;
         n++;
@@ -341,13 +324,20 @@ static int find_placements(const scene *sc, int *proto_of, int *nplaced)
     return n;
 }
 
+/* The object name build_object gives an object (the prototype's, for a
+ * reference's message). */
+static void object_name(const scene *sc, const scene_object *o, char *out, size_t outsz)
+{
+    snprintf(out, outsz, "%s at %s:%d",
+             o->name ? o->name : o->mesh ? "mesh" : geom_kind_name(o->surface->kind),
+             o->pos.file ? o->pos.file : sc->file, o->pos.line);
+}
+
 static void build_object(job_scene *self, const scene_object *o, trace_object *t,
                          trace_primvar *pv, int *undisplaced)
 {
     const scene *sc = self->scene;
-    snprintf(t->name, sizeof t->name, "%s at %s:%d",
-             o->name ? o->name : o->mesh ? "mesh" : geom_kind_name(o->surface->kind),
-             o->pos.file ? o->pos.file : sc->file, o->pos.line);
+    object_name(sc, o, t->name, sizeof t->name);
     if (o->surface) t->surf = *o->surface;
     t->to_camera = o->object_to_camera;
     t->from_camera = o->camera_to_object;
@@ -525,6 +515,31 @@ job_scene *job_scene_new(const job *jb, size_t cache_bytes, bool render,
     return job_scene_new_threads(jb, cache_bytes, render, 1, cancel, diag);
 }
 
+/* scene_check.placement: what trace_world_check asks of each placement of
+ * a group (its view's transforms, trace_object_derive), asked as it is
+ * read. */
+static bool check_placement(void *user, const scene *sc, const scene_object *proto,
+                            const scene_object *placement, char *err, size_t errsz)
+{
+    (void)user;
+    static const trace_world none;    /* derive without the grid reads no world */
+    trace_object probe;
+    memset(&probe, 0, sizeof probe);
+    object_name(sc, proto, probe.name, sizeof probe.name);
+    probe.to_camera = placement->object_to_camera;
+    probe.from_camera = placement->camera_to_object;
+    return trace_object_derive(&none, &probe, false, err, errsz);
+}
+
+const scene_check *job_scene_checker(void)
+{
+    static const scene_check checker = { check_placement, NULL };
+    return &checker;
+}
+
+static job_scene *build(job_scene *self, size_t cache_bytes, bool render, int threads,
+                        const atomic_int *cancel, sl_diag *diag);
+
 job_scene *job_scene_new_threads(const job *jb, size_t cache_bytes, bool render, int threads,
                                  const atomic_int *cancel, sl_diag *diag)
 {
@@ -537,7 +552,24 @@ job_scene *job_scene_new_threads(const job *jb, size_t cache_bytes, bool render,
     self->scene = scene_parse_frame(jb->scene_file, jb->scene_text, jb->scene_len, archives,
                                     SCENE_MAX_OBJECTS, jb->options.frame, cancel, diag);
     sl_source_set_destroy(&archives);
+    return build(self, cache_bytes, render, threads, cancel, diag);
+}
+
+job_scene *job_scene_check(const job *jb, scene *sc, const atomic_int *cancel, sl_diag *diag)
+{
+    job_scene *self = xcalloc(1, sizeof *self);
+    self->job = jb;
+    self->scene = sc;
+    return build(self, 0, false, 1, cancel, diag);
+}
+
+/* From the parsed scene (NULL: its errors are in diag) on. */
+static job_scene *build(job_scene *self, size_t cache_bytes, bool render, int threads,
+                        const atomic_int *cancel, sl_diag *diag)
+{
+    const job *jb = self->job;
     bool ok = self->scene != NULL;
+    assert(!ok || !render || !self->scene->checked);
     if (ok) ok = compile_programs(self, cancel, diag);
     if (ok) ok = build_objects(self, diag);
     if (ok) ok = !interrupted(cancel, diag);

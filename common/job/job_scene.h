@@ -43,6 +43,18 @@ job_scene *job_scene_new(const job *job, size_t cache_bytes, bool render,
  * worker passes its rendering threads. */
 job_scene *job_scene_new_threads(const job *job, size_t cache_bytes, bool render, int threads,
                                  const atomic_int *cancel, sl_diag *diag);
+/* The master's check of a job whose scene it has parsed with
+ * job_scene_checker (scene_check_frame: no mesh arrays, references
+ * checked and dropped): the scene is taken (destroyed with the result, or
+ * on errors); compiles, binds, builds the check's world and checks it as
+ * job_scene_new(render = false) does. */
+job_scene *job_scene_check(const job *job, scene *sc, const atomic_int *cancel, sl_diag *diag);
+
+/* What job_scene_check's parse hands the scene parser: the renderer's
+ * test of a reference's transforms (trace_object_derive), made for each
+ * placement as it is read. */
+const scene_check *job_scene_checker(void);
+
 void job_scene_destroy(job_scene **self_p);
 
 #endif

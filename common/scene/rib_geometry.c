@@ -119,7 +119,8 @@ static const char *shared_string(rib_parser *p, const char *prev, const char *s)
 static void object_lights(rib_parser *p, const scene_object *prev, scene_object *o)
 {
     const rib_attributes *a = &p->attr;
-    int *on = xmalloc((size_t)(p->scene->nlights ? p->scene->nlights : 1) * sizeof *on);
+    int few[64];                   /* most scenes: no allocation per object */
+    int *on = p->scene->nlights <= 64 ? few : xmalloc((size_t)p->scene->nlights * sizeof *on);
     int n = a->lights_on ? a->lights_on->n : 0, non = 0;
     for (int i = 0; i < p->scene->nlights && i < n; i++)
         if (a->lights_on->on[i])
@@ -128,7 +129,7 @@ static void object_lights(rib_parser *p, const scene_object *prev, scene_object 
                             prev ? (size_t)prev->nlights * sizeof *on : 0, on,
                             (size_t)non * sizeof *on);
     o->nlights = non;
-    free(on);
+    if (on != few) free(on);
 }
 
 void rib_place_surface(rib_parser *p, const rib_request *req, const geom_surface *surf,

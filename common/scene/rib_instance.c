@@ -19,6 +19,7 @@
  */
 #include "scene/rib_parser.h"
 #include "sl/strbuf.h"
+#include "util/err.h"
 #include "util/xalloc.h"
 
 #include <stdio.h>
@@ -145,7 +146,18 @@ void rib_object_instance(rib_parser *p, const rib_request *req)
             continue;                  /* not placed (an error said why) */
         if (part->first_object < 0)
             part->first_object = before;
-        p->scene->objects[before].instance_of = part->first_object;
+        scene_object *o = &p->scene->objects[before];
+        o->instance_of = part->first_object;
+        if (p->check && part->first_object < before &&
+            scene_object_placeable(o, &p->scene->objects[part->first_object])) {
+            /* a check's parse: a reference is checked and not kept */
+            char err[ERR_LEN] = "";
+            if (!p->check->placement(p->check->user, p->scene,
+                                     &p->scene->objects[part->first_object], o, err, sizeof err))
+                rib_error(p, req, req->pos, "%s", err[0] ? err : "cannot be placed");
+            p->scene->nobjects--;
+            p->scene->nchecked_placements++;
+        }
     }
 }
 

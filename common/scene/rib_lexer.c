@@ -16,6 +16,7 @@
 #include <math.h>
 #include <stdarg.h>
 #include <stdbool.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -128,12 +129,8 @@ static void bad(rib_lexer *self, rib_token *t, const char *fmt, ...)
 
 static rib_token make(rib_lexer *self, rib_token_kind kind, const char *start)
 {
-    rib_token t;
-    memset(&t, 0, sizeof t);
-    t.kind = kind;
-    t.pos = pos_at(self, start);
-    t.text = start;
-    t.len = (size_t)(self->p - start);
+    rib_token t = { .kind = kind, .pos = pos_at(self, start), .text = start,
+                    .len = (size_t)(self->p - start) };
     return t;
 }
 
@@ -141,29 +138,59 @@ static rib_token make(rib_lexer *self, rib_token_kind kind, const char *start)
 /* numbers                                                                 */
 /* ---------------------------------------------------------------------- */
 
-/* True when s[0..n) is exactly a RIB number. */
-static bool number_syntax(const char *s, size_t n)
+/* Reads s[0..n) as a RIB number: false when it is not exactly one.
+ * *fast is set, with its value in *v, when the value can be had without
+ * strtod and be the same double: at most 15 significant digits (the whole
+ * number then fits a double exactly) and a power of ten within 10^22
+ * (exact too), so that the one multiplication or division is the correctly
+ * rounded result strtod gives (Clinger 1990, the fast path). */
+static bool read_number(const char *s, size_t n, bool *fast, double *v)
 {
+    static const double pow10[] = { 1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10,
+                                    1e11, 1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19,
+                                    1e20, 1e21, 1e22 };
     size_t i = 0, digits = 0;
+    bool negative = false;
+    uint64_t m = 0;
+    int significant = 0, scale = 0;    /* value: m * 10^(scale + exponent) */
     if (i < n && (s[i] == '+' || s[i] == '-'))
-        i++;
-    while (i < n && is_digit(s[i])) { i++; digits++; }
+        negative = s[i++] == '-';
+    for (; i < n && is_digit(s[i]); i++, digits++)
+        if (m > 0 || s[i] != '0') {
+            if (++significant <= 15) m = m * 10 + (uint64_t)(s[i] - '0');
+        }
     if (i < n && s[i] == '.') {
-        i++;
-        while (i < n && is_digit(s[i])) { i++; digits++; }
+        for (i++; i < n && is_digit(s[i]); i++, digits++)
+            if (m > 0 || s[i] != '0') {
+                if (++significant <= 15) { m = m * 10 + (uint64_t)(s[i] - '0'); scale--; }
+            } else {
+                scale--;                     /* a leading zero after the point */
+            }
     }
     if (digits == 0)
         return false;
+    long exponent = 0;
     if (i < n && (s[i] == 'e' || s[i] == 'E')) {
         i++;
+        bool exp_negative = false;
         if (i < n && (s[i] == '+' || s[i] == '-'))
-            i++;
+            exp_negative = s[i++] == '-';
         size_t exp_digits = 0;
-        while (i < n && is_digit(s[i])) { i++; exp_digits++; }
+        for (; i < n && is_digit(s[i]); i++, exp_digits++)
+            if (exponent < 100000) exponent = exponent * 10 + (s[i] - '0');
         if (exp_digits == 0)
             return false;
+        if (exp_negative) exponent = -exponent;
     }
-    return i == n;
+    if (i != n)
+        return false;
+    long e = scale + exponent;
+    *fast = significant <= 15 && (m == 0 || (e >= -22 && e <= 22));
+    if (*fast) {
+        double x = m == 0 ? 0.0 : e >= 0 ? (double)m * pow10[e] : (double)m / pow10[-e];
+        *v = negative ? -x : x;
+    }
+    return true;
 }
 
 static rib_token lex_number(rib_lexer *self)
@@ -174,7 +201,8 @@ static rib_token lex_number(rib_lexer *self)
     rib_token t = make(self, RIB_TOK_NUMBER, start);
     int shown = t.len > 40 ? 40 : (int)t.len;
     const char *more = t.len > 40 ? "..." : "";
-    if (!number_syntax(start, t.len)) {
+    bool fast = false;
+    if (!read_number(start, t.len, &fast, &t.number)) {
         bad(self, &t, "bad number '%.*s%s'", shown, start, more);
         return t;
     }
@@ -183,6 +211,8 @@ static rib_token lex_number(rib_lexer *self)
         bad(self, &t, "number '%.*s%s' is too long", shown, start, more);
         return t;
     }
+    if (fast)
+        return t;
     memcpy(buf, start, t.len);
     buf[t.len] = '\0';
     t.number = strtod(buf, NULL);

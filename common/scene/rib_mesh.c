@@ -367,8 +367,9 @@ static void read_mesh(rib_parser *p, const rib_request *req, const int *nloops, 
         m.N = smooth = smooth_normals(m.npoints, P->values, nloops, nfaces, nverts, idx);
     }
 #ifdef SCENE_HAVE_GEOM
-    m.out = scene_mesh_new(P->values, m.npoints, idx, nidx, m.ncls, m.N,
-                           N ? N->count / 3 : m.npoints, &m.pv, &params);
+    m.out = p->check ? scene_mesh_new_counted(m.pv.n)     /* a check keeps no arrays */
+                     : scene_mesh_new(P->values, m.npoints, idx, nidx, m.ncls, m.N,
+                                      N ? N->count / 3 : m.npoints, &m.pv, &params);
 #endif
     const int *loop = nverts, *vi = idx;
     for (int f = 0; f < nfaces && !sl_diag_full(p->diag); f++) {

@@ -20,6 +20,7 @@
 #include <ctype.h>
 #include <limits.h>
 #include <math.h>
+#include <pthread.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -496,11 +497,39 @@ static const request_def requests[] = {
 
 enum { NREQUESTS = sizeof requests / sizeof requests[0] };
 
+/* The table by name: an open-addressed hash of the requests' indices
+ * (+1; 0: empty), made once per process. A scene of a million instances
+ * is some ten million requests: a look-up is one hash and one strcmp. */
+enum { REQUEST_SLOTS = 256 };
+static unsigned char request_slots[REQUEST_SLOTS];
+static pthread_once_t request_slots_once = PTHREAD_ONCE_INIT;
+
+static unsigned request_hash(const char *name)
+{
+    unsigned h = 2166136261u;          /* FNV-1a */
+    for (const unsigned char *c = (const unsigned char *)name; *c; c++)
+        h = (h ^ *c) * 16777619u;
+    return h;
+}
+
+static void make_request_slots(void)
+{
+    _Static_assert(NREQUESTS < REQUEST_SLOTS / 2 && NREQUESTS < 255, "the table has room");
+    for (int i = 0; i < NREQUESTS; i++) {
+        unsigned k = request_hash(requests[i].name) % REQUEST_SLOTS;
+        while (request_slots[k])
+            k = (k + 1) % REQUEST_SLOTS;
+        request_slots[k] = (unsigned char)(i + 1);
+    }
+}
+
 static const request_def *find_request(const char *name)
 {
-    for (int i = 0; i < NREQUESTS; i++)
-        if (strcmp(requests[i].name, name) == 0)
-            return &requests[i];
+    pthread_once(&request_slots_once, make_request_slots);
+    for (unsigned k = request_hash(name) % REQUEST_SLOTS; request_slots[k];
+         k = (k + 1) % REQUEST_SLOTS)
+        if (strcmp(requests[request_slots[k] - 1].name, name) == 0)
+            return &requests[request_slots[k] - 1];
     return NULL;
 }
 
@@ -703,16 +732,23 @@ static void add_shader_name(scene *s, const char *name)
     s->shader_names[s->nshader_names++] = xstrndup(name, strlen(name));
 }
 
+/* The names of the shaders the objects and lights call, in the order of
+ * their first call; each shader call looked at once, however many objects
+ * share it. */
 static void finish_shader_names(scene *s)
 {
+    unsigned char *seen = xcalloc((size_t)(s->nshaders > 0 ? s->nshaders : 1), 1);
     for (int i = 0; i < s->nobjects; i++) {
-        const scene_shader *surf = scene_object_surface(s, &s->objects[i]);
-        const scene_shader *disp = scene_object_displacement(s, &s->objects[i]);
-        if (surf)
-            add_shader_name(s, surf->name);
-        if (disp)
-            add_shader_name(s, disp->name);
+        const scene_shader *calls[2] = { scene_object_surface(s, &s->objects[i]),
+                                         scene_object_displacement(s, &s->objects[i]) };
+        for (int k = 0; k < 2; k++) {
+            if (!calls[k] || seen[calls[k] - s->shaders])
+                continue;
+            seen[calls[k] - s->shaders] = 1;
+            add_shader_name(s, calls[k]->name);
+        }
     }
+    free(seen);
     for (int i = 0; i < s->nlights; i++)
         if (s->lights[i].kind == SCENE_SHADER_LIGHT)
             add_shader_name(s, s->shaders[s->lights[i].shader].name);
@@ -854,13 +890,20 @@ scene *scene_parse_limited(const char *file, const char *text, size_t len,
 
 static scene *parse_frame(const char *file, const char *text, size_t len,
                           sl_source_set *archives, int max_objects, int frame, bool scanning,
-                          const atomic_int *cancel, sl_diag *diag);
+                          const scene_check *check, const atomic_int *cancel, sl_diag *diag);
 
 scene *scene_parse_frame(const char *file, const char *text, size_t len,
                          sl_source_set *archives, int max_objects, int frame,
                          const atomic_int *cancel, sl_diag *diag)
 {
-    return parse_frame(file, text, len, archives, max_objects, frame, false, cancel, diag);
+    return parse_frame(file, text, len, archives, max_objects, frame, false, NULL, cancel, diag);
+}
+
+scene *scene_check_frame(const char *file, const char *text, size_t len,
+                         sl_source_set *archives, int max_objects, int frame,
+                         const scene_check *check, const atomic_int *cancel, sl_diag *diag)
+{
+    return parse_frame(file, text, len, archives, max_objects, frame, false, check, cancel, diag);
 }
 
 int scene_scan_frames(const char *file, const char *text, size_t len,
@@ -868,8 +911,8 @@ int scene_scan_frames(const char *file, const char *text, size_t len,
                       sl_diag *diag)
 {
     *numbers = NULL;
-    scene *s = parse_frame(file, text, len, archives, SCENE_MAX_OBJECTS, INT_MAX, true, cancel,
-                           diag);
+    scene *s = parse_frame(file, text, len, archives, SCENE_MAX_OBJECTS, INT_MAX, true, NULL,
+                           cancel, diag);
     if (!s)
         return -1;
     int n = s->nframes;
@@ -881,7 +924,7 @@ int scene_scan_frames(const char *file, const char *text, size_t len,
 
 static scene *parse_frame(const char *file, const char *text, size_t len,
                           sl_source_set *archives, int max_objects, int frame, bool scanning,
-                          const atomic_int *cancel, sl_diag *diag)
+                          const scene_check *check, const atomic_int *cancel, sl_diag *diag)
 {
     if (!file || !*file)
         file = "<scene>";
@@ -903,7 +946,9 @@ static scene *parse_frame(const char *file, const char *text, size_t len,
     p.frame_select = frame < 0 ? 0 : frame;
     p.scanning = scanning;
     p.cancel = cancel;
+    p.check = check;
     p.scene = scene_new(file);
+    p.scene->checked = check != NULL;
     p.file = p.scene->file;
     p.decls = rib_decls_new();
     p.reader = rib_reader_new(p.file, text, len, diag);

@@ -172,6 +172,7 @@ typedef struct rib_parser {
                                       scene.npieces for its undisplaced placements */
     int mesh_counted_cap;
     bool blocks_overflow;          /* RIB_MAX_BLOCKS was passed: the parse stops */
+    const scene_check *check;      /* a check's parse (scene_check_frame), or NULL */
     const atomic_int *cancel;      /* the program's stop flag (a signal), or NULL */
     unsigned requests;             /* read so far (the flag is looked at every
                                       RIB_CANCEL_EVERY) */
@@ -364,6 +365,9 @@ scene_mesh *scene_mesh_new(const double *P, int npoints, const int *idx, int nid
                            const struct rib_primvars *pv, const rib_params *params);
 /* Adds a piece: a polygon of face `face`'s ncorners corners from
  * face-vertex fv0 (k unused), or the triangle of its corners k[0..3). */
+/* A check's mesh (scene_check_frame): the pieces added are counted, and
+ * nothing else is kept; nprimvars: each piece's variables. */
+scene_mesh *scene_mesh_new_counted(int nprimvars);
 void scene_mesh_add_piece(scene_mesh *self, scene_piece_kind kind, int face, int fv0,
                           const int k[3], int ncorners);
 void scene_mesh_trim(scene_mesh *self);          /* frees the spare capacity */

@@ -3,6 +3,11 @@
  *
  * One token of lookahead: a request ends where the next name starts, so
  * the reader always holds the token after the current request.
+ *
+ * A request's name and strings live in buffers the reader keeps from one
+ * request to the next (a request costs no allocation once the buffers are
+ * as long as the longest seen): a scene of a million instances is some
+ * ten million requests.
  */
 #include "scene/rib_reader.h"
 #include "scene/rib_lexer.h"
@@ -17,6 +22,9 @@ struct rib_reader {
     rib_token tok;          /* lookahead */
     sl_diag *diag;
     rib_request req;
+    size_t name_cap;        /* of req.name */
+    size_t *str_caps;       /* of req.strs[i], for the nstrs_made slots made */
+    int nstrs_made;
 };
 
 rib_reader *rib_reader_new(const char *file, const char *text, size_t len, sl_diag *diag)
@@ -29,14 +37,23 @@ rib_reader *rib_reader_new(const char *file, const char *text, size_t len, sl_di
     return self;
 }
 
+/* Empties the request; its buffers stay for the next one. */
 static void request_clear(rib_request *req)
 {
-    free(req->name);
-    req->name = NULL;
-    for (int i = 0; i < req->nstrs; i++)
-        free(req->strs[i]);
     req->nargs = req->nnums = req->nstrs = 0;
     req->broken = false;
+}
+
+/* *buf (of capacity *cap) made to hold s[0..len) and a '\0'. */
+static void copy_into(char **buf, size_t *cap, const char *s, size_t len)
+{
+    if (len + 1 > *cap) {
+        *cap = len + 1 > 2 * *cap ? len + 1 : 2 * *cap;
+        free(*buf);
+        *buf = xmalloc(*cap);
+    }
+    memcpy(*buf, s, len);
+    (*buf)[len] = '\0';
 }
 
 void rib_reader_destroy(rib_reader **self_p)
@@ -45,6 +62,10 @@ void rib_reader_destroy(rib_reader **self_p)
         return;
     rib_reader *self = *self_p;
     request_clear(&self->req);
+    free(self->req.name);
+    for (int i = 0; i < self->nstrs_made; i++)
+        free(self->req.strs[i]);
+    free(self->str_caps);
     free(self->req.args);
     free(self->req.nums);
     free(self->req.strs);
@@ -76,13 +97,20 @@ static void push_number(rib_request *req, double v)
     req->nums[req->nnums++] = v;
 }
 
-static void push_string(rib_request *req, const char *s, size_t len)
+static void push_string(rib_reader *self, const char *s, size_t len)
 {
+    rib_request *req = &self->req;
     if (req->nstrs == req->strs_cap) {
         req->strs_cap = req->strs_cap ? 2 * req->strs_cap : 16;
         req->strs = xrealloc(req->strs, (size_t)req->strs_cap * sizeof *req->strs);
+        self->str_caps = xrealloc(self->str_caps, (size_t)req->strs_cap * sizeof *self->str_caps);
     }
-    req->strs[req->nstrs++] = xstrndup(s, len);
+    if (req->nstrs == self->nstrs_made) {
+        req->strs[self->nstrs_made] = NULL;
+        self->str_caps[self->nstrs_made++] = 0;
+    }
+    copy_into(&req->strs[req->nstrs], &self->str_caps[req->nstrs], s, len);
+    req->nstrs++;
 }
 
 static rib_arg *push_arg(rib_request *req, rib_arg_kind kind, sl_pos pos)
@@ -127,7 +155,7 @@ static void read_array_element(rib_reader *self, rib_arg *arg, bool *mixed_repor
     if (is_number)
         push_number(&self->req, self->tok.number);
     else
-        push_string(&self->req, self->tok.text, self->tok.len);
+        push_string(self, self->tok.text, self->tok.len);
     arg->count++;
 }
 
@@ -179,7 +207,7 @@ static void read_arguments(rib_reader *self)
         case RIB_TOK_STRING: {
             rib_arg *arg = push_arg(&self->req, RIB_ARG_STRING, self->tok.pos);
             arg->count = 1;
-            push_string(&self->req, self->tok.text, self->tok.len);
+            push_string(self, self->tok.text, self->tok.len);
             break;
         }
         case RIB_TOK_LBRACKET:
@@ -232,7 +260,7 @@ rib_request *rib_reader_next(rib_reader *self)
     skip_to_name(self);
     if (self->tok.kind == RIB_TOK_EOF)
         return NULL;
-    self->req.name = xstrndup(self->tok.text, self->tok.len);
+    copy_into(&self->req.name, &self->name_cap, self->tok.text, self->tok.len);
     self->req.pos = self->tok.pos;
     advance(self);
     read_arguments(self);

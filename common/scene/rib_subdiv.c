@@ -274,18 +274,24 @@ static void subdivision_mesh(rib_parser *p, const rib_request *req, bool hier)
             rib_error(p, req, req->pos, "%s", err);
             goto out;
         }
-        scene *sc = p->scene;
-        sc->subdivs = xrealloc(sc->subdivs, (size_t)(sc->nsubdivs + 1) * sizeof *sc->subdivs);
-        sc->subdivs[sc->nsubdivs++] = sd;
         /* one object (issue 23): a piece per drawn face of the refined
-         * mesh, its surface and variables made on demand (scene_mesh.c) */
-        scene_mesh *m = scene_mesh_new(NULL, 0, idx, nidx, SCENE_MESH_N_NONE, NULL, 0, &vars,
-                                       &params);
+         * mesh, its surface and variables made on demand (scene_mesh.c);
+         * a check's parse counts them and keeps neither */
+        scene_mesh *m = p->check ? scene_mesh_new_counted(vars.n)
+                                 : scene_mesh_new(NULL, 0, idx, nidx, SCENE_MESH_N_NONE, NULL,
+                                                  0, &vars, &params);
         scene_mesh_set_subdiv(m, sd, nverts, nfaces);
         for (int f = 0; f < geom_subdiv_nfaces(sd); f++)
             if (geom_subdiv_face_drawn(sd, f))
                 scene_mesh_add_piece(m, SCENE_PIECE_SUBDIV, f, 0, NULL, 0);
         scene_mesh_trim(m);
+        scene *sc = p->scene;
+        if (p->check) {
+            geom_subdiv_destroy(&sd);
+        } else {
+            sc->subdivs = xrealloc(sc->subdivs, (size_t)(sc->nsubdivs + 1) * sizeof *sc->subdivs);
+            sc->subdivs[sc->nsubdivs++] = sd;
+        }
         if (scene_mesh_npieces(m) == 0) {
             rib_warning(p, req, req->pos, "no face to draw (every face is a hole or touches "
                         "the boundary: add the tag \"interpolateboundary\")");

@@ -162,3 +162,19 @@ char *scene_find_shader(const scene *self, const char *name,
     }
     return NULL;
 }
+
+static bool same_string(const char *a, const char *b)
+{
+    return a == b || (a && b && strcmp(a, b) == 0);
+}
+
+bool scene_object_placeable(const scene_object *o, const scene_object *p)
+{
+    return o->displacement_shader < 0 && p->displacement_shader < 0 && o->mesh == p->mesh &&
+           o->surface == p->surface && o->surface_shader == p->surface_shader &&
+           o->sides == p->sides && o->nlights == p->nlights &&
+           (o->lights == p->lights ||
+            memcmp(o->lights, p->lights, sizeof *o->lights * (size_t)o->nlights) == 0) &&
+           o->primvars == p->primvars && o->nprimvars == p->nprimvars &&
+           same_string(o->name, p->name);
+}

@@ -267,6 +267,9 @@ typedef struct scene {
     scene_mesh **meshes;           /* polygon meshes, each placed by one or more
                                     * objects (scene_object.mesh) */
     int nmeshes;
+    bool checked;                  /* parsed by scene_check_frame: meshes count their
+                                    * pieces but keep no arrays, references dropped */
+    long nchecked_placements;      /* those references (checked, not kept) */
     long npieces;                  /* the pieces a renderer keeps boxes for: an
                                     * undisplaced mesh's once, a displaced mesh's
                                     * once per placing object, other objects one */
@@ -373,6 +376,37 @@ scene *scene_parse_limited(const char *file, const char *text, size_t len,
 scene *scene_parse_frame(const char *file, const char *text, size_t len,
                          sl_source_set *archives, int max_objects, int frame,
                          const atomic_int *cancel, sl_diag *diag);
+
+/* What a check's parse (scene_check_frame) asks of its caller: whether
+ * an undisplaced instance the renderer would keep as a reference to its
+ * prototype (scene_object_placeable) is one it can place (its transforms:
+ * the renderer's own test); false with a message, reported at the
+ * ObjectInstance. */
+typedef struct scene_check {
+    bool (*placement)(void *user, const scene *sc, const scene_object *proto,
+                      const scene_object *placement, char *err, size_t errsz);
+    void *user;
+} scene_check;
+
+/* As scene_parse_frame, for a program that checks a scene without
+ * rendering it (the master): the same requests read and the same errors
+ * reported at the same places, but what only a renderer needs is not kept,
+ * so that a million-face mesh or a million instances cost the check little
+ * memory (issue 23). Meshes (scene_mesh.h) count their pieces but keep no
+ * arrays (scene_object_piece must not be called on them); an ObjectInstance
+ * placement that the renderer keeps as a reference is handed to
+ * check->placement and not kept (scene.nchecked_placements counts them).
+ * The scene is marked `checked`. */
+scene *scene_check_frame(const char *file, const char *text, size_t len,
+                         sl_source_set *archives, int max_objects, int frame,
+                         const scene_check *check, const atomic_int *cancel, sl_diag *diag);
+
+/* May object o, a later placement of the recorded surface that object
+ * proto placed first (o->instance_of), be a reference to it in the
+ * renderer (trace/group.h): the same surface in object space, undisplaced,
+ * the same shaders, sides, lights, primitive variables and name, only its
+ * transform and colour its own? */
+bool scene_object_placeable(const scene_object *o, const scene_object *proto);
 
 /* The frames of a RIB without reading any of them: their FrameBegin
  * numbers into a malloc'd *numbers (NULL when there is none). Returns

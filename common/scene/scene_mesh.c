@@ -36,6 +36,7 @@ struct scene_mesh {
     const struct geom_subdiv *sd;
     int *nverts, *fo;
     int nfaces;
+    bool counted;                  /* a check's mesh: pieces counted, no arrays */
 };
 
 static void *copy_of(const void *src, size_t bytes)
@@ -82,9 +83,18 @@ scene_mesh *scene_mesh_new(const double *P, int npoints, const int *idx, int nid
     return self;
 }
 
+scene_mesh *scene_mesh_new_counted(int nprimvars)
+{
+    scene_mesh *self = xcalloc(1, sizeof *self);
+    self->counted = true;
+    self->pv.n = nprimvars;
+    return self;
+}
+
 void scene_mesh_set_subdiv(scene_mesh *self, const struct geom_subdiv *sd, const int *nverts,
                            int nfaces)
 {
+    if (self->counted) return;
     self->sd = sd;
     self->nfaces = nfaces;
     self->nverts = copy_of(nverts, (size_t)nfaces * sizeof *nverts);
@@ -96,6 +106,10 @@ void scene_mesh_set_subdiv(scene_mesh *self, const struct geom_subdiv *sd, const
 void scene_mesh_add_piece(scene_mesh *self, scene_piece_kind kind, int face, int fv0,
                           const int k[3], int ncorners)
 {
+    if (self->counted) {
+        self->npieces++;
+        return;
+    }
     if (self->npieces == self->cap) {
         self->cap = self->cap ? 2 * self->cap : 64;
         self->pieces = xreallocarray(self->pieces, (size_t)self->cap, sizeof *self->pieces);
@@ -244,6 +258,7 @@ bool scene_mesh_piece_surface(const scene_mesh *self, int k, geom_surface *s,
                               struct scene_primvar *vars, int *nvars)
 {
     assert(k >= 0 && k < self->npieces);
+    assert(!self->counted && "a checked scene's mesh has no pieces to make");
 #ifndef SCENE_HAVE_GEOM
     (void)s, (void)vars, (void)nvars;
     return false;
