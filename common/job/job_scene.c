@@ -17,21 +17,24 @@
 #include <stdlib.h>
 #include <string.h>
 
-static void spaces_for(const scene *sc, const scene_object *o, const scene_shader *sh,
-                       sl_spaces *sp)
+/* A shader's named spaces for an object whose transforms are to_camera,
+ * from_camera (scene_object_transforms); sh: the shader's call (its
+ * "shader" space), NULL: the object's. */
+static void spaces_for(const scene *sc, const mat4 *to_camera, const mat4 *from_camera,
+                       const scene_shader *sh, sl_spaces *sp)
 {
     mat4 id = mat4_identity();
     for (int i = 0; i < SL_SPACE__COUNT; i++) sp->to_current[i] = sp->from_current[i] = id;
     sp->to_current[SL_SPACE_WORLD] = sc->camera.camera_from_world;
     sp->from_current[SL_SPACE_WORLD] = sc->camera.world_from_camera;
-    sp->to_current[SL_SPACE_OBJECT] = o->object_to_camera;
-    sp->from_current[SL_SPACE_OBJECT] = o->camera_to_object;
+    sp->to_current[SL_SPACE_OBJECT] = *to_camera;
+    sp->from_current[SL_SPACE_OBJECT] = *from_camera;
     if (sh) {
         sp->to_current[SL_SPACE_SHADER] = sh->shader_to_camera;
         mat4_invert(&sh->shader_to_camera, &sp->from_current[SL_SPACE_SHADER]);
     } else {
-        sp->to_current[SL_SPACE_SHADER] = o->object_to_camera;
-        sp->from_current[SL_SPACE_SHADER] = o->camera_to_object;
+        sp->to_current[SL_SPACE_SHADER] = *to_camera;
+        sp->from_current[SL_SPACE_SHADER] = *from_camera;
     }
 }
 
@@ -283,9 +286,7 @@ typedef struct job_group {
 static void group_transform(const void *user, int k, mat4 *to_camera, mat4 *from_camera)
 {
     const job_group *g = user;
-    const scene_object *o = &g->scene->objects[g->objects[k]];
-    *to_camera = o->object_to_camera;
-    *from_camera = o->camera_to_object;
+    scene_object_transforms(g->scene, &g->scene->objects[g->objects[k]], to_camera, from_camera);
 }
 
 static bool group_place(const void *user, int k, trace_object *t, trace_primvar *pv)
@@ -293,8 +294,9 @@ static bool group_place(const void *user, int k, trace_object *t, trace_primvar 
     const job_group *g = user;
     const scene *sc = g->scene;
     const scene_object *o = &sc->objects[g->objects[k]];
-    spaces_for(sc, o, scene_object_displacement(sc, o), &t->displacement_spaces);
-    spaces_for(sc, o, scene_object_surface(sc, o), &t->surface_spaces);
+    spaces_for(sc, &t->to_camera, &t->from_camera, scene_object_displacement(sc, o),
+               &t->displacement_spaces);
+    spaces_for(sc, &t->to_camera, &t->from_camera, scene_object_surface(sc, o), &t->surface_spaces);
     memcpy(t->Cs, o->Cs, sizeof t->Cs);
     memcpy(t->Os, o->Os, sizeof t->Os);
     t->flip = o->reverse_normals;
@@ -339,12 +341,11 @@ static void build_object(job_scene *self, const scene_object *o, trace_object *t
     const scene *sc = self->scene;
     object_name(sc, o, t->name, sizeof t->name);
     if (o->surface) t->surf = *o->surface;
-    t->to_camera = o->object_to_camera;
-    t->from_camera = o->camera_to_object;
+    scene_object_transforms(sc, o, &t->to_camera, &t->from_camera);
     const scene_shader *ds = scene_object_displacement(sc, o);
     const scene_shader *ss = scene_object_surface(sc, o);
-    spaces_for(sc, o, ds, &t->displacement_spaces);
-    spaces_for(sc, o, ss, &t->surface_spaces);
+    spaces_for(sc, &t->to_camera, &t->from_camera, ds, &t->displacement_spaces);
+    spaces_for(sc, &t->to_camera, &t->from_camera, ss, &t->surface_spaces);
     t->displacement = o->displacement_shader >= 0 ? self->instances[o->displacement_shader] : NULL;
     t->surface = o->surface_shader >= 0 ? self->instances[o->surface_shader] : NULL;
     memcpy(t->Cs, o->Cs, sizeof t->Cs);
@@ -526,8 +527,7 @@ static bool check_placement(void *user, const scene *sc, const scene_object *pro
     trace_object probe;
     memset(&probe, 0, sizeof probe);
     object_name(sc, proto, probe.name, sizeof probe.name);
-    probe.to_camera = placement->object_to_camera;
-    probe.from_camera = placement->camera_to_object;
+    scene_object_transforms(sc, placement, &probe.to_camera, &probe.from_camera);
     return trace_object_derive(&none, &probe, false, err, errsz);
 }
 

@@ -201,8 +201,6 @@ void rib_place_surface(rib_parser *p, const rib_request *req, const geom_surface
     o->surface = surf;
     o->mesh = mesh;
     o->object_to_world = ctm;
-    o->object_to_camera = to_camera;
-    o->camera_to_object = inv;
     o->surface_shader = a->surface;
     o->displacement_shader = a->displacement;
     memcpy(o->Cs, a->Cs, sizeof o->Cs);

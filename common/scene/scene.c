@@ -12,6 +12,7 @@
 #include "util/xalloc.h"
 #endif
 
+#include <assert.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
@@ -89,6 +90,15 @@ void *scene_keep(scene *self, void *block)
     }
     self->kept[self->nkept++] = block;
     return block;
+}
+
+void scene_object_transforms(const scene *self, const scene_object *object, mat4 *to_camera,
+                             mat4 *from_camera)
+{
+    *to_camera = mat4_mul(self->camera.camera_from_world, object->object_to_world);
+    bool invertible = mat4_invert(to_camera, from_camera);
+    assert(invertible);                /* rib_place_surface refused it otherwise */
+    (void)invertible;
 }
 
 int scene_object_npieces(const scene_object *object)

@@ -180,9 +180,8 @@ typedef struct scene_object {
                                     * the scene (scene_keep) and shared by the
                                     * objects placed from one recorded surface
                                     * (instances); NULL for a mesh */
-    mat4 object_to_world;
-    mat4 object_to_camera;
-    mat4 camera_to_object;
+    mat4 object_to_world;          /* to camera space and back:
+                                      scene_object_transforms */
     int surface_shader;            /* index into scene.shaders, -1: none */
     int displacement_shader;       /* index into scene.shaders, -1: none */
     double Cs[3], Os[3];           /* Color, Opacity */
@@ -341,7 +340,7 @@ enum { SCENE_ARCHIVE_MAX_DEPTH = 16 };
 enum { SCENE_MAX_OBJECTS = 1 << 20 };
 
 /* The most undisplaced ObjectInstance placements a scene may hold: each is
- * a reference in a worker (trace/group.h: ~760 bytes with its scene
+ * a reference in a worker (trace/group.h: ~500 bytes with its scene
  * object, docs/renderer.md "Instances as references"), so 2^24 of them fit
  * a 24 GB worker; displaced instances count as objects. */
 enum { SCENE_MAX_INSTANCES = 1 << 24 };
@@ -357,6 +356,14 @@ enum { SCENE_MAX_INSTANCES = 1 << 24 };
  * primitive variables (out: at most RIB's 16 per object) into s, vars,
  * *nvars. */
 int scene_object_npieces(const scene_object *object);
+
+/* Object o's transforms between its object space and camera space: the
+ * camera's camera_from_world times its object_to_world, and the inverse,
+ * made the way the parser checked them (so the same bits every time; the
+ * parser refused a singular one). Not kept per object: 256 bytes an
+ * instance. */
+void scene_object_transforms(const scene *self, const scene_object *object, mat4 *to_camera,
+                             mat4 *from_camera);
 bool scene_object_piece(const scene_object *object, int k, geom_surface *s,
                         scene_primvar *vars, int *nvars);
 

@@ -110,9 +110,11 @@ static void test_wave_objects(void **state)
     assert_string_equal(o->pos.file, s->file);
 
     /* the vertex (-1,0,-1) seen from the camera, by hand */
-    vec3 p = mat4_xform_point(&o->object_to_camera, o->surface->verts[0]);
+    mat4 to_camera, from_camera;
+    scene_object_transforms(s, o, &to_camera, &from_camera);
+    vec3 p = mat4_xform_point(&to_camera, o->surface->verts[0]);
     assert_vec(p, v3(-1, 0.08 - sin(rad(35)), 3.5 - cos(rad(35))), eps);
-    vec3 back = mat4_xform_point(&o->camera_to_object, p);
+    vec3 back = mat4_xform_point(&from_camera, p);
     assert_vec(back, v3(-1, 0, -1), 1e-12);
 
     const scene_shader *disp = scene_object_displacement(s, o);
@@ -244,7 +246,9 @@ static void test_ufo(void **state)
     assert_true(pl->lightcolor[0] == 1 && pl->lightcolor[1] == 1 && pl->lightcolor[2] == 1);
     assert_vec(pl->from_world, v3(3, 2, -3), 0);
     /* the sphere's centre is the world origin: 5 units ahead */
-    assert_vec(mat4_xform_point(&o->object_to_camera, v3(0, 0, 0)), v3(0, 0, 5), eps);
+    mat4 to_camera, from_camera;
+    scene_object_transforms(s, o, &to_camera, &from_camera);
+    assert_vec(mat4_xform_point(&to_camera, v3(0, 0, 0)), v3(0, 0, 5), eps);
     scene_destroy(&s);
 }
 

@@ -176,7 +176,9 @@ static void test_camera_transform(void **state)
     const scene_object *o = &s->objects[0];
     assert_vec(mat4_xform_point(&o->object_to_world, v3(0, 0, 0)), v3(1, 0, 0), 0);
     /* Rotate 90 about y: x -> -z, so world (1,0,0) -> camera (0,0,-1+10) */
-    assert_vec(mat4_xform_point(&o->object_to_camera, v3(0, 0, 0)), v3(0, 0, 9), 1e-14);
+    mat4 to_camera, from_camera;
+    scene_object_transforms(s, o, &to_camera, &from_camera);
+    assert_vec(mat4_xform_point(&to_camera, v3(0, 0, 0)), v3(0, 0, 9), 1e-14);
     assert_vec(mat4_xform_point(&s->camera.camera_from_world, v3(1, 0, 0)), v3(0, 0, 9), 1e-14);
     scene_destroy(&s);
 }

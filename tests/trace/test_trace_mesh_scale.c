@@ -20,7 +20,7 @@
  *   mirrored, render as the same objects written out one by one (objects
  *   of their own: the other path); 20,000 instances cost at most
  *   INSTANCE_BYTES each in all (scene, world, renderer), counted by the
- *   allocator (an instance was ~14 KB when each was a full object).
+ *   allocator (an instance was ~14 KB when each was a full object; ~500 now).
  * - A shadow ray cast while a piece's hit is being shaded cannot
  *   overwrite it: a mesh lit through another mesh renders as the same
  *   faces written one Polygon each.
@@ -46,9 +46,9 @@
 enum { FACE_BYTES = 300 };
 
 /* the budget per instance of a recorded mesh, everything included: the
- * scene's object (~560 bytes, its transforms in double) and the world's
- * box, BVH share and index */
-enum { INSTANCE_BYTES = 1000 };
+ * scene's object (~300 bytes, its transform in double), the world's box,
+ * BVH share and index, and its RIB text in the job (~150) */
+enum { INSTANCE_BYTES = 640 };
 
 static char *torus_rib(int nu, int nv, const char *head)
 {
