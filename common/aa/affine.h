@@ -84,6 +84,30 @@ double aa_radius(const aa_form *x);                   /* sum |xi| + err, up */
 ia_interval aa_range_radius(const aa_form *x, double *radius);
 bool aa_is_point(const aa_form *x);                   /* no noise at all */
 
+/* An exact constant: what aa_const makes of a finite value (no symbols, no
+ * error, the hull the point itself). aa_range(x) is [x->x0, x->x0]. */
+static inline bool aa_is_exact_const(const aa_form *x)
+{
+    return x->n == 0 && x->err == 0.0 && !(x->flags & AA_UNBOUNDED) && x->lo == x->x0 &&
+           x->hi == x->x0 && x->x0 - x->x0 == 0.0;          /* finite */
+}
+
+/* x - y of two exact constants, when the double difference is exact:
+ * true with *d the difference, and then aa_range of aa_sub(x, y) is
+ * [*d, *d] (up to the sign of a zero), so a comparison of x and y is
+ * decided by *d alone: the shading VM's loop tests on counters, without
+ * building the form of the difference (issue 24). False otherwise. */
+static inline bool aa_exact_difference(const aa_form *x, const aa_form *y, double *d)
+{
+    if (!aa_is_exact_const(x) || !aa_is_exact_const(y))
+        return false;
+    double a = x->x0, b = -y->x0, s = a + b, bb = s - a;
+    if (s - s != 0.0 || (a - (s - bb)) + (b - bb) != 0.0)     /* overflow, or rounded */
+        return false;
+    *d = s;
+    return true;
+}
+
 /* ---- affine operations: exact up to rounding, no new symbol ---- */
 void aa_add(aa_context *ctx, aa_form *z, const aa_form *x, const aa_form *y);
 void aa_sub(aa_context *ctx, aa_form *z, const aa_form *x, const aa_form *y);
