@@ -59,29 +59,7 @@ static int fresh_symbol(aa_context *ctx)
 /* construction and queries                                                */
 /* ---------------------------------------------------------------------- */
 
-void aa_unbounded(aa_form *z, unsigned flags)
-{
-    z->x0 = 0.0;
-    z->err = INFINITY;
-    z->lo = -INFINITY;
-    z->hi = INFINITY;
-    z->n = 0;
-    z->flags = (unsigned short)(flags | AA_UNBOUNDED);
-}
-
-void aa_const(aa_form *z, double value)
-{
-    if (!isfinite(value)) {
-        aa_unbounded(z, 0);
-        return;
-    }
-    z->x0 = value;
-    z->err = 0.0;
-    z->lo = value;
-    z->hi = value;
-    z->n = 0;
-    z->flags = 0;
-}
+/* aa_unbounded, aa_const and aa_is_point are inline in affine.h */
 
 void aa_add_new_error(aa_context *ctx, aa_form *z, double delta)
 {
@@ -221,16 +199,6 @@ ia_interval aa_range_radius(const aa_form *x, double *radius)
 {
     *radius = aa_radius(x);
     return aa_range_r(x, *radius);
-}
-
-bool aa_is_point(const aa_form *x)
-{
-    if ((x->flags & AA_UNBOUNDED) || x->err != 0.0)
-        return false;
-    for (int i = 0; i < x->n; i++)
-        if (x->c[i] != 0.0)
-            return false;
-    return true;
 }
 
 /* ---------------------------------------------------------------------- */

@@ -74,15 +74,45 @@ void aa_context_init(aa_context *ctx, int capacity);  /* clamps to [0, MAX] */
 void aa_context_reset(aa_context *ctx);               /* next query: no symbols */
 
 /* ---- construction and queries ---- */
+/* (the small ones are inline: the shading VM makes a constant or asks
+ * whether an operand is one for most instructions, issue 24) */
 void aa_input(aa_context *ctx, aa_form *z, double lo, double hi); /* new symbol */
-void aa_const(aa_form *z, double value);
+static inline void aa_unbounded(aa_form *z, unsigned flags)
+{
+    z->x0 = 0.0;
+    z->err = INFINITY;
+    z->lo = -INFINITY;
+    z->hi = INFINITY;
+    z->n = 0;
+    z->flags = (unsigned short)(flags | AA_UNBOUNDED);
+}
+static inline void aa_const(aa_form *z, double value)   /* unbounded if not finite */
+{
+    if (!isfinite(value)) {
+        aa_unbounded(z, 0);
+        return;
+    }
+    z->x0 = value;
+    z->err = 0.0;
+    z->lo = value;
+    z->hi = value;
+    z->n = 0;
+    z->flags = 0;
+}
 void aa_from_interval(aa_context *ctx, aa_form *z, ia_interval x);
-void aa_unbounded(aa_form *z, unsigned flags);
 ia_interval aa_range(const aa_form *x);   /* affine range (rounded outward) meet hull */
 double aa_radius(const aa_form *x);                   /* sum |xi| + err, up */
 /* aa_range(x), and aa_radius(x) in *radius, the sum taken once */
 ia_interval aa_range_radius(const aa_form *x, double *radius);
-bool aa_is_point(const aa_form *x);                   /* no noise at all */
+static inline bool aa_is_point(const aa_form *x)      /* no noise at all */
+{
+    if ((x->flags & AA_UNBOUNDED) || x->err != 0.0)
+        return false;
+    for (int i = 0; i < x->n; i++)
+        if (x->c[i] != 0.0)
+            return false;
+    return true;
+}
 
 /* An exact constant: what aa_const makes of a finite value (no symbols, no
  * error, the hull the point itself). aa_range(x) is [x->x0, x->x0]. */

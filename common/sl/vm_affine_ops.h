@@ -178,8 +178,10 @@ static inline sl_status VM_OP(v_noise, b_noise)(sl_vm *vm, A *S, const sl_insn *
             period[k] = (int)q;
         }
     }
-    A out[3];                        /* the noise functions may not alias p */
-    int outs = (v & SL_NOISE_VECTOR) ? 3 : 1;
+    A tmp[3];                        /* the noise functions may not alias p: */
+    int outs = (v & SL_NOISE_VECTOR) ? 3 : 1;     /* straight into the slots when */
+    bool apart = in->a + outs <= in->b || in->b + dim <= in->a;   /* they are not p */
+    A *out = apart ? &S[in->a] : tmp;
     const int *per = kind == SL_NOISE_PERIODIC ? period : NULL;
     if (outs == 3) {
         if (kind == SL_NOISE_CELL)
@@ -191,7 +193,7 @@ static inline sl_status VM_OP(v_noise, b_noise)(sl_vm *vm, A *S, const sl_insn *
     } else {
         sl_pnoise_aa(vm->ctx, out, dim, p, per);
     }
-    for (int i = 0; i < outs; i++)
+    for (int i = 0; i < outs && !apart; i++)
         VM_OP(v_mov, b_mov)(vm, &S[in->a + i], &out[i]);
     return SL_OK;
 }
