@@ -60,29 +60,7 @@ static int fresh_symbol(aa_context *ctx)
 /* construction and queries                                                */
 /* ---------------------------------------------------------------------- */
 
-void aa_unbounded(aa_form *z, unsigned flags)
-{
-    z->x0 = 0.0;
-    z->err = INFINITY;
-    z->lo = -INFINITY;
-    z->hi = INFINITY;
-    z->n = 0;
-    z->flags = (unsigned short)(flags | AA_UNBOUNDED);
-}
-
-void aa_const(aa_form *z, double value)
-{
-    if (!isfinite(value)) {
-        aa_unbounded(z, 0);
-        return;
-    }
-    z->x0 = value;
-    z->err = 0.0;
-    z->lo = value;
-    z->hi = value;
-    z->n = 0;
-    z->flags = 0;
-}
+/* aa_unbounded, aa_const and aa_is_point are inline in affine.h */
 
 void aa_add_new_error(aa_context *ctx, aa_form *z, double delta)
 {
@@ -222,16 +200,6 @@ ia_interval aa_range_radius(const aa_form *x, double *radius)
 {
     *radius = aa_radius(x);
     return aa_range_r(x, *radius);
-}
-
-bool aa_is_point(const aa_form *x)
-{
-    if ((x->flags & AA_UNBOUNDED) || x->err != 0.0)
-        return false;
-    for (int i = 0; i < x->n; i++)
-        if (x->c[i] != 0.0)
-            return false;
-    return true;
 }
 
 /* ---------------------------------------------------------------------- */
@@ -424,6 +392,23 @@ void aa_lincomb(aa_context *ctx, aa_form *z, double a, const aa_form *x,
 }
 
 /*
+ * The shapes of lincomb that the shading VM runs most (issue 24: on
+ * dented, constant x form, x + y and x - y were 2/3 of aa_lincomb's time):
+ * lincomb inlined with the factors that make them constant, so that the
+ * compiler drops the classification of the factors, the product
+ * bookkeeping a factor +-1 does not need, the second operand's loop and
+ * hull when there is none. What is left is the same operations in the
+ * same order on the same values (the build has no contraction and no
+ * fast-math), hence bit for bit aa_lincomb's result with those arguments
+ * (test_aa_fastpath compares them on random operands).
+ */
+/* z = a*x + c: aa_lincomb(a, x, 0, NULL, c) */
+static void lincomb_scale(aa_form *z, double a, const aa_form *x, double c)
+{
+    lincomb(z, a, x, 0.0, NULL, c, true);
+}
+
+/*
  * One row of a transformation: every coefficient (and the centre) is a sum
  * of at most three products (four terms with c) in RN, whose error is at
  * most gamma_3 = 3u/(1 - 3u) times the sum of the terms' magnitudes plus
@@ -550,24 +535,29 @@ void aa_lincomb3_centred(aa_context *ctx, aa_form *z, const double m[3],
     lincomb3(z, m, x, c, true);
 }
 
+/* aa_lincomb(1, x, +-1, y, 0), specialised as lincomb_scale */
 void aa_add(aa_context *ctx, aa_form *z, const aa_form *x, const aa_form *y)
 {
-    aa_lincomb(ctx, z, 1.0, x, 1.0, y, 0.0);
+    (void)ctx;
+    lincomb(z, 1.0, x, 1.0, y, 0.0, true);
 }
 
 void aa_sub(aa_context *ctx, aa_form *z, const aa_form *x, const aa_form *y)
 {
-    aa_lincomb(ctx, z, 1.0, x, -1.0, y, 0.0);
+    (void)ctx;
+    lincomb(z, 1.0, x, -1.0, y, 0.0, true);
 }
 
 void aa_neg(aa_context *ctx, aa_form *z, const aa_form *x)
 {
-    aa_lincomb(ctx, z, -1.0, x, 0.0, NULL, 0.0);
+    (void)ctx;
+    lincomb_scale(z, -1.0, x, 0.0);
 }
 
 void aa_add_s(aa_context *ctx, aa_form *z, const aa_form *x, double s)
 {
-    aa_lincomb(ctx, z, 1.0, x, 0.0, NULL, s);
+    (void)ctx;
+    lincomb_scale(z, 1.0, x, s);
 }
 
 void aa_mul_s(aa_context *ctx, aa_form *z, const aa_form *x, double s)
@@ -578,7 +568,8 @@ void aa_mul_s(aa_context *ctx, aa_form *z, const aa_form *x, double s)
         z->flags = (unsigned short)flags;
         return;
     }
-    aa_lincomb(ctx, z, s, x, 0.0, NULL, 0.0);
+    (void)ctx;
+    lincomb_scale(z, s, x, 0.0);
 }
 
 void aa_apply_linear(aa_context *ctx, aa_form *z, const aa_form *x,
@@ -623,7 +614,7 @@ void aa_mul(aa_context *ctx, aa_form *z, const aa_form *x, const aa_form *y)
             return;
         }
         double k = p->x0;
-        aa_lincomb(ctx, z, k, o, 0.0, NULL, 0.0);
+        lincomb_scale(z, k, o, 0.0);
         z->flags |= (unsigned short)flags;
         return;
     }

@@ -74,15 +74,69 @@ void aa_context_init(aa_context *ctx, int capacity);  /* clamps to [0, MAX] */
 void aa_context_reset(aa_context *ctx);               /* next query: no symbols */
 
 /* ---- construction and queries ---- */
+/* (the small ones are inline: the shading VM makes a constant or asks
+ * whether an operand is one for most instructions, issue 24) */
 void aa_input(aa_context *ctx, aa_form *z, double lo, double hi); /* new symbol */
-void aa_const(aa_form *z, double value);
+static inline void aa_unbounded(aa_form *z, unsigned flags)
+{
+    z->x0 = 0.0;
+    z->err = INFINITY;
+    z->lo = -INFINITY;
+    z->hi = INFINITY;
+    z->n = 0;
+    z->flags = (unsigned short)(flags | AA_UNBOUNDED);
+}
+static inline void aa_const(aa_form *z, double value)   /* unbounded if not finite */
+{
+    if (!isfinite(value)) {
+        aa_unbounded(z, 0);
+        return;
+    }
+    z->x0 = value;
+    z->err = 0.0;
+    z->lo = value;
+    z->hi = value;
+    z->n = 0;
+    z->flags = 0;
+}
 void aa_from_interval(aa_context *ctx, aa_form *z, ia_interval x);
-void aa_unbounded(aa_form *z, unsigned flags);
 ia_interval aa_range(const aa_form *x);   /* affine range (rounded outward) meet hull */
 double aa_radius(const aa_form *x);                   /* sum |xi| + err, up */
 /* aa_range(x), and aa_radius(x) in *radius, the sum taken once */
 ia_interval aa_range_radius(const aa_form *x, double *radius);
-bool aa_is_point(const aa_form *x);                   /* no noise at all */
+static inline bool aa_is_point(const aa_form *x)      /* no noise at all */
+{
+    if ((x->flags & AA_UNBOUNDED) || x->err != 0.0)
+        return false;
+    for (int i = 0; i < x->n; i++)
+        if (x->c[i] != 0.0)
+            return false;
+    return true;
+}
+
+/* An exact constant: what aa_const makes of a finite value (no symbols, no
+ * error, the hull the point itself). aa_range(x) is [x->x0, x->x0]. */
+static inline bool aa_is_exact_const(const aa_form *x)
+{
+    return x->n == 0 && x->err == 0.0 && !(x->flags & AA_UNBOUNDED) && x->lo == x->x0 &&
+           x->hi == x->x0 && x->x0 - x->x0 == 0.0;          /* finite */
+}
+
+/* x - y of two exact constants, when the double difference is exact:
+ * true with *d the difference, and then aa_range of aa_sub(x, y) is
+ * [*d, *d] (up to the sign of a zero), so a comparison of x and y is
+ * decided by *d alone: the shading VM's loop tests on counters, without
+ * building the form of the difference (issue 24). False otherwise. */
+static inline bool aa_exact_difference(const aa_form *x, const aa_form *y, double *d)
+{
+    if (!aa_is_exact_const(x) || !aa_is_exact_const(y))
+        return false;
+    double a = x->x0, b = -y->x0, s = a + b, bb = s - a;
+    if (s - s != 0.0 || (a - (s - bb)) + (b - bb) != 0.0)     /* overflow, or rounded */
+        return false;
+    *d = s;
+    return true;
+}
 
 /* ---- affine operations: exact up to rounding, no new symbol ---- */
 void aa_add(aa_context *ctx, aa_form *z, const aa_form *x, const aa_form *y);

@@ -459,12 +459,22 @@ void sl_vm_set_interval(sl_vm *self, sl_global g, const ia_interval *values)
     memcpy(&self->i[sl_global_slot(g)], values, (size_t)sl_global_size(g) * sizeof *values);
 }
 
+/* count forms, each up to its last symbol in use (a form is never read
+ * past n: the rest of its array is stale by design, affine.h) */
+static void copy_forms(aa_form *dst, const aa_form *src, int count)
+{
+    for (int k = 0; k < count; k++) {
+        assert(src[k].n <= AA_MAX_SYMBOLS);
+        memcpy(&dst[k], &src[k], offsetof(aa_form, c) + (size_t)src[k].n * sizeof src[k].c[0]);
+    }
+}
+
 void sl_vm_set_affine(sl_vm *self, sl_global g, const aa_form *values)
 {
     ensure_clear(self, SL_MODE_AFFINE);
     if (!global_ok(g))
         return;
-    memcpy(&self->a[sl_global_slot(g)], values, (size_t)sl_global_size(g) * sizeof *values);
+    copy_forms(&self->a[sl_global_slot(g)], values, sl_global_size(g));
 }
 
 void sl_vm_get_float(const sl_vm *self, sl_global g, double *values)
@@ -492,7 +502,7 @@ void sl_vm_get_affine(const sl_vm *self, sl_global g, aa_form *values)
 {
     ensure_clear((sl_vm *)self, SL_MODE_AFFINE);
     if (global_ok(g))
-        memcpy(values, &self->a[sl_global_slot(g)], (size_t)sl_global_size(g) * sizeof *values);
+        copy_forms(values, &self->a[sl_global_slot(g)], sl_global_size(g));
 }
 
 /* ---------------------------------------------------------------------- */

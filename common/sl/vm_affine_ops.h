@@ -109,11 +109,17 @@ static inline void VM_OP(v_mix, b_mix)(sl_vm *vm, A *z, const A *x, const A *y, 
 /* Tri-state comparison through the range of x - y (keeps correlations). */
 static inline int VM_OP(v_cmp, b_cmp)(sl_vm *vm, int op, const A *x, const A *y)
 {
-    A d;
-    aa_sub(vm->ctx, &d, x, y);
-    ia_interval r = aa_range(&d);
-    if ((d.flags & AA_UNBOUNDED) || !(r.lo <= r.hi))
-        return 2;
+    ia_interval r;
+    double e;
+    if (aa_exact_difference(x, y, &e)) {        /* two constants: the same range */
+        r.lo = r.hi = e;
+    } else {
+        A d;
+        aa_sub(vm->ctx, &d, x, y);
+        r = aa_range(&d);
+        if ((d.flags & AA_UNBOUNDED) || !(r.lo <= r.hi))
+            return 2;
+    }
     switch (op) {
     case SL_OP_LT: return r.hi < 0 ? 1 : r.lo >= 0 ? 0 : 2;
     case SL_OP_LE: return r.hi <= 0 ? 1 : r.lo > 0 ? 0 : 2;
@@ -138,6 +144,8 @@ static inline void VM_OP(v_bool, b_bool)(sl_vm *vm, A *z, int t)
 }
 static inline int VM_OP(v_truth, b_truth)(const A *x)
 {
+    if (aa_is_exact_const(x))                   /* its range: [x0, x0] */
+        return x->x0 > 0.5 ? 1 : x->x0 < 0.5 ? 0 : 2;
     ia_interval r = aa_range(x);
     return r.lo > 0.5 ? 1 : r.hi < 0.5 ? 0 : 2;
 }
@@ -170,8 +178,10 @@ static inline sl_status VM_OP(v_noise, b_noise)(sl_vm *vm, A *S, const sl_insn *
             period[k] = (int)q;
         }
     }
-    A out[3];                        /* the noise functions may not alias p */
-    int outs = (v & SL_NOISE_VECTOR) ? 3 : 1;
+    A tmp[3];                        /* the noise functions may not alias p: */
+    int outs = (v & SL_NOISE_VECTOR) ? 3 : 1;     /* straight into the slots when */
+    bool apart = in->a + outs <= in->b || in->b + dim <= in->a;   /* they are not p */
+    A *out = apart ? &S[in->a] : tmp;
     const int *per = kind == SL_NOISE_PERIODIC ? period : NULL;
     if (outs == 3) {
         if (kind == SL_NOISE_CELL)
@@ -183,7 +193,7 @@ static inline sl_status VM_OP(v_noise, b_noise)(sl_vm *vm, A *S, const sl_insn *
     } else {
         sl_pnoise_aa(vm->ctx, out, dim, p, per);
     }
-    for (int i = 0; i < outs; i++)
+    for (int i = 0; i < outs && !apart; i++)
         VM_OP(v_mov, b_mov)(vm, &S[in->a + i], &out[i]);
     return SL_OK;
 }
