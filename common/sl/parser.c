@@ -49,7 +49,8 @@ typedef struct parser {
     int else_ifs;        /* links of `else if` chains among the open levels */
     long consumed;       /* tokens consumed so far: progress of the loops */
     const atomic_int *cancel;   /* the program's stop flag, or NULL */
-    bool cancelled;      /* it was found set: the text "ends" here */
+    bool cancelled;      /* it was found set, or the nesting limit was met:
+                            the text "ends" here (no cascade of errors) */
     bool coshader_said;  /* co-shaders reported once per source (coshader_error) */
 } parser;
 
@@ -131,7 +132,7 @@ static bool expect_closing(parser *p, sl_token_kind kind, const sl_token *open)
 {
     if (match(p, kind))
         return true;
-    if (p->panic)
+    if (p->panic || p->cancelled)
         return false;
     error_at(p, p->cur.pos, &p->cur, "expected %s", sl_token_kind_name(kind));
     if (open)
@@ -233,6 +234,11 @@ static bool enter(parser *p, const char *what)
                      expr ? "expression" : "statements", SL_PARSE_MAX_DEPTH,
                      expr ? "split it into statements with temporary variables"
                           : "move the inner blocks into functions");
+        /* a resource limit, not a syntax error: nothing after it is worth
+         * a message (the recovery saw each remaining link of a chain as a
+         * broken statement) */
+        p->cancelled = true;
+        p->cur.kind = SL_TOK_EOF;
         return false;
     }
     p->depth++;
