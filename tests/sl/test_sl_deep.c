@@ -8,7 +8,9 @@
  * compiles or ends with its exact message; none may crash. The time is not
  * asserted (each case takes well under 2 s in a release build).
  *
- *   preprocessor   #if chain of 1e6 terms, 1e6 parentheses, 3e5 nested #if
+ *   preprocessor   #if chain of 1e6 terms, 1e6 parentheses, 3e5 nested #if,
+ *                  1e6 #elif links, 1e6 nested #ifdef, a #if ?: chain of
+ *                  1e6, 1e6 macros each naming the one before (budgets)
  *   parser         1e6 parentheses, unary minus, blocks, assignments, ?:,
  *                  else-if links, nested ifs, whiles and fors, call
  *                  arguments (each a level of nesting; the message names
@@ -132,6 +134,39 @@ static void test_pp_nested_if(void **state)
     (void)state;
     /* a stack of conditions, no recursion */
     expect_compiled(nest("", "#if 1\n", 300000, "displacement d() { }\n", "#endif\n", ""), 8);
+}
+
+static void test_pp_elif_chain(void **state)
+{
+    (void)state;
+    /* a million #elif links: one condition frame, no recursion */
+    expect_compiled(nest("#if 0\n", "#elif 0\n", MILLION, "#else\ndisplacement d() { }\n#endif\n",
+                         "", ""), 8);
+}
+
+static const char too_many_tokens[] = "error: too many tokens (more than 2097152 scanned or "
+                                      "produced by macro expansion)";
+
+static void test_pp_million_deep(void **state)
+{
+    (void)state;
+    /* nested #ifdef, a #if ?: chain, a chain of a million macros each
+     * naming the one before: each stops at a budget, none recurses */
+    expect_error(nest("", "#ifdef X\n", MILLION, "", "#endif\n", "displacement d() { }\n"), NULL,
+                 too_many_tokens);
+    expect_error(nest("#if ", "1?1:", MILLION, "0", "", "\n#endif\ndisplacement d() { }\n"), NULL,
+                 too_many_tokens);
+    sl_strbuf b = { 0 };
+    sl_strbuf_puts(&b, "#define M0 1\n");
+    char line[64];
+    for (int i = 1; i < MILLION; i++) {
+        snprintf(line, sizeof line, "#define M%d M%d\n", i, i - 1);
+        sl_strbuf_puts(&b, line);
+    }
+    snprintf(line, sizeof line, "displacement d() { float x = M%d; }\n", MILLION - 1);
+    sl_strbuf_puts(&b, line);
+    expect_error(b, NULL, "error: macro expansion too large (more than 67108864 bytes of "
+                          "preprocessor storage)");
 }
 
 /* ---------------------------------------------------------------------- */
@@ -345,6 +380,8 @@ int main(void)
         cmocka_unit_test(test_pp_if_chain),
         cmocka_unit_test(test_pp_if_parens),
         cmocka_unit_test(test_pp_nested_if),
+        cmocka_unit_test(test_pp_elif_chain),
+        cmocka_unit_test(test_pp_million_deep),
         cmocka_unit_test(test_parse_parens),
         cmocka_unit_test(test_parse_unary),
         cmocka_unit_test(test_parse_assignments),
