@@ -170,6 +170,10 @@ geom_cover geom_uv_box_cover(const geom_surface *s, double u0, double u1,
  * rounding margin; other kinds: true. */
 bool geom_uv_box_clear_of(const geom_surface *s, double u0, double u1, double v0, double v1,
                           uint64_t edges);
+/* Polygons: whether (u,v) lies beyond one edge of the set (bit i: edge i),
+ * by more than the rounding margin (outside the polygon across it); other
+ * kinds: false. */
+bool geom_uv_beyond(const geom_surface *s, double u, double v, uint64_t edges);
 /* Polygons: the object-space end points of edge i. */
 void geom_polygon_edge(const geom_surface *s, int i, vec3 *a, vec3 *b);
 

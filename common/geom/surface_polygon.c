@@ -265,6 +265,16 @@ bool geom_uv_box_clear_of(const geom_surface *s, double u0, double u1, double v0
     return true;
 }
 
+bool geom_uv_beyond(const geom_surface *s, double u, double v, uint64_t edges)
+{
+    if (s->kind != GEOM_POLYGON)
+        return false;
+    for (int i = 0; i < s->nuv; i++)
+        if (((edges >> i) & 1) && edge_eval(s, i, u, v) < -UV_TOL)
+            return true;
+    return false;
+}
+
 void geom_polygon_edge(const geom_surface *s, int i, vec3 *a, vec3 *b)
 {
     const double *p = s->uv[i], *q = s->uv[(i + 1) % s->nuv];

@@ -28,6 +28,10 @@ typedef struct checker {
     int nvfuncs, vfuncs_cap;
     int vfuncs_start;              /* first of the innermost scope */
     int depth;                     /* block depth */
+    int *fhead, *fnext;            /* file-level functions by name: a hash
+                                      table of chains in file order (fhead:
+                                      index + 1 of a chain's first, 0: none) */
+    unsigned fmask;                /* fhead's size - 1 */
     sl_func **allfuncs;            /* every function, nested ones too */
     int nallfuncs, allfuncs_cap;
     sl_func *func;                 /* function being checked (NULL: shader) */

@@ -45,9 +45,12 @@ typedef struct parser {
     sl_token prev;       /* the last consumed token */
     bool panic;
     int depth;
+    int stmts;           /* statements among the open levels */
+    int else_ifs;        /* links of `else if` chains among the open levels */
     long consumed;       /* tokens consumed so far: progress of the loops */
     const atomic_int *cancel;   /* the program's stop flag, or NULL */
-    bool cancelled;      /* it was found set: the text "ends" here */
+    bool cancelled;      /* it was found set, or the nesting limit was met:
+                            the text "ends" here (no cascade of errors) */
     bool coshader_said;  /* co-shaders reported once per source (coshader_error) */
 } parser;
 
@@ -129,7 +132,7 @@ static bool expect_closing(parser *p, sl_token_kind kind, const sl_token *open)
 {
     if (match(p, kind))
         return true;
-    if (p->panic)
+    if (p->panic || p->cancelled)
         return false;
     error_at(p, p->cur.pos, &p->cur, "expected %s", sl_token_kind_name(kind));
     if (open)
@@ -219,11 +222,23 @@ static sl_node *error_node(parser *p, sl_pos pos)
 static bool enter(parser *p, const char *what)
 {
     if (p->depth >= SL_PARSE_MAX_DEPTH) {
-        bool expr = strcmp(what, "expression") == 0;
-        error_at(p, p->cur.pos, &p->cur, "%s nested too deeply (more than %d levels): %s", what,
-                 SL_PARSE_MAX_DEPTH,
-                 expr ? "split it into statements with temporary variables"
-                      : "move the inner blocks into functions");
+        /* named by what makes up most of the depth: the conditions of a
+         * thousand nested ifs are not the expressions to split */
+        bool expr = strcmp(what, "expression") == 0 && 2 * p->stmts <= p->depth;
+        if (2 * p->else_ifs > p->depth)     /* mostly a chain of else-ifs */
+            error_at(p, p->cur.pos, &p->cur, "'else if' chain too long (more than %d levels of "
+                     "nesting, each 'else if' one): split it into several if statements",
+                     SL_PARSE_MAX_DEPTH);
+        else
+            error_at(p, p->cur.pos, &p->cur, "%s nested too deeply (more than %d levels): %s",
+                     expr ? "expression" : "statements", SL_PARSE_MAX_DEPTH,
+                     expr ? "split it into statements with temporary variables"
+                          : "move the inner blocks into functions");
+        /* a resource limit, not a syntax error: nothing after it is worth
+         * a message (the recovery saw each remaining link of a chain as a
+         * broken statement) */
+        p->cancelled = true;
+        p->cur.kind = SL_TOK_EOF;
         return false;
     }
     p->depth++;
@@ -817,8 +832,14 @@ static sl_node *if_statement(parser *p)
     if (p->panic)
         return n;
     n->b = statement(p);
-    if (!p->panic && match(p, SL_KW_ELSE))
+    if (!p->panic && match(p, SL_KW_ELSE)) {
+        /* `else if` nests (every pass recurses along the chain): one level
+         * a link, named in the message when the chain meets the limit */
+        int link = check(p, SL_KW_IF);
+        p->else_ifs += link;
         n->c = statement(p);
+        p->else_ifs -= link;
+    }
     return n;
 }
 
@@ -1054,7 +1075,9 @@ static sl_node *statement(parser *p)
 {
     if (!enter(p, "statements"))
         return NULL;
+    p->stmts++;
     sl_node *s = statement_inner(p);
+    p->stmts--;
     p->depth--;
     return s;
 }

@@ -315,7 +315,16 @@ static bool leaf_point(walk *w, const double *r, bool partial, double *uc, doubl
     r = rw;
     if (centre) *sp = *centre;
     else trace_surface_point_eval(w->th, obj, *uc, *vc, sp);
-    double u, v;
+    double u, v, s[3];
+    /* a mesh piece's partial cell: the clamp below keeps a ray beside a
+     * shared edge for one of its two polygons, but one beyond an edge of
+     * the piece's own (the mesh's outline) is no hit of the mesh: taken,
+     * a leaf drew the outline up to its width past the polygon the mesh
+     * tiles where a shared edge met it (issue 27) */
+    if (partial && obj->shared_edges && v3_is_finite(sp->P) &&
+        trace_newton_step(sp->Pu, sp->Pv, w->cam_ray->d, v3_sub(sp->P, w->cam_ray->o), s) &&
+        geom_uv_beyond(&obj->surf, sp->u + s[0], sp->v + s[1], ~obj->shared_edges))
+        return false;
     if (!v3_is_finite(sp->P) || !newton_uv(w->cam_ray, sp, r, &u, &v))
         return partial ? geom_uv_inside(&obj->surf, *uc, *vc) : true;
     if (!geom_uv_inside(&obj->surf, u, v))

@@ -6,6 +6,7 @@
  * has a message, and a scene's object count is within the limit.
  */
 #include "fuzz_target.h"
+#include "fuzz_nest.h"
 #include "scene/scene.h"
 
 enum { FUZZ_MAX_OBJECTS = 4096 };

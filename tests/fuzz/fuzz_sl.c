@@ -13,6 +13,7 @@
 
 #include "aa/interval.h"
 #include "fuzz_target.h"
+#include "fuzz_nest.h"
 #include "sl/diag.h"
 #include "sl/shader.h"
 #include "sl/source.h"

@@ -5,7 +5,9 @@
  * every request, and copied the light switches at every push: 100,000
  * levels took minutes), and more than RIB_MAX_BLOCKS open blocks stop the
  * parse with one error at file:line:col (docs/scenes.md, Limits). The time
- * is not asserted: a million levels end in a fraction of a second.
+ * is not asserted: a million levels end in a fraction of a second. So do
+ * a million nested SolidBegin and ArchiveBegin blocks, and a chain of
+ * 100,000 archives stops at the archive depth limit.
  */
 #include <stdarg.h>
 #include <stddef.h>
@@ -130,6 +132,52 @@ static void test_million_deep_stops_at_the_limit(void **state)
     free(text.data);
 }
 
+/* The other blocks a million deep (issue 27): nested SolidBegin (not
+ * rendered: its surfaces as a union) and ArchiveBegin blocks parse with a
+ * loop, into a scene; a chain of 100,000 archives, each reading the one
+ * before, stops at the archive depth limit (16) with one error. */
+static void test_other_blocks_million_deep(void **state)
+{
+    (void)state;
+    enum { DEPTH = 1000000 };
+    sl_strbuf text = { 0 };
+    sl_strbuf_puts(&text, CAMERA "WorldBegin\n");
+    repeat(&text, "SolidBegin \"union\"\n", DEPTH);
+    sl_strbuf_puts(&text, "Sphere 1 -1 1 360\n");
+    repeat(&text, "SolidEnd\n", DEPTH);
+    sl_strbuf_puts(&text, "WorldEnd\n");
+    scene *s = parse_ok(&text, 1);
+    scene_destroy(&s);
+
+    sl_strbuf_puts(&text, CAMERA);
+    repeat(&text, "ArchiveBegin \"x\"\n", DEPTH);
+    repeat(&text, "ArchiveEnd\n", DEPTH);
+    sl_strbuf_puts(&text, "WorldBegin\nSphere 1 -1 1 360\nWorldEnd\n");
+    s = parse_ok(&text, 1);
+    scene_destroy(&s);
+
+    /* the chain: 100,000 archives (5 MB, past the 4 MiB a scene file
+     * may have: a million would only add parsing time) */
+    enum { CHAIN = 100000 };
+    sl_strbuf_puts(&text, CAMERA "ArchiveBegin \"a0\"\nSphere 1 -1 1 360\nArchiveEnd\n");
+    char line[96];
+    for (int i = 1; i < CHAIN; i++) {
+        snprintf(line, sizeof line, "ArchiveBegin \"a%d\"\nReadArchive \"a%d\"\nArchiveEnd\n", i,
+                 i - 1);
+        sl_strbuf_puts(&text, line);
+    }
+    snprintf(line, sizeof line, "WorldBegin\nReadArchive \"a%d\"\nWorldEnd\n", CHAIN - 1);
+    sl_strbuf_puts(&text, line);
+    sl_diag *d;
+    s = parse_rib(text.data, &d);
+    assert_null(s);
+    const char *got = diag_line(nth_diag(d, SL_DIAG_ERROR, 0));
+    assert_non_null(strstr(got, "ReadArchive: archives nested more than 16 deep (is there a "
+                                "cycle?)"));
+    sl_diag_destroy(&d);
+    free(text.data);
+}
+
 /* At the limit exactly: a scene. */
 static void test_at_the_limit(void **state)
 {
@@ -152,6 +200,7 @@ int main(void)
         cmocka_unit_test(test_object_inside_deep_blocks),
         cmocka_unit_test(test_million_deep_stops_at_the_limit),
         cmocka_unit_test(test_at_the_limit),
+        cmocka_unit_test(test_other_blocks_million_deep),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

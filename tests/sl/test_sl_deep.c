@@ -8,8 +8,16 @@
  * compiles or ends with its exact message; none may crash. The time is not
  * asserted (each case takes well under 2 s in a release build).
  *
- *   preprocessor   #if chain of 1e6 terms, 1e6 parentheses, 3e5 nested #if
- *   parser         1e6 parentheses, unary minus, blocks, assignments, ?:
+ *   preprocessor   #if chain of 1e6 terms, 1e6 parentheses, 3e5 nested #if,
+ *                  1e6 #elif links, 1e6 nested #ifdef, a #if ?: chain of
+ *                  1e6, 1e6 macros each naming the one before (budgets)
+ *   parser         1e6 parentheses, unary minus, blocks, assignments, ?:,
+ *                  else-if links, nested ifs, whiles and fors, call
+ *                  arguments (each a level of nesting; the message names
+ *                  the chain or the statements, not their conditions)
+ *   checker        100,000 functions each calling the one before (the
+ *                  inlining limit; the lookup of a function by name was a
+ *                  scan of every function: 150 s)
  *   checker        a 1e6-term chain ending in an undeclared name
  *   codegen        a folded 1e6-term chain (compiled), a 1e6-term chain
  *                  of variables (the register limit), 2e5 statements that
@@ -50,11 +58,28 @@ static sl_strbuf nest(const char *head, const char *open, int n, const char *mid
 }
 
 /* `src` (freed) fails to compile; its first diagnostic is exactly `first`,
+ * or with first NULL, some diagnostic holds `part`. Sources over the 4 MiB
+ * of sl_source_set (a million else-ifs) are compiled with the limit raised:
+ * the passes, not the size check, are under test. */
+static char *compile_text(const char *src, sl_program **out)
+{
+    sl_source_set *set = sl_source_set_new();
+    sl_source_set_set_max_size(set, (size_t)1 << 30);
+    sl_diag *diag = sl_diag_new();
+    sl_source_set_add(set, "t.sl", src, strlen(src));
+    *out = sl_compile(set, "t.sl", NULL, NULL, diag);
+    char *text = sl_diag_to_string(diag);
+    sl_diag_destroy(&diag);
+    sl_source_set_destroy(&set);
+    return text;
+}
+
+/* `src` (freed) fails to compile; its first diagnostic is exactly `first`,
  * or with first NULL, some diagnostic holds `part`. */
 static void expect_error(sl_strbuf src, const char *first, const char *part)
 {
-    char *text = NULL;
-    sl_program *p = h_compile_named("t.sl", src.data, &text);
+    sl_program *p = NULL;
+    char *text = compile_text(src.data, &p);
     assert_null(p);
     size_t len = strcspn(text, "\n");
     if (first && (strlen(first) != len || strncmp(text, first, len) != 0))
@@ -72,8 +97,8 @@ static void expect_error(sl_strbuf src, const char *first, const char *part)
 /* `src` (freed) compiles; the program has fewer than `max_code` instructions. */
 static void expect_compiled(sl_strbuf src, int max_code)
 {
-    char *text = NULL;
-    sl_program *p = h_compile_named("t.sl", src.data, &text);
+    sl_program *p = NULL;
+    char *text = compile_text(src.data, &p);
     if (!p)
         fprintf(stderr, "%.300s\n", text);
     assert_non_null(p);
@@ -109,6 +134,39 @@ static void test_pp_nested_if(void **state)
     (void)state;
     /* a stack of conditions, no recursion */
     expect_compiled(nest("", "#if 1\n", 300000, "displacement d() { }\n", "#endif\n", ""), 8);
+}
+
+static void test_pp_elif_chain(void **state)
+{
+    (void)state;
+    /* a million #elif links: one condition frame, no recursion */
+    expect_compiled(nest("#if 0\n", "#elif 0\n", MILLION, "#else\ndisplacement d() { }\n#endif\n",
+                         "", ""), 8);
+}
+
+static const char too_many_tokens[] = "error: too many tokens (more than 2097152 scanned or "
+                                      "produced by macro expansion)";
+
+static void test_pp_million_deep(void **state)
+{
+    (void)state;
+    /* nested #ifdef, a #if ?: chain, a chain of a million macros each
+     * naming the one before: each stops at a budget, none recurses */
+    expect_error(nest("", "#ifdef X\n", MILLION, "", "#endif\n", "displacement d() { }\n"), NULL,
+                 too_many_tokens);
+    expect_error(nest("#if ", "1?1:", MILLION, "0", "", "\n#endif\ndisplacement d() { }\n"), NULL,
+                 too_many_tokens);
+    sl_strbuf b = { 0 };
+    sl_strbuf_puts(&b, "#define M0 1\n");
+    char line[64];
+    for (int i = 1; i < MILLION; i++) {
+        snprintf(line, sizeof line, "#define M%d M%d\n", i, i - 1);
+        sl_strbuf_puts(&b, line);
+    }
+    snprintf(line, sizeof line, "displacement d() { float x = M%d; }\n", MILLION - 1);
+    sl_strbuf_puts(&b, line);
+    expect_error(b, NULL, "error: macro expansion too large (more than 67108864 bytes of "
+                          "preprocessor storage)");
 }
 
 /* ---------------------------------------------------------------------- */
@@ -162,6 +220,49 @@ static void test_parse_blocks(void **state)
     expect_error(nest("displacement d() { ", "{", MILLION, "float x = s;", "}", " }\n"),
                  "t.sl:1:220: error: statements nested too deeply (more than 200 levels): "
                  "move the inner blocks into functions", NULL);
+}
+
+static const char stmt_deep[] = "error: statements nested too deeply (more than 200 levels): "
+                                "move the inner blocks into functions";
+
+static void test_parse_else_if_chain(void **state)
+{
+    (void)state;
+    /* a link a level, its condition two more: the 198th link's '(' */
+    expect_error(nest("displacement d() { float x = 0; if (s>0) x=1;", " else if (s>0) x=1;",
+                      MILLION, "", "", " }\n"),
+                 "t.sl:1:3768: error: 'else if' chain too long (more than 200 levels of "
+                 "nesting, each 'else if' one): split it into several if statements", NULL);
+}
+
+static void test_parse_nested_ifs(void **state)
+{
+    (void)state;
+    char want[256];
+    snprintf(want, sizeof want, "t.sl:1:1819: %s", stmt_deep);
+    expect_error(nest("displacement d() { float x = 0; ", "if (s>0) ", MILLION, "x=1;", "",
+                      " }\n"), want, NULL);
+}
+
+static void test_parse_nested_loops(void **state)
+{
+    (void)state;
+    char want[256];
+    snprintf(want, sizeof want, "t.sl:1:2416: %s", stmt_deep);
+    expect_error(nest("displacement d() { float x = 0; ", "while (s>0) ", MILLION, "x=0;", "",
+                      " }\n"), want, NULL);
+    snprintf(want, sizeof want, "t.sl:1:2415: %s", stmt_deep);
+    expect_error(nest("displacement d() { float x = 0; ", "for (;s>0;) ", MILLION, "x=0;", "",
+                      " }\n"), want, NULL);
+}
+
+static void test_parse_nested_calls(void **state)
+{
+    (void)state;
+    expect_expr_deep(nest("displacement d() { float x = ", "abs(", MILLION, "s", ")", "; }\n"),
+                     426);
+    expect_expr_deep(nest("displacement d() { float x = ", "float(", MILLION, "s", ")",
+                          "; }\n"), 624);
 }
 
 /* ---------------------------------------------------------------------- */
@@ -222,6 +323,22 @@ static void test_many_escapes(void **state)
                  "inlining functions)", NULL);
 }
 
+static void test_function_chain(void **state)
+{
+    (void)state;
+    /* 100,000 definitions (4 MiB of source at most): the lookup by name
+     * is a hash chain; the call depth stops at the 64th inlined call */
+    sl_strbuf b = { 0 };
+    sl_strbuf_puts(&b, "float f0(float x) { return x; }\n");
+    char line[96];
+    for (int i = 1; i < 100000; i++) {
+        snprintf(line, sizeof line, "float f%d(float x) { return f%d(x); }\n", i, i - 1);
+        sl_strbuf_puts(&b, line);
+    }
+    sl_strbuf_puts(&b, "displacement d() { P += f99999(u) * N; }\n");
+    expect_error(b, "t.sl:99937:32: error: function calls nested too deeply (limit 64)", NULL);
+}
+
 /* 63 functions each calling the previous one from inside `blocks` nested
  * blocks and `minus` unary minus signs: each within the parser's limit,
  * SL_CG_MAX_DEPTH levels after inlining. */
@@ -263,11 +380,18 @@ int main(void)
         cmocka_unit_test(test_pp_if_chain),
         cmocka_unit_test(test_pp_if_parens),
         cmocka_unit_test(test_pp_nested_if),
+        cmocka_unit_test(test_pp_elif_chain),
+        cmocka_unit_test(test_pp_million_deep),
         cmocka_unit_test(test_parse_parens),
         cmocka_unit_test(test_parse_unary),
         cmocka_unit_test(test_parse_assignments),
         cmocka_unit_test(test_parse_conditionals),
         cmocka_unit_test(test_parse_blocks),
+        cmocka_unit_test(test_parse_else_if_chain),
+        cmocka_unit_test(test_parse_nested_ifs),
+        cmocka_unit_test(test_parse_nested_loops),
+        cmocka_unit_test(test_parse_nested_calls),
+        cmocka_unit_test(test_function_chain),
         cmocka_unit_test(test_chain_folded),
         cmocka_unit_test(test_chain_logical),
         cmocka_unit_test(test_chain_registers),

@@ -70,6 +70,15 @@ static const char *SHELL_SL =
     "    P += Km * normalize(N);\n"
     "}\n";
 
+/* a gentle bowl: G curves a little over a cell, so K is a few per cent of
+ * the cell wide, about the zero */
+static const char *BOWL_SL =
+    "displacement bowl(float Km = 0.02)\n"
+    "{\n"
+    "    float x = s - 0.3, y = t - 0.6;\n"
+    "    P += Km * (x * x + 0.7 * y * y) * normalize(N);\n"
+    "}\n";
+
 static const char *DU_SL =
     "displacement dudep(float Km = 0.05)\n"
     "{\n"
@@ -586,8 +595,83 @@ static void check_zero_beside_the_box(const char *name, const char *src, bool pl
 static void test_zero_beside_the_box_is_never_taken(void **state)
 {
     (void)state;
+    check_zero_beside_the_box("bowl", BOWL_SL, false);
     check_zero_beside_the_box("shell", SHELL_SL, true);
     check_zero_beside_the_box("wave", WAVE_SL, false);
+}
+
+/* The box a proven hit hands the walk (trace_zero: the proof's box about
+ * the zero, which the walk takes for X's only zero) lies inside X, and so
+ * does the hit. Rays aimed at zeros in the margin between the cell and X
+ * (and in the cell), on cells of 1/4 to 1/64 on the gentle bowl and on the
+ * wave: there K is a fifth to a half of X wide about a zero near X's
+ * border, so it ends just inside X or just beyond it, where only the
+ * strict inclusion K in int(X) tells a proven zero from a box that merely
+ * overlaps X (Krawczyk's theorem says nothing of K outside X). */
+static void check_zero_boxes(const char *name, const char *src, int *hits_out)
+{
+    fixture f;
+    fixture_shader sh[] = {{name, src}};
+    char rib[512];
+    snprintf(rib, sizeof rib, SQUARE_RIB("%s"), name);
+    assert_true(fixture_open(&f, rib, sh, 1, NULL, 0));
+    trace_thread *th = trace_thread_new(&f.js->world);
+    const trace_object *obj = &f.js->world.objects[0];
+    unsigned seed = 2027;
+    int hits = 0, tries = 0, escaped = 0;
+    for (int k = 0; k < 6000; k++) {
+        double w = 1.0 / (4 << (k % 5));       /* cells of 1/4 .. 1/64 */
+        double r[4], X[4];
+        r[0] = 0.1 + (0.8 - w) * urand(&seed);
+        r[2] = 0.1 + (0.8 - w) * urand(&seed);
+        r[1] = r[0] + w;
+        r[3] = r[2] + w;
+        slopes_box(r, X);
+        /* the margin beside one side of the cell (a quarter of the cell
+         * wide), or the cell */
+        double in = 0.25 * urand(&seed) * w, along = urand(&seed), u, v;
+        switch (k % 5) {
+        case 0: u = X[0] + in; v = X[2] + along * (X[3] - X[2]); break;
+        case 1: u = X[1] - in; v = X[2] + along * (X[3] - X[2]); break;
+        case 2: v = X[2] + in; u = X[0] + along * (X[1] - X[0]); break;
+        case 3: v = X[3] - in; u = X[0] + along * (X[1] - X[0]); break;
+        default: u = r[0] + along * w; v = r[2] + urand(&seed) * w; break;
+        }
+        trace_ray ray = ray_through(th, obj, u, v);
+        double t;
+        trace_surface_point sp;
+        trace_proof_detail why;
+        trace_zero zero = {.set = false};
+        tries++;
+        if (trace_prove_hit(th, obj, &ray, r, 0.0, INFINITY, &zero, &t, &sp, &why) !=
+            TRACE_PROOF_HIT)
+            continue;
+        hits++;
+        assert_true(zero.set);
+        bool inside = zero.uv[0][0] >= X[0] && zero.uv[0][1] <= X[1] && zero.uv[1][0] >= X[2] &&
+                      zero.uv[1][1] <= X[3] && sp.u >= X[0] && sp.u <= X[1] && sp.v >= X[2] &&
+                      sp.v <= X[3];
+        if (!inside && escaped++ < 5)
+            printf("  %s: cell [%.6f %.6f] x [%.6f %.6f]: the proof's box [%.6f %.6f] x "
+                   "[%.6f %.6f] (hit at %.6f, %.6f) leaves X [%.6f %.6f] x [%.6f %.6f]\n",
+                   name, r[0], r[1], r[2], r[3], zero.uv[0][0], zero.uv[0][1], zero.uv[1][0],
+                   zero.uv[1][1], sp.u, sp.v, X[0], X[1], X[2], X[3]);
+    }
+    printf("%s: %d of %d rays at zeros near X's border proven, %d proofs' boxes outside X\n",
+           name, hits, tries, escaped);
+    assert_int_equal(escaped, 0);
+    *hits_out = hits;
+    trace_thread_destroy(&th);
+    fixture_close(&f);
+}
+
+static void test_proofs_boxes_lie_in_x(void **state)
+{
+    (void)state;
+    int bowl = 0, wave = 0;
+    check_zero_boxes("bowl", BOWL_SL, &bowl);
+    check_zero_boxes("wave", WAVE_SL, &wave);
+    assert_true(bowl > 800 && wave > 1000);    /* the test exercises proofs */
 }
 
 /* A fold: rays crossing the ridge twice, against cells whose slopes' box
@@ -703,6 +787,7 @@ int main(void)
         cmocka_unit_test(test_proven_walks_agree_with_leaves),
         cmocka_unit_test(test_cell_with_two_zeros),
         cmocka_unit_test(test_zero_beside_the_box_is_never_taken),
+        cmocka_unit_test(test_proofs_boxes_lie_in_x),
         cmocka_unit_test(test_fold_with_two_zeros_is_never_unique),
         cmocka_unit_test(test_silhouettes_match_a_finer_tolerance),
     };

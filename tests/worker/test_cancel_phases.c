@@ -6,7 +6,8 @@
  *   reading    a RIB that reads a 100,000-request archive 200 times
  *              (20 million requests: seconds per parse), in the
  *              standalone worker and in the master
- *   compiling  a shader with 30,000 functions (the checker takes seconds),
+ *   compiling  a shader with 30,000 overloads of one function (the checker
+ *              takes seconds),
  *              in aafarm-slc, the standalone worker and the master
  *   evaluating one displacement loop within --budget 1e9 in interval
  *              arithmetic, and one surface shader loop (the float path)
@@ -200,14 +201,28 @@ static void write_long_rib(void)
     fclose(f);
 }
 
-/* wide.sl: 30,000 functions before the shader (each checked against the
- * others: seconds); wide.rib uses it. */
+/* wide.sl: 30,000 overloads of one function before the shader (each
+ * definition is checked against its namesakes for a duplicate: seconds;
+ * 30,000 differently named functions no longer are, found by a hash
+ * chain); wide.rib uses it. The signatures: 1 to 6 parameters of the 7
+ * types, in order. */
 static void write_wide_shader(void)
 {
+    static const char *const types[] = {"float", "point", "vector", "color",
+                                        "normal", "matrix", "string"};
     FILE *f = open_in_dir("wide.sl");
-    for (int i = 0; i < 30000; i++)
-        fprintf(f, "float f%d(float a) { return a * a + a * 0.5 - a / 3; }\n", i);
-    fputs("surface wide()\n{\n    Ci = f1(s) * Cs;\n}\n", f);
+    int written = 0;
+    for (int k = 1; k <= 6 && written < 30000; k++) {
+        int combos = 1;
+        for (int i = 0; i < k; i++) combos *= 7;
+        for (int c = 0; c < combos && written < 30000; c++, written++) {
+            fputs("float f(", f);
+            for (int i = 0, x = c; i < k; i++, x /= 7)
+                fprintf(f, "%s%s a%d", i ? ", " : "", types[x % 7], i);
+            fputs(") { return 1; }\n", f);
+        }
+    }
+    fputs("surface wide()\n{\n    Ci = f(s) * Cs;\n}\n", f);
     fclose(f);
     f = open_in_dir("wide.rib");
     fputs("Format 16 16 1\nProjection \"perspective\" \"fov\" [40]\n"
