@@ -6,8 +6,9 @@
  *   reading    a RIB that reads a 100,000-request archive 200 times
  *              (20 million requests: seconds per parse), in the
  *              standalone worker and in the master
- *   compiling  a shader with 30,000 overloads of one function (the checker
- *              takes seconds),
+ *   compiling  40 shaders that each include 30,000 overloads of one
+ *              function and 30,000 calls that choose among them (a few
+ *              tenths of a second each: seconds in all),
  *              in aafarm-slc, the standalone worker and the master
  *   evaluating one displacement loop within --budget 1e9 in interval
  *              arithmetic, and one surface shader loop (the float path)
@@ -201,16 +202,20 @@ static void write_long_rib(void)
     fclose(f);
 }
 
-/* wide.sl: 30,000 overloads of one function before the shader (each
- * definition is checked against its namesakes for a duplicate: seconds;
- * 30,000 differently named functions no longer are, found by a hash
- * chain); wide.rib uses it. The signatures: 1 to 6 parameters of the 7
- * types, in order. */
+/* wide_body.h: 30,000 overloads of one function, then 3,000 functions
+ * that each call it 10 times (~2.6 MB: the checker and code generator,
+ * linear in it, take a few tenths of a second); WIDE_SHADERS shaders
+ * wideK.sl include it, and wide.rib gives each to a sphere: the compile
+ * phase of a run lasts seconds, one shader after another, the flag looked
+ * at while reading, checking and between shaders. The signatures: 1 to 6
+ * parameters of the 7 types, in order. */
+enum { WIDE_SHADERS = 40 };
+
 static void write_wide_shader(void)
 {
     static const char *const types[] = {"float", "point", "vector", "color",
                                         "normal", "matrix", "string"};
-    FILE *f = open_in_dir("wide.sl");
+    FILE *f = open_in_dir("wide_body.h");
     int written = 0;
     for (int k = 1; k <= 6 && written < 30000; k++) {
         int combos = 1;
@@ -222,12 +227,23 @@ static void write_wide_shader(void)
             fputs(") { return 1; }\n", f);
         }
     }
-    fputs("surface wide()\n{\n    Ci = f(s) * Cs;\n}\n", f);
+    for (int g = 0; g < 3000; g++)
+        fprintf(f, "float g%d(float x) { return f(x) + f(x) + f(x) + f(x) + f(x) + f(x) + f(x) + "
+                   "f(x) + f(x) + f(x); }\n", g);
     fclose(f);
+    for (int k = 0; k < WIDE_SHADERS; k++) {
+        char name[32];
+        snprintf(name, sizeof name, "wide%d.sl", k);
+        f = open_in_dir(name);
+        fprintf(f, "#include \"wide_body.h\"\nsurface wide%d()\n{\n    Ci = f(s) * Cs;\n}\n", k);
+        fclose(f);
+    }
     f = open_in_dir("wide.rib");
     fputs("Format 16 16 1\nProjection \"perspective\" \"fov\" [40]\n"
-          "Option \"searchpath\" \"shader\" [\".\"]\nWorldBegin\nSurface \"wide\"\n"
-          "Translate 0 0 5\nSphere 1 -1 1 360\nWorldEnd\n", f);
+          "Option \"searchpath\" \"shader\" [\".\"]\nWorldBegin\nTranslate 0 0 5\n", f);
+    for (int k = 0; k < WIDE_SHADERS; k++)
+        fprintf(f, "AttributeBegin\nSurface \"wide%d\"\nSphere 1 -1 1 360\nAttributeEnd\n", k);
+    fputs("WorldEnd\n", f);
     fclose(f);
 }
 
@@ -262,7 +278,12 @@ static void test_compiling_slc(void **state)
 {
     (void)state;
     write_wide_shader();
-    const char *argv[] = {slc, "wide.sl", NULL};
+    const char *argv[WIDE_SHADERS + 2] = {slc};
+    static char names[WIDE_SHADERS][32];
+    for (int k = 0; k < WIDE_SHADERS; k++) {
+        snprintf(names[k], sizeof names[k], "wide%d.sl", k);
+        argv[1 + k] = names[k];
+    }
     pid_t pid = start(argv, "compile-slc.log");
     assert_int_equal(sigterm_in_phase(pid, "compiling (aafarm-slc)", 300, NULL), 130);
     assert_log_has("compile-slc.log", "interrupted");
