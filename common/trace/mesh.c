@@ -16,7 +16,6 @@
 
 #include <assert.h>
 #include <math.h>
-#include <pthread.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
@@ -515,23 +514,15 @@ static bool boxes_in_parallel(trace_thread *th, const trace_object *obj, trace_b
     if (threads > m->npieces / 2048) threads = m->npieces / 2048;
     if (threads < 1) threads = 1;
     box_share *share = xcalloc((size_t)threads, sizeof *share);
-    pthread_t *tid = xcalloc((size_t)threads, sizeof *tid);
-    bool *started = xcalloc((size_t)threads, sizeof *started);
-    for (int i = 0; i < threads; i++) {
+    for (int i = 0; i < threads; i++)
         share[i] = (box_share){i == 0 ? th : trace_thread_new(th->world), obj, roots, dudv,
                                (int)((long)m->npieces * i / threads),
                                (int)((long)m->npieces * (i + 1) / threads)};
-        if (i > 0) started[i] = pthread_create(&tid[i], NULL, box_range, &share[i]) == 0;
-    }
-    box_range(&share[0]);
+    trace_run_shares(share, sizeof *share, threads, box_range);
     for (int i = 1; i < threads; i++) {
-        if (started[i]) pthread_join(tid[i], NULL);
-        else box_range(&share[i]);     /* no thread: this one does its share */
         if (share[i].th->failed && !th->failed) trace_thread_fail(th, share[i].th->error);
         trace_thread_destroy(&share[i].th);
     }
-    free(started);
-    free(tid);
     free(share);
     return !th->failed;
 }

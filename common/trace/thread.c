@@ -6,6 +6,7 @@
 #include "util/err.h"
 #include "util/xalloc.h"
 
+#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -171,4 +172,19 @@ void trace_thread_sync_stats(trace_thread *self)
     self->stats.cache_misses = c->misses;
     self->stats.cache_evictions = c->evictions;
     self->stats.cache_peak_bytes = c->peak_bytes;
+}
+
+void trace_run_shares(void *shares, size_t size, int n, void *(*fn)(void *))
+{
+    char *base = shares;
+    pthread_t *tid = xcalloc((size_t)(n > 0 ? n : 1), sizeof *tid);
+    bool *started = xcalloc((size_t)(n > 0 ? n : 1), sizeof *started);
+    for (int i = 1; i < n; i++)
+        started[i] = pthread_create(&tid[i], NULL, fn, base + (size_t)i * size) == 0;
+    if (n > 0) fn(base);
+    for (int i = 1; i < n; i++)
+        if (started[i]) pthread_join(tid[i], NULL);
+        else fn(base + (size_t)i * size);     /* no thread: the caller does it */
+    free(started);
+    free(tid);
 }

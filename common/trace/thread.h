@@ -102,4 +102,11 @@ void trace_object_work_report(const trace_world *world, const trace_object_work 
 /* Folds the cache's counters into stats (call before reading stats). */
 void trace_thread_sync_stats(trace_thread *self);
 
+/* Runs fn on each of the n shares (shares[i] at shares + i * size): share
+ * 0 on the calling thread, the others on threads of their own, joined
+ * before it returns; a share whose thread cannot be started runs on the
+ * calling thread after share 0. For the world's build over
+ * trace_options.build_threads (mesh.c, world.c). */
+void trace_run_shares(void *shares, size_t size, int n, void *(*fn)(void *));
+
 #endif

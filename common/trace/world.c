@@ -14,7 +14,6 @@
 
 #include <assert.h>
 #include <math.h>
-#include <pthread.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -239,20 +238,14 @@ static void mesh_edges_in_parallel(const trace_world *world, const trace_object 
     if (threads > npieces / 4096) threads = npieces / 4096;
     if (threads < 1) threads = 1;
     edge_share *share = xcalloc((size_t)threads, sizeof *share);
-    pthread_t *tid = xcalloc((size_t)threads, sizeof *tid);
-    bool *started = xcalloc((size_t)threads, sizeof *started);
     for (int i = 0; i < threads; i++) {
         share[i].obj = obj;
         share[i].k0 = (int)((long)npieces * i / threads);
         share[i].k1 = (int)((long)npieces * (i + 1) / threads);
         share[i].cap = 3 * (size_t)(share[i].k1 - share[i].k0) + 1;
         share[i].e = xmalloc(sizeof *share[i].e * share[i].cap);
-        if (i > 0) started[i] = pthread_create(&tid[i], NULL, mesh_edges, &share[i]) == 0;
     }
-    mesh_edges(&share[0]);
-    for (int i = 1; i < threads; i++)
-        if (started[i]) pthread_join(tid[i], NULL);
-        else mesh_edges(&share[i]);    /* no thread: this one does its share */
+    trace_run_shares(share, sizeof *share, threads, mesh_edges);
     for (int i = 0; i < threads; i++) {
         if (*n + share[i].n > *cap) {
             *cap = *n + share[i].n;
@@ -262,8 +255,6 @@ static void mesh_edges_in_parallel(const trace_world *world, const trace_object 
         *n += share[i].n;
         free(share[i].e);
     }
-    free(started);
-    free(tid);
     free(share);
 }
 
