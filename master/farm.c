@@ -941,6 +941,16 @@ static void teardown(farm *f)
     free(f->frames);
 }
 
+void farm_console_open(farm *f, const farm_options *opt)
+{
+    f->con = console_new(opt->verbosity, isatty(STDERR_FILENO));
+    char detail[200];
+    snprintf(detail, sizeof detail, "without a result (%d x the measured time per tile, at most "
+             "%.0f s): back in the queue", opt->lease_factor, (double)opt->lease_ms / 1000.0);
+    console_tally_init(&f->expired, "lease passed its deadline", "leases passed their deadlines",
+                       detail, FARM_WARN_INTERVAL_MS);
+}
+
 int farm_run(const farm_options *opt, const farm_frame_in *frames, int nframes)
 {
     farm f;
@@ -957,12 +967,7 @@ int farm_run(const farm_options *opt, const farm_frame_in *frames, int nframes)
         f.frames[i].job_frames = nframes;
     }
     f.fmt = frames[0].fmt;   /* the tile size (the same in every frame): limits */
-    f.con = console_new(opt->verbosity, isatty(STDERR_FILENO));
-    char detail[200];
-    snprintf(detail, sizeof detail, "without a result (%d x the measured time per tile, at most "
-             "%.0f s): back in the queue", opt->lease_factor, (double)opt->lease_ms / 1000.0);
-    console_tally_init(&f.expired, "lease passed its deadline", "leases passed their deadlines",
-                       detail, FARM_WARN_INTERVAL_MS);
+    farm_console_open(&f, opt);
 
     farm_catch_signals();
 

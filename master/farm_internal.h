@@ -161,6 +161,11 @@ farm_frame *farm_frame_of(farm *f, int tile, int *local);
 void farm_frame_complete(farm *f, farm_frame *fr);
 
 /* farm_messages.c */
+/* f's console (opt's verbosity, stderr) and its tally of leases that
+ * passed their deadlines (farm.c): one setup for the one-shot master and
+ * the serving one. */
+void farm_console_open(farm *f, const farm_options *opt);
+
 void farm_handle(farm *f, wire_msg *m, int64_t now);
 void farm_grant_all(farm *f, int64_t now);
 void farm_send_heartbeat(farm *f, farm_worker *w, int64_t now);

@@ -594,12 +594,7 @@ int farm_serve(const farm_options *opt, const char *db_path)
     f.opt = &s.opt;
     f.serve = &s;
     f.tick = tick;
-    f.con = console_new(opt->verbosity, isatty(STDERR_FILENO));
-    char detail[200];
-    snprintf(detail, sizeof detail, "without a result (%d x the measured time per tile, at most "
-             "%.0f s): back in the queue", opt->lease_factor, (double)opt->lease_ms / 1000.0);
-    console_tally_init(&f.expired, "lease passed its deadline", "leases passed their deadlines",
-                       detail, FARM_WARN_INTERVAL_MS);
+    farm_console_open(&f, opt);
     const atomic_int *interrupted = farm_catch_signals();
 
     int rc = farm_serve_open(&f, err, sizeof err);

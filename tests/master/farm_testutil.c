@@ -213,6 +213,15 @@ char *ft_read(const char *path)
     return buf;
 }
 
+long ft_position(const char *path, const char *needle)
+{
+    char *text = ft_read(path);
+    const char *p = strstr(text, needle);
+    long at = p ? (long)(p - text) : -1;
+    free(text);
+    return at;
+}
+
 int ft_count(const char *path, const char *needle)
 {
     char *text = ft_read(path);

@@ -64,6 +64,9 @@ char *ft_read(const char *path);
 /* Occurrences of needle in the file now. */
 int ft_count(const char *path, const char *needle);
 
+/* Where needle first is in the file, in bytes (-1: not there). */
+long ft_position(const char *path, const char *needle);
+
 /* Waits until the file holds at least n occurrences of needle; false on
  * timeout. */
 /* Seconds on the monotonic clock. */

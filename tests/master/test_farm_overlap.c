@@ -96,15 +96,6 @@ static pid_t submit(const char *log, const char *d, const char *out)
     return ft_spawn(log, argv);
 }
 
-static long position(const char *path, const char *needle)
-{
-    char *text = ft_read(path);
-    const char *p = strstr(text, needle);
-    long at = p ? (long)(p - text) : -1;
-    free(text);
-    return at;
-}
-
 static void test_next_job_joins_the_last_tiles(void **state)
 {
     (void)state;
@@ -143,8 +134,8 @@ static void test_next_job_joins_the_last_tiles(void **state)
     assert_int_equal(ft_count(log, "job 2: 1 tile leased while "), 1);
     assert_int_equal(ft_count(log, " tiles of job 1 are still out (overlap)\n"), 1);
     assert_int_equal(ft_count(log, "frames done"), 0);   /* one frame a job */
-    assert_true(position(log, "job 2: ") < position(log, "job 1 done"));
-    assert_true(position(log, "job 2 done") < position(log, "job 1 done"));   /* Y overtook */
+    assert_true(ft_position(log, "job 2: ") < ft_position(log, "job 1 done"));
+    assert_true(ft_position(log, "job 2 done") < ft_position(log, "job 1 done"));   /* Y overtook */
     assert_int_equal(ft_exr_diff(ft_path(dir_x, "ref.exr"), ft_path(dir, "x.exr")), 0);
     assert_int_equal(ft_exr_diff(ft_path(dir_y, "ref.exr"), ft_path(dir, "y.exr")), 0);
     assert_int_equal(ft_count_files(dir, "x.exr."), 0);   /* no journal, no temporary file */
@@ -165,7 +156,7 @@ static void test_next_job_joins_the_last_tiles(void **state)
     assert_int_equal(ft_count(log, "job 4 requeued: the job beside it was cancelled"), 1);
     assert_int_equal(ft_count(log, "job 4 done"), 1);
     assert_int_equal(ft_count(log, "job 3 done"), 0);
-    assert_true(position(log, "job 4 requeued") < position(log, "job 4 done"));
+    assert_true(ft_position(log, "job 4 requeued") < ft_position(log, "job 4 done"));
     assert_int_equal(ft_exr_diff(ft_path(dir_y, "ref.exr"), ft_path(dir, "q.exr")), 0);
     assert_int_equal(access(ft_path(dir, "p.exr"), F_OK), -1);
     assert_int_equal(ft_count_files(dir, "p.exr"), 0);   /* nor its journal */

@@ -78,16 +78,6 @@ static pid_t submit(const char *log, const char *out, const char *priority, bool
     return ft_spawn(log, argv);
 }
 
-/* Where needle is in the file (-1: not there). */
-static long position(const char *path, const char *needle)
-{
-    char *text = ft_read(path);
-    const char *p = strstr(text, needle);
-    long at = p ? (long)(p - text) : -1;
-    free(text);
-    return at;
-}
-
 static void test_queue_priorities_cancel_and_restart(void **state)
 {
     (void)state;
@@ -144,7 +134,7 @@ static void test_queue_priorities_cancel_and_restart(void **state)
     assert_true(ft_wait_for(log2, "job 3: ", 1, 1));
     assert_true(ft_count(log2, "; resumed, tiles from its journal") == 1);
     /* job 2 starts after job 3 (it may join job 3's last tiles: overlap) */
-    assert_true(position(log2, "job 3: ") < position(log2, "job 2: "));
+    assert_true(ft_position(log2, "job 3: ") < ft_position(log2, "job 2: "));
     assert_int_equal(ft_count(log1, "job 4: ") + ft_count(log2, "job 4: "), 0);
 
     /* the list says so */

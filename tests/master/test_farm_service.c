@@ -52,35 +52,13 @@ static const char token[] = "test-token-0123456789abcdef";
 static int group_setup(void **state)
 {
     (void)state;
-    dir = ft_tempdir();
-    ft_write_scene(dir, FT_SCENE_WAVE);
-    if (ft_standalone(dir, 16) != 0) {
-        fprintf(stderr, "the standalone render failed:\n%s\n",
-                ft_read(ft_path(dir, "standalone.log")));
-        return -1;
-    }
+    if (ft_group_begin(&dir, FT_SCENE_WAVE, 16) != 0) return -1;
     FILE *t = fopen(ft_path(dir, "token"), "w");
     fprintf(t, "%s\n", token);
     fclose(t);
     t = fopen(ft_path(dir, "wrong-token"), "w");
     fprintf(t, "not-the-token-0123456789abcdef\n");
     fclose(t);
-    return 0;
-}
-
-static int group_teardown(void **state)
-{
-    (void)state;
-    ft_stop_all();
-    ft_rmtree(dir);
-    free(dir);
-    return 0;
-}
-
-static int teardown(void **state)
-{
-    (void)state;
-    ft_stop_all();
     return 0;
 }
 
@@ -466,9 +444,9 @@ int main(int argc, char **argv)
     }
     submit_bin = argv[3];
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test_teardown(test_token_malformed_and_cancel_running, teardown),
-        cmocka_unit_test_teardown(test_workers_lost_job_requeued, teardown),
-        cmocka_unit_test_teardown(test_pools_and_benching, teardown),
+        cmocka_unit_test_teardown(test_token_malformed_and_cancel_running, ft_teardown),
+        cmocka_unit_test_teardown(test_workers_lost_job_requeued, ft_teardown),
+        cmocka_unit_test_teardown(test_pools_and_benching, ft_teardown),
     };
-    return cmocka_run_group_tests(tests, group_setup, group_teardown);
+    return cmocka_run_group_tests(tests, group_setup, ft_group_teardown);
 }
