@@ -92,9 +92,3 @@ void trace_group_clear(trace_group *gr)
     gr->bounds = NULL;
     trace_float_bvh_free(&gr->bvh);
 }
-
-size_t trace_group_bytes(const trace_group *gr)
-{
-    return (gr->bounds ? sizeof *gr->bounds * (size_t)gr->n : 0) +
-           trace_float_bvh_bytes(gr->bvh, gr->n);
-}

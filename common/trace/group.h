@@ -38,7 +38,4 @@ bool trace_group_view_make(trace_thread *th, const trace_object *g, int k, trace
 /* Frees the derived arrays (boxes, BVH). */
 void trace_group_clear(trace_group *group);
 
-/* Bytes of the derived arrays. */
-size_t trace_group_bytes(const trace_group *group);
-
 #endif

@@ -142,6 +142,7 @@ void trace_view_copy(trace_view *dst, const trace_view *src)
 
 static void cache_init(view_cache *c, int sets)
 {
+    assert(sets > 0 && (sets & (sets - 1)) == 0);
     c->sets = sets;
     c->slot = xmalloc(sizeof *c->slot * (size_t)(2 * sets));
     c->key = xmalloc(sizeof *c->key * (size_t)(2 * sets));
@@ -185,7 +186,7 @@ const trace_object *trace_view_get(trace_thread *th, trace_view_kind which, cons
      * placements tell them apart */
     int64_t key = (int64_t)obj->id << 32 | (uint32_t)k;
     uint64_t h = ((uint64_t)key ^ (uint64_t)obj->place << 40) * 0x9e3779b97f4a7c15ull;
-    unsigned set = (unsigned)((h >> 32) % (unsigned)c->sets);
+    unsigned set = (unsigned)(h >> 32) & (unsigned)(c->sets - 1);   /* sets: a power of 2 */
     th->stats.views_asked++;
     for (unsigned w = 0; w < 2; w++)
         if (c->key[2 * set + w] == key && c->place[2 * set + w] == obj->place) {

@@ -365,7 +365,6 @@ bool trace_world_check(trace_world *world, char *err, size_t errsz)
     for (int i = 0; i < world->nobjects; i++)
         if (world->objects[i].group && !check_placements(world, &world->objects[i], err, errsz))
             return false;
-    world->nplaces = places;
     return true;
 }
 

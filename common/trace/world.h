@@ -240,7 +240,6 @@ typedef struct trace_world {
     int nobjects;
     int nids;                      /* object ids in use: the objects, then every
                                       mesh's pieces (trace_world_prepare) */
-    int nplaces;                   /* the groups' placements in all */
     trace_light *lights;
     int nlights;
     trace_options options;
