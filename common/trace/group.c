@@ -37,17 +37,18 @@ bool trace_group_view_make(trace_thread *th, const trace_object *g, int k, trace
 
 void trace_group_build(trace_group *gr, const trace_world *world, trace_object *g)
 {
-    assert(!gr->bounds && !gr->bvh);
+    assert(!gr->bvh);
     const trace_object *proto = &world->objects[gr->proto];
-    gr->bounds = xmalloc(sizeof *gr->bounds * (size_t)(gr->n > 0 ? gr->n : 1));
+    float (*bounds)[6] = xmalloc(sizeof *bounds * (size_t)(gr->n > 0 ? gr->n : 1));
     trace_object moved = *proto;
     for (int k = 0; k < gr->n; k++) {
         trace_box b;
         gr->transform(gr->user, k, &moved.to_camera, &moved.from_camera);
         trace_object_camera_bound(&moved, &proto->root, &b);
-        trace_float_box(&b, gr->bounds[k]);
+        trace_float_box(&b, bounds[k]);
     }
-    gr->bvh = trace_float_bvh_build((const float (*)[6])gr->bounds, gr->n);
+    gr->bvh = trace_float_bvh_build((const float (*)[6])bounds, gr->n);
+    free(bounds);                      /* the tree keeps them, quantized */
     trace_float_bvh_root(gr->bvh, &g->root);
     g->bound = g->root;                /* camera space: the group's own space */
 }
@@ -82,13 +83,10 @@ bool trace_group_intersect(trace_thread *th, const trace_object *g, const trace_
 {
     const trace_group *gr = g->group;
     group_walk w = {th, g, ray, tol, any, best};
-    return trace_float_bvh_walk(gr->bvh, (const float (*)[6])gr->bounds, ray, best, any,
-                                group_leaf, &w);
+    return trace_float_bvh_walk(gr->bvh, ray, best, any, group_leaf, &w);
 }
 
 void trace_group_clear(trace_group *gr)
 {
-    free(gr->bounds);
-    gr->bounds = NULL;
     trace_float_bvh_free(&gr->bvh);
 }

@@ -7,8 +7,14 @@
  * one) and shared read-only by all threads: binned surface-area heuristic
  * over the pieces' box centres (Wald, "On fast construction of SAH-based
  * bounding volume hierarchies", 2007: 12 bins along the axis where the
- * centres spread most, O(n log n)), a leaf holding up to 4 pieces, 32-byte
- * nodes of float boxes rounded outward, in the mesh's object space.
+ * centres spread most, O(n log n)), a leaf holding up to LEAF_MAX pieces,
+ * 32-byte nodes of float boxes rounded outward, in the mesh's object space.
+ * A piece's own box is kept in 6 bytes, each coordinate one step of a
+ * 255-step grid over its leaf's box, rounded outward (the quantized leaf
+ * boxes of compressed BVHs: Mahovsky, "Ray tracing with reduced-precision
+ * bounding volume hierarchies", 2005; Ylitie et al., "Efficient incoherent
+ * ray traversal on GPUs through compressed wide BVHs", 2017), so the
+ * pieces' float boxes are freed once the tree is built.
  * Traversal visits the nearer child first and skips what lies beyond the
  * best hit, as the object BVH (bvh.c).
  */
@@ -98,7 +104,7 @@ static bool make(trace_thread *th, const trace_object *mesh_obj, int k, bool box
         trace_thread_fail(th, "a mesh piece could not be made again (internal error)");
         return false;
     }
-    v->shared_edges = m->shared_edges ? m->shared_edges[k] : 0;
+    v->shared_edges = trace_mesh_shared_edges(m, k);
     if (m->dudv && m->roots) {
         /* displaced: what trace_mesh_build found, once */
         v->du = m->dudv[k][0];
@@ -241,6 +247,7 @@ struct trace_mesh_bvh {
     mesh_node *nodes;
     int nnodes;
     int32_t *idx;
+    uint8_t (*q)[6];                   /* per idx slot: its element's box on its leaf's grid */
 };
 
 enum { LEAF_MAX = 4, BINS = 12, SAH_DEPTH = 40, MESH_STACK = 128 };
@@ -411,6 +418,45 @@ static void build_node(build_ctx *c, int id, int first, int count, int depth)
     build_node(c, left + 1, first + mid, count - mid, depth + 1);
 }
 
+/* Coordinate q (0..255) of a leaf's grid along axis a: the leaf's lo at
+ * 0, its hi at 255, the steps between rounded to float. The build and the
+ * walk decode with this one function (no contraction: -ffp-contract=off),
+ * so a box the walk tests is the box the build checked. */
+static float grid_at(const mesh_node *leaf, int a, int q)
+{
+    if (q <= 0) return leaf->lo[a];
+    if (q >= 255) return leaf->hi[a];
+    return (float)((double)leaf->lo[a] + ((double)leaf->hi[a] - leaf->lo[a]) * (q * (1.0 / 255.0)));
+}
+
+/* The leaf's elements' boxes on its grid, rounded outward: the largest
+ * step at or below each lo, the smallest at or above each hi, each
+ * checked by decoding it (a box that is not finite, or NaN, keeps the
+ * leaf's own extent on that axis). */
+static void quantize_leaf(struct trace_mesh_bvh *t, const mesh_node *leaf,
+                          const float (*bounds)[6])
+{
+    for (int i = 0; i < leaf->n; i++) {
+        const float *b = bounds[t->idx[leaf->a + i]];
+        uint8_t *q = t->q[leaf->a + i];
+        for (int a = 0; a < 3; a++) {
+            double w = (double)leaf->hi[a] - leaf->lo[a];
+            int lo = 0, hi = 255;
+            if (isfinite(w) && w > 0) {
+                /* a first guess; the checks below make it hold */
+                double f = ((double)b[a] - leaf->lo[a]) / w * 255.0;
+                double g = ((double)b[3 + a] - leaf->lo[a]) / w * 255.0;
+                lo = f > 0 ? (f < 255 ? (int)f : 255) : 0;
+                hi = g < 255 ? (g > 0 ? (int)ceil(g) : 0) : 255;
+            }
+            while (lo > 0 && !(grid_at(leaf, a, lo) <= b[a])) lo--;
+            while (hi < 255 && !(grid_at(leaf, a, hi) >= b[3 + a])) hi++;
+            q[a] = (uint8_t)lo;
+            q[3 + a] = (uint8_t)hi;
+        }
+    }
+}
+
 struct trace_mesh_bvh *trace_float_bvh_build(const float (*bounds)[6], int n)
 {
     struct trace_mesh_bvh *t = xcalloc(1, sizeof *t);
@@ -427,6 +473,9 @@ struct trace_mesh_bvh *trace_float_bvh_build(const float (*bounds)[6], int n)
     }
     free(c.centres);
     t->nodes = xreallocarray(t->nodes, (size_t)(t->nnodes > 0 ? t->nnodes : 1), sizeof *t->nodes);
+    t->q = xmalloc(sizeof *t->q * (size_t)(n > 0 ? n : 1));
+    for (int i = 0; i < t->nnodes; i++)
+        if (t->nodes[i].n > 0) quantize_leaf(t, &t->nodes[i], bounds);
     return t;
 }
 
@@ -448,13 +497,24 @@ void trace_float_bvh_free(struct trace_mesh_bvh **t)
     if (!*t) return;
     free((*t)->nodes);
     free((*t)->idx);
+    free((*t)->q);
     free(*t);
     *t = NULL;
 }
 
 size_t trace_float_bvh_bytes(const struct trace_mesh_bvh *t, int n)
 {
-    return t ? (size_t)t->nnodes * sizeof(mesh_node) + (size_t)n * sizeof *t->idx : 0;
+    return t ? (size_t)t->nnodes * sizeof(mesh_node) + (size_t)n * (sizeof *t->idx + sizeof *t->q)
+             : 0;
+}
+
+bool trace_float_bvh_equal(const struct trace_mesh_bvh *a, const struct trace_mesh_bvh *b, int n)
+{
+    if (!a || !b) return a == b;
+    return a->nnodes == b->nnodes &&
+           !memcmp(a->nodes, b->nodes, sizeof *a->nodes * (size_t)a->nnodes) &&
+           !memcmp(a->idx, b->idx, sizeof *a->idx * (size_t)n) &&
+           !memcmp(a->q, b->q, sizeof *a->q * (size_t)n);
 }
 
 bool trace_float_bvh_root(const struct trace_mesh_bvh *t, trace_box *out)
@@ -467,11 +527,6 @@ bool trace_float_bvh_root(const struct trace_mesh_bvh *t, trace_box *out)
     out->lo = v3(r->lo[0], r->lo[1], r->lo[2]);
     out->hi = v3(r->hi[0], r->hi[1], r->hi[2]);
     return true;
-}
-
-void trace_mesh_clear_bvh(trace_mesh *self)
-{
-    trace_float_bvh_free(&self->bvh);
 }
 
 /* One thread's share of the pieces' boxes: pieces [k0, k1) of obj with
@@ -547,6 +602,8 @@ bool trace_mesh_build(trace_thread *th, trace_object *obj)
         }
         if (th->failed) return false;
         m->bvh = trace_float_bvh_build((const float (*)[6])m->bounds, m->npieces);
+        free(m->bounds);               /* the tree keeps them, quantized */
+        m->bounds = NULL;
     }
     /* the root: the union of the pieces' boxes (object space), the
      * bound: its camera-space box, as any object's */
@@ -569,9 +626,8 @@ static bool node_hit(const mesh_node *n, const trace_ray *ray, double tmax, doub
     return float_box_hit(n->lo, n->hi, ray, tmax, t0);
 }
 
-bool trace_float_bvh_walk(const struct trace_mesh_bvh *t, const float (*bounds)[6],
-                          const trace_ray *ray, trace_hit *best, bool any,
-                          trace_float_bvh_leaf leaf, void *ctx)
+bool trace_float_bvh_walk(const struct trace_mesh_bvh *t, const trace_ray *ray, trace_hit *best,
+                          bool any, trace_float_bvh_leaf leaf, void *ctx)
 {
     if (!t || t->nnodes == 0) return false;
     struct { int node; double t0; } stack[MESH_STACK];
@@ -587,10 +643,15 @@ bool trace_float_bvh_walk(const struct trace_mesh_bvh *t, const float (*bounds)[
         const mesh_node *n = &t->nodes[stack[sp].node];
         if (n->n > 0) {
             for (int i = 0; i < n->n; i++) {
-                int k = t->idx[n->a + i];
+                const uint8_t *q = t->q[n->a + i];
+                float lo[3], hi[3];
+                for (int a = 0; a < 3; a++) {
+                    lo[a] = grid_at(n, a, q[a]);
+                    hi[a] = grid_at(n, a, q[3 + a]);
+                }
                 double r0;
-                if (!float_box_hit(bounds[k], bounds[k] + 3, ray, best->t, &r0)) continue;
-                int got = leaf(ctx, k);
+                if (!float_box_hit(lo, hi, ray, best->t, &r0)) continue;
+                int got = leaf(ctx, t->idx[n->a + i]);
                 if (got < 0) return found;
                 if (got > 0) {
                     found = true;
@@ -655,13 +716,70 @@ bool trace_mesh_intersect(trace_thread *th, const trace_object *obj, const trace
     trace_ray_init(&oray, mat4_xform_point(&obj->from_camera, cam_ray->o),
                    mat4_xform_vector(&obj->from_camera, cam_ray->d), cam_ray->tmin, cam_ray->tmax);
     mesh_walk w = {th, obj, cam_ray, &oray, tol, any, best};
-    return trace_float_bvh_walk(m->bvh, (const float (*)[6])m->bounds, &oray, best, any,
-                                mesh_leaf, &w);
+    return trace_float_bvh_walk(m->bvh, &oray, best, any, mesh_leaf, &w);
+}
+
+/* ---- shared edges ----------------------------------------------------- */
+
+/* A piece's bits 8-63: the pieces with more than 8 corners are few, so
+ * their wide bits are a list by piece (a piece may appear once per
+ * marked edge until trace_mesh_edges_done merges them). */
+struct trace_mesh_edges {
+    int32_t k;
+    uint64_t bits;
+};
+
+uint64_t trace_mesh_shared_edges(const trace_mesh *m, int k)
+{
+    assert(k >= 0 && k < m->npieces);
+    uint64_t e = m->shared_edges ? m->shared_edges[k] : 0;
+    int lo = 0, hi = m->nwide;         /* the first entry of piece >= k */
+    while (lo < hi) {
+        int mid = lo + (hi - lo) / 2;
+        if (m->wide[mid].k < k) lo = mid + 1; else hi = mid;
+    }
+    if (lo < m->nwide && m->wide[lo].k == k) e |= m->wide[lo].bits;
+    return e;
+}
+
+void trace_mesh_mark_edge(trace_mesh *m, int k, int edge)
+{
+    assert(k >= 0 && k < m->npieces && edge >= 0 && edge < 64 && m->shared_edges);
+    if (edge < 8) {
+        m->shared_edges[k] |= (uint8_t)(1u << edge);
+        return;
+    }
+    /* a power-of-two capacity: grown when nwide reaches one */
+    if (m->nwide == 0 || (m->nwide & (m->nwide - 1)) == 0)
+        m->wide = xreallocarray(m->wide, (size_t)(m->nwide > 0 ? 2 * m->nwide : 1), sizeof *m->wide);
+    m->wide[m->nwide++] = (struct trace_mesh_edges){k, (uint64_t)1 << edge};
+}
+
+static int edges_cmp(const void *a, const void *b)
+{
+    int32_t x = ((const struct trace_mesh_edges *)a)->k, y = ((const struct trace_mesh_edges *)b)->k;
+    return (x > y) - (x < y);
+}
+
+void trace_mesh_edges_done(trace_mesh *m)
+{
+    if (m->nwide == 0) return;
+    qsort(m->wide, (size_t)m->nwide, sizeof *m->wide, edges_cmp);
+    int n = 0;
+    for (int i = 0; i < m->nwide; i++) {
+        if (n > 0 && m->wide[n - 1].k == m->wide[i].k) m->wide[n - 1].bits |= m->wide[i].bits;
+        else m->wide[n++] = m->wide[i];
+    }
+    m->nwide = n;
+    m->wide = xreallocarray(m->wide, (size_t)n, sizeof *m->wide);
 }
 
 void trace_mesh_clear(trace_mesh *self)
 {
     free(self->shared_edges);
+    free(self->wide);
+    self->wide = NULL;
+    self->nwide = 0;
     free(self->bounds);
     free(self->roots);
     free(self->dudv);
@@ -677,6 +795,7 @@ size_t trace_mesh_bytes(const trace_mesh *self)
     size_t n = (size_t)self->npieces;
     size_t b = 0;
     if (self->shared_edges) b += n * sizeof *self->shared_edges;
+    b += (size_t)self->nwide * sizeof *self->wide;
     if (self->bounds) b += n * sizeof *self->bounds;
     if (self->roots) b += n * (sizeof *self->roots + sizeof *self->dudv);
     return b + trace_float_bvh_bytes(self->bvh, self->npieces);

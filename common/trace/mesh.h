@@ -15,10 +15,10 @@
  * hit being shaded is a copy per trace() depth (trace_view_hold), so the
  * shadow and trace() rays its shader casts cannot overwrite it.
  *
- * Per piece, a worker holds the scene's 16-byte piece, a 24-byte float
- * box, 8 bytes of shared edges and ~16 bytes of BVH (docs/renderer.md
- * "Meshes"); the box cache holds the displaced pieces' refinement trees
- * under its budget, as for any object.
+ * Per piece, a worker holds the scene's 16-byte piece, its shared edges
+ * and its share of the BVH (docs/renderer.md "Meshes"); the box cache
+ * holds the displaced pieces' refinement trees under its budget, as for
+ * any object.
  */
 #ifndef TRACE_MESH_H
 #define TRACE_MESH_H
@@ -79,9 +79,6 @@ void trace_view_copy(trace_view *dst, const trace_view *src);
  * rounded outward). */
 void trace_mesh_piece_bounds(const geom_surface *s, float out[6]);
 
-/* Frees the mesh's BVH (trace_mesh_build makes it again). */
-void trace_mesh_clear_bvh(trace_mesh *self);
-
 /* The pieces' boxes and BVH of mesh object obj's mesh (once for the
  * objects that share it), and obj's root (their union, object space) and
  * camera-space bound; false when the thread failed or was cancelled. A
@@ -102,6 +99,15 @@ const trace_object *trace_view_hold(trace_thread *th, const trace_object *obj, i
 /* The per-thread view storage (thread.c frees it). */
 void trace_views_free(trace_thread *th);
 
+/* Piece k's shared edges (trace_object.shared_edges): its byte, and its
+ * wide bits when it has more than 8 corners. */
+uint64_t trace_mesh_shared_edges(const trace_mesh *m, int k);
+
+/* Marks edge `edge` of piece k shared (world.c); trace_mesh_edges_done
+ * orders the wide bits once every edge is marked. */
+void trace_mesh_mark_edge(trace_mesh *m, int k, int edge);
+void trace_mesh_edges_done(trace_mesh *m);
+
 /* Frees the derived arrays (shared edges, boxes, BVH); the source stays. */
 void trace_mesh_clear(trace_mesh *self);
 
@@ -109,7 +115,9 @@ void trace_mesh_clear(trace_mesh *self);
 size_t trace_mesh_bytes(const trace_mesh *self);
 
 /* A BVH over float boxes (a mesh's pieces, a group's placements): binned
- * SAH, leaves of up to 4, 32-byte nodes (mesh.c). */
+ * SAH, 32-byte nodes, each element's box kept in 6 bytes on its leaf's
+ * grid, rounded outward (mesh.c): the caller's boxes may be freed once it
+ * is built. */
 struct trace_mesh_bvh *trace_float_bvh_build(const float (*bounds)[6], int n);
 void trace_float_bvh_free(struct trace_mesh_bvh **t);
 size_t trace_float_bvh_bytes(const struct trace_mesh_bvh *t, int n);
@@ -120,9 +128,10 @@ bool trace_float_bvh_root(const struct trace_mesh_bvh *t, trace_box *out);
  * found a hit (best updated), 0 when not, -1 to stop (a failure). True
  * when a leaf found a hit; `any`: stops at the first. */
 typedef int (*trace_float_bvh_leaf)(void *ctx, int k);
-bool trace_float_bvh_walk(const struct trace_mesh_bvh *t, const float (*bounds)[6],
-                          const trace_ray *ray, trace_hit *best, bool any,
-                          trace_float_bvh_leaf leaf, void *ctx);
+bool trace_float_bvh_walk(const struct trace_mesh_bvh *t, const trace_ray *ray, trace_hit *best,
+                          bool any, trace_float_bvh_leaf leaf, void *ctx);
+/* Whether two trees are the same to the bit (nodes, order, element boxes). */
+bool trace_float_bvh_equal(const struct trace_mesh_bvh *a, const struct trace_mesh_bvh *b, int n);
 /* b as a float box (lo, hi), rounded outward. */
 void trace_float_box(const trace_box *b, float f[6]);
 

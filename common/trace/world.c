@@ -185,7 +185,7 @@ static void mark_shared(trace_world *world, const int *meshes, int nmeshes, uint
     int id = (int)(ref / 64), edge = (int)(ref % 64);
     trace_object *owner = owner_of_id(world, meshes, nmeshes, id);
     if (owner->mesh)
-        owner->mesh->shared_edges[id - owner->mesh->first_id] |= (uint64_t)1 << edge;
+        trace_mesh_mark_edge(owner->mesh, id - owner->mesh->first_id, edge);
     else
         owner->shared_edges |= (uint64_t)1 << edge;
 }
@@ -303,6 +303,7 @@ static void find_shared_edges(trace_world *world, const int *meshes, int nmeshes
         mark_shared(world, meshes, nmeshes, e[j].ref);
     }
     free(e);
+    for (int j = 0; j < nmeshes; j++) trace_mesh_edges_done(world->objects[meshes[j]].mesh);
 }
 
 bool trace_object_derive(const trace_world *world, trace_object *obj, bool grid, char *err,

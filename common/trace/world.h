@@ -68,10 +68,16 @@ typedef struct trace_mesh {
     int first_id;                  /* piece k's object id is first_id + k (-1:
                                       not given yet); shared by the objects
                                       that share the mesh */
-    uint64_t *shared_edges;        /* per piece, as trace_object.shared_edges
-                                      (the first placing object's transform) */
+    uint8_t *shared_edges;         /* per piece, bits 0-7 of its
+                                      trace_object.shared_edges (the first
+                                      placing object's transform) */
+    struct trace_mesh_edges *wide; /* and its bits 8-63 (polygons of more
+                                      than 8 corners), by piece, nwide */
+    int nwide;
     float (*bounds)[6];            /* per piece: object-space box (lo, hi) of
-                                      its root box, rounded outward */
+                                      its root box, rounded outward; freed
+                                      once the BVH (which keeps them in 6
+                                      bytes each) is built */
     trace_box *roots;              /* displaced: per piece, its root box (its
                                       shader run over the whole piece once) */
     double (*dudv)[2];             /* displaced: per piece, its du and dv */
@@ -100,8 +106,7 @@ typedef struct trace_group {
     /* derived (trace_world_prepare, trace_renderer_new; trace_group_clear
      * frees them) */
     int first;                     /* placement k's number in the world: first + k */
-    float (*bounds)[6];            /* per placement: its camera-space box */
-    struct trace_mesh_bvh *bvh;    /* over the bounds */
+    struct trace_mesh_bvh *bvh;    /* over the placements' camera-space boxes */
 } trace_group;
 
 typedef struct trace_object {

@@ -396,17 +396,69 @@ static void test_boxes_by_threads(void **state)
             assert_memory_equal(a->roots, b->roots, sizeof *a->roots * n);
             assert_memory_equal(a->dudv, b->dudv, sizeof *a->dudv * n);
         }
-        assert_memory_equal(a->bounds, b->bounds, sizeof *a->bounds * n);
+        assert_true(trace_float_bvh_equal(a->bvh, b->bvh, a->npieces));
         /* the closed torus: every piece's three edges are another's */
         int shared = 0;
-        for (size_t k = 0; k < n; k++) shared += __builtin_popcountll(a->shared_edges[k]);
+        for (int k = 0; k < a->npieces; k++) {
+            uint64_t e = trace_mesh_shared_edges(a, k);
+            shared += __builtin_popcountll(e);
+            assert_true(e == trace_mesh_shared_edges(b, k));
+        }
         assert_int_equal(shared, 3 * a->npieces);
-        assert_memory_equal(a->shared_edges, b->shared_edges, sizeof *a->shared_edges * n);
         printf("%d %s pieces: the same boxes and shared edges from 1 and 4 threads\n",
                a->npieces, displaced ? "displaced" : "undisplaced");
         for (int i = 0; i < 2; i++) job_scene_destroy(&js[i]);
         job_destroy(&jb);
     }
+}
+
+/* Two 12-sided faces of a PointsPolygons sharing their 11th edge (from
+ * corner 10 to 11): a piece's edges past the 8th are kept apart from its
+ * byte (trace_mesh_mark_edge) and must still be found. */
+static void test_wide_faces_share_their_edges(void **state)
+{
+    (void)state;
+    char rib[4096];
+    size_t n = (size_t)snprintf(rib, sizeof rib, "Format 32 32 1\nProjection \"perspective\" "
+                                "\"fov\" [40]\nTranslate 0 0 6\nWorldBegin\nPointsPolygons [12 12] [");
+    for (int i = 0; i < 24; i++) n += (size_t)snprintf(rib + n, sizeof rib - n, "%d ", i);
+    n += (size_t)snprintf(rib + n, sizeof rib - n, "] \"P\" [");
+    /* a regular 12-gon, and its mirror image across the line through
+     * corners 10 and 11 (which stay where they are) */
+    double x[12], y[12];
+    for (int i = 0; i < 12; i++) x[i] = cos(2 * M_PI * i / 12), y[i] = sin(2 * M_PI * i / 12);
+    double ax = x[10], ay = y[10], dx = x[11] - ax, dy = y[11] - ay, dd = dx * dx + dy * dy;
+    for (int f = 0; f < 2; f++)
+        for (int i = 0; i < 12; i++) {
+            double px = x[i], py = y[i];
+            if (f == 1 && i != 10 && i != 11) {
+                double t = ((px - ax) * dx + (py - ay) * dy) / dd;
+                px = 2 * (ax + t * dx) - px;
+                py = 2 * (ay + t * dy) - py;
+            }
+            n += (size_t)snprintf(rib + n, sizeof rib - n, "%.17g %.17g 0 ", px, py);
+        }
+    snprintf(rib + n, sizeof rib - n, "]\nWorldEnd\n");
+    job_options opt;
+    job_options_default(&opt);
+    job *jb = job_new("wide.rib", rib, strlen(rib), &opt);
+    char err[256];
+    assert_true(job_finish(jb, err, sizeof err));
+    sl_diag *d = sl_diag_new();
+    job_scene *js = job_scene_new(jb, 0, true, NULL, d);
+    if (!js) sl_diag_print(d, stderr);
+    assert_non_null(js);
+    const trace_mesh *m = js->world.objects[0].mesh;
+    assert_non_null(m);
+    assert_int_equal(m->npieces, 2);
+    for (int k = 0; k < 2; k++) {
+        uint64_t e = trace_mesh_shared_edges(m, k);
+        printf("12-gon %d: shared edges %#llx\n", k, (unsigned long long)e);
+        assert_true(e == (uint64_t)1 << 10);
+    }
+    job_scene_destroy(&js);
+    sl_diag_destroy(&d);
+    job_destroy(&jb);
 }
 
 static void test_instances_share_the_mesh(void **state)
@@ -612,6 +664,7 @@ int main(void)
         cmocka_unit_test(test_hits_outlive_the_view_cache),
         cmocka_unit_test(test_instances_render_as_copies),
         cmocka_unit_test(test_boxes_by_threads),
+        cmocka_unit_test(test_wide_faces_share_their_edges),
         cmocka_unit_test(test_instances_share_the_mesh),
         cmocka_unit_test(test_instances_are_references),
         cmocka_unit_test(test_bytes_per_instance),
