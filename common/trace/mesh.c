@@ -274,11 +274,13 @@ static double area_of(const float lo[3], const float hi[3])
     return e[0] * e[1] + e[1] * e[2] + e[2] * e[0];
 }
 
-static void grow(float lo[3], float hi[3], const float b[6])
+/* lo, hi grown to hold b; a NaN of b is passed over (as fminf, fmaxf
+ * would, for accumulators that start at +-infinity: never NaN) */
+static inline void grow(float lo[3], float hi[3], const float b[6])
 {
     for (int i = 0; i < 3; i++) {
-        lo[i] = fminf(lo[i], b[i]);
-        hi[i] = fmaxf(hi[i], b[3 + i]);
+        lo[i] = b[i] < lo[i] ? b[i] : lo[i];
+        hi[i] = b[3 + i] > hi[i] ? b[3 + i] : hi[i];
     }
 }
 
@@ -308,7 +310,8 @@ static int bin_of(float x, float lo, float scale)
 /* the SAH split of idx[first, first + count): the pieces are binned by
  * their centres along the axis where the centres spread most; false when
  * no split beats the leaf */
-static bool sah_split(build_ctx *c, int first, int count, double parent_area, int *mid)
+static bool sah_split(build_ctx *c, int first, int count, double parent_area, int *mid,
+                      float left[6], float right[6])
 {
     int32_t *idx = c->bvh->idx + first;
     float clo[3] = {INFINITY, INFINITY, INFINITY}, chi[3] = {-INFINITY, -INFINITY, -INFINITY};
@@ -379,6 +382,18 @@ static bool sah_split(build_ctx *c, int first, int count, double parent_area, in
         }
     }
     if (best_axis < 0) return false;
+    /* the two sides' boxes: the unions of their bins' */
+    for (int i = 0; i < 3; i++) {
+        left[i] = right[i] = INFINITY;
+        left[3 + i] = right[3 + i] = -INFINITY;
+    }
+    for (int b = 0; b < BINS; b++) {
+        const sah_bin *bn = &bins[best_axis][b];
+        if (bn->n == 0) continue;
+        float bb[6] = {bn->lo[0], bn->lo[1], bn->lo[2], bn->hi[0], bn->hi[1], bn->hi[2]};
+        float *side = b <= best_bin ? left : right;
+        grow(side, side + 3, bb);
+    }
     int i = 0, j = count - 1;
     while (i <= j) {
         if (bin_of(c->centres[idx[i]][best_axis], clo[best_axis], scale[best_axis]) <= best_bin) {
@@ -393,13 +408,20 @@ static bool sah_split(build_ctx *c, int first, int count, double parent_area, in
     return i > 0 && i < count;
 }
 
-static void build_node(build_ctx *c, int id, int first, int count, int depth)
+/* Node id over idx[first, first + count); box: its elements' union when
+ * the parent's split knew it, else NULL (made here) */
+static void build_node(build_ctx *c, int id, int first, int count, int depth, const float *box)
 {
     struct trace_mesh_bvh *t = c->bvh;
     assert(count > 0 && id < t->nnodes);
     mesh_node *n = &t->nodes[id];
-    for (int i = 0; i < 3; i++) n->lo[i] = INFINITY, n->hi[i] = -INFINITY;
-    for (int i = 0; i < count; i++) grow(n->lo, n->hi, c->bounds[t->idx[first + i]]);
+    if (box) {
+        memcpy(n->lo, box, sizeof n->lo);
+        memcpy(n->hi, box + 3, sizeof n->hi);
+    } else {
+        for (int i = 0; i < 3; i++) n->lo[i] = INFINITY, n->hi[i] = -INFINITY;
+        for (int i = 0; i < count; i++) grow(n->lo, n->hi, c->bounds[t->idx[first + i]]);
+    }
     if (count <= LEAF_MAX) {
         n->a = first;
         n->n = count;
@@ -407,7 +429,10 @@ static void build_node(build_ctx *c, int id, int first, int count, int depth)
     }
     int mid = 0;
     double area = area_of(n->lo, n->hi);
-    if (depth >= SAH_DEPTH || !isfinite(area) || !sah_split(c, first, count, area, &mid)) {
+    float lbox[6], rbox[6];
+    bool split = depth < SAH_DEPTH && isfinite(area) &&
+                 sah_split(c, first, count, area, &mid, lbox, rbox);
+    if (!split) {
         /* no split worth its cost (or too deep, or boxes without end):
          * halves by index, so the depth stays logarithmic */
         mid = count / 2;
@@ -417,8 +442,8 @@ static void build_node(build_ctx *c, int id, int first, int count, int depth)
     n = &t->nodes[id];
     n->a = left;
     n->n = 0;
-    build_node(c, left, first, mid, depth + 1);
-    build_node(c, left + 1, first + mid, count - mid, depth + 1);
+    build_node(c, left, first, mid, depth + 1, split ? lbox : NULL);
+    build_node(c, left + 1, first + mid, count - mid, depth + 1, split ? rbox : NULL);
 }
 
 /* Step q (0..255) of a leaf's grid along an axis from lo over width w
@@ -473,7 +498,7 @@ struct trace_mesh_bvh *trace_float_bvh_build(const float (*bounds)[6], int n)
         for (int a = 0; a < 3; a++) c.centres[i][a] = (float)centre(bounds[i], a);
     if (n > 0) {
         t->nnodes = 1;
-        build_node(&c, 0, 0, n, 0);
+        build_node(&c, 0, 0, n, 0, NULL);
     }
     free(c.centres);
     t->nodes = xreallocarray(t->nodes, (size_t)(t->nnodes > 0 ? t->nnodes : 1), sizeof *t->nodes);
