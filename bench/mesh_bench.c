@@ -131,7 +131,7 @@ int main(int argc, char **argv)
         long pieces = 0;
         for (int i = 0; i < js->scene->nmeshes; i++) {
             const scene_mesh *m = js->scene->meshes[i];
-            size_t pb = (size_t)scene_mesh_npieces(m) * sizeof(scene_mesh_piece);
+            size_t pb = scene_mesh_piece_bytes(m);
             shared += scene_mesh_bytes(m) - pb;
             beyond += pb;
             pieces += scene_mesh_npieces(m);

@@ -28,7 +28,10 @@ struct scene_mesh {
     double **values;               /* the variables' arrays (owned), nvalues */
     int nvalues;
     size_t values_bytes;
-    scene_mesh_piece *pieces;
+    scene_mesh_piece *pieces;      /* polygon meshes' pieces (cap of them) */
+    int32_t *sub_face;             /* a subdivision mesh's: piece k is refined
+                                    * face sub_face[k]; NULL once trimmed when
+                                    * that is k (every face drawn) */
     int npieces, cap;
     int index;                     /* in scene.meshes (rib_add_mesh) */
     /* a subdivision mesh: the refined mesh, the control faces' corner
@@ -110,6 +113,17 @@ void scene_mesh_add_piece(scene_mesh *self, scene_piece_kind kind, int face, int
         self->npieces++;
         return;
     }
+    if (kind == SCENE_PIECE_SUBDIV) {
+        /* 4 bytes a piece: its refined face */
+        assert(self->sd && !self->pieces && face >= 0);
+        if (self->npieces == self->cap) {
+            self->cap = self->cap ? 2 * self->cap : 64;
+            self->sub_face = xreallocarray(self->sub_face, (size_t)self->cap, sizeof *self->sub_face);
+        }
+        self->sub_face[self->npieces++] = face;
+        return;
+    }
+    assert(!self->sub_face);
     if (self->npieces == self->cap) {
         self->cap = self->cap ? 2 * self->cap : 64;
         self->pieces = xreallocarray(self->pieces, (size_t)self->cap, sizeof *self->pieces);
@@ -122,8 +136,6 @@ void scene_mesh_add_piece(scene_mesh *self, scene_piece_kind kind, int face, int
     if (kind == SCENE_PIECE_POLYGON) {
         assert(ncorners >= 3 && ncorners <= GEOM_MAX_POLY_VERTS);
         pc->k[0] = (uint16_t)ncorners;
-    } else if (kind == SCENE_PIECE_SUBDIV) {
-        assert(self->sd);
     } else {
         for (int i = 0; i < 3; i++) {
             assert(k[i] >= 0 && k[i] <= UINT16_MAX);
@@ -134,6 +146,19 @@ void scene_mesh_add_piece(scene_mesh *self, scene_piece_kind kind, int face, int
 
 void scene_mesh_trim(scene_mesh *self)
 {
+    if (self->sub_face) {
+        bool identity = true;
+        for (int k = 0; k < self->npieces && identity; k++) identity = self->sub_face[k] == k;
+        if (identity) {
+            free(self->sub_face);
+            self->sub_face = NULL;
+            self->cap = 0;
+        } else if (self->npieces < self->cap) {
+            self->sub_face = xreallocarray(self->sub_face, (size_t)self->npieces, sizeof *self->sub_face);
+            self->cap = self->npieces;
+        }
+        return;
+    }
     if (self->npieces > 0 && self->npieces < self->cap) {
         self->pieces = xreallocarray(self->pieces, (size_t)self->npieces, sizeof *self->pieces);
         self->cap = self->npieces;
@@ -146,12 +171,17 @@ int scene_mesh_index(const scene_mesh *self) { return self->index; }
 void scene_mesh_set_index(scene_mesh *self, int index) { self->index = index; }
 int scene_mesh_nprimvars(const scene_mesh *self) { return self->pv.n; }
 
+size_t scene_mesh_piece_bytes(const scene_mesh *self)
+{
+    return (size_t)self->cap * (self->sub_face ? sizeof *self->sub_face : sizeof *self->pieces);
+}
+
 size_t scene_mesh_bytes(const scene_mesh *self)
 {
     return sizeof *self + (size_t)self->npoints * 3 * sizeof(double) +
            (size_t)self->nidx * sizeof(int) + (size_t)self->nN * 3 * sizeof(double) +
            (size_t)self->pv.n * sizeof(rib_primvar_src) + self->values_bytes +
-           (size_t)self->cap * sizeof(scene_mesh_piece) +
+           scene_mesh_piece_bytes(self) +
            (size_t)(2 * self->nfaces + (self->sd ? 1 : 0)) * sizeof(int);
 }
 
@@ -166,6 +196,7 @@ void scene_mesh_destroy(scene_mesh **self_p)
     free(self->values);
     free(self->pv.v);
     free(self->pieces);
+    free(self->sub_face);
     free(self->nverts);
     free(self->fo);
     free(self);
@@ -239,10 +270,10 @@ static void refined_face_vars(const scene_mesh *m, int f, scene_primvar *out)
 
 /* A refined face's surface, and its variables where its control face
  * holds it (as rib_subdiv.c placed one object per face). */
-static bool subdiv_piece(const scene_mesh *m, const scene_mesh_piece *pc, geom_surface *s,
+static bool subdiv_piece(const scene_mesh *m, int k, geom_surface *s,
                          struct scene_primvar *vars, int *nvars)
 {
-    int f = pc->face;
+    int f = m->sub_face ? m->sub_face[k] : k;
     geom_subdiv_surface(m->sd, f, s);
     int F = geom_subdiv_face_origin(m->sd, f);
     *nvars = 0;
@@ -263,8 +294,8 @@ bool scene_mesh_piece_surface(const scene_mesh *self, int k, geom_surface *s,
     (void)s, (void)vars, (void)nvars;
     return false;
 #else
+    if (self->sd) return subdiv_piece(self, k, s, vars, nvars);
     const scene_mesh_piece *pc = &self->pieces[k];
-    if (pc->kind == SCENE_PIECE_SUBDIV) return subdiv_piece(self, pc, s, vars, nvars);
     *nvars = self->pv.n;
     memset(s, 0, sizeof *s);
     s->kind = GEOM_POLYGON;

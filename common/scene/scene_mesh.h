@@ -45,10 +45,12 @@ typedef enum scene_piece_kind {
     SCENE_PIECE_POLYGON,           /* the whole face, one convex planar polygon */
     SCENE_PIECE_TRIANGLE,          /* corners k[0..3) of the face, flat */
     SCENE_PIECE_TRIANGLE_N,        /* the same with its corner normals */
-    SCENE_PIECE_SUBDIV,            /* face `face` of the refined subdivision mesh */
+    SCENE_PIECE_SUBDIV,            /* face `face` of the refined subdivision mesh
+                                    * (kept as its face alone) */
 } scene_piece_kind;
 
-/* One piece: 16 bytes. */
+/* One piece of a polygon mesh: 16 bytes (a subdivision mesh's piece is
+ * its refined face: 4 bytes, or none, scene_mesh.c). */
 typedef struct scene_mesh_piece {
     int32_t face;                  /* the face (uniform class index) */
     int32_t fv0;                   /* its first face-vertex (index into the vertex indices) */
@@ -72,9 +74,12 @@ int scene_mesh_nprimvars(const scene_mesh *self);
 bool scene_mesh_piece_surface(const scene_mesh *self, int k, geom_surface *s,
                               struct scene_primvar *vars, int *nvars);
 
-/* The bytes the mesh holds (arrays and pieces), for benchmarks and the
- * per-face budget's test. */
+/* The bytes the mesh holds (arrays and pieces), and of them its pieces'
+ * records (16 bytes a piece of a polygon mesh, 4 a piece of a subdivision
+ * mesh, none when every refined face is drawn), for benchmarks and the
+ * per-face budgets' tests. */
 size_t scene_mesh_bytes(const scene_mesh *self);
+size_t scene_mesh_piece_bytes(const scene_mesh *self);
 
 void scene_mesh_destroy(scene_mesh **self_p);
 

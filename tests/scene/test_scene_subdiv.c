@@ -12,6 +12,7 @@
 #include <stdint.h>
 #include <cmocka.h>
 
+#include "geom/subdiv.h"
 #include "scene_testing.h"
 
 #define WORLD(body) CAMERA "WorldBegin\n" body "WorldEnd\n"
@@ -57,6 +58,16 @@ static void test_faces(void **state)
     test_piece *pc = scene_pieces(s, &np);
     assert_ptr_equal(pc[0].surface.subdiv, s->subdivs[0]);
     assert_ptr_equal(pc[20].surface.subdiv, s->subdivs[1]);
+    /* the holed mesh's 20 pieces are its 20 drawn faces, each once (its
+     * pieces name their faces; the other mesh's are faces 0..23) */
+    unsigned char seen[24] = {0};
+    for (int i = 0; i < 20; i++) {
+        int f = pc[i].surface.subdiv_face;
+        assert_true(f >= 0 && f < 24 && !seen[f]);
+        assert_true(geom_subdiv_face_drawn(s->subdivs[0], f));
+        seen[f] = 1;
+    }
+    for (int i = 20; i < 44; i++) assert_int_equal(pc[i].surface.subdiv_face, i - 20);
     free(pc);
     scene_destroy(&s);
     sl_diag_destroy(&d);

@@ -111,7 +111,7 @@ static void test_bytes_per_face(void **state)
     double per_face = (double)(after - before) / (NU * NV);
     const scene_mesh *sm = js->scene->meshes[0];
     const trace_mesh *m = js->world.objects[0].mesh;
-    size_t shared = scene_mesh_bytes(sm) - (size_t)scene_mesh_npieces(sm) * sizeof(scene_mesh_piece);
+    size_t shared = scene_mesh_bytes(sm) - scene_mesh_piece_bytes(sm);
     double beyond = (double)(after - before - shared) / (NU * NV);
     double bvh = (double)trace_float_bvh_bytes(m->bvh, m->npieces) / (NU * NV);
     printf("torus of %d quads (%d pieces): %zu bytes held, %.1f bytes per face (budget %d); "
