@@ -47,7 +47,8 @@ void trace_group_build(trace_group *gr, const trace_world *world, trace_object *
         trace_object_camera_bound(&moved, &proto->root, &b);
         trace_float_box(&b, bounds[k]);
     }
-    gr->bvh = trace_float_bvh_build((const float (*)[6])bounds, gr->n);
+    gr->bvh = trace_float_bvh_build((const float (*)[6])bounds, gr->n,
+                                    world->options.build_threads);
     free(bounds);                      /* the tree keeps them, quantized */
     trace_float_bvh_root(gr->bvh, &g->root);
     g->bound = g->root;                /* camera space: the group's own space */

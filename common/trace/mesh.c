@@ -253,7 +253,7 @@ struct trace_mesh_bvh {
 /* LEAF_MAX: a leaf's elements are culled by their 6-byte boxes, so large
  * leaves cost little (1.5 % of a render of 100,000 instances against
  * leaves of 4) and save nodes: 0.17 nodes an element instead of 0.58. */
-enum { LEAF_MAX = 16, BINS = 12, SAH_DEPTH = 40, MESH_STACK = 128 };
+enum { LEAF_MAX = 16, BINS = 12, SAH_DEPTH = 40, MESH_STACK = 128, TASK_MAX = 8192 };
 
 static float down(double x)
 {
@@ -290,10 +290,23 @@ static double centre(const float b[6], int axis)
     return isfinite(c) ? c : 0.0;
 }
 
+/* A subtree built apart (on any of the build's threads) into its own
+ * nodes, joined to the tree afterwards: which subtrees are tasks depends
+ * on the tree alone (TASK_MAX), never on the thread count, so the tree is
+ * the same for any count. */
+typedef struct bvh_task {
+    int id, first, count, depth;       /* its root's node, its elements, its depth */
+    float box[6];                      /* its root's box */
+    mesh_node *nodes;                  /* the subtree, its root first */
+    int nnodes;
+} bvh_task;
+
 typedef struct build_ctx {
     const float (*bounds)[6];
     float (*centres)[3];               /* each piece's box centre (0 where not finite) */
     struct trace_mesh_bvh *bvh;
+    bvh_task *tasks;                   /* subtrees left to build (NULL: build them here) */
+    int ntasks, cap;
 } build_ctx;
 
 typedef struct sah_bin {
@@ -427,6 +440,16 @@ static void build_node(build_ctx *c, int id, int first, int count, int depth, co
         n->n = count;
         return;
     }
+    if (c->tasks && count <= TASK_MAX) {
+        /* a subtree for the build's threads (trace_float_bvh_build) */
+        if (c->ntasks == c->cap)
+            c->tasks = xreallocarray(c->tasks, (size_t)(c->cap *= 2), sizeof *c->tasks);
+        bvh_task *k = &c->tasks[c->ntasks++];
+        *k = (bvh_task){.id = id, .first = first, .count = count, .depth = depth};
+        memcpy(k->box, n->lo, sizeof n->lo);
+        memcpy(k->box + 3, n->hi, sizeof n->hi);
+        return;
+    }
     int mid = 0;
     double area = area_of(n->lo, n->hi);
     float lbox[6], rbox[6];
@@ -486,19 +509,78 @@ static void quantize_leaf(struct trace_mesh_bvh *t, const mesh_node *leaf,
     }
 }
 
-struct trace_mesh_bvh *trace_float_bvh_build(const float (*bounds)[6], int n)
+/* One thread's share of the tasks: every stride-th from k. */
+typedef struct task_share {
+    const build_ctx *c;
+    int k, stride;
+} task_share;
+
+static void *build_tasks(void *arg)
+{
+    task_share *sh = arg;
+    const build_ctx *c = sh->c;
+    for (int i = sh->k; i < c->ntasks; i += sh->stride) {
+        bvh_task *k = &c->tasks[i];
+        /* the subtree's own nodes; its elements are its own range of idx */
+        struct trace_mesh_bvh sub = {.nodes = xmalloc(sizeof *sub.nodes * (size_t)(2 * k->count)),
+                                     .nnodes = 1, .idx = c->bvh->idx};
+        build_ctx lc = {c->bounds, c->centres, &sub, NULL, 0, 0};
+        build_node(&lc, 0, k->first, k->count, k->depth, k->box);
+        k->nodes = sub.nodes;
+        k->nnodes = sub.nnodes;
+    }
+    return NULL;
+}
+
+/* The tasks' subtrees joined to the top of the tree, in task order: a
+ * task's root in its place, its other nodes after the tree's (a subtree's
+ * node i >= 1 at off + i - 1, so children stay side by side). */
+static void join_tasks(build_ctx *c)
+{
+    struct trace_mesh_bvh *t = c->bvh;
+    int total = t->nnodes;
+    for (int i = 0; i < c->ntasks; i++) total += c->tasks[i].nnodes - 1;
+    t->nodes = xreallocarray(t->nodes, (size_t)total, sizeof *t->nodes);
+    int off = t->nnodes;
+    for (int i = 0; i < c->ntasks; i++) {
+        const bvh_task *k = &c->tasks[i];
+        for (int j = 0; j < k->nnodes; j++) {
+            mesh_node nd = k->nodes[j];
+            if (nd.n == 0) nd.a = off + nd.a - 1;      /* interior: its children moved */
+            t->nodes[j == 0 ? k->id : off + j - 1] = nd;
+        }
+        off += k->nnodes - 1;
+        free(k->nodes);
+    }
+    assert(off == total);
+    t->nnodes = total;
+}
+
+struct trace_mesh_bvh *trace_float_bvh_build(const float (*bounds)[6], int n, int threads)
 {
     struct trace_mesh_bvh *t = xcalloc(1, sizeof *t);
     t->idx = xmalloc(sizeof *t->idx * (size_t)(n > 0 ? n : 1));
     for (int i = 0; i < n; i++) t->idx[i] = i;
     /* a binary tree with leaves of >= 1 piece: at most 2n - 1 nodes */
     t->nodes = xmalloc(sizeof *t->nodes * (size_t)(2 * n > 0 ? 2 * n : 1));
-    build_ctx c = {bounds, xmalloc(sizeof *c.centres * (size_t)(n > 0 ? n : 1)), t};
+    build_ctx c = {bounds, xmalloc(sizeof *c.centres * (size_t)(n > 0 ? n : 1)), t, NULL, 0, 0};
     for (int i = 0; i < n; i++)
         for (int a = 0; a < 3; a++) c.centres[i][a] = (float)centre(bounds[i], a);
     if (n > 0) {
+        /* the top of the tree here, its subtrees of up to TASK_MAX
+         * elements over the threads */
+        c.cap = 16;
+        c.tasks = xmalloc(sizeof *c.tasks * (size_t)c.cap);
         t->nnodes = 1;
         build_node(&c, 0, 0, n, 0, NULL);
+        if (threads > c.ntasks) threads = c.ntasks;
+        if (threads < 1) threads = 1;
+        task_share *share = xmalloc(sizeof *share * (size_t)threads);
+        for (int i = 0; i < threads; i++) share[i] = (task_share){&c, i, threads};
+        trace_run_shares(share, sizeof *share, threads, build_tasks);
+        free(share);
+        join_tasks(&c);
+        free(c.tasks);
     }
     free(c.centres);
     t->nodes = xreallocarray(t->nodes, (size_t)(t->nnodes > 0 ? t->nnodes : 1), sizeof *t->nodes);
@@ -630,7 +712,8 @@ bool trace_mesh_build(trace_thread *th, trace_object *obj)
             m->dudv = dudv;
         }
         if (th->failed) return false;
-        m->bvh = trace_float_bvh_build((const float (*)[6])m->bounds, m->npieces);
+        m->bvh = trace_float_bvh_build((const float (*)[6])m->bounds, m->npieces,
+                                       th->world->options.build_threads);
         free(m->bounds);               /* the tree keeps them, quantized */
         m->bounds = NULL;
     }

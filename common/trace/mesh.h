@@ -117,8 +117,9 @@ size_t trace_mesh_bytes(const trace_mesh *self);
 /* A BVH over float boxes (a mesh's pieces, a group's placements): binned
  * SAH, 32-byte nodes, each element's box kept in 6 bytes on its leaf's
  * grid, rounded outward (mesh.c): the caller's boxes may be freed once it
- * is built. */
-struct trace_mesh_bvh *trace_float_bvh_build(const float (*bounds)[6], int n);
+ * is built. Its subtrees are built over `threads` threads: the same tree,
+ * to the bit, for any count. */
+struct trace_mesh_bvh *trace_float_bvh_build(const float (*bounds)[6], int n, int threads);
 void trace_float_bvh_free(struct trace_mesh_bvh **t);
 size_t trace_float_bvh_bytes(const struct trace_mesh_bvh *t, int n);
 /* Its root's box (all the boxes); false (an empty box) when it has none. */

@@ -19,7 +19,9 @@
 
 #include "trace/mesh.h"
 
-enum { NBOXES = 3000, NRAYS = 4000 };
+/* more boxes than one subtree task of the build holds (mesh.c TASK_MAX):
+ * the tree is joined from several */
+enum { NBOXES = 20000, NRAYS = 1500 };
 
 static uint64_t rng = 0x9e3779b97f4a7c15ull;
 
@@ -79,7 +81,7 @@ static void test_walk_reaches_every_box_a_ray_meets(void **state)
     float (*b)[6] = malloc(sizeof *b * NBOXES);
     assert_non_null(b);
     make_boxes(b, NBOXES);
-    struct trace_mesh_bvh *t = trace_float_bvh_build((const float (*)[6])b, NBOXES);
+    struct trace_mesh_bvh *t = trace_float_bvh_build((const float (*)[6])b, NBOXES, 3);
     /* its root is the union of the boxes */
     trace_box root;
     assert_true(trace_float_bvh_root(t, &root));
@@ -140,11 +142,17 @@ static void test_build_is_a_function_of_the_boxes(void **state)
     float (*b)[6] = malloc(sizeof *b * NBOXES);
     assert_non_null(b);
     make_boxes(b, NBOXES);
-    struct trace_mesh_bvh *x = trace_float_bvh_build((const float (*)[6])b, NBOXES);
-    struct trace_mesh_bvh *y = trace_float_bvh_build((const float (*)[6])b, NBOXES);
+    struct trace_mesh_bvh *x = trace_float_bvh_build((const float (*)[6])b, NBOXES, 1);
+    struct trace_mesh_bvh *y = trace_float_bvh_build((const float (*)[6])b, NBOXES, 1);
     assert_true(trace_float_bvh_equal(x, y, NBOXES));
+    /* and over threads: the subtrees built apart and joined */
+    for (int threads = 2; threads <= 5; threads += 3) {
+        struct trace_mesh_bvh *p = trace_float_bvh_build((const float (*)[6])b, NBOXES, threads);
+        assert_true(trace_float_bvh_equal(x, p, NBOXES));
+        trace_float_bvh_free(&p);
+    }
     b[NBOXES / 2][4] = nextafterf(b[NBOXES / 2][4], INFINITY) + 1.0f;
-    struct trace_mesh_bvh *z = trace_float_bvh_build((const float (*)[6])b, NBOXES);
+    struct trace_mesh_bvh *z = trace_float_bvh_build((const float (*)[6])b, NBOXES, 1);
     assert_false(trace_float_bvh_equal(x, z, NBOXES));
     trace_float_bvh_free(&x);
     trace_float_bvh_free(&y);
