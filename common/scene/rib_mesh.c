@@ -331,16 +331,9 @@ static void read_mesh(rib_parser *p, const rib_request *req, const int *nloops, 
     }
     if (!rib_params_read(p, req, first_vertices + 1, RIB_PARAMS_VARYING, &params))
         goto out;
-    const scene_param *P = rib_params_find(&params, "P");
-    if (!P) {
-        rib_error(p, req, req->pos, "missing the points: add \"P\" [x y z x y z ...]");
+    const scene_param *P = rib_params_points(p, req, &params);
+    if (!P)
         goto out;
-    }
-    if (P->type != SL_TYPE_POINT) {
-        rib_error(p, req, P->pos, "\"P\" must be declared as a point, not a %s",
-                  rib_type_name(P->type));
-        goto out;
-    }
     int maxidx = 0;
     for (int i = 0; i < nidx; i++)
         maxidx = idx[i] > maxidx ? idx[i] : maxidx;
@@ -417,13 +410,10 @@ void rib_general_polygon(rib_parser *p, const rib_request *req)
         return;
     rib_params params;
     if (rib_params_read(p, req, 1, RIB_PARAMS_VARYING, &params)) {
-        const scene_param *P = rib_params_find(&params, "P");
+        const scene_param *P = rib_params_points(p, req, &params);
         long n = sum(nverts, nloops);
         if (!P)
-            rib_error(p, req, req->pos, "missing the points: add \"P\" [x y z x y z ...]");
-        else if (P->type != SL_TYPE_POINT)
-            rib_error(p, req, P->pos, "\"P\" must be declared as a point, not a %s",
-                      rib_type_name(P->type));
+            ;                          /* reported */
         else if (P->count / 3 != n)
             rib_error(p, req, P->pos, "the loops have %ld points in all, but \"P\" has %d",
                       n, P->count / 3);

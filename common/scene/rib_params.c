@@ -36,6 +36,22 @@ const scene_param *rib_params_find(const rib_params *params, const char *name)
     return NULL;
 }
 
+const scene_param *rib_params_points(rib_parser *p, const rib_request *req,
+                                     const rib_params *params)
+{
+    const scene_param *P = rib_params_find(params, "P");
+    if (!P) {
+        rib_error(p, req, req->pos, "missing the points: add \"P\" [x y z x y z ...]");
+        return NULL;
+    }
+    if (P->type != SL_TYPE_POINT) {
+        rib_error(p, req, P->pos, "\"P\" must be declared as a point, not a %s",
+                  rib_type_name(P->type));
+        return NULL;
+    }
+    return P;
+}
+
 /* The name and declared type of a parameter name as written. Returns
  * false after an error; *decl type VOID when undeclared in LOOSE mode. */
 static bool resolve_name(rib_parser *p, const rib_request *req, const rib_arg *arg,

@@ -240,6 +240,10 @@ bool rib_params_read(rib_parser *p, const rib_request *req, int first,
                      rib_params_mode mode, rib_params *out);
 void rib_params_clear(rib_params *params);
 const scene_param *rib_params_find(const rib_params *params, const char *name);
+/* The geometry's "P": NULL after an error (missing, or not declared a
+ * point), reported at the request or at the parameter. */
+const scene_param *rib_params_points(rib_parser *p, const rib_request *req,
+                                     const rib_params *params);
 
 /* ---- the requests -------------------------------------------------------- */
 

@@ -290,12 +290,9 @@ void rib_patch_mesh(rib_parser *p, const rib_request *req)
     rib_params params;
     if (!rib_params_read(p, req, 5, RIB_PARAMS_VARYING, &params))
         return;
-    const scene_param *P = rib_params_find(&params, "P");
+    const scene_param *P = rib_params_points(p, req, &params);
     if (!P)
-        rib_error(p, req, req->pos, "missing the points: add \"P\" [x y z x y z ...]");
-    else if (P->type != SL_TYPE_POINT)
-        rib_error(p, req, P->pos, "\"P\" must be declared as a point, not a %s",
-                  rib_type_name(P->type));
+        ;                              /* reported */
     else if (P->count / 3 != (int)nu * (int)nv)
         rib_error(p, req, P->pos, "\"P\" needs %d x %d = %d points, got %d", (int)nu, (int)nv,
                   (int)nu * (int)nv, P->count / 3);

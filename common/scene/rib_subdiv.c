@@ -238,16 +238,9 @@ static void subdivision_mesh(rib_parser *p, const rib_request *req, bool hier)
         }
     if (!rib_params_read(p, req, have_tags ? after_tags : first, RIB_PARAMS_VARYING, &params))
         goto out;
-    const scene_param *P = rib_params_find(&params, "P");
-    if (!P) {
-        rib_error(p, req, req->pos, "missing the points: add \"P\" [x y z x y z ...]");
+    const scene_param *P = rib_params_points(p, req, &params);
+    if (!P)
         goto out;
-    }
-    if (P->type != SL_TYPE_POINT) {
-        rib_error(p, req, P->pos, "\"P\" must be declared as a point, not a %s",
-                  rib_type_name(P->type));
-        goto out;
-    }
     int npoints = P->count / 3;
     for (int i = 0; i < nidx; i++)
         if (idx[i] >= npoints) {

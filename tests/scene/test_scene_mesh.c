@@ -246,6 +246,17 @@ static const error_case cases[] = {
       "number >= 0" },
     { WORLD("PointsPolygons [3] [0 1 2]\n"),
       "t.rib:4:1: PointsPolygons: missing the points: add \"P\" [x y z x y z ...]" },
+    /* every kind of geometry checks its "P" the same way (rib_params_points) */
+    { WORLD("PointsPolygons [3] [0 1 2] \"vertex float P\" [0 0 0 1 0 0 0 1 0]\n"),
+      "t.rib:4:28: PointsPolygons: \"P\" must be declared as a point, not a float" },
+    { WORLD("PointsGeneralPolygons [1] [3] [0 1 2]\n"),
+      "t.rib:4:1: PointsGeneralPolygons: missing the points: add \"P\" [x y z x y z ...]" },
+    { WORLD("GeneralPolygon [3] \"vertex color P\" [0 0 0 1 0 0 0 1 0]\n"),
+      "t.rib:4:20: GeneralPolygon: \"P\" must be declared as a point, not a color" },
+    { WORLD("PatchMesh \"bilinear\" 2 \"nonperiodic\" 2 \"nonperiodic\" \"constant color Cs\" [1 0 0]\n"),
+      "t.rib:4:1: PatchMesh: missing the points: add \"P\" [x y z x y z ...]" },
+    { WORLD("SubdivisionMesh \"catmull-clark\" [3] [0 1 2] \"vertex normal P\" [0 0 1 0 0 1 0 0 1]\n"),
+      "t.rib:4:45: SubdivisionMesh: \"P\" must be declared as a point, not a normal" },
     { WORLD("PointsPolygons [3] [0 1 2] \"P\" [0 0 0 1 0 0 0 1]\n"),
       "t.rib:4:32: PointsPolygons: parameter \"P\" is a point and needs a multiple of 3 "
       "numbers, got 8" },
