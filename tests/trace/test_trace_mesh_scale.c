@@ -108,19 +108,26 @@ static void test_bytes_per_face(void **state)
     assert_int_equal(js->scene->nobjects, 1);
     assert_int_equal(js->world.nobjects, 1);
     assert_int_equal(trace_object_npieces(&js->world.objects[0]), 2 * NU * NV);
-    double per_face = (double)(after - before) / (NU * NV);
     const scene_mesh *sm = js->scene->meshes[0];
     const trace_mesh *m = js->world.objects[0].mesh;
-    size_t shared = scene_mesh_bytes(sm) - scene_mesh_piece_bytes(sm);
-    double beyond = (double)(after - before - shared) / (NU * NV);
     double bvh = (double)trace_float_bvh_bytes(m->bvh, m->npieces) / (NU * NV);
-    printf("torus of %d quads (%d pieces): %zu bytes held, %.1f bytes per face (budget %d); "
-           "beyond the shared arrays %.1f (budget %d), of which BVH %.1f (budget %d)\n",
-           NU * NV, 2 * NU * NV, after - before, per_face, FACE_BYTES, beyond,
-           FACE_BYTES_BEYOND, bvh, FACE_BVH_BYTES);
-    assert_true(per_face <= FACE_BYTES);
-    assert_true(beyond <= FACE_BYTES_BEYOND);
+    printf("torus of %d quads (%d pieces): BVH %.1f bytes per face (budget %d)\n", NU * NV,
+           2 * NU * NV, bvh, FACE_BVH_BYTES);
     assert_true(bvh <= FACE_BVH_BYTES);
+    size_t shared = scene_mesh_bytes(sm) - scene_mesh_piece_bytes(sm);
+    if (after > before + shared) {
+        double per_face = (double)(after - before) / (NU * NV);
+        double beyond = (double)(after - before - shared) / (NU * NV);
+        printf("%zu bytes held, %.1f bytes per face (budget %d), beyond the shared arrays "
+               "%.1f (budget %d)\n", after - before, per_face, FACE_BYTES, beyond,
+               FACE_BYTES_BEYOND);
+        assert_true(per_face <= FACE_BYTES);
+        assert_true(beyond <= FACE_BYTES_BEYOND);
+    } else {
+        /* a sanitizer's allocator: mallinfo2 counts nothing */
+        printf("the heap is not counted here (%zu -> %zu bytes): budgets of the whole not "
+               "checked\n", before, after);
+    }
     /* and it renders: the torus covers the middle of the image */
     trace_thread *th = trace_thread_new(&js->world);
     double rgb[3], a, z;
