@@ -33,6 +33,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 #include <cmocka.h>
 
 #include "corpus.h"
@@ -309,6 +310,50 @@ static void test_region_holds_every_piece(void **state)
     assert_true(esc.subsets > 400);
 }
 
+/* The cost, printed (not asserted: wall time): a region of every piece
+ * (one shader run and a visit of the pieces) against every piece's own
+ * root box (a shader run each) */
+static void test_cost_is_printed(void **state)
+{
+    (void)state;
+    static const char *names[] = {"dents_shader", "tex_heightmap", "calcnormal_before"};
+    for (size_t s = 0; s < sizeof names / sizeof names[0]; s++) {
+        fixture f;
+        assert_true(open_grid(&f, names[s], NULL, true, NULL));
+        const trace_object *mobj = mesh_of(&f);
+        int np = mobj->mesh->npieces, *all = malloc(sizeof *all * (size_t)np);
+        for (int i = 0; i < np; i++) all[i] = i;
+        trace_thread *th = trace_thread_new(&f.js->world);
+        trace_view *v = malloc(sizeof *v);
+        trace_box b;
+        struct timespec t0, t1, t2, t3, t4;
+        clock_gettime(CLOCK_MONOTONIC, &t4);
+        for (int rep = 0; rep < 10; rep++)     /* the views alone */
+            for (int i = 0; i < np; i++) assert_true(trace_mesh_view_make(th, mobj, i, false, v));
+        clock_gettime(CLOCK_MONOTONIC, &t3);
+        clock_gettime(CLOCK_MONOTONIC, &t0);
+        for (int rep = 0; rep < 10; rep++) assert_true(trace_mesh_region_box(th, mobj, all, np, &b));
+        clock_gettime(CLOCK_MONOTONIC, &t1);
+        for (int rep = 0; rep < 10; rep++)
+            for (int i = 0; i < np; i++) {
+                assert_true(trace_mesh_view_make(th, mobj, i, false, v));
+                trace_surface_box(th, &v->obj, 0, 1, 0, 1, &b);
+            }
+        clock_gettime(CLOCK_MONOTONIC, &t2);
+        double region = ((double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec)) / 10;
+        double roots = ((double)(t2.tv_sec - t1.tv_sec) + 1e-9 * (double)(t2.tv_nsec - t1.tv_nsec)) / 10;
+        double views = ((double)(t3.tv_sec - t4.tv_sec) + 1e-9 * (double)(t3.tv_nsec - t4.tv_nsec)) / 10;
+        printf("%-18s region of %d pieces %.0f us (%.2f us a piece, %.2f of it making the "
+               "views), their %d root boxes %.0f us (%.1f us each)\n", names[s], np,
+               1e6 * region, 1e6 * region / np, 1e6 * views / np, np, 1e6 * roots,
+               1e6 * roots / np);
+        free(v);
+        free(all);
+        trace_thread_destroy(&th);
+        fixture_close(&f);
+    }
+}
+
 static const char *LIFT_SL =
     "displacement lift(float height = 0)\n"
     "{\n"
@@ -361,6 +406,7 @@ int main(void)
         cmocka_unit_test(test_region_holds_every_piece),
         cmocka_unit_test(test_param_primvar_is_refused),
         cmocka_unit_test(test_empty_region),
+        cmocka_unit_test(test_cost_is_printed),
     };
     int rc = cmocka_run_group_tests(tests, NULL, NULL);
     corpus_free(&C);
