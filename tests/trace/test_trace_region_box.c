@@ -3,9 +3,10 @@
  * 23), the one-run box of many pieces of a displaced mesh, against an
  * independent oracle.
  *
- * Meshes: a curved 8 x 8 grid (a saddle-dome z = f(x, y)) as quads with
- * vertex normals "N" and "st", and as triangles with neither (flat
- * pieces), displaced by corpus shaders of different kinds (noise, du/dv
+ * Meshes: a curved 8 x 8 grid (a saddle z = f(x, y)) as quads with
+ * vertex normals "N" and "st" (the pieces are their triangles), as
+ * triangles with neither (flat pieces), and as a Catmull-Clark cage with
+ * "st" (the pieces its refined faces), displaced by corpus shaders of different kinds (noise, du/dv
  * filter widths, a texture() height map read through st, raw N, dPdu,
  * the globals u v I Ng, calculatenormal). For subsets of pieces
  * (contiguous runs, as a BVH node's, and random sets) the region box must
@@ -19,7 +20,7 @@
  *
  * (b) is asserted; (a) is counted and printed: the two are enclosures of
  * the same surface, each looser than the other in places, and a root box
- * pokes out of its region in about a fifth of the subsets (by up to a
+ * pokes out of its region in about a sixth of the subsets (by up to a
  * third of its extent), where 33 x 33 samples of the piece find no
  * displaced point outside.
  *
@@ -48,11 +49,17 @@ static corpus C;
 
 static double height(double x, double y) { return 0.3 * (x * x - 0.6 * y * y) + 0.1 * x * y; }
 
-/* The grid over [-1,1]^2 as PointsPolygons: quads with "N" and "st"
- * (smooth), or triangles without (flat) */
-static void grid_rib(char *out, size_t size, bool smooth)
+enum { FLAT, SMOOTH, SUBDIV, NKINDS };
+static const char *KIND_NAMES[NKINDS] = {"triangles", "quads", "subdiv"};
+
+/* The grid over [-1,1]^2: PointsPolygons of quads with "N" and "st"
+ * (SMOOTH), of triangles without (FLAT), or a Catmull-Clark cage of the
+ * quads with "st" (SUBDIV) */
+static void grid_rib(char *out, size_t size, int kind)
 {
-    size_t n = (size_t)snprintf(out, size, "PointsPolygons [");
+    bool smooth = kind != FLAT;
+    size_t n = (size_t)snprintf(out, size, kind == SUBDIV ? "SubdivisionMesh \"catmull-clark\" ["
+                                                          : "PointsPolygons [");
     for (int f = 0; f < GRID * GRID * (smooth ? 1 : 2); f++)
         n += (size_t)snprintf(out + n, size - n, "%d ", smooth ? 4 : 3);
     n += (size_t)snprintf(out + n, size - n, "] [");
@@ -64,7 +71,8 @@ static void grid_rib(char *out, size_t size, bool smooth)
             else
                 n += (size_t)snprintf(out + n, size - n, "%d %d %d  %d %d %d  ", a, b, c, a, c, d);
         }
-    n += (size_t)snprintf(out + n, size - n, "] \"P\" [");
+    n += (size_t)snprintf(out + n, size - n, kind == SUBDIV ? "] [\"interpolateboundary\"] [0 0] [] []"
+                                                           " \"P\" ["  : "] \"P\" [");
     for (int j = 0; j <= GRID; j++)
         for (int i = 0; i <= GRID; i++) {
             double x = -1 + 2.0 * i / GRID, y = -1 + 2.0 * j / GRID;
@@ -72,14 +80,17 @@ static void grid_rib(char *out, size_t size, bool smooth)
         }
     n += (size_t)snprintf(out + n, size - n, "]\n");
     if (!smooth) return;
-    n += (size_t)snprintf(out + n, size - n, "  \"N\" [");
-    for (int j = 0; j <= GRID; j++)
-        for (int i = 0; i <= GRID; i++) {
-            double x = -1 + 2.0 * i / GRID, y = -1 + 2.0 * j / GRID;
-            double fx = 0.6 * x + 0.1 * y, fy = -0.36 * y + 0.1 * x;
-            n += (size_t)snprintf(out + n, size - n, "%.17g %.17g 1  ", -fx, -fy);
-        }
-    n += (size_t)snprintf(out + n, size - n, "]\n  \"st\" [");
+    if (kind == SMOOTH) {
+        n += (size_t)snprintf(out + n, size - n, "  \"N\" [");
+        for (int j = 0; j <= GRID; j++)
+            for (int i = 0; i <= GRID; i++) {
+                double x = -1 + 2.0 * i / GRID, y = -1 + 2.0 * j / GRID;
+                double fx = 0.6 * x + 0.1 * y, fy = -0.36 * y + 0.1 * x;
+                n += (size_t)snprintf(out + n, size - n, "%.17g %.17g 1  ", -fx, -fy);
+            }
+        n += (size_t)snprintf(out + n, size - n, "]\n");
+    }
+    n += (size_t)snprintf(out + n, size - n, "  \"st\" [");
     for (int j = 0; j <= GRID; j++)
         for (int i = 0; i <= GRID; i++)
             n += (size_t)snprintf(out + n, size - n, "%.17g %.17g  ", 0.1 + 0.8 * i / GRID,
@@ -89,11 +100,11 @@ static void grid_rib(char *out, size_t size, bool smooth)
 
 /* The job of `sh` (a corpus shader, or an inline one when src is set)
  * displacing the grid, its renderer prepared (the pieces' root boxes) */
-static bool open_grid(fixture *f, const char *name, const char *src, bool smooth,
+static bool open_grid(fixture *f, const char *name, const char *src, int kind,
                       const char *extra)
 {
     static char geom[65536], rib[70000];
-    grid_rib(geom, sizeof geom, smooth);
+    grid_rib(geom, sizeof geom, kind);
     snprintf(rib, sizeof rib,
              "Option \"searchpath\" \"texture\" [\"%s\"]\n"
              "Format 64 48 1\nProjection \"perspective\" \"fov\" [35]\n"
@@ -230,10 +241,10 @@ static void check_subset(trace_thread *th, const trace_object *mobj, const int *
 
 /* Subsets of the mesh's pieces: contiguous runs of 1, 4, 16 and all,
  * and random sets of 2, 8 and 32, three times */
-static void check_mesh(const char *name, bool smooth, escapes *esc, looseness *loose)
+static void check_mesh(const char *name, int kind, escapes *esc, looseness *loose)
 {
     fixture f;
-    assert_true(open_grid(&f, name, NULL, smooth, NULL));
+    assert_true(open_grid(&f, name, NULL, kind, NULL));
     const trace_object *mobj = mesh_of(&f);
     assert_non_null(mobj);
     int np = mobj->mesh->npieces;
@@ -249,14 +260,14 @@ static void check_mesh(const char *name, bool smooth, escapes *esc, looseness *l
             int a = (int)(corpus_rng_uniform(&rng) * (np - n + 1));
             for (int i = 0; i < n; i++) set[i] = a + i;
             snprintf(what, sizeof what, "%s on %s, pieces [%d, %d)", name,
-                     smooth ? "quads" : "triangles", a, a + n);
+                     KIND_NAMES[kind], a, a + n);
             check_subset(th, mobj, set, n, loose, esc, what);
         }
         for (size_t s = 0; s < sizeof picks / sizeof picks[0]; s++) {
             int n = picks[s];
             for (int i = 0; i < n; i++) set[i] = (int)(corpus_rng_uniform(&rng) * np);
             snprintf(what, sizeof what, "%s on %s, %d random pieces", name,
-                     smooth ? "quads" : "triangles", n);
+                     KIND_NAMES[kind], n);
             check_subset(th, mobj, set, n, loose, esc, what);
         }
     }
@@ -288,12 +299,12 @@ static void test_region_holds_every_piece(void **state)
            "%-18s %-9s %9s %9s %9s %9s\n", "shader", "mesh", "roots<=4", "roots>4",
            "points<=4", "points>4");
     for (size_t s = 0; s < sizeof SHADERS / sizeof SHADERS[0]; s++)
-        for (int smooth = 1; smooth >= 0; smooth--) {
+        for (int kind = 0; kind < NKINDS; kind++) {
             looseness l = {{0, 0}, {0, 0}, {0, 0}};
             int r0 = esc.refused;
-            check_mesh(SHADERS[s], smooth, &esc, &l);
+            check_mesh(SHADERS[s], kind, &esc, &l);
             printf("%-18s %-9s %9.3g %9.3g %9.3g %9.3g%s\n", SHADERS[s],
-                   smooth ? "quads" : "triangles", exp(l.log_sum[0] / l.count[0]),
+                   KIND_NAMES[kind], exp(l.log_sum[0] / l.count[0]),
                    exp(l.log_sum[1] / l.count[1]), exp(l.log_pts[0] / l.count[0]),
                    exp(l.log_pts[1] / l.count[1]), esc.refused > r0 ? " (some refused)" : "");
         }
@@ -319,7 +330,7 @@ static void test_cost_is_printed(void **state)
     static const char *names[] = {"dents_shader", "tex_heightmap", "calcnormal_before"};
     for (size_t s = 0; s < sizeof names / sizeof names[0]; s++) {
         fixture f;
-        assert_true(open_grid(&f, names[s], NULL, true, NULL));
+        assert_true(open_grid(&f, names[s], NULL, SMOOTH, NULL));
         const trace_object *mobj = mesh_of(&f);
         int np = mobj->mesh->npieces, *all = malloc(sizeof *all * (size_t)np);
         for (int i = 0; i < np; i++) all[i] = i;
@@ -371,7 +382,7 @@ static void test_param_primvar_is_refused(void **state)
         n += (size_t)snprintf(extra + n, sizeof extra - n, "%g ", 0.01 * (k % 7));
     snprintf(extra + n, sizeof extra - n, "]");
     fixture f;
-    assert_true(open_grid(&f, "lift", LIFT_SL, true, extra));
+    assert_true(open_grid(&f, "lift", LIFT_SL, SMOOTH, extra));
     const trace_object *mobj = mesh_of(&f);
     assert_non_null(mobj);
     trace_thread *th = trace_thread_new(&f.js->world);
@@ -390,7 +401,7 @@ static void test_empty_region(void **state)
 {
     (void)state;
     fixture f;
-    assert_true(open_grid(&f, "dents_shader", NULL, false, NULL));
+    assert_true(open_grid(&f, "dents_shader", NULL, FLAT, NULL));
     trace_thread *th = trace_thread_new(&f.js->world);
     trace_box r;
     assert_true(trace_mesh_region_box(th, mesh_of(&f), NULL, 0, &r));
