@@ -40,8 +40,8 @@ static inline void dual_const_(sl_dual *z, double k) { *z = (sl_dual){k, 0, 0}; 
 /* ---- affine ---- */
 
 /* out = m * in (a point: with m's translation); out must not alias in */
-static void aa_xform(aa_context *ctx, const mat4 *m, const aa_form in[3],
-                     aa_form out[3], bool point)
+void trace_xform_aa(aa_context *ctx, const mat4 *m, const aa_form in[3], aa_form out[3],
+                    bool point)
 {
     for (int i = 0; i < 3; i++)
         aa_lincomb3(ctx, &out[i], m->m[i], in, point ? m->m[i][3] : 0.0);
@@ -51,11 +51,11 @@ static void aa_xform(aa_context *ctx, const mat4 *m, const aa_form in[3],
  * transpose of to_camera (from_camera^T), then normalised; for a similarity
  * (obj->normal_scale > 0) the length is that constant and no non-affine
  * operation is needed. */
-static void aa_camera_normal(aa_context *ctx, const trace_object *obj,
-                             const aa_form Nn[3], aa_form N[3])
+void trace_camera_normal_aa(aa_context *ctx, const trace_object *obj, const aa_form Nn[3],
+                            aa_form N[3])
 {
     mat4 t = mat4_transpose(obj->from_camera);
-    aa_xform(ctx, &t, Nn, N, false);
+    trace_xform_aa(ctx, &t, Nn, N, false);
     double k = obj->flip ? -1.0 : 1.0;
     if (obj->normal_scale > 0) {
         for (int i = 0; i < 3; i++) aa_mul_s(ctx, &N[i], &N[i], k * obj->normal_scale);
@@ -197,9 +197,9 @@ static void box_affine(trace_thread *th, const trace_object *obj,
         return;
     }
     aa_form P[3], N[3], dPdu[3], dPdv[3], Nn[3];
-    aa_xform(ctx, &obj->to_camera, g.P, P, true);
+    trace_xform_aa(ctx, &obj->to_camera, g.P, P, true);
     geom_unit_normal_aa(ctx, &obj->surf, &u, &v, &g, Nn);
-    aa_camera_normal(ctx, obj, Nn, N);
+    trace_camera_normal_aa(ctx, obj, Nn, N);
     ia_interval Pd[2][3];
     if (obj->box_skip_tangents) {         /* never read: not computed */
         for (int i = 0; i < 3; i++) {
@@ -207,8 +207,8 @@ static void box_affine(trace_thread *th, const trace_object *obj,
             aa_const(&dPdv[i], 0.0);
         }
     } else {
-        aa_xform(ctx, &obj->to_camera, g.dPdu, dPdu, false);
-        aa_xform(ctx, &obj->to_camera, g.dPdv, dPdv, false);
+        trace_xform_aa(ctx, &obj->to_camera, g.dPdu, dPdu, false);
+        trace_xform_aa(ctx, &obj->to_camera, g.dPdv, dPdv, false);
         for (int i = 0; i < 3; i++) {
             Pd[0][i] = aa_range(&dPdu[i]);
             Pd[1][i] = aa_range(&dPdv[i]);
@@ -226,7 +226,7 @@ static void box_affine(trace_thread *th, const trace_object *obj,
     } else {
         aa_form Pc[3];
         sl_vm_get_affine(vm, SL_G_P, Pc);
-        aa_xform(ctx, &obj->from_camera, Pc, P, true);
+        trace_xform_aa(ctx, &obj->from_camera, Pc, P, true);
     }
     box_from_affine(P, out);
 }
@@ -243,7 +243,7 @@ static void ia_xform(const mat4 *m, const ia_interval in[3], ia_interval out[3],
     }
 }
 
-/* as aa_camera_normal, in interval arithmetic */
+/* as trace_camera_normal_aa, in interval arithmetic */
 static void ia_camera_normal(const trace_object *obj, const ia_interval Nn[3],
                              ia_interval N[3])
 {

@@ -29,6 +29,15 @@ void trace_surface_box(trace_thread *th, const trace_object *obj,
                        double u0, double u1, double v0, double v1,
                        trace_box *out);
 
+/* The pieces of a box's affine binding (also trace/region.c's): out = m *
+ * in (with m's translation when `point`; out must not alias in), and the
+ * camera-space unit normal N of obj from its object-space unit normal Nn
+ * (the inverse transpose, normalised; exact scaling for a similarity). */
+void trace_xform_aa(aa_context *ctx, const mat4 *m, const aa_form in[3], aa_form out[3],
+                    bool point);
+void trace_camera_normal_aa(aa_context *ctx, const trace_object *obj, const aa_form Nn[3],
+                            aa_form N[3]);
+
 /* N is constant over the object (its d/du, d/dv are 0): disks, and
  * polygons unless they carry interpolated vertex normals
  * (geom_vertex_normal). */
