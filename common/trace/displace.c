@@ -180,8 +180,11 @@ bool trace_surface_flat(const trace_object *obj)
            obj->surf.kind == GEOM_DISK;
 }
 
-static void box_affine(trace_thread *th, const trace_object *obj,
-                       double u0, double u1, double v0, double v1, trace_box *out)
+/* One affine run of the displacement over the (u,v) box (of the case
+ * the VM's splits select): the shader's P in object space, in th->ctx
+ * (valid until its next reset). */
+static void affine_run(trace_thread *th, const trace_object *obj,
+                       double u0, double u1, double v0, double v1, aa_form P[3])
 {
     aa_context *ctx = &th->ctx;
     aa_context_reset(ctx);
@@ -193,10 +196,10 @@ static void box_affine(trace_thread *th, const trace_object *obj,
     th->stats.evals_affine++;
 
     if (!obj->displacement) {
-        box_from_affine(g.P, out);
+        for (int i = 0; i < 3; i++) P[i] = g.P[i];
         return;
     }
-    aa_form P[3], N[3], dPdu[3], dPdv[3], Nn[3];
+    aa_form N[3], dPdu[3], dPdv[3], Nn[3];
     aa_xform(ctx, &obj->to_camera, g.P, P, true);
     geom_unit_normal_aa(ctx, &obj->surf, &u, &v, &g, Nn);
     aa_camera_normal(ctx, obj, Nn, N);
@@ -228,7 +231,46 @@ static void box_affine(trace_thread *th, const trace_object *obj,
         sl_vm_get_affine(vm, SL_G_P, Pc);
         aa_xform(ctx, &obj->from_camera, Pc, P, true);
     }
+}
+
+/* out grown to hold another case's box (box_affine): the hull; the slab
+ * and the proofs' bend are the single case's only */
+static void box_hull(trace_box *out, const trace_box *b)
+{
+    out->lo = v3(fmin(out->lo.x, b->lo.x), fmin(out->lo.y, b->lo.y), fmin(out->lo.z, b->lo.z));
+    out->hi = v3(fmax(out->hi.x, b->hi.x), fmax(out->hi.y, b->hi.y), fmax(out->hi.z, b->hi.z));
+    /* a NaN side stays NaN (trace_surface_box empties such a box) */
+    if (isnan(b->lo.x) || isnan(b->lo.y) || isnan(b->lo.z)) out->lo = b->lo;
+    if (isnan(b->hi.x) || isnan(b->hi.y) || isnan(b->hi.z)) out->hi = b->hi;
+    out->flags = box_flags(out, out->flags | b->flags | AA_DISCONTINUOUS);
+    out->bend = 1e30f;
+    trace_box_no_slab(out);
+}
+
+/* Issue 24, walls and patterns: floor, mod and step across one seam of a
+ * brick or a tile are split into their two cases (sl_vm_split_begin), at
+ * most TRACE_SPLIT_OPS of them per box (2^TRACE_SPLIT_OPS runs), and the
+ * box is the hull of the cases' boxes. Each point of the cell is in one
+ * case, whose box holds it: the hull is as conservative as one run, and
+ * thin where the two sides of a seam meet (mortar on both sides) instead
+ * of the height of the whole pattern. */
+#define TRACE_SPLIT_OPS 3
+
+static void box_affine(trace_thread *th, const trace_object *obj,
+                       double u0, double u1, double v0, double v1, trace_box *out)
+{
+    sl_vm *vm = th->vm;
+    aa_form P[3];
+    sl_vm_split_begin(vm, obj->displacement ? TRACE_SPLIT_OPS : 0);
+    affine_run(th, obj, u0, u1, v0, v1, P);
     box_from_affine(P, out);
+    while (!th->failed && sl_vm_split_next(vm)) {
+        trace_box b;
+        affine_run(th, obj, u0, u1, v0, v1, P);
+        box_from_affine(P, &b);
+        box_hull(out, &b);
+    }
+    sl_vm_split_end(vm);
 }
 
 /* ---- interval ---- */
