@@ -233,44 +233,73 @@ static void affine_run(trace_thread *th, const trace_object *obj,
     }
 }
 
-/* out grown to hold another case's box (box_affine): the hull; the slab
- * and the proofs' bend are the single case's only */
+static void box_affine(trace_thread *th, const trace_object *obj,
+                       double u0, double u1, double v0, double v1, trace_box *out)
+{
+    aa_form P[3];
+    affine_run(th, obj, u0, u1, v0, v1, P);
+    box_from_affine(P, out);
+}
+
+/* out grown to hold another case's box (trace_surface_box_cases) */
 static void box_hull(trace_box *out, const trace_box *b)
 {
     out->lo = v3(fmin(out->lo.x, b->lo.x), fmin(out->lo.y, b->lo.y), fmin(out->lo.z, b->lo.z));
     out->hi = v3(fmax(out->hi.x, b->hi.x), fmax(out->hi.y, b->hi.y), fmax(out->hi.z, b->hi.z));
-    /* a NaN side stays NaN (trace_surface_box empties such a box) */
-    if (isnan(b->lo.x) || isnan(b->lo.y) || isnan(b->lo.z)) out->lo = b->lo;
-    if (isnan(b->hi.x) || isnan(b->hi.y) || isnan(b->hi.z)) out->hi = b->hi;
-    out->flags = box_flags(out, out->flags | b->flags | AA_DISCONTINUOUS);
-    out->bend = 1e30f;
-    trace_box_no_slab(out);
+    out->flags |= b->flags;
 }
 
-/* Issue 24, walls and patterns: floor, mod and step across one seam of a
- * brick or a tile are split into their two cases (sl_vm_split_begin), at
- * most TRACE_SPLIT_OPS of them per box (2^TRACE_SPLIT_OPS runs), and the
- * box is the hull of the cases' boxes. Each point of the cell is in one
- * case, whose box holds it: the hull is as conservative as one run, and
- * thin where the two sides of a seam meet (mortar on both sides) instead
- * of the height of the whole pattern. */
+/* At most this many operations split per box: 2^TRACE_SPLIT_OPS runs */
 #define TRACE_SPLIT_OPS 3
+/* The cases' box is taken where it is at most this fraction of the box's
+ * extent; else the box stays (a narrower box that still does not shrink
+ * makes its children stagnant against it: more splits and samples for
+ * nothing; the filtered pulse trains of dv_lines and fw_stripes, whose
+ * floors the cases do not decide together) */
+#define TRACE_SPLIT_GAIN 0.75
 
-static void box_affine(trace_thread *th, const trace_object *obj,
-                       double u0, double u1, double v0, double v1, trace_box *out)
+bool trace_surface_box_cases(trace_thread *th, const trace_object *obj,
+                             double u0, double u1, double v0, double v1, trace_box *box)
 {
+    obj = trace_box_owner(obj);
+    if (th->world->options.arith == TRACE_ARITH_INTERVAL || !obj->displacement) return false;
     sl_vm *vm = th->vm;
     aa_form P[3];
-    sl_vm_split_begin(vm, obj->displacement ? TRACE_SPLIT_OPS : 0);
+    trace_box hull;
+    sl_vm_split_begin(vm, TRACE_SPLIT_OPS);
     affine_run(th, obj, u0, u1, v0, v1, P);
-    box_from_affine(P, out);
+    box_from_affine(P, &hull);
+    bool split = false;
     while (!th->failed && sl_vm_split_next(vm)) {
         trace_box b;
         affine_run(th, obj, u0, u1, v0, v1, P);
         box_from_affine(P, &b);
-        box_hull(out, &b);
+        box_hull(&hull, &b);
+        split = true;
     }
     sl_vm_split_end(vm);
+    th->stats.boxes++;
+    if (th->failed || !split) return false;
+    /* a NaN side (no surface where the cases run): the box as it was */
+    if (isnan(hull.lo.x) || isnan(hull.lo.y) || isnan(hull.lo.z) || isnan(hull.hi.x) ||
+        isnan(hull.hi.y) || isnan(hull.hi.z))
+        return false;
+    /* both enclose the surface over the cell: so does their meet */
+    trace_box m = *box;
+    m.lo = v3(fmax(box->lo.x, hull.lo.x), fmax(box->lo.y, hull.lo.y), fmax(box->lo.z, hull.lo.z));
+    m.hi = v3(fmin(box->hi.x, hull.hi.x), fmin(box->hi.y, hull.hi.y), fmin(box->hi.z, hull.hi.z));
+    m.flags = box_flags(&m, box->flags | AA_DISCONTINUOUS);
+    if (m.lo.x > m.hi.x || m.lo.y > m.hi.y || m.lo.z > m.hi.z) {
+        m.lo = v3(INFINITY, INFINITY, INFINITY);          /* empty: no surface */
+        m.hi = v3(-INFINITY, -INFINITY, -INFINITY);
+        m.flags &= ~(unsigned)AA_UNBOUNDED;
+    } else if (trace_box_extent(&m) > TRACE_SPLIT_GAIN * trace_box_extent(box)) {
+        return false;
+    }
+    m.bend = 1e30f;                       /* no proofs on a split cell */
+    trace_box_no_slab(&m);
+    *box = m;
+    return true;
 }
 
 /* ---- interval ---- */
