@@ -262,10 +262,13 @@ sl_status sl_vm_run(sl_vm *self, const sl_instance *inst, sl_mode mode,
  * encloses the values, as one run does, and it is tighter where the
  * hull of the two values lost what the rest of the program made of them
  * (mortar on both sides of a brick's seam: 0, not [0, 1]). max_ops is at
- * most SL_VM_MAX_SPLITS (2^max_ops runs); 0 splits nothing. */
+ * most SL_VM_MAX_SPLITS (2^max_ops runs); 0 splits nothing.
+ * sl_vm_split_full: whether the last run met more such operations than
+ * max_ops (those beyond took both values, as without splits). */
 enum { SL_VM_MAX_SPLITS = 8 };
 void sl_vm_split_begin(sl_vm *self, int max_ops);
 bool sl_vm_split_next(sl_vm *self);
+bool sl_vm_split_full(const sl_vm *self);
 void sl_vm_split_end(sl_vm *self);
 
 /* After a failed run: "shader 'wave': instruction budget of 1000000

@@ -661,6 +661,7 @@ static sl_status run(sl_vm *self, const sl_instance *inst, sl_mode mode, aa_cont
     self->rng = self->seed;
     self->nillum = self->illum_next = 0;
     self->split.n = 0;
+    self->split.full = false;
     ensure_clear(self, mode);
     load_strings(self, p);
     if (slopes || (p->takes_derivatives && (mode == SL_MODE_INTERVAL || mode == SL_MODE_AFFINE)))
@@ -697,10 +698,13 @@ bool sl_vm_split_next(sl_vm *self)
     return true;
 }
 
+bool sl_vm_split_full(const sl_vm *self) { return self->split.full; }
+
 void sl_vm_split_end(sl_vm *self)
 {
     self->split.on = false;
     self->split.max = self->split.n = self->split.fixed = 0;
+    self->split.full = false;
 }
 
 const char *sl_vm_error(const sl_vm *self) { return self->error; }

@@ -57,7 +57,11 @@ static inline bool exact(int op, A *z, const A *x, const A *y)
  * split, and which of its two values this run takes */
 static inline bool split_take(sl_vm *vm, int *pick)
 {
-    if (!vm->split.on || vm->split.n >= vm->split.max) return false;
+    if (!vm->split.on) return false;
+    if (vm->split.n >= vm->split.max) {
+        vm->split.full = true;            /* this one takes both values */
+        return false;
+    }
     int i = vm->split.n++;
     if (i >= vm->split.fixed) vm->split.pick[i] = 0;
     *pick = vm->split.pick[i];

@@ -170,6 +170,7 @@ struct sl_vm {
      * 0 (the choices before replay the previous run's) */
     struct {
         bool on;
+        bool full;                /* this run met more than max of them */
         int max, n, fixed;
         unsigned char pick[SL_VM_MAX_SPLITS];
     } split;

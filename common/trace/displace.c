@@ -269,6 +269,14 @@ bool trace_surface_box_cases(trace_thread *th, const trace_object *obj,
     sl_vm_split_begin(vm, TRACE_SPLIT_OPS);
     affine_run(th, obj, u0, u1, v0, v1, P);
     box_from_affine(P, &hull);
+    if (sl_vm_split_full(vm)) {
+        /* more seams than cases: the rest would stay as wide as one run
+         * makes them (the filtered pulse trains' four floors, which the
+         * cases do not decide together): not worth the runs */
+        sl_vm_split_end(vm);
+        th->stats.boxes++;
+        return false;
+    }
     bool split = false;
     while (!th->failed && sl_vm_split_next(vm)) {
         trace_box b;

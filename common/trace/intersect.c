@@ -535,8 +535,12 @@ static trace_brood_id children_of(walk *w, trace_brood_id parent, int slot,
         child_range(i, r[0], r[1], r[2], r[3], c);
         trace_surface_box(th, owner, c[0], c[1], c[2], c[3], &kids[i]);
         if (!stagnant(&kids[i], node_extent)) continue;
-        /* issue 24: the cases of a seam, then (still stagnant) samples */
-        trace_surface_box_cases(th, owner, c[0], c[1], c[2], c[3], &kids[i]);
+        /* issue 24: the cases of a seam, then (still stagnant) samples;
+         * below a box they did not narrow, not again (a pattern whose
+         * floors the cases do not decide together: filtered pulse trains) */
+        if ((node->flags & TRACE_BOX_UNSPLIT) ||
+            !trace_surface_box_cases(th, owner, c[0], c[1], c[2], c[3], &kids[i]))
+            kids[i].flags |= TRACE_BOX_UNSPLIT;
         if (depth >= TRACE_SAMPLE_DEPTH && stagnant(&kids[i], node_extent))
             sample_stagnant(th, owner, c, &kids[i]);
     }
