@@ -247,6 +247,30 @@ bool sl_vm_set_varying_param(sl_vm *self, int param, int size, const double coef
 /* Runs the instance. `ctx` is used (and required) in affine mode only. */
 sl_status sl_vm_run(sl_vm *self, const sl_instance *inst, sl_mode mode,
                     aa_context *ctx);
+/* Case splits of affine runs (issue 24, "walls and patterns"). Between
+ * sl_vm_split_begin and sl_vm_split_end, an affine run splits the first
+ * max_ops of its floor, ceil, round, mod and step operations whose result
+ * takes exactly two values over the range (a cell across one seam of a
+ * brick or a tile): the operation gives one of them exactly, a constant
+ * (mod: x - k y for one k), flagged AA_DISCONTINUOUS, instead of their
+ * hull. The caller runs the shader once per case: after each run,
+ * sl_vm_split_next says whether another case remains and selects it (the
+ * runs replay the choices before the last one that can change, so they
+ * meet the same operations). Every point of the range belongs to one
+ * case, in which the run computes what the point computes with bounds
+ * over the whole range for the rest: the hull of the cases' results
+ * encloses the values, as one run does, and it is tighter where the
+ * hull of the two values lost what the rest of the program made of them
+ * (mortar on both sides of a brick's seam: 0, not [0, 1]). max_ops is at
+ * most SL_VM_MAX_SPLITS (2^max_ops runs); 0 splits nothing.
+ * sl_vm_split_full: whether the last run met more such operations than
+ * max_ops (those beyond took both values, as without splits). */
+enum { SL_VM_MAX_SPLITS = 8 };
+void sl_vm_split_begin(sl_vm *self, int max_ops);
+bool sl_vm_split_next(sl_vm *self);
+bool sl_vm_split_full(const sl_vm *self);
+void sl_vm_split_end(sl_vm *self);
+
 /* After a failed run: "shader 'wave': instruction budget of 1000000
  * exceeded" and the like. */
 const char *sl_vm_error(const sl_vm *self);

@@ -660,6 +660,8 @@ static sl_status run(sl_vm *self, const sl_instance *inst, sl_mode mode, aa_cont
     self->sacc_bottom = SL_VM_POOL_VALUES;
     self->rng = self->seed;
     self->nillum = self->illum_next = 0;
+    self->split.n = 0;
+    self->split.full = false;
     ensure_clear(self, mode);
     load_strings(self, p);
     if (slopes || (p->takes_derivatives && (mode == SL_MODE_INTERVAL || mode == SL_MODE_AFFINE)))
@@ -671,6 +673,38 @@ static sl_status run(sl_vm *self, const sl_instance *inst, sl_mode mode, aa_cont
     case SL_MODE_AFFINE: return sl_vm_exec_affine(self);
     }
     return sl_vm_fail(self, SL_ERR_RUNTIME, "unknown mode %d", (int)mode);
+}
+
+void sl_vm_split_begin(sl_vm *self, int max_ops)
+{
+    assert(max_ops >= 0 && max_ops <= SL_VM_MAX_SPLITS);
+    self->split.on = max_ops > 0;
+    self->split.max = max_ops;
+    self->split.n = self->split.fixed = 0;
+}
+
+/* the next case in depth-first order: the last split of the run that
+ * took its lower value takes the upper one, the splits after it start
+ * again from their lower values */
+bool sl_vm_split_next(sl_vm *self)
+{
+    if (!self->split.on) return false;
+    assert(self->split.n >= self->split.fixed && self->split.n <= self->split.max);
+    int i = self->split.n - 1;
+    while (i >= 0 && self->split.pick[i] == 1) i--;
+    if (i < 0) return false;
+    self->split.pick[i] = 1;
+    self->split.fixed = i + 1;
+    return true;
+}
+
+bool sl_vm_split_full(const sl_vm *self) { return self->split.full; }
+
+void sl_vm_split_end(sl_vm *self)
+{
+    self->split.on = false;
+    self->split.max = self->split.n = self->split.fixed = 0;
+    self->split.full = false;
 }
 
 const char *sl_vm_error(const sl_vm *self) { return self->error; }

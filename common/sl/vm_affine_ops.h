@@ -53,6 +53,72 @@ static inline bool exact(int op, A *z, const A *x, const A *y)
     return true;
 }
 
+/* Case splits (sl_vm_split_begin, shader.h): whether this operation is
+ * split, and which of its two values this run takes */
+static inline bool split_take(sl_vm *vm, int *pick)
+{
+    if (!vm->split.on) return false;
+    if (vm->split.n >= vm->split.max) {
+        vm->split.full = true;            /* this one takes both values */
+        return false;
+    }
+    int i = vm->split.n++;
+    if (i >= vm->split.fixed) vm->split.pick[i] = 0;
+    *pick = vm->split.pick[i];
+    return true;
+}
+
+/* floor, ceil, round of x over a range where they take two values: one of
+ * them exactly, in its case */
+static inline bool split_stepped(sl_vm *vm, A *z, const A *x, ia_interval (*fi)(ia_interval))
+{
+    if (!vm->split.on || (x->flags & AA_UNBOUNDED)) return false;
+    ia_interval r = aa_range(x);
+    if (!isfinite(r.lo) || !isfinite(r.hi)) return false;
+    ia_interval v = fi(r);
+    int pick;
+    if (!(v.hi - v.lo == 1.0) || !split_take(vm, &pick)) return false;
+    unsigned short flags = (unsigned short)((x->flags & ~AA_UNBOUNDED) | AA_DISCONTINUOUS);
+    aa_const(z, pick ? v.hi : v.lo);
+    z->flags = flags;
+    return true;
+}
+
+/* step(edge, x) where it is undecided: 0 or 1 */
+static inline bool split_step(sl_vm *vm, A *z, const A *edge, const A *x)
+{
+    if (!vm->split.on || ((x->flags | edge->flags) & AA_UNBOUNDED)) return false;
+    A d;
+    aa_sub(vm->ctx, &d, x, edge);
+    ia_interval r = aa_range(&d);
+    int pick;
+    if (!(r.lo < 0 && r.hi >= 0) || !split_take(vm, &pick)) return false;
+    unsigned short flags = (unsigned short)(((x->flags | edge->flags) & ~AA_UNBOUNDED) |
+                                            AA_DISCONTINUOUS);
+    aa_const(z, pick);
+    z->flags = flags;
+    return true;
+}
+
+/* mod(x, y) = x - k y where k = floor(x / y) takes two values: x - k y for
+ * one of them (the affine form: its correlation with x stays) */
+static inline bool split_mod(sl_vm *vm, A *z, const A *x, const A *y)
+{
+    if (!vm->split.on || ((x->flags | y->flags) & AA_UNBOUNDED)) return false;
+    ia_interval rx = aa_range(x), ry = aa_range(y);
+    if (!isfinite(rx.lo) || !isfinite(rx.hi) || !isfinite(ry.lo) || !isfinite(ry.hi) ||
+        (ry.lo <= 0 && ry.hi >= 0))
+        return false;
+    ia_interval k = ia_floor(ia_div(rx, ry));
+    int pick;
+    if (!(k.hi - k.lo == 1.0) || !split_take(vm, &pick)) return false;
+    unsigned short flags = (unsigned short)(((x->flags | y->flags) & ~AA_UNBOUNDED) |
+                                            AA_DISCONTINUOUS);
+    aa_lincomb(vm->ctx, z, 1.0, x, -(pick ? k.hi : k.lo), y, 0.0);
+    z->flags = (unsigned short)(z->flags | flags);
+    return true;
+}
+
 #define BIN(name, f) \
     static inline void name(sl_vm *vm, A *z, const A *x, const A *y) { f(vm->ctx, z, x, y); }
 #define UN(name, f) \
@@ -69,10 +135,8 @@ EXACT_BIN(VM_OP(v_mul, b_mul), SL_OP_MUL, aa_mul)
 EXACT_BIN(VM_OP(v_div, b_div), SL_OP_DIV, aa_div)
 BIN(VM_OP(v_pow, b_pow), aa_pow)
 BIN(VM_OP(v_atan2, b_atan2), aa_atan2)
-EXACT_BIN(VM_OP(v_mod, b_mod), SL_OP_MOD, aa_mod)
 BIN(VM_OP(v_min, b_min), aa_min)
 BIN(VM_OP(v_max, b_max), aa_max)
-BIN(VM_OP(v_step, b_step), aa_step)
 UN(VM_OP(v_neg, b_neg), aa_neg)
 UN(VM_OP(v_sqrt, b_sqrt), aa_sqrt)
 UN(VM_OP(v_invsqrt, b_invsqrt), aa_invsqrt)
@@ -86,12 +150,35 @@ UN(VM_OP(v_acos, b_acos), aa_acos)
 UN(VM_OP(v_atan, b_atan), aa_atan)
 UN(VM_OP(v_abs, b_abs), aa_abs)
 UN(VM_OP(v_sign, b_sign), aa_sign)
-UN(VM_OP(v_floor, b_floor), aa_floor)
-UN(VM_OP(v_ceil, b_ceil), aa_ceil)
-UN(VM_OP(v_round, b_round), aa_round)
 #undef BIN
 #undef UN
 #undef EXACT_BIN
+
+static inline void VM_OP(v_mod, b_mod)(sl_vm *vm, A *z, const A *x, const A *y)
+{
+    if (!exact(SL_OP_MOD, z, x, y) && !split_mod(vm, z, x, y))
+        aa_mod(vm->ctx, z, x, y);
+}
+static inline void VM_OP(v_step, b_step)(sl_vm *vm, A *z, const A *edge, const A *x)
+{
+    if (!split_step(vm, z, edge, x))
+        aa_step(vm->ctx, z, edge, x);
+}
+static inline void VM_OP(v_floor, b_floor)(sl_vm *vm, A *z, const A *x)
+{
+    if (!split_stepped(vm, z, x, ia_floor))
+        aa_floor(vm->ctx, z, x);
+}
+static inline void VM_OP(v_ceil, b_ceil)(sl_vm *vm, A *z, const A *x)
+{
+    if (!split_stepped(vm, z, x, ia_ceil))
+        aa_ceil(vm->ctx, z, x);
+}
+static inline void VM_OP(v_round, b_round)(sl_vm *vm, A *z, const A *x)
+{
+    if (!split_stepped(vm, z, x, ia_round))
+        aa_round(vm->ctx, z, x);
+}
 
 static inline void VM_OP(v_clamp, b_clamp)(sl_vm *vm, A *z, const A *x, const A *lo, const A *hi)
 {

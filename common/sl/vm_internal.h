@@ -164,6 +164,17 @@ struct sl_vm {
     vm_accumulator accs[SL_VM_MAX_ACCUMULATORS];
     int naccs, acc_bottom, sacc_bottom;
 
+    /* case splits of affine runs (sl_vm_split_begin): the first max
+     * two-valued discontinuous operations of a run take pick[i] (0: the
+     * lower value); n of them so far this run; picks from `fixed` on are
+     * 0 (the choices before replay the previous run's) */
+    struct {
+        bool on;
+        bool full;                /* this run met more than max of them */
+        int max, n, fixed;
+        unsigned char pick[SL_VM_MAX_SPLITS];
+    } split;
+
     /* the current run */
     const sl_program *prog;
     const sl_instance *inst;

@@ -36,10 +36,15 @@
 /* A box estimated from samples where range arithmetic stagnated
  * (intersect.c, "stagnant-box fallback"); above the flags of common/aa. */
 #define TRACE_BOX_SAMPLED (1u << 8)
+/* A stagnant box that the cases of its seams did not narrow, or the
+ * stagnant child of one (intersect.c, children_of): its stagnant children
+ * do not try them again (issue 24) */
+#define TRACE_BOX_UNSPLIT (1u << 9)
 
 typedef struct trace_box {
     vec3 lo, hi;
-    unsigned flags;          /* AA_DISCONTINUOUS | AA_UNBOUNDED | TRACE_BOX_SAMPLED */
+    unsigned flags;          /* AA_DISCONTINUOUS | AA_UNBOUNDED | TRACE_BOX_SAMPLED |
+                                TRACE_BOX_UNSPLIT */
     float bend;              /* how far from linear in (u,v) the surface is over
                                 the box: the affine forms' other terms over
                                 their u and v terms (displace.c); 0: unknown */

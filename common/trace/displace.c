@@ -180,8 +180,11 @@ bool trace_surface_flat(const trace_object *obj)
            obj->surf.kind == GEOM_DISK;
 }
 
-static void box_affine(trace_thread *th, const trace_object *obj,
-                       double u0, double u1, double v0, double v1, trace_box *out)
+/* One affine run of the displacement over the (u,v) box (of the case
+ * the VM's splits select): the shader's P in object space, in th->ctx
+ * (valid until its next reset). */
+static void affine_run(trace_thread *th, const trace_object *obj,
+                       double u0, double u1, double v0, double v1, aa_form P[3])
 {
     aa_context *ctx = &th->ctx;
     aa_context_reset(ctx);
@@ -193,10 +196,10 @@ static void box_affine(trace_thread *th, const trace_object *obj,
     th->stats.evals_affine++;
 
     if (!obj->displacement) {
-        box_from_affine(g.P, out);
+        for (int i = 0; i < 3; i++) P[i] = g.P[i];
         return;
     }
-    aa_form P[3], N[3], dPdu[3], dPdv[3], Nn[3];
+    aa_form N[3], dPdu[3], dPdv[3], Nn[3];
     trace_xform_aa(ctx, &obj->to_camera, g.P, P, true);
     geom_unit_normal_aa(ctx, &obj->surf, &u, &v, &g, Nn);
     trace_camera_normal_aa(ctx, obj, Nn, N);
@@ -228,7 +231,83 @@ static void box_affine(trace_thread *th, const trace_object *obj,
         sl_vm_get_affine(vm, SL_G_P, Pc);
         trace_xform_aa(ctx, &obj->from_camera, Pc, P, true);
     }
+}
+
+static void box_affine(trace_thread *th, const trace_object *obj,
+                       double u0, double u1, double v0, double v1, trace_box *out)
+{
+    aa_form P[3];
+    affine_run(th, obj, u0, u1, v0, v1, P);
     box_from_affine(P, out);
+}
+
+/* out grown to hold another case's box (trace_surface_box_cases) */
+static void box_hull(trace_box *out, const trace_box *b)
+{
+    out->lo = v3(fmin(out->lo.x, b->lo.x), fmin(out->lo.y, b->lo.y), fmin(out->lo.z, b->lo.z));
+    out->hi = v3(fmax(out->hi.x, b->hi.x), fmax(out->hi.y, b->hi.y), fmax(out->hi.z, b->hi.z));
+    out->flags |= b->flags;
+}
+
+/* At most this many operations split per box: 2^TRACE_SPLIT_OPS runs */
+#define TRACE_SPLIT_OPS 3
+/* The cases' box is taken where it is at most this fraction of the box's
+ * extent; else the box stays (a narrower box that still does not shrink
+ * makes its children stagnant against it: more splits and samples for
+ * nothing; the filtered pulse trains of dv_lines and fw_stripes, whose
+ * floors the cases do not decide together) */
+#define TRACE_SPLIT_GAIN 0.75
+
+bool trace_surface_box_cases(trace_thread *th, const trace_object *obj,
+                             double u0, double u1, double v0, double v1, trace_box *box)
+{
+    obj = trace_box_owner(obj);
+    if (th->world->options.arith == TRACE_ARITH_INTERVAL || !obj->displacement) return false;
+    sl_vm *vm = th->vm;
+    aa_form P[3];
+    trace_box hull;
+    sl_vm_split_begin(vm, TRACE_SPLIT_OPS);
+    affine_run(th, obj, u0, u1, v0, v1, P);
+    box_from_affine(P, &hull);
+    if (sl_vm_split_full(vm)) {
+        /* more seams than cases: the rest would stay as wide as one run
+         * makes them (the filtered pulse trains' four floors, which the
+         * cases do not decide together): not worth the runs */
+        sl_vm_split_end(vm);
+        th->stats.boxes++;
+        return false;
+    }
+    bool split = false;
+    while (!th->failed && sl_vm_split_next(vm)) {
+        trace_box b;
+        affine_run(th, obj, u0, u1, v0, v1, P);
+        box_from_affine(P, &b);
+        box_hull(&hull, &b);
+        split = true;
+    }
+    sl_vm_split_end(vm);
+    th->stats.boxes++;
+    if (th->failed || !split) return false;
+    /* a NaN side (no surface where the cases run): the box as it was */
+    if (isnan(hull.lo.x) || isnan(hull.lo.y) || isnan(hull.lo.z) || isnan(hull.hi.x) ||
+        isnan(hull.hi.y) || isnan(hull.hi.z))
+        return false;
+    /* both enclose the surface over the cell: so does their meet */
+    trace_box m = *box;
+    m.lo = v3(fmax(box->lo.x, hull.lo.x), fmax(box->lo.y, hull.lo.y), fmax(box->lo.z, hull.lo.z));
+    m.hi = v3(fmin(box->hi.x, hull.hi.x), fmin(box->hi.y, hull.hi.y), fmin(box->hi.z, hull.hi.z));
+    m.flags = box_flags(&m, box->flags | AA_DISCONTINUOUS);
+    if (m.lo.x > m.hi.x || m.lo.y > m.hi.y || m.lo.z > m.hi.z) {
+        m.lo = v3(INFINITY, INFINITY, INFINITY);          /* empty: no surface */
+        m.hi = v3(-INFINITY, -INFINITY, -INFINITY);
+        m.flags &= ~(unsigned)AA_UNBOUNDED;
+    } else if (trace_box_extent(&m) > TRACE_SPLIT_GAIN * trace_box_extent(box)) {
+        return false;
+    }
+    m.bend = 1e30f;                       /* no proofs on a split cell */
+    trace_box_no_slab(&m);
+    *box = m;
+    return true;
 }
 
 /* ---- interval ---- */

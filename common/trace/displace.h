@@ -38,6 +38,23 @@ void trace_xform_aa(aa_context *ctx, const mat4 *m, const aa_form in[3], aa_form
 void trace_camera_normal_aa(aa_context *ctx, const trace_object *obj, const aa_form Nn[3],
                             aa_form N[3]);
 
+/* Issue 24, walls and patterns: *box, the range's trace_surface_box in
+ * affine arithmetic, narrowed by case splits (sl_vm_split_begin): floor,
+ * ceil, round, mod and step taking two values over the range (a cell
+ * across a seam of bricks or tiles) run once per value, at most 3 of them
+ * (8 runs), and *box becomes its meet with the hull of the cases' boxes.
+ * Every point of the range is in one case, whose box holds it, so the
+ * meet is as conservative as *box; it is thin where the values the
+ * pattern takes on both sides of its seam agree (mortar on both sides of a
+ * brick's joint: no displacement, where one run bounds [0, 1] of it).
+ * Flagged AA_DISCONTINUOUS, without slab or proofs (bend). False (and *box
+ * untouched) when nothing was split: interval arithmetic, no displacement,
+ * no such operation. Costs 1 to 8 shader runs, counted as one box; the
+ * intersector calls it on discontinuous boxes that stopped shrinking
+ * (intersect.c). A pure function of (object, range, *box). */
+bool trace_surface_box_cases(trace_thread *th, const trace_object *obj,
+                             double u0, double u1, double v0, double v1, trace_box *box);
+
 /* N is constant over the object (its d/du, d/dv are 0): disks, and
  * polygons unless they carry interpolated vertex normals
  * (geom_vertex_normal). */

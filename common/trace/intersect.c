@@ -512,6 +512,14 @@ static bool sample_stagnant(trace_thread *th, const trace_object *obj, const dou
     return true;
 }
 
+/* A discontinuous box that kept more than TRACE_NO_SHRINK of its
+ * parent's size (§5: smooth boxes halve, roughly) */
+static bool stagnant(const trace_box *b, double parent_extent)
+{
+    return (b->flags & AA_DISCONTINUOUS) && !(b->flags & AA_UNBOUNDED) &&
+           !trace_box_is_empty(b) && trace_box_extent(b) >= TRACE_NO_SHRINK * parent_extent;
+}
+
 static trace_brood_id children_of(walk *w, trace_brood_id parent, int slot,
                                   const double r[4], const trace_box *node, int depth,
                                   trace_box kids[4])
@@ -526,9 +534,14 @@ static trace_brood_id children_of(walk *w, trace_brood_id parent, int slot,
         double c[4];
         child_range(i, r[0], r[1], r[2], r[3], c);
         trace_surface_box(th, owner, c[0], c[1], c[2], c[3], &kids[i]);
-        if (depth >= TRACE_SAMPLE_DEPTH && (kids[i].flags & AA_DISCONTINUOUS) &&
-            !(kids[i].flags & AA_UNBOUNDED) && !trace_box_is_empty(&kids[i]) &&
-            trace_box_extent(&kids[i]) >= TRACE_NO_SHRINK * node_extent)
+        if (!stagnant(&kids[i], node_extent)) continue;
+        /* issue 24: the cases of a seam, then (still stagnant) samples;
+         * below a box they did not narrow, not again (a pattern whose
+         * floors the cases do not decide together: filtered pulse trains) */
+        if ((node->flags & TRACE_BOX_UNSPLIT) ||
+            !trace_surface_box_cases(th, owner, c[0], c[1], c[2], c[3], &kids[i]))
+            kids[i].flags |= TRACE_BOX_UNSPLIT;
+        if (depth >= TRACE_SAMPLE_DEPTH && stagnant(&kids[i], node_extent))
             sample_stagnant(th, owner, c, &kids[i]);
     }
     return trace_boxcache_insert(th->cache, owner->id, parent, slot, kids);

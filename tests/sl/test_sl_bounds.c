@@ -120,6 +120,74 @@ static void assert_range(ia_interval r, double lo, double hi)
 }
 
 /* ---------------------------------------------------------------------- */
+/* case splits (issue 24)                                                  */
+/* ---------------------------------------------------------------------- */
+
+/* Runs `body` over u in [0.2, 0.3] (v in [0.25, 0.5]) of the plane with
+ * case splits of at most max_ops operations: each case's P in out[]
+ * (aa_range per component), the number of runs returned */
+static int split_runs(const char *body, int max_ops, ia_interval out[][3], int nout)
+{
+    char src[2048];
+    snprintf(src, sizeof src, "displacement t() { %s }", body);
+    sl_program *p = h_compile(src);
+    assert_non_null(p);
+    sl_instance *inst = sl_instance_new(p);
+    sl_vm *vm = sl_vm_new(NULL);
+    aa_context ctx;
+    aa_context_init(&ctx, AA_DEFAULT_CAPACITY);
+    int runs = 0;
+    sl_vm_split_begin(vm, max_ops);
+    do {
+        aa_context_reset(&ctx);
+        h_globals_affine(vm, &ctx, H_PLANE, 0.2, 0.3, 0.25, 0.5);
+        assert_int_equal(sl_vm_run(vm, inst, SL_MODE_AFFINE, &ctx), SL_OK);
+        aa_form a[3];
+        sl_vm_get_affine(vm, SL_G_P, a);
+        assert_true(runs < nout);
+        for (int i = 0; i < 3; i++) out[runs][i] = aa_range(&a[i]);
+        runs++;
+    } while (sl_vm_split_next(vm));
+    sl_vm_split_end(vm);
+    sl_vm_destroy(&vm);
+    sl_instance_destroy(&inst);
+    sl_program_destroy(&p);
+    return runs;
+}
+
+static void test_case_splits(void **state)
+{
+    (void)state;
+    ia_interval r[8][3];
+    /* k = floor(4u) over [0.8, 1.2]: 0 or 1, so k*k - k is 0 in both
+     * cases; one run bounds it by [-1/4, 0] or wider */
+    const char *body = "float k = floor(4 * u); P = point(k * k - k, 0, 0);";
+    assert_int_equal(split_runs(body, 0, r, 8), 1);
+    assert_true(r[0][0].lo <= -0.2 && r[0][0].hi >= 0);
+    assert_int_equal(split_runs(body, 3, r, 8), 2);
+    for (int c = 0; c < 2; c++) assert_true(r[c][0].lo == 0 && r[c][0].hi == 0);
+    /* two operations: four cases, every pair of values once (depth first) */
+    body = "P = point(floor(4 * u), step(0.25, u), mod(4 * u, 1));";
+    assert_int_equal(split_runs(body, 3, r, 8), 8);
+    for (int c = 0; c < 8; c++) {
+        assert_true(r[c][0].lo == r[c][0].hi && r[c][0].lo == (c >> 2));
+        assert_true(r[c][1].lo == r[c][1].hi && r[c][1].lo == ((c >> 1) & 1));
+        /* mod: 4u - k for k = 0 ([0.8, 1.2]) or 1 ([-0.2, 0.2]) */
+        double k = c & 1;
+        assert_true(r[c][2].lo <= 0.8 - k && r[c][2].hi >= 1.2 - k);
+        assert_true(r[c][2].lo >= 0.8 - k - 1e-9 && r[c][2].hi <= 1.2 - k + 1e-9);
+    }
+    /* at most max_ops splits: the rest bound both values as one run does */
+    assert_int_equal(split_runs(body, 1, r, 8), 2);
+    for (int c = 0; c < 2; c++) {
+        assert_true(r[c][0].lo == c && r[c][0].hi == c);
+        assert_true(r[c][1].lo <= 0 && r[c][1].hi >= 1);
+    }
+    /* decided operations are not split: one run */
+    assert_int_equal(split_runs("P = point(floor(u), step(0.1, u), ceil(2 * u));", 3, r, 8), 1);
+}
+
+/* ---------------------------------------------------------------------- */
 /* merging                                                                 */
 /* ---------------------------------------------------------------------- */
 
@@ -602,6 +670,7 @@ static void test_granite(void **state) { (void)state; check_shader("granite", SL
 int main(void)
 {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_case_splits),
         cmocka_unit_test(test_undecided_if_merges),
         cmocka_unit_test(test_undecided_conditional_expression),
         cmocka_unit_test(test_undecided_loop),
