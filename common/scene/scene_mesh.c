@@ -115,7 +115,8 @@ void scene_mesh_add_piece(scene_mesh *self, scene_piece_kind kind, int face, int
     }
     if (kind == SCENE_PIECE_SUBDIV) {
         /* 4 bytes a piece: its refined face */
-        assert(self->sd && !self->pieces && face >= 0);
+        /* (none after scene_mesh_trim, which may drop an identity list) */
+        assert(self->sd && !self->pieces && face >= 0 && (self->npieces == 0 || self->sub_face));
         if (self->npieces == self->cap) {
             self->cap = self->cap ? 2 * self->cap : 64;
             self->sub_face = xreallocarray(self->sub_face, (size_t)self->cap, sizeof *self->sub_face);
