@@ -280,8 +280,7 @@ static bool region_run(trace_thread *th, const trace_object *mobj, const region_
 bool trace_mesh_region_box(trace_thread *th, const trace_object *mesh_obj, const int *pieces,
                            int n, trace_box *out)
 {
-    const trace_mesh *m = mesh_obj->mesh;
-    assert(m && n >= 0);
+    assert(mesh_obj->mesh && n >= 0);
     unbounded_box(out);
     if (n == 0) {
         out->lo = v3(INFINITY, INFINITY, INFINITY);
@@ -293,7 +292,7 @@ bool trace_mesh_region_box(trace_thread *th, const trace_object *mesh_obj, const
     trace_view *view = xmalloc(sizeof *view);
     bool ok = true;
     for (int i = 0; ok && i < n; i++) {
-        assert(pieces[i] >= 0 && pieces[i] < m->npieces);
+        assert(pieces[i] >= 0 && pieces[i] < mesh_obj->mesh->npieces);
         ok = trace_mesh_view_make(th, mesh_obj, pieces[i], false, view) &&
              hull_piece(th, &view->obj, h, i == 0);
     }
