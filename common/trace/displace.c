@@ -241,14 +241,6 @@ static void box_affine(trace_thread *th, const trace_object *obj,
     box_from_affine(P, out);
 }
 
-/* out grown to hold another case's box (trace_surface_box_cases) */
-static void box_hull(trace_box *out, const trace_box *b)
-{
-    out->lo = v3(fmin(out->lo.x, b->lo.x), fmin(out->lo.y, b->lo.y), fmin(out->lo.z, b->lo.z));
-    out->hi = v3(fmax(out->hi.x, b->hi.x), fmax(out->hi.y, b->hi.y), fmax(out->hi.z, b->hi.z));
-    out->flags |= b->flags;
-}
-
 /* At most this many operations split per box: 2^TRACE_SPLIT_OPS runs */
 #define TRACE_SPLIT_OPS 3
 /* The cases' box is taken where it is at most this fraction of the box's
@@ -282,7 +274,7 @@ bool trace_surface_box_cases(trace_thread *th, const trace_object *obj,
         trace_box b;
         affine_run(th, obj, u0, u1, v0, v1, P);
         box_from_affine(P, &b);
-        box_hull(&hull, &b);
+        trace_box_union(&hull, &b);
         split = true;
     }
     sl_vm_split_end(vm);
