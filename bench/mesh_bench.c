@@ -13,10 +13,15 @@
  * are 64 bytes a face before any box and 32 of BVH), per face. Never
  * fails on timing.
  *
- *   mesh_bench [max_faces [subdiv]]   (default 100000; 1000000 and
+ *   mesh_bench [max_faces [subdiv|displaced]]
+ *                                     (default 100000; 1000000 and
  *                                      10000000 run the production rows;
  *                                      subdiv: the torus as a Catmull-Clark
- *                                      cage, 4 limit pieces a face)
+ *                                      cage, 4 limit pieces a face;
+ *                                      displaced: bumped by a noise shader,
+ *                                      its root boxes made lazily, then the
+ *                                      world built again with all of them
+ *                                      first, as before: "eager" rows)
  */
 #include <stdbool.h>
 #include <stdio.h>
@@ -29,7 +34,9 @@
 
 #include "job/job.h"
 #include "job/job_scene.h"
+#include "trace/lazy_roots.h"
 #include "trace/mesh.h"
+#include "trace/render.h"
 
 static double wall_now(void)
 {
@@ -54,13 +61,14 @@ static long peak_mib(void)
 
 /* The RIB text of a torus (radii 1 and 0.4) of nu x nv quads, a
  * PointsPolygons or (subdiv) a SubdivisionMesh. */
-static char *torus_rib(int nu, int nv, bool subdiv, size_t *len)
+static char *torus_rib(int nu, int nv, bool subdiv, bool displaced, size_t *len)
 {
     size_t cap = (size_t)nu * nv * 80 + 4096, n = 0;
     char *t = malloc(cap);
     if (!t) abort();
     n += (size_t)sprintf(t + n, "Format 128 128 1\nProjection \"perspective\" \"fov\" [40]\n"
-                         "Translate 0 0 4\nRotate 60 1 0 0\nWorldBegin\n%s [",
+                         "Translate 0 0 4\nRotate 60 1 0 0\nWorldBegin\n%s%s [",
+                         displaced ? "Displacement \"bumps\"\n" : "",
                          subdiv ? "SubdivisionMesh \"catmull-clark\"" : "PointsPolygons");
     for (int i = 0; i < nu * nv; i++) n += (size_t)sprintf(t + n, "4 ");
     n += (size_t)sprintf(t + n, "]\n[");
@@ -81,26 +89,65 @@ static char *torus_rib(int nu, int nv, bool subdiv, size_t *len)
     return t;
 }
 
+/* noise bumps along the normal (the displaced rows) */
+static const char *BUMPS_SL =
+    "displacement bumps(float Km = 0.03)\n"
+    "{\n"
+    "    P += Km * (noise(P * 8) - 0.5) * normalize(N);\n"
+    "    N = calculatenormal(P);\n"
+    "}\n";
+
+/* The world of js built again with its root boxes made first (as before
+ * they were made lazily): its wall seconds */
+static double eager_world(job_scene *js)
+{
+    trace_renderer_destroy(&js->renderer);
+    js->world.options.lazy_roots = false;
+    char err[256];
+    double t0 = wall_now();
+    js->renderer = trace_renderer_new(&js->world, err, sizeof err);
+    double t = wall_now() - t0;
+    if (!js->renderer) { fprintf(stderr, "%s\n", err); exit(1); }
+    return t;
+}
+
+/* Root boxes made so far, over the scene's meshes */
+static long roots_known(const job_scene *js)
+{
+    long n = 0;
+    for (int i = 0; i < js->world.nobjects; i++)
+        if (js->world.objects[i].mesh && js->world.objects[i].mesh->lazy)
+            n += trace_lazy_roots_known(js->world.objects[i].mesh->lazy);
+    return n;
+}
+
 int main(int argc, char **argv)
 {
     int max_faces = argc > 1 ? atoi(argv[1]) : 100000;
     bool subdiv = argc > 2 && strcmp(argv[2], "subdiv") == 0;
+    bool displaced = argc > 2 && strcmp(argv[2], "displaced") == 0;
     int threads = (int)sysconf(_SC_NPROCESSORS_ONLN);
     if (threads < 1) threads = 1;
     printf("%s torus; build s: job_scene_new as a worker runs it (the parse again and the "
            "world, %d threads, wall seconds)\n",
-           subdiv ? "Catmull-Clark (SubdivisionMesh)" : "PointsPolygons", threads);
+           subdiv ? "Catmull-Clark (SubdivisionMesh)" : displaced ? "PointsPolygons, displaced" : "PointsPolygons", threads);
     printf("%9s %8s %8s %8s %8s %9s %12s %12s %9s %9s\n", "faces", "parse s", "build s",
            "render s", "objects", "pieces", "shared B/f", "beyond B/f", "(BVH B/f)", "peak MiB");
     for (int faces = 1000; faces <= max_faces; faces *= 10) {
         int nv = (int)sqrt(faces / 2.5), nu = faces / nv;
         size_t len;
-        char *text = torus_rib(nu, nv, subdiv, &len);
+        char *text = torus_rib(nu, nv, subdiv, displaced, &len);
         job_options opt;
         job_options_default(&opt);
         job *jb = job_new("torus.rib", text, len, &opt);
         free(text);
         char why[256];
+        if (displaced && (!job_add_source(jb, "bumps.sl", BUMPS_SL, strlen(BUMPS_SL), why,
+                                          sizeof why) ||
+                          !job_add_shader(jb, "bumps", "bumps.sl", why, sizeof why))) {
+            fprintf(stderr, "%s\n", why);
+            return 1;
+        }
         if (!job_finish(jb, why, sizeof why)) { fprintf(stderr, "%s\n", why); return 1; }
         sl_diag *d = sl_diag_new();
         double t0 = cpu_now();
@@ -114,6 +161,7 @@ int main(int argc, char **argv)
         job_scene *js = job_scene_new_threads(jb, 0, true, threads, NULL, d);
         double world = wall_now() - t0;
         if (!js) { sl_diag_print(d, stderr); return 1; }
+        long known_built = roots_known(js);
         t0 = cpu_now();
         trace_thread *th = trace_thread_new(&js->world);
         long hits = 0;
@@ -125,6 +173,7 @@ int main(int argc, char **argv)
             }
         double render = cpu_now() - t0;
         trace_thread_destroy(&th);
+        long known_rendered = roots_known(js);
         /* bytes: the scene's meshes (shared arrays and 16-byte pieces), the
          * world's per-piece arrays */
         size_t shared = 0, beyond = 0;
@@ -147,6 +196,11 @@ int main(int argc, char **argv)
         printf("%9d %8.3f %8.3f %8.3f %8d %9ld %12.1f %12.1f %9.1f %9ld   (%ld of 16384 pixels)\n",
                f, parse, world - parse, render, nobj, pieces, (double)shared / f,
                (double)beyond / f, (double)bvh / f, peak_mib(), hits);
+        if (displaced) {
+            printf("%9s root boxes: %ld made with the world, %ld after the render; the world "
+                   "built again with all %ld first (eager): %.3f s wall\n", "", known_built,
+                   known_rendered, pieces, eager_world(js));
+        }
         job_scene_destroy(&js);
         job_destroy(&jb);
         sl_diag_destroy(&d);

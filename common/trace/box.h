@@ -53,6 +53,19 @@ typedef struct trace_box {
     double slo, shi;         /* n . P over the cell, rounded outward */
 } trace_box;
 
+/* x as a float rounded down (up): the float boxes of BVHs */
+static inline float trace_float_down(double x)
+{
+    float f = (float)x;
+    return (double)f > x ? nextafterf(f, -INFINITY) : f;
+}
+
+static inline float trace_float_up(double x)
+{
+    float f = (float)x;
+    return (double)f < x ? nextafterf(f, INFINITY) : f;
+}
+
 static inline void trace_box_no_slab(trace_box *b)
 {
     b->sn[0] = b->sn[1] = b->sn[2] = b->pad = 0.0f;

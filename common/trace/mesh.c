@@ -2,9 +2,11 @@
  * mesh.c: mesh objects, their pieces' BVH and the views of pieces (see
  * mesh.h).
  *
- * The BVH over a mesh's pieces is built once per world (trace_renderer_new:
- * the displaced pieces' root boxes over build_threads threads, the tree by
- * one) and shared read-only by all threads: binned surface-area heuristic
+ * The BVH over a mesh's pieces is built once per world (trace_renderer_new,
+ * over build_threads threads; a displaced mesh's boxes from regions of the
+ * tree, its pieces' root boxes made when a ray first reaches them: see
+ * "a displaced mesh's boxes" below) and shared by all threads: binned
+ * surface-area heuristic
  * over the pieces' box centres (Wald, "On fast construction of SAH-based
  * bounding volume hierarchies", 2007: 12 bins along the axis where the
  * centres spread most, O(n log n)), a leaf holding up to LEAF_MAX pieces,
@@ -27,6 +29,8 @@
 #include <string.h>
 
 #include "trace/displace.h"
+#include "trace/lazy_roots.h"
+#include "trace/region.h"
 #include "util/xalloc.h"
 
 /* ---- views ---------------------------------------------------------- */
@@ -105,18 +109,22 @@ static bool make(trace_thread *th, const trace_object *mesh_obj, int k, bool box
         return false;
     }
     v->shared_edges = trace_mesh_shared_edges(m, k);
-    if (m->dudv && m->roots) {
-        /* displaced: what trace_mesh_build found, once */
-        v->du = m->dudv[k][0];
-        v->dv = m->dudv[k][1];
-    } else if (grid || v->displacement) {
+    double dudv[2];
+    const trace_box *known = m->lazy ? trace_lazy_root(m->lazy, k, dudv) : NULL;
+    if (known) {
+        v->du = dudv[0];               /* what a thread found first */
+        v->dv = dudv[1];
+    } else if (grid || (boxes && v->displacement)) {
         trace_object_grid_spacing(th->world, v);
     }
     if (boxes) {
-        if (v->displacement && m->roots) {
-            v->root = m->roots[k];
+        if (v->displacement && known) {
+            v->root = *known;
         } else if (v->displacement) {
             trace_surface_box(th, v, 0, 1, 0, 1, &v->root);
+            /* a pure function of the piece: the first thread's is every
+             * thread's (a failed or cancelled run is not one) */
+            if (m->lazy && !th->failed) trace_lazy_root_put(m->lazy, k, &v->root, v->du, v->dv);
         } else {
             geom_bounds(&v->surf, &v->root.lo, &v->root.hi);
             v->root.flags = 0;
@@ -254,18 +262,6 @@ struct trace_mesh_bvh {
  * leaves cost little (1.5 % of a render of 100,000 instances against
  * leaves of 4) and save nodes: 0.17 nodes an element instead of 0.58. */
 enum { LEAF_MAX = 16, BINS = 12, SAH_DEPTH = 40, MESH_STACK = 128, TASK_MAX = 8192 };
-
-static float down(double x)
-{
-    float f = (float)x;
-    return (double)f > x ? nextafterf(f, -INFINITY) : f;
-}
-
-static float up(double x)
-{
-    float f = (float)x;
-    return (double)f < x ? nextafterf(f, INFINITY) : f;
-}
 
 static double area_of(const float lo[3], const float hi[3])
 {
@@ -592,8 +588,9 @@ struct trace_mesh_bvh *trace_float_bvh_build(const float (*bounds)[6], int n, in
 
 void trace_float_box(const trace_box *b, float f[6])
 {
-    f[0] = down(b->lo.x), f[1] = down(b->lo.y), f[2] = down(b->lo.z);
-    f[3] = up(b->hi.x), f[4] = up(b->hi.y), f[5] = up(b->hi.z);
+    f[0] = trace_float_down(b->lo.x), f[1] = trace_float_down(b->lo.y);
+    f[2] = trace_float_down(b->lo.z);
+    f[3] = trace_float_up(b->hi.x), f[4] = trace_float_up(b->hi.y), f[5] = trace_float_up(b->hi.z);
 }
 
 void trace_mesh_piece_bounds(const geom_surface *s, float out[6])
@@ -640,58 +637,213 @@ bool trace_float_bvh_root(const struct trace_mesh_bvh *t, trace_box *out)
     return true;
 }
 
-/* One thread's share of the pieces' boxes: pieces [k0, k1) of obj with
- * its own trace_thread (VM, affine context) on the shared arrays. */
-typedef struct box_share {
-    trace_thread *th;                  /* the caller's, or made for this share */
-    const trace_object *obj;
-    trace_box *roots;
-    double (*dudv)[2];
-    int k0, k1;
-} box_share;
+/* ---- a displaced mesh's boxes (issue 23) -------------------------------
+ *
+ * A displaced mesh's pieces' root boxes are made when a ray first reaches
+ * them, not all when the world is built (17 us a piece for a height map:
+ * 35 s of CPU for a 1M-face terrain before its first ray). The BVH needs
+ * boxes that hold the displaced pieces before their own boxes exist:
+ *
+ *   1. each piece's undisplaced box over its (u,v) square (no shader), and
+ *      a BVH over those;
+ *   2. the BVH's subtrees of at most REGION_MAX pieces are regions
+ *      (trace/region.h): one pass over a region's pieces, without their
+ *      shader, gives the enclosures of its globals, and ONE affine run of
+ *      the shader over them (Heidrich & Seidel 1998 §3.1, §4.2) bounds the
+ *      displacement P' - P of every point of its pieces by `shift`, and
+ *      the region's displaced box; a piece's box is its undisplaced box
+ *      plus `shift`, met with the region's box (both hold every displaced
+ *      point of the piece);
+ *   3. the tree's boxes made again from those, bottom-up (its shape stays).
+ *
+ * A region the shader's inputs cannot be bound over (trace_region_add), or
+ * whose run fails, or whose displacement comes out wider than the whole
+ * mesh (a filter width from Du(s) on "st": boxes that large would send
+ * every ray to every leaf), has its pieces' root boxes made at once
+ * instead, and they are the pieces' boxes (as every piece's was before);
+ * so are all with world option lazy_roots off.
+ *
+ * Every box is a pure function of the scene (made by whichever thread
+ * first, the same bits), and the regions are the tree's, which is the
+ * same for any thread count: so is the result. */
+enum { REGION_MAX = 64 };
 
-static void *box_range(void *arg)
+/* The elements idx[first, first + count) of node id's subtree */
+static void node_range(const struct trace_mesh_bvh *t, int id, int *first, int *count)
 {
-    box_share *b = arg;
-    trace_mesh *m = b->obj->mesh;
-    trace_view *v = xmalloc(sizeof *v);
-    for (int k = b->k0; k < b->k1; k++) {
-        if (((k - b->k0) & 255) == 0 && trace_thread_cancelled(b->th)) break;
-        if (!make(b->th, b->obj, k, true, false, v)) break;
-        trace_float_box(&v->obj.root, m->bounds[k]);
-        if (b->roots) {
-            b->roots[k] = v->obj.root;
-            b->dudv[k][0] = v->obj.du;
-            b->dudv[k][1] = v->obj.dv;
+    int l = id, r = id;
+    while (t->nodes[l].n == 0) l = t->nodes[l].a;
+    while (t->nodes[r].n == 0) r = t->nodes[r].a + 1;
+    *first = t->nodes[l].a;
+    *count = t->nodes[r].a + t->nodes[r].n - *first;
+}
+
+/* The regions: the largest subtrees of at most REGION_MAX elements, as
+ * ranges of idx, in the tree's order */
+static int regions_of(const struct trace_mesh_bvh *t, int (*out)[2])
+{
+    int n = 0, stack[MESH_STACK], sp = 0;
+    stack[sp++] = 0;
+    while (sp > 0) {
+        int id = stack[--sp], first, count;
+        node_range(t, id, &first, &count);
+        if (count <= REGION_MAX || t->nodes[id].n > 0) {
+            out[n][0] = first;
+            out[n++][1] = count;
+            continue;
         }
+        assert(sp + 2 <= MESH_STACK);
+        stack[sp++] = t->nodes[id].a + 1;
+        stack[sp++] = t->nodes[id].a;
+    }
+    return n;
+}
+
+/* One thread's share of the regions: every stride-th from i0 */
+typedef struct region_share {
+    trace_thread *th;
+    const trace_object *obj;
+    const struct trace_mesh_bvh *bvh;
+    float (*bounds)[6];
+    const int (*regions)[2];
+    int nregions, i0, stride;
+    double extent;                     /* the mesh's undisplaced extent */
+    bool dudv;                         /* the shader reads du or dv */
+} region_share;
+
+/* Region [first, first + count) of idx: its pieces' boxes (above) */
+static void region_boxes(region_share *b, int first, int count, trace_view *v)
+{
+    trace_thread *th = b->th;
+    const int32_t *idx = b->bvh->idx + first;
+    trace_box box;
+    ia_interval shift[3];
+    bool lazy = th->world->options.lazy_roots;
+    if (lazy) {
+        trace_region *region = trace_region_new();
+        for (int i = 0; lazy && i < count; i++) {
+            lazy = make(th, b->obj, idx[i], false, b->dudv, v);
+            if (!b->dudv) v->obj.du = v->obj.dv = 0.0;     /* not known: any */
+            lazy = lazy && trace_region_add(th, region, &v->obj);
+        }
+        lazy = lazy && trace_region_run(th, b->obj, region, &box, shift);
+        trace_region_destroy(&region);
+        for (int a = 0; a < 3; a++) lazy = lazy && shift[a].hi - shift[a].lo <= b->extent;
+    }
+    if (th->failed) return;
+    if (!lazy) {
+        /* the pieces' own root boxes, now (published in the mesh's store) */
+        for (int i = 0; i < count; i++) {
+            if (!make(th, b->obj, idx[i], true, true, v)) return;
+            trace_float_box(&v->obj.root, b->bounds[idx[i]]);
+        }
+        return;
+    }
+    const double blo[3] = {box.lo.x, box.lo.y, box.lo.z}, bhi[3] = {box.hi.x, box.hi.y, box.hi.z};
+    for (int i = 0; i < count; i++) {
+        float *f = b->bounds[idx[i]];
+        for (int a = 0; a < 3; a++) {
+            /* its undisplaced box plus the shift, rounded outward, met with
+             * the region's box */
+            ia_interval x = ia_add(ia_make(f[a], f[3 + a]), shift[a]);
+            f[a] = trace_float_down(fmax(x.lo, blo[a]));
+            f[3 + a] = trace_float_up(fmin(x.hi, bhi[a]));
+        }
+    }
+}
+
+static void *region_range(void *arg)
+{
+    region_share *b = arg;
+    trace_view *v = xmalloc(sizeof *v);
+    for (int i = b->i0; i < b->nregions && !b->th->failed; i += b->stride) {
+        if (trace_thread_cancelled(b->th)) break;
+        region_boxes(b, b->regions[i][0], b->regions[i][1], v);
     }
     free(v);
     return NULL;
 }
 
-/* The pieces' boxes over `threads` threads (world options.build_threads):
- * each piece's box is a pure function of the piece, so the split changes
- * no bit. False with th failed (the first share's error) when one failed. */
-static bool boxes_in_parallel(trace_thread *th, const trace_object *obj, trace_box *roots,
-                              double (*dudv)[2])
+/* The tree's boxes made again, bottom-up, from new element boxes (a
+ * node's children come after it); its shape stays */
+static void refit(struct trace_mesh_bvh *t, const float (*bounds)[6])
 {
-    const trace_mesh *m = obj->mesh;
-    int threads = th->world->options.build_threads;
-    /* a thread is worth its start for a few thousand pieces of shader work */
-    if (threads > m->npieces / 2048) threads = m->npieces / 2048;
-    if (threads < 1) threads = 1;
-    box_share *share = xcalloc((size_t)threads, sizeof *share);
-    for (int i = 0; i < threads; i++)
-        share[i] = (box_share){i == 0 ? th : trace_thread_new(th->world), obj, roots, dudv,
-                               (int)((long)m->npieces * i / threads),
-                               (int)((long)m->npieces * (i + 1) / threads)};
-    trace_run_shares(share, sizeof *share, threads, box_range);
-    for (int i = 1; i < threads; i++) {
-        if (share[i].th->failed && !th->failed) trace_thread_fail(th, share[i].th->error);
-        trace_thread_destroy(&share[i].th);
+    for (int i = t->nnodes - 1; i >= 0; i--) {
+        mesh_node *n = &t->nodes[i];
+        for (int a = 0; a < 3; a++) n->lo[a] = INFINITY, n->hi[a] = -INFINITY;
+        if (n->n > 0) {
+            for (int j = 0; j < n->n; j++) grow(n->lo, n->hi, bounds[t->idx[n->a + j]]);
+            continue;
+        }
+        assert(n->a > i);
+        for (int c = 0; c < 2; c++) {
+            const mesh_node *ch = &t->nodes[n->a + c];
+            float cb[6] = {ch->lo[0], ch->lo[1], ch->lo[2], ch->hi[0], ch->hi[1], ch->hi[2]};
+            grow(n->lo, n->hi, cb);
+        }
     }
-    free(share);
-    return !th->failed;
+    for (int i = 0; i < t->nnodes; i++)
+        if (t->nodes[i].n > 0) quantize_leaf(t, &t->nodes[i], bounds);
+}
+
+/* The threads worth starting for `work` pieces */
+static int build_threads_for(const trace_thread *th, long work)
+{
+    int threads = th->world->options.build_threads;
+    /* a thread is worth its start for a few thousand pieces of work */
+    if (threads > work / 2048) threads = (int)(work / 2048);
+    return threads < 1 ? 1 : threads;
+}
+
+/* The threads made for shares 1.. (share 0 is the caller's), failures
+ * passed to th, then freed */
+static void end_threads(trace_thread *th, trace_thread **made, int threads)
+{
+    for (int i = 1; i < threads; i++) {
+        if (made[i]->failed && !th->failed) trace_thread_fail(th, made[i]->error);
+        trace_thread_destroy(&made[i]);
+    }
+}
+
+/* The displaced mesh's BVH over boxes that hold its pieces (above) */
+static void build_displaced(trace_thread *th, const trace_object *obj)
+{
+    trace_mesh *m = obj->mesh;
+    size_t n = (size_t)(m->npieces > 0 ? m->npieces : 1);
+    /* the pieces' undisplaced boxes (trace_world_prepare's pass) */
+    float (*bounds)[6] = m->bounds;
+    m->bounds = NULL;
+    int threads = build_threads_for(th, m->npieces);
+    trace_thread **made = xcalloc((size_t)threads, sizeof *made);
+    for (int i = 0; i < threads; i++) made[i] = i == 0 ? th : trace_thread_new(th->world);
+    {
+        m->bvh = trace_float_bvh_build((const float (*)[6])bounds, m->npieces,
+                                       th->world->options.build_threads);
+        m->lazy = trace_lazy_roots_new(m->npieces);
+        const mesh_node *root = &m->bvh->nodes[0];
+        double extent = 0.0;
+        for (int a = 0; a < 3; a++) extent = fmax(extent, (double)root->hi[a] - root->lo[a]);
+        int (*regions)[2] = xmalloc(sizeof *regions * n);
+        int nregions = regions_of(m->bvh, regions);
+        const sl_program *dp = sl_instance_program(obj->displacement);
+        bool dudv = sl_program_reads_global(dp, SL_G_du) || sl_program_reads_global(dp, SL_G_dv);
+        region_share *rs = xcalloc((size_t)threads, sizeof *rs);
+        for (int i = 0; i < threads; i++)
+            rs[i] = (region_share){made[i], obj, m->bvh, bounds, (const int (*)[2])regions,
+                                   nregions, i, threads, extent, dudv};
+        trace_run_shares(rs, sizeof *rs, threads, region_range);
+        free(rs);
+        free(regions);
+        refit(m->bvh, (const float (*)[6])bounds);
+    }
+    end_threads(th, made, threads);
+    free(made);
+    free(bounds);
+    if (th->failed || trace_thread_cancelled(th)) {
+        /* a failure, or a signal: no tree (the boxes may be unfinished) */
+        trace_lazy_roots_destroy(&m->lazy);
+        trace_float_bvh_free(&m->bvh);
+    }
 }
 
 bool trace_mesh_build(trace_thread *th, trace_object *obj)
@@ -699,23 +851,17 @@ bool trace_mesh_build(trace_thread *th, trace_object *obj)
     trace_mesh *m = obj->mesh;
     assert(m);
     if (!m->bvh) {                     /* not yet made for another object sharing m */
-        if (obj->displacement || !m->bounds) {
-            /* displaced: each piece's root box runs its shader (undisplaced:
-             * trace_world_prepare's pass over the pieces made the bounds) */
-            size_t n = (size_t)(m->npieces > 0 ? m->npieces : 1);
-            assert(!m->bounds && !m->roots && !m->dudv);   /* trace_world_prepare cleared them */
-            m->bounds = xmalloc(sizeof *m->bounds * n);
-            trace_box *roots = obj->displacement ? xmalloc(sizeof *roots * n) : NULL;
-            double (*dudv)[2] = obj->displacement ? xmalloc(sizeof *dudv * n) : NULL;
-            boxes_in_parallel(th, obj, roots, dudv);
-            m->roots = roots;          /* from now on, views take these */
-            m->dudv = dudv;
+        /* trace_world_prepare's pass over the pieces made the bounds */
+        assert(!m->lazy && m->bounds);
+        if (obj->displacement) {
+            build_displaced(th, obj);
+        } else {
+            m->bvh = trace_float_bvh_build((const float (*)[6])m->bounds, m->npieces,
+                                           th->world->options.build_threads);
+            free(m->bounds);           /* the tree keeps them, quantized */
+            m->bounds = NULL;
         }
         if (th->failed) return false;
-        m->bvh = trace_float_bvh_build((const float (*)[6])m->bounds, m->npieces,
-                                       th->world->options.build_threads);
-        free(m->bounds);               /* the tree keeps them, quantized */
-        m->bounds = NULL;
     }
     /* the root: the union of the pieces' boxes (object space), the
      * bound: its camera-space box, as any object's */
@@ -813,9 +959,10 @@ static int mesh_leaf(void *ctx, int k)
 {
     mesh_walk *w = ctx;
     const trace_mesh *m = w->obj->mesh;
-    double r0, r1;
+    double r0, r1, dudv[2];
     /* a displaced piece's root box, as its walk tests it */
-    if (m->roots && !trace_box_hit(&m->roots[k], w->ray, w->ray->tmin, w->best->t, &r0, &r1, NULL))
+    const trace_box *root = m->lazy ? trace_lazy_root(m->lazy, k, dudv) : NULL;
+    if (root && !trace_box_hit(root, w->ray, w->ray->tmin, w->best->t, &r0, &r1, NULL))
         return 0;
     const trace_object *v = trace_mesh_view(w->th, w->obj, k);
     if (!v) return -1;
@@ -899,13 +1046,10 @@ void trace_mesh_clear(trace_mesh *self)
     self->wide = NULL;
     self->nwide = 0;
     free(self->bounds);
-    free(self->roots);
-    free(self->dudv);
+    trace_lazy_roots_destroy(&self->lazy);
     trace_float_bvh_free(&self->bvh);
     self->shared_edges = NULL;
     self->bounds = NULL;
-    self->roots = NULL;
-    self->dudv = NULL;
 }
 
 size_t trace_mesh_bytes(const trace_mesh *self)
@@ -915,6 +1059,6 @@ size_t trace_mesh_bytes(const trace_mesh *self)
     if (self->shared_edges) b += n * sizeof *self->shared_edges;
     b += (size_t)self->nwide * sizeof *self->wide;
     if (self->bounds) b += n * sizeof *self->bounds;
-    if (self->roots) b += n * (sizeof *self->roots + sizeof *self->dudv);
+    b += trace_lazy_roots_bytes(self->lazy);
     return b + trace_float_bvh_bytes(self->bvh, self->npieces);
 }

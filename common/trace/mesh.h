@@ -16,9 +16,10 @@
  * shadow and trace() rays its shader casts cannot overwrite it.
  *
  * Per piece, a worker holds the scene's 16-byte piece, its shared edges
- * and its share of the BVH (docs/renderer.md "Meshes"); the box cache
- * holds the displaced pieces' refinement trees under its budget, as for
- * any object.
+ * and its share of the BVH (docs/renderer.md "Meshes"), and a displaced
+ * piece's root box and du/dv once a ray has reached it (lazy_roots.h); the
+ * box cache holds the displaced pieces' refinement trees under its budget,
+ * as for any object.
  */
 #ifndef TRACE_MESH_H
 #define TRACE_MESH_H
@@ -81,9 +82,11 @@ void trace_mesh_piece_bounds(const geom_surface *s, float out[6]);
 
 /* The pieces' boxes and BVH of mesh object obj's mesh (once for the
  * objects that share it), and obj's root (their union, object space) and
- * camera-space bound; false when the thread failed or was cancelled. A
- * displaced mesh's root boxes are shared among world options.build_threads
- * threads (the same boxes, to the bit, for any count). */
+ * camera-space bound; false when the thread failed (cancelled: no tree).
+ * A displaced mesh's boxes come from regions of its tree (its pieces' root
+ * boxes are made when a ray first reaches them: mesh.c), over world
+ * options.build_threads threads (the same boxes, to the bit, for any
+ * count). */
 bool trace_mesh_build(trace_thread *th, trace_object *obj);
 
 /* Nearest hit of the camera-space ray with the mesh's pieces in

@@ -68,8 +68,10 @@ typedef struct region_pv {
     ia_interval v[3], du[3], dv[3];
 } region_pv;
 
-/* What the pieces' visit found */
-typedef struct region_hull {
+/* What the pieces' visit found: a region */
+struct trace_region {
+    int count;                         /* pieces added (0: every hull empty) */
+    bool refused;                      /* a piece the region cannot bind */
     ia_interval B[3];                  /* undisplaced, object space */
     ia_interval N[3];                  /* unit normal, camera space */
     ia_interval dPdu[3], dPdv[3];      /* camera space */
@@ -78,8 +80,7 @@ typedef struct region_hull {
     int npv;
     region_pv pv[TRACE_MAX_PRIMVARS];
     int kinds[TRACE_MAX_PRIMVARS][3];  /* the first piece's variables: global, param, size */
-} region_hull;
-
+};
 static void hull3(ia_interval h[3], const ia_interval x[3], bool first)
 {
     for (int i = 0; i < 3; i++) h[i] = first ? x[i] : ia_hull(h[i], x[i]);
@@ -90,9 +91,17 @@ static void hull3(ia_interval h[3], const ia_interval x[3], bool first)
 static ia_interval poly_range(const double c[16][3], int k, int dk)
 {
     ia_interval unit = ia_make(0.0, 1.0), acc = ia_point(0.0);
-    for (int j = 3; j >= 0; j--) {
+    /* the degrees the coefficients reach (zero terms add nothing) */
+    int di = 0, dj = 0;
+    for (int i = 0; i < 4; i++)
+        for (int j = 0; j < 4; j++)
+            if (c[i + 4 * j][k] != 0.0) {
+                di = i > di ? i : di;
+                dj = j > dj ? j : dj;
+            }
+    for (int j = dj; j >= 0; j--) {
         ia_interval q = ia_point(0.0);
-        for (int i = 3; i >= 0; i--) {
+        for (int i = di; i >= 0; i--) {
             int si = dk == 1 ? i + 1 : i, sj = dk == 2 ? j + 1 : j;
             double a = si < 4 && sj < 4 ? c[si + 4 * sj][k] : 0.0;
             ia_interval t = ia_point(a);
@@ -112,7 +121,7 @@ static bool region_global(sl_global g)
 }
 
 /* The piece's primitive variables into the hull; false: refused */
-static bool hull_primvars(const trace_object *obj, region_hull *h, bool first)
+static bool hull_primvars(const trace_object *obj, trace_region *h, bool first)
 {
     if (first) h->npv = obj->nprimvars;
     if (obj->nprimvars != h->npv) return false;
@@ -144,12 +153,14 @@ static bool hull_primvars(const trace_object *obj, region_hull *h, bool first)
 
 /* Piece obj (a view) into the hull: no shader, its geometry's affine
  * forms over its whole (u,v) square as box_affine makes them */
-static bool hull_piece(trace_thread *th, const trace_object *obj, region_hull *h, bool first)
+static bool hull_piece(trace_thread *th, const trace_object *obj, trace_region *h, bool first,
+                       ia_interval base[3])
 {
     vec3 lo, hi;
     geom_bounds(&obj->surf, &lo, &hi);
     ia_interval B[3] = {ia_make(lo.x, hi.x), ia_make(lo.y, hi.y), ia_make(lo.z, hi.z)};
     if (!obj->displacement) {
+        for (int i = 0; i < 3; i++) base[i] = B[i];
         hull3(h->B, B, first);
         return true;
     }
@@ -164,7 +175,7 @@ static bool hull_piece(trace_thread *th, const trace_object *obj, region_hull *h
      * the surface (a polygon's is its bounding rectangle: the piece's box
      * holds that): the square's base points too */
     ia_interval r[3];
-    for (int i = 0; i < 3; i++) r[i] = ia_hull(B[i], aa_range(&g.P[i]));
+    for (int i = 0; i < 3; i++) base[i] = r[i] = ia_hull(B[i], aa_range(&g.P[i]));
     hull3(h->B, r, first);
     geom_unit_normal_aa(ctx, &obj->surf, &u, &v, &g, Nn);
     trace_camera_normal_aa(ctx, obj, Nn, N);
@@ -179,8 +190,12 @@ static bool hull_piece(trace_thread *th, const trace_object *obj, region_hull *h
         hull3(h->dPdv, r, first);
     }
     h->flat = (first || h->flat) && trace_surface_flat(obj);
-    h->du = first ? ia_point(obj->du) : ia_hull(h->du, ia_point(obj->du));
-    h->dv = first ? ia_point(obj->dv) : ia_hull(h->dv, ia_point(obj->dv));
+    /* du, dv of 0: not made (a shader that never reads them); any value
+     * trace_object_grid_spacing may give */
+    ia_interval du = obj->du > 0 ? ia_point(obj->du) : ia_make(0x1p-16, 1.0);
+    ia_interval dv = obj->dv > 0 ? ia_point(obj->dv) : ia_make(0x1p-16, 1.0);
+    h->du = first ? du : ia_hull(h->du, du);
+    h->dv = first ? dv : ia_hull(h->dv, dv);
     return hull_primvars(obj, h, first);
 }
 
@@ -211,13 +226,15 @@ static ia_interval widen(ia_interval x)
 }
 
 /* The shader's one run over the region (hull h, every piece visited) */
-static bool region_run(trace_thread *th, const trace_object *mobj, const region_hull *h,
-                       trace_box *out)
+static bool region_run(trace_thread *th, const trace_object *mobj, const trace_region *h,
+                       trace_box *out, ia_interval shift[3])
 {
     aa_context ctx;
     aa_context_init(&ctx, th->world->options.aa_capacity + 6);
     aa_form Po[3], P[3], u, v, N[3], dPdu[3], dPdv[3];
-    for (int i = 0; i < 3; i++) aa_input(&ctx, &Po[i], h->B[i].lo, h->B[i].hi);
+    ia_interval B[3];
+    for (int i = 0; i < 3; i++) B[i] = widen(h->B[i]);
+    for (int i = 0; i < 3; i++) aa_input(&ctx, &Po[i], B[i].lo, B[i].hi);
     aa_input(&ctx, &u, 0.0, 1.0);
     aa_input(&ctx, &v, 0.0, 1.0);
     for (int i = 0; i < 3; i++) aa_input(&ctx, &N[i], h->N[i].lo, h->N[i].hi);
@@ -264,10 +281,12 @@ static bool region_run(trace_thread *th, const trace_object *mobj, const region_
     unsigned flags = 0;
     for (int i = 0; i < 3; i++) {
         aa_sub(&ctx, &D, &Pn[i], &Po[i]);       /* the shift: P's symbols cancel */
-        ia_interval a = aa_range(&Pn[i]), b = ia_add(h->B[i], aa_range(&D));
+        ia_interval d = aa_range(&D), a = aa_range(&Pn[i]), b = ia_add(B[i], d);
         flags |= Pn[i].flags | D.flags;
         r[i] = ia_make(fmax(a.lo, b.lo), fmin(a.hi, b.hi));
         if (!(r[i].lo <= r[i].hi) || !isfinite(r[i].lo) || !isfinite(r[i].hi)) return false;
+        if (shift && !(isfinite(d.lo) && isfinite(d.hi))) return false;
+        if (shift) shift[i] = d;
     }
     out->lo = v3(r[0].lo, r[1].lo, r[2].lo);
     out->hi = v3(r[0].hi, r[1].hi, r[2].hi);
@@ -277,38 +296,129 @@ static bool region_run(trace_thread *th, const trace_object *mobj, const region_
     return true;
 }
 
+trace_region *trace_region_new(void)
+{
+    return xcalloc(1, sizeof(trace_region));
+}
+
+void trace_region_destroy(trace_region **self)
+{
+    free(*self);
+    *self = NULL;
+}
+
+bool trace_region_add(trace_thread *th, trace_region *self, const trace_object *piece)
+{
+    ia_interval b[3];
+    bool first = self->count == 0;
+    self->count++;
+    if (!hull_piece(th, piece, self, first, b)) self->refused = true;
+    return !self->refused;
+}
+
+void trace_region_base(aa_context *ctx, const geom_surface *surf, float base[6])
+{
+    vec3 lo, hi;
+    geom_bounds(surf, &lo, &hi);
+    ia_interval b[3] = {ia_make(lo.x, hi.x), ia_make(lo.y, hi.y), ia_make(lo.z, hi.z)};
+    /* the square's base points too, as hull_piece */
+    aa_context_reset(ctx);
+    aa_form u, v;
+    aa_input(ctx, &u, 0.0, 1.0);
+    aa_input(ctx, &v, 0.0, 1.0);
+    geom_aa g;
+    geom_eval_aa(ctx, surf, &u, &v, &g);
+    for (int i = 0; i < 3; i++) {
+        b[i] = widen(ia_hull(b[i], aa_range(&g.P[i])));
+        base[i] = trace_float_down(b[i].lo);
+        base[3 + i] = trace_float_up(b[i].hi);
+    }
+}
+
+void trace_region_merge(trace_region *into, const trace_region *from)
+{
+    if (from->count == 0) return;
+    if (into->count == 0) {
+        *into = *from;
+        return;
+    }
+    into->count += from->count;
+    into->refused |= from->refused;
+    if (into->refused) return;
+    hull3(into->B, from->B, false);
+    hull3(into->N, from->N, false);
+    hull3(into->dPdu, from->dPdu, false);
+    hull3(into->dPdv, from->dPdv, false);
+    into->du = ia_hull(into->du, from->du);
+    into->dv = ia_hull(into->dv, from->dv);
+    into->flat = into->flat && from->flat;
+    if (into->npv != from->npv) {
+        into->refused = true;
+        return;
+    }
+    for (int i = 0; i < into->npv; i++) {
+        for (int k = 0; k < 3; k++)
+            if (into->kinds[i][k] != from->kinds[i][k]) {
+                into->refused = true;
+                return;
+            }
+        region_pv *a = &into->pv[i];
+        const region_pv *b = &from->pv[i];
+        if (into->kinds[i][0] == (int)SL_G__COUNT) continue;
+        for (int k = 0; k < a->size; k++) {
+            a->v[k] = ia_hull(a->v[k], b->v[k]);
+            a->du[k] = ia_hull(a->du[k], b->du[k]);
+            a->dv[k] = ia_hull(a->dv[k], b->dv[k]);
+        }
+    }
+}
+
+bool trace_region_run(trace_thread *th, const trace_object *mesh_obj, const trace_region *self,
+                      trace_box *out, ia_interval shift[3])
+{
+    assert(mesh_obj->mesh);
+    unbounded_box(out);
+    if (self->count == 0 || self->refused) return false;
+    bool ok;
+    if (mesh_obj->displacement) {
+        ok = region_run(th, mesh_obj, self, out, shift);
+    } else {
+        ia_interval B[3];
+        for (int i = 0; i < 3; i++) B[i] = widen(self->B[i]);
+        out->lo = v3(B[0].lo, B[1].lo, B[2].lo);
+        out->hi = v3(B[0].hi, B[1].hi, B[2].hi);
+        out->flags = 0;
+        out->bend = 0.0f;
+        if (shift)
+            for (int i = 0; i < 3; i++) shift[i] = ia_point(0.0);
+        ok = true;
+    }
+    if (!ok) unbounded_box(out);
+    return ok;
+}
+
 bool trace_mesh_region_box(trace_thread *th, const trace_object *mesh_obj, const int *pieces,
                            int n, trace_box *out)
 {
     assert(mesh_obj->mesh && n >= 0);
-    unbounded_box(out);
     if (n == 0) {
+        unbounded_box(out);
         out->lo = v3(INFINITY, INFINITY, INFINITY);
         out->hi = v3(-INFINITY, -INFINITY, -INFINITY);
         out->flags = 0;
         return true;
     }
-    region_hull *h = xmalloc(sizeof *h);
+    trace_region *h = trace_region_new();
     trace_view *view = xmalloc(sizeof *view);
     bool ok = true;
     for (int i = 0; ok && i < n; i++) {
         assert(pieces[i] >= 0 && pieces[i] < mesh_obj->mesh->npieces);
         ok = trace_mesh_view_make(th, mesh_obj, pieces[i], false, view) &&
-             hull_piece(th, &view->obj, h, i == 0);
+             trace_region_add(th, h, &view->obj);
     }
     free(view);
-    if (ok) {
-        for (int i = 0; i < 3; i++) h->B[i] = widen(h->B[i]);
-        if (mesh_obj->displacement) {
-            ok = region_run(th, mesh_obj, h, out);
-        } else {
-            out->lo = v3(h->B[0].lo, h->B[1].lo, h->B[2].lo);
-            out->hi = v3(h->B[0].hi, h->B[1].hi, h->B[2].hi);
-            out->flags = 0;
-            out->bend = 0.0f;
-        }
-    }
-    free(h);
+    ok = ok && trace_region_run(th, mesh_obj, h, out, NULL);
+    trace_region_destroy(&h);
     if (!ok) unbounded_box(out);
     return ok;
 }

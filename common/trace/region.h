@@ -32,4 +32,31 @@
 bool trace_mesh_region_box(trace_thread *th, const trace_object *mesh_obj, const int *pieces,
                            int n, trace_box *out);
 
+/* The same in steps, for a pass over many pieces on several threads (the
+ * lazy root boxes of mesh.c): a region's enclosures start empty, take
+ * pieces (views) one by one, merge (the hulls are exact minima and
+ * maxima: any order gives the same bits), and run the shader once. */
+typedef struct trace_region trace_region;
+trace_region *trace_region_new(void);
+void trace_region_destroy(trace_region **self);
+
+/* Adds piece view `piece` (made with its du/dv, trace_mesh_view_make).
+ * False where the region must refuse the piece (its primitive variables:
+ * see above); the region then stays refused. */
+bool trace_region_add(trace_thread *th, trace_region *self, const trace_object *piece);
+/* A displaced piece's undisplaced object-space box over its whole (u,v)
+ * square (lo, hi), rounded outward, from its surface: its displaced points
+ * lie in it plus the `shift` of any region it is in (trace_region_run).
+ * ctx: a context of at least 2 symbols, reset here. */
+void trace_region_base(aa_context *ctx, const geom_surface *surf, float base[6]);
+void trace_region_merge(trace_region *into, const trace_region *from);
+
+/* The region's box, as trace_mesh_region_box; with `shift` (may be NULL)
+ * also an enclosure of the displacement itself, P' - P in object space,
+ * over every point of every piece: a piece's displaced points lie in its
+ * trace_region_base box plus `shift`. False (the unbounded box) as above, and for an
+ * empty or refused region. */
+bool trace_region_run(trace_thread *th, const trace_object *mesh_obj, const trace_region *self,
+                      trace_box *out, ia_interval shift[3]);
+
 #endif

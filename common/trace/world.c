@@ -9,6 +9,7 @@
 #include "trace/world.h"
 #include "trace/group.h"
 #include "trace/mesh.h"
+#include "trace/region.h"
 #include "util/err.h"
 #include "util/xalloc.h"
 
@@ -236,7 +237,7 @@ static void add_edges(world_edge **e, size_t *n, size_t *cap, const geom_surface
 }
 
 /* One thread's share of a mesh's pieces [k0, k1): their edges (in piece
- * order) and, undisplaced, their bounds. */
+ * order) and their bounds (displaced: undisplaced, over their squares). */
 typedef struct edge_share {
     const trace_object *obj;
     int k0, k1;
@@ -249,10 +250,13 @@ static void *mesh_edges(void *arg)
     edge_share *sh = arg;
     trace_mesh *m = sh->obj->mesh;
     geom_surface *tmp = xmalloc(sizeof *tmp);
+    aa_context ctx;
+    aa_context_init(&ctx, 2);
     for (int k = sh->k0; k < sh->k1; k++) {
         int npv;
         if (!m->piece(m->user, sh->obj, k, tmp, NULL, &npv)) continue;
         if (!sh->obj->displacement) trace_mesh_piece_bounds(tmp, m->bounds[k]);
+        else trace_region_base(&ctx, tmp, m->bounds[k]);   /* before its regions' shift */
         add_edges(&sh->e, &sh->n, &sh->cap, tmp, sh->obj, m->first_id + k);
     }
     free(tmp);
@@ -324,8 +328,7 @@ static void find_shared_edges(trace_world *world, const int *meshes, int nmeshes
     for (int j = 0; j < nmeshes; j++) {
         trace_object *obj = &world->objects[meshes[j]];
         trace_mesh *m = obj->mesh;
-        if (!obj->displacement)
-            m->bounds = xmalloc(sizeof *m->bounds * (size_t)(m->npieces > 0 ? m->npieces : 1));
+        m->bounds = xmalloc(sizeof *m->bounds * (size_t)(m->npieces > 0 ? m->npieces : 1));
         mesh_edges_in_parallel(world, obj, &e, &n, &cap);
     }
     sort_edges(e, n);

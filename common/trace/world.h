@@ -74,13 +74,15 @@ typedef struct trace_mesh {
     struct trace_mesh_edges *wide; /* and its bits 8-63 (polygons of more
                                       than 8 corners), by piece, nwide */
     int nwide;
-    float (*bounds)[6];            /* per piece: object-space box (lo, hi) of
-                                      its root box, rounded outward; freed
-                                      once the BVH (which keeps them in 6
-                                      bytes each) is built */
-    trace_box *roots;              /* displaced: per piece, its root box (its
-                                      shader run over the whole piece once) */
-    double (*dudv)[2];             /* displaced: per piece, its du and dv */
+    float (*bounds)[6];            /* per piece: object-space box (lo, hi),
+                                      rounded outward (displaced: undisplaced,
+                                      over its (u,v) square: mesh.c adds its
+                                      region's shift); freed once the BVH
+                                      (which keeps them in 6 bytes each) is
+                                      built */
+    struct trace_lazy_roots *lazy; /* displaced: the pieces' root boxes and
+                                      du/dv, made when a ray first reaches
+                                      them (mesh.c) */
     struct trace_mesh_bvh *bvh;    /* over the pieces' bounds */
 } trace_mesh;
 
@@ -219,6 +221,9 @@ typedef struct trace_options {
     int build_threads;             /* threads trace_renderer_new may use for
                                       the boxes of displaced meshes' pieces
                                       (0, 1: the calling thread alone) */
+    bool lazy_roots;               /* a displaced mesh's root boxes made when
+                                      a ray first reaches its pieces (mesh.c);
+                                      off: all of them when the world is built */
     bool prove_hits;               /* try hit proofs on small cells
                                       (trace/prove.h); off: leaves only */
     const atomic_int *cancel;      /* the program's stop flag (a signal), or
