@@ -138,71 +138,62 @@ static rib_token make(rib_lexer *self, rib_token_kind kind, const char *start)
 /* numbers                                                                 */
 /* ---------------------------------------------------------------------- */
 
-/* Reads s[0..n) as a RIB number: false when it is not exactly one.
- * *fast is set, with its value in *v, when the value can be had without
- * strtod and be the same double: at most 15 significant digits (the whole
- * number then fits a double exactly) and a power of ten within 10^22
- * (exact too), so that the one multiplication or division is the correctly
- * rounded result strtod gives (Clinger 1990, the fast path). */
-static bool read_number(const char *s, size_t n, bool *fast, double *v)
+/* Reads the number at self->p in one pass: its syntax and its value
+ * together, then (a number must end at a delimiter) the rest of the run of
+ * non-delimiter bytes, so that "1.2.3" and "12abc" are one bad token.
+ * The value is had without strtod when it can be the same double: at most
+ * 15 significant digits (the whole number then fits a double exactly) and
+ * a power of ten within 10^22 (exact too), so that the one multiplication
+ * or division is the correctly rounded result strtod gives (Clinger 1990,
+ * the fast path); any other number goes to strtod
+ * (tests/scene/test_scene_numbers.c holds both to strtod). */
+static rib_token lex_number(rib_lexer *self)
 {
     static const double pow10[] = { 1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10,
                                     1e11, 1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19,
                                     1e20, 1e21, 1e22 };
-    size_t i = 0, digits = 0;
-    bool negative = false;
+    const char *start = self->p, *q = start, *end = self->end;
+    size_t digits = 0;
+    bool negative = false, ok = true;
     uint64_t m = 0;
     int significant = 0, scale = 0;    /* value: m * 10^(scale + exponent) */
-    if (i < n && (s[i] == '+' || s[i] == '-'))
-        negative = s[i++] == '-';
-    for (; i < n && is_digit(s[i]); i++, digits++)
-        if (m > 0 || s[i] != '0') {
-            if (++significant <= 15) m = m * 10 + (uint64_t)(s[i] - '0');
+    if (q < end && (*q == '+' || *q == '-'))
+        negative = *q++ == '-';
+    for (; q < end && is_digit(*q); q++, digits++)
+        if (m > 0 || *q != '0') {
+            if (++significant <= 15) m = m * 10 + (uint64_t)(*q - '0');
         }
-    if (i < n && s[i] == '.') {
-        for (i++; i < n && is_digit(s[i]); i++, digits++)
-            if (m > 0 || s[i] != '0') {
-                if (++significant <= 15) { m = m * 10 + (uint64_t)(s[i] - '0'); scale--; }
+    if (q < end && *q == '.') {
+        for (q++; q < end && is_digit(*q); q++, digits++)
+            if (m > 0 || *q != '0') {
+                if (++significant <= 15) { m = m * 10 + (uint64_t)(*q - '0'); scale--; }
             } else {
                 scale--;                     /* a leading zero after the point */
             }
     }
-    if (digits == 0)
-        return false;
+    ok = digits > 0;
     long exponent = 0;
-    if (i < n && (s[i] == 'e' || s[i] == 'E')) {
-        i++;
+    if (ok && q < end && (*q == 'e' || *q == 'E')) {
+        q++;
         bool exp_negative = false;
-        if (i < n && (s[i] == '+' || s[i] == '-'))
-            exp_negative = s[i++] == '-';
+        if (q < end && (*q == '+' || *q == '-'))
+            exp_negative = *q++ == '-';
         size_t exp_digits = 0;
-        for (; i < n && is_digit(s[i]); i++, exp_digits++)
-            if (exponent < 100000) exponent = exponent * 10 + (s[i] - '0');
-        if (exp_digits == 0)
-            return false;
+        for (; q < end && is_digit(*q); q++, exp_digits++)
+            if (exponent < 100000) exponent = exponent * 10 + (*q - '0');
+        ok = exp_digits > 0;
         if (exp_negative) exponent = -exponent;
     }
-    if (i != n)
-        return false;
-    long e = scale + exponent;
-    *fast = significant <= 15 && (m == 0 || (e >= -22 && e <= 22));
-    if (*fast) {
-        double x = m == 0 ? 0.0 : e >= 0 ? (double)m * pow10[e] : (double)m / pow10[-e];
-        *v = negative ? -x : x;
+    if (q < end && !is_delimiter(*q)) {    /* more of the word: not a number */
+        ok = false;
+        while (q < end && !is_delimiter(*q))
+            q++;
     }
-    return true;
-}
-
-static rib_token lex_number(rib_lexer *self)
-{
-    const char *start = self->p;
-    while (self->p < self->end && !is_delimiter(*self->p))
-        self->p++;
+    self->p = q;
     rib_token t = make(self, RIB_TOK_NUMBER, start);
     int shown = t.len > 40 ? 40 : (int)t.len;
     const char *more = t.len > 40 ? "..." : "";
-    bool fast = false;
-    if (!read_number(start, t.len, &fast, &t.number)) {
+    if (!ok) {
         bad(self, &t, "bad number '%.*s%s'", shown, start, more);
         return t;
     }
@@ -211,8 +202,12 @@ static rib_token lex_number(rib_lexer *self)
         bad(self, &t, "number '%.*s%s' is too long", shown, start, more);
         return t;
     }
-    if (fast)
+    long e = scale + exponent;
+    if (significant <= 15 && (m == 0 || (e >= -22 && e <= 22))) {
+        double x = m == 0 ? 0.0 : e >= 0 ? (double)m * pow10[e] : (double)m / pow10[-e];
+        t.number = negative ? -x : x;
         return t;
+    }
     memcpy(buf, start, t.len);
     buf[t.len] = '\0';
     t.number = strtod(buf, NULL);
