@@ -383,10 +383,28 @@ static void read_mesh(rib_parser *p, const rib_request *req, const int *nloops, 
     } else {
         m.N = smooth = smooth_normals(m.npoints, P->values, nloops, nfaces, nverts, idx);
     }
+    bool taken = false;                /* idx and smooth are the mesh's */
 #ifdef SCENE_HAVE_GEOM
-    m.out = p->check ? scene_mesh_new_counted(m.pv.n)     /* a check keeps no arrays */
-                     : scene_mesh_new(P->values, m.npoints, idx, nidx, m.ncls, m.N,
-                                      N ? N->count / 3 : m.npoints, &m.pv, &params);
+    if (p->check) {
+        m.out = scene_mesh_new_counted(m.pv.n);        /* a check keeps no arrays */
+    } else {
+        /* the mesh takes the arrays as they are (P's and N's values out
+         * of params, the smooth normals, the indices): no copies; m's
+         * pointers stay valid while it lives */
+        scene_param *Pp = &params.items[P - params.items];
+        double *Nv = smooth;
+        int nN = m.npoints;
+        if (N) {
+            scene_param *Np = &params.items[N - params.items];
+            Nv = Np->values;
+            Np->values = NULL;
+            nN = N->count / 3;
+        }
+        m.out = scene_mesh_new_taking(Pp->values, m.npoints, idx, nidx, m.ncls, Nv, nN, &m.pv,
+                                      &params);
+        Pp->values = NULL;
+        taken = true;
+    }
     m.scratch = xcalloc(1, sizeof *m.scratch);
 #endif
     const int *loop = nverts, *vi = idx;
@@ -397,6 +415,10 @@ static void read_mesh(rib_parser *p, const rib_request *req, const int *nloops, 
         add_face(p, &m, f, loop, nl, vi);
         loop += nl;
         vi += npts;
+    }
+    if (taken) {
+        idx = NULL;
+        smooth = NULL;
     }
     free(smooth);
     free(m.scratch);
