@@ -138,21 +138,29 @@ static rib_token make(rib_lexer *self, rib_token_kind kind, const char *start)
 /* numbers                                                                 */
 /* ---------------------------------------------------------------------- */
 
-/* Reads the number at self->p in one pass: its syntax and its value
+/* How a run of bytes reads as a number (scan_number). */
+typedef enum number_kind {
+    NUMBER_BAD,          /* not the RIB number syntax */
+    NUMBER_FAST,         /* its value is had without strtod */
+    NUMBER_STRTOD,       /* its value is strtod's */
+} number_kind;
+
+/* Reads the number at p (before end) in one pass: its syntax and its value
  * together, then (a number must end at a delimiter) the rest of the run of
- * non-delimiter bytes, so that "1.2.3" and "12abc" are one bad token.
- * The value is had without strtod when it can be the same double: at most
- * 15 significant digits (the whole number then fits a double exactly) and
- * a power of ten within 10^22 (exact too), so that the one multiplication
- * or division is the correctly rounded result strtod gives (Clinger 1990,
- * the fast path); any other number goes to strtod
- * (tests/scene/test_scene_numbers.c holds both to strtod). */
-static rib_token lex_number(rib_lexer *self)
+ * non-delimiter bytes, so that "1.2.3" and "12abc" are one bad token; *stop
+ * is where the token ends. The value (*v, NUMBER_FAST) is had without
+ * strtod when it can be the same double: at most 15 significant digits
+ * (the whole number then fits a double exactly) and a power of ten within
+ * 10^22 (exact too), so that the one multiplication or division is the
+ * correctly rounded result strtod gives (Clinger 1990, the fast path); any
+ * other number is NUMBER_STRTOD (tests/scene/test_scene_numbers.c holds
+ * both to strtod). */
+static number_kind scan_number(const char *p, const char *end, const char **stop, double *v)
 {
     static const double pow10[] = { 1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10,
                                     1e11, 1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19,
                                     1e20, 1e21, 1e22 };
-    const char *start = self->p, *q = start, *end = self->end;
+    const char *q = p;
     size_t digits = 0;
     bool negative = false, ok = true;
     uint64_t m = 0;
@@ -189,11 +197,28 @@ static rib_token lex_number(rib_lexer *self)
         while (q < end && !is_delimiter(*q))
             q++;
     }
-    self->p = q;
+    *stop = q;
+    if (!ok)
+        return NUMBER_BAD;
+    long e = scale + exponent;
+    if (significant <= 15 && (m == 0 || (e >= -22 && e <= 22))) {
+        double x = m == 0 ? 0.0 : e >= 0 ? (double)m * pow10[e] : (double)m / pow10[-e];
+        *v = negative ? -x : x;
+        return NUMBER_FAST;
+    }
+    return NUMBER_STRTOD;
+}
+
+static rib_token lex_number(rib_lexer *self)
+{
+    const char *start = self->p;
+    double v = 0;
+    number_kind kind = scan_number(start, self->end, &self->p, &v);
     rib_token t = make(self, RIB_TOK_NUMBER, start);
+    t.number = v;
     int shown = t.len > 40 ? 40 : (int)t.len;
     const char *more = t.len > 40 ? "..." : "";
-    if (!ok) {
+    if (kind == NUMBER_BAD) {
         bad(self, &t, "bad number '%.*s%s'", shown, start, more);
         return t;
     }
@@ -202,12 +227,8 @@ static rib_token lex_number(rib_lexer *self)
         bad(self, &t, "number '%.*s%s' is too long", shown, start, more);
         return t;
     }
-    long e = scale + exponent;
-    if (significant <= 15 && (m == 0 || (e >= -22 && e <= 22))) {
-        double x = m == 0 ? 0.0 : e >= 0 ? (double)m * pow10[e] : (double)m / pow10[-e];
-        t.number = negative ? -x : x;
+    if (kind == NUMBER_FAST)
         return t;
-    }
     memcpy(buf, start, t.len);
     buf[t.len] = '\0';
     t.number = strtod(buf, NULL);
@@ -215,6 +236,21 @@ static rib_token lex_number(rib_lexer *self)
         bad(self, &t, "number '%.*s%s' is out of range", shown, start, more);
     }
     return t;
+}
+
+bool rib_lexer_next_number(rib_lexer *self, double *v)
+{
+    skip_space_and_comments(self);
+    if (self->p >= self->end)
+        return false;
+    char c = *self->p;
+    if (!is_digit(c) && c != '+' && c != '-' && c != '.')
+        return false;
+    const char *stop;
+    if (scan_number(self->p, self->end, &stop, v) != NUMBER_FAST || stop - self->p >= 512)
+        return false;                  /* rib_lexer_next reads it (strtod, or its error) */
+    self->p = stop;
+    return true;
 }
 
 /* ---------------------------------------------------------------------- */

@@ -10,7 +10,9 @@
  * RIB number syntax as a POSIX regular expression: a word it matches is
  * one number token (strtod's value, or "out of range" where strtod
  * overflows), any other one bad token naming the whole word, and the
- * delimiter after it is the next token.
+ * delimiter after it is the next token; the same through the tokenless
+ * read of long arrays (rib_lexer_next_number), which must take only the
+ * numbers it reads right.
  */
 #include <stdarg.h>
 #include <stddef.h>
@@ -19,6 +21,7 @@
 #include <cmocka.h>
 
 #include <math.h>
+#include <stdbool.h>
 #include <regex.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -79,14 +82,25 @@ static void test_random(void **state)
 
 /* word (its bytes are no delimiter) then delim (a delimiter or ""): the
  * lexer's first token against the oracle, then the token after it. */
-static void check_word(const regex_t *syntax, const char *word, const char *delim)
+static void check_word(const regex_t *syntax, const char *word, const char *delim, bool bulk)
 {
     char text[160];
     snprintf(text, sizeof text, "%s%s", word, delim);
     rib_lexer *lx = rib_lexer_new("n.rib", text, strlen(text));
-    rib_token t = rib_lexer_next(lx);
     bool number = regexec(syntax, word, 0, NULL, 0) == 0;
     double want = number ? strtod(word, NULL) : 0;
+    rib_token t = {0};
+    if (bulk && rib_lexer_next_number(lx, &t.number)) {
+        /* the tokenless read (long arrays) takes only numbers it reads
+         * right, and leaves every other word to rib_lexer_next */
+        t.kind = RIB_TOK_NUMBER;
+        t.pos.line = t.pos.col = 1;
+        if (!number || !isfinite(want))
+            fail_msg("'%s' (before '%s') is read as a number by rib_lexer_next_number", word,
+                     delim);
+    } else {
+        t = rib_lexer_next(lx);
+    }
     char msg[256];
     if (number && isfinite(want)) {
         if (t.kind != RIB_TOK_NUMBER)
@@ -133,7 +147,8 @@ static void test_words(void **state)
     };
     for (size_t i = 0; i < sizeof fixed / sizeof fixed[0]; i++)
         for (size_t d = 0; d < sizeof delims / sizeof delims[0]; d++)
-            check_word(&syntax, fixed[i], delims[d]);
+            for (int bulk = 0; bulk < 2; bulk++)
+                check_word(&syntax, fixed[i], delims[d], bulk);
     /* a number starts with a digit, a sign or a point (other words are
      * names); the rest mostly number bytes, a few letters */
     static const char first[] = "0123456789+-.";
@@ -145,7 +160,7 @@ static void test_words(void **state)
         w[0] = first[rand() % (int)(sizeof first - 1)];
         for (int i = 1; i < n; i++) w[i] = rest[rand() % (int)(sizeof rest - 1)];
         w[n] = '\0';
-        check_word(&syntax, w, delims[rand() % (int)(sizeof delims / sizeof delims[0])]);
+        check_word(&syntax, w, delims[rand() % (int)(sizeof delims / sizeof delims[0])], k % 2);
     }
     regfree(&syntax);
 }
