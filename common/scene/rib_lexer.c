@@ -161,24 +161,32 @@ static number_kind scan_number(const char *p, const char *end, const char **stop
                                     1e11, 1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19,
                                     1e20, 1e21, 1e22 };
     const char *q = p;
-    size_t digits = 0;
     bool negative = false, ok = true;
-    uint64_t m = 0;
-    int significant = 0, scale = 0;    /* value: m * 10^(scale + exponent) */
+    uint64_t m = 0;                    /* the significant digits (when at most 15) */
     if (q < end && (*q == '+' || *q == '-'))
         negative = *q++ == '-';
-    for (; q < end && is_digit(*q); q++, digits++)
-        if (m > 0 || *q != '0') {
-            if (++significant <= 15) m = m * 10 + (uint64_t)(*q - '0');
-        }
+    /* whole part: leading zeros, then the significant digits */
+    const char *d0 = q;
+    while (q < end && *q == '0')
+        q++;
+    const char *s0 = q;
+    for (; q < end && is_digit(*q); q++)
+        m = m * 10 + (uint64_t)(*q - '0');
+    long significant = q - s0, scale = 0;    /* value: m * 10^(scale + exponent) */
+    long digits = q - d0;
     if (q < end && *q == '.') {
-        for (q++; q < end && is_digit(*q); q++, digits++)
-            if (m > 0 || *q != '0') {
-                if (++significant <= 15) { m = m * 10 + (uint64_t)(*q - '0'); scale--; }
-            } else {
-                scale--;                     /* a leading zero after the point */
-            }
+        const char *f0 = ++q;
+        if (m == 0)                    /* zeros after the point before the first digit */
+            while (q < end && *q == '0')
+                q++;
+        const char *f1 = q;
+        for (; q < end && is_digit(*q); q++)
+            m = m * 10 + (uint64_t)(*q - '0');
+        significant += q - f1;
+        scale = -(q - f0);
+        digits += q - f0;
     }
+    /* (m wraps past 19 digits: then significant > 15 and m is not used) */
     ok = digits > 0;
     long exponent = 0;
     if (ok && q < end && (*q == 'e' || *q == 'E')) {

@@ -304,7 +304,7 @@ static double *smooth_normals(int npoints, const double *P, const int *nloops, i
         int npts = (int)sum(loop, nl);
         double nn[3] = {0, 0, 0};
         for (int i = 0; i < loop[0]; i++) {
-            const double *a = P + 3 * vi[i], *b = P + 3 * vi[(i + 1) % loop[0]];
+            const double *a = P + 3 * vi[i], *b = P + 3 * vi[i + 1 < loop[0] ? i + 1 : 0];
             nn[0] += (a[1] - b[1]) * (a[2] + b[2]);
             nn[1] += (a[2] - b[2]) * (a[0] + b[0]);
             nn[2] += (a[0] - b[0]) * (a[1] + b[1]);
