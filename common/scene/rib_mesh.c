@@ -111,7 +111,7 @@ static vec3 point(const mesh *m, int i)
  * (m->out) is kept nowhere: only whether it prepares, its normal and its
  * (u,v) are read, so every face and piece of the mesh is prepared in the
  * one scratch surface, zeroed once (a geom_surface is ~4.9 KB; zeroing
- * one per face and per piece was a tenth of the parse of a million quads).
+ * one per face and per piece was ~8 % of the parse of a million quads).
  * That is the same surface to the prepare: it reads only what is set here
  * and the corners (and corner normals when nvn > 0), and derives the rest
  * anew (geom_surface_prepare). */
