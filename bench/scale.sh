@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # bench/scale.sh: production scale (issue 23), the aims' figures:
 #   1. mesh_bench: a torus of PointsPolygons quads to FACES (default
-#      1,000,000; 10000000 is the opt-in row): parse, world, render CPU
-#      seconds, bytes per face, peak RSS; the same torus as a
+#      1,000,000; 10000000 is the opt-in row): parse, world, parse+world
+#      (the aim), render seconds, bytes per face, peak RSS; the same torus as a
 #      SubdivisionMesh cage to SUBDIV_FACES (default 100,000)
 #   2. a production-style asset (bench/asset_gen: a displaced, textured
 #      terrain of ASSET_FACES quads from a gzip archive and ROCKS instanced

@@ -138,71 +138,95 @@ static rib_token make(rib_lexer *self, rib_token_kind kind, const char *start)
 /* numbers                                                                 */
 /* ---------------------------------------------------------------------- */
 
-/* Reads s[0..n) as a RIB number: false when it is not exactly one.
- * *fast is set, with its value in *v, when the value can be had without
- * strtod and be the same double: at most 15 significant digits (the whole
- * number then fits a double exactly) and a power of ten within 10^22
- * (exact too), so that the one multiplication or division is the correctly
- * rounded result strtod gives (Clinger 1990, the fast path). */
-static bool read_number(const char *s, size_t n, bool *fast, double *v)
+/* How a run of bytes reads as a number (scan_number). */
+typedef enum number_kind {
+    NUMBER_BAD,          /* not the RIB number syntax */
+    NUMBER_FAST,         /* its value is had without strtod */
+    NUMBER_STRTOD,       /* its value is strtod's */
+} number_kind;
+
+/* Reads the number at p (before end) in one pass: its syntax and its value
+ * together, then (a number must end at a delimiter) the rest of the run of
+ * non-delimiter bytes, so that "1.2.3" and "12abc" are one bad token; *stop
+ * is where the token ends. The value (*v, NUMBER_FAST) is had without
+ * strtod when it can be the same double: at most 15 significant digits
+ * (the whole number then fits a double exactly) and a power of ten within
+ * 10^22 (exact too), so that the one multiplication or division is the
+ * correctly rounded result strtod gives (Clinger 1990, the fast path); any
+ * other number is NUMBER_STRTOD (tests/scene/test_scene_numbers.c holds
+ * both to strtod). */
+static number_kind scan_number(const char *p, const char *end, const char **stop, double *v)
 {
     static const double pow10[] = { 1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10,
                                     1e11, 1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19,
                                     1e20, 1e21, 1e22 };
-    size_t i = 0, digits = 0;
-    bool negative = false;
-    uint64_t m = 0;
-    int significant = 0, scale = 0;    /* value: m * 10^(scale + exponent) */
-    if (i < n && (s[i] == '+' || s[i] == '-'))
-        negative = s[i++] == '-';
-    for (; i < n && is_digit(s[i]); i++, digits++)
-        if (m > 0 || s[i] != '0') {
-            if (++significant <= 15) m = m * 10 + (uint64_t)(s[i] - '0');
-        }
-    if (i < n && s[i] == '.') {
-        for (i++; i < n && is_digit(s[i]); i++, digits++)
-            if (m > 0 || s[i] != '0') {
-                if (++significant <= 15) { m = m * 10 + (uint64_t)(s[i] - '0'); scale--; }
-            } else {
-                scale--;                     /* a leading zero after the point */
-            }
+    const char *q = p;
+    bool negative = false, ok = true;
+    uint64_t m = 0;                    /* the significant digits (when at most 15) */
+    if (q < end && (*q == '+' || *q == '-'))
+        negative = *q++ == '-';
+    /* whole part: leading zeros, then the significant digits */
+    const char *d0 = q;
+    while (q < end && *q == '0')
+        q++;
+    const char *s0 = q;
+    for (; q < end && is_digit(*q); q++)
+        m = m * 10 + (uint64_t)(*q - '0');
+    long significant = q - s0, scale = 0;    /* value: m * 10^(scale + exponent) */
+    long digits = q - d0;
+    if (q < end && *q == '.') {
+        const char *f0 = ++q;
+        if (m == 0)                    /* zeros after the point before the first digit */
+            while (q < end && *q == '0')
+                q++;
+        const char *f1 = q;
+        for (; q < end && is_digit(*q); q++)
+            m = m * 10 + (uint64_t)(*q - '0');
+        significant += q - f1;
+        scale = -(q - f0);
+        digits += q - f0;
     }
-    if (digits == 0)
-        return false;
+    /* (m wraps past 19 digits: then significant > 15 and m is not used) */
+    ok = digits > 0;
     long exponent = 0;
-    if (i < n && (s[i] == 'e' || s[i] == 'E')) {
-        i++;
+    if (ok && q < end && (*q == 'e' || *q == 'E')) {
+        q++;
         bool exp_negative = false;
-        if (i < n && (s[i] == '+' || s[i] == '-'))
-            exp_negative = s[i++] == '-';
+        if (q < end && (*q == '+' || *q == '-'))
+            exp_negative = *q++ == '-';
         size_t exp_digits = 0;
-        for (; i < n && is_digit(s[i]); i++, exp_digits++)
-            if (exponent < 100000) exponent = exponent * 10 + (s[i] - '0');
-        if (exp_digits == 0)
-            return false;
+        for (; q < end && is_digit(*q); q++, exp_digits++)
+            if (exponent < 100000) exponent = exponent * 10 + (*q - '0');
+        ok = exp_digits > 0;
         if (exp_negative) exponent = -exponent;
     }
-    if (i != n)
-        return false;
+    if (q < end && !is_delimiter(*q)) {    /* more of the word: not a number */
+        ok = false;
+        while (q < end && !is_delimiter(*q))
+            q++;
+    }
+    *stop = q;
+    if (!ok)
+        return NUMBER_BAD;
     long e = scale + exponent;
-    *fast = significant <= 15 && (m == 0 || (e >= -22 && e <= 22));
-    if (*fast) {
+    if (significant <= 15 && (m == 0 || (e >= -22 && e <= 22))) {
         double x = m == 0 ? 0.0 : e >= 0 ? (double)m * pow10[e] : (double)m / pow10[-e];
         *v = negative ? -x : x;
+        return NUMBER_FAST;
     }
-    return true;
+    return NUMBER_STRTOD;
 }
 
 static rib_token lex_number(rib_lexer *self)
 {
     const char *start = self->p;
-    while (self->p < self->end && !is_delimiter(*self->p))
-        self->p++;
+    double v = 0;
+    number_kind kind = scan_number(start, self->end, &self->p, &v);
     rib_token t = make(self, RIB_TOK_NUMBER, start);
+    t.number = v;
     int shown = t.len > 40 ? 40 : (int)t.len;
     const char *more = t.len > 40 ? "..." : "";
-    bool fast = false;
-    if (!read_number(start, t.len, &fast, &t.number)) {
+    if (kind == NUMBER_BAD) {
         bad(self, &t, "bad number '%.*s%s'", shown, start, more);
         return t;
     }
@@ -211,7 +235,7 @@ static rib_token lex_number(rib_lexer *self)
         bad(self, &t, "number '%.*s%s' is too long", shown, start, more);
         return t;
     }
-    if (fast)
+    if (kind == NUMBER_FAST)
         return t;
     memcpy(buf, start, t.len);
     buf[t.len] = '\0';
@@ -220,6 +244,21 @@ static rib_token lex_number(rib_lexer *self)
         bad(self, &t, "number '%.*s%s' is out of range", shown, start, more);
     }
     return t;
+}
+
+bool rib_lexer_next_number(rib_lexer *self, double *v)
+{
+    skip_space_and_comments(self);
+    if (self->p >= self->end)
+        return false;
+    char c = *self->p;
+    if (!is_digit(c) && c != '+' && c != '-' && c != '.')
+        return false;
+    const char *stop;
+    if (scan_number(self->p, self->end, &stop, v) != NUMBER_FAST || stop - self->p >= 512)
+        return false;                  /* rib_lexer_next reads it (strtod, or its error) */
+    self->p = stop;
+    return true;
 }
 
 /* ---------------------------------------------------------------------- */

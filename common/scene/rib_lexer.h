@@ -15,6 +15,7 @@
 #ifndef SCENE_RIB_LEXER_H
 #define SCENE_RIB_LEXER_H
 
+#include <stdbool.h>
 #include <stddef.h>
 
 #include "sl/diag.h"
@@ -46,5 +47,11 @@ rib_lexer *rib_lexer_new(const char *file, const char *text, size_t len);
 void rib_lexer_destroy(rib_lexer **self_p);
 
 rib_token rib_lexer_next(rib_lexer *self);
+
+/* The next token when it is a number read without strtod and without
+ * error (true, its value in *v), for the long arrays of meshes: no token is
+ * made. Else false, and only the blanks and comments before the token are
+ * consumed: rib_lexer_next reads it (and says what is wrong with it). */
+bool rib_lexer_next_number(rib_lexer *self, double *v);
 
 #endif

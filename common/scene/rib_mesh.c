@@ -80,6 +80,8 @@ typedef struct mesh {
     scene_mesh *out;               /* PointsPolygons, PointsGeneralPolygons: the
                                     * pieces go here (one object, issue 23);
                                     * NULL: one object each */
+    geom_surface *scratch;         /* with out: the one surface every face and
+                                    * piece is prepared in (polygon_surface) */
 } mesh;
 
 /* Corner i of face `face` (point idx[i]) in the variables' classes. */
@@ -104,6 +106,28 @@ static vec3 point(const mesh *m, int i)
     return v3(m->P[3 * i], m->P[3 * i + 1], m->P[3 * i + 2]);
 }
 
+/* The surface to prepare a polygon of n corners in, its corners still to
+ * be set. A surface that becomes an object is *local, zeroed. A mesh's
+ * (m->out) is kept nowhere: only whether it prepares, its normal and its
+ * (u,v) are read, so every face and piece of the mesh is prepared in the
+ * one scratch surface, zeroed once (a geom_surface is ~4.9 KB; zeroing
+ * one per face and per piece was ~8 % of the parse of a million quads).
+ * That is the same surface to the prepare: it reads only what is set here
+ * and the corners (and corner normals when nvn > 0), and derives the rest
+ * anew (geom_surface_prepare). */
+static geom_surface *polygon_surface(const mesh *m, geom_surface *local, int n)
+{
+    geom_surface *s = m->scratch;
+    if (!s) {
+        memset(local, 0, sizeof *local);
+        s = local;
+    }
+    s->kind = GEOM_POLYGON;
+    s->nverts = n;
+    s->nvn = 0;
+    return s;
+}
+
 /* The normal of corner i of the current face (point idx[i]). */
 static vec3 corner_normal(const mesh *m, int face, const int *idx, int i)
 {
@@ -123,23 +147,26 @@ static vec3 corner_normal(const mesh *m, int face, const int *idx, int i)
 static bool add_triangle(rib_parser *p, const mesh *m, int face, const int *idx,
                          const int k[3], const vec3 *n)
 {
-    geom_surface s;
-    memset(&s, 0, sizeof s);
-    s.kind = GEOM_POLYGON;
-    s.nverts = 3;
+    geom_surface local, *s = polygon_surface(m, &local, 3);
     for (int i = 0; i < 3; i++)
-        s.verts[i] = point(m, idx[k[i]]);
-    if (n) {
-        s.nvn = 3;
-        s.vn[0] = n[0], s.vn[1] = n[1], s.vn[2] = n[2];
+        s->verts[i] = point(m, idx[k[i]]);
+    /* A piece of a mesh (m->out) keeps no surface: whether it is kept
+     * and its (u,v) are all that is asked here, and the corner normals
+     * change neither (they are read only by the last step of the
+     * prepare, geom_vertex_normal_prepare, which may fail where the flat
+     * triangle does not: the piece is then flat, scene_mesh.c). So a
+     * mesh's triangle is prepared once, flat. */
+    if (n && !m->out) {
+        s->nvn = 3;
+        s->vn[0] = n[0], s->vn[1] = n[1], s->vn[2] = n[2];
     }
 #ifdef SCENE_HAVE_GEOM
     char err[ERR_LEN];
-    if (!geom_surface_prepare(&s, err, sizeof err)) {
-        if (!n)
+    if (!geom_surface_prepare(s, err, sizeof err)) {
+        if (s->nvn == 0)
             return false;
-        s.nvn = 0;                  /* normals it cannot interpolate: flat */
-        if (!geom_surface_prepare(&s, err, sizeof err))
+        s->nvn = 0;                 /* normals it cannot interpolate: flat */
+        if (!geom_surface_prepare(s, err, sizeof err))
             return false;
     }
 #endif
@@ -148,14 +175,14 @@ static bool add_triangle(rib_parser *p, const mesh *m, int face, const int *idx,
         rib_corner c[3];
         for (int i = 0; i < 3; i++)
             c[i] = corner_of(m, face, idx, k[i]);
-        if (s.nuv != 3 || !rib_primvars_triangle(&m->pv, c, (const double (*)[2])s.uv, vars))
+        if (s->nuv != 3 || !rib_primvars_triangle(&m->pv, c, (const double (*)[2])s->uv, vars))
             return false;
     }
     if (m->out)      /* scene_mesh_piece_surface makes s and vars again */
         scene_mesh_add_piece(m->out, n ? SCENE_PIECE_TRIANGLE_N : SCENE_PIECE_TRIANGLE, face,
                              m->fv0, k, 3);
     else
-        add_with_vars(p, m, &s, vars);
+        add_with_vars(p, m, s, vars);
     return true;
 }
 
@@ -182,19 +209,16 @@ static bool add_face(rib_parser *p, mesh *m, int face, const int *loop_sizes, in
 {
     int total = (int)sum(loop_sizes, nloops);
     if (nloops == 1 && total <= GEOM_MAX_POLY_VERTS) {
-        geom_surface s;
-        memset(&s, 0, sizeof s);
-        s.kind = GEOM_POLYGON;
-        s.nverts = total;
+        geom_surface local, *s = polygon_surface(m, &local, total);
         for (int i = 0; i < total; i++)
-            s.verts[i] = point(m, idx[i]);
+            s->verts[i] = point(m, idx[i]);
 #ifdef SCENE_HAVE_GEOM
         char err[ERR_LEN];
-        if (geom_surface_prepare(&s, err, sizeof err)) {
+        if (geom_surface_prepare(s, err, sizeof err)) {
             rib_corner corners[GEOM_MAX_POLY_VERTS];
             for (int i = 0; i < total; i++)
                 corners[i] = corner_of(m, face, idx, i);
-            if ((m->ncls == MESH_N_NONE || corners_flat(m, &s, face, idx, total)) &&
+            if ((m->ncls == MESH_N_NONE || corners_flat(m, s, face, idx, total)) &&
                 rib_primvars_same_at(&m->pv, corners, total)) {
                 if (m->out) {
                     scene_mesh_add_piece(m->out, SCENE_PIECE_POLYGON, face, m->fv0, NULL, total);
@@ -202,7 +226,7 @@ static bool add_face(rib_parser *p, mesh *m, int face, const int *loop_sizes, in
                 }
                 scene_primvar vars[RIB_MAX_PRIMVARS];
                 rib_primvars_constant(&m->pv, &corners[0], vars);
-                add_with_vars(p, m, &s, vars);
+                add_with_vars(p, m, s, vars);
                 return true;
             }
             /* convex and planar: a fan of triangles with corner normals
@@ -221,7 +245,7 @@ static bool add_face(rib_parser *p, mesh *m, int face, const int *loop_sizes, in
         }
 #else
         (void)face;
-        rib_add_surface(p, m->req, &s);
+        rib_add_surface(p, m->req, s);
         return true;
 #endif
     }
@@ -280,7 +304,7 @@ static double *smooth_normals(int npoints, const double *P, const int *nloops, i
         int npts = (int)sum(loop, nl);
         double nn[3] = {0, 0, 0};
         for (int i = 0; i < loop[0]; i++) {
-            const double *a = P + 3 * vi[i], *b = P + 3 * vi[(i + 1) % loop[0]];
+            const double *a = P + 3 * vi[i], *b = P + 3 * vi[i + 1 < loop[0] ? i + 1 : 0];
             nn[0] += (a[1] - b[1]) * (a[2] + b[2]);
             nn[1] += (a[2] - b[2]) * (a[0] + b[0]);
             nn[2] += (a[0] - b[0]) * (a[1] + b[1]);
@@ -343,7 +367,7 @@ static void read_mesh(rib_parser *p, const rib_request *req, const int *nloops, 
         goto out;
     }
     mesh m = { req, P->values, P->count / 3, 0, req->args[first_vertices].pos,
-               MESH_N_VERTEX, NULL, 0, { NULL, 0 }, NULL };
+               MESH_N_VERTEX, NULL, 0, { NULL, 0 }, NULL, NULL };
     int counts[] = { 0, 1, nfaces, m.npoints, m.npoints, nidx };
     if (!rib_primvars_collect(p, req, &params, counts, NULL, &m.pv))
         goto out;
@@ -359,10 +383,29 @@ static void read_mesh(rib_parser *p, const rib_request *req, const int *nloops, 
     } else {
         m.N = smooth = smooth_normals(m.npoints, P->values, nloops, nfaces, nverts, idx);
     }
+    bool taken = false;                /* idx and smooth are the mesh's */
 #ifdef SCENE_HAVE_GEOM
-    m.out = p->check ? scene_mesh_new_counted(m.pv.n)     /* a check keeps no arrays */
-                     : scene_mesh_new(P->values, m.npoints, idx, nidx, m.ncls, m.N,
-                                      N ? N->count / 3 : m.npoints, &m.pv, &params);
+    if (p->check) {
+        m.out = scene_mesh_new_counted(m.pv.n);        /* a check keeps no arrays */
+    } else {
+        /* the mesh takes the arrays as they are (P's and N's values out
+         * of params, the smooth normals, the indices): no copies; m's
+         * pointers stay valid while it lives */
+        scene_param *Pp = &params.items[P - params.items];
+        double *Nv = smooth;
+        int nN = m.npoints;
+        if (N) {
+            scene_param *Np = &params.items[N - params.items];
+            Nv = Np->values;
+            Np->values = NULL;
+            nN = N->count / 3;
+        }
+        m.out = scene_mesh_new_taking(Pp->values, m.npoints, idx, nidx, m.ncls, Nv, nN, &m.pv,
+                                      &params);
+        Pp->values = NULL;
+        taken = true;
+    }
+    m.scratch = xcalloc(1, sizeof *m.scratch);
 #endif
     const int *loop = nverts, *vi = idx;
     for (int f = 0; f < nfaces && !sl_diag_full(p->diag); f++) {
@@ -373,7 +416,12 @@ static void read_mesh(rib_parser *p, const rib_request *req, const int *nloops, 
         loop += nl;
         vi += npts;
     }
+    if (taken) {
+        idx = NULL;
+        smooth = NULL;
+    }
     free(smooth);
+    free(m.scratch);
     if (m.out) {
         scene_mesh_trim(m.out);
         if (scene_mesh_npieces(m.out) > 0 && !sl_diag_full(p->diag))
@@ -422,7 +470,7 @@ void rib_general_polygon(rib_parser *p, const rib_request *req)
             for (int i = 0; i < n; i++)
                 idx[i] = i;
             mesh m = { req, P->values, (int)n, 0, req->args[0].pos, MESH_N_NONE, NULL, 0,
-                       { NULL, 0 }, NULL };
+                       { NULL, 0 }, NULL, NULL };
             int counts[] = { 0, 1, 1, (int)n, (int)n, (int)n };
             const scene_param *N = rib_params_find(&params, "N");
             if (N) {
@@ -476,7 +524,7 @@ bool rib_polygon_vars(rib_parser *p, const rib_request *req, const rib_params *p
     int *idx = xrealloc(NULL, (size_t)n * sizeof *idx);
     for (int i = 0; i < n; i++)
         idx[i] = i;
-    mesh m = { req, P->values, n, 0, req->pos, MESH_N_NONE, NULL, 0, { NULL, 0 }, NULL };
+    mesh m = { req, P->values, n, 0, req->pos, MESH_N_NONE, NULL, 0, { NULL, 0 }, NULL, NULL };
     int counts[] = { 0, 1, 1, n, n, n };
     if (rib_primvars_collect(p, req, params, counts, NULL, &m.pv)) {
         int loop[1] = { n };

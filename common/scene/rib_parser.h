@@ -367,6 +367,13 @@ struct rib_primvars;
 scene_mesh *scene_mesh_new(const double *P, int npoints, const int *idx, int nidx,
                            scene_mesh_nclass ncls, const double *N, int nN,
                            const struct rib_primvars *pv, const rib_params *params);
+/* The same without copies (a million-face mesh's arrays are ~60 MB): the
+ * mesh takes P, idx and N (NULL: none), which the caller allocated and
+ * must no longer free, and moves the variables' arrays out of params (their
+ * values become NULL there); the pointers stay valid while the mesh lives. */
+scene_mesh *scene_mesh_new_taking(double *P, int npoints, int *idx, int nidx,
+                                  scene_mesh_nclass ncls, double *N, int nN,
+                                  const struct rib_primvars *pv, rib_params *params);
 /* Adds a piece: a polygon of face `face`'s ncorners corners from
  * face-vertex fv0 (k unused), or the triangle of its corners k[0..3). */
 /* A check's mesh (scene_check_frame): the pieces added are counted, and

@@ -170,6 +170,17 @@ static void read_array(rib_reader *self)
         arg = &self->req.args[index];
         switch (self->tok.kind) {
         case RIB_TOK_NUMBER:
+            read_array_element(self, arg, &mixed);
+            if (arg->kind == RIB_ARG_NUMBERS) {
+                /* the numbers after it without tokens (a mesh's arrays
+                 * are millions): up to the first that is not a plain one */
+                double v;
+                while (rib_lexer_next_number(self->lexer, &v)) {
+                    push_number(&self->req, v);
+                    arg->count++;
+                }
+            }
+            break;
         case RIB_TOK_STRING:
             read_array_element(self, arg, &mixed);
             break;

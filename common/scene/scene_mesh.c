@@ -49,41 +49,65 @@ static void *copy_of(const void *src, size_t bytes)
     return dst;
 }
 
-scene_mesh *scene_mesh_new(const double *P, int npoints, const int *idx, int nidx,
-                           scene_mesh_nclass ncls, const double *N, int nN,
-                           const rib_primvars *pv, const rib_params *params)
+/* The mesh of the arrays P, idx and N (taken: the mesh frees them); the
+ * variables' arrays are found among params' and copied, or, with `take`
+ * (params then writable), moved out of params (their values set NULL). */
+static scene_mesh *assemble(double *P, int npoints, int *idx, int nidx, scene_mesh_nclass ncls,
+                            double *N, int nN, const rib_primvars *pv, const rib_params *params,
+                            rib_params *take)
 {
+    assert(!take || take == params);
     scene_mesh *self = xcalloc(1, sizeof *self);
-    self->P = copy_of(P, (size_t)npoints * 3 * sizeof *P);
+    self->P = P;
     self->npoints = npoints;
-    self->idx = copy_of(idx, (size_t)nidx * sizeof *idx);
+    self->idx = idx;
     self->nidx = nidx;
     self->ncls = ncls;
-    self->N = N ? copy_of(N, (size_t)nN * 3 * sizeof *N) : NULL;
+    self->N = N;
     self->nN = N ? nN : 0;
     /* the variables: each source points into a parameter's values, which
-     * go with the parameters; copy every parameter array a source uses
-     * (st's s and t share one) and point the sources at the copies */
+     * go with the parameters; copy (or take) every parameter array a
+     * source uses (st's s and t share one) and point the sources at the
+     * mesh's */
     self->pv.n = pv->n;
     self->pv.v = pv->n > 0 ? copy_of(pv->v, (size_t)pv->n * sizeof *pv->v) : NULL;
     self->values = xcalloc((size_t)(params->count > 0 ? params->count : 1), sizeof *self->values);
     for (int k = 0; k < pv->n; k++) {
         rib_primvar_src *v = &self->pv.v[k];
-        for (int i = 0; i < params->count; i++) {
+        bool found = v->values == NULL;
+        for (int i = 0; i < params->count && !found; i++) {
             const scene_param *pa = &params->items[i];
             if (pa->values != v->values) continue;
             if (!self->values[i]) {
                 size_t bytes = (size_t)pa->count * sizeof *pa->values;
-                self->values[i] = copy_of(pa->values, bytes);
+                self->values[i] = take ? pa->values : copy_of(pa->values, bytes);
                 self->values_bytes += bytes;
             }
             v->values = self->values[i];
-            break;
+            found = true;
         }
-        assert(v->values != pv->v[k].values || pv->v[k].values == NULL);
+        assert(found && "a variable's values are a parameter's");
     }
+    for (int i = 0; take && i < params->count; i++)
+        if (self->values[i]) take->items[i].values = NULL;
     self->nvalues = params->count;
     return self;
+}
+
+scene_mesh *scene_mesh_new(const double *P, int npoints, const int *idx, int nidx,
+                           scene_mesh_nclass ncls, const double *N, int nN,
+                           const rib_primvars *pv, const rib_params *params)
+{
+    return assemble(copy_of(P, (size_t)npoints * 3 * sizeof *P), npoints,
+                    copy_of(idx, (size_t)nidx * sizeof *idx), nidx, ncls,
+                    N ? copy_of(N, (size_t)nN * 3 * sizeof *N) : NULL, nN, pv, params, NULL);
+}
+
+scene_mesh *scene_mesh_new_taking(double *P, int npoints, int *idx, int nidx,
+                                  scene_mesh_nclass ncls, double *N, int nN,
+                                  const rib_primvars *pv, rib_params *params)
+{
+    return assemble(P, npoints, idx, nidx, ncls, N, nN, pv, params, params);
 }
 
 scene_mesh *scene_mesh_new_counted(int nprimvars)
