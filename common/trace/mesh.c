@@ -722,9 +722,17 @@ static void region_boxes(region_share *b, int first, int count, trace_view *v)
     if (lazy) {
         trace_region *region = trace_region_new();
         for (int i = 0; lazy && i < count; i++) {
-            lazy = make(th, b->obj, idx[i], false, b->dudv, v);
-            if (!b->dudv) v->obj.du = v->obj.dv = 0.0;     /* not known: any */
-            lazy = lazy && trace_region_add(th, region, &v->obj);
+            /* du, dv: enclosures (their bounds from a 3 x 3 grid, or any
+             * value for a shader that never reads them), not the 9 x 9
+             * grid's values */
+            ia_interval dudv[2] = {ia_make(0x1p-16, 1.0), ia_make(0x1p-16, 1.0)};
+            lazy = make(th, b->obj, idx[i], false, false, v);
+            if (lazy && b->dudv) {
+                trace_object_grid_spacing_max(th->world, &v->obj, &dudv[0].hi, &dudv[1].hi);
+                dudv[0].lo = fmin(dudv[0].lo, dudv[0].hi);
+                dudv[1].lo = fmin(dudv[1].lo, dudv[1].hi);
+            }
+            lazy = lazy && trace_region_add(th, region, &v->obj, dudv);
         }
         lazy = lazy && trace_region_run(th, b->obj, region, &box, shift);
         trace_region_destroy(&region);

@@ -153,8 +153,8 @@ static bool hull_primvars(const trace_object *obj, trace_region *h, bool first)
 
 /* Piece obj (a view) into the hull: no shader, its geometry's affine
  * forms over its whole (u,v) square as box_affine makes them */
-static bool hull_piece(trace_thread *th, const trace_object *obj, trace_region *h, bool first,
-                       ia_interval base[3])
+static bool hull_piece(trace_thread *th, const trace_object *obj, const ia_interval *dudv,
+                       trace_region *h, bool first, ia_interval base[3])
 {
     vec3 lo, hi;
     geom_bounds(&obj->surf, &lo, &hi);
@@ -190,10 +190,8 @@ static bool hull_piece(trace_thread *th, const trace_object *obj, trace_region *
         hull3(h->dPdv, r, first);
     }
     h->flat = (first || h->flat) && trace_surface_flat(obj);
-    /* du, dv of 0: not made (a shader that never reads them); any value
-     * trace_object_grid_spacing may give */
-    ia_interval du = obj->du > 0 ? ia_point(obj->du) : ia_make(0x1p-16, 1.0);
-    ia_interval dv = obj->dv > 0 ? ia_point(obj->dv) : ia_make(0x1p-16, 1.0);
+    ia_interval du = dudv ? dudv[0] : ia_point(obj->du);
+    ia_interval dv = dudv ? dudv[1] : ia_point(obj->dv);
     h->du = first ? du : ia_hull(h->du, du);
     h->dv = first ? dv : ia_hull(h->dv, dv);
     return hull_primvars(obj, h, first);
@@ -307,12 +305,13 @@ void trace_region_destroy(trace_region **self)
     *self = NULL;
 }
 
-bool trace_region_add(trace_thread *th, trace_region *self, const trace_object *piece)
+bool trace_region_add(trace_thread *th, trace_region *self, const trace_object *piece,
+                      const ia_interval *dudv)
 {
     ia_interval b[3];
     bool first = self->count == 0;
     self->count++;
-    if (!hull_piece(th, piece, self, first, b)) self->refused = true;
+    if (!hull_piece(th, piece, dudv, self, first, b)) self->refused = true;
     return !self->refused;
 }
 
@@ -414,7 +413,7 @@ bool trace_mesh_region_box(trace_thread *th, const trace_object *mesh_obj, const
     for (int i = 0; ok && i < n; i++) {
         assert(pieces[i] >= 0 && pieces[i] < mesh_obj->mesh->npieces);
         ok = trace_mesh_view_make(th, mesh_obj, pieces[i], false, view) &&
-             trace_region_add(th, h, &view->obj);
+             trace_region_add(th, h, &view->obj, NULL);
     }
     free(view);
     ok = ok && trace_region_run(th, mesh_obj, h, out, NULL);

@@ -40,10 +40,12 @@ typedef struct trace_region trace_region;
 trace_region *trace_region_new(void);
 void trace_region_destroy(trace_region **self);
 
-/* Adds piece view `piece` (made with its du/dv, trace_mesh_view_make).
- * False where the region must refuse the piece (its primitive variables:
- * see above); the region then stays refused. */
-bool trace_region_add(trace_thread *th, trace_region *self, const trace_object *piece);
+/* Adds piece view `piece` (made with its du/dv, trace_mesh_view_make),
+ * or with `dudv` (not NULL) enclosures of its du and dv instead. False
+ * where the region must refuse the piece (its primitive variables: see
+ * above); the region then stays refused. */
+bool trace_region_add(trace_thread *th, trace_region *self, const trace_object *piece,
+                      const ia_interval *dudv);
 /* A displaced piece's undisplaced object-space box over its whole (u,v)
  * square (lo, hi), rounded outward, from its surface: its displaced points
  * lie in it plus the `shift` of any region it is in (trace_region_run).

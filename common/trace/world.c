@@ -74,15 +74,22 @@ static double normal_scale_of(const trace_object *obj)
  * raster, in pixels), dv likewise, from a 9x9 grid of base-surface points;
  * between 2^-16 and 1. A pure function of the scene (no tile, thread or
  * worker enters it). Points behind the eye are measured at distance 1. */
-void trace_object_grid_spacing(const trace_world *world, trace_object *obj)
+/* The longest u- and v-lines of obj's base surface on the raster, in
+ * pixels, over the rows and points of the 9 x 9 grid every `step`-th (1:
+ * all; 4: 3 x 3, a subset of the same points, so by the triangle
+ * inequality and the max over fewer rows never longer; a surface of
+ * finite points, a polynomial of (u,v) with finite coefficients, has
+ * finite points at all 81) */
+static void raster_lines(const trace_world *world, const trace_object *obj, int step, double *lu,
+                         double *lv)
 {
     const trace_camera *cam = &world->camera;
     double px = fabs(cam->screen[1] - cam->screen[0]) / cam->xres;
     if (!cam->orthographic) px *= cam->tan_half_fov;
     enum { G = 9 };
     double raster[G][G][2];
-    for (int j = 0; j < G; j++)
-        for (int i = 0; i < G; i++) {
+    for (int j = 0; j < G; j += step)
+        for (int i = 0; i < G; i += step) {
             geom_sample g;
             geom_eval(&obj->surf, i / (double)(G - 1), j / (double)(G - 1), &g);
             vec3 p = mat4_xform_point(&obj->to_camera, g.P);
@@ -90,19 +97,43 @@ void trace_object_grid_spacing(const trace_world *world, trace_object *obj)
             raster[j][i][0] = p.x / z / px;
             raster[j][i][1] = p.y / z / px;
         }
-    double lu = 0, lv = 0;
-    for (int k = 0; k < G; k++) {
+    *lu = *lv = 0;
+    for (int k = 0; k < G; k += step) {
         double su = 0, sv = 0;
-        for (int m = 1; m < G; m++) {
-            su += hypot(raster[k][m][0] - raster[k][m - 1][0], raster[k][m][1] - raster[k][m - 1][1]);
-            sv += hypot(raster[m][k][0] - raster[m - 1][k][0], raster[m][k][1] - raster[m - 1][k][1]);
+        for (int m = step; m < G; m += step) {
+            su += hypot(raster[k][m][0] - raster[k][m - step][0],
+                        raster[k][m][1] - raster[k][m - step][1]);
+            sv += hypot(raster[m][k][0] - raster[m - step][k][0],
+                        raster[m][k][1] - raster[m - step][k][1]);
         }
-        lu = fmax(lu, su);
-        lv = fmax(lv, sv);
+        *lu = fmax(*lu, su);
+        *lv = fmax(*lv, sv);
     }
+}
+
+/* du or dv from a line's length */
+static double spacing(const trace_world *world, double l)
+{
     double k = sqrt(world->shading_rate > 0 ? world->shading_rate : 1.0);
-    obj->du = fmin(1.0, fmax(0x1p-16, lu > 0 && isfinite(lu) ? k / lu : 1.0));
-    obj->dv = fmin(1.0, fmax(0x1p-16, lv > 0 && isfinite(lv) ? k / lv : 1.0));
+    return fmin(1.0, fmax(0x1p-16, l > 0 && isfinite(l) ? k / l : 1.0));
+}
+
+void trace_object_grid_spacing(const trace_world *world, trace_object *obj)
+{
+    double lu, lv;
+    raster_lines(world, obj, 1, &lu, &lv);
+    obj->du = spacing(world, lu);
+    obj->dv = spacing(world, lv);
+}
+
+void trace_object_grid_spacing_max(const trace_world *world, const trace_object *obj,
+                                   double *du, double *dv)
+{
+    double lu, lv;
+    raster_lines(world, obj, 4, &lu, &lv);
+    /* a hair over for the rounding of the 9 x 9 grid's longer sums */
+    *du = fmin(1.0, spacing(world, lu) * (1.0 + 0x1p-30));
+    *dv = fmin(1.0, spacing(world, lv) * (1.0 + 0x1p-30));
 }
 
 static bool matrix_finite(const mat4 *m)

@@ -268,6 +268,11 @@ bool trace_world_check(trace_world *world, char *err, size_t errsz);
 
 /* The object's du, dv (world.c; a mesh piece's view sets its own). */
 void trace_object_grid_spacing(const trace_world *world, trace_object *obj);
+/* Upper bounds of what trace_object_grid_spacing gives obj, from a 3 x 3
+ * grid of the same points (9 evaluations instead of 81): du, dv lie in
+ * [2^-16, *du] and [2^-16, *dv]. */
+void trace_object_grid_spacing_max(const trace_world *world, const trace_object *obj,
+                                   double *du, double *dv);
 
 /* What trace_world_check derives of one object from its transforms
  * (scale, normal bounds, and du, dv when `grid`); false with a message

@@ -6,6 +6,8 @@
  *   per region of the tree, hold every displaced point of every piece:
  *   points sampled on the surface by the float evaluator (not by the
  *   boxes' code) are each reached by a ray aimed at them through the tree.
+ * - The regions' bounds of du and dv (from a 3 x 3 grid) hold each
+ *   piece's own (the 9 x 9 grid's).
  * - Nothing of a lazily bounded mesh's roots is made when the world is
  *   built, and a view of a corner of the mesh makes a fraction of them.
  * - The image is the one the eager build gives (every root box made
@@ -223,6 +225,37 @@ static void test_boxes_hold_the_surface(void **state)
     }
 }
 
+/* The regions' du, dv: the 3 x 3 grid's bounds hold each piece's own
+ * (the 9 x 9 grid's) value, on a grid seen from near (perspective: the
+ * pieces' raster sizes vary) */
+static void test_grid_spacing_bounds(void **state)
+{
+    (void)state;
+    fixture f;
+    open_grid(&f, 24, "Displacement \"stwave\"", false, false);
+    const trace_object *obj = &f.js->world.objects[0];
+    trace_thread *th = trace_thread_new(&f.js->world);
+    trace_view *v = malloc(sizeof *v);
+    int n = obj->mesh->npieces, above = 0;
+    double lo = INFINITY, hi = 0, slack = INFINITY;
+    for (int k = 0; k < n; k++) {
+        assert_true(trace_mesh_view_make(th, obj, k, false, v));
+        double du, dv;
+        trace_object_grid_spacing_max(&f.js->world, &v->obj, &du, &dv);
+        above += !(v->obj.du <= du) + !(v->obj.dv <= dv);
+        lo = fmin(lo, v->obj.du);
+        hi = fmax(hi, v->obj.du);
+        slack = fmin(slack, du / v->obj.du);
+    }
+    printf("%d pieces: du in [%g, %g], its 3 x 3 bound at least %g of it; %d values above\n",
+           n, lo, hi, slack, above);
+    assert_true(hi > 2 * lo);       /* the sizes vary */
+    assert_int_equal(above, 0);
+    free(v);
+    trace_thread_destroy(&th);
+    fixture_close(&f);
+}
+
 /* ---- lazy = eager, on any number of threads --------------------------- */
 
 typedef struct band {
@@ -358,6 +391,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_boxes_hold_the_surface),
+        cmocka_unit_test(test_grid_spacing_bounds),
         cmocka_unit_test(test_lazy_renders_as_eager),
         cmocka_unit_test(test_unbounded_regions_make_roots_first),
     };
