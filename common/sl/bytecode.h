@@ -255,6 +255,9 @@ struct sl_program {
     bool takes_derivatives;         /* a DU, DV, DERIV, CALCNORMAL or AREA may
                                        flow into P: interval/affine runs carry
                                        derivative bounds (vm_deriv.inc) */
+    uint64_t global_slots;          /* bit s: a run may read or write global
+                                       slot s (sl_program_global_slots); 0:
+                                       not known, every slot */
 };
 
 /* Scalar slot of a global: P at 0, N at 3, ... (3 slots for points and
@@ -269,6 +272,14 @@ const char *sl_global_name(sl_global g);
  * cannot (`N = calculatenormal(P)` after the last write of P, the common
  * case), range runs need no derivative bounds to bound P. */
 bool sl_program_derivatives_reach_P(const sl_program *p);
+
+/* The global slots a run of p may read or write, as bit s for slot s:
+ * those of every global sl_program_reads_global names, u and v (a varying
+ * parameter is evaluated from them), and all of them for a program with an
+ * operation that reaches globals without naming them (lights, illuminance,
+ * trace, message passing). The derivative-carrying runs copy only these
+ * in and out of their own slot file (vm.c). */
+uint64_t sl_program_global_slots(const sl_program *p);
 
 /* Asserts the invariants of a generated program (every slot, string slot,
  * jump and table operand inside the program's bounds, END last), once when
