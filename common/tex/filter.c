@@ -17,6 +17,7 @@
  */
 #include "tex/tex_internal.h"
 
+#include <assert.h>
 #include <float.h>
 #include <math.h>
 
@@ -233,6 +234,24 @@ static bool few_cells(double s0, double s1, int n, int most, double *first, doub
     return *last - *first < most;
 }
 
+/* v[b][a] = fetch(t, k, c, i + a, j + b) for a < ni <= 4, b < nj <= 4: the
+ * texels under at most 3 x 3 cells, each read once and each index wrapped
+ * once (the cells share their edges: 16 reads where 36 were, issue 24) */
+static void gather(const tex_texture *t, int k, int c, int i, int ni, int j, int nj,
+                   tex_wrap sw, tex_wrap tw, double v[4][4])
+{
+    assert(ni >= 1 && ni <= 4 && nj >= 1 && nj <= 4);
+    int wi[4], wj[4];
+    bool oi[4], oj[4];
+    for (int a = 0; a < ni; a++)
+        wi[a] = wrap_index(i + a, t->lw[k], sw, &oi[a]);
+    for (int b = 0; b < nj; b++)
+        wj[b] = wrap_index(j + b, t->lh[k], tw, &oj[b]);
+    for (int b = 0; b < nj; b++)
+        for (int a = 0; a < ni; a++)
+            v[b][a] = oi[a] || oj[b] ? 0.0 : tex_at(t, 0, k, c, wi[a], wj[b]);
+}
+
 /* lo <= level k's bilinear <= hi over the s and t of r: exact where r
  * covers at most 3 x 3 cells (each cell's part of r is a rectangle, and a
  * bilinear function takes its extremes at a rectangle's corners), so the
@@ -248,12 +267,13 @@ static void level_range(const tex_texture *t, int k, int c, const tex_range *r, 
         double x0 = r->s[0] * n - 0.5, x1 = r->s[1] * n - 0.5;
         double y0 = r->t[0] * m - 0.5, y1 = r->t[1] * m - 0.5;
         double l = INFINITY, h = -INFINITY;
+        double tx[4][4];
+        gather(t, k, c, (int)i0, (int)i1 - (int)i0 + 2, (int)j0, (int)j1 - (int)j0 + 2, sw, tw, tx);
         for (double cj = j0; cj <= j1; cj++)
             for (double ci = i0; ci <= i1; ci++) {
-                int i = (int)ci, j = (int)cj;
-                double v00 = fetch(t, k, c, i, j, sw, tw), v10 = fetch(t, k, c, i + 1, j, sw, tw);
-                double v01 = fetch(t, k, c, i, j + 1, sw, tw);
-                double v11 = fetch(t, k, c, i + 1, j + 1, sw, tw);
+                int ti = (int)(ci - i0), tj = (int)(cj - j0);
+                double v00 = tx[tj][ti], v10 = tx[tj][ti + 1], v01 = tx[tj + 1][ti];
+                double v11 = tx[tj + 1][ti + 1];
                 double vmin = fmin(fmin(v00, v10), fmin(v01, v11));
                 double vmax = fmax(fmax(v00, v10), fmax(v01, v11));
                 double fs[2] = { fmax(x0, ci) - ci, fmin(x1, ci + 1) - ci };
