@@ -29,6 +29,11 @@ const char *sl_opcode_name(sl_opcode op)
     return (unsigned)op < SL_OP__COUNT ? names[op] : "?";
 }
 
+const char *sl_opcode_operands(sl_opcode op)
+{
+    return (unsigned)op < SL_OP__COUNT ? kinds[op] : "----";
+}
+
 static bool is_derivative_op(int op)
 {
     return op == SL_OP_DU || op == SL_OP_DV || op == SL_OP_DERIV || op == SL_OP_CALCNORMAL ||
@@ -110,6 +115,8 @@ static int operand_reach(int op)
     }
 }
 
+int sl_operand_reach(sl_opcode op) { return operand_reach(op); }
+
 void sl_program_assert_valid(const sl_program *p)
 {
     assert(p->nslots <= SL_MAX_SLOTS && p->nstring_slots <= SL_MAX_STRING_SLOTS);
@@ -189,6 +196,7 @@ void sl_program_destroy(sl_program **self_p)
     free(p->pos);
     free(p->consts);
     free(p->tables);
+    free(p->box_plan);
     for (int i = 0; i < p->nstrings; i++)
         free(p->strings[i]);
     free(p->strings);

@@ -277,6 +277,8 @@ void sl_vm_set_print(sl_vm *self, sl_print_fn fn, void *ctx)
     self->print_ctx = ctx;
 }
 
+void sl_vm_set_box_runs(sl_vm *self, bool on) { self->box_runs = on; }
+
 void sl_vm_set_cancel(sl_vm *self, const atomic_int *flag)
 {
     self->cancel = flag;
