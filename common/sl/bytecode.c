@@ -29,6 +29,11 @@ const char *sl_opcode_name(sl_opcode op)
     return (unsigned)op < SL_OP__COUNT ? names[op] : "?";
 }
 
+const char *sl_opcode_operands(sl_opcode op)
+{
+    return (unsigned)op < SL_OP__COUNT ? kinds[op] : "----";
+}
+
 static bool is_derivative_op(int op)
 {
     return op == SL_OP_DU || op == SL_OP_DV || op == SL_OP_DERIV || op == SL_OP_CALCNORMAL ||
@@ -110,6 +115,8 @@ static int operand_reach(int op)
     }
 }
 
+int sl_operand_reach(sl_opcode op) { return operand_reach(op); }
+
 void sl_program_assert_valid(const sl_program *p)
 {
     assert(p->nslots <= SL_MAX_SLOTS && p->nstring_slots <= SL_MAX_STRING_SLOTS);
@@ -159,6 +166,26 @@ bool sl_program_reads_global(const sl_program *p, sl_global g)
     return false;
 }
 
+uint64_t sl_program_global_slots(const sl_program *p)
+{
+    _Static_assert(SL_GLOBAL_SLOTS <= 64, "a global slot mask fits 64 bits");
+    const uint64_t all = SL_GLOBAL_SLOTS == 64 ? ~0ull : (1ull << SL_GLOBAL_SLOTS) - 1;
+    for (int pc = 0; pc < p->ncode; pc++)
+        switch (p->code[pc].op) {
+        case SL_OP_LSTART: case SL_OP_LNEXT: case SL_OP_AMBIENT: case SL_OP_DIFFUSE:
+        case SL_OP_SPECULAR: case SL_OP_PHONG: case SL_OP_RAY: case SL_OP_MESSAGE:
+            return all;
+        default:
+            break;
+        }
+    uint64_t mask = 0;
+    for (int g = 0; g < SL_G__COUNT; g++)
+        if (g == SL_G_u || g == SL_G_v || sl_program_reads_global(p, (sl_global)g))
+            for (int k = 0; k < sl_global_size((sl_global)g); k++)
+                mask |= 1ull << (sl_global_slot((sl_global)g) + k);
+    return mask;
+}
+
 void sl_program_destroy(sl_program **self_p)
 {
     sl_program *p = *self_p;
@@ -169,6 +196,7 @@ void sl_program_destroy(sl_program **self_p)
     free(p->pos);
     free(p->consts);
     free(p->tables);
+    free(p->box_plan);
     for (int i = 0; i < p->nstrings; i++)
         free(p->strings[i]);
     free(p->strings);

@@ -100,6 +100,11 @@ typedef enum sl_opcode {
 } sl_opcode;
 
 const char *sl_opcode_name(sl_opcode op);
+/* The operand kinds of op, four letters as in SL_OPCODES ("zxx-"). */
+const char *sl_opcode_operands(sl_opcode op);
+/* How many slots past its first a slot operand of op may reach (0 for the
+ * scalar operations; conservative for the rest: sl_program_reads_global). */
+int sl_operand_reach(sl_opcode op);
 
 /* ALOAD z, base, index, d / ASTORE base, index, value, d: one lane of an
  * array element, z = base[index * stride] / base[index * stride] = value,
@@ -255,6 +260,12 @@ struct sl_program {
     bool takes_derivatives;         /* a DU, DV, DERIV, CALCNORMAL or AREA may
                                        flow into P: interval/affine runs carry
                                        derivative bounds (vm_deriv.inc) */
+    uint8_t *box_plan;              /* per instruction, what a box run may
+                                       leave out (SL_BOX_*, box_plan.c); NULL:
+                                       nothing */
+    uint64_t global_slots;          /* bit s: a run may read or write global
+                                       slot s (sl_program_global_slots); 0:
+                                       not known, every slot */
 };
 
 /* Scalar slot of a global: P at 0, N at 3, ... (3 slots for points and
@@ -269,6 +280,28 @@ const char *sl_global_name(sl_global g);
  * cannot (`N = calculatenormal(P)` after the last write of P, the common
  * case), range runs need no derivative bounds to bound P. */
 bool sl_program_derivatives_reach_P(const sl_program *p);
+
+/* The global slots a run of p may read or write, as bit s for slot s:
+ * those of every global sl_program_reads_global names, u and v (a varying
+ * parameter is evaluated from them), and all of them for a program with an
+ * operation that reaches globals without naming them (lights, illuminance,
+ * trace, message passing). The derivative-carrying runs copy only these
+ * in and out of their own slot file (vm.c). */
+uint64_t sl_program_global_slots(const sl_program *p);
+
+/* What a box run (an affine run read for P alone: sl_vm_set_box_runs) may
+ * leave out of instruction pc (box_plan.c): */
+enum {
+    SL_BOX_RUN = 0,       /* run it as it is */
+    SL_BOX_VALUE = 1,     /* its value only: no derivative bounds reach P
+                             from what it writes (they are set to the
+                             whole line) */
+    SL_BOX_DEAD = 2,      /* nothing it writes reaches P: unbounded */
+};
+/* The plan of p (ncode bytes, freed with the program), or NULL where the
+ * analysis does not apply (loops, lights, trace, message passing, a
+ * program too large to analyse): then every instruction runs. */
+uint8_t *sl_program_box_plan(const sl_program *p);
 
 /* Asserts the invariants of a generated program (every slot, string slot,
  * jump and table operand inside the program's bounds, END last), once when

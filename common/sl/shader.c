@@ -34,8 +34,11 @@ sl_program *sl_compile(sl_source_set *set, const char *main_file,
         sl_program_destroy(&program);
         return NULL;
     }
-    if (program)
+    if (program) {
         program->takes_derivatives = sl_program_derivatives_reach_P(program);
+        program->global_slots = sl_program_global_slots(program);
+        program->box_plan = sl_program_box_plan(program);
+    }
     return program;
 }
 

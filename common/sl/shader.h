@@ -178,6 +178,13 @@ sl_vm *sl_vm_new(const sl_limits *limits);    /* NULL: defaults */
  * --budget) does not hold a signal up. NULL: never. */
 enum { SL_VM_CANCEL_EVERY = 4096 };
 void sl_vm_set_cancel(sl_vm *self, const atomic_int *flag);
+/* Box runs: the caller reads P alone from this VM's affine runs (the
+ * renderer's boxes of a displaced surface). A program that takes
+ * derivatives then leaves out what cannot reach P (box_plan.c: operations
+ * whose results only reach N = calculatenormal(P), derivative bounds that
+ * only reach such results); P is as without. The other globals an affine
+ * run writes are then not meaningful. Default off. */
+void sl_vm_set_box_runs(sl_vm *self, bool on);
 void sl_vm_destroy(sl_vm **self_p);
 
 /* The named spaces the next runs read: kept by pointer (the binding of

@@ -277,6 +277,8 @@ void sl_vm_set_print(sl_vm *self, sl_print_fn fn, void *ctx)
     self->print_ctx = ctx;
 }
 
+void sl_vm_set_box_runs(sl_vm *self, bool on) { self->box_runs = on; }
+
 void sl_vm_set_cancel(sl_vm *self, const atomic_int *flag)
 {
     self->cancel = flag;
@@ -459,13 +461,15 @@ void sl_vm_set_interval(sl_vm *self, sl_global g, const ia_interval *values)
     memcpy(&self->i[sl_global_slot(g)], values, (size_t)sl_global_size(g) * sizeof *values);
 }
 
-/* count forms, each up to its last symbol in use (a form is never read
- * past n: the rest of its array is stale by design, affine.h) */
+/* count forms (a form is never read past n: the rest of its array is
+ * stale by design, affine.h); copied whole, as a struct: a fixed size
+ * compiles to a few vector moves, where a copy up to n compiled to rep
+ * movs, whose start-up cost dominated these short copies (issue 24) */
 static void copy_forms(aa_form *dst, const aa_form *src, int count)
 {
     for (int k = 0; k < count; k++) {
         assert(src[k].n <= AA_MAX_SYMBOLS);
-        memcpy(&dst[k], &src[k], offsetof(aa_form, c) + (size_t)src[k].n * sizeof src[k].c[0]);
+        dst[k] = src[k];
     }
 }
 
@@ -585,18 +589,26 @@ static sl_status run_with_derivatives(sl_vm *self, sl_mode mode)
     if (mode == SL_MODE_AFFINE) {
         if (!self->ad)
             self->ad = xcalloc(SL_MAX_SLOTS, sizeof *self->ad);
-        for (int s = 0; s < SL_GLOBAL_SLOTS; s++) {
+        /* only the globals the program may touch (a slot it never names
+         * keeps its value in self->a; issue 24: copying all 46 forms in
+         * and out was 12 % of a displaced terrain's time) */
+        uint64_t used = self->prog->global_slots ? self->prog->global_slots : ~0ull;
+        for (uint64_t m = used; m; m &= m - 1) {
+            int s = __builtin_ctzll(m);
+            if (s >= SL_GLOBAL_SLOTS) break;
             const aa_form *x = &self->a[s];
             assert(x->n <= AA_MAX_SYMBOLS);
-            memcpy(&self->ad[s].v, x, offsetof(aa_form, c) + (size_t)x->n * sizeof x->c[0]);
+            self->ad[s].v = *x;       /* whole: a fixed-size copy beats rep movs */
             self->ad[s].du = gderiv_of(self, s, 0);
             self->ad[s].dv = gderiv_of(self, s, 1);
         }
         st = sl_vm_exec_affine_deriv(self);
-        for (int s = 0; s < SL_GLOBAL_SLOTS; s++) {
+        for (uint64_t m = used; m; m &= m - 1) {
+            int s = __builtin_ctzll(m);
+            if (s >= SL_GLOBAL_SLOTS) break;
             const aa_form *x = &self->ad[s].v;
             assert(x->n <= AA_MAX_SYMBOLS);
-            memcpy(&self->a[s], x, offsetof(aa_form, c) + (size_t)x->n * sizeof x->c[0]);
+            self->a[s] = *x;
         }
     } else {
         if (!self->id)

@@ -27,4 +27,5 @@ static inline void b_from_interval(sl_vm *vm, B *z, ia_interval r)
 #define VM_SUFFIX affine_deriv
 #define VM_FILE(vm) ((vm)->ad)
 #define VM_VARIANT VM_VAR_AFFINE_DERIV
+#define VM_BOX_RUNS 1                 /* box runs follow the program's plan */
 #include "vm_deriv.inc"

@@ -182,6 +182,8 @@ struct sl_vm {
     sl_mode mode;
     bool slopes;                  /* sl_vm_run_slopes: derivative bounds must be
                                      true slope bounds (vm_deriv.inc) */
+    bool box_runs;                /* sl_vm_set_box_runs: affine runs are read
+                                     for P alone (box_plan.c) */
     long executed;
     uint64_t rng;
     char error[ERR_LEN];

@@ -17,6 +17,7 @@
  */
 #include "tex/tex_internal.h"
 
+#include <assert.h>
 #include <float.h>
 #include <math.h>
 
@@ -198,12 +199,19 @@ static void minmax(const tex_texture *t, int c, int i0, int i1, int j0, int j1, 
         }
 }
 
+/* A texel coordinate moved out by a relative 1e-9 (as texel_ranges): the
+ * float lookup computes it differently (periodic wrap first), so it may
+ * land in the cell next to the one the exact coordinate is in; the exact
+ * bounds take in every cell it can reach. */
+static double widen_lo(double x) { return x - 1e-9 * (fabs(x) + 1.0); }
+static double widen_hi(double x) { return x + 1e-9 * (fabs(x) + 1.0); }
+
 /* The bilinear cell of level k (n texels along the axis) under every s of
  * [s0, s1]: true with its origin i (texel coordinate x = s n - 1/2, the
  * cell spans [i, i + 1]); unreduced, the texels wrap when fetched. */
 static bool one_cell(double s0, double s1, int n, double *origin)
 {
-    double x0 = s0 * n - 0.5, x1 = s1 * n - 0.5;
+    double x0 = widen_lo(s0 * n - 0.5), x1 = widen_hi(s1 * n - 0.5);
     if (!(fabs(x0) < 1e9 && fabs(x1) < 1e9))
         return false;
     double f = floor(x0);
@@ -212,6 +220,12 @@ static bool one_cell(double s0, double s1, int n, double *origin)
     *origin = f;
     return true;
 }
+
+/* min and max of two numbers, neither NaN (texels are finite: tex.h; the
+ * coordinates were checked by few_cells): a compare, where fmin and fmax
+ * are library calls that also order NaNs */
+static inline double dmin(double a, double b) { return b < a ? b : a; }
+static inline double dmax(double a, double b) { return b > a ? b : a; }
 
 /* 1e-9 of the largest magnitude: covers the float lookup's rounding (its
  * texel coordinate and blend are computed differently from the bound's) */
@@ -225,12 +239,30 @@ static double slack(double a, double b)
  * too large to split. */
 static bool few_cells(double s0, double s1, int n, int most, double *first, double *last)
 {
-    double x0 = s0 * n - 0.5, x1 = s1 * n - 0.5;
+    double x0 = widen_lo(s0 * n - 0.5), x1 = widen_hi(s1 * n - 0.5);
     if (!(fabs(x0) < 1e9 && fabs(x1) < 1e9))
         return false;
     *first = floor(x0);
     *last = fmax(*first, ceil(x1) - 1.0);
     return *last - *first < most;
+}
+
+/* v[b][a] = fetch(t, k, c, i + a, j + b) for a < ni <= 4, b < nj <= 4: the
+ * texels under at most 3 x 3 cells, each read once and each index wrapped
+ * once (the cells share their edges: 16 reads where 36 were, issue 24) */
+static void gather(const tex_texture *t, int k, int c, int i, int ni, int j, int nj,
+                   tex_wrap sw, tex_wrap tw, double v[4][4])
+{
+    assert(ni >= 1 && ni <= 4 && nj >= 1 && nj <= 4);
+    int wi[4], wj[4];
+    bool oi[4], oj[4];
+    for (int a = 0; a < ni; a++)
+        wi[a] = wrap_index(i + a, t->lw[k], sw, &oi[a]);
+    for (int b = 0; b < nj; b++)
+        wj[b] = wrap_index(j + b, t->lh[k], tw, &oj[b]);
+    for (int b = 0; b < nj; b++)
+        for (int a = 0; a < ni; a++)
+            v[b][a] = oi[a] || oj[b] ? 0.0 : tex_at(t, 0, k, c, wi[a], wj[b]);
 }
 
 /* lo <= level k's bilinear <= hi over the s and t of r: exact where r
@@ -245,32 +277,42 @@ static void level_range(const tex_texture *t, int k, int c, const tex_range *r, 
     int n = t->lw[k], m = t->lh[k];
     if (few_cells(r->s[0], r->s[1], n, 3, &i0, &i1) &&
         few_cells(r->t[0], r->t[1], m, 3, &j0, &j1)) {
-        double x0 = r->s[0] * n - 0.5, x1 = r->s[1] * n - 0.5;
-        double y0 = r->t[0] * m - 0.5, y1 = r->t[1] * m - 0.5;
+        double x0 = widen_lo(r->s[0] * n - 0.5), x1 = widen_hi(r->s[1] * n - 0.5);
+        double y0 = widen_lo(r->t[0] * m - 0.5), y1 = widen_hi(r->t[1] * m - 0.5);
         double l = INFINITY, h = -INFINITY;
+        double tx[4][4];
+        gather(t, k, c, (int)i0, (int)i1 - (int)i0 + 2, (int)j0, (int)j1 - (int)j0 + 2, sw, tw, tx);
         for (double cj = j0; cj <= j1; cj++)
             for (double ci = i0; ci <= i1; ci++) {
-                int i = (int)ci, j = (int)cj;
-                double v00 = fetch(t, k, c, i, j, sw, tw), v10 = fetch(t, k, c, i + 1, j, sw, tw);
-                double v01 = fetch(t, k, c, i, j + 1, sw, tw);
-                double v11 = fetch(t, k, c, i + 1, j + 1, sw, tw);
-                double vmin = fmin(fmin(v00, v10), fmin(v01, v11));
-                double vmax = fmax(fmax(v00, v10), fmax(v01, v11));
-                double fs[2] = { fmax(x0, ci) - ci, fmin(x1, ci + 1) - ci };
-                double gs[2] = { fmax(y0, cj) - cj, fmin(y1, cj + 1) - cj };
+                int ti = (int)(ci - i0), tj = (int)(cj - j0);
+                double v00 = tx[tj][ti], v10 = tx[tj][ti + 1], v01 = tx[tj + 1][ti];
+                double v11 = tx[tj + 1][ti + 1];
+                double vmin = dmin(dmin(v00, v10), dmin(v01, v11));
+                double vmax = dmax(dmax(v00, v10), dmax(v01, v11));
+                double fs[2] = { dmax(x0, ci) - ci, dmin(x1, ci + 1) - ci };
+                double gs[2] = { dmax(y0, cj) - cj, dmin(y1, cj + 1) - cj };
+                for (int a = 0; a < 2; a++) {
+                    fs[a] = fs[a] < 0 ? 0 : fs[a] > 1 ? 1 : fs[a];
+                    gs[a] = gs[a] < 0 ? 0 : gs[a] > 1 ? 1 : gs[a];
+                }
+                if (fs[0] == 0 && fs[1] == 1 && gs[0] == 0 && gs[1] == 1) {
+                    /* the whole cell: its extremes are its texels */
+                    l = dmin(l, vmin);
+                    h = dmax(h, vmax);
+                    continue;
+                }
                 double cl = INFINITY, ch = -INFINITY;
                 for (int a = 0; a < 2; a++)
                     for (int b = 0; b < 2; b++) {
-                        double f = fs[a] < 0 ? 0 : fs[a] > 1 ? 1 : fs[a];
-                        double g = gs[b] < 0 ? 0 : gs[b] > 1 ? 1 : gs[b];
+                        double f = fs[a], g = gs[b];
                         double v = (1 - f) * (1 - g) * v00 + f * (1 - g) * v10 +
                                    (1 - f) * g * v01 + f * g * v11;
-                        cl = fmin(cl, v);
-                        ch = fmax(ch, v);
+                        cl = dmin(cl, v);
+                        ch = dmax(ch, v);
                     }
                 double e = slack(vmin, vmax);
-                l = fmin(l, fmax(cl - e, vmin));
-                h = fmax(h, fmin(ch + e, vmax));
+                l = dmin(l, dmax(cl - e, vmin));
+                h = dmax(h, dmin(ch + e, vmax));
             }
         *lo = l;
         *hi = h;

@@ -44,6 +44,9 @@ static sl_vm *new_vm(const trace_world *world)
                                                                 cam->far_clip);
     sl_vm_set_projection(vm, &screen, cam->screen, cam->xres, cam->yres);
     sl_vm_set_textures(vm, world->textures);
+    /* the renderer's affine runs are displacements' boxes: P alone is read
+     * (displace.c, region.c), so a run leaves out what only reaches N */
+    sl_vm_set_box_runs(vm, true);
     sl_vm_set_message(vm, SL_MSG_OPTION, "Format", SL_TYPE_POINT, format, NULL);
     sl_vm_set_message(vm, SL_MSG_OPTION, "Clipping", SL_TYPE_POINT, clipping, NULL);
     return vm;

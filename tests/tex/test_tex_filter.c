@@ -181,6 +181,60 @@ static void test_bound_contains_filter(void **state)
     assert_true(checked > 500000);
 }
 
+/* Ranges over bilinear cells (1.5 to 3.5 texels of level 0 or 1, or
+ * exactly 1 to 3 whole cells; no blend): the bound holds the filter at
+ * every texel centre of the level inside the range, where the filter is
+ * that texel. Random samples seldom land on a texel, which is where a
+ * whole cell's bound (its four texels, filter.c) takes its extremes. */
+static void test_bound_holds_texels(void **state)
+{
+    (void)state;
+    static const int sizes[][2] = { { 8, 8 }, { 13, 31 }, { 64, 32 } };
+    long checked = 0;
+    for (size_t n = 0; n < sizeof sizes / sizeof sizes[0]; n++) {
+        float *px;
+        int w = sizes[n][0], h = sizes[n][1];
+        tex_texture *t = random_texture(w, h, 2, &px);
+        for (int k = 0; k < 4000; k++) {
+            int lv = k % 2, lw = lv == 0 ? w : (w + 1) / 2, lh = lv == 0 ? h : (h + 1) / 2;
+            double ws = lv == 0 ? 0.0 : 2.0 / w, wt = lv == 0 ? 0.0 : 2.0 / h;
+            if (lv == 1 && (w < 2 || h < 2))
+                continue;
+            tex_wrap sw = (tex_wrap)(k / 2 % 3), tw = (tex_wrap)(k / 6 % 3);
+            double s0 = range(-0.5, 1.5), t0 = range(-0.5, 1.5);
+            tex_range r = { { s0, s0 + range(1.5, 3.5) / lw }, { t0, t0 + range(1.5, 3.5) / lh },
+                            { ws, ws }, { wt, wt } };
+            if (k % 4 >= 2) {
+                /* from texel centre to texel centre (exact in binary for
+                 * the power-of-two sizes): 1 to 3 whole cells, no part
+                 * of a neighbour around them */
+                r.s[0] = (floor(range(-4, lw + 4)) + 0.5) / lw;
+                r.s[1] = r.s[0] + (double)(1 + k / 4 % 3) / lw;
+                r.t[0] = (floor(range(-4, lh + 4)) + 0.5) / lh;
+                r.t[1] = r.t[0] + (double)(1 + k / 12 % 3) / lh;
+            }
+            double lo, hi;
+            tex_bound(t, k % 2, &r, sw, tw, 0.0, &lo, &hi);
+            for (long j = (long)floor(r.t[0] * lh - 0.5); j <= (long)ceil(r.t[1] * lh); j++)
+                for (long i = (long)floor(r.s[0] * lw - 0.5); i <= (long)ceil(r.s[1] * lw); i++) {
+                    double s = (i + 0.5) / lw, tt = (j + 0.5) / lh;
+                    if (s < r.s[0] || s > r.s[1] || tt < r.t[0] || tt > r.t[1])
+                        continue;
+                    double v = tex_sample(t, k % 2, s, tt, ws, wt, sw, tw, 0, NULL, NULL);
+                    if (!(v >= lo && v <= hi))
+                        fail_msg("%dx%d level %d wrap %d/%d: the texel at s %.17g t %.17g = "
+                                 "%.17g outside the bound [%.17g, %.17g] of s [%.17g, %.17g] "
+                                 "t [%.17g, %.17g]", w, h, lv, sw, tw, s, tt, v, lo, hi,
+                                 r.s[0], r.s[1], r.t[0], r.t[1]);
+                    checked++;
+                }
+        }
+        tex_destroy(&t);
+        free(px);
+    }
+    assert_true(checked > 20000);
+}
+
 static void test_bound_is_tight(void **state)
 {
     (void)state;
@@ -315,6 +369,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_level0_is_bilinear),
         cmocka_unit_test(test_bound_contains_filter),
+        cmocka_unit_test(test_bound_holds_texels),
         cmocka_unit_test(test_bound_is_tight),
         cmocka_unit_test(test_cells_are_the_filter),
         cmocka_unit_test(test_bound_converges),

@@ -1,0 +1,282 @@
+/*
+ * tests/sl/test_sl_box_plan.c: box runs (sl_vm_set_box_runs, box_plan.c)
+ * leave out of a displacement's affine run only what cannot reach P.
+ *
+ *   same P      on random boxes of the plane and the sphere, P of a box
+ *               run equals P of the full derivative-carrying run form for
+ *               form (centre, coefficients, error, hull, flags) for
+ *               shaders that take derivatives: a height map's filter width
+ *               from Du/Dv then calculatenormal, branches on the range,
+ *               an early return, Deriv and area, the library's
+ *               displacement shaders; the corpus's the same, or (P merged
+ *               after calculatenormal: other noise symbols) enclosing the
+ *               float P at 5 x 5 points of every box
+ *   the plan    a terrain-like shader leaves calculatenormal and N out
+ *               (SL_BOX_DEAD) and runs the normalize chain without
+ *               derivatives (SL_BOX_VALUE), keeps the derivative chain of
+ *               the filter width (SL_BOX_RUN); a loop gets no plan
+ */
+#include <dirent.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <setjmp.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include "sl/bytecode.h"
+#include "sl_harness.h"
+
+#ifndef AAFARM_CORPUS_DIR
+#define AAFARM_CORPUS_DIR "tests/shaders/corpus"
+#endif
+
+static bool same_form(const aa_form *a, const aa_form *b)
+{
+    if (a->n != b->n || a->flags != b->flags)
+        return false;
+    if (memcmp(&a->x0, &b->x0, sizeof a->x0) || memcmp(&a->err, &b->err, sizeof a->err) ||
+        memcmp(&a->lo, &b->lo, sizeof a->lo) || memcmp(&a->hi, &b->hi, sizeof a->hi))
+        return false;
+    return memcmp(a->c, b->c, (size_t)a->n * sizeof a->c[0]) == 0;
+}
+
+/* P of one affine run over the box, box runs on or off */
+static sl_status run_P(sl_vm *vm, const sl_instance *inst, aa_context *ctx, h_surface s,
+                       const double box[4], bool box_runs, aa_form P[3])
+{
+    sl_vm_set_box_runs(vm, box_runs);
+    h_globals_affine(vm, ctx, s, box[0], box[1], box[2], box[3]);
+    sl_status st = sl_vm_run(vm, inst, SL_MODE_AFFINE, ctx);
+    if (st == SL_OK)
+        sl_vm_get_affine(vm, SL_G_P, P);
+    return st;
+}
+
+/* float P at 5 x 5 points of the box (edges included) inside the box
+ * run's P (the float run's rounding: 1e-9, as test_sl_bounds) */
+static bool contains_samples(sl_vm *vm, const sl_instance *inst, h_surface s,
+                             const double box[4], const aa_form P[3])
+{
+    for (int a = 0; a <= 4; a++)
+        for (int b = 0; b <= 4; b++) {
+            double u = box[0] + (box[1] - box[0]) * a / 4, v = box[2] + (box[3] - box[2]) * b / 4;
+            double f[3];
+            h_globals_float(vm, s, u, v);
+            if (sl_vm_run(vm, inst, SL_MODE_FLOAT, NULL) != SL_OK)
+                continue;
+            sl_vm_get_float(vm, SL_G_P, f);
+            for (int i = 0; i < 3; i++) {
+                ia_interval r = aa_range(&P[i]);
+                double tol = 1e-9 * (1 + fabs(f[i]));
+                if (!(f[i] >= r.lo - tol && f[i] <= r.hi + tol))
+                    return false;
+            }
+        }
+    return true;
+}
+
+/* The number of boxes (of 2 x 40) whose P differs between box and full
+ * runs (when !exact: only those where the box run's P misses a float
+ * sample; *renamed counts the others); -1 when the shader fails to run
+ * the same way in both. */
+static int differing_as(sl_program *p, const char *what, bool exact, int *renamed)
+{
+    sl_instance *inst = sl_instance_new(p);
+    sl_vm *vm = sl_vm_new(NULL);
+    aa_context ctx;
+    aa_context_init(&ctx, AA_DEFAULT_CAPACITY);
+    unsigned long long seed = 0x5eedull;
+    int bad = 0;
+    for (int si = 0; si < 2; si++) {
+        h_surface s = si == 0 ? H_PLANE : H_SPHERE;
+        for (int k = 0; k < 40; k++) {
+            double w = k < 10 ? 0.3 : k < 25 ? 0.03 : 0.002;
+            double u0 = 0.05 + 0.85 * h_rand(&seed), v0 = 0.05 + 0.85 * h_rand(&seed);
+            double box[4] = { u0, u0 + w * (0.5 + h_rand(&seed)), v0,
+                              v0 + w * (0.5 + h_rand(&seed)) };
+            aa_form full[3], cut[3];
+            sl_status a = run_P(vm, inst, &ctx, s, box, false, full);
+            sl_status b = run_P(vm, inst, &ctx, s, box, true, cut);
+            if (a != b) {
+                fprintf(stderr, "%s: status %d full, %d box run\n", what, (int)a, (int)b);
+                bad = -1;
+                goto done;
+            }
+            if (a != SL_OK)
+                continue;
+            bool same = true;
+            for (int i = 0; i < 3; i++)
+                same = same && same_form(&full[i], &cut[i]);
+            if (!same && !exact && contains_samples(vm, inst, s, box, cut)) {
+                ++*renamed;
+                continue;
+            }
+            if (!same && bad < 3) {
+                ia_interval f = aa_range(&full[0]), c = aa_range(&cut[0]);
+                fprintf(stderr, "%s (%s) box [%g %g]x[%g %g]: P.x full [%.17g, %.17g], box run "
+                        "[%.17g, %.17g]\n", what, s == H_PLANE ? "plane" : "sphere", box[0],
+                        box[1], box[2], box[3], f.lo, f.hi, c.lo, c.hi);
+            }
+            bad += !same;
+        }
+    }
+done:
+    sl_vm_destroy(&vm);
+    sl_instance_destroy(&inst);
+    return bad;
+}
+
+static int differing(sl_program *p, const char *what)
+{
+    int renamed = 0;
+    return differing_as(p, what, true, &renamed);
+}
+
+static void check_source(const char *src)
+{
+    sl_program *p = h_compile(src);
+    assert_non_null(p);
+    assert_true(sl_program_takes_derivatives(p));
+    assert_int_equal(differing(p, src), 0);
+    sl_program_destroy(&p);
+}
+
+/* a height field as heightmap.sl writes it, with a function instead of the
+ * map: the filter width from Du/Dv, the normal from calculatenormal */
+static const char TERRAIN[] =
+    "displacement t(float Km = 0.3, blur = 1) {\n"
+    "  float ss = s * 2, tt = t * 2;\n"
+    "  float fw = max(abs(Du(ss) * du) + abs(Dv(ss) * dv),\n"
+    "                 abs(Du(tt) * du) + abs(Dv(tt) * dv));\n"
+    "  float h = sin(ss * 5 + blur * fw) * cos(tt * 3) + 0.2 * clamp(ss - tt, -0.5, 0.5);\n"
+    "  P += Km * h * normalize(N);\n"
+    "  N = calculatenormal(P);\n"
+    "}\n";
+
+static void test_same_P(void **state)
+{
+    (void)state;
+    check_source(TERRAIN);
+    /* branches undecided over the range, merged */
+    check_source("displacement t() {\n"
+                 "  float h = Du(s * s) * 0.1;\n"
+                 "  if (s > 0.5) h = h * 2 + sqrt(t + 1); else h = -h / (t + 1);\n"
+                 "  vector d = normalize(N);\n"
+                 "  P += h * d;\n"
+                 "  N = calculatenormal(P);\n"
+                 "}\n");
+    /* an early return from a function, Deriv and area */
+    check_source("float f(float x) { if (x > 0.6) return x * x; return -x; }\n"
+                 "displacement t() {\n"
+                 "  float a = area(P), g = Deriv(s * t, s);\n"
+                 "  float h = f(s) * 0.1 + min(a, 1) * 0.01 + g * 0.05;\n"
+                 "  P += h * normalize(N);\n"
+                 "  N = calculatenormal(P);\n"
+                 "}\n");
+    /* the derivative of a result that is written again before P */
+    check_source("displacement t() {\n"
+                 "  float x = s * 3;\n"
+                 "  float d = Du(x);\n"
+                 "  x = d * t;\n"
+                 "  P += point(x * 0.01, abs(Dv(x)) * 0.01, 0);\n"
+                 "  N = calculatenormal(P);\n"
+                 "}\n");
+}
+
+static void test_library_and_corpus(void **state)
+{
+    (void)state;
+    int checked = 0;
+    static const char *const lib[] = { "heightmap", "dented", "wave", "nail", "threads", "ufo" };
+    for (size_t i = 0; i < sizeof lib / sizeof lib[0]; i++) {
+        sl_program *p = h_compile_library(lib[i]);
+        if (!p)
+            continue;
+        if (sl_program_kind(p) == SL_SHADER_DISPLACEMENT && sl_program_takes_derivatives(p)) {
+            assert_int_equal(differing(p, lib[i]), 0);
+            checked++;
+        }
+        sl_program_destroy(&p);
+    }
+    DIR *d = opendir(AAFARM_CORPUS_DIR);
+    assert_non_null(d);
+    struct dirent *e;
+    while ((e = readdir(d))) {
+        size_t n = strlen(e->d_name);
+        if (n < 4 || strcmp(e->d_name + n - 3, ".sl") != 0)
+            continue;
+        char path[1024];
+        snprintf(path, sizeof path, "%s/%s", AAFARM_CORPUS_DIR, e->d_name);
+        FILE *f = fopen(path, "rb");
+        assert_non_null(f);
+        static char text[1 << 16];
+        size_t len = fread(text, 1, sizeof text - 1, f);
+        fclose(f);
+        text[len] = '\0';
+        char *diag = NULL;
+        sl_program *p = h_compile_named(e->d_name, text, &diag);
+        free(diag);
+        if (!p)
+            continue;            /* one that needs an include path: not ours */
+        if (sl_program_kind(p) == SL_SHADER_DISPLACEMENT && sl_program_takes_derivatives(p)) {
+            /* a shader that merges P after calculatenormal (a return
+             * after it, an undecided branch around it) may give P other
+             * noise symbols: calculatenormal no longer takes its three
+             * (box_plan.c); P then still holds every sample */
+            int renamed = 0;
+            int bad = differing_as(p, e->d_name, false, &renamed);
+            if (bad != -1)        /* a texture shader without its maps fails both ways */
+                assert_int_equal(bad, 0);
+            if (renamed)
+                fprintf(stderr, "%s: %d boxes with P on other symbols, samples inside\n",
+                        e->d_name, renamed);
+            checked++;
+        }
+        sl_program_destroy(&p);
+    }
+    closedir(d);
+    fprintf(stderr, "%d library and corpus shaders that take derivatives\n", checked);
+    assert_true(checked >= 3);
+}
+
+static int find_op(const sl_program *p, int op, int from)
+{
+    for (int pc = from; pc < p->ncode; pc++)
+        if (p->code[pc].op == op)
+            return pc;
+    return -1;
+}
+
+static void test_plan(void **state)
+{
+    (void)state;
+    sl_program *p = h_compile(TERRAIN);
+    assert_non_null(p);
+    assert_non_null(p->box_plan);
+    int cn = find_op(p, SL_OP_CALCNORMAL, 0), inv = find_op(p, SL_OP_INVSQRT, 0);
+    int du = find_op(p, SL_OP_DU, 0);
+    assert_true(cn >= 0 && inv >= 0 && du >= 0);
+    assert_int_equal(p->box_plan[cn], SL_BOX_DEAD);       /* only N reads it */
+    assert_int_equal(p->box_plan[inv], SL_BOX_VALUE);     /* normalize(N) */
+    /* ss = s * 2, whose derivative Du reads */
+    int mul = find_op(p, SL_OP_MUL, 0);
+    assert_true(mul >= 0 && mul < du);
+    assert_int_equal(p->box_plan[mul], SL_BOX_RUN);
+    sl_program_destroy(&p);
+
+    p = h_compile("displacement t() { float h = 0; for (float i = 0; i < 3; i += 1)"
+                  " h += Du(s * i); P += h * normalize(N); N = calculatenormal(P); }");
+    assert_non_null(p);
+    assert_null(p->box_plan);                              /* a loop: no plan */
+    sl_program_destroy(&p);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_same_P),
+        cmocka_unit_test(test_library_and_corpus),
+        cmocka_unit_test(test_plan),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
