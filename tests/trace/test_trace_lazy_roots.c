@@ -3,7 +3,8 @@
  * ray first reaches a piece (issue 23; trace/mesh.c, trace/lazy_roots.h).
  *
  * - The BVH's boxes, made before any piece's own box from one shader run
- *   per region of the tree, hold every displaced point of every piece:
+ *   per region of the tree, hold every displaced point of every piece (of
+ *   polygon meshes and of a Catmull-Clark cage):
  *   points sampled on the surface by the float evaluator (not by the
  *   boxes' code) are each reached by a ray aimed at them through the tree.
  * - The regions' bounds of du and dv (from a 3 x 3 grid) hold each
@@ -39,6 +40,8 @@ enum { W = 48, H = 36, PX = W * H * 4 };
 /* An n x n grid of quads over [-n/2, n/2]^2 (z = 0), bent a little so its
  * normals differ, with "st" and an optional "varying float amp"; seen
  * whole (fov 60) or only near its middle (fov 12) */
+static bool subdiv_grid = false;   /* grid_rib: a Catmull-Clark cage instead */
+
 static char *grid_rib(int n, const char *disp, bool amp, bool narrow)
 {
     size_t cap = (size_t)(n + 1) * (n + 1) * 120 + (size_t)n * n * 40 + 4096, len = 0;
@@ -48,8 +51,9 @@ static char *grid_rib(int n, const char *disp, bool amp, bool narrow)
                             "Format %d %d 1\nProjection \"perspective\" \"fov\" [%d]\n"
                             "Translate 0 0 %g\nRotate -40 1 0 0\nWorldBegin\n"
                             "LightSource \"distantlight\" 1 \"from\" [1 2 -3] \"to\" [0 0 0]\n"
-                            "%s\nPointsPolygons [",
-                            W, H, narrow ? 12 : 60, 0.9 * n, disp);
+                            "%s\n%s [",
+                            W, H, narrow ? 12 : 60, 0.9 * n, disp,
+                            subdiv_grid ? "SubdivisionMesh \"catmull-clark\"" : "PointsPolygons");
     for (int i = 0; i < n * n; i++) len += (size_t)snprintf(t + len, cap - len, "4 ");
     len += (size_t)snprintf(t + len, cap - len, "] [");
     for (int j = 0; j < n; j++)
@@ -59,6 +63,7 @@ static char *grid_rib(int n, const char *disp, bool amp, bool narrow)
                                     a + n + 1);
         }
     double h = n / 2.0;
+    if (subdiv_grid) len += (size_t)snprintf(t + len, cap - len, "] [\"interpolateboundary\"] [0 0] [] [");
     len += (size_t)snprintf(t + len, cap - len, "] \"P\" [");
     for (int j = 0; j <= n; j++)
         for (int i = 0; i <= n; i++) {
@@ -209,17 +214,20 @@ static int misses(fixture *f, int samples)
 static void test_boxes_hold_the_surface(void **state)
 {
     (void)state;
-    const char *disp[] = {"Displacement \"bumps\"", "Displacement \"stwave\""};
-    for (int i = 0; i < 2; i++) {
+    const char *disp[] = {"Displacement \"bumps\"", "Displacement \"stwave\"",
+                          "Displacement \"bumps\""};
+    for (int i = 0; i < 3; i++) {
         fixture f;
-        open_grid(&f, 24, disp[i], false, false);
+        subdiv_grid = i == 2;          /* a Catmull-Clark cage's limit pieces */
+        open_grid(&f, i == 2 ? 12 : 24, disp[i], false, false);
+        subdiv_grid = false;
         const trace_mesh *m = mesh_of(&f);
         /* every region bounded its pieces: no root made yet */
         assert_non_null(m->lazy);
         assert_int_equal(trace_lazy_roots_known(m->lazy), 0);
         int missed = misses(&f, 6);
-        printf("%s: %d pieces, %d sampled points missed by the BVH\n", disp[i], m->npieces,
-               missed);
+        printf("%s on %s: %d pieces, %d sampled points missed by the BVH\n", disp[i],
+               i == 2 ? "a Catmull-Clark cage" : "a polygon mesh", m->npieces, missed);
         assert_int_equal(missed, 0);
         fixture_close(&f);
     }
