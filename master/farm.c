@@ -80,10 +80,13 @@ void farm_options_default(farm_options *opt)
     opt->threads_per_worker = 1;
     opt->heartbeat_ms = 1000;
     opt->liveness = 3;
-    opt->max_attempts = 3;
-    opt->max_duplicates = 1;
-    opt->lease_ms = 120000;
-    opt->lease_factor = 4;
+    /* the scheduler's own defaults, which these options pass on to it */
+    scheduler_options so;
+    scheduler_options_default(&so);
+    opt->max_attempts = so.max_attempts;
+    opt->max_duplicates = so.max_duplicates;
+    opt->lease_ms = so.lease_ms;
+    opt->lease_factor = so.lease_factor;
     opt->max_workers = 1024;
     opt->wait_report_ms = 30000;
 }
