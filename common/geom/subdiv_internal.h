@@ -40,16 +40,32 @@ void sd_refine(const sd_mesh *m, sd_mesh *out);
 
 typedef struct sd_node sd_node;    /* subdiv_cache.c */
 
+/* The mesh a worker keeps (issue 23: a few bytes a control face): the
+ * control mesh and its point -> corners table, and per face of the refined
+ * mesh (level 1, all quads: face f is the child of control corner f) one
+ * byte of flags. The refined mesh itself is not kept: the 1-ring of a
+ * refined face is made when it is asked for (sd_local_from_shared,
+ * subdiv_mesh.c) by refining the control faces around its control face,
+ * the same steps in the same order as refining the whole mesh, so it is
+ * the same to the bit; a regular face's Bezier net is made with its
+ * surface (geom_subdiv_surface) and travels in it. */
+enum { SD_DRAWN = 1, SD_REGULAR = 2 };
+
 struct geom_subdiv {
-    sd_mesh m;                     /* level 1: all quads */
-    int *vf_off, *vf;              /* point -> corners holding it (CSR) */
-    int maxval;                    /* the largest valence (>= 4): local meshes' sizes */
-    unsigned char *drawn;          /* per face */
-    int *origin;                   /* per face: the control face */
-    int *net_of;                   /* per face: index into nets, or -1 */
-    vec3 *nets;                    /* Bezier nets (16 each) of regular faces */
-    _Atomic(sd_node *) *roots;     /* per face: its local refinements (subdiv_cache.c) */
+    sd_mesh m0;                    /* the control mesh (vs, es NULL when all 0) */
+    int nf1;                       /* refined faces (control corners) */
+    int *vf_off, *vf;              /* control point -> corners holding it (CSR) */
+    int maxval;                    /* the largest valence of the refined mesh (>= 4):
+                                    * local meshes' sizes */
+    unsigned char *flags;          /* per refined face: SD_DRAWN, SD_REGULAR */
+    int *irr_base;                 /* per 64 refined faces: drawn irregular faces before */
+    int nirr;
+    _Atomic(sd_node *) *roots;     /* per drawn irregular face (by rank): its local
+                                    * refinements (subdiv_cache.c) */
 };
+
+/* The rank of drawn irregular face f among them (its slot in roots). */
+int sd_irregular_rank(const geom_subdiv *sd, int f);
 
 /* The per-face trees of subdiv_cache.c: made empty, freed with the mesh. */
 void sd_cache_init(geom_subdiv *sd);
