@@ -37,26 +37,23 @@
 void sd_local_init(sd_local *L, int maxval)
 {
     assert(maxval >= 4);
-    int lf = sd_lf(maxval), lc = sd_lc(maxval), lv = sd_lv(maxval);
+    size_t lf = (size_t)sd_lf(maxval), lc = (size_t)sd_lc(maxval), lv = (size_t)sd_lv(maxval);
     *L = (sd_local){ .maxval = maxval };
-    L->P = xmalloc((size_t)lv * sizeof *L->P);
-    L->vs = xmalloc((size_t)lv * sizeof *L->vs);
-    L->fo = xmalloc((size_t)(lf + 1) * sizeof *L->fo);
-    L->fv = xmalloc((size_t)lc * sizeof *L->fv);
-    L->es = xmalloc((size_t)lc * sizeof *L->es);
-    L->list = xmalloc((size_t)lf * sizeof *L->list);
-    L->src = xmalloc((size_t)lv * sizeof *L->src);
+    /* one block (a 1-ring is made for every face's surface) */
+    char *b = xmalloc(lv * sizeof(vec3) + (lv + lc) * sizeof(double) +
+                      (lf + 1 + lc + lf + lv) * sizeof(int));
+    L->P = (vec3 *)b;
+    L->vs = (double *)(L->P + lv);
+    L->es = L->vs + lv;
+    L->fo = (int *)(L->es + lc);
+    L->fv = L->fo + lf + 1;
+    L->list = L->fv + lc;
+    L->src = L->list + lf;
 }
 
 void sd_local_clear(sd_local *L)
 {
     free(L->P);
-    free(L->vs);
-    free(L->fo);
-    free(L->fv);
-    free(L->es);
-    free(L->list);
-    free(L->src);
     *L = (sd_local){ 0 };
 }
 

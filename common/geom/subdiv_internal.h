@@ -25,11 +25,8 @@ typedef struct sd_mesh {
     double *es;
 } sd_mesh;
 
-/* Sizes of one Catmull-Clark step of m: points nv + nf + nedges, faces =
- * corners of m, corners = 4 * corners of m. */
-int sd_edge_count(const sd_mesh *m);
-
-/* One step: out's arrays must hold the sizes above. New points: the
+/* One step: out's arrays must hold its sizes: points nv + nf + nedges
+ * (nedges <= corners), faces = corners of m, corners = 4 * corners of m. New points: the
  * vertex points of m's points (same indices), then face points (nv + f),
  * then edge points. Child faces are quads, one per corner, in corner
  * order; a quad parent's child k covers the parent's quadrant k (0:
@@ -52,6 +49,7 @@ typedef struct sd_node sd_node;    /* subdiv_cache.c */
 enum { SD_DRAWN = 1, SD_REGULAR = 2 };
 
 struct geom_subdiv {
+    unsigned long serial;          /* a number of its own (subdiv_mesh.c's ring cache) */
     sd_mesh m0;                    /* the control mesh (vs, es NULL when all 0) */
     int nf1;                       /* refined faces (control corners) */
     int *vf_off, *vf;              /* control point -> corners holding it (CSR) */

@@ -66,6 +66,7 @@ typedef struct sd_ring {
     sd_mesh ctl, ref;              /* the control faces, and refined */
     int base;                      /* F's first corner in ctl (its children in ref) */
     int *list;                     /* scratch */
+    void *block;                   /* all of the above's arrays */
 } sd_ring;
 
 void sd_ring_make(const geom_subdiv *sd, int F, sd_ring *R);

@@ -31,6 +31,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* the meshes' serial numbers (ring_of_face's cache below) */
+static _Atomic unsigned long next_serial = 1;
+
 static double tag_sharpness(double s)
 {
     return s >= GEOM_SUBDIV_INFINITE ? INFINITY : (s > 0 ? s : 0);
@@ -84,6 +87,7 @@ geom_subdiv *geom_subdiv_new(const geom_subdiv_desc *d, char *err, size_t errsz)
     int *count = xcalloc((size_t)nv + 1, sizeof *count);
     unsigned char *hole0 = xcalloc((size_t)nf + 1, 1);
     geom_subdiv *sd = xcalloc(1, sizeof *sd);
+    sd->serial = atomic_fetch_add(&next_serial, 1);
     bool ok = true;
     for (int i = 0; i < nv; i++) m0.P[i] = v3(d->P[3 * i], d->P[3 * i + 1], d->P[3 * i + 2]);
     m0.fo[0] = 0;
@@ -328,7 +332,15 @@ static int int_cmp(const void *x, const void *y)
 /* sorts a[0..n) and drops repeats; the new count */
 static int sort_unique(int *a, int n)
 {
-    qsort(a, (size_t)n, sizeof *a, int_cmp);
+    if (n <= 64) {                     /* a control face's ring: a few dozen */
+        for (int i = 1; i < n; i++) {
+            int x = a[i], j = i;
+            for (; j > 0 && a[j - 1] > x; j--) a[j] = a[j - 1];
+            a[j] = x;
+        }
+    } else {
+        qsort(a, (size_t)n, sizeof *a, int_cmp);
+    }
     int m = 0;
     for (int i = 0; i < n; i++)
         if (m == 0 || a[m - 1] != a[i]) a[m++] = a[i];
@@ -347,28 +359,46 @@ static int find_sorted(const int *a, int n, int x)
     return lo;
 }
 
-void sd_ring_make(const geom_subdiv *sd, int F, sd_ring *R)
+/* sd_ring_make into buf when its arrays fit in cap bytes (false if they
+ * do not: R untouched), or on the heap (buf NULL) */
+static bool ring_build(const geom_subdiv *sd, int F, sd_ring *R, void *buf, size_t cap)
 {
     const sd_mesh *m = &sd->m0;
     int nfc = 0;
     for (int c = m->fo[F]; c < m->fo[F + 1]; c++) nfc += sd->vf_off[m->fv[c] + 1] - sd->vf_off[m->fv[c]];
-    int *faces = xmalloc((size_t)nfc * sizeof *faces);
+    int stack[256];
+    int *faces = nfc <= 256 ? stack : xmalloc((size_t)nfc * sizeof *faces);
     nfc = 0;
     for (int c = m->fo[F]; c < m->fo[F + 1]; c++)
         for (int i = sd->vf_off[m->fv[c]]; i < sd->vf_off[m->fv[c] + 1]; i++)
             faces[nfc++] = face_of_corner(m, sd->vf[i]);
     int nf = sort_unique(faces, nfc), nc = 0;
     for (int i = 0; i < nf; i++) nc += m->fo[faces[i] + 1] - m->fo[faces[i]];
-    int *pts = xmalloc((size_t)nc * sizeof *pts);
+    /* one block: the control faces (nv <= nc points), their refinement
+     * (nv + nf + nc points, nc faces, 4 nc corners), the points' names and
+     * the children's list */
+    size_t c1 = (size_t)nc, f1 = (size_t)nf, v1 = (size_t)(nc + nf + nc);
+    size_t bytes = (c1 + v1) * (sizeof(vec3) + sizeof(double)) + c1 * sizeof(double) +
+                   4 * c1 * sizeof(double) +
+                   (f1 + 1 + c1 + c1 + 1 + 4 * c1 + c1 + c1 + 1) * sizeof(int);
+    if (buf && bytes > cap) {
+        if (faces != stack) free(faces);
+        return false;
+    }
+    char *b = buf ? buf : xmalloc(bytes);
+    sd_mesh *lm = &R->ctl, *lr = &R->ref;
+    vec3 *P0 = (vec3 *)b, *P1 = P0 + c1;
+    double *vs0 = (double *)(P1 + v1), *vs1 = vs0 + c1, *es0 = vs1 + v1, *es1 = es0 + c1;
+    int *fo0 = (int *)(es1 + 4 * c1), *fv0 = fo0 + f1 + 1, *fo1 = fv0 + c1, *fv1 = fo1 + c1 + 1;
+    int *pts = fv1 + 4 * c1;
+    R->list = pts + c1;
+    R->block = buf ? NULL : b;
     nc = 0;
     for (int i = 0; i < nf; i++)
         for (int c = m->fo[faces[i]]; c < m->fo[faces[i] + 1]; c++) pts[nc++] = m->fv[c];
     int nv = sort_unique(pts, nc);
     /* the control faces, their points numbered in the mesh's order */
-    sd_mesh *lm = &R->ctl, *lr = &R->ref;
-    *lm = (sd_mesh){ nv, nf, xmalloc((size_t)nv * sizeof(vec3)), xmalloc((size_t)nv * sizeof(double)),
-                     xmalloc((size_t)(nf + 1) * sizeof(int)), xmalloc((size_t)nc * sizeof(int)),
-                     xmalloc((size_t)nc * sizeof(double)) };
+    *lm = (sd_mesh){ nv, nf, P0, vs0, fo0, fv0, es0 };
     for (int i = 0; i < nv; i++) {
         lm->P[i] = m->P[pts[i]];
         lm->vs[i] = m->vs ? m->vs[pts[i]] : 0;
@@ -382,14 +412,43 @@ void sd_ring_make(const geom_subdiv *sd, int F, sd_ring *R)
         }
         lm->fo[i + 1] = lc;
     }
-    int nv1 = nv + nf + nc;         /* edges <= corners */
-    *lr = (sd_mesh){ 0, 0, xmalloc((size_t)nv1 * sizeof(vec3)), xmalloc((size_t)nv1 * sizeof(double)),
-                     xmalloc((size_t)(nc + 1) * sizeof(int)), xmalloc((size_t)(4 * nc) * sizeof(int)),
-                     xmalloc((size_t)(4 * nc) * sizeof(double)) };
+    *lr = (sd_mesh){ 0, 0, P1, vs1, fo1, fv1, es1 };
     sd_refine(lm, lr);
-    R->list = xmalloc((size_t)(nc + 1) * sizeof *R->list);
-    free(faces);
-    free(pts);
+    if (faces != stack) free(faces);
+    return true;
+}
+
+void sd_ring_make(const geom_subdiv *sd, int F, sd_ring *R)
+{
+    ring_build(sd, F, R, NULL, 0);
+}
+
+/* The last ring a thread made, in a buffer of its own (no heap, so
+ * nothing is left when the thread ends): the children of a control face
+ * come one after the other (the world's pass over the pieces, a ray's
+ * neighbouring faces), and share it. Keyed by the mesh's serial number,
+ * never reused. */
+enum { RING_CACHE_BYTES = 32768 };
+static _Thread_local struct {
+    unsigned long serial;
+    int F;
+    sd_ring R;
+    _Alignas(16) char buf[RING_CACHE_BYTES];
+} ring_cache;
+
+/* F's ring: the thread's cached one, or made into *heap (then freed by
+ * the caller with sd_ring_clear) */
+static const sd_ring *ring_of_face(const geom_subdiv *sd, int F, sd_ring *heap)
+{
+    if (ring_cache.serial == sd->serial && ring_cache.F == F) return &ring_cache.R;
+    ring_cache.serial = 0;
+    if (ring_build(sd, F, &ring_cache.R, ring_cache.buf, sizeof ring_cache.buf)) {
+        ring_cache.serial = sd->serial;
+        ring_cache.F = F;
+        return &ring_cache.R;
+    }
+    ring_build(sd, F, heap, NULL, 0);
+    return heap;
 }
 
 void sd_ring_child(const sd_ring *R, int k, sd_local *L)
@@ -413,27 +472,18 @@ void sd_ring_child(const sd_ring *R, int k, sd_local *L)
 
 void sd_ring_clear(sd_ring *R)
 {
-    sd_mesh *ms[2] = { &R->ctl, &R->ref };
-    for (int i = 0; i < 2; i++) {
-        free(ms[i]->P);
-        free(ms[i]->vs);
-        free(ms[i]->fo);
-        free(ms[i]->fv);
-        free(ms[i]->es);
-        *ms[i] = (sd_mesh){ 0 };
-    }
-    free(R->list);
-    R->list = NULL;
+    free(R->block);
+    *R = (sd_ring){ 0 };
 }
 
 void sd_local_from_shared(const geom_subdiv *sd, int f, sd_local *L)
 {
     assert(L->maxval == sd->maxval);
     int F = face_of_corner(&sd->m0, f);
-    sd_ring R;
-    sd_ring_make(sd, F, &R);
-    sd_ring_child(&R, f - sd->m0.fo[F], L);
-    sd_ring_clear(&R);
+    sd_ring heap = { 0 };
+    const sd_ring *R = ring_of_face(sd, F, &heap);
+    sd_ring_child(R, f - sd->m0.fo[F], L);
+    sd_ring_clear(&heap);
 }
 
 void geom_subdiv_surface(const geom_subdiv *self, int f, geom_surface *out)

@@ -76,11 +76,12 @@ typedef struct vring {
     int nfaces, nedges, ninf;
     bool ok;                       /* every sharpness 0 or infinite */
     int *other;
+    int stack[64];                 /* other, when it fits */
 } vring;
 
 static void ring_clear(vring *r)
 {
-    free(r->other);
+    if (r->other != r->stack) free(r->other);
     r->other = NULL;
 }
 
@@ -89,8 +90,9 @@ static void ring_of(const sd_mesh *m, int v, vring *r)
     r->nfaces = r->nedges = r->ninf = 0;
     r->ok = tag_ok(m->vs[v]);
     int cap = 2 * m->nf;
-    r->other = xmalloc((size_t)cap * sizeof *r->other);
-    double *sh = xmalloc((size_t)cap * sizeof *sh);
+    double sh_stack[64];
+    r->other = cap <= 64 ? r->stack : xmalloc((size_t)cap * sizeof *r->other);
+    double *sh = cap <= 64 ? sh_stack : xmalloc((size_t)cap * sizeof *sh);
     for (int f = 0; f < m->nf; f++)
         for (int c = m->fo[f]; c < m->fo[f + 1]; c++) {
             if (m->fv[c] != v) continue;
@@ -114,7 +116,7 @@ static void ring_of(const sd_mesh *m, int v, vring *r)
         if (!tag_ok(sh[i])) r->ok = false;
         if (isinf(sh[i])) r->ninf++;
     }
-    free(sh);
+    if (sh != sh_stack) free(sh);
 }
 
 /* grid positions (i along u, j along v) of the face's corners */
