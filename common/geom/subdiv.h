@@ -79,7 +79,9 @@ void geom_subdiv_face_points(const geom_subdiv *self, int f, int out[4]);
  * (a pure function of the cage: the same bits each time). */
 void geom_subdiv_surface(const geom_subdiv *self, int f, geom_surface *out);
 
-/* The bytes the mesh holds, and of them (*points) its control points. */
+/* The bytes the mesh holds (its irregular faces' trees of local
+ * refinements, grown while rendering, not counted), and of them (*points)
+ * its control points. */
 size_t geom_subdiv_bytes(const geom_subdiv *self, size_t *points);
 
 /* Bounds of d/du, d/dv of the unit normal over the box where it lies in
