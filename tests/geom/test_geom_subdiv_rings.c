@@ -112,13 +112,13 @@ static void check_rings(geom_subdiv *sd)
     free(m.es);
 }
 
-/* A bumpy 6 x 6 grid of points (25 faces) whose middle quad is two
+/* A bumpy 6 x 6 grid of points (26 faces) whose middle quad is two
  * triangles, with a hole, a semi-sharp crease along a row and a corner. */
 static geom_subdiv *grid(bool interpolate, double crease)
 {
     enum { N = 6 };
     static double P[3 * N * N];
-    static int nv[26], v[100];
+    static int nv[26], v[4 * 26];
     for (int j = 0; j < N; j++)
         for (int i = 0; i < N; i++) {
             double *p = P + 3 * (j * N + i);
