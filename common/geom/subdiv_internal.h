@@ -38,7 +38,7 @@ void sd_refine(const sd_mesh *m, sd_mesh *out);
 typedef struct sd_node sd_node;    /* subdiv_cache.c */
 
 /* The mesh a worker keeps (issue 23: a few bytes a control face): the
- * control mesh and its point -> corners table, and per face of the refined
+ * control mesh and its point -> faces table, and per face of the refined
  * mesh (level 1, all quads: face f is the child of control corner f) one
  * byte of flags. The refined mesh itself is not kept: the 1-ring of a
  * refined face is made when it is asked for (sd_local_from_shared,
@@ -52,7 +52,7 @@ struct geom_subdiv {
     unsigned long serial;          /* a number of its own (subdiv_mesh.c's ring cache) */
     sd_mesh m0;                    /* the control mesh (vs, es NULL when all 0) */
     int nf1;                       /* refined faces (control corners) */
-    int *vf_off, *vf;              /* control point -> corners holding it (CSR) */
+    int *vf_off, *vf;              /* control point -> faces holding it (CSR, ascending) */
     int maxval;                    /* the largest valence of the refined mesh (>= 4):
                                     * local meshes' sizes */
     unsigned char *flags;          /* per refined face: SD_DRAWN, SD_REGULAR */

@@ -65,7 +65,9 @@ void sd_local_from_shared(const geom_subdiv *sd, int f, sd_local *L);
 typedef struct sd_ring {
     sd_mesh ctl, ref;              /* the control faces, and refined */
     int base;                      /* F's first corner in ctl (its children in ref) */
-    int *list;                     /* scratch */
+    int *list;                     /* scratch: a child's faces */
+    int *local;                    /* scratch: ref's points' numbers in a child's
+                                    * 1-ring (-1 between children) */
     void *block;                   /* all of the above's arrays */
 } sd_ring;
 
@@ -85,6 +87,9 @@ void sd_local_child(sd_local *L, int k, sd_big *big);
  * 4x4 grid, boundary and infinitely sharp edges by mirrored points); if so
  * its Bezier net (verts[4 j + i] order, u along face 0's first edge). */
 bool sd_regular_net(const sd_mesh *L, vec3 net[16]);
+/* The same net for a face known to be regular (geom_subdiv's SD_REGULAR
+ * flag, found by sd_regular_net): the tests of its corners skipped. */
+void sd_known_regular_net(const sd_mesh *L, vec3 net[16]);
 
 /* The limit position of face 0's corner k when no semi-sharp tag touches
  * it (false otherwise): smooth, crease or corner mask. */

@@ -4,7 +4,7 @@
  * §5.5: crease, corner, hole, interpolateboundary), one global refinement
  * step so that every face is a quad (subdiv_refine.c), made again around
  * a face whenever its 1-ring is asked for, not kept (issue 23: what a
- * worker keeps is the control mesh, its point -> corners table and a byte
+ * worker keeps is the control mesh, its point -> faces table and a byte
  * of flags per refined face, subdiv_internal.h), and a refined face's
  * surface with its Bezier net where the face is regular.
  *
@@ -176,7 +176,7 @@ geom_subdiv *geom_subdiv_new(const geom_subdiv_desc *d, char *err, size_t errsz)
         int *fill = xcalloc((size_t)nv + 1, sizeof(int));
         for (int c = 0; c < nc; c++) {
             int v = m0.fv[c];
-            sd->vf[sd->vf_off[v] + fill[v]++] = c;
+            sd->vf[sd->vf_off[v] + fill[v]++] = face_of[c];
         }
         free(fill);
         /* the refined mesh's valences: a vertex point's (its point's
@@ -298,6 +298,15 @@ int geom_subdiv_face_origin(const geom_subdiv *self, int f) { return face_of_cor
 static int next_in(const sd_mesh *m, int F, int c) { return c + 1 < m->fo[F + 1] ? c + 1 : m->fo[F]; }
 static int prev_in(const sd_mesh *m, int F, int c) { return c > m->fo[F] ? c - 1 : m->fo[F + 1] - 1; }
 
+/* the corner of control face G at point v (G holds v) */
+static int corner_at(const sd_mesh *m, int G, int v)
+{
+    int c = m->fo[G];
+    while (m->fv[c] != v) c++;
+    assert(c < m->fo[G + 1]);
+    return c;
+}
+
 /* A name for the edge of control corner c (from its point to the next):
  * the smaller of its corner and the corner running it the other way */
 static int edge_name(const geom_subdiv *sd, int c)
@@ -305,7 +314,7 @@ static int edge_name(const geom_subdiv *sd, int c)
     const sd_mesh *m = &sd->m0;
     int F = face_of_corner(m, c), a = m->fv[c], b = m->fv[next_in(m, F, c)];
     for (int i = sd->vf_off[b]; i < sd->vf_off[b + 1]; i++) {
-        int cb = sd->vf[i], G = face_of_corner(m, cb);
+        int G = sd->vf[i], cb = corner_at(m, G, b);
         if (m->fv[next_in(m, G, cb)] == a) return cb < c ? cb : c;
     }
     return c;
@@ -371,7 +380,7 @@ static bool ring_build(const geom_subdiv *sd, int F, sd_ring *R, void *buf, size
     nfc = 0;
     for (int c = m->fo[F]; c < m->fo[F + 1]; c++)
         for (int i = sd->vf_off[m->fv[c]]; i < sd->vf_off[m->fv[c] + 1]; i++)
-            faces[nfc++] = face_of_corner(m, sd->vf[i]);
+            faces[nfc++] = sd->vf[i];
     int nf = sort_unique(faces, nfc), nc = 0;
     for (int i = 0; i < nf; i++) nc += m->fo[faces[i] + 1] - m->fo[faces[i]];
     /* one block: the control faces (nv <= nc points), their refinement
@@ -380,7 +389,7 @@ static bool ring_build(const geom_subdiv *sd, int F, sd_ring *R, void *buf, size
     size_t c1 = (size_t)nc, f1 = (size_t)nf, v1 = (size_t)(nc + nf + nc);
     size_t bytes = (c1 + v1) * (sizeof(vec3) + sizeof(double)) + c1 * sizeof(double) +
                    4 * c1 * sizeof(double) +
-                   (f1 + 1 + c1 + c1 + 1 + 4 * c1 + c1 + c1 + 1) * sizeof(int);
+                   (f1 + 1 + c1 + c1 + 1 + 4 * c1 + c1 + c1 + 1 + v1) * sizeof(int);
     if (buf && bytes > cap) {
         if (faces != stack) free(faces);
         return false;
@@ -392,6 +401,8 @@ static bool ring_build(const geom_subdiv *sd, int F, sd_ring *R, void *buf, size
     int *fo0 = (int *)(es1 + 4 * c1), *fv0 = fo0 + f1 + 1, *fo1 = fv0 + c1, *fv1 = fo1 + c1 + 1;
     int *pts = fv1 + 4 * c1;
     R->list = pts + c1;
+    R->local = R->list + c1 + 1;
+    for (size_t i = 0; i < v1; i++) R->local[i] = -1;
     R->block = buf ? NULL : b;
     nc = 0;
     for (int i = 0; i < nf; i++)
@@ -467,7 +478,30 @@ void sd_ring_child(const sd_ring *R, int k, sd_local *L)
         }
     }
     assert(n <= sd_lf(L->maxval));
-    sd_local_take(L, lr, list, n);
+    /* sd_local_take's copy (points numbered as they come), its search for a
+     * point by the ring's table of local numbers */
+    L->m = (sd_mesh){ 0, 0, L->P, L->vs, L->fo, L->fv, L->es };
+    int nc = 0, *local = R->local;
+    L->fo[0] = 0;
+    for (int i = 0; i < n; i++) {
+        int g = list[i];
+        assert(nc + 4 <= sd_lc(L->maxval));
+        for (int c = 4 * g; c < 4 * g + 4; c++) {
+            int v = lr->fv[c];
+            if (local[v] < 0) {
+                int j = L->m.nv++;
+                local[v] = j;
+                L->src[j] = v;
+                L->P[j] = lr->P[v];
+                L->vs[j] = lr->vs[v];
+            }
+            L->fv[nc] = local[v];
+            L->es[nc] = lr->es[c];
+            nc++;
+        }
+        L->fo[++L->m.nf] = nc;
+    }
+    for (int j = 0; j < L->m.nv; j++) local[L->src[j]] = -1;
 }
 
 void sd_ring_clear(sd_ring *R)
@@ -496,7 +530,10 @@ void geom_subdiv_surface(const geom_subdiv *self, int f, geom_surface *out)
     sd_local_init(&L, self->maxval);
     sd_local_from_shared(self, f, &L);
     /* a regular face's net, in verts (subdiv_eval.c reads it there) */
-    if ((self->flags[f] & SD_REGULAR) && sd_regular_net(&L.m, out->verts)) out->nverts = 16;
+    if (self->flags[f] & SD_REGULAR) {
+        sd_known_regular_net(&L.m, out->verts);
+        out->nverts = 16;
+    }
     sd_local_hull(&L.m, &out->subdiv_lo, &out->subdiv_hi);
     sd_local_clear(&L);
 }
@@ -506,7 +543,7 @@ bool geom_subdiv_limit_point(const geom_subdiv *self, int point, vec3 *out)
     if (point < 0 || point >= self->m0.nv || self->vf_off[point] == self->vf_off[point + 1])
         return false;
     /* the child of a corner at the point: its corner at the vertex point */
-    int c = self->vf[self->vf_off[point]], F = face_of_corner(&self->m0, c);
+    int F = self->vf[self->vf_off[point]], c = corner_at(&self->m0, F, point);
     int n = self->m0.fo[F + 1] - self->m0.fo[F], k = c - self->m0.fo[F];
     int j = n == 4 ? k : 0;
     static const double U[4] = { 0, 1, 1, 0 }, V[4] = { 0, 0, 1, 1 };

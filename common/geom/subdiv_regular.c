@@ -126,7 +126,8 @@ static const int OI[4] = { 0, 1, 0, -1 }, OJ[4] = { -1, 0, 1, 0 };
 
 static vec3 mirror(vec3 a, vec3 b) { return v3_sub(v3_scale(a, 2), b); }
 
-bool sd_regular_net(const sd_mesh *m, vec3 net[16])
+/* check: whether face 0 is regular (else known, and only its net made) */
+static bool face_net(const sd_mesh *m, bool check, vec3 net[16])
 {
     if (m->nf < 1 || m->fo[1] - m->fo[0] != 4) return false;
     int c[4];
@@ -137,7 +138,7 @@ bool sd_regular_net(const sd_mesh *m, vec3 net[16])
         if (!tag_ok(e)) return false;
         sharp[s] = isinf(e);
     }
-    for (int k = 0; k < 4; k++) {
+    for (int k = 0; k < 4 && check; k++) {
         vring r;
         ring_of(m, c[k], &r);
         ring_clear(&r);    /* its counts are all this test needs */
@@ -222,6 +223,15 @@ bool sd_regular_net(const sd_mesh *m, vec3 net[16])
         net[4 * 3 + i] = v3_scale(v3_add(v3_add(p1, v3_scale(p2, 4)), p3), 1.0 / 6);
     }
     return true;
+}
+
+bool sd_regular_net(const sd_mesh *m, vec3 net[16]) { return face_net(m, true, net); }
+
+void sd_known_regular_net(const sd_mesh *m, vec3 net[16])
+{
+    bool made = face_net(m, false, net);
+    assert(made && "a face flagged regular has its net");
+    (void)made;
 }
 
 /* The limit mask of point v given its ring (sd_corner_limit). */
