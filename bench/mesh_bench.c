@@ -9,8 +9,10 @@
  * parse's seconds), of rendering 128x128 at one sample per
  * pixel with the default surface, and the peak resident memory; and the
  * bytes a face costs (issue 23: a mesh is one object): the scene's shared
- * arrays (points, indices, normals) and, beyond them, the pieces, their
- * shared edges and the BVH (its part printed apart: the issue's budgets
+ * arrays (points, indices, normals; a subdivision cage's control points)
+ * and, beyond them, the pieces, their shared edges, a subdivision mesh's
+ * own tables (geom/subdiv.h: its control faces, point -> corners and a
+ * byte per refined face) and the BVH (its part printed apart: the issue's budgets
  * are 64 bytes a face before any box and 32 of BVH), per face. Never
  * fails on timing.
  *
@@ -186,8 +188,9 @@ int main(int argc, char **argv)
         for (int i = 0; i < js->scene->nmeshes; i++) {
             const scene_mesh *m = js->scene->meshes[i];
             size_t pb = scene_mesh_piece_bytes(m);
-            shared += scene_mesh_bytes(m) - pb;
-            beyond += pb;
+            size_t points, sdb = scene_mesh_subdiv_bytes(m, &points);
+            shared += scene_mesh_bytes(m) - pb + points;
+            beyond += pb + sdb - points;
             pieces += scene_mesh_npieces(m);
         }
         size_t bvh = 0;

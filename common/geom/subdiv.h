@@ -9,7 +9,10 @@
  * with "interpolateboundary"; hole faces are kept as control but not
  * drawn). Each drawable face of that mesh is one geom_surface of kind
  * GEOM_SUBDIV pointing at the mesh (subdiv, subdiv_face), so a face costs
- * no copy of control points.
+ * no copy of control points. The refined mesh is not kept: what lasts is
+ * the control mesh and a byte a refined face (subdiv_internal.h); a face's
+ * 1-ring and Bezier net are made again, the same to the bit, when its
+ * surface is made.
  *
  * The surface of a face is its exact Catmull-Clark limit over the unit
  * square (u along the face's first edge, v along its last): where the
@@ -22,6 +25,7 @@
 #define GEOM_SUBDIV_H
 
 #include <stdbool.h>
+#include <stddef.h>
 
 #include "geom/surface.h"
 
@@ -70,8 +74,15 @@ int geom_subdiv_face_origin(const geom_subdiv *self, int f);
  * npoints points are the control points' vertex points). */
 void geom_subdiv_face_points(const geom_subdiv *self, int f, int out[4]);
 
-/* A GEOM_SUBDIV surface for face f (prepared). */
+/* A GEOM_SUBDIV surface for face f (prepared): its 1-ring is made again
+ * from the control mesh, and so is its Bezier net where the face is regular
+ * (a pure function of the cage: the same bits each time). */
 void geom_subdiv_surface(const geom_subdiv *self, int f, geom_surface *out);
+
+/* The bytes the mesh holds (its irregular faces' trees of local
+ * refinements, grown while rendering, not counted), and of them (*points)
+ * its control points. */
+size_t geom_subdiv_bytes(const geom_subdiv *self, size_t *points);
 
 /* Bounds of d/du, d/dv of the unit normal over the box where it lies in
  * one regular sub-patch (a bicubic's, surface_bicubic.c); false

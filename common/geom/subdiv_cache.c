@@ -213,27 +213,28 @@ static const sd_node *publish(_Atomic(sd_node *) *slot, sd_node *n)
 
 void sd_cache_init(geom_subdiv *sd)
 {
-    sd->roots = xcalloc((size_t)sd->m.nf + 1, sizeof *sd->roots);
+    sd->roots = xcalloc((size_t)sd->nirr + 1, sizeof *sd->roots);
 }
 
 void sd_cache_clear(geom_subdiv *sd)
 {
     if (!sd->roots) return;
-    for (int f = 0; f < sd->m.nf; f++) node_free(atomic_load(&sd->roots[f]));
+    for (int i = 0; i < sd->nirr; i++) node_free(atomic_load(&sd->roots[i]));
     free(sd->roots);
     sd->roots = NULL;
 }
 
 const sd_node *sd_node_root(const geom_subdiv *sd, int f)
 {
-    sd_node *n = atomic_load(&sd->roots[f]);
+    _Atomic(sd_node *) *slot = &sd->roots[sd_irregular_rank(sd, f)];
+    sd_node *n = atomic_load(slot);
     if (n) return n;
     sd_local L;
     sd_local_init(&L, sd->maxval);
     sd_local_from_shared(sd, f, &L);
     n = node_new(&L, 0);
     sd_local_clear(&L);
-    return publish(&sd->roots[f], n);
+    return publish(slot, n);
 }
 
 const sd_node *sd_node_child(const sd_node *p, int q)

@@ -37,26 +37,23 @@
 void sd_local_init(sd_local *L, int maxval)
 {
     assert(maxval >= 4);
-    int lf = sd_lf(maxval), lc = sd_lc(maxval), lv = sd_lv(maxval);
+    size_t lf = (size_t)sd_lf(maxval), lc = (size_t)sd_lc(maxval), lv = (size_t)sd_lv(maxval);
     *L = (sd_local){ .maxval = maxval };
-    L->P = xmalloc((size_t)lv * sizeof *L->P);
-    L->vs = xmalloc((size_t)lv * sizeof *L->vs);
-    L->fo = xmalloc((size_t)(lf + 1) * sizeof *L->fo);
-    L->fv = xmalloc((size_t)lc * sizeof *L->fv);
-    L->es = xmalloc((size_t)lc * sizeof *L->es);
-    L->list = xmalloc((size_t)lf * sizeof *L->list);
-    L->src = xmalloc((size_t)lv * sizeof *L->src);
+    /* one block (a 1-ring is made for every face's surface) */
+    char *b = xmalloc(lv * sizeof(vec3) + (lv + lc) * sizeof(double) +
+                      (lf + 1 + lc + lf + lv) * sizeof(int));
+    L->P = (vec3 *)b;
+    L->vs = (double *)(L->P + lv);
+    L->es = L->vs + lv;
+    L->fo = (int *)(L->es + lc);
+    L->fv = L->fo + lf + 1;
+    L->list = L->fv + lc;
+    L->src = L->list + lf;
 }
 
 void sd_local_clear(sd_local *L)
 {
     free(L->P);
-    free(L->vs);
-    free(L->fo);
-    free(L->fv);
-    free(L->es);
-    free(L->list);
-    free(L->src);
     *L = (sd_local){ 0 };
 }
 
@@ -117,19 +114,6 @@ static void add_face(int *list, int *n, int cap, int f)
     list[(*n)++] = f;
 }
 
-void sd_local_from_shared(const geom_subdiv *sd, int f, sd_local *L)
-{
-    assert(L->maxval == sd->maxval);
-    int *list = L->list, n = 0, cap = sd_lf(L->maxval);
-    add_face(list, &n, cap, f);
-    for (int k = 0; k < 4; k++) {
-        int v = sd->m.fv[sd->m.fo[f] + k];
-        for (int i = sd->vf_off[v]; i < sd->vf_off[v + 1]; i++)
-            add_face(list, &n, cap, sd->vf[i] / 4);
-    }
-    sd_local_take(L, &sd->m, list, n);
-}
-
 void sd_local_child(sd_local *L, int k, sd_big *big)
 {
     big->m = (sd_mesh){ 0, 0, big->P, big->vs, big->fo, big->fv, big->es };
@@ -162,11 +146,13 @@ static void net_surface(const vec3 net[16], geom_surface *b)
 /* ---- float and dual ---- */
 
 /* 0: out filled; 1: (u,v) is an irregular corner: out->P is its limit */
-static int eval_point(const geom_subdiv *sd, int f, double u, double v, geom_sample *out)
+static int eval_point(const geom_surface *fs, double u, double v, geom_sample *out)
 {
+    const geom_subdiv *sd = fs->subdiv;
+    int f = fs->subdiv_face;
     geom_surface b;                    /* fields other than verts unused */
-    if (sd->net_of[f] >= 0) {
-        net_surface(sd->nets + 16 * sd->net_of[f], &b);
+    if (fs->nverts == 16) {            /* a regular face: its net (geom_subdiv_surface) */
+        net_surface(fs->verts, &b);
         geom_bicubic_eval_dual(&b, u, v, out);
         return 0;
     }
@@ -218,11 +204,10 @@ static int eval_point(const geom_subdiv *sd, int f, double u, double v, geom_sam
 
 void geom_subdiv_eval_dual(const geom_surface *s, double u, double v, geom_sample *out)
 {
-    const geom_subdiv *sd = s->subdiv;
-    if (eval_point(sd, s->subdiv_face, u, v, out) == 1) {
+    if (eval_point(s, u, v, out) == 1) {
         vec3 P = out->P;
         double e = ldexp(1, -30);
-        eval_point(sd, s->subdiv_face, u < 0.5 ? u + e : u - e, v < 0.5 ? v + e : v - e, out);
+        eval_point(s, u < 0.5 ? u + e : u - e, v < 0.5 ? v + e : v - e, out);
         out->P = P;
     }
 }
@@ -241,7 +226,7 @@ typedef struct sd_range {
                                     * of the sub-face's quadrants (else NAN) */
 } sd_range;
 
-static void hull(const sd_mesh *m, vec3 *lo, vec3 *hi)
+void sd_local_hull(const sd_mesh *m, vec3 *lo, vec3 *hi)
 {
     *lo = *hi = m->P[0];
     double big = 0;
@@ -269,15 +254,17 @@ static double sub_dir(double x, double o, int dir)
 
 /* The sub-face of face f that holds the box [u0,u1] x [v0,v1] whole
  * (found in the face's tree of local refinements, subdiv_cache.c). */
-static void find_range(const geom_subdiv *sd, int f, double u0, double u1, double v0,
-                       double v1, sd_range *r)
+static void find_range(const geom_surface *s, double u0, double u1, double v0, double v1,
+                       sd_range *r)
 {
+    const geom_subdiv *sd = s->subdiv;
+    int f = s->subdiv_face;
     r->level = 0;
     r->ou = r->ov = 0;
     r->node = r->normal_node = NULL;
-    if (sd->net_of[f] >= 0) {
+    if (s->nverts == 16) {             /* a regular face: its net (geom_subdiv_surface) */
         r->regular = true;
-        r->net = sd->nets + 16 * sd->net_of[f];
+        r->net = s->verts;
         return;
     }
     const sd_node *n = sd_node_root(sd, f);
@@ -493,7 +480,7 @@ static bool can_split(const sd_range *r, ia_interval u, ia_interval v)
 void geom_subdiv_eval_ia(const geom_surface *s, ia_interval u, ia_interval v, geom_ia *out)
 {
     sd_range r;
-    find_range(s->subdiv, s->subdiv_face, u.lo, u.hi, v.lo, v.hi, &r);
+    find_range(s, u.lo, u.hi, v.lo, v.hi, &r);
     if (!r.regular && can_split(&r, u, v)) {
         split_ia(s, u, v, &r, out);
         return;
@@ -524,7 +511,7 @@ bool geom_subdiv_normal_slopes_ia(const geom_surface *s, ia_interval u, ia_inter
                                   ia_interval dNdu[3], ia_interval dNdv[3])
 {
     sd_range r;
-    find_range(s->subdiv, s->subdiv_face, u.lo, u.hi, v.lo, v.hi, &r);
+    find_range(s, u.lo, u.hi, v.lo, v.hi, &r);
     if (!r.regular) return false;
     /* the regular sub-patch's Bezier net over the box, in its own
      * coordinates s = k (u - ou): d/du = k d/ds (k a power of 2: exact) */
@@ -549,7 +536,7 @@ void geom_subdiv_eval_aa(aa_context *ctx, const geom_surface *s, const aa_form *
 {
     ia_interval ur = aa_range(u), vr = aa_range(v);
     sd_range r;
-    find_range(s->subdiv, s->subdiv_face, ur.lo, ur.hi, vr.lo, vr.hi, &r);
+    find_range(s, ur.lo, ur.hi, vr.lo, vr.hi, &r);
     if (!r.regular && can_split(&r, ur, vr)) {
         /* a box across quadrant lines (never one of the renderer's dyadic
          * boxes): the hull of its pieces, without correlation */
@@ -609,7 +596,7 @@ bool geom_subdiv_unit_normal_box(const geom_surface *s, ia_interval u, ia_interv
     if (s->kind != GEOM_SUBDIV || !s->subdiv)
         return false;              /* other kinds come through the same callers */
     sd_range r;
-    find_range(s->subdiv, s->subdiv_face, u.lo, u.hi, v.lo, v.hi, &r);
+    find_range(s, u.lo, u.hi, v.lo, v.hi, &r);
     vec3 N;
     if (r.regular || can_split(&r, u, v) || !sd_node_unit_normal(r.normal_node, &N))
         return false;
@@ -627,11 +614,8 @@ bool geom_subdiv_unit_normal_box(const geom_surface *s, ia_interval u, ia_interv
 
 void geom_subdiv_bounds(const geom_surface *s, vec3 *lo, vec3 *hi)
 {
-    sd_local L;
-    sd_local_init(&L, s->subdiv->maxval);
-    sd_local_from_shared(s->subdiv, s->subdiv_face, &L);
-    hull(&L.m, lo, hi);
-    sd_local_clear(&L);
+    *lo = s->subdiv_lo;              /* the 1-ring's hull, made with the surface */
+    *hi = s->subdiv_hi;
 }
 
 static bool slab(vec3 o, vec3 d, vec3 lo, vec3 hi, double *t0, double *t1)
@@ -671,7 +655,7 @@ bool geom_subdiv_intersect(const geom_surface *s, vec3 o, vec3 d, double tmin, d
         int level = stack[--n].level;
         double side = ldexp(1, -level);
         sd_range r;
-        find_range(s->subdiv, s->subdiv_face, u0, u0 + side, v0, v0 + side, &r);
+        find_range(s, u0, u0 + side, v0, v0 + side, &r);
         if (r.regular) {
             geom_surface b;
             net_surface(r.net, &b);

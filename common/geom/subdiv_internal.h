@@ -25,11 +25,8 @@ typedef struct sd_mesh {
     double *es;
 } sd_mesh;
 
-/* Sizes of one Catmull-Clark step of m: points nv + nf + nedges, faces =
- * corners of m, corners = 4 * corners of m. */
-int sd_edge_count(const sd_mesh *m);
-
-/* One step: out's arrays must hold the sizes above. New points: the
+/* One step: out's arrays must hold its sizes: points nv + nf + nedges
+ * (nedges <= corners), faces = corners of m, corners = 4 * corners of m. New points: the
  * vertex points of m's points (same indices), then face points (nv + f),
  * then edge points. Child faces are quads, one per corner, in corner
  * order; a quad parent's child k covers the parent's quadrant k (0:
@@ -40,16 +37,33 @@ void sd_refine(const sd_mesh *m, sd_mesh *out);
 
 typedef struct sd_node sd_node;    /* subdiv_cache.c */
 
+/* The mesh a worker keeps (issue 23: a few bytes a control face): the
+ * control mesh and its point -> faces table, and per face of the refined
+ * mesh (level 1, all quads: face f is the child of control corner f) one
+ * byte of flags. The refined mesh itself is not kept: the 1-ring of a
+ * refined face is made when it is asked for (sd_local_from_shared,
+ * subdiv_mesh.c) by refining the control faces around its control face,
+ * the same steps in the same order as refining the whole mesh, so it is
+ * the same to the bit; a regular face's Bezier net is made with its
+ * surface (geom_subdiv_surface) and travels in it. */
+enum { SD_DRAWN = 1, SD_REGULAR = 2 };
+
 struct geom_subdiv {
-    sd_mesh m;                     /* level 1: all quads */
-    int *vf_off, *vf;              /* point -> corners holding it (CSR) */
-    int maxval;                    /* the largest valence (>= 4): local meshes' sizes */
-    unsigned char *drawn;          /* per face */
-    int *origin;                   /* per face: the control face */
-    int *net_of;                   /* per face: index into nets, or -1 */
-    vec3 *nets;                    /* Bezier nets (16 each) of regular faces */
-    _Atomic(sd_node *) *roots;     /* per face: its local refinements (subdiv_cache.c) */
+    unsigned long serial;          /* a number of its own (subdiv_mesh.c's ring cache) */
+    sd_mesh m0;                    /* the control mesh (vs, es NULL when all 0) */
+    int nf1;                       /* refined faces (control corners) */
+    int *vf_off, *vf;              /* control point -> faces holding it (CSR, ascending) */
+    int maxval;                    /* the largest valence of the refined mesh (>= 4):
+                                    * local meshes' sizes */
+    unsigned char *flags;          /* per refined face: SD_DRAWN, SD_REGULAR */
+    int *irr_base;                 /* per 64 refined faces: drawn irregular faces before */
+    int nirr;
+    _Atomic(sd_node *) *roots;     /* per drawn irregular face (by rank): its local
+                                    * refinements (subdiv_cache.c) */
 };
+
+/* The rank of drawn irregular face f among them (its slot in roots). */
+int sd_irregular_rank(const geom_subdiv *sd, int f);
 
 /* The per-face trees of subdiv_cache.c: made empty, freed with the mesh. */
 void sd_cache_init(geom_subdiv *sd);

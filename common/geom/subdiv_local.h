@@ -55,8 +55,29 @@ void sd_big_clear(sd_big *big);
 /* Copies faces list[0..n) of M into L (list[0] becomes face 0). */
 void sd_local_take(sd_local *L, const sd_mesh *M, const int *list, int n);
 
-/* Face f of the shared mesh with its 1-ring (L made with sd->maxval). */
+/* Face f of the refined mesh with its 1-ring (L made with sd->maxval),
+ * made again from the control mesh (subdiv_mesh.c). */
 void sd_local_from_shared(const geom_subdiv *sd, int f, sd_local *L);
+
+/* The control faces around control face F (those sharing a point with
+ * it) and their refinement, from which the 1-rings of F's children are
+ * copied (sd_ring_child: child k, of F's corner k): subdiv_mesh.c. */
+typedef struct sd_ring {
+    sd_mesh ctl, ref;              /* the control faces, and refined */
+    int base;                      /* F's first corner in ctl (its children in ref) */
+    int *list;                     /* scratch: a child's faces */
+    int *local;                    /* scratch: ref's points' numbers in a child's
+                                    * 1-ring (-1 between children) */
+    void *block;                   /* all of the above's arrays */
+} sd_ring;
+
+void sd_ring_make(const geom_subdiv *sd, int F, sd_ring *R);
+void sd_ring_child(const sd_ring *R, int k, sd_local *L);
+void sd_ring_clear(sd_ring *R);
+
+/* The hull of a local mesh's points, padded for the rounding of the
+ * refinement (subdiv_eval.c). */
+void sd_local_hull(const sd_mesh *m, vec3 *lo, vec3 *hi);
 
 /* Refines L and makes L the child k (quadrant, subdiv_internal.h) of its
  * face 0 with that child's 1-ring. big is scratch. */
@@ -66,6 +87,9 @@ void sd_local_child(sd_local *L, int k, sd_big *big);
  * 4x4 grid, boundary and infinitely sharp edges by mirrored points); if so
  * its Bezier net (verts[4 j + i] order, u along face 0's first edge). */
 bool sd_regular_net(const sd_mesh *L, vec3 net[16]);
+/* The same net for a face known to be regular (geom_subdiv's SD_REGULAR
+ * flag, found by sd_regular_net): the tests of its corners skipped. */
+void sd_known_regular_net(const sd_mesh *L, vec3 net[16]);
 
 /* The limit position of face 0's corner k when no semi-sharp tag touches
  * it (false otherwise): smooth, crease or corner mask. */

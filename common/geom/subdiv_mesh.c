@@ -2,19 +2,37 @@
  * subdiv_mesh.c: building a Catmull-Clark mesh (geom_subdiv) from a
  * SubdivisionMesh: the topology checks, the tags (RI Specification 3.2
  * §5.5: crease, corner, hole, interpolateboundary), one global refinement
- * step so that every face is a quad (subdiv_refine.c), the point -> faces
- * table for 1-rings, and the Bezier nets of the faces that are regular
- * from the start (most of them), so that they cost no refinement later.
+ * step so that every face is a quad (subdiv_refine.c), made again around
+ * a face whenever its 1-ring is asked for, not kept (issue 23: what a
+ * worker keeps is the control mesh, its point -> faces table and a byte
+ * of flags per refined face, subdiv_internal.h), and a refined face's
+ * surface with its Bezier net where the face is regular.
+ *
+ * The 1-ring of refined face f (the child of control corner f, of
+ * control face F) lies in the refinement of the control faces that share a
+ * point with F: its points are the vertex points of F's points (their
+ * rings of faces and edges all there), the edge points of edges at F's
+ * points (both faces there) and the face points of those faces. Those
+ * faces, in the order of the whole mesh, with their points numbered in the
+ * whole mesh's order, refine (sd_refine: faces in order, edges sorted by
+ * their points, each sum in that order) to the same numbers, bit for bit,
+ * as the whole mesh refined at once; and the 1-ring is copied out of it in
+ * the order the whole refined mesh would give (faces holding each corner
+ * point by ascending index).
  */
 #include "geom/subdiv_local.h"
 #include "geom/surface_internal.h"
 #include "util/err.h"
 #include "util/xalloc.h"
 
+#include <assert.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+/* the meshes' serial numbers (ring_of_face's cache below) */
+static _Atomic unsigned long next_serial = 1;
 
 static double tag_sharpness(double s)
 {
@@ -69,6 +87,7 @@ geom_subdiv *geom_subdiv_new(const geom_subdiv_desc *d, char *err, size_t errsz)
     int *count = xcalloc((size_t)nv + 1, sizeof *count);
     unsigned char *hole0 = xcalloc((size_t)nf + 1, 1);
     geom_subdiv *sd = xcalloc(1, sizeof *sd);
+    sd->serial = atomic_fetch_add(&next_serial, 1);
     bool ok = true;
     for (int i = 0; i < nv; i++) m0.P[i] = v3(d->P[3 * i], d->P[3 * i + 1], d->P[3 * i + 2]);
     m0.fo[0] = 0;
@@ -148,52 +167,63 @@ geom_subdiv *geom_subdiv_new(const geom_subdiv_desc *d, char *err, size_t errsz)
     free(e);
     free(count);
     if (ok) {
-        int ne = sd_edge_count(&m0);
-        int nv1 = nv + nf + ne, nf1 = nc;
-        sd->m = (sd_mesh){ 0, 0, xmalloc((size_t)nv1 * sizeof(vec3)),
-                           xmalloc((size_t)nv1 * sizeof(double)),
-                           xmalloc((size_t)(nf1 + 1) * sizeof(int)),
-                           xmalloc((size_t)(4 * nf1 + 1) * sizeof(int)),
-                           xmalloc((size_t)(4 * nf1 + 1) * sizeof(double)) };
-        sd_refine(&m0, &sd->m);
-        sd->origin = xmalloc((size_t)(nf1 + 1) * sizeof(int));
-        sd->drawn = xcalloc((size_t)nf1 + 1, 1);
-        sd->net_of = xmalloc((size_t)(nf1 + 1) * sizeof(int));
-        sd->vf_off = xcalloc((size_t)nv1 + 2, sizeof(int));
-        sd->vf = xmalloc((size_t)(4 * nf1 + 1) * sizeof(int));
-        sd_cache_init(sd);
-        for (int c = 0; c < 4 * nf1; c++) sd->vf_off[sd->m.fv[c] + 1]++;
-        for (int i = 0; i < nv1; i++) sd->vf_off[i + 1] += sd->vf_off[i];
-        int *fill = xcalloc((size_t)nv1 + 1, sizeof(int));
-        for (int c = 0; c < 4 * nf1; c++) {
-            int v = sd->m.fv[c];
-            sd->vf[sd->vf_off[v] + fill[v]++] = c;
+        int nf1 = nc;
+        sd->nf1 = nf1;
+        sd->vf_off = xcalloc((size_t)nv + 2, sizeof(int));
+        sd->vf = xmalloc((size_t)(nc + 1) * sizeof(int));
+        for (int c = 0; c < nc; c++) sd->vf_off[m0.fv[c] + 1]++;
+        for (int i = 0; i < nv; i++) sd->vf_off[i + 1] += sd->vf_off[i];
+        int *fill = xcalloc((size_t)nv + 1, sizeof(int));
+        for (int c = 0; c < nc; c++) {
+            int v = m0.fv[c];
+            sd->vf[sd->vf_off[v] + fill[v]++] = face_of[c];
         }
         free(fill);
+        /* the refined mesh's valences: a vertex point's (its point's
+         * corners), a face point's (its face's size), an edge point's (4) */
         sd->maxval = 4;
-        for (int v = 0; v < nv1; v++)
+        for (int v = 0; v < nv; v++)
             if (sd->vf_off[v + 1] - sd->vf_off[v] > sd->maxval)
                 sd->maxval = sd->vf_off[v + 1] - sd->vf_off[v];
-        int nnets = 0;
-        sd->nets = NULL;
+        for (int f = 0; f < nf; f++)
+            if (m0.fo[f + 1] - m0.fo[f] > sd->maxval) sd->maxval = m0.fo[f + 1] - m0.fo[f];
+        /* tags that are all 0 are not kept */
+        bool tagged = false;
+        for (int c = 0; c < nc && !tagged; c++) tagged = m0.es[c] != 0;
+        if (!tagged) {
+            free(m0.es);
+            m0.es = NULL;
+        }
+        tagged = false;
+        for (int v = 0; v < nv && !tagged; v++) tagged = m0.vs[v] != 0;
+        if (!tagged) {
+            free(m0.vs);
+            m0.vs = NULL;
+        }
+        sd->m0 = m0;
+        m0 = (sd_mesh){ 0 };
+        sd->flags = xcalloc((size_t)nf1 + 1, 1);
+        sd->irr_base = xcalloc((size_t)nf1 / 64 + 2, sizeof(int));
         sd_local L;
         sd_local_init(&L, sd->maxval);
-        for (int f = 0; f < nf1; f++) {
-            sd->origin[f] = face_of[f];
-            sd->drawn[f] = !hole0[face_of[f]] && (d->interpolateboundary || !open0[face_of[f]]);
-            sd->net_of[f] = -1;
-            if (!sd->drawn[f]) continue;
-            vec3 net[16];
-            sd_local_from_shared(sd, f, &L);
-            if (sd_regular_net(&L.m, net)) {
-                if ((nnets & (nnets - 1)) == 0) {
-                    sd->nets = xrealloc(sd->nets, (size_t)(nnets ? 2 * nnets : 1) * 16 * sizeof(vec3));
-                }
-                memcpy(sd->nets + 16 * nnets, net, sizeof net);
-                sd->net_of[f] = nnets++;
+        sd_ring R;
+        for (int f = 0; f < nf; f++) {
+            bool drawn = !hole0[f] && (d->interpolateboundary || !open0[f]);
+            if (!drawn) continue;
+            sd_ring_make(sd, f, &R);
+            for (int c = sd->m0.fo[f]; c < sd->m0.fo[f + 1]; c++) {
+                vec3 net[16];
+                sd_ring_child(&R, c - sd->m0.fo[f], &L);
+                sd->flags[c] = SD_DRAWN | (sd_regular_net(&L.m, net) ? SD_REGULAR : 0);
             }
+            sd_ring_clear(&R);
         }
         sd_local_clear(&L);
+        for (int f = 0; f < nf1; f++) {
+            if ((f & 63) == 0) sd->irr_base[f >> 6] = sd->nirr;
+            if (sd->flags[f] == SD_DRAWN) sd->nirr++;
+        }
+        sd_cache_init(sd);
     }
     free(m0.P);
     free(m0.vs);
@@ -214,31 +244,280 @@ void geom_subdiv_destroy(geom_subdiv **self_p)
 {
     geom_subdiv *sd = *self_p;
     if (!sd) return;
-    free(sd->m.P);
-    free(sd->m.vs);
-    free(sd->m.fo);
-    free(sd->m.fv);
-    free(sd->m.es);
+    sd_cache_clear(sd);
+    free(sd->m0.P);
+    free(sd->m0.vs);
+    free(sd->m0.fo);
+    free(sd->m0.fv);
+    free(sd->m0.es);
     free(sd->vf_off);
     free(sd->vf);
-    free(sd->drawn);
-    free(sd->origin);
-    free(sd->net_of);
-    free(sd->nets);
-    sd_cache_clear(sd);
+    free(sd->flags);
+    free(sd->irr_base);
     free(sd);
     *self_p = NULL;
 }
 
-int geom_subdiv_nfaces(const geom_subdiv *self) { return self->m.nf; }
+size_t geom_subdiv_bytes(const geom_subdiv *self, size_t *points)
+{
+    int nv = self->m0.nv, nf = self->m0.nf, nc = self->nf1;
+    *points = (size_t)(nv + 1) * sizeof(vec3);
+    return sizeof *self + *points + (self->m0.vs ? (size_t)(nv + 1) * sizeof(double) : 0) +
+           (size_t)(nf + 1 + nc + 1) * sizeof(int) +
+           (self->m0.es ? (size_t)(nc + 1) * sizeof(double) : 0) +
+           (size_t)(nv + 2 + nc + 1) * sizeof(int) + (size_t)nc + 1 +
+           (size_t)(nc / 64 + 2) * sizeof(int) + (size_t)(self->nirr + 1) * sizeof(*self->roots);
+}
 
-bool geom_subdiv_face_drawn(const geom_subdiv *self, int f) { return self->drawn[f] != 0; }
+int sd_irregular_rank(const geom_subdiv *sd, int f)
+{
+    assert(f >= 0 && f < sd->nf1 && sd->flags[f] == SD_DRAWN);
+    int r = sd->irr_base[f >> 6];
+    for (int g = f & ~63; g < f; g++) r += sd->flags[g] == SD_DRAWN;
+    return r;
+}
 
-int geom_subdiv_face_origin(const geom_subdiv *self, int f) { return self->origin[f]; }
+int geom_subdiv_nfaces(const geom_subdiv *self) { return self->nf1; }
+
+bool geom_subdiv_face_drawn(const geom_subdiv *self, int f) { return self->flags[f] & SD_DRAWN; }
+
+/* the control face holding corner c */
+static int face_of_corner(const sd_mesh *m, int c)
+{
+    int lo = 0, hi = m->nf - 1;
+    while (lo < hi) {
+        int mid = (lo + hi + 1) / 2;
+        if (m->fo[mid] <= c) lo = mid;
+        else hi = mid - 1;
+    }
+    return lo;
+}
+
+int geom_subdiv_face_origin(const geom_subdiv *self, int f) { return face_of_corner(&self->m0, f); }
+
+static int next_in(const sd_mesh *m, int F, int c) { return c + 1 < m->fo[F + 1] ? c + 1 : m->fo[F]; }
+static int prev_in(const sd_mesh *m, int F, int c) { return c > m->fo[F] ? c - 1 : m->fo[F + 1] - 1; }
+
+/* the corner of control face G at point v (G holds v) */
+static int corner_at(const sd_mesh *m, int G, int v)
+{
+    int c = m->fo[G];
+    while (m->fv[c] != v) c++;
+    assert(c < m->fo[G + 1]);
+    return c;
+}
+
+/* A name for the edge of control corner c (from its point to the next):
+ * the smaller of its corner and the corner running it the other way */
+static int edge_name(const geom_subdiv *sd, int c)
+{
+    const sd_mesh *m = &sd->m0;
+    int F = face_of_corner(m, c), a = m->fv[c], b = m->fv[next_in(m, F, c)];
+    for (int i = sd->vf_off[b]; i < sd->vf_off[b + 1]; i++) {
+        int G = sd->vf[i], cb = corner_at(m, G, b);
+        if (m->fv[next_in(m, G, cb)] == a) return cb < c ? cb : c;
+    }
+    return c;
+}
 
 void geom_subdiv_face_points(const geom_subdiv *self, int f, int out[4])
 {
-    for (int k = 0; k < 4; k++) out[k] = self->m.fv[4 * f + k];
+    const sd_mesh *m = &self->m0;
+    int F = face_of_corner(m, f), n = m->fo[F + 1] - m->fo[F], k = f - m->fo[F];
+    int g[4] = { m->fv[f], m->nv + m->nf + edge_name(self, f), m->nv + F,
+                 m->nv + m->nf + edge_name(self, prev_in(m, F, f)) };
+    int start = n == 4 ? (4 - k) % 4 : 0;     /* as sd_refine turns the child */
+    for (int j = 0; j < 4; j++) out[j] = g[(j + start) % 4];
+}
+
+/* ---- 1-rings made again (the comment at the top) ---- */
+
+static int int_cmp(const void *x, const void *y)
+{
+    int a = *(const int *)x, b = *(const int *)y;
+    return (a > b) - (a < b);
+}
+
+/* sorts a[0..n) and drops repeats; the new count */
+static int sort_unique(int *a, int n)
+{
+    if (n <= 64) {                     /* a control face's ring: a few dozen */
+        for (int i = 1; i < n; i++) {
+            int x = a[i], j = i;
+            for (; j > 0 && a[j - 1] > x; j--) a[j] = a[j - 1];
+            a[j] = x;
+        }
+    } else {
+        qsort(a, (size_t)n, sizeof *a, int_cmp);
+    }
+    int m = 0;
+    for (int i = 0; i < n; i++)
+        if (m == 0 || a[m - 1] != a[i]) a[m++] = a[i];
+    return m;
+}
+
+static int find_sorted(const int *a, int n, int x)
+{
+    int lo = 0, hi = n - 1;
+    while (lo < hi) {
+        int mid = (lo + hi) / 2;
+        if (a[mid] < x) lo = mid + 1;
+        else hi = mid;
+    }
+    assert(n > 0 && a[lo] == x);
+    return lo;
+}
+
+/* sd_ring_make into buf when its arrays fit in cap bytes (false if they
+ * do not: R untouched), or on the heap (buf NULL) */
+static bool ring_build(const geom_subdiv *sd, int F, sd_ring *R, void *buf, size_t cap)
+{
+    const sd_mesh *m = &sd->m0;
+    int nfc = 0;
+    for (int c = m->fo[F]; c < m->fo[F + 1]; c++) nfc += sd->vf_off[m->fv[c] + 1] - sd->vf_off[m->fv[c]];
+    int stack[256];
+    int *faces = nfc <= 256 ? stack : xmalloc((size_t)nfc * sizeof *faces);
+    nfc = 0;
+    for (int c = m->fo[F]; c < m->fo[F + 1]; c++)
+        for (int i = sd->vf_off[m->fv[c]]; i < sd->vf_off[m->fv[c] + 1]; i++)
+            faces[nfc++] = sd->vf[i];
+    int nf = sort_unique(faces, nfc), nc = 0;
+    for (int i = 0; i < nf; i++) nc += m->fo[faces[i] + 1] - m->fo[faces[i]];
+    /* one block: the control faces (nv <= nc points), their refinement
+     * (nv + nf + nc points, nc faces, 4 nc corners), the points' names and
+     * the children's list */
+    size_t c1 = (size_t)nc, f1 = (size_t)nf, v1 = (size_t)(nc + nf + nc);
+    size_t bytes = (c1 + v1) * (sizeof(vec3) + sizeof(double)) + c1 * sizeof(double) +
+                   4 * c1 * sizeof(double) +
+                   (f1 + 1 + c1 + c1 + 1 + 4 * c1 + c1 + c1 + 1 + v1) * sizeof(int);
+    if (buf && bytes > cap) {
+        if (faces != stack) free(faces);
+        return false;
+    }
+    char *b = buf ? buf : xmalloc(bytes);
+    sd_mesh *lm = &R->ctl, *lr = &R->ref;
+    vec3 *P0 = (vec3 *)b, *P1 = P0 + c1;
+    double *vs0 = (double *)(P1 + v1), *vs1 = vs0 + c1, *es0 = vs1 + v1, *es1 = es0 + c1;
+    int *fo0 = (int *)(es1 + 4 * c1), *fv0 = fo0 + f1 + 1, *fo1 = fv0 + c1, *fv1 = fo1 + c1 + 1;
+    int *pts = fv1 + 4 * c1;
+    R->list = pts + c1;
+    R->local = R->list + c1 + 1;
+    for (size_t i = 0; i < v1; i++) R->local[i] = -1;
+    R->block = buf ? NULL : b;
+    nc = 0;
+    for (int i = 0; i < nf; i++)
+        for (int c = m->fo[faces[i]]; c < m->fo[faces[i] + 1]; c++) pts[nc++] = m->fv[c];
+    int nv = sort_unique(pts, nc);
+    /* the control faces, their points numbered in the mesh's order */
+    *lm = (sd_mesh){ nv, nf, P0, vs0, fo0, fv0, es0 };
+    for (int i = 0; i < nv; i++) {
+        lm->P[i] = m->P[pts[i]];
+        lm->vs[i] = m->vs ? m->vs[pts[i]] : 0;
+    }
+    lm->fo[0] = 0;
+    for (int i = 0, lc = 0; i < nf; i++) {
+        if (faces[i] == F) R->base = lc;
+        for (int c = m->fo[faces[i]]; c < m->fo[faces[i] + 1]; c++, lc++) {
+            lm->fv[lc] = find_sorted(pts, nv, m->fv[c]);
+            lm->es[lc] = m->es ? m->es[c] : 0;
+        }
+        lm->fo[i + 1] = lc;
+    }
+    *lr = (sd_mesh){ 0, 0, P1, vs1, fo1, fv1, es1 };
+    sd_refine(lm, lr);
+    if (faces != stack) free(faces);
+    return true;
+}
+
+void sd_ring_make(const geom_subdiv *sd, int F, sd_ring *R)
+{
+    ring_build(sd, F, R, NULL, 0);
+}
+
+/* The last ring a thread made, in a buffer of its own (no heap, so
+ * nothing is left when the thread ends): the children of a control face
+ * come one after the other (the world's pass over the pieces, a ray's
+ * neighbouring faces), and share it. Keyed by the mesh's serial number,
+ * never reused. */
+enum { RING_CACHE_BYTES = 32768 };
+static _Thread_local struct {
+    unsigned long serial;
+    int F;
+    sd_ring R;
+    _Alignas(16) char buf[RING_CACHE_BYTES];
+} ring_cache;
+
+/* F's ring: the thread's cached one, or made into *heap (then freed by
+ * the caller with sd_ring_clear) */
+static const sd_ring *ring_of_face(const geom_subdiv *sd, int F, sd_ring *heap)
+{
+    if (ring_cache.serial == sd->serial && ring_cache.F == F) return &ring_cache.R;
+    ring_cache.serial = 0;
+    if (ring_build(sd, F, &ring_cache.R, ring_cache.buf, sizeof ring_cache.buf)) {
+        ring_cache.serial = sd->serial;
+        ring_cache.F = F;
+        return &ring_cache.R;
+    }
+    ring_build(sd, F, heap, NULL, 0);
+    return heap;
+}
+
+void sd_ring_child(const sd_ring *R, int k, sd_local *L)
+{
+    const sd_mesh *lr = &R->ref;
+    int f = R->base + k, n = 0, *list = R->list;
+    list[n++] = f;
+    for (int j = 0; j < 4; j++) {
+        int p = lr->fv[4 * f + j];
+        for (int g = 0; g < lr->nf; g++) {
+            const int *q = lr->fv + 4 * g;
+            if (q[0] != p && q[1] != p && q[2] != p && q[3] != p) continue;
+            int i = 0;
+            while (i < n && list[i] != g) i++;
+            if (i == n) list[n++] = g;
+        }
+    }
+    assert(n <= sd_lf(L->maxval));
+    /* sd_local_take's copy (points numbered as they come), its search for a
+     * point by the ring's table of local numbers */
+    L->m = (sd_mesh){ 0, 0, L->P, L->vs, L->fo, L->fv, L->es };
+    int nc = 0, *local = R->local;
+    L->fo[0] = 0;
+    for (int i = 0; i < n; i++) {
+        int g = list[i];
+        assert(nc + 4 <= sd_lc(L->maxval));
+        for (int c = 4 * g; c < 4 * g + 4; c++) {
+            int v = lr->fv[c];
+            if (local[v] < 0) {
+                int j = L->m.nv++;
+                local[v] = j;
+                L->src[j] = v;
+                L->P[j] = lr->P[v];
+                L->vs[j] = lr->vs[v];
+            }
+            L->fv[nc] = local[v];
+            L->es[nc] = lr->es[c];
+            nc++;
+        }
+        L->fo[++L->m.nf] = nc;
+    }
+    for (int j = 0; j < L->m.nv; j++) local[L->src[j]] = -1;
+}
+
+void sd_ring_clear(sd_ring *R)
+{
+    free(R->block);
+    *R = (sd_ring){ 0 };
+}
+
+void sd_local_from_shared(const geom_subdiv *sd, int f, sd_local *L)
+{
+    assert(L->maxval == sd->maxval);
+    int F = face_of_corner(&sd->m0, f);
+    sd_ring heap = { 0 };
+    const sd_ring *R = ring_of_face(sd, F, &heap);
+    sd_ring_child(R, f - sd->m0.fo[F], L);
+    sd_ring_clear(&heap);
 }
 
 void geom_subdiv_surface(const geom_subdiv *self, int f, geom_surface *out)
@@ -247,18 +526,31 @@ void geom_subdiv_surface(const geom_subdiv *self, int f, geom_surface *out)
     out->kind = GEOM_SUBDIV;
     out->subdiv = self;
     out->subdiv_face = f;
+    sd_local L;
+    sd_local_init(&L, self->maxval);
+    sd_local_from_shared(self, f, &L);
+    /* a regular face's net, in verts (subdiv_eval.c reads it there) */
+    if (self->flags[f] & SD_REGULAR) {
+        sd_known_regular_net(&L.m, out->verts);
+        out->nverts = 16;
+    }
+    sd_local_hull(&L.m, &out->subdiv_lo, &out->subdiv_hi);
+    sd_local_clear(&L);
 }
 
 bool geom_subdiv_limit_point(const geom_subdiv *self, int point, vec3 *out)
 {
-    if (point < 0 || point >= self->m.nv || self->vf_off[point] == self->vf_off[point + 1])
+    if (point < 0 || point >= self->m0.nv || self->vf_off[point] == self->vf_off[point + 1])
         return false;
-    int c = self->vf[self->vf_off[point]];
+    /* the child of a corner at the point: its corner at the vertex point */
+    int F = self->vf[self->vf_off[point]], c = corner_at(&self->m0, F, point);
+    int n = self->m0.fo[F + 1] - self->m0.fo[F], k = c - self->m0.fo[F];
+    int j = n == 4 ? k : 0;
     static const double U[4] = { 0, 1, 1, 0 }, V[4] = { 0, 0, 1, 1 };
     geom_surface s;
-    geom_subdiv_surface(self, c / 4, &s);
+    geom_subdiv_surface(self, c, &s);
     geom_sample g;
-    geom_eval(&s, U[c % 4], V[c % 4], &g);
+    geom_eval(&s, U[j], V[j], &g);
     *out = g.P;
     return true;
 }

@@ -45,12 +45,22 @@ static int next_corner(const sd_mesh *m, int f, int c)
 static int build_edges(const sd_mesh *m, const int *face_of, int *cedge, int (*ec)[2])
 {
     int nc = m->fo[m->nf];
-    sd_ekey *k = xmalloc((size_t)(nc > 0 ? nc : 1) * sizeof *k);
+    sd_ekey stack[64];
+    sd_ekey *k = nc <= 64 ? stack : xmalloc((size_t)nc * sizeof *k);
     for (int c = 0; c < nc; c++) {
         int a = m->fv[c], b = m->fv[next_corner(m, face_of[c], c)];
         k[c] = (sd_ekey){ a < b ? a : b, a < b ? b : a, c };
     }
-    qsort(k, (size_t)nc, sizeof *k, ekey_cmp);
+    if (nc <= 64) {                    /* the local meshes: a few dozen corners */
+        for (int i = 1; i < nc; i++) {
+            sd_ekey x = k[i];
+            int j = i;
+            for (; j > 0 && ekey_cmp(&k[j - 1], &x) > 0; j--) k[j] = k[j - 1];
+            k[j] = x;
+        }
+    } else {
+        qsort(k, (size_t)nc, sizeof *k, ekey_cmp);
+    }
     int ne = 0;
     for (int i = 0; i < nc; i++) {
         if (i > 0 && k[i].a == k[i - 1].a && k[i].b == k[i - 1].b) {
@@ -62,22 +72,7 @@ static int build_edges(const sd_mesh *m, const int *face_of, int *cedge, int (*e
         }
         cedge[k[i].c] = ne - 1;
     }
-    free(k);
-    return ne;
-}
-
-int sd_edge_count(const sd_mesh *m)
-{
-    int nc = m->fo[m->nf];
-    int *face_of = xcalloc((size_t)nc + 1, sizeof *face_of);
-    int *cedge = xmalloc((size_t)(nc + 1) * sizeof *cedge);
-    int (*ec)[2] = xmalloc((size_t)(nc + 1) * sizeof *ec);
-    for (int f = 0; f < m->nf; f++)
-        for (int c = m->fo[f]; c < m->fo[f + 1]; c++) face_of[c] = f;
-    int ne = build_edges(m, face_of, cedge, ec);
-    free(face_of);
-    free(cedge);
-    free(ec);
+    if (k != stack) free(k);
     return ne;
 }
 
@@ -95,18 +90,17 @@ static vec3 lerp3(vec3 a, vec3 b, double t)
 void sd_refine(const sd_mesh *m, sd_mesh *out)
 {
     int nv = m->nv, nf = m->nf, nc = m->fo[nf];
-    int *face_of = xcalloc((size_t)nc + 1, sizeof *face_of);
-    int *cedge = xmalloc((size_t)(nc + 1) * sizeof *cedge);
-    int (*ec)[2] = xmalloc((size_t)(nc + 1) * sizeof *ec);
+    /* the scratch in one block (this runs for every face's 1-ring) */
+    size_t nc1 = (size_t)nc + 1, nv1 = (size_t)nv + 1;
+    char *block = xcalloc(1, 3 * nv1 * sizeof(vec3) + nv1 * sizeof(double) +
+                             (3 * nc1 + 3 * nv1) * sizeof(int) + nc1 * 2 * sizeof(int));
+    vec3 *fsum = (vec3 *)block, *rsum = fsum + nv1, *esum = rsum + nv1;
+    double *ssum = (double *)(esum + nv1);
+    int (*ec)[2] = (int (*)[2])(ssum + nv1);
+    int *face_of = (int *)(ec + nc1), *cedge = face_of + nc1;
+    int *nfc = cedge + nc1, *nec = nfc + nv1, *nsh = nec + nv1;
     /* per point: face point sum, faces, midpoint sum, edges, sharp edges,
      * their sharpness sum, their far ends' sum */
-    vec3 *fsum = xcalloc((size_t)nv + 1, sizeof *fsum);
-    vec3 *rsum = xcalloc((size_t)nv + 1, sizeof *rsum);
-    vec3 *esum = xcalloc((size_t)nv + 1, sizeof *esum);
-    int *nfc = xcalloc((size_t)nv + 1, sizeof *nfc);
-    int *nec = xcalloc((size_t)nv + 1, sizeof *nec);
-    int *nsh = xcalloc((size_t)nv + 1, sizeof *nsh);
-    double *ssum = xcalloc((size_t)nv + 1, sizeof *ssum);
     for (int f = 0; f < nf; f++)
         for (int c = m->fo[f]; c < m->fo[f + 1]; c++) face_of[c] = f;
     int ne = build_edges(m, face_of, cedge, ec);
@@ -191,14 +185,5 @@ void sd_refine(const sd_mesh *m, sd_mesh *out)
         }
     }
     out->fo[nc] = 4 * nc;
-    free(face_of);
-    free(cedge);
-    free(ec);
-    free(fsum);
-    free(rsum);
-    free(esum);
-    free(nfc);
-    free(nec);
-    free(nsh);
-    free(ssum);
+    free(block);
 }

@@ -76,11 +76,12 @@ typedef struct vring {
     int nfaces, nedges, ninf;
     bool ok;                       /* every sharpness 0 or infinite */
     int *other;
+    int stack[64];                 /* other, when it fits */
 } vring;
 
 static void ring_clear(vring *r)
 {
-    free(r->other);
+    if (r->other != r->stack) free(r->other);
     r->other = NULL;
 }
 
@@ -89,8 +90,9 @@ static void ring_of(const sd_mesh *m, int v, vring *r)
     r->nfaces = r->nedges = r->ninf = 0;
     r->ok = tag_ok(m->vs[v]);
     int cap = 2 * m->nf;
-    r->other = xmalloc((size_t)cap * sizeof *r->other);
-    double *sh = xmalloc((size_t)cap * sizeof *sh);
+    double sh_stack[64];
+    r->other = cap <= 64 ? r->stack : xmalloc((size_t)cap * sizeof *r->other);
+    double *sh = cap <= 64 ? sh_stack : xmalloc((size_t)cap * sizeof *sh);
     for (int f = 0; f < m->nf; f++)
         for (int c = m->fo[f]; c < m->fo[f + 1]; c++) {
             if (m->fv[c] != v) continue;
@@ -114,7 +116,7 @@ static void ring_of(const sd_mesh *m, int v, vring *r)
         if (!tag_ok(sh[i])) r->ok = false;
         if (isinf(sh[i])) r->ninf++;
     }
-    free(sh);
+    if (sh != sh_stack) free(sh);
 }
 
 /* grid positions (i along u, j along v) of the face's corners */
@@ -124,7 +126,8 @@ static const int OI[4] = { 0, 1, 0, -1 }, OJ[4] = { -1, 0, 1, 0 };
 
 static vec3 mirror(vec3 a, vec3 b) { return v3_sub(v3_scale(a, 2), b); }
 
-bool sd_regular_net(const sd_mesh *m, vec3 net[16])
+/* check: whether face 0 is regular (else known, and only its net made) */
+static bool face_net(const sd_mesh *m, bool check, vec3 net[16])
 {
     if (m->nf < 1 || m->fo[1] - m->fo[0] != 4) return false;
     int c[4];
@@ -135,7 +138,7 @@ bool sd_regular_net(const sd_mesh *m, vec3 net[16])
         if (!tag_ok(e)) return false;
         sharp[s] = isinf(e);
     }
-    for (int k = 0; k < 4; k++) {
+    for (int k = 0; k < 4 && check; k++) {
         vring r;
         ring_of(m, c[k], &r);
         ring_clear(&r);    /* its counts are all this test needs */
@@ -220,6 +223,15 @@ bool sd_regular_net(const sd_mesh *m, vec3 net[16])
         net[4 * 3 + i] = v3_scale(v3_add(v3_add(p1, v3_scale(p2, 4)), p3), 1.0 / 6);
     }
     return true;
+}
+
+bool sd_regular_net(const sd_mesh *m, vec3 net[16]) { return face_net(m, true, net); }
+
+void sd_known_regular_net(const sd_mesh *m, vec3 net[16])
+{
+    bool made = face_net(m, false, net);
+    assert(made && "a face flagged regular has its net");
+    (void)made;
 }
 
 /* The limit mask of point v given its ring (sd_corner_limit). */

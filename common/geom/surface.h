@@ -81,9 +81,12 @@ typedef struct geom_surface {
                                             * (zmax - zmin, ...) for the interval and
                                             * affine evaluations; see surface_internal.h */
     /* GEOM_SUBDIV: the mesh (shared by its faces, owned by whoever built it,
-     * geom/subdiv.h) and the face of its refined mesh */
+     * geom/subdiv.h) and the face of its refined mesh; made with the surface
+     * (geom_subdiv_surface): a regular face's Bezier net in verts (nverts =
+     * 16, else 0) and the hull of its 1-ring */
     const struct geom_subdiv *subdiv;
     int subdiv_face;
+    vec3 subdiv_lo, subdiv_hi;
     /* GEOM_NURBS: the NuPatch (shared by its pieces, owned by whoever built
      * it, geom/nurbs.h) and the piece */
     const struct geom_nurbs *nurbs;

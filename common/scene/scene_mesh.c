@@ -210,6 +210,15 @@ size_t scene_mesh_bytes(const scene_mesh *self)
            (size_t)(2 * self->nfaces + (self->sd ? 1 : 0)) * sizeof(int);
 }
 
+size_t scene_mesh_subdiv_bytes(const scene_mesh *self, size_t *points)
+{
+    *points = 0;
+#ifdef SCENE_HAVE_GEOM
+    if (self->sd) return geom_subdiv_bytes(self->sd, points);
+#endif
+    return 0;
+}
+
 void scene_mesh_destroy(scene_mesh **self_p)
 {
     scene_mesh *self = *self_p;

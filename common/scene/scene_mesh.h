@@ -81,6 +81,11 @@ bool scene_mesh_piece_surface(const scene_mesh *self, int k, geom_surface *s,
 size_t scene_mesh_bytes(const scene_mesh *self);
 size_t scene_mesh_piece_bytes(const scene_mesh *self);
 
+/* A subdivision mesh's own bytes (geom/subdiv.h: its control mesh and
+ * its flags per refined face; 0 for a polygon mesh), and of them its
+ * control points' (*points), which count with the shared arrays. */
+size_t scene_mesh_subdiv_bytes(const scene_mesh *self, size_t *points);
+
 void scene_mesh_destroy(scene_mesh **self_p);
 
 #endif
