@@ -35,11 +35,12 @@
  *
  * Threads (issue 23): a large PointsPolygons or PointsGeneralPolygons mesh
  * has its faces prepared over the parser's threads (p->threads, a worker's:
- * scene_parse_frame_threads), in rounds of contiguous shares of faces. Each
- * share logs what its faces did (a piece, a face without area, an error's
- * message) and the logs are played back in face order, stopping where one
- * thread would have stopped (the diagnostics full): the same pieces, the same
- * messages in the same order, for any number of threads.
+ * scene_parse_frame_threads), in chunks of contiguous faces that the
+ * threads take as they come free. Each chunk logs what its faces did (a
+ * piece, a face without area, an error's message) and the logs are played
+ * back in face order, stopping where one thread would have stopped (the
+ * diagnostics full): the same pieces, the same messages in the same order,
+ * for any number of threads.
  */
 #include "scene/rib_parser.h"
 #include "scene/rib_primvar.h"
@@ -54,6 +55,7 @@
 
 #include <math.h>
 #include <stdarg.h>
+#include <stdatomic.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -77,22 +79,25 @@ typedef scene_mesh_nclass mesh_nclass;
 #define MESH_N_UNIFORM SCENE_MESH_N_UNIFORM
 #define MESH_N_CONSTANT SCENE_MESH_N_CONSTANT
 
-/* What a face did, logged by a share of the faces (threads) to be played
- * back in face order. */
+/* What a face did, logged by a chunk of the faces (threads) to be played
+ * back in face order: 20 bytes (a piece's corners fit 16 bits, as in
+ * scene_mesh_piece). */
 typedef enum { FACE_PIECE, FACE_SKIPPED, FACE_ERROR } face_event_kind;
 
 typedef struct face_event {
     int face, fv0;
+    uint16_t k[3];                 /* FACE_PIECE: scene_mesh_add_piece's */
+    uint8_t n;
     uint8_t what;                  /* face_event_kind */
     uint8_t kind;                  /* FACE_PIECE: its scene_piece_kind */
     bool has_k;
-    int n, k[3];                   /* FACE_PIECE: scene_mesh_add_piece's */
-    char *msg;                     /* FACE_ERROR: the message (xalloc) */
 } face_event;
 
 typedef struct face_log {
     face_event *ev;
     size_t n, cap;
+    char **msgs;                   /* the FACE_ERROR events' messages, in order */
+    size_t nmsgs;
 } face_log;
 
 /* A mesh being cut into surfaces. */
@@ -139,9 +144,10 @@ static void add_piece(const mesh *m, scene_piece_kind kind, int face, const int 
     }
     face_event *e = log_event(m, face, FACE_PIECE);
     e->kind = (uint8_t)kind;
-    e->n = n;
+    e->n = (uint8_t)n;             /* 3, or a whole face's <= GEOM_MAX_POLY_VERTS */
     e->has_k = k != NULL;
-    if (k) e->k[0] = k[0], e->k[1] = k[1], e->k[2] = k[2];
+    if (k)                         /* corners of a face of <= RIB_MAX_FACE_POINTS */
+        for (int i = 0; i < 3; i++) e->k[i] = (uint16_t)k[i];
 }
 
 /* a face without area */
@@ -161,9 +167,12 @@ static void face_error(rib_parser *p, const mesh *m, int face, const char *fmt, 
     va_start(ap, fmt);
     vsnprintf(msg, sizeof msg, fmt, ap);
     va_end(ap);
-    if (m->log)
-        log_event(m, face, FACE_ERROR)->msg = xstrdup(msg);
-    else
+    if (m->log) {
+        face_log *l = m->log;
+        log_event(m, face, FACE_ERROR);
+        l->msgs = xreallocarray(l->msgs, l->nmsgs + 1, sizeof *l->msgs);
+        l->msgs[l->nmsgs++] = xstrdup(msg);
+    } else
         rib_error(p, m->req, m->vertices_pos, "%s", msg);
 }
 
@@ -421,104 +430,131 @@ static mesh_nclass normal_class(rib_parser *p, const rib_request *req, const sce
 }
 
 #ifdef SCENE_HAVE_GEOM
-/* Faces a share holds per round, and the fewest faces worth a thread */
-enum { FACES_PER_SHARE = 16384, FACES_FOR_THREADS = 8192 };
+/* Faces a chunk holds, chunks a wave holds per thread, and the fewest
+ * faces worth threads */
+enum { FACES_PER_CHUNK = 8192, CHUNKS_PER_THREAD = 4, FACES_FOR_THREADS = 8192 };
 
-/* A share of a round: faces [f0, f1), their loops from `loop` and their
- * points from `vi`; m: the mesh's copy with a scratch and a log of its own */
-typedef struct face_share {
+/* The faces in chunks over threads, a wave of chunks at a time (so that
+ * the logs are a wave's: ~0.7 MB a chunk, reused): chunk c is faces
+ * [c * FACES_PER_CHUNK, ...), its loops from loop[c] and its points from
+ * vi[c]; a thread takes the wave's next chunk not taken (next) until none
+ * is left before `end`, into log[c - first]. */
+typedef struct face_chunks {
     rib_parser *p;
+    const int *nloops, *idx;
+    int nfaces, nchunks;
+    const int **loop, **vi;
+    face_log *log;
+    int first, end;
+    atomic_int next;
+} face_chunks;
+
+/* A thread's share: the chunks and its own copy of the mesh (a scratch
+ * surface of its own; its log set per chunk) */
+typedef struct face_share {
+    face_chunks *all;
     mesh m;
-    const int *nloops, *idx, *loop, *vi;
-    int f0, f1;
-    face_log log;
 } face_share;
 
 static void *faces_of_share(void *arg)
 {
     face_share *sh = arg;
-    const int *loop = sh->loop, *vi = sh->vi;
-    for (int f = sh->f0; f < sh->f1; f++) {
-        int nl = sh->nloops ? sh->nloops[f] : 1;
-        int npts = (int)sum(loop, nl);
-        sh->m.fv0 = (int)(vi - sh->idx);
-        add_face(sh->p, &sh->m, f, loop, nl, vi);
-        loop += nl;
-        vi += npts;
+    face_chunks *all = sh->all;
+    int c;
+    while ((c = atomic_fetch_add(&all->next, 1)) < all->end) {
+        const int *loop = all->loop[c], *vi = all->vi[c];
+        int f1 = (c + 1) * FACES_PER_CHUNK < all->nfaces ? (c + 1) * FACES_PER_CHUNK : all->nfaces;
+        sh->m.log = &all->log[c - all->first];
+        for (int f = c * FACES_PER_CHUNK; f < f1; f++) {
+            int nl = all->nloops ? all->nloops[f] : 1;
+            int npts = (int)sum(loop, nl);
+            sh->m.fv0 = (int)(vi - all->idx);
+            add_face(all->p, &sh->m, f, loop, nl, vi);
+            loop += nl;
+            vi += npts;
+        }
     }
     return NULL;
 }
 
-/* Plays back a share's log in face order into m (its pieces, faces
- * without area and errors); false where one thread would have stopped: the
- * diagnostics are full before a face that did something. */
-static bool play_back(rib_parser *p, mesh *m, face_log *log)
+/* Plays back a chunk's log in face order into m (its pieces, faces
+ * without area and errors) while `go`; false where one thread would have
+ * stopped: the diagnostics full before a face that did something. Empties
+ * the log (its events' array kept for the next wave). */
+static bool play_back(rib_parser *p, mesh *m, face_log *log, bool go)
 {
-    bool go = true;
     int last = -1;
-    for (size_t i = 0; i < log->n; i++) {
-        face_event *e = &log->ev[i];
-        if (go && e->face != last) {
+    size_t msg = 0;
+    for (size_t i = 0; i < log->n && go; i++) {
+        const face_event *e = &log->ev[i];
+        if (e->face != last) {
             go = !sl_diag_full(p->diag);
             last = e->face;
+            if (!go) break;
         }
-        if (go && e->what == FACE_PIECE)
+        if (e->what == FACE_PIECE) {
+            int k[3] = {e->k[0], e->k[1], e->k[2]};
             scene_mesh_add_piece(m->out, (scene_piece_kind)e->kind, e->face, e->fv0,
-                                 e->has_k ? e->k : NULL, e->n);
-        else if (go && e->what == FACE_SKIPPED)
+                                 e->has_k ? k : NULL, e->n);
+        } else if (e->what == FACE_SKIPPED) {
             m->skipped++;
-        else if (go && e->what == FACE_ERROR)
-            rib_error(p, m->req, m->vertices_pos, "%s", e->msg);
-        free(e->msg);
+        } else {
+            rib_error(p, m->req, m->vertices_pos, "%s", log->msgs[msg++]);
+        }
     }
+    for (size_t i = 0; i < log->nmsgs; i++) free(log->msgs[i]);
+    free(log->msgs);
+    log->msgs = NULL;
+    log->nmsgs = 0;
     log->n = 0;
     return go;
 }
 
-/* The faces of mesh m over p->threads threads: rounds of FACES_PER_SHARE
- * faces a thread, each round's logs played back in order. */
+/* The faces of mesh m over p->threads threads in chunks of
+ * FACES_PER_CHUNK (taken as threads come free: a thread held up by the
+ * machine's load holds up no other for more than a chunk), a wave of
+ * CHUNKS_PER_THREAD chunks a thread at a time, each wave's logs played
+ * back in order. */
 static void faces_in_threads(rib_parser *p, mesh *m, const int *nloops, int nfaces,
                              const int *nverts, const int *idx)
 {
-    int threads = p->threads;
+    face_chunks all = { p, nloops, idx, nfaces, (nfaces + FACES_PER_CHUNK - 1) / FACES_PER_CHUNK,
+                        NULL, NULL, NULL, 0, 0, 0 };
+    int threads = p->threads < all.nchunks ? p->threads : all.nchunks;
+    int wave = CHUNKS_PER_THREAD * threads;
+    all.loop = xcalloc((size_t)all.nchunks, sizeof *all.loop);
+    all.vi = xcalloc((size_t)all.nchunks, sizeof *all.vi);
+    all.log = xcalloc((size_t)wave, sizeof *all.log);
+    const int *loop = nverts, *vi = idx;
+    for (int f = 0; f < nfaces; f++) {
+        if (f % FACES_PER_CHUNK == 0) {
+            all.loop[f / FACES_PER_CHUNK] = loop;
+            all.vi[f / FACES_PER_CHUNK] = vi;
+        }
+        int nl = nloops ? nloops[f] : 1;
+        vi += sum(loop, nl);
+        loop += nl;
+    }
     face_share *sh = xcalloc((size_t)threads, sizeof *sh);
     for (int i = 0; i < threads; i++) {
-        sh[i].p = p;
+        sh[i].all = &all;
         sh[i].m = *m;
         sh[i].m.scratch = xcalloc(1, sizeof *sh[i].m.scratch);
-        sh[i].m.log = &sh[i].log;
-        sh[i].nloops = nloops;
-        sh[i].idx = idx;
     }
-    const int *loop = nverts, *vi = idx;
-    int f = 0;
     bool go = true;
-    while (go && f < nfaces && !sl_diag_full(p->diag)) {
-        int n = 0;
-        for (; n < threads && f < nfaces; n++) {
-            sh[n].f0 = f;
-            sh[n].loop = loop;
-            sh[n].vi = vi;
-            int f1 = nfaces - f > FACES_PER_SHARE ? f + FACES_PER_SHARE : nfaces;
-            for (; f < f1; f++) {
-                int nl = nloops ? nloops[f] : 1;
-                vi += sum(loop, nl);
-                loop += nl;
-            }
-            sh[n].f1 = f1;
-        }
-        util_run_shares(sh, sizeof *sh, n, faces_of_share);
-        for (int i = 0; i < n; i++)
-            if (go)
-                go = play_back(p, m, &sh[i].log);
-            else
-                play_back(p, m, &sh[i].log);     /* frees the messages */
+    for (all.first = 0; all.first < all.nchunks && go; all.first = all.end) {
+        all.end = all.nchunks - all.first > wave ? all.first + wave : all.nchunks;
+        atomic_store(&all.next, all.first);
+        util_run_shares(sh, sizeof *sh, threads, faces_of_share);
+        for (int c = all.first; c < all.end; c++)
+            go = play_back(p, m, &all.log[c - all.first], go);
     }
-    for (int i = 0; i < threads; i++) {
-        free(sh[i].m.scratch);
-        free(sh[i].log.ev);
-    }
+    for (int i = 0; i < threads; i++) free(sh[i].m.scratch);
     free(sh);
+    for (int i = 0; i < wave; i++) free(all.log[i].ev);
+    free(all.log);
+    free(all.vi);
+    free(all.loop);
 }
 #endif
 
