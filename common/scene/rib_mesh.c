@@ -430,9 +430,11 @@ static mesh_nclass normal_class(rib_parser *p, const rib_request *req, const sce
 }
 
 #ifdef SCENE_HAVE_GEOM
-/* Faces a chunk holds, chunks a wave holds per thread, and the fewest
- * faces worth threads */
-enum { FACES_PER_CHUNK = 8192, CHUNKS_PER_THREAD = 4, FACES_FOR_THREADS = 8192 };
+/* Faces a chunk holds; chunks a wave holds (at least WAVE_CHUNKS, at
+ * least CHUNKS_PER_THREAD a thread: a wave's logs are ~10 MB on 2
+ * threads); the fewest faces worth threads */
+enum { FACES_PER_CHUNK = 8192, WAVE_CHUNKS = 32, CHUNKS_PER_THREAD = 4,
+       FACES_FOR_THREADS = 8192 };
 
 /* The faces in chunks over threads, a wave of chunks at a time (so that
  * the logs are a wave's: ~0.7 MB a chunk, reused): chunk c is faces
@@ -513,15 +515,14 @@ static bool play_back(rib_parser *p, mesh *m, face_log *log, bool go)
 /* The faces of mesh m over p->threads threads in chunks of
  * FACES_PER_CHUNK (taken as threads come free: a thread held up by the
  * machine's load holds up no other for more than a chunk), a wave of
- * CHUNKS_PER_THREAD chunks a thread at a time, each wave's logs played
- * back in order. */
+ * chunks at a time, each wave's logs played back in order. */
 static void faces_in_threads(rib_parser *p, mesh *m, const int *nloops, int nfaces,
                              const int *nverts, const int *idx)
 {
     face_chunks all = { p, nloops, idx, nfaces, (nfaces + FACES_PER_CHUNK - 1) / FACES_PER_CHUNK,
                         NULL, NULL, NULL, 0, 0, 0 };
     int threads = p->threads < all.nchunks ? p->threads : all.nchunks;
-    int wave = CHUNKS_PER_THREAD * threads;
+    int wave = CHUNKS_PER_THREAD * threads > WAVE_CHUNKS ? CHUNKS_PER_THREAD * threads : WAVE_CHUNKS;
     all.loop = xcalloc((size_t)all.nchunks, sizeof *all.loop);
     all.vi = xcalloc((size_t)all.nchunks, sizeof *all.vi);
     all.log = xcalloc((size_t)wave, sizeof *all.log);
