@@ -9,8 +9,8 @@
  *               pairs
  *   bounds      a polygon's geom_bounds is the hull of geom_eval_ia's P (its
  *               formula, spelled out) at its vertices' (u,v), padded as
- *               before, for random convex
- *               polygons (triangles to 12 corners, random planes and sizes)
+ *               before, for random convex polygons (triangles to 12
+ *               corners, random planes, sizes from 1e-140 to 1e140)
  *   ng          the polygon's Ng constants are ia_mul's products of the
  *               axes as point intervals, for the same polygons
  */
