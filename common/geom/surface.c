@@ -289,19 +289,33 @@ bool geom_surface_prepare(geom_surface *s, char *err, size_t errsz)
 
 static void grow(vec3 *lo, vec3 *hi, const ia_interval *p)
 {
-    lo->x = fmin(lo->x, p[0].lo); hi->x = fmax(hi->x, p[0].hi);
-    lo->y = fmin(lo->y, p[1].lo); hi->y = fmax(hi->y, p[1].hi);
-    lo->z = fmin(lo->z, p[2].lo); hi->z = fmax(hi->z, p[2].hi);
+    lo->x = geom_min(lo->x, p[0].lo); hi->x = geom_max(hi->x, p[0].hi);
+    lo->y = geom_min(lo->y, p[1].lo); hi->y = geom_max(hi->y, p[1].hi);
+    lo->z = geom_min(lo->z, p[2].lo); hi->z = geom_max(hi->z, p[2].hi);
+}
+
+/* ia_mul_s(ia_point(x), s), the same bits */
+static ia_interval point_times(double x, double s)
+{
+    ia_interval r;
+    return geom_point_product(x, s, &r) ? r : ia_mul_s(ia_point(x), s);
 }
 
 /* Polygons: the hull of the vertices (the polygon is their convex hull
- * and P is affine), widened by what geom_uv_inside's tolerance admits. */
+ * and P is affine), widened by what geom_uv_inside's tolerance admits.
+ * P at each vertex's (u,v) as geom_eval_ia makes it (surface_interval.c's
+ * eval_polygon: the same operations on the same numbers), without its
+ * dPdu, dPdv and Ng (tests/geom/test_geom_same_bits.c). */
 static void polygon_bounds(const geom_surface *s, vec3 *lo, vec3 *hi)
 {
-    geom_ia box;
+    ia_interval P[3];
     for (int i = 0; i < s->nuv; i++) {
-        geom_eval_ia(s, ia_point(s->uv[i][0]), ia_point(s->uv[i][1]), &box);
-        grow(lo, hi, box.P);
+        double u = s->uv[i][0], v = s->uv[i][1];
+        for (int k = 0; k < 3; k++)
+            P[k] = ia_add_s(ia_add(point_times(u, v3_comp(s->axis_u, k)),
+                                   point_times(v, v3_comp(s->axis_v, k))),
+                            v3_comp(s->origin, k));
+        grow(lo, hi, P);
     }
     double pad = 1e-9 * (v3_length(s->axis_u) + v3_length(s->axis_v));
     *lo = v3_sub(*lo, v3(pad, pad, pad));

@@ -55,11 +55,11 @@ static bool distinct_vertices(const geom_surface *s, poly_work *w, char *err, si
     vec3 lo = s->verts[0], hi = s->verts[0];
     for (int i = 1; i < s->nverts; i++) {
         vec3 p = s->verts[i];
-        lo = v3(fmin(lo.x, p.x), fmin(lo.y, p.y), fmin(lo.z, p.z));
-        hi = v3(fmax(hi.x, p.x), fmax(hi.y, p.y), fmax(hi.z, p.z));
+        lo = v3(geom_min(lo.x, p.x), geom_min(lo.y, p.y), geom_min(lo.z, p.z));
+        hi = v3(geom_max(hi.x, p.x), geom_max(hi.y, p.y), geom_max(hi.z, p.z));
     }
     vec3 ext = v3_sub(hi, lo);
-    w->size = fmax(ext.x, fmax(ext.y, ext.z));
+    w->size = geom_max(ext.x, geom_max(ext.y, ext.z));
     if (!isfinite(w->size))
         return err_set(err, errsz, "polygon vertices are too large");
     double same = 1e-12 * w->size;
@@ -108,16 +108,19 @@ static void extents(const poly_work *w, vec3 c, vec3 e1, vec3 e2, double *a0,
     for (int i = 0; i < w->n; i++) {
         vec3 r = v3_sub(w->p[i], c);
         double a = v3_dot(r, e1), b = v3_dot(r, e2);
-        *a0 = fmin(*a0, a); *a1 = fmax(*a1, a);
-        *b0 = fmin(*b0, b); *b1 = fmax(*b1, b);
+        *a0 = geom_min(*a0, a); *a1 = geom_max(*a1, a);
+        *b0 = geom_min(*b0, b); *b1 = geom_max(*b1, b);
     }
 }
 
-/* The in-plane direction of the minimum-area bounding rectangle. */
-static vec3 best_axis(const poly_work *w, vec3 nrm, vec3 c)
+/* The in-plane direction of the minimum-area bounding rectangle, and the
+ * vertices' extents along it and nrm x it (ext: a0 a1 b0 b1; those of the
+ * zero direction when no edge has one, as extents() gives them). */
+static vec3 best_axis(const poly_work *w, vec3 nrm, vec3 c, double ext[4])
 {
     vec3 best = v3(0, 0, 0);
     double best_area = INFINITY;
+    bool found = false;
     for (int i = 0; i < w->n; i++) {
         vec3 e = v3_sub(w->p[(i + 1) % w->n], w->p[i]);
         e = v3_normalize(v3_sub(e, v3_scale(nrm, v3_dot(nrm, e))));
@@ -129,8 +132,12 @@ static vec3 best_axis(const poly_work *w, vec3 nrm, vec3 c)
         if (area < best_area * (1 - 1e-12)) {
             best_area = area;
             best = e;
+            ext[0] = a0, ext[1] = a1, ext[2] = b0, ext[3] = b1;
+            found = true;
         }
     }
+    if (!found)
+        extents(w, c, best, v3_cross(nrm, best), &ext[0], &ext[1], &ext[2], &ext[3]);
     return best;
 }
 
@@ -185,12 +192,19 @@ static bool check_planar(const poly_work *w, vec3 nrm, vec3 c, char *err, size_t
     return true;
 }
 
+/* ia_mul(ia_point(a), ia_point(b)), the same bits */
+static ia_interval point_product(double a, double b)
+{
+    ia_interval r;
+    return geom_point_product(a, b, &r) ? r : ia_mul(ia_point(a), ia_point(b));
+}
+
 /* The plane basis, the vertices' (u,v) and the edge lines. */
 static void plane_basis(geom_surface *s, const poly_work *w, vec3 nrm, vec3 c)
 {
-    vec3 e1 = best_axis(w, nrm, c), e2 = v3_cross(nrm, e1);
-    double a0, a1, b0, b1;
-    extents(w, c, e1, e2, &a0, &a1, &b0, &b1);
+    double ext[4] = {0, 0, 0, 0};
+    vec3 e1 = best_axis(w, nrm, c, ext), e2 = v3_cross(nrm, e1);
+    double a0 = ext[0], a1 = ext[1], b0 = ext[2], b1 = ext[3];
     s->normal = nrm;
     s->origin = v3_add(c, v3_add(v3_scale(e1, a0), v3_scale(e2, b0)));
     s->axis_u = v3_scale(e1, a1 - a0);
@@ -202,14 +216,11 @@ static void plane_basis(geom_surface *s, const poly_work *w, vec3 nrm, vec3 c)
         s->uv[i][1] = (v3_dot(r, e2) - b0) / (b1 - b0);
     }
     edge_lines(s);
-    ia_interval au[3], av[3];
-    for (int k = 0; k < 3; k++) {
-        au[k] = ia_point(v3_comp(s->axis_u, k));
-        av[k] = ia_point(v3_comp(s->axis_v, k));
-    }
+    double au[3] = {s->axis_u.x, s->axis_u.y, s->axis_u.z};
+    double av[3] = {s->axis_v.x, s->axis_v.y, s->axis_v.z};
     for (int k = 0; k < 3; k++) {
         int i = (k + 1) % 3, j = (k + 2) % 3;
-        s->consts[K_NG + k] = ia_sub(ia_mul(au[i], av[j]), ia_mul(au[j], av[i]));
+        s->consts[K_NG + k] = ia_sub(point_product(au[i], av[j]), point_product(au[j], av[i]));
     }
 }
 

@@ -549,8 +549,9 @@ job_scene *job_scene_new_threads(const job *jb, size_t cache_bytes, bool render,
      * store), never from a folder of this machine; their texts are freed
      * once parsed */
     sl_source_set *archives = job_archive_set_new(jb);
-    self->scene = scene_parse_frame(jb->scene_file, jb->scene_text, jb->scene_len, archives,
-                                    SCENE_MAX_OBJECTS, jb->options.frame, cancel, diag);
+    self->scene = scene_parse_frame_threads(jb->scene_file, jb->scene_text, jb->scene_len,
+                                            archives, SCENE_MAX_OBJECTS, jb->options.frame,
+                                            threads, cancel, diag);
     sl_source_set_destroy(&archives);
     return build(self, cache_bytes, render, threads, cancel, diag);
 }

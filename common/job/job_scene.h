@@ -38,9 +38,10 @@ typedef struct job_scene {
  * job_scene. */
 job_scene *job_scene_new(const job *job, size_t cache_bytes, bool render,
                          const atomic_int *cancel, sl_diag *diag);
-/* The same, the renderer's world built with `threads` threads (the root
+/* The same, the scene's polygon meshes parsed (scene_parse_frame_threads)
+ * and the renderer's world built with `threads` threads (the root
  * boxes of displaced meshes' pieces, trace_options.build_threads): a
- * worker passes its rendering threads. */
+ * worker passes its rendering threads. The scene is the same for any. */
 job_scene *job_scene_new_threads(const job *job, size_t cache_bytes, bool render, int threads,
                                  const atomic_int *cancel, sl_diag *diag);
 /* The master's check of a job whose scene it has parsed with

@@ -32,6 +32,15 @@
  * with each surface (rib_primvar.c): a face whose variables differ at its
  * corners is cut into triangles too, over each of which they are linear.
  * A Polygon with variables is read as a one-face mesh (rib_polygon_vars).
+ *
+ * Threads (issue 23): a large PointsPolygons or PointsGeneralPolygons mesh
+ * has its faces prepared over the parser's threads (p->threads, a worker's:
+ * scene_parse_frame_threads), in chunks of contiguous faces that the
+ * threads take as they come free. Each chunk logs what its faces did (a
+ * piece, a face without area, an error's message) and the logs are played
+ * back in face order, stopping where one thread would have stopped (the
+ * diagnostics full): the same pieces, the same messages in the same order,
+ * for any number of threads.
  */
 #include "scene/rib_parser.h"
 #include "scene/rib_primvar.h"
@@ -40,10 +49,14 @@
 #ifdef SCENE_HAVE_GEOM
 #include "geom/triangulate.h"
 #include "util/err.h"
+#include "util/shares.h"
 #include "util/xalloc.h"
 #endif
 
 #include <math.h>
+#include <stdarg.h>
+#include <stdatomic.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -66,6 +79,27 @@ typedef scene_mesh_nclass mesh_nclass;
 #define MESH_N_UNIFORM SCENE_MESH_N_UNIFORM
 #define MESH_N_CONSTANT SCENE_MESH_N_CONSTANT
 
+/* What a face did, logged by a chunk of the faces (threads) to be played
+ * back in face order: 20 bytes (a piece's corners fit 16 bits, as in
+ * scene_mesh_piece). */
+typedef enum { FACE_PIECE, FACE_SKIPPED, FACE_ERROR } face_event_kind;
+
+typedef struct face_event {
+    int face, fv0;
+    uint16_t k[3];                 /* FACE_PIECE: scene_mesh_add_piece's */
+    uint8_t n;
+    uint8_t what;                  /* face_event_kind */
+    uint8_t kind;                  /* FACE_PIECE: its scene_piece_kind */
+    bool has_k;
+} face_event;
+
+typedef struct face_log {
+    face_event *ev;
+    size_t n, cap;
+    char **msgs;                   /* the FACE_ERROR events' messages, in order */
+    size_t nmsgs;
+} face_log;
+
 /* A mesh being cut into surfaces. */
 typedef struct mesh {
     const rib_request *req;
@@ -82,7 +116,65 @@ typedef struct mesh {
                                     * NULL: one object each */
     geom_surface *scratch;         /* with out: the one surface every face and
                                     * piece is prepared in (polygon_surface) */
+    face_log *log;                 /* a share's (threads): what the faces did
+                                    * goes here; NULL: to out, skipped, p */
 } mesh;
+
+static face_event *log_event(const mesh *m, int face, face_event_kind what)
+{
+    face_log *l = m->log;
+    if (l->n == l->cap) {
+        l->cap = l->cap ? 2 * l->cap : 1024;
+        l->ev = xreallocarray(l->ev, l->cap, sizeof *l->ev);
+    }
+    face_event *e = &l->ev[l->n++];
+    memset(e, 0, sizeof *e);
+    e->face = face;
+    e->fv0 = m->fv0;
+    e->what = (uint8_t)what;
+    return e;
+}
+
+/* scene_mesh_add_piece(m->out, ...) for the current face, or its log entry */
+static void add_piece(const mesh *m, scene_piece_kind kind, int face, const int k[3], int n)
+{
+    if (!m->log) {
+        scene_mesh_add_piece(m->out, kind, face, m->fv0, k, n);
+        return;
+    }
+    face_event *e = log_event(m, face, FACE_PIECE);
+    e->kind = (uint8_t)kind;
+    e->n = (uint8_t)n;             /* 3, or a whole face's <= GEOM_MAX_POLY_VERTS */
+    e->has_k = k != NULL;
+    if (k)                         /* corners of a face of <= RIB_MAX_FACE_POINTS */
+        for (int i = 0; i < 3; i++) e->k[i] = (uint16_t)k[i];
+}
+
+/* a face without area */
+static void skip_face(mesh *m, int face)
+{
+    if (m->log)
+        log_event(m, face, FACE_SKIPPED);
+    else
+        m->skipped++;
+}
+
+/* rib_error at the mesh's vertices, or its log entry */
+static void face_error(rib_parser *p, const mesh *m, int face, const char *fmt, ...)
+{
+    char msg[2048];                /* rib_error's own bound */
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    if (m->log) {
+        face_log *l = m->log;
+        log_event(m, face, FACE_ERROR);
+        l->msgs = xreallocarray(l->msgs, l->nmsgs + 1, sizeof *l->msgs);
+        l->msgs[l->nmsgs++] = xstrdup(msg);
+    } else
+        rib_error(p, m->req, m->vertices_pos, "%s", msg);
+}
 
 /* Corner i of face `face` (point idx[i]) in the variables' classes. */
 static rib_corner corner_of(const mesh *m, int face, const int *idx, int i)
@@ -179,8 +271,7 @@ static bool add_triangle(rib_parser *p, const mesh *m, int face, const int *idx,
             return false;
     }
     if (m->out)      /* scene_mesh_piece_surface makes s and vars again */
-        scene_mesh_add_piece(m->out, n ? SCENE_PIECE_TRIANGLE_N : SCENE_PIECE_TRIANGLE, face,
-                             m->fv0, k, 3);
+        add_piece(m, n ? SCENE_PIECE_TRIANGLE_N : SCENE_PIECE_TRIANGLE, face, k, 3);
     else
         add_with_vars(p, m, s, vars);
     return true;
@@ -221,7 +312,7 @@ static bool add_face(rib_parser *p, mesh *m, int face, const int *loop_sizes, in
             if ((m->ncls == MESH_N_NONE || corners_flat(m, s, face, idx, total)) &&
                 rib_primvars_same_at(&m->pv, corners, total)) {
                 if (m->out) {
-                    scene_mesh_add_piece(m->out, SCENE_PIECE_POLYGON, face, m->fv0, NULL, total);
+                    add_piece(m, SCENE_PIECE_POLYGON, face, NULL, total);
                     return true;
                 }
                 scene_primvar vars[RIB_MAX_PRIMVARS];
@@ -240,7 +331,7 @@ static bool add_face(rib_parser *p, mesh *m, int face, const int *loop_sizes, in
                 added += add_triangle(p, m, face, idx, c, m->ncls != MESH_N_NONE ? cn : NULL);
             }
             if (added == 0)
-                m->skipped++;
+                skip_face(m, face);
             return true;
         }
 #else
@@ -251,8 +342,8 @@ static bool add_face(rib_parser *p, mesh *m, int face, const int *loop_sizes, in
     }
 #ifdef SCENE_HAVE_GEOM
     if (total > RIB_MAX_FACE_POINTS) {      /* cutting is quadratic in them */
-        rib_error(p, m->req, m->vertices_pos, "face %d has %d points; faces to be cut into "
-                  "triangles may have at most %d", face, total, RIB_MAX_FACE_POINTS);
+        face_error(p, m, face, "face %d has %d points; faces to be cut into triangles may "
+                   "have at most %d", face, total, RIB_MAX_FACE_POINTS);
         return false;
     }
     vec3 *pts = xrealloc(NULL, (size_t)total * sizeof *pts);
@@ -264,9 +355,9 @@ static bool add_face(rib_parser *p, mesh *m, int face, const int *loop_sizes, in
     int n = geom_triangulate(pts, loop_sizes, nloops, tris, max, err, sizeof err);
     bool ok = true;
     if (n < 0 && strcmp(err, "the polygon has no area") == 0) {
-        m->skipped++;
+        skip_face(m, face);
     } else if (n < 0) {
-        rib_error(p, m->req, m->vertices_pos, "face %d: %s", face, err);
+        face_error(p, m, face, "face %d: %s", face, err);
         ok = false;
     } else {
         int added = 0;
@@ -278,14 +369,14 @@ static bool add_face(rib_parser *p, mesh *m, int face, const int *loop_sizes, in
             added += add_triangle(p, m, face, idx, tris[t], m->ncls != MESH_N_NONE ? cn : NULL);
         }
         if (added == 0)
-            m->skipped++;
+            skip_face(m, face);
     }
     free(pts);
     free(tris);
     return ok;
 #else
     (void)face;
-    m->skipped++;
+    skip_face(m, face);
     return true;
 #endif
 }
@@ -338,6 +429,136 @@ static mesh_nclass normal_class(rib_parser *p, const rib_request *req, const sce
     return MESH_N_NONE;
 }
 
+#ifdef SCENE_HAVE_GEOM
+/* Faces a chunk holds; chunks a wave holds (at least WAVE_CHUNKS, at
+ * least CHUNKS_PER_THREAD a thread: a wave's logs are ~10 MB on 2
+ * threads); the fewest faces worth threads */
+enum { FACES_PER_CHUNK = 8192, WAVE_CHUNKS = 32, CHUNKS_PER_THREAD = 4,
+       FACES_FOR_THREADS = 8192 };
+
+/* The faces in chunks over threads, a wave of chunks at a time (so that
+ * the logs are a wave's: ~0.7 MB a chunk, reused): chunk c is faces
+ * [c * FACES_PER_CHUNK, ...), its loops from loop[c] and its points from
+ * vi[c]; a thread takes the wave's next chunk not taken (next) until none
+ * is left before `end`, into log[c - first]. */
+typedef struct face_chunks {
+    rib_parser *p;
+    const int *nloops, *idx;
+    int nfaces, nchunks;
+    const int **loop, **vi;
+    face_log *log;
+    int first, end;
+    atomic_int next;
+} face_chunks;
+
+/* A thread's share: the chunks and its own copy of the mesh (a scratch
+ * surface of its own; its log set per chunk) */
+typedef struct face_share {
+    face_chunks *all;
+    mesh m;
+} face_share;
+
+static void *faces_of_share(void *arg)
+{
+    face_share *sh = arg;
+    face_chunks *all = sh->all;
+    int c;
+    while ((c = atomic_fetch_add(&all->next, 1)) < all->end) {
+        const int *loop = all->loop[c], *vi = all->vi[c];
+        int f1 = (c + 1) * FACES_PER_CHUNK < all->nfaces ? (c + 1) * FACES_PER_CHUNK : all->nfaces;
+        sh->m.log = &all->log[c - all->first];
+        for (int f = c * FACES_PER_CHUNK; f < f1; f++) {
+            int nl = all->nloops ? all->nloops[f] : 1;
+            int npts = (int)sum(loop, nl);
+            sh->m.fv0 = (int)(vi - all->idx);
+            add_face(all->p, &sh->m, f, loop, nl, vi);
+            loop += nl;
+            vi += npts;
+        }
+    }
+    return NULL;
+}
+
+/* Plays back a chunk's log in face order into m (its pieces, faces
+ * without area and errors) while `go`; false where one thread would have
+ * stopped: the diagnostics full before a face that did something. Empties
+ * the log (its events' array kept for the next wave). */
+static bool play_back(rib_parser *p, mesh *m, face_log *log, bool go)
+{
+    int last = -1;
+    size_t msg = 0;
+    for (size_t i = 0; i < log->n && go; i++) {
+        const face_event *e = &log->ev[i];
+        if (e->face != last) {
+            go = !sl_diag_full(p->diag);
+            last = e->face;
+            if (!go) break;
+        }
+        if (e->what == FACE_PIECE) {
+            int k[3] = {e->k[0], e->k[1], e->k[2]};
+            scene_mesh_add_piece(m->out, (scene_piece_kind)e->kind, e->face, e->fv0,
+                                 e->has_k ? k : NULL, e->n);
+        } else if (e->what == FACE_SKIPPED) {
+            m->skipped++;
+        } else {
+            rib_error(p, m->req, m->vertices_pos, "%s", log->msgs[msg++]);
+        }
+    }
+    for (size_t i = 0; i < log->nmsgs; i++) free(log->msgs[i]);
+    free(log->msgs);
+    log->msgs = NULL;
+    log->nmsgs = 0;
+    log->n = 0;
+    return go;
+}
+
+/* The faces of mesh m over p->threads threads in chunks of
+ * FACES_PER_CHUNK (taken as threads come free: a thread held up by the
+ * machine's load holds up no other for more than a chunk), a wave of
+ * chunks at a time, each wave's logs played back in order. */
+static void faces_in_threads(rib_parser *p, mesh *m, const int *nloops, int nfaces,
+                             const int *nverts, const int *idx)
+{
+    face_chunks all = { p, nloops, idx, nfaces, (nfaces + FACES_PER_CHUNK - 1) / FACES_PER_CHUNK,
+                        NULL, NULL, NULL, 0, 0, 0 };
+    int threads = p->threads < all.nchunks ? p->threads : all.nchunks;
+    int wave = CHUNKS_PER_THREAD * threads > WAVE_CHUNKS ? CHUNKS_PER_THREAD * threads : WAVE_CHUNKS;
+    all.loop = xcalloc((size_t)all.nchunks, sizeof *all.loop);
+    all.vi = xcalloc((size_t)all.nchunks, sizeof *all.vi);
+    all.log = xcalloc((size_t)wave, sizeof *all.log);
+    const int *loop = nverts, *vi = idx;
+    for (int f = 0; f < nfaces; f++) {
+        if (f % FACES_PER_CHUNK == 0) {
+            all.loop[f / FACES_PER_CHUNK] = loop;
+            all.vi[f / FACES_PER_CHUNK] = vi;
+        }
+        int nl = nloops ? nloops[f] : 1;
+        vi += sum(loop, nl);
+        loop += nl;
+    }
+    face_share *sh = xcalloc((size_t)threads, sizeof *sh);
+    for (int i = 0; i < threads; i++) {
+        sh[i].all = &all;
+        sh[i].m = *m;
+        sh[i].m.scratch = xcalloc(1, sizeof *sh[i].m.scratch);
+    }
+    bool go = true;
+    for (all.first = 0; all.first < all.nchunks && go; all.first = all.end) {
+        all.end = all.nchunks - all.first > wave ? all.first + wave : all.nchunks;
+        atomic_store(&all.next, all.first);
+        util_run_shares(sh, sizeof *sh, threads, faces_of_share);
+        for (int c = all.first; c < all.end; c++)
+            go = play_back(p, m, &all.log[c - all.first], go);
+    }
+    for (int i = 0; i < threads; i++) free(sh[i].m.scratch);
+    free(sh);
+    for (int i = 0; i < wave; i++) free(all.log[i].ev);
+    free(all.log);
+    free(all.vi);
+    free(all.loop);
+}
+#endif
+
 /* The shared part of both requests: nloops per face (NULL: one loop per
  * face), nverts per loop, the vertex indices, then the parameters. */
 static void read_mesh(rib_parser *p, const rib_request *req, const int *nloops, int nfaces,
@@ -367,7 +588,7 @@ static void read_mesh(rib_parser *p, const rib_request *req, const int *nloops, 
         goto out;
     }
     mesh m = { req, P->values, P->count / 3, 0, req->args[first_vertices].pos,
-               MESH_N_VERTEX, NULL, 0, { NULL, 0 }, NULL, NULL };
+               MESH_N_VERTEX, NULL, 0, { NULL, 0 }, NULL, NULL, NULL };
     int counts[] = { 0, 1, nfaces, m.npoints, m.npoints, nidx };
     if (!rib_primvars_collect(p, req, &params, counts, NULL, &m.pv))
         goto out;
@@ -408,6 +629,11 @@ static void read_mesh(rib_parser *p, const rib_request *req, const int *nloops, 
     m.scratch = xcalloc(1, sizeof *m.scratch);
 #endif
     const int *loop = nverts, *vi = idx;
+#ifdef SCENE_HAVE_GEOM
+    if (p->threads > 1 && nfaces >= FACES_FOR_THREADS)
+        faces_in_threads(p, &m, nloops, nfaces, nverts, idx);
+    else
+#endif
     for (int f = 0; f < nfaces && !sl_diag_full(p->diag); f++) {
         int nl = nloops ? nloops[f] : 1;
         int npts = (int)sum(loop, nl);
@@ -470,7 +696,7 @@ void rib_general_polygon(rib_parser *p, const rib_request *req)
             for (int i = 0; i < n; i++)
                 idx[i] = i;
             mesh m = { req, P->values, (int)n, 0, req->args[0].pos, MESH_N_NONE, NULL, 0,
-                       { NULL, 0 }, NULL, NULL };
+                       { NULL, 0 }, NULL, NULL, NULL };
             int counts[] = { 0, 1, 1, (int)n, (int)n, (int)n };
             const scene_param *N = rib_params_find(&params, "N");
             if (N) {
@@ -524,7 +750,8 @@ bool rib_polygon_vars(rib_parser *p, const rib_request *req, const rib_params *p
     int *idx = xrealloc(NULL, (size_t)n * sizeof *idx);
     for (int i = 0; i < n; i++)
         idx[i] = i;
-    mesh m = { req, P->values, n, 0, req->pos, MESH_N_NONE, NULL, 0, { NULL, 0 }, NULL, NULL };
+    mesh m = { req, P->values, n, 0, req->pos, MESH_N_NONE, NULL, 0, { NULL, 0 }, NULL, NULL,
+               NULL };
     int counts[] = { 0, 1, 1, n, n, n };
     if (rib_primvars_collect(p, req, params, counts, NULL, &m.pv)) {
         int loop[1] = { n };

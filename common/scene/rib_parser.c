@@ -890,20 +890,31 @@ scene *scene_parse_limited(const char *file, const char *text, size_t len,
 
 static scene *parse_frame(const char *file, const char *text, size_t len,
                           sl_source_set *archives, int max_objects, int frame, bool scanning,
-                          const scene_check *check, const atomic_int *cancel, sl_diag *diag);
+                          const scene_check *check, int threads, const atomic_int *cancel,
+                          sl_diag *diag);
 
 scene *scene_parse_frame(const char *file, const char *text, size_t len,
                          sl_source_set *archives, int max_objects, int frame,
                          const atomic_int *cancel, sl_diag *diag)
 {
-    return parse_frame(file, text, len, archives, max_objects, frame, false, NULL, cancel, diag);
+    return parse_frame(file, text, len, archives, max_objects, frame, false, NULL, 1, cancel,
+                       diag);
+}
+
+scene *scene_parse_frame_threads(const char *file, const char *text, size_t len,
+                                 sl_source_set *archives, int max_objects, int frame,
+                                 int threads, const atomic_int *cancel, sl_diag *diag)
+{
+    return parse_frame(file, text, len, archives, max_objects, frame, false, NULL, threads,
+                       cancel, diag);
 }
 
 scene *scene_check_frame(const char *file, const char *text, size_t len,
                          sl_source_set *archives, int max_objects, int frame,
                          const scene_check *check, const atomic_int *cancel, sl_diag *diag)
 {
-    return parse_frame(file, text, len, archives, max_objects, frame, false, check, cancel, diag);
+    return parse_frame(file, text, len, archives, max_objects, frame, false, check, 1, cancel,
+                       diag);
 }
 
 int scene_scan_frames(const char *file, const char *text, size_t len,
@@ -912,7 +923,7 @@ int scene_scan_frames(const char *file, const char *text, size_t len,
 {
     *numbers = NULL;
     scene *s = parse_frame(file, text, len, archives, SCENE_MAX_OBJECTS, INT_MAX, true, NULL,
-                           cancel, diag);
+                           1, cancel, diag);
     if (!s)
         return -1;
     int n = s->nframes;
@@ -924,7 +935,8 @@ int scene_scan_frames(const char *file, const char *text, size_t len,
 
 static scene *parse_frame(const char *file, const char *text, size_t len,
                           sl_source_set *archives, int max_objects, int frame, bool scanning,
-                          const scene_check *check, const atomic_int *cancel, sl_diag *diag)
+                          const scene_check *check, int threads, const atomic_int *cancel,
+                          sl_diag *diag)
 {
     if (!file || !*file)
         file = "<scene>";
@@ -946,6 +958,7 @@ static scene *parse_frame(const char *file, const char *text, size_t len,
     p.frame_select = frame < 0 ? 0 : frame;
     p.scanning = scanning;
     p.cancel = cancel;
+    p.threads = threads < 1 ? 1 : threads;
     p.check = check;
     p.scene = scene_new(file);
     p.scene->checked = check != NULL;

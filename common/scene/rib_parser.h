@@ -174,6 +174,7 @@ typedef struct rib_parser {
     bool blocks_overflow;          /* RIB_MAX_BLOCKS was passed: the parse stops */
     const scene_check *check;      /* a check's parse (scene_check_frame), or NULL */
     const atomic_int *cancel;      /* the program's stop flag (a signal), or NULL */
+    int threads;                   /* a mesh's faces are read over this many (rib_mesh.c) */
     unsigned requests;             /* read so far (the flag is looked at every
                                       RIB_CANCEL_EVERY) */
     bool cancelled;                /* the flag was found set: the parse stops */

@@ -384,6 +384,14 @@ scene *scene_parse_frame(const char *file, const char *text, size_t len,
                          sl_source_set *archives, int max_objects, int frame,
                          const atomic_int *cancel, sl_diag *diag);
 
+/* As scene_parse_frame, the faces of each large polygon mesh prepared over
+ * `threads` threads (a worker's: common/job). The scene, its messages and
+ * their order are those of one thread (rib_mesh.c puts the faces' pieces
+ * and messages together in face order). */
+scene *scene_parse_frame_threads(const char *file, const char *text, size_t len,
+                                 sl_source_set *archives, int max_objects, int frame,
+                                 int threads, const atomic_int *cancel, sl_diag *diag);
+
 /* What a check's parse (scene_check_frame) asks of its caller: whether
  * an undisplaced instance the renderer would keep as a reference to its
  * prototype (scene_object_placeable) is one it can place (its transforms:

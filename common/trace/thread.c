@@ -4,6 +4,7 @@
 #include "trace/thread.h"
 #include "trace/mesh.h"
 #include "util/err.h"
+#include "util/shares.h"
 #include "util/xalloc.h"
 
 #include <pthread.h>
@@ -180,15 +181,5 @@ void trace_thread_sync_stats(trace_thread *self)
 
 void trace_run_shares(void *shares, size_t size, int n, void *(*fn)(void *))
 {
-    char *base = shares;
-    pthread_t *tid = xcalloc((size_t)(n > 0 ? n : 1), sizeof *tid);
-    bool *started = xcalloc((size_t)(n > 0 ? n : 1), sizeof *started);
-    for (int i = 1; i < n; i++)
-        started[i] = pthread_create(&tid[i], NULL, fn, base + (size_t)i * size) == 0;
-    if (n > 0) fn(base);
-    for (int i = 1; i < n; i++)
-        if (started[i]) pthread_join(tid[i], NULL);
-        else fn(base + (size_t)i * size);     /* no thread: the caller does it */
-    free(started);
-    free(tid);
+    util_run_shares(shares, size, n, fn);
 }

@@ -106,7 +106,7 @@ void trace_thread_sync_stats(trace_thread *self);
  * 0 on the calling thread, the others on threads of their own, joined
  * before it returns; a share whose thread cannot be started runs on the
  * calling thread after share 0. For the world's build over
- * trace_options.build_threads (mesh.c, world.c). */
+ * trace_options.build_threads (mesh.c, world.c); util_run_shares. */
 void trace_run_shares(void *shares, size_t size, int n, void *(*fn)(void *));
 
 #endif

@@ -1,0 +1,187 @@
+/*
+ * tests/geom/test_geom_same_bits.c: the short paths of the polygon code
+ * (issue 23: a mesh's faces are prepared and bounded millions of times)
+ * give the very bits of the general ones they replace, so no image moves.
+ *
+ *   minmax      geom_min / geom_max against libm's fmin / fmax: signed
+ *               zeros in both orders, infinities, (quiet) NaN on either side,
+ *               random numbers of random signs and magnitudes, and equal
+ *               pairs
+ *   bounds      a polygon's geom_bounds is the hull of geom_eval_ia's P (its
+ *               formula, spelled out) at its vertices' (u,v), padded as
+ *               before, for random convex polygons (triangles to 12
+ *               corners, random planes, sizes from 1e-140 to 1e140)
+ *   ng          the polygon's Ng constants are ia_mul's products of the
+ *               axes as point intervals, for the same polygons
+ */
+#include <stdarg.h>
+#include <stddef.h>
+#include <setjmp.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "geom_fixtures.h"
+#include "geom/surface_internal.h"
+
+static uint64_t bits_of(double x)
+{
+    uint64_t b;
+    memcpy(&b, &x, sizeof b);
+    return b;
+}
+
+static double of_bits(uint64_t b)
+{
+    double x;
+    memcpy(&x, &b, sizeof x);
+    return x;
+}
+
+/* the same bits, or both NaN (fmin of two NaNs is some NaN) */
+static void expect_same(double got, double want, const char *what, double x, double y)
+{
+    if (isnan(got) && isnan(want))
+        return;
+    if (bits_of(got) != bits_of(want))
+        fail_msg("%s(%a, %a): %a (bits %016llx), libm gives %a (bits %016llx)", what, x, y, got,
+                 (unsigned long long)bits_of(got), want, (unsigned long long)bits_of(want));
+}
+
+static void check_pair(double x, double y)
+{
+    expect_same(geom_min(x, y), fmin(x, y), "geom_min", x, y);
+    expect_same(geom_max(x, y), fmax(x, y), "geom_max", x, y);
+}
+
+/* random bits; a NaN made quiet (arithmetic never makes a signalling one,
+ * which libm's fmin turns into a NaN result) */
+static uint64_t rnd_bits(void)
+{
+    uint64_t b = (uint64_t)(fx_unit() * 4294967296.0) << 32 | (uint64_t)(fx_unit() * 4294967296.0);
+    if (isnan(of_bits(b)))
+        b |= (uint64_t)1 << 51;
+    return b;
+}
+
+static void test_minmax(void **state)
+{
+    (void)state;
+    const double special[] = {0.0, -0.0, 1.0, -1.0, INFINITY, -INFINITY, NAN, -NAN,
+                              0x1p-1074, -0x1p-1074, 0x1.fffffffffffffp+1023, 1e-300, -2.5};
+    int ns = (int)(sizeof special / sizeof special[0]);
+    for (int i = 0; i < ns; i++)
+        for (int j = 0; j < ns; j++)
+            check_pair(special[i], special[j]);
+    fx_seed(23);
+    for (int k = 0; k < 200000; k++) {
+        double x = of_bits(rnd_bits()), y = of_bits(rnd_bits());
+        check_pair(x, y);
+        double a = fx_range(-4, 4), b = k % 3 == 0 ? a : k % 3 == 1 ? -a : fx_range(-4, 4);
+        check_pair(a, b);
+        check_pair(b, a);
+    }
+}
+
+/* a random convex polygon of n corners: points on an ellipse in a random
+ * plane, at a random place and scale (one in three from 1e-140 to 1e140:
+ * products near underflow and overflow) */
+static geom_surface random_polygon(int k)
+{
+    int n = 3 + k % 10;
+    geom_surface s;
+    memset(&s, 0, sizeof s);
+    s.kind = GEOM_POLYGON;
+    s.nverts = n;
+    vec3 e1 = fx_unit_vector(), t = fx_unit_vector();
+    vec3 e2 = v3_normalize(v3_cross(e1, t));
+    double scale = pow(10, k % 3 == 0 ? fx_range(-140, 140) : fx_range(-3, 3));
+    double ra = scale * fx_range(0.2, 1), rb = scale * fx_range(0.2, 1);
+    double far = k % 3 == 0 ? scale : 1;
+    vec3 c = v3_scale(v3(fx_range(-100, 100), fx_range(-100, 100), fx_range(-100, 100)), far);
+    double phase = fx_range(0, 6.283185307179586);
+    for (int i = 0; i < n; i++) {
+        double a = phase + 6.283185307179586 * (i + fx_range(-0.3, 0.3)) / n;
+        s.verts[i] = v3_add(c, v3_add(v3_scale(e1, ra * cos(a)), v3_scale(e2, rb * sin(a))));
+    }
+    return s;
+}
+
+static void test_bounds(void **state)
+{
+    (void)state;
+    fx_seed(2323);
+    int tried = 0;
+    for (int k = 0; k < 20000; k++) {
+        geom_surface s = random_polygon(k);
+        if (!geom_surface_prepare(&s, NULL, 0))
+            continue;
+        tried++;
+        vec3 lo, hi;
+        geom_bounds(&s, &lo, &hi);
+        /* the old path: geom_eval_ia's polygon P (spelled out here, so
+         * that a change there shows) at each vertex, fmin/fmax */
+        vec3 wlo = v3(INFINITY, INFINITY, INFINITY), whi = v3(-INFINITY, -INFINITY, -INFINITY);
+        for (int i = 0; i < s.nuv; i++) {
+            geom_ia box;
+            geom_eval_ia(&s, ia_point(s.uv[i][0]), ia_point(s.uv[i][1]), &box);
+            ia_interval u = ia_point(s.uv[i][0]), v = ia_point(s.uv[i][1]);
+            for (int c = 0; c < 3; c++) {
+                double au = v3_comp(s.axis_u, c), av = v3_comp(s.axis_v, c);
+                ia_interval P = ia_add_s(ia_add(ia_mul_s(u, au), ia_mul_s(v, av)),
+                                         v3_comp(s.origin, c));
+                if (bits_of(P.lo) != bits_of(box.P[c].lo) || bits_of(P.hi) != bits_of(box.P[c].hi))
+                    fail_msg("polygon %d: geom_eval_ia's P[%d] at vertex %d is not the formula's",
+                             k, c, i);
+            }
+            wlo = v3(fmin(wlo.x, box.P[0].lo), fmin(wlo.y, box.P[1].lo), fmin(wlo.z, box.P[2].lo));
+            whi = v3(fmax(whi.x, box.P[0].hi), fmax(whi.y, box.P[1].hi), fmax(whi.z, box.P[2].hi));
+        }
+        double pad = 1e-9 * (v3_length(s.axis_u) + v3_length(s.axis_v));
+        wlo = v3_sub(wlo, v3(pad, pad, pad));
+        whi = v3_add(whi, v3(pad, pad, pad));
+        double got[6] = {lo.x, lo.y, lo.z, hi.x, hi.y, hi.z};
+        double want[6] = {wlo.x, wlo.y, wlo.z, whi.x, whi.y, whi.z};
+        for (int i = 0; i < 6; i++)
+            if (bits_of(got[i]) != bits_of(want[i]))
+                fail_msg("polygon %d (%d corners): bound %d is %a, the full evaluation gives %a",
+                         k, s.nverts, i, got[i], want[i]);
+    }
+    assert_true(tried > 15000);
+}
+
+static void test_ng(void **state)
+{
+    (void)state;
+    fx_seed(4242);
+    for (int k = 0; k < 20000; k++) {
+        geom_surface s = random_polygon(k);
+        if (!geom_surface_prepare(&s, NULL, 0))
+            continue;
+        double au[3] = {s.axis_u.x, s.axis_u.y, s.axis_u.z};
+        double av[3] = {s.axis_v.x, s.axis_v.y, s.axis_v.z};
+        for (int c = 0; c < 3; c++) {
+            int i = (c + 1) % 3, j = (c + 2) % 3;
+            ia_interval want = ia_sub(ia_mul(ia_point(au[i]), ia_point(av[j])),
+                                      ia_mul(ia_point(au[j]), ia_point(av[i])));
+            ia_interval got = s.consts[K_NG + c];
+            if (bits_of(got.lo) != bits_of(want.lo) || bits_of(got.hi) != bits_of(want.hi) ||
+                got.flags != want.flags)
+                fail_msg("polygon %d: Ng[%d] [%a, %a] flags %u, ia_mul gives [%a, %a] flags %u",
+                         k, c, got.lo, got.hi, got.flags, want.lo, want.hi, want.flags);
+        }
+    }
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_minmax),
+        cmocka_unit_test(test_bounds),
+        cmocka_unit_test(test_ng),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
