@@ -3,6 +3,8 @@
  */
 #include "fixture.h"
 
+#include <malloc.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -76,4 +78,37 @@ bool fixture_render(fixture *f, int tile, int nthreads, size_t cache_bytes,
     for (int i = 0; i < nthreads; i++) trace_thread_destroy(&th[i]);
     free(th);
     return ok;
+}
+
+char *fixture_torus_rib(int nu, int nv, const char *head, const char *request)
+{
+    size_t cap = (size_t)nu * nv * 90 + 4096, n = 0;
+    char *t = malloc(cap);
+    if (!t) abort();
+    n += (size_t)snprintf(t + n, cap - n, "Format 32 32 1\nProjection \"perspective\" "
+                          "\"fov\" [40]\nTranslate 0 0 4\nRotate 60 1 0 0\nWorldBegin\n%s"
+                          "%s [", head, request);
+    for (int i = 0; i < nu * nv; i++) n += (size_t)snprintf(t + n, cap - n, "4 ");
+    n += (size_t)snprintf(t + n, cap - n, "]\n[");
+    for (int i = 0; i < nu; i++)
+        for (int j = 0; j < nv; j++) {
+            int i1 = (i + 1) % nu, j1 = (j + 1) % nv;
+            n += (size_t)snprintf(t + n, cap - n, "%d %d %d %d ", i * nv + j, i * nv + j1,
+                                  i1 * nv + j1, i1 * nv + j);
+        }
+    n += (size_t)snprintf(t + n, cap - n, "]\n\"P\" [");
+    for (int i = 0; i < nu; i++)
+        for (int j = 0; j < nv; j++) {
+            double a = 2 * M_PI * i / nu, b = 2 * M_PI * j / nv, r = 1 + 0.4 * cos(b);
+            n += (size_t)snprintf(t + n, cap - n, "%.9g %.9g %.9g ", r * cos(a), r * sin(a),
+                                  0.4 * sin(b));
+        }
+    snprintf(t + n, cap - n, "]\nWorldEnd\n");
+    return t;
+}
+
+size_t fixture_heap_bytes(void)
+{
+    struct mallinfo2 mi = mallinfo2();
+    return mi.uordblks + mi.hblkhd;
 }

@@ -33,4 +33,15 @@ void fixture_close(fixture *f);
 bool fixture_render(fixture *f, int tile, int nthreads, size_t cache_bytes,
                     float *rgba, float *z);
 
+/* The RIB text (malloc'd) of a closed torus (radii 1 and 0.4) of nu x nv
+ * quads sharing their points, 32 x 32 pixels: `head` (RIB text after
+ * WorldBegin, may be "") and then the mesh as `request` ("PointsPolygons"
+ * or "SubdivisionMesh \"catmull-clark\""). */
+char *fixture_torus_rib(int nu, int nv, const char *head, const char *request);
+
+/* Bytes the allocator holds (glibc's mallinfo2; 0 under ASan, whose
+ * allocator it does not see: byte budgets are checked only where it
+ * reads more) */
+size_t fixture_heap_bytes(void);
+
 #endif

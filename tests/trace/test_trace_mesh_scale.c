@@ -56,44 +56,11 @@ enum { FACE_BYTES_BEYOND = 64 + 32, FACE_BVH_BYTES = 32, FACE_BYTES = 150 };
  * (~150) */
 enum { INSTANCE_BYTES = 560 };
 
-static char *torus_rib(int nu, int nv, const char *head)
-{
-    size_t cap = (size_t)nu * nv * 90 + 4096, n = 0;
-    char *t = malloc(cap);
-    assert_non_null(t);
-    n += (size_t)snprintf(t + n, cap - n, "Format 32 32 1\nProjection \"perspective\" "
-                          "\"fov\" [40]\nTranslate 0 0 4\nRotate 60 1 0 0\nWorldBegin\n%s"
-                          "PointsPolygons [", head);
-    for (int i = 0; i < nu * nv; i++) n += (size_t)snprintf(t + n, cap - n, "4 ");
-    n += (size_t)snprintf(t + n, cap - n, "]\n[");
-    for (int i = 0; i < nu; i++)
-        for (int j = 0; j < nv; j++) {
-            int i1 = (i + 1) % nu, j1 = (j + 1) % nv;
-            n += (size_t)snprintf(t + n, cap - n, "%d %d %d %d ", i * nv + j, i * nv + j1,
-                                  i1 * nv + j1, i1 * nv + j);
-        }
-    n += (size_t)snprintf(t + n, cap - n, "]\n\"P\" [");
-    for (int i = 0; i < nu; i++)
-        for (int j = 0; j < nv; j++) {
-            double a = 2 * M_PI * i / nu, b = 2 * M_PI * j / nv, r = 1 + 0.4 * cos(b);
-            n += (size_t)snprintf(t + n, cap - n, "%.9g %.9g %.9g ", r * cos(a), r * sin(a),
-                                  0.4 * sin(b));
-        }
-    snprintf(t + n, cap - n, "]\nWorldEnd\n");
-    return t;
-}
-
-static size_t heap_bytes(void)
-{
-    struct mallinfo2 mi = mallinfo2();
-    return mi.uordblks + mi.hblkhd;
-}
-
 static void test_bytes_per_face(void **state)
 {
     (void)state;
     enum { NU = 200, NV = 100 };
-    char *rib = torus_rib(NU, NV, "");
+    char *rib = fixture_torus_rib(NU, NV, "", "PointsPolygons");
     job_options opt;
     job_options_default(&opt);
     job *jb = job_new("torus.rib", rib, strlen(rib), &opt);
@@ -101,9 +68,9 @@ static void test_bytes_per_face(void **state)
     char err[256];
     assert_true(job_finish(jb, err, sizeof err));
     sl_diag *d = sl_diag_new();
-    size_t before = heap_bytes();
+    size_t before = fixture_heap_bytes();
     job_scene *js = job_scene_new(jb, 0, true, NULL, d);
-    size_t after = heap_bytes();
+    size_t after = fixture_heap_bytes();
     if (!js) sl_diag_print(d, stderr);
     assert_non_null(js);
     assert_int_equal(js->scene->nobjects, 1);
@@ -263,7 +230,7 @@ static void test_displaced_mesh_renders_as_its_faces(void **state)
 static void test_hits_outlive_the_view_cache(void **state)
 {
     (void)state;
-    char *rib = torus_rib(40, 30, "");
+    char *rib = fixture_torus_rib(40, 30, "", "PointsPolygons");
     fixture f;
     assert_true(fixture_open(&f, rib, NULL, 0, NULL, 0));
     free(rib);
@@ -351,7 +318,7 @@ static void render_places(const char *mesh, unsigned which, bool copies, float *
 static void test_instances_render_as_copies(void **state)
 {
     (void)state;
-    char *torus = torus_rib(30, 20, "");
+    char *torus = fixture_torus_rib(30, 20, "", "PointsPolygons");
     char *pp = strstr(torus, "PointsPolygons"), *we = strstr(torus, "WorldEnd");
     *we = '\0';
     float *inst = malloc(sizeof *inst * IPX), *copies = malloc(sizeof *copies * IPX);
@@ -392,7 +359,8 @@ static void test_boxes_by_threads(void **state)
      * (world.c), and for the displaced roots' */
     enum { NU = 100, NV = 60 };
     for (int displaced = 0; displaced < 2; displaced++) {
-        char *rib = torus_rib(NU, NV, displaced ? "Displacement \"lift\"\n" : "");
+        char *rib = fixture_torus_rib(NU, NV, displaced ? "Displacement \"lift\"\n" : "",
+                                      "PointsPolygons");
         job_options opt;
         job_options_default(&opt);
         job *jb = job_new("torus.rib", rib, strlen(rib), &opt);
@@ -498,8 +466,8 @@ static void test_instances_share_the_mesh(void **state)
     /* the mesh recorded once, placed COPIES times */
     size_t cap = (size_t)NU * NV * 90 + 4096 + COPIES * 64;
     char *t = malloc(cap);
-    char *torus = torus_rib(NU, NV, "");
-    /* torus_rib's text from "PointsPolygons" to "WorldEnd" */
+    char *torus = fixture_torus_rib(NU, NV, "", "PointsPolygons");
+    /* fixture_torus_rib's text from "PointsPolygons" to "WorldEnd" */
     char *pp = strstr(torus, "PointsPolygons"), *we = strstr(torus, "WorldEnd");
     *we = '\0';
     size_t n = (size_t)snprintf(t, cap, "Format 32 32 1\nProjection \"perspective\" \"fov\" "
@@ -511,9 +479,9 @@ static void test_instances_share_the_mesh(void **state)
     snprintf(t + n, cap - n, "WorldEnd\n");
     free(torus);
     sl_diag *d = sl_diag_new();
-    size_t before = heap_bytes();
+    size_t before = fixture_heap_bytes();
     scene *s = scene_parse("inst.rib", t, strlen(t), d);
-    size_t after = heap_bytes();
+    size_t after = fixture_heap_bytes();
     if (!s) sl_diag_print(d, stderr);
     assert_non_null(s);
     assert_int_equal(s->nobjects, COPIES);
@@ -665,10 +633,10 @@ static void test_instances_are_references(void **state)
 static size_t instances_bytes(int n)
 {
     char *rib = instances_rib(n, 16, false, false);
-    size_t before = heap_bytes();
+    size_t before = fixture_heap_bytes();
     fixture f;
     assert_true(fixture_open(&f, rib, STC, 1, NULL, 0));
-    size_t after = heap_bytes();
+    size_t after = fixture_heap_bytes();
     fixture_close(&f);
     free(rib);
     return after - before;

@@ -34,44 +34,11 @@
  * before any box; <= 32 of BVH a piece (the BVH is over the limit pieces) */
 enum { FACE_BYTES_BEYOND = 64, PIECE_BVH_BYTES = 32 };
 
-static char *cage_rib(int nu, int nv)
-{
-    size_t cap = (size_t)nu * nv * 90 + 4096, n = 0;
-    char *t = malloc(cap);
-    assert_non_null(t);
-    n += (size_t)snprintf(t + n, cap - n, "Format 32 32 1\nProjection \"perspective\" "
-                          "\"fov\" [40]\nTranslate 0 0 4\nRotate 60 1 0 0\nWorldBegin\n"
-                          "SubdivisionMesh \"catmull-clark\" [");
-    for (int i = 0; i < nu * nv; i++) n += (size_t)snprintf(t + n, cap - n, "4 ");
-    n += (size_t)snprintf(t + n, cap - n, "]\n[");
-    for (int i = 0; i < nu; i++)
-        for (int j = 0; j < nv; j++) {
-            int i1 = (i + 1) % nu, j1 = (j + 1) % nv;
-            n += (size_t)snprintf(t + n, cap - n, "%d %d %d %d ", i * nv + j, i * nv + j1,
-                                  i1 * nv + j1, i1 * nv + j);
-        }
-    n += (size_t)snprintf(t + n, cap - n, "]\n\"P\" [");
-    for (int i = 0; i < nu; i++)
-        for (int j = 0; j < nv; j++) {
-            double a = 2 * M_PI * i / nu, b = 2 * M_PI * j / nv, r = 1 + 0.4 * cos(b);
-            n += (size_t)snprintf(t + n, cap - n, "%.9g %.9g %.9g ", r * cos(a), r * sin(a),
-                                  0.4 * sin(b));
-        }
-    snprintf(t + n, cap - n, "]\nWorldEnd\n");
-    return t;
-}
-
-static size_t heap_bytes(void)
-{
-    struct mallinfo2 mi = mallinfo2();
-    return mi.uordblks + mi.hblkhd;
-}
-
 static void test_cage_bytes_per_face(void **state)
 {
     (void)state;
     enum { NU = 200, NV = 100, NF = NU * NV };
-    char *rib = cage_rib(NU, NV);
+    char *rib = fixture_torus_rib(NU, NV, "", "SubdivisionMesh \"catmull-clark\"");
     job_options opt;
     job_options_default(&opt);
     job *jb = job_new("cage.rib", rib, strlen(rib), &opt);
@@ -79,9 +46,9 @@ static void test_cage_bytes_per_face(void **state)
     char err[256];
     assert_true(job_finish(jb, err, sizeof err));
     sl_diag *d = sl_diag_new();
-    size_t before = heap_bytes();
+    size_t before = fixture_heap_bytes();
     job_scene *js = job_scene_new(jb, 0, true, NULL, d);
-    size_t after = heap_bytes();
+    size_t after = fixture_heap_bytes();
     if (!js) sl_diag_print(d, stderr);
     assert_non_null(js);
     assert_int_equal(js->world.nobjects, 1);
