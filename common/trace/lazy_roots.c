@@ -87,7 +87,7 @@ const trace_box *trace_lazy_root(const trace_lazy_roots *self, int k, double dud
     return &e->root;
 }
 
-void trace_lazy_root_put(trace_lazy_roots *self, int k, const trace_box *root, double du,
+bool trace_lazy_root_put(trace_lazy_roots *self, int k, const trace_box *root, double du,
                          double dv)
 {
     assert(k >= 0 && k < self->npieces);
@@ -95,10 +95,11 @@ void trace_lazy_root_put(trace_lazy_roots *self, int k, const trace_box *root, d
     unsigned char expected = EMPTY;
     if (!atomic_compare_exchange_strong_explicit(&c->state[k % CHUNK], &expected, WRITING,
                                                  memory_order_acquire, memory_order_relaxed))
-        return;                        /* made by another thread: the same bits */
+        return false;                  /* made by another thread: the same bits */
     c->e[k % CHUNK] = (root_entry){*root, du, dv};
     atomic_store_explicit(&c->state[k % CHUNK], KNOWN, memory_order_release);
     atomic_fetch_add_explicit(&self->known, 1, memory_order_relaxed);
+    return true;
 }
 
 long trace_lazy_roots_known(const trace_lazy_roots *self)

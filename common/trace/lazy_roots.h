@@ -15,6 +15,7 @@
 #ifndef TRACE_LAZY_ROOTS_H
 #define TRACE_LAZY_ROOTS_H
 
+#include <stdbool.h>
 #include <stddef.h>
 
 #include "trace/box.h"
@@ -27,7 +28,8 @@ void trace_lazy_roots_destroy(trace_lazy_roots **self);
 /* Piece k's root box (and its du, dv into dudv) when published; NULL when
  * not yet. The box stays valid until the store is destroyed. */
 const trace_box *trace_lazy_root(const trace_lazy_roots *self, int k, double dudv[2]);
-void trace_lazy_root_put(trace_lazy_roots *self, int k, const trace_box *root, double du,
+/* True when this call published it (false: another thread had). */
+bool trace_lazy_root_put(trace_lazy_roots *self, int k, const trace_box *root, double du,
                          double dv);
 
 /* Root boxes published so far (tests, bench) */

@@ -124,7 +124,9 @@ static bool make(trace_thread *th, const trace_object *mesh_obj, int k, bool box
             trace_surface_box(th, v, 0, 1, 0, 1, &v->root);
             /* a pure function of the piece: the first thread's is every
              * thread's (a failed or cancelled run is not one) */
-            if (m->lazy && !th->failed) trace_lazy_root_put(m->lazy, k, &v->root, v->du, v->dv);
+            if (m->lazy && !th->failed &&
+                trace_lazy_root_put(m->lazy, k, &v->root, v->du, v->dv))
+                th->stats.lazy_roots++;
         } else {
             geom_bounds(&v->surf, &v->root.lo, &v->root.hi);
             v->root.flags = 0;

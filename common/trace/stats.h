@@ -31,6 +31,9 @@ typedef struct trace_stats {
                                       range is defined (pruned, counted) */
     long views_made;               /* mesh pieces made into objects (mesh.c) */
     long views_asked;              /* views asked of the thread's cache (mesh.c) */
+    long lazy_roots;               /* displaced pieces' root boxes this thread
+                                      made first and published (mesh.c,
+                                      lazy_roots.h) */
     long max_nodes_per_ray;        /* the largest walk (a peak, not a sum) */
     long cache_hits, cache_misses, cache_evictions;
     size_t cache_peak_bytes;

@@ -271,6 +271,7 @@ typedef struct band {
     int y0, y1;
     float *rgba;
     bool ok;
+    long published;                    /* the thread's stats.lazy_roots */
 } band;
 
 static void *render_band(void *arg)
@@ -281,24 +282,29 @@ static void *render_band(void *arg)
     b->ok = trace_render_tile(b->f->js->renderer, th, 0, b->y0, W, b->y1 - b->y0,
                               b->rgba + (size_t)b->y0 * W * 4, z);
     free(z);
+    b->published = th->stats.lazy_roots;
     trace_thread_destroy(&th);
     return NULL;
 }
 
-/* The image by `threads` threads at once, each a band of rows */
-static void render_parallel(fixture *f, int threads, float *rgba)
+/* The image by `threads` threads at once, each a band of rows; the root
+ * boxes they published, by their stats */
+static long render_parallel(fixture *f, int threads, float *rgba)
 {
     pthread_t tid[8];
     band b[8];
     assert_true(threads <= 8);
     for (int i = 0; i < threads; i++) {
-        b[i] = (band){f, H * i / threads, H * (i + 1) / threads, rgba, false};
+        b[i] = (band){f, H * i / threads, H * (i + 1) / threads, rgba, false, 0};
         assert_int_equal(pthread_create(&tid[i], NULL, render_band, &b[i]), 0);
     }
+    long published = 0;
     for (int i = 0; i < threads; i++) {
         pthread_join(tid[i], NULL);
         assert_true(b[i].ok);
+        published += b[i].published;
     }
+    return published;
 }
 
 static int differ(const float *a, const float *b)
@@ -317,7 +323,7 @@ static void test_lazy_renders_as_eager(void **state)
     open_grid(&f, 40, "Displacement \"bumps\"", false, true);
     const trace_mesh *m = mesh_of(&f);
     int n = m->npieces;
-    render_parallel(&f, 1, lazy1);
+    long published1 = render_parallel(&f, 1, lazy1);
     long known1 = trace_lazy_roots_known(m->lazy);
     /* the roots one thread made, kept to compare */
     trace_box *roots = calloc((size_t)n, sizeof *roots);
@@ -330,7 +336,7 @@ static void test_lazy_renders_as_eager(void **state)
     rebuild(&f, true);
     m = mesh_of(&f);
     assert_int_equal(trace_lazy_roots_known(m->lazy), 0);
-    render_parallel(&f, 4, lazy4);
+    long published4 = render_parallel(&f, 4, lazy4);
     long known4 = trace_lazy_roots_known(m->lazy);
     rebuild(&f, false);
     m = mesh_of(&f);
@@ -354,6 +360,9 @@ static void test_lazy_renders_as_eager(void **state)
     /* a corner of the mesh: a fraction of its roots */
     assert_true(known1 > 0 && known1 < n / 2);
     assert_int_equal(same_roots, known1);
+    /* each root published once, by one thread (--stats' lazy_roots) */
+    assert_int_equal(published1, known1);
+    assert_int_equal(published4, known4);
     assert_int_equal(differ(lazy1, eager), 0);
     assert_int_equal(differ(lazy1, lazy4), 0);
     free(roots);
