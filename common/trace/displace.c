@@ -274,8 +274,8 @@ static void box_affine(trace_thread *th, const trace_object *obj,
 /* The cases' box is taken where it is at most this fraction of the box's
  * extent; else the box stays (a narrower box that still does not shrink
  * makes its children stagnant against it: more splits and samples for
- * nothing; the filtered pulse trains of dv_lines and fw_stripes, whose
- * floors the cases do not decide together) */
+ * nothing; the filtered pulse trains of dv_lines and fw_stripes before
+ * the cases of one value agreed, split_plan.c) */
 #define TRACE_SPLIT_GAIN 0.75
 
 bool trace_surface_box_cases(trace_thread *th, const trace_object *obj,
@@ -293,8 +293,7 @@ bool trace_surface_box_cases(trace_thread *th, const trace_object *obj,
     box_from_affine(P, &hull);
     if (sl_vm_split_full(vm)) {
         /* more seams than cases: the rest would stay as wide as one run
-         * makes them (the filtered pulse trains' four floors, which the
-         * cases do not decide together): not worth the runs */
+         * makes them: not worth the runs */
         sl_vm_split_end(vm);
         th->stats.boxes++;
         return false;
