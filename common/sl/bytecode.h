@@ -263,6 +263,10 @@ struct sl_program {
     uint8_t *box_plan;              /* per instruction, what a box run may
                                        leave out (SL_BOX_*, box_plan.c); NULL:
                                        nothing */
+    int32_t *split_same;            /* per instruction, the earlier case
+                                       split of the same value it must agree
+                                       with, or -1 (split_plan.c); NULL:
+                                       none */
     uint64_t global_slots;          /* bit s: a run may read or write global
                                        slot s (sl_program_global_slots); 0:
                                        not known, every slot */
@@ -302,6 +306,16 @@ enum {
  * analysis does not apply (loops, lights, trace, message passing, a
  * program too large to analyse): then every instruction runs. */
 uint8_t *sl_program_box_plan(const sl_program *p);
+
+/* Case splits that must agree (split_plan.c, issue 24): per instruction,
+ * -1 or the pc of an earlier floor, ceil, round, mod or step of the same
+ * opcode on the same operand slots, not written since, that every run
+ * reaching this one executed just before on the same values (no jump
+ * target and only plain operations between): a split run gives it that
+ * operation's case (sl_vm_split_begin). ncode entries freed with the
+ * program, or NULL where no operation has such a twin, or the program has
+ * lights, illuminance, trace or message passing. */
+int32_t *sl_program_split_same(const sl_program *p);
 
 /* Asserts the invariants of a generated program (every slot, string slot,
  * jump and table operand inside the program's bounds, END last), once when

@@ -38,6 +38,7 @@ sl_program *sl_compile(sl_source_set *set, const char *main_file,
         program->takes_derivatives = sl_program_derivatives_reach_P(program);
         program->global_slots = sl_program_global_slots(program);
         program->box_plan = sl_program_box_plan(program);
+        program->split_same = sl_program_split_same(program);
     }
     return program;
 }

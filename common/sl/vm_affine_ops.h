@@ -57,13 +57,24 @@ static inline bool exact(int op, A *z, const A *x, const A *y)
  * split, and which of its two values this run takes */
 static inline bool split_take(sl_vm *vm, int *pick)
 {
-    if (!vm->split.on) return false;
+    if (!vm->split.on || vm->split.full) return false;
+    const int32_t *same = vm->prog->split_same;
+    if (same && same[vm->split.pc] >= 0) {
+        /* the same value as an earlier split (split_plan.c): its case; it
+         * ran just before on this operand, and the run is not full */
+        for (int i = vm->split.n - 1; i >= 0; i--)
+            if (vm->split.at[i] == same[vm->split.pc]) {
+                *pick = vm->split.pick[i];
+                return true;
+            }
+    }
     if (vm->split.n >= vm->split.max) {
         vm->split.full = true;            /* this one takes both values */
         return false;
     }
     int i = vm->split.n++;
     if (i >= vm->split.fixed) vm->split.pick[i] = 0;
+    vm->split.at[i] = vm->split.pc;
     *pick = vm->split.pick[i];
     return true;
 }

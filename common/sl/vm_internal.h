@@ -167,12 +167,15 @@ struct sl_vm {
     /* case splits of affine runs (sl_vm_split_begin): the first max
      * two-valued discontinuous operations of a run take pick[i] (0: the
      * lower value); n of them so far this run; picks from `fixed` on are
-     * 0 (the choices before replay the previous run's) */
+     * 0 (the choices before replay the previous run's); at[i]: the pc of
+     * split i, whose case a later operation of the same value takes
+     * (prog->split_same, split_plan.c); pc: the operation running now */
     struct {
         bool on;
         bool full;                /* this run met more than max of them */
-        int max, n, fixed;
+        int max, n, fixed, pc;
         unsigned char pick[SL_VM_MAX_SPLITS];
+        int at[SL_VM_MAX_SPLITS];
     } split;
 
     /* the current run */

@@ -40,11 +40,14 @@
  * stagnant child of one (intersect.c, children_of): its stagnant children
  * do not try them again (issue 24) */
 #define TRACE_BOX_UNSPLIT (1u << 9)
+/* A box narrowed by the cases of its seams (trace_surface_box_cases,
+ * trace_surface_box_split): its children run their cases first */
+#define TRACE_BOX_SPLIT (1u << 10)
 
 typedef struct trace_box {
     vec3 lo, hi;
     unsigned flags;          /* AA_DISCONTINUOUS | AA_UNBOUNDED | TRACE_BOX_SAMPLED |
-                                TRACE_BOX_UNSPLIT */
+                                TRACE_BOX_UNSPLIT | TRACE_BOX_SPLIT */
     float bend;              /* how far from linear in (u,v) the surface is over
                                 the box: the affine forms' other terms over
                                 their u and v terms (displace.c); 0: unknown */

@@ -180,47 +180,67 @@ bool trace_surface_flat(const trace_object *obj)
            obj->surf.kind == GEOM_DISK;
 }
 
-/* One affine run of the displacement over the (u,v) box (of the case
- * the VM's splits select): the shader's P in object space, in th->ctx
- * (valid until its next reset). */
-static void affine_run(trace_thread *th, const trace_object *obj,
-                       double u0, double u1, double v0, double v1, aa_form P[3])
+/* The base surface over a (u,v) box in affine arithmetic, as the
+ * displacement's affine runs bind it (camera space), and the context
+ * after it: every case of the box's splits runs on the same (a run
+ * restores the context, so its forms are those of a run from scratch) */
+typedef struct affine_cell {
+    aa_context ctx;
+    aa_form u, v, P[3], N[3], dPdu[3], dPdv[3];
+    ia_interval Pd[2][3];
+} affine_cell;
+
+static void affine_geometry(trace_thread *th, const trace_object *obj,
+                            double u0, double u1, double v0, double v1, affine_cell *c)
 {
     aa_context *ctx = &th->ctx;
     aa_context_reset(ctx);
-    aa_form u, v;
-    aa_input(ctx, &u, u0, u1);
-    aa_input(ctx, &v, v0, v1);
+    aa_input(ctx, &c->u, u0, u1);
+    aa_input(ctx, &c->v, v0, v1);
     geom_aa g;
-    geom_eval_aa(ctx, &obj->surf, &u, &v, &g);
-    th->stats.evals_affine++;
-
+    geom_eval_aa(ctx, &obj->surf, &c->u, &c->v, &g);
     if (!obj->displacement) {
-        for (int i = 0; i < 3; i++) P[i] = g.P[i];
+        for (int i = 0; i < 3; i++) c->P[i] = g.P[i];
+        c->ctx = *ctx;
         return;
     }
-    aa_form N[3], dPdu[3], dPdv[3], Nn[3];
-    trace_xform_aa(ctx, &obj->to_camera, g.P, P, true);
-    geom_unit_normal_aa(ctx, &obj->surf, &u, &v, &g, Nn);
-    trace_camera_normal_aa(ctx, obj, Nn, N);
-    ia_interval Pd[2][3];
+    aa_form Nn[3];
+    trace_xform_aa(ctx, &obj->to_camera, g.P, c->P, true);
+    geom_unit_normal_aa(ctx, &obj->surf, &c->u, &c->v, &g, Nn);
+    trace_camera_normal_aa(ctx, obj, Nn, c->N);
     if (obj->box_skip_tangents) {         /* never read: not computed */
         for (int i = 0; i < 3; i++) {
-            aa_const(&dPdu[i], 0.0);
-            aa_const(&dPdv[i], 0.0);
+            aa_const(&c->dPdu[i], 0.0);
+            aa_const(&c->dPdv[i], 0.0);
         }
     } else {
-        trace_xform_aa(ctx, &obj->to_camera, g.dPdu, dPdu, false);
-        trace_xform_aa(ctx, &obj->to_camera, g.dPdv, dPdv, false);
+        trace_xform_aa(ctx, &obj->to_camera, g.dPdu, c->dPdu, false);
+        trace_xform_aa(ctx, &obj->to_camera, g.dPdv, c->dPdv, false);
         for (int i = 0; i < 3; i++) {
-            Pd[0][i] = aa_range(&dPdu[i]);
-            Pd[1][i] = aa_range(&dPdv[i]);
+            c->Pd[0][i] = aa_range(&c->dPdu[i]);
+            c->Pd[1][i] = aa_range(&c->dPdv[i]);
         }
     }
+    c->ctx = *ctx;
+}
 
+/* One affine run of the displacement over the cell (of the case the VM's
+ * splits select): the shader's P in object space, in th->ctx (valid until
+ * its next reset). */
+static void affine_shade(trace_thread *th, const trace_object *obj, const affine_cell *c,
+                         aa_form P[3])
+{
+    aa_context *ctx = &th->ctx;
+    *ctx = c->ctx;
+    th->stats.evals_affine++;
+    if (!obj->displacement) {
+        for (int i = 0; i < 3; i++) P[i] = c->P[i];
+        return;
+    }
     sl_vm *vm = th->vm;
-    bind_globals_affine(vm, obj, &obj->displacement_spaces, P, N, N, dPdu, dPdv, &u, &v,
-                        obj->box_skip_tangents ? NULL : Pd, trace_surface_flat(obj));
+    bind_globals_affine(vm, obj, &obj->displacement_spaces, c->P, c->N, c->N, c->dPdu, c->dPdv,
+                        &c->u, &c->v, obj->box_skip_tangents ? NULL : c->Pd,
+                        trace_surface_flat(obj));
     trace_primvars_bind(vm, obj, false);
     if (sl_vm_run(vm, obj->displacement, SL_MODE_AFFINE, ctx) != SL_OK) {
         trace_thread_fail(th, sl_vm_error(vm));
@@ -231,6 +251,14 @@ static void affine_run(trace_thread *th, const trace_object *obj,
         sl_vm_get_affine(vm, SL_G_P, Pc);
         trace_xform_aa(ctx, &obj->from_camera, Pc, P, true);
     }
+}
+
+static void affine_run(trace_thread *th, const trace_object *obj,
+                       double u0, double u1, double v0, double v1, aa_form P[3])
+{
+    affine_cell c;
+    affine_geometry(th, obj, u0, u1, v0, v1, &c);
+    affine_shade(th, obj, &c, P);
 }
 
 static void box_affine(trace_thread *th, const trace_object *obj,
@@ -246,8 +274,8 @@ static void box_affine(trace_thread *th, const trace_object *obj,
 /* The cases' box is taken where it is at most this fraction of the box's
  * extent; else the box stays (a narrower box that still does not shrink
  * makes its children stagnant against it: more splits and samples for
- * nothing; the filtered pulse trains of dv_lines and fw_stripes, whose
- * floors the cases do not decide together) */
+ * nothing; the filtered pulse trains of dv_lines and fw_stripes before
+ * the cases of one value agreed, split_plan.c) */
 #define TRACE_SPLIT_GAIN 0.75
 
 bool trace_surface_box_cases(trace_thread *th, const trace_object *obj,
@@ -258,13 +286,14 @@ bool trace_surface_box_cases(trace_thread *th, const trace_object *obj,
     sl_vm *vm = th->vm;
     aa_form P[3];
     trace_box hull;
+    affine_cell cell;
+    affine_geometry(th, obj, u0, u1, v0, v1, &cell);
     sl_vm_split_begin(vm, TRACE_SPLIT_OPS);
-    affine_run(th, obj, u0, u1, v0, v1, P);
+    affine_shade(th, obj, &cell, P);
     box_from_affine(P, &hull);
     if (sl_vm_split_full(vm)) {
         /* more seams than cases: the rest would stay as wide as one run
-         * makes them (the filtered pulse trains' four floors, which the
-         * cases do not decide together): not worth the runs */
+         * makes them: not worth the runs */
         sl_vm_split_end(vm);
         th->stats.boxes++;
         return false;
@@ -272,7 +301,7 @@ bool trace_surface_box_cases(trace_thread *th, const trace_object *obj,
     bool split = false;
     while (!th->failed && sl_vm_split_next(vm)) {
         trace_box b;
-        affine_run(th, obj, u0, u1, v0, v1, P);
+        affine_shade(th, obj, &cell, P);
         box_from_affine(P, &b);
         trace_box_union(&hull, &b);
         split = true;
@@ -296,9 +325,82 @@ bool trace_surface_box_cases(trace_thread *th, const trace_object *obj,
     } else if (trace_box_extent(&m) > TRACE_SPLIT_GAIN * trace_box_extent(box)) {
         return false;
     }
+    m.flags |= TRACE_BOX_SPLIT;
     m.bend = 1e30f;                       /* no proofs on a split cell */
     trace_box_no_slab(&m);
     *box = m;
+    return true;
+}
+
+/* trace_surface_box's end: counted, and a NaN side makes it empty */
+static void box_finish(trace_thread *th, trace_box *out)
+{
+    th->stats.boxes++;
+    /* A NaN bound: the shader's result is defined nowhere in the range
+     * (common/aa gives unbounded, not NaN, where only some points are
+     * undefined or huge): no surface there. Empty box, counted. */
+    if (isnan(out->lo.x) || isnan(out->lo.y) || isnan(out->lo.z) ||
+        isnan(out->hi.x) || isnan(out->hi.y) || isnan(out->hi.z)) {
+        out->lo = v3(INFINITY, INFINITY, INFINITY);
+        out->hi = v3(-INFINITY, -INFINITY, -INFINITY);
+        out->flags &= ~(unsigned)AA_UNBOUNDED;
+        trace_box_no_slab(out);
+        th->stats.empty_boxes++;
+    }
+}
+
+bool trace_surface_box_split(trace_thread *th, const trace_object *obj,
+                             double u0, double u1, double v0, double v1, trace_box *box)
+{
+    const trace_object *o = trace_box_owner(obj);
+    if (th->world->options.arith == TRACE_ARITH_INTERVAL || !o->displacement) {
+        trace_surface_box(th, obj, u0, u1, v0, v1, box);
+        return false;
+    }
+    sl_vm *vm = th->vm;
+    aa_form P[3];
+    trace_box hull;
+    affine_cell cell;
+    affine_geometry(th, o, u0, u1, v0, v1, &cell);
+    sl_vm_split_begin(vm, TRACE_SPLIT_OPS);
+    affine_shade(th, o, &cell, P);
+    box_from_affine(P, &hull);
+    bool full = sl_vm_split_full(vm);
+    if (!full && (th->failed || !sl_vm_split_next(vm))) {
+        /* nothing split (or failed): the run was box_affine's own */
+        sl_vm_split_end(vm);
+        *box = hull;
+        box_finish(th, box);
+        return false;
+    }
+    if (full) {
+        /* more seams than cases: the case run is lost, the box as usual
+         * (box_affine's run on the same cell) */
+        sl_vm_split_end(vm);
+        th->stats.boxes++;
+        affine_shade(th, o, &cell, P);
+        box_from_affine(P, box);
+        box_finish(th, box);
+        return false;
+    }
+    do {
+        trace_box b;
+        affine_shade(th, o, &cell, P);
+        box_from_affine(P, &b);
+        trace_box_union(&hull, &b);
+    } while (!th->failed && sl_vm_split_next(vm));
+    sl_vm_split_end(vm);
+    th->stats.boxes++;
+    if (th->failed || isnan(hull.lo.x) || isnan(hull.lo.y) || isnan(hull.lo.z) ||
+        isnan(hull.hi.x) || isnan(hull.hi.y) || isnan(hull.hi.z)) {
+        /* a NaN side (no surface where a case runs): the box as usual */
+        trace_surface_box(th, obj, u0, u1, v0, v1, box);
+        return false;
+    }
+    hull.flags = box_flags(&hull, AA_DISCONTINUOUS) | TRACE_BOX_SPLIT;
+    hull.bend = 1e30f;                    /* no proofs on a split cell */
+    trace_box_no_slab(&hull);
+    *box = hull;
     return true;
 }
 
@@ -458,18 +560,7 @@ void trace_surface_box(trace_thread *th, const trace_object *obj,
         box_interval(th, obj, u0, u1, v0, v1, out);
     else
         box_affine(th, obj, u0, u1, v0, v1, out);
-    th->stats.boxes++;
-    /* A NaN bound: the shader's result is defined nowhere in the range
-     * (common/aa gives unbounded, not NaN, where only some points are
-     * undefined or huge): no surface there. Empty box, counted. */
-    if (isnan(out->lo.x) || isnan(out->lo.y) || isnan(out->lo.z) ||
-        isnan(out->hi.x) || isnan(out->hi.y) || isnan(out->hi.z)) {
-        out->lo = v3(INFINITY, INFINITY, INFINITY);
-        out->hi = v3(-INFINITY, -INFINITY, -INFINITY);
-        out->flags &= ~(unsigned)AA_UNBOUNDED;
-        trace_box_no_slab(out);
-        th->stats.empty_boxes++;
-    }
+    box_finish(th, out);
 }
 
 /* ---- points: dual mode ---- */

@@ -530,16 +530,24 @@ static trace_brood_id children_of(walk *w, trace_brood_id parent, int slot,
     trace_brood_id id = trace_boxcache_lookup(th->cache, owner->id, parent, slot, kids);
     if (id != TRACE_BROOD_NONE) return id;
     double node_extent = trace_box_extent(node);
+    /* below a box its cases narrowed, the children run their cases first
+     * (the plain run of one across the same seam is stagnant again) */
+    bool cases_first = (node->flags & TRACE_BOX_SPLIT) != 0;
     for (int i = 0; i < 4; i++) {
         double c[4];
         child_range(i, r[0], r[1], r[2], r[3], c);
-        trace_surface_box(th, owner, c[0], c[1], c[2], c[3], &kids[i]);
+        bool split = false;
+        if (cases_first)
+            split = trace_surface_box_split(th, owner, c[0], c[1], c[2], c[3], &kids[i]);
+        else
+            trace_surface_box(th, owner, c[0], c[1], c[2], c[3], &kids[i]);
         if (!stagnant(&kids[i], node_extent)) continue;
         /* issue 24: the cases of a seam, then (still stagnant) samples;
          * below a box they did not narrow, not again (a pattern whose
-         * floors the cases do not decide together: filtered pulse trains) */
-        if ((node->flags & TRACE_BOX_UNSPLIT) ||
-            !trace_surface_box_cases(th, owner, c[0], c[1], c[2], c[3], &kids[i]))
+         * seams overflow the cases); with its cases run first, not again */
+        if (cases_first ? !split
+                        : (node->flags & TRACE_BOX_UNSPLIT) ||
+                              !trace_surface_box_cases(th, owner, c[0], c[1], c[2], c[3], &kids[i]))
             kids[i].flags |= TRACE_BOX_UNSPLIT;
         if (depth >= TRACE_SAMPLE_DEPTH && stagnant(&kids[i], node_extent))
             sample_stagnant(th, owner, c, &kids[i]);

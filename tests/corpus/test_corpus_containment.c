@@ -56,6 +56,7 @@ typedef struct tally {
     long cases, points, violations, unbounded, unbounded_wide, box_errors, point_errors;
     long slab_points;               /* points also checked against a slab (box.h) */
     long split;                     /* boxes narrowed by case splits (trace_surface_box_cases) */
+    long split_first;               /* boxes of the cases first (trace_surface_box_split) */
     long undefined;                 /* NaN points on a base's axis (check_point) */
     double worst;                   /* largest excess outside the box, object units */
     double unb_side;                /* smallest range (larger side) with an unbounded box */
@@ -100,7 +101,7 @@ static double excess(double p, double lo, double hi, double slack)
 }
 
 static void check_point(trace_thread *th, const trace_object *obj, const trace_box *b,
-                        double u, double v, tally *t)
+                        const trace_box *b2, double u, double v, tally *t)
 {
     if (!geom_uv_inside(&obj->surf, u, v)) return;     /* not on the polygon */
     trace_surface_point sp;
@@ -116,6 +117,10 @@ static void check_point(trace_thread *th, const trace_object *obj, const trace_b
         t->slab_points++;
         e = fmax(e, excess(s, b->slo, b->shi, 2 * slack));
     }
+    if (b2)                               /* the box of the cases first (no slab) */
+        e = fmax(e, fmax(excess(p.x, b2->lo.x, b2->hi.x, slack),
+                         fmax(excess(p.y, b2->lo.y, b2->hi.y, slack),
+                              excess(p.z, b2->lo.z, b2->hi.z, slack))));
     t->points++;
     if (isnan(p.x) || isnan(p.y) || isnan(p.z)) {
         /* the shader's own 0/0 on the z axis of a surface of revolution
@@ -227,6 +232,15 @@ static void run_cases(trace_thread *th, const trace_world *w, long ncases, uint6
         if ((b.flags & AA_DISCONTINUOUS) && trace_surface_box_cases(th, obj, u0, u1, v0, v1, &b))
             t->split++;
         take_error(th, t, &t->box_errors);
+        /* and as the children of such a box run theirs first
+         * (trace_surface_box_split): the points in the hull of the cases */
+        trace_box b2, *split = NULL;
+        if ((b.flags & AA_DISCONTINUOUS) && trace_surface_box_split(th, obj, u0, u1, v0, v1, &b2) &&
+            !(b2.flags & AA_UNBOUNDED)) {
+            split = &b2;
+            t->split_first++;
+        }
+        take_error(th, t, &t->box_errors);
         t->cases++;
         if ((b.flags & AA_UNBOUNDED) || !isfinite(b.lo.x) || !isfinite(b.lo.y) ||
             !isfinite(b.lo.z) || !isfinite(b.hi.x) || !isfinite(b.hi.y) || !isfinite(b.hi.z)) {
@@ -249,12 +263,12 @@ static void run_cases(trace_thread *th, const trace_world *w, long ncases, uint6
         }
         for (int j = 0; j < GRID; j++)
             for (int i = 0; i < GRID; i++)
-                check_point(th, obj, &b, u0 + (u1 - u0) * i / (GRID - 1),
+                check_point(th, obj, &b, split, u0 + (u1 - u0) * i / (GRID - 1),
                             v0 + (v1 - v0) * j / (GRID - 1), t);
         for (int i = 0; i < RANDOM_POINTS; i++) {
             double u = u0 + (u1 - u0) * corpus_rng_uniform(&rng);
             double v = v0 + (v1 - v0) * corpus_rng_uniform(&rng);
-            check_point(th, obj, &b, u, v, t);
+            check_point(th, obj, &b, split, u, v, t);
         }
     }
     free(view);
@@ -297,6 +311,7 @@ static void run_surface(corpus_surface s)
             total.points += t.points;
             total.slab_points += t.slab_points;
             total.split += t.split;
+            total.split_first += t.split_first;
             total.violations += t.violations;
             total.unbounded += t.unbounded;
             total.unbounded_wide += t.unbounded_wide;
@@ -308,12 +323,12 @@ static void run_surface(corpus_surface s)
             fixture_close(&f);
         }
     printf("%s total: %ld cases, %ld points (%ld also against a slab), %ld boxes narrowed by "
-           "case splits, %ld violations (worst %.2e), %ld unbounded boxes "
+           "case splits (%ld of the cases first), %ld violations (worst %.2e), %ld unbounded boxes "
            "(+ %ld of ranges wider than 1/32, counted), %ld/%ld shader errors (box/point), "
            "%ld failing rows, %ld scenes not opened, %ld undefined points (NaN on a "
            "base's axis)\n",
            corpus_surface_name(s), total.cases, total.points, total.slab_points, total.split,
-           total.violations, total.worst,
+           total.split_first, total.violations, total.worst,
            total.unbounded, total.unbounded_wide, total.box_errors, total.point_errors,
            bad_rows, failed_opens, total.undefined);
     fflush(stdout);

@@ -187,6 +187,65 @@ static void test_case_splits(void **state)
     assert_int_equal(split_runs("P = point(floor(u), step(0.1, u), ceil(2 * u));", 3, r, 8), 1);
 }
 
+/* The hull of the cases' P.x, and whether P.x at u (float) lies in it for
+ * every u of a fine grid over the split range [0.2, 0.3] */
+static ia_interval cases_hull(ia_interval r[][3], int runs)
+{
+    ia_interval h = r[0][0];
+    for (int c = 1; c < runs; c++) h = ia_make(fmin(h.lo, r[c][0].lo), fmax(h.hi, r[c][0].hi));
+    return h;
+}
+static void assert_cases_enclose(const char *body, ia_interval h)
+{
+    for (int k = 0; k <= 200; k++) {
+        double u = 0.2 + 0.1 * k / 200.0;
+        assert_true(inside(h, body_float(body, u)));
+    }
+}
+
+static void test_case_splits_same_value(void **state)
+{
+    (void)state;
+    ia_interval r[8][3];
+    /* the filtered pulse train's integral (tests/shaders/corpus/include/
+     * filterwidth.h): floor(x) twice of one x, continuous over x = 1 (the
+     * seam in u = 0.25). Both floors take one case (split_plan.c): 2 runs,
+     * k = 0: min(0.3, [0.8, 1.2]) = 0.3; k = 1: 0.3 + [-0.2, 0.2]. Split
+     * apart: four runs, two of them cases no point has (0.6 and
+     * [-0.2, 0.2]), and a hull of [-0.2, 0.6] */
+    const char *body = "float x = 4 * u; P = point(0.3 * floor(x) + min(0.3, x - floor(x)), 0, 0);";
+    int runs = split_runs(body, 3, r, 8);
+    assert_int_equal(runs, 2);
+    ia_interval h = cases_hull(r, runs);
+    assert_true(h.lo >= 0.1 - 1e-9 && h.hi <= 0.5 + 1e-9);
+    assert_cases_enclose(body, h);
+    /* the pulse train itself: two integrals, four floors, two values: 2 of
+     * the budget of 3, where apart they overflowed it */
+    body = "float x0 = 4 * u - 0.05, x1 = x0 + 0.1;"
+           "float i1 = 0.3 * floor(x1) + min(0.3, x1 - floor(x1));"
+           "float i0 = 0.3 * floor(x0) + min(0.3, x0 - floor(x0));"
+           "P = point((i1 - i0) / 0.1, 0, 0);";
+    runs = split_runs(body, 3, r, 8);
+    assert_int_equal(runs, 4);
+    assert_cases_enclose(body, cases_hull(r, runs));
+    /* the same slot written between the floors: two values, split apart
+     * (x = 0.95: floor 0, then floor(1.05) = 1, a case of its own) */
+    body = "float x = 4 * u; float a = floor(x); x = x + 0.1; P = point(a + 2 * floor(x), 0, 0);";
+    runs = split_runs(body, 3, r, 8);
+    assert_int_equal(runs, 4);
+    assert_cases_enclose(body, cases_hull(r, runs));
+    /* a branch between them (a merge writes x): apart */
+    body = "float x = 4 * u; float a = floor(x); if (u > 0.24) x = x + 0.1;"
+           "P = point(a + 2 * floor(x), 0, 0);";
+    runs = split_runs(body, 3, r, 8);
+    assert_int_equal(runs, 4);
+    assert_cases_enclose(body, cases_hull(r, runs));
+    /* mod and step of the same operands agree too; of other operands not */
+    body = "float x = 4 * u; P = point(mod(x, 1) + mod(x, 1), step(1, x) - step(1, x), step(1, x));";
+    assert_int_equal(split_runs(body, 3, r, 8), 4);
+    for (int c = 0; c < 4; c++) assert_true(r[c][1].lo == 0 && r[c][1].hi == 0);
+}
+
 /* ---------------------------------------------------------------------- */
 /* merging                                                                 */
 /* ---------------------------------------------------------------------- */
@@ -671,6 +730,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_case_splits),
+        cmocka_unit_test(test_case_splits_same_value),
         cmocka_unit_test(test_undecided_if_merges),
         cmocka_unit_test(test_undecided_conditional_expression),
         cmocka_unit_test(test_undecided_loop),
