@@ -823,29 +823,31 @@ static void build_displaced(trace_thread *th, const trace_object *obj)
     /* the pieces' undisplaced boxes (trace_world_prepare's pass) */
     float (*bounds)[6] = m->bounds;
     m->bounds = NULL;
+    m->bvh = trace_float_bvh_build((const float (*)[6])bounds, m->npieces,
+                                   th->world->options.build_threads);
+    m->lazy = trace_lazy_roots_new(m->npieces);
+    if (m->npieces == 0) {             /* no piece: an empty tree */
+        free(bounds);
+        return;
+    }
     int threads = build_threads_for(th, m->npieces);
     trace_thread **made = xcalloc((size_t)threads, sizeof *made);
     for (int i = 0; i < threads; i++) made[i] = i == 0 ? th : trace_thread_new(th->world);
-    {
-        m->bvh = trace_float_bvh_build((const float (*)[6])bounds, m->npieces,
-                                       th->world->options.build_threads);
-        m->lazy = trace_lazy_roots_new(m->npieces);
-        const mesh_node *root = &m->bvh->nodes[0];
-        double extent = 0.0;
-        for (int a = 0; a < 3; a++) extent = fmax(extent, (double)root->hi[a] - root->lo[a]);
-        int (*regions)[2] = xmalloc(sizeof *regions * n);
-        int nregions = regions_of(m->bvh, regions);
-        const sl_program *dp = sl_instance_program(obj->displacement);
-        bool dudv = sl_program_reads_global(dp, SL_G_du) || sl_program_reads_global(dp, SL_G_dv);
-        region_share *rs = xcalloc((size_t)threads, sizeof *rs);
-        for (int i = 0; i < threads; i++)
-            rs[i] = (region_share){made[i], obj, m->bvh, bounds, (const int (*)[2])regions,
-                                   nregions, i, threads, extent, dudv};
-        trace_run_shares(rs, sizeof *rs, threads, region_range);
-        free(rs);
-        free(regions);
-        refit(m->bvh, (const float (*)[6])bounds);
-    }
+    const mesh_node *root = &m->bvh->nodes[0];
+    double extent = 0.0;
+    for (int a = 0; a < 3; a++) extent = fmax(extent, (double)root->hi[a] - root->lo[a]);
+    int (*regions)[2] = xmalloc(sizeof *regions * n);
+    int nregions = regions_of(m->bvh, regions);
+    const sl_program *dp = sl_instance_program(obj->displacement);
+    bool dudv = sl_program_reads_global(dp, SL_G_du) || sl_program_reads_global(dp, SL_G_dv);
+    region_share *rs = xcalloc((size_t)threads, sizeof *rs);
+    for (int i = 0; i < threads; i++)
+        rs[i] = (region_share){made[i], obj, m->bvh, bounds, (const int (*)[2])regions,
+                               nregions, i, threads, extent, dudv};
+    trace_run_shares(rs, sizeof *rs, threads, region_range);
+    free(rs);
+    free(regions);
+    refit(m->bvh, (const float (*)[6])bounds);
     end_threads(th, made, threads);
     free(made);
     free(bounds);
