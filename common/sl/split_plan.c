@@ -42,26 +42,17 @@ static bool splittable(int op)
 
 static bool binary(int op) { return op == SL_OP_MOD || op == SL_OP_STEP; }
 
-/* A plain operation: writes [*first, *first + *n) and nothing else */
+/* A plain operation: writes [*first, *first + *n) and nothing else (a
+ * copy of n slots, or one of the scalar operations: sl_operand_reach 0) */
 static bool plain(const sl_insn *in, int *first, int *n)
 {
-    switch ((sl_opcode)in->op) {
-    case SL_OP_MOVN:
+    if (in->op == SL_OP_MOVN) {
         *first = in->a, *n = in->c;
         return true;
-    case SL_OP_MOV: case SL_OP_ADD: case SL_OP_SUB: case SL_OP_MUL: case SL_OP_DIV:
-    case SL_OP_NEG: case SL_OP_SQRT: case SL_OP_INVSQRT: case SL_OP_EXP: case SL_OP_LOG:
-    case SL_OP_SIN: case SL_OP_COS: case SL_OP_TAN: case SL_OP_ASIN: case SL_OP_ACOS:
-    case SL_OP_ATAN: case SL_OP_ABS: case SL_OP_SIGN: case SL_OP_FLOOR: case SL_OP_CEIL:
-    case SL_OP_ROUND: case SL_OP_POW: case SL_OP_ATAN2: case SL_OP_MOD: case SL_OP_MIN:
-    case SL_OP_MAX: case SL_OP_STEP: case SL_OP_CLAMP: case SL_OP_SMOOTHSTEP: case SL_OP_MIX:
-    case SL_OP_LT: case SL_OP_LE: case SL_OP_GT: case SL_OP_GE: case SL_OP_EQ: case SL_OP_NE:
-    case SL_OP_AND: case SL_OP_OR: case SL_OP_NOT:
-        *first = in->a, *n = 1;
-        return true;
-    default:
-        return false;
     }
+    if (sl_operand_reach((sl_opcode)in->op) != 0) return false;
+    *first = in->a, *n = 1;
+    return true;
 }
 
 static bool no_plan(int op)

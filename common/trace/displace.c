@@ -278,6 +278,27 @@ static void box_affine(trace_thread *th, const trace_object *obj,
  * the cases of one value agreed, split_plan.c) */
 #define TRACE_SPLIT_GAIN 0.75
 
+/* Whether a side of b is NaN (no surface where the shader ran) */
+static bool box_has_nan(const trace_box *b)
+{
+    return isnan(b->lo.x) || isnan(b->lo.y) || isnan(b->lo.z) || isnan(b->hi.x) ||
+           isnan(b->hi.y) || isnan(b->hi.z);
+}
+
+/* The boxes of the cell's remaining cases (sl_vm_split_next has given
+ * the first of them) united into *hull */
+static void union_cases(trace_thread *th, const trace_object *obj, const affine_cell *cell,
+                        trace_box *hull)
+{
+    aa_form P[3];
+    do {
+        trace_box b;
+        affine_shade(th, obj, cell, P);
+        box_from_affine(P, &b);
+        trace_box_union(hull, &b);
+    } while (!th->failed && sl_vm_split_next(th->vm));
+}
+
 bool trace_surface_box_cases(trace_thread *th, const trace_object *obj,
                              double u0, double u1, double v0, double v1, trace_box *box)
 {
@@ -298,21 +319,13 @@ bool trace_surface_box_cases(trace_thread *th, const trace_object *obj,
         th->stats.boxes++;
         return false;
     }
-    bool split = false;
-    while (!th->failed && sl_vm_split_next(vm)) {
-        trace_box b;
-        affine_shade(th, obj, &cell, P);
-        box_from_affine(P, &b);
-        trace_box_union(&hull, &b);
-        split = true;
-    }
+    bool split = !th->failed && sl_vm_split_next(vm);
+    if (split) union_cases(th, obj, &cell, &hull);
     sl_vm_split_end(vm);
     th->stats.boxes++;
     if (th->failed || !split) return false;
     /* a NaN side (no surface where the cases run): the box as it was */
-    if (isnan(hull.lo.x) || isnan(hull.lo.y) || isnan(hull.lo.z) || isnan(hull.hi.x) ||
-        isnan(hull.hi.y) || isnan(hull.hi.z))
-        return false;
+    if (box_has_nan(&hull)) return false;
     /* both enclose the surface over the cell: so does their meet */
     trace_box m = *box;
     m.lo = v3(fmax(box->lo.x, hull.lo.x), fmax(box->lo.y, hull.lo.y), fmax(box->lo.z, hull.lo.z));
@@ -339,8 +352,7 @@ static void box_finish(trace_thread *th, trace_box *out)
     /* A NaN bound: the shader's result is defined nowhere in the range
      * (common/aa gives unbounded, not NaN, where only some points are
      * undefined or huge): no surface there. Empty box, counted. */
-    if (isnan(out->lo.x) || isnan(out->lo.y) || isnan(out->lo.z) ||
-        isnan(out->hi.x) || isnan(out->hi.y) || isnan(out->hi.z)) {
+    if (box_has_nan(out)) {
         out->lo = v3(INFINITY, INFINITY, INFINITY);
         out->hi = v3(-INFINITY, -INFINITY, -INFINITY);
         out->flags &= ~(unsigned)AA_UNBOUNDED;
@@ -383,16 +395,10 @@ bool trace_surface_box_split(trace_thread *th, const trace_object *obj,
         box_finish(th, box);
         return false;
     }
-    do {
-        trace_box b;
-        affine_shade(th, o, &cell, P);
-        box_from_affine(P, &b);
-        trace_box_union(&hull, &b);
-    } while (!th->failed && sl_vm_split_next(vm));
+    union_cases(th, o, &cell, &hull);
     sl_vm_split_end(vm);
     th->stats.boxes++;
-    if (th->failed || isnan(hull.lo.x) || isnan(hull.lo.y) || isnan(hull.lo.z) ||
-        isnan(hull.hi.x) || isnan(hull.hi.y) || isnan(hull.hi.z)) {
+    if (th->failed || box_has_nan(&hull)) {
         /* a NaN side (no surface where a case runs): the box as usual */
         trace_surface_box(th, obj, u0, u1, v0, v1, box);
         return false;

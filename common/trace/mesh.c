@@ -729,11 +729,8 @@ static void region_boxes(region_share *b, int first, int count, trace_view *v)
              * grid's values */
             ia_interval dudv[2] = {ia_make(0x1p-16, 1.0), ia_make(0x1p-16, 1.0)};
             lazy = make(th, b->obj, idx[i], false, false, v);
-            if (lazy && b->dudv) {
+            if (lazy && b->dudv)       /* (the bounds are never under 2^-16) */
                 trace_object_grid_spacing_max(th->world, &v->obj, &dudv[0].hi, &dudv[1].hi);
-                dudv[0].lo = fmin(dudv[0].lo, dudv[0].hi);
-                dudv[1].lo = fmin(dudv[1].lo, dudv[1].hi);
-            }
             lazy = lazy && trace_region_add(th, region, &v->obj, dudv);
         }
         lazy = lazy && trace_region_run(th, b->obj, region, &box, shift);

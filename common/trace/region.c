@@ -154,13 +154,12 @@ static bool hull_primvars(const trace_object *obj, trace_region *h, bool first)
 /* Piece obj (a view) into the hull: no shader, its geometry's affine
  * forms over its whole (u,v) square as box_affine makes them */
 static bool hull_piece(trace_thread *th, const trace_object *obj, const ia_interval *dudv,
-                       trace_region *h, bool first, ia_interval base[3])
+                       trace_region *h, bool first)
 {
     vec3 lo, hi;
     geom_bounds(&obj->surf, &lo, &hi);
     ia_interval B[3] = {ia_make(lo.x, hi.x), ia_make(lo.y, hi.y), ia_make(lo.z, hi.z)};
     if (!obj->displacement) {
-        for (int i = 0; i < 3; i++) base[i] = B[i];
         hull3(h->B, B, first);
         return true;
     }
@@ -175,7 +174,7 @@ static bool hull_piece(trace_thread *th, const trace_object *obj, const ia_inter
      * the surface (a polygon's is its bounding rectangle: the piece's box
      * holds that): the square's base points too */
     ia_interval r[3];
-    for (int i = 0; i < 3; i++) base[i] = r[i] = ia_hull(B[i], aa_range(&g.P[i]));
+    for (int i = 0; i < 3; i++) r[i] = ia_hull(B[i], aa_range(&g.P[i]));
     hull3(h->B, r, first);
     geom_unit_normal_aa(ctx, &obj->surf, &u, &v, &g, Nn);
     trace_camera_normal_aa(ctx, obj, Nn, N);
@@ -308,10 +307,9 @@ void trace_region_destroy(trace_region **self)
 bool trace_region_add(trace_thread *th, trace_region *self, const trace_object *piece,
                       const ia_interval *dudv)
 {
-    ia_interval b[3];
     bool first = self->count == 0;
     self->count++;
-    if (!hull_piece(th, piece, dudv, self, first, b)) self->refused = true;
+    if (!hull_piece(th, piece, dudv, self, first)) self->refused = true;
     return !self->refused;
 }
 
