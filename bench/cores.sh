@@ -1,0 +1,43 @@
+#!/usr/bin/env bash
+# bench/cores.sh: the figures only a machine of many cores gives, in one
+# run (a lent 16-core machine: docs/benchmarks.md "Many cores"):
+#   1. issue 24's scaling: gallery and vase at twice their size, the
+#      standalone renderer at 1 and at all cores' threads, and a master
+#      with as many local workers (bench/thread_scaling.sh FARM=1 SCALE=2)
+#   2. issue 23's asset: a 1M-face displaced terrain with instanced rocks
+#      at 640x480, standalone and on 2 workers of half the cores each,
+#      each worker's peak memory (bench/scale.sh part 2)
+#   3. mesh_bench 1,000,000 quads, RUNS times (parse + world over all cores)
+#   4. the opt-in 10,000,000-quad row and the subdivision torus (scale.sh
+#      part 1)
+# Usage: bash bench/cores.sh [BUILD_DIR] [LOG]   (default build; LOG: also
+# append everything to this file). Each part is bounded by timeout -k;
+# figures only, nothing fails on time.
+set -u
+here="$(cd "$(dirname "$0")/.." && pwd)"
+build="$(cd "${1:-$here/build}" && pwd)"
+LOG=${2:-/dev/null}
+RUNS=${RUNS:-3}
+N=$(nproc)
+cd "$here"
+say() { echo "$@" | tee -a "$LOG"; }
+part() {  # part SECONDS CMD...: one bounded part, its output kept in LOG
+    local limit=$1
+    shift
+    timeout -k 5 "$limit" "$@" 2>&1 | tee -a "$LOG"
+    local rc=${PIPESTATUS[0]}
+    [ "$rc" = 0 ] || say "   (exit $rc$([ "$rc" = 124 ] && echo ": stopped at ${limit} s"))"
+}
+say "== cores.sh: $N cores, $(awk '/MemTotal/ {printf "%.0f GiB", $2 / 1048576}' /proc/meminfo), $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2-), load $(cut -d' ' -f1 /proc/loadavg)"
+say "== 1. threads and local workers"
+for s in gallery vase; do
+    THREADS="$N" FARM=1 SCALE=2 part 240 bash bench/thread_scaling.sh "$build/bin" "scenes/$s.rib" "$RUNS"
+done
+say "== 2. the 1M-face asset at 640x480"
+PARTS=2 THREADS=$((N / 2)) part 300 bash bench/scale.sh "$build"
+say "== 3. mesh_bench 1000000, $RUNS runs"
+for ((r = 0; r < RUNS; r++)); do
+    part 120 /usr/bin/time -f "   (whole process: %e s wall, %U s user, peak %M KB)" "$build/bin/mesh_bench" 1000000
+done
+say "== 4. mesh_bench 10000000 and the subdivision torus"
+PARTS=1 FACES=10000000 part 300 bash bench/scale.sh "$build"
