@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include "job_message.h"
+#include "job_proto.h"
 #include "util/err.h"
 #include "util/hash.h"
 #include "util/xalloc.h"
@@ -280,35 +281,10 @@ bool job_bundle_decode(job_bundle *b, const uint8_t *data, size_t len, char *err
 job *job_bundle_job(const job_bundle *b, int i, image_format *fmt, char *err, size_t errsz)
 {
     const proto_job *m = proto_saved_job_get(b->jobs[i]);
-    job_options jo;
-    job_options_default(&jo);
-    jo.arith = m->options.arithmetic == PROTO_ARITH_INTERVAL ? TRACE_ARITH_INTERVAL
-                                                             : TRACE_ARITH_AFFINE;
-    jo.tile_size = (int)m->options.tile_size;
-    if (m->options.instruction_budget)
-        jo.max_instructions = m->options.instruction_budget > (uint64_t)LONG_MAX
-                                  ? LONG_MAX : (long)m->options.instruction_budget;
-    jo.frame = m->options.frame > (uint32_t)INT_MAX / 2 ? -1 : (int)m->options.frame;
-    job *jb = job_new(m->scene_name, (const char *)m->scene_text, m->scene_len, &jo);
     char why[ERR_LEN];
-    bool ok = true;
-    for (size_t k = 0; ok && k < m->n_sources; k++)
-        ok = job_add_source(jb, m->sources[k].name, (const char *)m->sources[k].text,
-                            m->sources[k].text_len, why, sizeof why);
-    for (size_t k = 0; ok && k < m->n_shaders; k++)
-        ok = job_add_shader(jb, m->shaders[k].name, m->shaders[k].source, why, sizeof why);
-    for (size_t k = 0; ok && k < m->n_files; k++)
-        ok = job_add_file(jb, m->files[k].name, m->files[k].sha256, m->files[k].size, why,
-                          sizeof why);
-    jb->files_known = true;
-    if (ok) ok = job_finish(jb, why, sizeof why);
-    if (ok && strcmp(jb->hash, m->job_hash) != 0) {   /* err_set returns false */
-        ok = err_set(why, sizeof why, "its content hashes to %.12s... here, the submitter "
-                     "said %.12s... (different aafarm versions?)", jb->hash, m->job_hash);
-    }
-    if (!ok) {
+    job *jb = job_from_proto(m, why, sizeof why);
+    if (!jb) {
         err_set(err, errsz, "frame %d: %s", b->frame_numbers[i], why);
-        job_destroy(&jb);
         return NULL;
     }
     jb->frame_number = b->frame_numbers[i];

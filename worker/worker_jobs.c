@@ -5,12 +5,12 @@
 #include "worker_jobs.h"
 
 #include <assert.h>
-#include <limits.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "file_store.h"
+#include "job_proto.h"
 #include "tile_render.h"
 #include "util/err.h"
 #include "util/xalloc.h"
@@ -79,48 +79,12 @@ held_job *worker_jobs_find(const worker_jobs *self, const char *hash)
     return NULL;
 }
 
-static job_options options_of(const proto_render_options *o)
-{
-    job_options jo;
-    job_options_default(&jo);
-    jo.arith = o->arithmetic == PROTO_ARITH_INTERVAL ? TRACE_ARITH_INTERVAL : TRACE_ARITH_AFFINE;
-    jo.tile_size = (int)o->tile_size;
-    if (o->instruction_budget)
-        jo.max_instructions = o->instruction_budget > (uint64_t)LONG_MAX ? LONG_MAX
-                                                                          : (long)o->instruction_budget;
-    /* an index no scene can have is refused by job_finish */
-    jo.frame = o->frame > (uint32_t)INT_MAX / 2 ? -1 : (int)o->frame;
-    return jo;
-}
-
 /* The job from the message's fields, hashed again and compared. */
 static job *rebuild(const proto_job *m, char *err, size_t errsz)
 {
-    job_options jo = options_of(&m->options);
-    job *jb = job_new(m->scene_name, (const char *)m->scene_text, m->scene_len, &jo);
     char why[ERR_LEN];
-    bool ok = true;
-    for (size_t i = 0; ok && i < m->n_sources; i++)
-        ok = job_add_source(jb, m->sources[i].name, (const char *)m->sources[i].text,
-                            m->sources[i].text_len, why, sizeof why);
-    for (size_t i = 0; ok && i < m->n_shaders; i++)
-        ok = job_add_shader(jb, m->shaders[i].name, m->shaders[i].source, why, sizeof why);
-    for (size_t i = 0; ok && i < m->n_files; i++)
-        ok = job_add_file(jb, m->files[i].name, m->files[i].sha256, m->files[i].size, why,
-                          sizeof why);
-    jb->files_known = true;                 /* the master's list, even when empty */
-    if (ok) ok = job_finish(jb, why, sizeof why);
-    if (!ok) {
-        err_set(err, errsz, "job %.12s... is inconsistent: %s", m->job_hash, why);
-        job_destroy(&jb);
-        return NULL;
-    }
-    if (strcmp(jb->hash, m->job_hash) != 0) {
-        err_set(err, errsz, "job %.12s...: its content hashes to %.12s... here (the master "
-                "and this worker run different aafarm versions?)", m->job_hash, jb->hash);
-        job_destroy(&jb);
-        return NULL;
-    }
+    job *jb = job_from_proto(m, why, sizeof why);
+    if (!jb) err_set(err, errsz, "job %.12s...: %s", m->job_hash, why);
     return jb;
 }
 
