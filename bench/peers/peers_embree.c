@@ -46,7 +46,21 @@
 #include "peers_png.h"
 #include "trace/camera.h"
 #include "trace/displace.h"
+#include "trace/mesh.h"
 #include "trace/render.h"
+
+/* Piece k of ob as an object: ob itself, or a mesh's piece made into
+ * *view (its surface and primitive variables; no boxes: points only) */
+static const trace_object *piece_of(trace_thread *th, const trace_object *ob, int k,
+                                    trace_view *view)
+{
+    if (!ob->mesh) return ob;
+    if (!trace_mesh_view_make(th, ob, k, false, view)) {
+        fprintf(stderr, "peers_embree: piece %d of object %d could not be made\n", k, ob->id);
+        exit(1);
+    }
+    return &view->obj;
+}
 
 static double cpu_now(void)
 {
@@ -105,7 +119,7 @@ int main(int argc, char **argv)
     job_options_default(&opt);
     sl_diag *diag = sl_diag_new();
     job *jb = job_load(rib, &opt, NULL, diag);
-    job_scene *js = jb ? job_scene_new(jb, 0, true, diag) : NULL;
+    job_scene *js = jb ? job_scene_new(jb, 0, true, NULL, diag) : NULL;
     sl_diag_print(diag, stderr);
     sl_diag_destroy(&diag);
     if (!js) {
@@ -124,25 +138,32 @@ int main(int argc, char **argv)
      * triangle: a grid whose last row collapses to its third corner; more
      * corners: a fan of such triangles); one float3 of padding: Embree
      * reads 16 bytes per vertex */
-    typedef struct gpatch { int obj; double c[4][2]; } gpatch;
+    typedef struct gpatch { int obj, piece; double c[4][2]; } gpatch;
     gpatch *gp = NULL;
     long ngp = 0;
+    trace_view *view = malloc(sizeof *view);
+    if (!view) abort();
     for (int o = 0; o < w->nobjects; o++) {
-        const geom_surface *sf = &w->objects[o].surf;
-        int parts = sf->kind == GEOM_POLYGON && sf->nuv > 4 ? sf->nuv - 2 : 1;
-        gp = realloc(gp, sizeof *gp * (size_t)(ngp + parts));
-        if (!gp) abort();
-        for (int k = 0; k < parts; k++) {
-            gpatch *g = &gp[ngp++];
-            g->obj = o;
-            if (sf->kind != GEOM_POLYGON) {
-                double sq[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
-                memcpy(g->c, sq, sizeof sq);
-            } else if (sf->nuv == 4) {
-                for (int q = 0; q < 4; q++) g->c[q][0] = sf->uv[q][0], g->c[q][1] = sf->uv[q][1];
-            } else {
-                int id[4] = {0, k + 1, k + 2, k + 2};
-                for (int q = 0; q < 4; q++) g->c[q][0] = sf->uv[id[q]][0], g->c[q][1] = sf->uv[id[q]][1];
+        const trace_object *ob = &w->objects[o];
+        for (int pc = 0; pc < trace_object_npieces(ob); pc++) {
+            const geom_surface *sf = &piece_of(th, ob, pc, view)->surf;
+            int parts = sf->kind == GEOM_POLYGON && sf->nuv > 4 ? sf->nuv - 2 : 1;
+            gp = realloc(gp, sizeof *gp * (size_t)(ngp + parts));
+            if (!gp) abort();
+            for (int k = 0; k < parts; k++) {
+                gpatch *g = &gp[ngp++];
+                g->obj = o;
+                g->piece = pc;
+                if (sf->kind != GEOM_POLYGON) {
+                    double sq[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+                    memcpy(g->c, sq, sizeof sq);
+                } else if (sf->nuv == 4) {
+                    for (int q = 0; q < 4; q++) g->c[q][0] = sf->uv[q][0], g->c[q][1] = sf->uv[q][1];
+                } else {
+                    int id[4] = {0, k + 1, k + 2, k + 2};
+                    for (int q = 0; q < 4; q++)
+                        g->c[q][0] = sf->uv[id[q]][0], g->c[q][1] = sf->uv[id[q]][1];
+                }
             }
         }
     }
@@ -154,10 +175,12 @@ int main(int argc, char **argv)
         return 1;
     }
     long outside = 0;
+    const trace_object *obj = NULL;
     double t0 = cpu_now();
     for (long gi = 0; gi < ngp; gi++) {
         const gpatch *gq = &gp[gi];
-        const trace_object *obj = &w->objects[gq->obj];
+        if (gi == 0 || gq->obj != gp[gi - 1].obj || gq->piece != gp[gi - 1].piece)
+            obj = piece_of(th, &w->objects[gq->obj], gq->piece, view);
         float *GP = P + 3 * per * gi, *GN = N + 3 * per * gi;
         for (long j = 0; j <= n; j++) {
             double v = (double)j / (double)n;
@@ -283,7 +306,7 @@ int main(int argc, char **argv)
             rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
             rtcIntersect1(rscene, &ctx, &rh);
             if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) continue;
-            const trace_object *obj = &w->objects[rh.hit.geomID];
+            const trace_object *hit_obj = &w->objects[rh.hit.geomID];
             float nf[3];
             rtcInterpolate0(rtcGetGeometry(rscene, rh.hit.geomID), rh.hit.primID, rh.hit.u, rh.hit.v,
                             RTC_BUFFER_TYPE_VERTEX_ATTRIBUTE, 0, nf, 3);
@@ -293,8 +316,8 @@ int main(int argc, char **argv)
             nn = v3_scale(nn, 1.0 / len);
             if (v3_dot(nn, ray.d) > 0) nn = v3_neg(nn);     /* faceforward(N, I) */
             double amb[3] = {0, 0, 0}, dif[3] = {0, 0, 0};
-            for (int l = 0; l < obj->nlights; l++) {
-                const trace_light *lt = &w->lights[obj->lights[l]];
+            for (int l = 0; l < hit_obj->nlights; l++) {
+                const trace_light *lt = &w->lights[hit_obj->lights[l]];
                 if (lt->kind == TRACE_LIGHT_AMBIENT) {
                     for (int k = 0; k < 3; k++) amb[k] += lt->color[k];
                 } else if (lt->kind == TRACE_LIGHT_DISTANT) {
@@ -305,7 +328,7 @@ int main(int argc, char **argv)
             }
             float *p = &img[((size_t)y * (size_t)W + (size_t)x) * 4];
             for (int k = 0; k < 3; k++)
-                p[k] = (float)(obj->Os[k] * obj->Cs[k] * (ka * amb[k] + kd * dif[k]) * w->gain);
+                p[k] = (float)(hit_obj->Os[k] * hit_obj->Cs[k] * (ka * amb[k] + kd * dif[k]) * w->gain);
             p[3] = 1.0f;
             hits++;
         }
@@ -328,6 +351,7 @@ int main(int argc, char **argv)
     free(P);
     free(N);
     free(gp);
+    free(view);
     trace_thread_destroy(&th);
     job_scene_destroy(&js);
     job_destroy(&jb);

@@ -15,6 +15,14 @@
 #                                      the patch NS_terrain; its own table
 #                                      (marker "bench-peers-meshes"); QUICK=1
 #                                      with it: fewer N, one run
+#   MESH1M=1 bash bench/peers/run.sh   issue 23's 1M-face displaced mesh
+#                                      against Embree: bench/asset_gen's
+#                                      terrain of 1,000,000 quads (a height
+#                                      map through texture(), no rocks) as
+#                                      the peer scenes are set up, at
+#                                      MESH1M_W x MESH1M_H (320 x 240), N per
+#                                      face NS_mesh1m (1 2 4); its own table
+#                                      (marker "bench-peers-mesh1m")
 #
 # It installs the peers (deploy/install-bench-deps.sh), builds aafarm and
 # the helpers in build-bench/, and for each scene of bench/peers/scenes/:
@@ -44,6 +52,8 @@ set -euo pipefail
 
 MESHES=${MESHES:-0}
 [ "$MESHES" = "0" ] && MESHES=""
+MESH1M=${MESH1M:-0}
+[ "$MESH1M" = "0" ] && MESH1M=""
 ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)
 QUICK=${QUICK:-0}
 [ "$QUICK" = "0" ] && QUICK=""
@@ -66,8 +76,19 @@ if [ -n "$MESHES" ]; then
     NS_terrain=${NS_terrain:-"128 256 512 1024 2048 4096"}
   fi
 fi
+if [ -n "$MESH1M" ]; then
+  SCENES=mesh1m
+  CACHE_SCENES=""
+  RSS=0
+  DOC_BLOCK=bench-peers-mesh1m
+  MESH1M_W=${MESH1M_W:-320}
+  MESH1M_H=${MESH1M_H:-240}
+  if [ -n "$QUICK" ]; then NS_mesh1m=${NS_mesh1m:-"1 2"}; else NS_mesh1m=${NS_mesh1m:-"1 2 4"}; fi
+  RUNS=${RUNS:-3}
+fi
 # the maps a scene reads, shipped to each worker host once (issue 16)
 TEX_terrain=$ROOT/scenes/textures/terrain_height.exr
+TEX_mesh1m=$TEX_terrain
 if [ -n "$QUICK" ]; then
   SCENES=${SCENES:-wave}
   RUNS=${RUNS:-1}
@@ -90,7 +111,7 @@ say() { printf 'bench-peers: %s\n' "$*" >&2; }
 bash "$ROOT/deploy/install-bench-deps.sh"
 cmake -S "$ROOT" -B "$BUILD" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DAAFARM_TESTS=OFF >/dev/null
 cmake --build "$BUILD" -j "$(nproc 2>/dev/null || echo 2)" \
-  --target aafarm-worker aafarm-maketx peers_aafarm peers_compare peers_rusage peers_embree >/dev/null
+  --target aafarm-worker aafarm-maketx asset_gen peers_aafarm peers_compare peers_rusage peers_embree >/dev/null
 BIN=$BUILD/bin
 for b in aafarm-worker peers_aafarm peers_compare peers_rusage peers_embree; do
   if [ ! -x "$BIN/$b" ]; then
@@ -101,7 +122,7 @@ done
 rm -rf "$WORK"
 mkdir -p "$WORK"
 case " $SCENES " in
-  *" terrain "*) [ -f "$TEX_terrain" ] || bash "$ROOT/scenes/make_textures.sh" "$BUILD" >&2 ;;
+  *" terrain "*|*" mesh1m "*) [ -f "$TEX_terrain" ] || bash "$ROOT/scenes/make_textures.sh" "$BUILD" >&2 ;;
 esac
 DATE=$(date -u +%Y-%m-%d)
 HOST="$(nproc) cores, $(awk '/MemTotal/ {printf "%.0f GiB", $2 / 1048576}' /proc/meminfo), load $(cut -d' ' -f1 /proc/loadavg) at start"
@@ -163,6 +184,18 @@ for s in $SCENES; do
     cp "$ROOT/bench/peers/pov/$s.pov" "$ROOT/bench/peers/pov/peers_common.inc" "$D/"
   fi
   RIB=$ROOT/bench/peers/scenes/$s.rib
+  if [ "$s" = mesh1m ]; then
+    # asset_gen's terrain (1M quads from a gzip archive, displaced by
+    # heightmap.sl) set up as terrain.rib is: one sample per pixel, a box
+    # filter, matte shading, no shadows
+    say "$s: writing the asset (bench/asset_gen --faces 1000000 --rocks 0)"
+    "$BIN/asset_gen" --faces 1000000 --rocks 0 --format "$MESH1M_W" "$MESH1M_H" \
+      --shaders "$ROOT/scenes/shaders" --textures "$ROOT/scenes/textures" "$D" >&2
+    sed -e 's/^PixelSamples .*/PixelSamples 1 1\nPixelFilter "box" 1 1\nExposure 1 1/' \
+      -e 's/^WorldBegin$/WorldBegin\n  Attribute "light" "shadows" ["off"]/' \
+      -e 's/Surface "plastic" .*/Surface "matte" "Ka" [1] "Kd" [0.7]/' "$D/asset.rib" >"$D/mesh1m.rib"
+    RIB=$D/mesh1m.rib
+  fi
   leaf=$REF_LEAF
   say "$s: reference (aafarm, boxes of $leaf pixel)"
   run "$s.ref" "$D/ref.log" "$BIN/peers_aafarm" "$RIB" "$D/ref.png" --leaf "$leaf"
