@@ -49,6 +49,16 @@ static bool check_vertices(const geom_surface *s, char *err, size_t errsz)
     return true;
 }
 
+/* v3_length(p - q) <= same, its root taken only when the squared length
+ * is not clearly over (far: 4 same^2, a margin far beyond the roundings
+ * of both, an underflowing same^2 included; NaN takes the root) */
+static bool within(vec3 p, vec3 q, double same, double far)
+{
+    vec3 d = v3_sub(p, q);
+    double d2 = v3_dot(d, d);
+    return d2 > far ? false : sqrt(d2) <= same;
+}
+
 /* Drops repeated consecutive vertices (and a last one equal to the first). */
 static bool distinct_vertices(const geom_surface *s, poly_work *w, char *err, size_t errsz)
 {
@@ -62,13 +72,13 @@ static bool distinct_vertices(const geom_surface *s, poly_work *w, char *err, si
     w->size = geom_max(ext.x, geom_max(ext.y, ext.z));
     if (!isfinite(w->size))
         return err_set(err, errsz, "polygon vertices are too large");
-    double same = 1e-12 * w->size;
+    double same = 1e-12 * w->size, far = 4 * same * same;
     w->n = 0;
     for (int i = 0; i < s->nverts; i++) {
         vec3 p = s->verts[i];
-        if (w->n > 0 && v3_length(v3_sub(p, w->p[w->n - 1])) <= same)
+        if (w->n > 0 && within(p, w->p[w->n - 1], same, far))
             continue;
-        if (i == s->nverts - 1 && w->n > 0 && v3_length(v3_sub(p, w->p[0])) <= same)
+        if (i == s->nverts - 1 && w->n > 0 && within(p, w->p[0], same, far))
             continue;
         w->index[w->n] = i;
         w->p[w->n++] = p;
@@ -124,7 +134,7 @@ static vec3 best_axis(const poly_work *w, vec3 nrm, vec3 c, double ext[4])
     for (int i = 0; i < w->n; i++) {
         vec3 e = v3_sub(w->p[(i + 1) % w->n], w->p[i]);
         e = v3_normalize(v3_sub(e, v3_scale(nrm, v3_dot(nrm, e))));
-        if (v3_length(e) == 0)
+        if (v3_dot(e, e) == 0)          /* v3_length(e) == 0, without the root */
             continue;
         double a0, a1, b0, b1;
         extents(w, c, e, v3_cross(nrm, e), &a0, &a1, &b0, &b1);
@@ -199,7 +209,7 @@ static ia_interval point_product(double a, double b)
     return geom_point_product(a, b, &r) ? r : ia_mul(ia_point(a), ia_point(b));
 }
 
-/* The plane basis, the vertices' (u,v) and the edge lines. */
+/* The plane basis and the vertices' (u,v). */
 static void plane_basis(geom_surface *s, const poly_work *w, vec3 nrm, vec3 c)
 {
     double ext[4] = {0, 0, 0, 0};
@@ -215,6 +225,11 @@ static void plane_basis(geom_surface *s, const poly_work *w, vec3 nrm, vec3 c)
         s->uv[i][0] = (v3_dot(r, e1) - a0) / (a1 - a0);
         s->uv[i][1] = (v3_dot(r, e2) - b0) / (b1 - b0);
     }
+}
+
+/* The edge lines and the enclosures of Ng, from the basis. */
+static void plane_rest(geom_surface *s)
+{
     edge_lines(s);
     double au[3] = {s->axis_u.x, s->axis_u.y, s->axis_u.z};
     double av[3] = {s->axis_v.x, s->axis_v.y, s->axis_v.z};
@@ -224,20 +239,42 @@ static void plane_basis(geom_surface *s, const poly_work *w, vec3 nrm, vec3 c)
     }
 }
 
+/* The distinct vertices, the unit normal and the centroid of polygon s */
+static bool plane_of(const geom_surface *s, poly_work *w, vec3 *nrm, vec3 *c, char *err,
+                     size_t errsz)
+{
+    if (!check_vertices(s, err, errsz) || !distinct_vertices(s, w, err, errsz))
+        return false;
+    vec3 nn = newell_normal(w);
+    double len = v3_length(nn);
+    if (!(len > 1e-12 * w->size * w->size))
+        return err_set(err, errsz, "polygon has no area: its vertices lie on one line");
+    *nrm = v3_scale(nn, 1.0 / len);
+    *c = centroid(w);
+    return true;
+}
+
 bool geom_polygon_prepare(geom_surface *s, char *err, size_t errsz)
 {
     poly_work w;
-    if (!check_vertices(s, err, errsz) || !distinct_vertices(s, &w, err, errsz))
-        return false;
-    vec3 nn = newell_normal(&w);
-    double len = v3_length(nn);
-    if (!(len > 1e-12 * w.size * w.size))
-        return err_set(err, errsz, "polygon has no area: its vertices lie on one line");
-    vec3 nrm = v3_scale(nn, 1.0 / len), c = centroid(&w);
-    if (!check_planar(&w, nrm, c, err, errsz))
+    vec3 nrm, c;
+    if (!plane_of(s, &w, &nrm, &c, err, errsz) || !check_planar(&w, nrm, c, err, errsz))
         return false;
     plane_basis(s, &w, nrm, c);
+    plane_rest(s);
     return check_convex(s, &w, err, errsz) && geom_vertex_normal_prepare(s, err, errsz);
+}
+
+bool geom_polygon_basis(geom_surface *s, char *err, size_t errsz)
+{
+    poly_work w;
+    vec3 nrm, c;
+    if (s->kind != GEOM_POLYGON)
+        return err_set(err, errsz, "geom_polygon_basis: not a polygon");
+    if (!plane_of(s, &w, &nrm, &c, err, errsz))
+        return false;
+    plane_basis(s, &w, nrm, c);
+    return true;
 }
 
 /* ---------------------------------------------------------------------- */
@@ -286,11 +323,16 @@ bool geom_uv_beyond(const geom_surface *s, double u, double v, uint64_t edges)
     return false;
 }
 
+vec3 geom_polygon_corner(const geom_surface *s, int i)
+{
+    const double *p = s->uv[i];
+    return v3_add(s->origin, v3_add(v3_scale(s->axis_u, p[0]), v3_scale(s->axis_v, p[1])));
+}
+
 void geom_polygon_edge(const geom_surface *s, int i, vec3 *a, vec3 *b)
 {
-    const double *p = s->uv[i], *q = s->uv[(i + 1) % s->nuv];
-    *a = v3_add(s->origin, v3_add(v3_scale(s->axis_u, p[0]), v3_scale(s->axis_v, p[1])));
-    *b = v3_add(s->origin, v3_add(v3_scale(s->axis_u, q[0]), v3_scale(s->axis_v, q[1])));
+    *a = geom_polygon_corner(s, i);
+    *b = geom_polygon_corner(s, (i + 1) % s->nuv);
 }
 
 geom_cover geom_uv_box_cover(const geom_surface *s, double u0, double u1,

@@ -326,11 +326,13 @@ static bool sah_split(build_ctx *c, int first, int count, double parent_area, in
 {
     int32_t *idx = c->bvh->idx + first;
     float clo[3] = {INFINITY, INFINITY, INFINITY}, chi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    /* (the centres are finite, and which zero an end of the range is
+     * changes no bin, scale or axis below: compares, not fminf/fmaxf) */
     for (int i = 0; i < count; i++) {
         const float *x = c->centres[idx[i]];
         for (int a = 0; a < 3; a++) {
-            clo[a] = fminf(clo[a], x[a]);
-            chi[a] = fmaxf(chi[a], x[a]);
+            clo[a] = x[a] < clo[a] ? x[a] : clo[a];
+            chi[a] = x[a] > chi[a] ? x[a] : chi[a];
         }
     }
     float scale[3];
@@ -1070,4 +1072,30 @@ size_t trace_mesh_bytes(const trace_mesh *self)
     if (self->bounds) b += n * sizeof *self->bounds;
     b += trace_lazy_roots_bytes(self->lazy);
     return b + trace_float_bvh_bytes(self->bvh, self->npieces);
+}
+
+/* FNV-1a over n bytes, from h */
+static uint64_t digest_bytes(uint64_t h, const void *p, size_t n)
+{
+    const unsigned char *b = p;
+    for (size_t i = 0; i < n; i++) h = (h ^ b[i]) * 0x100000001b3ull;
+    return h;
+}
+
+uint64_t trace_mesh_digest(const trace_mesh *self)
+{
+    uint64_t h = 0xcbf29ce484222325ull;
+    const struct trace_mesh_bvh *t = self->bvh;
+    size_t n = (size_t)self->npieces;
+    if (t) {
+        h = digest_bytes(h, &t->nnodes, sizeof t->nnodes);
+        h = digest_bytes(h, t->nodes, sizeof *t->nodes * (size_t)t->nnodes);
+        h = digest_bytes(h, t->idx, sizeof *t->idx * n);
+        h = digest_bytes(h, t->q, sizeof *t->q * n);
+    }
+    for (int k = 0; k < self->npieces; k++) {
+        uint64_t e = trace_mesh_shared_edges(self, k);
+        h = digest_bytes(h, &e, sizeof e);
+    }
+    return h;
 }
