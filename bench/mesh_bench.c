@@ -14,8 +14,10 @@
  * and, beyond them, the pieces, their shared edges, a subdivision mesh's
  * own tables (geom/subdiv.h: its control faces, point -> corners and a
  * byte per refined face) and the BVH (its part printed apart: the issue's budgets
- * are 64 bytes a face before any box and 32 of BVH), per face. Never
- * fails on timing.
+ * are 64 bytes a face before any box and 32 of BVH), per face; and a
+ * digest of the meshes' worlds (their BVHs and shared edges,
+ * trace_mesh_digest: equal between builds that make the same world, to
+ * hold a change to main's bits). Never fails on timing.
  *
  *   mesh_bench [max_faces [subdiv|displaced]]
  *                                     (default 100000; 1000000 and

@@ -115,6 +115,13 @@ bool geom_surface_prepare(geom_surface *s, char *err, size_t errsz);
  * distinct finite vertices or no area. */
 bool geom_polygon_basis(geom_surface *s, char *err, size_t errsz);
 
+/* Whether geom_surface_prepare accepts polygon s, which has no corner
+ * normals (nvn = 0), and the same message when not; with its basis,
+ * (u,v) and edge lines as the prepare makes them, but not the enclosures
+ * of Ng (s->consts), which a mesh's parse never reads (rib_mesh.c): s is
+ * not prepared for evaluation. */
+bool geom_polygon_check(geom_surface *s, char *err, size_t errsz);
+
 const char *geom_kind_name(geom_kind kind);    /* "sphere", "disk", ... */
 
 void geom_eval(const geom_surface *s, double u, double v, geom_sample *out);

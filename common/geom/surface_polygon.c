@@ -109,15 +109,15 @@ static vec3 centroid(const poly_work *w)
     return v3_scale(c, 1.0 / w->n);
 }
 
-/* Extents of the vertices along e1 and e2 (relative to c). */
-static void extents(const poly_work *w, vec3 c, vec3 e1, vec3 e2, double *a0,
-                    double *a1, double *b0, double *b1)
+/* Extents along e1 and e2 of the vertices' offsets r[0..n) from the
+ * centroid. */
+static void extents(const vec3 *r, int n, vec3 e1, vec3 e2, double *a0, double *a1, double *b0,
+                    double *b1)
 {
     *a0 = *b0 = INFINITY;
     *a1 = *b1 = -INFINITY;
-    for (int i = 0; i < w->n; i++) {
-        vec3 r = v3_sub(w->p[i], c);
-        double a = v3_dot(r, e1), b = v3_dot(r, e2);
+    for (int i = 0; i < n; i++) {
+        double a = v3_dot(r[i], e1), b = v3_dot(r[i], e2);
         *a0 = geom_min(*a0, a); *a1 = geom_max(*a1, a);
         *b0 = geom_min(*b0, b); *b1 = geom_max(*b1, b);
     }
@@ -125,19 +125,25 @@ static void extents(const poly_work *w, vec3 c, vec3 e1, vec3 e2, double *a0,
 
 /* The in-plane direction of the minimum-area bounding rectangle, and the
  * vertices' extents along it and nrm x it (ext: a0 a1 b0 b1; those of the
- * zero direction when no edge has one, as extents() gives them). */
-static vec3 best_axis(const poly_work *w, vec3 nrm, vec3 c, double ext[4])
+ * zero direction when no edge has one, as extents() gives them); r: the
+ * vertices' offsets from the centroid. The edges' directions are made
+ * first, all of them (their roots and divisions independent of one
+ * another, so they overlap), then tried in order. */
+static vec3 best_axis(const poly_work *w, const vec3 *r, vec3 nrm, double ext[4])
 {
-    vec3 best = v3(0, 0, 0);
+    vec3 best = v3(0, 0, 0), dir[GEOM_MAX_POLY_VERTS];
+    for (int i = 0; i < w->n; i++) {
+        vec3 e = v3_sub(w->p[(i + 1) % w->n], w->p[i]);
+        dir[i] = v3_normalize(v3_sub(e, v3_scale(nrm, v3_dot(nrm, e))));
+    }
     double best_area = INFINITY;
     bool found = false;
     for (int i = 0; i < w->n; i++) {
-        vec3 e = v3_sub(w->p[(i + 1) % w->n], w->p[i]);
-        e = v3_normalize(v3_sub(e, v3_scale(nrm, v3_dot(nrm, e))));
+        vec3 e = dir[i];
         if (v3_dot(e, e) == 0)          /* v3_length(e) == 0, without the root */
             continue;
         double a0, a1, b0, b1;
-        extents(w, c, e, v3_cross(nrm, e), &a0, &a1, &b0, &b1);
+        extents(r, w->n, e, v3_cross(nrm, e), &a0, &a1, &b0, &b1);
         double area = (a1 - a0) * (b1 - b0);
         if (area < best_area * (1 - 1e-12)) {
             best_area = area;
@@ -147,7 +153,7 @@ static vec3 best_axis(const poly_work *w, vec3 nrm, vec3 c, double ext[4])
         }
     }
     if (!found)
-        extents(w, c, best, v3_cross(nrm, best), &ext[0], &ext[1], &ext[2], &ext[3]);
+        extents(r, w->n, best, v3_cross(nrm, best), &ext[0], &ext[1], &ext[2], &ext[3]);
     return best;
 }
 
@@ -213,7 +219,9 @@ static ia_interval point_product(double a, double b)
 static void plane_basis(geom_surface *s, const poly_work *w, vec3 nrm, vec3 c)
 {
     double ext[4] = {0, 0, 0, 0};
-    vec3 e1 = best_axis(w, nrm, c, ext), e2 = v3_cross(nrm, e1);
+    vec3 r[GEOM_MAX_POLY_VERTS];
+    for (int i = 0; i < w->n; i++) r[i] = v3_sub(w->p[i], c);
+    vec3 e1 = best_axis(w, r, nrm, ext), e2 = v3_cross(nrm, e1);
     double a0 = ext[0], a1 = ext[1], b0 = ext[2], b1 = ext[3];
     s->normal = nrm;
     s->origin = v3_add(c, v3_add(v3_scale(e1, a0), v3_scale(e2, b0)));
@@ -221,16 +229,14 @@ static void plane_basis(geom_surface *s, const poly_work *w, vec3 nrm, vec3 c)
     s->axis_v = v3_scale(e2, b1 - b0);
     s->nuv = w->n;
     for (int i = 0; i < w->n; i++) {
-        vec3 r = v3_sub(w->p[i], c);
-        s->uv[i][0] = (v3_dot(r, e1) - a0) / (a1 - a0);
-        s->uv[i][1] = (v3_dot(r, e2) - b0) / (b1 - b0);
+        s->uv[i][0] = (v3_dot(r[i], e1) - a0) / (a1 - a0);
+        s->uv[i][1] = (v3_dot(r[i], e2) - b0) / (b1 - b0);
     }
 }
 
-/* The edge lines and the enclosures of Ng, from the basis. */
-static void plane_rest(geom_surface *s)
+/* The enclosures of Ng, from the basis. */
+static void ng_consts(geom_surface *s)
 {
-    edge_lines(s);
     double au[3] = {s->axis_u.x, s->axis_u.y, s->axis_u.z};
     double av[3] = {s->axis_v.x, s->axis_v.y, s->axis_v.z};
     for (int k = 0; k < 3; k++) {
@@ -254,15 +260,31 @@ static bool plane_of(const geom_surface *s, poly_work *w, vec3 *nrm, vec3 *c, ch
     return true;
 }
 
-bool geom_polygon_prepare(geom_surface *s, char *err, size_t errsz)
+/* geom_polygon_prepare but the enclosures of Ng and the corner normals */
+static bool polygon_checked(geom_surface *s, char *err, size_t errsz)
 {
     poly_work w;
     vec3 nrm, c;
     if (!plane_of(s, &w, &nrm, &c, err, errsz) || !check_planar(&w, nrm, c, err, errsz))
         return false;
     plane_basis(s, &w, nrm, c);
-    plane_rest(s);
-    return check_convex(s, &w, err, errsz) && geom_vertex_normal_prepare(s, err, errsz);
+    edge_lines(s);
+    return check_convex(s, &w, err, errsz);
+}
+
+bool geom_polygon_prepare(geom_surface *s, char *err, size_t errsz)
+{
+    if (!polygon_checked(s, err, errsz))
+        return false;
+    ng_consts(s);
+    return geom_vertex_normal_prepare(s, err, errsz);
+}
+
+bool geom_polygon_check(geom_surface *s, char *err, size_t errsz)
+{
+    if (s->kind != GEOM_POLYGON || s->nvn != 0)
+        return err_set(err, errsz, "geom_polygon_check: not a polygon without corner normals");
+    return polygon_checked(s, err, errsz);
 }
 
 bool geom_polygon_basis(geom_surface *s, char *err, size_t errsz)

@@ -526,6 +526,9 @@ static void *build_tasks(void *arg)
                                      .nnodes = 1, .idx = c->bvh->idx};
         build_ctx lc = {c->bounds, c->centres, &sub, NULL, 0, 0};
         build_node(&lc, 0, k->first, k->count, k->depth, k->box);
+        /* its leaves' boxes on their grids (its own slots of q) */
+        for (int j = 0; j < sub.nnodes; j++)
+            if (sub.nodes[j].n > 0) quantize_leaf(c->bvh, &sub.nodes[j], c->bounds);
         k->nodes = sub.nodes;
         k->nnodes = sub.nnodes;
     }
@@ -563,6 +566,7 @@ struct trace_mesh_bvh *trace_float_bvh_build(const float (*bounds)[6], int n, in
     for (int i = 0; i < n; i++) t->idx[i] = i;
     /* a binary tree with leaves of >= 1 piece: at most 2n - 1 nodes */
     t->nodes = xmalloc(sizeof *t->nodes * (size_t)(2 * n > 0 ? 2 * n : 1));
+    t->q = xmalloc(sizeof *t->q * (size_t)(n > 0 ? n : 1));
     build_ctx c = {bounds, xmalloc(sizeof *c.centres * (size_t)(n > 0 ? n : 1)), t, NULL, 0, 0};
     for (int i = 0; i < n; i++)
         for (int a = 0; a < 3; a++) c.centres[i][a] = (float)centre(bounds[i], a);
@@ -573,6 +577,7 @@ struct trace_mesh_bvh *trace_float_bvh_build(const float (*bounds)[6], int n, in
         c.tasks = xmalloc(sizeof *c.tasks * (size_t)c.cap);
         t->nnodes = 1;
         build_node(&c, 0, 0, n, 0, NULL);
+        int top = t->nnodes;           /* the top's nodes; the tasks' join after */
         if (threads > c.ntasks) threads = c.ntasks;
         if (threads < 1) threads = 1;
         task_share *share = xmalloc(sizeof *share * (size_t)threads);
@@ -581,12 +586,13 @@ struct trace_mesh_bvh *trace_float_bvh_build(const float (*bounds)[6], int n, in
         free(share);
         join_tasks(&c);
         free(c.tasks);
+        /* the top's leaves on their grids (the tasks' are: build_tasks;
+         * a task's root, in the top's place, is never a leaf) */
+        for (int i = 0; i < top; i++)
+            if (t->nodes[i].n > 0) quantize_leaf(t, &t->nodes[i], bounds);
     }
     free(c.centres);
     t->nodes = xreallocarray(t->nodes, (size_t)(t->nnodes > 0 ? t->nnodes : 1), sizeof *t->nodes);
-    t->q = xmalloc(sizeof *t->q * (size_t)(n > 0 ? n : 1));
-    for (int i = 0; i < t->nnodes; i++)
-        if (t->nodes[i].n > 0) quantize_leaf(t, &t->nodes[i], bounds);
     return t;
 }
 
