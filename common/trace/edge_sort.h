@@ -17,9 +17,15 @@ typedef struct trace_edge {
     uint64_t h, ref;
 } trace_edge;
 
-/* Sorts e[0..n) by h, then by ref: the order of qsort with that
- * comparison, over `threads` threads (< 1: one). A list of 4096 or more
- * must come in increasing ref (world.c makes it so; asserted). */
+/* The list made of parts[0..nparts) one after another (lens[p] edges
+ * each), sorted by h, then by ref: the order of qsort with that comparison,
+ * over `threads` threads (< 1: one), into a new array (the caller frees
+ * it; the parts are left as they are). A list of 4096 or more must come in
+ * increasing ref (world.c makes it so; asserted). */
+trace_edge *trace_edges_sort_parts(trace_edge *const *parts, const size_t *lens, int nparts,
+                                   int threads);
+
+/* The same for one list e[0..n), in place. */
 void trace_edges_sort(trace_edge *e, size_t n, int threads);
 
 #endif

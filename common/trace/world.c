@@ -191,12 +191,31 @@ static uint64_t transform_hash(const mat4 *to_camera)
     return mix_doubles(0x243f6a8885a308d3ull, &to_camera->m[0][0], 16);
 }
 
+/* memcmp(x, y, 24) < 0 for three doubles each, without the call: bytes
+ * compare in memory order, so each double's bits read big-endian are
+ * compared as unsigned numbers, the first that differ deciding */
+static bool bytes_below(const double x[3], const double y[3])
+{
+    for (int i = 0; i < 3; i++) {
+        uint64_t a, b;
+        memcpy(&a, &x[i], sizeof a);
+        memcpy(&b, &y[i], sizeof b);
+#if __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
+        a = __builtin_bswap64(a);
+        b = __builtin_bswap64(b);
+#endif
+        if (a != b) return a < b;
+    }
+    return false;
+}
+
 /* The hash of the edge from RIB vertex a to RIB vertex b (either way
- * round: the lower first) under the transform of hash h0 */
+ * round: the lower first, as memcmp orders their bytes) under the
+ * transform of hash h0 */
 static uint64_t edge_hash(uint64_t h0, vec3 a, vec3 b)
 {
     double pa[3] = {a.x, a.y, a.z}, pb[3] = {b.x, b.y, b.z}, key[6];
-    bool swap = memcmp(pb, pa, sizeof pa) < 0;
+    bool swap = bytes_below(pb, pa);
     memcpy(key, swap ? pb : pa, sizeof pa);
     memcpy(key + 3, swap ? pa : pb, sizeof pa);
     return mix_doubles(h0, key, 6);
@@ -273,11 +292,30 @@ static void *mesh_edges(void *arg)
     return NULL;
 }
 
+/* The edges' lists, in ref order one after another (the world's parts
+ * of the list it sorts: edge_sort.h), each owned */
+typedef struct edge_parts {
+    world_edge **part;
+    size_t *len;
+    int n, cap;
+} edge_parts;
+
+static void push_part(edge_parts *p, world_edge *e, size_t n)
+{
+    if (p->n == p->cap) {
+        p->cap = p->cap ? 2 * p->cap : 8;
+        p->part = xreallocarray(p->part, (size_t)p->cap, sizeof *p->part);
+        p->len = xreallocarray(p->len, (size_t)p->cap, sizeof *p->len);
+    }
+    p->part[p->n] = e;
+    p->len[p->n++] = n;
+}
+
 /* The pass over mesh object obj's pieces, over the world's build threads:
- * each share's edges are appended to *e in piece order, so the list (and
+ * each share's edges a part of *parts, in piece order, so the list (and
  * everything after it) is the one a single thread makes. */
 static void mesh_edges_in_parallel(const trace_world *world, const trace_object *obj,
-                                   world_edge **e, size_t *n, size_t *cap)
+                                   edge_parts *parts)
 {
     int npieces = obj->mesh->npieces;
     int threads = world->options.build_threads;
@@ -293,15 +331,7 @@ static void mesh_edges_in_parallel(const trace_world *world, const trace_object 
         share[i].e = xmalloc(sizeof *share[i].e * share[i].cap);
     }
     trace_run_shares(share, sizeof *share, threads, mesh_edges);
-    for (int i = 0; i < threads; i++) {
-        if (*n + share[i].n > *cap) {
-            *cap = *n + share[i].n;
-            *e = xreallocarray(*e, *cap, sizeof **e);
-        }
-        memcpy(*e + *n, share[i].e, sizeof **e * share[i].n);
-        *n += share[i].n;
-        free(share[i].e);
-    }
+    for (int i = 0; i < threads; i++) push_part(parts, share[i].e, share[i].n);
     free(share);
 }
 
@@ -327,8 +357,8 @@ static void find_shared_edges(trace_world *world, const int *meshes, int nmeshes
         trace_mesh *m = world->objects[meshes[j]].mesh;
         m->shared_edges = xcalloc((size_t)(m->npieces > 0 ? m->npieces : 1),
                                   sizeof *m->shared_edges);
-        n += 3 * (size_t)m->npieces;               /* an estimate: grown below */
     }
+    /* the plain objects' edges, then each mesh's */
     size_t cap = n > 0 ? n : 1;
     world_edge *e = xmalloc(cap * sizeof *e);
     n = 0;
@@ -336,13 +366,22 @@ static void find_shared_edges(trace_world *world, const int *meshes, int nmeshes
         if (!world->objects[i].mesh && !world->objects[i].group)
             add_edges(&e, &n, &cap, &world->objects[i].surf,
                       transform_hash(&world->objects[i].to_camera), i);
+    edge_parts parts = {0};
+    push_part(&parts, e, n);
     for (int j = 0; j < nmeshes; j++) {
         trace_object *obj = &world->objects[meshes[j]];
         trace_mesh *m = obj->mesh;
         m->bounds = xmalloc(sizeof *m->bounds * (size_t)(m->npieces > 0 ? m->npieces : 1));
-        mesh_edges_in_parallel(world, obj, &e, &n, &cap);
+        mesh_edges_in_parallel(world, obj, &parts);
     }
-    trace_edges_sort(e, n, world->options.build_threads);
+    e = trace_edges_sort_parts(parts.part, parts.len, parts.n, world->options.build_threads);
+    n = 0;
+    for (int p = 0; p < parts.n; p++) {
+        n += parts.len[p];
+        free(parts.part[p]);
+    }
+    free(parts.part);
+    free(parts.len);
     for (size_t i = 0; i + 1 < n; i++) {
         size_t j = i + 1;
         if (e[i].h != e[j].h || e[i].ref / 64 == e[j].ref / 64) continue;

@@ -2,7 +2,9 @@
  * test_trace_edge_sort.c: the sort of the world's polygon edges
  * (trace/edge_sort.h) gives the order of one qsort by (hash, ref) for any
  * thread count: lists short (the qsort) and long (buckets by the hashes'
- * top bits, a radix sort in each), hashes random, drawn from a few values
+ * top bits, a radix sort in each), whole or in parts (the world's
+ * threads' lists, 70 of them more than are dealt at once), hashes random,
+ * drawn from a few values
  * (groups of equal hashes, whose refs must stay in order: the shared
  * edges are found between neighbours), and all in one bucket or sharing
  * their low bits (the radix's digits, each of them, must count).
@@ -83,6 +85,26 @@ static void test_sorts_as_qsort(void **state)
                              (unsigned long long)got[i].h, (unsigned long long)got[i].ref,
                              (unsigned long long)want[i].h, (unsigned long long)want[i].ref);
                 }
+                lists++;
+            }
+            /* the list in parts (some empty; more than the deal takes at
+             * once: 64), as the world hands its threads' lists over */
+            static const int nparts[] = {1, 2, 7, 70};
+            for (size_t q = 0; q < sizeof nparts / sizeof nparts[0]; q++) {
+                trace_edge *parts[70];
+                size_t lens[70], at = 0;
+                for (int i = 0; i < nparts[q]; i++) {
+                    size_t end = i + 1 == nparts[q] ? n : at + (i % 3 == 1 ? 0 : next() % (n / 8 + 1));
+                    if (end > n) end = n;
+                    parts[i] = src + at;
+                    lens[i] = end - at;
+                    at = end;
+                }
+                trace_edge *out = trace_edges_sort_parts(parts, lens, nparts[q], 1 + (int)q);
+                if (n > 0 && memcmp(out, want, sizeof *out * n) != 0)
+                    fail_msg("%zu edges (kind %d) in %d parts: not qsort's order", n, k,
+                             nparts[q]);
+                free(out);
                 lists++;
             }
         }
