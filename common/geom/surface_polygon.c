@@ -111,8 +111,8 @@ static vec3 centroid(const poly_work *w)
 
 /* Extents along e1 and e2 of the vertices' offsets r[0..n) from the
  * centroid. */
-static inline void extents(const vec3 *r, int n, vec3 e1, vec3 e2, double *a0, double *a1, double *b0,
-                           double *b1)
+static inline void extents(const vec3 *r, int n, vec3 e1, vec3 e2, double *a0, double *a1,
+                           double *b0, double *b1)
 {
     *a0 = *b0 = INFINITY;
     *a1 = *b1 = -INFINITY;

@@ -68,7 +68,8 @@ static void *deal_parts(void *arg)
     int shift = 64 - s->top;
     for (int p = sh->t; p < s->nparts; p += s->threads) {
         size_t *at = s->count + ((size_t)p << s->top);
-        for (size_t i = 0; i < s->len[p]; i++) s->out[at[s->part[p][i].h >> shift]++] = s->part[p][i];
+        const trace_edge *e = s->part[p];
+        for (size_t i = 0; i < s->len[p]; i++) s->out[at[e[i].h >> shift]++] = e[i];
     }
     return NULL;
 }

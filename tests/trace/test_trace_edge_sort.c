@@ -94,7 +94,8 @@ static void test_sorts_as_qsort(void **state)
                 trace_edge *parts[70];
                 size_t lens[70], at = 0;
                 for (int i = 0; i < nparts[q]; i++) {
-                    size_t end = i + 1 == nparts[q] ? n : at + (i % 3 == 1 ? 0 : next() % (n / 8 + 1));
+                    size_t step = i % 3 == 1 ? 0 : next() % (n / 8 + 1);
+                    size_t end = i + 1 == nparts[q] ? n : at + step;
                     if (end > n) end = n;
                     parts[i] = src + at;
                     lens[i] = end - at;

@@ -168,11 +168,11 @@ static void test_build_is_a_function_of_the_boxes(void **state)
 static void test_float_rounding(void **state)
 {
     (void)state;
-    static const double special[] = {0.0, -0.0, 1.0, -1.0, FLT_MAX, -FLT_MAX, 0x1p-149, -0x1p-149,
-                                     0x1p-150, -0x1p-150, 0x1p-160, -0x1p-160, 0x1p-126,
-                                     (double)FLT_MAX * (1 + 0x1p-30), -(double)FLT_MAX * (1 + 0x1p-30),
-                                     1e300, -1e300, INFINITY, -INFINITY, NAN, 1.0 + 0x1p-40,
-                                     -1.0 - 0x1p-40};
+    static const double special[] = {
+        0.0, -0.0, 1.0, -1.0, FLT_MAX, -FLT_MAX, 0x1p-149, -0x1p-149, 0x1p-150, -0x1p-150,
+        0x1p-160, -0x1p-160, 0x1p-126, (double)FLT_MAX * (1 + 0x1p-30),
+        -(double)FLT_MAX * (1 + 0x1p-30), 1e300, -1e300, INFINITY, -INFINITY, NAN,
+        1.0 + 0x1p-40, -1.0 - 0x1p-40};
     int n = 0;
     for (int k = 0; k < 400000; k++) {
         double x;
