@@ -14,8 +14,10 @@
  * and, beyond them, the pieces, their shared edges, a subdivision mesh's
  * own tables (geom/subdiv.h: its control faces, point -> corners and a
  * byte per refined face) and the BVH (its part printed apart: the issue's budgets
- * are 64 bytes a face before any box and 32 of BVH), per face. Never
- * fails on timing.
+ * are 64 bytes a face before any box and 32 of BVH), per face; and a
+ * digest of the meshes' worlds (their BVHs and shared edges,
+ * trace_mesh_digest: equal between builds that make the same world, to
+ * hold a change to main's bits). Never fails on timing.
  *
  *   mesh_bench [max_faces [subdiv|displaced]]
  *                                     (default 100000; 1000000 and
@@ -204,10 +206,15 @@ int main(int argc, char **argv)
             bvh += trace_float_bvh_bytes(tm->bvh, tm->npieces);
         }
         int f = nu * nv;
+        uint64_t digest = 0;
+        for (int i = 0; i < js->world.nobjects; i++)
+            if (js->world.objects[i].mesh)
+                digest ^= trace_mesh_digest(js->world.objects[i].mesh);
         printf("%9d %8.3f %8.3f %13.3f %8.3f %8d %9ld %12.1f %12.1f %9.1f %9ld   (%ld of 16384 "
-               "pixels)\n",
+               "pixels; world %016llx)\n",
                f, parse, world - parse, world, render, nobj, pieces, (double)shared / f,
-               (double)beyond / f, (double)bvh / f, peak_mib(), hits);
+               (double)beyond / f, (double)bvh / f, peak_mib(), hits,
+               (unsigned long long)digest);
         if (displaced) {
             printf("%9s root boxes: %ld made with the world, %ld after the render; the world "
                    "built again with all %ld first (eager): %.3f s wall\n", "", known_built,

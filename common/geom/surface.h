@@ -106,6 +106,22 @@ typedef struct geom_sample {
  * one-line reason ("sphere radius must be > 0, got -1") into err. */
 bool geom_surface_prepare(geom_surface *s, char *err, size_t errsz);
 
+/* A polygon's plane basis alone (a mesh's pass over its pieces' bounds
+ * and edges, trace/world.c): origin, axis_u, axis_v, normal, nuv and uv,
+ * the same bits geom_surface_prepare gives them; nothing else is derived
+ * (no edge lines, no enclosures, no corner normals) and the polygon is
+ * not checked for planarity or convexity: for a polygon that
+ * geom_surface_prepare has accepted. False (err) when it has fewer than 3
+ * distinct finite vertices or no area. */
+bool geom_polygon_basis(geom_surface *s, char *err, size_t errsz);
+
+/* Whether geom_surface_prepare accepts polygon s, which has no corner
+ * normals (nvn = 0), and the same message when not; with its basis,
+ * (u,v) and edge lines as the prepare makes them, but not the enclosures
+ * of Ng (s->consts), which a mesh's parse never reads (rib_mesh.c): s is
+ * not prepared for evaluation. */
+bool geom_polygon_check(geom_surface *s, char *err, size_t errsz);
+
 const char *geom_kind_name(geom_kind kind);    /* "sphere", "disk", ... */
 
 void geom_eval(const geom_surface *s, double u, double v, geom_sample *out);
@@ -177,8 +193,11 @@ bool geom_uv_box_clear_of(const geom_surface *s, double u0, double u1, double v0
  * by more than the rounding margin (outside the polygon across it); other
  * kinds: false. */
 bool geom_uv_beyond(const geom_surface *s, double u, double v, uint64_t edges);
-/* Polygons: the object-space end points of edge i. */
+/* Polygons: the object-space end points of edge i (corners i and i + 1,
+ * after the last the first). */
 void geom_polygon_edge(const geom_surface *s, int i, vec3 *a, vec3 *b);
+/* Polygons: the object-space point of corner i, at uv[i] (0 <= i < nuv). */
+vec3 geom_polygon_corner(const geom_surface *s, int i);
 
 /* Object-space bounds of the undisplaced surface (conservative). */
 void geom_bounds(const geom_surface *s, vec3 *lo, vec3 *hi);

@@ -49,6 +49,16 @@ static bool check_vertices(const geom_surface *s, char *err, size_t errsz)
     return true;
 }
 
+/* v3_length(p - q) <= same, its root taken only when the squared length
+ * is not clearly over (far: 4 same^2, a margin far beyond the roundings
+ * of both, an underflowing same^2 included; NaN takes the root) */
+static bool within(vec3 p, vec3 q, double same, double far)
+{
+    vec3 d = v3_sub(p, q);
+    double d2 = v3_dot(d, d);
+    return d2 > far ? false : sqrt(d2) <= same;
+}
+
 /* Drops repeated consecutive vertices (and a last one equal to the first). */
 static bool distinct_vertices(const geom_surface *s, poly_work *w, char *err, size_t errsz)
 {
@@ -62,13 +72,13 @@ static bool distinct_vertices(const geom_surface *s, poly_work *w, char *err, si
     w->size = geom_max(ext.x, geom_max(ext.y, ext.z));
     if (!isfinite(w->size))
         return err_set(err, errsz, "polygon vertices are too large");
-    double same = 1e-12 * w->size;
+    double same = 1e-12 * w->size, far = 4 * same * same;
     w->n = 0;
     for (int i = 0; i < s->nverts; i++) {
         vec3 p = s->verts[i];
-        if (w->n > 0 && v3_length(v3_sub(p, w->p[w->n - 1])) <= same)
+        if (w->n > 0 && within(p, w->p[w->n - 1], same, far))
             continue;
-        if (i == s->nverts - 1 && w->n > 0 && v3_length(v3_sub(p, w->p[0])) <= same)
+        if (i == s->nverts - 1 && w->n > 0 && within(p, w->p[0], same, far))
             continue;
         w->index[w->n] = i;
         w->p[w->n++] = p;
@@ -99,15 +109,15 @@ static vec3 centroid(const poly_work *w)
     return v3_scale(c, 1.0 / w->n);
 }
 
-/* Extents of the vertices along e1 and e2 (relative to c). */
-static void extents(const poly_work *w, vec3 c, vec3 e1, vec3 e2, double *a0,
-                    double *a1, double *b0, double *b1)
+/* Extents along e1 and e2 of the vertices' offsets r[0..n) from the
+ * centroid. */
+static inline void extents(const vec3 *r, int n, vec3 e1, vec3 e2, double *a0, double *a1,
+                           double *b0, double *b1)
 {
     *a0 = *b0 = INFINITY;
     *a1 = *b1 = -INFINITY;
-    for (int i = 0; i < w->n; i++) {
-        vec3 r = v3_sub(w->p[i], c);
-        double a = v3_dot(r, e1), b = v3_dot(r, e2);
+    for (int i = 0; i < n; i++) {
+        double a = v3_dot(r[i], e1), b = v3_dot(r[i], e2);
         *a0 = geom_min(*a0, a); *a1 = geom_max(*a1, a);
         *b0 = geom_min(*b0, b); *b1 = geom_max(*b1, b);
     }
@@ -115,19 +125,25 @@ static void extents(const poly_work *w, vec3 c, vec3 e1, vec3 e2, double *a0,
 
 /* The in-plane direction of the minimum-area bounding rectangle, and the
  * vertices' extents along it and nrm x it (ext: a0 a1 b0 b1; those of the
- * zero direction when no edge has one, as extents() gives them). */
-static vec3 best_axis(const poly_work *w, vec3 nrm, vec3 c, double ext[4])
+ * zero direction when no edge has one, as extents() gives them); r: the
+ * vertices' offsets from the centroid. The edges' directions are made
+ * first, all of them (their roots and divisions independent of one
+ * another, so they overlap), then tried in order. */
+static vec3 best_axis(const poly_work *w, const vec3 *r, vec3 nrm, double ext[4])
 {
-    vec3 best = v3(0, 0, 0);
+    vec3 best = v3(0, 0, 0), dir[GEOM_MAX_POLY_VERTS];
+    for (int i = 0; i < w->n; i++) {
+        vec3 e = v3_sub(w->p[(i + 1) % w->n], w->p[i]);
+        dir[i] = v3_normalize(v3_sub(e, v3_scale(nrm, v3_dot(nrm, e))));
+    }
     double best_area = INFINITY;
     bool found = false;
     for (int i = 0; i < w->n; i++) {
-        vec3 e = v3_sub(w->p[(i + 1) % w->n], w->p[i]);
-        e = v3_normalize(v3_sub(e, v3_scale(nrm, v3_dot(nrm, e))));
-        if (v3_length(e) == 0)
+        vec3 e = dir[i];
+        if (v3_dot(e, e) == 0)          /* v3_length(e) == 0, without the root */
             continue;
         double a0, a1, b0, b1;
-        extents(w, c, e, v3_cross(nrm, e), &a0, &a1, &b0, &b1);
+        extents(r, w->n, e, v3_cross(nrm, e), &a0, &a1, &b0, &b1);
         double area = (a1 - a0) * (b1 - b0);
         if (area < best_area * (1 - 1e-12)) {
             best_area = area;
@@ -137,7 +153,7 @@ static vec3 best_axis(const poly_work *w, vec3 nrm, vec3 c, double ext[4])
         }
     }
     if (!found)
-        extents(w, c, best, v3_cross(nrm, best), &ext[0], &ext[1], &ext[2], &ext[3]);
+        extents(r, w->n, best, v3_cross(nrm, best), &ext[0], &ext[1], &ext[2], &ext[3]);
     return best;
 }
 
@@ -199,11 +215,13 @@ static ia_interval point_product(double a, double b)
     return geom_point_product(a, b, &r) ? r : ia_mul(ia_point(a), ia_point(b));
 }
 
-/* The plane basis, the vertices' (u,v) and the edge lines. */
+/* The plane basis and the vertices' (u,v). */
 static void plane_basis(geom_surface *s, const poly_work *w, vec3 nrm, vec3 c)
 {
     double ext[4] = {0, 0, 0, 0};
-    vec3 e1 = best_axis(w, nrm, c, ext), e2 = v3_cross(nrm, e1);
+    vec3 r[GEOM_MAX_POLY_VERTS];
+    for (int i = 0; i < w->n; i++) r[i] = v3_sub(w->p[i], c);
+    vec3 e1 = best_axis(w, r, nrm, ext), e2 = v3_cross(nrm, e1);
     double a0 = ext[0], a1 = ext[1], b0 = ext[2], b1 = ext[3];
     s->normal = nrm;
     s->origin = v3_add(c, v3_add(v3_scale(e1, a0), v3_scale(e2, b0)));
@@ -211,11 +229,14 @@ static void plane_basis(geom_surface *s, const poly_work *w, vec3 nrm, vec3 c)
     s->axis_v = v3_scale(e2, b1 - b0);
     s->nuv = w->n;
     for (int i = 0; i < w->n; i++) {
-        vec3 r = v3_sub(w->p[i], c);
-        s->uv[i][0] = (v3_dot(r, e1) - a0) / (a1 - a0);
-        s->uv[i][1] = (v3_dot(r, e2) - b0) / (b1 - b0);
+        s->uv[i][0] = (v3_dot(r[i], e1) - a0) / (a1 - a0);
+        s->uv[i][1] = (v3_dot(r[i], e2) - b0) / (b1 - b0);
     }
-    edge_lines(s);
+}
+
+/* The enclosures of Ng, from the basis. */
+static void ng_consts(geom_surface *s)
+{
     double au[3] = {s->axis_u.x, s->axis_u.y, s->axis_u.z};
     double av[3] = {s->axis_v.x, s->axis_v.y, s->axis_v.z};
     for (int k = 0; k < 3; k++) {
@@ -224,20 +245,58 @@ static void plane_basis(geom_surface *s, const poly_work *w, vec3 nrm, vec3 c)
     }
 }
 
-bool geom_polygon_prepare(geom_surface *s, char *err, size_t errsz)
+/* The distinct vertices, the unit normal and the centroid of polygon s */
+static bool plane_of(const geom_surface *s, poly_work *w, vec3 *nrm, vec3 *c, char *err,
+                     size_t errsz)
+{
+    if (!check_vertices(s, err, errsz) || !distinct_vertices(s, w, err, errsz))
+        return false;
+    vec3 nn = newell_normal(w);
+    double len = v3_length(nn);
+    if (!(len > 1e-12 * w->size * w->size))
+        return err_set(err, errsz, "polygon has no area: its vertices lie on one line");
+    *nrm = v3_scale(nn, 1.0 / len);
+    *c = centroid(w);
+    return true;
+}
+
+/* geom_polygon_prepare but the enclosures of Ng and the corner normals */
+static bool polygon_checked(geom_surface *s, char *err, size_t errsz)
 {
     poly_work w;
-    if (!check_vertices(s, err, errsz) || !distinct_vertices(s, &w, err, errsz))
-        return false;
-    vec3 nn = newell_normal(&w);
-    double len = v3_length(nn);
-    if (!(len > 1e-12 * w.size * w.size))
-        return err_set(err, errsz, "polygon has no area: its vertices lie on one line");
-    vec3 nrm = v3_scale(nn, 1.0 / len), c = centroid(&w);
-    if (!check_planar(&w, nrm, c, err, errsz))
+    vec3 nrm, c;
+    if (!plane_of(s, &w, &nrm, &c, err, errsz) || !check_planar(&w, nrm, c, err, errsz))
         return false;
     plane_basis(s, &w, nrm, c);
-    return check_convex(s, &w, err, errsz) && geom_vertex_normal_prepare(s, err, errsz);
+    edge_lines(s);
+    return check_convex(s, &w, err, errsz);
+}
+
+bool geom_polygon_prepare(geom_surface *s, char *err, size_t errsz)
+{
+    if (!polygon_checked(s, err, errsz))
+        return false;
+    ng_consts(s);
+    return geom_vertex_normal_prepare(s, err, errsz);
+}
+
+bool geom_polygon_check(geom_surface *s, char *err, size_t errsz)
+{
+    if (s->kind != GEOM_POLYGON || s->nvn != 0)
+        return err_set(err, errsz, "geom_polygon_check: not a polygon without corner normals");
+    return polygon_checked(s, err, errsz);
+}
+
+bool geom_polygon_basis(geom_surface *s, char *err, size_t errsz)
+{
+    poly_work w;
+    vec3 nrm, c;
+    if (s->kind != GEOM_POLYGON)
+        return err_set(err, errsz, "geom_polygon_basis: not a polygon");
+    if (!plane_of(s, &w, &nrm, &c, err, errsz))
+        return false;
+    plane_basis(s, &w, nrm, c);
+    return true;
 }
 
 /* ---------------------------------------------------------------------- */
@@ -286,11 +345,16 @@ bool geom_uv_beyond(const geom_surface *s, double u, double v, uint64_t edges)
     return false;
 }
 
+vec3 geom_polygon_corner(const geom_surface *s, int i)
+{
+    const double *p = s->uv[i];
+    return v3_add(s->origin, v3_add(v3_scale(s->axis_u, p[0]), v3_scale(s->axis_v, p[1])));
+}
+
 void geom_polygon_edge(const geom_surface *s, int i, vec3 *a, vec3 *b)
 {
-    const double *p = s->uv[i], *q = s->uv[(i + 1) % s->nuv];
-    *a = v3_add(s->origin, v3_add(v3_scale(s->axis_u, p[0]), v3_scale(s->axis_v, p[1])));
-    *b = v3_add(s->origin, v3_add(v3_scale(s->axis_u, q[0]), v3_scale(s->axis_v, q[1])));
+    *a = geom_polygon_corner(s, i);
+    *b = geom_polygon_corner(s, (i + 1) % s->nuv);
 }
 
 geom_cover geom_uv_box_cover(const geom_surface *s, double u0, double u1,

@@ -274,6 +274,12 @@ static bool mesh_piece(const void *user, const trace_object *t, int k, geom_surf
     return true;
 }
 
+/* trace_mesh.outline: piece k's outline (scene_object_piece_outline) */
+static bool mesh_outline(const void *user, int k, geom_surface *s)
+{
+    return scene_object_piece_outline(user, k, s);
+}
+
 /* The instances of a prototype kept as references (trace/group.h): the
  * scene objects they are, whose transforms, spaces, colours and primitive
  * variables their views take. */
@@ -368,6 +374,7 @@ static void build_object(job_scene *self, const scene_object *o, trace_object *t
             m->npieces = scene_mesh_npieces(o->mesh);
             m->nprimvars = scene_mesh_nprimvars(o->mesh);
             m->piece = mesh_piece;
+            m->outline = mesh_outline;
             m->user = o;
         }
         t->mesh = m;

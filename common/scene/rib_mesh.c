@@ -220,6 +220,17 @@ static geom_surface *polygon_surface(const mesh *m, geom_surface *local, int n)
     return s;
 }
 
+#ifdef SCENE_HAVE_GEOM
+/* geom_surface_prepare of a face or piece s; a mesh's (m->out) keeps no
+ * surface and reads only whether it is accepted, its normal and (u,v):
+ * geom_polygon_check, without the enclosures of Ng the prepare adds */
+static bool prepare(const mesh *m, geom_surface *s, char *err, size_t errsz)
+{
+    return m->out && s->nvn == 0 ? geom_polygon_check(s, err, errsz)
+                                 : geom_surface_prepare(s, err, errsz);
+}
+#endif
+
 /* The normal of corner i of the current face (point idx[i]). */
 static vec3 corner_normal(const mesh *m, int face, const int *idx, int i)
 {
@@ -254,11 +265,11 @@ static bool add_triangle(rib_parser *p, const mesh *m, int face, const int *idx,
     }
 #ifdef SCENE_HAVE_GEOM
     char err[ERR_LEN];
-    if (!geom_surface_prepare(s, err, sizeof err)) {
+    if (!prepare(m, s, err, sizeof err)) {
         if (s->nvn == 0)
             return false;
         s->nvn = 0;                 /* normals it cannot interpolate: flat */
-        if (!geom_surface_prepare(s, err, sizeof err))
+        if (!prepare(m, s, err, sizeof err))
             return false;
     }
 #endif
@@ -305,7 +316,7 @@ static bool add_face(rib_parser *p, mesh *m, int face, const int *loop_sizes, in
             s->verts[i] = point(m, idx[i]);
 #ifdef SCENE_HAVE_GEOM
         char err[ERR_LEN];
-        if (geom_surface_prepare(s, err, sizeof err)) {
+        if (prepare(m, s, err, sizeof err)) {
             rib_corner corners[GEOM_MAX_POLY_VERTS];
             for (int i = 0; i < total; i++)
                 corners[i] = corner_of(m, face, idx, i);

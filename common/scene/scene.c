@@ -121,6 +121,17 @@ bool scene_object_piece(const scene_object *object, int k, geom_surface *s,
     return scene_mesh_piece_surface(object->mesh, k, s, vars, nvars);
 }
 
+bool scene_object_piece_outline(const scene_object *object, int k, geom_surface *s)
+{
+    if (!object->mesh) {
+        if (k != 0) return false;
+        *s = *object->surface;
+        return true;
+    }
+    if (k < 0 || k >= scene_mesh_npieces(object->mesh)) return false;
+    return scene_mesh_piece_outline(object->mesh, k, s);
+}
+
 const scene_shader *scene_object_surface(const scene *self, const scene_object *object)
 {
     int i = object->surface_shader;

@@ -366,6 +366,9 @@ void scene_object_transforms(const scene *self, const scene_object *object, mat4
                              mat4 *from_camera);
 bool scene_object_piece(const scene_object *object, int k, geom_surface *s,
                         scene_primvar *vars, int *nvars);
+/* Piece k's outline (scene_mesh_piece_outline; an object of no mesh:
+ * its surface). */
+bool scene_object_piece_outline(const scene_object *object, int k, geom_surface *s);
 
 /* As scene_parse_archives, with at most max_objects objects (more is an
  * error naming the request that passes the limit). */

@@ -367,3 +367,29 @@ bool scene_mesh_piece_surface(const scene_mesh *self, int k, geom_surface *s,
     return true;
 #endif
 }
+
+bool scene_mesh_piece_outline(const scene_mesh *self, int k, geom_surface *s)
+{
+    assert(k >= 0 && k < self->npieces);
+    assert(!self->counted && "a checked scene's mesh has no pieces to make");
+#ifndef SCENE_HAVE_GEOM
+    (void)s;
+    return false;
+#else
+    if (self->sd) {
+        geom_subdiv_surface(self->sd, self->sub_face ? self->sub_face[k] : k, s);
+        return true;
+    }
+    const scene_mesh_piece *pc = &self->pieces[k];
+    s->kind = GEOM_POLYGON;
+    s->nvn = 0;
+    if (pc->kind == SCENE_PIECE_POLYGON) {
+        s->nverts = pc->k[0];
+        for (int i = 0; i < s->nverts; i++) s->verts[i] = point_at(self, self->idx[pc->fv0 + i]);
+    } else {
+        s->nverts = 3;
+        for (int i = 0; i < 3; i++) s->verts[i] = point_at(self, self->idx[pc->fv0 + pc->k[i]]);
+    }
+    return geom_polygon_basis(s, NULL, 0);
+#endif
+}

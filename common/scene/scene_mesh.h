@@ -74,6 +74,14 @@ int scene_mesh_nprimvars(const scene_mesh *self);
 bool scene_mesh_piece_surface(const scene_mesh *self, int k, geom_surface *s,
                               struct scene_primvar *vars, int *nvars);
 
+/* Piece k's outline: for a polygon mesh, its flat polygon's corners and
+ * plane basis alone (geom_polygon_basis: origin, axes, normal, nuv and
+ * uv the same bits as scene_mesh_piece_surface gives them; the rest of s
+ * is not set, kind, nverts, verts and nvn = 0 aside), what its bounds and
+ * shared edges need at a fraction of the cost; for a subdivision mesh, its
+ * surface. False as scene_mesh_piece_surface. */
+bool scene_mesh_piece_outline(const scene_mesh *self, int k, geom_surface *s);
+
 /* The bytes the mesh holds (arrays and pieces), and of them its pieces'
  * records (16 bytes a piece of a polygon mesh, 4 a piece of a subdivision
  * mesh, none when every refined face is drawn), for benchmarks and the

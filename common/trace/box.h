@@ -28,6 +28,9 @@
 #define TRACE_BOX_H
 
 #include <float.h>
+#include <stdbool.h>
+#include <stdint.h>
+#include <string.h>
 #include <math.h>
 #include <stdbool.h>
 
@@ -57,16 +60,30 @@ typedef struct trace_box {
 } trace_box;
 
 /* x as a float rounded down (up): the float boxes of BVHs */
+/* The float after f towards +infinity (up) or -infinity: nextafterf's
+ * number without the call, for an f that is not NaN and not the infinity
+ * it steps towards (floats of one sign are ordered as their bits; from a
+ * zero, the smallest subnormal) */
+static inline float trace_float_step(float f, bool up)
+{
+    if (f == 0.0f) return up ? 0x1p-149f : -0x1p-149f;
+    uint32_t b;
+    memcpy(&b, &f, sizeof b);
+    b += (f > 0.0f) == up ? 1u : ~0u;
+    memcpy(&f, &b, sizeof f);
+    return f;
+}
+
 static inline float trace_float_down(double x)
 {
     float f = (float)x;
-    return (double)f > x ? nextafterf(f, -INFINITY) : f;
+    return (double)f > x ? trace_float_step(f, false) : f;
 }
 
 static inline float trace_float_up(double x)
 {
     float f = (float)x;
-    return (double)f < x ? nextafterf(f, INFINITY) : f;
+    return (double)f < x ? trace_float_step(f, true) : f;
 }
 
 static inline void trace_box_no_slab(trace_box *b)

@@ -295,6 +295,8 @@ static double centre(const float b[6], int axis)
 typedef struct bvh_task {
     int id, first, count, depth;       /* its root's node, its elements, its depth */
     float box[6];                      /* its root's box */
+    float cbox[6];                     /* and its elements' centres' range (lo, hi) */
+    bool has_cbox;
     mesh_node *nodes;                  /* the subtree, its root first */
     int nnodes;
 } bvh_task;
@@ -321,17 +323,30 @@ static int bin_of(float x, float lo, float scale)
 /* the SAH split of idx[first, first + count): the pieces are binned by
  * their centres along the axis where the centres spread most; false when
  * no split beats the leaf */
+/* lo[0..3), hi[0..3) grown to hold point x (finite: compares, not
+ * fminf/fmaxf; which zero an end of a centres' range is changes no bin,
+ * scale or axis in sah_split, so neither does the order of the points) */
+static inline void grow_point(float lo[3], float hi[3], const float x[3])
+{
+    for (int a = 0; a < 3; a++) {
+        lo[a] = x[a] < lo[a] ? x[a] : lo[a];
+        hi[a] = x[a] > hi[a] ? x[a] : hi[a];
+    }
+}
+
+/* cbox: the range of the elements' centres when the parent's split made
+ * it (NULL: made here); lc, rc: the two sides' ranges, made while the
+ * elements are parted (for the children's splits: a pass less each) */
 static bool sah_split(build_ctx *c, int first, int count, double parent_area, int *mid,
-                      float left[6], float right[6])
+                      float left[6], float right[6], const float *cbox, float lc[6], float rc[6])
 {
     int32_t *idx = c->bvh->idx + first;
     float clo[3] = {INFINITY, INFINITY, INFINITY}, chi[3] = {-INFINITY, -INFINITY, -INFINITY};
-    for (int i = 0; i < count; i++) {
-        const float *x = c->centres[idx[i]];
-        for (int a = 0; a < 3; a++) {
-            clo[a] = fminf(clo[a], x[a]);
-            chi[a] = fmaxf(chi[a], x[a]);
-        }
+    if (cbox) {
+        memcpy(clo, cbox, sizeof clo);
+        memcpy(chi, cbox + 3, sizeof chi);
+    } else {
+        for (int i = 0; i < count; i++) grow_point(clo, chi, c->centres[idx[i]]);
     }
     float scale[3];
     sah_bin bins[3][BINS];
@@ -405,11 +420,18 @@ static bool sah_split(build_ctx *c, int first, int count, double parent_area, in
         float *side = b <= best_bin ? left : right;
         grow(side, side + 3, bb);
     }
+    for (int a = 0; a < 3; a++) {
+        lc[a] = rc[a] = INFINITY;
+        lc[3 + a] = rc[3 + a] = -INFINITY;
+    }
     int i = 0, j = count - 1;
     while (i <= j) {
-        if (bin_of(c->centres[idx[i]][best_axis], clo[best_axis], scale[best_axis]) <= best_bin) {
+        const float *x = c->centres[idx[i]];
+        if (bin_of(x[best_axis], clo[best_axis], scale[best_axis]) <= best_bin) {
+            grow_point(lc, lc + 3, x);
             i++;
         } else {
+            grow_point(rc, rc + 3, x);
             int32_t t = idx[i];
             idx[i] = idx[j];
             idx[j--] = t;
@@ -420,8 +442,10 @@ static bool sah_split(build_ctx *c, int first, int count, double parent_area, in
 }
 
 /* Node id over idx[first, first + count); box: its elements' union when
- * the parent's split knew it, else NULL (made here) */
-static void build_node(build_ctx *c, int id, int first, int count, int depth, const float *box)
+ * the parent's split knew it, else NULL (made here); cbox: their centres'
+ * range likewise */
+static void build_node(build_ctx *c, int id, int first, int count, int depth, const float *box,
+                       const float *cbox)
 {
     struct trace_mesh_bvh *t = c->bvh;
     assert(count > 0 && id < t->nnodes);
@@ -443,16 +467,18 @@ static void build_node(build_ctx *c, int id, int first, int count, int depth, co
         if (c->ntasks == c->cap)
             c->tasks = xreallocarray(c->tasks, (size_t)(c->cap *= 2), sizeof *c->tasks);
         bvh_task *k = &c->tasks[c->ntasks++];
-        *k = (bvh_task){.id = id, .first = first, .count = count, .depth = depth};
+        *k = (bvh_task){.id = id, .first = first, .count = count, .depth = depth,
+                        .has_cbox = cbox != NULL};
         memcpy(k->box, n->lo, sizeof n->lo);
         memcpy(k->box + 3, n->hi, sizeof n->hi);
+        if (cbox) memcpy(k->cbox, cbox, sizeof k->cbox);
         return;
     }
     int mid = 0;
     double area = area_of(n->lo, n->hi);
-    float lbox[6], rbox[6];
+    float lbox[6], rbox[6], lc[6], rc[6];
     bool split = depth < SAH_DEPTH && isfinite(area) &&
-                 sah_split(c, first, count, area, &mid, lbox, rbox);
+                 sah_split(c, first, count, area, &mid, lbox, rbox, cbox, lc, rc);
     if (!split) {
         /* no split worth its cost (or too deep, or boxes without end):
          * halves by index, so the depth stays logarithmic */
@@ -463,8 +489,9 @@ static void build_node(build_ctx *c, int id, int first, int count, int depth, co
     n = &t->nodes[id];
     n->a = left;
     n->n = 0;
-    build_node(c, left, first, mid, depth + 1, split ? lbox : NULL);
-    build_node(c, left + 1, first + mid, count - mid, depth + 1, split ? rbox : NULL);
+    build_node(c, left, first, mid, depth + 1, split ? lbox : NULL, split ? lc : NULL);
+    build_node(c, left + 1, first + mid, count - mid, depth + 1, split ? rbox : NULL,
+               split ? rc : NULL);
 }
 
 /* Step q (0..255) of a leaf's grid along an axis from lo over width w
@@ -523,7 +550,10 @@ static void *build_tasks(void *arg)
         struct trace_mesh_bvh sub = {.nodes = xmalloc(sizeof *sub.nodes * (size_t)(2 * k->count)),
                                      .nnodes = 1, .idx = c->bvh->idx};
         build_ctx lc = {c->bounds, c->centres, &sub, NULL, 0, 0};
-        build_node(&lc, 0, k->first, k->count, k->depth, k->box);
+        build_node(&lc, 0, k->first, k->count, k->depth, k->box, k->has_cbox ? k->cbox : NULL);
+        /* its leaves' boxes on their grids (its own slots of q) */
+        for (int j = 0; j < sub.nnodes; j++)
+            if (sub.nodes[j].n > 0) quantize_leaf(c->bvh, &sub.nodes[j], c->bounds);
         k->nodes = sub.nodes;
         k->nnodes = sub.nnodes;
     }
@@ -561,6 +591,7 @@ struct trace_mesh_bvh *trace_float_bvh_build(const float (*bounds)[6], int n, in
     for (int i = 0; i < n; i++) t->idx[i] = i;
     /* a binary tree with leaves of >= 1 piece: at most 2n - 1 nodes */
     t->nodes = xmalloc(sizeof *t->nodes * (size_t)(2 * n > 0 ? 2 * n : 1));
+    t->q = xmalloc(sizeof *t->q * (size_t)(n > 0 ? n : 1));
     build_ctx c = {bounds, xmalloc(sizeof *c.centres * (size_t)(n > 0 ? n : 1)), t, NULL, 0, 0};
     for (int i = 0; i < n; i++)
         for (int a = 0; a < 3; a++) c.centres[i][a] = (float)centre(bounds[i], a);
@@ -570,7 +601,8 @@ struct trace_mesh_bvh *trace_float_bvh_build(const float (*bounds)[6], int n, in
         c.cap = 16;
         c.tasks = xmalloc(sizeof *c.tasks * (size_t)c.cap);
         t->nnodes = 1;
-        build_node(&c, 0, 0, n, 0, NULL);
+        build_node(&c, 0, 0, n, 0, NULL, NULL);
+        int top = t->nnodes;           /* the top's nodes; the tasks' join after */
         if (threads > c.ntasks) threads = c.ntasks;
         if (threads < 1) threads = 1;
         task_share *share = xmalloc(sizeof *share * (size_t)threads);
@@ -579,12 +611,13 @@ struct trace_mesh_bvh *trace_float_bvh_build(const float (*bounds)[6], int n, in
         free(share);
         join_tasks(&c);
         free(c.tasks);
+        /* the top's leaves on their grids (the tasks' are: build_tasks;
+         * a task's root, in the top's place, is never a leaf) */
+        for (int i = 0; i < top; i++)
+            if (t->nodes[i].n > 0) quantize_leaf(t, &t->nodes[i], bounds);
     }
     free(c.centres);
     t->nodes = xreallocarray(t->nodes, (size_t)(t->nnodes > 0 ? t->nnodes : 1), sizeof *t->nodes);
-    t->q = xmalloc(sizeof *t->q * (size_t)(n > 0 ? n : 1));
-    for (int i = 0; i < t->nnodes; i++)
-        if (t->nodes[i].n > 0) quantize_leaf(t, &t->nodes[i], bounds);
     return t;
 }
 
@@ -1070,4 +1103,30 @@ size_t trace_mesh_bytes(const trace_mesh *self)
     if (self->bounds) b += n * sizeof *self->bounds;
     b += trace_lazy_roots_bytes(self->lazy);
     return b + trace_float_bvh_bytes(self->bvh, self->npieces);
+}
+
+/* FNV-1a over n bytes, from h */
+static uint64_t digest_bytes(uint64_t h, const void *p, size_t n)
+{
+    const unsigned char *b = p;
+    for (size_t i = 0; i < n; i++) h = (h ^ b[i]) * 0x100000001b3ull;
+    return h;
+}
+
+uint64_t trace_mesh_digest(const trace_mesh *self)
+{
+    uint64_t h = 0xcbf29ce484222325ull;
+    const struct trace_mesh_bvh *t = self->bvh;
+    size_t n = (size_t)self->npieces;
+    if (t) {
+        h = digest_bytes(h, &t->nnodes, sizeof t->nnodes);
+        h = digest_bytes(h, t->nodes, sizeof *t->nodes * (size_t)t->nnodes);
+        h = digest_bytes(h, t->idx, sizeof *t->idx * n);
+        h = digest_bytes(h, t->q, sizeof *t->q * n);
+    }
+    for (int k = 0; k < self->npieces; k++) {
+        uint64_t e = trace_mesh_shared_edges(self, k);
+        h = digest_bytes(h, &e, sizeof e);
+    }
+    return h;
 }

@@ -143,4 +143,9 @@ void trace_float_box(const trace_box *b, float f[6]);
  * widened by a relative hair for the rounding). */
 void trace_object_camera_bound(const trace_object *obj, const trace_box *b, trace_box *out);
 
+/* A 64-bit digest of what the world derived for mesh m: its BVH (nodes,
+ * order, quantized boxes) and its pieces' shared edges; equal worlds have
+ * equal digests (benchmarks and tests compare builds with it). */
+uint64_t trace_mesh_digest(const trace_mesh *self);
+
 #endif

@@ -7,6 +7,7 @@
  * so every worker derives the same values.
  */
 #include "trace/world.h"
+#include "trace/edge_sort.h"
 #include "trace/group.h"
 #include "trace/mesh.h"
 #include "trace/region.h"
@@ -144,54 +145,14 @@ static bool matrix_finite(const mat4 *m)
     return true;
 }
 
-/* A polygon edge by a 64-bit hash of its exact key: the bits of its RIB
- * vertices (the lower first) and of its object's transform; and where it
+/* A polygon edge by a 64-bit hash of its exact key: the bits of its
+ * object's transform and of its RIB vertices (the lower first); and where it
  * is: its object id (a mesh piece's id for pieces) times 64 plus its
  * index. 16 bytes an edge. Equal keys have equal hashes; two different
  * keys whose hashes agree (about one chance in 10^6 for a scene of 10^6
  * edges) would only turn the hit proofs off near one more edge: the
  * proofs decide nothing the leaves do not. */
-typedef struct world_edge { uint64_t h, ref; } world_edge;
-
-static int world_edge_cmp(const void *x, const void *y)
-{
-    const world_edge *a = x, *b = y;
-    if (a->h != b->h) return a->h < b->h ? -1 : 1;
-    return (a->ref > b->ref) - (a->ref < b->ref);
-}
-
-/* Sorts the edges by hash, and equal hashes by ref: a stable radix sort
- * on the hash (four passes of 16 bits) of a list made in ref order, so
- * the order world_edge_cmp gives, in O(n) (qsort of the 6 million edges of
- * a 1M-quad mesh took a second). */
-static void sort_edges(world_edge *e, size_t n)
-{
-    if (n < 4096) {
-        qsort(e, n, sizeof *e, world_edge_cmp);
-        return;
-    }
-    for (size_t i = 1; i < n; i++) assert(e[i - 1].ref < e[i].ref);
-    world_edge *tmp = xmalloc(sizeof *tmp * n), *src = e, *dst = tmp;
-    size_t *count = xmalloc(sizeof *count * 65536);
-    for (int pass = 0; pass < 4; pass++) {
-        int shift = 16 * pass;
-        memset(count, 0, sizeof *count * 65536);
-        for (size_t i = 0; i < n; i++) count[(src[i].h >> shift) & 0xffff]++;
-        size_t at = 0;
-        for (int d = 0; d < 65536; d++) {
-            size_t c = count[d];
-            count[d] = at;
-            at += c;
-        }
-        for (size_t i = 0; i < n; i++) dst[count[(src[i].h >> shift) & 0xffff]++] = src[i];
-        world_edge *t = src;
-        src = dst;
-        dst = t;
-    }
-    assert(src == e);                  /* an even number of passes */
-    free(count);
-    free(tmp);
-}
+typedef trace_edge world_edge;
 
 /* the RIB vertex of the polygon nearest to p (p is one of them, up to the
  * rounding of its (u,v) round trip) */
@@ -212,24 +173,52 @@ static uint64_t mix(uint64_t h, uint64_t b, uint64_t m)
     return h ^ (h >> 31);
 }
 
-static void edge_hash(const geom_surface *s, const mat4 *to_camera, int k, world_edge *out)
+static uint64_t mix_doubles(uint64_t h, const double *x, int n)
 {
-    vec3 a, b;
-    geom_polygon_edge(s, k, &a, &b);
-    a = rib_vertex(s, a);
-    b = rib_vertex(s, b);
-    double pa[3] = {a.x, a.y, a.z}, pb[3] = {b.x, b.y, b.z}, key[6 + 16];
-    bool swap = memcmp(pb, pa, sizeof pa) < 0;
-    memcpy(key, swap ? pb : pa, sizeof pa);
-    memcpy(key + 3, swap ? pa : pb, sizeof pa);
-    memcpy(key + 6, to_camera->m, sizeof to_camera->m);
-    uint64_t h = 0x243f6a8885a308d3ull;
-    for (int i = 0; i < 22; i++) {
+    for (int i = 0; i < n; i++) {
         uint64_t bits;
-        memcpy(&bits, &key[i], sizeof bits);
+        memcpy(&bits, &x[i], sizeof bits);
         h = mix(h, bits, 0x9e3779b97f4a7c15ull);
     }
-    out->h = h;
+    return h;
+}
+
+/* The hash of an object's transform: where its edges' hashes start
+ * (edge_hash), made once per object instead of once per edge. The key is
+ * the transform's bits, then the edge's: equal keys, equal hashes. */
+static uint64_t transform_hash(const mat4 *to_camera)
+{
+    return mix_doubles(0x243f6a8885a308d3ull, &to_camera->m[0][0], 16);
+}
+
+/* memcmp(x, y, 24) < 0 for three doubles each, without the call: bytes
+ * compare in memory order, so each double's bits read big-endian are
+ * compared as unsigned numbers, the first that differ deciding */
+static bool bytes_below(const double x[3], const double y[3])
+{
+    for (int i = 0; i < 3; i++) {
+        uint64_t a, b;
+        memcpy(&a, &x[i], sizeof a);
+        memcpy(&b, &y[i], sizeof b);
+#if __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
+        a = __builtin_bswap64(a);
+        b = __builtin_bswap64(b);
+#endif
+        if (a != b) return a < b;
+    }
+    return false;
+}
+
+/* The hash of the edge from RIB vertex a to RIB vertex b (either way
+ * round: the lower first, as memcmp orders their bytes) under the
+ * transform of hash h0 */
+static uint64_t edge_hash(uint64_t h0, vec3 a, vec3 b)
+{
+    double pa[3] = {a.x, a.y, a.z}, pb[3] = {b.x, b.y, b.z}, key[6];
+    bool swap = bytes_below(pb, pa);
+    memcpy(key, swap ? pb : pa, sizeof pa);
+    memcpy(key + 3, swap ? pa : pb, sizeof pa);
+    return mix_doubles(h0, key, 6);
 }
 
 /* The object of id `id`: a plain object, or the mesh of a piece (meshes:
@@ -255,14 +244,18 @@ static void mark_shared(trace_world *world, const int *meshes, int nmeshes, uint
         owner->shared_edges |= (uint64_t)1 << edge;
 }
 
-/* Adds the edges of polygon s (object id `id`, transform of obj) to *e. */
+/* Adds the edges of polygon s (object id `id`, the hash of its object's
+ * transform h0) to *e: edge j from corner j to corner j + 1, each corner
+ * taken to its RIB vertex once (as geom_polygon_edge gives them). */
 static void add_edges(world_edge **e, size_t *n, size_t *cap, const geom_surface *s,
-                      const trace_object *obj, int id)
+                      uint64_t h0, int id)
 {
-    if (s->kind != GEOM_POLYGON) return;
+    if (s->kind != GEOM_POLYGON || s->nuv < 1) return;
+    vec3 v[GEOM_MAX_POLY_VERTS];
+    for (int j = 0; j < s->nuv; j++) v[j] = rib_vertex(s, geom_polygon_corner(s, j));
     for (int j = 0; j < s->nuv && j < 64; j++) {
         if (*n == *cap) *e = xreallocarray(*e, *cap *= 2, sizeof **e);
-        edge_hash(s, &obj->to_camera, j, &(*e)[*n]);
+        (*e)[*n].h = edge_hash(h0, v[j], v[(j + 1) % s->nuv]);
         (*e)[(*n)++].ref = (uint64_t)id * 64 + (uint64_t)j;
     }
 }
@@ -280,25 +273,49 @@ static void *mesh_edges(void *arg)
 {
     edge_share *sh = arg;
     trace_mesh *m = sh->obj->mesh;
-    geom_surface *tmp = xmalloc(sizeof *tmp);
+    geom_surface *tmp = xcalloc(1, sizeof *tmp);
     aa_context ctx;
     aa_context_init(&ctx, 2);
+    uint64_t h0 = transform_hash(&sh->obj->to_camera);
+    /* an undisplaced piece's bounds and edges need its outline alone */
+    bool outline = m->outline && !sh->obj->displacement;
     for (int k = sh->k0; k < sh->k1; k++) {
         int npv;
-        if (!m->piece(m->user, sh->obj, k, tmp, NULL, &npv)) continue;
+        if (outline ? !m->outline(m->user, k, tmp)
+                    : !m->piece(m->user, sh->obj, k, tmp, NULL, &npv))
+            continue;
         if (!sh->obj->displacement) trace_mesh_piece_bounds(tmp, m->bounds[k]);
         else trace_region_base(&ctx, tmp, m->bounds[k]);   /* before its regions' shift */
-        add_edges(&sh->e, &sh->n, &sh->cap, tmp, sh->obj, m->first_id + k);
+        add_edges(&sh->e, &sh->n, &sh->cap, tmp, h0, m->first_id + k);
     }
     free(tmp);
     return NULL;
 }
 
+/* The edges' lists, in ref order one after another (the world's parts
+ * of the list it sorts: edge_sort.h), each owned */
+typedef struct edge_parts {
+    world_edge **part;
+    size_t *len;
+    int n, cap;
+} edge_parts;
+
+static void push_part(edge_parts *p, world_edge *e, size_t n)
+{
+    if (p->n == p->cap) {
+        p->cap = p->cap ? 2 * p->cap : 8;
+        p->part = xreallocarray(p->part, (size_t)p->cap, sizeof *p->part);
+        p->len = xreallocarray(p->len, (size_t)p->cap, sizeof *p->len);
+    }
+    p->part[p->n] = e;
+    p->len[p->n++] = n;
+}
+
 /* The pass over mesh object obj's pieces, over the world's build threads:
- * each share's edges are appended to *e in piece order, so the list (and
+ * each share's edges a part of *parts, in piece order, so the list (and
  * everything after it) is the one a single thread makes. */
 static void mesh_edges_in_parallel(const trace_world *world, const trace_object *obj,
-                                   world_edge **e, size_t *n, size_t *cap)
+                                   edge_parts *parts)
 {
     int npieces = obj->mesh->npieces;
     int threads = world->options.build_threads;
@@ -314,15 +331,7 @@ static void mesh_edges_in_parallel(const trace_world *world, const trace_object 
         share[i].e = xmalloc(sizeof *share[i].e * share[i].cap);
     }
     trace_run_shares(share, sizeof *share, threads, mesh_edges);
-    for (int i = 0; i < threads; i++) {
-        if (*n + share[i].n > *cap) {
-            *cap = *n + share[i].n;
-            *e = xreallocarray(*e, *cap, sizeof **e);
-        }
-        memcpy(*e + *n, share[i].e, sizeof **e * share[i].n);
-        *n += share[i].n;
-        free(share[i].e);
-    }
+    for (int i = 0; i < threads; i++) push_part(parts, share[i].e, share[i].n);
     free(share);
 }
 
@@ -348,21 +357,31 @@ static void find_shared_edges(trace_world *world, const int *meshes, int nmeshes
         trace_mesh *m = world->objects[meshes[j]].mesh;
         m->shared_edges = xcalloc((size_t)(m->npieces > 0 ? m->npieces : 1),
                                   sizeof *m->shared_edges);
-        n += 3 * (size_t)m->npieces;               /* an estimate: grown below */
     }
+    /* the plain objects' edges, then each mesh's */
     size_t cap = n > 0 ? n : 1;
     world_edge *e = xmalloc(cap * sizeof *e);
     n = 0;
     for (int i = 0; i < world->nobjects; i++)
         if (!world->objects[i].mesh && !world->objects[i].group)
-            add_edges(&e, &n, &cap, &world->objects[i].surf, &world->objects[i], i);
+            add_edges(&e, &n, &cap, &world->objects[i].surf,
+                      transform_hash(&world->objects[i].to_camera), i);
+    edge_parts parts = {0};
+    push_part(&parts, e, n);
     for (int j = 0; j < nmeshes; j++) {
         trace_object *obj = &world->objects[meshes[j]];
         trace_mesh *m = obj->mesh;
         m->bounds = xmalloc(sizeof *m->bounds * (size_t)(m->npieces > 0 ? m->npieces : 1));
-        mesh_edges_in_parallel(world, obj, &e, &n, &cap);
+        mesh_edges_in_parallel(world, obj, &parts);
     }
-    sort_edges(e, n);
+    e = trace_edges_sort_parts(parts.part, parts.len, parts.n, world->options.build_threads);
+    n = 0;
+    for (int p = 0; p < parts.n; p++) {
+        n += parts.len[p];
+        free(parts.part[p]);
+    }
+    free(parts.part);
+    free(parts.len);
     for (size_t i = 0; i + 1 < n; i++) {
         size_t j = i + 1;
         if (e[i].h != e[j].h || e[i].ref / 64 == e[j].ref / 64) continue;

@@ -62,6 +62,13 @@ typedef struct trace_mesh {
      * piece of a parsed mesh). A pure function, called from any thread. */
     bool (*piece)(const void *user, const struct trace_object *obj, int k, geom_surface *s,
                   trace_primvar *pv, int *npv);
+    /* Optional (NULL: piece): piece k's outline, what the world's pass
+     * over the pieces reads for their bounds and shared edges: a polygon's
+     * corners and plane basis (geom_polygon_basis: origin, axes, normal,
+     * nuv and uv the same bits as piece gives them), any other kind's
+     * surface as piece makes it; for an undisplaced mesh. A pure
+     * function, called from any thread. */
+    bool (*outline)(const void *user, int k, geom_surface *s);
     const void *user;
     /* derived: trace_world_prepare, trace_renderer_new (trace_mesh_clear
      * frees them) */

@@ -13,6 +13,9 @@
  *               corners, random planes, sizes from 1e-140 to 1e140)
  *   ng          the polygon's Ng constants are ia_mul's products of the
  *               axes as point intervals, for the same polygons
+ *   basis       geom_polygon_basis's basis and (u,v) are the prepare's, and
+ *               the corners kept are those a root at every pair keeps,
+ *               for polygons with corners repeated near the threshold
  */
 #include <stdarg.h>
 #include <stddef.h>
@@ -176,12 +179,101 @@ static void test_ng(void **state)
     }
 }
 
+/* The old test of a repeated corner (distinct_vertices), with the root
+ * taken every time: how many distinct corners s has */
+static int distinct_by_length(const geom_surface *s)
+{
+    vec3 lo = s->verts[0], hi = s->verts[0];
+    for (int i = 1; i < s->nverts; i++) {
+        vec3 p = s->verts[i];
+        lo = v3(fmin(lo.x, p.x), fmin(lo.y, p.y), fmin(lo.z, p.z));
+        hi = v3(fmax(hi.x, p.x), fmax(hi.y, p.y), fmax(hi.z, p.z));
+    }
+    vec3 ext = v3_sub(hi, lo);
+    double same = 1e-12 * fmax(ext.x, fmax(ext.y, ext.z));
+    vec3 kept[GEOM_MAX_POLY_VERTS];
+    int n = 0;
+    for (int i = 0; i < s->nverts; i++) {
+        vec3 p = s->verts[i];
+        if (n > 0 && v3_length(v3_sub(p, kept[n - 1])) <= same) continue;
+        if (i == s->nverts - 1 && n > 0 && v3_length(v3_sub(p, kept[0])) <= same) continue;
+        kept[n++] = p;
+    }
+    return n;
+}
+
+/* geom_polygon_basis (a mesh's pass over its pieces' bounds and edges)
+ * gives the basis and (u,v) of geom_surface_prepare, to the bit; and the
+ * corners the prepare keeps are those the test with a root at every pair
+ * keeps: random polygons (scales 1e-165 to 1e150, where 1e-12 of the size
+ * squared underflows) with corners repeated at distances around the
+ * threshold (1e-12 of the size) and twice it (where the squared test
+ * hands over to the root) */
+static void test_basis(void **state)
+{
+    (void)state;
+    fx_seed(777);
+    static const double at[] = {0, 0.5, 1 - 1e-15, 1, 1 + 1e-15, 1.5, 2 - 1e-15, 2, 2 + 1e-15, 3};
+    int tried = 0, repeated = 0;
+    for (int k = 0; k < 40000; k++) {
+        geom_surface s = random_polygon(k);
+        if (k % 4 == 1) {                  /* tiny or huge */
+            double f = pow(10, k % 8 == 1 ? fx_range(-165, -150) : fx_range(100, 150));
+            for (int i = 0; i < s.nverts; i++) s.verts[i] = v3_scale(s.verts[i], f);
+        }
+        vec3 lo = s.verts[0], hi = s.verts[0];
+        for (int i = 1; i < s.nverts; i++) {
+            lo = v3(fmin(lo.x, s.verts[i].x), fmin(lo.y, s.verts[i].y), fmin(lo.z, s.verts[i].z));
+            hi = v3(fmax(hi.x, s.verts[i].x), fmax(hi.y, s.verts[i].y), fmax(hi.z, s.verts[i].z));
+        }
+        double same = 1e-12 * fmax(hi.x - lo.x, fmax(hi.y - lo.y, hi.z - lo.z));
+        for (int i = 1; i < s.nverts; i++)
+            if (fx_range(0, 1) < 0.3) {
+                /* corner i near corner i - 1 (or the last near the first) */
+                int j = i == s.nverts - 1 && fx_range(0, 1) < 0.5 ? 0 : i - 1;
+                vec3 d = fx_unit_vector();
+                s.verts[i] = v3_add(s.verts[j], v3_scale(d, same * at[(int)fx_range(0, 10) % 10]));
+            }
+        int want = distinct_by_length(&s);
+        geom_surface full = s, basis = s;
+        bool ok = geom_surface_prepare(&full, NULL, 0);
+        char err[256];
+        bool bok = geom_polygon_basis(&basis, err, sizeof err);
+        if (want < 3) {
+            assert_false(bok);
+            assert_false(ok);
+            continue;
+        }
+        if (bok) assert_int_equal(basis.nuv, want);
+        if (!ok) continue;
+        tried++;
+        repeated += want < s.nverts;
+        if (!bok) fail_msg("polygon %d: prepared, but its basis failed: %s", k, err);
+        vec3 got[4] = {basis.origin, basis.axis_u, basis.axis_v, basis.normal};
+        vec3 exp[4] = {full.origin, full.axis_u, full.axis_v, full.normal};
+        for (int i = 0; i < 4; i++)
+            for (int c = 0; c < 3; c++)
+                if (bits_of(v3_comp(got[i], c)) != bits_of(v3_comp(exp[i], c)))
+                    fail_msg("polygon %d: basis vector %d[%d] is %a, the prepare's %a", k, i, c,
+                             v3_comp(got[i], c), v3_comp(exp[i], c));
+        assert_int_equal(basis.nuv, full.nuv);
+        for (int i = 0; i < full.nuv; i++)
+            for (int c = 0; c < 2; c++)
+                if (bits_of(basis.uv[i][c]) != bits_of(full.uv[i][c]))
+                    fail_msg("polygon %d: uv[%d][%d] is %a, the prepare's %a", k, i, c,
+                             basis.uv[i][c], full.uv[i][c]);
+    }
+    printf("%d polygons prepared (%d with a corner repeated): the same basis\n", tried, repeated);
+    assert_true(tried > 12000 && repeated > 4000);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_minmax),
         cmocka_unit_test(test_bounds),
         cmocka_unit_test(test_ng),
+        cmocka_unit_test(test_basis),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

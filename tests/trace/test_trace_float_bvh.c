@@ -7,6 +7,7 @@
  * size (tiny, flat, huge, not finite) and rays aimed at their corners and
  * faces, where a box rounded the wrong way would be missed.
  */
+#include <float.h>
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -160,9 +161,44 @@ static void test_build_is_a_function_of_the_boxes(void **state)
     free(b);
 }
 
+/* trace_float_down/up (the pieces' boxes in float, rounded outward)
+ * without nextafterf: the same floats as the call, over zeros, the
+ * largest floats, overflow, subnormals, infinities, NaN and random
+ * doubles of every magnitude */
+static void test_float_rounding(void **state)
+{
+    (void)state;
+    static const double special[] = {
+        0.0, -0.0, 1.0, -1.0, FLT_MAX, -FLT_MAX, 0x1p-149, -0x1p-149, 0x1p-150, -0x1p-150,
+        0x1p-160, -0x1p-160, 0x1p-126, (double)FLT_MAX * (1 + 0x1p-30),
+        -(double)FLT_MAX * (1 + 0x1p-30), 1e300, -1e300, INFINITY, -INFINITY, NAN,
+        1.0 + 0x1p-40, -1.0 - 0x1p-40};
+    int n = 0;
+    for (int k = 0; k < 400000; k++) {
+        double x;
+        if (k < (int)(sizeof special / sizeof special[0])) {
+            x = special[k];
+        } else {
+            uint64_t b = ((uint64_t)(uniform() * 4294967296.0) << 32) |
+                         (uint64_t)(uniform() * 4294967296.0);
+            memcpy(&x, &b, sizeof x);
+            if (k % 2) x = ldexp(uniform() - 0.5, (int)(uniform() * 300) - 160);
+        }
+        float f = (float)x;
+        float dn = (double)f > x ? nextafterf(f, -INFINITY) : f;
+        float up = (double)f < x ? nextafterf(f, INFINITY) : f;
+        float gd = trace_float_down(x), gu = trace_float_up(x);
+        if (memcmp(&gd, &dn, sizeof gd) != 0 || memcmp(&gu, &up, sizeof gu) != 0)
+            fail_msg("%a: down %a up %a, nextafterf gives %a and %a", x, gd, gu, dn, up);
+        n++;
+    }
+    printf("%d doubles rounded to floats as nextafterf rounds them\n", n);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_float_rounding),
         cmocka_unit_test(test_walk_reaches_every_box_a_ray_meets),
         cmocka_unit_test(test_build_is_a_function_of_the_boxes),
     };

@@ -459,6 +459,159 @@ static void test_wide_faces_share_their_edges(void **state)
     job_destroy(&jb);
 }
 
+/* A mesh of every kind of piece: a flat grid of jittered quads (whole
+ * polygons), some with a corner repeated (3 distinct corners of 4), some
+ * pentagons, some concave (cut into triangles), beside a bumpy grid whose
+ * quads are curved or not planar (triangles with corner normals), and a
+ * Polygon sharing an edge with the flat grid. */
+static char *mixed_rib(void)
+{
+    enum { N = 40 };
+    size_t cap = 1 << 20, n = 0;
+    char *t = malloc(cap);
+    assert_non_null(t);
+    n += (size_t)snprintf(t + n, cap - n, "Format 32 32 1\nProjection \"perspective\" \"fov\" "
+                          "[40]\nTranslate 0 0 8\nWorldBegin\n");
+    for (int bumpy = 0; bumpy < 2; bumpy++) {
+        n += (size_t)snprintf(t + n, cap - n, "AttributeBegin\nTranslate %d 0 0\nPointsPolygons [",
+                              bumpy ? 3 : -3);
+        for (int f = 0; f < (N - 1) * (N - 1); f++)
+            n += (size_t)snprintf(t + n, cap - n, "%d ", !bumpy && f % 13 == 5 ? 5 : 4);
+        n += (size_t)snprintf(t + n, cap - n, "] [");
+        for (int i = 0; i + 1 < N; i++)
+            for (int j = 0; j + 1 < N; j++) {
+                int f = i * (N - 1) + j, a = i * N + j, b = a + 1, c = a + N + 1, d = a + N;
+                if (!bumpy && f % 13 == 5)           /* a pentagon: the quad's centre too */
+                    n += (size_t)snprintf(t + n, cap - n, "%d %d %d %d %d ", a, b, c, d, N * N + f);
+                else if (!bumpy && f % 7 == 3)       /* a corner repeated */
+                    n += (size_t)snprintf(t + n, cap - n, "%d %d %d %d ", a, b, b, c);
+                else
+                    n += (size_t)snprintf(t + n, cap - n, "%d %d %d %d ", a, b, c, d);
+            }
+        n += (size_t)snprintf(t + n, cap - n, "] \"P\" [");
+        for (int i = 0; i < N; i++)
+            for (int j = 0; j < N; j++) {
+                double x = 4.0 * j / (N - 1) - 2, y = 4.0 * i / (N - 1) - 2, z = 0;
+                if (bumpy) {
+                    z = 0.3 * sin(3 * x) * cos(2 * y) + ((i * 7 + j * 3) % 5 == 0 ? 0.05 : 0);
+                } else if (i > 0 && j > 0 && i + 1 < N && j + 1 < N) {
+                    /* jittered; every 17th far enough to make its faces concave */
+                    double k = (i * N + j) % 17 == 0 ? 0.9 : 0.2;
+                    x += k * 4.0 / (N - 1) * sin(i * 12.9898 + j * 78.233);
+                    y += k * 4.0 / (N - 1) * cos(i * 39.346 + j * 11.135);
+                }
+                n += (size_t)snprintf(t + n, cap - n, "%.17g %.17g %.17g ", x, y, z);
+            }
+        if (!bumpy)                                  /* the pentagons' centres (beyond the grid) */
+            for (int f = 0; f < (N - 1) * (N - 1); f++) {
+                int i = f / (N - 1), j = f % (N - 1);
+                n += (size_t)snprintf(t + n, cap - n, "%.17g %.17g 0 ",
+                                      4.0 * (j + 0.5) / (N - 1) - 2 - 0.3 * 4.0 / (N - 1),
+                                      4.0 * (i + 0.5) / (N - 1) - 2);
+            }
+        n += (size_t)snprintf(t + n, cap - n, "]\nAttributeEnd\n");
+    }
+    /* a Polygon on the flat grid's first edge (corners 0 and 1), outside it */
+    n += (size_t)snprintf(t + n, cap - n, "AttributeBegin\nTranslate -3 0 0\nPolygon \"P\" "
+                          "[-2 -2 0  %.17g -2 0  -1.9 -2.5 0]\nAttributeEnd\nWorldEnd\n",
+                          4.0 / (N - 1) - 2);
+    assert_true(n < cap);
+    return t;
+}
+
+/* The world's pass over a mesh's pieces reads their outlines (trace_mesh.
+ * outline: the flat polygon's basis alone): the pieces' bounds and shared
+ * edges are those the full pieces give, to the bit, for every kind of
+ * piece and any thread count. */
+static void test_outlines_give_the_pieces_bounds_and_edges(void **state)
+{
+    (void)state;
+    char *rib = mixed_rib();
+    job_options opt;
+    job_options_default(&opt);
+    job *jb = job_new("mixed.rib", rib, strlen(rib), &opt);
+    free(rib);
+    char err[256];
+    assert_true(job_finish(jb, err, sizeof err));
+    uint64_t first = 0;
+    for (int threads = 1; threads <= 3; threads += 2) {
+        sl_diag *d = sl_diag_new();
+        job_scene *js = job_scene_new_threads(jb, 0, true, threads, NULL, d);
+        if (!js) sl_diag_print(d, stderr);
+        assert_non_null(js);
+        trace_world *w = &js->world;
+        trace_renderer_destroy(&js->renderer);
+        /* the pass, with the outlines and with the full pieces */
+        float (*bounds[2][2])[6] = {{NULL}};
+        uint64_t *edges[2][2] = {{NULL}};
+        int meshes = 0, kinds[3] = {0, 0, 0}, shared = 0, npieces[2] = {0, 0};
+        for (int pass = 0; pass < 2; pass++) {
+            assert_true(trace_world_prepare(w, err, sizeof err));
+            int j = 0;
+            for (int i = 0; i < w->nobjects; i++) {
+                trace_mesh *m = w->objects[i].mesh;
+                if (!m) continue;
+                assert_true(j < 2);
+                assert_true(pass == 1 || m->outline != NULL);
+                npieces[j] = m->npieces;
+                size_t b = sizeof *m->bounds * (size_t)m->npieces;
+                bounds[pass][j] = malloc(b);
+                edges[pass][j] = malloc(sizeof(uint64_t) * (size_t)m->npieces);
+                memcpy(bounds[pass][j], m->bounds, b);
+                for (int k = 0; k < m->npieces; k++)
+                    edges[pass][j][k] = trace_mesh_shared_edges(m, k);
+                m->outline = NULL;     /* the next pass: the full pieces */
+                j++;
+            }
+            meshes = j;
+        }
+        assert_int_equal(meshes, 2);
+        for (int j = 0; j < meshes; j++) {
+            for (int k = 0; k < npieces[j]; k++) {
+                if (memcmp(bounds[0][j][k], bounds[1][j][k], sizeof bounds[0][j][k]) != 0)
+                    fail_msg("mesh %d piece %d: its outline's bounds differ from its surface's",
+                             j, k);
+                if (edges[0][j][k] != edges[1][j][k])
+                    fail_msg("mesh %d piece %d: shared edges %#llx from its outline, %#llx from "
+                             "its surface", j, k, (unsigned long long)edges[0][j][k],
+                             (unsigned long long)edges[1][j][k]);
+                shared += __builtin_popcountll(edges[0][j][k]);
+            }
+            free(bounds[0][j]);
+            free(bounds[1][j]);
+            free(edges[0][j]);
+            free(edges[1][j]);
+        }
+        /* the world as built, its digest the same for any thread count */
+        js->renderer = trace_renderer_new(w, err, sizeof err);
+        assert_non_null(js->renderer);
+        uint64_t digest = 0;
+        for (int i = 0; i < w->nobjects; i++) {
+            const trace_mesh *m = w->objects[i].mesh;
+            if (!m) continue;
+            digest ^= trace_mesh_digest(m);
+            for (int k = 0; k < m->npieces; k++) {
+                geom_surface *s = malloc(sizeof *s);
+                int npv;
+                assert_non_null(s);
+                assert_true(m->piece(m->user, &w->objects[i], k, s, NULL, &npv));
+                kinds[s->nuv == 3 ? (s->nvn ? 1 : 0) : 2]++;
+                free(s);
+            }
+        }
+        if (threads == 1) first = digest;
+        assert_true(digest == first);
+        printf("%d threads: %d flat triangles, %d with corner normals, %d larger polygons; "
+               "%d shared edges, the same from outlines and pieces\n", threads, kinds[0],
+               kinds[1], kinds[2], shared);
+        assert_true(kinds[0] > 0 && kinds[1] > 0 && kinds[2] > 0);
+        assert_true(shared > 4 * 39 * 39);
+        job_scene_destroy(&js);
+        sl_diag_destroy(&d);
+    }
+    job_destroy(&jb);
+}
+
 static void test_instances_share_the_mesh(void **state)
 {
     (void)state;
@@ -663,6 +816,7 @@ int main(void)
         cmocka_unit_test(test_instances_render_as_copies),
         cmocka_unit_test(test_boxes_by_threads),
         cmocka_unit_test(test_wide_faces_share_their_edges),
+        cmocka_unit_test(test_outlines_give_the_pieces_bounds_and_edges),
         cmocka_unit_test(test_instances_share_the_mesh),
         cmocka_unit_test(test_instances_are_references),
         cmocka_unit_test(test_bytes_per_instance),
