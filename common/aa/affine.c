@@ -167,49 +167,6 @@ double aa_radius(const aa_form *x)
     return radius_from_sum(x, r, terms);
 }
 
-/* An upper bound of the exact sum of n >= 0 nonnegative doubles whose RN
- * sum (in any order) is s: each addition errs by at most 2^-53 of its
- * result, so (n + 1) * 2^-53 relative, stepped up, covers the lot; tiny
- * sums get a constant (no subnormal bounds, rounding.h). */
-static inline double sum_up(double s, int n)
-{
-    if (s == 0.0)
-        return 0.0;
-    if (!(s >= 0x1p-960))
-        return s != s ? s : 0x1p-958;
-    return fp_next_up(s + s * ((double)(n + 1) * 0x1p-53));
-}
-
-/*
- * Meets z's hull with its affine range z0 +- R, R the radius (the sum of
- * |coefficients| and err) summed in RN from at most 31 terms: the hull
- * then is aa_range(z), so that a range costs no sum of the coefficients
- * (issue 24). Branch-free, in RN: the exact radius is at most R (1 + 31u)
- * (u = 2^-53), and x0 -+ R rounds by at most u (|x0| + R) (1 + u), the
- * outward step w by as much again, so w = 2^-51 (|x0| + R) + 2^-48 R +
- * 2^-1022 (the last for underflow of w itself) covers all of it; R = 0
- * (a point: its centre is exact) takes no step. Both are
- * enclosures of the same values; if they are disjoint (possible only
- * outside a domain) the hull stays.
- */
-static inline void tighten(aa_form *z, double R)
-{
-    double x0 = z->x0;
-    double w = ((fabs(x0) + R) * 0x1p-51 + R * 0x1p-48 + 0x1p-1022) * (double)(R != 0.0);
-    double lo = (x0 - R) - w, hi = (x0 + R) + w;
-    lo = lo < z->lo ? z->lo : lo;
-    hi = hi > z->hi ? z->hi : hi;
-    if (lo <= hi && !(z->flags & AA_UNBOUNDED)) {
-        z->lo = lo;
-        z->hi = hi;
-    }
-}
-
-void aa_tighten(aa_form *z)
-{
-    tighten(z, aa_radius(z));     /* already up: more than R */
-}
-
 ia_interval aa_range_r(const aa_form *x, double r)
 {
     if (x->flags & AA_UNBOUNDED) {
@@ -234,23 +191,9 @@ ia_interval aa_range_r(const aa_form *x, double r)
     return out;
 }
 
-/* The hull, which every operation of this file meets with the affine range
- * when it makes a form (tighten); the meet computed here only where the
- * hull is not finite (a form some caller built without one). */
-ia_interval aa_range_slow(const aa_form *x)
+ia_interval aa_range(const aa_form *x)
 {
     return aa_range_r(x, aa_radius(x));
-}
-
-/* aa_range(x) where x's radius r is known (aa_mul: x's coefficients may be
- * overwritten by then, z aliasing x) */
-static inline ia_interval range_r(const aa_form *x, double r)
-{
-    if (!(x->flags & AA_UNBOUNDED) && x->lo > -INFINITY && x->hi < INFINITY) {
-        ia_interval out = { x->lo, x->hi, x->flags };
-        return out;
-    }
-    return aa_range_r(x, r);
 }
 
 ia_interval aa_range_radius(const aa_form *x, double *radius)
@@ -318,7 +261,7 @@ static inline int uflow_k(int k, double p, double v)
 /* z[i] = a x[i] for the i in [from, to) that only one operand has */
 static inline __attribute__((always_inline)) void
 lincomb_tail(int track, double a, const double *xc, int from, int to, double *zc, int ka,
-             double wa, double *sa, double *ap, int *uf)
+             double wa, double *ap, int *uf)
 {
     for (int i = from; i < to; i++) {
         double xi = xc[i], p = a * xi;
@@ -326,7 +269,6 @@ lincomb_tail(int track, double a, const double *xc, int from, int to, double *zc
             *ap += wa * fabs(p);
             *uf |= uflow_k(ka, p, xi);
         }
-        *sa += fabs(p);
         zc[i] = p;
     }
 }
@@ -334,49 +276,37 @@ lincomb_tail(int track, double a, const double *xc, int from, int to, double *zc
 static inline __attribute__((always_inline)) void
 lincomb_loops(int track, double a, const double *xc, int xn, double b,
               const double *yc, int yn, double *zc, int ka, int kb,
-              double wa, double wb, double *ss_out, double *sa_out, double *ap_out,
-              int *uf_out)
+              double wa, double wb, double *es_out, double *ap_out, int *uf_out)
 {
     int m = xn < yn ? xn : yn;
-    double ss = 0.0, ap = 0.0;
+    double es = 0.0, ap = 0.0;
     int uf = 0;
     for (int i = 0; i < m; i++) {
         double xi = xc[i], yi = yc[i];
         double p = a * xi, q = b * yi, s = p + q;
-        ss += fabs(s);
+        es += fabs(fp_two_sum_err(p, q, s));
         if (track) {
             ap += wa * fabs(p) + wb * fabs(q);
             uf |= uflow_k(ka, p, xi) | uflow_k(kb, q, yi);
         }
         zc[i] = s;
     }
-    double sa = ss;
-    lincomb_tail(track, a, xc, m, xn, zc, ka, wa, &sa, &ap, &uf);
-    lincomb_tail(track, b, yc, m, yn, zc, kb, wb, &sa, &ap, &uf);
-    *ss_out = ss;
-    *sa_out = sa;
+    lincomb_tail(track, a, xc, m, xn, zc, ka, wa, &ap, &uf);
+    lincomb_tail(track, b, yc, m, yn, zc, kb, wb, &ap, &uf);
+    *es_out = es;
     *ap_out = ap;
     *uf_out = uf;
 }
 
 /*
- * z = a*x + b*y + c. Coefficients in RN, each rounding bounded a priori
- * (no error-free transform per coefficient, issue 24): a sum s = RN(p + q)
- * errs by at most 2^-53 |s| (and is exact where s is subnormal), so the
- * sum of |z_i| bounds the sums' errors (x - x: every z_i is 0, no error);
- * a product by an inexact factor errs by at most 2^-53 of its magnitude,
- * plus 2^-1075 when it underflowed. fp_rounding_bound(sum |z_i| + sum
- * |inexact products|) is twice that, which also covers the RN sums of the
- * magnitudes (lincomb_loops; the bookkeeping a factor does not need is
- * multiplied away: wa, wb are 0 or 1). The two sums of the centre keep
- * their exact TwoSum errors, so that a sum of constants that rounds
- * nothing stays a point; coefficients of one operand only are no sums
- * (x + constant adds no error). The hull is met with the affine range
- * (tighten); want_hull false takes the affine range alone, for a caller
- * that sets its own hull (aa_apply_linear, aa_merge). Returns the radius
- * bound of z (infinity for an unbounded z).
+ * z = a*x + b*y + c. Coefficients in RN: the exact error of each sum from
+ * TwoSum (so x - x is exactly 0), 2^-53 of each product by an inexact
+ * factor, 2^-1075 per product that underflowed, all summed and bounded from
+ * above once (lincomb_loops; the bookkeeping a factor does not need is
+ * multiplied away: wa, wb are 0 or 1). want_hull false leaves the hull
+ * [-inf, inf] for a caller that sets its own (aa_apply_linear, aa_merge).
  */
-static inline __attribute__((always_inline)) double
+static inline __attribute__((always_inline)) void
 lincomb(aa_form *z, double a, const aa_form *x, double b, const aa_form *y, double c,
         bool want_hull)
 {
@@ -390,7 +320,7 @@ lincomb(aa_form *z, double a, const aa_form *x, double b, const aa_form *y, doub
         ((y->flags & AA_UNBOUNDED) && b != 0.0) || !isfinite(a) ||
         !isfinite(b) || !isfinite(c)) {
         aa_unbounded(z, flags);
-        return INFINITY;
+        return;
     }
     flags &= ~AA_UNBOUNDED;
     int ka = factor_kind(a), kb = factor_kind(b);
@@ -424,18 +354,16 @@ lincomb(aa_form *z, double a, const aa_form *x, double b, const aa_form *y, doub
         hhi = (h1 + h2 + c) + hb;
     }
 
-    double ss = 0.0;      /* sum of |z_i| that are sums (rounded) */
-    double sa = 0.0;      /* sum of all |z_i| (the radius) */
+    double es = 0.0;      /* sum of exact errors of the additions */
     double ap = 0.0;      /* sum of |inexact products| */
     int uf = 0;           /* a product may have underflowed */
     if (ka == FACTOR_EXACT && kb == FACTOR_EXACT)      /* add, sub, neg */
-        lincomb_loops(0, a, x->c, xn, b, y->c, yn, z->c, 0, 0, 0, 0, &ss, &sa, &ap, &uf);
+        lincomb_loops(0, a, x->c, xn, b, y->c, yn, z->c, 0, 0, 0, 0, &es, &ap, &uf);
     else
-        lincomb_loops(1, a, x->c, xn, b, y->c, yn, z->c, ka, kb, wa, wb, &ss, &sa, &ap,
-                      &uf);
+        lincomb_loops(1, a, x->c, xn, b, y->c, yn, z->c, ka, kb, wa, wb, &es, &ap, &uf);
     double p = a * x0, q = b * y0;
     double s1 = p + q, s2 = s1 + c;
-    double es = fabs(fp_two_sum_err(p, q, s1)) + fabs(fp_two_sum_err(s1, c, s2));
+    es += fabs(fp_two_sum_err(p, q, s1)) + fabs(fp_two_sum_err(s1, c, s2));
     ap += wa * fabs(p) + wb * fabs(q);
     uf |= uflow_k(ka, p, x0) | uflow_k(kb, q, y0);
 
@@ -444,7 +372,7 @@ lincomb(aa_form *z, double a, const aa_form *x, double b, const aa_form *y, doub
         err = ka == FACTOR_EXACT ? xe * fabs(a) : fp_mul_up(fabs(a), xe);
     if (ye != 0.0)
         err = add_up_nn(err, kb == FACTOR_EXACT ? ye * fabs(b) : fp_mul_up(fabs(b), ye));
-    err = add_up_nn(err, add_up_nn(sum_err_bound(es), fp_rounding_bound(ss + ap, uf)));
+    err = add_up_nn(err, add_up_nn(sum_err_bound(es), fp_rounding_bound(ap, uf)));
 
     z->x0 = s2;
     z->err = err;
@@ -452,13 +380,8 @@ lincomb(aa_form *z, double a, const aa_form *x, double b, const aa_form *y, doub
     z->hi = hhi == hhi ? hhi : INFINITY;
     z->n = (unsigned short)n;
     z->flags = (unsigned short)flags;
-    if (!isfinite(s2) || !isfinite(err)) {
+    if (!isfinite(s2) || !isfinite(err))
         aa_unbounded(z, flags);
-        return INFINITY;
-    }
-    double r = sa + err;
-    tighten(z, r);
-    return r * (1.0 + 0x1p-48);     /* an upper bound of the radius (tighten) */
 }
 
 void aa_lincomb(aa_context *ctx, aa_form *z, double a, const aa_form *x,
@@ -510,24 +433,8 @@ centred_hull(const aa_form *x, double *lo, double *hi)
     double hb = 2.0 * fp_rounding_bound(3.0 * (fabs(x->lo) + fabs(x->hi) + 0.0 + 0.0 +
                                                fabs(c)), 0);
     double l = (x->lo + 0.0 + c) - hb, h = (x->hi + 0.0 + c) + hb;
-    l = l == l ? l : -INFINITY;
-    h = h == h ? h : INFINITY;
-    /* met with y's affine range 0 +- r (tighten): y's coefficients are
-     * x's (a factor 1, no sums), its err x's, its centre 0 */
-    double sa = 0.0;
-    for (int j = 0; j < x->n; j++)
-        sa += fabs(x->c[j]);
-    double R = sa + x->err;
-    double w = ((0.0 + R) * 0x1p-51 + R * 0x1p-48 + 0x1p-1022) * (double)(R != 0.0);
-    double tl = (0.0 - R) - w, th = (0.0 + R) + w;
-    tl = tl < l ? l : tl;
-    th = th > h ? h : th;
-    if (tl <= th) {
-        l = tl;
-        h = th;
-    }
-    *lo = l;
-    *hi = h;
+    *lo = l == l ? l : -INFINITY;
+    *hi = h == h ? h : INFINITY;
 }
 
 static inline __attribute__((always_inline)) void
@@ -610,14 +517,8 @@ lincomb3(aa_form *z, const double m[3], const aa_form x[3], double c, bool centr
     z->hi = hi == hi ? hi : INFINITY;
     z->n = (unsigned short)n;
     z->flags = (unsigned short)flags;
-    if (!isfinite(x0) || !isfinite(z->err)) {
+    if (!isfinite(x0) || !isfinite(z->err))
         aa_unbounded(z, flags);
-        return;
-    }
-    double sa = 0.0;
-    for (int j = 0; j < n; j++)
-        sa += fabs(zc[j]);
-    tighten(z, sa + z->err);
 }
 
 void aa_lincomb3(aa_context *ctx, aa_form *z, const double m[3], const aa_form x[3],
@@ -675,14 +576,13 @@ void aa_apply_linear(aa_context *ctx, aa_form *z, const aa_form *x,
                      double alpha, double zeta, double delta, ia_interval hull,
                      unsigned flags)
 {
-    double r = lincomb(z, alpha, x, 0.0, NULL, zeta, false);    /* the hull is given */
+    lincomb(z, alpha, x, 0.0, NULL, zeta, false);    /* the hull is given */
     if (!(z->flags & AA_UNBOUNDED)) {
         z->lo = hull.lo;
         z->hi = hull.hi;
     }
     z->flags |= (unsigned short)(flags & ~AA_UNBOUNDED);
     aa_add_new_error(ctx, z, delta);
-    tighten(z, r + delta);
 }
 
 /* ---------------------------------------------------------------------- */
@@ -738,13 +638,13 @@ void aa_mul(aa_context *ctx, aa_form *z, const aa_form *x, const aa_form *y)
     /* as aa_lincomb: the symbols both use, then the rest of the longer;
      * the operands' radii are summed on the way (in symbol order, the
      * same numbers as aa_radius) */
-    double sz = 0.0, ap = 0.0, dsum = 0.0, dabs = 0.0, sx = 0.0, sy = 0.0;
+    double es = 0.0, ap = 0.0, dsum = 0.0, dabs = 0.0, sx = 0.0, sy = 0.0;
     int uf = 0, tx = 0, ty = 0;
     for (int i = 0; i < m; i++) {
         double xi = xc[i], yi = yc[i];
         double p = x0 * yi, q = y0 * xi, s = p + q;
         double d = xi * yi;
-        sz += fabs(s);        /* RN(p + q) errs by <= 2^-53 |s| (lincomb) */
+        es += fabs(fp_two_sum_err(p, q, s));
         ap += fabs(p) + fabs(q);
         dsum += d;
         dabs += fabs(d);
@@ -758,7 +658,6 @@ void aa_mul(aa_context *ctx, aa_form *z, const aa_form *x, const aa_form *y)
     for (int i = m; i < xn; i++) {        /* yi = 0: p = 0, d = 0 */
         double xi = xc[i], q = y0 * xi;
         ap += fabs(q);
-        sz += fabs(q);
         sx += fabs(xi);
         tx += xi != 0.0;
         uf |= fp_uflow(q, y0, xi);
@@ -767,7 +666,6 @@ void aa_mul(aa_context *ctx, aa_form *z, const aa_form *x, const aa_form *y)
     for (int i = m; i < yn; i++) {        /* xi = 0 */
         double yi = yc[i], p = x0 * yi;
         ap += fabs(p);
-        sz += fabs(p);
         sy += fabs(yi);
         ty += yi != 0.0;
         uf |= fp_uflow(p, x0, yi);
@@ -775,17 +673,17 @@ void aa_mul(aa_context *ctx, aa_form *z, const aa_form *x, const aa_form *y)
     }
     /* z's coefficients are written, x's and y's other fields not yet */
     double rx = radius_from_sum(x, sx, tx), ry = radius_from_sum(y, sy, ty);
-    ia_interval hull = ia_mul(range_r(x, rx), range_r(y, ry));
+    ia_interval hull = ia_mul(aa_range_r(x, rx), aa_range_r(y, ry));
     double p0 = x0 * y0, mid = 0.5 * dsum, s0 = p0 + mid;
     uf |= fp_uflow(p0, x0, y0) | (fabs(mid) < 0x1p-1022 && dsum != 0.0);
-    double es = fabs(fp_two_sum_err(p0, mid, s0));
+    es += fabs(fp_two_sum_err(p0, mid, s0));
     /* errors: 2n + 1 products above, the n products d and their RN sum
      * (at most (n+1) * 2^-53 * dabs), and the halving */
     ap += fabs(p0) + (double)(n + 2) * dabs;
 
     double err = fp_add_up(fp_mul_up(fabs(x0), ye), fp_mul_up(fabs(y0), xe));
     err = fp_add_up(err, sum_err_bound(es));
-    err = fp_add_up(err, fp_rounding_bound(ap + sz, uf));
+    err = fp_add_up(err, fp_rounding_bound(ap, uf));
 
     /* lower bound of sum|xi*yi|/2 */
     double dlow = dabs - dabs * (double)(n + 2) * 0x1p-52 - 0x1p-1022;   /* >= n * 2^-1074; normal */
@@ -800,13 +698,11 @@ void aa_mul(aa_context *ctx, aa_form *z, const aa_form *x, const aa_form *y)
     z->hi = hull.hi;
     z->n = (unsigned short)n;
     z->flags = (unsigned short)(flags & ~AA_UNBOUNDED);
-    if (!isfinite(s0) || !isfinite(err) || !isfinite(delta) || !isfinite(ap) ||
-        !isfinite(sz)) {
+    if (!isfinite(s0) || !isfinite(err) || !isfinite(delta) || !isfinite(ap)) {
         aa_unbounded(z, flags);
         return;
     }
     aa_add_new_error(ctx, z, delta);
-    tighten(z, sz + err + delta);
 }
 
 /* ---------------------------------------------------------------------- */
@@ -827,14 +723,12 @@ void aa_merge(aa_context *ctx, aa_form *z, const aa_form *x, const aa_form *y)
     }
     aa_form d;
     ia_interval hull = ia_hull(aa_range(x), aa_range(y));
-    double rd = lincomb(&d, 0.5, x, -0.5, y, 0.0, false);
-    double rz = lincomb(z, 0.5, x, 0.5, y, 0.0, false);
+    lincomb(&d, 0.5, x, -0.5, y, 0.0, false);
+    lincomb(z, 0.5, x, 0.5, y, 0.0, false);
     z->lo = hull.lo;
     z->hi = hull.hi;
     z->flags = (unsigned short)(flags & ~AA_UNBOUNDED);
-    double delta = fp_add_up(fabs(d.x0), rd);
-    aa_add_new_error(ctx, z, delta);
-    tighten(z, rz + delta);
+    aa_add_new_error(ctx, z, fp_add_up(fabs(d.x0), aa_radius(&d)));
 }
 
 void aa_meet_hull(aa_form *z, ia_interval r)

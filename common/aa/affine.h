@@ -100,21 +100,7 @@ static inline void aa_const(aa_form *z, double value)   /* unbounded if not fini
     z->flags = 0;
 }
 void aa_from_interval(aa_context *ctx, aa_form *z, ia_interval x);
-/* affine range (rounded outward) meet hull: the hull itself, which the
- * operations meet with the affine range when they make a form (issue 24);
- * computed only where the hull is not finite */
-ia_interval aa_range_slow(const aa_form *x);
-static inline ia_interval aa_range(const aa_form *x)
-{
-    if (!(x->flags & AA_UNBOUNDED) && x->lo > -INFINITY && x->hi < INFINITY) {
-        ia_interval out = { x->lo, x->hi, x->flags };
-        return out;
-    }
-    return aa_range_slow(x);
-}
-/* Meets x's hull with its affine range (for a form built or changed
- * outside this library's operations) */
-void aa_tighten(aa_form *z);
+ia_interval aa_range(const aa_form *x);   /* affine range (rounded outward) meet hull */
 double aa_radius(const aa_form *x);                   /* sum |xi| + err, up */
 /* aa_range(x), and aa_radius(x) in *radius, the sum taken once */
 ia_interval aa_range_radius(const aa_form *x, double *radius);
