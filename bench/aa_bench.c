@@ -7,6 +7,10 @@
  * same context, so that every affine operation takes the same path (a fresh
  * symbol for its error, as in a query with capacity left).
  *
+ * Table 3 (printed second), "dense": the dense fixed-width forms of
+ * dense.h against aa_form, ns per add, sub, lincomb, mul and range on the
+ * same operands (u, v and their error symbols).
+ *
  * Table 2, "full vs reduced": shader-like expressions over (u, v) squares of
  * side 1, 1/4, 1/16 and 1/64 tiling [0,1]^2, evaluated with context
  * capacities 2 (fully reduced: only u and v are symbols, every new error is
@@ -35,6 +39,7 @@
 #include <time.h>
 
 #include "aa/affine.h"
+#include "aa/dense.h"
 #include "aa/interval.h"
 
 static volatile double g_sink;
@@ -384,6 +389,65 @@ static void table_full_vs_reduced(long evals)
     printf("\n");
 }
 
+/* Table 3: the dense fixed-width forms (dense.h) against aa_form on the
+ * same operands (u, v and the error symbols of building them: n <= 4) */
+enum { D_ADD, D_SUB, D_LINCOMB, D_MUL, D_RANGE, D_COUNT };
+static const char *const DENSE_NAMES[D_COUNT] = {"add", "sub", "lincomb", "mul", "range"};
+
+static double time_dense_op(int op, bool dense, const aa_operands *sets, long iters)
+{
+    aa_dense dx[NSETS], dy[NSETS], dz;
+    for (int k = 0; k < NSETS; k++) {
+        aa_dense_from_form(&dx[k], &sets[k].x);
+        aa_dense_from_form(&dy[k], &sets[k].y);
+    }
+    aa_form z;
+    double sum = 0.0;
+    double t0 = now_ns();
+    for (long i = 0; i < iters; i++) {
+        int k = (int)(i & (NSETS - 1));
+        const aa_operands *o = &sets[k];
+        aa_context c = o->ctx;
+        if (dense) {
+            switch (op) {
+            case D_ADD: aa_dense_add(&dz, &dx[k], &dy[k]); break;
+            case D_SUB: aa_dense_sub(&dz, &dx[k], &dy[k]); break;
+            case D_LINCOMB: aa_dense_lincomb(&dz, 0.8, &dx[k], 0.6, &dy[k], 0.1); break;
+            case D_MUL: aa_dense_mul(&c, &dz, &dx[k], &dy[k]); break;
+            default: dz.x0 = aa_dense_range(&dx[k]).hi; break;
+            }
+            sum += dz.x0;
+        } else {
+            switch (op) {
+            case D_ADD: aa_add(&c, &z, &o->x, &o->y); break;
+            case D_SUB: aa_sub(&c, &z, &o->x, &o->y); break;
+            case D_LINCOMB: aa_lincomb(&c, &z, 0.8, &o->x, 0.6, &o->y, 0.1); break;
+            case D_MUL: aa_mul(&c, &z, &o->x, &o->y); break;
+            default: z.x0 = aa_range(&o->x).hi; break;
+            }
+            sum += z.x0;
+        }
+    }
+    double t1 = now_ns();
+    g_sink = sum;
+    return (t1 - t0) / (double)iters;
+}
+
+static void table_dense(long iters)
+{
+    static aa_operands sets[NSETS];
+    for (int k = 0; k < NSETS; k++)
+        build_aa_operands(&sets[k], 0, k);
+    printf("dense fixed-width forms (dense.h, %d symbols + err, no hull) against aa_form,\n"
+           "ns per operation on the same operands (%ld iterations each)\n", AA_DENSE_W, iters);
+    printf("%-12s %10s %10s %8s\n", "operation", "aa_form", "dense", "ratio");
+    for (int op = 0; op < D_COUNT; op++) {
+        double f = time_dense_op(op, false, sets, iters), d = time_dense_op(op, true, sets, iters);
+        printf("%-12s %10.1f %10.1f %7.1fx\n", DENSE_NAMES[op], f, d, f / d);
+    }
+    printf("\n");
+}
+
 int main(int argc, char **argv)
 {
     int quick = 0;
@@ -399,6 +463,7 @@ int main(int argc, char **argv)
     printf("aa_bench%s: common/aa, AA_MAX_SYMBOLS %d, AA_DEFAULT_CAPACITY %d\n\n",
            quick ? " --quick" : "", AA_MAX_SYMBOLS, AA_DEFAULT_CAPACITY);
     table_ops(quick ? 20000 : 100000);
+    table_dense(quick ? 200000 : 2000000);
     table_full_vs_reduced(quick ? 300 : 1500);
     printf("total %.2f s\n", (now_ns() - t0) * 1e-9);
     return 0;

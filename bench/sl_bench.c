@@ -4,7 +4,11 @@
  * against its peer: a hand-written C version of the wave shader in float
  * mode, the same formula compiled by the C compiler.
  *
- *   sl_bench [--quick] [SHADER_DIR]
+ *   sl_bench [--quick] [--only NAME] [--affine-only | --mode M] [SHADER_DIR]
+ *
+ * --only NAME runs one library shader; --affine-only times float and affine
+ * only (the ratio the issue 24 aim is about); --mode M (0 float, 1 dual,
+ * 2 interval, 3 affine) times one mode alone, for `perf record`.
  *
  * Displacement shaders run on the plane P = (2u-1, 2v-1, 0), surface
  * shaders on the unit sphere, with (u, v) moving every evaluation; the
@@ -256,12 +260,22 @@ static double measure_peer(double seconds)
 
 int main(int argc, char **argv)
 {
-    bool quick = false;
-    const char *dir = AAFARM_SHADER_DIR;
+    bool quick = false, affine_only = false;
+    int only_mode = -1;
+    const char *dir = AAFARM_SHADER_DIR, *only = NULL;
     for (int i = 1; i < argc; i++) {
         if (strcmp(argv[i], "--quick") == 0)
             quick = true;
-        else
+        else if (strcmp(argv[i], "--affine-only") == 0)
+            affine_only = true;
+        else if (strcmp(argv[i], "--mode") == 0 && i + 1 < argc)
+            only_mode = atoi(argv[++i]);
+        else if (strcmp(argv[i], "--only") == 0 && i + 1 < argc)
+            only = argv[++i];
+        else if (strcmp(argv[i], "--help") == 0) {
+            printf("usage: sl_bench [--quick] [--only NAME] [--affine-only | --mode 0-3] [SHADER_DIR]\n");
+            return 0;
+        } else
             dir = argv[i];
     }
     double seconds = quick ? 0.05 : 0.5;
@@ -283,6 +297,8 @@ int main(int argc, char **argv)
     printf("  %s\n", "affine/float cost");
     double wave_float = 0;
     for (size_t s = 0; s < sizeof shaders / sizeof shaders[0]; s++) {
+        if (only && strcmp(only, shaders[s]) != 0)
+            continue;
         sl_program *p = load(dir, shaders[s]);
         if (!p) {
             fprintf(stderr, "sl_bench: cannot compile %s\n", shaders[s]);
@@ -294,17 +310,24 @@ int main(int argc, char **argv)
         sl_vm_set_fixed_lights(vm, lights, 2);
         result r[4];
         for (int m = 0; m < 4; m++)
-            r[m] = measure(vm, inst, (sl_mode)m, sphere, seconds);
+            r[m] = (affine_only && m != 0 && m != 3) || (only_mode >= 0 && m != only_mode)
+                       ? (result){ 0, 0 }
+                       : measure(vm, inst, (sl_mode)m, sphere, seconds);
         printf("%-9s %6ld", shaders[s], r[0].instructions);
         for (int m = 0; m < 4; m++)
             printf(" %10.1f", r[m].per_second / 1e3);
-        printf("  %.0fx\n", r[0].per_second / r[3].per_second);
-        if (s == 0)
+        if (r[0].per_second > 0 && r[3].per_second > 0)
+            printf("  %.1fx\n", r[0].per_second / r[3].per_second);
+        else
+            printf("\n");
+        if (strcmp(shaders[s], "wave") == 0)
             wave_float = r[0].per_second;
         sl_vm_destroy(&vm);
         sl_instance_destroy(&inst);
         sl_program_destroy(&p);
     }
+    if (wave_float == 0)
+        return 0;
     double peer = measure_peer(seconds);
     printf("\npeer: wave written in C, float: %.1f thousand evaluations per second;\n"
            "the VM's float mode runs wave at %.3f of that speed (%.1fx slower)\n",
