@@ -90,6 +90,7 @@
 
 #include "aa/affine.h"
 #include "aa/interval.h"
+#include "test_rng.h"
 
 _Static_assert(LDBL_MANT_DIG >= 64, "the oracle needs an extended long double");
 
@@ -113,10 +114,7 @@ typedef struct rng {
 
 static uint64_t splitmix64(uint64_t *x)
 {
-    uint64_t z = (*x += 0x9e3779b97f4a7c15u);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9u;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebu;
-    return z ^ (z >> 31);
+    return test_rng_next(x);
 }
 
 static void rng_seed(rng *r, uint64_t seed)

@@ -24,21 +24,14 @@
 #include <string.h>
 
 #include "aa/dense.h"
+#include "test_rng.h"
 
 enum { CASES = 60000, POINTS = 12 };
 
 static uint64_t g_rng = 0x5eedd15eu;
 
-static uint64_t rng_next(void)
-{
-    uint64_t z = (g_rng += 0x9e3779b97f4a7c15u);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9u;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebu;
-    return z ^ (z >> 31);
-}
-
-static int rng_int(int n) { return (int)(rng_next() % (uint64_t)n); }
-static double rng_unit(void) { return (double)(rng_next() >> 11) * 0x1p-53; }
+static int rng_int(int n) { return test_rng_int(&g_rng, n); }
+static double rng_unit(void) { return test_rng_unit(&g_rng); }
 
 /* a number of every kind the bounds care about; `scale` keeps most of one
  * case's numbers near one magnitude, so that sums cancel and round */

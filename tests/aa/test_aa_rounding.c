@@ -36,6 +36,7 @@
 #include <string.h>
 
 #include "aa/rounding.h"
+#include "test_rng.h"
 
 _Static_assert(LDBL_MANT_DIG >= 64, "these checks need an extended long double");
 
@@ -45,10 +46,7 @@ static uint64_t rng_state[4];
 
 static uint64_t splitmix64(uint64_t *x)
 {
-    uint64_t z = (*x += 0x9e3779b97f4a7c15u);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9u;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebu;
-    return z ^ (z >> 31);
+    return test_rng_next(x);
 }
 
 static void rng_seed(uint64_t seed)

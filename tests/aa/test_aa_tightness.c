@@ -38,6 +38,7 @@
 
 #include "aa/affine.h"
 #include "aa/interval.h"
+#include "test_rng.h"
 
 #define TWO_PI 6.283185307179586
 
@@ -47,10 +48,7 @@ static uint64_t g_rng = 0x7167e5u;
 
 static uint64_t rng_next(void)
 {
-    uint64_t z = (g_rng += 0x9e3779b97f4a7c15u);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9u;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebu;
-    return z ^ (z >> 31);
+    return test_rng_next(&g_rng);
 }
 
 static double rng_unit(void)

@@ -11,6 +11,7 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <unistd.h>
+#include "test_rng.h"
 
 /* ---- splitmix64 ---- */
 
@@ -23,10 +24,7 @@ void tu_seed(uint64_t seed)
 
 uint64_t tu_next(void)
 {
-    uint64_t z = (state += 0x9e3779b97f4a7c15u);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9u;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebu;
-    return z ^ (z >> 31);
+    return test_rng_next(&state);
 }
 
 uint32_t tu_below(uint32_t n)

@@ -28,6 +28,7 @@
 
 #include "samples.h"
 #include "wire_pb.h"
+#include "test_rng.h"
 
 /* ---------------------------------------------------------------------- */
 /* helpers                                                                 */
@@ -37,11 +38,7 @@ static uint64_t rng_state = 0x9e3779b97f4a7c15ull;
 
 static uint64_t rng(void)
 {
-    /* splitmix64 */
-    uint64_t z = (rng_state += 0x9e3779b97f4a7c15ull);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-    return z ^ (z >> 31);
+    return test_rng_next(&rng_state);
 }
 
 /* Sends frames[0..n) as one message with plain zmq_send (no checks). */

@@ -55,6 +55,7 @@
 #include "aa/interval.h"
 #include "aa/rounding.h"
 #include "sl/noise.h"
+#include "test_rng.h"
 
 _Static_assert(LDBL_MANT_DIG >= 64, "the reconstruction needs an extended long double");
 
@@ -81,10 +82,7 @@ static uint64_t rng_state = 0x5eed1234abcdef01u;
 
 static uint64_t rng_next(void)
 {
-    uint64_t z = (rng_state += 0x9e3779b97f4a7c15u);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9u;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebu;
-    return z ^ (z >> 31);
+    return test_rng_next(&rng_state);
 }
 
 static void rng_seed(uint64_t s) { rng_state = s; }
