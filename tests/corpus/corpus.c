@@ -12,6 +12,7 @@
 
 #include "sl/noise.h"
 #include "tex/tex.h"
+#include "test_rng.h"
 
 #ifndef AAFARM_CORPUS_DIR
 #error "AAFARM_CORPUS_DIR must name tests/shaders/corpus"
@@ -347,9 +348,5 @@ long corpus_env_long(const char *name, long def)
 
 double corpus_rng_uniform(corpus_rng *r)
 {
-    uint64_t z = (r->s += 0x9e3779b97f4a7c15ULL);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-    z ^= z >> 31;
-    return (double)(z >> 11) * 0x1.0p-53;
+    return test_rng_unit(&r->s);
 }
