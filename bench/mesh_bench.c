@@ -25,7 +25,9 @@
  *                                      subdiv: the torus as a Catmull-Clark
  *                                      cage, 4 limit pieces a face;
  *                                      displaced: bumped by a noise shader,
- *                                      its root boxes made lazily, then the
+ *                                      its root boxes made lazily, then
+ *                                      again under a worker's default
+ *                                      roots budget (the same image), then the
  *                                      world built again with all of them
  *                                      first, as before: "eager" rows)
  */
@@ -127,6 +129,59 @@ static long roots_known(const job_scene *js)
     return n;
 }
 
+/* The 128x128 image at one sample per pixel into rgba (its covered
+ * pixels into *hits): its CPU seconds */
+static double render_128(job_scene *js, double *rgba, long *hits)
+{
+    double t0 = cpu_now();
+    trace_thread *th = trace_thread_new(&js->world);
+    *hits = 0;
+    for (int y = 0; y < 128; y++)
+        for (int x = 0; x < 128; x++) {
+            double *px = rgba + 4 * (y * 128 + x), z;
+            trace_render_sample(js->renderer, th, x + 0.5, y + 0.5, px, &px[3], &z);
+            *hits += px[3] > 0;
+        }
+    trace_thread_destroy(&th);
+    return cpu_now() - t0;
+}
+
+/* The world built again lazily under a worker's default roots budget
+ * (4 MiB a thread: trace_options.roots_bytes, job_scene.c) and rendered
+ * again: its seconds, the roots made (evicted ones again where rays come
+ * back) and evicted, and the image
+ * against the unlimited store's (the same, to the bit) */
+static void budget_row(job_scene *js, int threads, const double *image, double render,
+                       long made)
+{
+    trace_renderer_destroy(&js->renderer);
+    js->world.options.roots_bytes = (size_t)threads << 22;
+    char err[256];
+    js->renderer = trace_renderer_new(&js->world, err, sizeof err);
+    if (!js->renderer) { fprintf(stderr, "%s\n", err); exit(1); }
+    double *again = malloc(sizeof *again * 128 * 128 * 4);
+    if (!again) { fprintf(stderr, "out of memory\n"); exit(1); }
+    long hits;
+    double t = render_128(js, again, &hits);
+    long evicted = 0, held = 0;
+    size_t bytes = 0;
+    for (int i = 0; i < js->world.nobjects; i++) {
+        const trace_mesh *m = js->world.objects[i].mesh;
+        if (!m || !m->lazy) continue;
+        evicted += trace_lazy_roots_evicted(m->lazy);
+        held += trace_lazy_roots_known(m->lazy);
+        bytes += trace_lazy_roots_bytes(m->lazy);
+    }
+    int differ = 0;
+    for (int i = 0; i < 128 * 128 * 4; i++) differ += image[i] != again[i];
+    printf("%9s under a roots budget of %d MiB (a worker's default, %d threads): render %.3f s "
+           "(unlimited %.3f), %ld roots made (unlimited %ld), %ld held in %zu bytes, %ld "
+           "evicted; %d values differ from the unlimited store's image\n", "", 4 * threads,
+           threads, t, render, held + evicted, made, held, bytes, evicted, differ);
+    free(again);
+    js->world.options.roots_bytes = 0;
+}
+
 int main(int argc, char **argv)
 {
     int max_faces = argc > 1 ? atoi(argv[1]) : 100000;
@@ -174,17 +229,10 @@ int main(int argc, char **argv)
         double world = wall_now() - t0;
         if (!js) { sl_diag_print(d, stderr); return 1; }
         long known_built = roots_known(js);
-        t0 = cpu_now();
-        trace_thread *th = trace_thread_new(&js->world);
+        double *image = malloc(sizeof *image * 128 * 128 * 4);
+        if (!image) { fprintf(stderr, "out of memory\n"); return 1; }
         long hits = 0;
-        for (int y = 0; y < 128; y++)
-            for (int x = 0; x < 128; x++) {
-                double rgb[3], a, z;
-                trace_render_sample(js->renderer, th, x + 0.5, y + 0.5, rgb, &a, &z);
-                hits += a > 0;
-            }
-        double render = cpu_now() - t0;
-        trace_thread_destroy(&th);
+        double render = render_128(js, image, &hits);
         long known_rendered = roots_known(js);
         /* bytes: the scene's meshes (shared arrays and 16-byte pieces), the
          * world's per-piece arrays */
@@ -216,10 +264,13 @@ int main(int argc, char **argv)
                (double)beyond / f, (double)bvh / f, peak_mib(), hits,
                (unsigned long long)digest);
         if (displaced) {
-            printf("%9s root boxes: %ld made with the world, %ld after the render; the world "
-                   "built again with all %ld first (eager): %.3f s wall\n", "", known_built,
-                   known_rendered, pieces, eager_world(js));
+            printf("%9s root boxes: %ld made with the world, %ld after the render\n", "",
+                   known_built, known_rendered);
+            budget_row(js, threads, image, render, known_rendered);
+            printf("%9s the world built again with all %ld first (eager): %.3f s wall\n", "",
+                   pieces, eager_world(js));
         }
+        free(image);
         job_scene_destroy(&js);
         job_destroy(&jb);
         sl_diag_destroy(&d);

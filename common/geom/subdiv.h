@@ -79,6 +79,13 @@ void geom_subdiv_face_points(const geom_subdiv *self, int f, int out[4]);
  * (a pure function of the cage: the same bits each time). */
 void geom_subdiv_surface(const geom_subdiv *self, int f, geom_surface *out);
 
+/* The control faces' corner offsets (nfaces + 1, from 0: face f's corners
+ * are fo[f] .. fo[f + 1] - 1) and points (the desc's verts) read from
+ * the caller's arrays from now on instead of the mesh's own copies
+ * (issue 23: 20 bytes a quad face): they must hold the same values (an
+ * assert) and outlive the mesh. */
+void geom_subdiv_share_faces(geom_subdiv *self, const int *fo, const int *verts);
+
 /* The bytes the mesh holds (its irregular faces' trees of local
  * refinements, grown while rendering, not counted), and of them (*points)
  * its control points. */

@@ -51,6 +51,8 @@ enum { SD_DRAWN = 1, SD_REGULAR = 2 };
 struct geom_subdiv {
     unsigned long serial;          /* a number of its own (subdiv_mesh.c's ring cache) */
     sd_mesh m0;                    /* the control mesh (vs, es NULL when all 0) */
+    bool faces_shared;             /* m0.fo, m0.fv are the caller's
+                                    * (geom_subdiv_share_faces): not freed */
     int nf1;                       /* refined faces (control corners) */
     int *vf_off, *vf;              /* control point -> faces holding it (CSR, ascending) */
     int maxval;                    /* the largest valence of the refined mesh (>= 4):

@@ -247,8 +247,10 @@ void geom_subdiv_destroy(geom_subdiv **self_p)
     sd_cache_clear(sd);
     free(sd->m0.P);
     free(sd->m0.vs);
-    free(sd->m0.fo);
-    free(sd->m0.fv);
+    if (!sd->faces_shared) {
+        free(sd->m0.fo);
+        free(sd->m0.fv);
+    }
     free(sd->m0.es);
     free(sd->vf_off);
     free(sd->vf);
@@ -258,12 +260,26 @@ void geom_subdiv_destroy(geom_subdiv **self_p)
     *self_p = NULL;
 }
 
+void geom_subdiv_share_faces(geom_subdiv *self, const int *fo, const int *verts)
+{
+    assert(!self->faces_shared);
+    int nf = self->m0.nf;
+    assert(memcmp(fo, self->m0.fo, (size_t)(nf + 1) * sizeof *fo) == 0);
+    assert(memcmp(verts, self->m0.fv, (size_t)self->m0.fo[nf] * sizeof *verts) == 0);
+    free(self->m0.fo);
+    free(self->m0.fv);
+    /* never written through: the control mesh is read only once made */
+    self->m0.fo = (int *)fo;
+    self->m0.fv = (int *)verts;
+    self->faces_shared = true;
+}
+
 size_t geom_subdiv_bytes(const geom_subdiv *self, size_t *points)
 {
     int nv = self->m0.nv, nf = self->m0.nf, nc = self->nf1;
     *points = (size_t)(nv + 1) * sizeof(vec3);
     return sizeof *self + *points + (self->m0.vs ? (size_t)(nv + 1) * sizeof(double) : 0) +
-           (size_t)(nf + 1 + nc + 1) * sizeof(int) +
+           (self->faces_shared ? 0 : (size_t)(nf + 1 + nc + 1) * sizeof(int)) +
            (self->m0.es ? (size_t)(nc + 1) * sizeof(double) : 0) +
            (size_t)(nv + 2 + nc + 1) * sizeof(int) + (size_t)nc + 1 +
            (size_t)(nc / 64 + 2) * sizeof(int) + (size_t)(self->nirr + 1) * sizeof(*self->roots);

@@ -600,6 +600,10 @@ static job_scene *build(job_scene *self, size_t cache_bytes, bool render, int th
         w->options.arith = jb->options.arith;
         w->options.max_instructions = jb->options.max_instructions;
         w->options.cache_bytes = cache_bytes;
+        /* the root boxes shared by the threads (trace/lazy_roots.h): as
+         * much again as their caches, so a worker's boxes stay within
+         * 2 x threads x cache_bytes (issue 23) */
+        w->options.roots_bytes = cache_bytes * (size_t)(threads > 1 ? threads : 1);
         w->options.cancel = cancel;
         w->options.build_threads = threads;
         if (sc->trace_maxdepth >= 0) w->options.max_ray_depth = sc->trace_maxdepth;

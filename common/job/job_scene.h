@@ -31,7 +31,9 @@ typedef struct job_scene {
     int ngroups;
 } job_scene;
 
-/* cache_bytes: this worker's box cache budget per thread (0: unlimited).
+/* cache_bytes: this worker's box cache budget per thread (0: unlimited);
+ * the displaced meshes' root boxes, shared by the threads, get as much
+ * again per thread (trace_options.roots_bytes).
  * render: also prepare the renderer (root boxes and BVH). cancel: the
  * program's stop flag (trace_options.cancel) or NULL. NULL on errors
  * (in diag; "interrupted" when cancel was set). The job must outlive the

@@ -389,6 +389,12 @@ void scene_mesh_set_index(scene_mesh *self, int index);
 struct geom_subdiv;
 void scene_mesh_set_subdiv(scene_mesh *self, const struct geom_subdiv *sd, const int *nverts,
                            int nfaces);
+/* A subdivision mesh's control faces' first face-vertices (nfaces + 1)
+ * and the face-vertices' points (its vertex indices): what its refined
+ * mesh reads for its control faces (geom_subdiv_share_faces; the scene
+ * holds both, and outlives the worker's world) */
+const int *scene_mesh_face_offsets(const scene_mesh *self);
+const int *scene_mesh_indices(const scene_mesh *self);
 vec3 scene_mesh_corner_normal(scene_mesh_nclass ncls, const double *N, int face,
                               const int *idx, int fv0, int i);
 /* Hands a mesh (with pieces) to the scene, placed as one object with the

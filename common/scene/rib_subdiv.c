@@ -290,6 +290,10 @@ static void subdivision_mesh(rib_parser *p, const rib_request *req, bool hier)
                         "the boundary: add the tag \"interpolateboundary\")");
             scene_mesh_destroy(&m);
         } else {
+            /* the refined mesh reads its control faces from the scene's
+             * mesh (16 + 4 bytes a quad face less: issue 23), which the
+             * scene holds as long as it */
+            if (sd) geom_subdiv_share_faces(sd, scene_mesh_face_offsets(m), scene_mesh_indices(m));
             rib_add_mesh(p, req, m);
         }
     }

@@ -130,6 +130,18 @@ void scene_mesh_set_subdiv(scene_mesh *self, const struct geom_subdiv *sd, const
     for (int f = 0; f < nfaces; f++) self->fo[f + 1] = self->fo[f] + nverts[f];
 }
 
+const int *scene_mesh_face_offsets(const scene_mesh *self)
+{
+    assert(self->sd && !self->counted);
+    return self->fo;
+}
+
+const int *scene_mesh_indices(const scene_mesh *self)
+{
+    assert(!self->counted);
+    return self->idx;
+}
+
 void scene_mesh_add_piece(scene_mesh *self, scene_piece_kind kind, int face, int fv0,
                           const int k[3], int ncorners)
 {

@@ -34,7 +34,9 @@ typedef struct edge_sort {
     trace_edge *const *part;           /* the list: its parts, in order */
     const size_t *len;
     int nparts;
-    trace_edge *out;                   /* the sorted list (n) */
+    trace_edge *out;                   /* the slice being sorted: buckets
+                                        * [b0, b1), the list's [base, base + m) */
+    size_t b0, b1, base, m;
     size_t n;
     int top, threads;
     size_t *count;                     /* per part, per bucket: its edges in
@@ -61,15 +63,21 @@ static void *count_parts(void *arg)
     return NULL;
 }
 
+/* the slice's edges of thread t's parts, to where they go in it */
 static void *deal_parts(void *arg)
 {
     edge_sort_share *sh = arg;
     const edge_sort *s = sh->s;
     int shift = 64 - s->top;
+    size_t b0 = s->b0, nb = s->b1 - s->b0;
+    trace_edge *out = s->out - s->base;
     for (int p = sh->t; p < s->nparts; p += s->threads) {
         size_t *at = s->count + ((size_t)p << s->top);
         const trace_edge *e = s->part[p];
-        for (size_t i = 0; i < s->len[p]; i++) s->out[at[e[i].h >> shift]++] = e[i];
+        for (size_t i = 0; i < s->len[p]; i++) {
+            size_t b = (size_t)(e[i].h >> shift);
+            if (b - b0 < nb) out[at[b]++] = e[i];
+        }
     }
     return NULL;
 }
@@ -103,40 +111,46 @@ static void sort_bucket(trace_edge *e, trace_edge *scratch, size_t m, int bits)
     assert(from == e);
 }
 
-/* thread t's buckets: those whose first edge lies in its t-th of out */
+/* thread t's buckets of the slice: those whose first edge lies in its
+ * t-th of the slice */
 static void *sort_buckets(void *arg)
 {
     edge_sort_share *sh = arg;
     const edge_sort *s = sh->s;
-    size_t lo = s->n * (size_t)sh->t / (size_t)s->threads;   /* n < 2^31 (refs) */
-    size_t hi = s->n * (size_t)(sh->t + 1) / (size_t)s->threads;
-    for (size_t b = 0; b < (size_t)1 << s->top; b++) {
+    size_t lo = s->base + s->m * (size_t)sh->t / (size_t)s->threads;   /* n < 2^31 (refs) */
+    size_t hi = s->base + s->m * (size_t)(sh->t + 1) / (size_t)s->threads;
+    for (size_t b = s->b0; b < s->b1; b++) {
         size_t first = s->start[b], m = s->start[b + 1] - first;
         if (first < lo || first >= hi || m == 0) continue;
-        sort_bucket(s->out + first, sh->scratch, m, 64 - s->top);
+        sort_bucket(s->out + (first - s->base), sh->scratch, m, 64 - s->top);
     }
     return NULL;
 }
 
-trace_edge *trace_edges_sort_parts(trace_edge *const *parts, const size_t *lens, int nparts,
-                                   int threads)
+/* The sort of the list in slices (trace_edges_sort_each); buf: where the
+ * slices go (NULL: made here, and freed), as long as the list when
+ * slice_edges is 0 */
+static void sort_slices(trace_edge *const *parts, const size_t *lens, int nparts, int threads,
+                        size_t slice_edges, trace_edges_fn each, void *ctx, trace_edge *buf)
 {
     size_t n = 0;
     for (int p = 0; p < nparts; p++) n += lens[p];
-    trace_edge *out = xmalloc(sizeof *out * (n > 0 ? n : 1));
+    if (slice_edges == 0 || slice_edges > n) slice_edges = n;
+    trace_edge *own = NULL;
     if (n < EDGE_SORT_MIN || nparts > EDGE_PARTS_MAX) {
-        /* short (one qsort), or of many parts (one for the deal) */
+        /* short (one qsort), or of many parts (one for the deal): one
+         * slice, the whole list */
+        trace_edge *out = buf ? buf : (own = xmalloc(sizeof *out * (n > 0 ? n : 1)));
         size_t at = 0;
         for (int p = 0; p < nparts; p++) {
             if (lens[p] > 0) memcpy(out + at, parts[p], sizeof *out * lens[p]);
             at += lens[p];
         }
-        if (n < EDGE_SORT_MIN) {
-            qsort(out, n, sizeof *out, edge_cmp);
-            return out;
-        }
-        trace_edges_sort(out, n, threads);
-        return out;
+        if (n < EDGE_SORT_MIN) qsort(out, n, sizeof *out, edge_cmp);
+        else trace_edges_sort(out, n, threads);
+        if (each) each(ctx, out, n);
+        free(own);
+        return;
     }
 #ifndef NDEBUG
     const trace_edge *last = NULL;
@@ -146,7 +160,7 @@ trace_edge *trace_edges_sort_parts(trace_edge *const *parts, const size_t *lens,
             last = &parts[p][i];
         }
 #endif
-    edge_sort s = {.part = parts, .len = lens, .nparts = nparts, .out = out, .n = n, .top = 1,
+    edge_sort s = {.part = parts, .len = lens, .nparts = nparts, .n = n, .top = 1,
                    .threads = threads < 1 ? 1 : threads};
     while (s.top < 16 && (n >> s.top) > EDGE_BUCKET) s.top++;
     size_t nb = (size_t)1 << s.top;
@@ -168,14 +182,44 @@ trace_edge *trace_edges_sort_parts(trace_edge *const *parts, const size_t *lens,
     }
     s.start[nb] = at;
     assert(at == n);
-    trace_run_shares(sh, sizeof *sh, s.threads, deal_parts);
-    for (int t = 0; t < s.threads; t++) sh[t].scratch = xmalloc(sizeof *out * longest);
-    trace_run_shares(sh, sizeof *sh, s.threads, sort_buckets);
+    /* slices: runs of whole buckets, each at most slice_edges (or one
+     * bucket longer than that), dealt from the parts and sorted in turn */
+    if (slice_edges < longest) slice_edges = longest;
+    s.out = buf ? buf : (own = xmalloc(sizeof *s.out * slice_edges));
+    for (int t = 0; t < s.threads; t++) sh[t].scratch = xmalloc(sizeof *s.out * longest);
+    for (size_t b0 = 0; b0 < nb;) {
+        size_t b1 = b0 + 1;
+        while (b1 < nb && s.start[b1 + 1] - s.start[b0] <= slice_edges) b1++;
+        s.b0 = b0;
+        s.b1 = b1;
+        s.base = s.start[b0];
+        s.m = s.start[b1] - s.base;
+        trace_run_shares(sh, sizeof *sh, s.threads, deal_parts);
+        trace_run_shares(sh, sizeof *sh, s.threads, sort_buckets);
+        if (each && s.m > 0) each(ctx, s.out, s.m);
+        b0 = b1;
+    }
     for (int t = 0; t < s.threads; t++) free(sh[t].scratch);
+    free(own);
     free(sh);
     free(s.start);
     free(s.count);
+}
+
+trace_edge *trace_edges_sort_parts(trace_edge *const *parts, const size_t *lens, int nparts,
+                                   int threads)
+{
+    size_t n = 0;
+    for (int p = 0; p < nparts; p++) n += lens[p];
+    trace_edge *out = xmalloc(sizeof *out * (n > 0 ? n : 1));
+    sort_slices(parts, lens, nparts, threads, 0, NULL, NULL, out);   /* one slice */
     return out;
+}
+
+void trace_edges_sort_each(trace_edge *const *parts, const size_t *lens, int nparts, int threads,
+                           size_t slice_edges, trace_edges_fn each, void *ctx)
+{
+    sort_slices(parts, lens, nparts, threads, slice_edges, each, ctx, NULL);
 }
 
 void trace_edges_sort(trace_edge *e, size_t n, int threads)

@@ -25,6 +25,18 @@ typedef struct trace_edge {
 trace_edge *trace_edges_sort_parts(trace_edge *const *parts, const size_t *lens, int nparts,
                                    int threads);
 
+/* The same list, sorted the same, handed to each(ctx, e, n) in slices,
+ * in order (their concatenation is the list trace_edges_sort_parts
+ * returns), one slice held at a time: a slice is a run of the sort's
+ * buckets (the hashes' top bits), so equal hashes are never split
+ * between two, of at most slice_edges edges (0: the whole list) unless
+ * one bucket is longer. The peak beside the parts is a slice, not the
+ * list (issue 23: the world's edges at 10^7 faces). A short list (under
+ * 4096) or one of more than 64 parts is one slice. */
+typedef void (*trace_edges_fn)(void *ctx, const trace_edge *e, size_t n);
+void trace_edges_sort_each(trace_edge *const *parts, const size_t *lens, int nparts, int threads,
+                           size_t slice_edges, trace_edges_fn each, void *ctx);
+
 /* The same for one list e[0..n), in place. */
 void trace_edges_sort(trace_edge *e, size_t n, int threads);
 

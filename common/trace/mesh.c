@@ -110,7 +110,8 @@ static bool make(trace_thread *th, const trace_object *mesh_obj, int k, bool box
     }
     v->shared_edges = trace_mesh_shared_edges(m, k);
     double dudv[2];
-    const trace_box *known = m->lazy ? trace_lazy_root(m->lazy, k, dudv) : NULL;
+    trace_box held;                    /* its root box when the store holds it */
+    bool known = m->lazy && trace_lazy_root(m->lazy, k, &held, dudv);
     if (known) {
         v->du = dudv[0];               /* what a thread found first */
         v->dv = dudv[1];
@@ -119,7 +120,7 @@ static bool make(trace_thread *th, const trace_object *mesh_obj, int k, bool box
     }
     if (boxes) {
         if (v->displacement && known) {
-            v->root = *known;
+            v->root = held;
         } else if (v->displacement) {
             trace_surface_box(th, v, 0, 1, 0, 1, &v->root);
             /* a pure function of the piece: the first thread's is every
@@ -845,6 +846,23 @@ static void end_threads(trace_thread *th, trace_thread **made, int threads)
     }
 }
 
+/* Mesh m's share of the world's root-box budget (trace_options.roots_bytes;
+ * 0: unlimited): in proportion to its pieces among the displaced meshes'
+ * (a mesh placed by two objects counted twice: a smaller share) */
+static size_t roots_share(const trace_world *world, const trace_mesh *m)
+{
+    size_t budget = world->options.roots_bytes;
+    if (budget == 0) return 0;
+    double pieces = 0.0;
+    for (int i = 0; i < world->nobjects; i++) {
+        const trace_object *o = &world->objects[i];
+        if (o->mesh && o->displacement) pieces += o->mesh->npieces;
+    }
+    if (pieces <= m->npieces) return budget;
+    size_t share = (size_t)((double)budget * m->npieces / pieces);
+    return share > 0 ? share : 1;
+}
+
 /* The displaced mesh's BVH over boxes that hold its pieces (above) */
 static void build_displaced(trace_thread *th, const trace_object *obj)
 {
@@ -855,7 +873,7 @@ static void build_displaced(trace_thread *th, const trace_object *obj)
     m->bounds = NULL;
     m->bvh = trace_float_bvh_build((const float (*)[6])bounds, m->npieces,
                                    th->world->options.build_threads);
-    m->lazy = trace_lazy_roots_new(m->npieces);
+    m->lazy = trace_lazy_roots_new(m->npieces, roots_share(th->world, m));
     if (m->npieces == 0) {             /* no piece: an empty tree */
         free(bounds);
         return;
@@ -1002,9 +1020,10 @@ static int mesh_leaf(void *ctx, int k)
     mesh_walk *w = ctx;
     const trace_mesh *m = w->obj->mesh;
     double r0, r1, dudv[2];
-    /* a displaced piece's root box, as its walk tests it */
-    const trace_box *root = m->lazy ? trace_lazy_root(m->lazy, k, dudv) : NULL;
-    if (root && !trace_box_hit(root, w->ray, w->ray->tmin, w->best->t, &r0, &r1, NULL))
+    /* a displaced piece's root box, as its walk tests it (when held) */
+    trace_box root;
+    if (m->lazy && trace_lazy_root(m->lazy, k, &root, dudv) &&
+        !trace_box_hit(&root, w->ray, w->ray->tmin, w->best->t, &r0, &r1, NULL))
         return 0;
     const trace_object *v = trace_mesh_view(w->th, w->obj, k);
     if (!v) return -1;

@@ -16,6 +16,7 @@ void trace_options_default(trace_options *opt)
 {
     opt->arith = TRACE_ARITH_AFFINE;
     opt->cache_bytes = 0;
+    opt->roots_bytes = 0;
     opt->aa_capacity = 16;   /* a sphere alone takes 11 symbols (docs/renderer.md) */
     opt->max_instructions = 1000000;
     opt->leaf_fraction = 1.0;

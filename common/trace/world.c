@@ -335,6 +335,27 @@ static void mesh_edges_in_parallel(const trace_world *world, const trace_object 
     free(share);
 }
 
+/* The shared edges' marks from a slice of the sorted list: neighbours
+ * of equal hashes in two objects or pieces */
+enum { EDGE_SLICES = 4 };
+
+typedef struct marking {
+    trace_world *world;
+    const int *meshes;
+    int nmeshes;
+} marking;
+
+static void mark_slice(void *ctx, const world_edge *e, size_t n)
+{
+    marking *mk = ctx;
+    for (size_t i = 0; i + 1 < n; i++) {
+        size_t j = i + 1;
+        if (e[i].h != e[j].h || e[i].ref / 64 == e[j].ref / 64) continue;
+        mark_shared(mk->world, mk->meshes, mk->nmeshes, e[i].ref);
+        mark_shared(mk->world, mk->meshes, mk->nmeshes, e[j].ref);
+    }
+}
+
 /* The edges polygons share (the meshes of Polygon and PointsPolygons
  * calls, whose shared vertices are the same numbers under the same
  * transform): the hit proofs (intersect.c) stay off near them, where the
@@ -374,21 +395,16 @@ static void find_shared_edges(trace_world *world, const int *meshes, int nmeshes
         m->bounds = xmalloc(sizeof *m->bounds * (size_t)(m->npieces > 0 ? m->npieces : 1));
         mesh_edges_in_parallel(world, obj, &parts);
     }
-    e = trace_edges_sort_parts(parts.part, parts.len, parts.n, world->options.build_threads);
+    /* sorted a slice at a time (equal hashes never split between two):
+     * the list and a quarter of it held, not the list twice */
     n = 0;
-    for (int p = 0; p < parts.n; p++) {
-        n += parts.len[p];
-        free(parts.part[p]);
-    }
+    for (int p = 0; p < parts.n; p++) n += parts.len[p];
+    marking mk = {world, meshes, nmeshes};
+    trace_edges_sort_each(parts.part, parts.len, parts.n, world->options.build_threads,
+                          n / EDGE_SLICES + 1, mark_slice, &mk);
+    for (int p = 0; p < parts.n; p++) free(parts.part[p]);
     free(parts.part);
     free(parts.len);
-    for (size_t i = 0; i + 1 < n; i++) {
-        size_t j = i + 1;
-        if (e[i].h != e[j].h || e[i].ref / 64 == e[j].ref / 64) continue;
-        mark_shared(world, meshes, nmeshes, e[i].ref);
-        mark_shared(world, meshes, nmeshes, e[j].ref);
-    }
-    free(e);
     for (int j = 0; j < nmeshes; j++) trace_mesh_edges_done(world->objects[meshes[j]].mesh);
 }
 

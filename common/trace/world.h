@@ -217,6 +217,9 @@ typedef struct trace_camera {
 typedef struct trace_options {
     trace_arith arith;             /* bounding arithmetic */
     size_t cache_bytes;            /* per thread box cache budget; 0: unlimited */
+    size_t roots_bytes;            /* the displaced meshes' root boxes, shared
+                                      by the threads (trace/lazy_roots.h): the
+                                      world's budget for them; 0: unlimited */
     int aa_capacity;               /* noise symbols per box query */
     long max_instructions;         /* shader budget per evaluation */
     double leaf_fraction;          /* box size / pixel footprint at which to stop */

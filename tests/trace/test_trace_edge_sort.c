@@ -8,7 +8,10 @@
  * (groups of equal hashes, whose refs must stay in order: the shared
  * edges are found between neighbours), and all in one bucket or sharing
  * their low bits (the radix's digits, each of them, must count).
+ * Handed over in slices (trace_edges_sort_each), the list is the same,
+ * each slice within its size and no group of equal hashes split.
  */
+#include <malloc.h>
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -115,10 +118,91 @@ static void test_sorts_as_qsort(void **state)
     free(got);
 }
 
+/* ---- in slices ---------------------------------------------------------- */
+
+typedef struct slices {
+    trace_edge *got;                   /* the slices one after another */
+    size_t n, longest, count;
+    int split;                         /* equal hashes across a slice boundary */
+    size_t heap0, heap_over;           /* the heap before the sort; the most
+                                        * beyond it while a slice is handed over */
+} slices;
+
+/* Bytes the allocator holds (0 under a sanitizer's allocator) */
+static size_t heap_bytes(void)
+{
+    struct mallinfo2 mi = mallinfo2();
+    return mi.uordblks + mi.hblkhd;
+}
+
+static void take(void *ctx, const trace_edge *e, size_t n)
+{
+    slices *s = ctx;
+    assert_true(n > 0);
+    if (s->n > 0 && s->got[s->n - 1].h == e[0].h) s->split++;
+    memcpy(s->got + s->n, e, sizeof *e * n);
+    s->n += n;
+    if (n > s->longest) s->longest = n;
+    s->count++;
+    size_t h = heap_bytes();
+    if (h > s->heap0 && h - s->heap0 > s->heap_over) s->heap_over = h - s->heap0;
+}
+
+/* The slices of trace_edges_sort_each: qsort's list, in order, each within
+ * its size (the buckets here are far shorter than it), equal hashes never
+ * split, and several of them; the heap beside the parts is a slice */
+static void test_slices(void **state)
+{
+    (void)state;
+    enum { N = 300000, PARTS = 5 };
+    trace_edge *src = malloc(sizeof *src * N), *want = malloc(sizeof *src * N);
+    slices s = {.got = malloc(sizeof *src * N)};
+    assert_non_null(src);
+    assert_non_null(want);
+    assert_non_null(s.got);
+    for (int k = RANDOM; k <= FEW; k++) {
+        make(src, N, (kind)k);
+        memcpy(want, src, sizeof *src * N);
+        qsort(want, N, sizeof *want, cmp);
+        trace_edge *parts[PARTS];
+        size_t lens[PARTS];
+        for (int i = 0; i < PARTS; i++) {
+            parts[i] = src + (size_t)N * i / PARTS;
+            lens[i] = (size_t)N * (i + 1) / PARTS - (size_t)N * i / PARTS;
+        }
+        for (int threads = 1; threads <= 3; threads += 2) {
+            s.n = s.longest = s.count = 0;
+            s.split = 0;
+            s.heap_over = 0;
+            s.heap0 = heap_bytes();
+            trace_edges_sort_each(parts, lens, PARTS, threads, N / 4, take, &s);
+            printf("%s hashes, %d threads: %zu slices, the longest %zu edges (at most %d), "
+                   "%d groups of equal hashes split; the heap held %zu bytes beyond the "
+                   "parts (the list: %zu)\n", k == RANDOM ? "random" : "7",
+                   threads, s.count, s.longest, N / 4, s.split, s.heap_over,
+                   sizeof(trace_edge) * N);
+            assert_int_equal(s.n, N);
+            assert_memory_equal(s.got, want, sizeof *want * N);
+            assert_int_equal(s.split, 0);
+            if (k == RANDOM) {
+                /* buckets of ~16k edges: slices of nearly N / 4 */
+                assert_true(s.longest <= N / 4);
+                assert_true(s.count >= 4 && s.count <= 5);
+                /* a slice and the radix's scratch, far from the list */
+                assert_true(s.heap_over <= sizeof(trace_edge) * N / 2);
+            }
+        }
+    }
+    free(src);
+    free(want);
+    free(s.got);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_sorts_as_qsort),
+        cmocka_unit_test(test_slices),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

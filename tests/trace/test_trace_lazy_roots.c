@@ -15,6 +15,10 @@
  *   first, as before: world option lazy_roots off), and rendered by four
  *   threads at once it is the one thread's, with the same roots, to the
  *   bit, as the eager build's.
+ * - Under a budget for the roots (trace_options.roots_bytes) the store,
+ *   counted by the allocator, stays within it while 1 and 4 threads
+ *   render the whole mesh (roots evicted and made again), and the image
+ *   is the eager build's, to the bit.
  * - Where a region cannot bound its pieces (a displacement shader
  *   parameter from a primitive variable; a filter width that makes a
  *   region's bound useless), their roots are made when the world is built.
@@ -330,8 +334,7 @@ static void test_lazy_renders_as_eager(void **state)
     unsigned char *had = calloc((size_t)n, 1);
     for (int k = 0; k < n; k++) {
         double dudv[2];
-        const trace_box *r = trace_lazy_root(m->lazy, k, dudv);
-        if (r) roots[k] = *r, had[k] = 1;
+        if (trace_lazy_root(m->lazy, k, &roots[k], dudv)) had[k] = 1;
     }
     rebuild(&f, true);
     m = mesh_of(&f);
@@ -348,9 +351,9 @@ static void test_lazy_renders_as_eager(void **state)
     for (int k = 0; k < n; k++) {
         if (!had[k]) continue;
         double dudv[2];
-        const trace_box *r = trace_lazy_root(m->lazy, k, dudv);
-        assert_non_null(r);
-        assert_memory_equal(r, &roots[k], sizeof *r);
+        trace_box r;
+        assert_true(trace_lazy_root(m->lazy, k, &r, dudv));
+        assert_memory_equal(&r, &roots[k], sizeof r);
         same_roots++;
     }
     printf("%d pieces: 1 thread made %ld roots, 4 threads %ld (the eager build %d); "
@@ -371,6 +374,50 @@ static void test_lazy_renders_as_eager(void **state)
     free(lazy1);
     free(lazy4);
     free(eager);
+}
+
+/* ---- the roots' budget ------------------------------------------------ */
+
+/* The world's roots budget (trace_options.roots_bytes) kept, counted by
+ * the allocator while 1 and 4 threads render the whole mesh, whose roots
+ * would take several times the budget: roots are evicted and made again,
+ * and the image is the eager build's, to the bit */
+static void test_roots_budget_kept(void **state)
+{
+    (void)state;
+    enum { BUDGET = 8192 };
+    float *eager = malloc(sizeof(float) * PX), *img = malloc(sizeof(float) * PX);
+    fixture f;
+    open_grid(&f, 40, "Displacement \"bumps\"", false, false);
+    rebuild(&f, false);
+    render_parallel(&f, 2, eager);
+    long all = trace_lazy_roots_known(mesh_of(&f)->lazy);
+    f.js->world.options.roots_bytes = BUDGET;
+    for (int threads = 1; threads <= 4; threads += 3) {
+        rebuild(&f, true);
+        const trace_mesh *m = mesh_of(&f);
+        size_t before = fixture_heap_bytes();
+        long published = render_parallel(&f, threads, img);
+        size_t after = fixture_heap_bytes();
+        long known = trace_lazy_roots_known(m->lazy);
+        long evicted = trace_lazy_roots_evicted(m->lazy);
+        size_t held = trace_lazy_roots_bytes(m->lazy);
+        long grown = (long)after - (long)before;
+        printf("budget %d bytes, %d threads: %d slots for %d pieces (%ld roots eagerly); "
+               "%ld published, %ld held, %ld evicted; the store %zu bytes, the heap grew by "
+               "%ld; %d values differ from the eager image\n",
+               BUDGET, threads, trace_lazy_roots_slots(m->lazy), m->npieces, all, published,
+               known, evicted, held, grown, differ(img, eager));
+        assert_true(held <= BUDGET);
+        assert_true(known <= trace_lazy_roots_slots(m->lazy));
+        assert_true(evicted > 0);      /* the budget bit */
+        /* the allocator's count (0 under a sanitizer's allocator) */
+        if (after > 0) assert_true(grown <= BUDGET);
+        assert_int_equal(differ(img, eager), 0);
+    }
+    fixture_close(&f);
+    free(eager);
+    free(img);
 }
 
 /* ---- regions that cannot bound their pieces ------------------------- */
@@ -410,6 +457,7 @@ int main(void)
         cmocka_unit_test(test_boxes_hold_the_surface),
         cmocka_unit_test(test_grid_spacing_bounds),
         cmocka_unit_test(test_lazy_renders_as_eager),
+        cmocka_unit_test(test_roots_budget_kept),
         cmocka_unit_test(test_unbounded_regions_make_roots_first),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -8,7 +8,8 @@
  * refines to 4), parsed and made into a renderable world: beyond the
  * shared arrays (the control points and the scene's indices), what the
  * worker holds before any box is computed must be at most
- * FACE_BYTES_BEYOND a control face, and the pieces' BVH at most
+ * FACE_BYTES_BEYOND a control face (the issue's 64, tightened to what
+ * the code holds with a margin), and the pieces' BVH at most
  * PIECE_BVH_BYTES a piece. Until session 13 the worker kept the refined
  * mesh and the 16-point Bezier net of every regular refined face: ~2 KB a
  * control face. Under a sanitizer's allocator mallinfo2 counts nothing and
@@ -31,8 +32,10 @@
 #include "scene/scene_mesh.h"
 
 /* the budgets (issue 23): <= 64 bytes a face beyond the shared arrays
- * before any box; <= 32 of BVH a piece (the BVH is over the limit pieces) */
-enum { FACE_BYTES_BEYOND = 64, PIECE_BVH_BYTES = 32 };
+ * before any box, held here to 36 (29.2 measured since the control faces
+ * are read from the scene's arrays, geom_subdiv_share_faces; 49.2 with
+ * their copy); <= 32 of BVH a piece (the BVH is over the limit pieces) */
+enum { FACE_BYTES_BEYOND = 36, PIECE_BVH_BYTES = 32 };
 
 static void test_cage_bytes_per_face(void **state)
 {
