@@ -125,6 +125,41 @@ static void build(void)
     }
 }
 
+/* Keep only the points sector 0's sub-face depends on (the corners of
+ * the cells touching its 4 corners: the point's 2n+1 and 7 more, Stam's
+ * 2n+8), checking that one step maps them onto themselves; the test ring's
+ * points pos[] follow. */
+static int keep_subface(double (*pos)[3])
+{
+    int in[NMAX] = { 0 }, map[NMAX], m = 0;
+    static const int CELLS[][2] = { { 0, 0 }, { 1, 0 }, { 0, -1 }, { 1, -1 }, { 0, 1 }, { 1, 1 },
+                                    { -1, 0 }, { -1, 1 } };
+    for (int j = 0; j < n; j++)
+        for (int q = 0; q < 4; q++) in[idx(j, q == 1 || q == 2, q >= 2)] = 1;
+    for (int k = 0; k < 8; k++)
+        for (int q = 0; q < 4; q++) in[idx(0, CELLS[k][0] + (q == 1 || q == 2), CELLS[k][1] + (q >= 2))] = 1;
+    for (int c = 0; c < N; c++) map[c] = in[c] ? m++ : -1;
+    for (int r = 0; r < N; r++)
+        for (int c = 0; c < N; c++)
+            if (in[r] && !in[c] && S[r][c] != 0) return -1;       /* not closed */
+    for (int p = 0; p < 3; p++)
+        for (int q = 0; q < 16; q++)
+            for (int c = 0; c < N; c++)
+                if (!in[c] && E[p][q][c] != 0) return -2;
+    for (int r = 0; r < N; r++) {
+        if (!in[r]) continue;
+        for (int c = 0; c < N; c++)
+            if (in[c]) S[map[r]][map[c]] = S[r][c];
+        for (int d = 0; d < 3; d++) pos[map[r]][d] = pos[r][d];
+    }
+    for (int p = 0; p < 3; p++)
+        for (int q = 0; q < 16; q++)
+            for (int c = 0; c < N; c++)
+                if (in[c]) E[p][q][map[c]] = E[p][q][c];
+    N = m;
+    return m;
+}
+
 static void mulv(double y[NMAX], const double x[NMAX], int transpose)
 {
     double t[NMAX];
@@ -171,7 +206,70 @@ static void cross(const double a[3], const double b[3], double c[3])
 
 static double norm3(const double a[3]) { return sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]); }
 
-static double l0[NMAX];
+static double l0[NMAX], Chod;
+
+static double binom(int m, int i)
+{
+    double r = 1;
+    for (int k = 1; k <= i; k++) r = r * (m - i + k) / k;
+    return r;
+}
+
+/* cubic Bezier p[0..3] (2D) restricted to [t0, t1] (blossoms) */
+static void restrict4(const double p[4][2], double t0, double t1, double q[4][2])
+{
+    double ts[4][3] = { { t0, t0, t0 }, { t0, t0, t1 }, { t0, t1, t1 }, { t1, t1, t1 } };
+    for (int k = 0; k < 4; k++)
+        for (int d = 0; d < 2; d++) {
+            double a[4] = { p[0][d], p[1][d], p[2][d], p[3][d] };
+            for (int r = 0; r < 3; r++)
+                for (int i = 0; i < 3 - r; i++) a[i] = a[i] * (1 - ts[k][r]) + a[i + 1] * ts[k][r];
+            q[k][d] = a[0];
+        }
+}
+
+/* A lower bound of J = det(dchi/ds, dchi/dt) over a 2D bicubic net
+ * (net[4 j + i]) split into G x G pieces: the least Bernstein coefficient
+ * of the degree (5,5) product of its hodographs, per piece (the
+ * coefficients' convex hull holds the polynomial); times G^2 for the
+ * pieces' own parameters. Orientation sign s: bound of s J. */
+static double jac_low(const double net[16][2], int G, double sgn)
+{
+    double low = INFINITY;
+    for (int pj = 0; pj < G; pj++)
+        for (int pi = 0; pi < G; pi++) {
+            double H[4][4][2], P[4][4][2];
+            for (int j = 0; j < 4; j++) {
+                double row[4][2], out[4][2];
+                for (int i = 0; i < 4; i++) row[i][0] = net[4 * j + i][0], row[i][1] = net[4 * j + i][1];
+                restrict4((const double (*)[2])row, (double)pi / G, (double)(pi + 1) / G, out);
+                memcpy(H[j], out, sizeof out);
+            }
+            for (int i = 0; i < 4; i++) {
+                double col[4][2], out[4][2];
+                for (int j = 0; j < 4; j++) col[j][0] = H[j][i][0], col[j][1] = H[j][i][1];
+                restrict4((const double (*)[2])col, (double)pj / G, (double)(pj + 1) / G, out);
+                for (int j = 0; j < 4; j++) P[j][i][0] = out[j][0], P[j][i][1] = out[j][1];
+            }
+            /* hodographs: U[j][i] (j 0..3, i 0..2) degree (2 in s, 3 in t),
+             * V[j][i] (j 0..2, i 0..3) degree (3 in s, 2 in t) */
+            double C[6][6];
+            memset(C, 0, sizeof C);
+            for (int j = 0; j < 4; j++)
+                for (int i = 0; i < 3; i++)
+                    for (int l = 0; l < 3; l++)
+                        for (int k = 0; k < 4; k++) {
+                            double ux = 3 * (P[j][i + 1][0] - P[j][i][0]), uy = 3 * (P[j][i + 1][1] - P[j][i][1]);
+                            double vx = 3 * (P[l + 1][k][0] - P[l][k][0]), vy = 3 * (P[l + 1][k][1] - P[l][k][1]);
+                            double w = binom(2, i) * binom(3, k) / binom(5, i + k) *
+                                       binom(3, j) * binom(2, l) / binom(5, j + l);
+                            C[j + l][i + k] += w * (ux * vy - uy * vx);
+                        }
+            for (int a = 0; a < 6; a++)
+                for (int b = 0; b < 6; b++) low = fmin(low, sgn * C[a][b] * G * G);
+        }
+    return low;
+}
 
 /* subtract the limit point (constants do not change the normals; the
  * ring's differences, lambda^k small, keep their precision) */
@@ -188,6 +286,19 @@ static void study(int val)
 {
     n = val, N = 6 * n + 1;
     build();
+    static double X[NMAX][3], Xk[NMAX][3], Y[NMAX][3];
+    for (int c = 0; c < N; c++) {
+        int i = c == 0 ? 0 : (c - 1) / 6, a = c == 0 ? 0 : 1 + ((c - 1) % 6) / 3, b = c == 0 ? 0 : (c - 1) % 3;
+        double ang = 2 * M_PI * (i + (a + b > 0 ? (double)b / (a + b) : 0)) / n, rad = sqrt(a * a + b * b);
+        X[c][0] = rad * cos(ang), X[c][1] = rad * sin(ang);
+        X[c][2] = 0.3 * sin(3.0 * c) + 0.1 * rad * rad;
+    }
+    if (getenv("EV_SUBFACE")) {
+        int m = keep_subface(X);
+        printf("valence %d: the sub-face's points: %d (2n+8 = %d)%s\n", n, m, 2 * n + 8,
+               m < 0 ? ": NOT CLOSED" : "");
+        if (m < 0) return;
+    }
     /* l0: the limit mask (power iteration on S^T) */
     static double r1[NMAX], r2[NMAX], m1[NMAX], m2[NMAX];
     for (int c = 0; c < N; c++) l0[c] = 1.0 / N;
@@ -281,65 +392,55 @@ static void study(int val)
                 Cmax = fmax(Cmax, fmax(fabs(du[0]) + fabs(du[1]), fabs(dv[0]) + fabs(dv[1])));
             }
     }
-    /* omega_c = sup over the patches' derivative functionals a (sampled
-     * 9 x 9 per patch) and k of |(a^T B^k)_c| / lambda^k: then
-     * |a^T Y_k| <= lambda^k sum_c omega_c |Y_0 row c| for every k */
+    /* omega_c >= |(a^T B^k)_c| / lambda^k for every derivative functional
+     * a of the 3 patches at any (s, t) and every k <= 160: a is a convex
+     * combination of the hodograph functionals 3 (b_i+1,j - b_ij) (and
+     * likewise in v), so their largest |.| bounds it (not sampled) */
     static double omega[NMAX];
     memset(omega, 0, sizeof omega);
+    Chod = 0;
     for (int p = 0; p < 3; p++)
-        for (int sa = 0; sa <= 8; sa++)
-            for (int sb = 0; sb <= 8; sb++)
-                for (int dir = 0; dir < 2; dir++) {
-                    double sv = sa / 8., tv = sb / 8., dn[16];
-                    double Bs[4] = { (1 - sv) * (1 - sv) * (1 - sv), 3 * sv * (1 - sv) * (1 - sv),
-                                     3 * sv * sv * (1 - sv), sv * sv * sv };
-                    double Bt[4] = { (1 - tv) * (1 - tv) * (1 - tv), 3 * tv * (1 - tv) * (1 - tv),
-                                     3 * tv * tv * (1 - tv), tv * tv * tv };
-                    double Ds[3] = { (1 - sv) * (1 - sv), 2 * sv * (1 - sv), sv * sv };
-                    double Dt[3] = { (1 - tv) * (1 - tv), 2 * tv * (1 - tv), tv * tv };
-                    memset(dn, 0, sizeof dn);
-                    for (int j = 0; j < 4; j++)
-                        for (int i = 0; i < 3; i++) {
-                            if (dir == 0) {
-                                double w3 = 3 * Ds[i] * Bt[j];
-                                dn[4 * j + i + 1] += w3, dn[4 * j + i] -= w3;
-                            } else {
-                                double w3 = 3 * Bs[j] * Dt[i];
-                                dn[4 * (i + 1) + j] += w3, dn[4 * i + j] -= w3;
-                            }
-                        }
-                    double v[NMAX], t[NMAX];
-                    for (int c = 0; c < N; c++) {
-                        double sum = 0;
-                        for (int q = 0; q < 16; q++) sum += dn[q] * E[p][q][c];
-                        v[c] = sum;
-                    }
-                    for (int k = 0; k <= 160; k++) {
-                        double sc = pow(lam, -k);
-                        for (int c = 0; c < N; c++) omega[c] = fmax(omega[c], fabs(v[c]) * sc);
-                        for (int c = 0; c < N; c++) {
-                            double sum = 0;
-                            for (int q = 0; q < N; q++) sum += v[q] * B[q][c];
-                            t[c] = sum;
-                        }
-                        memcpy(v, t, sizeof t);
-                    }
+        for (int h = 0; h < 24; h++) {
+            int j = (h % 12) / 3, i = h % 3;            /* u: rows j, i -> i+1 */
+            int q1 = h < 12 ? 4 * j + i + 1 : 4 * (i + 1) + j, q0 = h < 12 ? 4 * j + i : 4 * i + j;
+            double v[NMAX], t[NMAX], cr1 = 0, cr2 = 0;
+            for (int c = 0; c < N; c++) v[c] = 3 * (E[p][q1][c] - E[p][q0][c]);
+            for (int c = 0; c < N; c++) cr1 += v[c] * r1[c], cr2 += v[c] * r2[c];
+            Chod = fmax(Chod, fabs(cr1) + fabs(cr2));
+            for (int k = 0; k <= 160; k++) {
+                double sc = pow(lam, -k);
+                for (int c = 0; c < N; c++) omega[c] = fmax(omega[c], fabs(v[c]) * sc);
+                for (int c = 0; c < N; c++) {
+                    double sum = 0;
+                    for (int q = 0; q < N; q++) sum += v[q] * B[q][c];
+                    t[c] = sum;
                 }
+                memcpy(v, t, sizeof t);
+            }
+        }
     double osum = 0;
     for (int c = 0; c < N; c++) osum += omega[c];
+    double Jlow[4];
+    for (int g = 0; g < 4; g++) {
+        Jlow[g] = INFINITY;
+        for (int p = 0; p < 3; p++) {
+            double net[16][2];
+            for (int q = 0; q < 16; q++) {
+                net[q][0] = net[q][1] = 0;
+                for (int c = 0; c < N; c++) net[q][0] += E[p][q][c] * r1[c], net[q][1] += E[p][q][c] * r2[c];
+            }
+            Jlow[g] = fmin(Jlow[g], jac_low((const double (*)[2])net, 1 << g, Jmax < 0 ? -1 : 1));
+        }
+    }
+    double Jbest = fmax(fmax(Jlow[0], Jlow[1]), fmax(Jlow[2], Jlow[3]));
     printf("valence %d: lambda %.6f (|det A|^1/2 %.6f, A = [%.2e %.2e; %.2e %.2e] - lambda I)\n", n, lam, lamA,
            A[0][0] - lam, A[0][1], A[1][0], A[1][1] - lam);
-    printf("  sum of omega %.3f (crude: 6 gamma = %.3f)\n", osum, 6 * gamma);
+    printf("  sum of omega %.3f (crude: 6 gamma = %.3f), C from hodographs %.3f\n", osum, 6 * gamma, Chod);
+    printf("  |J| >= %.4f / %.4f / %.4f / %.4f (Bernstein, 1 / 2x2 / 4x4 / 8x8 pieces; sampled %.4f)\n",
+           Jlow[0], Jlow[1], Jlow[2], Jlow[3], Jmax < 0 ? -Jmax : Jmin);
     printf("  gamma = sup ||B^k||/lambda^k = %.3f at k = %d (at k = 400: %.2e); J in [%.4f, %.4f], C_max %.3f\n",
            gamma, kmax, rowmax, Jmin, Jmax, Cmax);
-    /* a bumpy 3D ring, its levels: bound against sampled angles */
-    static double X[NMAX][3], Xk[NMAX][3], Y[NMAX][3];
-    for (int c = 0; c < N; c++) {
-        int i = c == 0 ? 0 : (c - 1) / 6, a = c == 0 ? 0 : 1 + ((c - 1) % 6) / 3, b = c == 0 ? 0 : (c - 1) % 3;
-        double ang = 2 * M_PI * (i + (a + b > 0 ? (double)b / (a + b) : 0)) / n, rad = sqrt(a * a + b * b + a * b * 0.0);
-        X[c][0] = rad * cos(ang), X[c][1] = rad * sin(ang);
-        X[c][2] = 0.3 * sin(3.0 * c) + 0.1 * rad * rad;
-    }
+    /* the bumpy 3D ring's levels: bound against sampled angles */
     printf("  level  bound (deg)  sampled (deg)  bound/sampled\n");
     for (int j = 0; j <= 22; j++) {
         /* T = L^T X, Y = Q X, ymax */
@@ -361,8 +462,8 @@ static void study(int val)
         for (int r = 0; r < N; r++) e += omega[r] * norm3(Y[r]);
         (void)gamma;
         if (getenv("EV_CRUDE")) e = 6 * gamma * ymax;
-        double rho = (2 * Cmax * fmax(norm3(t1), norm3(t2)) * e + e * e) /
-                     ((Jmin > 0 ? Jmin : -Jmax) * norm3(w));
+        double rho = (2 * Chod * fmax(norm3(t1), norm3(t2)) * e + e * e) /
+                     (Jbest * norm3(w));
         double bound = rho < 1 ? asin(rho) * 180 / M_PI : 90;
         /* sampled: patches E_p S^k X for k = 0..30 */
         double worst = 0;
