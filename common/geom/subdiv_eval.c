@@ -34,8 +34,6 @@
 
 #include "util/xalloc.h"
 
-bool sd_ev_normal_box(const sd_mesh *m, ia_interval Nn[3]);
-
 void sd_local_init(sd_local *L, int maxval)
 {
     assert(maxval >= 4);
@@ -600,17 +598,8 @@ bool geom_subdiv_unit_normal_box(const geom_surface *s, ia_interval u, ia_interv
     sd_range r;
     find_range(s, u.lo, u.hi, v.lo, v.hi, &r);
     vec3 N;
-    if (r.regular || can_split(&r, u, v)) return false;
-    if (!sd_node_unit_normal(r.normal_node, &N)) {
-        /* EXPERIMENT (numerical constants: not for merge) */
-        if (!getenv("EV_ROUTE") || r.level < 1) return false;
-        sd_local L;
-        sd_local_init(&L, sd_node_maxval(r.node));
-        sd_node_local(r.node, &L);
-        bool ok = sd_ev_normal_box(&L.m, Nn);
-        sd_local_clear(&L);
-        return ok;
-    }
+    if (r.regular || can_split(&r, u, v) || !sd_node_unit_normal(r.normal_node, &N))
+        return false;
     /* the exact normal, widened by 1e-6 for the float evaluation of points
      * near the irregular corner, whose normals tilt by the refinement's
      * rounding amplified by 2^level (1e-9 at 2^-22 from a crease point) */
