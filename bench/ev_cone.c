@@ -7,10 +7,10 @@
  * ring of regular sub-patches at each level k next to the EV (the points
  * 2^-k (a, b), (a, b) in [0,1]^2 minus [0,1/2)^2) and prints the largest
  * angle to the normal at 2^-26 from the EV (deeper, the float normals
- * are the refinement's rounding: Ng is exactly 0 past 2^-40 at valence 3), with the ratio of successive
- * levels, next to the eigenvalues that predict it (Stam 1998: the
- * subdominant lambda and the next one, mu; the normal's spread at level k
- * decays like (mu / lambda)^k, the sub-face's size like lambda^k).
+ * are the refinement's rounding: Ng is exactly 0 past 2^-40 at valence 3), with the ratio of
+ * successive levels, next to the eigenvalues that predict it (Stam 1998: the subdominant lambda and
+ * the next one, mu; the normal's spread at level k decays like (mu / lambda)^k, the sub-face's size
+ * like lambda^k).
  *
  * Usage: ev_cone [levels]   (valence 3 on a bent cube, 5, 6, 8 on fans)
  */
@@ -81,15 +81,18 @@ int main(int argc, char **argv)
     int levels = argc > 1 ? atoi(argv[1]) : 24;
     char why[200];
     /* a bent cube: its corner 0 has valence 3 */
-    static const double P[] = { -1, -1, -1, 1, -1, -1, 1, 1, -1, -1, 1, -1,
-                                -1, -1, 1, 1.2, -1, 1.1, 1.1, 0.8, 1.3, -1, 1, 0.9 };
-    static const int NV[] = { 4, 4, 4, 4, 4, 4 };
-    static const int V[] = { 0, 3, 2, 1, 4, 5, 6, 7, 0, 1, 5, 4, 1, 2, 6, 5, 2, 3, 7, 6, 3, 0, 4, 7 };
-    geom_subdiv_desc d = { 6, NV, V, 8, P, 0, NULL, NULL, NULL, 0, NULL, NULL, 0, NULL, false };
+    static const double P[] = {-1, -1, -1, 1,   -1, -1,  1,   1,   -1,  -1, 1, -1,
+                               -1, -1, 1,  1.2, -1, 1.1, 1.1, 0.8, 1.3, -1, 1, 0.9};
+    static const int NV[] = {4, 4, 4, 4, 4, 4};
+    static const int V[] = {0, 3, 2, 1, 4, 5, 6, 7, 0, 1, 5, 4, 1, 2, 6, 5, 2, 3, 7, 6, 3, 0, 4, 7};
+    geom_subdiv_desc d = {6, NV, V, 8, P, 0, NULL, NULL, NULL, 0, NULL, NULL, 0, NULL, false};
     geom_subdiv *sd = geom_subdiv_new(&d, why, sizeof why);
-    if (!sd) { fprintf(stderr, "ev_cone: cube: %s\n", why); return 1; }
+    if (!sd) {
+        fprintf(stderr, "ev_cone: cube: %s\n", why);
+        return 1;
+    }
     study("bent cube", sd, 0, 3, levels);
-    int vals[] = { 5, 6, 8 };
+    int vals[] = {5, 6, 8};
     for (int q = 0; q < 3; q++) {
         int n = vals[q];
         double fp[3 * 17];
@@ -104,10 +107,13 @@ int main(int argc, char **argv)
             fv[4 * i + 3] = 1 + 2 * ((i + 1) % n);
             fnv[i] = 4;
         }
-        geom_subdiv_desc fd = { n, fnv, fv, 2 * n + 1, fp, 0, NULL, NULL, NULL,
-                                0, NULL, NULL, 0, NULL, true };
+        geom_subdiv_desc fd = {n,    fnv, fv,   2 * n + 1, fp, 0,    NULL, NULL,
+                               NULL, 0,   NULL, NULL,      0,  NULL, true};
         sd = geom_subdiv_new(&fd, why, sizeof why);
-        if (!sd) { fprintf(stderr, "ev_cone: fan %d: %s\n", n, why); return 1; }
+        if (!sd) {
+            fprintf(stderr, "ev_cone: fan %d: %s\n", n, why);
+            return 1;
+        }
         char name[32];
         snprintf(name, sizeof name, "fan of %d", n);
         study(name, sd, 0, n, levels);
