@@ -408,7 +408,7 @@ static void study(int val)
         }
     memcpy(P, Q, sizeof P);
     double gamma = 0, rowmax = 0;
-    int kmax = 0;
+    int kmax = 0, khalf = -1;
     for (int k = 0; k <= 400; k++) {
         double nm = 0;
         for (int r = 0; r < N; r++) {
@@ -417,6 +417,7 @@ static void study(int val)
             nm = fmax(nm, s);
         }
         if (nm / pow(lam, k) > gamma) gamma = nm / pow(lam, k), kmax = k;
+        if (khalf < 0 && k > 0 && nm / pow(lam, k) <= 0.5) khalf = k;
         rowmax = nm / pow(lam, k);
         for (int r = 0; r < N; r++)
             for (int c = 0; c < N; c++) {
@@ -425,6 +426,24 @@ static void study(int val)
                 T[r][c] = s;
             }
         memcpy(P, T, sizeof P);
+    }
+    /* the couplings E = Q S R and F = L^T S Q (0 for exact eigenvectors) */
+    double Emax = 0, Fmax = 0;
+    for (int r = 0; r < N; r++) {
+        double e1 = 0, e2 = 0, f1 = 0, f2 = 0;
+        for (int q = 0; q < N; q++) {
+            double a1 = 0, a2 = 0;
+            for (int k = 0; k < N; k++) a1 += S[q][k] * r1[k], a2 += S[q][k] * r2[k];
+            e1 += Q[r][q] * a1, e2 += Q[r][q] * a2;
+        }
+        /* F's column r: sum_q (L^T S)_q Q[q][r] */
+        for (int q = 0; q < N; q++) {
+            double b1 = 0, b2 = 0;
+            for (int k = 0; k < N; k++) b1 += L1[k] * S[k][q], b2 += L2[k] * S[k][q];
+            f1 += b1 * Q[q][r], f2 += b2 * Q[q][r];
+        }
+        Emax = fmax(Emax, fmax(fabs(e1), fabs(e2)));
+        Fmax = fmax(Fmax, fmax(fabs(f1), fabs(f2)));
     }
     /* the characteristic map's 3 patches: J_min, C_max (sampled) */
     double Jmin = INFINITY, Jmax = -INFINITY, Cmax = 0;
@@ -488,6 +507,8 @@ static void study(int val)
     double Jbest = fmax(fmax(Jlow[0], Jlow[1]), fmax(Jlow[2], Jlow[3]));
     printf("valence %d: lambda %.6f (|det A|^1/2 %.6f, A = [%.2e %.2e; %.2e %.2e] - lambda I)\n", n,
            lam, lamA, A[0][0] - lam, A[0][1], A[1][0], A[1][1] - lam);
+    printf("  |E|, |F| <= %.1e, %.1e (max entries); ||B^k||/lambda^k <= 1/2 from k = %d\n", Emax,
+           Fmax, khalf);
     printf("  sum of omega %.3f (crude: 6 gamma = %.3f), C from hodographs %.3f\n", osum, 6 * gamma,
            Chod);
     printf("  |J| >= %.4f / %.4f / %.4f / %.4f (Bernstein, 1 / 2x2 / 4x4 / 8x8 pieces; sampled "
