@@ -205,7 +205,7 @@ static void mulv(double y[NMAX], const double x[NMAX], int transpose)
         for (int c = 0; c < N; c++) s += (transpose ? S[c][r] : S[r][c]) * x[c];
         t[r] = s;
     }
-    memcpy(y, t, sizeof t);
+    memcpy(y, t, sizeof t[0] * (size_t)N);   /* rows N.. are not the matrix's */
 }
 
 static void orth2(double a[NMAX], double b[NMAX])

@@ -263,9 +263,8 @@ void geom_subdiv_destroy(geom_subdiv **self_p)
 void geom_subdiv_share_faces(geom_subdiv *self, const int *fo, const int *verts)
 {
     assert(!self->faces_shared);
-    int nf = self->m0.nf;
-    assert(memcmp(fo, self->m0.fo, (size_t)(nf + 1) * sizeof *fo) == 0);
-    assert(memcmp(verts, self->m0.fv, (size_t)self->m0.fo[nf] * sizeof *verts) == 0);
+    assert(memcmp(fo, self->m0.fo, (size_t)(self->m0.nf + 1) * sizeof *fo) == 0);
+    assert(memcmp(verts, self->m0.fv, (size_t)self->m0.fo[self->m0.nf] * sizeof *verts) == 0);
     free(self->m0.fo);
     free(self->m0.fv);
     /* never written through: the control mesh is read only once made */
