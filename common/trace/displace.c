@@ -299,19 +299,27 @@ static void union_cases(trace_thread *th, const trace_object *obj, const affine_
     } while (!th->failed && sl_vm_split_next(th->vm));
 }
 
+/* The cell's base surface and the first of its case runs (the VM's
+ * splits begun; the caller ends them): its box in *hull */
+static void first_case(trace_thread *th, const trace_object *obj, double u0, double u1,
+                       double v0, double v1, affine_cell *cell, trace_box *hull)
+{
+    aa_form P[3];
+    affine_geometry(th, obj, u0, u1, v0, v1, cell);
+    sl_vm_split_begin(th->vm, TRACE_SPLIT_OPS);
+    affine_shade(th, obj, cell, P);
+    box_from_affine(P, hull);
+}
+
 bool trace_surface_box_cases(trace_thread *th, const trace_object *obj,
                              double u0, double u1, double v0, double v1, trace_box *box)
 {
     obj = trace_box_owner(obj);
     if (th->world->options.arith == TRACE_ARITH_INTERVAL || !obj->displacement) return false;
     sl_vm *vm = th->vm;
-    aa_form P[3];
     trace_box hull;
     affine_cell cell;
-    affine_geometry(th, obj, u0, u1, v0, v1, &cell);
-    sl_vm_split_begin(vm, TRACE_SPLIT_OPS);
-    affine_shade(th, obj, &cell, P);
-    box_from_affine(P, &hull);
+    first_case(th, obj, u0, u1, v0, v1, &cell, &hull);
     if (sl_vm_split_full(vm)) {
         /* more seams than cases: the rest would stay as wide as one run
          * makes them: not worth the runs */
@@ -370,13 +378,9 @@ bool trace_surface_box_split(trace_thread *th, const trace_object *obj,
         return false;
     }
     sl_vm *vm = th->vm;
-    aa_form P[3];
     trace_box hull;
     affine_cell cell;
-    affine_geometry(th, o, u0, u1, v0, v1, &cell);
-    sl_vm_split_begin(vm, TRACE_SPLIT_OPS);
-    affine_shade(th, o, &cell, P);
-    box_from_affine(P, &hull);
+    first_case(th, o, u0, u1, v0, v1, &cell, &hull);
     bool full = sl_vm_split_full(vm);
     if (!full && (th->failed || !sl_vm_split_next(vm))) {
         /* nothing split (or failed): the run was box_affine's own */
@@ -390,6 +394,7 @@ bool trace_surface_box_split(trace_thread *th, const trace_object *obj,
          * (box_affine's run on the same cell) */
         sl_vm_split_end(vm);
         th->stats.boxes++;
+        aa_form P[3];
         affine_shade(th, o, &cell, P);
         box_from_affine(P, box);
         box_finish(th, box);
