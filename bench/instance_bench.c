@@ -6,11 +6,14 @@
  * once as N ObjectInstance of one definition and once as N separate
  * Sphere requests; 256 x 256 pixels at one sample per pixel on one thread
  * with an unlimited box cache. Prints the objects that share their
- * prototype's boxes, the cache's peak bytes and broods, the boxes
- * computed and the render CPU seconds. Never fails on timing.
+ * prototype's boxes (objects, or placements of a group: trace/group.h),
+ * the bytes the scene and world hold (job_scene_new, with the allocator),
+ * the cache's peak bytes and broods, the boxes computed and the render
+ * CPU seconds. Never fails on timing.
  *
  *   instance_bench [max_n]     (N = 1, 4, 16, 64 up to max_n; default 64)
  */
+#include <malloc.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -67,6 +70,13 @@ static char *scene_rib(int n, bool instanced, size_t *len)
     return t;
 }
 
+/* bytes the allocator holds (glibc) */
+static size_t heap_bytes(void)
+{
+    struct mallinfo2 mi = mallinfo2();
+    return mi.uordblks + mi.hblkhd;
+}
+
 static int run(int n, bool instanced)
 {
     size_t len, llen, plen;
@@ -88,10 +98,18 @@ static int run(int n, bool instanced)
     free(lumpy);
     free(plastic);
     sl_diag *d = sl_diag_new();
+    size_t before = heap_bytes();
     job_scene *js = job_scene_new(jb, 0, true, NULL, d);
     if (!js) { sl_diag_print(d, stderr); return 1; }
+    size_t held = heap_bytes() - before;
+    /* objects sharing a prototype's boxes, and placements (trace/group.h)
+     * that are their prototype moved */
     int shared = 0;
-    for (int i = 0; i < js->world.nobjects; i++) shared += js->world.objects[i].box_proto != NULL;
+    for (int i = 0; i < js->world.nobjects; i++) {
+        const trace_object *o = &js->world.objects[i];
+        shared += o->box_proto != NULL;
+        if (o->group && o->group->first_id >= 0) shared += o->group->n - o->group->nown;
+    }
     trace_thread *th = trace_thread_new(&js->world);
     double t0 = cpu_now();
     long covered = 0;
@@ -103,8 +121,8 @@ static int run(int n, bool instanced)
         }
     double secs = cpu_now() - t0;
     const trace_boxcache_stats *c = trace_boxcache_stats_get(th->cache);
-    printf("%4d %-10s %7d %12.1f %10zu %12ld %10.3f %9ld\n", n,
-           instanced ? "instances" : "copies", shared, c->peak_bytes / 1024.0,
+    printf("%4d %-10s %7d %10.1f %12.1f %10zu %12ld %10.3f %9ld\n", n,
+           instanced ? "instances" : "copies", shared, held / 1024.0, c->peak_bytes / 1024.0,
            c->peak_bytes / trace_boxcache_brood_bytes(), th->stats.boxes, secs, covered);
     trace_thread_destroy(&th);
     job_scene_destroy(&js);
@@ -116,8 +134,8 @@ static int run(int n, bool instanced)
 int main(int argc, char **argv)
 {
     int max_n = argc > 1 ? atoi(argv[1]) : 64;
-    printf("%4s %-10s %7s %12s %10s %12s %10s %9s\n", "N", "written as", "shared",
-           "cache KiB", "broods", "boxes", "render s", "pixels");
+    printf("%4s %-10s %7s %10s %12s %10s %12s %10s %9s\n", "N", "written as", "shared",
+           "scene KiB", "cache KiB", "broods", "boxes", "render s", "pixels");
     for (int n = 1; n <= max_n; n *= 4)
         for (int inst = 1; inst >= 0; inst--)
             if (run(n, inst)) return 1;

@@ -150,18 +150,19 @@ void rib_place_surface(rib_parser *p, const rib_request *req, const geom_surface
         rib_error(p, req, req->pos, "the current transform is singular (a Scale by 0?)");
         return;
     }
-    /* an undisplaced instance is a reference in the renderer (trace/group.h):
-     * a few hundred bytes, where an object of its own takes ~14 KB */
-    bool reference = again && a->displacement < 0;
+    /* an instance (but of a displaced mesh) is a reference in the renderer
+     * (trace/group.h): a few hundred bytes, where an object of its own
+     * takes ~9 KB */
+    bool reference = again && (a->displacement < 0 || !mesh);
     if (reference ? p->ninstances >= SCENE_MAX_INSTANCES : p->nown >= p->max_objects) {
         if (!p->objects_overflow) {
             if (reference)
-                rib_error(p, req, req->pos, "too many instances (the limit is %ld undisplaced "
-                          "instances per scene): split the scene into several renders",
+                rib_error(p, req, req->pos, "too many instances (the limit is %ld instances "
+                          "per scene): split the scene into several renders",
                           (long)SCENE_MAX_INSTANCES);
             else
                 rib_error(p, req, req->pos, "too many objects (the limit is %d per scene, "
-                          "undisplaced instances apart): split the scene into several renders, "
+                          "instances apart): split the scene into several renders, "
                           "use fewer, larger primitives, or place repeated ones with "
                           "ObjectInstance", p->max_objects);
         }

@@ -166,7 +166,7 @@ typedef struct rib_parser {
     sl_pos motion_pos;
     int max_objects;               /* SCENE_MAX_OBJECTS or the caller's */
     long nown;                     /* objects counted against it */
-    long ninstances;               /* undisplaced instances (SCENE_MAX_INSTANCES) */
+    long ninstances;               /* instances, displaced meshes' apart (SCENE_MAX_INSTANCES) */
     bool objects_overflow;         /* that limit was reported */
     unsigned char *mesh_counted;   /* per scene mesh (its index): its pieces are in
                                       scene.npieces for its undisplaced placements */
@@ -434,8 +434,8 @@ bool rib_motion_filter(rib_parser *p, const rib_request *req);
  * surface was written. vars_kept: vars[0..nvars) is kept by the scene (a
  * recorded part's) and the object may point at it. again: a later
  * ObjectInstance placement of a recorded part (a reference in the
- * renderer when undisplaced: it counts against SCENE_MAX_INSTANCES, not
- * the objects' limit). */
+ * renderer but for a displaced mesh: it counts against
+ * SCENE_MAX_INSTANCES, not the objects' limit). */
 void rib_place_surface(rib_parser *p, const rib_request *req, const geom_surface *surf,
                        const scene_mesh *mesh, mat4 ctm, sl_pos pos,
                        const scene_primvar *vars, int nvars, bool vars_kept, bool again);

@@ -330,19 +330,19 @@ int scene_archive_read(sl_source_set *set, const char *name, const char *path,
 /* How deep archives may read archives. */
 enum { SCENE_ARCHIVE_MAX_DEPTH = 16 };
 
-/* The most objects a scene may place (primitives, meshes, displaced
- * instances: each an object of its own in the renderer, ~14 KB;
- * undisplaced instances have their own limit below), so that a scene
+/* The most objects a scene may place (primitives, meshes, instances of
+ * displaced meshes: each an object of its own in the renderer, ~9 KB;
+ * other instances have their own limit below), so that a scene
  * received over the network
  * cannot exhaust the memory of the master or a worker (issue 12). The
  * scene text itself is bounded by the source size (4 MiB, sl/source.h),
  * each archive by SCENE_ARCHIVE_MAX_BYTES. */
 enum { SCENE_MAX_OBJECTS = 1 << 20 };
 
-/* The most undisplaced ObjectInstance placements a scene may hold: each is
- * a reference in a worker (trace/group.h: ~500 bytes with its scene
- * object, docs/renderer.md "Instances as references"), so 2^24 of them fit
- * a 24 GB worker; displaced instances count as objects. */
+/* The most ObjectInstance placements a scene may hold: each is a
+ * reference in a worker (trace/group.h: ~500 bytes with its scene object,
+ * docs/renderer.md "Instances as references"), so 2^24 of them fit a 24 GB
+ * worker; instances of displaced meshes count as objects. */
 enum { SCENE_MAX_INSTANCES = 1 << 24 };
 
 /* The most mesh pieces (a face, or a triangle of one) a scene may hold
@@ -396,7 +396,7 @@ scene *scene_parse_frame_threads(const char *file, const char *text, size_t len,
                                  int threads, const atomic_int *cancel, sl_diag *diag);
 
 /* What a check's parse (scene_check_frame) asks of its caller: whether
- * an undisplaced instance the renderer would keep as a reference to its
+ * an instance the renderer would keep as a reference to its
  * prototype (scene_object_placeable) is one it can place (its transforms:
  * the renderer's own test); false with a message, reported at the
  * ObjectInstance. */
@@ -421,9 +421,10 @@ scene *scene_check_frame(const char *file, const char *text, size_t len,
 
 /* May object o, a later placement of the recorded surface that object
  * proto placed first (o->instance_of), be a reference to it in the
- * renderer (trace/group.h): the same surface in object space, undisplaced,
- * the same shaders, sides, lights, primitive variables and name, only its
- * transform and colour its own? */
+ * renderer (trace/group.h): the same surface in object space (not a
+ * displaced mesh), the same shaders (displacement included), sides,
+ * lights, primitive variables and name, only its transform, orientation
+ * and colour its own? */
 bool scene_object_placeable(const scene_object *o, const scene_object *proto);
 
 /* The frames of a RIB without reading any of them: their FrameBegin

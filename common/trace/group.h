@@ -9,12 +9,18 @@
  * scale, normal bounds and du/dv derived again, and the prototype's ids:
  * the placements of an undisplaced surface or mesh are the same surface
  * in object space, where boxes and cell caches live, so they share them
- * (its `place` keeps their views apart). A view is a pure function of the
- * scene: the same on any thread or host.
+ * (its `place` keeps their views apart). A displaced surface's placement
+ * (never a displaced mesh's) has an id of its own and is either the
+ * prototype's displaced surface moved rigidly (trace/instance.c: its
+ * boxes are the prototype's) or its own surface with its own boxes,
+ * decided for every placement when the group is built (group.c,
+ * docs/renderer.md "Instances as references"). A view is a pure function
+ * of the scene: the same on any thread or host.
  *
  * Per placement the world holds a 24-byte float box, ~16 bytes of BVH and
  * what the adapter keeps to make it again (job_scene.c: its scene object's
- * index); the scene holds the placement's scene_object.
+ * index), a displaced one 4 bytes more (and its root box when it has its
+ * own surface); the scene holds the placement's scene_object.
  */
 #ifndef TRACE_GROUP_H
 #define TRACE_GROUP_H
@@ -22,8 +28,11 @@
 #include "trace/mesh.h"
 
 /* The placements' boxes and BVH of group object g (its prototype's root
- * must be known) and g's root and bound (their union, camera space). */
-void trace_group_build(trace_group *group, const trace_world *world, trace_object *g);
+ * must be known) and g's root and bound (their union, camera space); for
+ * a displaced prototype first which placements are its surface moved
+ * (the shader runs on th). False when the thread failed or was
+ * cancelled. */
+bool trace_group_build(trace_thread *th, trace_group *group, trace_object *g);
 
 /* Nearest hit of the camera-space ray with the placements in
  * (ray->tmin, best->t) (trace_intersect_object's contract); a hit's

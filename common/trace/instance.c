@@ -28,6 +28,7 @@
  */
 #include "trace/instance.h"
 
+#include <assert.h>
 #include <math.h>
 
 #include "trace/displace.h"
@@ -85,16 +86,23 @@ static bool same_surface(trace_thread *th, trace_object *obj, const trace_object
     return compared > 0;
 }
 
-static bool can_share(trace_thread *th, trace_object *obj, const trace_object *proto)
+bool trace_instance_rigid(trace_object *obj, const trace_object *proto)
 {
-    if (proto->id >= obj->id || proto->box_proto || !obj->displacement ||
-        obj->displacement != proto->displacement || obj->flip != proto->flip ||
-        obj->surf.kind != proto->surf.kind || !shader_allows(obj->displacement))
+    if (proto->box_proto || !obj->displacement || obj->displacement != proto->displacement ||
+        obj->flip != proto->flip || obj->surf.kind != proto->surf.kind ||
+        !shader_allows(obj->displacement))
         return false;
     obj->from_proto = mat4_mul(obj->to_camera, proto->from_camera);
     obj->to_proto = mat4_mul(proto->to_camera, obj->from_camera);
-    if (!rigid(&obj->from_proto)) return false;
-    return same_surface(th, obj, proto);
+    return rigid(&obj->from_proto);
+}
+
+bool trace_instance_moves(trace_thread *th, trace_object *obj, const trace_object *proto)
+{
+    assert(!obj->box_proto);
+    bool moves = trace_instance_rigid(obj, proto) && same_surface(th, obj, proto);
+    obj->box_proto = NULL;
+    return moves;
 }
 
 int trace_instances_share(trace_thread *th, trace_world *world)
@@ -104,7 +112,7 @@ int trace_instances_share(trace_thread *th, trace_world *world)
         trace_object *obj = &world->objects[i];
         const trace_object *proto = obj->box_proto;
         obj->box_proto = NULL;
-        bool share = proto && can_share(th, obj, proto);   /* sets box_proto meanwhile */
+        bool share = proto && proto->id < obj->id && trace_instance_moves(th, obj, proto);
         obj->box_proto = share ? proto : NULL;
         shared += share;
     }

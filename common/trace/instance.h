@@ -23,4 +23,15 @@
  * trace_renderer_new after trace_world_prepare. */
 int trace_instances_share(trace_thread *th, trace_world *world);
 
+/* Whether obj (box_proto NULL) may be proto's displaced surface moved:
+ * the same displacement instance without output parameters, orientation
+ * and kind of surface, and a rigid motion between their camera spaces
+ * (set into obj->from_proto, to_proto). No shader runs. */
+bool trace_instance_rigid(trace_object *obj, const trace_object *proto);
+
+/* trace_instance_rigid, and the probe: obj's own displaced points and
+ * normals on a 5 x 5 grid of (u,v) equal proto's moved ones (the shader
+ * runs on th). obj->box_proto is NULL on return either way. */
+bool trace_instance_moves(trace_thread *th, trace_object *obj, const trace_object *proto);
+
 #endif

@@ -30,7 +30,7 @@ trace_renderer *trace_renderer_new(trace_world *world, char *err, size_t errsz)
         trace_object *obj = &world->objects[i];
         if (obj->group) {
             /* its placements' boxes (its prototype, before it, is built) */
-            trace_group_build(obj->group, world, obj);
+            trace_group_build(th, obj->group, obj);
             continue;
         }
         if (obj->mesh) {

@@ -453,7 +453,12 @@ bool trace_world_check(trace_world *world, char *err, size_t errsz)
         if (obj->group) {
             /* after its prototype (the adapter appends the groups) */
             assert(obj->group->proto >= 0 && obj->group->proto < i &&
-                   !world->objects[obj->group->proto].group);
+                   !world->objects[obj->group->proto].group &&
+                   !world->objects[obj->group->proto].box_proto);
+            /* a displaced mesh's boxes run its shader in its own camera
+             * space: its placements are objects of their own */
+            assert(!world->objects[obj->group->proto].mesh ||
+                   !world->objects[obj->group->proto].displacement);
             obj->group->first = places;
             places += obj->group->n;
             continue;
@@ -499,6 +504,21 @@ bool trace_world_prepare(trace_world *world, char *err, size_t errsz)
         m->first_id = (int)next;
         next += m->npieces;
         meshes[nmeshes++] = i;                 /* the mesh's first placing object */
+    }
+    /* then each displaced group's placements (trace_group.first_id) */
+    for (int i = 0; i < world->nobjects; i++) {
+        trace_group *gr = world->objects[i].group;
+        if (!gr) continue;
+        gr->first_id = -1;
+        if (!world->objects[gr->proto].displacement) continue;
+        if (next + gr->n > INT32_MAX / 64) {
+            free(meshes);
+            return err_set(err, errsz, "%s: too many objects and pieces in the scene (%ld "
+                           "before these %d instances)", world->objects[i].name,
+                           next - world->nobjects, gr->n);
+        }
+        gr->first_id = (int)next;
+        next += gr->n;
     }
     world->nids = (int)next;
     find_shared_edges(world, meshes, nmeshes);

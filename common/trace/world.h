@@ -94,11 +94,14 @@ typedef struct trace_mesh {
 } trace_mesh;
 
 /* Instances kept as references (issue 23, trace/group.h): the objects
- * that place one recorded surface or mesh again, undisplaced and with the
- * prototype's shaders, each only a transform and a colour in the scene;
- * ONE world object (a "group") stands for them, a BVH over their
- * camera-space boxes, and a placement becomes a full trace_object (a view)
- * only where a ray reaches it. */
+ * that place one recorded surface or mesh again with the prototype's
+ * shaders, each only a transform and a colour in the scene; ONE world
+ * object (a "group") stands for them, a BVH over their camera-space
+ * boxes, and a placement becomes a full trace_object (a view) only where
+ * a ray reaches it. A displaced surface's placement is its prototype's
+ * displaced surface moved rigidly (box_proto) where that is the surface
+ * its own shader gives (trace/instance.c), else a surface of its own
+ * with its own boxes. */
 typedef struct trace_group {
     int n;                         /* placements */
     int proto;                     /* the prototype: its index in world.objects
@@ -116,6 +119,15 @@ typedef struct trace_group {
      * frees them) */
     int first;                     /* placement k's number in the world: first + k */
     struct trace_mesh_bvh *bvh;    /* over the placements' camera-space boxes */
+    /* a displaced prototype's placements (else first_id = -1, own = NULL):
+     * placement k's view has the id first_id + k (its own cell caches: its
+     * points are in its camera space); own[k] < 0: it is the prototype
+     * moved (its boxes are the prototype's), else its root box is
+     * own_roots[own[k]] and its boxes are its own (under its id) */
+    int first_id;
+    int32_t *own;
+    trace_box *own_roots;
+    int nown;
 } trace_group;
 
 typedef struct trace_object {

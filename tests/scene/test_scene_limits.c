@@ -1,7 +1,7 @@
 /*
  * tests/scene/test_scene_limits.c: the limits on a scene received from
- * outside (issue 12): the number of objects (primitives and displaced
- * instances alike, undisplaced instances apart; more is one error naming
+ * outside (issue 12): the number of objects (primitives and instances
+ * of displaced meshes alike, other instances apart; more is one error naming
  * the request that passes the limit, with file:line:col, and no scene) and the size of the scene text
  * read from disk (the source size limit, a clear error naming the file).
  */
@@ -44,47 +44,54 @@ static void test_objects_over_the_limit(void **state)
     assert_int_equal(sl_diag_error_count(d), 1);      /* reported once */
     assert_string_equal(diag_line(nth_diag(d, SL_DIAG_ERROR, 0)),
                         "t.rib:7:1: Sphere: too many objects (the limit is 3 per scene, "
-                        "undisplaced instances apart): split the scene into several renders, "
+                        "instances apart): split the scene into several renders, "
                         "use fewer, larger primitives, or place repeated ones with "
                         "ObjectInstance");
     sl_diag_destroy(&d);
 }
 
 /* Instancing multiplies objects cheaply: ten instances of a definition
- * of four spheres are forty objects. Undisplaced, they are references in
- * the renderer (a few hundred bytes each) and have their own limit
- * (SCENE_MAX_INSTANCES): the objects' limit counts only the definition's
- * first placement. Displaced, each is an object of its own and counts. */
+ * of four surfaces are forty objects. They are references in the
+ * renderer (a few hundred bytes each: trace/group.h), displaced or not,
+ * and have their own limit (SCENE_MAX_INSTANCES): the objects' limit
+ * counts only the definition's first placement. A displaced mesh's
+ * instance is an object of its own (its shader runs in its own camera
+ * space) and counts. */
 static void test_instances_count(void **state)
 {
     (void)state;
     char text[4096];
-    for (int displaced = 0; displaced < 2; displaced++) {
-        size_t o = (size_t)snprintf(text, sizeof text,
-                                    CAMERA "WorldBegin\n%sObjectBegin 1\n" SPHERE SPHERE SPHERE
-                                    SPHERE "ObjectEnd\n",
-                                    displaced ? "Displacement \"dented\"\n" : "");
+    static const char *const kinds[] = {"", "Displacement \"dented\"\n", "Displacement \"dented\"\n"};
+#define QUAD "PointsPolygons [4] [0 1 2 3] \"P\" [0 0 0 1 0 0 1 1 0 0 1 0]\n"
+    for (int kind = 0; kind < 3; kind++) {
+        bool mesh = kind == 2;
+        size_t o = (size_t)snprintf(text, sizeof text, CAMERA "WorldBegin\n%sObjectBegin 1\n%s%s%s%s"
+                                    "ObjectEnd\n", kinds[kind], mesh ? QUAD : SPHERE,
+                                    mesh ? QUAD : SPHERE, mesh ? QUAD : SPHERE,
+                                    mesh ? QUAD : SPHERE);
         for (int i = 0; i < 10; i++)
             o += (size_t)snprintf(text + o, sizeof text - o, "ObjectInstance 1\n");
         snprintf(text + o, sizeof text - o, "WorldEnd\n");
         sl_diag *d;
-        scene *s = parse_limited(text, displaced ? 40 : 4, &d);
+        scene *s = parse_limited(text, mesh ? 40 : 4, &d);
         assert_non_null(s);
         assert_int_equal(s->nobjects, 40);
         scene_destroy(&s);
         sl_diag_destroy(&d);
-        /* undisplaced: the first placement's four are objects; displaced:
-         * all forty, the 40th passes a limit of 39 */
-        s = parse_limited(text, displaced ? 39 : 3, &d);
+        /* references: the first placement's four are objects; a displaced
+         * mesh's: all forty, the 40th passes a limit of 39 */
+        s = parse_limited(text, mesh ? 39 : 3, &d);
         assert_null(s);
         assert_int_equal(sl_diag_error_count(d), 1);
         const sl_diagnostic *e = nth_diag(d, SL_DIAG_ERROR, 0);
         assert_non_null(e);
-        assert_int_equal(e->line, displaced ? 20 : 10);   /* the tenth, the first instance */
-        assert_non_null(strstr(e->message, displaced ? "ObjectInstance: too many objects (the limit is 39"
-                                                      : "ObjectInstance: too many objects (the limit is 3"));
+        /* the tenth instance, or the first (after a Displacement line) */
+        assert_int_equal(e->line, mesh ? 20 : kind == 1 ? 11 : 10);
+        assert_non_null(strstr(e->message, mesh ? "ObjectInstance: too many objects (the limit is 39"
+                                                : "ObjectInstance: too many objects (the limit is 3"));
         sl_diag_destroy(&d);
     }
+#undef QUAD
 }
 
 /* scene_parse uses the default limit. */

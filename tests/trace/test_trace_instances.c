@@ -1,22 +1,29 @@
 /*
  * test_trace_instances.c: instances share one box cache per object in
- * object space (issue 14, "no copy per instance"; trace/instance.c).
+ * object space (issue 14, "no copy per instance"; trace/instance.c) and
+ * are references, not copies (issue 23; trace/group.h).
  *
  * A displaced sphere (bumps from "object"-space P along normalize(N))
  * placed four times by ObjectInstance, each moved and turned differently,
  * against the same four spheres written out as separate copies:
- *   - the instances share their prototype (box_proto) and its cache
- *     entries: after a render no instance but the first has a root brood of
- *     its own, and the cache holds under half the bytes of the copies'
- *     (which have a root brood each);
+ *   - the instances are the prototype and one group of three placements,
+ *     each the prototype moved, sharing its cache entries: after a render
+ *     no instance but the first has a root brood of its own, and the
+ *     cache holds under half the bytes of the copies' (which have a root
+ *     brood each);
  *   - the two images agree (alpha in the same pixels but for 1 % on
  *     silhouettes, colours within a small tolerance: the instances' hits
  *     come from other boxes of the same surface);
- *   - containment: for the instances, random (u,v) ranges' boxes (from the
- *     prototype) hold the instance's own surface points, mapped to object
- *     space, up to a few ulps: 0 violations;
- *   - the fall-backs: a shader of camera-space P, or a scaled instance,
- *     keeps its own boxes.
+ *   - containment: for the placements, random (u,v) ranges' boxes (from
+ *     the prototype) hold the placement's own surface points, mapped to
+ *     object space, up to a few ulps, and its camera-space bound (the
+ *     group's BVH) holds them: 0 violations;
+ *   - the fall-backs: a shader of camera-space P gives every placement
+ *     its own boxes, a scaled instance its own;
+ *   - bytes: 2,000 displaced instances cost a few hundred bytes each
+ *     with the allocator (a full object each was ~9 KB), and with more
+ *     placements than the probe asks, a shader of camera-space P still
+ *     gives every one its own boxes.
  */
 #include <float.h>
 #include <math.h>
@@ -30,6 +37,7 @@
 
 #include "fixture.h"
 #include "trace/displace.h"
+#include "trace/group.h"
 #include "trace/render.h"
 
 static const char *BUMPS_SL =
@@ -40,11 +48,13 @@ static const char *BUMPS_SL =
     "    N = calculatenormal(P);\n"
     "}\n";
 
-/* the same bumps from camera-space P: depends on where the instance is */
+/* bumps from camera-space P, their height growing to the right: depends
+ * on where the instance is (the right one's stand out of the left one's
+ * box) */
 static const char *CAMBUMPS_SL =
     "displacement cambumps(float Km = 0.08)\n"
     "{\n"
-    "    P += Km * sin(7 * xcomp(P)) * sin(6 * ycomp(P)) * normalize(N);\n"
+    "    P += Km * (2 + xcomp(P)) * (1 + sin(7 * xcomp(P)) * sin(6 * ycomp(P))) * normalize(N);\n"
     "    N = calculatenormal(P);\n"
     "}\n";
 
@@ -84,30 +94,44 @@ static const char *PLASTIC_SL =
 typedef struct shot {
     float *rgba;
     size_t peak_bytes;
-    int own_roots;                 /* objects with a root brood of their own */
-    int shared;                    /* objects with a box_proto */
+    int own_roots;                 /* ids with a root brood of their own */
+    int shared;                    /* surfaces using their prototype's boxes */
 } shot;
 
-static void render(const char *rib, shot *out)
+/* The surfaces of the world that use their prototype's boxes: objects
+ * with a box_proto, and the placements of groups that are their
+ * prototype moved (trace/group.h). */
+static int count_shared(const trace_world *w)
+{
+    int n = 0;
+    for (int i = 0; i < w->nobjects; i++) {
+        const trace_group *g = w->objects[i].group;
+        n += w->objects[i].box_proto != NULL;
+        if (g && g->first_id >= 0) n += g->n - g->nown;
+    }
+    return n;
+}
+
+static void render(const char *rib, int nobjects, shot *out)
 {
     fixture f;
     fixture_shader sh[] = {{"bumps", BUMPS_SL}, {"cambumps", CAMBUMPS_SL},
                            {"plastic", PLASTIC_SL}};
     assert_true(fixture_open(&f, rib, sh, 3, NULL, 0));
     const trace_world *w = &f.js->world;
-    assert_int_equal(w->nobjects, N);
+    assert_int_equal(w->nobjects, nobjects);
     trace_thread *th = trace_thread_new(w);
     out->rgba = calloc((size_t)W * H * 4, sizeof *out->rgba);
     float *z = calloc((size_t)W * H, sizeof *z);
     assert_true(trace_render_tile(f.js->renderer, th, 0, 0, W, H, out->rgba, z));
     out->peak_bytes = trace_boxcache_stats_get(th->cache)->peak_bytes;
-    out->own_roots = out->shared = 0;
-    for (int i = 0; i < N; i++) {
+    out->own_roots = 0;
+    for (int i = 0; i < w->nids; i++) {
         trace_box kids[4];
         if (trace_boxcache_lookup(th->cache, i, TRACE_BROOD_NONE, 0, kids) != TRACE_BROOD_NONE)
             out->own_roots++;
-        if (w->objects[i].box_proto) out->shared++;
     }
+    out->shared = count_shared(w);
     free(z);
     trace_thread_destroy(&th);
     fixture_close(&f);
@@ -118,8 +142,8 @@ static void test_instances_share_the_prototypes_cache(void **state)
     (void)state;
     char *a = scene_rib(true, "bumps", false), *b = scene_rib(false, "bumps", false);
     shot inst, copies;
-    render(a, &inst);
-    render(b, &copies);
+    render(a, 2, &inst);               /* the prototype, a group of N - 1 */
+    render(b, N, &copies);
     free(a);
     free(b);
     printf("box cache: %d instances %zu bytes (%d root broods), %d copies %zu bytes "
@@ -164,22 +188,31 @@ static double vmax_abs(vec3 a)
     return fmax(fabs(a.x), fmax(fabs(a.y), fabs(a.z)));
 }
 
-/* boxes from the prototype, points of each instance: 0 violations */
-static void test_shared_boxes_contain_every_instance(void **state)
+/* boxes from the prototype (bumps) or the placement's own (cambumps),
+ * points of each placement: 0 violations */
+static void check_placements_contained(const char *shader)
 {
-    (void)state;
-    char *rib = scene_rib(true, "bumps", false);
+    char *rib = scene_rib(true, shader, false);
     fixture f;
-    fixture_shader sh[] = {{"bumps", BUMPS_SL}, {"plastic", PLASTIC_SL}};
-    assert_true(fixture_open(&f, rib, sh, 2, NULL, 0));
+    fixture_shader sh[] = {{"bumps", BUMPS_SL}, {"cambumps", CAMBUMPS_SL},
+                           {"plastic", PLASTIC_SL}};
+    assert_true(fixture_open(&f, rib, sh, 3, NULL, 0));
     free(rib);
+    bool moved = strcmp(shader, "bumps") == 0;
     const trace_world *w = &f.js->world;
+    assert_int_equal(w->nobjects, 2);
+    const trace_object *g = &w->objects[1];
+    assert_non_null(g->group);
+    assert_int_equal(g->group->n, N - 1);
     trace_thread *th = trace_thread_new(w);
+    trace_view *view = malloc(sizeof *view);
     unsigned seed = 12345;
     long points = 0, violations = 0;
-    for (int i = 1; i < N; i++) {
-        const trace_object *obj = &w->objects[i];
-        assert_non_null(obj->box_proto);
+    for (int i = 0; i < N - 1; i++) {
+        assert_true(trace_group_view_make(th, g, i, view));
+        const trace_object *obj = &view->obj;
+        assert_ptr_equal(obj->box_proto, moved ? &w->objects[0] : NULL);
+        assert_int_equal(obj->id, g->group->first_id + i);
         for (int c = 0; c < 300; c++) {
             double side = ldexp(1.0, -(int)(c % 10));
             seed = seed * 1103515245u + 12345u;
@@ -200,12 +233,34 @@ static void test_shared_boxes_contain_every_instance(void **state)
                     violations++;
             }
         }
+        /* and the placement's root box (whose camera-space box the
+         * group's BVH holds) holds its points */
+        const trace_box *r = &obj->root;
+        for (int k = 0; k < 400; k++) {
+            trace_surface_point sp;
+            trace_surface_point_eval(th, obj, (k % 20) / 19.0, (k / 20) / 19.0, &sp);
+            vec3 p = mat4_xform_point(&obj->from_camera, sp.P);
+            double slack = 8 * DBL_EPSILON * (vmax_abs(sp.P) + vmax_abs(p));
+            points++;
+            if (p.x < r->lo.x - slack || p.x > r->hi.x + slack || p.y < r->lo.y - slack ||
+                p.y > r->hi.y + slack || p.z < r->lo.z - slack || p.z > r->hi.z + slack)
+                violations++;
+        }
     }
     assert_false(th->failed);
-    printf("instances: %ld points in shared boxes, %ld violations\n", points, violations);
+    printf("%s placements: %ld points in %s boxes, %ld violations\n", shader, points,
+           moved ? "shared" : "their own", violations);
     assert_int_equal(violations, 0);
+    free(view);
     trace_thread_destroy(&th);
     fixture_close(&f);
+}
+
+static void test_shared_boxes_contain_every_instance(void **state)
+{
+    (void)state;
+    check_placements_contained("bumps");
+    check_placements_contained("cambumps");
 }
 
 /* camera-space P, or a scaled instance: each keeps its own boxes */
@@ -214,8 +269,8 @@ static void test_fall_back_to_own_boxes(void **state)
     (void)state;
     char *a = scene_rib(true, "cambumps", false), *b = scene_rib(true, "bumps", true);
     shot cam, scaled;
-    render(a, &cam);
-    render(b, &scaled);
+    render(a, 2, &cam);
+    render(b, 2, &scaled);
     free(a);
     free(b);
     assert_int_equal(cam.shared, 0);
@@ -226,12 +281,77 @@ static void test_fall_back_to_own_boxes(void **state)
     free(scaled.rgba);
 }
 
+/* n instances of the bumped sphere, each moved and turned (rigid) */
+static char *many_rib(int n, const char *shader)
+{
+    size_t cap = (size_t)n * 120 + 4096, len = 0;
+    char *s = malloc(cap);
+    assert_non_null(s);
+    int side = (int)ceil(sqrt(n));
+    len += (size_t)snprintf(s + len, cap - len,
+        "Format 16 16 1\nProjection \"perspective\" \"fov\" [40]\nTranslate 0 0 %d\n"
+        "WorldBegin\nSurface \"plastic\"\nDisplacement \"%s\" \"float Km\" [0.08]\n"
+        "ObjectBegin 1\n  Sphere 0.4 -0.4 0.4 360\nObjectEnd\n", side + 2, shader);
+    for (int i = 0; i < n; i++)
+        len += (size_t)snprintf(s + len, cap - len,
+                                "AttributeBegin\nTranslate %d %d 0\nRotate %d 0.3 1 0.2\n"
+                                "ObjectInstance 1\nAttributeEnd\n",
+                                i % side - side / 2, i / side - side / 2, (i * 37) % 360);
+    snprintf(s + len, cap - len, "WorldEnd\n");
+    return s;
+}
+
+/* the budget per displaced instance, everything included (the scene's
+ * object, the RIB text, the group's BVH share and per-placement word) */
+enum { DISPLACED_INSTANCE_BYTES = 600, MANY = 2001 };
+
+static size_t world_bytes(int n, const char *shader, int *shared, int *placements)
+{
+    char *rib = many_rib(n, shader);
+    fixture_shader sh[] = {{"bumps", BUMPS_SL}, {"cambumps", CAMBUMPS_SL},
+                           {"plastic", PLASTIC_SL}};
+    size_t before = fixture_heap_bytes();
+    fixture f;
+    assert_true(fixture_open(&f, rib, sh, 3, NULL, 0));
+    size_t after = fixture_heap_bytes();
+    const trace_world *w = &f.js->world;
+    *shared = count_shared(w);
+    *placements = 0;
+    for (int i = 0; i < w->nobjects; i++)
+        if (w->objects[i].group) *placements += w->objects[i].group->n;
+    fixture_close(&f);
+    free(rib);
+    return after - before;
+}
+
+static void test_displaced_instances_are_references(void **state)
+{
+    (void)state;
+    int shared, placed;
+    size_t one = world_bytes(1, "bumps", &shared, &placed);
+    assert_int_equal(placed, 0);
+    size_t many = world_bytes(MANY, "bumps", &shared, &placed);
+    double per = (double)(many - one) / (MANY - 1);
+    printf("%d displaced instances: %zu bytes held, %zu for one: %.0f bytes per instance "
+           "(budget %d); %d of %d placements are the prototype moved\n", MANY, many, one, per,
+           DISPLACED_INSTANCE_BYTES, shared, placed);
+    assert_int_equal(placed, MANY - 1);
+    assert_int_equal(shared, MANY - 1);
+    if (one > 0) assert_true(per <= DISPLACED_INSTANCE_BYTES);
+    /* more placements than the probe asks (PROBE_PLACEMENTS): the shader
+     * of camera-space P still gives each its own surface */
+    world_bytes(200, "cambumps", &shared, &placed);
+    assert_int_equal(placed, 199);
+    assert_int_equal(shared, 0);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_instances_share_the_prototypes_cache),
         cmocka_unit_test(test_shared_boxes_contain_every_instance),
         cmocka_unit_test(test_fall_back_to_own_boxes),
+        cmocka_unit_test(test_displaced_instances_are_references),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
