@@ -11,7 +11,8 @@
  * the cache's peak bytes and broods, the boxes computed and the render
  * CPU seconds. Never fails on timing.
  *
- *   instance_bench [max_n]     (N = 1, 4, 16, 64 up to max_n; default 64)
+ *   instance_bench [max_n] [--instances-only]
+ *                              (N = 1, 4, 16, 64 up to max_n; default 64)
  */
 #include <malloc.h>
 #include <math.h>
@@ -133,11 +134,21 @@ static int run(int n, bool instanced)
 
 int main(int argc, char **argv)
 {
-    int max_n = argc > 1 ? atoi(argv[1]) : 64;
+    int max_n = 64;
+    bool copies = true;
+    for (int i = 1; i < argc; i++) {
+        if (strcmp(argv[i], "--instances-only") == 0) copies = false;
+        else if (strcmp(argv[i], "--help") == 0 || atoi(argv[i]) <= 0) {
+            fprintf(stderr, "usage: instance_bench [max_n] [--instances-only]\n"
+                            "  N = 1, 4, 16 ... up to max_n (default 64) bumped spheres, written\n"
+                            "  as instances and (unless --instances-only) as copies\n");
+            return strcmp(argv[i], "--help") == 0 ? 0 : 2;
+        } else max_n = atoi(argv[i]);
+    }
     printf("%4s %-10s %7s %10s %12s %10s %12s %10s %9s\n", "N", "written as", "shared",
            "scene KiB", "cache KiB", "broods", "boxes", "render s", "pixels");
     for (int n = 1; n <= max_n; n *= 4)
-        for (int inst = 1; inst >= 0; inst--)
+        for (int inst = 1; inst >= (copies ? 0 : 1); inst--)
             if (run(n, inst)) return 1;
     return 0;
 }
