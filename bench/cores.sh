@@ -28,7 +28,20 @@ part() {  # part SECONDS CMD...: one bounded part, its output kept in LOG
     local rc=${PIPESTATUS[0]}
     [ "$rc" = 0 ] || say "   (exit $rc$([ "$rc" = 124 ] && echo ": stopped at ${limit} s"))"
 }
-say "== cores.sh: $N cores, $(awk '/MemTotal/ {printf "%.0f GiB", $2 / 1048576}' /proc/meminfo), $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2-), load $(cut -d' ' -f1 /proc/loadavg)"
+# physical cores and hardware threads per core (a vCPU may be a
+# hyperthread: 16 vCPUs of 8 cores cannot give 16x), from sysfs
+topology() {
+    local d cores
+    cores=$(for d in /sys/devices/system/cpu/cpu[0-9]*/topology; do
+                [ -r "$d/core_id" ] && echo "$(cat "$d/physical_package_id" 2>/dev/null):$(cat "$d/core_id")"
+            done | sort -u | wc -l)
+    if [ "$cores" -gt 0 ]; then
+        echo "$cores physical cores, $(awk -v n="$N" -v c="$cores" 'BEGIN {printf "%g", n / c}') hardware threads a core"
+    else
+        echo "topology unknown"
+    fi
+}
+say "== cores.sh: $N cores ($(topology)), $(awk '/MemTotal/ {printf "%.0f GiB", $2 / 1048576}' /proc/meminfo), $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2-), load $(cut -d' ' -f1 /proc/loadavg)"
 say "== 1. threads and local workers"
 for s in gallery vase; do
     THREADS="$N" FARM=1 SCALE=2 part 240 bash bench/thread_scaling.sh "$build/bin" "scenes/$s.rib" "$RUNS"

@@ -19,7 +19,10 @@
 # Renders SCENE with 1 thread and with each T, RUNS times each in turn
 # (1, T, 1, T, ...: a drift of the machine's speed hits both alike), and
 # prints the median wall seconds of each, the speed-up over 1 thread and
-# the efficiency (speed-up / T). Figures, never a verdict: on a machine
+# the efficiency (speed-up / T), and where the rest went: the CPU seconds
+# (user + system of the render's processes), their ratio to the one-thread
+# render's (each thread slower) and the share of the T cores kept busy
+# (idle threads). Figures, never a verdict: on a machine
 # with other work running the efficiency is low for reasons that are not
 # the renderer's. Every render is bounded by timeout -k; nothing is left
 # running. With FARM=1 the farm's image must equal the standalone one
@@ -50,31 +53,47 @@ if [ "$SCALE" != 1 ]; then
     SCENE=$COPY
 fi
 
-# wall seconds of one standalone render with $1 threads
+# CPU seconds (user + system) of process $1's reaped children so far:
+# /proc/PID/stat's cutime and cstime, in clock ticks (no procps needed)
+child_cpu() {
+    local f
+    f=$(sed 's/.*) //' "/proc/$1/stat")   # the fields after "(comm) "
+    echo "$f" | awk -v hz="$(getconf CLK_TCK 2>/dev/null || echo 100)" '{printf "%.2f\n", ($14 + $15) / hz}'
+}
+
+# "wall CPU" seconds of one standalone render with $1 threads
 one() {
-    local t0 t1
+    local t0 t1 c0 c1 me=$BASHPID
+    c0=$(child_cpu "$me")
     t0=$(date +%s.%N)
     timeout -k 5 900 "$BIN/aafarm-worker" --standalone "$SCENE" -o "$WORK/out$1.exr" \
         -t "$1" -q || { echo "thread_scaling.sh: render with $1 threads failed" >&2; kill -TERM $$; }
     t1=$(date +%s.%N)
-    awk -v a="$t0" -v b="$t1" 'BEGIN {printf "%.4f\n", b - a}'
+    c1=$(child_cpu "$me")
+    awk -v a="$t0" -v b="$t1" -v c="$c0" -v d="$c1" 'BEGIN {printf "%.4f:%.2f\n", b - a, d - c}'
 }
 
-# wall seconds of one farm render: a master and $1 local workers
+# "wall CPU" seconds of one farm render: a master and $1 local workers
+# (the workers' CPU counts: the master reaps them)
 farm() {
-    local t0 t1
+    local t0 t1 c0 c1 me=$BASHPID
+    c0=$(child_cpu "$me")
     t0=$(date +%s.%N)
     timeout -k 5 900 "$BIN/aafarm-master" "$SCENE" -o "$WORK/farm$1.exr" \
         --local-workers "$1" -q >"$WORK/farm.log" 2>&1 ||
         { echo "thread_scaling.sh: farm of $1 workers failed: $(tail -2 "$WORK/farm.log")" >&2; kill -TERM $$; }
     t1=$(date +%s.%N)
-    awk -v a="$t0" -v b="$t1" 'BEGIN {printf "%.4f\n", b - a}'
+    c1=$(child_cpu "$me")
+    awk -v a="$t0" -v b="$t1" -v c="$c0" -v d="$c1" 'BEGIN {printf "%.4f:%.2f\n", b - a, d - c}'
 }
 
 median() { sort -g | awk '{v[NR] = $1} END {print (NR % 2) ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2}'; }
+# field $1 (1: wall, 2: CPU) of each "wall:CPU" word on stdin, one a line
+field() { tr ' ' '\n' | grep . | cut -d: -f"$1"; }
 
 echo "thread_scaling: $(basename "$2" 2>/dev/null || echo "$SCENE") x$SCALE, $RUNS runs each, $CORES cores, load $(cut -d' ' -f1 /proc/loadavg) ($(date -u +%F))"
-printf "%8s %12s %10s %9s %11s\n" threads how "wall s" speed-up efficiency
+printf "%8s %12s %10s %9s %11s %8s %7s %6s\n" threads how "wall s" speed-up efficiency \
+    "CPU s" "CPU x" busy
 declare -A times ftimes
 for T in $THREADS; do
     [ "$T" = 1 ] && [ "$FARM" = 0 ] && continue
@@ -85,14 +104,22 @@ for T in $THREADS; do
     done
 done
 [ -n "${times[1]:-}" ] || for ((r = 0; r < RUNS; r++)); do times[1]+="$(one 1) "; done
-base=$(echo ${times[1]} | tr ' ' '\n' | median)
-printf "%8d %12s %10.3f %9s %11s\n" 1 standalone "$base" "1.00" "100%"
+base=$(echo ${times[1]} | field 1 | median)
+cbase=$(echo ${times[1]} | field 2 | median)
+# CPU x: the CPU the render took over the one-thread render's (above 1:
+# each thread got slower: shared caches, memory, hyperthreads, the farm's
+# messages); busy: CPU / (T x wall), the share of the T cores kept working
+# (below 1: idle threads, the tail of the tiles, start and finish). The
+# speed-up is about T x busy / (CPU x).
 row() {  # row T HOW TIMES
-    local m
-    m=$(echo $3 | tr ' ' '\n' | median)
-    awk -v t="$1" -v h="$2" -v m="$m" -v b="$base" \
-        'BEGIN {printf "%8d %12s %10.3f %9.2f %10.0f%%\n", t, h, m, b / m, 100 * b / m / t}'
+    local m c
+    m=$(echo $3 | field 1 | median)
+    c=$(echo $3 | field 2 | median)
+    awk -v t="$1" -v h="$2" -v m="$m" -v b="$base" -v c="$c" -v cb="$cbase" \
+        'BEGIN {x = cb > 0 ? c / cb : 0; u = m > 0 ? 100 * c / (t * m) : 0;
+                printf "%8d %12s %10.3f %9.2f %10.0f%% %8.2f %7.2f %5.0f%%\n", t, h, m, b / m, 100 * b / m / t, c, x, u}'
 }
+row 1 standalone "${times[1]}"
 for T in $THREADS; do
     [ "$T" = 1 ] || row "$T" standalone "${times[$T]}"
     if [ "$FARM" != 0 ]; then
