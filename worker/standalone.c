@@ -252,6 +252,11 @@ static int render_frame(const standalone_options *opt, const job *jb, const fram
     if (opt->stats) {
         fprintf(stderr, "statistics:\n");
         trace_stats_print(&s.stats, stderr);
+        trace_world_counts wc;
+        trace_world_count(&js->world, &wc);
+        fprintf(stderr, "  world: %d objects (%d meshes of %ld pieces), %d groups of %ld "
+                "instances (displaced: %ld the prototype moved, %ld own surfaces)\n", wc.objects,
+                wc.meshes, wc.pieces, wc.groups, wc.placements, wc.moved, wc.own);
         tex_tile_stats ts;
         tex_tiles_stats(tex_tiles_process(), &ts);
         if (ts.loads)

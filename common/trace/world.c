@@ -525,3 +525,31 @@ bool trace_world_prepare(trace_world *world, char *err, size_t errsz)
     free(meshes);
     return true;
 }
+
+void trace_world_count(const trace_world *world, trace_world_counts *out)
+{
+    memset(out, 0, sizeof *out);
+    for (int i = 0; i < world->nobjects; i++) {
+        const trace_object *obj = &world->objects[i];
+        const trace_group *gr = obj->group;
+        if (gr) {
+            out->groups++;
+            out->placements += gr->n;
+            if (gr->first_id >= 0 && gr->own) {
+                out->own += gr->nown;
+                out->moved += gr->n - gr->nown;
+            }
+            continue;
+        }
+        out->objects++;
+        out->meshes += obj->mesh != NULL;
+    }
+    /* the ids (trace_world_prepare): the objects, each mesh's pieces once,
+     * each displaced group's placements */
+    long ids = world->nids;
+    for (int i = 0; i < world->nobjects; i++) {
+        const trace_group *gr = world->objects[i].group;
+        if (gr && gr->first_id >= 0) ids -= gr->n;
+    }
+    out->pieces = ids > world->nobjects ? ids - world->nobjects : 0;
+}

@@ -303,4 +303,21 @@ void trace_object_grid_spacing_max(const trace_world *world, const trace_object 
 bool trace_object_derive(const trace_world *world, trace_object *obj, bool grid, char *err,
                          size_t errsz);
 
+/* What a world holds, for a worker's --stats (after trace_renderer_new:
+ * the groups' placements are sorted into moved and own when it builds
+ * them). */
+typedef struct trace_world_counts {
+    int objects;                   /* world objects but groups */
+    int meshes;                    /* mesh objects among them */
+    long pieces;                   /* their pieces (each shared mesh once) */
+    int groups;                    /* groups of placements (instances) */
+    long placements;
+    long moved;                    /* displaced placements that are their
+                                      prototype moved (its boxes) */
+    long own;                      /* displaced placements with surfaces and
+                                      boxes of their own */
+} trace_world_counts;
+
+void trace_world_count(const trace_world *world, trace_world_counts *out);
+
 #endif

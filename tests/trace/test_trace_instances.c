@@ -319,6 +319,15 @@ static size_t world_bytes(int n, const char *shader, int *shared, int *placement
     *placements = 0;
     for (int i = 0; i < w->nobjects; i++)
         if (w->objects[i].group) *placements += w->objects[i].group->n;
+    /* what a worker's --stats prints says the same */
+    trace_world_counts wc;
+    trace_world_count(w, &wc);
+    assert_int_equal(wc.objects, 1);
+    assert_int_equal(wc.groups, n > 1);
+    assert_int_equal(wc.placements, *placements);
+    assert_int_equal(wc.moved, *shared);
+    assert_int_equal(wc.own, *placements - *shared);
+    assert_int_equal(wc.pieces, 0);
     fixture_close(&f);
     free(rib);
     return after - before;
