@@ -87,7 +87,10 @@ static bool classify(trace_thread *th, trace_group *gr, const trace_object *g)
     for (int k = 0; k < gr->n && !th->failed; k++) {
         gr->transform(gr->user, k, &v->to_camera, &v->from_camera);
         v->primvars = tv->pv;
-        gr->place(gr->user, k, v, tv->pv);
+        if (!gr->place(gr->user, k, v, tv->pv)) {
+            trace_thread_fail(th, "an instance could not be made again (internal error)");
+            break;
+        }
         gr->own[k] = moves && trace_instance_rigid(v, proto) ? -1 : gr->nown++;
     }
     gr->own_roots = xmalloc(sizeof *gr->own_roots * (size_t)(gr->nown > 0 ? gr->nown : 1));

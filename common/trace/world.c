@@ -460,6 +460,7 @@ bool trace_world_check(trace_world *world, char *err, size_t errsz)
             assert(!world->objects[obj->group->proto].mesh ||
                    !world->objects[obj->group->proto].displacement);
             obj->group->first = places;
+            obj->group->first_id = -1;         /* trace_world_prepare's */
             places += obj->group->n;
             continue;
         }
