@@ -166,6 +166,18 @@ bool sl_program_reads_global(const sl_program *p, sl_global g)
     return false;
 }
 
+bool sl_program_uses_space(const sl_program *p, int space)
+{
+    for (int pc = 0; pc < p->ncode; pc++) {
+        const sl_insn *in = &p->code[pc];
+        if (in->op == SL_OP_SPACE) return true;            /* named at run time */
+        if (in->op == SL_OP_SPACEK &&
+            (in->b == space || (in->b == SL_SPACE_DEPTH && space == SL_SPACE_CAMERA)))
+            return true;
+    }
+    return false;
+}
+
 uint64_t sl_program_global_slots(const sl_program *p)
 {
     _Static_assert(SL_GLOBAL_SLOTS <= 64, "a global slot mask fits 64 bits");

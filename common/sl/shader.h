@@ -101,6 +101,10 @@ typedef struct sl_param_info {
 /* Whether the program may touch global g (conservative: an operand that
  * could be a matrix or triple starting below g counts too). */
 bool sl_program_reads_global(const sl_program *self, sl_global g);
+/* Whether the program may use named space `space` (SL_SPACE_*: transform()
+ * and the casts; conservative: a space named by a string variable counts
+ * as every space, and depth() as a use of "camera"). */
+bool sl_program_uses_space(const sl_program *self, int space);
 /* Whether range runs carry derivative bounds (sl_program_derivatives_reach_P). */
 bool sl_program_takes_derivatives(const sl_program *self);
 int sl_program_param_count(const sl_program *self);

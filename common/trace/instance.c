@@ -20,9 +20,11 @@
  * gives (the shader run on the instance itself): the motion must be rigid
  * (orientation kept), the shader instance the same, with no output
  * parameters (their values would be the prototype's), and on a 5 x 5 grid
- * of (u,v) the instance's own displaced points and normals must equal the
- * prototype's moved ones within 1e-9 of the coordinates (1e-7 for unit
- * normals). A shader that reads camera-space P directly (noise(P)), or
+ * of (u,v) (the cells' centres: an edge of the (u,v) square is often a
+ * singular line, a sphere's pole, where a normal is a limit that the two
+ * evaluations reach by different roundings) the instance's own displaced
+ * points and normals must equal the prototype's moved ones within 1e-9 of
+ * the coordinates (1e-7 for unit normals). A shader that reads camera-space P directly (noise(P)), or
  * the eye (I, E) or the per-object du, dv where they matter, fails the
  * grid and the instance keeps its own boxes, as before.
  */
@@ -57,19 +59,44 @@ static bool shader_allows(const sl_instance *inst)
     return true;
 }
 
+/* The shader's named spaces move with the instance: "object" always does
+ * (its to_camera), "shader" where the call's space is the instance's (a
+ * Displacement inside ObjectBegin), "world", "camera", screen, NDC and
+ * raster never do. (I and E do not either; sl_program_reads_global cannot
+ * tell them from a transformed P, so the probe finds them.) A shader that names
+ * one that does not is the instance's own surface wherever its use shows,
+ * which the probe's grid may miss (fbm_filtered's shader-space noise
+ * shows only near a sphere's poles): decided here from the program. */
+static bool spaces_move(const trace_object *obj, const trace_object *proto)
+{
+    const sl_program *p = sl_instance_program(obj->displacement);
+    static const int fixed[] = {SL_SPACE_WORLD, SL_SPACE_CAMERA, SL_SPACE_SCREEN, SL_SPACE_NDC,
+                                SL_SPACE_RASTER};
+    for (size_t i = 0; i < sizeof fixed / sizeof fixed[0]; i++)
+        if (sl_program_uses_space(p, fixed[i])) return false;
+    if (!sl_program_uses_space(p, SL_SPACE_SHADER)) return true;
+    mat4 moved = mat4_mul(obj->from_proto, proto->displacement_spaces.to_current[SL_SPACE_SHADER]);
+    const mat4 *own = &obj->displacement_spaces.to_current[SL_SPACE_SHADER];
+    for (int r = 0; r < 4; r++)
+        for (int c = 0; c < 4; c++)
+            if (!(fabs(moved.m[r][c] - own->m[r][c]) <= 1e-9 * (1.0 + fabs(own->m[r][c]))))
+                return false;
+    return true;
+}
+
 static double vmax_abs(vec3 a)
 {
     return fmax(fabs(a.x), fmax(fabs(a.y), fabs(a.z)));
 }
 
-/* The instance's own points against the prototype's moved ones (at
- * least one of the grid's points must be on the surface). */
+/* The instance's own points against the prototype's moved ones at the
+ * grid's cell centres (at least one must be on the surface). */
 static bool same_surface(trace_thread *th, trace_object *obj, const trace_object *proto)
 {
     int compared = 0;
     for (int j = 0; j < PROBE; j++)
         for (int i = 0; i < PROBE; i++) {
-            double u = i / (double)(PROBE - 1), v = j / (double)(PROBE - 1);
+            double u = (i + 0.5) / PROBE, v = (j + 0.5) / PROBE;
             if (!geom_uv_inside(&obj->surf, u, v)) continue;
             trace_surface_point own, moved;
             obj->box_proto = NULL;
@@ -94,7 +121,7 @@ bool trace_instance_rigid(trace_object *obj, const trace_object *proto)
         return false;
     obj->from_proto = mat4_mul(obj->to_camera, proto->from_camera);
     obj->to_proto = mat4_mul(proto->to_camera, obj->from_camera);
-    return rigid(&obj->from_proto);
+    return rigid(&obj->from_proto) && spaces_move(obj, proto);
 }
 
 bool trace_instance_moves(trace_thread *th, trace_object *obj, const trace_object *proto)

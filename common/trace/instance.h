@@ -25,8 +25,10 @@ int trace_instances_share(trace_thread *th, trace_world *world);
 
 /* Whether obj (box_proto NULL) may be proto's displaced surface moved:
  * the same displacement instance without output parameters, orientation
- * and kind of surface, and a rigid motion between their camera spaces
- * (set into obj->from_proto, to_proto). No shader runs. */
+ * and kind of surface, a rigid motion between their camera spaces (set
+ * into obj->from_proto, to_proto), and every space the shader names
+ * moving with it (no "world", "camera", screen, NDC or raster; "shader"
+ * space only where it is the instance's). No shader runs. */
 bool trace_instance_rigid(trace_object *obj, const trace_object *proto);
 
 /* trace_instance_rigid, and the probe: obj's own displaced points and

@@ -206,7 +206,7 @@ static const char *nurbs_points(void)
 bool corpus_open(fixture *f, const corpus *c, const corpus_file *sh,
                  corpus_surface s, trace_arith arith, int xres, int yres, bool render)
 {
-    char disp[128], geom[4096], rib[8192];
+    char disp[128], geom[4096];
     snprintf(disp, sizeof disp, "Displacement \"%s\"\n", sh->name);
     switch (s) {
     case CORPUS_PLANE:
@@ -302,11 +302,20 @@ bool corpus_open(fixture *f, const corpus *c, const corpus_file *sh,
     default:
         return false;
     }
-    snprintf(rib, sizeof rib,
+    return corpus_open_world(f, c, sh, corpus_surface_name(s), geom, arith, xres, yres, render);
+}
+
+bool corpus_open_world(fixture *f, const corpus *c, const corpus_file *sh, const char *what,
+                       const char *world, trace_arith arith, int xres, int yres, bool render)
+{
+    size_t cap = strlen(world) + 1024;
+    char *rib = malloc(cap);
+    if (!rib) return false;
+    snprintf(rib, cap,
              "Option \"searchpath\" \"texture\" [\"%s\"]\n"
              "Format %d %d 1\nProjection \"perspective\" \"fov\" [35]\n"
              "WorldBegin\nAttributeBegin\n%sAttributeEnd\nWorldEnd\n",
-             c->texdir, xres, yres, geom);
+             c->texdir, xres, yres, world);
 
     job_options opt;
     job_options_default(&opt);
@@ -314,6 +323,7 @@ bool corpus_open(fixture *f, const corpus *c, const corpus_file *sh,
     memset(f, 0, sizeof *f);
     f->diag = sl_diag_new();
     f->job = job_new("corpus.rib", rib, strlen(rib), &opt);
+    free(rib);
     char why[256], file[96];
     for (int i = 0; i < c->nheaders; i++)
         if (!job_add_source(f->job, c->headers[i].name, c->headers[i].text,
@@ -330,7 +340,7 @@ bool corpus_open(fixture *f, const corpus *c, const corpus_file *sh,
     }
     f->js = job_scene_new(f->job, 0, render, NULL, f->diag);
     if (!f->js) {
-        fprintf(stderr, "corpus: %s on the %s:\n", sh->name, corpus_surface_name(s));
+        fprintf(stderr, "corpus: %s on the %s:\n", sh->name, what);
         sl_diag_print(f->diag, stderr);
         return false;
     }

@@ -57,6 +57,13 @@ const char *corpus_surface_name(corpus_surface s);
 bool corpus_open(fixture *f, const corpus *c, const corpus_file *sh,
                  corpus_surface s, trace_arith arith, int xres, int yres, bool render);
 
+/* The same for a world of one's own: `world` is the RIB between
+ * WorldBegin and WorldEnd (inside an AttributeBegin, after the texture
+ * search path, Format and Projection corpus_open gives every job); `what`
+ * names it in messages. The shader is not bound: `world` says where. */
+bool corpus_open_world(fixture *f, const corpus *c, const corpus_file *sh, const char *what,
+                       const char *world, trace_arith arith, int xres, int yres, bool render);
+
 /* Environment integer with a default (values < 1 give the default). */
 long corpus_env_long(const char *name, long def);
 
