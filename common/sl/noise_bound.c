@@ -255,7 +255,116 @@ IV_INLINE iv iv_lerp_pos(iv a, iv x, iv b, iv y)
  * are carried by the other steps as any part off their own axis. With no
  * point axis the operations are exactly the ones of before.
  */
-/* always inlined into cell_jet, once per (dim, order), so the loops unroll */
+/* always inlined into cell_jet, once per (dim, order), so the loops unroll;
+ * on the vector kit where there is one (noise_interval.h: the same bits) */
+#if NOISE_IV_VECTOR
+typedef struct vjet {
+    ivv v;
+    ivv g[4];
+    ivv h[4][4];
+} vjet;
+
+static inline __attribute__((always_inline)) void
+vjet_copy(int dim, int order, vjet *dst, const vjet *src)
+{
+    dst->v = src->v;
+    if (order < 1)
+        return;
+    for (int j = 0; j < dim; j++)
+        dst->g[j] = src->g[j];
+    if (order < 2)
+        return;
+    for (int j = 0; j < dim; j++)
+        for (int k = j; k < dim; k++)
+            dst->h[j][k] = src->h[j][k];
+}
+
+static inline __attribute__((always_inline)) void
+cell_jet_d(int dim, const axis_fade *ax, const uint32_t h[16], int order,
+           unsigned pmask, unsigned pside, jet *J)
+{
+    vjet t[16];
+    int act[4] = { 0, 1, 2, 3 }, na = 0;
+    for (int k = 0; k < dim; k++)
+        if (!(pmask >> k & 1u))
+            act[na++] = k;
+    int n = 1 << na;
+    for (int c = 0; c < n; c++) {
+        /* the full corner: the point axes' sides, c's bits on the others */
+        unsigned cf = pside & pmask;
+        for (int m = 0; m < na; m++)
+            cf |= (unsigned)((c >> m) & 1) << act[m];
+        int g[4];
+        gradient(dim, h[cf], g);
+        iv l = iv_pt(0.0);
+        for (int m = 0; m < na; m++) {
+            int k = act[m];
+            if (m == 0)
+                l = iv_mul_int(ax[k].d[(cf >> k) & 1u], g[k]);
+            else if (g[k] != 0)
+                l = iv_add(l, iv_mul_int(ax[k].d[(cf >> k) & 1u], g[k]));
+        }
+        t[c].v = ivv_of(l);
+        if (order < 1)
+            continue;
+        for (int k = 0; k < dim; k++)
+            t[c].g[k] = ivv_pt((double)g[k]);
+        /* the corners' Hessians are 0: the first step knows it */
+    }
+    for (int st = 0; st < na; st++) {
+        int k = act[st];
+        n >>= 1;
+        ivv w0 = ivv_of(ax[k].w[0]), w1 = ivv_of(ax[k].w[1]);
+        ivv D = ivv_of(ax[k].ds);
+        iv DD = ax[k].dds;
+        for (int i = 0; i < n; i++) {
+            const vjet *A = &t[2 * i], *B = &t[2 * i + 1];
+            vjet r;
+            r.v = ivv_add(ivv_mul_pos(w0, A->v), ivv_mul_pos(w1, B->v));
+            if (order >= 1) {
+                ivv dv = ivv_sub(B->v, A->v);
+                for (int j = 0; j < dim; j++)
+                    r.g[j] = ivv_add(ivv_mul_pos(w0, A->g[j]), ivv_mul_pos(w1, B->g[j]));
+                r.g[k] = ivv_add(r.g[k], ivv_mul_pos(D, dv));
+                if (order >= 2) {
+                    for (int j = 0; j < dim; j++)
+                        for (int m = j; m < dim; m++)
+                            r.h[j][m] = st == 0 ? ivv_pt(0.0)
+                                                : ivv_add(ivv_mul_pos(w0, A->h[j][m]),
+                                                          ivv_mul_pos(w1, B->h[j][m]));
+                    ivv dgk = ivv_sub(B->g[k], A->g[k]);
+                    ivv m = ivv_mul_pos(D, dgk);
+                    ivv kk = ivv_add(2.0 * m, ivv_of(iv_mul(DD, iv_of_v(dv))));
+                    r.h[k][k] = ivv_add(r.h[k][k], kk);
+                    for (int j = 0; j < dim; j++) {
+                        if (j == k)
+                            continue;
+                        ivv t_jk = ivv_mul_pos(D, ivv_sub(B->g[j], A->g[j]));
+                        if (j < k) r.h[j][k] = ivv_add(r.h[j][k], t_jk);
+                        else r.h[k][j] = ivv_add(r.h[k][j], t_jk);
+                    }
+                }
+            }
+            vjet_copy(dim, order, &t[i], &r);
+        }
+    }
+    if (order >= 2 && na == 0)          /* every axis a point: H = 0 */
+        for (int j = 0; j < dim; j++)
+            for (int m = j; m < dim; m++)
+                t[0].h[j][m] = ivv_pt(0.0);
+    J->v = iv_of_v(t[0].v);
+    if (order < 1)
+        return;
+    for (int j = 0; j < dim; j++)
+        J->g[j] = iv_of_v(t[0].g[j]);
+    if (order < 2)
+        return;
+    for (int j = 0; j < dim; j++)
+        for (int m = j; m < dim; m++)
+            J->h[j][m] = iv_of_v(t[0].h[j][m]);
+}
+#else
+
 static inline __attribute__((always_inline)) void
 cell_jet_d(int dim, const axis_fade *ax, const uint32_t h[16], int order,
            unsigned pmask, unsigned pside, jet *J)
@@ -329,6 +438,8 @@ cell_jet_d(int dim, const axis_fade *ax, const uint32_t h[16], int order,
                 t[0].h[j][m] = iv_pt(0.0);
     jet_copy(dim, order, J, &t[0]);
 }
+
+#endif
 
 static void cell_jet(int dim, const axis_fade *ax, const uint32_t h[16],
                      int order, unsigned pmask, unsigned pside, jet *J)
