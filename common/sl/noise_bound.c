@@ -603,7 +603,7 @@ point_jet_d(int dim, const double f[4], const uint32_t hs[16], int order, point_
             double dv = B->v - A->v;
             r.v = w0[k] * A->v + w1[k] * B->v;
             if (order == 0) {
-                t[i] = r;
+                t[i].v = r.v;        /* not the whole 168-byte struct */
                 continue;
             }
             for (int j = 0; j < dim; j++)
@@ -621,7 +621,13 @@ point_jet_d(int dim, const double f[4], const uint32_t hs[16], int order, point_
                 if (j < k) r.h[j][k] = r.h[j][k] + tjk;
                 else r.h[k][j] = r.h[k][j] + tjk;
             }
-            t[i] = r;
+            /* the parts dim has, not the whole 168-byte struct */
+            t[i].v = r.v;
+            for (int j = 0; j < dim; j++) {
+                t[i].g[j] = r.g[j];
+                for (int m = j; m < dim; m++)
+                    t[i].h[j][m] = r.h[j][m];
+            }
         }
     }
     *J = t[0];
@@ -870,7 +876,7 @@ static bool enclose_jets(const box_query *q, bool want_affine, const point_jet *
             double mvf = point_value(dim, fm, h), e0 = point_jet_err[dim][0];
             iv mv = iv_mk(out_dn(mvf - e0), out_up(mvf + e0));
             for (int k = 0; k < dim; k++)
-                mv = iv_add(mv, iv_mul(J.g[k], iv_mk(-r[k], r[k])));
+                mv = iv_add(mv, iv_mul_sym(J.g[k], r[k]));
             iv sr = J.v;
             if (mv.lo > sr.lo) sr.lo = mv.lo;
             if (mv.hi < sr.hi) sr.hi = mv.hi;
@@ -922,7 +928,7 @@ static bool enclose_jets(const box_query *q, bool want_affine, const point_jet *
         /* the centred form over the whole box */
         iv mv = C.v;
         for (int k = 0; k < dim; k++)
-            mv = iv_add(mv, iv_mul(hull.g[k], iv_mk(-q->r[k], q->r[k])));
+            mv = iv_add(mv, iv_mul_sym(hull.g[k], q->r[k]));
         if (mv.lo > raw.lo) raw.lo = mv.lo;
         if (mv.hi < raw.hi) raw.hi = mv.hi;
     }

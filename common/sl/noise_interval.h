@@ -77,6 +77,16 @@ IV_INLINE iv iv_mul(iv a, iv b)
     double lo2 = p3 < p4 ? p3 : p4, hi2 = p3 < p4 ? p4 : p3;
     return iv_mk(out_dn(lo < lo2 ? lo : lo2), out_up(hi > hi2 ? hi : hi2));
 }
+/* a times [-r, r] for r >= 0: the same bits as iv_mul(a, iv_mk(-r, r))
+ * (its four products are +-a.lo r and +-a.hi r, rounding is symmetric,
+ * so their least is -(mag(a) r) and their greatest mag(a) r), with one
+ * product */
+IV_INLINE iv iv_mul_sym(iv a, double r)
+{
+    double l = fabs(a.lo), h = fabs(a.hi);
+    double p = (l > h ? l : h) * r;
+    return iv_mk(out_dn(-p), out_up(p));
+}
 /* a times a small integer: exact for 0, +-1, +-2, +-4, +-8 */
 IV_INLINE iv iv_mul_int(iv a, int g)
 {
