@@ -312,7 +312,7 @@ cell_jet_d(int dim, const axis_fade *ax, const uint32_t h[16], int order,
         /* the corners' Hessians are 0: the first step knows it */
     }
     for (int st = 0; st < na; st++) {
-        int k = act[st];
+        int k = act[st] & 3;            /* (0..3: tells the compiler) */
         n >>= 1;
         ivv w0 = ivv_of(ax[k].w[0]), w1 = ivv_of(ax[k].w[1]);
         ivv D = ivv_of(ax[k].ds);
@@ -398,7 +398,7 @@ cell_jet_d(int dim, const axis_fade *ax, const uint32_t h[16], int order,
         /* the corners' Hessians are 0: the first step knows it */
     }
     for (int st = 0; st < na; st++) {
-        int k = act[st];
+        int k = act[st] & 3;            /* (0..3: tells the compiler) */
         n >>= 1;
         iv w0 = ax[k].w[0], w1 = ax[k].w[1];
         iv D = ax[k].ds, DD = ax[k].dds;
