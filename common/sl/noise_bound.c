@@ -36,8 +36,12 @@
  * gradient and Hessian of raw, from per-axis enclosures of s, s', s''
  * (s and s' have exact ranges from their monotonicity; s'' from its end
  * points and its extrema at (3 -+ sqrt 3)/6) and the sum above written as
- * nested linear interpolations, one axis at a time (cell_jet_d).
- * At the box centre c the float jet's value and gradient are used.
+ * nested linear interpolations, one axis at a time (cell_jet_d, on the
+ * two-lane vector kit of noise_interval.h where the compiler has one: the
+ * same bits). An axis on a lattice plane (or a sliver of one, projected)
+ * is not interpolated: the jets take the corners of its side only
+ * ("Point axes" at cell_jet_d). At the box centre c the float jet's value
+ * and gradient are used.
  *   interval: [0,1] ∩ natural extension (hull over sub-boxes)
  *             ∩ centred (mean-value) form N(c) + sum_k [dN/dx_k over box]
  *               [-r_k, r_k] (one sub-box), or the hull over sub-boxes of
