@@ -210,6 +210,7 @@ jet_copy(int dim, int order, jet *dst, const jet *src)
             dst->h[j][k] = src->h[j][k];
 }
 
+#if !NOISE_IV_VECTOR      /* the scalar jets' (the vector ones: ivv_mul_pos) */
 /* a times b for a >= 0 (a.lo >= 0): two products, picked by b's signs */
 IV_INLINE iv iv_mul_pos(iv a, iv b)
 {
@@ -223,6 +224,7 @@ IV_INLINE iv iv_lerp_pos(iv a, iv x, iv b, iv y)
 {
     return iv_add(iv_mul_pos(a, x), iv_mul_pos(b, y));
 }
+#endif
 
 /*
  * Value (order 0), gradient (order >= 1) and Hessian (order 2) of raw

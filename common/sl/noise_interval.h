@@ -136,9 +136,9 @@ static inline double iv_rad_about(iv a, double m)
  * sum, -1 * m being exact; the selections of iv_mul_pos are masks), so
  * the results are the same bits; the interval jets (noise_bound.c) run on
  * it where the compiler has the extensions, and on the scalar kit
- * otherwise (NOISE_IV_VECTOR 0).
+ * otherwise (NOISE_IV_VECTOR 0; -DNOISE_IV_SCALAR forces it, to compare).
  */
-#if defined(__GNUC__) || defined(__clang__)
+#if (defined(__GNUC__) || defined(__clang__)) && !defined(NOISE_IV_SCALAR)
 #define NOISE_IV_VECTOR 1
 typedef double ivv __attribute__((vector_size(16)));
 typedef long long ivv_mask __attribute__((vector_size(16)));
