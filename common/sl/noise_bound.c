@@ -36,8 +36,12 @@
  * gradient and Hessian of raw, from per-axis enclosures of s, s', s''
  * (s and s' have exact ranges from their monotonicity; s'' from its end
  * points and its extrema at (3 -+ sqrt 3)/6) and the sum above written as
- * nested linear interpolations, one axis at a time (cell_jet_d).
- * At the box centre c the float jet's value and gradient are used.
+ * nested linear interpolations, one axis at a time (cell_jet_d, on the
+ * two-lane vector kit of noise_interval.h where the compiler has one: the
+ * same bits). An axis on a lattice plane (or a sliver of one, projected)
+ * is not interpolated: the jets take the corners of its side only
+ * ("Point axes" at cell_jet_d). At the box centre c the float jet's value
+ * and gradient are used.
  *   interval: [0,1] ∩ natural extension (hull over sub-boxes)
  *             ∩ centred (mean-value) form N(c) + sum_k [dN/dx_k over box]
  *               [-r_k, r_k] (one sub-box), or the hull over sub-boxes of
@@ -188,6 +192,25 @@ typedef struct jet {
     iv h[4][4];          /* j <= k used */
 } jet;
 
+/* Copies the parts of a jet that its order has (the whole struct is 336
+ * bytes, of which an order-1 jet in 3D uses 64: copying all of it cost an
+ * eighth of sl_bench's dented time, a `rep movsq` per interpolation step) */
+static inline __attribute__((always_inline)) void
+jet_copy(int dim, int order, jet *dst, const jet *src)
+{
+    dst->v = src->v;
+    if (order < 1)
+        return;
+    for (int j = 0; j < dim; j++)
+        dst->g[j] = src->g[j];
+    if (order < 2)
+        return;
+    for (int j = 0; j < dim; j++)
+        for (int k = j; k < dim; k++)
+            dst->h[j][k] = src->h[j][k];
+}
+
+#if !NOISE_IV_VECTOR      /* the scalar jets' (the vector ones: ivv_mul_pos) */
 /* a times b for a >= 0 (a.lo >= 0): two products, picked by b's signs */
 IV_INLINE iv iv_mul_pos(iv a, iv b)
 {
@@ -201,6 +224,7 @@ IV_INLINE iv iv_lerp_pos(iv a, iv x, iv b, iv y)
 {
     return iv_add(iv_mul_pos(a, x), iv_mul_pos(b, y));
 }
+#endif
 
 /*
  * Value (order 0), gradient (order >= 1) and Hessian (order 2) of raw
@@ -224,27 +248,163 @@ IV_INLINE iv iv_lerp_pos(iv a, iv x, iv b, iv y)
  * encloses the true one over the piece. Weights are >= 0 (clipped to
  * [0, 1] in axis_setup), which halves their products (iv_mul_pos).
  */
-/* always inlined into cell_jet, once per (dim, order), so the loops unroll */
+/*
+ * Point axes. An axis k whose piece is the single point f_k = b (b = 0 or
+ * 1: a lattice plane, pmask bit k, side pside bit k) needs no step: there
+ * w_b = 1, w_(1-b) = 0 and s' = s'' = 0 exactly, so a step along k gives
+ * the jet of the corners on side b unchanged (value, every gradient and
+ * Hessian part; the kk part gets 2 s' (..) + s'' (..) = 0), and their
+ * linear functions have g_k (f_k - b) = 0. So only the corners on side b
+ * are interpolated, along the other axes: 2^(dim-1) corners and half the
+ * steps for a box on a ground plane y = 0 (enclose_jets projects such
+ * thin pieces onto the plane). The gradient's and Hessian's parts along k
+ * are carried by the other steps as any part off their own axis. With no
+ * point axis the operations are exactly the ones of before.
+ */
+/* always inlined into cell_jet, once per (dim, order), so the loops unroll;
+ * on the vector kit where there is one (noise_interval.h: the same bits) */
+#if NOISE_IV_VECTOR
+typedef struct vjet {
+    ivv v;
+    ivv g[4];
+    ivv h[4][4];
+} vjet;
+
 static inline __attribute__((always_inline)) void
-cell_jet_d(int dim, const axis_fade *ax, const uint32_t h[16], int order, jet *J)
+vjet_copy(int dim, int order, vjet *dst, const vjet *src)
+{
+    dst->v = src->v;
+    if (order < 1)
+        return;
+    for (int j = 0; j < dim; j++)
+        dst->g[j] = src->g[j];
+    if (order < 2)
+        return;
+    for (int j = 0; j < dim; j++)
+        for (int k = j; k < dim; k++)
+            dst->h[j][k] = src->h[j][k];
+}
+
+static inline __attribute__((always_inline)) void
+cell_jet_d(int dim, const axis_fade *ax, const uint32_t h[16], int order,
+           unsigned pmask, unsigned pside, jet *J)
+{
+    vjet t[16];
+    int act[4] = { 0, 1, 2, 3 }, na = 0;
+    for (int k = 0; k < dim; k++)
+        if (!(pmask >> k & 1u))
+            act[na++] = k;
+    int n = 1 << na;
+    for (int c = 0; c < n; c++) {
+        /* the full corner: the point axes' sides, c's bits on the others */
+        unsigned cf = pside & pmask;
+        for (int m = 0; m < na; m++)
+            cf |= (unsigned)((c >> m) & 1) << act[m];
+        int g[4];
+        gradient(dim, h[cf], g);
+        iv l = iv_pt(0.0);
+        for (int m = 0; m < na; m++) {
+            int k = act[m];
+            if (m == 0)
+                l = iv_mul_int(ax[k].d[(cf >> k) & 1u], g[k]);
+            else if (g[k] != 0)
+                l = iv_add(l, iv_mul_int(ax[k].d[(cf >> k) & 1u], g[k]));
+        }
+        t[c].v = ivv_of(l);
+        if (order < 1)
+            continue;
+        for (int k = 0; k < dim; k++)
+            t[c].g[k] = ivv_pt((double)g[k]);
+        /* the corners' Hessians are 0: the first step knows it */
+    }
+    for (int st = 0; st < na; st++) {
+        int k = act[st] & 3;            /* (0..3: tells the compiler) */
+        n >>= 1;
+        ivv w0 = ivv_of(ax[k].w[0]), w1 = ivv_of(ax[k].w[1]);
+        ivv D = ivv_of(ax[k].ds);
+        iv DD = ax[k].dds;
+        for (int i = 0; i < n; i++) {
+            const vjet *A = &t[2 * i], *B = &t[2 * i + 1];
+            vjet r;
+            r.v = ivv_add(ivv_mul_pos(w0, A->v), ivv_mul_pos(w1, B->v));
+            if (order >= 1) {
+                ivv dv = ivv_sub(B->v, A->v);
+                for (int j = 0; j < dim; j++)
+                    r.g[j] = ivv_add(ivv_mul_pos(w0, A->g[j]), ivv_mul_pos(w1, B->g[j]));
+                r.g[k] = ivv_add(r.g[k], ivv_mul_pos(D, dv));
+                if (order >= 2) {
+                    for (int j = 0; j < dim; j++)
+                        for (int m = j; m < dim; m++)
+                            r.h[j][m] = st == 0 ? ivv_pt(0.0)
+                                                : ivv_add(ivv_mul_pos(w0, A->h[j][m]),
+                                                          ivv_mul_pos(w1, B->h[j][m]));
+                    ivv dgk = ivv_sub(B->g[k], A->g[k]);
+                    ivv m = ivv_mul_pos(D, dgk);
+                    ivv kk = ivv_add(2.0 * m, ivv_of(iv_mul(DD, iv_of_v(dv))));
+                    r.h[k][k] = ivv_add(r.h[k][k], kk);
+                    for (int j = 0; j < dim; j++) {
+                        if (j == k)
+                            continue;
+                        ivv t_jk = ivv_mul_pos(D, ivv_sub(B->g[j], A->g[j]));
+                        if (j < k) r.h[j][k] = ivv_add(r.h[j][k], t_jk);
+                        else r.h[k][j] = ivv_add(r.h[k][j], t_jk);
+                    }
+                }
+            }
+            vjet_copy(dim, order, &t[i], &r);
+        }
+    }
+    if (order >= 2 && na == 0)          /* every axis a point: H = 0 */
+        for (int j = 0; j < dim; j++)
+            for (int m = j; m < dim; m++)
+                t[0].h[j][m] = ivv_pt(0.0);
+    J->v = iv_of_v(t[0].v);
+    if (order < 1)
+        return;
+    for (int j = 0; j < dim; j++)
+        J->g[j] = iv_of_v(t[0].g[j]);
+    if (order < 2)
+        return;
+    for (int j = 0; j < dim; j++)
+        for (int m = j; m < dim; m++)
+            J->h[j][m] = iv_of_v(t[0].h[j][m]);
+}
+#else
+
+static inline __attribute__((always_inline)) void
+cell_jet_d(int dim, const axis_fade *ax, const uint32_t h[16], int order,
+           unsigned pmask, unsigned pside, jet *J)
 {
     jet t[16];
-    int n = 1 << dim;
+    int act[4] = { 0, 1, 2, 3 }, na = 0;
+    for (int k = 0; k < dim; k++)
+        if (!(pmask >> k & 1u))
+            act[na++] = k;
+    int n = 1 << na;
     for (int c = 0; c < n; c++) {
+        /* the full corner: the point axes' sides, c's bits on the others */
+        unsigned cf = pside & pmask;
+        for (int m = 0; m < na; m++)
+            cf |= (unsigned)((c >> m) & 1) << act[m];
         int g[4];
-        gradient(dim, h[c], g);
-        iv l = iv_mul_int(ax[0].d[c & 1], g[0]);
-        for (int k = 1; k < dim; k++)
-            if (g[k] != 0)
-                l = iv_add(l, iv_mul_int(ax[k].d[(c >> k) & 1], g[k]));
+        gradient(dim, h[cf], g);
+        iv l = iv_pt(0.0);
+        for (int m = 0; m < na; m++) {
+            int k = act[m];
+            if (m == 0)
+                l = iv_mul_int(ax[k].d[(cf >> k) & 1u], g[k]);
+            else if (g[k] != 0)
+                l = iv_add(l, iv_mul_int(ax[k].d[(cf >> k) & 1u], g[k]));
+        }
         t[c].v = l;
         if (order < 1)
             continue;
         for (int k = 0; k < dim; k++)
             t[c].g[k] = iv_pt((double)g[k]);
-        /* the corners' Hessians are 0: the step along axis 0 knows it */
+        /* the corners' Hessians are 0: the first step knows it */
     }
-    for (int k = 0; k < dim; k++) {
+    for (int st = 0; st < na; st++) {
+        int k = act[st] & 3;            /* (0..3: tells the compiler) */
         n >>= 1;
         iv w0 = ax[k].w[0], w1 = ax[k].w[1];
         iv D = ax[k].ds, DD = ax[k].dds;
@@ -260,8 +420,8 @@ cell_jet_d(int dim, const axis_fade *ax, const uint32_t h[16], int order, jet *J
                 if (order >= 2) {
                     for (int j = 0; j < dim; j++)
                         for (int m = j; m < dim; m++)
-                            r.h[j][m] = k == 0 ? iv_pt(0.0)
-                                               : iv_lerp_pos(w0, A->h[j][m], w1, B->h[j][m]);
+                            r.h[j][m] = st == 0 ? iv_pt(0.0)
+                                                : iv_lerp_pos(w0, A->h[j][m], w1, B->h[j][m]);
                     iv dgk = iv_sub(B->g[k], A->g[k]);
                     iv m = iv_mul_pos(D, dgk);
                     iv kk = iv_add(iv_mk(2.0 * m.lo, 2.0 * m.hi), iv_mul(DD, dv));
@@ -275,20 +435,26 @@ cell_jet_d(int dim, const axis_fade *ax, const uint32_t h[16], int order, jet *J
                     }
                 }
             }
-            t[i] = r;
+            jet_copy(dim, order, &t[i], &r);
         }
     }
-    *J = t[0];
+    if (order >= 2 && na == 0)          /* every axis a point: H = 0 */
+        for (int j = 0; j < dim; j++)
+            for (int m = j; m < dim; m++)
+                t[0].h[j][m] = iv_pt(0.0);
+    jet_copy(dim, order, J, &t[0]);
 }
 
+#endif
+
 static void cell_jet(int dim, const axis_fade *ax, const uint32_t h[16],
-                     int order, jet *J)
+                     int order, unsigned pmask, unsigned pside, jet *J)
 {
-#define CELL_JET_ORDERS(D)                             \
-    switch (order) {                                   \
-    case 0: cell_jet_d(D, ax, h, 0, J); break;         \
-    case 1: cell_jet_d(D, ax, h, 1, J); break;         \
-    default: cell_jet_d(D, ax, h, 2, J); break;        \
+#define CELL_JET_ORDERS(D)                                           \
+    switch (order) {                                                 \
+    case 0: cell_jet_d(D, ax, h, 0, pmask, pside, J); break;         \
+    case 1: cell_jet_d(D, ax, h, 1, pmask, pside, J); break;         \
+    default: cell_jet_d(D, ax, h, 2, pmask, pside, J); break;        \
     }
     switch (dim) {
     case 1: CELL_JET_ORDERS(1) break;
@@ -443,7 +609,7 @@ point_jet_d(int dim, const double f[4], const uint32_t hs[16], int order, point_
             double dv = B->v - A->v;
             r.v = w0[k] * A->v + w1[k] * B->v;
             if (order == 0) {
-                t[i] = r;
+                t[i].v = r.v;        /* not the whole 168-byte struct */
                 continue;
             }
             for (int j = 0; j < dim; j++)
@@ -461,7 +627,13 @@ point_jet_d(int dim, const double f[4], const uint32_t hs[16], int order, point_
                 if (j < k) r.h[j][k] = r.h[j][k] + tjk;
                 else r.h[k][j] = r.h[k][j] + tjk;
             }
-            t[i] = r;
+            /* the parts dim has, not the whole 168-byte struct */
+            t[i].v = r.v;
+            for (int j = 0; j < dim; j++) {
+                t[i].g[j] = r.g[j];
+                for (int m = j; m < dim; m++)
+                    t[i].h[j][m] = r.h[j][m];
+            }
         }
     }
     *J = t[0];
@@ -602,6 +774,32 @@ static bool enclose_jets(const box_query *q, bool want_affine, const point_jet *
         }
     }
 
+    /*
+     * Point axes. A piece [0, e] or [1 - e, 1] of one cell with e at most
+     * the sliver width (the ground plane y = 0 again: after the sliver is
+     * dropped, its piece is [0, a few ulps]) is projected onto its lattice
+     * plane f_k = 0 or 1, by the argument above (its e goes into the
+     * widening), and the jets skip the axis (cell_jet_d, "Point axes"): on
+     * a plane the interval jets cost half. A piece that is the plane
+     * itself needs no widening.
+     */
+    unsigned pmask = 0, pside = 0;
+    for (int k = 0; k < dim; k++) {
+        if (ncell[k] != 1)
+            continue;
+        iv F = piece_of(q->lo[k], q->hi[k], i0[k]);
+        if (F.lo == 0.0 && F.hi <= sliver_max) {
+            pmask |= 1u << k;
+            if (F.hi > 0.0)
+                sliver = fp_add_up(sliver, F.hi);
+        } else if (F.hi == 1.0 && fp_add_up(1.0, -F.lo) <= sliver_max) {
+            pmask |= 1u << k;
+            pside |= 1u << k;
+            if (F.lo < 1.0)
+                sliver = fp_add_up(sliver, fp_add_up(1.0, -F.lo));
+        }
+    }
+
     /* segments per axis: the cell pieces, each halved when wider than
      * NOISE_SPLIT_WIDTH, as long as there are at most NOISE_MAX_SUBBOXES
      * sub-boxes in all */
@@ -611,6 +809,8 @@ static bool enclose_jets(const box_query *q, bool want_affine, const point_jet *
         int nk = 0, sk = 0;
         for (int j = 0; j < ncell[k]; j++) {
             piece[k][j] = piece_of(q->lo[k], q->hi[k], i0[k] + j);
+            if (pmask >> k & 1u)
+                piece[k][j] = iv_pt(pside >> k & 1u ? 1.0 : 0.0);
             parts[k][j] = piece[k][j].hi - piece[k][j].lo > NOISE_SPLIT_WIDTH ? 2 : 1;
             nk += 1;
             sk += parts[k][j];
@@ -668,7 +868,7 @@ static bool enclose_jets(const box_query *q, bool want_affine, const point_jet *
         uint32_t h[16];
         corner_hashes(dim, q->seed, pkey, h);
         jet J;
-        cell_jet(dim, pax, h, order, &J);
+        cell_jet(dim, pax, h, order, pmask, pside, &J);
         if (nsub > 1) {
             double r[4], fm[4];
             rest = sb;
@@ -682,14 +882,14 @@ static bool enclose_jets(const box_query *q, bool want_affine, const point_jet *
             double mvf = point_value(dim, fm, h), e0 = point_jet_err[dim][0];
             iv mv = iv_mk(out_dn(mvf - e0), out_up(mvf + e0));
             for (int k = 0; k < dim; k++)
-                mv = iv_add(mv, iv_mul(J.g[k], iv_mk(-r[k], r[k])));
+                mv = iv_add(mv, iv_mul_sym(J.g[k], r[k]));
             iv sr = J.v;
             if (mv.lo > sr.lo) sr.lo = mv.lo;
             if (mv.hi < sr.hi) sr.hi = mv.hi;
             subrange = sb == 0 ? sr : iv_hull(subrange, sr);
         }
         if (sb == 0) {
-            hull = J;
+            jet_copy(dim, order, &hull, &J);
             continue;
         }
         hull.v = iv_hull(hull.v, J.v);
@@ -734,7 +934,7 @@ static bool enclose_jets(const box_query *q, bool want_affine, const point_jet *
         /* the centred form over the whole box */
         iv mv = C.v;
         for (int k = 0; k < dim; k++)
-            mv = iv_add(mv, iv_mul(hull.g[k], iv_mk(-q->r[k], q->r[k])));
+            mv = iv_add(mv, iv_mul_sym(hull.g[k], q->r[k]));
         if (mv.lo > raw.lo) raw.lo = mv.lo;
         if (mv.hi < raw.hi) raw.hi = mv.hi;
     }

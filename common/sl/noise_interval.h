@@ -77,6 +77,16 @@ IV_INLINE iv iv_mul(iv a, iv b)
     double lo2 = p3 < p4 ? p3 : p4, hi2 = p3 < p4 ? p4 : p3;
     return iv_mk(out_dn(lo < lo2 ? lo : lo2), out_up(hi > hi2 ? hi : hi2));
 }
+/* a times [-r, r] for r >= 0: the same bits as iv_mul(a, iv_mk(-r, r))
+ * (its four products are +-a.lo r and +-a.hi r, rounding is symmetric,
+ * so their least is -(mag(a) r) and their greatest mag(a) r), with one
+ * product */
+IV_INLINE iv iv_mul_sym(iv a, double r)
+{
+    double l = fabs(a.lo), h = fabs(a.hi);
+    double p = (l > h ? l : h) * r;
+    return iv_mk(out_dn(-p), out_up(p));
+}
 /* a times a small integer: exact for 0, +-1, +-2, +-4, +-8 */
 IV_INLINE iv iv_mul_int(iv a, int g)
 {
@@ -117,5 +127,70 @@ static inline double iv_rad_about(iv a, double m)
     double r = r1 > r2 ? r1 : r2;
     return r > 0.0 ? r : 0.0;
 }
+
+/*
+ * The same kit on two-lane vectors (GCC and Clang vector extensions):
+ * lane 0 the lower bound, lane 1 the upper, so one instruction does both
+ * bounds' operation. Every lane computes exactly the scalar kit's IEEE
+ * operations (out_dn(x) = x - m and x + (-1 * m) are the same rounded
+ * sum, -1 * m being exact; the selections of iv_mul_pos are masks), so
+ * the results are the same bits; the interval jets (noise_bound.c) run on
+ * it where the compiler has the extensions, and on the scalar kit
+ * otherwise (NOISE_IV_VECTOR 0; -DNOISE_IV_SCALAR forces it, to compare).
+ */
+#if (defined(__GNUC__) || defined(__clang__)) && !defined(NOISE_IV_SCALAR)
+#define NOISE_IV_VECTOR 1
+typedef double ivv __attribute__((vector_size(16)));
+typedef long long ivv_mask __attribute__((vector_size(16)));
+
+IV_INLINE ivv ivv_of(iv a)
+{
+    ivv r = { a.lo, a.hi };
+    return r;
+}
+IV_INLINE iv iv_of_v(ivv a) { return iv_mk(a[0], a[1]); }
+IV_INLINE ivv ivv_pt(double x)
+{
+    ivv r = { x, x };
+    return r;
+}
+/* (hi, lo) */
+IV_INLINE ivv ivv_swap(ivv a)
+{
+#if defined(__clang__)
+    return __builtin_shufflevector(a, a, 1, 0);
+#else
+    const ivv_mask idx = { 1, 0 };
+    return __builtin_shuffle(a, idx);
+#endif
+}
+IV_INLINE ivv ivv_abs(ivv a)
+{
+    const ivv_mask m = { 0x7fffffffffffffffLL, 0x7fffffffffffffffLL };
+    return (ivv)((ivv_mask)a & m);
+}
+/* out_dn on lane 0, out_up on lane 1 */
+IV_INLINE ivv ivv_out(ivv x)
+{
+    const ivv sgn = { -1.0, 1.0 }, tiny = { -0x1p-500, 0x1p-500 };
+    const ivv eps = { 0x1p-52, 0x1p-52 }, floor_ = { 0x1p-600, 0x1p-600 },
+              lim = { 0x1p-500, 0x1p-500 };
+    ivv t = x + sgn * (ivv_abs(x) * eps + floor_);
+    ivv_mask small = ivv_abs(t) < lim;
+    return (ivv)(((ivv_mask)t & ~small) | ((ivv_mask)tiny & small));
+}
+IV_INLINE ivv ivv_add(ivv a, ivv b) { return ivv_out(a + b); }
+IV_INLINE ivv ivv_sub(ivv a, ivv b) { return ivv_out(a - ivv_swap(b)); }
+/* a times b for a >= 0, as iv_mul_pos */
+IV_INLINE ivv ivv_mul_pos(ivv a, ivv b)
+{
+    const ivv zero = { 0.0, 0.0 };
+    ivv_mask nonneg = b >= zero;
+    ivv f = (ivv)(((ivv_mask)a & nonneg) | ((ivv_mask)ivv_swap(a) & ~nonneg));
+    return ivv_out(f * b);
+}
+#else
+#define NOISE_IV_VECTOR 0
+#endif
 
 #endif

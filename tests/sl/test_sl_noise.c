@@ -1327,6 +1327,226 @@ static void test_box_methods(void **state)
 }
 
 /* ---------------------------------------------------------------------- */
+/* boxes on lattice planes, against an independent oracle                  */
+/* ---------------------------------------------------------------------- */
+/*
+ * The interval jets skip an axis whose piece is a lattice plane, or a
+ * sliver of a few ulps on one (noise_bound.c, "Point axes": a ground plane
+ * y = 0 in shader space). These boxes have such axes (exactly on a plane,
+ * a sliver of 1e-18..1e-8 on one side or both, or that close to a plane
+ * without touching it) beside wide ones (0.05..0.6, so the jets run in the
+ * default method too). The oracle is Perlin's formula and its gradient in
+ * long double from the corner gradients read off at the lattice points
+ * (as test_reconstruction), not noise.c's evaluation: its rounding is
+ * below 2^-56 (|raw| <= 8, |d raw| <= 40, a few dozen long double
+ * operations of relative error 2^-64 each), so OTOL = 2^-48 and GOTOL =
+ * 2^-44 are slack enough and far below the enclosures' widths.
+ */
+#define OTOL 0x1p-48
+#define GOTOL 0x1p-44
+
+/* the corner gradients of the lattice points base[k] + 0..2 per axis */
+typedef struct plane_oracle {
+    int dim;
+    double base[4];
+    long g[81][4];
+} plane_oracle;
+
+static void plane_oracle_init(plane_oracle *o, int dim, const double lo[4])
+{
+    o->dim = dim;
+    double worst = 0.0;
+    for (int k = 0; k < dim; k++)
+        o->base[k] = floor(lo[k]);
+    int n = 1;
+    for (int k = 0; k < dim; k++)
+        n *= 3;
+    for (int i = 0; i < n; i++) {
+        double q[4];
+        int rest = i;
+        for (int k = 0; k < dim; k++) {
+            q[k] = o->base[k] + rest % 3;
+            rest /= 3;
+        }
+        lattice_gradient(dim, q, o->g[i], &worst);
+        assert_true(in_gradient_set(dim, o->g[i]));
+    }
+    assert_true(worst < 1e-9);
+}
+
+/* noise and its gradient at x (within 2 cells of base per axis) */
+static long double plane_oracle_eval(const plane_oracle *o, const double *x,
+                                     long double grad[4])
+{
+    int dim = o->dim, cell[4];
+    long double f[4], s[4], ds[4];
+    for (int k = 0; k < dim; k++) {
+        double b = floor(x[k]);
+        cell[k] = (int)(b - o->base[k]);
+        assert_true(cell[k] >= 0 && cell[k] <= 1);
+        f[k] = (long double)x[k] - (long double)b;
+        s[k] = fade_l(f[k]);
+        ds[k] = 30.0L * f[k] * f[k] * (1.0L - f[k]) * (1.0L - f[k]);
+        grad[k] = 0.0L;
+    }
+    long double raw = 0.0L;
+    for (int c = 0; c < (1 << dim); c++) {
+        int idx = 0, mul = 1;
+        for (int k = 0; k < dim; k++) {
+            idx += (cell[k] + ((c >> k) & 1)) * mul;
+            mul *= 3;
+        }
+        const long *g = o->g[idx];
+        long double W = 1.0L, dot = 0.0L, w[4], dw[4];
+        for (int k = 0; k < dim; k++) {
+            int b = (c >> k) & 1;
+            w[k] = b ? s[k] : 1.0L - s[k];
+            dw[k] = b ? ds[k] : -ds[k];
+            W *= w[k];
+            dot += (long double)g[k] * (f[k] - b);
+        }
+        raw += W * dot;
+        for (int j = 0; j < dim; j++) {
+            long double dW = dw[j];
+            for (int k = 0; k < dim; k++)
+                if (k != j)
+                    dW *= w[k];
+            grad[j] += dW * dot + W * (long double)g[j];
+        }
+    }
+    long double K = (long double)sl_noise_scale(dim);
+    for (int k = 0; k < dim; k++)
+        grad[k] *= K;
+    return 0.5L + K * raw;
+}
+
+/* a box with at least one axis on (or a hair from) a lattice plane */
+static void plane_box(int dim, double lo[4], double hi[4])
+{
+    int thin = irange(1, (1 << dim) - 1);     /* which axes are thin */
+    for (int k = 0; k < dim; k++) {
+        double cell = (double)irange(-200, 200);
+        if (thin >> k & 1) {
+            double e = pow(10.0, urange(-18.0, -8.0)), e2 = pow(10.0, urange(-18.0, -8.0));
+            switch (irange(0, 5)) {
+            case 0: lo[k] = hi[k] = cell; break;                   /* the plane */
+            case 1: lo[k] = cell; hi[k] = cell + e; break;
+            case 2: lo[k] = cell - e; hi[k] = cell; break;
+            case 3: lo[k] = cell - e; hi[k] = cell + e2; break;    /* a sliver across */
+            case 4: lo[k] = cell + e; hi[k] = cell + e + e2; break; /* near, not on */
+            default: lo[k] = cell - e - e2; hi[k] = cell - e; break;
+            }
+            if (!(lo[k] <= hi[k]))
+                hi[k] = lo[k];
+        } else {
+            double w = pow(10.0, urange(log10(0.05), log10(0.6)));
+            lo[k] = cell + urange(-0.5 * w, 1.0 - 0.5 * w);
+            hi[k] = lo[k] + w;
+        }
+    }
+}
+
+typedef struct plane_stats {
+    long boxes, points, ia_viol, aa_viol, grad_viol;
+    double width;
+} plane_stats;
+
+static void check_plane_box(int dim, plane_stats *st)
+{
+    double lo[4], hi[4];
+    plane_box(dim, lo, hi);
+    plane_oracle o;
+    plane_oracle_init(&o, dim, lo);
+    ia_interval P[4], gv, G[4];
+    aa_form in[4], z;
+    aa_context ctx;
+    aa_context_init(&ctx, AA_DEFAULT_CAPACITY);
+    for (int k = 0; k < dim; k++) {
+        P[k] = ia_make(lo[k], hi[k]);
+        aa_input(&ctx, &in[k], lo[k], hi[k]);
+    }
+    ia_interval r = sl_noise_ia(dim, P);
+    sl_noise_aa(&ctx, &z, dim, in);
+    bool have_grad = sl_noise_gradient_ia(dim, P, NULL, -1, &gv, G);
+    ia_interval zr = aa_range(&z);
+    st->boxes++;
+    st->width += r.hi - r.lo;
+    double slack = z.err, mag = fabs(z.x0);
+    for (int i = 0; i < z.n; i++) {
+        if (i >= dim)
+            slack += fabs(z.c[i]);
+        else
+            mag += fabs(z.c[i]);
+    }
+    double aa_tol = OTOL + 0x1p-48 * mag;     /* as in check_box */
+    /* the corners, then a dense random set; thin axes also at the plane */
+    for (int s = 0; s < (1 << dim) + 150; s++) {
+        double x[4];
+        for (int k = 0; k < dim; k++) {
+            double plane = floor(hi[k]);
+            if (s < (1 << dim))
+                x[k] = ((s >> k) & 1) ? hi[k] : lo[k];
+            else if (s % 4 == 0 && plane >= lo[k])
+                x[k] = plane;
+            else {
+                x[k] = urange(lo[k], hi[k]);
+                if (x[k] > hi[k]) x[k] = hi[k];
+                if (x[k] < lo[k]) x[k] = lo[k];
+            }
+        }
+        long double gl[4];
+        long double v = plane_oracle_eval(&o, x, gl);
+        st->points++;
+        if (v < (long double)r.lo - OTOL || v > (long double)r.hi + OTOL)
+            st->ia_viol++;
+        long double val = z.x0;
+        for (int k = 0; k < dim && k < z.n; k++) {
+            double rad = in[k].c[k];
+            double eps = rad > 0.0 ? (x[k] - in[k].x0) / rad : 0.0;
+            val += (long double)z.c[k] * eps;
+        }
+        if (fabsl(v - val) > slack + aa_tol || (z.flags & AA_UNBOUNDED))
+            st->aa_viol++;
+        if (v < (long double)zr.lo - OTOL || v > (long double)zr.hi + OTOL)
+            st->aa_viol++;
+        if (have_grad) {
+            if (v < (long double)gv.lo - OTOL || v > (long double)gv.hi + OTOL)
+                st->ia_viol++;
+            for (int k = 0; k < dim; k++)
+                if (gl[k] < (long double)G[k].lo - GOTOL || gl[k] > (long double)G[k].hi + GOTOL)
+                    st->grad_viol++;
+        }
+    }
+}
+
+static void test_plane_boxes(void **state)
+{
+    (void)state;
+    static const char *const mname[2] = { "auto", "jets" };
+    static const int methods[2] = { SL_NOISE_BOX_AUTO, SL_NOISE_BOX_JETS };
+    double t0 = now_s();
+    long total = 0;
+    for (int m = 0; m < 2; m++) {
+        sl_noise_set_box_method(methods[m]);
+        for (int dim = 1; dim <= 4; dim++) {
+            rng_seed(60 + (uint64_t)dim);
+            plane_stats st = { 0 };
+            int n = dim <= 2 ? 300 : 400;
+            for (int i = 0; i < n; i++)
+                check_plane_box(dim, &st);
+            printf("plane boxes: %-4s %dD %4ld boxes %6ld points: %ld interval, %ld affine, "
+                   "%ld gradient violations; mean interval width %.4f\n", mname[m], dim,
+                   st.boxes, st.points, st.ia_viol, st.aa_viol, st.grad_viol,
+                   st.width / (double)st.boxes);
+            total += st.ia_viol + st.aa_viol + st.grad_viol;
+        }
+    }
+    sl_noise_set_box_method(SL_NOISE_BOX_AUTO);
+    printf("plane boxes: %.2f s\n", now_s() - t0);
+    assert_int_equal(total, 0);
+}
+
+/* ---------------------------------------------------------------------- */
 /* tightness                                                               */
 /* ---------------------------------------------------------------------- */
 
@@ -1564,6 +1784,7 @@ int main(void)
         cmocka_unit_test(test_float_accuracy),
         cmocka_unit_test(test_containment),
         cmocka_unit_test(test_box_methods),
+        cmocka_unit_test(test_plane_boxes),
         cmocka_unit_test(test_tightness),
         cmocka_unit_test(test_correlation),
         cmocka_unit_test(test_special_inputs),
