@@ -497,7 +497,7 @@ static bool compute(int n, sd_ev_consts *K)
         1.0 / 16);
     K->info.lambda_lo = lam.lo;
     /* eigenvectors */
-    double ar[2 * KD], al[2 * KD], rr = 0, rl = 0;
+    double ar[2 * KD] = {0}, al[2 * KD] = {0}, rr = 0, rl = 0;
     iv Lraw[KD][2];
     if (ok) {
         subspace(m, Mm, false, ar);

@@ -16,6 +16,11 @@
  *   the float pad PAD: 0 violations;
  * - the cone shrinks with the level (box side below 0.2 at level 22 at
  *   every valence);
+ * - the renderer's path, geom_subdiv_unit_normal_box on the dyadic boxes
+ *   at the EV of refined face 0 (rings from the renderer's refinement, its
+ *   rounding counted), gives a box from level 12 on at the latest, and the
+ *   float normals lie in it; a ring with a crease gets no box (today's
+ *   answer);
  * - the same boxes with the cone shrunk to 1/64 and no pad fail at every
  *   valence (the test would see a cone too narrow; the share of the cone
  *   the sampled normals need is printed).
@@ -100,8 +105,10 @@ static bool in_box(const ia_interval B[3], const double N[3])
     return true;
 }
 
-static void one_valence(int n, int cage, long *viol, long *viol_half, long *checked,
-                        double *last_width, double *need)
+/* the 2-ring of an EV of valence n as a cage (4n quads, random bumps; face 0
+ * is sector 0's cell at the EV, corner 0 the EV); a crease (infinitely
+ * sharp) on the EV's edge 1 when creased */
+static geom_subdiv *make_cage(int n, int cage, bool creased, double **Pout)
 {
     int np = 6 * n + 1, nf = 4 * n;
     double *P = malloc(sizeof(double) * 3 * (size_t)np);
@@ -124,11 +131,24 @@ static void one_valence(int n, int cage, long *viol, long *viol_half, long *chec
             fv[4 * f] = ring_idx(n, i, a, b), fv[4 * f + 1] = ring_idx(n, i, a + 1, b);
             fv[4 * f + 2] = ring_idx(n, i, a + 1, b + 1), fv[4 * f + 3] = ring_idx(n, i, a, b + 1);
         }
-    geom_subdiv_desc d = {nf, nv, fv, np, P, 0, NULL, NULL, NULL, 0, NULL, NULL, 0, NULL, false};
+    int clen[1] = {2}, cv[2] = {0, ring_idx(n, 1, 1, 0)};
+    double csh[1] = {GEOM_SUBDIV_INFINITE};
+    geom_subdiv_desc d = {nf, nv, fv, np, P, creased ? 1 : 0, clen, cv, csh, 0, NULL, NULL, 0, NULL,
+                          false};
     char why[200];
     geom_subdiv *sd = geom_subdiv_new(&d, why, sizeof why);
     if (!sd) fail_msg("cage of valence %d: %s", n, why);
     assert_true(geom_subdiv_face_drawn(sd, 0));
+    free(nv), free(fv);
+    *Pout = P;
+    return sd;
+}
+
+static void one_valence(int n, int cage, long *viol, long *viol_half, long *checked,
+                        double *last_width, double *need)
+{
+    double *P;
+    geom_subdiv *sd = make_cage(n, cage, false, &P);
     geom_surface s;
     geom_subdiv_surface(sd, 0, &s);
     const sd_ev_consts *K = sd_ev_consts_get(n);
@@ -182,7 +202,7 @@ static void one_valence(int n, int cage, long *viol, long *viol_half, long *chec
     }
     assert_true(boxes >= 12);   /* a box from level 10 on at least */
     geom_subdiv_destroy(&sd);
-    free(P), free(nv), free(fv);
+    free(P);
 }
 
 static void test_cone_holds_float_normals(void **state)
@@ -208,6 +228,62 @@ static void test_cone_holds_float_normals(void **state)
     assert_int_equal(total, 0);
 }
 
+/* The renderer's path: geom_subdiv_unit_normal_box on the dyadic boxes
+ * [0, 2^-j]^2 of refined face 0 (the sub-face nodes at the EV, their rings
+ * from the renderer's own refinement, rounding counted from pmax) holds
+ * the float normals; a creased ring keeps today's answer (no box). */
+static void test_renderer_box(void **state)
+{
+    (void)state;
+    static const int VALS[] = {3, 5, 6, 8};
+    for (int q = 0; q < 4; q++) {
+        long viol = 0, checked = 0;
+        int boxes = 0;
+        for (int cage = 0; cage < 2; cage++) {
+            double *P;
+            geom_subdiv *sd = make_cage(VALS[q], cage, false, &P);
+            geom_surface s;
+            geom_subdiv_surface(sd, 0, &s);
+            for (int j = 0; j <= 24; j++) {
+                double side = ldexp(1, -j);
+                ia_interval B[3];
+                if (!geom_subdiv_unit_normal_box(&s, ia_make(0, side), ia_make(0, side), B)) {
+                    assert_true(j < 12);
+                    continue;
+                }
+                boxes++;
+                for (int t = 0; t < 200; t++) {
+                    double u = side * urand() * (t % 2 ? 1 : ldexp(1, -(t % 8))),
+                           v = side * urand() * (t % 3 ? 1 : ldexp(1, -(t % 8)));
+                    if (fmax(u, v) < ldexp(1, -25)) continue;
+                    geom_sample g;
+                    geom_eval(&s, u, v, &g);
+                    double L = sqrt(g.Ng.x * g.Ng.x + g.Ng.y * g.Ng.y + g.Ng.z * g.Ng.z);
+                    if (!(L > 0)) continue;
+                    double Nn[3] = {g.Ng.x / L, g.Ng.y / L, g.Ng.z / L};
+                    checked++;
+                    viol += !in_box(B, Nn);
+                }
+            }
+            geom_subdiv_destroy(&sd);
+            free(P);
+            sd = make_cage(VALS[q], cage, true, &P);
+            geom_subdiv_surface(sd, 0, &s);
+            for (int j = 0; j <= 24; j++) {
+                ia_interval B[3];
+                assert_false(geom_subdiv_unit_normal_box(&s, ia_make(0, ldexp(1, -j)),
+                                                         ia_make(0, ldexp(1, -j)), B));
+            }
+            geom_subdiv_destroy(&sd);
+            free(P);
+        }
+        print_message("valence %d: %d renderer boxes, %ld float normals, %ld outside\n", VALS[q],
+                      boxes, checked, viol);
+        assert_true(checked > 2000);
+        assert_int_equal(viol, 0);
+    }
+}
+
 int main(void)
 {
     const char *seed = getenv("AAFARM_PROPERTY_SEED");
@@ -215,6 +291,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_constants),
         cmocka_unit_test(test_cone_holds_float_normals),
+        cmocka_unit_test(test_renderer_box),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
