@@ -9,7 +9,9 @@
  * Bezier nets E_p of those points; the map M on differences D = X - X_0
  * (no eigenvalue 1 left); enclosures of the exact right and left
  * eigenvectors R*, L* of the subdominant eigenvalue lambda (double,
- * semisimple: the Fourier block of frequency 1), proven by a verified
+ * semisimple: the Fourier block of frequency 1; that lambda has a
+ * 2-dimensional eigenspace is the one fact taken from the literature,
+ * Doo & Sabin 1978, Stam 1998), proven by a verified
  * linear solve with lambda from its closed form, normalised L*^T R* = I;
  * Q = I - R L^T and B = Q M (then T_m = lambda^m T_0 and Y_{m+1} = B Y_m
  * exactly, no coupling left); P with ||B^P|| <= lambda^P / 2; decay weights

@@ -16,6 +16,11 @@
  *   the float pad PAD: 0 violations;
  * - the cone shrinks with the level (box side below 0.2 at level 22 at
  *   every valence);
+ * - an oracle in long double (the test's own Catmull-Clark on the 2-ring
+ *   as a mesh, centred each step, limit normals at regular points from
+ *   B-spline tangent masks) agrees with subdiv_ev's step and its normals
+ *   at the regular points (1,0), (0,1), (1,1) of levels j .. j+40 lie in
+ *   the level-j box with no pad: 0 outside; shrunk to 1/64 some fail;
  * - the renderer's path, geom_subdiv_unit_normal_box on the dyadic boxes
  *   at the EV of refined face 0 (rings from the renderer's refinement, its
  *   rounding counted), gives a box from level 12 on at the latest, and the
@@ -54,16 +59,14 @@ static double urand(void)
  * a = 1..2, b = 0..2 at 1 + 6 i + 3 (a - 1) + b (G_i(0, b) = G_{i+1}(b, 0)) */
 static int ring_idx(int n, int i, int a, int b)
 {
+    while (!(a == 0 && b == 0)) {
+        int t;
+        if (a <= 0 && b >= 0) t = a, a = b, b = -t, i++;          /* G_i(a,b) = G_{i+1}(b,-a) */
+        else if (b < 0) t = b, b = a, a = -t, i--;                /* G_i(a,b) = G_{i-1}(-b,a) */
+        else break;
+    }
     if (a == 0 && b == 0) return 0;
-    if (a == 0) a = b, b = 0, i++;           /* G_i(0, b) = G_{i+1}(b, 0) */
-    if (b < 0) {                             /* G_i(a, -1) = G_{i-1}(1, a) */
-        int t = a;
-        a = -b, b = t, i--;
-    }
-    if (a < 0) {                             /* G_i(-1, b) = G_{i+1}(b, 1) */
-        int t = a;
-        a = b, b = -t, i++;
-    }
+    assert_true(a <= 2 && b <= 2);
     i = ((i % n) + n) % n;
     return 1 + 6 * i + 3 * (a - 1) + b;
 }
@@ -284,6 +287,160 @@ static void test_renderer_box(void **state)
     }
 }
 
+/* ---- an oracle in long double: Catmull-Clark on the 2-ring as a mesh ---- */
+
+typedef long double ld;
+
+/* One step of the rules on the 4n quads of the 2-ring (face points, edge
+ * points of edges with two faces, vertex points of the EV and its 1-ring),
+ * then the 2-ring one level down read off by position: a vertex point at
+ * even (A, B), a face point at odd, odd, an edge point else. Centred on the
+ * EV afterwards (normals do not see a translation; the small ring keeps its
+ * digits). */
+static void ld_step(int n, ld (*X)[3])
+{
+    int np = 6 * n + 1;
+    ld (*Y)[3] = calloc((size_t)np, sizeof *Y);
+    assert_non_null(Y);
+    for (int i = 0; i < n; i++)
+        for (int A = 0; A <= 2; A++)
+            for (int B = 0; B <= 2; B++) {
+                if ((A == 0 && B > 0) || (A == 0 && B == 0 && i > 0)) continue;
+                int out = ring_idx(n, i, A, B);
+                for (int d = 0; d < 3; d++) {
+                    ld v = 0;
+                    if (A % 2 && B % 2) { /* face point of cell ((A-1)/2, (B-1)/2) */
+                        int a = (A - 1) / 2, b = (B - 1) / 2;
+                        v = (X[ring_idx(n, i, a, b)][d] + X[ring_idx(n, i, a + 1, b)][d] +
+                             X[ring_idx(n, i, a + 1, b + 1)][d] + X[ring_idx(n, i, a, b + 1)][d]) / 4;
+                    } else if (A % 2 || B % 2) { /* edge point: its two ends, two faces */
+                        int a0 = A / 2, b0 = B / 2, a1 = (A + 1) / 2, b1 = (B + 1) / 2;
+                        ld ends = X[ring_idx(n, i, a0, b0)][d] + X[ring_idx(n, i, a1, b1)][d], fs = 0;
+                        for (int side = -1; side <= 1; side += 2) {
+                            /* the cells on either side of the edge */
+                            int ca = A % 2 ? a0 : a0 + (side < 0 ? -1 : 0);
+                            int cb = A % 2 ? b0 + (side < 0 ? -1 : 0) : b0;
+                            fs += (X[ring_idx(n, i, ca, cb)][d] + X[ring_idx(n, i, ca + 1, cb)][d] +
+                                   X[ring_idx(n, i, ca + 1, cb + 1)][d] +
+                                   X[ring_idx(n, i, ca, cb + 1)][d]) / 4;
+                        }
+                        v = (ends + fs) / 4;
+                    } else if (A == 0) { /* the EV */
+                        ld Q = 0, R = 0;
+                        for (int j = 0; j < n; j++) {
+                            Q += (X[0][d] + X[ring_idx(n, j, 1, 0)][d] + X[ring_idx(n, j, 1, 1)][d] +
+                                  X[ring_idx(n, j, 0, 1)][d]) / 4;
+                            R += (X[0][d] + X[ring_idx(n, j, 1, 0)][d]) / 2;
+                        }
+                        Q /= n, R /= n;
+                        v = (Q + 2 * R + (n - 3) * X[0][d]) / n;
+                    } else { /* a regular point of the 1-ring: 9 / 16, 3 / 32, 1 / 64 */
+                        int a = A / 2, b = B / 2;
+                        ld sum4 = 0, diag = 0;
+                        static const int E4[4][2] = {{1, 0}, {-1, 0}, {0, 1}, {0, -1}};
+                        static const int D4[4][2] = {{1, 1}, {-1, 1}, {1, -1}, {-1, -1}};
+                        for (int q = 0; q < 4; q++) {
+                            sum4 += X[ring_idx(n, i, a + E4[q][0], b + E4[q][1])][d];
+                            diag += X[ring_idx(n, i, a + D4[q][0], b + D4[q][1])][d];
+                        }
+                        v = X[ring_idx(n, i, a, b)][d] * 9 / 16 + sum4 * 3 / 32 + diag / 64;
+                    }
+                    Y[out][d] = v;
+                }
+            }
+    for (int c = np - 1; c >= 0; c--)
+        for (int d = 0; d < 3; d++) X[c][d] = Y[c][d] - Y[0][d];
+    free(Y);
+}
+
+/* the limit normal at a regular point G_0(a, b) of the ring: B-spline
+ * tangents (1, 4, 1) x central differences */
+static void ld_normal(int n, ld (*X)[3], int a, int b, double N[3])
+{
+    ld du[3], dv[3];
+    for (int d = 0; d < 3; d++) {
+        du[d] = dv[d] = 0;
+        for (int k = -1; k <= 1; k++) {
+            ld w = k == 0 ? 4 : 1;
+            du[d] += w * (X[ring_idx(n, 0, a + 1, b + k)][d] - X[ring_idx(n, 0, a - 1, b + k)][d]);
+            dv[d] += w * (X[ring_idx(n, 0, a + k, b + 1)][d] - X[ring_idx(n, 0, a + k, b - 1)][d]);
+        }
+    }
+    ld c[3] = {du[1] * dv[2] - du[2] * dv[1], du[2] * dv[0] - du[0] * dv[2],
+               du[0] * dv[1] - du[1] * dv[0]};
+    ld L = sqrtl(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
+    for (int d = 0; d < 3; d++) N[d] = (double)(c[d] / L);
+}
+
+/* The exact limit's normals (long double, no float pad: the sound box with
+ * pad 0) at the regular points (1,0), (0,1), (1,1) of the level-(j+k) ring,
+ * k = 0..40, all on the level-j sub-face; the box shrunk to 1/64 fails. */
+static void test_cone_holds_limit_normals(void **state)
+{
+    (void)state;
+    static const int VALS[] = {3, 5, 6, 8};
+    static const int PTS[3][2] = {{1, 0}, {0, 1}, {1, 1}};
+    for (int q = 0; q < 4; q++) {
+        int n = VALS[q], np = 6 * n + 1, N = 2 * n + 8;
+        long checked = 0, viol = 0, shrunk = 0;
+        const sd_ev_consts *K = sd_ev_consts_get(n);
+        assert_non_null(K);
+        for (int cage = 0; cage < 3; cage++) {
+            double *P;
+            geom_subdiv *sd = make_cage(n, cage, false, &P);
+            geom_subdiv_destroy(&sd);
+            ia_interval X[SD_EV_RING_MAX][3], Xn[SD_EV_RING_MAX][3];
+            for (int k = 0; k < N; k++)
+                for (int c = 0; c < 3; c++) X[k][c] = ia_point(P[3 * canon(n, k) + c]);
+            ld (*R)[3] = calloc((size_t)np, sizeof *R);
+            assert_non_null(R);
+            for (int c = 0; c < np; c++)
+                for (int d = 0; d < 3; d++) R[c][d] = P[3 * c + d];
+            for (int j = 1; j <= 22; j++) {
+                sd_ev_step(K, (const ia_interval(*)[3])X, Xn);
+                memcpy(X, Xn, sizeof X);
+                ld_step(n, R);
+                /* the two refinements agree (the interval ring less its EV) */
+                for (int k = 0; k < N; k++)
+                    for (int c = 0; c < 3; c++)
+                        assert_true(fabs((double)R[canon(n, k)][c] -
+                                         (ia_mid(X[k][c]) - ia_mid(X[0][c]))) < 1e-12);
+                ia_interval B[3], H[3];
+                if (!sd_ev_unit_normal_box(K, (const ia_interval(*)[3])X, 1.0, 0, B)) continue;
+                assert_true(sd_ev_unit_normal_box(K, (const ia_interval(*)[3])X, SHRUNK, 0, H));
+                ld (*Z)[3] = calloc((size_t)np, sizeof *Z);
+                assert_non_null(Z);
+                memcpy(Z, R, sizeof *Z * (size_t)np);
+                for (int k = 0; k <= 40; k++) {
+                    for (int p = 0; p < 3; p++) {
+                        double Nn[3];
+                        ld_normal(n, Z, PTS[p][0], PTS[p][1], Nn);
+                        checked++;
+                        if (!in_box(B, Nn)) {
+                            if (viol < 5)
+                                print_message("valence %d level %d + %d point (%d,%d): N (%.12f "
+                                              "%.12f %.12f) outside the box\n",
+                                              n, j, k, PTS[p][0], PTS[p][1], Nn[0], Nn[1], Nn[2]);
+                            viol++;
+                        }
+                        shrunk += !in_box(H, Nn);
+                    }
+                    ld_step(n, Z);
+                }
+                free(Z);
+            }
+            free(R);
+            free(P);
+        }
+        print_message("valence %d: %ld long double limit normals, %ld outside the box (pad 0), "
+                      "%ld outside the box shrunk to %g\n",
+                      n, checked, viol, shrunk, SHRUNK);
+        assert_true(checked > 3000);
+        assert_int_equal(viol, 0);
+        assert_true(shrunk > 0);
+    }
+}
+
 int main(void)
 {
     const char *seed = getenv("AAFARM_PROPERTY_SEED");
@@ -292,6 +449,7 @@ int main(void)
         cmocka_unit_test(test_constants),
         cmocka_unit_test(test_cone_holds_float_normals),
         cmocka_unit_test(test_renderer_box),
+        cmocka_unit_test(test_cone_holds_limit_normals),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
