@@ -63,7 +63,8 @@ struct sd_node {
     vec3 lo, hi;                   /* irregular: the sector hull, padded */
     int axis;                      /* the sector lies in x_axis = const, or -1 */
     _Atomic int normal;            /* 0 not known yet, 1 none, else 2 + 2 axis + (sign > 0) */
-    _Atomic int ev;                /* the EV cone: 0 not known yet, 1 none, 2 evbox, 3 being stored */
+    _Atomic int ev;                /* the EV cone: 0 not known yet, 1 none, 2 evbox,
+                                    * 3 being stored */
     ia_interval evbox[3];          /* the unit normal box at a smooth EV (subdiv_ev.c) */
     _Atomic(sd_node *) kid[4];
 };

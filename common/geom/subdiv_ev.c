@@ -16,9 +16,9 @@
  * Q = I - R L^T and B = Q M (then T_m = lambda^m T_0 and Y_{m+1} = B Y_m
  * exactly, no coupling left); P with ||B^P|| <= lambda^P / 2; decay weights
  * omega_c >= |(h^T B^m)_c| / lambda^m for the 72 hodograph functionals h
- * and every m (explicit to m = 200, the tail from B^P); C >= |R^T h|_1; J
- * <= |det| of the characteristic map's Jacobian (Bernstein coefficients,
- * G x G pieces). Per call: T = L^T D, Y = Q D, e = sum omega_c |Y_c|,
+ * and every m (explicit to m = 10 P, at most 200, the tail from B^P);
+ * C >= |R^T h|_1; J <= |det| of the characteristic map's Jacobian
+ * (Bernstein coefficients, G x G pieces). Per call: T = L^T D, Y = Q D, e = sum omega_c |Y_c|,
  * rho = (2 C max|t_i| e + e^2) / (J |t1 x t2|).
  */
 #include "geom/subdiv_ev.h"
@@ -264,8 +264,8 @@ static bool invert(int k, const double *A, double *inv)
  * (M is block triangular), so i1, i2 are taken among them: any other
  * choice leaves the singular inner block in G.
  */
-static bool verify_eig(int m, int inner, const iv *A, bool tr, iv lam, const double *approx, iv *out,
-                       double *rad_out)
+static bool verify_eig(int m, int inner, const iv *A, bool tr, iv lam, const double *approx,
+                       iv *out, double *rad_out)
 {
 #define AT(i, j) (tr ? A[(j) * m + (i)] : A[(i) * m + (j)])
     int i1 = 0, i2 = 1;
@@ -279,7 +279,8 @@ static bool verify_eig(int m, int inner, const iv *A, bool tr, iv lam, const dou
     for (int i = 0, q = 0; i < m; i++)
         if (i != i1 && i != i2) rest[q++] = i;
     iv *G = xmalloc(sizeof(iv) * (size_t)(k * k));
-    double *Gm = xmalloc(sizeof(double) * (size_t)(k * k)), *C = xmalloc(sizeof(double) * (size_t)(k * k));
+    double *Gm = xmalloc(sizeof(double) * (size_t)(k * k));
+    double *C = xmalloc(sizeof(double) * (size_t)(k * k));
     for (int a = 0; a < k; a++)
         for (int b = 0; b < k; b++) {
             iv g = AT(rest[a], rest[b]);
@@ -425,8 +426,8 @@ static double jac_low(const iv P[16][2], int G, int *sgn)
                             iv vy = ia_mul_s(ia_sub(H[l + 1][k][1], H[l][k][1]), 3);
                             iv w = ia_div(ia_point(B2[i] * B3[k] * B3[j] * B2[l]),
                                           ia_point(B5[i + k] * B5[j + l]));
-                            Cf[j + l][i + k] =
-                                ia_add(Cf[j + l][i + k], ia_mul(w, ia_sub(ia_mul(ux, vy), ia_mul(uy, vx))));
+                            iv J = ia_sub(ia_mul(ux, vy), ia_mul(uy, vx));
+                            Cf[j + l][i + k] = ia_add(Cf[j + l][i + k], ia_mul(w, J));
                         }
             for (int a = 0; a < 6; a++)
                 for (int b = 0; b < 6; b++) {
@@ -555,8 +556,11 @@ static bool compute(int n, sd_ev_consts *K)
     /* omega, C from the 72 hodograph functionals (in differences) */
     K->C = 0;
     for (int c = 0; c < m; c++) K->omega[c] = 0;
-    enum { KEXP = 200 };
-    iv(*hist)[KD] = xcalloc(KEXP, sizeof *hist);
+    /* explicit to 10 P (at most 200): the tail's bound, half the largest of
+     * the last P, is then about 2^-10 of the weights' peaks */
+    enum { KMAX_EXP = 200 };
+    int KEXP = 10 * P < 40 ? 40 : 10 * P > KMAX_EXP ? KMAX_EXP : 10 * P;
+    iv(*hist)[KD] = xcalloc(KMAX_EXP, sizeof *hist);
     for (int h = 0; h < NH && ok; h++) {
         int p = h / 24, hh = h % 24, j = (hh % 12) / 3, i = hh % 3;
         int q1 = hh < 12 ? 4 * j + i + 1 : 4 * (i + 1) + j, q0 = hh < 12 ? 4 * j + i : 4 * i + j;

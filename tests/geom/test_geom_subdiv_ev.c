@@ -312,10 +312,12 @@ static void ld_step(int n, ld (*X)[3])
                     if (A % 2 && B % 2) { /* face point of cell ((A-1)/2, (B-1)/2) */
                         int a = (A - 1) / 2, b = (B - 1) / 2;
                         v = (X[ring_idx(n, i, a, b)][d] + X[ring_idx(n, i, a + 1, b)][d] +
-                             X[ring_idx(n, i, a + 1, b + 1)][d] + X[ring_idx(n, i, a, b + 1)][d]) / 4;
+                             X[ring_idx(n, i, a + 1, b + 1)][d] +
+                             X[ring_idx(n, i, a, b + 1)][d]) / 4;
                     } else if (A % 2 || B % 2) { /* edge point: its two ends, two faces */
                         int a0 = A / 2, b0 = B / 2, a1 = (A + 1) / 2, b1 = (B + 1) / 2;
-                        ld ends = X[ring_idx(n, i, a0, b0)][d] + X[ring_idx(n, i, a1, b1)][d], fs = 0;
+                        ld ends = X[ring_idx(n, i, a0, b0)][d] + X[ring_idx(n, i, a1, b1)][d];
+                        ld fs = 0;
                         for (int side = -1; side <= 1; side += 2) {
                             /* the cells on either side of the edge */
                             int ca = A % 2 ? a0 : a0 + (side < 0 ? -1 : 0);
@@ -328,8 +330,8 @@ static void ld_step(int n, ld (*X)[3])
                     } else if (A == 0) { /* the EV */
                         ld Q = 0, R = 0;
                         for (int j = 0; j < n; j++) {
-                            Q += (X[0][d] + X[ring_idx(n, j, 1, 0)][d] + X[ring_idx(n, j, 1, 1)][d] +
-                                  X[ring_idx(n, j, 0, 1)][d]) / 4;
+                            Q += (X[0][d] + X[ring_idx(n, j, 1, 0)][d] +
+                                  X[ring_idx(n, j, 1, 1)][d] + X[ring_idx(n, j, 0, 1)][d]) / 4;
                             R += (X[0][d] + X[ring_idx(n, j, 1, 0)][d]) / 2;
                         }
                         Q /= n, R /= n;
