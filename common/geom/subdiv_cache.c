@@ -45,6 +45,7 @@
  * sector) keeps the unknown normal: a finite bound there needs the
  * eigen-analysis of the subdivision matrix.
  */
+#include "geom/subdiv_ev.h"
 #include "geom/subdiv_local.h"
 #include "util/xalloc.h"
 
@@ -62,6 +63,9 @@ struct sd_node {
     vec3 lo, hi;                   /* irregular: the sector hull, padded */
     int axis;                      /* the sector lies in x_axis = const, or -1 */
     _Atomic int normal;            /* 0 not known yet, 1 none, else 2 + 2 axis + (sign > 0) */
+    _Atomic int ev;                /* the EV cone: 0 not known yet, 1 none, 2 evbox,
+                                    * 3 being stored */
+    ia_interval evbox[3];          /* the unit normal box at a smooth EV (subdiv_ev.c) */
     _Atomic(sd_node *) kid[4];
 };
 
@@ -314,4 +318,118 @@ bool sd_node_unit_normal(const sd_node *n, vec3 *N)
     double s = (state - 2) % 2 ? 1.0 : -1.0;
     *N = v3(axis == 0 ? s : 0, axis == 1 ? s : 0, axis == 2 ? s : 0);
     return true;
+}
+
+/* ---- the cone at a smooth extraordinary point (subdiv_ev.c) ---- */
+
+/* The quad holding the directed edge a -> b: its two corners after b. */
+static bool quad_after(const sd_mesh *m, int a, int b, int *x, int *y)
+{
+    for (int f = 0; f < m->nf; f++) {
+        if (m->fo[f + 1] - m->fo[f] != 4) continue;
+        for (int c = 0; c < 4; c++)
+            if (m->fv[m->fo[f] + c] == a && m->fv[m->fo[f] + (c + 1) % 4] == b) {
+                *x = m->fv[m->fo[f] + (c + 2) % 4];
+                *y = m->fv[m->fo[f] + (c + 3) % 4];
+                return true;
+            }
+    }
+    return false;
+}
+
+static int faces_at(const sd_mesh *m, int v)
+{
+    int k = 0;
+    for (int c = 0; c < m->fo[m->nf]; c++) k += m->fv[c] == v;
+    return k;
+}
+
+/* The 2n+8 points the sub-face's limit depends on, in subdiv_ev.h's order,
+ * when face 0 is a quad whose one irregular corner is an interior point of
+ * valence n (3..SD_EV_NMAX) and no edge or point of the 1-ring is tagged
+ * (so the smooth rules alone refine those points); else 0. The walk goes
+ * round the EV by directed edges (faces agree on orientation), which also
+ * proves it interior (the walk closes). */
+static int ev_ring(const sd_mesh *m, int idxs[SD_EV_RING_MAX])
+{
+    if (m->fo[1] - m->fo[0] != 4) return 0;
+    for (int c = 0; c < m->fo[m->nf]; c++)
+        if (m->es[c] != 0) return 0;
+    for (int v = 0; v < m->nv; v++)
+        if (m->vs[v] != 0) return 0;
+    int k = -1;
+    for (int c = 0; c < 4; c++)
+        if (faces_at(m, m->fv[m->fo[0] + c]) != 4) {
+            if (k >= 0) return 0;
+            k = c;
+        }
+    if (k < 0) return 0;
+    int cpt = m->fv[m->fo[0] + k], n = faces_at(m, cpt);
+    if (n < 3 || n > SD_EV_NMAX) return 0;
+    int *e = idxs + 1, *f = idxs + 1 + n, *g = idxs + 1 + 2 * n;
+    idxs[0] = cpt;
+    e[0] = m->fv[m->fo[0] + (k + 1) % 4];
+    f[0] = m->fv[m->fo[0] + (k + 2) % 4];
+    e[1 % n] = m->fv[m->fo[0] + (k + 3) % 4];
+    for (int i = 1; i < n; i++) {
+        int en;
+        if (!quad_after(m, cpt, e[i], &f[i], &en)) return 0;
+        if (i + 1 < n) e[i + 1] = en;
+        else if (en != e[0]) return 0;
+    }
+    int x, y;
+    if (!quad_after(m, f[0], e[0], &g[0], &g[1])) return 0;
+    if (!quad_after(m, e[0], f[n - 1], &g[6], &x) || x != g[0]) return 0;
+    if (!quad_after(m, f[0], g[1], &g[2], &g[3])) return 0;
+    if (!quad_after(m, e[1], f[0], &x, &g[4]) || x != g[3]) return 0;
+    if (!quad_after(m, f[1], e[1], &y, &g[5]) || y != g[4]) return 0;
+    if (faces_at(m, e[0]) != 4 || faces_at(m, e[1]) != 4 || faces_at(m, f[0]) != 4) return 0;
+    return n;
+}
+
+/* The float pad of the box: the renderer's float evaluation of normals
+ * near the EV tilts by the refinement's rounding amplified by the level
+ * (measured: below 1e-5 down to 2^-26 from the point, test_geom_subdiv_ev;
+ * not part of the proof, like the planar case's 1e-6). */
+#define EV_FLOAT_PAD 1e-5
+
+static bool ev_box(const sd_node *n, double pmax, ia_interval N[3])
+{
+    int idxs[SD_EV_RING_MAX];
+    int val = ev_ring(&n->m, idxs);
+    const sd_ev_consts *K = val ? sd_ev_consts_get(val) : NULL;
+    if (!K) return false;
+    /* The ring's rounding: level + 1 steps of sd_refine from the control
+     * points, each new point a fixed sum of at most maxval + 12 rounded
+     * operations on points no larger than pmax (convex combinations), its
+     * parents' errors carried with weights summing to 1: per coordinate at
+     * most (level + 1) (maxval + 12) u pmax; taken twice over. */
+    double steps = (double)(n->level + 1) * (2.0 * n->maxval + 24);
+    double delta = fp_mul_up(fp_mul_up(steps, 0x1p-53), fp_mul_up(pmax, 1.01));
+    ia_interval X[SD_EV_RING_MAX][3];
+    for (int c = 0; c < 2 * val + 8; c++)
+        for (int d = 0; d < 3; d++) {
+            double x = v3_comp(n->m.P[idxs[c]], d);
+            X[c][d] = ia_make(fp_add_dn(x, -delta), fp_add_up(x, delta));
+        }
+    return sd_ev_unit_normal_box(K, (const ia_interval(*)[3])X, 1.0, EV_FLOAT_PAD, N);
+}
+
+bool sd_node_ev_box(const sd_node *n, double pmax, ia_interval N[3])
+{
+    if (n->regular) return false;
+    sd_node *w = (sd_node *)n;
+    int st = atomic_load_explicit(&w->ev, memory_order_acquire);
+    if (st == 1) return false;
+    if (st == 2) {
+        memcpy(N, w->evbox, sizeof w->evbox);
+        return true;
+    }
+    bool ok = ev_box(n, pmax, N);
+    int expected = 0;
+    if (atomic_compare_exchange_strong(&w->ev, &expected, 3)) {
+        if (ok) memcpy(w->evbox, N, sizeof w->evbox);
+        atomic_store_explicit(&w->ev, ok ? 2 : 1, memory_order_release);
+    }
+    return ok;
 }

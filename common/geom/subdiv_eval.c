@@ -598,8 +598,9 @@ bool geom_subdiv_unit_normal_box(const geom_surface *s, ia_interval u, ia_interv
     sd_range r;
     find_range(s, u.lo, u.hi, v.lo, v.hi, &r);
     vec3 N;
-    if (r.regular || can_split(&r, u, v) || !sd_node_unit_normal(r.normal_node, &N))
-        return false;
+    if (r.regular || can_split(&r, u, v)) return false;
+    if (!sd_node_unit_normal(r.normal_node, &N))   /* a smooth EV's proven cone, or none */
+        return sd_node_ev_box(r.node, s->subdiv->pmax, Nn);
     /* the exact normal, widened by 1e-6 for the float evaluation of points
      * near the irregular corner, whose normals tilt by the refinement's
      * rounding amplified by 2^level (1e-9 at 2^-22 from a crease point) */

@@ -57,6 +57,8 @@ struct geom_subdiv {
     int *vf_off, *vf;              /* control point -> faces holding it (CSR, ascending) */
     int maxval;                    /* the largest valence of the refined mesh (>= 4):
                                     * local meshes' sizes */
+    double pmax;                   /* the largest |coordinate| of a control point:
+                                    * the refinement's rounding (subdiv_ev.c's rings) */
     unsigned char *flags;          /* per refined face: SD_DRAWN, SD_REGULAR */
     int *irr_base;                 /* per 64 refined faces: drawn irregular faces before */
     int nirr;

@@ -112,6 +112,11 @@ void sd_node_hull(const sd_node *n, vec3 *lo, vec3 *hi);
 /* The unit normal of an irregular sub-face's limit where it is proven
  * constant (a planar sector, subdiv_cache.c); false otherwise. */
 bool sd_node_unit_normal(const sd_node *n, vec3 *N);
+/* The unit normal box of an irregular sub-face at an interior smooth
+ * extraordinary point (subdiv_ev.h's proven cone, the ring's rounding from
+ * pmax, the mesh's largest |coordinate|), made once per node; false where
+ * the sub-face is not such a one or the cone is not below 90 degrees. */
+bool sd_node_ev_box(const sd_node *n, double pmax, ia_interval N[3]);
 
 /* Component `axis` of Ng = dP/du x dP/dv over a whole regular sub-patch
  * from its hodographs (subdiv_eval.c). */

@@ -187,6 +187,9 @@ geom_subdiv *geom_subdiv_new(const geom_subdiv_desc *d, char *err, size_t errsz)
                 sd->maxval = sd->vf_off[v + 1] - sd->vf_off[v];
         for (int f = 0; f < nf; f++)
             if (m0.fo[f + 1] - m0.fo[f] > sd->maxval) sd->maxval = m0.fo[f + 1] - m0.fo[f];
+        sd->pmax = 0;
+        for (int v = 0; v < nv; v++)
+            sd->pmax = fmax(sd->pmax, fmax(fabs(m0.P[v].x), fmax(fabs(m0.P[v].y), fabs(m0.P[v].z))));
         /* tags that are all 0 are not kept */
         bool tagged = false;
         for (int c = 0; c < nc && !tagged; c++) tagged = m0.es[c] != 0;
