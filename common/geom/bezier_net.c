@@ -84,15 +84,25 @@ void geom_net_form(aa_context *ctx, aa_form *z, const ia_interval *w, int ld, in
     if (!isfinite(alpha) || !isfinite(beta) || !isfinite(gamma)) alpha = beta = gamma = 0;
     double rmax = 0;
     ia_interval hull = ia_empty();
+    /* the plane's terms at the net's abscissae, once per column and row
+     * (the same operations on the same values as per point: the same
+     * bits; the asset's subdivision rocks spent 16 % of their time here) */
+    assert(nu <= GEOM_NURBS_MAX_ORDER && nv <= GEOM_NURBS_MAX_ORDER);
+    ia_interval at_s[GEOM_NURBS_MAX_ORDER], at_t[GEOM_NURBS_MAX_ORDER];
+    for (int i = 0; i < nu; i++) {
+        ia_interval si = ia_add(ia_point(s0), ia_mul_s(ia_sub(ia_point(s1), ia_point(s0)),
+                                                       (double)i / (nu - 1)));
+        at_s[i] = ia_mul_s(si, alpha);
+    }
+    for (int j = 0; j < nv; j++) {
+        ia_interval tj = ia_add(ia_point(t0), ia_mul_s(ia_sub(ia_point(t1), ia_point(t0)),
+                                                       (double)j / (nv - 1)));
+        at_t[j] = ia_mul_s(tj, beta);
+    }
     for (int j = 0; j < nv; j++)
         for (int i = 0; i < nu; i++) {
             ia_interval x = ia_mul(W(j, i), scale);
-            ia_interval si = ia_add(ia_point(s0), ia_mul_s(ia_sub(ia_point(s1), ia_point(s0)),
-                                                           (double)i / (nu - 1)));
-            ia_interval tj = ia_add(ia_point(t0), ia_mul_s(ia_sub(ia_point(t1), ia_point(t0)),
-                                                           (double)j / (nv - 1)));
-            ia_interval plane = ia_add(ia_add(ia_mul_s(si, alpha), ia_mul_s(tj, beta)),
-                                       ia_point(gamma));
+            ia_interval plane = ia_add(ia_add(at_s[i], at_t[j]), ia_point(gamma));
             ia_interval d = ia_sub(x, plane);
             rmax = fmax(rmax, fmax(-d.lo, d.hi));
             hull = i == 0 && j == 0 ? x : ia_hull(hull, x);
