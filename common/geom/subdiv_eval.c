@@ -374,17 +374,19 @@ static void net_piece_of_rows(const vec3 net[16], const vec3 H[4][4], double s0,
     for (int c = 0; c < 3; c++) {
         double lo = INFINITY, hi = -INFINITY, ulo = INFINITY, uhi = -INFINITY;
         double vlo = INFINITY, vhi = -INFINITY;
+        /* (comparisons, not fmin/fmax: those are calls into libm here,
+         * and no value is NaN; a NaN would be skipped alike) */
         for (int j = 0; j < 4; j++)
             for (int i = 0; i < 4; i++) {
                 double x = v3_comp(B[j][i], c);
-                lo = fmin(lo, x), hi = fmax(hi, x);
+                lo = x < lo ? x : lo, hi = x > hi ? x : hi;
                 if (i < 3) {
                     double d = 3 * (v3_comp(B[j][i + 1], c) - x);
-                    ulo = fmin(ulo, d), uhi = fmax(uhi, d);
+                    ulo = d < ulo ? d : ulo, uhi = d > uhi ? d : uhi;
                 }
                 if (j < 3) {
                     double d = 3 * (v3_comp(B[j + 1][i], c) - x);
-                    vlo = fmin(vlo, d), vhi = fmax(vhi, d);
+                    vlo = d < vlo ? d : vlo, vhi = d > vhi ? d : vhi;
                 }
             }
         nb->P[c] = pad_iv(lo, hi, pad);
