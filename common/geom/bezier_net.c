@@ -32,15 +32,20 @@ void geom_bezier_piece(const double *p, int stride, int n, double a, double b, d
                        int qstride)
 {
     assert(n >= 1 && n <= GEOM_NURBS_MAX_ORDER);
-    for (int k = 0; k < n; k++) {
-        double r[GEOM_NURBS_MAX_ORDER];
-        for (int i = 0; i < n; i++) r[i] = p[i * stride];
-        /* n - 1 levels: a at the first n - 1 - k, b at the last k */
-        for (int l = 0; l < n - 1; l++) {
-            double t = l < n - 1 - k ? a : b;
-            for (int i = 0; i < n - 1 - l; i++) r[i] = r[i] + (r[i + 1] - r[i]) * t;
-        }
-        q[k * qstride] = r[0];
+    /* q[k]: n - 1 levels, a at the first m = n - 1 - k, b at the last k.
+     * The levels at a are each q's prefix: computed once, as r, and each
+     * q[k] goes on from r at b (the same operations on the same values as
+     * running every q from p: the same bits; for a cubic 16 interpolations
+     * instead of 24) */
+    double r[GEOM_NURBS_MAX_ORDER];
+    for (int i = 0; i < n; i++) r[i] = p[i * stride];
+    for (int m = 0; m < n; m++) {
+        double t[GEOM_NURBS_MAX_ORDER];
+        for (int i = 0; i < n - m; i++) t[i] = r[i];
+        for (int l = m; l < n - 1; l++)
+            for (int i = 0; i < n - 1 - l; i++) t[i] = t[i] + (t[i + 1] - t[i]) * b;
+        q[(n - 1 - m) * qstride] = t[0];
+        for (int i = 0; i < n - 1 - m; i++) r[i] = r[i] + (r[i + 1] - r[i]) * a;
     }
 }
 
