@@ -210,21 +210,6 @@ jet_copy(int dim, int order, jet *dst, const jet *src)
             dst->h[j][k] = src->h[j][k];
 }
 
-#if !NOISE_IV_VECTOR      /* the scalar jets' (the vector ones: ivv_mul_pos) */
-/* a times b for a >= 0 (a.lo >= 0): two products, picked by b's signs */
-IV_INLINE iv iv_mul_pos(iv a, iv b)
-{
-    double lo = b.lo >= 0.0 ? a.lo * b.lo : a.hi * b.lo;
-    double hi = b.hi >= 0.0 ? a.hi * b.hi : a.lo * b.hi;
-    return iv_mk(out_dn(lo), out_up(hi));
-}
-
-/* a*x + b*y for a, b >= 0 */
-IV_INLINE iv iv_lerp_pos(iv a, iv x, iv b, iv y)
-{
-    return iv_add(iv_mul_pos(a, x), iv_mul_pos(b, y));
-}
-#endif
 
 /*
  * Value (order 0), gradient (order >= 1) and Hessian (order 2) of raw
@@ -246,7 +231,7 @@ IV_INLINE iv iv_lerp_pos(iv a, iv x, iv b, iv y)
  * B - A keep the weights' derivatives from being counted twice. Every
  * operation is an interval operation with outward rounding, so each part
  * encloses the true one over the piece. Weights are >= 0 (clipped to
- * [0, 1] in axis_setup), which halves their products (iv_mul_pos).
+ * [0, 1] in axis_setup), which halves their products (ivv_mul_pos).
  */
 /*
  * Point axes. An axis k whose piece is the single point f_k = b (b = 0 or
@@ -262,8 +247,8 @@ IV_INLINE iv iv_lerp_pos(iv a, iv x, iv b, iv y)
  * point axis the operations are exactly the ones of before.
  */
 /* always inlined into cell_jet, once per (dim, order), so the loops unroll;
- * on the vector kit where there is one (noise_interval.h: the same bits) */
-#if NOISE_IV_VECTOR
+ * on the vector kit where there is one, else the scalar kit, through the
+ * same ivv_ names (noise_interval.h: the same bits either way) */
 typedef struct vjet {
     ivv v;
     ivv g[4];
@@ -340,7 +325,7 @@ cell_jet_d(int dim, const axis_fade *ax, const uint32_t h[16], int order,
                                                           ivv_mul_pos(w1, B->h[j][m]));
                     ivv dgk = ivv_sub(B->g[k], A->g[k]);
                     ivv m = ivv_mul_pos(D, dgk);
-                    ivv kk = ivv_add(2.0 * m, ivv_of(iv_mul(DD, iv_of_v(dv))));
+                    ivv kk = ivv_add(ivv_twice(m), ivv_of(iv_mul(DD, iv_of_v(dv))));
                     r.h[k][k] = ivv_add(r.h[k][k], kk);
                     for (int j = 0; j < dim; j++) {
                         if (j == k)
@@ -369,83 +354,6 @@ cell_jet_d(int dim, const axis_fade *ax, const uint32_t h[16], int order,
         for (int m = j; m < dim; m++)
             J->h[j][m] = iv_of_v(t[0].h[j][m]);
 }
-#else
-
-static inline __attribute__((always_inline)) void
-cell_jet_d(int dim, const axis_fade *ax, const uint32_t h[16], int order,
-           unsigned pmask, unsigned pside, jet *J)
-{
-    jet t[16];
-    int act[4] = { 0, 1, 2, 3 }, na = 0;
-    for (int k = 0; k < dim; k++)
-        if (!(pmask >> k & 1u))
-            act[na++] = k;
-    int n = 1 << na;
-    for (int c = 0; c < n; c++) {
-        /* the full corner: the point axes' sides, c's bits on the others */
-        unsigned cf = pside & pmask;
-        for (int m = 0; m < na; m++)
-            cf |= (unsigned)((c >> m) & 1) << act[m];
-        int g[4];
-        gradient(dim, h[cf], g);
-        iv l = iv_pt(0.0);
-        for (int m = 0; m < na; m++) {
-            int k = act[m];
-            if (m == 0)
-                l = iv_mul_int(ax[k].d[(cf >> k) & 1u], g[k]);
-            else if (g[k] != 0)
-                l = iv_add(l, iv_mul_int(ax[k].d[(cf >> k) & 1u], g[k]));
-        }
-        t[c].v = l;
-        if (order < 1)
-            continue;
-        for (int k = 0; k < dim; k++)
-            t[c].g[k] = iv_pt((double)g[k]);
-        /* the corners' Hessians are 0: the first step knows it */
-    }
-    for (int st = 0; st < na; st++) {
-        int k = act[st] & 3;            /* (0..3: tells the compiler) */
-        n >>= 1;
-        iv w0 = ax[k].w[0], w1 = ax[k].w[1];
-        iv D = ax[k].ds, DD = ax[k].dds;
-        for (int i = 0; i < n; i++) {
-            const jet *A = &t[2 * i], *B = &t[2 * i + 1];
-            jet r;
-            r.v = iv_lerp_pos(w0, A->v, w1, B->v);
-            if (order >= 1) {
-                iv dv = iv_sub(B->v, A->v);
-                for (int j = 0; j < dim; j++)
-                    r.g[j] = iv_lerp_pos(w0, A->g[j], w1, B->g[j]);
-                r.g[k] = iv_add(r.g[k], iv_mul_pos(D, dv));
-                if (order >= 2) {
-                    for (int j = 0; j < dim; j++)
-                        for (int m = j; m < dim; m++)
-                            r.h[j][m] = st == 0 ? iv_pt(0.0)
-                                                : iv_lerp_pos(w0, A->h[j][m], w1, B->h[j][m]);
-                    iv dgk = iv_sub(B->g[k], A->g[k]);
-                    iv m = iv_mul_pos(D, dgk);
-                    iv kk = iv_add(iv_mk(2.0 * m.lo, 2.0 * m.hi), iv_mul(DD, dv));
-                    r.h[k][k] = iv_add(r.h[k][k], kk);
-                    for (int j = 0; j < dim; j++) {
-                        if (j == k)
-                            continue;
-                        iv t_jk = iv_mul_pos(D, iv_sub(B->g[j], A->g[j]));
-                        if (j < k) r.h[j][k] = iv_add(r.h[j][k], t_jk);
-                        else r.h[k][j] = iv_add(r.h[k][j], t_jk);
-                    }
-                }
-            }
-            jet_copy(dim, order, &t[i], &r);
-        }
-    }
-    if (order >= 2 && na == 0)          /* every axis a point: H = 0 */
-        for (int j = 0; j < dim; j++)
-            for (int m = j; m < dim; m++)
-                t[0].h[j][m] = iv_pt(0.0);
-    jet_copy(dim, order, J, &t[0]);
-}
-
-#endif
 
 static void cell_jet(int dim, const axis_fade *ax, const uint32_t h[16],
                      int order, unsigned pmask, unsigned pside, jet *J)

@@ -136,7 +136,8 @@ static inline double iv_rad_about(iv a, double m)
  * sum, -1 * m being exact; the selections of iv_mul_pos are masks), so
  * the results are the same bits; the interval jets (noise_bound.c) run on
  * it where the compiler has the extensions, and on the scalar kit
- * otherwise (NOISE_IV_VECTOR 0; -DNOISE_IV_SCALAR forces it, to compare).
+ * otherwise (NOISE_IV_VECTOR 0; -DNOISE_IV_SCALAR forces it, to compare:
+ * test_sl_noise_kits), through the same ivv_ names.
  */
 #if (defined(__GNUC__) || defined(__clang__)) && !defined(NOISE_IV_SCALAR)
 #define NOISE_IV_VECTOR 1
@@ -189,8 +190,25 @@ IV_INLINE ivv ivv_mul_pos(ivv a, ivv b)
     ivv f = (ivv)(((ivv_mask)a & nonneg) | ((ivv_mask)ivv_swap(a) & ~nonneg));
     return ivv_out(f * b);
 }
+IV_INLINE ivv ivv_twice(ivv a) { return 2.0 * a; }
 #else
 #define NOISE_IV_VECTOR 0
+/* The same names on the scalar kit, so that the jets are written once
+ * (noise_bound.c's cell_jet_d) and run on either kit. */
+typedef iv ivv;
+IV_INLINE ivv ivv_of(iv a) { return a; }
+IV_INLINE iv iv_of_v(ivv a) { return a; }
+IV_INLINE ivv ivv_pt(double x) { return iv_pt(x); }
+IV_INLINE ivv ivv_add(ivv a, ivv b) { return iv_add(a, b); }
+IV_INLINE ivv ivv_sub(ivv a, ivv b) { return iv_sub(a, b); }
+/* a times b for a >= 0 (a.lo >= 0): two products, picked by b's signs */
+IV_INLINE ivv ivv_mul_pos(ivv a, ivv b)
+{
+    double lo = b.lo >= 0.0 ? a.lo * b.lo : a.hi * b.lo;
+    double hi = b.hi >= 0.0 ? a.hi * b.hi : a.lo * b.hi;
+    return iv_mk(out_dn(lo), out_up(hi));
+}
+IV_INLINE ivv ivv_twice(ivv a) { return iv_mk(2.0 * a.lo, 2.0 * a.hi); }
 #endif
 
 #endif
