@@ -134,19 +134,24 @@ static bool write_stats_json(const char *path, const shared *s, int threads, dou
 {
     FILE *f = fopen(path, "w");
     if (!f) return false;
-    char extra[768];
+    char extra[8192];
     tex_tile_stats ts;
     tex_tiles_stats(tex_tiles_process(), &ts);
+    trace_world_counts wc;
+    trace_world_count(&s->js->world, &wc);
     snprintf(extra, sizeof extra,
              "\"scene\": \"%s\", \"width\": %d, \"height\": %d, \"tiles\": %d, "
              "\"threads\": %d, \"arith\": \"%s\", \"cache_bytes\": %zu, \"seconds\": %.3f, "
              "\"nonfinite_samples\": %llu, \"texture_bytes\": %zu, "
              "\"texture_tile_loads\": %llu, \"texture_tile_evictions\": %llu, "
-             "\"texture_tile_peak_bytes\": %zu",
+             "\"texture_tile_peak_bytes\": %zu, \"world_objects\": %d, \"world_meshes\": %d, "
+             "\"world_pieces\": %ld, \"instance_groups\": %d, \"instances\": %ld, "
+             "\"instances_moved\": %ld, \"instances_own\": %ld",
              s->opt->scene_path, s->fmt.width, s->fmt.height, s->ntiles, threads,
              trace_arith_name(s->opt->job.arith), s->opt->cache_bytes, secs,
              (unsigned long long)s->nonfinite.count, ts.budget, ts.loads, ts.evictions,
-             ts.peak_bytes);
+             ts.peak_bytes, wc.objects, wc.meshes, wc.pieces, wc.groups, wc.placements,
+             wc.moved, wc.own);
     trace_stats_write_json(&s->stats, extra, f);
     fputc('\n', f);
     return fclose(f) == 0;
@@ -252,11 +257,13 @@ static int render_frame(const standalone_options *opt, const job *jb, const fram
     if (opt->stats) {
         fprintf(stderr, "statistics:\n");
         trace_stats_print(&s.stats, stderr);
+        /* what the world holds (trace_world_count), as the lines above */
         trace_world_counts wc;
         trace_world_count(&js->world, &wc);
-        fprintf(stderr, "  world: %d objects (%d meshes of %ld pieces), %d groups of %ld "
-                "instances (displaced: %ld the prototype moved, %ld own surfaces)\n", wc.objects,
-                wc.meshes, wc.pieces, wc.groups, wc.placements, wc.moved, wc.own);
+        fprintf(stderr, "  %-18s %d\n  %-18s %d\n  %-18s %ld\n  %-18s %d\n  %-18s %ld\n"
+                "  %-18s %ld\n  %-18s %ld\n", "world_objects", wc.objects, "world_meshes",
+                wc.meshes, "world_pieces", wc.pieces, "instance_groups", wc.groups, "instances",
+                wc.placements, "instances_moved", wc.moved, "instances_own", wc.own);
         tex_tile_stats ts;
         tex_tiles_stats(tex_tiles_process(), &ts);
         if (ts.loads)

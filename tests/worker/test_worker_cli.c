@@ -161,6 +161,48 @@ static void test_good_render_leaves_exactly_the_output(void **state)
     image_buffer_destroy(&b);
 }
 
+/* --stats and --stats-json say what the world holds (trace_world_count):
+ * a displaced sphere recorded once and placed three times, the second
+ * turned (its prototype moved: an object-space shader) and the third
+ * scaled (a surface of its own), is one object and one group of two
+ * instances, one moved and one own. */
+static void test_stats_count_the_instances(void **state)
+{
+    (void)state;
+    char out[16384];
+    write_file("lumps.sl", "displacement lumps(float Km = 0.05)\n{\n"
+                           "    point Po = transform(\"object\", P);\n"
+                           "    P += Km * sin(9 * xcomp(Po)) * normalize(N);\n"
+                           "    N = calculatenormal(P);\n}\n");
+    write_file("inst.rib", "Format 24 16 1\nProjection \"perspective\" \"fov\" [40]\n"
+               "Option \"searchpath\" \"shader\" [\".\"]\nTranslate 0 0 6\nWorldBegin\n"
+               "Displacement \"lumps\"\nObjectBegin 1\nSphere 0.5 -0.5 0.5 360\nObjectEnd\n"
+               "AttributeBegin\nTranslate -1.2 0 0\nObjectInstance 1\nAttributeEnd\n"
+               "AttributeBegin\nRotate 40 0 1 0\nObjectInstance 1\nAttributeEnd\n"
+               "AttributeBegin\nTranslate 1.2 0 0\nScale 1 1.5 1\nObjectInstance 1\nAttributeEnd\n"
+               "WorldEnd\n");
+    assert_int_equal(run("--standalone inst.rib -o inst.exr --stats --stats-json inst.json -q",
+                         out, sizeof out), 0);
+    static const char *const lines[] = {
+        "world_objects      1\n", "world_meshes       0\n", "instance_groups    1\n",
+        "instances          2\n", "instances_moved    1\n", "instances_own      1\n"};
+    for (size_t i = 0; i < sizeof lines / sizeof lines[0]; i++) {
+        if (!strstr(out, lines[i])) printf("missing '%s' in:\n%s\n", lines[i], out);
+        assert_non_null(strstr(out, lines[i]));
+    }
+    char path[512];
+    snprintf(path, sizeof path, "%s/inst.json", dir);
+    FILE *f = fopen(path, "r");
+    assert_non_null(f);
+    char json[16384];
+    size_t n = fread(json, 1, sizeof json - 1, f);
+    json[n] = '\0';
+    fclose(f);
+    assert_non_null(strstr(json, "\"instances\": 2"));
+    assert_non_null(strstr(json, "\"instances_moved\": 1"));
+    assert_non_null(strstr(json, "\"instances_own\": 1"));
+}
+
 /* An independent oracle of the tile renderer (issue 27, item 7): a plane
  * far wider than the view covers every pixel, so every pixel's alpha is 1
  * whatever the tile grid; partial tiles (37x23 in tiles of 8) and two
@@ -317,6 +359,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_budget_exceeded_leaves_nothing),
         cmocka_unit_test(test_good_render_leaves_exactly_the_output),
         cmocka_unit_test(test_covering_plane_gives_alpha_one_everywhere),
+        cmocka_unit_test(test_stats_count_the_instances),
         cmocka_unit_test(test_shader_printf_reaches_stderr),
         cmocka_unit_test(test_sigterm_stops_a_runaway_render),
         cmocka_unit_test(test_sigterm_stops_one_long_evaluation),
