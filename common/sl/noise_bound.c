@@ -192,23 +192,20 @@ typedef struct jet {
     iv h[4][4];          /* j <= k used */
 } jet;
 
-/* Copies the parts of a jet that its order has (the whole struct is 336
- * bytes, of which an order-1 jet in 3D uses 64: copying all of it cost an
- * eighth of sl_bench's dented time, a `rep movsq` per interpolation step) */
-static inline __attribute__((always_inline)) void
-jet_copy(int dim, int order, jet *dst, const jet *src)
-{
-    dst->v = src->v;
-    if (order < 1)
-        return;
-    for (int j = 0; j < dim; j++)
-        dst->g[j] = src->g[j];
-    if (order < 2)
-        return;
-    for (int j = 0; j < dim; j++)
-        for (int k = j; k < dim; k++)
-            dst->h[j][k] = src->h[j][k];
-}
+/* Copies the parts of a jet (jet, or vjet below: the same fields) that
+ * its order has (the whole struct is 336 bytes, of which an order-1 jet
+ * in 3D uses 64: copying all of it cost an eighth of sl_bench's dented
+ * time, a `rep movsq` per interpolation step) */
+#define JET_COPY(dim, order, dst, src)                                  \
+    do {                                                                \
+        (dst)->v = (src)->v;                                            \
+        if ((order) >= 1)                                               \
+            for (int j_ = 0; j_ < (dim); j_++) (dst)->g[j_] = (src)->g[j_]; \
+        if ((order) >= 2)                                               \
+            for (int j_ = 0; j_ < (dim); j_++)                          \
+                for (int k_ = j_; k_ < (dim); k_++)                     \
+                    (dst)->h[j_][k_] = (src)->h[j_][k_];                \
+    } while (0)
 
 
 /*
@@ -254,21 +251,6 @@ typedef struct vjet {
     ivv g[4];
     ivv h[4][4];
 } vjet;
-
-static inline __attribute__((always_inline)) void
-vjet_copy(int dim, int order, vjet *dst, const vjet *src)
-{
-    dst->v = src->v;
-    if (order < 1)
-        return;
-    for (int j = 0; j < dim; j++)
-        dst->g[j] = src->g[j];
-    if (order < 2)
-        return;
-    for (int j = 0; j < dim; j++)
-        for (int k = j; k < dim; k++)
-            dst->h[j][k] = src->h[j][k];
-}
 
 static inline __attribute__((always_inline)) void
 cell_jet_d(int dim, const axis_fade *ax, const uint32_t h[16], int order,
@@ -336,7 +318,7 @@ cell_jet_d(int dim, const axis_fade *ax, const uint32_t h[16], int order,
                     }
                 }
             }
-            vjet_copy(dim, order, &t[i], &r);
+            JET_COPY(dim, order, &t[i], &r);
         }
     }
     if (order >= 2 && na == 0)          /* every axis a point: H = 0 */
@@ -797,7 +779,7 @@ static bool enclose_jets(const box_query *q, bool want_affine, const point_jet *
             subrange = sb == 0 ? sr : iv_hull(subrange, sr);
         }
         if (sb == 0) {
-            jet_copy(dim, order, &hull, &J);
+            JET_COPY(dim, order, &hull, &J);
             continue;
         }
         hull.v = iv_hull(hull.v, J.v);

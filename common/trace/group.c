@@ -52,8 +52,7 @@ bool trace_group_view_make(trace_thread *th, const trace_object *g, int k, trace
         /* the prototype's displaced surface moved (trace/instance.c) */
         const trace_object *proto = &th->world->objects[gr->proto];
         v->box_proto = proto;
-        v->from_proto = mat4_mul(v->to_camera, proto->from_camera);
-        v->to_proto = mat4_mul(proto->to_camera, v->from_camera);
+        trace_instance_set_motion(v, proto);
     }
     trace_object_camera_bound(v, &v->root, &v->bound);
     return true;

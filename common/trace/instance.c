@@ -119,9 +119,14 @@ bool trace_instance_rigid(trace_object *obj, const trace_object *proto)
         obj->flip != proto->flip || obj->surf.kind != proto->surf.kind ||
         !shader_allows(obj->displacement))
         return false;
+    trace_instance_set_motion(obj, proto);
+    return rigid(&obj->from_proto) && spaces_move(obj, proto);
+}
+
+void trace_instance_set_motion(trace_object *obj, const trace_object *proto)
+{
     obj->from_proto = mat4_mul(obj->to_camera, proto->from_camera);
     obj->to_proto = mat4_mul(proto->to_camera, obj->from_camera);
-    return rigid(&obj->from_proto) && spaces_move(obj, proto);
 }
 
 bool trace_instance_moves(trace_thread *th, trace_object *obj, const trace_object *proto)

@@ -31,6 +31,9 @@ int trace_instances_share(trace_thread *th, trace_world *world);
  * space only where it is the instance's). No shader runs. */
 bool trace_instance_rigid(trace_object *obj, const trace_object *proto);
 
+/* obj->from_proto and to_proto: proto's camera space to obj's and back. */
+void trace_instance_set_motion(trace_object *obj, const trace_object *proto);
+
 /* trace_instance_rigid, and the probe: obj's own displaced points and
  * normals on a 5 x 5 grid of (u,v) equal proto's moved ones (the shader
  * runs on th). obj->box_proto is NULL on return either way. */

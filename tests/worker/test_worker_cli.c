@@ -36,6 +36,16 @@ static void write_file(const char *name, const char *text)
     fclose(f);
 }
 
+/* the text of file `path` (its first cap - 1 bytes) into buf */
+static void read_text(const char *path, char *buf, size_t cap)
+{
+    FILE *f = fopen(path, "r");
+    assert_non_null(f);
+    size_t n = fread(buf, 1, cap - 1, f);
+    buf[n] = '\0';
+    fclose(f);
+}
+
 /* runs the worker with args (a shell fragment), output in *out; returns the exit status */
 static int run(const char *args, char *out, size_t outsz)
 {
@@ -192,12 +202,8 @@ static void test_stats_count_the_instances(void **state)
     }
     char path[512];
     snprintf(path, sizeof path, "%s/inst.json", dir);
-    FILE *f = fopen(path, "r");
-    assert_non_null(f);
     char json[16384];
-    size_t n = fread(json, 1, sizeof json - 1, f);
-    json[n] = '\0';
-    fclose(f);
+    read_text(path, json, sizeof json);
     assert_non_null(strstr(json, "\"instances\": 2"));
     assert_non_null(strstr(json, "\"instances_moved\": 1"));
     assert_non_null(strstr(json, "\"instances_own\": 1"));
@@ -296,12 +302,8 @@ static void test_sigterm_stops_one_long_evaluation(void **state)
     printf("SIGTERM in one evaluation: exited after ~%d ms\n", waited_ms);
     assert_int_equal(code, 130);
     assert_int_equal(count_files("spin.exr"), 0);
-    FILE *f = fopen(log, "r");
-    assert_non_null(f);
     char text[4096];
-    size_t n = fread(text, 1, sizeof text - 1, f);
-    text[n] = '\0';
-    fclose(f);
+    read_text(log, text, sizeof text);
     assert_non_null(strstr(text, "interrupted"));
     assert_null(strstr(text, "budget"));
 }
