@@ -9,9 +9,11 @@
  * prototype's boxes (objects, or placements of a group: trace/group.h),
  * the bytes the scene and world hold (job_scene_new, with the allocator),
  * the cache's peak bytes and broods, the boxes computed and the render
- * CPU seconds. Never fails on timing.
+ * CPU seconds. Never fails on timing. --mesh draws a Catmull-Clark cube
+ * (24 limit pieces, a displaced mesh: its placements walk the prototype's
+ * mesh, or have meshes of their own) instead of each sphere.
  *
- *   instance_bench [max_n] [--instances-only]
+ *   instance_bench [max_n] [--instances-only] [--mesh]
  *                              (N = 1, 4, 16, 64 up to max_n; default 64)
  */
 #include <malloc.h>
@@ -25,6 +27,15 @@
 #include "job/job_scene.h"
 
 enum { RES = 256 };
+
+/* the primitive: a unit sphere, or (--mesh) a cube cage of side 1.6 */
+static const char *SPHERE = "Sphere 1 -1 1 360";
+static const char *CUBE =
+    "SubdivisionMesh \"catmull-clark\" [4 4 4 4 4 4] "
+    "[0 1 3 2 2 3 5 4 4 5 7 6 6 7 1 0 1 7 5 3 6 0 2 4] [] [] [] [] "
+    "\"P\" [-0.8 -0.8 0.8  0.8 -0.8 0.8  -0.8 0.8 0.8  0.8 0.8 0.8  -0.8 0.8 -0.8  "
+    "0.8 0.8 -0.8  -0.8 -0.8 -0.8  0.8 -0.8 -0.8]";
+static const char *prim;
 
 static double cpu_now(void)
 {
@@ -50,7 +61,7 @@ static char *read_shader(const char *name, size_t *len)
 static char *scene_rib(int n, bool instanced, size_t *len)
 {
     int k = (int)ceil(sqrt(n));
-    size_t cap = (size_t)n * 200 + 4096, m = 0;
+    size_t cap = (size_t)n * (200 + strlen(prim)) + 4096, m = 0;
     char *t = malloc(cap);
     if (!t) abort();
     m += (size_t)snprintf(t + m, cap - m,
@@ -60,12 +71,12 @@ static char *scene_rib(int n, bool instanced, size_t *len)
         "Surface \"plastic\"\nDisplacement \"lumpy\" \"float Km\" [0.08] "
         "\"float frequency\" [7]\n", RES, RES, 2.9 * k);
     if (instanced)
-        m += (size_t)snprintf(t + m, cap - m, "ObjectBegin 1\nSphere 1 -1 1 360\nObjectEnd\n");
+        m += (size_t)snprintf(t + m, cap - m, "ObjectBegin 1\n%s\nObjectEnd\n", prim);
     for (int i = 0; i < n; i++)
         m += (size_t)snprintf(t + m, cap - m,
             "AttributeBegin\nTranslate %g %g 0\nRotate %d 0.3 1 0.2\n%s\nAttributeEnd\n",
             2.1 * (i % k - (k - 1) / 2.0), 2.1 * (i / k - (k - 1) / 2.0), 37 * i,
-            instanced ? "ObjectInstance 1" : "Sphere 1 -1 1 360");
+            instanced ? "ObjectInstance 1" : prim);
     m += (size_t)snprintf(t + m, cap - m, "WorldEnd\n");
     *len = m;
     return t;
@@ -109,7 +120,7 @@ static int run(int n, bool instanced)
     for (int i = 0; i < js->world.nobjects; i++) {
         const trace_object *o = &js->world.objects[i];
         shared += o->box_proto != NULL;
-        if (o->group && o->group->first_id >= 0) shared += o->group->n - o->group->nown;
+        if (o->group && o->group->own) shared += o->group->n - o->group->nown;
     }
     trace_thread *th = trace_thread_new(&js->world);
     double t0 = cpu_now();
@@ -136,12 +147,15 @@ int main(int argc, char **argv)
 {
     int max_n = 64;
     bool copies = true;
+    prim = SPHERE;
     for (int i = 1; i < argc; i++) {
         if (strcmp(argv[i], "--instances-only") == 0) copies = false;
+        else if (strcmp(argv[i], "--mesh") == 0) prim = CUBE;
         else if (strcmp(argv[i], "--help") == 0 || atoi(argv[i]) <= 0) {
-            fprintf(stderr, "usage: instance_bench [max_n] [--instances-only]\n"
-                            "  N = 1, 4, 16 ... up to max_n (default 64) bumped spheres, written\n"
-                            "  as instances and (unless --instances-only) as copies\n");
+            fprintf(stderr, "usage: instance_bench [max_n] [--instances-only] [--mesh]\n"
+                            "  N = 1, 4, 16 ... up to max_n (default 64) bumped spheres (--mesh:\n"
+                            "  Catmull-Clark cubes), written as instances and (unless\n"
+                            "  --instances-only) as copies\n");
             return strcmp(argv[i], "--help") == 0 ? 0 : 2;
         } else max_n = atoi(argv[i]);
     }

@@ -399,8 +399,8 @@ static bool build_objects(job_scene *self, sl_diag *diag)
     int nplacements = find_placements(sc, proto_of, nplaced);
     int nown = sc->nobjects - nplacements;
     if (nown > SCENE_MAX_OBJECTS) {
-        /* instances that differ from their prototype (or of a displaced
-         * mesh) are objects of their own (~9 KB each), not references */
+        /* instances that differ from their prototype are objects of
+         * their own (~9 KB each), not references */
         int differ = 0;
         for (int i = 0; i < sc->nobjects; i++)
             differ += sc->objects[i].instance_of >= 0 && sc->objects[i].instance_of != i &&

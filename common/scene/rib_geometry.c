@@ -134,7 +134,7 @@ static void object_lights(rib_parser *p, const scene_object *prev, scene_object 
 
 void rib_place_surface(rib_parser *p, const rib_request *req, const geom_surface *surf,
                        const scene_mesh *mesh, mat4 ctm, sl_pos pos,
-                       const scene_primvar *vars, int nvars, bool vars_kept, bool again)
+                       const scene_primvar *vars, int nvars, bool vars_kept, int first)
 {
     assert(!surf == !!mesh);
     const rib_attributes *a = &p->attr;
@@ -150,10 +150,9 @@ void rib_place_surface(rib_parser *p, const rib_request *req, const geom_surface
         rib_error(p, req, req->pos, "the current transform is singular (a Scale by 0?)");
         return;
     }
-    /* an instance (but of a displaced mesh) is a reference in the renderer
-     * (trace/group.h): a few hundred bytes, where an object of its own
-     * takes ~9 KB */
-    bool reference = again && (a->displacement < 0 || !mesh);
+    /* an instance is a reference in the renderer (trace/group.h): a few
+     * hundred bytes, where an object of its own takes ~9 KB */
+    bool reference = first >= 0;
     if (reference ? p->ninstances >= SCENE_MAX_INSTANCES : p->nown >= p->max_objects) {
         if (!p->objects_overflow) {
             if (reference)
@@ -171,8 +170,20 @@ void rib_place_surface(rib_parser *p, const rib_request *req, const geom_surface
     }
     /* what a renderer keeps per piece (trace/mesh.h): an undisplaced
      * mesh's boxes once, whatever places it; a displaced mesh's per
-     * placement (its shader runs in each object's space) */
+     * placement (its shader runs in each object's space), but for a
+     * placement that moves its first rigidly (the renderer's may then be
+     * the first's surface moved: trace/instance.c; where its shader says
+     * otherwise, the worker refuses what it cannot number: group.c) */
     long pieces = mesh ? scene_mesh_npieces(mesh) : 1;
+    if (mesh && first >= 0 && a->displacement >= 0) {
+        const scene_object *f = &p->scene->objects[first];
+        mat4 f_to_camera = mat4_mul(p->scene->camera.camera_from_world, f->object_to_world), f_inv;
+        mat4 motion = mat4_mul(to_camera, mat4_invert(&f_to_camera, &f_inv) ? f_inv
+                                                                              : mat4_identity());
+        if (f->displacement_shader == a->displacement && mat4_is_rotation(&motion) &&
+            f->orientation == a->orientation)
+            pieces = 0;
+    }
     int mi = mesh ? scene_mesh_index(mesh) : -1;
     if (mi >= 0 && mi >= p->mesh_counted_cap) {
         int cap = p->mesh_counted_cap;
@@ -186,7 +197,7 @@ void rib_place_surface(rib_parser *p, const rib_request *req, const geom_surface
         if (!p->objects_overflow)
             rib_error(p, req, req->pos, "too many mesh faces: %ld placed before this one's %ld "
                       "(the limit is %ld pieces per scene; a displaced mesh's count again for each "
-                      "instance): "
+                      "instance but those that move the first rigidly): "
                       "split the scene into several renders or use fewer faces",
                       p->scene->npieces, pieces, SCENE_MAX_PIECES);
         p->objects_overflow = true;
@@ -233,7 +244,7 @@ void rib_add_surface(rib_parser *p, const rib_request *req, const geom_surface *
     geom_surface *kept = scene_keep(p->scene, xmalloc(sizeof *kept));
     *kept = *surf;
     rib_place_surface(p, req, kept, NULL, p->attr.ctm, req->pos, p->surface_vars,
-                      p->nsurface_vars, false, false);
+                      p->nsurface_vars, false, -1);
 }
 
 void rib_add_mesh(rib_parser *p, const rib_request *req, scene_mesh *mesh)
@@ -245,7 +256,7 @@ void rib_add_mesh(rib_parser *p, const rib_request *req, scene_mesh *mesh)
     if (rib_defining(p))
         rib_record_surface(p, req, NULL, mesh);
     else
-        rib_place_surface(p, req, NULL, mesh, p->attr.ctm, req->pos, NULL, 0, false, false);
+        rib_place_surface(p, req, NULL, mesh, p->attr.ctm, req->pos, NULL, 0, false, -1);
 }
 
 /* Validates the surface and adds the object with the current attributes

@@ -141,7 +141,7 @@ void rib_object_instance(rib_parser *p, const rib_request *req)
         rib_object_part *part = &d->parts[i];
         int before = p->scene->nobjects;
         rib_place_surface(p, req, part->surface, part->mesh, mat4_mul(ctm, part->ctm), part->pos,
-                          part->primvars, part->nprimvars, true, part->first_object >= 0);
+                          part->primvars, part->nprimvars, true, part->first_object);
         if (p->scene->nobjects == before)
             continue;                  /* not placed (an error said why) */
         if (part->first_object < 0)

@@ -432,13 +432,14 @@ bool rib_motion_filter(rib_parser *p, const rib_request *req);
  * scene: scene_keep) or a mesh (mesh non-NULL, surf NULL) with the current
  * attributes and the object-to-world transform ctm; pos is where the
  * surface was written. vars_kept: vars[0..nvars) is kept by the scene (a
- * recorded part's) and the object may point at it. again: a later
- * ObjectInstance placement of a recorded part (a reference in the
- * renderer but for a displaced mesh: it counts against
- * SCENE_MAX_INSTANCES, not the objects' limit). */
+ * recorded part's) and the object may point at it. first: for a later
+ * ObjectInstance placement of a recorded part, the scene index of the
+ * part's first placement (a reference in the renderer: it counts against
+ * SCENE_MAX_INSTANCES, not the objects' limit; a displaced mesh's counts
+ * its pieces unless it is the first moved rigidly), else -1. */
 void rib_place_surface(rib_parser *p, const rib_request *req, const geom_surface *surf,
                        const scene_mesh *mesh, mat4 ctm, sl_pos pos,
-                       const scene_primvar *vars, int nvars, bool vars_kept, bool again);
+                       const scene_primvar *vars, int nvars, bool vars_kept, int first);
 
 /* rib_parser.c: blocks */
 /* False (reported, and the parse stops) past RIB_MAX_BLOCKS. */

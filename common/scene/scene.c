@@ -191,10 +191,7 @@ static bool same_string(const char *a, const char *b)
 
 bool scene_object_placeable(const scene_object *o, const scene_object *p)
 {
-    /* a displaced mesh runs its shader in its own camera space (its
-     * pieces' boxes): its placements are objects of their own */
-    return o->displacement_shader == p->displacement_shader &&
-           (o->displacement_shader < 0 || !o->mesh) && o->mesh == p->mesh &&
+    return o->displacement_shader == p->displacement_shader && o->mesh == p->mesh &&
            o->surface == p->surface && o->surface_shader == p->surface_shader &&
            o->sides == p->sides && o->nlights == p->nlights &&
            (o->lights == p->lights ||

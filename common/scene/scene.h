@@ -271,7 +271,8 @@ typedef struct scene {
     long nchecked_placements;      /* those references (checked, not kept) */
     long npieces;                  /* the pieces a renderer keeps boxes for: an
                                     * undisplaced mesh's once, a displaced mesh's
-                                    * once per placing object, other objects one */
+                                    * once per placing object (but an instance
+                                    * moving the first rigidly), other objects one */
     void **kept;                   /* what the objects share (scene_keep) */
     size_t nkept, kept_cap;
 } scene;
@@ -330,9 +331,9 @@ int scene_archive_read(sl_source_set *set, const char *name, const char *path,
 /* How deep archives may read archives. */
 enum { SCENE_ARCHIVE_MAX_DEPTH = 16 };
 
-/* The most objects a scene may place (primitives, meshes, instances of
- * displaced meshes: each an object of its own in the renderer, ~9 KB;
- * other instances have their own limit below), so that a scene
+/* The most objects a scene may place (primitives and meshes: each an
+ * object of its own in the renderer, ~9 KB; instances have their own
+ * limit below), so that a scene
  * received over the network
  * cannot exhaust the memory of the master or a worker (issue 12). The
  * scene text itself is bounded by the source size (4 MiB, sl/source.h),
@@ -342,12 +343,14 @@ enum { SCENE_MAX_OBJECTS = 1 << 20 };
 /* The most ObjectInstance placements a scene may hold: each is a
  * reference in a worker (trace/group.h: ~500 bytes with its scene object,
  * docs/renderer.md "Instances as references"), so 2^24 of them fit a 24 GB
- * worker; instances of displaced meshes count as objects. */
+ * worker; those of a displaced mesh that are not its first moved rigidly
+ * also count its pieces (SCENE_MAX_PIECES). */
 enum { SCENE_MAX_INSTANCES = 1 << 24 };
 
 /* The most mesh pieces (a face, or a triangle of one) a scene may hold
  * boxes for (scene.npieces: instances of an undisplaced mesh count its
- * pieces once, displaced ones each time): ~100 bytes each
+ * pieces once, displaced ones each time but where an instance moves the
+ * first placement rigidly): ~100 bytes each
  * in a worker (docs/renderer.md "Meshes"), so 2^25 of them fit a 24 GB
  * worker with room for the box cache. */
 #define SCENE_MAX_PIECES (1L << 25)
@@ -421,8 +424,8 @@ scene *scene_check_frame(const char *file, const char *text, size_t len,
 
 /* May object o, a later placement of the recorded surface that object
  * proto placed first (o->instance_of), be a reference to it in the
- * renderer (trace/group.h): the same surface in object space (not a
- * displaced mesh), the same shaders (displacement included), sides,
+ * renderer (trace/group.h): the same surface or mesh in object space,
+ * the same shaders (displacement included), sides,
  * lights, primitive variables and name, only its transform, orientation
  * and colour its own? */
 bool scene_object_placeable(const scene_object *o, const scene_object *proto);

@@ -9,18 +9,22 @@
  * scale, normal bounds and du/dv derived again, and the prototype's ids:
  * the placements of an undisplaced surface or mesh are the same surface
  * in object space, where boxes and cell caches live, so they share them
- * (its `place` keeps their views apart). A displaced surface's placement
- * (never a displaced mesh's) has an id of its own and is either the
- * prototype's displaced surface moved rigidly (trace/instance.c: its
- * boxes are the prototype's) or its own surface with its own boxes,
- * decided for every placement when the group is built (group.c,
- * docs/renderer.md "Instances as references"). A view is a pure function
- * of the scene: the same on any thread or host.
+ * (its `place` keeps their views apart). A displaced surface's or
+ * displaced mesh's placement is either the prototype's displaced surface
+ * moved rigidly (trace/instance.c: its boxes are the prototype's) or its
+ * own surface with its own boxes, decided for every placement before
+ * the group is built (group.c, docs/renderer.md "Instances as
+ * references"). A displaced surface's placement has an id of its own; a
+ * displaced mesh's moved placement is walked as its prototype, the ray
+ * moved into the prototype's camera space, and an own one gets a mesh of
+ * its own (ids, BVH and root boxes over the prototype's pieces). A view
+ * is a pure function of the scene: the same on any thread or host.
  *
  * Per placement the world holds a 24-byte float box, ~16 bytes of BVH and
  * what the adapter keeps to make it again (job_scene.c: its scene object's
  * index), a displaced one 4 bytes more (and its root box when it has its
- * own surface); the scene holds the placement's scene_object.
+ * own surface, and a displaced mesh's own mesh then: as an object of its
+ * own); the scene holds the placement's scene_object.
  */
 #ifndef TRACE_GROUP_H
 #define TRACE_GROUP_H
@@ -33,6 +37,15 @@
  * (the shader runs on th). False when the thread failed or was
  * cancelled. */
 bool trace_group_build(trace_thread *th, trace_group *group, trace_object *g);
+
+/* Sorts the placements of every group whose prototype is a displaced
+ * mesh into its surface moved and surfaces of their own (the probe:
+ * group.c), and gives each of the latter a mesh of its own over the
+ * prototype's pieces, with ids from world->nids (which grows: a thread
+ * made before has a box cache too small for them). Called by
+ * trace_renderer_new after trace_world_prepare, before any mesh is
+ * built. False (th failed) when a shader failed or the ids run out. */
+bool trace_group_classify_meshes(trace_thread *th, trace_world *world);
 
 /* Nearest hit of the camera-space ray with the placements in
  * (ray->tmin, best->t) (trace_intersect_object's contract); a hit's

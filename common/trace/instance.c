@@ -37,17 +37,6 @@
 
 enum { PROBE = 5 };
 
-/* the 3x3 part of m is a rotation (orthonormal columns, determinant > 0) */
-static bool rigid(const mat4 *m)
-{
-    vec3 c[3];
-    for (int i = 0; i < 3; i++) c[i] = v3(m->m[0][i], m->m[1][i], m->m[2][i]);
-    for (int i = 0; i < 3; i++)
-        for (int j = 0; j < 3; j++)
-            if (!(fabs(v3_dot(c[i], c[j]) - (i == j ? 1.0 : 0.0)) <= 1e-9)) return false;
-    return v3_dot(c[0], v3_cross(c[1], c[2])) > 0;
-}
-
 static bool shader_allows(const sl_instance *inst)
 {
     const sl_program *prog = sl_instance_program(inst);
@@ -120,7 +109,7 @@ bool trace_instance_rigid(trace_object *obj, const trace_object *proto)
         !shader_allows(obj->displacement))
         return false;
     trace_instance_set_motion(obj, proto);
-    return rigid(&obj->from_proto) && spaces_move(obj, proto);
+    return mat4_is_rotation(&obj->from_proto) && spaces_move(obj, proto);
 }
 
 void trace_instance_set_motion(trace_object *obj, const trace_object *proto)

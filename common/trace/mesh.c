@@ -29,6 +29,7 @@
 #include <string.h>
 
 #include "trace/displace.h"
+#include "trace/instance.h"
 #include "trace/lazy_roots.h"
 #include "trace/region.h"
 #include "util/xalloc.h"
@@ -51,7 +52,10 @@ typedef struct view_cache {
 typedef struct trace_views {
     view_cache cache[2];               /* trace_view_kind */
     trace_view hit;                    /* the hit a traversal returns */
+    trace_view hit_proto;              /* its box_proto, when that is a moved
+                                          placement's prototype piece */
     trace_view *held[TRACE_RAY_DEPTH_LIMIT + 1];   /* hits being shaded, per depth */
+    trace_view *held_proto[TRACE_RAY_DEPTH_LIMIT + 1];   /* and their box_proto */
 } trace_views;
 
 void trace_object_camera_bound(const trace_object *obj, const trace_box *b, trace_box *out)
@@ -97,6 +101,9 @@ static bool make(trace_thread *th, const trace_object *mesh_obj, int k, bool box
 {
     const trace_mesh *m = mesh_obj->mesh;
     assert(m && k >= 0 && k < m->npieces);
+    /* a moved placement's pieces are its prototype's (group.c walks
+     * them there): its box_proto is no piece's */
+    assert(!mesh_obj->box_proto);
     trace_object *v = &out->obj;
     *v = *mesh_obj;
     v->mesh = NULL;
@@ -189,7 +196,10 @@ static trace_views *views_of(trace_thread *th)
 void trace_views_free(trace_thread *th)
 {
     if (!th->views) return;
-    for (int d = 0; d <= TRACE_RAY_DEPTH_LIMIT; d++) free(th->views->held[d]);
+    for (int d = 0; d <= TRACE_RAY_DEPTH_LIMIT; d++) {
+        free(th->views->held[d]);
+        free(th->views->held_proto[d]);
+    }
     for (int i = 0; i < 2; i++) cache_free(&th->views->cache[i]);
     free(th->views);
     th->views = NULL;
@@ -236,6 +246,34 @@ void trace_view_hit(trace_thread *th, const trace_object *v, trace_hit *best)
     best->obj = &th->views->hit.obj;
 }
 
+bool trace_view_hit_moved(trace_thread *th, const trace_object *v, trace_hit *hit)
+{
+    trace_views *vs = views_of(th);
+    assert(v->mesh && v->box_proto && hit->obj == &vs->hit.obj);
+    const trace_mesh *m = v->mesh;
+    trace_view_copy(&vs->hit_proto, &vs->hit);
+    const trace_object *pp = &vs->hit_proto.obj;
+    int k = pp->id - m->first_id;
+    assert(k >= 0 && k < m->npieces);
+    /* the placement's piece: no boxes of its own (box_proto's), and the
+     * prototype's du, dv (a rigid motion keeps the grid's spacing) */
+    trace_object place = *v;
+    place.box_proto = NULL;
+    if (!make(th, &place, k, false, false, &vs->hit)) return false;
+    trace_object *p = &vs->hit.obj;
+    p->box_proto = pp;
+    trace_instance_set_motion(p, pp);
+    p->du = pp->du;
+    p->dv = pp->dv;
+    p->root = pp->root;
+    trace_object_camera_bound(p, &p->root, &p->bound);
+    if (hit->has_point) trace_surface_point_move(p, &hit->point);
+    if (hit->kind == TRACE_LEAF_WALL)
+        hit->wall_normal = v3_normalize(mat4_xform_vector(&p->from_proto, hit->wall_normal));
+    hit->obj = p;
+    return true;
+}
+
 const trace_object *trace_view_hold(trace_thread *th, const trace_object *obj, int depth)
 {
     if (!th->views || obj != &th->views->hit.obj) return obj;
@@ -243,6 +281,13 @@ const trace_object *trace_view_hold(trace_thread *th, const trace_object *obj, i
     trace_view **h = &th->views->held[depth];
     if (!*h) *h = xmalloc(sizeof **h);
     trace_view_copy(*h, &th->views->hit);
+    if (obj->box_proto == &th->views->hit_proto.obj) {
+        /* a moved placement's piece: its prototype's piece held too */
+        trace_view **hp = &th->views->held_proto[depth];
+        if (!*hp) *hp = xmalloc(sizeof **hp);
+        trace_view_copy(*hp, &th->views->hit_proto);
+        (*h)->obj.box_proto = &(*hp)->obj;
+    }
     return &(*h)->obj;
 }
 
@@ -857,6 +902,9 @@ static size_t roots_share(const trace_world *world, const trace_mesh *m)
     for (int i = 0; i < world->nobjects; i++) {
         const trace_object *o = &world->objects[i];
         if (o->mesh && o->displacement) pieces += o->mesh->npieces;
+        /* a displaced mesh's placements with meshes of their own */
+        if (o->group && o->group->own_meshes)
+            pieces += (double)o->group->nown * world->objects[o->group->proto].mesh->npieces;
     }
     if (pieces <= m->npieces) return budget;
     size_t share = (size_t)((double)budget * m->npieces / pieces);

@@ -95,6 +95,15 @@ bool trace_mesh_build(trace_thread *th, trace_object *obj);
 bool trace_mesh_intersect(trace_thread *th, const trace_object *obj, const trace_ray *ray,
                           const trace_tolerance *tol, bool any, trace_hit *best);
 
+/* A hit the walk of placement v's prototype found (v: a displaced mesh's
+ * placement that is its prototype moved, v->box_proto; the hit's object
+ * the prototype's piece in the thread's hit slot, its geometry in the
+ * prototype's camera space) made the placement's: its object the
+ * placement's piece, whose box_proto is the prototype's piece (kept
+ * beside it), its point and wall normal moved into v's camera space.
+ * False (the thread failed) when the piece cannot be made. */
+bool trace_view_hit_moved(trace_thread *th, const trace_object *v, trace_hit *hit);
+
 /* The object to shade for a hit at trace() depth `depth`: obj itself, or
  * when it is the thread's hit slot, its copy for that depth. */
 const trace_object *trace_view_hold(trace_thread *th, const trace_object *obj, int depth);

@@ -25,6 +25,12 @@ trace_renderer *trace_renderer_new(trace_world *world, char *err, size_t errsz)
         return NULL;
     trace_thread *th = trace_thread_new(world);
     trace_instances_share(th, world);
+    /* a displaced mesh's placements: moved or own (own ones take ids) */
+    int nids = world->nids;
+    if (trace_group_classify_meshes(th, world) && world->nids != nids) {
+        trace_thread_destroy(&th);     /* its box cache knew fewer ids */
+        th = trace_thread_new(world);
+    }
     for (int i = 0; i < world->nobjects && !th->failed; i++) {
         if (trace_thread_cancelled(th)) break;   /* a signal: stop between objects */
         trace_object *obj = &world->objects[i];

@@ -455,10 +455,6 @@ bool trace_world_check(trace_world *world, char *err, size_t errsz)
             assert(obj->group->proto >= 0 && obj->group->proto < i &&
                    !world->objects[obj->group->proto].group &&
                    !world->objects[obj->group->proto].box_proto);
-            /* a displaced mesh's boxes run its shader in its own camera
-             * space: its placements are objects of their own */
-            assert(!world->objects[obj->group->proto].mesh ||
-                   !world->objects[obj->group->proto].displacement);
             obj->group->first = places;
             obj->group->first_id = -1;         /* trace_world_prepare's */
             places += obj->group->n;
@@ -511,7 +507,8 @@ bool trace_world_prepare(trace_world *world, char *err, size_t errsz)
         trace_group *gr = world->objects[i].group;
         if (!gr) continue;
         gr->first_id = -1;
-        if (!world->objects[gr->proto].displacement) continue;
+        /* (a displaced mesh's placements: trace_group_classify_meshes) */
+        if (!world->objects[gr->proto].displacement || world->objects[gr->proto].mesh) continue;
         if (next + gr->n > INT32_MAX / 64) {
             free(meshes);
             return err_set(err, errsz, "%s: too many objects and pieces in the scene (%ld "
@@ -536,7 +533,7 @@ void trace_world_count(const trace_world *world, trace_world_counts *out)
         if (gr) {
             out->groups++;
             out->placements += gr->n;
-            if (gr->first_id >= 0 && gr->own) {
+            if (gr->own) {
                 out->own += gr->nown;
                 out->moved += gr->n - gr->nown;
             }

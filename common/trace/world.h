@@ -98,10 +98,11 @@ typedef struct trace_mesh {
  * shaders, each only a transform and a colour in the scene; ONE world
  * object (a "group") stands for them, a BVH over their camera-space
  * boxes, and a placement becomes a full trace_object (a view) only where
- * a ray reaches it. A displaced surface's placement is its prototype's
- * displaced surface moved rigidly (box_proto) where that is the surface
- * its own shader gives (trace/instance.c), else a surface of its own
- * with its own boxes. */
+ * a ray reaches it. A displaced surface's or mesh's placement is its
+ * prototype's displaced surface moved rigidly (box_proto) where that is
+ * the surface its own shader gives (trace/instance.c), else a surface of
+ * its own with its own boxes (a displaced mesh's: a trace_mesh of its
+ * own, own_meshes). */
 typedef struct trace_group {
     int n;                         /* placements */
     int proto;                     /* the prototype: its index in world.objects
@@ -119,15 +120,23 @@ typedef struct trace_group {
      * frees them) */
     int first;                     /* placement k's number in the world: first + k */
     struct trace_mesh_bvh *bvh;    /* over the placements' camera-space boxes */
-    /* a displaced prototype's placements (else first_id = -1, own = NULL):
-     * placement k's view has the id first_id + k (its own cell caches: its
-     * points are in its camera space); own[k] < 0: it is the prototype
-     * moved (its boxes are the prototype's), else its root box is
-     * own_roots[own[k]] and its boxes are its own (under its id) */
+    /* a displaced prototype's placements (else own = NULL): own[k] < 0:
+     * placement k is the prototype moved (its boxes are the
+     * prototype's), else its root box is own_roots[own[k]] and its boxes
+     * are its own. A displaced surface's placement k has the id
+     * first_id + k (its own cell caches: its points are in its camera
+     * space); a displaced mesh's placements have none (first_id = -1): a
+     * moved one is intersected as its prototype, the ray moved into the
+     * prototype's camera space (group.c), and an own one has the pieces,
+     * ids and boxes of own_meshes[own[k]], a mesh of its own over the
+     * prototype's pieces (trace_group_classify_meshes) */
     int first_id;
     int32_t *own;
     trace_box *own_roots;
     int nown;
+    trace_mesh *own_meshes;
+    float (*proto_bounds)[6];      /* a displaced mesh's: its pieces' undisplaced
+                                      boxes, until the own meshes are built */
 } trace_group;
 
 typedef struct trace_object {

@@ -162,5 +162,16 @@ static inline double mat4_det3(const mat4 *a)
            m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
            m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
 }
+/* Whether the 3x3 part of m is a rotation: orthonormal columns (each
+ * product within 1e-9 of the identity's) and a positive determinant. */
+static inline bool mat4_is_rotation(const mat4 *m)
+{
+    vec3 c[3];
+    for (int i = 0; i < 3; i++) c[i] = v3(m->m[0][i], m->m[1][i], m->m[2][i]);
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            if (!(fabs(v3_dot(c[i], c[j]) - (i == j ? 1.0 : 0.0)) <= 1e-9)) return false;
+    return v3_dot(c[0], v3_cross(c[1], c[2])) > 0;
+}
 
 #endif
