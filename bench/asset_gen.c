@@ -6,7 +6,7 @@
  * of .rib.gz files, ObjectBegin/ObjectInstance, facevarying "st",
  * "displacementbound", the shaders and texture on search paths).
  *
- *   asset_gen [--faces N] [--rocks K] [--cage M] [--format W H]
+ *   asset_gen [--faces N] [--rocks K] [--rock-kinds R] [--cage M] [--format W H]
  *             [--shaders DIR] [--textures DIR] OUTDIR
  *   asset_gen --instances K [--faces N] [--format W H] OUTDIR
  *
@@ -17,6 +17,17 @@
  * (scenes/make_textures.sh writes it), the rocks by dented.sl. Defaults:
  * 1,000,000 faces, 200 rocks, M = 6, 640 x 480, the source tree's scenes/
  * shaders and textures.
+ *
+ * --rock-kinds R (R >= 1) writes the rocks as a scatter is usually made:
+ * R recorded rocks of different sizes (the scale inside each definition),
+ * each rock a placement of one of them moved and turned about the up
+ * axis (no scale), all under one Displacement "rockdents" call (dented's
+ * dents in "object" space, Km 0.02), the placements in OUTDIR/
+ * scatter.rib.gz: each placement is then its rock
+ * moved rigidly, which the renderer draws as a reference to it
+ * (docs/renderer.md "Instances as references"). Without it each rock has
+ * its own Displacement "dented" call (Km 0.25, in the space of the call)
+ * and its own scale: 200 meshes of their own.
  *
  * --instances K writes instances.rib and instances_body.rib.gz instead:
  * one undisplaced PointsPolygons grid of about N bent quads (default
@@ -170,10 +181,64 @@ static void write_instances(const char *out, long instances, long faces, int w, 
     if (fclose(r) != 0) die("cannot finish", path);
 }
 
+/* the rocks, each with its own Displacement call and scale (the default) */
+static void write_rocks(FILE *f, int rocks)
+{
+    unsigned seed = 7;
+    for (int i = 0; i < rocks; i++) {
+        seed = seed * 1103515245u + 12345u;
+        double x = 7.0 * ((seed >> 8) / 16777216.0 - 0.5);
+        seed = seed * 1103515245u + 12345u;
+        double y = 7.0 * ((seed >> 8) / 16777216.0 - 0.5);
+        seed = seed * 1103515245u + 12345u;
+        double s = 0.06 + 0.12 * ((seed >> 8) / 16777216.0), a = 360.0 * ((seed >> 4) % 4096) / 4096;
+        fprintf(f, "  AttributeBegin\n    Color [0.45 0.43 0.4]\n    Surface \"plastic\" \"Ks\" "
+                   "[0.2]\n    Displacement \"dented\" \"Km\" [0.25]\n"
+                   "    Rotate -90 1 0 0\n    Translate %.4f %.4f %.4f\n    Rotate %.1f 0 0 1\n"
+                   "    Scale %.4f %.4f %.4f\n    ObjectInstance \"rock\"\n  AttributeEnd\n",
+                x, y, height(x, y) + 0.6 * s, a, s, s, 0.7 * s);
+    }
+}
+
+/* --rock-kinds: `kinds` recorded rocks of sizes 0.06 .. 0.18, each
+ * placement one of them moved and turned about the up axis, all under one
+ * Displacement call in "object" space; the placements in the gzip archive
+ * `path` (a large scatter's text stays out of the scene file) */
+static void write_scatter(FILE *f, const char *path, const char *name, int rocks, int kinds)
+{
+    for (int k = 0; k < kinds; k++) {
+        double s = 0.06 + 0.12 * (kinds > 1 ? (double)k / (kinds - 1) : 0.5);
+        fprintf(f, "  ObjectBegin \"rock%d\"\n    Scale %.4f %.4f %.4f\n"
+                   "    ReadArchive \"rock.rib.gz\"\n  ObjectEnd\n", k, s, s, 0.7 * s);
+    }
+    fprintf(f, "  AttributeBegin\n    Color [0.45 0.43 0.4]\n    Surface \"plastic\" \"Ks\" [0.2]\n"
+               "    Displacement \"rockdents\" \"Km\" [0.02]\n    ReadArchive \"%s\"\n"
+               "  AttributeEnd\n", name);
+    gzFile g = gzopen(path, "wb6");
+    if (!g) die("cannot write", path);
+    gzprintf(g, "##RenderMan RIB-Structure 1.1 Entity\n# scatter: %d rocks of %d kinds\n", rocks,
+             kinds);
+    unsigned seed = 7;
+    for (int i = 0; i < rocks; i++) {
+        seed = seed * 1103515245u + 12345u;
+        double x = 7.0 * ((seed >> 8) / 16777216.0 - 0.5);
+        seed = seed * 1103515245u + 12345u;
+        double y = 7.0 * ((seed >> 8) / 16777216.0 - 0.5);
+        seed = seed * 1103515245u + 12345u;
+        int k = (int)((seed >> 8) % (unsigned)kinds);
+        double s = 0.06 + 0.12 * (kinds > 1 ? (double)k / (kinds - 1) : 0.5);
+        double a = 360.0 * ((seed >> 4) % 4096) / 4096;
+        gzprintf(g, "AttributeBegin Rotate -90 1 0 0 Translate %.4f %.4f %.4f Rotate %.1f 0 0 1 "
+                    "ObjectInstance \"rock%d\" AttributeEnd\n",
+                 x, y, height(x, y) + 0.6 * s, a, k);
+    }
+    if (gzclose(g) != Z_OK) die("cannot finish", path);
+}
+
 int main(int argc, char **argv)
 {
     long faces = 1000000;
-    int rocks = 200, cage = 6, w = 640, h = 480;
+    int rocks = 200, cage = 6, w = 640, h = 480, kinds = 0;
     const char *shaders = AAFARM_SCENES_DIR "/shaders", *textures = AAFARM_SCENES_DIR "/textures";
     const char *out = NULL;
     long instances = 0;
@@ -184,6 +249,7 @@ int main(int argc, char **argv)
             faces_given = true;
         } else if (strcmp(argv[i], "--instances") == 0 && i + 1 < argc) instances = atol(argv[++i]);
         else if (strcmp(argv[i], "--rocks") == 0 && i + 1 < argc) rocks = atoi(argv[++i]);
+        else if (strcmp(argv[i], "--rock-kinds") == 0 && i + 1 < argc) kinds = atoi(argv[++i]);
         else if (strcmp(argv[i], "--cage") == 0 && i + 1 < argc) cage = atoi(argv[++i]);
         else if (strcmp(argv[i], "--format") == 0 && i + 2 < argc) {
             w = atoi(argv[++i]);
@@ -191,8 +257,8 @@ int main(int argc, char **argv)
         } else if (strcmp(argv[i], "--shaders") == 0 && i + 1 < argc) shaders = argv[++i];
         else if (strcmp(argv[i], "--textures") == 0 && i + 1 < argc) textures = argv[++i];
         else if (strcmp(argv[i], "--help") == 0) {
-            printf("usage: asset_gen [--faces N] [--rocks K] [--cage M] [--format W H] "
-                   "[--shaders DIR] [--textures DIR] OUTDIR\n"
+            printf("usage: asset_gen [--faces N] [--rocks K] [--rock-kinds R] [--cage M] "
+                   "[--format W H] [--shaders DIR] [--textures DIR] OUTDIR\n"
                    "       asset_gen --instances K [--faces N] [--format W H] OUTDIR\n");
             return 0;
         } else if (argv[i][0] != '-' && !out) out = argv[i];
@@ -201,7 +267,7 @@ int main(int argc, char **argv)
             return 2;
         }
     }
-    if (!out || faces < 1 || rocks < 0 || cage < 1 || w < 1 || h < 1) {
+    if (!out || faces < 1 || rocks < 0 || kinds < 0 || cage < 1 || w < 1 || h < 1) {
         fprintf(stderr, "asset_gen: give OUTDIR (and positive sizes; see --help)\n");
         return 2;
     }
@@ -229,7 +295,6 @@ int main(int argc, char **argv)
                "WorldBegin\n"
                "  LightSource \"ambientlight\" 1 \"intensity\" [0.2]\n"
                "  LightSource \"distantlight\" 2 \"intensity\" [1.0] \"from\" [-2 3 -1] \"to\" [0 0 0]\n"
-               "  ObjectBegin \"rock\"\n    ReadArchive \"rock.rib.gz\"\n  ObjectEnd\n"
                "  AttributeBegin\n    Attribute \"identifier\" \"name\" [\"terrain\"]\n"
                "    Attribute \"displacementbound\" \"sphere\" [0.2]\n    Color [0.55 0.5 0.4]\n"
                "    Surface \"plastic\" \"Ks\" [0.1] \"roughness\" [0.3]\n"
@@ -237,19 +302,12 @@ int main(int argc, char **argv)
                "[\"terrain_height.exr\"]\n"
                "    Rotate -90 1 0 0\n    ReadArchive \"terrain.rib.gz\"\n  AttributeEnd\n",
             n * n, rocks, shaders, textures, w, h);
-    unsigned seed = 7;
-    for (int i = 0; i < rocks; i++) {
-        seed = seed * 1103515245u + 12345u;
-        double x = 7.0 * ((seed >> 8) / 16777216.0 - 0.5);
-        seed = seed * 1103515245u + 12345u;
-        double y = 7.0 * ((seed >> 8) / 16777216.0 - 0.5);
-        seed = seed * 1103515245u + 12345u;
-        double s = 0.06 + 0.12 * ((seed >> 8) / 16777216.0), a = 360.0 * ((seed >> 4) % 4096) / 4096;
-        fprintf(f, "  AttributeBegin\n    Color [0.45 0.43 0.4]\n    Surface \"plastic\" \"Ks\" "
-                   "[0.2]\n    Displacement \"dented\" \"Km\" [0.25]\n"
-                   "    Rotate -90 1 0 0\n    Translate %.4f %.4f %.4f\n    Rotate %.1f 0 0 1\n"
-                   "    Scale %.4f %.4f %.4f\n    ObjectInstance \"rock\"\n  AttributeEnd\n",
-                x, y, height(x, y) + 0.6 * s, a, s, s, 0.7 * s);
+    if (kinds > 0) {
+        snprintf(path, sizeof path, "%s/scatter.rib.gz", out);
+        write_scatter(f, path, "scatter.rib.gz", rocks, kinds);
+    } else {
+        fprintf(f, "  ObjectBegin \"rock\"\n    ReadArchive \"rock.rib.gz\"\n  ObjectEnd\n");
+        write_rocks(f, rocks);
     }
     fprintf(f, "WorldEnd\n");
     if (fclose(f) != 0) die("cannot finish", path);

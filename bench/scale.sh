@@ -6,7 +6,8 @@
 #      SubdivisionMesh cage to SUBDIV_FACES (default 100,000)
 #   2. a production-style asset (bench/asset_gen: a displaced, textured
 #      terrain of ASSET_FACES quads from a gzip archive and ROCKS instanced
-#      subdivision rocks) rendered at ASSET_W x ASSET_H by a master with
+#      subdivision rocks; ROCK_KINDS=R: R recorded rocks scattered by rigid
+#      motions, references to them) rendered at ASSET_W x ASSET_H by a master with
 #      two workers on this host (their peak RSS each) and standalone (the
 #      farm image must equal it)
 #   3. INSTANCES (default 1,000,000) instances of a 1000-face undisplaced
@@ -15,7 +16,7 @@
 #      seconds (parse + world + render) and peak RSS
 # Usage: bash bench/scale.sh [BUILD_DIR]   (default build; a Release or
 # RelWithDebInfo build of the whole tree). Prints tables; never fails on
-# timing. Environment: FACES, SUBDIV_FACES, ASSET_FACES, ROCKS, ASSET_W,
+# timing. Environment: FACES, SUBDIV_FACES, ASSET_FACES, ROCKS, ROCK_KINDS, ASSET_W,
 # ASSET_H, THREADS (per worker, default 1), INSTANCES, PARTS (which of
 # 1 2 3 to run, default all; the SubdivisionMesh row is part 1).
 set -euo pipefail
@@ -25,6 +26,7 @@ FACES=${FACES:-1000000}
 SUBDIV_FACES=${SUBDIV_FACES:-100000}
 ASSET_FACES=${ASSET_FACES:-1000000}
 ROCKS=${ROCKS:-200}
+ROCK_KINDS=${ROCK_KINDS:-0}
 ASSET_W=${ASSET_W:-640}
 ASSET_H=${ASSET_H:-480}
 THREADS=${THREADS:-1}
@@ -55,11 +57,11 @@ pids=()
 cleanup() { for p in "${pids[@]}"; do kill -9 "$p" 2>/dev/null || true; done; rm -rf "$work"; }
 trap cleanup EXIT
 if [[ "$PARTS" == *" 2 "* ]]; then
-echo "== 2. asset: $ASSET_FACES terrain faces, $ROCKS rocks, ${ASSET_W}x${ASSET_H}"
+echo "== 2. asset: $ASSET_FACES terrain faces, $ROCKS rocks (kinds: $ROCK_KINDS), ${ASSET_W}x${ASSET_H}"
 if [ ! -f "$here/scenes/textures/terrain_height.exr" ]; then
   bash "$here/scenes/make_textures.sh" "$build" >/dev/null
 fi
-"$build/bin/asset_gen" --faces "$ASSET_FACES" --rocks "$ROCKS" --format "$ASSET_W" "$ASSET_H" \
+"$build/bin/asset_gen" --faces "$ASSET_FACES" --rocks "$ROCKS" --rock-kinds "$ROCK_KINDS" --format "$ASSET_W" "$ASSET_H" \
   --shaders "$here/scenes/shaders" --textures "$here/scenes/textures" "$work/asset"
 ls -l "$work/asset" | awk 'NR>1 {printf "   %s %d bytes\n", $9, $5}'
 cd "$work/asset"
