@@ -136,7 +136,8 @@ static bool own_roots(trace_thread *th, trace_group *gr, const trace_object *g)
 {
     trace_view *tv = xmalloc(sizeof *tv);
     trace_object *v = &tv->obj;
-    size_t nb = (size_t)(th->world->objects[gr->proto].mesh ? th->world->objects[gr->proto].mesh->npieces : 0);
+    const trace_mesh *pm = th->world->objects[gr->proto].mesh;
+    size_t nb = pm ? (size_t)pm->npieces : 0;
     for (int k = 0; k < gr->n && !th->failed; k++) {
         if (gr->own[k] < 0) continue;
         if ((k & 255) == 0 && trace_thread_cancelled(th)) break;
