@@ -90,7 +90,7 @@ static char *scene_rib(bool instanced, const char *shader, bool scale)
     char *s = malloc(cap);
     assert_non_null(s);
     size_t len = (size_t)snprintf(s, cap,
-        "Format %d %d 1\nPixelSamples 2 2\nProjection \"perspective\" \"fov\" [30]\n"
+        "Format %d %d 1\nPixelSamples 1 1\nProjection \"perspective\" \"fov\" [30]\n"
         "Translate 0 0 6\nWorldBegin\n"
         "LightSource \"distantlight\" 1 \"from\" [1 1 -2] \"to\" [0 0 0]\n"
         "Surface \"plastic\"\nDisplacement \"%s\" \"float Km\" [0.06]\n", W, H, shader);
@@ -171,7 +171,7 @@ static void test_moved_placements_render_as_copies(void **state)
     double mean = sum / ((double)W * H * 4);
     printf("instances vs copies: %d covered pixels, %d differ in alpha by > 0.3, "
            "mean |diff| %.2e, worst %.3f\n", covered, alpha_diff, mean, worst);
-    assert_true(covered > W * H / 8);
+    assert_true(covered > W * H / 10);
     assert_true(alpha_diff <= covered / 100);
     assert_true(mean < 2e-3);
     free(inst.rgba);
