@@ -255,16 +255,23 @@ bool trace_view_hit_moved(trace_thread *th, const trace_object *v, trace_hit *hi
     const trace_object *pp = &vs->hit_proto.obj;
     int k = pp->id - m->first_id;
     assert(k >= 0 && k < m->npieces);
-    /* the placement's piece: no boxes of its own (box_proto's), and the
-     * prototype's du, dv (a rigid motion keeps the grid's spacing) */
+    /* the placement's piece: no boxes of its own (box_proto's, whose
+     * displacement runs with the prototype's du, dv), and its own du, dv
+     * where its surface shader reads them (as a displaced surface's
+     * placement view has: they follow its size on the screen) */
     trace_object place = *v;
     place.box_proto = NULL;
     if (!make(th, &place, k, false, false, &vs->hit)) return false;
     trace_object *p = &vs->hit.obj;
     p->box_proto = pp;
     trace_instance_set_motion(p, pp);
-    p->du = pp->du;
-    p->dv = pp->dv;
+    const sl_program *sp = p->surface ? sl_instance_program(p->surface) : NULL;
+    if (sp && (sl_program_reads_global(sp, SL_G_du) || sl_program_reads_global(sp, SL_G_dv))) {
+        trace_object_grid_spacing(th->world, p);
+    } else {
+        p->du = pp->du;                /* read by nothing */
+        p->dv = pp->dv;
+    }
     p->root = pp->root;
     trace_object_camera_bound(p, &p->root, &p->bound);
     if (hit->has_point) trace_surface_point_move(p, &hit->point);

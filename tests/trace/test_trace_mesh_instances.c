@@ -67,11 +67,22 @@ static const char *PLASTIC_SL =
     "         Ks * specular(Nf, -normalize(I), roughness);\n"
     "}\n";
 
-static void shaders(fixture_shader sh[3])
+/* a surface of the placement's du and dv (its size on the screen) */
+static const char *SHOWDU_SL =
+    "surface showdu()\n"
+    "{\n"
+    "    Oi = Os;\n"
+    "    Ci = color(5 * du, 5 * dv, 0.5);\n"
+    "}\n";
+
+enum { NSHADERS = 4 };
+
+static void shaders(fixture_shader sh[NSHADERS])
 {
     sh[0] = (fixture_shader){"bumps", BUMPS_SL};
     sh[1] = (fixture_shader){"cambumps", CAMBUMPS_SL};
     sh[2] = (fixture_shader){"plastic", PLASTIC_SL};
+    sh[3] = (fixture_shader){"showdu", SHOWDU_SL};
 }
 
 static const char *CUBE =
@@ -84,6 +95,8 @@ enum { W = 128, H = 40, N = 4, CUBE_PIECES = 24 };
 
 /* The N placements; `scale`: the first (the prototype) stretched, so no
  * other moves it rigidly */
+static const char *surface = "plastic";
+
 static char *scene_rib(bool instanced, const char *shader, bool scale)
 {
     size_t cap = 8192;
@@ -93,7 +106,7 @@ static char *scene_rib(bool instanced, const char *shader, bool scale)
         "Format %d %d 1\nPixelSamples 1 1\nProjection \"perspective\" \"fov\" [30]\n"
         "Translate 0 0 6\nWorldBegin\n"
         "LightSource \"distantlight\" 1 \"from\" [1 1 -2] \"to\" [0 0 0]\n"
-        "Surface \"plastic\"\nDisplacement \"%s\" \"float Km\" [0.06]\n", W, H, shader);
+        "Surface \"%s\"\nDisplacement \"%s\" \"float Km\" [0.06]\n", W, H, surface, shader);
     if (instanced)
         len += (size_t)snprintf(s + len, cap - len, "ObjectBegin 1\n  %s\nObjectEnd\n", CUBE);
     for (int i = 0; i < N; i++)
@@ -114,9 +127,9 @@ typedef struct shot {
 static void render(const char *rib, shot *out)
 {
     fixture f;
-    fixture_shader sh[3];
+    fixture_shader sh[NSHADERS];
     shaders(sh);
-    assert_true(fixture_open(&f, rib, sh, 3, NULL, 0));
+    assert_true(fixture_open(&f, rib, sh, NSHADERS, NULL, 0));
     const trace_world *w = &f.js->world;
     trace_thread *th = trace_thread_new(w);
     out->rgba = calloc((size_t)W * H * 4, sizeof *out->rgba);
@@ -134,10 +147,12 @@ static void render(const char *rib, shot *out)
     fixture_close(&f);
 }
 
-static void test_moved_placements_render_as_copies(void **state)
+/* the instances' image against the copies', with surface shader `surf` */
+static void compare_with_copies(const char *surf)
 {
-    (void)state;
+    surface = surf;
     char *a = scene_rib(true, "bumps", false), *b = scene_rib(false, "bumps", false);
+    surface = "plastic";
     shot inst, copies;
     render(a, &inst);
     render(b, &copies);
@@ -169,13 +184,22 @@ static void test_moved_placements_render_as_copies(void **state)
         }
     }
     double mean = sum / ((double)W * H * 4);
-    printf("instances vs copies: %d covered pixels, %d differ in alpha by > 0.3, "
-           "mean |diff| %.2e, worst %.3f\n", covered, alpha_diff, mean, worst);
+    printf("%s: instances vs copies: %d covered pixels, %d differ in alpha by > 0.3, "
+           "mean |diff| %.2e, worst %.3f\n", surf, covered, alpha_diff, mean, worst);
     assert_true(covered > W * H / 10);
     assert_true(alpha_diff <= covered / 100);
     assert_true(mean < 2e-3);
     free(inst.rgba);
     free(copies.rgba);
+}
+
+/* plastic; and a surface of du, dv: a moved placement's are its own,
+ * not the prototype's (the displacement's are the prototype's) */
+static void test_moved_placements_render_as_copies(void **state)
+{
+    (void)state;
+    compare_with_copies("plastic");
+    compare_with_copies("showdu");
 }
 
 static double vmax_abs(vec3 a)
@@ -207,9 +231,9 @@ static void test_moved_points_are_own_and_contained(void **state)
     (void)state;
     char *rib = scene_rib(true, "bumps", false);
     fixture f;
-    fixture_shader sh[3];
+    fixture_shader sh[NSHADERS];
     shaders(sh);
-    assert_true(fixture_open(&f, rib, sh, 3, NULL, 0));
+    assert_true(fixture_open(&f, rib, sh, NSHADERS, NULL, 0));
     free(rib);
     const trace_world *w = &f.js->world;
     const trace_object *proto = &w->objects[0], *g = &w->objects[1];
@@ -328,11 +352,11 @@ enum { MESH_INSTANCE_BYTES = 600, MANY = 2001 };
 static size_t world_bytes(int n, trace_world_counts *wc)
 {
     char *rib = many_rib(n);
-    fixture_shader sh[3];
+    fixture_shader sh[NSHADERS];
     shaders(sh);
     size_t before = fixture_heap_bytes();
     fixture f;
-    assert_true(fixture_open(&f, rib, sh, 3, NULL, 0));
+    assert_true(fixture_open(&f, rib, sh, NSHADERS, NULL, 0));
     size_t after = fixture_heap_bytes();
     trace_world_count(&f.js->world, wc);
     fixture_close(&f);
