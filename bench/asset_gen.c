@@ -181,16 +181,24 @@ static void write_instances(const char *out, long instances, long faces, int w, 
     if (fclose(r) != 0) die("cannot finish", path);
 }
 
+/* A rock's place on the terrain (x, y in [-3.5, 3.5)) from the seed,
+ * which is then stepped once more for the caller's size and turn */
+static void rock_spot(unsigned *seed, double *x, double *y)
+{
+    *seed = *seed * 1103515245u + 12345u;
+    *x = 7.0 * ((*seed >> 8) / 16777216.0 - 0.5);
+    *seed = *seed * 1103515245u + 12345u;
+    *y = 7.0 * ((*seed >> 8) / 16777216.0 - 0.5);
+    *seed = *seed * 1103515245u + 12345u;
+}
+
 /* the rocks, each with its own Displacement call and scale (the default) */
 static void write_rocks(FILE *f, int rocks)
 {
     unsigned seed = 7;
     for (int i = 0; i < rocks; i++) {
-        seed = seed * 1103515245u + 12345u;
-        double x = 7.0 * ((seed >> 8) / 16777216.0 - 0.5);
-        seed = seed * 1103515245u + 12345u;
-        double y = 7.0 * ((seed >> 8) / 16777216.0 - 0.5);
-        seed = seed * 1103515245u + 12345u;
+        double x, y;
+        rock_spot(&seed, &x, &y);
         double s = 0.06 + 0.12 * ((seed >> 8) / 16777216.0), a = 360.0 * ((seed >> 4) % 4096) / 4096;
         fprintf(f, "  AttributeBegin\n    Color [0.45 0.43 0.4]\n    Surface \"plastic\" \"Ks\" "
                    "[0.2]\n    Displacement \"dented\" \"Km\" [0.25]\n"
@@ -220,11 +228,8 @@ static void write_scatter(FILE *f, const char *path, const char *name, int rocks
              kinds);
     unsigned seed = 7;
     for (int i = 0; i < rocks; i++) {
-        seed = seed * 1103515245u + 12345u;
-        double x = 7.0 * ((seed >> 8) / 16777216.0 - 0.5);
-        seed = seed * 1103515245u + 12345u;
-        double y = 7.0 * ((seed >> 8) / 16777216.0 - 0.5);
-        seed = seed * 1103515245u + 12345u;
+        double x, y;
+        rock_spot(&seed, &x, &y);
         int k = (int)((seed >> 8) % (unsigned)kinds);
         double s = 0.06 + 0.12 * (kinds > 1 ? (double)k / (kinds - 1) : 0.5);
         double a = 360.0 * ((seed >> 4) % 4096) / 4096;
