@@ -255,7 +255,8 @@ static int moved_mesh_leaf(group_walk *w, const trace_object *v)
     trace_hit hit = *w->best;
     if (!trace_mesh_intersect(w->th, v->box_proto, &moved, w->tol, w->any, &hit))
         return w->th->failed ? -1 : 0;
-    if (!trace_view_hit_moved(w->th, v, &hit)) return -1;
+    /* a shadow ray asks only whether (shade.c): its hit is not shaded */
+    if (!w->any && !trace_view_hit_moved(w->th, v, &hit)) return -1;
     *w->best = hit;
     return 1;
 }

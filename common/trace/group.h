@@ -49,7 +49,9 @@ bool trace_group_classify_meshes(trace_thread *th, trace_world *world);
 
 /* Nearest hit of the camera-space ray with the placements in
  * (ray->tmin, best->t) (trace_intersect_object's contract); a hit's
- * object is the thread's hit slot (a view). */
+ * object is the thread's hit slot (a view). With `any` (a shadow ray: only
+ * whether), a displaced mesh's moved placement's hit stays its prototype's
+ * piece, in the prototype's camera space. */
 bool trace_group_intersect(trace_thread *th, const trace_object *g, const trace_ray *ray,
                            const trace_tolerance *tol, bool any, trace_hit *best);
 

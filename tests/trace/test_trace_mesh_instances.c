@@ -14,7 +14,8 @@
  *     cache far fewer root broods than the copies', and the two images
  *     agree (alpha in the same pixels but for 1 % on silhouettes, colours
  *     close: the placements' hits come from other boxes of the same
- *     surface);
+ *     surface), with plastic, with a surface of du and dv (a placement's
+ *     own), and with the cubes' shadows on a wall (shadow rays);
  *   - points: at random pieces and (u,v) off the probe's grid, each moved
  *     placement's point (the prototype's moved) equals its own shader's
  *     within 1e-9, and lies in the prototype's boxes over random ranges
@@ -96,6 +97,7 @@ enum { W = 128, H = 40, N = 4, CUBE_PIECES = 24 };
 /* The N placements; `scale`: the first (the prototype) stretched, so no
  * other moves it rigidly */
 static const char *surface = "plastic";
+static bool shadows;               /* on, with a wall behind the cubes to take them */
 
 static char *scene_rib(bool instanced, const char *shader, bool scale)
 {
@@ -104,9 +106,13 @@ static char *scene_rib(bool instanced, const char *shader, bool scale)
     assert_non_null(s);
     size_t len = (size_t)snprintf(s, cap,
         "Format %d %d 1\nPixelSamples 1 1\nProjection \"perspective\" \"fov\" [30]\n"
-        "Translate 0 0 6\nWorldBegin\n"
-        "LightSource \"distantlight\" 1 \"from\" [1 1 -2] \"to\" [0 0 0]\n"
-        "Surface \"%s\"\nDisplacement \"%s\" \"float Km\" [0.06]\n", W, H, surface, shader);
+        "Translate 0 0 6\nWorldBegin\n%s"
+        "LightSource \"distantlight\" 1 \"from\" [%s] \"to\" [0 0 0]\n"
+        "Surface \"%s\"\n%sDisplacement \"%s\" \"float Km\" [0.06]\n", W, H,
+        shadows ? "Attribute \"light\" \"shadows\" [\"on\"]\n" : "",
+        shadows ? "-3 1 -1" : "1 1 -2",   /* shadows: long ones, beside the cubes */
+        surface, shadows ? "Polygon \"P\" [-8 -3 1.5  8 -3 1.5  8 3 1.5  -8 3 1.5]\n" : "",
+        shader);
     if (instanced)
         len += (size_t)snprintf(s + len, cap - len, "ObjectBegin 1\n  %s\nObjectEnd\n", CUBE);
     for (int i = 0; i < N; i++)
@@ -147,12 +153,15 @@ static void render(const char *rib, shot *out)
     fixture_close(&f);
 }
 
-/* the instances' image against the copies', with surface shader `surf` */
-static void compare_with_copies(const char *surf)
+/* the instances' image against the copies', with surface shader `surf`
+ * (and shadows: walks that ask only whether) */
+static void compare_with_copies(const char *surf, bool with_shadows)
 {
     surface = surf;
+    shadows = with_shadows;
     char *a = scene_rib(true, "bumps", false), *b = scene_rib(false, "bumps", false);
     surface = "plastic";
+    shadows = false;
     shot inst, copies;
     render(a, &inst);
     render(b, &copies);
@@ -171,35 +180,42 @@ static void compare_with_copies(const char *surf)
     assert_true(inst.root_broods > 0);
     assert_true(2 * inst.root_broods < copies.root_broods);
 
-    int alpha_diff = 0, covered = 0;
+    int alpha_diff = 0, covered = 0, colour_diff = 0;
     double worst = 0, sum = 0;
     for (size_t k = 0; k < (size_t)W * H; k++) {
         float ai = inst.rgba[k * 4 + 3], ac = copies.rgba[k * 4 + 3];
         if (ac > 0) covered++;
         if (fabsf(ai - ac) > 0.3f) alpha_diff++;
+        double pixel = 0;
         for (int c = 0; c < 4; c++) {
             double d = fabs((double)inst.rgba[k * 4 + c] - copies.rgba[k * 4 + c]);
             worst = fmax(worst, d);
+            pixel = fmax(pixel, d);
             sum += d;
         }
+        colour_diff += pixel > 0.05;
     }
     double mean = sum / ((double)W * H * 4);
-    printf("%s: instances vs copies: %d covered pixels, %d differ in alpha by > 0.3, "
-           "mean |diff| %.2e, worst %.3f\n", surf, covered, alpha_diff, mean, worst);
+    printf("%s%s: instances vs copies: %d covered pixels, %d differ in alpha by > 0.3, "
+           "%d by > 0.05 in a channel, mean |diff| %.2e, worst %.3f\n", surf,
+           with_shadows ? " (shadows)" : "", covered, alpha_diff, colour_diff, mean, worst);
     assert_true(covered > W * H / 10);
     assert_true(alpha_diff <= covered / 100);
+    assert_true(colour_diff <= covered / 25);
     assert_true(mean < 2e-3);
     free(inst.rgba);
     free(copies.rgba);
 }
 
-/* plastic; and a surface of du, dv: a moved placement's are its own,
- * not the prototype's (the displacement's are the prototype's) */
+/* plastic; a surface of du, dv: a moved placement's are its own, not
+ * the prototype's (the displacement's are the prototype's); and the cubes'
+ * shadows on a wall behind them */
 static void test_moved_placements_render_as_copies(void **state)
 {
     (void)state;
-    compare_with_copies("plastic");
-    compare_with_copies("showdu");
+    compare_with_copies("plastic", false);
+    compare_with_copies("showdu", false);
+    compare_with_copies("plastic", true);
 }
 
 static double vmax_abs(vec3 a)
