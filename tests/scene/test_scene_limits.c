@@ -90,6 +90,44 @@ static void test_instances_count(void **state)
 #undef QUAD
 }
 
+/* The pieces a renderer keeps boxes for (scene.npieces, against
+ * SCENE_MAX_PIECES): an undisplaced mesh's once, a displaced mesh's again
+ * for each instance that does not move the first placement rigidly (a
+ * rigid one may be the first moved: trace/group.h). */
+static void test_displaced_mesh_pieces_count(void **state)
+{
+    (void)state;
+    /* times the mesh's pieces (the first case's count) */
+    static const struct { const char *disp, *motion; long times; } cases[] = {
+        {"", "Translate 1 0 0 Rotate 30 0 1 0", 1},                 /* shared */
+        {"Displacement \"dented\"\n", "Translate 1 0 0 Rotate 30 0 1 0", 1},   /* moved */
+        {"Displacement \"dented\"\n", "Translate 1 0 0 Scale 2 2 2", 6},      /* own */
+        {"Displacement \"dented\"\n", "Scale 1 1 -1", 6},           /* mirrored */
+    };
+    long mesh = 0;
+    for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++) {
+        char text[4096];
+        size_t o = (size_t)snprintf(text, sizeof text, CAMERA "WorldBegin\n%sObjectBegin 1\n"
+                                    "PointsPolygons [4 4 4 4] [0 1 2 3 1 4 5 2 4 6 7 5 6 0 3 7] "
+                                    "\"P\" [0 0 0 1 0 0 1 1 0 0 1 0 2 0 0 2 1 0 3 0 0 3 1 0]\n"
+                                    "ObjectEnd\nObjectInstance 1\n", cases[c].disp);
+        for (int i = 0; i < 5; i++)
+            o += (size_t)snprintf(text + o, sizeof text - o,
+                                  "AttributeBegin %s ObjectInstance 1 AttributeEnd\n",
+                                  cases[c].motion);
+        snprintf(text + o, sizeof text - o, "WorldEnd\n");
+        sl_diag *d;
+        scene *sc = parse_limited(text, 100, &d);
+        assert_non_null(sc);
+        assert_int_equal(sc->nobjects, 6);
+        if (c == 0) mesh = sc->npieces;
+        assert_true(mesh >= 4);
+        assert_int_equal(sc->npieces, cases[c].times * mesh);
+        scene_destroy(&sc);
+        sl_diag_destroy(&d);
+    }
+}
+
 /* scene_parse uses the default limit. */
 static void test_default_limit(void **state)
 {
@@ -136,6 +174,7 @@ int main(void)
         cmocka_unit_test(test_objects_at_the_limit),
         cmocka_unit_test(test_objects_over_the_limit),
         cmocka_unit_test(test_instances_count),
+        cmocka_unit_test(test_displaced_mesh_pieces_count),
         cmocka_unit_test(test_default_limit),
         cmocka_unit_test(test_scene_file_too_large),
     };
