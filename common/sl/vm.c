@@ -462,14 +462,21 @@ void sl_vm_set_interval(sl_vm *self, sl_global g, const ia_interval *values)
 }
 
 /* count forms (a form is never read past n: the rest of its array is
- * stale by design, affine.h); copied whole, as a struct: a fixed size
- * compiles to a few vector moves, where a copy up to n compiled to rep
- * movs, whose start-up cost dominated these short copies (issue 24) */
+ * stale by design, affine.h): the fields before the coefficients, then
+ * the coefficients in blocks of four up to n (AA_MAX_SYMBOLS is a
+ * multiple of four), each block a fixed-size copy: a few vector moves,
+ * where a copy up to n compiled to rep movs, whose start-up cost
+ * dominated these short copies, and a whole form moved 168 bytes for the
+ * 2-4 symbols of most globals (issue 24) */
+_Static_assert(AA_MAX_SYMBOLS % 4 == 0, "coefficients copy in blocks of four");
 static void copy_forms(aa_form *dst, const aa_form *src, int count)
 {
     for (int k = 0; k < count; k++) {
-        assert(src[k].n <= AA_MAX_SYMBOLS);
-        dst[k] = src[k];
+        int n = src[k].n;
+        assert(n <= AA_MAX_SYMBOLS);
+        memcpy(&dst[k], &src[k], offsetof(aa_form, c));
+        for (int i = 0; i < n; i += 4)
+            memcpy(&dst[k].c[i], &src[k].c[i], 4 * sizeof src[k].c[0]);
     }
 }
 
