@@ -326,6 +326,22 @@ lincomb_loops(int track, double a, const double *xc, int xn, double b,
     *uf_out = uf;
 }
 
+/* The end of every linear combination: z's fields, the hull's NaN ends
+ * (inf - inf) as the whole line, unbounded when the centre or the error
+ * overflowed. */
+static inline __attribute__((always_inline)) void
+finish_form(aa_form *z, double x0, double err, double lo, double hi, int n, unsigned flags)
+{
+    z->x0 = x0;
+    z->err = err;
+    z->lo = lo == lo ? lo : -INFINITY;
+    z->hi = hi == hi ? hi : INFINITY;
+    z->n = (unsigned short)n;
+    z->flags = (unsigned short)flags;
+    if (!isfinite(x0) || !isfinite(err))
+        aa_unbounded(z, flags);
+}
+
 /*
  * z = a*x + b*y + c. Coefficients in RN: the exact error of each sum from
  * TwoSum (so x - x is exactly 0), 2^-53 of each product by an inexact
@@ -402,14 +418,7 @@ lincomb(aa_form *z, double a, const aa_form *x, double b, const aa_form *y, doub
         err = add_up_nn(err, kb == FACTOR_EXACT ? ye * fabs(b) : fp_mul_up(fabs(b), ye));
     err = add_up_nn(err, add_up_nn(sum_err_bound(es), fp_rounding_bound(ap, uf)));
 
-    z->x0 = s2;
-    z->err = err;
-    z->lo = hlo == hlo ? hlo : -INFINITY;
-    z->hi = hhi == hhi ? hhi : INFINITY;
-    z->n = (unsigned short)n;
-    z->flags = (unsigned short)flags;
-    if (!isfinite(s2) || !isfinite(err))
-        aa_unbounded(z, flags);
+    finish_form(z, s2, err, hlo, hhi, n, flags);
 }
 
 void aa_lincomb(aa_context *ctx, aa_form *z, double a, const aa_form *x,
@@ -483,14 +492,7 @@ scale(aa_form *z, double a, const aa_form *x, double c, bool want_hull)
     if (xe != 0.0)
         err = ka == FACTOR_EXACT ? xe * fabs(a) : fp_mul_up(fabs(a), xe);
     err = add_up_nn(err, add_up_nn(sum_err_bound(es), fp_rounding_bound(ap, uf)));
-    z->x0 = s2;
-    z->err = err;
-    z->lo = hlo == hlo ? hlo : -INFINITY;
-    z->hi = hhi == hhi ? hhi : INFINITY;
-    z->n = (unsigned short)n;
-    z->flags = (unsigned short)flags;
-    if (!isfinite(s2) || !isfinite(err))
-        aa_unbounded(z, flags);
+    finish_form(z, s2, err, hlo, hhi, n, flags);
 }
 
 static void lincomb_scale(aa_form *z, double a, const aa_form *x, double c)
@@ -541,14 +543,7 @@ add_sign(aa_form *z, const aa_form *x, const aa_form *y, double b)
     if (ye != 0.0)
         err = add_up_nn(err, ye);
     err = add_up_nn(err, sum_err_bound(es));
-    z->x0 = s2;
-    z->err = err;
-    z->lo = hlo == hlo ? hlo : -INFINITY;
-    z->hi = hhi == hhi ? hhi : INFINITY;
-    z->n = (unsigned short)n;
-    z->flags = (unsigned short)flags;
-    if (!isfinite(s2) || !isfinite(err))
-        aa_unbounded(z, flags);
+    finish_form(z, s2, err, hlo, hhi, n, flags);
 }
 
 /*
