@@ -9,7 +9,11 @@
  *
  * Table 3 (printed second), "dense": the dense fixed-width forms of
  * dense.h against aa_form, ns per add, sub, lincomb, mul and range on the
- * same operands (u, v and their error symbols).
+ * same operands (u, v and their error symbols). A second aa_form column,
+ * "varied", takes its operands from 256 sets in a fixed random order (the
+ * other columns cycle through 8): whether a sum was rounded, and which
+ * way, then varies as in a renderer, and a branch on it is mispredicted
+ * as it is there (the 256 sets live in L2, not L1).
  *
  * Table 2, "full vs reduced": shader-like expressions over (u, v) squares of
  * side 1, 1/4, 1/16 and 1/64 tiling [0,1]^2, evaluated with context
@@ -394,7 +398,12 @@ static void table_full_vs_reduced(long evals)
 enum { D_ADD, D_SUB, D_LINCOMB, D_MUL, D_RANGE, D_COUNT };
 static const char *const DENSE_NAMES[D_COUNT] = {"add", "sub", "lincomb", "mul", "range"};
 
-static double time_dense_op(int op, bool dense, const aa_operands *sets, long iters)
+#define VARIED_SETS 256
+#define VARIED_ORDER 4096
+
+/* order: NULL to cycle through NSETS sets, else VARIED_ORDER indices */
+static double time_dense_op(int op, bool dense, const aa_operands *sets,
+                            const unsigned char *order, long iters)
 {
     aa_dense dx[NSETS], dy[NSETS], dz;
     for (int k = 0; k < NSETS; k++) {
@@ -405,7 +414,7 @@ static double time_dense_op(int op, bool dense, const aa_operands *sets, long it
     double sum = 0.0;
     double t0 = now_ns();
     for (long i = 0; i < iters; i++) {
-        int k = (int)(i & (NSETS - 1));
+        int k = order ? order[i & (VARIED_ORDER - 1)] : (int)(i & (NSETS - 1));
         const aa_operands *o = &sets[k];
         aa_context c = o->ctx;
         if (dense) {
@@ -435,15 +444,28 @@ static double time_dense_op(int op, bool dense, const aa_operands *sets, long it
 
 static void table_dense(long iters)
 {
-    static aa_operands sets[NSETS];
+    static aa_operands sets[NSETS], varied[VARIED_SETS];
+    static unsigned char order[VARIED_ORDER];
     for (int k = 0; k < NSETS; k++)
         build_aa_operands(&sets[k], 0, k);
+    for (int k = 0; k < VARIED_SETS; k++)          /* u, v shifted by 0.01 k */
+        build_aa_operands(&varied[k], 0, k);
+    uint64_t r = 0x9e3779b97f4a7c15ull;            /* a fixed random order */
+    for (int i = 0; i < VARIED_ORDER; i++) {
+        r ^= r << 13;
+        r ^= r >> 7;
+        r ^= r << 17;
+        order[i] = (unsigned char)(r >> 56);
+    }
     printf("dense fixed-width forms (dense.h, %d symbols + err, no hull) against aa_form,\n"
-           "ns per operation on the same operands (%ld iterations each)\n", AA_DENSE_W, iters);
-    printf("%-12s %10s %10s %8s\n", "operation", "aa_form", "dense", "ratio");
+           "ns per operation on the same operands (%ld iterations each; varied: aa_form on\n"
+           "%d operand sets in a random order)\n", AA_DENSE_W, iters, VARIED_SETS);
+    printf("%-12s %10s %10s %10s %8s\n", "operation", "aa_form", "varied", "dense", "ratio");
     for (int op = 0; op < D_COUNT; op++) {
-        double f = time_dense_op(op, false, sets, iters), d = time_dense_op(op, true, sets, iters);
-        printf("%-12s %10.1f %10.1f %7.1fx\n", DENSE_NAMES[op], f, d, f / d);
+        double f = time_dense_op(op, false, sets, NULL, iters);
+        double v = time_dense_op(op, false, varied, order, iters);
+        double d = time_dense_op(op, true, sets, NULL, iters);
+        printf("%-12s %10.1f %10.1f %10.1f %7.1fx\n", DENSE_NAMES[op], f, v, d, f / d);
     }
     printf("\n");
 }

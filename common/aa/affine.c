@@ -48,7 +48,7 @@ void aa_context_reset(aa_context *ctx)
 }
 
 /* A fresh noise symbol, or -1 when the context's capacity is spent. */
-static int fresh_symbol(aa_context *ctx)
+static inline int fresh_symbol(aa_context *ctx)
 {
     check_context(ctx);
     if (ctx->used >= ctx->capacity)
@@ -62,7 +62,22 @@ static int fresh_symbol(aa_context *ctx)
 
 /* aa_unbounded, aa_const and aa_is_point are inline in affine.h */
 
-void aa_add_new_error(aa_context *ctx, aa_form *z, double delta)
+/* c[i] = 0 for n <= i < k (and past k: stale anyway), c[0..n) kept:
+ * before a new symbol k is written. Usually k == n (the form uses the
+ * last symbol) and nothing is done; else a fixed trip count compiles to a
+ * few vector blends, where a loop from n to k compiled to a call of
+ * memset (issue 24). */
+static inline void zero_from(double *c, int n, int k)
+{
+    if (n >= k)
+        return;
+    for (int i = 0; i < AA_MAX_SYMBOLS; i++)
+        c[i] = i < n ? c[i] : 0.0;
+}
+
+/* aa_add_new_error, inlined where the operations of this file end with it */
+static inline __attribute__((always_inline)) void
+new_error(aa_context *ctx, aa_form *z, double delta)
 {
     assert(!(delta < 0.0));                 /* an upper bound of an error */
     assert(z->n <= AA_MAX_SYMBOLS);
@@ -79,11 +94,15 @@ void aa_add_new_error(aa_context *ctx, aa_form *z, double delta)
         return;
     }
     assert(k < AA_MAX_SYMBOLS);
-    for (int i = z->n; i < k; i++)
-        z->c[i] = 0.0;
+    zero_from(z->c, z->n, k);
     z->c[k] = delta;
     if (k + 1 > z->n)
         z->n = (unsigned short)(k + 1);
+}
+
+void aa_add_new_error(aa_context *ctx, aa_form *z, double delta)
+{
+    new_error(ctx, z, delta);
 }
 
 void aa_input(aa_context *ctx, aa_form *z, double lo, double hi)
@@ -105,8 +124,7 @@ void aa_input(aa_context *ctx, aa_form *z, double lo, double hi)
         ctx->folded++;
         return;
     }
-    for (int i = 0; i < k; i++)
-        z->c[i] = 0.0;
+    zero_from(z->c, 0, k);
     z->c[k] = rad;
     z->n = (unsigned short)(k + 1);
 }
@@ -117,13 +135,13 @@ void aa_set_interval(aa_context *ctx, aa_form *z, ia_interval r, unsigned flags)
         aa_unbounded(z, flags);
         return;
     }
-    double mid = ia_mid(r);
+    double mid = 0.5 * r.lo + 0.5 * r.hi;     /* ia_mid of finite ends */
     double rad = fmax(fp_add_up(r.hi, -mid), fp_add_up(mid, -r.lo));
     aa_const(z, mid);
     z->lo = r.lo;
     z->hi = r.hi;
     z->flags = (unsigned short)(flags & ~AA_UNBOUNDED);
-    aa_add_new_error(ctx, z, rad);
+    new_error(ctx, z, rad);
 }
 
 void aa_from_interval(aa_context *ctx, aa_form *z, ia_interval x)
@@ -152,7 +170,7 @@ static double radius_from_sum(const aa_form *x, double r, int terms)
  * result, so the exact sum is at most the computed one times (1 + 2^-53)^n,
  * which (n + 1) * 2^-53 relative, stepped up, covers. A form with one term
  * (an input, a fresh min-range result) comes back exactly. */
-double aa_radius(const aa_form *x)
+static inline __attribute__((always_inline)) double radius(const aa_form *x)
 {
     if (x->flags & AA_UNBOUNDED)
         return INFINITY;
@@ -167,7 +185,12 @@ double aa_radius(const aa_form *x)
     return radius_from_sum(x, r, terms);
 }
 
-ia_interval aa_range_r(const aa_form *x, double r)
+double aa_radius(const aa_form *x)
+{
+    return radius(x);
+}
+
+static inline __attribute__((always_inline)) ia_interval range_r(const aa_form *x, double r)
 {
     if (x->flags & AA_UNBOUNDED) {
         ia_interval e = ia_entire();
@@ -191,15 +214,20 @@ ia_interval aa_range_r(const aa_form *x, double r)
     return out;
 }
 
-ia_interval aa_range(const aa_form *x)
+ia_interval aa_range_r(const aa_form *x, double r)
 {
-    return aa_range_r(x, aa_radius(x));
+    return range_r(x, r);
 }
 
-ia_interval aa_range_radius(const aa_form *x, double *radius)
+ia_interval aa_range(const aa_form *x)
 {
-    *radius = aa_radius(x);
-    return aa_range_r(x, *radius);
+    return range_r(x, radius(x));
+}
+
+ia_interval aa_range_radius(const aa_form *x, double *r)
+{
+    *r = radius(x);
+    return range_r(x, *r);
 }
 
 /* ---------------------------------------------------------------------- */
@@ -298,6 +326,22 @@ lincomb_loops(int track, double a, const double *xc, int xn, double b,
     *uf_out = uf;
 }
 
+/* The end of every linear combination: z's fields, the hull's NaN ends
+ * (inf - inf) as the whole line, unbounded when the centre or the error
+ * overflowed. */
+static inline __attribute__((always_inline)) void
+finish_form(aa_form *z, double x0, double err, double lo, double hi, int n, unsigned flags)
+{
+    z->x0 = x0;
+    z->err = err;
+    z->lo = lo == lo ? lo : -INFINITY;
+    z->hi = hi == hi ? hi : INFINITY;
+    z->n = (unsigned short)n;
+    z->flags = (unsigned short)flags;
+    if (!isfinite(x0) || !isfinite(err))
+        aa_unbounded(z, flags);
+}
+
 /*
  * z = a*x + b*y + c. Coefficients in RN: the exact error of each sum from
  * TwoSum (so x - x is exactly 0), 2^-53 of each product by an inexact
@@ -374,14 +418,7 @@ lincomb(aa_form *z, double a, const aa_form *x, double b, const aa_form *y, doub
         err = add_up_nn(err, kb == FACTOR_EXACT ? ye * fabs(b) : fp_mul_up(fabs(b), ye));
     err = add_up_nn(err, add_up_nn(sum_err_bound(es), fp_rounding_bound(ap, uf)));
 
-    z->x0 = s2;
-    z->err = err;
-    z->lo = hlo == hlo ? hlo : -INFINITY;
-    z->hi = hhi == hhi ? hhi : INFINITY;
-    z->n = (unsigned short)n;
-    z->flags = (unsigned short)flags;
-    if (!isfinite(s2) || !isfinite(err))
-        aa_unbounded(z, flags);
+    finish_form(z, s2, err, hlo, hhi, n, flags);
 }
 
 void aa_lincomb(aa_context *ctx, aa_form *z, double a, const aa_form *x,
@@ -402,10 +439,111 @@ void aa_lincomb(aa_context *ctx, aa_form *z, double a, const aa_form *x,
  * fast-math), hence bit for bit aa_lincomb's result with those arguments
  * (test_aa_fastpath compares them on random operands).
  */
-/* z = a*x + c: aa_lincomb(a, x, 0, NULL, c) */
+/*
+ * z = a*x + c: lincomb(a, x, 0, NULL, c), written out for a finite nonzero
+ * a and c and a bounded x (the rest goes to lincomb): the terms of the
+ * absent second operand are the zeros they were (the same sums, in the
+ * same order, down to the + 0.0 that turns a -0 into 0), and the product
+ * bookkeeping is done only for the factors that need it (issue 24).
+ */
+static inline __attribute__((always_inline)) void
+scale(aa_form *z, double a, const aa_form *x, double c, bool want_hull)
+{
+    if (a == 0.0 || !isfinite(a) || !isfinite(c) || (x->flags & AA_UNBOUNDED)) {
+        lincomb(z, a, x, 0.0, NULL, c, want_hull);
+        return;
+    }
+    unsigned flags = x->flags;
+    int ka = factor_kind(a);
+    double wa = ka == FACTOR_INEXACT ? 1.0 : 0.0;
+    int n = x->n;
+    double x0 = x->x0, xe = x->err;
+    double hlo = -INFINITY, hhi = INFINITY;
+    if (want_hull) {
+        double l1, h1;
+        scale_ends(a, x->lo, x->hi, &l1, &h1);
+        int huf = uflow_k(ka, l1, a > 0.0 ? x->lo : x->hi) |
+                  uflow_k(ka, h1, a > 0.0 ? x->hi : x->lo);
+        double hb = 2.0 * fp_rounding_bound(3.0 * (fabs(l1) + fabs(h1) + 0.0 + 0.0 + fabs(c)),
+                                            huf);
+        hlo = (l1 + 0.0 + c) - hb;
+        hhi = (h1 + 0.0 + c) + hb;
+    }
+    const double *xc = x->c;
+    double *zc = z->c;
+    double ap = 0.0;
+    int uf = 0;
+    if (ka == FACTOR_EXACT) {
+        for (int i = 0; i < n; i++)
+            zc[i] = a * xc[i];
+    } else {
+        for (int i = 0; i < n; i++) {
+            double xi = xc[i], p = a * xi;
+            ap += wa * fabs(p);
+            uf |= uflow_k(ka, p, xi);
+            zc[i] = p;
+        }
+    }
+    double p = a * x0, s1 = p + 0.0, s2 = s1 + c;
+    double es = fabs(fp_two_sum_err(p, 0.0, s1)) + fabs(fp_two_sum_err(s1, c, s2));
+    ap += wa * fabs(p) + 0.0;
+    uf |= uflow_k(ka, p, x0);
+    double err = 0.0;
+    if (xe != 0.0)
+        err = ka == FACTOR_EXACT ? xe * fabs(a) : fp_mul_up(fabs(a), xe);
+    err = add_up_nn(err, add_up_nn(sum_err_bound(es), fp_rounding_bound(ap, uf)));
+    finish_form(z, s2, err, hlo, hhi, n, flags);
+}
+
 static void lincomb_scale(aa_form *z, double a, const aa_form *x, double c)
 {
-    lincomb(z, a, x, 0.0, NULL, c, true);
+    scale(z, a, x, c, true);
+}
+
+/*
+ * z = x + b*y for b = +-1: lincomb(1, x, b, y, 0) written out (issue 24):
+ * the products by +-1 are exact and need no bookkeeping, the tail of the
+ * longer operand is one loop, the centre's sum with c = 0 is kept as it
+ * was (s1 + 0.0). The same operations on the same values in the same
+ * order, hence the same bits (test_aa_fastpath).
+ */
+static inline __attribute__((always_inline)) void
+add_sign(aa_form *z, const aa_form *x, const aa_form *y, double b)
+{
+    unsigned flags = x->flags | y->flags;
+    if (flags & AA_UNBOUNDED) {
+        aa_unbounded(z, flags);
+        return;
+    }
+    int xn = x->n, yn = y->n;
+    int m = xn < yn ? xn : yn, n = xn > yn ? xn : yn;
+    double x0 = x->x0, y0 = y->x0, xe = x->err, ye = y->err;
+    double l1 = x->lo, h1 = x->hi, l2, h2;
+    scale_ends(b, y->lo, y->hi, &l2, &h2);
+    double hb = 2.0 * fp_rounding_bound(3.0 * (fabs(l1) + fabs(h1) + fabs(l2) + fabs(h2) + 0.0),
+                                        0);
+    double hlo = (l1 + l2 + 0.0) - hb, hhi = (h1 + h2 + 0.0) + hb;
+    const double *xc = x->c, *yc = y->c;
+    double *zc = z->c;
+    double es = 0.0;
+    for (int i = 0; i < m; i++) {
+        double p = xc[i], q = b * yc[i], s = p + q;
+        es += fabs(fp_two_sum_err(p, q, s));
+        zc[i] = s;
+    }
+    const double *tc = xn > yn ? xc : yc;      /* the longer one's own symbols */
+    double tb = xn > yn ? 1.0 : b;
+    for (int i = m; i < n; i++)
+        zc[i] = tb * tc[i];
+    double q = b * y0, s1 = x0 + q, s2 = s1 + 0.0;
+    es += fabs(fp_two_sum_err(x0, q, s1)) + fabs(fp_two_sum_err(s1, 0.0, s2));
+    double err = 0.0;
+    if (xe != 0.0)
+        err = xe;
+    if (ye != 0.0)
+        err = add_up_nn(err, ye);
+    err = add_up_nn(err, sum_err_bound(es));
+    finish_form(z, s2, err, hlo, hhi, n, flags);
 }
 
 /*
@@ -535,17 +673,17 @@ void aa_lincomb3_centred(aa_context *ctx, aa_form *z, const double m[3],
     lincomb3(z, m, x, c, true);
 }
 
-/* aa_lincomb(1, x, +-1, y, 0), specialised as lincomb_scale */
+/* aa_lincomb(1, x, +-1, y, 0), written out as add_sign */
 void aa_add(aa_context *ctx, aa_form *z, const aa_form *x, const aa_form *y)
 {
     (void)ctx;
-    lincomb(z, 1.0, x, 1.0, y, 0.0, true);
+    add_sign(z, x, y, 1.0);
 }
 
 void aa_sub(aa_context *ctx, aa_form *z, const aa_form *x, const aa_form *y)
 {
     (void)ctx;
-    lincomb(z, 1.0, x, -1.0, y, 0.0, true);
+    add_sign(z, x, y, -1.0);
 }
 
 void aa_neg(aa_context *ctx, aa_form *z, const aa_form *x)
@@ -576,13 +714,13 @@ void aa_apply_linear(aa_context *ctx, aa_form *z, const aa_form *x,
                      double alpha, double zeta, double delta, ia_interval hull,
                      unsigned flags)
 {
-    lincomb(z, alpha, x, 0.0, NULL, zeta, false);    /* the hull is given */
+    scale(z, alpha, x, zeta, false);                 /* the hull is given */
     if (!(z->flags & AA_UNBOUNDED)) {
         z->lo = hull.lo;
         z->hi = hull.hi;
     }
     z->flags |= (unsigned short)(flags & ~AA_UNBOUNDED);
-    aa_add_new_error(ctx, z, delta);
+    new_error(ctx, z, delta);
 }
 
 /* ---------------------------------------------------------------------- */
@@ -673,7 +811,7 @@ void aa_mul(aa_context *ctx, aa_form *z, const aa_form *x, const aa_form *y)
     }
     /* z's coefficients are written, x's and y's other fields not yet */
     double rx = radius_from_sum(x, sx, tx), ry = radius_from_sum(y, sy, ty);
-    ia_interval hull = ia_mul(aa_range_r(x, rx), aa_range_r(y, ry));
+    ia_interval hull = ia_mul(range_r(x, rx), range_r(y, ry));
     double p0 = x0 * y0, mid = 0.5 * dsum, s0 = p0 + mid;
     uf |= fp_uflow(p0, x0, y0) | (fabs(mid) < 0x1p-1022 && dsum != 0.0);
     es += fabs(fp_two_sum_err(p0, mid, s0));
@@ -702,7 +840,7 @@ void aa_mul(aa_context *ctx, aa_form *z, const aa_form *x, const aa_form *y)
         aa_unbounded(z, flags);
         return;
     }
-    aa_add_new_error(ctx, z, delta);
+    new_error(ctx, z, delta);
 }
 
 /* ---------------------------------------------------------------------- */

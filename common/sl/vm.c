@@ -409,8 +409,8 @@ void sl_vm_set_derivs(sl_vm *self, sl_global g, const ia_interval *du, const ia_
 {
     if (!global_ok(g))
         return;
-    int s = sl_global_slot(g);
-    for (int k = 0; k < sl_global_size(g); k++) {
+    int s = sl_global_slot(g), size = sl_global_size(g);    /* calls: not in the loop */
+    for (int k = 0; k < size; k++) {
         self->gderiv[s + k][0] = du[k];
         self->gderiv[s + k][1] = dv[k];
         self->gderiv_set |= (uint64_t)1 << (s + k);
@@ -462,15 +462,26 @@ void sl_vm_set_interval(sl_vm *self, sl_global g, const ia_interval *values)
 }
 
 /* count forms (a form is never read past n: the rest of its array is
- * stale by design, affine.h); copied whole, as a struct: a fixed size
- * compiles to a few vector moves, where a copy up to n compiled to rep
- * movs, whose start-up cost dominated these short copies (issue 24) */
+ * stale by design, affine.h): the fields before the coefficients, then
+ * the coefficients in blocks of four up to n (AA_MAX_SYMBOLS is a
+ * multiple of four), each block a fixed-size copy: a few vector moves,
+ * where a copy up to n compiled to rep movs, whose start-up cost
+ * dominated these short copies, and a whole form moved 168 bytes for the
+ * 2-4 symbols of most globals (issue 24) */
+_Static_assert(AA_MAX_SYMBOLS % 4 == 0, "coefficients copy in blocks of four");
+static inline void copy_form(aa_form *dst, const aa_form *src)
+{
+    int n = src->n;
+    assert(n <= AA_MAX_SYMBOLS);
+    memcpy(dst, src, offsetof(aa_form, c));
+    for (int i = 0; i < n; i += 4)
+        memcpy(&dst->c[i], &src->c[i], 4 * sizeof src->c[0]);
+}
+
 static void copy_forms(aa_form *dst, const aa_form *src, int count)
 {
-    for (int k = 0; k < count; k++) {
-        assert(src[k].n <= AA_MAX_SYMBOLS);
-        dst[k] = src[k];
-    }
+    for (int k = 0; k < count; k++)
+        copy_form(&dst[k], &src[k]);
 }
 
 void sl_vm_set_affine(sl_vm *self, sl_global g, const aa_form *values)
@@ -596,9 +607,7 @@ static sl_status run_with_derivatives(sl_vm *self, sl_mode mode)
         for (uint64_t m = used; m; m &= m - 1) {
             int s = __builtin_ctzll(m);
             if (s >= SL_GLOBAL_SLOTS) break;
-            const aa_form *x = &self->a[s];
-            assert(x->n <= AA_MAX_SYMBOLS);
-            self->ad[s].v = *x;       /* whole: a fixed-size copy beats rep movs */
+            copy_form(&self->ad[s].v, &self->a[s]);     /* up to n, fixed-size blocks */
             self->ad[s].du = gderiv_of(self, s, 0);
             self->ad[s].dv = gderiv_of(self, s, 1);
         }
@@ -606,9 +615,7 @@ static sl_status run_with_derivatives(sl_vm *self, sl_mode mode)
         for (uint64_t m = used; m; m &= m - 1) {
             int s = __builtin_ctzll(m);
             if (s >= SL_GLOBAL_SLOTS) break;
-            const aa_form *x = &self->ad[s].v;
-            assert(x->n <= AA_MAX_SYMBOLS);
-            self->a[s] = *x;
+            copy_form(&self->a[s], &self->ad[s].v);
         }
     } else {
         if (!self->id)

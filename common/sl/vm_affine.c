@@ -1,14 +1,14 @@
 /*
  * vm_affine.c: the VM in rounding-safe affine arithmetic (common/aa
  * affine.h) over the caller's aa_context: the range analysis of Heidrich
- * & Seidel 1998 §4. Slots are aa_forms written in place; copies move only
- * the coefficients in use. A comparison looks at the affine form of the
- * difference of its operands, so correlated operands (u against u + 0.1)
- * decide where intervals could not; undecided ones run both branches and
- * merge with aa_merge (§4.1, §5). The operations live in vm_affine_ops.h;
- * programs that take derivatives run in vm_affine_deriv.c instead, so here
- * Du/Dv/Deriv/calculatenormal/area are never reached with a meaning
- * (unbounded if they were).
+ * & Seidel 1998 §4. Slots are aa_forms written in place; a copy moves the
+ * whole form (a fixed size, no libc call). A comparison looks at the
+ * affine form of the difference of its operands, so correlated operands
+ * (u against u + 0.1) decide where intervals could not; undecided ones
+ * run both branches and merge with aa_merge (§4.1, §5). The operations
+ * live in vm_affine_ops.h; programs that take derivatives run in
+ * vm_affine_deriv.c instead, so here Du/Dv/Deriv/calculatenormal/area are
+ * never reached with a meaning (unbounded if they were).
  */
 #include "sl/noise.h"
 #include "sl/vm_internal.h"

@@ -17,8 +17,11 @@ static inline void VM_OP(v_mov, b_mov)(sl_vm *vm, A *z, const A *x)
 {
     (void)vm;
     assert(x->n <= AA_MAX_SYMBOLS);      /* a form's symbol count fits its array */
+    /* whole, as a struct (the coefficients past n are stale by design): a
+     * fixed size compiles to a few vector moves, where memcpy up to n was
+     * a libc call per move (issue 24) */
     if (z != x)
-        memcpy(z, x, offsetof(aa_form, c) + (size_t)x->n * sizeof x->c[0]);
+        memcpy(z, x, sizeof *z);
 }
 static inline void VM_OP(v_swap, b_swap)(sl_vm *vm, A *a, A *b)
 {

@@ -11,7 +11,10 @@
  *                               subnormal, exponent and overflow edges
  *   fp_add_dn / fp_add_up       exact directed roundings: checked against the
  *                               exact sum recovered with TwoSum, including at
- *                               overflow, in the subnormal range and at +-inf
+ *                               overflow, in the subnormal range and at +-inf;
+ *                               and bit for bit against their one-step
+ *                               definition (s, or fp_next_up/down(s) when
+ *                               TwoSum says s was rounded the other way)
  *   fp_mul_dn/up, fp_div_dn/up  bound the exact product / quotient (fma, long
  *                               double), at most one step outward, and follow
  *                               the documented conventions (0 * inf = 0,
@@ -389,6 +392,13 @@ static void test_add_directed(void **state)
         }
         double s = a + b, e = fp_two_sum_err(a, b, s);
         double up = fp_add_up(a, b), dn = fp_add_dn(a, b);
+        double up1 = e > 0 ? fp_next_up(s) : s, dn1 = e < 0 ? fp_next_down(s) : s;
+        if (memcmp(&up, &up1, sizeof up) != 0 || memcmp(&dn, &dn1, sizeof dn) != 0) {
+            if (bad < 5)
+                printf("add directed not its one-step definition: %a + %a: dn %a (%a) up %a "
+                       "(%a)\n", a, b, dn, dn1, up, up1);
+            bad++;
+        }
         if (isnan(e) || !is_directed_sum(dn, s, e, -1) || !is_directed_sum(up, s, e, +1)) {
             if (bad < 5)
                 printf("add directed wrong: %a + %a: dn %a up %a (s %a e %a)\n", a, b, dn, up,
