@@ -66,6 +66,17 @@ static vec3 tensor(const vec3 *p, const double *bu, const double *bv)
     return r;
 }
 
+vec3 geom_bicubic_eval_point(const geom_surface *s, double u, double v)
+{
+    /* P as geom_bicubic_eval_dual makes it (the same bernstein weights, the
+     * same sum in the same order: the same bits), without the 5 tensor
+     * sums of the derivatives (the grid spacing's 81 points a piece) */
+    double bu[4], du[4], ddu[4], bv[4], dv[4], ddv[4];
+    bernstein(u, bu, du, ddu);
+    bernstein(v, bv, dv, ddv);
+    return tensor(s->verts, bu, bv);
+}
+
 void geom_bicubic_eval_dual(const geom_surface *s, double u, double v, geom_sample *out)
 {
     double bu[4], du[4], ddu[4], bv[4], dv[4], ddv[4];
@@ -334,6 +345,32 @@ bool geom_bicubic_net_aa(aa_context *ctx, const geom_surface *b, const aa_form *
         geom_net_form(ctx, &o->dPdv[c], &dv[0][0], 4, 4, 3, it, s, t, s0, s1, t0, t1);
     }
     geom_ng_aa(ctx, o);
+    return true;
+}
+
+bool geom_bicubic_net_range_P(const geom_surface *b, const aa_form *s, const aa_form *t,
+                              ia_interval P[3])
+{
+    /* geom_bicubic_net_aa's conditions and P nets, and the hull that
+     * geom_net_form gives P's forms (scale 1): the form's affine range
+     * holds that hull (the plane over the box plus the net's largest
+     * distance from it reaches every net point), so aa_range is the hull */
+    ia_interval sr = aa_range(s), tr = aa_range(t);
+    if (!(sr.hi - sr.lo > 0x1p-12) || !(tr.hi - tr.lo > 0x1p-12) || (s->flags | t->flags))
+        return false;
+    ia_interval q[3][4][4];
+    if (!piece_net(b, sr, tr, q)) return false;
+    ia_interval one = ia_point(1);
+    for (int c = 0; c < 3; c++) {
+        ia_interval hull = ia_empty();
+        for (int j = 0; j < 4; j++)
+            for (int i = 0; i < 4; i++) {
+                ia_interval x = ia_mul(q[c][j][i], one);
+                hull = i == 0 && j == 0 ? x : ia_hull(hull, x);
+            }
+        if (!isfinite(hull.lo) || !isfinite(hull.hi)) return false;
+        P[c] = hull;
+    }
     return true;
 }
 

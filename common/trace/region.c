@@ -323,10 +323,10 @@ void trace_region_base(aa_context *ctx, const geom_surface *surf, float base[6])
     aa_form u, v;
     aa_input(ctx, &u, 0.0, 1.0);
     aa_input(ctx, &v, 0.0, 1.0);
-    geom_aa g;
-    geom_eval_aa(ctx, surf, &u, &v, &g);
+    ia_interval P[3];                  /* a box is all it needs: no forms */
+    geom_eval_aa_range_P(ctx, surf, &u, &v, P);
     for (int i = 0; i < 3; i++) {
-        b[i] = widen(ia_hull(b[i], aa_range(&g.P[i])));
+        b[i] = widen(ia_hull(b[i], P[i]));
         base[i] = trace_float_down(b[i].lo);
         base[3 + i] = trace_float_up(b[i].hi);
     }

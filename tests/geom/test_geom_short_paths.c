@@ -1,0 +1,290 @@
+/*
+ * tests/geom/test_geom_short_paths.c: the P-only paths of the patch kinds
+ * (issues 23 and 24: a displaced Catmull-Clark mesh's world build wants
+ * each piece's base box and 81 points of its grid spacing, not its
+ * derivatives) give the very bits of the general paths they replace, so
+ * no box and no image moves:
+ *
+ *   range_P  geom_eval_aa_range_P (the hull of the piece's Bezier net met
+ *            with its float net's box) against aa_range of geom_eval_aa's
+ *            P, bit for bit, on subdivision faces (a bumpy grid: regular
+ *            faces; a cube: valence 3; a fan of 5 with a boundary; a cube
+ *            with creases and a corner tag) and bicubic patches, over the
+ *            whole square, dyadic boxes down to 2^-14 (below 2^-12 the
+ *            tensor form's path) and arbitrary boxes; and float samples lie
+ *            inside (1e-11 of slack)
+ *   point    geom_eval_point against geom_eval's P, bit for bit, at random
+ *            points, the square's corners and edges (irregular corners:
+ *            the limit masks) on the same surfaces
+ */
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <string.h>
+#include <cmocka.h>
+
+#include "geom/subdiv.h"
+#include "geom/surface.h"
+
+static unsigned long long rng_state = 0x2545f4914f6cdd1dULL;
+static double urand(void)
+{
+    rng_state = rng_state * 6364136223846793005ULL + 1442695040888963407ULL;
+    return (double)(rng_state >> 11) / 9007199254740992.0;
+}
+
+static uint64_t bits_of(double x)
+{
+    uint64_t b;
+    memcpy(&b, &x, sizeof b);
+    return b;
+}
+
+/* ---- surfaces ---- */
+
+enum { G = 9 };
+static double grid_P[3 * G * G];
+static int grid_NV[(G - 1) * (G - 1)], grid_V[4 * (G - 1) * (G - 1)];
+
+/* a bumpy G x G grid of quads: its inner faces are regular */
+static geom_subdiv *grid(void)
+{
+    for (int j = 0; j < G; j++)
+        for (int i = 0; i < G; i++) {
+            double *p = grid_P + 3 * (j * G + i);
+            p[0] = i + 0.2 * urand(), p[1] = j + 0.2 * urand(), p[2] = 2 * urand() - 1;
+        }
+    for (int j = 0; j < G - 1; j++)
+        for (int i = 0; i < G - 1; i++) {
+            int f = j * (G - 1) + i, *q = grid_V + 4 * f;
+            grid_NV[f] = 4;
+            q[0] = j * G + i, q[1] = j * G + i + 1, q[2] = (j + 1) * G + i + 1;
+            q[3] = (j + 1) * G + i;
+        }
+    geom_subdiv_desc d = { (G - 1) * (G - 1), grid_NV, grid_V, G * G, grid_P, 0, NULL, NULL,
+                           NULL, 0, NULL, NULL, 0, NULL, false };
+    char why[200];
+    geom_subdiv *sd = geom_subdiv_new(&d, why, sizeof why);
+    if (!sd) fprintf(stderr, "grid: %s\n", why);
+    assert_non_null(sd);
+    return sd;
+}
+
+static const double CUBE_P[] = { -1, -1, -1,  1, -1, -1,  1, 1, -1,  -1, 1, -1,
+                                 -1, -1, 1,   1, -1, 1,   1, 1, 1,   -1, 1, 1 };
+static const int CUBE_NV[] = { 4, 4, 4, 4, 4, 4 };
+static const int CUBE_V[] = { 0, 3, 2, 1,  4, 5, 6, 7,  0, 1, 5, 4,
+                              1, 2, 6, 5,  2, 3, 7, 6,  3, 0, 4, 7 };
+
+static geom_subdiv *cube(bool creased)
+{
+    static const int clen[] = { 5, 2 }, cv[] = { 0, 1, 2, 3, 0,  4, 5 }, corner[] = { 6 };
+    static const double cs[] = { 10, 1.5 }, corner_s[] = { 10 };
+    geom_subdiv_desc d = { 6, CUBE_NV, CUBE_V, 8, CUBE_P, creased ? 2 : 0, clen, cv, cs,
+                           creased ? 1 : 0, corner, corner_s, 0, NULL, false };
+    char why[200];
+    geom_subdiv *sd = geom_subdiv_new(&d, why, sizeof why);
+    if (!sd) fprintf(stderr, "cube: %s\n", why);
+    assert_non_null(sd);
+    return sd;
+}
+
+/* n quads around point 0, a boundary outside (interpolateboundary) */
+enum { FAN = 5 };
+static double fan_P[3 * (2 * FAN + 1)];
+static int fan_V[4 * FAN], fan_NV[FAN];
+
+static geom_subdiv *fan(void)
+{
+    fan_P[0] = 0.1, fan_P[1] = -0.05, fan_P[2] = 0.3;
+    for (int i = 0; i < FAN; i++) {
+        double a = 2 * M_PI * i / FAN, b = 2 * M_PI * (i + 0.5) / FAN;
+        double *E = fan_P + 3 * (1 + 2 * i), *F = fan_P + 3 * (2 + 2 * i);
+        E[0] = cos(a), E[1] = sin(a), E[2] = 0.2 * sin(3 * a);
+        F[0] = 1.5 * cos(b), F[1] = 1.5 * sin(b), F[2] = -0.3 + 0.1 * i;
+        fan_V[4 * i] = 0, fan_V[4 * i + 1] = 1 + 2 * i, fan_V[4 * i + 2] = 2 + 2 * i;
+        fan_V[4 * i + 3] = 1 + 2 * ((i + 1) % FAN);
+        fan_NV[i] = 4;
+    }
+    geom_subdiv_desc d = { FAN, fan_NV, fan_V, 2 * FAN + 1, fan_P, 0, NULL, NULL, NULL,
+                           0, NULL, NULL, 0, NULL, true };
+    char why[200];
+    geom_subdiv *sd = geom_subdiv_new(&d, why, sizeof why);
+    assert_non_null(sd);
+    return sd;
+}
+
+static geom_surface bicubic(double scale)
+{
+    geom_surface s;
+    memset(&s, 0, sizeof s);
+    s.kind = GEOM_BICUBIC;
+    s.nverts = 16;
+    for (int j = 0; j < 4; j++)
+        for (int i = 0; i < 4; i++)
+            s.verts[4 * j + i] = v3(scale * (i + 0.4 * urand()), scale * (j + 0.4 * urand()),
+                                    scale * (2 * urand() - 1));
+    char why[200];
+    if (!geom_surface_prepare(&s, why, sizeof why)) fprintf(stderr, "bicubic: %s\n", why);
+    return s;
+}
+
+/* ---- range_P ---- */
+
+typedef struct count { long boxes, points, differ, outside; } count;
+
+static void box_same(const geom_surface *s, double u0, double u1, double v0, double v1,
+                     count *c)
+{
+    aa_context ctx;
+    aa_context_init(&ctx, 2);          /* as a mesh's world pass (trace/world.c) */
+    aa_form U, V;
+    aa_input(&ctx, &U, u0, u1);
+    aa_input(&ctx, &V, v0, v1);
+    geom_aa g;
+    geom_eval_aa(&ctx, s, &U, &V, &g);
+    ia_interval want[3], got[3];
+    for (int i = 0; i < 3; i++) want[i] = aa_range(&g.P[i]);
+    aa_context_reset(&ctx);
+    aa_input(&ctx, &U, u0, u1);
+    aa_input(&ctx, &V, v0, v1);
+    geom_eval_aa_range_P(&ctx, s, &U, &V, got);
+    c->boxes++;
+    for (int i = 0; i < 3; i++)
+        if (bits_of(got[i].lo) != bits_of(want[i].lo) ||
+            bits_of(got[i].hi) != bits_of(want[i].hi) || got[i].flags != want[i].flags) {
+            if (c->differ++ < 5)
+                printf("box [%.17g %.17g] x [%.17g %.17g] axis %d: [%a %a] want [%a %a]\n", u0,
+                       u1, v0, v1, i, got[i].lo, got[i].hi, want[i].lo, want[i].hi);
+        }
+    for (int k = 0; k < 9; k++) {
+        double u = k < 4 ? (k & 1 ? u1 : u0) : u0 + (u1 - u0) * urand();
+        double v = k < 4 ? (k & 2 ? v1 : v0) : v0 + (v1 - v0) * urand();
+        geom_sample p;
+        geom_eval(s, u, v, &p);
+        for (int i = 0; i < 3; i++) {
+            double x = v3_comp(p.P, i), slack = 1e-11 * (1 + fabs(x));
+            if (!(x >= got[i].lo - slack && x <= got[i].hi + slack)) c->outside++;
+        }
+        c->points++;
+    }
+}
+
+static void boxes_same(const geom_surface *s, int n, count *c)
+{
+    box_same(s, 0, 1, 0, 1, c);
+    for (int b = 0; b < n; b++) {
+        double u0, u1, v0, v1;
+        if (b % 3 != 2) {              /* dyadic, as the renderer's quadtree */
+            double side = ldexp(1, -(int)(urand() * 15));
+            u0 = floor(urand() / side) * side, v0 = floor(urand() / side) * side;
+            u1 = u0 + side, v1 = v0 + side;
+        } else {
+            double su = pow(10, -4 * urand()), sv = pow(10, -4 * urand());
+            u0 = (1 - su) * urand(), v0 = (1 - sv) * urand();
+            u1 = u0 + su, v1 = v0 + sv;
+        }
+        box_same(s, u0, u1, v0, v1, c);
+    }
+}
+
+static void mesh_same(const char *name, geom_subdiv *sd, int n)
+{
+    count c = { 0, 0, 0, 0 };
+    for (int f = 0; f < geom_subdiv_nfaces(sd); f++) {
+        if (!geom_subdiv_face_drawn(sd, f)) continue;
+        geom_surface s;
+        geom_subdiv_surface(sd, f, &s);
+        boxes_same(&s, n, &c);
+    }
+    printf("%-13s %6ld boxes, %ld differ; %6ld points, %ld outside\n", name, c.boxes, c.differ,
+           c.points, c.outside);
+    assert_true(c.boxes > 100);
+    assert_int_equal(c.differ, 0);
+    assert_int_equal(c.outside, 0);
+}
+
+static void test_range_P(void **state)
+{
+    (void)state;
+    geom_subdiv *sd = grid();
+    mesh_same("bumpy grid", sd, 30);
+    geom_subdiv_destroy(&sd);
+    sd = cube(false);
+    mesh_same("cube", sd, 60);
+    geom_subdiv_destroy(&sd);
+    sd = fan();
+    mesh_same("fan 5", sd, 60);
+    geom_subdiv_destroy(&sd);
+    sd = cube(true);
+    mesh_same("creased cube", sd, 60);
+    geom_subdiv_destroy(&sd);
+    count c = { 0, 0, 0, 0 };
+    for (int k = 0; k < 40; k++) {
+        geom_surface s = bicubic(k % 4 == 0 ? 1e6 : k % 4 == 1 ? 1e-5 : 1);
+        boxes_same(&s, 30, &c);
+    }
+    printf("%-13s %6ld boxes, %ld differ; %6ld points, %ld outside\n", "bicubic", c.boxes,
+           c.differ, c.points, c.outside);
+    assert_int_equal(c.differ, 0);
+    assert_int_equal(c.outside, 0);
+}
+
+/* ---- point ---- */
+
+static long point_differ(const geom_surface *s, int n, long *points)
+{
+    long differ = 0;
+    for (int k = 0; k < n; k++) {
+        double u, v;
+        if (k < 81) {                  /* the grid spacing's 9 x 9 (corners, edges) */
+            u = (k % 9) / 8.0, v = (k / 9) / 8.0;
+        } else {
+            u = urand(), v = urand();
+        }
+        geom_sample g;
+        geom_eval(s, u, v, &g);
+        vec3 p = geom_eval_point(s, u, v);
+        (*points)++;
+        for (int i = 0; i < 3; i++)
+            if (bits_of(v3_comp(p, i)) != bits_of(v3_comp(g.P, i)) && differ++ < 5)
+                printf("point (%.17g, %.17g) axis %d: %a, geom_eval %a\n", u, v, i,
+                       v3_comp(p, i), v3_comp(g.P, i));
+    }
+    return differ;
+}
+
+static void test_point(void **state)
+{
+    (void)state;
+    geom_subdiv *meshes[4] = { grid(), cube(false), fan(), cube(true) };
+    long points = 0, differ = 0;
+    for (int m = 0; m < 4; m++) {
+        for (int f = 0; f < geom_subdiv_nfaces(meshes[m]); f++) {
+            if (!geom_subdiv_face_drawn(meshes[m], f)) continue;
+            geom_surface s;
+            geom_subdiv_surface(meshes[m], f, &s);
+            differ += point_differ(&s, 120, &points);
+        }
+        geom_subdiv_destroy(&meshes[m]);
+    }
+    for (int k = 0; k < 20; k++) {
+        geom_surface s = bicubic(1);
+        differ += point_differ(&s, 120, &points);
+    }
+    printf("points %ld, %ld differ\n", points, differ);
+    assert_true(points > 10000);
+    assert_int_equal(differ, 0);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_range_P),
+        cmocka_unit_test(test_point),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
