@@ -371,8 +371,22 @@ static void net_rows(const vec3 net[16], double s0, double s1, vec3 H[4][4])
     for (int j = 0; j < 4; j++) bezier_piece(net + 4 * j, s0, s1, H[j]);
 }
 
-static void net_piece_of_rows(const vec3 net[16], const vec3 H[4][4], double s0, double s1,
-                              double t0, double t1, double k, bool derivs, net_boxes *nb)
+/* The largest coordinate of the net, as fmax would find it (a NaN is
+ * passed over) without the calls into libm */
+static double net_big(const vec3 net[16])
+{
+    double big = 0;
+    for (int i = 0; i < 16; i++) {
+        double x = fabs(net[i].x), y = fabs(net[i].y), z = fabs(net[i].z);
+        double m = y > z || z != z ? y : z;           /* fmax(y, z) */
+        m = x > m || m != m ? x : m;                  /* fmax(x, that) */
+        big = m > big ? m : big;                      /* fmax(big, that) */
+    }
+    return big;
+}
+
+static void net_piece_of_rows(double big, const vec3 H[4][4], double s0, double s1, double t0,
+                              double t1, double k, bool derivs, net_boxes *nb)
 {
     vec3 B[4][4];                          /* [j][i] */
     for (int i = 0; i < 4; i++) {
@@ -380,9 +394,6 @@ static void net_piece_of_rows(const vec3 net[16], const vec3 H[4][4], double s0,
         bezier_piece(col, t0, t1, out);
         for (int j = 0; j < 4; j++) B[j][i] = out[j];
     }
-    double big = 0;
-    for (int i = 0; i < 16; i++)
-        big = fmax(big, fmax(fabs(net[i].x), fmax(fabs(net[i].y), fabs(net[i].z))));
     double pad = 1e-12 * big;
     if (!derivs) {                         /* P alone (geom_subdiv_range_P_aa) */
         for (int c = 0; c < 3; c++) {
@@ -434,7 +445,7 @@ static void net_piece(const vec3 net[16], double s0, double s1, double t0, doubl
 {
     vec3 H[4][4];
     net_rows(net, s0, s1, H);
-    net_piece_of_rows(net, (const vec3(*)[4])H, s0, s1, t0, t1, k, derivs, nb);
+    net_piece_of_rows(net_big(net), (const vec3(*)[4])H, s0, s1, t0, t1, k, derivs, nb);
 }
 
 /* The whole box of net_bounds (its clamp to the unit square) */
@@ -464,6 +475,7 @@ static void net_bounds(const vec3 net[16], ia_interval su, ia_interval sv, doubl
     ia_interval n2 = ia_add(ia_add(ia_sqr(nb->Ng[0]), ia_sqr(nb->Ng[1])), ia_sqr(nb->Ng[2]));
     if (n2.lo > 0.8 * n2.hi) return;
     enum { NP = 3 };
+    double big = net_big(net);
     ia_interval Ng[3];
     double a0s[NP], a1s[NP];
     vec3 H[NP][4][4];                      /* each column's rows, once */
@@ -477,7 +489,7 @@ static void net_bounds(const vec3 net[16], ia_interval su, ia_interval sv, doubl
             double a0 = a0s[i], a1 = a1s[i];
             double b0 = t0 + (t1 - t0) * j / NP, b1 = j == NP - 1 ? t1 : t0 + (t1 - t0) * (j + 1) / NP;
             net_boxes piece;
-            net_piece_of_rows(net, (const vec3(*)[4])H[i], a0, a1, b0, b1, k, true, &piece);
+            net_piece_of_rows(big, (const vec3(*)[4])H[i], a0, a1, b0, b1, k, true, &piece);
             for (int c = 0; c < 3; c++)
                 Ng[c] = i == 0 && j == 0 ? piece.Ng[c] : ia_hull(Ng[c], piece.Ng[c]);
         }

@@ -145,7 +145,8 @@ static bool piece_net(const geom_surface *s, ia_interval u, ia_interval v,
     for (int i = 0; i < 16; i++)
         for (int c = 0; c < 3; c++) {
             p[3 * i + c] = v3_comp(s->verts[i], c);
-            big = fmax(big, fabs(p[3 * i + c]));
+            double a = fabs(p[3 * i + c]);
+            big = a > big ? a : big;   /* fmax's result (a NaN: big), without the call */
         }
     for (int c = 0; c < 3; c++)
         if (!geom_net_piece(p + c, 3, 4, 4, u.lo, u.hi, v.lo, v.hi, GEOM_NET_PAD * big,

@@ -16,6 +16,9 @@
  *   point    geom_eval_point against geom_eval's P, bit for bit, at random
  *            points, the square's corners and edges (irregular corners:
  *            the limit masks) on the same surfaces
+ *   cubic    geom_bezier_piece's cubic written out against its loops (the
+ *            blossoms' de Casteljau levels, spelled here as bezier_net.c
+ *            had them), bit for bit, on random cubics and pieces
  */
 #include <math.h>
 #include <setjmp.h>
@@ -28,6 +31,7 @@
 
 #include "geom/subdiv.h"
 #include "geom/surface.h"
+#include "geom/surface_internal.h"
 
 static unsigned long long rng_state = 0x2545f4914f6cdd1dULL;
 static double urand(void)
@@ -280,11 +284,53 @@ static void test_point(void **state)
     assert_int_equal(differ, 0);
 }
 
+/* ---- cubic ---- */
+
+/* the loops of geom_bezier_piece for any n: n - 1 levels, a at the first
+ * n - 1 - k, b at the last k; the levels at a shared */
+static void loops_piece(const double *p, int n, double a, double b, double *q)
+{
+    double r[8];
+    for (int i = 0; i < n; i++) r[i] = p[i];
+    for (int m = 0; m < n; m++) {
+        double t[8];
+        for (int i = 0; i < n - m; i++) t[i] = r[i];
+        for (int l = m; l < n - 1; l++)
+            for (int i = 0; i < n - 1 - l; i++) t[i] = t[i] + (t[i + 1] - t[i]) * b;
+        q[n - 1 - m] = t[0];
+        for (int i = 0; i < n - 1 - m; i++) r[i] = r[i] + (r[i + 1] - r[i]) * a;
+    }
+}
+
+static void test_cubic(void **state)
+{
+    (void)state;
+    long differ = 0, n = 0;
+    for (int k = 0; k < 200000; k++) {
+        double p[12], want[4], got[8];
+        double scale = ldexp(1, (int)(urand() * 80) - 40);
+        for (int i = 0; i < 4; i++) p[3 * i] = scale * (2 * urand() - 1);
+        double a = urand(), b = urand();
+        if (k % 4 == 0) a = 0, b = 1;
+        if (k % 4 == 1 && a > b) { double t = a; a = b; b = t; }
+        double row[4] = { p[0], p[3], p[6], p[9] };
+        loops_piece(row, 4, a, b, want);
+        geom_bezier_piece(p, 3, 4, a, b, got, 2);     /* strides as the nets' */
+        for (int i = 0; i < 4; i++, n++)
+            if (bits_of(got[2 * i]) != bits_of(want[i]) && differ++ < 5)
+                printf("cubic %a %a %a %a over [%a, %a]: q%d %a, loops %a\n", row[0], row[1],
+                       row[2], row[3], a, b, i, got[2 * i], want[i]);
+    }
+    printf("cubic pieces: %ld points, %ld differ\n", n, differ);
+    assert_int_equal(differ, 0);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_range_P),
         cmocka_unit_test(test_point),
+        cmocka_unit_test(test_cubic),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
