@@ -135,6 +135,34 @@ void geom_net_form(aa_context *ctx, aa_form *z, const ia_interval *w, int ld, in
                                                        (double)j / (nv - 1)));
         at_t[j] = ia_mul_s(tj, beta);
     }
+    /* every input finite and under 2^400 in magnitude (the usual case):
+     * then no end below overflows or is NaN, and no interval is empty, so
+     * the interval operations' checks for those cases are no-ops: the ends
+     * alone, by the same directed roundings (the same bits) */
+    const double big = 0x1p400;
+    bool tame = fabs(gamma) < big && fabs(scale.lo) < big && fabs(scale.hi) < big;
+    for (int i = 0; i < nu && tame; i++)
+        tame = fabs(at_s[i].lo) < big && fabs(at_s[i].hi) < big;
+    for (int j = 0; j < nv && tame; j++)
+        tame = fabs(at_t[j].lo) < big && fabs(at_t[j].hi) < big;
+    for (int j = 0; j < nv && tame; j++)
+        for (int i = 0; i < nu && tame; i++)
+            tame = W(j, i).lo <= W(j, i).hi && fabs(W(j, i).lo) < big && fabs(W(j, i).hi) < big;
+    if (tame) {
+        double hlo = 0, hhi = 0;
+        for (int j = 0; j < nv; j++)
+            for (int i = 0; i < nu; i++) {
+                ia_interval x = ia_mul(W(j, i), scale);
+                double plo = fp_add_dn(fp_add_dn(at_s[i].lo, at_t[j].lo), gamma);
+                double phi = fp_add_up(fp_add_up(at_s[i].hi, at_t[j].hi), gamma);
+                double dlo = fp_add_dn(x.lo, -phi), dhi = fp_add_up(x.hi, -plo);
+                rmax = max2(rmax, max2(-dlo, dhi));
+                bool first = i == 0 && j == 0;
+                hlo = first ? x.lo : ia_min2_(hlo, x.lo);   /* ia_hull's */
+                hhi = first ? x.hi : ia_max2_(hhi, x.hi);
+            }
+        hull = ia_make(hlo, hhi);
+    } else {
     for (int j = 0; j < nv; j++)
         for (int i = 0; i < nu; i++) {
             ia_interval x = ia_mul(W(j, i), scale);
@@ -145,6 +173,7 @@ void geom_net_form(aa_context *ctx, aa_form *z, const ia_interval *w, int ld, in
             rmax = max2(rmax, max2(-d.lo, d.hi));
             hull = i == 0 && j == 0 ? x : ia_hull(hull, x);
         }
+    }
 #undef W
     aa_lincomb(ctx, z, alpha, s, beta, t, gamma);
     if (!(rmax < INFINITY) || !isfinite(hull.lo) || !isfinite(hull.hi)) {

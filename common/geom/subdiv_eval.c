@@ -245,9 +245,10 @@ void sd_local_hull(const sd_mesh *m, vec3 *lo, vec3 *hi)
     double big = 0;
     for (int i = 0; i < m->nv; i++) {
         vec3 p = m->P[i];
-        lo->x = fmin(lo->x, p.x), lo->y = fmin(lo->y, p.y), lo->z = fmin(lo->z, p.z);
-        hi->x = fmax(hi->x, p.x), hi->y = fmax(hi->y, p.y), hi->z = fmax(hi->z, p.z);
-        big = fmax(big, fmax(fabs(p.x), fmax(fabs(p.y), fabs(p.z))));
+        /* (geom_min/max: fmin/fmax's bits without the calls) */
+        lo->x = geom_min(lo->x, p.x), lo->y = geom_min(lo->y, p.y), lo->z = geom_min(lo->z, p.z);
+        hi->x = geom_max(hi->x, p.x), hi->y = geom_max(hi->y, p.y), hi->z = geom_max(hi->z, p.z);
+        big = geom_max(big, geom_max(fabs(p.x), geom_max(fabs(p.y), fabs(p.z))));
     }
     double pad = 1e-12 * (big + v3_length(v3_sub(*hi, *lo)));
     *lo = v3_sub(*lo, v3(pad, pad, pad));
@@ -371,22 +372,30 @@ static void net_rows(const vec3 net[16], double s0, double s1, vec3 H[4][4])
     for (int j = 0; j < 4; j++) bezier_piece(net + 4 * j, s0, s1, H[j]);
 }
 
-/* The largest coordinate of the net, as fmax would find it (a NaN is
- * passed over) without the calls into libm */
+/* The largest coordinate of the net (geom_max: fmax's bits without the
+ * calls into libm) */
 static double net_big(const vec3 net[16])
 {
     double big = 0;
-    for (int i = 0; i < 16; i++) {
-        double x = fabs(net[i].x), y = fabs(net[i].y), z = fabs(net[i].z);
-        double m = y > z || z != z ? y : z;           /* fmax(y, z) */
-        m = x > m || m != m ? x : m;                  /* fmax(x, that) */
-        big = m > big ? m : big;                      /* fmax(big, that) */
-    }
+    for (int i = 0; i < 16; i++)
+        big = geom_max(big, geom_max(fabs(net[i].x), geom_max(fabs(net[i].y), fabs(net[i].z))));
     return big;
 }
 
+/* d/du = k d/ds = k / (s1 - s0) d/dw over a piece [s0, s1] */
+static ia_interval slope_scale(double k, double s0, double s1)
+{
+    return s1 > s0 ? ia_div(ia_point(k), ia_sub(ia_point(s1), ia_point(s0))) : ia_entire();
+}
+
+/* What net_piece_of_rows fills: P, or dPdu, dPdv and Ng, or all */
+enum { NB_P = 1, NB_D = 2, NB_ALL = 3 };
+
+/* ks, kt: slope_scale of the piece's [s0, s1] and [t0, t1] (by the caller:
+ * pieces of one column or row share them) */
 static void net_piece_of_rows(double big, const vec3 H[4][4], double s0, double s1, double t0,
-                              double t1, double k, bool derivs, net_boxes *nb)
+                              double t1, ia_interval ks, ia_interval kt, int what,
+                              net_boxes *nb)
 {
     vec3 B[4][4];                          /* [j][i] */
     for (int i = 0; i < 4; i++) {
@@ -395,7 +404,7 @@ static void net_piece_of_rows(double big, const vec3 H[4][4], double s0, double 
         for (int j = 0; j < 4; j++) B[j][i] = out[j];
     }
     double pad = 1e-12 * big;
-    if (!derivs) {                         /* P alone (geom_subdiv_range_P_aa) */
+    if (what == NB_P) {                    /* P alone (geom_subdiv_range_P_aa) */
         for (int c = 0; c < 3; c++) {
             double lo = INFINITY, hi = -INFINITY;
             for (int j = 0; j < 4; j++)
@@ -407,11 +416,6 @@ static void net_piece_of_rows(double big, const vec3 H[4][4], double s0, double 
         }
         return;
     }
-    /* d/du = k d/ds = k / (s1 - s0) d/dw (once for the 3 coordinates) */
-    ia_interval ks = s1 > s0 ? ia_div(ia_point(k), ia_sub(ia_point(s1), ia_point(s0)))
-                             : ia_entire();
-    ia_interval kt = t1 > t0 ? ia_div(ia_point(k), ia_sub(ia_point(t1), ia_point(t0)))
-                             : ia_entire();
     for (int c = 0; c < 3; c++) {
         double lo = INFINITY, hi = -INFINITY, ulo = INFINITY, uhi = -INFINITY;
         double vlo = INFINITY, vhi = -INFINITY;
@@ -430,7 +434,7 @@ static void net_piece_of_rows(double big, const vec3 H[4][4], double s0, double 
                     vlo = d < vlo ? d : vlo, vhi = d > vhi ? d : vhi;
                 }
             }
-        nb->P[c] = pad_iv(lo, hi, pad);
+        if (what & NB_P) nb->P[c] = pad_iv(lo, hi, pad);
         nb->dPdu[c] = s1 > s0 ? ia_mul(pad_iv(ulo, uhi, 8 * pad), ks) : ia_entire();
         nb->dPdv[c] = t1 > t0 ? ia_mul(pad_iv(vlo, vhi, 8 * pad), kt) : ia_entire();
     }
@@ -441,19 +445,22 @@ static void net_piece_of_rows(double big, const vec3 H[4][4], double s0, double 
 }
 
 static void net_piece(const vec3 net[16], double s0, double s1, double t0, double t1,
-                      double k, bool derivs, net_boxes *nb)
+                      double k, int what, net_boxes *nb)
 {
     vec3 H[4][4];
     net_rows(net, s0, s1, H);
-    net_piece_of_rows(net_big(net), (const vec3(*)[4])H, s0, s1, t0, t1, k, derivs, nb);
+    ia_interval ks = ia_entire(), kt = ia_entire();
+    if (what & NB_D) ks = slope_scale(k, s0, s1), kt = slope_scale(k, t0, t1);
+    net_piece_of_rows(net_big(net), (const vec3(*)[4])H, s0, s1, t0, t1, ks, kt, what, nb);
 }
 
 /* The whole box of net_bounds (its clamp to the unit square) */
 static void clamp_box(ia_interval su, ia_interval sv, double b[4])
 {
-    double s0 = fmax(su.lo, 0), s1 = fmin(su.hi, 1), t0 = fmax(sv.lo, 0), t1 = fmin(sv.hi, 1);
-    if (!(s0 <= s1)) s0 = s1 = fmin(fmax(su.lo, 0), 1);
-    if (!(t0 <= t1)) t0 = t1 = fmin(fmax(sv.lo, 0), 1);
+    double s0 = geom_max(su.lo, 0), s1 = geom_min(su.hi, 1);
+    double t0 = geom_max(sv.lo, 0), t1 = geom_min(sv.hi, 1);
+    if (!(s0 <= s1)) s0 = s1 = geom_min(geom_max(su.lo, 0), 1);
+    if (!(t0 <= t1)) t0 = t1 = geom_min(geom_max(sv.lo, 0), 1);
     b[0] = s0, b[1] = s1, b[2] = t0, b[3] = t1;
 }
 
@@ -467,7 +474,7 @@ static void net_bounds(const vec3 net[16], ia_interval su, ia_interval sv, doubl
     double b[4];
     clamp_box(su, sv, b);
     double s0 = b[0], s1 = b[1], t0 = b[2], t1 = b[3];
-    net_piece(net, s0, s1, t0, t1, k, true, nb);
+    net_piece(net, s0, s1, t0, t1, k, NB_ALL, nb);
     if (!(s1 > s0 && t1 > t0)) return;
     /* not where the whole box's Ng already keeps well away from 0 (|Ng|^2
      * within a factor 1.25): there the pieces narrow it little (on
@@ -477,19 +484,23 @@ static void net_bounds(const vec3 net[16], ia_interval su, ia_interval sv, doubl
     enum { NP = 3 };
     double big = net_big(net);
     ia_interval Ng[3];
-    double a0s[NP], a1s[NP];
+    double a0s[NP], a1s[NP], b0s[NP], b1s[NP];
+    ia_interval ks[NP], kt[NP];            /* each column's and row's, once */
     vec3 H[NP][4][4];                      /* each column's rows, once */
     for (int i = 0; i < NP; i++) {
         a0s[i] = s0 + (s1 - s0) * i / NP;
         a1s[i] = i == NP - 1 ? s1 : s0 + (s1 - s0) * (i + 1) / NP;
+        b0s[i] = t0 + (t1 - t0) * i / NP;
+        b1s[i] = i == NP - 1 ? t1 : t0 + (t1 - t0) * (i + 1) / NP;
+        ks[i] = slope_scale(k, a0s[i], a1s[i]);
+        kt[i] = slope_scale(k, b0s[i], b1s[i]);
         net_rows(net, a0s[i], a1s[i], H[i]);
     }
     for (int j = 0; j < NP; j++)
         for (int i = 0; i < NP; i++) {
-            double a0 = a0s[i], a1 = a1s[i];
-            double b0 = t0 + (t1 - t0) * j / NP, b1 = j == NP - 1 ? t1 : t0 + (t1 - t0) * (j + 1) / NP;
-            net_boxes piece;
-            net_piece_of_rows(big, (const vec3(*)[4])H[i], a0, a1, b0, b1, k, true, &piece);
+            net_boxes piece;               /* (its Ng alone is wanted) */
+            net_piece_of_rows(big, (const vec3(*)[4])H[i], a0s[i], a1s[i], b0s[j], b1s[j], ks[i],
+                              kt[j], NB_D, &piece);
             for (int c = 0; c < 3; c++)
                 Ng[c] = i == 0 && j == 0 ? piece.Ng[c] : ia_hull(Ng[c], piece.Ng[c]);
         }
@@ -686,7 +697,7 @@ void geom_subdiv_range_P_aa(aa_context *ctx, const geom_surface *s, const aa_for
             double box[4];
             clamp_box(aa_range(&su), aa_range(&sv), box);
             net_boxes nb;
-            net_piece(r.net, box[0], box[1], box[2], box[3], k, false, &nb);
+            net_piece(r.net, box[0], box[1], box[2], box[3], k, NB_P, &nb);
             for (int i = 0; i < 3; i++)
                 if (isfinite(nb.P[i].lo) && isfinite(nb.P[i].hi) &&
                     !(nb.P[i].flags & AA_UNBOUNDED)) {

@@ -452,29 +452,34 @@ void sd_ring_make(const geom_subdiv *sd, int F, sd_ring *R)
     ring_build(sd, F, R, NULL, 0);
 }
 
-/* The last ring a thread made, in a buffer of its own (no heap, so
+/* The last rings a thread made, in buffers of its own (no heap, so
  * nothing is left when the thread ends): the children of a control face
- * come one after the other (the world's pass over the pieces, a ray's
- * neighbouring faces), and share it. Keyed by the mesh's serial number,
- * never reused. */
-enum { RING_CACHE_BYTES = 32768 };
-static _Thread_local struct {
+ * come one after the other in the world's pass over the pieces, and close
+ * together in the mesh's BVH order (its regions' pass, a ray's
+ * neighbouring faces), and share them: 4 ways, replaced in turn. Keyed by the mesh's serial number, never reused; a ring is a pure
+ * function of the mesh and the face, so the cache changes no bit. */
+enum { RING_CACHE_BYTES = 32768, RING_CACHE_WAYS = 4 };
+static _Thread_local struct ring_way {
     unsigned long serial;
     int F;
     sd_ring R;
     _Alignas(16) char buf[RING_CACHE_BYTES];
-} ring_cache;
+} ring_cache[RING_CACHE_WAYS];
+static _Thread_local int ring_next;    /* the way to replace next */
 
 /* F's ring: the thread's cached one, or made into *heap (then freed by
  * the caller with sd_ring_clear) */
 static const sd_ring *ring_of_face(const geom_subdiv *sd, int F, sd_ring *heap)
 {
-    if (ring_cache.serial == sd->serial && ring_cache.F == F) return &ring_cache.R;
-    ring_cache.serial = 0;
-    if (ring_build(sd, F, &ring_cache.R, ring_cache.buf, sizeof ring_cache.buf)) {
-        ring_cache.serial = sd->serial;
-        ring_cache.F = F;
-        return &ring_cache.R;
+    for (int w = 0; w < RING_CACHE_WAYS; w++)
+        if (ring_cache[w].serial == sd->serial && ring_cache[w].F == F) return &ring_cache[w].R;
+    struct ring_way *way = &ring_cache[ring_next];
+    way->serial = 0;
+    if (ring_build(sd, F, &way->R, way->buf, sizeof way->buf)) {
+        ring_next = (ring_next + 1) % RING_CACHE_WAYS;
+        way->serial = sd->serial;
+        way->F = F;
+        return &way->R;
     }
     ring_build(sd, F, heap, NULL, 0);
     return heap;

@@ -48,10 +48,16 @@
 
 /* ---- float ---------------------------------------------------------- */
 
-static void bernstein(double u, double b[4], double d1[4], double d2[4])
+static void bernstein_b(double u, double b[4])
 {
     double s = 1 - u;
     b[0] = s * s * s, b[1] = 3 * s * s * u, b[2] = 3 * s * u * u, b[3] = u * u * u;
+}
+
+static void bernstein(double u, double b[4], double d1[4], double d2[4])
+{
+    double s = 1 - u;
+    bernstein_b(u, b);
     d1[0] = -3 * s * s, d1[1] = 3 * (s * s - 2 * s * u), d1[2] = 3 * (2 * s * u - u * u);
     d1[3] = 3 * u * u;
     d2[0] = 6 * s, d2[1] = -12 * s + 6 * u, d2[2] = 6 * s - 12 * u, d2[3] = 6 * u;
@@ -71,9 +77,9 @@ vec3 geom_bicubic_eval_point(const geom_surface *s, double u, double v)
     /* P as geom_bicubic_eval_dual makes it (the same bernstein weights, the
      * same sum in the same order: the same bits), without the 5 tensor
      * sums of the derivatives (the grid spacing's 81 points a piece) */
-    double bu[4], du[4], ddu[4], bv[4], dv[4], ddv[4];
-    bernstein(u, bu, du, ddu);
-    bernstein(v, bv, dv, ddv);
+    double bu[4], bv[4];
+    bernstein_b(u, bu);
+    bernstein_b(v, bv);
     return tensor(s->verts, bu, bv);
 }
 
@@ -145,8 +151,7 @@ static bool piece_net(const geom_surface *s, ia_interval u, ia_interval v,
     for (int i = 0; i < 16; i++)
         for (int c = 0; c < 3; c++) {
             p[3 * i + c] = v3_comp(s->verts[i], c);
-            double a = fabs(p[3 * i + c]);
-            big = a > big ? a : big;   /* fmax's result (a NaN: big), without the call */
+            big = geom_max(big, fabs(p[3 * i + c]));   /* fmax's bits, no call */
         }
     for (int c = 0; c < 3; c++)
         if (!geom_net_piece(p + c, 3, 4, 4, u.lo, u.hi, v.lo, v.hi, GEOM_NET_PAD * big,
