@@ -13,6 +13,11 @@
  *            whole square, dyadic boxes down to 2^-14 (below 2^-12 the
  *            tensor form's path) and arbitrary boxes; and float samples lie
  *            inside (1e-11 of slack)
+ *   in_bounds  a subdivision face's P over its whole square (the range
+ *            above) lies inside its geom_bounds (the 1-ring's hull), so
+ *            their hull, a mesh piece's base box (trace_region_base), is
+ *            geom_bounds bit for bit, on the same meshes and on rings
+ *            moved far from the origin (1e6) and shrunk (1e-6)
  *   point    geom_eval_point against geom_eval's P, bit for bit, at random
  *            points, the square's corners and edges (irregular corners:
  *            the limit masks) on the same surfaces
@@ -237,6 +242,76 @@ static void test_range_P(void **state)
     assert_int_equal(c.outside, 0);
 }
 
+/* ---- in_bounds ---- */
+
+static geom_subdiv *moved(const geom_subdiv_desc *d0, double *P, int np, double scale,
+                          double shift)
+{
+    for (int i = 0; i < 3 * np; i++) P[i] = P[i] * scale + shift;
+    geom_subdiv_desc d = *d0;
+    d.P = P;
+    char why[200];
+    geom_subdiv *sd = geom_subdiv_new(&d, why, sizeof why);
+    if (!sd) fprintf(stderr, "moved: %s\n", why);
+    assert_non_null(sd);
+    return sd;
+}
+
+static long outside_bounds(geom_subdiv *sd, long *faces)
+{
+    long out = 0;
+    for (int f = 0; f < geom_subdiv_nfaces(sd); f++) {
+        if (!geom_subdiv_face_drawn(sd, f)) continue;
+        geom_surface s;
+        geom_subdiv_surface(sd, f, &s);
+        aa_context ctx;
+        aa_context_init(&ctx, 2);
+        aa_form U, V;
+        aa_input(&ctx, &U, 0, 1);
+        aa_input(&ctx, &V, 0, 1);
+        ia_interval P[3];
+        geom_eval_aa_range_P(&ctx, &s, &U, &V, P);
+        vec3 lo, hi;
+        geom_bounds(&s, &lo, &hi);
+        (*faces)++;
+        for (int i = 0; i < 3; i++)
+            if (!(P[i].lo >= v3_comp(lo, i) && P[i].hi <= v3_comp(hi, i)) && out++ < 5)
+                printf("face %d axis %d: P [%a %a], bounds [%a %a]\n", f, i, P[i].lo, P[i].hi,
+                       v3_comp(lo, i), v3_comp(hi, i));
+    }
+    return out;
+}
+
+static void test_in_bounds(void **state)
+{
+    (void)state;
+    long faces = 0, out = 0;
+    geom_subdiv *sd = grid();
+    out += outside_bounds(sd, &faces);
+    geom_subdiv_destroy(&sd);
+    static double P[3 * G * G];
+    geom_subdiv_desc d = { (G - 1) * (G - 1), grid_NV, grid_V, G * G, NULL, 0, NULL, NULL,
+                           NULL, 0, NULL, NULL, 0, NULL, false };
+    for (int k = 0; k < 12; k++) {
+        if (k % 4 == 0) {              /* a fresh grid */
+            sd = grid();
+            geom_subdiv_destroy(&sd);
+        }
+        memcpy(P, grid_P, sizeof P);
+        sd = moved(&d, P, G * G, k & 1 ? 1e-6 : 1, k & 2 ? 1e6 : 0.3);
+        out += outside_bounds(sd, &faces);
+        geom_subdiv_destroy(&sd);
+    }
+    geom_subdiv *meshes[3] = { cube(false), fan(), cube(true) };
+    for (int m = 0; m < 3; m++) {
+        out += outside_bounds(meshes[m], &faces);
+        geom_subdiv_destroy(&meshes[m]);
+    }
+    printf("whole faces: %ld, %ld with P outside their bounds\n", faces, out);
+    assert_true(faces > 1500);
+    assert_int_equal(out, 0);
+}
+
 /* ---- point ---- */
 
 static long point_differ(const geom_surface *s, int n, long *points)
@@ -329,6 +404,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_range_P),
+        cmocka_unit_test(test_in_bounds),
         cmocka_unit_test(test_point),
         cmocka_unit_test(test_cubic),
     };
