@@ -617,6 +617,17 @@ bool geom_subdiv_normal_slopes_ia(const geom_surface *s, ia_interval u, ia_inter
     return true;
 }
 
+/* The regular sub-patch r as a bicubic patch b of its own, over the
+ * inputs in its coordinates su = k (u - ou), sv = k (v - ov), k = 2^level */
+static void sub_patch(aa_context *ctx, const sd_range *r, const aa_form *u, const aa_form *v,
+                      double *k, aa_form *su, aa_form *sv, geom_surface *b)
+{
+    *k = ldexp(1, r->level);
+    aa_lincomb(ctx, su, *k, u, 0, u, -r->ou * *k);
+    aa_lincomb(ctx, sv, *k, v, 0, v, -r->ov * *k);
+    net_surface(r->net, b);
+}
+
 void geom_subdiv_eval_aa(aa_context *ctx, const geom_surface *s, const aa_form *u,
                          const aa_form *v, geom_aa *out)
 {
@@ -655,12 +666,10 @@ void geom_subdiv_eval_aa(aa_context *ctx, const geom_surface *s, const aa_form *
         }
         return;
     }
-    double k = ldexp(1, r.level);
+    double k;
     aa_form su, sv;
-    aa_lincomb(ctx, &su, k, u, 0, u, -r.ou * k);
-    aa_lincomb(ctx, &sv, k, v, 0, v, -r.ov * k);
     geom_surface b;
-    net_surface(r.net, &b);
+    sub_patch(ctx, &r, u, v, &k, &su, &sv, &b);
     if (!geom_bicubic_net_aa(ctx, &b, &su, &sv, out))
         geom_bicubic_eval_aa(ctx, &b, &su, &sv, out);
     net_boxes nb;
@@ -687,12 +696,10 @@ void geom_subdiv_range_P_aa(aa_context *ctx, const geom_surface *s, const aa_for
     sd_range r;
     find_range(s, ur.lo, ur.hi, vr.lo, vr.hi, &r);
     if (r.regular) {
-        double k = ldexp(1, r.level);
+        double k;
         aa_form su, sv;
-        aa_lincomb(ctx, &su, k, u, 0, u, -r.ou * k);
-        aa_lincomb(ctx, &sv, k, v, 0, v, -r.ov * k);
         geom_surface b;
-        net_surface(r.net, &b);
+        sub_patch(ctx, &r, u, v, &k, &su, &sv, &b);
         if (geom_bicubic_net_range_P(&b, &su, &sv, P)) {
             double box[4];
             clamp_box(aa_range(&su), aa_range(&sv), box);

@@ -37,6 +37,7 @@
 #include "geom/subdiv.h"
 #include "geom/surface.h"
 #include "geom/surface_internal.h"
+#include "geom_fixtures.h"
 
 static unsigned long long rng_state = 0x2545f4914f6cdd1dULL;
 static double urand(void)
@@ -82,46 +83,20 @@ static geom_subdiv *grid(void)
     return sd;
 }
 
-static const double CUBE_P[] = { -1, -1, -1,  1, -1, -1,  1, 1, -1,  -1, 1, -1,
-                                 -1, -1, 1,   1, -1, 1,   1, 1, 1,   -1, 1, 1 };
-static const int CUBE_NV[] = { 4, 4, 4, 4, 4, 4 };
-static const int CUBE_V[] = { 0, 3, 2, 1,  4, 5, 6, 7,  0, 1, 5, 4,
-                              1, 2, 6, 5,  2, 3, 7, 6,  3, 0, 4, 7 };
-
 static geom_subdiv *cube(bool creased)
 {
     static const int clen[] = { 5, 2 }, cv[] = { 0, 1, 2, 3, 0,  4, 5 }, corner[] = { 6 };
     static const double cs[] = { 10, 1.5 }, corner_s[] = { 10 };
-    geom_subdiv_desc d = { 6, CUBE_NV, CUBE_V, 8, CUBE_P, creased ? 2 : 0, clen, cv, cs,
-                           creased ? 1 : 0, corner, corner_s, 0, NULL, false };
-    char why[200];
-    geom_subdiv *sd = geom_subdiv_new(&d, why, sizeof why);
-    if (!sd) fprintf(stderr, "cube: %s\n", why);
+    geom_subdiv *sd = creased ? fx_subdiv_cube(2, clen, cv, cs, 1, corner, corner_s)
+                              : fx_subdiv_cube(0, NULL, NULL, NULL, 0, NULL, NULL);
     assert_non_null(sd);
     return sd;
 }
 
-/* n quads around point 0, a boundary outside (interpolateboundary) */
-enum { FAN = 5 };
-static double fan_P[3 * (2 * FAN + 1)];
-static int fan_V[4 * FAN], fan_NV[FAN];
-
+/* 5 quads around a point of valence 5, a boundary outside */
 static geom_subdiv *fan(void)
 {
-    fan_P[0] = 0.1, fan_P[1] = -0.05, fan_P[2] = 0.3;
-    for (int i = 0; i < FAN; i++) {
-        double a = 2 * M_PI * i / FAN, b = 2 * M_PI * (i + 0.5) / FAN;
-        double *E = fan_P + 3 * (1 + 2 * i), *F = fan_P + 3 * (2 + 2 * i);
-        E[0] = cos(a), E[1] = sin(a), E[2] = 0.2 * sin(3 * a);
-        F[0] = 1.5 * cos(b), F[1] = 1.5 * sin(b), F[2] = -0.3 + 0.1 * i;
-        fan_V[4 * i] = 0, fan_V[4 * i + 1] = 1 + 2 * i, fan_V[4 * i + 2] = 2 + 2 * i;
-        fan_V[4 * i + 3] = 1 + 2 * ((i + 1) % FAN);
-        fan_NV[i] = 4;
-    }
-    geom_subdiv_desc d = { FAN, fan_NV, fan_V, 2 * FAN + 1, fan_P, 0, NULL, NULL, NULL,
-                           0, NULL, NULL, 0, NULL, true };
-    char why[200];
-    geom_subdiv *sd = geom_subdiv_new(&d, why, sizeof why);
+    geom_subdiv *sd = fx_subdiv_fan(5, NULL);
     assert_non_null(sd);
     return sd;
 }
