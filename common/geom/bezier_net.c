@@ -142,9 +142,9 @@ void geom_net_form(aa_context *ctx, aa_form *z, const ia_interval *w, int ld, in
     const double big = 0x1p400;
     bool tame = fabs(gamma) < big && fabs(scale.lo) < big && fabs(scale.hi) < big;
     for (int i = 0; i < nu && tame; i++)
-        tame = fabs(at_s[i].lo) < big && fabs(at_s[i].hi) < big;
+        tame = at_s[i].lo <= at_s[i].hi && fabs(at_s[i].lo) < big && fabs(at_s[i].hi) < big;
     for (int j = 0; j < nv && tame; j++)
-        tame = fabs(at_t[j].lo) < big && fabs(at_t[j].hi) < big;
+        tame = at_t[j].lo <= at_t[j].hi && fabs(at_t[j].lo) < big && fabs(at_t[j].hi) < big;
     for (int j = 0; j < nv && tame; j++)
         for (int i = 0; i < nu && tame; i++)
             tame = W(j, i).lo <= W(j, i).hi && fabs(W(j, i).lo) < big && fabs(W(j, i).hi) < big;
