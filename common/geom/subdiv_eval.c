@@ -145,15 +145,17 @@ static void net_surface(const vec3 net[16], geom_surface *b)
 
 /* ---- float and dual ---- */
 
-/* 0: out filled; 1: (u,v) is an irregular corner: out->P is its limit */
-static int eval_point(const geom_surface *fs, double u, double v, geom_sample *out)
+/* 0: out filled; 1: (u,v) is an irregular corner: out->P is its limit.
+ * point: out->P alone (the same bits; the grid spacing's points) */
+static int eval_point(const geom_surface *fs, double u, double v, geom_sample *out, bool point)
 {
     const geom_subdiv *sd = fs->subdiv;
     int f = fs->subdiv_face;
     geom_surface b;                    /* fields other than verts unused */
     if (fs->nverts == 16) {            /* a regular face: its net (geom_subdiv_surface) */
         net_surface(fs->verts, &b);
-        geom_bicubic_eval_dual(&b, u, v, out);
+        if (point) out->P = geom_bicubic_eval_point(&b, u, v);
+        else geom_bicubic_eval_dual(&b, u, v, out);
         return 0;
     }
     const sd_node *n = sd_node_root(sd, f);
@@ -163,6 +165,10 @@ static int eval_point(const geom_surface *fs, double u, double v, geom_sample *o
         const vec3 *net;
         if (sd_node_regular(n, &net)) {
             net_surface(net, &b);
+            if (point) {
+                out->P = geom_bicubic_eval_point(&b, s, t);
+                return 0;
+            }
             geom_bicubic_eval_dual(&b, s, t, out);
             double k = ldexp(1, d), k2 = k * k;
             out->dPdu = v3_scale(out->dPdu, k);
@@ -204,12 +210,19 @@ static int eval_point(const geom_surface *fs, double u, double v, geom_sample *o
 
 void geom_subdiv_eval_dual(const geom_surface *s, double u, double v, geom_sample *out)
 {
-    if (eval_point(s, u, v, out) == 1) {
+    if (eval_point(s, u, v, out, false) == 1) {
         vec3 P = out->P;
         double e = ldexp(1, -30);
-        eval_point(s, u < 0.5 ? u + e : u - e, v < 0.5 ? v + e : v - e, out);
+        eval_point(s, u < 0.5 ? u + e : u - e, v < 0.5 ? v + e : v - e, out, false);
         out->P = P;
     }
+}
+
+vec3 geom_subdiv_eval_point(const geom_surface *s, double u, double v)
+{
+    geom_sample g;
+    eval_point(s, u, v, &g, true);
+    return g.P;
 }
 
 /* ---- interval and affine ---- */
@@ -232,9 +245,10 @@ void sd_local_hull(const sd_mesh *m, vec3 *lo, vec3 *hi)
     double big = 0;
     for (int i = 0; i < m->nv; i++) {
         vec3 p = m->P[i];
-        lo->x = fmin(lo->x, p.x), lo->y = fmin(lo->y, p.y), lo->z = fmin(lo->z, p.z);
-        hi->x = fmax(hi->x, p.x), hi->y = fmax(hi->y, p.y), hi->z = fmax(hi->z, p.z);
-        big = fmax(big, fmax(fabs(p.x), fmax(fabs(p.y), fabs(p.z))));
+        /* (geom_min/max: fmin/fmax's bits without the calls) */
+        lo->x = geom_min(lo->x, p.x), lo->y = geom_min(lo->y, p.y), lo->z = geom_min(lo->z, p.z);
+        hi->x = geom_max(hi->x, p.x), hi->y = geom_max(hi->y, p.y), hi->z = geom_max(hi->z, p.z);
+        big = geom_max(big, geom_max(fabs(p.x), geom_max(fabs(p.y), fabs(p.z))));
     }
     double pad = 1e-12 * (big + v3_length(v3_sub(*hi, *lo)));
     *lo = v3_sub(*lo, v3(pad, pad, pad));
@@ -358,8 +372,30 @@ static void net_rows(const vec3 net[16], double s0, double s1, vec3 H[4][4])
     for (int j = 0; j < 4; j++) bezier_piece(net + 4 * j, s0, s1, H[j]);
 }
 
-static void net_piece_of_rows(const vec3 net[16], const vec3 H[4][4], double s0, double s1,
-                              double t0, double t1, double k, net_boxes *nb)
+/* The largest coordinate of the net (geom_max: fmax's bits without the
+ * calls into libm) */
+static double net_big(const vec3 net[16])
+{
+    double big = 0;
+    for (int i = 0; i < 16; i++)
+        big = geom_max(big, geom_max(fabs(net[i].x), geom_max(fabs(net[i].y), fabs(net[i].z))));
+    return big;
+}
+
+/* d/du = k d/ds = k / (s1 - s0) d/dw over a piece [s0, s1] */
+static ia_interval slope_scale(double k, double s0, double s1)
+{
+    return s1 > s0 ? ia_div(ia_point(k), ia_sub(ia_point(s1), ia_point(s0))) : ia_entire();
+}
+
+/* What net_piece_of_rows fills: P, or dPdu, dPdv and Ng, or all */
+enum { NB_P = 1, NB_D = 2, NB_ALL = 3 };
+
+/* ks, kt: slope_scale of the piece's [s0, s1] and [t0, t1] (by the caller:
+ * pieces of one column or row share them) */
+static void net_piece_of_rows(double big, const vec3 H[4][4], double s0, double s1, double t0,
+                              double t1, ia_interval ks, ia_interval kt, int what,
+                              net_boxes *nb)
 {
     vec3 B[4][4];                          /* [j][i] */
     for (int i = 0; i < 4; i++) {
@@ -367,10 +403,19 @@ static void net_piece_of_rows(const vec3 net[16], const vec3 H[4][4], double s0,
         bezier_piece(col, t0, t1, out);
         for (int j = 0; j < 4; j++) B[j][i] = out[j];
     }
-    double big = 0;
-    for (int i = 0; i < 16; i++)
-        big = fmax(big, fmax(fabs(net[i].x), fmax(fabs(net[i].y), fabs(net[i].z))));
     double pad = 1e-12 * big;
+    if (what == NB_P) {                    /* P alone (geom_subdiv_range_P_aa) */
+        for (int c = 0; c < 3; c++) {
+            double lo = INFINITY, hi = -INFINITY;
+            for (int j = 0; j < 4; j++)
+                for (int i = 0; i < 4; i++) {
+                    double x = v3_comp(B[j][i], c);
+                    lo = x < lo ? x : lo, hi = x > hi ? x : hi;
+                }
+            nb->P[c] = pad_iv(lo, hi, pad);
+        }
+        return;
+    }
     for (int c = 0; c < 3; c++) {
         double lo = INFINITY, hi = -INFINITY, ulo = INFINITY, uhi = -INFINITY;
         double vlo = INFINITY, vhi = -INFINITY;
@@ -389,20 +434,9 @@ static void net_piece_of_rows(const vec3 net[16], const vec3 H[4][4], double s0,
                     vlo = d < vlo ? d : vlo, vhi = d > vhi ? d : vhi;
                 }
             }
-        nb->P[c] = pad_iv(lo, hi, pad);
-        /* d/du = k d/ds = k / (s1 - s0) d/dw */
-        if (s1 > s0) {
-            ia_interval ks = ia_div(ia_point(k), ia_sub(ia_point(s1), ia_point(s0)));
-            nb->dPdu[c] = ia_mul(pad_iv(ulo, uhi, 8 * pad), ks);
-        } else {
-            nb->dPdu[c] = ia_entire();
-        }
-        if (t1 > t0) {
-            ia_interval kt = ia_div(ia_point(k), ia_sub(ia_point(t1), ia_point(t0)));
-            nb->dPdv[c] = ia_mul(pad_iv(vlo, vhi, 8 * pad), kt);
-        } else {
-            nb->dPdv[c] = ia_entire();
-        }
+        if (what & NB_P) nb->P[c] = pad_iv(lo, hi, pad);
+        nb->dPdu[c] = s1 > s0 ? ia_mul(pad_iv(ulo, uhi, 8 * pad), ks) : ia_entire();
+        nb->dPdv[c] = t1 > t0 ? ia_mul(pad_iv(vlo, vhi, 8 * pad), kt) : ia_entire();
     }
     for (int c = 0; c < 3; c++) {
         int a = (c + 1) % 3, b = (c + 2) % 3;
@@ -411,11 +445,23 @@ static void net_piece_of_rows(const vec3 net[16], const vec3 H[4][4], double s0,
 }
 
 static void net_piece(const vec3 net[16], double s0, double s1, double t0, double t1,
-                      double k, net_boxes *nb)
+                      double k, int what, net_boxes *nb)
 {
     vec3 H[4][4];
     net_rows(net, s0, s1, H);
-    net_piece_of_rows(net, (const vec3(*)[4])H, s0, s1, t0, t1, k, nb);
+    ia_interval ks = ia_entire(), kt = ia_entire();
+    if (what & NB_D) ks = slope_scale(k, s0, s1), kt = slope_scale(k, t0, t1);
+    net_piece_of_rows(net_big(net), (const vec3(*)[4])H, s0, s1, t0, t1, ks, kt, what, nb);
+}
+
+/* The whole box of net_bounds (its clamp to the unit square) */
+static void clamp_box(ia_interval su, ia_interval sv, double b[4])
+{
+    double s0 = geom_max(su.lo, 0), s1 = geom_min(su.hi, 1);
+    double t0 = geom_max(sv.lo, 0), t1 = geom_min(sv.hi, 1);
+    if (!(s0 <= s1)) s0 = s1 = geom_min(geom_max(su.lo, 0), 1);
+    if (!(t0 <= t1)) t0 = t1 = geom_min(geom_max(sv.lo, 0), 1);
+    b[0] = s0, b[1] = s1, b[2] = t0, b[3] = t1;
 }
 
 /* The whole box, and Ng as the hull over 3 x 3 pieces of it: the cross
@@ -425,10 +471,10 @@ static void net_piece(const vec3 net[16], double s0, double s1, double t0, doubl
 static void net_bounds(const vec3 net[16], ia_interval su, ia_interval sv, double k,
                        net_boxes *nb)
 {
-    double s0 = fmax(su.lo, 0), s1 = fmin(su.hi, 1), t0 = fmax(sv.lo, 0), t1 = fmin(sv.hi, 1);
-    if (!(s0 <= s1)) s0 = s1 = fmin(fmax(su.lo, 0), 1);
-    if (!(t0 <= t1)) t0 = t1 = fmin(fmax(sv.lo, 0), 1);
-    net_piece(net, s0, s1, t0, t1, k, nb);
+    double b[4];
+    clamp_box(su, sv, b);
+    double s0 = b[0], s1 = b[1], t0 = b[2], t1 = b[3];
+    net_piece(net, s0, s1, t0, t1, k, NB_ALL, nb);
     if (!(s1 > s0 && t1 > t0)) return;
     /* not where the whole box's Ng already keeps well away from 0 (|Ng|^2
      * within a factor 1.25): there the pieces narrow it little (on
@@ -436,20 +482,25 @@ static void net_bounds(const vec3 net[16], ia_interval su, ia_interval sv, doubl
     ia_interval n2 = ia_add(ia_add(ia_sqr(nb->Ng[0]), ia_sqr(nb->Ng[1])), ia_sqr(nb->Ng[2]));
     if (n2.lo > 0.8 * n2.hi) return;
     enum { NP = 3 };
+    double big = net_big(net);
     ia_interval Ng[3];
-    double a0s[NP], a1s[NP];
+    double a0s[NP], a1s[NP], b0s[NP], b1s[NP];
+    ia_interval ks[NP], kt[NP];            /* each column's and row's, once */
     vec3 H[NP][4][4];                      /* each column's rows, once */
     for (int i = 0; i < NP; i++) {
         a0s[i] = s0 + (s1 - s0) * i / NP;
         a1s[i] = i == NP - 1 ? s1 : s0 + (s1 - s0) * (i + 1) / NP;
+        b0s[i] = t0 + (t1 - t0) * i / NP;
+        b1s[i] = i == NP - 1 ? t1 : t0 + (t1 - t0) * (i + 1) / NP;
+        ks[i] = slope_scale(k, a0s[i], a1s[i]);
+        kt[i] = slope_scale(k, b0s[i], b1s[i]);
         net_rows(net, a0s[i], a1s[i], H[i]);
     }
     for (int j = 0; j < NP; j++)
         for (int i = 0; i < NP; i++) {
-            double a0 = a0s[i], a1 = a1s[i];
-            double b0 = t0 + (t1 - t0) * j / NP, b1 = j == NP - 1 ? t1 : t0 + (t1 - t0) * (j + 1) / NP;
-            net_boxes piece;
-            net_piece_of_rows(net, (const vec3(*)[4])H[i], a0, a1, b0, b1, k, &piece);
+            net_boxes piece;               /* (its Ng alone is wanted) */
+            net_piece_of_rows(big, (const vec3(*)[4])H[i], a0s[i], a1s[i], b0s[j], b1s[j], ks[i],
+                              kt[j], NB_D, &piece);
             for (int c = 0; c < 3; c++)
                 Ng[c] = i == 0 && j == 0 ? piece.Ng[c] : ia_hull(Ng[c], piece.Ng[c]);
         }
@@ -566,6 +617,17 @@ bool geom_subdiv_normal_slopes_ia(const geom_surface *s, ia_interval u, ia_inter
     return true;
 }
 
+/* The regular sub-patch r as a bicubic patch b of its own, over the
+ * inputs in its coordinates su = k (u - ou), sv = k (v - ov), k = 2^level */
+static void sub_patch(aa_context *ctx, const sd_range *r, const aa_form *u, const aa_form *v,
+                      double *k, aa_form *su, aa_form *sv, geom_surface *b)
+{
+    *k = ldexp(1, r->level);
+    aa_lincomb(ctx, su, *k, u, 0, u, -r->ou * *k);
+    aa_lincomb(ctx, sv, *k, v, 0, v, -r->ov * *k);
+    net_surface(r->net, b);
+}
+
 void geom_subdiv_eval_aa(aa_context *ctx, const geom_surface *s, const aa_form *u,
                          const aa_form *v, geom_aa *out)
 {
@@ -604,12 +666,10 @@ void geom_subdiv_eval_aa(aa_context *ctx, const geom_surface *s, const aa_form *
         }
         return;
     }
-    double k = ldexp(1, r.level);
+    double k;
     aa_form su, sv;
-    aa_lincomb(ctx, &su, k, u, 0, u, -r.ou * k);
-    aa_lincomb(ctx, &sv, k, v, 0, v, -r.ov * k);
     geom_surface b;
-    net_surface(r.net, &b);
+    sub_patch(ctx, &r, u, v, &k, &su, &sv, &b);
     if (!geom_bicubic_net_aa(ctx, &b, &su, &sv, out))
         geom_bicubic_eval_aa(ctx, &b, &su, &sv, out);
     net_boxes nb;
@@ -623,6 +683,42 @@ void geom_subdiv_eval_aa(aa_context *ctx, const geom_surface *s, const aa_form *
         meet_aa(&out->dPdv[i], nb.dPdv[i]);
         meet_aa(&out->Ng[i], nb.Ng[i]);
     }
+}
+
+void geom_subdiv_range_P_aa(aa_context *ctx, const geom_surface *s, const aa_form *u,
+                            const aa_form *v, ia_interval P[3])
+{
+    /* geom_subdiv_eval_aa's way to a regular sub-patch, and of its forms
+     * the P part alone: the hull of the piece's nets (the forms' range,
+     * geom_bicubic_net_range_P) met with net_bounds' P (net_piece of the
+     * clamped box: its 3 x 3 pieces narrow Ng only) */
+    ia_interval ur = aa_range(u), vr = aa_range(v);
+    sd_range r;
+    find_range(s, ur.lo, ur.hi, vr.lo, vr.hi, &r);
+    if (r.regular) {
+        double k;
+        aa_form su, sv;
+        geom_surface b;
+        sub_patch(ctx, &r, u, v, &k, &su, &sv, &b);
+        if (geom_bicubic_net_range_P(&b, &su, &sv, P)) {
+            double box[4];
+            clamp_box(aa_range(&su), aa_range(&sv), box);
+            net_boxes nb;
+            net_piece(r.net, box[0], box[1], box[2], box[3], k, NB_P, &nb);
+            for (int i = 0; i < 3; i++)
+                if (isfinite(nb.P[i].lo) && isfinite(nb.P[i].hi) &&
+                    !(nb.P[i].flags & AA_UNBOUNDED)) {
+                    if (nb.P[i].lo > P[i].lo) P[i].lo = nb.P[i].lo;
+                    if (nb.P[i].hi < P[i].hi) P[i].hi = nb.P[i].hi;
+                }
+            return;
+        }
+    }
+    /* the rest (irregular sub-faces, thin boxes) costs little or is rare:
+     * the forms themselves */
+    geom_aa g;
+    geom_subdiv_eval_aa(ctx, s, u, v, &g);
+    for (int i = 0; i < 3; i++) P[i] = aa_range(&g.P[i]);
 }
 
 bool geom_subdiv_unit_normal_box(const geom_surface *s, ia_interval u, ia_interval v,

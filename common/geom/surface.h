@@ -126,6 +126,10 @@ const char *geom_kind_name(geom_kind kind);    /* "sphere", "disk", ... */
 
 void geom_eval(const geom_surface *s, double u, double v, geom_sample *out);
 void geom_eval_dual(const geom_surface *s, double u, double v, geom_sample *out);
+/* geom_eval's P alone, the same bits, without the derivatives where a
+ * kind allows it (bicubic patches and subdivision faces: 1 tensor sum of
+ * the 6; a view's grid spacing evaluates 81 points) */
+vec3 geom_eval_point(const geom_surface *s, double u, double v);
 
 /* Enclosures over the box [u0,u1] x [v0,v1]. */
 typedef struct geom_ia { ia_interval P[3], dPdu[3], dPdv[3], Ng[3]; } geom_ia;
@@ -141,6 +145,13 @@ void geom_eval_ia_tight(const geom_surface *s, ia_interval u, ia_interval v, geo
 typedef struct geom_aa { aa_form P[3], dPdu[3], dPdv[3], Ng[3]; } geom_aa;
 void geom_eval_aa(aa_context *ctx, const geom_surface *s, const aa_form *u,
                   const aa_form *v, geom_aa *out);
+
+/* aa_range of geom_eval_aa's P over the box, without the forms where a
+ * kind allows it (bicubic patches and regular subdivision sub-patches:
+ * the hull of the piece's Bezier net, which the forms' range holds, so
+ * the same bits; where only a box is wanted: a mesh piece's base box) */
+void geom_eval_aa_range_P(aa_context *ctx, const geom_surface *s, const aa_form *u,
+                          const aa_form *v, ia_interval P[3]);
 
 /* The UNIT normal Ng/|Ng| over the box (surface_normal.c), in closed form
  * where one exists (sphere, torus, disk, cylinder, cone, polygon), so that

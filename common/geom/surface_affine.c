@@ -331,6 +331,19 @@ void geom_eval_aa(aa_context *ctx, const geom_surface *s, const aa_form *u,
     }
 }
 
+void geom_eval_aa_range_P(aa_context *ctx, const geom_surface *s, const aa_form *u,
+                          const aa_form *v, ia_interval P[3])
+{
+    if (s->kind == GEOM_SUBDIV) {
+        geom_subdiv_range_P_aa(ctx, s, u, v, P);
+        return;
+    }
+    if (s->kind == GEOM_BICUBIC && geom_bicubic_net_range_P(s, u, v, P)) return;
+    geom_aa g;
+    geom_eval_aa(ctx, s, u, v, &g);
+    for (int i = 0; i < 3; i++) P[i] = aa_range(&g.P[i]);
+}
+
 void geom_ng_aa(aa_context *ctx, geom_aa *o)
 {
     for (int c = 0; c < 3; c++) {

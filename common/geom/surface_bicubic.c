@@ -48,10 +48,16 @@
 
 /* ---- float ---------------------------------------------------------- */
 
-static void bernstein(double u, double b[4], double d1[4], double d2[4])
+static void bernstein_b(double u, double b[4])
 {
     double s = 1 - u;
     b[0] = s * s * s, b[1] = 3 * s * s * u, b[2] = 3 * s * u * u, b[3] = u * u * u;
+}
+
+static void bernstein(double u, double b[4], double d1[4], double d2[4])
+{
+    double s = 1 - u;
+    bernstein_b(u, b);
     d1[0] = -3 * s * s, d1[1] = 3 * (s * s - 2 * s * u), d1[2] = 3 * (2 * s * u - u * u);
     d1[3] = 3 * u * u;
     d2[0] = 6 * s, d2[1] = -12 * s + 6 * u, d2[2] = 6 * s - 12 * u, d2[3] = 6 * u;
@@ -64,6 +70,17 @@ static vec3 tensor(const vec3 *p, const double *bu, const double *bv)
         for (int i = 0; i < 4; i++)
             r = v3_add(r, v3_scale(p[4 * j + i], bu[i] * bv[j]));
     return r;
+}
+
+vec3 geom_bicubic_eval_point(const geom_surface *s, double u, double v)
+{
+    /* P as geom_bicubic_eval_dual makes it (the same bernstein weights, the
+     * same sum in the same order: the same bits), without the 5 tensor
+     * sums of the derivatives (the grid spacing's 81 points a piece) */
+    double bu[4], bv[4];
+    bernstein_b(u, bu);
+    bernstein_b(v, bv);
+    return tensor(s->verts, bu, bv);
 }
 
 void geom_bicubic_eval_dual(const geom_surface *s, double u, double v, geom_sample *out)
@@ -134,7 +151,7 @@ static bool piece_net(const geom_surface *s, ia_interval u, ia_interval v,
     for (int i = 0; i < 16; i++)
         for (int c = 0; c < 3; c++) {
             p[3 * i + c] = v3_comp(s->verts[i], c);
-            big = fmax(big, fabs(p[3 * i + c]));
+            big = geom_max(big, fabs(p[3 * i + c]));   /* fmax's bits, no call */
         }
     for (int c = 0; c < 3; c++)
         if (!geom_net_piece(p + c, 3, 4, 4, u.lo, u.hi, v.lo, v.hi, GEOM_NET_PAD * big,
@@ -334,6 +351,32 @@ bool geom_bicubic_net_aa(aa_context *ctx, const geom_surface *b, const aa_form *
         geom_net_form(ctx, &o->dPdv[c], &dv[0][0], 4, 4, 3, it, s, t, s0, s1, t0, t1);
     }
     geom_ng_aa(ctx, o);
+    return true;
+}
+
+bool geom_bicubic_net_range_P(const geom_surface *b, const aa_form *s, const aa_form *t,
+                              ia_interval P[3])
+{
+    /* geom_bicubic_net_aa's conditions and P nets, and the hull that
+     * geom_net_form gives P's forms (scale 1): the form's affine range
+     * holds that hull (the plane over the box plus the net's largest
+     * distance from it reaches every net point), so aa_range is the hull */
+    ia_interval sr = aa_range(s), tr = aa_range(t);
+    if (!(sr.hi - sr.lo > 0x1p-12) || !(tr.hi - tr.lo > 0x1p-12) || (s->flags | t->flags))
+        return false;
+    ia_interval q[3][4][4];
+    if (!piece_net(b, sr, tr, q)) return false;
+    ia_interval one = ia_point(1);
+    for (int c = 0; c < 3; c++) {
+        ia_interval hull = ia_empty();
+        for (int j = 0; j < 4; j++)
+            for (int i = 0; i < 4; i++) {
+                ia_interval x = ia_mul(q[c][j][i], one);
+                hull = i == 0 && j == 0 ? x : ia_hull(hull, x);
+            }
+        if (!isfinite(hull.lo) || !isfinite(hull.hi)) return false;
+        P[c] = hull;
+    }
     return true;
 }
 

@@ -170,3 +170,16 @@ void geom_eval(const geom_surface *s, double u, double v, geom_sample *out)
     geom_eval_dual(s, u, v, out);
     out->dNgdu = out->dNgdv = v3(0, 0, 0);
 }
+
+vec3 geom_eval_point(const geom_surface *s, double u, double v)
+{
+    switch (s->kind) {
+    case GEOM_BICUBIC: return geom_bicubic_eval_point(s, u, v);
+    case GEOM_SUBDIV:  return geom_subdiv_eval_point(s, u, v);
+    default: {
+        geom_sample g;
+        geom_eval(s, u, v, &g);
+        return g.P;
+    }
+    }
+}

@@ -109,6 +109,8 @@ bool geom_vertex_normal_prepare(geom_surface *s, char *err, size_t errsz);
 /* The bicubic Bezier patch (surface_bicubic.c). */
 bool geom_bicubic_prepare(geom_surface *s, char *err, size_t errsz);
 void geom_bicubic_eval_dual(const geom_surface *s, double u, double v, geom_sample *out);
+/* P of geom_bicubic_eval_dual alone, the same bits */
+vec3 geom_bicubic_eval_point(const geom_surface *s, double u, double v);
 void geom_bicubic_eval_ia(const geom_surface *s, ia_interval u, ia_interval v, geom_ia *out);
 /* o->Ng = o->dPdu x o->dPdv in affine arithmetic (surface_affine.c) */
 void geom_ng_aa(aa_context *ctx, geom_aa *o);
@@ -141,6 +143,11 @@ void geom_net_form(aa_context *ctx, aa_form *z, const ia_interval *w, int ld, in
  * boxes thinner than 2^-12 (tensor form there) */
 bool geom_bicubic_net_aa(aa_context *ctx, const geom_surface *b, const aa_form *s,
                          const aa_form *t, geom_aa *out);
+/* The ranges of geom_bicubic_net_aa's P over the same box, the same bits,
+ * without the forms (the nets of P alone, no plane, no derivatives);
+ * false where geom_bicubic_net_aa is false or P is not finite */
+bool geom_bicubic_net_range_P(const geom_surface *b, const aa_form *s, const aa_form *t,
+                              ia_interval P[3]);
 /* The slopes of the unit normal Nn = N / |N| from bounds of N and of its
  * derivatives dN/du, dN/dv over a box: d Nn = (dN - Nn (Nn . dN)) / |N|;
  * false where |N| may vanish or a bound is not finite */
@@ -162,6 +169,9 @@ bool geom_bicubic_intersect(const geom_surface *s, vec3 o, vec3 d, double tmin, 
 
 /* Catmull-Clark faces (subdiv_eval.c). */
 void geom_subdiv_eval_dual(const geom_surface *s, double u, double v, geom_sample *out);
+vec3 geom_subdiv_eval_point(const geom_surface *s, double u, double v);
+void geom_subdiv_range_P_aa(aa_context *ctx, const geom_surface *s, const aa_form *u,
+                            const aa_form *v, ia_interval P[3]);
 void geom_subdiv_eval_ia(const geom_surface *s, ia_interval u, ia_interval v, geom_ia *out);
 void geom_subdiv_eval_aa(aa_context *ctx, const geom_surface *s, const aa_form *u,
                          const aa_form *v, geom_aa *out);

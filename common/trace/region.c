@@ -318,15 +318,22 @@ void trace_region_base(aa_context *ctx, const geom_surface *surf, float base[6])
     vec3 lo, hi;
     geom_bounds(surf, &lo, &hi);
     ia_interval b[3] = {ia_make(lo.x, hi.x), ia_make(lo.y, hi.y), ia_make(lo.z, hi.z)};
-    /* the square's base points too, as hull_piece */
-    aa_context_reset(ctx);
-    aa_form u, v;
-    aa_input(ctx, &u, 0.0, 1.0);
-    aa_input(ctx, &v, 0.0, 1.0);
-    geom_aa g;
-    geom_eval_aa(ctx, surf, &u, &v, &g);
+    /* the square's base points too, as hull_piece (a box is all it
+     * needs: no forms); but a subdivision face's square is the face, and
+     * its bounds, the hull of its 1-ring padded by 1e-12 of its size, hold
+     * the hull of its nets (padded by 2^-40 of their size, each point a
+     * convex combination of the ring's) with room to spare, so the hull
+     * with them is the bounds, bit for bit (test_geom_short_paths) */
+    ia_interval P[3] = {b[0], b[1], b[2]};
+    if (surf->kind != GEOM_SUBDIV) {
+        aa_context_reset(ctx);
+        aa_form u, v;
+        aa_input(ctx, &u, 0.0, 1.0);
+        aa_input(ctx, &v, 0.0, 1.0);
+        geom_eval_aa_range_P(ctx, surf, &u, &v, P);
+    }
     for (int i = 0; i < 3; i++) {
-        b[i] = widen(ia_hull(b[i], aa_range(&g.P[i])));
+        b[i] = widen(ia_hull(b[i], P[i]));
         base[i] = trace_float_down(b[i].lo);
         base[3 + i] = trace_float_up(b[i].hi);
     }

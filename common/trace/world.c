@@ -91,9 +91,8 @@ static void raster_lines(const trace_world *world, const trace_object *obj, int 
     double raster[G][G][2];
     for (int j = 0; j < G; j += step)
         for (int i = 0; i < G; i += step) {
-            geom_sample g;
-            geom_eval(&obj->surf, i / (double)(G - 1), j / (double)(G - 1), &g);
-            vec3 p = mat4_xform_point(&obj->to_camera, g.P);
+            vec3 P = geom_eval_point(&obj->surf, i / (double)(G - 1), j / (double)(G - 1));
+            vec3 p = mat4_xform_point(&obj->to_camera, P);
             double z = cam->orthographic || !(p.z > 1.0) ? 1.0 : p.z;
             raster[j][i][0] = p.x / z / px;
             raster[j][i][1] = p.y / z / px;

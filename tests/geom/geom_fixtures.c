@@ -3,6 +3,7 @@
  * (see geom_fixtures.h).
  */
 #include "geom_fixtures.h"
+#include "geom/subdiv.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -364,4 +365,48 @@ void fx_oracle(const geom_surface *s, double u, double v, fx_exact *o)
 bool fx_on_surface(const geom_surface *s, double u, double v)
 {
     return u >= 0 && u <= 1 && v >= 0 && v <= 1 && geom_uv_inside(s, u, v);
+}
+
+/* ---- subdivision meshes ---- */
+
+const double FX_CUBE_P[24] = { -1, -1, -1,  1, -1, -1,  1, 1, -1,  -1, 1, -1,
+                               -1, -1, 1,   1, -1, 1,   1, 1, 1,   -1, 1, 1 };
+static const int CUBE_NV[] = { 4, 4, 4, 4, 4, 4 };
+static const int CUBE_V[] = { 0, 3, 2, 1,  4, 5, 6, 7,  0, 1, 5, 4,
+                              1, 2, 6, 5,  2, 3, 7, 6,  3, 0, 4, 7 };
+
+geom_subdiv *fx_subdiv_cube(int ncreases, const int *clen, const int *cverts,
+                            const double *csharp, int ncorners, const int *corners,
+                            const double *csh)
+{
+    geom_subdiv_desc d = { 6, CUBE_NV, CUBE_V, 8, FX_CUBE_P, ncreases, clen, cverts, csharp,
+                           ncorners, corners, csh, 0, NULL, false };
+    char why[200];
+    geom_subdiv *sd = geom_subdiv_new(&d, why, sizeof why);
+    if (!sd) fprintf(stderr, "cube: %s\n", why);
+    return sd;
+}
+
+geom_subdiv *fx_subdiv_fan(int n, const double **P)
+{
+    static double fan_P[3 * (2 * FX_FAN_MAX + 1)];
+    static int fan_V[4 * FX_FAN_MAX], fan_NV[FX_FAN_MAX];
+    if (n < 3 || n > FX_FAN_MAX) return NULL;
+    fan_P[0] = 0.1, fan_P[1] = -0.05, fan_P[2] = 0.3;
+    for (int i = 0; i < n; i++) {
+        double a = 2 * M_PI * i / n, b = 2 * M_PI * (i + 0.5) / n;
+        double *E = fan_P + 3 * (1 + 2 * i), *F = fan_P + 3 * (2 + 2 * i);
+        E[0] = cos(a), E[1] = sin(a), E[2] = 0.2 * sin(3 * a);
+        F[0] = 1.5 * cos(b), F[1] = 1.5 * sin(b), F[2] = -0.3 + 0.1 * i;
+        int e0 = 1 + 2 * i, f0 = 2 + 2 * i, e1 = 1 + 2 * ((i + 1) % n);
+        fan_V[4 * i] = 0, fan_V[4 * i + 1] = e0, fan_V[4 * i + 2] = f0, fan_V[4 * i + 3] = e1;
+        fan_NV[i] = 4;
+    }
+    geom_subdiv_desc d = { n, fan_NV, fan_V, 2 * n + 1, fan_P, 0, NULL, NULL, NULL,
+                           0, NULL, NULL, 0, NULL, true };
+    char why[200];
+    geom_subdiv *sd = geom_subdiv_new(&d, why, sizeof why);
+    if (!sd) fprintf(stderr, "fan %d: %s\n", n, why);
+    if (P) *P = fan_P;
+    return sd;
 }

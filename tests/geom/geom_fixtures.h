@@ -44,4 +44,20 @@ void fx_oracle(const geom_surface *s, double u, double v, fx_exact *out);
 /* Is (u,v) a real point of the surface (polygons: inside)? */
 bool fx_on_surface(const geom_surface *s, double u, double v);
 
+/* ---- subdivision meshes (geom/subdiv.h); NULL if refused (a message on
+ * stderr) ---- */
+struct geom_subdiv;
+/* The cube of FX_CUBE_P (8 points, 6 quads, valence 3) with the creases
+ * and corners given (geom_subdiv_desc's fields) */
+extern const double FX_CUBE_P[24];
+struct geom_subdiv *fx_subdiv_cube(int ncreases, const int *clen, const int *cverts,
+                                   const double *csharp, int ncorners, const int *corners,
+                                   const double *csh);
+/* n quads (n <= FX_FAN_MAX) around point 0, a boundary outside
+ * (interpolateboundary): points 0, the edge points E_i = 1 + 2i and the
+ * face points F_i = 2 + 2i, their coordinates in *P (3 doubles a point,
+ * until the next call) */
+enum { FX_FAN_MAX = 40 };
+struct geom_subdiv *fx_subdiv_fan(int n, const double **P);
+
 #endif

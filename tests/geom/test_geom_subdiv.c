@@ -36,6 +36,7 @@
 #include <cmocka.h>
 
 #include "geom/subdiv.h"
+#include "geom_fixtures.h"
 
 static unsigned long long rng_state = 0x9e3779b97f4a7c15ULL;
 static double urand(void)
@@ -46,45 +47,23 @@ static double urand(void)
 
 /* ---- meshes ---- */
 
-static const double CUBE_P[] = { -1, -1, -1,  1, -1, -1,  1, 1, -1,  -1, 1, -1,
-                                 -1, -1, 1,   1, -1, 1,   1, 1, 1,   -1, 1, 1 };
-static const int CUBE_NV[] = { 4, 4, 4, 4, 4, 4 };
-static const int CUBE_V[] = { 0, 3, 2, 1,  4, 5, 6, 7,  0, 1, 5, 4,
-                              1, 2, 6, 5,  2, 3, 7, 6,  3, 0, 4, 7 };
+#define CUBE_P FX_CUBE_P
 
 static geom_subdiv *cube(int ncreases, const int *clen, const int *cverts, const double *csharp,
                          int ncorners, const int *corners, const double *csh)
 {
-    geom_subdiv_desc d = { 6, CUBE_NV, CUBE_V, 8, CUBE_P, ncreases, clen, cverts, csharp,
-                           ncorners, corners, csh, 0, NULL, false };
-    char why[200];
-    geom_subdiv *sd = geom_subdiv_new(&d, why, sizeof why);
-    if (!sd) fprintf(stderr, "cube: %s\n", why);
+    geom_subdiv *sd = fx_subdiv_cube(ncreases, clen, cverts, csharp, ncorners, corners, csh);
     assert_non_null(sd);
     return sd;
 }
 
-/* n quads around point 0: (0, E_i, F_i, E_i+1), E_i = 1 + 2i, F_i = 2 + 2i */
-enum { FAN_MAX = 40 };   /* valences above 16 too (any valence is taken) */
-static double fan_P[3 * (2 * FAN_MAX + 1)];
-static int fan_V[4 * FAN_MAX], fan_NV[FAN_MAX];
+/* n quads around point 0 (geom_fixtures.c): its points in fan_P */
+enum { FAN_MAX = FX_FAN_MAX };   /* valences above 16 too (any valence is taken) */
+static const double *fan_P;
 
 static geom_subdiv *fan(int n)
 {
-    fan_P[0] = 0.1, fan_P[1] = -0.05, fan_P[2] = 0.3;
-    for (int i = 0; i < n; i++) {
-        double a = 2 * M_PI * i / n, b = 2 * M_PI * (i + 0.5) / n;
-        double *E = fan_P + 3 * (1 + 2 * i), *F = fan_P + 3 * (2 + 2 * i);
-        E[0] = cos(a), E[1] = sin(a), E[2] = 0.2 * sin(3 * a);
-        F[0] = 1.5 * cos(b), F[1] = 1.5 * sin(b), F[2] = -0.3 + 0.1 * i;
-        int e0 = 1 + 2 * i, f0 = 2 + 2 * i, e1 = 1 + 2 * ((i + 1) % n);
-        fan_V[4 * i] = 0, fan_V[4 * i + 1] = e0, fan_V[4 * i + 2] = f0, fan_V[4 * i + 3] = e1;
-        fan_NV[i] = 4;
-    }
-    geom_subdiv_desc d = { n, fan_NV, fan_V, 2 * n + 1, fan_P, 0, NULL, NULL, NULL,
-                           0, NULL, NULL, 0, NULL, true };
-    char why[200];
-    geom_subdiv *sd = geom_subdiv_new(&d, why, sizeof why);
+    geom_subdiv *sd = fx_subdiv_fan(n, &fan_P);
     assert_non_null(sd);
     return sd;
 }
