@@ -304,7 +304,7 @@ static bool group_place(const void *user, int k, trace_object *t, trace_primvar 
                &t->displacement_spaces);
     spaces_for(sc, &t->to_camera, &t->from_camera, scene_object_surface(sc, o), &t->surface_spaces);
     memcpy(t->Cs, o->Cs, sizeof t->Cs);
-    memcpy(t->Os, o->Os, sizeof t->Os);
+    memcpy(t->Os, o->attr->Os, sizeof t->Os);
     t->flip = o->reverse_normals;
     convert_primvars(o->primvars, o->nprimvars, t, pv);
     t->primvars = pv;
@@ -337,7 +337,7 @@ static int find_placements(const scene *sc, int *proto_of, int *nplaced)
 static void object_name(const scene *sc, const scene_object *o, char *out, size_t outsz)
 {
     snprintf(out, outsz, "%s at %s:%d",
-             o->name ? o->name : o->mesh ? "mesh" : geom_kind_name(o->surface->kind),
+             o->attr->name ? o->attr->name : o->mesh ? "mesh" : geom_kind_name(o->surface->kind),
              o->pos.file ? o->pos.file : sc->file, o->pos.line);
 }
 
@@ -352,14 +352,15 @@ static void build_object(job_scene *self, const scene_object *o, trace_object *t
     const scene_shader *ss = scene_object_surface(sc, o);
     spaces_for(sc, &t->to_camera, &t->from_camera, ds, &t->displacement_spaces);
     spaces_for(sc, &t->to_camera, &t->from_camera, ss, &t->surface_spaces);
-    t->displacement = o->displacement_shader >= 0 ? self->instances[o->displacement_shader] : NULL;
-    t->surface = o->surface_shader >= 0 ? self->instances[o->surface_shader] : NULL;
+    const scene_attributes *a = o->attr;
+    t->displacement = a->displacement_shader >= 0 ? self->instances[a->displacement_shader] : NULL;
+    t->surface = a->surface_shader >= 0 ? self->instances[a->surface_shader] : NULL;
     memcpy(t->Cs, o->Cs, sizeof t->Cs);
-    memcpy(t->Os, o->Os, sizeof t->Os);
-    t->sides = o->sides;
+    memcpy(t->Os, o->attr->Os, sizeof t->Os);
+    t->sides = a->sides;
     t->flip = o->reverse_normals;
-    t->lights = o->lights;
-    t->nlights = o->nlights;
+    t->lights = a->lights;
+    t->nlights = a->nlights;
     build_primvars(o, t, pv);
     if (o->mesh) {
         /* the objects placing one undisplaced mesh share its pieces'

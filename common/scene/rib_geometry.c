@@ -116,7 +116,7 @@ static const char *shared_string(rib_parser *p, const char *prev, const char *s)
 }
 
 /* the lights that are on, as indices into scene.lights */
-static void object_lights(rib_parser *p, const scene_object *prev, scene_object *o)
+static void object_lights(rib_parser *p, const scene_attributes *prev, scene_attributes *at)
 {
     const rib_attributes *a = &p->attr;
     int few[64];                   /* most scenes: no allocation per object */
@@ -125,11 +125,53 @@ static void object_lights(rib_parser *p, const scene_object *prev, scene_object 
     for (int i = 0; i < p->scene->nlights && i < n; i++)
         if (a->lights_on->on[i])
             on[non++] = i;
-    o->lights = shared_copy(p, prev ? prev->lights : NULL,
-                            prev ? (size_t)prev->nlights * sizeof *on : 0, on,
-                            (size_t)non * sizeof *on);
-    o->nlights = non;
+    at->lights = shared_copy(p, prev ? prev->lights : NULL,
+                             prev ? (size_t)prev->nlights * sizeof *on : 0, on,
+                             (size_t)non * sizeof *on);
+    at->nlights = non;
     if (on != few) free(on);
+}
+
+/* Whether two records say the same (the strings and light lists compared by
+ * pointer: object_attributes shares them with the previous record's where
+ * equal; the numbers bitwise, as each object used to copy them). */
+static bool attributes_same(const scene_attributes *x, const scene_attributes *y)
+{
+    return memcmp(x->Os, y->Os, sizeof x->Os) == 0 &&
+           memcmp(&x->shading_rate, &y->shading_rate, sizeof x->shading_rate) == 0 &&
+           memcmp(&x->displacement_bound, &y->displacement_bound,
+                  sizeof x->displacement_bound) == 0 &&
+           x->displacement_bound_space == y->displacement_bound_space &&
+           x->name == y->name && x->lights == y->lights && x->nlights == y->nlights &&
+           x->surface_shader == y->surface_shader &&
+           x->displacement_shader == y->displacement_shader && x->sides == y->sides &&
+           x->orientation == y->orientation;
+}
+
+/* The current attributes as a record kept by the scene: the previous
+ * object's when equal (a run of instances with one set of attributes
+ * shares one record), else a new one whose strings and lights are the
+ * previous record's where equal. */
+static const scene_attributes *object_attributes(rib_parser *p, const scene_attributes *prev)
+{
+    const rib_attributes *a = &p->attr;
+    scene_attributes at;
+    memset(&at, 0, sizeof at);
+    memcpy(at.Os, a->Os, sizeof at.Os);
+    at.shading_rate = a->shading_rate;
+    at.displacement_bound = a->displacement_bound;
+    at.displacement_bound_space = shared_string(p, prev ? prev->displacement_bound_space : NULL,
+                                                a->bound_space);
+    at.name = shared_string(p, prev ? prev->name : NULL, a->name);
+    object_lights(p, prev, &at);
+    at.surface_shader = a->surface;
+    at.displacement_shader = a->displacement;
+    at.sides = a->sides;
+    at.orientation = a->orientation;
+    if (prev && attributes_same(prev, &at)) return prev;
+    scene_attributes *kept = scene_keep(p->scene, xmalloc(sizeof *kept));
+    *kept = at;
+    return kept;
 }
 
 void rib_place_surface(rib_parser *p, const rib_request *req, const geom_surface *surf,
@@ -180,8 +222,8 @@ void rib_place_surface(rib_parser *p, const rib_request *req, const geom_surface
         mat4 f_to_camera = mat4_mul(p->scene->camera.camera_from_world, f->object_to_world), f_inv;
         mat4 motion = mat4_mul(to_camera, mat4_invert(&f_to_camera, &f_inv) ? f_inv
                                                                               : mat4_identity());
-        if (f->displacement_shader == a->displacement && mat4_is_rotation(&motion) &&
-            f->orientation == a->orientation)
+        if (f->attr->displacement_shader == a->displacement && mat4_is_rotation(&motion) &&
+            f->attr->orientation == a->orientation)
             pieces = 0;
     }
     int mi = mesh ? scene_mesh_index(mesh) : -1;
@@ -213,18 +255,9 @@ void rib_place_surface(rib_parser *p, const rib_request *req, const geom_surface
     o->surface = surf;
     o->mesh = mesh;
     o->object_to_world = ctm;
-    o->surface_shader = a->surface;
-    o->displacement_shader = a->displacement;
+    o->attr = object_attributes(p, prev ? prev->attr : NULL);
     memcpy(o->Cs, a->Cs, sizeof o->Cs);
-    memcpy(o->Os, a->Os, sizeof o->Os);
-    o->sides = a->sides;
-    o->orientation = a->orientation;
     o->reverse_normals = reverse_normals(a->orientation, &to_camera);
-    o->shading_rate = a->shading_rate;
-    o->displacement_bound = a->displacement_bound;
-    o->displacement_bound_space = shared_string(p, prev ? prev->displacement_bound_space : NULL,
-                                                a->bound_space);
-    o->name = shared_string(p, prev ? prev->name : NULL, a->name);
     o->pos = pos;
     o->primvars = vars_kept || nvars == 0
         ? (nvars > 0 ? vars : NULL)
@@ -232,7 +265,6 @@ void rib_place_surface(rib_parser *p, const rib_request *req, const geom_surface
                       prev ? (size_t)prev->nprimvars * sizeof *vars : 0, vars,
                       (size_t)nvars * sizeof *vars);
     o->nprimvars = nvars;
-    object_lights(p, prev, o);
 }
 
 void rib_add_surface(rib_parser *p, const rib_request *req, const geom_surface *surf)

@@ -134,13 +134,13 @@ bool scene_object_piece_outline(const scene_object *object, int k, geom_surface 
 
 const scene_shader *scene_object_surface(const scene *self, const scene_object *object)
 {
-    int i = object->surface_shader;
+    int i = object->attr->surface_shader;
     return i >= 0 && i < self->nshaders ? &self->shaders[i] : NULL;
 }
 
 const scene_shader *scene_object_displacement(const scene *self, const scene_object *object)
 {
-    int i = object->displacement_shader;
+    int i = object->attr->displacement_shader;
     return i >= 0 && i < self->nshaders ? &self->shaders[i] : NULL;
 }
 
@@ -191,11 +191,12 @@ static bool same_string(const char *a, const char *b)
 
 bool scene_object_placeable(const scene_object *o, const scene_object *p)
 {
-    return o->displacement_shader == p->displacement_shader && o->mesh == p->mesh &&
-           o->surface == p->surface && o->surface_shader == p->surface_shader &&
-           o->sides == p->sides && o->nlights == p->nlights &&
-           (o->lights == p->lights ||
-            memcmp(o->lights, p->lights, sizeof *o->lights * (size_t)o->nlights) == 0) &&
+    const scene_attributes *oa = o->attr, *pa = p->attr;
+    return oa->displacement_shader == pa->displacement_shader && o->mesh == p->mesh &&
+           o->surface == p->surface && oa->surface_shader == pa->surface_shader &&
+           oa->sides == pa->sides && oa->nlights == pa->nlights &&
+           (oa->lights == pa->lights ||
+            memcmp(oa->lights, pa->lights, sizeof *oa->lights * (size_t)oa->nlights) == 0) &&
            o->primvars == p->primvars && o->nprimvars == p->nprimvars &&
-           same_string(o->name, p->name);
+           same_string(oa->name, pa->name);
 }

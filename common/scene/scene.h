@@ -175,38 +175,52 @@ typedef enum scene_orientation {
     SCENE_RH,
 } scene_orientation;
 
-typedef struct scene_object {
-    const geom_surface *surface;   /* object space, radians; prepared; kept by
-                                    * the scene (scene_keep) and shared by the
-                                    * objects placed from one recorded surface
-                                    * (instances); NULL for a mesh */
-    mat4 object_to_world;          /* to camera space and back:
-                                      scene_object_transforms */
-    int surface_shader;            /* index into scene.shaders, -1: none */
-    int displacement_shader;       /* index into scene.shaders, -1: none */
-    double Cs[3], Os[3];           /* Color, Opacity */
-    int sides;                     /* 1 or 2 */
-    scene_orientation orientation; /* as recorded (ReverseOrientation applied) */
-    bool reverse_normals;          /* flip Ng (orientation vs handedness) */
+/* The attributes a run of objects shares (RI Spec 3.2 §4: the graphics
+ * state at the primitive), kept once by the scene (scene_keep) and pointed
+ * at by every object placed while they did not change: a run of instances
+ * with one set of attributes costs one record (issue 23). The strings and
+ * the light list are kept by the scene too and shared with the previous
+ * record where equal. */
+typedef struct scene_attributes {
+    double Os[3];                  /* Opacity */
     double shading_rate;
     double displacement_bound;     /* Attribute "displacementbound" "sphere" */
-    /* The arrays and strings below are kept by the scene (scene_keep) and
-     * shared with the previous object where equal: a run of instances with
-     * the same attributes costs one copy (issue 23). */
     const char *displacement_bound_space;   /* its "coordinatesystem" ("object") */
     const char *name;              /* Attribute "identifier" "name", or NULL */
     const int *lights;             /* indices into scene.lights that are on */
     int nlights;
+    int surface_shader;            /* index into scene.shaders, -1: none */
+    int displacement_shader;       /* index into scene.shaders, -1: none */
+    int sides;                     /* 1 or 2 */
+    scene_orientation orientation; /* as recorded (ReverseOrientation applied) */
+} scene_attributes;
+
+/* One placed primitive or mesh: what differs from object to object (the
+ * surface, the transform, the colour, the primitive variables), and the
+ * shared attributes. ~216 bytes (an instance's share of the scene). */
+typedef struct scene_object {
+    mat4 object_to_world;          /* to camera space and back:
+                                      scene_object_transforms */
+    double Cs[3];                  /* Color */
+    const geom_surface *surface;   /* object space, radians; prepared; kept by
+                                    * the scene (scene_keep) and shared by the
+                                    * objects placed from one recorded surface
+                                    * (instances); NULL for a mesh */
+    const scene_attributes *attr;  /* kept by the scene, shared with the
+                                    * previous object where equal */
     sl_pos pos;                    /* the defining request (file = scene.file) */
-    const scene_primvar *primvars; /* its primitive variables (other than P, N) */
-    int nprimvars;
+    const scene_primvar *primvars; /* its primitive variables (other than P, N):
+                                    * kept by the scene (scene_keep), shared
+                                    * with the previous object where equal */
     const scene_mesh *mesh;        /* a polygon mesh (scene_mesh.h): its pieces stand
                                     * for `surface` (unused) and `primvars` (none
                                     * here); owned by scene.meshes. NULL: one surface */
+    int nprimvars;
     int instance_of;               /* ObjectInstance: the index of the first object
                                     * placed from the same recorded surface (its
                                     * own index for that one); -1: not instanced.
                                     * The renderer may share its boxes (Instances) */
+    bool reverse_normals;          /* flip Ng (attr->orientation vs handedness) */
 } scene_object;
 
 /* CoordinateSystem "name": a named space. */

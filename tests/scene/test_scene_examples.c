@@ -46,7 +46,7 @@ static void assert_vec(vec3 got, vec3 want, double tol)
 static const scene_object *object_named(const scene *s, const char *name)
 {
     for (int i = 0; i < s->nobjects; i++)
-        if (s->objects[i].name && strcmp(s->objects[i].name, name) == 0)
+        if (s->objects[i].attr->name && strcmp(s->objects[i].attr->name, name) == 0)
             return &s->objects[i];
     fail_msg("no object named %s", name);
     return NULL;
@@ -96,14 +96,14 @@ static void test_wave_objects(void **state)
     assert_int_equal(s->nobjects, 1);
     assert_int_equal(s->nlights, 2);
     const scene_object *o = &s->objects[0];
-    assert_string_equal(o->name, "wave");
+    assert_string_equal(o->attr->name, "wave");
     assert_int_equal(o->surface->kind, GEOM_POLYGON);
     assert_int_equal(o->surface->nverts, 4);
     assert_vec(o->surface->verts[0], v3(-1, 0, -1), 0);
     assert_vec(o->surface->verts[2], v3(1, 0, 1), 0);
-    assert_int_equal(o->sides, 2);
-    assert_true(o->displacement_bound == 0.25);
-    assert_string_equal(o->displacement_bound_space, "object");
+    assert_int_equal(o->attr->sides, 2);
+    assert_true(o->attr->displacement_bound == 0.25);
+    assert_string_equal(o->attr->displacement_bound_space, "object");
     assert_true(o->Cs[0] == 0.8 && o->Cs[1] == 0.75 && o->Cs[2] == 0.6);
     assert_int_equal(o->pos.line, 32);   /* the Polygon line of wave.rib */
     assert_int_equal(o->pos.col, 5);
@@ -148,7 +148,7 @@ static void test_wave_objects(void **state)
                    3.5 - 2 * sin(rad(35)) - 2 * cos(rad(35)));
     assert_vec(l->from_camera, want, eps);
     assert_false(l->shadows);
-    assert_int_equal(o->nlights, 2);
+    assert_int_equal(o->attr->nlights, 2);
     scene_destroy(&s);
 }
 
@@ -220,7 +220,7 @@ static void test_nail(void **state)
     assert_vec(mat4_xform_vector(&o->object_to_world, v3(0, 0, 1)), v3(0, 1, 0), 1e-15);
     assert_string_equal(scene_object_displacement(s, o)->name, "nail");
     assert_string_equal(scene_object_surface(s, o)->name, "metal");
-    assert_true(o->displacement_bound == 1.5);
+    assert_true(o->attr->displacement_bound == 1.5);
     scene_destroy(&s);
 }
 
@@ -266,7 +266,7 @@ static void test_gallery(void **state)
     for (int i = 0; i < s->nobjects; i++) {
         spheres += s->objects[i].surface->kind == GEOM_SPHERE;
         /* light 2 went off at its AttributeEnd and Illuminate turned it on */
-        assert_int_equal(s->objects[i].nlights, 3);
+        assert_int_equal(s->objects[i].attr->nlights, 3);
     }
     assert_int_equal(spheres, 5);
     /* Translate 0 0.5 -0.5, Rotate -90 1 0 0: object (0,0,0.5) (the north
@@ -307,7 +307,7 @@ static void test_surfaces(void **state)
     /* the shared Surface call before the objects */
     for (int i = 0; i < s->nobjects; i++) {
         assert_string_equal(scene_object_surface(s, &s->objects[i])->name, "plastic");
-        assert_int_equal(s->objects[i].sides, 2);
+        assert_int_equal(s->objects[i].attr->sides, 2);
     }
     assert_null(scene_object_displacement(s, object_named(s, "cylinder")));
     assert_int_equal(s->nshader_names, 3);

@@ -169,10 +169,10 @@ static void check_answer(const buffer *b, scene *s, const sl_diag *d)
     assert_null(s->search_path[s->nsearch_path]);
     for (int i = 0; i < s->nobjects; i++) {
         const scene_object *o = &s->objects[i];
-        assert_true(o->surface_shader >= -1 && o->surface_shader < s->nshaders);
-        assert_true(o->displacement_shader >= -1 && o->displacement_shader < s->nshaders);
-        for (int k = 0; k < o->nlights; k++)
-            assert_true(o->lights[k] >= 0 && o->lights[k] < s->nlights);
+        assert_true(o->attr->surface_shader >= -1 && o->attr->surface_shader < s->nshaders);
+        assert_true(o->attr->displacement_shader >= -1 && o->attr->displacement_shader < s->nshaders);
+        for (int k = 0; k < o->attr->nlights; k++)
+            assert_true(o->attr->lights[k] >= 0 && o->attr->lights[k] < s->nlights);
     }
 }
 

@@ -61,10 +61,10 @@ static void test_attributes_10000_deep(void **state)
     const scene_object *inner = &s->objects[0], *outer = &s->objects[1];
     assert_true(inner->object_to_world.m[2][3] == DEPTH);
     assert_true(inner->Cs[0] == DEPTH && inner->Cs[1] == 0);
-    assert_int_equal(inner->nlights, DEPTH);
+    assert_int_equal(inner->attr->nlights, DEPTH);
     assert_true(outer->object_to_world.m[2][3] == 0);
     assert_true(outer->Cs[0] == 0.1 && outer->Cs[1] == 0.2 && outer->Cs[2] == 0.3);
-    assert_int_equal(outer->nlights, 0);
+    assert_int_equal(outer->attr->nlights, 0);
     scene_destroy(&s);
 }
 

@@ -193,10 +193,10 @@ static void test_stacks(void **state)
     assert_int_equal(s->nobjects, 3);
     assert_vec(mat4_xform_point(&s->objects[0].object_to_world, v3(0, 0, 0)), v3(1, 0, 0), 0);
     assert_true(s->objects[0].Cs[1] == 1 && s->objects[0].Cs[0] == 0);
-    assert_int_equal(s->objects[0].sides, 1);
+    assert_int_equal(s->objects[0].attr->sides, 1);
     assert_vec(mat4_xform_point(&s->objects[1].object_to_world, v3(0, 0, 0)), v3(0, 2, 0), 0);
     assert_true(s->objects[1].Cs[2] == 1);
-    assert_int_equal(s->objects[1].sides, 2);
+    assert_int_equal(s->objects[1].attr->sides, 2);
     /* TransformEnd restores the transform only: the blue stays */
     assert_vec(mat4_xform_point(&s->objects[2].object_to_world, v3(0, 0, 0)), v3(0, 0, 0), 0);
     assert_true(s->objects[2].Cs[2] == 1 && s->objects[2].Cs[0] == 0);
@@ -265,12 +265,12 @@ static void test_light_scope_and_illuminate(void **state)
         "AttributeBegin\nLightSource \"pointlight\" 2\nSphere 1 -1 1 360\nAttributeEnd\n"
         "Sphere 1 -1 1 360\n"
         "Illuminate 1 0\nIlluminate 2 1\nSphere 1 -1 1 360\nWorldEnd\n");
-    assert_int_equal(s->objects[0].nlights, 2);
+    assert_int_equal(s->objects[0].attr->nlights, 2);
     /* the point light is off after its AttributeEnd */
-    assert_int_equal(s->objects[1].nlights, 1);
-    assert_int_equal(s->objects[1].lights[0], 0);
-    assert_int_equal(s->objects[2].nlights, 1);
-    assert_int_equal(s->objects[2].lights[0], 1);
+    assert_int_equal(s->objects[1].attr->nlights, 1);
+    assert_int_equal(s->objects[1].attr->lights[0], 0);
+    assert_int_equal(s->objects[2].attr->nlights, 1);
+    assert_int_equal(s->objects[2].attr->lights[0], 1);
     scene_destroy(&s);
 }
 
@@ -302,12 +302,12 @@ static void test_orientation(void **state)
         "AttributeBegin\nReverseOrientation\nSphere 1 -1 1 360\nAttributeEnd\n"
         "AttributeBegin\nOrientation \"lh\"\nSphere 1 -1 1 360\nScale -1 1 1\n"
         "Sphere 1 -1 1 360\nOrientation \"rh\"\nSphere 1 -1 1 360\nAttributeEnd\nWorldEnd\n");
-    assert_int_equal(s->objects[0].orientation, SCENE_OUTSIDE);
+    assert_int_equal(s->objects[0].attr->orientation, SCENE_OUTSIDE);
     assert_false(s->objects[0].reverse_normals);
-    assert_int_equal(s->objects[1].orientation, SCENE_INSIDE);
+    assert_int_equal(s->objects[1].attr->orientation, SCENE_INSIDE);
     assert_true(s->objects[1].reverse_normals);
     /* lh in a left-handed space: no flip; mirrored by Scale -1: flip */
-    assert_int_equal(s->objects[2].orientation, SCENE_LH);
+    assert_int_equal(s->objects[2].attr->orientation, SCENE_LH);
     assert_false(s->objects[2].reverse_normals);
     assert_true(s->objects[3].reverse_normals);
     assert_false(s->objects[4].reverse_normals);
@@ -328,13 +328,13 @@ static void test_attributes(void **state)
         "AttributeBegin\nAttribute \"identifier\" \"name\" \"inner\"\nSphere 1 -1 1 360\n"
         "AttributeEnd\nSphere 1 -1 1 360\nWorldEnd\n");
     const scene_object *o = &s->objects[0];
-    assert_true(o->displacement_bound == 0.5);
-    assert_string_equal(o->displacement_bound_space, "shader");
-    assert_string_equal(o->name, "ball");
-    assert_true(o->Os[2] == 0.5);
-    assert_true(o->shading_rate == 0.5);
-    assert_string_equal(s->objects[1].name, "inner");
-    assert_string_equal(s->objects[2].name, "ball");
+    assert_true(o->attr->displacement_bound == 0.5);
+    assert_string_equal(o->attr->displacement_bound_space, "shader");
+    assert_string_equal(o->attr->name, "ball");
+    assert_true(o->attr->Os[2] == 0.5);
+    assert_true(o->attr->shading_rate == 0.5);
+    assert_string_equal(s->objects[1].attr->name, "inner");
+    assert_string_equal(s->objects[2].attr->name, "ball");
     /* the scene's shading rate is the one current at WorldBegin */
     assert_true(s->shading_rate == 1);
     scene_destroy(&s);
@@ -437,7 +437,7 @@ static void test_light_before_world(void **state)
     assert_true(vec_dist(l->from_camera, v3(0, 0, 6)) < 1e-12);
     /* world = camera rotated back by -90 about y after the translation */
     assert_true(vec_dist(l->from_world, v3(-1, 0, 0)) < 1e-12);
-    assert_int_equal(s->objects[0].nlights, 2);
+    assert_int_equal(s->objects[0].attr->nlights, 2);
     scene_destroy(&s);
     sl_diag_destroy(&d);
 }
@@ -529,7 +529,7 @@ static void test_comments_and_layout(void **state)
     scene *s = parse_ok(text);
     assert_int_equal(s->camera.yres, 32);
     assert_true(s->camera.fov == 45);
-    assert_string_equal(s->objects[0].name, "a\"bA");
+    assert_string_equal(s->objects[0].attr->name, "a\"bA");
     assert_true(s->objects[0].surface->zmax == 1);
     assert_true(fabs(s->objects[0].surface->thetamax - 2 * M_PI) < 1e-15);
     assert_int_equal(s->objects[0].pos.line, 8);
@@ -549,7 +549,7 @@ static void test_cr_line_ends(void **state)
     scene *s = parse_ok(text);
     assert_int_equal(s->camera.xres, 64);
     assert_true(s->camera.fov == 45);
-    assert_string_equal(s->objects[0].name, "abc");
+    assert_string_equal(s->objects[0].attr->name, "abc");
     assert_int_equal(s->objects[0].pos.line, 9);
     assert_int_equal(s->objects[0].pos.col, 1);
     scene_destroy(&s);
