@@ -355,7 +355,7 @@ enum { SCENE_ARCHIVE_MAX_DEPTH = 16 };
 enum { SCENE_MAX_OBJECTS = 1 << 20 };
 
 /* The most ObjectInstance placements a scene may hold: each is a
- * reference in a worker (trace/group.h: ~500 bytes with its scene object,
+ * reference in a worker (trace/group.h: ~400 bytes with its scene object,
  * docs/renderer.md "Instances as references"), so 2^24 of them fit a 24 GB
  * worker; those of a displaced mesh that are not its first moved rigidly
  * also count its pieces (SCENE_MAX_PIECES). */

@@ -20,7 +20,7 @@
  *   mirrored, render as the same objects written out one by one (objects
  *   of their own: the other path); 20,000 instances cost at most
  *   INSTANCE_BYTES each in all (scene, world, renderer), counted by the
- *   allocator (an instance was ~14 KB when each was a full object; ~500 now).
+ *   allocator (an instance was ~14 KB when each was a full object; ~380 now).
  * - A shadow ray cast while a piece's hit is being shaded cannot
  *   overwrite it: a mesh lit through another mesh renders as the same
  *   faces written one Polygon each.
@@ -51,10 +51,10 @@
 enum { FACE_BYTES_BEYOND = 64 + 32, FACE_BVH_BYTES = 32, FACE_BYTES = 150 };
 
 /* the budget per instance of a recorded mesh, everything included: the
- * scene's object (~300 bytes, its transform in double), the world's
- * 6-byte box, index and BVH share (~20), and its RIB text in the job
- * (~150) */
-enum { INSTANCE_BYTES = 560 };
+ * scene's object (216 bytes, its transform in double, its attributes
+ * shared: scene_attributes), the world's 6-byte box, index and BVH share
+ * (~20), and its RIB text in the job (~150): 382 measured (2026-11-28) */
+enum { INSTANCE_BYTES = 420 };
 
 static void test_bytes_per_face(void **state)
 {
