@@ -3,8 +3,9 @@
  * the quadrics of §5.2 (Sphere, Disk, Cylinder, Cone, Torus, Hyperboloid,
  * Paraboloid), Polygon (§5.1, convex planar) and Patch "bilinear" (§5.3).
  * Each becomes one scene_object: its geom_surface in object space (angles
- * converted from the RIB's degrees to radians), its transforms and a copy
- * of the current attributes.
+ * converted from the RIB's degrees to radians), its transforms and the
+ * current attributes (a scene_attributes record, the previous object's
+ * when equal).
  *
  * Validation is geom_surface_prepare's (common/geom), whose reason goes
  * into the message ("Sphere: sphere radius must be > 0, got -1"); when the
