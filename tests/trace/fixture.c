@@ -80,6 +80,25 @@ bool fixture_render(fixture *f, int tile, int nthreads, size_t cache_bytes,
     return ok;
 }
 
+char *fixture_instances_rib(int n, const char *definition, const char *shader, double km)
+{
+    size_t cap = (size_t)n * 120 + strlen(definition) + 4096, len = 0;
+    char *s = malloc(cap);
+    if (!s) abort();
+    int side = (int)ceil(sqrt(n));
+    len += (size_t)snprintf(s + len, cap - len,
+        "Format 16 16 1\nProjection \"perspective\" \"fov\" [40]\nTranslate 0 0 %d\n"
+        "WorldBegin\nSurface \"plastic\"\nDisplacement \"%s\" \"float Km\" [%g]\n"
+        "ObjectBegin 1\n  %s\nObjectEnd\n", side + 2, shader, km, definition);
+    for (int i = 0; i < n; i++)
+        len += (size_t)snprintf(s + len, cap - len,
+                                "AttributeBegin\nTranslate %d %d 0\nRotate %d 0.3 1 0.2\n"
+                                "ObjectInstance 1\nAttributeEnd\n",
+                                i % side - side / 2, i / side - side / 2, (i * 37) % 360);
+    snprintf(s + len, cap - len, "WorldEnd\n");
+    return s;
+}
+
 char *fixture_torus_rib(int nu, int nv, const char *head, const char *request)
 {
     size_t cap = (size_t)nu * nv * 90 + 4096, n = 0;

@@ -39,6 +39,13 @@ bool fixture_render(fixture *f, int tile, int nthreads, size_t cache_bytes,
  * or "SubdivisionMesh \"catmull-clark\""). */
 char *fixture_torus_rib(int nu, int nv, const char *head, const char *request);
 
+/* The RIB text (malloc'd) of n instances of one definition (`definition`:
+ * its RIB text, inside ObjectBegin 1) on a square grid seen from the
+ * front, 16 x 16 pixels, each moved and turned differently (rigid
+ * motions), under one Surface "plastic" and Displacement `shader` with
+ * "float Km" [km]. */
+char *fixture_instances_rib(int n, const char *definition, const char *shader, double km);
+
 /* Bytes the allocator holds (glibc's mallinfo2; 0 under ASan, whose
  * allocator it does not see: byte budgets are checked only where it
  * reads more) */

@@ -281,26 +281,6 @@ static void test_fall_back_to_own_boxes(void **state)
     free(scaled.rgba);
 }
 
-/* n instances of the bumped sphere, each moved and turned (rigid) */
-static char *many_rib(int n, const char *shader)
-{
-    size_t cap = (size_t)n * 120 + 4096, len = 0;
-    char *s = malloc(cap);
-    assert_non_null(s);
-    int side = (int)ceil(sqrt(n));
-    len += (size_t)snprintf(s + len, cap - len,
-        "Format 16 16 1\nProjection \"perspective\" \"fov\" [40]\nTranslate 0 0 %d\n"
-        "WorldBegin\nSurface \"plastic\"\nDisplacement \"%s\" \"float Km\" [0.08]\n"
-        "ObjectBegin 1\n  Sphere 0.4 -0.4 0.4 360\nObjectEnd\n", side + 2, shader);
-    for (int i = 0; i < n; i++)
-        len += (size_t)snprintf(s + len, cap - len,
-                                "AttributeBegin\nTranslate %d %d 0\nRotate %d 0.3 1 0.2\n"
-                                "ObjectInstance 1\nAttributeEnd\n",
-                                i % side - side / 2, i / side - side / 2, (i * 37) % 360);
-    snprintf(s + len, cap - len, "WorldEnd\n");
-    return s;
-}
-
 /* the budget per displaced instance, everything included (the scene's
  * object, 216 bytes with its attributes shared (scene_attributes), the
  * RIB text, ~75 bytes here, the group's BVH share and per-placement
@@ -310,7 +290,7 @@ enum { DISPLACED_INSTANCE_BYTES = 360, MANY = 2001 };
 
 static size_t world_bytes(int n, const char *shader, int *shared, int *placements)
 {
-    char *rib = many_rib(n, shader);
+    char *rib = fixture_instances_rib(n, "Sphere 0.4 -0.4 0.4 360", shader, 0.08);
     fixture_shader sh[] = {{"bumps", BUMPS_SL}, {"cambumps", CAMBUMPS_SL},
                            {"plastic", PLASTIC_SL}};
     size_t before = fixture_heap_bytes();

@@ -340,26 +340,6 @@ static void test_own_meshes_are_the_copies(void **state)
     check_own("bumps", true);
 }
 
-/* n moved placements of the cube */
-static char *many_rib(int n)
-{
-    size_t cap = (size_t)n * 120 + 4096, len = 0;
-    char *s = malloc(cap);
-    assert_non_null(s);
-    int side = (int)ceil(sqrt(n));
-    len += (size_t)snprintf(s + len, cap - len,
-        "Format 16 16 1\nProjection \"perspective\" \"fov\" [40]\nTranslate 0 0 %d\n"
-        "WorldBegin\nSurface \"plastic\"\nDisplacement \"bumps\" \"float Km\" [0.06]\n"
-        "ObjectBegin 1\n  Scale 0.5 0.5 0.5\n  %s\nObjectEnd\n", side + 2, CUBE);
-    for (int i = 0; i < n; i++)
-        len += (size_t)snprintf(s + len, cap - len,
-                                "AttributeBegin\nTranslate %d %d 0\nRotate %d 0.3 1 0.2\n"
-                                "ObjectInstance 1\nAttributeEnd\n",
-                                i % side - side / 2, i / side - side / 2, (i * 37) % 360);
-    snprintf(s + len, cap - len, "WorldEnd\n");
-    return s;
-}
-
 /* the budget per moved placement of a displaced mesh, everything
  * included (the scene's object, the RIB text, the group's BVH share and
  * per-placement word): as a displaced surface's (test_trace_instances);
@@ -368,7 +348,9 @@ enum { MESH_INSTANCE_BYTES = 390, MANY = 2001 };
 
 static size_t world_bytes(int n, trace_world_counts *wc)
 {
-    char *rib = many_rib(n);
+    char def[1024];
+    snprintf(def, sizeof def, "Scale 0.5 0.5 0.5\n  %s", CUBE);
+    char *rib = fixture_instances_rib(n, def, "bumps", 0.06);
     fixture_shader sh[NSHADERS];
     shaders(sh);
     size_t before = fixture_heap_bytes();
