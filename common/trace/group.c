@@ -72,7 +72,7 @@ bool trace_group_view_make(trace_thread *th, const trace_object *g, int k, trace
  * definition RenderMan gives. */
 enum { PROBE_PLACEMENTS = 64, PROBE_PIECES = 4 };
 
-/* Whether placement v (a view, box_proto NULL) of a displaced mesh
+/* Whether placement v (a view, not yet the prototype moved) of a displaced mesh
  * prototype is the prototype moved at the probe's pieces (their views:
  * trace_instance_moves on each) */
 static bool mesh_moves(trace_thread *th, const trace_object *v, const trace_object *proto)
@@ -104,7 +104,6 @@ static bool classify(trace_thread *th, trace_group *gr, const trace_object *g)
         if (!place_view(th, g, k, tv)) break;
         if (trace_instance_rigid(v, proto)) {
             if (proto->mesh) {
-                v->box_proto = NULL;
                 moves = mesh_moves(th, v, proto);
             } else {
                 moves = trace_instance_moves(th, v, proto);

@@ -101,12 +101,12 @@ static bool make(trace_thread *th, const trace_object *mesh_obj, int k, bool box
 {
     const trace_mesh *m = mesh_obj->mesh;
     assert(m && k >= 0 && k < m->npieces);
-    /* a moved placement's pieces are its prototype's (group.c walks
-     * them there): its box_proto is no piece's */
-    assert(!mesh_obj->box_proto);
     trace_object *v = &out->obj;
     *v = *mesh_obj;
     v->mesh = NULL;
+    /* a moved placement's box_proto is its prototype mesh, no piece's
+     * (trace_view_hit_moved gives its piece the prototype's piece) */
+    v->box_proto = NULL;
     v->id = m->first_id + k;
     v->top = mesh_obj->id;
     v->primvars = out->pv;
@@ -259,9 +259,7 @@ bool trace_view_hit_moved(trace_thread *th, const trace_object *v, trace_hit *hi
      * displacement runs with the prototype's du, dv), and its own du, dv
      * where its surface shader reads them (as a displaced surface's
      * placement view has: they follow its size on the screen) */
-    trace_object place = *v;
-    place.box_proto = NULL;
-    if (!make(th, &place, k, false, false, &vs->hit)) return false;
+    if (!make(th, v, k, false, false, &vs->hit)) return false;
     trace_object *p = &vs->hit.obj;
     p->box_proto = pp;
     trace_instance_set_motion(p, pp);
@@ -272,8 +270,7 @@ bool trace_view_hit_moved(trace_thread *th, const trace_object *v, trace_hit *hi
         p->du = pp->du;                /* read by nothing */
         p->dv = pp->dv;
     }
-    p->root = pp->root;
-    trace_object_camera_bound(p, &p->root, &p->bound);
+    p->root = pp->root;                /* (no bound: a hit is not walked again) */
     if (hit->has_point) trace_surface_point_move(p, &hit->point);
     if (hit->kind == TRACE_LEAF_WALL)
         hit->wall_normal = v3_normalize(mat4_xform_vector(&p->from_proto, hit->wall_normal));
@@ -1090,6 +1087,8 @@ static int mesh_leaf(void *ctx, int k)
 bool trace_mesh_intersect(trace_thread *th, const trace_object *obj, const trace_ray *cam_ray,
                           const trace_tolerance *tol, bool any, trace_hit *best)
 {
+    /* a moved placement is walked as its prototype (group.c) */
+    assert(!obj->box_proto);
     const trace_mesh *m = obj->mesh;
     /* the boxes are in object space: so is the ray (an affine map keeps
      * its parameter t); the pieces take the camera-space ray */
