@@ -223,13 +223,23 @@ static int teardown(void **state)
     return 0;
 }
 
-/* Starts argv inside namespace h under timeout -k (bounded at 150 s; a
- * process that outlives SIGTERM by 10 s is killed: 137). The 10 s leaves
- * room for a sanitized worker's exit on a loaded machine. */
-/* Seconds between SIGTERM and SIGKILL. Under AddressSanitizer a worker
- * has twice taken over 10 s to end after saying "stopped" (its teardown
- * and LeakSanitizer's scan at exit on a CI machine busy with other
- * sanitized tests); a real hang still fails at 30. */
+/* Starts argv inside namespace h under timeout --foreground -k (bounded
+ * at 150 s; a process that outlives SIGTERM by KILL_AFTER_S is killed:
+ * 137).
+ *
+ * --foreground matters: without it, timeout follows the SIGTERM it passes
+ * on with a SIGCONT to the child and its group. A sanitized child that
+ * has already reached exit() by then is inside LeakSanitizer's scan,
+ * whose tracer has just PTRACE_ATTACHed it and waits for it to stop; the
+ * late SIGCONT discards that pending stop and the tracer waits forever,
+ * until timeout's SIGKILL (the hub's and the workers' "took 30 s to end"
+ * in CI, sessions 15-16: reproduced here with two busy loops beside the
+ * test, about one run in five, the tracer in wait4 and the hub in
+ * sched_yield). Every process started here is a single process, so
+ * timing out only the direct child loses nothing. */
+/* Seconds between SIGTERM and SIGKILL: room for a sanitized process's
+ * teardown and leak scan on a machine busy with other sanitized tests; a
+ * real hang still fails. */
 #ifdef __SANITIZE_ADDRESS__
 #define KILL_AFTER_S 30
 #else
@@ -240,9 +250,9 @@ static int teardown(void **state)
 
 static pid_t ns_spawn(int h, const char *log_name, const char *const *argv)
 {
-    const char *full[40] = {ip_bin, "netns", "exec", ns[h], timeout_bin, "-k", STR(KILL_AFTER_S),
-                            "150"};
-    int n = 8;
+    const char *full[40] = {ip_bin, "netns", "exec", ns[h], timeout_bin, "--foreground",
+                            "-k", STR(KILL_AFTER_S), "150"};
+    int n = 9;
     for (; *argv && n < 39; argv++) full[n++] = *argv;
     full[n] = NULL;
     char log[4096];
@@ -395,8 +405,8 @@ static void test_delay_and_loss(void **state)
         for (int h = M; h < NNS; h++) sh("ip netns exec %s tc qdisc del dev eth0 root", ns[h]);
     } else {
         kill(hubpid, SIGTERM);
-        /* as the workers' (stop): a sanitized hub on a machine busy with
-         * other tests once took over 10 s to end (CI, session 16) */
+        /* see ns_spawn: without --foreground a sanitized hub once
+         * took 30 s to end here (CI, session 16) */
         double t0 = ft_now();
         int rc = ft_wait(hubpid, 30);
         if (ft_now() - t0 > 2) fprintf(stderr, "netns_hub took %.1f s to end\n", ft_now() - t0);
