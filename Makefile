@@ -46,7 +46,8 @@ test-sanitize: deps
 
 # what `make build` and the benchmarks compile (-DNDEBUG: no asserts), with
 # warnings as errors: a variable only an assert() reads must still compile
-# cleanly ((void)x), and -O3's maybe-uninitialized analysis must agree
+# cleanly ((void)x), and the optimiser's maybe-uninitialized analysis must
+# agree (Release is -O2, as the tests: CMakeLists.txt)
 check-release: deps
 	@cmake -S . -B build-release -DCMAKE_BUILD_TYPE=Release -DAAFARM_ASSERTS=OFF -DAAFARM_WERROR=ON >/dev/null
 	@cmake --build build-release -j $(JOBS)
