@@ -747,9 +747,14 @@ static bool enclose_jets(const box_query *q, bool want_affine, const point_jet *
     jet hull;
     memset(&hull, 0, sizeof hull);
     iv subrange = iv_mk(0.0, 0.0);
+    /* the corners' hashes per cell (bit k: the second cell along axis k),
+     * computed once: the halves of a split piece share their cell */
+    uint32_t cell_h[16][16];
+    unsigned cell_done = 0;
     for (int sb = 0; sb < nsub; sb++) {
         axis_fade pax[4];
         uint32_t pkey[4][2];
+        unsigned cell = 0;
         int rest = sb;
         for (int k = 0; k < dim; k++) {
             int s = rest % nseg[k];
@@ -757,9 +762,13 @@ static bool enclose_jets(const box_query *q, bool want_affine, const point_jet *
             pax[k] = ax[k][s];
             pkey[k][0] = key[k][segcell[k][s]];
             pkey[k][1] = key[k][segcell[k][s] + 1];
+            cell |= (unsigned)segcell[k][s] << k;
         }
-        uint32_t h[16];
-        corner_hashes(dim, q->seed, pkey, h);
+        const uint32_t *h = cell_h[cell];
+        if (!(cell_done >> cell & 1u)) {
+            corner_hashes(dim, q->seed, pkey, cell_h[cell]);
+            cell_done |= 1u << cell;
+        }
         jet J;
         cell_jet(dim, pax, h, order, pmask, pside, &J);
         if (nsub > 1) {
@@ -980,7 +989,17 @@ taylor_model_d(int dim, const box_query *q, const int64_t *i0, const point_jet *
     }
     /* L = gmax * (sum of the m largest dmax) */
     double L = 0.0;
-    {
+    if (dim == 3) {
+        /* the two largest of three, without the selection's unpredictable
+         * branches: (0 + x1) + x2 = x1 + x2 in either order (commutative,
+         * all >= 0), so the same bits as the loop below */
+        double s01 = dmax[0] + dmax[1], s02 = dmax[0] + dmax[2],
+               s12 = dmax[1] + dmax[2];
+        bool min0 = dmax[0] <= dmax[1] && dmax[0] <= dmax[2];
+        bool min1 = !min0 && dmax[1] <= dmax[2];
+        L = min0 ? s12 : (min1 ? s02 : s01);
+        L = L * gmax_of[dim] * TAYLOR_SUM_SCALE;
+    } else {
         double d[4];
         for (int k = 0; k < dim; k++)
             d[k] = dmax[k];
