@@ -485,11 +485,10 @@ point_jet_d(int dim, const double f[4], const uint32_t hs[16], int order, point_
         t[c].v = l;
         if (order == 0)
             continue;
-        for (int k = 0; k < dim; k++) {
+        /* the corners' Hessians (0) are never read: the step along axis 0
+         * sets the Hessian parts without them */
+        for (int k = 0; k < dim; k++)
             t[c].g[k] = (double)g[k];
-            for (int m = k; m < dim; m++)
-                t[c].h[k][m] = 0.0;   /* not read (k == 0 below), but the compiler cannot tell */
-        }
     }
     /* Each step writes its results straight into the other buffer (no
      * temporary jet copied back: the compiler copied its scalar stores with
@@ -501,6 +500,8 @@ point_jet_d(int dim, const double f[4], const uint32_t hs[16], int order, point_
 #pragma GCC unroll 4
     for (int k = 0; k < dim; k++) {
         const int nk = (1 << dim) >> (k + 1);
+        if (k == dim - 1)
+            dst = J;        /* the last step writes the result (no copy) */
 #pragma GCC unroll 8
         for (int i = 0; i < nk; i++) {
             const point_jet *A = &src[2 * i], *B = &src[2 * i + 1];
@@ -529,7 +530,6 @@ point_jet_d(int dim, const double f[4], const uint32_t hs[16], int order, point_
         src = dst;
         dst = x;
     }
-    *J = src[0];
 }
 
 /* The float jet of raw noise at the point c (|c_k| < 2^51). */
