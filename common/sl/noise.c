@@ -165,10 +165,12 @@ void sl_vpnoise(int dim, const double *p, const int *period, double out[3])
         out[i] = noise_float(dim, p, period, CH_VNOISE + (unsigned)i);
 }
 
-double sl_noise_grad(int dim, const double *p, const int *period, double *grad)
+/* The value and gradient of noise at p; always inlined once per dim (the
+ * dispatch below) so that the loops unroll: the same operations in the
+ * same order as the loops over a variable dim, so the same bits. */
+static inline __attribute__((always_inline)) double
+noise_grad_d(int dim, const double *p, const int *period, double *grad)
 {
-    if (!dim_ok(dim))
-        return 0.5;
     double f[4], s[4], ds[4];
     uint32_t h[16];
     lattice_at(dim, p, period, channel_seed(CH_NOISE), f, h);
@@ -201,6 +203,17 @@ double sl_noise_grad(int dim, const double *p, const int *period, double *grad)
     for (int k = 0; k < dim; k++)
         grad[k] *= noise_scale[dim];
     return scaled(dim, raw_value(dim, f, h));
+}
+
+double sl_noise_grad(int dim, const double *p, const int *period, double *grad)
+{
+    switch (dim) {
+    case 1: return noise_grad_d(1, p, period, grad);
+    case 2: return noise_grad_d(2, p, period, grad);
+    case 3: return noise_grad_d(3, p, period, grad);
+    case 4: return noise_grad_d(4, p, period, grad);
+    default: return 0.5;
+    }
 }
 
 /* ---- cellnoise ---- */
