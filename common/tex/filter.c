@@ -45,6 +45,16 @@ static int wrap_index(int i, int n, tex_wrap wrap, bool *outside)
     return 0;
 }
 
+static double fetch(const tex_texture *t, int k, int c, int i, int j, tex_wrap sw, tex_wrap tw)
+{
+    bool oi, oj;
+    i = wrap_index(i, t->lw[k], sw, &oi);
+    j = wrap_index(j, t->lh[k], tw, &oj);
+    if (oi || oj)
+        return 0.0;
+    return tex_at(t, 0, k, c, i, j);
+}
+
 /* out[b * ni + a] = texel (wi[a], wj[b]) of channel c of level k of part
  * p, for valid indexes: from memory, or a block of tiles at once */
 static void read_block(const tex_texture *t, int p, int k, int c, const int *wi, int ni,
@@ -61,9 +71,6 @@ static void read_block(const tex_texture *t, int p, int k, int c, const int *wi,
                                      (size_t)t->nch + (size_t)c];
 }
 
-static void gather(const tex_texture *t, int k, int c, int i, int ni, int j, int nj,
-                   tex_wrap sw, tex_wrap tw, double v[4][4]);
-
 /* The texel coordinate of s at a level of n texels. */
 static double coord(double s, int n, tex_wrap wrap)
 {
@@ -79,9 +86,8 @@ static double bilinear(const tex_texture *t, int k, int c, double s, double tt, 
     double x = coord(s, t->lw[k], sw), y = coord(tt, t->lh[k], tw);
     double fi = floor(x), fj = floor(y), f = x - fi, g = y - fj;
     int i = (int)fi, j = (int)fj;
-    double tx[4][4];
-    gather(t, k, c, i, 2, j, 2, sw, tw, tx);
-    double v00 = tx[0][0], v10 = tx[0][1], v01 = tx[1][0], v11 = tx[1][1];
+    double v00 = fetch(t, k, c, i, j, sw, tw), v10 = fetch(t, k, c, i + 1, j, sw, tw);
+    double v01 = fetch(t, k, c, i, j + 1, sw, tw), v11 = fetch(t, k, c, i + 1, j + 1, sw, tw);
     double v = (1 - f) * (1 - g) * v00 + f * (1 - g) * v10 + (1 - f) * g * v01 + f * g * v11;
     double lo = fmin(fmin(v00, v10), fmin(v01, v11)), hi = fmax(fmax(v00, v10), fmax(v01, v11));
     *dds = t->lw[k] * ((v10 - v00) * (1 - g) + (v11 - v01) * g);
