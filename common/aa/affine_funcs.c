@@ -840,15 +840,11 @@ void aa_abs(aa_context *ctx, aa_form *z, const aa_form *x)
     finish(ctx, z, x, ok, alpha, zeta, delta, fallback, fl, xr);
 }
 
-/* min(x, y) = (x + y - |x - y|)/2, max(x, y) = (x + y + |x - y|)/2 */
-static void min_max(aa_context *ctx, aa_form *z, const aa_form *x,
-                    const aa_form *y, double sign)
+/* min(x, y) = (x + y - |x - y|)/2, max(x, y) = (x + y + |x - y|)/2, with
+ * rx and ry the operands' aa_range (not both without symbols) */
+static void min_max_r(aa_context *ctx, aa_form *z, const aa_form *x, const aa_form *y,
+                      double sign, ia_interval rx, ia_interval ry)
 {
-    if (x->n == 0 && y->n == 0) {
-        private_result(z, sign < 0 ? ia_min(aa_range(x), aa_range(y)) : ia_max(aa_range(x), aa_range(y)));
-        return;
-    }
-    ia_interval rx = aa_range(x), ry = aa_range(y);
     unsigned fl = x->flags | y->flags;
     if (rx.hi <= ry.lo || ry.hi <= rx.lo) {   /* ordered: no new error */
         bool x_low = rx.hi <= ry.lo;
@@ -873,6 +869,16 @@ static void min_max(aa_context *ctx, aa_form *z, const aa_form *x,
     aa_meet_hull(z, sign < 0 ? ia_min(rx, ry) : ia_max(rx, ry));
 }
 
+static void min_max(aa_context *ctx, aa_form *z, const aa_form *x,
+                    const aa_form *y, double sign)
+{
+    if (x->n == 0 && y->n == 0) {
+        private_result(z, sign < 0 ? ia_min(aa_range(x), aa_range(y)) : ia_max(aa_range(x), aa_range(y)));
+        return;
+    }
+    min_max_r(ctx, z, x, y, sign, aa_range(x), aa_range(y));
+}
+
 void aa_min(aa_context *ctx, aa_form *z, const aa_form *x, const aa_form *y)
 {
     min_max(ctx, z, x, y, -1.0);
@@ -894,9 +900,37 @@ void aa_clamp(aa_context *ctx, aa_form *z, const aa_form *x,
         aa_set_interval(ctx, z, r, fl | r.flags);
         return;
     }
+    if (x->n == 0) {
+        aa_form t;
+        aa_max(ctx, &t, x, lo);
+        aa_min(ctx, z, &t, hi);
+        return;
+    }
+    /* max(x, lo), then min(that, hi): the same operations, each range
+     * computed once, and no copy where x lies between lo and hi (a
+     * normalize's clamp to [-1, 1]; issue 24) */
+    ia_interval rx = aa_range(x), rl = aa_range(lo), rh = aa_range(hi);
+    if (!(rx.hi <= rl.lo) && rl.hi <= rx.lo) {       /* the max is x */
+        ia_interval rt = rx;                         /* x's range, the max's flags */
+        rt.flags |= lo->flags;
+        if (rt.hi <= rh.lo || rh.hi <= rt.lo) {      /* and the min decided too */
+            const aa_form *pick = rt.hi <= rh.lo ? x : hi;
+            if (z != pick)
+                *z = *pick;
+            z->flags = (unsigned short)fl;
+            return;
+        }
+        aa_form t = *x;
+        t.flags = (unsigned short)(x->flags | lo->flags);
+        min_max_r(ctx, z, &t, hi, -1.0, rt, rh);
+        return;
+    }
     aa_form t;
-    aa_max(ctx, &t, x, lo);
-    aa_min(ctx, z, &t, hi);
+    min_max_r(ctx, &t, x, lo, +1.0, rx, rl);
+    if (t.n == 0 && hi->n == 0)                      /* the max was lo */
+        aa_min(ctx, z, &t, hi);
+    else
+        min_max_r(ctx, z, &t, hi, -1.0, aa_range(&t), rh);
 }
 
 /* mix(x, y, a) = x + a*(y - x) */

@@ -20,7 +20,8 @@
  *     is made of its operand's derivative bounds) writing into V;
  *   - of the kinds box runs can shorten (copies, the arithmetic, texture,
  *     calculatenormal) is SL_BOX_DEAD when nothing it writes is in V or D,
- *     SL_BOX_VALUE when nothing is in D (copies and arithmetic only);
+ *     SL_BOX_VALUE when nothing is in D (copies, arithmetic and texture
+ *     lookups);
  *   - of any other kind runs as it is, and so reads all its operands'
  *     values (a texture channel, a branch condition, an escape flag stay
  *     exact), merge tables' death and return flags included.
@@ -111,9 +112,12 @@ static bool shortenable(const sl_insn *in, int *zf, int *zn, int xf[4], int xn[4
     }
 }
 
+/* texture lookups too: their values read only their arguments' values
+ * (issue 24: a terrain's lookups feed P alone, and their derivative
+ * bounds were a tenth of a box run) */
 static bool value_only_kind(int op)
 {
-    return op != SL_OP_TEXTURE && op != SL_OP_CALCNORMAL;
+    return op != SL_OP_CALCNORMAL;
 }
 
 static bool is_derivative(int op)

@@ -28,4 +28,5 @@ static inline void b_from_interval(sl_vm *vm, B *z, ia_interval r)
 #define VM_FILE(vm) ((vm)->ad)
 #define VM_VARIANT VM_VAR_AFFINE_DERIV
 #define VM_BOX_RUNS 1                 /* box runs follow the program's plan */
+#define VM_TEXTURE_ARGS 1             /* b_texture_args: no copies of the arguments */
 #include "vm_deriv.inc"

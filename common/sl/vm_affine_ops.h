@@ -354,19 +354,20 @@ static inline void VM_OP(v_cells, b_cells)(sl_vm *vm, A *z, const A *s, const A 
     aa_clamp(vm->ctx, z, z, &flo, &fhi);
 }
 
-static inline sl_status VM_OP(v_texture, b_texture)(sl_vm *vm, A *S, const sl_insn *in, int pc)
+/* The lookup of TEXTURE instruction `in` of texture t (sl_vm_texture),
+ * its arguments at arg[0..5], into out[0..outs): the derivative mode
+ * hands in its slots' values where a copy of them was (issue 24). */
+static inline sl_status VM_OP(v_texture_args, b_texture_args)(sl_vm *vm, const tex_texture *t,
+                                                              const A *const arg[6],
+                                                              const sl_insn *in, int pc,
+                                                              A out[3])
 {
-    sl_status st = SL_OK;
-    const tex_texture *t = sl_vm_texture(vm, vm->str[in->b], pc, &st);
-    if (!t)
-        return st;
     double q;
-    if (!VM_OP(v_is_const, b_is_const)(&S[in->c + 4], &q))
+    if (!VM_OP(v_is_const, b_is_const)(arg[4], &q))
         return sl_vm_texture_channel_error(vm, pc);
     tex_wrap sw = (tex_wrap)SL_TEXOP_SWRAP(in->d), tw = (tex_wrap)SL_TEXOP_TWRAP(in->d);
     int c = sl_tex_channel(q);
     int outs = sl_texop_outs(in->d);
-    A out[3];
     if (SL_TEXOP_KIND(in->d) == SL_TEXOP_GRAD) {
         double ls, lt;
         tex_lipschitz(t, c, &ls, &lt);
@@ -376,29 +377,44 @@ static inline sl_status VM_OP(v_texture, b_texture)(sl_vm *vm, A *S, const sl_in
         tex_range r;
         double *ends[4] = { r.s, r.t, r.ws, r.wt };
         for (int k = 0; k < 4; k++) {
-            ia_interval x = aa_range(&S[in->c + k]);
+            ia_interval x = aa_range(arg[k]);
             ends[k][0] = x.lo;
             ends[k][1] = x.hi;
         }
         for (int i = 0; i < outs; i++) {
             int ch = c < 0 ? -1 : c + i;
             tex_cell cells[2];
+            double lo, hi;
             int n;
             if (ch < 0 || ch >= tex_channels(t)) {
                 if (in->d & SL_TEXOP_FILL)
-                    VM_OP(v_mov, b_mov)(vm, &out[i], &S[in->c + 5]);
+                    VM_OP(v_mov, b_mov)(vm, &out[i], arg[5]);
                 else
                     aa_const(&out[i], sl_tex_default_fill(ch));
-            } else if ((n = tex_cells(t, ch, &r, sw, tw, cells)) > 0) {
-                VM_OP(v_cells, b_cells)(vm, &out[i], &S[in->c], &S[in->c + 1], cells, n);
+            } else if ((n = tex_cells_or_bound(t, ch, &r, sw, tw, 0.0, cells, &lo, &hi)) > 0) {
+                VM_OP(v_cells, b_cells)(vm, &out[i], arg[0], arg[1], cells, n);
             } else {
-                double lo, hi;
-                tex_bound(t, ch, &r, sw, tw, 0.0, &lo, &hi);
                 VM_OP(v_span, b_span)(&out[i], lo, hi);
             }
         }
     }
-    for (int i = 0; i < outs; i++)
+    return SL_OK;
+}
+
+static inline sl_status VM_OP(v_texture, b_texture)(sl_vm *vm, A *S, const sl_insn *in, int pc)
+{
+    sl_status st = SL_OK;
+    const tex_texture *t = sl_vm_texture(vm, vm->str[in->b], pc, &st);
+    if (!t)
+        return st;
+    const A *arg[6];
+    for (int k = 0; k < 6; k++)
+        arg[k] = &S[in->c + k];
+    A out[3];
+    st = VM_OP(v_texture_args, b_texture_args)(vm, t, arg, in, pc, out);
+    if (st != SL_OK)
+        return st;
+    for (int i = 0; i < sl_texop_outs(in->d); i++)
         VM_OP(v_mov, b_mov)(vm, &S[in->a + i], &out[i]);
     return SL_OK;
 }

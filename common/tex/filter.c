@@ -55,6 +55,22 @@ static double fetch(const tex_texture *t, int k, int c, int i, int j, tex_wrap s
     return tex_at(t, 0, k, c, i, j);
 }
 
+/* out[b * ni + a] = texel (wi[a], wj[b]) of channel c of level k of part
+ * p, for valid indexes: from memory, or a block of tiles at once */
+static void read_block(const tex_texture *t, int p, int k, int c, const int *wi, int ni,
+                       const int *wj, int nj, float *out)
+{
+    const float *lv = p == 0 ? t->avg[k] : p == 1 ? t->mn[k] : t->mx[k];
+    if (!lv) {
+        tex_tile_block(t, p, k, c, wi, ni, wj, nj, out);
+        return;
+    }
+    for (int b = 0; b < nj; b++)
+        for (int a = 0; a < ni; a++)
+            out[b * ni + a] = lv[((size_t)wj[b] * (size_t)t->lw[k] + (size_t)wi[a]) *
+                                     (size_t)t->nch + (size_t)c];
+}
+
 /* The texel coordinate of s at a level of n texels. */
 static double coord(double s, int n, tex_wrap wrap)
 {
@@ -192,6 +208,22 @@ static void minmax(const tex_texture *t, int c, int i0, int i1, int j0, int j1, 
     int m = 0;
     while (m + 1 < t->nlevels && (((i1 >> m) - (i0 >> m)) > 3 || ((j1 >> m) - (j0 >> m)) > 3))
         m++;
+    int ni = (i1 >> m) - (i0 >> m) + 1, nj = (j1 >> m) - (j0 >> m) + 1;
+    if (ni <= TEX_BLOCK_MAX && nj <= TEX_BLOCK_MAX) {     /* the texels a block at a time */
+        int wi[TEX_BLOCK_MAX], wj[TEX_BLOCK_MAX];
+        float mn[TEX_BLOCK_MAX * TEX_BLOCK_MAX], mx[TEX_BLOCK_MAX * TEX_BLOCK_MAX];
+        for (int a = 0; a < ni; a++)
+            wi[a] = (i0 >> m) + a;
+        for (int b = 0; b < nj; b++)
+            wj[b] = (j0 >> m) + b;
+        read_block(t, 1, m, c, wi, ni, wj, nj, mn);
+        read_block(t, 2, m, c, wi, ni, wj, nj, mx);
+        for (int q = 0; q < ni * nj; q++) {     /* the same order as below */
+            *lo = fmin(*lo, mn[q]);
+            *hi = fmax(*hi, mx[q]);
+        }
+        return;
+    }
     for (int j = j0 >> m; j <= j1 >> m; j++)
         for (int i = i0 >> m; i <= i1 >> m; i++) {
             *lo = fmin(*lo, tex_at(t, 1, m, c, i, j));
@@ -247,22 +279,25 @@ static bool few_cells(double s0, double s1, int n, int most, double *first, doub
     return *last - *first < most;
 }
 
-/* v[b][a] = fetch(t, k, c, i + a, j + b) for a < ni <= 4, b < nj <= 4: the
+/* v[b][a] = texel (i + a, j + b) of level k, wrapped (0 outside a black
+ * edge), for a < ni <= 4, b < nj <= 4: the
  * texels under at most 3 x 3 cells, each read once and each index wrapped
  * once (the cells share their edges: 16 reads where 36 were, issue 24) */
 static void gather(const tex_texture *t, int k, int c, int i, int ni, int j, int nj,
                    tex_wrap sw, tex_wrap tw, double v[4][4])
 {
     assert(ni >= 1 && ni <= 4 && nj >= 1 && nj <= 4);
-    int wi[4], wj[4];
+    int wi[4] = { 0 }, wj[4] = { 0 };
     bool oi[4], oj[4];
     for (int a = 0; a < ni; a++)
         wi[a] = wrap_index(i + a, t->lw[k], sw, &oi[a]);
     for (int b = 0; b < nj; b++)
         wj[b] = wrap_index(j + b, t->lh[k], tw, &oj[b]);
+    float f[16];
+    read_block(t, 0, k, c, wi, ni, wj, nj, f);       /* outside: index 0, then 0 */
     for (int b = 0; b < nj; b++)
         for (int a = 0; a < ni; a++)
-            v[b][a] = oi[a] || oj[b] ? 0.0 : tex_at(t, 0, k, c, wi[a], wj[b]);
+            v[b][a] = oi[a] || oj[b] ? 0.0 : f[b * ni + a];
 }
 
 /* lo <= level k's bilinear <= hi over the s and t of r: exact where r
@@ -337,22 +372,26 @@ static void level_range(const tex_texture *t, int k, int c, const tex_range *r, 
     *hi = h;
 }
 
-void tex_bound(const tex_texture *t, int c, const tex_range *r, tex_wrap swrap,
-               tex_wrap twrap, double fill, double *lo, double *hi)
+/* The filter's levels over the widths of r: lmin <= l <= lmax. */
+static void levels_of(const tex_texture *t, const tex_range *r, double *lmin, double *lmax)
 {
-    if (c < 0 || c >= t->nch) {
-        *lo = *hi = fill;
-        return;
-    }
-    if (isnan(r->s[0]) || isnan(r->s[1]) || isnan(r->t[0]) || isnan(r->t[1])) {
-        tex_range all = { { 0, 2 }, { 0, 2 }, { INFINITY, INFINITY }, { INFINITY, INFINITY } };
-        tex_bound(t, c, &all, TEX_WRAP_BLACK, TEX_WRAP_BLACK, fill, lo, hi);
-        return;
-    }
     double wslo, wshi, wtlo, wthi;
     abs_range(r->ws, &wslo, &wshi);
     abs_range(r->wt, &wtlo, &wthi);
-    double lmin = tex_level_of(t, wslo, wtlo), lmax = tex_level_of(t, wshi, wthi);
+    *lmin = tex_level_of(t, wslo, wtlo);
+    *lmax = tex_level_of(t, wshi, wthi);
+}
+
+static bool has_nan(const tex_range *r)
+{
+    return isnan(r->s[0]) || isnan(r->s[1]) || isnan(r->t[0]) || isnan(r->t[1]);
+}
+
+/* tex_bound of a valid channel and coordinates without NaN, at the levels
+ * [lmin, lmax] (levels_of), the tiles left pinned */
+static void bound_at(const tex_texture *t, int c, const tex_range *r, tex_wrap swrap,
+                     tex_wrap twrap, double lmin, double lmax, double *lo, double *hi)
+{
     int k0 = (int)floor(lmin), k1 = (int)floor(lmax);
     double l, h;
     if (k0 == k1) {              /* one pair of levels, blend f in [f0, f1] */
@@ -381,19 +420,32 @@ void tex_bound(const tex_texture *t, int c, const tex_range *r, tex_wrap swrap,
     }
     *lo = l;
     *hi = h;
+}
+
+void tex_bound(const tex_texture *t, int c, const tex_range *r, tex_wrap swrap,
+               tex_wrap twrap, double fill, double *lo, double *hi)
+{
+    if (c < 0 || c >= t->nch) {
+        *lo = *hi = fill;
+        return;
+    }
+    if (has_nan(r)) {
+        tex_range all = { { 0, 2 }, { 0, 2 }, { INFINITY, INFINITY }, { INFINITY, INFINITY } };
+        tex_bound(t, c, &all, TEX_WRAP_BLACK, TEX_WRAP_BLACK, fill, lo, hi);
+        return;
+    }
+    double lmin, lmax;
+    levels_of(t, r, &lmin, &lmax);
+    bound_at(t, c, r, swrap, twrap, lmin, lmax, lo, hi);
     if (t->tiled)
         tex_tiles_unpin();
 }
 
-static int cells(const tex_texture *t, int c, const tex_range *r, tex_wrap swrap,
-                 tex_wrap twrap, tex_cell out[2])
+/* tex_cells of a valid channel at the levels [lmin, lmax], the tiles left
+ * pinned */
+static int cells_at(const tex_texture *t, int c, const tex_range *r, tex_wrap swrap,
+                    tex_wrap twrap, double lmin, double lmax, tex_cell out[2])
 {
-    if (c < 0 || c >= t->nch)
-        return 0;
-    double wslo, wshi, wtlo, wthi;
-    abs_range(r->ws, &wslo, &wshi);
-    abs_range(r->wt, &wtlo, &wthi);
-    double lmin = tex_level_of(t, wslo, wtlo), lmax = tex_level_of(t, wshi, wthi);
     if (lmin != lmax)
         return 0;                /* the blend varies: no single form */
     int k = (int)floor(lmin);
@@ -411,11 +463,12 @@ static int cells(const tex_texture *t, int c, const tex_range *r, tex_wrap swrap
         cell->h = t->lh[lv];
         cell->oi = oi;
         cell->oj = oj;
-        int i = (int)oi, j = (int)oj;
-        cell->v[0] = fetch(t, lv, c, i, j, swrap, twrap);
-        cell->v[1] = fetch(t, lv, c, i + 1, j, swrap, twrap);
-        cell->v[2] = fetch(t, lv, c, i, j + 1, swrap, twrap);
-        cell->v[3] = fetch(t, lv, c, i + 1, j + 1, swrap, twrap);
+        double tx[4][4];
+        gather(t, lv, c, (int)oi, 2, (int)oj, 2, swrap, twrap, tx);
+        cell->v[0] = tx[0][0];
+        cell->v[1] = tx[0][1];
+        cell->v[2] = tx[1][0];
+        cell->v[3] = tx[1][1];
     }
     return n;
 }
@@ -423,7 +476,34 @@ static int cells(const tex_texture *t, int c, const tex_range *r, tex_wrap swrap
 int tex_cells(const tex_texture *t, int c, const tex_range *r, tex_wrap swrap,
               tex_wrap twrap, tex_cell out[2])
 {
-    int n = cells(t, c, r, swrap, twrap, out);
+    if (c < 0 || c >= t->nch)
+        return 0;
+    double lmin, lmax;
+    levels_of(t, r, &lmin, &lmax);
+    int n = cells_at(t, c, r, swrap, twrap, lmin, lmax, out);
+    if (t->tiled)
+        tex_tiles_unpin();
+    return n;
+}
+
+int tex_cells_or_bound(const tex_texture *t, int c, const tex_range *r, tex_wrap swrap,
+                       tex_wrap twrap, double fill, tex_cell out[2], double *lo, double *hi)
+{
+    if (c < 0 || c >= t->nch) {
+        *lo = *hi = fill;
+        return 0;
+    }
+    double lmin, lmax;
+    levels_of(t, r, &lmin, &lmax);
+    int n = cells_at(t, c, r, swrap, twrap, lmin, lmax, out);
+    if (n == 0 && has_nan(r)) {
+        if (t->tiled)
+            tex_tiles_unpin();
+        tex_bound(t, c, r, swrap, twrap, fill, lo, hi);   /* the whole map */
+        return 0;
+    }
+    if (n == 0)
+        bound_at(t, c, r, swrap, twrap, lmin, lmax, lo, hi);
     if (t->tiled)
         tex_tiles_unpin();
     return n;

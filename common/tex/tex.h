@@ -145,6 +145,12 @@ typedef struct tex_cell {
  * parts, which affine runs write as an affine form of s and t. */
 int tex_cells(const tex_texture *t, int c, const tex_range *r, tex_wrap swrap,
               tex_wrap twrap, tex_cell out[2]);
+/* tex_cells where it gives cells (returns their number, out filled), else
+ * tex_bound (returns 0, [*lo, *hi]): the same results as the two calls,
+ * with the filter's levels computed once (issue 24: the affine lookup's
+ * path). */
+int tex_cells_or_bound(const tex_texture *t, int c, const tex_range *r, tex_wrap swrap,
+                       tex_wrap twrap, double fill, tex_cell out[2], double *lo, double *hi);
 
 /* Bounds of |d filter / ds| and |d filter / dt| of channel c over all
  * lookups at any footprint (0 for a missing channel). */

@@ -47,6 +47,13 @@ struct tex_texture {
  * the min, 2 the max): from memory, or from its tile (tiles.c). */
 float tex_tile_texel(const tex_texture *t, int p, int k, int c, int i, int j);
 
+/* out[b * ni + a] = texel (wi[a], wj[b]) of channel c of level k of part
+ * p, a tiled level (tex_at's NULL table), for ni, nj <= TEX_BLOCK_MAX
+ * valid indexes (tiles.c). */
+enum { TEX_BLOCK_MAX = 4 };
+void tex_tile_block(const tex_texture *t, int p, int k, int c, const int *wi, int ni,
+                    const int *wj, int nj, float *out);
+
 static inline float tex_at(const tex_texture *t, int p, int k, int c, int i, int j)
 {
     const float *lv = p == 0 ? t->avg[k] : p == 1 ? t->mn[k] : t->mx[k];

@@ -347,18 +347,12 @@ void tex_tiles_unpin(void)
     pinned.n = 0;
 }
 
-float tex_tile_texel(const tex_texture *t, int p, int k, int c, int i, int j)
+/* The texels of a tile, pinned by this thread until the lookup returns. */
+static const float *pin(tex_tile *tile)
 {
-    const tex_tiled *tl = t->tiled;
-    if (k == 0)
-        p = 0;
-    int tx = i / tl->tw, ty = j / tl->th;
-    tex_tile *tile = &tl->tiles[p * tl->resident + k][(size_t)ty * tl->ntx[k] + tx];
-    size_t at = ((size_t)(j - ty * tl->th) * (size_t)tl->tw + (size_t)(i - tx * tl->tw)) *
-                    (size_t)t->nch + (size_t)c;
     for (int q = 0; q < pinned.n; q++)
         if (pinned.tile[q] == tile)
-            return pinned.data[q][at];
+            return pinned.data[q];
     if (pinned.n == PINS)
         tex_tiles_unpin();
     atomic_fetch_add(&tile->pins, 1);
@@ -369,5 +363,52 @@ float tex_tile_texel(const tex_texture *t, int p, int k, int c, int i, int j)
         atomic_store_explicit(&tile->used, true, memory_order_relaxed);
     pinned.tile[pinned.n] = tile;
     pinned.data[pinned.n++] = d;
-    return d[at];
+    return d;
+}
+
+float tex_tile_texel(const tex_texture *t, int p, int k, int c, int i, int j)
+{
+    const tex_tiled *tl = t->tiled;
+    if (k == 0)
+        p = 0;
+    int tx = i / tl->tw, ty = j / tl->th;
+    tex_tile *tile = &tl->tiles[p * tl->resident + k][(size_t)ty * tl->ntx[k] + tx];
+    size_t at = ((size_t)(j - ty * tl->th) * (size_t)tl->tw + (size_t)(i - tx * tl->tw)) *
+                    (size_t)t->nch + (size_t)c;
+    return pin(tile)[at];
+}
+
+/* The same texels as tex_tile_texel at (wi[a], wj[b]), a block at a time
+ * (issue 24: a bound reads up to 4 x 4 texels, and each texel's tile
+ * division and pin search was most of its cost): the divisions once per
+ * column and row, the pin search once per tile the block touches. */
+void tex_tile_block(const tex_texture *t, int p, int k, int c, const int *wi, int ni,
+                    const int *wj, int nj, float *out)
+{
+    assert(ni >= 1 && ni <= TEX_BLOCK_MAX && nj >= 1 && nj <= TEX_BLOCK_MAX);
+    const tex_tiled *tl = t->tiled;
+    if (k == 0)
+        p = 0;
+    int tx[TEX_BLOCK_MAX], ox[TEX_BLOCK_MAX], ty[TEX_BLOCK_MAX], oy[TEX_BLOCK_MAX];
+    for (int a = 0; a < ni; a++) {
+        tx[a] = wi[a] / tl->tw;
+        ox[a] = wi[a] - tx[a] * tl->tw;
+    }
+    for (int b = 0; b < nj; b++) {
+        ty[b] = wj[b] / tl->th;
+        oy[b] = wj[b] - ty[b] * tl->th;
+    }
+    tex_tile *row = tl->tiles[p * tl->resident + k], *last = NULL;
+    const float *d = NULL;
+    for (int b = 0; b < nj; b++)
+        for (int a = 0; a < ni; a++) {
+            tex_tile *tile = &row[(size_t)ty[b] * tl->ntx[k] + tx[a]];
+            if (tile != last) {
+                d = pin(tile);
+                last = tile;
+            }
+            size_t at = ((size_t)oy[b] * (size_t)tl->tw + (size_t)ox[a]) * (size_t)t->nch +
+                        (size_t)c;
+            out[b * ni + a] = d[at];
+        }
 }

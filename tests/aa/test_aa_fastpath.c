@@ -17,6 +17,10 @@
  *   aa_exact_difference        when it answers, aa_range(aa_sub(x, y)) is
  *                              [d, d]; it answers for most pairs of constants
  *   aa_is_exact_const          aa_range(x) is [x0, x0]
+ *   aa_clamp(x, lo, hi)        = aa_min(aa_max(x, lo), hi) (bounded) with the same
+ *                              symbols taken, also with z aliasing x: x
+ *                              between lo and hi (its copy), below, above,
+ *                              across either end, constants and forms
  */
 #include <stdarg.h>
 #include <stddef.h>
@@ -258,11 +262,83 @@ static void test_exact_difference(void **state)
     assert_int_equal(bad, 0);
 }
 
+/* ---- clamp: max then min, each range once ---- */
+
+/* x: a random form, or one of 1..8 symbols of a small radius around a
+ * point of [-1.5, 1.5], so that it often lies between -1 and 1, across
+ * one of them, or outside (a normalize's clamp) */
+static void clamp_operand(aa_form *x)
+{
+    if (rng_int(3) == 0) {
+        rng_form(x);
+        return;
+    }
+    aa_const(x, 3.0 * rng_unit() - 1.5);
+    int n = rng_int(4) == 0 ? 0 : 1 + rng_int(8);
+    double r = ldexp(rng_unit(), -rng_int(12));
+    for (int i = 0; i < n; i++)
+        x->c[i] = rng_int(4) == 0 ? 0.0 : r * (rng_unit() - 0.5) / (n + 1);
+    x->n = (unsigned short)n;
+    x->err = rng_int(2) ? 0.0 : r * rng_unit() / (n + 1);
+    double rad = aa_radius(x);
+    x->lo = x->x0 - rad * (1.0 + 0x1p-40);
+    x->hi = x->x0 + rad * (1.0 + 0x1p-40);
+    if (rng_int(5) == 0)
+        x->flags |= AA_DISCONTINUOUS;
+}
+
+static void test_clamp_is_max_then_min(void **state)
+{
+    (void)state;
+    long bad = 0, between = 0, across = 0, outside = 0;
+    for (int t = 0; t < CASES; t++) {
+        aa_form x, lo, hi, z, m, r;
+        clamp_operand(&x);
+        if (rng_int(4) == 0) {
+            clamp_operand(&lo);
+            clamp_operand(&hi);
+        } else {
+            aa_const(&lo, -1.0);
+            aa_const(&hi, 1.0);
+            if (rng_int(6) == 0)
+                lo.flags |= AA_DISCONTINUOUS;
+        }
+        if ((x.flags | lo.flags | hi.flags) & AA_UNBOUNDED)
+            continue;                    /* clamped as intervals, not max then min */
+        int used = rng_int(AA_DEFAULT_CAPACITY + 1);
+        aa_context a, b;
+        aa_context_init(&a, AA_DEFAULT_CAPACITY);
+        aa_context_init(&b, AA_DEFAULT_CAPACITY);
+        a.used = b.used = used;
+        bool alias = rng_int(3) == 0;
+        z = x;
+        aa_clamp(&a, alias ? &z : &m, &z, &lo, &hi);
+        if (!alias)
+            z = m;
+        aa_max(&b, &m, &x, &lo);
+        aa_min(&b, &r, &m, &hi);
+        ia_interval rx = aa_range(&x), rl = aa_range(&lo), rh = aa_range(&hi);
+        if (rl.hi <= rx.lo && rx.hi <= rh.lo)
+            between++;
+        else if (rx.hi <= rl.lo || rh.hi <= rx.lo)
+            outside++;
+        else
+            across++;
+        if (!same_form(&z, &r) || a.used != b.used || a.folded != b.folded)
+            report("aa_clamp", ++bad, &z, &r);
+    }
+    printf("aa_clamp: %ld cases between, %ld across an end, %ld outside; %ld differ from "
+           "aa_min(aa_max(x, lo), hi)\n", between, across, outside, bad);
+    assert_true(between > CASES / 10 && across > CASES / 20 && outside > CASES / 20);
+    assert_int_equal(bad, 0);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_lincomb_shapes_bitwise),
         cmocka_unit_test(test_exact_difference),
+        cmocka_unit_test(test_clamp_is_max_then_min),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

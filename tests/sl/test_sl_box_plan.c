@@ -15,6 +15,9 @@
  *               (SL_BOX_DEAD) and runs the normalize chain without
  *               derivatives (SL_BOX_VALUE), keeps the derivative chain of
  *               the filter width (SL_BOX_RUN); a loop gets no plan
+ *   lookups     heightmap.sl's two lookups of a map (in a texture cache)
+ *               run without derivative bounds (SL_BOX_VALUE), and P is the
+ *               full run's form for form
  */
 #include <dirent.h>
 #include <stdarg.h>
@@ -25,6 +28,9 @@
 
 #include "sl/bytecode.h"
 #include "sl_harness.h"
+#include "tex/tex.h"
+
+static tex_cache *g_textures;      /* the maps of the runs below (NULL: none) */
 
 #ifndef AAFARM_CORPUS_DIR
 #define AAFARM_CORPUS_DIR "tests/shaders/corpus"
@@ -83,6 +89,8 @@ static int differing_as(sl_program *p, const char *what, bool exact, int *rename
 {
     sl_instance *inst = sl_instance_new(p);
     sl_vm *vm = sl_vm_new(NULL);
+    if (g_textures)
+        sl_vm_set_textures(vm, g_textures);
     aa_context ctx;
     aa_context_init(&ctx, AA_DEFAULT_CAPACITY);
     unsigned long long seed = 0x5eedull;
@@ -271,12 +279,51 @@ static void test_plan(void **state)
     sl_program_destroy(&p);
 }
 
+/* heightmap.sl (scenes/shaders) with its map named: the main lookup and
+ * the detail layer, both blurred by the filter width */
+static const char LOOKUPS[] =
+    "displacement t(float Km = 0.3, detail = 0.15, detailrepeat = 6, blur = 1) {\n"
+    "  float ss = s, tt = t;\n"
+    "  float fw = max(abs(Du(ss) * du) + abs(Dv(ss) * dv),\n"
+    "                 abs(Du(tt) * du) + abs(Dv(tt) * dv));\n"
+    "  float h = texture(\"h.tx\"[0], ss, tt, \"blur\", blur * fw);\n"
+    "  h += detail * texture(\"h.tx\"[0], ss * detailrepeat, tt * detailrepeat,\n"
+    "                        \"blur\", blur * fw * detailrepeat);\n"
+    "  P += Km * h * normalize(N);\n"
+    "  N = calculatenormal(P);\n"
+    "}\n";
+
+static void test_lookups(void **state)
+{
+    (void)state;
+    enum { W = 64 };
+    static float px[W * W];
+    unsigned long long rs = 11;
+    for (int k = 0; k < W * W; k++)
+        px[k] = (float)(h_rand(&rs) - 0.5);
+    g_textures = tex_cache_new(0);
+    assert_true(tex_cache_put(g_textures, "h.tx", tex_from_pixels(px, W, W, 1, "h.tx")));
+    sl_program *p = h_compile(LOOKUPS);
+    assert_non_null(p);
+    assert_non_null(p->box_plan);
+    int n = 0;
+    for (int pc = find_op(p, SL_OP_TEXTURE, 0); pc >= 0; pc = find_op(p, SL_OP_TEXTURE, pc + 1)) {
+        assert_int_equal(p->box_plan[pc], SL_BOX_VALUE);
+        n++;
+    }
+    assert_int_equal(n, 2);
+    assert_int_equal(differing(p, "lookups"), 0);
+    sl_program_destroy(&p);
+    tex_cache_destroy(&g_textures);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_same_P),
         cmocka_unit_test(test_library_and_corpus),
         cmocka_unit_test(test_plan),
+        cmocka_unit_test(test_lookups),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

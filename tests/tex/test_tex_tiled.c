@@ -6,7 +6,8 @@
  *    writes) opens with levels in tiles, and gives exactly what the same
  *    image built in memory gives: every texel of every level, the filter
  *    and its derivatives (float and dual), the bound of random ranges
- *    (interval), the single cells (affine), the derivative bounds, all
+ *    (interval), the single cells (affine), cells-or-bound (the affine
+ *    lookup: the same as the two), the derivative bounds, all
  *    wraps, both odd and even sizes and 1 to 3 channels;
  *  - with a pool of a budget of a few tiles, 4 threads doing random
  *    lookups get bit for bit what the in-memory map gives, while tiles are
@@ -88,6 +89,26 @@ static char *write_map(const tex_texture *t, const char *name)
     return p;
 }
 
+/* tex_cells_or_bound against tex_cells, then tex_bound where that gives
+ * no cells (the affine lookup's path, issue 24): 1 when they differ */
+static int cells_or_bound_differs(const tex_texture *t, int c, const tex_range *rg,
+                                  tex_wrap sw, tex_wrap tw)
+{
+    tex_cell one[2], two[2];
+    double lo1 = 0, hi1 = 0, lo2, hi2;
+    memset(one, 0, sizeof one);
+    memset(two, 0, sizeof two);
+    int n1 = tex_cells(t, c, rg, sw, tw, one);
+    if (n1 == 0)
+        tex_bound(t, c, rg, sw, tw, 0.5, &lo1, &hi1);
+    int n2 = tex_cells_or_bound(t, c, rg, sw, tw, 0.5, two, &lo2, &hi2);
+    if (n1 != n2)
+        return 1;
+    if (n1 > 0)
+        return memcmp(one, two, (size_t)n1 * sizeof one[0]) != 0;
+    return !(memcmp(&lo1, &lo2, sizeof lo1) == 0 && memcmp(&hi1, &hi2, sizeof hi1) == 0);
+}
+
 /* one random lookup of every kind, a against b: the number of results
  * that differ (0: all exactly equal) */
 static int compare_once(const tex_texture *a, const tex_texture *b, rng *r)
@@ -113,6 +134,14 @@ static int compare_once(const tex_texture *a, const tex_texture *b, rng *r)
     tex_cell ca[2], cb[2];
     int na = tex_cells(a, c, &pt, sw, tw, ca), nb = tex_cells(b, c, &pt, sw, tw, cb);
     bad += na != nb || (na > 0 && memcmp(ca, cb, (size_t)na * sizeof ca[0]) != 0);
+    bad += cells_or_bound_differs(a, c, &rg, sw, tw) + cells_or_bound_differs(b, c, &rg, sw, tw);
+    bad += cells_or_bound_differs(a, c, &pt, sw, tw) + cells_or_bound_differs(b, c, &pt, sw, tw);
+    tex_range odd = uniform(r) < 0.5 ? rg : pt;       /* a NaN end; a missing channel */
+    if (uniform(r) < 0.5)
+        odd.s[0] = NAN;
+    else
+        odd.ws[1] = NAN;
+    bad += cells_or_bound_differs(b, c, &odd, sw, tw) + cells_or_bound_differs(b, nch, &pt, sw, tw);
     return bad;
 }
 
