@@ -83,7 +83,9 @@ bool geom_net_piece(const double *p, int stride, int ku, int kv, double s0, doub
     double h[GEOM_NURBS_MAX_ORDER][GEOM_NURBS_MAX_ORDER];
     for (int j = 0; j < kv; j++) geom_bezier_piece(p + j * ku * stride, stride, ku, s0, s1, h[j], 1);
     for (int i = 0; i < ku; i++) {
-        double col[GEOM_NURBS_MAX_ORDER], r[GEOM_NURBS_MAX_ORDER];
+        /* zeroed: GCC 12 at -O2 without asserts cannot see kv >= 1 and
+         * warns that geom_bezier_piece may read it unset */
+        double col[GEOM_NURBS_MAX_ORDER] = {0}, r[GEOM_NURBS_MAX_ORDER];
         for (int j = 0; j < kv; j++) col[j] = h[j][i];
         geom_bezier_piece(col, 1, kv, t0, t1, r, 1);
         for (int j = 0; j < kv; j++) q[j * ld + i] = ia_make(r[j] - pad, r[j] + pad);
