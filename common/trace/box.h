@@ -86,6 +86,68 @@ static inline float trace_float_up(double x)
     return (double)f < x ? trace_float_step(f, true) : f;
 }
 
+/* A box as the box cache stores it (issue 24, session 17): lo, hi, slo
+ * and shi as floats ROUNDED OUTWARD (lo and slo down, hi and shi up), so
+ * the float box contains the double box it came from, which contains the
+ * surface; converted back to double exactly. 52 bytes against 88. An axis
+ * (or slab) with lo > hi, or NaN, is rounded INWARD (lo up, hi down), so an
+ * empty box stays empty; +-inf stay +-inf, a finite value beyond FLT_MAX
+ * goes outward to +-inf (inward to +-FLT_MAX), and a nonzero value below
+ * the smallest subnormal float outward to +-2^-149 (inward to 0). */
+typedef struct trace_fbox {
+    float lo[3], hi[3];
+    unsigned flags;
+    float bend;
+    float sn[3];
+    float slo, shi;
+} trace_fbox;
+
+/* [lo, hi] as floats: outward when lo <= hi, else inward (empty stays empty) */
+static inline void trace_float_range(double lo, double hi, float *flo, float *fhi)
+{
+    if (lo <= hi) {
+        *flo = trace_float_down(lo);
+        *fhi = trace_float_up(hi);
+    } else {
+        *flo = trace_float_up(lo);
+        *fhi = trace_float_down(hi);
+    }
+}
+
+static inline void trace_fbox_pack(const trace_box *b, trace_fbox *f)
+{
+    const double *lo = &b->lo.x, *hi = &b->hi.x;
+    for (int i = 0; i < 3; i++) {
+        trace_float_range(lo[i], hi[i], &f->lo[i], &f->hi[i]);
+        f->sn[i] = b->sn[i];
+    }
+    f->flags = b->flags;
+    f->bend = b->bend;
+    trace_float_range(b->slo, b->shi, &f->slo, &f->shi);
+}
+
+static inline void trace_fbox_unpack(const trace_fbox *f, trace_box *b)
+{
+    b->lo = v3(f->lo[0], f->lo[1], f->lo[2]);
+    b->hi = v3(f->hi[0], f->hi[1], f->hi[2]);
+    b->flags = f->flags;
+    b->bend = f->bend;
+    for (int i = 0; i < 3; i++) b->sn[i] = f->sn[i];
+    b->pad = 0.0f;
+    b->slo = f->slo;
+    b->shi = f->shi;
+}
+
+/* The box as the cache would give it back: every box the traversal uses
+ * below a node goes through this, cached or not, so a box stays a pure
+ * function of (object, u-range, v-range) whatever the cache holds */
+static inline void trace_box_round_float(trace_box *b)
+{
+    trace_fbox f;
+    trace_fbox_pack(b, &f);
+    trace_fbox_unpack(&f, b);
+}
+
 static inline void trace_box_no_slab(trace_box *b)
 {
     b->sn[0] = b->sn[1] = b->sn[2] = b->pad = 0.0f;

@@ -175,7 +175,7 @@ trace_brood_id trace_boxcache_lookup(trace_boxcache *self, int object,
     }
     trace_brood_id id = *link;
     assert(id >= 0 && id < self->used && self->pool[id].parent == parent);
-    memcpy(out, self->pool[id].box, sizeof self->pool[id].box);
+    for (int i = 0; i < 4; i++) trace_fbox_unpack(&self->pool[id].box[i], &out[i]);
     lru_touch(self, id);
     self->stats.hits++;
     return id;
@@ -201,7 +201,7 @@ trace_brood_id trace_boxcache_insert(trace_boxcache *self, int object,
         return TRACE_BROOD_UNCACHED;
     }
     trace_brood *b = &self->pool[id];
-    memcpy(b->box, boxes, sizeof b->box);
+    for (int i = 0; i < 4; i++) trace_fbox_pack(&boxes[i], &b->box[i]);
     for (int i = 0; i < 4; i++) b->child[i] = TRACE_BROOD_NONE;
     b->parent = parent;
     b->object = object;

@@ -19,8 +19,12 @@
  * everything is pinned the new brood is simply not stored (the caller keeps
  * its own copy), so the budget is a hard limit.
  *
- * The cache changes speed only, never pixels: a box is a pure function of
- * (object, u-range, v-range), so a recomputed box equals the cached one.
+ * Boxes are stored as floats rounded outward (trace_fbox, box.h: 52 bytes
+ * a box instead of 88, a brood 244 instead of 392). The cache changes speed
+ * only, never pixels: a box is a pure function of (object, u-range,
+ * v-range), and the traversal rounds every box it makes to floats before it
+ * uses or stores it (trace_box_round_float), so a recomputed box equals the
+ * cached one.
  */
 #ifndef TRACE_BOXCACHE_H
 #define TRACE_BOXCACHE_H
@@ -38,7 +42,7 @@ typedef int32_t trace_brood_id;       /* -1: none, -2: not stored */
 #define TRACE_BROOD_UNCACHED (-2)
 
 typedef struct trace_brood {
-    trace_box box[4];
+    trace_fbox box[4];                /* floats rounded outward (box.h) */
     trace_brood_id child[4];          /* brood of child i's children */
     trace_brood_id parent;            /* brood holding our parent node, or NONE */
     int32_t object;                   /* object id (for roots) */

@@ -552,6 +552,9 @@ static trace_brood_id children_of(walk *w, trace_brood_id parent, int slot,
         if (depth >= TRACE_SAMPLE_DEPTH && stagnant(&kids[i], node_extent))
             sample_stagnant(th, owner, c, &kids[i]);
     }
+    /* the boxes as floats rounded outward, as the cache keeps them (a hit
+     * and a miss give the same boxes) */
+    for (int i = 0; i < 4; i++) trace_box_round_float(&kids[i]);
     return trace_boxcache_insert(th->cache, owner->id, parent, slot, kids);
 }
 

@@ -15,6 +15,7 @@
 
 static void fill(trace_box b[4], double k)
 {
+    memset(b, 0, 4 * sizeof *b);
     for (int i = 0; i < 4; i++) {
         b[i].lo = v3(k, k + i, -k);
         b[i].hi = v3(k + 1, k + i + 1, -k + 1);

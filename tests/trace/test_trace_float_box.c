@@ -1,0 +1,211 @@
+/*
+ * test_trace_float_box.c: the box cache's float boxes (box.h, trace_fbox):
+ * a box stored as floats contains the double box it came from (lo and slo
+ * rounded down, hi and shi up) for random boxes of every magnitude (huge,
+ * beyond FLT_MAX, tiny, subnormal, zeros, +-inf); an empty box stays empty;
+ * NaN stays NaN; a box already in floats comes back bit for bit; and the
+ * box cache gives back the rounded box (a hit equals a recomputation).
+ */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <string.h>
+#include <math.h>
+#include <cmocka.h>
+
+#include "trace/box.h"
+#include "trace/boxcache.h"
+
+static uint64_t rng = 0x9E3779B97F4A7C15ull;
+
+static uint64_t next(void)
+{
+    rng ^= rng << 13;
+    rng ^= rng >> 7;
+    rng ^= rng << 17;
+    return rng;
+}
+
+/* a double of any kind: random bits (every exponent, subnormals), ones
+ * near float boundaries, +-inf, zeros */
+static double any_double(void)
+{
+    uint64_t k = next() % 16;
+    double sign = (next() & 1) ? -1.0 : 1.0;
+    double m = (double)(next() >> 11) * 0x1p-53;          /* [0, 1) */
+    switch (k) {
+    case 0: return sign * INFINITY;
+    case 1: return sign * 0.0;
+    case 2: return sign * (double)FLT_MAX * (1.0 + m * 0x1p-20);   /* just above FLT_MAX */
+    case 3: return sign * 0x1p-149 * m * 2.0;                       /* below/at float subnormal */
+    case 4: return sign * 0x1p-126 * m;                             /* float subnormal range */
+    case 5: return sign * ldexp(1.0 + m, (int)(next() % 2000) - 1000);   /* huge and tiny */
+    case 6: { /* a float exactly */
+        float f = (float)(sign * ldexp(1.0 + m, (int)(next() % 200) - 100));
+        return f;
+    }
+    default: {
+        uint64_t b = next();
+        double x;
+        memcpy(&x, &b, sizeof x);
+        if (x != x) x = sign * m * 1e10;    /* NaN handled apart */
+        return x;
+    }
+    }
+}
+
+static void random_box(trace_box *b)
+{
+    memset(b, 0, sizeof *b);
+    double *lo = &b->lo.x, *hi = &b->hi.x;
+    for (int i = 0; i < 3; i++) {
+        double a = any_double(), c = any_double();
+        lo[i] = fmin(a, c);
+        hi[i] = fmax(a, c);
+    }
+    double a = any_double(), c = any_double();
+    b->slo = fmin(a, c);
+    b->shi = fmax(a, c);
+    b->sn[0] = 0.6f;
+    b->sn[2] = -0.8f;
+    b->flags = (unsigned)(next() & 0x7ff);
+    b->bend = (float)(next() % 1000) * 0.25f;
+}
+
+static void test_float_box_contains_the_double_box(void **state)
+{
+    (void)state;
+    long widened = 0;
+    for (int n = 0; n < 200000; n++) {
+        trace_box b, r;
+        random_box(&b);
+        r = b;
+        trace_box_round_float(&r);
+        const double *lo = &b.lo.x, *hi = &b.hi.x, *rlo = &r.lo.x, *rhi = &r.hi.x;
+        for (int i = 0; i < 3; i++) {
+            assert_true(rlo[i] <= lo[i]);
+            assert_true(rhi[i] >= hi[i]);
+            /* as floats, and at most one float step out */
+            assert_true((double)(float)rlo[i] == rlo[i] || isinf(rlo[i]));
+            assert_true((double)(float)rhi[i] == rhi[i] || isinf(rhi[i]));
+            if (isinf(lo[i])) assert_true(rlo[i] == lo[i]);
+            if (isinf(hi[i])) assert_true(rhi[i] == hi[i]);
+            widened += rlo[i] < lo[i];
+            widened += rhi[i] > hi[i];
+        }
+        assert_true(r.slo <= b.slo);
+        assert_true(r.shi >= b.shi);
+        assert_int_equal(r.flags, b.flags);
+        assert_true(r.bend == b.bend);
+        assert_memory_equal(r.sn, b.sn, sizeof b.sn);
+        assert_false(trace_box_is_empty(&r));
+        /* a box in floats comes back bit for bit */
+        trace_box again = r;
+        trace_box_round_float(&again);
+        assert_memory_equal(&again, &r, sizeof r);
+    }
+    assert_true(widened > 0);
+}
+
+static void test_edges(void **state)
+{
+    (void)state;
+    trace_box b;
+    memset(&b, 0, sizeof b);
+    /* beyond FLT_MAX: outward to inf; an unbounded box stays unbounded */
+    b.lo = v3(-1e300, -INFINITY, -0.0);
+    b.hi = v3(1e300, INFINITY, 0.0);
+    b.slo = -1e-300;
+    b.shi = 1e-300;
+    b.flags = 1u << 1;
+    trace_box r = b;
+    trace_box_round_float(&r);
+    assert_true(r.lo.x == -INFINITY && r.hi.x == INFINITY);
+    assert_true(r.lo.y == -INFINITY && r.hi.y == INFINITY);
+    assert_true(r.lo.z == 0.0 && r.hi.z == 0.0);
+    assert_true(r.slo == -0x1p-149 && r.shi == 0x1p-149);
+    /* just below the smallest subnormal float */
+    b.lo = v3(0x1p-150, -0x1p-150, 0x1p-149);
+    b.hi = v3(0x1p-149 * 1.5, 0x1p-200, 0x1p-149);
+    r = b;
+    trace_box_round_float(&r);
+    assert_true(r.lo.x == 0.0 && r.hi.x == 0x1p-148);
+    assert_true(r.lo.y == -0x1p-149 && r.hi.y == 0x1p-149);
+    assert_true(r.lo.z == 0x1p-149 && r.hi.z == 0x1p-149);
+    /* FLT_MAX itself and just above: the box stays finite only where it was */
+    b.lo = v3(-(double)FLT_MAX, (double)FLT_MAX, 1.0);
+    b.hi = v3((double)FLT_MAX, (double)FLT_MAX * (1.0 + 0x1p-40), 1.0 + 0x1p-30);
+    r = b;
+    trace_box_round_float(&r);
+    assert_true(r.lo.x == -(double)FLT_MAX && r.hi.x == (double)FLT_MAX);
+    assert_true(r.lo.y == (double)FLT_MAX && r.hi.y == INFINITY);
+    assert_true(r.lo.z == 1.0 && r.hi.z == 1.0 + 0x1p-23);
+}
+
+static void test_empty_stays_empty_and_nan_stays_nan(void **state)
+{
+    (void)state;
+    trace_box b;
+    memset(&b, 0, sizeof b);
+    /* lo above hi by less than a float step: outward would make it a point */
+    b.lo = v3(0.0, 1.0 + 0x1p-40, 0.0);
+    b.hi = v3(1.0, 1.0, 1.0);
+    assert_true(trace_box_is_empty(&b));
+    trace_box r = b;
+    trace_box_round_float(&r);
+    assert_true(trace_box_is_empty(&r));
+    assert_true(r.lo.y > r.hi.y);
+    /* the empty box of unions */
+    b.lo = v3(INFINITY, INFINITY, INFINITY);
+    b.hi = v3(-INFINITY, -INFINITY, -INFINITY);
+    r = b;
+    trace_box_round_float(&r);
+    assert_memory_equal(&r.lo, &b.lo, sizeof b.lo);
+    assert_memory_equal(&r.hi, &b.hi, sizeof b.hi);
+    /* NaN: still NaN, still empty */
+    b.lo = v3(NAN, 0.0, 0.0);
+    b.hi = v3(1.0, 1.0, 1.0);
+    b.slo = 0.3;
+    b.shi = NAN;
+    r = b;
+    trace_box_round_float(&r);
+    assert_true(isnan(r.lo.x) && r.hi.x == 1.0);
+    assert_true(isnan(r.shi) && r.slo == 0.3f);
+    assert_true(trace_box_is_empty(&r));
+    /* an inverted slab stays inverted */
+    b.lo = v3(0.0, 0.0, 0.0);
+    b.slo = 2.0 + 0x1p-40;
+    b.shi = 2.0;
+    r = b;
+    trace_box_round_float(&r);
+    assert_true(r.slo > r.shi);
+}
+
+static void test_cache_gives_back_the_rounded_box(void **state)
+{
+    (void)state;
+    trace_boxcache *c = trace_boxcache_new(0, 1);
+    assert_true(sizeof(trace_fbox) < sizeof(trace_box) * 2 / 3);
+    trace_box in[4], want[4], out[4];
+    for (int i = 0; i < 4; i++) {
+        random_box(&in[i]);
+        want[i] = in[i];
+        trace_box_round_float(&want[i]);
+    }
+    trace_brood_id id = trace_boxcache_insert(c, 0, TRACE_BROOD_NONE, 0, in);
+    assert_int_equal(trace_boxcache_lookup(c, 0, TRACE_BROOD_NONE, 0, out), id);
+    assert_memory_equal(out, want, sizeof want);
+    trace_boxcache_destroy(&c);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_float_box_contains_the_double_box),
+        cmocka_unit_test(test_edges),
+        cmocka_unit_test(test_empty_stays_empty_and_nan_stays_nan),
+        cmocka_unit_test(test_cache_gives_back_the_rounded_box),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
