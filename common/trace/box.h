@@ -17,7 +17,8 @@
  * the surface over the cell lies between the planes n . P = slo and
  * n . P = shi, n the unit normal of the plane spanned by the affine forms'
  * u and v terms (the cell's mean tangent plane), [slo, shi] the range of
- * the affine form n . P (rounded outward: displace.c). A box is as thick as
+ * the affine form n . P (rounded outward: displace.c; in the box cache as
+ * floats rounded outward again, trace_fbox below). A box is as thick as
  * the cell is tilted against the axes; the slab only as thick as the
  * surface is bumpy, so a grazing ray leaves it far sooner (the paper's
  * wave: 2.4x fewer boxes computed, the nodes a ray visits -12 %). It is
@@ -233,7 +234,9 @@ static inline bool trace_box_hit(const trace_box *b, const trace_ray *r,
  * planes are moved out by 2^-48 of om + |slo| + |shi|, which also covers
  * the subtractions, and n . d is kept as the interval den -+ 2^-48 dm. A
  * ray that may run along the planes (that interval holds 0) is not
- * narrowed. The quotients are moved out by 2^-50 of themselves. */
+ * narrowed. The quotients are moved out by 2^-50 of themselves. slo and
+ * shi may be the box cache's floats (trace_fbox): exact as doubles, so the
+ * argument holds as it is. */
 static inline bool trace_box_slab_hit(const trace_box *b, const trace_ray *r, double *t0,
                                       double *t1)
 {
