@@ -87,14 +87,19 @@ static inline float trace_float_up(double x)
     return (double)f < x ? trace_float_step(f, true) : f;
 }
 
-/* A box as the box cache stores it (issue 24, session 17): lo, hi, slo
- * and shi as floats ROUNDED OUTWARD (lo and slo down, hi and shi up), so
- * the float box contains the double box it came from, which contains the
- * surface; converted back to double exactly. 52 bytes against 88. An axis
- * (or slab) with lo > hi, or NaN, is rounded INWARD (lo up, hi down), so an
- * empty box stays empty; +-inf stay +-inf, a finite value beyond FLT_MAX
- * goes outward to +-inf (inward to +-FLT_MAX), and a nonzero value below
- * the smallest subnormal float outward to +-2^-149 (inward to 0). */
+/* A box as the box cache stores it (issue 24, session 17): lo and hi as
+ * float OFFSETS from a base box (the parent node's box: a child's offsets
+ * are about its parent's size, so a float keeps 2^-24 of that, not of the
+ * coordinates; a flat child of a flat parent stays exact), slo and shi as
+ * floats; all ROUNDED OUTWARD: lo and slo such that base + offset,
+ * converted and added in double, is at most the double value, hi and shi at
+ * least it. So the float box contains the double box it came from, which
+ * contains the surface. 52 bytes against 88. A base coordinate that is not
+ * finite counts as 0 (no base: all 0). An axis (or slab) with lo > hi, or
+ * NaN, is rounded INWARD (lo up, hi down), so an empty box stays empty;
+ * +-inf stay +-inf, a value out of the floats' range goes outward to
+ * +-inf, a nonzero offset below the smallest subnormal float outward to
+ * +-2^-149. */
 typedef struct trace_fbox {
     float lo[3], hi[3];
     unsigned flags;
@@ -103,34 +108,71 @@ typedef struct trace_fbox {
     float slo, shi;
 } trace_fbox;
 
-/* [lo, hi] as floats: outward when lo <= hi, else inward (empty stays empty) */
-static inline void trace_float_range(double lo, double hi, float *flo, float *fhi)
+/* x - base as a float d such that base + d (double, rounded to nearest) is
+ * <= x (up false) or >= x (up true): d is on that side of x - base exactly
+ * (the subtraction's error by two-sum), and rounding is monotonic */
+static inline float trace_float_offset(double x, double base, bool up)
 {
-    if (lo <= hi) {
-        *flo = trace_float_down(lo);
-        *fhi = trace_float_up(hi);
-    } else {
-        *flo = trace_float_up(lo);
-        *fhi = trace_float_down(hi);
+    double diff = x - base;
+    if (!isfinite(diff) && isfinite(x) && isfinite(base))   /* overflow */
+        return up ? INFINITY : -INFINITY;
+    float d = up ? trace_float_up(diff) : trace_float_down(diff);
+    if (isfinite(diff) && (double)d == diff) {
+        double bb = diff - x;
+        double err = (x - (diff - bb)) + (-base - bb);     /* x - base = diff + err */
+        if (up ? err > 0.0 : err < 0.0) d = trace_float_step(d, up);
+    }
+    return d;
+}
+
+/* [lo, hi] as float offsets from [blo, bhi]: outward when lo <= hi, else
+ * inward (empty stays empty) */
+static inline void trace_float_range(double lo, double hi, double blo, double bhi, float *flo,
+                                     float *fhi)
+{
+    bool outward = lo <= hi;
+    *flo = trace_float_offset(lo, blo, !outward);
+    *fhi = trace_float_offset(hi, bhi, outward);
+}
+
+/* the base box's coordinates, 0 where not finite (or no base) */
+static inline void trace_fbox_base(const trace_box *base, double blo[3], double bhi[3])
+{
+    for (int i = 0; i < 3; i++) {
+        double l = base ? (&base->lo.x)[i] : 0.0, h = base ? (&base->hi.x)[i] : 0.0;
+        blo[i] = isfinite(l) ? l : 0.0;
+        bhi[i] = isfinite(h) ? h : 0.0;
     }
 }
 
-static inline void trace_fbox_pack(const trace_box *b, trace_fbox *f)
+static inline void trace_fbox_pack(const trace_box *b, const trace_box *base, trace_fbox *f)
 {
+    double blo[3], bhi[3];
+    trace_fbox_base(base, blo, bhi);
     const double *lo = &b->lo.x, *hi = &b->hi.x;
     for (int i = 0; i < 3; i++) {
-        trace_float_range(lo[i], hi[i], &f->lo[i], &f->hi[i]);
+        trace_float_range(lo[i], hi[i], blo[i], bhi[i], &f->lo[i], &f->hi[i]);
         f->sn[i] = b->sn[i];
     }
     f->flags = b->flags;
     f->bend = b->bend;
-    trace_float_range(b->slo, b->shi, &f->slo, &f->shi);
+    trace_float_range(b->slo, b->shi, 0.0, 0.0, &f->slo, &f->shi);
 }
 
-static inline void trace_fbox_unpack(const trace_fbox *f, trace_box *b)
+/* base + d in double (a base of 0 keeps the sign of a zero d) */
+static inline double trace_fbox_coord(double base, float d)
 {
-    b->lo = v3(f->lo[0], f->lo[1], f->lo[2]);
-    b->hi = v3(f->hi[0], f->hi[1], f->hi[2]);
+    return base == 0.0 ? (double)d : base + (double)d;
+}
+
+static inline void trace_fbox_unpack(const trace_fbox *f, const trace_box *base, trace_box *b)
+{
+    double blo[3], bhi[3];
+    trace_fbox_base(base, blo, bhi);
+    b->lo = v3(trace_fbox_coord(blo[0], f->lo[0]), trace_fbox_coord(blo[1], f->lo[1]),
+               trace_fbox_coord(blo[2], f->lo[2]));
+    b->hi = v3(trace_fbox_coord(bhi[0], f->hi[0]), trace_fbox_coord(bhi[1], f->hi[1]),
+               trace_fbox_coord(bhi[2], f->hi[2]));
     b->flags = f->flags;
     b->bend = f->bend;
     for (int i = 0; i < 3; i++) b->sn[i] = f->sn[i];
@@ -139,14 +181,15 @@ static inline void trace_fbox_unpack(const trace_fbox *f, trace_box *b)
     b->shi = f->shi;
 }
 
-/* The box as the cache would give it back: every box the traversal uses
- * below a node goes through this, cached or not, so a box stays a pure
- * function of (object, u-range, v-range) whatever the cache holds */
-static inline void trace_box_round_float(trace_box *b)
+/* The box as the cache would give it back (stored against base): every box
+ * the traversal uses below a node goes through this, cached or not, so a
+ * box stays a pure function of (object, u-range, v-range) whatever the
+ * cache holds */
+static inline void trace_box_round_float(trace_box *b, const trace_box *base)
 {
     trace_fbox f;
-    trace_fbox_pack(b, &f);
-    trace_fbox_unpack(&f, b);
+    trace_fbox_pack(b, base, &f);
+    trace_fbox_unpack(&f, base, b);
 }
 
 static inline void trace_box_no_slab(trace_box *b)

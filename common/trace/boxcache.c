@@ -168,6 +168,13 @@ trace_brood_id trace_boxcache_lookup(trace_boxcache *self, int object,
                                      trace_brood_id parent, int slot,
                                      trace_box out[4])
 {
+    return trace_boxcache_lookup_at(self, object, parent, slot, NULL, out);
+}
+
+trace_brood_id trace_boxcache_lookup_at(trace_boxcache *self, int object,
+                                        trace_brood_id parent, int slot,
+                                        const trace_box *base, trace_box out[4])
+{
     trace_brood_id *link = link_of(self, object, parent, slot);
     if (!link || *link == TRACE_BROOD_NONE) {
         self->stats.misses++;
@@ -175,7 +182,7 @@ trace_brood_id trace_boxcache_lookup(trace_boxcache *self, int object,
     }
     trace_brood_id id = *link;
     assert(id >= 0 && id < self->used && self->pool[id].parent == parent);
-    for (int i = 0; i < 4; i++) trace_fbox_unpack(&self->pool[id].box[i], &out[i]);
+    for (int i = 0; i < 4; i++) trace_fbox_unpack(&self->pool[id].box[i], base, &out[i]);
     lru_touch(self, id);
     self->stats.hits++;
     return id;
@@ -184,6 +191,13 @@ trace_brood_id trace_boxcache_lookup(trace_boxcache *self, int object,
 trace_brood_id trace_boxcache_insert(trace_boxcache *self, int object,
                                      trace_brood_id parent, int slot,
                                      const trace_box boxes[4])
+{
+    return trace_boxcache_insert_at(self, object, parent, slot, NULL, boxes);
+}
+
+trace_brood_id trace_boxcache_insert_at(trace_boxcache *self, int object,
+                                        trace_brood_id parent, int slot,
+                                        const trace_box *base, const trace_box boxes[4])
 {
     if (!link_of(self, object, parent, slot)) {
         self->stats.not_stored++;
@@ -201,7 +215,7 @@ trace_brood_id trace_boxcache_insert(trace_boxcache *self, int object,
         return TRACE_BROOD_UNCACHED;
     }
     trace_brood *b = &self->pool[id];
-    for (int i = 0; i < 4; i++) trace_fbox_pack(&boxes[i], &b->box[i]);
+    for (int i = 0; i < 4; i++) trace_fbox_pack(&boxes[i], base, &b->box[i]);
     for (int i = 0; i < 4; i++) b->child[i] = TRACE_BROOD_NONE;
     b->parent = parent;
     b->object = object;

@@ -19,12 +19,12 @@
  * everything is pinned the new brood is simply not stored (the caller keeps
  * its own copy), so the budget is a hard limit.
  *
- * Boxes are stored as floats rounded outward (trace_fbox, box.h: 52 bytes
- * a box instead of 88, a brood 244 instead of 392). The cache changes speed
- * only, never pixels: a box is a pure function of (object, u-range,
- * v-range), and the traversal rounds every box it makes to floats before it
- * uses or stores it (trace_box_round_float), so a recomputed box equals the
- * cached one.
+ * Boxes are stored as float offsets from their node's box, rounded
+ * outward (trace_fbox, box.h: 52 bytes a box instead of 88, a brood 244
+ * instead of 392). The cache changes speed only, never pixels: a box is a
+ * pure function of (object, u-range, v-range), and the traversal rounds
+ * every box it makes that way before it uses or stores it
+ * (trace_box_round_float), so a recomputed box equals the cached one.
  */
 #ifndef TRACE_BOXCACHE_H
 #define TRACE_BOXCACHE_H
@@ -77,6 +77,16 @@ trace_brood_id trace_boxcache_lookup(trace_boxcache *self, int object,
 trace_brood_id trace_boxcache_insert(trace_boxcache *self, int object,
                                      trace_brood_id parent, int slot,
                                      const trace_box boxes[4]);
+
+/* The same with the boxes stored as offsets from a base box (trace_fbox,
+ * box.h): the node's own box; a lookup must give the base it was inserted
+ * with (NULL: none, as the two above) */
+trace_brood_id trace_boxcache_lookup_at(trace_boxcache *self, int object,
+                                        trace_brood_id parent, int slot,
+                                        const trace_box *base, trace_box out[4]);
+trace_brood_id trace_boxcache_insert_at(trace_boxcache *self, int object,
+                                        trace_brood_id parent, int slot,
+                                        const trace_box *base, const trace_box boxes[4]);
 
 /* Pin / unpin a brood while the traversal is below it. */
 void trace_boxcache_pin(trace_boxcache *self, trace_brood_id id);

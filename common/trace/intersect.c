@@ -527,7 +527,11 @@ static trace_brood_id children_of(walk *w, trace_brood_id parent, int slot,
     trace_thread *th = w->th;
     /* instances sharing a prototype's boxes share its cache entries */
     const trace_object *owner = trace_box_owner(w->obj);
-    trace_brood_id id = trace_boxcache_lookup(th->cache, owner->id, parent, slot, kids);
+    /* the boxes as float offsets from the node's box (box.h, trace_fbox);
+     * an object's root box may differ between instances sharing the
+     * prototype's broods: the root's children are stored without a base */
+    const trace_box *base = parent == TRACE_BROOD_NONE ? NULL : node;
+    trace_brood_id id = trace_boxcache_lookup_at(th->cache, owner->id, parent, slot, base, kids);
     if (id != TRACE_BROOD_NONE) return id;
     double node_extent = trace_box_extent(node);
     /* below a box its cases narrowed, the children run their cases first
@@ -552,10 +556,10 @@ static trace_brood_id children_of(walk *w, trace_brood_id parent, int slot,
         if (depth >= TRACE_SAMPLE_DEPTH && stagnant(&kids[i], node_extent))
             sample_stagnant(th, owner, c, &kids[i]);
     }
-    /* the boxes as floats rounded outward, as the cache keeps them (a hit
-     * and a miss give the same boxes) */
-    for (int i = 0; i < 4; i++) trace_box_round_float(&kids[i]);
-    return trace_boxcache_insert(th->cache, owner->id, parent, slot, kids);
+    /* the boxes rounded outward as the cache keeps them (a hit and a miss
+     * give the same boxes) */
+    for (int i = 0; i < 4; i++) trace_box_round_float(&kids[i], base);
+    return trace_boxcache_insert_at(th->cache, owner->id, parent, slot, base, kids);
 }
 
 /* Bounded work (issue 9): a walk ends after max_nodes_per_ray nodes, or

@@ -3,8 +3,10 @@
  * a box stored as floats contains the double box it came from (lo and slo
  * rounded down, hi and shi up) for random boxes of every magnitude (huge,
  * beyond FLT_MAX, tiny, subnormal, zeros, +-inf); an empty box stays empty;
- * NaN stays NaN; a box already in floats comes back bit for bit; and the
- * box cache gives back the rounded box (a hit equals a recomputation).
+ * NaN stays NaN; a box already in floats comes back bit for bit; offsets
+ * from a parent box (near, far, infinite) contain too, and a flat child of
+ * a flat parent is exact; and the box cache gives back the rounded box (a
+ * hit equals a recomputation).
  */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -73,22 +75,39 @@ static void random_box(trace_box *b)
     b->bend = (float)(next() % 1000) * 0.25f;
 }
 
+/* a base box: none, one of any kind, or one near b (a parent) */
+static const trace_box *random_base(const trace_box *b, trace_box *base)
+{
+    switch (next() % 3) {
+    case 0: return NULL;
+    case 1: random_box(base); return base;
+    default: {
+        *base = *b;
+        double *lo = &base->lo.x, *hi = &base->hi.x;
+        for (int i = 0; i < 3; i++) {
+            double w = fabs(hi[i] - lo[i]) * (double)(next() % 5) * 0.3;
+            lo[i] -= w;
+            hi[i] += w * 0.7;
+        }
+        return base;
+    }
+    }
+}
+
 static void test_float_box_contains_the_double_box(void **state)
 {
     (void)state;
     long widened = 0;
-    for (int n = 0; n < 200000; n++) {
-        trace_box b, r;
+    for (int n = 0; n < 300000; n++) {
+        trace_box b, r, bb;
         random_box(&b);
+        const trace_box *base = random_base(&b, &bb);
         r = b;
-        trace_box_round_float(&r);
+        trace_box_round_float(&r, base);
         const double *lo = &b.lo.x, *hi = &b.hi.x, *rlo = &r.lo.x, *rhi = &r.hi.x;
         for (int i = 0; i < 3; i++) {
             assert_true(rlo[i] <= lo[i]);
             assert_true(rhi[i] >= hi[i]);
-            /* as floats, and at most one float step out */
-            assert_true((double)(float)rlo[i] == rlo[i] || isinf(rlo[i]));
-            assert_true((double)(float)rhi[i] == rhi[i] || isinf(rhi[i]));
             if (isinf(lo[i])) assert_true(rlo[i] == lo[i]);
             if (isinf(hi[i])) assert_true(rhi[i] == hi[i]);
             widened += rlo[i] < lo[i];
@@ -100,10 +119,16 @@ static void test_float_box_contains_the_double_box(void **state)
         assert_true(r.bend == b.bend);
         assert_memory_equal(r.sn, b.sn, sizeof b.sn);
         assert_false(trace_box_is_empty(&r));
-        /* a box in floats comes back bit for bit */
-        trace_box again = r;
-        trace_box_round_float(&again);
-        assert_memory_equal(&again, &r, sizeof r);
+        if (!base) {
+            /* without a base: floats, and a box in floats comes back bit for bit */
+            for (int i = 0; i < 3; i++) {
+                assert_true((double)(float)rlo[i] == rlo[i] || isinf(rlo[i]));
+                assert_true((double)(float)rhi[i] == rhi[i] || isinf(rhi[i]));
+            }
+            trace_box again = r;
+            trace_box_round_float(&again, NULL);
+            assert_memory_equal(&again, &r, sizeof r);
+        }
     }
     assert_true(widened > 0);
 }
@@ -120,7 +145,7 @@ static void test_edges(void **state)
     b.shi = 1e-300;
     b.flags = 1u << 1;
     trace_box r = b;
-    trace_box_round_float(&r);
+    trace_box_round_float(&r, NULL);
     assert_true(r.lo.x == -INFINITY && r.hi.x == INFINITY);
     assert_true(r.lo.y == -INFINITY && r.hi.y == INFINITY);
     assert_true(r.lo.z == 0.0 && r.hi.z == 0.0);
@@ -129,7 +154,7 @@ static void test_edges(void **state)
     b.lo = v3(0x1p-150, -0x1p-150, 0x1p-149);
     b.hi = v3(0x1p-149 * 1.5, 0x1p-200, 0x1p-149);
     r = b;
-    trace_box_round_float(&r);
+    trace_box_round_float(&r, NULL);
     assert_true(r.lo.x == 0.0 && r.hi.x == 0x1p-148);
     assert_true(r.lo.y == -0x1p-149 && r.hi.y == 0x1p-149);
     assert_true(r.lo.z == 0x1p-149 && r.hi.z == 0x1p-149);
@@ -137,7 +162,7 @@ static void test_edges(void **state)
     b.lo = v3(-(double)FLT_MAX, (double)FLT_MAX, 1.0);
     b.hi = v3((double)FLT_MAX, (double)FLT_MAX * (1.0 + 0x1p-40), 1.0 + 0x1p-30);
     r = b;
-    trace_box_round_float(&r);
+    trace_box_round_float(&r, NULL);
     assert_true(r.lo.x == -(double)FLT_MAX && r.hi.x == (double)FLT_MAX);
     assert_true(r.lo.y == (double)FLT_MAX && r.hi.y == INFINITY);
     assert_true(r.lo.z == 1.0 && r.hi.z == 1.0 + 0x1p-23);
@@ -153,14 +178,14 @@ static void test_empty_stays_empty_and_nan_stays_nan(void **state)
     b.hi = v3(1.0, 1.0, 1.0);
     assert_true(trace_box_is_empty(&b));
     trace_box r = b;
-    trace_box_round_float(&r);
+    trace_box_round_float(&r, NULL);
     assert_true(trace_box_is_empty(&r));
     assert_true(r.lo.y > r.hi.y);
     /* the empty box of unions */
     b.lo = v3(INFINITY, INFINITY, INFINITY);
     b.hi = v3(-INFINITY, -INFINITY, -INFINITY);
     r = b;
-    trace_box_round_float(&r);
+    trace_box_round_float(&r, NULL);
     assert_memory_equal(&r.lo, &b.lo, sizeof b.lo);
     assert_memory_equal(&r.hi, &b.hi, sizeof b.hi);
     /* NaN: still NaN, still empty */
@@ -169,7 +194,7 @@ static void test_empty_stays_empty_and_nan_stays_nan(void **state)
     b.slo = 0.3;
     b.shi = NAN;
     r = b;
-    trace_box_round_float(&r);
+    trace_box_round_float(&r, NULL);
     assert_true(isnan(r.lo.x) && r.hi.x == 1.0);
     assert_true(isnan(r.shi) && r.slo == 0.3f);
     assert_true(trace_box_is_empty(&r));
@@ -178,8 +203,47 @@ static void test_empty_stays_empty_and_nan_stays_nan(void **state)
     b.slo = 2.0 + 0x1p-40;
     b.shi = 2.0;
     r = b;
-    trace_box_round_float(&r);
+    trace_box_round_float(&r, NULL);
     assert_true(r.slo > r.shi);
+}
+
+static void test_offsets_from_the_parent(void **state)
+{
+    (void)state;
+    /* a flat child of a flat parent at a height that is no float: exact */
+    trace_box p, b;
+    memset(&p, 0, sizeof p);
+    p.lo = v3(0.1, 0.2, 0.3);
+    p.hi = v3(0.7, 0.2, 1e-300);
+    b = p;
+    b.lo.x = 0.1 + 0x1p-40;
+    trace_box r = b;
+    trace_box_round_float(&r, &p);
+    assert_true(r.lo.y == 0.2 && r.hi.y == 0.2);
+    assert_true(r.lo.z == 0.3 && r.hi.z == 1e-300);
+    assert_true(r.lo.x <= b.lo.x && r.lo.x >= 0.1 && b.lo.x - r.lo.x < 0x1p-60);
+    assert_true(r.hi.x == 0.7);
+    /* offsets a float step cannot move past the base's own rounding, and
+     * subtractions that round: still contained */
+    p.lo = v3(1e10, -1e10, 1.0);
+    p.hi = v3(1e10, -1e10, 1.0);
+    b.lo = v3(1e10 - 1e-7, -1e10 - 3e-7, 1.0 - 0x1p-53);
+    b.hi = v3(1e10 + 1e-7, -1e10 + 3e-7, 1.0 + 0x1p-52);
+    r = b;
+    trace_box_round_float(&r, &p);
+    assert_true(r.lo.x <= b.lo.x && r.hi.x >= b.hi.x);
+    assert_true(r.lo.y <= b.lo.y && r.hi.y >= b.hi.y);
+    assert_true(r.lo.z <= b.lo.z && r.hi.z >= b.hi.z);
+    /* a base far away, of the other sign: the offset overflows outward;
+     * bases that are not finite count as 0 */
+    p.lo = v3(-1.5e308, -INFINITY, NAN);
+    p.hi = v3(-1.6e308, INFINITY, 0.0);
+    b.lo = v3(1.5e308, 2.0, 3.0);
+    b.hi = v3(1.6e308, 2.5, 3.5);
+    r = b;
+    trace_box_round_float(&r, &p);
+    assert_true(r.lo.x <= b.lo.x && r.hi.x == INFINITY);
+    assert_true(r.lo.y == 2.0 && r.hi.y == 2.5 && r.lo.z == 3.0 && r.hi.z == 3.5);
 }
 
 static void test_cache_gives_back_the_rounded_box(void **state)
@@ -191,10 +255,20 @@ static void test_cache_gives_back_the_rounded_box(void **state)
     for (int i = 0; i < 4; i++) {
         random_box(&in[i]);
         want[i] = in[i];
-        trace_box_round_float(&want[i]);
+        trace_box_round_float(&want[i], NULL);
     }
     trace_brood_id id = trace_boxcache_insert(c, 0, TRACE_BROOD_NONE, 0, in);
     assert_int_equal(trace_boxcache_lookup(c, 0, TRACE_BROOD_NONE, 0, out), id);
+    assert_memory_equal(out, want, sizeof want);
+    /* against a base */
+    trace_box base;
+    random_box(&base);
+    for (int i = 0; i < 4; i++) {
+        want[i] = in[i];
+        trace_box_round_float(&want[i], &base);
+    }
+    trace_brood_id kid = trace_boxcache_insert_at(c, 0, id, 1, &base, in);
+    assert_int_equal(trace_boxcache_lookup_at(c, 0, id, 1, &base, out), kid);
     assert_memory_equal(out, want, sizeof want);
     trace_boxcache_destroy(&c);
 }
@@ -205,6 +279,7 @@ int main(void)
         cmocka_unit_test(test_float_box_contains_the_double_box),
         cmocka_unit_test(test_edges),
         cmocka_unit_test(test_empty_stays_empty_and_nan_stays_nan),
+        cmocka_unit_test(test_offsets_from_the_parent),
         cmocka_unit_test(test_cache_gives_back_the_rounded_box),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
