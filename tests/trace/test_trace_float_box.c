@@ -18,16 +18,11 @@
 
 #include "trace/box.h"
 #include "trace/boxcache.h"
+#include "test_rng.h"
 
+/* the tests' fixed-seed generator (test_rng.h) */
 static uint64_t rng = 0x9E3779B97F4A7C15ull;
-
-static uint64_t next(void)
-{
-    rng ^= rng << 13;
-    rng ^= rng >> 7;
-    rng ^= rng << 17;
-    return rng;
-}
+static uint64_t next(void) { return test_rng_next(&rng); }
 
 /* a double of any kind: random bits (every exponent, subnormals), ones
  * near float boundaries, +-inf, zeros */
