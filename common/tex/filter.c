@@ -60,15 +60,13 @@ static double fetch(const tex_texture *t, int k, int c, int i, int j, tex_wrap s
 static void read_block(const tex_texture *t, int p, int k, int c, const int *wi, int ni,
                        const int *wj, int nj, float *out)
 {
-    const float *lv = p == 0 ? t->avg[k] : p == 1 ? t->mn[k] : t->mx[k];
-    if (!lv) {
+    if (!(p == 0 ? t->avg[k] : p == 1 ? t->mn[k] : t->mx[k])) {   /* a tiled level */
         tex_tile_block(t, p, k, c, wi, ni, wj, nj, out);
         return;
     }
     for (int b = 0; b < nj; b++)
         for (int a = 0; a < ni; a++)
-            out[b * ni + a] = lv[((size_t)wj[b] * (size_t)t->lw[k] + (size_t)wi[a]) *
-                                     (size_t)t->nch + (size_t)c];
+            out[b * ni + a] = tex_at(t, p, k, c, wi[a], wj[b]);
 }
 
 /* The texel coordinate of s at a level of n texels. */
@@ -493,15 +491,13 @@ int tex_cells_or_bound(const tex_texture *t, int c, const tex_range *r, tex_wrap
         *lo = *hi = fill;
         return 0;
     }
+    if (has_nan(r)) {            /* no cells (one_cell fails on NaN): the whole map */
+        tex_bound(t, c, r, swrap, twrap, fill, lo, hi);
+        return 0;
+    }
     double lmin, lmax;
     levels_of(t, r, &lmin, &lmax);
     int n = cells_at(t, c, r, swrap, twrap, lmin, lmax, out);
-    if (n == 0 && has_nan(r)) {
-        if (t->tiled)
-            tex_tiles_unpin();
-        tex_bound(t, c, r, swrap, twrap, fill, lo, hi);   /* the whole map */
-        return 0;
-    }
     if (n == 0)
         bound_at(t, c, r, swrap, twrap, lmin, lmax, lo, hi);
     if (t->tiled)
