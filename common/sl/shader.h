@@ -189,6 +189,13 @@ void sl_vm_set_cancel(sl_vm *self, const atomic_int *flag);
  * only reach such results); P is as without. The other globals an affine
  * run writes are then not meaningful. Default off. */
 void sl_vm_set_box_runs(sl_vm *self, bool on);
+/* The uniform memo (vm_uniform.inc): affine runs copy the result of an
+ * operation on symbol-free operands they met before instead of computing
+ * it again (the same bits either way). Default on; off for tests that
+ * compare the two. */
+void sl_vm_set_uniform_memo(sl_vm *self, bool on);
+/* Operations the memo answered, over this VM's life */
+long sl_vm_uniform_hits(const sl_vm *self);
 void sl_vm_destroy(sl_vm **self_p);
 
 /* The named spaces the next runs read: kept by pointer (the binding of

@@ -81,6 +81,7 @@ void sl_vm_destroy(sl_vm **self_p)
     free(self->str);
     free(self->pool);
     free(self->spool);
+    vm_uniform_free(self);
     free(self);
     *self_p = NULL;
 }

@@ -24,4 +24,5 @@
 #define VM_OP(plain, deriv) plain
 #include "vm_affine_ops.h"
 
+#define VM_UNIFORM 1                  /* the uniform memo (vm_uniform.inc) */
 #include "vm_exec.inc"

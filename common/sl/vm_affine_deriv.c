@@ -29,4 +29,6 @@ static inline void b_from_interval(sl_vm *vm, B *z, ia_interval r)
 #define VM_VARIANT VM_VAR_AFFINE_DERIV
 #define VM_BOX_RUNS 1                 /* box runs follow the program's plan */
 #define VM_TEXTURE_ARGS 1             /* b_texture_args: no copies of the arguments */
+#define VM_UNIFORM 1                  /* the uniform memo (vm_uniform.inc) */
+#define VM_UNIFORM_DERIV 1
 #include "vm_deriv.inc"

@@ -103,6 +103,46 @@ typedef struct vm_accumulator {
     bool live;
 } vm_accumulator;
 
+/* The uniform memo of the affine VMs (vm_uniform.inc): per program, the
+ * last symbol-free operands and result of each eligible instruction. */
+enum {
+    VM_UNIFORM_BLOCKS = 8,        /* programs remembered per VM */
+    VM_UNIFORM_GIVE_UP = 8,       /* misses in a row: the instruction is varying */
+};
+typedef struct vm_uniform_val {   /* a symbol-free slot; no padding (memcmp) */
+    double x0, err, lo, hi;
+    double dlo[2], dhi[2];        /* derivative bounds (zero without them) */
+    uint32_t dflags[2];
+    uint32_t flags, spare;
+} vm_uniform_val;
+typedef struct vm_uniform_entry {
+    vm_uniform_val ops[3], out;
+    int plan;                     /* the box plan it ran with */
+} vm_uniform_entry;
+typedef struct vm_uniform_block {
+    unsigned long serial;         /* the program's (0: unused block) */
+    int variant, flavour;
+    unsigned long last_use;
+    int ncode;
+    uint8_t *misses;              /* per pc; VM_UNIFORM_GIVE_UP: not looked at */
+    uint8_t *arity;               /* per pc: vm_uniform_arity of its opcode */
+    int32_t *index;               /* per pc: its entry, or -1 */
+    vm_uniform_entry *entries;
+    int nentries, cap;
+} vm_uniform_block;
+
+/* How many slot operands (b, c, d) an eligible opcode reads; 0: not
+ * eligible (several outputs, cases, random numbers, textures, state);
+ * VM_UNIFORM_DERIVS_OF_B: Du and Dv, which read b's derivative bounds
+ * alone (a symbol in b's value does not make them varying) */
+enum { VM_UNIFORM_DERIVS_OF_B = 4 };
+int vm_uniform_arity(int op);
+/* b now holds no entry, for program p in this arithmetic and flavour */
+void vm_uniform_block_reset(vm_uniform_block *b, const sl_program *p, int variant, int flavour);
+/* pc's entry, made when it has none */
+vm_uniform_entry *vm_uniform_entry_at(vm_uniform_block *b, int pc);
+void vm_uniform_free(sl_vm *vm);
+
 struct sl_vm {
     sl_limits limits;
     /* the caller's spaces, read in place (sl_vm_set_spaces: a pointer, not
@@ -189,6 +229,11 @@ struct sl_vm {
                                      for P alone (box_plan.c) */
     long executed;
     uint64_t rng;
+    /* the uniform memo (vm_uniform.inc) */
+    bool uniform_off;             /* sl_vm_set_uniform_memo(false) */
+    vm_uniform_block uniform[VM_UNIFORM_BLOCKS];
+    unsigned long uniform_clock;
+    long uniform_hits;
     char error[ERR_LEN];
 };
 

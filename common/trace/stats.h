@@ -15,6 +15,8 @@ typedef struct trace_stats {
     long boxes;                    /* boxes computed (root + 4 per cache miss) */
     long evals_affine, evals_interval, evals_dual, evals_float;
     long evals_slopes;             /* interval runs with slope bounds (prove.c) */
+    long uniform_hits;             /* affine operations the VM's uniform memo
+                                      answered (sl_vm_uniform_hits) */
     long leaves, wall_leaves, depth_cap_leaves;
     long proofs;                   /* hit proofs tried (prove.c) */
     long proven_hits;              /* leaves whose hit was proven unique and

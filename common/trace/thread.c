@@ -178,6 +178,7 @@ void trace_thread_sync_stats(trace_thread *self)
     self->stats.cache_misses = c->misses;
     self->stats.cache_evictions = c->evictions;
     self->stats.cache_peak_bytes = c->peak_bytes;
+    self->stats.uniform_hits = sl_vm_uniform_hits(self->vm);
 }
 
 void trace_run_shares(void *shares, size_t size, int n, void *(*fn)(void *))
