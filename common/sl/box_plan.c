@@ -34,6 +34,12 @@
  * before P's last write no longer takes a noise symbol (then P is still
  * an enclosure, with other symbols). Programs with loops, lights,
  * illuminance, trace or message passing get no plan (NULL).
+ *
+ * What is live into the first instruction says which globals' values and
+ * derivative bounds a box run reads at all (sl_program_box_reads): the
+ * renderer leaves the others out of its box runs' binding (on heightmap.sl,
+ * the tangents dPdu, dPdv and P's derivative bounds, which only
+ * calculatenormal reads).
  */
 #include "sl/bytecode.h"
 #include "util/xalloc.h"
@@ -198,8 +204,9 @@ static uint8_t step(const sl_program *p, const sl_insn *in, uint64_t *V, uint64_
     return SL_BOX_RUN;
 }
 
-uint8_t *sl_program_box_plan(const sl_program *p)
+uint8_t *sl_program_box_plan(const sl_program *p, uint64_t *values, uint64_t *derivs)
 {
+    *values = *derivs = ~0ull;
     if (!p->takes_derivatives || p->ncode <= 0 || !applies(p))
         return NULL;
     live l;
@@ -240,6 +247,14 @@ uint8_t *sl_program_box_plan(const sl_program *p)
         add_range(D, sl_global_slot(SL_G_v), 1, p->nslots);
         plan[pc] = step(p, in, V, D);
         any = any || plan[pc] != SL_BOX_RUN;
+    }
+    if (any) {
+        /* the globals a box run reads: live into its first instruction
+         * (nothing is killed, so that is everything read on a way to P) */
+        _Static_assert(SL_GLOBAL_SLOTS <= 64, "a bit per global slot");
+        uint64_t globals = (1ull << SL_GLOBAL_SLOTS) - 1;
+        *values = set_v(&l, 0)[0] & globals;
+        *derivs = set_d(&l, 0)[0] & globals;
     }
     free(l.sets);
     if (!any)

@@ -270,6 +270,10 @@ struct sl_program {
     uint64_t global_slots;          /* bit s: a run may read or write global
                                        slot s (sl_program_global_slots); 0:
                                        not known, every slot */
+    uint64_t box_values, box_derivs; /* bit s: a box run may read global slot
+                                       s's value, its derivative bounds
+                                       (box_plan.c); every bit where the
+                                       program has no plan */
 };
 
 /* Scalar slot of a global: P at 0, N at 3, ... (3 slots for points and
@@ -304,8 +308,10 @@ enum {
 };
 /* The plan of p (ncode bytes, freed with the program), or NULL where the
  * analysis does not apply (loops, lights, trace, message passing, a
- * program too large to analyse): then every instruction runs. */
-uint8_t *sl_program_box_plan(const sl_program *p);
+ * program too large to analyse): then every instruction runs. *values and
+ * *derivs get the global slots whose values and derivative bounds a box
+ * run may read (every bit without a plan). */
+uint8_t *sl_program_box_plan(const sl_program *p, uint64_t *values, uint64_t *derivs);
 
 /* Case splits that must agree (split_plan.c, issue 24): per instruction,
  * -1 or the pc of an earlier floor, ceil, round, mod or step of the same

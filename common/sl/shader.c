@@ -37,7 +37,8 @@ sl_program *sl_compile(sl_source_set *set, const char *main_file,
     if (program) {
         program->takes_derivatives = sl_program_derivatives_reach_P(program);
         program->global_slots = sl_program_global_slots(program);
-        program->box_plan = sl_program_box_plan(program);
+        program->box_plan = sl_program_box_plan(program, &program->box_values,
+                                                &program->box_derivs);
         program->split_same = sl_program_split_same(program);
     }
     return program;
@@ -47,6 +48,16 @@ const char *sl_program_name(const sl_program *self) { return self->name; }
 sl_shader_kind sl_program_kind(const sl_program *self) { return self->kind; }
 int sl_program_param_count(const sl_program *self) { return self->nparams; }
 bool sl_program_takes_derivatives(const sl_program *self) { return self->takes_derivatives; }
+
+bool sl_program_box_reads(const sl_program *self, sl_global g, bool derivs)
+{
+    uint64_t set = derivs ? self->box_derivs : self->box_values;
+    int s = sl_global_slot(g), n = sl_global_size(g);
+    for (int k = 0; k < n; k++)
+        if (s + k >= 64 || (set >> (s + k)) & 1)
+            return true;
+    return false;
+}
 
 void sl_program_param(const sl_program *self, int index, sl_param_info *info)
 {

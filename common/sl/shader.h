@@ -107,6 +107,11 @@ bool sl_program_reads_global(const sl_program *self, sl_global g);
 bool sl_program_uses_space(const sl_program *self, int space);
 /* Whether range runs carry derivative bounds (sl_program_derivatives_reach_P). */
 bool sl_program_takes_derivatives(const sl_program *self);
+/* Whether a box run of this displacement (sl_vm_set_box_runs) may read
+ * global g's value (derivs false) or its derivative bounds (derivs true):
+ * what box_plan.c finds can reach P; true for a program without a plan.
+ * A renderer need not compute what no box run reads. */
+bool sl_program_box_reads(const sl_program *self, sl_global g, bool derivs);
 int sl_program_param_count(const sl_program *self);
 void sl_program_param(const sl_program *self, int index, sl_param_info *info);
 int sl_program_find_param(const sl_program *self, const char *name); /* -1 */

@@ -208,7 +208,7 @@ static void affine_geometry(trace_thread *th, const trace_object *obj,
     trace_xform_aa(ctx, &obj->to_camera, g.P, c->P, true);
     geom_unit_normal_aa(ctx, &obj->surf, &c->u, &c->v, &g, Nn);
     trace_camera_normal_aa(ctx, obj, Nn, c->N);
-    if (obj->box_skip_tangents) {         /* never read: not computed */
+    if (obj->box_skip_tangents || obj->box_runs_skip_tangents) {   /* never read: not computed */
         for (int i = 0; i < 3; i++) {
             aa_const(&c->dPdu[i], 0.0);
             aa_const(&c->dPdv[i], 0.0);
@@ -238,8 +238,16 @@ static void affine_shade(trace_thread *th, const trace_object *obj, const affine
         return;
     }
     sl_vm *vm = th->vm;
+    /* P's and I's derivative bounds where no box run reads them: the
+     * whole line (not made from tangents that were not computed) */
+    static const ia_interval unread[2][3] = {
+        {{-INFINITY, INFINITY, AA_UNBOUNDED}, {-INFINITY, INFINITY, AA_UNBOUNDED},
+         {-INFINITY, INFINITY, AA_UNBOUNDED}},
+        {{-INFINITY, INFINITY, AA_UNBOUNDED}, {-INFINITY, INFINITY, AA_UNBOUNDED},
+         {-INFINITY, INFINITY, AA_UNBOUNDED}}};
     bind_globals_affine(vm, obj, &obj->displacement_spaces, c->P, c->N, c->N, c->dPdu, c->dPdv,
-                        &c->u, &c->v, obj->box_skip_tangents ? NULL : c->Pd,
+                        &c->u, &c->v,
+                        obj->box_skip_tangents ? NULL : obj->box_runs_skip_tangents ? unread : c->Pd,
                         trace_surface_flat(obj));
     trace_primvars_bind(vm, obj, false);
     if (sl_vm_run(vm, obj->displacement, SL_MODE_AFFINE, ctx) != SL_OK) {

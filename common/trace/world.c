@@ -465,6 +465,10 @@ bool trace_world_check(trace_world *world, char *err, size_t errsz)
         obj->box_skip_tangents = dp && !sl_program_takes_derivatives(dp) &&
                                  !sl_program_reads_global(dp, SL_G_dPdu) &&
                                  !sl_program_reads_global(dp, SL_G_dPdv);
+        obj->box_runs_skip_tangents = dp && !sl_program_box_reads(dp, SL_G_dPdu, false) &&
+                                      !sl_program_box_reads(dp, SL_G_dPdv, false) &&
+                                      !sl_program_box_reads(dp, SL_G_P, true) &&
+                                      !sl_program_box_reads(dp, SL_G_I, true);
     }
     for (int i = 0; i < world->nobjects; i++)
         if (world->objects[i].group && !check_placements(world, &world->objects[i], err, errsz))

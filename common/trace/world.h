@@ -177,6 +177,11 @@ typedef struct trace_object {
     bool box_skip_tangents;        /* the displacement shader never names dPdu,
                                       dPdv nor takes derivatives: boxes need
                                       not transform the tangents (world.c) */
+    bool box_runs_skip_tangents;   /* its affine box runs read neither dPdu,
+                                      dPdv nor the derivative bounds of P and
+                                      I (sl_program_box_reads: a height map's
+                                      calculatenormal alone did): the affine
+                                      boxes leave them out (displace.c) */
     trace_box root;                /* OBJECT space box over the whole (u,v) square */
     trace_box bound;               /* camera space box of root (for the BVH) */
     /* instances (trace/instance.c): the earlier instance of the same

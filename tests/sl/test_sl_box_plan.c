@@ -18,6 +18,11 @@
  *   lookups     heightmap.sl's two lookups of a map (in a texture cache)
  *               run without derivative bounds (SL_BOX_VALUE), and P is the
  *               full run's form for form
+ *   unread      the globals box_plan.c says no box run reads
+ *               (sl_program_box_reads: on a height map the tangents and
+ *               P's derivative bounds) can be unbounded without changing
+ *               P, on all the shaders above; a shader that reads Du(P) and
+ *               dPdv is said to
  */
 #include <dirent.h>
 #include <stdarg.h>
@@ -56,6 +61,72 @@ static sl_status run_P(sl_vm *vm, const sl_instance *inst, aa_context *ctx, h_su
     if (st == SL_OK)
         sl_vm_get_affine(vm, SL_G_P, P);
     return st;
+}
+
+/* Globals that no box run reads (sl_program_box_reads) spoiled: their
+ * values unbounded, their derivative bounds the whole line */
+static void spoil_unread(sl_vm *vm, const sl_program *p)
+{
+    for (int g = 0; g < SL_G__COUNT; g++) {
+        int n = sl_global_size((sl_global)g);
+        assert_true(n >= 1 && n <= 3);
+        aa_form f[3];
+        ia_interval e[3];
+        for (int k = 0; k < 3; k++) {
+            aa_unbounded(&f[k], AA_UNBOUNDED);
+            e[k] = ia_entire();
+        }
+        if (!sl_program_box_reads(p, (sl_global)g, false))
+            sl_vm_set_affine(vm, (sl_global)g, f);
+        if (!sl_program_box_reads(p, (sl_global)g, true))
+            sl_vm_set_derivs(vm, (sl_global)g, e, e);
+    }
+}
+
+/* The boxes (of 2 x 40) whose box-run P changes when the globals no box
+ * run reads are spoiled: what the renderer leaves out of its binding
+ * (box_runs_skip_tangents) must not reach P */
+static int spoiled_differing(const sl_program *p, const char *what)
+{
+    sl_instance *inst = sl_instance_new(p);
+    sl_vm *vm = sl_vm_new(NULL);
+    if (g_textures)
+        sl_vm_set_textures(vm, g_textures);
+    sl_vm_set_box_runs(vm, true);
+    aa_context ctx;
+    aa_context_init(&ctx, AA_DEFAULT_CAPACITY);
+    unsigned long long seed = 0x51ull;
+    int bad = 0;
+    for (int si = 0; si < 2; si++)
+        for (int k = 0; k < 40; k++) {
+            double w = k < 10 ? 0.3 : k < 25 ? 0.03 : 0.002;
+            double u0 = 0.05 + 0.85 * h_rand(&seed), v0 = 0.05 + 0.85 * h_rand(&seed);
+            double box[4] = { u0, u0 + w * (0.5 + h_rand(&seed)), v0,
+                              v0 + w * (0.5 + h_rand(&seed)) };
+            aa_form P[2][3];
+            sl_status st[2];
+            for (int spoil = 0; spoil < 2; spoil++) {
+                h_globals_affine(vm, &ctx, si ? H_SPHERE : H_PLANE, box[0], box[1], box[2],
+                                 box[3]);
+                if (spoil)
+                    spoil_unread(vm, p);
+                st[spoil] = sl_vm_run(vm, inst, SL_MODE_AFFINE, &ctx);
+                sl_vm_get_affine(vm, SL_G_P, P[spoil]);
+            }
+            bool same = st[0] == st[1];
+            for (int i = 0; i < 3 && same && st[0] == SL_OK; i++)
+                same = same_form(&P[0][i], &P[1][i]);
+            if (!same && bad < 3) {
+                ia_interval a = aa_range(&P[0][0]), b = aa_range(&P[1][0]);
+                fprintf(stderr, "%s: unread globals spoiled, box [%g %g]x[%g %g]: P.x "
+                        "[%.17g, %.17g], was [%.17g, %.17g]\n", what, box[0], box[1], box[2],
+                        box[3], b.lo, b.hi, a.lo, a.hi);
+            }
+            bad += !same;
+        }
+    sl_vm_destroy(&vm);
+    sl_instance_destroy(&inst);
+    return bad;
 }
 
 /* float P at 5 x 5 points of the box (edges included) inside the box
@@ -146,6 +217,7 @@ static void check_source(const char *src)
     assert_non_null(p);
     assert_true(sl_program_takes_derivatives(p));
     assert_int_equal(differing(p, src), 0);
+    assert_int_equal(spoiled_differing(p, src), 0);
     sl_program_destroy(&p);
 }
 
@@ -202,6 +274,7 @@ static void test_library_and_corpus(void **state)
             continue;
         if (sl_program_kind(p) == SL_SHADER_DISPLACEMENT && sl_program_takes_derivatives(p)) {
             assert_int_equal(differing(p, lib[i]), 0);
+            assert_int_equal(spoiled_differing(p, lib[i]), 0);
             checked++;
         }
         sl_program_destroy(&p);
@@ -233,8 +306,10 @@ static void test_library_and_corpus(void **state)
              * (box_plan.c); P then still holds every sample */
             int renamed = 0;
             int bad = differing_as(p, e->d_name, false, &renamed);
-            if (bad != -1)        /* a texture shader without its maps fails both ways */
+            if (bad != -1) {      /* a texture shader without its maps fails both ways */
                 assert_int_equal(bad, 0);
+                assert_int_equal(spoiled_differing(p, e->d_name), 0);
+            }
             if (renamed)
                 fprintf(stderr, "%s: %d boxes with P on other symbols, samples inside\n",
                         e->d_name, renamed);
@@ -270,12 +345,35 @@ static void test_plan(void **state)
     int mul = find_op(p, SL_OP_MUL, 0);
     assert_true(mul >= 0 && mul < du);
     assert_int_equal(p->box_plan[mul], SL_BOX_RUN);
+    /* what its box runs read of the globals: s and t with their
+     * derivative bounds (the filter width), N's value (normalize), P's
+     * value; not the tangents, nor P's derivative bounds (calculatenormal
+     * alone read them) */
+    assert_true(sl_program_box_reads(p, SL_G_s, true) && sl_program_box_reads(p, SL_G_t, true));
+    assert_true(sl_program_box_reads(p, SL_G_N, false) && sl_program_box_reads(p, SL_G_P, false));
+    assert_false(sl_program_box_reads(p, SL_G_dPdu, false));
+    assert_false(sl_program_box_reads(p, SL_G_dPdv, false));
+    assert_false(sl_program_box_reads(p, SL_G_P, true));
+    assert_false(sl_program_box_reads(p, SL_G_I, true));
+    assert_false(sl_program_box_reads(p, SL_G_N, true));
+    sl_program_destroy(&p);
+
+    /* Du(P) and a tangent reach P: read */
+    p = h_compile("displacement t() { P += Du(P) * 0.01 + dPdv * 0.01;"
+                  " N = calculatenormal(P); }");
+    assert_non_null(p);
+    assert_non_null(p->box_plan);
+    assert_true(sl_program_box_reads(p, SL_G_P, true));
+    assert_true(sl_program_box_reads(p, SL_G_dPdv, false));
+    assert_false(sl_program_box_reads(p, SL_G_dPdu, false));
     sl_program_destroy(&p);
 
     p = h_compile("displacement t() { float h = 0; for (float i = 0; i < 3; i += 1)"
                   " h += Du(s * i); P += h * normalize(N); N = calculatenormal(P); }");
     assert_non_null(p);
     assert_null(p->box_plan);                              /* a loop: no plan */
+    assert_true(sl_program_box_reads(p, SL_G_dPdu, false));  /* no plan: all read */
+    assert_true(sl_program_box_reads(p, SL_G_P, true));
     sl_program_destroy(&p);
 }
 
@@ -313,6 +411,7 @@ static void test_lookups(void **state)
     }
     assert_int_equal(n, 2);
     assert_int_equal(differing(p, "lookups"), 0);
+    assert_int_equal(spoiled_differing(p, "lookups"), 0);
     sl_program_destroy(&p);
     tex_cache_destroy(&g_textures);
 }
