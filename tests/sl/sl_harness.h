@@ -270,4 +270,47 @@ static inline double h_rand(unsigned long long *state)
     return (double)((x * 0x2545F4914F6CDD1DULL) >> 11) * 0x1p-53;
 }
 
+/* Box k of a sequence of (u, v) boxes of sides about 0.3 (k < 10), 0.03
+ * (k < 25) and 0.002 at random places, from *seed */
+static inline void h_box(unsigned long long *seed, int k, double box[4])
+{
+    double w = k < 10 ? 0.3 : k < 25 ? 0.03 : 0.002;
+    double u0 = 0.05 + 0.85 * h_rand(seed), v0 = 0.05 + 0.85 * h_rand(seed);
+    box[0] = u0;
+    box[1] = u0 + w * (0.5 + h_rand(seed));
+    box[2] = v0;
+    box[3] = v0 + w * (0.5 + h_rand(seed));
+}
+
+/* Whether two affine forms are the same bits: centre, error, hull, flags
+ * and the coefficients of the symbols they use */
+static inline bool h_same_form(const aa_form *a, const aa_form *b)
+{
+    if (a->n != b->n || a->flags != b->flags)
+        return false;
+    if (memcmp(&a->x0, &b->x0, sizeof a->x0) || memcmp(&a->err, &b->err, sizeof a->err) ||
+        memcmp(&a->lo, &b->lo, sizeof a->lo) || memcmp(&a->hi, &b->hi, sizeof a->hi))
+        return false;
+    return memcmp(a->c, b->c, (size_t)a->n * sizeof a->c[0]) == 0;
+}
+
+/* dir/name compiled (as file `name`); NULL on errors, silently (a corpus
+ * shader that needs an include path) */
+static inline sl_program *h_compile_file(const char *dir, const char *name)
+{
+    char path[1024];
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return NULL;
+    static char text[1 << 17];
+    size_t len = fread(text, 1, sizeof text - 1, f);
+    fclose(f);
+    text[len] = '\0';
+    char *diag = NULL;
+    sl_program *p = h_compile_named(name, text, &diag);
+    free(diag);
+    return p;
+}
+
 #endif

@@ -41,16 +41,6 @@ static tex_cache *g_textures;      /* the maps of the runs below (NULL: none) */
 #define AAFARM_CORPUS_DIR "tests/shaders/corpus"
 #endif
 
-static bool same_form(const aa_form *a, const aa_form *b)
-{
-    if (a->n != b->n || a->flags != b->flags)
-        return false;
-    if (memcmp(&a->x0, &b->x0, sizeof a->x0) || memcmp(&a->err, &b->err, sizeof a->err) ||
-        memcmp(&a->lo, &b->lo, sizeof a->lo) || memcmp(&a->hi, &b->hi, sizeof a->hi))
-        return false;
-    return memcmp(a->c, b->c, (size_t)a->n * sizeof a->c[0]) == 0;
-}
-
 /* P of one affine run over the box, box runs on or off */
 static sl_status run_P(sl_vm *vm, const sl_instance *inst, aa_context *ctx, h_surface s,
                        const double box[4], bool box_runs, aa_form P[3])
@@ -99,10 +89,8 @@ static int spoiled_differing(const sl_program *p, const char *what)
     int bad = 0;
     for (int si = 0; si < 2; si++)
         for (int k = 0; k < 40; k++) {
-            double w = k < 10 ? 0.3 : k < 25 ? 0.03 : 0.002;
-            double u0 = 0.05 + 0.85 * h_rand(&seed), v0 = 0.05 + 0.85 * h_rand(&seed);
-            double box[4] = { u0, u0 + w * (0.5 + h_rand(&seed)), v0,
-                              v0 + w * (0.5 + h_rand(&seed)) };
+            double box[4];
+            h_box(&seed, k, box);
             aa_form P[2][3];
             sl_status st[2];
             for (int spoil = 0; spoil < 2; spoil++) {
@@ -115,7 +103,7 @@ static int spoiled_differing(const sl_program *p, const char *what)
             }
             bool same = st[0] == st[1];
             for (int i = 0; i < 3 && same && st[0] == SL_OK; i++)
-                same = same_form(&P[0][i], &P[1][i]);
+                same = h_same_form(&P[0][i], &P[1][i]);
             if (!same && bad < 3) {
                 ia_interval a = aa_range(&P[0][0]), b = aa_range(&P[1][0]);
                 fprintf(stderr, "%s: unread globals spoiled, box [%g %g]x[%g %g]: P.x "
@@ -169,10 +157,8 @@ static int differing_as(sl_program *p, const char *what, bool exact, int *rename
     for (int si = 0; si < 2; si++) {
         h_surface s = si == 0 ? H_PLANE : H_SPHERE;
         for (int k = 0; k < 40; k++) {
-            double w = k < 10 ? 0.3 : k < 25 ? 0.03 : 0.002;
-            double u0 = 0.05 + 0.85 * h_rand(&seed), v0 = 0.05 + 0.85 * h_rand(&seed);
-            double box[4] = { u0, u0 + w * (0.5 + h_rand(&seed)), v0,
-                              v0 + w * (0.5 + h_rand(&seed)) };
+            double box[4];
+            h_box(&seed, k, box);
             aa_form full[3], cut[3];
             sl_status a = run_P(vm, inst, &ctx, s, box, false, full);
             sl_status b = run_P(vm, inst, &ctx, s, box, true, cut);
@@ -185,7 +171,7 @@ static int differing_as(sl_program *p, const char *what, bool exact, int *rename
                 continue;
             bool same = true;
             for (int i = 0; i < 3; i++)
-                same = same && same_form(&full[i], &cut[i]);
+                same = same && h_same_form(&full[i], &cut[i]);
             if (!same && !exact && contains_samples(vm, inst, s, box, cut)) {
                 ++*renamed;
                 continue;
@@ -286,17 +272,7 @@ static void test_library_and_corpus(void **state)
         size_t n = strlen(e->d_name);
         if (n < 4 || strcmp(e->d_name + n - 3, ".sl") != 0)
             continue;
-        char path[1024];
-        snprintf(path, sizeof path, "%s/%s", AAFARM_CORPUS_DIR, e->d_name);
-        FILE *f = fopen(path, "rb");
-        assert_non_null(f);
-        static char text[1 << 16];
-        size_t len = fread(text, 1, sizeof text - 1, f);
-        fclose(f);
-        text[len] = '\0';
-        char *diag = NULL;
-        sl_program *p = h_compile_named(e->d_name, text, &diag);
-        free(diag);
+        sl_program *p = h_compile_file(AAFARM_CORPUS_DIR, e->d_name);
         if (!p)
             continue;            /* one that needs an include path: not ours */
         if (sl_program_kind(p) == SL_SHADER_DISPLACEMENT && sl_program_takes_derivatives(p)) {

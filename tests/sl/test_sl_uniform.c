@@ -34,16 +34,6 @@
 #define AAFARM_CORPUS_DIR "tests/shaders/corpus"
 #endif
 
-static bool same_form(const aa_form *a, const aa_form *b)
-{
-    if (a->n != b->n || a->flags != b->flags)
-        return false;
-    if (memcmp(&a->x0, &b->x0, sizeof a->x0) || memcmp(&a->err, &b->err, sizeof a->err) ||
-        memcmp(&a->lo, &b->lo, sizeof a->lo) || memcmp(&a->hi, &b->hi, sizeof a->hi))
-        return false;
-    return memcmp(a->c, b->c, (size_t)a->n * sizeof a->c[0]) == 0;
-}
-
 static int g_prints;              /* mismatches printed since the last reset */
 
 typedef struct run_pair {
@@ -85,7 +75,7 @@ static bool same_run(run_pair *r, const sl_instance *inst, h_surface s, const do
     bool same = st[0] == st[1] && r->ctx_on.used == r->ctx_off.used &&
                 r->ctx_on.folded == r->ctx_off.folded;
     for (int i = 0; i < 3 && same && st[0] == SL_OK; i++)
-        same = same_form(&P[0][i], &P[1][i]) && same_form(&N[0][i], &N[1][i]);
+        same = h_same_form(&P[0][i], &P[1][i]) && h_same_form(&N[0][i], &N[1][i]);
     if (!same && g_prints++ < 3) {
         ia_interval a = aa_range(&P[0][0]), b = aa_range(&P[1][0]);
         fprintf(stderr, "%s (%s, box runs %d) box [%g %g]x[%g %g]: status %d / %d, used %d / "
@@ -95,18 +85,6 @@ static bool same_run(run_pair *r, const sl_instance *inst, h_surface s, const do
                 b.lo, b.hi);
     }
     return same;
-}
-
-/* Boxes of sides 0.3, 0.03 and 0.002 at random places (the same boxes on
- * every call) */
-static void nth_box(unsigned long long *seed, int k, double box[4])
-{
-    double w = k < 10 ? 0.3 : k < 25 ? 0.03 : 0.002;
-    double u0 = 0.05 + 0.85 * h_rand(seed), v0 = 0.05 + 0.85 * h_rand(seed);
-    box[0] = u0;
-    box[1] = u0 + w * (0.5 + h_rand(seed));
-    box[2] = v0;
-    box[3] = v0 + w * (0.5 + h_rand(seed));
 }
 
 /* The boxes of p whose runs differ with and without the memo (2 surfaces x
@@ -122,7 +100,7 @@ static int differing(const sl_program *p, const char *what, int capacity, long *
     for (int si = 0; si < 2; si++)
         for (int k = 0; k < 40; k++) {
             double box[4];
-            nth_box(&seed, k, box);
+            h_box(&seed, k, box);
             bad += !same_run(&r, inst, si ? H_SPHERE : H_PLANE, box, k % 3 == 2, what);
         }
     assert_int_equal(sl_vm_uniform_hits(r.off), 0);
@@ -130,22 +108,6 @@ static int differing(const sl_program *p, const char *what, int capacity, long *
     pair_free(&r);
     sl_instance_destroy(&inst);
     return bad;
-}
-
-static sl_program *compile_file(const char *dir, const char *name)
-{
-    char path[1024];
-    snprintf(path, sizeof path, "%s/%s", dir, name);
-    FILE *f = fopen(path, "rb");
-    assert_non_null(f);
-    static char text[1 << 17];
-    size_t len = fread(text, 1, sizeof text - 1, f);
-    fclose(f);
-    text[len] = '\0';
-    char *diag = NULL;
-    sl_program *p = h_compile_named(name, text, &diag);
-    free(diag);
-    return p;                 /* NULL: one that needs an include path */
 }
 
 static void test_same_forms(void **state)
@@ -162,7 +124,7 @@ static void test_same_forms(void **state)
             size_t n = strlen(e->d_name);
             if (n < 4 || strcmp(e->d_name + n - 3, ".sl") != 0)
                 continue;
-            sl_program *p = compile_file(dirs[di], e->d_name);
+            sl_program *p = h_compile_file(dirs[di], e->d_name);
             if (!p)
                 continue;
             bad += differing(p, e->d_name, AA_DEFAULT_CAPACITY, &hits);
@@ -237,7 +199,7 @@ static void test_instances(void **state)
     int bad = 0;
     for (int k = 0; k < 80; k++) {
         double box[4];
-        nth_box(&seed, k % 40, box);
+        h_box(&seed, k % 40, box);
         /* two runs of one instance, then one of the other */
         bad += !same_run(&r, inst[(k % 3) == 2], k & 1 ? H_SPHERE : H_PLANE, box, k % 5 == 0,
                          "instances");
@@ -301,7 +263,7 @@ static void test_answers(void **state)
     long before = 0;
     for (int k = 0; k < 30; k++) {
         double box[4];
-        nth_box(&seed, k, box);
+        h_box(&seed, k, box);
         assert_true(same_run(&r, inst, H_PLANE, box, k & 1, "width"));
         long now = sl_vm_uniform_hits(r.on);
         /* the first box of each flavour (box runs on, off) fills the memo */
