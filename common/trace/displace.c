@@ -11,6 +11,7 @@
  * (globals.inc), so boxes and points see the same surface.
  */
 #include "trace/displace.h"
+#include "trace/normal_memo.h"
 #include "trace/primvar.h"
 
 #include <stdint.h>
@@ -204,10 +205,8 @@ static void affine_geometry(trace_thread *th, const trace_object *obj,
         c->ctx = *ctx;
         return;
     }
-    aa_form Nn[3];
     trace_xform_aa(ctx, &obj->to_camera, g.P, c->P, true);
-    geom_unit_normal_aa(ctx, &obj->surf, &c->u, &c->v, &g, Nn);
-    trace_camera_normal_aa(ctx, obj, Nn, c->N);
+    trace_camera_unit_normal_aa(th, obj, &c->u, &c->v, &g, c->N);
     if (obj->box_skip_tangents || obj->box_runs_skip_tangents) {   /* never read: not computed */
         for (int i = 0; i < 3; i++) {
             aa_const(&c->dPdu[i], 0.0);

@@ -17,6 +17,8 @@ typedef struct trace_stats {
     long evals_slopes;             /* interval runs with slope bounds (prove.c) */
     long uniform_hits;             /* affine operations the VM's uniform memo
                                       answered (sl_vm_uniform_hits) */
+    long normal_hits;              /* box normals the normal memo answered
+                                      (normal_memo.c) */
     long leaves, wall_leaves, depth_cap_leaves;
     long proofs;                   /* hit proofs tried (prove.c) */
     long proven_hits;              /* leaves whose hit was proven unique and

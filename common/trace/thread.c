@@ -3,6 +3,7 @@
  */
 #include "trace/thread.h"
 #include "trace/mesh.h"
+#include "trace/normal_memo.h"
 #include "util/err.h"
 #include "util/shares.h"
 #include "util/xalloc.h"
@@ -111,6 +112,7 @@ void trace_thread_destroy(trace_thread **self_p)
         sl_vm_destroy(&self->ray_vm[d]);
     trace_boxcache_destroy(&self->cache);
     free(self->slopes);
+    trace_normal_memo_free(self);
     free(self->walls);
     trace_views_free(self);
     free(self->work);
