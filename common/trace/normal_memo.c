@@ -6,15 +6,18 @@
  * (geom_unit_normal_aa, then trace_camera_normal_aa), which for a bilinear
  * patch is normalize(Ng) in affine arithmetic. On a planar patch (a height
  * field's base, a flat quad) Ng carries no noise symbol and is the same in
- * every box, and so is N; the memo keeps, per object slot (16, by the
- * object's id), the last such Ng and object transform and the N they gave.
+ * every box, and so is N, as on a flat polygon (a mesh face); the memo
+ * keeps, per object slot (16, by the object's id), the last such Ng and
+ * object transform and the N they gave.
  *
  * Same bits by construction, as the VM's uniform memo (vm_uniform.inc):
  * the computation reads Ng, the object's from_camera, flip, normal_scale
  * and normal_len2 (all of them key the entry, compared bit for bit), and
  * the context only where it takes a noise symbol or folds an error for
  * lack of one, which a kept result did not (it is also symbol-free). Only
- * bilinear patches: other kinds' normals read u, v or P too.
+ * bilinear patches (normalize(Ng)) and polygons without vertex normals
+ * (Ng's range normalised): other kinds' normals read u, v, P or the
+ * vertex normals too.
  */
 #include "trace/normal_memo.h"
 #include "trace/displace.h"
@@ -68,7 +71,9 @@ void trace_camera_unit_normal_aa(trace_thread *th, const trace_object *obj, cons
 {
     aa_context *ctx = &th->ctx;
     normal_entry *e = NULL;
-    if (obj->surf.kind == GEOM_PATCH && symbol_free(g->Ng)) {
+    bool pure = obj->surf.kind == GEOM_PATCH ||
+                (obj->surf.kind == GEOM_POLYGON && !geom_has_vertex_normals(&obj->surf));
+    if (pure && symbol_free(g->Ng)) {
         if (!th->normals)
             th->normals = xcalloc(1, sizeof *th->normals);
         e = &th->normals->e[(unsigned)obj->id & (NORMAL_MEMO_ENTRIES - 1)];

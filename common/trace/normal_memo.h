@@ -1,10 +1,10 @@
 /*
  * normal_memo.h: the camera-space unit normal of a displaced surface's
  * base over a (u,v) box in affine arithmetic, through a per-thread memo
- * (issue 24): a planar bilinear patch (a height field's base) has the same
- * symbol-free Ng in every box, so the same unit normal, which cost a box
- * ~4,600 instructions (normalize and the camera transform in affine
- * arithmetic). See normal_memo.c.
+ * (issue 24): a planar bilinear patch (a height field's base) or a flat
+ * polygon has the same symbol-free Ng in every box, so the same unit
+ * normal, which cost a box 3,500-4,600 instructions (normalize and the
+ * camera transform in affine arithmetic). See normal_memo.c.
  */
 #ifndef TRACE_NORMAL_MEMO_H
 #define TRACE_NORMAL_MEMO_H

@@ -2,7 +2,7 @@
  * test_trace_normal_memo.c: the per-thread memo of a planar patch's
  * camera-space unit normal (trace/normal_memo.c) changes no box.
  *
- *   same boxes   18 planar patches turned by quarter turns about the x
+ *   same boxes   18 planar patches (and 18 polygons) turned by quarter turns about the x
  *                axis (ids 0 and 16, 1 and 17 share a memo slot: 16 has
  *                0's Ng and another transform, 17 has 1's transform and
  *                another Ng), displaced by a shader that reads
@@ -41,7 +41,7 @@ static const char *BUMPS_SL =
  * is patch 1's transform over the square tilted to z = x (another Ng, the
  * same transform): the pairs that share a memo slot differ in one key
  * each, and so do their normals */
-static char *patches_rib(void)
+static char *patches_rib(bool polygons)
 {
     static const char *const turn[4] = {
         "1 0 0 0  0 1 0 0  0 0 1 0  0 0 0 1", "1 0 0 0  0 0 1 0  0 -1 0 0  0 0 0 1",
@@ -57,9 +57,13 @@ static char *patches_rib(void)
         int q = k == 16 ? 1 : k == 17 ? 1 : k % 4;
         double tilt = k == 17 ? 1 : 0, dx = k == 16 ? 0 : k == 17 ? 0.125 : 0.125 * k;
         n += snprintf(rib + n, size - (size_t)n,
-                      "AttributeBegin\nTranslate %g 0 0\nConcatTransform [%s]\n"
-                      "Patch \"bilinear\" \"P\" [-1 -1 %g  1 -1 %g  -1 1 %g  1 1 %g]\n"
-                      "AttributeEnd\n", dx, turn[q], -tilt, tilt, -tilt, tilt);
+                      polygons ? "AttributeBegin\nTranslate %g 0 0\nConcatTransform [%s]\n"
+                                 "Polygon \"P\" [-1 -1 %g  1 -1 %g  1 1 %g  -1 1 %g]\n"
+                                 "AttributeEnd\n"
+                               : "AttributeBegin\nTranslate %g 0 0\nConcatTransform [%s]\n"
+                                 "Patch \"bilinear\" \"P\" [-1 -1 %g  1 -1 %g  -1 1 %g  "
+                                 "1 1 %g]\nAttributeEnd\n",
+                      dx, turn[q], -tilt, tilt, polygons ? tilt : -tilt, polygons ? -tilt : tilt);
     }
     snprintf(rib + n, size - (size_t)n, "WorldEnd\n");
     return rib;
@@ -74,12 +78,11 @@ static double rnd(void)
     return (double)(rng >> 11) * 0x1p-53;
 }
 
-static void test_same_boxes(void **state)
+static void check_same_boxes(bool polygons)
 {
-    (void)state;
     fixture f;
     fixture_shader sh[] = {{"bumps", BUMPS_SL}};
-    char *rib = patches_rib();
+    char *rib = patches_rib(polygons);
     assert_true(fixture_open(&f, rib, sh, 1, NULL, 0));
     free(rib);
     const trace_world *world = &f.js->world;
@@ -104,14 +107,21 @@ static void test_same_boxes(void **state)
                            "%.17g] cold\n", obj->id, u0, w, v0, w, a.lo.x, a.hi.x, b.lo.x, b.hi.x);
             }
         }
-    printf("%d boxes, %d differ; the memo answered %ld times\n", cases, differ,
-           warm->stats.normal_hits);
+    printf("%s: %d boxes, %d differ; the memo answered %ld times\n",
+           polygons ? "polygons" : "patches", cases, differ, warm->stats.normal_hits);
     assert_int_equal(differ, 0);
     /* the first round fills the 16 slots, the two pairs that share one
      * evict each other; most of the rest are answers */
     assert_true(warm->stats.normal_hits > cases / 2);
     trace_thread_destroy(&warm);
     fixture_close(&f);
+}
+
+static void test_same_boxes(void **state)
+{
+    (void)state;
+    check_same_boxes(false);
+    check_same_boxes(true);
 }
 
 int main(void)
