@@ -10,6 +10,7 @@
 #ifndef SL_HARNESS_H
 #define SL_HARNESS_H
 
+#include <dirent.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -311,6 +312,26 @@ static inline sl_program *h_compile_file(const char *dir, const char *name)
     sl_program *p = h_compile_named(name, text, &diag);
     free(diag);
     return p;
+}
+
+/* The next shader of an open directory of them (dir, for the paths) that
+ * compiles, its file name in *name (valid until the next readdir); NULL at
+ * the end. Files that are not .sl, and shaders that do not compile alone
+ * (a corpus shader that needs an include path), are passed over. */
+static inline sl_program *h_next_program(DIR *d, const char *dir, const char **name)
+{
+    struct dirent *e;
+    while ((e = readdir(d))) {
+        size_t n = strlen(e->d_name);
+        if (n < 4 || strcmp(e->d_name + n - 3, ".sl") != 0)
+            continue;
+        sl_program *p = h_compile_file(dir, e->d_name);
+        if (p) {
+            *name = e->d_name;
+            return p;
+        }
+    }
+    return NULL;
 }
 
 #endif

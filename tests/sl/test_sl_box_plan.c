@@ -267,28 +267,23 @@ static void test_library_and_corpus(void **state)
     }
     DIR *d = opendir(AAFARM_CORPUS_DIR);
     assert_non_null(d);
-    struct dirent *e;
-    while ((e = readdir(d))) {
-        size_t n = strlen(e->d_name);
-        if (n < 4 || strcmp(e->d_name + n - 3, ".sl") != 0)
-            continue;
-        sl_program *p = h_compile_file(AAFARM_CORPUS_DIR, e->d_name);
-        if (!p)
-            continue;            /* one that needs an include path: not ours */
+    const char *name;
+    sl_program *p;
+    while ((p = h_next_program(d, AAFARM_CORPUS_DIR, &name))) {
         if (sl_program_kind(p) == SL_SHADER_DISPLACEMENT && sl_program_takes_derivatives(p)) {
             /* a shader that merges P after calculatenormal (a return
              * after it, an undecided branch around it) may give P other
              * noise symbols: calculatenormal no longer takes its three
              * (box_plan.c); P then still holds every sample */
             int renamed = 0;
-            int bad = differing_as(p, e->d_name, false, &renamed);
+            int bad = differing_as(p, name, false, &renamed);
             if (bad != -1) {      /* a texture shader without its maps fails both ways */
                 assert_int_equal(bad, 0);
-                assert_int_equal(spoiled_differing(p, e->d_name), 0);
+                assert_int_equal(spoiled_differing(p, name), 0);
             }
             if (renamed)
                 fprintf(stderr, "%s: %d boxes with P on other symbols, samples inside\n",
-                        e->d_name, renamed);
+                        name, renamed);
             checked++;
         }
         sl_program_destroy(&p);
