@@ -35,6 +35,17 @@
  * an enclosure, with other symbols). Programs with loops, lights,
  * illuminance, trace or message passing get no plan (NULL).
  *
+ * A slope run (sl_vm_run_slopes: P's values and its slope bounds, for the
+ * renderer's hit proofs) has a plan of its own, the same liveness from P
+ * in both V and D at END, and no SL_BOX_VALUE: there calculatenormal(P)
+ * and what feeds only N is left out, and everything else runs as it is.
+ * (A merge tells an unchanged slot by its value and derivative bounds
+ * alike, so a value-only slot merged undecided could lose the
+ * AA_DISCONTINUOUS flag its full run gives it, which a slope run must
+ * keep: the flag refuses the proof. Its P and bounds are then the full
+ * run's bit for bit. A box run's P keeps its values; its flags may
+ * differ there, which only the walk's heuristics read.)
+ *
  * What is live into the first instruction says which globals' values and
  * derivative bounds a box run reads at all (sl_program_box_reads): the
  * renderer leaves the others out of its box runs' binding (on heightmap.sl,
@@ -155,7 +166,8 @@ static bool applies(const sl_program *p)
 
 /* Instruction pc's reads into live-in (V and D at pc), given live-out
  * (already copied there); its plan. */
-static uint8_t step(const sl_program *p, const sl_insn *in, uint64_t *V, uint64_t *D)
+static uint8_t step(const sl_program *p, const sl_insn *in, bool slopes, uint64_t *V,
+                    uint64_t *D)
 {
     int n = p->nslots;
     int zf, zn, xf[4], xn[4], nx;
@@ -169,7 +181,7 @@ static uint8_t step(const sl_program *p, const sl_insn *in, uint64_t *V, uint64_
             if (derivs)
                 add_range(D, xf[i], xn[i], n);
         }
-        return !derivs && value_only_kind(in->op) ? SL_BOX_VALUE : SL_BOX_RUN;
+        return !derivs && !slopes && value_only_kind(in->op) ? SL_BOX_VALUE : SL_BOX_RUN;
     }
     const char *k = sl_opcode_operands((sl_opcode)in->op);
     const uint16_t ops[4] = { in->a, in->b, in->c, in->d };
@@ -204,10 +216,11 @@ static uint8_t step(const sl_program *p, const sl_insn *in, uint64_t *V, uint64_
     return SL_BOX_RUN;
 }
 
-uint8_t *sl_program_box_plan(const sl_program *p, uint64_t *values, uint64_t *derivs)
+uint8_t *sl_program_box_plan(const sl_program *p, bool slopes, uint64_t *values,
+                             uint64_t *derivs)
 {
     *values = *derivs = ~0ull;
-    if (!p->takes_derivatives || p->ncode <= 0 || !applies(p))
+    if ((!slopes && !p->takes_derivatives) || p->ncode <= 0 || !applies(p))
         return NULL;
     live l;
     l.words = (p->nslots + 63) / 64;
@@ -222,8 +235,11 @@ uint8_t *sl_program_box_plan(const sl_program *p, uint64_t *values, uint64_t *de
         const sl_insn *in = &p->code[pc];
         uint64_t *V = set_v(&l, pc), *D = set_d(&l, pc);
         if (in->op == SL_OP_END) {
-            /* what a box run reads: P's values */
+            /* what a box run reads: P's values (and a slope run P's
+             * derivative bounds) */
             add_range(V, sl_global_slot(SL_G_P), sl_global_size(SL_G_P), p->nslots);
+            if (slopes)
+                add_range(D, sl_global_slot(SL_G_P), sl_global_size(SL_G_P), p->nslots);
         } else {
             /* every successor: the next instruction (conservatively, after
              * a jump too) and the jump targets */
@@ -245,7 +261,7 @@ uint8_t *sl_program_box_plan(const sl_program *p, uint64_t *values, uint64_t *de
         add_range(V, sl_global_slot(SL_G_v), 1, p->nslots);
         add_range(D, sl_global_slot(SL_G_u), 1, p->nslots);
         add_range(D, sl_global_slot(SL_G_v), 1, p->nslots);
-        plan[pc] = step(p, in, V, D);
+        plan[pc] = step(p, in, slopes, V, D);
         any = any || plan[pc] != SL_BOX_RUN;
     }
     if (any) {

@@ -209,6 +209,7 @@ void sl_program_destroy(sl_program **self_p)
     free(p->consts);
     free(p->tables);
     free(p->box_plan);
+    free(p->slope_plan);
     free(p->split_same);
     for (int i = 0; i < p->nstrings; i++)
         free(p->strings[i]);

@@ -263,6 +263,8 @@ struct sl_program {
     uint8_t *box_plan;              /* per instruction, what a box run may
                                        leave out (SL_BOX_*, box_plan.c); NULL:
                                        nothing */
+    uint8_t *slope_plan;            /* the same for a slope run, which also
+                                       reads P's derivative bounds */
     int32_t *split_same;            /* per instruction, the earlier case
                                        split of the same value it must agree
                                        with, or -1 (split_plan.c); NULL:
@@ -297,8 +299,9 @@ bool sl_program_derivatives_reach_P(const sl_program *p);
  * in and out of their own slot file (vm.c). */
 uint64_t sl_program_global_slots(const sl_program *p);
 
-/* What a box run (an affine run read for P alone: sl_vm_set_box_runs) may
- * leave out of instruction pc (box_plan.c): */
+/* What a box run (an affine or interval run read for P alone:
+ * sl_vm_set_box_runs) may leave out of instruction pc (box_plan.c); with
+ * slopes, a slope run's (P and its derivative bounds): */
 enum {
     SL_BOX_RUN = 0,       /* run it as it is */
     SL_BOX_VALUE = 1,     /* its value only: no derivative bounds reach P
@@ -311,7 +314,8 @@ enum {
  * program too large to analyse): then every instruction runs. *values and
  * *derivs get the global slots whose values and derivative bounds a box
  * run may read (every bit without a plan). */
-uint8_t *sl_program_box_plan(const sl_program *p, uint64_t *values, uint64_t *derivs);
+uint8_t *sl_program_box_plan(const sl_program *p, bool slopes, uint64_t *values,
+                             uint64_t *derivs);
 
 /* Case splits that must agree (split_plan.c, issue 24): per instruction,
  * -1 or the pc of an earlier floor, ceil, round, mod or step of the same

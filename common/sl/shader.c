@@ -37,8 +37,10 @@ sl_program *sl_compile(sl_source_set *set, const char *main_file,
     if (program) {
         program->takes_derivatives = sl_program_derivatives_reach_P(program);
         program->global_slots = sl_program_global_slots(program);
-        program->box_plan = sl_program_box_plan(program, &program->box_values,
+        program->box_plan = sl_program_box_plan(program, false, &program->box_values,
                                                 &program->box_derivs);
+        uint64_t sv, sd;
+        program->slope_plan = sl_program_box_plan(program, true, &sv, &sd);
         program->split_same = sl_program_split_same(program);
     }
     return program;

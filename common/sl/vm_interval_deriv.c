@@ -27,4 +27,5 @@ static inline void b_from_interval(sl_vm *vm, B *z, ia_interval r)
 #define VM_SUFFIX interval_deriv
 #define VM_FILE(vm) ((vm)->id)
 #define VM_VARIANT VM_VAR_INTERVAL_DERIV
+#define VM_BOX_RUNS 1                 /* box and slope runs follow the plans */
 #include "vm_deriv.inc"

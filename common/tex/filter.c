@@ -20,6 +20,7 @@
 #include <assert.h>
 #include <float.h>
 #include <math.h>
+#include <string.h>
 
 double tex_level_of(const tex_texture *t, double ws, double wt)
 {
@@ -503,6 +504,115 @@ int tex_cells_or_bound(const tex_texture *t, int c, const tex_range *r, tex_wrap
     if (t->tiled)
         tex_tiles_unpin();
     return n;
+}
+
+/* The slopes of level k's bilinear filter over the s and t of r:
+ * ds[0] <= d/ds <= ds[1] and dt likewise. Per cell under r, d/ds =
+ * n ((v10 - v00)(1 - g) + (v11 - v01) g) is linear in the cell's g, so its
+ * extremes over the cell's part of r are at that part's two g ends (and
+ * d/dt likewise in f). The texels are read with the lookup's wrap; cells
+ * beyond a clamp or black edge have equal texels, as the lookup's clamped
+ * coordinate is constant there. False where r spans more than
+ * TEX_SLOPE_CELLS cells along an axis. */
+enum { TEX_SLOPE_CELLS = 24 };
+static bool level_slopes(const tex_texture *t, int k, int c, const tex_range *r, tex_wrap sw,
+                         tex_wrap tw, double ds[2], double dt[2])
+{
+    double i0, i1, j0, j1;
+    int n = t->lw[k], m = t->lh[k];
+    if (!few_cells(r->s[0], r->s[1], n, TEX_SLOPE_CELLS, &i0, &i1) ||
+        !few_cells(r->t[0], r->t[1], m, TEX_SLOPE_CELLS, &j0, &j1))
+        return false;
+    double x0 = widen_lo(r->s[0] * n - 0.5), x1 = widen_hi(r->s[1] * n - 0.5);
+    double y0 = widen_lo(r->t[0] * m - 0.5), y1 = widen_hi(r->t[1] * m - 0.5);
+    int ni = (int)(i1 - i0) + 2, nj = (int)(j1 - j0) + 2;
+    double row0[TEX_SLOPE_CELLS + 1], row1[TEX_SLOPE_CELLS + 1];
+    double sl = INFINITY, sh = -INFINITY, tl = INFINITY, th = -INFINITY;
+    for (int a = 0; a < ni; a++)
+        row1[a] = fetch(t, k, c, (int)i0 + a, (int)j0, sw, tw);
+    for (int b = 0; b + 1 < nj; b++) {
+        memcpy(row0, row1, (size_t)ni * sizeof *row0);
+        for (int a = 0; a < ni; a++)
+            row1[a] = fetch(t, k, c, (int)i0 + a, (int)j0 + b + 1, sw, tw);
+        double cj = j0 + b;
+        double g0 = dmax(y0, cj) - cj, g1 = dmin(y1, cj + 1) - cj;
+        g0 = g0 < 0 ? 0 : g0 > 1 ? 1 : g0;
+        g1 = g1 < 0 ? 0 : g1 > 1 ? 1 : g1;
+        for (int a = 0; a + 1 < ni; a++) {
+            double ci = i0 + a;
+            double f0 = dmax(x0, ci) - ci, f1 = dmin(x1, ci + 1) - ci;
+            f0 = f0 < 0 ? 0 : f0 > 1 ? 1 : f0;
+            f1 = f1 < 0 ? 0 : f1 > 1 ? 1 : f1;
+            double es0 = row0[a + 1] - row0[a], es1 = row1[a + 1] - row1[a];
+            double et0 = row1[a] - row0[a], et1 = row1[a + 1] - row0[a + 1];
+            double s0 = es0 + (es1 - es0) * g0, s1 = es0 + (es1 - es0) * g1;
+            double q0 = et0 + (et1 - et0) * f0, q1 = et0 + (et1 - et0) * f1;
+            sl = dmin(sl, dmin(s0, s1));
+            sh = dmax(sh, dmax(s0, s1));
+            tl = dmin(tl, dmin(q0, q1));
+            th = dmax(th, dmax(q0, q1));
+        }
+    }
+    /* differences and blends in doubles of float texels: a few roundings
+     * each, which slack's relative 1e-9 covers many times over; times n
+     * (a factor 1 + 2^-53) inside the outward step of tex_slopes */
+    double es = slack(sl, sh), et = slack(tl, th);
+    ds[0] = n * (sl - es);
+    ds[1] = n * (sh + es);
+    dt[0] = m * (tl - et);
+    dt[1] = m * (th + et);
+    return true;
+}
+
+/* the hull over f in [f0, f1] of (1 - f) a + f b, a in [a0, a1], b in
+ * [b0, b1]: linear in f for fixed ends, so at f0 or f1 */
+static void blend_slopes(double f0, double f1, const double a[2], const double b[2],
+                         double out[2])
+{
+    out[0] = dmin((1 - f0) * a[0] + f0 * b[0], (1 - f1) * a[0] + f1 * b[0]);
+    out[1] = dmax((1 - f0) * a[1] + f0 * b[1], (1 - f1) * a[1] + f1 * b[1]);
+}
+
+bool tex_slopes(const tex_texture *t, int c, const tex_range *r, tex_wrap swrap,
+                tex_wrap twrap, bool fixed_widths, double ds[2], double dt[2])
+{
+    ds[0] = ds[1] = dt[0] = dt[1] = 0.0;
+    if (c < 0 || c >= t->nch)
+        return true;
+    if (!(isfinite(r->s[0]) && isfinite(r->s[1]) && isfinite(r->t[0]) && isfinite(r->t[1])))
+        return false;
+    double lmin, lmax;
+    levels_of(t, r, &lmin, &lmax);
+    int k = (int)floor(lmin);
+    /* the blend may vary over r only where the widths are constant (then
+     * it is one f of [f0, f1]), and the pair of levels may not */
+    if (lmin != lmax && !(fixed_widths && floor(lmax) == k))
+        return false;
+    double f0 = lmin - k, f1 = lmax - k;
+    bool two = f1 > 0 && k + 1 < t->nlevels;
+    double as[2], at[2], bs[2] = { 0, 0 }, bt[2] = { 0, 0 };
+    bool ok = level_slopes(t, k, c, r, swrap, twrap, as, at);
+    if (ok && two)
+        ok = level_slopes(t, k + 1, c, r, swrap, twrap, bs, bt);
+    if (t->tiled)
+        tex_tiles_unpin();
+    if (!ok)
+        return false;
+    if (two) {
+        blend_slopes(f0, f1, as, bs, ds);
+        blend_slopes(f0, f1, at, bt, dt);
+    } else {
+        memcpy(ds, as, sizeof as);
+        memcpy(dt, at, sizeof at);
+    }
+    /* the level's n and the blend's products and sums: outward by a
+     * relative 2^-40 */
+    for (int q = 0; q < 2; q++) {
+        double sg = q ? 1.0 : -1.0;
+        ds[q] += sg * (0x1p-40 * fabs(ds[q]) + 0x1p-1000);
+        dt[q] += sg * (0x1p-40 * fabs(dt[q]) + 0x1p-1000);
+    }
+    return true;
 }
 
 void tex_lipschitz(const tex_texture *t, int c, double *ls, double *lt)

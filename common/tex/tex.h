@@ -152,6 +152,18 @@ int tex_cells(const tex_texture *t, int c, const tex_range *r, tex_wrap swrap,
 int tex_cells_or_bound(const tex_texture *t, int c, const tex_range *r, tex_wrap swrap,
                        tex_wrap twrap, double fill, tex_cell out[2], double *lo, double *hi);
 
+/* Slope bounds of the filter over a range of lookups, for proofs that
+ * need them (trace/prove.c): ds[0] <= d filter / ds <= ds[1] and dt
+ * likewise, at every (s, t) of r where the filter is differentiable. At
+ * one level blend the filter is continuous in (s, t) under every wrap
+ * (bilinear cells meet at their edges; a clamped coordinate is constant),
+ * so these are its Lipschitz slopes. True where the blend is one over r:
+ * the widths' levels agree, or fixed_widths (the caller knows the widths
+ * are constant over r, their ranges only rounding) and the levels share
+ * their pair. False elsewhere, or where r spans too many cells. A channel
+ * the texture lacks: 0. */
+bool tex_slopes(const tex_texture *t, int c, const tex_range *r, tex_wrap swrap,
+                tex_wrap twrap, bool fixed_widths, double ds[2], double dt[2]);
 /* Bounds of |d filter / ds| and |d filter / dt| of channel c over all
  * lookups at any footprint (0 for a missing channel). */
 void tex_lipschitz(const tex_texture *t, int c, double *ls, double *lt);

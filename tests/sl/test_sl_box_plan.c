@@ -18,6 +18,13 @@
  *   lookups     heightmap.sl's two lookups of a map (in a texture cache)
  *               run without derivative bounds (SL_BOX_VALUE), and P is the
  *               full run's form for form
+ *   intervals   interval runs (P alone) and slope runs (P and its slope
+ *               bounds, sl_vm_run_slopes: the hit proofs') with the box
+ *               and slope plans give the full runs' P (its values) and
+ *               slope bounds (values and flags) bit for bit, for every
+ *               library and corpus displacement shader
+ *               on random boxes of the plane and the sphere; the slope plan
+ *               leaves a terrain's calculatenormal out
  *   unread      the globals box_plan.c says no box run reads
  *               (sl_program_box_reads: on a height map the tangents and
  *               P's derivative bounds) can be unbounded without changing
@@ -362,6 +369,101 @@ static const char LOOKUPS[] =
     "  N = calculatenormal(P);\n"
     "}\n";
 
+/* the same bits (and, with flags, the same flags) */
+static bool same_interval(ia_interval a, ia_interval b, bool flags)
+{
+    return memcmp(&a.lo, &b.lo, sizeof a.lo) == 0 && memcmp(&a.hi, &b.hi, sizeof a.hi) == 0 &&
+           (!flags || a.flags == b.flags);
+}
+
+/* The boxes (of 2 x 30) where an interval run's P (slopes: a slope run's
+ * P and P's slope bounds) differs with the plans (box runs) and without */
+static int interval_differing(const sl_program *p, const char *what, bool slopes)
+{
+    sl_instance *inst = sl_instance_new(p);
+    sl_vm *vm = sl_vm_new(NULL);
+    if (g_textures)
+        sl_vm_set_textures(vm, g_textures);
+    unsigned long long seed = 0x1a7ull;
+    int bad = 0;
+    for (int si = 0; si < 2; si++)
+        for (int k = 0; k < 30; k++) {
+            double box[4];
+            h_box(&seed, k, box);
+            ia_interval P[2][3], Pu[2][3], Pv[2][3];
+            sl_status st[2];
+            for (int plan = 0; plan < 2; plan++) {
+                sl_vm_set_box_runs(vm, plan);
+                h_globals_interval(vm, si ? H_SPHERE : H_PLANE, box[0], box[1], box[2], box[3]);
+                st[plan] = slopes ? sl_vm_run_slopes(vm, inst)
+                                  : sl_vm_run(vm, inst, SL_MODE_INTERVAL, NULL);
+                sl_vm_get_interval(vm, SL_G_P, P[plan]);
+                if (slopes)
+                    sl_vm_get_slopes(vm, SL_G_P, Pu[plan], Pv[plan]);
+            }
+            bool same = st[0] == st[1];
+            /* a box run's flags may differ after an undecided merge
+             * (box_plan.c; the renderer reads the values of its interval
+             * runs for P alone), a slope run's may not */
+            for (int i = 0; i < 3 && same && st[0] == SL_OK; i++)
+                same = same_interval(P[0][i], P[1][i], slopes) &&
+                       (!slopes || (same_interval(Pu[0][i], Pu[1][i], true) &&
+                                    same_interval(Pv[0][i], Pv[1][i], true)));
+            if (!same && bad < 3)
+                fprintf(stderr, "%s: %s run, box [%g %g]x[%g %g]: P.x [%.17g, %.17g] with the "
+                        "plan, [%.17g, %.17g] without; dP.x/du [%.17g, %.17g], [%.17g, %.17g]\n",
+                        what, slopes ? "slope" : "interval", box[0], box[1], box[2], box[3],
+                        P[1][0].lo, P[1][0].hi, P[0][0].lo, P[0][0].hi, Pu[1][0].lo,
+                        Pu[1][0].hi, Pu[0][0].lo, Pu[0][0].hi);
+            bad += !same;
+        }
+    sl_vm_destroy(&vm);
+    sl_instance_destroy(&inst);
+    return bad;
+}
+
+static void test_interval_and_slope_runs(void **state)
+{
+    (void)state;
+    int checked = 0;
+    sl_program *t = h_compile(TERRAIN);
+    assert_non_null(t);
+    assert_non_null(t->slope_plan);
+    int cn = find_op(t, SL_OP_CALCNORMAL, 0);
+    assert_true(cn >= 0);
+    assert_int_equal(t->slope_plan[cn], SL_BOX_DEAD);          /* only N reads it */
+    assert_int_equal(interval_differing(t, "terrain", false), 0);
+    assert_int_equal(interval_differing(t, "terrain", true), 0);
+    sl_program_destroy(&t);
+    static const char *const lib[] = { "heightmap", "dented", "wave", "nail", "threads", "ufo" };
+    for (size_t i = 0; i < sizeof lib / sizeof lib[0]; i++) {
+        sl_program *p = h_compile_library(lib[i]);
+        if (!p)
+            continue;
+        if (sl_program_kind(p) == SL_SHADER_DISPLACEMENT) {
+            assert_int_equal(interval_differing(p, lib[i], false), 0);
+            assert_int_equal(interval_differing(p, lib[i], true), 0);
+            checked++;
+        }
+        sl_program_destroy(&p);
+    }
+    DIR *d = opendir(AAFARM_CORPUS_DIR);
+    assert_non_null(d);
+    const char *name;
+    sl_program *p;
+    while ((p = h_next_program(d, AAFARM_CORPUS_DIR, &name))) {
+        if (sl_program_kind(p) == SL_SHADER_DISPLACEMENT) {
+            assert_int_equal(interval_differing(p, name, false), 0);
+            assert_int_equal(interval_differing(p, name, true), 0);
+            checked++;
+        }
+        sl_program_destroy(&p);
+    }
+    closedir(d);
+    fprintf(stderr, "%d library and corpus shaders: interval and slope runs\n", checked);
+    assert_true(checked >= 40);
+}
+
 static void test_lookups(void **state)
 {
     (void)state;
@@ -394,6 +496,7 @@ int main(void)
         cmocka_unit_test(test_library_and_corpus),
         cmocka_unit_test(test_plan),
         cmocka_unit_test(test_lookups),
+        cmocka_unit_test(test_interval_and_slope_runs),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -17,7 +17,14 @@
  *  - inside one cell the bound converges: 1000 times smaller ranges give
  *    bounds at least 100 times narrower;
  *  - the derivative bounds (tex_lipschitz) hold for difference quotients
- *    and for the filter's own derivatives at every sampled point.
+ *    and for the filter's own derivatives at every sampled point;
+ *  - the slope bounds over a range (tex_slopes) hold the difference
+ *    quotients between any two points of the range along s and along t
+ *    (so the filter is continuous there: across cells, seams and black
+ *    or clamped edges) and its derivatives, for a fixed footprint and for
+ *    any fixed footprint of a width range (fixed_widths); a point range's
+ *    bound is the derivative there, and no bound is looser than the
+ *    global one.
  */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -364,6 +371,91 @@ static void test_lipschitz(void **state)
     free(px);
 }
 
+/* f(b) - f(a) over b - a, along s (axis 0) or t, at footprint w */
+static double quotient(const tex_texture *t, int axis, double s, double tt, double h, double w,
+                       tex_wrap sw, tex_wrap tw, double *err)
+{
+    double a = tex_sample(t, 0, s, tt, w, w, sw, tw, 0, NULL, NULL);
+    double b = axis ? tex_sample(t, 0, s, tt + h, w, w, sw, tw, 0, NULL, NULL)
+                    : tex_sample(t, 0, s + h, tt, w, w, sw, tw, 0, NULL, NULL);
+    /* the lookups' own rounding, over h */
+    *err = 1e-12 * (fabs(a) + fabs(b) + 1.0) / fabs(h);
+    return (b - a) / h;
+}
+
+static void test_slopes(void **state)
+{
+    (void)state;
+    static const int sizes[][2] = { { 1, 1 }, { 5, 3 }, { 16, 16 }, { 37, 20 } };
+    long checked = 0, refused = 0, points = 0;
+    for (size_t n = 0; n < sizeof sizes / sizeof sizes[0]; n++) {
+        float *px;
+        int W = sizes[n][0], H = sizes[n][1];
+        tex_texture *t = random_texture(W, H, 1, &px);
+        double ls, lt;
+        tex_lipschitz(t, 0, &ls, &lt);
+        for (int k = 0; k < 4000; k++) {
+            tex_wrap sw = (tex_wrap)(k % 3), tw = (tex_wrap)((k / 3) % 3);
+            bool fixed = k % 4 == 3;
+            double c = range(-1.5, 2.5), d = range(-1.5, 2.5);
+            if (uniform() < 0.3)
+                c = floor(c) + range(-2.0 / W, 2.0 / W);   /* across the seam */
+            double span = uniform() < 0.1 ? 0.0 : range(0, 6.0 / W);
+            double tspan = span == 0.0 ? 0.0 : range(0, 6.0 / H);
+            double w0 = uniform() < 0.4 ? 0.0 : range(0, 4.0 / W);
+            double w1 = fixed ? w0 * (1 + range(0, 0.01)) : w0;
+            tex_range r = { { c, c + span }, { d, d + tspan }, { w0, w1 }, { w0, w1 } };
+            double ds[2], dt[2];
+            if (!tex_slopes(t, 0, &r, sw, tw, fixed, ds, dt)) {
+                refused++;
+                continue;
+            }
+            assert_true(ds[0] <= ds[1] && dt[0] <= dt[1]);
+            if (!(ds[1] - ds[0] <= 2 * ls * (1 + 1e-8) + 1e-300 &&
+                  dt[1] - dt[0] <= 2 * lt * (1 + 1e-8) + 1e-300))
+                fail_msg("%dx%d wrap %d/%d: ds [%.17g, %.17g] dt [%.17g, %.17g] looser than the "
+                         "global %.17g, %.17g", W, H, sw, tw, ds[0], ds[1], dt[0], dt[1], ls, lt);
+            for (int q = 0; q < 20; q++) {
+                double w = w0 + uniform() * (w1 - w0);    /* one footprint for the range */
+                double sa = c + uniform() * span, sb = c + uniform() * span;
+                double ta = d + uniform() * tspan, tb = d + uniform() * tspan;
+                double g[2];
+                tex_sample(t, 0, sa, ta, w, w, sw, tw, 0, &g[0], &g[1]);
+                if (span == 0.0 && w0 == w1) {
+                    /* a point: the bound is the derivative there (off
+                     * the cells' edges, where random doubles fall) */
+                    assert_true(ds[1] - ds[0] <= 1e-6 * (ls + 1) && dt[1] - dt[0] <= 1e-6 * (lt + 1));
+                    points++;
+                }
+                if (!(g[0] >= ds[0] - 1e-9 * (fabs(g[0]) + 1) && g[0] <= ds[1] + 1e-9 * (fabs(g[0]) + 1) &&
+                      g[1] >= dt[0] - 1e-9 * (fabs(g[1]) + 1) && g[1] <= dt[1] + 1e-9 * (fabs(g[1]) + 1)))
+                    fail_msg("%dx%d wrap %d/%d: derivative (%.17g, %.17g) at s %.17g t %.17g w %g "
+                             "outside ds [%.17g, %.17g] dt [%.17g, %.17g]", W, H, sw, tw, g[0],
+                             g[1], sa, ta, w, ds[0], ds[1], dt[0], dt[1]);
+                for (int axis = 0; axis < 2 && span > 0; axis++) {
+                    double a0 = axis ? ta : sa, a1 = axis ? tb : sb;
+                    double h = a1 - a0;
+                    if (!(fabs(h) > 1e-4 * (axis ? tspan : span)))
+                        continue;
+                    double err, qv = quotient(t, axis, axis ? sa : a0, axis ? a0 : ta, h, w,
+                                              sw, tw, &err);
+                    const double *b = axis ? dt : ds;
+                    if (!(qv >= b[0] - err && qv <= b[1] + err))
+                        fail_msg("%dx%d wrap %d/%d axis %d: quotient %.17g from %.17g over "
+                                 "%.17g (w %g) outside [%.17g, %.17g]", W, H, sw, tw, axis, qv,
+                                 a0, h, w, b[0], b[1]);
+                    checked++;
+                }
+            }
+        }
+        tex_destroy(&t);
+        free(px);
+    }
+    assert_true(checked > 100000);
+    assert_true(points > 1000);
+    assert_true(refused < 4000);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -374,6 +466,7 @@ int main(void)
         cmocka_unit_test(test_cells_are_the_filter),
         cmocka_unit_test(test_bound_converges),
         cmocka_unit_test(test_lipschitz),
+        cmocka_unit_test(test_slopes),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
