@@ -166,6 +166,14 @@ bool sl_program_reads_global(const sl_program *p, sl_global g)
     return false;
 }
 
+bool sl_program_reads_textures(const sl_program *p)
+{
+    for (int pc = 0; pc < p->ncode; pc++)
+        if (p->code[pc].op == SL_OP_TEXTURE)
+            return true;
+    return false;
+}
+
 bool sl_program_uses_space(const sl_program *p, int space)
 {
     for (int pc = 0; pc < p->ncode; pc++) {

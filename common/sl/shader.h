@@ -105,6 +105,9 @@ bool sl_program_reads_global(const sl_program *self, sl_global g);
  * and the casts; conservative: a space named by a string variable counts
  * as every space, and depth() as a use of "camera"). */
 bool sl_program_uses_space(const sl_program *self, int space);
+/* Whether the program looks up a texture map (texture(), environment()
+ * and the like). */
+bool sl_program_reads_textures(const sl_program *self);
 /* Whether range runs carry derivative bounds (sl_program_derivatives_reach_P). */
 bool sl_program_takes_derivatives(const sl_program *self);
 /* Whether a box run of this displacement (sl_vm_set_box_runs) may read
