@@ -165,10 +165,10 @@ static inline double trace_fbox_coord(double base, float d)
     return base == 0.0 ? (double)d : base + (double)d;
 }
 
-static inline void trace_fbox_unpack(const trace_fbox *f, const trace_box *base, trace_box *b)
+/* trace_fbox_unpack with the base's coordinates given (trace_fbox_base) */
+static inline void trace_fbox_unpack_on(const trace_fbox *f, const double blo[3],
+                                        const double bhi[3], trace_box *b)
 {
-    double blo[3], bhi[3];
-    trace_fbox_base(base, blo, bhi);
     b->lo = v3(trace_fbox_coord(blo[0], f->lo[0]), trace_fbox_coord(blo[1], f->lo[1]),
                trace_fbox_coord(blo[2], f->lo[2]));
     b->hi = v3(trace_fbox_coord(bhi[0], f->hi[0]), trace_fbox_coord(bhi[1], f->hi[1]),
@@ -179,6 +179,13 @@ static inline void trace_fbox_unpack(const trace_fbox *f, const trace_box *base,
     b->pad = 0.0f;
     b->slo = f->slo;
     b->shi = f->shi;
+}
+
+static inline void trace_fbox_unpack(const trace_fbox *f, const trace_box *base, trace_box *b)
+{
+    double blo[3], bhi[3];
+    trace_fbox_base(base, blo, bhi);
+    trace_fbox_unpack_on(f, blo, bhi, b);
 }
 
 /* The box as the cache would give it back (stored against base): every box

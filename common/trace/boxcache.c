@@ -182,7 +182,9 @@ trace_brood_id trace_boxcache_lookup_at(trace_boxcache *self, int object,
     }
     trace_brood_id id = *link;
     assert(id >= 0 && id < self->used && self->pool[id].parent == parent);
-    for (int i = 0; i < 4; i++) trace_fbox_unpack(&self->pool[id].box[i], base, &out[i]);
+    double blo[3], bhi[3];             /* the four share their base */
+    trace_fbox_base(base, blo, bhi);
+    for (int i = 0; i < 4; i++) trace_fbox_unpack_on(&self->pool[id].box[i], blo, bhi, &out[i]);
     lru_touch(self, id);
     self->stats.hits++;
     return id;
