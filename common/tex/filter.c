@@ -515,6 +515,17 @@ int tex_cells_or_bound(const tex_texture *t, int c, const tex_range *r, tex_wrap
  * coordinate is constant there. False where r spans more than
  * TEX_SLOPE_CELLS cells along an axis. */
 enum { TEX_SLOPE_CELLS = 24 };
+
+/* row[a] = texel (wi[a], j) of level k, j wrapped (fetch's texels: 0
+ * outside a black edge) */
+static void slope_row(const tex_texture *t, int k, int c, const int *wi, const bool *oi, int ni,
+                      int j, int m, tex_wrap tw, double *row)
+{
+    bool oj;
+    int wj = wrap_index(j, m, tw, &oj);
+    for (int a = 0; a < ni; a++)
+        row[a] = oi[a] || oj ? 0.0 : tex_at(t, 0, k, c, wi[a], wj);
+}
 static bool level_slopes(const tex_texture *t, int k, int c, const tex_range *r, tex_wrap sw,
                          tex_wrap tw, double ds[2], double dt[2])
 {
@@ -528,12 +539,14 @@ static bool level_slopes(const tex_texture *t, int k, int c, const tex_range *r,
     int ni = (int)(i1 - i0) + 2, nj = (int)(j1 - j0) + 2;
     double row0[TEX_SLOPE_CELLS + 1], row1[TEX_SLOPE_CELLS + 1];
     double sl = INFINITY, sh = -INFINITY, tl = INFINITY, th = -INFINITY;
+    int wi[TEX_SLOPE_CELLS + 1];         /* the columns, wrapped once (as fetch) */
+    bool oi[TEX_SLOPE_CELLS + 1];
     for (int a = 0; a < ni; a++)
-        row1[a] = fetch(t, k, c, (int)i0 + a, (int)j0, sw, tw);
-    for (int b = 0; b + 1 < nj; b++) {
+        wi[a] = wrap_index((int)i0 + a, n, sw, &oi[a]);
+    slope_row(t, k, c, wi, oi, ni, (int)j0, m, tw, row1);
+    for (int b = 0; b + 1 < nj; b++) {   /* the cells between rows b and b + 1 */
         memcpy(row0, row1, (size_t)ni * sizeof *row0);
-        for (int a = 0; a < ni; a++)
-            row1[a] = fetch(t, k, c, (int)i0 + a, (int)j0 + b + 1, sw, tw);
+        slope_row(t, k, c, wi, oi, ni, (int)j0 + b + 1, m, tw, row1);
         double cj = j0 + b;
         double g0 = dmax(y0, cj) - cj, g1 = dmin(y1, cj + 1) - cj;
         g0 = g0 < 0 ? 0 : g0 > 1 ? 1 : g0;

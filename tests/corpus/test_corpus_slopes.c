@@ -33,7 +33,7 @@
 #include "trace/displace.h"
 #include "trace/mesh.h"
 
-enum { CELLS = 120, GRID = 3, RANDOM_POINTS = 8 };
+enum { CELLS = 400, GRID = 3, RANDOM_POINTS = 8 };
 
 static corpus C;
 
