@@ -360,3 +360,16 @@ double corpus_rng_uniform(corpus_rng *r)
 {
     return test_rng_unit(&r->s);
 }
+
+int corpus_group_load(corpus *c, void **state)
+{
+    (void)state;
+    return corpus_load(c) ? 0 : -1;
+}
+
+int corpus_group_free(corpus *c, void **state)
+{
+    (void)state;
+    corpus_free(c);
+    return 0;
+}

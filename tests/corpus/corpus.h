@@ -36,6 +36,10 @@ typedef struct corpus {
  * and corpus_rgb.exr (24 x 16, three channels of random texels). */
 bool corpus_load(corpus *c);
 void corpus_free(corpus *c);
+/* The two as a cmocka group's setup and teardown return them (0, or -1
+ * when the corpus cannot be read); the group state is not used. */
+int corpus_group_load(corpus *c, void **state);
+int corpus_group_free(corpus *c, void **state);
 
 typedef enum corpus_surface {
     CORPUS_PLANE, CORPUS_SPHERE, CORPUS_ELLIPSOID, CORPUS_CYLINDER,

@@ -65,18 +65,8 @@ typedef struct tally {
 
 static corpus C;
 
-static int setup(void **state)
-{
-    (void)state;
-    return corpus_load(&C) ? 0 : -1;
-}
-
-static int teardown(void **state)
-{
-    (void)state;
-    corpus_free(&C);
-    return 0;
-}
+static int setup(void **state) { return corpus_group_load(&C, state); }
+static int teardown(void **state) { return corpus_group_free(&C, state); }
 
 static void take_error(trace_thread *th, tally *t, long *counter)
 {

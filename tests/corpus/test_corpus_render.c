@@ -92,18 +92,8 @@ typedef struct render_result {
 
 static corpus C;
 
-static int setup(void **state)
-{
-    (void)state;
-    return corpus_load(&C) ? 0 : -1;
-}
-
-static int teardown(void **state)
-{
-    (void)state;
-    corpus_free(&C);
-    return 0;
-}
+static int setup(void **state) { return corpus_group_load(&C, state); }
+static int teardown(void **state) { return corpus_group_free(&C, state); }
 
 /* raster position of a camera-space point (the inverse of trace_camera_ray
  * for a perspective camera: RI Spec 3.2 §4.1.1) */

@@ -37,18 +37,8 @@ enum { CELLS = 400, GRID = 3, RANDOM_POINTS = 8 };
 
 static corpus C;
 
-static int setup(void **state)
-{
-    (void)state;
-    return corpus_load(&C) ? 0 : -1;
-}
-
-static int teardown(void **state)
-{
-    (void)state;
-    corpus_free(&C);
-    return 0;
-}
+static int setup(void **state) { return corpus_group_load(&C, state); }
+static int teardown(void **state) { return corpus_group_free(&C, state); }
 
 typedef struct tally {
     long cells, bounded, points, quotients, violations;
