@@ -223,6 +223,14 @@ static void affine_geometry(trace_thread *th, const trace_object *obj,
     c->ctx = *ctx;
 }
 
+/* P's and I's derivative bounds where no box run reads them: the whole
+ * line (not made from tangents that were not computed) */
+static const ia_interval unread_derivs[2][3] = {
+    {{-INFINITY, INFINITY, AA_UNBOUNDED}, {-INFINITY, INFINITY, AA_UNBOUNDED},
+     {-INFINITY, INFINITY, AA_UNBOUNDED}},
+    {{-INFINITY, INFINITY, AA_UNBOUNDED}, {-INFINITY, INFINITY, AA_UNBOUNDED},
+     {-INFINITY, INFINITY, AA_UNBOUNDED}}};
+
 /* One affine run of the displacement over the cell (of the case the VM's
  * splits select): the shader's P in object space, in th->ctx (valid until
  * its next reset). */
@@ -237,16 +245,10 @@ static void affine_shade(trace_thread *th, const trace_object *obj, const affine
         return;
     }
     sl_vm *vm = th->vm;
-    /* P's and I's derivative bounds where no box run reads them: the
-     * whole line (not made from tangents that were not computed) */
-    static const ia_interval unread[2][3] = {
-        {{-INFINITY, INFINITY, AA_UNBOUNDED}, {-INFINITY, INFINITY, AA_UNBOUNDED},
-         {-INFINITY, INFINITY, AA_UNBOUNDED}},
-        {{-INFINITY, INFINITY, AA_UNBOUNDED}, {-INFINITY, INFINITY, AA_UNBOUNDED},
-         {-INFINITY, INFINITY, AA_UNBOUNDED}}};
     bind_globals_affine(vm, obj, &obj->displacement_spaces, c->P, c->N, c->N, c->dPdu, c->dPdv,
                         &c->u, &c->v,
-                        obj->box_skip_tangents ? NULL : obj->box_runs_skip_tangents ? unread : c->Pd,
+                        obj->box_skip_tangents ? NULL
+                        : obj->box_runs_skip_tangents ? unread_derivs : c->Pd,
                         trace_surface_flat(obj));
     trace_primvars_bind(vm, obj, false);
     if (sl_vm_run(vm, obj->displacement, SL_MODE_AFFINE, ctx) != SL_OK) {
@@ -462,11 +464,21 @@ static void box_from_interval(const ia_interval P[3], trace_box *out)
     trace_box_no_slab(out);
 }
 
+/* Whether an interval run that reads P alone (a box run: box_interval, a
+ * proof's enclosure at a point) needs the tangents: not where the shader
+ * never names them, nor where its box runs read neither them nor P's and
+ * I's derivative bounds (box_runs_skip_tangents, as the affine boxes) */
+static bool box_run_tangents(const trace_object *obj)
+{
+    return !(obj->box_skip_tangents || obj->box_runs_skip_tangents);
+}
+
 /* The displacement shader's globals over the (u,v) box in interval
  * arithmetic, from the base surface's g (geom_eval_ia over the box), in
  * camera space: the one binding of box and slope runs. With tangents,
- * dPdu, dPdv and P's derivative bounds (Pd) too; without, zeros and no
- * bounds. */
+ * dPdu, dPdv and P's derivative bounds (Pd) too; without, zeros, and no
+ * bounds (a shader that takes no derivatives) or the whole line (one whose
+ * box runs read none). */
 static void bind_interval(sl_vm *vm, const trace_object *obj, ia_interval u, ia_interval v,
                           const geom_ia *g, bool tangents)
 {
@@ -483,7 +495,8 @@ static void bind_interval(sl_vm *vm, const trace_object *obj, ia_interval u, ia_
     }
     ia_interval Pd[2][3] = {{dPdu[0], dPdu[1], dPdu[2]}, {dPdv[0], dPdv[1], dPdv[2]}};
     bind_globals_interval(vm, obj, &obj->displacement_spaces, P, N, N, dPdu, dPdv, &u, &v,
-                          tangents ? Pd : NULL, trace_surface_flat(obj));
+                          tangents ? Pd : obj->box_skip_tangents ? NULL : unread_derivs,
+                          trace_surface_flat(obj));
     trace_primvars_bind(vm, obj, false);
 }
 
@@ -499,7 +512,7 @@ static void box_interval(trace_thread *th, const trace_object *obj,
         return;
     }
     sl_vm *vm = th->vm;
-    bind_interval(vm, obj, u, v, &g, !obj->box_skip_tangents);  /* never read: not computed */
+    bind_interval(vm, obj, u, v, &g, box_run_tangents(obj));  /* never read: not computed */
     ia_interval P[3];
     if (sl_vm_run(vm, obj->displacement, SL_MODE_INTERVAL, NULL) != SL_OK) {
         trace_thread_fail(th, sl_vm_error(vm));
@@ -524,7 +537,7 @@ bool trace_surface_slopes(trace_thread *th, const trace_object *obj,
     geom_eval_ia_tight(&obj->surf, u, v, &g);
     sl_vm *vm = th->vm;
     bool slopes = Pu && Pv;
-    bind_interval(vm, obj, u, v, &g, slopes || !obj->box_skip_tangents);
+    bind_interval(vm, obj, u, v, &g, slopes || box_run_tangents(obj));
     if (slopes && obj->surf.kind != GEOM_POLYGON) {
         /* the bind's tangents are constants to the shader, true only where
          * the base surface's tangents are (a polygon's parametrisation is
