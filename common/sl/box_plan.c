@@ -219,6 +219,11 @@ static uint8_t step(const sl_program *p, const sl_insn *in, bool slopes, uint64_
 uint8_t *sl_program_box_plan(const sl_program *p, bool slopes, uint64_t *values,
                              uint64_t *derivs)
 {
+    uint64_t unused_values, unused_derivs;      /* the outputs are optional */
+    if (!values)
+        values = &unused_values;
+    if (!derivs)
+        derivs = &unused_derivs;
     *values = *derivs = ~0ull;
     if ((!slopes && !p->takes_derivatives) || p->ncode <= 0 || !applies(p))
         return NULL;

@@ -312,8 +312,8 @@ enum {
 /* The plan of p (ncode bytes, freed with the program), or NULL where the
  * analysis does not apply (loops, lights, trace, message passing, a
  * program too large to analyse): then every instruction runs. *values and
- * *derivs get the global slots whose values and derivative bounds a box
- * run may read (every bit without a plan). */
+ * *derivs (each may be NULL) get the global slots whose values and
+ * derivative bounds a box run may read (every bit without a plan). */
 uint8_t *sl_program_box_plan(const sl_program *p, bool slopes, uint64_t *values,
                              uint64_t *derivs);
 

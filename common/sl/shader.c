@@ -39,8 +39,7 @@ sl_program *sl_compile(sl_source_set *set, const char *main_file,
         program->global_slots = sl_program_global_slots(program);
         program->box_plan = sl_program_box_plan(program, false, &program->box_values,
                                                 &program->box_derivs);
-        uint64_t sv, sd;
-        program->slope_plan = sl_program_box_plan(program, true, &sv, &sd);
+        program->slope_plan = sl_program_box_plan(program, true, NULL, NULL);
         program->split_same = sl_program_split_same(program);
     }
     return program;

@@ -181,6 +181,30 @@ bool trace_surface_flat(const trace_object *obj)
            obj->surf.kind == GEOM_DISK;
 }
 
+/* Whether a box run (one that reads P alone: the affine and interval
+ * boxes, a proof's enclosure at a point) needs the tangents: not where the
+ * shader never names them, nor where its box runs read neither them nor
+ * P's and I's derivative bounds (box_runs_skip_tangents) */
+static bool box_run_tangents(const trace_object *obj)
+{
+    return !(obj->box_skip_tangents || obj->box_runs_skip_tangents);
+}
+
+/* P's derivative bounds to bind (Pd, from the tangents) where they were
+ * computed; else none for a shader that takes no derivatives, and the
+ * whole line (for P's and I's: not made from tangents that were not
+ * computed) for one whose box runs read none */
+static const ia_interval (*bound_derivs(const trace_object *obj, bool tangents,
+                                        const ia_interval (*Pd)[3]))[3]
+{
+    static const ia_interval unread[2][3] = {
+        {{-INFINITY, INFINITY, AA_UNBOUNDED}, {-INFINITY, INFINITY, AA_UNBOUNDED},
+         {-INFINITY, INFINITY, AA_UNBOUNDED}},
+        {{-INFINITY, INFINITY, AA_UNBOUNDED}, {-INFINITY, INFINITY, AA_UNBOUNDED},
+         {-INFINITY, INFINITY, AA_UNBOUNDED}}};
+    return tangents ? Pd : obj->box_skip_tangents ? NULL : unread;
+}
+
 /* The base surface over a (u,v) box in affine arithmetic, as the
  * displacement's affine runs bind it (camera space), and the context
  * after it: every case of the box's splits runs on the same (a run
@@ -207,7 +231,7 @@ static void affine_geometry(trace_thread *th, const trace_object *obj,
     }
     trace_xform_aa(ctx, &obj->to_camera, g.P, c->P, true);
     trace_camera_unit_normal_aa(th, obj, &c->u, &c->v, &g, c->N);
-    if (obj->box_skip_tangents || obj->box_runs_skip_tangents) {   /* never read: not computed */
+    if (!box_run_tangents(obj)) {         /* never read: not computed */
         for (int i = 0; i < 3; i++) {
             aa_const(&c->dPdu[i], 0.0);
             aa_const(&c->dPdv[i], 0.0);
@@ -222,14 +246,6 @@ static void affine_geometry(trace_thread *th, const trace_object *obj,
     }
     c->ctx = *ctx;
 }
-
-/* P's and I's derivative bounds where no box run reads them: the whole
- * line (not made from tangents that were not computed) */
-static const ia_interval unread_derivs[2][3] = {
-    {{-INFINITY, INFINITY, AA_UNBOUNDED}, {-INFINITY, INFINITY, AA_UNBOUNDED},
-     {-INFINITY, INFINITY, AA_UNBOUNDED}},
-    {{-INFINITY, INFINITY, AA_UNBOUNDED}, {-INFINITY, INFINITY, AA_UNBOUNDED},
-     {-INFINITY, INFINITY, AA_UNBOUNDED}}};
 
 /* One affine run of the displacement over the cell (of the case the VM's
  * splits select): the shader's P in object space, in th->ctx (valid until
@@ -246,9 +262,7 @@ static void affine_shade(trace_thread *th, const trace_object *obj, const affine
     }
     sl_vm *vm = th->vm;
     bind_globals_affine(vm, obj, &obj->displacement_spaces, c->P, c->N, c->N, c->dPdu, c->dPdv,
-                        &c->u, &c->v,
-                        obj->box_skip_tangents ? NULL
-                        : obj->box_runs_skip_tangents ? unread_derivs : c->Pd,
+                        &c->u, &c->v, bound_derivs(obj, box_run_tangents(obj), c->Pd),
                         trace_surface_flat(obj));
     trace_primvars_bind(vm, obj, false);
     if (sl_vm_run(vm, obj->displacement, SL_MODE_AFFINE, ctx) != SL_OK) {
@@ -464,15 +478,6 @@ static void box_from_interval(const ia_interval P[3], trace_box *out)
     trace_box_no_slab(out);
 }
 
-/* Whether an interval run that reads P alone (a box run: box_interval, a
- * proof's enclosure at a point) needs the tangents: not where the shader
- * never names them, nor where its box runs read neither them nor P's and
- * I's derivative bounds (box_runs_skip_tangents, as the affine boxes) */
-static bool box_run_tangents(const trace_object *obj)
-{
-    return !(obj->box_skip_tangents || obj->box_runs_skip_tangents);
-}
-
 /* The displacement shader's globals over the (u,v) box in interval
  * arithmetic, from the base surface's g (geom_eval_ia over the box), in
  * camera space: the one binding of box and slope runs. With tangents,
@@ -495,8 +500,7 @@ static void bind_interval(sl_vm *vm, const trace_object *obj, ia_interval u, ia_
     }
     ia_interval Pd[2][3] = {{dPdu[0], dPdu[1], dPdu[2]}, {dPdv[0], dPdv[1], dPdv[2]}};
     bind_globals_interval(vm, obj, &obj->displacement_spaces, P, N, N, dPdu, dPdv, &u, &v,
-                          tangents ? Pd : obj->box_skip_tangents ? NULL : unread_derivs,
-                          trace_surface_flat(obj));
+                          bound_derivs(obj, tangents, Pd), trace_surface_flat(obj));
     trace_primvars_bind(vm, obj, false);
 }
 
