@@ -111,9 +111,7 @@ void aa_input(aa_context *ctx, aa_form *z, double lo, double hi)
         aa_unbounded(z, 0);
         return;
     }
-    double mid = 0.5 * lo + 0.5 * hi;
-    if (mid < lo) mid = lo;      /* halving subnormals may round */
-    if (mid > hi) mid = hi;
+    double mid = aa_input_mid(lo, hi);
     double rad = fmax(fp_add_up(hi, -mid), fp_add_up(mid, -lo));
     aa_const(z, mid);
     z->lo = lo;

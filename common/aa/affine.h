@@ -77,6 +77,16 @@ void aa_context_reset(aa_context *ctx);               /* next query: no symbols 
 /* (the small ones are inline: the shading VM makes a constant or asks
  * whether an operand is one for most instructions, issue 24) */
 void aa_input(aa_context *ctx, aa_form *z, double lo, double hi); /* new symbol */
+/* The centre aa_input gives [lo, hi] (finite, lo <= hi): its symbol e is
+ * (x - mid) / radius, so x <= mid means e <= 0 and x >= mid e >= 0 (the
+ * renderer's linear bounds restrict e to a child cell that way) */
+static inline double aa_input_mid(double lo, double hi)
+{
+    double mid = 0.5 * lo + 0.5 * hi;
+    if (mid < lo) mid = lo;      /* halving subnormals may round */
+    if (mid > hi) mid = hi;
+    return mid;
+}
 static inline void aa_unbounded(aa_form *z, unsigned flags)
 {
     z->x0 = 0.0;

@@ -229,6 +229,20 @@ trace_brood_id trace_boxcache_insert_at(trace_boxcache *self, int object,
     return id;
 }
 
+void trace_boxcache_update_at(trace_boxcache *self, trace_brood_id id, int i,
+                              const trace_box *base, const trace_box *box)
+{
+    if (id < 0) return;
+    assert(id < self->used && i >= 0 && i < 4);
+    trace_fbox_pack(box, base, &self->pool[id].box[i]);
+}
+
+const trace_lin *trace_boxcache_lin(const trace_boxcache *self, trace_brood_id id, int i)
+{
+    assert(id >= 0 && id < self->used && i >= 0 && i < 4);
+    return &self->pool[id].box[i].lin;
+}
+
 void trace_boxcache_pin(trace_boxcache *self, trace_brood_id id)
 {
     if (id < 0) return;

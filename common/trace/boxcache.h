@@ -88,6 +88,16 @@ trace_brood_id trace_boxcache_insert_at(trace_boxcache *self, int object,
                                         trace_brood_id parent, int slot,
                                         const trace_box *base, const trace_box boxes[4]);
 
+/* Replaces box i of a stored brood (a lazy child evaluated: intersect.c),
+ * stored against the brood's base as at insertion; nothing for a brood
+ * that was not stored (id < 0) */
+void trace_boxcache_update_at(trace_boxcache *self, trace_brood_id id, int i,
+                              const trace_box *base, const trace_box *box);
+
+/* The linear bound of box i of a stored brood (box.h: the lookups leave
+ * it out); valid until the next insertion */
+const trace_lin *trace_boxcache_lin(const trace_boxcache *self, trace_brood_id id, int i);
+
 /* Pin / unpin a brood while the traversal is below it. */
 void trace_boxcache_pin(trace_boxcache *self, trace_brood_id id);
 void trace_boxcache_unpin(trace_boxcache *self, trace_brood_id id);

@@ -284,12 +284,34 @@ static void affine_run(trace_thread *th, const trace_object *obj,
     affine_shade(th, obj, &c, P);
 }
 
+/* The box's linear bound (box.h, TRACE_BOX_LIN) from the run's forms:
+ * per coordinate the centre, the u and v terms (symbols 0 and 1, where
+ * the context gave u and v their own symbols) and the rest as a radius,
+ * rounded up, as floats (trace_lin_set). None for a form that is
+ * unbounded or not finite. */
+static void box_linear(const aa_context *ctx, const aa_form P[3], trace_box *out)
+{
+    memset(&out->lin, 0, sizeof out->lin);
+    if (ctx->capacity < 2) return;
+    for (int k = 0; k < 3; k++) {
+        const aa_form *f = &P[k];
+        if (f->flags & AA_UNBOUNDED) return;
+        double rad = f->err;
+        for (int i = 2; i < f->n; i++) rad = fp_add_up(rad, fabs(f->c[i]));
+        double lu = f->n > 0 ? f->c[0] : 0.0, lv = f->n > 1 ? f->c[1] : 0.0;
+        if (!isfinite(f->x0) || !isfinite(rad) || !trace_lin_set(&out->lin, k, f->x0, lu, lv, rad))
+            return;
+    }
+    out->flags |= TRACE_BOX_LIN;
+}
+
 static void box_affine(trace_thread *th, const trace_object *obj,
                        double u0, double u1, double v0, double v1, trace_box *out)
 {
     aa_form P[3];
     affine_run(th, obj, u0, u1, v0, v1, P);
     box_from_affine(P, out);
+    box_linear(&th->ctx, P, out);
 }
 
 /* At most this many operations split per box: 2^TRACE_SPLIT_OPS runs */
@@ -386,7 +408,7 @@ static void box_finish(trace_thread *th, trace_box *out)
     if (box_has_nan(out)) {
         out->lo = v3(INFINITY, INFINITY, INFINITY);
         out->hi = v3(-INFINITY, -INFINITY, -INFINITY);
-        out->flags &= ~(unsigned)AA_UNBOUNDED;
+        out->flags &= ~(unsigned)(AA_UNBOUNDED | TRACE_BOX_LIN);
         trace_box_no_slab(out);
         th->stats.empty_boxes++;
     }

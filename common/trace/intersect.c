@@ -4,6 +4,7 @@
  */
 #include "trace/intersect.h"
 
+#include <assert.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -527,6 +528,66 @@ static bool stagnant(const trace_box *b, double parent_extent)
            !trace_box_is_empty(b) && trace_box_extent(b) >= TRACE_NO_SHRINK * parent_extent;
 }
 
+/* Child i's box, evaluated: the shader's run over its cell (with the
+ * cases of its seams, then samples, where it stagnates), met with the
+ * restricted bound of the node's linear bound where the node has one
+ * (box.h), and rounded outward as the cache keeps it (against base: a hit
+ * and a miss give the same box) */
+static void child_box(walk *w, const trace_box *node, const trace_lin *lin,
+                      const trace_box *base, const double r[4], int depth, int i, trace_box *kid)
+{
+    trace_thread *th = w->th;
+    const trace_object *owner = trace_box_owner(w->obj);
+    double node_extent = trace_box_extent(node);
+    double c[4];
+    child_range(i, r[0], r[1], r[2], r[3], c);
+    /* below a box its cases narrowed, the children run their cases first
+     * (the plain run of one across the same seam is stagnant again) */
+    bool cases_first = (node->flags & TRACE_BOX_SPLIT) != 0, split = false;
+    if (cases_first)
+        split = trace_surface_box_split(th, owner, c[0], c[1], c[2], c[3], kid);
+    else
+        trace_surface_box(th, owner, c[0], c[1], c[2], c[3], kid);
+    if (stagnant(kid, node_extent)) {
+        /* issue 24: the cases of a seam, then (still stagnant) samples;
+         * below a box they did not narrow, not again (a pattern whose
+         * seams overflow the cases); with its cases run first, not again */
+        if (cases_first ? !split
+                        : (node->flags & TRACE_BOX_UNSPLIT) ||
+                              !trace_surface_box_cases(th, owner, c[0], c[1], c[2], c[3], kid))
+            kid->flags |= TRACE_BOX_UNSPLIT;
+        if (depth >= TRACE_SAMPLE_DEPTH && stagnant(kid, node_extent))
+            sample_stagnant(th, owner, c, kid);
+    }
+    if (lin) {
+        trace_box rb;
+        trace_box_restrict(lin, r, c, &rb);
+        trace_box_meet(kid, &rb);
+    }
+    trace_box_round_float(kid, base);
+}
+
+/*
+ * The node's children (the brood of its four cells), from the box cache
+ * or made here. Lazy children (issue 24): below a node with a linear
+ * bound a new brood holds only the children's restricted bounds
+ * (TRACE_BOX_LAZY); visit evaluates a child when a ray meets its
+ * restricted bound (lazy_child). A child's box is the same either way,
+ * child_box's, which its restricted bound holds, so no ray that misses
+ * the bound could meet the box: the cache's state never changes a walk.
+ */
+/* The node's linear bound, or NULL where it has none: its brood's (a
+ * box the cache gave has no copy of it), else its own; copied into *l
+ * (the cache's pool may move). None at an object's root: instances that
+ * share their prototype's broods have roots of their own. */
+static const trace_lin *node_lin(const walk *w, trace_brood_id parent, int slot,
+                                 const trace_box *node, trace_lin *l)
+{
+    if (!(node->flags & TRACE_BOX_LIN) || parent == TRACE_BROOD_NONE) return NULL;
+    *l = parent >= 0 ? *trace_boxcache_lin(w->th->cache, parent, slot) : node->lin;
+    return l;
+}
+
 static trace_brood_id children_of(walk *w, trace_brood_id parent, int slot,
                                   const double r[4], const trace_box *node, int depth,
                                   trace_box kids[4])
@@ -540,33 +601,32 @@ static trace_brood_id children_of(walk *w, trace_brood_id parent, int slot,
     const trace_box *base = parent == TRACE_BROOD_NONE ? NULL : node;
     trace_brood_id id = trace_boxcache_lookup_at(th->cache, owner->id, parent, slot, base, kids);
     if (id != TRACE_BROOD_NONE) return id;
-    double node_extent = trace_box_extent(node);
-    /* below a box its cases narrowed, the children run their cases first
-     * (the plain run of one across the same seam is stagnant again) */
-    bool cases_first = (node->flags & TRACE_BOX_SPLIT) != 0;
+    trace_lin l;
+    const trace_lin *lin = node_lin(w, parent, slot, node, &l);
     for (int i = 0; i < 4; i++) {
-        double c[4];
-        child_range(i, r[0], r[1], r[2], r[3], c);
-        bool split = false;
-        if (cases_first)
-            split = trace_surface_box_split(th, owner, c[0], c[1], c[2], c[3], &kids[i]);
-        else
-            trace_surface_box(th, owner, c[0], c[1], c[2], c[3], &kids[i]);
-        if (!stagnant(&kids[i], node_extent)) continue;
-        /* issue 24: the cases of a seam, then (still stagnant) samples;
-         * below a box they did not narrow, not again (a pattern whose
-         * seams overflow the cases); with its cases run first, not again */
-        if (cases_first ? !split
-                        : (node->flags & TRACE_BOX_UNSPLIT) ||
-                              !trace_surface_box_cases(th, owner, c[0], c[1], c[2], c[3], &kids[i]))
-            kids[i].flags |= TRACE_BOX_UNSPLIT;
-        if (depth >= TRACE_SAMPLE_DEPTH && stagnant(&kids[i], node_extent))
-            sample_stagnant(th, owner, c, &kids[i]);
+        if (lin) {
+            double c[4];
+            child_range(i, r[0], r[1], r[2], r[3], c);
+            trace_box_restrict(lin, r, c, &kids[i]);
+            trace_box_round_float(&kids[i], base);
+        } else {
+            child_box(w, node, NULL, base, r, depth, i, &kids[i]);
+        }
     }
-    /* the boxes rounded outward as the cache keeps them (a hit and a miss
-     * give the same boxes) */
-    for (int i = 0; i < 4; i++) trace_box_round_float(&kids[i], base);
     return trace_boxcache_insert_at(th->cache, owner->id, parent, slot, base, kids);
+}
+
+/* A lazy child that a ray meets: evaluated (child_box) and kept in its
+ * brood */
+static void lazy_child(walk *w, trace_brood_id brood, trace_brood_id parent, int slot,
+                       const trace_box *node, const double r[4], int depth, int i, trace_box *kid)
+{
+    const trace_box *base = parent == TRACE_BROOD_NONE ? NULL : node;
+    trace_lin l;
+    const trace_lin *lin = node_lin(w, parent, slot, node, &l);
+    assert(lin != NULL);                 /* a lazy child's node has one */
+    child_box(w, node, lin, base, r, depth, i, kid);
+    trace_boxcache_update_at(w->th->cache, brood, i, base, kid);
 }
 
 /* Bounded work (issue 9): a walk ends after max_nodes_per_ray nodes, or
@@ -660,6 +720,13 @@ static void visit(walk *w, const trace_box *node, const double r[4],
         if (cover == GEOM_OUTSIDE) continue;
         double t0, t1;
         int axis;
+        if (kids[i].flags & TRACE_BOX_LAZY) {
+            /* evaluated where the ray meets its restricted bound */
+            if (!trace_box_hit(&kids[i], &w->ray, w->ray.tmin, w->best->t, &t0, &t1, NULL))
+                continue;
+            lazy_child(w, brood, parent, slot, node, r, depth, i, &kids[i]);
+            if (trace_box_is_empty(&kids[i]) && !(kids[i].flags & AA_UNBOUNDED)) continue;
+        }
         if (!trace_box_hit(&kids[i], &w->ray, w->ray.tmin, w->best->t, &t0, &t1, &axis) ||
             !trace_box_slab_hit(&kids[i], &w->ray, &t0, &t1))
             continue;

@@ -55,6 +55,7 @@ enum { GRID = 4, RANDOM_POINTS = 16 };   /* samples per range: 4x4 grid (corners
 typedef struct tally {
     long cases, points, violations, unbounded, unbounded_wide, box_errors, point_errors;
     long slab_points;               /* points also checked against a slab (box.h) */
+    long restricted_points;         /* checks against restricted bounds (box.h) */
     long split;                     /* boxes narrowed by case splits (trace_surface_box_cases) */
     long split_first;               /* boxes of the cases first (trace_surface_box_split) */
     long undefined;                 /* NaN points on a base's axis (check_point) */
@@ -90,8 +91,34 @@ static double excess(double p, double lo, double hi, double slack)
     return 0;
 }
 
+/* The restricted bounds of the box's linear bound (box.h, issue 24's lazy
+ * children): the point's coordinate k against those of each child cell
+ * of r that holds (u, v) (two or four on the cell's middle lines), and of
+ * r itself; the largest excess */
+static double restricted_excess(const trace_box *b, const double r[4], double u, double v,
+                                vec3 p, double slack, tally *t)
+{
+    if (!(b->flags & TRACE_BOX_LIN)) return 0;
+    double um = 0.5 * (r[0] + r[1]), vm = 0.5 * (r[2] + r[3]), e = 0;
+    for (int i = 0; i < 5; i++) {
+        double c[4] = {r[0], r[1], r[2], r[3]};
+        if (i < 4) {                      /* the intersector's child cells */
+            if (i & 1) c[0] = um; else c[1] = um;
+            if (i & 2) c[2] = vm; else c[3] = vm;
+        }
+        if (u < c[0] || u > c[1] || v < c[2] || v > c[3]) continue;
+        trace_box rb;
+        trace_box_restrict(&b->lin, r, c, &rb);
+        t->restricted_points++;
+        e = fmax(e, fmax(excess(p.x, rb.lo.x, rb.hi.x, slack),
+                         fmax(excess(p.y, rb.lo.y, rb.hi.y, slack),
+                              excess(p.z, rb.lo.z, rb.hi.z, slack))));
+    }
+    return e;
+}
+
 static void check_point(trace_thread *th, const trace_object *obj, const trace_box *b,
-                        const trace_box *b2, double u, double v, tally *t)
+                        const trace_box *b2, const double r[4], double u, double v, tally *t)
 {
     if (!geom_uv_inside(&obj->surf, u, v)) return;     /* not on the polygon */
     trace_surface_point sp;
@@ -107,6 +134,7 @@ static void check_point(trace_thread *th, const trace_object *obj, const trace_b
         t->slab_points++;
         e = fmax(e, excess(s, b->slo, b->shi, 2 * slack));
     }
+    e = fmax(e, restricted_excess(b, r, u, v, p, slack, t));
     if (b2)                               /* the box of the cases first (no slab) */
         e = fmax(e, fmax(excess(p.x, b2->lo.x, b2->hi.x, slack),
                          fmax(excess(p.y, b2->lo.y, b2->hi.y, slack),
@@ -251,14 +279,21 @@ static void run_cases(trace_thread *th, const trace_world *w, long ncases, uint6
             if (fmax(u1 - u0, v1 - v0) < t->unb_side) t->unb_side = fmax(u1 - u0, v1 - v0);
             continue;          /* such a box contains everything: nothing to sample */
         }
+        double r[4] = {u0, u1, v0, v1};
         for (int j = 0; j < GRID; j++)
             for (int i = 0; i < GRID; i++)
-                check_point(th, obj, &b, split, u0 + (u1 - u0) * i / (GRID - 1),
+                check_point(th, obj, &b, split, r, u0 + (u1 - u0) * i / (GRID - 1),
                             v0 + (v1 - v0) * j / (GRID - 1), t);
+        /* the middle lines, where two or four child cells meet */
+        for (int i = 0; i < GRID; i++) {
+            double um = 0.5 * (u0 + u1), vm = 0.5 * (v0 + v1);
+            check_point(th, obj, &b, split, r, um, v0 + (v1 - v0) * i / (GRID - 1), t);
+            check_point(th, obj, &b, split, r, u0 + (u1 - u0) * i / (GRID - 1), vm, t);
+        }
         for (int i = 0; i < RANDOM_POINTS; i++) {
             double u = u0 + (u1 - u0) * corpus_rng_uniform(&rng);
             double v = v0 + (v1 - v0) * corpus_rng_uniform(&rng);
-            check_point(th, obj, &b, split, u, v, t);
+            check_point(th, obj, &b, split, r, u, v, t);
         }
     }
     free(view);
@@ -300,6 +335,7 @@ static void run_surface(corpus_surface s)
             total.cases += t.cases;
             total.points += t.points;
             total.slab_points += t.slab_points;
+            total.restricted_points += t.restricted_points;
             total.split += t.split;
             total.split_first += t.split_first;
             total.violations += t.violations;
@@ -312,12 +348,14 @@ static void run_surface(corpus_surface s)
             trace_thread_destroy(&th);
             fixture_close(&f);
         }
-    printf("%s total: %ld cases, %ld points (%ld also against a slab), %ld boxes narrowed by "
+    printf("%s total: %ld cases, %ld points (%ld also against a slab, %ld checks against "
+           "restricted bounds), %ld boxes narrowed by "
            "case splits (%ld of the cases first), %ld violations (worst %.2e), %ld unbounded boxes "
            "(+ %ld of ranges wider than 1/32, counted), %ld/%ld shader errors (box/point), "
            "%ld failing rows, %ld scenes not opened, %ld undefined points (NaN on a "
            "base's axis)\n",
-           corpus_surface_name(s), total.cases, total.points, total.slab_points, total.split,
+           corpus_surface_name(s), total.cases, total.points, total.slab_points,
+           total.restricted_points, total.split,
            total.split_first, total.violations, total.worst,
            total.unbounded, total.unbounded_wide, total.box_errors, total.point_errors,
            bad_rows, failed_opens, total.undefined);
@@ -325,6 +363,7 @@ static void run_surface(corpus_surface s)
     assert_int_equal(failed_opens, 0);
     assert_true(total.points > 0);
     assert_true(total.slab_points > total.points / 20);
+    assert_true(total.restricted_points > total.points / 2);   /* the lazy children's bounds */
     const char *only = getenv("AAFARM_CORPUS_ONLY");
     if (!only || !*only) assert_true(total.split > 0);   /* the split path is checked */
     assert_int_equal(total.violations, 0);

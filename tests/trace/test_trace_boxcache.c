@@ -3,7 +3,8 @@
  * unchanged, the byte budget is a hard limit, the least recently used
  * subtree goes first, pinned broods (the traversal's path) are never
  * evicted (a brood that finds no room is not stored, and nothing below it
- * is), and an unlimited cache never evicts.
+ * is), and an unlimited cache never evicts. (A lookup leaves the boxes'
+ * linear bounds as they were: out starts zeroed, as fill's are.)
  */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -27,7 +28,7 @@ static void test_store_and_lookup(void **state)
 {
     (void)state;
     trace_boxcache *c = trace_boxcache_new(0, 2);
-    trace_box in[4], out[4];
+    trace_box in[4], out[4] = {0};
     fill(in, 1);
     assert_int_equal(trace_boxcache_lookup(c, 0, TRACE_BROOD_NONE, 0, out), TRACE_BROOD_NONE);
     trace_brood_id root = trace_boxcache_insert(c, 0, TRACE_BROOD_NONE, 0, in);
@@ -54,7 +55,7 @@ static void test_budget_is_a_hard_limit_and_lru_goes_first(void **state)
     (void)state;
     size_t per = trace_boxcache_brood_bytes();
     trace_boxcache *c = trace_boxcache_new(3 * per, 4);
-    trace_box in[4], out[4];
+    trace_box in[4], out[4] = {0};
     fill(in, 0);
     trace_brood_id r[4];
     for (int o = 0; o < 3; o++) r[o] = trace_boxcache_insert(c, o, TRACE_BROOD_NONE, 0, in);
@@ -76,7 +77,7 @@ static void test_eviction_takes_the_subtree(void **state)
     (void)state;
     size_t per = trace_boxcache_brood_bytes();
     trace_boxcache *c = trace_boxcache_new(3 * per, 2);
-    trace_box in[4], out[4];
+    trace_box in[4], out[4] = {0};
     fill(in, 0);
     trace_brood_id root = trace_boxcache_insert(c, 0, TRACE_BROOD_NONE, 0, in);
     trace_brood_id kid = trace_boxcache_insert(c, 0, root, 1, in);
@@ -99,7 +100,7 @@ static void test_pinned_path_survives(void **state)
     (void)state;
     size_t per = trace_boxcache_brood_bytes();
     trace_boxcache *c = trace_boxcache_new(2 * per, 1);
-    trace_box in[4], out[4];
+    trace_box in[4], out[4] = {0};
     fill(in, 0);
     trace_brood_id root = trace_boxcache_insert(c, 0, TRACE_BROOD_NONE, 0, in);
     trace_boxcache_pin(c, root);
@@ -139,7 +140,7 @@ static void test_insert_keeps_its_parent(void **state)
     (void)state;
     size_t per = trace_boxcache_brood_bytes();
     trace_boxcache *c = trace_boxcache_new(2 * per, 2);
-    trace_box a_in[4], b_in[4], child_in[4], out[4];
+    trace_box a_in[4], b_in[4], child_in[4], out[4] = {0};
     fill(a_in, 1);
     fill(b_in, 2);
     fill(child_in, 3);

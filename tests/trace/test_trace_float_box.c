@@ -6,12 +6,15 @@
  * NaN stays NaN; a box already in floats comes back bit for bit; offsets
  * from a parent box (near, far, infinite) contain too, and a flat child of
  * a flat parent is exact; and the box cache gives back the rounded box (a
- * hit equals a recomputation).
+ * hit equals a recomputation). The linear bounds of issue 24's lazy
+ * children: in floats they hold what the doubles held, and a child cell's
+ * restricted bound holds the points of the child.
  */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
+#include <stdio.h>
 #include <string.h>
 #include <math.h>
 #include <cmocka.h>
@@ -245,27 +248,151 @@ static void test_cache_gives_back_the_rounded_box(void **state)
 {
     (void)state;
     trace_boxcache *c = trace_boxcache_new(0, 1);
-    assert_true(sizeof(trace_fbox) < sizeof(trace_box) * 2 / 3);
+    /* the box itself (the linear bound is floats in both) */
+    assert_true(sizeof(trace_fbox) - sizeof(trace_lin) <
+                (sizeof(trace_box) - sizeof(trace_lin)) * 2 / 3);
     trace_box in[4], want[4], out[4];
     for (int i = 0; i < 4; i++) {
         random_box(&in[i]);
+        for (int k = 0; k < 3; k++)          /* a linear bound, kept apart */
+            assert_true(trace_lin_set(&in[i].lin, k, 1.0 + i + k, 0.25, -0.5, 0.125));
         want[i] = in[i];
         trace_box_round_float(&want[i], NULL);
+        memset(&want[i].lin, 0, sizeof want[i].lin);
     }
+    memset(out, 0, sizeof out);
     trace_brood_id id = trace_boxcache_insert(c, 0, TRACE_BROOD_NONE, 0, in);
     assert_int_equal(trace_boxcache_lookup(c, 0, TRACE_BROOD_NONE, 0, out), id);
+    /* the lookup leaves the linear bounds out; the brood has them */
     assert_memory_equal(out, want, sizeof want);
+    for (int i = 0; i < 4; i++)
+        assert_memory_equal(trace_boxcache_lin(c, id, i), &in[i].lin, sizeof(trace_lin));
     /* against a base */
     trace_box base;
     random_box(&base);
     for (int i = 0; i < 4; i++) {
         want[i] = in[i];
         trace_box_round_float(&want[i], &base);
+        memset(&want[i].lin, 0, sizeof want[i].lin);
     }
+    memset(out, 0, sizeof out);
     trace_brood_id kid = trace_boxcache_insert_at(c, 0, id, 1, &base, in);
     assert_int_equal(trace_boxcache_lookup_at(c, 0, id, 1, &base, out), kid);
     assert_memory_equal(out, want, sizeof want);
+    /* a lazy child evaluated: its slot replaced, the others kept */
+    trace_box now = in[3];
+    random_box(&now);
+    trace_boxcache_update_at(c, kid, 2, &base, &now);
+    trace_box again[4];
+    memset(again, 0, sizeof again);
+    assert_int_equal(trace_boxcache_lookup_at(c, 0, id, 1, &base, again), kid);
+    want[2] = now;
+    trace_box_round_float(&want[2], &base);
+    memset(&want[2].lin, 0, sizeof want[2].lin);
+    assert_memory_equal(again, want, sizeof want);
     trace_boxcache_destroy(&c);
+}
+
+/* A linear bound in floats (trace_lin_set) holds what the doubles held:
+ * at every corner (eu, ev in -1, 0, 1) and either end of the radius the
+ * doubles' point, in long double (the differences of a double and its
+ * float are exact there), lies within the float bound's radius */
+static void test_linear_bound_in_floats(void **state)
+{
+    (void)state;
+    long checked = 0, dropped = 0;
+    for (int n = 0; n < 20000; n++) {
+        double x = any_double(), u = any_double(), v = any_double();
+        double r = fabs(any_double());
+        if (n % 3 == 0) {                  /* and ordinary magnitudes */
+            x = ldexp((double)(next() >> 11) * 0x1p-53 - 0.5, (int)(next() % 40) - 20);
+            u = x * 0x1p-10 * ((double)(next() >> 11) * 0x1p-53 - 0.5);
+            v = u * 3.1;
+            r = fabs(u) * 0.01;
+        }
+        trace_lin l;
+        if (!trace_lin_set(&l, 0, x, u, v, r)) {
+            dropped++;
+            continue;
+        }
+        if (!isfinite(x) || !isfinite(u) || !isfinite(v) || !isfinite(r)) fail();
+        for (int a = -1; a <= 1; a++)
+            for (int b = -1; b <= 1; b++)
+                for (int s = -1; s <= 1; s += 2) {
+                    long double d = ((long double)x - l.x[0]) + ((long double)u - l.u[0]) * a +
+                                    ((long double)v - l.v[0]) * b + (long double)r * s;
+                    if (!(fabsl(d) <= (long double)l.r[0])) {
+                        print_error("x %a u %a v %a r %a: off by %La, radius %a\n", x, u, v, r,
+                                    d, (double)l.r[0]);
+                        fail();
+                    }
+                    checked++;
+                }
+    }
+    printf("linear bounds: %ld corners inside, %ld bounds not finite (dropped)\n", checked,
+           dropped);
+    assert_true(checked > 100000);
+}
+
+/* The restricted bound of a child cell (trace_box_restrict) against points
+ * of the child mapped to eu, ev independently (long double, from the cell's
+ * centre and radius), at the corners of the radius; a child's bound is
+ * narrower than the whole cell's where its terms are */
+static void test_restricted_bound(void **state)
+{
+    (void)state;
+    long checked = 0;
+    for (int n = 0; n < 4000; n++) {
+        double u0 = (double)(next() >> 11) * 0x1p-53, v0 = (double)(next() >> 11) * 0x1p-53;
+        double w = ldexp(1.0 + (double)(next() >> 11) * 0x1p-53, -(int)(next() % 30));
+        double r[4] = {u0, u0 + w, v0, v0 + w * 0.75};
+        trace_lin l;
+        for (int k = 0; k < 3; k++) {
+            double x = (double)(next() >> 11) * 0x1p-50 - 4.0;
+            double du = w * ((double)(next() >> 11) * 0x1p-53 - 0.5);
+            double dv = w * ((double)(next() >> 11) * 0x1p-53 - 0.5);
+            assert_true(trace_lin_set(&l, k, x, du, dv, fabs(du) * 0.01));
+        }
+        /* the symbols as aa_input defines them: u = mid + rad eu, mid its
+         * centre (a double), rad at least the larger side (exact here) */
+        long double um = aa_input_mid(r[0], r[1]), vm = aa_input_mid(r[2], r[3]);
+        long double ur = fmaxl(r[1] - um, um - r[0]), vr = fmaxl(r[3] - vm, vm - r[2]);
+        trace_box whole;
+        trace_box_restrict(&l, r, r, &whole);
+        for (int i = 0; i < 4; i++) {
+            double c[4] = {r[0], r[1], r[2], r[3]};
+            double cu = 0.5 * (r[0] + r[1]), cv = 0.5 * (r[2] + r[3]);
+            if (i & 1) c[0] = cu; else c[1] = cu;
+            if (i & 2) c[2] = cv; else c[3] = cv;
+            trace_box b;
+            trace_box_restrict(&l, r, c, &b);
+            assert_int_equal(b.flags, TRACE_BOX_LAZY);
+            for (int j = 0; j < 25; j++) {
+                long double uu = c[0] + (c[1] - c[0]) * (j % 5) / 4.0L;
+                long double vv = c[2] + (c[3] - c[2]) * (j / 5) / 4.0L;
+                long double eu = (uu - um) / ur, ev = (vv - vm) / vr;
+                for (int k = 0; k < 3; k++)
+                    for (int s = -1; s <= 1; s += 2) {
+                        long double p = (long double)l.x[k] + (long double)l.u[k] * eu +
+                                        (long double)l.v[k] * ev + (long double)l.r[k] * s;
+                        const double *lo = &b.lo.x, *hi = &b.hi.x;
+                        if (!(p >= lo[k] && p <= hi[k])) {
+                            print_error("child %d point %d axis %d: %La not in [%a, %a]\n", i,
+                                        j, k, p, lo[k], hi[k]);
+                            fail();
+                        }
+                        checked++;
+                    }
+            }
+            /* the child's u and v terms are halves of the cell's */
+            for (int k = 0; k < 3; k++) {
+                double cw = (&b.hi.x)[k] - (&b.lo.x)[k], ww = (&whole.hi.x)[k] - (&whole.lo.x)[k];
+                assert_true(cw <= ww);
+                if (fabsf(l.u[k]) + fabsf(l.v[k]) > 8 * l.r[k]) assert_true(cw < 0.8 * ww);
+            }
+        }
+    }
+    printf("restricted bounds: %ld points inside\n", checked);
 }
 
 int main(void)
@@ -276,6 +403,8 @@ int main(void)
         cmocka_unit_test(test_empty_stays_empty_and_nan_stays_nan),
         cmocka_unit_test(test_offsets_from_the_parent),
         cmocka_unit_test(test_cache_gives_back_the_rounded_box),
+        cmocka_unit_test(test_linear_bound_in_floats),
+        cmocka_unit_test(test_restricted_bound),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
