@@ -35,8 +35,7 @@
 #include <math.h>
 #include <stdbool.h>
 
-#include "aa/affine.h"
-#include "aa/rounding.h"
+#include "trace/lin_bound.h"
 #include "util/vecmath.h"
 
 /* A box estimated from samples where range arithmetic stagnated
@@ -49,22 +48,13 @@
 /* A box narrowed by the cases of its seams (trace_surface_box_cases,
  * trace_surface_box_split): its children run their cases first */
 #define TRACE_BOX_SPLIT (1u << 10)
-/* The box carries its linear bound (lx, lu, lv, lr below): the plain
- * affine run's forms, reduced to u, v and a radius (displace.c) */
+/* The box carries its linear bound (lin_bound.h): the plain affine run's
+ * forms, reduced to u, v and a radius (displace.c) */
 #define TRACE_BOX_LIN (1u << 11)
 /* Not evaluated yet: only the restricted bound of the parent's linear
  * bound (trace_box_restrict), which holds the box the child will have
  * (intersect.c, "Lazy children") */
 #define TRACE_BOX_LAZY (1u << 12)
-
-/* A box's linear bound (TRACE_BOX_LIN): over the box's cell, with eu, ev
- * in [-1, 1] the cell's u and v as aa_input maps them (the symbols 0 and
- * 1 of the affine run), coordinate k of every point of the surface lies
- * in x[k] + u[k] eu + v[k] ev +- r[k]. Floats, r raised over their
- * roundings (trace_lin_set). */
-typedef struct trace_lin {
-    float x[3], u[3], v[3], r[3];
-} trace_lin;
 
 typedef struct trace_box {
     vec3 lo, hi;
@@ -76,10 +66,13 @@ typedef struct trace_box {
     float sn[3];             /* the slab's unit normal; all 0: no slab */
     float pad;               /* (no padding bytes of unknown value) */
     double slo, shi;         /* n . P over the cell, rounded outward */
-    /* The linear bound (TRACE_BOX_LIN). Not filled in by the box cache's
-     * lookups (trace_boxcache_lin gives it): where a box came from the
-     * cache, only its brood holds it. */
+    /* The linear bound (TRACE_BOX_LIN; lin_bound.h): lin as the affine run
+     * left it; qlin, its codes against the box, once the box is final
+     * (trace_box_round_float). The box cache keeps qlin alone, and its
+     * lookups leave both out (trace_boxcache_qlin gives them). */
     trace_lin lin;
+    trace_qlin qlin;
+    uint32_t lin_pad;        /* 0 (no padding bytes of unknown value) */
 } trace_box;
 
 /* x as a float rounded down (up): the float boxes of BVHs */
@@ -128,7 +121,7 @@ typedef struct trace_fbox {
     float bend;
     float sn[3];
     float slo, shi;
-    trace_lin lin;           /* the linear bound, as trace_box's */
+    trace_qlin qlin;         /* the linear bound's codes, as trace_box's */
 } trace_fbox;
 
 /* x - base as a float d such that base + d (double, rounded to nearest) is
@@ -174,29 +167,6 @@ static inline double trace_fbox_coord(double base, float d)
     return base == 0.0 ? (double)d : base + (double)d;
 }
 
-/* |a - b| rounded up */
-static inline double trace_abs_diff_up(double a, double b)
-{
-    return fmax(fp_add_up(a, -b), fp_add_up(b, -a));
-}
-
-/* Coordinate k of a linear bound from doubles: x + u eu + v ev +- r as
- * floats, x, u, v to nearest and r raised by what that moved, |x - x'| +
- * |u - u'| + |v - v'| (eu, ev in [-1, 1]), rounded up, so the float bound
- * holds every point the double one does. False where it does not fit the
- * floats (the caller drops TRACE_BOX_LIN). */
-static inline bool trace_lin_set(trace_lin *l, int k, double x, double u, double v, double r)
-{
-    float fx = (float)x, fu = (float)u, fv = (float)v;
-    double e = fp_add_up(fp_add_up(trace_abs_diff_up(x, fx), trace_abs_diff_up(u, fu)),
-                         fp_add_up(trace_abs_diff_up(v, fv), r));
-    l->x[k] = fx;
-    l->u[k] = fu;
-    l->v[k] = fv;
-    l->r[k] = trace_float_up(e);
-    return isfinite(fx) && isfinite(fu) && isfinite(fv) && isfinite(l->r[k]);
-}
-
 static inline void trace_fbox_pack(const trace_box *b, const trace_box *base, trace_fbox *f)
 {
     double blo[3], bhi[3];
@@ -209,7 +179,16 @@ static inline void trace_fbox_pack(const trace_box *b, const trace_box *base, tr
     f->flags = b->flags;
     f->bend = b->bend;
     trace_float_range(b->slo, b->shi, 0.0, 0.0, &f->slo, &f->shi);
-    f->lin = b->lin;
+    /* the linear bound as codes against the box as unpacked */
+    if (b->flags & TRACE_BOX_LIN) {
+        double flo[3], fhi[3];
+        for (int i = 0; i < 3; i++) {
+            flo[i] = trace_fbox_coord(blo[i], f->lo[i]);
+            fhi[i] = trace_fbox_coord(bhi[i], f->hi[i]);
+        }
+        if (!trace_qlin_encode(&b->lin, flo, fhi, &f->qlin)) f->flags &= ~(unsigned)TRACE_BOX_LIN;
+    }
+    if (!(f->flags & TRACE_BOX_LIN)) memset(&f->qlin, 0, sizeof f->qlin);
 }
 
 /* trace_fbox_unpack with the base's coordinates given (trace_fbox_base),
@@ -225,6 +204,7 @@ static inline void trace_fbox_unpack_on(const trace_fbox *f, const double blo[3]
     b->bend = f->bend;
     for (int i = 0; i < 3; i++) b->sn[i] = f->sn[i];
     b->pad = 0.0f;
+    b->lin_pad = 0;
     b->slo = f->slo;
     b->shi = f->shi;
 }
@@ -235,7 +215,7 @@ static inline void trace_fbox_unpack(const trace_fbox *f, const trace_box *base,
     double blo[3], bhi[3];
     trace_fbox_base(base, blo, bhi);
     trace_fbox_unpack_on(f, blo, bhi, b);
-    b->lin = f->lin;
+    b->qlin = f->qlin;
 }
 
 /* The box as the cache would give it back (stored against base): every box
@@ -249,32 +229,26 @@ static inline void trace_box_round_float(trace_box *b, const trace_box *base)
     trace_fbox_unpack(&f, base, b);
 }
 
-/*
- * The restricted bound (issue 24, "Lazy children"): the box that the
- * linear bound l of the box over the cell r (u0, u1, v0, v1) gives the
- * surface over its child cell c. Over c, eu lies in [-1, 0] where c ends
- * at or below r's centre (aa_input_mid), in [0, 1] where it starts at or
- * above, else in [-1, 1], and ev alike; the ends of x + u eu + v ev -+ r
- * over those ranges are sums of exact products (eu, ev's ends are -1, 0,
- * 1), rounded outward. No slab, no flags but TRACE_BOX_LAZY.
- */
-static inline void trace_box_restrict(const trace_lin *l, const double r[4], const double c[4],
-                                      trace_box *out)
+/* The restricted bound of the child cell c of the cell r (lin_bound.h)
+ * by the node's decoded linear bound d, within the node's box: no slab,
+ * no flags but TRACE_BOX_LAZY */
+static inline void trace_box_restrict(const trace_dlin *d, const trace_box *node, const double r[4],
+                                      const double c[4], trace_box *out)
 {
-    double mu = aa_input_mid(r[0], r[1]), mv = aa_input_mid(r[2], r[3]);
-    double ua = c[0] >= mu ? 0.0 : -1.0, ub = c[1] <= mu ? 0.0 : 1.0;
-    double va = c[2] >= mv ? 0.0 : -1.0, vb = c[3] <= mv ? 0.0 : 1.0;
     double lo[3], hi[3];
-    for (int k = 0; k < 3; k++) {
-        double x = l->x[k], u = l->u[k], v = l->v[k], e = l->r[k];
-        double u1 = u * ua, u2 = u * ub, v1 = v * va, v2 = v * vb;
-        lo[k] = fp_add_dn(fp_add_dn(fp_add_dn(x, fmin(u1, u2)), fmin(v1, v2)), -e);
-        hi[k] = fp_add_up(fp_add_up(fp_add_up(x, fmax(u1, u2)), fmax(v1, v2)), e);
-    }
+    trace_lin_restrict(d, r, c, lo, hi);
     memset(out, 0, sizeof *out);
-    out->lo = v3(lo[0], lo[1], lo[2]);
-    out->hi = v3(hi[0], hi[1], hi[2]);
+    out->lo = v3(fmax(lo[0], node->lo.x), fmax(lo[1], node->lo.y), fmax(lo[2], node->lo.z));
+    out->hi = v3(fmin(hi[0], node->hi.x), fmin(hi[1], node->hi.y), fmin(hi[2], node->hi.z));
     out->flags = TRACE_BOX_LAZY;
+}
+
+/* The node's linear bound decoded (against its box) */
+static inline void trace_box_lin(const trace_qlin *q, const trace_box *node, trace_dlin *d)
+{
+    const double lo[3] = {node->lo.x, node->lo.y, node->lo.z};
+    const double hi[3] = {node->hi.x, node->hi.y, node->hi.z};
+    trace_qlin_decode(q, lo, hi, d);
 }
 
 /* b met with a restricted bound rb (trace_box_restrict): both hold the

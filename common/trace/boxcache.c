@@ -229,18 +229,47 @@ trace_brood_id trace_boxcache_insert_at(trace_boxcache *self, int object,
     return id;
 }
 
-void trace_boxcache_update_at(trace_boxcache *self, trace_brood_id id, int i,
-                              const trace_box *base, const trace_box *box)
+/* box as the float box f holds it: unpacked over the same base, the raw
+ * linear bound kept (it is what the codes were made from) */
+static void kept(const trace_fbox *f, const trace_box *base, trace_box *box)
 {
-    if (id < 0) return;
-    assert(id < self->used && i >= 0 && i < 4);
-    trace_fbox_pack(box, base, &self->pool[id].box[i]);
+    trace_lin raw = box->lin;
+    trace_fbox_unpack(f, base, box);
+    box->lin = raw;
 }
 
-const trace_lin *trace_boxcache_lin(const trace_boxcache *self, trace_brood_id id, int i)
+void trace_boxcache_update_kept(trace_boxcache *self, trace_brood_id id, int i,
+                                const trace_box *base, trace_box *box)
+{
+    assert(i >= 0 && i < 4);
+    trace_fbox tmp, *f = &tmp;
+    if (id >= 0) {
+        assert(id < self->used);
+        f = &self->pool[id].box[i];
+    }
+    trace_fbox_pack(box, base, f);
+    kept(f, base, box);
+}
+
+trace_brood_id trace_boxcache_insert_kept(trace_boxcache *self, int object,
+                                          trace_brood_id parent, int slot,
+                                          const trace_box *base, trace_box boxes[4])
+{
+    trace_brood_id id = trace_boxcache_insert_at(self, object, parent, slot, base, boxes);
+    for (int i = 0; i < 4; i++) {
+        trace_fbox tmp;
+        const trace_fbox *f = &tmp;
+        if (id >= 0) f = &self->pool[id].box[i];
+        else trace_fbox_pack(&boxes[i], base, &tmp);
+        kept(f, base, &boxes[i]);
+    }
+    return id;
+}
+
+const trace_qlin *trace_boxcache_qlin(const trace_boxcache *self, trace_brood_id id, int i)
 {
     assert(id >= 0 && id < self->used && i >= 0 && i < 4);
-    return &self->pool[id].box[i].lin;
+    return &self->pool[id].box[i].qlin;
 }
 
 void trace_boxcache_pin(trace_boxcache *self, trace_brood_id id)

@@ -88,15 +88,23 @@ trace_brood_id trace_boxcache_insert_at(trace_boxcache *self, int object,
                                         trace_brood_id parent, int slot,
                                         const trace_box *base, const trace_box boxes[4]);
 
-/* Replaces box i of a stored brood (a lazy child evaluated: intersect.c),
- * stored against the brood's base as at insertion; nothing for a brood
- * that was not stored (id < 0) */
-void trace_boxcache_update_at(trace_boxcache *self, trace_brood_id id, int i,
-                              const trace_box *base, const trace_box *box);
+/* trace_boxcache_insert_at that also gives the boxes back as the cache
+ * keeps them (trace_box_round_float's: stored or not, a later lookup
+ * gives these very boxes); the intersector's way in */
+trace_brood_id trace_boxcache_insert_kept(trace_boxcache *self, int object,
+                                          trace_brood_id parent, int slot,
+                                          const trace_box *base, trace_box boxes[4]);
 
-/* The linear bound of box i of a stored brood (box.h: the lookups leave
- * it out); valid until the next insertion */
-const trace_lin *trace_boxcache_lin(const trace_boxcache *self, trace_brood_id id, int i);
+/* Replaces box i of a brood (a lazy child evaluated: intersect.c), stored
+ * against the brood's base as at insertion, and gives it back as kept
+ * (as trace_boxcache_insert_kept; rounded alike where the brood was not
+ * stored, id < 0) */
+void trace_boxcache_update_kept(trace_boxcache *self, trace_brood_id id, int i,
+                                const trace_box *base, trace_box *box);
+
+/* The linear bound's codes of box i of a stored brood (box.h: the lookups
+ * leave them out); valid until the next insertion */
+const trace_qlin *trace_boxcache_qlin(const trace_boxcache *self, trace_brood_id id, int i);
 
 /* Pin / unpin a brood while the traversal is below it. */
 void trace_boxcache_pin(trace_boxcache *self, trace_brood_id id);

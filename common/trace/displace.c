@@ -141,6 +141,9 @@ static void box_slab(const aa_form P[3], const ia_interval r[3], trace_box *out)
 
 static void box_from_affine(const aa_form P[3], trace_box *out)
 {
+    memset(&out->lin, 0, sizeof out->lin);       /* none (box_linear's) */
+    memset(&out->qlin, 0, sizeof out->qlin);
+    out->lin_pad = 0;
     ia_interval r[3];
     unsigned flags = 0;
     double lin = 0, other = 0;
@@ -292,6 +295,7 @@ static void affine_run(trace_thread *th, const trace_object *obj,
 static void box_linear(const aa_context *ctx, const aa_form P[3], trace_box *out)
 {
     memset(&out->lin, 0, sizeof out->lin);
+    memset(&out->qlin, 0, sizeof out->qlin);
     if (ctx->capacity < 2) return;
     for (int k = 0; k < 3; k++) {
         const aa_form *f = &P[k];
@@ -493,6 +497,9 @@ static void ia_camera_normal(const trace_object *obj, const ia_interval Nn[3],
 
 static void box_from_interval(const ia_interval P[3], trace_box *out)
 {
+    memset(&out->lin, 0, sizeof out->lin);       /* no linear bound */
+    memset(&out->qlin, 0, sizeof out->qlin);
+    out->lin_pad = 0;
     out->bend = 0.0f;
     out->lo = v3(P[0].lo, P[1].lo, P[2].lo);
     out->hi = v3(P[0].hi, P[1].hi, P[2].hi);

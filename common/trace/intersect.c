@@ -531,10 +531,11 @@ static bool stagnant(const trace_box *b, double parent_extent)
 /* Child i's box, evaluated: the shader's run over its cell (with the
  * cases of its seams, then samples, where it stagnates), met with the
  * restricted bound of the node's linear bound where the node has one
- * (box.h), and rounded outward as the cache keeps it (against base: a hit
- * and a miss give the same box) */
-static void child_box(walk *w, const trace_box *node, const trace_lin *lin,
-                      const trace_box *base, const double r[4], int depth, int i, trace_box *kid)
+ * (box.h). The caller stores it, which rounds it outward as the cache
+ * keeps it (trace_boxcache_insert_kept: a hit and a miss give the same
+ * box) */
+static void child_box(walk *w, const trace_box *node, const trace_dlin *lin, const double r[4],
+                      int depth, int i, trace_box *kid)
 {
     trace_thread *th = w->th;
     const trace_object *owner = trace_box_owner(w->obj);
@@ -559,12 +560,13 @@ static void child_box(walk *w, const trace_box *node, const trace_lin *lin,
         if (depth >= TRACE_SAMPLE_DEPTH && stagnant(kid, node_extent))
             sample_stagnant(th, owner, c, kid);
     }
+    /* an estimate: its children are made from their runs alone */
+    if (kid->flags & TRACE_BOX_SAMPLED) kid->flags &= ~(unsigned)TRACE_BOX_LIN;
     if (lin) {
         trace_box rb;
-        trace_box_restrict(lin, r, c, &rb);
+        trace_box_restrict(lin, node, r, c, &rb);
         trace_box_meet(kid, &rb);
     }
-    trace_box_round_float(kid, base);
 }
 
 /*
@@ -576,16 +578,18 @@ static void child_box(walk *w, const trace_box *node, const trace_lin *lin,
  * child_box's, which its restricted bound holds, so no ray that misses
  * the bound could meet the box: the cache's state never changes a walk.
  */
-/* The node's linear bound, or NULL where it has none: its brood's (a
- * box the cache gave has no copy of it), else its own; copied into *l
- * (the cache's pool may move). None at an object's root: instances that
- * share their prototype's broods have roots of their own. */
-static const trace_lin *node_lin(const walk *w, trace_brood_id parent, int slot,
-                                 const trace_box *node, trace_lin *l)
+/* The node's linear bound decoded, or NULL where it has none: from its
+ * brood's codes (a box the cache gave has no copy of them), else its own
+ * (the same codes: child_box rounds every box as the cache keeps it).
+ * None at an object's root: instances that share their prototype's broods
+ * have roots of their own. */
+static const trace_dlin *node_lin(const walk *w, trace_brood_id parent, int slot,
+                                  const trace_box *node, trace_dlin *d)
 {
     if (!(node->flags & TRACE_BOX_LIN) || parent == TRACE_BROOD_NONE) return NULL;
-    *l = parent >= 0 ? *trace_boxcache_lin(w->th->cache, parent, slot) : node->lin;
-    return l;
+    const trace_qlin *q = parent >= 0 ? trace_boxcache_qlin(w->th->cache, parent, slot) : &node->qlin;
+    trace_box_lin(q, node, d);
+    return d;
 }
 
 static trace_brood_id children_of(walk *w, trace_brood_id parent, int slot,
@@ -601,19 +605,18 @@ static trace_brood_id children_of(walk *w, trace_brood_id parent, int slot,
     const trace_box *base = parent == TRACE_BROOD_NONE ? NULL : node;
     trace_brood_id id = trace_boxcache_lookup_at(th->cache, owner->id, parent, slot, base, kids);
     if (id != TRACE_BROOD_NONE) return id;
-    trace_lin l;
-    const trace_lin *lin = node_lin(w, parent, slot, node, &l);
+    trace_dlin d;
+    const trace_dlin *lin = node_lin(w, parent, slot, node, &d);
     for (int i = 0; i < 4; i++) {
         if (lin) {
             double c[4];
             child_range(i, r[0], r[1], r[2], r[3], c);
-            trace_box_restrict(lin, r, c, &kids[i]);
-            trace_box_round_float(&kids[i], base);
+            trace_box_restrict(lin, node, r, c, &kids[i]);
         } else {
-            child_box(w, node, NULL, base, r, depth, i, &kids[i]);
+            child_box(w, node, NULL, r, depth, i, &kids[i]);
         }
     }
-    return trace_boxcache_insert_at(th->cache, owner->id, parent, slot, base, kids);
+    return trace_boxcache_insert_kept(th->cache, owner->id, parent, slot, base, kids);
 }
 
 /* A lazy child that a ray meets: evaluated (child_box) and kept in its
@@ -622,11 +625,11 @@ static void lazy_child(walk *w, trace_brood_id brood, trace_brood_id parent, int
                        const trace_box *node, const double r[4], int depth, int i, trace_box *kid)
 {
     const trace_box *base = parent == TRACE_BROOD_NONE ? NULL : node;
-    trace_lin l;
-    const trace_lin *lin = node_lin(w, parent, slot, node, &l);
+    trace_dlin d;
+    const trace_dlin *lin = node_lin(w, parent, slot, node, &d);
     assert(lin != NULL);                 /* a lazy child's node has one */
-    child_box(w, node, lin, base, r, depth, i, kid);
-    trace_boxcache_update_at(w->th->cache, brood, i, base, kid);
+    child_box(w, node, lin, r, depth, i, kid);
+    trace_boxcache_update_kept(w->th->cache, brood, i, base, kid);
 }
 
 /* Bounded work (issue 9): a walk ends after max_nodes_per_ray nodes, or

@@ -99,6 +99,13 @@ static double restricted_excess(const trace_box *b, const double r[4], double u,
                                 vec3 p, double slack, tally *t)
 {
     if (!(b->flags & TRACE_BOX_LIN)) return 0;
+    /* as the intersector has it: the codes against the box as the cache
+     * keeps it (the box itself rounded so, and no wider) */
+    trace_box kept = *b;
+    trace_box_round_float(&kept, NULL);
+    if (!(kept.flags & TRACE_BOX_LIN)) return 0;
+    trace_dlin d;
+    trace_box_lin(&kept.qlin, &kept, &d);
     double um = 0.5 * (r[0] + r[1]), vm = 0.5 * (r[2] + r[3]), e = 0;
     for (int i = 0; i < 5; i++) {
         double c[4] = {r[0], r[1], r[2], r[3]};
@@ -108,7 +115,7 @@ static double restricted_excess(const trace_box *b, const double r[4], double u,
         }
         if (u < c[0] || u > c[1] || v < c[2] || v > c[3]) continue;
         trace_box rb;
-        trace_box_restrict(&b->lin, r, c, &rb);
+        trace_box_restrict(&d, &kept, r, c, &rb);
         t->restricted_points++;
         e = fmax(e, fmax(excess(p.x, rb.lo.x, rb.hi.x, slack),
                          fmax(excess(p.y, rb.lo.y, rb.hi.y, slack),

@@ -7,7 +7,8 @@
  * from a parent box (near, far, infinite) contain too, and a flat child of
  * a flat parent is exact; and the box cache gives back the rounded box (a
  * hit equals a recomputation). The linear bounds of issue 24's lazy
- * children: in floats they hold what the doubles held, and a child cell's
+ * children (lin_bound.h): in floats they hold what the doubles held, as
+ * codes what the floats held within the box, and a child cell's
  * restricted bound holds the points of the child.
  */
 #include <setjmp.h>
@@ -248,25 +249,34 @@ static void test_cache_gives_back_the_rounded_box(void **state)
 {
     (void)state;
     trace_boxcache *c = trace_boxcache_new(0, 1);
-    /* the box itself (the linear bound is floats in both) */
-    assert_true(sizeof(trace_fbox) - sizeof(trace_lin) <
-                (sizeof(trace_box) - sizeof(trace_lin)) * 2 / 3);
+    /* the box itself, and its linear bound as 12 bytes of codes */
+    assert_true(sizeof(trace_fbox) - sizeof(trace_qlin) <
+                (sizeof(trace_box) - sizeof(trace_lin) - sizeof(trace_qlin)) * 2 / 3);
+    assert_int_equal(sizeof(trace_qlin), 12);
     trace_box in[4], want[4], out[4];
+    trace_qlin codes[4];
     for (int i = 0; i < 4; i++) {
         random_box(&in[i]);
-        for (int k = 0; k < 3; k++)          /* a linear bound, kept apart */
-            assert_true(trace_lin_set(&in[i].lin, k, 1.0 + i + k, 0.25, -0.5, 0.125));
+        for (int k = 0; k < 3; k++) {       /* a linear bound inside the box, kept apart */
+            double lo = (&in[i].lo.x)[k], hi = (&in[i].hi.x)[k];
+            double mid = 0.5 * lo + 0.5 * hi, q = 0.125 * (hi - lo);
+            if (!trace_lin_set(&in[i].lin, k, mid, q, -q, q))     /* beyond the floats */
+                assert_true(trace_lin_set(&in[i].lin, k, 0, 0, 0, 0));
+        }
+        in[i].flags |= TRACE_BOX_LIN;
         want[i] = in[i];
         trace_box_round_float(&want[i], NULL);
+        codes[i] = want[i].qlin;
         memset(&want[i].lin, 0, sizeof want[i].lin);
+        memset(&want[i].qlin, 0, sizeof want[i].qlin);
     }
     memset(out, 0, sizeof out);
     trace_brood_id id = trace_boxcache_insert(c, 0, TRACE_BROOD_NONE, 0, in);
     assert_int_equal(trace_boxcache_lookup(c, 0, TRACE_BROOD_NONE, 0, out), id);
-    /* the lookup leaves the linear bounds out; the brood has them */
+    /* the lookup leaves the linear bounds out; the brood has their codes */
     assert_memory_equal(out, want, sizeof want);
     for (int i = 0; i < 4; i++)
-        assert_memory_equal(trace_boxcache_lin(c, id, i), &in[i].lin, sizeof(trace_lin));
+        assert_memory_equal(trace_boxcache_qlin(c, id, i), &codes[i], sizeof(trace_qlin));
     /* against a base */
     trace_box base;
     random_box(&base);
@@ -274,22 +284,38 @@ static void test_cache_gives_back_the_rounded_box(void **state)
         want[i] = in[i];
         trace_box_round_float(&want[i], &base);
         memset(&want[i].lin, 0, sizeof want[i].lin);
+        memset(&want[i].qlin, 0, sizeof want[i].qlin);
     }
     memset(out, 0, sizeof out);
     trace_brood_id kid = trace_boxcache_insert_at(c, 0, id, 1, &base, in);
     assert_int_equal(trace_boxcache_lookup_at(c, 0, id, 1, &base, out), kid);
     assert_memory_equal(out, want, sizeof want);
-    /* a lazy child evaluated: its slot replaced, the others kept */
-    trace_box now = in[3];
+    /* a lazy child evaluated: its slot replaced, the others kept, and
+     * the box given back is the one a lookup gives (stored or not) */
+    trace_box now = in[3], now2;
     random_box(&now);
-    trace_boxcache_update_at(c, kid, 2, &base, &now);
+    now2 = now;
+    trace_boxcache_update_kept(c, kid, 2, &base, &now);
+    trace_boxcache_update_kept(c, -2, 2, &base, &now2);       /* a brood not stored */
+    assert_memory_equal(&now, &now2, sizeof now);
     trace_box again[4];
     memset(again, 0, sizeof again);
     assert_int_equal(trace_boxcache_lookup_at(c, 0, id, 1, &base, again), kid);
     want[2] = now;
-    trace_box_round_float(&want[2], &base);
     memset(&want[2].lin, 0, sizeof want[2].lin);
+    memset(&want[2].qlin, 0, sizeof want[2].qlin);
     assert_memory_equal(again, want, sizeof want);
+    /* and a brood inserted so: the boxes given back are the lookup's */
+    trace_box kept4[4];
+    memcpy(kept4, in, sizeof kept4);
+    trace_brood_id k2 = trace_boxcache_insert_kept(c, 0, id, 3, &base, kept4);
+    memset(again, 0, sizeof again);
+    assert_int_equal(trace_boxcache_lookup_at(c, 0, id, 3, &base, again), k2);
+    for (int i = 0; i < 4; i++) {
+        memset(&kept4[i].lin, 0, sizeof kept4[i].lin);
+        memset(&kept4[i].qlin, 0, sizeof kept4[i].qlin);
+    }
+    assert_memory_equal(again, kept4, sizeof again);
     trace_boxcache_destroy(&c);
 }
 
@@ -334,10 +360,77 @@ static void test_linear_bound_in_floats(void **state)
     assert_true(checked > 100000);
 }
 
-/* The restricted bound of a child cell (trace_box_restrict) against points
- * of the child mapped to eu, ev independently (long double, from the cell's
- * centre and radius), at the corners of the radius; a child's bound is
- * narrower than the whole cell's where its terms are */
+/* A linear bound as codes against its box (trace_qlin_encode) holds what
+ * the floats held within the box: points of the float bound at the
+ * corners (eu, ev in -1, 0, 1) and random inside, those that lie in the
+ * box, lie in the decoded bound (long double); a side of length 0 is the
+ * box itself; a radius wider than the box is refused */
+static void test_linear_bound_codes(void **state)
+{
+    (void)state;
+    long checked = 0, refused = 0, encoded = 0;
+    for (int n = 0; n < 20000; n++) {
+        trace_lin l;
+        double lo[3], hi[3];
+        for (int k = 0; k < 3; k++) {
+            double x = ldexp((double)(next() >> 11) * 0x1p-53 - 0.5, (int)(next() % 60) - 30);
+            double w = fabs(x) * ldexp(1.0, -(int)(next() % 30)) + 0x1p-60;
+            double u = w * ((double)(next() >> 11) * 0x1p-53 - 0.5);
+            double v = w * ((double)(next() >> 11) * 0x1p-53 - 0.5);
+            double r = w * (double)(next() % 100) * 0.002;
+            assert_true(trace_lin_set(&l, k, x, u, v, r));
+            /* the box: the bound's range, cut by up to a third on each side
+             * (a hull may be narrower), sometimes flat */
+            double a = (double)l.x[k] - fabs(l.u[k]) - fabs(l.v[k]) - l.r[k];
+            double b = (double)l.x[k] + fabs(l.u[k]) + fabs(l.v[k]) + l.r[k];
+            double cut = (b - a) * (double)(next() % 4) / 12.0;
+            lo[k] = a + cut * (double)(next() % 2);
+            hi[k] = b - cut * (double)(next() % 2);
+            if (next() % 16 == 0) hi[k] = lo[k];
+        }
+        trace_qlin q;
+        if (!trace_qlin_encode(&l, lo, hi, &q)) {
+            refused++;
+            continue;
+        }
+        encoded++;
+        trace_dlin d;
+        trace_qlin_decode(&q, lo, hi, &d);
+        for (int j = 0; j < 40; j++) {
+            double eu = j < 9 ? (double)(j % 3 - 1) : 2 * ((double)(next() >> 11) * 0x1p-53) - 1;
+            double ev = j < 9 ? (double)(j / 3 - 1) : 2 * ((double)(next() >> 11) * 0x1p-53) - 1;
+            double er = j < 9 ? (double)(j % 2 ? 1 : -1) : 2 * ((double)(next() >> 11) * 0x1p-53) - 1;
+            for (int k = 0; k < 3; k++) {
+                long double p = (long double)l.x[k] + (long double)l.u[k] * eu +
+                                (long double)l.v[k] * ev + (long double)l.r[k] * er;
+                if (p < lo[k] || p > hi[k]) continue;        /* not the surface */
+                long double c = (long double)d.x[k] + (long double)d.u[k] * eu +
+                                (long double)d.v[k] * ev;
+                if (!(fabsl(p - c) <= d.r[k])) {
+                    print_error("axis %d: %La off the decoded %La by more than %a\n", k, p, c,
+                                d.r[k]);
+                    fail();
+                }
+                checked++;
+            }
+        }
+    }
+    printf("linear bound codes: %ld encoded (%ld points inside), %ld refused\n", encoded,
+           checked, refused);
+    assert_true(encoded > 10000 && checked > 500000);
+    /* a radius wider than the box is refused */
+    trace_lin wide;
+    double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
+    for (int k = 0; k < 3; k++) assert_true(trace_lin_set(&wide, k, 0.5, 0, 0, k == 1 ? 2.0 : 0.1));
+    trace_qlin q;
+    assert_false(trace_qlin_encode(&wide, lo, hi, &q));
+}
+
+/* The restricted bound of a child cell (trace_lin_restrict) against points
+ * of the child mapped to eu, ev independently (long double, from the
+ * symbol's centre and radius), at the corners of the radius; a child's
+ * bound is narrower than the whole cell's where its terms are; and the
+ * box's (trace_box_restrict) lies within its node's box, flagged lazy */
 static void test_restricted_bound(void **state)
 {
     (void)state;
@@ -346,27 +439,26 @@ static void test_restricted_bound(void **state)
         double u0 = (double)(next() >> 11) * 0x1p-53, v0 = (double)(next() >> 11) * 0x1p-53;
         double w = ldexp(1.0 + (double)(next() >> 11) * 0x1p-53, -(int)(next() % 30));
         double r[4] = {u0, u0 + w, v0, v0 + w * 0.75};
-        trace_lin l;
+        trace_dlin l;
         for (int k = 0; k < 3; k++) {
-            double x = (double)(next() >> 11) * 0x1p-50 - 4.0;
-            double du = w * ((double)(next() >> 11) * 0x1p-53 - 0.5);
-            double dv = w * ((double)(next() >> 11) * 0x1p-53 - 0.5);
-            assert_true(trace_lin_set(&l, k, x, du, dv, fabs(du) * 0.01));
+            l.x[k] = (double)(next() >> 11) * 0x1p-50 - 4.0;
+            l.u[k] = w * ((double)(next() >> 11) * 0x1p-53 - 0.5);
+            l.v[k] = w * ((double)(next() >> 11) * 0x1p-53 - 0.5);
+            l.r[k] = fabs(l.u[k]) * 0.01;
         }
         /* the symbols as aa_input defines them: u = mid + rad eu, mid its
          * centre (a double), rad at least the larger side (exact here) */
         long double um = aa_input_mid(r[0], r[1]), vm = aa_input_mid(r[2], r[3]);
         long double ur = fmaxl(r[1] - um, um - r[0]), vr = fmaxl(r[3] - vm, vm - r[2]);
-        trace_box whole;
-        trace_box_restrict(&l, r, r, &whole);
+        double wlo[3], whi[3];
+        trace_lin_restrict(&l, r, r, wlo, whi);
         for (int i = 0; i < 4; i++) {
             double c[4] = {r[0], r[1], r[2], r[3]};
             double cu = 0.5 * (r[0] + r[1]), cv = 0.5 * (r[2] + r[3]);
             if (i & 1) c[0] = cu; else c[1] = cu;
             if (i & 2) c[2] = cv; else c[3] = cv;
-            trace_box b;
-            trace_box_restrict(&l, r, c, &b);
-            assert_int_equal(b.flags, TRACE_BOX_LAZY);
+            double lo[3], hi[3];
+            trace_lin_restrict(&l, r, c, lo, hi);
             for (int j = 0; j < 25; j++) {
                 long double uu = c[0] + (c[1] - c[0]) * (j % 5) / 4.0L;
                 long double vv = c[2] + (c[3] - c[2]) * (j / 5) / 4.0L;
@@ -375,7 +467,6 @@ static void test_restricted_bound(void **state)
                     for (int s = -1; s <= 1; s += 2) {
                         long double p = (long double)l.x[k] + (long double)l.u[k] * eu +
                                         (long double)l.v[k] * ev + (long double)l.r[k] * s;
-                        const double *lo = &b.lo.x, *hi = &b.hi.x;
                         if (!(p >= lo[k] && p <= hi[k])) {
                             print_error("child %d point %d axis %d: %La not in [%a, %a]\n", i,
                                         j, k, p, lo[k], hi[k]);
@@ -386,10 +477,19 @@ static void test_restricted_bound(void **state)
             }
             /* the child's u and v terms are halves of the cell's */
             for (int k = 0; k < 3; k++) {
-                double cw = (&b.hi.x)[k] - (&b.lo.x)[k], ww = (&whole.hi.x)[k] - (&whole.lo.x)[k];
+                double cw = hi[k] - lo[k], ww = whi[k] - wlo[k];
                 assert_true(cw <= ww);
-                if (fabsf(l.u[k]) + fabsf(l.v[k]) > 8 * l.r[k]) assert_true(cw < 0.8 * ww);
+                if (fabs(l.u[k]) + fabs(l.v[k]) > 8 * l.r[k]) assert_true(cw < 0.8 * ww);
             }
+            /* as a box: within its node's, lazy */
+            trace_box node, b;
+            memset(&node, 0, sizeof node);
+            node.lo = v3(wlo[0] + 0.1 * (whi[0] - wlo[0]), wlo[1], wlo[2]);
+            node.hi = v3(whi[0], whi[1] - 0.1 * (whi[1] - wlo[1]), whi[2]);
+            trace_box_restrict(&l, &node, r, c, &b);
+            assert_int_equal(b.flags, TRACE_BOX_LAZY);
+            assert_true(b.lo.x >= node.lo.x && b.hi.y <= node.hi.y);
+            assert_true(b.lo.z == lo[2] && b.hi.z == hi[2]);
         }
     }
     printf("restricted bounds: %ld points inside\n", checked);
@@ -404,6 +504,7 @@ int main(void)
         cmocka_unit_test(test_offsets_from_the_parent),
         cmocka_unit_test(test_cache_gives_back_the_rounded_box),
         cmocka_unit_test(test_linear_bound_in_floats),
+        cmocka_unit_test(test_linear_bound_codes),
         cmocka_unit_test(test_restricted_bound),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
