@@ -48,8 +48,9 @@
 /* A box narrowed by the cases of its seams (trace_surface_box_cases,
  * trace_surface_box_split): its children run their cases first */
 #define TRACE_BOX_SPLIT (1u << 10)
-/* The box carries its linear bound (lin_bound.h): the plain affine run's
- * forms, reduced to u, v and a radius (displace.c) */
+/* The box has a linear bound (lin_bound.h: the plain affine run's forms,
+ * reduced to u, v and a radius; displace.c), which travels beside it (a
+ * trace_lin) and is kept in the box cache as codes (trace_fbox's qlin) */
 #define TRACE_BOX_LIN (1u << 11)
 /* Not evaluated yet: only the restricted bound of the parent's linear
  * bound (trace_box_restrict), which holds the box the child will have
@@ -66,13 +67,6 @@ typedef struct trace_box {
     float sn[3];             /* the slab's unit normal; all 0: no slab */
     float pad;               /* (no padding bytes of unknown value) */
     double slo, shi;         /* n . P over the cell, rounded outward */
-    /* The linear bound (TRACE_BOX_LIN; lin_bound.h): lin as the affine run
-     * left it; qlin, its codes against the box, once the box is final
-     * (trace_box_round_float). The box cache keeps qlin alone, and its
-     * lookups leave both out (trace_boxcache_qlin gives them). */
-    trace_lin lin;
-    trace_qlin qlin;
-    uint32_t lin_pad;        /* 0 (no padding bytes of unknown value) */
 } trace_box;
 
 /* x as a float rounded down (up): the float boxes of BVHs */
@@ -121,7 +115,8 @@ typedef struct trace_fbox {
     float bend;
     float sn[3];
     float slo, shi;
-    trace_qlin qlin;         /* the linear bound's codes, as trace_box's */
+    trace_qlin qlin;         /* TRACE_BOX_LIN: the linear bound's codes against
+                                the box as unpacked (else all 0) */
 } trace_fbox;
 
 /* x - base as a float d such that base + d (double, rounded to nearest) is
@@ -167,7 +162,10 @@ static inline double trace_fbox_coord(double base, float d)
     return base == 0.0 ? (double)d : base + (double)d;
 }
 
-static inline void trace_fbox_pack(const trace_box *b, const trace_box *base, trace_fbox *f)
+/* b as floats against base, with its linear bound lin where b has
+ * TRACE_BOX_LIN and lin is given (else none: the flag goes) */
+static inline void trace_fbox_pack_lin(const trace_box *b, const trace_lin *lin,
+                                       const trace_box *base, trace_fbox *f)
 {
     double blo[3], bhi[3];
     trace_fbox_base(base, blo, bhi);
@@ -180,19 +178,26 @@ static inline void trace_fbox_pack(const trace_box *b, const trace_box *base, tr
     f->bend = b->bend;
     trace_float_range(b->slo, b->shi, 0.0, 0.0, &f->slo, &f->shi);
     /* the linear bound as codes against the box as unpacked */
-    if (b->flags & TRACE_BOX_LIN) {
+    if (lin && (b->flags & TRACE_BOX_LIN)) {
         double flo[3], fhi[3];
         for (int i = 0; i < 3; i++) {
             flo[i] = trace_fbox_coord(blo[i], f->lo[i]);
             fhi[i] = trace_fbox_coord(bhi[i], f->hi[i]);
         }
-        if (!trace_qlin_encode(&b->lin, flo, fhi, &f->qlin)) f->flags &= ~(unsigned)TRACE_BOX_LIN;
+        if (!trace_qlin_encode(lin, flo, fhi, &f->qlin)) f->flags &= ~(unsigned)TRACE_BOX_LIN;
+    } else {
+        f->flags &= ~(unsigned)TRACE_BOX_LIN;
     }
     if (!(f->flags & TRACE_BOX_LIN)) memset(&f->qlin, 0, sizeof f->qlin);
 }
 
-/* trace_fbox_unpack with the base's coordinates given (trace_fbox_base),
- * but without the linear bound (b->lin is left as it was) */
+/* b as floats against base, without a linear bound */
+static inline void trace_fbox_pack(const trace_box *b, const trace_box *base, trace_fbox *f)
+{
+    trace_fbox_pack_lin(b, NULL, base, f);
+}
+
+/* trace_fbox_unpack with the base's coordinates given (trace_fbox_base) */
 static inline void trace_fbox_unpack_on(const trace_fbox *f, const double blo[3],
                                         const double bhi[3], trace_box *b)
 {
@@ -204,24 +209,22 @@ static inline void trace_fbox_unpack_on(const trace_fbox *f, const double blo[3]
     b->bend = f->bend;
     for (int i = 0; i < 3; i++) b->sn[i] = f->sn[i];
     b->pad = 0.0f;
-    b->lin_pad = 0;
     b->slo = f->slo;
     b->shi = f->shi;
 }
 
-/* the box and its linear bound */
 static inline void trace_fbox_unpack(const trace_fbox *f, const trace_box *base, trace_box *b)
 {
     double blo[3], bhi[3];
     trace_fbox_base(base, blo, bhi);
     trace_fbox_unpack_on(f, blo, bhi, b);
-    b->qlin = f->qlin;
 }
 
-/* The box as the cache would give it back (stored against base): every box
- * the traversal uses below a node goes through this, cached or not, so a
- * box stays a pure function of (object, u-range, v-range) whatever the
- * cache holds */
+/* The box as the cache would give it back (stored against base, without
+ * a linear bound: TRACE_BOX_LIN goes). The traversal packs its boxes once
+ * and goes on with what the packing gives (trace_boxcache_insert_kept),
+ * cached or not, so a box stays a pure function of (object, u-range,
+ * v-range) whatever the cache holds */
 static inline void trace_box_round_float(trace_box *b, const trace_box *base)
 {
     trace_fbox f;

@@ -197,9 +197,9 @@ trace_brood_id trace_boxcache_insert(trace_boxcache *self, int object,
     return trace_boxcache_insert_at(self, object, parent, slot, NULL, boxes);
 }
 
-trace_brood_id trace_boxcache_insert_at(trace_boxcache *self, int object,
-                                        trace_brood_id parent, int slot,
-                                        const trace_box *base, const trace_box boxes[4])
+/* A new brood under (parent, slot), linked and on the LRU list, its boxes
+ * not yet written; TRACE_BROOD_UNCACHED where it cannot be stored */
+static trace_brood_id new_brood(trace_boxcache *self, int object, trace_brood_id parent, int slot)
 {
     if (!link_of(self, object, parent, slot)) {
         self->stats.not_stored++;
@@ -217,7 +217,6 @@ trace_brood_id trace_boxcache_insert_at(trace_boxcache *self, int object,
         return TRACE_BROOD_UNCACHED;
     }
     trace_brood *b = &self->pool[id];
-    for (int i = 0; i < 4; i++) trace_fbox_pack(&boxes[i], base, &b->box[i]);
     for (int i = 0; i < 4; i++) b->child[i] = TRACE_BROOD_NONE;
     b->parent = parent;
     b->object = object;
@@ -229,17 +228,43 @@ trace_brood_id trace_boxcache_insert_at(trace_boxcache *self, int object,
     return id;
 }
 
-/* box as the float box f holds it: unpacked over the same base, the raw
- * linear bound kept (it is what the codes were made from) */
-static void kept(const trace_fbox *f, const trace_box *base, trace_box *box)
+trace_brood_id trace_boxcache_insert_at(trace_boxcache *self, int object,
+                                        trace_brood_id parent, int slot,
+                                        const trace_box *base, const trace_box boxes[4])
 {
-    trace_lin raw = box->lin;
+    trace_brood_id id = new_brood(self, object, parent, slot);
+    if (id >= 0)
+        for (int i = 0; i < 4; i++) trace_fbox_pack(&boxes[i], base, &self->pool[id].box[i]);
+    return id;
+}
+
+/* box i packed (with its linear bound) into f, and given back as f keeps
+ * it, its codes in *code where asked */
+static void pack_kept(trace_fbox *f, trace_box *box, const trace_lin *lin, const trace_box *base,
+                      trace_qlin *code)
+{
+    trace_fbox_pack_lin(box, lin, base, f);
     trace_fbox_unpack(f, base, box);
-    box->lin = raw;
+    if (code) *code = f->qlin;
+}
+
+trace_brood_id trace_boxcache_insert_kept(trace_boxcache *self, int object,
+                                          trace_brood_id parent, int slot,
+                                          const trace_box *base, trace_box boxes[4],
+                                          const trace_lin lins[4], trace_qlin codes[4])
+{
+    trace_brood_id id = new_brood(self, object, parent, slot);
+    for (int i = 0; i < 4; i++) {
+        trace_fbox tmp;
+        pack_kept(id >= 0 ? &self->pool[id].box[i] : &tmp, &boxes[i], lins ? &lins[i] : NULL,
+                  base, codes ? &codes[i] : NULL);
+    }
+    return id;
 }
 
 void trace_boxcache_update_kept(trace_boxcache *self, trace_brood_id id, int i,
-                                const trace_box *base, trace_box *box)
+                                const trace_box *base, trace_box *box, const trace_lin *lin,
+                                trace_qlin *code)
 {
     assert(i >= 0 && i < 4);
     trace_fbox tmp, *f = &tmp;
@@ -247,23 +272,7 @@ void trace_boxcache_update_kept(trace_boxcache *self, trace_brood_id id, int i,
         assert(id < self->used);
         f = &self->pool[id].box[i];
     }
-    trace_fbox_pack(box, base, f);
-    kept(f, base, box);
-}
-
-trace_brood_id trace_boxcache_insert_kept(trace_boxcache *self, int object,
-                                          trace_brood_id parent, int slot,
-                                          const trace_box *base, trace_box boxes[4])
-{
-    trace_brood_id id = trace_boxcache_insert_at(self, object, parent, slot, base, boxes);
-    for (int i = 0; i < 4; i++) {
-        trace_fbox tmp;
-        const trace_fbox *f = &tmp;
-        if (id >= 0) f = &self->pool[id].box[i];
-        else trace_fbox_pack(&boxes[i], base, &tmp);
-        kept(f, base, &boxes[i]);
-    }
-    return id;
+    pack_kept(f, box, lin, base, code);
 }
 
 const trace_qlin *trace_boxcache_qlin(const trace_boxcache *self, trace_brood_id id, int i)

@@ -88,22 +88,25 @@ trace_brood_id trace_boxcache_insert_at(trace_boxcache *self, int object,
                                         trace_brood_id parent, int slot,
                                         const trace_box *base, const trace_box boxes[4]);
 
-/* trace_boxcache_insert_at that also gives the boxes back as the cache
- * keeps them (trace_box_round_float's: stored or not, a later lookup
- * gives these very boxes); the intersector's way in */
+/* trace_boxcache_insert_at for the intersector: each box with its linear
+ * bound lins[i] (lin_bound.h; lins NULL: none) kept as codes, and the
+ * boxes given back as the cache keeps them (stored or not, a later lookup
+ * gives these very boxes), the codes in codes[4] where asked (a brood
+ * that could not be stored has them nowhere else) */
 trace_brood_id trace_boxcache_insert_kept(trace_boxcache *self, int object,
                                           trace_brood_id parent, int slot,
-                                          const trace_box *base, trace_box boxes[4]);
+                                          const trace_box *base, trace_box boxes[4],
+                                          const trace_lin lins[4], trace_qlin codes[4]);
 
-/* Replaces box i of a brood (a lazy child evaluated: intersect.c), stored
- * against the brood's base as at insertion, and gives it back as kept
- * (as trace_boxcache_insert_kept; rounded alike where the brood was not
- * stored, id < 0) */
+/* Replaces box i of a brood (a lazy child evaluated: intersect.c) as
+ * trace_boxcache_insert_kept stores one (id < 0: a brood not stored,
+ * rounded alike) */
 void trace_boxcache_update_kept(trace_boxcache *self, trace_brood_id id, int i,
-                                const trace_box *base, trace_box *box);
+                                const trace_box *base, trace_box *box, const trace_lin *lin,
+                                trace_qlin *code);
 
-/* The linear bound's codes of box i of a stored brood (box.h: the lookups
- * leave them out); valid until the next insertion */
+/* The linear bound's codes of box i of a stored brood (the lookups leave
+ * them out); valid until the next insertion */
 const trace_qlin *trace_boxcache_qlin(const trace_boxcache *self, trace_brood_id id, int i);
 
 /* Pin / unpin a brood while the traversal is below it. */

@@ -141,9 +141,6 @@ static void box_slab(const aa_form P[3], const ia_interval r[3], trace_box *out)
 
 static void box_from_affine(const aa_form P[3], trace_box *out)
 {
-    memset(&out->lin, 0, sizeof out->lin);       /* none (box_linear's) */
-    memset(&out->qlin, 0, sizeof out->qlin);
-    out->lin_pad = 0;
     ia_interval r[3];
     unsigned flags = 0;
     double lin = 0, other = 0;
@@ -287,15 +284,14 @@ static void affine_run(trace_thread *th, const trace_object *obj,
     affine_shade(th, obj, &c, P);
 }
 
-/* The box's linear bound (box.h, TRACE_BOX_LIN) from the run's forms:
- * per coordinate the centre, the u and v terms (symbols 0 and 1, where
- * the context gave u and v their own symbols) and the rest as a radius,
- * rounded up, as floats (trace_lin_set). None for a form that is
- * unbounded or not finite. */
-static void box_linear(const aa_context *ctx, const aa_form P[3], trace_box *out)
+/* The box's linear bound (lin_bound.h; TRACE_BOX_LIN on the box) from
+ * the run's forms: per coordinate the centre, the u and v terms (symbols
+ * 0 and 1, where the context gave u and v their own symbols) and the rest
+ * as a radius, rounded up, as floats (trace_lin_set). None for a form
+ * that is unbounded or not finite. */
+static void box_linear(const aa_context *ctx, const aa_form P[3], trace_box *out, trace_lin *lin)
 {
-    memset(&out->lin, 0, sizeof out->lin);
-    memset(&out->qlin, 0, sizeof out->qlin);
+    memset(lin, 0, sizeof *lin);
     if (ctx->capacity < 2) return;
     for (int k = 0; k < 3; k++) {
         const aa_form *f = &P[k];
@@ -303,19 +299,21 @@ static void box_linear(const aa_context *ctx, const aa_form P[3], trace_box *out
         double rad = f->err;
         for (int i = 2; i < f->n; i++) rad = fp_add_up(rad, fabs(f->c[i]));
         double lu = f->n > 0 ? f->c[0] : 0.0, lv = f->n > 1 ? f->c[1] : 0.0;
-        if (!isfinite(f->x0) || !isfinite(rad) || !trace_lin_set(&out->lin, k, f->x0, lu, lv, rad))
+        if (!isfinite(f->x0) || !isfinite(rad) || !trace_lin_set(lin, k, f->x0, lu, lv, rad))
             return;
     }
     out->flags |= TRACE_BOX_LIN;
 }
 
+/* lin: where given, the box's linear bound (box_linear) */
 static void box_affine(trace_thread *th, const trace_object *obj,
-                       double u0, double u1, double v0, double v1, trace_box *out)
+                       double u0, double u1, double v0, double v1, trace_box *out,
+                       trace_lin *lin)
 {
     aa_form P[3];
     affine_run(th, obj, u0, u1, v0, v1, P);
     box_from_affine(P, out);
-    box_linear(&th->ctx, P, out);
+    if (lin) box_linear(&th->ctx, P, out, lin);
 }
 
 /* At most this many operations split per box: 2^TRACE_SPLIT_OPS runs */
@@ -497,9 +495,6 @@ static void ia_camera_normal(const trace_object *obj, const ia_interval Nn[3],
 
 static void box_from_interval(const ia_interval P[3], trace_box *out)
 {
-    memset(&out->lin, 0, sizeof out->lin);       /* no linear bound */
-    memset(&out->qlin, 0, sizeof out->qlin);
-    out->lin_pad = 0;
     out->bend = 0.0f;
     out->lo = v3(P[0].lo, P[1].lo, P[2].lo);
     out->hi = v3(P[0].hi, P[1].hi, P[2].hi);
@@ -616,15 +611,21 @@ bool trace_surface_slopes(trace_thread *th, const trace_object *obj,
     return !(flags & (AA_DISCONTINUOUS | AA_UNBOUNDED));
 }
 
-void trace_surface_box(trace_thread *th, const trace_object *obj,
-                       double u0, double u1, double v0, double v1, trace_box *out)
+void trace_surface_box_lin(trace_thread *th, const trace_object *obj, double u0, double u1,
+                           double v0, double v1, trace_box *out, trace_lin *lin)
 {
     obj = trace_box_owner(obj);           /* an instance: its prototype's box */
     if (th->world->options.arith == TRACE_ARITH_INTERVAL)
         box_interval(th, obj, u0, u1, v0, v1, out);
     else
-        box_affine(th, obj, u0, u1, v0, v1, out);
+        box_affine(th, obj, u0, u1, v0, v1, out, lin);
     box_finish(th, out);
+}
+
+void trace_surface_box(trace_thread *th, const trace_object *obj,
+                       double u0, double u1, double v0, double v1, trace_box *out)
+{
+    trace_surface_box_lin(th, obj, u0, u1, v0, v1, out, NULL);
 }
 
 /* ---- points: dual mode ---- */

@@ -28,6 +28,10 @@
 void trace_surface_box(trace_thread *th, const trace_object *obj,
                        double u0, double u1, double v0, double v1,
                        trace_box *out);
+/* The same, and the box's linear bound in *lin where the run gives one
+ * (TRACE_BOX_LIN on the box; lin_bound.h, issue 24's lazy children) */
+void trace_surface_box_lin(trace_thread *th, const trace_object *obj, double u0, double u1,
+                           double v0, double v1, trace_box *out, trace_lin *lin);
 
 /* The pieces of a box's affine binding (also trace/region.c's): out = m *
  * in (with m's translation when `point`; out must not alias in), and the

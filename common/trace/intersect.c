@@ -535,7 +535,7 @@ static bool stagnant(const trace_box *b, double parent_extent)
  * keeps it (trace_boxcache_insert_kept: a hit and a miss give the same
  * box) */
 static void child_box(walk *w, const trace_box *node, const trace_dlin *lin, const double r[4],
-                      int depth, int i, trace_box *kid)
+                      int depth, int i, trace_box *kid, trace_lin *kid_lin)
 {
     trace_thread *th = w->th;
     const trace_object *owner = trace_box_owner(w->obj);
@@ -548,7 +548,7 @@ static void child_box(walk *w, const trace_box *node, const trace_dlin *lin, con
     if (cases_first)
         split = trace_surface_box_split(th, owner, c[0], c[1], c[2], c[3], kid);
     else
-        trace_surface_box(th, owner, c[0], c[1], c[2], c[3], kid);
+        trace_surface_box_lin(th, owner, c[0], c[1], c[2], c[3], kid, kid_lin);
     if (stagnant(kid, node_extent)) {
         /* issue 24: the cases of a seam, then (still stagnant) samples;
          * below a box they did not narrow, not again (a pattern whose
@@ -569,32 +569,35 @@ static void child_box(walk *w, const trace_box *node, const trace_dlin *lin, con
     }
 }
 
+/* The node's linear bound decoded, or NULL where it has none: from its
+ * brood's codes (the lookups copy none), or where its brood could not be
+ * stored, from the codes the walk kept (node_q). None at an object's
+ * root: instances that share their prototype's broods have roots of
+ * their own. */
+static const trace_dlin *node_lin(const walk *w, trace_brood_id parent, int slot,
+                                  const trace_box *node, const trace_qlin *node_q, trace_dlin *d)
+{
+    if (!(node->flags & TRACE_BOX_LIN) || parent == TRACE_BROOD_NONE) return NULL;
+    const trace_qlin *q = parent >= 0 ? trace_boxcache_qlin(w->th->cache, parent, slot) : node_q;
+    assert(q != NULL);
+    trace_box_lin(q, node, d);
+    return d;
+}
+
 /*
  * The node's children (the brood of its four cells), from the box cache
- * or made here. Lazy children (issue 24): below a node with a linear
- * bound a new brood holds only the children's restricted bounds
+ * or made here; their linear bounds' codes in kq where the brood could not
+ * be stored. Lazy children (issue 24): below a node with a linear bound
+ * a new brood holds only the children's restricted bounds
  * (TRACE_BOX_LAZY); visit evaluates a child when a ray meets its
  * restricted bound (lazy_child). A child's box is the same either way,
  * child_box's, which its restricted bound holds, so no ray that misses
  * the bound could meet the box: the cache's state never changes a walk.
  */
-/* The node's linear bound decoded, or NULL where it has none: from its
- * brood's codes (a box the cache gave has no copy of them), else its own
- * (the same codes: child_box rounds every box as the cache keeps it).
- * None at an object's root: instances that share their prototype's broods
- * have roots of their own. */
-static const trace_dlin *node_lin(const walk *w, trace_brood_id parent, int slot,
-                                  const trace_box *node, trace_dlin *d)
-{
-    if (!(node->flags & TRACE_BOX_LIN) || parent == TRACE_BROOD_NONE) return NULL;
-    const trace_qlin *q = parent >= 0 ? trace_boxcache_qlin(w->th->cache, parent, slot) : &node->qlin;
-    trace_box_lin(q, node, d);
-    return d;
-}
-
 static trace_brood_id children_of(walk *w, trace_brood_id parent, int slot,
-                                  const double r[4], const trace_box *node, int depth,
-                                  trace_box kids[4])
+                                  const double r[4], const trace_box *node,
+                                  const trace_qlin *node_q, int depth, trace_box kids[4],
+                                  trace_qlin kq[4])
 {
     trace_thread *th = w->th;
     /* instances sharing a prototype's boxes share its cache entries */
@@ -606,30 +609,34 @@ static trace_brood_id children_of(walk *w, trace_brood_id parent, int slot,
     trace_brood_id id = trace_boxcache_lookup_at(th->cache, owner->id, parent, slot, base, kids);
     if (id != TRACE_BROOD_NONE) return id;
     trace_dlin d;
-    const trace_dlin *lin = node_lin(w, parent, slot, node, &d);
+    const trace_dlin *lin = node_lin(w, parent, slot, node, node_q, &d);
+    trace_lin lins[4];
     for (int i = 0; i < 4; i++) {
         if (lin) {
             double c[4];
             child_range(i, r[0], r[1], r[2], r[3], c);
             trace_box_restrict(lin, node, r, c, &kids[i]);
         } else {
-            child_box(w, node, NULL, r, depth, i, &kids[i]);
+            child_box(w, node, NULL, r, depth, i, &kids[i], &lins[i]);
         }
     }
-    return trace_boxcache_insert_kept(th->cache, owner->id, parent, slot, base, kids);
+    return trace_boxcache_insert_kept(th->cache, owner->id, parent, slot, base, kids,
+                                      lin ? NULL : lins, kq);
 }
 
 /* A lazy child that a ray meets: evaluated (child_box) and kept in its
- * brood */
+ * brood (its codes in *kq as well) */
 static void lazy_child(walk *w, trace_brood_id brood, trace_brood_id parent, int slot,
-                       const trace_box *node, const double r[4], int depth, int i, trace_box *kid)
+                       const trace_box *node, const trace_qlin *node_q, const double r[4],
+                       int depth, int i, trace_box *kid, trace_qlin *kq)
 {
     const trace_box *base = parent == TRACE_BROOD_NONE ? NULL : node;
     trace_dlin d;
-    const trace_dlin *lin = node_lin(w, parent, slot, node, &d);
+    const trace_dlin *lin = node_lin(w, parent, slot, node, node_q, &d);
     assert(lin != NULL);                 /* a lazy child's node has one */
-    child_box(w, node, lin, r, depth, i, kid);
-    trace_boxcache_update_kept(w->th->cache, brood, i, base, kid);
+    trace_lin kid_lin;
+    child_box(w, node, lin, r, depth, i, kid, &kid_lin);
+    trace_boxcache_update_kept(w->th->cache, brood, i, base, kid, &kid_lin, kq);
 }
 
 /* Bounded work (issue 9): a walk ends after max_nodes_per_ray nodes, or
@@ -701,12 +708,15 @@ static trace_proof test_cell(walk *w, const double c[4], double tol, trace_proof
     return pr;
 }
 
-static void visit(walk *w, const trace_box *node, const double r[4],
+/* node_q: the node's linear bound's codes where its brood (parent) could
+ * not be stored */
+static void visit(walk *w, const trace_box *node, const trace_qlin *node_q, const double r[4],
                   trace_brood_id parent, int slot, int depth, bool fine, geom_cover node_cover)
 {
     if (over_limit(w, r)) return;
     trace_box kids[4];
-    trace_brood_id brood = children_of(w, parent, slot, r, node, depth, kids);
+    trace_qlin kq[4];
+    trace_brood_id brood = children_of(w, parent, slot, r, node, node_q, depth, kids, kq);
     trace_boxcache_pin(w->th->cache, brood);
 
     child_order order[4];
@@ -727,7 +737,7 @@ static void visit(walk *w, const trace_box *node, const double r[4],
             /* evaluated where the ray meets its restricted bound */
             if (!trace_box_hit(&kids[i], &w->ray, w->ray.tmin, w->best->t, &t0, &t1, NULL))
                 continue;
-            lazy_child(w, brood, parent, slot, node, r, depth, i, &kids[i]);
+            lazy_child(w, brood, parent, slot, node, node_q, r, depth, i, &kids[i], &kq[i]);
             if (trace_box_is_empty(&kids[i]) && !(kids[i].flags & AA_UNBOUNDED)) continue;
         }
         if (!trace_box_hit(&kids[i], &w->ray, w->ray.tmin, w->best->t, &t0, &t1, &axis) ||
@@ -814,7 +824,8 @@ static void visit(walk *w, const trace_box *node, const double r[4],
             }
             kid_fine = true;
         }
-        visit(w, kid, c, brood, order[k].i, d, kid_fine, order[k].cover);
+        visit(w, kid, brood >= 0 ? NULL : &kq[order[k].i], c, brood, order[k].i, d, kid_fine,
+              order[k].cover);
     }
     trace_boxcache_unpin(w->th->cache, brood);
 }
@@ -840,7 +851,7 @@ static bool intersect_displaced(trace_thread *th, const trace_object *obj,
     if (!trace_box_hit(&obj->root, &w.ray, ray->tmin, best->t, &t0, &t1, NULL))
         return false;
     double r[4] = {0, 1, 0, 1};
-    visit(&w, &obj->root, r, TRACE_BROOD_NONE, 0, 0, false, GEOM_PARTIAL);
+    visit(&w, &obj->root, NULL, r, TRACE_BROOD_NONE, 0, 0, false, GEOM_PARTIAL);
     th->stats.nodes += w.nodes;
     if (w.nodes > th->stats.max_nodes_per_ray) th->stats.max_nodes_per_ray = w.nodes;
     return w.found;

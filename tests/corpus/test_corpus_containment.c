@@ -95,17 +95,19 @@ static double excess(double p, double lo, double hi, double slack)
  * children): the point's coordinate k against those of each child cell
  * of r that holds (u, v) (two or four on the cell's middle lines), and of
  * r itself; the largest excess */
-static double restricted_excess(const trace_box *b, const double r[4], double u, double v,
-                                vec3 p, double slack, tally *t)
+static double restricted_excess(const trace_box *b, const trace_lin *lin, const double r[4],
+                                double u, double v, vec3 p, double slack, tally *t)
 {
     if (!(b->flags & TRACE_BOX_LIN)) return 0;
     /* as the intersector has it: the codes against the box as the cache
      * keeps it (the box itself rounded so, and no wider) */
-    trace_box kept = *b;
-    trace_box_round_float(&kept, NULL);
+    trace_fbox f;
+    trace_box kept;
+    trace_fbox_pack_lin(b, lin, NULL, &f);
+    trace_fbox_unpack(&f, NULL, &kept);
     if (!(kept.flags & TRACE_BOX_LIN)) return 0;
     trace_dlin d;
-    trace_box_lin(&kept.qlin, &kept, &d);
+    trace_box_lin(&f.qlin, &kept, &d);
     double um = 0.5 * (r[0] + r[1]), vm = 0.5 * (r[2] + r[3]), e = 0;
     for (int i = 0; i < 5; i++) {
         double c[4] = {r[0], r[1], r[2], r[3]};
@@ -125,7 +127,8 @@ static double restricted_excess(const trace_box *b, const double r[4], double u,
 }
 
 static void check_point(trace_thread *th, const trace_object *obj, const trace_box *b,
-                        const trace_box *b2, const double r[4], double u, double v, tally *t)
+                        const trace_lin *lin, const trace_box *b2, const double r[4], double u,
+                        double v, tally *t)
 {
     if (!geom_uv_inside(&obj->surf, u, v)) return;     /* not on the polygon */
     trace_surface_point sp;
@@ -141,7 +144,7 @@ static void check_point(trace_thread *th, const trace_object *obj, const trace_b
         t->slab_points++;
         e = fmax(e, excess(s, b->slo, b->shi, 2 * slack));
     }
-    e = fmax(e, restricted_excess(b, r, u, v, p, slack, t));
+    e = fmax(e, restricted_excess(b, lin, r, u, v, p, slack, t));
     if (b2)                               /* the box of the cases first (no slab) */
         e = fmax(e, fmax(excess(p.x, b2->lo.x, b2->hi.x, slack),
                          fmax(excess(p.y, b2->lo.y, b2->hi.y, slack),
@@ -249,7 +252,8 @@ static void run_cases(trace_thread *th, const trace_world *w, long ncases, uint6
         if (v1 > 1) v1 = 1;
         snap_to_border(k, su, sv, &u0, &u1, &v0, &v1);
         trace_box b;
-        trace_surface_box(th, obj, u0, u1, v0, v1, &b);
+        trace_lin lin;            /* its linear bound, as the intersector gets it */
+        trace_surface_box_lin(th, obj, u0, u1, v0, v1, &b, &lin);
         take_error(th, t, &t->box_errors);
         /* a discontinuous box, narrowed by the cases of its seams as the
          * intersector narrows those that stop shrinking (issue 24): the
@@ -289,18 +293,18 @@ static void run_cases(trace_thread *th, const trace_world *w, long ncases, uint6
         double r[4] = {u0, u1, v0, v1};
         for (int j = 0; j < GRID; j++)
             for (int i = 0; i < GRID; i++)
-                check_point(th, obj, &b, split, r, u0 + (u1 - u0) * i / (GRID - 1),
+                check_point(th, obj, &b, &lin, split, r, u0 + (u1 - u0) * i / (GRID - 1),
                             v0 + (v1 - v0) * j / (GRID - 1), t);
         /* the middle lines, where two or four child cells meet */
         for (int i = 0; i < GRID; i++) {
             double um = 0.5 * (u0 + u1), vm = 0.5 * (v0 + v1);
-            check_point(th, obj, &b, split, r, um, v0 + (v1 - v0) * i / (GRID - 1), t);
-            check_point(th, obj, &b, split, r, u0 + (u1 - u0) * i / (GRID - 1), vm, t);
+            check_point(th, obj, &b, &lin, split, r, um, v0 + (v1 - v0) * i / (GRID - 1), t);
+            check_point(th, obj, &b, &lin, split, r, u0 + (u1 - u0) * i / (GRID - 1), vm, t);
         }
         for (int i = 0; i < RANDOM_POINTS; i++) {
             double u = u0 + (u1 - u0) * corpus_rng_uniform(&rng);
             double v = v0 + (v1 - v0) * corpus_rng_uniform(&rng);
-            check_point(th, obj, &b, split, r, u, v, t);
+            check_point(th, obj, &b, &lin, split, r, u, v, t);
         }
     }
     free(view);

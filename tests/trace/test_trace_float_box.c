@@ -249,73 +249,73 @@ static void test_cache_gives_back_the_rounded_box(void **state)
 {
     (void)state;
     trace_boxcache *c = trace_boxcache_new(0, 1);
-    /* the box itself, and its linear bound as 12 bytes of codes */
-    assert_true(sizeof(trace_fbox) - sizeof(trace_qlin) <
-                (sizeof(trace_box) - sizeof(trace_lin) - sizeof(trace_qlin)) * 2 / 3);
+    assert_true(sizeof(trace_fbox) < sizeof(trace_box) * 3 / 4);
     assert_int_equal(sizeof(trace_qlin), 12);
+    /* boxes with linear bounds inside them, as the intersector has them */
     trace_box in[4], want[4], out[4];
-    trace_qlin codes[4];
+    trace_lin lins[4];
+    trace_qlin codes[4], got[4];
     for (int i = 0; i < 4; i++) {
         random_box(&in[i]);
-        for (int k = 0; k < 3; k++) {       /* a linear bound inside the box, kept apart */
+        for (int k = 0; k < 3; k++) {
             double lo = (&in[i].lo.x)[k], hi = (&in[i].hi.x)[k];
             double mid = 0.5 * lo + 0.5 * hi, q = 0.125 * (hi - lo);
-            if (!trace_lin_set(&in[i].lin, k, mid, q, -q, q))     /* beyond the floats */
-                assert_true(trace_lin_set(&in[i].lin, k, 0, 0, 0, 0));
+            if (!trace_lin_set(&lins[i], k, mid, q, -q, q))     /* beyond the floats */
+                assert_true(trace_lin_set(&lins[i], k, 0, 0, 0, 0));
         }
         in[i].flags |= TRACE_BOX_LIN;
-        want[i] = in[i];
-        trace_box_round_float(&want[i], NULL);
-        codes[i] = want[i].qlin;
-        memset(&want[i].lin, 0, sizeof want[i].lin);
-        memset(&want[i].qlin, 0, sizeof want[i].qlin);
+        trace_fbox f;
+        trace_fbox_pack_lin(&in[i], &lins[i], NULL, &f);
+        trace_fbox_unpack(&f, NULL, &want[i]);
+        codes[i] = f.qlin;
     }
-    memset(out, 0, sizeof out);
-    trace_brood_id id = trace_boxcache_insert(c, 0, TRACE_BROOD_NONE, 0, in);
+    trace_box kept[4];
+    memcpy(kept, in, sizeof kept);
+    trace_brood_id id = trace_boxcache_insert_kept(c, 0, TRACE_BROOD_NONE, 0, NULL, kept, lins, got);
+    assert_true(id >= 0);
+    /* given back as kept, and a lookup gives the same; the codes kept too */
+    assert_memory_equal(kept, want, sizeof want);
+    assert_memory_equal(got, codes, sizeof codes);
     assert_int_equal(trace_boxcache_lookup(c, 0, TRACE_BROOD_NONE, 0, out), id);
-    /* the lookup leaves the linear bounds out; the brood has their codes */
     assert_memory_equal(out, want, sizeof want);
     for (int i = 0; i < 4; i++)
         assert_memory_equal(trace_boxcache_qlin(c, id, i), &codes[i], sizeof(trace_qlin));
-    /* against a base */
+    /* a brood that is not stored: the same boxes and codes */
+    trace_boxcache *none = trace_boxcache_new(1, 1);        /* no room for one brood */
+    memcpy(kept, in, sizeof kept);
+    memset(got, 0, sizeof got);
+    assert_int_equal(trace_boxcache_insert_kept(none, 0, TRACE_BROOD_NONE, 0, NULL, kept, lins, got),
+                     TRACE_BROOD_UNCACHED);
+    assert_memory_equal(kept, want, sizeof want);
+    assert_memory_equal(got, codes, sizeof codes);
+    trace_boxcache_destroy(&none);
+    /* against a base, without linear bounds: the flag goes */
     trace_box base;
     random_box(&base);
     for (int i = 0; i < 4; i++) {
         want[i] = in[i];
         trace_box_round_float(&want[i], &base);
-        memset(&want[i].lin, 0, sizeof want[i].lin);
-        memset(&want[i].qlin, 0, sizeof want[i].qlin);
+        assert_false(want[i].flags & TRACE_BOX_LIN);
     }
-    memset(out, 0, sizeof out);
     trace_brood_id kid = trace_boxcache_insert_at(c, 0, id, 1, &base, in);
     assert_int_equal(trace_boxcache_lookup_at(c, 0, id, 1, &base, out), kid);
     assert_memory_equal(out, want, sizeof want);
     /* a lazy child evaluated: its slot replaced, the others kept, and
      * the box given back is the one a lookup gives (stored or not) */
-    trace_box now = in[3], now2;
+    trace_box now, now2;
     random_box(&now);
+    now.flags |= TRACE_BOX_LIN;
     now2 = now;
-    trace_boxcache_update_kept(c, kid, 2, &base, &now);
-    trace_boxcache_update_kept(c, -2, 2, &base, &now2);       /* a brood not stored */
+    trace_qlin q1, q2;
+    trace_boxcache_update_kept(c, kid, 2, &base, &now, &lins[0], &q1);
+    trace_boxcache_update_kept(c, TRACE_BROOD_UNCACHED, 2, &base, &now2, &lins[0], &q2);
     assert_memory_equal(&now, &now2, sizeof now);
+    assert_memory_equal(&q1, &q2, sizeof q1);
+    assert_memory_equal(trace_boxcache_qlin(c, kid, 2), &q1, sizeof q1);
     trace_box again[4];
-    memset(again, 0, sizeof again);
     assert_int_equal(trace_boxcache_lookup_at(c, 0, id, 1, &base, again), kid);
     want[2] = now;
-    memset(&want[2].lin, 0, sizeof want[2].lin);
-    memset(&want[2].qlin, 0, sizeof want[2].qlin);
     assert_memory_equal(again, want, sizeof want);
-    /* and a brood inserted so: the boxes given back are the lookup's */
-    trace_box kept4[4];
-    memcpy(kept4, in, sizeof kept4);
-    trace_brood_id k2 = trace_boxcache_insert_kept(c, 0, id, 3, &base, kept4);
-    memset(again, 0, sizeof again);
-    assert_int_equal(trace_boxcache_lookup_at(c, 0, id, 3, &base, again), k2);
-    for (int i = 0; i < 4; i++) {
-        memset(&kept4[i].lin, 0, sizeof kept4[i].lin);
-        memset(&kept4[i].qlin, 0, sizeof kept4[i].qlin);
-    }
-    assert_memory_equal(again, kept4, sizeof again);
     trace_boxcache_destroy(&c);
 }
 
