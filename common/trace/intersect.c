@@ -611,17 +611,19 @@ static trace_brood_id children_of(walk *w, trace_brood_id parent, int slot,
     trace_dlin d;
     const trace_dlin *lin = node_lin(w, parent, slot, node, node_q, &d);
     trace_lin lins[4];
+    bool lazy = lin && th->world->options.lazy_children;
     for (int i = 0; i < 4; i++) {
-        if (lin) {
+        if (lazy) {
             double c[4];
             child_range(i, r[0], r[1], r[2], r[3], c);
             trace_box_restrict(lin, node, r, c, &kids[i]);
+            th->stats.lazy_bounds++;
         } else {
-            child_box(w, node, NULL, r, depth, i, &kids[i], &lins[i]);
+            child_box(w, node, lin, r, depth, i, &kids[i], &lins[i]);
         }
     }
     return trace_boxcache_insert_kept(th->cache, owner->id, parent, slot, base, kids,
-                                      lin ? NULL : lins, kq);
+                                      lazy ? NULL : lins, kq);
 }
 
 /* A lazy child that a ray meets: evaluated (child_box) and kept in its
@@ -635,6 +637,7 @@ static void lazy_child(walk *w, trace_brood_id brood, trace_brood_id parent, int
     const trace_dlin *lin = node_lin(w, parent, slot, node, node_q, &d);
     assert(lin != NULL);                 /* a lazy child's node has one */
     trace_lin kid_lin;
+    w->th->stats.lazy_evals++;
     child_box(w, node, lin, r, depth, i, kid, &kid_lin);
     trace_boxcache_update_kept(w->th->cache, brood, i, base, kid, &kid_lin, kq);
 }

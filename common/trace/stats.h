@@ -38,6 +38,10 @@ typedef struct trace_stats {
     long lazy_roots;               /* displaced pieces' root boxes this thread
                                       made first and published (mesh.c,
                                       lazy_roots.h) */
+    long lazy_bounds;              /* children made as restricted bounds only
+                                      (intersect.c, "lazy children") */
+    long lazy_evals;               /* of those, evaluated when a ray met the
+                                      bound (their runs count in boxes too) */
     long max_nodes_per_ray;        /* the largest walk (a peak, not a sum) */
     long cache_hits, cache_misses, cache_evictions;
     size_t cache_peak_bytes;

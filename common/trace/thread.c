@@ -25,6 +25,7 @@ void trace_options_default(trace_options *opt)
     opt->max_ray_depth = TRACE_MAX_RAY_DEPTH;
     opt->prove_hits = true;
     opt->lazy_roots = true;
+    opt->lazy_children = true;
     opt->cancel = NULL;
 }
 

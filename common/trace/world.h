@@ -263,6 +263,11 @@ typedef struct trace_options {
     bool lazy_roots;               /* a displaced mesh's root boxes made when
                                       a ray first reaches its pieces (mesh.c);
                                       off: all of them when the world is built */
+    bool lazy_children;            /* below a node with a linear bound, a
+                                      child evaluated when a ray meets its
+                                      restricted bound (intersect.c); off:
+                                      all four at once, the same boxes (for
+                                      tests: the same pixels either way) */
     bool prove_hits;               /* try hit proofs on small cells
                                       (trace/prove.h); off: leaves only */
     const atomic_int *cancel;      /* the program's stop flag (a signal), or

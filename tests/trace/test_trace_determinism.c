@@ -3,7 +3,8 @@
  * one process: different tile sizes, thread counts, tile orders and box
  * cache budgets (down to the paper's 40 KB and below) give identical
  * pixels, for a scene with displacement, shadows, several samples per
- * pixel and a filter wider than a pixel.
+ * pixel and a filter wider than a pixel; and lazy children (issue 24) give
+ * the pixels of children evaluated four at a time.
  */
 #include <math.h>
 #include <setjmp.h>
@@ -100,11 +101,62 @@ static void test_small_cache_evicts_and_respects_budget(void **state)
     fixture_close(&f);
 }
 
+/* The stats of a render in 8x8 tiles on one thread, unlimited cache */
+static trace_stats tile_stats(fixture *f)
+{
+    trace_thread *th = trace_thread_new(&f->js->world);
+    float rgba[4 * 64], z[64];
+    for (int y = 0; y < 30; y += 8)
+        for (int x = 0; x < 40; x += 8)
+            assert_true(trace_render_tile(f->js->renderer, th, x, y, x + 8 <= 40 ? 8 : 40 - x,
+                                          y + 8 <= 30 ? 8 : 30 - y, rgba, z));
+    trace_thread_sync_stats(th);
+    trace_stats st = th->stats;
+    trace_thread_destroy(&th);
+    return st;
+}
+
+/* Lazy children (issue 24): evaluating a child only where a ray meets its
+ * restricted bound gives the pixels of evaluating all four at once (the
+ * same boxes either way), with fewer box runs */
+static void test_lazy_children_change_no_pixel(void **state)
+{
+    (void)state;
+    fixture_shader sh[] = {{"ripple", SHADER_RIPPLE}, {"constd", SHADER_CONSTD},
+                           {"mymatte", SHADER_MYMATTE}};
+    fixture f;
+    assert_true(fixture_open(&f, RIB, sh, 3, NULL, 0));
+    int W = f.js->world.camera.xres, H = f.js->world.camera.yres;
+    size_t npx = (size_t)W * (size_t)H;
+    float *rgba[2], *z[2];
+    trace_stats st[2];
+    for (int lazy = 0; lazy < 2; lazy++) {
+        f.js->world.options.lazy_children = lazy;
+        rgba[lazy] = malloc(sizeof(float) * 4 * npx);
+        z[lazy] = malloc(sizeof(float) * npx);
+        assert_true(fixture_render(&f, 8, 2, 40 * 1024, rgba[lazy], z[lazy]));
+        st[lazy] = tile_stats(&f);
+    }
+    printf("all four children: %ld boxes; lazy: %ld boxes, %ld bounds made, %ld evaluated\n",
+           st[0].boxes, st[1].boxes, st[1].lazy_bounds, st[1].lazy_evals);
+    assert_memory_equal(rgba[0], rgba[1], sizeof(float) * 4 * npx);
+    assert_memory_equal(z[0], z[1], sizeof(float) * npx);
+    assert_int_equal(st[0].lazy_bounds, 0);
+    assert_true(st[1].lazy_evals > 0 && st[1].lazy_evals < st[1].lazy_bounds);
+    assert_true(st[1].boxes < st[0].boxes);
+    for (int i = 0; i < 2; i++) {
+        free(rgba[i]);
+        free(z[i]);
+    }
+    fixture_close(&f);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_pixels_identical_across_tilings_threads_caches),
         cmocka_unit_test(test_small_cache_evicts_and_respects_budget),
+        cmocka_unit_test(test_lazy_children_change_no_pixel),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
