@@ -35,6 +35,7 @@
 #include <math.h>
 #include <stdbool.h>
 
+#include "trace/float_round.h"
 #include "trace/lin_bound.h"
 #include "util/vecmath.h"
 
@@ -68,33 +69,6 @@ typedef struct trace_box {
     float pad;               /* (no padding bytes of unknown value) */
     double slo, shi;         /* n . P over the cell, rounded outward */
 } trace_box;
-
-/* x as a float rounded down (up): the float boxes of BVHs */
-/* The float after f towards +infinity (up) or -infinity: nextafterf's
- * number without the call, for an f that is not NaN and not the infinity
- * it steps towards (floats of one sign are ordered as their bits; from a
- * zero, the smallest subnormal) */
-static inline float trace_float_step(float f, bool up)
-{
-    if (f == 0.0f) return up ? 0x1p-149f : -0x1p-149f;
-    uint32_t b;
-    memcpy(&b, &f, sizeof b);
-    b += (f > 0.0f) == up ? 1u : ~0u;
-    memcpy(&f, &b, sizeof f);
-    return f;
-}
-
-static inline float trace_float_down(double x)
-{
-    float f = (float)x;
-    return (double)f > x ? trace_float_step(f, false) : f;
-}
-
-static inline float trace_float_up(double x)
-{
-    float f = (float)x;
-    return (double)f < x ? trace_float_step(f, true) : f;
-}
 
 /* A box as the box cache stores it (issue 24, session 17): lo and hi as
  * float OFFSETS from a base box (the parent node's box: a child's offsets
@@ -254,9 +228,11 @@ static inline void trace_box_lin(const trace_qlin *q, const trace_box *node, tra
     trace_qlin_decode(q, lo, hi, d);
 }
 
-/* b met with a restricted bound rb (trace_box_restrict): both hold the
- * surface over the cell, so their intersection does; where the meet is
- * finite it is bounded (AA_UNBOUNDED goes); an empty b stays empty */
+/* b met with another enclosure rb of the same surface (a restricted bound,
+ * trace_box_restrict; the hull of a cell's cases): both hold the surface
+ * over the cell, so their intersection does; where the meet is finite it
+ * is bounded (AA_UNBOUNDED goes); an empty b stays empty. Boxes only: b's
+ * slab and flags otherwise stay */
 static inline void trace_box_meet(trace_box *b, const trace_box *rb)
 {
     b->lo = v3(fmax(b->lo.x, rb->lo.x), fmax(b->lo.y, rb->lo.y), fmax(b->lo.z, rb->lo.z));

@@ -383,8 +383,7 @@ bool trace_surface_box_cases(trace_thread *th, const trace_object *obj,
     if (box_has_nan(&hull)) return false;
     /* both enclose the surface over the cell: so does their meet */
     trace_box m = *box;
-    m.lo = v3(fmax(box->lo.x, hull.lo.x), fmax(box->lo.y, hull.lo.y), fmax(box->lo.z, hull.lo.z));
-    m.hi = v3(fmin(box->hi.x, hull.hi.x), fmin(box->hi.y, hull.hi.y), fmin(box->hi.z, hull.hi.z));
+    trace_box_meet(&m, &hull);
     m.flags = box_flags(&m, box->flags | AA_DISCONTINUOUS);
     if (m.lo.x > m.hi.x || m.lo.y > m.hi.y || m.lo.z > m.hi.z) {
         m.lo = v3(INFINITY, INFINITY, INFINITY);          /* empty: no surface */

@@ -34,6 +34,7 @@
 
 #include "aa/affine.h"
 #include "aa/rounding.h"
+#include "trace/float_round.h"
 
 typedef struct trace_lin {
     float x[3], u[3], v[3], r[3];
@@ -54,13 +55,6 @@ static inline double trace_abs_diff_up(double a, double b)
     return fmax(fp_add_up(a, -b), fp_add_up(b, -a));
 }
 
-/* the float above x (x itself where it is a float) */
-static inline float trace_lin_float_up(double x)
-{
-    float f = (float)x;
-    return (double)f < x ? nextafterf(f, INFINITY) : f;
-}
-
 /* Coordinate k from doubles: x, u, v to the nearest floats and r raised by
  * what that moved, |x - x'| + |u - u'| + |v - v'| (eu, ev in [-1, 1]),
  * rounded up. False where it does not fit the floats (the caller drops
@@ -73,7 +67,7 @@ static inline bool trace_lin_set(trace_lin *l, int k, double x, double u, double
     l->x[k] = fx;
     l->u[k] = fu;
     l->v[k] = fv;
-    l->r[k] = trace_lin_float_up(e);
+    l->r[k] = trace_float_up(e);
     return isfinite(fx) && isfinite(fu) && isfinite(fv) && isfinite(l->r[k]);
 }
 

@@ -39,13 +39,35 @@ static const char *RIB =
 
 typedef struct run { int tile, threads; size_t cache; } run;
 
+/* The scene above with its shaders */
+static void open_scene(fixture *f)
+{
+    fixture_shader sh[] = {{"ripple", SHADER_RIPPLE}, {"constd", SHADER_CONSTD},
+                           {"mymatte", SHADER_MYMATTE}};
+    assert_true(fixture_open(f, RIB, sh, 3, NULL, 0));
+}
+
+/* The stats of a render in 8x8 tiles on one thread (the world's cache
+ * budget) */
+static trace_stats tile_stats(fixture *f)
+{
+    trace_thread *th = trace_thread_new(&f->js->world);
+    float rgba[4 * 64], z[64];
+    for (int y = 0; y < 30; y += 8)
+        for (int x = 0; x < 40; x += 8)
+            assert_true(trace_render_tile(f->js->renderer, th, x, y, x + 8 <= 40 ? 8 : 40 - x,
+                                          y + 8 <= 30 ? 8 : 30 - y, rgba, z));
+    trace_thread_sync_stats(th);
+    trace_stats st = th->stats;
+    trace_thread_destroy(&th);
+    return st;
+}
+
 static void test_pixels_identical_across_tilings_threads_caches(void **state)
 {
     (void)state;
-    fixture_shader sh[] = {{"ripple", SHADER_RIPPLE}, {"constd", SHADER_CONSTD},
-                           {"mymatte", SHADER_MYMATTE}};
     fixture f;
-    assert_true(fixture_open(&f, RIB, sh, 3, NULL, 0));
+    open_scene(&f);
     int W = f.js->world.camera.xres, H = f.js->world.camera.yres;
     size_t npx = (size_t)W * (size_t)H;
     const run runs[] = {{8, 1, 0}, {13, 3, 40 * 1024}, {40, 2, 4 * 1024}, {5, 2, 400 * 1024}, {32, 1, 2048}};
@@ -78,42 +100,17 @@ static void test_pixels_identical_across_tilings_threads_caches(void **state)
 static void test_small_cache_evicts_and_respects_budget(void **state)
 {
     (void)state;
-    fixture_shader sh[] = {{"ripple", SHADER_RIPPLE}, {"constd", SHADER_CONSTD},
-                           {"mymatte", SHADER_MYMATTE}};
     fixture f;
-    assert_true(fixture_open(&f, RIB, sh, 3, NULL, 0));
+    open_scene(&f);
     size_t budget = 16 * 1024;
     f.js->world.options.cache_bytes = budget;
-    trace_thread *th = trace_thread_new(&f.js->world);
-    float rgba[4 * 64], z[64];
-    for (int y = 0; y < 30; y += 8)
-        for (int x = 0; x < 40; x += 8)
-            assert_true(trace_render_tile(f.js->renderer, th, x, y,
-                                          x + 8 <= 40 ? 8 : 40 - x, y + 8 <= 30 ? 8 : 30 - y, rgba, z));
-    trace_thread_sync_stats(th);
+    trace_stats st = tile_stats(&f);
     printf("cache %zu bytes: hits %ld misses %ld evictions %ld peak %zu\n", budget,
-           th->stats.cache_hits, th->stats.cache_misses, th->stats.cache_evictions,
-           th->stats.cache_peak_bytes);
-    assert_true(th->stats.cache_evictions > 0);
-    assert_true(th->stats.cache_peak_bytes <= budget);
-    assert_true(th->stats.cache_hits > 0);
-    trace_thread_destroy(&th);
+           st.cache_hits, st.cache_misses, st.cache_evictions, st.cache_peak_bytes);
+    assert_true(st.cache_evictions > 0);
+    assert_true(st.cache_peak_bytes <= budget);
+    assert_true(st.cache_hits > 0);
     fixture_close(&f);
-}
-
-/* The stats of a render in 8x8 tiles on one thread, unlimited cache */
-static trace_stats tile_stats(fixture *f)
-{
-    trace_thread *th = trace_thread_new(&f->js->world);
-    float rgba[4 * 64], z[64];
-    for (int y = 0; y < 30; y += 8)
-        for (int x = 0; x < 40; x += 8)
-            assert_true(trace_render_tile(f->js->renderer, th, x, y, x + 8 <= 40 ? 8 : 40 - x,
-                                          y + 8 <= 30 ? 8 : 30 - y, rgba, z));
-    trace_thread_sync_stats(th);
-    trace_stats st = th->stats;
-    trace_thread_destroy(&th);
-    return st;
 }
 
 /* Lazy children (issue 24): evaluating a child only where a ray meets its
@@ -122,10 +119,8 @@ static trace_stats tile_stats(fixture *f)
 static void test_lazy_children_change_no_pixel(void **state)
 {
     (void)state;
-    fixture_shader sh[] = {{"ripple", SHADER_RIPPLE}, {"constd", SHADER_CONSTD},
-                           {"mymatte", SHADER_MYMATTE}};
     fixture f;
-    assert_true(fixture_open(&f, RIB, sh, 3, NULL, 0));
+    open_scene(&f);
     int W = f.js->world.camera.xres, H = f.js->world.camera.yres;
     size_t npx = (size_t)W * (size_t)H;
     float *rgba[2], *z[2];
