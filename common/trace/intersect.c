@@ -76,7 +76,31 @@ typedef struct walk {
     trace_zero zero;               /* the last zero a test proved (prove.h) */
 } walk;
 
-typedef struct child_order { double t0, t1; int i, axis; geom_cover cover; } child_order;
+/* A child in the walk's order: its entry and exit along the ray (of its
+ * restricted bound while it is pending: a lazy child not yet evaluated) */
+typedef struct child_order {
+    double t0, t1;
+    int i, axis;
+    geom_cover cover;
+    bool pending;
+} child_order;
+
+/* The walk's order: by entry, ties by the child's number (the order in
+ * which the children were put in) */
+static bool order_before(const child_order *a, const child_order *b)
+{
+    return a->t0 < b->t0 || (a->t0 == b->t0 && a->i < b->i);
+}
+
+static void order_insert(child_order *order, int *n, child_order o)
+{
+    int k = (*n)++;
+    while (k > 0 && order_before(&o, &order[k - 1])) {
+        order[k] = order[k - 1];
+        k--;
+    }
+    order[k] = o;
+}
 
 static void child_range(int i, double u0, double u1, double v0, double v1,
                         double r[4])
@@ -725,6 +749,9 @@ static void visit(walk *w, const trace_box *node, const trace_qlin *node_q, cons
     child_order order[4];
     int n = 0;
     double node_extent = trace_box_extent(node);
+    /* every box test of this node's children clips the ray at the hit it
+     * had on entry, wherever in the walk the test is made */
+    const double tmax = w->best->t;
     for (int i = 0; i < 4; i++) {
         double c[4];
         child_range(i, r[0], r[1], r[2], r[3], c);
@@ -737,23 +764,51 @@ static void visit(walk *w, const trace_box *node, const trace_qlin *node_q, cons
         double t0, t1;
         int axis;
         if (kids[i].flags & TRACE_BOX_LAZY) {
-            /* evaluated where the ray meets its restricted bound */
-            if (!trace_box_hit(&kids[i], &w->ray, w->ray.tmin, w->best->t, &t0, &t1, NULL))
-                continue;
-            lazy_child(w, brood, parent, slot, node, node_q, r, depth, i, &kids[i], &kq[i]);
-            if (trace_box_is_empty(&kids[i]) && !(kids[i].flags & AA_UNBOUNDED)) continue;
+            /* pending where the ray meets its restricted bound: evaluated
+             * when the walk reaches it (below) */
+            if (!trace_box_hit(&kids[i], &w->ray, w->ray.tmin, tmax, &t0, &t1, NULL)) continue;
+            w->th->stats.lazy_met++;
+            order_insert(order, &n, (child_order){t0, t1, i, -1, cover, true});
+            continue;
         }
-        if (!trace_box_hit(&kids[i], &w->ray, w->ray.tmin, w->best->t, &t0, &t1, &axis) ||
+        if (!trace_box_hit(&kids[i], &w->ray, w->ray.tmin, tmax, &t0, &t1, &axis) ||
             !trace_box_slab_hit(&kids[i], &w->ray, &t0, &t1))
             continue;
-        child_order o = {t0, t1, i, axis, cover};
-        int k = n++;
-        while (k > 0 && order[k - 1].t0 > o.t0) { order[k] = order[k - 1]; k--; }
-        order[k] = o;
+        order_insert(order, &n, (child_order){t0, t1, i, axis, cover, false});
     }
 
     for (int k = 0; k < n && !(w->any && w->found) && !w->stopped; k++) {
         if (!(order[k].t0 < w->best->t)) break;
+        if (order[k].pending) {
+            /* a lazy child the walk reaches (issue 24): evaluated now, and
+             * back in the order at its box's entry. Its bound holds its
+             * box, so the bound's entry is at most the box's: the children
+             * are walked in the order of their boxes' entries, ties by
+             * number, as if all had been evaluated first, and none whose
+             * bound starts beyond the hit is evaluated at all */
+            child_order o = order[k];
+            for (int j = k + 1; j < n; j++) order[j - 1] = order[j];
+            n--;
+            int i = o.i;
+            double t0, t1;
+            int axis;
+            lazy_child(w, brood, parent, slot, node, node_q, r, depth, i, &kids[i], &kq[i]);
+            if (!(trace_box_is_empty(&kids[i]) && !(kids[i].flags & AA_UNBOUNDED)) &&
+                trace_box_hit(&kids[i], &w->ray, w->ray.tmin, tmax, &t0, &t1, &axis) &&
+                trace_box_slab_hit(&kids[i], &w->ray, &t0, &t1)) {
+                o.t0 = t0;
+                o.t1 = t1;
+                o.axis = axis;
+                o.pending = false;
+                /* among the rest, from k on (all enter at or after o's
+                 * bound) */
+                int m = n - k;
+                order_insert(order + k, &m, o);
+                n = k + m;
+            }
+            k--;                         /* position k again */
+            continue;
+        }
         const trace_box *kid = &kids[order[k].i];
         double c[4];
         child_range(order[k].i, r[0], r[1], r[2], r[3], c);

@@ -40,8 +40,12 @@ typedef struct trace_stats {
                                       lazy_roots.h) */
     long lazy_bounds;              /* children made as restricted bounds only
                                       (intersect.c, "lazy children") */
-    long lazy_evals;               /* of those, evaluated when a ray met the
-                                      bound (their runs count in boxes too) */
+    long lazy_met;                 /* times a ray met such a bound and took
+                                      the child into its walk's order */
+    long lazy_evals;               /* children made as bounds, evaluated when
+                                      a walk reached one (their runs count in
+                                      boxes too): a bound met beyond the
+                                      ray's hit is never evaluated */
     long max_nodes_per_ray;        /* the largest walk (a peak, not a sum) */
     long cache_hits, cache_misses, cache_evictions;
     size_t cache_peak_bytes;

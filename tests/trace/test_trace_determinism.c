@@ -113,9 +113,11 @@ static void test_small_cache_evicts_and_respects_budget(void **state)
     fixture_close(&f);
 }
 
-/* Lazy children (issue 24): evaluating a child only where a ray meets its
- * restricted bound gives the pixels of evaluating all four at once (the
- * same boxes either way), with fewer box runs */
+/* Lazy children (issue 24): evaluating a child only where a walk reaches
+ * its restricted bound gives the pixels of evaluating all four at once
+ * (the same boxes, walked in the same order), with fewer box runs; a bound
+ * that a ray meets beyond its hit (the sphere's far side, behind its near
+ * side) is never evaluated for that ray */
 static void test_lazy_children_change_no_pixel(void **state)
 {
     (void)state;
@@ -132,12 +134,16 @@ static void test_lazy_children_change_no_pixel(void **state)
         assert_true(fixture_render(&f, 8, 2, 40 * 1024, rgba[lazy], z[lazy]));
         st[lazy] = tile_stats(&f);
     }
-    printf("all four children: %ld boxes; lazy: %ld boxes, %ld bounds made, %ld evaluated\n",
-           st[0].boxes, st[1].boxes, st[1].lazy_bounds, st[1].lazy_evals);
+    printf("all four children: %ld boxes; lazy: %ld boxes, %ld bounds made, met %ld times, "
+           "%ld evaluated\n",
+           st[0].boxes, st[1].boxes, st[1].lazy_bounds, st[1].lazy_met, st[1].lazy_evals);
     assert_memory_equal(rgba[0], rgba[1], sizeof(float) * 4 * npx);
     assert_memory_equal(z[0], z[1], sizeof(float) * npx);
     assert_int_equal(st[0].lazy_bounds, 0);
     assert_true(st[1].lazy_evals > 0 && st[1].lazy_evals < st[1].lazy_bounds);
+    /* each evaluation follows a meeting; some meetings lie beyond a hit */
+    assert_true(st[1].lazy_evals < st[1].lazy_met);
+    assert_int_equal(st[0].lazy_met, 0);
     assert_true(st[1].boxes < st[0].boxes);
     for (int i = 0; i < 2; i++) {
         free(rgba[i]);
