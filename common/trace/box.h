@@ -57,11 +57,17 @@
  * bound (trace_box_restrict), which holds the box the child will have
  * (intersect.c, "Lazy children") */
 #define TRACE_BOX_LAZY (1u << 12)
+/* The displacement left P as the base surface gave it over the cell (its
+ * affine form unchanged: displace.c, box_affine), so the surface there is
+ * the base surface: on a flat base the walk intersects it exactly
+ * (intersect.c, "Undisplaced cells") */
+#define TRACE_BOX_UNDISPLACED (1u << 13)
 
 typedef struct trace_box {
     vec3 lo, hi;
     unsigned flags;          /* AA_DISCONTINUOUS | AA_UNBOUNDED | TRACE_BOX_SAMPLED |
-                                TRACE_BOX_UNSPLIT | TRACE_BOX_SPLIT */
+                                TRACE_BOX_UNSPLIT | TRACE_BOX_SPLIT | TRACE_BOX_LIN |
+                                TRACE_BOX_LAZY | TRACE_BOX_UNDISPLACED */
     float bend;              /* how far from linear in (u,v) the surface is over
                                 the box: the affine forms' other terms over
                                 their u and v terms (displace.c); 0: unknown */

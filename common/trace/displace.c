@@ -247,12 +247,27 @@ static void affine_geometry(trace_thread *th, const trace_object *obj,
     c->ctx = *ctx;
 }
 
+/* Whether two forms have the same affine part and flags: the same
+ * centre, coefficients and error term (the hull aside: every operation
+ * recomputes it, rounding outward) */
+static bool same_affine(const aa_form *a, const aa_form *b)
+{
+    return a->x0 == b->x0 && a->err == b->err && a->n == b->n && a->flags == b->flags &&
+           memcmp(a->c, b->c, (size_t)a->n * sizeof a->c[0]) == 0;
+}
+
 /* One affine run of the displacement over the cell (of the case the VM's
  * splits select): the shader's P in object space, in th->ctx (valid until
- * its next reset). */
+ * its next reset). With same, whether the run left P's affine form as the
+ * base surface gave it: every operation that reached P was exact and
+ * changed nothing (adding an exact 0, as a decided step's branch gives),
+ * since one whose value may differ from P's changes its form, its error
+ * term at least; so the displaced surface over the cell is the base
+ * surface itself. */
 static void affine_shade(trace_thread *th, const trace_object *obj, const affine_cell *c,
-                         aa_form P[3])
+                         aa_form P[3], bool *same)
 {
+    if (same) *same = false;
     aa_context *ctx = &th->ctx;
     *ctx = c->ctx;
     th->stats.evals_affine++;
@@ -272,16 +287,19 @@ static void affine_shade(trace_thread *th, const trace_object *obj, const affine
     } else {
         aa_form Pc[3];
         sl_vm_get_affine(vm, SL_G_P, Pc);
+        if (same)
+            *same = same_affine(&Pc[0], &c->P[0]) && same_affine(&Pc[1], &c->P[1]) &&
+                    same_affine(&Pc[2], &c->P[2]);
         trace_xform_aa(ctx, &obj->from_camera, Pc, P, true);
     }
 }
 
 static void affine_run(trace_thread *th, const trace_object *obj,
-                       double u0, double u1, double v0, double v1, aa_form P[3])
+                       double u0, double u1, double v0, double v1, aa_form P[3], bool *same)
 {
     affine_cell c;
     affine_geometry(th, obj, u0, u1, v0, v1, &c);
-    affine_shade(th, obj, &c, P);
+    affine_shade(th, obj, &c, P, same);
 }
 
 /* The box's linear bound (lin_bound.h; TRACE_BOX_LIN on the box) from
@@ -311,8 +329,10 @@ static void box_affine(trace_thread *th, const trace_object *obj,
                        trace_lin *lin)
 {
     aa_form P[3];
-    affine_run(th, obj, u0, u1, v0, v1, P);
+    bool same;
+    affine_run(th, obj, u0, u1, v0, v1, P, &same);
     box_from_affine(P, out);
+    if (same && obj->displacement && !out->flags) out->flags |= TRACE_BOX_UNDISPLACED;
     if (lin) box_linear(&th->ctx, P, out, lin);
 }
 
@@ -340,7 +360,7 @@ static void union_cases(trace_thread *th, const trace_object *obj, const affine_
     aa_form P[3];
     do {
         trace_box b;
-        affine_shade(th, obj, cell, P);
+        affine_shade(th, obj, cell, P, NULL);
         box_from_affine(P, &b);
         trace_box_union(hull, &b);
     } while (!th->failed && sl_vm_split_next(th->vm));
@@ -354,7 +374,7 @@ static void first_case(trace_thread *th, const trace_object *obj, double u0, dou
     aa_form P[3];
     affine_geometry(th, obj, u0, u1, v0, v1, cell);
     sl_vm_split_begin(th->vm, TRACE_SPLIT_OPS);
-    affine_shade(th, obj, cell, P);
+    affine_shade(th, obj, cell, P, NULL);
     box_from_affine(P, hull);
 }
 
@@ -441,7 +461,7 @@ bool trace_surface_box_split(trace_thread *th, const trace_object *obj,
         sl_vm_split_end(vm);
         th->stats.boxes++;
         aa_form P[3];
-        affine_shade(th, o, &cell, P);
+        affine_shade(th, o, &cell, P, NULL);
         box_from_affine(P, box);
         box_finish(th, box);
         return false;

@@ -69,6 +69,8 @@ typedef struct walk {
     bool found;
     bool stopped;                  /* the work limit or a cancel ended the walk */
     bool prove;                    /* hit proofs may succeed on this object */
+    bool exact_cells;              /* undisplaced cells are intersected
+                                      exactly (exact_cell) */
     double prove_below;            /* ... on cells of at most this size (a
                                       failed test's estimate, visit) */
     long nodes;                    /* quadtree nodes visited so far */
@@ -492,6 +494,24 @@ static void proven_hit(walk *w, double t, double tol, const trace_surface_point 
     w->found = true;
 }
 
+/* A cell where the displacement left the base surface as it is
+ * (TRACE_BOX_UNDISPLACED), on a flat base (a polygon without vertex
+ * normals, a disk: one plane, one intersection): the ray against the base
+ * surface exactly, as objects without displacement are (geom_intersect),
+ * a hit only where it falls in the cell, and either way the cell is done
+ * (issue 24: the nail's disk, a displacement masked to 0). */
+static void exact_cell(walk *w, const double c[4], double tol)
+{
+    geom_hit h;
+    w->th->stats.exact_cells++;
+    if (!geom_intersect(&w->obj->surf, w->ray.o, w->ray.d, w->ray.tmin, w->best->t, &h) ||
+        !(h.u >= c[0] && h.u <= c[1] && h.v >= c[2] && h.v <= c[3]))
+        return;
+    trace_surface_point sp;
+    trace_surface_point_eval(w->th, w->obj, h.u, h.v, &sp);
+    proven_hit(w, h.t, tol, &sp);
+}
+
 /* The stagnant-box fallback (issue 9; docs/renderer.md "Stagnant boxes").
  * Range arithmetic loses the correlation of some continuous idioms, and
  * their boxes then stop shrinking along a curve of (u,v): a box-filtered
@@ -836,6 +856,10 @@ static void visit(walk *w, const trace_box *node, const trace_qlin *node_q, cons
         double t_at = order[k].t0 > 0 ? order[k].t0 : 0;
         double tol = w->tol.a + w->tol.b * t_at;
         int d = depth + 1;
+        if ((kid->flags & TRACE_BOX_UNDISPLACED) && w->exact_cells && clear_of_shared_edges(w, c)) {
+            exact_cell(w, c, tol);
+            continue;
+        }
         bool unbounded = (kid->flags & AA_UNBOUNDED) != 0;
         vec3 wall_n = v3(0, 0, 0);
         bool kid_fine = false, capped = false;
@@ -923,6 +947,7 @@ static bool intersect_displaced(trace_thread *th, const trace_object *obj,
     walk w = {.th = th, .obj = obj, .cam_ray = ray, .tol = *tol, .any = any,
               .found = false, .prove = th->world->options.prove_hits && trace_prove_eligible(obj),
               .prove_below = INFINITY,
+              .exact_cells = trace_surface_flat(obj) && !obj->box_proto,
               .best = best};
     object_ray(obj, ray, best->t, &w.ray);
     double t0, t1;

@@ -40,6 +40,8 @@ typedef struct trace_stats {
                                       lazy_roots.h) */
     long lazy_bounds;              /* children made as restricted bounds only
                                       (intersect.c, "lazy children") */
+    long exact_cells;              /* undisplaced cells of flat bases
+                                      intersected exactly (intersect.c) */
     long lazy_met;                 /* times a ray met such a bound and took
                                       the child into its walk's order */
     long lazy_evals;               /* children made as bounds, evaluated when

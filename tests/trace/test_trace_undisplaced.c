@@ -1,0 +1,140 @@
+/*
+ * test_trace_undisplaced.c: undisplaced cells (issue 24; docs/renderer.md
+ * "Undisplaced cells"). Where a displacement run leaves P's affine form as
+ * the base surface gave it (a decided step's branch that adds an exact 0),
+ * the cell's box says so (TRACE_BOX_UNDISPLACED) and, on a flat base, the
+ * walk intersects the base surface there exactly instead of subdividing.
+ *
+ * The scene: a disk seen from straight above, with a sunken wedge (the
+ * points with u, the angle's fraction, in [0.13, 0.25) pushed away from
+ * the eye by h). The other cells are undisplaced; the disk's cells are
+ * sectors, whose boxes reach beyond their angles (the box of u in [0,
+ * 0.125] covers points at 60 degrees), so a ray into the wedge crosses the
+ * base plane inside such a box: the exact test must take a hit only inside
+ * its own cell, or the wedge would be drawn filled at the plane's depth.
+ * And a displacement too small to see (1e-20 along N) changes the forms,
+ * so no cell of it may be taken for undisplaced.
+ */
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <cmocka.h>
+
+#include "fixture.h"
+#include "trace/camera.h"
+#include "trace/render.h"
+
+#define WEDGE_U0 0.13
+#define WEDGE_U1 0.25
+#define WEDGE_H 0.25
+#define DEPTH 3.0
+
+static const char *WEDGE_SL =
+    "displacement wedge(float u0 = 0.13, u1 = 0.25, h = 0.25)\n"
+    "{\n"
+    "    P += h * step(u0, u) * (1 - step(u1, u)) * normalize(I);\n"
+    "    N = calculatenormal(P);\n"
+    "}\n";
+
+static const char *TINY_SL =
+    "displacement tiny(float Km = 1e-20)\n"
+    "{\n"
+    "    P += Km * normalize(N);\n"
+    "    N = calculatenormal(P);\n"
+    "}\n";
+
+/* the unit disk at depth 3, facing the eye */
+#define DISK_RIB(shader)                                                   \
+    "Format 64 64 1\nProjection \"perspective\" \"fov\" [45]\n"            \
+    "Translate 0 0 3\nWorldBegin\nDisplacement \"" shader "\"\n"           \
+    "Disk 0 1 360\nWorldEnd\n"
+
+typedef struct disk_scan {
+    int flat, flat_hits, flat_exact;   /* rays onto the undisplaced part */
+    int sunk, sunk_hits, sunk_deep;    /* rays into the sunken wedge */
+    trace_stats st;
+} disk_scan;
+
+/* One ray through every pixel centre; the ray's point on the base plane
+ * (camera z = 3) says where it should land */
+static void scan_disk(const char *name, const char *src, disk_scan *out)
+{
+    fixture f;
+    fixture_shader sh[] = {{name, src}};
+    char rib[512];
+    snprintf(rib, sizeof rib, DISK_RIB("%s"), name);
+    assert_true(fixture_open(&f, rib, sh, 1, NULL, 0));
+    trace_thread *th = trace_thread_new(&f.js->world);
+    const trace_camera *cam = &f.js->world.camera;
+    *out = (disk_scan){0};
+    const double margin = 0.03, umargin = 0.01;
+    for (int y = 0; y < cam->yres; y++)
+        for (int x = 0; x < cam->xres; x++) {
+            trace_ray ray;
+            trace_camera_ray(cam, x + 0.5, y + 0.5, &ray);
+            vec3 at = trace_ray_at(&ray, DEPTH / ray.d.z);
+            double r = sqrt(at.x * at.x + at.y * at.y);
+            double u = atan2(at.y, at.x) / (2 * M_PI);
+            if (u < 0) u += 1;
+            double rgb[3], a, z;
+            trace_render_sample(f.js->renderer, th, x + 0.5, y + 0.5, rgb, &a, &z);
+            bool hit = a > 0;
+            if (r < margin || r > 1 - margin) continue;
+            if (u > WEDGE_U0 + umargin && u < WEDGE_U1 - umargin) {
+                out->sunk++;
+                out->sunk_hits += hit;
+                /* pushed back along the ray by h: at least h cos(22.5 deg) */
+                out->sunk_deep += hit && z > DEPTH + 0.9 * WEDGE_H;
+            } else if (u < WEDGE_U0 - umargin || u > WEDGE_U1 + umargin) {
+                out->flat++;
+                out->flat_hits += hit;
+                out->flat_exact += hit && fabs(z - DEPTH) <= 1e-12 * DEPTH;
+            }
+        }
+    trace_thread_sync_stats(th);
+    out->st = th->stats;
+    printf("%-5s flat %d/%d hit (%d at the plane's depth), sunken %d/%d hit (%d deep); "
+           "exact cells %ld, boxes %ld, proofs %ld\n", name, out->flat_hits, out->flat,
+           out->flat_exact, out->sunk_hits, out->sunk, out->sunk_deep, out->st.exact_cells,
+           out->st.boxes, out->st.proofs);
+    trace_thread_destroy(&th);
+    fixture_close(&f);
+}
+
+static void test_flat_exact_and_wedge_open(void **state)
+{
+    (void)state;
+    disk_scan s;
+    scan_disk("wedge", WEDGE_SL, &s);
+    assert_true(s.flat > 1000 && s.sunk > 100);
+    /* the undisplaced part is intersected exactly */
+    assert_true(s.st.exact_cells > 0);
+    assert_int_equal(s.flat_hits, s.flat);
+    assert_int_equal(s.flat_exact, s.flat);
+    /* and no exact test takes the plane's hit for a cell it is not in */
+    assert_int_equal(s.sunk_hits, s.sunk);
+    assert_int_equal(s.sunk_deep, s.sunk);
+}
+
+static void test_any_displacement_is_not_undisplaced(void **state)
+{
+    (void)state;
+    disk_scan s;
+    scan_disk("tiny", TINY_SL, &s);
+    /* 1e-20 is below every rounding of the plane, but the forms change */
+    assert_int_equal(s.st.exact_cells, 0);
+    assert_int_equal(s.flat_hits, s.flat);
+    assert_int_equal(s.sunk_hits, s.sunk);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_flat_exact_and_wedge_open),
+        cmocka_unit_test(test_any_displacement_is_not_undisplaced),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
