@@ -495,8 +495,9 @@ static void proven_hit(walk *w, double t, double tol, const trace_surface_point 
 }
 
 /* A cell where the displacement left the base surface as it is
- * (TRACE_BOX_UNDISPLACED), on a flat base (a polygon without vertex
- * normals, a disk: one plane, one intersection): the ray against the base
+ * (TRACE_BOX_UNDISPLACED), on a flat base (a polygon, with vertex normals
+ * or not, which only shading reads; a disk: one plane, one intersection):
+ * the ray against the base
  * surface exactly, as objects without displacement are (geom_intersect),
  * a hit only where it falls in the cell, and either way the cell is done
  * (issue 24: the nail's disk, a displacement masked to 0). */
@@ -947,7 +948,8 @@ static bool intersect_displaced(trace_thread *th, const trace_object *obj,
     walk w = {.th = th, .obj = obj, .cam_ray = ray, .tol = *tol, .any = any,
               .found = false, .prove = th->world->options.prove_hits && trace_prove_eligible(obj),
               .prove_below = INFINITY,
-              .exact_cells = trace_surface_flat(obj) && !obj->box_proto,
+              .exact_cells = (obj->surf.kind == GEOM_POLYGON || obj->surf.kind == GEOM_DISK) &&
+                             !obj->box_proto,
               .best = best};
     object_ray(obj, ray, best->t, &w.ray);
     double t0, t1;
