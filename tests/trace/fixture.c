@@ -37,6 +37,20 @@ bool fixture_open(fixture *f, const char *rib, const fixture_shader *shaders,
     return true;
 }
 
+bool fixture_open_named(fixture *f, const char *rib_format, const char *name,
+                        const char *source)
+{
+    fixture_shader sh[] = {{name, source}};
+    char rib[1024];
+    int n = snprintf(rib, sizeof rib, rib_format, name);
+    if (n < 0 || (size_t)n >= sizeof rib) {
+        fprintf(stderr, "fixture: the RIB of %s does not fit %zu bytes\n", name, sizeof rib);
+        memset(f, 0, sizeof *f);
+        return false;
+    }
+    return fixture_open(f, rib, sh, 1, NULL, 0);
+}
+
 void fixture_close(fixture *f)
 {
     job_scene_destroy(&f->js);

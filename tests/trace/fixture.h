@@ -24,6 +24,11 @@ typedef struct fixture {
  * (f->js NULL; f->diag keeps them for tests of error messages). */
 bool fixture_open(fixture *f, const char *rib, const fixture_shader *shaders,
                   int nshaders, const job_options *opt, size_t cache_bytes);
+/* fixture_open with one shader, `name` from `source`, on the RIB that
+ * rib_format gives with its one %s replaced by the shader's name (defaults,
+ * default cache) */
+bool fixture_open_named(fixture *f, const char *rib_format, const char *name,
+                        const char *source);
 void fixture_close(fixture *f);
 
 /* Renders the whole image into rgba (4 per px) and z with tiles of `tile`

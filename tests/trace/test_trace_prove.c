@@ -526,10 +526,7 @@ static trace_ray ray_through(trace_thread *th, const trace_object *obj, double u
 static void check_zero_beside_the_box(const char *name, const char *src, bool plane)
 {
     fixture f;
-    fixture_shader sh[] = {{name, src}};
-    char rib[512];
-    snprintf(rib, sizeof rib, SQUARE_RIB("%s"), name);
-    assert_true(fixture_open(&f, rib, sh, 1, NULL, 0));
+    assert_true(fixture_open_named(&f, SQUARE_RIB("%s"), name, src));
     trace_thread *th = trace_thread_new(&f.js->world);
     const trace_object *obj = &f.js->world.objects[0];
     unsigned seed = 27;
@@ -611,10 +608,7 @@ static void test_zero_beside_the_box_is_never_taken(void **state)
 static void check_zero_boxes(const char *name, const char *src, int *hits_out)
 {
     fixture f;
-    fixture_shader sh[] = {{name, src}};
-    char rib[512];
-    snprintf(rib, sizeof rib, SQUARE_RIB("%s"), name);
-    assert_true(fixture_open(&f, rib, sh, 1, NULL, 0));
+    assert_true(fixture_open_named(&f, SQUARE_RIB("%s"), name, src));
     trace_thread *th = trace_thread_new(&f.js->world);
     const trace_object *obj = &f.js->world.objects[0];
     unsigned seed = 2027;

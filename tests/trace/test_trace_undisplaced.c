@@ -63,10 +63,7 @@ typedef struct disk_scan {
 static void scan_disk(const char *name, const char *src, disk_scan *out)
 {
     fixture f;
-    fixture_shader sh[] = {{name, src}};
-    char rib[512];
-    snprintf(rib, sizeof rib, DISK_RIB("%s"), name);
-    assert_true(fixture_open(&f, rib, sh, 1, NULL, 0));
+    assert_true(fixture_open_named(&f, DISK_RIB("%s"), name, src));
     trace_thread *th = trace_thread_new(&f.js->world);
     const trace_camera *cam = &f.js->world.camera;
     *out = (disk_scan){0};

@@ -85,10 +85,7 @@ typedef struct scan {
 static void scan_square(const char *name, const char *src, double margin, scan *out)
 {
     fixture f;
-    fixture_shader sh[] = {{name, src}};
-    char rib[512];
-    snprintf(rib, sizeof rib, FACING_RIB("%s"), name);
-    assert_true(fixture_open(&f, rib, sh, 1, NULL, 0));
+    assert_true(fixture_open_named(&f, FACING_RIB("%s"), name, src));
     trace_thread *th = trace_thread_new(&f.js->world);
     const trace_camera *cam = &f.js->world.camera;
     *out = (scan){0, 0, 0, 0, 1e300, 1e300, -1e300, {0}};
