@@ -197,8 +197,14 @@ bool trace_render_tile(const trace_renderer *self, trace_thread *th,
         for (int px = x0; px < x0 + w; px++) {
             double cx = px + 0.5, cy = py + 0.5, sum[4] = {0, 0, 0, 0}, wsum = 0;
             float zmin = INFINITY;
-            int ax0 = (int)floor(cx - rx) - 1, ax1 = (int)floor(cx + rx);
-            int ay0 = (int)floor(cy - ry) - 1, ay1 = (int)floor(cy + ry);
+            /* the pixels whose samples can count here: a sample s of
+             * pixel q lies in [q, q + 1 - 2^-24] (trace_sample_position)
+             * and counts where cx - rx <= s < cx + rx, so q > cx - rx - 1,
+             * i.e. q >= floor(cx - rx) (the rounding of cx - rx is far
+             * below 2^-24 for raster coordinates under 2^28), and q <= s <
+             * cx + rx */
+            int ax0 = (int)floor(cx - rx), ax1 = (int)floor(cx + rx);
+            int ay0 = (int)floor(cy - ry), ay1 = (int)floor(cy + ry);
             for (int qy = ay0; qy <= ay1; qy++) {
                 if (qy < qy0 || qy > qy1) continue;
                 for (int qx = ax0; qx <= ax1; qx++) {
