@@ -89,12 +89,13 @@ typedef struct child_order {
 
 /* The walk's order: by entry, ties by the child's number (the order in
  * which the children were put in) */
-static bool order_before(const child_order *a, const child_order *b)
+static inline bool order_before(const child_order *a, const child_order *b)
 {
     return a->t0 < b->t0 || (a->t0 == b->t0 && a->i < b->i);
 }
 
-static void order_insert(child_order *order, int *n, child_order o)
+static inline __attribute__((always_inline)) void order_insert(child_order *order, int *n,
+                                                             child_order o)
 {
     int k = (*n)++;
     while (k > 0 && order_before(&o, &order[k - 1])) {
