@@ -498,10 +498,10 @@ static void proven_hit(walk *w, double t, double tol, const trace_surface_point 
 /* A cell where the displacement left the base surface as it is
  * (TRACE_BOX_UNDISPLACED), on a flat base (a polygon, with vertex normals
  * or not, which only shading reads; a disk: one plane, one intersection):
- * the ray against the base
- * surface exactly, as objects without displacement are (geom_intersect),
- * a hit only where it falls in the cell, and either way the cell is done
- * (issue 24: the nail's disk, a displacement masked to 0). */
+ * the ray against the base surface exactly, as objects without
+ * displacement are (geom_intersect), a hit only where it falls in the
+ * cell, and either way the cell is done (issue 24: the nail's disk, a
+ * displacement masked to 0). */
 static void exact_cell(walk *w, const double c[4], double tol)
 {
     geom_hit h;
@@ -760,8 +760,8 @@ static trace_proof test_cell(walk *w, const double c[4], double tol, trace_proof
 /* Whether the ray's stretch [t0, t1] in a child's box (or bound) misses
  * its stretch [nt0, nt1] in the node's box and slab, which hold the
  * child's surface too: then it cannot meet the surface over the child,
- * and the child is skipped (issue 24: dented's children evaluated 286 k
- * -> 272 k; the stretch itself is not narrowed). Not on cells near an
+ * and the child is skipped (issue 24: dented's boxes 292 k -> 278 k;
+ * the stretch itself is not narrowed). Not on cells near an
  * edge the polygon shares with another: there a leaf's hit may come from
  * its Newton steps into the next cell, across the edge, as both polygons'
  * leaves must apply alike (without this, test_corpus_render's fw_grooves

@@ -25,6 +25,8 @@ typedef struct trace_stats {
                                       placed at the root */
     long proven_misses;            /* cells proven free of any hit */
     long leaf_tests;               /* of the proofs, on leaves whose point did not settle */
+    long exact_cells;              /* undisplaced cells of flat bases
+                                      intersected exactly (intersect.c) */
     long rejected_leaves;          /* leaves whose surface point was not on the
                                       ray (depth cap) or not finite: no hit */
     long nodes;                    /* quadtree nodes visited by all rays */
@@ -40,8 +42,6 @@ typedef struct trace_stats {
                                       lazy_roots.h) */
     long lazy_bounds;              /* children made as restricted bounds only
                                       (intersect.c, "lazy children") */
-    long exact_cells;              /* undisplaced cells of flat bases
-                                      intersected exactly (intersect.c) */
     long lazy_met;                 /* times a ray met such a bound and took
                                       the child into its walk's order */
     long lazy_evals;               /* children made as bounds, evaluated when
