@@ -59,8 +59,8 @@
 #define TRACE_BOX_LAZY (1u << 12)
 /* The displacement left P as the base surface gave it over the cell (its
  * affine form unchanged: displace.c, box_affine), so the surface there is
- * the base surface: on a flat base the walk intersects it exactly
- * (intersect.c, "Undisplaced cells") */
+ * the base surface: where that has closed-form intersections the walk
+ * intersects it exactly (intersect.c, "Undisplaced cells") */
 #define TRACE_BOX_UNDISPLACED (1u << 13)
 
 typedef struct trace_box {

@@ -495,23 +495,48 @@ static void proven_hit(walk *w, double t, double tol, const trace_surface_point 
     w->found = true;
 }
 
+/* The base surfaces whose intersections with a ray geom_intersect gives
+ * in closed form, nearest first, at most EXACT_ROOTS of them: planes (a
+ * polygon, with vertex normals or not, which only shading reads; a disk)
+ * and the quadrics, the torus (a quartic) */
+#define EXACT_ROOTS 4
+static bool exact_kind(geom_kind k)
+{
+    switch (k) {
+    case GEOM_POLYGON: case GEOM_DISK: case GEOM_SPHERE: case GEOM_CYLINDER: case GEOM_CONE:
+    case GEOM_PARABOLOID: case GEOM_HYPERBOLOID: case GEOM_TORUS:
+        return true;
+    default:
+        return false;
+    }
+}
+
 /* A cell where the displacement left the base surface as it is
- * (TRACE_BOX_UNDISPLACED), on a flat base (a polygon, with vertex normals
- * or not, which only shading reads; a disk: one plane, one intersection):
- * the ray against the base surface exactly, as objects without
- * displacement are (geom_intersect), a hit only where it falls in the
- * cell, and either way the cell is done (issue 24: the nail's disk, a
- * displacement masked to 0). */
-static void exact_cell(walk *w, const double c[4], double tol)
+ * (TRACE_BOX_UNDISPLACED): the ray against the base surface exactly, as
+ * objects without displacement are (geom_intersect), its intersections
+ * nearest first (each query from the last one's t: geom_intersect takes
+ * only t beyond tmin) until one falls in the cell: that is the cell's
+ * hit; none, and the cell has none. True where the cell is settled so;
+ * false (the walk goes on as before) only if a closed form gave more
+ * intersections than it can have (issue 24: the nail's disk, a
+ * displacement masked to 0 or one that only bends N). */
+static bool exact_cell(walk *w, const double c[4], double tol)
 {
     geom_hit h;
+    double t = w->ray.tmin;
     w->th->stats.exact_cells++;
-    if (!geom_intersect(&w->obj->surf, w->ray.o, w->ray.d, w->ray.tmin, w->best->t, &h) ||
-        !(h.u >= c[0] && h.u <= c[1] && h.v >= c[2] && h.v <= c[3]))
-        return;
-    trace_surface_point sp;
-    trace_surface_point_eval(w->th, w->obj, h.u, h.v, &sp);
-    proven_hit(w, h.t, tol, &sp);
+    for (int i = 0; i < EXACT_ROOTS; i++) {
+        if (!geom_intersect(&w->obj->surf, w->ray.o, w->ray.d, t, w->best->t, &h)) return true;
+        if (h.u >= c[0] && h.u <= c[1] && h.v >= c[2] && h.v <= c[3]) {
+            trace_surface_point sp;
+            trace_surface_point_eval(w->th, w->obj, h.u, h.v, &sp);
+            proven_hit(w, h.t, tol, &sp);
+            return true;
+        }
+        if (!(h.t > t)) return false;
+        t = h.t;
+    }
+    return false;
 }
 
 /* The stagnant-box fallback (issue 9; docs/renderer.md "Stagnant boxes").
@@ -858,10 +883,9 @@ static void visit(walk *w, const trace_box *node, const trace_qlin *node_q, cons
         double t_at = order[k].t0 > 0 ? order[k].t0 : 0;
         double tol = w->tol.a + w->tol.b * t_at;
         int d = depth + 1;
-        if ((kid->flags & TRACE_BOX_UNDISPLACED) && w->exact_cells && clear_of_shared_edges(w, c)) {
-            exact_cell(w, c, tol);
+        if ((kid->flags & TRACE_BOX_UNDISPLACED) && w->exact_cells &&
+            clear_of_shared_edges(w, c) && exact_cell(w, c, tol))
             continue;
-        }
         bool unbounded = (kid->flags & AA_UNBOUNDED) != 0;
         vec3 wall_n = v3(0, 0, 0);
         bool kid_fine = false, capped = false;
@@ -949,8 +973,7 @@ static bool intersect_displaced(trace_thread *th, const trace_object *obj,
     walk w = {.th = th, .obj = obj, .cam_ray = ray, .tol = *tol, .any = any,
               .found = false, .prove = th->world->options.prove_hits && trace_prove_eligible(obj),
               .prove_below = INFINITY,
-              .exact_cells = (obj->surf.kind == GEOM_POLYGON || obj->surf.kind == GEOM_DISK) &&
-                             !obj->box_proto,
+              .exact_cells = exact_kind(obj->surf.kind) && !obj->box_proto,
               .best = best};
     object_ray(obj, ray, best->t, &w.ray);
     double t0, t1;

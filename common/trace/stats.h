@@ -25,8 +25,8 @@ typedef struct trace_stats {
                                       placed at the root */
     long proven_misses;            /* cells proven free of any hit */
     long leaf_tests;               /* of the proofs, on leaves whose point did not settle */
-    long exact_cells;              /* undisplaced cells of flat bases
-                                      intersected exactly (intersect.c) */
+    long exact_cells;              /* undisplaced cells intersected exactly
+                                      (intersect.c, exact_cell) */
     long rejected_leaves;          /* leaves whose surface point was not on the
                                       ray (depth cap) or not finite: no hit */
     long nodes;                    /* quadtree nodes visited by all rays */

@@ -13,7 +13,9 @@
  * base plane inside such a box: the exact test must take a hit only inside
  * its own cell, or the wedge would be drawn filled at the plane's depth.
  * And a displacement too small to see (1e-20 along N) changes the forms,
- * so no cell of it may be taken for undisplaced.
+ * so no cell of it may be taken for undisplaced. On a quadric (a sphere
+ * whose shader only bends N) every cell is undisplaced, and every hit is
+ * the sphere's own point.
  */
 #include <math.h>
 #include <setjmp.h>
@@ -127,11 +129,65 @@ static void test_any_displacement_is_not_undisplaced(void **state)
     assert_int_equal(s.sunk_hits, s.sunk);
 }
 
+static const char *BUMP_SL =
+    "displacement bumponly(float Kb = 0.02)\n"
+    "{\n"
+    "    N = calculatenormal(P + Kb * noise(P * 4) * normalize(N));\n"
+    "}\n";
+
+/* A sphere (radius 1, at depth 3) whose displacement only bends N: every
+ * cell is undisplaced, and on a quadric the walk intersects its base
+ * exactly too (the nearer root first, then the farther where the nearer
+ * falls outside the cell) */
+static void test_sphere_bent_normals_exact(void **state)
+{
+    (void)state;
+    fixture f;
+    assert_true(fixture_open_named(&f,
+                                   "Format 48 48 1\nProjection \"perspective\" \"fov\" [45]\n"
+                                   "Translate 0 0 3\nWorldBegin\nDisplacement \"%s\"\n"
+                                   "Sphere 1 -1 1 360\nWorldEnd\n",
+                                   "bumponly", BUMP_SL));
+    trace_thread *th = trace_thread_new(&f.js->world);
+    const trace_camera *cam = &f.js->world.camera;
+    int inside = 0, hits = 0, exact = 0, outside_hits = 0;
+    for (int y = 0; y < cam->yres; y++)
+        for (int x = 0; x < cam->xres; x++) {
+            trace_ray ray;
+            trace_camera_ray(cam, x + 0.5, y + 0.5, &ray);
+            /* the sphere |p - (0, 0, 3)| = 1 along o + t d, o = 0 */
+            vec3 d = ray.d;
+            double a = v3_dot(d, d), b = -6.0 * d.z, cc = 9.0 - 1.0, disc = b * b - 4 * a * cc;
+            double rgb[3], al, z;
+            trace_render_sample(f.js->renderer, th, x + 0.5, y + 0.5, rgb, &al, &z);
+            if (disc < 0.05 * b * b) {          /* off the sphere, or near its silhouette */
+                if (disc < 0) outside_hits += al > 0;
+                continue;
+            }
+            double t = (-b - sqrt(disc)) / (2 * a), zexp = t * d.z;
+            inside++;
+            hits += al > 0;
+            exact += al > 0 && fabs(z - zexp) <= 1e-9 * zexp;
+        }
+    trace_thread_sync_stats(th);
+    printf("bent normals: %d/%d hit, %d at the sphere's depth, %d hits off it; exact cells %ld, "
+           "boxes %ld\n", hits, inside, exact, outside_hits, th->stats.exact_cells,
+           th->stats.boxes);
+    assert_true(inside > 500);
+    assert_true(th->stats.exact_cells > 0);
+    assert_int_equal(hits, inside);
+    assert_int_equal(exact, inside);
+    assert_int_equal(outside_hits, 0);
+    trace_thread_destroy(&th);
+    fixture_close(&f);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_flat_exact_and_wedge_open),
         cmocka_unit_test(test_any_displacement_is_not_undisplaced),
+        cmocka_unit_test(test_sphere_bent_normals_exact),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
