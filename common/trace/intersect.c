@@ -797,6 +797,16 @@ static bool beside_node(const walk *w, const double c[4], double t0, double t1, 
     return (t1 < nt0 || t0 > nt1) && clear_of_shared_edges(w, c);
 }
 
+/* Whether the ray meets an evaluated child's box and slab before tmax and
+ * not beside its node's stretch [nt0, nt1]: its stretch in *t0, *t1 and
+ * its axis of entry in *axis */
+static bool meets_child(const walk *w, const trace_box *kid, const double c[4], double tmax,
+                        double nt0, double nt1, double *t0, double *t1, int *axis)
+{
+    return trace_box_hit(kid, &w->ray, w->ray.tmin, tmax, t0, t1, axis) &&
+           trace_box_slab_hit(kid, &w->ray, t0, t1) && !beside_node(w, c, *t0, *t1, nt0, nt1);
+}
+
 /* node_q: the node's linear bound's codes where its brood (parent) could
  * not be stored; nt0, nt1: the ray's stretch in the node's box and slab */
 static void visit(walk *w, const trace_box *node, const trace_qlin *node_q, const double r[4],
@@ -836,9 +846,7 @@ static void visit(walk *w, const trace_box *node, const trace_qlin *node_q, cons
             order_insert(order, &n, (child_order){t0, t1, i, -1, cover, true});
             continue;
         }
-        if (!trace_box_hit(&kids[i], &w->ray, w->ray.tmin, tmax, &t0, &t1, &axis) ||
-            !trace_box_slab_hit(&kids[i], &w->ray, &t0, &t1) || beside_node(w, c, t0, t1, nt0, nt1))
-            continue;
+        if (!meets_child(w, &kids[i], c, tmax, nt0, nt1, &t0, &t1, &axis)) continue;
         order_insert(order, &n, (child_order){t0, t1, i, axis, cover, false});
     }
 
@@ -860,9 +868,7 @@ static void visit(walk *w, const trace_box *node, const trace_qlin *node_q, cons
             child_range(i, r[0], r[1], r[2], r[3], c);
             lazy_child(w, brood, parent, slot, node, node_q, r, depth, i, &kids[i], &kq[i]);
             if (!(trace_box_is_empty(&kids[i]) && !(kids[i].flags & AA_UNBOUNDED)) &&
-                trace_box_hit(&kids[i], &w->ray, w->ray.tmin, tmax, &t0, &t1, &axis) &&
-                trace_box_slab_hit(&kids[i], &w->ray, &t0, &t1) &&
-                !beside_node(w, c, t0, t1, nt0, nt1)) {
+                meets_child(w, &kids[i], c, tmax, nt0, nt1, &t0, &t1, &axis)) {
                 o.t0 = t0;
                 o.t1 = t1;
                 o.axis = axis;
