@@ -497,14 +497,15 @@ static void proven_hit(walk *w, double t, double tol, const trace_surface_point 
 
 /* The base surfaces whose intersections with a ray geom_intersect gives
  * in closed form, nearest first, at most EXACT_ROOTS of them: planes (a
- * polygon, with vertex normals or not, which only shading reads; a disk)
- * and the quadrics, the torus (a quartic) */
+ * polygon, with vertex normals or not, which only shading reads; a disk),
+ * the quadrics, the bilinear patch (a quadratic after eliminating one
+ * parameter: two roots) and the torus (a quartic) */
 #define EXACT_ROOTS 4
 static bool exact_kind(geom_kind k)
 {
     switch (k) {
     case GEOM_POLYGON: case GEOM_DISK: case GEOM_SPHERE: case GEOM_CYLINDER: case GEOM_CONE:
-    case GEOM_PARABOLOID: case GEOM_HYPERBOLOID: case GEOM_TORUS:
+    case GEOM_PARABOLOID: case GEOM_HYPERBOLOID: case GEOM_TORUS: case GEOM_PATCH:
         return true;
     default:
         return false;
@@ -979,7 +980,7 @@ static bool intersect_displaced(trace_thread *th, const trace_object *obj,
     walk w = {.th = th, .obj = obj, .cam_ray = ray, .tol = *tol, .any = any,
               .found = false, .prove = th->world->options.prove_hits && trace_prove_eligible(obj),
               .prove_below = INFINITY,
-              .exact_cells = exact_kind(obj->surf.kind) && !obj->box_proto,
+              .exact_cells = exact_kind(obj->surf.kind),
               .best = best};
     object_ray(obj, ray, best->t, &w.ray);
     double t0, t1;

@@ -15,7 +15,8 @@
  * And a displacement too small to see (1e-20 along N) changes the forms,
  * so no cell of it may be taken for undisplaced. On a quadric (a sphere
  * whose shader only bends N) every cell is undisplaced, and every hit is
- * the sphere's own point.
+ * the sphere's own point; the same on a planar bilinear patch (its closed
+ * form), and on instances that share their prototype's boxes.
  */
 #include <math.h>
 #include <setjmp.h>
@@ -27,6 +28,7 @@
 
 #include "fixture.h"
 #include "trace/camera.h"
+#include "trace/group.h"
 #include "trace/render.h"
 
 #define WEDGE_U0 0.13
@@ -182,12 +184,173 @@ static void test_sphere_bent_normals_exact(void **state)
     fixture_close(&f);
 }
 
+/* A planar bilinear patch (four corners on the plane z = 3 + 0.2 x +
+ * 0.1 y, not a parallelogram, so its (u,v) are not affine in the plane's
+ * points) whose shader only bends N: every cell is undisplaced, and the
+ * patch's closed form (a quadratic) intersects it exactly; every hit at
+ * the plane's depth */
+static const double QUAD[4][2] = {{-1.0, -1.0}, {1.0, -0.8}, {1.1, 0.9}, {-0.7, 1.0}};
+
+static double plane_z(double x, double y) { return DEPTH + 0.2 * x + 0.1 * y; }
+
+/* (x, y) inside the convex quad QUAD (counter-clockwise), at least m from
+ * its edges */
+static bool in_quad(double x, double y, double m)
+{
+    for (int i = 0; i < 4; i++) {
+        const double *a = QUAD[i], *b = QUAD[(i + 1) % 4];
+        double ex = b[0] - a[0], ey = b[1] - a[1], len = sqrt(ex * ex + ey * ey);
+        if ((ex * (y - a[1]) - ey * (x - a[0])) / len < m) return false;
+    }
+    return true;
+}
+
+static void test_patch_bent_normals_exact(void **state)
+{
+    (void)state;
+    char rib[1024];
+    /* RIB order: (u, v) = (0, 0), (1, 0), (0, 1), (1, 1) */
+    const int order[4] = {0, 1, 3, 2};
+    int len = snprintf(rib, sizeof rib,
+                       "Format 48 48 1\nProjection \"perspective\" \"fov\" [45]\n"
+                       "WorldBegin\nDisplacement \"%%s\"\nPatch \"bilinear\" \"P\" [");
+    for (int k = 0; k < 4; k++) {
+        const double *q = QUAD[order[k]];
+        len += snprintf(rib + len, sizeof rib - (size_t)len, " %.17g %.17g %.17g", q[0], q[1],
+                        plane_z(q[0], q[1]));
+    }
+    snprintf(rib + len, sizeof rib - (size_t)len, "]\nWorldEnd\n");
+    fixture f;
+    assert_true(fixture_open_named(&f, rib, "bumponly", BUMP_SL));
+    trace_thread *th = trace_thread_new(&f.js->world);
+    const trace_camera *cam = &f.js->world.camera;
+    int inside = 0, hits = 0, exact = 0, outside_hits = 0;
+    for (int y = 0; y < cam->yres; y++)
+        for (int x = 0; x < cam->xres; x++) {
+            trace_ray ray;
+            trace_camera_ray(cam, x + 0.5, y + 0.5, &ray);
+            /* o = 0: t d.z = 3 + 0.2 t d.x + 0.1 t d.y */
+            vec3 d = ray.d;
+            double t = DEPTH / (d.z - 0.2 * d.x - 0.1 * d.y), zexp = t * d.z;
+            double rgb[3], al, z;
+            trace_render_sample(f.js->renderer, th, x + 0.5, y + 0.5, rgb, &al, &z);
+            if (!in_quad(t * d.x, t * d.y, 0.03)) {
+                if (!in_quad(t * d.x, t * d.y, -0.03)) outside_hits += al > 0;
+                continue;
+            }
+            inside++;
+            hits += al > 0;
+            exact += al > 0 && fabs(z - zexp) <= 1e-9 * zexp;
+        }
+    trace_thread_sync_stats(th);
+    printf("bilinear patch, bent normals: %d/%d hit, %d at the plane's depth, %d hits off it; "
+           "exact cells %ld, boxes %ld, proofs %ld\n", hits, inside, exact, outside_hits,
+           th->stats.exact_cells, th->stats.boxes, th->stats.proofs);
+    assert_true(inside > 500);
+    assert_true(th->stats.exact_cells > 0);
+    assert_int_equal(hits, inside);
+    assert_int_equal(exact, inside);
+    assert_int_equal(outside_hits, 0);
+    trace_thread_destroy(&th);
+    fixture_close(&f);
+}
+
+static const char *OBJBUMP_SL =
+    "displacement objbump(float Kb = 0.02)\n"
+    "{\n"
+    "    point Po = transform(\"object\", P);\n"
+    "    N = calculatenormal(P + Kb * noise(Po * 4) * normalize(N));\n"
+    "}\n";
+
+/* Three instances of a sphere whose shader only bends N (from object-space
+ * noise, so the placements share the prototype's boxes: trace/instance.c),
+ * moved and turned: every cell of every instance is undisplaced and each
+ * is intersected exactly on its own base (the walk's ray is in the
+ * object space the shared boxes are in); every hit at the nearest
+ * sphere's depth */
+#define NINST 3
+static const double INST_X[NINST] = {-1.9, 0.0, 1.9};
+
+static void test_instances_bent_normals_exact(void **state)
+{
+    (void)state;
+    char rib[2048];
+    int len = snprintf(rib, sizeof rib,
+                       "Format 96 40 1\nProjection \"perspective\" \"fov\" [45]\n"
+                       "Translate 0 0 4\nWorldBegin\nDisplacement \"%%s\"\n"
+                       "ObjectBegin 1\n  Sphere 0.8 -0.8 0.8 360\nObjectEnd\n");
+    for (int i = 0; i < NINST; i++)
+        len += snprintf(rib + len, sizeof rib - (size_t)len,
+                        "AttributeBegin\n  Translate %g 0 0\n  Rotate %d 0.3 1 0.2\n"
+                        "  ObjectInstance 1\nAttributeEnd\n", INST_X[i], 40 * i + 10);
+    snprintf(rib + len, sizeof rib - (size_t)len, "WorldEnd\n");
+    fixture f;
+    assert_true(fixture_open_named(&f, rib, "objbump", OBJBUMP_SL));
+    const trace_world *world = &f.js->world;
+    int shared = 0;
+    for (int i = 0; i < world->nobjects; i++) {
+        const trace_group *g = world->objects[i].group;
+        shared += world->objects[i].box_proto != NULL;
+        if (g && g->first_id >= 0) shared += g->n - g->nown;
+    }
+    trace_thread *th = trace_thread_new(world);
+    const trace_camera *cam = &world->camera;
+    int inside = 0, hits = 0, exact = 0, outside_hits = 0;
+    for (int y = 0; y < cam->yres; y++)
+        for (int x = 0; x < cam->xres; x++) {
+            trace_ray ray;
+            trace_camera_ray(cam, x + 0.5, y + 0.5, &ray);
+            /* the nearest of the spheres |p - (x_i, 0, 4)| = 0.8 along t d */
+            vec3 d = ray.d;
+            double tbest = INFINITY;
+            bool grazing = false;
+            for (int i = 0; i < NINST; i++) {
+                /* the ray's distance from the centre: near 0.8, a silhouette */
+                vec3 cen = v3(INST_X[i], 0, 4);
+                double dist = v3_length(v3_cross(cen, d)) / v3_length(d);
+                if (fabs(dist - 0.8) < 0.04) grazing = true;
+                if (dist >= 0.8) continue;
+                double a = v3_dot(d, d), b = -2.0 * v3_dot(cen, d),
+                       cc = v3_dot(cen, cen) - 0.64, disc = b * b - 4 * a * cc;
+                tbest = fmin(tbest, (-b - sqrt(disc)) / (2 * a));
+            }
+            double rgb[3], al, z;
+            trace_render_sample(f.js->renderer, th, x + 0.5, y + 0.5, rgb, &al, &z);
+            if (grazing) continue;             /* near a silhouette */
+            if (!isfinite(tbest)) {
+                outside_hits += al > 0;
+                continue;
+            }
+            double zexp = tbest * d.z;
+            inside++;
+            hits += al > 0;
+            exact += al > 0 && fabs(z - zexp) <= 1e-9 * zexp;
+        }
+    trace_thread_sync_stats(th);
+    printf("instances, bent normals: %d share the prototype's boxes; %d/%d hit, %d at the "
+           "sphere's depth, %d hits off them; exact cells %ld, boxes %ld, proofs %ld\n", shared,
+           hits, inside, exact, outside_hits, th->stats.exact_cells, th->stats.boxes,
+           th->stats.proofs);
+    assert_int_equal(shared, NINST - 1);
+    assert_true(inside > 500);
+    assert_int_equal(hits, inside);
+    assert_int_equal(exact, inside);
+    assert_int_equal(outside_hits, 0);
+    /* one root's children for the prototype, the placements none: every
+     * cell settled at the first level */
+    assert_true(th->stats.boxes <= 4);
+    trace_thread_destroy(&th);
+    fixture_close(&f);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_flat_exact_and_wedge_open),
         cmocka_unit_test(test_any_displacement_is_not_undisplaced),
         cmocka_unit_test(test_sphere_bent_normals_exact),
+        cmocka_unit_test(test_patch_bent_normals_exact),
+        cmocka_unit_test(test_instances_bent_normals_exact),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
