@@ -7,10 +7,13 @@
 #       defaults: build/bin; bricks bricks_filtered slate_roof tiles_hex
 #       tiles_pillow pnoise_tiles uv_quilt fwp_checks
 #
-# The scene is test_corpus_render's sphere (tests/corpus/corpus.c,
-# CORPUS_SPHERE: Translate 0 0 5, Rotate 70 1 0 0, Sphere 1 -1 1 360, fov 35)
-# at 96x72, one thread, affine arithmetic, the default box cache. For each
-# shader one line: CPU seconds of the render (user + system, /usr/bin/time),
+# Two scenes (PATTERN_BENCH_SCENES, default "sphere wall"): test_corpus_render's
+# sphere (tests/corpus/corpus.c, CORPUS_SPHERE: Translate 0 0 5, Rotate 70
+# 1 0 0, Sphere 1 -1 1 360, fov 35) at 96x72, and a flat wall (a 3 x 2
+# polygon, s and t across it, turned 30 degrees about the vertical and
+# seen from 3 units, fov 40, Km 0.03: the patterns' steps as real walls)
+# at 256x192; one thread, affine arithmetic, the default box cache. For
+# each scene and shader one line: CPU seconds of the render (user + system, /usr/bin/time),
 # and from `aafarm-worker --stats`: boxes per ray (box evaluations through
 # the shader / rays), evals per ray (affine + dual + float evaluations /
 # rays, as render_bench counts them), sampled_boxes (stagnant boxes
@@ -19,7 +22,7 @@
 # issue's aim is <= 10 boxes per ray. Figures, never a verdict: the script
 # fails only when a render fails. Every render is bounded by timeout -k
 # (PATTERN_BENCH_LIMIT seconds, default 600). PATTERN_BENCH_KEEP=DIR keeps
-# the images there (DIR/SHADER.exr), to compare two builds with exrcmp.
+# the images there (DIR/SCENE.SHADER.exr), to compare two builds with exrcmp.
 set -u
 BIN=${1:-build/bin}
 [ $# -gt 0 ] && shift
@@ -37,12 +40,14 @@ trap 'rm -rf "$WORK"' EXIT
 # the value of a --stats line
 stat() { awk -v k="$1" '$1 == k {print $2; exit}' "$2"; }
 
-echo "pattern_bench: corpus sphere 96x72, 1 thread, affine ($(date -u +%F), $(uname -m), $(nproc) cores)"
-printf "%-16s %8s %10s %10s %8s %7s %9s %7s\n" shader "CPU s" boxes/ray evals/ray sampled walls max_nodes limited
+echo "pattern_bench: corpus sphere 96x72 and a wall 256x192, 1 thread, affine ($(date -u +%F), $(uname -m), $(nproc) cores)"
+printf "%-6s %-16s %8s %10s %10s %8s %7s %9s %7s\n" scene shader "CPU s" boxes/ray evals/ray sampled walls max_nodes limited
 status=0
+for scene in ${PATTERN_BENCH_SCENES:-sphere wall}; do
 for sh in "${SHADERS[@]}"; do
     [ -r "$CORPUS/$sh.sl" ] || { echo "pattern_bench.sh: no shader $CORPUS/$sh.sl" >&2; status=1; continue; }
-    cat > "$WORK/$sh.rib" <<EOF
+    case $scene in
+    sphere) cat > "$WORK/$sh.rib" <<EOF
 Option "searchpath" "shader" ["$CORPUS:&"]
 Format 96 72 1
 Projection "perspective" "fov" [35]
@@ -55,6 +60,23 @@ Sphere 1 -1 1 360
 AttributeEnd
 WorldEnd
 EOF
+        ;;
+    wall) cat > "$WORK/$sh.rib" <<EOF
+Option "searchpath" "shader" ["$CORPUS:&"]
+Format 256 192 1
+Projection "perspective" "fov" [40]
+Translate 0 0 3
+Rotate -30 0 1 0
+WorldBegin
+LightSource "distantlight" 1 "from" [-1 2 -2] "to" [0 0 0]
+Attribute "displacementbound" "sphere" [0.05]
+Displacement "$sh" "float Km" [0.03]
+Polygon "P" [-1.5 -1 0  1.5 -1 0  1.5 1 0  -1.5 1 0] "st" [0 0  1 0  1 1  0 1]
+WorldEnd
+EOF
+        ;;
+    *) echo "pattern_bench.sh: no scene $scene (sphere, wall)" >&2; status=1; continue ;;
+    esac
     if ! /usr/bin/time -f "%U %S" -o "$WORK/time" timeout -k 5 "$LIMIT" \
             "$BIN/aafarm-worker" --standalone "$WORK/$sh.rib" -o "$WORK/$sh.exr" -t 1 \
             --stats 2> "$WORK/stats" > /dev/null; then
@@ -63,17 +85,18 @@ EOF
         status=1
         continue
     fi
-    [ -n "${PATTERN_BENCH_KEEP:-}" ] && cp "$WORK/$sh.exr" "$PATTERN_BENCH_KEEP/$sh.exr"
+    [ -n "${PATTERN_BENCH_KEEP:-}" ] && cp "$WORK/$sh.exr" "$PATTERN_BENCH_KEEP/$scene.$sh.exr"
     cpu=$(awk 'END {printf "%.2f", $1 + $2}' "$WORK/time")
     S=$WORK/stats
-    awk -v sh="$sh" -v cpu="$cpu" \
+    awk -v sc="$scene" -v sh="$sh" -v cpu="$cpu" \
         -v p="$(stat primary_rays "$S")" -v s="$(stat shadow_rays "$S")" \
         -v b="$(stat boxes "$S")" -v ea="$(stat evals_affine "$S")" \
         -v ed="$(stat evals_dual "$S")" -v ef="$(stat evals_float "$S")" \
         -v sb="$(stat sampled_boxes "$S")" -v wl="$(stat wall_leaves "$S")" \
         -v mx="$(stat max_nodes_per_ray "$S")" -v lr="$(stat limited_rays "$S")" \
         'BEGIN {r = p + s; if (r < 1) r = 1;
-                printf "%-16s %8s %10.2f %10.2f %8d %7d %9d %7d\n",
-                       sh, cpu, b / r, (ea + ed + ef) / r, sb, wl, mx, lr}'
+                printf "%-6s %-16s %8s %10.2f %10.2f %8d %7d %9d %7d\n",
+                       sc, sh, cpu, b / r, (ea + ed + ef) / r, sb, wl, mx, lr}'
+done
 done
 exit $status

@@ -35,13 +35,7 @@
  * the test settles most cells (the peer terrain: 396,013 of 692,090,
  * where the rule left 35 proven hits; 8.2 -> 7.9 s, 610 -> 447 pixels
  * from the 1/16-pixel reference; dented with every cell tried: 2.60 ->
- * 3.20 s). And not on a nearly linear cell of a leaf's size (at most one
- * tolerance), but where a texture displaces: there the test saves no box
- * below, only the leaf's own point, and the leaf tests the cells whose
- * point did not settle itself (leaf_hit's may_test); on dented those were
- * nearly all of the tests (27,767 -> 3,509, CPU 0.87x, 143 -> 145 pixels
- * from the 1/16-pixel reference; the wave, nail, meshes and terrain the
- * same number). */
+ * 3.20 s). */
 #define TRACE_PROVE_CELLS 16.0
 #define TRACE_PROVE_BEND 0.05
 /* Below a cell whose test failed at a fold (G's Jacobian may be singular
@@ -134,7 +128,12 @@ static double box_min_extent(const trace_box *b)
  * polygon or not finite are marked missing. `residual` is how far grid
  * neighbours miss the trapezoid rule P_k - P_i = (J_i + J_k) d / 2: a few
  * third-order terms on a continuous surface, the size of the jump where it
- * jumps. Used by the wall test and the stagnant-box fallback. */
+ * jumps. Used by the wall test and the stagnant-box fallback. With a
+ * finite `stop`, the sampling ends (n = -1) as soon as the residual
+ * exceeds it and two samples differ: the residual can only grow, so a
+ * caller that asks for residual <= stop with a spread above 0 has its
+ * answer. The residual is the largest over the same pairs, each computed
+ * the same way, whichever order they are met in. */
 enum { CELL_G = 3, CELL_N = CELL_G * CELL_G };
 typedef struct cell_samples {
     vec3 P[CELL_N], Pu[CELL_N], Pv[CELL_N], base[CELL_N];
@@ -144,37 +143,45 @@ typedef struct cell_samples {
 } cell_samples;
 
 static void sample_cell(trace_thread *th, const trace_object *obj, const double r[4],
-                        cell_samples *cs)
+                        double stop, cell_samples *cs)
 {
     double du = (r[1] - r[0]) / (CELL_G - 1), dv = (r[3] - r[2]) / (CELL_G - 1);
     cs->n = 0;
+    cs->residual = 0;
+    bool spread = false;                /* a sample apart from the first */
     for (int k = 0; k < CELL_N; k++) {
         double u = r[0] + du * (k % CELL_G), v = r[2] + dv * (k / CELL_G);
         cs->ok[k] = false;
-        if (!geom_uv_inside(&obj->surf, u, v)) continue;
-        trace_surface_point sp;
-        trace_surface_point_eval(th, obj, u, v, &sp);
-        if (!v3_is_finite(sp.P) || !v3_is_finite(sp.Pu) || !v3_is_finite(sp.Pv)) continue;
-        geom_sample g;
-        geom_eval(&obj->surf, u, v, &g);
-        cs->P[k] = sp.P;
-        cs->Pu[k] = sp.Pu;
-        cs->Pv[k] = sp.Pv;
-        cs->base[k] = mat4_xform_point(&obj->to_camera, g.P);
-        cs->ok[k] = true;
-        cs->n++;
-    }
-    cs->residual = 0;
-    for (int k = 0; k < CELL_N; k++) {
-        int right = k % CELL_G < CELL_G - 1 ? k + 1 : -1;
-        int down = k + CELL_G < CELL_N ? k + CELL_G : -1;
-        if (cs->ok[k] && right >= 0 && cs->ok[right]) {
-            vec3 pred = v3_add(cs->P[k], v3_scale(v3_add(cs->Pu[k], cs->Pu[right]), 0.5 * du));
-            cs->residual = fmax(cs->residual, v3_length(v3_sub(cs->P[right], pred)));
+        if (geom_uv_inside(&obj->surf, u, v)) {
+            trace_surface_point sp;
+            trace_surface_point_eval(th, obj, u, v, &sp);
+            if (v3_is_finite(sp.P) && v3_is_finite(sp.Pu) && v3_is_finite(sp.Pv)) {
+                geom_sample g;
+                geom_eval(&obj->surf, u, v, &g);
+                cs->P[k] = sp.P;
+                cs->Pu[k] = sp.Pu;
+                cs->Pv[k] = sp.Pv;
+                cs->base[k] = mat4_xform_point(&obj->to_camera, g.P);
+                cs->ok[k] = true;
+                cs->n++;
+            }
         }
-        if (cs->ok[k] && down >= 0 && cs->ok[down]) {
-            vec3 pred = v3_add(cs->P[k], v3_scale(v3_add(cs->Pv[k], cs->Pv[down]), 0.5 * dv));
-            cs->residual = fmax(cs->residual, v3_length(v3_sub(cs->P[down], pred)));
+        if (!cs->ok[k]) continue;
+        /* the pairs that end at k: from its left and upper neighbours */
+        int left = k % CELL_G > 0 ? k - 1 : -1, up = k - CELL_G;
+        if (left >= 0 && cs->ok[left]) {
+            vec3 pred = v3_add(cs->P[left], v3_scale(v3_add(cs->Pu[left], cs->Pu[k]), 0.5 * du));
+            cs->residual = fmax(cs->residual, v3_length(v3_sub(cs->P[k], pred)));
+        }
+        if (up >= 0 && cs->ok[up]) {
+            vec3 pred = v3_add(cs->P[up], v3_scale(v3_add(cs->Pv[up], cs->Pv[k]), 0.5 * dv));
+            cs->residual = fmax(cs->residual, v3_length(v3_sub(cs->P[k], pred)));
+        }
+        spread = spread || (cs->ok[0] && (cs->P[k].x != cs->P[0].x || cs->P[k].y != cs->P[0].y ||
+                                          cs->P[k].z != cs->P[0].z));
+        if (cs->residual > stop && spread) {
+            cs->n = -1;                 /* stopped: the caller's test fails */
+            return;
         }
     }
 }
@@ -213,7 +220,7 @@ static void analyse_wall(trace_thread *th, const trace_object *obj, const double
                          wall_entry *e)
 {
     cell_samples cs;
-    sample_cell(th, obj, r, &cs);
+    sample_cell(th, obj, r, INFINITY, &cs);
     e->residual = cs.residual;
     e->sided = e->jumps = false;
     int a = -1, b = -1;
@@ -573,7 +580,14 @@ static bool sample_stagnant(trace_thread *th, const trace_object *obj, const dou
                             trace_box *box)
 {
     cell_samples cs;
-    sample_cell(th, obj, r, &cs);
+    /* the samples lie in the box (object space), so their spread in camera
+     * space is at most its diagonal times the object's stretch (scale):
+     * a residual above a quarter of that fails the test below, whatever
+     * the rest of the samples (a jump at a wall: half the samples on
+     * average, issue 24) */
+    vec3 diag = v3_sub(box->hi, box->lo);
+    double bound = 0.25 * v3_length(diag) * obj->scale * (1.0 + 1e-6);
+    sample_cell(th, obj, r, isfinite(bound) ? bound : INFINITY, &cs);
     if (cs.n < CELL_N) return false;
     vec3 lo = v3(INFINITY, INFINITY, INFINITY), hi = v3(-INFINITY, -INFINITY, -INFINITY);
     double spread = 0;
@@ -910,7 +924,7 @@ static void visit(walk *w, const trace_box *node, const trace_qlin *node_q, cons
         bool provable = w->prove && !unbounded && !(kid->flags & AA_DISCONTINUOUS) &&
                         size <= TRACE_PROVE_CELLS * tol;
         bool try_proof = provable && (kid->bend <= TRACE_PROVE_BEND || w->obj->prove_any_bend) &&
-                         size <= w->prove_below && (size > tol || w->obj->prove_any_bend);
+                         size <= w->prove_below;
         bool at_leaf = provable && size <= tol && d < TRACE_MAX_DEPTH;
         if ((try_proof || at_leaf) && !clear_of_shared_edges(w, c)) try_proof = at_leaf = false;
         if (try_proof) {

@@ -306,11 +306,7 @@ static void check_walks(const char *rib)
     assert_int_equal(proofs_only, 0);      /* leaves are conservative: a superset */
     assert_true(both > 200);
     assert_true(th->stats.proven_hits > 100);
-    /* the misses come from leaves whose point did not settle (proofs on
-     * cells of a leaf's size are tried only there: the square's near
-     * misses along its crests, 6 of them; 12 when every such cell was
-     * tried) and from larger cells */
-    assert_true(th->stats.proven_misses > 0);
+    assert_true(th->stats.proven_misses > 10);
     trace_thread_destroy(&th);
     fixture_close(&f);
 }
