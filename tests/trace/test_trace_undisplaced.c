@@ -137,10 +137,66 @@ static const char *BUMP_SL =
     "    N = calculatenormal(P + Kb * noise(P * 4) * normalize(N));\n"
     "}\n";
 
+/* Where a ray through a pixel centre should land (o = 0): EXPECT_HIT
+ * with the camera depth *zexp, EXPECT_MISS, or EXPECT_SKIP near a
+ * silhouette or an edge */
+typedef enum { EXPECT_SKIP, EXPECT_HIT, EXPECT_MISS } expect;
+typedef expect (*expect_fn)(vec3 d, double *zexp);
+
+typedef struct exact_scan {
+    int inside, hits, exact, outside_hits;
+    trace_stats st;
+} exact_scan;
+
+/* One ray through every pixel centre against what expect says: how many
+ * of the rays that must hit do, how many at the expected depth to 1e-9,
+ * how many that must miss hit */
+static void scan_exact(fixture *f, expect_fn fn, exact_scan *out)
+{
+    trace_thread *th = trace_thread_new(&f->js->world);
+    const trace_camera *cam = &f->js->world.camera;
+    *out = (exact_scan){0};
+    for (int y = 0; y < cam->yres; y++)
+        for (int x = 0; x < cam->xres; x++) {
+            trace_ray ray;
+            trace_camera_ray(cam, x + 0.5, y + 0.5, &ray);
+            double zexp = 0, rgb[3], al, z;
+            expect e = fn(ray.d, &zexp);
+            trace_render_sample(f->js->renderer, th, x + 0.5, y + 0.5, rgb, &al, &z);
+            if (e == EXPECT_MISS) out->outside_hits += al > 0;
+            if (e != EXPECT_HIT) continue;
+            out->inside++;
+            out->hits += al > 0;
+            out->exact += al > 0 && fabs(z - zexp) <= 1e-9 * zexp;
+        }
+    trace_thread_sync_stats(th);
+    out->st = th->stats;
+    trace_thread_destroy(&th);
+}
+
+static void assert_all_exact(const exact_scan *s)
+{
+    assert_true(s->inside > 500);
+    assert_true(s->st.exact_cells > 0);
+    assert_int_equal(s->hits, s->inside);
+    assert_int_equal(s->exact, s->inside);
+    assert_int_equal(s->outside_hits, 0);
+}
+
 /* A sphere (radius 1, at depth 3) whose displacement only bends N: every
  * cell is undisplaced, and on a quadric the walk intersects its base
  * exactly too (the nearer root first, then the farther where the nearer
  * falls outside the cell) */
+static expect unit_sphere(vec3 d, double *zexp)
+{
+    /* |p - (0, 0, 3)| = 1 along t d */
+    double a = v3_dot(d, d), b = -6.0 * d.z, cc = 9.0 - 1.0, disc = b * b - 4 * a * cc;
+    if (disc < 0.05 * b * b)             /* off the sphere, or near its silhouette */
+        return disc < 0 ? EXPECT_MISS : EXPECT_SKIP;
+    *zexp = (-b - sqrt(disc)) / (2 * a) * d.z;
+    return EXPECT_HIT;
+}
+
 static void test_sphere_bent_normals_exact(void **state)
 {
     (void)state;
@@ -150,37 +206,12 @@ static void test_sphere_bent_normals_exact(void **state)
                                    "Translate 0 0 3\nWorldBegin\nDisplacement \"%s\"\n"
                                    "Sphere 1 -1 1 360\nWorldEnd\n",
                                    "bumponly", BUMP_SL));
-    trace_thread *th = trace_thread_new(&f.js->world);
-    const trace_camera *cam = &f.js->world.camera;
-    int inside = 0, hits = 0, exact = 0, outside_hits = 0;
-    for (int y = 0; y < cam->yres; y++)
-        for (int x = 0; x < cam->xres; x++) {
-            trace_ray ray;
-            trace_camera_ray(cam, x + 0.5, y + 0.5, &ray);
-            /* the sphere |p - (0, 0, 3)| = 1 along o + t d, o = 0 */
-            vec3 d = ray.d;
-            double a = v3_dot(d, d), b = -6.0 * d.z, cc = 9.0 - 1.0, disc = b * b - 4 * a * cc;
-            double rgb[3], al, z;
-            trace_render_sample(f.js->renderer, th, x + 0.5, y + 0.5, rgb, &al, &z);
-            if (disc < 0.05 * b * b) {          /* off the sphere, or near its silhouette */
-                if (disc < 0) outside_hits += al > 0;
-                continue;
-            }
-            double t = (-b - sqrt(disc)) / (2 * a), zexp = t * d.z;
-            inside++;
-            hits += al > 0;
-            exact += al > 0 && fabs(z - zexp) <= 1e-9 * zexp;
-        }
-    trace_thread_sync_stats(th);
+    exact_scan s;
+    scan_exact(&f, unit_sphere, &s);
     printf("bent normals: %d/%d hit, %d at the sphere's depth, %d hits off it; exact cells %ld, "
-           "boxes %ld\n", hits, inside, exact, outside_hits, th->stats.exact_cells,
-           th->stats.boxes);
-    assert_true(inside > 500);
-    assert_true(th->stats.exact_cells > 0);
-    assert_int_equal(hits, inside);
-    assert_int_equal(exact, inside);
-    assert_int_equal(outside_hits, 0);
-    trace_thread_destroy(&th);
+           "boxes %ld\n", s.hits, s.inside, s.exact, s.outside_hits, s.st.exact_cells,
+           s.st.boxes);
+    assert_all_exact(&s);
     fixture_close(&f);
 }
 
@@ -205,6 +236,16 @@ static bool in_quad(double x, double y, double m)
     return true;
 }
 
+static expect planar_quad(vec3 d, double *zexp)
+{
+    /* t d.z = 3 + 0.2 t d.x + 0.1 t d.y */
+    double t = DEPTH / (d.z - 0.2 * d.x - 0.1 * d.y);
+    if (!in_quad(t * d.x, t * d.y, 0.03))
+        return in_quad(t * d.x, t * d.y, -0.03) ? EXPECT_SKIP : EXPECT_MISS;
+    *zexp = t * d.z;
+    return EXPECT_HIT;
+}
+
 static void test_patch_bent_normals_exact(void **state)
 {
     (void)state;
@@ -222,36 +263,12 @@ static void test_patch_bent_normals_exact(void **state)
     snprintf(rib + len, sizeof rib - (size_t)len, "]\nWorldEnd\n");
     fixture f;
     assert_true(fixture_open_named(&f, rib, "bumponly", BUMP_SL));
-    trace_thread *th = trace_thread_new(&f.js->world);
-    const trace_camera *cam = &f.js->world.camera;
-    int inside = 0, hits = 0, exact = 0, outside_hits = 0;
-    for (int y = 0; y < cam->yres; y++)
-        for (int x = 0; x < cam->xres; x++) {
-            trace_ray ray;
-            trace_camera_ray(cam, x + 0.5, y + 0.5, &ray);
-            /* o = 0: t d.z = 3 + 0.2 t d.x + 0.1 t d.y */
-            vec3 d = ray.d;
-            double t = DEPTH / (d.z - 0.2 * d.x - 0.1 * d.y), zexp = t * d.z;
-            double rgb[3], al, z;
-            trace_render_sample(f.js->renderer, th, x + 0.5, y + 0.5, rgb, &al, &z);
-            if (!in_quad(t * d.x, t * d.y, 0.03)) {
-                if (!in_quad(t * d.x, t * d.y, -0.03)) outside_hits += al > 0;
-                continue;
-            }
-            inside++;
-            hits += al > 0;
-            exact += al > 0 && fabs(z - zexp) <= 1e-9 * zexp;
-        }
-    trace_thread_sync_stats(th);
+    exact_scan s;
+    scan_exact(&f, planar_quad, &s);
     printf("bilinear patch, bent normals: %d/%d hit, %d at the plane's depth, %d hits off it; "
-           "exact cells %ld, boxes %ld, proofs %ld\n", hits, inside, exact, outside_hits,
-           th->stats.exact_cells, th->stats.boxes, th->stats.proofs);
-    assert_true(inside > 500);
-    assert_true(th->stats.exact_cells > 0);
-    assert_int_equal(hits, inside);
-    assert_int_equal(exact, inside);
-    assert_int_equal(outside_hits, 0);
-    trace_thread_destroy(&th);
+           "exact cells %ld, boxes %ld, proofs %ld\n", s.hits, s.inside, s.exact, s.outside_hits,
+           s.st.exact_cells, s.st.boxes, s.st.proofs);
+    assert_all_exact(&s);
     fixture_close(&f);
 }
 
@@ -270,6 +287,25 @@ static const char *OBJBUMP_SL =
  * sphere's depth */
 #define NINST 3
 static const double INST_X[NINST] = {-1.9, 0.0, 1.9};
+
+static expect sphere_instances(vec3 d, double *zexp)
+{
+    /* the nearest of the spheres |p - (x_i, 0, 4)| = 0.8 along t d */
+    double tbest = INFINITY;
+    for (int i = 0; i < NINST; i++) {
+        /* the ray's distance from the centre: near 0.8, a silhouette */
+        vec3 cen = v3(INST_X[i], 0, 4);
+        double dist = v3_length(v3_cross(cen, d)) / v3_length(d);
+        if (fabs(dist - 0.8) < 0.04) return EXPECT_SKIP;
+        if (dist >= 0.8) continue;
+        double a = v3_dot(d, d), b = -2.0 * v3_dot(cen, d), cc = v3_dot(cen, cen) - 0.64,
+               disc = b * b - 4 * a * cc;
+        tbest = fmin(tbest, (-b - sqrt(disc)) / (2 * a));
+    }
+    if (!isfinite(tbest)) return EXPECT_MISS;
+    *zexp = tbest * d.z;
+    return EXPECT_HIT;
+}
 
 static void test_instances_bent_normals_exact(void **state)
 {
@@ -293,53 +329,16 @@ static void test_instances_bent_normals_exact(void **state)
         shared += world->objects[i].box_proto != NULL;
         if (g && g->first_id >= 0) shared += g->n - g->nown;
     }
-    trace_thread *th = trace_thread_new(world);
-    const trace_camera *cam = &world->camera;
-    int inside = 0, hits = 0, exact = 0, outside_hits = 0;
-    for (int y = 0; y < cam->yres; y++)
-        for (int x = 0; x < cam->xres; x++) {
-            trace_ray ray;
-            trace_camera_ray(cam, x + 0.5, y + 0.5, &ray);
-            /* the nearest of the spheres |p - (x_i, 0, 4)| = 0.8 along t d */
-            vec3 d = ray.d;
-            double tbest = INFINITY;
-            bool grazing = false;
-            for (int i = 0; i < NINST; i++) {
-                /* the ray's distance from the centre: near 0.8, a silhouette */
-                vec3 cen = v3(INST_X[i], 0, 4);
-                double dist = v3_length(v3_cross(cen, d)) / v3_length(d);
-                if (fabs(dist - 0.8) < 0.04) grazing = true;
-                if (dist >= 0.8) continue;
-                double a = v3_dot(d, d), b = -2.0 * v3_dot(cen, d),
-                       cc = v3_dot(cen, cen) - 0.64, disc = b * b - 4 * a * cc;
-                tbest = fmin(tbest, (-b - sqrt(disc)) / (2 * a));
-            }
-            double rgb[3], al, z;
-            trace_render_sample(f.js->renderer, th, x + 0.5, y + 0.5, rgb, &al, &z);
-            if (grazing) continue;             /* near a silhouette */
-            if (!isfinite(tbest)) {
-                outside_hits += al > 0;
-                continue;
-            }
-            double zexp = tbest * d.z;
-            inside++;
-            hits += al > 0;
-            exact += al > 0 && fabs(z - zexp) <= 1e-9 * zexp;
-        }
-    trace_thread_sync_stats(th);
+    exact_scan s;
+    scan_exact(&f, sphere_instances, &s);
     printf("instances, bent normals: %d share the prototype's boxes; %d/%d hit, %d at the "
            "sphere's depth, %d hits off them; exact cells %ld, boxes %ld, proofs %ld\n", shared,
-           hits, inside, exact, outside_hits, th->stats.exact_cells, th->stats.boxes,
-           th->stats.proofs);
+           s.hits, s.inside, s.exact, s.outside_hits, s.st.exact_cells, s.st.boxes, s.st.proofs);
     assert_int_equal(shared, NINST - 1);
-    assert_true(inside > 500);
-    assert_int_equal(hits, inside);
-    assert_int_equal(exact, inside);
-    assert_int_equal(outside_hits, 0);
+    assert_all_exact(&s);
     /* one root's children for the prototype, the placements none: every
      * cell settled at the first level */
-    assert_true(th->stats.boxes <= 4);
-    trace_thread_destroy(&th);
+    assert_true(s.st.boxes <= 4);
     fixture_close(&f);
 }
 
