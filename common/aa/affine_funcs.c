@@ -432,8 +432,34 @@ void aa_recip(aa_context *ctx, aa_form *z, const aa_form *x)
     approx_convex(ctx, z, x, &fn, &pc, 1, r.lo, r.hi, ia_recip(r), fl, xr);
 }
 
+/*
+ * x / y. By a point y = c (a shader's uniform: s / bwidth), x scaled by
+ * q = fl(1/c): for a normal q, |1/c - q| <= ulp(q)/2 <= 2^-53 |q|, which
+ * times the largest |x| goes to the private error term; the scale
+ * rounds as any scale does, and the hull is met with the intervals'
+ * quotient (outward). Else x times y's reciprocal (a form of y's
+ * symbols).
+ */
 void aa_div(aa_context *ctx, aa_form *z, const aa_form *x, const aa_form *y)
 {
+    if (aa_is_point(y) && !(x->flags & AA_UNBOUNDED) && isfinite(y->x0)) {
+        double c = y->x0, q = 1.0 / c;
+        ia_interval xr = aa_range(x);
+        double m = fmax(fabs(xr.lo), fabs(xr.hi));
+        double e = fp_mul_up(fp_mul_up(fabs(q), 0x1p-53), m);
+        if (c != 0.0 && isfinite(q) && fabs(q) >= 0x1p-1000 && isfinite(e)) {
+            unsigned fl = (x->flags | y->flags) & ~AA_UNBOUNDED;
+            aa_mul_s(ctx, z, x, q);
+            /* the quotient's own error stays private (no new symbol: the
+             * reciprocal's interval, which this replaces, had none) */
+            z->err = fp_add_up(z->err, e);
+            z->lo = fp_add_dn(z->lo, -e);
+            z->hi = fp_add_up(z->hi, e);
+            z->flags |= (unsigned short)fl;
+            aa_meet_hull(z, ia_div(xr, ia_point(c)));
+            return;
+        }
+    }
     aa_form inv;
     aa_recip(ctx, &inv, y);
     if (inv.flags & AA_UNBOUNDED) {
