@@ -62,12 +62,16 @@
  * the base surface: where that has closed-form intersections the walk
  * intersects it exactly (intersect.c, "Undisplaced cells") */
 #define TRACE_BOX_UNDISPLACED (1u << 13)
+/* The displacement moved the base surface by a constant over the cell
+ * (displace.c, offset_affine): the surface there is the base surface
+ * moved, intersected exactly where the base can be (intersect.c) */
+#define TRACE_BOX_OFFSET (1u << 14)
 
 typedef struct trace_box {
     vec3 lo, hi;
     unsigned flags;          /* AA_DISCONTINUOUS | AA_UNBOUNDED | TRACE_BOX_SAMPLED |
                                 TRACE_BOX_UNSPLIT | TRACE_BOX_SPLIT | TRACE_BOX_LIN |
-                                TRACE_BOX_LAZY | TRACE_BOX_UNDISPLACED */
+                                TRACE_BOX_LAZY | TRACE_BOX_UNDISPLACED | TRACE_BOX_OFFSET */
     float bend;              /* how far from linear in (u,v) the surface is over
                                 the box: the affine forms' other terms over
                                 their u and v terms (displace.c); 0: unknown */

@@ -247,12 +247,33 @@ static void affine_geometry(trace_thread *th, const trace_object *obj,
     c->ctx = *ctx;
 }
 
+/* What a box run's shader did to P over the cell (affine_shade) */
+typedef enum {
+    TRACE_MOVED_OTHER,             /* anything, or not known */
+    TRACE_MOVED_NOT,               /* nothing: P as the base gave it */
+    TRACE_MOVED_OFFSET             /* P moved by a constant */
+} trace_moved;
+
 /* Whether two forms have the same affine part and flags: the same
  * centre, coefficients and error term (the hull aside: every operation
  * recomputes it, rounding outward) */
 static bool same_affine(const aa_form *a, const aa_form *b)
 {
     return a->x0 == b->x0 && a->err == b->err && a->n == b->n && a->flags == b->flags &&
+           memcmp(a->c, b->c, (size_t)a->n * sizeof a->c[0]) == 0;
+}
+
+/* Whether the shader's form a is the base's form b moved by a constant:
+ * the same coefficients and flags, the centre anywhere, and an error term
+ * grown by no more than the rounding of that move (2^-40 of the centres:
+ * far below what the float evaluation of any hit point carries). A
+ * displacement that varies over the cell varies a coefficient (one of
+ * the cell's symbols) or the error term by more. */
+#define TRACE_OFFSET_SLACK 0x1p-40
+static bool offset_affine(const aa_form *a, const aa_form *b)
+{
+    return a->n == b->n && a->flags == b->flags && isfinite(a->x0) && a->err >= b->err &&
+           a->err - b->err <= TRACE_OFFSET_SLACK * (fabs(a->x0) + fabs(b->x0)) &&
            memcmp(a->c, b->c, (size_t)a->n * sizeof a->c[0]) == 0;
 }
 
@@ -263,11 +284,13 @@ static bool same_affine(const aa_form *a, const aa_form *b)
  * changed nothing (adding an exact 0, as a decided step's branch gives),
  * since one whose value may differ from P's changes its form, its error
  * term at least; so the displaced surface over the cell is the base
- * surface itself. */
+ * surface itself (TRACE_MOVED_NOT). Or moved by a constant
+ * (TRACE_MOVED_OFFSET, offset_affine: a brick's top, Km times a decided
+ * step along a flat base's N). */
 static void affine_shade(trace_thread *th, const trace_object *obj, const affine_cell *c,
-                         aa_form P[3], bool *same)
+                         aa_form P[3], trace_moved *same)
 {
-    if (same) *same = false;
+    if (same) *same = TRACE_MOVED_OTHER;
     aa_context *ctx = &th->ctx;
     *ctx = c->ctx;
     th->stats.evals_affine++;
@@ -287,15 +310,19 @@ static void affine_shade(trace_thread *th, const trace_object *obj, const affine
     } else {
         aa_form Pc[3];
         sl_vm_get_affine(vm, SL_G_P, Pc);
-        if (same)
-            *same = same_affine(&Pc[0], &c->P[0]) && same_affine(&Pc[1], &c->P[1]) &&
-                    same_affine(&Pc[2], &c->P[2]);
+        if (same && same_affine(&Pc[0], &c->P[0]) && same_affine(&Pc[1], &c->P[1]) &&
+            same_affine(&Pc[2], &c->P[2]))
+            *same = TRACE_MOVED_NOT;
+        else if (same && offset_affine(&Pc[0], &c->P[0]) && offset_affine(&Pc[1], &c->P[1]) &&
+                 offset_affine(&Pc[2], &c->P[2]))
+            *same = TRACE_MOVED_OFFSET;
         trace_xform_aa(ctx, &obj->from_camera, Pc, P, true);
     }
 }
 
 static void affine_run(trace_thread *th, const trace_object *obj,
-                       double u0, double u1, double v0, double v1, aa_form P[3], bool *same)
+                       double u0, double u1, double v0, double v1, aa_form P[3],
+                       trace_moved *same)
 {
     affine_cell c;
     affine_geometry(th, obj, u0, u1, v0, v1, &c);
@@ -329,10 +356,13 @@ static void box_affine(trace_thread *th, const trace_object *obj,
                        trace_lin *lin)
 {
     aa_form P[3];
-    bool same;
+    trace_moved same;
     affine_run(th, obj, u0, u1, v0, v1, P, &same);
     box_from_affine(P, out);
-    if (same && obj->displacement && !out->flags) out->flags |= TRACE_BOX_UNDISPLACED;
+    if (obj->displacement && !out->flags) {
+        if (same == TRACE_MOVED_NOT) out->flags |= TRACE_BOX_UNDISPLACED;
+        else if (same == TRACE_MOVED_OFFSET) out->flags |= TRACE_BOX_OFFSET;
+    }
     if (lin) box_linear(&th->ctx, P, out, lin);
 }
 

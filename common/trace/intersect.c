@@ -541,14 +541,61 @@ static bool exact_kind(geom_kind k)
  * hit; none, and the cell has none. True where the cell is settled so;
  * false (the walk goes on as before) only if a closed form gave more
  * intersections than it can have (issue 24: the nail's disk, a
- * displacement masked to 0 or one that only bends N). */
-static bool exact_cell(walk *w, const double c[4], double tol)
+ * displacement masked to 0 or one that only bends N). moved: the cell is
+ * the base moved by a constant (TRACE_BOX_OFFSET: the nail's top, a
+ * brick's), intersected as the base with the ray moved back. */
+/* The move of a cell the displacement moved by a constant
+ * (TRACE_BOX_OFFSET), in object space: the displaced point less the
+ * base's at any point of the cell, here its centre. A pure function of
+ * object and cell, kept in a direct-mapped per-thread cache as the walls'
+ * samples are (every ray that meets the cell asks; one evaluation each
+ * cost a brick wall 19 % more dual evaluations) */
+enum { MOVE_CACHE_LOG2 = 10, MOVE_CACHE_ENTRIES = 1 << MOVE_CACHE_LOG2 };
+typedef struct move_entry {
+    double r[4];                  /* the cell; r[0] >= r[1]: empty */
+    int obj;
+    vec3 back;                    /* object space; not finite: none */
+} move_entry;
+struct trace_move_cache { move_entry e[MOVE_CACHE_ENTRIES]; };
+
+static vec3 cell_move(trace_thread *th, const trace_object *obj, const double c[4])
+{
+    if (!th->moves) th->moves = xcalloc(1, sizeof *th->moves);   /* zeroed: empty */
+    move_entry *e = &th->moves->e[trace_cell_slot(c, obj->id, MOVE_CACHE_LOG2)];
+    if (trace_cell_is(e->r, e->obj, c, obj->id)) return e->back;
+    double uc = 0.5 * (c[0] + c[1]), vc = 0.5 * (c[2] + c[3]);
+    trace_surface_point sp;
+    trace_surface_point_eval(th, obj, uc, vc, &sp);
+    geom_sample g;
+    geom_eval(&obj->surf, uc, vc, &g);
+    vec3 move = v3_sub(sp.P, mat4_xform_point(&obj->to_camera, g.P));
+    e->back = mat4_xform_vector(&obj->from_camera, move);
+    if (th->failed) {                   /* a failed run: nothing to keep */
+        e->r[0] = 1.0;
+        e->r[1] = 0.0;
+        return v3(NAN, NAN, NAN);
+    }
+    memcpy(e->r, c, sizeof e->r);
+    e->obj = obj->id;
+    return e->back;
+}
+
+static bool exact_cell(walk *w, const double c[4], double tol, bool moved)
 {
     geom_hit h;
     double t = w->ray.tmin;
+    vec3 o = w->ray.o;
+    if (moved) {
+        /* the ray moved back by the cell's move meets the base where it
+         * meets the moved surface, at the same t */
+        vec3 back = cell_move(w->th, w->obj, c);
+        if (!v3_is_finite(back)) return false;
+        o = v3_sub(o, back);
+        w->th->stats.offset_cells++;
+    }
     w->th->stats.exact_cells++;
     for (int i = 0; i < EXACT_ROOTS; i++) {
-        if (!geom_intersect(&w->obj->surf, w->ray.o, w->ray.d, t, w->best->t, &h)) return true;
+        if (!geom_intersect(&w->obj->surf, o, w->ray.d, t, w->best->t, &h)) return true;
         if (h.u >= c[0] && h.u <= c[1] && h.v >= c[2] && h.v <= c[3]) {
             trace_surface_point sp;
             trace_surface_point_eval(w->th, w->obj, h.u, h.v, &sp);
@@ -918,8 +965,9 @@ static void visit(walk *w, const trace_box *node, const trace_qlin *node_q, cons
         double t_at = order[k].t0 > 0 ? order[k].t0 : 0;
         double tol = w->tol.a + w->tol.b * t_at;
         int d = depth + 1;
-        if ((kid->flags & TRACE_BOX_UNDISPLACED) && w->exact_cells &&
-            clear_of_shared_edges(w, c) && exact_cell(w, c, tol))
+        if ((kid->flags & (TRACE_BOX_UNDISPLACED | TRACE_BOX_OFFSET)) && w->exact_cells &&
+            clear_of_shared_edges(w, c) &&
+            exact_cell(w, c, tol, (kid->flags & TRACE_BOX_OFFSET) != 0))
             continue;
         bool unbounded = (kid->flags & AA_UNBOUNDED) != 0;
         vec3 wall_n = v3(0, 0, 0);

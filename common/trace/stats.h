@@ -27,6 +27,8 @@ typedef struct trace_stats {
     long leaf_tests;               /* of the proofs, on leaves whose point did not settle */
     long exact_cells;              /* undisplaced cells intersected exactly
                                       (intersect.c, exact_cell) */
+    long offset_cells;             /* of them, cells of the base moved by a
+                                      constant (TRACE_BOX_OFFSET) */
     long rejected_leaves;          /* leaves whose surface point was not on the
                                       ray (depth cap) or not finite: no hit */
     long nodes;                    /* quadtree nodes visited by all rays */

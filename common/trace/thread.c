@@ -115,6 +115,7 @@ void trace_thread_destroy(trace_thread **self_p)
     free(self->slopes);
     trace_normal_memo_free(self);
     free(self->walls);
+    free(self->moves);
     trace_views_free(self);
     free(self->work);
     free(self);

@@ -120,23 +120,6 @@ static void test_flat_exact_and_wedge_open(void **state)
     assert_int_equal(s.sunk_deep, s.sunk);
 }
 
-static void test_any_displacement_is_not_undisplaced(void **state)
-{
-    (void)state;
-    disk_scan s;
-    scan_disk("tiny", TINY_SL, &s);
-    /* 1e-20 is below every rounding of the plane, but the forms change */
-    assert_int_equal(s.st.exact_cells, 0);
-    assert_int_equal(s.flat_hits, s.flat);
-    assert_int_equal(s.sunk_hits, s.sunk);
-}
-
-static const char *BUMP_SL =
-    "displacement bumponly(float Kb = 0.02)\n"
-    "{\n"
-    "    N = calculatenormal(P + Kb * noise(P * 4) * normalize(N));\n"
-    "}\n";
-
 /* Where a ray through a pixel centre should land (o = 0): EXPECT_HIT
  * with the camera depth *zexp, EXPECT_MISS, or EXPECT_SKIP near a
  * silhouette or an edge */
@@ -182,6 +165,91 @@ static void assert_all_exact(const exact_scan *s)
     assert_int_equal(s->exact, s->inside);
     assert_int_equal(s->outside_hits, 0);
 }
+
+static void test_any_displacement_is_not_undisplaced(void **state)
+{
+    (void)state;
+    disk_scan s;
+    scan_disk("tiny", TINY_SL, &s);
+    /* 1e-20 is below every rounding of the plane, but the forms change:
+     * no cell is undisplaced; the move is a constant, so every exact cell
+     * is an offset cell (the base moved by 1e-20, at the plane's depth) */
+    assert_true(s.st.offset_cells > 0);
+    assert_int_equal(s.st.exact_cells, s.st.offset_cells);
+    assert_int_equal(s.flat_hits, s.flat);
+    assert_int_equal(s.flat_exact, s.flat);
+    assert_int_equal(s.sunk_hits, s.sunk);
+}
+
+static const char *SLOPE_SL =
+    "displacement slope(float Km = 1e-6)\n"
+    "{\n"
+    "    P += Km * u * normalize(N);\n"
+    "    N = calculatenormal(P);\n"
+    "}\n";
+
+/* A displacement that varies over every cell, however little (1e-6 u
+ * along N), moves no cell by a constant: no exact cell at all */
+static void test_varying_displacement_is_not_offset(void **state)
+{
+    (void)state;
+    disk_scan s;
+    scan_disk("slope", SLOPE_SL, &s);
+    assert_int_equal(s.st.exact_cells, 0);
+    assert_int_equal(s.flat_hits, s.flat);
+}
+
+static const char *RAISED_SL =
+    "displacement raised(float u0 = 0.13, u1 = 0.25, h = 0.25)\n"
+    "{\n"
+    "    P += h * step(u0, u) * (1 - step(u1, u)) * normalize(N);\n"
+    "    N = calculatenormal(P);\n"
+    "}\n";
+
+/* The disk with a wedge moved by h along its normal (object +z, away
+ * from the eye): the wedge's cells are the base moved by a constant
+ * (offset cells), the rest undisplaced; every hit exactly at its plane's
+ * depth, 3 or 3 + h (along a ray from the eye the angle u is the same at
+ * both depths) */
+static expect raised_wedge(vec3 d, double *zexp)
+{
+    double t = DEPTH / d.z, x = t * d.x, y = t * d.y, r = sqrt(x * x + y * y);
+    double u = atan2(y, x) / (2 * M_PI);
+    if (u < 0) u += 1;
+    const double m = 0.03, um = 0.01;
+    if (r < m || r > 1 - m) return r > 1 + m ? EXPECT_MISS : EXPECT_SKIP;
+    if (u > WEDGE_U0 + um && u < WEDGE_U1 - um) {
+        if (r * (DEPTH + WEDGE_H) / DEPTH > 1 - m) return EXPECT_SKIP;
+        *zexp = DEPTH + WEDGE_H;
+        return EXPECT_HIT;
+    }
+    if (u < WEDGE_U0 - um || u > WEDGE_U1 + um) {
+        *zexp = DEPTH;
+        return EXPECT_HIT;
+    }
+    return EXPECT_SKIP;
+}
+
+static void test_raised_wedge_offset_exact(void **state)
+{
+    (void)state;
+    fixture f;
+    assert_true(fixture_open_named(&f, DISK_RIB("%s"), "raised", RAISED_SL));
+    exact_scan s;
+    scan_exact(&f, raised_wedge, &s);
+    printf("raised wedge: %d/%d hit, %d at their plane's depth, %d hits off the disk; exact "
+           "cells %ld (offset %ld), boxes %ld, proofs %ld\n", s.hits, s.inside, s.exact,
+           s.outside_hits, s.st.exact_cells, s.st.offset_cells, s.st.boxes, s.st.proofs);
+    assert_all_exact(&s);
+    assert_true(s.st.offset_cells > 0);
+    fixture_close(&f);
+}
+
+static const char *BUMP_SL =
+    "displacement bumponly(float Kb = 0.02)\n"
+    "{\n"
+    "    N = calculatenormal(P + Kb * noise(P * 4) * normalize(N));\n"
+    "}\n";
 
 /* A sphere (radius 1, at depth 3) whose displacement only bends N: every
  * cell is undisplaced, and on a quadric the walk intersects its base
@@ -347,6 +415,8 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_flat_exact_and_wedge_open),
         cmocka_unit_test(test_any_displacement_is_not_undisplaced),
+        cmocka_unit_test(test_varying_displacement_is_not_offset),
+        cmocka_unit_test(test_raised_wedge_offset_exact),
         cmocka_unit_test(test_sphere_bent_normals_exact),
         cmocka_unit_test(test_patch_bent_normals_exact),
         cmocka_unit_test(test_instances_bent_normals_exact),
