@@ -533,17 +533,6 @@ static bool exact_kind(geom_kind k)
     }
 }
 
-/* A cell where the displacement left the base surface as it is
- * (TRACE_BOX_UNDISPLACED): the ray against the base surface exactly, as
- * objects without displacement are (geom_intersect), its intersections
- * nearest first (each query from the last one's t: geom_intersect takes
- * only t beyond tmin) until one falls in the cell: that is the cell's
- * hit; none, and the cell has none. True where the cell is settled so;
- * false (the walk goes on as before) only if a closed form gave more
- * intersections than it can have (issue 24: the nail's disk, a
- * displacement masked to 0 or one that only bends N). moved: the cell is
- * the base moved by a constant (TRACE_BOX_OFFSET: the nail's top, a
- * brick's), intersected as the base with the ray moved back. */
 /* The move of a cell the displacement moved by a constant
  * (TRACE_BOX_OFFSET), in object space: the displaced point less the
  * base's at any point of the cell, here its centre. A pure function of
@@ -580,6 +569,17 @@ static vec3 cell_move(trace_thread *th, const trace_object *obj, const double c[
     return e->back;
 }
 
+/* A cell where the displacement left the base surface as it is
+ * (TRACE_BOX_UNDISPLACED): the ray against the base surface exactly, as
+ * objects without displacement are (geom_intersect), its intersections
+ * nearest first (each query from the last one's t: geom_intersect takes
+ * only t beyond tmin) until one falls in the cell: that is the cell's
+ * hit; none, and the cell has none. True where the cell is settled so;
+ * false (the walk goes on as before) only if a closed form gave more
+ * intersections than it can have (issue 24: the nail's disk, a
+ * displacement masked to 0 or one that only bends N). moved: the cell is
+ * the base moved by a constant (TRACE_BOX_OFFSET: a brick's top, a
+ * tile's), intersected as the base with the ray moved back. */
 static bool exact_cell(walk *w, const double c[4], double tol, bool moved)
 {
     geom_hit h;
