@@ -9,6 +9,7 @@
 #include <fcntl.h>
 #include <netinet/in.h>
 #include <signal.h>
+#include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -354,19 +355,50 @@ void ft_stop_all(void)
     }
 }
 
-int ft_free_port(void)
+/* Whether a loopback TCP port can be bound now (0: any, the kernel's
+ * choice, returned in *got) */
+static bool port_bindable(int port, int *got)
 {
     int s = socket(AF_INET, SOCK_STREAM, 0);
+    if (s < 0) return false;
     struct sockaddr_in a;
     memset(&a, 0, sizeof a);
     a.sin_family = AF_INET;
     a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    a.sin_port = htons((unsigned short)port);
     socklen_t len = sizeof a;
+    bool ok = bind(s, (struct sockaddr *)&a, sizeof a) == 0 &&
+              getsockname(s, (struct sockaddr *)&a, &len) == 0;
+    if (ok && got) *got = ntohs(a.sin_port);
+    close(s);
+    return ok;
+}
+
+/* A free loopback port below the kernel's ephemeral range
+ * (/proc/sys/net/ipv4/ip_local_port_range): a port from that range, free
+ * when asked, can be handed to any program's next connect or listen
+ * before the test's own process binds it (srun's I/O sockets took a
+ * master's port so in CI: "Address already in use"); below it only an
+ * explicit bind takes it. Random candidates, so that tests run side by
+ * side rarely ask for the same one; the kernel's choice where none binds. */
+int ft_free_port(void)
+{
+    int lo = 32768;
+    FILE *f = fopen("/proc/sys/net/ipv4/ip_local_port_range", "r");
+    if (f) {
+        int a, b;
+        if (fscanf(f, "%d %d", &a, &b) == 2 && a > 1024) lo = a;
+        fclose(f);
+    }
+    static unsigned seed;
+    if (!seed) seed = (unsigned)getpid() ^ (unsigned)time(NULL) * 2654435761u;
+    const int base = 10000;
+    for (int i = 0; lo > base + 1000 && i < 64; i++) {
+        int port = base + (int)(rand_r(&seed) % (unsigned)(lo - base));
+        if (port_bindable(port, NULL)) return port;
+    }
     int port = -1;
-    if (s >= 0 && bind(s, (struct sockaddr *)&a, sizeof a) == 0 &&
-        getsockname(s, (struct sockaddr *)&a, &len) == 0)
-        port = ntohs(a.sin_port);
-    if (s >= 0) close(s);
+    if (!port_bindable(0, &port)) return -1;
     return port;
 }
 

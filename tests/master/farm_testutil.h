@@ -81,7 +81,8 @@ bool ft_master_endpoint(const char *log, char *buf, size_t bufsz, double timeout
  * --stats-json), or -1 when the key is missing. */
 long ft_json_number(const char *path, const char *key);
 
-/* A TCP port on 127.0.0.1 that was free a moment ago. */
+/* A TCP port on 127.0.0.1 that was free a moment ago, below the kernel's
+ * ephemeral range (no connect or listen of another program is handed it). */
 int ft_free_port(void);
 
 /* Samples that differ between two EXR files (0: equal), -1 when they
