@@ -254,15 +254,6 @@ typedef enum {
     TRACE_MOVED_OFFSET             /* P moved by a constant */
 } trace_moved;
 
-/* Whether two forms have the same affine part and flags: the same
- * centre, coefficients and error term (the hull aside: every operation
- * recomputes it, rounding outward) */
-static bool same_affine(const aa_form *a, const aa_form *b)
-{
-    return a->x0 == b->x0 && a->err == b->err && a->n == b->n && a->flags == b->flags &&
-           memcmp(a->c, b->c, (size_t)a->n * sizeof a->c[0]) == 0;
-}
-
 /* Whether the shader's form a is the base's form b moved by a constant:
  * the same coefficients and flags, the centre anywhere, and an error term
  * grown by no more than the rounding of that move (2^-40 of the centres:
@@ -275,6 +266,20 @@ static bool offset_affine(const aa_form *a, const aa_form *b)
     return a->n == b->n && a->flags == b->flags && isfinite(a->x0) && a->err >= b->err &&
            a->err - b->err <= TRACE_OFFSET_SLACK * (fabs(a->x0) + fabs(b->x0)) &&
            memcmp(a->c, b->c, (size_t)a->n * sizeof a->c[0]) == 0;
+}
+
+/* What the shader did to the base's P (both as forms, camera space):
+ * moved it by a constant (offset_affine, all three coordinates), and of
+ * that, nothing at all where the centres and error terms are the same
+ * too (the hull aside: every operation recomputes it, rounding outward) */
+static trace_moved moved_by(const aa_form Pc[3], const aa_form P[3])
+{
+    bool same = true;
+    for (int k = 0; k < 3; k++) {
+        if (!offset_affine(&Pc[k], &P[k])) return TRACE_MOVED_OTHER;
+        same = same && Pc[k].x0 == P[k].x0 && Pc[k].err == P[k].err;
+    }
+    return same ? TRACE_MOVED_NOT : TRACE_MOVED_OFFSET;
 }
 
 /* One affine run of the displacement over the cell (of the case the VM's
@@ -310,12 +315,7 @@ static void affine_shade(trace_thread *th, const trace_object *obj, const affine
     } else {
         aa_form Pc[3];
         sl_vm_get_affine(vm, SL_G_P, Pc);
-        if (same && same_affine(&Pc[0], &c->P[0]) && same_affine(&Pc[1], &c->P[1]) &&
-            same_affine(&Pc[2], &c->P[2]))
-            *same = TRACE_MOVED_NOT;
-        else if (same && offset_affine(&Pc[0], &c->P[0]) && offset_affine(&Pc[1], &c->P[1]) &&
-                 offset_affine(&Pc[2], &c->P[2]))
-            *same = TRACE_MOVED_OFFSET;
+        if (same) *same = moved_by(Pc, c->P);
         trace_xform_aa(ctx, &obj->from_camera, Pc, P, true);
     }
 }

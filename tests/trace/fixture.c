@@ -9,6 +9,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "trace/group.h"
+
 bool fixture_open(fixture *f, const char *rib, const fixture_shader *shaders,
                   int nshaders, const job_options *opt, size_t cache_bytes)
 {
@@ -49,6 +51,17 @@ bool fixture_open_named(fixture *f, const char *rib_format, const char *name,
         return false;
     }
     return fixture_open(f, rib, sh, 1, NULL, 0);
+}
+
+int fixture_count_shared(const trace_world *w)
+{
+    int n = 0;
+    for (int i = 0; i < w->nobjects; i++) {
+        const trace_group *g = w->objects[i].group;
+        n += w->objects[i].box_proto != NULL;
+        if (g && g->first_id >= 0) n += g->n - g->nown;
+    }
+    return n;
 }
 
 void fixture_close(fixture *f)

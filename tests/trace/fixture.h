@@ -31,6 +31,11 @@ bool fixture_open_named(fixture *f, const char *rib_format, const char *name,
                         const char *source);
 void fixture_close(fixture *f);
 
+/* The surfaces of the world that use their prototype's boxes: objects
+ * with a box_proto, and the placements of groups that are their
+ * prototype moved (trace/group.h) */
+int fixture_count_shared(const trace_world *w);
+
 /* Renders the whole image into rgba (4 per px) and z with tiles of `tile`
  * pixels, each tile on one of `nthreads` trace_threads in turn (round
  * robin, so threads see tiles in different orders than a single one).

@@ -98,20 +98,6 @@ typedef struct shot {
     int shared;                    /* surfaces using their prototype's boxes */
 } shot;
 
-/* The surfaces of the world that use their prototype's boxes: objects
- * with a box_proto, and the placements of groups that are their
- * prototype moved (trace/group.h). */
-static int count_shared(const trace_world *w)
-{
-    int n = 0;
-    for (int i = 0; i < w->nobjects; i++) {
-        const trace_group *g = w->objects[i].group;
-        n += w->objects[i].box_proto != NULL;
-        if (g && g->first_id >= 0) n += g->n - g->nown;
-    }
-    return n;
-}
-
 static void render(const char *rib, int nobjects, shot *out)
 {
     fixture f;
@@ -131,7 +117,7 @@ static void render(const char *rib, int nobjects, shot *out)
         if (trace_boxcache_lookup(th->cache, i, TRACE_BROOD_NONE, 0, kids) != TRACE_BROOD_NONE)
             out->own_roots++;
     }
-    out->shared = count_shared(w);
+    out->shared = fixture_count_shared(w);
     free(z);
     trace_thread_destroy(&th);
     fixture_close(&f);
@@ -298,7 +284,7 @@ static size_t world_bytes(int n, const char *shader, int *shared, int *placement
     assert_true(fixture_open(&f, rib, sh, 3, NULL, 0));
     size_t after = fixture_heap_bytes();
     const trace_world *w = &f.js->world;
-    *shared = count_shared(w);
+    *shared = fixture_count_shared(w);
     *placements = 0;
     for (int i = 0; i < w->nobjects; i++)
         if (w->objects[i].group) *placements += w->objects[i].group->n;

@@ -28,7 +28,6 @@
 
 #include "fixture.h"
 #include "trace/camera.h"
-#include "trace/group.h"
 #include "trace/render.h"
 
 #define WEDGE_U0 0.13
@@ -390,13 +389,7 @@ static void test_instances_bent_normals_exact(void **state)
     snprintf(rib + len, sizeof rib - (size_t)len, "WorldEnd\n");
     fixture f;
     assert_true(fixture_open_named(&f, rib, "objbump", OBJBUMP_SL));
-    const trace_world *world = &f.js->world;
-    int shared = 0;
-    for (int i = 0; i < world->nobjects; i++) {
-        const trace_group *g = world->objects[i].group;
-        shared += world->objects[i].box_proto != NULL;
-        if (g && g->first_id >= 0) shared += g->n - g->nown;
-    }
+    int shared = fixture_count_shared(&f.js->world);
     exact_scan s;
     scan_exact(&f, sphere_instances, &s);
     printf("instances, bent normals: %d share the prototype's boxes; %d/%d hit, %d at the "
