@@ -538,7 +538,7 @@ static bool exact_kind(geom_kind k)
  * base's at any point of the cell, here its centre. A pure function of
  * object and cell, kept in a direct-mapped per-thread cache as the walls'
  * samples are (every ray that meets the cell asks; one evaluation each
- * cost a brick wall 19 % more dual evaluations) */
+ * cost a brick wall 18 % more dual evaluations) */
 enum { MOVE_CACHE_LOG2 = 10, MOVE_CACHE_ENTRIES = 1 << MOVE_CACHE_LOG2 };
 typedef struct move_entry {
     double r[4];                  /* the cell; r[0] >= r[1]: empty */
