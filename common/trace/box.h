@@ -66,12 +66,19 @@
  * (displace.c, offset_affine): the surface there is the base surface
  * moved, intersected exactly where the base can be (intersect.c) */
 #define TRACE_BOX_OFFSET (1u << 14)
+/* A stagnant box across a proven step: the cases of its seams
+ * (trace_surface_box_cases) gave pairwise disjoint boxes, so wherever two
+ * of them meet inside the cell the surface jumps; not narrowed by them
+ * (TRACE_BOX_UNSPLIT too). Its stagnant children keep the flag and none of
+ * them is re-estimated from samples (intersect.c, "Stagnant boxes") */
+#define TRACE_BOX_STEP (1u << 15)
 
 typedef struct trace_box {
     vec3 lo, hi;
     unsigned flags;          /* AA_DISCONTINUOUS | AA_UNBOUNDED | TRACE_BOX_SAMPLED |
                                 TRACE_BOX_UNSPLIT | TRACE_BOX_SPLIT | TRACE_BOX_LIN |
-                                TRACE_BOX_LAZY | TRACE_BOX_UNDISPLACED | TRACE_BOX_OFFSET */
+                                TRACE_BOX_LAZY | TRACE_BOX_UNDISPLACED | TRACE_BOX_OFFSET |
+                                TRACE_BOX_STEP */
     float bend;              /* how far from linear in (u,v) the surface is over
                                 the box: the affine forms' other terms over
                                 their u and v terms (displace.c); 0: unknown */

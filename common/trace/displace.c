@@ -14,6 +14,7 @@
 #include "trace/normal_memo.h"
 #include "trace/primvar.h"
 
+#include <assert.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <string.h>
@@ -382,18 +383,38 @@ static bool box_has_nan(const trace_box *b)
            isnan(b->hi.y) || isnan(b->hi.z);
 }
 
+/* Whether no point lies in both boxes: on some axis one ends before the
+ * other begins (a NaN side: not apart) */
+static bool boxes_apart(const trace_box *a, const trace_box *b)
+{
+    return a->hi.x < b->lo.x || b->hi.x < a->lo.x || a->hi.y < b->lo.y || b->hi.y < a->lo.y ||
+           a->hi.z < b->lo.z || b->hi.z < a->lo.z;
+}
+
 /* The boxes of the cell's remaining cases (sl_vm_split_next has given
- * the first of them) united into *hull */
+ * the first of them, whose box *hull is) united into *hull; where apart
+ * is given, whether all the cases' boxes are pairwise apart */
 static void union_cases(trace_thread *th, const trace_object *obj, const affine_cell *cell,
-                        trace_box *hull)
+                        trace_box *hull, bool *apart)
 {
     aa_form P[3];
+    trace_box seen[1 << TRACE_SPLIT_OPS];
+    int n = 0;
+    bool all_apart = true;
+    if (apart) seen[n++] = *hull;
     do {
         trace_box b;
         affine_shade(th, obj, cell, P, NULL);
         box_from_affine(P, &b);
+        if (apart) {
+            for (int j = 0; j < n && all_apart; j++)
+                all_apart = boxes_apart(&seen[j], &b);
+            assert(n < (1 << TRACE_SPLIT_OPS));   /* at most 2^TRACE_SPLIT_OPS cases */
+            seen[n++] = b;
+        }
         trace_box_union(hull, &b);
     } while (!th->failed && sl_vm_split_next(th->vm));
+    if (apart) *apart = all_apart;
 }
 
 /* The cell's base surface and the first of its case runs (the VM's
@@ -425,7 +446,8 @@ bool trace_surface_box_cases(trace_thread *th, const trace_object *obj,
         return false;
     }
     bool split = !th->failed && sl_vm_split_next(vm);
-    if (split) union_cases(th, obj, &cell, &hull);
+    bool apart = false;
+    if (split) union_cases(th, obj, &cell, &hull, &apart);
     sl_vm_split_end(vm);
     th->stats.boxes++;
     if (th->failed || !split) return false;
@@ -440,6 +462,10 @@ bool trace_surface_box_cases(trace_thread *th, const trace_object *obj,
         m.hi = v3(-INFINITY, -INFINITY, -INFINITY);
         m.flags &= ~(unsigned)AA_UNBOUNDED;
     } else if (trace_box_extent(&m) > TRACE_SPLIT_GAIN * trace_box_extent(box)) {
+        /* not narrowed; where the cases' boxes are pairwise apart, the
+         * surface jumps wherever two cases meet in the cell (a continuous
+         * one would put their common values in both): a true step */
+        if (apart) box->flags |= TRACE_BOX_STEP;
         return false;
     }
     m.flags |= TRACE_BOX_SPLIT;
@@ -496,7 +522,8 @@ bool trace_surface_box_split(trace_thread *th, const trace_object *obj,
         box_finish(th, box);
         return false;
     }
-    union_cases(th, o, &cell, &hull);
+    bool apart;
+    union_cases(th, o, &cell, &hull, &apart);
     sl_vm_split_end(vm);
     th->stats.boxes++;
     if (th->failed || box_has_nan(&hull)) {
@@ -504,7 +531,8 @@ bool trace_surface_box_split(trace_thread *th, const trace_object *obj,
         trace_surface_box(th, obj, u0, u1, v0, v1, box);
         return false;
     }
-    hull.flags = box_flags(&hull, AA_DISCONTINUOUS) | TRACE_BOX_SPLIT;
+    hull.flags = box_flags(&hull, AA_DISCONTINUOUS) | TRACE_BOX_SPLIT |
+                 (apart ? TRACE_BOX_STEP : 0u);
     hull.bend = 1e30f;                    /* no proofs on a split cell */
     trace_box_no_slab(&hull);
     *box = hull;

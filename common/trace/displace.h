@@ -53,7 +53,10 @@ void trace_camera_normal_aa(aa_context *ctx, const trace_object *obj, const aa_f
  * brick's joint: no displacement, where one run bounds [0, 1] of it).
  * Flagged AA_DISCONTINUOUS, without slab or proofs (bend). False (and *box
  * untouched) when nothing was split: interval arithmetic, no displacement,
- * no such operation. Costs 1 to 8 shader runs, counted as one box; the
+ * no such operation; false too where the cases did not narrow it, and
+ * then *box gains TRACE_BOX_STEP where the cases' boxes are pairwise
+ * apart (a true step: the surface jumps where two cases meet, box.h).
+ * Costs 1 to 8 shader runs, counted as one box; the
  * intersector calls it on discontinuous boxes that stopped shrinking
  * (intersect.c). A pure function of (object, range, *box). */
 bool trace_surface_box_cases(trace_thread *th, const trace_object *obj,

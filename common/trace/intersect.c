@@ -635,6 +635,7 @@ static bool sample_stagnant(trace_thread *th, const trace_object *obj, const dou
                             trace_box *box)
 {
     cell_samples cs;
+    th->stats.samplings++;
     /* the samples lie in the box (object space), so their spread in camera
      * space is at most its diagonal times the object's stretch (scale):
      * a residual above a quarter of that fails the test below, whatever
@@ -704,7 +705,15 @@ static void child_box(walk *w, const trace_box *node, const trace_dlin *lin, con
                         : (node->flags & TRACE_BOX_UNSPLIT) ||
                               !trace_surface_box_cases(th, owner, c[0], c[1], c[2], c[3], kid))
             kid->flags |= TRACE_BOX_UNSPLIT;
-        if (depth >= TRACE_SAMPLE_DEPTH && stagnant(kid, node_extent))
+        /* across a proven step (the cases' boxes apart, box.h), its
+         * stagnant children too: the samples could only find the jump
+         * (or, in a cell beside it that the range has not yet decided,
+         * estimate a box the subdivision will prove) */
+        if (!cases_first && (node->flags & (TRACE_BOX_UNSPLIT | TRACE_BOX_STEP)) ==
+                                (TRACE_BOX_UNSPLIT | TRACE_BOX_STEP))
+            kid->flags |= TRACE_BOX_STEP;
+        if (depth >= TRACE_SAMPLE_DEPTH && stagnant(kid, node_extent) &&
+            !(kid->flags & TRACE_BOX_STEP))
             sample_stagnant(th, owner, c, kid);
     }
     /* an estimate: its children are made from their runs alone */

@@ -33,8 +33,9 @@ typedef struct trace_stats {
                                       ray (depth cap) or not finite: no hit */
     long nodes;                    /* quadtree nodes visited by all rays */
     long limited_rays;             /* walks stopped by the work limit */
-    long sampled_boxes;            /* stagnant boxes replaced by samples
-                                      (intersect.c), counted */
+    long samplings;                /* stagnant boxes sampled (intersect.c,
+                                      sample_stagnant), replaced or not */
+    long sampled_boxes;            /* of them, boxes replaced by the samples */
     long empty_boxes;              /* boxes that were NaN: no point of the
                                       range is defined (pruned, counted) */
     long views_made;               /* mesh pieces made into objects (mesh.c) */

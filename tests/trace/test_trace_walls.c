@@ -10,7 +10,10 @@
  *   - atan(y/x) jumps where x changes sign: hits stay on the object;
  *   - normalize(dPdu) vanishes at a sphere's poles: the root box is finite;
  *   - a raised disc (a nail head) has walls, shaded with the wall's own
- *     normal (radial), not a box face's.
+ *     normal (radial), not a box face's;
+ *   - a step whose two cases' boxes are apart is a proven step
+ *     (TRACE_BOX_STEP): its stagnant boxes are not sampled, its walls are
+ *     drawn; a flagged but continuous hinge is not one.
  */
 #include <math.h>
 #include <setjmp.h>
@@ -22,6 +25,7 @@
 
 #include "fixture.h"
 #include "trace/camera.h"
+#include "trace/displace.h"
 #include "trace/render.h"
 
 static const char *SINMOD_SL =
@@ -65,6 +69,20 @@ static const char *HEAD_SL =
     "    float r = distance(point(s, t, 0), point(0.5, 0.5, 0));\n"
     "    if (r < r0)\n"
     "        P += h * normalize(N);\n"
+    "}\n";
+
+/* a step up by Km across s = 0.5 */
+static const char *RAISED_SL =
+    "displacement raised(float Km = 0.1)\n"
+    "{\n"
+    "    P += Km * step(0.5, s) * normalize(N);\n"
+    "}\n";
+
+/* flagged (a step) but continuous: 0 on both sides of s = 0.5 */
+static const char *HINGE_SL =
+    "displacement hinge(float Km = 0.1)\n"
+    "{\n"
+    "    P += Km * step(0.5, s) * (s - 0.5) * 10 * normalize(N);\n"
     "}\n";
 
 /* a square polygon facing the camera at z = 5, side 2 */
@@ -247,6 +265,84 @@ static void test_wall_normals_are_the_walls(void **state)
     fixture_close(&f);
 }
 
+/* Of a 16 x 16 grid of (u,v) cells, those whose one run is flagged
+ * discontinuous, and of them those whose cases mark a proven step */
+static void count_step_cells(const char *name, const char *src, int *flagged, int *steps)
+{
+    fixture f;
+    assert_true(fixture_open_named(&f, FACING_RIB("%s"), name, src));
+    trace_thread *th = trace_thread_new(&f.js->world);
+    const trace_object *obj = &f.js->world.objects[0];
+    *flagged = *steps = 0;
+    for (int i = 0; i < 16; i++)
+        for (int j = 0; j < 16; j++) {
+            double u0 = i / 16.0, u1 = (i + 1) / 16.0, v0 = j / 16.0, v1 = (j + 1) / 16.0;
+            trace_box b;
+            trace_surface_box(th, obj, u0, u1, v0, v1, &b);
+            assert_false(b.flags & TRACE_BOX_STEP);      /* only the cases mark it */
+            if (!(b.flags & AA_DISCONTINUOUS)) continue;
+            (*flagged)++;
+            trace_surface_box_cases(th, obj, u0, u1, v0, v1, &b);
+            *steps += (b.flags & TRACE_BOX_STEP) != 0;
+        }
+    printf("%-7s %d of 256 cells flagged discontinuous, %d proven steps\n", name, *flagged,
+           *steps);
+    trace_thread_destroy(&th);
+    fixture_close(&f);
+}
+
+/* A step up by 0.1 is proven (its cases' boxes, at 0 and 0.1, are apart)
+ * in the cells across it, which then take no samples anywhere below
+ * them: a grazing render samples no stagnant box, and still draws the
+ * step's wall and both sides. The hinge, 0 on both sides of its step,
+ * is never a proven step: its cases' boxes share the hinge's points. */
+static void test_proven_steps_take_no_samples(void **state)
+{
+    (void)state;
+    int flagged, steps;
+    count_step_cells("raised", RAISED_SL, &flagged, &steps);
+    assert_true(flagged > 0);
+    assert_int_equal(steps, flagged);
+    count_step_cells("hinge", HINGE_SL, &flagged, &steps);
+    assert_true(flagged > 0);
+    assert_int_equal(steps, 0);
+
+    const char *rib = "Format 96 72 1\nProjection \"perspective\" \"fov\" [40]\n"
+                      "Translate 0 -0.2 3\nRotate -50 1 0 0\nRotate 20 0 0 1\nWorldBegin\n"
+                      "Displacement \"raised\"\n"
+                      "Polygon \"P\" [-1 -1 0  1 -1 0  1 1 0  -1 1 0]\nWorldEnd\n";
+    fixture f;
+    fixture_shader sh[] = {{"raised", RAISED_SL}};
+    assert_true(fixture_open(&f, rib, sh, 1, NULL, 0));
+    trace_thread *th = trace_thread_new(&f.js->world);
+    /* one ray per pixel centre; the hits' heights above the polygon's
+     * plane (along N, +-z in object space): the plane's and the raised
+     * plane's */
+    const trace_object *obj = &f.js->world.objects[0];
+    int low = 0, high = 0, hits = 0;
+    for (int y = 0; y < 72; y++)
+        for (int x = 0; x < 96; x++) {
+            double rgb[3], a, z;
+            trace_render_sample(f.js->renderer, th, x + 0.5, y + 0.5, rgb, &a, &z);
+            if (!(a > 0)) continue;
+            hits++;
+            trace_ray ray;
+            trace_camera_ray(&f.js->world.camera, x + 0.5, y + 0.5, &ray);
+            vec3 o = mat4_xform_point(&obj->from_camera, trace_ray_at(&ray, z / ray.d.z));
+            low += fabs(o.z) < 0.005;
+            high += fabs(fabs(o.z) - 0.1) < 0.005;
+        }
+    printf("raised grazing: %d hits, %d on the plane, %d raised; walls %ld, samplings %ld, "
+           "boxes/ray %.2f\n", hits, low, high, th->stats.wall_leaves, th->stats.samplings,
+           (double)th->stats.boxes / (double)th->stats.primary_rays);
+    assert_int_equal(th->stats.samplings, 0);
+    assert_int_equal(th->stats.sampled_boxes, 0);
+    assert_true(th->stats.wall_leaves > 0);
+    assert_true(low > hits / 4 && high > hits / 4);
+    trace_thread_destroy(&th);
+    fixture_close(&f);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -255,6 +351,7 @@ int main(void)
         cmocka_unit_test(test_atan_jump_stays_on_the_object),
         cmocka_unit_test(test_normalize_at_the_poles_is_bounded),
         cmocka_unit_test(test_wall_normals_are_the_walls),
+        cmocka_unit_test(test_proven_steps_take_no_samples),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
