@@ -351,7 +351,20 @@ static void box_linear(const aa_context *ctx, const aa_form P[3], trace_box *out
     out->flags |= TRACE_BOX_LIN;
 }
 
-/* lin: where given, the box's linear bound (box_linear) */
+/* The box of a plain run (one case: nothing split) from its forms P and
+ * what it did to the base (affine_shade); lin: where given, the box's
+ * linear bound (box_linear, from th->ctx as the run left it) */
+static void box_of_run(trace_thread *th, const trace_object *obj, const aa_form P[3],
+                       trace_moved same, trace_box *out, trace_lin *lin)
+{
+    box_from_affine(P, out);
+    if (obj->displacement && !out->flags) {
+        if (same == TRACE_MOVED_NOT) out->flags |= TRACE_BOX_UNDISPLACED;
+        else if (same == TRACE_MOVED_OFFSET) out->flags |= TRACE_BOX_OFFSET;
+    }
+    if (lin) box_linear(&th->ctx, P, out, lin);
+}
+
 static void box_affine(trace_thread *th, const trace_object *obj,
                        double u0, double u1, double v0, double v1, trace_box *out,
                        trace_lin *lin)
@@ -359,12 +372,7 @@ static void box_affine(trace_thread *th, const trace_object *obj,
     aa_form P[3];
     trace_moved same;
     affine_run(th, obj, u0, u1, v0, v1, P, &same);
-    box_from_affine(P, out);
-    if (obj->displacement && !out->flags) {
-        if (same == TRACE_MOVED_NOT) out->flags |= TRACE_BOX_UNDISPLACED;
-        else if (same == TRACE_MOVED_OFFSET) out->flags |= TRACE_BOX_OFFSET;
-    }
-    if (lin) box_linear(&th->ctx, P, out, lin);
+    box_of_run(th, obj, P, same, out, lin);
 }
 
 /* At most this many operations split per box: 2^TRACE_SPLIT_OPS runs */
@@ -418,15 +426,18 @@ static void union_cases(trace_thread *th, const trace_object *obj, const affine_
 }
 
 /* The cell's base surface and the first of its case runs (the VM's
- * splits begun; the caller ends them): its box in *hull */
+ * splits begun; the caller ends them): its box in *hull; where P is
+ * given, the run's forms there and what it did to the base in *same
+ * (the plain run's, where it split nothing) */
 static void first_case(trace_thread *th, const trace_object *obj, double u0, double u1,
-                       double v0, double v1, affine_cell *cell, trace_box *hull)
+                       double v0, double v1, affine_cell *cell, trace_box *hull,
+                       aa_form P[3], trace_moved *same)
 {
-    aa_form P[3];
+    aa_form Q[3];
     affine_geometry(th, obj, u0, u1, v0, v1, cell);
     sl_vm_split_begin(th->vm, TRACE_SPLIT_OPS);
-    affine_shade(th, obj, cell, P, NULL);
-    box_from_affine(P, hull);
+    affine_shade(th, obj, cell, P ? P : Q, same);
+    box_from_affine(P ? P : Q, hull);
 }
 
 bool trace_surface_box_cases(trace_thread *th, const trace_object *obj,
@@ -437,7 +448,7 @@ bool trace_surface_box_cases(trace_thread *th, const trace_object *obj,
     sl_vm *vm = th->vm;
     trace_box hull;
     affine_cell cell;
-    first_case(th, obj, u0, u1, v0, v1, &cell, &hull);
+    first_case(th, obj, u0, u1, v0, v1, &cell, &hull, NULL, NULL);
     if (sl_vm_split_full(vm)) {
         /* more seams than cases: the rest would stay as wide as one run
          * makes them: not worth the runs */
@@ -492,22 +503,26 @@ static void box_finish(trace_thread *th, trace_box *out)
 }
 
 bool trace_surface_box_split(trace_thread *th, const trace_object *obj,
-                             double u0, double u1, double v0, double v1, trace_box *box)
+                             double u0, double u1, double v0, double v1, trace_box *box,
+                             trace_lin *lin)
 {
     const trace_object *o = trace_box_owner(obj);
     if (th->world->options.arith == TRACE_ARITH_INTERVAL || !o->displacement) {
-        trace_surface_box(th, obj, u0, u1, v0, v1, box);
+        trace_surface_box_lin(th, obj, u0, u1, v0, v1, box, lin);
         return false;
     }
     sl_vm *vm = th->vm;
     trace_box hull;
     affine_cell cell;
-    first_case(th, o, u0, u1, v0, v1, &cell, &hull);
+    aa_form P[3];
+    trace_moved same;
+    first_case(th, o, u0, u1, v0, v1, &cell, &hull, P, &same);
     bool full = sl_vm_split_full(vm);
     if (!full && (th->failed || !sl_vm_split_next(vm))) {
-        /* nothing split (or failed): the run was box_affine's own */
+        /* nothing split (or failed): the run was box_affine's own, and so
+         * is the box (its flags and linear bound too) */
         sl_vm_split_end(vm);
-        *box = hull;
+        box_of_run(th, o, P, same, box, lin);
         box_finish(th, box);
         return false;
     }
@@ -516,9 +531,8 @@ bool trace_surface_box_split(trace_thread *th, const trace_object *obj,
          * (box_affine's run on the same cell) */
         sl_vm_split_end(vm);
         th->stats.boxes++;
-        aa_form P[3];
-        affine_shade(th, o, &cell, P, NULL);
-        box_from_affine(P, box);
+        affine_shade(th, o, &cell, P, &same);
+        box_of_run(th, o, P, same, box, lin);
         box_finish(th, box);
         return false;
     }
@@ -528,7 +542,7 @@ bool trace_surface_box_split(trace_thread *th, const trace_object *obj,
     th->stats.boxes++;
     if (th->failed || box_has_nan(&hull)) {
         /* a NaN side (no surface where a case runs): the box as usual */
-        trace_surface_box(th, obj, u0, u1, v0, v1, box);
+        trace_surface_box_lin(th, obj, u0, u1, v0, v1, box, lin);
         return false;
     }
     hull.flags = box_flags(&hull, AA_DISCONTINUOUS) | TRACE_BOX_SPLIT |

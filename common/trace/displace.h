@@ -65,15 +65,18 @@ bool trace_surface_box_cases(trace_thread *th, const trace_object *obj,
 /* The box of the range, its cases first: where the children of a box the
  * cases narrowed (TRACE_BOX_SPLIT) still lie across its seam, the plain
  * run would only find them stagnant again. One run with case splits: when
- * it split nothing it is trace_surface_box's own run, and *box is what
- * that gives (false); else the other cases run and *box is the hull of
- * their boxes, flagged AA_DISCONTINUOUS and TRACE_BOX_SPLIT, without slab
- * or proofs (true). Where the seams overflow the cases, or a case has a
- * NaN side, *box is trace_surface_box's (false; the lost runs counted as
- * a box). The hull encloses the surface as trace_surface_box_cases's
- * does (every point is in one case). A pure function of (object, range). */
+ * it split nothing it is trace_surface_box_lin's own run, and *box and
+ * *lin are what that gives (false); else the other cases run and *box is
+ * the hull of their boxes, flagged AA_DISCONTINUOUS and TRACE_BOX_SPLIT
+ * (and TRACE_BOX_STEP where their boxes are pairwise apart), without
+ * slab, proofs or linear bound (true). Where the seams overflow the
+ * cases, or a case has a NaN side, *box and *lin are
+ * trace_surface_box_lin's (false; the lost runs counted as a box). The
+ * hull encloses the surface as trace_surface_box_cases's does (every
+ * point is in one case). A pure function of (object, range). */
 bool trace_surface_box_split(trace_thread *th, const trace_object *obj,
-                             double u0, double u1, double v0, double v1, trace_box *box);
+                             double u0, double u1, double v0, double v1, trace_box *box,
+                             trace_lin *lin);
 
 /* N is constant over the object (its d/du, d/dv are 0): disks, and
  * polygons unless they carry interpolated vertex normals

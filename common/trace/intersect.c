@@ -694,7 +694,7 @@ static void child_box(walk *w, const trace_box *node, const trace_dlin *lin, con
      * (the plain run of one across the same seam is stagnant again) */
     bool cases_first = (node->flags & TRACE_BOX_SPLIT) != 0, split = false;
     if (cases_first)
-        split = trace_surface_box_split(th, owner, c[0], c[1], c[2], c[3], kid);
+        split = trace_surface_box_split(th, owner, c[0], c[1], c[2], c[3], kid, kid_lin);
     else
         trace_surface_box_lin(th, owner, c[0], c[1], c[2], c[3], kid, kid_lin);
     if (stagnant(kid, node_extent)) {

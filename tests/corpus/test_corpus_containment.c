@@ -58,6 +58,8 @@ typedef struct tally {
     long restricted_points;         /* checks against restricted bounds (box.h) */
     long split;                     /* boxes narrowed by case splits (trace_surface_box_cases) */
     long split_first;               /* boxes of the cases first (trace_surface_box_split) */
+    long split_plain;               /* of its calls, those that split nothing */
+    long plain_differ;              /* of them, boxes or linear bounds not the plain run's */
     long undefined;                 /* NaN points on a base's axis (check_point) */
     double worst;                   /* largest excess outside the box, object units */
     double unb_side;                /* smallest range (larger side) with an unbounded box */
@@ -232,6 +234,15 @@ static double side(corpus_rng *r)
     return pow(10.0, -3.0 * corpus_rng_uniform(r));
 }
 
+/* The same box, field by field (bit for bit; NaN sides equal) */
+static bool same_box(const trace_box *a, const trace_box *b)
+{
+    return memcmp(&a->lo, &b->lo, sizeof a->lo) == 0 && memcmp(&a->hi, &b->hi, sizeof a->hi) == 0 &&
+           a->flags == b->flags && memcmp(&a->bend, &b->bend, sizeof a->bend) == 0 &&
+           memcmp(a->sn, b->sn, sizeof a->sn) == 0 && memcmp(&a->slo, &b->slo, sizeof a->slo) == 0 &&
+           memcmp(&a->shi, &b->shi, sizeof a->shi) == 0;
+}
+
 static void run_cases(trace_thread *th, const trace_world *w, long ncases, uint64_t seed,
                       tally *t)
 {
@@ -262,12 +273,23 @@ static void run_cases(trace_thread *th, const trace_world *w, long ncases, uint6
             t->split++;
         take_error(th, t, &t->box_errors);
         /* and as the children of such a box run theirs first
-         * (trace_surface_box_split): the points in the hull of the cases */
+         * (trace_surface_box_split, on any cell: the walk runs it on every
+         * child of a split box): the points in the hull of the cases */
         trace_box b2, *split = NULL;
-        if ((b.flags & AA_DISCONTINUOUS) && trace_surface_box_split(th, obj, u0, u1, v0, v1, &b2) &&
-            !(b2.flags & AA_UNBOUNDED)) {
-            split = &b2;
-            t->split_first++;
+        trace_lin lin2;
+        if (trace_surface_box_split(th, obj, u0, u1, v0, v1, &b2, &lin2)) {
+            if (!(b2.flags & AA_UNBOUNDED)) {
+                split = &b2;
+                t->split_first++;
+            }
+        } else if (!th->failed) {
+            /* nothing split: the plain run's box and linear bound */
+            trace_box b3;
+            trace_lin lin3;
+            trace_surface_box_lin(th, obj, u0, u1, v0, v1, &b3, &lin3);
+            t->split_plain++;
+            t->plain_differ += !same_box(&b2, &b3) ||
+                               ((b3.flags & TRACE_BOX_LIN) && memcmp(&lin2, &lin3, sizeof lin3) != 0);
         }
         take_error(th, t, &t->box_errors);
         t->cases++;
@@ -335,7 +357,8 @@ static void run_surface(corpus_surface s)
             memset(&t, 0, sizeof t);
             t.unb_side = INFINITY;
             run_cases(th, &f.js->world, ncases, 0x5eed0000u + (uint64_t)i * 16 + (uint64_t)s, &t);
-            bool bad = t.violations || t.unbounded || t.box_errors || t.point_errors;
+            bool bad = t.violations || t.unbounded || t.box_errors || t.point_errors ||
+                       t.plain_differ;
             printf("%-20s %-9s %-8s %6ld %7ld %7ld %6ld %8ld %5ld %5ld %9.2e %9.2e%s\n",
                    C.shaders[i].name, corpus_surface_name(s), trace_arith_name(ariths[a]),
                    t.cases, t.points, t.violations, t.unbounded, t.unbounded_wide,
@@ -349,6 +372,8 @@ static void run_surface(corpus_surface s)
             total.restricted_points += t.restricted_points;
             total.split += t.split;
             total.split_first += t.split_first;
+            total.split_plain += t.split_plain;
+            total.plain_differ += t.plain_differ;
             total.violations += t.violations;
             total.unbounded += t.unbounded;
             total.unbounded_wide += t.unbounded_wide;
@@ -361,13 +386,14 @@ static void run_surface(corpus_surface s)
         }
     printf("%s total: %ld cases, %ld points (%ld also against a slab, %ld checks against "
            "restricted bounds), %ld boxes narrowed by "
-           "case splits (%ld of the cases first), %ld violations (worst %.2e), %ld unbounded boxes "
+           "case splits (%ld of the cases first; %ld split nothing, %ld of them not the plain "
+           "box), %ld violations (worst %.2e), %ld unbounded boxes "
            "(+ %ld of ranges wider than 1/32, counted), %ld/%ld shader errors (box/point), "
            "%ld failing rows, %ld scenes not opened, %ld undefined points (NaN on a "
            "base's axis)\n",
            corpus_surface_name(s), total.cases, total.points, total.slab_points,
            total.restricted_points, total.split,
-           total.split_first, total.violations, total.worst,
+           total.split_first, total.split_plain, total.plain_differ, total.violations, total.worst,
            total.unbounded, total.unbounded_wide, total.box_errors, total.point_errors,
            bad_rows, failed_opens, total.undefined);
     fflush(stdout);
@@ -378,6 +404,7 @@ static void run_surface(corpus_surface s)
     const char *only = getenv("AAFARM_CORPUS_ONLY");
     if (!only || !*only) assert_true(total.split > 0);   /* the split path is checked */
     assert_int_equal(total.violations, 0);
+    assert_int_equal(total.plain_differ, 0);
     assert_int_equal(total.unbounded, 0);
     assert_int_equal(total.box_errors + total.point_errors, 0);
 }
