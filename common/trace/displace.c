@@ -335,20 +335,25 @@ static void affine_run(trace_thread *th, const trace_object *obj,
  * 0 and 1, where the context gave u and v their own symbols) and the rest
  * as a radius, rounded up, as floats (trace_lin_set). None for a form
  * that is unbounded or not finite. */
-static void box_linear(const aa_context *ctx, const aa_form P[3], trace_box *out, trace_lin *lin)
+static bool run_linear(const aa_context *ctx, const aa_form P[3], trace_lin *lin)
 {
     memset(lin, 0, sizeof *lin);
-    if (ctx->capacity < 2) return;
+    if (ctx->capacity < 2) return false;
     for (int k = 0; k < 3; k++) {
         const aa_form *f = &P[k];
-        if (f->flags & AA_UNBOUNDED) return;
+        if (f->flags & AA_UNBOUNDED) return false;
         double rad = f->err;
         for (int i = 2; i < f->n; i++) rad = fp_add_up(rad, fabs(f->c[i]));
         double lu = f->n > 0 ? f->c[0] : 0.0, lv = f->n > 1 ? f->c[1] : 0.0;
         if (!isfinite(f->x0) || !isfinite(rad) || !trace_lin_set(lin, k, f->x0, lu, lv, rad))
-            return;
+            return false;
     }
-    out->flags |= TRACE_BOX_LIN;
+    return true;
+}
+
+static void box_linear(const aa_context *ctx, const aa_form P[3], trace_box *out, trace_lin *lin)
+{
+    if (run_linear(ctx, P, lin)) out->flags |= TRACE_BOX_LIN;
 }
 
 /* The box of a plain run (one case: nothing split) from its forms P and
@@ -399,56 +404,117 @@ static bool boxes_apart(const trace_box *a, const trace_box *b)
            a->hi.z < b->lo.z || b->hi.z < a->lo.z;
 }
 
+/* The cases of a cell, one by one: their boxes and linear bounds
+ * (run_linear), from which they are judged apart (a proven step) and one
+ * linear bound made that holds them all (cases_linear) */
+typedef struct case_set {
+    int n;
+    bool lins;                            /* every case has its linear bound */
+    trace_box box[1 << TRACE_SPLIT_OPS];
+    trace_lin lin[1 << TRACE_SPLIT_OPS];
+} case_set;
+
+static void case_add(case_set *cs, const aa_context *ctx, const aa_form P[3], const trace_box *b)
+{
+    assert(cs->n < (1 << TRACE_SPLIT_OPS));    /* at most 2^TRACE_SPLIT_OPS cases */
+    if (cs->n == 0) cs->lins = true;
+    cs->box[cs->n] = *b;
+    cs->lins = cs->lins && run_linear(ctx, P, &cs->lin[cs->n]);
+    cs->n++;
+}
+
+/* Whether the cases' boxes are pairwise apart */
+static bool cases_apart(const case_set *cs)
+{
+    for (int i = 0; i < cs->n; i++)
+        for (int j = i + 1; j < cs->n; j++)
+            if (!boxes_apart(&cs->box[i], &cs->box[j])) return false;
+    return true;
+}
+
+/* One linear bound holding every case's: per coordinate the middles of
+ * the cases' centres, u and v terms, and the largest of |x_j - x| +
+ * |u_j - u| + |v_j - v| + r_j (eu, ev in [-1, 1]), rounded up, so that a
+ * point within case j's bound is within it. False where a case has none
+ * or it does not fit the floats. */
+static bool cases_linear(const case_set *cs, trace_lin *lin)
+{
+    if (cs->n == 0 || !cs->lins) return false;
+    for (int k = 0; k < 3; k++) {
+        double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+        for (int j = 0; j < cs->n; j++) {
+            const double t[3] = {cs->lin[j].x[k], cs->lin[j].u[k], cs->lin[j].v[k]};
+            for (int a = 0; a < 3; a++) {
+                lo[a] = fmin(lo[a], t[a]);
+                hi[a] = fmax(hi[a], t[a]);
+            }
+        }
+        double m[3], r = 0.0;
+        for (int a = 0; a < 3; a++) m[a] = 0.5 * lo[a] + 0.5 * hi[a];
+        for (int j = 0; j < cs->n; j++) {
+            double e = fp_add_up(fp_add_up(trace_abs_diff_up(cs->lin[j].x[k], m[0]),
+                                           trace_abs_diff_up(cs->lin[j].u[k], m[1])),
+                                 fp_add_up(trace_abs_diff_up(cs->lin[j].v[k], m[2]),
+                                           (double)cs->lin[j].r[k]));
+            r = fmax(r, e);
+        }
+        if (!isfinite(r) || !trace_lin_set(lin, k, m[0], m[1], m[2], r)) return false;
+    }
+    return true;
+}
+
+/* The sum of a linear bound's radii (how loose it is) */
+static double lin_radius(const trace_lin *l)
+{
+    return (double)l->r[0] + (double)l->r[1] + (double)l->r[2];
+}
+
 /* The boxes of the cell's remaining cases (sl_vm_split_next has given
- * the first of them, whose box *hull is) united into *hull; where apart
- * is given, whether all the cases' boxes are pairwise apart */
+ * the first of them, whose box *hull is) united into *hull; where cs is
+ * given, each added to it */
 static void union_cases(trace_thread *th, const trace_object *obj, const affine_cell *cell,
-                        trace_box *hull, bool *apart)
+                        trace_box *hull, case_set *cs)
 {
     aa_form P[3];
-    trace_box seen[1 << TRACE_SPLIT_OPS];
-    int n = 0;
-    bool all_apart = true;
-    if (apart) seen[n++] = *hull;
     do {
         trace_box b;
         affine_shade(th, obj, cell, P, NULL);
         box_from_affine(P, &b);
-        if (apart) {
-            for (int j = 0; j < n && all_apart; j++)
-                all_apart = boxes_apart(&seen[j], &b);
-            assert(n < (1 << TRACE_SPLIT_OPS));   /* at most 2^TRACE_SPLIT_OPS cases */
-            seen[n++] = b;
-        }
+        if (cs) case_add(cs, &th->ctx, P, &b);
         trace_box_union(hull, &b);
     } while (!th->failed && sl_vm_split_next(th->vm));
-    if (apart) *apart = all_apart;
 }
 
 /* The cell's base surface and the first of its case runs (the VM's
- * splits begun; the caller ends them): its box in *hull; where P is
- * given, the run's forms there and what it did to the base in *same
- * (the plain run's, where it split nothing) */
+ * splits begun; the caller ends them): its box in *hull, and in cs (a new
+ * set) where given; where P is given, the run's forms there and what it
+ * did to the base in *same (the plain run's, where it split nothing) */
 static void first_case(trace_thread *th, const trace_object *obj, double u0, double u1,
                        double v0, double v1, affine_cell *cell, trace_box *hull,
-                       aa_form P[3], trace_moved *same)
+                       aa_form P[3], trace_moved *same, case_set *cs)
 {
     aa_form Q[3];
     affine_geometry(th, obj, u0, u1, v0, v1, cell);
     sl_vm_split_begin(th->vm, TRACE_SPLIT_OPS);
     affine_shade(th, obj, cell, P ? P : Q, same);
     box_from_affine(P ? P : Q, hull);
+    if (cs) {
+        cs->n = 0;
+        case_add(cs, &th->ctx, P ? P : Q, hull);
+    }
 }
 
 bool trace_surface_box_cases(trace_thread *th, const trace_object *obj,
-                             double u0, double u1, double v0, double v1, trace_box *box)
+                             double u0, double u1, double v0, double v1, trace_box *box,
+                             trace_lin *lin)
 {
     obj = trace_box_owner(obj);
     if (th->world->options.arith == TRACE_ARITH_INTERVAL || !obj->displacement) return false;
     sl_vm *vm = th->vm;
     trace_box hull;
     affine_cell cell;
-    first_case(th, obj, u0, u1, v0, v1, &cell, &hull, NULL, NULL);
+    case_set cs;
+    first_case(th, obj, u0, u1, v0, v1, &cell, &hull, NULL, NULL, &cs);
     if (sl_vm_split_full(vm)) {
         /* more seams than cases: the rest would stay as wide as one run
          * makes them: not worth the runs */
@@ -457,8 +523,7 @@ bool trace_surface_box_cases(trace_thread *th, const trace_object *obj,
         return false;
     }
     bool split = !th->failed && sl_vm_split_next(vm);
-    bool apart = false;
-    if (split) union_cases(th, obj, &cell, &hull, &apart);
+    if (split) union_cases(th, obj, &cell, &hull, &cs);
     sl_vm_split_end(vm);
     th->stats.boxes++;
     if (th->failed || !split) return false;
@@ -476,8 +541,15 @@ bool trace_surface_box_cases(trace_thread *th, const trace_object *obj,
         /* not narrowed; where the cases' boxes are pairwise apart, the
          * surface jumps wherever two cases meet in the cell (a continuous
          * one would put their common values in both): a true step */
-        if (apart) box->flags |= TRACE_BOX_STEP;
+        if (cases_apart(&cs)) box->flags |= TRACE_BOX_STEP;
         return false;
+    }
+    /* the cases' linear bound where it is tighter than the box's own */
+    trace_lin cl;
+    if (lin && cases_linear(&cs, &cl) &&
+        (!(box->flags & TRACE_BOX_LIN) || lin_radius(&cl) < lin_radius(lin))) {
+        *lin = cl;
+        m.flags |= TRACE_BOX_LIN;
     }
     m.flags |= TRACE_BOX_SPLIT;
     m.bend = 1e30f;                       /* no proofs on a split cell */
@@ -516,7 +588,8 @@ bool trace_surface_box_split(trace_thread *th, const trace_object *obj,
     affine_cell cell;
     aa_form P[3];
     trace_moved same;
-    first_case(th, o, u0, u1, v0, v1, &cell, &hull, P, &same);
+    case_set cs;
+    first_case(th, o, u0, u1, v0, v1, &cell, &hull, P, &same, &cs);
     bool full = sl_vm_split_full(vm);
     if (!full && (th->failed || !sl_vm_split_next(vm))) {
         /* nothing split (or failed): the run was box_affine's own, and so
@@ -536,8 +609,7 @@ bool trace_surface_box_split(trace_thread *th, const trace_object *obj,
         box_finish(th, box);
         return false;
     }
-    bool apart;
-    union_cases(th, o, &cell, &hull, &apart);
+    union_cases(th, o, &cell, &hull, &cs);
     sl_vm_split_end(vm);
     th->stats.boxes++;
     if (th->failed || box_has_nan(&hull)) {
@@ -546,7 +618,9 @@ bool trace_surface_box_split(trace_thread *th, const trace_object *obj,
         return false;
     }
     hull.flags = box_flags(&hull, AA_DISCONTINUOUS) | TRACE_BOX_SPLIT |
-                 (apart ? TRACE_BOX_STEP : 0u);
+                 (cases_apart(&cs) ? TRACE_BOX_STEP : 0u);
+    /* one linear bound for all the cases: its children can be lazy */
+    if (lin && cases_linear(&cs, lin)) hull.flags |= TRACE_BOX_LIN;
     hull.bend = 1e30f;                    /* no proofs on a split cell */
     trace_box_no_slab(&hull);
     *box = hull;

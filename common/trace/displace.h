@@ -56,11 +56,15 @@ void trace_camera_normal_aa(aa_context *ctx, const trace_object *obj, const aa_f
  * no such operation; false too where the cases did not narrow it, and
  * then *box gains TRACE_BOX_STEP where the cases' boxes are pairwise
  * apart (a true step: the surface jumps where two cases meet, box.h).
+ * Where lin is given (the box's linear bound, TRACE_BOX_LIN on *box if
+ * it has one) and the box is narrowed, *lin becomes the cases' own
+ * bound (one that holds every case's) where that is tighter.
  * Costs 1 to 8 shader runs, counted as one box; the
  * intersector calls it on discontinuous boxes that stopped shrinking
  * (intersect.c). A pure function of (object, range, *box). */
 bool trace_surface_box_cases(trace_thread *th, const trace_object *obj,
-                             double u0, double u1, double v0, double v1, trace_box *box);
+                             double u0, double u1, double v0, double v1, trace_box *box,
+                             trace_lin *lin);
 
 /* The box of the range, its cases first: where the children of a box the
  * cases narrowed (TRACE_BOX_SPLIT) still lie across its seam, the plain
@@ -69,7 +73,8 @@ bool trace_surface_box_cases(trace_thread *th, const trace_object *obj,
  * *lin are what that gives (false); else the other cases run and *box is
  * the hull of their boxes, flagged AA_DISCONTINUOUS and TRACE_BOX_SPLIT
  * (and TRACE_BOX_STEP where their boxes are pairwise apart), without
- * slab, proofs or linear bound (true). Where the seams overflow the
+ * slab or proofs, with a linear bound in *lin that holds every case's
+ * (TRACE_BOX_LIN, where all have one; lin may be NULL) (true). Where the seams overflow the
  * cases, or a case has a NaN side, *box and *lin are
  * trace_surface_box_lin's (false; the lost runs counted as a box). The
  * hull encloses the surface as trace_surface_box_cases's does (every

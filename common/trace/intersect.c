@@ -703,7 +703,8 @@ static void child_box(walk *w, const trace_box *node, const trace_dlin *lin, con
          * seams overflow the cases); with its cases run first, not again */
         if (cases_first ? !split
                         : (node->flags & TRACE_BOX_UNSPLIT) ||
-                              !trace_surface_box_cases(th, owner, c[0], c[1], c[2], c[3], kid))
+                              !trace_surface_box_cases(th, owner, c[0], c[1], c[2], c[3], kid,
+                                                       kid_lin))
             kid->flags |= TRACE_BOX_UNSPLIT;
         /* across a proven step (the cases' boxes apart, box.h), its
          * stagnant children too: the samples could only find the jump

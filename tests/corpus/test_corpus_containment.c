@@ -58,6 +58,7 @@ typedef struct tally {
     long restricted_points;         /* checks against restricted bounds (box.h) */
     long split;                     /* boxes narrowed by case splits (trace_surface_box_cases) */
     long split_first;               /* boxes of the cases first (trace_surface_box_split) */
+    long split_lin;                 /* of them, with a linear bound for all the cases */
     long split_plain;               /* of its calls, those that split nothing */
     long plain_differ;              /* of them, boxes or linear bounds not the plain run's */
     long undefined;                 /* NaN points on a base's axis (check_point) */
@@ -129,8 +130,8 @@ static double restricted_excess(const trace_box *b, const trace_lin *lin, const 
 }
 
 static void check_point(trace_thread *th, const trace_object *obj, const trace_box *b,
-                        const trace_lin *lin, const trace_box *b2, const double r[4], double u,
-                        double v, tally *t)
+                        const trace_lin *lin, const trace_box *b2, const trace_lin *lin2,
+                        const double r[4], double u, double v, tally *t)
 {
     if (!geom_uv_inside(&obj->surf, u, v)) return;     /* not on the polygon */
     trace_surface_point sp;
@@ -147,10 +148,12 @@ static void check_point(trace_thread *th, const trace_object *obj, const trace_b
         e = fmax(e, excess(s, b->slo, b->shi, 2 * slack));
     }
     e = fmax(e, restricted_excess(b, lin, r, u, v, p, slack, t));
-    if (b2)                               /* the box of the cases first (no slab) */
+    if (b2) {                             /* the box of the cases first (no slab) */
         e = fmax(e, fmax(excess(p.x, b2->lo.x, b2->hi.x, slack),
                          fmax(excess(p.y, b2->lo.y, b2->hi.y, slack),
                               excess(p.z, b2->lo.z, b2->hi.z, slack))));
+        e = fmax(e, restricted_excess(b2, lin2, r, u, v, p, slack, t));   /* all the cases' */
+    }
     t->points++;
     if (isnan(p.x) || isnan(p.y) || isnan(p.z)) {
         /* the shader's own 0/0 on the z axis of a surface of revolution
@@ -269,7 +272,7 @@ static void run_cases(trace_thread *th, const trace_world *w, long ncases, uint6
         /* a discontinuous box, narrowed by the cases of its seams as the
          * intersector narrows those that stop shrinking (issue 24): the
          * points must lie in the narrowed box */
-        if ((b.flags & AA_DISCONTINUOUS) && trace_surface_box_cases(th, obj, u0, u1, v0, v1, &b))
+        if ((b.flags & AA_DISCONTINUOUS) && trace_surface_box_cases(th, obj, u0, u1, v0, v1, &b, &lin))
             t->split++;
         take_error(th, t, &t->box_errors);
         /* and as the children of such a box run theirs first
@@ -281,6 +284,7 @@ static void run_cases(trace_thread *th, const trace_world *w, long ncases, uint6
             if (!(b2.flags & AA_UNBOUNDED)) {
                 split = &b2;
                 t->split_first++;
+                t->split_lin += (b2.flags & TRACE_BOX_LIN) != 0;
             }
         } else if (!th->failed) {
             /* nothing split: the plain run's box and linear bound */
@@ -315,18 +319,18 @@ static void run_cases(trace_thread *th, const trace_world *w, long ncases, uint6
         double r[4] = {u0, u1, v0, v1};
         for (int j = 0; j < GRID; j++)
             for (int i = 0; i < GRID; i++)
-                check_point(th, obj, &b, &lin, split, r, u0 + (u1 - u0) * i / (GRID - 1),
+                check_point(th, obj, &b, &lin, split, &lin2, r, u0 + (u1 - u0) * i / (GRID - 1),
                             v0 + (v1 - v0) * j / (GRID - 1), t);
         /* the middle lines, where two or four child cells meet */
         for (int i = 0; i < GRID; i++) {
             double um = 0.5 * (u0 + u1), vm = 0.5 * (v0 + v1);
-            check_point(th, obj, &b, &lin, split, r, um, v0 + (v1 - v0) * i / (GRID - 1), t);
-            check_point(th, obj, &b, &lin, split, r, u0 + (u1 - u0) * i / (GRID - 1), vm, t);
+            check_point(th, obj, &b, &lin, split, &lin2, r, um, v0 + (v1 - v0) * i / (GRID - 1), t);
+            check_point(th, obj, &b, &lin, split, &lin2, r, u0 + (u1 - u0) * i / (GRID - 1), vm, t);
         }
         for (int i = 0; i < RANDOM_POINTS; i++) {
             double u = u0 + (u1 - u0) * corpus_rng_uniform(&rng);
             double v = v0 + (v1 - v0) * corpus_rng_uniform(&rng);
-            check_point(th, obj, &b, &lin, split, r, u, v, t);
+            check_point(th, obj, &b, &lin, split, &lin2, r, u, v, t);
         }
     }
     free(view);
@@ -372,6 +376,7 @@ static void run_surface(corpus_surface s)
             total.restricted_points += t.restricted_points;
             total.split += t.split;
             total.split_first += t.split_first;
+            total.split_lin += t.split_lin;
             total.split_plain += t.split_plain;
             total.plain_differ += t.plain_differ;
             total.violations += t.violations;
@@ -386,14 +391,15 @@ static void run_surface(corpus_surface s)
         }
     printf("%s total: %ld cases, %ld points (%ld also against a slab, %ld checks against "
            "restricted bounds), %ld boxes narrowed by "
-           "case splits (%ld of the cases first; %ld split nothing, %ld of them not the plain "
+           "case splits (%ld of the cases first, %ld with a linear bound; %ld split nothing, "
+           "%ld of them not the plain "
            "box), %ld violations (worst %.2e), %ld unbounded boxes "
            "(+ %ld of ranges wider than 1/32, counted), %ld/%ld shader errors (box/point), "
            "%ld failing rows, %ld scenes not opened, %ld undefined points (NaN on a "
            "base's axis)\n",
            corpus_surface_name(s), total.cases, total.points, total.slab_points,
            total.restricted_points, total.split,
-           total.split_first, total.split_plain, total.plain_differ, total.violations, total.worst,
+           total.split_first, total.split_lin, total.split_plain, total.plain_differ, total.violations, total.worst,
            total.unbounded, total.unbounded_wide, total.box_errors, total.point_errors,
            bad_rows, failed_opens, total.undefined);
     fflush(stdout);
@@ -402,7 +408,10 @@ static void run_surface(corpus_surface s)
     assert_true(total.slab_points > total.points / 20);
     assert_true(total.restricted_points > total.points / 2);   /* the lazy children's bounds */
     const char *only = getenv("AAFARM_CORPUS_ONLY");
-    if (!only || !*only) assert_true(total.split > 0);   /* the split path is checked */
+    if (!only || !*only) {
+        assert_true(total.split > 0);      /* the split path is checked */
+        assert_true(total.split_lin > 0);  /* and the cases' linear bounds */
+    }
     assert_int_equal(total.violations, 0);
     assert_int_equal(total.plain_differ, 0);
     assert_int_equal(total.unbounded, 0);

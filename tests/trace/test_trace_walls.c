@@ -282,7 +282,7 @@ static void count_step_cells(const char *name, const char *src, int *flagged, in
             assert_false(b.flags & TRACE_BOX_STEP);      /* only the cases mark it */
             if (!(b.flags & AA_DISCONTINUOUS)) continue;
             (*flagged)++;
-            trace_surface_box_cases(th, obj, u0, u1, v0, v1, &b);
+            trace_surface_box_cases(th, obj, u0, u1, v0, v1, &b, NULL);
             *steps += (b.flags & TRACE_BOX_STEP) != 0;
         }
     printf("%-7s %d of 256 cells flagged discontinuous, %d proven steps\n", name, *flagged,
