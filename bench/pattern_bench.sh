@@ -16,8 +16,9 @@
 # each scene and shader one line: CPU seconds of the render (user + system, /usr/bin/time),
 # and from `aafarm-worker --stats`: boxes per ray (box evaluations through
 # the shader / rays), evals per ray (affine + dual + float evaluations /
-# rays, as render_bench counts them), sampled_boxes (stagnant boxes
-# re-estimated from samples, docs/renderer.md "Stagnant boxes"),
+# rays, as render_bench counts them), samplings (stagnant boxes sampled)
+# and sampled_boxes (of them, boxes re-estimated from the samples,
+# docs/renderer.md "Stagnant boxes"),
 # wall_leaves, the largest walk (max_nodes_per_ray) and limited_rays. The
 # issue's aim is <= 10 boxes per ray. Figures, never a verdict: the script
 # fails only when a render fails. Every render is bounded by timeout -k
@@ -41,7 +42,8 @@ trap 'rm -rf "$WORK"' EXIT
 stat() { awk -v k="$1" '$1 == k {print $2; exit}' "$2"; }
 
 echo "pattern_bench: corpus sphere 96x72 and a wall 256x192, 1 thread, affine ($(date -u +%F), $(uname -m), $(nproc) cores)"
-printf "%-6s %-16s %8s %10s %10s %8s %7s %9s %7s\n" scene shader "CPU s" boxes/ray evals/ray sampled walls max_nodes limited
+printf "%-6s %-16s %8s %10s %10s %9s %8s %7s %9s %7s\n" scene shader "CPU s" boxes/ray evals/ray samplings sampled \
+    walls max_nodes limited
 status=0
 for scene in ${PATTERN_BENCH_SCENES:-sphere wall}; do
 for sh in "${SHADERS[@]}"; do
@@ -92,11 +94,12 @@ EOF
         -v p="$(stat primary_rays "$S")" -v s="$(stat shadow_rays "$S")" \
         -v b="$(stat boxes "$S")" -v ea="$(stat evals_affine "$S")" \
         -v ed="$(stat evals_dual "$S")" -v ef="$(stat evals_float "$S")" \
-        -v sb="$(stat sampled_boxes "$S")" -v wl="$(stat wall_leaves "$S")" \
+        -v sn="$(stat samplings "$S")" -v sb="$(stat sampled_boxes "$S")" \
+        -v wl="$(stat wall_leaves "$S")" \
         -v mx="$(stat max_nodes_per_ray "$S")" -v lr="$(stat limited_rays "$S")" \
         'BEGIN {r = p + s; if (r < 1) r = 1;
-                printf "%-6s %-16s %8s %10.2f %10.2f %8d %7d %9d %7d\n",
-                       sc, sh, cpu, b / r, (ea + ed + ef) / r, sb, wl, mx, lr}'
+                printf "%-6s %-16s %8s %10.2f %10.2f %9d %8d %7d %9d %7d\n",
+                       sc, sh, cpu, b / r, (ea + ed + ef) / r, sn, sb, wl, mx, lr}'
 done
 done
 exit $status
