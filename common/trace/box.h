@@ -72,13 +72,18 @@
  * (TRACE_BOX_UNSPLIT too). Its stagnant children keep the flag and none of
  * them is re-estimated from samples (intersect.c, "Stagnant boxes") */
 #define TRACE_BOX_STEP (1u << 15)
+/* Every case of the box's seams is the flat base moved by a constant
+ * (trace_surface_box_cases): over the cell the surface is pieces of
+ * parallel planes and the walls between them, which all lie between the
+ * outermost two (intersect.c, "planes_cell") */
+#define TRACE_BOX_PLANES (1u << 16)
 
 typedef struct trace_box {
     vec3 lo, hi;
     unsigned flags;          /* AA_DISCONTINUOUS | AA_UNBOUNDED | TRACE_BOX_SAMPLED |
                                 TRACE_BOX_UNSPLIT | TRACE_BOX_SPLIT | TRACE_BOX_LIN |
                                 TRACE_BOX_LAZY | TRACE_BOX_UNDISPLACED | TRACE_BOX_OFFSET |
-                                TRACE_BOX_STEP */
+                                TRACE_BOX_STEP | TRACE_BOX_PLANES */
     float bend;              /* how far from linear in (u,v) the surface is over
                                 the box: the affine forms' other terms over
                                 their u and v terms (displace.c); 0: unknown */

@@ -264,7 +264,10 @@ typedef enum {
 #define TRACE_OFFSET_SLACK 0x1p-40
 static bool offset_affine(const aa_form *a, const aa_form *b)
 {
-    return a->n == b->n && a->flags == b->flags && isfinite(a->x0) && a->err >= b->err &&
+    /* AA_DISCONTINUOUS aside: a case run's split values carry it, and
+     * box_of_run takes no flagged box for a moved one */
+    unsigned fa = a->flags & ~(unsigned)AA_DISCONTINUOUS, fb = b->flags & ~(unsigned)AA_DISCONTINUOUS;
+    return a->n == b->n && fa == fb && isfinite(a->x0) && a->err >= b->err &&
            a->err - b->err <= TRACE_OFFSET_SLACK * (fabs(a->x0) + fabs(b->x0)) &&
            memcmp(a->c, b->c, (size_t)a->n * sizeof a->c[0]) == 0;
 }
@@ -294,7 +297,7 @@ static trace_moved moved_by(const aa_form Pc[3], const aa_form P[3])
  * (TRACE_MOVED_OFFSET, offset_affine: a brick's top, Km times a decided
  * step along a flat base's N). */
 static void affine_shade(trace_thread *th, const trace_object *obj, const affine_cell *c,
-                         aa_form P[3], trace_moved *same)
+                         aa_form P[3], trace_moved *same, vec3 *move)
 {
     if (same) *same = TRACE_MOVED_OTHER;
     aa_context *ctx = &th->ctx;
@@ -316,7 +319,15 @@ static void affine_shade(trace_thread *th, const trace_object *obj, const affine
     } else {
         aa_form Pc[3];
         sl_vm_get_affine(vm, SL_G_P, Pc);
-        if (same) *same = moved_by(Pc, c->P);
+        if (same) {
+            *same = moved_by(Pc, c->P);
+            /* the move, object space: the centres' difference (the rest of
+             * the forms is the same, up to TRACE_OFFSET_SLACK) */
+            if (move && *same != TRACE_MOVED_OTHER)
+                *move = mat4_xform_vector(&obj->from_camera,
+                                          v3(Pc[0].x0 - c->P[0].x0, Pc[1].x0 - c->P[1].x0,
+                                             Pc[2].x0 - c->P[2].x0));
+        }
         trace_xform_aa(ctx, &obj->from_camera, Pc, P, true);
     }
 }
@@ -327,7 +338,7 @@ static void affine_run(trace_thread *th, const trace_object *obj,
 {
     affine_cell c;
     affine_geometry(th, obj, u0, u1, v0, v1, &c);
-    affine_shade(th, obj, &c, P, same);
+    affine_shade(th, obj, &c, P, same, NULL);
 }
 
 /* The box's linear bound (lin_bound.h; TRACE_BOX_LIN on the box) from
@@ -380,8 +391,6 @@ static void box_affine(trace_thread *th, const trace_object *obj,
     box_of_run(th, obj, P, same, out, lin);
 }
 
-/* At most this many operations split per box: 2^TRACE_SPLIT_OPS runs */
-#define TRACE_SPLIT_OPS 3
 /* The cases' box is taken where it is at most this fraction of the box's
  * extent; else the box stays (a narrower box that still does not shrink
  * makes its children stagnant against it: more splits and samples for
@@ -410,17 +419,35 @@ static bool boxes_apart(const trace_box *a, const trace_box *b)
 typedef struct case_set {
     int n;
     bool lins;                            /* every case has its linear bound */
-    trace_box box[1 << TRACE_SPLIT_OPS];
-    trace_lin lin[1 << TRACE_SPLIT_OPS];
+    bool moved;                           /* every case moved the base by a constant */
+    trace_box box[TRACE_MAX_CASES];
+    trace_lin lin[TRACE_MAX_CASES];
+    vec3 move[TRACE_MAX_CASES];           /* its move (object space), where moved */
 } case_set;
 
-static void case_add(case_set *cs, const aa_context *ctx, const aa_form P[3], const trace_box *b)
+static void case_add(case_set *cs, const aa_context *ctx, const aa_form P[3], const trace_box *b,
+                     trace_moved same, vec3 move)
 {
-    assert(cs->n < (1 << TRACE_SPLIT_OPS));    /* at most 2^TRACE_SPLIT_OPS cases */
-    if (cs->n == 0) cs->lins = true;
+    assert(cs->n < TRACE_MAX_CASES);      /* at most 2^TRACE_SPLIT_OPS cases */
+    if (cs->n == 0) cs->lins = cs->moved = true;
     cs->box[cs->n] = *b;
     cs->lins = cs->lins && run_linear(ctx, P, &cs->lin[cs->n]);
+    cs->moved = cs->moved && same != TRACE_MOVED_OTHER && v3_is_finite(move);
+    cs->move[cs->n] = move;
     cs->n++;
+}
+
+/* Whether the cell's surface is pieces of parallel planes (the flat base
+ * moved by each case's constant) and the walls between them; their moves
+ * in *out where given (n = 0 where not) */
+static bool cases_planes(const trace_object *obj, const case_set *cs, trace_case_moves *out)
+{
+    bool planes = cs->moved && cs->n >= 2 && trace_surface_flat(obj);
+    if (out) {
+        out->n = planes ? cs->n : 0;
+        for (int i = 0; i < out->n; i++) out->move[i] = cs->move[i];
+    }
+    return planes;
 }
 
 /* Whether the cases' boxes are pairwise apart */
@@ -478,9 +505,11 @@ static void union_cases(trace_thread *th, const trace_object *obj, const affine_
     aa_form P[3];
     do {
         trace_box b;
-        affine_shade(th, obj, cell, P, NULL);
+        trace_moved same;
+        vec3 move = v3(NAN, NAN, NAN);
+        affine_shade(th, obj, cell, P, &same, &move);
         box_from_affine(P, &b);
-        if (cs) case_add(cs, &th->ctx, P, &b);
+        if (cs) case_add(cs, &th->ctx, P, &b, same, move);
         trace_box_union(hull, &b);
     } while (!th->failed && sl_vm_split_next(th->vm));
 }
@@ -494,20 +523,24 @@ static void first_case(trace_thread *th, const trace_object *obj, double u0, dou
                        aa_form P[3], trace_moved *same, case_set *cs)
 {
     aa_form Q[3];
+    trace_moved moved;
+    vec3 move = v3(NAN, NAN, NAN);
     affine_geometry(th, obj, u0, u1, v0, v1, cell);
     sl_vm_split_begin(th->vm, TRACE_SPLIT_OPS);
-    affine_shade(th, obj, cell, P ? P : Q, same);
+    affine_shade(th, obj, cell, P ? P : Q, &moved, &move);
+    if (same) *same = moved;
     box_from_affine(P ? P : Q, hull);
     if (cs) {
         cs->n = 0;
-        case_add(cs, &th->ctx, P ? P : Q, hull);
+        case_add(cs, &th->ctx, P ? P : Q, hull, moved, move);
     }
 }
 
 bool trace_surface_box_cases(trace_thread *th, const trace_object *obj,
                              double u0, double u1, double v0, double v1, trace_box *box,
-                             trace_lin *lin)
+                             trace_lin *lin, trace_case_moves *moves)
 {
+    if (moves) moves->n = 0;
     obj = trace_box_owner(obj);
     if (th->world->options.arith == TRACE_ARITH_INTERVAL || !obj->displacement) return false;
     sl_vm *vm = th->vm;
@@ -542,6 +575,7 @@ bool trace_surface_box_cases(trace_thread *th, const trace_object *obj,
          * surface jumps wherever two cases meet in the cell (a continuous
          * one would put their common values in both): a true step */
         if (cases_apart(&cs)) box->flags |= TRACE_BOX_STEP;
+        if (cases_planes(obj, &cs, moves)) box->flags |= TRACE_BOX_PLANES;
         return false;
     }
     /* the cases' linear bound where it is tighter than the box's own */
@@ -551,7 +585,7 @@ bool trace_surface_box_cases(trace_thread *th, const trace_object *obj,
         *lin = cl;
         m.flags |= TRACE_BOX_LIN;
     }
-    m.flags |= TRACE_BOX_SPLIT;
+    m.flags |= TRACE_BOX_SPLIT | (cases_planes(obj, &cs, moves) ? TRACE_BOX_PLANES : 0u);
     m.bend = 1e30f;                       /* no proofs on a split cell */
     trace_box_no_slab(&m);
     *box = m;
@@ -576,8 +610,9 @@ static void box_finish(trace_thread *th, trace_box *out)
 
 bool trace_surface_box_split(trace_thread *th, const trace_object *obj,
                              double u0, double u1, double v0, double v1, trace_box *box,
-                             trace_lin *lin)
+                             trace_lin *lin, trace_case_moves *moves)
 {
+    if (moves) moves->n = 0;
     const trace_object *o = trace_box_owner(obj);
     if (th->world->options.arith == TRACE_ARITH_INTERVAL || !o->displacement) {
         trace_surface_box_lin(th, obj, u0, u1, v0, v1, box, lin);
@@ -604,7 +639,7 @@ bool trace_surface_box_split(trace_thread *th, const trace_object *obj,
          * (box_affine's run on the same cell) */
         sl_vm_split_end(vm);
         th->stats.boxes++;
-        affine_shade(th, o, &cell, P, &same);
+        affine_shade(th, o, &cell, P, &same, NULL);
         box_of_run(th, o, P, same, box, lin);
         box_finish(th, box);
         return false;
@@ -618,13 +653,31 @@ bool trace_surface_box_split(trace_thread *th, const trace_object *obj,
         return false;
     }
     hull.flags = box_flags(&hull, AA_DISCONTINUOUS) | TRACE_BOX_SPLIT |
-                 (cases_apart(&cs) ? TRACE_BOX_STEP : 0u);
+                 (cases_apart(&cs) ? TRACE_BOX_STEP : 0u) |
+                 (cases_planes(o, &cs, moves) ? TRACE_BOX_PLANES : 0u);
     /* one linear bound for all the cases: its children can be lazy */
     if (lin && cases_linear(&cs, lin)) hull.flags |= TRACE_BOX_LIN;
     hull.bend = 1e30f;                    /* no proofs on a split cell */
     trace_box_no_slab(&hull);
     *box = hull;
     return true;
+}
+
+void trace_surface_case_moves(trace_thread *th, const trace_object *obj, double u0, double u1,
+                              double v0, double v1, trace_case_moves *moves)
+{
+    moves->n = 0;
+    obj = trace_box_owner(obj);
+    if (th->world->options.arith == TRACE_ARITH_INTERVAL || !obj->displacement) return;
+    sl_vm *vm = th->vm;
+    trace_box hull;
+    affine_cell cell;
+    case_set cs;
+    first_case(th, obj, u0, u1, v0, v1, &cell, &hull, NULL, NULL, &cs);
+    bool split = !sl_vm_split_full(vm) && !th->failed && sl_vm_split_next(vm);
+    if (split) union_cases(th, obj, &cell, &hull, &cs);
+    sl_vm_split_end(vm);
+    if (!th->failed && split) cases_planes(obj, &cs, moves);
 }
 
 /* ---- interval ---- */

@@ -42,6 +42,18 @@ void trace_xform_aa(aa_context *ctx, const mat4 *m, const aa_form in[3], aa_form
 void trace_camera_normal_aa(aa_context *ctx, const trace_object *obj, const aa_form Nn[3],
                             aa_form N[3]);
 
+/* At most this many operations split per box (trace_surface_box_cases):
+ * TRACE_MAX_CASES runs */
+#define TRACE_SPLIT_OPS 3
+#define TRACE_MAX_CASES (1 << TRACE_SPLIT_OPS)
+
+/* The moves (object space) of a cell's cases where every case is the flat
+ * base moved by a constant (TRACE_BOX_PLANES); n = 0 where not */
+typedef struct trace_case_moves {
+    int n;
+    vec3 move[TRACE_MAX_CASES];
+} trace_case_moves;
+
 /* Issue 24, walls and patterns: *box, the range's trace_surface_box in
  * affine arithmetic, narrowed by case splits (sl_vm_split_begin): floor,
  * ceil, round, mod and step taking two values over the range (a cell
@@ -55,7 +67,9 @@ void trace_camera_normal_aa(aa_context *ctx, const trace_object *obj, const aa_f
  * untouched) when nothing was split: interval arithmetic, no displacement,
  * no such operation; false too where the cases did not narrow it, and
  * then *box gains TRACE_BOX_STEP where the cases' boxes are pairwise
- * apart (a true step: the surface jumps where two cases meet, box.h).
+ * apart (a true step: the surface jumps where two cases meet, box.h),
+ * and TRACE_BOX_PLANES where every case is the flat base moved by a
+ * constant (their moves in *moves where given; else moves->n = 0).
  * Where lin is given (the box's linear bound, TRACE_BOX_LIN on *box if
  * it has one) and the box is narrowed, *lin becomes the cases' own
  * bound (one that holds every case's) where that is tighter.
@@ -64,7 +78,7 @@ void trace_camera_normal_aa(aa_context *ctx, const trace_object *obj, const aa_f
  * (intersect.c). A pure function of (object, range, *box). */
 bool trace_surface_box_cases(trace_thread *th, const trace_object *obj,
                              double u0, double u1, double v0, double v1, trace_box *box,
-                             trace_lin *lin);
+                             trace_lin *lin, trace_case_moves *moves);
 
 /* The box of the range, its cases first: where the children of a box the
  * cases narrowed (TRACE_BOX_SPLIT) still lie across its seam, the plain
@@ -74,14 +88,23 @@ bool trace_surface_box_cases(trace_thread *th, const trace_object *obj,
  * the hull of their boxes, flagged AA_DISCONTINUOUS and TRACE_BOX_SPLIT
  * (and TRACE_BOX_STEP where their boxes are pairwise apart), without
  * slab or proofs, with a linear bound in *lin that holds every case's
- * (TRACE_BOX_LIN, where all have one; lin may be NULL) (true). Where the seams overflow the
+ * (TRACE_BOX_LIN, where all have one; lin may be NULL), and
+ * TRACE_BOX_PLANES with the moves as trace_surface_box_cases gives them
+ * (true). Where the seams overflow the
  * cases, or a case has a NaN side, *box and *lin are
  * trace_surface_box_lin's (false; the lost runs counted as a box). The
  * hull encloses the surface as trace_surface_box_cases's does (every
  * point is in one case). A pure function of (object, range). */
 bool trace_surface_box_split(trace_thread *th, const trace_object *obj,
                              double u0, double u1, double v0, double v1, trace_box *box,
-                             trace_lin *lin);
+                             trace_lin *lin, trace_case_moves *moves);
+
+/* The moves of the cases of the range's seams, as trace_surface_box_cases
+ * runs them, where every case is the flat base moved by a constant
+ * (TRACE_BOX_PLANES; 2 to TRACE_MAX_CASES of them); else moves->n = 0. A
+ * pure function of (object, range). */
+void trace_surface_case_moves(trace_thread *th, const trace_object *obj, double u0, double u1,
+                              double v0, double v1, trace_case_moves *moves);
 
 /* N is constant over the object (its d/du, d/dv are 0): disks, and
  * polygons unless they carry interpolated vertex normals

@@ -608,6 +608,182 @@ static bool exact_cell(walk *w, const double c[4], double tol, bool moved)
     return false;
 }
 
+/* The moves of a TRACE_BOX_PLANES cell's cases (object space;
+ * trace_surface_case_moves), kept per cell in a direct-mapped per-thread
+ * cache as the single moves are: child_box stores what the cell's cases
+ * gave when it made the box, and a cell the cache lost runs its cases
+ * again. A pure function of the owner of the boxes and the cell. */
+enum { CASE_CACHE_LOG2 = 10, CASE_CACHE_ENTRIES = 1 << CASE_CACHE_LOG2 };
+typedef struct case_entry {
+    double r[4];                  /* the cell; r[0] >= r[1]: empty */
+    int obj;
+    trace_case_moves m;
+} case_entry;
+struct trace_case_cache { case_entry e[CASE_CACHE_ENTRIES]; };
+
+static case_entry *case_slot(trace_thread *th, const trace_object *owner, const double c[4])
+{
+    if (!th->cases) th->cases = xcalloc(1, sizeof *th->cases);   /* zeroed: empty */
+    return &th->cases->e[trace_cell_slot(c, owner->id, CASE_CACHE_LOG2)];
+}
+
+static void case_store(trace_thread *th, const trace_object *obj, const double c[4],
+                       const trace_case_moves *m)
+{
+    const trace_object *owner = trace_box_owner(obj);
+    case_entry *e = case_slot(th, owner, c);
+    memcpy(e->r, c, sizeof e->r);
+    e->obj = owner->id;
+    e->m = *m;
+}
+
+static const trace_case_moves *case_moves(trace_thread *th, const trace_object *obj,
+                                          const double c[4])
+{
+    const trace_object *owner = trace_box_owner(obj);
+    case_entry *e = case_slot(th, owner, c);
+    if (!trace_cell_is(e->r, e->obj, c, owner->id)) {
+        trace_surface_case_moves(th, owner, c[0], c[1], c[2], c[3], &e->m);
+        if (th->failed) {                 /* a failed run: nothing to keep */
+            e->r[0] = 1.0;
+            e->r[1] = 0.0;
+            e->m.n = 0;
+            return &e->m;
+        }
+        memcpy(e->r, c, sizeof e->r);
+        e->obj = owner->id;
+    }
+    return &e->m;
+}
+
+/* (u,v) of the point x of a polygon's plane (object space): its (u,v) are
+ * affine there, x = P0 + (u - uc) dPdu + (v - vc) dPdv (least squares:
+ * the part of x - P0 along the normal is left out) */
+static void plane_uv(const geom_sample *g, double uc, double vc, vec3 x, double *u, double *v)
+{
+    vec3 d = v3_sub(x, g->P);
+    double a = v3_dot(g->dPdu, g->dPdu), b = v3_dot(g->dPdu, g->dPdv),
+           e = v3_dot(g->dPdv, g->dPdv), p = v3_dot(g->dPdu, d), q = v3_dot(g->dPdv, d);
+    double det = a * e - b * b;
+    *u = uc + (e * p - b * q) / det;
+    *v = vc + (a * q - b * p) / det;
+}
+
+/* Whether the segment from (u0,v0) to (u1,v1) misses the rectangle r
+ * grown by mu, mv (clipped as Liang and Barsky do) */
+static bool segment_misses(double u0, double v0, double u1, double v1, const double r[4],
+                           double mu, double mv)
+{
+    double t0 = 0.0, t1 = 1.0, du = u1 - u0, dv = v1 - v0;
+    const double p[4] = {-du, du, -dv, dv},
+                 q[4] = {u0 - (r[0] - mu), (r[1] + mu) - u0, v0 - (r[2] - mv), (r[3] + mv) - v0};
+    for (int i = 0; i < 4; i++) {
+        if (p[i] == 0.0) {
+            if (q[i] < 0.0) return true;
+            continue;
+        }
+        double t = q[i] / p[i];
+        if (p[i] < 0.0) {
+            if (t > t1) return true;
+            if (t > t0) t0 = t;
+        } else {
+            if (t < t0) return true;
+            if (t < t1) t1 = t;
+        }
+    }
+    return false;
+}
+
+/*
+ * A cell whose every case is the flat base moved by a constant
+ * (TRACE_BOX_PLANES: a brick's edge, the top and the mortar): its surface
+ * is pieces of those parallel planes, and every wall between two pieces
+ * lies between the outermost planes (issue 24, "one box per branch").
+ * Along the ray, before it first crosses one of the planes it is outside
+ * that band and meets nothing of the cell. So:
+ *   - the band begins beyond the best hit: nothing of the cell is nearer;
+ *   - on a polygon whose cases move it along its normal alone, the ray's
+ *     stretch in the band lies over a segment of (u,v): one that misses
+ *     the cell misses everything of it;
+ *   - where the first crossing falls in the cell on the surface (the point
+ *     evaluated: its displacement there is that plane's move), it is the
+ *     cell's hit.
+ * True where one of these settles the cell, without subdividing it down
+ * to the wall. Otherwise false and the walk goes on: the ray crosses into
+ * the band over another piece (a wall or a lower piece may be its hit),
+ * starts inside the band, or runs along the planes.
+ */
+static bool planes_cell(walk *w, const double c[4], double tol)
+{
+    const trace_case_moves *m = case_moves(w->th, w->obj, c);
+    int n = m->n;
+    if (n < 2) return false;
+    const trace_ray *ray = &w->ray;
+    double uc = 0.5 * (c[0] + c[1]), vc = 0.5 * (c[2] + c[3]);
+    geom_sample g;
+    geom_eval(&w->obj->surf, uc, vc, &g);
+    vec3 nrm = g.Ng;
+    double dn = v3_dot(nrm, ray->d), nl = v3_length(nrm);
+    if (!(fabs(dn) > 1e-6 * nl * v3_length(ray->d))) return false;   /* along the planes */
+    int first = -1;
+    double t1 = INFINITY, t2 = -INFINITY, mmax = 0.0;
+    bool normal_moves = true;             /* every move less the first's along nrm */
+    for (int k = 0; k < n; k++) {
+        double tk = v3_dot(nrm, v3_sub(v3_add(g.P, m->move[k]), ray->o)) / dn;
+        if (!(tk > ray->tmin)) return false;        /* starts in or beyond the band */
+        if (tk < t1) {
+            t1 = tk;
+            first = k;
+        }
+        t2 = fmax(t2, tk);
+        vec3 dm = v3_sub(m->move[k], m->move[0]);
+        normal_moves = normal_moves &&
+                       v3_length(v3_cross(dm, nrm)) <= 1e-9 * v3_length(dm) * nl;
+        mmax = fmax(mmax, v3_length(m->move[k]));
+    }
+    w->th->stats.plane_cells++;
+    /* a thousandth of t's for the rounding of the t computed here against
+     * the walk's own */
+    if (t1 * (1.0 - 1e-3) >= w->best->t) return true;
+    double scale = v3_length(g.P) + v3_length(ray->o) + mmax;
+    if (w->obj->surf.kind == GEOM_POLYGON && normal_moves) {
+        /* the band's stretch of the ray, to the best hit, over (u,v): the
+         * points less the first move, which the others only lengthen
+         * along the normal; margins far above the rounding */
+        double te = fmin(t2, w->best->t), ua, va, ub, vb;
+        plane_uv(&g, uc, vc, v3_sub(trace_ray_at(ray, t1), m->move[0]), &ua, &va);
+        plane_uv(&g, uc, vc, v3_sub(trace_ray_at(ray, te), m->move[0]), &ub, &vb);
+        double mu = 1e-6 * (c[1] - c[0]) + 1e-9 * scale / v3_length(g.dPdu),
+               mv = 1e-6 * (c[3] - c[2]) + 1e-9 * scale / v3_length(g.dPdv);
+        if (isfinite(ua) && isfinite(va) && isfinite(ub) && isfinite(vb) &&
+            segment_misses(ua, va, ub, vb, c, mu, mv)) {
+            w->th->stats.plane_misses++;
+            return true;
+        }
+    }
+    geom_hit h;
+    vec3 o = v3_sub(ray->o, m->move[first]);
+    if (!geom_intersect(&w->obj->surf, o, ray->d, ray->tmin, INFINITY, &h) ||
+        !(h.u >= c[0] && h.u <= c[1] && h.v >= c[2] && h.v <= c[3]))
+        return false;
+    trace_surface_point sp;
+    trace_surface_point_eval(w->th, w->obj, h.u, h.v, &sp);
+    geom_sample b;
+    geom_eval(&w->obj->surf, h.u, h.v, &b);
+    vec3 p = mat4_xform_point(&w->obj->from_camera, sp.P);
+    if (!(v3_length(v3_sub(v3_sub(p, b.P), m->move[first])) <= 1e-9 * scale)) return false;
+    /* and no other plane within that of it along the normal (a piece of
+     * another case so near could be the one the point is on) */
+    for (int k = 0; k < n; k++) {
+        vec3 dm = v3_sub(m->move[k], m->move[first]);
+        bool same = dm.x == 0.0 && dm.y == 0.0 && dm.z == 0.0;
+        if (!same && fabs(v3_dot(nrm, dm)) / nl <= 1e-6 * scale) return false;
+    }
+    w->th->stats.plane_hits++;
+    proven_hit(w, h.t, tol, &sp);
+    return true;
+}
+
 /* The stagnant-box fallback (issue 9; docs/renderer.md "Stagnant boxes").
  * Range arithmetic loses the correlation of some continuous idioms, and
  * their boxes then stop shrinking along a curve of (u,v): a box-filtered
@@ -693,8 +869,9 @@ static void child_box(walk *w, const trace_box *node, const trace_dlin *lin, con
     /* below a box its cases narrowed, the children run their cases first
      * (the plain run of one across the same seam is stagnant again) */
     bool cases_first = (node->flags & TRACE_BOX_SPLIT) != 0, split = false;
+    trace_case_moves moves = {0};
     if (cases_first)
-        split = trace_surface_box_split(th, owner, c[0], c[1], c[2], c[3], kid, kid_lin);
+        split = trace_surface_box_split(th, owner, c[0], c[1], c[2], c[3], kid, kid_lin, &moves);
     else
         trace_surface_box_lin(th, owner, c[0], c[1], c[2], c[3], kid, kid_lin);
     if (stagnant(kid, node_extent)) {
@@ -704,7 +881,7 @@ static void child_box(walk *w, const trace_box *node, const trace_dlin *lin, con
         if (cases_first ? !split
                         : (node->flags & TRACE_BOX_UNSPLIT) ||
                               !trace_surface_box_cases(th, owner, c[0], c[1], c[2], c[3], kid,
-                                                       kid_lin))
+                                                       kid_lin, &moves))
             kid->flags |= TRACE_BOX_UNSPLIT;
         /* across a proven step (the cases' boxes apart, box.h), its
          * stagnant children too: the samples could only find the jump
@@ -717,6 +894,8 @@ static void child_box(walk *w, const trace_box *node, const trace_dlin *lin, con
             !(kid->flags & TRACE_BOX_STEP))
             sample_stagnant(th, owner, c, kid);
     }
+    /* the planes of its cases, for the walk (planes_cell) */
+    if (kid->flags & TRACE_BOX_PLANES) case_store(th, w->obj, c, &moves);
     /* an estimate: its children are made from their runs alone */
     if (kid->flags & TRACE_BOX_SAMPLED) kid->flags &= ~(unsigned)TRACE_BOX_LIN;
     if (lin) {
@@ -978,6 +1157,9 @@ static void visit(walk *w, const trace_box *node, const trace_qlin *node_q, cons
         if ((kid->flags & (TRACE_BOX_UNDISPLACED | TRACE_BOX_OFFSET)) && w->exact_cells &&
             clear_of_shared_edges(w, c) &&
             exact_cell(w, c, tol, (kid->flags & TRACE_BOX_OFFSET) != 0))
+            continue;
+        if ((kid->flags & TRACE_BOX_PLANES) && w->exact_cells && clear_of_shared_edges(w, c) &&
+            planes_cell(w, c, tol))
             continue;
         bool unbounded = (kid->flags & AA_UNBOUNDED) != 0;
         vec3 wall_n = v3(0, 0, 0);

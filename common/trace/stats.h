@@ -29,6 +29,11 @@ typedef struct trace_stats {
                                       (intersect.c, exact_cell) */
     long offset_cells;             /* of them, cells of the base moved by a
                                       constant (TRACE_BOX_OFFSET) */
+    long plane_cells;              /* cells of parallel planes (TRACE_BOX_PLANES)
+                                      a ray crossed into (intersect.c, planes_cell) */
+    long plane_hits;               /* of them, settled by a hit on the plane
+                                      it crossed first */
+    long plane_misses;             /* or by passing the cell outside the band */
     long rejected_leaves;          /* leaves whose surface point was not on the
                                       ray (depth cap) or not finite: no hit */
     long nodes;                    /* quadtree nodes visited by all rays */

@@ -116,6 +116,7 @@ void trace_thread_destroy(trace_thread **self_p)
     trace_normal_memo_free(self);
     free(self->walls);
     free(self->moves);
+    free(self->cases);
     trace_views_free(self);
     free(self->work);
     free(self);

@@ -272,7 +272,7 @@ static void run_cases(trace_thread *th, const trace_world *w, long ncases, uint6
         /* a discontinuous box, narrowed by the cases of its seams as the
          * intersector narrows those that stop shrinking (issue 24): the
          * points must lie in the narrowed box */
-        if ((b.flags & AA_DISCONTINUOUS) && trace_surface_box_cases(th, obj, u0, u1, v0, v1, &b, &lin))
+        if ((b.flags & AA_DISCONTINUOUS) && trace_surface_box_cases(th, obj, u0, u1, v0, v1, &b, &lin, NULL))
             t->split++;
         take_error(th, t, &t->box_errors);
         /* and as the children of such a box run theirs first
@@ -280,7 +280,7 @@ static void run_cases(trace_thread *th, const trace_world *w, long ncases, uint6
          * child of a split box): the points in the hull of the cases */
         trace_box b2, *split = NULL;
         trace_lin lin2;
-        if (trace_surface_box_split(th, obj, u0, u1, v0, v1, &b2, &lin2)) {
+        if (trace_surface_box_split(th, obj, u0, u1, v0, v1, &b2, &lin2, NULL)) {
             if (!(b2.flags & AA_UNBOUNDED)) {
                 split = &b2;
                 t->split_first++;

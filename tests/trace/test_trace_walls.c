@@ -13,7 +13,9 @@
  *     normal (radial), not a box face's;
  *   - a step whose two cases' boxes are apart is a proven step
  *     (TRACE_BOX_STEP): its stagnant boxes are not sampled, its walls are
- *     drawn; a flagged but continuous hinge is not one.
+ *     drawn; a flagged but continuous hinge is not one;
+ *   - a step of two planes (TRACE_BOX_PLANES) against its analytic hits:
+ *     the top's hits beside the wall are exact, not the wall's.
  */
 #include <math.h>
 #include <setjmp.h>
@@ -282,7 +284,7 @@ static void count_step_cells(const char *name, const char *src, int *flagged, in
             assert_false(b.flags & TRACE_BOX_STEP);      /* only the cases mark it */
             if (!(b.flags & AA_DISCONTINUOUS)) continue;
             (*flagged)++;
-            trace_surface_box_cases(th, obj, u0, u1, v0, v1, &b, NULL);
+            trace_surface_box_cases(th, obj, u0, u1, v0, v1, &b, NULL, NULL);
             *steps += (b.flags & TRACE_BOX_STEP) != 0;
         }
     printf("%-7s %d of 256 cells flagged discontinuous, %d proven steps\n", name, *flagged,
@@ -343,6 +345,108 @@ static void test_proven_steps_take_no_samples(void **state)
     fixture_close(&f);
 }
 
+/* The exact first hit (object space t; INFINITY: none) of the ray o + t d
+ * with the raised step on the square [-1, 1]^2 at z = 0, s = (x + 1) / 2:
+ * the plane z = h where x >= 0, z = 0 where x < 0, and the wall x = 0
+ * between them; *kind 0 the low plane, 1 the raised one, 2 the wall */
+static double step_hit(vec3 o, vec3 d, double h, int *kind)
+{
+    double best = INFINITY;
+    *kind = -1;
+    if (d.z != 0) {
+        double tz[2] = {(0 - o.z) / d.z, (h - o.z) / d.z};
+        for (int k = 0; k < 2; k++) {
+            double x = o.x + tz[k] * d.x, y = o.y + tz[k] * d.y;
+            bool side = k == 1 ? x >= 0 : x < 0;
+            if (tz[k] > 0 && side && fabs(x) <= 1 && fabs(y) <= 1 && tz[k] < best) {
+                best = tz[k];
+                *kind = k;
+            }
+        }
+    }
+    if (d.x != 0) {
+        double tw = -o.x / d.x, y = o.y + tw * d.y, z = o.z + tw * d.z;
+        if (tw > 0 && fabs(y) <= 1 && z >= fmin(0, h) && z <= fmax(0, h) && tw < best) {
+            best = tw;
+            *kind = 2;
+        }
+    }
+    return best;
+}
+
+/* The raised step seen at a slant, one ray per pixel centre, against its
+ * exact hits (step_hit): every hit that claims to be exact
+ * (TRACE_LEAF_PROVEN: proofs, undisplaced and moved cells, and the cells
+ * of two planes, planes_cell) is at the exact hit's t (to 1e-6 of it: a
+ * hit proof's Newton point is a few 1e-9 off), and so is every hit whose
+ * exact hit is on a plane away from the polygon's border; every ray whose
+ * exact hit is on the wall hits (a wall leaf, at its box's entry). The
+ * cells of two planes settle rays beside the wall by the first plane the
+ * ray crosses, where the surface there is that plane: without that check
+ * the raised plane is drawn over the low one there, as exact hits. */
+static void test_planes_hit_exactly_beside_the_wall(void **state)
+{
+    (void)state;
+    const char *rib = "Format 96 72 1\nProjection \"perspective\" \"fov\" [40]\n"
+                      "Translate 0 -0.2 3\nRotate -50 1 0 0\nRotate 20 0 0 1\nWorldBegin\n"
+                      "Displacement \"raised\"\n"
+                      "Polygon \"P\" [-1 -1 0  1 -1 0  1 1 0  -1 1 0] "
+                      "\"st\" [0 0  1 0  1 1  0 1]\nWorldEnd\n";
+    fixture f;
+    fixture_shader sh[] = {{"raised", RAISED_SL}};
+    assert_true(fixture_open(&f, rib, sh, 1, NULL, 0));
+    trace_thread *th = trace_thread_new(&f.js->world);
+    const trace_object *obj = &f.js->world.objects[0];
+    /* the side N points to (the raised plane's z): the step's height */
+    trace_surface_point sp;
+    trace_surface_point_eval(th, obj, 0.75, 0.5, &sp);
+    double h = mat4_xform_point(&obj->from_camera, sp.P).z;
+    assert_true(fabs(fabs(h) - 0.1) < 1e-12);
+    int proven = 0, proven_ok = 0, beside = 0, planes = 0, planes_ok = 0, walls = 0,
+        walls_hit = 0;
+    for (int y = 0; y < 72; y++)
+        for (int x = 0; x < 96; x++) {
+            trace_ray ray;
+            trace_camera_ray(&f.js->world.camera, x + 0.5, y + 0.5, &ray);
+            /* object space: the same t */
+            vec3 o = mat4_xform_point(&obj->from_camera, ray.o),
+                 d = mat4_xform_vector(&obj->from_camera, ray.d);
+            int kind;
+            double te = step_hit(o, d, h, &kind);
+            trace_hit hit = {.t = ray.tmax, .obj = NULL};
+            bool found = trace_bvh_intersect(f.js->renderer->bvh, th, &ray,
+                                             &f.js->renderer->primary_tol, false, &hit);
+            bool exact = found && fabs(hit.t - te) <= 1e-6 * te;
+            vec3 p = v3_add(o, v3_scale(d, te));
+            if (found && hit.kind == TRACE_LEAF_PROVEN) {
+                proven++;
+                proven_ok += exact;
+                beside += kind >= 0 && kind < 2 && fabs(p.x) < 0.05;
+            }
+            if (kind == 2) {
+                walls++;
+                walls_hit += found;
+            } else if (kind >= 0 && fabs(p.x) < 0.95 && fabs(p.y) < 0.95 && fabs(p.x) > 0.05) {
+                planes++;
+                planes_ok += exact;
+            }
+        }
+    printf("planes: %d/%d exact hits at the exact t (%d within 0.05 of the wall), %d/%d "
+           "plane hits exact, %d/%d wall rays hit; plane cells %ld (hits %ld, misses %ld)\n",
+           proven_ok, proven, beside, planes_ok, planes, walls_hit, walls, th->stats.plane_cells,
+           th->stats.plane_hits, th->stats.plane_misses);
+    assert_true(proven > 1000);
+    assert_int_equal(proven_ok, proven);
+    assert_true(beside > 20);
+    assert_true(planes > 1000);
+    assert_int_equal(planes_ok, planes);
+    assert_true(walls > 20);
+    assert_int_equal(walls_hit, walls);
+    assert_true(th->stats.plane_hits > 0 && th->stats.plane_misses > 0);
+    trace_thread_destroy(&th);
+    fixture_close(&f);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -352,6 +456,7 @@ int main(void)
         cmocka_unit_test(test_normalize_at_the_poles_is_bounded),
         cmocka_unit_test(test_wall_normals_are_the_walls),
         cmocka_unit_test(test_proven_steps_take_no_samples),
+        cmocka_unit_test(test_planes_hit_exactly_beside_the_wall),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
