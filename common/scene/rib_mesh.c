@@ -30,7 +30,8 @@
  *
  * Other primitive variables ("st", "Cs", user-declared; every class) go
  * with each surface (rib_primvar.c): a face whose variables differ at its
- * corners is cut into triangles too, over each of which they are linear.
+ * corners is cut into triangles too, over each of which they are linear
+ * (flat ones, without corner normals, where the face is flat).
  * A Polygon with variables is read as a one-face mesh (rib_polygon_vars).
  *
  * Threads (issue 23): a large PointsPolygons or PointsGeneralPolygons mesh
@@ -320,8 +321,8 @@ static bool add_face(rib_parser *p, mesh *m, int face, const int *loop_sizes, in
             rib_corner corners[GEOM_MAX_POLY_VERTS];
             for (int i = 0; i < total; i++)
                 corners[i] = corner_of(m, face, idx, i);
-            if ((m->ncls == MESH_N_NONE || corners_flat(m, s, face, idx, total)) &&
-                rib_primvars_same_at(&m->pv, corners, total)) {
+            bool flat = m->ncls == MESH_N_NONE || corners_flat(m, s, face, idx, total);
+            if (flat && rib_primvars_same_at(&m->pv, corners, total)) {
                 if (m->out) {
                     add_piece(m, SCENE_PIECE_POLYGON, face, NULL, total);
                     return true;
@@ -332,14 +333,17 @@ static bool add_face(rib_parser *p, mesh *m, int face, const int *loop_sizes, in
                 return true;
             }
             /* convex and planar: a fan of triangles with corner normals
-             * (and variables) */
+             * (and variables); flat ones where the face is (cut only for
+             * its variables: its corner normals are its own, so its
+             * triangles stay crack-free, and flat, their displaced cells
+             * are intersected exactly, docs/renderer.md) */
             int added = 0;
             for (int i = 1; i + 1 < total; i++) {
                 int c[3] = {0, i, i + 1};
                 vec3 cn[3];
-                for (int k = 0; k < 3 && m->ncls != MESH_N_NONE; k++)
+                for (int k = 0; k < 3 && !flat; k++)
                     cn[k] = corner_normal(m, face, idx, c[k]);
-                added += add_triangle(p, m, face, idx, c, m->ncls != MESH_N_NONE ? cn : NULL);
+                added += add_triangle(p, m, face, idx, c, flat ? NULL : cn);
             }
             if (added == 0)
                 skip_face(m, face);

@@ -267,9 +267,17 @@ static bool offset_affine(const aa_form *a, const aa_form *b)
     /* AA_DISCONTINUOUS aside: a case run's split values carry it, and
      * box_of_run takes no flagged box for a moved one */
     unsigned fa = a->flags & ~(unsigned)AA_DISCONTINUOUS, fb = b->flags & ~(unsigned)AA_DISCONTINUOUS;
-    return a->n == b->n && fa == fb && isfinite(a->x0) && a->err >= b->err &&
-           a->err - b->err <= TRACE_OFFSET_SLACK * (fabs(a->x0) + fabs(b->x0)) &&
-           memcmp(a->c, b->c, (size_t)a->n * sizeof a->c[0]) == 0;
+    if (fa != fb || !isfinite(a->x0) || !(a->err >= b->err) ||
+        !(a->err - b->err <= TRACE_OFFSET_SLACK * (fabs(a->x0) + fabs(b->x0))))
+        return false;
+    /* the same coefficients; a symbol one form lacks has 0 in it (an
+     * operation may leave a symbol of coefficient 0: a mesh's normal) */
+    int n = a->n > b->n ? a->n : b->n;
+    for (int i = 0; i < n; i++) {
+        double ca = i < a->n ? a->c[i] : 0.0, cb = i < b->n ? b->c[i] : 0.0;
+        if (ca != cb) return false;
+    }
+    return true;
 }
 
 /* What the shader did to the base's P (both as forms, camera space):

@@ -184,6 +184,42 @@ static void test_normals(void **state)
     sl_diag_destroy(&d);
 }
 
+/* A flat face cut into triangles only because its variables differ at
+ * its corners ("st" across a wall) keeps flat triangles, without corner
+ * normals (its corners' normals are its own: crack-free as it is), so a
+ * displacement along N moves them by a constant that the renderer
+ * intersects exactly; a folded face's triangles keep theirs. */
+static void test_flat_faces_cut_for_variables(void **state)
+{
+    (void)state;
+    sl_diag *d;
+    scene *s = parse_rib(WORLD(
+        "PointsPolygons [4 4] [0 1 4 3  1 2 5 4]\n"
+        "  \"P\" [0 0 0  1 0 0  2 0 0  0 1 0  1 1 0  2 1 0]\n"
+        "  \"st\" [0 0  0.5 0  1 0  0 1  0.5 1  1 1]\n"
+        "PointsPolygons [4 4] [0 1 4 3  1 2 5 4]\n"
+        "  \"P\" [0 0 0  1 0 1  2 0 0  0 1 0  1 1 1  2 1 0]\n"
+        "  \"st\" [0 0  0.5 0  1 0  0 1  0.5 1  1 1]\n"), &d);
+    if (!s)
+        sl_diag_print(d, stderr);
+    assert_non_null(s);
+    int np;
+    test_piece *pc = scene_pieces(s, &np);
+    assert_int_equal(np, 4 + 4);
+    for (int i = 0; i < 4; i++) {
+        assert_int_equal(pc[i].surface.nverts, 3);
+        assert_int_equal(pc[i].surface.nvn, 0);
+    }
+    for (int i = 4; i < 8; i++) {
+        assert_int_equal(pc[i].surface.nverts, 3);
+        assert_int_equal(pc[i].surface.nvn, 3);
+    }
+    assert_true(fabs(polygon_area(pc, 0, 4) - 2) < 1e-12);
+    free(pc);
+    scene_destroy(&s);
+    sl_diag_destroy(&d);
+}
+
 static void test_variables_degenerate_instances(void **state)
 {
     (void)state;
@@ -285,6 +321,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_cube),
         cmocka_unit_test(test_normals),
+        cmocka_unit_test(test_flat_faces_cut_for_variables),
         cmocka_unit_test(test_cut_faces),
         cmocka_unit_test(test_variables_degenerate_instances),
         cmocka_unit_test(test_errors),
