@@ -31,7 +31,9 @@
  * Other primitive variables ("st", "Cs", user-declared; every class) go
  * with each surface (rib_primvar.c): a face whose variables differ at its
  * corners is cut into triangles too, over each of which they are linear
- * (flat ones, without corner normals, where the face is flat).
+ * (flat ones, without corner normals, where the face is flat), unless the
+ * face is flat and they are affine in its (u,v) ("st" across a wall of
+ * quads): then it stays one polygon with them linear over it.
  * A Polygon with variables is read as a one-face mesh (rib_polygon_vars).
  *
  * Threads (issue 23): a large PointsPolygons or PointsGeneralPolygons mesh
@@ -322,13 +324,18 @@ static bool add_face(rib_parser *p, mesh *m, int face, const int *loop_sizes, in
             for (int i = 0; i < total; i++)
                 corners[i] = corner_of(m, face, idx, i);
             bool flat = m->ncls == MESH_N_NONE || corners_flat(m, s, face, idx, total);
-            if (flat && rib_primvars_same_at(&m->pv, corners, total)) {
+            scene_primvar vars[RIB_MAX_PRIMVARS];
+            bool same = flat && rib_primvars_same_at(&m->pv, corners, total);
+            /* one polygon where its variables are constant, or affine in
+             * its (u,v) ("st" across a wall of quads) */
+            if (same || (flat && s->nuv == total &&
+                         rib_primvars_polygon(&m->pv, corners, (const double (*)[2])s->uv, total,
+                                              vars))) {
                 if (m->out) {
                     add_piece(m, SCENE_PIECE_POLYGON, face, NULL, total);
                     return true;
                 }
-                scene_primvar vars[RIB_MAX_PRIMVARS];
-                rib_primvars_constant(&m->pv, &corners[0], vars);
+                if (same) rib_primvars_constant(&m->pv, &corners[0], vars);
                 add_with_vars(p, m, s, vars);
                 return true;
             }

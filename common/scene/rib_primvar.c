@@ -196,6 +196,41 @@ bool rib_primvars_triangle(const rib_primvars *pv, const rib_corner c[3],
     return true;
 }
 
+bool rib_primvars_polygon(const rib_primvars *pv, const rib_corner *c, const double (*uv)[2],
+                          int n, scene_primvar *out)
+{
+    /* the plane of the fan triangle (0, i, i + 1) widest in (u,v) */
+    int best = -1;
+    double area = 0;
+    for (int i = 1; i + 1 < n; i++) {
+        double d1u = uv[i][0] - uv[0][0], d1v = uv[i][1] - uv[0][1];
+        double d2u = uv[i + 1][0] - uv[0][0], d2v = uv[i + 1][1] - uv[0][1];
+        double a = fabs(d1u * d2v - d1v * d2u);
+        if (a > area) {
+            area = a;
+            best = i;
+        }
+    }
+    if (best < 0) return false;
+    const rib_corner tc[3] = {c[0], c[best], c[best + 1]};
+    const double tuv[3][2] = {{uv[0][0], uv[0][1]},
+                              {uv[best][0], uv[best][1]},
+                              {uv[best + 1][0], uv[best + 1][1]}};
+    if (!rib_primvars_triangle(pv, tc, tuv, out)) return false;
+    /* and every corner on that plane */
+    for (int k = 0; k < pv->n; k++)
+        for (int i = 0; i < n; i++) {
+            const double *v = value_at(&pv->v[k], &c[i]);
+            for (int j = 0; j < pv->v[k].size; j++) {
+                double fit = out[k].c[0][j] + out[k].c[1][j] * uv[i][0] + out[k].c[4][j] * uv[i][1];
+                double size = fabs(out[k].c[0][j]) + fabs(out[k].c[1][j]) + fabs(out[k].c[4][j]) +
+                              fabs(v[j]);
+                if (!(fabs(fit - v[j]) <= 1e-12 * size)) return false;
+            }
+        }
+    return true;
+}
+
 void rib_primvars_bilinear(const rib_primvars *pv, const rib_corner c[4], scene_primvar *out)
 {
     for (int k = 0; k < pv->n; k++) {

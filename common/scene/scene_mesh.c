@@ -352,8 +352,14 @@ bool scene_mesh_piece_surface(const scene_mesh *self, int k, geom_surface *s,
         for (int i = 0; i < n; i++) s->verts[i] = point_at(self, self->idx[pc->fv0 + i]);
         if (!geom_surface_prepare(s, err, sizeof err)) return false;
         if (self->pv.n > 0) {
-            rib_corner c0 = corner_at(self, pc, 0);
-            rib_primvars_constant(&self->pv, &c0, vars);
+            /* constant, or affine in its (u,v) (rib_mesh.c kept it whole) */
+            rib_corner c[GEOM_MAX_POLY_VERTS];
+            for (int i = 0; i < n; i++) c[i] = corner_at(self, pc, i);
+            if (rib_primvars_same_at(&self->pv, c, n))
+                rib_primvars_constant(&self->pv, &c[0], vars);
+            else if (s->nuv != n ||
+                     !rib_primvars_polygon(&self->pv, c, (const double (*)[2])s->uv, n, vars))
+                return false;
         }
         return true;
     }

@@ -184,12 +184,26 @@ static void test_normals(void **state)
     sl_diag_destroy(&d);
 }
 
-/* A flat face cut into triangles only because its variables differ at
- * its corners ("st" across a wall) keeps flat triangles, without corner
- * normals (its corners' normals are its own: crack-free as it is), so a
- * displacement along N moves them by a constant that the renderer
- * intersects exactly; a folded face's triangles keep theirs. */
-static void test_flat_faces_cut_for_variables(void **state)
+/* The value of primitive variable k of piece pc at its corner i: the
+ * polynomial in (u,v) (scene.h) at that corner's (u,v) */
+static double corner_value(const test_piece *pc, int k, int comp, int i)
+{
+    const scene_primvar *v = &pc->primvars[k];
+    double u = pc->surface.uv[i][0], w = pc->surface.uv[i][1], sum = 0;
+    for (int a = 0; a < 4; a++)
+        for (int b = 0; b < 4; b++)
+            sum += v->c[a + 4 * b][comp] * pow(u, a) * pow(w, b);
+    return sum;
+}
+
+/* Flat faces whose variables differ at their corners ("st" across a wall
+ * of quads): where the variables are affine in the face's (u,v), it stays
+ * one polygon with them linear over it (at each corner its given value);
+ * where they are not, it is cut into triangles, flat ones without corner
+ * normals (its corners' normals are its own: crack-free as it is). Either
+ * way a displacement along N moves them by a constant that the renderer
+ * intersects exactly. A folded face's triangles keep their corner normals. */
+static void test_flat_faces_with_variables(void **state)
 {
     (void)state;
     sl_diag *d;
@@ -198,6 +212,9 @@ static void test_flat_faces_cut_for_variables(void **state)
         "  \"P\" [0 0 0  1 0 0  2 0 0  0 1 0  1 1 0  2 1 0]\n"
         "  \"st\" [0 0  0.5 0  1 0  0 1  0.5 1  1 1]\n"
         "PointsPolygons [4 4] [0 1 4 3  1 2 5 4]\n"
+        "  \"P\" [0 0 0  1 0 0  2 0 0  0 1 0  1 1 0  2 1 0]\n"
+        "  \"st\" [0 0  0.5 0  1 0  0 1  0.7 1  1 1]\n"
+        "PointsPolygons [4 4] [0 1 4 3  1 2 5 4]\n"
         "  \"P\" [0 0 0  1 0 1  2 0 0  0 1 0  1 1 1  2 1 0]\n"
         "  \"st\" [0 0  0.5 0  1 0  0 1  0.5 1  1 1]\n"), &d);
     if (!s)
@@ -205,16 +222,36 @@ static void test_flat_faces_cut_for_variables(void **state)
     assert_non_null(s);
     int np;
     test_piece *pc = scene_pieces(s, &np);
-    assert_int_equal(np, 4 + 4);
-    for (int i = 0; i < 4; i++) {
+    assert_int_equal(np, 2 + 4 + 4);
+    /* affine st: two polygons, st at every corner as given */
+    const double st[6][2] = {{0, 0}, {0.5, 0}, {1, 0}, {0, 1}, {0.5, 1}, {1, 1}};
+    const int quad[2][4] = {{0, 1, 4, 3}, {1, 2, 5, 4}};
+    for (int f = 0; f < 2; f++) {
+        const geom_surface *g = &pc[f].surface;
+        assert_int_equal(g->nverts, 4);
+        assert_int_equal(g->nvn, 0);
+        assert_int_equal(pc[f].nprimvars, 2);        /* s and t */
+        for (int i = 0; i < 4; i++) {
+            /* the corner of the polygon at this point of the face */
+            int c = -1;
+            for (int k = 0; k < 4; k++)
+                if (g->verts[i].x == (quad[f][k] % 3) && g->verts[i].y == (quad[f][k] / 3)) c = k;
+            assert_true(c >= 0);
+            for (int k = 0; k < 2; k++)
+                assert_true(fabs(corner_value(&pc[f], k, 0, i) - st[quad[f][c]][k]) < 1e-12);
+        }
+    }
+    /* st not affine on the first quad: triangles, flat */
+    for (int i = 2; i < 6; i++) {
         assert_int_equal(pc[i].surface.nverts, 3);
         assert_int_equal(pc[i].surface.nvn, 0);
     }
-    for (int i = 4; i < 8; i++) {
+    assert_true(fabs(polygon_area(pc, 2, 6) - 2) < 1e-12);
+    /* folded: triangles with corner normals */
+    for (int i = 6; i < 10; i++) {
         assert_int_equal(pc[i].surface.nverts, 3);
         assert_int_equal(pc[i].surface.nvn, 3);
     }
-    assert_true(fabs(polygon_area(pc, 0, 4) - 2) < 1e-12);
     free(pc);
     scene_destroy(&s);
     sl_diag_destroy(&d);
@@ -321,7 +358,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_cube),
         cmocka_unit_test(test_normals),
-        cmocka_unit_test(test_flat_faces_cut_for_variables),
+        cmocka_unit_test(test_flat_faces_with_variables),
         cmocka_unit_test(test_cut_faces),
         cmocka_unit_test(test_variables_degenerate_instances),
         cmocka_unit_test(test_errors),

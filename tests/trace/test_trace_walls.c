@@ -80,6 +80,13 @@ static const char *RAISED_SL =
     "    P += Km * step(0.5, s) * normalize(N);\n"
     "}\n";
 
+/* a step up by Km across s = 0.3, a seam no cell's side lies on */
+static const char *RAISED3_SL =
+    "displacement raised3(float Km = 0.1)\n"
+    "{\n"
+    "    P += Km * step(0.3, s) * normalize(N);\n"
+    "}\n";
+
 /* flagged (a step) but continuous: 0 on both sides of s = 0.5 */
 static const char *HINGE_SL =
     "displacement hinge(float Km = 0.1)\n"
@@ -345,28 +352,39 @@ static void test_proven_steps_take_no_samples(void **state)
     fixture_close(&f);
 }
 
+/* The diamond |x| + |y| <= sqrt 2 at z = 0, "st" 0 0, 1 0, 1 1, 0 1 at
+ * its corners (0, -r), (r, 0), (0, r), (-r, 0): s = (x + y) / (2 r) + 1/2.
+ * Its cells' object-space boxes are loose (the cells run diagonally), so
+ * rays meet boxes of cells whose surface they pass beside. */
+#define DIAMOND_R 1.4142135623730951
+static bool in_diamond(double x, double y) { return fabs(x) + fabs(y) <= DIAMOND_R; }
+
 /* The exact first hit (object space t; INFINITY: none) of the ray o + t d
- * with the raised step on the square [-1, 1]^2 at z = 0, s = (x + 1) / 2:
- * the plane z = h where x >= 0, z = 0 where x < 0, and the wall x = 0
- * between them; *kind 0 the low plane, 1 the raised one, 2 the wall */
-static double step_hit(vec3 o, vec3 d, double h, int *kind)
+ * with the raised step on the diamond, its edge where s = s0: the plane
+ * z = h where s >= s0, z = 0 where s < s0, and the wall between them;
+ * *kind 0 the low plane, 1 the raised one, 2 the wall */
+static double step_hit(vec3 o, vec3 d, double h, double s0, int *kind)
 {
     double best = INFINITY;
     *kind = -1;
+    /* g(x, y) = s - s0, affine */
+    double gx = 1 / (2 * DIAMOND_R), gy = gx, g0 = 0.5 - s0;
     if (d.z != 0) {
         double tz[2] = {(0 - o.z) / d.z, (h - o.z) / d.z};
         for (int k = 0; k < 2; k++) {
-            double x = o.x + tz[k] * d.x, y = o.y + tz[k] * d.y;
-            bool side = k == 1 ? x >= 0 : x < 0;
-            if (tz[k] > 0 && side && fabs(x) <= 1 && fabs(y) <= 1 && tz[k] < best) {
+            double x = o.x + tz[k] * d.x, y = o.y + tz[k] * d.y, g = g0 + gx * x + gy * y;
+            bool side = k == 1 ? g >= 0 : g < 0;
+            if (tz[k] > 0 && side && in_diamond(x, y) && tz[k] < best) {
                 best = tz[k];
                 *kind = k;
             }
         }
     }
-    if (d.x != 0) {
-        double tw = -o.x / d.x, y = o.y + tw * d.y, z = o.z + tw * d.z;
-        if (tw > 0 && fabs(y) <= 1 && z >= fmin(0, h) && z <= fmax(0, h) && tw < best) {
+    double gd = gx * d.x + gy * d.y;
+    if (gd != 0) {
+        double tw = -(g0 + gx * o.x + gy * o.y) / gd;
+        double x = o.x + tw * d.x, y = o.y + tw * d.y, z = o.z + tw * d.z;
+        if (tw > 0 && in_diamond(x, y) && z >= fmin(0, h) && z <= fmax(0, h) && tw < best) {
             best = tw;
             *kind = 2;
         }
@@ -374,33 +392,43 @@ static double step_hit(vec3 o, vec3 d, double h, int *kind)
     return best;
 }
 
-/* The raised step seen at a slant, one ray per pixel centre, against its
- * exact hits (step_hit): every hit that claims to be exact
- * (TRACE_LEAF_PROVEN: proofs, undisplaced and moved cells, and the cells
- * of two planes, planes_cell) is at the exact hit's t (to 1e-6 of it: a
- * hit proof's Newton point is a few 1e-9 off), and so is every hit whose
- * exact hit is on a plane away from the polygon's border; every ray whose
- * exact hit is on the wall hits (a wall leaf, at its box's entry). The
- * cells of two planes settle rays beside the wall by the first plane the
- * ray crosses, where the surface there is that plane: without that check
- * the raised plane is drawn over the low one there, as exact hits. */
+/* The raised step (at s = 0.3) on the diamond seen at a slant, one ray per
+ * pixel centre, against its exact hits (step_hit): every hit that claims
+ * to be exact (TRACE_LEAF_PROVEN: proofs, undisplaced and moved cells,
+ * and the cells of two planes, planes_cell) is at the exact hit's t (to
+ * 1e-6 of it: a hit proof's Newton point is a few 1e-9 off), and so is
+ * every hit whose exact hit is on a plane away from the border and the
+ * wall; every ray whose exact hit is on the wall hits (a wall leaf, at its
+ * box's entry). The cells of two planes settle rays by the first plane
+ * they cross, where the surface there is that plane (without that check
+ * the raised plane is drawn over the low one, as exact hits), or as
+ * misses where the rays' stretch between the planes passes beside them. */
 static void test_planes_hit_exactly_beside_the_wall(void **state)
 {
     (void)state;
     const char *rib = "Format 96 72 1\nProjection \"perspective\" \"fov\" [40]\n"
                       "Translate 0 -0.2 3\nRotate -50 1 0 0\nRotate 20 0 0 1\nWorldBegin\n"
-                      "Displacement \"raised\"\n"
-                      "Polygon \"P\" [-1 -1 0  1 -1 0  1 1 0  -1 1 0] "
+                      "Displacement \"raised3\"\n"
+                      "Polygon \"P\" [0 -1.4142135623730951 0  1.4142135623730951 0 0  "
+                      "0 1.4142135623730951 0  -1.4142135623730951 0 0] "
                       "\"st\" [0 0  1 0  1 1  0 1]\nWorldEnd\n";
     fixture f;
-    fixture_shader sh[] = {{"raised", RAISED_SL}};
+    fixture_shader sh[] = {{"raised3", RAISED3_SL}};
     assert_true(fixture_open(&f, rib, sh, 1, NULL, 0));
     trace_thread *th = trace_thread_new(&f.js->world);
     const trace_object *obj = &f.js->world.objects[0];
-    /* the side N points to (the raised plane's z): the step's height */
-    trace_surface_point sp;
-    trace_surface_point_eval(th, obj, 0.75, 0.5, &sp);
-    double h = mat4_xform_point(&obj->from_camera, sp.P).z;
+    /* the side N points to (the raised plane's z): the step's height, at
+     * the point (0.5, 0.5) of the diamond (s = 0.75) */
+    double h = NAN;
+    for (int k = 0; k < 64 && isnan(h); k++) {
+        double u = (k % 8 + 0.5) / 8, v = (k / 8 + 0.5) / 8;
+        trace_surface_point sp;
+        trace_surface_point_eval(th, obj, u, v, &sp);
+        vec3 q = mat4_xform_point(&obj->from_camera, sp.P);
+        geom_sample g;
+        geom_eval(&obj->surf, u, v, &g);
+        if (in_diamond(g.P.x, g.P.y) && (g.P.x + g.P.y) / (2 * DIAMOND_R) + 0.5 > 0.5) h = q.z;
+    }
     assert_true(fabs(fabs(h) - 0.1) < 1e-12);
     int proven = 0, proven_ok = 0, beside = 0, planes = 0, planes_ok = 0, walls = 0,
         walls_hit = 0;
@@ -412,21 +440,24 @@ static void test_planes_hit_exactly_beside_the_wall(void **state)
             vec3 o = mat4_xform_point(&obj->from_camera, ray.o),
                  d = mat4_xform_vector(&obj->from_camera, ray.d);
             int kind;
-            double te = step_hit(o, d, h, &kind);
+            double te = step_hit(o, d, h, 0.3, &kind);
             trace_hit hit = {.t = ray.tmax, .obj = NULL};
             bool found = trace_bvh_intersect(f.js->renderer->bvh, th, &ray,
                                              &f.js->renderer->primary_tol, false, &hit);
             bool exact = found && fabs(hit.t - te) <= 1e-6 * te;
             vec3 p = v3_add(o, v3_scale(d, te));
+            /* distances from the border and from the wall, object units */
+            double border = DIAMOND_R - fabs(p.x) - fabs(p.y),
+                   wall = fabs((p.x + p.y) / (2 * DIAMOND_R) + 0.5 - 0.3) * 2 * DIAMOND_R;
             if (found && hit.kind == TRACE_LEAF_PROVEN) {
                 proven++;
                 proven_ok += exact;
-                beside += kind >= 0 && kind < 2 && fabs(p.x) < 0.05;
+                beside += kind >= 0 && kind < 2 && wall < 0.05;
             }
             if (kind == 2) {
                 walls++;
                 walls_hit += found;
-            } else if (kind >= 0 && fabs(p.x) < 0.95 && fabs(p.y) < 0.95 && fabs(p.x) > 0.05) {
+            } else if (kind >= 0 && border > 0.05 && wall > 0.05) {
                 planes++;
                 planes_ok += exact;
             }
