@@ -7,12 +7,13 @@
 #       defaults: build/bin; bricks bricks_filtered slate_roof tiles_hex
 #       tiles_pillow pnoise_tiles uv_quilt fwp_checks
 #
-# Two scenes (PATTERN_BENCH_SCENES, default "sphere wall"): test_corpus_render's
+# Three scenes (PATTERN_BENCH_SCENES, default "sphere wall mesh"): test_corpus_render's
 # sphere (tests/corpus/corpus.c, CORPUS_SPHERE: Translate 0 0 5, Rotate 70
 # 1 0 0, Sphere 1 -1 1 360, fov 35) at 96x72, and a flat wall (a 3 x 2
 # polygon, s and t across it, turned 30 degrees about the vertical and
 # seen from 3 units, fov 40, Km 0.03: the patterns' steps as real walls)
-# at 256x192; one thread, affine arithmetic, the default box cache. For
+# at 256x192, and the same wall as production models it (a PointsPolygons
+# mesh of 3 x 2 quads sharing their points, "st" per point); one thread, affine arithmetic, the default box cache. For
 # each scene and shader one line: CPU seconds of the render (user + system, /usr/bin/time),
 # and from `aafarm-worker --stats`: boxes per ray (box evaluations through
 # the shader / rays), evals per ray (affine + dual + float evaluations /
@@ -41,11 +42,11 @@ trap 'rm -rf "$WORK"' EXIT
 # the value of a --stats line
 stat() { awk -v k="$1" '$1 == k {print $2; exit}' "$2"; }
 
-echo "pattern_bench: corpus sphere 96x72 and a wall 256x192, 1 thread, affine ($(date -u +%F), $(uname -m), $(nproc) cores)"
+echo "pattern_bench: corpus sphere 96x72, a wall 256x192 (a polygon, a mesh), 1 thread, affine ($(date -u +%F), $(uname -m), $(nproc) cores)"
 printf "%-6s %-16s %8s %10s %10s %9s %8s %7s %9s %7s\n" scene shader "CPU s" boxes/ray evals/ray samplings sampled \
     walls max_nodes limited
 status=0
-for scene in ${PATTERN_BENCH_SCENES:-sphere wall}; do
+for scene in ${PATTERN_BENCH_SCENES:-sphere wall mesh}; do
 for sh in "${SHADERS[@]}"; do
     [ -r "$CORPUS/$sh.sl" ] || { echo "pattern_bench.sh: no shader $CORPUS/$sh.sl" >&2; status=1; continue; }
     case $scene in
@@ -77,7 +78,25 @@ Polygon "P" [-1.5 -1 0  1.5 -1 0  1.5 1 0  -1.5 1 0] "st" [0 0  1 0  1 1  0 1]
 WorldEnd
 EOF
         ;;
-    *) echo "pattern_bench.sh: no scene $scene (sphere, wall)" >&2; status=1; continue ;;
+    mesh) cat > "$WORK/$sh.rib" <<EOF
+Option "searchpath" "shader" ["$CORPUS:&"]
+Format 256 192 1
+Projection "perspective" "fov" [40]
+Translate 0 0 3
+Rotate -30 0 1 0
+WorldBegin
+LightSource "distantlight" 1 "from" [-1 2 -2] "to" [0 0 0]
+Attribute "displacementbound" "sphere" [0.05]
+Displacement "$sh" "float Km" [0.03]
+PointsPolygons [4 4 4 4 4 4] [0 1 5 4  1 2 6 5  2 3 7 6  4 5 9 8  5 6 10 9  6 7 11 10]
+  "P" [-1.5 -1 0  -0.5 -1 0  0.5 -1 0  1.5 -1 0  -1.5 0 0  -0.5 0 0  0.5 0 0  1.5 0 0
+       -1.5 1 0  -0.5 1 0  0.5 1 0  1.5 1 0]
+  "st" [0 0  0.333333333333 0  0.666666666667 0  1 0  0 0.5  0.333333333333 0.5
+        0.666666666667 0.5  1 0.5  0 1  0.333333333333 1  0.666666666667 1  1 1]
+WorldEnd
+EOF
+        ;;
+    *) echo "pattern_bench.sh: no scene $scene (sphere, wall, mesh)" >&2; status=1; continue ;;
     esac
     if ! /usr/bin/time -f "%U %S" -o "$WORK/time" timeout -k 5 "$LIMIT" \
             "$BIN/aafarm-worker" --standalone "$WORK/$sh.rib" -o "$WORK/$sh.exr" -t 1 \
