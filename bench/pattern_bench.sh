@@ -42,6 +42,24 @@ trap 'rm -rf "$WORK"' EXIT
 # the value of a --stats line
 stat() { awk -v k="$1" '$1 == k {print $2; exit}' "$2"; }
 
+# The wall scene for shader $1 with the geometry $2 (RIB text): the wall
+# as a polygon, or as a mesh of quads
+wall_rib() {
+    cat <<EOF
+Option "searchpath" "shader" ["$CORPUS:&"]
+Format 256 192 1
+Projection "perspective" "fov" [40]
+Translate 0 0 3
+Rotate -30 0 1 0
+WorldBegin
+LightSource "distantlight" 1 "from" [-1 2 -2] "to" [0 0 0]
+Attribute "displacementbound" "sphere" [0.05]
+Displacement "$1" "float Km" [0.03]
+$2
+WorldEnd
+EOF
+}
+
 echo "pattern_bench: corpus sphere 96x72, a wall 256x192 (a polygon, a mesh), 1 thread, affine ($(date -u +%F), $(uname -m), $(nproc) cores)"
 printf "%-6s %-16s %8s %10s %10s %9s %8s %7s %9s %7s\n" scene shader "CPU s" boxes/ray evals/ray samplings sampled \
     walls max_nodes limited
@@ -64,38 +82,13 @@ AttributeEnd
 WorldEnd
 EOF
         ;;
-    wall) cat > "$WORK/$sh.rib" <<EOF
-Option "searchpath" "shader" ["$CORPUS:&"]
-Format 256 192 1
-Projection "perspective" "fov" [40]
-Translate 0 0 3
-Rotate -30 0 1 0
-WorldBegin
-LightSource "distantlight" 1 "from" [-1 2 -2] "to" [0 0 0]
-Attribute "displacementbound" "sphere" [0.05]
-Displacement "$sh" "float Km" [0.03]
-Polygon "P" [-1.5 -1 0  1.5 -1 0  1.5 1 0  -1.5 1 0] "st" [0 0  1 0  1 1  0 1]
-WorldEnd
-EOF
-        ;;
-    mesh) cat > "$WORK/$sh.rib" <<EOF
-Option "searchpath" "shader" ["$CORPUS:&"]
-Format 256 192 1
-Projection "perspective" "fov" [40]
-Translate 0 0 3
-Rotate -30 0 1 0
-WorldBegin
-LightSource "distantlight" 1 "from" [-1 2 -2] "to" [0 0 0]
-Attribute "displacementbound" "sphere" [0.05]
-Displacement "$sh" "float Km" [0.03]
-PointsPolygons [4 4 4 4 4 4] [0 1 5 4  1 2 6 5  2 3 7 6  4 5 9 8  5 6 10 9  6 7 11 10]
+    wall) wall_rib "$sh" 'Polygon "P" [-1.5 -1 0  1.5 -1 0  1.5 1 0  -1.5 1 0] "st" [0 0  1 0  1 1  0 1]' \
+              > "$WORK/$sh.rib" ;;
+    mesh) wall_rib "$sh" 'PointsPolygons [4 4 4 4 4 4] [0 1 5 4  1 2 6 5  2 3 7 6  4 5 9 8  5 6 10 9  6 7 11 10]
   "P" [-1.5 -1 0  -0.5 -1 0  0.5 -1 0  1.5 -1 0  -1.5 0 0  -0.5 0 0  0.5 0 0  1.5 0 0
        -1.5 1 0  -0.5 1 0  0.5 1 0  1.5 1 0]
   "st" [0 0  0.333333333333 0  0.666666666667 0  1 0  0 0.5  0.333333333333 0.5
-        0.666666666667 0.5  1 0.5  0 1  0.333333333333 1  0.666666666667 1  1 1]
-WorldEnd
-EOF
-        ;;
+        0.666666666667 0.5  1 0.5  0 1  0.333333333333 1  0.666666666667 1  1 1]' > "$WORK/$sh.rib" ;;
     *) echo "pattern_bench.sh: no scene $scene (sphere, wall, mesh)" >&2; status=1; continue ;;
     esac
     if ! /usr/bin/time -f "%U %S" -o "$WORK/time" timeout -k 5 "$LIMIT" \

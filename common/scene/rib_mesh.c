@@ -325,17 +325,14 @@ static bool add_face(rib_parser *p, mesh *m, int face, const int *loop_sizes, in
                 corners[i] = corner_of(m, face, idx, i);
             bool flat = m->ncls == MESH_N_NONE || corners_flat(m, s, face, idx, total);
             scene_primvar vars[RIB_MAX_PRIMVARS];
-            bool same = flat && rib_primvars_same_at(&m->pv, corners, total);
             /* one polygon where its variables are constant, or affine in
              * its (u,v) ("st" across a wall of quads) */
-            if (same || (flat && s->nuv == total &&
-                         rib_primvars_polygon(&m->pv, corners, (const double (*)[2])s->uv, total,
-                                              vars))) {
+            const double (*uv)[2] = s->nuv == total ? (const double (*)[2])s->uv : NULL;
+            if (flat && rib_primvars_polygon(&m->pv, corners, uv, total, vars)) {
                 if (m->out) {
                     add_piece(m, SCENE_PIECE_POLYGON, face, NULL, total);
                     return true;
                 }
-                if (same) rib_primvars_constant(&m->pv, &corners[0], vars);
                 add_with_vars(p, m, s, vars);
                 return true;
             }

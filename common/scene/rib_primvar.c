@@ -199,6 +199,11 @@ bool rib_primvars_triangle(const rib_primvars *pv, const rib_corner c[3],
 bool rib_primvars_polygon(const rib_primvars *pv, const rib_corner *c, const double (*uv)[2],
                           int n, scene_primvar *out)
 {
+    if (rib_primvars_same_at(pv, c, n)) {
+        rib_primvars_constant(pv, &c[0], out);
+        return true;
+    }
+    if (!uv) return false;
     /* the plane of the fan triangle (0, i, i + 1) widest in (u,v) */
     int best = -1;
     double area = 0;

@@ -60,11 +60,13 @@ bool rib_primvars_same_at(const rib_primvars *pv, const rib_corner *c, int n);
 bool rib_primvars_triangle(const rib_primvars *pv, const rib_corner c[3],
                            const double uv[3][2], scene_primvar *out);
 
-/* The variables over a flat polygon of n corners c[i] at (u,v) = uv[i]
- * where every one is affine in (u,v) there (the plane of three corners
- * holds the others to 1e-12 of the values' size): linear in (u,v), as
- * over a triangle, the same bits where all corners agree. False (out
- * undefined) where one is not: the face is cut into triangles. */
+/* The variables over a flat polygon of n corners c[i] at (u,v) = uv[i]:
+ * constant where every one has one value at all corners
+ * (rib_primvars_constant), else linear in (u,v), as over a triangle,
+ * where every one is affine there (the plane of three corners holds the
+ * others to 1e-12 of the values' size). False (out undefined) where one
+ * is not, or uv is NULL (corners without their own (u,v)) and one varies:
+ * the face is cut into triangles. */
 bool rib_primvars_polygon(const rib_primvars *pv, const rib_corner *c, const double (*uv)[2],
                           int n, scene_primvar *out);
 

@@ -355,11 +355,8 @@ bool scene_mesh_piece_surface(const scene_mesh *self, int k, geom_surface *s,
             /* constant, or affine in its (u,v) (rib_mesh.c kept it whole) */
             rib_corner c[GEOM_MAX_POLY_VERTS];
             for (int i = 0; i < n; i++) c[i] = corner_at(self, pc, i);
-            if (rib_primvars_same_at(&self->pv, c, n))
-                rib_primvars_constant(&self->pv, &c[0], vars);
-            else if (s->nuv != n ||
-                     !rib_primvars_polygon(&self->pv, c, (const double (*)[2])s->uv, n, vars))
-                return false;
+            const double (*uv)[2] = s->nuv == n ? (const double (*)[2])s->uv : NULL;
+            if (!rib_primvars_polygon(&self->pv, c, uv, n, vars)) return false;
         }
         return true;
     }

@@ -505,8 +505,8 @@ static double lin_radius(const trace_lin *l)
 }
 
 /* The boxes of the cell's remaining cases (sl_vm_split_next has given
- * the first of them, whose box *hull is) united into *hull; where cs is
- * given, each added to it */
+ * the first of them, whose box *hull is) united into *hull, each added
+ * to cs */
 static void union_cases(trace_thread *th, const trace_object *obj, const affine_cell *cell,
                         trace_box *hull, case_set *cs)
 {
@@ -517,31 +517,42 @@ static void union_cases(trace_thread *th, const trace_object *obj, const affine_
         vec3 move = v3(NAN, NAN, NAN);
         affine_shade(th, obj, cell, P, &same, &move);
         box_from_affine(P, &b);
-        if (cs) case_add(cs, &th->ctx, P, &b, same, move);
+        case_add(cs, &th->ctx, P, &b, same, move);
         trace_box_union(hull, &b);
     } while (!th->failed && sl_vm_split_next(th->vm));
 }
 
-/* The cell's base surface and the first of its case runs (the VM's
- * splits begun; the caller ends them): its box in *hull, and in cs (a new
- * set) where given; where P is given, the run's forms there and what it
- * did to the base in *same (the plain run's, where it split nothing) */
-static void first_case(trace_thread *th, const trace_object *obj, double u0, double u1,
-                       double v0, double v1, affine_cell *cell, trace_box *hull,
-                       aa_form P[3], trace_moved *same, case_set *cs)
+/* What the case runs of a cell came to (run_cases) */
+typedef enum {
+    CASES_NONE,                   /* nothing split (or a run failed) */
+    CASES_FULL,                   /* more seams than TRACE_SPLIT_OPS */
+    CASES_SPLIT                   /* every case run, in *hull and cs */
+} cases_result;
+
+/* The cell's base surface and its case runs, the VM's splits begun and
+ * ended here: the first run's forms in P and what it did to the base in
+ * *same (the plain run's, where it split nothing), its box in *hull, and,
+ * where something split and the seams fit the cases, every case's box
+ * united into *hull and added to cs. The base surface stays in *cell. */
+static cases_result run_cases(trace_thread *th, const trace_object *obj, double u0, double u1,
+                              double v0, double v1, affine_cell *cell, aa_form P[3],
+                              trace_moved *same, trace_box *hull, case_set *cs)
 {
-    aa_form Q[3];
-    trace_moved moved;
+    sl_vm *vm = th->vm;
     vec3 move = v3(NAN, NAN, NAN);
     affine_geometry(th, obj, u0, u1, v0, v1, cell);
-    sl_vm_split_begin(th->vm, TRACE_SPLIT_OPS);
-    affine_shade(th, obj, cell, P ? P : Q, &moved, &move);
-    if (same) *same = moved;
-    box_from_affine(P ? P : Q, hull);
-    if (cs) {
-        cs->n = 0;
-        case_add(cs, &th->ctx, P ? P : Q, hull, moved, move);
+    sl_vm_split_begin(vm, TRACE_SPLIT_OPS);
+    affine_shade(th, obj, cell, P, same, &move);
+    box_from_affine(P, hull);
+    cs->n = 0;
+    case_add(cs, &th->ctx, P, hull, *same, move);
+    cases_result r = CASES_FULL;
+    if (!sl_vm_split_full(vm)) {
+        r = !th->failed && sl_vm_split_next(vm) ? CASES_SPLIT : CASES_NONE;
+        if (r == CASES_SPLIT) union_cases(th, obj, cell, hull, cs);
     }
+    sl_vm_split_end(vm);
+    return r;
 }
 
 bool trace_surface_box_cases(trace_thread *th, const trace_object *obj,
@@ -551,23 +562,16 @@ bool trace_surface_box_cases(trace_thread *th, const trace_object *obj,
     if (moves) moves->n = 0;
     obj = trace_box_owner(obj);
     if (th->world->options.arith == TRACE_ARITH_INTERVAL || !obj->displacement) return false;
-    sl_vm *vm = th->vm;
     trace_box hull;
     affine_cell cell;
+    aa_form P[3];
+    trace_moved same;
     case_set cs;
-    first_case(th, obj, u0, u1, v0, v1, &cell, &hull, NULL, NULL, &cs);
-    if (sl_vm_split_full(vm)) {
-        /* more seams than cases: the rest would stay as wide as one run
-         * makes them: not worth the runs */
-        sl_vm_split_end(vm);
-        th->stats.boxes++;
-        return false;
-    }
-    bool split = !th->failed && sl_vm_split_next(vm);
-    if (split) union_cases(th, obj, &cell, &hull, &cs);
-    sl_vm_split_end(vm);
+    /* none where the seams overflow the cases (CASES_FULL): the rest
+     * would stay as wide as one run makes them, not worth the runs */
+    cases_result r = run_cases(th, obj, u0, u1, v0, v1, &cell, P, &same, &hull, &cs);
     th->stats.boxes++;
-    if (th->failed || !split) return false;
+    if (th->failed || r != CASES_SPLIT) return false;
     /* a NaN side (no surface where the cases run): the box as it was */
     if (box_has_nan(&hull)) return false;
     /* both enclose the surface over the cell: so does their meet */
@@ -626,34 +630,25 @@ bool trace_surface_box_split(trace_thread *th, const trace_object *obj,
         trace_surface_box_lin(th, obj, u0, u1, v0, v1, box, lin);
         return false;
     }
-    sl_vm *vm = th->vm;
     trace_box hull;
     affine_cell cell;
     aa_form P[3];
     trace_moved same;
     case_set cs;
-    first_case(th, o, u0, u1, v0, v1, &cell, &hull, P, &same, &cs);
-    bool full = sl_vm_split_full(vm);
-    if (!full && (th->failed || !sl_vm_split_next(vm))) {
-        /* nothing split (or failed): the run was box_affine's own, and so
-         * is the box (its flags and linear bound too) */
-        sl_vm_split_end(vm);
-        box_of_run(th, o, P, same, box, lin);
-        box_finish(th, box);
-        return false;
-    }
-    if (full) {
+    cases_result r = run_cases(th, o, u0, u1, v0, v1, &cell, P, &same, &hull, &cs);
+    if (r == CASES_FULL) {
         /* more seams than cases: the case run is lost, the box as usual
          * (box_affine's run on the same cell) */
-        sl_vm_split_end(vm);
         th->stats.boxes++;
         affine_shade(th, o, &cell, P, &same, NULL);
+    }
+    if (r != CASES_SPLIT) {
+        /* nothing split (or failed): the run was box_affine's own, and so
+         * is the box (its flags and linear bound too) */
         box_of_run(th, o, P, same, box, lin);
         box_finish(th, box);
         return false;
     }
-    union_cases(th, o, &cell, &hull, &cs);
-    sl_vm_split_end(vm);
     th->stats.boxes++;
     if (th->failed || box_has_nan(&hull)) {
         /* a NaN side (no surface where a case runs): the box as usual */
@@ -677,15 +672,14 @@ void trace_surface_case_moves(trace_thread *th, const trace_object *obj, double 
     moves->n = 0;
     obj = trace_box_owner(obj);
     if (th->world->options.arith == TRACE_ARITH_INTERVAL || !obj->displacement) return;
-    sl_vm *vm = th->vm;
     trace_box hull;
     affine_cell cell;
+    aa_form P[3];
+    trace_moved same;
     case_set cs;
-    first_case(th, obj, u0, u1, v0, v1, &cell, &hull, NULL, NULL, &cs);
-    bool split = !sl_vm_split_full(vm) && !th->failed && sl_vm_split_next(vm);
-    if (split) union_cases(th, obj, &cell, &hull, &cs);
-    sl_vm_split_end(vm);
-    if (!th->failed && split) cases_planes(obj, &cs, moves);
+    if (run_cases(th, obj, u0, u1, v0, v1, &cell, P, &same, &hull, &cs) == CASES_SPLIT &&
+        !th->failed)
+        cases_planes(obj, &cs, moves);
 }
 
 /* ---- interval ---- */

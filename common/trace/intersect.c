@@ -869,7 +869,8 @@ static void child_box(walk *w, const trace_box *node, const trace_dlin *lin, con
     /* below a box its cases narrowed, the children run their cases first
      * (the plain run of one across the same seam is stagnant again) */
     bool cases_first = (node->flags & TRACE_BOX_SPLIT) != 0, split = false;
-    trace_case_moves moves = {0};
+    trace_case_moves moves;
+    moves.n = 0;                          /* set by the cases below, where they run */
     if (cases_first)
         split = trace_surface_box_split(th, owner, c[0], c[1], c[2], c[3], kid, kid_lin, &moves);
     else
