@@ -256,28 +256,34 @@ typedef enum {
 } trace_moved;
 
 /* Whether the shader's form a is the base's form b moved by a constant:
- * the same coefficients and flags, the centre anywhere, and an error term
- * grown by no more than the rounding of that move (2^-40 of the centres:
- * far below what the float evaluation of any hit point carries). A
- * displacement that varies over the cell varies a coefficient (one of
- * the cell's symbols) or the error term by more. */
+ * the same coefficients on the base's symbols and the same flags, the
+ * centre anywhere, and what a adds to b's radius (its error term's growth
+ * and its coefficients on symbols b does not use: the rounding of a
+ * product of two constants-up-to-rounding lands on a fresh symbol, as in
+ * a box-filtered pulse inside a brick, (hi - lo) / w) no more than the
+ * rounding of that move (2^-40 of the centres: far below what the float
+ * evaluation of any hit point carries). A displacement that varies over
+ * the cell varies a coefficient of the cell's symbols, or adds more. */
 #define TRACE_OFFSET_SLACK 0x1p-40
 static bool offset_affine(const aa_form *a, const aa_form *b)
 {
     /* AA_DISCONTINUOUS aside: a case run's split values carry it, and
      * box_of_run takes no flagged box for a moved one */
     unsigned fa = a->flags & ~(unsigned)AA_DISCONTINUOUS, fb = b->flags & ~(unsigned)AA_DISCONTINUOUS;
-    if (fa != fb || !isfinite(a->x0) || !(a->err >= b->err) ||
-        !(a->err - b->err <= TRACE_OFFSET_SLACK * (fabs(a->x0) + fabs(b->x0))))
+    if (fa != fb || !isfinite(a->x0) || !(a->err >= b->err))
         return false;
     /* the same coefficients; a symbol one form lacks has 0 in it (an
      * operation may leave a symbol of coefficient 0: a mesh's normal) */
+    double extra = a->err - b->err;
     int n = a->n > b->n ? a->n : b->n;
     for (int i = 0; i < n; i++) {
         double ca = i < a->n ? a->c[i] : 0.0, cb = i < b->n ? b->c[i] : 0.0;
-        if (ca != cb) return false;
+        if (ca != cb) {
+            if (cb != 0.0) return false;
+            extra += fabs(ca);
+        }
     }
-    return true;
+    return extra <= TRACE_OFFSET_SLACK * (fabs(a->x0) + fabs(b->x0));
 }
 
 /* What the shader did to the base's P (both as forms, camera space):

@@ -244,6 +244,56 @@ static void test_raised_wedge_offset_exact(void **state)
     fixture_close(&f);
 }
 
+/* The raised wedge with its height made as a box-filtered pulse makes it
+ * inside a brick (bricks_filtered's idiom): (hi - lo) / w is 1 up to
+ * rounding, and the product of two such factors carries its rounding on a
+ * fresh noise symbol, which the base's forms lack */
+static const char *FILTERED_SL =
+    "displacement filtered(float u0 = 0.13, u1 = 0.25, h = 0.25, w = 0.01)\n"
+    "{\n"
+    "    float x = u * 7.3, y = v * 3.1;\n"
+    "    float lo = x - 0.5 * w, hi = lo + w, a = (hi - lo) / w;\n"
+    "    float lo2 = y - 0.5 * w, hi2 = lo2 + w, b = (hi2 - lo2) / w;\n"
+    "    P += h * (a * b) * step(u0, u) * (1 - step(u1, u)) * normalize(N);\n"
+    "    N = calculatenormal(P);\n"
+    "}\n";
+
+/* A move that is constant up to rounding, some of it on a fresh symbol,
+ * is still a move by a constant: every hit at its plane's depth */
+static void test_rounded_constant_is_offset(void **state)
+{
+    (void)state;
+    fixture f;
+    assert_true(fixture_open_named(&f, DISK_RIB("%s"), "filtered", FILTERED_SL));
+    exact_scan s;
+    scan_exact(&f, raised_wedge, &s);
+    printf("filtered wedge: %d/%d hit, %d at their plane's depth, %d hits off the disk; exact "
+           "cells %ld (offset %ld), boxes %ld, proofs %ld\n", s.hits, s.inside, s.exact,
+           s.outside_hits, s.st.exact_cells, s.st.offset_cells, s.st.boxes, s.st.proofs);
+    assert_all_exact(&s);
+    assert_true(s.st.offset_cells > 0);
+    fixture_close(&f);
+}
+
+/* 1e-6 sin(1e6 u): over any cell a range of [-1e-6, 1e-6] with no u term
+ * (the whole of sin's range), all of it on a fresh symbol or the error
+ * term: a real variation, so no cell is moved by a constant */
+static const char *WIGGLE_SL =
+    "displacement wiggle(float h = 0.25)\n"
+    "{\n"
+    "    P += h * (1 + 1e-6 * sin(1e6 * u)) * normalize(N);\n"
+    "    N = calculatenormal(P);\n"
+    "}\n";
+
+static void test_fresh_symbol_variation_is_not_offset(void **state)
+{
+    (void)state;
+    disk_scan s;
+    scan_disk("wiggle", WIGGLE_SL, &s);
+    assert_int_equal(s.st.offset_cells, 0);
+    assert_int_equal(s.st.exact_cells, 0);
+}
+
 static const char *BUMP_SL =
     "displacement bumponly(float Kb = 0.02)\n"
     "{\n"
@@ -410,6 +460,8 @@ int main(void)
         cmocka_unit_test(test_any_displacement_is_not_undisplaced),
         cmocka_unit_test(test_varying_displacement_is_not_offset),
         cmocka_unit_test(test_raised_wedge_offset_exact),
+        cmocka_unit_test(test_rounded_constant_is_offset),
+        cmocka_unit_test(test_fresh_symbol_variation_is_not_offset),
         cmocka_unit_test(test_sphere_bent_normals_exact),
         cmocka_unit_test(test_patch_bent_normals_exact),
         cmocka_unit_test(test_instances_bent_normals_exact),
