@@ -77,13 +77,18 @@
  * parallel planes and the walls between them, which all lie between the
  * outermost two (intersect.c, "planes_cell") */
 #define TRACE_BOX_PLANES (1u << 16)
+/* The displaced surface over the cell is one plane piece: the run's
+ * forms are affine in the cell's u and v alone, up to rounding
+ * (displace.c, planar_forms: a slate's face, a ramp), intersected
+ * exactly (intersect.c, "planar_cell") */
+#define TRACE_BOX_PLANAR (1u << 17)
 
 typedef struct trace_box {
     vec3 lo, hi;
     unsigned flags;          /* AA_DISCONTINUOUS | AA_UNBOUNDED | TRACE_BOX_SAMPLED |
                                 TRACE_BOX_UNSPLIT | TRACE_BOX_SPLIT | TRACE_BOX_LIN |
                                 TRACE_BOX_LAZY | TRACE_BOX_UNDISPLACED | TRACE_BOX_OFFSET |
-                                TRACE_BOX_STEP | TRACE_BOX_PLANES */
+                                TRACE_BOX_STEP | TRACE_BOX_PLANES | TRACE_BOX_PLANAR */
     float bend;              /* how far from linear in (u,v) the surface is over
                                 the box: the affine forms' other terms over
                                 their u and v terms (displace.c); 0: unknown */

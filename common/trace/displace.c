@@ -11,8 +11,10 @@
  * (globals.inc), so boxes and points see the same surface.
  */
 #include "trace/displace.h"
+#include "trace/cellkey.h"
 #include "trace/normal_memo.h"
 #include "trace/primvar.h"
+#include "util/xalloc.h"
 
 #include <assert.h>
 #include <stdint.h>
@@ -346,14 +348,6 @@ static void affine_shade(trace_thread *th, const trace_object *obj, const affine
     }
 }
 
-static void affine_run(trace_thread *th, const trace_object *obj,
-                       double u0, double u1, double v0, double v1, aa_form P[3],
-                       trace_moved *same)
-{
-    affine_cell c;
-    affine_geometry(th, obj, u0, u1, v0, v1, &c);
-    affine_shade(th, obj, &c, P, same, NULL);
-}
 
 /* The box's linear bound (lin_bound.h; TRACE_BOX_LIN on the box) from
  * the run's forms: per coordinate the centre, the u and v terms (symbols
@@ -381,16 +375,79 @@ static void box_linear(const aa_context *ctx, const aa_form P[3], trace_box *out
     if (run_linear(ctx, P, lin)) out->flags |= TRACE_BOX_LIN;
 }
 
-/* The box of a plain run (one case: nothing split) from its forms P and
- * what it did to the base (affine_shade); lin: where given, the box's
- * linear bound (box_linear, from th->ctx as the run left it) */
-static void box_of_run(trace_thread *th, const trace_object *obj, const aa_form P[3],
-                       trace_moved same, trace_box *out, trace_lin *lin)
+/* Whether the run's object-space forms P are affine in the cell's u and
+ * v symbols alone (symbols 0 and 1: the context gave them), so that the
+ * displaced surface over the cell is one plane piece: every other
+ * coefficient and the error term together at most TRACE_OFFSET_SLACK of
+ * the form's size (the rounding of the run, as for a constant move), no
+ * flag. Then the piece in *out. (A plane on a curved base, or a
+ * displacement that bends, leaves a remainder far above that.) */
+static bool planar_forms(const affine_cell *c, const aa_form P[3], trace_plane *out)
+{
+    const aa_form *u = &c->u, *v = &c->v;
+    if (u->n != 1 || u->err != 0.0 || v->n != 2 || v->c[0] != 0.0 || v->err != 0.0 ||
+        !(u->c[0] > 0.0) || !(v->c[1] > 0.0))
+        return false;                     /* u and v are not symbols 0 and 1 */
+    double q[3], eu[3], ev[3];
+    for (int k = 0; k < 3; k++) {
+        const aa_form *f = &P[k];
+        if (f->flags) return false;
+        double rest = f->err;
+        for (int i = 2; i < f->n; i++) rest += fabs(f->c[i]);
+        q[k] = f->x0;
+        eu[k] = f->n > 0 ? f->c[0] : 0.0;
+        ev[k] = f->n > 1 ? f->c[1] : 0.0;
+        double size = fabs(q[k]) + fabs(eu[k]) + fabs(ev[k]);
+        if (!isfinite(size) || !(rest <= TRACE_OFFSET_SLACK * size)) return false;
+    }
+    out->Q = v3(q[0], q[1], q[2]);
+    out->Eu = v3(eu[0], eu[1], eu[2]);
+    out->Ev = v3(ev[0], ev[1], ev[2]);
+    out->um = u->x0;
+    out->ur = u->c[0];
+    out->vm = v->x0;
+    out->vr = v->c[1];
+    return true;
+}
+
+/* The planes of TRACE_BOX_PLANAR cells, kept per cell in a direct-mapped
+ * per-thread cache as its box is made (box_of_run); a cell the cache lost
+ * runs again (trace_surface_plane). A pure function of object and cell. */
+enum { PLANE_CACHE_LOG2 = 10, PLANE_CACHE_ENTRIES = 1 << PLANE_CACHE_LOG2 };
+typedef struct plane_entry {
+    double r[4];                  /* the cell; r[0] >= r[1]: empty */
+    int obj;
+    trace_plane p;
+} plane_entry;
+struct trace_plane_cache { plane_entry e[PLANE_CACHE_ENTRIES]; };
+
+static plane_entry *plane_slot(trace_thread *th, const trace_object *obj, const double c[4])
+{
+    if (!th->planes) th->planes = xcalloc(1, sizeof *th->planes);   /* zeroed: empty */
+    return &th->planes->e[trace_cell_slot(c, obj->id, PLANE_CACHE_LOG2)];
+}
+
+/* The box of a plain run (one case: nothing split) over the cell from its
+ * forms P and what it did to the base (affine_shade); lin: where given,
+ * the box's linear bound (box_linear, from th->ctx as the run left it) */
+static void box_of_run(trace_thread *th, const trace_object *obj, const affine_cell *cell,
+                       const aa_form P[3], trace_moved same, trace_box *out, trace_lin *lin)
 {
     box_from_affine(P, out);
     if (obj->displacement && !out->flags) {
-        if (same == TRACE_MOVED_NOT) out->flags |= TRACE_BOX_UNDISPLACED;
-        else if (same == TRACE_MOVED_OFFSET) out->flags |= TRACE_BOX_OFFSET;
+        trace_plane pl;
+        if (same == TRACE_MOVED_NOT) {
+            out->flags |= TRACE_BOX_UNDISPLACED;
+        } else if (same == TRACE_MOVED_OFFSET) {
+            out->flags |= TRACE_BOX_OFFSET;
+        } else if (planar_forms(cell, P, &pl)) {
+            out->flags |= TRACE_BOX_PLANAR;
+            double c[4] = {cell->u.lo, cell->u.hi, cell->v.lo, cell->v.hi};
+            plane_entry *e = plane_slot(th, obj, c);
+            memcpy(e->r, c, sizeof e->r);
+            e->obj = obj->id;
+            e->p = pl;
+        }
     }
     if (lin) box_linear(&th->ctx, P, out, lin);
 }
@@ -401,8 +458,29 @@ static void box_affine(trace_thread *th, const trace_object *obj,
 {
     aa_form P[3];
     trace_moved same;
-    affine_run(th, obj, u0, u1, v0, v1, P, &same);
-    box_of_run(th, obj, P, same, out, lin);
+    affine_cell c;
+    affine_geometry(th, obj, u0, u1, v0, v1, &c);
+    affine_shade(th, obj, &c, P, &same, NULL);
+    box_of_run(th, obj, &c, P, same, out, lin);
+}
+
+bool trace_surface_plane(trace_thread *th, const trace_object *obj, double u0, double u1,
+                         double v0, double v1, trace_plane *out)
+{
+    obj = trace_box_owner(obj);
+    double c[4] = {u0, u1, v0, v1};
+    plane_entry *e = plane_slot(th, obj, c);
+    if (trace_cell_is(e->r, e->obj, c, obj->id)) {
+        *out = e->p;
+        return true;
+    }
+    if (th->world->options.arith == TRACE_ARITH_INTERVAL || !obj->displacement) return false;
+    trace_box b;
+    box_affine(th, obj, u0, u1, v0, v1, &b, NULL);
+    th->stats.boxes++;
+    if (th->failed || !(b.flags & TRACE_BOX_PLANAR)) return false;
+    *out = plane_slot(th, obj, c)->p;    /* box_of_run kept it */
+    return true;
 }
 
 /* The cases' box is taken where it is at most this fraction of the box's
@@ -651,7 +729,7 @@ bool trace_surface_box_split(trace_thread *th, const trace_object *obj,
     if (r != CASES_SPLIT) {
         /* nothing split (or failed): the run was box_affine's own, and so
          * is the box (its flags and linear bound too) */
-        box_of_run(th, o, P, same, box, lin);
+        box_of_run(th, o, &cell, P, same, box, lin);
         box_finish(th, box);
         return false;
     }

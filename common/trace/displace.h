@@ -106,6 +106,22 @@ bool trace_surface_box_split(trace_thread *th, const trace_object *obj,
 void trace_surface_case_moves(trace_thread *th, const trace_object *obj, double u0, double u1,
                               double v0, double v1, trace_case_moves *moves);
 
+/* A cell whose displaced surface is one plane piece (TRACE_BOX_PLANAR:
+ * its run's forms are affine in u and v alone): object space,
+ * P(u, v) = Q + e Eu + f Ev where u = um + e ur and v = vm + f vr (e, f in
+ * [-1, 1] over the cell) */
+typedef struct trace_plane {
+    vec3 Q, Eu, Ev;
+    double um, ur, vm, vr;
+} trace_plane;
+
+/* The plane of a TRACE_BOX_PLANAR cell, as the run that made its box gave
+ * it (kept per cell in a per-thread cache; a cell the cache lost runs
+ * again, counted as a box): true with *out, or false where the cell is
+ * not planar. A pure function of (object, range). */
+bool trace_surface_plane(trace_thread *th, const trace_object *obj, double u0, double u1,
+                         double v0, double v1, trace_plane *out);
+
 /* N is constant over the object (its d/du, d/dv are 0): disks, and
  * polygons unless they carry interpolated vertex normals
  * (geom_vertex_normal). */

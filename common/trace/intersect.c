@@ -608,6 +608,41 @@ static bool exact_cell(walk *w, const double c[4], double tol, bool moved)
     return false;
 }
 
+/* A cell whose displaced surface is one plane piece (TRACE_BOX_PLANAR: a
+ * slate's face, a ramp; trace_surface_plane): the ray against that
+ * parallelogram, solved in closed form (Cramer's rule on o + t d = Q + e Eu
+ * + f Ev), is the cell's hit where (u,v) falls in the cell and t before
+ * the best hit; else the cell has none. A hit within 2^-30 of the cell's
+ * side outside it is taken, at the cell's edge (where two cells of one
+ * plane meet, the rounding of either solve must not let a ray through
+ * both). True where the cell is settled so; false (the walk goes on as
+ * before) where the plane is degenerate or the ray runs along it
+ * (|n . d| below 2^-20 of |n| |d|: t is ill-conditioned there). */
+#define PLANAR_GRAZE 0x1p-20
+#define PLANAR_MARGIN 0x1p-30
+static bool planar_cell(walk *w, const double c[4], double tol)
+{
+    trace_plane pl;
+    if (!trace_surface_plane(w->th, w->obj, c[0], c[1], c[2], c[3], &pl)) return false;
+    vec3 n = v3_cross(pl.Eu, pl.Ev), d = w->ray.d;
+    double nd = v3_dot(n, d), nn = v3_dot(n, n);
+    if (!(fabs(nd) > PLANAR_GRAZE * sqrt(nn * v3_dot(d, d)))) return false;
+    w->th->stats.planar_cells++;
+    w->th->stats.exact_cells++;
+    double t = v3_dot(n, v3_sub(pl.Q, w->ray.o)) / nd;
+    if (!(t > w->ray.tmin) || !(t < w->best->t)) return true;
+    vec3 x = v3_sub(trace_ray_at(&w->ray, t), pl.Q);
+    double e = v3_dot(v3_cross(x, pl.Ev), n) / nn, f = v3_dot(v3_cross(pl.Eu, x), n) / nn;
+    double u = pl.um + e * pl.ur, v = pl.vm + f * pl.vr;
+    double mu = PLANAR_MARGIN * (c[1] - c[0]), mv = PLANAR_MARGIN * (c[3] - c[2]);
+    if (!(u >= c[0] - mu && u <= c[1] + mu && v >= c[2] - mv && v <= c[3] + mv)) return true;
+    trace_surface_point sp;
+    trace_surface_point_eval(w->th, w->obj, fmin(fmax(u, c[0]), c[1]), fmin(fmax(v, c[2]), c[3]),
+                             &sp);
+    proven_hit(w, t, tol, &sp);
+    return true;
+}
+
 /* The moves of a TRACE_BOX_PLANES cell's cases (object space;
  * trace_surface_case_moves), kept per cell in a direct-mapped per-thread
  * cache as the single moves are: child_box stores what the cell's cases
@@ -1161,6 +1196,9 @@ static void visit(walk *w, const trace_box *node, const trace_qlin *node_q, cons
             continue;
         if ((kid->flags & TRACE_BOX_PLANES) && w->exact_cells && clear_of_shared_edges(w, c) &&
             planes_cell(w, c, tol))
+            continue;
+        if ((kid->flags & TRACE_BOX_PLANAR) && w->exact_cells && order[k].cover == GEOM_INSIDE &&
+            clear_of_shared_edges(w, c) && planar_cell(w, c, tol))
             continue;
         bool unbounded = (kid->flags & AA_UNBOUNDED) != 0;
         vec3 wall_n = v3(0, 0, 0);

@@ -34,6 +34,8 @@ typedef struct trace_stats {
     long plane_hits;               /* of them, settled by a hit on the plane
                                       it crossed first */
     long plane_misses;             /* or by passing the cell outside the band */
+    long planar_cells;             /* cells of one tilted plane (TRACE_BOX_PLANAR)
+                                      intersected exactly (intersect.c, planar_cell) */
     long rejected_leaves;          /* leaves whose surface point was not on the
                                       ray (depth cap) or not finite: no hit */
     long nodes;                    /* quadtree nodes visited by all rays */

@@ -117,6 +117,7 @@ void trace_thread_destroy(trace_thread **self_p)
     free(self->walls);
     free(self->moves);
     free(self->cases);
+    free(self->planes);
     trace_views_free(self);
     free(self->work);
     free(self);

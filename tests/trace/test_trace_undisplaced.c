@@ -294,6 +294,95 @@ static void test_fresh_symbol_variation_is_not_offset(void **state)
     assert_int_equal(s.st.exact_cells, 0);
 }
 
+/* A ramp: the unit square facing the eye (s = (x + 1) / 2 across it),
+ * pushed away from the eye by h s in camera space: over every cell the
+ * displaced surface is one tilted plane (its forms affine in u and v:
+ * TRACE_BOX_PLANAR), intersected in closed form. RAMP_CURVED_SL bends it
+ * (h s^2): no cell is one plane */
+#define RAMP_H 0.5
+static const char *RAMP_SL =
+    "displacement ramp(float h = 0.5)\n"
+    "{\n"
+    "    P += vector(0, 0, h * s);\n"
+    "    N = calculatenormal(P);\n"
+    "}\n";
+static const char *RAMP_CURVED_SL =
+    "displacement rampcurved(float h = 0.5)\n"
+    "{\n"
+    "    P += vector(0, 0, h * s * s);\n"
+    "    N = calculatenormal(P);\n"
+    "}\n";
+
+#define SQUARE_RIB(shader)                                                 \
+    "Format 64 64 1\nProjection \"perspective\" \"fov\" [45]\n"            \
+    "Translate 0 0 3\nWorldBegin\nDisplacement \"" shader "\"\n"           \
+    "Polygon \"P\" [-1 -1 0  1 -1 0  1 1 0  -1 1 0] \"st\" [0 0  1 0  1 1  0 1]\n" \
+    "WorldEnd\n"
+
+/* The ray t d meets z = 3 + h (x + 1) / 2 at t (3 + h/2) / (d.z - h d.x / 2) */
+static expect ramp(vec3 d, double *zexp)
+{
+    double t = (DEPTH + 0.5 * RAMP_H) / (d.z - 0.5 * RAMP_H * d.x);
+    double x = t * d.x, y = t * d.y;
+    const double m = 0.03;
+    if (fabs(x) > 1 + m || fabs(y) > 1 + m) return EXPECT_MISS;
+    if (fabs(x) > 1 - m || fabs(y) > 1 - m) return EXPECT_SKIP;
+    *zexp = t * d.z;
+    return EXPECT_HIT;
+}
+
+/* Every ray through a pixel centre against the ramp: hits where it must,
+ * at the plane's depth, and its shading point (the displaced surface
+ * evaluated at the hit's (u,v)) on the ray at the hit's t: the (u,v) the
+ * closed form gives are the hit's own */
+static void test_ramp_planar_exact(void **state)
+{
+    (void)state;
+    fixture f;
+    assert_true(fixture_open_named(&f, SQUARE_RIB("%s"), "ramp", RAMP_SL));
+    trace_thread *th = trace_thread_new(&f.js->world);
+    const trace_camera *cam = &f.js->world.camera;
+    int inside = 0, hits = 0, exact = 0, on_ray = 0, outside_hits = 0;
+    for (int y = 0; y < cam->yres; y++)
+        for (int x = 0; x < cam->xres; x++) {
+            trace_ray ray;
+            trace_camera_ray(cam, x + 0.5, y + 0.5, &ray);
+            double zexp = 0;
+            expect e = ramp(ray.d, &zexp);
+            trace_hit hit = {.t = ray.tmax, .obj = NULL};
+            bool found = trace_bvh_intersect(f.js->renderer->bvh, th, &ray,
+                                             &f.js->renderer->primary_tol, false, &hit);
+            if (e == EXPECT_MISS) outside_hits += found;
+            if (e != EXPECT_HIT) continue;
+            inside++;
+            if (!found) continue;
+            hits++;
+            vec3 at = trace_ray_at(&ray, hit.t);
+            exact += fabs(at.z - zexp) <= 1e-9 * zexp;
+            on_ray += hit.has_point && v3_length(v3_sub(hit.point.P, at)) <= 1e-9 * zexp;
+        }
+    trace_thread_sync_stats(th);
+    trace_stats st = th->stats;
+    printf("ramp: %d/%d hit, %d at the plane's depth, %d shading points on the ray, %d hits "
+           "off the square; planar cells %ld, boxes %ld, proofs %ld\n", hits, inside, exact,
+           on_ray, outside_hits, st.planar_cells, st.boxes, st.proofs);
+    assert_true(inside > 500);
+    assert_true(st.planar_cells > 0);
+    assert_int_equal(hits, inside);
+    assert_int_equal(exact, inside);
+    assert_int_equal(on_ray, inside);
+    assert_int_equal(outside_hits, 0);
+    trace_thread_destroy(&th);
+    fixture_close(&f);
+
+    assert_true(fixture_open_named(&f, SQUARE_RIB("%s"), "rampcurved", RAMP_CURVED_SL));
+    exact_scan s;
+    scan_exact(&f, ramp, &s);
+    printf("curved ramp: planar cells %ld, boxes %ld\n", s.st.planar_cells, s.st.boxes);
+    assert_int_equal(s.st.planar_cells, 0);
+    fixture_close(&f);
+}
+
 static const char *BUMP_SL =
     "displacement bumponly(float Kb = 0.02)\n"
     "{\n"
@@ -462,6 +551,7 @@ int main(void)
         cmocka_unit_test(test_raised_wedge_offset_exact),
         cmocka_unit_test(test_rounded_constant_is_offset),
         cmocka_unit_test(test_fresh_symbol_variation_is_not_offset),
+        cmocka_unit_test(test_ramp_planar_exact),
         cmocka_unit_test(test_sphere_bent_normals_exact),
         cmocka_unit_test(test_patch_bent_normals_exact),
         cmocka_unit_test(test_instances_bent_normals_exact),
