@@ -10,7 +10,8 @@
 #                        installs them, prints the table, writes it into
 #                        docs/benchmarks.md (QUICK=1: a ~2 minute smoke run)
 #                        MESHES=1: the displaced mesh and the terrain against
-#                        Embree (their own table)
+#                        Embree (their own table); WALLS=1: a brick wall
+#                        against Embree (its own table)
 # Everything else is plain CMake: cmake -S . -B build && cmake --build build
 MAKEFLAGS += --no-print-directory
 JOBS ?= $(shell nproc 2>/dev/null || echo 2)
@@ -57,7 +58,7 @@ bench: build
 	@build/bin/render_bench
 
 bench-peers: deps
-	@QUICK=$(QUICK) MESHES=$(MESHES) bash bench/peers/run.sh
+	@QUICK=$(QUICK) MESHES=$(MESHES) WALLS=$(WALLS) bash bench/peers/run.sh
 
 clean:
 	rm -rf build build-test build-asan build-bench build-release

@@ -23,6 +23,14 @@
 #                                      MESH1M_W x MESH1M_H (320 x 240), N per
 #                                      face NS_mesh1m (1 2 4); its own table
 #                                      (marker "bench-peers-mesh1m")
+#   WALLS=1 bash bench/peers/run.sh    issue 24's walls against Embree: a
+#                                      brick wall (bench/peers/scenes/
+#                                      wall.rib: the corpus's bricks.sl on
+#                                      a polygon), no POV-Ray (no gradient
+#                                      bound for a step), N over the
+#                                      polygon NS_wall; its own table
+#                                      (marker "bench-peers-walls"); QUICK=1
+#                                      with it: fewer N, one run
 #
 # It installs the peers (deploy/install-bench-deps.sh), builds aafarm and
 # the helpers in build-bench/, and for each scene of bench/peers/scenes/:
@@ -54,6 +62,8 @@ MESHES=${MESHES:-0}
 [ "$MESHES" = "0" ] && MESHES=""
 MESH1M=${MESH1M:-0}
 [ "$MESH1M" = "0" ] && MESH1M=""
+WALLS=${WALLS:-0}
+[ "$WALLS" = "0" ] && WALLS=""
 ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)
 QUICK=${QUICK:-0}
 [ "$QUICK" = "0" ] && QUICK=""
@@ -74,6 +84,18 @@ if [ -n "$MESHES" ]; then
   else
     NS_mesh=${NS_mesh:-"1 2 4 8 16 32"}
     NS_terrain=${NS_terrain:-"128 256 512 1024 2048 4096"}
+  fi
+fi
+if [ -n "$WALLS" ]; then
+  # a brick wall: N x N cells over its polygon
+  SCENES=${SCENES:-wall}
+  CACHE_SCENES=${CACHE_SCENES-}
+  RSS=0
+  DOC_BLOCK=bench-peers-walls
+  if [ -n "$QUICK" ]; then
+    NS_wall=${NS_wall:-"128 256 512"}
+  else
+    NS_wall=${NS_wall:-"128 256 512 1024 2048 4096"}
   fi
 fi
 if [ -n "$MESH1M" ]; then
