@@ -348,7 +348,6 @@ static void affine_shade(trace_thread *th, const trace_object *obj, const affine
     }
 }
 
-
 /* The box's linear bound (lin_bound.h; TRACE_BOX_LIN on the box) from
  * the run's forms: per coordinate the centre, the u and v terms (symbols
  * 0 and 1, where the context gave u and v their own symbols) and the rest
