@@ -229,19 +229,26 @@ static expect raised_wedge(vec3 d, double *zexp)
     return EXPECT_SKIP;
 }
 
-static void test_raised_wedge_offset_exact(void **state)
+/* The disk with the raised wedge of shader src: every hit exactly at its
+ * plane's depth, the wedge's cells offset cells */
+static void assert_raised_wedge_exact(const char *name, const char *src)
 {
-    (void)state;
     fixture f;
-    assert_true(fixture_open_named(&f, DISK_RIB("%s"), "raised", RAISED_SL));
+    assert_true(fixture_open_named(&f, DISK_RIB("%s"), name, src));
     exact_scan s;
     scan_exact(&f, raised_wedge, &s);
-    printf("raised wedge: %d/%d hit, %d at their plane's depth, %d hits off the disk; exact "
-           "cells %ld (offset %ld), boxes %ld, proofs %ld\n", s.hits, s.inside, s.exact,
+    printf("%s wedge: %d/%d hit, %d at their plane's depth, %d hits off the disk; exact "
+           "cells %ld (offset %ld), boxes %ld, proofs %ld\n", name, s.hits, s.inside, s.exact,
            s.outside_hits, s.st.exact_cells, s.st.offset_cells, s.st.boxes, s.st.proofs);
     assert_all_exact(&s);
     assert_true(s.st.offset_cells > 0);
     fixture_close(&f);
+}
+
+static void test_raised_wedge_offset_exact(void **state)
+{
+    (void)state;
+    assert_raised_wedge_exact("raised", RAISED_SL);
 }
 
 /* The raised wedge with its height made as a box-filtered pulse makes it
@@ -263,16 +270,7 @@ static const char *FILTERED_SL =
 static void test_rounded_constant_is_offset(void **state)
 {
     (void)state;
-    fixture f;
-    assert_true(fixture_open_named(&f, DISK_RIB("%s"), "filtered", FILTERED_SL));
-    exact_scan s;
-    scan_exact(&f, raised_wedge, &s);
-    printf("filtered wedge: %d/%d hit, %d at their plane's depth, %d hits off the disk; exact "
-           "cells %ld (offset %ld), boxes %ld, proofs %ld\n", s.hits, s.inside, s.exact,
-           s.outside_hits, s.st.exact_cells, s.st.offset_cells, s.st.boxes, s.st.proofs);
-    assert_all_exact(&s);
-    assert_true(s.st.offset_cells > 0);
-    fixture_close(&f);
+    assert_raised_wedge_exact("filtered", FILTERED_SL);
 }
 
 /* 1e-6 sin(1e6 u): over any cell a range of [-1e-6, 1e-6] with no u term
