@@ -425,7 +425,7 @@ void aa_recip(aa_context *ctx, aa_form *z, const aa_form *x)
     ia_interval r = operand_range(x, &fl, &xr);
     static const convex_fn fn = { f_recip, d_recip, t_recip, NULL };
     if (r.lo <= 0 && r.hi >= 0) {
-        aa_unbounded(z, fl);
+        aa_unbounded(z, fl | AA_DISCONTINUOUS);    /* a pole, as tan's */
         return;
     }
     piece pc = { r.lo, r.hi, r.lo > 0 ? +1 : -1 };
@@ -463,7 +463,7 @@ void aa_div(aa_context *ctx, aa_form *z, const aa_form *x, const aa_form *y)
     aa_form inv;
     aa_recip(ctx, &inv, y);
     if (inv.flags & AA_UNBOUNDED) {
-        aa_unbounded(z, x->flags | y->flags);
+        aa_unbounded(z, x->flags | y->flags | inv.flags);   /* a pole: discontinuous */
         return;
     }
     aa_mul(ctx, z, x, &inv);

@@ -79,8 +79,8 @@ ia_interval ia_recip(ia_interval x)
 {
     RETURN_IF_EMPTY1(x);
     if (x.lo <= 0.0 && x.hi >= 0.0) {
-        ia_interval r = ia_entire();
-        r.flags |= x.flags;
+        ia_interval r = ia_entire();        /* a pole, as tan's */
+        r.flags |= x.flags | AA_DISCONTINUOUS;
         return r;
     }
     return mk(fp_div_dn(1.0, x.hi), fp_div_up(1.0, x.lo), x.flags);
@@ -90,8 +90,8 @@ ia_interval ia_div(ia_interval x, ia_interval y)
 {
     RETURN_IF_EMPTY2(x, y);
     if (y.lo <= 0.0 && y.hi >= 0.0) {
-        ia_interval r = ia_entire();
-        r.flags |= x.flags | y.flags;
+        ia_interval r = ia_entire();        /* a pole, as tan's */
+        r.flags |= x.flags | y.flags | AA_DISCONTINUOUS;
         return r;
     }
     /* y has one sign: the signs of x's ends pick the extreme corners, as

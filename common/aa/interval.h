@@ -10,8 +10,11 @@
  *
  * Flags travel with the value and are OR-ed through every operation:
  *   AA_DISCONTINUOUS  the function jumps inside the operand range (step, floor,
- *                     ceil, round, mod, sign, a pole of tan, a branch cut of
- *                     atan2) or two branches were merged (paper §5);
+ *                     ceil, round, mod, sign, a pole of tan or of a division
+ *                     or reciprocal, a branch cut of atan2) or two branches
+ *                     were merged (paper §5); unlike AA_UNBOUNDED it stays
+ *                     on a function that bounds the value again (atan, a
+ *                     clamp);
  *   AA_UNBOUNDED      the result is (partly) the whole line: division by a
  *                     range containing 0, overflow, a pole.
  *

@@ -163,6 +163,16 @@ static void sample_cell(trace_thread *th, const trace_object *obj, const double 
         if (geom_uv_inside(&obj->surf, u, v)) {
             trace_surface_point sp;
             trace_surface_point_eval(th, obj, u, v, &sp);
+            if (!(v3_is_finite(sp.P) && v3_is_finite(sp.Pu) && v3_is_finite(sp.Pv))) {
+                /* a sample on a singular line of the shader's formula
+                 * (atan(y / x) at x = 0: inf / inf in the derivative): once
+                 * more a hair inside the cell (2^-20 of its side), where
+                 * the formula is finite if the surface is */
+                double un = u + (k % CELL_G < CELL_G - 1 ? 1 : -1) * 0x1p-20 * (r[1] - r[0]);
+                double vn = v + (k / CELL_G < CELL_G - 1 ? 1 : -1) * 0x1p-20 * (r[3] - r[2]);
+                if (geom_uv_inside(&obj->surf, un, vn))
+                    trace_surface_point_eval(th, obj, un, vn, &sp);
+            }
             if (v3_is_finite(sp.P) && v3_is_finite(sp.Pu) && v3_is_finite(sp.Pv)) {
                 geom_sample g;
                 geom_eval(&obj->surf, u, v, &g);

@@ -10,8 +10,9 @@
  *   (x+1)*(x-1) - x*x        over [2,3]: affine near -1, width < 0.1 of IA's
  *   sqr over [-1,1]          [0, 1] in both modes (Chebyshev square in AA)
  *   sin/cos, full periods    stay within [-1, 1] in both modes
- *   flags                    merge, floor, step, sign, smoothstep, sin, exp:
- *                            AA_DISCONTINUOUS exactly where a jump is inside
+ *   flags                    merge, floor, step, sign, smoothstep, sin, exp,
+ *                            a division's pole: AA_DISCONTINUOUS exactly
+ *                            where a jump (or a pole) is inside
  *   condensation             x*x*x - x and (x*x)^2 - x*x built from two inputs:
  *                            capacity 2 (fully reduced) stays conservative,
  *                            also symbol by symbol, and capacity 16 is never
@@ -401,6 +402,35 @@ static void test_flags(void **state)
         assert_true(r.lo <= 1.0 && r.hi >= 1.0 && r.lo > 0.5);
         assert_true(ia_step(ia_point(0.5), ia_make(0.0, 1.0)).flags & AA_DISCONTINUOUS);
         assert_int_equal(ia_step(ia_point(2.0), ia_make(0.0, 1.0)).flags, 0);
+    }
+
+    /* a division by a range that holds 0 has a pole there, as tan has:
+     * unbounded and discontinuous, and the flag survives an operation
+     * that bounds the value again (atan(y / x), x across 0: the renderer
+     * takes the box for a seam, not for a smooth piece that will shrink) */
+    {
+        aa_context ctx;
+        aa_context_init(&ctx, AA_DEFAULT_CAPACITY);
+        aa_form x, y, z, a;
+        aa_input(&ctx, &x, -0.5, 1.0);
+        aa_input(&ctx, &y, 0.25, 0.75);
+        aa_div(&ctx, &z, &y, &x);
+        assert_true(z.flags & AA_UNBOUNDED);
+        assert_true(z.flags & AA_DISCONTINUOUS);
+        aa_atan(&ctx, &a, &z);
+        assert_true(a.flags & AA_DISCONTINUOUS);
+        r = aa_range(&a);
+        assert_true(isfinite(r.lo) && isfinite(r.hi));
+        assert_true(aa_unary_flags(aa_recip, -1.0, 2.0, &r) & AA_DISCONTINUOUS);
+        /* away from the pole: no flag */
+        aa_input(&ctx, &x, 0.5, 1.0);
+        aa_div(&ctx, &z, &y, &x);
+        assert_int_equal(z.flags, 0);
+        assert_int_equal(aa_unary_flags(aa_recip, 1.0, 2.0, &r), 0);
+        assert_true(ia_div(ia_make(1.0, 2.0), ia_make(-1.0, 1.0)).flags & AA_DISCONTINUOUS);
+        assert_true(ia_recip(ia_make(-1.0, 1.0)).flags & AA_DISCONTINUOUS);
+        assert_int_equal(ia_div(ia_make(1.0, 2.0), ia_make(0.5, 1.0)).flags, 0);
+        assert_int_equal(ia_recip(ia_make(0.5, 1.0)).flags, 0);
     }
 
     /* smoothstep is continuous where e0 < e1 */
