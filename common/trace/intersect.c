@@ -212,7 +212,11 @@ static void sample_cell(trace_thread *th, const trace_object *obj, const double 
  * At a wall the samples fall into the two sides of the jump (nearer to one
  * or the other of the two farthest samples); the wall's normal is the step
  * between the sides' base-surface centroids, made perpendicular to the
- * jump of their displacements: for a nail, the radius.
+ * jump of their displacements: for a nail, the radius. Where the cell's
+ * (u,v) grid is skewed against the edge (a triangle of a mesh), that step
+ * leans with the grid, so once a cell is found to be a wall (real_wall)
+ * the step is also made perpendicular to the edge itself
+ * (refine_wall_normal).
  *
  * What the samples tell of a cell is a pure function of object and cell,
  * kept in a direct-mapped per-thread cache (wall_cell; fixed size, so
@@ -230,8 +234,21 @@ typedef struct wall_entry {
     vec3 j;                       /* the jump's direction, unit */
     double high, low;             /* the high side's lowest sample along j,
                                      the low side's highest */
+    vec3 step;                    /* the sides' base centroids' step */
+    vec3 pa, pb;                  /* the two farthest samples: side 0's, 1's */
+    unsigned short ok_bits, side_bits;  /* per sample: present, on side 1 */
+    bool refined;                 /* normal made perpendicular to the edge */
 } wall_entry;
 struct trace_wall_cache { wall_entry e[WALL_CACHE_ENTRIES]; };
+
+/* the wall's unit normal from the step between its sides: made
+ * perpendicular to the jump (0 where degenerate) */
+static void wall_normal_from(wall_entry *e, vec3 step)
+{
+    vec3 nrm = e->jumps ? v3_sub(step, v3_scale(e->j, v3_dot(step, e->j))) : step;
+    double len = v3_length(nrm);
+    e->normal = len > 0 && isfinite(len) ? v3_scale(nrm, 1.0 / len) : v3(0, 0, 0);
+}
 
 /* the samples' verdict on the cell: residual, normal, sides */
 static void analyse_wall(trace_thread *th, const trace_object *obj, const double r[4],
@@ -240,7 +257,7 @@ static void analyse_wall(trace_thread *th, const trace_object *obj, const double
     cell_samples cs;
     sample_cell(th, obj, r, INFINITY, &cs);
     e->residual = cs.residual;
-    e->sided = e->jumps = false;
+    e->sided = e->jumps = e->refined = false;
     int a = -1, b = -1;
     double far = -1;
     for (int i = 0; i < CELL_N; i++)
@@ -263,7 +280,15 @@ static void analyse_wall(trace_thread *th, const trace_object *obj, const double
         count[side]++;
     }
     e->sided = true;
+    e->pa = cs.P[a];
+    e->pb = cs.P[b];
+    e->ok_bits = e->side_bits = 0;
+    for (int i = 0; i < CELL_N; i++) {
+        if (cs.ok[i]) e->ok_bits |= (unsigned short)(1u << i);
+        if (side_of[i]) e->side_bits |= (unsigned short)(1u << i);
+    }
     vec3 step = v3_sub(v3_scale(sum_base[1], 1.0 / count[1]), v3_scale(sum_base[0], 1.0 / count[0]));
+    e->step = step;
     vec3 jump = v3_sub(v3_scale(sum_disp[1], 1.0 / count[1]), v3_scale(sum_disp[0], 1.0 / count[0]));
     double jj = v3_dot(jump, jump);
     if (jj > 0 && isfinite(jj)) {
@@ -280,12 +305,80 @@ static void analyse_wall(trace_thread *th, const trace_object *obj, const double
         }
         e->jumps = true;
     }
-    vec3 nrm = jj > 0 ? v3_sub(step, v3_scale(jump, v3_dot(step, jump) / jj)) : step;
-    double len = v3_length(nrm);
-    e->normal = len > 0 && isfinite(len) ? v3_scale(nrm, 1.0 / len) : v3(0, 0, 0);
+    wall_normal_from(e, step);
 }
 
-static const wall_entry *wall_cell(trace_thread *th, const trace_object *obj, const double r[4])
+/* A wall's normal made perpendicular to its edge too: where two grid
+ * neighbours of the samples lie on two sides, the edge crosses between
+ * them. Of those crossings, the two whose midpoints lie farthest apart are
+ * bisected (WALL_BISECT steps each, every point's side judged as the
+ * samples' were); their base points lie on the edge and span it, and the
+ * step between the sides' centroids loses its part along that span. A
+ * pure function of object and cell, as the analysis is. */
+#define WALL_BISECT 4
+static void refine_wall_normal(trace_thread *th, const trace_object *obj, const double r[4],
+                               wall_entry *e)
+{
+    e->refined = true;
+    enum { MAXC = 2 * CELL_G * (CELL_G - 1) };
+    double seg[MAXC][4];                  /* a crossing's (u,v) ends */
+    double mu[MAXC], mv[MAXC];
+    int side0[MAXC];                      /* the side of its first end */
+    int n = 0;
+    double du = (r[1] - r[0]) / (CELL_G - 1), dv = (r[3] - r[2]) / (CELL_G - 1);
+    for (int i = 0; i < CELL_N; i++)
+        for (int dir = 0; dir < 2; dir++) {
+            int k = dir == 0 ? (i % CELL_G < CELL_G - 1 ? i + 1 : -1)
+                             : (i + CELL_G < CELL_N ? i + CELL_G : -1);
+            if (k < 0 || !((e->ok_bits >> i) & 1) || !((e->ok_bits >> k) & 1)) continue;
+            if (((e->side_bits >> i) & 1) == ((e->side_bits >> k) & 1)) continue;
+            side0[n] = (e->side_bits >> i) & 1;
+            seg[n][0] = r[0] + du * (i % CELL_G);
+            seg[n][1] = r[2] + dv * (i / CELL_G);
+            seg[n][2] = r[0] + du * (k % CELL_G);
+            seg[n][3] = r[2] + dv * (k / CELL_G);
+            mu[n] = 0.5 * (seg[n][0] + seg[n][2]);
+            mv[n] = 0.5 * (seg[n][1] + seg[n][3]);
+            n++;
+        }
+    /* the two crossings farthest apart, by their midpoints' base points */
+    vec3 mid[MAXC];
+    for (int c = 0; c < n; c++) {
+        geom_sample g;
+        geom_eval(&obj->surf, mu[c], mv[c], &g);
+        mid[c] = g.P;
+    }
+    int pick[2] = {-1, -1};
+    double best = -1;
+    for (int a = 0; a < n; a++)
+        for (int b = a + 1; b < n; b++) {
+            vec3 d = v3_sub(mid[b], mid[a]);
+            if (v3_dot(d, d) > best) { best = v3_dot(d, d); pick[0] = a; pick[1] = b; }
+        }
+    if (pick[0] < 0) return;
+    vec3 at[2];
+    for (int m = 0; m < 2; m++) {
+        const double *sg = seg[pick[m]];
+        double u0 = sg[0], v0 = sg[1], u1 = sg[2], v1 = sg[3];
+        for (int it = 0; it < WALL_BISECT; it++) {
+            double um = 0.5 * (u0 + u1), vm = 0.5 * (v0 + v1);
+            trace_surface_point sp;
+            trace_surface_point_eval(th, obj, um, vm, &sp);
+            if (!v3_is_finite(sp.P)) break;
+            int sm = v3_length(v3_sub(sp.P, e->pb)) < v3_length(v3_sub(sp.P, e->pa));
+            if (sm == side0[pick[m]]) { u0 = um; v0 = vm; } else { u1 = um; v1 = vm; }
+        }
+        geom_sample g;
+        geom_eval(&obj->surf, 0.5 * (u0 + u1), 0.5 * (v0 + v1), &g);
+        at[m] = mat4_xform_point(&obj->to_camera, g.P);
+    }
+    vec3 edge = v3_sub(at[1], at[0]);
+    double ee = v3_dot(edge, edge);
+    if (!(ee > 0) || !isfinite(ee)) return;
+    wall_normal_from(e, v3_sub(e->step, v3_scale(edge, v3_dot(e->step, edge) / ee)));
+}
+
+static wall_entry *wall_cell(trace_thread *th, const trace_object *obj, const double r[4])
 {
     if (!th->walls) {                   /* zeroed: empty (cellkey.h) */
         th->walls = xcalloc(1, sizeof *th->walls);
@@ -313,8 +406,9 @@ static bool real_wall(walk *w, const double r[4], double tol, double t0, double 
                       vec3 *normal, bool *capped)
 {
     *capped = false;
-    const wall_entry *e = wall_cell(w->th, w->obj, r);
+    wall_entry *e = wall_cell(w->th, w->obj, r);
     if (!(e->residual > 2.0 * tol) || !e->sided) return false;
+    if (!e->refined) refine_wall_normal(w->th, w->obj, r, e);
     if (e->jumps) {
         double h0 = v3_dot(trace_ray_at(w->cam_ray, t0), e->j);
         double h1 = v3_dot(trace_ray_at(w->cam_ray, t1), e->j);

@@ -345,6 +345,61 @@ static void test_wall_normals_are_the_walls(void **state)
     fixture_close(&f);
 }
 
+/* a square of s, t in [0.3, 0.7] raised by h */
+static const char *PLINTH_SL =
+    "displacement plinth(float h = 0.2)\n"
+    "{\n"
+    "    P += h * step(0.3, s) * step(s, 0.7) * step(0.3, t) * step(t, 0.7) * normalize(N);\n"
+    "}\n";
+
+/* The raised square on a square cut into two triangles (a mesh whose
+ * faces' (u,v) are skewed against s and t): its walls run along object x
+ * and y, and the wall leaves' normals must say so. The step between the
+ * sides' sample centroids leans with a skewed sample grid (up to 30
+ * degrees before its part along the edge was taken out:
+ * refine_wall_normal): 56 of 64 within 10 degrees, 3.9 off on average;
+ * 63 of 64 and under a degree now. */
+static void test_wall_normals_on_skewed_faces(void **state)
+{
+    (void)state;
+    const char *rib = "Format 64 64 1\nProjection \"perspective\" \"fov\" [30]\n"
+                      "WorldBegin\nTranslate 0 0 5\nRotate -60 1 0 0\n"
+                      "Displacement \"plinth\"\n"
+                      "PointsPolygons [3 3] [0 1 2  0 2 3] \"P\" [-1 -1 0  1 -1 0  1 1 0  -1 1 0]\n"
+                      "  \"st\" [0 0  1 0  1 1  0 1]\nWorldEnd\n";
+    fixture f;
+    fixture_shader sh[] = {{"plinth", PLINTH_SL}};
+    assert_true(fixture_open(&f, rib, sh, 1, NULL, 0));
+    trace_thread *th = trace_thread_new(&f.js->world);
+    int walls = 0, square = 0;
+    double worst = 1, off_sum = 0;
+    for (int y = 0; y < 64; y++)
+        for (int x = 0; x < 64; x++) {
+            trace_ray ray;
+            trace_camera_ray(&f.js->world.camera, x + 0.5, y + 0.5, &ray);
+            trace_hit hit = {.t = ray.tmax, .obj = NULL};
+            if (!trace_bvh_intersect(f.js->renderer->bvh, th, &ray,
+                                     &f.js->renderer->primary_tol, false, &hit))
+                continue;
+            if (hit.kind != TRACE_LEAF_WALL || !hit.obj) continue;
+            walls++;
+            vec3 n = v3_normalize(mat4_xform_vector(&hit.obj->from_camera, hit.wall_normal));
+            double along = fmax(fabs(n.x), fabs(n.y));
+            worst = fmin(worst, along);
+            off_sum += acos(fmin(along, 1.0)) * 180 / M_PI;
+            square += along > cos(10 * M_PI / 180);
+        }
+    double mean = walls ? off_sum / walls : 0;
+    printf("plinth on triangles: %d wall hits, %d with a normal within 10 degrees of the "
+           "wall's, %.1f degrees off on average (the worst %.1f)\n", walls, square, mean,
+           acos(worst) * 180 / M_PI);
+    assert_true(walls > 20);
+    assert_true(square >= walls * 19 / 20);
+    assert_true(mean < 2.0);
+    trace_thread_destroy(&th);
+    fixture_close(&f);
+}
+
 /* Of a 16 x 16 grid of (u,v) cells, those whose one run is flagged
  * discontinuous, and of them those whose cases mark a proven step */
 static void count_step_cells(const char *name, const char *src, int *flagged, int *steps)
@@ -558,6 +613,7 @@ int main(void)
         cmocka_unit_test(test_pole_of_a_ratio_is_sampled),
         cmocka_unit_test(test_normalize_at_the_poles_is_bounded),
         cmocka_unit_test(test_wall_normals_are_the_walls),
+        cmocka_unit_test(test_wall_normals_on_skewed_faces),
         cmocka_unit_test(test_proven_steps_take_no_samples),
         cmocka_unit_test(test_planes_hit_exactly_beside_the_wall),
     };
