@@ -3,9 +3,11 @@
 # tile and slate-roof displacement shaders (step/mod/floor patterns in both
 # directions) on the corpus sphere, rendered by the standalone renderer.
 #
-#   bench/pattern_bench.sh [BIN_DIR] [SHADER ...]
+#   bench/pattern_bench.sh [BIN_DIR] [SHADER ... | all]
 #       defaults: build/bin; bricks bricks_filtered slate_roof tiles_hex
-#       tiles_pillow pnoise_tiles uv_quilt fwp_checks
+#       tiles_pillow pnoise_tiles uv_quilt fwp_checks; "all": the whole
+#       corpus (53 shaders; not the four tex_* ones, whose maps the test
+#       suite writes)
 #
 # Three scenes (PATTERN_BENCH_SCENES, default "sphere wall mesh"): test_corpus_render's
 # sphere (tests/corpus/corpus.c, CORPUS_SPHERE: Translate 0 0 5, Rotate 70
@@ -33,6 +35,15 @@ SHADERS=("$@")
                                       pnoise_tiles uv_quilt fwp_checks)
 HERE=$(cd "$(dirname "$0")" && pwd)
 CORPUS=$HERE/../tests/shaders/corpus
+# "all": every displacement shader of the corpus but those that read the
+# test suite's textures (tex_*)
+if [ "${SHADERS[0]}" = all ]; then
+  SHADERS=()
+  for f in "$CORPUS"/*.sl; do
+    n=$(basename "$f" .sl)
+    case $n in tex_*) ;; *) SHADERS+=("$n") ;; esac
+  done
+fi
 LIMIT=${PATTERN_BENCH_LIMIT:-600}
 [ -x "$BIN/aafarm-worker" ] || { echo "pattern_bench.sh: $BIN/aafarm-worker not built" >&2; exit 2; }
 [ -x /usr/bin/time ] || { echo "pattern_bench.sh: needs /usr/bin/time (Debian package time)" >&2; exit 2; }
