@@ -306,6 +306,42 @@ static void test_normalize_at_the_poles_is_bounded(void **state)
     }
 }
 
+/* The wall leaves of one ray through every pixel centre of a 64x64 scene
+ * (one object): their normals (camera space) handed to fn; how many */
+typedef void (*wall_normal_fn)(const trace_object *obj, vec3 n, void *ctx);
+static int scan_wall_normals(const char *rib, const char *name, const char *src,
+                             wall_normal_fn fn, void *ctx)
+{
+    fixture f;
+    fixture_shader sh[] = {{name, src}};
+    assert_true(fixture_open(&f, rib, sh, 1, NULL, 0));
+    trace_thread *th = trace_thread_new(&f.js->world);
+    const trace_object *obj = &f.js->world.objects[0];
+    int walls = 0;
+    for (int y = 0; y < 64; y++)
+        for (int x = 0; x < 64; x++) {
+            trace_ray ray;
+            trace_camera_ray(&f.js->world.camera, x + 0.5, y + 0.5, &ray);
+            trace_hit hit = {.t = ray.tmax, .obj = NULL};
+            if (!trace_bvh_intersect(f.js->renderer->bvh, th, &ray,
+                                     &f.js->renderer->primary_tol, false, &hit))
+                continue;
+            if (hit.kind != TRACE_LEAF_WALL) continue;
+            walls++;
+            fn(obj, hit.wall_normal, ctx);
+        }
+    trace_thread_destroy(&th);
+    fixture_close(&f);
+    return walls;
+}
+
+/* perpendicular to the displacement (the polygon's normal) */
+static void count_radial(const trace_object *obj, vec3 n, void *ctx)
+{
+    vec3 up = v3_normalize(mat4_xform_normal(&obj->from_camera, v3(0, 0, 1)));
+    *(int *)ctx += fabs(v3_dot(n, up)) < 0.2;
+}
+
 /* A disc of radius 0.3 (in s, t) raised by 0.2 on a square seen from the
  * side and above: rays that hit the head's wall are shaded with a normal
  * perpendicular to the displacement (the wall's), so its facing ratio is
@@ -317,32 +353,12 @@ static void test_wall_normals_are_the_walls(void **state)
                       "WorldBegin\nTranslate 0 0 5\nRotate -60 1 0 0\n"
                       "Displacement \"head\"\n"
                       "Polygon \"P\" [-1 -1 0  1 -1 0  1 1 0  -1 1 0]\nWorldEnd\n";
-    fixture f;
-    fixture_shader sh[] = {{"head", HEAD_SL}};
-    assert_true(fixture_open(&f, rib, sh, 1, NULL, 0));
-    trace_thread *th = trace_thread_new(&f.js->world);
-    const trace_object *obj = &f.js->world.objects[0];
-    vec3 up = v3_normalize(mat4_xform_normal(&obj->from_camera, v3(0, 0, 1)));
-    int walls = 0, radial = 0;
-    for (int y = 0; y < 64; y++)
-        for (int x = 0; x < 64; x++) {
-            trace_ray ray;
-            trace_camera_ray(&f.js->world.camera, x + 0.5, y + 0.5, &ray);
-            trace_hit hit = {.t = ray.tmax, .obj = NULL};
-            if (!trace_bvh_intersect(f.js->renderer->bvh, th, &ray,
-                                     &f.js->renderer->primary_tol, false, &hit))
-                continue;
-            if (hit.kind != TRACE_LEAF_WALL) continue;
-            walls++;
-            /* perpendicular to the displacement (the polygon's normal) */
-            if (fabs(v3_dot(hit.wall_normal, up)) < 0.2) radial++;
-        }
+    int radial = 0;
+    int walls = scan_wall_normals(rib, "head", HEAD_SL, count_radial, &radial);
     printf("head: %d wall hits, %d with a normal perpendicular to the displacement\n",
            walls, radial);
     assert_true(walls > 20);
     assert_true(radial >= walls * 9 / 10);
-    trace_thread_destroy(&th);
-    fixture_close(&f);
 }
 
 /* a square of s, t in [0.3, 0.7] raised by h */
@@ -351,6 +367,23 @@ static const char *PLINTH_SL =
     "{\n"
     "    P += h * step(0.3, s) * step(s, 0.7) * step(0.3, t) * step(t, 0.7) * normalize(N);\n"
     "}\n";
+
+/* how far a wall normal is from object x or y: within 10 degrees, the
+ * sum of the angles, the largest */
+typedef struct square_off {
+    int square;
+    double sum, worst;
+} square_off;
+
+static void off_square(const trace_object *obj, vec3 n, void *ctx)
+{
+    square_off *q = ctx;
+    vec3 o = v3_normalize(mat4_xform_vector(&obj->from_camera, n));
+    double along = fmin(fmax(fabs(o.x), fabs(o.y)), 1.0), deg = acos(along) * 180 / M_PI;
+    q->square += deg < 10;
+    q->sum += deg;
+    q->worst = fmax(q->worst, deg);
+}
 
 /* The raised square on a square cut into two triangles (a mesh whose
  * faces' (u,v) are skewed against s and t): its walls run along object x
@@ -367,37 +400,15 @@ static void test_wall_normals_on_skewed_faces(void **state)
                       "Displacement \"plinth\"\n"
                       "PointsPolygons [3 3] [0 1 2  0 2 3] \"P\" [-1 -1 0  1 -1 0  1 1 0  -1 1 0]\n"
                       "  \"st\" [0 0  1 0  1 1  0 1]\nWorldEnd\n";
-    fixture f;
-    fixture_shader sh[] = {{"plinth", PLINTH_SL}};
-    assert_true(fixture_open(&f, rib, sh, 1, NULL, 0));
-    trace_thread *th = trace_thread_new(&f.js->world);
-    int walls = 0, square = 0;
-    double worst = 1, off_sum = 0;
-    for (int y = 0; y < 64; y++)
-        for (int x = 0; x < 64; x++) {
-            trace_ray ray;
-            trace_camera_ray(&f.js->world.camera, x + 0.5, y + 0.5, &ray);
-            trace_hit hit = {.t = ray.tmax, .obj = NULL};
-            if (!trace_bvh_intersect(f.js->renderer->bvh, th, &ray,
-                                     &f.js->renderer->primary_tol, false, &hit))
-                continue;
-            if (hit.kind != TRACE_LEAF_WALL || !hit.obj) continue;
-            walls++;
-            vec3 n = v3_normalize(mat4_xform_vector(&hit.obj->from_camera, hit.wall_normal));
-            double along = fmax(fabs(n.x), fabs(n.y));
-            worst = fmin(worst, along);
-            off_sum += acos(fmin(along, 1.0)) * 180 / M_PI;
-            square += along > cos(10 * M_PI / 180);
-        }
-    double mean = walls ? off_sum / walls : 0;
+    square_off q = {0, 0, 0};
+    int walls = scan_wall_normals(rib, "plinth", PLINTH_SL, off_square, &q);
+    double mean = walls ? q.sum / walls : 0;
     printf("plinth on triangles: %d wall hits, %d with a normal within 10 degrees of the "
-           "wall's, %.1f degrees off on average (the worst %.1f)\n", walls, square, mean,
-           acos(worst) * 180 / M_PI);
+           "wall's, %.1f degrees off on average (the worst %.1f)\n", walls, q.square, mean,
+           q.worst);
     assert_true(walls > 20);
-    assert_true(square >= walls * 19 / 20);
+    assert_true(q.square >= walls * 19 / 20);
     assert_true(mean < 2.0);
-    trace_thread_destroy(&th);
-    fixture_close(&f);
 }
 
 /* Of a 16 x 16 grid of (u,v) cells, those whose one run is flagged
