@@ -212,11 +212,11 @@ static void sample_cell(trace_thread *th, const trace_object *obj, const double 
  * At a wall the samples fall into the two sides of the jump (nearer to one
  * or the other of the two farthest samples); the wall's normal is the step
  * between the sides' base-surface centroids, made perpendicular to the
- * jump of their displacements: for a nail, the radius. Where the cell's
- * (u,v) grid is skewed against the edge (a triangle of a mesh), that step
- * leans with the grid, so once a cell is found to be a wall (real_wall)
- * the step is also made perpendicular to the edge itself
- * (refine_wall_normal).
+ * jump of their displacements: for a nail, the radius. Where the edge
+ * runs at an angle to the cell's (u,v) grid (a mesh's triangle, whose "st"
+ * runs across its (u,v)), that step leans with the grid, so once a cell is
+ * found to be a wall (real_wall) the step is also made perpendicular to
+ * the edge itself (refine_wall_normal).
  *
  * What the samples tell of a cell is a pure function of object and cell,
  * kept in a direct-mapped per-thread cache (wall_cell; fixed size, so
