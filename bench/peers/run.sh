@@ -64,6 +64,10 @@ MESH1M=${MESH1M:-0}
 [ "$MESH1M" = "0" ] && MESH1M=""
 WALLS=${WALLS:-0}
 [ "$WALLS" = "0" ] && WALLS=""
+if [ $(( ${MESHES:+1} + ${MESH1M:+1} + ${WALLS:+1} + 0 )) -gt 1 ]; then
+  echo "bench-peers: MESHES=1, MESH1M=1 and WALLS=1 each make their own table: run one at a time" >&2
+  exit 2
+fi
 ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)
 QUICK=${QUICK:-0}
 [ "$QUICK" = "0" ] && QUICK=""
