@@ -56,6 +56,7 @@
 #include "util/xalloc.h"
 #endif
 
+#include <assert.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdatomic.h>
@@ -326,11 +327,28 @@ static bool add_face(rib_parser *p, mesh *m, int face, const int *loop_sizes, in
             bool flat = m->ncls == MESH_N_NONE || corners_flat(m, s, face, idx, total);
             scene_primvar vars[RIB_MAX_PRIMVARS];
             /* one polygon where its variables are constant, or affine in
-             * its (u,v) ("st" across a wall of quads) */
+             * its (u,v) ("st" across a wall of quads), started at the
+             * corner whose edge runs along s or t (its (u,v) follow its
+             * first edge: its cells then run along the pattern) */
             const double (*uv)[2] = s->nuv == total ? (const double (*)[2])s->uv : NULL;
+            int rot = flat ? rib_primvars_st_edge(&m->pv, corners, total) : 0;
+            if (rot) {
+                rib_corner rc[GEOM_MAX_POLY_VERTS];
+                for (int i = 0; i < total; i++) {
+                    rc[i] = corners[(i + rot) % total];
+                    s->verts[i] = point(m, idx[(i + rot) % total]);
+                }
+                memcpy(corners, rc, sizeof(rib_corner) * (size_t)total);
+                /* the same polygon, so it prepares as before */
+                bool again = prepare(m, s, err, sizeof err);
+                assert(again);
+                (void)again;
+                uv = s->nuv == total ? (const double (*)[2])s->uv : NULL;
+            }
             if (flat && rib_primvars_polygon(&m->pv, corners, uv, total, vars)) {
                 if (m->out) {
-                    add_piece(m, SCENE_PIECE_POLYGON, face, NULL, total);
+                    const int k[3] = {rot, 0, 0};
+                    add_piece(m, SCENE_PIECE_POLYGON, face, rot ? k : NULL, total);
                     return true;
                 }
                 add_with_vars(p, m, s, vars);

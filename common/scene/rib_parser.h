@@ -376,7 +376,8 @@ scene_mesh *scene_mesh_new_taking(double *P, int npoints, int *idx, int nidx,
                                   scene_mesh_nclass ncls, double *N, int nN,
                                   const struct rib_primvars *pv, rib_params *params);
 /* Adds a piece: a polygon of face `face`'s ncorners corners from
- * face-vertex fv0 (k unused), or the triangle of its corners k[0..3). */
+ * face-vertex fv0, started at corner k[0] (k NULL: the first), or the
+ * triangle of its corners k[0..3). */
 /* A check's mesh (scene_check_frame): the pieces added are counted, and
  * nothing else is kept; nprimvars: each piece's variables. */
 scene_mesh *scene_mesh_new_counted(int nprimvars);

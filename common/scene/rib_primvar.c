@@ -161,6 +161,30 @@ bool rib_primvars_same_at(const rib_primvars *pv, const rib_corner *c, int n)
     return true;
 }
 
+int rib_primvars_st_edge(const rib_primvars *pv, const rib_corner *c, int n)
+{
+    const rib_primvar_src *vs = NULL, *vt = NULL;
+    for (int k = 0; k < pv->n; k++) {
+        if (pv->v[k].size != 1) continue;
+        if (strcmp(pv->v[k].name, "s") == 0) vs = &pv->v[k];
+        else if (strcmp(pv->v[k].name, "t") == 0) vt = &pv->v[k];
+    }
+    if (!vs || !vt) return 0;
+    int best = 0;
+    double best_r = -1;
+    for (int i = 0; i < n; i++) {
+        int j = (i + 1) % n;
+        double ds = fabs(*value_at(vs, &c[j]) - *value_at(vs, &c[i]));
+        double dt = fabs(*value_at(vt, &c[j]) - *value_at(vt, &c[i]));
+        double r = ds + dt > 0 ? fmax(ds, dt) / (ds + dt) : -1;
+        if (r > best_r) {               /* the first of equals: a quad keeps 0 */
+            best_r = r;
+            best = i;
+        }
+    }
+    return best;
+}
+
 void rib_primvars_constant(const rib_primvars *pv, const rib_corner *c, scene_primvar *out)
 {
     for (int k = 0; k < pv->n; k++) {

@@ -70,6 +70,15 @@ bool rib_primvars_triangle(const rib_primvars *pv, const rib_corner c[3],
 bool rib_primvars_polygon(const rib_primvars *pv, const rib_corner *c, const double (*uv)[2],
                           int n, scene_primvar *out);
 
+/* The corner of a flat polygon's n corners c[i] whose edge to the next
+ * runs most nearly along s or t ("st", or "s" and "t": the largest of
+ * |ds|, |dt| over |ds| + |dt|; the first of equals), where both are
+ * given; else 0. A polygon's (u,v) run along its first edge: started
+ * there, its quadtree's cells run along the patterns of s and t (a
+ * triangle of a wall whose first edge is the quad's diagonal has cells at
+ * 45 degrees to its bricks). */
+int rib_primvars_st_edge(const rib_primvars *pv, const rib_corner *c, int n);
+
 /* The variables over a patch, corners c[0..4) at (u,v) = (0,0), (1,0),
  * (0,1), (1,1): bilinear. */
 void rib_primvars_bilinear(const rib_primvars *pv, const rib_corner c[4], scene_primvar *out);

@@ -172,7 +172,9 @@ void scene_mesh_add_piece(scene_mesh *self, scene_piece_kind kind, int face, int
     pc->kind = (uint8_t)kind;
     if (kind == SCENE_PIECE_POLYGON) {
         assert(ncorners >= 3 && ncorners <= GEOM_MAX_POLY_VERTS);
+        assert(!k || (k[0] >= 0 && k[0] < ncorners));
         pc->k[0] = (uint16_t)ncorners;
+        pc->k[1] = (uint16_t)(k ? k[0] : 0);     /* its first corner */
     } else {
         for (int i = 0; i < 3; i++) {
             assert(k[i] >= 0 && k[i] <= UINT16_MAX);
@@ -347,14 +349,15 @@ bool scene_mesh_piece_surface(const scene_mesh *self, int k, geom_surface *s,
     s->kind = GEOM_POLYGON;
     char err[ERR_LEN];
     if (pc->kind == SCENE_PIECE_POLYGON) {
-        int n = pc->k[0];
+        int n = pc->k[0], first = pc->k[1];
         s->nverts = n;
-        for (int i = 0; i < n; i++) s->verts[i] = point_at(self, self->idx[pc->fv0 + i]);
+        for (int i = 0; i < n; i++)
+            s->verts[i] = point_at(self, self->idx[pc->fv0 + (first + i) % n]);
         if (!geom_surface_prepare(s, err, sizeof err)) return false;
         if (self->pv.n > 0) {
             /* constant, or affine in its (u,v) (rib_mesh.c kept it whole) */
             rib_corner c[GEOM_MAX_POLY_VERTS];
-            for (int i = 0; i < n; i++) c[i] = corner_at(self, pc, i);
+            for (int i = 0; i < n; i++) c[i] = corner_at(self, pc, (first + i) % n);
             const double (*uv)[2] = s->nuv == n ? (const double (*)[2])s->uv : NULL;
             if (!rib_primvars_polygon(&self->pv, c, uv, n, vars)) return false;
         }
@@ -400,7 +403,8 @@ bool scene_mesh_piece_outline(const scene_mesh *self, int k, geom_surface *s)
     s->nvn = 0;
     if (pc->kind == SCENE_PIECE_POLYGON) {
         s->nverts = pc->k[0];
-        for (int i = 0; i < s->nverts; i++) s->verts[i] = point_at(self, self->idx[pc->fv0 + i]);
+        for (int i = 0; i < s->nverts; i++)
+            s->verts[i] = point_at(self, self->idx[pc->fv0 + (pc->k[1] + i) % s->nverts]);
     } else {
         s->nverts = 3;
         for (int i = 0; i < 3; i++) s->verts[i] = point_at(self, self->idx[pc->fv0 + pc->k[i]]);

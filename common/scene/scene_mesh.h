@@ -55,7 +55,8 @@ typedef struct scene_mesh_piece {
     int32_t face;                  /* the face (uniform class index) */
     int32_t fv0;                   /* its first face-vertex (index into the vertex indices) */
     uint16_t k[3];                 /* triangles: the face's corners; polygons: k[0] the
-                                    * corner count */
+                                    * corner count, k[1] the corner it starts at (its
+                                    * (u,v) follow "st": rib_primvars_st_edge) */
     uint8_t kind;                  /* scene_piece_kind */
     uint8_t unused;
 } scene_mesh_piece;

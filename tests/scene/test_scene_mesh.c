@@ -257,6 +257,43 @@ static void test_flat_faces_with_variables(void **state)
     sl_diag_destroy(&d);
 }
 
+/* A flat face kept whole starts at the corner whose edge runs along s or
+ * t, since a polygon's (u,v) follow its first edge: a wall's triangle whose
+ * first edge is the quad's diagonal would get quadtree cells at 45 degrees
+ * to its bricks. The mesh's pieces and a lone Polygon alike; st stays its
+ * given value at every corner. */
+static void test_faces_start_along_st(void **state)
+{
+    (void)state;
+    sl_diag *d;
+    scene *s = parse_rib(WORLD(
+        "PointsPolygons [3 3] [0 1 3  0 3 2]\n"
+        "  \"P\" [0 0 0  1 0 0  0 1 0  1 1 0]  \"st\" [0 0  1 0  0 1  1 1]\n"
+        "Polygon \"P\" [0 0 0  1 1 0  0 1 0] \"st\" [0 0  1 1  0 1]\n"), &d);
+    if (!s)
+        sl_diag_print(d, stderr);
+    assert_non_null(s);
+    int np;
+    test_piece *pc = scene_pieces(s, &np);
+    assert_int_equal(np, 3);
+    for (int f = 0; f < 3; f++) {
+        const geom_surface *g = &pc[f].surface;
+        assert_int_equal(g->nverts, 3);
+        /* the first edge: along x (s) or y (t), never the diagonal */
+        vec3 e = v3_sub(g->verts[1], g->verts[0]);
+        printf("piece %d: first edge (%g, %g, %g)\n", f, e.x, e.y, e.z);
+        assert_true(e.x == 0 || e.y == 0);
+        /* st at each corner is the point's own (s = x, t = y here) */
+        for (int i = 0; i < 3; i++) {
+            assert_true(fabs(corner_value(&pc[f], 0, 0, i) - g->verts[i].x) < 1e-12);
+            assert_true(fabs(corner_value(&pc[f], 1, 0, i) - g->verts[i].y) < 1e-12);
+        }
+    }
+    free(pc);
+    scene_destroy(&s);
+    sl_diag_destroy(&d);
+}
+
 static void test_variables_degenerate_instances(void **state)
 {
     (void)state;
@@ -359,6 +396,7 @@ int main(void)
         cmocka_unit_test(test_cube),
         cmocka_unit_test(test_normals),
         cmocka_unit_test(test_flat_faces_with_variables),
+        cmocka_unit_test(test_faces_start_along_st),
         cmocka_unit_test(test_cut_faces),
         cmocka_unit_test(test_variables_degenerate_instances),
         cmocka_unit_test(test_errors),
