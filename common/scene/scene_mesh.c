@@ -331,6 +331,12 @@ static bool subdiv_piece(const scene_mesh *m, int k, geom_surface *s,
     }
     return true;
 }
+
+/* A polygon piece's i-th corner among its face's: it starts at k[1] */
+static int polygon_corner(const scene_mesh_piece *pc, int i)
+{
+    return (pc->k[1] + i) % pc->k[0];
+}
 #endif
 
 bool scene_mesh_piece_surface(const scene_mesh *self, int k, geom_surface *s,
@@ -349,15 +355,15 @@ bool scene_mesh_piece_surface(const scene_mesh *self, int k, geom_surface *s,
     s->kind = GEOM_POLYGON;
     char err[ERR_LEN];
     if (pc->kind == SCENE_PIECE_POLYGON) {
-        int n = pc->k[0], first = pc->k[1];
+        int n = pc->k[0];
         s->nverts = n;
         for (int i = 0; i < n; i++)
-            s->verts[i] = point_at(self, self->idx[pc->fv0 + (first + i) % n]);
+            s->verts[i] = point_at(self, self->idx[pc->fv0 + polygon_corner(pc, i)]);
         if (!geom_surface_prepare(s, err, sizeof err)) return false;
         if (self->pv.n > 0) {
             /* constant, or affine in its (u,v) (rib_mesh.c kept it whole) */
             rib_corner c[GEOM_MAX_POLY_VERTS];
-            for (int i = 0; i < n; i++) c[i] = corner_at(self, pc, (first + i) % n);
+            for (int i = 0; i < n; i++) c[i] = corner_at(self, pc, polygon_corner(pc, i));
             const double (*uv)[2] = s->nuv == n ? (const double (*)[2])s->uv : NULL;
             if (!rib_primvars_polygon(&self->pv, c, uv, n, vars)) return false;
         }
@@ -404,7 +410,7 @@ bool scene_mesh_piece_outline(const scene_mesh *self, int k, geom_surface *s)
     if (pc->kind == SCENE_PIECE_POLYGON) {
         s->nverts = pc->k[0];
         for (int i = 0; i < s->nverts; i++)
-            s->verts[i] = point_at(self, self->idx[pc->fv0 + (pc->k[1] + i) % s->nverts]);
+            s->verts[i] = point_at(self, self->idx[pc->fv0 + polygon_corner(pc, i)]);
     } else {
         s->nverts = 3;
         for (int i = 0; i < 3; i++) s->verts[i] = point_at(self, self->idx[pc->fv0 + pc->k[i]]);

@@ -1,8 +1,9 @@
 /*
  * cellkey.h: the key of a quadtree cell, {u0, u1, v0, v1} of one object, in
  * the direct-mapped per-thread caches that keep pure functions of object
- * and cell (prove.c's slope bounds, intersect.c's wall samples): where an
- * entry goes, and whether it holds the cell. An entry whose key has
+ * and cell (prove.c's slope bounds, intersect.c's wall samples, moves and
+ * cases, displace.c's planes): where an entry goes, whether it holds the
+ * cell, and keying it to a cell or to none. An entry whose key has
  * r[0] >= r[1] (a zeroed one) holds none: cells have a width.
  */
 #ifndef TRACE_CELLKEY_H
@@ -34,6 +35,20 @@ static inline bool trace_cell_is(const double key[4], int key_obj, const double 
 {
     return key_obj == obj && key[0] == r[0] && key[1] == r[1] && key[2] == r[2] &&
            key[3] == r[3];
+}
+
+/* the entry now holds the cell r of object obj */
+static inline void trace_cell_keep(double key[4], int *key_obj, const double r[4], int obj)
+{
+    memcpy(key, r, 4 * sizeof key[0]);
+    *key_obj = obj;
+}
+
+/* the entry holds no cell (a failed run: nothing to keep) */
+static inline void trace_cell_forget(double key[4])
+{
+    key[0] = 1.0;
+    key[1] = 0.0;
 }
 
 #endif

@@ -443,8 +443,7 @@ static void box_of_run(trace_thread *th, const trace_object *obj, const affine_c
             out->flags |= TRACE_BOX_PLANAR;
             double c[4] = {cell->u.lo, cell->u.hi, cell->v.lo, cell->v.hi};
             plane_entry *e = plane_slot(th, obj, c);
-            memcpy(e->r, c, sizeof e->r);
-            e->obj = obj->id;
+            trace_cell_keep(e->r, &e->obj, c, obj->id);
             e->p = pl;
         }
     }

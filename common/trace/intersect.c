@@ -241,6 +241,13 @@ typedef struct wall_entry {
 } wall_entry;
 struct trace_wall_cache { wall_entry e[WALL_CACHE_ENTRIES]; };
 
+/* The side of the jump a surface point p lies on: 1 where it is nearer
+ * the farthest pair's second sample pb than its first pa */
+static int wall_side(vec3 p, vec3 pa, vec3 pb)
+{
+    return v3_length(v3_sub(p, pb)) < v3_length(v3_sub(p, pa));
+}
+
 /* the wall's unit normal from the step between its sides: made
  * perpendicular to the jump (0 where degenerate) */
 static void wall_normal_from(wall_entry *e, vec3 step)
@@ -273,7 +280,7 @@ static void analyse_wall(trace_thread *th, const trace_object *obj, const double
     for (int i = 0; i < CELL_N; i++) {
         side_of[i] = 0;
         if (!cs.ok[i]) continue;
-        int side = v3_length(v3_sub(cs.P[i], cs.P[b])) < v3_length(v3_sub(cs.P[i], cs.P[a]));
+        int side = wall_side(cs.P[i], cs.P[a], cs.P[b]);
         side_of[i] = side;
         sum_base[side] = v3_add(sum_base[side], cs.base[i]);
         sum_disp[side] = v3_add(sum_disp[side], v3_sub(cs.P[i], cs.base[i]));
@@ -322,7 +329,6 @@ static void refine_wall_normal(trace_thread *th, const trace_object *obj, const 
     e->refined = true;
     enum { MAXC = 2 * CELL_G * (CELL_G - 1) };
     double seg[MAXC][4];                  /* a crossing's (u,v) ends */
-    double mu[MAXC], mv[MAXC];
     int side0[MAXC];                      /* the side of its first end */
     int n = 0;
     double du = (r[1] - r[0]) / (CELL_G - 1), dv = (r[3] - r[2]) / (CELL_G - 1);
@@ -337,15 +343,13 @@ static void refine_wall_normal(trace_thread *th, const trace_object *obj, const 
             seg[n][1] = r[2] + dv * (i / CELL_G);
             seg[n][2] = r[0] + du * (k % CELL_G);
             seg[n][3] = r[2] + dv * (k / CELL_G);
-            mu[n] = 0.5 * (seg[n][0] + seg[n][2]);
-            mv[n] = 0.5 * (seg[n][1] + seg[n][3]);
             n++;
         }
     /* the two crossings farthest apart, by their midpoints' base points */
     vec3 mid[MAXC];
     for (int c = 0; c < n; c++) {
         geom_sample g;
-        geom_eval(&obj->surf, mu[c], mv[c], &g);
+        geom_eval(&obj->surf, 0.5 * (seg[c][0] + seg[c][2]), 0.5 * (seg[c][1] + seg[c][3]), &g);
         mid[c] = g.P;
     }
     int pick[2] = {-1, -1};
@@ -365,8 +369,13 @@ static void refine_wall_normal(trace_thread *th, const trace_object *obj, const 
             trace_surface_point sp;
             trace_surface_point_eval(th, obj, um, vm, &sp);
             if (!v3_is_finite(sp.P)) break;
-            int sm = v3_length(v3_sub(sp.P, e->pb)) < v3_length(v3_sub(sp.P, e->pa));
-            if (sm == side0[pick[m]]) { u0 = um; v0 = vm; } else { u1 = um; v1 = vm; }
+            if (wall_side(sp.P, e->pa, e->pb) == side0[pick[m]]) {
+                u0 = um;
+                v0 = vm;
+            } else {
+                u1 = um;
+                v1 = vm;
+            }
         }
         geom_sample g;
         geom_eval(&obj->surf, 0.5 * (u0 + u1), 0.5 * (v0 + v1), &g);
@@ -386,13 +395,10 @@ static wall_entry *wall_cell(trace_thread *th, const trace_object *obj, const do
     wall_entry *e = &th->walls->e[trace_cell_slot(r, obj->id, WALL_CACHE_LOG2)];
     if (trace_cell_is(e->r, e->obj, r, obj->id)) return e;
     analyse_wall(th, obj, r, e);
-    if (th->failed) {                   /* a failed run: nothing to keep */
-        e->r[0] = 1.0;
-        e->r[1] = 0.0;
-    } else {
-        memcpy(e->r, r, sizeof e->r);
-        e->obj = obj->id;
-    }
+    if (th->failed)                     /* a failed run: nothing to keep */
+        trace_cell_forget(e->r);
+    else
+        trace_cell_keep(e->r, &e->obj, r, obj->id);
     return e;
 }
 
@@ -664,12 +670,10 @@ static vec3 cell_move(trace_thread *th, const trace_object *obj, const double c[
     vec3 move = v3_sub(sp.P, mat4_xform_point(&obj->to_camera, g.P));
     e->back = mat4_xform_vector(&obj->from_camera, move);
     if (th->failed) {                   /* a failed run: nothing to keep */
-        e->r[0] = 1.0;
-        e->r[1] = 0.0;
+        trace_cell_forget(e->r);
         return v3(NAN, NAN, NAN);
     }
-    memcpy(e->r, c, sizeof e->r);
-    e->obj = obj->id;
+    trace_cell_keep(e->r, &e->obj, c, obj->id);
     return e->back;
 }
 
@@ -771,8 +775,7 @@ static void case_store(trace_thread *th, const trace_object *obj, const double c
 {
     const trace_object *owner = trace_box_owner(obj);
     case_entry *e = case_slot(th, owner, c);
-    memcpy(e->r, c, sizeof e->r);
-    e->obj = owner->id;
+    trace_cell_keep(e->r, &e->obj, c, owner->id);
     e->m = *m;
 }
 
@@ -784,13 +787,11 @@ static const trace_case_moves *case_moves(trace_thread *th, const trace_object *
     if (!trace_cell_is(e->r, e->obj, c, owner->id)) {
         trace_surface_case_moves(th, owner, c[0], c[1], c[2], c[3], &e->m);
         if (th->failed) {                 /* a failed run: nothing to keep */
-            e->r[0] = 1.0;
-            e->r[1] = 0.0;
+            trace_cell_forget(e->r);
             e->m.n = 0;
             return &e->m;
         }
-        memcpy(e->r, c, sizeof e->r);
-        e->obj = owner->id;
+        trace_cell_keep(e->r, &e->obj, c, owner->id);
     }
     return &e->m;
 }

@@ -146,12 +146,10 @@ static const slope_entry *cell_slopes(trace_thread *th, const trace_object *obj,
         e->Pc[i] = mr_of(Pc[i]);
     }
     if (th->failed) {                   /* a failed run: nothing to keep */
-        e->r[0] = 1.0;
-        e->r[1] = 0.0;
+        trace_cell_forget(e->r);
         return NULL;
     }
-    memcpy(e->r, r, sizeof e->r);
-    e->obj = obj->id;
+    trace_cell_keep(e->r, &e->obj, r, obj->id);
     return e->ok ? e : NULL;
 }
 
