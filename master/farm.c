@@ -486,6 +486,7 @@ static int add_frames(farm *f, int from, char *err, size_t errsz)
             farm_worker *w = registry_at(f->reg, i);
             if (!w->alive) continue;
             w->slot = scheduler_worker_add(f->sched);
+            scheduler_worker_threads(f->sched, w->slot, (int)w->threads);
             farm_worker_fit(f, w);
         }
     }

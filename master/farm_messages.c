@@ -281,6 +281,7 @@ static void on_hello(farm *f, const proto_hello *h, const uint8_t *id, size_t id
     w->threads = h->threads ? (h->threads > 1024 ? 1024 : h->threads) : 1;
     snprintf(w->pool, sizeof w->pool, "%s", h->pool ? h->pool : "");
     w->slot = scheduler_worker_add(f->sched);
+    scheduler_worker_threads(f->sched, w->slot, (int)w->threads);
     farm_worker_fit(f, w);
     for (int i = 0; i < f->nframes; i++)
         if (holds_job(h, f->frames[i].jb->hash)) mark_held(w, i);

@@ -43,6 +43,8 @@ typedef struct worker_slot {
     int64_t taken_ms_sum;
     int overdue;       /* its valid leases past their deadline */
     bool waiting;      /* getting the job's files (scheduler_worker_waiting) */
+    int threads;       /* its rendering threads (0: not told) */
+    int held;          /* its valid leases */
 } worker_slot;
 
 typedef struct failed_pair {
@@ -71,6 +73,8 @@ struct scheduler {
     size_t ngiven_up;
     bool job_failed;
     int done;
+    int nqueued;               /* tiles queued(): PENDING, no live lease */
+    int threads;               /* the active workers' threads told, in all */
     int64_t taken_ms_sum;      /* grant-to-result time of taken leases */
     int taken;                 /* their number (done counts resumed tiles too) */
     scheduler_counts counts;
@@ -103,6 +107,7 @@ scheduler *scheduler_new(int tiles_x, int tiles_y, const scheduler_options *opt)
     self->rq = xcalloc((size_t)self->ntiles, sizeof *self->rq);
     self->next_id = 1;
     self->counts.tiles = self->ntiles;
+    self->nqueued = self->ntiles;
     return self;
 }
 
@@ -130,6 +135,7 @@ bool scheduler_extend(scheduler *self, int more)
     self->rq = xreallocarray(self->rq, (size_t)n, sizeof *self->rq);
     self->ntiles = n;
     self->counts.tiles = n;
+    self->nqueued += more;
     return true;
 }
 
@@ -143,6 +149,14 @@ int scheduler_worker_add(scheduler *self)
 static bool worker_ok(const scheduler *self, int worker)
 {
     return worker >= 0 && worker < self->nworkers && self->workers[worker].active;
+}
+
+void scheduler_worker_threads(scheduler *self, int worker, int threads)
+{
+    assert(threads >= 1);
+    if (!worker_ok(self, worker)) return;
+    self->threads += threads - self->workers[worker].threads;
+    self->workers[worker].threads = threads;
 }
 
 /* ---- tiles and the requeue list ---- */
@@ -190,7 +204,10 @@ static void tile_lost_live(scheduler *self, int tile)
     tile_state *t = &self->tiles[tile];
     assert(t->live > 0);   /* lease counts balance: a live lease was counted */
     t->live--;
-    if (!t->done && t->live == 0) rq_push(self, tile);
+    if (!t->done && t->live == 0) {
+        self->nqueued++;
+        rq_push(self, tile);
+    }
 }
 
 static bool failed_by(const scheduler *self, int tile, int worker)
@@ -252,6 +269,10 @@ static void lease_remove(scheduler *self, scheduler_lease *l)
         self->workers[l->worker].overdue--;
     }
     assert(l->id != 0 && self->tiles[tile].held > 0);   /* a lease is held once */
+    if (l->worker >= 0 && l->worker < self->nworkers) {
+        assert(self->workers[l->worker].held > 0);
+        self->workers[l->worker].held--;
+    }
     l->id = 0;
     self->holes++;
     self->tiles[tile].held--;
@@ -271,6 +292,12 @@ static void lease_add(scheduler *self, int worker, int tile, int64_t now, bool d
                            .granted_ms = now, .from_ms = now,
                            .deadline_ms = now + scheduler_lease_limit(self, worker),
                            .duplicate = dup};
+    assert(!self->tiles[tile].done);
+    if (self->tiles[tile].live == 0) {
+        assert(self->nqueued > 0);
+        self->nqueued--;
+    }
+    self->workers[worker].held++;
     self->tiles[tile].live++;
     self->tiles[tile].held++;
     assert(self->tiles[tile].live <= self->tiles[tile].held);
@@ -368,7 +395,12 @@ static int pick_duplicate(const scheduler *self, int worker, int64_t now)
 bool scheduler_grant(scheduler *self, int worker, int64_t now_ms, scheduler_lease *out)
 {
     if (!worker_ok(self, worker) || self->job_failed || self->done == self->ntiles) return false;
-    if (self->workers[worker].overdue > 0) return false;   /* a hoarder, or a stalled worker */
+    const worker_slot *ws = &self->workers[worker];
+    if (ws->overdue > 0) return false;   /* a hoarder, or a stalled worker */
+    /* the end of the queue: a tile for a worker whose threads are all busy
+     * would wait in its pipeline while other workers' threads may run dry */
+    if (ws->threads > 0 && ws->held >= ws->threads && self->nqueued <= self->threads)
+        return false;
     int tile = pick_requeued(self, worker);
     if (tile >= 0) {
         lease_add(self, worker, tile, now_ms, self->tiles[tile].held > 0, out);
@@ -417,6 +449,7 @@ scheduler_verdict scheduler_complete(scheduler *self, int worker, uint64_t lease
         lease_remove(self, l);
         return SCHEDULER_DUPLICATE;
     }
+    if (t->live == 0) self->nqueued--;   /* its lease had expired: it was queued */
     t->done = 1;
     self->done++;
     assert(self->done <= self->ntiles);
@@ -494,6 +527,7 @@ int scheduler_worker_remove(scheduler *self, int worker)
     if (!worker_ok(self, worker)) return 0;
     uint64_t before = self->counts.requeued;
     self->workers[worker].active = false;
+    self->threads -= self->workers[worker].threads;
     for (size_t i = 0; i < self->nleases; i++) {
         scheduler_lease *l = &self->leases[i];
         if (l->id && l->worker == worker) {
@@ -576,6 +610,7 @@ bool scheduler_mark_done(scheduler *self, int tile)
     if (tile < 0 || tile >= self->ntiles) return false;
     tile_state *t = &self->tiles[tile];
     if (t->done || t->held) return false;
+    self->nqueued--;
     t->done = 1;
     self->done++;
     return true;
@@ -622,4 +657,5 @@ void scheduler_counts_get(const scheduler *self, scheduler_counts *out)
         if (self->tiles[i].live) out->leased++;
         else out->queued++;
     }
+    assert(out->queued == self->nqueued);   /* the running count agrees */
 }

@@ -42,6 +42,13 @@
  *     worker that has not failed it is there for join_window_ms (0: at
  *     once, when no other worker can join) does it fail the job
  *     (scheduler_check_given_up);
+ *   - the end of the queue: a worker whose threads are all busy (it holds
+ *     as many leases as it has threads, scheduler_worker_threads) gets no
+ *     further tile while no more tiles are queued than the active workers
+ *     have threads in all: near the end a tile goes to a worker with an
+ *     idle thread rather than waiting in a busy worker's pipeline (2 leases
+ *     a thread: worker_loop.c) while other workers run dry. A worker whose
+ *     threads were never told is not held back;
  *   - lease deadlines follow the measured speed: a lease lasts
  *     lease_factor x the mean grant-to-result time of its worker (of all
  *     workers until this one has delivered a tile; lease_ms until anyone
@@ -132,6 +139,10 @@ bool scheduler_extend(scheduler *self, int more);
 
 /* A new worker slot (0, 1, 2 ...; never reused). */
 int scheduler_worker_add(scheduler *self);
+
+/* The worker renders with `threads` (>= 1) threads (its Hello): the end of
+ * the queue's rule above. */
+void scheduler_worker_threads(scheduler *self, int worker, int threads);
 
 /* The worker is gone, or blocklisted for the job (the master stops
  * granting to it while it stays connected): its leases become unknown (their results are stale)

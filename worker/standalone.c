@@ -3,7 +3,13 @@
  * works through a contiguous run of tiles (tile_runs.h: neighbouring tiles
  * one after the other keep its box cache warm, as Pharr & Hanrahan's tile
  * orders do; idle threads steal half a run), renders them with its own
- * trace_thread, and hands them to the one writer under a mutex.
+ * trace_thread, compresses them, and hands the compressed chunks to the
+ * one writer under a mutex. At the end of the frame, when no tile is left
+ * to take, a thread helps the tiles still being traced: it takes blocks of
+ * 8 x 8 pixels' samples of the tile with the most blocks left (trace/
+ * render.h, trace_tile_samples), so the frame's tail is a block, not a
+ * tile (one expensive tile would otherwise keep one core busy while the
+ * others wait).
  */
 #include "standalone.h"
 
@@ -39,6 +45,18 @@ static void on_signal(int sig)
     atomic_store(&interrupted, 1);
 }
 
+/* A tile being traced by the thread that took it (its owner), whose
+ * blocks not yet taken other threads may take (the frame's tail). */
+typedef struct tile_share {
+    trace_tile_samples *ts;
+    image_rect rect;
+    int nblocks;
+    atomic_int next;               /* the next block to take */
+    int helpers;                   /* other threads on it (under the lock) */
+    bool failed;                   /* a helper failed (under the lock) */
+    char error[ERR_LEN];
+} tile_share;
+
 typedef struct shared {
     const standalone_options *opt;
     const job_scene *js;
@@ -47,7 +65,10 @@ typedef struct shared {
     tile_runs runs;                /* which tiles each thread renders next */
     atomic_int next_thread;        /* hands out thread indexes */
     int ntiles;
-    pthread_mutex_t lock;          /* writer, progress, error */
+    pthread_mutex_t lock;          /* writer, progress, error, active */
+    pthread_cond_t helped;         /* a helper left a tile */
+    tile_share **active;           /* per thread: the tile it owns, or NULL */
+    long tail_blocks;              /* blocks traced by a thread not their owner */
     int done;
     bool failed;
     char error[ERR_LEN];
@@ -74,6 +95,86 @@ static void progress(shared *s)
     fflush(stderr);
 }
 
+/* Takes blocks of the tile being traced with the most blocks left until
+ * no tile has any; false when a shader failed or the render was stopped. */
+static bool help_tail(shared *s, trace_thread *th, int threads)
+{
+    for (;;) {
+        pthread_mutex_lock(&s->lock);
+        tile_share *best = NULL;
+        int most = 0;
+        for (int t = 0; t < threads; t++) {
+            tile_share *sh = s->active[t];
+            int left = sh && !sh->failed ? sh->nblocks - atomic_load(&sh->next) : 0;
+            if (left > most) {
+                most = left;
+                best = sh;
+            }
+        }
+        if (best) best->helpers++;
+        pthread_mutex_unlock(&s->lock);
+        if (!best) return true;
+        bool ok = true;
+        long mine = 0;
+        for (int b; ok && (b = atomic_fetch_add(&best->next, 1)) < best->nblocks; mine++)
+            ok = trace_tile_samples_trace(s->js->renderer, th, best->ts, b);
+        pthread_mutex_lock(&s->lock);
+        s->tail_blocks += mine;
+        if (!ok && !best->failed) {
+            best->failed = true;
+            err_set(best->error, sizeof best->error, "tile at (%d,%d): %s",
+                    best->rect.x0, best->rect.y0, th->error);
+        }
+        best->helpers--;
+        pthread_cond_broadcast(&s->helped);
+        pthread_mutex_unlock(&s->lock);
+        if (!ok) return false;
+    }
+}
+
+/* Traces tile `r` with the threads that come to help (help_tail), filters
+ * it and compresses it: the tile's chunk (in *exr, the caller frees) or
+ * NULL with the reason in err. */
+static void *trace_tile(shared *s, trace_thread *th, int me, image_rect r,
+                        worker_nonfinite *nf, const void **chunk, size_t *chunk_len,
+                        char *err, size_t errsz)
+{
+    tile_share sh = {.ts = trace_tile_samples_new(s->js->renderer, r.x0, r.y0, r.w, r.h),
+                     .rect = r};
+    sh.nblocks = trace_tile_samples_blocks(sh.ts);
+    atomic_init(&sh.next, 0);
+    pthread_mutex_lock(&s->lock);
+    s->active[me] = &sh;
+    pthread_mutex_unlock(&s->lock);
+    bool ok = true;
+    for (int b; ok && (b = atomic_fetch_add(&sh.next, 1)) < sh.nblocks;)
+        ok = trace_tile_samples_trace(s->js->renderer, th, sh.ts, b);
+    if (!ok) atomic_store(&sh.next, sh.nblocks);   /* helpers take no more */
+    /* no helper comes once it is withdrawn; those on it finish their block */
+    pthread_mutex_lock(&s->lock);
+    s->active[me] = NULL;
+    while (sh.helpers > 0) pthread_cond_wait(&s->helped, &s->lock);
+    pthread_mutex_unlock(&s->lock);
+    void *exr = NULL;
+    size_t exr_len = 0;
+    if (!ok) {
+        err_set(err, errsz, "tile at (%d,%d): %s", r.x0, r.y0, th->error);
+    } else if (sh.failed) {
+        err_set(err, errsz, "%s", sh.error);
+    } else {
+        image_tile *tile = worker_filter_tile(s->js, sh.ts, r, s->fmt.layers, nf, err, errsz);
+        /* compressed here, in parallel: the writer's lock only copies it */
+        if (tile && image_tile_encode_exr(tile, &s->fmt, &exr, &exr_len, err, errsz) &&
+            !image_tile_exr_chunk(exr, exr_len, &s->fmt, r, chunk, chunk_len, err, errsz)) {
+            free(exr);
+            exr = NULL;
+        }
+        image_tile_destroy(&tile);
+    }
+    trace_tile_samples_destroy(&sh.ts);
+    return exr;
+}
+
 static void *render_thread(void *arg)
 {
     shared *s = arg;
@@ -84,17 +185,23 @@ static void *render_thread(void *arg)
     int me = atomic_fetch_add(&s->next_thread, 1);
     for (;;) {
         int i = tile_runs_take(&s->runs, me);
-        if (i < 0 || interrupted) break;
+        if (i < 0) {
+            if (!interrupted) help_tail(s, th, s->runs.nthreads);
+            break;
+        }
+        if (interrupted) break;
         pthread_mutex_lock(&s->lock);
         bool stop = s->failed;
         pthread_mutex_unlock(&s->lock);
         if (stop) break;
         image_rect r = image_format_tile_rect(&s->fmt, i % tx_count, i / tx_count);
         char err[ERR_LEN];
-        worker_nonfinite nf;
-        image_tile *tile = worker_render_tile(s->js, th, r, s->fmt.layers, &nf, err, sizeof err);
+        worker_nonfinite nf = {0, 0, 0};
+        const void *chunk = NULL;
+        size_t chunk_len = 0;
+        void *exr = trace_tile(s, th, me, r, &nf, &chunk, &chunk_len, err, sizeof err);
         pthread_mutex_lock(&s->lock);
-        if (tile && nf.count) {
+        if (exr && nf.count) {
             if (!s->nonfinite.count || nf.y < s->nonfinite.y ||
                 (nf.y == s->nonfinite.y && nf.x < s->nonfinite.x)) {
                 s->nonfinite.x = nf.x;
@@ -102,10 +209,11 @@ static void *render_thread(void *arg)
             }
             s->nonfinite.count += nf.count;
         }
-        if (!tile) {
+        if (!exr) {
             if (!s->failed) snprintf(s->error, sizeof s->error, "%s", err);
             s->failed = true;
-        } else if (!image_writer_put_tile(s->writer, tile, err, sizeof err)) {
+        } else if (!image_writer_put_chunk(s->writer, i % tx_count, i / tx_count, chunk,
+                                           chunk_len, err, sizeof err)) {
             if (!s->failed) snprintf(s->error, sizeof s->error, "%s", err);
             s->failed = true;
         } else {
@@ -113,7 +221,7 @@ static void *render_thread(void *arg)
             progress(s);
         }
         pthread_mutex_unlock(&s->lock);
-        image_tile_destroy(&tile);
+        free(exr);
     }
     trace_thread_sync_stats(th);
     pthread_mutex_lock(&s->lock);
@@ -146,12 +254,12 @@ static bool write_stats_json(const char *path, const shared *s, int threads, dou
              "\"texture_tile_loads\": %llu, \"texture_tile_evictions\": %llu, "
              "\"texture_tile_peak_bytes\": %zu, \"world_objects\": %d, \"world_meshes\": %d, "
              "\"world_pieces\": %ld, \"instance_groups\": %d, \"instances\": %ld, "
-             "\"instances_moved\": %ld, \"instances_own\": %ld",
+             "\"instances_moved\": %ld, \"instances_own\": %ld, \"tail_blocks\": %ld",
              s->opt->scene_path, s->fmt.width, s->fmt.height, s->ntiles, threads,
              trace_arith_name(s->opt->job.arith), s->opt->cache_bytes, secs,
              (unsigned long long)s->nonfinite.count, ts.budget, ts.loads, ts.evictions,
              ts.peak_bytes, wc.objects, wc.meshes, wc.pieces, wc.groups, wc.placements,
-             wc.moved, wc.own);
+             wc.moved, wc.own, s->tail_blocks);
     trace_stats_write_json(&s->stats, extra, f);
     fputc('\n', f);
     return fclose(f) == 0;
@@ -202,9 +310,11 @@ static int render_frame(const standalone_options *opt, const job *jb, const fram
     s.ntiles = image_format_tile_count(&s.fmt);
     s.work = xcalloc((size_t)js->world.nobjects + 1, sizeof *s.work);
     pthread_mutex_init(&s.lock, NULL);
+    pthread_cond_init(&s.helped, NULL);
     int threads = opt->threads > 0 ? opt->threads : default_threads();
     atomic_init(&s.next_thread, 0);
     tile_runs_init(&s.runs, s.ntiles, threads);
+    s.active = xcalloc((size_t)threads, sizeof *s.active);
     if (opt->verbosity >= 0)
         fprintf(stderr, "aafarm-worker: %s: %dx%d, %d tiles of %d, %d thread%s, %s arithmetic\n",
                 opt->scene_path, s.fmt.width, s.fmt.height, s.ntiles, s.fmt.tile_size,
@@ -264,6 +374,9 @@ static int render_frame(const standalone_options *opt, const job *jb, const fram
                 "  %-18s %ld\n  %-18s %ld\n", "world_objects", wc.objects, "world_meshes",
                 wc.meshes, "world_pieces", wc.pieces, "instance_groups", wc.groups, "instances",
                 wc.placements, "instances_moved", wc.moved, "instances_own", wc.own);
+        /* blocks of 8 x 8 pixels traced by a thread that had no tile left,
+         * for the thread that owned the tile (the frame's tail) */
+        fprintf(stderr, "  %-18s %ld\n", "tail_blocks", s.tail_blocks);
         tex_tile_stats ts;
         tex_tiles_stats(tex_tiles_process(), &ts);
         if (ts.loads)
@@ -278,6 +391,8 @@ static int render_frame(const standalone_options *opt, const job *jb, const fram
     }
     free(s.work);
     tile_runs_clear(&s.runs);
+    free(s.active);
+    pthread_cond_destroy(&s.helped);
     pthread_mutex_destroy(&s.lock);
     job_scene_destroy(&js);
     return rc;

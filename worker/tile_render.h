@@ -11,6 +11,7 @@
 
 #include "image/tile.h"
 #include "job/job_scene.h"
+#include "trace/render.h"
 #include "trace/thread.h"
 
 /* Non-finite samples found in a tile and written as 0 (image/tile.h,
@@ -28,6 +29,13 @@ image_tile *worker_render_tile(const job_scene *js, trace_thread *th,
                                image_rect rect, unsigned layers,
                                worker_nonfinite *nonfinite,
                                char *err, size_t errsz);
+
+/* The tile of rectangle `rect` from its traced samples (every block of ts
+ * traced, by any threads: trace/render.h), NaN and infinite samples made
+ * safe as above. NULL when the tile cannot be allocated (err says so). */
+image_tile *worker_filter_tile(const job_scene *js, const trace_tile_samples *ts,
+                               image_rect rect, unsigned layers,
+                               worker_nonfinite *nonfinite, char *err, size_t errsz);
 
 /* The renderer's warnings (trace_renderer_set_log) on stderr, as
  * "aafarm: warning: <message>". */

@@ -5,6 +5,7 @@
  */
 #include "trace/render.h"
 
+#include <assert.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -142,56 +143,110 @@ static double filter_weight(const trace_world *w, double dx, double dy)
 
 typedef struct sample_rec { float x, y, r, g, b, a, z; } sample_rec;
 
-bool trace_render_tile(const trace_renderer *self, trace_thread *th,
-                       int x0, int y0, int w, int h, float *rgba, float *z)
+/* A tile's samples: every sample of every pixel whose filter reaches the
+ * tile, traced in blocks of TRACE_TILE_BLOCK consecutive Morton indices. */
+struct trace_tile_samples {
+    int x0, y0, w, h;          /* the tile */
+    int qx0, qy0, qw, qh;      /* the pixels whose samples it needs */
+    int nx, ny, ns;            /* samples per pixel */
+    int side;                  /* the power-of-two square of the Morton order */
+    int nblocks;
+    sample_rec *smp;           /* qw x qh pixels of ns samples, row-major */
+};
+
+trace_tile_samples *trace_tile_samples_new(const trace_renderer *self, int x0, int y0,
+                                           int w, int h)
 {
     const trace_world *world = self->world;
     double rx = 0.5 * world->filter_width[0], ry = 0.5 * world->filter_width[1];
-    int nx = world->samples_x > 0 ? world->samples_x : 1;
-    int ny = world->samples_y > 0 ? world->samples_y : 1;
-    int ns = nx * ny;
+    trace_tile_samples *ts = xcalloc(1, sizeof *ts);
+    ts->x0 = x0;
+    ts->y0 = y0;
+    ts->w = w;
+    ts->h = h;
+    ts->nx = world->samples_x > 0 ? world->samples_x : 1;
+    ts->ny = world->samples_y > 0 ? world->samples_y : 1;
+    ts->ns = ts->nx * ts->ny;
     /* pixels whose samples can reach the tile's pixels through the filter:
      * pixel q's samples lie in [q, q + 1) (trace_sample_position), and one
      * at s counts for the pixel centred at c where c - r <= s < c + r
-     * (below), so the first is floor(x0 + 0.5 - r) and the last
-     * ceil(x0 + w - 0.5 + r) - 1 (a box filter of width 1: the tile's own
-     * pixels, no ring of neighbours whose samples would all get weight 0) */
-    int qx0 = (int)floor(x0 + 0.5 - rx), qx1 = (int)ceil(x0 + w - 0.5 + rx) - 1;
-    int qy0 = (int)floor(y0 + 0.5 - ry), qy1 = (int)ceil(y0 + h - 0.5 + ry) - 1;
-    int qw = qx1 - qx0 + 1, qh = qy1 - qy0 + 1;
-    sample_rec *smp = xmalloc(sizeof(sample_rec) * (size_t)qw * (size_t)qh * (size_t)ns);
+     * (trace_tile_samples_filter), so the first is floor(x0 + 0.5 - r) and
+     * the last ceil(x0 + w - 0.5 + r) - 1 (a box filter of width 1: the
+     * tile's own pixels, no ring of neighbours whose samples would all get
+     * weight 0) */
+    ts->qx0 = (int)floor(x0 + 0.5 - rx);
+    ts->qy0 = (int)floor(y0 + 0.5 - ry);
+    ts->qw = (int)ceil(x0 + w - 0.5 + rx) - 1 - ts->qx0 + 1;
+    ts->qh = (int)ceil(y0 + h - 0.5 + ry) - 1 - ts->qy0 + 1;
+    ts->smp = xmalloc(sizeof(sample_rec) * (size_t)ts->qw * (size_t)ts->qh * (size_t)ts->ns);
+    ts->side = 1;
+    while (ts->side < ts->qw || ts->side < ts->qh) ts->side *= 2;
+    long cells = (long)ts->side * ts->side;
+    ts->nblocks = (int)((cells + TRACE_TILE_BLOCK - 1) / TRACE_TILE_BLOCK);
+    return ts;
+}
+
+int trace_tile_samples_blocks(const trace_tile_samples *ts)
+{
+    return ts->nblocks;
+}
+
+void trace_tile_samples_destroy(trace_tile_samples **ts_p)
+{
+    if (!*ts_p) return;
+    free((*ts_p)->smp);
+    free(*ts_p);
+    *ts_p = NULL;
+}
+
+bool trace_tile_samples_trace(const trace_renderer *self, trace_thread *th,
+                              trace_tile_samples *ts, int block)
+{
+    assert(block >= 0 && block < ts->nblocks);
+    const trace_world *world = self->world;
     /* The pixels in Morton (Z) order over the smallest power-of-two square
      * that holds them: consecutive rays stay close in both directions, so
      * the box cache keeps what the next rays need (Heidrich & Seidel §6:
      * neighbouring rays share the quadtree's boxes). Each sample is a pure
-     * function of its pixel and index, so the order changes no result. */
-    int side = 1;
-    while (side < qw || side < qh) side *= 2;
-    for (long m = 0; m < (long)side * side; m++) {
+     * function of its pixel and index, so the order, and which thread
+     * traces which block, change no result. */
+    long m0 = (long)block * TRACE_TILE_BLOCK;
+    long m1 = m0 + TRACE_TILE_BLOCK;
+    if (m1 > (long)ts->side * ts->side) m1 = (long)ts->side * ts->side;
+    for (long m = m0; m < m1; m++) {
         int mx = 0, my = 0;
         for (int bit = 0; (1L << (2 * bit)) <= m; bit++) {
             mx |= (int)((m >> (2 * bit)) & 1) << bit;
             my |= (int)((m >> (2 * bit + 1)) & 1) << bit;
         }
-        if (mx >= qw || my >= qh) continue;
-        int qx = qx0 + mx, qy = qy0 + my;
-            for (int s = 0; s < ns; s++) {
-                if (th->failed || trace_thread_cancelled(th)) {
-                    free(smp);
-                    return false;
-                }
-                sample_rec *r = &smp[(((size_t)(qy - qy0) * (size_t)qw) + (size_t)(qx - qx0)) * (size_t)ns + (size_t)s];
-                double sx, sy, lu = 0.5, lv = 0.5, rgb[3], a, d;
-                trace_sample_position(qx, qy, s, nx, ny, &sx, &sy);
-                if (world->camera.lens_radius > 0)
-                    trace_sample_lens(qx, qy, s, nx, ny, &lu, &lv);
-                trace_render_sample_lens(self, th, sx, sy, lu, lv, rgb, &a, &d);
-                /* the offset inside the pixel (exact), rounded to float the
-                 * same way in every tile that traces this sample */
-                *r = (sample_rec){(float)(sx - qx), (float)(sy - qy), (float)rgb[0],
-                                  (float)rgb[1], (float)rgb[2], (float)a, (float)d};
-            }
+        if (mx >= ts->qw || my >= ts->qh) continue;
+        int qx = ts->qx0 + mx, qy = ts->qy0 + my;
+        sample_rec *r = &ts->smp[((size_t)my * (size_t)ts->qw + (size_t)mx) * (size_t)ts->ns];
+        for (int s = 0; s < ts->ns; s++) {
+            if (th->failed || trace_thread_cancelled(th)) return false;
+            double sx, sy, lu = 0.5, lv = 0.5, rgb[3], a, d;
+            trace_sample_position(qx, qy, s, ts->nx, ts->ny, &sx, &sy);
+            if (world->camera.lens_radius > 0)
+                trace_sample_lens(qx, qy, s, ts->nx, ts->ny, &lu, &lv);
+            trace_render_sample_lens(self, th, sx, sy, lu, lv, rgb, &a, &d);
+            /* the offset inside the pixel (exact), rounded to float the
+             * same way in every tile that traces this sample */
+            r[s] = (sample_rec){(float)(sx - qx), (float)(sy - qy), (float)rgb[0],
+                                (float)rgb[1], (float)rgb[2], (float)a, (float)d};
+        }
     }
+    return !th->failed;
+}
+
+void trace_tile_samples_filter(const trace_renderer *self, const trace_tile_samples *ts,
+                               float *rgba, float *z)
+{
+    const trace_world *world = self->world;
+    double rx = 0.5 * world->filter_width[0], ry = 0.5 * world->filter_width[1];
+    int x0 = ts->x0, y0 = ts->y0, w = ts->w, h = ts->h, ns = ts->ns;
+    int qx0 = ts->qx0, qy0 = ts->qy0, qw = ts->qw;
+    int qx1 = qx0 + ts->qw - 1, qy1 = qy0 + ts->qh - 1;
+    const sample_rec *smp = ts->smp;
     double inv_gamma = world->gamma > 0 ? 1.0 / world->gamma : 1.0;
     for (int py = y0; py < y0 + h; py++)
         for (int px = x0; px < x0 + w; px++) {
@@ -234,6 +289,15 @@ bool trace_render_tile(const trace_renderer *self, trace_thread *th,
             }
             z[(size_t)(py - y0) * (size_t)w + (size_t)(px - x0)] = zmin;
         }
-    free(smp);
-    return !th->failed;
+}
+
+bool trace_render_tile(const trace_renderer *self, trace_thread *th,
+                       int x0, int y0, int w, int h, float *rgba, float *z)
+{
+    trace_tile_samples *ts = trace_tile_samples_new(self, x0, y0, w, h);
+    bool ok = true;
+    for (int b = 0; ok && b < ts->nblocks; b++) ok = trace_tile_samples_trace(self, th, ts, b);
+    if (ok) trace_tile_samples_filter(self, ts, rgba, z);
+    trace_tile_samples_destroy(&ts);
+    return ok;
 }

@@ -7,6 +7,7 @@
  *   trace_render_tile  one tile: primary rays for every sample of every
  *                    pixel whose filter reaches the tile, shading with
  *                    shadows, pixel filter, exposure
+ *   trace_tile_samples one tile traced in blocks by several threads
  *
  * Determinism (DESIGN.md §2): a pixel's value depends only on the world and
  * the pixel: samples are hashed from (pixel, index), a sample outside the
@@ -56,6 +57,27 @@ void trace_renderer_set_log(trace_renderer *self, trace_log_fn fn, void *user);
  * when a shader failed (th->error says why); the buffers are then garbage. */
 bool trace_render_tile(const trace_renderer *self, trace_thread *th,
                        int x0, int y0, int w, int h, float *rgba, float *z);
+
+/* The same tile in parts, so that several threads can trace one tile (the
+ * standalone renderer's threads left without tiles at the end of a frame
+ * help the tiles still being traced: worker/standalone.c). A tile's samples
+ * fall into trace_tile_samples_blocks() blocks of TRACE_TILE_BLOCK
+ * consecutive Morton indices (8 x 8 pixels); each block is traced once, by
+ * any thread with its own trace_thread (blocks write disjoint samples),
+ * then one thread filters them into rgba and z as trace_render_tile does.
+ * A sample is a pure function of its pixel and index: who traces a block
+ * changes no bit of the tile. trace_tile_samples_trace returns false when
+ * a shader failed (th->error) or th was cancelled. */
+enum { TRACE_TILE_BLOCK = 64 };
+typedef struct trace_tile_samples trace_tile_samples;
+trace_tile_samples *trace_tile_samples_new(const trace_renderer *self, int x0, int y0,
+                                           int w, int h);
+int trace_tile_samples_blocks(const trace_tile_samples *ts);
+bool trace_tile_samples_trace(const trace_renderer *self, trace_thread *th,
+                              trace_tile_samples *ts, int block);
+void trace_tile_samples_filter(const trace_renderer *self, const trace_tile_samples *ts,
+                               float *rgba, float *z);
+void trace_tile_samples_destroy(trace_tile_samples **ts_p);
 
 /* One primary sample at raster (x, y): colour, alpha, depth. For tests.
  * Through the lens centre (a pinhole). */

@@ -122,6 +122,7 @@ static pid_t start_honest(const char *ep, const char *master_log)
 
 typedef struct rogue {
     void *s;
+    uint32_t threads;   /* what its Hello claims (0: 1) */
     int grants;
     int64_t last_hb;
 } rogue;
@@ -149,7 +150,7 @@ static void rogue_hello(rogue *r, void *ctx, const char *ep, const char *name)
     h.worker_name = (char *)name;
     h.host = "rogue-host";
     h.pid = 1;
-    h.threads = 1;
+    h.threads = r->threads ? r->threads : 1;
     Aafarm__Envelope env = AAFARM__ENVELOPE__INIT;
     env.body_case = AAFARM__ENVELOPE__BODY_HELLO;
     env.hello = &h;
@@ -240,7 +241,9 @@ static void test_hoarders_lose_their_tiles_and_get_no_more(void **state)
     char log[4096];
     snprintf(log, sizeof log, "%s", ft_path(dir, "hoard.log"));
     void *ctx = zmq_ctx_new();
-    rogue r[2] = {{0}, {0}};
+    /* they claim many threads, so the end of the queue's rule (master/
+     * scheduler.h) does not keep the last tiles from them: they take all */
+    rogue r[2] = {{.threads = 32}, {.threads = 32}};
     rogue_hello(&r[0], ctx, ep, "hoarder0");
     rogue_hello(&r[1], ctx, ep, "hoarder1");
     /* the hoarders take their tiles first */

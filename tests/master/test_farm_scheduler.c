@@ -522,6 +522,42 @@ static void test_stale_results(void **state)
 
 /* Random workers that join, die, fail, stall and answer in random order;
  * at the end every tile must have been taken exactly once. */
+/* The end of the queue: 5 tiles, two workers of one thread each. While
+ * more tiles are queued than the 2 threads, a busy worker gets a second
+ * tile for its pipeline; after that a tile goes only to a worker with an
+ * idle thread, so the last one does not wait behind a busy worker's tile
+ * while the other worker is idle. A worker that never told its threads
+ * is not held back. */
+static void test_end_of_queue_goes_to_idle_threads(void **state)
+{
+    (void)state;
+    scheduler *s = make(5, 1, 3, 0, 100000);
+    int a = scheduler_worker_add(s), b = scheduler_worker_add(s);
+    scheduler_worker_threads(s, a, 1);
+    scheduler_worker_threads(s, b, 1);
+    uint64_t ia, ia2, ib, ib2;
+    assert_int_equal(grant_tile(s, a, 0, &ia), 0);    /* 4 left queued */
+    assert_int_equal(grant_tile(s, a, 0, &ia2), 1);   /* pipelined: 3 > 2 threads */
+    assert_true(grant_tile(s, b, 0, &ib) >= 2);       /* b is idle: 2 left */
+    assert_int_equal(grant_tile(s, b, 0, NULL), -1);  /* 2 <= 2: no pipeline for b */
+    assert_int_equal(grant_tile(s, a, 0, NULL), -1);  /* nor for a */
+    assert_int_equal(scheduler_complete(s, b, ib, 10), SCHEDULER_TAKEN);
+    assert_true(grant_tile(s, b, 10, &ib2) >= 2);     /* b's thread is idle again */
+    assert_int_equal(grant_tile(s, b, 10, NULL), -1);
+    assert_int_equal(scheduler_complete(s, a, ia, 20), SCHEDULER_TAKEN);
+    assert_int_equal(grant_tile(s, a, 20, NULL), -1); /* a's pipeline holds tile 1 */
+    assert_int_equal(scheduler_complete(s, a, ia2, 30), SCHEDULER_TAKEN);
+    assert_true(grant_tile(s, a, 30, NULL) >= 2);     /* the last one */
+    assert_int_equal(scheduler_complete(s, b, ib2, 40), SCHEDULER_TAKEN);
+    scheduler_destroy(&s);
+
+    /* threads never told: pipelined to the end, as before the rule */
+    s = make(3, 1, 3, 0, 100000);
+    a = scheduler_worker_add(s);
+    for (int t = 0; t < 3; t++) assert_int_equal(grant_tile(s, a, 0, NULL), t);
+    scheduler_destroy(&s);
+}
+
 static void test_random_farm_takes_every_tile_once(void **state)
 {
     (void)state;
@@ -536,11 +572,14 @@ static void test_random_farm_takes_every_tile_once(void **state)
         int workers[64], nw = 0;
         workers[nw++] = scheduler_worker_add(s);
         int64_t now = 0;
+        scheduler_counts c;
         for (int step = 0; step < 100000 && !scheduler_finished(s); step++) {
             now += rand() % 7;
             int r = rand() % 100;
             if (r < 3 && nw < 64) {
                 workers[nw++] = scheduler_worker_add(s);
+                /* some told their threads (the end of the queue's rule) */
+                if (rand() % 3) scheduler_worker_threads(s, workers[nw - 1], 1 + rand() % 2);
             } else if (r < 5 && nw > 1) {
                 int k = rand() % nw;
                 scheduler_worker_remove(s, workers[k]);
@@ -567,6 +606,10 @@ static void test_random_farm_takes_every_tile_once(void **state)
             } else {
                 scheduler_expire(s, now);
             }
+            /* its running count of queued tiles agrees with a count of
+             * the tiles (an assert in scheduler_counts_get) */
+            scheduler_counts_get(s, &c);
+            assert_true(c.queued + c.leased + c.done == c.tiles);
         }
         assert_true(scheduler_finished(s));
         assert_false(scheduler_failed(s));
@@ -650,6 +693,7 @@ int main(void)
         cmocka_unit_test(test_stale_results),
         cmocka_unit_test(test_each_lease_visits_the_valid_ones),
         cmocka_unit_test(test_resumed_tiles_never_granted),
+        cmocka_unit_test(test_end_of_queue_goes_to_idle_threads),
         cmocka_unit_test(test_random_farm_takes_every_tile_once),
         cmocka_unit_test(test_extend_while_leases_are_out),
     };

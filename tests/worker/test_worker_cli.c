@@ -241,6 +241,63 @@ static void test_covering_plane_gives_alpha_one_everywhere(void **state)
     image_buffer_destroy(&b);
 }
 
+/* The number after "key": in file `name` of dir; -1 when absent. */
+static long json_number(const char *name, const char *key)
+{
+    char path[512], json[16384], needle[96];
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    read_text(path, json, sizeof json);
+    snprintf(needle, sizeof needle, "\"%s\": ", key);
+    const char *at = strstr(json, needle);
+    return at ? strtol(at + strlen(needle), NULL, 10) : -1;
+}
+
+/* The frame's tail (worker/standalone.c): an image of one tile leaves
+ * every thread but the one that took it without a tile, so they trace
+ * blocks of its samples. The image must equal the one thread's bit for
+ * bit (every channel, tolerance 0), and the helpers must have traced some
+ * blocks (tail_blocks, from --stats-json): 4 threads on one tile of a
+ * displaced sphere at 4 samples a pixel. */
+static void test_threads_without_tiles_help_the_last_tile(void **state)
+{
+    (void)state;
+    char out[8192];
+    write_file("bumps.sl", "displacement bumps(float Km = 0.08)\n{\n"
+                           "    P += Km * sin(12 * xcomp(P)) * sin(10 * ycomp(P)) * normalize(N);\n"
+                           "    N = calculatenormal(P);\n}\n");
+    write_file("one.rib", "Format 40 40 1\nPixelSamples 2 2\nProjection \"perspective\" "
+               "\"fov\" [40]\nOption \"searchpath\" \"shader\" [\".\"]\nTranslate 0 0 4\n"
+               "WorldBegin\nLightSource \"distantlight\" 1\nSurface \"plastic\"\n"
+               "Displacement \"bumps\"\nAttribute \"displacementbound\" \"sphere\" [0.1]\n"
+               "Sphere 1 -1 1 360\nWorldEnd\n");
+    assert_int_equal(run("--standalone one.rib -o one1.exr --tile 64 --threads 1 "
+                         "--stats-json one1.json -q", out, sizeof out), 0);
+    assert_int_equal(run("--standalone one.rib -o one4.exr --tile 64 --threads 4 "
+                         "--stats-json one4.json -q", out, sizeof out), 0);
+    assert_int_equal(json_number("one1.json", "tiles"), 1);
+    assert_int_equal(json_number("one1.json", "tail_blocks"), 0);
+    long helped = json_number("one4.json", "tail_blocks");
+    printf("4 threads on one tile: %ld blocks of 8x8 pixels traced by the 3 helpers\n", helped);
+    assert_true(helped > 0);
+    char p1[512], p4[512], err[256];
+    snprintf(p1, sizeof p1, "%s/one1.exr", dir);
+    snprintf(p4, sizeof p4, "%s/one4.exr", dir);
+    image_buffer *a = image_buffer_read_exr(p1, err, sizeof err);
+    image_buffer *b = image_buffer_read_exr(p4, err, sizeof err);
+    assert_non_null(a);
+    assert_non_null(b);
+    /* the sphere is there: not a comparison of two empty frames */
+    assert_true(image_buffer_channel(a, "A")[20 * 40 + 20] > 0.99f);
+    image_diff d;
+    assert_true(image_buffer_compare(a, b, 0.0, &d, err, sizeof err));
+    if (d.count)
+        printf("%zu samples differ, the largest by %g in %s at (%d,%d)\n", d.count, d.max_abs,
+               d.channel, d.x, d.y);
+    assert_int_equal(d.count, 0);
+    image_buffer_destroy(&a);
+    image_buffer_destroy(&b);
+}
+
 /* Starts the worker in dir with argv (stderr into err_path, or dropped),
  * sends SIGTERM after pause_ms, and waits up to 10 s for it; a worker
  * that ignores the signal is killed (SIGKILL) and the test fails. Returns
@@ -361,6 +418,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_budget_exceeded_leaves_nothing),
         cmocka_unit_test(test_good_render_leaves_exactly_the_output),
         cmocka_unit_test(test_covering_plane_gives_alpha_one_everywhere),
+        cmocka_unit_test(test_threads_without_tiles_help_the_last_tile),
         cmocka_unit_test(test_stats_count_the_instances),
         cmocka_unit_test(test_shader_printf_reaches_stderr),
         cmocka_unit_test(test_sigterm_stops_a_runaway_render),
