@@ -30,6 +30,7 @@
 #include "tex/tex.h"
 #include "tile_render.h"
 #include "tile_runs.h"
+#include "tile_share.h"
 #include "util/err.h"
 #include "util/exitcodes.h"
 #include "util/xalloc.h"
@@ -44,18 +45,6 @@ static void on_signal(int sig)
     (void)sig;
     atomic_store(&interrupted, 1);
 }
-
-/* A tile being traced by the thread that took it (its owner), whose
- * blocks not yet taken other threads may take (the frame's tail). */
-typedef struct tile_share {
-    trace_tile_samples *ts;
-    image_rect rect;
-    int nblocks;
-    atomic_int next;               /* the next block to take */
-    int helpers;                   /* other threads on it (under the lock) */
-    bool failed;                   /* a helper failed (under the lock) */
-    char error[ERR_LEN];
-} tile_share;
 
 typedef struct shared {
     const standalone_options *opt;
@@ -105,7 +94,7 @@ static bool help_tail(shared *s, trace_thread *th, int threads)
         int most = 0;
         for (int t = 0; t < threads; t++) {
             tile_share *sh = s->active[t];
-            int left = sh && !sh->failed ? sh->nblocks - atomic_load(&sh->next) : 0;
+            int left = sh && !sh->failed ? tile_share_left(sh) : 0;
             if (left > most) {
                 most = left;
                 best = sh;
@@ -114,17 +103,11 @@ static bool help_tail(shared *s, trace_thread *th, int threads)
         if (best) best->helpers++;
         pthread_mutex_unlock(&s->lock);
         if (!best) return true;
-        bool ok = true;
         long mine = 0;
-        for (int b; ok && (b = atomic_fetch_add(&best->next, 1)) < best->nblocks; mine++)
-            ok = trace_tile_samples_trace(s->js->renderer, th, best->ts, b);
+        bool ok = tile_share_trace(best, th, &mine);
         pthread_mutex_lock(&s->lock);
         s->tail_blocks += mine;
-        if (!ok && !best->failed) {
-            best->failed = true;
-            err_set(best->error, sizeof best->error, "tile at (%d,%d): %s",
-                    best->rect.x0, best->rect.y0, th->error);
-        }
+        if (!ok) tile_share_fail(best, th);
         best->helpers--;
         pthread_cond_broadcast(&s->helped);
         pthread_mutex_unlock(&s->lock);
@@ -133,23 +116,18 @@ static bool help_tail(shared *s, trace_thread *th, int threads)
 }
 
 /* Traces tile `r` with the threads that come to help (help_tail), filters
- * it and compresses it: the tile's chunk (in *exr, the caller frees) or
- * NULL with the reason in err. */
+ * it and compresses it: the tile's file (the caller frees) with *chunk
+ * pointing at its compressed chunk, or NULL with the reason in err. */
 static void *trace_tile(shared *s, trace_thread *th, int me, image_rect r,
                         worker_nonfinite *nf, const void **chunk, size_t *chunk_len,
                         char *err, size_t errsz)
 {
-    tile_share sh = {.ts = trace_tile_samples_new(s->js->renderer, r.x0, r.y0, r.w, r.h),
-                     .rect = r};
-    sh.nblocks = trace_tile_samples_blocks(sh.ts);
-    atomic_init(&sh.next, 0);
+    tile_share sh;
+    tile_share_init(&sh, s->js->renderer, r);
     pthread_mutex_lock(&s->lock);
     s->active[me] = &sh;
     pthread_mutex_unlock(&s->lock);
-    bool ok = true;
-    for (int b; ok && (b = atomic_fetch_add(&sh.next, 1)) < sh.nblocks;)
-        ok = trace_tile_samples_trace(s->js->renderer, th, sh.ts, b);
-    if (!ok) atomic_store(&sh.next, sh.nblocks);   /* helpers take no more */
+    bool ok = tile_share_trace(&sh, th, NULL);
     /* no helper comes once it is withdrawn; those on it finish their block */
     pthread_mutex_lock(&s->lock);
     s->active[me] = NULL;
@@ -171,7 +149,7 @@ static void *trace_tile(shared *s, trace_thread *th, int me, image_rect r,
         }
         image_tile_destroy(&tile);
     }
-    trace_tile_samples_destroy(&sh.ts);
+    tile_share_clear(&sh);
     return exr;
 }
 

@@ -253,8 +253,9 @@ static bool send_task(worker_loop *w, worker_task *t)
         return true;
     }
     w->tiles_sent++;
-    wlog(w, 1, "tile %u sent (lease %llu, %zu bytes, %.3f s)", t->tile_index,
-         (unsigned long long)t->lease_id, t->exr_len, t->stats.wall_seconds);
+    wlog(w, 1, "tile %u sent (lease %llu, %zu bytes, %.3f s, %llu blocks by idle threads)",
+         t->tile_index, (unsigned long long)t->lease_id, t->exr_len, t->stats.wall_seconds,
+         (unsigned long long)t->stats.helped_blocks);
     return true;
 }
 

@@ -1,8 +1,12 @@
 /*
  * worker_pool.c: render threads, their task queue and done list (see
  * worker_pool.h). One mutex guards the queue, the done list and each
- * thread's current task; a condition variable wakes idle threads; a pipe
- * wakes the connection loop.
+ * thread's current task and tile share; a condition variable wakes idle
+ * threads, another the owners of tiles whose helpers left; a pipe wakes
+ * the connection loop. A thread that finds the queue empty helps the
+ * tiles being rendered (tile_share.h): it traces blocks of the one with
+ * the most blocks left, so the last tiles of a job end within a block
+ * when the worker has idle threads.
  */
 #include "worker_pool.h"
 
@@ -17,6 +21,7 @@
 #include <unistd.h>
 
 #include "tile_render.h"
+#include "tile_share.h"
 #include "trace/thread.h"
 #include "util/xalloc.h"
 
@@ -26,11 +31,20 @@ typedef struct render_thread {
     bool started;
     long last_tile;            /* index of the last tile rendered, -1: none */
     worker_task *current;      /* being rendered (under the pool's lock) */
+    struct pool_share *share;  /* its blocks, while they may be helped (the lock) */
 } render_thread;
+
+/* A task's tile share and what its helpers did (under the pool's lock). */
+typedef struct pool_share {
+    tile_share sh;
+    held_job *job;             /* the task's (the helpers' VM and world) */
+    worker_tile_stats helped;  /* the helpers' work: rays ... CPU seconds */
+} pool_share;
 
 struct worker_pool {
     pthread_mutex_t lock;
     pthread_cond_t wake;
+    pthread_cond_t helped;     /* a helper left a tile share */
     worker_task *queue;        /* submitted, not started (a list) */
     worker_task *done, *done_tail;
     render_thread *threads;
@@ -91,20 +105,59 @@ static void stats_delta(worker_tile_stats *out, const trace_stats *a, const trac
     out->peak_cache_bytes = (uint64_t)b->cache_peak_bytes;
 }
 
-static void render_task(worker_pool *p, trace_thread *th, worker_task *t)
+static void stats_add(worker_tile_stats *to, const worker_tile_stats *d)
+{
+    to->rays += d->rays;
+    to->boxes += d->boxes;
+    to->shader_evals += d->shader_evals;
+    to->cache_hits += d->cache_hits;
+    to->cache_misses += d->cache_misses;
+    to->cache_evictions += d->cache_evictions;
+    if (d->peak_cache_bytes > to->peak_cache_bytes) to->peak_cache_bytes = d->peak_cache_bytes;
+    to->cpu_seconds += d->cpu_seconds;
+    to->helped_blocks += d->helped_blocks;
+}
+
+/* A failed tile's message from th; th is cleared for the next tile. */
+static void take_error(trace_thread *th, image_rect r, char *err, size_t errsz)
+{
+    snprintf(err, errsz, "tile at (%d,%d): %s", r.x0, r.y0, th->error);
+    th->failed = false;
+    th->error[0] = '\0';
+}
+
+static void render_task(worker_pool *p, render_thread *rt, trace_thread *th, worker_task *t)
 {
     if (p->tile_delay_ms > 0) sleep_ms(p->tile_delay_ms);
     const held_job *h = t->job;
     double wall0 = clock_s(CLOCK_MONOTONIC), cpu0 = clock_s(CLOCK_THREAD_CPUTIME_ID);
     trace_thread_sync_stats(th);
     trace_stats before = th->stats;
-    worker_nonfinite nf;
-    image_tile *tile = worker_render_tile(h->js, th, t->rect, h->fmt.layers, &nf, t->error,
+    pool_share ps = {.job = t->job};
+    tile_share_init(&ps.sh, h->js->renderer, t->rect);
+    pthread_mutex_lock(&p->lock);
+    rt->share = &ps;
+    pthread_cond_broadcast(&p->wake);   /* idle threads may help */
+    pthread_mutex_unlock(&p->lock);
+    bool ok = tile_share_trace(&ps.sh, th, NULL);
+    pthread_mutex_lock(&p->lock);
+    rt->share = NULL;   /* no helper comes now; those on it finish their block */
+    while (ps.sh.helpers > 0) pthread_cond_wait(&p->helped, &p->lock);
+    pthread_mutex_unlock(&p->lock);
+    worker_nonfinite nf = {0, 0, 0};
+    if (!ok) {
+        take_error(th, t->rect, t->error, sizeof t->error);
+    } else if (ps.sh.failed) {
+        snprintf(t->error, sizeof t->error, "%s", ps.sh.error);
+    } else {
+        image_tile *tile = worker_filter_tile(h->js, ps.sh.ts, t->rect, h->fmt.layers, &nf,
+                                              t->error, sizeof t->error);
+        if (tile)
+            t->ok = image_tile_encode_exr(tile, &h->fmt, &t->exr, &t->exr_len, t->error,
                                           sizeof t->error);
-    if (tile)
-        t->ok = image_tile_encode_exr(tile, &h->fmt, &t->exr, &t->exr_len, t->error,
-                                      sizeof t->error);
-    image_tile_destroy(&tile);
+        image_tile_destroy(&tile);
+    }
+    tile_share_clear(&ps.sh);
     trace_thread_sync_stats(th);
     stats_delta(&t->stats, &before, &th->stats);
     t->stats.nonfinite_samples = t->ok ? nf.count : 0;
@@ -112,6 +165,73 @@ static void render_task(worker_pool *p, trace_thread *th, worker_task *t)
     t->stats.wall_seconds = clock_s(CLOCK_MONOTONIC) - wall0;
     if (t->stats.cpu_seconds < 0) t->stats.cpu_seconds = 0;
     if (t->stats.wall_seconds < 0) t->stats.wall_seconds = 0;
+    stats_add(&t->stats, &ps.helped);
+}
+
+/* The end of a thread's work on a job: its work-limit warnings (one line
+ * per object, trace_object_work_report), then its VM and box cache go. */
+static void retire_thread(trace_thread **th, const held_job *held)
+{
+    if (*th && held)
+        trace_object_work_report(&held->js->world, (*th)->work, "aafarm-worker", stderr);
+    trace_thread_destroy(th);
+}
+
+/* This thread's VM and box cache for the job (new ones when it worked on
+ * another job). */
+static void use_job(worker_pool *p, trace_thread **th, held_job **cur, held_job *want)
+{
+    if (*cur == want) return;
+    retire_thread(th, *cur);
+    held_job_release(cur);
+    *cur = held_job_retain(want);
+    *th = trace_thread_new(&(*cur)->js->world);
+    trace_thread_set_cancel(*th, &p->abort_render);
+    trace_thread_set_print(*th, worker_print_shader_line, NULL);
+}
+
+/* The share with the most blocks left (under the lock), or NULL. */
+static pool_share *most_left(worker_pool *p)
+{
+    pool_share *best = NULL;
+    int most = 0;
+    for (int i = 0; i < p->nthreads; i++) {
+        pool_share *ps = p->threads[i].share;
+        int left = ps && !ps->sh.failed ? tile_share_left(&ps->sh) : 0;
+        if (left > most) {
+            most = left;
+            best = ps;
+        }
+    }
+    return best;
+}
+
+/* Helps share ps (called and returns under the lock). */
+static void help(worker_pool *p, pool_share *ps, trace_thread **th, held_job **cur)
+{
+    ps->sh.helpers++;
+    pthread_mutex_unlock(&p->lock);
+    use_job(p, th, cur, ps->job);
+    double cpu0 = clock_s(CLOCK_THREAD_CPUTIME_ID);
+    trace_thread_sync_stats(*th);
+    trace_stats before = (*th)->stats;
+    long blocks = 0;
+    bool ok = tile_share_trace(&ps->sh, *th, &blocks);
+    trace_thread_sync_stats(*th);
+    worker_tile_stats d;
+    stats_delta(&d, &before, &(*th)->stats);
+    d.cpu_seconds = clock_s(CLOCK_THREAD_CPUTIME_ID) - cpu0;
+    if (d.cpu_seconds < 0) d.cpu_seconds = 0;
+    d.helped_blocks = (uint64_t)blocks;
+    pthread_mutex_lock(&p->lock);
+    stats_add(&ps->helped, &d);
+    if (!ok) {
+        tile_share_fail(&ps->sh, *th);
+        (*th)->failed = false;
+        (*th)->error[0] = '\0';
+    }
+    ps->sh.helpers--;
+    pthread_cond_broadcast(&p->helped);
 }
 
 /* ---- the lists (under the lock) ---- */
@@ -148,15 +268,6 @@ static worker_task *take_nearest(worker_pool *p, long last)
     return t;
 }
 
-/* The end of a thread's work on a job: its work-limit warnings (one line
- * per object, trace_object_work_report), then its VM and box cache go. */
-static void retire_thread(trace_thread **th, const held_job *held)
-{
-    if (*th && held)
-        trace_object_work_report(&held->js->world, (*th)->work, "aafarm-worker", stderr);
-    trace_thread_destroy(th);
-}
-
 static void *render_main(void *arg)
 {
     render_thread *rt = arg;
@@ -165,20 +276,17 @@ static void *render_main(void *arg)
     held_job *cur = NULL;
     pthread_mutex_lock(&p->lock);
     for (;;) {
-        while (!p->stopping && !p->queue) pthread_cond_wait(&p->wake, &p->lock);
+        while (!p->stopping && !p->queue) {
+            pool_share *ps = most_left(p);
+            if (ps) help(p, ps, &th, &cur);
+            else pthread_cond_wait(&p->wake, &p->lock);
+        }
         if (p->stopping) break;
         worker_task *t = take_nearest(p, rt->last_tile);
         rt->current = t;
         pthread_mutex_unlock(&p->lock);
-        if (cur != t->job) {   /* another job: a new VM and box cache */
-            retire_thread(&th, cur);
-            held_job_release(&cur);
-            cur = held_job_retain(t->job);
-            th = trace_thread_new(&cur->js->world);
-            trace_thread_set_cancel(th, &p->abort_render);
-            trace_thread_set_print(th, worker_print_shader_line, NULL);
-        }
-        render_task(p, th, t);
+        use_job(p, &th, &cur, t->job);   /* another job: a new VM and box cache */
+        render_task(p, rt, th, t);
         pthread_mutex_lock(&p->lock);
         rt->current = NULL;
         rt->last_tile = (long)t->tile_index;
@@ -202,6 +310,7 @@ worker_pool *worker_pool_new(int threads, int tile_delay_ms)
     p->threads = xcalloc((size_t)p->nthreads, sizeof *p->threads);
     pthread_mutex_init(&p->lock, NULL);
     pthread_cond_init(&p->wake, NULL);
+    pthread_cond_init(&p->helped, NULL);
     p->pipe_fd[0] = p->pipe_fd[1] = -1;
     if (pipe(p->pipe_fd) != 0) {
         worker_pool_destroy(&p);
@@ -247,6 +356,7 @@ void worker_pool_destroy(worker_pool **self_p)
     for (int i = 0; i < 2; i++)
         if (p->pipe_fd[i] >= 0) close(p->pipe_fd[i]);
     pthread_cond_destroy(&p->wake);
+    pthread_cond_destroy(&p->helped);
     pthread_mutex_destroy(&p->lock);
     free(p->threads);
     free(p);

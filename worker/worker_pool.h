@@ -31,6 +31,8 @@ typedef struct worker_tile_stats {
     uint64_t cache_hits, cache_misses, cache_evictions, peak_cache_bytes;
     double cpu_seconds, wall_seconds;
     uint64_t nonfinite_samples;    /* NaN/Inf samples written as 0 */
+    uint64_t helped_blocks;        /* blocks traced by idle threads (tile_share.h);
+                                      the counts and CPU above include them */
 } worker_tile_stats;
 
 typedef struct worker_task {

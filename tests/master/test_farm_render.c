@@ -80,6 +80,39 @@ static void test_farm_two_processes_equal_standalone(void **state)
     stop_worker(worker);
 }
 
+/* A worker's idle threads help its last tile (worker/worker_pool.c,
+ * tile_share.h): the whole image is one tile, leased to one worker of 4
+ * threads; 3 threads have nothing else to do, so they trace blocks of it.
+ * The image equals the standalone one, and the worker says (-v) that
+ * blocks were traced by idle threads. */
+static void test_idle_threads_help_the_last_tile(void **state)
+{
+    (void)state;
+    const char *log = ft_path(dir, "one.log");
+    const char *argv[] = {ft_master, ft_path(dir, "scene.rib"), "-o", ft_path(dir, "one.exr"),
+                          "--bind", "tcp://127.0.0.1:*", "--tile", "64", NULL};
+    pid_t master = ft_spawn(log, argv);
+    char ep[256];
+    assert_true(ft_master_endpoint(log, ep, sizeof ep, 30));
+    const char *wlog = ft_path(dir, "helped.log");
+    const char *wargv[] = {ft_worker, "--connect", ep, "--name", "helped", "--threads", "4",
+                           "-v", NULL};
+    pid_t worker = ft_spawn(wlog, wargv);
+    assert_int_equal(ft_wait(master, 120), 0);
+    assert_int_equal(ft_exr_diff(ft_path(dir, "ref.exr"), ft_path(dir, "one.exr")), 0);
+    char *text = ft_read(wlog);
+    const char *sent = strstr(text, "tile 0 sent");
+    assert_non_null(sent);
+    const char *by = strstr(sent, " blocks by idle threads");
+    assert_non_null(by);
+    while (by > sent && by[-1] >= '0' && by[-1] <= '9') by--;
+    long helped = strtol(by, NULL, 10);
+    printf("one tile, 4 threads: %ld blocks of 8x8 pixels traced by the idle threads\n", helped);
+    assert_true(helped > 0);
+    free(text);
+    stop_worker(worker);
+}
+
 static void test_farm_three_workers_early_and_late(void **state)
 {
     (void)state;
@@ -252,6 +285,7 @@ int main(int argc, char **argv)
     if (!ft_init(argc, argv)) return 2;
     const struct CMUnitTest tests[] = {
         cmocka_unit_test_teardown(test_farm_two_processes_equal_standalone, ft_teardown),
+        cmocka_unit_test_teardown(test_idle_threads_help_the_last_tile, ft_teardown),
         cmocka_unit_test_teardown(test_farm_three_workers_early_and_late, ft_teardown),
         cmocka_unit_test_teardown(test_farm_embedded_default, ft_teardown),
         cmocka_unit_test_teardown(test_local_workers_end_with_their_master, ft_teardown),
