@@ -320,8 +320,10 @@ worker_pool *worker_pool_new(int threads, int tile_delay_ms)
         fcntl(p->pipe_fd[i], F_SETFL, fcntl(p->pipe_fd[i], F_GETFL) | O_NONBLOCK);
         fcntl(p->pipe_fd[i], F_SETFD, FD_CLOEXEC);
     }
-    for (int i = 0; i < p->nthreads; i++) {
+    /* all set before any thread starts: an idle one reads every slot */
+    for (int i = 0; i < p->nthreads; i++)
         p->threads[i] = (render_thread){.pool = p, .last_tile = -1};
+    for (int i = 0; i < p->nthreads; i++) {
         if (pthread_create(&p->threads[i].tid, NULL, render_main, &p->threads[i]) != 0) {
             worker_pool_destroy(&p);
             return NULL;
