@@ -267,6 +267,20 @@ bool ft_master_endpoint(const char *log, char *buf, size_t bufsz, double timeout
     return ok;
 }
 
+pid_t ft_start_master(const char *dir, const char *name, const char *tile, char *ep,
+                      size_t epsz)
+{
+    char log[4096], out[4096], file[128];
+    snprintf(file, sizeof file, "%s.log", name);
+    snprintf(log, sizeof log, "%s", ft_path(dir, file));
+    snprintf(file, sizeof file, "%s.exr", name);
+    snprintf(out, sizeof out, "%s", ft_path(dir, file));
+    const char *argv[] = {ft_master, ft_path(dir, "scene.rib"), "-o", out,
+                          "--bind", "tcp://127.0.0.1:*", "--tile", tile, NULL};
+    pid_t pid = ft_spawn(log, argv);
+    return pid > 0 && ft_master_endpoint(log, ep, epsz, 30) ? pid : -1;
+}
+
 int ft_count_files(const char *dir, const char *prefix)
 {
     DIR *d = opendir(dir);

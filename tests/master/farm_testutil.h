@@ -77,6 +77,13 @@ bool ft_wait_for(const char *path, const char *needle, int n, double timeout_s);
  * buf; false when it does not appear within timeout_s. */
 bool ft_master_endpoint(const char *log, char *buf, size_t bufsz, double timeout_s);
 
+/* A master rendering dir/scene.rib into dir/NAME.exr in tiles of `tile`,
+ * bound to loopback on a free port, its log dir/NAME.log; its endpoint
+ * into ep. The pid (ft_spawn: stopped by ft_stop_all), or -1 when it said
+ * no endpoint within 30 s. */
+pid_t ft_start_master(const char *dir, const char *name, const char *tile, char *ep,
+                      size_t epsz);
+
 /* The number after "\"key\": " in a JSON file (the master's
  * --stats-json), or -1 when the key is missing. */
 long ft_json_number(const char *path, const char *key);

@@ -57,12 +57,10 @@ static void stop_worker(pid_t pid)
 static void test_farm_two_processes_equal_standalone(void **state)
 {
     (void)state;
-    const char *log = ft_path(dir, "two.log");
-    const char *argv[] = {ft_master, ft_path(dir, "scene.rib"), "-o", ft_path(dir, "two.exr"),
-                          "--bind", "tcp://127.0.0.1:*", "--tile", "8", NULL};
-    pid_t master = ft_spawn(log, argv);
     char ep[256];
-    assert_true(ft_master_endpoint(log, ep, sizeof ep, 30));
+    pid_t master = ft_start_master(dir, "two", "8", ep, sizeof ep);
+    assert_true(master > 0);
+    const char *log = ft_path(dir, "two.log");
     assert_non_null(strstr(ep, "tcp://127.0.0.1:"));
     pid_t worker = start_worker(ep, "solo", "2", "0");
     assert_int_equal(ft_wait(master, 120), 0);
@@ -88,12 +86,9 @@ static void test_farm_two_processes_equal_standalone(void **state)
 static void test_idle_threads_help_the_last_tile(void **state)
 {
     (void)state;
-    const char *log = ft_path(dir, "one.log");
-    const char *argv[] = {ft_master, ft_path(dir, "scene.rib"), "-o", ft_path(dir, "one.exr"),
-                          "--bind", "tcp://127.0.0.1:*", "--tile", "64", NULL};
-    pid_t master = ft_spawn(log, argv);
     char ep[256];
-    assert_true(ft_master_endpoint(log, ep, sizeof ep, 30));
+    pid_t master = ft_start_master(dir, "one", "64", ep, sizeof ep);
+    assert_true(master > 0);
     const char *wlog = ft_path(dir, "helped.log");
     const char *wargv[] = {ft_worker, "--connect", ep, "--name", "helped", "--threads", "4",
                            "-v", NULL};
