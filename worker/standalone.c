@@ -142,11 +142,9 @@ static void *trace_tile(shared *s, trace_thread *th, int me, image_rect r,
     } else {
         image_tile *tile = worker_filter_tile(s->js, sh.ts, r, s->fmt.layers, nf, err, errsz);
         /* compressed here, in parallel: the writer's lock only copies it */
-        if (tile && image_tile_encode_exr(tile, &s->fmt, &exr, &exr_len, err, errsz) &&
-            !image_tile_exr_chunk(exr, exr_len, &s->fmt, r, chunk, chunk_len, err, errsz)) {
-            free(exr);
-            exr = NULL;
-        }
+        if (tile)
+            image_tile_encode_chunk(tile, &s->fmt, &exr, &exr_len, chunk, chunk_len, err,
+                                    errsz);
         image_tile_destroy(&tile);
     }
     tile_share_clear(&sh);

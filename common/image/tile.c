@@ -481,6 +481,26 @@ bool image_tile_exr_chunk(const void *bytes, size_t len,
     return ok;
 }
 
+bool image_tile_encode_chunk(const image_tile *self, const image_format *fmt,
+                             void **bytes, size_t *len, const void **chunk,
+                             size_t *chunk_len, char *err, size_t errsz)
+{
+    if (!image_tile_encode_exr(self, fmt, bytes, len, err, errsz))
+        return false;
+    /* our own encoder's one-tile file: header, the offset table's one
+     * entry (8 bytes), the chunk's leader (tile and level: 16 bytes, data
+     * size: 4), the data */
+    const uint8_t *b = *bytes;
+    size_t hlen = header_length(b, *len);
+    assert(hlen > 0 && hlen + 8 + 20 <= *len);
+    assert(read_u64(b + hlen) == hlen + 8);
+    uint32_t size = read_u32(b + hlen + 8 + 16);
+    assert(hlen + 8 + 20 + size == *len);
+    *chunk = b + hlen + 8 + 20;
+    *chunk_len = size;
+    return true;
+}
+
 bool image_tile_validate_exr(const void *bytes, size_t len,
                              const image_format *fmt, image_rect expect,
                              char *err, size_t errsz)

@@ -71,6 +71,16 @@ size_t image_tile_clear_nonfinite(image_tile *self, int *first_x, int *first_y);
 bool image_tile_encode_exr(const image_tile *self, const image_format *fmt,
                            void **bytes, size_t *len, char *err, size_t errsz);
 
+/* image_tile_encode_exr, and *chunk, *chunk_len point at the compressed
+ * chunk inside *bytes (what the output writer copies: the standalone
+ * renderer's threads compress their tiles before taking the writer's
+ * lock). Located, not checked as image_tile_exr_chunk checks a file from
+ * elsewhere: this process's own encoder wrote it (asserts hold the
+ * layout). */
+bool image_tile_encode_chunk(const image_tile *self, const image_format *fmt,
+                             void **bytes, size_t *len, const void **chunk,
+                             size_t *chunk_len, char *err, size_t errsz);
+
 /* True when bytes/len is the tile file of rectangle `expect` of image
  * `fmt`, as described above; otherwise false with the reason in err. */
 bool image_tile_validate_exr(const void *bytes, size_t len,

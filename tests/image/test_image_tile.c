@@ -131,6 +131,21 @@ static void test_accepts_own_tiles(void **state)
                                                  &chunk_len, err, sizeof err));
                 /* the chunk is the tail of the file */
                 assert_ptr_equal((const uint8_t *) chunk + chunk_len, b + n);
+                /* image_tile_encode_chunk locates (not checks) the same
+                 * chunk in the same bytes as the checking parser above */
+                image_tile *t = tu_tile(fmt, tx, ty, f, tx % 2 == 0);
+                void *own = NULL;
+                size_t own_len = 0, own_chunk_len = 0;
+                const void *own_chunk = NULL;
+                assert_true(image_tile_encode_chunk(t, fmt, &own, &own_len, &own_chunk,
+                                                    &own_chunk_len, err, sizeof err));
+                assert_int_equal(own_len, n);
+                assert_memory_equal(own, b, n);
+                assert_int_equal(own_chunk_len, chunk_len);
+                assert_int_equal((const uint8_t *) own_chunk - (const uint8_t *) own,
+                                 (const uint8_t *) chunk - b);
+                free(own);
+                image_tile_destroy(&t);
                 free(b);
             }
         }
