@@ -1,6 +1,8 @@
 /*
- * tile_render.h: rendering one tile of a job into an image_tile (the
- * worker's unit of work, in the farm and standalone alike).
+ * tile_render.h: a tile of a job from its traced samples into an
+ * image_tile (the worker's unit of work, in the farm and standalone
+ * alike; the tracing: tile_share.h), and where the renderer's warnings
+ * and shaders' printf() lines go.
  */
 #ifndef WORKER_TILE_RENDER_H
 #define WORKER_TILE_RENDER_H
@@ -21,18 +23,11 @@ typedef struct worker_nonfinite {
     int x, y;
 } worker_nonfinite;
 
-/* Renders rectangle `rect` with the given layers. NULL on failure (a
- * shader over its budget ...), with the reason in err. NaN and infinite
- * samples of the film are made safe here, at the film, and counted in
- * *nonfinite (the renderer itself is not asked to avoid them). */
-image_tile *worker_render_tile(const job_scene *js, trace_thread *th,
-                               image_rect rect, unsigned layers,
-                               worker_nonfinite *nonfinite,
-                               char *err, size_t errsz);
-
-/* The tile of rectangle `rect` from its traced samples (every block of ts
- * traced, by any threads: trace/render.h), NaN and infinite samples made
- * safe as above. NULL when the tile cannot be allocated (err says so). */
+/* The tile of rectangle `rect` with the given layers from its traced
+ * samples (every block of ts traced, by any threads: trace/render.h).
+ * NaN and infinite samples of the film are made safe here, at the film,
+ * and counted in *nonfinite (the renderer itself is not asked to avoid
+ * them). NULL when the tile cannot be allocated (err says so). */
 image_tile *worker_filter_tile(const job_scene *js, const trace_tile_samples *ts,
                                image_rect rect, unsigned layers,
                                worker_nonfinite *nonfinite, char *err, size_t errsz);

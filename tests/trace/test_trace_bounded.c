@@ -141,7 +141,7 @@ static void test_retry_on_the_same_thread_fails_fast(void **state)
         assert_false(trace_render_tile(f.js->renderer, th, 0, 0, 12, 8, rgba, z));
         assert_non_null(strstr(th->error, "does not converge"));
         assert_int_equal(th->stats.limited_rays - before, 1);
-        th->failed = false;               /* as worker_render_tile does */
+        th->failed = false;               /* as the worker does after a failed tile */
         th->error[0] = '\0';
     }
     trace_thread_destroy(&th);
