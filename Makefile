@@ -16,7 +16,7 @@
 MAKEFLAGS += --no-print-directory
 JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 
-.PHONY: all deps build demo test test-sanitize check-release bench bench-peers clean
+.PHONY: all deps build demo test test-sanitize test-threads check-release bench bench-peers clean
 
 all: build
 
@@ -45,6 +45,18 @@ test-sanitize: deps
 	@cd build-asan && ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
 		ctest --output-on-failure -j $(JOBS)
 
+# the tests whose processes run threads against each other (the standalone
+# renderer's tail blocks, a farm worker's pool, the scheduler, determinism
+# across threads) under ThreadSanitizer: a data race in aafarm's code ends
+# the process (halt_on_error) and fails its test. Not part of `make test`
+# (CI runs ASan/UBSan); tests/tsan.supp names libzmq's internals.
+TSAN_TESTS = test_worker_cli|test_farm_render|test_trace_determinism|test_tile_runs|test_farm_scheduler
+test-threads: deps
+	@cmake -S . -B build-tsan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DAAFARM_WERROR=ON -DAAFARM_ASSERTS=ON -DAAFARM_TSAN=ON >/dev/null
+	@cmake --build build-tsan -j $(JOBS)
+	@cd build-tsan && TSAN_OPTIONS="halt_on_error=1 exitcode=66 suppressions=$(CURDIR)/tests/tsan.supp" \
+		ctest --output-on-failure -j $(JOBS) -R '$(TSAN_TESTS)'
+
 # what `make build` and the benchmarks compile (-DNDEBUG: no asserts), with
 # warnings as errors: a variable only an assert() reads must still compile
 # cleanly ((void)x), and the optimiser's maybe-uninitialized analysis must
@@ -61,4 +73,4 @@ bench-peers: deps
 	@QUICK=$(QUICK) MESHES=$(MESHES) WALLS=$(WALLS) bash bench/peers/run.sh
 
 clean:
-	rm -rf build build-test build-asan build-bench build-release
+	rm -rf build build-test build-asan build-tsan build-bench build-release
