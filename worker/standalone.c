@@ -54,9 +54,8 @@ typedef struct shared {
     tile_runs runs;                /* which tiles each thread renders next */
     atomic_int next_thread;        /* hands out thread indexes */
     int ntiles;
-    pthread_mutex_t lock;          /* writer, progress, error, active */
-    pthread_cond_t helped;         /* a helper left a tile */
-    tile_share **active;           /* per thread: the tile it owns, or NULL */
+    pthread_mutex_t lock;          /* writer, progress, error, board */
+    tile_board board;              /* the tiles being traced (tile_share.h) */
     long tail_blocks;              /* blocks traced by a thread not their owner */
     int done;
     bool failed;
@@ -86,30 +85,18 @@ static void progress(shared *s)
 
 /* Takes blocks of the tile being traced with the most blocks left until
  * no tile has any; false when a shader failed or the render was stopped. */
-static bool help_tail(shared *s, trace_thread *th, int threads)
+static bool help_tail(shared *s, trace_thread *th)
 {
     for (;;) {
         pthread_mutex_lock(&s->lock);
-        tile_share *best = NULL;
-        int most = 0;
-        for (int t = 0; t < threads; t++) {
-            tile_share *sh = s->active[t];
-            int left = sh && !sh->failed ? tile_share_left(sh) : 0;
-            if (left > most) {
-                most = left;
-                best = sh;
-            }
-        }
-        if (best) best->helpers++;
+        tile_share *sh = tile_board_pick(&s->board);
         pthread_mutex_unlock(&s->lock);
-        if (!best) return true;
+        if (!sh) return true;
         long mine = 0;
-        bool ok = tile_share_trace(best, th, &mine);
+        bool ok = tile_share_trace(sh, th, &mine);
         pthread_mutex_lock(&s->lock);
         s->tail_blocks += mine;
-        if (!ok) tile_share_fail(best, th);
-        best->helpers--;
-        pthread_cond_broadcast(&s->helped);
+        tile_board_leave(&s->board, sh, ok, th);
         pthread_mutex_unlock(&s->lock);
         if (!ok) return false;
     }
@@ -124,15 +111,9 @@ static void *trace_tile(shared *s, trace_thread *th, int me, image_rect r,
 {
     tile_share sh;
     tile_share_init(&sh, s->js->renderer, r);
-    pthread_mutex_lock(&s->lock);
-    s->active[me] = &sh;
-    pthread_mutex_unlock(&s->lock);
+    tile_board_publish(&s->board, me, &sh);
     bool ok = tile_share_trace(&sh, th, NULL);
-    /* no helper comes once it is withdrawn; those on it finish their block */
-    pthread_mutex_lock(&s->lock);
-    s->active[me] = NULL;
-    while (sh.helpers > 0) pthread_cond_wait(&s->helped, &s->lock);
-    pthread_mutex_unlock(&s->lock);
+    tile_board_withdraw(&s->board, me, &sh);
     void *exr = NULL;
     size_t exr_len = 0;
     if (!ok) {
@@ -162,7 +143,7 @@ static void *render_thread(void *arg)
     for (;;) {
         int i = tile_runs_take(&s->runs, me);
         if (i < 0) {
-            if (!interrupted) help_tail(s, th, s->runs.nthreads);
+            if (!interrupted) help_tail(s, th);
             break;
         }
         if (interrupted) break;
@@ -286,11 +267,10 @@ static int render_frame(const standalone_options *opt, const job *jb, const fram
     s.ntiles = image_format_tile_count(&s.fmt);
     s.work = xcalloc((size_t)js->world.nobjects + 1, sizeof *s.work);
     pthread_mutex_init(&s.lock, NULL);
-    pthread_cond_init(&s.helped, NULL);
     int threads = opt->threads > 0 ? opt->threads : default_threads();
     atomic_init(&s.next_thread, 0);
     tile_runs_init(&s.runs, s.ntiles, threads);
-    s.active = xcalloc((size_t)threads, sizeof *s.active);
+    tile_board_init(&s.board, &s.lock, NULL, threads);
     if (opt->verbosity >= 0)
         fprintf(stderr, "aafarm-worker: %s: %dx%d, %d tiles of %d, %d thread%s, %s arithmetic\n",
                 opt->scene_path, s.fmt.width, s.fmt.height, s.ntiles, s.fmt.tile_size,
@@ -367,8 +347,7 @@ static int render_frame(const standalone_options *opt, const job *jb, const fram
     }
     free(s.work);
     tile_runs_clear(&s.runs);
-    free(s.active);
-    pthread_cond_destroy(&s.helped);
+    tile_board_clear(&s.board);
     pthread_mutex_destroy(&s.lock);
     job_scene_destroy(&js);
     return rc;

@@ -8,20 +8,21 @@
  * and the owner filters the tile once every block is traced. Who traces a
  * block changes no bit of the tile.
  *
- * The caller keeps the shares where its threads find them, under its own
- * lock: `helpers` and `failed` are read and written under that lock (the
- * standalone renderer's and the farm worker's pool's). The protocol:
- *   owner:  tile_share_init, publish it, tile_share_trace; withdraw it,
- *           wait (under the lock) until helpers == 0, then read failed,
- *           filter (trace_tile_samples_filter), tile_share_clear;
- *   helper: (under the lock) pick a published share with
- *           tile_share_left() > 0 and !failed, helpers++; then without
- *           the lock tile_share_trace; then (under the lock) record a
- *           failure (tile_share_fail), helpers--, wake the owner.
+ * The shares being traced stand on a board (tile_board: one slot per
+ * thread) under the caller's own mutex, which also guards the caller's
+ * state (the standalone renderer's writer, the farm worker's pool's
+ * queue). The protocol:
+ *   owner:  tile_share_init, tile_board_publish, tile_share_trace,
+ *           tile_board_withdraw (its helpers have finished when it
+ *           returns), then read `failed`, filter (trace_tile_samples_filter),
+ *           tile_share_clear;
+ *   helper: under the lock tile_board_pick; without it tile_share_trace;
+ *           under it again tile_board_leave.
  */
 #ifndef WORKER_TILE_SHARE_H
 #define WORKER_TILE_SHARE_H
 
+#include <pthread.h>
 #include <stdatomic.h>
 #include <stdbool.h>
 
@@ -35,8 +36,8 @@ typedef struct tile_share {
     image_rect rect;
     int nblocks;
     atomic_int next;               /* the next block to take */
-    int helpers;                   /* helpers on it (the caller's lock) */
-    bool failed;                   /* a helper failed (the caller's lock) */
+    int helpers;                   /* helpers on it (the board's lock) */
+    bool failed;                   /* a helper failed (the board's lock) */
     char error[ERR_LEN];
 } tile_share;
 
@@ -51,8 +52,32 @@ int tile_share_left(tile_share *self);
  * was cancelled (th->error says why; then no block is taken any more). */
 bool tile_share_trace(tile_share *self, trace_thread *th, long *blocks);
 
-/* A helper's failure (th->error) recorded for the owner (under the
- * caller's lock); the first one is kept. */
-void tile_share_fail(tile_share *self, const trace_thread *th);
+/* The shares being traced, one slot per thread, under the caller's lock. */
+typedef struct tile_board {
+    pthread_mutex_t *lock;         /* the caller's */
+    pthread_cond_t *wake;          /* broadcast when a share is published
+                                      (idle threads sleep on it), or NULL */
+    pthread_cond_t helped;         /* a helper left a share */
+    tile_share **slot;             /* per thread: the share it owns, or NULL */
+    int n;
+} tile_board;
+
+/* A board of n (>= 1) empty slots; every slot is set before any thread
+ * that reads them starts. */
+void tile_board_init(tile_board *self, pthread_mutex_t *lock, pthread_cond_t *wake, int n);
+void tile_board_clear(tile_board *self);
+
+/* Owner `me` puts sh on the board (takes the lock). */
+void tile_board_publish(tile_board *self, int me, tile_share *sh);
+/* Owner `me` takes sh off the board, so no helper comes, and waits for
+ * those on it to finish their blocks (takes the lock). */
+void tile_board_withdraw(tile_board *self, int me, tile_share *sh);
+
+/* Under the lock: the share with the most blocks left (none failed), with
+ * this helper counted on it; NULL when no share has any. */
+tile_share *tile_board_pick(tile_board *self);
+/* Under the lock: the helper is done with sh; ok false: its failure
+ * (th->error) goes to the owner (the first one is kept). */
+void tile_board_leave(tile_board *self, tile_share *sh, bool ok, const trace_thread *th);
 
 #endif

@@ -1,12 +1,12 @@
 /*
  * worker_pool.c: render threads, their task queue and done list (see
- * worker_pool.h). One mutex guards the queue, the done list and each
- * thread's current task and tile share; a condition variable wakes idle
- * threads, another the owners of tiles whose helpers left; a pipe wakes
- * the connection loop. A thread that finds the queue empty helps the
- * tiles being rendered (tile_share.h): it traces blocks of the one with
- * the most blocks left, so the last tiles of a job end within a block
- * when the worker has idle threads.
+ * worker_pool.h). One mutex guards the queue, the done list, each
+ * thread's current task and the board of tiles being rendered; a
+ * condition variable wakes idle threads, the board's the owners of tiles
+ * whose helpers left; a pipe wakes the connection loop. A thread that
+ * finds the queue empty helps the tiles on the board (tile_share.h): it
+ * traces blocks of the one with the most blocks left, so the last tiles of
+ * a job end within a block when the worker has idle threads.
  */
 #include "worker_pool.h"
 
@@ -31,10 +31,10 @@ typedef struct render_thread {
     bool started;
     long last_tile;            /* index of the last tile rendered, -1: none */
     worker_task *current;      /* being rendered (under the pool's lock) */
-    struct pool_share *share;  /* its blocks, while they may be helped (the lock) */
 } render_thread;
 
-/* A task's tile share and what its helpers did (under the pool's lock). */
+/* A task's tile share and what its helpers did (under the pool's lock);
+ * on the board by its first member, sh. */
 typedef struct pool_share {
     tile_share sh;
     held_job *job;             /* the task's (the helpers' VM and world) */
@@ -44,7 +44,7 @@ typedef struct pool_share {
 struct worker_pool {
     pthread_mutex_t lock;
     pthread_cond_t wake;
-    pthread_cond_t helped;     /* a helper left a tile share */
+    tile_board board;          /* the tiles being rendered (tile_share.h) */
     worker_task *queue;        /* submitted, not started (a list) */
     worker_task *done, *done_tail;
     render_thread *threads;
@@ -126,7 +126,7 @@ static void take_error(trace_thread *th, image_rect r, char *err, size_t errsz)
     th->error[0] = '\0';
 }
 
-static void render_task(worker_pool *p, render_thread *rt, trace_thread *th, worker_task *t)
+static void render_task(worker_pool *p, int me, trace_thread *th, worker_task *t)
 {
     if (p->tile_delay_ms > 0) sleep_ms(p->tile_delay_ms);
     const held_job *h = t->job;
@@ -135,15 +135,9 @@ static void render_task(worker_pool *p, render_thread *rt, trace_thread *th, wor
     trace_stats before = th->stats;
     pool_share ps = {.job = t->job};
     tile_share_init(&ps.sh, h->js->renderer, t->rect);
-    pthread_mutex_lock(&p->lock);
-    rt->share = &ps;
-    pthread_cond_broadcast(&p->wake);   /* idle threads may help */
-    pthread_mutex_unlock(&p->lock);
+    tile_board_publish(&p->board, me, &ps.sh);
     bool ok = tile_share_trace(&ps.sh, th, NULL);
-    pthread_mutex_lock(&p->lock);
-    rt->share = NULL;   /* no helper comes now; those on it finish their block */
-    while (ps.sh.helpers > 0) pthread_cond_wait(&p->helped, &p->lock);
-    pthread_mutex_unlock(&p->lock);
+    tile_board_withdraw(&p->board, me, &ps.sh);
     worker_nonfinite nf = {0, 0, 0};
     if (!ok) {
         take_error(th, t->rect, t->error, sizeof t->error);
@@ -190,26 +184,10 @@ static void use_job(worker_pool *p, trace_thread **th, held_job **cur, held_job 
     trace_thread_set_print(*th, worker_print_shader_line, NULL);
 }
 
-/* The share with the most blocks left (under the lock), or NULL. */
-static pool_share *most_left(worker_pool *p)
-{
-    pool_share *best = NULL;
-    int most = 0;
-    for (int i = 0; i < p->nthreads; i++) {
-        pool_share *ps = p->threads[i].share;
-        int left = ps && !ps->sh.failed ? tile_share_left(&ps->sh) : 0;
-        if (left > most) {
-            most = left;
-            best = ps;
-        }
-    }
-    return best;
-}
-
-/* Helps share ps (called and returns under the lock). */
+/* Helps share ps, picked from the board (called and returns under the
+ * lock). */
 static void help(worker_pool *p, pool_share *ps, trace_thread **th, held_job **cur)
 {
-    ps->sh.helpers++;
     pthread_mutex_unlock(&p->lock);
     use_job(p, th, cur, ps->job);
     double cpu0 = clock_s(CLOCK_THREAD_CPUTIME_ID);
@@ -225,13 +203,9 @@ static void help(worker_pool *p, pool_share *ps, trace_thread **th, held_job **c
     d.helped_blocks = (uint64_t)blocks;
     pthread_mutex_lock(&p->lock);
     stats_add(&ps->helped, &d);
-    if (!ok) {
-        tile_share_fail(&ps->sh, *th);
-        (*th)->failed = false;
-        (*th)->error[0] = '\0';
-    }
-    ps->sh.helpers--;
-    pthread_cond_broadcast(&p->helped);
+    tile_board_leave(&p->board, &ps->sh, ok, *th);
+    (*th)->failed = false;               /* its next tile starts afresh */
+    (*th)->error[0] = '\0';
 }
 
 /* ---- the lists (under the lock) ---- */
@@ -277,8 +251,8 @@ static void *render_main(void *arg)
     pthread_mutex_lock(&p->lock);
     for (;;) {
         while (!p->stopping && !p->queue) {
-            pool_share *ps = most_left(p);
-            if (ps) help(p, ps, &th, &cur);
+            tile_share *sh = tile_board_pick(&p->board);
+            if (sh) help(p, (pool_share *)sh, &th, &cur);   /* its first member */
             else pthread_cond_wait(&p->wake, &p->lock);
         }
         if (p->stopping) break;
@@ -286,7 +260,7 @@ static void *render_main(void *arg)
         rt->current = t;
         pthread_mutex_unlock(&p->lock);
         use_job(p, &th, &cur, t->job);   /* another job: a new VM and box cache */
-        render_task(p, rt, th, t);
+        render_task(p, (int)(rt - p->threads), th, t);
         pthread_mutex_lock(&p->lock);
         rt->current = NULL;
         rt->last_tile = (long)t->tile_index;
@@ -310,7 +284,7 @@ worker_pool *worker_pool_new(int threads, int tile_delay_ms)
     p->threads = xcalloc((size_t)p->nthreads, sizeof *p->threads);
     pthread_mutex_init(&p->lock, NULL);
     pthread_cond_init(&p->wake, NULL);
-    pthread_cond_init(&p->helped, NULL);
+    tile_board_init(&p->board, &p->lock, &p->wake, p->nthreads);
     p->pipe_fd[0] = p->pipe_fd[1] = -1;
     if (pipe(p->pipe_fd) != 0) {
         worker_pool_destroy(&p);
@@ -320,10 +294,8 @@ worker_pool *worker_pool_new(int threads, int tile_delay_ms)
         fcntl(p->pipe_fd[i], F_SETFL, fcntl(p->pipe_fd[i], F_GETFL) | O_NONBLOCK);
         fcntl(p->pipe_fd[i], F_SETFD, FD_CLOEXEC);
     }
-    /* all set before any thread starts: an idle one reads every slot */
-    for (int i = 0; i < p->nthreads; i++)
-        p->threads[i] = (render_thread){.pool = p, .last_tile = -1};
     for (int i = 0; i < p->nthreads; i++) {
+        p->threads[i] = (render_thread){.pool = p, .last_tile = -1};
         if (pthread_create(&p->threads[i].tid, NULL, render_main, &p->threads[i]) != 0) {
             worker_pool_destroy(&p);
             return NULL;
@@ -358,7 +330,7 @@ void worker_pool_destroy(worker_pool **self_p)
     for (int i = 0; i < 2; i++)
         if (p->pipe_fd[i] >= 0) close(p->pipe_fd[i]);
     pthread_cond_destroy(&p->wake);
-    pthread_cond_destroy(&p->helped);
+    tile_board_clear(&p->board);
     pthread_mutex_destroy(&p->lock);
     free(p->threads);
     free(p);
