@@ -106,19 +106,27 @@
 /* enclosures of the fade and its derivatives                              */
 /* ---------------------------------------------------------------------- */
 
-/* s(t) at a point, as an enclosure */
+/* s(t) at a point t of [0, 1], as an enclosure (issue 24, session 26:
+ * the interval kit's eight operations took 166 instructions, 1.6 % of
+ * dented's). fade(t) = ((t t) t) ((t (6t - 15)) + 10) in round to nearest
+ * errs by at most u s + 66u t^3 (the derivation at point_jet_err below,
+ * u = 2^-53), and t^3 <= s (the second factor is at least 1 on [0, 1]),
+ * so by at most 67u s, plus 2^-1074 per product where it underflows;
+ * s -+ (2^-46 s + 2^-1000), whose own rounding is at most u s, holds the
+ * exact value. */
 static iv fade_at(double t)
 {
-    iv x = iv_pt(t);
-    iv inner = iv_add(iv_mul(x, iv_sub(iv_mul_int(x, 6), iv_pt(15.0))),
-                      iv_pt(10.0));
-    return iv_mul(iv_mul(iv_mul(x, x), x), inner);
+    double s = fade(t), m = s * 0x1p-46 + 0x1p-1000;
+    return iv_mk(s - m, s + m);
 }
 
-/* q(t) = t(1 - t) at a point */
+/* q(t) = t(1 - t) at a point t of [0, 1]: in round to nearest within
+ * (2u + u^2) q (1 - t and the product each within u of their results),
+ * plus an underflow; q -+ (2^-50 q + 2^-1000) holds it */
 static iv q_at(double t)
 {
-    return iv_mul(iv_pt(t), iv_sub(iv_pt(1.0), iv_pt(t)));
+    double q = t * (1.0 - t), m = q * 0x1p-50 + 0x1p-1000;
+    return iv_mk(q - m, q + m);
 }
 
 /* s''(t) = 60 q(t) (1 - 2t) at a point */
@@ -530,6 +538,91 @@ point_jet_d(int dim, const double f[4], const uint32_t hs[16], int order, point_
     }
 }
 
+#if NOISE_IV_VECTOR
+/*
+ * point_jet_d(3, f, hs, 2, J) on two-lane vectors (the renderer's noise(P)
+ * is 3D; issue 24, session 26): a partial jet is five lane pairs, (v, g0)
+ * (g1, g2) (h00, h01) (h02, h11) (h12, h22), and the interpolation w0 A +
+ * w1 B of a step is five vector products and sums, the same IEEE
+ * operations as the scalar loop's on every lane; the terms of the step's
+ * own axis (D (B - A) and the Hessian's) are added lane by lane in the
+ * same order as there. The same bits as point_jet_d (test_sl_noise_kits
+ * compares this build with the scalar one, NOISE_IV_SCALAR).
+ */
+typedef double pj2 __attribute__((vector_size(16)));
+typedef struct pjet3 { pj2 p[5]; } pjet3;
+
+static inline __attribute__((always_inline)) void
+pjet3_step(pjet3 *R, const pjet3 *A, const pjet3 *B, int k, double w0, double w1, double D,
+           double DD, bool first)
+{
+    const pj2 W0 = { w0, w0 }, W1 = { w1, w1 };
+    const int n = first ? 2 : 5;      /* the first step's Hessians: 0 */
+    for (int i = 0; i < n; i++)
+        R->p[i] = W0 * A->p[i] + W1 * B->p[i];
+    if (first)
+        R->p[2] = R->p[3] = R->p[4] = (pj2){ 0.0, 0.0 };
+    double dv = B->p[0][0] - A->p[0][0];
+    double dg0 = B->p[0][1] - A->p[0][1], dg1 = B->p[1][0] - A->p[1][0],
+           dg2 = B->p[1][1] - A->p[1][1];
+    if (k == 0) {
+        R->p[0][1] = R->p[0][1] + D * dv;                            /* g0 */
+        R->p[2][0] = R->p[2][0] + (2.0 * (D * dg0) + DD * dv);       /* h00 */
+        R->p[2][1] = R->p[2][1] + D * dg1;                           /* h01 */
+        R->p[3][0] = R->p[3][0] + D * dg2;                           /* h02 */
+    } else if (k == 1) {
+        R->p[1][0] = R->p[1][0] + D * dv;                            /* g1 */
+        R->p[3][1] = R->p[3][1] + (2.0 * (D * dg1) + DD * dv);       /* h11 */
+        R->p[2][1] = R->p[2][1] + D * dg0;                           /* h01 */
+        R->p[4][0] = R->p[4][0] + D * dg2;                           /* h12 */
+    } else {
+        R->p[1][1] = R->p[1][1] + D * dv;                            /* g2 */
+        R->p[4][1] = R->p[4][1] + (2.0 * (D * dg2) + DD * dv);       /* h22 */
+        R->p[3][0] = R->p[3][0] + D * dg0;                           /* h02 */
+        R->p[4][0] = R->p[4][0] + D * dg1;                           /* h12 */
+    }
+}
+
+static void point_jet_3v(const double f[4], const uint32_t hs[16], point_jet *J)
+{
+    double w0[3], w1[3], D[3], DD[3], d[3][2];
+    for (int k = 0; k < 3; k++) {
+        double s = fade(f[k]);
+        w1[k] = s;
+        w0[k] = 1.0 - s;
+        D[k] = dfade(f[k]);
+        DD[k] = ddfade(f[k]);
+        d[k][0] = f[k];
+        d[k][1] = f[k] - 1.0;
+    }
+    pjet3 t[8], a[4], b[2], r;
+    for (int c = 0; c < 8; c++) {
+        int g[4];
+        gradient(3, hs[c], g);
+        double l = (double)g[0] * d[0][c & 1];
+        l = l + (double)g[1] * d[1][(c >> 1) & 1];
+        l = l + (double)g[2] * d[2][(c >> 2) & 1];
+        t[c].p[0] = (pj2){ l, (double)g[0] };
+        t[c].p[1] = (pj2){ (double)g[1], (double)g[2] };
+    }
+    for (int i = 0; i < 4; i++)
+        pjet3_step(&a[i], &t[2 * i], &t[2 * i + 1], 0, w0[0], w1[0], D[0], DD[0], true);
+    for (int i = 0; i < 2; i++)
+        pjet3_step(&b[i], &a[2 * i], &a[2 * i + 1], 1, w0[1], w1[1], D[1], DD[1], false);
+    pjet3_step(&r, &b[0], &b[1], 2, w0[2], w1[2], D[2], DD[2], false);
+    J->v = r.p[0][0];
+    J->g[0] = r.p[0][1];
+    J->g[1] = r.p[1][0];
+    J->g[2] = r.p[1][1];
+    J->h[0][0] = r.p[2][0];
+    J->h[0][1] = r.p[2][1];
+    J->h[0][2] = r.p[3][0];
+    J->h[1][1] = r.p[3][1];
+    J->h[1][2] = r.p[4][0];
+    J->h[2][2] = r.p[4][1];
+}
+#endif
+
 /* The float jet of raw noise at the point c (|c_k| < 2^51). */
 static void point_jet_at(int dim, const double *c, const int *period, uint32_t seed,
                          point_jet *J)
@@ -540,7 +633,11 @@ static void point_jet_at(int dim, const double *c, const int *period, uint32_t s
     switch (dim) {
     case 1: point_jet_d(1, f, hs, 2, J); break;
     case 2: point_jet_d(2, f, hs, 2, J); break;
+#if NOISE_IV_VECTOR
+    case 3: point_jet_3v(f, hs, J); break;
+#else
     case 3: point_jet_d(3, f, hs, 2, J); break;
+#endif
     default: point_jet_d(4, f, hs, 2, J); break;
     }
 }
@@ -1050,8 +1147,6 @@ taylor_model_d(int dim, const box_query *q, const int64_t *i0, const point_jet *
     *rem3 = c3;
 
     double K = noise_scale[dim];
-    jet C;
-    point_jet_enclosure(dim, P, &C);
 
     /* gradient over the box: g_j + sum_k H_jk d_k + R_j (only for a
      * caller that wants it: noise_aa and noise_ia do not) */
@@ -1070,38 +1165,48 @@ taylor_model_d(int dim, const box_query *q, const int64_t *i0, const point_jet *
         res->grad[j] = iv_scale_pos(iv_mk(out_dn(P->g[j] - w), out_up(P->g[j] + w)), K);
     }
 
-    /* the value: centre raw(c) + sum_k H_kk r_k^2 / 4; the radius about
-     * the linear part: the diagonal |H_kk| r_k^2 / 4 + e_h r_k^2 / 2, the
-     * off-diagonal (|H_jk| + e_h) r_j r_k (j < k, both orders), and rem3 */
-    iv N0 = C.v;
-    double quad = 0.0;
+    /* The value, in round to nearest with its rounding bounded a priori
+     * (issue 24, session 26: the interval kit's outward rounding per
+     * operation took a third of the model's instructions). Over the box,
+     * raw(c + d) = raw(c) + g(c) . d + d^T H(c) d / 2 + R3 (|R3| <= rem3),
+     * the float jet within e_v, e_g, e_h of raw(c), g(c), H(c) entrywise;
+     * d_k^2 in [0, r_k^2] moves the diagonal terms' centre by h_kk r_k^2
+     * / 4 and leaves |h_kk| r_k^2 / 4 + e_h r_k^2 / 2 (the off-diagonal
+     * terms: (|h_jk| + e_h) r_j r_k, both orders), so
+     *   N in n0* + sum_k K g_k d_k +- K (e_v + e_g sum_k r_k + quad + rem3)
+     * with n0* = 1/2 + K (v + sum_k h_kk r_k^2 / 4). n0 and alpha_k = K g_k
+     * are that in round to nearest: n0 within 2^-49 of the same sums in
+     * magnitude (a0: 2 dim + 2 roundings, each at most u of its result, so
+     * gamma_10 < 16u in 4D), alpha_k within u |alpha_k|, whose r_k-weighted
+     * sum is 2^-53 lin. delta adds all of it; every sum of nonnegative
+     * terms is raised by TAYLOR_SUM_SCALE (> (1 + u)^300) and 2^-1000 (the
+     * underflow of every product), as the remainders above. */
+    double s0 = P->v, a0 = fabs(P->v), quad = 0.0, rsum = 0.0;
     for (int k = 0; k < dim; k++) {
-        iv rr = iv_mul(iv_pt(q->r[k]), iv_pt(q->r[k]));
-        N0 = iv_add(N0, iv_mul(iv_scale_pos(iv_pt(P->h[k][k]), 0.25), rr));
+        double rq = q->r[k], hk = 0.25 * P->h[k][k];
+        s0 = s0 + hk * (rq * rq);
+        a0 = a0 + fabs(hk) * (rq * rq);
         quad += (0.25 * fabs(P->h[k][k]) + 0.5 * e[2]) * (r[k] * r[k]);
         for (int j = k + 1; j < dim; j++)
             quad += (fabs(P->h[k][j]) + e[2]) * (r[k] * r[j]);
+        rsum += rq;
     }
-    quad *= TAYLOR_SUM_SCALE;
-    iv half = iv_pt(0.5);
-    iv NC = iv_add(half, iv_scale_pos(N0, K));
-    double n0 = iv_mid(NC);
-    double delta = iv_rad_about(NC, n0);
+    double n0 = 0.5 + K * s0;
     double lin = 0.0;
     for (int k = 0; k < dim; k++) {
-        iv G = iv_scale_pos(C.g[k], K);
-        double a = iv_mid(G);
+        double a = K * P->g[k];
         res->alpha[k] = a;
-        delta = fp_add_up(delta, fp_mul_up(iv_rad_about(G, a), q->r[k]));
-        lin = fp_add_up(lin, fp_mul_up(fabs(a), q->r[k]));
+        lin += fabs(a) * q->r[k];
     }
-    delta = fp_add_up(delta, fp_mul_up(K, fp_add_up(quad, c3)));
+    double delta = K * (e[0] + e[1] * rsum + quad + c3) + 0x1p-49 * (0.5 + K * a0) +
+                   0x1p-53 * lin;
+    delta = delta * TAYLOR_SUM_SCALE + 0x1p-1000;
     res->n0 = n0;
     res->delta = delta;
 
     /* the range: n0 +- (sum |alpha_k| r_k + delta), within [0, 1] */
-    double rho = fp_add_up(lin, delta);
-    iv range = iv_mk(fp_add_dn(n0, -rho), fp_add_up(n0, rho));
+    double rho = (lin + delta) * TAYLOR_SUM_SCALE + 0x1p-1000;
+    iv range = iv_mk(out_dn(n0 - rho), out_up(n0 + rho));
     if (range.lo < 0.0) range.lo = 0.0;
     if (range.hi > 1.0) range.hi = 1.0;
     if (!(range.lo <= range.hi))
@@ -1338,7 +1443,9 @@ static void noise_aa(aa_context *ctx, aa_form *out, int dim, const aa_form *p,
         q.lo[k] = R.lo < c ? R.lo : c;
         q.hi[k] = R.hi > c ? R.hi : c;
         q.c[k] = c;
-        double rb1 = fp_add_up(q.hi[k], -c), rb2 = fp_add_up(c, -q.lo[k]);
+        /* the box's reach from c, rounded up (out_up: a step of 2^-52 of
+         * the magnitude, more than the subtraction's rounding) */
+        double rb1 = out_up(q.hi[k] - c), rb2 = out_up(c - q.lo[k]);
         double rb = rb1 > rb2 ? rb1 : rb2;
         q.r[k] = rb < rad ? rb : rad;
         if (!isfinite(R.lo) || !isfinite(R.hi) || !isfinite(rad))
@@ -1351,10 +1458,11 @@ static void noise_aa(aa_context *ctx, aa_form *out, int dim, const aa_form *p,
         return;
     }
 
+    /* which of two enclosures to keep: the radii in round to nearest */
     double rho_lin = res.delta;
     for (int k = 0; k < dim; k++)
-        rho_lin = fp_add_up(rho_lin, fp_mul_up(fabs(res.alpha[k]), q.r[k]));
-    double rho_int = 0.5 * fp_add_up(res.range.hi, -res.range.lo);
+        rho_lin += fabs(res.alpha[k]) * q.r[k];
+    double rho_int = 0.5 * (res.range.hi - res.range.lo);
     if (!(rho_lin <= NOISE_MINRANGE_RATIO * rho_int) || !isfinite(rho_lin)) {
         aa_interval_result(ctx, out, res.range.lo, res.range.hi, flags);
         return;
@@ -1379,7 +1487,7 @@ static void noise_aa(aa_context *ctx, aa_form *out, int dim, const aa_form *p,
         }
     }
     /* +- delta on a new symbol; the hull (of the linear part) widens by it */
-    double hull_lo = fp_add_dn(out->lo, -res.delta), hull_hi = fp_add_up(out->hi, res.delta);
+    double hull_lo = out_dn(out->lo - res.delta), hull_hi = out_up(out->hi + res.delta);
     aa_add_new_error(ctx, out, res.delta);
     out->lo = hull_lo;
     out->hi = hull_hi;

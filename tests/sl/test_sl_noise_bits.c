@@ -33,10 +33,17 @@
 #include "sl/noise.h"
 #include "test_rng.h"
 
-/* main 1819638, before issue 24's session 17 (same-bits changes since) */
-#define NOISE_BITS_DIGEST_AFFINE 0x655ecac6a50807e9ull
-#define NOISE_BITS_DIGEST_INTERVAL 0x2448e0542929cce5ull
-#define NOISE_BITS_DIGEST_GRADIENT 0x2193105fef0d5b79ull
+/* main 1819638, before issue 24's session 17 (same-bits changes since),
+ * but for session 26's roundings bounded a priori (the Taylor model's
+ * value part, the fade and t(1 - t) at the interval jets' piece ends, the
+ * box's reach and hull in noise_aa): the affine, interval and gradient
+ * results differ from before in their last bits (the rule that picks the
+ * interval jets compares them); the mean width over 500,000 boxes of
+ * 10^-4 to 0.3 cells is the same to 9 digits (docs/benchmarks.md,
+ * "Session 26") */
+#define NOISE_BITS_DIGEST_AFFINE 0x9925d10f24c4c006ull
+#define NOISE_BITS_DIGEST_INTERVAL 0x976ea5ec99c77e72ull
+#define NOISE_BITS_DIGEST_GRADIENT 0xd4b3e451695ee406ull
 #define NOISE_BITS_DIGEST_FLOAT 0x3f93e036cc049b90ull
 
 #define NBOXES 1500
