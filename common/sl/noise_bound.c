@@ -466,11 +466,13 @@ static inline double ddfade(double t)
     return (60.0 * q) * (1.0 - 2.0 * t);
 }
 
-/* always inlined once per dim, so the loops unroll */
+/* The weights of the float jets' interpolation steps along each axis at
+ * cell coordinates f: w0 = 1 - s, w1 = s, D = s', DD = s'', and the
+ * offsets d = f, f - 1 of the corners' linear functions */
 static inline __attribute__((always_inline)) void
-point_jet_d(int dim, const double f[4], const uint32_t hs[16], int order, point_jet *J)
+jet_weights(int dim, const double f[4], double w0[4], double w1[4], double D[4], double DD[4],
+            double d[4][2])
 {
-    double w0[4], w1[4], D[4], DD[4], d[4][2];
     for (int k = 0; k < dim; k++) {
         double s = fade(f[k]);
         w1[k] = s;
@@ -480,6 +482,14 @@ point_jet_d(int dim, const double f[4], const uint32_t hs[16], int order, point_
         d[k][0] = f[k];
         d[k][1] = f[k] - 1.0;
     }
+}
+
+/* always inlined once per dim, so the loops unroll */
+static inline __attribute__((always_inline)) void
+point_jet_d(int dim, const double f[4], const uint32_t hs[16], int order, point_jet *J)
+{
+    double w0[4], w1[4], D[4], DD[4], d[4][2];
+    jet_weights(dim, f, w0, w1, D, DD, d);
     point_jet t[16];
     int n = 1 << dim;
     for (int c = 0; c < n; c++) {
@@ -585,16 +595,8 @@ pjet3_step(pjet3 *R, const pjet3 *A, const pjet3 *B, int k, double w0, double w1
 
 static void point_jet_3v(const double f[4], const uint32_t hs[16], point_jet *J)
 {
-    double w0[3], w1[3], D[3], DD[3], d[3][2];
-    for (int k = 0; k < 3; k++) {
-        double s = fade(f[k]);
-        w1[k] = s;
-        w0[k] = 1.0 - s;
-        D[k] = dfade(f[k]);
-        DD[k] = ddfade(f[k]);
-        d[k][0] = f[k];
-        d[k][1] = f[k] - 1.0;
-    }
+    double w0[4], w1[4], D[4], DD[4], d[4][2];
+    jet_weights(3, f, w0, w1, D, DD, d);
     pjet3 t[8], a[4], b[2], r;
     for (int c = 0; c < 8; c++) {
         int g[4];
