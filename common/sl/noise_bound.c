@@ -406,9 +406,6 @@ static void cell_jet(int dim, const axis_fade *ax, const uint32_t h[16],
  * Results (units of u): 1D 1736 / 9162 / 43123, 2D 3344 / 24204 /
  * 171867, 3D 4952 / 45126 / 430333, 4D 6560 / 71928 / 862619.
  */
-typedef struct point_jet {
-    double v, g[4], h[4][4];     /* h[j][k], j <= k used */
-} point_jet;
 
 static const double point_jet_err[SL_NOISE_MAX_DIM + 1][3] = {
     { 0.0, 0.0, 0.0 },
@@ -457,95 +454,6 @@ void sl_noise_point_jet_error(int dim, double err[3], double used[3])
     err[0] = Ev + mag[dim][1] * dim * u;
     err[1] = Eg + mag[dim][2] * dim * u;
     err[2] = Eh + mag[dim][3] * dim * u;
-}
-
-/* s''(t) = 60 t (1 - t)(1 - 2t), as the error bound above assumes */
-static inline double ddfade(double t)
-{
-    double q = t * (1.0 - t);
-    return (60.0 * q) * (1.0 - 2.0 * t);
-}
-
-/* The weights of the float jets' interpolation steps along each axis at
- * cell coordinates f: w0 = 1 - s, w1 = s, D = s', DD = s'', and the
- * offsets d = f, f - 1 of the corners' linear functions */
-static inline __attribute__((always_inline)) void
-jet_weights(int dim, const double f[4], double w0[4], double w1[4], double D[4], double DD[4],
-            double d[4][2])
-{
-    for (int k = 0; k < dim; k++) {
-        double s = fade(f[k]);
-        w1[k] = s;
-        w0[k] = 1.0 - s;
-        D[k] = dfade(f[k]);
-        DD[k] = ddfade(f[k]);
-        d[k][0] = f[k];
-        d[k][1] = f[k] - 1.0;
-    }
-}
-
-/* always inlined once per dim, so the loops unroll */
-static inline __attribute__((always_inline)) void
-point_jet_d(int dim, const double f[4], const uint32_t hs[16], int order, point_jet *J)
-{
-    double w0[4], w1[4], D[4], DD[4], d[4][2];
-    jet_weights(dim, f, w0, w1, D, DD, d);
-    point_jet t[16];
-    int n = 1 << dim;
-    for (int c = 0; c < n; c++) {
-        int g[4];
-        gradient(dim, hs[c], g);
-        double l = (double)g[0] * d[0][c & 1];
-        for (int k = 1; k < dim; k++)
-            l = l + (double)g[k] * d[k][(c >> k) & 1];
-        t[c].v = l;
-        if (order == 0)
-            continue;
-        /* the corners' Hessians (0) are never read: the step along axis 0
-         * sets the Hessian parts without them */
-        for (int k = 0; k < dim; k++)
-            t[c].g[k] = (double)g[k];
-    }
-    /* Each step writes its results straight into the other buffer (no
-     * temporary jet copied back: the compiler copied its scalar stores with
-     * 16-byte loads, a store-forwarding stall that took a fifth of
-     * point_jet_at), and the loops have constant trip counts once dim is
-     * (so they unroll). The operations and their order are unchanged. */
-    point_jet u[8];
-    point_jet *src = t, *dst = u;
-#pragma GCC unroll 4
-    for (int k = 0; k < dim; k++) {
-        const int nk = (1 << dim) >> (k + 1);
-        if (k == dim - 1)
-            dst = J;        /* the last step writes the result (no copy) */
-#pragma GCC unroll 8
-        for (int i = 0; i < nk; i++) {
-            const point_jet *A = &src[2 * i], *B = &src[2 * i + 1];
-            point_jet *R = &dst[i];
-            double dv = B->v - A->v;
-            R->v = w0[k] * A->v + w1[k] * B->v;
-            if (order == 0)
-                continue;
-            for (int j = 0; j < dim; j++)
-                R->g[j] = w0[k] * A->g[j] + w1[k] * B->g[j];
-            R->g[k] = R->g[k] + D[k] * dv;
-            for (int j = 0; j < dim; j++)
-                for (int m = j; m < dim; m++)
-                    R->h[j][m] = k == 0 ? 0.0 : w0[k] * A->h[j][m] + w1[k] * B->h[j][m];
-            double dgk = B->g[k] - A->g[k];
-            R->h[k][k] = R->h[k][k] + (2.0 * (D[k] * dgk) + DD[k] * dv);
-            for (int j = 0; j < dim; j++) {
-                if (j == k)
-                    continue;
-                double tjk = D[k] * (B->g[j] - A->g[j]);
-                if (j < k) R->h[j][k] = R->h[j][k] + tjk;
-                else R->h[k][j] = R->h[k][j] + tjk;
-            }
-        }
-        point_jet *x = src;
-        src = dst;
-        dst = x;
-    }
 }
 
 #if NOISE_IV_VECTOR
