@@ -1086,11 +1086,13 @@ taylor_model_d(int dim, const box_query *q, const int64_t *i0, const point_jet *
      *   N in n0* + sum_k K g_k d_k +- K (e_v + e_g sum_k r_k + quad + rem3)
      * with n0* = 1/2 + K (v + sum_k h_kk r_k^2 / 4). n0 and alpha_k = K g_k
      * are that in round to nearest: n0 within 2^-49 of the same sums in
-     * magnitude (a0: 2 dim + 2 roundings, each at most u of its result, so
-     * gamma_10 < 16u in 4D), alpha_k within u |alpha_k|, whose r_k-weighted
-     * sum is 2^-53 lin. delta adds all of it; every sum of nonnegative
-     * terms is raised by TAYLOR_SUM_SCALE (> (1 + u)^300) and 2^-1000 (the
-     * underflow of every product), as the remainders above. */
+     * magnitude (a0: 3 dim + 2 roundings, r_k^2, its product and the sum
+     * per axis, then K s0 and 1/2 + .: each at most u of the magnitude of
+     * what it rounds, so 14u < 16u in 4D), alpha_k within u |alpha_k|,
+     * whose r_k-weighted sum is 2^-53 lin. delta adds all of it; every
+     * sum of nonnegative terms is raised by TAYLOR_SUM_SCALE (> (1 +
+     * u)^300) and 2^-1000 (the underflow of every product), as the
+     * remainders above. */
     double s0 = P->v, a0 = fabs(P->v), quad = 0.0, rsum = 0.0;
     for (int k = 0; k < dim; k++) {
         double rq = q->r[k], hk = 0.25 * P->h[k][k];
