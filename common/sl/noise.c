@@ -169,8 +169,8 @@ void sl_vpnoise(int dim, const double *p, const int *period, double out[3])
  * dispatch below) so that the loops unroll. The value is sl_noise's, bit
  * for bit (raw_value); the gradient is the float jet's to order 1
  * (noise_internal.h: the nested interpolations, 2^dim - 1 steps; issue 24,
- * session 26: the product of weights per corner and per component before
- * took 1,400 of this function's 2,300 instructions in 3D, the jet ~500) */
+ * session 26: with the product of weights per corner and per component
+ * before, a 3D call took 2,320 instructions, now 1,490) */
 static inline __attribute__((always_inline)) double
 noise_grad_d(int dim, const double *p, const int *period, double *grad)
 {

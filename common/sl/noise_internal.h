@@ -257,7 +257,9 @@ jet_weights(int dim, const double f[4], double w0[4], double w1[4], double D[4],
     }
 }
 
-/* always inlined once per dim, so the loops unroll */
+/* The jet to `order` (0: the value; 1: and the gradient; 2: and the
+ * Hessian, whose parts j <= k J holds; the parts an order leaves out are
+ * not written); always inlined once per dim, so the loops unroll */
 static inline __attribute__((always_inline)) void
 point_jet_d(int dim, const double f[4], const uint32_t hs[16], int order, point_jet *J)
 {
@@ -302,6 +304,8 @@ point_jet_d(int dim, const double f[4], const uint32_t hs[16], int order, point_
             for (int j = 0; j < dim; j++)
                 R->g[j] = w0[k] * A->g[j] + w1[k] * B->g[j];
             R->g[k] = R->g[k] + D[k] * dv;
+            if (order == 1)
+                continue;            /* value and gradient only: no Hessian */
             for (int j = 0; j < dim; j++)
                 for (int m = j; m < dim; m++)
                     R->h[j][m] = k == 0 ? 0.0 : w0[k] * A->h[j][m] + w1[k] * B->h[j][m];
