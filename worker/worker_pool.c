@@ -14,6 +14,7 @@
 #include <fcntl.h>
 #include <pthread.h>
 #include <stdatomic.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -40,6 +41,8 @@ typedef struct pool_share {
     held_job *job;             /* the task's (the helpers' VM and world) */
     worker_tile_stats helped;  /* the helpers' work: rays ... CPU seconds */
 } pool_share;
+/* the board hands back &ps->sh, which render_main turns back into ps */
+_Static_assert(offsetof(pool_share, sh) == 0, "pool_share starts with its tile_share");
 
 struct worker_pool {
     pthread_mutex_t lock;

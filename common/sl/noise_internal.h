@@ -1,8 +1,10 @@
 /*
  * noise_internal.h: what noise.c (the function in float mode) and
  * noise_bound.c (its proven bounds over boxes: interval and affine modes)
- * share: the lattice hashing, the gradient sets, the fade, the scales and
- * the global derivative bounds. Private to the noise; its interface is
+ * share: the lattice hashing, the gradient sets, the fade, the scales,
+ * the global derivative bounds and the float jet at a point (value,
+ * gradient, Hessian by nested interpolations: noise.c's gradient, the
+ * start of noise_bound.c's bounds). Private to the noise; its interface is
  * noise.h. The functions are static inline: the jets and the float
  * evaluation both unroll them per dimension.
  */
