@@ -25,4 +25,5 @@
 #include "vm_affine_ops.h"
 
 #define VM_UNIFORM 1                  /* the uniform memo (vm_uniform.inc) */
+#define VM_ROWS3 1                    /* transforms by rows (v_rows3) */
 #include "vm_exec.inc"

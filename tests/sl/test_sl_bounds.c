@@ -677,12 +677,16 @@ static void random_box(unsigned long long *rng, double *lo, double *hi)
     *hi = *lo + w;
 }
 
-static double check_shader(const char *name, sl_global g)
+/* Containment of global g of program p (named `name` in the report) over
+ * random ranges of the plane and the sphere, with the named spaces
+ * `spaces` (NULL: identity); the mean width ratio affine/interval. */
+static double check_program(sl_program *p, const char *name, sl_global g,
+                            const sl_spaces *spaces)
 {
-    sl_program *p = h_compile_library(name);
     assert_non_null(p);
     sl_instance *inst = sl_instance_new(p);
     sl_vm *vm = sl_vm_new(NULL);
+    sl_vm_set_spaces(vm, spaces);
     /* fixed lights (all modes): an ambient and a distant light */
     sl_light_sample lights[2] = {
         { { 0, 0, 0 }, { 0.2, 0.2, 0.2 }, true, false },
@@ -714,6 +718,48 @@ static double check_shader(const char *name, sl_global g)
     return ratio_sum / 2;
 }
 
+static double check_shader(const char *name, sl_global g)
+{
+    return check_program(h_compile_library(name), name, g, NULL);
+}
+
+/*
+ * Transforms by the named spaces (issue 24: the affine mode takes each
+ * row of a matrix of constants as one linear combination): points,
+ * vectors and normals of the surface through a rotated, scaled and
+ * translated "shader" space and a projective one, each component
+ * enclosing the float samples; with the identity (the library shaders'
+ * tests above) a row or column taken for another would go unseen.
+ */
+static void test_transforms_by_spaces(void **state)
+{
+    (void)state;
+    static sl_spaces sp;
+    for (int k = 0; k < SL_SPACE__COUNT; k++)
+        sp.to_current[k] = sp.from_current[k] = mat4_identity();
+    mat4 rot = mat4_mul(mat4_rotate(37.0, 0.3, -1.0, 0.6), mat4_scale(1.5, 0.25, 3.0));
+    sp.to_current[SL_SPACE_SHADER] = mat4_mul(mat4_translate(0.7, -2.0, 0.4), rot);
+    mat4_invert(&sp.to_current[SL_SPACE_SHADER], &sp.from_current[SL_SPACE_SHADER]);
+    sp.to_current[SL_SPACE_OBJECT] = sp.to_current[SL_SPACE_SHADER];
+    sp.to_current[SL_SPACE_OBJECT].m[3][0] = 0.05;     /* projective: w = 1 + 0.05 x */
+    sp.to_current[SL_SPACE_OBJECT].m[3][2] = -0.02;
+    mat4_invert(&sp.to_current[SL_SPACE_OBJECT], &sp.from_current[SL_SPACE_OBJECT]);
+    static const char *bodies[] = {
+        "P = transform(\"shader\", P) + 0.1 * vector(u, v, u * v);",
+        "P = vtransform(\"shader\", vector(P) * (1 + u));",
+        "P = vector(ntransform(\"shader\", N * (2 - v)));",
+        "P = transform(\"shader\", \"current\", P * u);",
+        "P = transform(\"object\", P);",
+    };
+    for (size_t i = 0; i < sizeof bodies / sizeof bodies[0]; i++) {
+        char src[512];
+        snprintf(src, sizeof src, "displacement t() { %s }", bodies[i]);
+        char name[16];
+        snprintf(name, sizeof name, "xform%zu", i);
+        check_program(h_compile(src), name, SL_G_P, &sp);
+    }
+}
+
 static void test_wave(void **state) { (void)state; assert_true(check_shader("wave", SL_G_P) < 1); }
 static void test_nail(void **state) { (void)state; check_shader("nail", SL_G_P); }
 static void test_ufo(void **state) { (void)state; assert_true(check_shader("ufo", SL_G_P) < 1); }
@@ -740,6 +786,7 @@ int main(void)
         cmocka_unit_test(test_flags_reach_P),
         cmocka_unit_test(test_uniform_parameter_in_condition),
         cmocka_unit_test(test_random_programs),
+        cmocka_unit_test(test_transforms_by_spaces),
         cmocka_unit_test(test_wave),
         cmocka_unit_test(test_nail),
         cmocka_unit_test(test_ufo),
