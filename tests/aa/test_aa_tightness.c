@@ -257,6 +257,60 @@ static void test_difference_of_squares(void **state)
     assert_true(width_ia(r2) < 0.1 * width_ia(di));
 }
 
+/* ---- products by powers of two: exact ---- */
+
+/* x times a power of two a (2, 1/2, the octave factors of fBm, -1 of a
+ * negation) is exactly a times x when no product is subnormal: centre,
+ * coefficients, private error and hull, with no rounding margin (issue
+ * 24, affine.c scale_exact); a subnormal product goes the general way and
+ * still encloses a x */
+static void test_power_of_two_scale_exact(void **state)
+{
+    (void)state;
+    static const double factors[] = { 2.0, 4.0, 1.0, -1.0, -2.0, 0.5, 0.25, -0.125, 0x1p-60 };
+    long cases = 0;
+    for (int i = 0; i < 20000; i++) {
+        aa_context ctx;
+        aa_context_init(&ctx, 2 + i % 7);
+        aa_form u, v, x, z;
+        double lo, hi;
+        random_range(i % 6, &lo, &hi);
+        aa_input(&ctx, &u, lo, hi);
+        random_range((i / 6) % 6, &lo, &hi);
+        aa_input(&ctx, &v, lo, hi);
+        aa_mul(&ctx, &x, &u, &v);            /* an error symbol, a private error, a hull */
+        aa_add_s(&ctx, &x, &x, rng_unit() - 0.5);
+        double a = factors[i % 9];
+        aa_mul_s(&ctx, &z, &x, a);
+        if (x.flags & AA_UNBOUNDED)
+            continue;
+        bool subnormal = false;           /* a product below 2^-1022: not exact */
+        double parts[4 + AA_MAX_SYMBOLS] = { x.x0, x.err, x.lo, x.hi };
+        for (int k = 0; k < x.n; k++)
+            parts[4 + k] = x.c[k];
+        for (int k = 0; k < 4 + x.n; k++)
+            subnormal |= parts[k] != 0.0 && fabs(a * parts[k]) < 0x1p-1022;
+        if (subnormal)
+            continue;
+        assert_true(z.x0 == a * x.x0 && z.err == fabs(a) * x.err && z.n == x.n);
+        for (int k = 0; k < x.n; k++)
+            assert_true(z.c[k] == a * x.c[k]);
+        assert_true(z.lo == (a > 0 ? a * x.lo : a * x.hi));
+        assert_true(z.hi == (a > 0 ? a * x.hi : a * x.lo));
+        cases++;
+    }
+    printf("powers of two: %ld products exact, hull included\n", cases);
+    /* subnormal products: the general path, which encloses them */
+    aa_context ctx;
+    aa_context_init(&ctx, 4);
+    aa_form x, z;
+    aa_input(&ctx, &x, 0x1.8p-1022, 0x1.cp-1020);
+    aa_mul_s(&ctx, &z, &x, 0x1p-10);
+    ia_interval r = aa_range(&z);
+    assert_true(r.lo <= 0x1.8p-1032 && r.hi >= 0x1.cp-1030);
+    assert_true(z.err > 0.0 || r.lo < 0x1.8p-1032);      /* the loss is accounted for */
+}
+
 /* ---- sqr over [-1, 1] ---- */
 
 static void test_sqr_symmetric(void **state)
@@ -681,6 +735,7 @@ int main(void)
         cmocka_unit_test(test_lincomb3_centred_bitwise),
         cmocka_unit_test(test_x_times_one_minus_x),
         cmocka_unit_test(test_difference_of_squares),
+        cmocka_unit_test(test_power_of_two_scale_exact),
         cmocka_unit_test(test_sqr_symmetric),
         cmocka_unit_test(test_sin_cos_full_period),
         cmocka_unit_test(test_flags),
