@@ -690,28 +690,64 @@ void aa_pow(aa_context *ctx, aa_form *z, const aa_form *x, const aa_form *y)
     aa_set_interval(ctx, z, fallback, fl | fallback.flags);
 }
 
-static ia_interval neg_sin(ia_interval x) { return ia_neg(ia_sin(x)); }
+/*
+ * sin and cos: the Taylor scheme (approx_taylor) in closed form, as aa_sqr
+ * is the Chebyshev scheme's (issue 24: the interval enclosures of f and f'
+ * at the centre were half of an affine sin's ~2,400 instructions). With c
+ * the centre of the operand's range [a, b] and r >= max|t - c| on it,
+ * g(t) = f(t) - alpha t is
+ *     g(c) + (f'(c) - alpha)(t - c) + f''(xi)(t - c)^2 / 2,
+ * f'' = -f (both), enclosed over [a, b] by the negated interval result.
+ * alpha is libm's f'(c) and g(c) = f(c) - alpha c is taken in round to
+ * nearest; their errors are bounded a priori: libm's values within
+ * AA_LIBM_ULPS = 4 ulps (rounding.h), at most 2^-50 of the value or
+ * 2^-1072 for a subnormal one, the product and the difference within
+ * 2^-53 of theirs, so 2^-49 (|f(c)| + |alpha c| + |g(c)|) + 2^-1000
+ * bounds |g(c) - fl(g(c))|, and |f'(c) - alpha| r is at most
+ * (2^-49 |alpha| + 2^-1000) r; each of these sums, taken in round to
+ * nearest, errs by far less than the factor 2 the 2^-49 leaves (it needs
+ * 2^-50 + 2^-52). The ends of g's enclosure then round outward.
+ */
+static void approx_sincos(aa_context *ctx, aa_form *z, const aa_form *x, bool is_cos)
+{
+    unsigned fl;
+    double xr;
+    ia_interval r = operand_range(x, &fl, &xr);
+    ia_interval fallback = is_cos ? ia_cos(r) : ia_sin(r);
+    double a = r.lo, b = r.hi;
+    bool ok = isfinite(a) && isfinite(b) && a < b;
+    double alpha = 0.0, zeta = 0.0, delta = 0.0;
+    if (ok) {
+        double c = 0.5 * a + 0.5 * b;
+        double rad = fmax(fp_add_up(b, -c), fp_add_up(c, -a));
+        double sc = sin(c), cc = cos(c);
+        double f = is_cos ? cc : sc;
+        alpha = is_cos ? -sc : cc;
+        double p = alpha * c, g0 = f - p;
+        double e = (fabs(f) + fabs(p) + fabs(g0)) * 0x1p-49 + 0x1p-1000;
+        double lr = (fabs(alpha) * 0x1p-49 + 0x1p-1000) * rad;
+        double h = fp_mul_up(0.5, fp_mul_up(rad, rad));
+        /* f'' = -f over [a, b]: in -fallback; times (t - c)^2 / 2 in [0, h] */
+        double rlo = fallback.hi > 0.0 ? fp_mul_dn(-fallback.hi, h) : 0.0;
+        double rhi = fallback.lo < 0.0 ? fp_mul_up(-fallback.lo, h) : 0.0;
+        double spread = fp_add_up(e, lr);
+        ia_interval g = ia_make(fp_add_dn(fp_add_dn(g0, -spread), rlo),
+                                fp_add_up(fp_add_up(g0, spread), rhi));
+        ok = isfinite(alpha) && isfinite(spread) && center_radius(g, &zeta, &delta);
+    }
+    finish(ctx, z, x, ok, alpha, zeta, delta, fallback, fl, xr);
+}
 
 void aa_sin(aa_context *ctx, aa_form *z, const aa_form *x)
 {
     PRIVATE1(z, x, ia_sin);
-    unsigned fl;
-    double xr;
-    ia_interval r = operand_range(x, &fl, &xr);
-    ia_interval fallback = ia_sin(r);
-    approx_taylor(ctx, z, x, ia_sin, ia_cos, ia_neg(fallback), r.lo, r.hi,
-                  fallback, fl, xr);
+    approx_sincos(ctx, z, x, false);
 }
 
 void aa_cos(aa_context *ctx, aa_form *z, const aa_form *x)
 {
     PRIVATE1(z, x, ia_cos);
-    unsigned fl;
-    double xr;
-    ia_interval r = operand_range(x, &fl, &xr);
-    ia_interval fallback = ia_cos(r);
-    approx_taylor(ctx, z, x, ia_cos, neg_sin, ia_neg(fallback), r.lo, r.hi,
-                  fallback, fl, xr);
+    approx_sincos(ctx, z, x, true);
 }
 
 /* tan' = 1 + tan^2 */
