@@ -449,7 +449,7 @@ bool sl_global_writable(sl_global g) { return globals[g].writable; }
 const char *sl_global_name(sl_global g) { return globals[g].name; }
 /* Slot offsets of the globals in the order of sl_global: 3 slots for
  * points, vectors, normals and colors, 1 for floats. */
-static const unsigned char global_slots[SL_G__COUNT + 1] = {
+const unsigned char sl_global_slot_table[SL_G__COUNT + 1] = {
     [SL_G_P] = 0, [SL_G_N] = 3, [SL_G_Ng] = 6, [SL_G_I] = 9, [SL_G_E] = 12,
     [SL_G_s] = 15, [SL_G_t] = 16, [SL_G_u] = 17, [SL_G_v] = 18, [SL_G_du] = 19,
     [SL_G_dv] = 20, [SL_G_dPdu] = 21, [SL_G_dPdv] = 24, [SL_G_Cs] = 27, [SL_G_Os] = 30,
@@ -457,8 +457,6 @@ static const unsigned char global_slots[SL_G__COUNT + 1] = {
     [SL_G__COUNT] = 46,
 };
 
-int sl_global_size(sl_global g) { return global_slots[g + 1] - global_slots[g]; }
-int sl_global_slot(sl_global g) { return global_slots[g]; }
 
 int sl_texinfo_find(const char *name)
 {

@@ -279,9 +279,15 @@ struct sl_program {
 };
 
 /* Scalar slot of a global: P at 0, N at 3, ... (3 slots for points and
- * colors, 1 for s t u v du dv time). */
-int sl_global_slot(sl_global g);
-int sl_global_size(sl_global g);
+ * colors, 1 for s t u v du dv time). Inline: the renderer binds a dozen
+ * globals before every shader evaluation (issue 24: the calls and the
+ * copies of unknown size were 8 % of the wave's frame). */
+extern const unsigned char sl_global_slot_table[SL_G__COUNT + 1];
+static inline int sl_global_slot(sl_global g) { return sl_global_slot_table[g]; }
+static inline int sl_global_size(sl_global g)
+{
+    return sl_global_slot_table[g + 1] - sl_global_slot_table[g];
+}
 const char *sl_global_name(sl_global g);
 
 /* Can a derivative (Du, Dv, Deriv, calculatenormal, area) flow into P? A

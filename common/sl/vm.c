@@ -438,12 +438,24 @@ static void ensure_clear(sl_vm *self, sl_mode mode)
     }
 }
 
+/* A global's values, 1 or 3 of them (sl_global_size), as a copy of fixed
+ * size, which compiles to a few moves: a copy of unknown size was a libc
+ * call for every global of every evaluation (issue 24) */
+#define COPY_GLOBAL(dst, src, count)                                    \
+    do {                                                                \
+        assert((count) == 1 || (count) == 3);                           \
+        if ((count) == 3)                                               \
+            memcpy((dst), (src), 3 * sizeof *(dst));                    \
+        else                                                            \
+            memcpy((dst), (src), sizeof *(dst));                        \
+    } while (0)
+
 void sl_vm_set_float(sl_vm *self, sl_global g, const double *values)
 {
     ensure_clear(self, SL_MODE_FLOAT);
     if (!global_ok(g))
         return;
-    memcpy(&self->f[sl_global_slot(g)], values, (size_t)sl_global_size(g) * sizeof *values);
+    COPY_GLOBAL(&self->f[sl_global_slot(g)], values, sl_global_size(g));
 }
 
 void sl_vm_set_dual(sl_vm *self, sl_global g, const sl_dual *values)
@@ -451,7 +463,7 @@ void sl_vm_set_dual(sl_vm *self, sl_global g, const sl_dual *values)
     ensure_clear(self, SL_MODE_DUAL);
     if (!global_ok(g))
         return;
-    memcpy(&self->d[sl_global_slot(g)], values, (size_t)sl_global_size(g) * sizeof *values);
+    COPY_GLOBAL(&self->d[sl_global_slot(g)], values, sl_global_size(g));
 }
 
 void sl_vm_set_interval(sl_vm *self, sl_global g, const ia_interval *values)
@@ -459,7 +471,7 @@ void sl_vm_set_interval(sl_vm *self, sl_global g, const ia_interval *values)
     ensure_clear(self, SL_MODE_INTERVAL);
     if (!global_ok(g))
         return;
-    memcpy(&self->i[sl_global_slot(g)], values, (size_t)sl_global_size(g) * sizeof *values);
+    COPY_GLOBAL(&self->i[sl_global_slot(g)], values, sl_global_size(g));
 }
 
 /* count forms (a form is never read past n: the rest of its array is
@@ -497,21 +509,21 @@ void sl_vm_get_float(const sl_vm *self, sl_global g, double *values)
 {
     ensure_clear((sl_vm *)self, SL_MODE_FLOAT);
     if (global_ok(g))
-        memcpy(values, &self->f[sl_global_slot(g)], (size_t)sl_global_size(g) * sizeof *values);
+        COPY_GLOBAL(values, &self->f[sl_global_slot(g)], sl_global_size(g));
 }
 
 void sl_vm_get_dual(const sl_vm *self, sl_global g, sl_dual *values)
 {
     ensure_clear((sl_vm *)self, SL_MODE_DUAL);
     if (global_ok(g))
-        memcpy(values, &self->d[sl_global_slot(g)], (size_t)sl_global_size(g) * sizeof *values);
+        COPY_GLOBAL(values, &self->d[sl_global_slot(g)], sl_global_size(g));
 }
 
 void sl_vm_get_interval(const sl_vm *self, sl_global g, ia_interval *values)
 {
     ensure_clear((sl_vm *)self, SL_MODE_INTERVAL);
     if (global_ok(g))
-        memcpy(values, &self->i[sl_global_slot(g)], (size_t)sl_global_size(g) * sizeof *values);
+        COPY_GLOBAL(values, &self->i[sl_global_slot(g)], sl_global_size(g));
 }
 
 void sl_vm_get_affine(const sl_vm *self, sl_global g, aa_form *values)
