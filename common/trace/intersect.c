@@ -1411,7 +1411,14 @@ static bool intersect_displaced(trace_thread *th, const trace_object *obj,
     if (!trace_box_hit(&obj->root, &w.ray, ray->tmin, best->t, &t0, &t1, NULL))
         return false;
     double r[4] = {0, 1, 0, 1};
-    visit(&w, &obj->root, NULL, r, TRACE_BROOD_NONE, 0, 0, false, GEOM_PARTIAL, t0, t1);
+    /* the whole domain's cover: a polygon that fills its (u,v) square (a
+     * quad: the wave's, the nail's) is inside at the root, and no node of
+     * the walk tests its children against the edges again (issue 24: four
+     * tests a ray at the root, 2 % of the wave's frame) */
+    geom_cover root_cover = geom_uv_box_cover(&obj->surf, r[0], r[1], r[2], r[3]);
+    if (root_cover == GEOM_OUTSIDE)
+        return false;
+    visit(&w, &obj->root, NULL, r, TRACE_BROOD_NONE, 0, 0, false, root_cover, t0, t1);
     th->stats.nodes += w.nodes;
     if (w.nodes > th->stats.max_nodes_per_ray) th->stats.max_nodes_per_ray = w.nodes;
     return w.found;

@@ -257,9 +257,11 @@ void trace_tile_samples_filter(const trace_renderer *self, const trace_tile_samp
              * and counts where cx - rx <= s < cx + rx, so q > cx - rx - 1,
              * i.e. q >= floor(cx - rx) (the rounding of cx - rx is far
              * below 2^-24 for raster coordinates under 2^28), and q <= s <
-             * cx + rx */
-            int ax0 = (int)floor(cx - rx), ax1 = (int)floor(cx + rx);
-            int ay0 = (int)floor(cy - ry), ay1 = (int)floor(cy + ry);
+             * cx + rx, i.e. q <= ceil(cx + rx) - 1 (a box filter of one
+             * pixel: that pixel alone, not its neighbour's samples tested
+             * and refused) */
+            int ax0 = (int)floor(cx - rx), ax1 = (int)ceil(cx + rx) - 1;
+            int ay0 = (int)floor(cy - ry), ay1 = (int)ceil(cy + ry) - 1;
             for (int qy = ay0; qy <= ay1; qy++) {
                 if (qy < qy0 || qy > qy1) continue;
                 for (int qx = ax0; qx <= ax1; qx++) {
