@@ -766,9 +766,59 @@ void trace_surface_case_moves(trace_thread *th, const trace_object *obj, double 
 
 /* ---- interval ---- */
 
+/*
+ * M (x, 1) (a point) or M (x, 0) over the box x. Each row in midpoint-
+ * radius form, all in round to nearest with the rounding bounded a priori
+ * (issue 24: nine directed interval scalings and six directed sums a
+ * transform were 3 % of the wave's frame). Over the box, s = sum_j m_j x_j
+ * (+ t) lies in C +- R exactly, C = sum_j m_j c_j (+ t), R = sum_j |m_j|
+ * r_j, for centres c_j in the box and radii r_j >= |x_j - c_j|. In round
+ * to nearest (u = 2^-53): each r_j errs by at most u r_j, C's four
+ * products and three sums by 7u S with S = sum_j |m_j c_j| (+ |t|), R's
+ * three products and two sums by 5u R, each product that underflows by
+ * 2^-1074 more; so e = 2^-49 (S + R) + 2^-1000 covers them with room for
+ * its own rounding, and s lies in C +- (R + e). The ends C -+ (R + e) are
+ * moved out by 2^-51 (|C| + R + e) more, which is more than their own
+ * rounding (u of their magnitude). A box with an unbounded, empty or NaN
+ * axis, or a result that is not finite, goes the interval way. The flags
+ * are the axes' (as the interval sums give).
+ */
+static bool ia_xform_midrad(const mat4 *m, const ia_interval in[3], ia_interval out[3],
+                            bool point)
+{
+    double c[3], r[3];
+    unsigned flags = 0;
+    for (int j = 0; j < 3; j++) {
+        double lo = in[j].lo, hi = in[j].hi;
+        if (!(lo <= hi) || !isfinite(lo) || !isfinite(hi))
+            return false;
+        c[j] = aa_input_mid(lo, hi);
+        double a = hi - c[j], b = c[j] - lo;
+        r[j] = a > b ? a : b;
+        flags |= in[j].flags;
+    }
+    for (int i = 0; i < 3; i++) {
+        const double *row = m->m[i];
+        double t = point ? row[3] : 0.0;
+        double p0 = row[0] * c[0], p1 = row[1] * c[1], p2 = row[2] * c[2];
+        double C = ((p0 + p1) + p2) + t;
+        double S = ((fabs(p0) + fabs(p1)) + fabs(p2)) + fabs(t);
+        double R = (fabs(row[0]) * r[0] + fabs(row[1]) * r[1]) + fabs(row[2]) * r[2];
+        double spread = R + ((S + R) * 0x1p-49 + 0x1p-1000);
+        spread = spread + (fabs(C) + spread) * 0x1p-51;
+        double lo = C - spread, hi = C + spread;
+        if (!isfinite(lo) || !isfinite(hi))
+            return false;
+        out[i] = (ia_interval){ lo, hi, flags };
+    }
+    return true;
+}
+
 static void ia_xform(const mat4 *m, const ia_interval in[3], ia_interval out[3],
                      bool point)
 {
+    if (ia_xform_midrad(m, in, out, point))
+        return;
     for (int i = 0; i < 3; i++) {
         ia_interval s = ia_add(ia_mul_s(in[0], m->m[i][0]), ia_mul_s(in[1], m->m[i][1]));
         s = ia_add(s, ia_mul_s(in[2], m->m[i][2]));
