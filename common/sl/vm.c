@@ -255,8 +255,11 @@ void sl_vm_clear_messages(sl_vm *self, sl_message_scope scope)
 {
     int kept = 0;
     for (int i = 0; i < self->nmessages; i++)
-        if (self->messages[i].scope != (int)scope)
-            self->messages[kept++] = self->messages[i];
+        if (self->messages[i].scope != (int)scope) {
+            if (kept != i)           /* a message is ~340 bytes: no copy onto itself */
+                self->messages[kept] = self->messages[i];
+            kept++;
+        }
     self->nmessages = kept;
 }
 
