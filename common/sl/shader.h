@@ -279,7 +279,10 @@ sl_status sl_vm_run(sl_vm *self, const sl_instance *inst, sl_mode mode,
  * takes exactly two values over the range (a cell across one seam of a
  * brick or a tile): the operation gives one of them exactly, a constant
  * (mod: x - k y for one k), flagged AA_DISCONTINUOUS, instead of their
- * hull. The caller runs the shader once per case: after each run,
+ * hull; an if (or ?:) whose condition the range leaves undecided counts
+ * as such an operation too, and runs one of its sides a case (the nearest
+ * cell of a Voronoi loop) instead of both merged. The caller runs the
+ * shader once per case: after each run,
  * sl_vm_split_next says whether another case remains and selects it (the
  * runs replay the choices before the last one that can change, so they
  * meet the same operations). Every point of the range belongs to one

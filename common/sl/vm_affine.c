@@ -26,4 +26,5 @@
 
 #define VM_UNIFORM 1                  /* the uniform memo (vm_uniform.inc) */
 #define VM_ROWS3 1                    /* transforms by rows (v_rows3) */
+#define VM_SPLIT_BRANCHES 1           /* case splits take branches too */
 #include "vm_exec.inc"

@@ -31,4 +31,5 @@ static inline void b_from_interval(sl_vm *vm, B *z, ia_interval r)
 #define VM_TEXTURE_ARGS 1             /* b_texture_args: no copies of the arguments */
 #define VM_UNIFORM 1                  /* the uniform memo (vm_uniform.inc) */
 #define VM_UNIFORM_DERIV 1
+#define VM_SPLIT_BRANCHES 1           /* case splits take branches too */
 #include "vm_deriv.inc"

@@ -234,16 +234,53 @@ static void test_case_splits_same_value(void **state)
     runs = split_runs(body, 3, r, 8);
     assert_int_equal(runs, 4);
     assert_cases_enclose(body, cases_hull(r, runs));
-    /* a branch between them (a merge writes x): apart */
+    /* a branch between them (it writes x): apart, and the undecided
+     * branch is a split of its own (one side a case): 2 x 2 x 2 runs */
     body = "float x = 4 * u; float a = floor(x); if (u > 0.24) x = x + 0.1;"
            "P = point(a + 2 * floor(x), 0, 0);";
     runs = split_runs(body, 3, r, 8);
-    assert_int_equal(runs, 4);
+    assert_int_equal(runs, 8);
     assert_cases_enclose(body, cases_hull(r, runs));
     /* mod and step of the same operands agree too; of other operands not */
     body = "float x = 4 * u; P = point(mod(x, 1) + mod(x, 1), step(1, x) - step(1, x), step(1, x));";
     assert_int_equal(split_runs(body, 3, r, 8), 4);
     for (int c = 0; c < 4; c++) assert_true(r[c][1].lo == 0 && r[c][1].hi == 0);
+}
+
+/* Undecided branches split into cases (issue 24: the nearest cell of a
+ * Voronoi loop is chosen by comparisons that a range leaves undecided, so
+ * its boxes were estimated from samples): one side a case, a branch in a
+ * loop once per time it is met, each case exact for the points that take
+ * its sides, the hull enclosing every point */
+static void test_case_splits_branches(void **state)
+{
+    (void)state;
+    ia_interval r[8][3];
+    /* u in [0.2, 0.3] against 0.25: 0 in one case, 1 in the other (one
+     * run merges them: [0, 1]) */
+    const char *body = "float h; if (u > 0.25) h = 1; else h = 0; P = point(h, 0, 0);";
+    assert_int_equal(split_runs(body, 0, r, 8), 1);
+    assert_true(r[0][0].lo <= 0 && r[0][0].hi >= 1);
+    assert_int_equal(split_runs(body, 3, r, 8), 2);
+    for (int c = 0; c < 2; c++) assert_true(r[c][0].lo == r[c][0].hi);
+    assert_true(r[0][0].lo != r[1][0].lo);
+    assert_cases_enclose(body, cases_hull(r, 2));
+    /* in a loop: met twice, four cases (h = 0, 1, 1, 2 by the sides) */
+    body = "float h = 0, i; for (i = 0; i < 2; i += 1) if (u > 0.24 + 0.02 * i) h += 1;"
+           "P = point(h, 0, 0);";
+    assert_int_equal(split_runs(body, 3, r, 8), 4);
+    double seen = 0;
+    for (int c = 0; c < 4; c++) {
+        assert_true(r[c][0].lo == r[c][0].hi);
+        seen += r[c][0].lo;
+    }
+    assert_true(seen == 4.0);
+    assert_cases_enclose(body, cases_hull(r, 4));
+    /* a decided condition takes no split; a conditional expression splits */
+    assert_int_equal(split_runs("float h = u > 0.1 ? 1 : 0; P = point(h, 0, 0);", 3, r, 8), 1);
+    body = "float h = u > 0.25 ? u : 1 - u; P = point(h, 0, 0);";
+    assert_int_equal(split_runs(body, 3, r, 8), 2);
+    assert_cases_enclose(body, cases_hull(r, 2));
 }
 
 /* ---------------------------------------------------------------------- */
@@ -777,6 +814,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_case_splits),
         cmocka_unit_test(test_case_splits_same_value),
+        cmocka_unit_test(test_case_splits_branches),
         cmocka_unit_test(test_undecided_if_merges),
         cmocka_unit_test(test_undecided_conditional_expression),
         cmocka_unit_test(test_undecided_loop),
