@@ -257,6 +257,8 @@ struct sl_program {
     int nslots;                     /* scalar slots used */
     int nstring_slots;
     bool emits_light;               /* a light shader with illuminate or solar */
+    bool has_outputs;               /* an output parameter (message passing:
+                                       the renderer captures them at a hit) */
     bool takes_derivatives;         /* a DU, DV, DERIV, CALCNORMAL or AREA may
                                        flow into P: interval/affine runs carry
                                        derivative bounds (vm_deriv.inc) */

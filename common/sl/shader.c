@@ -36,6 +36,9 @@ sl_program *sl_compile(sl_source_set *set, const char *main_file,
     }
     if (program) {
         program->takes_derivatives = sl_program_derivatives_reach_P(program);
+        program->has_outputs = false;
+        for (int i = 0; i < program->nparams; i++)
+            program->has_outputs = program->has_outputs || program->params[i].output;
         program->global_slots = sl_program_global_slots(program);
         program->box_plan = sl_program_box_plan(program, false, &program->box_values,
                                                 &program->box_derivs);
@@ -48,6 +51,7 @@ sl_program *sl_compile(sl_source_set *set, const char *main_file,
 const char *sl_program_name(const sl_program *self) { return self->name; }
 sl_shader_kind sl_program_kind(const sl_program *self) { return self->kind; }
 int sl_program_param_count(const sl_program *self) { return self->nparams; }
+bool sl_program_has_outputs(const sl_program *self) { return self->has_outputs; }
 bool sl_program_takes_derivatives(const sl_program *self) { return self->takes_derivatives; }
 
 bool sl_program_box_reads(const sl_program *self, sl_global g, bool derivs)

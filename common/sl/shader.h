@@ -116,6 +116,8 @@ bool sl_program_takes_derivatives(const sl_program *self);
  * A renderer need not compute what no box run reads. */
 bool sl_program_box_reads(const sl_program *self, sl_global g, bool derivs);
 int sl_program_param_count(const sl_program *self);
+/* Whether any parameter is an output (message passing) */
+bool sl_program_has_outputs(const sl_program *self);
 void sl_program_param(const sl_program *self, int index, sl_param_info *info);
 int sl_program_find_param(const sl_program *self, const char *name); /* -1 */
 

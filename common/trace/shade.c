@@ -236,13 +236,7 @@ static void default_surface(const trace_object *obj, vec3 I, vec3 N, double u, d
 
 static bool has_outputs(const sl_instance *inst)
 {
-    const sl_program *p = sl_instance_program(inst);
-    for (int i = 0, n = sl_program_param_count(p); i < n; i++) {
-        sl_param_info info;
-        sl_program_param(p, i, &info);
-        if (info.output) return true;
-    }
-    return false;
+    return sl_program_has_outputs(sl_instance_program(inst));
 }
 
 /* Message passing (RI Spec 3.2 §15.7): the displacement shader's output
