@@ -457,7 +457,6 @@ const unsigned char sl_global_slot_table[SL_G__COUNT + 1] = {
     [SL_G__COUNT] = 46,
 };
 
-
 int sl_texinfo_find(const char *name)
 {
     static const char *const names[] = { "resolution", "channels", "levels", "type" };
