@@ -13,7 +13,8 @@
  *     normal (radial), not a box face's;
  *   - a step whose two cases' boxes are apart is a proven step
  *     (TRACE_BOX_STEP): its stagnant boxes are not sampled, its walls are
- *     drawn; a flagged but continuous hinge is not one;
+ *     drawn; a flagged but continuous hinge is not one; the same when an
+ *     if chooses the sides;
  *   - a step of two planes (TRACE_BOX_PLANES) against its analytic hits:
  *     the top's hits beside the wall are exact, not the wall's.
  */
@@ -104,6 +105,23 @@ static const char *HINGE_SL =
     "displacement hinge(float Km = 0.1)\n"
     "{\n"
     "    P += Km * step(0.5, s) * (s - 0.5) * 10 * normalize(N);\n"
+    "}\n";
+
+/* the same step and hinge chosen by an if (session 27: the cases of a
+ * stagnant box take undecided branches one side a case) */
+static const char *RAISED_IF_SL =
+    "displacement raised_if(float Km = 0.1)\n"
+    "{\n"
+    "    float h = 0;\n"
+    "    if (s >= 0.5) h = 1;\n"
+    "    P += Km * h * normalize(N);\n"
+    "}\n";
+
+static const char *HINGE_IF_SL =
+    "displacement hinge_if(float Km = 0.1)\n"
+    "{\n"
+    "    float h = s > 0.5 ? (s - 0.5) * 10 : 0;\n"
+    "    P += Km * h * normalize(N);\n"
     "}\n";
 
 /* a square polygon facing the camera at z = 5, side 2 */
@@ -454,6 +472,13 @@ static void test_proven_steps_take_no_samples(void **state)
     assert_true(flagged > 0);
     assert_int_equal(steps, flagged);
     count_step_cells("hinge", HINGE_SL, &flagged, &steps);
+    assert_true(flagged > 0);
+    assert_int_equal(steps, 0);
+    /* the same chosen by branches: one side a case, the same verdicts */
+    count_step_cells("raised_if", RAISED_IF_SL, &flagged, &steps);
+    assert_true(flagged > 0);
+    assert_int_equal(steps, flagged);
+    count_step_cells("hinge_if", HINGE_IF_SL, &flagged, &steps);
     assert_true(flagged > 0);
     assert_int_equal(steps, 0);
 
