@@ -360,7 +360,7 @@ scale_exact(aa_form *z, double a, const aa_form *x, unsigned flags, bool want_hu
     const double *xc = x->c;
     double *zc = z->c;
     double x0 = a * x->x0, err = fabs(a) * x->err;
-    double lo = -INFINITY, hi = INFINITY, big = 0.0;
+    double lo = -INFINITY, hi = INFINITY;
     if (want_hull)
         scale_ends(a, x->lo, x->hi, &lo, &hi);
     if (a < 1.0 && a > -1.0) {    /* FACTOR_POW2: a product may be subnormal */
@@ -375,6 +375,7 @@ scale_exact(aa_form *z, double a, const aa_form *x, unsigned flags, bool want_hu
         if (uf)
             return false;
     } else {                      /* FACTOR_EXACT: a product may overflow */
+        double big = 0.0;
         for (int i = 0; i < n; i++)
             big += fabs(a * xc[i]);
         if (!(big < INFINITY))

@@ -467,20 +467,23 @@ static void count_step_cells(const char *name, const char *src, int *flagged, in
 static void test_proven_steps_take_no_samples(void **state)
 {
     (void)state;
-    int flagged, steps;
-    count_step_cells("raised", RAISED_SL, &flagged, &steps);
-    assert_true(flagged > 0);
-    assert_int_equal(steps, flagged);
-    count_step_cells("hinge", HINGE_SL, &flagged, &steps);
-    assert_true(flagged > 0);
-    assert_int_equal(steps, 0);
-    /* the same chosen by branches: one side a case, the same verdicts */
-    count_step_cells("raised_if", RAISED_IF_SL, &flagged, &steps);
-    assert_true(flagged > 0);
-    assert_int_equal(steps, flagged);
-    count_step_cells("hinge_if", HINGE_IF_SL, &flagged, &steps);
-    assert_true(flagged > 0);
-    assert_int_equal(steps, 0);
+    /* the step and the hinge, and the same chosen by branches (one side
+     * a case): the same verdicts */
+    const struct {
+        const char *name, *src;
+        bool step;
+    } shapes[] = {
+        {"raised", RAISED_SL, true},
+        {"hinge", HINGE_SL, false},
+        {"raised_if", RAISED_IF_SL, true},
+        {"hinge_if", HINGE_IF_SL, false},
+    };
+    for (size_t k = 0; k < sizeof shapes / sizeof shapes[0]; k++) {
+        int flagged, steps;
+        count_step_cells(shapes[k].name, shapes[k].src, &flagged, &steps);
+        assert_true(flagged > 0);
+        assert_int_equal(steps, shapes[k].step ? flagged : 0);
+    }
 
     const char *rib = "Format 96 72 1\nProjection \"perspective\" \"fov\" [40]\n"
                       "Translate 0 -0.2 3\nRotate -50 1 0 0\nRotate 20 0 0 1\nWorldBegin\n"
