@@ -104,7 +104,8 @@ static int operand_reach(int op)
     case SL_OP_ROUND: case SL_OP_POW: case SL_OP_ATAN2: case SL_OP_MOD: case SL_OP_MIN:
     case SL_OP_MAX: case SL_OP_STEP: case SL_OP_CLAMP: case SL_OP_SMOOTHSTEP: case SL_OP_MIX:
     case SL_OP_LT: case SL_OP_LE: case SL_OP_GT: case SL_OP_GE: case SL_OP_EQ: case SL_OP_NE:
-    case SL_OP_AND: case SL_OP_OR: case SL_OP_NOT:
+    case SL_OP_AND: case SL_OP_OR: case SL_OP_NOT: case SL_OP_BR_BEGIN: case SL_OP_LOOP_TEST:
+    case SL_OP_DU: case SL_OP_DV: case SL_OP_DERIV:
         return 0;
     case SL_OP_MOVN: case SL_OP_PARAM: case SL_OP_RAY: case SL_OP_TEXTURE:
     case SL_OP_TEXINFO: case SL_OP_SFMT: case SL_OP_MESSAGE: case SL_OP_ALOAD:
@@ -219,6 +220,7 @@ void sl_program_destroy(sl_program **self_p)
     free(p->box_plan);
     free(p->slope_plan);
     free(p->split_same);
+    free(p->tape_site_of);
     for (int i = 0; i < p->nstrings; i++)
         free(p->strings[i]);
     free(p->strings);

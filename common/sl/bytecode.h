@@ -274,6 +274,11 @@ struct sl_program {
     uint64_t global_slots;          /* bit s: a run may read or write global
                                        slot s (sl_program_global_slots); 0:
                                        not known, every slot */
+    int32_t tape_site[7];           /* the pcs of the tape sites (tape_plan.c;
+                                       SL_TAPE_SITES) */
+    int ntape_sites;
+    int8_t *tape_site_of;           /* per instruction, its site or -1; NULL:
+                                       no site */
     uint64_t box_values, box_derivs; /* bit s: a box run may read global slot
                                        s's value, its derivative bounds
                                        (box_plan.c); every bit where the
@@ -316,14 +321,58 @@ enum {
                              from what it writes (they are set to the
                              whole line) */
     SL_BOX_DEAD = 2,      /* nothing it writes reaches P: unbounded */
+    /* tape pruning (tape_plan.c): what a node's run proved the
+     * instruction does over the node, for its children's runs */
+    SL_BOX_TAKE_B = 3,    /* z = operand b (min, max, clamp, mix: x) */
+    SL_BOX_TAKE_C = 4,    /* z = operand c (min, max, mix: y; clamp: lo) */
+    SL_BOX_TAKE_D = 5,    /* z = operand d (clamp: hi) */
+    SL_BOX_ZERO = 6,      /* z = 0 (step, smoothstep) */
+    SL_BOX_ONE = 7,       /* z = 1 (step, smoothstep) */
+    SL_BOX_THEN = 8,      /* a branch (BR_BEGIN) into its then-part */
+    SL_BOX_ELSE = 9,      /* a branch to its else-part */
 };
+/* How many slots from operand a an instruction that a box run may leave
+ * out writes: a copy's n, a lookup's outputs, a normal's 3, a vector
+ * noise's 3; 1 for the others */
+static inline int sl_box_writes(const sl_insn *in)
+{
+    switch ((sl_opcode)in->op) {
+    case SL_OP_MOVN: return in->c;
+    case SL_OP_TEXTURE: return sl_texop_outs(in->d);
+    case SL_OP_CALCNORMAL: return 3;
+    case SL_OP_NOISE: return (in->c & SL_NOISE_VECTOR) ? 3 : 1;
+    default: return 1;
+    }
+}
 /* The plan of p (ncode bytes, freed with the program), or NULL where the
- * analysis does not apply (loops, lights, trace, message passing, a
- * program too large to analyse): then every instruction runs. *values and
- * *derivs (each may be NULL) get the global slots whose values and
- * derivative bounds a box run may read (every bit without a plan). */
+ * analysis does not apply (lights, trace, message passing, a program too
+ * large to analyse): then every instruction runs. *values and *derivs
+ * (each may be NULL) get the global slots whose values and derivative
+ * bounds a box run may read (every bit without a plan). */
 uint8_t *sl_program_box_plan(const sl_program *p, bool slopes, uint64_t *values,
                              uint64_t *derivs);
+/* The same with decisions (box runs only; NULL: none): per instruction 0
+ * or the SL_BOX_TAKE_B..SL_BOX_ELSE code it was proved to take; with
+ * decisions a plan is made for programs that take no derivatives too.
+ * The caller frees it. */
+uint8_t *sl_program_plan(const sl_program *p, bool slopes, const uint8_t *decided,
+                         uint64_t *values, uint64_t *derivs);
+
+/* Tape pruning (tape_plan.c, issue 24): the program's tape sites, at most
+ * SL_TAPE_SITES of its min, max, clamp, step, smoothstep, mix and branches,
+ * chosen where deciding them leaves the most of the program dead; a
+ * TAPE (uint32_t) holds SL_TAPE_BITS per site, site i at bits 2i:
+ * 0 undecided, else the decision (sl_tape_code: 1 the first choice,
+ * 2 the second, 3 a clamp's hi). Sets p->tape_site, p->ntape_sites and
+ * p->tape_site_of. */
+enum { SL_TAPE_SITES = 7, SL_TAPE_BITS = 2 };
+void sl_program_tape_sites(sl_program *p);
+/* The plan code of decision dec (1..3) of site instruction in, or 0 */
+uint8_t sl_tape_code(const sl_insn *in, int dec);
+/* The plan of a box run below a node whose runs proved `tape`
+ * (sl_program_plan with those decisions); the caller frees it. NULL
+ * where tape decides nothing. */
+uint8_t *sl_program_tape_plan(const sl_program *p, uint32_t tape);
 
 /* Case splits that must agree (split_plan.c, issue 24): per instruction,
  * -1 or the pc of an earlier floor, ceil, round, mod or step of the same

@@ -199,6 +199,18 @@ void sl_vm_set_cancel(sl_vm *self, const atomic_int *flag);
  * only reach such results); P is as without. The other globals an affine
  * run writes are then not meaningful. Default off. */
 void sl_vm_set_box_runs(sl_vm *self, bool on);
+/* Tape pruning (issue 24, tape_plan.c): the next affine box runs (box
+ * runs on, not slope runs) take `plan`, sl_program_tape_plan of the
+ * decisions `tape` that their node's runs proved (NULL: the program's own
+ * plan), and with record note the decisions of the program's tape sites
+ * (at most SL_TAPE_SITES min, max, clamp, step, smoothstep, mix and
+ * branches).
+ * A plan belongs to the program of the runs. Set it per run: it stays
+ * until changed (sl_vm_set_tape(vm, NULL, 0, false): none). */
+void sl_vm_set_tape(sl_vm *self, const uint8_t *plan, uint32_t tape, bool record);
+/* After a recorded run: `tape` with the decisions that run proved added
+ * (a site decided where each of its executions made the same choice) */
+uint32_t sl_vm_tape(const sl_vm *self);
 /* The uniform memo (vm_uniform.inc): affine runs copy the result of an
  * operation on symbol-free operands they met before instead of computing
  * it again (the same bits either way). Default on; off for tests that

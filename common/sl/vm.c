@@ -283,6 +283,28 @@ void sl_vm_set_print(sl_vm *self, sl_print_fn fn, void *ctx)
 
 void sl_vm_set_box_runs(sl_vm *self, bool on) { self->box_runs = on; }
 
+void sl_vm_set_tape(sl_vm *self, const uint8_t *plan, uint32_t tape, bool record)
+{
+    self->tape_plan = plan;
+    self->tape_in = tape;
+    self->tape_record = record;
+}
+
+uint32_t sl_vm_tape(const sl_vm *self)
+{
+    uint32_t t = self->tape_in;
+    const sl_program *p = self->prog;
+    if (!p || !self->tape_record)
+        return t;
+    for (int i = 0; i < p->ntape_sites; i++) {
+        unsigned mask = ((1u << SL_TAPE_BITS) - 1) << (SL_TAPE_BITS * i);
+        unsigned d = self->tape_seen[i];
+        if (!(t & mask) && d >= 1 && d <= 3)
+            t |= d << (SL_TAPE_BITS * i);
+    }
+    return t;
+}
+
 void sl_vm_set_cancel(sl_vm *self, const atomic_int *flag)
 {
     self->cancel = flag;

@@ -27,4 +27,5 @@
 #define VM_UNIFORM 1                  /* the uniform memo (vm_uniform.inc) */
 #define VM_ROWS3 1                    /* transforms by rows (v_rows3) */
 #define VM_SPLIT_BRANCHES 1           /* case splits take branches too */
+#define VM_TAPE 1                     /* tape pruning (tape_plan.c) */
 #include "vm_exec.inc"

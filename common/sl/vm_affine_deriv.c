@@ -32,4 +32,5 @@ static inline void b_from_interval(sl_vm *vm, B *z, ia_interval r)
 #define VM_UNIFORM 1                  /* the uniform memo (vm_uniform.inc) */
 #define VM_UNIFORM_DERIV 1
 #define VM_SPLIT_BRANCHES 1           /* case splits take branches too */
+#define VM_TAPE 1                     /* tape pruning (tape_plan.c) */
 #include "vm_deriv.inc"

@@ -229,6 +229,15 @@ struct sl_vm {
                                      for P alone (box_plan.c) */
     long executed;
     uint64_t rng;
+    /* tape pruning (sl_vm_set_tape, tape_plan.c): the plan of the next
+     * affine box runs (NULL: the program's), the tape it came from, and
+     * with tape_record the decisions of the program's tape sites, noted
+     * per site at every execution (0: not met, 1..3: the same decision at
+     * every one, VM_TAPE_MIXED: not) */
+    const uint8_t *tape_plan;
+    uint32_t tape_in;
+    bool tape_record;
+    uint8_t tape_seen[SL_TAPE_SITES];
     /* the uniform memo (vm_uniform.inc) */
     bool uniform_off;             /* sl_vm_set_uniform_memo(false) */
     vm_uniform_block uniform[VM_UNIFORM_BLOCKS];
@@ -236,6 +245,8 @@ struct sl_vm {
     long uniform_hits;
     char error[ERR_LEN];
 };
+
+enum { VM_TAPE_MIXED = 0xff };       /* tape_seen: executions disagreed */
 
 sl_status sl_vm_exec_float(sl_vm *vm);
 sl_status sl_vm_exec_dual(sl_vm *vm);

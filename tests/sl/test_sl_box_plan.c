@@ -14,7 +14,8 @@
  *   the plan    a terrain-like shader leaves calculatenormal and N out
  *               (SL_BOX_DEAD) and runs the normalize chain without
  *               derivatives (SL_BOX_VALUE), keeps the derivative chain of
- *               the filter width (SL_BOX_RUN); a loop gets no plan
+ *               the filter width (SL_BOX_RUN); in a loop the same, and
+ *               what a later iteration reads stays live in an earlier one
  *   lookups     heightmap.sl's two lookups of a map (in a texture cache)
  *               run without derivative bounds (SL_BOX_VALUE), and P is the
  *               full run's form for form
@@ -371,9 +372,35 @@ static void test_plan(void **state)
     p = h_compile("displacement t() { float h = 0; for (float i = 0; i < 3; i += 1)"
                   " h += Du(s * i); P += h * normalize(N); N = calculatenormal(P); }");
     assert_non_null(p);
-    assert_null(p->box_plan);                              /* a loop: no plan */
-    assert_true(sl_program_box_reads(p, SL_G_dPdu, false));  /* no plan: all read */
-    assert_true(sl_program_box_reads(p, SL_G_P, true));
+    /* a loop: the liveness passes until nothing grows (box_plan.c); in
+     * the loop s * i keeps its derivative (Du reads it), the sum h its
+     * value alone; calculatenormal is left out */
+    assert_non_null(p->box_plan);
+    cn = find_op(p, SL_OP_CALCNORMAL, 0);
+    du = find_op(p, SL_OP_DU, 0);
+    int lt = find_op(p, SL_OP_LOOP_TEST, 0);
+    mul = find_op(p, SL_OP_MUL, lt);
+    int add = find_op(p, SL_OP_ADD, du);
+    assert_true(cn >= 0 && du >= 0 && lt >= 0 && mul > lt && mul < du && add > du);
+    assert_int_equal(p->box_plan[cn], SL_BOX_DEAD);
+    assert_int_equal(p->box_plan[mul], SL_BOX_RUN);
+    assert_int_equal(p->box_plan[add], SL_BOX_VALUE);
+    assert_false(sl_program_box_reads(p, SL_G_dPdu, false));
+    assert_false(sl_program_box_reads(p, SL_G_P, true));
+    assert_true(sl_program_box_reads(p, SL_G_s, true));
+    sl_program_destroy(&p);
+
+    /* what a later iteration reads is live in an earlier one: x feeds P
+     * only through y, read in the next pass round the loop */
+    p = h_compile("displacement t() { float x = 0, y = 0, w = Du(s);"
+                  " for (float i = 0; i < 3; i += 1) { y += x; x = s * t; }"
+                  " P += (y + w) * normalize(N); N = calculatenormal(P); }");
+    assert_non_null(p);
+    assert_non_null(p->box_plan);
+    lt = find_op(p, SL_OP_LOOP_TEST, 0);
+    mul = find_op(p, SL_OP_MUL, lt);
+    assert_true(lt >= 0 && mul > lt);
+    assert_int_equal(p->box_plan[mul], SL_BOX_VALUE);         /* x = s * t */
     sl_program_destroy(&p);
 }
 

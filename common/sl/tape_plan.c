@@ -1,0 +1,187 @@
+/*
+ * tape_plan.c: tape pruning of box runs (issue 24, "shorter programs
+ * deeper in the tree"; the idea of Duff 1992's and Keeter 2020's interval
+ * evaluations of implicit surfaces, on affine box runs here).
+ *
+ * A box run bounds P over a node's (u,v) range. Where that run proves an
+ * operation's choice over the whole range (min(x, y) with x below y at
+ * every point, clamp(x, lo, hi) with x above hi, a smoothstep saturated,
+ * a branch's condition decided), the choice holds at every point of every
+ * child range too, since a child's range lies inside its node's: the exact
+ * function there is the program with that operation replaced by the
+ * operand it takes (or its constant, or the branch taken). So the
+ * children's runs take it so (the plan codes SL_BOX_TAKE_B .. SL_BOX_ELSE)
+ * and leave out what only the other side read (box_plan.c's liveness:
+ * mesa_clamp's fBm below a plateau, the dead layer of a saturated mask).
+ * The children's boxes still enclose the surface: each is the box run of
+ * a program equal to the shader on its range.
+ *
+ * Which operations count: per program at most SL_TAPE_SITES TAPE SITES,
+ * the min, max, clamp, step, smoothstep, mix and branches whose decisions
+ * would leave the most of the program dead (sl_program_tape_sites: a
+ * liveness per candidate and choice, the dead operations weighted by what
+ * they cost), so a node's proved decisions fit in SL_TAPE_BITS bits a site
+ * (its box's tape: common/trace keeps it in the box, 14 bits). A site the
+ * run executes several times (a loop) is decided only where every
+ * execution made the same choice (the VM notes them: vm_exec.inc).
+ *
+ * The tape of a node is a pure function of the node (the decisions its
+ * own run proved, plus those its parent's tape gave its run), so a box
+ * stays a pure function of (object, u-range, v-range): the same on every
+ * thread and in every tile, cached or not.
+ */
+#include "sl/bytecode.h"
+#include "util/xalloc.h"
+
+#include <stdbool.h>
+#include <stdlib.h>
+#include <string.h>
+
+_Static_assert(SL_TAPE_SITES * SL_TAPE_BITS <= 14, "a tape fits a box's 14 bits");
+_Static_assert(sizeof ((sl_program *)0)->tape_site / sizeof(int32_t) == SL_TAPE_SITES,
+               "tape_site holds SL_TAPE_SITES pcs");
+
+/* Programs above this many instructions get no sites (their liveness per
+ * candidate would cost too much at compile time), and only the first
+ * TAPE_MAX_CANDIDATES candidates are weighed. */
+#define TAPE_MAX_CODE 8192
+#define TAPE_MAX_CANDIDATES 48
+
+/* A site is kept only where one of its decisions leaves at least this much
+ * dead (tape_weight): a few operations, or one noise */
+#define TAPE_MIN_GAIN 4
+
+/* How many choices op has as a site (0: not a site) */
+static int choices(int op)
+{
+    switch (op) {
+    case SL_OP_MIN: case SL_OP_MAX: case SL_OP_STEP: case SL_OP_SMOOTHSTEP: case SL_OP_MIX:
+    case SL_OP_BR_BEGIN:
+        return 2;
+    case SL_OP_CLAMP:
+        return 3;
+    default:
+        return 0;
+    }
+}
+
+uint8_t sl_tape_code(const sl_insn *in, int dec)
+{
+    if (dec < 1 || dec > choices(in->op))
+        return 0;
+    switch (in->op) {
+    case SL_OP_MIN: case SL_OP_MAX: case SL_OP_CLAMP: case SL_OP_MIX:
+        return (uint8_t)(SL_BOX_TAKE_B + dec - 1);
+    case SL_OP_STEP: case SL_OP_SMOOTHSTEP:
+        return dec == 1 ? SL_BOX_ZERO : SL_BOX_ONE;
+    default:                                  /* BR_BEGIN */
+        return dec == 1 ? SL_BOX_THEN : SL_BOX_ELSE;
+    }
+}
+
+/* What leaving an operation out saves, roughly in units of an affine
+ * addition */
+static int tape_weight(const sl_insn *in)
+{
+    switch (in->op) {
+    case SL_OP_NOISE: case SL_OP_TEXTURE:
+        return 32;
+    case SL_OP_SQRT: case SL_OP_INVSQRT: case SL_OP_EXP: case SL_OP_LOG: case SL_OP_SIN:
+    case SL_OP_COS: case SL_OP_TAN: case SL_OP_ASIN: case SL_OP_ACOS: case SL_OP_ATAN:
+    case SL_OP_POW: case SL_OP_ATAN2: case SL_OP_SMOOTHSTEP:
+        return 4;
+    case SL_OP_MUL: case SL_OP_DIV: case SL_OP_XPOINT: case SL_OP_XVECTOR: case SL_OP_XNORMAL:
+        return 2;
+    default:
+        return 1;
+    }
+}
+
+/* What the plan leaves dead that the base plan runs, weighed */
+static long gain(const sl_program *p, const uint8_t *base, const uint8_t *plan)
+{
+    long g = 0;
+    for (int pc = 0; pc < p->ncode; pc++)
+        if (plan[pc] == SL_BOX_DEAD && base[pc] != SL_BOX_DEAD)
+            g += tape_weight(&p->code[pc]);
+    return g;
+}
+
+void sl_program_tape_sites(sl_program *p)
+{
+    p->ntape_sites = 0;
+    p->tape_site_of = NULL;
+    if (p->kind != SL_SHADER_DISPLACEMENT || p->ncode <= 0 || p->ncode > TAPE_MAX_CODE)
+        return;
+    uint8_t *decided = xcalloc((size_t)p->ncode, 1);
+    uint8_t *base = sl_program_plan(p, false, decided, NULL, NULL);
+    if (!base) {                         /* the analysis does not apply */
+        free(decided);
+        return;
+    }
+    long best_gain[SL_TAPE_SITES];
+    int best_pc[SL_TAPE_SITES], nbest = 0, candidates = 0;
+    for (int pc = 0; pc < p->ncode && candidates < TAPE_MAX_CANDIDATES; pc++) {
+        const sl_insn *in = &p->code[pc];
+        int n = choices(in->op);
+        if (n == 0 || base[pc] == SL_BOX_DEAD)
+            continue;
+        candidates++;
+        long g = 0;
+        for (int dec = 1; dec <= n; dec++) {
+            decided[pc] = sl_tape_code(in, dec);
+            uint8_t *plan = sl_program_plan(p, false, decided, NULL, NULL);
+            if (plan) {
+                long gd = gain(p, base, plan);
+                g = gd > g ? gd : g;
+                free(plan);
+            }
+        }
+        decided[pc] = 0;
+        if (g < TAPE_MIN_GAIN)
+            continue;
+        /* keep the SL_TAPE_SITES largest gains (the earlier site on a tie) */
+        int at = nbest;
+        while (at > 0 && best_gain[at - 1] < g)
+            at--;
+        if (at >= SL_TAPE_SITES)
+            continue;
+        int last = nbest < SL_TAPE_SITES ? nbest : SL_TAPE_SITES - 1;
+        for (int k = last; k > at; k--) {
+            best_gain[k] = best_gain[k - 1];
+            best_pc[k] = best_pc[k - 1];
+        }
+        best_gain[at] = g;
+        best_pc[at] = pc;
+        if (nbest < SL_TAPE_SITES)
+            nbest++;
+    }
+    free(base);
+    free(decided);
+    if (nbest == 0)
+        return;
+    p->tape_site_of = xmalloc((size_t)p->ncode);
+    memset(p->tape_site_of, -1, (size_t)p->ncode);
+    for (int i = 0; i < nbest; i++) {
+        p->tape_site[i] = best_pc[i];
+        p->tape_site_of[best_pc[i]] = (int8_t)i;
+    }
+    p->ntape_sites = nbest;
+}
+
+uint8_t *sl_program_tape_plan(const sl_program *p, uint32_t tape)
+{
+    if (tape == 0 || p->ntape_sites == 0)
+        return NULL;
+    uint8_t *decided = xcalloc((size_t)p->ncode, 1);
+    bool any = false;
+    for (int i = 0; i < p->ntape_sites; i++) {
+        int dec = (int)(tape >> (SL_TAPE_BITS * i) & ((1u << SL_TAPE_BITS) - 1));
+        const sl_insn *in = &p->code[p->tape_site[i]];
+        decided[p->tape_site[i]] = sl_tape_code(in, dec);
+        any = any || decided[p->tape_site[i]] != 0;
+    }
+    uint8_t *plan = any ? sl_program_plan(p, false, decided, NULL, NULL) : NULL;
+    free(decided);
+    return plan;
+}
