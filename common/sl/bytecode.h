@@ -358,21 +358,17 @@ uint8_t *sl_program_box_plan(const sl_program *p, bool slopes, uint64_t *values,
 uint8_t *sl_program_plan(const sl_program *p, bool slopes, const uint8_t *decided,
                          uint64_t *values, uint64_t *derivs);
 
-/* Tape pruning (tape_plan.c, issue 24): the program's tape sites, at most
+/* Tape pruning (tape_plan.c, issue 24; the tape: shader.h): the program's
+ * tape sites, at most
  * SL_TAPE_SITES of its min, max, clamp, step, smoothstep, mix and branches,
  * chosen where deciding them leaves the most of the program dead; a
  * TAPE (uint32_t) holds SL_TAPE_BITS per site, site i at bits 2i:
  * 0 undecided, else the decision (sl_tape_code: 1 the first choice,
  * 2 the second, 3 a clamp's hi). Sets p->tape_site, p->ntape_sites and
  * p->tape_site_of. */
-enum { SL_TAPE_SITES = 7, SL_TAPE_BITS = 2 };
-void sl_program_tape_sites(sl_program *p);
+void sl_program_choose_tape_sites(sl_program *p);
 /* The plan code of decision dec (1..3) of site instruction in, or 0 */
 uint8_t sl_tape_code(const sl_insn *in, int dec);
-/* The plan of a box run below a node whose runs proved `tape`
- * (sl_program_plan with those decisions); the caller frees it. NULL
- * where tape decides nothing. */
-uint8_t *sl_program_tape_plan(const sl_program *p, uint32_t tape);
 
 /* Case splits that must agree (split_plan.c, issue 24): per instruction,
  * -1 or the pc of an earlier floor, ceil, round, mod or step of the same

@@ -44,7 +44,7 @@ sl_program *sl_compile(sl_source_set *set, const char *main_file,
                                                 &program->box_derivs);
         program->slope_plan = sl_program_box_plan(program, true, NULL, NULL);
         program->split_same = sl_program_split_same(program);
-        sl_program_tape_sites(program);
+        sl_program_choose_tape_sites(program);
     }
     return program;
 }

@@ -110,6 +110,15 @@ bool sl_program_uses_space(const sl_program *self, int space);
 bool sl_program_reads_textures(const sl_program *self);
 /* Whether range runs carry derivative bounds (sl_program_derivatives_reach_P). */
 bool sl_program_takes_derivatives(const sl_program *self);
+/* Tape pruning (issue 24, tape_plan.c): a tape holds SL_TAPE_BITS bits
+ * for each of the program's tape sites (sl_program_tape_site_count, at
+ * most SL_TAPE_SITES; 0: its box runs take no tape), the decision a box
+ * run proved there or 0; sl_program_tape_plan gives the plan of a box
+ * run below a node whose runs proved `tape` (sl_vm_set_tape; the caller
+ * frees it), NULL where the tape decides nothing. */
+enum { SL_TAPE_SITES = 7, SL_TAPE_BITS = 2 };
+int sl_program_tape_site_count(const sl_program *self);
+uint8_t *sl_program_tape_plan(const sl_program *self, uint32_t tape);
 /* Whether a box run of this displacement (sl_vm_set_box_runs) may read
  * global g's value (derivs false) or its derivative bounds (derivs true):
  * what box_plan.c finds can reach P; true for a program without a plan.

@@ -18,9 +18,9 @@
  *
  * Which operations count: per program at most SL_TAPE_SITES TAPE SITES,
  * the min, max, clamp, step, smoothstep, mix and branches whose decisions
- * would leave the most of the program dead (sl_program_tape_sites: a
+ * would leave the most of the program dead (sl_program_choose_tape_sites: a
  * liveness per candidate and choice, the dead operations weighted by what
- * they cost), so a node's proved decisions fit in SL_TAPE_BITS bits a site
+ * they cost: sl_program_choose_tape_sites), so a node's proved decisions fit in SL_TAPE_BITS bits a site
  * (its box's tape: common/trace keeps it in the box, 14 bits). A site the
  * run executes several times (a loop) is decided only where every
  * execution made the same choice (the VM notes them: vm_exec.inc).
@@ -107,7 +107,7 @@ static long gain(const sl_program *p, const uint8_t *base, const uint8_t *plan)
     return g;
 }
 
-void sl_program_tape_sites(sl_program *p)
+void sl_program_choose_tape_sites(sl_program *p)
 {
     p->ntape_sites = 0;
     p->tape_site_of = NULL;
@@ -167,6 +167,11 @@ void sl_program_tape_sites(sl_program *p)
         p->tape_site_of[best_pc[i]] = (int8_t)i;
     }
     p->ntape_sites = nbest;
+}
+
+int sl_program_tape_site_count(const sl_program *self)
+{
+    return self->ntape_sites;
 }
 
 uint8_t *sl_program_tape_plan(const sl_program *p, uint32_t tape)

@@ -628,6 +628,15 @@ static void load_strings(sl_vm *vm, const sl_program *p)
         vm->str[p->string_slots[k]] = p->strings[k];
 }
 
+/* Whether this affine run takes or records a tape (sl_vm_set_tape): a box
+ * run with a tape plan, or recording a program's tape sites; it runs in
+ * the VM instantiated with VM_TAPE */
+static bool tape_run(const sl_vm *self)
+{
+    return self->box_runs && !self->slopes &&
+           (self->tape_plan || (self->tape_record && self->prog->tape_site_of));
+}
+
 /* A program that takes derivatives runs in the derivative-carrying variant
  * of its range mode (vm_deriv.inc): the globals go in with the bounds of
  * sl_vm_set_derivs, and their values come back to the mode's own file,
@@ -649,7 +658,7 @@ static sl_status run_with_derivatives(sl_vm *self, sl_mode mode)
             self->ad[s].du = gderiv_of(self, s, 0);
             self->ad[s].dv = gderiv_of(self, s, 1);
         }
-        st = sl_vm_exec_affine_deriv(self);
+        st = tape_run(self) ? sl_vm_exec_affine_deriv_tape(self) : sl_vm_exec_affine_deriv(self);
         for (uint64_t m = used; m; m &= m - 1) {
             int s = __builtin_ctzll(m);
             if (s >= SL_GLOBAL_SLOTS) break;
@@ -727,7 +736,8 @@ static sl_status run(sl_vm *self, const sl_instance *inst, sl_mode mode, aa_cont
     case SL_MODE_FLOAT: return sl_vm_exec_float(self);
     case SL_MODE_DUAL: return sl_vm_exec_dual(self);
     case SL_MODE_INTERVAL: return sl_vm_exec_interval(self);
-    case SL_MODE_AFFINE: return sl_vm_exec_affine(self);
+    case SL_MODE_AFFINE:
+        return tape_run(self) ? sl_vm_exec_affine_tape(self) : sl_vm_exec_affine(self);
     }
     return sl_vm_fail(self, SL_ERR_RUNTIME, "unknown mode %d", (int)mode);
 }

@@ -8,7 +8,9 @@
  * run both branches and merge with aa_merge (§4.1, §5). The operations
  * live in vm_affine_ops.h; programs that take derivatives run in
  * vm_affine_deriv.c instead, so here Du/Dv/Deriv/calculatenormal/area are
- * never reached with a meaning (unbounded if they were).
+ * never reached with a meaning (unbounded if they were). vm_affine_tape.c
+ * compiles this file once more with VM_TAPE, for the box runs that take
+ * or record a tape (tape_plan.c).
  */
 #include "sl/noise.h"
 #include "sl/vm_internal.h"
@@ -18,7 +20,11 @@
 #include <string.h>
 
 #define VM_T aa_form
+#ifdef VM_TAPE
+#define VM_SUFFIX affine_tape         /* vm_affine_tape.c */
+#else
 #define VM_SUFFIX affine
+#endif
 #define VM_FILE(vm) ((vm)->a)
 #define VM_VARIANT VM_VAR_AFFINE
 #define VM_OP(plain, deriv) plain
@@ -27,5 +33,4 @@
 #define VM_UNIFORM 1                  /* the uniform memo (vm_uniform.inc) */
 #define VM_ROWS3 1                    /* transforms by rows (v_rows3) */
 #define VM_SPLIT_BRANCHES 1           /* case splits take branches too */
-#define VM_TAPE 1                     /* tape pruning (tape_plan.c) */
 #include "vm_exec.inc"

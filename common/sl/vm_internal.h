@@ -254,6 +254,9 @@ sl_status sl_vm_exec_interval(sl_vm *vm);
 sl_status sl_vm_exec_affine(sl_vm *vm);
 sl_status sl_vm_exec_interval_deriv(sl_vm *vm);
 sl_status sl_vm_exec_affine_deriv(sl_vm *vm);
+/* the same with tape pruning (vm_affine_tape.c, vm_affine_deriv_tape.c) */
+sl_status sl_vm_exec_affine_tape(sl_vm *vm);
+sl_status sl_vm_exec_affine_deriv_tape(sl_vm *vm);
 
 /* "shader 'name': " + message into vm->error; returns st. */
 sl_status sl_vm_fail(sl_vm *vm, sl_status st, const char *fmt, ...)

@@ -29,6 +29,7 @@
 #define TRACE_BOX_H
 
 #include <float.h>
+#include <assert.h>
 #include <stdbool.h>
 #include <stdint.h>
 #include <string.h>
@@ -82,6 +83,10 @@
  * (displace.c, planar_forms: a slate's face, a ramp), intersected
  * exactly (intersect.c, "planar_cell") */
 #define TRACE_BOX_PLANAR (1u << 17)
+/* The flags above use the low TRACE_BOX_FLAG_BITS bits; the box cache
+ * keeps a box's tape (below) in the rest of trace_fbox's flags */
+#define TRACE_BOX_FLAG_BITS 18
+#define TRACE_BOX_TAPE_BITS 14
 
 typedef struct trace_box {
     vec3 lo, hi;
@@ -93,7 +98,9 @@ typedef struct trace_box {
                                 the box: the affine forms' other terms over
                                 their u and v terms (displace.c); 0: unknown */
     float sn[3];             /* the slab's unit normal; all 0: no slab */
-    float pad;               /* (no padding bytes of unknown value) */
+    uint32_t tape;           /* the decisions the box's affine run proved,
+                                for its children's runs (tape pruning:
+                                common/sl/tape_plan.c, displace.c); 0: none */
     double slo, shi;         /* n . P over the cell, rounded outward */
 } trace_box;
 
@@ -175,7 +182,8 @@ static inline void trace_fbox_pack_lin(const trace_box *b, const trace_lin *lin,
         trace_float_range(lo[i], hi[i], blo[i], bhi[i], &f->lo[i], &f->hi[i]);
         f->sn[i] = b->sn[i];
     }
-    f->flags = b->flags;
+    assert(b->flags < 1u << TRACE_BOX_FLAG_BITS && b->tape < 1u << TRACE_BOX_TAPE_BITS);
+    f->flags = b->flags | b->tape << TRACE_BOX_FLAG_BITS;
     f->bend = b->bend;
     trace_float_range(b->slo, b->shi, 0.0, 0.0, &f->slo, &f->shi);
     /* the linear bound as codes against the box as unpacked */
@@ -206,10 +214,10 @@ static inline void trace_fbox_unpack_on(const trace_fbox *f, const double blo[3]
                trace_fbox_coord(blo[2], f->lo[2]));
     b->hi = v3(trace_fbox_coord(bhi[0], f->hi[0]), trace_fbox_coord(bhi[1], f->hi[1]),
                trace_fbox_coord(bhi[2], f->hi[2]));
-    b->flags = f->flags;
+    b->flags = f->flags & ((1u << TRACE_BOX_FLAG_BITS) - 1);
+    b->tape = f->flags >> TRACE_BOX_FLAG_BITS;
     b->bend = f->bend;
     for (int i = 0; i < 3; i++) b->sn[i] = f->sn[i];
-    b->pad = 0.0f;
     b->slo = f->slo;
     b->shi = f->shi;
 }
@@ -271,7 +279,7 @@ static inline void trace_box_meet(trace_box *b, const trace_box *rb)
 
 static inline void trace_box_no_slab(trace_box *b)
 {
-    b->sn[0] = b->sn[1] = b->sn[2] = b->pad = 0.0f;
+    b->sn[0] = b->sn[1] = b->sn[2] = 0.0f;
     b->slo = b->shi = 0.0;
 }
 

@@ -14,6 +14,7 @@
 #include "trace/cellkey.h"
 #include "trace/normal_memo.h"
 #include "trace/primvar.h"
+#include "trace/tape_memo.h"
 #include "util/xalloc.h"
 
 #include <assert.h>
@@ -160,6 +161,7 @@ static void box_from_affine(const aa_form P[3], trace_box *out)
     out->lo = v3(r[0].lo, r[1].lo, r[2].lo);
     out->hi = v3(r[0].hi, r[1].hi, r[2].hi);
     out->flags = box_flags(out, flags);
+    out->tape = 0;
     out->bend = other == 0 ? 0.0f : lin > 0 ? (float)fmin(other / lin, 1e30) : 1e30f;
     if (out->flags) trace_box_no_slab(out);
     else box_slab(P, r, out);
@@ -450,20 +452,44 @@ static void box_of_run(trace_thread *th, const trace_object *obj, const affine_c
     if (lin) box_linear(&th->ctx, P, out, lin);
 }
 
+/*
+ * Tape pruning (issue 24, common/sl/tape_plan.c): the run over a cell
+ * takes the plan of `tape`, the decisions its parent node's run proved
+ * (every point of the cell is a point of the parent's, so they hold here
+ * too), and notes its own; the box keeps them all (out->tape) for its
+ * children. The tape of a box is thus a pure function of its cell (its
+ * own run's, and its parent's tape), as the box is.
+ */
+_Static_assert(SL_TAPE_SITES * SL_TAPE_BITS <= TRACE_BOX_TAPE_BITS, "a box holds a tape");
+_Static_assert(TRACE_BOX_PLANAR < 1u << TRACE_BOX_FLAG_BITS, "flags below the tape");
+
 static void box_affine(trace_thread *th, const trace_object *obj,
-                       double u0, double u1, double v0, double v1, trace_box *out,
-                       trace_lin *lin)
+                       double u0, double u1, double v0, double v1, uint32_t tape,
+                       trace_box *out, trace_lin *lin)
 {
     aa_form P[3];
     trace_moved same;
     affine_cell c;
     affine_geometry(th, obj, u0, u1, v0, v1, &c);
+    const sl_program *prog = obj->displacement ? sl_instance_program(obj->displacement) : NULL;
+    bool taped = prog && sl_program_tape_site_count(prog) > 0 && th->world->options.tape_pruning;
+    if (taped) {
+        const uint8_t *plan = trace_tape_plan(th, prog, tape);
+        sl_vm_set_tape(th->vm, plan, plan ? tape : 0, true);
+        if (plan) th->stats.tape_runs++;
+    }
     affine_shade(th, obj, &c, P, &same, NULL);
+    uint32_t proved = 0;
+    if (taped) {
+        proved = th->failed ? 0 : sl_vm_tape(th->vm);
+        sl_vm_set_tape(th->vm, NULL, 0, false);
+    }
     box_of_run(th, obj, &c, P, same, out, lin);
+    out->tape = proved;
 }
 
 bool trace_surface_plane(trace_thread *th, const trace_object *obj, double u0, double u1,
-                         double v0, double v1, trace_plane *out)
+                         double v0, double v1, uint32_t tape, trace_plane *out)
 {
     obj = trace_box_owner(obj);
     double c[4] = {u0, u1, v0, v1};
@@ -474,7 +500,7 @@ bool trace_surface_plane(trace_thread *th, const trace_object *obj, double u0, d
     }
     if (th->world->options.arith == TRACE_ARITH_INTERVAL || !obj->displacement) return false;
     trace_box b;
-    box_affine(th, obj, u0, u1, v0, v1, &b, NULL);
+    box_affine(th, obj, u0, u1, v0, v1, tape, &b, NULL);
     th->stats.boxes++;
     if (th->failed || !(b.flags & TRACE_BOX_PLANAR)) return false;
     *out = plane_slot(th, obj, c)->p;    /* box_of_run kept it */
@@ -848,6 +874,7 @@ static void ia_camera_normal(const trace_object *obj, const ia_interval Nn[3],
 static void box_from_interval(const ia_interval P[3], trace_box *out)
 {
     out->bend = 0.0f;
+    out->tape = 0;
     out->lo = v3(P[0].lo, P[1].lo, P[2].lo);
     out->hi = v3(P[0].hi, P[1].hi, P[2].hi);
     out->flags = box_flags(out, P[0].flags | P[1].flags | P[2].flags);
@@ -963,15 +990,21 @@ bool trace_surface_slopes(trace_thread *th, const trace_object *obj,
     return !(flags & (AA_DISCONTINUOUS | AA_UNBOUNDED));
 }
 
-void trace_surface_box_lin(trace_thread *th, const trace_object *obj, double u0, double u1,
-                           double v0, double v1, trace_box *out, trace_lin *lin)
+void trace_surface_box_tape(trace_thread *th, const trace_object *obj, double u0, double u1,
+                            double v0, double v1, uint32_t tape, trace_box *out, trace_lin *lin)
 {
     obj = trace_box_owner(obj);           /* an instance: its prototype's box */
     if (th->world->options.arith == TRACE_ARITH_INTERVAL)
         box_interval(th, obj, u0, u1, v0, v1, out);
     else
-        box_affine(th, obj, u0, u1, v0, v1, out, lin);
+        box_affine(th, obj, u0, u1, v0, v1, tape, out, lin);
     box_finish(th, out);
+}
+
+void trace_surface_box_lin(trace_thread *th, const trace_object *obj, double u0, double u1,
+                           double v0, double v1, trace_box *out, trace_lin *lin)
+{
+    trace_surface_box_tape(th, obj, u0, u1, v0, v1, 0, out, lin);
 }
 
 void trace_surface_box(trace_thread *th, const trace_object *obj,

@@ -32,6 +32,14 @@ void trace_surface_box(trace_thread *th, const trace_object *obj,
  * (TRACE_BOX_LIN on the box; lin_bound.h, issue 24's lazy children) */
 void trace_surface_box_lin(trace_thread *th, const trace_object *obj, double u0, double u1,
                            double v0, double v1, trace_box *out, trace_lin *lin);
+/* The same below a node whose box has tape `tape` (box.h: the decisions
+ * its run proved; 0 at a root, or to take the whole program): the run
+ * takes its plan and out->tape gets the decisions of this run too (tape
+ * pruning, common/sl/tape_plan.c; world option tape_pruning). The box
+ * still encloses the surface over the range; it is a pure function of the
+ * range and tape. */
+void trace_surface_box_tape(trace_thread *th, const trace_object *obj, double u0, double u1,
+                            double v0, double v1, uint32_t tape, trace_box *out, trace_lin *lin);
 
 /* The pieces of a box's affine binding (also trace/region.c's): out = m *
  * in (with m's translation when `point`; out must not alias in), and the
@@ -84,7 +92,7 @@ bool trace_surface_box_cases(trace_thread *th, const trace_object *obj,
  * cases narrowed (TRACE_BOX_SPLIT) still lie across its seam, the plain
  * run would only find them stagnant again. One run with case splits: when
  * it split nothing it is trace_surface_box_lin's own run, and *box and
- * *lin are what that gives (false); else the other cases run and *box is
+ * *lin are what that gives, but for its tape (none: box.h) (false); else the other cases run and *box is
  * the hull of their boxes, flagged AA_DISCONTINUOUS and TRACE_BOX_SPLIT
  * (and TRACE_BOX_STEP where their boxes are pairwise apart), without
  * slab or proofs, with a linear bound in *lin that holds every case's
@@ -117,10 +125,11 @@ typedef struct trace_plane {
 
 /* The plane of a TRACE_BOX_PLANAR cell, as the run that made its box gave
  * it (kept per cell in a per-thread cache; a cell the cache lost runs
- * again, counted as a box): true with *out, or false where the cell is
- * not planar. A pure function of (object, range). */
+ * again with the tape its box's run took, counted as a box): true with
+ * *out, or false where the cell is not planar. A pure function of
+ * (object, range, tape). */
 bool trace_surface_plane(trace_thread *th, const trace_object *obj, double u0, double u1,
-                         double v0, double v1, trace_plane *out);
+                         double v0, double v1, uint32_t tape, trace_plane *out);
 
 /* N is constant over the object (its d/du, d/dv are 0): disks, and
  * polygons unless they carry interpolated vertex normals

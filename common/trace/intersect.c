@@ -723,15 +723,16 @@ static bool exact_cell(walk *w, const double c[4], double tol, bool moved)
  * the best hit; else the cell has none. A hit within 2^-30 of the cell's
  * side outside it is taken, at the cell's edge (where two cells of one
  * plane meet, the rounding of either solve must not let a ray through
- * both). True where the cell is settled so; false (the walk goes on as
- * before) where the plane is degenerate or the ray runs along it
+ * both). tape: what the cell's box's run took (node_tape). True where the
+ * cell is settled so; false (the walk goes on as before) where the plane
+ * is degenerate or the ray runs along it
  * (|n . d| below 2^-20 of |n| |d|: t is ill-conditioned there). */
 #define PLANAR_GRAZE 0x1p-20
 #define PLANAR_MARGIN 0x1p-30
-static bool planar_cell(walk *w, const double c[4], double tol)
+static bool planar_cell(walk *w, const double c[4], double tol, uint32_t tape)
 {
     trace_plane pl;
-    if (!trace_surface_plane(w->th, w->obj, c[0], c[1], c[2], c[3], &pl)) return false;
+    if (!trace_surface_plane(w->th, w->obj, c[0], c[1], c[2], c[3], tape, &pl)) return false;
     vec3 n = v3_cross(pl.Eu, pl.Ev), d = w->ray.d;
     double nd = v3_dot(n, d), nn = v3_dot(n, n);
     if (!(fabs(nd) > PLANAR_GRAZE * sqrt(nn * v3_dot(d, d)))) return false;
@@ -992,14 +993,24 @@ static bool stagnant(const trace_box *b, double parent_extent)
            !trace_box_is_empty(b) && trace_box_extent(b) >= TRACE_NO_SHRINK * parent_extent;
 }
 
+/* The decisions a node's children's runs take (tape pruning: the node's
+ * box's tape, displace.c): none below an object's root (instances that
+ * share their prototype's broods have roots of their own, which a child's
+ * box must not depend on) */
+static uint32_t node_tape(trace_brood_id parent, const trace_box *node)
+{
+    return parent == TRACE_BROOD_NONE ? 0 : node->tape;
+}
+
 /* Child i's box, evaluated: the shader's run over its cell (with the
- * cases of its seams, then samples, where it stagnates), met with the
+ * cases of its seams, then samples, where it stagnates; taking the
+ * decisions `tape` of its node's run, node_tape), met with the
  * restricted bound of the node's linear bound where the node has one
  * (box.h). The caller stores it, which rounds it outward as the cache
  * keeps it (trace_boxcache_insert_kept: a hit and a miss give the same
  * box) */
 static void child_box(walk *w, const trace_box *node, const trace_dlin *lin, const double r[4],
-                      int depth, int i, trace_box *kid, trace_lin *kid_lin)
+                      int depth, int i, uint32_t tape, trace_box *kid, trace_lin *kid_lin)
 {
     trace_thread *th = w->th;
     const trace_object *owner = trace_box_owner(w->obj);
@@ -1014,7 +1025,7 @@ static void child_box(walk *w, const trace_box *node, const trace_dlin *lin, con
     if (cases_first)
         split = trace_surface_box_split(th, owner, c[0], c[1], c[2], c[3], kid, kid_lin, &moves);
     else
-        trace_surface_box_lin(th, owner, c[0], c[1], c[2], c[3], kid, kid_lin);
+        trace_surface_box_tape(th, owner, c[0], c[1], c[2], c[3], tape, kid, kid_lin);
     if (stagnant(kid, node_extent)) {
         /* issue 24: the cases of a seam, then (still stagnant) samples;
          * below a box they did not narrow, not again (a pattern whose
@@ -1096,7 +1107,7 @@ static trace_brood_id children_of(walk *w, trace_brood_id parent, int slot,
             trace_box_restrict(lin, node, r, c, &kids[i]);
             th->stats.lazy_bounds++;
         } else {
-            child_box(w, node, lin, r, depth, i, &kids[i], &lins[i]);
+            child_box(w, node, lin, r, depth, i, node_tape(parent, node), &kids[i], &lins[i]);
         }
     }
     return trace_boxcache_insert_kept(th->cache, owner->id, parent, slot, base, kids,
@@ -1115,7 +1126,7 @@ static void lazy_child(walk *w, trace_brood_id brood, trace_brood_id parent, int
     assert(lin != NULL);                 /* a lazy child's node has one */
     trace_lin kid_lin;
     w->th->stats.lazy_evals++;
-    child_box(w, node, lin, r, depth, i, kid, &kid_lin);
+    child_box(w, node, lin, r, depth, i, node_tape(parent, node), kid, &kid_lin);
     trace_boxcache_update_kept(w->th->cache, brood, i, base, kid, &kid_lin, kq);
 }
 
@@ -1303,7 +1314,7 @@ static void visit(walk *w, const trace_box *node, const trace_qlin *node_q, cons
             planes_cell(w, c, tol))
             continue;
         if ((kid->flags & TRACE_BOX_PLANAR) && w->exact_cells && order[k].cover == GEOM_INSIDE &&
-            clear_of_shared_edges(w, c) && planar_cell(w, c, tol))
+            clear_of_shared_edges(w, c) && planar_cell(w, c, tol, node_tape(parent, node)))
             continue;
         bool unbounded = (kid->flags & AA_UNBOUNDED) != 0;
         vec3 wall_n = v3(0, 0, 0);

@@ -19,6 +19,10 @@ typedef struct trace_stats {
                                       answered (sl_vm_uniform_hits) */
     long normal_hits;              /* box normals the normal memo answered
                                       (normal_memo.c) */
+    long tape_runs;                /* box runs that took a tape plan: the
+                                      decisions of their node (tape pruning,
+                                      displace.c) */
+    long tape_plans;               /* tape plans made (tape_memo.c) */
     long leaves, wall_leaves, depth_cap_leaves;
     long proofs;                   /* hit proofs tried (prove.c) */
     long proven_hits;              /* leaves whose hit was proven unique and

@@ -4,6 +4,7 @@
 #include "trace/thread.h"
 #include "trace/mesh.h"
 #include "trace/normal_memo.h"
+#include "trace/tape_memo.h"
 #include "util/err.h"
 #include "util/shares.h"
 #include "util/xalloc.h"
@@ -26,6 +27,7 @@ void trace_options_default(trace_options *opt)
     opt->prove_hits = true;
     opt->lazy_roots = true;
     opt->lazy_children = true;
+    opt->tape_pruning = true;
     opt->cancel = NULL;
 }
 
@@ -118,6 +120,7 @@ void trace_thread_destroy(trace_thread **self_p)
     free(self->moves);
     free(self->cases);
     free(self->planes);
+    trace_tape_memo_free(self);
     trace_views_free(self);
     free(self->work);
     free(self);

@@ -58,6 +58,7 @@ typedef struct trace_thread {
     struct trace_move_cache *moves;    /* intersect.c's, made on first use */
     struct trace_case_cache *cases;    /* intersect.c's, made on first use */
     struct trace_plane_cache *planes;  /* displace.c's, made on first use */
+    struct trace_tape_memo *tapes;     /* tape_memo.c's, made on first use */
     struct trace_views *views;     /* mesh.c's views of pieces, made on first use */
     struct trace_normal_memo *normals; /* normal_memo.c's, made on first use */
     trace_stats stats;

@@ -268,6 +268,10 @@ typedef struct trace_options {
                                       restricted bound (intersect.c); off:
                                       all four at once, the same boxes (for
                                       tests: the same pixels either way) */
+    bool tape_pruning;             /* children's box runs take the decisions
+                                      their node's run proved (displace.c,
+                                      common/sl/tape_plan.c); off: every box
+                                      run takes the whole program */
     bool prove_hits;               /* try hit proofs on small cells
                                       (trace/prove.h); off: leaves only */
     const atomic_int *cancel;      /* the program's stop flag (a signal), or

@@ -23,6 +23,13 @@
  * range although the values never do; the subdivision splits such ranges
  * (docs/renderer.md, "Shader globals").
  *
+ * Where a range's affine run proved decisions (its box's tape: tape
+ * pruning, common/sl/tape_plan.c), its four children are boxed as the walk
+ * boxes them, taking those decisions (trace_surface_box_tape), and points
+ * of each are checked against its box, which must be bounded wherever the
+ * whole program's box of the child is, and the same (box and tape) when
+ * made again after the thread made another box.
+ *
  * Prints one row per shader x surface x arithmetic: cases, points,
  * violations, unbounded boxes, shader errors (box runs / point runs), worst
  * excess, and the smallest range (its larger side, as a fraction of the
@@ -62,6 +69,12 @@ typedef struct tally {
     long split_plain;               /* of its calls, those that split nothing */
     long plain_differ;              /* of them, boxes or linear bounds not the plain run's */
     long undefined;                 /* NaN points on a base's axis (check_point) */
+    long taped;                     /* children boxed with their range's tape (tape
+                                       pruning: trace_surface_box_tape) */
+    long taped_unbounded;           /* of them, unbounded where the whole
+                                       program's box is bounded */
+    long taped_differ;              /* of them, not the same box or tape when
+                                       made again (a pure function) */
     double worst;                   /* largest excess outside the box, object units */
     double unb_side;                /* smallest range (larger side) with an unbounded box */
     char error[512];                /* the first shader error */
@@ -246,6 +259,12 @@ static bool same_box(const trace_box *a, const trace_box *b)
            memcmp(&a->shi, &b->shi, sizeof a->shi) == 0;
 }
 
+static bool unbounded_box(const trace_box *b)
+{
+    return (b->flags & AA_UNBOUNDED) || !isfinite(b->lo.x) || !isfinite(b->lo.y) ||
+           !isfinite(b->lo.z) || !isfinite(b->hi.x) || !isfinite(b->hi.y) || !isfinite(b->hi.z);
+}
+
 static void run_cases(trace_thread *th, const trace_world *w, long ncases, uint64_t seed,
                       tally *t)
 {
@@ -297,8 +316,7 @@ static void run_cases(trace_thread *th, const trace_world *w, long ncases, uint6
         }
         take_error(th, t, &t->box_errors);
         t->cases++;
-        if ((b.flags & AA_UNBOUNDED) || !isfinite(b.lo.x) || !isfinite(b.lo.y) ||
-            !isfinite(b.lo.z) || !isfinite(b.hi.x) || !isfinite(b.hi.y) || !isfinite(b.hi.z)) {
+        if (unbounded_box(&b)) {
             /* a subdivision face bounds a range holding one of its
              * corners, which may be an extraordinary point, by the hull of
              * its 1-ring with unbounded derivatives (dP/du is unbounded
@@ -332,6 +350,39 @@ static void run_cases(trace_thread *th, const trace_world *w, long ncases, uint6
             double v = v0 + (v1 - v0) * corpus_rng_uniform(&rng);
             check_point(th, obj, &b, &lin, split, &lin2, r, u, v, t);
         }
+        /* where the range's run proved decisions (its tape, box.h), the
+         * children as the walk boxes them, taking those decisions: the
+         * points of each quarter in its box */
+        if (b.tape != 0)
+            for (int q = 0; q < 4; q++) {
+                double um = 0.5 * (u0 + u1), vm = 0.5 * (v0 + v1);
+                double c[4] = {q & 1 ? um : u0, q & 1 ? u1 : um, q & 2 ? vm : v0, q & 2 ? v1 : vm};
+                trace_box cb;
+                trace_lin clin;
+                trace_surface_box_tape(th, obj, c[0], c[1], c[2], c[3], b.tape, &cb, &clin);
+                take_error(th, t, &t->box_errors);
+                t->taped++;
+                /* a pure function of (range, tape): once more, after the
+                 * thread made one box more, the same box and tape */
+                trace_box cb2;
+                trace_lin clin2;
+                trace_surface_box_tape(th, obj, c[0], c[1], c[2], c[3], b.tape, &cb2, &clin2);
+                take_error(th, t, &t->box_errors);
+                t->taped_differ += !same_box(&cb, &cb2) || cb.tape != cb2.tape;
+                /* and no wider where the whole program's is bounded: a
+                 * decided operation that took the dead side (whose values
+                 * the plan leaves unbounded) would give an unbounded box,
+                 * which holds every point */
+                trace_box zb;
+                trace_surface_box_lin(th, obj, c[0], c[1], c[2], c[3], &zb, NULL);
+                take_error(th, t, &t->box_errors);
+                t->taped_unbounded += unbounded_box(&cb) && !unbounded_box(&zb);
+                for (int i = 0; i < RANDOM_POINTS / 2; i++) {
+                    double u = c[0] + (c[1] - c[0]) * corpus_rng_uniform(&rng);
+                    double v = c[2] + (c[3] - c[2]) * corpus_rng_uniform(&rng);
+                    check_point(th, obj, &cb, &clin, NULL, NULL, c, u, v, t);
+                }
+            }
     }
     free(view);
 }
@@ -362,7 +413,7 @@ static void run_surface(corpus_surface s)
             t.unb_side = INFINITY;
             run_cases(th, &f.js->world, ncases, 0x5eed0000u + (uint64_t)i * 16 + (uint64_t)s, &t);
             bool bad = t.violations || t.unbounded || t.box_errors || t.point_errors ||
-                       t.plain_differ;
+                       t.plain_differ || t.taped_unbounded || t.taped_differ;
             printf("%-20s %-9s %-8s %6ld %7ld %7ld %6ld %8ld %5ld %5ld %9.2e %9.2e%s\n",
                    C.shaders[i].name, corpus_surface_name(s), trace_arith_name(ariths[a]),
                    t.cases, t.points, t.violations, t.unbounded, t.unbounded_wide,
@@ -385,6 +436,9 @@ static void run_surface(corpus_surface s)
             total.box_errors += t.box_errors;
             total.point_errors += t.point_errors;
             total.undefined += t.undefined;
+            total.taped += t.taped;
+            total.taped_unbounded += t.taped_unbounded;
+            total.taped_differ += t.taped_differ;
             if (t.worst > total.worst) total.worst = t.worst;
             trace_thread_destroy(&th);
             fixture_close(&f);
@@ -396,12 +450,14 @@ static void run_surface(corpus_surface s)
            "box), %ld violations (worst %.2e), %ld unbounded boxes "
            "(+ %ld of ranges wider than 1/32, counted), %ld/%ld shader errors (box/point), "
            "%ld failing rows, %ld scenes not opened, %ld undefined points (NaN on a "
-           "base's axis)\n",
+           "base's axis), %ld children boxed with their range's tape (%ld unbounded "
+           "where the whole program's box is not, %ld not the same made again)\n",
            corpus_surface_name(s), total.cases, total.points, total.slab_points,
            total.restricted_points, total.split,
            total.split_first, total.split_lin, total.split_plain, total.plain_differ, total.violations, total.worst,
            total.unbounded, total.unbounded_wide, total.box_errors, total.point_errors,
-           bad_rows, failed_opens, total.undefined);
+           bad_rows, failed_opens, total.undefined, total.taped, total.taped_unbounded,
+           total.taped_differ);
     fflush(stdout);
     assert_int_equal(failed_opens, 0);
     assert_true(total.points > 0);
@@ -411,9 +467,12 @@ static void run_surface(corpus_surface s)
     if (!only || !*only) {
         assert_true(total.split > 0);      /* the split path is checked */
         assert_true(total.split_lin > 0);  /* and the cases' linear bounds */
+        assert_true(total.taped > 0);      /* and tape pruning's children */
     }
     assert_int_equal(total.violations, 0);
     assert_int_equal(total.plain_differ, 0);
+    assert_int_equal(total.taped_unbounded, 0);
+    assert_int_equal(total.taped_differ, 0);
     assert_int_equal(total.unbounded, 0);
     assert_int_equal(total.box_errors + total.point_errors, 0);
 }

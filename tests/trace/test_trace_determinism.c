@@ -4,7 +4,8 @@
  * cache budgets (down to the paper's 40 KB and below) give identical
  * pixels, for a scene with displacement, shadows, several samples per
  * pixel and a filter wider than a pixel; and lazy children (issue 24) give
- * the pixels of children evaluated four at a time.
+ * the pixels of children evaluated four at a time; the same for a layered
+ * shader whose boxes' children take their node's decisions (tape pruning).
  */
 #include <math.h>
 #include <setjmp.h>
@@ -152,10 +153,72 @@ static void test_lazy_children_change_no_pixel(void **state)
     fixture_close(&f);
 }
 
+/* Tape pruning (issue 24): a patch under a layered shader (two noise
+ * layers mixed by a mask that saturates) and the higher of two noise
+ * fields; the children of boxes whose runs decided the mask or the max
+ * take those decisions. The pixels are the same for every tiling, thread
+ * count and cache budget (a box's tape, like the box, is a function of
+ * its cell), and boxes did take tapes */
+static const char *TAPE_RIB =
+    "Format 40 30 1\nProjection \"perspective\" \"fov\" [45]\n"
+    "PixelSamples 2 2\nPixelFilter \"gaussian\" 2 2\n"
+    "Translate 0 -0.3 3\nRotate -30 1 0 0\n"
+    "WorldBegin\n"
+    "LightSource \"distantlight\" 1 \"from\" [1 2 -1] \"to\" [0 0 0]\n"
+    "Surface \"mymatte\"\n"
+    "AttributeBegin\n"
+    "  Displacement \"layers\"\n"
+    "  Patch \"bilinear\" \"P\" [-1.5 0 -1.5  1.5 0 -1.5  -1.5 0 1.5  1.5 0 1.5]\n"
+    "AttributeEnd\n"
+    "WorldEnd\n";
+
+#define SHADER_LAYERS                                                             \
+    "displacement layers(float Km = 0.06)\n"                                      \
+    "{\n"                                                                         \
+    "    point q = transform(\"shader\", P) * 4;\n"                               \
+    "    float rock = noise(q) + 0.5 * noise(q * 2), sand = 0.4 * noise(q * 6);\n" \
+    "    float m = smoothstep(0.45, 0.55, noise(q * 0.5 + 7));\n"                 \
+    "    float h = max(mix(rock, sand, m), 0.3 * noise(q * 3));\n"                 \
+    "    P += Km * h * normalize(N);\n"                                            \
+    "    N = calculatenormal(P);\n"                                               \
+    "}\n"
+
+static void test_tape_pruning_same_pixels(void **state)
+{
+    (void)state;
+    fixture f;
+    fixture_shader sh[] = {{"layers", SHADER_LAYERS}, {"mymatte", SHADER_MYMATTE}};
+    assert_true(fixture_open(&f, TAPE_RIB, sh, 2, NULL, 0));
+    int W = f.js->world.camera.xres, H = f.js->world.camera.yres;
+    size_t npx = (size_t)W * (size_t)H;
+    const run runs[] = {{8, 1, 0}, {13, 3, 40 * 1024}, {40, 2, 4 * 1024}, {5, 2, 2048}};
+    float *ref_rgba = malloc(sizeof(float) * 4 * npx), *ref_z = malloc(sizeof(float) * npx);
+    float *rgba = malloc(sizeof(float) * 4 * npx), *z = malloc(sizeof(float) * npx);
+    assert_true(fixture_render(&f, runs[0].tile, runs[0].threads, runs[0].cache, ref_rgba, ref_z));
+    int hits = 0;
+    for (size_t i = 0; i < npx; i++) hits += isfinite(ref_z[i]) != 0;
+    assert_true(hits > (int)npx / 4);
+    for (size_t r = 1; r < sizeof runs / sizeof runs[0]; r++) {
+        assert_true(fixture_render(&f, runs[r].tile, runs[r].threads, runs[r].cache, rgba, z));
+        assert_memory_equal(rgba, ref_rgba, sizeof(float) * 4 * npx);
+        assert_memory_equal(z, ref_z, sizeof(float) * npx);
+    }
+    trace_stats st = tile_stats(&f);
+    printf("tape pruning: %ld of %ld box runs took a tape (%ld plans made)\n", st.tape_runs,
+           st.boxes, st.tape_plans);
+    assert_true(st.tape_runs > 0 && st.tape_plans > 0);
+    f.js->world.options.tape_pruning = false;
+    st = tile_stats(&f);
+    assert_int_equal(st.tape_runs, 0);
+    free(ref_rgba); free(ref_z); free(rgba); free(z);
+    fixture_close(&f);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_pixels_identical_across_tilings_threads_caches),
+        cmocka_unit_test(test_tape_pruning_same_pixels),
         cmocka_unit_test(test_small_cache_evicts_and_respects_budget),
         cmocka_unit_test(test_lazy_children_change_no_pixel),
     };
