@@ -6,7 +6,7 @@
 #   bench/pattern_bench.sh [BIN_DIR] [SHADER ... | all]
 #       defaults: build/bin; bricks bricks_filtered slate_roof tiles_hex
 #       tiles_pillow pnoise_tiles uv_quilt fwp_checks; "all": the whole
-#       corpus (53 shaders; not the four tex_* ones, whose maps the test
+#       corpus (55 shaders; not the four tex_* ones, whose maps the test
 #       suite writes)
 #
 # Three scenes (PATTERN_BENCH_SCENES, default "sphere wall mesh"): test_corpus_render's

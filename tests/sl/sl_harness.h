@@ -45,6 +45,44 @@ static inline sl_program *h_compile_named(const char *name, const char *text, ch
 
 static inline sl_program *h_compile(const char *text) { return h_compile_named("t.sl", text, NULL); }
 
+/* One shader's test set-up: the program compiled from text, an instance
+ * with its defaults, a VM and an affine context of the default capacity
+ * (h_session_close frees them) */
+typedef struct h_session {
+    sl_program *p;
+    sl_instance *inst;
+    sl_vm *vm;
+    aa_context ctx;
+} h_session;
+
+static inline void h_session_open(h_session *h, const char *text)
+{
+    h->p = h_compile(text);
+    assert_non_null(h->p);
+    h->inst = sl_instance_new(h->p);
+    h->vm = sl_vm_new(NULL);
+    aa_context_init(&h->ctx, AA_DEFAULT_CAPACITY);
+}
+
+static inline void h_session_close(h_session *h)
+{
+    sl_vm_destroy(&h->vm);
+    sl_instance_destroy(&h->inst);
+    sl_program_destroy(&h->p);
+}
+
+/* The first instruction of opcode op at or after pc `from`, or -1 (the
+ * tests that read the code include sl/bytecode.h before the harness) */
+#ifdef SL_BYTECODE_H
+static inline int h_find_op(const sl_program *p, int op, int from)
+{
+    for (int pc = from; pc < p->ncode; pc++)
+        if (p->code[pc].op == op)
+            return pc;
+    return -1;
+}
+#endif
+
 /* Compiles scenes/shaders/<name>.sl from disk. */
 static inline sl_program *h_compile_library(const char *name)
 {

@@ -323,27 +323,19 @@ static void test_library_and_corpus(void **state)
     assert_true(g_checked >= 3);
 }
 
-static int find_op(const sl_program *p, int op, int from)
-{
-    for (int pc = from; pc < p->ncode; pc++)
-        if (p->code[pc].op == op)
-            return pc;
-    return -1;
-}
-
 static void test_plan(void **state)
 {
     (void)state;
     sl_program *p = h_compile(TERRAIN);
     assert_non_null(p);
     assert_non_null(p->box_plan);
-    int cn = find_op(p, SL_OP_CALCNORMAL, 0), inv = find_op(p, SL_OP_INVSQRT, 0);
-    int du = find_op(p, SL_OP_DU, 0);
+    int cn = h_find_op(p, SL_OP_CALCNORMAL, 0), inv = h_find_op(p, SL_OP_INVSQRT, 0);
+    int du = h_find_op(p, SL_OP_DU, 0);
     assert_true(cn >= 0 && inv >= 0 && du >= 0);
     assert_int_equal(p->box_plan[cn], SL_BOX_DEAD);       /* only N reads it */
     assert_int_equal(p->box_plan[inv], SL_BOX_VALUE);     /* normalize(N) */
     /* ss = s * 2, whose derivative Du reads */
-    int mul = find_op(p, SL_OP_MUL, 0);
+    int mul = h_find_op(p, SL_OP_MUL, 0);
     assert_true(mul >= 0 && mul < du);
     assert_int_equal(p->box_plan[mul], SL_BOX_RUN);
     /* what its box runs read of the globals: s and t with their
@@ -376,11 +368,11 @@ static void test_plan(void **state)
      * the loop s * i keeps its derivative (Du reads it), the sum h its
      * value alone; calculatenormal is left out */
     assert_non_null(p->box_plan);
-    cn = find_op(p, SL_OP_CALCNORMAL, 0);
-    du = find_op(p, SL_OP_DU, 0);
-    int lt = find_op(p, SL_OP_LOOP_TEST, 0);
-    mul = find_op(p, SL_OP_MUL, lt);
-    int add = find_op(p, SL_OP_ADD, du);
+    cn = h_find_op(p, SL_OP_CALCNORMAL, 0);
+    du = h_find_op(p, SL_OP_DU, 0);
+    int lt = h_find_op(p, SL_OP_LOOP_TEST, 0);
+    mul = h_find_op(p, SL_OP_MUL, lt);
+    int add = h_find_op(p, SL_OP_ADD, du);
     assert_true(cn >= 0 && du >= 0 && lt >= 0 && mul > lt && mul < du && add > du);
     assert_int_equal(p->box_plan[cn], SL_BOX_DEAD);
     assert_int_equal(p->box_plan[mul], SL_BOX_RUN);
@@ -397,8 +389,8 @@ static void test_plan(void **state)
                   " P += (y + w) * normalize(N); N = calculatenormal(P); }");
     assert_non_null(p);
     assert_non_null(p->box_plan);
-    lt = find_op(p, SL_OP_LOOP_TEST, 0);
-    mul = find_op(p, SL_OP_MUL, lt);
+    lt = h_find_op(p, SL_OP_LOOP_TEST, 0);
+    mul = h_find_op(p, SL_OP_MUL, lt);
     assert_true(lt >= 0 && mul > lt);
     assert_int_equal(p->box_plan[mul], SL_BOX_VALUE);         /* x = s * t */
     sl_program_destroy(&p);
@@ -484,7 +476,7 @@ static void test_interval_and_slope_runs(void **state)
     sl_program *t = h_compile(TERRAIN);
     assert_non_null(t);
     assert_non_null(t->slope_plan);
-    int cn = find_op(t, SL_OP_CALCNORMAL, 0);
+    int cn = h_find_op(t, SL_OP_CALCNORMAL, 0);
     assert_true(cn >= 0);
     assert_int_equal(t->slope_plan[cn], SL_BOX_DEAD);          /* only N reads it */
     assert_int_equal(interval_differing(t, "terrain", false), 0);
@@ -509,7 +501,7 @@ static void test_lookups(void **state)
     assert_non_null(p);
     assert_non_null(p->box_plan);
     int n = 0;
-    for (int pc = find_op(p, SL_OP_TEXTURE, 0); pc >= 0; pc = find_op(p, SL_OP_TEXTURE, pc + 1)) {
+    for (int pc = h_find_op(p, SL_OP_TEXTURE, 0); pc >= 0; pc = h_find_op(p, SL_OP_TEXTURE, pc + 1)) {
         assert_int_equal(p->box_plan[pc], SL_BOX_VALUE);
         n++;
     }

@@ -83,12 +83,11 @@ typedef struct tally {
 static tally check_children(const char *src)
 {
     tally t = {0, 0, 0, 0};
-    sl_program *p = h_compile(src);
-    assert_non_null(p);
-    sl_instance *inst = sl_instance_new(p);
-    sl_vm *vm = sl_vm_new(NULL);
-    aa_context ctx;
-    aa_context_init(&ctx, AA_DEFAULT_CAPACITY);
+    h_session h;
+    h_session_open(&h, src);
+    const sl_program *p = h.p;
+    const sl_instance *inst = h.inst;
+    sl_vm *vm = h.vm;
     unsigned long long seed = 0x7a9eull;
     for (int si = 0; si < 2; si++) {
         h_surface s = si == 0 ? H_PLANE : H_SPHERE;
@@ -97,7 +96,7 @@ static tally check_children(const char *src)
             h_box(&seed, k, box);
             aa_form P[3];
             uint32_t tape;
-            if (run_box(vm, inst, &ctx, s, box, NULL, 0, P, &tape) != SL_OK)
+            if (run_box(vm, inst, &h.ctx, s, box, NULL, 0, P, &tape) != SL_OK)
                 continue;
             t.parents++;
             if (tape == 0)
@@ -122,7 +121,7 @@ static tally check_children(const char *src)
             for (int j = 0; j < 6; j++) {
                 aa_form Q[3];
                 uint32_t kt;
-                if (run_box(vm, inst, &ctx, s, kids[j], plan, tape, Q, &kt) != SL_OK)
+                if (run_box(vm, inst, &h.ctx, s, kids[j], plan, tape, Q, &kt) != SL_OK)
                     continue;
                 t.children++;
                 assert_int_equal(kt & tape, tape);      /* the parent's decisions kept */
@@ -136,9 +135,7 @@ static tally check_children(const char *src)
             free(plan);
         }
     }
-    sl_vm_destroy(&vm);
-    sl_instance_destroy(&inst);
-    sl_program_destroy(&p);
+    h_session_close(&h);
     fprintf(stderr, "%d parents, %d decided, %d children, %d samples outside\n", t.parents,
             t.decided, t.children, t.bad);
     return t;
@@ -155,14 +152,6 @@ static const char MESA[] =
     "  N = calculatenormal(P);\n"
     "}\n";
 
-static int find_op(const sl_program *p, int op, int from)
-{
-    for (int pc = from; pc < p->ncode; pc++)
-        if (p->code[pc].op == op)
-            return pc;
-    return -1;
-}
-
 static int site_index(const sl_program *p, int pc)
 {
     for (int i = 0; i < p->ntape_sites; i++)
@@ -176,19 +165,19 @@ static void test_sites(void **state)
     (void)state;
     sl_program *p = h_compile(MESA);
     assert_non_null(p);
-    int mx = find_op(p, SL_OP_MAX, 0), mn = find_op(p, SL_OP_MIN, 0);
+    int mx = h_find_op(p, SL_OP_MAX, 0), mn = h_find_op(p, SL_OP_MIN, 0);
     assert_true(mx >= 0 && mn > mx);
     int smx = site_index(p, mx), smn = site_index(p, mn);
     assert_true(smx >= 0 && smn >= 0);
     /* normalize(N)'s clamps to [-1, 1]: nothing dies either way */
-    for (int pc = find_op(p, SL_OP_CLAMP, 0); pc >= 0; pc = find_op(p, SL_OP_CLAMP, pc + 1))
+    for (int pc = h_find_op(p, SL_OP_CLAMP, 0); pc >= 0; pc = h_find_op(p, SL_OP_CLAMP, pc + 1))
         assert_int_equal(site_index(p, pc), -1);
     /* the max decided for lo: the fBm's noises are dead, P's sum is not */
     uint8_t *plan = sl_program_tape_plan(p, 2u << (SL_TAPE_BITS * smx));
     assert_non_null(plan);
     assert_int_equal(plan[mx], SL_BOX_TAKE_C);
     int noises = 0;
-    for (int pc = find_op(p, SL_OP_NOISE, 0); pc >= 0; pc = find_op(p, SL_OP_NOISE, pc + 1)) {
+    for (int pc = h_find_op(p, SL_OP_NOISE, 0); pc >= 0; pc = h_find_op(p, SL_OP_NOISE, pc + 1)) {
         assert_int_equal(plan[pc], SL_BOX_DEAD);
         noises++;
     }
@@ -265,27 +254,21 @@ static void test_loops(void **state)
         "  P += 0.05 * h * normalize(N);\n"
         "  N = calculatenormal(P);\n"
         "}\n";
-    sl_program *p = h_compile(LOOP);
-    assert_non_null(p);
-    int mx = find_op(p, SL_OP_MAX, 0);
-    int site = site_index(p, mx);
+    h_session h;
+    h_session_open(&h, LOOP);
+    int mx = h_find_op(h.p, SL_OP_MAX, 0);
+    int site = site_index(h.p, mx);
     assert_true(site >= 0);
-    sl_instance *inst = sl_instance_new(p);
-    sl_vm *vm = sl_vm_new(NULL);
-    aa_context ctx;
-    aa_context_init(&ctx, AA_DEFAULT_CAPACITY);
     unsigned long long seed = 0x100bull;
     for (int k = 0; k < 25; k++) {
         double box[4];
         h_box(&seed, k, box);
         aa_form P[3];
         uint32_t tape;
-        assert_int_equal(run_box(vm, inst, &ctx, H_PLANE, box, NULL, 0, P, &tape), SL_OK);
+        assert_int_equal(run_box(h.vm, h.inst, &h.ctx, H_PLANE, box, NULL, 0, P, &tape), SL_OK);
         assert_int_equal(tape >> (SL_TAPE_BITS * site) & 3u, 0);
     }
-    sl_vm_destroy(&vm);
-    sl_instance_destroy(&inst);
-    sl_program_destroy(&p);
+    h_session_close(&h);
     tally t = check_children(LOOP);
     assert_int_equal(t.bad, 0);
 }
