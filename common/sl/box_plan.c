@@ -32,9 +32,10 @@
  *     it is a derivative (Du, Dv, Deriv, area, calculatenormal: its value
  *     is made of its operand's derivative bounds) writing into V;
  *   - of the kinds box runs can shorten (copies, the arithmetic and math
- *     functions, comparisons, texture, noise, calculatenormal) is SL_BOX_DEAD when nothing it writes is in
- *     V or D, SL_BOX_VALUE when nothing is in D (copies, arithmetic,
- *     noise and texture lookups; the VM runs a noise in full);
+ *     functions, comparisons, texture, noise, calculatenormal) is
+ *     SL_BOX_DEAD when nothing it writes is in V or D, SL_BOX_VALUE when
+ *     nothing is in D (all but calculatenormal; the VM runs a noise or a
+ *     comparison in full);
  *   - of any other kind runs as it is, and so reads all its operands'
  *     values (a texture channel, a branch condition, an escape flag stay
  *     exact), merge tables' death and return flags included.
@@ -384,7 +385,8 @@ uint8_t *sl_program_plan(const sl_program *p, bool slopes, const uint8_t *decide
     uint8_t *plan = xcalloc((size_t)p->ncode, 1);
     size_t setbytes = (size_t)l.words * sizeof(uint64_t);
     uint64_t *tmp = xcalloc(2 * (size_t)l.words, sizeof(uint64_t));
-    int *end = xmalloc((size_t)p->ncode * sizeof *end), *table = xmalloc((size_t)p->ncode * sizeof *table);
+    int *end = xmalloc((size_t)p->ncode * sizeof *end);
+    int *table = xmalloc((size_t)p->ncode * sizeof *table);
     region_ends(p, end, table);
     bool any = false, grew = true;
     while (grew) {                  /* to the fixpoint (a loop: several passes) */

@@ -5,24 +5,25 @@
  *
  * A box run bounds P over a node's (u,v) range. Where that run proves an
  * operation's choice over the whole range (min(x, y) with x below y at
- * every point, clamp(x, lo, hi) with x above hi, a smoothstep saturated,
- * a branch's condition decided), the choice holds at every point of every
- * child range too, since a child's range lies inside its node's: the exact
- * function there is the program with that operation replaced by the
- * operand it takes (or its constant, or the branch taken). So the
- * children's runs take it so (the plan codes SL_BOX_TAKE_B .. SL_BOX_ELSE)
- * and leave out what only the other side read (box_plan.c's liveness:
- * mesa_clamp's fBm below a plateau, the dead layer of a saturated mask).
- * The children's boxes still enclose the surface: each is the box run of
- * a program equal to the shader on its range.
+ * every point, clamp(x, lo, hi) with x above hi, a smoothstep saturated, a
+ * mix by exactly 0 or 1, a branch's condition decided), the choice holds
+ * at every point of every child range too, since a child's range lies
+ * inside its node's: the exact function there is the program with that
+ * operation replaced by the operand it takes (or its constant, or the
+ * branch taken). So the children's runs take it so (the plan codes
+ * SL_BOX_TAKE_B .. SL_BOX_ELSE) and leave out what only the other side
+ * read (box_plan.c's liveness: the fBm under a clamp's plateau, the hidden
+ * layer of a saturated mask). The children's boxes still enclose the
+ * surface: each is the box run of a program equal to the shader on its
+ * range.
  *
  * Which operations count: per program at most SL_TAPE_SITES TAPE SITES,
  * the min, max, clamp, step, smoothstep, mix and branches whose decisions
- * would leave the most of the program dead (sl_program_choose_tape_sites: a
- * liveness per candidate and choice, the dead operations weighted by what
- * they cost: sl_program_choose_tape_sites), so a node's proved decisions fit in SL_TAPE_BITS bits a site
- * (its box's tape: common/trace keeps it in the box, 14 bits). A site the
- * run executes several times (a loop) is decided only where every
+ * would leave the most of the program dead (sl_program_choose_tape_sites:
+ * a liveness per candidate and choice, the dead operations weighted by
+ * what they cost), so a node's proved decisions fit in SL_TAPE_BITS bits a
+ * site (its box's tape: common/trace keeps it in the box, 14 bits). A
+ * site the run executes several times (a loop) is decided only where every
  * execution made the same choice (the VM notes them: vm_exec.inc).
  *
  * The tape of a node is a pure function of the node (the decisions its
