@@ -49,8 +49,15 @@ _Static_assert(sizeof ((sl_program *)0)->tape_site / sizeof(int32_t) == SL_TAPE_
 #define TAPE_MAX_CANDIDATES 48
 
 /* A site is kept only where one of its decisions leaves at least this much
- * dead (tape_weight): a few operations, or one noise */
+ * dead (tape_weight): a few operations, or one noise; and at least
+ * 1/TAPE_MIN_SHARE of the weight of what a box run runs: a tape run costs
+ * more a run (the notes, the plan's checks: about a tenth of a box run
+ * where nothing dies), so a site that saves less than that slows the
+ * render (with 1/8, the pattern shaders' steps, whose products by a mask
+ * kill a few operations, are no sites: bricks and slate_roof 1.003x and
+ * 1.006x of their instructions as sites) */
 #define TAPE_MIN_GAIN 4
+#define TAPE_MIN_SHARE 8
 
 /* How many choices op has as a site (0: not a site) */
 static int choices(int op)
@@ -78,6 +85,133 @@ uint8_t sl_tape_code(const sl_insn *in, int dec)
     default:                                  /* BR_BEGIN */
         return dec == 1 ? SL_BOX_THEN : SL_BOX_ELSE;
     }
+}
+
+/*
+ * Constants through arithmetic. A decided step or smoothstep gives an exact
+ * 0 or 1 (the ZERO and ONE codes); a product by it, a sum with it, is
+ * then decided too (0 y = 0, 1 y = y, 0 + y = y, y - 0 = y, for every real
+ * y), so that step(0.5, t) * noise(P) leaves the noise dead where the step
+ * is 0. A sweep in code order keeps the slots whose value is known: an
+ * instruction that runs exactly once in every run ("once": outside every
+ * jump's span and every escape's region, so no loop or branch is around
+ * it) and writes a known 0 or 1 makes its slot known; any other write (a
+ * merge's too) makes it unknown; and a known value is used only by a
+ * reader that runs once as well. Two such instructions run in code order,
+ * and a write between them in time would be between them in the code (a
+ * jump that could bring one in would span one of them), so the reader sees
+ * the value the sweep has. The constant pool's 0s and 1s are known from
+ * the start.
+ */
+enum { K_UNKNOWN = -1 };
+
+/* Per pc: whether it runs exactly once in every run, in code order */
+static bool *runs_once(const sl_program *p)
+{
+    bool *once = xmalloc((size_t)p->ncode * sizeof *once);
+    for (int pc = 0; pc < p->ncode; pc++)
+        once[pc] = true;
+    for (int pc = 0; pc < p->ncode; pc++) {
+        const sl_insn *in = &p->code[pc];
+        const char *k = sl_opcode_operands((sl_opcode)in->op);
+        const uint16_t ops[4] = { in->a, in->b, in->c, in->d };
+        for (int i = 0; i < 4; i++)
+            if (k[i] == 'j') {
+                int t = ops[i];
+                int lo = t > pc ? pc + 1 : t, hi = t > pc ? t - 1 : pc;
+                for (int q = lo; q <= hi && q < p->ncode; q++)
+                    once[q] = false;
+            }
+        if (in->op == SL_OP_ESCAPE)          /* what follows a return or break */
+            for (int q = pc + 1; q < p->ncode; q++)
+                once[q] = false;
+    }
+    return once;
+}
+
+/* Forgets what instruction in writes (its written operands as far as
+ * sl_operand_reach, the slots of its merge tables) */
+static void forget_writes(const sl_program *p, const sl_insn *in, int *known)
+{
+    const char *k = sl_opcode_operands((sl_opcode)in->op);
+    const uint16_t ops[4] = { in->a, in->b, in->c, in->d };
+    int reach = sl_operand_reach((sl_opcode)in->op) + 1;
+    for (int i = 0; i < 4; i++) {
+        if (k[i] == 'z') {
+            for (int q = 0; q < reach && ops[i] + q < p->nslots; q++)
+                known[ops[i] + q] = K_UNKNOWN;
+        } else if (k[i] == 't' && ops[i] < p->ntables) {
+            const uint16_t *t = &p->tables[ops[i]];
+            for (int e = 1; e <= t[0] && ops[i] + e < p->ntables; e++)
+                if (!(t[e] & SL_TABLE_STRING) && (int)(t[e] & SL_TABLE_SLOT) < p->nslots)
+                    known[t[e] & SL_TABLE_SLOT] = K_UNKNOWN;
+        }
+    }
+}
+
+/* decided[] with the products, sums and differences that known 0s and 1s
+ * decide (and those they make known in turn) */
+static void fold_constants(const sl_program *p, const bool *once, uint8_t *decided)
+{
+    int *known = xmalloc((size_t)p->nslots * sizeof *known);
+    for (int s = 0; s < p->nslots; s++) {
+        known[s] = K_UNKNOWN;
+        if (s >= SL_GLOBAL_SLOTS && s >= p->const_base && s < p->const_base + p->nconsts) {
+            double v = p->consts[s - p->const_base];
+            known[s] = v == 0.0 ? 0 : v == 1.0 ? 1 : K_UNKNOWN;
+        }
+    }
+    for (int pc = 0; pc < p->ncode; pc++) {
+        const sl_insn *in = &p->code[pc];
+        int v = K_UNKNOWN, x = K_UNKNOWN, y = K_UNKNOWN;
+        bool arith = in->op == SL_OP_MOV || in->op == SL_OP_MUL || in->op == SL_OP_ADD ||
+                     in->op == SL_OP_SUB;
+        if (arith && once[pc]) {
+            x = known[in->b];
+            y = in->op == SL_OP_MOV ? K_UNKNOWN : known[in->c];
+        }
+        uint8_t d = decided[pc];
+        if (d == SL_BOX_ZERO || d == SL_BOX_ONE) {
+            v = d == SL_BOX_ONE;
+        } else if (!d && in->op == SL_OP_MOV) {
+            v = x;
+        } else if (!d && in->op == SL_OP_MUL) {
+            if (x == 0 || y == 0)
+                d = SL_BOX_ZERO, v = 0;
+            else if (x == 1)
+                d = SL_BOX_TAKE_C, v = y;
+            else if (y == 1)
+                d = SL_BOX_TAKE_B, v = x;
+        } else if (!d && in->op == SL_OP_ADD) {
+            if (x == 0)
+                d = SL_BOX_TAKE_C, v = y;
+            else if (y == 0)
+                d = SL_BOX_TAKE_B, v = x;
+        } else if (!d && in->op == SL_OP_SUB) {
+            if (y == 0)
+                d = SL_BOX_TAKE_B, v = x;
+            else if (x == 1 && y == 1)
+                d = SL_BOX_ZERO, v = 0;
+        }
+        decided[pc] = d;
+        forget_writes(p, in, known);
+        if (v != K_UNKNOWN && once[pc] && in->a >= SL_GLOBAL_SLOTS && in->a < p->nslots &&
+            (arith || d == SL_BOX_ZERO || d == SL_BOX_ONE))
+            known[in->a] = v;
+    }
+    free(known);
+}
+
+/* The plan of decisions (sl_program_plan with the constants they make
+ * folded through arithmetic); decided[] is left as it was */
+static uint8_t *plan_of(const sl_program *p, const bool *once, const uint8_t *decided)
+{
+    uint8_t *d = xmalloc((size_t)p->ncode);
+    memcpy(d, decided, (size_t)p->ncode);
+    fold_constants(p, once, d);
+    uint8_t *plan = sl_program_plan(p, false, d, NULL, NULL);
+    free(d);
+    return plan;
 }
 
 /* What leaving an operation out saves, roughly in units of an affine
@@ -115,11 +249,17 @@ void sl_program_choose_tape_sites(sl_program *p)
     if (p->kind != SL_SHADER_DISPLACEMENT || p->ncode <= 0 || p->ncode > TAPE_MAX_CODE)
         return;
     uint8_t *decided = xcalloc((size_t)p->ncode, 1);
-    uint8_t *base = sl_program_plan(p, false, decided, NULL, NULL);
+    bool *once = runs_once(p);
+    uint8_t *base = plan_of(p, once, decided);
     if (!base) {                         /* the analysis does not apply */
+        free(once);
         free(decided);
         return;
     }
+    long live = 0;                       /* what a box run runs, weighed */
+    for (int pc = 0; pc < p->ncode; pc++)
+        if (base[pc] != SL_BOX_DEAD)
+            live += tape_weight(&p->code[pc]);
     long best_gain[SL_TAPE_SITES];
     int best_pc[SL_TAPE_SITES], nbest = 0, candidates = 0;
     for (int pc = 0; pc < p->ncode && candidates < TAPE_MAX_CANDIDATES; pc++) {
@@ -131,7 +271,7 @@ void sl_program_choose_tape_sites(sl_program *p)
         long g = 0;
         for (int dec = 1; dec <= n; dec++) {
             decided[pc] = sl_tape_code(in, dec);
-            uint8_t *plan = sl_program_plan(p, false, decided, NULL, NULL);
+            uint8_t *plan = plan_of(p, once, decided);
             if (plan) {
                 long gd = gain(p, base, plan);
                 g = gd > g ? gd : g;
@@ -139,7 +279,7 @@ void sl_program_choose_tape_sites(sl_program *p)
             }
         }
         decided[pc] = 0;
-        if (g < TAPE_MIN_GAIN)
+        if (g < TAPE_MIN_GAIN || g * TAPE_MIN_SHARE < live)
             continue;
         /* keep the SL_TAPE_SITES largest gains (the earlier site on a tie) */
         int at = nbest;
@@ -159,6 +299,7 @@ void sl_program_choose_tape_sites(sl_program *p)
     }
     free(base);
     free(decided);
+    free(once);
     if (nbest == 0)
         return;
     p->tape_site_of = xmalloc((size_t)p->ncode);
@@ -187,7 +328,12 @@ uint8_t *sl_program_tape_plan(const sl_program *p, uint32_t tape)
         decided[p->tape_site[i]] = sl_tape_code(in, dec);
         any = any || decided[p->tape_site[i]] != 0;
     }
-    uint8_t *plan = any ? sl_program_plan(p, false, decided, NULL, NULL) : NULL;
+    uint8_t *plan = NULL;
+    if (any) {
+        bool *once = runs_once(p);
+        plan = plan_of(p, once, decided);
+        free(once);
+    }
     free(decided);
     return plan;
 }

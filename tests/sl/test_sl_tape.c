@@ -5,7 +5,10 @@
  *
  *   sites      a clamped fBm's max and min are tape sites, normalize's
  *              clamps (nothing dead either way) are not; deciding the max
- *              for its lower bound leaves every noise of the fBm dead
+ *              for its lower bound leaves every noise of the fBm dead; a
+ *              step decided 0 makes its product with a noise 0 and the
+ *              noise dead (constants through arithmetic), decided 1 the
+ *              product the noise
  *   children   for shaders with min, max, clamp, step, smoothstep masks
  *              and branches on noise, plain and derivative-carrying, on
  *              the plane and the sphere: a parent box's recorded run
@@ -186,6 +189,35 @@ static void test_sites(void **state)
     free(plan);
     /* undecided: no plan */
     assert_null(sl_program_tape_plan(p, 0));
+    sl_program_destroy(&p);
+
+    /* constants through arithmetic: a step decided 0 makes its product
+     * with a noise 0, and the noise dead; decided 1, the product is the
+     * noise */
+    p = h_compile("displacement t() { point q = transform(\"shader\", P) * 3;\n"
+                  "  float h = 0.2 * noise(q) + step(0.5, t) * noise(q * 9);\n"
+                  "  P += 0.05 * h * normalize(N); N = calculatenormal(P); }");
+    assert_non_null(p);
+    int st = h_find_op(p, SL_OP_STEP, 0), sst = site_index(p, st);
+    int n1 = h_find_op(p, SL_OP_NOISE, 0), n2 = h_find_op(p, SL_OP_NOISE, n1 + 1);
+    assert_true(st >= 0 && sst >= 0 && n1 >= 0 && n2 > n1);
+    int mul = h_find_op(p, SL_OP_MUL, n2);                  /* step * noise */
+    int add = h_find_op(p, SL_OP_ADD, mul);                 /* 0.2 * noise + that */
+    assert_true(mul > n2 && add > mul);
+    plan = sl_program_tape_plan(p, 1u << (SL_TAPE_BITS * sst));       /* step: 0 */
+    assert_non_null(plan);
+    assert_int_equal(plan[add], SL_BOX_TAKE_B);             /* the sum: its first term */
+    assert_int_equal(plan[mul], SL_BOX_DEAD);               /* the product 0, unread */
+    assert_int_equal(plan[n2], SL_BOX_DEAD);
+    assert_int_equal(plan[st], SL_BOX_DEAD);
+    assert_int_not_equal(plan[n1], SL_BOX_DEAD);
+    free(plan);
+    plan = sl_program_tape_plan(p, 2u << (SL_TAPE_BITS * sst));       /* step: 1 */
+    assert_non_null(plan);
+    assert_int_equal(plan[mul], SL_BOX_TAKE_C);
+    assert_int_not_equal(plan[n2], SL_BOX_DEAD);
+    assert_int_equal(plan[st], SL_BOX_DEAD);
+    free(plan);
     sl_program_destroy(&p);
 
     /* a program without a choice that kills anything has no site */
