@@ -274,8 +274,8 @@ struct sl_program {
     uint64_t global_slots;          /* bit s: a run may read or write global
                                        slot s (sl_program_global_slots); 0:
                                        not known, every slot */
-    int32_t tape_site[7];           /* the pcs of the tape sites (tape_plan.c;
-                                       SL_TAPE_SITES) */
+    int32_t tape_site[SL_TAPE_SITES]; /* the pcs of the tape sites
+                                       (tape_plan.c) */
     int ntape_sites;
     int8_t *tape_site_of;           /* per instruction, its site or -1; NULL:
                                        no site */

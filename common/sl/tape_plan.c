@@ -39,9 +39,6 @@
 #include <string.h>
 
 _Static_assert(SL_TAPE_SITES * SL_TAPE_BITS <= 14, "a tape fits a box's 14 bits");
-_Static_assert(sizeof ((sl_program *)0)->tape_site / sizeof(int32_t) == SL_TAPE_SITES,
-               "tape_site holds SL_TAPE_SITES pcs");
-
 /* Programs above this many instructions get no sites (their liveness per
  * candidate would cost too much at compile time), and only the first
  * TAPE_MAX_CANDIDATES candidates are weighed. */

@@ -158,7 +158,10 @@ static void test_lazy_children_change_no_pixel(void **state)
  * fields; the children of boxes whose runs decided the mask or the max
  * take those decisions. The pixels are the same for every tiling, thread
  * count and cache budget (a box's tape, like the box, is a function of
- * its cell), and boxes did take tapes */
+ * its cell), and boxes did take tapes. (The pixels alone would not show a
+ * tape that depended on the thread's history: a pruned run mostly gives
+ * the whole program's box bits; test_corpus_containment makes each taped
+ * box twice and compares them.) */
 static const char *TAPE_RIB =
     "Format 40 30 1\nProjection \"perspective\" \"fov\" [45]\n"
     "PixelSamples 2 2\nPixelFilter \"gaussian\" 2 2\n"
