@@ -440,7 +440,9 @@ static bool newton_uv(const trace_ray *ray, const trace_surface_point *sp,
 
 /*
  * The point of a leaf's cell where the ray meets the surface: Newton's
- * iteration from the cell's centre (newton_uv, each step clamped to the
+ * iteration from the cell's centre, or from the point `start` of the
+ * cell already evaluated (leaf_start; its (u,v) in *uc, *vc on return
+ * as the steps move them) (newton_uv, each step clamped to the
  * cell grown by half its width on each side, within the unit square: the
  * ray's hit may lie just beside the cell whose box it entered). Fills sp
  * at the (u,v) used.
@@ -468,7 +470,7 @@ static bool newton_uv(const trace_ray *ray, const trace_surface_point *sp,
 #define LEAF_NEWTON_STEPS 4
 #define LEAF_SETTLED 0x1p-7             /* of the widened cell: 1/64 of the cell */
 static bool leaf_point(walk *w, const double *r, bool partial, double *uc, double *vc,
-                       const trace_surface_point *centre, trace_surface_point *sp,
+                       const trace_surface_point *start, trace_surface_point *sp,
                        bool *settled)
 {
     const trace_object *obj = w->obj;
@@ -479,8 +481,13 @@ static bool leaf_point(walk *w, const double *r, bool partial, double *uc, doubl
     double rw[4] = {fmax(0.0, r[0] - hu), fmin(1.0, r[1] + hu), fmax(0.0, r[2] - hv),
                     fmin(1.0, r[3] + hv)};
     r = rw;
-    if (centre) *sp = *centre;
-    else trace_surface_point_eval(w->th, obj, *uc, *vc, sp);
+    if (start) {
+        *sp = *start;
+        *uc = sp->u;
+        *vc = sp->v;
+    } else {
+        trace_surface_point_eval(w->th, obj, *uc, *vc, sp);
+    }
     double u, v, s[3];
     /* a mesh piece's partial cell: the clamp below keeps a ray beside a
      * shared edge for one of its two polygons, but one beyond an edge of
@@ -526,12 +533,14 @@ static bool leaf_point(walk *w, const double *r, bool partial, double *uc, doubl
     }
 }
 
-/* The hit a leaf stands for, recorded in w->best when nearer. With
- * may_test, a leaf whose point did not settle (leaf_point) records
- * nothing and returns true: the caller tests the cell first. */
+/* The hit a leaf stands for, recorded in w->best when nearer; Newton's
+ * steps start at `start` where given (a point of the cell: leaf_start),
+ * else at the cell's centre. With may_test, a leaf whose point did not
+ * settle (leaf_point) records nothing and returns true: the caller tests
+ * the cell first. */
 static bool leaf_hit(walk *w, const trace_box *box, const double r[4],
                      const child_order *o, trace_leaf_kind kind, vec3 surface_normal,
-                     const trace_surface_point *centre, bool may_test)
+                     const trace_surface_point *start, bool may_test)
 {
     double t0 = o->t0, t1 = o->t1;
     int axis = o->axis;
@@ -542,12 +551,12 @@ static bool leaf_hit(walk *w, const trace_box *box, const double r[4],
     bool has_point = false;
     bool settled;
     if (cover == GEOM_PARTIAL && kind != TRACE_LEAF_WALL) {
-        if (!leaf_point(w, r, true, &uc, &vc, centre, &sp, &settled)) return false;
+        if (!leaf_point(w, r, true, &uc, &vc, start, &sp, &settled)) return false;
         has_point = true;
     } else if (!geom_uv_inside(&obj->surf, uc, vc)) {
         return false;
     } else if (kind == TRACE_LEAF_SMALL) {
-        leaf_point(w, r, false, &uc, &vc, centre, &sp, &settled);
+        leaf_point(w, r, false, &uc, &vc, start, &sp, &settled);
         if (may_test && !settled) return true;
         has_point = true;
     }
@@ -1178,14 +1187,78 @@ static bool ray_grazes(const walk *w, vec3 n, double cos_max)
     return !(nd * nd > cos_max * cos_max * nn * dd);
 }
 
-/* Whether the ray grazes the surface at the cell's centre (its point in
- * *centre): the displaced surface's normal Pu x Pv at TRACE_PROVE_GRAZE.
- * A leaf there may be a near miss at a fold (a silhouette), which finer
- * leaves resolve. */
-static bool grazes(walk *w, const double r[4], trace_surface_point *centre)
+/*
+ * Where a leaf's first point goes (issue 24, session 29). Its box's
+ * linear bound (lin_bound.h) says that over the cell the surface lies
+ * within r of the plane x + U eu + V ev, eu and ev in [-1, 1] the cell's
+ * u and v as aa_input maps them: the affine run fitted that plane over
+ * the whole cell. Where the ray meets it (clamped to the cell) is about
+ * where a Newton step from the centre would go, so the steps started
+ * there (leaf_point) settle one evaluation sooner: the corpus's fbm_du on
+ * the wall 2.0 -> 1.06 dual evaluations a leaf. Only where the steps
+ * start changes; the leaf, its box and the tests are the same, and the
+ * point is a pure function of the box and its codes (cached or not).
+ *
+ * The centre instead where the box has no bound, the cell is the
+ * polygon's only in part (a partial cell's one step comes from its
+ * centre: leaf_point), the ray runs within LEAF_START_GRAZE of along the
+ * plane, the world's option leaf_start is off, or the surface bends over
+ * the cell (its bend above LEAF_START_BEND, or unknown): at a crease
+ * (dented's abs()) a start on the plane often settles at once where the
+ * steps from the centre would not, and the cell then goes without the
+ * test visit gives a leaf that does not settle. Against the peer
+ * dented's 1/16-pixel reference: 145 pixels off with the centre, 201
+ * with starts at every bend, 143 up to bend 0.1, 149 up to 0.2.
+ */
+#define LEAF_START_GRAZE 0x1p-10        /* |cos| of the ray's angle to the plane's normal */
+#define LEAF_START_BEND 0.1
+static void leaf_start_uv(const walk *w, const trace_box *kid, const trace_qlin *q,
+                          const double c[4], geom_cover cover, double *u, double *v)
 {
-    trace_surface_point_eval(w->th, w->obj, 0.5 * (r[0] + r[1]), 0.5 * (r[2] + r[3]), centre);
-    return ray_grazes(w, v3_cross(centre->Pu, centre->Pv), TRACE_PROVE_GRAZE);
+    *u = 0.5 * (c[0] + c[1]);
+    *v = 0.5 * (c[2] + c[3]);
+    if (!(kid->flags & TRACE_BOX_LIN) || !q || cover != GEOM_INSIDE ||
+        !(kid->bend > 0.0f && kid->bend <= LEAF_START_BEND) || !w->th->world->options.leaf_start)
+        return;
+    trace_dlin d;
+    trace_box_lin(q, kid, &d);
+    vec3 x = v3(d.x[0], d.x[1], d.x[2]), U = v3(d.u[0], d.u[1], d.u[2]),
+         V = v3(d.v[0], d.v[1], d.v[2]), n = v3_cross(U, V);
+    const trace_ray *ray = &w->ray;
+    double nd = v3_dot(n, ray->d), nn = v3_dot(n, n);
+    if (!(nd * nd > LEAF_START_GRAZE * LEAF_START_GRAZE * nn * v3_dot(ray->d, ray->d)))
+        return;                          /* along the plane, or no plane (NaN) */
+    /* x + U eu + V ev = o + t d: t from the normal, then eu, ev */
+    double t = v3_dot(n, v3_sub(x, ray->o)) / nd;
+    vec3 p = v3_sub(trace_ray_at(ray, t), x);
+    double eu = v3_dot(v3_cross(p, V), n) / nn, ev = v3_dot(v3_cross(U, p), n) / nn;
+    if (!(eu == eu) || !(ev == ev)) return;
+    eu = fmin(fmax(eu, -1.0), 1.0);
+    ev = fmin(fmax(ev, -1.0), 1.0);
+    double mu = aa_input_mid(c[0], c[1]), mv = aa_input_mid(c[2], c[3]);
+    *u = fmin(fmax(mu + eu * (mu - c[0] > c[1] - mu ? mu - c[0] : c[1] - mu), c[0]), c[1]);
+    *v = fmin(fmax(mv + ev * (mv - c[2] > c[3] - mv ? mv - c[2] : c[3] - mv), c[2]), c[3]);
+    w->th->stats.leaf_starts++;
+}
+
+/* The leaf's first point (leaf_start_uv) evaluated, in *sp; `i` the
+ * child's number in its brood, whose codes kq holds where the brood is
+ * not stored */
+static void leaf_start(walk *w, const trace_box *kid, trace_brood_id brood, const trace_qlin kq[4],
+                       int i, const double c[4], geom_cover cover, trace_surface_point *sp)
+{
+    const trace_qlin *q = brood >= 0 ? trace_boxcache_qlin(w->th->cache, brood, i) : &kq[i];
+    double u, v;
+    leaf_start_uv(w, kid, q, c, cover, &u, &v);
+    trace_surface_point_eval(w->th, w->obj, u, v, sp);
+}
+
+/* Whether the ray grazes the surface at the point sp: the displaced
+ * surface's normal Pu x Pv at TRACE_PROVE_GRAZE. A leaf there may be a
+ * near miss at a fold (a silhouette), which finer leaves resolve. */
+static bool grazes(const walk *w, const trace_surface_point *sp)
+{
+    return ray_grazes(w, v3_cross(sp->Pu, sp->Pv), TRACE_PROVE_GRAZE);
 }
 
 /* The hit test on the cell c (prove.h), a proven hit recorded */
@@ -1330,17 +1403,20 @@ static void visit(walk *w, const trace_box *node, const trace_qlin *node_q, cons
                          size <= w->prove_below;
         bool at_leaf = provable && size <= tol && d < TRACE_MAX_DEPTH;
         if ((try_proof || at_leaf) && !clear_of_shared_edges(w, c)) try_proof = at_leaf = false;
+        /* the leaf's first point (leaf_start), where the graze test looks
+         * and Newton's steps start */
+        trace_surface_point start;
+        bool started = false, grazing = false;
         /* a whole cell of a leaf's size where the ray does not graze the
          * surface: its test would only place the leaf's point, which the
          * leaf's own Newton steps place where they settle; tested (below)
          * only where they do not */
-        trace_surface_point centre;
-        bool centred = false, grazing = false;
         if (try_proof && at_leaf && !fine && !w->obj->prove_any_bend &&
             order[k].cover == GEOM_INSIDE) {
-            centred = true;
-            grazing = grazes(w, c, &centre);
-            if (!grazing && !leaf_hit(w, kid, c, &order[k], TRACE_LEAF_SMALL, wall_n, &centre, true))
+            started = true;
+            leaf_start(w, kid, brood, kq, order[k].i, c, order[k].cover, &start);
+            grazing = grazes(w, &start);
+            if (!grazing && !leaf_hit(w, kid, c, &order[k], TRACE_LEAF_SMALL, wall_n, &start, true))
                 continue;
         }
         if (try_proof) {
@@ -1355,8 +1431,11 @@ static void visit(walk *w, const trace_box *node, const trace_qlin *node_q, cons
         kid_fine = kid_fine || fine;
         /* a leaf where the ray grazes the surface: finer leaves */
         if (!kid_fine && at_leaf) {
-            if (!centred) grazing = grazes(w, c, &centre);
-            centred = true;
+            if (!started) {
+                leaf_start(w, kid, brood, kq, order[k].i, c, order[k].cover, &start);
+                grazing = grazes(w, &start);
+            }
+            started = true;
             kid_fine = grazing && trace_prove_cell_has_slopes(w->th, w->obj, c);
         }
         if (d >= TRACE_MAX_DEPTH) {
@@ -1368,14 +1447,18 @@ static void visit(walk *w, const trace_box *node, const trace_qlin *node_q, cons
              * it was not above: a proven miss drops it, a proven hit is
              * exact, a fold takes finer leaves */
             bool may_test = at_leaf && !try_proof && !kid_fine;
-            if (!leaf_hit(w, kid, c, &order[k], TRACE_LEAF_SMALL, wall_n,
-                          centred ? &centre : NULL, may_test))
+            if (!started)
+                leaf_start(w, kid, brood, kq, order[k].i, c, order[k].cover, &start);
+            started = true;
+            if (!leaf_hit(w, kid, c, &order[k], TRACE_LEAF_SMALL, wall_n, &start, may_test))
                 continue;
             trace_proof_detail why;
             w->th->stats.leaf_tests++;
             if (test_cell(w, c, tol, &why) != TRACE_PROOF_UNKNOWN) continue;
             if (!why.fold) {
-                leaf_hit(w, kid, c, &order[k], TRACE_LEAF_SMALL, wall_n, NULL, false);
+                /* the leaf as its steps left it (from the same start:
+                 * the same point, no evaluation of the start again) */
+                leaf_hit(w, kid, c, &order[k], TRACE_LEAF_SMALL, wall_n, &start, false);
                 continue;
             }
             kid_fine = true;

@@ -6,7 +6,8 @@
 #define STATS_FIELDS(X) \
     X(primary_rays) X(shadow_rays) X(boxes) X(evals_affine) X(evals_interval) \
     X(evals_dual) X(evals_float) X(evals_slopes) X(uniform_hits) X(normal_hits) X(tape_runs) X(tape_plans) X(leaves) X(wall_leaves) \
-    X(depth_cap_leaves) X(proofs) X(proven_hits) X(proven_misses) X(leaf_tests) X(exact_cells) X(offset_cells) X(plane_cells) X(plane_hits) X(plane_misses) X(planar_cells) X(views_made) X(views_asked) \
+    X(depth_cap_leaves) X(proofs) X(proven_hits) X(proven_misses) X(leaf_tests) X(leaf_starts) \
+    X(exact_cells) X(offset_cells) X(plane_cells) X(plane_hits) X(plane_misses) X(planar_cells) X(views_made) X(views_asked) \
     X(lazy_roots) X(lazy_bounds) X(lazy_met) X(lazy_evals) \
     X(rejected_leaves) X(nodes) X(limited_rays) X(samplings) X(sampled_boxes) X(empty_boxes) \
     X(cache_hits) X(cache_misses) X(cache_evictions)

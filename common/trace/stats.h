@@ -29,6 +29,9 @@ typedef struct trace_stats {
                                       placed at the root */
     long proven_misses;            /* cells proven free of any hit */
     long leaf_tests;               /* of the proofs, on leaves whose point did not settle */
+    long leaf_starts;              /* leaves whose Newton steps started on their
+                                      box's linear bound, not at the cell's
+                                      centre (intersect.c, leaf_start) */
     long exact_cells;              /* undisplaced cells intersected exactly
                                       (intersect.c, exact_cell) */
     long offset_cells;             /* of them, cells of the base moved by a

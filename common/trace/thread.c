@@ -28,6 +28,7 @@ void trace_options_default(trace_options *opt)
     opt->lazy_roots = true;
     opt->lazy_children = true;
     opt->tape_pruning = true;
+    opt->leaf_start = true;
     opt->cancel = NULL;
 }
 

@@ -272,6 +272,11 @@ typedef struct trace_options {
                                       their node's run proved (displace.c,
                                       common/sl/tape_plan.c); off: every box
                                       run takes the whole program */
+    bool leaf_start;               /* a leaf's Newton steps start where the
+                                      ray meets its box's linear bound
+                                      (intersect.c, leaf_start); off: at
+                                      the cell's centre (for tests and
+                                      benchmarks) */
     bool prove_hits;               /* try hit proofs on small cells
                                       (trace/prove.h); off: leaves only */
     const atomic_int *cancel;      /* the program's stop flag (a signal), or
