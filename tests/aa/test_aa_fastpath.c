@@ -17,6 +17,8 @@
  *   aa_exact_difference        when it answers, aa_range(aa_sub(x, y)) is
  *                              [d, d]; it answers for most pairs of constants
  *   aa_is_exact_const          aa_range(x) is [x0, x0]
+ *   aa_smoothstep(e0, e1, x)   of three points = their interval smoothstep
+ *                              (ia_smoothstep on a private error)
  *   aa_clamp(x, lo, hi)        = aa_min(aa_max(x, lo), hi) (bounded) with the same
  *                              symbols taken, also with z aliasing x: x
  *                              between lo and hi (its copy), below, above,
@@ -333,12 +335,57 @@ static void test_clamp_is_max_then_min(void **state)
     assert_int_equal(bad, 0);
 }
 
+/* smoothstep of three points: what the interval path gives (aa_smoothstep
+ * of constants is their interval smoothstep on a private error), on flat
+ * sides (0 or 1: the fast path), across the ramp, at its ends, with
+ * e1 <= e0 and with flags; points that carry symbols with zero
+ * coefficients are exactly 0 or 1 on a flat side */
+static void test_smoothstep_of_points(void **state)
+{
+    (void)state;
+    long bad = 0, flat = 0, ramp = 0;
+    for (int t = 0; t < CASES; t++) {
+        double a = rng_value(), b = rng_int(8) == 0 ? rng_value() : a + fabs(rng_value()),
+               x = rng_int(4) == 0 ? (rng_int(2) ? a : b) : rng_value();
+        if (rng_int(3) == 0) x = a + (b - a) * (2.0 * rng_unit() - 0.5);
+        aa_form e0, e1, xf, z, ref;
+        aa_const(&e0, a);
+        aa_const(&e1, b);
+        aa_const(&xf, x);
+        if (rng_int(5) == 0) xf.flags |= AA_DISCONTINUOUS;
+        if (rng_int(7) == 0) e1.flags |= AA_DISCONTINUOUS;
+        aa_context ctx, none;
+        aa_context_init(&ctx, AA_DEFAULT_CAPACITY);
+        aa_context_init(&none, 0);
+        aa_smoothstep(&ctx, &z, &e0, &e1, &xf);
+        ia_interval r = ia_smoothstep(aa_range(&e0), aa_range(&e1), aa_range(&xf));
+        aa_set_interval(&none, &ref, r, r.flags);
+        if (r.lo == r.hi && (r.lo == 0.0 || r.lo == 1.0)) flat++;
+        else ramp++;
+        if (!same_form(&z, &ref) || ctx.used != 0)
+            report("aa_smoothstep of points", ++bad, &z, &ref);
+        /* the same points with zero-coefficient symbols */
+        if (a < b && (x < a || x >= b) && isfinite(x)) {
+            xf.n = 2;
+            xf.c[0] = xf.c[1] = 0.0;
+            aa_smoothstep(&ctx, &z, &e0, &e1, &xf);
+            if (!(z.x0 == (x < a ? 0.0 : 1.0) && z.err == 0.0 && aa_is_point(&z)))
+                report("aa_smoothstep of points with symbols", ++bad, &z, &ref);
+        }
+    }
+    printf("aa_smoothstep of points: %ld flat, %ld on the ramp (or degenerate); %ld differ\n",
+           flat, ramp, bad);
+    assert_true(flat > CASES / 4 && ramp > CASES / 10);
+    assert_int_equal(bad, 0);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_lincomb_shapes_bitwise),
         cmocka_unit_test(test_exact_difference),
         cmocka_unit_test(test_clamp_is_max_then_min),
+        cmocka_unit_test(test_smoothstep_of_points),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
