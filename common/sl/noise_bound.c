@@ -541,14 +541,14 @@ static void point_jet_at(int dim, const double *c, const int *period, uint32_t s
     uint32_t hs[16];
     lattice_at(dim, c, period, seed, f, hs);
     switch (dim) {
-    case 1: point_jet_d(1, f, hs, 2, J); break;
-    case 2: point_jet_d(2, f, hs, 2, J); break;
+    case 1: point_jet_d(1, f, hs, 2, J, NULL); break;
+    case 2: point_jet_d(2, f, hs, 2, J, NULL); break;
 #if NOISE_IV_VECTOR
     case 3: point_jet_3v(f, hs, J); break;
 #else
-    case 3: point_jet_d(3, f, hs, 2, J); break;
+    case 3: point_jet_d(3, f, hs, 2, J, NULL); break;
 #endif
-    default: point_jet_d(4, f, hs, 2, J); break;
+    default: point_jet_d(4, f, hs, 2, J, NULL); break;
     }
 }
 
@@ -559,10 +559,10 @@ static double point_value(int dim, const double f[4], const uint32_t hs[16])
 {
     point_jet J;
     switch (dim) {
-    case 1: point_jet_d(1, f, hs, 0, &J); break;
-    case 2: point_jet_d(2, f, hs, 0, &J); break;
-    case 3: point_jet_d(3, f, hs, 0, &J); break;
-    default: point_jet_d(4, f, hs, 0, &J); break;
+    case 1: point_jet_d(1, f, hs, 0, &J, NULL); break;
+    case 2: point_jet_d(2, f, hs, 0, &J, NULL); break;
+    case 3: point_jet_d(3, f, hs, 0, &J, NULL); break;
+    default: point_jet_d(4, f, hs, 0, &J, NULL); break;
     }
     return J.v;
 }

@@ -261,13 +261,19 @@ jet_weights(int dim, const double f[4], double w0[4], double w1[4], double D[4],
 
 /* The jet to `order` (0: the value; 1: and the gradient; 2: and the
  * Hessian, whose parts j <= k J holds; the parts an order leaves out are
- * not written); always inlined once per dim, so the loops unroll */
+ * not written); always inlined once per dim, so the loops unroll. With
+ * raw not NULL, also raw noise as noise.c's raw_value computes it, bit
+ * for bit (its interpolations a + s (b - a) beside the jet's w0 a + w1 b,
+ * on the same corner values and the same s: issue 24, session 29, the
+ * float gradient's second pass over the corners gone) */
 static inline __attribute__((always_inline)) void
-point_jet_d(int dim, const double f[4], const uint32_t hs[16], int order, point_jet *J)
+point_jet_d(int dim, const double f[4], const uint32_t hs[16], int order, point_jet *J,
+            double *raw)
 {
     double w0[4], w1[4], D[4], DD[4], d[4][2];
     jet_weights(dim, f, w0, w1, D, DD, d);
     point_jet t[16];
+    double rv[16];
     int n = 1 << dim;
     for (int c = 0; c < n; c++) {
         int g[4];
@@ -276,6 +282,8 @@ point_jet_d(int dim, const double f[4], const uint32_t hs[16], int order, point_
         for (int k = 1; k < dim; k++)
             l = l + (double)g[k] * d[k][(c >> k) & 1];
         t[c].v = l;
+        if (raw)
+            rv[c] = l;
         if (order == 0)
             continue;
         /* the corners' Hessians (0) are never read: the step along axis 0
@@ -299,6 +307,8 @@ point_jet_d(int dim, const double f[4], const uint32_t hs[16], int order, point_
         for (int i = 0; i < nk; i++) {
             const point_jet *A = &src[2 * i], *B = &src[2 * i + 1];
             point_jet *R = &dst[i];
+            if (raw)                     /* in place: i < 2i for i > 0 */
+                rv[i] = rv[2 * i] + w1[k] * (rv[2 * i + 1] - rv[2 * i]);
             double dv = B->v - A->v;
             R->v = w0[k] * A->v + w1[k] * B->v;
             if (order == 0)
@@ -325,6 +335,8 @@ point_jet_d(int dim, const double f[4], const uint32_t hs[16], int order, point_
         src = dst;
         dst = x;
     }
+    if (raw)
+        *raw = rv[0];
 }
 
 
