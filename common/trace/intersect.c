@@ -1208,7 +1208,7 @@ static bool ray_grazes(const walk *w, vec3 n, double cos_max)
  * steps from the centre would not, and the cell then goes without the
  * test visit gives a leaf that does not settle. Against the peer
  * dented's 1/16-pixel reference: 145 pixels off with the centre, 201
- * with starts at every bend, 143 up to bend 0.1, 149 up to 0.2.
+ * with starts at every bend, 144 up to bend 0.1, 149 up to 0.2.
  */
 #define LEAF_START_GRAZE 0x1p-10        /* |cos| of the ray's angle to the plane's normal */
 #define LEAF_START_BEND 0.1
