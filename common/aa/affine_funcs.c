@@ -888,6 +888,7 @@ void aa_abs(aa_context *ctx, aa_form *z, const aa_form *x)
         return;
     }
     ia_interval fallback = ia_abs(r);
+    fl |= AA_KINK;                       /* across 0: the crease */
     if (!isfinite(r.lo) || !isfinite(r.hi)) {
         aa_set_interval(ctx, z, fallback, fl);
         return;

@@ -431,7 +431,7 @@ ia_interval ia_abs(ia_interval x)
         return x;
     if (x.hi <= 0)
         return ia_neg(x);
-    return mk(0.0, max2(-x.lo, x.hi), x.flags);
+    return mk(0.0, max2(-x.lo, x.hi), x.flags | AA_KINK);
 }
 
 static double sign_of(double v) { return v > 0 ? 1.0 : (v < 0 ? -1.0 : 0.0); }
@@ -455,16 +455,23 @@ ia_interval ia_sign(ia_interval x)
     return stepped(sign_of(x.lo), sign_of(x.hi), x.flags);
 }
 
+/* AA_KINK where the operands' ranges overlap: the min or max may take
+ * either inside them */
+static unsigned kink_of(ia_interval x, ia_interval y)
+{
+    return x.hi <= y.lo || y.hi <= x.lo ? 0u : (unsigned)AA_KINK;
+}
+
 ia_interval ia_min(ia_interval x, ia_interval y)
 {
     RETURN_IF_EMPTY2(x, y);
-    return mk(min2(x.lo, y.lo), min2(x.hi, y.hi), x.flags | y.flags);
+    return mk(min2(x.lo, y.lo), min2(x.hi, y.hi), x.flags | y.flags | kink_of(x, y));
 }
 
 ia_interval ia_max(ia_interval x, ia_interval y)
 {
     RETURN_IF_EMPTY2(x, y);
-    return mk(max2(x.lo, y.lo), max2(x.hi, y.hi), x.flags | y.flags);
+    return mk(max2(x.lo, y.lo), max2(x.hi, y.hi), x.flags | y.flags | kink_of(x, y));
 }
 
 ia_interval ia_floor(ia_interval x)

@@ -16,7 +16,14 @@
  *                     on a function that bounds the value again (atan, a
  *                     clamp);
  *   AA_UNBOUNDED      the result is (partly) the whole line: division by a
- *                     range containing 0, overflow, a pole.
+ *                     range containing 0, overflow, a pole;
+ *   AA_KINK           the function is continuous but bends sharply inside
+ *                     the operand range: abs across 0, a min or max (and so
+ *                     a clamp) whose operands' ranges overlap. Nothing in
+ *                     the arithmetic reads it; the renderer starts a leaf's
+ *                     Newton steps at its cell's centre there (a crease
+ *                     fools a start on the cell's plane: intersect.c,
+ *                     leaf_start). Like AA_DISCONTINUOUS it stays on.
  *
  * Domain: sqrt, log, pow, asin, acos are evaluated over the part of the
  * operand inside their domain (sqrt of [-1, 4] is [0, 2]); an operand wholly
@@ -33,6 +40,7 @@
 enum {
     AA_DISCONTINUOUS = 1u << 0,
     AA_UNBOUNDED     = 1u << 1,
+    AA_KINK          = 1u << 2,
 };
 
 typedef struct ia_interval {

@@ -216,7 +216,10 @@ static inline void VM_OP(v_round, b_round)(sl_vm *vm, A *z, const A *x)
 
 static inline void VM_OP(v_clamp, b_clamp)(sl_vm *vm, A *z, const A *x, const A *lo, const A *hi)
 {
+    unsigned kink = x->flags & AA_KINK;
     aa_clamp(vm->ctx, z, x, lo, hi);
+    if (sl_unit_clamp(lo->x0, hi->x0) && aa_is_point(lo) && aa_is_point(hi))
+        z->flags = (unsigned short)((z->flags & ~(unsigned)AA_KINK) | kink);
 }
 static inline void VM_OP(v_smoothstep, b_smoothstep)(sl_vm *vm, A *z, const A *e0, const A *e1, const A *x)
 {

@@ -315,6 +315,17 @@ const char *sl_mode_name(sl_mode mode);
 /* The message of this scope, name and size (0: a string), or NULL. */
 const vm_message *sl_vm_message(const sl_vm *vm, int scope, const char *name, int size);
 
+/* Whether clamp(x, lo, hi) is to [-1, 1], the clamp normalize() puts on
+ * each component of a unit vector (codegen_builtin.c, gen_normalize):
+ * there it only cuts the arithmetic's overshoot (a component of a flat
+ * base's N that is -1 up to rounding), so the range modes give it no
+ * AA_KINK (a shader's own clamp to [-1, 1] loses the flag too; only the
+ * renderer's leaf starts read it: intersect.c, leaf_start) */
+static inline bool sl_unit_clamp(double lo, double hi)
+{
+    return lo == -1.0 && hi == 1.0;
+}
+
 /* a op b (op: SL_OP_ADD/SUB/MUL/DIV/MOD) when the double result is EXACT, so
  * that interval and affine runs keep integer counters and octave
  * frequencies as points instead of widening them by a rounding error

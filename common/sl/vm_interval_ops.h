@@ -101,7 +101,10 @@ static inline void VM_OP(v_mul, b_mul)(sl_vm *vm, I *z, const I *x, const I *y)
 static inline void VM_OP(v_clamp, b_clamp)(sl_vm *vm, I *z, const I *x, const I *lo, const I *hi)
 {
     (void)vm;
+    unsigned kink = x->flags & AA_KINK;
     *z = ia_clamp(*x, *lo, *hi);
+    if (sl_unit_clamp(lo->lo, hi->lo) && lo->lo == lo->hi && hi->lo == hi->hi)
+        z->flags = (z->flags & ~(unsigned)AA_KINK) | kink;
 }
 static inline void VM_OP(v_smoothstep, b_smoothstep)(sl_vm *vm, I *z, const I *e0, const I *e1, const I *x)
 {

@@ -90,10 +90,13 @@ void trace_camera_normal_aa(aa_context *ctx, const trace_object *obj, const aa_f
 
 /* A box is unbounded when a side is infinite. The arithmetic's
  * AA_UNBOUNDED flag is sticky (it stays on a clamp or a normalize of an
- * unbounded value, whose range is finite again), so it is not used. */
+ * unbounded value, whose range is finite again), so it is not used.
+ * AA_KINK (a crease in the cell) goes on the box for the leaves' starts
+ * alone (intersect.c, leaf_start): the slab, the planar and moved cells
+ * read the other flags only. */
 static unsigned box_flags(const trace_box *b, unsigned flags)
 {
-    unsigned f = flags & AA_DISCONTINUOUS;
+    unsigned f = flags & (AA_DISCONTINUOUS | AA_KINK);
     if (!isfinite(b->lo.x) || !isfinite(b->lo.y) || !isfinite(b->lo.z) ||
         !isfinite(b->hi.x) || !isfinite(b->hi.y) || !isfinite(b->hi.z))
         f |= AA_UNBOUNDED;
@@ -163,7 +166,7 @@ static void box_from_affine(const aa_form P[3], trace_box *out)
     out->flags = box_flags(out, flags);
     out->tape = 0;
     out->bend = other == 0 ? 0.0f : lin > 0 ? (float)fmin(other / lin, 1e30) : 1e30f;
-    if (out->flags) trace_box_no_slab(out);
+    if (out->flags & ~(unsigned)AA_KINK) trace_box_no_slab(out);
     else box_slab(P, r, out);
 }
 
@@ -272,8 +275,10 @@ typedef enum {
 static bool offset_affine(const aa_form *a, const aa_form *b)
 {
     /* AA_DISCONTINUOUS aside: a case run's split values carry it, and
-     * box_of_run takes no flagged box for a moved one */
-    unsigned fa = a->flags & ~(unsigned)AA_DISCONTINUOUS, fb = b->flags & ~(unsigned)AA_DISCONTINUOUS;
+     * box_of_run takes no flagged box for a moved one; AA_KINK aside: a
+     * crease adds a symbol or an error, which the comparison below sees */
+    unsigned fa = a->flags & ~(unsigned)(AA_DISCONTINUOUS | AA_KINK),
+             fb = b->flags & ~(unsigned)(AA_DISCONTINUOUS | AA_KINK);
     if (fa != fb || !isfinite(a->x0) || !(a->err >= b->err))
         return false;
     /* the same coefficients; a symbol one form lacks has 0 in it (an
@@ -392,7 +397,7 @@ static bool planar_forms(const affine_cell *c, const aa_form P[3], trace_plane *
     double q[3], eu[3], ev[3];
     for (int k = 0; k < 3; k++) {
         const aa_form *f = &P[k];
-        if (f->flags) return false;
+        if (f->flags & ~(unsigned)AA_KINK) return false;
         double rest = f->err;
         for (int i = 2; i < f->n; i++) rest += fabs(f->c[i]);
         q[k] = f->x0;
@@ -435,7 +440,7 @@ static void box_of_run(trace_thread *th, const trace_object *obj, const affine_c
                        const aa_form P[3], trace_moved same, trace_box *out, trace_lin *lin)
 {
     box_from_affine(P, out);
-    if (obj->displacement && !out->flags) {
+    if (obj->displacement && !(out->flags & ~(unsigned)AA_KINK)) {
         trace_plane pl;
         if (same == TRACE_MOVED_NOT) {
             out->flags |= TRACE_BOX_UNDISPLACED;

@@ -433,10 +433,41 @@ static void test_flags(void **state)
     assert_int_equal(aa_unary_flags(aa_sin, -3.0, 2.0, &r), 0);
     assert_int_equal(aa_unary_flags(aa_exp, -3.0, 2.0, &r), 0);
     assert_int_equal(aa_unary_flags(aa_sqrt, 0.5, 2.0, &r), 0);
-    assert_int_equal(aa_unary_flags(aa_abs, -3.0, 2.0, &r), 0);
     assert_int_equal(ia_sin(ia_make(-3.0, 2.0)).flags, 0);
     assert_int_equal(ia_exp(ia_make(-3.0, 2.0)).flags, 0);
     assert_int_equal(ia_log(ia_make(0.5, 2.0)).flags, 0);
+
+    /* creases (AA_KINK, continuous): abs across 0, a min or max whose
+     * operands' ranges overlap; none where the function is smooth over
+     * the range */
+    assert_int_equal(aa_unary_flags(aa_abs, -3.0, 2.0, &r), AA_KINK);
+    assert_int_equal(aa_unary_flags(aa_abs, 0.5, 2.0, &r), 0);
+    assert_int_equal(aa_unary_flags(aa_abs, -2.0, -0.5, &r), 0);
+    assert_int_equal(ia_abs(ia_make(-3.0, 2.0)).flags, AA_KINK);
+    assert_int_equal(ia_abs(ia_make(0.0, 2.0)).flags, 0);
+    assert_int_equal(ia_min(ia_make(0.0, 2.0), ia_make(1.0, 3.0)).flags, AA_KINK);
+    assert_int_equal(ia_max(ia_make(0.0, 2.0), ia_make(1.0, 3.0)).flags, AA_KINK);
+    assert_int_equal(ia_min(ia_make(0.0, 1.0), ia_make(1.0, 3.0)).flags, 0);
+    assert_int_equal(ia_max(ia_make(0.0, 1.0), ia_make(2.0, 3.0)).flags, 0);
+    {
+        aa_context ctx;
+        aa_context_init(&ctx, AA_DEFAULT_CAPACITY);
+        aa_form x, y, z;
+        aa_input(&ctx, &x, 0.0, 2.0);
+        aa_input(&ctx, &y, 1.0, 3.0);
+        aa_min(&ctx, &z, &x, &y);
+        assert_int_equal(z.flags, AA_KINK);
+        aa_max(&ctx, &z, &x, &y);
+        assert_int_equal(z.flags, AA_KINK);
+        aa_add_s(&ctx, &y, &y, 2.0);          /* [3, 5]: decided */
+        aa_min(&ctx, &z, &x, &y);
+        assert_int_equal(z.flags, 0);
+        aa_form lo, hi;
+        aa_const(&lo, 0.5);
+        aa_const(&hi, 1.5);
+        aa_clamp(&ctx, &z, &x, &lo, &hi);
+        assert_int_equal(z.flags, AA_KINK);
+    }
 
     /* step: edge inside the range of x or not */
     {

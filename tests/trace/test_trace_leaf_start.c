@@ -43,11 +43,33 @@ static const char *FBM_SL =
     "    P += Km * h * normalize(N);\n"
     "}\n";
 
-/* a tilted wall under a perspective camera */
+/* a wall facing the camera (%s: the shader) */
+static const char *FACING_RIB =
+    "Format 48 36 1\nProjection \"perspective\" \"fov\" [30]\n"
+    "WorldBegin\nTranslate 0 0 2.5\nDisplacement \"%s\"\n"
+    "Polygon \"P\" [-1 -1 0  1 -1 0  1 1 0  -1 1 0] \"st\" [0 0  1 0  1 1  0 1]\nWorldEnd\n";
+
+/* the same octaves folded at their middle: a crease wherever a noise
+ * crosses 0.5 (ridged noise) */
+static const char *RIDGED_SL =
+    "displacement ridged3(float Km = 0.05)\n"
+    "{\n"
+    "    point p = point(s * 1.5, t * 1.5, 0);\n"
+    "    float h = 0, amp = 1, i;\n"
+    "    for (i = 0; i < 3; i += 1) {\n"
+    "        h += amp * (1 - abs(2 * noise(p) - 1));\n"
+    "        amp *= 0.5;\n"
+    "        p *= 2;\n"
+    "    }\n"
+    "    P += Km * h * normalize(N);\n"
+    "}\n";
+
+/* a tilted wall under a perspective camera (%s: the shader) */
 static const char *WALL_RIB =
     "Format 48 36 1\nProjection \"perspective\" \"fov\" [30]\n"
-    "WorldBegin\nTranslate 0 0 3\nRotate -50 1 0 0\nDisplacement \"fbm3\"\n"
+    "WorldBegin\nTranslate 0 0 3\nRotate -50 1 0 0\nDisplacement \"%s\"\n"
     "Polygon \"P\" [-1 -1 0  1 -1 0  1 1 0  -1 1 0] \"st\" [0 0  1 0  1 1  0 1]\nWorldEnd\n";
+
 
 typedef struct pass {
     bool hit[48 * 36];
@@ -88,58 +110,97 @@ static void trace_pass(fixture *f, bool leaf_start, pass *p)
     trace_thread_destroy(&th);
 }
 
-static void test_leaves_start_on_their_plane(void **state)
+/* Traces the scene both ways and checks the hits agree; the passes in
+ * *on and *off */
+static void check_hits_agree(const char *rib, const char *name, const char *source, pass *on,
+                             pass *off)
 {
-    (void)state;
     fixture f;
-    fixture_shader sh[] = {{"fbm3", FBM_SL}};
-    assert_true(fixture_open(&f, WALL_RIB, sh, 1, NULL, 0));
-    static pass on, off;
-    trace_pass(&f, true, &on);
-    trace_pass(&f, false, &off);
+    fixture_shader sh[] = {{name, source}};
+    assert_true(fixture_open(&f, rib, sh, 1, NULL, 0));
+    trace_pass(&f, true, on);
+    trace_pass(&f, false, off);
     trace_tolerance tol = f.js->renderer->primary_tol;
     const trace_camera *cam = &f.js->world.camera;
     int hits = 0, differ = 0, far = 0;
     for (int y = 0; y < cam->yres; y++)
         for (int x = 0; x < cam->xres; x++) {
             int i = y * cam->xres + x;
-            if (on.hit[i] != off.hit[i]) {
+            if (on->hit[i] != off->hit[i]) {
                 differ++;
                 continue;
             }
-            if (!on.hit[i]) continue;
+            if (!on->hit[i]) continue;
             hits++;
             trace_ray ray;
             trace_camera_ray(cam, x + 0.5, y + 0.5, &ray);
-            double t_tol = (tol.a + tol.b * off.h[i].t) / v3_length(ray.d);
-            if (!(fabs(on.h[i].t - off.h[i].t) <= t_tol)) {
+            double t_tol = (tol.a + tol.b * off->h[i].t) / v3_length(ray.d);
+            if (!(fabs(on->h[i].t - off->h[i].t) <= t_tol)) {
                 if (far++ < 5)
                     printf("  pixel (%d, %d): t %.9f from the plane, %.9f from the centre\n", x,
-                           y, on.h[i].t, off.h[i].t);
+                           y, on->h[i].t, off->h[i].t);
             }
         }
-    printf("%d rays hit; leaves %ld and %ld (%ld started on the plane), evaluations a leaf "
-           "%.3f from the plane, %.3f from the centre; hits' points at most %.3g and %.3g "
-           "footprints off their ray\n",
-           hits, on.leaves, off.leaves, on.starts, (double)on.evals / (double)on.leaves,
-           (double)off.evals / (double)off.leaves, on.worst, off.worst);
+    printf("%s: %d rays hit; leaves %ld and %ld (%ld started on the plane), evaluations a "
+           "leaf %.3f from the plane, %.3f from the centre; hits' points at most %.3g and "
+           "%.3g footprints off their ray\n",
+           name, hits, on->leaves, off->leaves, on->starts, (double)on->evals / (double)on->leaves,
+           (double)off->evals / (double)off->leaves, on->worst, off->worst);
     assert_true(hits > 48 * 36 / 2);
     assert_int_equal(differ, 0);
     assert_int_equal(far, 0);
-    assert_true(on.worst <= 1.0);
-    assert_true(off.worst <= 1.0);
-    assert_true(on.leaves > 0 && off.leaves > 0);
+    assert_true(on->worst <= 1.0);
+    assert_true(off->worst <= 1.0);
+    assert_true(on->leaves > 0 && off->leaves > 0);
+    assert_int_equal(off->starts, 0);
+    fixture_close(&f);
+}
+
+static void test_leaves_start_on_their_plane(void **state)
+{
+    (void)state;
+    static pass on, off;
+    char rib[512];
+    snprintf(rib, sizeof rib, WALL_RIB, "fbm3");
+    check_hits_agree(rib, "fbm3", FBM_SL, &on, &off);
     assert_true(on.starts > on.leaves / 2);
-    assert_int_equal(off.starts, 0);
     assert_true((double)on.evals <= 1.3 * (double)on.leaves);
     assert_true((double)off.evals >= 1.8 * (double)off.leaves);
-    fixture_close(&f);
+}
+
+/* A wall facing the camera: its normal is (0, 0, -1) up to rounding,
+ * which normalize()'s clamps to [-1, 1] cut without a crease (with the
+ * clamps taken for creases, no leaf starts on the plane) */
+static void test_normalize_is_no_crease(void **state)
+{
+    (void)state;
+    static pass on, off;
+    char rib[512];
+    snprintf(rib, sizeof rib, FACING_RIB, "fbm3");
+    check_hits_agree(rib, "fbm3", FBM_SL, &on, &off);
+    assert_true(on.starts > on.leaves / 2);
+}
+
+/* Where the run saw a crease (abs across 0: AA_KINK) the leaf starts at
+ * its centre: a start on the plane settles at once beside a crease where
+ * the steps from the centre would not, and the leaf goes untested */
+static void test_creases_start_at_the_centre(void **state)
+{
+    (void)state;
+    static pass on, off;
+    char rib[512];
+    snprintf(rib, sizeof rib, WALL_RIB, "ridged3");
+    check_hits_agree(rib, "ridged3", RIDGED_SL, &on, &off);
+    assert_true(on.starts > 0);
+    assert_true(on.starts < on.leaves - on.leaves / 8);
 }
 
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_leaves_start_on_their_plane),
+        cmocka_unit_test(test_normalize_is_no_crease),
+        cmocka_unit_test(test_creases_start_at_the_centre),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
