@@ -375,6 +375,15 @@ static void test_sin_cos_full_period(void **state)
 
 /* ---- flags ---- */
 
+/* a fresh context and two inputs over [xl, xh] and [yl, yh] */
+static void two_inputs(aa_context *ctx, aa_form *x, aa_form *y, double xl, double xh, double yl,
+                       double yh)
+{
+    aa_context_init(ctx, AA_DEFAULT_CAPACITY);
+    aa_input(ctx, x, xl, xh);
+    aa_input(ctx, y, yl, yh);
+}
+
 static unsigned aa_unary_flags(void (*f)(aa_context *, aa_form *, const aa_form *), double lo,
                                double hi, ia_interval *range)
 {
@@ -395,10 +404,8 @@ static void test_flags(void **state)
     /* merge always flags */
     {
         aa_context ctx;
-        aa_context_init(&ctx, AA_DEFAULT_CAPACITY);
         aa_form x, y, z;
-        aa_input(&ctx, &x, 0.0, 1.0);
-        aa_input(&ctx, &y, 2.0, 3.0);
+        two_inputs(&ctx, &x, &y, 0.0, 1.0, 2.0, 3.0);
         aa_merge(&ctx, &z, &x, &y);
         assert_true(z.flags & AA_DISCONTINUOUS);
         r = aa_range(&z);
@@ -451,10 +458,8 @@ static void test_flags(void **state)
     assert_int_equal(ia_max(ia_make(0.0, 1.0), ia_make(2.0, 3.0)).flags, 0);
     {
         aa_context ctx;
-        aa_context_init(&ctx, AA_DEFAULT_CAPACITY);
         aa_form x, y, z;
-        aa_input(&ctx, &x, 0.0, 2.0);
-        aa_input(&ctx, &y, 1.0, 3.0);
+        two_inputs(&ctx, &x, &y, 0.0, 2.0, 1.0, 3.0);
         aa_min(&ctx, &z, &x, &y);
         assert_int_equal(z.flags, AA_KINK);
         aa_max(&ctx, &z, &x, &y);

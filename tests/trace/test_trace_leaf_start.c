@@ -110,11 +110,13 @@ static void trace_pass(fixture *f, bool leaf_start, pass *p)
     trace_thread_destroy(&th);
 }
 
-/* Traces the scene both ways and checks the hits agree; the passes in
- * *on and *off */
-static void check_hits_agree(const char *rib, const char *name, const char *source, pass *on,
-                             pass *off)
+/* Traces the scene (rib_format with the shader's name) both ways and
+ * checks the hits agree; the passes in *on and *off */
+static void check_hits_agree(const char *rib_format, const char *name, const char *source,
+                             pass *on, pass *off)
 {
+    char rib[512];
+    snprintf(rib, sizeof rib, rib_format, name);
     fixture f;
     fixture_shader sh[] = {{name, source}};
     assert_true(fixture_open(&f, rib, sh, 1, NULL, 0));
@@ -160,9 +162,7 @@ static void test_leaves_start_on_their_plane(void **state)
 {
     (void)state;
     static pass on, off;
-    char rib[512];
-    snprintf(rib, sizeof rib, WALL_RIB, "fbm3");
-    check_hits_agree(rib, "fbm3", FBM_SL, &on, &off);
+    check_hits_agree(WALL_RIB, "fbm3", FBM_SL, &on, &off);
     assert_true(on.starts > on.leaves / 2);
     assert_true((double)on.evals <= 1.3 * (double)on.leaves);
     assert_true((double)off.evals >= 1.8 * (double)off.leaves);
@@ -175,9 +175,7 @@ static void test_normalize_is_no_crease(void **state)
 {
     (void)state;
     static pass on, off;
-    char rib[512];
-    snprintf(rib, sizeof rib, FACING_RIB, "fbm3");
-    check_hits_agree(rib, "fbm3", FBM_SL, &on, &off);
+    check_hits_agree(FACING_RIB, "fbm3", FBM_SL, &on, &off);
     assert_true(on.starts > on.leaves / 2);
 }
 
@@ -188,9 +186,7 @@ static void test_creases_start_at_the_centre(void **state)
 {
     (void)state;
     static pass on, off;
-    char rib[512];
-    snprintf(rib, sizeof rib, WALL_RIB, "ridged3");
-    check_hits_agree(rib, "ridged3", RIDGED_SL, &on, &off);
+    check_hits_agree(WALL_RIB, "ridged3", RIDGED_SL, &on, &off);
     assert_true(on.starts > 0);
     assert_true(on.starts < on.leaves - on.leaves / 8);
 }
