@@ -440,9 +440,9 @@ static bool newton_uv(const trace_ray *ray, const trace_surface_point *sp,
 
 /*
  * The point of a leaf's cell where the ray meets the surface: Newton's
- * iteration from the cell's centre, or from the point `start` of the
- * cell already evaluated (leaf_start; its (u,v) in *uc, *vc on return
- * as the steps move them) (newton_uv, each step clamped to the
+ * iteration from the cell's centre, or from a point of the cell already
+ * evaluated (`start`: leaf_start; *uc, *vc follow its (u,v) and the
+ * steps) (newton_uv, each step clamped to the
  * cell grown by half its width on each side, within the unit square: the
  * ray's hit may lie just beside the cell whose box it entered). Fills sp
  * at the (u,v) used.
@@ -1213,6 +1213,15 @@ static bool ray_grazes(const walk *w, vec3 n, double cos_max)
  * (0.1) kept it at 144 but left out most cells of fbm with fixed octaves.
  */
 #define LEAF_START_GRAZE 0x1p-10        /* |cos| of the ray's angle to the plane's normal */
+
+/* The point of [lo, hi] where a symbol e in [-1, 1] puts it, as aa_input
+ * maps the cell (its midpoint, the larger half), kept in [lo, hi] */
+static double cell_at(double lo, double hi, double e)
+{
+    double m = aa_input_mid(lo, hi), half = m - lo > hi - m ? m - lo : hi - m;
+    return fmin(fmax(m + e * half, lo), hi);
+}
+
 static void leaf_start_uv(const walk *w, const trace_box *kid, const trace_qlin *q,
                           const double c[4], geom_cover cover, double *u, double *v)
 {
@@ -1234,11 +1243,8 @@ static void leaf_start_uv(const walk *w, const trace_box *kid, const trace_qlin 
     vec3 p = v3_sub(trace_ray_at(ray, t), x);
     double eu = v3_dot(v3_cross(p, V), n) / nn, ev = v3_dot(v3_cross(U, p), n) / nn;
     if (!(eu == eu) || !(ev == ev)) return;
-    eu = fmin(fmax(eu, -1.0), 1.0);
-    ev = fmin(fmax(ev, -1.0), 1.0);
-    double mu = aa_input_mid(c[0], c[1]), mv = aa_input_mid(c[2], c[3]);
-    *u = fmin(fmax(mu + eu * (mu - c[0] > c[1] - mu ? mu - c[0] : c[1] - mu), c[0]), c[1]);
-    *v = fmin(fmax(mv + ev * (mv - c[2] > c[3] - mv ? mv - c[2] : c[3] - mv), c[2]), c[3]);
+    *u = cell_at(c[0], c[1], fmin(fmax(eu, -1.0), 1.0));
+    *v = cell_at(c[2], c[3], fmin(fmax(ev, -1.0), 1.0));
     w->th->stats.leaf_starts++;
 }
 
