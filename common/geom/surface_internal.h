@@ -215,6 +215,11 @@ void geom_nurbs_eval_ia(const geom_surface *s, ia_interval u, ia_interval v, geo
 void geom_nurbs_eval_aa(aa_context *ctx, const geom_surface *s, const aa_form *u,
                         const aa_form *v, geom_aa *out);
 void geom_nurbs_bounds(const geom_surface *s, vec3 *lo, vec3 *hi);
+/* A bilinear patch's general solve alone, without geom_intersect's slab
+ * rejection (surface_intersect.c, patch_slab_misses): the oracle that
+ * test_geom_same_bits holds the short path to. */
+bool geom_patch_solve(const geom_surface *s, vec3 o, vec3 d, double tmin, double tmax,
+                      geom_hit *hit);
 bool geom_nurbs_intersect(const geom_surface *s, vec3 o, vec3 d, double tmin, double tmax,
                           geom_hit *hit);
 

@@ -16,6 +16,15 @@
  *   basis       geom_polygon_basis's basis and (u,v) are the prepare's, and
  *               the corners kept are those a root at every pair keeps,
  *               for polygons with corners repeated near the threshold
+ *   patch slab  geom_intersect on a bilinear patch (which first rejects
+ *               rays that start beyond the patch's slab and head away)
+ *               gives geom_patch_solve's answer (the general solve alone)
+ *               to the bit: hit or miss, t, u and v, for flat, trapezoid
+ *               and twisted patches at scales 1e-3 to 1e3, on shadow-like
+ *               rays leaving the patch (0 to 1e-3 of its size off it,
+ *               down to 1e-9 radians off its plane), rays aimed at it and
+ *               random rays (the aimed rays must hit, the leaving ones
+ *               mostly miss)
  */
 #include <stdarg.h>
 #include <stddef.h>
@@ -267,6 +276,95 @@ static void test_basis(void **state)
     assert_true(tried > 12000 && repeated > 4000);
 }
 
+/* a bilinear patch: a parallelogram, a flat trapezoid or a twisted one
+ * (corner 3 moved off the plane), in a random frame and place */
+static geom_surface random_patch(int k)
+{
+    geom_surface s;
+    memset(&s, 0, sizeof s);
+    s.kind = GEOM_PATCH;
+    s.nverts = 4;
+    vec3 e1 = fx_unit_vector(), t = fx_unit_vector();
+    vec3 e2 = v3_normalize(v3_cross(e1, t)), e3 = v3_cross(e1, e2);
+    double scale = pow(10, fx_range(-3, 3));
+    vec3 c = v3_scale(v3(fx_range(-10, 10), fx_range(-10, 10), fx_range(-10, 10)), scale);
+    double w = scale * fx_range(0.3, 1), h = scale * fx_range(0.3, 1), sk = fx_range(-0.5, 0.5);
+    s.verts[0] = c;
+    s.verts[1] = v3_add(c, v3_scale(e1, w));
+    s.verts[2] = v3_add(c, v3_add(v3_scale(e2, h), v3_scale(e1, sk * w)));
+    s.verts[3] = v3_add(s.verts[1], v3_sub(s.verts[2], s.verts[0]));
+    if (k % 3 == 1)                        /* trapezoid: still flat */
+        s.verts[3] = v3_add(s.verts[3], v3_scale(e1, fx_range(-0.4, 0.4) * w));
+    else if (k % 3 == 2)                   /* twisted */
+        s.verts[3] = v3_add(s.verts[3], v3_scale(e3, fx_range(-0.8, 0.8) * w));
+    return s;
+}
+
+static void expect_same_hit(const geom_surface *s, vec3 o, vec3 d, double tmin, double tmax,
+                            int *hits)
+{
+    geom_hit a = {-1, -1, -1}, b = {-1, -1, -1};
+    bool ha = geom_intersect(s, o, d, tmin, tmax, &a);
+    bool hb = geom_patch_solve(s, o, d, tmin, tmax, &b);
+    if (ha != hb)
+        fail_msg("patch (%a %a %a ...), ray o (%a %a %a) d (%a %a %a): geom_intersect %s, "
+                 "the general solve %s (t %a)", s->verts[0].x, s->verts[0].y, s->verts[0].z,
+                 o.x, o.y, o.z, d.x, d.y, d.z, ha ? "hits" : "misses", hb ? "hits" : "misses",
+                 ha ? a.t : b.t);
+    if (ha) {
+        expect_same(a.t, b.t, "patch t", o.x, d.x);
+        expect_same(a.u, b.u, "patch u", o.x, d.x);
+        expect_same(a.v, b.v, "patch v", o.x, d.x);
+        ++*hits;
+    }
+}
+
+static void test_patch_slab(void **state)
+{
+    (void)state;
+    fx_seed(2430);
+    int hits = 0, leaving = 0, leaving_hits = 0, aimed = 0, aimed_hits = 0;
+    for (int k = 0; k < 6000; k++) {
+        geom_surface s = random_patch(k);
+        char err[128];
+        assert_true(geom_surface_prepare(&s, err, sizeof err));
+        double u = fx_range(0, 1), v = fx_range(0, 1);
+        geom_sample g;
+        geom_eval(&s, u, v, &g);
+        vec3 n = v3_normalize(v3_cross(g.dPdu, g.dPdv));
+        double size = v3_length(v3_sub(s.verts[3], s.verts[0])) + v3_length(g.dPdu);
+        for (int j = 0; j < 8; j++) {
+            /* a shadow-like ray: from just off the patch, away from it
+             * (on either side), at angles down to 1e-9 of its plane */
+            static const double offs[] = {0, 1e-12, 1e-9, 1e-6, 1e-3};
+            double side = j % 2 ? 1.0 : -1.0;
+            vec3 o = v3_add(g.P, v3_scale(n, side * offs[j % 5] * size));
+            vec3 tan = v3_normalize(v3_cross(n, fx_unit_vector()));
+            double lift = pow(10, fx_range(-9, 0));
+            vec3 d = v3_scale(v3_add(v3_scale(n, side * lift), tan), pow(10, fx_range(-2, 2)));
+            int before = hits;
+            expect_same_hit(&s, o, d, 0, j % 3 ? INFINITY : fx_range(0, 10) * size, &hits);
+            leaving++;
+            leaving_hits += hits - before;
+            /* aimed at the point from either side, and a random ray */
+            vec3 a = v3_scale(v3_add(v3_scale(n, -side * fx_range(0.01, 1)), v3_scale(tan, fx_range(-1, 1))),
+                              size);
+            before = hits;
+            expect_same_hit(&s, v3_sub(g.P, a), a, 0, INFINITY, &hits);
+            aimed++;
+            aimed_hits += hits - before;
+            vec3 r = v3_add(g.P, v3_scale(fx_unit_vector(), size * fx_range(0, 3)));
+            expect_same_hit(&s, r, fx_unit_vector(), fx_range(-1, 0.5) * size, INFINITY, &hits);
+        }
+    }
+    /* the aimed rays are meaningful (they hit), and the leaving ones mostly
+     * miss: a flat patch is never hit again, a twisted one sometimes */
+    printf("patch slab: %d rays leaving a patch (%d hit it again), %d aimed (%d hit)\n", leaving,
+           leaving_hits, aimed, aimed_hits);
+    assert_true(aimed_hits > aimed * 9 / 10);
+    assert_true(leaving_hits < leaving / 2);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -274,6 +372,7 @@ int main(void)
         cmocka_unit_test(test_bounds),
         cmocka_unit_test(test_ng),
         cmocka_unit_test(test_basis),
+        cmocka_unit_test(test_patch_slab),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
