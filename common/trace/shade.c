@@ -11,6 +11,18 @@
 
 #include <math.h>
 #include <stdio.h>
+#include <string.h>
+
+/* The light samples of one shading point, kept for the shader's next
+ * ambient(), diffuse(), specular(), phong() or illuminance loop: each asks
+ * for them (plastic three times), and each would trace the shadow rays
+ * again. The samples depend on the point alone (P and N of the context,
+ * the lights and their shaders, whose VM starts every run from the same
+ * seed and has no messages of the surface's), so the copy is what a new
+ * call would give (test_trace_light_memo: the same pixels with the memo
+ * off, world option light_memo).
+ * Up to this many samples; a call asking for more makes them anew. */
+#define LIGHT_MEMO 16
 
 typedef struct shade_ctx {
     const trace_renderer *r;
@@ -22,6 +34,9 @@ typedef struct shade_ctx {
     double tol;          /* shadow ray leaf tolerance (camera units) */
     int depth;           /* trace() rays that led here (0: a primary hit) */
     int light;           /* the light shader being run (its index), or -1 */
+    int nmemo;           /* light samples kept (memo), or -1: none yet */
+    int memo_max;        /* the `max` they were made for */
+    sl_light_sample memo[LIGHT_MEMO];
 } shade_ctx;
 
 static void shade_hit(const trace_renderer *r, trace_thread *th, const trace_ray *ray,
@@ -59,10 +74,27 @@ static bool occluded(shade_ctx *c, vec3 L, double tmax)
     return occluded_from(c, c->P, L, tmax);
 }
 
+static int make_light_samples(shade_ctx *c, sl_light_sample *out, int max);
+
 static int light_samples(void *user, const double P[3], sl_light_sample *out, int max)
 {
     (void)P;   /* the shaded point is c->P: a shader moving P does not move shadows */
     shade_ctx *c = user;
+    if (c->nmemo >= 0 && c->memo_max == max) {
+        memcpy(out, c->memo, (size_t)c->nmemo * sizeof *out);
+        return c->nmemo;
+    }
+    int n = make_light_samples(c, out, max);
+    if (n <= LIGHT_MEMO && c->r->world->options.light_memo) {
+        memcpy(c->memo, out, (size_t)n * sizeof *out);
+        c->nmemo = n;
+        c->memo_max = max;
+    }
+    return n;
+}
+
+static int make_light_samples(shade_ctx *c, sl_light_sample *out, int max)
+{
     const trace_world *w = c->r->world;
     int n = 0;
     for (int i = 0; i < c->obj->nlights && n < max; i++) {
@@ -295,7 +327,7 @@ static void shade_hit(const trace_renderer *r, trace_thread *th, const trace_ray
     shade_ctx c = {.r = r, .th = th, .obj = obj, .P = sp.P, .N = sp.N,
                    .offset = 2.0 * hit->leaf_size + 1e-9 * (1.0 + v3_length(sp.P)),
                    .tol = hit->leaf_size > pixel_tol ? hit->leaf_size : pixel_tol,
-                   .depth = depth, .light = -1};
+                   .depth = depth, .light = -1, .nmemo = -1};
     sl_vm *vm = trace_thread_shade_vm(th, depth);
     pass_messages(th, vm, obj, sp.u, sp.v);
     double P[3] = {sp.P.x, sp.P.y, sp.P.z}, N[3] = {sp.N.x, sp.N.y, sp.N.z};

@@ -25,6 +25,7 @@ void trace_options_default(trace_options *opt)
     opt->max_nodes_per_ray = TRACE_DEFAULT_MAX_NODES_PER_RAY;
     opt->max_ray_depth = TRACE_MAX_RAY_DEPTH;
     opt->prove_hits = true;
+    opt->light_memo = true;
     opt->lazy_roots = true;
     opt->lazy_children = true;
     opt->tape_pruning = true;

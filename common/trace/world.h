@@ -279,6 +279,10 @@ typedef struct trace_options {
                                       benchmarks) */
     bool prove_hits;               /* try hit proofs on small cells
                                       (trace/prove.h); off: leaves only */
+    bool light_memo;               /* a shading point's light samples (and
+                                      their shadow rays) made once for all
+                                      the shader's light calls (shade.c);
+                                      off: made on every call (for tests) */
     const atomic_int *cancel;      /* the program's stop flag (a signal), or
                                       NULL: every trace_thread and shader VM
                                       of the world watches it, the root boxes
