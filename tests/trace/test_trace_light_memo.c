@@ -25,16 +25,6 @@
 #include "trace/render.h"
 #include "trace/thread.h"
 
-/* a sun written as a user would (RI Spec 3.2 Appendix A's distantlight) */
-#define SHADER_MYSUN \
-    "light mysun(float intensity = 1; color lightcolor = 1;\n" \
-    "            point from = point \"shader\" (0, 0, 0);\n" \
-    "            point to = point \"shader\" (0, 0, 1))\n" \
-    "{\n" \
-    "    solar(to - from, 0.0)\n" \
-    "        Cl = intensity * lightcolor;\n" \
-    "}\n"
-
 /* an illuminance loop beside diffuse() and ambient(): three light calls */
 #define SHADER_LOOPLIT \
     "surface looplit(float Kd = 1)\n" \

@@ -18,24 +18,6 @@
 #include "fixture.h"
 #include "shaders.h"
 
-/* the standard lights' formulas (RI Spec 3.2 Appendix A), written as a
- * user would; "from"/"to" in shader space, which is the light's space */
-#define SHADER_MYPOINT \
-    "light mypoint(float intensity = 1; color lightcolor = 1;\n" \
-    "              point from = point \"shader\" (0, 0, 0))\n" \
-    "{\n" \
-    "    illuminate(from)\n" \
-    "        Cl = intensity * lightcolor / (L . L);\n" \
-    "}\n"
-#define SHADER_MYSUN \
-    "light mysun(float intensity = 1; color lightcolor = 1;\n" \
-    "            point from = point \"shader\" (0, 0, 0);\n" \
-    "            point to = point \"shader\" (0, 0, 1))\n" \
-    "{\n" \
-    "    solar(to - from, 0.0)\n" \
-    "        Cl = intensity * lightcolor;\n" \
-    "}\n"
-
 enum { W = 48, H = 32 };
 
 /* camera at the origin looking down +z; a displaced wall at z = 6 and a
