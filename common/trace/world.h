@@ -184,7 +184,9 @@ typedef struct trace_object {
                                       boxes leave them out (displace.c) */
     bool prove_any_bend;           /* its displacement reads a texture: hit
                                       proofs are tried on cells of any bend
-                                      (intersect.c, TRACE_PROVE_BEND) */
+                                      (intersect.c, TRACE_PROVE_BEND), and
+                                      leaves start at their centre
+                                      (intersect.c, leaf_start) */
     trace_box root;                /* OBJECT space box over the whole (u,v) square */
     trace_box bound;               /* camera space box of root (for the BVH) */
     /* instances (trace/instance.c): the earlier instance of the same
