@@ -347,8 +347,9 @@ static void test_patch_slab(void **state)
             leaving++;
             leaving_hits += hits - before;
             /* aimed at the point from either side, and a random ray */
-            vec3 a = v3_scale(v3_add(v3_scale(n, -side * fx_range(0.01, 1)), v3_scale(tan, fx_range(-1, 1))),
-                              size);
+            vec3 toward = v3_add(v3_scale(n, -side * fx_range(0.01, 1)),
+                                 v3_scale(tan, fx_range(-1, 1)));
+            vec3 a = v3_scale(toward, size);
             before = hits;
             expect_same_hit(&s, v3_sub(g.P, a), a, 0, INFINITY, &hits);
             aimed++;
