@@ -29,7 +29,7 @@
  * most this fraction of its u and v terms (trace_box.bend). Cells that
  * bend more rarely pass the test (dented without this rule: 258 hits in
  * 25,230 tests) and cost a slope run each (docs/benchmarks.md, step 4).
- * Not on an object whose displacement reads a texture (prove_any_bend):
+ * Not on an object whose displacement reads a texture (bend_unknown):
  * there a lookup over several texels is a bound, a fresh noise symbol
  * however smooth the map, so the bend says nothing of the surface's, and
  * the test settles most cells (the peer terrain: 396,013 of 692,090,
@@ -1211,7 +1211,7 @@ static bool ray_grazes(const walk *w, vec3 n, double cos_max)
  * dented's 1/16-pixel reference: 145 pixels off with the centre, 201
  * with starts in every cell; a limit on the bend instead of the creases
  * (0.1) kept it at 144 but left out most cells of fbm with fixed octaves.
- * And on an object whose displacement reads a texture (prove_any_bend): a
+ * And on an object whose displacement reads a texture (bend_unknown): a
  * lookup over several texels is a bound, whose linear part says nothing
  * of where the ray meets the map (the peer terrain: 379 pixels off its
  * 1/16-pixel reference with starts on the plane, 353 without).
@@ -1232,7 +1232,7 @@ static void leaf_start_uv(const walk *w, const trace_box *kid, const trace_qlin 
     *u = 0.5 * (c[0] + c[1]);
     *v = 0.5 * (c[2] + c[3]);
     if (!(kid->flags & TRACE_BOX_LIN) || !q || cover != GEOM_INSIDE || !(kid->bend > 0.0f) ||
-        (kid->flags & (AA_KINK | AA_DISCONTINUOUS)) || w->obj->prove_any_bend ||
+        (kid->flags & (AA_KINK | AA_DISCONTINUOUS)) || w->obj->bend_unknown ||
         !w->th->world->options.leaf_start)
         return;
     trace_dlin d;
@@ -1411,7 +1411,7 @@ static void visit(walk *w, const trace_box *node, const trace_qlin *node_q, cons
          * mesh); at an edge of its own a proof draws it exactly */
         bool provable = w->prove && !unbounded && !(kid->flags & AA_DISCONTINUOUS) &&
                         size <= TRACE_PROVE_CELLS * tol;
-        bool try_proof = provable && (kid->bend <= TRACE_PROVE_BEND || w->obj->prove_any_bend) &&
+        bool try_proof = provable && (kid->bend <= TRACE_PROVE_BEND || w->obj->bend_unknown) &&
                          size <= w->prove_below;
         bool at_leaf = provable && size <= tol && d < TRACE_MAX_DEPTH;
         if ((try_proof || at_leaf) && !clear_of_shared_edges(w, c)) try_proof = at_leaf = false;
@@ -1423,7 +1423,7 @@ static void visit(walk *w, const trace_box *node, const trace_qlin *node_q, cons
          * surface: its test would only place the leaf's point, which the
          * leaf's own Newton steps place where they settle; tested (below)
          * only where they do not */
-        if (try_proof && at_leaf && !fine && !w->obj->prove_any_bend &&
+        if (try_proof && at_leaf && !fine && !w->obj->bend_unknown &&
             order[k].cover == GEOM_INSIDE) {
             started = true;
             leaf_start(w, kid, brood, kq, order[k].i, c, order[k].cover, &start);

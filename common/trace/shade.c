@@ -74,25 +74,8 @@ static bool occluded(shade_ctx *c, vec3 L, double tmax)
     return occluded_from(c, c->P, L, tmax);
 }
 
-static int make_light_samples(shade_ctx *c, sl_light_sample *out, int max);
-
-static int light_samples(void *user, const double P[3], sl_light_sample *out, int max)
-{
-    (void)P;   /* the shaded point is c->P: a shader moving P does not move shadows */
-    shade_ctx *c = user;
-    if (c->nmemo >= 0 && c->memo_max == max) {
-        memcpy(out, c->memo, (size_t)c->nmemo * sizeof *out);
-        return c->nmemo;
-    }
-    int n = make_light_samples(c, out, max);
-    if (n <= LIGHT_MEMO && c->r->world->options.light_memo) {
-        memcpy(c->memo, out, (size_t)n * sizeof *out);
-        c->nmemo = n;
-        c->memo_max = max;
-    }
-    return n;
-}
-
+/* The light samples of the shading point c (at most max): each light's L
+ * and Cl, a shadowed light's dropped where its shadow ray is blocked */
 static int make_light_samples(shade_ctx *c, sl_light_sample *out, int max)
 {
     const trace_world *w = c->r->world;
@@ -159,6 +142,25 @@ static int make_light_samples(shade_ctx *c, sl_light_sample *out, int max)
         s->directional = l->kind == TRACE_LIGHT_DISTANT;
         for (int k = 0; k < 3; k++) s->Cl[k] = l->color[k] * atten;
         n++;
+    }
+    return n;
+}
+
+/* The VM's light callback: make_light_samples once per shading point,
+ * copies of them after (LIGHT_MEMO) */
+static int light_samples(void *user, const double P[3], sl_light_sample *out, int max)
+{
+    (void)P;   /* the shaded point is c->P: a shader moving P does not move shadows */
+    shade_ctx *c = user;
+    if (c->nmemo >= 0 && c->memo_max == max) {
+        memcpy(out, c->memo, (size_t)c->nmemo * sizeof *out);
+        return c->nmemo;
+    }
+    int n = make_light_samples(c, out, max);
+    if (n <= LIGHT_MEMO && c->r->world->options.light_memo) {
+        memcpy(c->memo, out, (size_t)n * sizeof *out);
+        c->nmemo = n;
+        c->memo_max = max;
     }
     return n;
 }

@@ -469,7 +469,7 @@ bool trace_world_check(trace_world *world, char *err, size_t errsz)
                                       !sl_program_box_reads(dp, SL_G_dPdv, false) &&
                                       !sl_program_box_reads(dp, SL_G_P, true) &&
                                       !sl_program_box_reads(dp, SL_G_I, true);
-        obj->prove_any_bend = dp && sl_program_reads_textures(dp);
+        obj->bend_unknown = dp && sl_program_reads_textures(dp);
     }
     for (int i = 0; i < world->nobjects; i++)
         if (world->objects[i].group && !check_placements(world, &world->objects[i], err, errsz))

@@ -182,11 +182,13 @@ typedef struct trace_object {
                                       I (sl_program_box_reads: a height map's
                                       calculatenormal alone did): the affine
                                       boxes leave them out (displace.c) */
-    bool prove_any_bend;           /* its displacement reads a texture: hit
-                                      proofs are tried on cells of any bend
-                                      (intersect.c, TRACE_PROVE_BEND), and
-                                      leaves start at their centre
-                                      (intersect.c, leaf_start) */
+    bool bend_unknown;             /* its displacement reads a texture: a
+                                      lookup over several texels is a bound,
+                                      so its boxes' bend says nothing of the
+                                      surface's: hit proofs are tried on
+                                      cells of any bend (intersect.c,
+                                      TRACE_PROVE_BEND), and leaves start at
+                                      their centre (intersect.c, leaf_start) */
     trace_box root;                /* OBJECT space box over the whole (u,v) square */
     trace_box bound;               /* camera space box of root (for the BVH) */
     /* instances (trace/instance.c): the earlier instance of the same
